@@ -1,0 +1,306 @@
+//! The ball centre for one ridge point: the seed's tangent-line construction (deburr.md §2.7,
+//! the unified normal form) and kerf's exact variant, which puts the band edges on the true
+//! surfaces. Everything here is in the local frame (§1.3): A1 is the y_L axis, the hole axis runs
+//! along z_L through (f, 0).
+
+use super::profile::{Profile, ProfilePoint};
+use super::request::{Edge, Job};
+use crate::geometry::{Vec3, root_near};
+
+/// The per-job constants of the construction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Construction {
+    /// R1: radius of the deburred cylinder surface.
+    pub cylinder_radius: f64,
+    /// True for the inner ridge (material at r > R1).
+    pub inner: bool,
+    /// W/2: half the band width.
+    pub half_width: f64,
+    /// D: ball radius.
+    pub ball_radius: f64,
+    /// CM = √(D² − W²/4): distance from the band chord's midpoint to the centre.
+    pub centre_to_chord: f64,
+}
+
+/// The construction at one ridge point (deburr.md §2.5, §2.7), local frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct RidgeCentre {
+    /// Ridge point P.
+    pub target: Vec3,
+    /// Ball centre C.
+    pub centre: Vec3,
+    /// Cylinder-surface normal into the material, m1.
+    pub cylinder_normal: Vec3,
+    /// Hole-wall normal into the material, m2.
+    pub wall_normal: Vec3,
+    /// Unit bisector u, into the material.
+    pub bisector: Vec3,
+    /// Wedge angle β, radians.
+    pub wedge_angle: f64,
+    /// CL: signed distance from P to C along −u.
+    pub centre_offset: f64,
+}
+
+impl RidgeCentre {
+    /// The band edges G1 (on the cylinder-surface tangent) and G2 (on the hole-wall tangent).
+    pub fn band_edges(&self, half_width: f64) -> (Vec3, Vec3) {
+        let cos_wedge = self.cylinder_normal.dot(&self.wall_normal);
+        let leg = half_width / (0.5 * self.wedge_angle).sin();
+        let along_cylinder = (self.wall_normal - cos_wedge * self.cylinder_normal).normalize();
+        let along_wall = (self.cylinder_normal - cos_wedge * self.wall_normal).normalize();
+        (
+            self.target + leg * along_cylinder,
+            self.target + leg * along_wall,
+        )
+    }
+
+    /// Unit vectors spanning the normal plane VP: the wall normal m2 and the wall tangent d3.
+    fn plane_basis(&self) -> (Vec3, Vec3) {
+        let cos_wedge = self.cylinder_normal.dot(&self.wall_normal);
+        (
+            self.wall_normal,
+            (self.cylinder_normal - cos_wedge * self.wall_normal).normalize(),
+        )
+    }
+}
+
+impl Construction {
+    /// The constants of a validated job.
+    pub fn for_job(job: &Job) -> Self {
+        let ball = job.tool.radius;
+        let half_width = job.width / 2.0;
+        Self {
+            cylinder_radius: job.cylinder_radius,
+            inner: job.edge == Edge::Inner,
+            half_width,
+            ball_radius: ball,
+            centre_to_chord: (ball * ball - half_width * half_width).sqrt(),
+        }
+    }
+
+    /// The seed's construction at profile point `point` (deburr.md §2.7). The caller has checked
+    /// |x| < R1.
+    pub fn tangent(&self, point: &ProfilePoint) -> RidgeCentre {
+        let r1 = self.cylinder_radius;
+        let z = (r1 * r1 - point.x * point.x).sqrt();
+        let target = Vec3::new(point.x, point.y, z);
+        let radial = Vec3::new(point.x / r1, 0.0, z / r1);
+        let cylinder_normal = if self.inner { radial } else { -radial };
+        let wall_normal = Vec3::new(point.normal_x, point.normal_y, 0.0);
+        let cos_theta = cylinder_normal.dot(&wall_normal).clamp(-1.0, 1.0);
+        let sum = cylinder_normal + wall_normal;
+        let bisector = sum.normalize();
+        // L = (W/2)/tan(β/2) = (W/2)·|m1 − m2|/|m1 + m2|, free of trigonometry (§2.5).
+        let chord_depth = self.half_width * ((1.0 - cos_theta) / (1.0 + cos_theta)).sqrt();
+        let centre_offset = self.centre_to_chord - chord_depth;
+        RidgeCentre {
+            target,
+            centre: target - centre_offset * bisector,
+            cylinder_normal,
+            wall_normal,
+            bisector,
+            wedge_angle: std::f64::consts::PI - cos_theta.acos(),
+            centre_offset,
+        }
+    }
+
+    /// Only the centre C of [`Self::tangent`], for the tolerance bisection's inner loop.
+    pub fn tangent_centre(&self, point: &ProfilePoint) -> Vec3 {
+        self.tangent(point).centre
+    }
+
+    /// Cylinder-surface function: zero on the surface, positive away from A1.
+    fn cylinder(&self, q: &Vec3) -> f64 {
+        q.x.hypot(q.z) - self.cylinder_radius
+    }
+
+    fn cylinder_gradient(q: &Vec3) -> Vec3 {
+        let r = q.x.hypot(q.z);
+        Vec3::new(q.x / r, 0.0, q.z / r)
+    }
+
+    /// Where the circle of radius `radius` around `centre` in VP meets the cylinder surface
+    /// (`on_wall` false) or the hole wall (`on_wall` true), nearest to direction `near`.
+    fn circle_meets_surface(
+        &self,
+        profile: &Profile,
+        plane: (Vec3, Vec3),
+        centre: &Vec3,
+        radius: f64,
+        near: &Vec3,
+        on_wall: bool,
+    ) -> Option<Vec3> {
+        let (b1, b2) = plane;
+        let at = |angle: f64| centre + radius * (angle.cos() * b1 + angle.sin() * b2);
+        let surface = |q: Vec3| {
+            if on_wall {
+                profile.signed_distance(q.x, q.y).0
+            } else {
+                self.cylinder(&q)
+            }
+        };
+        let start = near.dot(&b2).atan2(near.dot(&b1));
+        // Newton from the tangent-line estimate converges in a few steps; the bracketing search
+        // below is the fallback for strongly curved cases.
+        let mut angle = start;
+        for _ in 0..12 {
+            let q = at(angle);
+            let value = surface(q);
+            if value.abs() < 1e-14 {
+                return Some(q);
+            }
+            let gradient = if on_wall {
+                let (_, (gx, gy)) = profile.signed_distance(q.x, q.y);
+                Vec3::new(gx, gy, 0.0)
+            } else {
+                Self::cylinder_gradient(&q)
+            };
+            let slope = gradient.dot(&(radius * (-angle.sin() * b1 + angle.cos() * b2)));
+            if slope.abs() < 1e-12 {
+                break;
+            }
+            angle -= value / slope;
+            if (angle - start).abs() > 1.0 {
+                break;
+            }
+        }
+        let angle = root_near(|a| surface(at(a)), start, 1e-3, 1.2, 1e-15)?;
+        Some(at(angle))
+    }
+
+    /// The chamfer width the tangent-line centre really cuts: the distance between the points
+    /// where the ball's section circle in VP meets the true cylinder surface and hole wall
+    /// (deburr.md §2.9, W_APPROX). `None` if a circle misses a surface.
+    pub fn true_width(&self, profile: &Profile, ridge: &RidgeCentre) -> Option<f64> {
+        let (g1, g2) = ridge.band_edges(self.half_width);
+        let plane = ridge.plane_basis();
+        let c = ridge.centre;
+        let on_cylinder =
+            self.circle_meets_surface(profile, plane, &c, self.ball_radius, &(g1 - c), false)?;
+        let on_wall =
+            self.circle_meets_surface(profile, plane, &c, self.ball_radius, &(g2 - c), true)?;
+        Some((on_cylinder - on_wall).norm())
+    }
+
+    /// kerf's exact variant: band edges G1 on the true cylinder surface and G2 on the true hole
+    /// wall, both in VP, at equal distances from P and W apart; C on the air side at distance D
+    /// from both. Returns the centre and the band edges, or `None` when no such edges exist near
+    /// the tangent-line solution.
+    pub fn exact(&self, profile: &Profile, ridge: &RidgeCentre) -> Option<(Vec3, Vec3, Vec3)> {
+        let plane = ridge.plane_basis();
+        let p = ridge.target;
+        let (tangent_g1, tangent_g2) = ridge.band_edges(self.half_width);
+        let edges = |leg: f64| -> Option<(Vec3, Vec3)> {
+            let g1 =
+                self.circle_meets_surface(profile, plane, &p, leg, &(tangent_g1 - p), false)?;
+            let g2 = self.circle_meets_surface(profile, plane, &p, leg, &(tangent_g2 - p), true)?;
+            Some((g1, g2))
+        };
+        let width_error = |leg: f64| {
+            edges(leg).map_or(f64::NAN, |(g1, g2)| {
+                (g1 - g2).norm() - 2.0 * self.half_width
+            })
+        };
+        let tangent_leg = (tangent_g1 - p).norm();
+        // Secant steps from the tangent-line leg, which is within a few per cent of the answer.
+        let (mut leg_a, mut leg_b) = (tangent_leg, tangent_leg * 1.01);
+        let (mut error_a, mut error_b) = (width_error(leg_a), width_error(leg_b));
+        let mut leg = f64::NAN;
+        for _ in 0..30 {
+            if !(error_a.is_finite() && error_b.is_finite()) || error_b == error_a {
+                break;
+            }
+            let next = leg_b - error_b * (leg_b - leg_a) / (error_b - error_a);
+            if !(next > 0.0 && next < 4.0 * tangent_leg) {
+                break;
+            }
+            (leg_a, error_a) = (leg_b, error_b);
+            leg_b = next;
+            error_b = width_error(leg_b);
+            if error_b.abs() < 1e-13 {
+                leg = leg_b;
+                break;
+            }
+        }
+        if !leg.is_finite() {
+            leg = root_near(
+                width_error,
+                tangent_leg,
+                tangent_leg * 1e-3,
+                tangent_leg * 0.9,
+                1e-15,
+            )?;
+        }
+        let (g1, g2) = edges(leg)?;
+        let midpoint = 0.5 * (g1 + g2);
+        // In VP, the unit normal of G1G2 on the air side (against the bisector).
+        let chord = (g2 - g1).normalize();
+        let normal_axis = ridge.bisector - ridge.bisector.dot(&chord) * chord;
+        let away = -normal_axis.normalize();
+        Some((midpoint + self.centre_to_chord * away, g1, g2))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_abs_diff_eq;
+
+    fn case1() -> (Construction, Profile) {
+        let w = 0.5 * 2f64.sqrt();
+        let construction = Construction {
+            cylinder_radius: 50.0,
+            inner: false,
+            half_width: w / 2.0,
+            ball_radius: 3.0,
+            centre_to_chord: (9.0 - w * w / 4.0).sqrt(),
+        };
+        (construction, Profile::round(10.0, 0.0, 0.0))
+    }
+
+    #[test]
+    fn hand_check_at_phi_zero() {
+        let (construction, profile) = case1();
+        let ridge = construction.tangent(&profile.segments[0].point(10.0, 0.0));
+        assert_abs_diff_eq!(
+            ridge.wedge_angle.to_degrees(),
+            78.463_040_967,
+            epsilon = 1e-8
+        );
+        assert_abs_diff_eq!(ridge.centre_offset, 2.546_081_12, epsilon = 1e-8);
+        assert_abs_diff_eq!(
+            ridge.centre,
+            Vec3::new(8.389_716_911, 0.0, 50.961_980_811),
+            epsilon = 1e-8
+        );
+    }
+
+    #[test]
+    fn exact_edges_lie_on_the_true_surfaces() {
+        let (construction, profile) = case1();
+        for k in 0..8 {
+            let point = profile.segments[0].point(10.0, f64::from(k) / 8.0);
+            let ridge = construction.tangent(&point);
+            let (centre, g1, g2) = construction.exact(&profile, &ridge).unwrap();
+            assert_abs_diff_eq!(construction.cylinder(&g1), 0.0, epsilon = 1e-10);
+            assert_abs_diff_eq!(profile.signed_distance(g2.x, g2.y).0, 0.0, epsilon = 1e-10);
+            assert_abs_diff_eq!(
+                (g1 - g2).norm(),
+                2.0 * construction.half_width,
+                epsilon = 1e-10
+            );
+            assert_abs_diff_eq!(
+                (g1 - ridge.target).norm(),
+                (g2 - ridge.target).norm(),
+                epsilon = 1e-10
+            );
+            assert_abs_diff_eq!((centre - g1).norm(), 3.0, epsilon = 1e-10);
+            assert_abs_diff_eq!((centre - g2).norm(), 3.0, epsilon = 1e-10);
+            let tangent = ridge.cylinder_normal.cross(&ridge.wall_normal).normalize();
+            assert_abs_diff_eq!((centre - ridge.target).dot(&tangent), 0.0, epsilon = 1e-10);
+            // The seed's approximation is off by well under a per cent of W here (§2.9).
+            let true_width = construction.true_width(&profile, &ridge).unwrap();
+            assert!((true_width / (2.0 * construction.half_width) - 1.0).abs() < 0.01);
+        }
+    }
+}

@@ -1,0 +1,434 @@
+//! Cross-hole deburring with a ball end mill (spec: deburr.md; seed 000).
+//!
+//! A through hole meets the outer or inner cylindrical surface of a tube (or the bore of a block)
+//! in a closed ridge. For points on that ridge this module computes the ball centre that cuts a
+//! chamfer band of width W = √2·Q, chooses the points so the centre polyline stays within the
+//! tolerance TA of the ideal centre path, checks the limits of §4, and builds a safe approach and
+//! retract for the G-code program.
+//!
+//! * [`request`]: the request and its validation (§1.4);
+//! * `frame`: local frame and its map to the machine (§1.3);
+//! * `profile`: hole cross-sections (§2.8);
+//! * `centre`: the ball-centre construction (§2.5, §2.7) and the exact variant;
+//! * `tolerance`: the target points from TA (§3);
+//! * `checks`: validity limits and warnings (§4);
+//! * [`program`]: lead moves and G-code (§6.3).
+
+mod answer;
+mod centre;
+mod checks;
+mod frame;
+mod profile;
+pub mod program;
+pub mod request;
+mod tolerance;
+
+pub use answer::{Deburr, DeburrPoint, DeburrSummary, LeadMotion, LeadMove};
+pub use program::{Post, program};
+pub use request::{
+    CentreDistance, DeburrRequest, Direction, Edge, Hole, HoleShape, Method, Workpiece,
+};
+
+use centre::{Construction, RidgeCentre};
+use tolerance::Target;
+
+use crate::error::{SolverError, Warning};
+use crate::geometry::{Vec3, array3};
+use crate::tool::Tool;
+
+/// Most points a deburr loop may have; a tolerance needing more is refused (`E_TOO_MANY_POINTS`).
+pub const MAX_POINTS: usize = 200_000;
+
+/// Sub-samples per interval for the summary's `max_deviation`.
+const DEVIATION_SAMPLES: u32 = 16;
+
+/// Relative chamfer-width error of the tangent-line method above which `W_APPROX` is raised (§4).
+const APPROX_LIMIT: f64 = 0.05;
+
+/// Solves a deburr request with its resolved tool.
+///
+/// # Errors
+/// Every failure of deburr.md §4 with its code, and `E_INPUT` naming the field for bad numbers.
+pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError> {
+    let job = request.validate(tool)?;
+    let mut warnings = checks::ridge(&job)?;
+    let ball = job.tool.radius;
+    let construction = Construction::for_job(&job);
+    let profile = &job.profile;
+    let exact_centre = |segment: usize, s: f64, ridge: &RidgeCentre| {
+        construction.exact(profile, ridge).map(|(c, _, _)| c).ok_or_else(|| {
+            SolverError::new(
+                "E_EXACT_NO_SOLUTION",
+                format!(
+                    "no band edges on the true surfaces near {} s = {s:.6}: the chamfer is too wide for the curvature here",
+                    profile.segments[segment].name
+                ),
+            )
+            .at("method")
+        })
+    };
+    let centre_at = |segment: usize, s: f64| -> Result<Vec3, SolverError> {
+        let point = profile.segments[segment].point(profile.radius, s);
+        match job.method {
+            Method::Tangent => Ok(construction.tangent_centre(&point)),
+            Method::Exact => exact_centre(segment, s, &construction.tangent(&point)),
+        }
+    };
+
+    let mut targets = tolerance::targets(profile, job.tolerance, MAX_POINTS, centre_at)?;
+    let mut ridges: Vec<RidgeCentre> = Vec::with_capacity(targets.len());
+    let mut centres: Vec<Vec3> = Vec::with_capacity(targets.len());
+    let mut exact_offset: Option<f64> = None;
+    for target in &targets {
+        let point = profile.segments[target.segment].point(profile.radius, target.parameter);
+        let ridge = construction.tangent(&point);
+        let centre = match job.method {
+            Method::Tangent => ridge.centre,
+            Method::Exact => {
+                let centre = exact_centre(target.segment, target.parameter, &ridge)?;
+                exact_offset = Some(
+                    exact_offset
+                        .unwrap_or(0.0)
+                        .max((centre - ridge.centre).norm()),
+                );
+                centre
+            }
+        };
+        ridges.push(ridge);
+        centres.push(centre);
+    }
+    // The loop ends where it starts: the closing target (end of the last segment) is the start
+    // point, which evaluates differently only by rounding (sin 2π ≠ 0).
+    let (last, first) = (ridges.len() - 1, 0);
+    (ridges[last], centres[last]) = (ridges[first], centres[first]);
+    let max_deviation = tolerance::max_deviation(&targets, &centres, DEVIATION_SAMPLES, centre_at)?;
+
+    warnings.extend(point_checks(&job, &targets, &ridges)?);
+    let (true_width_min, true_width_max) = match job.method {
+        Method::Exact => (job.width, job.width),
+        Method::Tangent => {
+            let (low, high, worst) = true_widths(&construction, &job, &targets, &ridges);
+            warnings.extend(worst);
+            (low, high)
+        }
+    };
+    checks::far_gouge(&job, &targets, &centres)?;
+    let shank_direction = job.frame.local_vector(&Vec3::z());
+    let (access_warnings, mut program_blocker) =
+        checks::inner_access(&job, &ridges, &shank_direction);
+    warnings.extend(access_warnings);
+    warnings.extend(checks::overlap(&job, &construction, &ridges));
+
+    if job.direction == Direction::Cw {
+        targets.reverse();
+        ridges.reverse();
+        centres.reverse();
+    }
+    let frame = &job.frame;
+    let down = ball * Vec3::z();
+    let points: Vec<DeburrPoint> = targets
+        .iter()
+        .zip(&ridges)
+        .zip(&centres)
+        .map(|((target, ridge), centre)| {
+            let machine_centre = frame.point(centre);
+            let point = profile.segments[target.segment].point(profile.radius, target.parameter);
+            DeburrPoint {
+                target: array3(&frame.point(&ridge.target)),
+                centre: array3(&machine_centre),
+                tip: array3(&(machine_centre - down)),
+                wedge_angle_deg: ridge.wedge_angle.to_degrees(),
+                segment: profile.segments[target.segment].name,
+                parameter: target.parameter,
+                phi_deg: point.phi.map(f64::to_degrees),
+                centre_offset: ridge.centre_offset,
+            }
+        })
+        .collect();
+    let path_length: f64 = centres
+        .windows(2)
+        .map(|pair| (pair[1] - pair[0]).norm())
+        .sum();
+
+    let safe_centre_z = program::safe_centre_z(&job, frame);
+    let (lead_in, lead_out) = match &safe_centre_z {
+        Ok(z) => program::leads(
+            &job,
+            frame.point(&centres[0]),
+            frame.vector(&ridges[0].bisector),
+            *z,
+        ),
+        Err(_) => (Vec::new(), Vec::new()),
+    };
+    if program_blocker.is_none() {
+        program_blocker = safe_centre_z.as_ref().err().cloned();
+    }
+    if let Some(blocker) = &program_blocker {
+        warnings.push(Warning::new(
+            "W_NO_PROGRAM",
+            format!("no G-code can be written: {}", blocker.message()),
+        ));
+    }
+    let lead_feed_length: f64 = lead_feed_length(&lead_in, frame.point(&centres[0]))
+        + lead_feed_length(&lead_out, frame.point(&centres[centres.len() - 1]));
+    let wedge = ridges.iter().map(|r| r.wedge_angle.to_degrees());
+    let summary = DeburrSummary {
+        count: targets.len() - 1,
+        path_length,
+        max_deviation,
+        tolerance: job.tolerance,
+        cut_amount: job.cut_amount,
+        width: job.width,
+        true_width_min,
+        true_width_max,
+        wedge_angle_min_deg: wedge.clone().fold(f64::INFINITY, f64::min),
+        wedge_angle_max_deg: wedge.fold(f64::NEG_INFINITY, f64::max),
+        max_exact_offset: exact_offset,
+        feed: job.feed,
+        spindle_rpm: job.spindle_rpm,
+        safe_centre_z: safe_centre_z.ok(),
+        estimated_time_s: (path_length + lead_feed_length) / job.feed * 60.0,
+    };
+    let description = describe(request, &job, &summary);
+    Ok(Deburr {
+        edge: job.edge,
+        method: job.method,
+        points,
+        lead_in,
+        lead_out,
+        summary,
+        warnings,
+        program_blocker,
+        description,
+        ball_radius: ball,
+    })
+}
+
+/// The full construction at one ridge point, for diagnostics (deburr.md §1.5): machine
+/// coordinates, tangent-line method.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct PointConstruction {
+    /// Ridge point P.
+    pub target: [f64; 3],
+    /// Ball centre C.
+    pub centre: [f64; 3],
+    /// Unit bisector u, into the material.
+    pub bisector: [f64; 3],
+    /// Band edge G1 on the cylinder-surface tangent.
+    pub band_edge_cylinder: [f64; 3],
+    /// Band edge G2 on the hole-wall tangent.
+    pub band_edge_wall: [f64; 3],
+    /// β, degrees.
+    pub wedge_angle_deg: f64,
+    /// L = |PM|, mm.
+    pub chord_depth: f64,
+    /// CL, mm.
+    pub centre_offset: f64,
+}
+
+/// The construction of §2.7 at parameter `parameter` of the segment named `segment`, with the
+/// request's geometry; for diagnostics and tests.
+///
+/// # Errors
+/// The request's validation errors, or `E_INPUT` for an unknown segment or parameter.
+pub fn construction_at(
+    request: &DeburrRequest,
+    tool: &Tool,
+    segment: &str,
+    parameter: f64,
+) -> Result<PointConstruction, SolverError> {
+    let job = request.validate(tool)?;
+    checks::ridge(&job)?;
+    let profile = &job.profile;
+    let Some(piece) = profile.segments.iter().find(|s| s.name == segment) else {
+        return Err(SolverError::input(
+            "segment",
+            format!("this hole has no segment {segment}"),
+        ));
+    };
+    if !(0.0..=1.0).contains(&parameter) {
+        return Err(SolverError::input(
+            "parameter",
+            "parameter must be in [0, 1]",
+        ));
+    }
+    let construction = Construction::for_job(&job);
+    let ridge = construction.tangent(&piece.point(profile.radius, parameter));
+    let (g1, g2) = ridge.band_edges(construction.half_width);
+    let frame = &job.frame;
+    Ok(PointConstruction {
+        target: array3(&frame.point(&ridge.target)),
+        centre: array3(&frame.point(&ridge.centre)),
+        bisector: array3(&frame.vector(&ridge.bisector)),
+        band_edge_cylinder: array3(&frame.point(&g1)),
+        band_edge_wall: array3(&frame.point(&g2)),
+        wedge_angle_deg: ridge.wedge_angle.to_degrees(),
+        chord_depth: construction.centre_to_chord - ridge.centre_offset,
+        centre_offset: ridge.centre_offset,
+    })
+}
+
+/// Length of the feed moves of a lead, starting from `start`.
+fn lead_feed_length(moves: &[LeadMove], start: Vec3) -> f64 {
+    let mut from = start;
+    let mut length = 0.0;
+    for step in moves {
+        let to = crate::geometry::vec3(step.centre);
+        if step.motion == LeadMotion::Feed {
+            length += (to - from).norm();
+        }
+        from = to;
+    }
+    length
+}
+
+/// Per-point limits: E_BALL_MISSES_EDGE, W_CENTRE_IN_MATERIAL, W_SHARP_EDGE (§4).
+fn point_checks(
+    job: &Job,
+    targets: &[Target],
+    ridges: &[RidgeCentre],
+) -> Result<Vec<Warning>, SolverError> {
+    let ball = job.tool.radius;
+    let mut in_material = 0;
+    let mut deepest = 0.0_f64;
+    let mut sharp = 0;
+    let mut sharpest = 90.0_f64;
+    for (target, ridge) in targets.iter().zip(ridges) {
+        let name = job.profile.segments[target.segment].name;
+        if ridge.centre_offset <= -ball {
+            return Err(SolverError::new(
+                "E_BALL_MISSES_EDGE",
+                format!(
+                    "at {name} s = {:.4} the wedge is so sharp (β = {:.2}°) that the ball would not reach the edge: \
+                     reduce Q or use a larger ball",
+                    target.parameter,
+                    ridge.wedge_angle.to_degrees()
+                ),
+            )
+            .at("cut_amount"));
+        }
+        if ridge.centre_offset < 0.0 {
+            in_material += 1;
+            deepest = deepest.min(ridge.centre_offset);
+        }
+        let wedge = ridge.wedge_angle.to_degrees();
+        if !(30.0..=170.0).contains(&wedge) {
+            sharp += 1;
+            if (wedge - 90.0).abs() > (sharpest - 90.0).abs() {
+                sharpest = wedge;
+            }
+        }
+    }
+    let mut warnings = Vec::new();
+    if in_material > 0 {
+        warnings.push(Warning::new(
+            "W_CENTRE_IN_MATERIAL",
+            format!(
+                "at {in_material} points the ball centre lies inside the wedge (CL down to {deepest:.4} mm): the profile \
+                 is a deep cove, cut depth up to {:.4} mm",
+                ball - deepest
+            ),
+        ));
+    }
+    if sharp > 0 {
+        warnings.push(Warning::new(
+            "W_SHARP_EDGE",
+            format!("at {sharp} points the wedge angle is outside 30°–170° (down to {sharpest:.2}°): W loses its meaning there"),
+        ));
+    }
+    Ok(warnings)
+}
+
+use request::Job;
+
+/// Range of the chamfer width really cut by the tangent-line centres, and W_APPROX if the worst
+/// is more than 5 % off W (§2.9, §4).
+fn true_widths(
+    construction: &Construction,
+    job: &Job,
+    targets: &[Target],
+    ridges: &[RidgeCentre],
+) -> (f64, f64, Option<Warning>) {
+    let (mut low, mut high) = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut worst: Option<(f64, usize)> = None;
+    for (index, ridge) in ridges.iter().enumerate() {
+        let Some(width) = construction.true_width(&job.profile, ridge) else {
+            continue;
+        };
+        low = low.min(width);
+        high = high.max(width);
+        let error = (width / job.width - 1.0).abs();
+        if error > APPROX_LIMIT && worst.is_none_or(|(e, _)| error > e) {
+            worst = Some((error, index));
+        }
+    }
+    if !low.is_finite() {
+        (low, high) = (job.width, job.width);
+    }
+    let warning = worst.map(|(error, index)| {
+        let target = targets[index];
+        Warning::new(
+            "W_APPROX",
+            format!(
+                "the tangent-line approximation cuts a chamfer {:.1} % off W at {} s = {:.4}; use method \"exact\"",
+                error * 100.0,
+                job.profile.segments[target.segment].name,
+                target.parameter
+            ),
+        )
+    });
+    (low, high, warning)
+}
+
+/// Header lines naming the job parameters for the G-code program.
+fn describe(request: &DeburrRequest, job: &Job, summary: &DeburrSummary) -> Vec<String> {
+    let edge = match job.edge {
+        Edge::Outer => "outer",
+        Edge::Inner => "inner",
+    };
+    let part = match &request.workpiece {
+        Workpiece::Tube {
+            inner_radius,
+            outer_radius,
+            arrangement_angle_deg,
+            ..
+        } => {
+            format!(
+                "tube RN {inner_radius} RT {outer_radius} arrangement {arrangement_angle_deg} deg"
+            )
+        }
+        Workpiece::BoreBlock {
+            bore_radius,
+            arrangement_angle_deg,
+            ..
+        } => {
+            format!("bore block R {bore_radius} arrangement {arrangement_angle_deg} deg")
+        }
+    };
+    let hole = &request.hole;
+    let shape = match hole.shape {
+        HoleShape::Round => "round",
+        HoleShape::Slot => "slot",
+        HoleShape::RoundedRect => "rounded rect",
+    };
+    let extent = match hole.centre_distance {
+        Some(CentreDistance::Along(length)) => format!(" centres {length}"),
+        Some(CentreDistance::AcrossAlong([across, along])) => {
+            format!(" centres {across} x {along}")
+        }
+        None => String::new(),
+    };
+    vec![
+        format!("deburr {edge} edge, {part}"),
+        format!(
+            "{shape} hole R {}{extent} eccentricity {} penetration {} deg",
+            hole.radius, job.profile.centre_x, hole.penetration_angle_deg
+        ),
+        format!(
+            "ball R {} Q {:.4} W {:.4} TA {} method {:?}, {} points",
+            job.tool.radius, job.cut_amount, job.width, job.tolerance, job.method, summary.count
+        ),
+        format!("feed {} mm/min spindle {} rpm", job.feed, job.spindle_rpm),
+    ]
+}

@@ -1,0 +1,407 @@
+//! The deburr request as clients send it (api.md, Deburr) and its validation into a [`Job`]
+//! (deburr.md §1.4 inputs, §4 `E_INPUT`/`E_NOT_THROUGH`/`E_INCONSISTENT_ECC`).
+
+use serde::{Deserialize, Serialize};
+
+use super::frame::Frame;
+use super::profile::Profile;
+use crate::error::{SolverError, finite, non_negative, positive};
+use crate::geometry::vec3;
+use crate::tool::{Tool, ToolKind, ToolRef};
+
+/// Default tolerance TA in mm (deburr.md §1.4, proposed value).
+pub const DEFAULT_TOLERANCE: f64 = 0.01;
+/// Default feed in mm/min for the deburring loop.
+pub const DEFAULT_FEED: f64 = 300.0;
+/// Default spindle speed in rpm.
+pub const DEFAULT_SPINDLE_RPM: f64 = 6000.0;
+/// Default clearance in mm above the part for the clearance plane.
+pub const DEFAULT_CLEARANCE: f64 = 5.0;
+/// Default lead distance in mm: how far the outer-edge approach starts back along the bisector.
+pub const DEFAULT_LEAD_DISTANCE: f64 = 1.0;
+/// Smallest tolerance accepted (deburr.md §4, `E_TOL`).
+pub const MIN_TOLERANCE: f64 = 1e-6;
+
+/// The part carrying the cylindrical surface.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Workpiece {
+    /// A thick-walled tube: both the outer and the inner ridge exist.
+    Tube {
+        /// A point on the tube axis A1 at the hole station, machine/work coordinates.
+        origin: [f64; 3],
+        /// θ_A: angle of A1 from +Y in the XY plane, counter-clockwise seen from +Z (deburr.md §1.3).
+        #[serde(default)]
+        arrangement_angle_deg: f64,
+        /// RN, mm.
+        inner_radius: f64,
+        /// RT, mm.
+        outer_radius: f64,
+    },
+    /// A block with a cylindrical bore (manifold block): only the inner ridge exists.
+    BoreBlock {
+        /// A point on the bore axis A1 at the hole station.
+        origin: [f64; 3],
+        /// θ_A as for the tube.
+        #[serde(default)]
+        arrangement_angle_deg: f64,
+        /// Bore radius, mm.
+        bore_radius: f64,
+        /// Distance from A1 to the block face the hole enters through, along the hole axis, mm.
+        /// Places the clearance plane for the approach; needed for G-code unless `safe_z` is given.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        face_distance: Option<f64>,
+    },
+}
+
+/// Cross-section of the through hole seen along its axis (deburr.md §1.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum HoleShape {
+    /// Round hole of `radius` R2.
+    Round,
+    /// Slot: two half circles of `radius` joined by sides parallel to A1, `centre_distance` L_s apart.
+    Slot,
+    /// Rounded rectangle: four quarter circles of `radius`, sides parallel to x_L and A1,
+    /// `centre_distance` `[across, along]` between corner-circle centres.
+    RoundedRect,
+}
+
+/// Distance between a slot's end circles (a number) or a rounded rectangle's corner circles
+/// (`[across, along]`), mm.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(untagged)]
+pub enum CentreDistance {
+    /// Slot: L_s along A1.
+    Along(f64),
+    /// Rounded rectangle: `[across, along]` = [2a, 2b].
+    AcrossAlong([f64; 2]),
+}
+
+/// The through hole and where its axis A2 lies relative to A1 (deburr.md §1.2–1.4).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct Hole {
+    /// `round`, `slot` or `rounded_rect`.
+    pub shape: HoleShape,
+    /// R2: hole radius, slot half-width or corner radius, mm.
+    pub radius: f64,
+    /// Slot: L_s (a number); rounded rectangle: `[across, along]`. Not used for round holes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub centre_distance: Option<CentreDistance>,
+    /// f: signed distance of A2 from A1 along x_L, mm (default 0, or from `axis_point`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eccentricity: Option<f64>,
+    /// θ_P: angle of A2 from +Z, a rotation about A1 (deburr.md §1.3).
+    #[serde(default)]
+    pub penetration_angle_deg: f64,
+    /// Any point on the hole axis A2 (the seed's "third position"): its station along A1 moves
+    /// the origin there, and it fixes f (which must agree if also given).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis_point: Option<[f64; 3]>,
+}
+
+/// Which ridge is deburred.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Edge {
+    /// Hole wall × outer surface of the tube (RLT).
+    Outer,
+    /// Hole wall × inner surface (bore) (RLN).
+    Inner,
+}
+
+/// How the band edges are placed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// The seed's closed form: band edges on the tangent lines at P (deburr.md §2.5).
+    #[default]
+    Tangent,
+    /// Band edges on the true surfaces, so the cut chamfer is really W wide.
+    Exact,
+}
+
+/// Travel direction seen from +z_L (outside the hole, looking down its axis).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Direction {
+    /// Counter-clockwise (increasing φ): climb milling with M03 on both ridges.
+    #[default]
+    Ccw,
+    /// Clockwise: conventional milling.
+    Cw,
+}
+
+/// `POST /api/v1/deburr`: deburr one ridge of a cross hole with a ball end mill.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct DeburrRequest {
+    /// A registered tool number or an inline ball tool.
+    pub tool: ToolRef,
+    /// The tube or bored block.
+    pub workpiece: Workpiece,
+    /// The through hole.
+    pub hole: Hole,
+    /// Which ridge.
+    pub edge: Edge,
+    /// Q, the amount of cutting (W = √2·Q), mm. Give this or `width`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cut_amount: Option<f64>,
+    /// W, the chamfer width, mm. Give this or `cut_amount`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub width: Option<f64>,
+    /// TA: largest distance of the centre polyline from the ideal centre path, mm (default 0.01).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
+    /// `tangent` (default, the seed) or `exact`.
+    #[serde(default)]
+    pub method: Method,
+    /// φ_0: where a round hole's loop starts, degrees from +x_L (round holes only).
+    #[serde(default)]
+    pub start_deg: f64,
+    /// `ccw` (default, climb milling with M03) or `cw`.
+    #[serde(default)]
+    pub direction: Direction,
+    /// Cutting feed, mm/min (default 300).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feed: Option<f64>,
+    /// Spindle speed, rpm (default 6000).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spindle_rpm: Option<f64>,
+    /// Height of the clearance plane above the part, mm (default 5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clearance: Option<f64>,
+    /// Outer edge: how far back along the bisector the approach starts, mm (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lead_distance: Option<f64>,
+    /// Absolute Z of the clearance plane of the ball centre, overriding the computed one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub safe_z: Option<f64>,
+}
+
+/// A validated deburr job: every number finite and in range, the frame and profile built.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Job {
+    pub frame: Frame,
+    pub profile: Profile,
+    pub edge: Edge,
+    /// R1.
+    pub cylinder_radius: f64,
+    /// RN and RT when the workpiece is a tube.
+    pub tube_radii: Option<(f64, f64)>,
+    /// Distance from A1 to the part's top along the hole axis (RT, or the block face), if known.
+    pub top_distance: Option<f64>,
+    pub width: f64,
+    pub cut_amount: f64,
+    pub tolerance: f64,
+    pub method: Method,
+    pub direction: Direction,
+    pub tool: Tool,
+    pub feed: f64,
+    pub spindle_rpm: f64,
+    pub clearance: f64,
+    pub lead_distance: f64,
+    pub safe_z: Option<f64>,
+}
+
+fn point(field: &str, p: [f64; 3]) -> Result<[f64; 3], SolverError> {
+    for (axis, value) in ["0", "1", "2"].iter().zip(p) {
+        finite(&format!("{field}[{axis}]"), value)?;
+    }
+    Ok(p)
+}
+
+fn optional_positive(field: &str, value: Option<f64>, default: f64) -> Result<f64, SolverError> {
+    value.map_or(Ok(default), |v| positive(field, v))
+}
+
+impl DeburrRequest {
+    /// Validates the request against `tool` (already resolved from `self.tool`).
+    pub(crate) fn validate(&self, tool: &Tool) -> Result<Job, SolverError> {
+        tool.validate("tool.")?;
+        if tool.kind != ToolKind::Ball {
+            return Err(SolverError::new(
+                "E_TOOL_KIND",
+                format!(
+                    "deburring needs a ball end mill, but the tool is {}",
+                    tool.kind.as_str()
+                ),
+            )
+            .at("tool"));
+        }
+        let (origin, arrangement, cylinder_radius, tube_radii, top_distance) = match &self.workpiece
+        {
+            Workpiece::Tube {
+                origin,
+                arrangement_angle_deg,
+                inner_radius,
+                outer_radius,
+            } => {
+                let inner = positive("workpiece.inner_radius", *inner_radius)?;
+                let outer = positive("workpiece.outer_radius", *outer_radius)?;
+                if inner >= outer {
+                    return Err(SolverError::new(
+                        "E_NOT_THROUGH",
+                        format!("inner_radius {inner} must be smaller than outer_radius {outer}"),
+                    )
+                    .at("workpiece.inner_radius"));
+                }
+                let r1 = if self.edge == Edge::Inner {
+                    inner
+                } else {
+                    outer
+                };
+                (
+                    origin,
+                    arrangement_angle_deg,
+                    r1,
+                    Some((inner, outer)),
+                    Some(outer),
+                )
+            }
+            Workpiece::BoreBlock {
+                origin,
+                arrangement_angle_deg,
+                bore_radius,
+                face_distance,
+            } => {
+                let bore = positive("workpiece.bore_radius", *bore_radius)?;
+                if self.edge != Edge::Inner {
+                    return Err(SolverError::input(
+                        "edge",
+                        "a bore_block has only an inner edge (edge: \"inner\")",
+                    ));
+                }
+                if let Some(face) = face_distance {
+                    positive("workpiece.face_distance", *face)?;
+                    if *face <= bore {
+                        return Err(SolverError::input(
+                            "workpiece.face_distance",
+                            format!("face_distance {face} must exceed bore_radius {bore}"),
+                        ));
+                    }
+                }
+                (origin, arrangement_angle_deg, bore, None, *face_distance)
+            }
+        };
+        let origin = vec3(point("workpiece.origin", *origin)?);
+        let arrangement = finite("workpiece.arrangement_angle_deg", *arrangement)?;
+
+        let hole = &self.hole;
+        let radius = positive("hole.radius", hole.radius)?;
+        let penetration = finite("hole.penetration_angle_deg", hole.penetration_angle_deg)?;
+        let start = finite("start_deg", self.start_deg)?;
+        if start != 0.0 && hole.shape != HoleShape::Round {
+            return Err(SolverError::input(
+                "start_deg",
+                "start_deg applies only to round holes",
+            ));
+        }
+        let eccentricity = hole
+            .eccentricity
+            .map(|f| finite("hole.eccentricity", f))
+            .transpose()?;
+        let axis_point = hole
+            .axis_point
+            .map(|p| point("hole.axis_point", p))
+            .transpose()?
+            .map(vec3);
+        let (frame, eccentricity) =
+            Frame::resolve(origin, arrangement, penetration, axis_point, eccentricity)?;
+
+        let profile = match (hole.shape, hole.centre_distance) {
+            (HoleShape::Round, None) => Profile::round(radius, eccentricity, start.to_radians()),
+            (HoleShape::Slot, Some(CentreDistance::Along(length))) => {
+                let length = non_negative("hole.centre_distance", length)?;
+                Profile::rounded_rect(radius, eccentricity, 0.0, length / 2.0, true)
+            }
+            (HoleShape::RoundedRect, Some(CentreDistance::AcrossAlong([across, along]))) => {
+                let across = non_negative("hole.centre_distance[0]", across)?;
+                let along = non_negative("hole.centre_distance[1]", along)?;
+                Profile::rounded_rect(radius, eccentricity, across / 2.0, along / 2.0, false)
+            }
+            (HoleShape::Round, Some(_)) => {
+                return Err(SolverError::input(
+                    "hole.centre_distance",
+                    "a round hole has no centre_distance",
+                ));
+            }
+            (HoleShape::Slot, _) => {
+                return Err(SolverError::input(
+                    "hole.centre_distance",
+                    "a slot needs centre_distance: the distance L_s between its end circles along A1",
+                ));
+            }
+            (HoleShape::RoundedRect, _) => {
+                return Err(SolverError::input(
+                    "hole.centre_distance",
+                    "a rounded_rect needs centre_distance: [across, along] between its corner circles",
+                ));
+            }
+        };
+
+        let (width, cut_amount) = match (self.cut_amount, self.width) {
+            (Some(q), None) => {
+                let q = positive("cut_amount", q)?;
+                (q * std::f64::consts::SQRT_2, q)
+            }
+            (None, Some(w)) => {
+                let w = positive("width", w)?;
+                (w, w / std::f64::consts::SQRT_2)
+            }
+            (Some(_), Some(_)) => {
+                return Err(SolverError::input(
+                    "width",
+                    "give cut_amount or width, not both",
+                ));
+            }
+            (None, None) => {
+                return Err(SolverError::input(
+                    "cut_amount",
+                    "cut_amount (Q) or width (W) is required",
+                ));
+            }
+        };
+        let tolerance = optional_positive("tolerance", self.tolerance, DEFAULT_TOLERANCE)?;
+        if tolerance < MIN_TOLERANCE {
+            return Err(SolverError::new(
+                "E_TOL",
+                format!("tolerance {tolerance} is below the smallest reachable {MIN_TOLERANCE} mm"),
+            )
+            .at("tolerance"));
+        }
+        let safe_z = self.safe_z.map(|z| finite("safe_z", z)).transpose()?;
+        Ok(Job {
+            frame,
+            profile,
+            edge: self.edge,
+            cylinder_radius,
+            tube_radii,
+            top_distance,
+            width,
+            cut_amount,
+            tolerance,
+            method: self.method,
+            direction: self.direction,
+            tool: tool.clone(),
+            feed: optional_positive("feed", self.feed, DEFAULT_FEED)?,
+            spindle_rpm: optional_positive("spindle_rpm", self.spindle_rpm, DEFAULT_SPINDLE_RPM)?,
+            clearance: optional_positive("clearance", self.clearance, DEFAULT_CLEARANCE)?,
+            lead_distance: optional_positive(
+                "lead_distance",
+                self.lead_distance,
+                DEFAULT_LEAD_DISTANCE,
+            )?,
+            safe_z,
+        })
+    }
+}

@@ -1,0 +1,108 @@
+//! Solver failures and warnings, each with a stable code (deburr.md §4 and the other specs' edge-case tables).
+
+use serde::Serialize;
+
+/// Why a solver refused a request. `code` is stable and documented (e.g. `E_HOLE_TOO_LARGE`);
+/// `field` names the request field at fault when there is one (a dotted JSON path such as
+/// `hole.radius`), so the server can point the client at it.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{message}")]
+pub struct SolverError {
+    code: &'static str,
+    field: Option<String>,
+    message: String,
+}
+
+impl SolverError {
+    /// An error with a code and a message, not tied to one field.
+    pub fn new(code: &'static str, message: impl Into<String>) -> Self {
+        Self {
+            code,
+            field: None,
+            message: message.into(),
+        }
+    }
+
+    /// An `E_INPUT` error naming the field at fault.
+    pub fn input(field: impl Into<String>, message: impl Into<String>) -> Self {
+        Self::new("E_INPUT", message).at(field)
+    }
+
+    /// The same error, tied to `field`.
+    #[must_use]
+    pub fn at(mut self, field: impl Into<String>) -> Self {
+        self.field = Some(field.into());
+        self
+    }
+
+    /// The stable error code.
+    pub fn code(&self) -> &'static str {
+        self.code
+    }
+
+    /// The request field at fault, if any.
+    pub fn field(&self) -> Option<&str> {
+        self.field.as_deref()
+    }
+
+    /// The human-readable explanation.
+    pub fn message(&self) -> &str {
+        &self.message
+    }
+}
+
+/// Something the user should know about a result that was still computed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct Warning {
+    /// Stable warning code, e.g. `W_CENTRE_IN_MATERIAL`.
+    pub code: &'static str,
+    /// What happened and where.
+    pub message: String,
+}
+
+impl Warning {
+    /// A warning with its code and message.
+    pub fn new(code: &'static str, message: impl Into<String>) -> Self {
+        Self {
+            code,
+            message: message.into(),
+        }
+    }
+}
+
+/// Checks that `value` is a finite number, naming `field` otherwise.
+pub fn finite(field: &str, value: f64) -> Result<f64, SolverError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(SolverError::input(
+            field,
+            format!("{field} must be a finite number"),
+        ))
+    }
+}
+
+/// Checks that `value` is finite and strictly positive, naming `field` otherwise.
+pub fn positive(field: &str, value: f64) -> Result<f64, SolverError> {
+    if finite(field, value)? > 0.0 {
+        Ok(value)
+    } else {
+        Err(SolverError::input(
+            field,
+            format!("{field} must be greater than 0 (got {value})"),
+        ))
+    }
+}
+
+/// Checks that `value` is finite and not negative, naming `field` otherwise.
+pub fn non_negative(field: &str, value: f64) -> Result<f64, SolverError> {
+    if finite(field, value)? >= 0.0 {
+        Ok(value)
+    } else {
+        Err(SolverError::input(
+            field,
+            format!("{field} must not be negative (got {value})"),
+        ))
+    }
+}

@@ -1,0 +1,231 @@
+//! G-code posts: turns a [`Toolpath`] into a complete program for a Fanuc-style control or
+//! LinuxCNC (api.md, G-code conventions; README "G-code conventions").
+//!
+//! Both dialects print every coordinate with 4 decimals in mm (never `-0.0000`), absolute mode,
+//! feed per minute, and start with a safety line, the tool change with its length offset and the
+//! spindle, and end with spindle stop and `M30`. They differ where the controls differ: the Fanuc
+//! post wraps the program in `%` with an `O` number; the LinuxCNC post adds `G64 P` (path blending
+//! held within the path tolerance). Both are accepted by LinuxCNC's `rs274` interpreter.
+
+use std::fmt::Write as _;
+
+use serde::{Deserialize, Serialize};
+
+use crate::path::{Motion, Toolpath};
+
+/// The control the program is written for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Dialect {
+    /// Fanuc-style controls (also Haas, Okuma in G-code mode, ...): `%`, `O` number.
+    #[default]
+    Fanuc,
+    /// LinuxCNC (rs274ngc): adds `G64 P` blending tolerance.
+    Linuxcnc,
+}
+
+/// Which point of the tool the program coordinates describe.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Reference {
+    /// The tool tip (lowest point along the tool axis); the length offset is measured to the tip.
+    #[default]
+    Tip,
+    /// The ball centre (or the centre of the end's rounding); the length offset is measured to it.
+    Centre,
+}
+
+impl Reference {
+    /// The name used in comments and JSON.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Tip => "tip",
+            Self::Centre => "centre",
+        }
+    }
+}
+
+/// How the program selects its tool.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ToolCall {
+    /// A tool from the machine's table: `T n M06` and length offset `H n`.
+    Table(u32),
+    /// A tool given inline, unknown to the control: the program stops (`M00`) and asks the
+    /// operator to load it and activate its length offset.
+    Manual(String),
+}
+
+/// Everything the post needs besides the path.
+#[derive(Debug, Clone)]
+pub struct Program<'a> {
+    /// Dialect to write.
+    pub dialect: Dialect,
+    /// Program number for the Fanuc `O` word (1–9999).
+    pub number: u32,
+    /// Short title, e.g. `KERF DEBURR`.
+    pub title: &'a str,
+    /// Header comment lines naming the job parameters.
+    pub comments: Vec<String>,
+    /// The tool.
+    pub tool: ToolCall,
+    /// Spindle speed, rpm (clockwise, M03).
+    pub spindle_rpm: f64,
+    /// Z of the clearance plane the program starts and ends at.
+    pub safe_z: f64,
+    /// Path blending tolerance for LinuxCNC's `G64 P`, mm.
+    pub blend_tolerance: f64,
+    /// The moves; the first should start from the clearance plane.
+    pub path: &'a Toolpath,
+}
+
+/// A coordinate or value in mm with 4 decimals, never printed as `-0.0000`.
+pub fn mm(value: f64) -> String {
+    let text = format!("{value:.4}");
+    if text.starts_with('-') && text[1..].bytes().all(|b| b == b'0' || b == b'.') {
+        text[1..].to_owned()
+    } else {
+        text
+    }
+}
+
+/// A comment safe for both dialects: upper case, no parentheses or control characters.
+pub fn comment(text: &str) -> String {
+    let cleaned: String = text
+        .chars()
+        .map(|c| {
+            if c == '(' || c == ')' || c.is_control() || !c.is_ascii() {
+                ' '
+            } else {
+                c.to_ascii_uppercase()
+            }
+        })
+        .collect();
+    format!("({})", cleaned.trim())
+}
+
+/// Writes the whole program.
+pub fn write(program: &Program<'_>) -> String {
+    let mut out = String::with_capacity(64 + program.path.moves.len() * 40);
+    let fanuc = program.dialect == Dialect::Fanuc;
+    if fanuc {
+        out.push_str("%\n");
+        let _ = writeln!(out, "O{:04} {}", program.number, comment(program.title));
+    } else {
+        let _ = writeln!(out, "{}", comment(program.title));
+    }
+    for line in &program.comments {
+        let _ = writeln!(out, "{}", comment(line));
+    }
+    out.push_str("G21 G17 G90 G40 G49 G80 G94\n");
+    if !fanuc {
+        let _ = writeln!(out, "G64 P{}", mm(program.blend_tolerance));
+    }
+    match &program.tool {
+        ToolCall::Table(number) => {
+            let _ = writeln!(out, "T{number} M06");
+            let _ = writeln!(out, "G00 G43 H{number} Z{}", mm(program.safe_z));
+        }
+        ToolCall::Manual(description) => {
+            let _ = writeln!(
+                out,
+                "{}",
+                comment(&format!("TOOL NOT IN THE TOOL TABLE: {description}"))
+            );
+            let _ = writeln!(
+                out,
+                "{}",
+                comment("LOAD IT, ACTIVATE ITS LENGTH OFFSET, THEN CYCLE START")
+            );
+            out.push_str("M00\n");
+            let _ = writeln!(out, "G00 Z{}", mm(program.safe_z));
+        }
+    }
+    let _ = writeln!(out, "S{} M03", program.spindle_rpm.round());
+    let mut current_feed: Option<f64> = None;
+    for step in &program.path.moves {
+        let (x, y, z) = (mm(step.to.x), mm(step.to.y), mm(step.to.z));
+        match step.motion {
+            Motion::Rapid => {
+                let _ = writeln!(out, "G00 X{x} Y{y} Z{z}");
+            }
+            Motion::Linear { feed } => {
+                if current_feed == Some(feed) {
+                    let _ = writeln!(out, "G01 X{x} Y{y} Z{z}");
+                } else {
+                    let _ = writeln!(out, "G01 X{x} Y{y} Z{z} F{}", feed_word(feed));
+                    current_feed = Some(feed);
+                }
+            }
+        }
+    }
+    out.push_str("M05\n");
+    let _ = writeln!(out, "G00 Z{}", mm(program.safe_z));
+    out.push_str("M30\n");
+    if fanuc {
+        out.push_str("%\n");
+    }
+    out
+}
+
+/// Feed word value: whole mm/min where exact, else one decimal.
+fn feed_word(feed: f64) -> String {
+    if feed.fract() == 0.0 {
+        format!("{feed:.0}")
+    } else {
+        format!("{feed:.1}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Vec3;
+
+    #[test]
+    fn mm_never_prints_negative_zero() {
+        assert_eq!(mm(-0.00001), "0.0000");
+        assert_eq!(mm(-0.0), "0.0000");
+        assert_eq!(mm(-1.23456), "-1.2346");
+        assert_eq!(mm(12.0), "12.0000");
+    }
+
+    #[test]
+    fn comments_cannot_break_out() {
+        assert_eq!(comment("a (b) c"), "(A  B  C)");
+        assert_eq!(comment("ø3\nx"), "(3 X)");
+    }
+
+    #[test]
+    fn program_has_prologue_moves_and_epilogue() {
+        let mut path = Toolpath::default();
+        path.rapid(Vec3::new(1.0, 2.0, 50.0));
+        path.linear(Vec3::new(1.0, 2.0, 3.0), 300.0);
+        path.linear(Vec3::new(2.0, 2.0, 3.0), 300.0);
+        path.rapid(Vec3::new(2.0, 2.0, 50.0));
+        let program = Program {
+            dialect: Dialect::Fanuc,
+            number: 1000,
+            title: "kerf test",
+            comments: vec!["tool t7".to_owned()],
+            tool: ToolCall::Table(7),
+            spindle_rpm: 6000.0,
+            safe_z: 50.0,
+            blend_tolerance: 0.01,
+            path: &path,
+        };
+        let fanuc = write(&program);
+        assert!(fanuc.starts_with("%\nO1000 (KERF TEST)\n(TOOL T7)\nG21"));
+        assert!(fanuc.contains("T7 M06\nG00 G43 H7 Z50.0000\nS6000 M03\n"));
+        assert!(fanuc.contains("G01 X1.0000 Y2.0000 Z3.0000 F300\nG01 X2.0000 Y2.0000 Z3.0000\n"));
+        assert!(fanuc.ends_with("M05\nG00 Z50.0000\nM30\n%\n"));
+        let linuxcnc = write(&Program {
+            dialect: Dialect::Linuxcnc,
+            ..program
+        });
+        assert!(linuxcnc.starts_with("(KERF TEST)\n"));
+        assert!(linuxcnc.contains("G64 P0.0100\n"));
+        assert!(!linuxcnc.contains('%'));
+    }
+}

@@ -1,0 +1,141 @@
+//! Shared geometry: vector aliases, rotations, point-to-segment distance and a safeguarded
+//! one-dimensional root finder.
+
+use nalgebra::{Matrix3, Vector3};
+
+/// A 3-D point or free vector in millimetres.
+pub type Vec3 = Vector3<f64>;
+
+/// Converts `[x, y, z]` to a vector.
+pub fn vec3(p: [f64; 3]) -> Vec3 {
+    Vec3::new(p[0], p[1], p[2])
+}
+
+/// Converts a vector to `[x, y, z]`.
+pub fn array3(v: &Vec3) -> [f64; 3] {
+    [v.x, v.y, v.z]
+}
+
+/// Right-handed rotation about +Z by `angle` radians.
+pub fn rotation_z(angle: f64) -> Matrix3<f64> {
+    let (s, c) = angle.sin_cos();
+    Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
+}
+
+/// Right-handed rotation about +Y by `angle` radians.
+pub fn rotation_y(angle: f64) -> Matrix3<f64> {
+    let (s, c) = angle.sin_cos();
+    Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c)
+}
+
+/// Distance from `p` to the closed segment `[a, b]` (a degenerate segment is a point).
+pub fn distance_to_segment(p: &Vec3, a: &Vec3, b: &Vec3) -> f64 {
+    let ab = b - a;
+    let length_squared = ab.norm_squared();
+    if length_squared == 0.0 {
+        return (p - a).norm();
+    }
+    let t = ((p - a).dot(&ab) / length_squared).clamp(0.0, 1.0);
+    (p - (a + t * ab)).norm()
+}
+
+/// Finds a root of `f` near `start`: steps outwards in both directions (first `step`, growing by
+/// half each time, up to `reach` away) until the sign changes, then bisects the bracket to `tol`.
+/// Returns `None` when no sign change lies within `reach`. Deterministic; never returns NaN.
+pub fn root_near(
+    f: impl Fn(f64) -> f64,
+    start: f64,
+    step: f64,
+    reach: f64,
+    tol: f64,
+) -> Option<f64> {
+    let f_start = f(start);
+    if f_start == 0.0 {
+        return Some(start);
+    }
+    if !f_start.is_finite() {
+        return None;
+    }
+    let mut offset = 0.0;
+    let mut stride = step;
+    let (mut below, mut above) = (start, start);
+    let (mut f_below, mut f_above) = (f_start, f_start);
+    while offset < reach {
+        offset = (offset + stride).min(reach);
+        stride *= 1.5;
+        for (side, last, f_last) in [
+            (-1.0, &mut below, &mut f_below),
+            (1.0, &mut above, &mut f_above),
+        ] {
+            let x = start + side * offset;
+            let fx = f(x);
+            if fx.is_finite() && fx * *f_last <= 0.0 {
+                return Some(bisect(&f, *last, *f_last, x, tol));
+            }
+            *last = x;
+            *f_last = fx;
+        }
+    }
+    None
+}
+
+/// Bisection on a bracket `[a, b]` with `f(a) = fa` and a sign change somewhere inside.
+fn bisect(f: &impl Fn(f64) -> f64, mut a: f64, mut fa: f64, mut b: f64, tol: f64) -> f64 {
+    for _ in 0..200 {
+        let mid = 0.5 * (a + b);
+        if (b - a).abs() <= tol {
+            return mid;
+        }
+        let fm = f(mid);
+        if fm == 0.0 {
+            return mid;
+        }
+        if fm * fa < 0.0 {
+            b = mid;
+        } else {
+            a = mid;
+            fa = fm;
+        }
+    }
+    0.5 * (a + b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_abs_diff_eq;
+
+    #[test]
+    fn segment_distance_covers_interior_and_ends() {
+        let a = Vec3::new(0.0, 0.0, 0.0);
+        let b = Vec3::new(2.0, 0.0, 0.0);
+        assert_abs_diff_eq!(distance_to_segment(&Vec3::new(1.0, 1.0, 0.0), &a, &b), 1.0);
+        assert_abs_diff_eq!(distance_to_segment(&Vec3::new(3.0, 0.0, 0.0), &a, &b), 1.0);
+        assert_abs_diff_eq!(distance_to_segment(&Vec3::new(-3.0, 4.0, 0.0), &a, &b), 5.0);
+        assert_abs_diff_eq!(distance_to_segment(&Vec3::new(0.0, 2.0, 0.0), &a, &a), 2.0);
+    }
+
+    #[test]
+    fn root_near_finds_the_nearest_sign_change() {
+        let root = root_near(|x| x.cos(), 1.0, 0.01, 3.0, 1e-14).unwrap();
+        assert_abs_diff_eq!(root, std::f64::consts::FRAC_PI_2, epsilon = 1e-12);
+        let left = root_near(|x| x * x - 4.0, -1.5, 0.01, 3.0, 1e-14).unwrap();
+        assert_abs_diff_eq!(left, -2.0, epsilon = 1e-12);
+        assert!(root_near(|x| x * x + 1.0, 0.0, 0.1, 5.0, 1e-12).is_none());
+    }
+
+    #[test]
+    fn rotations_are_right_handed() {
+        let x = Vec3::x();
+        assert_abs_diff_eq!(
+            rotation_z(std::f64::consts::FRAC_PI_2) * x,
+            Vec3::y(),
+            epsilon = 1e-15
+        );
+        assert_abs_diff_eq!(
+            rotation_y(std::f64::consts::FRAC_PI_2) * Vec3::z(),
+            x,
+            epsilon = 1e-15
+        );
+    }
+}

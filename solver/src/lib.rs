@@ -1,0 +1,19 @@
+//! kerf's solvers: pure, deterministic tool-path computation.
+//!
+//! Every capability is a function from a validated request to an answer or a [`SolverError`]; no
+//! I/O, no clocks, no global state, so the same request always gives the same bytes and a solver
+//! call can run on any thread or worker. The server crate does HTTP, storage and jobs.
+//!
+//! Modules: [`geometry`] (vectors and small numeric helpers), [`tool`] (the cutter),
+//! [`path`] (typed moves), [`gcode`] (posts for the supported dialects), and one module per
+//! capability: [`deburr`].
+#![deny(missing_docs)]
+
+pub mod deburr;
+pub mod error;
+pub mod gcode;
+pub mod geometry;
+pub mod path;
+pub mod tool;
+
+pub use error::{SolverError, Warning};

@@ -1,0 +1,268 @@
+//! The cutter: kind, radius and the optional data later capabilities need (api.md, Tools).
+
+use std::fmt;
+
+use serde::de::{self, MapAccess, Visitor};
+use serde::{Deserialize, Deserializer, Serialize};
+
+use crate::error::{SolverError, finite, positive};
+
+/// The cutter's end shape.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum ToolKind {
+    /// Ball end mill: `radius` is the ball radius.
+    Ball,
+    /// Flat (square) end mill.
+    Flat,
+    /// Bull-nose end mill: flat bottom with a `corner_radius`.
+    Bull,
+}
+
+impl ToolKind {
+    /// The name used in JSON and messages.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Ball => "ball",
+            Self::Flat => "flat",
+            Self::Bull => "bull",
+        }
+    }
+}
+
+/// A cutter as registered in the tool table or given inline in a request.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct Tool {
+    /// End shape.
+    pub kind: ToolKind,
+    /// Cutter radius in mm (> 0); for `ball` the ball radius.
+    pub radius: f64,
+    /// Corner radius in mm, only for `bull` (required there, 0 < corner_radius ≤ radius).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub corner_radius: Option<f64>,
+    /// Number of flutes (1–32).
+    #[serde(default = "default_flutes")]
+    pub flutes: u32,
+    /// Free-text name shown in listings and G-code comments (at most 200 characters).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Helix angle in degrees (0 ≤ helix < 90).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub helix_deg: Option<f64>,
+    /// Length from the holder face to the tip in mm (> 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stickout: Option<f64>,
+    /// Neck radius in mm of a lollipop or back-deburring cutter (0 < neck_radius < radius): the
+    /// radius of the shank just above the cutting head. Without it the shank is taken to be as
+    /// wide as the cutter.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub neck_radius: Option<f64>,
+}
+
+fn default_flutes() -> u32 {
+    2
+}
+
+/// Longest accepted tool name.
+pub const MAX_NAME_CHARS: usize = 200;
+
+impl Tool {
+    /// A tool of `kind` and `radius` with every optional datum left out.
+    pub fn new(kind: ToolKind, radius: f64) -> Self {
+        Self {
+            kind,
+            radius,
+            corner_radius: None,
+            flutes: default_flutes(),
+            name: None,
+            helix_deg: None,
+            stickout: None,
+            neck_radius: None,
+        }
+    }
+
+    /// Checks every field; `prefix` is prepended to field names in errors (e.g. `tool.`).
+    pub fn validate(&self, prefix: &str) -> Result<(), SolverError> {
+        let field = |name: &str| format!("{prefix}{name}");
+        positive(&field("radius"), self.radius)?;
+        match (self.kind, self.corner_radius) {
+            (ToolKind::Bull, None) => {
+                return Err(SolverError::input(
+                    field("corner_radius"),
+                    "a bull-nose tool needs corner_radius",
+                ));
+            }
+            (ToolKind::Bull, Some(corner)) => {
+                positive(&field("corner_radius"), corner)?;
+                if corner > self.radius {
+                    return Err(SolverError::input(
+                        field("corner_radius"),
+                        format!(
+                            "corner_radius {corner} must not exceed radius {}",
+                            self.radius
+                        ),
+                    ));
+                }
+            }
+            (kind, Some(_)) => {
+                return Err(SolverError::input(
+                    field("corner_radius"),
+                    format!(
+                        "corner_radius applies only to bull-nose tools, not {}",
+                        kind.as_str()
+                    ),
+                ));
+            }
+            (_, None) => {}
+        }
+        if !(1..=32).contains(&self.flutes) {
+            return Err(SolverError::input(
+                field("flutes"),
+                format!("flutes must be 1 to 32 (got {})", self.flutes),
+            ));
+        }
+        if let Some(name) = &self.name
+            && name.chars().count() > MAX_NAME_CHARS
+        {
+            return Err(SolverError::input(
+                field("name"),
+                format!("name must be at most {MAX_NAME_CHARS} characters"),
+            ));
+        }
+        if let Some(helix) = self.helix_deg
+            && !(0.0..90.0).contains(&finite(&field("helix_deg"), helix)?)
+        {
+            return Err(SolverError::input(
+                field("helix_deg"),
+                format!("helix_deg must be in [0, 90) (got {helix})"),
+            ));
+        }
+        if let Some(stickout) = self.stickout {
+            positive(&field("stickout"), stickout)?;
+        }
+        if let Some(neck) = self.neck_radius {
+            positive(&field("neck_radius"), neck)?;
+            if neck >= self.radius {
+                return Err(SolverError::input(
+                    field("neck_radius"),
+                    format!(
+                        "neck_radius {neck} must be smaller than radius {}",
+                        self.radius
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Smallest and largest tool numbers (api.md, Tools).
+pub const TOOL_NUMBERS: std::ops::RangeInclusive<u32> = 1..=9999;
+
+/// How a solver request names its tool: a number in the tool table, or the tool itself.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(untagged)]
+pub enum ToolRef {
+    /// A registered tool number (1–9999).
+    Number(u32),
+    /// A tool given inline.
+    Inline(Tool),
+}
+
+// Hand-written so that a bad inline tool reports its own field error instead of serde's
+// "did not match any variant".
+impl<'de> Deserialize<'de> for ToolRef {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct ToolRefVisitor;
+
+        impl<'de> Visitor<'de> for ToolRefVisitor {
+            type Value = ToolRef;
+
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str("a tool number (1-9999) or a tool object like {\"kind\": \"ball\", \"radius\": 3}")
+            }
+
+            fn visit_u64<E: de::Error>(self, value: u64) -> Result<ToolRef, E> {
+                u32::try_from(value)
+                    .ok()
+                    .filter(|n| TOOL_NUMBERS.contains(n))
+                    .map(ToolRef::Number)
+                    .ok_or_else(|| E::custom(format!("tool number {value} is outside 1-9999")))
+            }
+
+            fn visit_i64<E: de::Error>(self, value: i64) -> Result<ToolRef, E> {
+                u64::try_from(value)
+                    .map_err(|_| E::custom(format!("tool number {value} is outside 1-9999")))
+                    .and_then(|v| self.visit_u64(v))
+            }
+
+            fn visit_map<M: MapAccess<'de>>(self, map: M) -> Result<ToolRef, M::Error> {
+                Tool::deserialize(de::value::MapAccessDeserializer::new(map)).map(ToolRef::Inline)
+            }
+        }
+
+        deserializer.deserialize_any(ToolRefVisitor)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn validation_names_the_field() {
+        let mut tool = Tool::new(ToolKind::Ball, 3.0);
+        assert!(tool.validate("tool.").is_ok());
+        tool.radius = f64::NAN;
+        assert_eq!(
+            tool.validate("tool.").unwrap_err().field(),
+            Some("tool.radius")
+        );
+        tool.radius = 3.0;
+        tool.corner_radius = Some(1.0);
+        assert_eq!(
+            tool.validate("").unwrap_err().field(),
+            Some("corner_radius")
+        );
+        let mut bull = Tool::new(ToolKind::Bull, 5.0);
+        assert_eq!(
+            bull.validate("").unwrap_err().field(),
+            Some("corner_radius")
+        );
+        bull.corner_radius = Some(1.0);
+        assert!(bull.validate("").is_ok());
+        tool.corner_radius = None;
+        tool.neck_radius = Some(3.0);
+        assert_eq!(tool.validate("").unwrap_err().field(), Some("neck_radius"));
+        tool.neck_radius = None;
+        tool.flutes = 0;
+        assert_eq!(tool.validate("").unwrap_err().field(), Some("flutes"));
+    }
+
+    #[test]
+    fn tool_ref_reads_numbers_and_inline_tools() {
+        let number: ToolRef = serde_json::from_str("7").unwrap();
+        assert_eq!(number, ToolRef::Number(7));
+        let inline: ToolRef = serde_json::from_str(r#"{"kind": "ball", "radius": 3}"#).unwrap();
+        assert_eq!(inline, ToolRef::Inline(Tool::new(ToolKind::Ball, 3.0)));
+        for bad in [
+            "0",
+            "10000",
+            "-1",
+            "2.5",
+            r#""7""#,
+            r#"{"kind": "ball"}"#,
+            r#"{"kind": "ball", "radius": 3, "x": 1}"#,
+        ] {
+            assert!(serde_json::from_str::<ToolRef>(bad).is_err(), "{bad}");
+        }
+        let message = serde_json::from_str::<ToolRef>(r#"{"kind": "drill", "radius": 3}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains("unknown variant `drill`"), "{message}");
+    }
+}
