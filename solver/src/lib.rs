@@ -6,14 +6,19 @@
 //!
 //! Modules: [`geometry`] (vectors and small numeric helpers), [`tool`] (the cutter),
 //! [`path`] (typed moves), [`gcode`] (posts for the supported dialects), and one module per
-//! capability: [`deburr`].
+//! capability: [`deburr`], [`chord`], [`corners`], [`engagement`], [`predict`].
 #![deny(missing_docs)]
 
+pub mod chord;
+pub mod corners;
 pub mod deburr;
+pub mod engagement;
 pub mod error;
 pub mod gcode;
 pub mod geometry;
 pub mod path;
+pub mod planar;
+pub mod predict;
 pub mod tool;
 
 pub use error::{SolverError, Warning};

@@ -1,0 +1,3 @@
+//! Benchmarks for solver::chord (not written yet).
+
+fn main() {}

@@ -1,0 +1,3 @@
+//! Benchmarks for solver::corners (not written yet).
+
+fn main() {}

@@ -1,0 +1,3 @@
+//! Benchmarks for solver::engagement (not written yet).
+
+fn main() {}

@@ -1,0 +1,3 @@
+//! Benchmarks for solver::predict (not written yet).
+
+fn main() {}

@@ -1,0 +1,1 @@
+//! Reading G-code programs into typed moves with their line numbers. Not built yet.
