@@ -36,6 +36,11 @@ impl ToolKind {
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(deny_unknown_fields)]
 pub struct Tool {
+    /// Tool number on the machine (1–9999). For a registered tool it is the table key (the
+    /// path's number; the body may repeat it). For an inline tool it is the pocket the G-code
+    /// calls (`T`/`H`); without it the program stops for a manual tool change.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub number: Option<u32>,
     /// End shape.
     pub kind: ToolKind,
     /// Cutter radius in mm (> 0); for `ball` the ball radius.
@@ -73,6 +78,7 @@ impl Tool {
     /// A tool of `kind` and `radius` with every optional datum left out.
     pub fn new(kind: ToolKind, radius: f64) -> Self {
         Self {
+            number: None,
             kind,
             radius,
             corner_radius: None,
@@ -87,6 +93,11 @@ impl Tool {
     /// Checks every field; `prefix` is prepended to field names in errors (e.g. `tool.`).
     pub fn validate(&self, prefix: &str) -> Result<(), SolverError> {
         let field = |name: &str| format!("{prefix}{name}");
+        if let Some(number) = self.number
+            && !TOOL_NUMBERS.contains(&number)
+        {
+            return Err(SolverError::input(field("number"), format!("tool number must be 1 to 9999 (got {number})")));
+        }
         positive(&field("radius"), self.radius)?;
         match (self.kind, self.corner_radius) {
             (ToolKind::Bull, None) => {
