@@ -59,6 +59,16 @@ pub enum ToolCall {
     Manual(String),
 }
 
+impl ToolCall {
+    /// The call for `tool`: from the table when it has a number, otherwise a manual change.
+    pub fn for_tool(tool: &crate::tool::Tool) -> Self {
+        match tool.number {
+            Some(number) => Self::Table(number),
+            None => Self::Manual(format!("{} R{}", tool.kind.as_str(), mm(tool.radius))),
+        }
+    }
+}
+
 /// Everything the post needs besides the path.
 #[derive(Debug, Clone)]
 pub struct Program<'a> {
