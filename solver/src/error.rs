@@ -16,11 +16,7 @@ pub struct SolverError {
 impl SolverError {
     /// An error with a code and a message, not tied to one field.
     pub fn new(code: &'static str, message: impl Into<String>) -> Self {
-        Self {
-            code,
-            field: None,
-            message: message.into(),
-        }
+        Self { code, field: None, message: message.into() }
     }
 
     /// An `E_INPUT` error naming the field at fault.
@@ -64,10 +60,7 @@ pub struct Warning {
 impl Warning {
     /// A warning with its code and message.
     pub fn new(code: &'static str, message: impl Into<String>) -> Self {
-        Self {
-            code,
-            message: message.into(),
-        }
+        Self { code, message: message.into() }
     }
 }
 
@@ -76,10 +69,7 @@ pub fn finite(field: &str, value: f64) -> Result<f64, SolverError> {
     if value.is_finite() {
         Ok(value)
     } else {
-        Err(SolverError::input(
-            field,
-            format!("{field} must be a finite number"),
-        ))
+        Err(SolverError::input(field, format!("{field} must be a finite number")))
     }
 }
 
@@ -88,10 +78,7 @@ pub fn positive(field: &str, value: f64) -> Result<f64, SolverError> {
     if finite(field, value)? > 0.0 {
         Ok(value)
     } else {
-        Err(SolverError::input(
-            field,
-            format!("{field} must be greater than 0 (got {value})"),
-        ))
+        Err(SolverError::input(field, format!("{field} must be greater than 0 (got {value})")))
     }
 }
 
@@ -100,9 +87,6 @@ pub fn non_negative(field: &str, value: f64) -> Result<f64, SolverError> {
     if finite(field, value)? >= 0.0 {
         Ok(value)
     } else {
-        Err(SolverError::input(
-            field,
-            format!("{field} must not be negative (got {value})"),
-        ))
+        Err(SolverError::input(field, format!("{field} must not be negative (got {value})")))
     }
 }

@@ -42,13 +42,7 @@ pub fn distance_to_segment(p: &Vec3, a: &Vec3, b: &Vec3) -> f64 {
 /// Finds a root of `f` near `start`: steps outwards in both directions (first `step`, growing by
 /// half each time, up to `reach` away) until the sign changes, then bisects the bracket to `tol`.
 /// Returns `None` when no sign change lies within `reach`. Deterministic; never returns NaN.
-pub fn root_near(
-    f: impl Fn(f64) -> f64,
-    start: f64,
-    step: f64,
-    reach: f64,
-    tol: f64,
-) -> Option<f64> {
+pub fn root_near(f: impl Fn(f64) -> f64, start: f64, step: f64, reach: f64, tol: f64) -> Option<f64> {
     let f_start = f(start);
     if f_start == 0.0 {
         return Some(start);
@@ -63,10 +57,7 @@ pub fn root_near(
     while offset < reach {
         offset = (offset + stride).min(reach);
         stride *= 1.5;
-        for (side, last, f_last) in [
-            (-1.0, &mut below, &mut f_below),
-            (1.0, &mut above, &mut f_above),
-        ] {
+        for (side, last, f_last) in [(-1.0, &mut below, &mut f_below), (1.0, &mut above, &mut f_above)] {
             let x = start + side * offset;
             let fx = f(x);
             if fx.is_finite() && fx * *f_last <= 0.0 {
@@ -127,15 +118,7 @@ mod tests {
     #[test]
     fn rotations_are_right_handed() {
         let x = Vec3::x();
-        assert_abs_diff_eq!(
-            rotation_z(std::f64::consts::FRAC_PI_2) * x,
-            Vec3::y(),
-            epsilon = 1e-15
-        );
-        assert_abs_diff_eq!(
-            rotation_y(std::f64::consts::FRAC_PI_2) * Vec3::z(),
-            x,
-            epsilon = 1e-15
-        );
+        assert_abs_diff_eq!(rotation_z(std::f64::consts::FRAC_PI_2) * x, Vec3::y(), epsilon = 1e-15);
+        assert_abs_diff_eq!(rotation_y(std::f64::consts::FRAC_PI_2) * Vec3::z(), x, epsilon = 1e-15);
     }
 }

@@ -34,31 +34,18 @@ pub struct Toolpath {
 impl Toolpath {
     /// Appends a rapid move.
     pub fn rapid(&mut self, to: Vec3) {
-        self.moves.push(Move {
-            motion: Motion::Rapid,
-            to,
-        });
+        self.moves.push(Move { motion: Motion::Rapid, to });
     }
 
     /// Appends a cutting move at `feed` mm/min.
     pub fn linear(&mut self, to: Vec3, feed: f64) {
-        self.moves.push(Move {
-            motion: Motion::Linear { feed },
-            to,
-        });
+        self.moves.push(Move { motion: Motion::Linear { feed }, to });
     }
 
     /// The same path with every point shifted by `offset` (e.g. from ball centre to tip).
     #[must_use]
     pub fn shifted(&self, offset: Vec3) -> Self {
-        let moves = self
-            .moves
-            .iter()
-            .map(|m| Move {
-                motion: m.motion,
-                to: m.to + offset,
-            })
-            .collect();
+        let moves = self.moves.iter().map(|m| Move { motion: m.motion, to: m.to + offset }).collect();
         Self { moves }
     }
 }

@@ -101,55 +101,37 @@ impl Tool {
         positive(&field("radius"), self.radius)?;
         match (self.kind, self.corner_radius) {
             (ToolKind::Bull, None) => {
-                return Err(SolverError::input(
-                    field("corner_radius"),
-                    "a bull-nose tool needs corner_radius",
-                ));
+                return Err(SolverError::input(field("corner_radius"), "a bull-nose tool needs corner_radius"));
             }
             (ToolKind::Bull, Some(corner)) => {
                 positive(&field("corner_radius"), corner)?;
                 if corner > self.radius {
                     return Err(SolverError::input(
                         field("corner_radius"),
-                        format!(
-                            "corner_radius {corner} must not exceed radius {}",
-                            self.radius
-                        ),
+                        format!("corner_radius {corner} must not exceed radius {}", self.radius),
                     ));
                 }
             }
             (kind, Some(_)) => {
                 return Err(SolverError::input(
                     field("corner_radius"),
-                    format!(
-                        "corner_radius applies only to bull-nose tools, not {}",
-                        kind.as_str()
-                    ),
+                    format!("corner_radius applies only to bull-nose tools, not {}", kind.as_str()),
                 ));
             }
             (_, None) => {}
         }
         if !(1..=32).contains(&self.flutes) {
-            return Err(SolverError::input(
-                field("flutes"),
-                format!("flutes must be 1 to 32 (got {})", self.flutes),
-            ));
+            return Err(SolverError::input(field("flutes"), format!("flutes must be 1 to 32 (got {})", self.flutes)));
         }
         if let Some(name) = &self.name
             && name.chars().count() > MAX_NAME_CHARS
         {
-            return Err(SolverError::input(
-                field("name"),
-                format!("name must be at most {MAX_NAME_CHARS} characters"),
-            ));
+            return Err(SolverError::input(field("name"), format!("name must be at most {MAX_NAME_CHARS} characters")));
         }
         if let Some(helix) = self.helix_deg
             && !(0.0..90.0).contains(&finite(&field("helix_deg"), helix)?)
         {
-            return Err(SolverError::input(
-                field("helix_deg"),
-                format!("helix_deg must be in [0, 90) (got {helix})"),
-            ));
+            return Err(SolverError::input(field("helix_deg"), format!("helix_deg must be in [0, 90) (got {helix})")));
         }
         if let Some(stickout) = self.stickout {
             positive(&field("stickout"), stickout)?;
@@ -159,10 +141,7 @@ impl Tool {
             if neck >= self.radius {
                 return Err(SolverError::input(
                     field("neck_radius"),
-                    format!(
-                        "neck_radius {neck} must be smaller than radius {}",
-                        self.radius
-                    ),
+                    format!("neck_radius {neck} must be smaller than radius {}", self.radius),
                 ));
             }
         }
@@ -229,21 +208,12 @@ mod tests {
         let mut tool = Tool::new(ToolKind::Ball, 3.0);
         assert!(tool.validate("tool.").is_ok());
         tool.radius = f64::NAN;
-        assert_eq!(
-            tool.validate("tool.").unwrap_err().field(),
-            Some("tool.radius")
-        );
+        assert_eq!(tool.validate("tool.").unwrap_err().field(), Some("tool.radius"));
         tool.radius = 3.0;
         tool.corner_radius = Some(1.0);
-        assert_eq!(
-            tool.validate("").unwrap_err().field(),
-            Some("corner_radius")
-        );
+        assert_eq!(tool.validate("").unwrap_err().field(), Some("corner_radius"));
         let mut bull = Tool::new(ToolKind::Bull, 5.0);
-        assert_eq!(
-            bull.validate("").unwrap_err().field(),
-            Some("corner_radius")
-        );
+        assert_eq!(bull.validate("").unwrap_err().field(), Some("corner_radius"));
         bull.corner_radius = Some(1.0);
         assert!(bull.validate("").is_ok());
         tool.corner_radius = None;
@@ -260,20 +230,12 @@ mod tests {
         assert_eq!(number, ToolRef::Number(7));
         let inline: ToolRef = serde_json::from_str(r#"{"kind": "ball", "radius": 3}"#).unwrap();
         assert_eq!(inline, ToolRef::Inline(Tool::new(ToolKind::Ball, 3.0)));
-        for bad in [
-            "0",
-            "10000",
-            "-1",
-            "2.5",
-            r#""7""#,
-            r#"{"kind": "ball"}"#,
-            r#"{"kind": "ball", "radius": 3, "x": 1}"#,
-        ] {
+        for bad in
+            ["0", "10000", "-1", "2.5", r#""7""#, r#"{"kind": "ball"}"#, r#"{"kind": "ball", "radius": 3, "x": 1}"#]
+        {
             assert!(serde_json::from_str::<ToolRef>(bad).is_err(), "{bad}");
         }
-        let message = serde_json::from_str::<ToolRef>(r#"{"kind": "drill", "radius": 3}"#)
-            .unwrap_err()
-            .to_string();
+        let message = serde_json::from_str::<ToolRef>(r#"{"kind": "drill", "radius": 3}"#).unwrap_err().to_string();
         assert!(message.contains("unknown variant `drill`"), "{message}");
     }
 }

@@ -15,9 +15,7 @@ fn cases() -> Vec<Value> {
 }
 
 fn number(value: &Value) -> f64 {
-    value
-        .as_f64()
-        .unwrap_or_else(|| panic!("not a number: {value}"))
+    value.as_f64().unwrap_or_else(|| panic!("not a number: {value}"))
 }
 
 fn triple(value: &Value) -> [f64; 3] {
@@ -26,10 +24,7 @@ fn triple(value: &Value) -> [f64; 3] {
 }
 
 fn assert_close(what: &str, got: f64, expected: f64) {
-    assert!(
-        (got - expected).abs() <= TOLERANCE,
-        "{what}: got {got}, expected {expected}"
-    );
+    assert!((got - expected).abs() <= TOLERANCE, "{what}: got {got}, expected {expected}");
 }
 
 fn assert_point(what: &str, got: [f64; 3], expected: [f64; 3]) {
@@ -44,18 +39,11 @@ fn request(case: &Value) -> (DeburrRequest, Tool) {
     let r1 = number(&inputs["R1"]);
     let origin = triple(&inputs["O_on_A1_at_hole_station"]);
     let arrangement = number(&inputs["arrangement_deg"]);
-    let edge = if inputs["side"] == "outer" {
-        Edge::Outer
-    } else {
-        Edge::Inner
-    };
+    let edge = if inputs["side"] == "outer" { Edge::Outer } else { Edge::Inner };
     let workpiece = match edge {
-        Edge::Outer => Workpiece::Tube {
-            origin,
-            arrangement_angle_deg: arrangement,
-            inner_radius: r1 * 0.75,
-            outer_radius: r1,
-        },
+        Edge::Outer => {
+            Workpiece::Tube { origin, arrangement_angle_deg: arrangement, inner_radius: r1 * 0.75, outer_radius: r1 }
+        }
         Edge::Inner => Workpiece::BoreBlock {
             origin,
             arrangement_angle_deg: arrangement,
@@ -116,27 +104,11 @@ fn sample_constructions_match() {
             assert_point(&format!("{at} P"), got.target, triple(&sample["P"]));
             assert_point(&format!("{at} C"), got.centre, triple(&sample["C"]));
             assert_point(&format!("{at} u"), got.bisector, triple(&sample["u"]));
-            assert_point(
-                &format!("{at} G1"),
-                got.band_edge_cylinder,
-                triple(&sample["G1"]),
-            );
-            assert_point(
-                &format!("{at} G2"),
-                got.band_edge_wall,
-                triple(&sample["G2"]),
-            );
-            assert_close(
-                &format!("{at} beta"),
-                got.wedge_angle_deg,
-                number(&sample["beta_deg"]),
-            );
+            assert_point(&format!("{at} G1"), got.band_edge_cylinder, triple(&sample["G1"]));
+            assert_point(&format!("{at} G2"), got.band_edge_wall, triple(&sample["G2"]));
+            assert_close(&format!("{at} beta"), got.wedge_angle_deg, number(&sample["beta_deg"]));
             assert_close(&format!("{at} L"), got.chord_depth, number(&sample["L"]));
-            assert_close(
-                &format!("{at} CL"),
-                got.centre_offset,
-                number(&sample["CL"]),
-            );
+            assert_close(&format!("{at} CL"), got.centre_offset, number(&sample["CL"]));
         }
     }
 }
@@ -148,33 +120,15 @@ fn tolerance_paths_match_counts_and_parameters() {
         let id = case["id"].as_str().unwrap();
         let path = &case["path"];
         let result = deburr::solve(&request, &tool).unwrap();
-        assert_eq!(
-            result.points.len() as u64,
-            path["n_points_closed"].as_u64().unwrap(),
-            "{id} closed count"
-        );
-        assert_eq!(
-            result.summary.count as u64,
-            path["n_distinct"].as_u64().unwrap(),
-            "{id} distinct count"
-        );
+        assert_eq!(result.points.len() as u64, path["n_points_closed"].as_u64().unwrap(), "{id} closed count");
+        assert_eq!(result.summary.count as u64, path["n_distinct"].as_u64().unwrap(), "{id} distinct count");
 
         // The parameter list of each segment, with its start shared with the previous segment's end.
         for name in path["segment_order"].as_array().unwrap() {
             let name = name.as_str().unwrap();
-            let expected: Vec<f64> = path["segment_params"][name]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(number)
-                .collect();
+            let expected: Vec<f64> = path["segment_params"][name].as_array().unwrap().iter().map(number).collect();
             let lower = segment_name(name);
-            let mut got: Vec<f64> = result
-                .points
-                .iter()
-                .filter(|p| p.segment == lower)
-                .map(|p| p.parameter)
-                .collect();
+            let mut got: Vec<f64> = result.points.iter().filter(|p| p.segment == lower).map(|p| p.parameter).collect();
             if got.first() != Some(&0.0) {
                 got.insert(0, 0.0);
             }
@@ -185,35 +139,16 @@ fn tolerance_paths_match_counts_and_parameters() {
 
         for (index, first) in path["first_points"].as_array().unwrap().iter().enumerate() {
             let point = &result.points[index];
-            assert_eq!(
-                point.segment,
-                segment_name(first["segment"].as_str().unwrap()),
-                "{id} first {index}"
-            );
-            assert_close(
-                &format!("{id} first {index} s"),
-                point.parameter,
-                number(&first["s"]),
-            );
-            assert_point(
-                &format!("{id} first {index} C"),
-                point.centre,
-                triple(&first["C"]),
-            );
+            assert_eq!(point.segment, segment_name(first["segment"].as_str().unwrap()), "{id} first {index}");
+            assert_close(&format!("{id} first {index} s"), point.parameter, number(&first["s"]));
+            assert_point(&format!("{id} first {index} C"), point.centre, triple(&first["C"]));
         }
         let last = result.points.last().unwrap();
-        assert_point(
-            &format!("{id} last C"),
-            last.centre,
-            triple(&path["last_point"]["C"]),
-        );
+        assert_point(&format!("{id} last C"), last.centre, triple(&path["last_point"]["C"]));
         assert_eq!(last.centre, result.points[0].centre, "{id} closed");
 
         let dense = number(&path["max_dev_dense_check"]);
-        assert!(
-            result.summary.max_deviation <= number(&case["inputs"]["TA"]) + 1e-12,
-            "{id} deviation"
-        );
+        assert!(result.summary.max_deviation <= number(&case["inputs"]["TA"]) + 1e-12, "{id} deviation");
         assert!(
             (result.summary.max_deviation - dense).abs() < 0.1 * dense,
             "{id} deviation {} vs {dense}",

@@ -1,1 +1,153 @@
-//! placeholder
+//! Test harness: starts the real service on `127.0.0.1:0` with a temporary SQLite file and talks
+//! HTTP to it, and helpers for the external checks (LinuxCNC's `rs274`, headless Chromium).
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use kerf_server::app::Config;
+use kerf_server::state::Limits;
+use reqwest::{Client, Response};
+use serde_json::Value;
+use tokio::net::TcpListener;
+use tokio::sync::oneshot;
+use tokio::task::JoinHandle;
+
+/// A running service with its own database in a temporary directory.
+pub struct TestApp {
+    /// `http://127.0.0.1:PORT`.
+    pub base: String,
+    /// HTTP client.
+    pub client: Client,
+    /// The database file.
+    pub database: PathBuf,
+    /// The configuration it was started with.
+    pub config: Config,
+    directory: tempfile::TempDir,
+    stop: Option<oneshot::Sender<()>>,
+    task: Option<JoinHandle<std::io::Result<()>>>,
+}
+
+impl TestApp {
+    /// Starts a service with default limits.
+    pub async fn spawn() -> Self {
+        Self::spawn_with(Limits::default()).await
+    }
+
+    /// Starts a service with `limits`.
+    pub async fn spawn_with(limits: Limits) -> Self {
+        let directory = tempfile::tempdir().expect("temporary directory");
+        let database = directory.path().join("kerf.db");
+        let config = Config { database: database.clone(), limits, solver_slots: 2 };
+        let mut app = Self {
+            base: String::new(),
+            client: Client::builder().timeout(Duration::from_secs(60)).build().expect("client"),
+            database,
+            config,
+            directory,
+            stop: None,
+            task: None,
+        };
+        app.start().await;
+        app
+    }
+
+    async fn start(&mut self) {
+        let (router, _state) = kerf_server::app::build(&self.config).await.expect("service builds");
+        let listener = TcpListener::bind("127.0.0.1:0").await.expect("bind");
+        self.base = format!("http://{}", listener.local_addr().expect("address"));
+        let (stop, stopped) = oneshot::channel::<()>();
+        self.stop = Some(stop);
+        self.task = Some(tokio::spawn(kerf_server::serve(listener, router, async {
+            let _ = stopped.await;
+        })));
+    }
+
+    /// Stops the service gracefully and starts it again on the same database file.
+    pub async fn restart(&mut self) {
+        self.shutdown().await;
+        self.start().await;
+    }
+
+    /// Stops the service and waits for it.
+    pub async fn shutdown(&mut self) {
+        if let Some(stop) = self.stop.take() {
+            let _ = stop.send(());
+        }
+        if let Some(task) = self.task.take() {
+            task.await.expect("server task").expect("server ran");
+        }
+    }
+
+    /// The temporary directory (for files a test writes).
+    pub fn directory(&self) -> &Path {
+        self.directory.path()
+    }
+
+    /// `base` + `path`.
+    pub fn url(&self, path: &str) -> String {
+        format!("{}{path}", self.base)
+    }
+
+    /// GET.
+    pub async fn get(&self, path: &str) -> Response {
+        self.client.get(self.url(path)).send().await.expect("request")
+    }
+
+    /// POST a JSON value.
+    pub async fn post_json(&self, path: &str, body: &Value) -> Response {
+        self.client.post(self.url(path)).json(body).send().await.expect("request")
+    }
+
+    /// PUT a JSON value.
+    pub async fn put_json(&self, path: &str, body: &Value) -> Response {
+        self.client.put(self.url(path)).json(body).send().await.expect("request")
+    }
+
+    /// DELETE.
+    pub async fn delete(&self, path: &str) -> Response {
+        self.client.delete(self.url(path)).send().await.expect("request")
+    }
+
+    /// Registers `tool` under `number`, expecting success.
+    pub async fn register_tool(&self, number: u32, tool: &Value) {
+        let response = self.put_json(&format!("/api/v1/tools/{number}"), tool).await;
+        assert!(response.status().is_success(), "registering tool {number}: {}", response.status());
+    }
+}
+
+/// Reads the body as JSON, asserting the status first.
+pub async fn json_with(response: Response, status: u16) -> Value {
+    let actual = response.status().as_u16();
+    let text = response.text().await.expect("body");
+    assert_eq!(actual, status, "unexpected status; body: {text}");
+    serde_json::from_str(&text).unwrap_or_else(|error| panic!("not JSON ({error}): {text}"))
+}
+
+/// Asserts a problem+json answer with `status` and returns it.
+pub async fn problem(response: Response, status: u16) -> Value {
+    let content_type =
+        response.headers().get("content-type").and_then(|v| v.to_str().ok()).unwrap_or_default().to_owned();
+    let body = json_with(response, status).await;
+    assert_eq!(content_type, "application/problem+json", "problem content type; body: {body}");
+    assert_eq!(body["status"], status, "problem status field: {body}");
+    assert!(body["detail"].as_str().is_some_and(|d| !d.is_empty()), "problem detail: {body}");
+    body
+}
+
+/// Whether external programs are required (`KERF_REQUIRE_EXTERNAL=1`, set by `.ci/run`).
+pub fn external_required() -> bool {
+    std::env::var("KERF_REQUIRE_EXTERNAL").is_ok_and(|v| v == "1")
+}
+
+/// Finds `program` on the PATH. When it is missing, prints why the calling test skips and
+/// returns `None` — or panics when external programs are required.
+pub fn external_program(program: &str, purpose: &str) -> Option<PathBuf> {
+    let found = std::env::var_os("PATH")
+        .and_then(|paths| std::env::split_paths(&paths).map(|dir| dir.join(program)).find(|path| path.is_file()));
+    if found.is_none() {
+        let message = format!("{program} not found on PATH: skipping {purpose}");
+        assert!(!external_required(), "{message}, but KERF_REQUIRE_EXTERNAL=1");
+        eprintln!("SKIP: {message}");
+    }
+    found
+}

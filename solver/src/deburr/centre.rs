@@ -48,19 +48,13 @@ impl RidgeCentre {
         let leg = half_width / (0.5 * self.wedge_angle).sin();
         let along_cylinder = (self.wall_normal - cos_wedge * self.cylinder_normal).normalize();
         let along_wall = (self.cylinder_normal - cos_wedge * self.wall_normal).normalize();
-        (
-            self.target + leg * along_cylinder,
-            self.target + leg * along_wall,
-        )
+        (self.target + leg * along_cylinder, self.target + leg * along_wall)
     }
 
     /// Unit vectors spanning the normal plane VP: the wall normal m2 and the wall tangent d3.
     fn plane_basis(&self) -> (Vec3, Vec3) {
         let cos_wedge = self.cylinder_normal.dot(&self.wall_normal);
-        (
-            self.wall_normal,
-            (self.cylinder_normal - cos_wedge * self.wall_normal).normalize(),
-        )
+        (self.wall_normal, (self.cylinder_normal - cos_wedge * self.wall_normal).normalize())
     }
 }
 
@@ -133,11 +127,7 @@ impl Construction {
         let (b1, b2) = plane;
         let at = |angle: f64| centre + radius * (angle.cos() * b1 + angle.sin() * b2);
         let surface = |q: Vec3| {
-            if on_wall {
-                profile.signed_distance(q.x, q.y).0
-            } else {
-                self.cylinder(&q)
-            }
+            if on_wall { profile.signed_distance(q.x, q.y).0 } else { self.cylinder(&q) }
         };
         let start = near.dot(&b2).atan2(near.dot(&b1));
         // Newton from the tangent-line estimate converges in a few steps; the bracketing search
@@ -175,10 +165,8 @@ impl Construction {
         let (g1, g2) = ridge.band_edges(self.half_width);
         let plane = ridge.plane_basis();
         let c = ridge.centre;
-        let on_cylinder =
-            self.circle_meets_surface(profile, plane, &c, self.ball_radius, &(g1 - c), false)?;
-        let on_wall =
-            self.circle_meets_surface(profile, plane, &c, self.ball_radius, &(g2 - c), true)?;
+        let on_cylinder = self.circle_meets_surface(profile, plane, &c, self.ball_radius, &(g1 - c), false)?;
+        let on_wall = self.circle_meets_surface(profile, plane, &c, self.ball_radius, &(g2 - c), true)?;
         Some((on_cylinder - on_wall).norm())
     }
 
@@ -191,16 +179,11 @@ impl Construction {
         let p = ridge.target;
         let (tangent_g1, tangent_g2) = ridge.band_edges(self.half_width);
         let edges = |leg: f64| -> Option<(Vec3, Vec3)> {
-            let g1 =
-                self.circle_meets_surface(profile, plane, &p, leg, &(tangent_g1 - p), false)?;
+            let g1 = self.circle_meets_surface(profile, plane, &p, leg, &(tangent_g1 - p), false)?;
             let g2 = self.circle_meets_surface(profile, plane, &p, leg, &(tangent_g2 - p), true)?;
             Some((g1, g2))
         };
-        let width_error = |leg: f64| {
-            edges(leg).map_or(f64::NAN, |(g1, g2)| {
-                (g1 - g2).norm() - 2.0 * self.half_width
-            })
-        };
+        let width_error = |leg: f64| edges(leg).map_or(f64::NAN, |(g1, g2)| (g1 - g2).norm() - 2.0 * self.half_width);
         let tangent_leg = (tangent_g1 - p).norm();
         // Secant steps from the tangent-line leg, which is within a few per cent of the answer.
         let (mut leg_a, mut leg_b) = (tangent_leg, tangent_leg * 1.01);
@@ -223,13 +206,7 @@ impl Construction {
             }
         }
         if !leg.is_finite() {
-            leg = root_near(
-                width_error,
-                tangent_leg,
-                tangent_leg * 1e-3,
-                tangent_leg * 0.9,
-                1e-15,
-            )?;
+            leg = root_near(width_error, tangent_leg, tangent_leg * 1e-3, tangent_leg * 0.9, 1e-15)?;
         }
         let (g1, g2) = edges(leg)?;
         let midpoint = 0.5 * (g1 + g2);
@@ -262,17 +239,9 @@ mod tests {
     fn hand_check_at_phi_zero() {
         let (construction, profile) = case1();
         let ridge = construction.tangent(&profile.segments[0].point(10.0, 0.0));
-        assert_abs_diff_eq!(
-            ridge.wedge_angle.to_degrees(),
-            78.463_040_967,
-            epsilon = 1e-8
-        );
+        assert_abs_diff_eq!(ridge.wedge_angle.to_degrees(), 78.463_040_967, epsilon = 1e-8);
         assert_abs_diff_eq!(ridge.centre_offset, 2.546_081_12, epsilon = 1e-8);
-        assert_abs_diff_eq!(
-            ridge.centre,
-            Vec3::new(8.389_716_911, 0.0, 50.961_980_811),
-            epsilon = 1e-8
-        );
+        assert_abs_diff_eq!(ridge.centre, Vec3::new(8.389_716_911, 0.0, 50.961_980_811), epsilon = 1e-8);
     }
 
     #[test]
@@ -284,16 +253,8 @@ mod tests {
             let (centre, g1, g2) = construction.exact(&profile, &ridge).unwrap();
             assert_abs_diff_eq!(construction.cylinder(&g1), 0.0, epsilon = 1e-10);
             assert_abs_diff_eq!(profile.signed_distance(g2.x, g2.y).0, 0.0, epsilon = 1e-10);
-            assert_abs_diff_eq!(
-                (g1 - g2).norm(),
-                2.0 * construction.half_width,
-                epsilon = 1e-10
-            );
-            assert_abs_diff_eq!(
-                (g1 - ridge.target).norm(),
-                (g2 - ridge.target).norm(),
-                epsilon = 1e-10
-            );
+            assert_abs_diff_eq!((g1 - g2).norm(), 2.0 * construction.half_width, epsilon = 1e-10);
+            assert_abs_diff_eq!((g1 - ridge.target).norm(), (g2 - ridge.target).norm(), epsilon = 1e-10);
             assert_abs_diff_eq!((centre - g1).norm(), 3.0, epsilon = 1e-10);
             assert_abs_diff_eq!((centre - g2).norm(), 3.0, epsilon = 1e-10);
             let tangent = ridge.cylinder_normal.cross(&ridge.wall_normal).normalize();

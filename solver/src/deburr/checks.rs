@@ -16,6 +16,13 @@ const MAX_RIDGE_SAMPLES: usize = 20_000;
 pub(crate) fn ridge(job: &Job) -> Result<Vec<Warning>, SolverError> {
     let reach = job.profile.max_abs_x();
     let r1 = job.cylinder_radius;
+    if reach >= r1 {
+        return Err(SolverError::new(
+            "E_HOLE_TOO_LARGE",
+            format!("hole too large: |eccentricity| + half-width = {reach} must be below the cylinder radius {r1}"),
+        )
+        .at("hole.radius"));
+    }
     if let Some((inner, _)) = job.tube_radii
         && job.edge == Edge::Outer
         && reach >= inner
@@ -26,13 +33,6 @@ pub(crate) fn ridge(job: &Job) -> Result<Vec<Warning>, SolverError> {
                 "the hole reaches |x| = {reach} across the tube, not below the inner radius {inner}: it does not \
                  meet the bore as a separate loop"
             ),
-        )
-        .at("hole.radius"));
-    }
-    if reach >= r1 {
-        return Err(SolverError::new(
-            "E_HOLE_TOO_LARGE",
-            format!("hole too large: |eccentricity| + half-width = {reach} must be below the cylinder radius {r1}"),
         )
         .at("hole.radius"));
     }
@@ -53,7 +53,9 @@ pub(crate) fn ridge(job: &Job) -> Result<Vec<Warning>, SolverError> {
     if lowest < 0.05 * r1 {
         warnings.push(Warning::new(
             "W_NEAR_TANGENT",
-            format!("the ridge comes down to {lowest:.4} mm from the axis plane (< 5 % of R1): the edge is nearly tangent"),
+            format!(
+                "the ridge comes down to {lowest:.4} mm from the axis plane (< 5 % of R1): the edge is nearly tangent"
+            ),
         ));
     }
     Ok(warnings)
@@ -73,11 +75,7 @@ const CHUNK: usize = 16;
 impl RidgeSamples {
     fn new(profile: &Profile, cylinder_radius: f64, ball_radius: f64) -> Self {
         let spacing = profile.radius.min(ball_radius) / 8.0;
-        let lengths: Vec<f64> = profile
-            .segments
-            .iter()
-            .map(|s| s.length(profile.radius))
-            .collect();
+        let lengths: Vec<f64> = profile.segments.iter().map(|s| s.length(profile.radius)).collect();
         let total: f64 = lengths.iter().sum();
         let scale = (total / spacing / MAX_RIDGE_SAMPLES as f64).max(1.0);
         let mut points = Vec::new();
@@ -87,11 +85,7 @@ impl RidgeSamples {
             segments.push((points.len(), count));
             for j in 0..count {
                 let p = segment.point(profile.radius, j as f64 / count as f64);
-                points.push(Vec3::new(
-                    p.x,
-                    p.y,
-                    (cylinder_radius * cylinder_radius - p.x * p.x).sqrt(),
-                ));
+                points.push(Vec3::new(p.x, p.y, (cylinder_radius * cylinder_radius - p.x * p.x).sqrt()));
             }
         }
         let chunks = points
@@ -99,18 +93,11 @@ impl RidgeSamples {
             .enumerate()
             .map(|(index, chunk)| {
                 let centre = chunk.iter().sum::<Vec3>() / chunk.len() as f64;
-                let radius = chunk
-                    .iter()
-                    .map(|p| (p - centre).norm())
-                    .fold(0.0, f64::max);
+                let radius = chunk.iter().map(|p| (p - centre).norm()).fold(0.0, f64::max);
                 (centre, radius, index * CHUNK)
             })
             .collect();
-        Self {
-            points,
-            segments,
-            chunks,
-        }
+        Self { points, segments, chunks }
     }
 
     fn nearest_index(&self, target: &Target) -> usize {
@@ -121,11 +108,7 @@ impl RidgeSamples {
 
 /// E_FAR_GOUGE (deburr.md §4): for every centre, the ridge samples inside the ball must form
 /// one run around its own target and must not be the whole ridge.
-pub(crate) fn far_gouge(
-    job: &Job,
-    targets: &[Target],
-    centres: &[Vec3],
-) -> Result<(), SolverError> {
+pub(crate) fn far_gouge(job: &Job, targets: &[Target], centres: &[Vec3]) -> Result<(), SolverError> {
     let ball = job.tool.radius;
     let samples = RidgeSamples::new(&job.profile, job.cylinder_radius, ball);
     let total = samples.points.len();
@@ -138,24 +121,15 @@ pub(crate) fn far_gouge(
             while ahead + 1 < total && inside(centre, (home + ahead + 1) % total) {
                 ahead += 1;
             }
-            while ahead + behind + 1 < total && inside(centre, (home + total - behind - 1) % total)
-            {
+            while ahead + behind + 1 < total && inside(centre, (home + total - behind - 1) % total) {
                 behind += 1;
             }
             if ahead + behind + 1 == total {
-                return Err(far_gouge_error(
-                    job,
-                    target,
-                    "the ball contains the whole ridge",
-                ));
+                return Err(far_gouge_error(job, target, "the ball contains the whole ridge"));
             }
         }
         let run_start = (home + total - behind) % total;
-        let run_length = if inside(centre, home) {
-            ahead + behind + 1
-        } else {
-            0
-        };
+        let run_length = if inside(centre, home) { ahead + behind + 1 } else { 0 };
         for &(chunk_centre, chunk_radius, first) in &samples.chunks {
             if (chunk_centre - centre).norm() - chunk_radius >= ball {
                 continue;
@@ -163,11 +137,7 @@ pub(crate) fn far_gouge(
             for k in first..(first + CHUNK).min(total) {
                 let in_run = (k + total - run_start) % total < run_length;
                 if !in_run && inside(centre, k) {
-                    return Err(far_gouge_error(
-                        job,
-                        target,
-                        "the ball also reaches another part of the ridge",
-                    ));
+                    return Err(far_gouge_error(job, target, "the ball also reaches another part of the ridge"));
                 }
             }
         }
@@ -235,10 +205,7 @@ pub(crate) fn inner_access(
     if tightest < 0.0 {
         let error = SolverError::new(
             "E_NECK_COLLISION",
-            format!(
-                "the neck (radius {neck}) would cut the hole wall: it is short of room by {:.4} mm",
-                -tightest
-            ),
+            format!("the neck (radius {neck}) would cut the hole wall: it is short of room by {:.4} mm", -tightest),
         )
         .at("tool.neck_radius");
         return (warnings, Some(approach.unwrap_or(error)));
@@ -247,11 +214,7 @@ pub(crate) fn inner_access(
 }
 
 /// W_OVERLAP: on a tube, whether the same chamfer on the other edge would meet this one.
-pub(crate) fn overlap(
-    job: &Job,
-    construction: &Construction,
-    ridges: &[RidgeCentre],
-) -> Option<Warning> {
+pub(crate) fn overlap(job: &Job, construction: &Construction, ridges: &[RidgeCentre]) -> Option<Warning> {
     let (inner, outer) = job.tube_radii?;
     let mut worst: Option<(f64, f64)> = None;
     for ridge in ridges {

@@ -24,12 +24,8 @@ impl Frame {
         axis_point: Option<Vec3>,
         eccentricity: Option<f64>,
     ) -> Result<(Self, f64), SolverError> {
-        let rotation =
-            rotation_z(arrangement_deg.to_radians()) * rotation_y(penetration_deg.to_radians());
-        let mut frame = Self {
-            origin: origin_on_axis,
-            rotation,
-        };
+        let rotation = rotation_z(arrangement_deg.to_radians()) * rotation_y(penetration_deg.to_radians());
+        let mut frame = Self { origin: origin_on_axis, rotation };
         let Some(hole_point) = axis_point else {
             return Ok((frame, eccentricity.unwrap_or(0.0)));
         };
@@ -72,14 +68,9 @@ mod tests {
 
     #[test]
     fn axes_match_case_2() {
-        let (frame, f) =
-            Frame::resolve(Vec3::new(100.0, 50.0, -20.0), 30.0, 15.0, None, Some(12.0)).unwrap();
+        let (frame, f) = Frame::resolve(Vec3::new(100.0, 50.0, -20.0), 30.0, 15.0, None, Some(12.0)).unwrap();
         assert_abs_diff_eq!(f, 12.0);
-        assert_abs_diff_eq!(
-            frame.vector(&Vec3::y()),
-            Vec3::new(-0.5, 0.866_025_404, 0.0),
-            epsilon = 1e-9
-        );
+        assert_abs_diff_eq!(frame.vector(&Vec3::y()), Vec3::new(-0.5, 0.866_025_404, 0.0), epsilon = 1e-9);
         assert_abs_diff_eq!(
             frame.vector(&Vec3::z()),
             Vec3::new(0.224_143_868, 0.129_409_523, 0.965_925_826),
@@ -99,11 +90,7 @@ mod tests {
         let hole_point = frame.point(&Vec3::new(4.0, 7.0, 20.0));
         let (moved, f) = Frame::resolve(origin, 30.0, 15.0, Some(hole_point), None).unwrap();
         assert_abs_diff_eq!(f, 4.0, epsilon = 1e-12);
-        assert_abs_diff_eq!(
-            moved.origin,
-            frame.point(&Vec3::new(0.0, 7.0, 0.0)),
-            epsilon = 1e-12
-        );
+        assert_abs_diff_eq!(moved.origin, frame.point(&Vec3::new(0.0, 7.0, 0.0)), epsilon = 1e-12);
         assert!(Frame::resolve(origin, 30.0, 15.0, Some(hole_point), Some(4.0)).is_ok());
         let error = Frame::resolve(origin, 30.0, 15.0, Some(hole_point), Some(3.0)).unwrap_err();
         assert_eq!(error.code(), "E_INCONSISTENT_ECC");

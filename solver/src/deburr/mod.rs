@@ -25,9 +25,7 @@ mod tolerance;
 
 pub use answer::{Deburr, DeburrPoint, DeburrSummary, LeadMotion, LeadMove};
 pub use program::{Post, program};
-pub use request::{
-    CentreDistance, DeburrRequest, Direction, Edge, Hole, HoleShape, Method, Workpiece,
-};
+pub use request::{CentreDistance, DeburrRequest, Direction, Edge, Hole, HoleShape, Method, Workpiece};
 
 use centre::{Construction, RidgeCentre};
 use tolerance::Target;
@@ -81,16 +79,17 @@ pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError
     let mut exact_offset: Option<f64> = None;
     for target in &targets {
         let point = profile.segments[target.segment].point(profile.radius, target.parameter);
-        let ridge = construction.tangent(&point);
+        let mut ridge = construction.tangent(&point);
         let centre = match job.method {
             Method::Tangent => ridge.centre,
             Method::Exact => {
                 let centre = exact_centre(target.segment, target.parameter, &ridge)?;
-                exact_offset = Some(
-                    exact_offset
-                        .unwrap_or(0.0)
-                        .max((centre - ridge.centre).norm()),
-                );
+                exact_offset = Some(exact_offset.unwrap_or(0.0).max((centre - ridge.centre).norm()));
+                // CL of the exact centre: its distance from P, signed as for the seed (positive
+                // when C is on the air side).
+                let from_target = ridge.target - centre;
+                ridge.centre_offset = from_target.norm().copysign(from_target.dot(&ridge.bisector));
+                ridge.centre = centre;
                 centre
             }
         };
@@ -114,8 +113,7 @@ pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError
     };
     checks::far_gouge(&job, &targets, &centres)?;
     let shank_direction = job.frame.local_vector(&Vec3::z());
-    let (access_warnings, mut program_blocker) =
-        checks::inner_access(&job, &ridges, &shank_direction);
+    let (access_warnings, mut program_blocker) = checks::inner_access(&job, &ridges, &shank_direction);
     warnings.extend(access_warnings);
     warnings.extend(checks::overlap(&job, &construction, &ridges));
 
@@ -145,29 +143,18 @@ pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError
             }
         })
         .collect();
-    let path_length: f64 = centres
-        .windows(2)
-        .map(|pair| (pair[1] - pair[0]).norm())
-        .sum();
+    let path_length: f64 = centres.windows(2).map(|pair| (pair[1] - pair[0]).norm()).sum();
 
     let safe_centre_z = program::safe_centre_z(&job, frame);
     let (lead_in, lead_out) = match &safe_centre_z {
-        Ok(z) => program::leads(
-            &job,
-            frame.point(&centres[0]),
-            frame.vector(&ridges[0].bisector),
-            *z,
-        ),
+        Ok(z) => program::leads(&job, frame.point(&centres[0]), frame.vector(&ridges[0].bisector), *z),
         Err(_) => (Vec::new(), Vec::new()),
     };
     if program_blocker.is_none() {
         program_blocker = safe_centre_z.as_ref().err().cloned();
     }
     if let Some(blocker) = &program_blocker {
-        warnings.push(Warning::new(
-            "W_NO_PROGRAM",
-            format!("no G-code can be written: {}", blocker.message()),
-        ));
+        warnings.push(Warning::new("W_NO_PROGRAM", format!("no G-code can be written: {}", blocker.message())));
     }
     let lead_feed_length: f64 = lead_feed_length(&lead_in, frame.point(&centres[0]))
         + lead_feed_length(&lead_out, frame.point(&centres[centres.len() - 1]));
@@ -242,16 +229,10 @@ pub fn construction_at(
     checks::ridge(&job)?;
     let profile = &job.profile;
     let Some(piece) = profile.segments.iter().find(|s| s.name == segment) else {
-        return Err(SolverError::input(
-            "segment",
-            format!("this hole has no segment {segment}"),
-        ));
+        return Err(SolverError::input("segment", format!("this hole has no segment {segment}")));
     };
     if !(0.0..=1.0).contains(&parameter) {
-        return Err(SolverError::input(
-            "parameter",
-            "parameter must be in [0, 1]",
-        ));
+        return Err(SolverError::input("parameter", "parameter must be in [0, 1]"));
     }
     let construction = Construction::for_job(&job);
     let ridge = construction.tangent(&piece.point(profile.radius, parameter));
@@ -284,11 +265,7 @@ fn lead_feed_length(moves: &[LeadMove], start: Vec3) -> f64 {
 }
 
 /// Per-point limits: E_BALL_MISSES_EDGE, W_CENTRE_IN_MATERIAL, W_SHARP_EDGE (§4).
-fn point_checks(
-    job: &Job,
-    targets: &[Target],
-    ridges: &[RidgeCentre],
-) -> Result<Vec<Warning>, SolverError> {
+fn point_checks(job: &Job, targets: &[Target], ridges: &[RidgeCentre]) -> Result<Vec<Warning>, SolverError> {
     let ball = job.tool.radius;
     let mut in_material = 0;
     let mut deepest = 0.0_f64;
@@ -388,21 +365,10 @@ fn describe(request: &DeburrRequest, job: &Job, summary: &DeburrSummary) -> Vec<
         Edge::Inner => "inner",
     };
     let part = match &request.workpiece {
-        Workpiece::Tube {
-            inner_radius,
-            outer_radius,
-            arrangement_angle_deg,
-            ..
-        } => {
-            format!(
-                "tube RN {inner_radius} RT {outer_radius} arrangement {arrangement_angle_deg} deg"
-            )
+        Workpiece::Tube { inner_radius, outer_radius, arrangement_angle_deg, .. } => {
+            format!("tube RN {inner_radius} RT {outer_radius} arrangement {arrangement_angle_deg} deg")
         }
-        Workpiece::BoreBlock {
-            bore_radius,
-            arrangement_angle_deg,
-            ..
-        } => {
+        Workpiece::BoreBlock { bore_radius, arrangement_angle_deg, .. } => {
             format!("bore block R {bore_radius} arrangement {arrangement_angle_deg} deg")
         }
     };

@@ -18,18 +18,9 @@ pub(crate) struct ProfilePoint {
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum Piece {
     /// Part of a circle of radius R2 around `(centre_x, centre_y)`, φ from `phi_start` to `phi_end`.
-    Arc {
-        centre_x: f64,
-        centre_y: f64,
-        phi_start: f64,
-        phi_end: f64,
-    },
+    Arc { centre_x: f64, centre_y: f64, phi_start: f64, phi_end: f64 },
     /// Straight side from `start` to `end` with outward normal `normal`.
-    Line {
-        start: (f64, f64),
-        end: (f64, f64),
-        normal: (f64, f64),
-    },
+    Line { start: (f64, f64), end: (f64, f64), normal: (f64, f64) },
 }
 
 /// A named piece of the profile (names as in deburr.md §2.8, lower case).
@@ -43,12 +34,7 @@ impl Segment {
     /// The profile point at parameter `s` ∈ [0, 1].
     pub fn point(&self, radius: f64, s: f64) -> ProfilePoint {
         match self.piece {
-            Piece::Arc {
-                centre_x,
-                centre_y,
-                phi_start,
-                phi_end,
-            } => {
+            Piece::Arc { centre_x, centre_y, phi_start, phi_end } => {
                 let phi = phi_start + s * (phi_end - phi_start);
                 let (sin, cos) = phi.sin_cos();
                 ProfilePoint {
@@ -73,13 +59,9 @@ impl Segment {
     /// ⌈sweep/90°⌉ for arcs, 1 for lines.
     pub fn initial_intervals(&self) -> u32 {
         match self.piece {
-            Piece::Arc {
-                phi_start, phi_end, ..
-            } => {
+            Piece::Arc { phi_start, phi_end, .. } => {
                 // At most 4 quarter turns; the small slack keeps an exact quarter at 1.
-                ((phi_end - phi_start).abs() / FRAC_PI_2 - 1e-9)
-                    .ceil()
-                    .max(1.0) as u32
+                ((phi_end - phi_start).abs() / FRAC_PI_2 - 1e-9).ceil().max(1.0) as u32
             }
             Piece::Line { .. } => 1,
         }
@@ -93,9 +75,7 @@ impl Segment {
     /// Length of the piece on a profile of corner radius `radius`.
     pub fn length(&self, radius: f64) -> f64 {
         match self.piece {
-            Piece::Arc {
-                phi_start, phi_end, ..
-            } => radius * (phi_end - phi_start).abs(),
+            Piece::Arc { phi_start, phi_end, .. } => radius * (phi_end - phi_start).abs(),
             Piece::Line { start, end, .. } => (end.0 - start.0).hypot(end.1 - start.1),
         }
     }
@@ -118,55 +98,28 @@ pub(crate) struct Profile {
 impl Profile {
     /// A round hole, starting at `start` (radians from +x_L) and running counter-clockwise.
     pub fn round(radius: f64, centre_x: f64, start: f64) -> Self {
-        let arc = Piece::Arc {
-            centre_x,
-            centre_y: 0.0,
-            phi_start: start,
-            phi_end: start + TAU,
-        };
+        let arc = Piece::Arc { centre_x, centre_y: 0.0, phi_start: start, phi_end: start + TAU };
         Self {
             radius,
             centre_x,
             half_across: 0.0,
             half_along: 0.0,
-            segments: vec![Segment {
-                name: "arc",
-                piece: arc,
-            }],
+            segments: vec![Segment { name: "arc", piece: arc }],
         }
     }
 
     /// A rounded rectangle with corner centres at (f ± a, ± b); a = 0 gives a slot along A1 and
     /// a = b = 0 a round hole split into half circles. Zero-length sides are left out.
-    pub fn rounded_rect(
-        radius: f64,
-        centre_x: f64,
-        half_across: f64,
-        half_along: f64,
-        slot_names: bool,
-    ) -> Self {
+    pub fn rounded_rect(radius: f64, centre_x: f64, half_across: f64, half_along: f64, slot_names: bool) -> Self {
         let (f, a, b, r) = (centre_x, half_across, half_along, radius);
         let arc = |name, cx: f64, cy: f64, from: f64, to: f64| Segment {
             name,
-            piece: Piece::Arc {
-                centre_x: cx,
-                centre_y: cy,
-                phi_start: from,
-                phi_end: to,
-            },
+            piece: Piece::Arc { centre_x: cx, centre_y: cy, phi_start: from, phi_end: to },
         };
-        let line = |name, start, end, normal| Segment {
-            name,
-            piece: Piece::Line { start, end, normal },
-        };
+        let line = |name, start, end, normal| Segment { name, piece: Piece::Line { start, end, normal } };
         let mut segments = Vec::with_capacity(8);
         if b > 0.0 {
-            segments.push(line(
-                "line_y+x",
-                (f + a + r, -b),
-                (f + a + r, b),
-                (1.0, 0.0),
-            ));
+            segments.push(line("line_y+x", (f + a + r, -b), (f + a + r, b), (1.0, 0.0)));
         }
         if slot_names {
             segments.push(arc("arc_cs2", f, b, 0.0, PI));
@@ -178,34 +131,18 @@ impl Profile {
             segments.push(arc("arc_q2", f - a, b, FRAC_PI_2, PI));
         }
         if b > 0.0 {
-            segments.push(line(
-                "line_y-x",
-                (f - a - r, b),
-                (f - a - r, -b),
-                (-1.0, 0.0),
-            ));
+            segments.push(line("line_y-x", (f - a - r, b), (f - a - r, -b), (-1.0, 0.0)));
         }
         if slot_names {
             segments.push(arc("arc_cs1", f, -b, PI, TAU));
         } else {
             segments.push(arc("arc_q3", f - a, -b, PI, 1.5 * PI));
             if a > 0.0 {
-                segments.push(line(
-                    "line_x-y",
-                    (f - a, -b - r),
-                    (f + a, -b - r),
-                    (0.0, -1.0),
-                ));
+                segments.push(line("line_x-y", (f - a, -b - r), (f + a, -b - r), (0.0, -1.0)));
             }
             segments.push(arc("arc_q4", f + a, -b, 1.5 * PI, TAU));
         }
-        Self {
-            radius,
-            centre_x,
-            half_across,
-            half_along,
-            segments,
-        }
+        Self { radius, centre_x, half_across, half_along, segments }
     }
 
     /// Largest |x| over the profile: the ridge exists only while this stays below R1 (§4).
@@ -264,13 +201,7 @@ mod tests {
     fn segments_join_end_to_start_and_close() {
         let profile = Profile::rounded_rect(4.0, 5.0, 10.0, 15.0, false);
         let names: Vec<_> = profile.segments.iter().map(|s| s.name).collect();
-        assert_eq!(
-            names,
-            [
-                "line_y+x", "arc_q1", "line_x+y", "arc_q2", "line_y-x", "arc_q3", "line_x-y",
-                "arc_q4"
-            ]
-        );
+        assert_eq!(names, ["line_y+x", "arc_q1", "line_x+y", "arc_q2", "line_y-x", "arc_q3", "line_x-y", "arc_q4"]);
         let count = profile.segments.len();
         for (i, segment) in profile.segments.iter().enumerate() {
             let end = segment.point(4.0, 1.0);
@@ -281,10 +212,7 @@ mod tests {
         assert_eq!(profile.segments[1].initial_intervals(), 1);
         assert!(profile.segments[0].is_axial_line());
         assert!(!profile.segments[2].is_axial_line());
-        assert_eq!(
-            Profile::round(1.0, 0.0, 0.0).segments[0].initial_intervals(),
-            4
-        );
+        assert_eq!(Profile::round(1.0, 0.0, 0.0).segments[0].initial_intervals(), 4);
     }
 
     #[test]

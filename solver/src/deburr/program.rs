@@ -46,11 +46,7 @@ pub(crate) fn safe_centre_z(job: &Job, frame: &Frame) -> Result<f64, SolverError
 }
 
 fn lead(motion: LeadMotion, centre: Vec3, ball_radius: f64) -> LeadMove {
-    LeadMove {
-        motion,
-        centre: array3(&centre),
-        tip: array3(&(centre - ball_radius * Vec3::z())),
-    }
+    LeadMove { motion, centre: array3(&centre), tip: array3(&(centre - ball_radius * Vec3::z())) }
 }
 
 /// The approach to the first centre and the way out from it, in machine coordinates.
@@ -71,17 +67,13 @@ pub(crate) fn leads(
                     lead(LeadMotion::Feed, lead_point, ball),
                     lead(LeadMotion::Feed, first_centre, ball),
                 ],
-                vec![
-                    lead(LeadMotion::Feed, lead_point, ball),
-                    lead(LeadMotion::Rapid, above(lead_point), ball),
-                ],
+                vec![lead(LeadMotion::Feed, lead_point, ball), lead(LeadMotion::Rapid, above(lead_point), ball)],
             )
         }
         Edge::Inner => {
             let local_first = job.frame.rotation.transpose() * (first_centre - job.frame.origin);
             let axis_x = job.profile.centre_x;
-            let entry_height =
-                job.top_distance.unwrap_or(job.cylinder_radius) + job.clearance + ball;
+            let entry_height = job.top_distance.unwrap_or(job.cylinder_radius) + job.clearance + ball;
             let over_hole = job.frame.point(&Vec3::new(axis_x, 0.0, entry_height));
             let on_axis = job.frame.point(&Vec3::new(axis_x, 0.0, local_first.z));
             let mut lead_in = vec![lead(LeadMotion::Rapid, above(over_hole), ball)];
@@ -127,11 +119,7 @@ pub fn program(deburr: &Deburr, post: &Post) -> Result<String, SolverError> {
         add(step.motion, step.centre);
     }
     let safe_centre_z = deburr.summary.safe_centre_z.ok_or_else(|| {
-        SolverError::new(
-            "E_NO_CLEARANCE_PLANE",
-            "the clearance plane is unknown; give safe_z",
-        )
-        .at("safe_z")
+        SolverError::new("E_NO_CLEARANCE_PLANE", "the clearance plane is unknown; give safe_z").at("safe_z")
     })?;
     let mut comments = deburr.description.clone();
     comments.push(format!(

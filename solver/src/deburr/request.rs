@@ -231,21 +231,12 @@ impl DeburrRequest {
         if tool.kind != ToolKind::Ball {
             return Err(SolverError::new(
                 "E_TOOL_KIND",
-                format!(
-                    "deburring needs a ball end mill, but the tool is {}",
-                    tool.kind.as_str()
-                ),
+                format!("deburring needs a ball end mill, but the tool is {}", tool.kind.as_str()),
             )
             .at("tool"));
         }
-        let (origin, arrangement, cylinder_radius, tube_radii, top_distance) = match &self.workpiece
-        {
-            Workpiece::Tube {
-                origin,
-                arrangement_angle_deg,
-                inner_radius,
-                outer_radius,
-            } => {
+        let (origin, arrangement, cylinder_radius, tube_radii, top_distance) = match &self.workpiece {
+            Workpiece::Tube { origin, arrangement_angle_deg, inner_radius, outer_radius } => {
                 let inner = positive("workpiece.inner_radius", *inner_radius)?;
                 let outer = positive("workpiece.outer_radius", *outer_radius)?;
                 if inner >= outer {
@@ -255,31 +246,13 @@ impl DeburrRequest {
                     )
                     .at("workpiece.inner_radius"));
                 }
-                let r1 = if self.edge == Edge::Inner {
-                    inner
-                } else {
-                    outer
-                };
-                (
-                    origin,
-                    arrangement_angle_deg,
-                    r1,
-                    Some((inner, outer)),
-                    Some(outer),
-                )
+                let r1 = if self.edge == Edge::Inner { inner } else { outer };
+                (origin, arrangement_angle_deg, r1, Some((inner, outer)), Some(outer))
             }
-            Workpiece::BoreBlock {
-                origin,
-                arrangement_angle_deg,
-                bore_radius,
-                face_distance,
-            } => {
+            Workpiece::BoreBlock { origin, arrangement_angle_deg, bore_radius, face_distance } => {
                 let bore = positive("workpiece.bore_radius", *bore_radius)?;
                 if self.edge != Edge::Inner {
-                    return Err(SolverError::input(
-                        "edge",
-                        "a bore_block has only an inner edge (edge: \"inner\")",
-                    ));
+                    return Err(SolverError::input("edge", "a bore_block has only an inner edge (edge: \"inner\")"));
                 }
                 if let Some(face) = face_distance {
                     positive("workpiece.face_distance", *face)?;
@@ -301,22 +274,11 @@ impl DeburrRequest {
         let penetration = finite("hole.penetration_angle_deg", hole.penetration_angle_deg)?;
         let start = finite("start_deg", self.start_deg)?;
         if start != 0.0 && hole.shape != HoleShape::Round {
-            return Err(SolverError::input(
-                "start_deg",
-                "start_deg applies only to round holes",
-            ));
+            return Err(SolverError::input("start_deg", "start_deg applies only to round holes"));
         }
-        let eccentricity = hole
-            .eccentricity
-            .map(|f| finite("hole.eccentricity", f))
-            .transpose()?;
-        let axis_point = hole
-            .axis_point
-            .map(|p| point("hole.axis_point", p))
-            .transpose()?
-            .map(vec3);
-        let (frame, eccentricity) =
-            Frame::resolve(origin, arrangement, penetration, axis_point, eccentricity)?;
+        let eccentricity = hole.eccentricity.map(|f| finite("hole.eccentricity", f)).transpose()?;
+        let axis_point = hole.axis_point.map(|p| point("hole.axis_point", p)).transpose()?.map(vec3);
+        let (frame, eccentricity) = Frame::resolve(origin, arrangement, penetration, axis_point, eccentricity)?;
 
         let profile = match (hole.shape, hole.centre_distance) {
             (HoleShape::Round, None) => Profile::round(radius, eccentricity, start.to_radians()),
@@ -330,10 +292,7 @@ impl DeburrRequest {
                 Profile::rounded_rect(radius, eccentricity, across / 2.0, along / 2.0, false)
             }
             (HoleShape::Round, Some(_)) => {
-                return Err(SolverError::input(
-                    "hole.centre_distance",
-                    "a round hole has no centre_distance",
-                ));
+                return Err(SolverError::input("hole.centre_distance", "a round hole has no centre_distance"));
             }
             (HoleShape::Slot, _) => {
                 return Err(SolverError::input(
@@ -359,16 +318,10 @@ impl DeburrRequest {
                 (w, w / std::f64::consts::SQRT_2)
             }
             (Some(_), Some(_)) => {
-                return Err(SolverError::input(
-                    "width",
-                    "give cut_amount or width, not both",
-                ));
+                return Err(SolverError::input("width", "give cut_amount or width, not both"));
             }
             (None, None) => {
-                return Err(SolverError::input(
-                    "cut_amount",
-                    "cut_amount (Q) or width (W) is required",
-                ));
+                return Err(SolverError::input("cut_amount", "cut_amount (Q) or width (W) is required"));
             }
         };
         let tolerance = optional_positive("tolerance", self.tolerance, DEFAULT_TOLERANCE)?;
@@ -396,11 +349,7 @@ impl DeburrRequest {
             feed: optional_positive("feed", self.feed, DEFAULT_FEED)?,
             spindle_rpm: optional_positive("spindle_rpm", self.spindle_rpm, DEFAULT_SPINDLE_RPM)?,
             clearance: optional_positive("clearance", self.clearance, DEFAULT_CLEARANCE)?,
-            lead_distance: optional_positive(
-                "lead_distance",
-                self.lead_distance,
-                DEFAULT_LEAD_DISTANCE,
-            )?,
+            lead_distance: optional_positive("lead_distance", self.lead_distance, DEFAULT_LEAD_DISTANCE)?,
             safe_z,
         })
     }

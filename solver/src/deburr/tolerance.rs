@@ -30,17 +30,8 @@ pub(crate) fn targets<F>(
 where
     F: FnMut(usize, f64) -> Result<Vec3, SolverError>,
 {
-    let mut bisection = Bisection {
-        centre,
-        tolerance,
-        max_points,
-        segment: 0,
-        out: Vec::new(),
-    };
-    bisection.out.push(Target {
-        segment: 0,
-        parameter: 0.0,
-    });
+    let mut bisection = Bisection { centre, tolerance, max_points, segment: 0, out: Vec::new() };
+    bisection.out.push(Target { segment: 0, parameter: 0.0 });
     for (index, segment) in profile.segments.iter().enumerate() {
         bisection.segment = index;
         if segment.is_axial_line() {
@@ -50,10 +41,7 @@ where
         let count = segment.initial_intervals();
         let mut start_centre = (bisection.centre)(index, 0.0)?;
         for k in 0..count {
-            let (a, b) = (
-                f64::from(k) / f64::from(count),
-                f64::from(k + 1) / f64::from(count),
-            );
+            let (a, b) = (f64::from(k) / f64::from(count), f64::from(k + 1) / f64::from(count));
             let end_centre = (bisection.centre)(index, b)?;
             let inner = bisection.samples(a, b, [1, 2, 3, 4, 5, 6, 7], 8.0)?;
             bisection.split(a, b, &start_centre, &end_centre, &inner, 0)?;
@@ -93,17 +81,11 @@ where
         if self.out.len() > self.max_points {
             return Err(SolverError::new(
                 "E_TOO_MANY_POINTS",
-                format!(
-                    "the tolerance needs more than {} points; raise it",
-                    self.max_points
-                ),
+                format!("the tolerance needs more than {} points; raise it", self.max_points),
             )
             .at("tolerance"));
         }
-        self.out.push(Target {
-            segment: self.segment,
-            parameter,
-        });
+        self.out.push(Target { segment: self.segment, parameter });
         Ok(())
     }
 
@@ -118,43 +100,22 @@ where
         inner: &[Vec3; 7],
         depth: u32,
     ) -> Result<(), SolverError> {
-        let exceeds = inner
-            .iter()
-            .any(|p| distance_to_segment(p, start, end) > self.tolerance);
+        let exceeds = inner.iter().any(|p| distance_to_segment(p, start, end) > self.tolerance);
         if !exceeds {
             return self.emit(b);
         }
         if depth >= MAX_DEPTH {
             return Err(SolverError::new(
                 "E_TOL",
-                format!(
-                    "tolerance {} not reached after {MAX_DEPTH} bisections",
-                    self.tolerance
-                ),
+                format!("tolerance {} not reached after {MAX_DEPTH} bisections", self.tolerance),
             )
             .at("tolerance"));
         }
         let middle = 0.5 * (a + b);
         let left_new = self.samples(a, b, [1, 3, 5, 7], 16.0)?;
         let right_new = self.samples(a, b, [9, 11, 13, 15], 16.0)?;
-        let left = [
-            left_new[0],
-            inner[0],
-            left_new[1],
-            inner[1],
-            left_new[2],
-            inner[2],
-            left_new[3],
-        ];
-        let right = [
-            right_new[0],
-            inner[4],
-            right_new[1],
-            inner[5],
-            right_new[2],
-            inner[6],
-            right_new[3],
-        ];
+        let left = [left_new[0], inner[0], left_new[1], inner[1], left_new[2], inner[2], left_new[3]];
+        let right = [right_new[0], inner[4], right_new[1], inner[5], right_new[2], inner[6], right_new[3]];
         self.split(a, middle, start, &inner[3], &left, depth + 1)?;
         self.split(middle, b, &inner[3], end, &right, depth + 1)
     }
@@ -174,11 +135,7 @@ where
     let mut worst = 0.0_f64;
     for (pair, ends) in targets.windows(2).zip(centres.windows(2)) {
         let (previous, current) = (pair[0], pair[1]);
-        let start = if previous.segment == current.segment {
-            previous.parameter
-        } else {
-            0.0
-        };
+        let start = if previous.segment == current.segment { previous.parameter } else { 0.0 };
         for j in 1..=samples {
             let s = start + f64::from(j) / f64::from(samples + 1) * (current.parameter - start);
             let point = centre(current.segment, s)?;

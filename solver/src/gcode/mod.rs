@@ -95,24 +95,14 @@ pub struct Program<'a> {
 /// A coordinate or value in mm with 4 decimals, never printed as `-0.0000`.
 pub fn mm(value: f64) -> String {
     let text = format!("{value:.4}");
-    if text.starts_with('-') && text[1..].bytes().all(|b| b == b'0' || b == b'.') {
-        text[1..].to_owned()
-    } else {
-        text
-    }
+    if text.starts_with('-') && text[1..].bytes().all(|b| b == b'0' || b == b'.') { text[1..].to_owned() } else { text }
 }
 
 /// A comment safe for both dialects: upper case, no parentheses or control characters.
 pub fn comment(text: &str) -> String {
     let cleaned: String = text
         .chars()
-        .map(|c| {
-            if c == '(' || c == ')' || c.is_control() || !c.is_ascii() {
-                ' '
-            } else {
-                c.to_ascii_uppercase()
-            }
-        })
+        .map(|c| if c == '(' || c == ')' || c.is_control() || !c.is_ascii() { ' ' } else { c.to_ascii_uppercase() })
         .collect();
     format!("({})", cleaned.trim())
 }
@@ -140,16 +130,8 @@ pub fn write(program: &Program<'_>) -> String {
             let _ = writeln!(out, "G00 G43 H{number} Z{}", mm(program.safe_z));
         }
         ToolCall::Manual(description) => {
-            let _ = writeln!(
-                out,
-                "{}",
-                comment(&format!("TOOL NOT IN THE TOOL TABLE: {description}"))
-            );
-            let _ = writeln!(
-                out,
-                "{}",
-                comment("LOAD IT, ACTIVATE ITS LENGTH OFFSET, THEN CYCLE START")
-            );
+            let _ = writeln!(out, "{}", comment(&format!("TOOL NOT IN THE TOOL TABLE: {description}")));
+            let _ = writeln!(out, "{}", comment("LOAD IT, ACTIVATE ITS LENGTH OFFSET, THEN CYCLE START"));
             out.push_str("M00\n");
             let _ = writeln!(out, "G00 Z{}", mm(program.safe_z));
         }
@@ -183,11 +165,7 @@ pub fn write(program: &Program<'_>) -> String {
 
 /// Feed word value: whole mm/min where exact, else one decimal.
 fn feed_word(feed: f64) -> String {
-    if feed.fract() == 0.0 {
-        format!("{feed:.0}")
-    } else {
-        format!("{feed:.1}")
-    }
+    if feed.fract() == 0.0 { format!("{feed:.0}") } else { format!("{feed:.1}") }
 }
 
 #[cfg(test)]
@@ -232,10 +210,7 @@ mod tests {
         assert!(fanuc.contains("T7 M06\nG00 G43 H7 Z50.0000\nS6000 M03\n"));
         assert!(fanuc.contains("G01 X1.0000 Y2.0000 Z3.0000 F300\nG01 X2.0000 Y2.0000 Z3.0000\n"));
         assert!(fanuc.ends_with("M05\nG00 Z50.0000\nM30\n%\n"));
-        let linuxcnc = write(&Program {
-            dialect: Dialect::Linuxcnc,
-            ..program
-        });
+        let linuxcnc = write(&Program { dialect: Dialect::Linuxcnc, ..program });
         assert!(linuxcnc.starts_with("(KERF TEST)\n"));
         assert!(linuxcnc.contains("G64 P0.0100\n"));
         assert!(!linuxcnc.contains('%'));

@@ -1,0 +1,75 @@
+//! Assembles the service: routes, OpenAPI document and docs, the page, problem+json for every
+//! rejection (unknown path, wrong method, panics), body limit and request tracing.
+
+use std::any::Any;
+use std::path::PathBuf;
+
+use axum::Router;
+use axum::body::Body;
+use axum::extract::DefaultBodyLimit;
+use axum::http::Response;
+use axum::response::IntoResponse;
+use tower_http::catch_panic::CatchPanicLayer;
+use tower_http::trace::TraceLayer;
+use utoipa::OpenApi;
+use utoipa_axum::router::OpenApiRouter;
+use utoipa_swagger_ui::SwaggerUi;
+
+use crate::error::AppError;
+use crate::openapi::ApiDoc;
+use crate::state::{AppState, Limits};
+use crate::{db, http, web};
+
+/// How to run the service.
+#[derive(Debug, Clone)]
+pub struct Config {
+    /// SQLite file (created with the schema if missing).
+    pub database: PathBuf,
+    /// Request limits.
+    pub limits: Limits,
+    /// Solver calls allowed at once.
+    pub solver_slots: usize,
+}
+
+/// The OpenAPI document and the API routes.
+pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
+    OpenApiRouter::with_openapi(ApiDoc::openapi())
+        .merge(http::health::router())
+        .merge(http::tools::router())
+        .merge(http::deburr::router())
+        .split_for_parts()
+}
+
+/// The whole service over `state`.
+pub fn router(state: AppState) -> Router {
+    let max_body = state.limits.max_body_bytes;
+    let (api_routes, document) = api();
+    api_routes
+        .merge(SwaggerUi::new("/docs").url("/api/v1/openapi.json", document))
+        .merge(web::router())
+        .fallback(|| async { AppError::not_found("no such resource") })
+        .method_not_allowed_fallback(|| async { AppError::MethodNotAllowed })
+        .layer(DefaultBodyLimit::max(max_body))
+        .layer(TraceLayer::new_for_http())
+        .layer(CatchPanicLayer::custom(panic_response))
+        .with_state(state)
+}
+
+fn panic_response(cause: Box<dyn Any + Send + 'static>) -> Response<Body> {
+    let message = cause
+        .downcast_ref::<String>()
+        .map(String::as_str)
+        .or_else(|| cause.downcast_ref::<&str>().copied())
+        .unwrap_or("unknown panic");
+    AppError::Internal(anyhow::anyhow!("handler panicked: {message}")).into_response()
+}
+
+/// Opens the database and builds the service.
+///
+/// # Errors
+/// When the database cannot be opened or migrated.
+pub async fn build(config: &Config) -> anyhow::Result<(Router, AppState)> {
+    let pool = db::open(&config.database).await?;
+    let state = AppState::new(pool, config.limits.clone(), config.solver_slots);
+    Ok((router(state.clone()), state))
+}

@@ -1,0 +1,161 @@
+//! `AppError`: every failure the HTTP layer can answer, rendered as RFC 9457
+//! `application/problem+json` (api.md, Errors). 5xx causes are logged, never sent to the client.
+
+use axum::http::{HeaderValue, StatusCode, header};
+use axum::response::{IntoResponse, Response};
+use kerf_solver::SolverError;
+use serde::Serialize;
+use utoipa::ToSchema;
+
+/// One field-level complaint inside a problem document.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, ToSchema)]
+pub struct FieldProblem {
+    /// Dotted JSON path of the field (`hole.radius`, `tool`, `contour[3]`), or the query/path
+    /// parameter name.
+    pub path: String,
+    /// What is wrong with it.
+    pub message: String,
+}
+
+/// An RFC 9457 problem document, as every error answer carries.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct Problem {
+    /// Always `about:blank`: the status code and `code` say what happened.
+    #[serde(rename = "type")]
+    pub kind: &'static str,
+    /// Short, human-readable summary of the status.
+    pub title: &'static str,
+    /// HTTP status code.
+    pub status: u16,
+    /// Human-readable explanation specific to this request.
+    pub detail: String,
+    /// Stable machine-readable code (e.g. `E_HOLE_TOO_LARGE`, `E_JSON`, `E_NOT_FOUND`).
+    pub code: String,
+    /// The fields at fault.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub errors: Vec<FieldProblem>,
+}
+
+/// Everything a handler can fail with.
+#[derive(Debug, thiserror::Error)]
+pub enum AppError {
+    /// 400: the body or a parameter is not of the right shape.
+    #[error("{detail}")]
+    BadRequest { code: &'static str, detail: String, field: Option<String> },
+    /// 401: a state-changing request without the right bearer token.
+    #[error("{0}")]
+    Unauthorized(String),
+    /// 404: no such resource; `field` names the request field that referred to it, if any.
+    #[error("{detail}")]
+    NotFound { detail: String, field: Option<String> },
+    /// 405: the path exists, the method does not.
+    #[error("method not allowed")]
+    MethodNotAllowed,
+    /// 409: the request conflicts with stored state.
+    #[error("{0}")]
+    Conflict(String),
+    /// 413: the body is over the limit.
+    #[error("request body is larger than the limit of {limit} bytes")]
+    PayloadTooLarge { limit: usize },
+    /// 415: wrong content type.
+    #[error("{0}")]
+    UnsupportedMediaType(String),
+    /// 422: well-formed but impossible; from the solver or a validation rule.
+    #[error(transparent)]
+    Unprocessable(#[from] SolverError),
+    /// 429: the service is saturated; try again.
+    #[error("{0}")]
+    TooManyRequests(String),
+    /// 503: the synchronous time limit was hit; submit a job instead.
+    #[error("{0}")]
+    Timeout(String),
+    /// 500: a bug or an infrastructure failure. The cause is logged, not sent.
+    #[error(transparent)]
+    Internal(#[from] anyhow::Error),
+}
+
+impl AppError {
+    /// A 400 naming `field`.
+    pub fn bad_request(code: &'static str, field: impl Into<String>, detail: impl Into<String>) -> Self {
+        Self::BadRequest { code, detail: detail.into(), field: Some(field.into()) }
+    }
+
+    /// A 404 for a resource addressed by the path.
+    pub fn not_found(detail: impl Into<String>) -> Self {
+        Self::NotFound { detail: detail.into(), field: None }
+    }
+
+    /// A 404 for a resource a request field refers to (an unknown tool number, machine, ...).
+    pub fn unknown(field: impl Into<String>, detail: impl Into<String>) -> Self {
+        Self::NotFound { detail: detail.into(), field: Some(field.into()) }
+    }
+
+    fn status_title(&self) -> (StatusCode, &'static str) {
+        match self {
+            Self::BadRequest { .. } => (StatusCode::BAD_REQUEST, "Bad request"),
+            Self::Unauthorized(_) => (StatusCode::UNAUTHORIZED, "Unauthorized"),
+            Self::NotFound { .. } => (StatusCode::NOT_FOUND, "Not found"),
+            Self::MethodNotAllowed => (StatusCode::METHOD_NOT_ALLOWED, "Method not allowed"),
+            Self::Conflict(_) => (StatusCode::CONFLICT, "Conflict"),
+            Self::PayloadTooLarge { .. } => (StatusCode::PAYLOAD_TOO_LARGE, "Payload too large"),
+            Self::UnsupportedMediaType(_) => (StatusCode::UNSUPPORTED_MEDIA_TYPE, "Unsupported media type"),
+            Self::Unprocessable(_) => (StatusCode::UNPROCESSABLE_ENTITY, "Unprocessable request"),
+            Self::TooManyRequests(_) => (StatusCode::TOO_MANY_REQUESTS, "Too many requests"),
+            Self::Timeout(_) => (StatusCode::SERVICE_UNAVAILABLE, "Time limit exceeded"),
+            Self::Internal(_) => (StatusCode::INTERNAL_SERVER_ERROR, "Internal error"),
+        }
+    }
+
+    /// The problem document for this error.
+    pub fn problem(&self) -> Problem {
+        let (status, title) = self.status_title();
+        let (code, detail, field): (String, String, Option<String>) = match self {
+            Self::BadRequest { code, detail, field } => ((*code).to_owned(), detail.clone(), field.clone()),
+            Self::NotFound { detail, field } => ("E_NOT_FOUND".to_owned(), detail.clone(), field.clone()),
+            Self::Unprocessable(error) => {
+                (error.code().to_owned(), error.message().to_owned(), error.field().map(str::to_owned))
+            }
+            Self::Internal(_) => ("E_INTERNAL".to_owned(), "internal error; it has been logged".to_owned(), None),
+            other => {
+                let code = match other {
+                    Self::Unauthorized(_) => "E_UNAUTHORIZED",
+                    Self::MethodNotAllowed => "E_METHOD",
+                    Self::Conflict(_) => "E_CONFLICT",
+                    Self::PayloadTooLarge { .. } => "E_TOO_LARGE",
+                    Self::UnsupportedMediaType(_) => "E_CONTENT_TYPE",
+                    Self::TooManyRequests(_) => "E_BUSY",
+                    _ => "E_TIMEOUT",
+                };
+                (code.to_owned(), other.to_string(), None)
+            }
+        };
+        let errors = field.map(|path| vec![FieldProblem { path, message: detail.clone() }]).unwrap_or_default();
+        Problem { kind: "about:blank", title, status: status.as_u16(), detail, code, errors }
+    }
+}
+
+impl IntoResponse for AppError {
+    fn into_response(self) -> Response {
+        if let Self::Internal(cause) = &self {
+            tracing::error!(error = ?cause, "internal error");
+        }
+        let problem = self.problem();
+        let status = StatusCode::from_u16(problem.status).unwrap_or(StatusCode::INTERNAL_SERVER_ERROR);
+        let body = serde_json::to_vec(&problem).unwrap_or_default();
+        let mut response = (status, body).into_response();
+        response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("application/problem+json"));
+        if matches!(self, Self::Unauthorized(_)) {
+            response.headers_mut().insert(header::WWW_AUTHENTICATE, HeaderValue::from_static("Bearer"));
+        }
+        response
+    }
+}
+
+impl From<sqlx::Error> for AppError {
+    fn from(error: sqlx::Error) -> Self {
+        Self::Internal(error.into())
+    }
+}
+
+/// Result of a handler.
+pub type AppResult<T> = Result<T, AppError>;

@@ -1,0 +1,138 @@
+//! Extractors whose rejections are problem documents: JSON bodies (415 on the wrong content type,
+//! 413 over the limit, 400 naming the field on bad shape), query strings and path parameters.
+
+use axum::body::Bytes;
+use axum::extract::path::ErrorKind;
+use axum::extract::rejection::{BytesRejection, PathRejection};
+use axum::extract::{FromRef, FromRequest, FromRequestParts, Request};
+use axum::http::HeaderMap;
+use axum::http::header::CONTENT_TYPE;
+use axum::http::request::Parts;
+use serde::de::DeserializeOwned;
+
+use crate::error::AppError;
+use crate::state::AppState;
+
+/// A JSON body parsed into `T` (`application/json` only).
+#[derive(Debug, Clone)]
+pub struct AppJson<T>(pub T);
+
+impl<T, S> FromRequest<S> for AppJson<T>
+where
+    T: DeserializeOwned,
+    S: Send + Sync,
+    AppState: FromRef<S>,
+{
+    type Rejection = AppError;
+
+    async fn from_request(request: Request, state: &S) -> Result<Self, Self::Rejection> {
+        if !is_json(request.headers()) {
+            return Err(AppError::UnsupportedMediaType(
+                "the body must be JSON: send Content-Type: application/json".to_owned(),
+            ));
+        }
+        let limit = AppState::from_ref(state).limits.max_body_bytes;
+        let bytes = body_bytes(request, state, limit).await?;
+        parse_json(&bytes).map(Self)
+    }
+}
+
+/// True when the request says its body is JSON (`application/json` or `application/*+json`).
+pub fn is_json(headers: &HeaderMap) -> bool {
+    media_type(headers).is_some_and(|essence| {
+        essence == "application/json" || (essence.starts_with("application/") && essence.ends_with("+json"))
+    })
+}
+
+/// The request's media type without parameters, lower case (`text/plain; charset=utf-8` → `text/plain`).
+pub fn media_type(headers: &HeaderMap) -> Option<String> {
+    let value = headers.get(CONTENT_TYPE)?.to_str().ok()?;
+    let essence = value.split(';').next().unwrap_or_default().trim().to_ascii_lowercase();
+    (!essence.is_empty()).then_some(essence)
+}
+
+/// Reads the whole body, mapping the body-limit rejection to 413.
+pub async fn body_bytes<S: Send + Sync>(request: Request, state: &S, limit: usize) -> Result<Bytes, AppError> {
+    Bytes::from_request(request, state).await.map_err(|rejection| match rejection {
+        BytesRejection::FailedToBufferBody(_) if rejection.status() == axum::http::StatusCode::PAYLOAD_TOO_LARGE => {
+            AppError::PayloadTooLarge { limit }
+        }
+        other => AppError::bad_request("E_BODY", "body", format!("could not read the body: {other}")),
+    })
+}
+
+/// Parses JSON into `T`; a failure names the JSON path of the offending field.
+pub fn parse_json<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, AppError> {
+    // Every request body is an object; serde would otherwise read an array as the fields in order.
+    if bytes.iter().find(|b| !b.is_ascii_whitespace()) != Some(&b'{') {
+        return Err(AppError::bad_request("E_JSON", "body", "the body must be a JSON object"));
+    }
+    let mut deserializer = serde_json::Deserializer::from_slice(bytes);
+    let value = serde_path_to_error::deserialize(&mut deserializer).map_err(|error| {
+        let path = error.path().to_string();
+        let inner = error.into_inner();
+        // serde_path_to_error says "." for the root and "?" where it could not track the path.
+        let field = if path == "." || path == "?" { "body".to_owned() } else { path };
+        AppError::bad_request("E_JSON", field.clone(), format!("{field}: {}", clean_serde_message(&inner.to_string())))
+    })?;
+    deserializer.end().map_err(|error| {
+        AppError::bad_request("E_JSON", "body", format!("trailing characters after the JSON value: {error}"))
+    })?;
+    Ok(value)
+}
+
+/// serde_json appends " at line 0 column 0" to errors raised inside nested deserializers.
+fn clean_serde_message(message: &str) -> String {
+    message.strip_suffix(" at line 0 column 0").unwrap_or(message).to_owned()
+}
+
+/// Query parameters parsed into `T`; a failure names the parameter.
+#[derive(Debug, Clone)]
+pub struct AppQuery<T>(pub T);
+
+impl<T, S> FromRequestParts<S> for AppQuery<T>
+where
+    T: DeserializeOwned,
+    S: Send + Sync,
+{
+    type Rejection = AppError;
+
+    async fn from_request_parts(parts: &mut Parts, _state: &S) -> Result<Self, Self::Rejection> {
+        let query = parts.uri.query().unwrap_or_default();
+        let deserializer = serde_urlencoded::Deserializer::new(form_urlencoded::parse(query.as_bytes()));
+        serde_path_to_error::deserialize(deserializer).map(Self).map_err(|error| {
+            let path = error.path().to_string();
+            let field = if path == "." { "query".to_owned() } else { path };
+            AppError::bad_request("E_QUERY", field.clone(), format!("query parameter {field}: {}", error.into_inner()))
+        })
+    }
+}
+
+/// Path parameters parsed into `T`; a failure is a 400 naming the parameter.
+#[derive(Debug, Clone)]
+pub struct AppPath<T>(pub T);
+
+impl<T, S> FromRequestParts<S> for AppPath<T>
+where
+    T: DeserializeOwned + Send,
+    S: Send + Sync,
+{
+    type Rejection = AppError;
+
+    async fn from_request_parts(parts: &mut Parts, state: &S) -> Result<Self, Self::Rejection> {
+        axum::extract::Path::<T>::from_request_parts(parts, state).await.map(|path| Self(path.0)).map_err(
+            |rejection: PathRejection| {
+                let key = match &rejection {
+                    PathRejection::FailedToDeserializePathParams(error) => match error.kind() {
+                        ErrorKind::ParseErrorAtKey { key, .. }
+                        | ErrorKind::InvalidUtf8InPathParam { key }
+                        | ErrorKind::DeserializeError { key, .. } => Some(key.clone()),
+                        _ => None,
+                    },
+                    _ => None,
+                };
+                AppError::bad_request("E_PATH", key.unwrap_or_else(|| "path".to_owned()), rejection.body_text())
+            },
+        )
+    }
+}

@@ -1,0 +1,70 @@
+//! `POST /api/v1/deburr` (api.md, Deburr): cross-hole deburring, as JSON or G-code.
+
+use axum::Json;
+use axum::extract::State;
+use axum::http::HeaderMap;
+use axum::response::{IntoResponse, Response};
+use kerf_solver::deburr::{self, Deburr, DeburrRequest, Post};
+use kerf_solver::gcode::ToolCall;
+use kerf_solver::tool::Tool;
+use serde::Serialize;
+use utoipa::ToSchema;
+use utoipa_axum::router::OpenApiRouter;
+use utoipa_axum::routes;
+
+use super::output::{Output, OutputQuery, gcode_response};
+use crate::error::{AppResult, Problem};
+use crate::extract::{AppJson, AppQuery};
+use crate::state::AppState;
+use crate::store;
+
+/// The deburr answer: the tool used and the solver's result.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct DeburrAnswer {
+    /// The tool, as resolved from the table or given inline.
+    pub tool: Tool,
+    /// The loop of centres, leads, summary and warnings.
+    #[serde(flatten)]
+    pub result: Deburr,
+}
+
+/// Deburrs one ridge of a cross hole with a ball end mill.
+///
+/// Returns the closed loop of ball centres in machining order (JSON), or with
+/// `Accept: text/x-gcode` / `?format=gcode` a complete program.
+#[utoipa::path(post, path = "/api/v1/deburr", tag = "deburr",
+    params(OutputQuery),
+    request_body = DeburrRequest,
+    responses(
+        (status = 200, description = "The path as JSON", body = DeburrAnswer),
+        (status = 200, description = "The program (`?format=gcode`)", body = String, content_type = "text/x-gcode"),
+        (status = 400, body = Problem, content_type = "application/problem+json"),
+        (status = 404, description = "Unknown tool number", body = Problem, content_type = "application/problem+json"),
+        (status = 413, body = Problem, content_type = "application/problem+json"),
+        (status = 415, body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "Impossible geometry (codes in deburr.md §4)", body = Problem, content_type = "application/problem+json")))]
+async fn post_deburr(
+    State(state): State<AppState>,
+    headers: HeaderMap,
+    AppQuery(query): AppQuery<OutputQuery>,
+    AppJson(request): AppJson<DeburrRequest>,
+) -> AppResult<Response> {
+    let output = Output::negotiate(&headers, &query);
+    let tool = store::tools::resolve(&state.db, &request.tool).await?;
+    let used_tool = tool.clone();
+    let result = state.solve(move || deburr::solve(&request, &tool)).await??;
+    if output.gcode {
+        let post = Post {
+            dialect: output.dialect.unwrap_or_default(),
+            reference: output.reference,
+            tool: ToolCall::for_tool(&used_tool),
+        };
+        return Ok(gcode_response(deburr::program(&result, &post)?));
+    }
+    Ok(Json(DeburrAnswer { tool: used_tool, result }).into_response())
+}
+
+/// Routes of this module.
+pub fn router() -> OpenApiRouter<AppState> {
+    OpenApiRouter::new().routes(routes!(post_deburr))
+}

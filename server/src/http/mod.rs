@@ -1,0 +1,6 @@
+//! HTTP routes, one module per resource, each with a `router()`.
+
+pub mod deburr;
+pub mod health;
+pub mod output;
+pub mod tools;

@@ -1,0 +1,70 @@
+//! Output negotiation shared by every path-producing endpoint (api.md, Conventions: G-code):
+//! JSON by default; G-code with `Accept: text/x-gcode` or `?format=gcode`, in `?dialect=`
+//! (`fanuc` default, or the machine's) with `?reference=tip|centre`.
+
+use axum::http::{HeaderMap, HeaderValue, header};
+use axum::response::{IntoResponse, Response};
+use kerf_solver::gcode::{Dialect, Reference};
+use serde::Deserialize;
+use utoipa::{IntoParams, ToSchema};
+
+/// Media type of G-code answers.
+pub const GCODE_MEDIA_TYPE: &str = "text/x-gcode";
+
+/// `json` or `gcode`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Format {
+    /// The JSON answer (default).
+    Json,
+    /// A complete G-code program.
+    Gcode,
+}
+
+/// Query parameters of path-producing endpoints.
+#[derive(Debug, Clone, Default, Deserialize, IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+pub struct OutputQuery {
+    /// `json` (default) or `gcode`; `Accept: text/x-gcode` also selects G-code.
+    pub format: Option<Format>,
+    /// G-code dialect: `fanuc` (default) or `linuxcnc`.
+    pub dialect: Option<Dialect>,
+    /// Programmed point: `tip` (default; length offset to the tool tip) or `centre`.
+    pub reference: Option<Reference>,
+}
+
+/// What the client asked for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Output {
+    /// G-code instead of JSON.
+    pub gcode: bool,
+    /// Dialect, if the client chose one (else the machine's, else Fanuc).
+    pub dialect: Option<Dialect>,
+    /// Programmed point.
+    pub reference: Reference,
+}
+
+impl Output {
+    /// Reads the query and the `Accept` header; an explicit `format` wins over `Accept`.
+    pub fn negotiate(headers: &HeaderMap, query: &OutputQuery) -> Self {
+        let accepts_gcode = headers
+            .get_all(header::ACCEPT)
+            .iter()
+            .filter_map(|value| value.to_str().ok())
+            .flat_map(|value| value.split(','))
+            .any(|item| item.split(';').next().unwrap_or_default().trim().eq_ignore_ascii_case(GCODE_MEDIA_TYPE));
+        let gcode = match query.format {
+            Some(format) => format == Format::Gcode,
+            None => accepts_gcode,
+        };
+        Self { gcode, dialect: query.dialect, reference: query.reference.unwrap_or_default() }
+    }
+}
+
+/// A G-code program as the answer.
+pub fn gcode_response(program: String) -> Response {
+    let mut response = program.into_response();
+    response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("text/x-gcode; charset=utf-8"));
+    response
+}

@@ -1,0 +1,97 @@
+//! The tool table over HTTP (api.md, Tools): `PUT/GET/DELETE /api/v1/tools/{number}`, list.
+
+use axum::Json;
+use axum::extract::State;
+use axum::http::StatusCode;
+use kerf_solver::SolverError;
+use kerf_solver::tool::{TOOL_NUMBERS, Tool};
+use utoipa_axum::router::OpenApiRouter;
+use utoipa_axum::routes;
+
+use crate::error::{AppError, AppResult, Problem};
+use crate::extract::{AppJson, AppPath};
+use crate::state::AppState;
+use crate::store;
+
+/// The `{number}` path parameter.
+#[derive(Debug, serde::Deserialize)]
+struct ToolNumber {
+    number: u32,
+}
+
+fn checked_number(ToolNumber { number }: ToolNumber) -> AppResult<u32> {
+    if TOOL_NUMBERS.contains(&number) {
+        Ok(number)
+    } else {
+        Err(SolverError::input("number", format!("tool number must be 1 to 9999 (got {number})")).into())
+    }
+}
+
+/// All registered tools, ordered by number.
+#[utoipa::path(get, path = "/api/v1/tools", tag = "tools", responses((status = 200, body = Vec<Tool>)))]
+async fn list_tools(State(state): State<AppState>) -> AppResult<Json<Vec<Tool>>> {
+    Ok(Json(store::tools::list(&state.db).await?))
+}
+
+/// One tool.
+#[utoipa::path(get, path = "/api/v1/tools/{number}", tag = "tools",
+    params(("number" = u32, Path, description = "Tool number, 1–9999")),
+    responses(
+        (status = 200, body = Tool),
+        (status = 400, body = Problem, content_type = "application/problem+json"),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 422, body = Problem, content_type = "application/problem+json")))]
+async fn get_tool(State(state): State<AppState>, AppPath(number): AppPath<ToolNumber>) -> AppResult<Json<Tool>> {
+    let number = checked_number(number)?;
+    store::tools::get(&state.db, number)
+        .await?
+        .map(Json)
+        .ok_or_else(|| AppError::not_found(format!("tool {number} is not in the tool table")))
+}
+
+/// Registers or replaces a tool: 201 when new, 200 when replaced.
+#[utoipa::path(put, path = "/api/v1/tools/{number}", tag = "tools",
+    params(("number" = u32, Path, description = "Tool number, 1–9999")),
+    request_body = Tool,
+    responses(
+        (status = 201, description = "Created", body = Tool),
+        (status = 200, description = "Replaced", body = Tool),
+        (status = 400, body = Problem, content_type = "application/problem+json"),
+        (status = 413, body = Problem, content_type = "application/problem+json"),
+        (status = 415, body = Problem, content_type = "application/problem+json"),
+        (status = 422, body = Problem, content_type = "application/problem+json")))]
+async fn put_tool(
+    State(state): State<AppState>,
+    AppPath(number): AppPath<ToolNumber>,
+    AppJson(mut tool): AppJson<Tool>,
+) -> AppResult<(StatusCode, Json<Tool>)> {
+    let number = checked_number(number)?;
+    if tool.number.is_some_and(|given| given != number) {
+        return Err(SolverError::input("number", format!("body number differs from the path's {number}")).into());
+    }
+    tool.number = Some(number);
+    tool.validate("")?;
+    let created = store::tools::put(&state.db, &tool).await?;
+    let status = if created { StatusCode::CREATED } else { StatusCode::OK };
+    Ok((status, Json(tool)))
+}
+
+/// Removes a tool.
+#[utoipa::path(delete, path = "/api/v1/tools/{number}", tag = "tools",
+    params(("number" = u32, Path, description = "Tool number, 1–9999")),
+    responses(
+        (status = 204, description = "Deleted"),
+        (status = 404, body = Problem, content_type = "application/problem+json")))]
+async fn delete_tool(State(state): State<AppState>, AppPath(number): AppPath<ToolNumber>) -> AppResult<StatusCode> {
+    let number = checked_number(number)?;
+    if store::tools::delete(&state.db, number).await? {
+        Ok(StatusCode::NO_CONTENT)
+    } else {
+        Err(AppError::not_found(format!("tool {number} is not in the tool table")))
+    }
+}
+
+/// Routes of this module.
+pub fn router() -> OpenApiRouter<AppState> {
+    OpenApiRouter::new().routes(routes!(list_tools)).routes(routes!(get_tool, put_tool, delete_tool))
+}

@@ -1,0 +1,21 @@
+//! The OpenAPI document (utoipa): its header here, the paths and schemas from the route modules.
+
+use utoipa::OpenApi;
+
+/// Document header; `app::router` adds every route's path and schemas.
+#[derive(OpenApi)]
+#[openapi(
+    info(
+        title = "kerf",
+        description = "CAM web service: tool-centre paths as JSON or G-code. Lengths in mm, angles in degrees \
+                       (`_deg`), feed in mm/min, times in s (`_s`) or ms (`_ms`). Every error is \
+                       application/problem+json (RFC 9457) with a stable `code` and the fields at fault in `errors`.",
+        license(name = "MIT OR Apache-2.0")
+    ),
+    tags(
+        (name = "service", description = "Health"),
+        (name = "tools", description = "The tool table, keyed by tool number"),
+        (name = "deburr", description = "Cross-hole deburring with a ball end mill (deburr.md)")
+    )
+)]
+pub struct ApiDoc;

@@ -1,0 +1,3 @@
+//! Repositories: the only place with SQL. Handlers call these functions.
+
+pub mod tools;

@@ -1,0 +1,22 @@
+//! The served OpenAPI document covers every route, and the docs page is served offline.
+
+use kerf_tests::{TestApp, json_with};
+
+#[tokio::test(flavor = "multi_thread")]
+async fn document_covers_every_route_and_docs_are_served() {
+    let app = TestApp::spawn().await;
+    let document = json_with(app.get("/api/v1/openapi.json").await, 200).await;
+    let (_, built) = kerf_server::app::api();
+    assert_eq!(document, serde_json::to_value(&built).unwrap(), "served document is the built one");
+    let paths = document["paths"].as_object().unwrap();
+    for path in ["/healthz", "/api/v1/tools", "/api/v1/tools/{number}", "/api/v1/deburr"] {
+        assert!(paths.contains_key(path), "{path} documented");
+    }
+    let docs = app.get("/docs/").await;
+    assert_eq!(docs.status(), 200);
+    let html = docs.text().await.unwrap();
+    assert!(html.contains("swagger"), "swagger UI page");
+    let initializer = app.get("/docs/swagger-initializer.js").await;
+    assert_eq!(initializer.status(), 200);
+    assert!(initializer.text().await.unwrap().contains("/api/v1/openapi.json"));
+}
