@@ -1,0 +1,74 @@
+// kerf page shell: tabs, the API helper, problem display and downloads shared by the views.
+import { deburrView } from '/views/deburr.js';
+import { toolsView } from '/views/tools.js';
+
+const views = [deburrView, toolsView];
+
+// Calls the API; resolves to the parsed JSON (or text for G-code); rejects with the problem document.
+export async function api(method, path, body, accept = 'application/json') {
+  const options = { method, headers: { accept } };
+  if (body !== undefined) {
+    options.headers['content-type'] = 'application/json';
+    options.body = JSON.stringify(body);
+  }
+  const response = await fetch(path, options);
+  if (response.status === 204) return null;
+  const type = response.headers.get('content-type') || '';
+  const payload = type.includes('json') ? await response.json() : await response.text();
+  if (!response.ok) {
+    throw typeof payload === 'object' ? payload : { status: response.status, detail: String(payload) };
+  }
+  return payload;
+}
+
+// Shows a problem document in `box` and marks the inputs whose data-field matches an error path.
+export function showProblem(box, form, problem) {
+  form?.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+  const fields = (problem.errors || []).map((e) => e.path);
+  for (const path of fields) {
+    form?.querySelectorAll(`[data-field="${CSS.escape(path)}"]`).forEach((e) => e.classList.add('invalid'));
+  }
+  box.replaceChildren(message('error', `${problem.title || 'Error'} (${problem.status})${problem.code ? ' ' + problem.code : ''}: ${problem.detail}`));
+}
+
+export function message(kind, text) {
+  const div = document.createElement('div');
+  div.className = `message ${kind}`;
+  div.textContent = text;
+  return div;
+}
+
+export function download(name, text, type = 'text/plain') {
+  const url = URL.createObjectURL(new Blob([text], { type }));
+  const link = document.createElement('a');
+  link.href = url;
+  link.download = name;
+  document.body.append(link);
+  link.click();
+  link.remove();
+  setTimeout(() => URL.revokeObjectURL(url), 1000);
+}
+
+export function number(value, digits = 4) {
+  return Number.isFinite(value) ? value.toFixed(digits) : '–';
+}
+
+function show(view) {
+  for (const button of document.querySelectorAll('#tabs button')) {
+    button.setAttribute('aria-selected', String(button.dataset.view === view.id));
+  }
+  const main = document.getElementById('view');
+  main.replaceChildren();
+  view.mount(main);
+  history.replaceState(null, '', `#${view.id}`);
+}
+
+const tabs = document.getElementById('tabs');
+for (const view of views) {
+  const button = document.createElement('button');
+  button.textContent = view.title;
+  button.dataset.view = view.id;
+  button.addEventListener('click', () => show(view));
+  tabs.append(button);
+}
+show(views.find((v) => `#${v.id}` === location.hash) || views[0]);

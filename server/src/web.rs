@@ -13,15 +13,24 @@ struct Asset {
     body: &'static [u8],
 }
 
+const HTML: &str = "text/html; charset=utf-8";
+const CSS: &str = "text/css; charset=utf-8";
+const JS: &str = "text/javascript; charset=utf-8";
+
+/// A file of `web/` served at its own path.
+macro_rules! asset {
+    ($path:literal, $media_type:expr) => {
+        Asset { path: $path, media_type: $media_type, body: include_bytes!(concat!("../../web", $path)) }
+    };
+}
+
 const ASSETS: &[Asset] = &[
-    Asset { path: "/", media_type: "text/html; charset=utf-8", body: include_bytes!("../../web/index.html") },
-    Asset { path: "/style.css", media_type: "text/css; charset=utf-8", body: include_bytes!("../../web/style.css") },
-    Asset { path: "/app.js", media_type: "text/javascript; charset=utf-8", body: include_bytes!("../../web/app.js") },
-    Asset {
-        path: "/plot3d.js",
-        media_type: "text/javascript; charset=utf-8",
-        body: include_bytes!("../../web/plot3d.js"),
-    },
+    Asset { path: "/", media_type: HTML, body: include_bytes!("../../web/index.html") },
+    asset!("/style.css", CSS),
+    asset!("/app.js", JS),
+    asset!("/plot3d.js", JS),
+    asset!("/views/deburr.js", JS),
+    asset!("/views/tools.js", JS),
 ];
 
 /// Routes for the page's files.

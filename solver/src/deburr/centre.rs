@@ -35,17 +35,22 @@ pub(crate) struct RidgeCentre {
     pub wall_normal: Vec3,
     /// Unit bisector u, into the material.
     pub bisector: Vec3,
-    /// Wedge angle β, radians.
-    pub wedge_angle: f64,
+    /// cos θ = m1·m2, where θ = π − β.
+    pub cos_theta: f64,
     /// CL: signed distance from P to C along −u.
     pub centre_offset: f64,
 }
 
 impl RidgeCentre {
+    /// Wedge angle β = π − acos(m1·m2), radians.
+    pub fn wedge_angle(&self) -> f64 {
+        std::f64::consts::PI - self.cos_theta.acos()
+    }
+
     /// The band edges G1 (on the cylinder-surface tangent) and G2 (on the hole-wall tangent).
     pub fn band_edges(&self, half_width: f64) -> (Vec3, Vec3) {
-        let cos_wedge = self.cylinder_normal.dot(&self.wall_normal);
-        let leg = half_width / (0.5 * self.wedge_angle).sin();
+        let cos_wedge = self.cos_theta;
+        let leg = half_width / (0.5 * self.wedge_angle()).sin();
         let along_cylinder = (self.wall_normal - cos_wedge * self.cylinder_normal).normalize();
         let along_wall = (self.cylinder_normal - cos_wedge * self.wall_normal).normalize();
         (self.target + leg * along_cylinder, self.target + leg * along_wall)
@@ -82,10 +87,11 @@ impl Construction {
         let cylinder_normal = if self.inner { radial } else { -radial };
         let wall_normal = Vec3::new(point.normal_x, point.normal_y, 0.0);
         let cos_theta = cylinder_normal.dot(&wall_normal).clamp(-1.0, 1.0);
-        let sum = cylinder_normal + wall_normal;
-        let bisector = sum.normalize();
-        // L = (W/2)/tan(β/2) = (W/2)·|m1 − m2|/|m1 + m2|, free of trigonometry (§2.5).
-        let chord_depth = self.half_width * ((1.0 - cos_theta) / (1.0 + cos_theta)).sqrt();
+        // |m1 + m2| = √(2 + 2c) and |m1 − m2| = √(2 − 2c): one division serves the bisector and
+        // L = (W/2)/tan(β/2) = (W/2)·|m1 − m2|/|m1 + m2| (§2.5), with no trigonometry.
+        let inverse_half_sum = 1.0 / (1.0 + cos_theta).sqrt();
+        let bisector = (cylinder_normal + wall_normal) * (inverse_half_sum * std::f64::consts::FRAC_1_SQRT_2);
+        let chord_depth = self.half_width * (1.0 - cos_theta).sqrt() * inverse_half_sum;
         let centre_offset = self.centre_to_chord - chord_depth;
         RidgeCentre {
             target,
@@ -93,7 +99,7 @@ impl Construction {
             cylinder_normal,
             wall_normal,
             bisector,
-            wedge_angle: std::f64::consts::PI - cos_theta.acos(),
+            cos_theta,
             centre_offset,
         }
     }
@@ -105,11 +111,11 @@ impl Construction {
 
     /// Cylinder-surface function: zero on the surface, positive away from A1.
     fn cylinder(&self, q: &Vec3) -> f64 {
-        q.x.hypot(q.z) - self.cylinder_radius
+        (q.x * q.x + q.z * q.z).sqrt() - self.cylinder_radius
     }
 
     fn cylinder_gradient(q: &Vec3) -> Vec3 {
-        let r = q.x.hypot(q.z);
+        let r = (q.x * q.x + q.z * q.z).sqrt();
         Vec3::new(q.x / r, 0.0, q.z / r)
     }
 
@@ -239,7 +245,7 @@ mod tests {
     fn hand_check_at_phi_zero() {
         let (construction, profile) = case1();
         let ridge = construction.tangent(&profile.segments[0].point(10.0, 0.0));
-        assert_abs_diff_eq!(ridge.wedge_angle.to_degrees(), 78.463_040_967, epsilon = 1e-8);
+        assert_abs_diff_eq!(ridge.wedge_angle().to_degrees(), 78.463_040_967, epsilon = 1e-8);
         assert_abs_diff_eq!(ridge.centre_offset, 2.546_081_12, epsilon = 1e-8);
         assert_abs_diff_eq!(ridge.centre, Vec3::new(8.389_716_911, 0.0, 50.961_980_811), epsilon = 1e-8);
     }

@@ -17,6 +17,7 @@
 mod answer;
 mod centre;
 mod checks;
+mod diagnostics;
 mod frame;
 mod profile;
 pub mod program;
@@ -24,6 +25,7 @@ pub mod request;
 mod tolerance;
 
 pub use answer::{Deburr, DeburrPoint, DeburrSummary, LeadMotion, LeadMove};
+pub use diagnostics::{ExactConstruction, PointConstruction, construction_at};
 pub use program::{Post, program};
 pub use request::{CentreDistance, DeburrRequest, Direction, Edge, Hole, HoleShape, Method, Workpiece};
 
@@ -36,9 +38,6 @@ use crate::tool::Tool;
 
 /// Most points a deburr loop may have; a tolerance needing more is refused (`E_TOO_MANY_POINTS`).
 pub const MAX_POINTS: usize = 200_000;
-
-/// Sub-samples per interval for the summary's `max_deviation`.
-const DEVIATION_SAMPLES: u32 = 16;
 
 /// Relative chamfer-width error of the tangent-line method above which `W_APPROX` is raised (§4).
 const APPROX_LIMIT: f64 = 0.05;
@@ -73,34 +72,30 @@ pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError
         }
     };
 
-    let mut targets = tolerance::targets(profile, job.tolerance, MAX_POINTS, centre_at)?;
-    let mut ridges: Vec<RidgeCentre> = Vec::with_capacity(targets.len());
-    let mut centres: Vec<Vec3> = Vec::with_capacity(targets.len());
-    let mut exact_offset: Option<f64> = None;
-    for target in &targets {
-        let point = profile.segments[target.segment].point(profile.radius, target.parameter);
-        let mut ridge = construction.tangent(&point);
-        let centre = match job.method {
-            Method::Tangent => ridge.centre,
-            Method::Exact => {
-                let centre = exact_centre(target.segment, target.parameter, &ridge)?;
-                exact_offset = Some(exact_offset.unwrap_or(0.0).max((centre - ridge.centre).norm()));
-                // CL of the exact centre: its distance from P, signed as for the seed (positive
-                // when C is on the air side).
-                let from_target = ridge.target - centre;
-                ridge.centre_offset = from_target.norm().copysign(from_target.dot(&ridge.bisector));
-                ridge.centre = centre;
-                centre
-            }
-        };
-        ridges.push(ridge);
-        centres.push(centre);
-    }
+    let mut bisected = tolerance::targets(profile, job.tolerance, MAX_POINTS, centre_at)?;
     // The loop ends where it starts: the closing target (end of the last segment) is the start
     // point, which evaluates differently only by rounding (sin 2π ≠ 0).
-    let (last, first) = (ridges.len() - 1, 0);
-    (ridges[last], centres[last]) = (ridges[first], centres[first]);
-    let max_deviation = tolerance::max_deviation(&targets, &centres, DEVIATION_SAMPLES, centre_at)?;
+    let last = bisected.centres.len() - 1;
+    bisected.centres[last] = bisected.centres[0];
+    let (mut targets, mut centres, max_deviation) = tolerance::refine(&bisected, job.tolerance, MAX_POINTS, centre_at)?;
+
+    let mut ridges: Vec<RidgeCentre> = Vec::with_capacity(targets.len());
+    let mut exact_offset: Option<f64> = None;
+    for (target, centre) in targets.iter().zip(&centres) {
+        let point = profile.segments[target.segment].point(profile.radius, target.parameter);
+        let mut ridge = construction.tangent(&point);
+        if job.method == Method::Exact {
+            exact_offset = Some(exact_offset.unwrap_or(0.0).max((centre - ridge.centre).norm()));
+            // CL of the exact centre: its distance from P, signed as for the seed (positive when
+            // C is on the air side).
+            let from_target = ridge.target - centre;
+            ridge.centre_offset = from_target.norm().copysign(from_target.dot(&ridge.bisector));
+            ridge.centre = *centre;
+        }
+        ridges.push(ridge);
+    }
+    let last = ridges.len() - 1;
+    ridges[last] = ridges[0];
 
     warnings.extend(point_checks(&job, &targets, &ridges)?);
     let (true_width_min, true_width_max) = match job.method {
@@ -135,7 +130,7 @@ pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError
                 target: array3(&frame.point(&ridge.target)),
                 centre: array3(&machine_centre),
                 tip: array3(&(machine_centre - down)),
-                wedge_angle_deg: ridge.wedge_angle.to_degrees(),
+                wedge_angle_deg: ridge.wedge_angle().to_degrees(),
                 segment: profile.segments[target.segment].name,
                 parameter: target.parameter,
                 phi_deg: point.phi.map(f64::to_degrees),
@@ -158,7 +153,7 @@ pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError
     }
     let lead_feed_length: f64 = lead_feed_length(&lead_in, frame.point(&centres[0]))
         + lead_feed_length(&lead_out, frame.point(&centres[centres.len() - 1]));
-    let wedge = ridges.iter().map(|r| r.wedge_angle.to_degrees());
+    let wedge = ridges.iter().map(|r| r.wedge_angle().to_degrees());
     let summary = DeburrSummary {
         count: targets.len() - 1,
         path_length,
@@ -188,65 +183,6 @@ pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError
         program_blocker,
         description,
         ball_radius: ball,
-    })
-}
-
-/// The full construction at one ridge point, for diagnostics (deburr.md §1.5): machine
-/// coordinates, tangent-line method.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
-pub struct PointConstruction {
-    /// Ridge point P.
-    pub target: [f64; 3],
-    /// Ball centre C.
-    pub centre: [f64; 3],
-    /// Unit bisector u, into the material.
-    pub bisector: [f64; 3],
-    /// Band edge G1 on the cylinder-surface tangent.
-    pub band_edge_cylinder: [f64; 3],
-    /// Band edge G2 on the hole-wall tangent.
-    pub band_edge_wall: [f64; 3],
-    /// β, degrees.
-    pub wedge_angle_deg: f64,
-    /// L = |PM|, mm.
-    pub chord_depth: f64,
-    /// CL, mm.
-    pub centre_offset: f64,
-}
-
-/// The construction of §2.7 at parameter `parameter` of the segment named `segment`, with the
-/// request's geometry; for diagnostics and tests.
-///
-/// # Errors
-/// The request's validation errors, or `E_INPUT` for an unknown segment or parameter.
-pub fn construction_at(
-    request: &DeburrRequest,
-    tool: &Tool,
-    segment: &str,
-    parameter: f64,
-) -> Result<PointConstruction, SolverError> {
-    let job = request.validate(tool)?;
-    checks::ridge(&job)?;
-    let profile = &job.profile;
-    let Some(piece) = profile.segments.iter().find(|s| s.name == segment) else {
-        return Err(SolverError::input("segment", format!("this hole has no segment {segment}")));
-    };
-    if !(0.0..=1.0).contains(&parameter) {
-        return Err(SolverError::input("parameter", "parameter must be in [0, 1]"));
-    }
-    let construction = Construction::for_job(&job);
-    let ridge = construction.tangent(&piece.point(profile.radius, parameter));
-    let (g1, g2) = ridge.band_edges(construction.half_width);
-    let frame = &job.frame;
-    Ok(PointConstruction {
-        target: array3(&frame.point(&ridge.target)),
-        centre: array3(&frame.point(&ridge.centre)),
-        bisector: array3(&frame.vector(&ridge.bisector)),
-        band_edge_cylinder: array3(&frame.point(&g1)),
-        band_edge_wall: array3(&frame.point(&g2)),
-        wedge_angle_deg: ridge.wedge_angle.to_degrees(),
-        chord_depth: construction.centre_to_chord - ridge.centre_offset,
-        centre_offset: ridge.centre_offset,
     })
 }
 
@@ -280,7 +216,7 @@ fn point_checks(job: &Job, targets: &[Target], ridges: &[RidgeCentre]) -> Result
                     "at {name} s = {:.4} the wedge is so sharp (β = {:.2}°) that the ball would not reach the edge: \
                      reduce Q or use a larger ball",
                     target.parameter,
-                    ridge.wedge_angle.to_degrees()
+                    ridge.wedge_angle().to_degrees()
                 ),
             )
             .at("cut_amount"));
@@ -289,7 +225,7 @@ fn point_checks(job: &Job, targets: &[Target], ridges: &[RidgeCentre]) -> Result
             in_material += 1;
             deepest = deepest.min(ridge.centre_offset);
         }
-        let wedge = ridge.wedge_angle.to_degrees();
+        let wedge = ridge.wedge_angle().to_degrees();
         if !(30.0..=170.0).contains(&wedge) {
             sharp += 1;
             if (wedge - 90.0).abs() > (sharpest - 90.0).abs() {

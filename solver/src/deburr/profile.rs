@@ -160,7 +160,7 @@ impl Profile {
         let dx = x - self.centre_x;
         let (qx, qy) = (dx.abs() - self.half_across, y.abs() - self.half_along);
         let (ox, oy) = (qx.max(0.0), qy.max(0.0));
-        let outside = ox.hypot(oy);
+        let outside = (ox * ox + oy * oy).sqrt();
         if outside > 0.0 {
             let gradient = (ox / outside * dx.signum(), oy / outside * y.signum());
             (outside - self.radius, gradient)

@@ -1,0 +1,65 @@
+// Browser checks of the kerf page, driven by cargo test (tests/tests/api/browser.rs).
+// Usage: node run.mjs <scenario> <base-url> <screenshot.png>
+// Prints one JSON line with what it saw; exits non-zero with the reason when a check fails.
+import { chromium } from 'playwright-core';
+
+const [scenario, base, screenshot] = process.argv.slice(2);
+const browser = await chromium.launch({
+  executablePath: process.env.KERF_CHROMIUM || '/usr/bin/chromium',
+  args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
+    '--disable-component-update', '--disable-sync'],
+});
+const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
+const problems = [];
+page.on('pageerror', (error) => problems.push(`page error: ${error.message}`));
+// Chromium logs every non-2xx fetch as a console error; the API's 4xx answers are expected here.
+page.on('console', (m) => {
+  if (m.type() === 'error' && !/status of 4\d\d/.test(m.text())) problems.push(`console error: ${m.text()}`);
+});
+
+// Counts plot pixels that differ from the white background.
+async function inkedPixels(selector) {
+  return page.$eval(selector, (canvas) => {
+    const data = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
+    let inked = 0;
+    for (let i = 0; i < data.length; i += 4) {
+      if (data[i] < 200 || data[i + 1] < 200 || data[i + 2] < 200) inked++;
+    }
+    return inked;
+  });
+}
+
+const scenarios = {
+  // Loads the page, submits the sample deburr job with the button, waits for the plot.
+  async deburr() {
+    await page.goto(`${base}/`);
+    await page.click('#deburr-compute');
+    await page.waitForSelector('#deburr-plot[data-state="drawn"]', { timeout: 15000 });
+    const segments = Number(await page.getAttribute('#deburr-plot', 'data-segments'));
+    const inked = await inkedPixels('#deburr-plot');
+    const summary = await page.textContent('#deburr-summary');
+    if (segments < 10) throw new Error(`only ${segments} segments drawn`);
+    if (inked < 500) throw new Error(`plot nearly blank: ${inked} inked pixels`);
+    if (!/points\s*\d+/.test(summary)) throw new Error(`no summary: ${summary}`);
+    // A bad value is reported with the field highlighted.
+    await page.fill('input[name="hole_radius"]', '-1');
+    await page.click('#deburr-compute');
+    await page.waitForSelector('#deburr-messages .message.error', { timeout: 15000 });
+    const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
+    if (!highlighted.includes('hole_radius')) throw new Error(`field not highlighted: ${highlighted}`);
+    return { segments, inked };
+  },
+};
+
+try {
+  const result = await scenarios[scenario]();
+  if (screenshot) await page.screenshot({ path: screenshot, fullPage: true });
+  if (problems.length) throw new Error(problems.join('; '));
+  console.log(JSON.stringify({ ok: true, ...result }));
+  await browser.close();
+} catch (error) {
+  if (screenshot) await page.screenshot({ path: screenshot, fullPage: true }).catch(() => {});
+  console.log(JSON.stringify({ ok: false, error: String(error.message || error) }));
+  await browser.close();
+  process.exit(1);
+}

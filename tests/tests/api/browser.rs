@@ -1,0 +1,46 @@
+//! The page in real headless Chromium (Debian's `chromium`, driven by playwright-core from
+//! `tests/browser/`): it loads, submits the sample job with its button, and plots.
+
+use std::path::Path;
+use std::process::Command;
+
+use kerf_tests::{TestApp, external_program, external_required};
+
+/// Runs `tests/browser/run.mjs <scenario>` against `app`; `None` when the tools are missing.
+pub fn run_scenario(app: &TestApp, scenario: &str) -> Option<serde_json::Value> {
+    let node = external_program("node", "the browser test")?;
+    external_program("chromium", "the browser test")?;
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("browser");
+    if !folder.join("node_modules/playwright-core").is_dir() {
+        let message =
+            "playwright-core is not installed: run `npm ci --prefix tests/browser` (skipping the browser test)";
+        assert!(!external_required(), "{message}, but KERF_REQUIRE_EXTERNAL=1");
+        eprintln!("SKIP: {message}");
+        return None;
+    }
+    let screenshot = app.directory().join(format!("{scenario}.png"));
+    let output = Command::new(node)
+        .current_dir(&folder)
+        .arg("run.mjs")
+        .arg(scenario)
+        .arg(&app.base)
+        .arg(&screenshot)
+        .output()
+        .expect("node runs");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "browser scenario {scenario} failed: {stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let line = stdout.lines().last().unwrap_or_default();
+    Some(serde_json::from_str(line).unwrap_or_else(|_| panic!("scenario output: {stdout}")))
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn deburr_page_plots_the_sample_job() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "deburr") else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["segments"].as_u64().unwrap() >= 10, "{result}");
+}

@@ -1,0 +1,176 @@
+// Deburr view: a form for one cross-hole ridge, the 3-D plot of ridge and ball-centre path,
+// the summary, warnings and the G-code download (api.md, Deburr).
+import { api, download, message, number, showProblem } from '/app.js';
+import { Plot3D } from '/plot3d.js';
+
+const FORM = `
+<div class="layout">
+  <form id="deburr-form" novalidate>
+    <fieldset><legend>Tool</legend>
+      <label>Tool <select name="tool_choice" data-field="tool"></select></label>
+      <label data-inline-tool>Ball radius, mm <input name="ball_radius" type="number" step="any" value="2" data-field="tool.radius"></label>
+    </fieldset>
+    <fieldset><legend>Workpiece</legend>
+      <label>Kind <select name="workpiece_kind" data-field="workpiece.kind">
+        <option value="tube">tube</option><option value="bore_block">block with bore</option></select></label>
+      <label>Origin on axis <span class="triple">
+        <input name="ox" type="number" step="any" value="0" data-field="workpiece.origin">
+        <input name="oy" type="number" step="any" value="0" data-field="workpiece.origin">
+        <input name="oz" type="number" step="any" value="0" data-field="workpiece.origin"></span></label>
+      <label>Arrangement, ° <input name="arrangement" type="number" step="any" value="0" data-field="workpiece.arrangement_angle_deg"></label>
+      <label data-kind="tube">Inner radius <input name="inner_radius" type="number" step="any" value="15" data-field="workpiece.inner_radius"></label>
+      <label data-kind="tube">Outer radius <input name="outer_radius" type="number" step="any" value="25" data-field="workpiece.outer_radius"></label>
+      <label data-kind="bore_block">Bore radius <input name="bore_radius" type="number" step="any" value="20" data-field="workpiece.bore_radius"></label>
+      <label data-kind="bore_block">Face distance <input name="face_distance" type="number" step="any" value="40" data-field="workpiece.face_distance"></label>
+    </fieldset>
+    <fieldset><legend>Hole</legend>
+      <label>Shape <select name="shape" data-field="hole.shape">
+        <option value="round">round</option><option value="slot">slot</option><option value="rounded_rect">rounded rectangle</option></select></label>
+      <label>Radius R2 <input name="hole_radius" type="number" step="any" value="5" data-field="hole.radius"></label>
+      <label data-shape="slot">Centre distance <input name="slot_length" type="number" step="any" value="10" data-field="hole.centre_distance"></label>
+      <label data-shape="rounded_rect">Centres across, along <span class="pair">
+        <input name="rect_across" type="number" step="any" value="8" data-field="hole.centre_distance">
+        <input name="rect_along" type="number" step="any" value="12" data-field="hole.centre_distance"></span></label>
+      <label>Eccentricity f <input name="eccentricity" type="number" step="any" value="0" data-field="hole.eccentricity"></label>
+      <label>Penetration, ° <input name="penetration" type="number" step="any" value="0" data-field="hole.penetration_angle_deg"></label>
+    </fieldset>
+    <fieldset><legend>Cut</legend>
+      <label>Edge <select name="edge" data-field="edge"><option value="outer">outer</option><option value="inner">inner</option></select></label>
+      <label>Amount Q, mm <input name="cut_amount" type="number" step="any" value="0.2" data-field="cut_amount"></label>
+      <label>Tolerance TA, mm <input name="tolerance" type="number" step="any" value="0.01" data-field="tolerance"></label>
+      <label>Method <select name="method" data-field="method"><option value="tangent">tangent (seed)</option><option value="exact">exact width</option></select></label>
+      <label>Direction <select name="direction" data-field="direction"><option value="ccw">ccw (climb)</option><option value="cw">cw</option></select></label>
+      <label>Feed, mm/min <input name="feed" type="number" step="any" value="300" data-field="feed"></label>
+      <label>Spindle, rpm <input name="spindle_rpm" type="number" step="any" value="6000" data-field="spindle_rpm"></label>
+    </fieldset>
+    <div class="actions">
+      <button class="primary" type="submit" id="deburr-compute">Compute</button>
+      <select name="dialect" aria-label="G-code dialect"><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select>
+      <select name="reference" aria-label="Programmed point"><option value="tip">tip</option><option value="centre">ball centre</option></select>
+      <button class="secondary" type="button" id="deburr-gcode">G-code</button>
+    </div>
+  </form>
+  <section>
+    <canvas class="plot" id="deburr-plot" aria-label="Ridge line and tool-centre path"></canvas>
+    <p class="hint">Drag to rotate, shift-drag to pan, wheel to zoom, double-click to reset.</p>
+    <div id="deburr-messages"></div>
+    <div id="deburr-summary" class="summary"></div>
+  </section>
+</div>`;
+
+function value(form, name) {
+  return form.elements[name].value;
+}
+
+function numeric(form, name) {
+  const text = value(form, name).trim();
+  return text === '' ? undefined : Number(text);
+}
+
+// The request body from the form (field names as api.md).
+export function deburrRequest(form) {
+  const choice = value(form, 'tool_choice');
+  const tool = choice === 'inline' ? { kind: 'ball', radius: numeric(form, 'ball_radius') } : Number(choice);
+  const origin = [numeric(form, 'ox') ?? 0, numeric(form, 'oy') ?? 0, numeric(form, 'oz') ?? 0];
+  const kind = value(form, 'workpiece_kind');
+  const workpiece = kind === 'tube'
+    ? { kind, origin, arrangement_angle_deg: numeric(form, 'arrangement') ?? 0, inner_radius: numeric(form, 'inner_radius'), outer_radius: numeric(form, 'outer_radius') }
+    : { kind, origin, arrangement_angle_deg: numeric(form, 'arrangement') ?? 0, bore_radius: numeric(form, 'bore_radius'), face_distance: numeric(form, 'face_distance') };
+  const shape = value(form, 'shape');
+  const hole = { shape, radius: numeric(form, 'hole_radius'), eccentricity: numeric(form, 'eccentricity') ?? 0, penetration_angle_deg: numeric(form, 'penetration') ?? 0 };
+  if (shape === 'slot') hole.centre_distance = numeric(form, 'slot_length');
+  if (shape === 'rounded_rect') hole.centre_distance = [numeric(form, 'rect_across'), numeric(form, 'rect_along')];
+  return {
+    tool, workpiece, hole,
+    edge: value(form, 'edge'),
+    cut_amount: numeric(form, 'cut_amount'),
+    tolerance: numeric(form, 'tolerance'),
+    method: value(form, 'method'),
+    direction: value(form, 'direction'),
+    feed: numeric(form, 'feed'),
+    spindle_rpm: numeric(form, 'spindle_rpm'),
+  };
+}
+
+function syncVisibility(form) {
+  const kind = value(form, 'workpiece_kind');
+  const shape = value(form, 'shape');
+  form.querySelectorAll('[data-kind]').forEach((e) => { e.hidden = e.dataset.kind !== kind; });
+  form.querySelectorAll('[data-shape]').forEach((e) => { e.hidden = e.dataset.shape !== shape; });
+  form.querySelector('[data-inline-tool]').hidden = value(form, 'tool_choice') !== 'inline';
+  if (kind === 'bore_block') form.elements.edge.value = 'inner';
+}
+
+async function loadTools(select) {
+  select.replaceChildren(new Option('inline ball (radius below)', 'inline'));
+  try {
+    for (const tool of await api('GET', '/api/v1/tools')) {
+      if (tool.kind === 'ball') select.append(new Option(`T${tool.number} ball R${tool.radius}${tool.name ? ' ' + tool.name : ''}`, String(tool.number)));
+    }
+  } catch (problem) {
+    // The inline tool still works without the table.
+  }
+}
+
+function render(plot, summaryBox, messages, answer) {
+  const points = answer.points;
+  const lead = (moves) => moves.map((m) => m.centre);
+  plot.setSeries([
+    { label: 'ridge (targets)', points: points.map((p) => p.target), colour: '#555', width: 1.5 },
+    { label: 'ball centres', points: points.map((p) => p.centre), colour: '#0b63b6', width: 2, marks: true },
+    { label: 'approach / retract', points: [...lead(answer.lead_in), ...lead(answer.lead_out)].length ? [...lead(answer.lead_in)] : [], colour: '#c77700', width: 1.5, dash: [5, 4] },
+    { label: '', points: answer.lead_out.length ? [points[points.length - 1].centre, ...lead(answer.lead_out)] : [], colour: '#c77700', width: 1.5, dash: [5, 4] },
+  ]);
+  const s = answer.summary;
+  const items = [
+    ['points', s.count], ['path length, mm', number(s.path_length, 3)], ['max deviation, mm', number(s.max_deviation, 5)],
+    ['width W, mm', number(s.width)], ['true width, mm', `${number(s.true_width_min)} – ${number(s.true_width_max)}`],
+    ['wedge angle, °', `${number(s.wedge_angle_min_deg, 2)} – ${number(s.wedge_angle_max_deg, 2)}`],
+    ['est. time, s', number(s.estimated_time_s, 1)],
+  ];
+  if (s.max_exact_offset !== undefined) items.push(['exact vs seed, mm', number(s.max_exact_offset, 5)]);
+  summaryBox.replaceChildren(...items.map(([name, v]) => {
+    const div = document.createElement('div');
+    div.append(name);
+    const b = document.createElement('b');
+    b.textContent = String(v);
+    div.append(b);
+    return div;
+  }));
+  messages.replaceChildren(...answer.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
+}
+
+export const deburrView = {
+  id: 'deburr',
+  title: 'Deburr',
+  mount(root) {
+    root.innerHTML = FORM;
+    const form = root.querySelector('#deburr-form');
+    const plot = new Plot3D(root.querySelector('#deburr-plot'));
+    const messages = root.querySelector('#deburr-messages');
+    const summary = root.querySelector('#deburr-summary');
+    form.addEventListener('change', () => syncVisibility(form));
+    loadTools(form.elements.tool_choice).then(() => syncVisibility(form));
+    syncVisibility(form);
+    form.addEventListener('submit', async (event) => {
+      event.preventDefault();
+      form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+      messages.replaceChildren(message('warning', 'computing…'));
+      try {
+        render(plot, summary, messages, await api('POST', '/api/v1/deburr', deburrRequest(form)));
+      } catch (problem) {
+        summary.replaceChildren();
+        showProblem(messages, form, problem);
+      }
+    });
+    root.querySelector('#deburr-gcode').addEventListener('click', async () => {
+      const query = `?format=gcode&dialect=${value(form, 'dialect')}&reference=${value(form, 'reference')}`;
+      try {
+        const program = await api('POST', `/api/v1/deburr${query}`, deburrRequest(form), 'text/x-gcode');
+        download(`deburr-${value(form, 'dialect')}.nc`, program);
+      } catch (problem) {
+        showProblem(messages, form, problem);
+      }
+    });
+  },
+};
