@@ -27,8 +27,10 @@ pub struct Config {
     pub database: PathBuf,
     /// Request limits.
     pub limits: Limits,
-    /// Solver calls allowed at once.
+    /// Solver calls allowed at once (synchronous requests and jobs together).
     pub solver_slots: usize,
+    /// Job workers.
+    pub job_workers: usize,
 }
 
 /// The OpenAPI document and the API routes.
@@ -37,6 +39,7 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
         .merge(http::health::router())
         .merge(http::tools::router())
         .merge(http::deburr::router())
+        .merge(http::jobs::router())
         .split_for_parts()
 }
 
@@ -64,12 +67,13 @@ fn panic_response(cause: Box<dyn Any + Send + 'static>) -> Response<Body> {
     AppError::Internal(anyhow::anyhow!("handler panicked: {message}")).into_response()
 }
 
-/// Opens the database and builds the service.
+/// Opens the database, recovers interrupted jobs, starts the job workers and builds the service.
 ///
 /// # Errors
 /// When the database cannot be opened or migrated.
 pub async fn build(config: &Config) -> anyhow::Result<(Router, AppState)> {
     let pool = db::open(&config.database).await?;
     let state = AppState::new(pool, config.limits.clone(), config.solver_slots);
+    state.jobs.start(&state.db, &state.solver_slots, config.job_workers).await?;
     Ok((router(state.clone()), state))
 }

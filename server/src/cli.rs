@@ -1,10 +1,14 @@
-//! Command line and environment configuration of the `kerf` binary.
+//! The `kerf` program: command line and environment configuration, `serve` (until SIGINT or
+//! SIGTERM) and `run`.
 
 use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::time::Duration;
 
+use anyhow::Context;
 use clap::{Args, Parser, Subcommand};
+use tokio::net::TcpListener;
+use tracing_subscriber::EnvFilter;
 
 use crate::app::Config;
 use crate::state::Limits;
@@ -26,6 +30,21 @@ pub struct Cli {
 pub enum Command {
     /// Run the HTTP service (the default).
     Serve(ServeArgs),
+    /// Run a job file locally, without the service, and write its results as files.
+    Run(RunArgs),
+}
+
+/// Options of `kerf run`.
+#[derive(Debug, Clone, Args)]
+pub struct RunArgs {
+    /// The job file (JSON or TOML).
+    pub job_file: PathBuf,
+    /// Folder for the results (created if missing).
+    #[arg(short, long, default_value = "kerf-out")]
+    pub out: PathBuf,
+    /// Tool table to resolve tool numbers the job file does not define (read only; used if it exists).
+    #[arg(long, env = "KERF_DATABASE", default_value = "kerf.db")]
+    pub database: PathBuf,
 }
 
 /// Options of the service.
@@ -46,6 +65,9 @@ pub struct ServeArgs {
     /// Solver calls allowed at once (default: the number of CPU cores).
     #[arg(long, env = "KERF_SOLVER_SLOTS")]
     pub solver_slots: Option<usize>,
+    /// Job workers (default: the number of CPU cores).
+    #[arg(long, env = "KERF_JOB_WORKERS")]
+    pub job_workers: Option<usize>,
 }
 
 impl ServeArgs {
@@ -60,6 +82,68 @@ impl ServeArgs {
                 ..Limits::default()
             },
             solver_slots: self.solver_slots.unwrap_or(cores),
+            job_workers: self.job_workers.unwrap_or(cores),
         }
     }
+}
+
+/// The `kerf` program: parses the command line, sets up logging and runs the command.
+///
+/// # Errors
+/// Whatever the command fails with.
+pub fn main() -> anyhow::Result<()> {
+    let cli = Cli::parse();
+    tracing_subscriber::fmt()
+        .with_env_filter(EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new("info,tower_http=info")))
+        .init();
+    let runtime = tokio::runtime::Runtime::new().context("starting the async runtime")?;
+    match cli.command {
+        Some(Command::Serve(args)) => runtime.block_on(serve(args)),
+        Some(Command::Run(args)) => runtime.block_on(run(args)),
+        None => runtime.block_on(serve(cli.serve)),
+    }
+}
+
+async fn run(args: RunArgs) -> anyhow::Result<()> {
+    let report = crate::jobs::local::run(&args.job_file, &args.out, Some(&args.database)).await?;
+    for file in report.files {
+        println!("{}", file.display());
+    }
+    Ok(())
+}
+
+async fn serve(args: ServeArgs) -> anyhow::Result<()> {
+    let config = args.config();
+    let (router, _state) = crate::app::build(&config).await?;
+    let listener = TcpListener::bind(args.bind).await.with_context(|| format!("binding {}", args.bind))?;
+    tracing::info!(address = %listener.local_addr()?, database = %config.database.display(), "kerf listening");
+    crate::serve(listener, router, shutdown_signal()).await?;
+    tracing::info!("kerf stopped");
+    Ok(())
+}
+
+/// Completes on SIGINT (Ctrl-C) or SIGTERM.
+async fn shutdown_signal() {
+    let interrupt = async {
+        let _ = tokio::signal::ctrl_c().await;
+    };
+    #[cfg(unix)]
+    let terminate = async {
+        match tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate()) {
+            Ok(mut signal) => {
+                signal.recv().await;
+            }
+            Err(error) => {
+                tracing::warn!(%error, "cannot listen for SIGTERM");
+                std::future::pending::<()>().await;
+            }
+        }
+    };
+    #[cfg(not(unix))]
+    let terminate = std::future::pending::<()>();
+    tokio::select! {
+        () = interrupt => {},
+        () = terminate => {},
+    }
+    tracing::info!("shutting down");
 }

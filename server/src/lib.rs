@@ -9,6 +9,7 @@ pub mod db;
 pub mod error;
 pub mod extract;
 pub mod http;
+pub mod jobs;
 pub mod openapi;
 pub mod state;
 pub mod store;

@@ -8,6 +8,7 @@ use sqlx::SqlitePool;
 use tokio::sync::Semaphore;
 
 use crate::error::{AppError, AppResult};
+use crate::jobs::queue::JobRunner;
 
 /// Limits that protect the service from large or slow requests.
 #[derive(Debug, Clone)]
@@ -37,14 +38,22 @@ pub struct AppState {
     pub db: SqlitePool,
     /// Request limits.
     pub limits: Limits,
-    /// Permits for solver work running at once (bounds CPU and memory under a burst).
+    /// Permits for solver work running at once (bounds CPU and memory under a burst); shared
+    /// by synchronous requests and job workers.
     pub solver_slots: Arc<Semaphore>,
+    /// The job workers' coordination.
+    pub jobs: Arc<JobRunner>,
 }
 
 impl AppState {
     /// State over `db` with `limits`, allowing `solver_slots` solver calls at once.
     pub fn new(db: SqlitePool, limits: Limits, solver_slots: usize) -> Self {
-        Self { db, limits, solver_slots: Arc::new(Semaphore::new(solver_slots.max(1))) }
+        Self {
+            db,
+            limits,
+            solver_slots: Arc::new(Semaphore::new(solver_slots.max(1))),
+            jobs: Arc::new(JobRunner::default()),
+        }
     }
 
     /// Runs pure solver work on the blocking pool, never on an async worker thread, under the

@@ -37,7 +37,7 @@ impl TestApp {
     pub async fn spawn_with(limits: Limits) -> Self {
         let directory = tempfile::tempdir().expect("temporary directory");
         let database = directory.path().join("kerf.db");
-        let config = Config { database: database.clone(), limits, solver_slots: 2 };
+        let config = Config { database: database.clone(), limits, solver_slots: 2, job_workers: 2 };
         let mut app = Self {
             base: String::new(),
             client: Client::builder().timeout(Duration::from_secs(60)).build().expect("client"),
@@ -150,4 +150,70 @@ pub fn external_program(program: &str, purpose: &str) -> Option<PathBuf> {
         eprintln!("SKIP: {message}");
     }
     found
+}
+
+/// The real `kerf` program running as a child process on a database file, for tests that
+/// kill it (SIGKILL) or restart it.
+pub struct ServerProcess {
+    /// `http://127.0.0.1:PORT`.
+    pub base: String,
+    child: std::process::Child,
+}
+
+impl ServerProcess {
+    /// Starts `program serve` on `database` at a free loopback port and waits until it answers.
+    pub async fn start(program: &Path, database: &Path) -> Self {
+        let port = std::net::TcpListener::bind("127.0.0.1:0").and_then(|l| l.local_addr()).expect("free port").port();
+        let child = std::process::Command::new(program)
+            .arg("serve")
+            .arg("--bind")
+            .arg(format!("127.0.0.1:{port}"))
+            .arg("--database")
+            .arg(database)
+            .env("RUST_LOG", "warn")
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .expect("server starts");
+        let server = Self { base: format!("http://127.0.0.1:{port}"), child };
+        let client = Client::new();
+        for _ in 0..200 {
+            if client.get(format!("{}/healthz", server.base)).send().await.is_ok_and(|r| r.status().is_success()) {
+                return server;
+            }
+            tokio::time::sleep(Duration::from_millis(50)).await;
+        }
+        panic!("the server did not come up on port {port}");
+    }
+
+    /// Kills the process at once (SIGKILL), as a power cut or `kill -9` would.
+    pub fn kill(mut self) {
+        self.child.kill().expect("kill");
+        self.child.wait().expect("wait");
+    }
+}
+
+impl Drop for ServerProcess {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// Polls job `id` at `base` until `done(job)` or `seconds` pass; returns the last state.
+pub async fn poll_job(client: &Client, base: &str, id: i64, seconds: u64, done: impl Fn(&Value) -> bool) -> Value {
+    let deadline = std::time::Instant::now() + Duration::from_secs(seconds);
+    loop {
+        let job: Value =
+            client.get(format!("{base}/api/v1/jobs/{id}")).send().await.expect("poll").json().await.expect("job");
+        if done(&job) || std::time::Instant::now() > deadline {
+            return job;
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+}
+
+/// True once a job reached a final status.
+pub fn finished(job: &Value) -> bool {
+    matches!(job["status"].as_str(), Some("done" | "failed" | "cancelled"))
 }

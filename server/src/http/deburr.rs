@@ -4,8 +4,9 @@ use axum::Json;
 use axum::extract::State;
 use axum::http::HeaderMap;
 use axum::response::{IntoResponse, Response};
+use kerf_solver::SolverError;
 use kerf_solver::deburr::{self, Deburr, DeburrRequest, Post};
-use kerf_solver::gcode::ToolCall;
+use kerf_solver::gcode::{Dialect, Reference, ToolCall};
 use kerf_solver::tool::Tool;
 use serde::Serialize;
 use utoipa::ToSchema;
@@ -51,17 +52,23 @@ async fn post_deburr(
 ) -> AppResult<Response> {
     let output = Output::negotiate(&headers, &query);
     let tool = store::tools::resolve(&state.db, &request.tool).await?;
-    let used_tool = tool.clone();
-    let result = state.solve(move || deburr::solve(&request, &tool)).await??;
+    let answer = state.solve(move || run(&request, tool)).await??;
     if output.gcode {
-        let post = Post {
-            dialect: output.dialect.unwrap_or_default(),
-            reference: output.reference,
-            tool: ToolCall::for_tool(&used_tool),
-        };
-        return Ok(gcode_response(deburr::program(&result, &post)?));
+        return Ok(gcode_response(program(&answer, output.dialect.unwrap_or_default(), output.reference)?));
     }
-    Ok(Json(DeburrAnswer { tool: used_tool, result }).into_response())
+    Ok(Json(answer).into_response())
+}
+
+/// Solves a deburr request with its resolved tool (used by the route and by jobs).
+pub fn run(request: &DeburrRequest, tool: Tool) -> Result<DeburrAnswer, SolverError> {
+    let result = deburr::solve(request, &tool)?;
+    Ok(DeburrAnswer { tool, result })
+}
+
+/// The G-code program of a solved deburr request.
+pub fn program(answer: &DeburrAnswer, dialect: Dialect, reference: Reference) -> Result<String, SolverError> {
+    let post = Post { dialect, reference, tool: ToolCall::for_tool(&answer.tool) };
+    deburr::program(&answer.result, &post)
 }
 
 /// Routes of this module.

@@ -2,5 +2,6 @@
 
 pub mod deburr;
 pub mod health;
+pub mod jobs;
 pub mod output;
 pub mod tools;

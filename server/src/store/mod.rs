@@ -1,3 +1,4 @@
 //! Repositories: the only place with SQL. Handlers call these functions.
 
+pub mod jobs;
 pub mod tools;

@@ -79,6 +79,7 @@ impl Construction {
 
     /// The seed's construction at profile point `point` (deburr.md §2.7). The caller has checked
     /// |x| < R1.
+    #[inline]
     pub fn tangent(&self, point: &ProfilePoint) -> RidgeCentre {
         let r1 = self.cylinder_radius;
         let z = (r1 * r1 - point.x * point.x).sqrt();
@@ -104,7 +105,9 @@ impl Construction {
         }
     }
 
-    /// Only the centre C of [`Self::tangent`], for the tolerance bisection's inner loop.
+    /// Only the centre C of [`Self::tangent`], for the tolerance bisection's inner loop (inlined,
+    /// so the other fields are never stored).
+    #[inline]
     pub fn tangent_centre(&self, point: &ProfilePoint) -> Vec3 {
         self.tangent(point).centre
     }

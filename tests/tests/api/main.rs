@@ -4,5 +4,6 @@ mod bad_requests;
 mod browser;
 mod deburr;
 mod gcode;
+mod jobs;
 mod openapi;
 mod tools;

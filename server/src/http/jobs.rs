@@ -1,0 +1,285 @@
+//! Jobs over HTTP (api.md, Jobs): submit a job file (multipart field `file`, or the raw body as
+//! JSON or TOML), follow it, fetch its results and G-code, cancel it, list jobs with paging.
+
+use axum::Json;
+use axum::extract::{FromRequest, Multipart, Request, State};
+use axum::http::{HeaderValue, StatusCode, header};
+use axum::response::{IntoResponse, Response};
+use serde::{Deserialize, Serialize};
+use utoipa::{IntoParams, ToSchema};
+use utoipa_axum::router::OpenApiRouter;
+use utoipa_axum::routes;
+
+use super::output::gcode_response;
+use crate::error::{AppError, AppResult, Problem};
+use crate::extract::{AppPath, AppQuery, body_bytes, media_type};
+use crate::jobs::file::{self, Format, JobFile};
+use crate::state::AppState;
+use crate::store;
+use crate::store::jobs::{JobRecord, JobStatus};
+
+/// The answer to a submission.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct Submitted {
+    /// Job id; follow it at `Location`.
+    pub id: i64,
+    /// `queued`, or `done` when an identical finished job was reused.
+    pub status: JobStatus,
+    /// True when the answer is an earlier identical job's.
+    pub reused: bool,
+}
+
+/// One operation's result in a finished job.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct JobResult {
+    /// The operation's name.
+    pub operation: String,
+    /// Its answer, as its endpoint answers JSON.
+    pub result: serde_json::Value,
+    /// Whether `GET /api/v1/jobs/{id}/gcode?operation=N` has a program for it.
+    pub gcode: bool,
+    /// Why no program could be written, if so.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gcode_problem: Option<String>,
+}
+
+/// A job with its results once done.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct JobView {
+    /// The job.
+    #[serde(flatten)]
+    pub job: JobRecord,
+    /// Results in operation order (only when `status` is `done`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub results: Option<Vec<JobResult>>,
+}
+
+/// A page of jobs, newest first.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct JobPage {
+    /// The jobs.
+    pub jobs: Vec<JobRecord>,
+    /// Pass as `before` for the next page; absent on the last page.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub next_before: Option<i64>,
+}
+
+/// Paging of the job list.
+#[derive(Debug, Deserialize, IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+pub struct PageQuery {
+    /// Jobs per page (1–200, default 50).
+    pub limit: Option<i64>,
+    /// Only jobs with a smaller id (from `next_before`).
+    pub before: Option<i64>,
+}
+
+/// Which program of a job.
+#[derive(Debug, Deserialize, IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+pub struct ProgramQuery {
+    /// Operation index (0-based); needed when the job has several programs.
+    pub operation: Option<usize>,
+}
+
+/// The `{id}` path parameter.
+#[derive(Debug, Deserialize)]
+struct JobId {
+    id: i64,
+}
+
+/// Reads the uploaded job file's text and its format.
+async fn upload(state: &AppState, request: Request) -> AppResult<(String, Format)> {
+    let limit = state.limits.max_body_bytes;
+    let media = media_type(request.headers());
+    let (bytes, name, media) = match media.as_deref() {
+        Some("multipart/form-data") => {
+            let mut multipart = Multipart::from_request(request, state)
+                .await
+                .map_err(|rejection| AppError::bad_request("E_MULTIPART", "file", rejection.body_text()))?;
+            let mut found = None;
+            loop {
+                let field = match multipart.next_field().await {
+                    Ok(Some(field)) => field,
+                    Ok(None) => break,
+                    Err(error) if error.status() == StatusCode::PAYLOAD_TOO_LARGE => {
+                        return Err(AppError::PayloadTooLarge { limit });
+                    }
+                    Err(error) => return Err(AppError::bad_request("E_MULTIPART", "file", error.body_text())),
+                };
+                if field.name() != Some("file") {
+                    continue;
+                }
+                let name = field.file_name().map(str::to_owned);
+                let media = field.content_type().map(str::to_owned);
+                let bytes = field.bytes().await.map_err(|error| {
+                    if error.status() == StatusCode::PAYLOAD_TOO_LARGE {
+                        AppError::PayloadTooLarge { limit }
+                    } else {
+                        AppError::bad_request("E_MULTIPART", "file", error.body_text())
+                    }
+                })?;
+                found = Some((bytes, name, media));
+                break;
+            }
+            found.ok_or_else(|| AppError::bad_request("E_MULTIPART", "file", "the form has no field named file"))?
+        }
+        Some("application/json" | "application/toml" | "text/toml" | "application/x-toml" | "text/x-toml") => {
+            (body_bytes(request, state, limit).await?, None, media)
+        }
+        _ => {
+            return Err(AppError::UnsupportedMediaType(
+                "send the job file as multipart/form-data (field file), application/json or application/toml"
+                    .to_owned(),
+            ));
+        }
+    };
+    let text = String::from_utf8(bytes.to_vec())
+        .map_err(|_| AppError::bad_request("E_JOB_FILE", "file", "the job file is not UTF-8 text"))?;
+    let format = Format::detect(name.as_deref(), media.as_deref(), &text);
+    Ok((text, format))
+}
+
+fn located(id: i64, status: StatusCode, body: &Submitted) -> Response {
+    let mut response = (status, Json(body)).into_response();
+    if let Ok(location) = HeaderValue::from_str(&format!("/api/v1/jobs/{id}")) {
+        response.headers_mut().insert(header::LOCATION, location);
+    }
+    response
+}
+
+/// Submits a job file. 202 with the queued job; 200 when an identical finished job is reused.
+#[utoipa::path(post, path = "/api/v1/jobs", tag = "jobs",
+    request_body(description = "The job file: JSON, TOML (`application/toml`), or a form with it in field `file`.",
+        content(
+            (JobFile = "application/json"),
+            (String = "application/toml"),
+            (String = "multipart/form-data"))),
+    responses(
+        (status = 202, description = "Queued", body = Submitted, headers(("Location" = String))),
+        (status = 200, description = "An identical finished job", body = Submitted, headers(("Location" = String))),
+        (status = 400, description = "Not a job file; line and field in the problem", body = Problem, content_type = "application/problem+json"),
+        (status = 404, description = "Unknown tool number", body = Problem, content_type = "application/problem+json"),
+        (status = 413, body = Problem, content_type = "application/problem+json"),
+        (status = 415, body = Problem, content_type = "application/problem+json"),
+        (status = 422, body = Problem, content_type = "application/problem+json")))]
+async fn submit(State(state): State<AppState>, request: Request) -> AppResult<Response> {
+    let (text, format) = upload(&state, request).await?;
+    let job = file::parse(&text, format)?.resolve(&state.db).await?;
+    let hash = job.content_hash();
+    if let Some(id) = store::jobs::find_done(&state.db, &hash).await? {
+        return Ok(located(id, StatusCode::OK, &Submitted { id, status: JobStatus::Done, reused: true }));
+    }
+    let id = store::jobs::insert(&state.db, &job, &hash).await?;
+    state.jobs.submitted.notify_one();
+    Ok(located(id, StatusCode::ACCEPTED, &Submitted { id, status: JobStatus::Queued, reused: false }))
+}
+
+/// Jobs, newest first, a page at a time.
+#[utoipa::path(get, path = "/api/v1/jobs", tag = "jobs", params(PageQuery),
+    responses((status = 200, body = JobPage), (status = 400, body = Problem, content_type = "application/problem+json")))]
+async fn list(State(state): State<AppState>, AppQuery(query): AppQuery<PageQuery>) -> AppResult<Json<JobPage>> {
+    let limit = query.limit.unwrap_or(50);
+    if !(1..=200).contains(&limit) {
+        return Err(AppError::bad_request("E_QUERY", "limit", "limit must be 1 to 200"));
+    }
+    let jobs = store::jobs::list(&state.db, limit + 1, query.before).await?;
+    let more = jobs.len() > usize::try_from(limit).unwrap_or(usize::MAX);
+    let jobs: Vec<JobRecord> = jobs.into_iter().take(usize::try_from(limit).unwrap_or(0)).collect();
+    let next_before = if more { jobs.last().map(|job| job.id) } else { None };
+    Ok(Json(JobPage { jobs, next_before }))
+}
+
+async fn record(state: &AppState, id: i64) -> AppResult<JobRecord> {
+    store::jobs::get(&state.db, id).await?.ok_or_else(|| AppError::not_found(format!("job {id} does not exist")))
+}
+
+/// A job: status, progress and, when done, its results.
+#[utoipa::path(get, path = "/api/v1/jobs/{id}", tag = "jobs",
+    params(("id" = i64, Path, description = "Job id")),
+    responses((status = 200, body = JobView), (status = 404, body = Problem, content_type = "application/problem+json")))]
+async fn show(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobId>) -> AppResult<Json<JobView>> {
+    let job = record(&state, id).await?;
+    let results = if job.status == JobStatus::Done {
+        let rows = store::jobs::results(&state.db, id).await?;
+        let mut results = Vec::with_capacity(rows.len());
+        for (operation, json, gcode, gcode_problem) in rows {
+            let result = serde_json::from_str(&json).map_err(|e| AppError::Internal(e.into()))?;
+            results.push(JobResult { operation, result, gcode, gcode_problem });
+        }
+        Some(results)
+    } else {
+        None
+    };
+    Ok(Json(JobView { job, results }))
+}
+
+/// A finished job's G-code program (one per operation).
+#[utoipa::path(get, path = "/api/v1/jobs/{id}/gcode", tag = "jobs",
+    params(("id" = i64, Path, description = "Job id"), ProgramQuery),
+    responses(
+        (status = 200, body = String, content_type = "text/x-gcode"),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 409, description = "Not finished", body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "No program for that operation, or several to choose from", body = Problem, content_type = "application/problem+json")))]
+async fn gcode(
+    State(state): State<AppState>,
+    AppPath(JobId { id }): AppPath<JobId>,
+    AppQuery(query): AppQuery<ProgramQuery>,
+) -> AppResult<Response> {
+    let job = record(&state, id).await?;
+    if job.status != JobStatus::Done {
+        return Err(AppError::Conflict(format!("job {id} is {:?}, not done", job.status).to_lowercase()));
+    }
+    let programs = store::jobs::programs(&state.db, id).await?;
+    let index = match (query.operation, programs.len()) {
+        (Some(index), count) if index < count => index,
+        (Some(index), count) => {
+            return Err(AppError::bad_request("E_QUERY", "operation", format!("operation {index} out of 0..{count}")));
+        }
+        (None, 1) => 0,
+        (None, count) => {
+            return Err(kerf_solver::SolverError::input(
+                "operation",
+                format!("job {id} has {count} operations: choose one with ?operation=0..{}", count - 1),
+            )
+            .into());
+        }
+    };
+    match &programs[index] {
+        (Some(program), _) => Ok(gcode_response(program.clone())),
+        (None, problem) => Err(kerf_solver::SolverError::new(
+            "E_NO_PROGRAM",
+            format!("operation {index} has no program: {}", problem.as_deref().unwrap_or("it writes no path")),
+        )
+        .at("operation")
+        .into()),
+    }
+}
+
+/// Cancels a queued or running job.
+#[utoipa::path(delete, path = "/api/v1/jobs/{id}", tag = "jobs",
+    params(("id" = i64, Path, description = "Job id")),
+    responses(
+        (status = 200, description = "Cancelled", body = JobView),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 409, description = "Already finished", body = Problem, content_type = "application/problem+json")))]
+async fn cancel(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobId>) -> AppResult<Json<JobView>> {
+    match store::jobs::cancel(&state.db, id).await? {
+        None => Err(AppError::not_found(format!("job {id} does not exist"))),
+        Some((status, false)) => {
+            Err(AppError::Conflict(format!("job {id} already finished ({})", format!("{status:?}").to_lowercase())))
+        }
+        Some((_, true)) => {
+            state.jobs.cancel(id);
+            Ok(Json(JobView { job: record(&state, id).await?, results: None }))
+        }
+    }
+}
+
+/// Routes of this module.
+pub fn router() -> OpenApiRouter<AppState> {
+    OpenApiRouter::new().routes(routes!(submit, list)).routes(routes!(show, cancel)).routes(routes!(gcode))
+}

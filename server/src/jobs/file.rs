@@ -1,0 +1,388 @@
+//! Job files: a name, optional tools, output options and a list of operations, each with the
+//! same request its endpoint takes. JSON or TOML; errors point at the line and the field.
+//!
+//! ```toml
+//! name = "manifold deburr"
+//! [output]
+//! dialect = "linuxcnc"
+//!
+//! [[tools]]
+//! number = 7
+//! kind = "ball"
+//! radius = 3
+//!
+//! [[operations]]
+//! operation = "deburr"
+//! tool = 7
+//! edge = "outer"
+//! cut_amount = 0.2
+//! workpiece = { kind = "tube", origin = [0, 0, 0], inner_radius = 15, outer_radius = 25 }
+//! hole = { shape = "round", radius = 5 }
+//! ```
+
+use kerf_solver::deburr::DeburrRequest;
+use kerf_solver::gcode::{Dialect, Reference};
+use kerf_solver::tool::{Tool, ToolRef};
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use sqlx::SqlitePool;
+use utoipa::ToSchema;
+
+use crate::error::{AppError, AppResult};
+use crate::store;
+
+/// Most operations one job may hold.
+pub const MAX_OPERATIONS: usize = 100;
+/// Deepest nesting of arrays and tables accepted in a job file.
+pub const MAX_NESTING: usize = 32;
+
+/// A job file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct JobFile {
+    /// Free-text name shown in job lists.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Tools the operations may name by number; they take precedence over the tool table.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub tools: Vec<Tool>,
+    /// How the G-code of every operation is written.
+    #[serde(default)]
+    pub output: OutputOptions,
+    /// The operations, run in order (1–100).
+    pub operations: Vec<Operation>,
+}
+
+/// G-code options of a job.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct OutputOptions {
+    /// `fanuc` (default) or `linuxcnc`.
+    #[serde(default)]
+    pub dialect: Dialect,
+    /// `tip` (default) or `centre`.
+    #[serde(default)]
+    pub reference: Reference,
+}
+
+/// One operation: `operation` names it, the other fields are its endpoint's request.
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[serde(tag = "operation", rename_all = "snake_case")]
+pub enum Operation {
+    /// `POST /api/v1/deburr`.
+    Deburr(DeburrRequest),
+}
+
+/// The names `operation` may take.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum OperationKind {
+    Deburr,
+}
+
+impl OperationKind {
+    /// Reads the operation's request from `fields` (the table without `operation`).
+    fn read<'de, D: serde::Deserializer<'de>>(self, fields: D) -> Result<Operation, D::Error> {
+        match self {
+            Self::Deburr => DeburrRequest::deserialize(fields).map(Operation::Deburr),
+        }
+    }
+}
+
+// Hand-written instead of serde's internally tagged enum, which buffers the table and so loses
+// the field path and line of errors inside it. When `operation` is the first key (as in every
+// example) the rest of the table is read in place; otherwise it is buffered and dispatched.
+impl<'de> Deserialize<'de> for Operation {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct OperationVisitor;
+
+        impl<'de> serde::de::Visitor<'de> for OperationVisitor {
+            type Value = Operation;
+
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("an operation table with `operation` and its request's fields")
+            }
+
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Operation, A::Error> {
+                use serde::de::Error;
+                let Some(first) = map.next_key::<String>()? else {
+                    return Err(A::Error::missing_field("operation"));
+                };
+                if first == "operation" {
+                    let kind: OperationKind = map.next_value()?;
+                    return kind.read(serde::de::value::MapAccessDeserializer::new(map));
+                }
+                let mut fields = serde_json::Map::new();
+                fields.insert(first, map.next_value()?);
+                while let Some(key) = map.next_key::<String>()? {
+                    let value = map.next_value()?;
+                    fields.insert(key, value);
+                }
+                let kind = fields.remove("operation").ok_or_else(|| A::Error::missing_field("operation"))?;
+                let kind: OperationKind = serde_json::from_value(kind).map_err(A::Error::custom)?;
+                kind.read(serde_json::Value::Object(fields)).map_err(A::Error::custom)
+            }
+        }
+
+        deserializer.deserialize_map(OperationVisitor)
+    }
+}
+
+impl Operation {
+    /// The operation's name.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Deburr(_) => "deburr",
+        }
+    }
+
+    /// The tool reference, for operations that use a tool.
+    fn tool_mut(&mut self) -> Option<&mut ToolRef> {
+        match self {
+            Self::Deburr(request) => Some(&mut request.tool),
+        }
+    }
+}
+
+/// The two file formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// JSON.
+    Json,
+    /// TOML.
+    Toml,
+}
+
+impl Format {
+    /// The format a file name or media type says, else a guess from the first character.
+    pub fn detect(name: Option<&str>, media_type: Option<&str>, text: &str) -> Self {
+        let by_name = name.map(str::to_ascii_lowercase);
+        if by_name.as_deref().is_some_and(|n| n.ends_with(".toml")) || media_type.is_some_and(|m| m.contains("toml")) {
+            return Self::Toml;
+        }
+        if by_name.as_deref().is_some_and(|n| n.ends_with(".json")) || media_type.is_some_and(|m| m.contains("json")) {
+            return Self::Json;
+        }
+        if text.trim_start().starts_with('{') { Self::Json } else { Self::Toml }
+    }
+}
+
+/// 1-based line and column of byte `offset` in `text`.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
+fn file_error(path: &str, line: Option<(usize, usize)>, message: &str) -> AppError {
+    let field = if path.is_empty() || path == "." || path == "?" { "file".to_owned() } else { path.to_owned() };
+    let place = line.map(|(l, c)| format!("line {l}, column {c}: ")).unwrap_or_default();
+    AppError::bad_request("E_JOB_FILE", field.clone(), format!("{place}{field}: {message}"))
+}
+
+/// Deepest bracket nesting, ignoring brackets inside strings (a cheap guard before parsing).
+fn nesting(text: &str) -> usize {
+    let (mut depth, mut deepest, mut quote, mut escaped) = (0_usize, 0_usize, None::<char>, false);
+    for c in text.chars() {
+        if let Some(q) = quote {
+            if escaped {
+                escaped = false;
+            } else if c == '\\' && q == '"' {
+                escaped = true;
+            } else if c == q {
+                quote = None;
+            }
+            continue;
+        }
+        match c {
+            '"' | '\'' => quote = Some(c),
+            '[' | '{' => {
+                depth += 1;
+                deepest = deepest.max(depth);
+            }
+            ']' | '}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    deepest
+}
+
+/// Parses and checks a job file. Errors are 400 with the field path and, where known, the line.
+pub fn parse(text: &str, format: Format) -> AppResult<JobFile> {
+    if nesting(text) > MAX_NESTING {
+        return Err(file_error("file", None, &format!("nested deeper than {MAX_NESTING} levels")));
+    }
+    let job: JobFile = match format {
+        Format::Json => {
+            let mut deserializer = serde_json::Deserializer::from_str(text);
+            let job = serde_path_to_error::deserialize(&mut deserializer).map_err(|error| {
+                let path = error.path().to_string();
+                let inner = error.into_inner();
+                let line = (inner.line() > 0).then(|| (inner.line(), inner.column()));
+                let message = inner.to_string();
+                let message = message.split(" at line ").next().unwrap_or(&message).to_owned();
+                file_error(&path, line, &message)
+            })?;
+            deserializer.end().map_err(|e| file_error("file", Some((e.line(), e.column())), "trailing characters"))?;
+            job
+        }
+        Format::Toml => {
+            let deserializer = toml::de::Deserializer::parse(text).map_err(|error| {
+                let line = error.span().map(|span| line_column(text, span.start));
+                file_error("file", line, error.message())
+            })?;
+            serde_path_to_error::deserialize(deserializer).map_err(|error| {
+                let path = error.path().to_string();
+                let inner = error.into_inner();
+                let line = inner.span().map(|span| line_column(text, span.start));
+                file_error(&path, line, inner.message())
+            })?
+        }
+    };
+    check(&job)?;
+    Ok(job)
+}
+
+fn check(job: &JobFile) -> AppResult<()> {
+    if job.operations.is_empty() || job.operations.len() > MAX_OPERATIONS {
+        return Err(file_error("operations", None, &format!("a job needs 1 to {MAX_OPERATIONS} operations")));
+    }
+    for (index, tool) in job.tools.iter().enumerate() {
+        let field = format!("tools[{index}]");
+        let Some(number) = tool.number else {
+            return Err(file_error(&format!("{field}.number"), None, "tools in a job file need their number"));
+        };
+        tool.validate(&format!("{field}."))?;
+        if job.tools[..index].iter().any(|t| t.number == Some(number)) {
+            return Err(file_error(&format!("{field}.number"), None, &format!("tool {number} is defined twice")));
+        }
+    }
+    Ok(())
+}
+
+impl JobFile {
+    /// The job with every tool reference replaced by the tool itself (from the file's `tools`,
+    /// else the tool table), so it runs anywhere without the database. `lookup` finds a number.
+    pub async fn resolve_with<F, Fut>(mut self, lookup: F) -> AppResult<Self>
+    where
+        F: Fn(u32) -> Fut,
+        Fut: std::future::Future<Output = AppResult<Option<Tool>>>,
+    {
+        let local = std::mem::take(&mut self.tools);
+        for (index, operation) in self.operations.iter_mut().enumerate() {
+            let Some(tool) = operation.tool_mut() else { continue };
+            if let ToolRef::Number(number) = *tool {
+                let found = match local.iter().find(|t| t.number == Some(number)) {
+                    Some(tool) => Some(tool.clone()),
+                    None => lookup(number).await?,
+                };
+                let found = found.ok_or_else(|| {
+                    AppError::unknown(
+                        format!("operations[{index}].tool"),
+                        format!("tool {number} is neither in the job file nor in the tool table"),
+                    )
+                })?;
+                *tool = ToolRef::Inline(found);
+            }
+        }
+        Ok(self)
+    }
+
+    /// [`Self::resolve_with`] against the server's tool table.
+    pub async fn resolve(self, db: &SqlitePool) -> AppResult<Self> {
+        self.resolve_with(|number| store::tools::get(db, number)).await
+    }
+
+    /// SHA-256 of the resolved job's canonical JSON: identical jobs have identical hashes.
+    pub fn content_hash(&self) -> String {
+        let bytes = serde_json::to_vec(self).unwrap_or_default();
+        Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TOML_JOB: &str = r#"
+name = "tube"
+[[tools]]
+number = 7
+kind = "ball"
+radius = 3
+
+[[operations]]
+operation = "deburr"
+tool = 7
+edge = "outer"
+cut_amount = 0.2
+workpiece = { kind = "tube", origin = [0, 0, 0], inner_radius = 15, outer_radius = 25 }
+hole = { shape = "round", radius = 5 }
+"#;
+
+    fn path_and_detail(error: AppError) -> (String, String) {
+        let problem = error.problem();
+        (problem.errors[0].path.clone(), problem.detail)
+    }
+
+    #[test]
+    fn toml_and_json_give_the_same_job() {
+        let from_toml = parse(TOML_JOB, Format::Toml).unwrap();
+        let json = serde_json::to_string(&from_toml).unwrap();
+        assert_eq!(parse(&json, Format::Json).unwrap(), from_toml);
+        assert_eq!(from_toml.operations[0].kind(), "deburr");
+    }
+
+    #[test]
+    fn errors_point_at_line_and_field() {
+        let bad = TOML_JOB.replace("radius = 5", "radius = \"five\"");
+        let (path, detail) = path_and_detail(parse(&bad, Format::Toml).unwrap_err());
+        assert_eq!(path, "operations[0].hole.radius");
+        assert!(detail.starts_with("line 14,"), "{detail}");
+
+        let unknown = TOML_JOB.replace("edge = \"outer\"", "edge = \"outer\"\ncolour = 1");
+        let (path, detail) = path_and_detail(parse(&unknown, Format::Toml).unwrap_err());
+        assert_eq!(path, "operations[0].colour");
+        assert!(detail.contains("line"), "{detail}");
+
+        let broken = "name = \"x\"\noperations = [ {";
+        let (path, detail) = path_and_detail(parse(broken, Format::Toml).unwrap_err());
+        assert_eq!(path, "file");
+        assert!(detail.starts_with("line 2,"), "{detail}");
+
+        let json = "{\"operations\": [{\"operation\": \"deburr\",\n \"tool\": \"x\"}]}";
+        let (path, detail) = path_and_detail(parse(json, Format::Json).unwrap_err());
+        assert_eq!(path, "operations[0].tool");
+        assert!(detail.starts_with("line 2,"), "{detail}");
+
+        let (path, _) = path_and_detail(parse("{\"operations\": []}", Format::Json).unwrap_err());
+        assert_eq!(path, "operations");
+        let deep = format!("x = {}{}", "[".repeat(200), "]".repeat(200));
+        assert!(parse(&deep, Format::Toml).is_err());
+        let twice =
+            TOML_JOB.replace("[[operations]]", "[[tools]]\nnumber = 7\nkind = \"ball\"\nradius = 2\n\n[[operations]]");
+        let (path, _) = path_and_detail(parse(&twice, Format::Toml).unwrap_err());
+        assert_eq!(path, "tools[1].number");
+    }
+
+    #[test]
+    fn operation_key_anywhere_in_the_table() {
+        let reordered = TOML_JOB
+            .replace("operation = \"deburr\"\n", "")
+            .replace("cut_amount = 0.2", "cut_amount = 0.2\noperation = \"deburr\"");
+        assert_eq!(parse(&reordered, Format::Toml).unwrap(), parse(TOML_JOB, Format::Toml).unwrap());
+        let missing = TOML_JOB.replace("operation = \"deburr\"\n", "");
+        let (path, detail) = path_and_detail(parse(&missing, Format::Toml).unwrap_err());
+        assert_eq!(path, "operations[0]");
+        assert!(detail.contains("missing field `operation`"), "{detail}");
+    }
+
+    #[test]
+    fn format_detection() {
+        assert_eq!(Format::detect(Some("a.TOML"), None, "{"), Format::Toml);
+        assert_eq!(Format::detect(None, Some("application/json"), "x = 1"), Format::Json);
+        assert_eq!(Format::detect(None, None, "  {\"a\": 1}"), Format::Json);
+        assert_eq!(Format::detect(None, None, "a = 1"), Format::Toml);
+    }
+}

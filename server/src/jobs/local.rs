@@ -1,0 +1,107 @@
+//! `kerf run JOB_FILE [-o OUT_DIR]`: runs a job file without the server, through the same parser,
+//! resolution and execution as the job workers, and writes the results as files.
+
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+use std::sync::atomic::AtomicBool;
+
+use anyhow::{Context, bail};
+use sqlx::SqlitePool;
+use sqlx::sqlite::{SqliteConnectOptions, SqlitePoolOptions};
+
+use super::execute::{JobFailure, execute};
+use super::file::{self, Format};
+use crate::error::AppError;
+use crate::store;
+
+/// What `kerf run` wrote.
+#[derive(Debug)]
+pub struct RunReport {
+    /// Files written, in order.
+    pub files: Vec<PathBuf>,
+}
+
+fn describe(error: &AppError) -> String {
+    let problem = error.problem();
+    format!("{} ({})", problem.detail, problem.code)
+}
+
+async fn open_tools(database: &Path) -> anyhow::Result<SqlitePool> {
+    let options = SqliteConnectOptions::from_str("sqlite:")?.filename(database).read_only(true);
+    Ok(SqlitePoolOptions::new().max_connections(1).connect_with(options).await?)
+}
+
+/// Runs the job file at `path`, resolving tool numbers against `database` when it exists, and
+/// writes `job.json`, one `NN-operation.json` per operation and its `NN-operation.nc` program
+/// into `out`.
+///
+/// # Errors
+/// When the file cannot be read or parsed, a tool is unknown, an operation is refused, or the
+/// outputs cannot be written; the message names the line and field where known.
+pub async fn run(path: &Path, out: &Path, database: Option<&Path>) -> anyhow::Result<RunReport> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let format = Format::detect(path.file_name().and_then(|n| n.to_str()), None, &text);
+    let job = file::parse(&text, format).map_err(|e| anyhow::anyhow!("{}: {}", path.display(), describe(&e)))?;
+    let pool = match database {
+        Some(database) if database.exists() => Some(open_tools(database).await?),
+        _ => None,
+    };
+    let job = job
+        .resolve_with(|number| {
+            let pool = pool.clone();
+            async move {
+                match pool {
+                    Some(pool) => store::tools::get(&pool, number).await,
+                    None => Ok(None),
+                }
+            }
+        })
+        .await
+        .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), describe(&e)))?;
+
+    let terminal = std::io::stderr().is_terminal();
+    let show = move |fraction: f64| {
+        if terminal {
+            let filled = (fraction * 30.0).round() as usize;
+            eprint!("\r[{}{}] {:3.0}%", "#".repeat(filled), " ".repeat(30 - filled.min(30)), fraction * 100.0);
+            let _ = std::io::stderr().flush();
+        }
+    };
+    show(0.0);
+    let job_for_task = job.clone();
+    let outputs = tokio::task::spawn_blocking(move || execute(&job_for_task, &show, &AtomicBool::new(false))).await?;
+    if terminal {
+        eprintln!();
+    }
+    let outputs = match outputs {
+        Ok(outputs) => outputs,
+        Err(JobFailure::Cancelled) => bail!("cancelled"),
+        Err(JobFailure::Refused { message, field }) => {
+            bail!("{message}{}", field.map(|f| format!(" [field {f}]")).unwrap_or_default())
+        }
+    };
+
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let mut files = Vec::new();
+    let mut write = |name: String, contents: &str| -> anyhow::Result<()> {
+        let target = out.join(name);
+        std::fs::write(&target, contents).with_context(|| format!("writing {}", target.display()))?;
+        files.push(target);
+        Ok(())
+    };
+    let summary = serde_json::json!({
+        "name": job.name,
+        "operations": outputs.iter().map(|o| serde_json::json!({
+            "operation": o.operation, "gcode": o.gcode.is_some(), "gcode_problem": o.gcode_problem
+        })).collect::<Vec<_>>(),
+    });
+    write("job.json".to_owned(), &serde_json::to_string_pretty(&summary)?)?;
+    for (index, output) in outputs.iter().enumerate() {
+        write(format!("{index:02}-{}.json", output.operation), &serde_json::to_string_pretty(&output.result)?)?;
+        if let Some(program) = &output.gcode {
+            write(format!("{index:02}-{}.nc", output.operation), program)?;
+        }
+    }
+    Ok(RunReport { files })
+}

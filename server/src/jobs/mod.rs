@@ -1,0 +1,7 @@
+//! Jobs (issue 7; api.md, Jobs): job files naming one or more operations, their resolution into
+//! self-contained jobs, the pure execution of a job, and the persistent queue with its workers.
+
+pub mod execute;
+pub mod file;
+pub mod local;
+pub mod queue;

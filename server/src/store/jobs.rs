@@ -1,0 +1,240 @@
+//! The job queue in SQLite (issue 7): jobs with status, progress, attempts and heartbeat, and
+//! their results. Workers claim the oldest queued job with one atomic UPDATE.
+
+use serde::Serialize;
+use sqlx::SqlitePool;
+use utoipa::ToSchema;
+
+use crate::error::{AppError, AppResult};
+use crate::jobs::execute::OperationOutput;
+use crate::jobs::file::JobFile;
+
+/// Attempts a job gets: one retry after a server stop interrupted it.
+pub const MAX_ATTEMPTS: i64 = 2;
+
+const NOW: &str = "strftime('%Y-%m-%dT%H:%M:%fZ', 'now')";
+
+/// Where a job is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema, sqlx::Type)]
+#[serde(rename_all = "snake_case")]
+#[sqlx(rename_all = "snake_case")]
+pub enum JobStatus {
+    /// Waiting for a worker.
+    Queued,
+    /// A worker runs it.
+    Running,
+    /// Finished; results stored.
+    Done,
+    /// An operation was refused, or the job was interrupted too often; see `error`.
+    Failed,
+    /// Cancelled by `DELETE`.
+    Cancelled,
+}
+
+/// A job as listed and shown.
+#[derive(Debug, Clone, Serialize, ToSchema, sqlx::FromRow)]
+pub struct JobRecord {
+    /// Job id.
+    pub id: i64,
+    /// Name from the job file.
+    pub name: Option<String>,
+    /// Status.
+    pub status: JobStatus,
+    /// Fraction done, 0–1.
+    pub progress: f64,
+    /// The operations' names, in order.
+    #[sqlx(json)]
+    pub operations: Vec<String>,
+    /// Times it was started (a server stop while running re-queues it once).
+    pub attempts: i64,
+    /// Why it failed.
+    pub error: Option<String>,
+    /// The job-file field at fault, if any (e.g. `operations[1].hole.radius`).
+    pub error_field: Option<String>,
+    /// UTC timestamps.
+    pub submitted_at: String,
+    /// When a worker started it.
+    pub started_at: Option<String>,
+    /// When it finished.
+    pub finished_at: Option<String>,
+}
+
+const COLUMNS: &str =
+    "id, name, status, progress, operations, attempts, error, error_field, submitted_at, started_at, finished_at";
+
+/// Stores a new queued job; returns its id.
+pub async fn insert(db: &SqlitePool, job: &JobFile, hash: &str) -> AppResult<i64> {
+    let json = serde_json::to_string(job).map_err(|e| AppError::Internal(e.into()))?;
+    let operations: Vec<&str> = job.operations.iter().map(|o| o.kind()).collect();
+    let operations = serde_json::to_string(&operations).map_err(|e| AppError::Internal(e.into()))?;
+    let (id,): (i64,) = sqlx::query_as(
+        "INSERT INTO jobs (name, status, content_hash, job_json, operations) VALUES (?, 'queued', ?, ?, ?) RETURNING id",
+    )
+    .bind(&job.name)
+    .bind(hash)
+    .bind(json)
+    .bind(operations)
+    .fetch_one(db)
+    .await?;
+    Ok(id)
+}
+
+/// A finished job with the same content, if any.
+pub async fn find_done(db: &SqlitePool, hash: &str) -> AppResult<Option<i64>> {
+    let row: Option<(i64,)> =
+        sqlx::query_as("SELECT id FROM jobs WHERE content_hash = ? AND status = 'done' ORDER BY id LIMIT 1")
+            .bind(hash)
+            .fetch_optional(db)
+            .await?;
+    Ok(row.map(|(id,)| id))
+}
+
+/// One job.
+pub async fn get(db: &SqlitePool, id: i64) -> AppResult<Option<JobRecord>> {
+    Ok(sqlx::query_as(&format!("SELECT {COLUMNS} FROM jobs WHERE id = ?")).bind(id).fetch_optional(db).await?)
+}
+
+/// Up to `limit` jobs with ids below `before`, newest first.
+pub async fn list(db: &SqlitePool, limit: i64, before: Option<i64>) -> AppResult<Vec<JobRecord>> {
+    Ok(sqlx::query_as(&format!("SELECT {COLUMNS} FROM jobs WHERE id < ? ORDER BY id DESC LIMIT ?"))
+        .bind(before.unwrap_or(i64::MAX))
+        .bind(limit)
+        .fetch_all(db)
+        .await?)
+}
+
+/// Claims the oldest queued job for a worker: marks it running and returns it.
+pub async fn claim(db: &SqlitePool) -> AppResult<Option<(i64, JobFile)>> {
+    let row: Option<(i64, String)> = sqlx::query_as(&format!(
+        "UPDATE jobs SET status = 'running', attempts = attempts + 1, progress = 0, started_at = {NOW},
+                heartbeat_at = {NOW}
+         WHERE id = (SELECT id FROM jobs WHERE status = 'queued' ORDER BY id LIMIT 1)
+         RETURNING id, job_json"
+    ))
+    .fetch_optional(db)
+    .await?;
+    let Some((id, json)) = row else { return Ok(None) };
+    match serde_json::from_str(&json) {
+        Ok(job) => Ok(Some((id, job))),
+        Err(error) => {
+            fail(db, id, &format!("stored job is unreadable: {error}"), None).await?;
+            Ok(None)
+        }
+    }
+}
+
+/// Records progress and the heartbeat of a running job.
+pub async fn heartbeat(db: &SqlitePool, id: i64, progress: f64) -> AppResult<()> {
+    sqlx::query(&format!("UPDATE jobs SET progress = ?, heartbeat_at = {NOW} WHERE id = ? AND status = 'running'"))
+        .bind(progress.clamp(0.0, 1.0))
+        .bind(id)
+        .execute(db)
+        .await?;
+    Ok(())
+}
+
+/// Stores the results and marks the job done, in one transaction, unless it was cancelled
+/// meanwhile. Returns whether it was stored.
+pub async fn finish(db: &SqlitePool, id: i64, outputs: &[OperationOutput]) -> AppResult<bool> {
+    let mut transaction = db.begin().await?;
+    let updated = sqlx::query(&format!(
+        "UPDATE jobs SET status = 'done', progress = 1, finished_at = {NOW} WHERE id = ? AND status = 'running'"
+    ))
+    .bind(id)
+    .execute(&mut *transaction)
+    .await?;
+    if updated.rows_affected() == 0 {
+        transaction.rollback().await?;
+        return Ok(false);
+    }
+    for (position, output) in outputs.iter().enumerate() {
+        let result = serde_json::to_string(&output.result).map_err(|e| AppError::Internal(e.into()))?;
+        sqlx::query(
+            "INSERT INTO job_results (job_id, position, operation, result_json, gcode, gcode_problem)
+             VALUES (?, ?, ?, ?, ?, ?)",
+        )
+        .bind(id)
+        .bind(i64::try_from(position).unwrap_or(i64::MAX))
+        .bind(&output.operation)
+        .bind(result)
+        .bind(&output.gcode)
+        .bind(&output.gcode_problem)
+        .execute(&mut *transaction)
+        .await?;
+    }
+    transaction.commit().await?;
+    Ok(true)
+}
+
+/// Marks a running job failed with the reason.
+pub async fn fail(db: &SqlitePool, id: i64, message: &str, field: Option<&str>) -> AppResult<()> {
+    sqlx::query(&format!(
+        "UPDATE jobs SET status = 'failed', error = ?, error_field = ?, finished_at = {NOW}
+         WHERE id = ? AND status = 'running'"
+    ))
+    .bind(message)
+    .bind(field)
+    .bind(id)
+    .execute(db)
+    .await?;
+    Ok(())
+}
+
+/// Cancels a queued or running job. `Ok(None)` if there is no such job; otherwise the status
+/// the job had, and whether this call cancelled it.
+pub async fn cancel(db: &SqlitePool, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
+    let mut transaction = db.begin().await?;
+    let row: Option<(JobStatus,)> =
+        sqlx::query_as("SELECT status FROM jobs WHERE id = ?").bind(id).fetch_optional(&mut *transaction).await?;
+    let Some((status,)) = row else { return Ok(None) };
+    let cancellable = matches!(status, JobStatus::Queued | JobStatus::Running);
+    if cancellable {
+        sqlx::query(&format!(
+            "UPDATE jobs SET status = 'cancelled', finished_at = {NOW}, error = 'cancelled by request' WHERE id = ?"
+        ))
+        .bind(id)
+        .execute(&mut *transaction)
+        .await?;
+    }
+    transaction.commit().await?;
+    Ok(Some((status, cancellable)))
+}
+
+/// A finished job's results, in operation order: operation, result JSON, whether a program
+/// exists and why not.
+pub async fn results(db: &SqlitePool, id: i64) -> AppResult<Vec<(String, String, bool, Option<String>)>> {
+    Ok(sqlx::query_as(
+        "SELECT operation, result_json, gcode IS NOT NULL, gcode_problem FROM job_results WHERE job_id = ?
+         ORDER BY position",
+    )
+    .bind(id)
+    .fetch_all(db)
+    .await?)
+}
+
+/// The programs of a finished job, in operation order (`None` where none could be written).
+pub async fn programs(db: &SqlitePool, id: i64) -> AppResult<Vec<(Option<String>, Option<String>)>> {
+    Ok(sqlx::query_as("SELECT gcode, gcode_problem FROM job_results WHERE job_id = ? ORDER BY position")
+        .bind(id)
+        .fetch_all(db)
+        .await?)
+}
+
+/// At start-up no job can be running: each one a stopped server left `running` is queued again,
+/// or failed with the reason once it has used its attempts. Returns (re-queued, failed).
+pub async fn recover(db: &SqlitePool) -> AppResult<(u64, u64)> {
+    let failed = sqlx::query(&format!(
+        "UPDATE jobs SET status = 'failed', finished_at = {NOW},
+                error = 'interrupted by a server stop on each of its ' || attempts || ' attempts; not retried'
+         WHERE status = 'running' AND attempts >= ?"
+    ))
+    .bind(MAX_ATTEMPTS)
+    .execute(db)
+    .await?
+    .rows_affected();
+    let requeued = sqlx::query("UPDATE jobs SET status = 'queued', progress = 0 WHERE status = 'running'")
+        .execute(db)
+        .await?
+        .rows_affected();
+    Ok((requeued, failed))
+}

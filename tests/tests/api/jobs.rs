@@ -1,0 +1,307 @@
+//! Jobs over HTTP: every example job file uploaded (multipart and raw) and run to the end, reuse
+//! of identical jobs, failures with their field, cancellation, paging, bad uploads, and a server
+//! killed with SIGKILL in the middle of a job.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use kerf_server::state::Limits;
+use kerf_tests::{ServerProcess, TestApp, finished, json_with, poll_job, problem};
+use reqwest::multipart::{Form, Part};
+use serde_json::{Value, json};
+
+pub fn examples() -> Vec<PathBuf> {
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(folder)
+        .expect("examples folder")
+        .map(|entry| entry.expect("entry").path())
+        .filter(|path| path.extension().is_some_and(|e| e == "json" || e == "toml"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 2, "example job files");
+    files
+}
+
+fn media_type(path: &Path) -> &'static str {
+    if path.extension().is_some_and(|e| e == "toml") { "application/toml" } else { "application/json" }
+}
+
+async fn upload_multipart(app: &TestApp, path: &Path) -> reqwest::Response {
+    let bytes = std::fs::read(path).unwrap();
+    let name = path.file_name().unwrap().to_string_lossy().into_owned();
+    let form = Form::new().part("file", Part::bytes(bytes).file_name(name));
+    app.client.post(app.url("/api/v1/jobs")).multipart(form).send().await.unwrap()
+}
+
+async fn upload_raw(app: &TestApp, body: String, media_type: &str) -> reqwest::Response {
+    app.client.post(app.url("/api/v1/jobs")).header("content-type", media_type).body(body).send().await.unwrap()
+}
+
+/// A job whose operations take a while: exact-width deburring at a tiny tolerance.
+pub fn long_job(operations: usize) -> Value {
+    let operation = json!({
+        "operation": "deburr", "tool": {"kind": "ball", "radius": 3, "number": 7},
+        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
+        "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5,
+        "tolerance": 2e-6, "method": "exact"
+    });
+    json!({"name": "long", "operations": vec![operation; operations]})
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn example_jobs_run_to_the_end() {
+    let app = TestApp::spawn().await;
+    for path in examples() {
+        let operations = if path.extension().is_some_and(|e| e == "toml") {
+            toml::from_str::<Value>(&std::fs::read_to_string(&path).unwrap()).unwrap()["operations"]
+                .as_array()
+                .unwrap()
+                .len()
+        } else {
+            serde_json::from_str::<Value>(&std::fs::read_to_string(&path).unwrap()).unwrap()["operations"]
+                .as_array()
+                .unwrap()
+                .len()
+        };
+        let response = upload_multipart(&app, &path).await;
+        let location = response.headers()["location"].to_str().unwrap().to_owned();
+        let submitted = json_with(response, 202).await;
+        assert_eq!(submitted["status"], "queued");
+        let id = submitted["id"].as_i64().unwrap();
+        assert_eq!(location, format!("/api/v1/jobs/{id}"));
+        let job = poll_job(&app.client, &app.base, id, 60, finished).await;
+        assert_eq!(job["status"], "done", "{}: {job}", path.display());
+        assert_eq!(job["progress"], 1.0);
+        let results = job["results"].as_array().unwrap();
+        assert_eq!(results.len(), operations);
+        for (index, result) in results.iter().enumerate() {
+            assert_eq!(result["operation"], "deburr");
+            assert!(result["result"]["points"].as_array().unwrap().len() > 8);
+            assert_eq!(result["gcode"], true, "{result}");
+            let program = app.get(&format!("/api/v1/jobs/{id}/gcode?operation={index}")).await;
+            assert_eq!(program.status(), 200);
+            assert!(program.text().await.unwrap().contains("M30"));
+        }
+        if operations > 1 {
+            let answer = problem(app.get(&format!("/api/v1/jobs/{id}/gcode")).await, 422).await;
+            assert_eq!(answer["errors"][0]["path"], "operation");
+        }
+
+        // The same file again, raw this time: an identical finished job is reused.
+        let again =
+            json_with(upload_raw(&app, std::fs::read_to_string(&path).unwrap(), media_type(&path)).await, 200).await;
+        assert_eq!(again, json!({"id": id, "status": "done", "reused": true}));
+    }
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn raw_uploads_run_and_refusals_name_the_field() {
+    let app = TestApp::spawn().await;
+    for path in examples() {
+        // A changed name makes a different job, so it runs instead of being reused.
+        let text = std::fs::read_to_string(&path).unwrap().replacen("name = \"", "name = \"raw ", 1).replacen(
+            "\"name\": \"",
+            "\"name\": \"raw ",
+            1,
+        );
+        let submitted = json_with(upload_raw(&app, text, media_type(&path)).await, 202).await;
+        let job = poll_job(&app.client, &app.base, submitted["id"].as_i64().unwrap(), 60, finished).await;
+        assert_eq!(job["status"], "done", "{job}");
+    }
+    // An operation the solver refuses fails the job with the field at fault.
+    let mut bad = long_job(1);
+    bad["operations"][0]["hole"]["radius"] = json!(60);
+    bad["operations"][0]["tolerance"] = json!(0.01);
+    let submitted = json_with(upload_raw(&app, bad.to_string(), "application/json").await, 202).await;
+    let job = poll_job(&app.client, &app.base, submitted["id"].as_i64().unwrap(), 30, finished).await;
+    assert_eq!(job["status"], "failed");
+    assert_eq!(job["error_field"], "operations[0].hole.radius");
+    assert!(job["error"].as_str().unwrap().contains("E_HOLE_TOO_LARGE"));
+    assert!(job.get("results").is_none());
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn bad_uploads() {
+    let app = TestApp::spawn_with(Limits { max_body_bytes: 64 * 1024, ..Limits::default() }).await;
+    app.register_tool(7, &json!({"kind": "ball", "radius": 3})).await;
+    let good = "name = \"x\"\n[[operations]]\noperation = \"deburr\"\ntool = 7\nedge = \"outer\"\ncut_amount = 0.2\nworkpiece = { kind = \"tube\", origin = [0, 0, 0], inner_radius = 15, outer_radius = 25 }\nhole = { shape = \"round\", radius = 5 }\n";
+    // (what, body, media type, status, field at fault, start of the detail)
+    type Case = (&'static str, String, &'static str, u16, Option<&'static str>, Option<&'static str>);
+    let cases: Vec<Case> = vec![
+        (
+            "TOML syntax",
+            good.replace("edge = \"outer\"", "edge = outer"),
+            "application/toml",
+            400,
+            Some("file"),
+            Some("line 5,"),
+        ),
+        (
+            "wrong type",
+            good.replace("cut_amount = 0.2", "cut_amount = \"0.2\""),
+            "application/toml",
+            400,
+            Some("operations[0].cut_amount"),
+            Some("line 6,"),
+        ),
+        (
+            "unknown operation",
+            good.replace("operation = \"deburr\"", "operation = \"drill\""),
+            "application/toml",
+            400,
+            Some("operations[0].operation"),
+            Some("line 3,"),
+        ),
+        (
+            "unknown field",
+            good.replace("tool = 7", "tool = 7\ncolour = \"red\""),
+            "application/toml",
+            400,
+            Some("operations[0].colour"),
+            None,
+        ),
+        (
+            "no operations",
+            "name = \"x\"\noperations = []\n".to_owned(),
+            "application/toml",
+            400,
+            Some("operations"),
+            None,
+        ),
+        (
+            "unknown tool",
+            good.replace("tool = 7", "tool = 8"),
+            "application/toml",
+            404,
+            Some("operations[0].tool"),
+            None,
+        ),
+        ("JSON syntax", "{\"operations\": [".to_owned(), "application/json", 400, None, None),
+        ("not text", String::from_utf8_lossy(&[0xff, 0xfe]).into_owned(), "application/toml", 400, None, None),
+        ("wrong content type", good.to_owned(), "text/plain", 415, None, None),
+        ("too large", format!("name = \"{}\"", "x".repeat(100_000)), "application/toml", 413, None, None),
+        (
+            "too deep",
+            format!("x = {}{}", "[".repeat(100), "]".repeat(100)),
+            "application/toml",
+            400,
+            Some("file"),
+            None,
+        ),
+    ];
+    for (what, body, media, status, field, line) in cases {
+        let answer = problem(upload_raw(&app, body, media).await, status).await;
+        if let Some(field) = field {
+            assert_eq!(answer["errors"][0]["path"], field, "{what}: {answer}");
+        }
+        if let Some(line) = line {
+            assert!(answer["detail"].as_str().unwrap().starts_with(line), "{what}: {answer}");
+        }
+    }
+    let form = Form::new().part("other", Part::bytes(good.as_bytes().to_vec()));
+    let response = app.client.post(app.url("/api/v1/jobs")).multipart(form).send().await.unwrap();
+    assert_eq!(problem(response, 400).await["errors"][0]["path"], "file");
+    let big = Form::new().part("file", Part::bytes(vec![b'#'; 100_000]).file_name("big.toml"));
+    let response = app.client.post(app.url("/api/v1/jobs")).multipart(big).send().await.unwrap();
+    problem(response, 413).await;
+    assert_eq!(json_with(app.get("/api/v1/jobs").await, 200).await["jobs"], json!([]), "nothing stored");
+    problem(app.get("/api/v1/jobs/999").await, 404).await;
+    problem(app.delete("/api/v1/jobs/999").await, 404).await;
+    problem(app.get("/api/v1/jobs/abc").await, 400).await;
+    problem(app.get("/api/v1/jobs?limit=0").await, 400).await;
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn cancel_paging_and_conflicts() {
+    let app = TestApp::spawn().await;
+    // Two long jobs on two workers, then a third waits in the queue.
+    let mut ids = Vec::new();
+    for n in 0..3 {
+        let mut job = long_job(30);
+        job["name"] = json!(format!("long {n}"));
+        ids.push(
+            json_with(upload_raw(&app, job.to_string(), "application/json").await, 202).await["id"].as_i64().unwrap(),
+        );
+    }
+    let running = poll_job(&app.client, &app.base, ids[0], 30, |j| j["status"] == "running").await;
+    assert_eq!(running["status"], "running");
+    let queued = json_with(app.get(&format!("/api/v1/jobs/{}", ids[2])).await, 200).await;
+    assert_eq!(queued["status"], "queued");
+
+    // Cancel the queued one and a running one.
+    let cancelled = json_with(app.delete(&format!("/api/v1/jobs/{}", ids[2])).await, 200).await;
+    assert_eq!(cancelled["status"], "cancelled");
+    let started = std::time::Instant::now();
+    let cancelled = json_with(app.delete(&format!("/api/v1/jobs/{}", ids[0])).await, 200).await;
+    assert_eq!(cancelled["status"], "cancelled");
+    // The worker lets go promptly: a small job submitted now runs on it.
+    let small = json!({"name": "small", "operations": [{"operation": "deburr", "tool": {"kind": "ball", "radius": 3},
+        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
+        "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5}]});
+    let small_id =
+        json_with(upload_raw(&app, small.to_string(), "application/json").await, 202).await["id"].as_i64().unwrap();
+    let small_job = poll_job(&app.client, &app.base, small_id, 30, finished).await;
+    assert_eq!(small_job["status"], "done");
+    assert!(started.elapsed() < Duration::from_secs(20), "cancelled worker freed in {:?}", started.elapsed());
+    tokio::time::sleep(Duration::from_millis(500)).await;
+    let still = json_with(app.get(&format!("/api/v1/jobs/{}", ids[0])).await, 200).await;
+    assert_eq!(still["status"], "cancelled", "a cancelled job never turns done");
+    problem(app.delete(&format!("/api/v1/jobs/{}", ids[0])).await, 409).await;
+    problem(app.delete(&format!("/api/v1/jobs/{small_id}")).await, 409).await;
+    problem(app.get(&format!("/api/v1/jobs/{}/gcode", ids[2])).await, 409).await;
+    app.delete(&format!("/api/v1/jobs/{}", ids[1])).await;
+
+    // Paging, newest first.
+    let first = json_with(app.get("/api/v1/jobs?limit=2").await, 200).await;
+    let page: Vec<i64> = first["jobs"].as_array().unwrap().iter().map(|j| j["id"].as_i64().unwrap()).collect();
+    assert_eq!(page, [small_id, ids[2]]);
+    let before = first["next_before"].as_i64().unwrap();
+    let second = json_with(app.get(&format!("/api/v1/jobs?limit=2&before={before}")).await, 200).await;
+    let page: Vec<i64> = second["jobs"].as_array().unwrap().iter().map(|j| j["id"].as_i64().unwrap()).collect();
+    assert_eq!(page, [ids[1], ids[0]]);
+    assert!(second.get("next_before").is_none());
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn killed_server_loses_no_job() {
+    let program = PathBuf::from(env!("CARGO_BIN_EXE_kerf-under-test"));
+    let folder = tempfile::tempdir().unwrap();
+    let database = folder.path().join("kerf.db");
+    let client = reqwest::Client::new();
+
+    // Killed once while running: re-run after the restart and finished.
+    let server = ServerProcess::start(&program, &database).await;
+    let submit = |base: String, body: Value| {
+        let client = client.clone();
+        async move {
+            let response = client.post(format!("{base}/api/v1/jobs")).json(&body).send().await.unwrap();
+            json_with(response, 202).await["id"].as_i64().unwrap()
+        }
+    };
+    let first = submit(server.base.clone(), long_job(12)).await;
+    let running = poll_job(&client, &server.base, first, 30, |j| j["status"] == "running").await;
+    assert_eq!(running["status"], "running");
+    server.kill();
+    let server = ServerProcess::start(&program, &database).await;
+    let after = json_with(client.get(format!("{}/api/v1/jobs/{first}", server.base)).send().await.unwrap(), 200).await;
+    assert!(matches!(after["status"].as_str(), Some("queued" | "running")), "re-queued after the kill: {after}");
+    let done = poll_job(&client, &server.base, first, 120, finished).await;
+    assert_eq!(done["status"], "done", "{done}");
+    assert_eq!(done["attempts"], 2);
+
+    // Killed on both attempts: failed with the reason, never stuck in running.
+    let mut second_job = long_job(40);
+    second_job["name"] = json!("killed twice");
+    let second = submit(server.base.clone(), second_job).await;
+    poll_job(&client, &server.base, second, 30, |j| j["status"] == "running").await;
+    server.kill();
+    let server = ServerProcess::start(&program, &database).await;
+    poll_job(&client, &server.base, second, 30, |j| j["status"] == "running" && j["attempts"] == 2).await;
+    server.kill();
+    let server = ServerProcess::start(&program, &database).await;
+    let failed =
+        json_with(client.get(format!("{}/api/v1/jobs/{second}", server.base)).send().await.unwrap(), 200).await;
+    assert_eq!(failed["status"], "failed", "{failed}");
+    assert!(failed["error"].as_str().unwrap().contains("interrupted"), "{failed}");
+    drop(server);
+}
