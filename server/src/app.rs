@@ -15,6 +15,7 @@ use utoipa::OpenApi;
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_swagger_ui::SwaggerUi;
 
+use crate::auth::{Auth, require_token};
 use crate::error::AppError;
 use crate::openapi::ApiDoc;
 use crate::state::{AppState, Limits};
@@ -31,6 +32,8 @@ pub struct Config {
     pub solver_slots: usize,
     /// Job workers.
     pub job_workers: usize,
+    /// The optional API token.
+    pub auth: Auth,
 }
 
 /// The OpenAPI document and the API routes.
@@ -52,6 +55,7 @@ pub fn router(state: AppState) -> Router {
         .merge(web::router())
         .fallback(|| async { AppError::not_found("no such resource") })
         .method_not_allowed_fallback(|| async { AppError::MethodNotAllowed })
+        .layer(axum::middleware::from_fn_with_state(state.clone(), require_token))
         .layer(DefaultBodyLimit::max(max_body))
         .layer(TraceLayer::new_for_http())
         .layer(CatchPanicLayer::custom(panic_response))
@@ -73,7 +77,7 @@ fn panic_response(cause: Box<dyn Any + Send + 'static>) -> Response<Body> {
 /// When the database cannot be opened or migrated.
 pub async fn build(config: &Config) -> anyhow::Result<(Router, AppState)> {
     let pool = db::open(&config.database).await?;
-    let state = AppState::new(pool, config.limits.clone(), config.solver_slots);
+    let state = AppState::new(pool, config.limits.clone(), config.solver_slots, config.auth.clone());
     state.jobs.start(&state.db, &state.solver_slots, config.job_workers).await?;
     Ok((router(state.clone()), state))
 }

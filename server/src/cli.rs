@@ -11,6 +11,7 @@ use tokio::net::TcpListener;
 use tracing_subscriber::EnvFilter;
 
 use crate::app::Config;
+use crate::auth::Auth;
 use crate::state::Limits;
 
 /// kerf: CAM web service (tool-centre paths as JSON or G-code).
@@ -68,6 +69,12 @@ pub struct ServeArgs {
     /// Job workers (default: the number of CPU cores).
     #[arg(long, env = "KERF_JOB_WORKERS")]
     pub job_workers: Option<usize>,
+    /// API token: when set, requests that change state need `Authorization: Bearer <token>`.
+    #[arg(long, env = "KERF_API_TOKEN", hide_env_values = true)]
+    pub api_token: Option<String>,
+    /// With a token, reads of the API need it too.
+    #[arg(long, env = "KERF_PRIVATE")]
+    pub private: bool,
 }
 
 impl ServeArgs {
@@ -83,6 +90,7 @@ impl ServeArgs {
             },
             solver_slots: self.solver_slots.unwrap_or(cores),
             job_workers: self.job_workers.unwrap_or(cores),
+            auth: Auth { token: self.api_token.clone().filter(|t| !t.is_empty()), private: self.private },
         }
     }
 }

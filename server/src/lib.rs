@@ -4,6 +4,7 @@
 //! on the blocking pool.
 
 pub mod app;
+pub mod auth;
 pub mod cli;
 pub mod db;
 pub mod error;

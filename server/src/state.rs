@@ -7,6 +7,7 @@ use std::time::Duration;
 use sqlx::SqlitePool;
 use tokio::sync::Semaphore;
 
+use crate::auth::Auth;
 use crate::error::{AppError, AppResult};
 use crate::jobs::queue::JobRunner;
 
@@ -43,16 +44,19 @@ pub struct AppState {
     pub solver_slots: Arc<Semaphore>,
     /// The job workers' coordination.
     pub jobs: Arc<JobRunner>,
+    /// The optional API token.
+    pub auth: Auth,
 }
 
 impl AppState {
-    /// State over `db` with `limits`, allowing `solver_slots` solver calls at once.
-    pub fn new(db: SqlitePool, limits: Limits, solver_slots: usize) -> Self {
+    /// State over `db` with `limits`, allowing `solver_slots` solver calls at once, guarded by `auth`.
+    pub fn new(db: SqlitePool, limits: Limits, solver_slots: usize, auth: Auth) -> Self {
         Self {
             db,
             limits,
             solver_slots: Arc::new(Semaphore::new(solver_slots.max(1))),
             jobs: Arc::new(JobRunner::default()),
+            auth,
         }
     }
 

@@ -35,9 +35,21 @@ impl TestApp {
 
     /// Starts a service with `limits`.
     pub async fn spawn_with(limits: Limits) -> Self {
+        Self::spawn_configured(|config| config.limits = limits).await
+    }
+
+    /// Starts a service with the default configuration changed by `adjust`.
+    pub async fn spawn_configured(adjust: impl FnOnce(&mut Config)) -> Self {
         let directory = tempfile::tempdir().expect("temporary directory");
         let database = directory.path().join("kerf.db");
-        let config = Config { database: database.clone(), limits, solver_slots: 2, job_workers: 2 };
+        let mut config = Config {
+            database: database.clone(),
+            limits: Limits::default(),
+            solver_slots: 2,
+            job_workers: 2,
+            auth: kerf_server::auth::Auth::default(),
+        };
+        adjust(&mut config);
         let mut app = Self {
             base: String::new(),
             client: Client::builder().timeout(Duration::from_secs(60)).build().expect("client"),

@@ -1,9 +1,12 @@
 //! Loopback tests: the real service on 127.0.0.1:0 with a temporary SQLite file, over HTTP.
 
+mod auth;
 mod bad_requests;
 mod browser;
+mod cli;
 mod deburr;
 mod gcode;
+mod job_fuzz;
 mod jobs;
 mod openapi;
 mod tools;

@@ -1,0 +1,69 @@
+//! `kerf run`: runs each example job file locally and writes its results; a bad file fails with
+//! the line and field.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use crate::jobs::examples;
+
+fn program() -> PathBuf {
+    PathBuf::from(env!("CARGO_BIN_EXE_kerf-under-test"))
+}
+
+#[test]
+fn runs_each_example_locally() {
+    for example in examples() {
+        let out = tempfile::tempdir().unwrap();
+        let output = Command::new(program())
+            .arg("run")
+            .arg(&example)
+            .arg("-o")
+            .arg(out.path())
+            .arg("--database")
+            .arg(out.path().join("no-such.db"))
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}: {}", example.display(), String::from_utf8_lossy(&output.stderr));
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.path().join("job.json")).unwrap()).unwrap();
+        let operations = summary["operations"].as_array().unwrap();
+        assert!(!operations.is_empty());
+        for index in 0..operations.len() {
+            let result: serde_json::Value = serde_json::from_str(
+                &std::fs::read_to_string(out.path().join(format!("{index:02}-deburr.json"))).unwrap(),
+            )
+            .unwrap();
+            assert!(result["points"].as_array().unwrap().len() > 8);
+            let program = std::fs::read_to_string(out.path().join(format!("{index:02}-deburr.nc"))).unwrap();
+            assert!(program.contains("M30"));
+        }
+        let listed = String::from_utf8_lossy(&output.stdout);
+        assert!(listed.lines().count() > operations.len(), "lists the files written: {listed}");
+    }
+}
+
+#[test]
+fn bad_file_names_line_and_field() {
+    let folder = tempfile::tempdir().unwrap();
+    let file = folder.path().join("bad.toml");
+    std::fs::write(
+        &file,
+        "[[operations]]\noperation = \"deburr\"\ntool = { kind = \"ball\", radius = 3 }\nedge = \"outer\"\ncut_amount = -1\n\
+         workpiece = { kind = \"tube\", origin = [0, 0, 0], inner_radius = 15, outer_radius = 25 }\n\
+         hole = { shape = \"round\", radius = \"5\" }\n",
+    )
+    .unwrap();
+    let output =
+        Command::new(program()).arg("run").arg(&file).arg("-o").arg(folder.path().join("out")).output().unwrap();
+    assert!(!output.status.success());
+    let message = String::from_utf8_lossy(&output.stderr);
+    assert!(message.contains("line 7") && message.contains("operations[0].hole.radius"), "{message}");
+
+    std::fs::write(&file, std::fs::read_to_string(&file).unwrap().replace("radius = \"5\"", "radius = 5")).unwrap();
+    let output =
+        Command::new(program()).arg("run").arg(&file).arg("-o").arg(folder.path().join("out")).output().unwrap();
+    assert!(!output.status.success());
+    let message = String::from_utf8_lossy(&output.stderr);
+    assert!(message.contains("operations[0].cut_amount"), "a refused operation names its field: {message}");
+    assert!(!folder.path().join("out").exists(), "nothing written for a failed job");
+}
