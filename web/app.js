@@ -1,17 +1,34 @@
 // kerf page shell: tabs, the API helper, problem display and downloads shared by the views.
 import { deburrView } from '/views/deburr.js';
+import { jobsView } from '/views/jobs.js';
 import { toolsView } from '/views/tools.js';
 
-const views = [deburrView, toolsView];
+const views = [deburrView, jobsView, toolsView];
+
+// The API token (KERF_API_TOKEN), kept in this browser once entered.
+function token() {
+  return localStorage.getItem('kerf-token') || '';
+}
+
+function askForToken() {
+  const box = document.getElementById('token-box');
+  box.hidden = false;
+  box.querySelector('input').focus();
+}
 
 // Calls the API; resolves to the parsed JSON (or text for G-code); rejects with the problem document.
+// A FormData body is sent as multipart/form-data.
 export async function api(method, path, body, accept = 'application/json') {
   const options = { method, headers: { accept } };
-  if (body !== undefined) {
+  if (token()) options.headers.authorization = `Bearer ${token()}`;
+  if (body instanceof FormData) {
+    options.body = body;
+  } else if (body !== undefined) {
     options.headers['content-type'] = 'application/json';
     options.body = JSON.stringify(body);
   }
   const response = await fetch(path, options);
+  if (response.status === 401) askForToken();
   if (response.status === 204) return null;
   const type = response.headers.get('content-type') || '';
   const payload = type.includes('json') ? await response.json() : await response.text();
@@ -62,6 +79,12 @@ function show(view) {
   view.mount(main);
   history.replaceState(null, '', `#${view.id}`);
 }
+
+document.getElementById('token-box').addEventListener('submit', (event) => {
+  event.preventDefault();
+  localStorage.setItem('kerf-token', event.target.elements.token.value.trim());
+  event.target.hidden = true;
+});
 
 const tabs = document.getElementById('tabs');
 for (const view of views) {

@@ -61,17 +61,36 @@ export class Plot3D {
     this.draw();
   }
 
-  project(p) {
+  // Rotated view coordinates (right, up, depth) of p relative to the centre, before scaling.
+  view(p) {
     const [x, y, z] = [p[0] - this.centre[0], p[1] - this.centre[1], p[2] - this.centre[2]];
     const cy = Math.cos(this.yaw), sy = Math.sin(this.yaw);
     const cp = Math.cos(this.pitch), sp = Math.sin(this.pitch);
     // Machine Z points up on screen; yaw turns about Z, pitch tilts towards the viewer.
-    const u = cy * x - sy * y;
     const v = sy * x + cy * y;
-    const up = cp * z - sp * v;
-    const depth = sp * z + cp * v;
-    const scale = this.zoom * 0.8 * Math.min(this.width, this.height) / this.extent;
-    return [this.width / 2 + this.panX + u * scale, this.height / 2 + this.panY - up * scale, depth];
+    return [cy * x - sy * y, cp * z - sp * v, sp * z + cp * v];
+  }
+
+  // Fits the projected drawing into the canvas at the current rotation (zoom 1 = fit).
+  fit() {
+    let [left, right, bottom, top] = [Infinity, -Infinity, Infinity, -Infinity];
+    for (const s of this.series) {
+      for (const p of s.points) {
+        const [u, up] = this.view(p);
+        left = Math.min(left, u); right = Math.max(right, u);
+        bottom = Math.min(bottom, up); top = Math.max(top, up);
+      }
+    }
+    const spanX = Math.max(right - left, 1e-9 * this.extent, 1e-12);
+    const spanY = Math.max(top - bottom, 1e-9 * this.extent, 1e-12);
+    this.scale = 0.9 * Math.min(this.width / spanX, this.height / spanY);
+    this.offset = [(left + right) / 2, (bottom + top) / 2];
+  }
+
+  project(p) {
+    const [u, up, depth] = this.view(p);
+    const scale = this.scale * this.zoom;
+    return [this.width / 2 + this.panX + (u - this.offset[0]) * scale, this.height / 2 + this.panY - (up - this.offset[1]) * scale, depth];
   }
 
   draw() {
@@ -91,6 +110,7 @@ export class Plot3D {
       canvas.dataset.state = 'empty';
       return;
     }
+    this.fit();
     this.drawAxes(g);
     let segments = 0;
     for (const s of this.series) {

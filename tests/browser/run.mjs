@@ -1,9 +1,9 @@
 // Browser checks of the kerf page, driven by cargo test (tests/tests/api/browser.rs).
-// Usage: node run.mjs <scenario> <base-url> <screenshot.png>
+// Usage: node run.mjs <scenario> <base-url> <screenshot.png> [job-file]
 // Prints one JSON line with what it saw; exits non-zero with the reason when a check fails.
 import { chromium } from 'playwright-core';
 
-const [scenario, base, screenshot] = process.argv.slice(2);
+const [scenario, base, screenshot, jobFile] = process.argv.slice(2);
 const browser = await chromium.launch({
   executablePath: process.env.KERF_CHROMIUM || '/usr/bin/chromium',
   args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
@@ -37,10 +37,11 @@ const scenarios = {
     await page.waitForSelector('#deburr-plot[data-state="drawn"]', { timeout: 15000 });
     const segments = Number(await page.getAttribute('#deburr-plot', 'data-segments'));
     const inked = await inkedPixels('#deburr-plot');
-    const summary = await page.textContent('#deburr-summary');
+    const summary = await page.textContent('#deburr-result .summary');
     if (segments < 10) throw new Error(`only ${segments} segments drawn`);
     if (inked < 500) throw new Error(`plot nearly blank: ${inked} inked pixels`);
     if (!/points\s*\d+/.test(summary)) throw new Error(`no summary: ${summary}`);
+    
     // A bad value is reported with the field highlighted.
     await page.fill('input[name="hole_radius"]', '-1');
     await page.click('#deburr-compute');
@@ -48,6 +49,24 @@ const scenarios = {
     const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
     if (!highlighted.includes('hole_radius')) throw new Error(`field not highlighted: ${highlighted}`);
     return { segments, inked };
+  },
+
+  // Uploads a job file on the Jobs page, waits for it to finish, opens it, and checks each
+  // operation's plot.
+  async jobs() {
+    await page.goto(`${base}/#jobs`);
+    const started = Date.now();
+    await page.setInputFiles('#job-file', jobFile);
+    await page.waitForSelector('#job-rows tr[data-status="done"]', { timeout: 60000 });
+    const seconds = (Date.now() - started) / 1000;
+    await page.click('#job-rows tr[data-status="done"] button');
+    await page.waitForSelector('#job-result canvas[data-state="drawn"]', { timeout: 15000 });
+    const plots = await page.$$eval('#job-result canvas', (list) => list.length);
+    const inked = await inkedPixels('#job-result canvas');
+    const downloads = await page.$$eval('#job-result button', (list) => list.map((b) => b.textContent));
+    if (inked < 500) throw new Error(`job plot nearly blank: ${inked} inked pixels`);
+    if (!downloads.includes('G-code') || !downloads.includes('JSON')) throw new Error(`downloads: ${downloads}`);
+    return { plots, inked, seconds };
   },
 };
 

@@ -51,10 +51,8 @@ const FORM = `
     </div>
   </form>
   <section>
-    <canvas class="plot" id="deburr-plot" aria-label="Ridge line and tool-centre path"></canvas>
-    <p class="hint">Drag to rotate, shift-drag to pan, wheel to zoom, double-click to reset.</p>
     <div id="deburr-messages"></div>
-    <div id="deburr-summary" class="summary"></div>
+    <div id="deburr-result"></div>
   </section>
 </div>`;
 
@@ -112,19 +110,34 @@ async function loadTools(select) {
   }
 }
 
-function render(plot, summaryBox, messages, answer) {
+// Shows a deburr answer in `container`: plot of ridge, centres and leads, summary, warnings.
+// Used by the form and by job results.
+export function deburrResult(container, answer) {
+  container.replaceChildren();
+  const canvas = document.createElement('canvas');
+  canvas.className = 'plot';
+  canvas.setAttribute('aria-label', 'Ridge line and tool-centre path');
+  const hint = document.createElement('p');
+  hint.className = 'hint';
+  hint.textContent = 'Drag to rotate, shift-drag to pan, wheel to zoom, double-click to reset.';
+  const warnings = document.createElement('div');
+  const summaryBox = document.createElement('div');
+  summaryBox.className = 'summary';
+  container.append(canvas, hint, warnings, summaryBox);
+
   const points = answer.points;
-  const lead = (moves) => moves.map((m) => m.centre);
-  plot.setSeries([
+  const centres = (moves) => moves.map((m) => m.centre);
+  new Plot3D(canvas).setSeries([
     { label: 'ridge (targets)', points: points.map((p) => p.target), colour: '#555', width: 1.5 },
     { label: 'ball centres', points: points.map((p) => p.centre), colour: '#0b63b6', width: 2, marks: true },
-    { label: 'approach / retract', points: [...lead(answer.lead_in), ...lead(answer.lead_out)].length ? [...lead(answer.lead_in)] : [], colour: '#c77700', width: 1.5, dash: [5, 4] },
-    { label: '', points: answer.lead_out.length ? [points[points.length - 1].centre, ...lead(answer.lead_out)] : [], colour: '#c77700', width: 1.5, dash: [5, 4] },
+    { label: 'approach / retract', points: centres(answer.lead_in), colour: '#c77700', width: 1.5, dash: [5, 4] },
+    { label: '', points: answer.lead_out.length ? [points[points.length - 1].centre, ...centres(answer.lead_out)] : [], colour: '#c77700', width: 1.5, dash: [5, 4] },
   ]);
   const s = answer.summary;
   const items = [
-    ['points', s.count], ['path length, mm', number(s.path_length, 3)], ['max deviation, mm', number(s.max_deviation, 5)],
-    ['width W, mm', number(s.width)], ['true width, mm', `${number(s.true_width_min)} – ${number(s.true_width_max)}`],
+    ['edge', `${answer.edge} (${answer.method})`], ['points', s.count], ['path length, mm', number(s.path_length, 3)],
+    ['max deviation, mm', number(s.max_deviation, 5)], ['width W, mm', number(s.width)],
+    ['true width, mm', `${number(s.true_width_min)} – ${number(s.true_width_max)}`],
     ['wedge angle, °', `${number(s.wedge_angle_min_deg, 2)} – ${number(s.wedge_angle_max_deg, 2)}`],
     ['est. time, s', number(s.estimated_time_s, 1)],
   ];
@@ -137,7 +150,8 @@ function render(plot, summaryBox, messages, answer) {
     div.append(b);
     return div;
   }));
-  messages.replaceChildren(...answer.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
+  warnings.replaceChildren(...answer.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
+  return canvas;
 }
 
 export const deburrView = {
@@ -146,9 +160,8 @@ export const deburrView = {
   mount(root) {
     root.innerHTML = FORM;
     const form = root.querySelector('#deburr-form');
-    const plot = new Plot3D(root.querySelector('#deburr-plot'));
     const messages = root.querySelector('#deburr-messages');
-    const summary = root.querySelector('#deburr-summary');
+    const result = root.querySelector('#deburr-result');
     form.addEventListener('change', () => syncVisibility(form));
     loadTools(form.elements.tool_choice).then(() => syncVisibility(form));
     syncVisibility(form);
@@ -157,9 +170,11 @@ export const deburrView = {
       form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
       messages.replaceChildren(message('warning', 'computing…'));
       try {
-        render(plot, summary, messages, await api('POST', '/api/v1/deburr', deburrRequest(form)));
+        const answer = await api('POST', '/api/v1/deburr', deburrRequest(form));
+        messages.replaceChildren();
+        deburrResult(result, answer).id = 'deburr-plot';
       } catch (problem) {
-        summary.replaceChildren();
+        result.replaceChildren();
         showProblem(messages, form, problem);
       }
     });

@@ -7,7 +7,7 @@ use std::process::Command;
 use kerf_tests::{TestApp, external_program, external_required};
 
 /// Runs `tests/browser/run.mjs <scenario>` against `app`; `None` when the tools are missing.
-pub fn run_scenario(app: &TestApp, scenario: &str) -> Option<serde_json::Value> {
+pub fn run_scenario(app: &TestApp, scenario: &str, extra: &[&str]) -> Option<serde_json::Value> {
     let node = external_program("node", "the browser test")?;
     external_program("chromium", "the browser test")?;
     let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("browser");
@@ -25,6 +25,7 @@ pub fn run_scenario(app: &TestApp, scenario: &str) -> Option<serde_json::Value> 
         .arg(scenario)
         .arg(&app.base)
         .arg(&screenshot)
+        .args(extra)
         .output()
         .expect("node runs");
     let stdout = String::from_utf8_lossy(&output.stdout);
@@ -40,7 +41,17 @@ pub fn run_scenario(app: &TestApp, scenario: &str) -> Option<serde_json::Value> 
 #[tokio::test(flavor = "multi_thread")]
 async fn deburr_page_plots_the_sample_job() {
     let app = TestApp::spawn().await;
-    let Some(result) = run_scenario(&app, "deburr") else { return };
+    let Some(result) = run_scenario(&app, "deburr", &[]) else { return };
     assert_eq!(result["ok"], true);
     assert!(result["segments"].as_u64().unwrap() >= 10, "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn jobs_page_runs_an_uploaded_example() {
+    let app = TestApp::spawn().await;
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/deburr-tube.toml");
+    let Some(result) = run_scenario(&app, "jobs", &[example.to_str().unwrap()]) else { return };
+    assert_eq!(result["ok"], true);
+    assert_eq!(result["plots"], 2, "one plot per operation: {result}");
+    eprintln!("upload to result on the page: {} s", result["seconds"]);
 }

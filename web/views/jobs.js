@@ -1,0 +1,185 @@
+// Jobs workbench: drop or pick a job file, watch it queue and run, browse past jobs, open a
+// result with the view of its operation, download G-code and JSON (api.md, Jobs).
+import { api, download, message, showProblem } from '/app.js';
+import { deburrResult } from '/views/deburr.js';
+
+// How each operation's result is shown; later capabilities add theirs here.
+const resultViews = { deburr: deburrResult };
+
+const LAYOUT = `
+<section>
+  <div id="job-drop" class="drop" tabindex="0">
+    <p><b>Drop a job file here</b> (JSON or TOML) or <label class="pick">choose one<input id="job-file" type="file" accept=".json,.toml,application/json,application/toml"></label></p>
+  </div>
+  <div id="job-messages"></div>
+  <table class="jobs"><thead><tr><th>job</th><th>name</th><th>operations</th><th>status</th><th>progress</th><th>submitted</th><th></th></tr></thead>
+    <tbody id="job-rows"></tbody></table>
+  <div class="actions"><button class="secondary" id="job-older" type="button" hidden>Older jobs</button></div>
+  <div id="job-result"></div>
+</section>`;
+
+const state = { jobs: new Map(), next: null, timer: null, open: null };
+
+function cell(text) {
+  const td = document.createElement('td');
+  td.textContent = text;
+  return td;
+}
+
+function row(job, root) {
+  const tr = document.createElement('tr');
+  tr.dataset.job = String(job.id);
+  tr.dataset.status = job.status;
+  const bar = document.createElement('progress');
+  bar.max = 1;
+  bar.value = job.progress;
+  const progress = document.createElement('td');
+  progress.append(bar, ` ${Math.round(job.progress * 100)}%`);
+  const status = cell(job.status);
+  status.className = `status ${job.status}`;
+  if (job.error) status.title = job.error;
+  const actions = document.createElement('td');
+  if (job.status === 'done') {
+    const open = document.createElement('button');
+    open.className = 'secondary';
+    open.textContent = 'Open';
+    open.addEventListener('click', () => openJob(job.id, root));
+    actions.append(open);
+  }
+  if (job.status === 'queued' || job.status === 'running') {
+    const cancel = document.createElement('button');
+    cancel.className = 'secondary';
+    cancel.textContent = 'Cancel';
+    cancel.addEventListener('click', async () => {
+      try {
+        await api('DELETE', `/api/v1/jobs/${job.id}`);
+        refresh(root);
+      } catch (problem) {
+        showProblem(root.querySelector('#job-messages'), null, problem);
+      }
+    });
+    actions.append(cancel);
+  }
+  tr.append(cell(`#${job.id}`), cell(job.name ?? ''), cell(job.operations.join(', ')), status, progress,
+    cell(job.submitted_at.replace('T', ' ').slice(0, 19)), actions);
+  if (job.status === 'failed' && job.error) {
+    const detail = document.createElement('tr');
+    const td = cell(`${job.error}${job.error_field ? ` [${job.error_field}]` : ''}`);
+    td.colSpan = 7;
+    td.className = 'error-line';
+    detail.append(td);
+    return [tr, detail];
+  }
+  return [tr];
+}
+
+function render(root) {
+  const rows = root.querySelector('#job-rows');
+  const jobs = [...state.jobs.values()].sort((a, b) => b.id - a.id);
+  rows.replaceChildren(...jobs.flatMap((job) => row(job, root)));
+  root.querySelector('#job-older').hidden = state.next === null;
+}
+
+async function refresh(root) {
+  try {
+    const page = await api('GET', '/api/v1/jobs?limit=20');
+    for (const job of page.jobs) state.jobs.set(job.id, job);
+    if (state.next === null && page.next_before !== undefined) state.next = page.next_before;
+    render(root);
+    const active = page.jobs.some((j) => j.status === 'queued' || j.status === 'running');
+    clearTimeout(state.timer);
+    if (active && document.body.contains(root)) state.timer = setTimeout(() => refresh(root), 700);
+  } catch (problem) {
+    showProblem(root.querySelector('#job-messages'), null, problem);
+  }
+}
+
+async function older(root) {
+  const page = await api('GET', `/api/v1/jobs?limit=20&before=${state.next}`);
+  for (const job of page.jobs) state.jobs.set(job.id, job);
+  state.next = page.next_before ?? null;
+  render(root);
+}
+
+async function openJob(id, root) {
+  const box = root.querySelector('#job-result');
+  try {
+    const job = await api('GET', `/api/v1/jobs/${id}`);
+    box.replaceChildren();
+    const title = document.createElement('h2');
+    title.textContent = `Job #${job.id}${job.name ? ': ' + job.name : ''}`;
+    box.append(title);
+    job.results.forEach((result, index) => {
+      const section = document.createElement('section');
+      section.className = 'job-operation';
+      section.dataset.operation = String(index);
+      const heading = document.createElement('h3');
+      heading.textContent = `${index}: ${result.operation}`;
+      const actions = document.createElement('div');
+      actions.className = 'actions';
+      const json = document.createElement('button');
+      json.className = 'secondary';
+      json.textContent = 'JSON';
+      json.addEventListener('click', () => download(`job-${id}-${index}-${result.operation}.json`, JSON.stringify(result.result, null, 2), 'application/json'));
+      actions.append(json);
+      if (result.gcode) {
+        const gcode = document.createElement('button');
+        gcode.className = 'secondary';
+        gcode.textContent = 'G-code';
+        gcode.addEventListener('click', async () => {
+          download(`job-${id}-${index}-${result.operation}.nc`, await api('GET', `/api/v1/jobs/${id}/gcode?operation=${index}`, undefined, 'text/x-gcode'));
+        });
+        actions.append(gcode);
+      } else if (result.gcode_problem) {
+        actions.append(message('warning', `no G-code: ${result.gcode_problem}`));
+      }
+      const view = document.createElement('div');
+      section.append(heading, actions, view);
+      box.append(section);
+      (resultViews[result.operation] || ((c, r) => { c.textContent = JSON.stringify(r).slice(0, 2000); }))(view, result.result);
+    });
+    box.scrollIntoView({ behavior: 'smooth', block: 'start' });
+  } catch (problem) {
+    showProblem(root.querySelector('#job-messages'), null, problem);
+  }
+}
+
+async function submit(file, root) {
+  const messages = root.querySelector('#job-messages');
+  const form = new FormData();
+  form.append('file', file, file.name);
+  try {
+    const answer = await api('POST', '/api/v1/jobs', form);
+    messages.replaceChildren(message('warning', answer.reused
+      ? `${file.name}: identical to job #${answer.id}, reusing its result`
+      : `${file.name}: queued as job #${answer.id}`));
+    await refresh(root);
+    if (answer.reused) openJob(answer.id, root);
+  } catch (problem) {
+    showProblem(messages, null, problem);
+  }
+}
+
+export const jobsView = {
+  id: 'jobs',
+  title: 'Jobs',
+  mount(root) {
+    root.innerHTML = LAYOUT;
+    state.jobs.clear();
+    state.next = null;
+    const drop = root.querySelector('#job-drop');
+    drop.addEventListener('dragover', (e) => { e.preventDefault(); drop.classList.add('over'); });
+    drop.addEventListener('dragleave', () => drop.classList.remove('over'));
+    drop.addEventListener('drop', (e) => {
+      e.preventDefault();
+      drop.classList.remove('over');
+      for (const file of e.dataTransfer.files) submit(file, root);
+    });
+    root.querySelector('#job-file').addEventListener('change', (e) => {
+      for (const file of e.target.files) submit(file, root);
+      e.target.value = '';
+    });
+    root.querySelector('#job-older').addEventListener('click', () => older(root));
+    refresh(root);
+  },
+};
