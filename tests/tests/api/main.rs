@@ -8,5 +8,6 @@ mod deburr;
 mod gcode;
 mod job_fuzz;
 mod jobs;
+mod load;
 mod openapi;
 mod tools;
