@@ -229,3 +229,48 @@ pub async fn poll_job(client: &Client, base: &str, id: i64, seconds: u64, done: 
 pub fn finished(job: &Value) -> bool {
     matches!(job["status"].as_str(), Some("done" | "failed" | "cancelled"))
 }
+
+/// Tool table for `rs274`: every pocket 1–99 holds a tool, so any program's `T n M06` and
+/// `G43 H n` resolve.
+fn rs274_tool_table() -> String {
+    (1..100).map(|n| format!("T{n} P{n} D6.0 Z0 ;test tool\n")).collect()
+}
+
+/// Runs `program` through LinuxCNC's `rs274` (writing it to `folder/name.ngc`), asserts that the
+/// interpreter accepts it to its end without complaint, and returns its canonical moves:
+/// (is a feed move, end point). `None` when `rs274` is missing (see [`external_program`]).
+pub fn rs274_moves(program: &str, folder: &Path, name: &str) -> Option<Vec<(bool, [f64; 3])>> {
+    let rs274 = external_program("rs274", "the LinuxCNC G-code check")?;
+    let file = folder.join(format!("{name}.ngc"));
+    std::fs::write(&file, program).expect("write program");
+    let table = folder.join("rs274-tools.tbl");
+    std::fs::write(&table, rs274_tool_table()).expect("write tool table");
+    let output = std::process::Command::new(rs274)
+        .arg("-t")
+        .arg(&table)
+        .arg("-g")
+        .arg(&file)
+        .stdin(std::process::Stdio::null())
+        .output()
+        .expect("rs274 runs");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "rs274 rejected {name}: {stderr}\n{program}");
+    let complaints: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty() && l.trim() != "executing").collect();
+    assert!(complaints.is_empty(), "rs274 complained about {name}: {complaints:?}");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(stdout.contains("PROGRAM_END"), "{name} runs to its end");
+    Some(
+        stdout
+            .lines()
+            .filter_map(|line| {
+                let feed = line.contains("STRAIGHT_FEED(");
+                if !feed && !line.contains("STRAIGHT_TRAVERSE(") {
+                    return None;
+                }
+                let inside = line.split('(').nth(1)?.split(')').next()?;
+                let numbers: Vec<f64> = inside.split(',').take(3).filter_map(|n| n.trim().parse().ok()).collect();
+                (numbers.len() == 3).then(|| (feed, [numbers[0], numbers[1], numbers[2]]))
+            })
+            .collect(),
+    )
+}

