@@ -236,3 +236,43 @@ pub(crate) fn overlap(job: &Job, construction: &Construction, ridges: &[RidgeCen
         )
     })
 }
+
+/// W_SHANK_CLEARANCE: on a tube's outer edge, whether the vertical shank above the ball (radius:
+/// the tool's neck radius, else the ball's) clears the tube. Seen along the horizontal tube axis the
+/// shank is a vertical strip above the centre and the tube a disc of radius R_T; the hole is
+/// ignored, which errs on the side of warning.
+pub(crate) fn outer_shank(job: &Job, ridges: &[RidgeCentre]) -> Option<Warning> {
+    let (_, outer) = job.tube_radii?;
+    if job.edge != Edge::Outer {
+        return None;
+    }
+    let frame = &job.frame;
+    let axis = frame.vector(&Vec3::y());
+    let across = Vec3::z().cross(&axis).normalize();
+    let shank = job.tool.neck_radius.unwrap_or(job.tool.radius);
+    let mut blocked = 0;
+    let mut first: Option<f64> = None;
+    for ridge in ridges {
+        let centre = frame.point(&ridge.centre);
+        let u = (centre - frame.origin).dot(&across);
+        let nearest = 0.0_f64.clamp(u - shank, u + shank);
+        if nearest.abs() >= outer {
+            continue;
+        }
+        let top = frame.origin.z + (outer * outer - nearest * nearest).sqrt();
+        if top > centre.z + 1e-9 {
+            blocked += 1;
+            first.get_or_insert(top - centre.z);
+        }
+    }
+    first.map(|overlap| {
+        Warning::new(
+            "W_SHANK_CLEARANCE",
+            format!(
+                "at {blocked} points the vertical shank above the ball (radius {shank}) would meet the tube (by up to \
+                 {overlap:.3} mm at the first): a vertical tool cannot reach that part of the edge; turn the part so the \
+                 hole points up"
+            ),
+        )
+    })
+}

@@ -111,6 +111,7 @@ pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError
     let (access_warnings, mut program_blocker) = checks::inner_access(&job, &ridges, &shank_direction);
     warnings.extend(access_warnings);
     warnings.extend(checks::overlap(&job, &construction, &ridges));
+    warnings.extend(checks::outer_shank(&job, &ridges));
 
     if job.direction == Direction::Cw {
         targets.reverse();

@@ -143,4 +143,13 @@ async fn warnings_are_reported() {
     let answer = json_with(app.post_json("/api/v1/deburr", &sharp).await, 200).await;
     let codes: Vec<&str> = answer["warnings"].as_array().unwrap().iter().map(|w| w["code"].as_str().unwrap()).collect();
     assert!(codes.contains(&"W_APPROX"), "{codes:?}");
+
+    // A hole far round the side of the tube: the vertical shank would meet the tube.
+    let mut side = request(json!({"shape": "round", "radius": 8, "penetration_angle_deg": 70}), "outer");
+    let answer = json_with(app.post_json("/api/v1/deburr", &side).await, 200).await;
+    let codes: Vec<&str> = answer["warnings"].as_array().unwrap().iter().map(|w| w["code"].as_str().unwrap()).collect();
+    assert!(codes.contains(&"W_SHANK_CLEARANCE"), "{codes:?}");
+    side["hole"]["penetration_angle_deg"] = json!(0);
+    let answer = json_with(app.post_json("/api/v1/deburr", &side).await, 200).await;
+    assert!(answer["warnings"].as_array().unwrap().iter().all(|w| w["code"] != "W_SHANK_CLEARANCE"));
 }
