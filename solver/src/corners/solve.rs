@@ -728,7 +728,7 @@ fn pass_report(pass: &PassPlan) -> PassReport {
             .iter()
             .filter(|e| kinds.contains(&e.kind()))
             .map(super::element::Element::length)
-            .sum()
+            .fold(0.0, |total, length| total + length)
     };
     PassReport {
         allowance: pass.allowance,
