@@ -50,9 +50,6 @@ pub(crate) fn ideal(layer: &Layer, corner: &CornerPlan, radius: f64) -> Material
     let (d1, d2) = layer.corner_directions(k);
     let (f1, f2) = (-d1, d2);
     let p = corner.cl_point;
-    let u = (p - vertex)
-        .try_normalize(0.0)
-        .unwrap_or_else(|| layer.air_normal(k));
     let air_angle = 2.0 * PI - corner.material_angle;
     let along = (p - vertex).norm() * (0.5 * air_angle).cos();
     let kite = [vertex, vertex + along * f1, p, vertex + along * f2];
@@ -74,7 +71,6 @@ pub(crate) fn ideal(layer: &Layer, corner: &CornerPlan, radius: f64) -> Material
                 let side = |x: &Vec2| (x - vertex).dot(&normal);
                 (radius - side(&p).min(side(&target))).max(0.0)
             };
-            let _ = u;
             Material {
                 left_area: (kite_area - capsule_convex_area(&p, &target, radius, &kite)).max(0.0),
                 left_depth: (point_segment_distance(&vertex, &p, &target) - radius).max(0.0),

@@ -38,35 +38,19 @@ pub(crate) fn shape(
     match style {
         Relief::Tbone => {
             let (incoming, outgoing) = (layer.previous(k), k);
+            // "previous" and "next" follow the request's point order, whatever the travel.
+            let (previous, next) = if request_order {
+                (incoming, outgoing)
+            } else {
+                (outgoing, incoming)
+            };
+            let (length_previous, length_next) = (layer.lengths[previous], layer.lengths[next]);
             let along = match edge {
-                TboneEdge::Longer => {
-                    if layer.lengths[outgoing] > layer.lengths[incoming] {
-                        outgoing
-                    } else {
-                        incoming
-                    }
-                }
-                TboneEdge::Shorter => {
-                    if layer.lengths[outgoing] < layer.lengths[incoming] {
-                        outgoing
-                    } else {
-                        incoming
-                    }
-                }
-                TboneEdge::Previous => {
-                    if request_order {
-                        incoming
-                    } else {
-                        outgoing
-                    }
-                }
-                TboneEdge::Next => {
-                    if request_order {
-                        outgoing
-                    } else {
-                        incoming
-                    }
-                }
+                TboneEdge::Longer if length_next > length_previous => next,
+                TboneEdge::Shorter if length_next < length_previous => next,
+                // Ties go to the previous edge, so the choice never depends on the direction.
+                TboneEdge::Longer | TboneEdge::Shorter | TboneEdge::Previous => previous,
+                TboneEdge::Next => next,
             };
             ReliefShape {
                 style,

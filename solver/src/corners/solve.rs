@@ -3,8 +3,6 @@
 //! clearance plane between layers, and assembles the answer with its corner reports and
 //! warnings.
 
-use std::f64::consts::PI;
-
 use super::answer::{
     ContourAnswer, ContourCorner, ContourLayer, ContourMove, ContourSummary, Convexity,
     CornerAction, LoopReport, MaterialReport, MoveKind, PassReport, ReliefReport,
@@ -14,7 +12,7 @@ use super::layer::Layer;
 use super::material::{self, Material};
 use super::pass::{self, Action, GOUGE_TOLERANCE, MAX_ARC_STEPS, PassInput, PassPlan, Stock};
 use super::prepare::list_indices;
-use super::request::{ContourRequest, CutDirection, Job, Join, LoopStyle, MAX_MOVES, Relief, Side};
+use super::request::{ContourRequest, CutDirection, Job, Join, LoopStyle, MAX_MOVES, Side};
 use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
 use crate::planar::{SegmentGrid, Vec2, array2, miter_point};
@@ -145,12 +143,21 @@ pub fn solve(request: &ContourRequest, tool: &Tool) -> Result<ContourAnswer, Sol
             tilted = (layer, passes);
             (&tilted.0, &tilted.1)
         };
-        let (lead_point, lead) = lead_point(&job, layer, passes);
+        let lead_point = lead_point(&job, layer, passes);
+        let lead = lead_point.map_or(0.0, |(_, lead)| lead);
         if lead < job.lead {
             shortened = true;
         }
         lead_used = lead_used.min(lead);
-        let moves = layer_moves(&job, layer, passes, lead_point, index == 0, previous_z, z);
+        let moves = layer_moves(
+            &job,
+            layer,
+            passes,
+            lead_point.map(|(point, _)| point),
+            index == 0,
+            previous_z,
+            z,
+        );
         layers.push(ContourLayer { z, moves });
         previous_z = z;
     }
@@ -168,7 +175,7 @@ pub fn solve(request: &ContourRequest, tool: &Tool) -> Result<ContourAnswer, Sol
         .last()
         .ok_or_else(|| SolverError::new("E_INPUT", "at least one pass is needed").at("passes"))?;
     let corners = corner_reports(&job, &setup, &first_layer, final_pass);
-    warnings.extend(corner_warnings(&job, &first_layer, &first_passes, &corners));
+    warnings.extend(corner_warnings(&job, &first_passes, &corners));
     let passes: Vec<PassReport> = first_passes.iter().map(pass_report).collect();
 
     let mut feed_length = 0.0;
@@ -366,8 +373,9 @@ fn layer_move_count(passes: &[PassPlan], tolerance: f64) -> usize {
 
 /// The lead point above which every pass of the layer starts, and the lead length used: on the
 /// normal of the start edge's middle, `lead` beyond the outermost pass, shortened until the
-/// leads to every pass's S clear the contour.
-fn lead_point(job: &Job, layer: &Layer, passes: &[PassPlan]) -> (Vec2, f64) {
+/// leads to every pass's S clear the contour; `None` when no lead along that normal does (the
+/// passes then start by plunging at their S).
+fn lead_point(job: &Job, layer: &Layer, passes: &[PassPlan]) -> Option<(Vec2, f64)> {
     let middle = 0.5 * (layer.vertices[0] + layer.vertices[layer.next(0)]);
     let normal = layer.air_normal(0);
     let outermost = passes
@@ -391,11 +399,20 @@ fn lead_point(job: &Job, layer: &Layer, passes: &[PassPlan]) -> (Vec2, f64) {
                 .is_none()
         });
         if clear {
-            return (point, lead);
+            return Some((point, lead));
         }
         lead *= 0.5;
     }
-    (middle + outermost * normal, 0.0)
+    None
+}
+
+/// Whether the straight move `[a, b]` keeps `clear` from the contour.
+fn clears(layer: &Layer, a: &Vec2, b: &Vec2, clear: f64) -> bool {
+    let mut scratch = Vec::new();
+    layer
+        .grid
+        .nearest(a, b, clear - GOUGE_TOLERANCE, &mut scratch, |_| false)
+        .is_none()
 }
 
 /// The tool axis of traversal edge `edge`: cos β·ẑ + sin β·n(t_e) (O6).
@@ -411,13 +428,15 @@ fn axis(job: &Job, layer: &Layer, edge: usize) -> Option<Vec3> {
 }
 
 /// Every move of one layer: down from the clearance plane at the lead point, each pass with its
-/// lead-in and lead-out, back up.
+/// lead-in and lead-out, back up. Without a lead point the first pass starts by plunging at its S,
+/// and later passes are reached by a straight link where it clears the contour, else over the
+/// clearance plane.
 #[allow(clippy::too_many_arguments)]
 fn layer_moves(
     job: &Job,
     layer: &Layer,
     passes: &[PassPlan],
-    lead_point: Vec2,
+    lead_point: Option<Vec2>,
     first: bool,
     previous_z: f64,
     z: f64,
@@ -425,40 +444,39 @@ fn layer_moves(
     let start_axis = axis(job, layer, 0).map(|a| [a.x, a.y, a.z]);
     let at = |p: &Vec2, height: f64| [p.x, p.y, height];
     let mut moves = Vec::new();
-    let mut push = |kind: MoveKind, to: [f64; 3], feed: Option<f64>, axis: Option<[f64; 3]>| {
-        moves.push(ContourMove {
-            kind,
-            to,
-            feed,
-            axis,
-        });
+    let step = |kind: MoveKind, to: [f64; 3], feed: Option<f64>| ContourMove {
+        kind,
+        to,
+        feed,
+        axis: start_axis,
     };
-    if first {
-        push(
-            MoveKind::Rapid,
-            at(&lead_point, job.safe_z),
-            None,
-            start_axis,
-        );
-    }
+    let Some(first_start) = passes.first().map(|p| p.start) else {
+        return Vec::new();
+    };
+    let entry = lead_point.unwrap_or(first_start);
     let approach = (previous_z + APPROACH_GAP.min(job.safe_z - previous_z)).max(z);
-    if approach < job.safe_z {
-        push(MoveKind::Rapid, at(&lead_point, approach), None, start_axis);
+    if first {
+        moves.push(step(MoveKind::Rapid, at(&entry, job.safe_z), None));
     }
-    push(
-        MoveKind::Link,
-        at(&lead_point, z),
-        Some(job.feed),
-        start_axis,
-    );
+    if approach < job.safe_z {
+        moves.push(step(MoveKind::Rapid, at(&entry, approach), None));
+    }
+    moves.push(step(MoveKind::Link, at(&entry, z), Some(job.feed)));
+    let mut here = entry;
     let loop_feed = job.loop_feed.unwrap_or(job.feed);
     for pass in passes {
-        push(
-            MoveKind::Link,
-            at(&pass.start, z),
-            Some(job.feed),
-            start_axis,
-        );
+        if here != pass.start {
+            if lead_point.is_some() || clears(layer, &here, &pass.start, pass.offset) {
+                moves.push(step(MoveKind::Link, at(&pass.start, z), Some(job.feed)));
+            } else {
+                moves.push(step(MoveKind::Rapid, at(&here, job.safe_z), None));
+                moves.push(step(MoveKind::Rapid, at(&pass.start, job.safe_z), None));
+                if approach < job.safe_z {
+                    moves.push(step(MoveKind::Rapid, at(&pass.start, approach), None));
+                }
+                moves.push(step(MoveKind::Link, at(&pass.start, z), Some(job.feed)));
+            }
+        }
         for (element, meta) in pass.elements.iter().zip(&pass.meta) {
             let kind = if element.kind() == ElementKind::Loop {
                 MoveKind::Loop
@@ -476,22 +494,31 @@ fn layer_moves(
                     let mixed = (a * (1.0 - s) + b * s).try_normalize(0.0).unwrap_or(b);
                     [mixed.x, mixed.y, mixed.z]
                 });
-                push(kind, at(point, z), Some(feed), axis);
+                moves.push(ContourMove {
+                    kind,
+                    to: at(point, z),
+                    feed: Some(feed),
+                    axis,
+                });
             }
         }
-        push(
-            MoveKind::Link,
-            at(&lead_point, z),
-            Some(job.feed),
-            start_axis,
-        );
+        here = pass.start;
+        if let Some(lead) = lead_point {
+            moves.push(ContourMove {
+                kind: MoveKind::Link,
+                to: at(&lead, z),
+                feed: Some(job.feed),
+                axis: start_axis,
+            });
+            here = lead;
+        }
     }
-    push(
-        MoveKind::Rapid,
-        at(&lead_point, job.safe_z),
-        None,
-        start_axis,
-    );
+    moves.push(ContourMove {
+        kind: MoveKind::Rapid,
+        to: at(&here, job.safe_z),
+        feed: None,
+        axis: start_axis,
+    });
     moves
 }
 
@@ -594,12 +621,7 @@ fn corner_reports(
 
 /// Warnings about corners: acute tips, corners too flat to loop, inside corners, loops at the
 /// cutting feed, and passes whose allowance does not protect the tip (E1).
-fn corner_warnings(
-    job: &Job,
-    layer: &Layer,
-    passes: &[PassPlan],
-    corners: &[ContourCorner],
-) -> Vec<Warning> {
+fn corner_warnings(job: &Job, passes: &[PassPlan], corners: &[ContourCorner]) -> Vec<Warning> {
     let mut warnings = Vec::new();
     let acute: Vec<usize> = corners
         .iter()
@@ -718,7 +740,6 @@ fn corner_warnings(
             ));
         }
     }
-    let _ = (layer, PI, Relief::None);
     warnings
 }
 
