@@ -176,3 +176,38 @@ fn pocket_corners_get_dogbones_and_no_loops() {
         );
     }
 }
+
+#[test]
+fn fillet_tighter_than_the_tool_is_passed_over_and_reported() {
+    // The L-shape's inside corner rounded with radius 0.5 in 10 chords; the tool (r = 2) cannot
+    // follow the chords, cuts past them at one merged corner point, and leaves the area between
+    // its own r = 2 fillet and the contour's: A_f(2, 90°) − A_f(0.5, 90°) up to the chords.
+    let mut contour: Vec<[f64; 2]> = vec![[0.0, 0.0], [30.0, 0.0], [30.0, 10.0]];
+    for i in 0..=10 {
+        let angle = -std::f64::consts::FRAC_PI_2 * f64::from(i) / 10.0;
+        // Centre (10.5, 10.5): from (10.5, 10) round to (10, 10.5), concave (centre in the air).
+        let a = -std::f64::consts::FRAC_PI_2 + angle;
+        contour.push([10.5 + 0.5 * a.cos(), 10.5 + 0.5 * a.sin()]);
+    }
+    contour.extend([[10.0, 25.0], [0.0, 25.0]]);
+    let answer = solve("none", "longer", "outside", &contour, 2.0);
+    let unreached: Vec<_> = answer
+        .corners
+        .iter()
+        .filter(|c| c.action == CornerAction::Unreached)
+        .collect();
+    assert_eq!(unreached.len(), 11);
+    let left: f64 = unreached.iter().map(|c| c.material.left_area).sum();
+    let expected =
+        4.0 * (1.0 - std::f64::consts::FRAC_PI_4) - 0.25 * (1.0 - std::f64::consts::FRAC_PI_4);
+    assert!((left - expected).abs() < 2e-3, "{left} vs {expected}");
+    assert!(answer.warnings.iter().any(|w| w.code == "W_EDGE_UNREACHED"));
+    // All corner points of the stretch share one CL point, 2 from both straight faces.
+    let p = vec2(unreached[0].cl_point);
+    assert!(
+        unreached
+            .iter()
+            .all(|c| (vec2(c.cl_point) - p).norm() < 1e-12)
+    );
+    assert!((p - Vec2::new(12.0, 12.0)).norm() < 1e-9, "{p:?}");
+}

@@ -33,9 +33,10 @@ pub struct ContourMove {
     /// Feed, mm/min (absent for rapids).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub feed: Option<f64>,
-    /// Unit tool axis at the end point (only with tilted walls).
+    /// Unit tool axis at the end point (only with tilted walls; boxed to keep the common move
+    /// small).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub axis: Option<[f64; 3]>,
+    pub axis: Option<Box<[f64; 3]>>,
 }
 
 /// One layer: its height and every move made there, from the clearance plane back to it.
@@ -76,6 +77,9 @@ pub enum CornerAction {
     Round,
     /// Inside corner without relief.
     Reflex,
+    /// On a stretch of short edges the tool cannot follow: cut past at one merged corner point,
+    /// material left (reported at the stretch's first corner).
+    Unreached,
     /// Inside corner with a dogbone relief.
     Dogbone,
     /// Inside corner with a T-bone relief.

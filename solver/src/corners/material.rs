@@ -82,6 +82,34 @@ pub(crate) fn ideal(layer: &Layer, corner: &CornerPlan, radius: f64) -> Material
     }
 }
 
+/// The material left along a stretch the tool cannot follow: the region between the contour
+/// from the foot of P on the last followed edge, through the stretch's corners `chain` (traversal
+/// order), to the foot of P on the next followed edge, and the tool circle at P.
+pub(crate) fn unreached(layer: &Layer, p: &Vec2, chain: &[usize], radius: f64) -> Material {
+    let (Some(&first), Some(&last)) = (chain.first(), chain.last()) else {
+        return Material::default();
+    };
+    let foot = |edge: usize| {
+        let origin = layer.vertices[edge];
+        let t = layer.directions[edge];
+        origin + (p - origin).dot(&t) * t
+    };
+    let mut polygon = vec![*p, foot(layer.previous(first))];
+    polygon.extend(chain.iter().map(|&k| layer.vertices[k]));
+    polygon.push(foot(last));
+    let area = signed_area(&polygon).abs();
+    let depth = chain
+        .iter()
+        .map(|&k| (layer.vertices[k] - p).norm() - radius)
+        .fold(0.0, f64::max);
+    Material {
+        left_area: (area - disk_polygon_area(p, radius, &polygon)).max(0.0),
+        left_depth: depth,
+        overcut_area: 0.0,
+        overcut_depth: 0.0,
+    }
+}
+
 /// The material under the control models of the final pass: M1 blends line-to-line corners with
 /// `blend_radius`, M2 shrinks arcs by Δ = (v·T)²/(2R) with `lag_product` = (v·T)² in mm².
 pub(crate) fn predicted(

@@ -10,7 +10,8 @@
 //! * `prepare`: closing, duplicates, collinear points, simplicity, orientation (§3.1);
 //! * `layer`: one layer's contour in traversal order, corner classification (§3.2), tilted
 //!   walls (§3.9.2);
-//! * `pass`: miter CL polygon and its validity (§3.3), corner actions, global gouge check with
+//! * `offset`: the miter CL polygon with edge events (O2–O4, §3.3);
+//! * `pass`: CL validity (O5, global clearance), corner actions, global gouge check with
 //!   fallbacks (§3.5.5), stock contact (§3.5.7);
 //! * [`loops`]: arc, triangle and parallelogram loops and their sizing (§3.5.1–3.5.4);
 //! * `relief`: dogbone and T-bone reliefs (beyond the seed);
@@ -46,6 +47,7 @@ mod element;
 mod layer;
 pub mod loops;
 pub mod material;
+mod offset;
 mod pass;
 mod prepare;
 pub mod program;

@@ -6,10 +6,11 @@
 use super::element::{Element, ElementKind};
 use super::layer::{Class, Layer};
 use super::loops::{self, LoopShape};
+use super::offset::{self, Offset};
 use super::relief::{self, ReliefShape};
 use super::request::{CornerChoice, Join, LoopConfig, LoopStyle, PassJob, Relief};
 use crate::error::{SolverError, Warning};
-use crate::planar::{SegmentGrid, Vec2, find_self_intersection, miter_point, signed_area};
+use crate::planar::{SegmentGrid, Vec2, find_self_intersection, signed_area};
 
 /// Clearance below which a move gouges, mm.
 pub const GOUGE_TOLERANCE: f64 = 1e-9;
@@ -31,6 +32,9 @@ pub enum Action {
     Round,
     /// Inside corner: to its miter point and on (the tool leaves a fillet).
     Reflex,
+    /// On a stretch the tool cannot follow (an edge too short for the tool next to an inside
+    /// corner): the tool cuts past it at the merged miter point and leaves material.
+    Unreached,
     /// Inside corner with a dogbone relief.
     Dogbone,
     /// Inside corner with a T-bone relief.
@@ -47,6 +51,7 @@ impl Action {
             Self::Miter => "miter",
             Self::Round => "round",
             Self::Reflex => "reflex",
+            Self::Unreached => "unreached",
             Self::Dogbone => "dogbone",
             Self::Tbone => "tbone",
         }
@@ -68,8 +73,12 @@ pub struct CornerPlan {
     pub material_angle: f64,
     /// Whether the material protrudes (α < π).
     pub convex: bool,
-    /// P: the miter point of the CL polygon.
+    /// P: the miter point of the CL polygon (shared by the corners of a stretch the tool cannot
+    /// follow).
     pub cl_point: Vec2,
+    /// The first corner (traversal index) of the stretch sharing this CL point; `k` itself for an
+    /// ordinary corner.
+    pub chain_start: usize,
     /// What the pass does there.
     pub action: Action,
     /// The loop, if one is made.
@@ -101,8 +110,13 @@ pub struct PassPlan {
     pub join: Join,
     /// S: where the pass starts and ends.
     pub start: Vec2,
-    /// The miter CL polygon P_k in traversal order.
+    /// The traversal edge S lies on (edge 0 unless the tool cannot follow it).
+    pub start_edge: usize,
+    /// The miter CL point of every corner, in traversal order (corners on a stretch the tool
+    /// cannot follow share one).
     pub cl: Vec<Vec2>,
+    /// Traversal edges the tool cannot follow (removed by edge events).
+    pub unreached_edges: Vec<usize>,
     /// The path from S round to S.
     pub elements: Vec<Element>,
     /// Per element: the edges whose tool axes it starts and ends with, and whether it may run at
@@ -188,11 +202,18 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
     let n = layer.len();
     let offsets = &input.edge_offsets;
     let clear = input.radius + input.pass.allowance;
-    let cl = cl_polygon(layer, offsets, &input.source)?;
-    check_offset(layer, &cl, input)?;
+    let tool = format!(
+        "the tool (radius {} + allowance {})",
+        input.radius, input.pass.allowance
+    );
+    let offset = offset::offset(layer, offsets, &input.edge_source, &tool)?;
+    check_offset(layer, &offset, input, &tool)?;
+    let cl = offset.cl.clone();
 
     let mut warnings = Vec::new();
-    let start = start_point(layer, &cl, offsets);
+    // S lies on edge 0, or on the first edge the tool follows.
+    let first_edge = (0..n).find(|&k| offset.active[k]).unwrap_or(0);
+    let start = start_point(layer, &cl, offsets, first_edge);
     let mut path = Path::default();
     let mut corners: Vec<Option<CornerPlan>> = vec![None; n];
     let mut current = start;
@@ -201,7 +222,7 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
     let mut reliefs_skipped: Vec<usize> = Vec::new();
     let mut scratch = Vec::new();
     for step in 1..=n {
-        let k = step % n;
+        let k = (first_edge + step) % n;
         let vertex = layer.vertices[k];
         let (d1, d2) = layer.corner_directions(k);
         let turn = layer.turn(k);
@@ -217,6 +238,7 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
             material_angle: layer.material_angle(k),
             convex: class == Class::Convex,
             cl_point: p,
+            chain_start: offset.chain_start[k],
             action: Action::Reflex,
             loop_shape: None,
             relief: None,
@@ -226,6 +248,15 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
         };
         let big_enough = turn.abs() >= input.loop_config.min_turn;
         let incoming = layer.previous(k);
+        if offset.merged(layer, k) {
+            plan.action = Action::Unreached;
+            if offset.chain_start[k] == k {
+                path.push(cut(current, p), incoming, incoming, false);
+                current = p;
+            }
+            corners[k] = Some(plan);
+            continue;
+        }
         match class {
             Class::Convex => {
                 let wanted = input.pass.loops
@@ -365,7 +396,7 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
         }
         corners[k] = Some(plan);
     }
-    path.push(cut(current, start), 0, 0, false);
+    path.push(cut(current, start), first_edge, first_edge, false);
     check_clearance(layer, &path.elements, clear, input, &mut scratch)?;
 
     if !skipped.is_empty() {
@@ -384,6 +415,21 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
         warnings.push(Warning::new(
             "W_LOOP_FALLBACK",
             format!("pass {}: {}", input.index + 1, first_few(&fallbacks)),
+        ));
+    }
+    if !offset.active.iter().all(|a| *a) {
+        let unreached: Vec<usize> = (0..n)
+            .filter(|&k| !offset.active[k])
+            .map(|k| input.edge_source[k])
+            .collect();
+        warnings.push(Warning::new(
+            "W_EDGE_UNREACHED",
+            format!(
+                "pass {}: {tool} cannot follow {} edges (too short next to inside corners, or concave arcs tighter than the tool); material stays there: edges from {}",
+                input.index + 1,
+                unreached.len(),
+                list(&unreached)
+            ),
         ));
     }
     if !reliefs_skipped.is_empty() {
@@ -410,7 +456,9 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
         loops: input.pass.loops,
         join: input.pass.join,
         start,
+        start_edge: first_edge,
         cl,
+        unreached_edges: (0..n).filter(|&k| !offset.active[k]).collect(),
         elements: path.elements,
         meta: path.meta,
         corners,
@@ -447,68 +495,28 @@ fn cut(start: Vec2, end: Vec2) -> Element {
     }
 }
 
-/// The miter CL polygon (O2/O3).
-pub(crate) fn cl_polygon(
+/// O5 (the CL polygon is simple) and its orientation; O4 is the edge events of `offset`.
+fn check_offset(
     layer: &Layer,
-    offsets: &[f64],
-    source: &[usize],
-) -> Result<Vec<Vec2>, SolverError> {
-    (0..layer.len())
-        .map(|k| {
-            let previous = layer.previous(k);
-            miter_point(
-                &layer.vertices[k],
-                &layer.air_normal(previous),
-                offsets[previous],
-                &layer.air_normal(k),
-                offsets[k],
-            )
-            .ok_or_else(|| {
-                SolverError::new(
-                    "E_DEGENERATE",
-                    format!("the contour reverses by 180° at {}", field(source[k])),
-                )
-                .at(field(source[k]))
-            })
-        })
-        .collect()
-}
-
-/// O4 (no offset edge collapses), O5 (the CL polygon is simple) and its orientation.
-fn check_offset(layer: &Layer, cl: &[Vec2], input: &PassInput<'_>) -> Result<(), SolverError> {
-    let n = layer.len();
-    let scale = layer.lengths.iter().copied().fold(0.0, f64::max).max(1.0);
-    for k in 0..n {
-        let length = (cl[(k + 1) % n] - cl[k]).dot(&layer.directions[k]);
-        if length <= 1e-12 * scale {
-            let source = input.edge_source[k];
-            return Err(SolverError::new(
-                "E_OFFSET_COLLAPSE",
-                format!(
-                    "the tool (radius {} + allowance {}) does not fit the edge from {} (length {:.6}): its offset edge has length {length:.6}",
-                    input.radius,
-                    input.pass.allowance,
-                    field(source),
-                    layer.lengths[k]
-                ),
-            )
-            .at(field(source)));
-        }
-    }
-    match find_self_intersection(cl) {
+    offset: &Offset,
+    input: &PassInput<'_>,
+    tool: &str,
+) -> Result<(), SolverError> {
+    let edges: Vec<usize> = (0..layer.len()).filter(|&k| offset.active[k]).collect();
+    let polygon = offset.polygon(layer);
+    match find_self_intersection(&polygon) {
         Ok(None) => {}
         Ok(Some((i, j))) => {
+            let (first, second) = (input.edge_source[edges[i]], input.edge_source[edges[j]]);
             return Err(SolverError::new(
                 "E_OFFSET_SELF_INTERSECTION",
                 format!(
-                    "the tool (radius {} + allowance {}) does not fit between the edges from {} and {}: their offsets cross",
-                    input.radius,
-                    input.pass.allowance,
-                    field(input.edge_source[i]),
-                    field(input.edge_source[j])
+                    "{tool} does not fit between the edges from {} and {}: their offsets cross",
+                    field(first),
+                    field(second)
                 ),
             )
-            .at(field(input.edge_source[j])));
+            .at(field(second)));
         }
         Err(_) => {
             return Err(SolverError::new(
@@ -518,32 +526,29 @@ fn check_offset(layer: &Layer, cl: &[Vec2], input: &PassInput<'_>) -> Result<(),
             .at("contour"));
         }
     }
-    if signed_area(cl) * signed_area(&layer.vertices) <= 0.0 {
+    if signed_area(&polygon) * signed_area(&layer.vertices) <= 0.0 {
         return Err(SolverError::new(
             "E_OFFSET_COLLAPSE",
-            format!(
-                "the tool (radius {} + allowance {}) does not fit inside the contour",
-                input.radius, input.pass.allowance
-            ),
+            format!("{tool} does not fit inside the contour"),
         )
         .at("contour"));
     }
     Ok(())
 }
 
-/// S: the offset foot of the middle of edge 0, or the middle of the offset edge if that foot
-/// falls outside it.
-fn start_point(layer: &Layer, cl: &[Vec2], offsets: &[f64]) -> Vec2 {
-    let n = layer.len();
-    let middle = 0.5 * (layer.vertices[0] + layer.vertices[1 % n]);
-    let foot = middle + offsets[0] * layer.air_normal(0);
-    let t = layer.directions[0];
-    let along = (foot - cl[0]).dot(&t);
-    let length = (cl[1 % n] - cl[0]).dot(&t);
+/// S: the offset foot of the middle of edge `edge`, or the middle of the offset edge if that
+/// foot falls outside it.
+fn start_point(layer: &Layer, cl: &[Vec2], offsets: &[f64], edge: usize) -> Vec2 {
+    let after = layer.next(edge);
+    let middle = 0.5 * (layer.vertices[edge] + layer.vertices[after]);
+    let foot = middle + offsets[edge] * layer.air_normal(edge);
+    let t = layer.directions[edge];
+    let along = (foot - cl[edge]).dot(&t);
+    let length = (cl[after] - cl[edge]).dot(&t);
     if along > 0.0 && along < length {
         foot
     } else {
-        0.5 * (cl[0] + cl[1 % n])
+        0.5 * (cl[edge] + cl[after])
     }
 }
 

@@ -13,8 +13,9 @@ pub const MAX_POINTS: usize = 200_000;
 pub const MAX_LAYERS: usize = 10_000;
 /// Most passes per layer (`E_INPUT` at `passes`).
 pub const MAX_PASSES: usize = 100;
-/// Most moves in one answer, all layers together (`E_TOO_MANY_MOVES`), about 320 MB.
-pub const MAX_MOVES: usize = 10_000_000;
+/// Most moves in one answer, all layers together (`E_TOO_MANY_MOVES`): 56 bytes each, so at
+/// most about 340 MB.
+pub const MAX_MOVES: usize = 6_000_000;
 /// Default height of the clearance plane above `depths.top`, mm.
 pub const DEFAULT_CLEARANCE: f64 = 5.0;
 /// Default chord tolerance for arcs (loops, round joins), mm.

@@ -376,11 +376,12 @@ fn layer_move_count(passes: &[PassPlan], tolerance: f64) -> usize {
 /// leads to every pass's S clear the contour; `None` when no lead along that normal does (the
 /// passes then start by plunging at their S).
 fn lead_point(job: &Job, layer: &Layer, passes: &[PassPlan]) -> Option<(Vec2, f64)> {
-    let middle = 0.5 * (layer.vertices[0] + layer.vertices[layer.next(0)]);
-    let normal = layer.air_normal(0);
+    let edge = passes.first().map_or(0, |p| p.start_edge);
+    let middle = 0.5 * (layer.vertices[edge] + layer.vertices[layer.next(edge)]);
+    let normal = layer.air_normal(edge);
     let outermost = passes
         .iter()
-        .filter_map(|p| p.edge_offsets.first().copied())
+        .filter_map(|p| p.edge_offsets.get(edge).copied())
         .fold(0.0, f64::max);
     let mut lead = job.lead;
     let mut scratch = Vec::new();
@@ -441,14 +442,14 @@ fn layer_moves(
     previous_z: f64,
     z: f64,
 ) -> Vec<ContourMove> {
-    let start_axis = axis(job, layer, 0).map(|a| [a.x, a.y, a.z]);
+    let start_axis = axis(job, layer, 0).map(|a| Box::new([a.x, a.y, a.z]));
     let at = |p: &Vec2, height: f64| [p.x, p.y, height];
     let mut moves = Vec::new();
     let step = |kind: MoveKind, to: [f64; 3], feed: Option<f64>| ContourMove {
         kind,
         to,
         feed,
-        axis: start_axis,
+        axis: start_axis.clone(),
     };
     let Some(first_start) = passes.first().map(|p| p.start) else {
         return Vec::new();
@@ -492,7 +493,7 @@ fn layer_moves(
                 let axis = from_axis.zip(to_axis).map(|(a, b)| {
                     let s = (index as f64 + 1.0) / count;
                     let mixed = (a * (1.0 - s) + b * s).try_normalize(0.0).unwrap_or(b);
-                    [mixed.x, mixed.y, mixed.z]
+                    Box::new([mixed.x, mixed.y, mixed.z])
                 });
                 moves.push(ContourMove {
                     kind,
@@ -508,7 +509,7 @@ fn layer_moves(
                 kind: MoveKind::Link,
                 to: at(&lead, z),
                 feed: Some(job.feed),
-                axis: start_axis,
+                axis: start_axis.clone(),
             });
             here = lead;
         }
@@ -530,6 +531,7 @@ fn corner_action(action: Action) -> CornerAction {
         Action::Miter => CornerAction::Miter,
         Action::Round => CornerAction::Round,
         Action::Reflex => CornerAction::Reflex,
+        Action::Unreached => CornerAction::Unreached,
         Action::Dogbone => CornerAction::Dogbone,
         Action::Tbone => CornerAction::Tbone,
     }
@@ -559,7 +561,21 @@ fn corner_reports(
         .corners
         .iter()
         .map(|corner| {
-            let ideal = material::ideal(layer, corner, job.radius);
+            let ideal = if corner.action == Action::Unreached {
+                if corner.chain_start == corner.k {
+                    let chain: Vec<usize> = final_pass
+                        .corners
+                        .iter()
+                        .filter(|c| c.chain_start == corner.k)
+                        .map(|c| c.k)
+                        .collect();
+                    material::unreached(layer, &corner.cl_point, &chain, job.radius)
+                } else {
+                    Material::default()
+                }
+            } else {
+                material::ideal(layer, corner, job.radius)
+            };
             let predicted = model.then(|| {
                 material::predicted(
                     corner,
