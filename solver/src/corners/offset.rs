@@ -102,8 +102,8 @@ pub(crate) fn offset(
     };
     // start[e]: the CL point where edge e begins (intersection with its active predecessor).
     let mut start: Vec<Vec2> = Vec::with_capacity(n);
-    for k in 0..n {
-        start.push(corner(previous[k], k).ok_or_else(|| {
+    for (k, &before) in previous.iter().enumerate() {
+        start.push(corner(before, k).ok_or_else(|| {
             SolverError::new(
                 "E_DEGENERATE",
                 format!("the contour reverses by 180° at {}", field(k)),
@@ -190,13 +190,13 @@ pub(crate) fn offset(
             vertex = before;
         }
         let first = vertex;
-        let mut vertex = first;
+        let mut member = first;
         loop {
-            chain_start[vertex] = first;
-            if vertex == edge {
+            chain_start[member] = first;
+            if member == edge {
                 break;
             }
-            vertex = layer.next(vertex);
+            member = layer.next(member);
         }
     }
     Ok(Offset {
