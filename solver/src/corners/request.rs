@@ -113,6 +113,51 @@ pub struct CornerLoop {
     pub max_angle_deg: Option<f64>,
 }
 
+impl CornerLoop {
+    /// The sizing with every default resolved for a tool of `radius`.
+    pub(crate) fn config(&self, radius: f64) -> Result<LoopConfig, SolverError> {
+        let spec = self;
+        let positive_or = |name: &str, value: Option<f64>, default: f64| {
+            positive(&format!("corner_loop.{name}"), value.unwrap_or(default))
+        };
+        let loop_radius = positive_or("radius", spec.radius, radius)?;
+        let leg = positive_or("leg", spec.leg, radius)?;
+        let min_leg = non_negative("corner_loop.min_leg", spec.min_leg.unwrap_or(0.0))?;
+        let max_leg = positive_or("max_leg", spec.max_leg, 10.0 * radius)?;
+        let min_radius = positive_or("min_radius", spec.min_radius, 0.1 * radius)?;
+        let max_radius = positive_or("max_radius", spec.max_radius, 5.0 * radius)?;
+        if min_leg > max_leg {
+            return Err(SolverError::input(
+                "corner_loop.min_leg",
+                format!("min_leg {min_leg} exceeds max_leg {max_leg}"),
+            ));
+        }
+        if min_radius > max_radius {
+            return Err(SolverError::input(
+                "corner_loop.min_radius",
+                format!("min_radius {min_radius} exceeds max_radius {max_radius}"),
+            ));
+        }
+        let max_angle = spec.max_angle_deg.unwrap_or(DEFAULT_MAX_ANGLE_DEG);
+        if !(finite("corner_loop.max_angle_deg", max_angle)? > 0.0 && max_angle < 180.0) {
+            return Err(SolverError::input(
+                "corner_loop.max_angle_deg",
+                format!("max_angle_deg must lie strictly between 0 and 180 (got {max_angle})"),
+            ));
+        }
+        Ok(LoopConfig {
+            style: spec.style,
+            radius: loop_radius,
+            leg,
+            min_leg,
+            max_leg,
+            min_radius,
+            max_radius,
+            min_turn: (180.0 - max_angle).to_radians(),
+        })
+    }
+}
+
 /// How a pass joins the faces at corners that get no loop.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
@@ -412,7 +457,7 @@ impl ContourRequest {
                 ),
             ));
         }
-        let loop_config = self.loop_config(radius)?;
+        let loop_config = self.corner_loop.config(radius)?;
         let (contour, mut warnings) = prepare::prepare(&self.contour, self.fix_orientation)?;
         let start_edge = match self.start_edge {
             None => contour.edge_containing(0),
@@ -518,48 +563,6 @@ impl ContourRequest {
                 })
             })
             .collect()
-    }
-
-    fn loop_config(&self, radius: f64) -> Result<LoopConfig, SolverError> {
-        let spec = &self.corner_loop;
-        let positive_or = |name: &str, value: Option<f64>, default: f64| {
-            positive(&format!("corner_loop.{name}"), value.unwrap_or(default))
-        };
-        let loop_radius = positive_or("radius", spec.radius, radius)?;
-        let leg = positive_or("leg", spec.leg, radius)?;
-        let min_leg = non_negative("corner_loop.min_leg", spec.min_leg.unwrap_or(0.0))?;
-        let max_leg = positive_or("max_leg", spec.max_leg, 10.0 * radius)?;
-        let min_radius = positive_or("min_radius", spec.min_radius, 0.1 * radius)?;
-        let max_radius = positive_or("max_radius", spec.max_radius, 5.0 * radius)?;
-        if min_leg > max_leg {
-            return Err(SolverError::input(
-                "corner_loop.min_leg",
-                format!("min_leg {min_leg} exceeds max_leg {max_leg}"),
-            ));
-        }
-        if min_radius > max_radius {
-            return Err(SolverError::input(
-                "corner_loop.min_radius",
-                format!("min_radius {min_radius} exceeds max_radius {max_radius}"),
-            ));
-        }
-        let max_angle = spec.max_angle_deg.unwrap_or(DEFAULT_MAX_ANGLE_DEG);
-        if !(finite("corner_loop.max_angle_deg", max_angle)? > 0.0 && max_angle < 180.0) {
-            return Err(SolverError::input(
-                "corner_loop.max_angle_deg",
-                format!("max_angle_deg must lie strictly between 0 and 180 (got {max_angle})"),
-            ));
-        }
-        Ok(LoopConfig {
-            style: spec.style,
-            radius: loop_radius,
-            leg,
-            min_leg,
-            max_leg,
-            min_radius,
-            max_radius,
-            min_turn: (180.0 - max_angle).to_radians(),
-        })
     }
 
     fn corner_choices(&self, contour: &Contour) -> Result<Vec<CornerChoice>, SolverError> {
