@@ -106,16 +106,24 @@ impl SegmentGrid {
         self.cell
     }
 
-    /// Appends to `out` the indices of every segment that may lie within `radius` of the segment
-    /// `[a, b]` (a superset; sorted, without repeats).
-    pub fn candidates(&self, a: &Vec2, b: &Vec2, radius: f64, out: &mut Vec<usize>) {
-        let start = out.len();
+    /// Calls `f` with the index of every segment that may lie within `radius` of the segment
+    /// `[a, b]` (a superset; a segment spanning several cells comes once per cell).
+    pub fn visit(&self, a: &Vec2, b: &Vec2, radius: f64, mut f: impl FnMut(usize)) {
         let pad = radius.max(0.0) + self.cell * 1e-9;
         self.for_each_column(a, b, pad, |column, first, last| {
             let low = self.keys.partition_point(|k| *k < key(column, first));
             let high = self.keys.partition_point(|k| *k <= key(column, last));
-            out.extend(self.items[low..high].iter().map(|&i| i as usize));
+            for &item in &self.items[low..high] {
+                f(item as usize);
+            }
         });
+    }
+
+    /// Appends to `out` the indices of every segment that may lie within `radius` of the segment
+    /// `[a, b]` (a superset; sorted, without repeats).
+    pub fn candidates(&self, a: &Vec2, b: &Vec2, radius: f64, out: &mut Vec<usize>) {
+        let start = out.len();
+        self.visit(a, b, radius, |i| out.push(i));
         out[start..].sort_unstable();
         let mut unique = start;
         for read in start..out.len() {
@@ -139,18 +147,28 @@ impl SegmentGrid {
         skip: impl Fn(usize) -> bool,
     ) -> Option<(f64, usize)> {
         scratch.clear();
-        self.candidates(a, b, radius, scratch);
+        let (low, high) = (a.inf(b).add_scalar(-radius), a.sup(b).add_scalar(radius));
         let mut best: Option<(f64, usize)> = None;
-        for &index in scratch.iter() {
-            if skip(index) {
-                continue;
-            }
+        self.visit(a, b, radius, |index| {
             let (c, d) = self.segments[index];
+            // Bounding boxes farther apart than the radius cannot hold a closer pair.
+            if c.x.max(d.x) < low.x
+                || c.x.min(d.x) > high.x
+                || c.y.max(d.y) < low.y
+                || c.y.min(d.y) > high.y
+            {
+                return;
+            }
+            if best.is_some_and(|(_, i)| i == index) || skip(index) {
+                return;
+            }
             let distance = segment_segment_distance(a, b, &c, &d);
-            if distance <= radius && best.is_none_or(|(d0, _)| distance < d0) {
+            if distance <= radius
+                && best.is_none_or(|(d0, i0)| distance < d0 || (distance == d0 && index < i0))
+            {
                 best = Some((distance, index));
             }
-        }
+        });
         best
     }
 
