@@ -667,3 +667,57 @@ fn edge_case_detection_on_a_thin_triangle() {
         assert!((measure.delta_l_per_step - number(&want["dL_over_h"][k])).abs() <= 1e-4);
     }
 }
+
+#[test]
+fn loops_shrink_where_the_full_loop_would_gouge_a_neighbour() {
+    // §3.5.5 global check: a tooth (1 wide, 5 high) standing in a bay 2.6 from each bay wall.
+    // Full arc loops (ρ = r = 1) at the tooth's tip would reach past the bay walls; halving twice
+    // (ρ = 0.25) clears them by 0.1. The other corners keep ρ = 1.
+    let contour = json!([
+        [0, 0],
+        [30, 0],
+        [30, 30],
+        [18.1, 30],
+        [18.1, 20],
+        [15.5, 20],
+        [15.5, 25],
+        [14.5, 25],
+        [14.5, 20],
+        [11.9, 20],
+        [11.9, 30],
+        [0, 30]
+    ]);
+    let request: ContourRequest = serde_json::from_value(json!({
+        "tool": {"kind": "flat", "radius": 1}, "contour": contour, "side": "outside",
+        "direction": "conventional", "depths": {"top": 1, "bottom": 0, "step": 1}, "feed": 500
+    }))
+    .unwrap();
+    let answer = corners::solve(&request, &Tool::new(ToolKind::Flat, 1.0)).unwrap();
+    for corner in answer.corners.iter().filter(|c| c.looped) {
+        let report = corner.corner_loop.as_ref().unwrap();
+        assert!(report.clearance >= -1e-9, "corner {}", corner.index);
+        let tooth_tip = corner.index == 6 || corner.index == 7;
+        let expected = if tooth_tip { 0.25 } else { 1.0 };
+        assert!(
+            (report.radius.unwrap() - expected).abs() < 1e-12,
+            "corner {}: ρ {:?}",
+            corner.index,
+            report.radius
+        );
+        if tooth_tip {
+            assert!(
+                (report.clearance - 0.1).abs() < 0.011,
+                "corner {}: {}",
+                corner.index,
+                report.clearance
+            );
+        }
+    }
+    assert_eq!(answer.corners.iter().filter(|c| c.looped).count(), 8);
+    assert!(
+        !answer
+            .warnings
+            .iter()
+            .any(|w| w.code == "W_LOOP_SKIPPED_GOUGE")
+    );
+}

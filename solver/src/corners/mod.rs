@@ -10,7 +10,9 @@
 //! * `prepare`: closing, duplicates, collinear points, simplicity, orientation (§3.1);
 //! * `layer`: one layer's contour in traversal order, corner classification (§3.2), tilted
 //!   walls (§3.9.2);
-//! * `offset`: the miter CL polygon with edge events (O2–O4, §3.3);
+//! * `offset`: the miter CL polygon with edge events (O2–O4, §3.3): edges too short for the
+//!   tool next to inside corners (tessellated fillets tighter than the tool) are passed over at
+//!   one merged corner point and their material reported, instead of refusing the contour;
 //! * `pass`: CL validity (O5, global clearance), corner actions, global gouge check with
 //!   fallbacks (§3.5.5), stock contact (§3.5.7);
 //! * [`loops`]: arc, triangle and parallelogram loops and their sizing (§3.5.1–3.5.4);
@@ -37,6 +39,9 @@
 //!   exit leg exactly.
 //! * The stock before the first pass is unknown unless `stock_allowance` is given; loops run at
 //!   `loop_feed` only where they provably clear the stock (S1/S2 models), else at `feed`.
+//! * Material is reported per corner for ideal execution of the final pass (inside-corner fillets,
+//!   relief over-cuts, stretches the tool cannot follow) and, with a `controller` model, as
+//!   predicted under blending (M1) and servo lag (M2); convex corners lose nothing ideally.
 //! * The effective radius is the tool's `radius` for every kind (its widest part cuts the
 //!   vertical wall); ball and bull tools differ only in the G-code reference point.
 

@@ -680,7 +680,7 @@ fn corner_warnings(job: &Job, passes: &[PassPlan], corners: &[ContourCorner]) ->
     }
     let inside: Vec<&ContourCorner> = corners
         .iter()
-        .filter(|c| c.convexity == Convexity::Concave && c.relief.is_none())
+        .filter(|c| c.action == CornerAction::Reflex)
         .collect();
     if !inside.is_empty() {
         let largest = inside
