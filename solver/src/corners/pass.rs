@@ -210,6 +210,7 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
     check_offset(layer, &offset, input, &tool)?;
     let cl = offset.cl.clone();
 
+    check_loop_budget(layer, &offset, input)?;
     let mut warnings = Vec::new();
     // S lies on edge 0, or on the first edge the tool follows.
     let first_edge = (0..n).find(|&k| offset.active[k]).unwrap_or(0);
@@ -493,6 +494,45 @@ fn cut(start: Vec2, end: Vec2) -> Element {
         end,
         kind: ElementKind::Cut,
     }
+}
+
+/// Refuses before building any loop when the loops alone would need more moves than an answer
+/// may hold (huge loop radii with a fine chord tolerance on many corners).
+fn check_loop_budget(
+    layer: &Layer,
+    offset: &Offset,
+    input: &PassInput<'_>,
+) -> Result<(), SolverError> {
+    if !input.pass.loops || input.loop_config.style == LoopStyle::None {
+        return Ok(());
+    }
+    let mut moves = 0usize;
+    for k in 0..layer.len() {
+        if offset.merged(layer, k) || layer.class(k) != Class::Convex {
+            continue;
+        }
+        let (d1, d2) = layer.corner_directions(k);
+        if let Some((shape, _)) =
+            loops::sized(input.loop_config, &offset.cl[k], &d1, &d2, layer.sigma)
+        {
+            moves += shape
+                .elements(&offset.cl[k])
+                .iter()
+                .map(|e| e.chord_count(input.tolerance, MAX_ARC_STEPS))
+                .sum::<usize>();
+        }
+        if moves > super::request::MAX_MOVES {
+            return Err(SolverError::new(
+                "E_TOO_MANY_MOVES",
+                format!(
+                    "the corner loops alone need more than {} moves: use a coarser tolerance or smaller loops",
+                    super::request::MAX_MOVES
+                ),
+            )
+            .at("tolerance"));
+        }
+    }
+    Ok(())
 }
 
 /// O5 (the CL polygon is simple) and its orientation; O4 is the edge events of `offset`.

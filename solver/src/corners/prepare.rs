@@ -7,6 +7,8 @@ use crate::planar::{self, Vec2, find_self_intersection, signed_area, turn_angle}
 
 /// Points closer than this are one point, mm (corners.md §1.4 `tol`).
 pub const DUPLICATE_TOLERANCE: f64 = 1e-6;
+/// Largest coordinate accepted, mm (1 km: keeps every derived number finite and precise).
+pub const MAX_COORDINATE: f64 = 1e6;
 /// Vertices turning by at most this are straight and removed, radians (corners.md §3.1).
 pub const STRAIGHT_TURN: f64 = 1e-9;
 
@@ -101,8 +103,14 @@ pub(crate) fn prepare(
     }
     for (index, point) in points.iter().enumerate() {
         let field = format!("contour[{index}]");
-        finite(&field, point[0])?;
-        finite(&field, point[1])?;
+        if finite(&field, point[0])?.abs() > MAX_COORDINATE
+            || finite(&field, point[1])?.abs() > MAX_COORDINATE
+        {
+            return Err(SolverError::input(
+                field,
+                format!("coordinates must lie within ±{MAX_COORDINATE} mm"),
+            ));
+        }
     }
     let mut warnings = Vec::new();
     let mut kept: Vec<(Vec2, usize)> = Vec::with_capacity(points.len());

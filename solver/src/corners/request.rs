@@ -409,6 +409,23 @@ impl ContourRequest {
         let top = finite("depths.top", depths.top)?;
         let bottom = finite("depths.bottom", depths.bottom)?;
         let step = positive("depths.step", depths.step)?;
+        for (field, value) in [("depths.top", top), ("depths.bottom", bottom)] {
+            if value.abs() > super::prepare::MAX_COORDINATE {
+                return Err(SolverError::input(
+                    field,
+                    format!(
+                        "{field} must lie within ±{} mm",
+                        super::prepare::MAX_COORDINATE
+                    ),
+                ));
+            }
+        }
+        if radius > super::prepare::MAX_COORDINATE {
+            return Err(SolverError::input(
+                "tool.radius",
+                "the tool radius is implausibly large",
+            ));
+        }
         if bottom > top {
             return Err(SolverError::input(
                 "depths.bottom",
