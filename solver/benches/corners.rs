@@ -90,42 +90,54 @@ fn fixture_request(
     (request, Tool::new(ToolKind::Flat, radius))
 }
 
-/// The with/without-loops material table of the issue, printed once.
+/// The with/without-loops material table of the issue, printed once: per corner of the final
+/// pass, material left / over-cut (mm²) with loops, and without loops as miter or round joins,
+/// ideal and under M1 (blend radius ρ_b: 1.5 mm for C1 as in corners.md §3.10, 1 mm for C2 as in
+/// its case, 3 mm for C3) and M2 (servo T = 31.62 ms at 600 mm/min: Δ = 0.05 mm on a 1 mm arc).
 fn material_table() {
     let fixture: Value =
         serde_json::from_str(include_str!("../tests/fixtures/corners.json")).unwrap_or(Value::Null);
-    let models = [
-        ("ideal", None),
-        (
-            "M1 blend 1.5 mm",
-            Some(ControllerModel {
-                blend_radius: Some(1.5),
-                servo_time_constant_ms: None,
-            }),
-        ),
-        (
-            "M2 T = 30 ms at 600 mm/min",
-            Some(ControllerModel {
-                blend_radius: None,
-                servo_time_constant_ms: Some(30.0),
-            }),
-        ),
-    ];
-    println!("material per corner (left area / over-cut area, mm²), final pass:");
+    println!("material per corner, final pass: left area / over-cut area, mm²");
     for case in fixture["cases"]
         .as_array()
         .map(Vec::as_slice)
         .unwrap_or_default()
     {
+        let id = case["id"].as_str().unwrap_or("?");
+        let blend = match id {
+            "C1" => 1.5,
+            "C2" => 1.0,
+            _ => 3.0,
+        };
+        let models = [
+            ("ideal", None),
+            (
+                "M1",
+                Some(ControllerModel {
+                    blend_radius: Some(blend),
+                    servo_time_constant_ms: None,
+                }),
+            ),
+            (
+                "M2",
+                Some(ControllerModel {
+                    blend_radius: None,
+                    servo_time_constant_ms: Some(31.622_776_6),
+                }),
+            ),
+        ];
         for (label, model) in &models {
-            for loops in [true, false] {
-                let (mut request, tool) = fixture_request(case, loops, model.clone());
-                if !loops && case["id"] == "C3" {
-                    // Without loops the C3 finishing passes use their round join.
-                    if let Some(passes) = request.passes.as_mut() {
-                        for pass in passes.iter_mut() {
-                            pass.join = corners::Join::Round;
-                        }
+            for variant in ["loops", "miter", "round"] {
+                let (mut request, tool) = fixture_request(case, variant == "loops", model.clone());
+                if variant != "loops"
+                    && let Some(passes) = request.passes.as_mut()
+                {
+                    for pass in passes.iter_mut() {
+                        pass.join = if variant == "round" {
+                            corners::Join::Round
+                        } else {
+                            corners::Join::Miter
+                        };
                     }
                 }
                 let Ok(answer) = corners::solve(&request, &tool) else {
@@ -142,12 +154,12 @@ fn material_table() {
                         )
                     })
                     .collect();
-                println!(
-                    "  {} {label:<26} {:<13} {}",
-                    case["id"].as_str().unwrap_or("?"),
-                    if loops { "with loops" } else { "without loops" },
-                    cells.join("  ")
-                );
+                let name = if *label == "M1" {
+                    format!("M1 ρb={blend}")
+                } else {
+                    (*label).to_owned()
+                };
+                println!("  {id} {name:<9} {variant:<6} {}", cells.join("  "));
             }
         }
     }
