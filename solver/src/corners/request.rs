@@ -1,0 +1,724 @@
+//! The contour request as clients send it (api.md, Contour) and its validation into a [`Job`]
+//! (corners.md §1.4 inputs, §3.1 preparation, §5 input codes).
+
+use serde::{Deserialize, Serialize};
+
+use super::prepare::{self, Contour};
+use crate::error::{SolverError, Warning, finite, non_negative, positive};
+use crate::tool::{Tool, ToolKind, ToolRef};
+
+/// Most contour points accepted (`E_TOO_MANY_POINTS`).
+pub const MAX_POINTS: usize = 200_000;
+/// Most layers accepted (`E_TOO_MANY_LAYERS`).
+pub const MAX_LAYERS: usize = 10_000;
+/// Most passes per layer (`E_INPUT` at `passes`).
+pub const MAX_PASSES: usize = 100;
+/// Most moves in one answer, all layers together (`E_TOO_MANY_MOVES`): 56 bytes each, so at
+/// most about 340 MB.
+pub const MAX_MOVES: usize = 6_000_000;
+/// Default height of the clearance plane above `depths.top`, mm.
+pub const DEFAULT_CLEARANCE: f64 = 5.0;
+/// Default chord tolerance for arcs (loops, round joins), mm.
+pub const DEFAULT_TOLERANCE: f64 = 0.01;
+/// Smallest chord tolerance accepted, mm.
+pub const MIN_TOLERANCE: f64 = 1e-6;
+/// Default spindle speed, rpm.
+pub const DEFAULT_SPINDLE_RPM: f64 = 6000.0;
+/// Default largest material angle that still gets a loop (corners.md §1.4 `alpha_max`), degrees.
+pub const DEFAULT_MAX_ANGLE_DEG: f64 = 170.0;
+/// Largest wall tilt accepted, degrees.
+pub const MAX_TILT_DEG: f64 = 80.0;
+
+/// Which side of the contour the tool runs on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Side {
+    /// The material is inside the polygon (islands, outer profiles); the tool runs outside it.
+    Outside,
+    /// The material is outside the polygon (pockets, inner profiles); the tool runs inside it.
+    Inside,
+}
+
+/// Climb or conventional milling with a clockwise spindle (M03): fixes the travel direction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum CutDirection {
+    /// Material on the right of travel: clockwise around islands, counter-clockwise in pockets.
+    #[default]
+    Climb,
+    /// Material on the left of travel (corners.md σ = +1 for an island, as in its cases).
+    Conventional,
+}
+
+/// The layers: from `top` down to `bottom` in equal steps of at most `step`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct Depths {
+    /// Z of the stock top, mm (the first layer is one step below it).
+    pub top: f64,
+    /// Z of the last layer, mm (not above `top`; equal to it gives one layer at that height).
+    pub bottom: f64,
+    /// Largest depth of cut per layer, mm (> 0).
+    pub step: f64,
+}
+
+/// The shape of the corner loops.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum LoopStyle {
+    /// Straight exit and entry legs joined by a circular arc (claim 4, corners.md §3.5.1).
+    #[default]
+    Arc,
+    /// Exit, one straight connecting segment, entry (claim 5, §3.5.2).
+    Triangle,
+    /// Exit, two straight segments parallel to the faces, entry (claim 5, §3.5.3).
+    Parallelogram,
+    /// No loops: a conventional join at every corner.
+    None,
+}
+
+/// Corner loop style and sizing (corners.md §3.5.4).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct CornerLoop {
+    /// `arc` (default), `triangle`, `parallelogram` or `none`.
+    #[serde(default)]
+    pub style: LoopStyle,
+    /// Arc loop radius ρ0, mm (default: the tool radius).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// Leg length L of triangle and parallelogram loops, mm (default: the tool radius).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub leg: Option<f64>,
+    /// Shortest leg, mm (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_leg: Option<f64>,
+    /// Longest leg, mm (default 10 × tool radius).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_leg: Option<f64>,
+    /// Smallest arc radius before falling back to a parallelogram, mm (default 0.1 × tool radius).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_radius: Option<f64>,
+    /// Largest arc radius before falling back to a parallelogram, mm (default 5 × tool radius).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_radius: Option<f64>,
+    /// Loop only corners whose material angle is at most this, degrees in (0, 180) (default 170:
+    /// nearly straight corners gain almost nothing from a loop).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_angle_deg: Option<f64>,
+}
+
+impl CornerLoop {
+    /// The sizing with every default resolved for a tool of `radius`.
+    pub(crate) fn config(&self, radius: f64) -> Result<LoopConfig, SolverError> {
+        let spec = self;
+        let positive_or = |name: &str, value: Option<f64>, default: f64| {
+            positive(&format!("corner_loop.{name}"), value.unwrap_or(default))
+        };
+        let loop_radius = positive_or("radius", spec.radius, radius)?;
+        let leg = positive_or("leg", spec.leg, radius)?;
+        let min_leg = non_negative("corner_loop.min_leg", spec.min_leg.unwrap_or(0.0))?;
+        let max_leg = positive_or("max_leg", spec.max_leg, 10.0 * radius)?;
+        let min_radius = positive_or("min_radius", spec.min_radius, 0.1 * radius)?;
+        let max_radius = positive_or("max_radius", spec.max_radius, 5.0 * radius)?;
+        if min_leg > max_leg {
+            return Err(SolverError::input(
+                "corner_loop.min_leg",
+                format!("min_leg {min_leg} exceeds max_leg {max_leg}"),
+            ));
+        }
+        if min_radius > max_radius {
+            return Err(SolverError::input(
+                "corner_loop.min_radius",
+                format!("min_radius {min_radius} exceeds max_radius {max_radius}"),
+            ));
+        }
+        let max_angle = spec.max_angle_deg.unwrap_or(DEFAULT_MAX_ANGLE_DEG);
+        if !(finite("corner_loop.max_angle_deg", max_angle)? > 0.0 && max_angle < 180.0) {
+            return Err(SolverError::input(
+                "corner_loop.max_angle_deg",
+                format!("max_angle_deg must lie strictly between 0 and 180 (got {max_angle})"),
+            ));
+        }
+        Ok(LoopConfig {
+            style: spec.style,
+            radius: loop_radius,
+            leg,
+            min_leg,
+            max_leg,
+            min_radius,
+            max_radius,
+            min_turn: (180.0 - max_angle).to_radians(),
+        })
+    }
+}
+
+/// How a pass joins the faces at corners that get no loop.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Join {
+    /// Straight to the offset-line intersection and on (a sharp turn the control may blend).
+    #[default]
+    Miter,
+    /// An arc about the vertex (the tool rolls round the corner).
+    Round,
+}
+
+/// One pass of the contour in every layer (claim 7, corners.md §3.8).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct PassSpec {
+    /// Radial stock left on the wall by this pass, mm (≥ 0, not larger than the previous pass's).
+    pub allowance: f64,
+    /// Whether this pass makes corner loops (default: only the last pass does).
+    #[serde(default, rename = "loop", skip_serializing_if = "Option::is_none")]
+    pub loops: Option<bool>,
+    /// Join at corners without a loop: `miter` (default) or `round`.
+    #[serde(default)]
+    pub join: Join,
+}
+
+/// Relief cut into inside corners, which a round tool otherwise leaves with a fillet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Relief {
+    /// No relief: the corner keeps a fillet of the tool radius (reported).
+    #[default]
+    None,
+    /// Along the bisector until the tool reaches the vertex.
+    Dogbone,
+    /// Along one edge until the tool reaches the vertex (`tbone_edge` says which).
+    Tbone,
+}
+
+/// The edge a T-bone relief runs along.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum TboneEdge {
+    /// The longer of the two edges at the corner (the cut goes into the shorter face).
+    #[default]
+    Longer,
+    /// The shorter edge.
+    Shorter,
+    /// The edge from `contour[k−1]` to `contour[k]` (request order).
+    Previous,
+    /// The edge from `contour[k]` to `contour[k+1]` (request order).
+    Next,
+}
+
+/// A per-corner choice that overrides the request-wide settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct CornerOverride {
+    /// The corner: an index into `contour`.
+    pub index: usize,
+    /// Force (`true`) or skip (`false`) the loop at this convex corner on looping passes.
+    #[serde(default, rename = "loop", skip_serializing_if = "Option::is_none")]
+    pub loops: Option<bool>,
+    /// Relief at this inside corner.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relief: Option<Relief>,
+    /// Edge of a T-bone relief at this corner.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tbone_edge: Option<TboneEdge>,
+}
+
+/// Wall tilt (claim 3): one angle for every wall, or one per contour edge.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(untagged)]
+pub enum Tilt {
+    /// The same tilt for every wall, degrees.
+    All(f64),
+    /// Tilt of the wall on edge k (from `contour[k]` to `contour[k+1]`), degrees.
+    PerEdge(Vec<f64>),
+}
+
+/// An optional model of the control, used only to predict the over-cut at corners and to check
+/// the allowances of passes without loops (corners.md §3.8 E1, §3.10 M1/M2).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct ControllerModel {
+    /// M1: the control blends every line-to-line corner with a tangent arc of this radius, mm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blend_radius: Option<f64>,
+    /// M2: servo time constant T, ms; arcs of radius R run with their radius shrunk by
+    /// Δ = v²T²/(2R) at the cutting feed v.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub servo_time_constant_ms: Option<f64>,
+}
+
+/// `POST /api/v1/contour`: layered contour milling with sharp protruding corners (corner loops)
+/// and optional inside-corner relief.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct ContourRequest {
+    /// A registered tool number or an inline tool; its `radius` is the cutting radius.
+    pub tool: ToolRef,
+    /// The closed polygon `[[x, y], ...]`, counter-clockwise (the last point need not repeat the
+    /// first). Curved faces are given as fine polylines.
+    pub contour: Vec<[f64; 2]>,
+    /// `outside` (material inside the polygon) or `inside` (a pocket: material outside it).
+    pub side: Side,
+    /// Layer heights.
+    pub depths: Depths,
+    /// Corner loop style and sizing (default `{"style": "arc"}`).
+    #[serde(default)]
+    pub corner_loop: CornerLoop,
+    /// Cutting feed, mm/min.
+    pub feed: f64,
+    /// Feed of the loops proper (not their exit and entry legs) where they clear the stock,
+    /// mm/min (default: `feed`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub loop_feed: Option<f64>,
+    /// `climb` (default) or `conventional`.
+    #[serde(default)]
+    pub direction: CutDirection,
+    /// Accept a clockwise contour by reversing it (with a warning) instead of refusing it.
+    #[serde(default)]
+    pub fix_orientation: bool,
+    /// Passes per layer, outermost first (default: one pass with allowance 0 and loops).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub passes: Option<Vec<PassSpec>>,
+    /// Relief at inside corners: `none` (default), `dogbone` or `tbone`.
+    #[serde(default)]
+    pub inside_corner_relief: Relief,
+    /// Edge of T-bone reliefs: `longer` (default), `shorter`, `previous` or `next`.
+    #[serde(default)]
+    pub tbone_edge: TboneEdge,
+    /// Per-corner overrides of loops and reliefs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub corner_overrides: Option<Vec<CornerOverride>>,
+    /// Height of the clearance plane above `depths.top`, mm (default 5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clearance: Option<f64>,
+    /// Absolute Z of the clearance plane, overriding `clearance`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub safe_z: Option<f64>,
+    /// Length of the straight lead-in and lead-out along the normal of the start edge, mm
+    /// (default: the tool radius; shortened if it would gouge).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lead: Option<f64>,
+    /// The edge whose middle is the start and end point of every pass (index into `contour`,
+    /// default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start_edge: Option<usize>,
+    /// Chord tolerance for arcs (loop arcs, round joins), mm (default 0.01). Arcs are chorded from
+    /// outside, so the tool never cuts inside them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
+    /// Spindle speed, rpm (default 6000).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spindle_rpm: Option<f64>,
+    /// Radial stock on the wall before the first pass (left by roughing), mm. With it the first
+    /// pass's loops may run at `loop_feed` where they clear that stock.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stock_allowance: Option<f64>,
+    /// Wall tilt β in degrees (claim 3, positive: the wall moves towards the air as z rises), one
+    /// value or one per edge. The contour is the wall's section at `depths.bottom`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tilt_deg: Option<Tilt>,
+    /// Optional control model for predictions and allowance checks.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub controller: Option<ControllerModel>,
+}
+
+/// A validated pass.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PassJob {
+    pub allowance: f64,
+    pub loops: bool,
+    pub join: Join,
+}
+
+/// Loop sizing, every value resolved.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct LoopConfig {
+    pub style: LoopStyle,
+    pub radius: f64,
+    pub leg: f64,
+    pub min_leg: f64,
+    pub max_leg: f64,
+    pub min_radius: f64,
+    pub max_radius: f64,
+    /// ψ_min: the smallest turn that gets a loop, radians.
+    pub min_turn: f64,
+}
+
+/// Per prepared vertex: loop override, relief and T-bone edge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct CornerChoice {
+    pub loops: Option<bool>,
+    pub relief: Relief,
+    pub tbone_edge: TboneEdge,
+}
+
+/// A validated contour job.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Job {
+    pub tool: Tool,
+    pub radius: f64,
+    pub contour: Contour,
+    pub side: Side,
+    pub direction: CutDirection,
+    /// Prepared edge index of the start edge.
+    pub start_edge: usize,
+    pub layers: Vec<f64>,
+    pub top: f64,
+    pub bottom: f64,
+    pub passes: Vec<PassJob>,
+    pub loop_config: LoopConfig,
+    pub choices: Vec<CornerChoice>,
+    pub feed: f64,
+    pub loop_feed: Option<f64>,
+    pub safe_z: f64,
+    pub lead: f64,
+    pub tolerance: f64,
+    pub spindle_rpm: f64,
+    pub stock_allowance: Option<f64>,
+    /// Tilt per prepared edge, radians; `None` when every wall is vertical.
+    pub tilt: Option<Vec<f64>>,
+    pub blend_radius: Option<f64>,
+    pub servo_time_constant_s: Option<f64>,
+    pub warnings: Vec<Warning>,
+}
+
+impl ContourRequest {
+    /// Checks every field and prepares the contour.
+    pub(crate) fn validate(&self, tool: &Tool) -> Result<Job, SolverError> {
+        tool.validate("tool.")?;
+        let radius = tool.radius;
+        let feed = positive("feed", self.feed)?;
+        let loop_feed = self
+            .loop_feed
+            .map(|f| positive("loop_feed", f))
+            .transpose()?;
+        let depths = &self.depths;
+        let top = finite("depths.top", depths.top)?;
+        let bottom = finite("depths.bottom", depths.bottom)?;
+        let step = positive("depths.step", depths.step)?;
+        for (field, value) in [("depths.top", top), ("depths.bottom", bottom)] {
+            if value.abs() > super::prepare::MAX_COORDINATE {
+                return Err(SolverError::input(
+                    field,
+                    format!(
+                        "{field} must lie within ±{} mm",
+                        super::prepare::MAX_COORDINATE
+                    ),
+                ));
+            }
+        }
+        if radius > super::prepare::MAX_COORDINATE {
+            return Err(SolverError::input(
+                "tool.radius",
+                "the tool radius is implausibly large",
+            ));
+        }
+        if bottom > top {
+            return Err(SolverError::input(
+                "depths.bottom",
+                format!("depths.bottom {bottom} lies above depths.top {top}"),
+            ));
+        }
+        let layers = layer_heights(top, bottom, step)?;
+        let tolerance = self.tolerance.unwrap_or(DEFAULT_TOLERANCE);
+        if finite("tolerance", tolerance)? < MIN_TOLERANCE {
+            return Err(SolverError::input(
+                "tolerance",
+                format!("tolerance must be at least {MIN_TOLERANCE} mm (got {tolerance})"),
+            ));
+        }
+        let spindle_rpm = positive(
+            "spindle_rpm",
+            self.spindle_rpm.unwrap_or(DEFAULT_SPINDLE_RPM),
+        )?;
+        let clearance = non_negative("clearance", self.clearance.unwrap_or(DEFAULT_CLEARANCE))?;
+        let safe_z = match self.safe_z {
+            Some(z) => {
+                if finite("safe_z", z)? <= top {
+                    return Err(SolverError::input(
+                        "safe_z",
+                        format!("safe_z {z} must lie above depths.top {top}"),
+                    ));
+                }
+                z
+            }
+            None => top + clearance.max(1e-3),
+        };
+        let lead = non_negative("lead", self.lead.unwrap_or(radius))?;
+        let stock_allowance = self
+            .stock_allowance
+            .map(|s| non_negative("stock_allowance", s))
+            .transpose()?;
+        let passes = self.pass_jobs()?;
+        if let (Some(stock), Some(first)) = (stock_allowance, passes.first())
+            && stock < first.allowance
+        {
+            return Err(SolverError::input(
+                "stock_allowance",
+                format!(
+                    "stock_allowance {stock} is smaller than the first pass's allowance {}",
+                    first.allowance
+                ),
+            ));
+        }
+        let loop_config = self.corner_loop.config(radius)?;
+        let (contour, mut warnings) = prepare::prepare(&self.contour, self.fix_orientation)?;
+        let start_edge = match self.start_edge {
+            None => contour.edge_containing(0),
+            Some(k) if k < self.contour.len() => contour.edge_containing(k),
+            Some(k) => {
+                return Err(SolverError::input(
+                    "start_edge",
+                    format!(
+                        "start_edge {k} is not an index of contour (0 to {})",
+                        self.contour.len() - 1
+                    ),
+                ));
+            }
+        };
+        let choices = self.corner_choices(&contour)?;
+        let tilt = self.tilt(&contour)?;
+        let (blend_radius, servo_time_constant_s) = match &self.controller {
+            None => (None, None),
+            Some(model) => (
+                model
+                    .blend_radius
+                    .map(|b| non_negative("controller.blend_radius", b))
+                    .transpose()?,
+                model
+                    .servo_time_constant_ms
+                    .map(|t| {
+                        non_negative("controller.servo_time_constant_ms", t).map(|t| t / 1000.0)
+                    })
+                    .transpose()?,
+            ),
+        };
+        if tilt.is_some() && tool.kind != ToolKind::Flat {
+            warnings.push(Warning::new(
+                "W_TILT_TOOL_KIND",
+                format!(
+                    "tilted walls are planned with the {} tool's full radius as a cylinder",
+                    tool.kind.as_str()
+                ),
+            ));
+        }
+        Ok(Job {
+            tool: tool.clone(),
+            radius,
+            contour,
+            side: self.side,
+            direction: self.direction,
+            start_edge,
+            layers,
+            top,
+            bottom,
+            passes,
+            loop_config,
+            choices,
+            feed,
+            loop_feed,
+            safe_z,
+            lead,
+            tolerance,
+            spindle_rpm,
+            stock_allowance,
+            tilt,
+            blend_radius,
+            servo_time_constant_s,
+            warnings,
+        })
+    }
+
+    fn pass_jobs(&self) -> Result<Vec<PassJob>, SolverError> {
+        let Some(passes) = &self.passes else {
+            return Ok(vec![PassJob {
+                allowance: 0.0,
+                loops: true,
+                join: Join::Miter,
+            }]);
+        };
+        if passes.is_empty() || passes.len() > MAX_PASSES {
+            return Err(SolverError::input(
+                "passes",
+                format!("give 1 to {MAX_PASSES} passes (got {})", passes.len()),
+            ));
+        }
+        let mut previous = f64::INFINITY;
+        let last = passes.len() - 1;
+        passes
+            .iter()
+            .enumerate()
+            .map(|(index, pass)| {
+                let field = format!("passes[{index}].allowance");
+                let allowance = non_negative(&field, pass.allowance)?;
+                if allowance > previous {
+                    return Err(SolverError::input(
+                        field,
+                        format!(
+                            "passes run from outside in: allowance {allowance} exceeds the previous pass's {previous}"
+                        ),
+                    ));
+                }
+                previous = allowance;
+                Ok(PassJob {
+                    allowance,
+                    loops: pass.loops.unwrap_or(index == last),
+                    join: pass.join,
+                })
+            })
+            .collect()
+    }
+
+    fn corner_choices(&self, contour: &Contour) -> Result<Vec<CornerChoice>, SolverError> {
+        let default = CornerChoice {
+            loops: None,
+            relief: self.inside_corner_relief,
+            tbone_edge: self.tbone_edge,
+        };
+        let mut choices = vec![default; contour.points.len()];
+        for (position, item) in self.corner_overrides.iter().flatten().enumerate() {
+            let field = format!("corner_overrides[{position}].index");
+            if item.index >= self.contour.len() {
+                return Err(SolverError::input(
+                    field,
+                    format!("{} is not an index of contour", item.index),
+                ));
+            }
+            let Some(vertex) = contour.vertex_of(item.index) else {
+                return Err(SolverError::input(
+                    field,
+                    format!(
+                        "contour[{}] was removed (a duplicate or collinear point): it is no corner",
+                        item.index
+                    ),
+                ));
+            };
+            let choice = &mut choices[vertex];
+            choice.loops = item.loops.or(choice.loops);
+            choice.relief = item.relief.unwrap_or(choice.relief);
+            choice.tbone_edge = item.tbone_edge.unwrap_or(choice.tbone_edge);
+        }
+        Ok(choices)
+    }
+
+    /// Tilt per prepared edge, radians; an edge merged from several request edges must have one
+    /// tilt.
+    fn tilt(&self, contour: &Contour) -> Result<Option<Vec<f64>>, SolverError> {
+        let check = |field: &str, value: f64| -> Result<f64, SolverError> {
+            if finite(field, value)?.abs() > MAX_TILT_DEG {
+                return Err(SolverError::input(
+                    field,
+                    format!("tilt must lie within ±{MAX_TILT_DEG}° (got {value})"),
+                ));
+            }
+            Ok(value.to_radians())
+        };
+        match &self.tilt_deg {
+            None => Ok(None),
+            Some(Tilt::All(value)) => {
+                let tilt = check("tilt_deg", *value)?;
+                Ok((tilt != 0.0).then(|| vec![tilt; contour.points.len()]))
+            }
+            Some(Tilt::PerEdge(values)) => {
+                if values.len() != self.contour.len() {
+                    return Err(SolverError::input(
+                        "tilt_deg",
+                        format!(
+                            "give one tilt per contour edge: {} values for {} edges",
+                            values.len(),
+                            self.contour.len()
+                        ),
+                    ));
+                }
+                let mut per_edge = Vec::with_capacity(contour.points.len());
+                for edge in 0..contour.points.len() {
+                    let members = contour.request_edges(edge, self.contour.len());
+                    let mut tilt: Option<(f64, usize)> = None;
+                    for k in members {
+                        let field = format!("tilt_deg[{k}]");
+                        let value = check(&field, values[k])?;
+                        match tilt {
+                            None => tilt = Some((value, k)),
+                            Some((first, first_k)) if (first - value).abs() > 1e-12 => {
+                                return Err(SolverError::input(
+                                    field,
+                                    format!(
+                                        "edges {first_k} and {k} lie on one straight wall and need the same tilt"
+                                    ),
+                                ));
+                            }
+                            Some(_) => {}
+                        }
+                    }
+                    per_edge.push(tilt.map_or(0.0, |(value, _)| value));
+                }
+                Ok(per_edge.iter().any(|t| *t != 0.0).then_some(per_edge))
+            }
+        }
+    }
+}
+
+/// Layer heights from `top` to `bottom` in equal steps of at most `step`: `top − k·Δ`, k = 1..n.
+pub(crate) fn layer_heights(top: f64, bottom: f64, step: f64) -> Result<Vec<f64>, SolverError> {
+    let depth = top - bottom;
+    if depth <= 0.0 {
+        return Ok(vec![bottom]);
+    }
+    let count = (depth / step - 1e-9).ceil().max(1.0);
+    if count > MAX_LAYERS as f64 {
+        return Err(SolverError::new(
+            "E_TOO_MANY_LAYERS",
+            format!(
+                "{count} layers of at most {step} mm from {top} to {bottom}: the limit is {MAX_LAYERS}"
+            ),
+        )
+        .at("depths.step"));
+    }
+    // `count` is a whole number in 1..=MAX_LAYERS here.
+    let count = count as usize;
+    let delta = depth / count as f64;
+    Ok((1..=count)
+        .map(|k| {
+            if k == count {
+                bottom
+            } else {
+                top - k as f64 * delta
+            }
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn layers_are_equal_steps_ending_at_the_bottom() {
+        assert_eq!(
+            layer_heights(0.0, -6.0, 2.0).unwrap(),
+            vec![-2.0, -4.0, -6.0]
+        );
+        let layers = layer_heights(0.0, -5.0, 2.0).unwrap();
+        assert_eq!(layers.len(), 3);
+        assert!((layers[0] + 5.0 / 3.0).abs() < 1e-12);
+        assert_eq!(layers[2], -5.0);
+        assert_eq!(layer_heights(1.0, 1.0, 2.0).unwrap(), vec![1.0]);
+        assert_eq!(
+            layer_heights(0.0, -1e6, 1.0).unwrap_err().code(),
+            "E_TOO_MANY_LAYERS"
+        );
+    }
+}
