@@ -45,11 +45,7 @@ fn big_request() -> ContourRequest {
     .unwrap_or_else(|e| panic!("bench request: {e}"))
 }
 
-fn fixture_request(
-    case: &Value,
-    loops: bool,
-    controller: Option<ControllerModel>,
-) -> (ContourRequest, Tool) {
+fn fixture_request(case: &Value, loops: bool, controller: Option<ControllerModel>) -> (ContourRequest, Tool) {
     let inputs = &case["inputs"];
     let radius = inputs["tool_radius"].as_f64().unwrap_or(1.0);
     let mut corner_loop = json!({"max_angle_deg": 179.0});
@@ -95,14 +91,9 @@ fn fixture_request(
 /// ideal and under M1 (blend radius ρ_b: 1.5 mm for C1 as in corners.md §3.10, 1 mm for C2 as in
 /// its case, 3 mm for C3) and M2 (servo T = 31.62 ms at 600 mm/min: Δ = 0.05 mm on a 1 mm arc).
 fn material_table() {
-    let fixture: Value =
-        serde_json::from_str(include_str!("../tests/fixtures/corners.json")).unwrap_or(Value::Null);
+    let fixture: Value = serde_json::from_str(include_str!("../tests/fixtures/corners.json")).unwrap_or(Value::Null);
     println!("material per corner, final pass: left area / over-cut area, mm²");
-    for case in fixture["cases"]
-        .as_array()
-        .map(Vec::as_slice)
-        .unwrap_or_default()
-    {
+    for case in fixture["cases"].as_array().map(Vec::as_slice).unwrap_or_default() {
         let id = case["id"].as_str().unwrap_or("?");
         let blend = match id {
             "C1" => 1.5,
@@ -111,20 +102,8 @@ fn material_table() {
         };
         let models = [
             ("ideal", None),
-            (
-                "M1",
-                Some(ControllerModel {
-                    blend_radius: Some(blend),
-                    servo_time_constant_ms: None,
-                }),
-            ),
-            (
-                "M2",
-                Some(ControllerModel {
-                    blend_radius: None,
-                    servo_time_constant_ms: Some(31.622_776_6),
-                }),
-            ),
+            ("M1", Some(ControllerModel { blend_radius: Some(blend), servo_time_constant_ms: None })),
+            ("M2", Some(ControllerModel { blend_radius: None, servo_time_constant_ms: Some(31.622_776_6) })),
         ];
         for (label, model) in &models {
             for variant in ["loops", "miter", "round"] {
@@ -133,11 +112,7 @@ fn material_table() {
                     && let Some(passes) = request.passes.as_mut()
                 {
                     for pass in passes.iter_mut() {
-                        pass.join = if variant == "round" {
-                            corners::Join::Round
-                        } else {
-                            corners::Join::Miter
-                        };
+                        pass.join = if variant == "round" { corners::Join::Round } else { corners::Join::Miter };
                     }
                 }
                 let Ok(answer) = corners::solve(&request, &tool) else {
@@ -148,17 +123,10 @@ fn material_table() {
                     .iter()
                     .map(|c| {
                         let m = c.predicted.unwrap_or(c.material);
-                        format!(
-                            "{:.0}°:{:.6}/{:.6}",
-                            c.angle_deg, m.left_area, m.overcut_area
-                        )
+                        format!("{:.0}°:{:.6}/{:.6}", c.angle_deg, m.left_area, m.overcut_area)
                     })
                     .collect();
-                let name = if *label == "M1" {
-                    format!("M1 ρb={blend}")
-                } else {
-                    (*label).to_owned()
-                };
+                let name = if *label == "M1" { format!("M1 ρb={blend}") } else { (*label).to_owned() };
                 println!("  {id} {name:<9} {variant:<6} {}", cells.join("  "));
             }
         }
@@ -188,13 +156,8 @@ fn bench(c: &mut Criterion) {
     group.bench_function("plan_100k_vertices_one_layer", |b| {
         b.iter(|| corners::plan(black_box(&request), &tool).map(|p| p.passes.len()))
     });
-    let polygon: Vec<Vec2> = castellated_ring()
-        .into_iter()
-        .map(|[x, y]| Vec2::new(x, y))
-        .collect();
-    group.bench_function("simple_polygon_check_100k", |b| {
-        b.iter(|| find_self_intersection(black_box(&polygon)))
-    });
+    let polygon: Vec<Vec2> = castellated_ring().into_iter().map(|[x, y]| Vec2::new(x, y)).collect();
+    group.bench_function("simple_polygon_check_100k", |b| b.iter(|| find_self_intersection(black_box(&polygon))));
     group.finish();
 }
 

@@ -101,11 +101,7 @@ pub fn centroid(polygon: &[Vec2]) -> Option<Vec2> {
 
 /// Length of a closed polygon's boundary.
 pub fn perimeter(polygon: &[Vec2]) -> f64 {
-    polygon
-        .iter()
-        .enumerate()
-        .map(|(index, point)| (polygon[(index + 1) % polygon.len()] - point).norm())
-        .sum()
+    polygon.iter().enumerate().map(|(index, point)| (polygon[(index + 1) % polygon.len()] - point).norm()).sum()
 }
 
 /// Distance from `p` to the closed segment `[a, b]` (a degenerate segment is a point).
@@ -128,9 +124,7 @@ pub fn closest_on_segment(p: &Vec2, a: &Vec2, b: &Vec2) -> Vec2 {
 pub fn segments_intersect(a: &Vec2, b: &Vec2, c: &Vec2, d: &Vec2) -> bool {
     let (o1, o2) = (orient(a, b, c), orient(a, b, d));
     let (o3, o4) = (orient(c, d, a), orient(c, d, b));
-    if ((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0))
-        && ((o3 > 0.0 && o4 < 0.0) || (o3 < 0.0 && o4 > 0.0))
-    {
+    if ((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0)) && ((o3 > 0.0 && o4 < 0.0) || (o3 < 0.0 && o4 > 0.0)) {
         return true;
     }
     (o1 == 0.0 && within_box(c, a, b))
@@ -182,11 +176,7 @@ pub fn point_in_polygon(p: &Vec2, polygon: &[Vec2]) -> Containment {
             }
         }
     }
-    if inside {
-        Containment::Inside
-    } else {
-        Containment::Outside
-    }
+    if inside { Containment::Inside } else { Containment::Outside }
 }
 
 /// Intersection of the lines `p + s·dp` and `q + u·dq`, or `None` when they are parallel.
@@ -230,24 +220,13 @@ pub fn miter_offset(polygon: &[Vec2], offsets: &[f64], left: bool) -> Result<Vec
     let n = polygon.len();
     let normal = |k: usize| {
         let t = (polygon[(k + 1) % n] - polygon[k]).normalize();
-        if left {
-            left_normal(&t)
-        } else {
-            right_normal(&t)
-        }
+        if left { left_normal(&t) } else { right_normal(&t) }
     };
     let offset = |k: usize| offsets.get(k).copied().unwrap_or(0.0);
     (0..n)
         .map(|k| {
             let previous = (k + n - 1) % n;
-            miter_point(
-                &polygon[k],
-                &normal(previous),
-                offset(previous),
-                &normal(k),
-                offset(k),
-            )
-            .ok_or(k)
+            miter_point(&polygon[k], &normal(previous), offset(previous), &normal(k), offset(k)).ok_or(k)
         })
         .collect()
 }
@@ -258,10 +237,7 @@ mod tests {
     use approx::assert_abs_diff_eq;
 
     fn square() -> Vec<Vec2> {
-        [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]
-            .into_iter()
-            .map(vec2)
-            .collect()
+        [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]].into_iter().map(vec2).collect()
     }
 
     #[test]
@@ -278,51 +254,19 @@ mod tests {
     #[test]
     fn point_in_polygon_has_three_answers() {
         let polygon = square();
-        assert_eq!(
-            point_in_polygon(&Vec2::new(1.0, 1.0), &polygon),
-            Containment::Inside
-        );
-        assert_eq!(
-            point_in_polygon(&Vec2::new(2.0, 1.0), &polygon),
-            Containment::Boundary
-        );
-        assert_eq!(
-            point_in_polygon(&Vec2::new(0.0, 0.0), &polygon),
-            Containment::Boundary
-        );
-        assert_eq!(
-            point_in_polygon(&Vec2::new(3.0, 1.0), &polygon),
-            Containment::Outside
-        );
+        assert_eq!(point_in_polygon(&Vec2::new(1.0, 1.0), &polygon), Containment::Inside);
+        assert_eq!(point_in_polygon(&Vec2::new(2.0, 1.0), &polygon), Containment::Boundary);
+        assert_eq!(point_in_polygon(&Vec2::new(0.0, 0.0), &polygon), Containment::Boundary);
+        assert_eq!(point_in_polygon(&Vec2::new(3.0, 1.0), &polygon), Containment::Outside);
     }
 
     #[test]
     fn segments_touching_crossing_and_apart() {
         let p = |x, y| Vec2::new(x, y);
-        assert!(segments_intersect(
-            &p(0.0, 0.0),
-            &p(2.0, 2.0),
-            &p(0.0, 2.0),
-            &p(2.0, 0.0)
-        ));
-        assert!(segments_intersect(
-            &p(0.0, 0.0),
-            &p(2.0, 0.0),
-            &p(1.0, 0.0),
-            &p(1.0, 1.0)
-        ));
-        assert!(segments_intersect(
-            &p(0.0, 0.0),
-            &p(2.0, 0.0),
-            &p(1.0, 0.0),
-            &p(3.0, 0.0)
-        ));
-        assert!(!segments_intersect(
-            &p(0.0, 0.0),
-            &p(1.0, 0.0),
-            &p(2.0, 0.0),
-            &p(3.0, 0.0)
-        ));
+        assert!(segments_intersect(&p(0.0, 0.0), &p(2.0, 2.0), &p(0.0, 2.0), &p(2.0, 0.0)));
+        assert!(segments_intersect(&p(0.0, 0.0), &p(2.0, 0.0), &p(1.0, 0.0), &p(1.0, 1.0)));
+        assert!(segments_intersect(&p(0.0, 0.0), &p(2.0, 0.0), &p(1.0, 0.0), &p(3.0, 0.0)));
+        assert!(!segments_intersect(&p(0.0, 0.0), &p(1.0, 0.0), &p(2.0, 0.0), &p(3.0, 0.0)));
         assert_abs_diff_eq!(
             segment_segment_distance(&p(0.0, 0.0), &p(1.0, 0.0), &p(2.0, 1.0), &p(3.0, 5.0)),
             2.0_f64.sqrt()
@@ -337,14 +281,7 @@ mod tests {
         assert_abs_diff_eq!(p, Vec2::new(21.0, -1.0), epsilon = 1e-15);
         // O3 with different offsets (corners.md §3.9.2 example, as a right-hand corner).
         let v = Vec2::new(20.0, 20.0);
-        let p = miter_point(
-            &v,
-            &Vec2::new(1.0, 0.0),
-            1.015427,
-            &Vec2::new(0.0, 1.0),
-            1.154701,
-        )
-        .unwrap();
+        let p = miter_point(&v, &Vec2::new(1.0, 0.0), 1.015427, &Vec2::new(0.0, 1.0), 1.154701).unwrap();
         assert_abs_diff_eq!(p, Vec2::new(21.015427, 21.154701), epsilon = 1e-12);
         assert!(miter_point(&v, &Vec2::x(), 1.0, &(-Vec2::x()), 1.0).is_none());
     }

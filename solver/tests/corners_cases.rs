@@ -8,9 +8,7 @@ use std::f64::consts::PI;
 use kerf_solver::corners::detect::{self, DetectMode};
 use kerf_solver::corners::division::{self, collinearity, divide_polygon, replay};
 use kerf_solver::corners::loops::LoopShape;
-use kerf_solver::corners::{
-    self, Action, ContourRequest, CornerAction, Element, ElementKind, PassPlan, Plan,
-};
+use kerf_solver::corners::{self, Action, ContourRequest, CornerAction, Element, ElementKind, PassPlan, Plan};
 use kerf_solver::planar::{Vec2, turn_angle, vec2};
 use kerf_solver::tool::{Tool, ToolKind};
 use serde_json::{Value, json};
@@ -22,19 +20,11 @@ fn fixture() -> Value {
 }
 
 fn case(id: &str) -> Value {
-    fixture()["cases"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|c| c["id"] == id)
-        .unwrap()
-        .clone()
+    fixture()["cases"].as_array().unwrap().iter().find(|c| c["id"] == id).unwrap().clone()
 }
 
 fn number(value: &Value) -> f64 {
-    value
-        .as_f64()
-        .unwrap_or_else(|| panic!("not a number: {value}"))
+    value.as_f64().unwrap_or_else(|| panic!("not a number: {value}"))
 }
 
 fn point(value: &Value) -> Vec2 {
@@ -42,18 +32,12 @@ fn point(value: &Value) -> Vec2 {
 }
 
 fn close(what: &str, got: f64, expected: f64) {
-    assert!(
-        (got - expected).abs() <= TOLERANCE,
-        "{what}: got {got}, expected {expected}"
-    );
+    assert!((got - expected).abs() <= TOLERANCE, "{what}: got {got}, expected {expected}");
 }
 
 fn close_point(what: &str, got: Vec2, expected: &Value) {
     let expected = point(expected);
-    assert!(
-        (got - expected).norm() <= TOLERANCE * 1.5,
-        "{what}: got {got:?}, expected {expected:?}"
-    );
+    assert!((got - expected).norm() <= TOLERANCE * 1.5, "{what}: got {got:?}, expected {expected:?}");
 }
 
 /// The API request for a case: an inline flat tool, one layer at z = 0, conventional milling
@@ -90,11 +74,7 @@ fn request(case: &Value) -> (ContourRequest, Tool) {
         .iter()
         .map(|p| {
             let p = [number(&p[0]), number(&p[1])];
-            if (p[0] - exact[0]).abs() < 1e-6 && (p[1] - exact[1]).abs() < 1e-6 {
-                exact
-            } else {
-                p
-            }
+            if (p[0] - exact[0]).abs() < 1e-6 && (p[1] - exact[1]).abs() < 1e-6 { exact } else { p }
         })
         .collect();
     let body = json!({
@@ -107,10 +87,7 @@ fn request(case: &Value) -> (ContourRequest, Tool) {
         "passes": passes,
         "feed": 800,
     });
-    (
-        serde_json::from_value(body).unwrap(),
-        Tool::new(ToolKind::Flat, radius),
-    )
+    (serde_json::from_value(body).unwrap(), Tool::new(ToolKind::Flat, radius))
 }
 
 fn plan_of(case: &Value) -> Plan {
@@ -134,34 +111,12 @@ fn check_corners(id: &str, pass: &PassPlan, expected: &Value) {
         let plan = pass.corners.iter().find(|c| c.k == k).unwrap();
         let what = |name: &str| format!("{id} pass {} corner {k} {name}", pass.index + 1);
         close_point(&what("V"), plan.vertex, &corner["V"]);
-        close(
-            &what("phi"),
-            plan.turn.to_degrees(),
-            number(&corner["phi_deg"]),
-        );
-        close(
-            &what("alpha"),
-            plan.material_angle.to_degrees(),
-            number(&corner["alpha_deg"]),
-        );
-        assert_eq!(
-            plan.convex,
-            corner["convex"].as_bool().unwrap(),
-            "{}",
-            what("convex")
-        );
+        close(&what("phi"), plan.turn.to_degrees(), number(&corner["phi_deg"]));
+        close(&what("alpha"), plan.material_angle.to_degrees(), number(&corner["alpha_deg"]));
+        assert_eq!(plan.convex, corner["convex"].as_bool().unwrap(), "{}", what("convex"));
         close_point(&what("P"), plan.cl_point, &corner["P"]);
-        close(
-            &what("PV"),
-            (plan.cl_point - plan.vertex).norm(),
-            number(&corner["PV"]),
-        );
-        assert_eq!(
-            action_name(plan.action),
-            corner["action"].as_str().unwrap(),
-            "{}",
-            what("action")
-        );
+        close(&what("PV"), (plan.cl_point - plan.vertex).norm(), number(&corner["PV"]));
+        assert_eq!(action_name(plan.action), corner["action"].as_str().unwrap(), "{}", what("action"));
         let Some(expected_loop) = corner.get("loop") else {
             assert!(plan.loop_shape.is_none(), "{}", what("no loop"));
             continue;
@@ -172,21 +127,11 @@ fn check_corners(id: &str, pass: &PassPlan, expected: &Value) {
         close_point(&what("B"), shape.entry_start, &expected_loop["B"]);
         match expected_loop["type"].as_str().unwrap() {
             "arc" => {
-                close(
-                    &what("rho"),
-                    shape.radius.unwrap(),
-                    number(&expected_loop["rho"]),
-                );
+                close(&what("rho"), shape.radius.unwrap(), number(&expected_loop["rho"]));
                 close_point(&what("C"), shape.centre.unwrap(), &expected_loop["C"]);
-                close(
-                    &what("sweep"),
-                    shape.sweep.unwrap().to_degrees(),
-                    number(&expected_loop["sweep_deg"]),
-                );
+                close(&what("sweep"), shape.sweep.unwrap().to_degrees(), number(&expected_loop["sweep_deg"]));
             }
-            "parallelogram" => {
-                close_point(&what("M"), shape.far_corner.unwrap(), &expected_loop["M"])
-            }
+            "parallelogram" => close_point(&what("M"), shape.far_corner.unwrap(), &expected_loop["M"]),
             other => panic!("unknown loop type {other}"),
         }
     }
@@ -197,33 +142,16 @@ fn check_elements(id: &str, pass: &PassPlan, expected: &Value) {
     assert_eq!(pass.elements.len(), expected.len(), "{id} element count");
     for (index, (element, want)) in pass.elements.iter().zip(expected).enumerate() {
         let what = |name: &str| format!("{id} pass {} element {index} {name}", pass.index + 1);
-        assert_eq!(
-            element.kind().as_str(),
-            want["kind"].as_str().unwrap(),
-            "{}",
-            what("kind")
-        );
+        assert_eq!(element.kind().as_str(), want["kind"].as_str().unwrap(), "{}", what("kind"));
         close_point(&what("start"), element.start(), &want["start"]);
         close_point(&what("end"), element.end(), &want["end"]);
         close(&what("length"), element.length(), number(&want["length"]));
         match (element, want["type"].as_str().unwrap()) {
             (Element::Line { .. }, "line") => {}
-            (
-                Element::Arc {
-                    centre,
-                    radius,
-                    sweep,
-                    ..
-                },
-                "arc",
-            ) => {
+            (Element::Arc { centre, radius, sweep, .. }, "arc") => {
                 close_point(&what("centre"), *centre, &want["centre"]);
                 close(&what("radius"), *radius, number(&want["radius"]));
-                close(
-                    &what("sweep"),
-                    sweep.to_degrees(),
-                    number(&want["sweep_deg"]),
-                );
+                close(&what("sweep"), sweep.to_degrees(), number(&want["sweep_deg"]));
             }
             (got, expected) => panic!("{}: {got:?} is not a {expected}", what("type")),
         }
@@ -232,23 +160,14 @@ fn check_elements(id: &str, pass: &PassPlan, expected: &Value) {
 
 fn check_lengths(id: &str, pass: &PassPlan, expected: &Value) {
     let total: f64 = pass.elements.iter().map(Element::length).sum();
-    close(
-        &format!("{id} total length"),
-        total,
-        number(&expected["length_total"]),
-    );
+    close(&format!("{id} total length"), total, number(&expected["length_total"]));
     for (name, kind) in [
         ("cut", ElementKind::Cut),
         ("exit", ElementKind::Exit),
         ("loop", ElementKind::Loop),
         ("entry", ElementKind::Entry),
     ] {
-        let length: f64 = pass
-            .elements
-            .iter()
-            .filter(|e| e.kind() == kind)
-            .map(Element::length)
-            .sum();
+        let length: f64 = pass.elements.iter().filter(|e| e.kind() == kind).map(Element::length).sum();
         let want = expected["length_by_kind"].get(name).map_or(0.0, number);
         close(&format!("{id} {name} length"), length, want);
     }
@@ -263,55 +182,22 @@ fn check_division(id: &str, pass: &PassPlan, h: f64, expected: &Value) {
         "{id} pass {} division count",
         pass.index + 1
     );
-    for (index, (got, point)) in division
-        .points
-        .iter()
-        .zip(want["points"].as_array().unwrap())
-        .enumerate()
-    {
+    for (index, (got, point)) in division.points.iter().zip(want["points"].as_array().unwrap()).enumerate() {
         close_point(&format!("{id} division point {index}"), *got, point);
     }
     let visits = want["corner_visits"].as_array().unwrap();
-    assert_eq!(
-        division.corner_visits.len(),
-        visits.len(),
-        "{id} corner visit count"
-    );
+    assert_eq!(division.corner_visits.len(), visits.len(), "{id} corner visit count");
     for (&index, visit) in division.corner_visits.iter().zip(visits) {
-        assert_eq!(
-            index as u64,
-            visit["index"].as_u64().unwrap(),
-            "{id} visit index"
-        );
-        close(
-            &format!("{id} visit s"),
-            division.s[index],
-            number(&visit["s"]),
-        );
-        close_point(
-            &format!("{id} visit point"),
-            division.points[index],
-            &visit["point"],
-        );
+        assert_eq!(index as u64, visit["index"].as_u64().unwrap(), "{id} visit index");
+        close(&format!("{id} visit s"), division.s[index], number(&visit["s"]));
+        close_point(&format!("{id} visit point"), division.points[index], &visit["point"]);
     }
-    for (index, (got, step)) in division
-        .turtle
-        .iter()
-        .zip(expected["turtle_first10"].as_array().unwrap())
-        .enumerate()
-    {
+    for (index, (got, step)) in division.turtle.iter().zip(expected["turtle_first10"].as_array().unwrap()).enumerate() {
         let heading = got.0.to_degrees();
         let want_heading = number(&step["heading_deg"]);
         let difference = (heading - want_heading + 540.0).rem_euclid(360.0) - 180.0;
-        assert!(
-            difference.abs() <= TOLERANCE,
-            "{id} turtle {index} heading {heading} vs {want_heading}"
-        );
-        close(
-            &format!("{id} turtle {index} length"),
-            got.1,
-            number(&step["length"]),
-        );
+        assert!(difference.abs() <= TOLERANCE, "{id} turtle {index} heading {heading} vs {want_heading}");
+        close(&format!("{id} turtle {index} length"), got.1, number(&step["length"]));
     }
     // T1: the turtle replays the points exactly.
     let replayed = replay(division.points[0], &division.turtle);
@@ -319,28 +205,17 @@ fn check_division(id: &str, pass: &PassPlan, h: f64, expected: &Value) {
         assert!((a - b).norm() < 1e-9, "{id} turtle replay");
     }
     if let Some(claim10) = expected.get("claim10_collinearity") {
-        let (cross, dot) = collinearity(
-            &division,
-            claim10["f"].as_u64().unwrap() as usize,
-            claim10["k"].as_u64().unwrap() as usize,
-        );
+        let (cross, dot) =
+            collinearity(&division, claim10["f"].as_u64().unwrap() as usize, claim10["k"].as_u64().unwrap() as usize);
         assert!(cross <= 1e-9, "{id} claim 10 cross {cross}");
-        close(
-            &format!("{id} claim 10 dot"),
-            dot,
-            number(&claim10["min_dot"]),
-        );
+        close(&format!("{id} claim 10 dot"), dot, number(&claim10["min_dot"]));
     }
 }
 
 fn check_detection(id: &str, pass: &PassPlan, h: f64, sigma: f64, expected: &Value) {
     let (points, vertices) = divide_polygon(&pass.cl, h);
     let (centre, measures) = detect::measures(&points);
-    close_point(
-        &format!("{id} detection centre"),
-        centre,
-        &expected["centre_ab"],
-    );
+    close_point(&format!("{id} detection centre"), centre, &expected["centre_ab"]);
     for corner in expected["at_corners"].as_array().unwrap() {
         let k = corner["k"].as_u64().unwrap() as usize;
         let what = |name: &str| format!("{id} pass {} detection {k} {name}", pass.index + 1);
@@ -349,38 +224,16 @@ fn check_detection(id: &str, pass: &PassPlan, h: f64, sigma: f64, expected: &Val
             None => assert!(measure.curvature.is_none(), "{}", what("kappa undefined")),
             Some(kappa) => {
                 let got = measure.curvature.unwrap();
-                assert!(
-                    (got - kappa).abs() <= 1e-6 * kappa.max(1.0),
-                    "{}: {got} vs {kappa}",
-                    what("kappa")
-                );
+                assert!((got - kappa).abs() <= 1e-6 * kappa.max(1.0), "{}: {got} vs {kappa}", what("kappa"));
             }
         }
-        assert_eq!(
-            measure.protrudes,
-            corner["d_ok"].as_bool().unwrap(),
-            "{}",
-            what("d")
-        );
+        assert_eq!(measure.protrudes, corner["d_ok"].as_bool().unwrap(), "{}", what("d"));
         close(&what("dL"), measure.delta_l, number(&corner["dL"]));
-        close(
-            &what("dL/h"),
-            measure.delta_l_per_step,
-            number(&corner["dL_over_h"]),
-        );
-        close(
-            &what("phi"),
-            measure.turn.to_degrees(),
-            number(&corner["phi_deg"]),
-        );
+        close(&what("dL/h"), measure.delta_l_per_step, number(&corner["dL_over_h"]));
+        close(&what("phi"), measure.turn.to_degrees(), number(&corner["phi_deg"]));
         // TurnAngle finds every convex corner; claim 9's rule agrees with it wherever ΔL/h > 0.
         let convex = detect::is_corner(&measure, DetectMode::TurnAngle, 1f64.to_radians(), sigma);
-        assert_eq!(
-            convex,
-            number(&corner["phi_deg"]) * sigma > 0.0,
-            "{}",
-            what("turn rule")
-        );
+        assert_eq!(convex, number(&corner["phi_deg"]) * sigma > 0.0, "{}", what("turn rule"));
     }
 }
 
@@ -393,11 +246,7 @@ fn check_case(id: &str) {
     assert_eq!(plan.passes.len(), expected_passes.len());
     for (pass, expected) in plan.passes.iter().zip(expected_passes) {
         let label = format!("{id} pass {}", pass.index + 1);
-        close(
-            &format!("{label} offset"),
-            pass.offset,
-            number(&expected["offset"]),
-        );
+        close(&format!("{label} offset"), pass.offset, number(&expected["offset"]));
         close_point(&format!("{label} start"), pass.start, &expected["start"]);
         check_corners(id, pass, &expected["corners"]);
         check_elements(id, pass, &expected["elements"]);
@@ -405,19 +254,11 @@ fn check_case(id: &str) {
         check_division(id, pass, h, expected);
         check_detection(id, pass, detection_h, plan.sigma, &expected["detection"]);
         match expected.get("gouge_min_clearance") {
-            Some(value) => close(
-                &format!("{label} gouge clearance"),
-                pass.gouge_min_clearance.unwrap(),
-                number(value),
-            ),
+            Some(value) => close(&format!("{label} gouge clearance"), pass.gouge_min_clearance.unwrap(), number(value)),
             None => assert!(pass.gouge_min_clearance.is_none()),
         }
         if let Some(value) = expected.get("stock_min_clearance_of_noncut_moves") {
-            close(
-                &format!("{label} stock clearance"),
-                pass.stock_min_clearance.unwrap(),
-                number(value),
-            );
+            close(&format!("{label} stock clearance"), pass.stock_min_clearance.unwrap(), number(value));
         }
     }
 }
@@ -434,29 +275,18 @@ fn c2_quadrilateral_parallelogram_loop() {
     let case = case("C2");
     let plan = plan_of(&case);
     let pass = &plan.passes[0];
-    for want in case["expected"]["arc_variant_for_comparison"]
-        .as_array()
-        .unwrap()
-    {
+    for want in case["expected"]["arc_variant_for_comparison"].as_array().unwrap() {
         let k = want["k"].as_u64().unwrap() as usize;
         let corner = pass.corners.iter().find(|c| c.k == k).unwrap();
         let n = pass.cl.len();
         let d1 = (pass.cl[k] - pass.cl[(k + n - 1) % n]).normalize();
         let d2 = (pass.cl[(k + 1) % n] - pass.cl[k]).normalize();
         let shape = LoopShape::arc(&corner.cl_point, &d1, &d2, plan.sigma, 0.5);
-        close(
-            "arc variant L",
-            shape.leg,
-            number(&want["arc_variant_rho_0p5_leg_L"]),
-        );
+        close("arc variant L", shape.leg, number(&want["arc_variant_rho_0p5_leg_L"]));
         close_point("arc variant A", shape.exit_end, &want["A"]);
         close_point("arc variant C", shape.centre.unwrap(), &want["C"]);
         close_point("arc variant B", shape.entry_start, &want["B"]);
-        close(
-            "arc variant sweep",
-            shape.sweep.unwrap().to_degrees(),
-            number(&want["sweep_deg"]),
-        );
+        close("arc variant sweep", shape.sweep.unwrap().to_degrees(), number(&want["sweep_deg"]));
     }
 }
 
@@ -470,16 +300,8 @@ fn c3_l_shape_three_passes() {
     let inside = answer.corners.iter().find(|c| c.index == 3).unwrap();
     assert_eq!(inside.action, CornerAction::Reflex);
     let expected = &case["expected"]["with_without_loop"]["closed_form"];
-    close(
-        "C3 inside corner left-over",
-        inside.material.left_area,
-        number(&expected["inside_corner_leftover_area"]),
-    );
-    close(
-        "C3 inside corner depth",
-        inside.material.left_depth,
-        2.0 * 2f64.sqrt() - 2.0,
-    );
+    close("C3 inside corner left-over", inside.material.left_area, number(&expected["inside_corner_leftover_area"]));
+    close("C3 inside corner depth", inside.material.left_depth, 2.0 * 2f64.sqrt() - 2.0);
     for corner in answer.corners.iter().filter(|c| c.index != 3) {
         assert_eq!(corner.material.left_area, 0.0);
         assert_eq!(corner.material.overcut_area, 0.0);
@@ -491,18 +313,15 @@ fn c3_l_shape_three_passes() {
 fn c1_and_c2_material_with_and_without_loops_under_m1() {
     // C1 corner (20, 20) with ρ_b = 1.5 and C2 with ρ_b = 1: the miter path over-cuts
     // A_f(ρ_b − r, α); the loop path loses nothing.
-    for (id, blend, key) in [
-        ("C1", 1.5, "M1_miter_rho_b_1p5_overcut_per_corner"),
-        ("C2", 1.0, "M1_miter_rho_b_1_overcut_per_corner"),
-    ] {
+    for (id, blend, key) in
+        [("C1", 1.5, "M1_miter_rho_b_1p5_overcut_per_corner"), ("C2", 1.0, "M1_miter_rho_b_1_overcut_per_corner")]
+    {
         let case = case(id);
         let closed = &case["expected"]["with_without_loop"]["closed_form"];
         for style in ["none", "loop"] {
             let (mut request, tool) = request(&case);
-            request.controller = Some(corners::ControllerModel {
-                blend_radius: Some(blend),
-                servo_time_constant_ms: None,
-            });
+            request.controller =
+                Some(corners::ControllerModel { blend_radius: Some(blend), servo_time_constant_ms: None });
             if style == "none" {
                 request.corner_loop.style = corners::LoopStyle::None;
             }
@@ -510,11 +329,7 @@ fn c1_and_c2_material_with_and_without_loops_under_m1() {
             for corner in &answer.corners {
                 let predicted = corner.predicted.unwrap();
                 if style == "loop" {
-                    assert_eq!(
-                        predicted.overcut_area, 0.0,
-                        "{id} loop corner {}",
-                        corner.index
-                    );
+                    assert_eq!(predicted.overcut_area, 0.0, "{id} loop corner {}", corner.index);
                     continue;
                 }
                 let want = if closed[key].is_object() {
@@ -559,11 +374,7 @@ fn edge_cases_of_acute_and_flat_corners() {
         close("PV", p.norm(), number(&want["PV"]));
         let shape = LoopShape::arc(&p, &d1, &d2, 1.0, 1.0);
         close("arc leg", shape.leg, number(&want["arc_leg_L"]));
-        close(
-            "arc sweep",
-            -shape.sweep.unwrap().to_degrees(),
-            number(&want["arc_sweep_deg"]),
-        );
+        close("arc sweep", -shape.sweep.unwrap().to_degrees(), number(&want["arc_sweep_deg"]));
         assert!((shape.length() - number(&want["loop_length"])).abs() <= 1e-5);
         close("turn", turn_angle(&d1, &d2), psi);
     }
@@ -572,31 +383,14 @@ fn edge_cases_of_acute_and_flat_corners() {
 #[test]
 fn edge_case_notch_collapses() {
     let want = edge_case("notch 3 wide");
-    let notch = [
-        [0.0, 0.0],
-        [30.0, 0.0],
-        [30.0, 20.0],
-        [17.0, 20.0],
-        [17.0, 10.0],
-        [14.0, 10.0],
-        [14.0, 20.0],
-        [0.0, 20.0],
-    ];
+    let notch =
+        [[0.0, 0.0], [30.0, 0.0], [30.0, 20.0], [17.0, 20.0], [17.0, 10.0], [14.0, 10.0], [14.0, 20.0], [0.0, 20.0]];
     // O4 on the miter offset with o = 2.
     let polygon: Vec<Vec2> = notch.iter().copied().map(vec2).collect();
     let offset = kerf_solver::planar::miter_offset(&polygon, &[2.0; 8], false).unwrap();
-    for (k, expected) in want["offset_edge_lengths"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .enumerate()
-    {
+    for (k, expected) in want["offset_edge_lengths"].as_array().unwrap().iter().enumerate() {
         let t = (polygon[(k + 1) % 8] - polygon[k]).normalize();
-        close(
-            "offset edge length",
-            (offset[(k + 1) % 8] - offset[k]).dot(&t),
-            number(expected),
-        );
+        close("offset edge length", (offset[(k + 1) % 8] - offset[k]).dot(&t), number(expected));
     }
     let request: ContourRequest = serde_json::from_value(json!({
         "tool": {"kind": "flat", "radius": 2}, "contour": notch, "side": "outside",
@@ -611,16 +405,11 @@ fn edge_case_notch_collapses() {
 #[test]
 fn edge_case_tilted_tool_offsets() {
     let want = edge_case("claim 3 tilted tool");
-    let (o1, o2) = (
-        1.0 / 10f64.to_radians().cos(),
-        1.0 / 30f64.to_radians().cos(),
-    );
+    let (o1, o2) = (1.0 / 10f64.to_radians().cos(), 1.0 / 30f64.to_radians().cos());
     close("o1", o1, number(&want["o1"]));
     close("o2", o2, number(&want["o2"]));
     // Square island corner (20, 20): face 21 is the right wall (air +x), face 22 the top (air +y).
-    let p =
-        kerf_solver::planar::miter_point(&Vec2::new(20.0, 20.0), &Vec2::x(), o1, &Vec2::y(), o2)
-            .unwrap();
+    let p = kerf_solver::planar::miter_point(&Vec2::new(20.0, 20.0), &Vec2::x(), o1, &Vec2::y(), o2).unwrap();
     close_point("P", p, &want["P"]);
     // The same through the solver: a square with walls tilted 10° (right) and 30° (top).
     let request: ContourRequest = serde_json::from_value(json!({
@@ -651,17 +440,8 @@ fn edge_case_detection_on_a_thin_triangle() {
     let (_, measures) = detect::measures(&points);
     for k in 0..3 {
         // This edge case is rounded to 1e-4.
-        let alpha = pass
-            .corners
-            .iter()
-            .find(|c| c.k == k)
-            .unwrap()
-            .material_angle
-            .to_degrees();
-        assert!(
-            (alpha - number(&want["alpha_deg"][k])).abs() <= 1e-4,
-            "alpha {alpha}"
-        );
+        let alpha = pass.corners.iter().find(|c| c.k == k).unwrap().material_angle.to_degrees();
+        assert!((alpha - number(&want["alpha_deg"][k])).abs() <= 1e-4, "alpha {alpha}");
         let measure = measures[vertices[k]];
         assert_eq!(measure.protrudes, want["d_ok"][k].as_bool().unwrap());
         assert!((measure.delta_l_per_step - number(&want["dL_over_h"][k])).abs() <= 1e-4);
@@ -698,26 +478,11 @@ fn loops_shrink_where_the_full_loop_would_gouge_a_neighbour() {
         assert!(report.clearance >= -1e-9, "corner {}", corner.index);
         let tooth_tip = corner.index == 6 || corner.index == 7;
         let expected = if tooth_tip { 0.25 } else { 1.0 };
-        assert!(
-            (report.radius.unwrap() - expected).abs() < 1e-12,
-            "corner {}: ρ {:?}",
-            corner.index,
-            report.radius
-        );
+        assert!((report.radius.unwrap() - expected).abs() < 1e-12, "corner {}: ρ {:?}", corner.index, report.radius);
         if tooth_tip {
-            assert!(
-                (report.clearance - 0.1).abs() < 0.011,
-                "corner {}: {}",
-                corner.index,
-                report.clearance
-            );
+            assert!((report.clearance - 0.1).abs() < 0.011, "corner {}: {}", corner.index, report.clearance);
         }
     }
     assert_eq!(answer.corners.iter().filter(|c| c.looped).count(), 8);
-    assert!(
-        !answer
-            .warnings
-            .iter()
-            .any(|w| w.code == "W_LOOP_SKIPPED_GOUGE")
-    );
+    assert!(!answer.warnings.iter().any(|w| w.code == "W_LOOP_SKIPPED_GOUGE"));
 }

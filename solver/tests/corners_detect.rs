@@ -22,12 +22,7 @@ fn cl_points(contour: serde_json::Value, radius: f64, h: f64) -> (Vec<[f64; 2]>,
 }
 
 fn c2() -> serde_json::Value {
-    json!([
-        [0.0, 0.0],
-        [20.0, 0.0],
-        [24.0, 4.0],
-        [18.0 + 3f64.sqrt(), 1.0 + 6.0 * 3f64.sqrt()]
-    ])
+    json!([[0.0, 0.0], [20.0, 0.0], [24.0, 4.0], [18.0 + 3f64.sqrt(), 1.0 + 6.0 * 3f64.sqrt()]])
 }
 
 fn request(path: &[[f64; 2]], detect: DetectMode, threshold: Option<f64>) -> PathLoopRequest {
@@ -52,20 +47,11 @@ fn the_three_rules_on_case_c2() {
         assert!(turn.points[index].corner, "turn angle finds corner {k}");
         assert!(delta.points[index].corner, "claim 9 finds corner {k}");
         // Claim 8's condition (d) misses the 135° corner (k = 1).
-        assert_eq!(
-            curvature.points[index].corner,
-            k != 1,
-            "claim 8 at corner {k}"
-        );
+        assert_eq!(curvature.points[index].corner, k != 1, "claim 8 at corner {k}");
     }
     // Nothing else is a corner: the straight runs between have no turn.
     assert_eq!(turn.points.iter().filter(|p| p.corner).count(), 4);
-    assert!(
-        curvature
-            .warnings
-            .iter()
-            .any(|w| w.code == "W_DETECT_DISAGREE")
-    );
+    assert!(curvature.warnings.iter().any(|w| w.code == "W_DETECT_DISAGREE"));
     assert!((turn.centre[0] - 14.253013).abs() < 1e-6 && (turn.centre[1] - 3.942080).abs() < 1e-6);
 }
 
@@ -79,18 +65,11 @@ fn loops_pass_the_corner_points_straight_and_stay_in_the_air() {
     for &index in &vertices {
         assert!(answer.points[index].looped);
         let p = polygon[index];
-        let visits = answer
-            .moves
-            .iter()
-            .filter(|m| (vec2(m.to) - p).norm() < 1e-9)
-            .count();
+        let visits = answer.moves.iter().filter(|m| (vec2(m.to) - p).norm() < 1e-9).count();
         assert_eq!(visits, 2, "corner point passed twice");
     }
     for step in answer.moves.iter().filter(|m| m.kind == MoveKind::Loop) {
-        assert_eq!(
-            point_in_polygon(&vec2(step.to), &polygon),
-            Containment::Outside
-        );
+        assert_eq!(point_in_polygon(&vec2(step.to), &polygon), Containment::Outside);
     }
     // The path is the given one plus 4 moves per parallelogram loop.
     assert_eq!(answer.moves.len(), path.len() + 4 * 4);
@@ -100,12 +79,7 @@ fn loops_pass_the_corner_points_straight_and_stay_in_the_air() {
 fn curvature_is_undefined_on_axis_parallel_squares() {
     let (path, _) = cl_points(json!([[0, 0], [20, 0], [20, 20], [0, 20]]), 1.0, 0.5);
     let answer = loop_path(&request(&path, DetectMode::PatentCurvature, Some(1.0))).unwrap();
-    assert!(
-        answer
-            .warnings
-            .iter()
-            .any(|w| w.code == "W_DETECT_UNDEFINED")
-    );
+    assert!(answer.warnings.iter().any(|w| w.code == "W_DETECT_UNDEFINED"));
     assert_eq!(answer.points.iter().filter(|p| p.looped).count(), 0);
 }
 

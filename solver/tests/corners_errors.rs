@@ -59,16 +59,7 @@ fn table_of_bad_inputs() {
         [18.5, 30],
         [0, 30]
     ]);
-    let notch = json!([
-        [0, 0],
-        [30, 0],
-        [30, 20],
-        [17, 20],
-        [17, 10],
-        [14, 10],
-        [14, 20],
-        [0, 20]
-    ]);
+    let notch = json!([[0, 0], [30, 0], [30, 20], [17, 20], [17, 10], [14, 10], [14, 20], [0, 20]]);
     let cases = [
         (
             "self-intersecting polygon",
@@ -76,30 +67,15 @@ fn table_of_bad_inputs() {
             "E_SELF_INTERSECTION",
             "contour[2]",
         ),
-        (
-            "fewer than 3 points",
-            with(json!({"contour": [[0, 0], [10, 0]]})),
-            "E_DEGENERATE",
-            "contour",
-        ),
-        (
-            "3 points, 2 of them equal",
-            with(json!({"contour": [[0, 0], [10, 0], [10, 0]]})),
-            "E_DEGENERATE",
-            "contour",
-        ),
+        ("fewer than 3 points", with(json!({"contour": [[0, 0], [10, 0]]})), "E_DEGENERATE", "contour"),
+        ("3 points, 2 of them equal", with(json!({"contour": [[0, 0], [10, 0], [10, 0]]})), "E_DEGENERATE", "contour"),
         (
             "duplicate point",
             with(json!({"contour": [[0, 0], [20, 0], [10, 10], [20, 20], [0, 20], [10, 10]]})),
             "E_DUPLICATE_POINT",
             "contour[5]",
         ),
-        (
-            "zero area",
-            with(json!({"contour": [[0, 0], [10, 0], [20, 0], [5, 0]]})),
-            "E_DEGENERATE",
-            "contour",
-        ),
+        ("zero area", with(json!({"contour": [[0, 0], [10, 0], [20, 0], [5, 0]]})), "E_DEGENERATE", "contour"),
         (
             "clockwise contour",
             with(json!({"contour": [[0, 0], [0, 30], [40, 30], [40, 0]]})),
@@ -126,24 +102,9 @@ fn table_of_bad_inputs() {
             "E_OFFSET_COLLAPSE",
             "contour[0]",
         ),
-        (
-            "bottom above top",
-            with(json!({"depths": {"top": 0, "bottom": 5, "step": 1}})),
-            "E_INPUT",
-            "depths.bottom",
-        ),
-        (
-            "zero step",
-            with(json!({"depths": {"top": 0, "bottom": -5, "step": 0}})),
-            "E_INPUT",
-            "depths.step",
-        ),
-        (
-            "negative step",
-            with(json!({"depths": {"top": 0, "bottom": -5, "step": -1}})),
-            "E_INPUT",
-            "depths.step",
-        ),
+        ("bottom above top", with(json!({"depths": {"top": 0, "bottom": 5, "step": 1}})), "E_INPUT", "depths.bottom"),
+        ("zero step", with(json!({"depths": {"top": 0, "bottom": -5, "step": 0}})), "E_INPUT", "depths.step"),
+        ("negative step", with(json!({"depths": {"top": 0, "bottom": -5, "step": -1}})), "E_INPUT", "depths.step"),
         (
             "too many layers",
             with(json!({"depths": {"top": 0, "bottom": -100, "step": 0.001}})),
@@ -151,30 +112,15 @@ fn table_of_bad_inputs() {
             "depths.step",
         ),
         ("zero feed", with(json!({"feed": 0})), "E_INPUT", "feed"),
-        (
-            "negative loop feed",
-            with(json!({"loop_feed": -5})),
-            "E_INPUT",
-            "loop_feed",
-        ),
-        (
-            "bad tool radius",
-            with(json!({"tool": {"kind": "flat", "radius": -1}})),
-            "E_INPUT",
-            "tool.radius",
-        ),
+        ("negative loop feed", with(json!({"loop_feed": -5})), "E_INPUT", "loop_feed"),
+        ("bad tool radius", with(json!({"tool": {"kind": "flat", "radius": -1}})), "E_INPUT", "tool.radius"),
         (
             "allowances growing inwards",
             with(json!({"passes": [{"allowance": 0.2}, {"allowance": 0.5}]})),
             "E_INPUT",
             "passes[1].allowance",
         ),
-        (
-            "no passes",
-            with(json!({"passes": []})),
-            "E_INPUT",
-            "passes",
-        ),
+        ("no passes", with(json!({"passes": []})), "E_INPUT", "passes"),
         (
             "loop angle of 180°",
             with(json!({"corner_loop": {"style": "arc", "max_angle_deg": 180}})),
@@ -201,36 +147,11 @@ fn table_of_bad_inputs() {
             "E_INPUT",
             "corner_overrides[0].index",
         ),
-        (
-            "tilt list of the wrong length",
-            with(json!({"tilt_deg": [1, 2]})),
-            "E_INPUT",
-            "tilt_deg",
-        ),
-        (
-            "tilt too steep",
-            with(json!({"tilt_deg": [0, 85, 0, 0]})),
-            "E_INPUT",
-            "tilt_deg[1]",
-        ),
-        (
-            "safe_z below the top",
-            with(json!({"safe_z": -1})),
-            "E_INPUT",
-            "safe_z",
-        ),
-        (
-            "chord tolerance too fine",
-            with(json!({"tolerance": 1e-9})),
-            "E_INPUT",
-            "tolerance",
-        ),
-        (
-            "start edge out of range",
-            with(json!({"start_edge": 4})),
-            "E_INPUT",
-            "start_edge",
-        ),
+        ("tilt list of the wrong length", with(json!({"tilt_deg": [1, 2]})), "E_INPUT", "tilt_deg"),
+        ("tilt too steep", with(json!({"tilt_deg": [0, 85, 0, 0]})), "E_INPUT", "tilt_deg[1]"),
+        ("safe_z below the top", with(json!({"safe_z": -1})), "E_INPUT", "safe_z"),
+        ("chord tolerance too fine", with(json!({"tolerance": 1e-9})), "E_INPUT", "tolerance"),
+        ("start edge out of range", with(json!({"start_edge": 4})), "E_INPUT", "start_edge"),
         (
             "too many moves",
             with(
@@ -257,17 +178,11 @@ fn non_finite_numbers_name_their_field() {
     let mut request: ContourRequest = serde_json::from_value(base()).unwrap();
     request.contour[2] = [40.0, f64::NAN];
     let error = corners::solve(&request, &Tool::new(ToolKind::Flat, 1.0)).unwrap_err();
-    assert_eq!(
-        (error.code(), error.field()),
-        ("E_INPUT", Some("contour[2]"))
-    );
+    assert_eq!((error.code(), error.field()), ("E_INPUT", Some("contour[2]")));
     let mut request: ContourRequest = serde_json::from_value(base()).unwrap();
     request.depths.top = f64::INFINITY;
     let error = corners::solve(&request, &Tool::new(ToolKind::Flat, 1.0)).unwrap_err();
-    assert_eq!(
-        (error.code(), error.field()),
-        ("E_INPUT", Some("depths.top"))
-    );
+    assert_eq!((error.code(), error.field()), ("E_INPUT", Some("depths.top")));
 }
 
 #[test]
@@ -279,12 +194,7 @@ fn too_many_points_are_refused_before_any_work() {
             [angle.cos() * 100.0, angle.sin() * 100.0]
         })
         .collect();
-    assert_refused(
-        "too many points",
-        with(json!({"contour": contour})),
-        "E_TOO_MANY_POINTS",
-        "contour",
-    );
+    assert_refused("too many points", with(json!({"contour": contour})), "E_TOO_MANY_POINTS", "contour");
 }
 
 #[test]

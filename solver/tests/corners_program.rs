@@ -3,7 +3,7 @@
 //! programs are also run through it.
 
 use kerf_solver::corners::{self, ContourRequest};
-use kerf_solver::deburr::Post;
+use kerf_solver::gcode::Post;
 use kerf_solver::gcode::{Dialect, Reference, ToolCall};
 use kerf_solver::tool::{Tool, ToolKind};
 use serde_json::json;
@@ -26,11 +26,7 @@ fn request(extra: serde_json::Value) -> ContourRequest {
 }
 
 fn post(dialect: Dialect, reference: Reference) -> Post {
-    Post {
-        dialect,
-        reference,
-        tool: ToolCall::Table(3),
-    }
+    Post { dialect, reference, tool: ToolCall::Table(3) }
 }
 
 #[test]
@@ -41,33 +37,21 @@ fn program_has_layers_loop_feeds_and_links() {
     assert!(text.starts_with("%\nO1000 (KERF CONTOUR)\n"));
     assert!(text.contains("T3 M06\nG00 G43 H3 Z5.0000\n"));
     assert!(text.contains("F800"));
-    assert!(
-        text.contains("F3000"),
-        "loops clear the stock and run at loop_feed"
-    );
+    assert!(text.contains("F3000"), "loops clear the stock and run at loop_feed");
     for z in ["Z-2.0000", "Z-4.0000", "Z-6.0000"] {
         assert!(text.contains(z), "{z}");
     }
     // Between layers the tool goes up to the clearance plane.
-    let rapids_up = text
-        .lines()
-        .filter(|l| l.starts_with("G00") && l.ends_with("Z5.0000"))
-        .count();
+    let rapids_up = text.lines().filter(|l| l.starts_with("G00") && l.ends_with("Z5.0000")).count();
     assert!(rapids_up >= 4, "{rapids_up}");
     assert!(text.ends_with("M05\nG00 Z5.0000\nM30\n%\n"));
     let moves = text.lines().filter(|l| l.starts_with("G0")).count();
     let answer_moves: usize = answer.layers.iter().map(|l| l.moves.len()).sum();
-    assert_eq!(
-        moves,
-        answer_moves + 2,
-        "every move plus the tool-length line and the final retract"
-    );
+    assert_eq!(moves, answer_moves + 2, "every move plus the tool-length line and the final retract");
     // The same request gives the same bytes.
-    let again = corners::program(
-        &corners::solve(&request(json!({})), &tool).unwrap(),
-        &post(Dialect::Fanuc, Reference::Tip),
-    )
-    .unwrap();
+    let again =
+        corners::program(&corners::solve(&request(json!({})), &tool).unwrap(), &post(Dialect::Fanuc, Reference::Tip))
+            .unwrap();
     assert_eq!(text, again);
 }
 
@@ -75,22 +59,11 @@ fn program_has_layers_loop_feeds_and_links() {
 fn ball_centre_reference_lifts_the_program_and_tilt_is_refused() {
     let mut ball = Tool::new(ToolKind::Ball, 3.0);
     ball.flutes = 2;
-    let answer = corners::solve(
-        &request(json!({"tool": {"kind": "ball", "radius": 3}})),
-        &ball,
-    )
-    .unwrap();
+    let answer = corners::solve(&request(json!({"tool": {"kind": "ball", "radius": 3}})), &ball).unwrap();
     let text = corners::program(&answer, &post(Dialect::Linuxcnc, Reference::Centre)).unwrap();
     assert!(text.contains("G64 P0.0100"));
-    assert!(
-        text.contains("Z1.0000"),
-        "the layer at z = −2 is programmed at the ball centre −2 + 3"
-    );
-    let tilted = corners::solve(
-        &request(json!({"tilt_deg": 5})),
-        &Tool::new(ToolKind::Flat, 3.0),
-    )
-    .unwrap();
+    assert!(text.contains("Z1.0000"), "the layer at z = −2 is programmed at the ball centre −2 + 3");
+    let tilted = corners::solve(&request(json!({"tilt_deg": 5})), &Tool::new(ToolKind::Flat, 3.0)).unwrap();
     let error = corners::program(&tilted, &post(Dialect::Fanuc, Reference::Tip)).unwrap_err();
     assert_eq!(error.code(), "E_TILT_NEEDS_5_AXIS");
 }
@@ -103,42 +76,24 @@ fn rs274_accepts_both_dialects() {
     };
     let _ = status;
     let tool = Tool::new(ToolKind::Flat, 3.0);
-    let answer =
-        corners::solve(&request(json!({"inside_corner_relief": "dogbone"})), &tool).unwrap();
+    let answer = corners::solve(&request(json!({"inside_corner_relief": "dogbone"})), &tool).unwrap();
     let directory = std::env::temp_dir().join(format!("kerf-corners-{}", std::process::id()));
     std::fs::create_dir_all(&directory).unwrap();
     for dialect in [Dialect::Fanuc, Dialect::Linuxcnc] {
         let text = corners::program(&answer, &post(dialect, Reference::Tip)).unwrap();
         let file = directory.join(format!("{dialect:?}.ngc"));
         std::fs::write(&file, &text).unwrap();
-        let output = std::process::Command::new("rs274")
-            .arg("-g")
-            .arg(&file)
-            .output()
-            .unwrap();
+        let output = std::process::Command::new("rs274").arg("-g").arg(&file).output().unwrap();
         let stdout = String::from_utf8_lossy(&output.stdout);
         let stderr = String::from_utf8_lossy(&output.stderr);
         // rs274 stops at the first bad block: every motion block must reach the canonical output.
-        let blocks = text
-            .lines()
-            .filter(|l| l.starts_with("G00") || l.starts_with("G01"))
-            .count();
-        let executed = stdout
-            .lines()
-            .filter(|l| l.contains("STRAIGHT_FEED") || l.contains("STRAIGHT_TRAVERSE"))
-            .count();
-        let complaints: Vec<&str> = stderr
-            .lines()
-            .filter(|l| !l.trim().is_empty() && l.trim() != "executing")
-            .collect();
-        assert!(
-            output.status.success() && complaints.is_empty(),
-            "{dialect:?}: {stderr}"
-        );
-        assert!(
-            executed >= blocks,
-            "{dialect:?}: {executed} of {blocks} motion blocks ran"
-        );
+        let blocks = text.lines().filter(|l| l.starts_with("G00") || l.starts_with("G01")).count();
+        let executed =
+            stdout.lines().filter(|l| l.contains("STRAIGHT_FEED") || l.contains("STRAIGHT_TRAVERSE")).count();
+        let complaints: Vec<&str> =
+            stderr.lines().filter(|l| !l.trim().is_empty() && l.trim() != "executing").collect();
+        assert!(output.status.success() && complaints.is_empty(), "{dialect:?}: {stderr}");
+        assert!(executed >= blocks, "{dialect:?}: {executed} of {blocks} motion blocks ran");
     }
     let _ = std::fs::remove_dir_all(&directory);
 }

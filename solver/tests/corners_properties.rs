@@ -14,9 +14,7 @@
 use std::f64::consts::TAU;
 
 use kerf_solver::corners::{self, ContourAnswer, ContourRequest, MoveKind};
-use kerf_solver::planar::{
-    Containment, Vec2, cross, point_in_polygon, segment_segment_distance, vec2,
-};
+use kerf_solver::planar::{Containment, Vec2, cross, point_in_polygon, segment_segment_distance, vec2};
 use kerf_solver::tool::{Tool, ToolKind};
 use proptest::prelude::*;
 use serde_json::json;
@@ -25,13 +23,7 @@ const GOUGE: f64 = 1e-9;
 
 fn star_polygon() -> impl Strategy<Value = Vec<[f64; 2]>> {
     (3usize..12)
-        .prop_flat_map(|n| {
-            (
-                prop::collection::vec(0.0f64..1.0, n),
-                prop::collection::vec(2.0f64..10.0, n),
-                0.0f64..TAU,
-            )
-        })
+        .prop_flat_map(|n| (prop::collection::vec(0.0f64..1.0, n), prop::collection::vec(2.0f64..10.0, n), 0.0f64..TAU))
         // Every angular gap below π keeps the polygon star-shaped about the origin, so simple
         // and counter-clockwise.
         .prop_filter("an angular gap of π or more", |(gaps, _, _)| {
@@ -77,18 +69,16 @@ fn setup() -> impl Strategy<Value = Setup> {
         any::<bool>(),
         100.0f64..179.0,
     )
-        .prop_map(
-            |(contour, radius, outside, climb, style, two_passes, round, max_angle_deg)| Setup {
-                contour,
-                radius,
-                outside,
-                climb,
-                style,
-                two_passes,
-                round,
-                max_angle_deg,
-            },
-        )
+        .prop_map(|(contour, radius, outside, climb, style, two_passes, round, max_angle_deg)| Setup {
+            contour,
+            radius,
+            outside,
+            climb,
+            style,
+            two_passes,
+            round,
+            max_angle_deg,
+        })
 }
 
 fn request(setup: &Setup) -> ContourRequest {
@@ -121,10 +111,7 @@ fn solve(setup: &Setup) -> Option<ContourAnswer> {
         Ok(answer) => Some(answer),
         Err(error) => {
             assert!(
-                matches!(
-                    error.code(),
-                    "E_OFFSET_COLLAPSE" | "E_OFFSET_SELF_INTERSECTION"
-                ),
+                matches!(error.code(), "E_OFFSET_COLLAPSE" | "E_OFFSET_SELF_INTERSECTION"),
                 "unexpected refusal {}: {}",
                 error.code(),
                 error.message()

@@ -7,14 +7,7 @@ use kerf_solver::planar::{Containment, Vec2, point_in_polygon, point_segment_dis
 use kerf_solver::tool::{Tool, ToolKind};
 use serde_json::json;
 
-const L_SHAPE: [[f64; 2]; 6] = [
-    [0.0, 0.0],
-    [30.0, 0.0],
-    [30.0, 10.0],
-    [10.0, 10.0],
-    [10.0, 25.0],
-    [0.0, 25.0],
-];
+const L_SHAPE: [[f64; 2]; 6] = [[0.0, 0.0], [30.0, 0.0], [30.0, 10.0], [10.0, 10.0], [10.0, 25.0], [0.0, 25.0]];
 
 fn solve(relief: &str, edge: &str, side: &str, contour: &[[f64; 2]], radius: f64) -> ContourAnswer {
     let request = serde_json::from_value(json!({
@@ -32,14 +25,7 @@ fn solve(relief: &str, edge: &str, side: &str, contour: &[[f64; 2]], radius: f64
 
 /// Area of {within `radius` of segment [p, target]} ∩ material near `vertex`, by counting the
 /// centres of a fine grid.
-fn grid_overcut(
-    contour: &[[f64; 2]],
-    outside: bool,
-    vertex: Vec2,
-    p: Vec2,
-    target: Vec2,
-    radius: f64,
-) -> f64 {
+fn grid_overcut(contour: &[[f64; 2]], outside: bool, vertex: Vec2, p: Vec2, target: Vec2, radius: f64) -> f64 {
     let polygon: Vec<Vec2> = contour.iter().copied().map(vec2).collect();
     let step = 0.004;
     // Cell edges on the vertex's coordinates, so the axis-parallel faces through it are cell
@@ -50,20 +36,13 @@ fn grid_overcut(
     let mut inside = 0u64;
     for i in 0..count {
         for j in 0..count {
-            let x = vertex
-                + Vec2::new(
-                    -reach + (i as f64 + 0.5) * step,
-                    -reach + (j as f64 + 0.5) * step,
-                );
+            let x = vertex + Vec2::new(-reach + (i as f64 + 0.5) * step, -reach + (j as f64 + 0.5) * step);
             if point_segment_distance(&x, &p, &target) > radius {
                 continue;
             }
             let containment = point_in_polygon(&x, &polygon);
-            let material = if outside {
-                containment == Containment::Inside
-            } else {
-                containment == Containment::Outside
-            };
+            let material =
+                if outside { containment == Containment::Inside } else { containment == Containment::Outside };
             if material {
                 inside += 1;
             }
@@ -78,15 +57,8 @@ fn dogbone_reaches_the_vertex_and_reports_its_overcut() {
     let corner = answer.corners.iter().find(|c| c.index == 3).unwrap();
     assert_eq!(corner.action, CornerAction::Dogbone);
     let relief = corner.relief.as_ref().unwrap();
-    let (vertex, target, p) = (
-        vec2(corner.vertex),
-        vec2(relief.target),
-        vec2(corner.cl_point),
-    );
-    assert!(
-        ((target - vertex).norm() - 2.0).abs() < 1e-12,
-        "the tool circle passes through V"
-    );
+    let (vertex, target, p) = (vec2(corner.vertex), vec2(relief.target), vec2(corner.cl_point));
+    assert!(((target - vertex).norm() - 2.0).abs() < 1e-12, "the tool circle passes through V");
     assert!(corner.material.left_area < 1e-9 && corner.material.left_depth < 1e-12);
     // Over-cut depth r(1 − sin(γ/2)) for γ = 90°.
     assert!((corner.material.overcut_depth - 2.0 * (1.0 - 0.5f64.sqrt())).abs() < 1e-12);
@@ -112,11 +84,7 @@ fn tbone_runs_along_the_chosen_edge() {
         assert_eq!(corner.action, CornerAction::Tbone, "{edge}");
         let relief = corner.relief.as_ref().unwrap();
         assert_eq!(relief.along_edge, Some(along), "{edge}");
-        let (vertex, target, p) = (
-            vec2(corner.vertex),
-            vec2(relief.target),
-            vec2(corner.cl_point),
-        );
+        let (vertex, target, p) = (vec2(corner.vertex), vec2(relief.target), vec2(corner.cl_point));
         assert!(((target - vertex).norm() - 2.0).abs() < 1e-12);
         // Along edge 2 (y = 10) the relief moves in x only; along edge 3 (x = 10) in y only.
         let travel = target - p;
@@ -125,15 +93,8 @@ fn tbone_runs_along_the_chosen_edge() {
         } else {
             assert!(travel.x.abs() < 1e-12)
         }
-        assert!(
-            corner.material.left_area < 1e-9,
-            "{edge}: {}",
-            corner.material.left_area
-        );
-        assert!(
-            (corner.material.overcut_depth - 2.0).abs() < 1e-12,
-            "a T-bone cuts r deep into the other face"
-        );
+        assert!(corner.material.left_area < 1e-9, "{edge}: {}", corner.material.left_area);
+        assert!((corner.material.overcut_depth - 2.0).abs() < 1e-12, "a T-bone cuts r deep into the other face");
         let counted = grid_overcut(&L_SHAPE, true, vertex, p, target, 2.0);
         assert!(
             (corner.material.overcut_area - counted).abs() < 2e-3 * counted.max(1.0),
@@ -152,14 +113,8 @@ fn pocket_corners_get_dogbones_and_no_loops() {
         assert_eq!(corner.action, CornerAction::Dogbone);
         assert!(!corner.looped);
         let relief = corner.relief.as_ref().unwrap();
-        let counted = grid_overcut(
-            &pocket,
-            false,
-            vec2(corner.vertex),
-            vec2(corner.cl_point),
-            vec2(relief.target),
-            3.0,
-        );
+        let counted =
+            grid_overcut(&pocket, false, vec2(corner.vertex), vec2(corner.cl_point), vec2(relief.target), 3.0);
         assert!(
             (corner.material.overcut_area - counted).abs() < 2e-3 * counted.max(1.0),
             "{} {} vs {counted}",
@@ -171,9 +126,7 @@ fn pocket_corners_get_dogbones_and_no_loops() {
     let plain = solve("none", "longer", "inside", &pocket, 3.0);
     for corner in &plain.corners {
         assert_eq!(corner.action, CornerAction::Reflex);
-        assert!(
-            (corner.material.left_area - 9.0 * (1.0 - std::f64::consts::FRAC_PI_4)).abs() < 1e-9
-        );
+        assert!((corner.material.left_area - 9.0 * (1.0 - std::f64::consts::FRAC_PI_4)).abs() < 1e-9);
     }
 }
 
@@ -191,23 +144,14 @@ fn fillet_tighter_than_the_tool_is_passed_over_and_reported() {
     }
     contour.extend([[10.0, 25.0], [0.0, 25.0]]);
     let answer = solve("none", "longer", "outside", &contour, 2.0);
-    let unreached: Vec<_> = answer
-        .corners
-        .iter()
-        .filter(|c| c.action == CornerAction::Unreached)
-        .collect();
+    let unreached: Vec<_> = answer.corners.iter().filter(|c| c.action == CornerAction::Unreached).collect();
     assert_eq!(unreached.len(), 11);
     let left: f64 = unreached.iter().map(|c| c.material.left_area).sum();
-    let expected =
-        4.0 * (1.0 - std::f64::consts::FRAC_PI_4) - 0.25 * (1.0 - std::f64::consts::FRAC_PI_4);
+    let expected = 4.0 * (1.0 - std::f64::consts::FRAC_PI_4) - 0.25 * (1.0 - std::f64::consts::FRAC_PI_4);
     assert!((left - expected).abs() < 2e-3, "{left} vs {expected}");
     assert!(answer.warnings.iter().any(|w| w.code == "W_EDGE_UNREACHED"));
     // All corner points of the stretch share one CL point, 2 from both straight faces.
     let p = vec2(unreached[0].cl_point);
-    assert!(
-        unreached
-            .iter()
-            .all(|c| (vec2(c.cl_point) - p).norm() < 1e-12)
-    );
+    assert!(unreached.iter().all(|c| (vec2(c.cl_point) - p).norm() < 1e-12));
     assert!((p - Vec2::new(12.0, 12.0)).norm() < 1e-9, "{p:?}");
 }

@@ -65,11 +65,7 @@ pub fn measures(points: &[Vec2]) -> (Vec2, Vec<PointMeasures>) {
                 curvature,
                 protrudes: l1 > l0 && l1 > l2,
                 delta_l,
-                delta_l_per_step: if spacing > 0.0 {
-                    delta_l / spacing
-                } else {
-                    0.0
-                },
+                delta_l_per_step: if spacing > 0.0 { delta_l / spacing } else { 0.0 },
                 turn: turn_angle(&(here - before), &(after - here)),
             }
         })
@@ -82,9 +78,7 @@ pub fn measures(points: &[Vec2]) -> (Vec2, Vec<PointMeasures>) {
 pub fn is_corner(measure: &PointMeasures, mode: DetectMode, threshold: f64, sigma: f64) -> bool {
     match mode {
         DetectMode::TurnAngle => sigma * measure.turn >= threshold,
-        DetectMode::PatentCurvature => {
-            measure.protrudes && measure.curvature.is_some_and(|k| k >= threshold)
-        }
+        DetectMode::PatentCurvature => measure.protrudes && measure.curvature.is_some_and(|k| k >= threshold),
         DetectMode::PatentDeltaL => measure.delta_l_per_step >= threshold,
     }
 }
@@ -193,19 +187,13 @@ pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, crate::err
     use super::pass::MAX_ARC_STEPS;
     use super::request::{self as contour_request, LoopStyle};
     use crate::error::{SolverError, Warning, finite, positive};
-    use crate::planar::{
-        Containment, SegmentGrid, point_in_polygon, segments_intersect, signed_area, vec2,
-    };
+    use crate::planar::{Containment, SegmentGrid, point_in_polygon, segments_intersect, signed_area, vec2};
 
     let radius = positive("tool_radius", request.tool_radius)?;
     if request.path.len() > contour_request::MAX_POINTS {
         return Err(SolverError::new(
             "E_TOO_MANY_POINTS",
-            format!(
-                "the path has {} points; the limit is {}",
-                request.path.len(),
-                contour_request::MAX_POINTS
-            ),
+            format!("the path has {} points; the limit is {}", request.path.len(), contour_request::MAX_POINTS),
         )
         .at("path"));
     }
@@ -213,33 +201,20 @@ pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, crate::err
     for (index, point) in request.path.iter().enumerate() {
         let field = format!("path[{index}]");
         let p = vec2([finite(&field, point[0])?, finite(&field, point[1])?]);
-        if points
-            .last()
-            .is_none_or(|last| (p - last).norm() > super::prepare::DUPLICATE_TOLERANCE)
-        {
+        if points.last().is_none_or(|last| (p - last).norm() > super::prepare::DUPLICATE_TOLERANCE) {
             points.push(p);
         }
     }
-    while points.len() > 1
-        && (points[0] - points[points.len() - 1]).norm() <= super::prepare::DUPLICATE_TOLERANCE
-    {
+    while points.len() > 1 && (points[0] - points[points.len() - 1]).norm() <= super::prepare::DUPLICATE_TOLERANCE {
         points.pop();
     }
     let n = points.len();
     if n < 3 {
-        return Err(
-            SolverError::new("E_DEGENERATE", "the path needs at least 3 distinct points")
-                .at("path"),
-        );
+        return Err(SolverError::new("E_DEGENERATE", "the path needs at least 3 distinct points").at("path"));
     }
-    let tolerance = request
-        .tolerance
-        .unwrap_or(contour_request::DEFAULT_TOLERANCE);
+    let tolerance = request.tolerance.unwrap_or(contour_request::DEFAULT_TOLERANCE);
     if finite("tolerance", tolerance)? < contour_request::MIN_TOLERANCE {
-        return Err(SolverError::input(
-            "tolerance",
-            "tolerance is below the smallest accepted",
-        ));
+        return Err(SolverError::input("tolerance", "tolerance is below the smallest accepted"));
     }
     let sigma = match request.material_side {
         MaterialSide::Left => 1.0,
@@ -253,10 +228,7 @@ pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, crate::err
     };
     let threshold = if request.detect == DetectMode::TurnAngle {
         if threshold >= 180.0 {
-            return Err(SolverError::input(
-                "threshold",
-                "a turn threshold must lie below 180°",
-            ));
+            return Err(SolverError::input("threshold", "a turn threshold must lie below 180°"));
         }
         threshold.to_radians()
     } else {
@@ -271,34 +243,26 @@ pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, crate::err
     if request.detect == DetectMode::PatentCurvature && undefined > 0 {
         warnings.push(Warning::new(
             "W_DETECT_UNDEFINED",
-            format!(
-                "Eq. (a) is undefined at {undefined} points (vertical chords); use turn_angle there"
-            ),
+            format!("Eq. (a) is undefined at {undefined} points (vertical chords); use turn_angle there"),
         ));
     }
-    let corner: Vec<bool> = measures
-        .iter()
-        .map(|m| sigma * m.turn > 0.0 && is_corner(m, request.detect, threshold, sigma))
-        .collect();
+    let corner: Vec<bool> =
+        measures.iter().map(|m| sigma * m.turn > 0.0 && is_corner(m, request.detect, threshold, sigma)).collect();
     if request.detect != DetectMode::TurnAngle {
-        let disagree = measures
-            .iter()
-            .zip(&corner)
-            .filter(|(m, c)| sigma * m.turn >= config.min_turn && !**c)
-            .count();
+        let disagree = measures.iter().zip(&corner).filter(|(m, c)| sigma * m.turn >= config.min_turn && !**c).count();
         if disagree > 0 {
             warnings.push(Warning::new(
                 "W_DETECT_DISAGREE",
-                format!("{disagree} points turn by at least {:.1}° towards the air but the patent rule misses them", config.min_turn.to_degrees()),
+                format!(
+                    "{disagree} points turn by at least {:.1}° towards the air but the patent rule misses them",
+                    config.min_turn.to_degrees()
+                ),
             ));
         }
     }
 
     let material_inside = (signed_area(&points) > 0.0) == (sigma > 0.0);
-    let grid = SegmentGrid::new(
-        (0..n).map(|k| (points[k], points[(k + 1) % n])).collect(),
-        0.0,
-    );
+    let grid = SegmentGrid::new((0..n).map(|k| (points[k], points[(k + 1) % n])).collect(), 0.0);
     let mut scratch = Vec::new();
     let loop_moves = |shape: &LoopShape, p: &Vec2| -> Vec<(Vec2, Vec2, ElementKind)> {
         let mut from = *p;
@@ -320,10 +284,7 @@ pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, crate::err
     for step in 1..=n {
         let k = step % n;
         let p = points[k];
-        moves.push(PathMove {
-            kind: cut,
-            to: [p.x, p.y],
-        });
+        moves.push(PathMove { kind: cut, to: [p.x, p.y] });
         route.push(p);
         if !corner[k] || config.style == LoopStyle::None {
             continue;
@@ -345,9 +306,7 @@ pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, crate::err
                 grid.candidates(a, b, 0.0, scratch);
                 outside
                     && scratch.iter().all(|&e| {
-                        e == before
-                            || e == after
-                            || !segments_intersect(a, b, &points[e], &points[(e + 1) % n])
+                        e == before || e == after || !segments_intersect(a, b, &points[e], &points[(e + 1) % n])
                     })
             })
         };
@@ -373,15 +332,8 @@ pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, crate::err
         looped[k] = true;
         visits.push(route.len() - 1);
         for (_, to, kind) in loop_moves(&shape, &p) {
-            let kind = if kind == ElementKind::Loop {
-                super::answer::MoveKind::Loop
-            } else {
-                cut
-            };
-            moves.push(PathMove {
-                kind,
-                to: [to.x, to.y],
-            });
+            let kind = if kind == ElementKind::Loop { super::answer::MoveKind::Loop } else { cut };
+            moves.push(PathMove { kind, to: [to.x, to.y] });
             route.push(to);
         }
         visits.push(route.len() - 1);
@@ -394,17 +346,12 @@ pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, crate::err
     }
     let (mut max_abs_cross, mut min_dot) = (0.0_f64, 1.0_f64);
     for &i in &visits {
-        let (Some(back), Some(here), Some(ahead)) = (
-            i.checked_sub(1).and_then(|j| route.get(j)),
-            route.get(i),
-            route.get(i + 1),
-        ) else {
+        let (Some(back), Some(here), Some(ahead)) =
+            (i.checked_sub(1).and_then(|j| route.get(j)), route.get(i), route.get(i + 1))
+        else {
             continue;
         };
-        let (Some(u), Some(v)) = (
-            (here - back).try_normalize(0.0),
-            (ahead - here).try_normalize(0.0),
-        ) else {
+        let (Some(u), Some(v)) = ((here - back).try_normalize(0.0), (ahead - here).try_normalize(0.0)) else {
             continue;
         };
         max_abs_cross = max_abs_cross.max(crate::planar::cross(&u, &v).abs());
@@ -423,12 +370,5 @@ pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, crate::err
             looped,
         })
         .collect();
-    Ok(PathLoopAnswer {
-        centre: [centre.x, centre.y],
-        points,
-        moves,
-        max_abs_cross,
-        min_dot,
-        warnings,
-    })
+    Ok(PathLoopAnswer { centre: [centre.x, centre.y], points, moves, max_abs_cross, min_dot, warnings })
 }

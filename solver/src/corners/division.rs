@@ -34,31 +34,16 @@ pub fn divide(elements: &[Element], h: f64) -> Division {
         if element.kind() == ElementKind::Exit {
             division.corner_visits.push(division.points.len() - 1);
         }
-        let start = division
-            .points
-            .last()
-            .copied()
-            .unwrap_or_else(|| element.start());
+        let start = division.points.last().copied().unwrap_or_else(|| element.start());
         let mut new_points: Vec<Vec2> = match element {
             Element::Line { end, .. } => {
                 let count = steps(element.length());
-                (1..=count)
-                    .map(|i| start + (end - start) * (i as f64 / count as f64))
-                    .collect()
+                (1..=count).map(|i| start + (end - start) * (i as f64 / count as f64)).collect()
             }
-            Element::Arc {
-                centre,
-                radius,
-                sweep,
-                ..
-            } => {
+            Element::Arc { centre, radius, sweep, .. } => {
                 let count = steps(element.length());
                 let begin = (start - centre).y.atan2((start - centre).x);
-                (1..=count)
-                    .map(|i| {
-                        centre + *radius * direction(begin + sweep * (i as f64 / count as f64))
-                    })
-                    .collect()
+                (1..=count).map(|i| centre + *radius * direction(begin + sweep * (i as f64 / count as f64))).collect()
             }
         };
         if let Some(last) = new_points.last_mut() {
@@ -69,9 +54,7 @@ pub fn divide(elements: &[Element], h: f64) -> Division {
             let step = point - previous;
             let length = step.norm();
             division.turtle.push((step.y.atan2(step.x), length));
-            division
-                .s
-                .push(division.s.last().copied().unwrap_or(0.0) + length);
+            division.s.push(division.s.last().copied().unwrap_or(0.0) + length);
             division.points.push(point);
         }
         if element.kind() == ElementKind::Entry {
@@ -94,10 +77,7 @@ pub fn collinearity(division: &Division, before: usize, after: usize) -> (f64, f
         ) else {
             continue;
         };
-        let (Some(u), Some(v)) = (
-            (here - back).try_normalize(0.0),
-            (ahead - here).try_normalize(0.0),
-        ) else {
+        let (Some(u), Some(v)) = ((here - back).try_normalize(0.0), (ahead - here).try_normalize(0.0)) else {
             continue;
         };
         worst_cross = worst_cross.max(cross(&u, &v).abs());

@@ -94,9 +94,7 @@ impl Element {
     pub fn chord_count(&self, tolerance: f64, max_steps: usize) -> usize {
         match self {
             Self::Line { .. } => 1,
-            Self::Arc { radius, sweep, .. } => {
-                arc_steps(*radius, *sweep, tolerance).min(max_steps.max(1)) + 1
-            }
+            Self::Arc { radius, sweep, .. } => arc_steps(*radius, *sweep, tolerance).min(max_steps.max(1)) + 1,
         }
     }
 
@@ -106,13 +104,7 @@ impl Element {
     pub fn chord(&self, tolerance: f64, max_steps: usize) -> Vec<Vec2> {
         match self {
             Self::Line { end, .. } => vec![*end],
-            Self::Arc {
-                start,
-                end,
-                centre,
-                sweep,
-                ..
-            } => {
+            Self::Arc { start, end, centre, sweep, .. } => {
                 let mut points = circumscribed_arc(centre, start, *sweep, tolerance, max_steps);
                 // The exact end point, not its recomputation from the angle.
                 if let Some(last) = points.last_mut() {

@@ -59,9 +59,7 @@ impl Layer {
             })
             .unzip();
         let base: Vec<Vec2> = prepared_vertex.iter().map(|&v| contour.points[v]).collect();
-        let directions: Vec<Vec2> = (0..n)
-            .map(|k| (base[(k + 1) % n] - base[k]).normalize())
-            .collect();
+        let directions: Vec<Vec2> = (0..n).map(|k| (base[(k + 1) % n] - base[k]).normalize()).collect();
         let vertices = match shift {
             None => base,
             Some(shift) => {
@@ -70,14 +68,7 @@ impl Layer {
                 let moved: Vec<Vec2> = (0..n)
                     .map(|k| {
                         let previous = (k + n - 1) % n;
-                        miter_point(
-                            &base[k],
-                            &air(previous),
-                            offset(previous),
-                            &air(k),
-                            offset(k),
-                        )
-                        .unwrap_or(base[k])
+                        miter_point(&base[k], &air(previous), offset(previous), &air(k), offset(k)).unwrap_or(base[k])
                     })
                     .collect();
                 for k in 0..n {
@@ -95,24 +86,9 @@ impl Layer {
                 moved
             }
         };
-        let lengths = (0..n)
-            .map(|k| (vertices[(k + 1) % n] - vertices[k]).norm())
-            .collect();
-        let grid = SegmentGrid::new(
-            (0..n)
-                .map(|k| (vertices[k], vertices[(k + 1) % n]))
-                .collect(),
-            cell,
-        );
-        Ok(Self {
-            sigma,
-            vertices,
-            prepared_vertex,
-            prepared_edge,
-            directions,
-            lengths,
-            grid,
-        })
+        let lengths = (0..n).map(|k| (vertices[(k + 1) % n] - vertices[k]).norm()).collect();
+        let grid = SegmentGrid::new((0..n).map(|k| (vertices[k], vertices[(k + 1) % n])).collect(), cell);
+        Ok(Self { sigma, vertices, prepared_vertex, prepared_edge, directions, lengths, grid })
     }
 
     /// Number of vertices (and edges).
@@ -153,10 +129,6 @@ impl Layer {
 
     /// Convex (α < π) or reflex.
     pub fn class(&self, k: usize) -> Class {
-        if self.sigma * self.turn(k) > 0.0 {
-            Class::Convex
-        } else {
-            Class::Reflex
-        }
+        if self.sigma * self.turn(k) > 0.0 { Class::Convex } else { Class::Reflex }
     }
 }

@@ -83,9 +83,7 @@ impl LoopShape {
         match self.style {
             LoopStyle::Arc => Self::arc(p, d1, d2, sigma, self.radius.unwrap_or(0.0) * factor),
             LoopStyle::Triangle => Self::triangle(p, d1, d2, self.leg * factor),
-            LoopStyle::Parallelogram | LoopStyle::None => {
-                Self::parallelogram(p, d1, d2, self.leg * factor)
-            }
+            LoopStyle::Parallelogram | LoopStyle::None => Self::parallelogram(p, d1, d2, self.leg * factor),
         }
     }
 
@@ -195,11 +193,7 @@ mod tests {
         let shape = LoopShape::arc(&p, &Vec2::x(), &Vec2::y(), 1.0, 1.0);
         assert_abs_diff_eq!(shape.leg, 1.0, epsilon = 1e-15);
         assert_abs_diff_eq!(shape.exit_end, Vec2::new(22.0, -1.0), epsilon = 1e-15);
-        assert_abs_diff_eq!(
-            shape.centre.unwrap(),
-            Vec2::new(22.0, -2.0),
-            epsilon = 1e-15
-        );
+        assert_abs_diff_eq!(shape.centre.unwrap(), Vec2::new(22.0, -2.0), epsilon = 1e-15);
         assert_abs_diff_eq!(shape.entry_start, Vec2::new(21.0, -2.0), epsilon = 1e-15);
         assert_abs_diff_eq!(shape.sweep.unwrap(), -1.5 * PI, epsilon = 1e-15);
         assert_abs_diff_eq!(shape.length(), 2.0 + 1.5 * PI, epsilon = 1e-14);
@@ -227,16 +221,9 @@ mod tests {
         let (shape, fallback) = sized(&config, &p, &Vec2::x(), &d2, 1.0).unwrap();
         assert!(fallback.is_none());
         assert_abs_diff_eq!(shape.leg, 10.0, epsilon = 1e-12);
-        assert_abs_diff_eq!(
-            shape.radius.unwrap(),
-            10.0 * 2.5f64.to_radians().tan(),
-            epsilon = 1e-12
-        );
+        assert_abs_diff_eq!(shape.radius.unwrap(), 10.0 * 2.5f64.to_radians().tan(), epsilon = 1e-12);
         // A tiny max_leg pushes ρ below its minimum: parallelogram.
-        let tight = LoopConfig {
-            max_leg: 0.5,
-            ..config
-        };
+        let tight = LoopConfig { max_leg: 0.5, ..config };
         let (shape, fallback) = sized(&tight, &p, &Vec2::x(), &d2, 1.0).unwrap();
         assert_eq!(shape.style, LoopStyle::Parallelogram);
         assert!(fallback.is_some());

@@ -6,9 +6,7 @@ use std::f64::consts::PI;
 
 use super::layer::Layer;
 use super::pass::{Action, CornerPlan};
-use crate::planar::{
-    Vec2, capsule_convex_area, disk_polygon_area, point_segment_distance, signed_area,
-};
+use crate::planar::{Vec2, capsule_convex_area, disk_polygon_area, point_segment_distance, signed_area};
 
 /// Material left in and cut beyond the ideal corner.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -75,8 +73,7 @@ pub(crate) fn ideal(layer: &Layer, corner: &CornerPlan, radius: f64) -> Material
                 left_area: (kite_area - capsule_convex_area(&p, &target, radius, &kite)).max(0.0),
                 left_depth: (point_segment_distance(&vertex, &p, &target) - radius).max(0.0),
                 overcut_area: (capsule - inside_air).max(0.0),
-                overcut_depth: depth_beyond(layer.air_normal(layer.previous(k)))
-                    .max(depth_beyond(layer.air_normal(k))),
+                overcut_depth: depth_beyond(layer.air_normal(layer.previous(k))).max(depth_beyond(layer.air_normal(k))),
             }
         }
     }
@@ -98,10 +95,7 @@ pub(crate) fn unreached(layer: &Layer, p: &Vec2, chain: &[usize], radius: f64) -
     polygon.extend(chain.iter().map(|&k| layer.vertices[k]));
     polygon.push(foot(last));
     let area = signed_area(&polygon).abs();
-    let depth = chain
-        .iter()
-        .map(|&k| (layer.vertices[k] - p).norm() - radius)
-        .fold(0.0, f64::max);
+    let depth = chain.iter().map(|&k| (layer.vertices[k] - p).norm() - radius).fold(0.0, f64::max);
     Material {
         left_area: (area - disk_polygon_area(p, radius, &polygon)).max(0.0),
         left_depth: depth,
@@ -134,11 +128,7 @@ pub(crate) fn predicted(
             Some(product) if product > 0.0 => {
                 let delta = product / (2.0 * offset);
                 let (area, depth) = lag_loss(radius, offset - delta, PI - alpha);
-                Material {
-                    overcut_area: area,
-                    overcut_depth: depth,
-                    ..*ideal
-                }
+                Material { overcut_area: area, overcut_depth: depth, ..*ideal }
             }
             _ => *ideal,
         },
@@ -166,11 +156,7 @@ pub fn lag_loss(radius: f64, path_radius: f64, psi: f64) -> (f64, f64) {
         // the nearest tool-centre direction on the arc.
         let c = -(phi + 0.5 * psi).cos();
         let discriminant = path_radius * path_radius * (c * c - 1.0) + radius * radius;
-        if discriminant <= 0.0 {
-            0.0
-        } else {
-            (path_radius * c + discriminant.sqrt()).max(0.0)
-        }
+        if discriminant <= 0.0 { 0.0 } else { (path_radius * c + discriminant.sqrt()).max(0.0) }
     };
     let half = 0.5 * (PI - psi);
     let steps = 4000;

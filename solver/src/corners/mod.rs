@@ -61,15 +61,15 @@ pub mod request;
 mod solve;
 
 pub use answer::{
-    ContourAnswer, ContourCorner, ContourLayer, ContourMove, ContourSummary, Convexity,
-    CornerAction, LoopReport, MaterialReport, MoveKind, PassReport, ReliefReport,
+    ContourAnswer, ContourCorner, ContourLayer, ContourMove, ContourSummary, Convexity, CornerAction, LoopReport,
+    MaterialReport, MoveKind, PassReport, ReliefReport,
 };
 pub use element::{Element, ElementKind};
 pub use pass::{Action, CornerPlan, ElementMeta, PassPlan};
 pub use program::program;
 pub use relief::ReliefShape;
 pub use request::{
-    ContourRequest, ControllerModel, CornerLoop, CornerOverride, CutDirection, Depths, Join,
-    LoopStyle, PassSpec, Relief, Side, TboneEdge, Tilt,
+    ContourRequest, ControllerModel, CornerLoop, CornerOverride, CutDirection, Depths, Join, LoopStyle, PassSpec,
+    Relief, Side, TboneEdge, Tilt,
 };
 pub use solve::{Plan, plan, solve};

@@ -34,10 +34,7 @@ impl Offset {
 
     /// The CL polygon: one point per surviving edge's start, in traversal order.
     pub fn polygon(&self, layer: &Layer) -> Vec<Vec2> {
-        (0..layer.len())
-            .filter(|&k| self.active[k])
-            .map(|k| self.cl[k])
-            .collect()
+        (0..layer.len()).filter(|&k| self.active[k]).map(|k| self.cl[k]).collect()
     }
 }
 
@@ -53,10 +50,7 @@ impl Eq for Event {}
 
 impl Ord for Event {
     fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .length
-            .total_cmp(&self.length)
-            .then(other.edge.cmp(&self.edge))
+        other.length.total_cmp(&self.length).then(other.edge.cmp(&self.edge))
     }
 }
 
@@ -104,18 +98,13 @@ pub(crate) fn offset(
     let mut start: Vec<Vec2> = Vec::with_capacity(n);
     for (k, &before) in previous.iter().enumerate() {
         start.push(corner(before, k).ok_or_else(|| {
-            SolverError::new(
-                "E_DEGENERATE",
-                format!("the contour reverses by 180° at {}", field(k)),
-            )
-            .at(field(k))
+            SolverError::new("E_DEGENERATE", format!("the contour reverses by 180° at {}", field(k))).at(field(k))
         })?);
     }
     let scale = layer.lengths.iter().copied().fold(0.0, f64::max).max(1.0);
     let limit = 1e-12 * scale;
-    let length = |edge: usize, start: &[Vec2], next: &[usize]| {
-        (start[next[edge]] - start[edge]).dot(&layer.directions[edge])
-    };
+    let length =
+        |edge: usize, start: &[Vec2], next: &[usize]| (start[next[edge]] - start[edge]).dot(&layer.directions[edge]);
     let mut active = vec![true; n];
     let mut remaining = n;
     let mut version = vec![0u32; n];
@@ -123,11 +112,7 @@ pub(crate) fn offset(
     for edge in 0..n {
         let l = length(edge, &start, &next);
         if l <= limit {
-            heap.push(Event {
-                length: l,
-                edge,
-                version: 0,
-            });
+            heap.push(Event { length: l, edge, version: 0 });
         }
     }
     while let Some(event) = heap.pop() {
@@ -136,21 +121,11 @@ pub(crate) fn offset(
             continue;
         }
         if remaining <= 3 {
-            return Err(collapse(
-                describe_tool,
-                &field(edge),
-                layer.lengths[edge],
-                event.length,
-            ));
+            return Err(collapse(describe_tool, &field(edge), layer.lengths[edge], event.length));
         }
         let (before, after) = (previous[edge], next[edge]);
         let Some(point) = corner(before, after) else {
-            return Err(collapse(
-                describe_tool,
-                &field(edge),
-                layer.lengths[edge],
-                event.length,
-            ));
+            return Err(collapse(describe_tool, &field(edge), layer.lengths[edge], event.length));
         };
         active[edge] = false;
         remaining -= 1;
@@ -161,11 +136,7 @@ pub(crate) fn offset(
             version[neighbour] += 1;
             let l = length(neighbour, &start, &next);
             if l <= limit {
-                heap.push(Event {
-                    length: l,
-                    edge: neighbour,
-                    version: version[neighbour],
-                });
+                heap.push(Event { length: l, edge: neighbour, version: version[neighbour] });
             }
         }
     }
@@ -199,11 +170,7 @@ pub(crate) fn offset(
             member = layer.next(member);
         }
     }
-    Ok(Offset {
-        cl,
-        active,
-        chain_start,
-    })
+    Ok(Offset { cl, active, chain_start })
 }
 
 fn collapse(describe_tool: &str, field: &str, length: f64, offset_length: f64) -> SolverError {

@@ -153,11 +153,7 @@ struct Path {
 impl Path {
     fn push(&mut self, element: Element, from_edge: usize, to_edge: usize, fast: bool) {
         self.elements.push(element);
-        self.meta.push(ElementMeta {
-            from_edge,
-            to_edge,
-            fast,
-        });
+        self.meta.push(ElementMeta { from_edge, to_edge, fast });
     }
 }
 
@@ -202,10 +198,7 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
     let n = layer.len();
     let offsets = &input.edge_offsets;
     let clear = input.radius + input.pass.allowance;
-    let tool = format!(
-        "the tool (radius {} + allowance {})",
-        input.radius, input.pass.allowance
-    );
+    let tool = format!("the tool (radius {} + allowance {})", input.radius, input.pass.allowance);
     let offset = offset::offset(layer, offsets, &input.edge_source, &tool)?;
     check_offset(layer, &offset, input, &tool)?;
     let cl = offset.cl.clone();
@@ -264,31 +257,18 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
                     && input.loop_config.style != LoopStyle::None
                     && choice.loops.unwrap_or(big_enough);
                 let found = if wanted {
-                    loops::sized(input.loop_config, &p, &d1, &d2, layer.sigma).and_then(
-                        |(shape, fallback)| {
-                            let chosen = gouge_fallbacks(
-                                layer,
-                                &shape,
-                                &p,
-                                &d1,
-                                &d2,
-                                &vertex,
-                                clear,
-                                input,
-                                &mut scratch,
-                            );
-                            match &chosen {
-                                Ok(_) => {
-                                    if let Some(reason) = fallback {
-                                        fallbacks
-                                            .push(format!("{}: {reason}", field(input.source[k])));
-                                    }
+                    loops::sized(input.loop_config, &p, &d1, &d2, layer.sigma).and_then(|(shape, fallback)| {
+                        let chosen = gouge_fallbacks(layer, &shape, &p, &d1, &d2, &vertex, clear, input, &mut scratch);
+                        match &chosen {
+                            Ok(_) => {
+                                if let Some(reason) = fallback {
+                                    fallbacks.push(format!("{}: {reason}", field(input.source[k])));
                                 }
-                                Err(_) => skipped.push(input.source[k]),
                             }
-                            chosen.ok()
-                        },
-                    )
+                            Err(_) => skipped.push(input.source[k]),
+                        }
+                        chosen.ok()
+                    })
                 } else {
                     None
                 };
@@ -300,8 +280,7 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
                     };
                     plan.clearance = Some(clearance);
                     if let Some(stock) = input.stock {
-                        let stock_clearance =
-                            stock_clearance(stock, &shape, &p, &vertex, input, &mut scratch);
+                        let stock_clearance = stock_clearance(stock, &shape, &p, &vertex, input, &mut scratch);
                         plan.stock_clearance = Some(stock_clearance);
                         plan.loop_feed = stock_clearance >= -GOUGE_TOLERANCE;
                     }
@@ -345,21 +324,9 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
             Class::Reflex => {
                 path.push(cut(current, p), incoming, incoming, false);
                 current = p;
-                let style = if big_enough {
-                    choice.relief
-                } else {
-                    Relief::None
-                };
+                let style = if big_enough { choice.relief } else { Relief::None };
                 if style != Relief::None {
-                    let shape = relief::shape(
-                        layer,
-                        k,
-                        &p,
-                        o1.min(o2),
-                        style,
-                        choice.tbone_edge,
-                        input.request_order,
-                    );
+                    let shape = relief::shape(layer, k, &p, o1.min(o2), style, choice.tbone_edge, input.request_order);
                     let moves = [(p, shape.target), (shape.target, p)];
                     let (previous_edge, next_edge) = (layer.previous(k), k);
                     let gouges = moves.iter().any(|(a, b)| {
@@ -373,18 +340,10 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
                     if gouges {
                         reliefs_skipped.push(input.source[k]);
                     } else {
-                        plan.action = if style == Relief::Dogbone {
-                            Action::Dogbone
-                        } else {
-                            Action::Tbone
-                        };
+                        plan.action = if style == Relief::Dogbone { Action::Dogbone } else { Action::Tbone };
                         for (a, b) in moves {
                             path.push(
-                                Element::Line {
-                                    start: a,
-                                    end: b,
-                                    kind: ElementKind::Relief,
-                                },
+                                Element::Line { start: a, end: b, kind: ElementKind::Relief },
                                 incoming,
                                 incoming,
                                 false,
@@ -413,16 +372,10 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
         ));
     }
     if !fallbacks.is_empty() {
-        warnings.push(Warning::new(
-            "W_LOOP_FALLBACK",
-            format!("pass {}: {}", input.index + 1, first_few(&fallbacks)),
-        ));
+        warnings.push(Warning::new("W_LOOP_FALLBACK", format!("pass {}: {}", input.index + 1, first_few(&fallbacks))));
     }
     if !offset.active.iter().all(|a| *a) {
-        let unreached: Vec<usize> = (0..n)
-            .filter(|&k| !offset.active[k])
-            .map(|k| input.edge_source[k])
-            .collect();
+        let unreached: Vec<usize> = (0..n).filter(|&k| !offset.active[k]).map(|k| input.edge_source[k]).collect();
         warnings.push(Warning::new(
             "W_EDGE_UNREACHED",
             format!(
@@ -436,19 +389,12 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
     if !reliefs_skipped.is_empty() {
         warnings.push(Warning::new(
             "W_RELIEF_SKIPPED",
-            format!(
-                "pass {}: the relief would gouge another face at {}",
-                input.index + 1,
-                list(&reliefs_skipped)
-            ),
+            format!("pass {}: the relief would gouge another face at {}", input.index + 1, list(&reliefs_skipped)),
         ));
     }
     let corners: Vec<CornerPlan> = corners.into_iter().flatten().collect();
     let gouge_min_clearance = corners.iter().filter_map(|c| c.clearance).reduce(f64::min);
-    let stock_min_clearance = corners
-        .iter()
-        .filter_map(|c| c.stock_clearance)
-        .reduce(f64::min);
+    let stock_min_clearance = corners.iter().filter_map(|c| c.stock_clearance).reduce(f64::min);
     Ok(PassPlan {
         index: input.index,
         allowance: input.pass.allowance,
@@ -489,20 +435,12 @@ fn first_few(items: &[String]) -> String {
 }
 
 fn cut(start: Vec2, end: Vec2) -> Element {
-    Element::Line {
-        start,
-        end,
-        kind: ElementKind::Cut,
-    }
+    Element::Line { start, end, kind: ElementKind::Cut }
 }
 
 /// Refuses before building any loop when the loops alone would need more moves than an answer
 /// may hold (huge loop radii with a fine chord tolerance on many corners).
-fn check_loop_budget(
-    layer: &Layer,
-    offset: &Offset,
-    input: &PassInput<'_>,
-) -> Result<(), SolverError> {
+fn check_loop_budget(layer: &Layer, offset: &Offset, input: &PassInput<'_>) -> Result<(), SolverError> {
     if !input.pass.loops || input.loop_config.style == LoopStyle::None {
         return Ok(());
     }
@@ -512,9 +450,7 @@ fn check_loop_budget(
             continue;
         }
         let (d1, d2) = layer.corner_directions(k);
-        if let Some((shape, _)) =
-            loops::sized(input.loop_config, &offset.cl[k], &d1, &d2, layer.sigma)
-        {
+        if let Some((shape, _)) = loops::sized(input.loop_config, &offset.cl[k], &d1, &d2, layer.sigma) {
             moves += shape
                 .elements(&offset.cl[k])
                 .iter()
@@ -536,12 +472,7 @@ fn check_loop_budget(
 }
 
 /// O5 (the CL polygon is simple) and its orientation; O4 is the edge events of `offset`.
-fn check_offset(
-    layer: &Layer,
-    offset: &Offset,
-    input: &PassInput<'_>,
-    tool: &str,
-) -> Result<(), SolverError> {
+fn check_offset(layer: &Layer, offset: &Offset, input: &PassInput<'_>, tool: &str) -> Result<(), SolverError> {
     let edges: Vec<usize> = (0..layer.len()).filter(|&k| offset.active[k]).collect();
     let polygon = offset.polygon(layer);
     match find_self_intersection(&polygon) {
@@ -567,11 +498,9 @@ fn check_offset(
         }
     }
     if signed_area(&polygon) * signed_area(&layer.vertices) <= 0.0 {
-        return Err(SolverError::new(
-            "E_OFFSET_COLLAPSE",
-            format!("{tool} does not fit inside the contour"),
-        )
-        .at("contour"));
+        return Err(
+            SolverError::new("E_OFFSET_COLLAPSE", format!("{tool} does not fit inside the contour")).at("contour")
+        );
     }
     Ok(())
 }
@@ -585,11 +514,7 @@ fn start_point(layer: &Layer, cl: &[Vec2], offsets: &[f64], edge: usize) -> Vec2
     let t = layer.directions[edge];
     let along = (foot - cl[edge]).dot(&t);
     let length = (cl[after] - cl[edge]).dot(&t);
-    if along > 0.0 && along < length {
-        foot
-    } else {
-        0.5 * (cl[edge] + cl[after])
-    }
+    if along > 0.0 && along < length { foot } else { 0.5 * (cl[edge] + cl[after]) }
 }
 
 /// The loop, or a smaller or simpler one, that clears the contour by r + δ (§3.5.5): halve the
@@ -613,15 +538,7 @@ fn gouge_fallbacks(
         if attempt == 5 {
             candidate = LoopShape::triangle(p, d1, d2, candidate.leg);
         }
-        let clearance = loop_clearance(
-            layer,
-            &candidate,
-            p,
-            vertex,
-            clear,
-            input.tolerance,
-            scratch,
-        );
+        let clearance = loop_clearance(layer, &candidate, p, vertex, clear, input.tolerance, scratch);
         if clearance >= -GOUGE_TOLERANCE {
             return Ok((candidate, clearance));
         }
@@ -700,10 +617,7 @@ fn check_clearance(
     for element in elements.iter().filter(|e| e.kind() == ElementKind::Cut) {
         let mut from = element.start();
         for to in element.chord(input.tolerance, MAX_ARC_STEPS) {
-            if let Some((distance, edge)) =
-                layer
-                    .grid
-                    .nearest(&from, &to, clear - GOUGE_TOLERANCE, scratch, |_| false)
+            if let Some((distance, edge)) = layer.grid.nearest(&from, &to, clear - GOUGE_TOLERANCE, scratch, |_| false)
             {
                 let source = input.edge_source[edge];
                 return Err(SolverError::new(

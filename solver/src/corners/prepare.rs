@@ -38,11 +38,7 @@ impl Contour {
         let m = self.points.len();
         // Edge i of the request order runs from given-order vertex i to i + 1.
         let given = |i: usize| {
-            if self.reversed {
-                self.source[m - 1 - i]
-            } else {
-                self.source[i]
-            }
+            if self.reversed { self.source[m - 1 - i] } else { self.source[i] }
         };
         let mut edge = m - 1;
         for i in 0..m {
@@ -53,11 +49,7 @@ impl Contour {
         if given(0) > k {
             edge = m - 1;
         }
-        if self.reversed {
-            (2 * m - 2 - edge) % m
-        } else {
-            edge
-        }
+        if self.reversed { (2 * m - 2 - edge) % m } else { edge }
     }
 
     /// The request edges merged into prepared edge `edge`.
@@ -87,29 +79,18 @@ impl Contour {
 /// `E_DEGENERATE` (fewer than 3 distinct points, zero area), `E_DUPLICATE_POINT`,
 /// `E_SELF_INTERSECTION`, `E_ORIENTATION` (clockwise and not `fix_orientation`),
 /// `E_TOO_MANY_POINTS`, `E_TOO_COMPLEX`, `E_INPUT` for non-finite coordinates.
-pub(crate) fn prepare(
-    points: &[[f64; 2]],
-    fix_orientation: bool,
-) -> Result<(Contour, Vec<Warning>), SolverError> {
+pub(crate) fn prepare(points: &[[f64; 2]], fix_orientation: bool) -> Result<(Contour, Vec<Warning>), SolverError> {
     if points.len() > MAX_POINTS {
         return Err(SolverError::new(
             "E_TOO_MANY_POINTS",
-            format!(
-                "the contour has {} points; the limit is {MAX_POINTS}",
-                points.len()
-            ),
+            format!("the contour has {} points; the limit is {MAX_POINTS}", points.len()),
         )
         .at("contour"));
     }
     for (index, point) in points.iter().enumerate() {
         let field = format!("contour[{index}]");
-        if finite(&field, point[0])?.abs() > MAX_COORDINATE
-            || finite(&field, point[1])?.abs() > MAX_COORDINATE
-        {
-            return Err(SolverError::input(
-                field,
-                format!("coordinates must lie within ±{MAX_COORDINATE} mm"),
-            ));
+        if finite(&field, point[0])?.abs() > MAX_COORDINATE || finite(&field, point[1])?.abs() > MAX_COORDINATE {
+            return Err(SolverError::input(field, format!("coordinates must lie within ±{MAX_COORDINATE} mm")));
         }
     }
     let mut warnings = Vec::new();
@@ -119,14 +100,8 @@ pub(crate) fn prepare(
         && points
             .first()
             .zip(points.last())
-            .is_some_and(|(first, last)| {
-                (planar::vec2(*first) - planar::vec2(*last)).norm() <= DUPLICATE_TOLERANCE
-            });
-    let used = if closing {
-        points.len() - 1
-    } else {
-        points.len()
-    };
+            .is_some_and(|(first, last)| (planar::vec2(*first) - planar::vec2(*last)).norm() <= DUPLICATE_TOLERANCE);
+    let used = if closing { points.len() - 1 } else { points.len() };
     for (index, point) in points.iter().take(used).enumerate() {
         let p = planar::vec2(*point);
         match kept.last() {
@@ -135,10 +110,7 @@ pub(crate) fn prepare(
         }
     }
     while kept.len() > 1
-        && kept
-            .first()
-            .zip(kept.last())
-            .is_some_and(|(first, last)| (first.0 - last.0).norm() <= DUPLICATE_TOLERANCE)
+        && kept.first().zip(kept.last()).is_some_and(|(first, last)| (first.0 - last.0).norm() <= DUPLICATE_TOLERANCE)
     {
         if let Some((_, index)) = kept.pop() {
             removed.push(index);
@@ -147,10 +119,7 @@ pub(crate) fn prepare(
     if kept.len() < 3 {
         return Err(SolverError::new(
             "E_DEGENERATE",
-            format!(
-                "the contour needs at least 3 distinct points (got {})",
-                kept.len()
-            ),
+            format!("the contour needs at least 3 distinct points (got {})", kept.len()),
         )
         .at("contour"));
     }
@@ -190,11 +159,7 @@ pub(crate) fn prepare(
         removed.sort_unstable();
         warnings.push(Warning::new(
             "W_VERTEX_REMOVED",
-            format!(
-                "{} duplicate or collinear points removed: {}",
-                removed.len(),
-                list_indices(&removed)
-            ),
+            format!("{} duplicate or collinear points removed: {}", removed.len(), list_indices(&removed)),
         ));
     }
     let mut points: Vec<Vec2> = kept.iter().map(|(p, _)| *p).collect();
@@ -213,32 +178,15 @@ pub(crate) fn prepare(
         }
         points.reverse();
         source.reverse();
-        warnings.push(Warning::new(
-            "W_CONTOUR_REVERSED",
-            "the contour ran clockwise and was reversed",
-        ));
+        warnings.push(Warning::new("W_CONTOUR_REVERSED", "the contour ran clockwise and was reversed"));
     }
-    Ok((
-        Contour {
-            points,
-            source,
-            reversed,
-            request_len: used,
-        },
-        warnings,
-    ))
+    Ok((Contour { points, source, reversed, request_len: used }, warnings))
 }
 
 /// `E_DUPLICATE_POINT` when two non-consecutive points coincide (the polygon touches itself).
 fn check_duplicates(kept: &[(Vec2, usize)]) -> Result<(), SolverError> {
     let mut order: Vec<usize> = (0..kept.len()).collect();
-    order.sort_by(|&a, &b| {
-        kept[a]
-            .0
-            .x
-            .total_cmp(&kept[b].0.x)
-            .then(kept[a].0.y.total_cmp(&kept[b].0.y))
-    });
+    order.sort_by(|&a, &b| kept[a].0.x.total_cmp(&kept[b].0.x).then(kept[a].0.y.total_cmp(&kept[b].0.y)));
     for pair in order.windows(2) {
         let (a, b) = (&kept[pair[0]], &kept[pair[1]]);
         if (a.0 - b.0).norm() <= DUPLICATE_TOLERANCE {
@@ -263,16 +211,11 @@ fn check_area(kept: &[(Vec2, usize)]) -> Result<(), SolverError> {
         .unwrap_or(origin);
     let axis = far - origin;
     let length = axis.norm();
-    let spread = kept
-        .iter()
-        .map(|(p, _)| planar::cross(&axis, &(p - origin)).abs() / length)
-        .fold(0.0, f64::max);
+    let spread = kept.iter().map(|(p, _)| planar::cross(&axis, &(p - origin)).abs() / length).fold(0.0, f64::max);
     if length == 0.0 || spread <= DUPLICATE_TOLERANCE {
-        return Err(SolverError::new(
-            "E_DEGENERATE",
-            "the contour has zero area: all its points lie on one line",
-        )
-        .at("contour"));
+        return Err(
+            SolverError::new("E_DEGENERATE", "the contour has zero area: all its points lie on one line").at("contour")
+        );
     }
     Ok(())
 }
@@ -280,8 +223,7 @@ fn check_area(kept: &[(Vec2, usize)]) -> Result<(), SolverError> {
 /// Removes vertices where the contour runs straight on; returns the rest and the removed
 /// request indices.
 fn remove_straight(points: Vec<(Vec2, usize)>) -> (Vec<(Vec2, usize)>, Vec<usize>) {
-    let straight =
-        |a: &Vec2, b: &Vec2, c: &Vec2| turn_angle(&(b - a), &(c - b)).abs() <= STRAIGHT_TURN;
+    let straight = |a: &Vec2, b: &Vec2, c: &Vec2| turn_angle(&(b - a), &(c - b)).abs() <= STRAIGHT_TURN;
     let mut removed = Vec::new();
     let mut kept: Vec<(Vec2, usize)> = Vec::with_capacity(points.len());
     for point in points {
@@ -315,12 +257,7 @@ fn remove_straight(points: Vec<(Vec2, usize)>) -> (Vec<(Vec2, usize)>, Vec<usize
 
 /// `contour[3], contour[7], ...` for at most ten indices.
 pub(crate) fn list_indices(indices: &[usize]) -> String {
-    let mut text = indices
-        .iter()
-        .take(10)
-        .map(|i| format!("contour[{i}]"))
-        .collect::<Vec<_>>()
-        .join(", ");
+    let mut text = indices.iter().take(10).map(|i| format!("contour[{i}]")).collect::<Vec<_>>().join(", ");
     if indices.len() > 10 {
         text.push_str(&format!(" and {} more", indices.len() - 10));
     }
@@ -333,15 +270,7 @@ mod tests {
 
     #[test]
     fn closing_duplicates_and_collinear_points_are_removed() {
-        let points = [
-            [0.0, 0.0],
-            [5.0, 0.0],
-            [10.0, 0.0],
-            [10.0, 0.0],
-            [10.0, 10.0],
-            [0.0, 10.0],
-            [0.0, 0.0],
-        ];
+        let points = [[0.0, 0.0], [5.0, 0.0], [10.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0], [0.0, 0.0]];
         let (contour, warnings) = prepare(&points, false).unwrap();
         assert_eq!(contour.source, vec![0, 2, 4, 5]);
         assert_eq!(warnings[0].code, "W_VERTEX_REMOVED");
@@ -373,19 +302,9 @@ mod tests {
         let code = |points: &[[f64; 2]]| prepare(points, false).unwrap_err().code();
         assert_eq!(code(&[[0.0, 0.0], [1.0, 0.0]]), "E_DEGENERATE");
         assert_eq!(code(&[[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]), "E_DEGENERATE");
+        assert_eq!(code(&[[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]]), "E_SELF_INTERSECTION");
         assert_eq!(
-            code(&[[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]]),
-            "E_SELF_INTERSECTION"
-        );
-        assert_eq!(
-            code(&[
-                [0.0, 0.0],
-                [4.0, 0.0],
-                [2.0, 2.0],
-                [4.0, 4.0],
-                [0.0, 4.0],
-                [2.0, 2.0]
-            ]),
+            code(&[[0.0, 0.0], [4.0, 0.0], [2.0, 2.0], [4.0, 4.0], [0.0, 4.0], [2.0, 2.0]]),
             "E_DUPLICATE_POINT"
         );
         assert_eq!(code(&[[0.0, 0.0], [f64::NAN, 0.0], [1.0, 1.0]]), "E_INPUT");

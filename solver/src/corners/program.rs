@@ -3,8 +3,8 @@
 //! they clear the stock).
 
 use super::answer::{ContourAnswer, MoveKind};
-use crate::deburr::Post;
 use crate::error::SolverError;
+use crate::gcode::Post;
 use crate::gcode::{self, Program, Reference};
 use crate::geometry::Vec3;
 use crate::path::Toolpath;
@@ -38,11 +38,7 @@ pub fn program(answer: &ContourAnswer, post: &Post) -> Result<String, SolverErro
         }
     }
     let mut comments = answer.description.clone();
-    comments.push(format!(
-        "control point: {} of the {} tool",
-        post.reference.as_str(),
-        answer.tool_kind.as_str()
-    ));
+    comments.push(format!("control point: {} of the {} tool", post.reference.as_str(), answer.tool_kind.as_str()));
     Ok(gcode::write(&Program {
         dialect: post.dialect,
         number: 1000,

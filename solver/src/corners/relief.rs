@@ -39,11 +39,7 @@ pub(crate) fn shape(
         Relief::Tbone => {
             let (incoming, outgoing) = (layer.previous(k), k);
             // "previous" and "next" follow the request's point order, whatever the travel.
-            let (previous, next) = if request_order {
-                (incoming, outgoing)
-            } else {
-                (outgoing, incoming)
-            };
+            let (previous, next) = if request_order { (incoming, outgoing) } else { (outgoing, incoming) };
             let (length_previous, length_next) = (layer.lengths[previous], layer.lengths[next]);
             let along = match edge {
                 TboneEdge::Longer if length_next > length_previous => next,
@@ -52,21 +48,11 @@ pub(crate) fn shape(
                 TboneEdge::Longer | TboneEdge::Shorter | TboneEdge::Previous => previous,
                 TboneEdge::Next => next,
             };
-            ReliefShape {
-                style,
-                target: vertex + offset * layer.air_normal(along),
-                along_edge: Some(along),
-            }
+            ReliefShape { style, target: vertex + offset * layer.air_normal(along), along_edge: Some(along) }
         }
         Relief::Dogbone | Relief::None => {
-            let towards_p = (p - vertex)
-                .try_normalize(0.0)
-                .unwrap_or_else(|| layer.air_normal(k));
-            ReliefShape {
-                style: Relief::Dogbone,
-                target: vertex + offset * towards_p,
-                along_edge: None,
-            }
+            let towards_p = (p - vertex).try_normalize(0.0).unwrap_or_else(|| layer.air_normal(k));
+            ReliefShape { style: Relief::Dogbone, target: vertex + offset * towards_p, along_edge: None }
         }
     }
 }

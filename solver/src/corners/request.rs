@@ -401,10 +401,7 @@ impl ContourRequest {
         tool.validate("tool.")?;
         let radius = tool.radius;
         let feed = positive("feed", self.feed)?;
-        let loop_feed = self
-            .loop_feed
-            .map(|f| positive("loop_feed", f))
-            .transpose()?;
+        let loop_feed = self.loop_feed.map(|f| positive("loop_feed", f)).transpose()?;
         let depths = &self.depths;
         let top = finite("depths.top", depths.top)?;
         let bottom = finite("depths.bottom", depths.bottom)?;
@@ -413,18 +410,12 @@ impl ContourRequest {
             if value.abs() > super::prepare::MAX_COORDINATE {
                 return Err(SolverError::input(
                     field,
-                    format!(
-                        "{field} must lie within ±{} mm",
-                        super::prepare::MAX_COORDINATE
-                    ),
+                    format!("{field} must lie within ±{} mm", super::prepare::MAX_COORDINATE),
                 ));
             }
         }
         if radius > super::prepare::MAX_COORDINATE {
-            return Err(SolverError::input(
-                "tool.radius",
-                "the tool radius is implausibly large",
-            ));
+            return Err(SolverError::input("tool.radius", "the tool radius is implausibly large"));
         }
         if bottom > top {
             return Err(SolverError::input(
@@ -440,38 +431,26 @@ impl ContourRequest {
                 format!("tolerance must be at least {MIN_TOLERANCE} mm (got {tolerance})"),
             ));
         }
-        let spindle_rpm = positive(
-            "spindle_rpm",
-            self.spindle_rpm.unwrap_or(DEFAULT_SPINDLE_RPM),
-        )?;
+        let spindle_rpm = positive("spindle_rpm", self.spindle_rpm.unwrap_or(DEFAULT_SPINDLE_RPM))?;
         let clearance = non_negative("clearance", self.clearance.unwrap_or(DEFAULT_CLEARANCE))?;
         let safe_z = match self.safe_z {
             Some(z) => {
                 if finite("safe_z", z)? <= top {
-                    return Err(SolverError::input(
-                        "safe_z",
-                        format!("safe_z {z} must lie above depths.top {top}"),
-                    ));
+                    return Err(SolverError::input("safe_z", format!("safe_z {z} must lie above depths.top {top}")));
                 }
                 z
             }
             None => top + clearance.max(1e-3),
         };
         let lead = non_negative("lead", self.lead.unwrap_or(radius))?;
-        let stock_allowance = self
-            .stock_allowance
-            .map(|s| non_negative("stock_allowance", s))
-            .transpose()?;
+        let stock_allowance = self.stock_allowance.map(|s| non_negative("stock_allowance", s)).transpose()?;
         let passes = self.pass_jobs()?;
         if let (Some(stock), Some(first)) = (stock_allowance, passes.first())
             && stock < first.allowance
         {
             return Err(SolverError::input(
                 "stock_allowance",
-                format!(
-                    "stock_allowance {stock} is smaller than the first pass's allowance {}",
-                    first.allowance
-                ),
+                format!("stock_allowance {stock} is smaller than the first pass's allowance {}", first.allowance),
             ));
         }
         let loop_config = self.corner_loop.config(radius)?;
@@ -482,10 +461,7 @@ impl ContourRequest {
             Some(k) => {
                 return Err(SolverError::input(
                     "start_edge",
-                    format!(
-                        "start_edge {k} is not an index of contour (0 to {})",
-                        self.contour.len() - 1
-                    ),
+                    format!("start_edge {k} is not an index of contour (0 to {})", self.contour.len() - 1),
                 ));
             }
         };
@@ -494,25 +470,17 @@ impl ContourRequest {
         let (blend_radius, servo_time_constant_s) = match &self.controller {
             None => (None, None),
             Some(model) => (
-                model
-                    .blend_radius
-                    .map(|b| non_negative("controller.blend_radius", b))
-                    .transpose()?,
+                model.blend_radius.map(|b| non_negative("controller.blend_radius", b)).transpose()?,
                 model
                     .servo_time_constant_ms
-                    .map(|t| {
-                        non_negative("controller.servo_time_constant_ms", t).map(|t| t / 1000.0)
-                    })
+                    .map(|t| non_negative("controller.servo_time_constant_ms", t).map(|t| t / 1000.0))
                     .transpose()?,
             ),
         };
         if tilt.is_some() && tool.kind != ToolKind::Flat {
             warnings.push(Warning::new(
                 "W_TILT_TOOL_KIND",
-                format!(
-                    "tilted walls are planned with the {} tool's full radius as a cylinder",
-                    tool.kind.as_str()
-                ),
+                format!("tilted walls are planned with the {} tool's full radius as a cylinder", tool.kind.as_str()),
             ));
         }
         Ok(Job {
@@ -544,17 +512,10 @@ impl ContourRequest {
 
     fn pass_jobs(&self) -> Result<Vec<PassJob>, SolverError> {
         let Some(passes) = &self.passes else {
-            return Ok(vec![PassJob {
-                allowance: 0.0,
-                loops: true,
-                join: Join::Miter,
-            }]);
+            return Ok(vec![PassJob { allowance: 0.0, loops: true, join: Join::Miter }]);
         };
         if passes.is_empty() || passes.len() > MAX_PASSES {
-            return Err(SolverError::input(
-                "passes",
-                format!("give 1 to {MAX_PASSES} passes (got {})", passes.len()),
-            ));
+            return Err(SolverError::input("passes", format!("give 1 to {MAX_PASSES} passes (got {})", passes.len())));
         }
         let mut previous = f64::INFINITY;
         let last = passes.len() - 1;
@@ -573,37 +534,23 @@ impl ContourRequest {
                     ));
                 }
                 previous = allowance;
-                Ok(PassJob {
-                    allowance,
-                    loops: pass.loops.unwrap_or(index == last),
-                    join: pass.join,
-                })
+                Ok(PassJob { allowance, loops: pass.loops.unwrap_or(index == last), join: pass.join })
             })
             .collect()
     }
 
     fn corner_choices(&self, contour: &Contour) -> Result<Vec<CornerChoice>, SolverError> {
-        let default = CornerChoice {
-            loops: None,
-            relief: self.inside_corner_relief,
-            tbone_edge: self.tbone_edge,
-        };
+        let default = CornerChoice { loops: None, relief: self.inside_corner_relief, tbone_edge: self.tbone_edge };
         let mut choices = vec![default; contour.points.len()];
         for (position, item) in self.corner_overrides.iter().flatten().enumerate() {
             let field = format!("corner_overrides[{position}].index");
             if item.index >= self.contour.len() {
-                return Err(SolverError::input(
-                    field,
-                    format!("{} is not an index of contour", item.index),
-                ));
+                return Err(SolverError::input(field, format!("{} is not an index of contour", item.index)));
             }
             let Some(vertex) = contour.vertex_of(item.index) else {
                 return Err(SolverError::input(
                     field,
-                    format!(
-                        "contour[{}] was removed (a duplicate or collinear point): it is no corner",
-                        item.index
-                    ),
+                    format!("contour[{}] was removed (a duplicate or collinear point): it is no corner", item.index),
                 ));
             };
             let choice = &mut choices[vertex];
@@ -619,10 +566,7 @@ impl ContourRequest {
     fn tilt(&self, contour: &Contour) -> Result<Option<Vec<f64>>, SolverError> {
         let check = |field: &str, value: f64| -> Result<f64, SolverError> {
             if finite(field, value)?.abs() > MAX_TILT_DEG {
-                return Err(SolverError::input(
-                    field,
-                    format!("tilt must lie within ±{MAX_TILT_DEG}° (got {value})"),
-                ));
+                return Err(SolverError::input(field, format!("tilt must lie within ±{MAX_TILT_DEG}° (got {value})")));
             }
             Ok(value.to_radians())
         };
@@ -655,9 +599,7 @@ impl ContourRequest {
                             Some((first, first_k)) if (first - value).abs() > 1e-12 => {
                                 return Err(SolverError::input(
                                     field,
-                                    format!(
-                                        "edges {first_k} and {k} lie on one straight wall and need the same tilt"
-                                    ),
+                                    format!("edges {first_k} and {k} lie on one straight wall and need the same tilt"),
                                 ));
                             }
                             Some(_) => {}
@@ -681,24 +623,14 @@ pub(crate) fn layer_heights(top: f64, bottom: f64, step: f64) -> Result<Vec<f64>
     if count > MAX_LAYERS as f64 {
         return Err(SolverError::new(
             "E_TOO_MANY_LAYERS",
-            format!(
-                "{count} layers of at most {step} mm from {top} to {bottom}: the limit is {MAX_LAYERS}"
-            ),
+            format!("{count} layers of at most {step} mm from {top} to {bottom}: the limit is {MAX_LAYERS}"),
         )
         .at("depths.step"));
     }
     // `count` is a whole number in 1..=MAX_LAYERS here.
     let count = count as usize;
     let delta = depth / count as f64;
-    Ok((1..=count)
-        .map(|k| {
-            if k == count {
-                bottom
-            } else {
-                top - k as f64 * delta
-            }
-        })
-        .collect())
+    Ok((1..=count).map(|k| if k == count { bottom } else { top - k as f64 * delta }).collect())
 }
 
 #[cfg(test)]
@@ -707,18 +639,12 @@ mod tests {
 
     #[test]
     fn layers_are_equal_steps_ending_at_the_bottom() {
-        assert_eq!(
-            layer_heights(0.0, -6.0, 2.0).unwrap(),
-            vec![-2.0, -4.0, -6.0]
-        );
+        assert_eq!(layer_heights(0.0, -6.0, 2.0).unwrap(), vec![-2.0, -4.0, -6.0]);
         let layers = layer_heights(0.0, -5.0, 2.0).unwrap();
         assert_eq!(layers.len(), 3);
         assert!((layers[0] + 5.0 / 3.0).abs() < 1e-12);
         assert_eq!(layers[2], -5.0);
         assert_eq!(layer_heights(1.0, 1.0, 2.0).unwrap(), vec![1.0]);
-        assert_eq!(
-            layer_heights(0.0, -1e6, 1.0).unwrap_err().code(),
-            "E_TOO_MANY_LAYERS"
-        );
+        assert_eq!(layer_heights(0.0, -1e6, 1.0).unwrap_err().code(), "E_TOO_MANY_LAYERS");
     }
 }

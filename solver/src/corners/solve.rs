@@ -4,8 +4,8 @@
 //! warnings.
 
 use super::answer::{
-    ContourAnswer, ContourCorner, ContourLayer, ContourMove, ContourSummary, Convexity,
-    CornerAction, LoopReport, MaterialReport, MoveKind, PassReport, ReliefReport,
+    ContourAnswer, ContourCorner, ContourLayer, ContourMove, ContourSummary, Convexity, CornerAction, LoopReport,
+    MaterialReport, MoveKind, PassReport, ReliefReport,
 };
 use super::element::ElementKind;
 use super::layer::Layer;
@@ -78,12 +78,7 @@ pub fn plan(request: &ContourRequest, tool: &Tool) -> Result<Plan, SolverError> 
     for pass in &passes {
         warnings.extend(pass.warnings.iter().cloned());
     }
-    Ok(Plan {
-        sigma: setup.sigma,
-        z,
-        passes,
-        warnings,
-    })
+    Ok(Plan { sigma: setup.sigma, z, passes, warnings })
 }
 
 /// Solves a contour request with its resolved tool.
@@ -111,9 +106,7 @@ pub fn solve(request: &ContourRequest, tool: &Tool) -> Result<ContourAnswer, Sol
         )
         .at("depths.step"));
     }
-    if job.tilt.is_some()
-        && job.layers.len().saturating_mul(first_layer.len()) > MAX_TILTED_VERTEX_LAYERS
-    {
+    if job.tilt.is_some() && job.layers.len().saturating_mul(first_layer.len()) > MAX_TILTED_VERTEX_LAYERS {
         return Err(SolverError::new(
             "E_TOO_MANY_MOVES",
             format!(
@@ -149,31 +142,19 @@ pub fn solve(request: &ContourRequest, tool: &Tool) -> Result<ContourAnswer, Sol
             shortened = true;
         }
         lead_used = lead_used.min(lead);
-        let moves = layer_moves(
-            &job,
-            layer,
-            passes,
-            lead_point.map(|(point, _)| point),
-            index == 0,
-            previous_z,
-            z,
-        );
+        let moves = layer_moves(&job, layer, passes, lead_point.map(|(point, _)| point), index == 0, previous_z, z);
         layers.push(ContourLayer { z, moves });
         previous_z = z;
     }
     if shortened {
         warnings.push(Warning::new(
             "W_LEAD_SHORTENED",
-            format!(
-                "the lead of {} mm would gouge the contour; {lead_used:.4} mm is used",
-                job.lead
-            ),
+            format!("the lead of {} mm would gouge the contour; {lead_used:.4} mm is used", job.lead),
         ));
     }
 
-    let final_pass = first_passes
-        .last()
-        .ok_or_else(|| SolverError::new("E_INPUT", "at least one pass is needed").at("passes"))?;
+    let final_pass =
+        first_passes.last().ok_or_else(|| SolverError::new("E_INPUT", "at least one pass is needed").at("passes"))?;
     let corners = corner_reports(&job, &setup, &first_layer, final_pass);
     warnings.extend(corner_warnings(&job, &first_passes, &corners));
     let passes: Vec<PassReport> = first_passes.iter().map(pass_report).collect();
@@ -232,51 +213,22 @@ pub fn solve(request: &ContourRequest, tool: &Tool) -> Result<ContourAnswer, Sol
 
 /// The layer's contour at height `z` (tilted walls move with z).
 fn build_layer(job: &Job, setup: &Setup, z: f64) -> Result<Layer, SolverError> {
-    let shift: Option<Vec<f64>> = job.tilt.as_ref().map(|tilt| {
-        tilt.iter()
-            .map(|beta| (z - job.bottom) * beta.tan())
-            .collect()
-    });
-    Layer::new(
-        &job.contour,
-        job.start_edge,
-        setup.counter_clockwise,
-        setup.sigma,
-        shift.as_deref(),
-        setup.cell,
-    )
+    let shift: Option<Vec<f64>> =
+        job.tilt.as_ref().map(|tilt| tilt.iter().map(|beta| (z - job.bottom) * beta.tan()).collect());
+    Layer::new(&job.contour, job.start_edge, setup.counter_clockwise, setup.sigma, shift.as_deref(), setup.cell)
 }
 
 /// Every pass of one layer, each with the stock the previous one left.
 fn plan_passes(job: &Job, setup: &Setup, layer: &Layer) -> Result<Vec<PassPlan>, SolverError> {
-    let source: Vec<usize> = layer
-        .prepared_vertex
-        .iter()
-        .map(|&v| job.contour.source[v])
-        .collect();
-    let edge_source: Vec<usize> = (0..layer.len())
-        .map(|k| {
-            source[if setup.request_order {
-                k
-            } else {
-                layer.next(k)
-            }]
-        })
-        .collect();
-    let choices: Vec<_> = layer
-        .prepared_vertex
-        .iter()
-        .map(|&v| job.choices[v])
-        .collect();
+    let source: Vec<usize> = layer.prepared_vertex.iter().map(|&v| job.contour.source[v]).collect();
+    let edge_source: Vec<usize> =
+        (0..layer.len()).map(|k| source[if setup.request_order { k } else { layer.next(k) }]).collect();
+    let choices: Vec<_> = layer.prepared_vertex.iter().map(|&v| job.choices[v]).collect();
     let mut plans: Vec<PassPlan> = Vec::with_capacity(job.passes.len());
     for (index, pass) in job.passes.iter().enumerate() {
         let edge_offsets: Vec<f64> = (0..layer.len())
             .map(|k| {
-                let beta = job
-                    .tilt
-                    .as_ref()
-                    .and_then(|t| t.get(layer.prepared_edge[k]).copied())
-                    .unwrap_or(0.0);
+                let beta = job.tilt.as_ref().and_then(|t| t.get(layer.prepared_edge[k]).copied()).unwrap_or(0.0);
                 job.radius / beta.cos() + pass.allowance
             })
             .collect();
@@ -308,25 +260,14 @@ fn stock_before(job: &Job, layer: &Layer, previous: Option<&PassPlan>) -> Option
         let points: Option<Vec<Vec2>> = (0..n)
             .map(|k| {
                 let before = layer.previous(k);
-                miter_point(
-                    &layer.vertices[k],
-                    &layer.air_normal(before),
-                    allowance,
-                    &layer.air_normal(k),
-                    allowance,
-                )
+                miter_point(&layer.vertices[k], &layer.air_normal(before), allowance, &layer.air_normal(k), allowance)
             })
             .collect();
         let points = points?;
-        Some(SegmentGrid::new(
-            (0..n).map(|k| (points[k], points[(k + 1) % n])).collect(),
-            job.radius,
-        ))
+        Some(SegmentGrid::new((0..n).map(|k| (points[k], points[(k + 1) % n])).collect(), job.radius))
     };
     let Some(previous) = previous else {
-        return job.stock_allowance.and_then(sharp).map(|grid| Stock {
-            parts: vec![(grid, 0.0)],
-        });
+        return job.stock_allowance.and_then(sharp).map(|grid| Stock { parts: vec![(grid, 0.0)] });
     };
     let allowance = previous.allowance;
     let mut parts = Vec::new();
@@ -343,8 +284,7 @@ fn stock_before(job: &Job, layer: &Layer, previous: Option<&PassPlan>) -> Option
             let k = corner.k;
             let before = layer.previous(k);
             let (n1, n2) = (layer.air_normal(before), layer.air_normal(k));
-            let corner_point = miter_point(&corner.vertex, &n1, allowance, &n2, allowance)
-                .unwrap_or(corner.vertex);
+            let corner_point = miter_point(&corner.vertex, &n1, allowance, &n2, allowance).unwrap_or(corner.vertex);
             let t1 = corner.cl_point - (previous.edge_offsets[before] - allowance) * n1;
             let t2 = corner.cl_point - (previous.edge_offsets[k] - allowance) * n2;
             [(corner_point, t1), (t1, t2), (t2, corner_point)]
@@ -360,13 +300,7 @@ fn stock_before(job: &Job, layer: &Layer, previous: Option<&PassPlan>) -> Option
 fn layer_move_count(passes: &[PassPlan], tolerance: f64) -> usize {
     passes
         .iter()
-        .map(|pass| {
-            pass.elements
-                .iter()
-                .map(|e| e.chord_count(tolerance, MAX_ARC_STEPS))
-                .sum::<usize>()
-                + 2
-        })
+        .map(|pass| pass.elements.iter().map(|e| e.chord_count(tolerance, MAX_ARC_STEPS)).sum::<usize>() + 2)
         .sum::<usize>()
         + 4
 }
@@ -379,25 +313,13 @@ fn lead_point(job: &Job, layer: &Layer, passes: &[PassPlan]) -> Option<(Vec2, f6
     let edge = passes.first().map_or(0, |p| p.start_edge);
     let middle = 0.5 * (layer.vertices[edge] + layer.vertices[layer.next(edge)]);
     let normal = layer.air_normal(edge);
-    let outermost = passes
-        .iter()
-        .filter_map(|p| p.edge_offsets.get(edge).copied())
-        .fold(0.0, f64::max);
+    let outermost = passes.iter().filter_map(|p| p.edge_offsets.get(edge).copied()).fold(0.0, f64::max);
     let mut lead = job.lead;
     let mut scratch = Vec::new();
     for _ in 0..40 {
         let point = middle + (outermost + lead) * normal;
         let clear = passes.iter().all(|pass| {
-            layer
-                .grid
-                .nearest(
-                    &point,
-                    &pass.start,
-                    pass.offset - GOUGE_TOLERANCE,
-                    &mut scratch,
-                    |_| false,
-                )
-                .is_none()
+            layer.grid.nearest(&point, &pass.start, pass.offset - GOUGE_TOLERANCE, &mut scratch, |_| false).is_none()
         });
         if clear {
             return Some((point, lead));
@@ -410,10 +332,7 @@ fn lead_point(job: &Job, layer: &Layer, passes: &[PassPlan]) -> Option<(Vec2, f6
 /// Whether the straight move `[a, b]` keeps `clear` from the contour.
 fn clears(layer: &Layer, a: &Vec2, b: &Vec2, clear: f64) -> bool {
     let mut scratch = Vec::new();
-    layer
-        .grid
-        .nearest(a, b, clear - GOUGE_TOLERANCE, &mut scratch, |_| false)
-        .is_none()
+    layer.grid.nearest(a, b, clear - GOUGE_TOLERANCE, &mut scratch, |_| false).is_none()
 }
 
 /// The tool axis of traversal edge `edge`: cos β·ẑ + sin β·n(t_e) (O6).
@@ -421,11 +340,7 @@ fn axis(job: &Job, layer: &Layer, edge: usize) -> Option<Vec3> {
     let tilt = job.tilt.as_ref()?;
     let beta = tilt.get(layer.prepared_edge.get(edge).copied()?).copied()?;
     let normal = layer.air_normal(edge);
-    Some(Vec3::new(
-        beta.sin() * normal.x,
-        beta.sin() * normal.y,
-        beta.cos(),
-    ))
+    Some(Vec3::new(beta.sin() * normal.x, beta.sin() * normal.y, beta.cos()))
 }
 
 /// Every move of one layer: down from the clearance plane at the lead point, each pass with its
@@ -445,12 +360,8 @@ fn layer_moves(
     let start_axis = axis(job, layer, 0).map(|a| Box::new([a.x, a.y, a.z]));
     let at = |p: &Vec2, height: f64| [p.x, p.y, height];
     let mut moves = Vec::new();
-    let step = |kind: MoveKind, to: [f64; 3], feed: Option<f64>| ContourMove {
-        kind,
-        to,
-        feed,
-        axis: start_axis.clone(),
-    };
+    let step =
+        |kind: MoveKind, to: [f64; 3], feed: Option<f64>| ContourMove { kind, to, feed, axis: start_axis.clone() };
     let Some(first_start) = passes.first().map(|p| p.start) else {
         return Vec::new();
     };
@@ -479,11 +390,7 @@ fn layer_moves(
             }
         }
         for (element, meta) in pass.elements.iter().zip(&pass.meta) {
-            let kind = if element.kind() == ElementKind::Loop {
-                MoveKind::Loop
-            } else {
-                MoveKind::Cut
-            };
+            let kind = if element.kind() == ElementKind::Loop { MoveKind::Loop } else { MoveKind::Cut };
             let feed = if meta.fast { loop_feed } else { job.feed };
             let points = element.chord(job.tolerance, MAX_ARC_STEPS);
             let count = points.len() as f64;
@@ -495,12 +402,7 @@ fn layer_moves(
                     let mixed = (a * (1.0 - s) + b * s).try_normalize(0.0).unwrap_or(b);
                     Box::new([mixed.x, mixed.y, mixed.z])
                 });
-                moves.push(ContourMove {
-                    kind,
-                    to: at(point, z),
-                    feed: Some(feed),
-                    axis,
-                });
+                moves.push(ContourMove { kind, to: at(point, z), feed: Some(feed), axis });
             }
         }
         here = pass.start;
@@ -514,12 +416,7 @@ fn layer_moves(
             here = lead;
         }
     }
-    moves.push(ContourMove {
-        kind: MoveKind::Rapid,
-        to: at(&here, job.safe_z),
-        feed: None,
-        axis: start_axis,
-    });
+    moves.push(ContourMove { kind: MoveKind::Rapid, to: at(&here, job.safe_z), feed: None, axis: start_axis });
     moves
 }
 
@@ -547,15 +444,8 @@ fn material_report(material: &Material) -> MaterialReport {
 }
 
 /// The corner reports from the final pass of the first layer, in request order.
-fn corner_reports(
-    job: &Job,
-    setup: &Setup,
-    layer: &Layer,
-    final_pass: &PassPlan,
-) -> Vec<ContourCorner> {
-    let lag_product = job
-        .servo_time_constant_s
-        .map(|t| (job.feed / 60.0 * t).powi(2));
+fn corner_reports(job: &Job, setup: &Setup, layer: &Layer, final_pass: &PassPlan) -> Vec<ContourCorner> {
+    let lag_product = job.servo_time_constant_s.map(|t| (job.feed / 60.0 * t).powi(2));
     let model = job.blend_radius.is_some() || lag_product.is_some();
     let mut corners: Vec<ContourCorner> = final_pass
         .corners
@@ -563,12 +453,8 @@ fn corner_reports(
         .map(|corner| {
             let ideal = if corner.action == Action::Unreached {
                 if corner.chain_start == corner.k {
-                    let chain: Vec<usize> = final_pass
-                        .corners
-                        .iter()
-                        .filter(|c| c.chain_start == corner.k)
-                        .map(|c| c.k)
-                        .collect();
+                    let chain: Vec<usize> =
+                        final_pass.corners.iter().filter(|c| c.chain_start == corner.k).map(|c| c.k).collect();
                     material::unreached(layer, &corner.cl_point, &chain, job.radius)
                 } else {
                     Material::default()
@@ -577,14 +463,7 @@ fn corner_reports(
                 material::ideal(layer, corner, job.radius)
             };
             let predicted = model.then(|| {
-                material::predicted(
-                    corner,
-                    &ideal,
-                    job.radius,
-                    final_pass.offset,
-                    job.blend_radius,
-                    lag_product,
-                )
+                material::predicted(corner, &ideal, job.radius, final_pass.offset, job.blend_radius, lag_product)
             });
             let corner_loop = corner.loop_shape.map(|shape| LoopReport {
                 style: shape.style,
@@ -603,11 +482,7 @@ fn corner_reports(
                 style: shape.style,
                 target: array2(&shape.target),
                 along_edge: shape.along_edge.map(|edge| {
-                    let start = if setup.request_order {
-                        edge
-                    } else {
-                        layer.next(edge)
-                    };
+                    let start = if setup.request_order { edge } else { layer.next(edge) };
                     job.contour.source[layer.prepared_vertex[start]]
                 }),
             });
@@ -616,11 +491,7 @@ fn corner_reports(
                 vertex: array2(&job.contour.points[layer.prepared_vertex[corner.k]]),
                 angle_deg: corner.material_angle.to_degrees(),
                 turn_deg: corner.turn.to_degrees(),
-                convexity: if corner.convex {
-                    Convexity::Convex
-                } else {
-                    Convexity::Concave
-                },
+                convexity: if corner.convex { Convexity::Convex } else { Convexity::Concave },
                 looped: corner.loop_shape.is_some(),
                 action: corner_action(corner.action),
                 cl_point: array2(&corner.cl_point),
@@ -661,9 +532,7 @@ fn corner_warnings(job: &Job, passes: &[PassPlan], corners: &[ContourCorner]) ->
         let flat: Vec<usize> = final_pass
             .corners
             .iter()
-            .filter(|c| {
-                c.convex && c.turn.abs() < job.loop_config.min_turn && c.loop_shape.is_none()
-            })
+            .filter(|c| c.convex && c.turn.abs() < job.loop_config.min_turn && c.loop_shape.is_none())
             .map(|c| c.source)
             .collect();
         if !flat.is_empty() {
@@ -678,15 +547,9 @@ fn corner_warnings(job: &Job, passes: &[PassPlan], corners: &[ContourCorner]) ->
             ));
         }
     }
-    let inside: Vec<&ContourCorner> = corners
-        .iter()
-        .filter(|c| c.action == CornerAction::Reflex)
-        .collect();
+    let inside: Vec<&ContourCorner> = corners.iter().filter(|c| c.action == CornerAction::Reflex).collect();
     if !inside.is_empty() {
-        let largest = inside
-            .iter()
-            .map(|c| c.material.left_area)
-            .fold(0.0, f64::max);
+        let largest = inside.iter().map(|c| c.material.left_area).fold(0.0, f64::max);
         let indices: Vec<usize> = inside.iter().map(|c| c.index).collect();
         warnings.push(Warning::new(
             "W_INSIDE_CORNER",
@@ -700,12 +563,8 @@ fn corner_warnings(job: &Job, passes: &[PassPlan], corners: &[ContourCorner]) ->
     }
     if job.loop_feed.is_some_and(|f| f != job.feed) {
         for pass in passes {
-            let slow: Vec<usize> = pass
-                .corners
-                .iter()
-                .filter(|c| c.loop_shape.is_some() && !c.loop_feed)
-                .map(|c| c.source)
-                .collect();
+            let slow: Vec<usize> =
+                pass.corners.iter().filter(|c| c.loop_shape.is_some() && !c.loop_feed).map(|c| c.source).collect();
             if !slow.is_empty() {
                 let reason = if pass.index == 0 && job.stock_allowance.is_none() {
                     "the stock before the first pass is unknown (give stock_allowance)"
@@ -724,9 +583,7 @@ fn corner_warnings(job: &Job, passes: &[PassPlan], corners: &[ContourCorner]) ->
             }
         }
     }
-    let lag_product = job
-        .servo_time_constant_s
-        .map(|t| (job.feed / 60.0 * t).powi(2));
+    let lag_product = job.servo_time_constant_s.map(|t| (job.feed / 60.0 * t).powi(2));
     for pass in passes.iter().take(passes.len().saturating_sub(1)) {
         let mut needed: f64 = 0.0;
         for corner in pass.corners.iter().filter(|c| c.convex) {
@@ -773,11 +630,7 @@ fn pass_report(pass: &PassPlan) -> PassReport {
         loops: pass.loops,
         join: pass.join,
         start: array2(&pass.start),
-        looped_corners: pass
-            .corners
-            .iter()
-            .filter(|c| c.loop_shape.is_some())
-            .count(),
+        looped_corners: pass.corners.iter().filter(|c| c.loop_shape.is_some()).count(),
         cut_length: length(&[ElementKind::Cut]),
         leg_length: length(&[ElementKind::Exit, ElementKind::Entry]),
         loop_length: length(&[ElementKind::Loop]),
@@ -811,15 +664,7 @@ fn describe(job: &Job, summary: &ContourSummary) -> Vec<String> {
             job.top,
             job.bottom
         ),
-        format!(
-            "{} R {} corner loops {style}, {} passes",
-            job.tool.kind.as_str(),
-            job.radius,
-            summary.passes
-        ),
-        format!(
-            "feed {} mm/min loop feed {} mm/min spindle {} rpm",
-            job.feed, summary.loop_feed, job.spindle_rpm
-        ),
+        format!("{} R {} corner loops {style}, {} passes", job.tool.kind.as_str(), job.radius, summary.passes),
+        format!("feed {} mm/min loop feed {} mm/min spindle {} rpm", job.feed, summary.loop_feed, job.spindle_rpm),
     ]
 }

@@ -26,7 +26,7 @@ mod tolerance;
 
 pub use answer::{Deburr, DeburrPoint, DeburrSummary, LeadMotion, LeadMove};
 pub use diagnostics::{ExactConstruction, PointConstruction, construction_at};
-pub use program::{Post, program};
+pub use program::program;
 pub use request::{CentreDistance, DeburrRequest, Direction, Edge, Hole, HoleShape, Method, Workpiece};
 
 use centre::{Construction, RidgeCentre};

@@ -10,20 +10,9 @@ use super::answer::{Deburr, LeadMotion, LeadMove};
 use super::frame::Frame;
 use super::request::{Edge, Job};
 use crate::error::SolverError;
-use crate::gcode::{self, Dialect, Program, Reference, ToolCall};
+use crate::gcode::{self, Post, Program, Reference};
 use crate::geometry::{Vec3, array3, vec3};
 use crate::path::Toolpath;
-
-/// How to post the program.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Post {
-    /// Control dialect.
-    pub dialect: Dialect,
-    /// Programmed point: tip or ball centre.
-    pub reference: Reference,
-    /// Tool selection.
-    pub tool: ToolCall,
-}
 
 /// Z of the ball centre on the clearance plane, or why it is unknown.
 pub(crate) fn safe_centre_z(job: &Job, frame: &Frame) -> Result<f64, SolverError> {

@@ -69,6 +69,17 @@ impl ToolCall {
     }
 }
 
+/// How a caller wants a capability's program written: every `program(answer, &Post)` takes one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Post {
+    /// Control dialect.
+    pub dialect: Dialect,
+    /// Programmed point: tip or centre.
+    pub reference: Reference,
+    /// Tool selection.
+    pub tool: ToolCall,
+}
+
 /// Everything the post needs besides the path.
 #[derive(Debug, Clone)]
 pub struct Program<'a> {

@@ -10,13 +10,7 @@ use super::{Vec2, direction};
 /// at the crossing of the tangents of each sub-arc's ends (at radius `R / cos(Δ/2)`), and the
 /// arc's exact end point last. `n` is the smallest count keeping that outward deviation within
 /// `max_error` (at least 1), capped at `max_steps`.
-pub fn circumscribed_arc(
-    centre: &Vec2,
-    start: &Vec2,
-    sweep: f64,
-    max_error: f64,
-    max_steps: usize,
-) -> Vec<Vec2> {
+pub fn circumscribed_arc(centre: &Vec2, start: &Vec2, sweep: f64, max_error: f64, max_steps: usize) -> Vec<Vec2> {
     let radius = (start - centre).norm();
     let start_angle = (start.y - centre.y).atan2(start.x - centre.x);
     let end = centre + radius * direction(start_angle + sweep);
@@ -26,9 +20,8 @@ pub fn circumscribed_arc(
     let steps = arc_steps(radius, sweep, max_error).min(max_steps.max(1));
     let step = sweep / steps as f64;
     let outer = radius / (0.5 * step).cos();
-    let mut points: Vec<Vec2> = (0..steps)
-        .map(|k| centre + outer * direction(start_angle + (k as f64 + 0.5) * step))
-        .collect();
+    let mut points: Vec<Vec2> =
+        (0..steps).map(|k| centre + outer * direction(start_angle + (k as f64 + 0.5) * step)).collect();
     points.push(end);
     points
 }
@@ -36,12 +29,8 @@ pub fn circumscribed_arc(
 /// Sub-arcs needed so that the circumscribed polyline stays within `max_error` of the arc:
 /// `R (1/cos(Δ/2) − 1) ≤ max_error`, and at most 120° per sub-arc.
 pub fn arc_steps(radius: f64, sweep: f64, max_error: f64) -> usize {
-    let max_step = if max_error > 0.0 && radius > 0.0 {
-        2.0 * (radius / (radius + max_error)).acos()
-    } else {
-        0.0
-    }
-    .min(std::f64::consts::TAU / 3.0);
+    let max_step = if max_error > 0.0 && radius > 0.0 { 2.0 * (radius / (radius + max_error)).acos() } else { 0.0 }
+        .min(std::f64::consts::TAU / 3.0);
     if max_step <= 0.0 {
         return 1;
     }
@@ -61,11 +50,7 @@ mod tests {
         let centre = Vec2::new(22.0, -2.0);
         let start = Vec2::new(22.0, -1.0);
         let points = circumscribed_arc(&centre, &start, -1.5 * PI, 0.01, 10_000);
-        assert_abs_diff_eq!(
-            *points.last().unwrap(),
-            Vec2::new(21.0, -2.0),
-            epsilon = 1e-12
-        );
+        assert_abs_diff_eq!(*points.last().unwrap(), Vec2::new(21.0, -2.0), epsilon = 1e-12);
         let mut previous = start;
         for point in &points {
             let nearest = point_segment_distance(&centre, &previous, point);

@@ -77,21 +77,14 @@ pub fn capsule_convex_area(a: &Vec2, b: &Vec2, radius: f64, convex: &[Vec2]) -> 
     }
     let u = axis / length;
     let w = Vec2::new(-u.y, u.x);
-    let rectangle = [
-        a - radius * w,
-        b - radius * w,
-        b + radius * w,
-        a + radius * w,
-    ];
+    let rectangle = [a - radius * w, b - radius * w, b + radius * w, a + radius * w];
     let mut middle = convex.to_vec();
     for (point, normal) in [(a, u), (b, -u), (&rectangle[0], w), (&rectangle[2], -w)] {
         middle = clip_half_plane(&middle, point, &normal);
     }
     let behind_a = clip_half_plane(convex, a, &(-u));
     let beyond_b = clip_half_plane(convex, b, &u);
-    signed_area(&middle).abs()
-        + disk_polygon_area(a, radius, &behind_a)
-        + disk_polygon_area(b, radius, &beyond_b)
+    signed_area(&middle).abs() + disk_polygon_area(a, radius, &behind_a) + disk_polygon_area(b, radius, &beyond_b)
 }
 
 #[cfg(test)]
@@ -101,74 +94,33 @@ mod tests {
     use std::f64::consts::PI;
 
     fn square(half: f64) -> Vec<Vec2> {
-        vec![
-            Vec2::new(-half, -half),
-            Vec2::new(half, -half),
-            Vec2::new(half, half),
-            Vec2::new(-half, half),
-        ]
+        vec![Vec2::new(-half, -half), Vec2::new(half, -half), Vec2::new(half, half), Vec2::new(-half, half)]
     }
 
     #[test]
     fn disk_areas_inside_partial_and_outside() {
-        assert_abs_diff_eq!(
-            disk_polygon_area(&Vec2::zeros(), 1.0, &square(5.0)),
-            PI,
-            epsilon = 1e-12
-        );
+        assert_abs_diff_eq!(disk_polygon_area(&Vec2::zeros(), 1.0, &square(5.0)), PI, epsilon = 1e-12);
         // A quarter disk: the square's corner at the centre.
-        let quarter = vec![
-            Vec2::zeros(),
-            Vec2::new(5.0, 0.0),
-            Vec2::new(5.0, 5.0),
-            Vec2::new(0.0, 5.0),
-        ];
-        assert_abs_diff_eq!(
-            disk_polygon_area(&Vec2::zeros(), 2.0, &quarter),
-            PI,
-            epsilon = 1e-12
-        );
+        let quarter = vec![Vec2::zeros(), Vec2::new(5.0, 0.0), Vec2::new(5.0, 5.0), Vec2::new(0.0, 5.0)];
+        assert_abs_diff_eq!(disk_polygon_area(&Vec2::zeros(), 2.0, &quarter), PI, epsilon = 1e-12);
         // Half-plane through the centre, clockwise polygon.
-        let mut half: Vec<Vec2> = vec![
-            Vec2::new(-5.0, 0.0),
-            Vec2::new(5.0, 0.0),
-            Vec2::new(5.0, 5.0),
-            Vec2::new(-5.0, 5.0),
-        ];
+        let mut half: Vec<Vec2> =
+            vec![Vec2::new(-5.0, 0.0), Vec2::new(5.0, 0.0), Vec2::new(5.0, 5.0), Vec2::new(-5.0, 5.0)];
         half.reverse();
-        assert_abs_diff_eq!(
-            disk_polygon_area(&Vec2::zeros(), 1.0, &half),
-            PI / 2.0,
-            epsilon = 1e-12
-        );
+        assert_abs_diff_eq!(disk_polygon_area(&Vec2::zeros(), 1.0, &half), PI / 2.0, epsilon = 1e-12);
         // Circle segment of height 0.5 on a unit disk.
         let cut = clip_half_plane(&square(5.0), &Vec2::new(0.5, 0.0), &Vec2::x());
         let expected = (0.5_f64).acos() - 0.5 * (1.0 - 0.25_f64).sqrt();
-        assert_abs_diff_eq!(
-            disk_polygon_area(&Vec2::zeros(), 1.0, &cut),
-            expected,
-            epsilon = 1e-12
-        );
-        assert_abs_diff_eq!(
-            disk_polygon_area(&Vec2::new(20.0, 0.0), 1.0, &square(5.0)),
-            0.0
-        );
+        assert_abs_diff_eq!(disk_polygon_area(&Vec2::zeros(), 1.0, &cut), expected, epsilon = 1e-12);
+        assert_abs_diff_eq!(disk_polygon_area(&Vec2::new(20.0, 0.0), 1.0, &square(5.0)), 0.0);
     }
 
     #[test]
     fn capsule_area_is_rectangle_plus_disk() {
         let a = Vec2::new(-1.0, 0.0);
         let b = Vec2::new(1.0, 0.0);
-        assert_abs_diff_eq!(
-            capsule_convex_area(&a, &b, 0.5, &square(10.0)),
-            2.0 + PI * 0.25,
-            epsilon = 1e-12
-        );
+        assert_abs_diff_eq!(capsule_convex_area(&a, &b, 0.5, &square(10.0)), 2.0 + PI * 0.25, epsilon = 1e-12);
         let upper = clip_half_plane(&square(10.0), &Vec2::zeros(), &Vec2::y());
-        assert_abs_diff_eq!(
-            capsule_convex_area(&a, &b, 0.5, &upper),
-            1.0 + PI * 0.125,
-            epsilon = 1e-12
-        );
+        assert_abs_diff_eq!(capsule_convex_area(&a, &b, 0.5, &upper), 1.0 + PI * 0.125, epsilon = 1e-12);
     }
 }

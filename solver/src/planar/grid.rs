@@ -49,28 +49,17 @@ impl SegmentGrid {
             let middle = lengths.len() / 2;
             *lengths.select_nth_unstable_by(middle, f64::total_cmp).1
         };
-        let mut cell = min_cell
-            .max(median)
-            .max(extent / MAX_CELLS_PER_AXIS)
-            .max(1e-9);
+        let mut cell = min_cell.max(median).max(extent / MAX_CELLS_PER_AXIS).max(1e-9);
         let budget = 16.0 * segments.len() as f64 + 4096.0;
         loop {
-            let estimate: f64 = segments
-                .iter()
-                .map(|(a, b)| ((b.x - a.x).abs() + (b.y - a.y).abs()) / cell + 4.0)
-                .sum();
+            let estimate: f64 =
+                segments.iter().map(|(a, b)| ((b.x - a.x).abs() + (b.y - a.y).abs()) / cell + 4.0).sum();
             if estimate <= budget {
                 break;
             }
             cell *= 2.0;
         }
-        let mut grid = Self {
-            segments,
-            origin: low,
-            cell,
-            keys: Vec::new(),
-            items: Vec::new(),
-        };
+        let mut grid = Self { segments, origin: low, cell, keys: Vec::new(), items: Vec::new() };
         let pad = cell * 1e-9;
         let mut entries: Vec<(u64, u32)> = Vec::new();
         for (index, (a, b)) in grid.segments.iter().enumerate() {
@@ -152,20 +141,14 @@ impl SegmentGrid {
         self.visit(a, b, radius, |index| {
             let (c, d) = self.segments[index];
             // Bounding boxes farther apart than the radius cannot hold a closer pair.
-            if c.x.max(d.x) < low.x
-                || c.x.min(d.x) > high.x
-                || c.y.max(d.y) < low.y
-                || c.y.min(d.y) > high.y
-            {
+            if c.x.max(d.x) < low.x || c.x.min(d.x) > high.x || c.y.max(d.y) < low.y || c.y.min(d.y) > high.y {
                 return;
             }
             if best.is_some_and(|(_, i)| i == index) || skip(index) {
                 return;
             }
             let distance = segment_segment_distance(a, b, &c, &d);
-            if distance <= radius
-                && best.is_none_or(|(d0, i0)| distance < d0 || (distance == d0 && index < i0))
-            {
+            if distance <= radius && best.is_none_or(|(d0, i0)| distance < d0 || (distance == d0 && index < i0)) {
                 best = Some((distance, index));
             }
         });
@@ -216,9 +199,7 @@ fn key(column: u32, row: u32) -> u64 {
 ///
 /// # Errors
 /// [`GridBudgetExceeded`] when more than `64·n + 10⁶` edge pairs would need testing.
-pub fn find_self_intersection(
-    polygon: &[Vec2],
-) -> Result<Option<(usize, usize)>, GridBudgetExceeded> {
+pub fn find_self_intersection(polygon: &[Vec2]) -> Result<Option<(usize, usize)>, GridBudgetExceeded> {
     let n = polygon.len();
     if n < 3 {
         return Ok(None);
@@ -307,31 +288,10 @@ mod tests {
         ];
         let grid = SegmentGrid::new(segments, 1.0);
         let mut scratch = Vec::new();
-        let found = grid.nearest(
-            &Vec2::new(5.0, 1.0),
-            &Vec2::new(6.0, 1.0),
-            5.0,
-            &mut scratch,
-            |_| false,
-        );
+        let found = grid.nearest(&Vec2::new(5.0, 1.0), &Vec2::new(6.0, 1.0), 5.0, &mut scratch, |_| false);
         assert_eq!(found, Some((1.0, 0)));
-        let skipped = grid.nearest(
-            &Vec2::new(5.0, 1.0),
-            &Vec2::new(6.0, 1.0),
-            5.0,
-            &mut scratch,
-            |i| i == 0,
-        );
+        let skipped = grid.nearest(&Vec2::new(5.0, 1.0), &Vec2::new(6.0, 1.0), 5.0, &mut scratch, |i| i == 0);
         assert_eq!(skipped, Some((2.0, 1)));
-        assert!(
-            grid.nearest(
-                &Vec2::new(30.0, 30.0),
-                &Vec2::new(31.0, 30.0),
-                5.0,
-                &mut scratch,
-                |_| false
-            )
-            .is_none()
-        );
+        assert!(grid.nearest(&Vec2::new(30.0, 30.0), &Vec2::new(31.0, 30.0), 5.0, &mut scratch, |_| false).is_none());
     }
 }
