@@ -1,0 +1,428 @@
+//! Segmentation with C_ep (chord.md §2.9): greedy maximal chords (first crossing), the
+//! per-window procedure of embodiments 1, 2 and 6 (Fig. 7/8, S101–S108) with carry-over and the
+//! progress rule, and the single-value run of embodiments 3–5 and of fixed-tolerance baselines.
+//! Paths are split at corners (E11): every corner is a command point and starts fresh windows.
+
+use super::numeric::last_fitting;
+use super::rule::{BlockRule, ChordStatus, Infeasible, chord_length};
+use super::shape::{Shape, circumradius};
+use crate::error::SolverError;
+use crate::geometry::Vec3;
+
+/// Slack on the chord error when testing a chord (chord.md §2.9: eps = 1e-12 mm).
+const EPS: f64 = 1e-12;
+/// Width (mm of arc length) to which the crossing is bracketed.
+const CROSSING_WIDTH: f64 = 1e-12;
+/// Fixed steps before the search for the crossing starts doubling its step (long straights).
+const STEPS_BEFORE_GALLOP: usize = 32;
+/// A chord shorter than this (mm) means the search made no progress (E14).
+const MIN_PROGRESS: f64 = 1e-9;
+/// Slack on window ends (chord.md §2.9: s1 + 1e-12).
+const WINDOW_SLACK: f64 = 1e-12;
+
+/// A command point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Vertex {
+    /// Curve parameter.
+    pub u: f64,
+    /// Arc length from the curve start, mm.
+    pub s: f64,
+    /// P(u).
+    pub point: Vec3,
+}
+
+/// How a window's chord error was chosen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Status {
+    Surface,
+    Straight,
+    ClampedToMin,
+    LimitedByTolerance,
+}
+
+/// One window of constant chord error.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct WindowRecord {
+    pub s_start: f64,
+    pub s_end: f64,
+    /// Radius the chord error came from (infinite when straight).
+    pub radius: f64,
+    /// C_ep before the accuracy bound.
+    pub rule_chord_error: f64,
+    /// Chord error used for the chords.
+    pub chord_error: f64,
+    pub status: Status,
+    /// The radius estimate exceeds the smallest radius inside the window by this factor (E10).
+    pub spread: f64,
+    pub blocks: usize,
+}
+
+/// The result of a cut: command points, windows, and which blocks end a span (a corner or the
+/// path end).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct Cut {
+    pub vertices: Vec<Vertex>,
+    pub windows: Vec<WindowRecord>,
+    /// Block indices (block i runs from vertex i to i + 1) that end at a corner or the path end.
+    pub span_ends: Vec<usize>,
+}
+
+/// How the window radius is estimated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Estimate {
+    /// Circumradius of P(s0), P(sm), P(s1) (chord.md §2.8, the patent).
+    ThreePoint,
+    /// Smallest radius over the window and the reach of its first chord.
+    Minimum,
+}
+
+/// Where a failure happened: E3 with its arc length.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct InfeasibleAt {
+    pub s: f64,
+    pub infeasible: Infeasible,
+}
+
+/// Why a cut stopped.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum CutError {
+    Infeasible(InfeasibleAt),
+    Solver(SolverError),
+}
+
+impl From<SolverError> for CutError {
+    fn from(error: SolverError) -> Self {
+        Self::Solver(error)
+    }
+}
+
+/// The segmentation of one curve under a block limit.
+pub(crate) struct Cutter<'a> {
+    pub shape: &'a Shape,
+    /// Parameter ranges between corners, in order.
+    pub spans: &'a [(f64, f64)],
+    /// Most blocks before `E_TOO_MANY_BLOCKS`.
+    pub max_blocks: usize,
+    /// Field blamed when the limit is hit.
+    pub limit_field: &'a str,
+}
+
+impl Cutter<'_> {
+    /// dev(u_a, u_b) > C + eps?
+    fn exceeds(&self, ua: f64, ub: f64, chord_error: f64) -> bool {
+        self.shape.deviation(ua, ub) > chord_error + EPS
+    }
+
+    fn vertex(&self, u: f64) -> Vertex {
+        Vertex {
+            u,
+            s: self.shape.s_at(u),
+            point: self.shape.point(u),
+        }
+    }
+
+    /// `greedy_end` of chord.md §2.9: the end of the longest chord from `start` whose deviation
+    /// stays within `chord_error` (the first crossing), searched in steps of `step_guess/4` of
+    /// arc length up to `limit`.
+    fn greedy_end(
+        &self,
+        start: &Vertex,
+        chord_error: f64,
+        limit: &Vertex,
+        step_guess: f64,
+    ) -> Result<Vertex, SolverError> {
+        let quarter = step_guess / 4.0;
+        if limit.s - start.s <= quarter && !self.exceeds(start.u, limit.u, chord_error) {
+            return Ok(*limit);
+        }
+        let mut step = quarter.max(1e-9);
+        let (mut lo_u, mut lo_s) = (start.u, start.s);
+        let mut steps = 0;
+        let (hi_u, hi_s) = loop {
+            let hi_s = (lo_s + step).min(limit.s);
+            let hi_u = if hi_s >= limit.s {
+                limit.u
+            } else {
+                self.shape.u_at(hi_s)
+            };
+            if self.exceeds(start.u, hi_u, chord_error) {
+                break (hi_u, hi_s);
+            }
+            if hi_s >= limit.s {
+                return Ok(*limit);
+            }
+            (lo_u, lo_s) = (hi_u, hi_s);
+            steps += 1;
+            if steps >= STEPS_BEFORE_GALLOP {
+                step *= 2.0;
+            }
+        };
+        let g = |u: f64| self.shape.deviation(start.u, u) - chord_error - EPS;
+        // Bracket to 1e-12 mm of arc length: convert with the bracket's mean speed.
+        let speed = (hi_s - lo_s) / (hi_u - lo_u).abs().max(f64::MIN_POSITIVE);
+        let tol = (CROSSING_WIDTH / speed.max(f64::MIN_POSITIVE)).max(f64::MIN_POSITIVE);
+        let end = last_fitting(g, lo_u, g(lo_u), hi_u, g(hi_u), tol).ok_or_else(|| {
+            SolverError::new(
+                "E_NUMERIC_FAILURE",
+                format!(
+                    "the chord search did not converge at s = {:.6} mm (E14)",
+                    start.s
+                ),
+            )
+            .at("curve")
+        })?;
+        Ok(self.vertex(end))
+    }
+
+    fn push(&self, cut: &mut Cut, vertex: Vertex) -> Result<(), SolverError> {
+        if cut.vertices.len() > self.max_blocks {
+            return Err(SolverError::new(
+                "E_TOO_MANY_BLOCKS",
+                format!(
+                    "the segmentation needs more than {} blocks; raise the chord error (feed, margin, \
+                     min_chord_error or tolerance) or shorten the curve",
+                    self.max_blocks
+                ),
+            )
+            .at(self.limit_field));
+        }
+        if let Some(last) = cut.vertices.last()
+            && vertex.s - last.s < MIN_PROGRESS
+            && vertex.u != last.u
+        {
+            return Err(SolverError::new(
+                "E_NUMERIC_FAILURE",
+                format!(
+                    "no chord longer than {MIN_PROGRESS} mm fits at s = {:.6} mm: the chord error is too small for \
+                     the curve here (E14)",
+                    last.s
+                ),
+            )
+            .at("curve"));
+        }
+        cut.vertices.push(vertex);
+        Ok(())
+    }
+
+    fn start(&self) -> Option<Cut> {
+        let &(first, _) = self.spans.first()?;
+        Some(Cut {
+            vertices: vec![self.vertex(first)],
+            ..Cut::default()
+        })
+    }
+
+    /// Embodiments 3–5 and fixed tolerances: one chord error for the whole curve. `radius` is
+    /// the radius it came from (for the step guess; infinite when unknown or straight).
+    pub(crate) fn constant(&self, chord_error: f64, radius: f64) -> Result<Cut, SolverError> {
+        let Some(mut cut) = self.start() else {
+            return Ok(Cut::default());
+        };
+        for &(u_start, u_end) in self.spans {
+            let mut from = self.vertex(u_start);
+            let limit = self.vertex(u_end);
+            let guess = step_guess(radius, chord_error, limit.s - from.s);
+            while from.s < limit.s && from.u != limit.u {
+                let next = self.greedy_end(&from, chord_error, &limit, guess)?;
+                self.push(&mut cut, next)?;
+                from = next;
+            }
+            cut.span_ends.push(cut.vertices.len().saturating_sub(2));
+        }
+        Ok(cut)
+    }
+
+    /// Radius estimates of windows of length `window` laid end to end along every span
+    /// (embodiment 3, Eq. 10: the chord error is the largest over these), with the arc length
+    /// where each window starts.
+    pub(crate) fn tiled_radii(
+        &self,
+        window: f64,
+        estimate: Estimate,
+        scale: f64,
+    ) -> Result<Vec<(f64, f64)>, SolverError> {
+        let mut out = Vec::new();
+        for &(u_start, u_end) in self.spans {
+            let (s_start, s_end) = (self.shape.s_at(u_start), self.shape.s_at(u_end));
+            let count = ((s_end - s_start) / window).ceil().max(1.0);
+            if out.len() as f64 + count > self.max_blocks as f64 {
+                return Err(SolverError::new(
+                    "E_TOO_MANY_BLOCKS",
+                    format!(
+                        "windows of {window} mm cut this curve into more than {} pieces; lengthen the window",
+                        self.max_blocks
+                    ),
+                )
+                .at("window"));
+            }
+            let count = count as usize;
+            for k in 0..count {
+                let s0 = s_start + window * k as f64;
+                let s1 = (s0 + window).min(s_end);
+                let (u0, u1) = (self.shape.u_at(s0), self.shape.u_at(s1));
+                let radius = match estimate {
+                    Estimate::ThreePoint => circumradius(
+                        &self.shape.point(u0),
+                        &self.shape.point(self.shape.u_at(0.5 * (s0 + s1))),
+                        &self.shape.point(u1),
+                    ),
+                    Estimate::Minimum => self.shape.min_radius(u0, u1, scale).0,
+                };
+                out.push((s0, radius));
+            }
+        }
+        Ok(out)
+    }
+
+    /// Embodiments 1, 2 and 6: the per-window procedure (chord.md §2.9, normative version).
+    /// `chord_error_of(radius)` is the rule (with the accuracy bound applied by the caller's
+    /// `tolerance`); `window` is Δs.
+    pub(crate) fn windows(
+        &self,
+        rule: &BlockRule,
+        tolerance: Option<f64>,
+        window: f64,
+        estimate: Estimate,
+    ) -> Result<Cut, CutError> {
+        let Some(mut cut) = self.start() else {
+            return Ok(Cut::default());
+        };
+        let scale = rule.target_chord();
+        for &(u_start, u_end) in self.spans {
+            let span_end = self.vertex(u_end);
+            let (s_end, mut s0) = (span_end.s, self.shape.s_at(u_start));
+            let mut from = self.vertex(u_start);
+            let mut s1 = s0 + window;
+            let mut last_window = false;
+            if s1 >= s_end {
+                (s1, last_window) = (s_end, true);
+            }
+            loop {
+                let u0 = from.u;
+                let u1 = if last_window {
+                    u_end
+                } else {
+                    self.shape.u_at(s1)
+                };
+                let three_point = {
+                    let middle = self.shape.point(self.shape.u_at(0.5 * (s0 + s1)));
+                    circumradius(&from.point, &middle, &self.shape.point(u1))
+                };
+                let (smallest, _) = self.shape.min_radius(u0, u1, scale);
+                let spread = if three_point.is_finite() {
+                    three_point / smallest
+                } else if smallest.is_finite() {
+                    f64::INFINITY
+                } else {
+                    1.0
+                };
+                let radius = match estimate {
+                    Estimate::ThreePoint => three_point,
+                    Estimate::Minimum => self.reach_radius(rule, smallest, s0, s1, u0, s_end)?,
+                };
+                let (rule_chord_error, surface) =
+                    rule.chord_error(radius).map_err(|infeasible| {
+                        CutError::Infeasible(InfeasibleAt { s: s0, infeasible })
+                    })?;
+                let (chord_error, status) = classify(rule_chord_error, surface, radius, tolerance);
+                let guess = step_guess(radius, chord_error, window);
+                let mut blocks = 0;
+                let limit = span_end;
+                while from.s < s_end && from.u != u_end {
+                    let next = self.greedy_end(&from, chord_error, &limit, guess)?;
+                    let beyond = next.s > s1 + WINDOW_SLACK && !last_window;
+                    if beyond && blocks > 0 {
+                        break; // carry over: the next window starts at the last command point
+                    }
+                    self.push(&mut cut, next)?;
+                    from = next;
+                    blocks += 1;
+                    if beyond {
+                        break; // progress rule
+                    }
+                }
+                cut.windows.push(WindowRecord {
+                    s_start: s0,
+                    s_end: s1,
+                    radius,
+                    rule_chord_error,
+                    chord_error,
+                    status,
+                    spread,
+                    blocks,
+                });
+                if last_window || from.s >= s_end || from.u == u_end {
+                    break;
+                }
+                s0 = from.s;
+                s1 = s0 + window;
+                if s1 >= s_end {
+                    (s1, last_window) = (s_end, true);
+                }
+            }
+            cut.span_ends.push(cut.vertices.len().saturating_sub(2));
+        }
+        Ok(cut)
+    }
+
+    /// The smallest radius over the window and over the reach of a chord cut with it, so that
+    /// the first chord (which may run past the window, progress rule) also sees every bend.
+    fn reach_radius(
+        &self,
+        rule: &BlockRule,
+        window_radius: f64,
+        s0: f64,
+        s1: f64,
+        u0: f64,
+        s_end: f64,
+    ) -> Result<f64, CutError> {
+        let mut radius = window_radius;
+        for _ in 0..8 {
+            let (chord_error, _) = rule
+                .chord_error(radius)
+                .map_err(|infeasible| CutError::Infeasible(InfeasibleAt { s: s0, infeasible }))?;
+            let reach = (s0 + 1.05 * chord_length(radius, chord_error)).min(s_end);
+            if reach <= s1 {
+                break;
+            }
+            let (wider, _) = self
+                .shape
+                .min_radius(u0, self.shape.u_at(reach), rule.target_chord());
+            if wider >= radius {
+                break;
+            }
+            radius = wider;
+        }
+        Ok(radius)
+    }
+}
+
+/// The chord error a window cuts with and why.
+pub(crate) fn classify(
+    rule_chord_error: f64,
+    surface: ChordStatus,
+    radius: f64,
+    tolerance: Option<f64>,
+) -> (f64, Status) {
+    if let Some(limit) = tolerance
+        && rule_chord_error > limit
+    {
+        return (limit, Status::LimitedByTolerance);
+    }
+    let status = match surface {
+        ChordStatus::ClampedToMin => Status::ClampedToMin,
+        ChordStatus::Surface if radius == f64::INFINITY => Status::Straight,
+        ChordStatus::Surface => Status::Surface,
+    };
+    (rule_chord_error, status)
+}
+
+/// The step guess of chord.md §2.9: the circle chord `2√(2rC − C²)`, or `fallback` (Δs, or the
+/// span) when the radius is infinite or the chord error zero.
+fn step_guess(radius: f64, chord_error: f64, fallback: f64) -> f64 {
+    if radius.is_finite() && chord_error > 0.0 {
+        chord_length(radius, chord_error)
+    } else {
+        fallback
+    }
+}
