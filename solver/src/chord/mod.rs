@@ -280,6 +280,7 @@ fn answer(job: &Job, request: &SegmentRequest, cut: &Cut) -> Result<SegmentAnswe
     });
 
     let mut warnings = job.warnings.clone();
+    warnings.extend(sparse_polyline(job));
     warnings.extend(window_warnings(job, cut));
     warnings.extend(block_warnings(job, cut, &stats));
 
@@ -350,6 +351,30 @@ fn answer(job: &Job, request: &SegmentRequest, cut: &Cut) -> Result<SegmentAnswe
         description,
         spindle_rpm: job.spindle_rpm,
         safe_z,
+    })
+}
+
+/// A polyline is its own true curve: where its points are not much closer than the chords, its
+/// corners (not the curve they sample) decide the chord lengths.
+fn sparse_polyline(job: &Job) -> Option<Warning> {
+    let shape::Shape::Polyline(line) = &job.shape else {
+        return None;
+    };
+    let longest = line
+        .stations
+        .windows(2)
+        .map(|pair| pair[1] - pair[0])
+        .fold(0.0, f64::max);
+    let target = job.rule.target_chord();
+    (longest > 0.25 * target).then(|| {
+        Warning::new(
+            "W_SPARSE_POLYLINE",
+            format!(
+                "the polyline's points are up to {longest:.4} mm apart, more than a quarter of the {target:.4} mm \
+                 chord the rule aims at: its own corners limit the chords, so blocks may come out shorter; send \
+                 denser points or the curve itself (arc, ellipse, bspline)"
+            ),
+        )
     })
 }
 

@@ -163,9 +163,24 @@ impl Nurbs {
         Vec3::new(sum[0] / sum[3], sum[1] / sum[3], sum[2] / sum[3])
     }
 
-    /// Point, first and second derivative with respect to u.
+    /// Point, first and second derivative with respect to u (the right-hand limits at a knot).
     pub(crate) fn derivatives(&self, u: f64) -> [Vec3; 3] {
-        let span = self.span(u);
+        self.derivatives_in(self.span(u), u)
+    }
+
+    /// The left-hand limits of [`Nurbs::derivatives`] when `u` is an interior knot, where the
+    /// curvature may jump (a degree-2 curve is only C1 there); `None` elsewhere.
+    pub(crate) fn derivatives_from_left(&self, u: f64) -> Option<[Vec3; 3]> {
+        let right = self.span(u);
+        let n = self.weighted.len();
+        let left = self.knots[..=n]
+            .partition_point(|&k| k < u)
+            .saturating_sub(1)
+            .clamp(self.degree, n - 1);
+        (left != right).then(|| self.derivatives_in(left, u))
+    }
+
+    fn derivatives_in(&self, span: usize, u: f64) -> [Vec3; 3] {
         let ders = self.basis_derivatives(span, u);
         let mut homogeneous = [[0.0_f64; 4]; 3];
         for (order, row) in ders.iter().enumerate() {

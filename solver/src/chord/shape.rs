@@ -103,14 +103,20 @@ impl Spline {
         self.nurbs.derivatives(u)[1].norm()
     }
 
+    /// Radius of curvature |C'|³/|C'×C''|; at a knot the smaller of both one-sided values.
     fn radius(&self, u: f64) -> f64 {
-        let [_, first, second] = self.nurbs.derivatives(u);
-        let bend = first.cross(&second).norm();
-        if bend == 0.0 {
-            f64::INFINITY
-        } else {
-            first.norm().powi(3) / bend
-        }
+        let of = |[_, first, second]: [Vec3; 3]| {
+            let bend = first.cross(&second).norm();
+            if bend == 0.0 {
+                f64::INFINITY
+            } else {
+                first.norm().powi(3) / bend
+            }
+        };
+        let right = of(self.nurbs.derivatives(u));
+        self.nurbs
+            .derivatives_from_left(u)
+            .map_or(right, |left| right.min(of(left)))
     }
 }
 
