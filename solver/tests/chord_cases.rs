@@ -146,11 +146,12 @@ fn case_a_reproduces_the_patent_experiment() {
     // The fixture counts the final remainder among its short blocks (index 471).
     assert_eq!(answer.stats.short_blocks, 0);
     assert_eq!(answer.stats.short_end_blocks, 1);
+    // The greedy chord may use the 1e-12 mm slack of chord.md §2.9.
     close(
         "max deviation",
         answer.max_deviation,
         number(&expected["Cep_mm"]),
-        1e-12,
+        2e-12,
     );
     close(
         "feed limit",
@@ -207,7 +208,7 @@ fn case_a_baselines() {
             number(&expected["time_per_block_ms"]),
             1e-6,
         );
-        close(key, comparison.max_deviation, tolerance, 1e-12);
+        close(key, comparison.max_deviation, tolerance, 2e-12);
     }
     // 0.0005 mm starves the control on every block: the feed it can hold (E4), from the greedy
     // chord (which carries the 1e-12 mm slack) and from the closed form.

@@ -121,6 +121,13 @@ impl Nurbs {
         out
     }
 
+    /// How many knots (with repetition) lie strictly between `lo` and `hi`.
+    pub(crate) fn knots_inside(&self, lo: f64, hi: f64) -> usize {
+        let from = self.knots.partition_point(|&k| k <= lo);
+        let to = self.knots.partition_point(|&k| k < hi);
+        to.saturating_sub(from)
+    }
+
     /// Degree p.
     pub(crate) fn degree(&self) -> usize {
         self.degree
@@ -151,7 +158,34 @@ impl Nurbs {
 
     /// The curve point at `u`.
     pub(crate) fn point(&self, u: f64) -> Vec3 {
-        let span = self.span(u);
+        self.point_in(self.span(u), u)
+    }
+
+    /// The curve point at `u`, with `hint` a span index near it (updated to u's span): cheap
+    /// for the increasing parameters of a sampling loop.
+    pub(crate) fn point_near(&self, u: f64, hint: &std::cell::Cell<usize>) -> Vec3 {
+        let n = self.weighted.len();
+        let guess = hint.get();
+        let span = if guess >= self.degree
+            && guess < n
+            && self.knots[guess] <= u
+            && (u < self.knots[guess + 1] || (guess == n - 1 && u <= self.knots[n]))
+        {
+            guess
+        } else if guess + 1 >= self.degree
+            && guess + 1 < n
+            && self.knots[guess + 1] <= u
+            && u < self.knots[guess + 2]
+        {
+            guess + 1
+        } else {
+            self.span(u)
+        };
+        hint.set(span);
+        self.point_in(span, u)
+    }
+
+    fn point_in(&self, span: usize, u: f64) -> Vec3 {
         let basis = self.basis(span, u);
         let mut sum = [0.0; 4];
         for (j, value) in basis.iter().take(self.degree + 1).enumerate() {

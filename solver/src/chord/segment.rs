@@ -108,11 +108,6 @@ pub(crate) struct Cutter<'a> {
 }
 
 impl Cutter<'_> {
-    /// dev(u_a, u_b) > C + eps?
-    fn exceeds(&self, ua: f64, ub: f64, chord_error: f64) -> bool {
-        self.shape.deviation(ua, ub) > chord_error + EPS
-    }
-
     fn vertex(&self, u: f64) -> Vertex {
         Vertex {
             u,
@@ -131,37 +126,54 @@ impl Cutter<'_> {
         limit: &Vertex,
         step_guess: f64,
     ) -> Result<Vertex, SolverError> {
+        let allowed = chord_error + EPS;
         let quarter = step_guess / 4.0;
-        if limit.s - start.s <= quarter && !self.exceeds(start.u, limit.u, chord_error) {
+        if limit.s - start.s <= quarter
+            && self.shape.deviation_against(start.u, limit.u, allowed) <= allowed
+        {
             return Ok(*limit);
         }
+        // Steps of a quarter guess of arc length, taken in the parameter with the local speed.
         let mut step = quarter.max(1e-9);
-        let (mut lo_u, mut lo_s) = (start.u, start.s);
+        let (mut lo_u, mut lo_dev) = (start.u, 0.0);
         let mut steps = 0;
-        let (hi_u, hi_s) = loop {
-            let hi_s = (lo_s + step).min(limit.s);
-            let hi_u = if hi_s >= limit.s {
-                limit.u
+        let (hi_u, hi_dev) = loop {
+            let speed = self.shape.speed(lo_u);
+            let ahead = if speed > 0.0 {
+                lo_u + step / speed
             } else {
-                self.shape.u_at(hi_s)
+                limit.u
             };
-            if self.exceeds(start.u, hi_u, chord_error) {
-                break (hi_u, hi_s);
+            let hi_u = ahead.min(limit.u);
+            let dev = self.shape.deviation_against(start.u, hi_u, allowed);
+            if dev > allowed {
+                break (hi_u, dev);
             }
-            if hi_s >= limit.s {
+            if hi_u >= limit.u {
                 return Ok(*limit);
             }
-            (lo_u, lo_s) = (hi_u, hi_s);
+            (lo_u, lo_dev) = (hi_u, dev);
             steps += 1;
             if steps >= STEPS_BEFORE_GALLOP {
                 step *= 2.0;
             }
         };
-        let g = |u: f64| self.shape.deviation(start.u, u) - chord_error - EPS;
-        // Bracket to 1e-12 mm of arc length: convert with the bracket's mean speed.
-        let speed = (hi_s - lo_s) / (hi_u - lo_u).abs().max(f64::MIN_POSITIVE);
-        let tol = (CROSSING_WIDTH / speed.max(f64::MIN_POSITIVE)).max(f64::MIN_POSITIVE);
-        let end = last_fitting(g, lo_u, g(lo_u), hi_u, g(hi_u), tol).ok_or_else(|| {
+        // The deviation grows about with the square of the chord: its root is nearly linear in
+        // the chord's end, which the root finder solves in a few steps.
+        let root = allowed.sqrt();
+        let g = |u: f64| self.shape.deviation(start.u, u).sqrt() - root;
+        // Bracket to 1e-12 mm of arc length, converted with the local speed.
+        let speed = self.shape.speed(lo_u).max(f64::MIN_POSITIVE);
+        let tol = (CROSSING_WIDTH / speed).max(f64::MIN_POSITIVE);
+        let end = last_fitting(
+            g,
+            lo_u,
+            lo_dev.sqrt() - root,
+            hi_u,
+            hi_dev.sqrt() - root,
+            tol,
+        )
+        .ok_or_else(|| {
             SolverError::new(
                 "E_NUMERIC_FAILURE",
                 format!(
