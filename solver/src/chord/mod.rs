@@ -40,7 +40,9 @@ pub use machine::{MachineProfile, validate_machine_name};
 pub use nurbs::{MAX_CONTROL_POINTS, MAX_DEGREE};
 pub use program::{Post, program};
 pub use request::{Curve, CurveRule, Direction, Mode, RadiusEstimate, SegmentRequest};
-pub use rule::{BlockRule, ChordStatus, Infeasible, block_time_from_saturation, chord_length};
+pub use rule::{
+    BlockRule, ChordStatus, Infeasible, RuleSettings, block_time_from_saturation, chord_length,
+};
 pub use stats::{BlockStats, block_stats};
 
 use request::{Job, Plan};
@@ -360,11 +362,16 @@ fn sparse_polyline(job: &Job) -> Option<Warning> {
     let shape::Shape::Polyline(line) = &job.shape else {
         return None;
     };
-    let longest = line
-        .stations
-        .windows(2)
-        .map(|pair| pair[1] - pair[0])
-        .fold(0.0, f64::max);
+    // Edges next to a bend that is not a corner (corners split the path and are kept).
+    let corner = |station: f64| job.spans.iter().any(|&(start, _)| start == station);
+    let mut longest = 0.0_f64;
+    for (k, three) in line.vertices.windows(3).enumerate() {
+        let (before, after) = (three[1] - three[0], three[2] - three[1]);
+        let bends = before.cross(&after).norm() > 1e-12 * before.norm() * after.norm();
+        if bends && !corner(line.stations[k + 1]) {
+            longest = longest.max(before.norm()).max(after.norm());
+        }
+    }
     let target = job.rule.target_chord();
     (longest > 0.25 * target).then(|| {
         Warning::new(

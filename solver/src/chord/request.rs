@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use super::arclength::ArcLengthTable;
 use super::machine::MachineProfile;
 use super::nurbs::Nurbs;
-use super::rule::BlockRule;
+use super::rule::{BlockRule, RuleSettings};
 use super::segment::Estimate;
 use super::shape::{Arc, Ellipse, Polyline, Shape, Spline, require_length};
 use crate::error::{SolverError, Warning, finite, positive};
@@ -572,6 +572,34 @@ fn optional_tolerance(field: &str, value: Option<f64>) -> Result<Option<f64>, So
 }
 
 impl SegmentRequest {
+    /// A request for `curve` at `feed` (mm/min) on a control with `block_time_ms`, everything
+    /// else at its default (window mode, no margins, no bounds): the starting point for callers
+    /// in Rust, e.g. a path solver resampling its own dense points as a `polyline`.
+    pub fn new(curve: Curve, feed: f64, block_time_ms: f64) -> Self {
+        Self {
+            curve,
+            feed: Some(feed),
+            block_time_ms: Some(block_time_ms),
+            mode: Mode::Window,
+            window: None,
+            rule: None,
+            min_radius: None,
+            radius_estimate: None,
+            margin: None,
+            chord_error_factor: None,
+            radius_factor: None,
+            block_time_factor: None,
+            allow_unsafe_margin: false,
+            sagitta_approximation: false,
+            min_chord_error: None,
+            tolerance: None,
+            compare_tolerance: None,
+            machine: None,
+            spindle_rpm: None,
+            safe_z: None,
+        }
+    }
+
     /// The block-time rule of this request with `machine`'s defaults (fields are named as in
     /// the request); also the warnings about unsafe factors or a feed above the machine's.
     ///
@@ -581,55 +609,19 @@ impl SegmentRequest {
         &self,
         machine: Option<&MachineProfile>,
     ) -> Result<(BlockRule, Vec<Warning>), SolverError> {
-        if let Some(profile) = machine {
-            profile.validate().map_err(|error| {
-                SolverError::input(
-                    "machine",
-                    format!("the stored machine is invalid: {}", error.message()),
-                )
-            })?;
-        }
-        let feed = self.feed.or(machine.map(|m| m.max_feed)).ok_or_else(|| {
-            SolverError::input(
-                "feed",
-                "feed is required (or name a machine: its max_feed is used)",
-            )
-        })?;
-        let block_time_ms = self
-            .block_time_ms
-            .or(machine.map(|m| m.block_time_ms))
-            .ok_or_else(|| {
-                SolverError::input(
-                    "block_time_ms",
-                    "block_time_ms is required (or name a machine that has it)",
-                )
-            })?;
-        let mut rule = BlockRule::new(feed, block_time_ms)?;
-        rule.margin = self
-            .margin
-            .or(machine.and_then(|m| m.margin))
-            .unwrap_or(1.0);
-        rule.chord_error_factor = self.chord_error_factor.unwrap_or(1.0);
-        rule.radius_factor = self.radius_factor.unwrap_or(1.0);
-        rule.block_time_factor = self.block_time_factor.unwrap_or(1.0);
-        rule.min_chord_error = self
-            .min_chord_error
-            .or(machine.and_then(|m| m.min_chord_error))
-            .unwrap_or(0.0);
-        rule.sagitta_approximation = self.sagitta_approximation;
-        let mut warnings = rule.validate(self.allow_unsafe_margin)?;
-        if let Some(profile) = machine
-            && feed > profile.max_feed
-        {
-            warnings.push(Warning::new(
-                "W_FEED_ABOVE_MACHINE_MAX",
-                format!(
-                    "feed {feed} mm/min is above the machine's max_feed {} mm/min: the control will not reach it",
-                    profile.max_feed
-                ),
-            ));
-        }
-        Ok((rule, warnings))
+        let settings = RuleSettings {
+            feed: self.feed,
+            block_time_ms: self.block_time_ms,
+            margin: self.margin,
+            min_chord_error: self.min_chord_error,
+        };
+        let adjust = |rule: &mut BlockRule| {
+            rule.chord_error_factor = self.chord_error_factor.unwrap_or(1.0);
+            rule.radius_factor = self.radius_factor.unwrap_or(1.0);
+            rule.block_time_factor = self.block_time_factor.unwrap_or(1.0);
+            rule.sagitta_approximation = self.sagitta_approximation;
+        };
+        BlockRule::resolve_with(&settings, machine, adjust, self.allow_unsafe_margin)
     }
 
     /// Validates the request with the resolved machine (if it names one).

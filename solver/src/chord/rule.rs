@@ -5,6 +5,7 @@
 //! of sagitta C_ep on a circle of radius r is exactly `k_f·F·T_b/60000` long, so a polyline cut
 //! with C_ep never asks the control for a block shorter than it can digest at feed F.
 
+use super::machine::MachineProfile;
 use crate::error::{SolverError, Warning, finite, non_negative, positive};
 
 /// Milliseconds per minute: `F·T_b/MS_PER_MIN` is the distance (mm) travelled in one block time.
@@ -63,7 +64,94 @@ pub struct BlockRule {
     pub sagitta_approximation: bool,
 }
 
+/// What a request says about the block-time rule; `None` takes the named machine's value, else
+/// the default (`margin` 1, `min_chord_error` 0; `feed` falls back to the machine's `max_feed`,
+/// `block_time_ms` has no default). Any path solver with `machine`, `feed` and `block_time_ms`
+/// fields fills this and calls [`BlockRule::resolve`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RuleSettings {
+    /// Feed, mm/min.
+    pub feed: Option<f64>,
+    /// Block processing time, ms.
+    pub block_time_ms: Option<f64>,
+    /// k_f.
+    pub margin: Option<f64>,
+    /// C_emin, mm.
+    pub min_chord_error: Option<f64>,
+}
+
 impl BlockRule {
+    /// The rule of a request: `settings` over `machine`'s defaults, validated (safe factors
+    /// only). Also returns `W_FEED_ABOVE_MACHINE_MAX` when the feed exceeds the machine's.
+    ///
+    /// # Errors
+    /// `E_INPUT` naming `feed`, `block_time_ms`, `margin` or `min_chord_error` for a missing or
+    /// bad value, or `machine` when the stored profile is invalid.
+    pub fn resolve(
+        settings: &RuleSettings,
+        machine: Option<&MachineProfile>,
+    ) -> Result<(Self, Vec<Warning>), SolverError> {
+        Self::resolve_with(settings, machine, |_| {}, false)
+    }
+
+    /// [`BlockRule::resolve`] with the other factors set by `adjust` before validation.
+    pub(crate) fn resolve_with(
+        settings: &RuleSettings,
+        machine: Option<&MachineProfile>,
+        adjust: impl FnOnce(&mut Self),
+        allow_unsafe: bool,
+    ) -> Result<(Self, Vec<Warning>), SolverError> {
+        if let Some(profile) = machine {
+            profile.validate().map_err(|error| {
+                SolverError::input(
+                    "machine",
+                    format!("the stored machine is invalid: {}", error.message()),
+                )
+            })?;
+        }
+        let feed = settings
+            .feed
+            .or(machine.map(|m| m.max_feed))
+            .ok_or_else(|| {
+                SolverError::input(
+                    "feed",
+                    "feed is required (or name a machine: its max_feed is used)",
+                )
+            })?;
+        let block_time_ms = settings
+            .block_time_ms
+            .or(machine.map(|m| m.block_time_ms))
+            .ok_or_else(|| {
+                SolverError::input(
+                    "block_time_ms",
+                    "block_time_ms is required (or name a machine that has it)",
+                )
+            })?;
+        let mut rule = Self::new(feed, block_time_ms)?;
+        rule.margin = settings
+            .margin
+            .or(machine.and_then(|m| m.margin))
+            .unwrap_or(1.0);
+        rule.min_chord_error = settings
+            .min_chord_error
+            .or(machine.and_then(|m| m.min_chord_error))
+            .unwrap_or(0.0);
+        adjust(&mut rule);
+        let mut warnings = rule.validate(allow_unsafe)?;
+        if let Some(profile) = machine
+            && feed > profile.max_feed
+        {
+            warnings.push(Warning::new(
+                "W_FEED_ABOVE_MACHINE_MAX",
+                format!(
+                    "feed {feed} mm/min is above the machine's max_feed {} mm/min: the control will not reach it",
+                    profile.max_feed
+                ),
+            ));
+        }
+        Ok((rule, warnings))
+    }
+
     /// The plain rule (embodiment 1: on the surface, no margins, no lower bound) for `feed`
     /// (mm/min) and `block_time_ms`.
     ///

@@ -272,13 +272,14 @@ impl Cutter<'_> {
                 let s0 = s_start + window * k as f64;
                 let s1 = (s0 + window).min(s_end);
                 let (u0, u1) = (self.shape.u_at(s0), self.shape.u_at(s1));
+                let three_point = circumradius(
+                    &self.shape.point(u0),
+                    &self.shape.point(self.shape.u_at(0.5 * (s0 + s1))),
+                    &self.shape.point(u1),
+                );
                 let radius = match estimate {
-                    Estimate::ThreePoint => circumradius(
-                        &self.shape.point(u0),
-                        &self.shape.point(self.shape.u_at(0.5 * (s0 + s1))),
-                        &self.shape.point(u1),
-                    ),
-                    Estimate::Minimum => self.shape.min_radius(u0, u1, scale).0,
+                    Estimate::ThreePoint if three_point.is_finite() => three_point,
+                    _ => self.shape.min_radius(u0, u1, scale).0,
                 };
                 out.push((s0, radius));
             }
@@ -329,6 +330,9 @@ impl Cutter<'_> {
                     1.0
                 };
                 let radius = match estimate {
+                    // Three collinear points on a window that bends (an S around its middle)
+                    // would mean C_ep = 0 on a curve: take the bend that is there.
+                    Estimate::ThreePoint if three_point.is_infinite() => smallest,
                     Estimate::ThreePoint => three_point,
                     Estimate::Minimum => self.reach_radius(rule, smallest, s0, s1, u0, s_end)?,
                 };
@@ -436,5 +440,68 @@ fn step_guess(radius: f64, chord_error: f64, fallback: f64) -> f64 {
         chord_length(radius, chord_error)
     } else {
         fallback
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::chord::shape::Arc;
+
+    fn circle(radius: f64) -> Shape {
+        Shape::Arc(Arc {
+            centre: Vec3::zeros(),
+            radius,
+            start: 0.0,
+            sense: 1.0,
+            sweep: std::f64::consts::TAU,
+        })
+    }
+
+    #[test]
+    fn the_block_limit_names_its_field() {
+        let shape = circle(50.0);
+        let spans = [shape.domain()];
+        let cutter = Cutter {
+            shape: &shape,
+            spans: &spans,
+            max_blocks: 10,
+            limit_field: "compare_tolerance",
+        };
+        let error = cutter.constant(0.001, 50.0).unwrap_err();
+        assert_eq!(error.code(), "E_TOO_MANY_BLOCKS");
+        assert_eq!(error.field(), Some("compare_tolerance"));
+    }
+
+    #[test]
+    fn a_search_without_progress_fails_instead_of_looping() {
+        // Chord error 0 on a 0.1 µm circle: the longest fitting chord is below 1 nm (E14).
+        let shape = circle(1e-7);
+        let spans = [shape.domain()];
+        let cutter = Cutter {
+            shape: &shape,
+            spans: &spans,
+            max_blocks: 1000,
+            limit_field: "tolerance",
+        };
+        let error = cutter.constant(0.0, f64::INFINITY).unwrap_err();
+        assert_eq!(error.code(), "E_NUMERIC_FAILURE");
+    }
+
+    #[test]
+    fn greedy_chords_on_a_circle_have_the_sagitta_length() {
+        let shape = circle(50.0);
+        let spans = [shape.domain()];
+        let cutter = Cutter {
+            shape: &shape,
+            spans: &spans,
+            max_blocks: 1000,
+            limit_field: "tolerance",
+        };
+        let cut = cutter.constant(0.01, 50.0).unwrap();
+        assert_eq!(cut.vertices.len(), 159);
+        let chord = (cut.vertices[1].point - cut.vertices[0].point).norm();
+        assert!((chord - chord_length(50.0, 0.01)).abs() < 1e-9);
+        assert_eq!(cut.span_ends, vec![157]);
     }
 }
