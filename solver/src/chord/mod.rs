@@ -14,14 +14,40 @@
 //! * `segment`: greedy chords, the window procedure with carry-over and progress rule, the
 //!   single-value run (§2.9);
 //! * [`stats`]: block figures of any polyline ([`block_stats`]);
-//! * [`machine`]: controller profiles; [`program`]: G-code.
+//! * [`machine`]: controller profiles; [`mod@program`]: G-code.
 //!
-//! Choices where the spec is open (chord.md §8): the window radius is the 3-point circumradius
-//! by default (`radius_estimate: minimum` is the conservative option); the feed is constant along
-//! the curve; a polyline is its own true curve (chords end on its edges); corners (direction
-//! change above `corner_angle_deg`, default 20°) split the path and remainders there count as
-//! span ends; the greedy step doubles after 32 fixed steps (long straights), which changes
-//! nothing on convex pieces.
+//! # Calling it
+//!
+//! * `POST /api/v1/segment`: parse a [`SegmentRequest`], resolve its `machine` name to a
+//!   [`MachineProfile`] (404 if unknown), call [`solve`]`(&request, machine.as_ref())` and answer
+//!   the [`SegmentAnswer`] as JSON, or [`fn@program`]`(&answer, &`[`Post`]`)` for G-code (the dialect
+//!   from the query, else the machine's). Errors: `E_INPUT`, `E_DEGENERATE_CURVE`,
+//!   `E_INFEASIBLE_FEED_FOR_RADIUS`, `E_TOO_MANY_BLOCKS`, `E_TOO_MANY_POINTS`,
+//!   `E_NUMERIC_FAILURE`: all 422.
+//! * Machines: store a validated ([`MachineProfile::validate`]) profile as JSON under a name
+//!   checked by [`validate_machine_name`].
+//! * Another path solver (deburr, contour) with `machine`, `feed`, `block_time_ms` and a
+//!   `tolerance`: [`BlockRule::resolve`] gives the rule; [`BlockRule::tolerance_for`]`(r, tol)`
+//!   the chord tolerance at a local radius (never coarser than `tol`), or for the whole path
+//!   `tolerance_for(r_min, tol)` (embodiment 4); [`block_stats`] reports any polyline's blocks,
+//!   shortest block, short blocks and block-limited time. To cut its own curve by the rule,
+//!   sample it densely (≤ 1/10 of [`BlockRule::target_chord`] apart), send the samples as a
+//!   [`Curve::Polyline`] through [`SegmentRequest::new`] and [`solve`], and map each answer
+//!   point back by its `s` (arc length along the samples).
+//!
+//! # Choices where the spec is open (chord.md §8)
+//!
+//! The window radius is the 3-point circumradius by default (the patent); `radius_estimate:
+//! minimum` is the conservative option that keeps every block at least margin × feed × block
+//! time (a 3-point window that sees three collinear points on a bend takes the bend's smallest
+//! radius instead of C_ep = 0). The feed is constant along the curve. A polyline is its own true
+//! curve: chords end on its edges, and points much sparser than the chords get
+//! `W_SPARSE_POLYLINE`. Corners (direction change above `corner_angle_deg`, default 20°) split the
+//! path; the remainders there and at the path end count as span ends, apart from `short_blocks`.
+//! The accuracy bound `tolerance` wins over the rule and over `min_chord_error`. The greedy step
+//! doubles after 32 fixed steps (long straights) and is taken in the curve parameter with the
+//! local speed, which changes nothing on convex pieces. Window mode's default window is 5 target
+//! chords. The G-code program plunges to the start at the cutting feed.
 
 mod answer;
 mod arclength;

@@ -1,4 +1,4 @@
-//! The segment request as clients send it (api.md, Segment) and its validation into a [`Job`]
+//! The segment request as clients send it (api.md, Segment) and its validation into a `Job`
 //! with the machine's defaults applied (chord.md §1.2 inputs, §4 E6 and E16).
 
 use serde::{Deserialize, Serialize};
