@@ -203,12 +203,14 @@ fn refine_maximum(
 }
 
 /// Radius of the circle through three points, in any dimension (chord.md §2.8); infinite when
-/// they are collinear (|u×v| ≤ 1e-15·longest side²).
+/// they are collinear: |u×v| ≤ 1e-15·longest side², plus the rounding of coordinates of this
+/// size (points interpolated far from the origin are collinear only to that).
 pub(crate) fn circumradius(p0: &Vec3, pm: &Vec3, p1: &Vec3) -> f64 {
     let (u, v, w) = (pm - p0, p1 - p0, p1 - pm);
     let twice_area = u.cross(&v).norm();
     let longest = u.norm().max(v.norm()).max(w.norm());
-    if twice_area <= 1e-15 * longest * longest {
+    let size = p0.amax().max(pm.amax()).max(p1.amax());
+    if twice_area <= 1e-15 * longest * longest + 16.0 * f64::EPSILON * size * longest {
         return f64::INFINITY;
     }
     u.norm() * v.norm() * w.norm() / (2.0 * twice_area)
@@ -430,7 +432,8 @@ impl Shape {
     }
 
     /// Break points of [u_a, u_b] into pieces small enough for [`Shape::min_radius`] to sample
-    /// well: NURBS knot spans, polyline pieces of at most 1000 `scale`, else the whole range.
+    /// well: NURBS knot spans, polyline pieces of 1000 `scale` (at most 10 000 of them), else
+    /// the whole range.
     pub(crate) fn radius_pieces(&self, ua: f64, ub: f64, scale: f64) -> Vec<f64> {
         let mut out = vec![ua];
         match self {
@@ -443,7 +446,8 @@ impl Shape {
                     .filter(|&knot| knot > ua && knot < ub),
             ),
             Self::Polyline(_) => {
-                let piece = 1000.0 * scale;
+                // At most 10 000 pieces, whatever the scale.
+                let piece = (1000.0 * scale).max((ub - ua) / 10_000.0);
                 let count = ((ub - ua) / piece).ceil();
                 if count > 1.0 && count.is_finite() {
                     for k in 1..count as usize {
