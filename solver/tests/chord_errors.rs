@@ -300,25 +300,29 @@ fn infeasible_feed_gives_the_largest_feasible_feed() {
     assert_eq!(answer.feed_limit, Some(9000.0));
     // An ellipse: the limit comes from its smallest radius b²/a = 0.25 mm, even when the window
     // that failed saw a larger one.
-    // An ellipse with radii from 0.25 to 16 mm: the 3-point windows (3.3 mm) do not see its
-    // sharp ends and say so; the conservative estimate finds them, and the limit comes from the
-    // smallest radius b²/a = 0.25 mm.
+    // An ellipse with radii from 0.25 to 16 mm: its 3-point windows (3.3 mm) see radii of 4 mm
+    // at its sharp ends, but are held within 1.1 times the smallest radius in the window, so the
+    // infeasibility is found with both estimates; the limit comes from b²/a = 0.25 mm.
     let ellipse = json!({"kind": "ellipse", "centre": [0, 0], "semi_axes": [4, 1]});
-    let rough = ok(with(base(), "curve", ellipse.clone()));
-    assert!(codes(&rough).contains(&"W_CURVATURE_ESTIMATE_UNRELIABLE"));
-    let conservative = with(
-        with(base(), "curve", ellipse),
-        "radius_estimate",
-        json!("minimum"),
-    );
-    let (code, _, message) = error(conservative.clone());
-    assert_eq!(code, "E_INFEASIBLE_FEED_FOR_RADIUS");
-    assert!(
-        message.contains("largest feasible feed is 7500 mm/min"),
-        "{message}"
-    );
-    let answer = ok(with(conservative, "feed", json!(7500)));
-    assert_eq!(answer.stats.short_blocks, 0);
+    for estimate in ["three_point", "minimum"] {
+        let request = with(
+            with(base(), "curve", ellipse.clone()),
+            "radius_estimate",
+            json!(estimate),
+        );
+        let (code, _, message) = error(request.clone());
+        assert_eq!(code, "E_INFEASIBLE_FEED_FOR_RADIUS");
+        assert!(
+            message.contains("largest feasible feed is 7500 mm/min"),
+            "{message}"
+        );
+        let answer = ok(with(request, "feed", json!(7500)));
+        if estimate == "minimum" {
+            assert_eq!(answer.stats.short_blocks, 0);
+        } else {
+            assert!(codes(&answer).contains(&"W_CURVATURE_ESTIMATE_UNRELIABLE"));
+        }
+    }
     // r_min read off the drawing: the error names that field.
     let (code, field, _) = error(with(
         with(
@@ -550,4 +554,22 @@ fn programs_in_both_dialects() {
     assert!(linuxcnc.contains("G64 P"));
     assert!(linuxcnc.contains("M00\n"));
     assert!(!linuxcnc.contains('%'));
+}
+
+#[test]
+fn cusps_of_coincident_control_points_are_corners() {
+    // Three coincident control points of a cubic: the curve stops and turns 90° there.
+    let spline = json!({"kind": "bspline", "degree": 3,
+        "control_points": [[0, 0], [10, 0], [20, 10], [20, 10], [20, 10], [30, 0], [40, 0]]});
+    let answer = ok(with(
+        with(with(base(), "curve", spline), "feed", json!(5000)),
+        "radius_estimate",
+        json!("minimum"),
+    ));
+    let cusp = answer
+        .points
+        .iter()
+        .position(|p| (p[0] - 20.0).abs() < 1e-9 && (p[1] - 10.0).abs() < 1e-9);
+    assert!(cusp.is_some(), "the cusp is a command point");
+    assert_eq!(answer.stats.short_blocks, 0);
 }

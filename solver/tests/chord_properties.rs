@@ -390,11 +390,13 @@ proptest! {
         block_time_ms in 1.0_f64..4.0,
         window in 1.0_f64..20.0,
         min_chord_error in 0.0_f64..0.002,
+        margin in 1.0_f64..1.3,
     ) {
         let control: Vec<Point> = heights.iter().enumerate().map(|(i, y)| [10.0 * i as f64, *y, 0.0]).collect();
         let request = json!({
             "curve": {"kind": "bspline", "degree": degree, "control_points": control},
-            "feed": feed, "block_time_ms": block_time_ms, "window": window, "min_chord_error": min_chord_error
+            "feed": feed, "block_time_ms": block_time_ms, "window": window, "min_chord_error": min_chord_error,
+            "margin": margin
         });
         let Some(answer) = solve_feasible(request) else { return Ok(()); };
         let curve = Spline::new(degree, control, vec![1.0; heights.len()]);
@@ -406,6 +408,12 @@ proptest! {
             .filter(|w| norm(&sub(&to_point(&w[1]), &to_point(&w[0]))) < answer.stats.block_length * (1.0 - SLACK))
             .count();
         prop_assert_eq!(short, answer.stats.short_blocks);
+        // The 3-point radius is held within 1.1 times the smallest radius in its window, so a
+        // margin of √1.1 (with a little room for the first chord of a window, which may reach past
+        // it) keeps every block at least feed × block time long.
+        if margin >= 1.08 {
+            prop_assert_eq!(answer.stats.short_blocks, 0, "margin {}", margin);
+        }
     }
 
     #[test]

@@ -80,10 +80,6 @@ use crate::geometry::Vec3;
 /// Most blocks one cut may have (`E_TOO_MANY_BLOCKS`).
 pub const MAX_BLOCKS: usize = 1_000_000;
 
-/// A window's radius estimate may exceed the smallest radius inside it by this factor before
-/// `W_CURVATURE_ESTIMATE_UNRELIABLE` is raised (E10).
-const SPREAD_LIMIT: f64 = 1.1;
-
 /// Least increment of the G-code (4 decimals), mm; a chord error below 5 of them is
 /// resolution-limited (E13).
 const LEAST_INCREMENT: f64 = 1e-4;
@@ -485,7 +481,7 @@ fn window_warnings(job: &Job, cut: &Cut) -> Vec<Warning> {
         let unreliable: Vec<_> = cut
             .windows
             .iter()
-            .filter(|w| w.spread > SPREAD_LIMIT)
+            .filter(|w| w.spread > segment::SPREAD_CAP)
             .collect();
         if let Some(worst) = unreliable
             .iter()
@@ -495,15 +491,16 @@ fn window_warnings(job: &Job, cut: &Cut) -> Vec<Warning> {
                 "W_CURVATURE_ESTIMATE_UNRELIABLE",
                 format!(
                     "in {} of {total} windows the curvature grows inside the window (worst at s = {:.3} mm: the \
-                     3-point radius is {} the smallest radius there); use a shorter window or radius_estimate \
-                     \"minimum\" (E10)",
+                     3-point radius is {} the smallest radius there); their radius was held at {} times the \
+                     smallest. Use a shorter window or radius_estimate \"minimum\" (E10)",
                     unreliable.len(),
                     worst.s_start,
                     if worst.spread.is_finite() {
                         format!("{:.2} times", worst.spread)
                     } else {
                         "infinite, not".to_owned()
-                    }
+                    },
+                    segment::SPREAD_CAP
                 ),
             ));
         }

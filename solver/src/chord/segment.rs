@@ -17,6 +17,10 @@ const CROSSING_WIDTH: f64 = 1e-12;
 const STEPS_BEFORE_GALLOP: usize = 32;
 /// A chord shorter than this (mm) means the search made no progress (E14).
 const MIN_PROGRESS: f64 = 1e-9;
+/// Largest ratio of a window's 3-point radius to the smallest radius inside the window that is
+/// used as it is; beyond it the radius is held at this multiple of the smallest (E10). A chord
+/// cut with it is at least 1/√SPREAD_CAP of the target chord long.
+pub(crate) const SPREAD_CAP: f64 = 1.1;
 /// Slack on window ends (chord.md §2.9: s1 + 1e-12).
 const WINDOW_SLACK: f64 = 1e-12;
 
@@ -162,9 +166,15 @@ impl Cutter<'_> {
         // the chord's end, which the root finder solves in a few steps.
         let root = allowed.sqrt();
         let g = |u: f64| self.shape.deviation(start.u, u).sqrt() - root;
-        // Bracket to 1e-12 mm of arc length, converted with the local speed.
-        let speed = self.shape.speed(lo_u).max(f64::MIN_POSITIVE);
-        let tol = (CROSSING_WIDTH / speed).max(f64::MIN_POSITIVE);
+        // Bracket to 1e-12 mm of arc length, converted with the bracket's mean speed (the speed
+        // at one end may be zero: a cusp).
+        let width = self.shape.s_at(hi_u) - self.shape.s_at(lo_u);
+        let speed = width / (hi_u - lo_u);
+        let tol = if speed > 0.0 {
+            (CROSSING_WIDTH / speed).max(f64::MIN_POSITIVE)
+        } else {
+            f64::EPSILON * hi_u.abs().max(f64::MIN_POSITIVE)
+        };
         let end = last_fitting(
             g,
             lo_u,
@@ -183,10 +193,17 @@ impl Cutter<'_> {
             )
             .at("curve")
         })?;
-        Ok(self.vertex(end))
+        let end = self.vertex(end);
+        // A remainder below a nanometre is not a block: the chord takes it.
+        Ok(if limit.s - end.s < MIN_PROGRESS {
+            *limit
+        } else {
+            end
+        })
     }
 
-    fn push(&self, cut: &mut Cut, vertex: Vertex) -> Result<(), SolverError> {
+    /// Appends a command point; `span_end` is the parameter where its span ends.
+    fn push(&self, cut: &mut Cut, vertex: Vertex, span_end: f64) -> Result<(), SolverError> {
         if cut.vertices.len() > self.max_blocks {
             return Err(SolverError::new(
                 "E_TOO_MANY_BLOCKS",
@@ -200,7 +217,7 @@ impl Cutter<'_> {
         }
         if let Some(last) = cut.vertices.last()
             && vertex.s - last.s < MIN_PROGRESS
-            && vertex.u != last.u
+            && vertex.u != span_end
         {
             return Err(SolverError::new(
                 "E_NUMERIC_FAILURE",
@@ -236,7 +253,7 @@ impl Cutter<'_> {
             let guess = step_guess(radius, chord_error, limit.s - from.s);
             while from.s < limit.s && from.u != limit.u {
                 let next = self.greedy_end(&from, chord_error, &limit, guess)?;
-                self.push(&mut cut, next)?;
+                self.push(&mut cut, next, limit.u)?;
                 from = next;
             }
             cut.span_ends.push(cut.vertices.len().saturating_sub(2));
@@ -277,9 +294,12 @@ impl Cutter<'_> {
                     &self.shape.point(self.shape.u_at(0.5 * (s0 + s1))),
                     &self.shape.point(u1),
                 );
+                let smallest = self.shape.min_radius(u0, u1, scale).0;
                 let radius = match estimate {
-                    Estimate::ThreePoint if three_point.is_finite() => three_point,
-                    _ => self.shape.min_radius(u0, u1, scale).0,
+                    Estimate::ThreePoint if three_point.is_finite() => {
+                        three_point.min(SPREAD_CAP * smallest)
+                    }
+                    _ => smallest,
                 };
                 out.push((s0, radius));
             }
@@ -330,10 +350,12 @@ impl Cutter<'_> {
                     1.0
                 };
                 let radius = match estimate {
-                    // Three collinear points on a window that bends (an S around its middle)
-                    // would mean C_ep = 0 on a curve: take the bend that is there.
+                    // The 3-point circle of a window whose curvature grows inside it (towards a
+                    // flat point, an inflection, three collinear points on an S) can be orders of
+                    // magnitude too large, so C_ep tiny and the chords far shorter than a block:
+                    // the estimate is held within SPREAD_CAP of the smallest radius there (E10).
                     Estimate::ThreePoint if three_point.is_infinite() => smallest,
-                    Estimate::ThreePoint => three_point,
+                    Estimate::ThreePoint => three_point.min(SPREAD_CAP * smallest),
                     Estimate::Minimum => self.reach_radius(rule, smallest, s0, s1, u0, s_end)?,
                 };
                 let (rule_chord_error, surface) =
@@ -350,7 +372,7 @@ impl Cutter<'_> {
                     if beyond && blocks > 0 {
                         break; // carry over: the next window starts at the last command point
                     }
-                    self.push(&mut cut, next)?;
+                    self.push(&mut cut, next, limit.u)?;
                     from = next;
                     blocks += 1;
                     if beyond {

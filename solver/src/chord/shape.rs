@@ -462,7 +462,8 @@ impl Shape {
     }
 
     /// Parameters of the interior corners, where the direction turns by more than `corner`
-    /// radians (E11): polyline vertices and NURBS knots of multiplicity ≥ the degree.
+    /// radians (E11): polyline vertices, and NURBS knots of multiplicity ≥ the degree or where
+    /// the curve stops (cusps).
     pub(crate) fn corners(&self, corner: f64) -> Vec<f64> {
         let turn = |before: Vec3, after: Vec3| {
             let (nb, na) = (before.norm(), after.norm());
@@ -483,17 +484,32 @@ impl Shape {
             Self::Spline(spline) => {
                 let degree = spline.nurbs.degree();
                 let breaks = spline.nurbs.breaks();
+                let (start, end) = spline.nurbs.domain();
+                let mean_speed = spline.table.length() / (end - start);
                 let mut out = Vec::new();
                 for window in breaks.windows(3) {
                     let (before, (knot, multiplicity), after) =
                         (window[0].0, window[1], window[2].0);
-                    if multiplicity < degree {
+                    // A tangent may break where the curve is only C0 (multiplicity ≥ degree) or
+                    // where it stops (a cusp from `degree` coincident control points).
+                    let stops = spline.speed(knot) <= 1e-9 * mean_speed;
+                    if multiplicity < degree && !stops {
                         continue;
                     }
-                    let delta = 1e-7 * (knot - before).min(after - knot);
+                    // Directions just before and after; at a cusp the curve moves only with
+                    // the square of the step, so grow it until the moves stand above rounding.
                     let here = spline.nurbs.point(knot);
-                    let incoming = here - spline.nurbs.point(knot - delta);
-                    let outgoing = spline.nurbs.point(knot + delta) - here;
+                    let noise = 1e-11 * here.amax().max(1.0);
+                    let room = (knot - before).min(after - knot);
+                    let (mut incoming, mut outgoing) = (Vec3::zeros(), Vec3::zeros());
+                    for fraction in [1e-7, 1e-5, 1e-3] {
+                        let delta = fraction * room;
+                        incoming = here - spline.nurbs.point(knot - delta);
+                        outgoing = spline.nurbs.point(knot + delta) - here;
+                        if incoming.norm() > noise && outgoing.norm() > noise {
+                            break;
+                        }
+                    }
                     if turn(incoming, outgoing) > corner {
                         out.push(knot);
                     }
