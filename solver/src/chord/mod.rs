@@ -37,10 +37,12 @@
 //!
 //! # Choices where the spec is open (chord.md §8)
 //!
-//! The window radius is the 3-point circumradius by default (the patent); `radius_estimate:
-//! minimum` is the conservative option that keeps every block at least margin × feed × block
-//! time (a 3-point window that sees three collinear points on a bend takes the bend's smallest
-//! radius instead of C_ep = 0). The feed is constant along the curve. A polyline is its own true
+//! The window radius is the 3-point circumradius by default (the patent), held within 1.1 times
+//! the smallest radius of curvature inside the window (E10: near flat points and inflections the
+//! 3-point circle can be orders of magnitude too large, making C_ep tiny and the blocks far too
+//! short; with the guard a margin of 1.08 keeps every block at least feed × block time, and case
+//! C is unchanged); `radius_estimate: minimum` is the conservative option that keeps every block
+//! at least margin × feed × block time. The feed is constant along the curve. A polyline is its own true
 //! curve: chords end on its edges, and points much sparser than the chords get
 //! `W_SPARSE_POLYLINE`. Corners (direction change above `corner_angle_deg`, default 20°) split the
 //! path; the remainders there and at the path end count as span ends, apart from `short_blocks`.
@@ -214,28 +216,43 @@ fn infeasible_error(job: &Job, at: InfeasibleAt) -> SolverError {
         (at.infeasible.radius, at.s)
     };
     let limit = rule.feed_limit(radius);
+    // Rounded down, so the feed named is feasible.
     let feasible = if limit >= 100.0 {
         format!("{:.0}", limit.floor())
-    } else {
+    } else if limit >= 0.1 {
         format!("{:.1}", (limit * 10.0).floor() / 10.0)
+    } else {
+        let exponent = limit.log10().floor();
+        let mantissa = (limit / 10f64.powf(exponent) * 100.0).floor() / 100.0;
+        format!("{mantissa:.2}e{exponent}")
     };
     SolverError::new(
         "E_INFEASIBLE_FEED_FOR_RADIUS",
         format!(
-            "feed {} mm/min is too high for the radius {:.4} mm at s = {:.3} mm: one block of {} ms at this feed \
-             (margin {}) is {:.4} mm, longer than any chord of a circle of radius {:.4} mm. The largest feasible feed \
-             is {feasible} mm/min (smallest radius of the curve {radius:.4} mm at s = {s:.3} mm); or use arc or \
-             spline output, or a faster control mode",
+            "feed {} mm/min is too high for the radius {} mm at s = {:.3} mm: one block of {} ms at this feed \
+             (margin {}) is {:.4} mm, longer than any chord of a circle of radius {} mm. The largest feasible feed \
+             is {feasible} mm/min (smallest radius of the curve {} mm at s = {s:.3} mm); or use arc or spline \
+             output, or a faster control mode",
             rule.feed,
-            at.infeasible.radius,
+            length(at.infeasible.radius),
             at.s,
             rule.block_time_ms,
             rule.margin,
             rule.target_chord(),
-            at.infeasible.radius * rule.radius_factor,
+            length(at.infeasible.radius * rule.radius_factor),
+            length(radius),
         ),
     )
     .at("feed")
+}
+
+/// A length for a message: 4 decimals, or 3 significant digits below a micrometre.
+fn length(value: f64) -> String {
+    if value >= 1e-3 {
+        format!("{value:.4}")
+    } else {
+        format!("{value:.3e}")
+    }
 }
 
 fn status_of(status: Status) -> WindowStatus {
@@ -491,8 +508,8 @@ fn window_warnings(job: &Job, cut: &Cut) -> Vec<Warning> {
                 "W_CURVATURE_ESTIMATE_UNRELIABLE",
                 format!(
                     "in {} of {total} windows the curvature grows inside the window (worst at s = {:.3} mm: the \
-                     3-point radius is {} the smallest radius there); their radius was held at {} times the \
-                     smallest. Use a shorter window or radius_estimate \"minimum\" (E10)",
+                     3-point radius is {} the smallest radius there); their radius was held at most {} times \
+                     the smallest. Use a shorter window or radius_estimate \"minimum\" (E10)",
                     unreliable.len(),
                     worst.s_start,
                     if worst.spread.is_finite() {

@@ -154,7 +154,8 @@ pub enum CurveRule {
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum RadiusEstimate {
-    /// Circle through the window's start, middle and end (chord.md §2.8, the patent).
+    /// Circle through the window's start, middle and end (chord.md §2.8, the patent), held
+    /// within 1.1 times the smallest radius of curvature inside the window.
     #[default]
     ThreePoint,
     /// Smallest radius of curvature inside the window and the reach of its first chord: every
