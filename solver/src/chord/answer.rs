@@ -1,0 +1,107 @@
+//! What a segment request answers (api.md, Segment; chord.md §1.3 outputs and §6 reports).
+
+use serde::Serialize;
+
+use super::stats::BlockStats;
+use crate::error::Warning;
+
+/// How a window's chord error was chosen (chord.md §2.7, §4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum WindowStatus {
+    /// On (or with margins just above) the chord-error surface.
+    Ok,
+    /// Straight (r = ∞): chord error 0, the chord runs to the end of the straight (E1).
+    Straight,
+    /// Raised to `min_chord_error` (embodiment 6, E5).
+    ClampedToMinChordError,
+    /// Lowered to the accuracy bound `tolerance`: blocks here are shorter than the rule wants (E4).
+    LimitedByTolerance,
+}
+
+/// A stretch of the curve cut with one chord error.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct SegmentWindow {
+    /// Arc length where the window starts, mm.
+    pub s_start: f64,
+    /// Arc length where it ends, mm (its last chord may run past it, see chord.md §2.9).
+    pub s_end: f64,
+    /// Radius of curvature the chord error came from, mm (null where straight).
+    pub radius: Option<f64>,
+    /// Chord error the window was cut with, mm.
+    pub chord_error: f64,
+    /// The rule's chord error C_ep before the accuracy bound, mm.
+    pub rule_chord_error: f64,
+    /// Why this chord error.
+    pub status: WindowStatus,
+    /// Blocks that start in this window.
+    pub blocks: usize,
+}
+
+/// The same curve cut with a plain fixed chord error (`compare_tolerance`), for comparison.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct Comparison {
+    /// The fixed chord error, mm.
+    pub tolerance: f64,
+    /// Largest distance of the curve from its chord, mm.
+    pub max_deviation: f64,
+    /// Block figures of that cut.
+    #[serde(flatten)]
+    pub stats: BlockStats,
+}
+
+/// The answer: the command points, their windows, block figures, warnings.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct SegmentAnswer {
+    /// The whole-curve chord error, or the largest window value, mm.
+    pub chord_error: f64,
+    /// The smallest window value, mm.
+    pub min_window_chord_error: f64,
+    /// Windows in order along the curve (one for `mode: curve`).
+    pub windows: Vec<SegmentWindow>,
+    /// The command points in order, `[x, y]` or `[x, y, z]` like the curve; the first is the curve
+    /// start, the last its end. Consecutive points are one G01 block.
+    pub points: Vec<Vec<f64>>,
+    /// Arc length of each point along the curve, mm.
+    pub s: Vec<f64>,
+    /// Block figures at the feed and block time.
+    #[serde(flatten)]
+    pub stats: BlockStats,
+    /// Largest distance of the target curve from its chord, mm.
+    pub max_deviation: f64,
+    /// Arc length of the target curve, mm.
+    pub curve_length: f64,
+    /// Smallest radius of curvature the chord error was computed from, mm (null where the curve
+    /// is straight).
+    pub min_radius: Option<f64>,
+    /// Largest feed at which one block still fits the smallest radius, mm/min (E3).
+    pub feed_limit: Option<f64>,
+    /// With `tolerance`: the largest feed at which the rule's chord error stays within it
+    /// everywhere, so every block is feed × block time long at that accuracy, mm/min (E4).
+    pub tolerance_feed: Option<f64>,
+    /// Feed used, mm/min.
+    pub feed: f64,
+    /// Block time used, ms.
+    pub block_time_ms: f64,
+    /// Margin k_f used.
+    pub margin: f64,
+    /// Lower bound C_emin used, mm.
+    pub min_chord_error: f64,
+    /// The fixed-tolerance cut of `compare_tolerance`, side by side.
+    pub comparison: Option<Comparison>,
+    /// Everything worth knowing that did not stop the computation.
+    pub warnings: Vec<Warning>,
+    /// Header lines for the G-code program.
+    #[serde(skip)]
+    pub(crate) description: Vec<String>,
+    /// Spindle speed for the program, rpm.
+    #[serde(skip)]
+    pub(crate) spindle_rpm: f64,
+    /// Clearance plane for the program.
+    #[serde(skip)]
+    pub(crate) safe_z: f64,
+}

@@ -1,0 +1,137 @@
+//! Controller profiles (api.md, Machines; chord.md §2.1, §6.4): the block processing time and
+//! limits of one control, stored by the server and used as defaults by any request that names it.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{SolverError, non_negative, positive};
+use crate::gcode::Dialect;
+
+/// Longest machine name.
+pub const MAX_NAME_CHARS: usize = 64;
+/// Longest description.
+pub const MAX_DESCRIPTION_CHARS: usize = 200;
+
+/// A machine (controller profile): `PUT /api/v1/machines/{name}` stores it; a request with
+/// `"machine": "name"` takes these values as defaults it can override.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct MachineProfile {
+    /// T_b: time the control needs to read and prepare one block, ms (> 0). Measure it with a
+    /// run of short blocks: T_b = block length / saturated speed × 60000 (chord.md §2.1, Eq. 1).
+    pub block_time_ms: f64,
+    /// Highest programmable cutting feed, mm/min (> 0); the feed of a request that gives none.
+    pub max_feed: f64,
+    /// G-code dialect of the control (default `fanuc`).
+    #[serde(default)]
+    pub dialect: Dialect,
+    /// k_f: margin factor on the feed for the block-time rule (≥ 1, e.g. 1.1; default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub margin: Option<f64>,
+    /// C_emin: smallest chord error worth programming on this control, mm (≥ 0, e.g. 0.001).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_chord_error: Option<f64>,
+    /// Free text: control model, mode the block time was measured in (axes, look-ahead,
+    /// compensation), date (at most 200 characters).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub description: Option<String>,
+}
+
+impl MachineProfile {
+    /// Checks every value, naming the field as written in the machine's JSON.
+    ///
+    /// # Errors
+    /// `E_INPUT` for a block time or feed that is not positive, a margin below 1, a negative
+    /// minimum chord error or a description over 200 characters.
+    pub fn validate(&self) -> Result<(), SolverError> {
+        positive("block_time_ms", self.block_time_ms)?;
+        positive("max_feed", self.max_feed)?;
+        if let Some(margin) = self.margin
+            && positive("margin", margin)? < 1.0
+        {
+            return Err(SolverError::input(
+                "margin",
+                format!(
+                    "margin must be at least 1 (got {margin}): below 1 blocks get shorter than the control can process"
+                ),
+            ));
+        }
+        if let Some(min_chord_error) = self.min_chord_error {
+            non_negative("min_chord_error", min_chord_error)?;
+        }
+        if let Some(description) = &self.description
+            && description.chars().count() > MAX_DESCRIPTION_CHARS
+        {
+            return Err(SolverError::input(
+                "description",
+                format!("description must be at most {MAX_DESCRIPTION_CHARS} characters"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Checks a machine name for the registry path `/api/v1/machines/{name}`: 1–64 characters of
+/// letters, digits, `-`, `_` and `.`, not starting with `.`.
+///
+/// # Errors
+/// `E_INPUT` at `name` otherwise.
+pub fn validate_machine_name(name: &str) -> Result<(), SolverError> {
+    let allowed = |c: char| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.');
+    if name.is_empty()
+        || name.chars().count() > MAX_NAME_CHARS
+        || name.starts_with('.')
+        || !name.chars().all(allowed)
+    {
+        return Err(SolverError::input(
+            "name",
+            format!(
+                "a machine name has 1 to {MAX_NAME_CHARS} letters, digits, '-', '_' or '.', and does not start with '.'"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn profiles_round_trip_and_validate() {
+        let json =
+            r#"{"block_time_ms": 4, "max_feed": 12000, "dialect": "linuxcnc", "margin": 1.1}"#;
+        let machine: MachineProfile = serde_json::from_str(json).unwrap();
+        assert_eq!(machine.dialect, Dialect::Linuxcnc);
+        machine.validate().unwrap();
+        let text = serde_json::to_string(&machine).unwrap();
+        assert_eq!(
+            serde_json::from_str::<MachineProfile>(&text).unwrap(),
+            machine
+        );
+        let bad = MachineProfile {
+            margin: Some(0.9),
+            ..machine.clone()
+        };
+        assert_eq!(bad.validate().unwrap_err().field(), Some("margin"));
+        let bad = MachineProfile {
+            block_time_ms: 0.0,
+            ..machine
+        };
+        assert_eq!(bad.validate().unwrap_err().field(), Some("block_time_ms"));
+        assert!(
+            serde_json::from_str::<MachineProfile>(
+                r#"{"block_time_ms": 4, "max_feed": 1, "x": 1}"#
+            )
+            .is_err()
+        );
+    }
+
+    #[test]
+    fn names_are_path_safe() {
+        assert!(validate_machine_name("dmu-50_hsc.2").is_ok());
+        for bad in ["", ".hidden", "a/b", "with space", &"x".repeat(65)] {
+            assert!(validate_machine_name(bad).is_err(), "{bad}");
+        }
+    }
+}

@@ -1,0 +1,569 @@
+//! NURBS curves of degree 1–5 (chord.md §1.2 "Prior art uses NURBS", §2.9 "Curve types"):
+//! knot-vector and weight validation, points and the first two derivatives by the basis-function
+//! algorithms A2.1–A2.3 of Piegl & Tiller, *The NURBS Book*, in homogeneous coordinates.
+
+use crate::error::{SolverError, finite};
+use crate::geometry::Vec3;
+
+/// Highest supported degree.
+pub const MAX_DEGREE: usize = 5;
+/// Most control points accepted.
+pub const MAX_CONTROL_POINTS: usize = 100_000;
+
+const SLOTS: usize = MAX_DEGREE + 1;
+
+/// A validated clamped NURBS curve.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Nurbs {
+    degree: usize,
+    knots: Vec<f64>,
+    /// Control points times their weight, and the weight: (w·x, w·y, w·z, w).
+    weighted: Vec<[f64; 4]>,
+}
+
+impl Nurbs {
+    /// Builds and validates a curve. `knots` defaults to the clamped uniform vector on [0, 1],
+    /// `weights` to 1 (a plain B-spline). Field paths start with `field` (e.g. `curve`).
+    ///
+    /// # Errors
+    /// `E_INPUT` for a bad degree, too few or too many control points, a knot vector of the wrong
+    /// length, decreasing, not clamped (first and last knot each `degree + 1` times) or with an
+    /// interior knot repeated more than `degree` times (the curve would break apart), and for
+    /// weights that are not positive.
+    pub(crate) fn new(
+        degree: usize,
+        points: &[Vec3],
+        knots: Option<&[f64]>,
+        weights: Option<&[f64]>,
+        field: &str,
+    ) -> Result<Self, SolverError> {
+        if !(1..=MAX_DEGREE).contains(&degree) {
+            return Err(SolverError::input(
+                format!("{field}.degree"),
+                format!("degree must be 1 to {MAX_DEGREE} (got {degree})"),
+            ));
+        }
+        let count = points.len();
+        if count < degree + 1 {
+            return Err(SolverError::input(
+                format!("{field}.control_points"),
+                format!(
+                    "a degree-{degree} curve needs at least {} control points (got {count})",
+                    degree + 1
+                ),
+            ));
+        }
+        if count > MAX_CONTROL_POINTS {
+            return Err(SolverError::input(
+                format!("{field}.control_points"),
+                format!("at most {MAX_CONTROL_POINTS} control points are accepted (got {count})"),
+            ));
+        }
+        let knots = match knots {
+            Some(given) => validate_knots(given, degree, count, field)?,
+            None => clamped_uniform(degree, count),
+        };
+        let weights: Vec<f64> = match weights {
+            Some(given) => {
+                if given.len() != count {
+                    return Err(SolverError::input(
+                        format!("{field}.weights"),
+                        format!(
+                            "weights must have one entry per control point ({count}), got {}",
+                            given.len()
+                        ),
+                    ));
+                }
+                for (index, &weight) in given.iter().enumerate() {
+                    let path = format!("{field}.weights[{index}]");
+                    if finite(&path, weight)? <= 0.0 {
+                        return Err(SolverError::input(
+                            path,
+                            format!("weights must be greater than 0 (got {weight})"),
+                        ));
+                    }
+                }
+                given.to_vec()
+            }
+            None => vec![1.0; count],
+        };
+        let weighted = points
+            .iter()
+            .zip(&weights)
+            .map(|(p, &w)| [w * p.x, w * p.y, w * p.z, w])
+            .collect();
+        Ok(Self {
+            degree,
+            knots,
+            weighted,
+        })
+    }
+
+    /// Parameter range [u_p, u_n].
+    pub(crate) fn domain(&self) -> (f64, f64) {
+        let n = self.weighted.len();
+        (self.knots[self.degree], self.knots[n])
+    }
+
+    /// The distinct knots inside the domain, ends included, with their multiplicity.
+    pub(crate) fn breaks(&self) -> Vec<(f64, usize)> {
+        let (start, end) = self.domain();
+        let mut out: Vec<(f64, usize)> = Vec::new();
+        for &knot in &self.knots {
+            if knot < start || knot > end {
+                continue;
+            }
+            match out.last_mut() {
+                Some((value, multiplicity)) if *value == knot => *multiplicity += 1,
+                _ => out.push((knot, 1)),
+            }
+        }
+        out
+    }
+
+    /// How many knots (with repetition) lie strictly between `lo` and `hi`.
+    pub(crate) fn knots_inside(&self, lo: f64, hi: f64) -> usize {
+        let from = self.knots.partition_point(|&k| k <= lo);
+        let to = self.knots.partition_point(|&k| k < hi);
+        to.saturating_sub(from)
+    }
+
+    /// Degree p.
+    pub(crate) fn degree(&self) -> usize {
+        self.degree
+    }
+
+    /// Knot span index i with u_i ≤ u < u_{i+1} (A2.1), the last non-empty span at the end.
+    fn span(&self, u: f64) -> usize {
+        let n = self.weighted.len();
+        let (start, end) = self.domain();
+        if u >= end {
+            // Last span with a non-zero length.
+            let mut i = n - 1;
+            while i > self.degree && self.knots[i] >= end {
+                i -= 1;
+            }
+            return i;
+        }
+        if u <= start {
+            let mut i = self.degree;
+            while i + 1 < n && self.knots[i + 1] <= start {
+                i += 1;
+            }
+            return i;
+        }
+        // First index with knot > u, minus one.
+        self.knots[..=n].partition_point(|&k| k <= u) - 1
+    }
+
+    /// The curve point at `u`.
+    pub(crate) fn point(&self, u: f64) -> Vec3 {
+        self.point_in(self.span(u), u)
+    }
+
+    /// The curve point at `u`, with `hint` a span index near it (updated to u's span): cheap
+    /// for the increasing parameters of a sampling loop.
+    pub(crate) fn point_near(&self, u: f64, hint: &std::cell::Cell<usize>) -> Vec3 {
+        let n = self.weighted.len();
+        let guess = hint.get();
+        let span = if guess >= self.degree
+            && guess < n
+            && self.knots[guess] <= u
+            && (u < self.knots[guess + 1] || (guess == n - 1 && u <= self.knots[n]))
+        {
+            guess
+        } else if guess + 1 >= self.degree
+            && guess + 1 < n
+            && self.knots[guess + 1] <= u
+            && u < self.knots[guess + 2]
+        {
+            guess + 1
+        } else {
+            self.span(u)
+        };
+        hint.set(span);
+        self.point_in(span, u)
+    }
+
+    fn point_in(&self, span: usize, u: f64) -> Vec3 {
+        let basis = self.basis(span, u);
+        let mut sum = [0.0; 4];
+        for (j, value) in basis.iter().take(self.degree + 1).enumerate() {
+            let control = &self.weighted[span - self.degree + j];
+            for (total, coordinate) in sum.iter_mut().zip(control) {
+                *total += value * coordinate;
+            }
+        }
+        Vec3::new(sum[0] / sum[3], sum[1] / sum[3], sum[2] / sum[3])
+    }
+
+    /// Point, first and second derivative with respect to u (the right-hand limits at a knot).
+    pub(crate) fn derivatives(&self, u: f64) -> [Vec3; 3] {
+        self.derivatives_in(self.span(u), u)
+    }
+
+    /// The left-hand limits of [`Nurbs::derivatives`] when `u` is an interior knot, where the
+    /// curvature may jump (a degree-2 curve is only C1 there); `None` elsewhere.
+    pub(crate) fn derivatives_from_left(&self, u: f64) -> Option<[Vec3; 3]> {
+        let right = self.span(u);
+        let n = self.weighted.len();
+        let left = self.knots[..=n]
+            .partition_point(|&k| k < u)
+            .saturating_sub(1)
+            .clamp(self.degree, n - 1);
+        (left != right).then(|| self.derivatives_in(left, u))
+    }
+
+    fn derivatives_in(&self, span: usize, u: f64) -> [Vec3; 3] {
+        let ders = self.basis_derivatives(span, u);
+        let mut homogeneous = [[0.0_f64; 4]; 3];
+        for (order, row) in ders.iter().enumerate() {
+            for (j, value) in row.iter().take(self.degree + 1).enumerate() {
+                let control = &self.weighted[span - self.degree + j];
+                for (total, coordinate) in homogeneous[order].iter_mut().zip(control) {
+                    *total += value * coordinate;
+                }
+            }
+        }
+        let vector = |h: &[f64; 4]| Vec3::new(h[0], h[1], h[2]);
+        let (a0, a1, a2) = (
+            vector(&homogeneous[0]),
+            vector(&homogeneous[1]),
+            vector(&homogeneous[2]),
+        );
+        let (w0, w1, w2) = (homogeneous[0][3], homogeneous[1][3], homogeneous[2][3]);
+        let point = a0 / w0;
+        let first = (a1 - w1 * point) / w0;
+        let second = (a2 - 2.0 * w1 * first - w2 * point) / w0;
+        [point, first, second]
+    }
+
+    /// Non-zero basis functions N_{span−p..span, p}(u) (A2.2).
+    fn basis(&self, span: usize, u: f64) -> [f64; SLOTS] {
+        let p = self.degree;
+        let knots = &self.knots;
+        let mut values = [0.0; SLOTS];
+        let (mut left, mut right) = ([0.0; SLOTS], [0.0; SLOTS]);
+        values[0] = 1.0;
+        for j in 1..=p {
+            left[j] = u - knots[span + 1 - j];
+            right[j] = knots[span + j] - u;
+            let mut saved = 0.0;
+            for r in 0..j {
+                let temp = values[r] / (right[r + 1] + left[j - r]);
+                values[r] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            values[j] = saved;
+        }
+        values
+    }
+
+    /// Basis functions and their first two derivatives (A2.3); rows are the derivative order.
+    fn basis_derivatives(&self, span: usize, u: f64) -> [[f64; SLOTS]; 3] {
+        let p = self.degree;
+        let knots = &self.knots;
+        let mut ndu = [[0.0_f64; SLOTS]; SLOTS];
+        let (mut left, mut right) = ([0.0; SLOTS], [0.0; SLOTS]);
+        ndu[0][0] = 1.0;
+        for j in 1..=p {
+            left[j] = u - knots[span + 1 - j];
+            right[j] = knots[span + j] - u;
+            let mut saved = 0.0;
+            for r in 0..j {
+                ndu[j][r] = right[r + 1] + left[j - r];
+                let temp = ndu[r][j - 1] / ndu[j][r];
+                ndu[r][j] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            ndu[j][j] = saved;
+        }
+        let mut ders = [[0.0_f64; SLOTS]; 3];
+        for j in 0..=p {
+            ders[0][j] = ndu[j][p];
+        }
+        let orders = p.min(2);
+        let (p_i, n_i) = (p as isize, orders as isize);
+        for r in 0..=p_i {
+            let mut a = [[0.0_f64; SLOTS]; 2];
+            let (mut s1, mut s2) = (0_usize, 1_usize);
+            a[0][0] = 1.0;
+            for k in 1..=n_i {
+                let mut d = 0.0;
+                let rk = r - k;
+                let pk = p_i - k;
+                let idx = |x: isize| x as usize;
+                if r >= k {
+                    a[s2][0] = a[s1][0] / ndu[idx(pk + 1)][idx(rk)];
+                    d = a[s2][0] * ndu[idx(rk)][idx(pk)];
+                }
+                let j1 = if rk >= -1 { 1 } else { -rk };
+                let j2 = if r - 1 <= pk { k - 1 } else { p_i - r };
+                for j in j1..=j2 {
+                    a[s2][idx(j)] =
+                        (a[s1][idx(j)] - a[s1][idx(j - 1)]) / ndu[idx(pk + 1)][idx(rk + j)];
+                    d += a[s2][idx(j)] * ndu[idx(rk + j)][idx(pk)];
+                }
+                if r <= pk {
+                    a[s2][idx(k)] = -a[s1][idx(k - 1)] / ndu[idx(pk + 1)][idx(r)];
+                    d += a[s2][idx(k)] * ndu[idx(r)][idx(pk)];
+                }
+                ders[idx(k)][idx(r)] = d;
+                std::mem::swap(&mut s1, &mut s2);
+            }
+        }
+        let mut factor = p as f64;
+        for (k, row) in ders.iter_mut().enumerate().skip(1).take(orders) {
+            for value in row.iter_mut().take(p + 1) {
+                *value *= factor;
+            }
+            factor *= (p - k) as f64;
+        }
+        ders
+    }
+}
+
+/// The clamped uniform knot vector on [0, 1] for `count` control points.
+fn clamped_uniform(degree: usize, count: usize) -> Vec<f64> {
+    let interior = count - degree - 1;
+    let mut knots = vec![0.0; degree + 1];
+    for k in 1..=interior {
+        knots.push(k as f64 / (interior + 1) as f64);
+    }
+    knots.extend(std::iter::repeat_n(1.0, degree + 1));
+    knots
+}
+
+fn validate_knots(
+    knots: &[f64],
+    degree: usize,
+    count: usize,
+    field: &str,
+) -> Result<Vec<f64>, SolverError> {
+    let path = format!("{field}.knots");
+    let expected = count + degree + 1;
+    if knots.len() != expected {
+        return Err(SolverError::input(
+            path,
+            format!(
+                "a degree-{degree} curve with {count} control points needs {expected} knots \
+                 (control points + degree + 1), got {}",
+                knots.len()
+            ),
+        ));
+    }
+    for (index, &knot) in knots.iter().enumerate() {
+        finite(&format!("{path}[{index}]"), knot)?;
+        if index > 0 && knot < knots[index - 1] {
+            return Err(SolverError::input(
+                format!("{path}[{index}]"),
+                format!(
+                    "knots must not decrease: {knot} follows {}",
+                    knots[index - 1]
+                ),
+            ));
+        }
+    }
+    let (first, last) = (knots[0], knots[expected - 1]);
+    for index in 1..=degree {
+        if knots[index] != first {
+            return Err(SolverError::input(
+                format!("{path}[{index}]"),
+                format!(
+                    "the knot vector must be clamped: the first {} knots must be equal",
+                    degree + 1
+                ),
+            ));
+        }
+        let back = expected - 1 - index;
+        if knots[back] != last {
+            return Err(SolverError::input(
+                format!("{path}[{back}]"),
+                format!(
+                    "the knot vector must be clamped: the last {} knots must be equal",
+                    degree + 1
+                ),
+            ));
+        }
+    }
+    if last <= first {
+        return Err(SolverError::input(
+            path,
+            "the knot vector spans no parameter range: its first and last knot are equal",
+        ));
+    }
+    // The ends appear exactly degree + 1 times, interior knots at most degree times: more and
+    // the curve would not start at its first control point, or would fall apart.
+    if knots[degree + 1] == first {
+        return Err(SolverError::input(
+            format!("{path}[{}]", degree + 1),
+            format!("the first knot may appear at most {} times", degree + 1),
+        ));
+    }
+    if knots[count - 1] == last {
+        return Err(SolverError::input(
+            format!("{path}[{}]", count - 1),
+            format!("the last knot may appear at most {} times", degree + 1),
+        ));
+    }
+    let mut run = 0;
+    for index in degree + 1..count {
+        run = if index > degree + 1 && knots[index] == knots[index - 1] {
+            run + 1
+        } else {
+            1
+        };
+        if run > degree {
+            return Err(SolverError::input(
+                format!("{path}[{index}]"),
+                format!(
+                    "interior knot {} is repeated {run} times; at most the degree ({degree}) is allowed",
+                    knots[index]
+                ),
+            ));
+        }
+    }
+    Ok(knots.to_vec())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_abs_diff_eq;
+
+    fn points(list: &[[f64; 2]]) -> Vec<Vec3> {
+        list.iter().map(|p| Vec3::new(p[0], p[1], 0.0)).collect()
+    }
+
+    #[test]
+    fn rational_quadratic_is_an_exact_quarter_circle() {
+        let control = points(&[[1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]);
+        let weights = [1.0, std::f64::consts::FRAC_1_SQRT_2, 1.0];
+        let curve = Nurbs::new(2, &control, None, Some(&weights), "curve").unwrap();
+        for k in 0..=10 {
+            let u = f64::from(k) / 10.0;
+            let [point, first, second] = curve.derivatives(u);
+            assert_abs_diff_eq!(point.norm(), 1.0, epsilon = 1e-14);
+            assert_abs_diff_eq!((curve.point(u) - point).norm(), 0.0, epsilon = 1e-15);
+            // Curvature of the unit circle is 1.
+            let curvature = first.cross(&second).norm() / first.norm().powi(3);
+            assert_abs_diff_eq!(curvature, 1.0, epsilon = 1e-12);
+        }
+    }
+
+    #[test]
+    fn derivatives_match_finite_differences() {
+        let control = points(&[
+            [0.0, 0.0],
+            [1.0, 2.0],
+            [3.0, 3.0],
+            [4.0, 0.0],
+            [6.0, 1.0],
+            [7.0, 4.0],
+        ]);
+        let weights = [1.0, 2.0, 0.5, 1.0, 3.0, 1.0];
+        for degree in 1..=5 {
+            let curve = Nurbs::new(degree, &control, None, Some(&weights), "curve").unwrap();
+            let step = 1e-5;
+            for k in 1..10 {
+                let u = f64::from(k) / 10.0 + 0.013;
+                let [_, first, second] = curve.derivatives(u);
+                let difference = (curve.point(u + step) - curve.point(u - step)) / (2.0 * step);
+                assert_abs_diff_eq!(
+                    (first - difference).norm(),
+                    0.0,
+                    epsilon = 1e-6 * (1.0 + first.norm())
+                );
+                if degree >= 3 {
+                    let [_, ahead, _] = curve.derivatives(u + step);
+                    let [_, behind, _] = curve.derivatives(u - step);
+                    let change = (ahead - behind) / (2.0 * step);
+                    assert_abs_diff_eq!(
+                        (second - change).norm(),
+                        0.0,
+                        epsilon = 1e-5 * (1.0 + second.norm())
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn knot_vectors_are_checked() {
+        let control = points(&[[0.0, 0.0], [1.0, 1.0], [2.0, 0.0], [3.0, 1.0]]);
+        let field = |knots: &[f64]| {
+            Nurbs::new(2, &control, Some(knots), None, "curve")
+                .unwrap_err()
+                .field()
+                .map(str::to_owned)
+        };
+        assert_eq!(
+            field(&[0.0, 0.0, 0.0, 1.0, 1.0, 1.0]).as_deref(),
+            Some("curve.knots")
+        );
+        assert_eq!(
+            field(&[0.0, 0.0, 0.0, 0.6, 0.5, 1.0, 1.0]).as_deref(),
+            Some("curve.knots[4]")
+        );
+        assert_eq!(
+            field(&[0.0, 0.0, 0.1, 0.5, 1.0, 1.0, 1.0]).as_deref(),
+            Some("curve.knots[2]")
+        );
+        assert_eq!(
+            field(&[0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 2.0]).as_deref(),
+            Some("curve.knots[5]")
+        );
+        assert_eq!(
+            field(&[0.0, 0.0, 0.0, f64::NAN, 1.0, 1.0, 1.0]).as_deref(),
+            Some("curve.knots[3]")
+        );
+        assert!(
+            Nurbs::new(
+                2,
+                &control,
+                Some(&[0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0]),
+                None,
+                "curve"
+            )
+            .is_ok()
+        );
+        let weights =
+            Nurbs::new(2, &control, None, Some(&[1.0, 0.0, 1.0, 1.0]), "curve").unwrap_err();
+        assert_eq!(weights.field(), Some("curve.weights[1]"));
+        assert_eq!(
+            Nurbs::new(6, &control, None, None, "curve")
+                .unwrap_err()
+                .field(),
+            Some("curve.degree")
+        );
+        assert_eq!(
+            Nurbs::new(3, &control[..3], None, None, "curve")
+                .unwrap_err()
+                .field(),
+            Some("curve.control_points")
+        );
+    }
+
+    #[test]
+    fn interior_knots_may_repeat_up_to_the_degree() {
+        let control = points(&[[0.0, 0.0], [1.0, 1.0], [2.0, 0.0], [3.0, 1.0], [4.0, 0.0]]);
+        let ok = [0.0, 0.0, 0.0, 0.5, 0.5, 1.0, 1.0, 1.0];
+        assert!(Nurbs::new(2, &control, Some(&ok), None, "curve").is_ok());
+        let control6 = points(&[
+            [0.0, 0.0],
+            [1.0, 1.0],
+            [2.0, 0.0],
+            [3.0, 1.0],
+            [4.0, 0.0],
+            [5.0, 1.0],
+        ]);
+        let bad = [0.0, 0.0, 0.0, 0.5, 0.5, 0.5, 1.0, 1.0, 1.0];
+        let error = Nurbs::new(2, &control6, Some(&bad), None, "curve").unwrap_err();
+        assert_eq!(error.field(), Some("curve.knots[5]"));
+        let curve = Nurbs::new(2, &control, Some(&ok), None, "curve").unwrap();
+        assert_eq!(curve.breaks(), vec![(0.0, 3), (0.5, 2), (1.0, 3)]);
+        // Clamped: the ends are the end control points.
+        assert_abs_diff_eq!((curve.point(0.0) - control[0]).norm(), 0.0);
+        assert_abs_diff_eq!((curve.point(1.0) - control[4]).norm(), 0.0, epsilon = 1e-15);
+    }
+}

@@ -1,0 +1,63 @@
+//! The G-code program of a segment answer (chord.md §6.1): G01 blocks through the command points
+//! with the F word, written by the house post.
+//!
+//! The path: rapid to the clearance plane above the first point, feed down to it, the G01
+//! blocks, and (by the post) back up to the clearance plane. A segment program has no tool of its
+//! own: the caller says how the program selects one. Coordinates are those of the curve (the
+//! programmed point), 2-D curves at z = 0.
+
+use super::answer::SegmentAnswer;
+use crate::error::SolverError;
+use crate::gcode::{self, Dialect, Program, ToolCall};
+use crate::geometry::Vec3;
+use crate::path::Toolpath;
+
+/// How to post the program.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Post {
+    /// Control dialect.
+    pub dialect: Dialect,
+    /// Tool selection, as the caller wants it written.
+    pub tool: ToolCall,
+}
+
+/// The complete program for a segment answer.
+///
+/// # Errors
+/// `E_NO_PROGRAM` when the answer has no block (it always has one when `solve` succeeded).
+pub fn program(answer: &SegmentAnswer, post: &Post) -> Result<String, SolverError> {
+    let points: Vec<Vec3> = answer
+        .points
+        .iter()
+        .map(|p| {
+            Vec3::new(
+                p.first().copied().unwrap_or(0.0),
+                p.get(1).copied().unwrap_or(0.0),
+                p.get(2).copied().unwrap_or(0.0),
+            )
+        })
+        .collect();
+    let Some(first) = points.first() else {
+        return Err(SolverError::new("E_NO_PROGRAM", "the answer has no points"));
+    };
+    if points.len() < 2 {
+        return Err(SolverError::new("E_NO_PROGRAM", "the answer has no block"));
+    }
+    let mut path = Toolpath::default();
+    path.rapid(Vec3::new(first.x, first.y, answer.safe_z));
+    path.linear(*first, answer.feed);
+    for point in &points[1..] {
+        path.linear(*point, answer.feed);
+    }
+    Ok(gcode::write(&Program {
+        dialect: post.dialect,
+        number: 1001,
+        title: "kerf segment",
+        comments: answer.description.clone(),
+        tool: post.tool.clone(),
+        spindle_rpm: answer.spindle_rpm,
+        safe_z: answer.safe_z,
+        blend_tolerance: answer.chord_error.max(1e-4),
+        path: &path,
+    }))
+}

@@ -1,0 +1,731 @@
+//! The segment request as clients send it (api.md, Segment) and its validation into a `Job`
+//! with the machine's defaults applied (chord.md §1.2 inputs, §4 E6 and E16).
+
+use serde::{Deserialize, Serialize};
+
+use super::arclength::ArcLengthTable;
+use super::machine::MachineProfile;
+use super::nurbs::Nurbs;
+use super::rule::{BlockRule, RuleSettings};
+use super::segment::Estimate;
+use super::shape::{Arc, Ellipse, Polyline, Shape, Spline, require_length};
+use crate::error::{SolverError, Warning, finite, positive};
+use crate::geometry::Vec3;
+
+/// Most polyline points accepted.
+pub const MAX_POLYLINE_POINTS: usize = 1_000_000;
+/// Largest coordinate magnitude accepted, mm.
+pub const MAX_COORDINATE: f64 = 1e6;
+/// Smallest accuracy tolerance accepted, mm.
+pub const MIN_TOLERANCE: f64 = 1e-6;
+/// Default corner angle for polylines and splines, degrees.
+pub const DEFAULT_CORNER_ANGLE_DEG: f64 = 20.0;
+/// Default window length in target chords (chord.md §8 Q2: 3–5 chords per window).
+pub const DEFAULT_WINDOW_CHORDS: f64 = 5.0;
+/// Default spindle speed for the G-code program, rpm.
+pub const DEFAULT_SPINDLE_RPM: f64 = 6000.0;
+/// Default height of the clearance plane above the curve's highest point, mm.
+pub const DEFAULT_CLEARANCE: f64 = 5.0;
+
+/// Travel direction, seen from +Z.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Direction {
+    /// Counter-clockwise (increasing angle).
+    #[default]
+    Ccw,
+    /// Clockwise.
+    Cw,
+}
+
+/// The target curve. Points are `[x, y]` (the XY plane) or `[x, y, z]`; circles, arcs and
+/// ellipses lie in a plane parallel to XY at the centre's z.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Curve {
+    /// A full circle, starting and ending at `start_deg`.
+    Circle {
+        /// Centre, `[x, y]` or `[x, y, z]`.
+        centre: Vec<f64>,
+        /// Radius, mm.
+        radius: f64,
+        /// Angle of the start point from +X, degrees (default 0).
+        #[serde(default)]
+        start_deg: f64,
+        /// `ccw` (default) or `cw`.
+        #[serde(default)]
+        direction: Direction,
+    },
+    /// A circular arc from `start_deg` to `end_deg` in `direction` (equal angles 360° apart, or
+    /// 0 and 360, make a full circle).
+    Arc {
+        /// Centre, `[x, y]` or `[x, y, z]`.
+        centre: Vec<f64>,
+        /// Radius, mm.
+        radius: f64,
+        /// Angle of the start point from +X, degrees.
+        start_deg: f64,
+        /// Angle of the end point from +X, degrees.
+        end_deg: f64,
+        /// `ccw` (default) or `cw`.
+        #[serde(default)]
+        direction: Direction,
+    },
+    /// An elliptic arc x = a·cos t, y = b·sin t (in the ellipse's own axes), t from `start_deg`
+    /// to `end_deg`: the parametric (eccentric) angle, not the polar angle of the point.
+    Ellipse {
+        /// Centre, `[x, y]` or `[x, y, z]`.
+        centre: Vec<f64>,
+        /// `[a, b]`: semi-axis along the ellipse's first axis and across it, mm.
+        semi_axes: [f64; 2],
+        /// Start parameter t, degrees (default 0).
+        #[serde(default)]
+        start_deg: f64,
+        /// End parameter t, degrees (default: a full turn after `start_deg`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        end_deg: Option<f64>,
+        /// Angle of the first axis (of `a`) from +X, degrees (default 0).
+        #[serde(default)]
+        rotation_deg: f64,
+        /// `ccw` (default, increasing t) or `cw`.
+        #[serde(default)]
+        direction: Direction,
+    },
+    /// Dense points of the target curve (2-D or 3-D), taken as the true curve: the chords end on
+    /// its edges. Repeated consecutive points are dropped. Vertices where the direction turns by
+    /// more than `corner_angle_deg` are corners: always command points, never inside a window.
+    Polyline {
+        /// The points in order, all with the same number of coordinates.
+        points: Vec<Vec<f64>>,
+        /// Smallest direction change that makes a corner, degrees (default 20).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        corner_angle_deg: Option<f64>,
+    },
+    /// A B-spline or NURBS curve (CAD output). Knots must be clamped (first and last knot
+    /// `degree + 1` times, interior knots at most `degree` times).
+    Bspline {
+        /// Degree, 1 to 5.
+        degree: usize,
+        /// Control points, all `[x, y]` or all `[x, y, z]`.
+        control_points: Vec<Vec<f64>>,
+        /// Knot vector, `control_points + degree + 1` values (default: clamped uniform on [0, 1]).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        knots: Option<Vec<f64>>,
+        /// Weights, one per control point, > 0 (default: all 1, a plain B-spline).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        weights: Option<Vec<f64>>,
+        /// Smallest direction change at a knot of multiplicity ≥ degree that makes a corner,
+        /// degrees (default 20).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        corner_angle_deg: Option<f64>,
+    },
+}
+
+/// Where the chord error comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    /// Per curvature window of length `window` (embodiments 1, 2 and 6; Fig. 7).
+    #[default]
+    Window,
+    /// One value for the whole curve by `rule` (embodiments 3–5).
+    Curve,
+}
+
+/// The whole-curve rule of `mode: curve`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum CurveRule {
+    /// The largest window value along the curve (embodiment 3, Eq. 10).
+    Max,
+    /// From the smallest radius and the feed (embodiment 4, Eq. 13).
+    #[default]
+    Extremes,
+    /// From the largest normal acceleration F²/r (embodiment 5, Eq. 15).
+    NormalAccel,
+}
+
+/// How a window's radius of curvature is estimated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum RadiusEstimate {
+    /// Circle through the window's start, middle and end (chord.md §2.8, the patent), held
+    /// within 1.1 times the smallest radius of curvature inside the window.
+    #[default]
+    ThreePoint,
+    /// Smallest radius of curvature inside the window and the reach of its first chord: every
+    /// block is then at least margin × feed × block time long, even where the curvature grows.
+    Minimum,
+}
+
+/// `POST /api/v1/segment`: cut a curve into G01 blocks whose chord error follows the control's
+/// block processing time (chord.md; seed 001).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct SegmentRequest {
+    /// The target curve.
+    pub curve: Curve,
+    /// F: commanded feed, mm/min (default: the machine's `max_feed`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feed: Option<f64>,
+    /// T_b: block processing time of the control, ms (default: the machine's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub block_time_ms: Option<f64>,
+    /// `window` (default) or `curve`.
+    #[serde(default)]
+    pub mode: Mode,
+    /// Δs: window length for `mode: window` (and `rule: max`), mm (default 5 target chords).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub window: Option<f64>,
+    /// `mode: curve` only: `extremes` (default), `max` or `normal_accel`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rule: Option<CurveRule>,
+    /// `rule: extremes` or `normal_accel` only: r_min read off the drawing, mm (default: computed
+    /// from the curve).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_radius: Option<f64>,
+    /// `three_point` (default) or `minimum`; `mode: window` and `rule: max` only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius_estimate: Option<RadiusEstimate>,
+    /// k_f: margin factor on the feed, ≥ 1 (default: the machine's, else 1). The blocks aim at
+    /// margin × feed × block time.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub margin: Option<f64>,
+    /// k_ce: factor on the chord error, ≥ 1 (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub chord_error_factor: Option<f64>,
+    /// k_r: factor on the radius, in (0, 1] (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius_factor: Option<f64>,
+    /// k_Tb: factor on the block time, ≥ 1 (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub block_time_factor: Option<f64>,
+    /// Accept factors on the unsafe side (below the surface) with a `W_UNSAFE_MARGIN` warning.
+    #[serde(default)]
+    pub allow_unsafe_margin: bool,
+    /// Use the first-order sagitta h²/2r (Eq. 9) instead of the exact Eq. 8.
+    #[serde(default)]
+    pub sagitta_approximation: bool,
+    /// C_emin: lower bound of the chord error, mm (default: the machine's, else 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_chord_error: Option<f64>,
+    /// C_tol: accuracy bound, mm. The chord error is never coarser; where the rule wants more,
+    /// blocks get shorter than feed × block time and `W_CHORD_ERROR_EXCEEDS_TOLERANCE` gives the
+    /// feed that would meet both.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
+    /// Also cut the curve with this plain fixed chord error, mm, and report its figures side by
+    /// side (`comparison`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compare_tolerance: Option<f64>,
+    /// A registered machine whose values are the defaults of this request.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub machine: Option<String>,
+    /// Spindle speed for the G-code program, rpm (default 6000).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spindle_rpm: Option<f64>,
+    /// Z of the clearance plane for the G-code program, mm (default 5 above the curve's highest point).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub safe_z: Option<f64>,
+}
+
+/// Where the chord error comes from, resolved.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Plan {
+    Window { length: f64, estimate: Estimate },
+    Max { length: f64, estimate: Estimate },
+    Extremes { min_radius: Option<f64> },
+    NormalAccel { min_radius: Option<f64> },
+}
+
+/// A validated request: the curve built, the machine's defaults applied.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Job {
+    pub shape: Shape,
+    /// Parameter ranges between corners.
+    pub spans: Vec<(f64, f64)>,
+    /// 2 or 3: the coordinates of the answer's points.
+    pub dimension: usize,
+    pub rule: BlockRule,
+    pub plan: Plan,
+    pub tolerance: Option<f64>,
+    pub compare_tolerance: Option<f64>,
+    pub spindle_rpm: f64,
+    pub safe_z: Option<f64>,
+    pub warnings: Vec<Warning>,
+}
+
+/// A point `[x, y]` or `[x, y, z]` with finite coordinates of sane size.
+fn point(field: &str, coordinates: &[f64]) -> Result<Vec3, SolverError> {
+    if !(2..=3).contains(&coordinates.len()) {
+        return Err(SolverError::input(
+            field,
+            format!(
+                "a point has 2 or 3 coordinates (got {}); extra axes such as rotary ones have no metric here",
+                coordinates.len()
+            ),
+        ));
+    }
+    for (axis, &value) in coordinates.iter().enumerate() {
+        let path = format!("{field}[{axis}]");
+        if finite(&path, value)?.abs() > MAX_COORDINATE {
+            return Err(SolverError::input(
+                path,
+                format!("coordinates must be within ±{MAX_COORDINATE} mm (got {value})"),
+            ));
+        }
+    }
+    Ok(Vec3::new(
+        coordinates[0],
+        coordinates[1],
+        coordinates.get(2).copied().unwrap_or(0.0),
+    ))
+}
+
+/// Points of one list, all with the dimension of the first.
+fn points(field: &str, list: &[Vec<f64>]) -> Result<(Vec<Vec3>, usize), SolverError> {
+    let dimension = list.first().map_or(2, Vec::len);
+    let mut out = Vec::with_capacity(list.len());
+    for (index, coordinates) in list.iter().enumerate() {
+        let path = format!("{field}[{index}]");
+        if coordinates.len() != dimension {
+            return Err(SolverError::input(
+                path,
+                format!(
+                    "every point must have {dimension} coordinates like the first (got {})",
+                    coordinates.len()
+                ),
+            ));
+        }
+        out.push(point(&path, coordinates)?);
+    }
+    Ok((out, dimension))
+}
+
+fn radius(field: &str, value: f64) -> Result<f64, SolverError> {
+    if positive(field, value)? > MAX_COORDINATE {
+        return Err(SolverError::input(
+            field,
+            format!("{field} must be at most {MAX_COORDINATE} mm (got {value})"),
+        ));
+    }
+    Ok(value)
+}
+
+/// Swept angle in radians from start to end in the direction: in (0, 2π], a full turn when the
+/// angles differ by a non-zero multiple of 360°.
+fn sweep(start_deg: f64, end_deg: f64, direction: Direction) -> f64 {
+    let forward = match direction {
+        Direction::Ccw => end_deg - start_deg,
+        Direction::Cw => start_deg - end_deg,
+    };
+    let wrapped = forward.rem_euclid(360.0);
+    if wrapped == 0.0 && forward != 0.0 {
+        std::f64::consts::TAU
+    } else {
+        wrapped.to_radians()
+    }
+}
+
+fn sense(direction: Direction) -> f64 {
+    match direction {
+        Direction::Ccw => 1.0,
+        Direction::Cw => -1.0,
+    }
+}
+
+fn corner_angle(value: Option<f64>) -> Result<f64, SolverError> {
+    let field = "curve.corner_angle_deg";
+    let degrees = value.unwrap_or(DEFAULT_CORNER_ANGLE_DEG);
+    if !(finite(field, degrees)? > 0.0 && degrees < 180.0) {
+        return Err(SolverError::input(
+            field,
+            format!("corner_angle_deg must be between 0 and 180 (got {degrees})"),
+        ));
+    }
+    Ok(degrees.to_radians())
+}
+
+impl Curve {
+    /// Builds the curve, its corner list and its dimension.
+    pub(crate) fn build(&self) -> Result<(Shape, Vec<f64>, usize, Vec<Warning>), SolverError> {
+        let mut warnings = Vec::new();
+        let (shape, corners, dimension) = match self {
+            Self::Circle {
+                centre,
+                radius: r,
+                start_deg,
+                direction,
+            } => {
+                let c = point("curve.centre", centre)?;
+                let shape = Shape::Arc(Arc {
+                    centre: c,
+                    radius: radius("curve.radius", *r)?,
+                    start: finite("curve.start_deg", *start_deg)?.to_radians(),
+                    sense: sense(*direction),
+                    sweep: std::f64::consts::TAU,
+                });
+                (shape, Vec::new(), centre.len())
+            }
+            Self::Arc {
+                centre,
+                radius: r,
+                start_deg,
+                end_deg,
+                direction,
+            } => {
+                let c = point("curve.centre", centre)?;
+                let start = finite("curve.start_deg", *start_deg)?;
+                let end = finite("curve.end_deg", *end_deg)?;
+                let swept = sweep(start, end, *direction);
+                if swept == 0.0 {
+                    return Err(SolverError::new(
+                        "E_DEGENERATE_CURVE",
+                        "the arc starts and ends at the same angle: it has no length (use 0 and 360 for a full circle)",
+                    )
+                    .at("curve.end_deg"));
+                }
+                let shape = Shape::Arc(Arc {
+                    centre: c,
+                    radius: radius("curve.radius", *r)?,
+                    start: start.to_radians(),
+                    sense: sense(*direction),
+                    sweep: swept,
+                });
+                (shape, Vec::new(), centre.len())
+            }
+            Self::Ellipse {
+                centre,
+                semi_axes,
+                start_deg,
+                end_deg,
+                rotation_deg,
+                direction,
+            } => {
+                let c = point("curve.centre", centre)?;
+                let a = radius("curve.semi_axes[0]", semi_axes[0])?;
+                let b = radius("curve.semi_axes[1]", semi_axes[1])?;
+                let start = finite("curve.start_deg", *start_deg)?;
+                let end = match end_deg {
+                    Some(end) => finite("curve.end_deg", *end)?,
+                    None => start + 360.0,
+                };
+                let swept = sweep(start, end, *direction);
+                if swept == 0.0 {
+                    return Err(SolverError::new(
+                        "E_DEGENERATE_CURVE",
+                        "the ellipse arc starts and ends at the same angle: it has no length",
+                    )
+                    .at("curve.end_deg"));
+                }
+                let start = start.to_radians();
+                let sense = sense(*direction);
+                let speed = |u: f64| {
+                    let t = start + sense * u;
+                    (a * t.sin()).hypot(b * t.cos())
+                };
+                // Panel breaks at the quarter points, where the speed has its extremes.
+                let quarter = std::f64::consts::FRAC_PI_2;
+                let mut breaks = vec![0.0];
+                let first = if sense > 0.0 {
+                    (start / quarter).floor() + 1.0
+                } else {
+                    (start / quarter).ceil() - 1.0
+                };
+                let mut k = first;
+                loop {
+                    let u = (k * quarter - start) * sense;
+                    if u >= swept - 1e-12 {
+                        break;
+                    }
+                    breaks.push(u);
+                    k += sense;
+                }
+                breaks.push(swept);
+                let table = ArcLengthTable::build(&speed, &breaks, 16, "curve")?;
+                let shape = Shape::Ellipse(Ellipse {
+                    centre: c,
+                    semi_axes: [a, b],
+                    rotation: finite("curve.rotation_deg", *rotation_deg)?.to_radians(),
+                    start,
+                    sense,
+                    sweep: swept,
+                    table,
+                });
+                (shape, Vec::new(), centre.len())
+            }
+            Self::Polyline {
+                points: list,
+                corner_angle_deg,
+            } => {
+                if list.len() > MAX_POLYLINE_POINTS {
+                    return Err(SolverError::input(
+                        "curve.points",
+                        format!(
+                            "at most {MAX_POLYLINE_POINTS} points are accepted (got {})",
+                            list.len()
+                        ),
+                    ));
+                }
+                let corner = corner_angle(*corner_angle_deg)?;
+                let (all, dimension) = points("curve.points", list)?;
+                let mut vertices: Vec<Vec3> = Vec::with_capacity(all.len());
+                let mut dropped = 0;
+                for p in all {
+                    if vertices.last() == Some(&p) {
+                        dropped += 1;
+                    } else {
+                        vertices.push(p);
+                    }
+                }
+                if dropped > 0 {
+                    warnings.push(Warning::new(
+                        "W_DUPLICATE_POINTS",
+                        format!("{dropped} repeated consecutive points were dropped"),
+                    ));
+                }
+                if vertices.len() < 2 {
+                    return Err(SolverError::new(
+                        "E_DEGENERATE_CURVE",
+                        "a polyline needs at least two distinct points",
+                    )
+                    .at("curve.points"));
+                }
+                let mut stations = Vec::with_capacity(vertices.len());
+                let mut length = 0.0;
+                stations.push(0.0);
+                for pair in vertices.windows(2) {
+                    length += (pair[1] - pair[0]).norm();
+                    stations.push(length);
+                }
+                let shape = Shape::Polyline(Polyline { vertices, stations });
+                let corners = shape.corners(corner);
+                (shape, corners, dimension)
+            }
+            Self::Bspline {
+                degree,
+                control_points,
+                knots,
+                weights,
+                corner_angle_deg,
+            } => {
+                let corner = corner_angle(*corner_angle_deg)?;
+                if control_points.len() > super::nurbs::MAX_CONTROL_POINTS {
+                    return Err(SolverError::input(
+                        "curve.control_points",
+                        format!(
+                            "at most {} control points are accepted (got {})",
+                            super::nurbs::MAX_CONTROL_POINTS,
+                            control_points.len()
+                        ),
+                    ));
+                }
+                let (control, dimension) = points("curve.control_points", control_points)?;
+                let nurbs = Nurbs::new(
+                    *degree,
+                    &control,
+                    knots.as_deref(),
+                    weights.as_deref(),
+                    "curve",
+                )?;
+                if control.windows(2).all(|pair| pair[0] == pair[1]) {
+                    return Err(SolverError::new(
+                        "E_DEGENERATE_CURVE",
+                        "all control points coincide: the curve has no length",
+                    )
+                    .at("curve.control_points"));
+                }
+                let breaks: Vec<f64> = nurbs.breaks().iter().map(|(knot, _)| *knot).collect();
+                let speed = |u: f64| nurbs.derivatives(u)[1].norm();
+                let table = ArcLengthTable::build(&speed, &breaks, 4, "curve.control_points")?;
+                let shape = Shape::Spline(Spline { nurbs, table });
+                let corners = shape.corners(corner);
+                (shape, corners, dimension)
+            }
+        };
+        let field = match self {
+            Self::Polyline { .. } => "curve.points",
+            Self::Bspline { .. } => "curve.control_points",
+            _ => "curve.radius",
+        };
+        require_length(&shape, field)?;
+        Ok((shape, corners, dimension, warnings))
+    }
+}
+
+fn optional_tolerance(field: &str, value: Option<f64>) -> Result<Option<f64>, SolverError> {
+    let Some(value) = value else {
+        return Ok(None);
+    };
+    if positive(field, value)? < MIN_TOLERANCE {
+        return Err(SolverError::input(
+            field,
+            format!("{field} must be at least {MIN_TOLERANCE} mm (got {value})"),
+        ));
+    }
+    Ok(Some(value))
+}
+
+impl SegmentRequest {
+    /// A request for `curve` at `feed` (mm/min) on a control with `block_time_ms`, everything
+    /// else at its default (window mode, no margins, no bounds): the starting point for callers
+    /// in Rust, e.g. a path solver resampling its own dense points as a `polyline`.
+    pub fn new(curve: Curve, feed: f64, block_time_ms: f64) -> Self {
+        Self {
+            curve,
+            feed: Some(feed),
+            block_time_ms: Some(block_time_ms),
+            mode: Mode::Window,
+            window: None,
+            rule: None,
+            min_radius: None,
+            radius_estimate: None,
+            margin: None,
+            chord_error_factor: None,
+            radius_factor: None,
+            block_time_factor: None,
+            allow_unsafe_margin: false,
+            sagitta_approximation: false,
+            min_chord_error: None,
+            tolerance: None,
+            compare_tolerance: None,
+            machine: None,
+            spindle_rpm: None,
+            safe_z: None,
+        }
+    }
+
+    /// The block-time rule of this request with `machine`'s defaults (fields are named as in
+    /// the request); also the warnings about unsafe factors or a feed above the machine's.
+    ///
+    /// # Errors
+    /// `E_INPUT` naming the field for a missing or bad value.
+    pub fn block_rule(
+        &self,
+        machine: Option<&MachineProfile>,
+    ) -> Result<(BlockRule, Vec<Warning>), SolverError> {
+        let settings = RuleSettings {
+            feed: self.feed,
+            block_time_ms: self.block_time_ms,
+            margin: self.margin,
+            min_chord_error: self.min_chord_error,
+        };
+        let adjust = |rule: &mut BlockRule| {
+            rule.chord_error_factor = self.chord_error_factor.unwrap_or(1.0);
+            rule.radius_factor = self.radius_factor.unwrap_or(1.0);
+            rule.block_time_factor = self.block_time_factor.unwrap_or(1.0);
+            rule.sagitta_approximation = self.sagitta_approximation;
+        };
+        BlockRule::resolve_with(&settings, machine, adjust, self.allow_unsafe_margin)
+    }
+
+    /// Validates the request with the resolved machine (if it names one).
+    pub(crate) fn validate(&self, machine: Option<&MachineProfile>) -> Result<Job, SolverError> {
+        let (rule, mut warnings) = self.block_rule(machine)?;
+        let window = self.window.map(|w| positive("window", w)).transpose()?;
+        let default_window = DEFAULT_WINDOW_CHORDS * rule.target_chord();
+        let estimate = match self.radius_estimate.unwrap_or_default() {
+            RadiusEstimate::ThreePoint => Estimate::ThreePoint,
+            RadiusEstimate::Minimum => Estimate::Minimum,
+        };
+        let min_radius = self
+            .min_radius
+            .map(|r| positive("min_radius", r))
+            .transpose()?;
+        let plan = match (self.mode, self.rule) {
+            (Mode::Window, Some(_)) => {
+                return Err(SolverError::input(
+                    "rule",
+                    "rule applies to mode \"curve\" only",
+                ));
+            }
+            (Mode::Window, None) => Plan::Window {
+                length: window.unwrap_or(default_window),
+                estimate,
+            },
+            (Mode::Curve, rule) => match rule.unwrap_or_default() {
+                CurveRule::Max => Plan::Max {
+                    length: window.unwrap_or(default_window),
+                    estimate,
+                },
+                other => {
+                    if window.is_some() {
+                        return Err(SolverError::input(
+                            "window",
+                            "window applies to mode \"window\" and rule \"max\" only",
+                        ));
+                    }
+                    if self.radius_estimate.is_some() {
+                        return Err(SolverError::input(
+                            "radius_estimate",
+                            "radius_estimate applies to mode \"window\" and rule \"max\" only",
+                        ));
+                    }
+                    if other == CurveRule::NormalAccel {
+                        Plan::NormalAccel { min_radius }
+                    } else {
+                        Plan::Extremes { min_radius }
+                    }
+                }
+            },
+        };
+        if min_radius.is_some() && !matches!(plan, Plan::Extremes { .. } | Plan::NormalAccel { .. })
+        {
+            return Err(SolverError::input(
+                "min_radius",
+                "min_radius applies to mode \"curve\" with rule \"extremes\" or \"normal_accel\" only",
+            ));
+        }
+        let tolerance = optional_tolerance("tolerance", self.tolerance)?;
+        let compare_tolerance = optional_tolerance("compare_tolerance", self.compare_tolerance)?;
+        let spindle_rpm = self
+            .spindle_rpm
+            .map_or(Ok(DEFAULT_SPINDLE_RPM), |rpm| positive("spindle_rpm", rpm))?;
+        let safe_z = self.safe_z.map(|z| finite("safe_z", z)).transpose()?;
+        let (shape, corners, dimension, curve_warnings) = self.curve.build()?;
+        warnings.extend(curve_warnings);
+        let (start, end) = shape.domain();
+        let mut spans = Vec::with_capacity(corners.len() + 1);
+        let mut from = start;
+        for corner in corners {
+            if corner > from && corner < end {
+                spans.push((from, corner));
+                from = corner;
+            }
+        }
+        spans.push((from, end));
+        Ok(Job {
+            shape,
+            spans,
+            dimension,
+            rule,
+            plan,
+            tolerance,
+            compare_tolerance,
+            spindle_rpm,
+            safe_z,
+            warnings,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sweeps_follow_the_direction() {
+        let deg = |x: f64| x.to_radians();
+        assert!((sweep(0.0, 90.0, Direction::Ccw) - deg(90.0)).abs() < 1e-15);
+        assert!((sweep(0.0, 90.0, Direction::Cw) - deg(270.0)).abs() < 1e-15);
+        assert!((sweep(350.0, 10.0, Direction::Ccw) - deg(20.0)).abs() < 1e-14);
+        assert!((sweep(0.0, 360.0, Direction::Ccw) - deg(360.0)).abs() < 1e-15);
+        assert_eq!(sweep(30.0, 30.0, Direction::Ccw), 0.0);
+    }
+}

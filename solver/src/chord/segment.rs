@@ -1,0 +1,529 @@
+//! Segmentation with C_ep (chord.md §2.9): greedy maximal chords (first crossing), the
+//! per-window procedure of embodiments 1, 2 and 6 (Fig. 7/8, S101–S108) with carry-over and the
+//! progress rule, and the single-value run of embodiments 3–5 and of fixed-tolerance baselines.
+//! Paths are split at corners (E11): every corner is a command point and starts fresh windows.
+
+use super::numeric::last_fitting;
+use super::rule::{BlockRule, ChordStatus, Infeasible, chord_length};
+use super::shape::{Shape, circumradius};
+use crate::error::SolverError;
+use crate::geometry::Vec3;
+
+/// Slack on the chord error when testing a chord (chord.md §2.9: eps = 1e-12 mm).
+const EPS: f64 = 1e-12;
+/// Width (mm of arc length) to which the crossing is bracketed.
+const CROSSING_WIDTH: f64 = 1e-12;
+/// Fixed steps before the search for the crossing starts doubling its step (long straights).
+const STEPS_BEFORE_GALLOP: usize = 32;
+/// A chord shorter than this (mm) means the search made no progress (E14).
+const MIN_PROGRESS: f64 = 1e-9;
+/// Largest ratio of a window's 3-point radius to the smallest radius inside the window that is
+/// used as it is; beyond it the radius is held at this multiple of the smallest (E10). A chord
+/// cut with it is at least 1/√SPREAD_CAP of the target chord long.
+pub(crate) const SPREAD_CAP: f64 = 1.1;
+/// Slack on window ends (chord.md §2.9: s1 + 1e-12).
+const WINDOW_SLACK: f64 = 1e-12;
+
+/// A command point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Vertex {
+    /// Curve parameter.
+    pub u: f64,
+    /// Arc length from the curve start, mm.
+    pub s: f64,
+    /// P(u).
+    pub point: Vec3,
+}
+
+/// How a window's chord error was chosen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Status {
+    Surface,
+    Straight,
+    ClampedToMin,
+    LimitedByTolerance,
+}
+
+/// One window of constant chord error.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct WindowRecord {
+    pub s_start: f64,
+    pub s_end: f64,
+    /// Radius the chord error came from (infinite when straight).
+    pub radius: f64,
+    /// C_ep before the accuracy bound.
+    pub rule_chord_error: f64,
+    /// Chord error used for the chords.
+    pub chord_error: f64,
+    pub status: Status,
+    /// The radius estimate exceeds the smallest radius inside the window by this factor (E10).
+    pub spread: f64,
+    pub blocks: usize,
+}
+
+/// The result of a cut: command points, windows, and which blocks end a span (a corner or the
+/// path end).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct Cut {
+    pub vertices: Vec<Vertex>,
+    pub windows: Vec<WindowRecord>,
+    /// Block indices (block i runs from vertex i to i + 1) that end at a corner or the path end.
+    pub span_ends: Vec<usize>,
+}
+
+/// How the window radius is estimated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Estimate {
+    /// Circumradius of P(s0), P(sm), P(s1) (chord.md §2.8, the patent).
+    ThreePoint,
+    /// Smallest radius over the window and the reach of its first chord.
+    Minimum,
+}
+
+/// Where a failure happened: E3 with its arc length.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct InfeasibleAt {
+    pub s: f64,
+    pub infeasible: Infeasible,
+}
+
+/// Why a cut stopped.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum CutError {
+    Infeasible(InfeasibleAt),
+    Solver(SolverError),
+}
+
+impl From<SolverError> for CutError {
+    fn from(error: SolverError) -> Self {
+        Self::Solver(error)
+    }
+}
+
+/// The segmentation of one curve under a block limit.
+pub(crate) struct Cutter<'a> {
+    pub shape: &'a Shape,
+    /// Parameter ranges between corners, in order.
+    pub spans: &'a [(f64, f64)],
+    /// Most blocks before `E_TOO_MANY_BLOCKS`.
+    pub max_blocks: usize,
+    /// Field blamed when the limit is hit.
+    pub limit_field: &'a str,
+}
+
+impl Cutter<'_> {
+    fn vertex(&self, u: f64) -> Vertex {
+        Vertex {
+            u,
+            s: self.shape.s_at(u),
+            point: self.shape.point(u),
+        }
+    }
+
+    /// `greedy_end` of chord.md §2.9: the end of the longest chord from `start` whose deviation
+    /// stays within `chord_error` (the first crossing), searched in steps of `step_guess/4` of
+    /// arc length up to `limit`.
+    fn greedy_end(
+        &self,
+        start: &Vertex,
+        chord_error: f64,
+        limit: &Vertex,
+        step_guess: f64,
+    ) -> Result<Vertex, SolverError> {
+        let allowed = chord_error + EPS;
+        let quarter = step_guess / 4.0;
+        if limit.s - start.s <= quarter
+            && self.shape.deviation_against(start.u, limit.u, allowed) <= allowed
+        {
+            return Ok(*limit);
+        }
+        // Steps of a quarter guess of arc length, taken in the parameter with the local speed.
+        let mut step = quarter.max(1e-9);
+        let (mut lo_u, mut lo_dev) = (start.u, 0.0);
+        let mut steps = 0;
+        let (hi_u, hi_dev) = loop {
+            let speed = self.shape.speed(lo_u);
+            let ahead = if speed > 0.0 {
+                lo_u + step / speed
+            } else {
+                limit.u
+            };
+            let hi_u = ahead.min(limit.u);
+            let dev = self.shape.deviation_against(start.u, hi_u, allowed);
+            if dev > allowed {
+                break (hi_u, dev);
+            }
+            if hi_u >= limit.u {
+                return Ok(*limit);
+            }
+            (lo_u, lo_dev) = (hi_u, dev);
+            steps += 1;
+            if steps >= STEPS_BEFORE_GALLOP {
+                step *= 2.0;
+            }
+        };
+        // The deviation grows about with the square of the chord: its root is nearly linear in
+        // the chord's end, which the root finder solves in a few steps.
+        let root = allowed.sqrt();
+        let g = |u: f64| self.shape.deviation(start.u, u).sqrt() - root;
+        // Bracket to 1e-12 mm of arc length, converted with the bracket's mean speed (the speed
+        // at one end may be zero: a cusp).
+        let width = self.shape.s_at(hi_u) - self.shape.s_at(lo_u);
+        let speed = width / (hi_u - lo_u);
+        let tol = if speed > 0.0 {
+            (CROSSING_WIDTH / speed).max(f64::MIN_POSITIVE)
+        } else {
+            f64::EPSILON * hi_u.abs().max(f64::MIN_POSITIVE)
+        };
+        let end = last_fitting(
+            g,
+            lo_u,
+            lo_dev.sqrt() - root,
+            hi_u,
+            hi_dev.sqrt() - root,
+            tol,
+        )
+        .ok_or_else(|| {
+            SolverError::new(
+                "E_NUMERIC_FAILURE",
+                format!(
+                    "the chord search did not converge at s = {:.6} mm (E14)",
+                    start.s
+                ),
+            )
+            .at("curve")
+        })?;
+        let end = self.vertex(end);
+        // A remainder below a nanometre is not a block: the chord takes it.
+        Ok(if limit.s - end.s < MIN_PROGRESS {
+            *limit
+        } else {
+            end
+        })
+    }
+
+    /// Appends a command point; `span_end` is the parameter where its span ends.
+    fn push(&self, cut: &mut Cut, vertex: Vertex, span_end: f64) -> Result<(), SolverError> {
+        if cut.vertices.len() > self.max_blocks {
+            return Err(SolverError::new(
+                "E_TOO_MANY_BLOCKS",
+                format!(
+                    "the segmentation needs more than {} blocks; raise the chord error (feed, margin, \
+                     min_chord_error or tolerance) or shorten the curve",
+                    self.max_blocks
+                ),
+            )
+            .at(self.limit_field));
+        }
+        if let Some(last) = cut.vertices.last()
+            && vertex.s - last.s < MIN_PROGRESS
+            && vertex.u != span_end
+        {
+            return Err(SolverError::new(
+                "E_NUMERIC_FAILURE",
+                format!(
+                    "no chord longer than {MIN_PROGRESS} mm fits at s = {:.6} mm: the chord error is too small for \
+                     the curve here (E14)",
+                    last.s
+                ),
+            )
+            .at("curve"));
+        }
+        cut.vertices.push(vertex);
+        Ok(())
+    }
+
+    fn start(&self) -> Option<Cut> {
+        let &(first, _) = self.spans.first()?;
+        Some(Cut {
+            vertices: vec![self.vertex(first)],
+            ..Cut::default()
+        })
+    }
+
+    /// Embodiments 3–5 and fixed tolerances: one chord error for the whole curve. `radius` is
+    /// the radius it came from (for the step guess; infinite when unknown or straight).
+    pub(crate) fn constant(&self, chord_error: f64, radius: f64) -> Result<Cut, SolverError> {
+        let Some(mut cut) = self.start() else {
+            return Ok(Cut::default());
+        };
+        for &(u_start, u_end) in self.spans {
+            let mut from = self.vertex(u_start);
+            let limit = self.vertex(u_end);
+            let guess = step_guess(radius, chord_error, limit.s - from.s);
+            while from.s < limit.s && from.u != limit.u {
+                let next = self.greedy_end(&from, chord_error, &limit, guess)?;
+                self.push(&mut cut, next, limit.u)?;
+                from = next;
+            }
+            cut.span_ends.push(cut.vertices.len().saturating_sub(2));
+        }
+        Ok(cut)
+    }
+
+    /// Radius estimates of windows of length `window` laid end to end along every span
+    /// (embodiment 3, Eq. 10: the chord error is the largest over these), with the arc length
+    /// where each window starts.
+    pub(crate) fn tiled_radii(
+        &self,
+        window: f64,
+        estimate: Estimate,
+        scale: f64,
+    ) -> Result<Vec<(f64, f64)>, SolverError> {
+        let mut out = Vec::new();
+        for &(u_start, u_end) in self.spans {
+            let (s_start, s_end) = (self.shape.s_at(u_start), self.shape.s_at(u_end));
+            let count = ((s_end - s_start) / window).ceil().max(1.0);
+            if out.len() as f64 + count > self.max_blocks as f64 {
+                return Err(SolverError::new(
+                    "E_TOO_MANY_BLOCKS",
+                    format!(
+                        "windows of {window} mm cut this curve into more than {} pieces; lengthen the window",
+                        self.max_blocks
+                    ),
+                )
+                .at("window"));
+            }
+            let count = count as usize;
+            for k in 0..count {
+                let s0 = s_start + window * k as f64;
+                let s1 = (s0 + window).min(s_end);
+                let (u0, u1) = (self.shape.u_at(s0), self.shape.u_at(s1));
+                let three_point = circumradius(
+                    &self.shape.point(u0),
+                    &self.shape.point(self.shape.u_at(0.5 * (s0 + s1))),
+                    &self.shape.point(u1),
+                );
+                let smallest = self.shape.min_radius(u0, u1, scale).0;
+                let radius = match estimate {
+                    Estimate::ThreePoint if three_point.is_finite() => {
+                        three_point.min(SPREAD_CAP * smallest)
+                    }
+                    _ => smallest,
+                };
+                out.push((s0, radius));
+            }
+        }
+        Ok(out)
+    }
+
+    /// Embodiments 1, 2 and 6: the per-window procedure (chord.md §2.9, normative version).
+    /// `chord_error_of(radius)` is the rule (with the accuracy bound applied by the caller's
+    /// `tolerance`); `window` is Δs.
+    pub(crate) fn windows(
+        &self,
+        rule: &BlockRule,
+        tolerance: Option<f64>,
+        window: f64,
+        estimate: Estimate,
+    ) -> Result<Cut, CutError> {
+        let Some(mut cut) = self.start() else {
+            return Ok(Cut::default());
+        };
+        let scale = rule.target_chord();
+        for &(u_start, u_end) in self.spans {
+            let span_end = self.vertex(u_end);
+            let (s_end, mut s0) = (span_end.s, self.shape.s_at(u_start));
+            let mut from = self.vertex(u_start);
+            let mut s1 = s0 + window;
+            let mut last_window = false;
+            if s1 >= s_end {
+                (s1, last_window) = (s_end, true);
+            }
+            loop {
+                let u0 = from.u;
+                let u1 = if last_window {
+                    u_end
+                } else {
+                    self.shape.u_at(s1)
+                };
+                let three_point = {
+                    let middle = self.shape.point(self.shape.u_at(0.5 * (s0 + s1)));
+                    circumradius(&from.point, &middle, &self.shape.point(u1))
+                };
+                let (smallest, _) = self.shape.min_radius(u0, u1, scale);
+                let spread = if three_point.is_finite() {
+                    three_point / smallest
+                } else if smallest.is_finite() {
+                    f64::INFINITY
+                } else {
+                    1.0
+                };
+                let radius = match estimate {
+                    // The 3-point circle of a window whose curvature grows inside it (towards a
+                    // flat point, an inflection, three collinear points on an S) can be orders of
+                    // magnitude too large, so C_ep tiny and the chords far shorter than a block:
+                    // the estimate is held within SPREAD_CAP of the smallest radius there (E10).
+                    Estimate::ThreePoint if three_point.is_infinite() => smallest,
+                    Estimate::ThreePoint => three_point.min(SPREAD_CAP * smallest),
+                    Estimate::Minimum => self.reach_radius(rule, smallest, s0, s1, u0, s_end)?,
+                };
+                let (rule_chord_error, surface) =
+                    rule.chord_error(radius).map_err(|infeasible| {
+                        CutError::Infeasible(InfeasibleAt { s: s0, infeasible })
+                    })?;
+                let (chord_error, status) = classify(rule_chord_error, surface, radius, tolerance);
+                let guess = step_guess(radius, chord_error, window);
+                let mut blocks = 0;
+                let limit = span_end;
+                while from.s < s_end && from.u != u_end {
+                    let next = self.greedy_end(&from, chord_error, &limit, guess)?;
+                    let beyond = next.s > s1 + WINDOW_SLACK && !last_window;
+                    if beyond && blocks > 0 {
+                        break; // carry over: the next window starts at the last command point
+                    }
+                    self.push(&mut cut, next, limit.u)?;
+                    from = next;
+                    blocks += 1;
+                    if beyond {
+                        break; // progress rule
+                    }
+                }
+                cut.windows.push(WindowRecord {
+                    s_start: s0,
+                    s_end: s1,
+                    radius,
+                    rule_chord_error,
+                    chord_error,
+                    status,
+                    spread,
+                    blocks,
+                });
+                if last_window || from.s >= s_end || from.u == u_end {
+                    break;
+                }
+                s0 = from.s;
+                s1 = s0 + window;
+                if s1 >= s_end {
+                    (s1, last_window) = (s_end, true);
+                }
+            }
+            cut.span_ends.push(cut.vertices.len().saturating_sub(2));
+        }
+        Ok(cut)
+    }
+
+    /// The smallest radius over the window and over the reach of a chord cut with it, so that
+    /// the first chord (which may run past the window, progress rule) also sees every bend.
+    fn reach_radius(
+        &self,
+        rule: &BlockRule,
+        window_radius: f64,
+        s0: f64,
+        s1: f64,
+        u0: f64,
+        s_end: f64,
+    ) -> Result<f64, CutError> {
+        let mut radius = window_radius;
+        for _ in 0..8 {
+            let (chord_error, _) = rule
+                .chord_error(radius)
+                .map_err(|infeasible| CutError::Infeasible(InfeasibleAt { s: s0, infeasible }))?;
+            let reach = (s0 + 1.05 * chord_length(radius, chord_error)).min(s_end);
+            if reach <= s1 {
+                break;
+            }
+            let (wider, _) = self
+                .shape
+                .min_radius(u0, self.shape.u_at(reach), rule.target_chord());
+            if wider >= radius {
+                break;
+            }
+            radius = wider;
+        }
+        Ok(radius)
+    }
+}
+
+/// The chord error a window cuts with and why.
+pub(crate) fn classify(
+    rule_chord_error: f64,
+    surface: ChordStatus,
+    radius: f64,
+    tolerance: Option<f64>,
+) -> (f64, Status) {
+    if let Some(limit) = tolerance
+        && rule_chord_error > limit
+    {
+        return (limit, Status::LimitedByTolerance);
+    }
+    let status = match surface {
+        ChordStatus::ClampedToMin => Status::ClampedToMin,
+        ChordStatus::Surface if radius == f64::INFINITY => Status::Straight,
+        ChordStatus::Surface => Status::Surface,
+    };
+    (rule_chord_error, status)
+}
+
+/// The step guess of chord.md §2.9: the circle chord `2√(2rC − C²)`, or `fallback` (Δs, or the
+/// span) when the radius is infinite or the chord error zero.
+fn step_guess(radius: f64, chord_error: f64, fallback: f64) -> f64 {
+    if radius.is_finite() && chord_error > 0.0 {
+        chord_length(radius, chord_error)
+    } else {
+        fallback
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::chord::shape::Arc;
+
+    fn circle(radius: f64) -> Shape {
+        Shape::Arc(Arc {
+            centre: Vec3::zeros(),
+            radius,
+            start: 0.0,
+            sense: 1.0,
+            sweep: std::f64::consts::TAU,
+        })
+    }
+
+    #[test]
+    fn the_block_limit_names_its_field() {
+        let shape = circle(50.0);
+        let spans = [shape.domain()];
+        let cutter = Cutter {
+            shape: &shape,
+            spans: &spans,
+            max_blocks: 10,
+            limit_field: "compare_tolerance",
+        };
+        let error = cutter.constant(0.001, 50.0).unwrap_err();
+        assert_eq!(error.code(), "E_TOO_MANY_BLOCKS");
+        assert_eq!(error.field(), Some("compare_tolerance"));
+    }
+
+    #[test]
+    fn a_search_without_progress_fails_instead_of_looping() {
+        // Chord error 0 on a 0.1 µm circle: the longest fitting chord is below 1 nm (E14).
+        let shape = circle(1e-7);
+        let spans = [shape.domain()];
+        let cutter = Cutter {
+            shape: &shape,
+            spans: &spans,
+            max_blocks: 1000,
+            limit_field: "tolerance",
+        };
+        let error = cutter.constant(0.0, f64::INFINITY).unwrap_err();
+        assert_eq!(error.code(), "E_NUMERIC_FAILURE");
+    }
+
+    #[test]
+    fn greedy_chords_on_a_circle_have_the_sagitta_length() {
+        let shape = circle(50.0);
+        let spans = [shape.domain()];
+        let cutter = Cutter {
+            shape: &shape,
+            spans: &spans,
+            max_blocks: 1000,
+            limit_field: "tolerance",
+        };
+        let cut = cutter.constant(0.01, 50.0).unwrap();
+        assert_eq!(cut.vertices.len(), 159);
+        let chord = (cut.vertices[1].point - cut.vertices[0].point).norm();
+        assert!((chord - chord_length(50.0, 0.01)).abs() < 1e-9);
+        assert_eq!(cut.span_ends, vec![157]);
+    }
+}

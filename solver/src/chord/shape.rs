@@ -1,0 +1,625 @@
+//! The target curve P as the segmentation sees it (chord.md §1.2, §2.8, §2.9): points by an
+//! internal parameter u, arc length both ways, the deviation of a chord from the curve, the
+//! smallest radius of curvature on a stretch, and the corners where the path must be split (E11).
+//!
+//! u is the arc length itself for circular arcs and polylines, the ellipse angle t for ellipses
+//! and the knot parameter for NURBS; evaluating there and converting only chord ends keeps the
+//! arc-length inversion out of the inner loops.
+
+use super::arclength::ArcLengthTable;
+use super::numeric::minimise;
+use super::nurbs::Nurbs;
+use crate::error::SolverError;
+use crate::geometry::{Vec3, distance_to_segment};
+
+/// Sub-intervals sampled before the deviation is refined (chord.md §2.9).
+const DEVIATION_SAMPLES: usize = 32;
+
+/// Below this fraction of a threshold the refinement of the best sample cannot change a
+/// "does the chord fit" answer on a smooth curve (it raises the sampled maximum by about
+/// 1/1000 of the deviation), so it is skipped.
+const REFINE_FRACTION: f64 = 0.9;
+
+/// Most parabolic steps when refining a deviation.
+const PARABOLIC_STEPS: usize = 6;
+
+/// Curvature samples per window or knot span when looking for the smallest radius.
+const RADIUS_SAMPLES: usize = 16;
+
+/// Most radius samples on one stretch.
+const MAX_RADIUS_SAMPLES: usize = 4096;
+
+/// A circular arc in a plane parallel to XY: P(s) = c + r·(cos φ, sin φ, 0), φ = φ0 + σ·s/r.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Arc {
+    pub centre: Vec3,
+    pub radius: f64,
+    pub start: f64,
+    /// +1 counter-clockwise, −1 clockwise.
+    pub sense: f64,
+    /// Swept angle, rad (> 0).
+    pub sweep: f64,
+}
+
+/// An elliptic arc: P(t) = c + R(ψ)·(a cos t, b sin t, 0), t = t0 + σ·u, u ∈ [0, sweep].
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Ellipse {
+    pub centre: Vec3,
+    pub semi_axes: [f64; 2],
+    pub rotation: f64,
+    pub start: f64,
+    pub sense: f64,
+    pub sweep: f64,
+    pub table: ArcLengthTable,
+}
+
+/// A polyline taken as the true curve: P(s) runs along its edges.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Polyline {
+    pub vertices: Vec<Vec3>,
+    /// Arc length at each vertex.
+    pub stations: Vec<f64>,
+}
+
+/// A NURBS curve with its arc-length table.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Spline {
+    pub nurbs: Nurbs,
+    pub table: ArcLengthTable,
+}
+
+/// One of the supported curves.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Shape {
+    Arc(Arc),
+    Ellipse(Ellipse),
+    Polyline(Polyline),
+    Spline(Spline),
+}
+
+impl Ellipse {
+    fn angle(&self, u: f64) -> f64 {
+        self.start + self.sense * u
+    }
+
+    fn local(&self, t: f64) -> (f64, f64) {
+        (self.semi_axes[0] * t.cos(), self.semi_axes[1] * t.sin())
+    }
+
+    fn point(&self, u: f64) -> Vec3 {
+        let (x, y) = self.local(self.angle(u));
+        let (sin, cos) = self.rotation.sin_cos();
+        self.centre + Vec3::new(cos * x - sin * y, sin * x + cos * y, 0.0)
+    }
+
+    /// |dP/du|.
+    fn speed(&self, u: f64) -> f64 {
+        let t = self.angle(u);
+        let [a, b] = self.semi_axes;
+        (a * t.sin()).hypot(b * t.cos())
+    }
+
+    /// Radius of curvature at t: (a² sin² t + b² cos² t)^{3/2} / (a·b).
+    fn radius(&self, t: f64) -> f64 {
+        let [a, b] = self.semi_axes;
+        (a * t.sin()).hypot(b * t.cos()).powi(3) / (a * b)
+    }
+}
+
+impl Spline {
+    fn speed(&self, u: f64) -> f64 {
+        self.nurbs.derivatives(u)[1].norm()
+    }
+
+    /// Radius of curvature |C'|³/|C'×C''|; at a knot the smaller of both one-sided values.
+    fn radius(&self, u: f64) -> f64 {
+        let of = |[_, first, second]: [Vec3; 3]| {
+            let bend = first.cross(&second).norm();
+            if bend == 0.0 {
+                f64::INFINITY
+            } else {
+                first.norm().powi(3) / bend
+            }
+        };
+        let right = of(self.nurbs.derivatives(u));
+        self.nurbs
+            .derivatives_from_left(u)
+            .map_or(right, |left| right.min(of(left)))
+    }
+}
+
+impl Polyline {
+    /// Index of the edge holding arc length `s`.
+    fn edge(&self, s: f64) -> usize {
+        let last_edge = self.vertices.len().saturating_sub(2);
+        self.stations
+            .partition_point(|&x| x <= s)
+            .saturating_sub(1)
+            .min(last_edge)
+    }
+
+    fn point(&self, s: f64) -> Vec3 {
+        let k = self.edge(s);
+        let (Some(a), Some(b), Some(&s0), Some(&s1)) = (
+            self.vertices.get(k),
+            self.vertices.get(k + 1),
+            self.stations.get(k),
+            self.stations.get(k + 1),
+        ) else {
+            return self.vertices.first().copied().unwrap_or_else(Vec3::zeros);
+        };
+        let fraction = ((s - s0) / (s1 - s0)).clamp(0.0, 1.0);
+        a + (b - a) * fraction
+    }
+}
+
+/// The maximum of a smooth `f` near the middle of three samples `x` (increasing) with values
+/// `y` (the middle one the largest): successive parabolic interpolation, kept inside the
+/// bracket, until a step gains less than 1e-13 of the value or the `rounding` of the distances;
+/// Brent's method when the parabola has no peak inside the bracket or converges slowly.
+fn refine_maximum(
+    f: &impl Fn(f64) -> f64,
+    x: [f64; 3],
+    y: [f64; 3],
+    tol: f64,
+    rounding: f64,
+) -> f64 {
+    let ([mut a, mut b, mut c], [mut fa, mut fb, mut fc]) = (x, y);
+    // A smooth maximum is found to 1e-13 in three or four steps (superlinear convergence from
+    // a bracket of 1/16 of the chord); beyond that the values' rounding only moves the vertex.
+    for _ in 0..PARABOLIC_STEPS {
+        let (left, right) = (b - a, b - c);
+        let numerator = left * left * (fb - fc) - right * right * (fb - fa);
+        let denominator = left * (fb - fc) - right * (fb - fa);
+        let vertex = b - 0.5 * numerator / denominator;
+        if denominator == 0.0 || !(vertex > a && vertex < c) {
+            // Not a peak the parabola sees (flat, or rounding): search the bracket.
+            let (_, negative) = minimise(|u| -f(u), a, c, tol);
+            return fb.max(-negative);
+        }
+        if (vertex - b).abs() <= tol {
+            return fb.max(f(vertex));
+        }
+        let value = f(vertex);
+        if (value - fb).abs() <= 1e-13 * fb + rounding {
+            return fb.max(value);
+        }
+        if value >= fb {
+            if vertex < b {
+                (c, fc) = (b, fb);
+            } else {
+                (a, fa) = (b, fb);
+            }
+            (b, fb) = (vertex, value);
+        } else if vertex < b {
+            (a, fa) = (vertex, value);
+        } else {
+            (c, fc) = (vertex, value);
+        }
+    }
+    // Slow convergence (a kink, e.g. a curvature jump at a knot): finish on the bracket.
+    let (_, negative) = minimise(|u| -f(u), a, c, tol);
+    fb.max(-negative)
+}
+
+/// Radius of the circle through three points, in any dimension (chord.md §2.8); infinite when
+/// they are collinear: |u×v| ≤ 1e-15·longest side², plus the rounding of coordinates of this
+/// size (points interpolated far from the origin are collinear only to that).
+pub(crate) fn circumradius(p0: &Vec3, pm: &Vec3, p1: &Vec3) -> f64 {
+    let (u, v, w) = (pm - p0, p1 - p0, p1 - pm);
+    let twice_area = u.cross(&v).norm();
+    let longest = u.norm().max(v.norm()).max(w.norm());
+    let size = p0.amax().max(pm.amax()).max(p1.amax());
+    if twice_area <= 1e-15 * longest * longest + 16.0 * f64::EPSILON * size * longest {
+        return f64::INFINITY;
+    }
+    u.norm() * v.norm() * w.norm() / (2.0 * twice_area)
+}
+
+impl Shape {
+    /// Parameter range.
+    pub(crate) fn domain(&self) -> (f64, f64) {
+        match self {
+            Self::Arc(arc) => (0.0, arc.radius * arc.sweep),
+            Self::Ellipse(ellipse) => (0.0, ellipse.sweep),
+            Self::Polyline(line) => (0.0, line.stations.last().copied().unwrap_or(0.0)),
+            Self::Spline(spline) => spline.nurbs.domain(),
+        }
+    }
+
+    /// Arc length, mm.
+    pub(crate) fn length(&self) -> f64 {
+        match self {
+            Self::Arc(_) | Self::Polyline(_) => self.domain().1,
+            Self::Ellipse(ellipse) => ellipse.table.length(),
+            Self::Spline(spline) => spline.table.length(),
+        }
+    }
+
+    /// P(u).
+    pub(crate) fn point(&self, u: f64) -> Vec3 {
+        match self {
+            Self::Arc(arc) => {
+                let angle = arc.start + arc.sense * u / arc.radius;
+                arc.centre + arc.radius * Vec3::new(angle.cos(), angle.sin(), 0.0)
+            }
+            Self::Ellipse(ellipse) => ellipse.point(u),
+            Self::Polyline(line) => line.point(u),
+            Self::Spline(spline) => spline.nurbs.point(u),
+        }
+    }
+
+    /// |dP/du|: 1 where u is the arc length.
+    pub(crate) fn speed(&self, u: f64) -> f64 {
+        match self {
+            Self::Arc(_) | Self::Polyline(_) => 1.0,
+            Self::Ellipse(ellipse) => ellipse.speed(u),
+            Self::Spline(spline) => spline.speed(u),
+        }
+    }
+
+    /// Arc length from the start to parameter `u`.
+    pub(crate) fn s_at(&self, u: f64) -> f64 {
+        match self {
+            Self::Arc(_) | Self::Polyline(_) => u,
+            Self::Ellipse(ellipse) => ellipse.table.s_at(&|x| ellipse.speed(x), u),
+            Self::Spline(spline) => spline.table.s_at(&|x| spline.speed(x), u),
+        }
+    }
+
+    /// Parameter at arc length `s`.
+    pub(crate) fn u_at(&self, s: f64) -> f64 {
+        match self {
+            Self::Arc(_) | Self::Polyline(_) => s.clamp(0.0, self.domain().1),
+            Self::Ellipse(ellipse) => ellipse.table.u_at(&|x| ellipse.speed(x), s),
+            Self::Spline(spline) => spline.table.u_at(&|x| spline.speed(x), s),
+        }
+    }
+
+    /// dev(u_a, u_b): the largest distance of the curve between the two parameters from the
+    /// segment joining their points (chord.md §2.9). Exact for arcs (the sagitta) and polylines
+    /// (the farthest vertex); otherwise 32 samples refined by Brent's method on the two
+    /// sub-intervals around the best.
+    pub(crate) fn deviation(&self, ua: f64, ub: f64) -> f64 {
+        match self {
+            Self::Arc(arc) => {
+                let quarter = (ub - ua).abs() / (4.0 * arc.radius);
+                2.0 * arc.radius * quarter.sin().powi(2)
+            }
+            Self::Polyline(line) => {
+                let (a, b) = (line.point(ua), line.point(ub));
+                let (lo, hi) = (ua.min(ub), ua.max(ub));
+                let first = line.stations.partition_point(|&x| x <= lo);
+                let mut worst = 0.0_f64;
+                for (vertex, &station) in line.vertices.iter().zip(&line.stations).skip(first) {
+                    if station >= hi {
+                        break;
+                    }
+                    worst = worst.max(distance_to_segment(vertex, &a, &b));
+                }
+                worst
+            }
+            Self::Ellipse(_) | Self::Spline(_) => self.sampled_deviation(ua, ub, None),
+        }
+    }
+
+    /// dev(u_a, u_b) where only "is it above `limit`" matters: the sampling stops at the first
+    /// sample above it, and the refinement is skipped well below it.
+    pub(crate) fn deviation_against(&self, ua: f64, ub: f64, limit: f64) -> f64 {
+        match self {
+            Self::Ellipse(_) | Self::Spline(_) => self.sampled_deviation(ua, ub, Some(limit)),
+            Self::Arc(_) | Self::Polyline(_) => self.deviation(ua, ub),
+        }
+    }
+
+    fn sampled_deviation(&self, ua: f64, ub: f64, threshold: Option<f64>) -> f64 {
+        let (a, b) = (self.point(ua), self.point(ub));
+        let hint = std::cell::Cell::new(0);
+        let distance = |u: f64| {
+            let p = match self {
+                Self::Spline(spline) => spline.nurbs.point_near(u, &hint),
+                _ => self.point(u),
+            };
+            distance_to_segment(&p, &a, &b)
+        };
+        let step = (ub - ua) / DEVIATION_SAMPLES as f64;
+        let mut samples = [0.0_f64; DEVIATION_SAMPLES + 1];
+        let mut best_index = 0;
+        for j in 1..DEVIATION_SAMPLES {
+            samples[j] = distance(ua + step * j as f64);
+            if threshold.is_some_and(|limit| samples[j] > limit) {
+                return samples[j];
+            }
+            if samples[j] > samples[best_index] {
+                best_index = j;
+            }
+        }
+        let best = samples[best_index];
+        if best_index == 0 || threshold.is_some_and(|limit| best < REFINE_FRACTION * limit) {
+            return best;
+        }
+        let at = |j: usize| ua + step * j as f64;
+        let tol = 1e-9 * (ub - ua).abs() + 4.0 * f64::EPSILON * ua.abs().max(ub.abs());
+        // Distances are computed from coordinates of this size: their rounding is the floor.
+        let rounding = 8.0 * f64::EPSILON * a.amax().max(b.amax());
+        refine_maximum(
+            &distance,
+            [at(best_index - 1), at(best_index), at(best_index + 1)],
+            [samples[best_index - 1], best, samples[best_index + 1]],
+            tol,
+            rounding,
+        )
+    }
+
+    /// The smallest radius of curvature on [u_a, u_b] (mm; infinite where straight), and where it
+    /// is. Analytic for arcs and ellipses, sampled from the derivatives and refined for NURBS;
+    /// for polylines the circumradius of P(s − L/2), P(s), P(s + L/2) at steps of L/4 with
+    /// `scale` = L (the block length), which measures the bend at the scale of the chords and
+    /// not the noise of the points.
+    pub(crate) fn min_radius(&self, ua: f64, ub: f64, scale: f64) -> (f64, f64) {
+        let (lo, hi) = (ua.min(ub), ua.max(ub));
+        match self {
+            Self::Arc(arc) => (arc.radius, lo),
+            Self::Ellipse(ellipse) => {
+                // r(t) is monotone between multiples of π/2: check the ends and those.
+                let mut best = (ellipse.radius(ellipse.angle(lo)), lo);
+                let end = ellipse.radius(ellipse.angle(hi));
+                if end < best.0 {
+                    best = (end, hi);
+                }
+                let quarter = std::f64::consts::FRAC_PI_2;
+                let (t_lo, t_hi) = {
+                    let (x, y) = (ellipse.angle(lo), ellipse.angle(hi));
+                    (x.min(y), x.max(y))
+                };
+                let mut k = (t_lo / quarter).ceil();
+                while k * quarter <= t_hi {
+                    let t = k * quarter;
+                    let radius = ellipse.radius(t);
+                    if radius < best.0 {
+                        best = (radius, (t - ellipse.start) * ellipse.sense);
+                    }
+                    k += 1.0;
+                }
+                best
+            }
+            Self::Polyline(line) => {
+                let half = 0.5 * scale;
+                if hi - lo <= scale {
+                    let middle = 0.5 * (lo + hi);
+                    let radius =
+                        circumradius(&line.point(lo), &line.point(middle), &line.point(hi));
+                    return (radius, middle);
+                }
+                let count =
+                    (((hi - lo) / (0.25 * scale)).ceil() as usize).clamp(1, MAX_RADIUS_SAMPLES);
+                let step = (hi - lo - scale) / count as f64;
+                let mut best = (f64::INFINITY, lo + half);
+                for j in 0..=count {
+                    let s = lo + half + step * j as f64;
+                    let radius =
+                        circumradius(&line.point(s - half), &line.point(s), &line.point(s + half));
+                    if radius < best.0 {
+                        best = (radius, s);
+                    }
+                }
+                best
+            }
+            Self::Spline(spline) => {
+                let breaks = spline.nurbs.knots_inside(lo, hi);
+                let count = (RADIUS_SAMPLES * (breaks + 1)).min(MAX_RADIUS_SAMPLES);
+                let step = (hi - lo) / count as f64;
+                let mut best = (f64::INFINITY, lo);
+                let mut best_index = 0;
+                for j in 0..=count {
+                    let u = lo + step * j as f64;
+                    let radius = spline.radius(u);
+                    if radius < best.0 {
+                        (best, best_index) = ((radius, u), j);
+                    }
+                }
+                if best.0.is_finite() && hi > lo {
+                    let from = lo + step * best_index.saturating_sub(1) as f64;
+                    let to = (lo + step * (best_index + 1) as f64).min(hi);
+                    let (u, radius) = minimise(|u| spline.radius(u), from, to, 1e-9 * (hi - lo));
+                    if radius < best.0 {
+                        best = (radius, u);
+                    }
+                }
+                best
+            }
+        }
+    }
+
+    /// Break points of [u_a, u_b] into pieces small enough for [`Shape::min_radius`] to sample
+    /// well: NURBS knot spans, polyline pieces of 1000 `scale` (at most 10 000 of them), else
+    /// the whole range.
+    pub(crate) fn radius_pieces(&self, ua: f64, ub: f64, scale: f64) -> Vec<f64> {
+        let mut out = vec![ua];
+        match self {
+            Self::Spline(spline) => out.extend(
+                spline
+                    .nurbs
+                    .breaks()
+                    .iter()
+                    .map(|(knot, _)| *knot)
+                    .filter(|&knot| knot > ua && knot < ub),
+            ),
+            Self::Polyline(_) => {
+                // At most 10 000 pieces, whatever the scale.
+                let piece = (1000.0 * scale).max((ub - ua) / 10_000.0);
+                let count = ((ub - ua) / piece).ceil();
+                if count > 1.0 && count.is_finite() {
+                    for k in 1..count as usize {
+                        out.push(ua + piece * k as f64);
+                    }
+                }
+            }
+            Self::Arc(_) | Self::Ellipse(_) => {}
+        }
+        out.push(ub);
+        out
+    }
+
+    /// Parameters of the interior corners, where the direction turns by more than `corner`
+    /// radians (E11): polyline vertices, and NURBS knots of multiplicity ≥ the degree or where
+    /// the curve stops (cusps).
+    pub(crate) fn corners(&self, corner: f64) -> Vec<f64> {
+        let turn = |before: Vec3, after: Vec3| {
+            let (nb, na) = (before.norm(), after.norm());
+            if nb == 0.0 || na == 0.0 {
+                return 0.0;
+            }
+            (before.dot(&after) / (nb * na)).clamp(-1.0, 1.0).acos()
+        };
+        match self {
+            Self::Arc(_) | Self::Ellipse(_) => Vec::new(),
+            Self::Polyline(line) => line
+                .vertices
+                .windows(3)
+                .zip(line.stations.iter().skip(1))
+                .filter(|(three, _)| turn(three[1] - three[0], three[2] - three[1]) > corner)
+                .map(|(_, &station)| station)
+                .collect(),
+            Self::Spline(spline) => {
+                let degree = spline.nurbs.degree();
+                let breaks = spline.nurbs.breaks();
+                let (start, end) = spline.nurbs.domain();
+                let mean_speed = spline.table.length() / (end - start);
+                let mut out = Vec::new();
+                for window in breaks.windows(3) {
+                    let (before, (knot, multiplicity), after) =
+                        (window[0].0, window[1], window[2].0);
+                    // A tangent may break where the curve is only C0 (multiplicity ≥ degree) or
+                    // where it stops (a cusp from `degree` coincident control points).
+                    let stops = spline.speed(knot) <= 1e-9 * mean_speed;
+                    if multiplicity < degree && !stops {
+                        continue;
+                    }
+                    // Directions just before and after; at a cusp the curve moves only with
+                    // the square of the step, so grow it until the moves stand above rounding.
+                    let here = spline.nurbs.point(knot);
+                    let noise = 1e-11 * here.amax().max(1.0);
+                    let room = (knot - before).min(after - knot);
+                    let (mut incoming, mut outgoing) = (Vec3::zeros(), Vec3::zeros());
+                    for fraction in [1e-7, 1e-5, 1e-3] {
+                        let delta = fraction * room;
+                        incoming = here - spline.nurbs.point(knot - delta);
+                        outgoing = spline.nurbs.point(knot + delta) - here;
+                        if incoming.norm() > noise && outgoing.norm() > noise {
+                            break;
+                        }
+                    }
+                    if turn(incoming, outgoing) > corner {
+                        out.push(knot);
+                    }
+                }
+                out
+            }
+        }
+    }
+}
+
+/// Checks that a curve has a usable length.
+pub(crate) fn require_length(shape: &Shape, field: &str) -> Result<f64, SolverError> {
+    let length = shape.length();
+    if length.is_nan() || length <= 1e-9 || !length.is_finite() {
+        return Err(SolverError::new(
+            "E_DEGENERATE_CURVE",
+            format!("the curve has no length ({length:e} mm): nothing to segment"),
+        )
+        .at(field));
+    }
+    Ok(length)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    fn ellipse() -> Shape {
+        let (a, b) = (100.0_f64, 50.0_f64);
+        let speed = |t: f64| (a * t.sin()).hypot(b * t.cos());
+        let table = ArcLengthTable::build(&speed, &[0.0, std::f64::consts::FRAC_PI_2], 16, "curve")
+            .unwrap();
+        Shape::Ellipse(Ellipse {
+            centre: Vec3::zeros(),
+            semi_axes: [a, b],
+            rotation: 0.0,
+            start: 0.0,
+            sense: 1.0,
+            sweep: std::f64::consts::FRAC_PI_2,
+            table,
+        })
+    }
+
+    #[test]
+    fn circumradius_of_points_on_a_circle() {
+        let on = |angle: f64| Vec3::new(7.0 * angle.cos(), 7.0 * angle.sin(), 0.0);
+        assert_relative_eq!(
+            circumradius(&on(0.1), &on(0.5), &on(1.3)),
+            7.0,
+            max_relative = 1e-12
+        );
+        let line = circumradius(&Vec3::zeros(), &Vec3::x(), &(2.0 * Vec3::x()));
+        assert!(line.is_infinite());
+    }
+
+    #[test]
+    fn ellipse_deviation_peaks_at_the_mean_angle() {
+        // Affine image of a circle: the farthest point from the chord is at t = (ta + tb)/2.
+        let shape = ellipse();
+        let (ta, tb) = (0.2, 0.35);
+        let (a, b) = (shape.point(ta), shape.point(tb));
+        let expected = distance_to_segment(&shape.point(0.5 * (ta + tb)), &a, &b);
+        assert_relative_eq!(shape.deviation(ta, tb), expected, max_relative = 1e-12);
+    }
+
+    #[test]
+    fn ellipse_minimum_radius_is_b_squared_over_a() {
+        let shape = ellipse();
+        let (radius, at) = shape.min_radius(0.0, 1.0, 1.0);
+        assert_relative_eq!(radius, 25.0, max_relative = 1e-15);
+        assert_eq!(at, 0.0);
+        let (top, _) = shape.min_radius(1.0, std::f64::consts::FRAC_PI_2, 1.0);
+        assert_relative_eq!(top, shape_radius_at(1.0), max_relative = 1e-12);
+    }
+
+    fn shape_radius_at(t: f64) -> f64 {
+        let (a, b) = (100.0_f64, 50.0_f64);
+        (a * t.sin()).hypot(b * t.cos()).powi(3) / (a * b)
+    }
+
+    #[test]
+    fn arc_sagitta_equals_sampled_deviation() {
+        let arc = Shape::Arc(Arc {
+            centre: Vec3::zeros(),
+            radius: 50.0,
+            start: 0.0,
+            sense: 1.0,
+            sweep: std::f64::consts::TAU,
+        });
+        let exact = arc.deviation(1.0, 1.7);
+        assert_relative_eq!(
+            exact,
+            arc.sampled_deviation(1.0, 1.7, None),
+            max_relative = 1e-10
+        );
+    }
+
+    #[test]
+    fn polyline_deviation_is_the_farthest_vertex() {
+        let vertices = vec![
+            Vec3::zeros(),
+            Vec3::new(1.0, 0.2, 0.0),
+            Vec3::new(2.0, 0.0, 0.0),
+        ];
+        let first = (vertices[1] - vertices[0]).norm();
+        let stations = vec![0.0, first, 2.0 * first];
+        let line = Shape::Polyline(Polyline { vertices, stations });
+        assert_relative_eq!(line.deviation(0.0, 2.0 * first), 0.2, max_relative = 1e-15);
+        assert_eq!(line.corners(10f64.to_radians()), vec![first]);
+        assert!(line.corners(30f64.to_radians()).is_empty());
+    }
+}

@@ -1,0 +1,144 @@
+//! Block statistics of any polyline at a feed and block time (chord.md §6.2–§6.3, E8, E9): the
+//! figures a CAM engineer checks before sending a program to a control with a block processing
+//! time: how many blocks, the shortest, how many starve the control, and a cycle time that
+//! accounts for the block limit.
+
+use serde::Serialize;
+
+use super::rule::MS_PER_MIN;
+use crate::error::{SolverError, positive};
+use crate::geometry::Vec3;
+
+/// A block counts as short when it is below `F·T_b/60000` by more than this fraction (rounding
+/// of a chord that sits exactly on the surface must not count).
+const SHORT_SLACK: f64 = 1e-9;
+
+/// Block figures of a polyline run at one feed on a control with a block processing time.
+///
+/// A *span end* is a block that ends where the control stops or nearly stops anyway: the end of
+/// the path, or a corner the path was split at (chord.md E8, E11). Greedy chords leave a shorter
+/// remainder there; it is counted apart from the other blocks.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct BlockStats {
+    /// Number of blocks (linear moves).
+    pub blocks: usize,
+    /// F·T_b/60000: the distance covered in one block time at the feed, mm. A shorter block
+    /// starves the control.
+    pub block_length: f64,
+    /// Shortest block that does not end a span (the one that must be at least `block_length`),
+    /// mm; the shortest of all blocks when every block ends a span.
+    pub min_block_length: f64,
+    /// Longest block, mm.
+    pub max_block_length: f64,
+    /// Length of the final block (the remainder at the path end), mm.
+    pub last_block_length: f64,
+    /// Blocks shorter than `block_length` that do not end a span: must be 0 (E9).
+    pub short_blocks: usize,
+    /// Blocks shorter than `block_length` that end a span: the final remainder and remainders at
+    /// corners, harmless where the control stops (E8), not on a loop that continues.
+    pub short_end_blocks: usize,
+    /// Shortest non-end block over `block_length` (below 1 when blocks starve the control).
+    pub min_block_ratio: f64,
+    /// Length of the polyline, mm.
+    pub path_length: f64,
+    /// Block-limited time Σ max(Lᵢ/F, T_b), s (chord.md §6.3). Does not model acceleration or
+    /// deceleration at vertices, so it flatters coarse polygons.
+    pub estimated_time_s: f64,
+    /// Path length over feed, s: the time if blocks were free.
+    pub path_time_s: f64,
+    /// Largest direction change between consecutive blocks, degrees.
+    pub max_vertex_angle_deg: f64,
+    /// Mean direction change between consecutive blocks, degrees.
+    pub mean_vertex_angle_deg: f64,
+}
+
+/// The block figures of `points` (in order, mm) run at `feed` (mm/min) on a control with
+/// `block_time_ms`; the last block is the only span end. Zero-length moves count as blocks.
+///
+/// ```
+/// use kerf_solver::chord::block_stats;
+/// use kerf_solver::geometry::Vec3;
+/// let points = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.5, 0.0, 0.0)];
+/// let stats = block_stats(&points, 10_000.0, 4.0).unwrap();
+/// assert_eq!((stats.blocks, stats.short_blocks, stats.short_end_blocks), (2, 0, 1));
+/// assert!((stats.estimated_time_s - (0.006 + 0.004)).abs() < 1e-12);
+/// ```
+///
+/// # Errors
+/// `E_INPUT` when `feed` or `block_time_ms` is not a positive finite number.
+pub fn block_stats(
+    points: &[Vec3],
+    feed: f64,
+    block_time_ms: f64,
+) -> Result<BlockStats, SolverError> {
+    let feed = positive("feed", feed)?;
+    let block_time_ms = positive("block_time_ms", block_time_ms)?;
+    let last = points.len().saturating_sub(2);
+    Ok(stats_with_ends(points, feed, block_time_ms, &[last]))
+}
+
+/// [`block_stats`] with the span ends given as block indices (block i joins points i and i + 1).
+pub(crate) fn stats_with_ends(
+    points: &[Vec3],
+    feed: f64,
+    block_time_ms: f64,
+    span_ends: &[usize],
+) -> BlockStats {
+    let block_length = feed * block_time_ms / MS_PER_MIN;
+    let short_below = block_length * (1.0 - SHORT_SLACK);
+    let lengths: Vec<f64> = points
+        .windows(2)
+        .map(|pair| (pair[1] - pair[0]).norm())
+        .collect();
+    let (mut inner_min, mut all_min, mut max) = (f64::INFINITY, f64::INFINITY, 0.0_f64);
+    let (mut short_blocks, mut short_end_blocks) = (0, 0);
+    let mut estimated_time_s = 0.0;
+    for (index, &length) in lengths.iter().enumerate() {
+        let span_end = span_ends.binary_search(&index).is_ok();
+        all_min = all_min.min(length);
+        max = max.max(length);
+        if span_end {
+            short_end_blocks += usize::from(length < short_below);
+        } else {
+            inner_min = inner_min.min(length);
+            short_blocks += usize::from(length < short_below);
+        }
+        estimated_time_s += (length / feed * 60.0).max(block_time_ms / 1000.0);
+    }
+    let min_block_length = if inner_min.is_finite() {
+        inner_min
+    } else if all_min.is_finite() {
+        all_min
+    } else {
+        0.0
+    };
+    let path_length: f64 = lengths.iter().sum();
+    let angles: Vec<f64> = points
+        .windows(3)
+        .filter_map(|three| {
+            let (a, b) = (three[1] - three[0], three[2] - three[1]);
+            let norms = a.norm() * b.norm();
+            (norms > 0.0).then(|| (a.dot(&b) / norms).clamp(-1.0, 1.0).acos().to_degrees())
+        })
+        .collect();
+    BlockStats {
+        blocks: lengths.len(),
+        block_length,
+        min_block_length,
+        max_block_length: max,
+        last_block_length: lengths.last().copied().unwrap_or(0.0),
+        short_blocks,
+        short_end_blocks,
+        min_block_ratio: min_block_length / block_length,
+        path_length,
+        estimated_time_s,
+        path_time_s: path_length / feed * 60.0,
+        max_vertex_angle_deg: angles.iter().copied().fold(0.0, f64::max),
+        mean_vertex_angle_deg: if angles.is_empty() {
+            0.0
+        } else {
+            angles.iter().sum::<f64>() / angles.len() as f64
+        },
+    }
+}
