@@ -21,11 +21,7 @@ fn spiral() -> Value {
         if radius > 520.0 {
             break;
         }
-        control.push([
-            radius * angle.cos(),
-            radius * angle.sin(),
-            0.5 * (3.0 * angle).sin(),
-        ]);
+        control.push([radius * angle.cos(), radius * angle.sin(), 0.5 * (3.0 * angle).sin()]);
         angle += 10.0 / radius;
     }
     json!({"kind": "bspline", "degree": 3, "control_points": control})
@@ -51,16 +47,11 @@ fn bench(c: &mut Criterion) {
             b.iter(|| chord::solve(std::hint::black_box(&request), None))
         });
     }
-    let circle = request(
-        &json!({"kind": "circle", "centre": [0, 0], "radius": 50}),
-        "window",
-    );
+    let circle = request(&json!({"kind": "circle", "centre": [0, 0], "radius": 50}), "window");
     let blocks = chord::solve(&circle, None).expect("solve").stats.blocks;
     println!("circle R50: {blocks} blocks");
     group.throughput(Throughput::Elements(blocks as u64));
-    group.bench_function("circle_r50", |b| {
-        b.iter(|| chord::solve(std::hint::black_box(&circle), None))
-    });
+    group.bench_function("circle_r50", |b| b.iter(|| chord::solve(std::hint::black_box(&circle), None)));
     group.finish();
 }
 

@@ -1,8 +1,8 @@
 //! Writes the G-code of the patent's R50 circle (case A) in both dialects to the files named on
 //! the command line (Fanuc, then LinuxCNC), e.g. to check them with LinuxCNC's `rs274`.
 
-use kerf_solver::chord::{self, Post, SegmentRequest};
-use kerf_solver::gcode::{Dialect, ToolCall};
+use kerf_solver::chord::{self, SegmentRequest};
+use kerf_solver::gcode::{Dialect, Post, ToolCall};
 
 fn main() {
     let request: SegmentRequest = serde_json::from_value(serde_json::json!({
@@ -15,10 +15,7 @@ fn main() {
     for dialect in [Dialect::Fanuc, Dialect::Linuxcnc] {
         let program = chord::program(
             &answer,
-            &Post {
-                dialect,
-                tool: ToolCall::Table(1),
-            },
+            &Post { reference: kerf_solver::gcode::Reference::Tip, dialect, tool: ToolCall::Table(1) },
         )
         .expect("program");
         match files.next() {

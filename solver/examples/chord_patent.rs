@@ -27,16 +27,7 @@ fn table(title: &str, request: &Value, fixed: &[f64]) -> SegmentAnswer {
     println!("\n{title}");
     println!(
         "{:<18} {:>6} {:>9} {:>9} {:>6} {:>6} {:>8} {:>8} {:>9} {:>8}",
-        "cut",
-        "blocks",
-        "shortest",
-        "last",
-        "short",
-        "s_end",
-        "t_est_s",
-        "t_path_s",
-        "max_dev",
-        "max_ang"
+        "cut", "blocks", "shortest", "last", "short", "s_end", "t_est_s", "t_path_s", "max_dev", "max_ang"
     );
     let mut first: Option<SegmentAnswer> = None;
     for &tolerance in fixed {
@@ -88,7 +79,8 @@ fn main() {
         &[0.01, 0.001],
     );
     println!("\nProgram head (case A, Fanuc):");
-    let post = chord::Post {
+    let post = kerf_solver::gcode::Post {
+        reference: kerf_solver::gcode::Reference::Tip,
         dialect: Dialect::Fanuc,
         tool: ToolCall::Table(1),
     };

@@ -4,9 +4,7 @@
 use kerf_solver::chord::{self, SegmentRequest};
 
 fn main() {
-    let path = std::env::args()
-        .nth(1)
-        .expect("usage: chord_solve request.json");
+    let path = std::env::args().nth(1).expect("usage: chord_solve request.json");
     let text = std::fs::read_to_string(path).expect("read the request");
     let request: SegmentRequest = serde_json::from_str(&text).expect("a segment request");
     match chord::solve(&request, None) {
@@ -28,11 +26,6 @@ fn main() {
                 println!("  {} {}", warning.code, warning.message);
             }
         }
-        Err(error) => println!(
-            "{} at {:?}: {}",
-            error.code(),
-            error.field(),
-            error.message()
-        ),
+        Err(error) => println!("{} at {:?}: {}", error.code(), error.field(), error.message()),
     }
 }

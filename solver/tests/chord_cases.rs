@@ -3,10 +3,8 @@
 //! printed precision), the fixed-tolerance baselines, the edge cases E1–E5 and the surface table
 //! through [`BlockRule`], and the G-code head of case A.
 
-use kerf_solver::chord::{
-    self, BlockRule, ChordStatus, Post, SegmentAnswer, SegmentRequest, WindowStatus,
-};
-use kerf_solver::gcode::{Dialect, ToolCall};
+use kerf_solver::chord::{self, BlockRule, ChordStatus, SegmentAnswer, SegmentRequest, WindowStatus};
+use kerf_solver::gcode::{Dialect, Post, ToolCall};
 use serde_json::{Value, json};
 
 const POINT_TOLERANCE: f64 = 1e-6;
@@ -16,26 +14,15 @@ fn fixture() -> Value {
 }
 
 fn case(id: &str) -> Value {
-    fixture()["cases"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|c| c["id"] == id)
-        .unwrap()
-        .clone()
+    fixture()["cases"].as_array().unwrap().iter().find(|c| c["id"] == id).unwrap().clone()
 }
 
 fn number(value: &Value) -> f64 {
-    value
-        .as_f64()
-        .unwrap_or_else(|| panic!("not a number: {value}"))
+    value.as_f64().unwrap_or_else(|| panic!("not a number: {value}"))
 }
 
 fn close(what: &str, got: f64, expected: f64, tolerance: f64) {
-    assert!(
-        (got - expected).abs() <= tolerance,
-        "{what}: got {got}, expected {expected} (±{tolerance})"
-    );
+    assert!((got - expected).abs() <= tolerance, "{what}: got {got}, expected {expected} (±{tolerance})");
 }
 
 fn solve(request: Value) -> SegmentAnswer {
@@ -48,12 +35,7 @@ fn check_points(what: &str, got: &[Vec<f64>], expected: &Value) {
     assert_eq!(got.len(), expected.len(), "{what}: count");
     for (index, (point, want)) in got.iter().zip(expected).enumerate() {
         for axis in 0..2 {
-            close(
-                &format!("{what}[{index}][{axis}]"),
-                point[axis],
-                number(&want[axis]),
-                POINT_TOLERANCE,
-            );
+            close(&format!("{what}[{index}][{axis}]"), point[axis], number(&want[axis]), POINT_TOLERANCE);
         }
     }
 }
@@ -61,24 +43,12 @@ fn check_points(what: &str, got: &[Vec<f64>], expected: &Value) {
 fn check_ends(answer: &SegmentAnswer, expected: &Value) {
     let first = expected["first_points"].as_array().unwrap().len();
     let last = expected["last_points"].as_array().unwrap().len();
-    check_points(
-        "first points",
-        &answer.points[..first],
-        &expected["first_points"],
-    );
-    check_points(
-        "last points",
-        &answer.points[answer.points.len() - last..],
-        &expected["last_points"],
-    );
+    check_points("first points", &answer.points[..first], &expected["first_points"]);
+    check_points("last points", &answer.points[answer.points.len() - last..], &expected["last_points"]);
 }
 
 fn block_lengths(answer: &SegmentAnswer) -> Vec<f64> {
-    answer
-        .points
-        .windows(2)
-        .map(|pair| (pair[1][0] - pair[0][0]).hypot(pair[1][1] - pair[0][1]))
-        .collect()
+    answer.points.windows(2).map(|pair| (pair[1][0] - pair[0][0]).hypot(pair[1][1] - pair[0][1])).collect()
 }
 
 fn circle_a() -> Value {
@@ -97,68 +67,30 @@ fn case_a_reproduces_the_patent_experiment() {
         "curve": circle_a(), "feed": 10000, "block_time_ms": 4, "mode": "window",
         "margin": 1.0, "min_chord_error": 0.0
     }));
-    close(
-        "C_ep",
-        answer.chord_error,
-        number(&expected["Cep_mm"]),
-        1e-13,
-    );
+    close("C_ep", answer.chord_error, number(&expected["Cep_mm"]), 1e-13);
     assert!(answer.windows.iter().all(|w| w.status == WindowStatus::Ok));
     assert_eq!(answer.stats.blocks, 472);
-    assert_eq!(
-        answer.points.len(),
-        number(&expected["summary"]["points"]) as usize
-    );
+    assert_eq!(answer.points.len(), number(&expected["summary"]["points"]) as usize);
     check_ends(&answer, expected);
     let lengths = block_lengths(&answer);
     for (index, length) in lengths[..lengths.len() - 1].iter().enumerate() {
-        close(
-            &format!("chord {index}"),
-            *length,
-            number(&expected["chord_length_mm"]),
-            1e-9,
-        );
+        close(&format!("chord {index}"), *length, number(&expected["chord_length_mm"]), 1e-9);
     }
-    close(
-        "last chord",
-        answer.stats.last_block_length,
-        number(&expected["last_chord_mm"]),
-        1e-6,
-    );
-    close(
-        "max chord",
-        answer.stats.max_block_length,
-        number(&expected["summary"]["max_chord_mm"]),
-        1e-9,
-    );
+    close("last chord", answer.stats.last_block_length, number(&expected["last_chord_mm"]), 1e-6);
+    close("max chord", answer.stats.max_block_length, number(&expected["summary"]["max_chord_mm"]), 1e-9);
     close(
         "block-limited time",
         answer.stats.estimated_time_s,
         number(&expected["summary"]["est_time_s_block_limited"]),
         1e-9,
     );
-    close(
-        "path time",
-        answer.stats.path_time_s,
-        number(&expected["summary"]["path_time_s_at_F"]),
-        1e-6,
-    );
+    close("path time", answer.stats.path_time_s, number(&expected["summary"]["path_time_s_at_F"]), 1e-6);
     // The fixture counts the final remainder among its short blocks (index 471).
     assert_eq!(answer.stats.short_blocks, 0);
     assert_eq!(answer.stats.short_end_blocks, 1);
     // The greedy chord may use the 1e-12 mm slack of chord.md §2.9.
-    close(
-        "max deviation",
-        answer.max_deviation,
-        number(&expected["Cep_mm"]),
-        2e-12,
-    );
-    close(
-        "feed limit",
-        answer.feed_limit.unwrap(),
-        150_000.0 * 10.0,
-        1e-6,
-    );
+    close("max deviation", answer.max_deviation, number(&expected["Cep_mm"]), 2e-12);
+    close("feed limit", answer.feed_limit.unwrap(), 150_000.0 * 10.0, 1e-6);
     let codes: Vec<_> = answer.warnings.iter().map(|w| w.code).collect();
     assert_eq!(codes, ["W_SHORT_LAST_BLOCK"]);
     assert!(answer.warnings[0].message.contains("closed"));
@@ -174,11 +106,7 @@ fn case_a_in_every_curve_mode_gives_the_same_polygon() {
         assert_eq!(answer.stats.blocks, 472, "{rule}");
         assert_eq!(answer.windows.len(), 1);
         close(rule, answer.chord_error, reference.chord_error, 1e-15);
-        check_points(
-            rule,
-            &answer.points,
-            &serde_json::to_value(&reference.points).unwrap(),
-        );
+        check_points(rule, &answer.points, &serde_json::to_value(&reference.points).unwrap());
     }
 }
 
@@ -191,17 +119,8 @@ fn case_a_baselines() {
             "curve": circle_a(), "feed": 10000, "block_time_ms": 4, "compare_tolerance": tolerance
         }));
         let comparison = answer.comparison.unwrap();
-        assert_eq!(
-            comparison.stats.blocks,
-            number(&expected["blocks"]) as usize,
-            "{key}"
-        );
-        close(
-            key,
-            comparison.stats.max_block_length,
-            number(&expected["chord_mm"]),
-            1e-9,
-        );
+        assert_eq!(comparison.stats.blocks, number(&expected["blocks"]) as usize, "{key}");
+        close(key, comparison.stats.max_block_length, number(&expected["chord_mm"]), 1e-9);
         close(
             key,
             comparison.stats.max_block_length / 10_000.0 * 60_000.0,
@@ -216,27 +135,14 @@ fn case_a_baselines() {
     let answer = solve(json!({
         "curve": circle_a(), "feed": 10000, "block_time_ms": 4, "tolerance": 0.0005
     }));
-    close(
-        "feed cap",
-        answer.stats.max_block_length / 4.0 * 60_000.0,
-        cap,
-        1e-6,
-    );
+    close("feed cap", answer.stats.max_block_length / 4.0 * 60_000.0, cap, 1e-6);
     close("tolerance feed", answer.tolerance_feed.unwrap(), cap, 1e-5);
     assert_eq!(answer.stats.blocks, 703);
     assert_eq!(answer.stats.short_blocks, 702);
     let codes: Vec<_> = answer.warnings.iter().map(|w| w.code).collect();
-    assert!(
-        codes.contains(&"W_CHORD_ERROR_EXCEEDS_TOLERANCE"),
-        "{codes:?}"
-    );
+    assert!(codes.contains(&"W_CHORD_ERROR_EXCEEDS_TOLERANCE"), "{codes:?}");
     assert!(codes.contains(&"W_BLOCK_TIME_VIOLATION"), "{codes:?}");
-    let advice = &answer
-        .warnings
-        .iter()
-        .find(|w| w.code == "W_CHORD_ERROR_EXCEEDS_TOLERANCE")
-        .unwrap()
-        .message;
+    let advice = &answer.warnings.iter().find(|w| w.code == "W_CHORD_ERROR_EXCEEDS_TOLERANCE").unwrap().message;
     assert!(advice.contains("6708 mm/min"), "{advice}");
 }
 
@@ -245,25 +151,15 @@ fn case_a_gcode_head() {
     let answer = solve(json!({"curve": circle_a(), "feed": 10000, "block_time_ms": 4}));
     let program = chord::program(
         &answer,
-        &Post {
-            dialect: Dialect::Fanuc,
-            tool: ToolCall::Table(1),
-        },
+        &Post { reference: kerf_solver::gcode::Reference::Tip, dialect: Dialect::Fanuc, tool: ToolCall::Table(1) },
     )
     .unwrap();
     let case = case("A");
-    let head: Vec<&str> = case["gcode_head_4_decimals"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_str().unwrap())
-        .collect();
+    let head: Vec<&str> =
+        case["gcode_head_4_decimals"].as_array().unwrap().iter().map(|v| v.as_str().unwrap()).collect();
     // The house post writes every line with its G word and Z; compare the coordinates.
     let lines: Vec<&str> = program.lines().collect();
-    let start = lines
-        .iter()
-        .position(|l| l.starts_with("G00 X50.0000 Y0.0000"))
-        .expect("rapid above the start");
+    let start = lines.iter().position(|l| l.starts_with("G00 X50.0000 Y0.0000")).expect("rapid above the start");
     assert!(lines[start + 1].starts_with("G01 X50.0000 Y0.0000 Z0.0000 F10000"));
     assert!(head[2].starts_with("G01 X49.9956 Y0.6667"));
     assert!(lines[start + 2].starts_with("G01 X49.9956 Y0.6667 Z0.0000"));
@@ -274,9 +170,8 @@ fn case_a_gcode_head() {
         .iter()
         .filter(|l| {
             l.split(' ').any(|word| {
-                word.strip_prefix('F').is_some_and(|value| {
-                    !value.is_empty() && value.chars().all(|c| c.is_ascii_digit() || c == '.')
-                })
+                word.strip_prefix('F')
+                    .is_some_and(|value| !value.is_empty() && value.chars().all(|c| c.is_ascii_digit() || c == '.'))
             })
         })
         .count();
@@ -292,76 +187,26 @@ fn case_b_embodiment_4_on_the_quarter_ellipse() {
         "curve": ellipse_bc(), "feed": 10000, "block_time_ms": 4, "margin": 1.1,
         "mode": "curve", "rule": "extremes"
     }));
-    close(
-        "C_ep",
-        answer.chord_error,
-        number(&expected["Cep_mm"]),
-        1e-13,
-    );
-    close(
-        "r_min",
-        answer.min_radius.unwrap(),
-        number(&case["curve"]["r_min_mm"]),
-        1e-12,
-    );
-    close(
-        "arc length",
-        answer.curve_length,
-        number(&case["curve"]["arc_length_mm"]),
-        1e-9,
-    );
-    assert_eq!(
-        answer.stats.blocks,
-        number(&expected["blocks_total_greedy"]) as usize
-    );
+    close("C_ep", answer.chord_error, number(&expected["Cep_mm"]), 1e-13);
+    close("r_min", answer.min_radius.unwrap(), number(&case["curve"]["r_min_mm"]), 1e-12);
+    close("arc length", answer.curve_length, number(&case["curve"]["arc_length_mm"]), 1e-9);
+    assert_eq!(answer.stats.blocks, number(&expected["blocks_total_greedy"]) as usize);
     check_ends(&answer, expected);
     let lengths = block_lengths(&answer);
-    close(
-        "first chord",
-        lengths[0],
-        number(&expected["first_chord_mm"]),
-        1e-6,
-    );
+    close("first chord", lengths[0], number(&expected["first_chord_mm"]), 1e-6);
     close(
         "shortest chord but the last",
         answer.stats.min_block_length,
         number(&expected["chord_min_mm_excluding_last"]),
         1e-6,
     );
-    close(
-        "longest chord",
-        answer.stats.max_block_length,
-        number(&expected["chord_max_mm"]),
-        1e-6,
-    );
-    close(
-        "last chord",
-        answer.stats.last_block_length,
-        number(&expected["last_chord_mm"]),
-        1e-6,
-    );
-    close(
-        "max deviation",
-        answer.max_deviation,
-        number(&expected["max_deviation_mm"]),
-        1e-9,
-    );
-    close(
-        "block-limited time",
-        answer.stats.estimated_time_s,
-        number(&expected["est_time_s_block_limited"]),
-        1e-9,
-    );
-    assert_eq!(
-        answer.stats.short_blocks,
-        number(&expected["short_blocks_below_F_Tb"]) as usize
-    );
+    close("longest chord", answer.stats.max_block_length, number(&expected["chord_max_mm"]), 1e-6);
+    close("last chord", answer.stats.last_block_length, number(&expected["last_chord_mm"]), 1e-6);
+    close("max deviation", answer.max_deviation, number(&expected["max_deviation_mm"]), 1e-9);
+    close("block-limited time", answer.stats.estimated_time_s, number(&expected["est_time_s_block_limited"]), 1e-9);
+    assert_eq!(answer.stats.short_blocks, number(&expected["short_blocks_below_F_Tb"]) as usize);
     // The parameters t of the first points.
-    for (point, t) in answer
-        .points
-        .iter()
-        .zip(expected["first_points_t_rad"].as_array().unwrap())
-    {
+    for (point, t) in answer.points.iter().zip(expected["first_points_t_rad"].as_array().unwrap()) {
         let t = number(t);
         close("x(t)", point[0], 100.0 * t.cos(), 1e-6);
         close("y(t)", point[1], 50.0 * t.sin(), 1e-6);
@@ -371,12 +216,7 @@ fn case_b_embodiment_4_on_the_quarter_ellipse() {
         "curve": ellipse_bc(), "feed": 10000, "block_time_ms": 4, "margin": 1.1,
         "mode": "curve", "rule": "normal_accel"
     }));
-    close(
-        "C_ep Eq. 15",
-        eq15.chord_error,
-        number(&expected["Cep_eq15_mm"]),
-        1e-13,
-    );
+    close("C_ep Eq. 15", eq15.chord_error, number(&expected["Cep_eq15_mm"]), 1e-13);
     // r_min read off the drawing gives the same value.
     let drawing = solve(json!({
         "curve": ellipse_bc(), "feed": 10000, "block_time_ms": 4, "margin": 1.1,
@@ -397,17 +237,8 @@ fn case_b_and_c_baselines() {
             let what = format!("{id} {key}");
             let stats = answer.comparison.unwrap().stats;
             assert_eq!(stats.blocks, number(&expected["blocks"]) as usize, "{what}");
-            close(
-                &what,
-                stats.min_block_length,
-                number(&expected["min_chord_mm"]),
-                1e-6,
-            );
-            assert_eq!(
-                stats.short_blocks,
-                number(&expected["short_blocks_below_F_Tb"]) as usize,
-                "{what}"
-            );
+            close(&what, stats.min_block_length, number(&expected["min_chord_mm"]), 1e-6);
+            assert_eq!(stats.short_blocks, number(&expected["short_blocks_below_F_Tb"]) as usize, "{what}");
             if let Some(time) = expected.get("est_time_s_block_limited") {
                 close(&what, stats.estimated_time_s, number(time), 1e-9);
             }
@@ -424,36 +255,18 @@ fn case_c_adaptive_windows() {
         "min_chord_error": 0.001, "mode": "window", "window": 5
     }));
     assert_eq!(answer.windows.len(), number(&expected["windows"]) as usize);
-    let clamped = answer
-        .windows
-        .iter()
-        .filter(|w| w.status == WindowStatus::ClampedToMinChordError)
-        .count();
-    assert_eq!(
-        clamped,
-        number(&expected["windows_clamped_to_Cemin"]) as usize
-    );
-    for (window, want) in answer
-        .windows
-        .iter()
-        .zip(expected["first_windows"].as_array().unwrap())
-    {
+    let clamped = answer.windows.iter().filter(|w| w.status == WindowStatus::ClampedToMinChordError).count();
+    assert_eq!(clamped, number(&expected["windows_clamped_to_Cemin"]) as usize);
+    for (window, want) in answer.windows.iter().zip(expected["first_windows"].as_array().unwrap()) {
         close("s0", window.s_start, number(&want["s0"]), 1e-8);
         close("s1", window.s_end, number(&want["s1"]), 1e-8);
         close("r", window.radius.unwrap(), number(&want["r"]), 1e-8);
         close("cep", window.chord_error, number(&want["cep"]), 1e-9);
         assert_eq!(window.status, WindowStatus::Ok);
     }
-    assert_eq!(
-        answer.stats.blocks,
-        number(&expected["blocks_total"]) as usize
-    );
+    assert_eq!(answer.stats.blocks, number(&expected["blocks_total"]) as usize);
     check_ends(&answer, expected);
-    for (s, want) in answer
-        .s
-        .iter()
-        .zip(expected["first_points_s_mm"].as_array().unwrap())
-    {
+    for (s, want) in answer.s.iter().zip(expected["first_points_s_mm"].as_array().unwrap()) {
         close("s", *s, number(want), 1e-6);
     }
     close(
@@ -462,66 +275,18 @@ fn case_c_adaptive_windows() {
         number(&expected["chord_min_mm_excluding_last"]),
         1e-6,
     );
-    close(
-        "longest chord",
-        answer.stats.max_block_length,
-        number(&expected["chord_max_mm"]),
-        1e-6,
-    );
-    close(
-        "last chord",
-        answer.stats.last_block_length,
-        number(&expected["last_chord_mm"]),
-        1e-6,
-    );
-    close(
-        "max deviation",
-        answer.max_deviation,
-        number(&expected["max_deviation_mm"]),
-        1e-9,
-    );
-    assert_eq!(
-        answer.stats.short_blocks,
-        number(&expected["blocks_below_F_Tb_excluding_last"]) as usize
-    );
-    close(
-        "block-limited time",
-        answer.stats.estimated_time_s,
-        number(&expected["est_time_s_block_limited"]),
-        1e-9,
-    );
-    close(
-        "block length",
-        answer.stats.block_length,
-        number(&expected["L_min_plain_mm"]),
-        1e-12,
-    );
+    close("longest chord", answer.stats.max_block_length, number(&expected["chord_max_mm"]), 1e-6);
+    close("last chord", answer.stats.last_block_length, number(&expected["last_chord_mm"]), 1e-6);
+    close("max deviation", answer.max_deviation, number(&expected["max_deviation_mm"]), 1e-9);
+    assert_eq!(answer.stats.short_blocks, number(&expected["blocks_below_F_Tb_excluding_last"]) as usize);
+    close("block-limited time", answer.stats.estimated_time_s, number(&expected["est_time_s_block_limited"]), 1e-9);
+    close("block length", answer.stats.block_length, number(&expected["L_min_plain_mm"]), 1e-12);
     // Derived values of the case.
     let rule = BlockRule::new(12_000.0, 4.0).unwrap().with_margin(1.05);
-    close(
-        "h",
-        rule.half_chord(),
-        number(&expected["half_chord_h_mm"]),
-        1e-15,
-    );
-    close(
-        "L_min k_f",
-        rule.target_chord(),
-        number(&expected["L_min_kf_mm"]),
-        1e-15,
-    );
-    close(
-        "C_e(25)",
-        rule.chord_error(25.0).unwrap().0,
-        number(&expected["Ce_at_r25_mm"]),
-        1e-15,
-    );
-    close(
-        "C_e(200)",
-        rule.chord_error(200.0).unwrap().0,
-        number(&expected["Ce_at_r200_mm"]),
-        1e-15,
-    );
+    close("h", rule.half_chord(), number(&expected["half_chord_h_mm"]), 1e-15);
+    close("L_min k_f", rule.target_chord(), number(&expected["L_min_kf_mm"]), 1e-15);
+    close("C_e(25)", rule.chord_error(25.0).unwrap().0, number(&expected["Ce_at_r25_mm"]), 1e-15);
+    close("C_e(200)", rule.chord_error(200.0).unwrap().0, number(&expected["Ce_at_r200_mm"]), 1e-15);
 }
 
 #[test]
@@ -529,18 +294,8 @@ fn case_derived_constants() {
     for (id, margin) in [("A", 1.0), ("B", 1.1)] {
         let expected = &case(id)["expected"];
         let rule = BlockRule::new(10_000.0, 4.0).unwrap().with_margin(margin);
-        close(
-            "alpha",
-            rule.alpha(),
-            number(&expected["alpha_min2"]),
-            1e-22,
-        );
-        close(
-            "h",
-            rule.half_chord(),
-            number(&expected["half_chord_h_mm"]),
-            1e-15,
-        );
+        close("alpha", rule.alpha(), number(&expected["alpha_min2"]), 1e-22);
+        close("h", rule.half_chord(), number(&expected["half_chord_h_mm"]), 1e-15);
     }
     let expected = &case("A")["expected"];
     let rule = BlockRule::new(10_000.0, 4.0).unwrap();
@@ -549,18 +304,8 @@ fn case_derived_constants() {
     // The fixture's chord is the greedy one, 1e-12 mm of slack on the chord error longer.
     close("chord", chord, number(&expected["chord_length_mm"]), 1e-9);
     let angle = 2.0 * (chord / 100.0).asin();
-    close(
-        "angle",
-        angle.to_degrees(),
-        number(&expected["chord_angle_deg"]),
-        1e-9,
-    );
-    close(
-        "sides",
-        std::f64::consts::TAU / angle,
-        number(&expected["sides_exact"]),
-        1e-6,
-    );
+    close("angle", angle.to_degrees(), number(&expected["chord_angle_deg"]), 1e-9);
+    close("sides", std::f64::consts::TAU / angle, number(&expected["sides_exact"]), 1e-6);
 }
 
 #[test]
@@ -600,22 +345,12 @@ fn edge_cases_e1_to_e5() {
 #[test]
 fn surface_table_in_micrometres() {
     let table = &fixture()["surface_table_um_Tb4"];
-    let radii: Vec<f64> = table["r_mm"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(number)
-        .collect();
+    let radii: Vec<f64> = table["r_mm"].as_array().unwrap().iter().map(number).collect();
     for (feed, row) in table["rows"].as_object().unwrap() {
         let rule = BlockRule::new(feed.parse().unwrap(), 4.0).unwrap();
         for (radius, value) in radii.iter().zip(row.as_array().unwrap()) {
             let micrometres = rule.chord_error(*radius).unwrap().0 * 1000.0;
-            close(
-                &format!("F {feed} r {radius}"),
-                micrometres,
-                number(value),
-                5.01e-7,
-            );
+            close(&format!("F {feed} r {radius}"), micrometres, number(value), 5.01e-7);
         }
     }
 }

@@ -2,8 +2,8 @@
 //! the curve checks), machine defaults and overrides, warnings of the edge-case table (E1, E4,
 //! E5, E8–E10, E12, E13) and the G-code program in both dialects.
 
-use kerf_solver::chord::{self, MachineProfile, Post, SegmentAnswer, SegmentRequest, WindowStatus};
-use kerf_solver::gcode::{Dialect, ToolCall};
+use kerf_solver::chord::{self, MachineProfile, SegmentAnswer, SegmentRequest, WindowStatus};
+use kerf_solver::gcode::{Dialect, Post, ToolCall};
 use serde_json::{Value, json};
 
 fn parse(request: Value) -> SegmentRequest {
@@ -25,11 +25,7 @@ fn base() -> Value {
 
 fn error(request: Value) -> (String, Option<String>, String) {
     let error = chord::solve(&parse(request), None).unwrap_err();
-    (
-        error.code().to_owned(),
-        error.field().map(str::to_owned),
-        error.message().to_owned(),
-    )
+    (error.code().to_owned(), error.field().map(str::to_owned), error.message().to_owned())
 }
 
 fn ok(request: Value) -> SegmentAnswer {
@@ -48,49 +44,20 @@ fn bad_numbers_name_their_field() {
         (with(base(), "block_time_ms", json!(0)), "block_time_ms"),
         (with(base(), "block_time_ms", json!(-4)), "block_time_ms"),
         (with(base(), "margin", json!(0.9)), "margin"),
-        (
-            with(base(), "chord_error_factor", json!(0.95)),
-            "chord_error_factor",
-        ),
-        (
-            with(base(), "block_time_factor", json!(0.5)),
-            "block_time_factor",
-        ),
+        (with(base(), "chord_error_factor", json!(0.95)), "chord_error_factor"),
+        (with(base(), "block_time_factor", json!(0.5)), "block_time_factor"),
         (with(base(), "radius_factor", json!(1.2)), "radius_factor"),
         (with(base(), "radius_factor", json!(0)), "radius_factor"),
-        (
-            with(base(), "min_chord_error", json!(-0.001)),
-            "min_chord_error",
-        ),
+        (with(base(), "min_chord_error", json!(-0.001)), "min_chord_error"),
         (with(base(), "tolerance", json!(1e-9)), "tolerance"),
-        (
-            with(base(), "compare_tolerance", json!(0)),
-            "compare_tolerance",
-        ),
+        (with(base(), "compare_tolerance", json!(0)), "compare_tolerance"),
         (with(base(), "window", json!(0)), "window"),
         (with(base(), "spindle_rpm", json!(0)), "spindle_rpm"),
         (with(base(), "rule", json!("max")), "rule"),
         (with(base(), "min_radius", json!(25)), "min_radius"),
-        (
-            with(with(base(), "mode", json!("curve")), "window", json!(5)),
-            "window",
-        ),
-        (
-            with(
-                with(base(), "mode", json!("curve")),
-                "radius_estimate",
-                json!("minimum"),
-            ),
-            "radius_estimate",
-        ),
-        (
-            with(
-                with(base(), "mode", json!("curve")),
-                "min_radius",
-                json!(-1),
-            ),
-            "min_radius",
-        ),
+        (with(with(base(), "mode", json!("curve")), "window", json!(5)), "window"),
+        (with(with(base(), "mode", json!("curve")), "radius_estimate", json!("minimum")), "radius_estimate"),
+        (with(with(base(), "mode", json!("curve")), "min_radius", json!(-1)), "min_radius"),
         (with(base(), "safe_z", json!(-1)), "safe_z"),
         (json!({"curve": circle(), "block_time_ms": 4}), "feed"),
         (json!({"curve": circle(), "feed": 10000}), "block_time_ms"),
@@ -106,10 +73,7 @@ fn bad_numbers_name_their_field() {
 fn nan_is_refused_not_propagated() {
     let mut request = parse(base());
     request.feed = Some(f64::NAN);
-    assert_eq!(
-        chord::solve(&request, None).unwrap_err().field(),
-        Some("feed")
-    );
+    assert_eq!(chord::solve(&request, None).unwrap_err().field(), Some("feed"));
     let mut request = parse(base());
     request.curve = chord::Curve::Circle {
         centre: vec![0.0, f64::NAN],
@@ -117,25 +81,15 @@ fn nan_is_refused_not_propagated() {
         start_deg: 0.0,
         direction: chord::Direction::Ccw,
     };
-    assert_eq!(
-        chord::solve(&request, None).unwrap_err().field(),
-        Some("curve.centre[1]")
-    );
+    assert_eq!(chord::solve(&request, None).unwrap_err().field(), Some("curve.centre[1]"));
     let mut request = parse(base());
     request.margin = Some(f64::INFINITY);
-    assert_eq!(
-        chord::solve(&request, None).unwrap_err().field(),
-        Some("margin")
-    );
+    assert_eq!(chord::solve(&request, None).unwrap_err().field(), Some("margin"));
 }
 
 #[test]
 fn unsafe_margins_need_an_explicit_override() {
-    let answer = ok(with(
-        with(base(), "margin", json!(0.9)),
-        "allow_unsafe_margin",
-        json!(true),
-    ));
+    let answer = ok(with(with(base(), "margin", json!(0.9)), "allow_unsafe_margin", json!(true)));
     assert!(codes(&answer).contains(&"W_UNSAFE_MARGIN"));
     // Below the surface every block is shorter than F·T_b.
     assert!(answer.stats.short_blocks > 0);
@@ -145,56 +99,20 @@ fn unsafe_margins_need_an_explicit_override() {
 #[test]
 fn curves_are_checked_with_field_paths() {
     let cases = [
-        (
-            json!({"kind": "circle", "centre": [0, 0], "radius": 0}),
-            "E_INPUT",
-            "curve.radius",
-        ),
-        (
-            json!({"kind": "circle", "centre": [0, 0, 0, 0], "radius": 5}),
-            "E_INPUT",
-            "curve.centre",
-        ),
-        (
-            json!({"kind": "circle", "centre": [0], "radius": 5}),
-            "E_INPUT",
-            "curve.centre",
-        ),
-        (
-            json!({"kind": "circle", "centre": [2e6, 0], "radius": 5}),
-            "E_INPUT",
-            "curve.centre[0]",
-        ),
+        (json!({"kind": "circle", "centre": [0, 0], "radius": 0}), "E_INPUT", "curve.radius"),
+        (json!({"kind": "circle", "centre": [0, 0, 0, 0], "radius": 5}), "E_INPUT", "curve.centre"),
+        (json!({"kind": "circle", "centre": [0], "radius": 5}), "E_INPUT", "curve.centre"),
+        (json!({"kind": "circle", "centre": [2e6, 0], "radius": 5}), "E_INPUT", "curve.centre[0]"),
         (
             json!({"kind": "arc", "centre": [0, 0], "radius": 5, "start_deg": 30, "end_deg": 30}),
             "E_DEGENERATE_CURVE",
             "curve.end_deg",
         ),
-        (
-            json!({"kind": "ellipse", "centre": [0, 0], "semi_axes": [10, -1]}),
-            "E_INPUT",
-            "curve.semi_axes[1]",
-        ),
-        (
-            json!({"kind": "polyline", "points": [[0, 0], [1, 1, 1]]}),
-            "E_INPUT",
-            "curve.points[1]",
-        ),
-        (
-            json!({"kind": "polyline", "points": [[0, 0, 0, 1], [1, 1, 1, 1]]}),
-            "E_INPUT",
-            "curve.points[0]",
-        ),
-        (
-            json!({"kind": "polyline", "points": [[1, 1], [1, 1], [1, 1]]}),
-            "E_DEGENERATE_CURVE",
-            "curve.points",
-        ),
-        (
-            json!({"kind": "polyline", "points": [[1, 1]]}),
-            "E_DEGENERATE_CURVE",
-            "curve.points",
-        ),
+        (json!({"kind": "ellipse", "centre": [0, 0], "semi_axes": [10, -1]}), "E_INPUT", "curve.semi_axes[1]"),
+        (json!({"kind": "polyline", "points": [[0, 0], [1, 1, 1]]}), "E_INPUT", "curve.points[1]"),
+        (json!({"kind": "polyline", "points": [[0, 0, 0, 1], [1, 1, 1, 1]]}), "E_INPUT", "curve.points[0]"),
+        (json!({"kind": "polyline", "points": [[1, 1], [1, 1], [1, 1]]}), "E_DEGENERATE_CURVE", "curve.points"),
+        (json!({"kind": "polyline", "points": [[1, 1]]}), "E_DEGENERATE_CURVE", "curve.points"),
         (
             json!({"kind": "polyline", "points": [[0, 0], [10, 0]], "corner_angle_deg": 180}),
             "E_INPUT",
@@ -205,16 +123,8 @@ fn curves_are_checked_with_field_paths() {
             "E_INPUT",
             "curve.control_points",
         ),
-        (
-            json!({"kind": "bspline", "degree": 0, "control_points": [[0, 0], [1, 1]]}),
-            "E_INPUT",
-            "curve.degree",
-        ),
-        (
-            json!({"kind": "bspline", "degree": 6, "control_points": [[0, 0], [1, 1]]}),
-            "E_INPUT",
-            "curve.degree",
-        ),
+        (json!({"kind": "bspline", "degree": 0, "control_points": [[0, 0], [1, 1]]}), "E_INPUT", "curve.degree"),
+        (json!({"kind": "bspline", "degree": 6, "control_points": [[0, 0], [1, 1]]}), "E_INPUT", "curve.degree"),
         (
             json!({"kind": "bspline", "degree": 2, "control_points": [[0, 0], [5, 5], [10, 0]],
                    "knots": [0, 0, 0, 1, 1]}),
@@ -263,11 +173,7 @@ fn unknown_fields_and_kinds_are_refused_by_serde() {
     for request in [
         with(base(), "speed", json!(1)),
         with(base(), "curve", json!({"kind": "spiral", "radius": 3})),
-        with(
-            base(),
-            "curve",
-            json!({"kind": "circle", "centre": [0, 0], "radius": 5, "r": 1}),
-        ),
+        with(base(), "curve", json!({"kind": "circle", "centre": [0, 0], "radius": 5, "r": 1})),
         with(base(), "mode", json!("global")),
     ] {
         assert!(serde_json::from_value::<SegmentRequest>(request).is_err());
@@ -279,24 +185,13 @@ fn infeasible_feed_gives_the_largest_feasible_feed() {
     // E3: r = 0.3 mm at 10 000 mm/min and 4 ms needs a 0.667 mm chord: at most 9000 mm/min.
     let small = json!({"kind": "circle", "centre": [0, 0], "radius": 0.3});
     for mode in ["window", "curve"] {
-        let (code, field, message) = error(with(
-            with(base(), "curve", small.clone()),
-            "mode",
-            json!(mode),
-        ));
+        let (code, field, message) = error(with(with(base(), "curve", small.clone()), "mode", json!(mode)));
         assert_eq!(code, "E_INFEASIBLE_FEED_FOR_RADIUS");
         assert_eq!(field.as_deref(), Some("feed"));
-        assert!(
-            message.contains("largest feasible feed is 9000 mm/min"),
-            "{message}"
-        );
+        assert!(message.contains("largest feasible feed is 9000 mm/min"), "{message}");
     }
     // At the feed it names, the same curve is cut.
-    let answer = ok(with(
-        with(base(), "curve", small.clone()),
-        "feed",
-        json!(9000),
-    ));
+    let answer = ok(with(with(base(), "curve", small.clone()), "feed", json!(9000)));
     assert_eq!(answer.feed_limit, Some(9000.0));
     // An ellipse: the limit comes from its smallest radius b²/a = 0.25 mm, even when the window
     // that failed saw a larger one.
@@ -305,17 +200,10 @@ fn infeasible_feed_gives_the_largest_feasible_feed() {
     // infeasibility is found with both estimates; the limit comes from b²/a = 0.25 mm.
     let ellipse = json!({"kind": "ellipse", "centre": [0, 0], "semi_axes": [4, 1]});
     for estimate in ["three_point", "minimum"] {
-        let request = with(
-            with(base(), "curve", ellipse.clone()),
-            "radius_estimate",
-            json!(estimate),
-        );
+        let request = with(with(base(), "curve", ellipse.clone()), "radius_estimate", json!(estimate));
         let (code, _, message) = error(request.clone());
         assert_eq!(code, "E_INFEASIBLE_FEED_FOR_RADIUS");
-        assert!(
-            message.contains("largest feasible feed is 7500 mm/min"),
-            "{message}"
-        );
+        assert!(message.contains("largest feasible feed is 7500 mm/min"), "{message}");
         let answer = ok(with(request, "feed", json!(7500)));
         if estimate == "minimum" {
             assert_eq!(answer.stats.short_blocks, 0);
@@ -324,26 +212,16 @@ fn infeasible_feed_gives_the_largest_feasible_feed() {
         }
     }
     // r_min read off the drawing: the error names that field.
-    let (code, field, _) = error(with(
-        with(
-            with(base(), "mode", json!("curve")),
-            "rule",
-            json!("extremes"),
-        ),
-        "min_radius",
-        json!(0.2),
-    ));
+    let (code, field, _) =
+        error(with(with(with(base(), "mode", json!("curve")), "rule", json!("extremes")), "min_radius", json!(0.2)));
     assert_eq!(code, "E_INFEASIBLE_FEED_FOR_RADIUS");
     assert_eq!(field.as_deref(), Some("min_radius"));
 }
 
 #[test]
 fn too_many_windows_are_refused_before_the_work() {
-    let (code, field, _) = error(with(
-        with(with(base(), "mode", json!("curve")), "rule", json!("max")),
-        "window",
-        json!(1e-5),
-    ));
+    let (code, field, _) =
+        error(with(with(with(base(), "mode", json!("curve")), "rule", json!("max")), "window", json!(1e-5)));
     assert_eq!(code, "E_TOO_MANY_BLOCKS");
     assert_eq!(field.as_deref(), Some("window"));
 }
@@ -360,36 +238,19 @@ fn machine_values_are_defaults_the_request_overrides() {
     };
     let request = parse(json!({"curve": circle(), "machine": "hsc"}));
     let answer = chord::solve(&request, Some(&machine)).unwrap();
-    assert_eq!(
-        (
-            answer.feed,
-            answer.block_time_ms,
-            answer.margin,
-            answer.min_chord_error
-        ),
-        (10_000.0, 4.0, 1.1, 0.001)
-    );
+    assert_eq!((answer.feed, answer.block_time_ms, answer.margin, answer.min_chord_error), (10_000.0, 4.0, 1.1, 0.001));
     // k_f = 1.1 at r = 50: 0.0013445 mm, above the clamp.
     assert!((answer.chord_error - 0.001_344_5).abs() < 1e-6);
     let overridden = parse(json!({
         "curve": circle(), "machine": "hsc", "feed": 12000, "margin": 1.0, "min_chord_error": 0.002
     }));
     let answer = chord::solve(&overridden, Some(&machine)).unwrap();
-    assert_eq!(
-        (answer.feed, answer.margin, answer.min_chord_error),
-        (12_000.0, 1.0, 0.002)
-    );
-    assert_eq!(
-        answer.windows[0].status,
-        WindowStatus::ClampedToMinChordError
-    );
+    assert_eq!((answer.feed, answer.margin, answer.min_chord_error), (12_000.0, 1.0, 0.002));
+    assert_eq!(answer.windows[0].status, WindowStatus::ClampedToMinChordError);
     assert!(codes(&answer).contains(&"W_FEED_ABOVE_MACHINE_MAX"));
     assert!(codes(&answer).contains(&"I_CLAMPED_TO_CEMIN"));
     // A corrupt stored profile is reported, not used.
-    let broken = MachineProfile {
-        block_time_ms: -1.0,
-        ..machine
-    };
+    let broken = MachineProfile { block_time_ms: -1.0, ..machine };
     let error = chord::solve(&request, Some(&broken)).unwrap_err();
     assert_eq!(error.field(), Some("machine"));
 }
@@ -400,12 +261,7 @@ fn tolerance_never_coarser_with_feed_advice() {
     let answer = ok(with(base(), "tolerance", json!(0.0005)));
     assert!((answer.chord_error - 0.0005).abs() < 1e-15);
     assert!(answer.max_deviation <= 0.0005 + 2e-12);
-    assert!(
-        answer
-            .windows
-            .iter()
-            .all(|w| w.status == WindowStatus::LimitedByTolerance)
-    );
+    assert!(answer.windows.iter().all(|w| w.status == WindowStatus::LimitedByTolerance));
     assert_eq!(answer.tolerance_feed.map(f64::floor), Some(6708.0));
     // A tolerance above the rule's chord error changes nothing.
     let loose = ok(with(base(), "tolerance", json!(0.01)));
@@ -416,19 +272,12 @@ fn tolerance_never_coarser_with_feed_advice() {
 #[test]
 fn straight_lines_are_one_block() {
     // E1: r = ∞, C_ep = 0: the chord runs to the end of the straight.
-    let line =
-        json!({"kind": "polyline", "points": [[0, 0, 0], [10, 0, 0], [20, 0, 0], [30, 0, 0]]});
+    let line = json!({"kind": "polyline", "points": [[0, 0, 0], [10, 0, 0], [20, 0, 0], [30, 0, 0]]});
     let answer = ok(with(base(), "curve", line.clone()));
     assert_eq!(answer.stats.blocks, 1);
-    assert_eq!(
-        answer.windows.iter().map(|w| w.status).collect::<Vec<_>>()[0],
-        WindowStatus::Straight
-    );
+    assert_eq!(answer.windows.iter().map(|w| w.status).collect::<Vec<_>>()[0], WindowStatus::Straight);
     assert!(codes(&answer).contains(&"I_STRAIGHT"));
-    assert_eq!(
-        answer.points,
-        vec![vec![0.0, 0.0, 0.0], vec![30.0, 0.0, 0.0]]
-    );
+    assert_eq!(answer.points, vec![vec![0.0, 0.0, 0.0], vec![30.0, 0.0, 0.0]]);
     // E12: a curve shorter than one block time.
     let short = json!({"kind": "polyline", "points": [[0, 0], [0.5, 0]]});
     let answer = ok(with(base(), "curve", short));
@@ -446,26 +295,14 @@ fn corners_split_the_path_and_are_always_points() {
     for k in 1..=100 {
         points.push([20.0, 0.2 * f64::from(k)]);
     }
-    let answer = ok(with(
-        base(),
-        "curve",
-        json!({"kind": "polyline", "points": points}),
-    ));
-    assert_eq!(
-        answer.points,
-        vec![vec![0.0, 0.0], vec![20.0, 0.0], vec![20.0, 20.0]]
-    );
+    let answer = ok(with(base(), "curve", json!({"kind": "polyline", "points": points})));
+    assert_eq!(answer.points, vec![vec![0.0, 0.0], vec![20.0, 0.0], vec![20.0, 20.0]]);
     // A spline with a double knot (degree 2: C0) turning 90° is split there too.
     let spline = json!({"kind": "bspline", "degree": 2,
         "control_points": [[0, 0], [10, 0], [20, 0], [20, 10], [20, 20]],
         "knots": [0, 0, 0, 0.5, 0.5, 1, 1, 1]});
     let answer = ok(with(base(), "curve", spline));
-    assert!(
-        answer
-            .points
-            .iter()
-            .any(|p| (p[0] - 20.0).abs() < 1e-9 && p[1].abs() < 1e-9)
-    );
+    assert!(answer.points.iter().any(|p| (p[0] - 20.0).abs() < 1e-9 && p[1].abs() < 1e-9));
 }
 
 #[test]
@@ -473,18 +310,10 @@ fn unreliable_windows_and_resolution_are_reported() {
     // E10: a long window on an ellipse with a sharp end: the 3-point radius overshoots.
     let ellipse = json!({"kind": "ellipse", "centre": [0, 0], "semi_axes": [100, 10],
                          "start_deg": -60, "end_deg": 60});
-    let answer = ok(with(
-        with(base(), "curve", ellipse.clone()),
-        "window",
-        json!(20),
-    ));
+    let answer = ok(with(with(base(), "curve", ellipse.clone()), "window", json!(20)));
     assert!(codes(&answer).contains(&"W_CURVATURE_ESTIMATE_UNRELIABLE"));
     // The conservative estimate keeps every block long enough there.
-    let safe = ok(with(
-        with(with(base(), "curve", ellipse), "window", json!(20)),
-        "radius_estimate",
-        json!("minimum"),
-    ));
+    let safe = ok(with(with(with(base(), "curve", ellipse), "window", json!(20)), "radius_estimate", json!("minimum")));
     assert_eq!(safe.stats.short_blocks, 0);
     assert!(!codes(&safe).contains(&"W_CURVATURE_ESTIMATE_UNRELIABLE"));
     // E13: chord errors below 5 increments of the 4-decimal G-code.
@@ -530,21 +359,21 @@ fn programs_in_both_dialects() {
     }));
     let fanuc = chord::program(
         &answer,
-        &Post {
-            dialect: Dialect::Fanuc,
-            tool: ToolCall::Table(3),
-        },
+        &Post { reference: kerf_solver::gcode::Reference::Tip, dialect: Dialect::Fanuc, tool: ToolCall::Table(3) },
     )
     .unwrap();
     assert!(fanuc.starts_with("%\nO1001 (KERF SEGMENT)\n"));
     // Clearance 5 mm above the highest point (the start, z = -1).
-    assert!(fanuc.contains("T3 M06\nG00 G43 H3 Z4.0000\nS8000 M03\nG00 X20.0000 Y0.0000 Z4.0000\nG01 X20.0000 Y0.0000 Z-1.0000 F2000\n"));
+    assert!(fanuc.contains(
+        "T3 M06\nG00 G43 H3 Z4.0000\nS8000 M03\nG00 X20.0000 Y0.0000 Z4.0000\nG01 X20.0000 Y0.0000 Z-1.0000 F2000\n"
+    ));
     assert!(fanuc.ends_with("M05\nG00 Z4.0000\nM30\n%\n"));
     let g01 = fanuc.lines().filter(|l| l.starts_with("G01")).count();
     assert_eq!(g01, answer.stats.blocks + 1);
     let linuxcnc = chord::program(
         &answer,
         &Post {
+            reference: kerf_solver::gcode::Reference::Tip,
             dialect: Dialect::Linuxcnc,
             tool: ToolCall::Manual("as set up".to_owned()),
         },
@@ -561,15 +390,9 @@ fn cusps_of_coincident_control_points_are_corners() {
     // Three coincident control points of a cubic: the curve stops and turns 90° there.
     let spline = json!({"kind": "bspline", "degree": 3,
         "control_points": [[0, 0], [10, 0], [20, 10], [20, 10], [20, 10], [30, 0], [40, 0]]});
-    let answer = ok(with(
-        with(with(base(), "curve", spline), "feed", json!(5000)),
-        "radius_estimate",
-        json!("minimum"),
-    ));
-    let cusp = answer
-        .points
-        .iter()
-        .position(|p| (p[0] - 20.0).abs() < 1e-9 && (p[1] - 10.0).abs() < 1e-9);
+    let answer =
+        ok(with(with(with(base(), "curve", spline), "feed", json!(5000)), "radius_estimate", json!("minimum")));
+    let cusp = answer.points.iter().position(|p| (p[0] - 20.0).abs() < 1e-9 && (p[1] - 10.0).abs() < 1e-9);
     assert!(cusp.is_some(), "the cusp is a command point");
     assert_eq!(answer.stats.short_blocks, 0);
 }

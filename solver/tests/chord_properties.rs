@@ -37,11 +37,7 @@ fn segment_distance(p: &Point, a: &Point, b: &Point) -> f64 {
     let ab = sub(b, a);
     let ap = sub(p, a);
     let length_squared = dot(&ab, &ab);
-    let t = if length_squared == 0.0 {
-        0.0
-    } else {
-        (dot(&ap, &ab) / length_squared).clamp(0.0, 1.0)
-    };
+    let t = if length_squared == 0.0 { 0.0 } else { (dot(&ap, &ab) / length_squared).clamp(0.0, 1.0) };
     norm(&sub(&ap, &[ab[0] * t, ab[1] * t, ab[2] * t]))
 }
 
@@ -64,11 +60,7 @@ impl Reference for Ellipse {
         let angle = self.start + self.sweep * t;
         let (x, y) = (self.a * angle.cos(), self.b * angle.sin());
         let (sin, cos) = self.rotation.sin_cos();
-        [
-            self.centre[0] + cos * x - sin * y,
-            self.centre[1] + sin * x + cos * y,
-            self.centre[2],
-        ]
+        [self.centre[0] + cos * x - sin * y, self.centre[1] + sin * x + cos * y, self.centre[2]]
     }
 }
 
@@ -88,23 +80,14 @@ impl Spline {
             knots.push(k as f64 / (n - degree) as f64);
         }
         knots.extend(std::iter::repeat_n(1.0, degree + 1));
-        Self {
-            degree,
-            control,
-            weights,
-            knots,
-        }
+        Self { degree, control, weights, knots }
     }
 
     fn basis(&self, i: usize, p: usize, u: f64) -> f64 {
         let k = &self.knots;
         if p == 0 {
             let last = u >= 1.0 && k[i + 1] == 1.0 && k[i] < 1.0;
-            return if (k[i] <= u && u < k[i + 1]) || last {
-                1.0
-            } else {
-                0.0
-            };
+            return if (k[i] <= u && u < k[i + 1]) || last { 1.0 } else { 0.0 };
         }
         let mut value = 0.0;
         if k[i + p] > k[i] {
@@ -155,14 +138,9 @@ impl Dense {
     /// Index of the sample nearest to `point` among those within 1 mm of arc length of `s_hint`.
     fn locate(&self, point: &Point, s_hint: f64) -> usize {
         let lo = self.s.partition_point(|&s| s < s_hint - 1.0);
-        let hi = self
-            .s
-            .partition_point(|&s| s <= s_hint + 1.0)
-            .min(self.s.len());
+        let hi = self.s.partition_point(|&s| s <= s_hint + 1.0).min(self.s.len());
         (lo..hi)
-            .min_by(|&a, &b| {
-                norm(&sub(&self.points[a], point)).total_cmp(&norm(&sub(&self.points[b], point)))
-            })
+            .min_by(|&a, &b| norm(&sub(&self.points[a], point)).total_cmp(&norm(&sub(&self.points[b], point))))
             .unwrap()
     }
 }
@@ -191,10 +169,7 @@ fn block_chord_errors(answer: &SegmentAnswer) -> Vec<f64> {
     answer.s[..answer.s.len() - 1]
         .iter()
         .map(|&s| {
-            let index = answer
-                .windows
-                .partition_point(|w| w.s_start <= s + 1e-9)
-                .saturating_sub(1);
+            let index = answer.windows.partition_point(|w| w.s_start <= s + 1e-9).saturating_sub(1);
             answer.windows[index].chord_error
         })
         .collect()
@@ -207,14 +182,8 @@ fn check(answer: &SegmentAnswer, curve: &dyn Reference, samples: usize, min_bloc
     let points: Vec<Point> = answer.points.iter().map(|p| to_point(p)).collect();
     let first = points.first().unwrap();
     let last = points.last().unwrap();
-    assert!(
-        norm(&sub(first, &curve.at(0.0))) <= 1e-9,
-        "first point off the start"
-    );
-    assert!(
-        norm(&sub(last, &curve.at(1.0))) <= 1e-9,
-        "last point off the end"
-    );
+    assert!(norm(&sub(first, &curve.at(0.0))) <= 1e-9, "first point off the start");
+    assert!(norm(&sub(last, &curve.at(1.0))) <= 1e-9, "last point off the end");
     let indices: Vec<usize> = points
         .iter()
         .zip(&answer.s)
@@ -222,18 +191,13 @@ fn check(answer: &SegmentAnswer, curve: &dyn Reference, samples: usize, min_bloc
         .collect();
     for (point, &index) in points.iter().zip(&indices) {
         let distance = distance_to_curve(curve, &dense, index, point);
-        assert!(
-            distance <= 1e-8,
-            "point {point:?} is {distance} off the curve"
-        );
+        assert!(distance <= 1e-8, "point {point:?} is {distance} off the curve");
     }
     let allowed = block_chord_errors(answer);
     for (block, pair) in indices.windows(2).enumerate() {
         let (a, b) = (&points[block], &points[block + 1]);
         // Samples strictly between the ones nearest the ends lie inside the chord's stretch.
-        let worst = (pair[0] + 1..pair[1])
-            .map(|j| segment_distance(&dense.points[j], a, b))
-            .fold(0.0, f64::max);
+        let worst = (pair[0] + 1..pair[1]).map(|j| segment_distance(&dense.points[j], a, b)).fold(0.0, f64::max);
         assert!(
             worst <= allowed[block] + SLACK,
             "block {block}: deviation {worst} over its chord error {}",
@@ -249,10 +213,7 @@ fn check(answer: &SegmentAnswer, curve: &dyn Reference, samples: usize, min_bloc
             .filter(|&(_, length)| length < min_block * (1.0 - SLACK))
             .collect();
         // Only span-end remainders may be short: the answer counts them apart.
-        assert_eq!(
-            answer.stats.short_blocks, 0,
-            "short blocks {short:?} of {count}"
-        );
+        assert_eq!(answer.stats.short_blocks, 0, "short blocks {short:?} of {count}");
         if let Some(&(index, _)) = short.iter().find(|&&(i, _)| i + 1 != count) {
             // A short block that is not the last must end at a corner; smooth curves have none.
             panic!("block {index} of {count} is short and not the last");

@@ -5,13 +5,8 @@
 use crate::error::SolverError;
 
 /// 5-point Gauss–Legendre nodes on [−1, 1].
-const NODES: [f64; 5] = [
-    -0.906_179_845_938_664,
-    -0.538_469_310_105_683_1,
-    0.0,
-    0.538_469_310_105_683_1,
-    0.906_179_845_938_664,
-];
+const NODES: [f64; 5] =
+    [-0.906_179_845_938_664, -0.538_469_310_105_683_1, 0.0, 0.538_469_310_105_683_1, 0.906_179_845_938_664];
 /// Their weights.
 const WEIGHTS: [f64; 5] = [
     0.236_926_885_056_189_1,
@@ -58,10 +53,7 @@ impl ArcLengthTable {
         panels_per_break: usize,
         field: &str,
     ) -> Result<Self, SolverError> {
-        let mut table = Self {
-            u: vec![breaks.first().copied().unwrap_or(0.0)],
-            s: vec![0.0],
-        };
+        let mut table = Self { u: vec![breaks.first().copied().unwrap_or(0.0)], s: vec![0.0] };
         for pair in breaks.windows(2) {
             let (start, end) = (pair[0], pair[1]);
             for k in 0..panels_per_break {
@@ -94,9 +86,7 @@ impl ArcLengthTable {
             if self.u.len() + 2 > MAX_PANELS {
                 return Err(SolverError::new(
                     "E_TOO_MANY_POINTS",
-                    format!(
-                        "the curve needs more than {MAX_PANELS} arc-length panels; simplify it"
-                    ),
+                    format!("the curve needs more than {MAX_PANELS} arc-length panels; simplify it"),
                 )
                 .at(field));
             }
@@ -119,10 +109,7 @@ impl ArcLengthTable {
     /// Index of the panel holding parameter `u`.
     fn panel_of_u(&self, u: f64) -> usize {
         let last_panel = self.u.len().saturating_sub(2);
-        self.u
-            .partition_point(|&x| x <= u)
-            .saturating_sub(1)
-            .min(last_panel)
+        self.u.partition_point(|&x| x <= u).saturating_sub(1).min(last_panel)
     }
 
     /// Arc length from the start to parameter `u`.
@@ -138,17 +125,10 @@ impl ArcLengthTable {
     /// Parameter at arc length `s` (clamped to the curve).
     pub(crate) fn u_at(&self, speed: &impl Fn(f64) -> f64, s: f64) -> f64 {
         let last_panel = self.s.len().saturating_sub(2);
-        let k = self
-            .s
-            .partition_point(|&x| x <= s)
-            .saturating_sub(1)
-            .min(last_panel);
-        let (Some(&u0), Some(&u1), Some(&s0), Some(&s1)) = (
-            self.u.get(k),
-            self.u.get(k + 1),
-            self.s.get(k),
-            self.s.get(k + 1),
-        ) else {
+        let k = self.s.partition_point(|&x| x <= s).saturating_sub(1).min(last_panel);
+        let (Some(&u0), Some(&u1), Some(&s0), Some(&s1)) =
+            (self.u.get(k), self.u.get(k + 1), self.s.get(k), self.s.get(k + 1))
+        else {
             return self.u.first().copied().unwrap_or(0.0);
         };
         if s <= s0 {
@@ -173,11 +153,7 @@ impl ArcLengthTable {
             }
             let slope = speed(u);
             let newton = u - residual / slope;
-            u = if slope > 0.0 && newton > lo && newton < hi {
-                newton
-            } else {
-                0.5 * (lo + hi)
-            };
+            u = if slope > 0.0 && newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
         }
         u
     }
@@ -192,8 +168,7 @@ mod tests {
     fn quarter_ellipse_length_matches_the_reference() {
         let (a, b) = (100.0_f64, 50.0_f64);
         let speed = |t: f64| (a * a * t.sin().powi(2) + b * b * t.cos().powi(2)).sqrt();
-        let table = ArcLengthTable::build(&speed, &[0.0, std::f64::consts::FRAC_PI_2], 16, "curve")
-            .unwrap();
+        let table = ArcLengthTable::build(&speed, &[0.0, std::f64::consts::FRAC_PI_2], 16, "curve").unwrap();
         assert_relative_eq!(table.length(), 121.105_602_756_846_01, max_relative = 1e-13);
         let t = table.u_at(&speed, 60.0);
         assert_relative_eq!(table.s_at(&speed, t), 60.0, max_relative = 1e-14);

@@ -78,11 +78,7 @@ impl MachineProfile {
 /// `E_INPUT` at `name` otherwise.
 pub fn validate_machine_name(name: &str) -> Result<(), SolverError> {
     let allowed = |c: char| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.');
-    if name.is_empty()
-        || name.chars().count() > MAX_NAME_CHARS
-        || name.starts_with('.')
-        || !name.chars().all(allowed)
-    {
+    if name.is_empty() || name.chars().count() > MAX_NAME_CHARS || name.starts_with('.') || !name.chars().all(allowed) {
         return Err(SolverError::input(
             "name",
             format!(
@@ -99,32 +95,17 @@ mod tests {
 
     #[test]
     fn profiles_round_trip_and_validate() {
-        let json =
-            r#"{"block_time_ms": 4, "max_feed": 12000, "dialect": "linuxcnc", "margin": 1.1}"#;
+        let json = r#"{"block_time_ms": 4, "max_feed": 12000, "dialect": "linuxcnc", "margin": 1.1}"#;
         let machine: MachineProfile = serde_json::from_str(json).unwrap();
         assert_eq!(machine.dialect, Dialect::Linuxcnc);
         machine.validate().unwrap();
         let text = serde_json::to_string(&machine).unwrap();
-        assert_eq!(
-            serde_json::from_str::<MachineProfile>(&text).unwrap(),
-            machine
-        );
-        let bad = MachineProfile {
-            margin: Some(0.9),
-            ..machine.clone()
-        };
+        assert_eq!(serde_json::from_str::<MachineProfile>(&text).unwrap(), machine);
+        let bad = MachineProfile { margin: Some(0.9), ..machine.clone() };
         assert_eq!(bad.validate().unwrap_err().field(), Some("margin"));
-        let bad = MachineProfile {
-            block_time_ms: 0.0,
-            ..machine
-        };
+        let bad = MachineProfile { block_time_ms: 0.0, ..machine };
         assert_eq!(bad.validate().unwrap_err().field(), Some("block_time_ms"));
-        assert!(
-            serde_json::from_str::<MachineProfile>(
-                r#"{"block_time_ms": 4, "max_feed": 1, "x": 1}"#
-            )
-            .is_err()
-        );
+        assert!(serde_json::from_str::<MachineProfile>(r#"{"block_time_ms": 4, "max_feed": 1, "x": 1}"#).is_err());
     }
 
     #[test]

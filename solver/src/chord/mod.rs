@@ -67,11 +67,9 @@ pub mod stats;
 pub use answer::{Comparison, SegmentAnswer, SegmentWindow, WindowStatus};
 pub use machine::{MachineProfile, validate_machine_name};
 pub use nurbs::{MAX_CONTROL_POINTS, MAX_DEGREE};
-pub use program::{Post, program};
+pub use program::program;
 pub use request::{Curve, CurveRule, Direction, Mode, RadiusEstimate, SegmentRequest};
-pub use rule::{
-    BlockRule, ChordStatus, Infeasible, RuleSettings, block_time_from_saturation, chord_length,
-};
+pub use rule::{BlockRule, ChordStatus, Infeasible, RuleSettings, block_time_from_saturation, chord_length};
 pub use stats::{BlockStats, block_stats};
 
 use request::{Job, Plan};
@@ -91,27 +89,15 @@ pub const MAX_BLOCKS: usize = 1_000_000;
 /// (no length), `E_INFEASIBLE_FEED_FOR_RADIUS` (E3: the message gives the largest feasible
 /// feed), `E_TOO_MANY_BLOCKS` (over [`MAX_BLOCKS`]), `E_TOO_MANY_POINTS` (arc-length table over
 /// its limit), `E_NUMERIC_FAILURE` (E14).
-pub fn solve(
-    request: &SegmentRequest,
-    machine: Option<&MachineProfile>,
-) -> Result<SegmentAnswer, SolverError> {
+pub fn solve(request: &SegmentRequest, machine: Option<&MachineProfile>) -> Result<SegmentAnswer, SolverError> {
     let job = request.validate(machine)?;
     let rule = &job.rule;
-    let limit_field = if job.tolerance.is_some() {
-        "tolerance"
-    } else {
-        "min_chord_error"
-    };
-    let cutter = Cutter {
-        shape: &job.shape,
-        spans: &job.spans,
-        max_blocks: MAX_BLOCKS,
-        limit_field,
-    };
+    let limit_field = if job.tolerance.is_some() { "tolerance" } else { "min_chord_error" };
+    let cutter = Cutter { shape: &job.shape, spans: &job.spans, max_blocks: MAX_BLOCKS, limit_field };
     let cut = match job.plan {
-        Plan::Window { length, estimate } => cutter
-            .windows(rule, job.tolerance, length, estimate)
-            .map_err(|error| cut_error(&job, error))?,
+        Plan::Window { length, estimate } => {
+            cutter.windows(rule, job.tolerance, length, estimate).map_err(|error| cut_error(&job, error))?
+        }
         Plan::Max { length, estimate } => {
             let radii = cutter.tiled_radii(length, estimate, rule.target_chord())?;
             let mut worst: Option<(f64, f64, rule::ChordStatus)> = None;
@@ -123,11 +109,8 @@ pub fn solve(
                     worst = Some((chord_error, radius, status));
                 }
             }
-            let (chord_error, radius, status) = worst.unwrap_or((
-                rule.min_chord_error,
-                f64::INFINITY,
-                rule::ChordStatus::Surface,
-            ));
+            let (chord_error, radius, status) =
+                worst.unwrap_or((rule.min_chord_error, f64::INFINITY, rule::ChordStatus::Surface));
             single_value(&job, &cutter, chord_error, radius, status)?
         }
         Plan::Extremes { min_radius } | Plan::NormalAccel { min_radius } => {
@@ -142,11 +125,7 @@ pub fn solve(
             };
             let (chord_error, status) = value.map_err(|infeasible| {
                 let error = infeasible_error(&job, InfeasibleAt { s, infeasible });
-                if min_radius.is_some() {
-                    error.at("min_radius")
-                } else {
-                    error
-                }
+                if min_radius.is_some() { error.at("min_radius") } else { error }
             })?;
             single_value(&job, &cutter, chord_error, radius, status)?
         }
@@ -207,11 +186,8 @@ fn cut_error(job: &Job, error: CutError) -> SolverError {
 fn infeasible_error(job: &Job, at: InfeasibleAt) -> SolverError {
     let rule = &job.rule;
     let (curve_radius, curve_s) = curve_min_radius(job);
-    let (radius, s) = if curve_radius < at.infeasible.radius {
-        (curve_radius, curve_s)
-    } else {
-        (at.infeasible.radius, at.s)
-    };
+    let (radius, s) =
+        if curve_radius < at.infeasible.radius { (curve_radius, curve_s) } else { (at.infeasible.radius, at.s) };
     let limit = rule.feed_limit(radius);
     // Rounded down, so the feed named is feasible.
     let feasible = if limit >= 100.0 {
@@ -245,11 +221,7 @@ fn infeasible_error(job: &Job, at: InfeasibleAt) -> SolverError {
 
 /// A length for a message: 4 decimals, or 3 significant digits below a micrometre.
 fn length(value: f64) -> String {
-    if value >= 1e-3 {
-        format!("{value:.4}")
-    } else {
-        format!("{value:.3e}")
-    }
+    if value >= 1e-3 { format!("{value:.4}") } else { format!("{value:.3e}") }
 }
 
 fn status_of(status: Status) -> WindowStatus {
@@ -272,10 +244,7 @@ fn finite_or_none(value: f64) -> Option<f64> {
 
 /// Largest deviation of the curve from the chords of a cut.
 fn max_deviation(job: &Job, cut: &Cut) -> f64 {
-    cut.vertices
-        .windows(2)
-        .map(|pair| job.shape.deviation(pair[0].u, pair[1].u))
-        .fold(0.0, f64::max)
+    cut.vertices.windows(2).map(|pair| job.shape.deviation(pair[0].u, pair[1].u)).fold(0.0, f64::max)
 }
 
 fn answer(job: &Job, request: &SegmentRequest, cut: &Cut) -> Result<SegmentAnswer, SolverError> {
@@ -295,26 +264,11 @@ fn answer(job: &Job, request: &SegmentRequest, cut: &Cut) -> Result<SegmentAnswe
             blocks: w.blocks,
         })
         .collect();
-    let chord_error = cut
-        .windows
-        .iter()
-        .map(|w| w.chord_error)
-        .fold(0.0, f64::max);
-    let min_window_chord_error = cut
-        .windows
-        .iter()
-        .map(|w| w.chord_error)
-        .fold(f64::INFINITY, f64::min);
-    let min_radius = cut
-        .windows
-        .iter()
-        .map(|w| w.radius)
-        .fold(f64::INFINITY, f64::min);
+    let chord_error = cut.windows.iter().map(|w| w.chord_error).fold(0.0, f64::max);
+    let min_window_chord_error = cut.windows.iter().map(|w| w.chord_error).fold(f64::INFINITY, f64::min);
+    let min_radius = cut.windows.iter().map(|w| w.radius).fold(f64::INFINITY, f64::min);
     let tolerance_feed = job.tolerance.map(|tolerance| {
-        cut.windows
-            .iter()
-            .map(|w| rule.feed_for_tolerance(w.radius, tolerance))
-            .fold(f64::INFINITY, f64::min)
+        cut.windows.iter().map(|w| rule.feed_for_tolerance(w.radius, tolerance)).fold(f64::INFINITY, f64::min)
     });
 
     let mut warnings = job.warnings.clone();
@@ -335,21 +289,13 @@ fn answer(job: &Job, request: &SegmentRequest, cut: &Cut) -> Result<SegmentAnswe
             Some(Comparison {
                 tolerance,
                 max_deviation: max_deviation(job, &fixed),
-                stats: stats::stats_with_ends(
-                    &fixed_points,
-                    rule.feed,
-                    rule.block_time_ms,
-                    &fixed.span_ends,
-                ),
+                stats: stats::stats_with_ends(&fixed_points, rule.feed, rule.block_time_ms, &fixed.span_ends),
             })
         }
         None => None,
     };
 
-    let highest = positions
-        .iter()
-        .map(|p| p.z)
-        .fold(f64::NEG_INFINITY, f64::max);
+    let highest = positions.iter().map(|p| p.z).fold(f64::NEG_INFINITY, f64::max);
     let safe_z = match job.safe_z {
         Some(z) if z < highest => {
             return Err(SolverError::input(
@@ -363,16 +309,9 @@ fn answer(job: &Job, request: &SegmentRequest, cut: &Cut) -> Result<SegmentAnswe
     let description = report::describe(job, request, chord_error, min_window_chord_error, &stats);
     Ok(SegmentAnswer {
         chord_error,
-        min_window_chord_error: if min_window_chord_error.is_finite() {
-            min_window_chord_error
-        } else {
-            0.0
-        },
+        min_window_chord_error: if min_window_chord_error.is_finite() { min_window_chord_error } else { 0.0 },
         windows,
-        points: positions
-            .iter()
-            .map(|p| coordinates(p, job.dimension))
-            .collect(),
+        points: positions.iter().map(|p| coordinates(p, job.dimension)).collect(),
         s: cut.vertices.iter().map(|v| v.s).collect(),
         max_deviation: max_deviation(job, cut),
         stats,

@@ -84,14 +84,7 @@ pub(crate) fn minimise(f: impl Fn(f64) -> f64, lo: f64, hi: f64, tol: f64) -> (f
 /// returns a point `x` with `g(x) ≤ 0` within `tol` (absolute, > 0) of a sign change of `g`
 /// between them. Brent (1973), `zeroin`, with the answer taken on the non-positive side. `None`
 /// when the iteration cap is reached (E14) or `g` stops being a number.
-pub(crate) fn last_fitting(
-    g: impl Fn(f64) -> f64,
-    lo: f64,
-    g_lo: f64,
-    hi: f64,
-    g_hi: f64,
-    tol: f64,
-) -> Option<f64> {
+pub(crate) fn last_fitting(g: impl Fn(f64) -> f64, lo: f64, g_lo: f64, hi: f64, g_hi: f64, tol: f64) -> Option<f64> {
     let (mut a, mut fa, mut b, mut fb) = (lo, g_lo, hi, g_hi);
     let (mut c, mut fc) = (a, fa);
     let mut d = b - a;
@@ -141,11 +134,7 @@ pub(crate) fn last_fitting(
             e = d;
         }
         (a, fa) = (b, fb);
-        b += if d.abs() > tol1 {
-            d
-        } else {
-            tol1.copysign(half)
-        };
+        b += if d.abs() > tol1 { d } else { tol1.copysign(half) };
         fb = g(b);
         if fb.is_nan() {
             return None;

@@ -47,10 +47,7 @@ impl Nurbs {
         if count < degree + 1 {
             return Err(SolverError::input(
                 format!("{field}.control_points"),
-                format!(
-                    "a degree-{degree} curve needs at least {} control points (got {count})",
-                    degree + 1
-                ),
+                format!("a degree-{degree} curve needs at least {} control points (got {count})", degree + 1),
             ));
         }
         if count > MAX_CONTROL_POINTS {
@@ -68,35 +65,21 @@ impl Nurbs {
                 if given.len() != count {
                     return Err(SolverError::input(
                         format!("{field}.weights"),
-                        format!(
-                            "weights must have one entry per control point ({count}), got {}",
-                            given.len()
-                        ),
+                        format!("weights must have one entry per control point ({count}), got {}", given.len()),
                     ));
                 }
                 for (index, &weight) in given.iter().enumerate() {
                     let path = format!("{field}.weights[{index}]");
                     if finite(&path, weight)? <= 0.0 {
-                        return Err(SolverError::input(
-                            path,
-                            format!("weights must be greater than 0 (got {weight})"),
-                        ));
+                        return Err(SolverError::input(path, format!("weights must be greater than 0 (got {weight})")));
                     }
                 }
                 given.to_vec()
             }
             None => vec![1.0; count],
         };
-        let weighted = points
-            .iter()
-            .zip(&weights)
-            .map(|(p, &w)| [w * p.x, w * p.y, w * p.z, w])
-            .collect();
-        Ok(Self {
-            degree,
-            knots,
-            weighted,
-        })
+        let weighted = points.iter().zip(&weights).map(|(p, &w)| [w * p.x, w * p.y, w * p.z, w]).collect();
+        Ok(Self { degree, knots, weighted })
     }
 
     /// Parameter range [u_p, u_n].
@@ -172,11 +155,7 @@ impl Nurbs {
             && (u < self.knots[guess + 1] || (guess == n - 1 && u <= self.knots[n]))
         {
             guess
-        } else if guess + 1 >= self.degree
-            && guess + 1 < n
-            && self.knots[guess + 1] <= u
-            && u < self.knots[guess + 2]
-        {
+        } else if guess + 1 >= self.degree && guess + 1 < n && self.knots[guess + 1] <= u && u < self.knots[guess + 2] {
             guess + 1
         } else {
             self.span(u)
@@ -207,10 +186,7 @@ impl Nurbs {
     pub(crate) fn derivatives_from_left(&self, u: f64) -> Option<[Vec3; 3]> {
         let right = self.span(u);
         let n = self.weighted.len();
-        let left = self.knots[..=n]
-            .partition_point(|&k| k < u)
-            .saturating_sub(1)
-            .clamp(self.degree, n - 1);
+        let left = self.knots[..=n].partition_point(|&k| k < u).saturating_sub(1).clamp(self.degree, n - 1);
         (left != right).then(|| self.derivatives_in(left, u))
     }
 
@@ -226,11 +202,7 @@ impl Nurbs {
             }
         }
         let vector = |h: &[f64; 4]| Vec3::new(h[0], h[1], h[2]);
-        let (a0, a1, a2) = (
-            vector(&homogeneous[0]),
-            vector(&homogeneous[1]),
-            vector(&homogeneous[2]),
-        );
+        let (a0, a1, a2) = (vector(&homogeneous[0]), vector(&homogeneous[1]), vector(&homogeneous[2]));
         let (w0, w1, w2) = (homogeneous[0][3], homogeneous[1][3], homogeneous[2][3]);
         let point = a0 / w0;
         let first = (a1 - w1 * point) / w0;
@@ -300,8 +272,7 @@ impl Nurbs {
                 let j1 = if rk >= -1 { 1 } else { -rk };
                 let j2 = if r - 1 <= pk { k - 1 } else { p_i - r };
                 for j in j1..=j2 {
-                    a[s2][idx(j)] =
-                        (a[s1][idx(j)] - a[s1][idx(j - 1)]) / ndu[idx(pk + 1)][idx(rk + j)];
+                    a[s2][idx(j)] = (a[s1][idx(j)] - a[s1][idx(j - 1)]) / ndu[idx(pk + 1)][idx(rk + j)];
                     d += a[s2][idx(j)] * ndu[idx(rk + j)][idx(pk)];
                 }
                 if r <= pk {
@@ -334,12 +305,7 @@ fn clamped_uniform(degree: usize, count: usize) -> Vec<f64> {
     knots
 }
 
-fn validate_knots(
-    knots: &[f64],
-    degree: usize,
-    count: usize,
-    field: &str,
-) -> Result<Vec<f64>, SolverError> {
+fn validate_knots(knots: &[f64], degree: usize, count: usize, field: &str) -> Result<Vec<f64>, SolverError> {
     let path = format!("{field}.knots");
     let expected = count + degree + 1;
     if knots.len() != expected {
@@ -357,10 +323,7 @@ fn validate_knots(
         if index > 0 && knot < knots[index - 1] {
             return Err(SolverError::input(
                 format!("{path}[{index}]"),
-                format!(
-                    "knots must not decrease: {knot} follows {}",
-                    knots[index - 1]
-                ),
+                format!("knots must not decrease: {knot} follows {}", knots[index - 1]),
             ));
         }
     }
@@ -369,20 +332,14 @@ fn validate_knots(
         if knots[index] != first {
             return Err(SolverError::input(
                 format!("{path}[{index}]"),
-                format!(
-                    "the knot vector must be clamped: the first {} knots must be equal",
-                    degree + 1
-                ),
+                format!("the knot vector must be clamped: the first {} knots must be equal", degree + 1),
             ));
         }
         let back = expected - 1 - index;
         if knots[back] != last {
             return Err(SolverError::input(
                 format!("{path}[{back}]"),
-                format!(
-                    "the knot vector must be clamped: the last {} knots must be equal",
-                    degree + 1
-                ),
+                format!("the knot vector must be clamped: the last {} knots must be equal", degree + 1),
             ));
         }
     }
@@ -408,11 +365,7 @@ fn validate_knots(
     }
     let mut run = 0;
     for index in degree + 1..count {
-        run = if index > degree + 1 && knots[index] == knots[index - 1] {
-            run + 1
-        } else {
-            1
-        };
+        run = if index > degree + 1 && knots[index] == knots[index - 1] { run + 1 } else { 1 };
         if run > degree {
             return Err(SolverError::input(
                 format!("{path}[{index}]"),
@@ -453,14 +406,7 @@ mod tests {
 
     #[test]
     fn derivatives_match_finite_differences() {
-        let control = points(&[
-            [0.0, 0.0],
-            [1.0, 2.0],
-            [3.0, 3.0],
-            [4.0, 0.0],
-            [6.0, 1.0],
-            [7.0, 4.0],
-        ]);
+        let control = points(&[[0.0, 0.0], [1.0, 2.0], [3.0, 3.0], [4.0, 0.0], [6.0, 1.0], [7.0, 4.0]]);
         let weights = [1.0, 2.0, 0.5, 1.0, 3.0, 1.0];
         for degree in 1..=5 {
             let curve = Nurbs::new(degree, &control, None, Some(&weights), "curve").unwrap();
@@ -469,20 +415,12 @@ mod tests {
                 let u = f64::from(k) / 10.0 + 0.013;
                 let [_, first, second] = curve.derivatives(u);
                 let difference = (curve.point(u + step) - curve.point(u - step)) / (2.0 * step);
-                assert_abs_diff_eq!(
-                    (first - difference).norm(),
-                    0.0,
-                    epsilon = 1e-6 * (1.0 + first.norm())
-                );
+                assert_abs_diff_eq!((first - difference).norm(), 0.0, epsilon = 1e-6 * (1.0 + first.norm()));
                 if degree >= 3 {
                     let [_, ahead, _] = curve.derivatives(u + step);
                     let [_, behind, _] = curve.derivatives(u - step);
                     let change = (ahead - behind) / (2.0 * step);
-                    assert_abs_diff_eq!(
-                        (second - change).norm(),
-                        0.0,
-                        epsilon = 1e-5 * (1.0 + second.norm())
-                    );
+                    assert_abs_diff_eq!((second - change).norm(), 0.0, epsilon = 1e-5 * (1.0 + second.norm()));
                 }
             }
         }
@@ -491,55 +429,19 @@ mod tests {
     #[test]
     fn knot_vectors_are_checked() {
         let control = points(&[[0.0, 0.0], [1.0, 1.0], [2.0, 0.0], [3.0, 1.0]]);
-        let field = |knots: &[f64]| {
-            Nurbs::new(2, &control, Some(knots), None, "curve")
-                .unwrap_err()
-                .field()
-                .map(str::to_owned)
-        };
-        assert_eq!(
-            field(&[0.0, 0.0, 0.0, 1.0, 1.0, 1.0]).as_deref(),
-            Some("curve.knots")
-        );
-        assert_eq!(
-            field(&[0.0, 0.0, 0.0, 0.6, 0.5, 1.0, 1.0]).as_deref(),
-            Some("curve.knots[4]")
-        );
-        assert_eq!(
-            field(&[0.0, 0.0, 0.1, 0.5, 1.0, 1.0, 1.0]).as_deref(),
-            Some("curve.knots[2]")
-        );
-        assert_eq!(
-            field(&[0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 2.0]).as_deref(),
-            Some("curve.knots[5]")
-        );
-        assert_eq!(
-            field(&[0.0, 0.0, 0.0, f64::NAN, 1.0, 1.0, 1.0]).as_deref(),
-            Some("curve.knots[3]")
-        );
-        assert!(
-            Nurbs::new(
-                2,
-                &control,
-                Some(&[0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0]),
-                None,
-                "curve"
-            )
-            .is_ok()
-        );
-        let weights =
-            Nurbs::new(2, &control, None, Some(&[1.0, 0.0, 1.0, 1.0]), "curve").unwrap_err();
+        let field =
+            |knots: &[f64]| Nurbs::new(2, &control, Some(knots), None, "curve").unwrap_err().field().map(str::to_owned);
+        assert_eq!(field(&[0.0, 0.0, 0.0, 1.0, 1.0, 1.0]).as_deref(), Some("curve.knots"));
+        assert_eq!(field(&[0.0, 0.0, 0.0, 0.6, 0.5, 1.0, 1.0]).as_deref(), Some("curve.knots[4]"));
+        assert_eq!(field(&[0.0, 0.0, 0.1, 0.5, 1.0, 1.0, 1.0]).as_deref(), Some("curve.knots[2]"));
+        assert_eq!(field(&[0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 2.0]).as_deref(), Some("curve.knots[5]"));
+        assert_eq!(field(&[0.0, 0.0, 0.0, f64::NAN, 1.0, 1.0, 1.0]).as_deref(), Some("curve.knots[3]"));
+        assert!(Nurbs::new(2, &control, Some(&[0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0]), None, "curve").is_ok());
+        let weights = Nurbs::new(2, &control, None, Some(&[1.0, 0.0, 1.0, 1.0]), "curve").unwrap_err();
         assert_eq!(weights.field(), Some("curve.weights[1]"));
+        assert_eq!(Nurbs::new(6, &control, None, None, "curve").unwrap_err().field(), Some("curve.degree"));
         assert_eq!(
-            Nurbs::new(6, &control, None, None, "curve")
-                .unwrap_err()
-                .field(),
-            Some("curve.degree")
-        );
-        assert_eq!(
-            Nurbs::new(3, &control[..3], None, None, "curve")
-                .unwrap_err()
-                .field(),
+            Nurbs::new(3, &control[..3], None, None, "curve").unwrap_err().field(),
             Some("curve.control_points")
         );
     }
@@ -549,14 +451,7 @@ mod tests {
         let control = points(&[[0.0, 0.0], [1.0, 1.0], [2.0, 0.0], [3.0, 1.0], [4.0, 0.0]]);
         let ok = [0.0, 0.0, 0.0, 0.5, 0.5, 1.0, 1.0, 1.0];
         assert!(Nurbs::new(2, &control, Some(&ok), None, "curve").is_ok());
-        let control6 = points(&[
-            [0.0, 0.0],
-            [1.0, 1.0],
-            [2.0, 0.0],
-            [3.0, 1.0],
-            [4.0, 0.0],
-            [5.0, 1.0],
-        ]);
+        let control6 = points(&[[0.0, 0.0], [1.0, 1.0], [2.0, 0.0], [3.0, 1.0], [4.0, 0.0], [5.0, 1.0]]);
         let bad = [0.0, 0.0, 0.0, 0.5, 0.5, 0.5, 1.0, 1.0, 1.0];
         let error = Nurbs::new(2, &control6, Some(&bad), None, "curve").unwrap_err();
         assert_eq!(error.field(), Some("curve.knots[5]"));

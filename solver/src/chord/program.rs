@@ -8,20 +8,12 @@
 
 use super::answer::SegmentAnswer;
 use crate::error::SolverError;
-use crate::gcode::{self, Dialect, Program, ToolCall};
+use crate::gcode::{self, Post, Program};
 use crate::geometry::Vec3;
 use crate::path::Toolpath;
 
-/// How to post the program.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Post {
-    /// Control dialect.
-    pub dialect: Dialect,
-    /// Tool selection, as the caller wants it written.
-    pub tool: ToolCall,
-}
-
-/// The complete program for a segment answer.
+/// The complete program for a segment answer. `post.reference` does not apply: the curve is
+/// the programmed point.
 ///
 /// # Errors
 /// `E_NO_PROGRAM` when the answer has no block (it always has one when `solve` succeeded).

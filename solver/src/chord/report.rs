@@ -20,9 +20,7 @@ pub(super) fn sparse_polyline(job: &Job) -> Option<Warning> {
     // Edges next to a bend that is not a corner (corners split the path and are kept).
     let corner = |station: f64| {
         let index = job.spans.partition_point(|&(start, _)| start < station);
-        job.spans
-            .get(index)
-            .is_some_and(|&(start, _)| start == station)
+        job.spans.get(index).is_some_and(|&(start, _)| start == station)
     };
     let mut longest = 0.0_f64;
     for (k, three) in line.vertices.windows(3).enumerate() {
@@ -70,30 +68,15 @@ pub(super) fn window_warnings(job: &Job, cut: &Cut) -> Vec<Warning> {
         ));
     }
     if let Some(tolerance) = job.tolerance {
-        let limited: Vec<_> = cut
-            .windows
-            .iter()
-            .filter(|w| w.status == Status::LimitedByTolerance)
-            .collect();
+        let limited: Vec<_> = cut.windows.iter().filter(|w| w.status == Status::LimitedByTolerance).collect();
         if !limited.is_empty() {
-            let largest = limited
-                .iter()
-                .map(|w| w.rule_chord_error)
-                .fold(0.0, f64::max);
-            let feed = limited
-                .iter()
-                .map(|w| rule.feed_for_tolerance(w.radius, tolerance))
-                .fold(f64::INFINITY, f64::min);
+            let largest = limited.iter().map(|w| w.rule_chord_error).fold(0.0, f64::max);
+            let feed =
+                limited.iter().map(|w| rule.feed_for_tolerance(w.radius, tolerance)).fold(f64::INFINITY, f64::min);
             let advice = if rule.min_chord_error > tolerance {
-                format!(
-                    "min_chord_error {} mm is above the tolerance; lower it",
-                    rule.min_chord_error
-                )
+                format!("min_chord_error {} mm is above the tolerance; lower it", rule.min_chord_error)
             } else {
-                format!(
-                    "at feed {:.0} mm/min the rule meets the tolerance with blocks of one block time",
-                    feed.floor()
-                )
+                format!("at feed {:.0} mm/min the rule meets the tolerance with blocks of one block time", feed.floor())
             };
             warnings.push(Warning::new(
                 "W_CHORD_ERROR_EXCEEDS_TOLERANCE",
@@ -106,20 +89,9 @@ pub(super) fn window_warnings(job: &Job, cut: &Cut) -> Vec<Warning> {
             ));
         }
     }
-    if let Plan::Window {
-        estimate: segment::Estimate::ThreePoint,
-        ..
-    } = job.plan
-    {
-        let unreliable: Vec<_> = cut
-            .windows
-            .iter()
-            .filter(|w| w.spread > segment::SPREAD_CAP)
-            .collect();
-        if let Some(worst) = unreliable
-            .iter()
-            .max_by(|a, b| a.spread.total_cmp(&b.spread))
-        {
+    if let Plan::Window { estimate: segment::Estimate::ThreePoint, .. } = job.plan {
+        let unreliable: Vec<_> = cut.windows.iter().filter(|w| w.spread > segment::SPREAD_CAP).collect();
+        if let Some(worst) = unreliable.iter().max_by(|a, b| a.spread.total_cmp(&b.spread)) {
             warnings.push(Warning::new(
                 "W_CURVATURE_ESTIMATE_UNRELIABLE",
                 format!(
@@ -138,12 +110,7 @@ pub(super) fn window_warnings(job: &Job, cut: &Cut) -> Vec<Warning> {
             ));
         }
     }
-    let finest = cut
-        .windows
-        .iter()
-        .map(|w| w.chord_error)
-        .filter(|&c| c > 0.0)
-        .fold(f64::INFINITY, f64::min);
+    let finest = cut.windows.iter().map(|w| w.chord_error).filter(|&c| c > 0.0).fold(f64::INFINITY, f64::min);
     if finest < 5.0 * LEAST_INCREMENT {
         warnings.push(Warning::new(
             "W_RESOLUTION_LIMITED",
@@ -186,11 +153,7 @@ pub(super) fn block_warnings(job: &Job, cut: &Cut, stats: &BlockStats) -> Vec<Wa
                 } else {
                     ": harmless where the control stops at the path end"
                 },
-                if corners > 0 {
-                    format!("; {corners} more short remainders end at corners")
-                } else {
-                    String::new()
-                }
+                if corners > 0 { format!("; {corners} more short remainders end at corners") } else { String::new() }
             ),
         ));
     }

@@ -281,11 +281,7 @@ fn point(field: &str, coordinates: &[f64]) -> Result<Vec3, SolverError> {
             ));
         }
     }
-    Ok(Vec3::new(
-        coordinates[0],
-        coordinates[1],
-        coordinates.get(2).copied().unwrap_or(0.0),
-    ))
+    Ok(Vec3::new(coordinates[0], coordinates[1], coordinates.get(2).copied().unwrap_or(0.0)))
 }
 
 /// Points of one list, all with the dimension of the first.
@@ -297,10 +293,7 @@ fn points(field: &str, list: &[Vec<f64>]) -> Result<(Vec<Vec3>, usize), SolverEr
         if coordinates.len() != dimension {
             return Err(SolverError::input(
                 path,
-                format!(
-                    "every point must have {dimension} coordinates like the first (got {})",
-                    coordinates.len()
-                ),
+                format!("every point must have {dimension} coordinates like the first (got {})", coordinates.len()),
             ));
         }
         out.push(point(&path, coordinates)?);
@@ -310,10 +303,7 @@ fn points(field: &str, list: &[Vec<f64>]) -> Result<(Vec<Vec3>, usize), SolverEr
 
 fn radius(field: &str, value: f64) -> Result<f64, SolverError> {
     if positive(field, value)? > MAX_COORDINATE {
-        return Err(SolverError::input(
-            field,
-            format!("{field} must be at most {MAX_COORDINATE} mm (got {value})"),
-        ));
+        return Err(SolverError::input(field, format!("{field} must be at most {MAX_COORDINATE} mm (got {value})")));
     }
     Ok(value)
 }
@@ -326,11 +316,7 @@ fn sweep(start_deg: f64, end_deg: f64, direction: Direction) -> f64 {
         Direction::Cw => start_deg - end_deg,
     };
     let wrapped = forward.rem_euclid(360.0);
-    if wrapped == 0.0 && forward != 0.0 {
-        std::f64::consts::TAU
-    } else {
-        wrapped.to_radians()
-    }
+    if wrapped == 0.0 && forward != 0.0 { std::f64::consts::TAU } else { wrapped.to_radians() }
 }
 
 fn sense(direction: Direction) -> f64 {
@@ -344,10 +330,7 @@ fn corner_angle(value: Option<f64>) -> Result<f64, SolverError> {
     let field = "curve.corner_angle_deg";
     let degrees = value.unwrap_or(DEFAULT_CORNER_ANGLE_DEG);
     if !(finite(field, degrees)? > 0.0 && degrees < 180.0) {
-        return Err(SolverError::input(
-            field,
-            format!("corner_angle_deg must be between 0 and 180 (got {degrees})"),
-        ));
+        return Err(SolverError::input(field, format!("corner_angle_deg must be between 0 and 180 (got {degrees})")));
     }
     Ok(degrees.to_radians())
 }
@@ -357,12 +340,7 @@ impl Curve {
     pub(crate) fn build(&self) -> Result<(Shape, Vec<f64>, usize, Vec<Warning>), SolverError> {
         let mut warnings = Vec::new();
         let (shape, corners, dimension) = match self {
-            Self::Circle {
-                centre,
-                radius: r,
-                start_deg,
-                direction,
-            } => {
+            Self::Circle { centre, radius: r, start_deg, direction } => {
                 let c = point("curve.centre", centre)?;
                 let shape = Shape::Arc(Arc {
                     centre: c,
@@ -373,13 +351,7 @@ impl Curve {
                 });
                 (shape, Vec::new(), centre.len())
             }
-            Self::Arc {
-                centre,
-                radius: r,
-                start_deg,
-                end_deg,
-                direction,
-            } => {
+            Self::Arc { centre, radius: r, start_deg, end_deg, direction } => {
                 let c = point("curve.centre", centre)?;
                 let start = finite("curve.start_deg", *start_deg)?;
                 let end = finite("curve.end_deg", *end_deg)?;
@@ -400,14 +372,7 @@ impl Curve {
                 });
                 (shape, Vec::new(), centre.len())
             }
-            Self::Ellipse {
-                centre,
-                semi_axes,
-                start_deg,
-                end_deg,
-                rotation_deg,
-                direction,
-            } => {
+            Self::Ellipse { centre, semi_axes, start_deg, end_deg, rotation_deg, direction } => {
                 let c = point("curve.centre", centre)?;
                 let a = radius("curve.semi_axes[0]", semi_axes[0])?;
                 let b = radius("curve.semi_axes[1]", semi_axes[1])?;
@@ -433,11 +398,7 @@ impl Curve {
                 // Panel breaks at the quarter points, where the speed has its extremes.
                 let quarter = std::f64::consts::FRAC_PI_2;
                 let mut breaks = vec![0.0];
-                let first = if sense > 0.0 {
-                    (start / quarter).floor() + 1.0
-                } else {
-                    (start / quarter).ceil() - 1.0
-                };
+                let first = if sense > 0.0 { (start / quarter).floor() + 1.0 } else { (start / quarter).ceil() - 1.0 };
                 let mut k = first;
                 loop {
                     let u = (k * quarter - start) * sense;
@@ -460,17 +421,11 @@ impl Curve {
                 });
                 (shape, Vec::new(), centre.len())
             }
-            Self::Polyline {
-                points: list,
-                corner_angle_deg,
-            } => {
+            Self::Polyline { points: list, corner_angle_deg } => {
                 if list.len() > MAX_POLYLINE_POINTS {
                     return Err(SolverError::input(
                         "curve.points",
-                        format!(
-                            "at most {MAX_POLYLINE_POINTS} points are accepted (got {})",
-                            list.len()
-                        ),
+                        format!("at most {MAX_POLYLINE_POINTS} points are accepted (got {})", list.len()),
                     ));
                 }
                 let corner = corner_angle(*corner_angle_deg)?;
@@ -508,13 +463,7 @@ impl Curve {
                 let corners = shape.corners(corner);
                 (shape, corners, dimension)
             }
-            Self::Bspline {
-                degree,
-                control_points,
-                knots,
-                weights,
-                corner_angle_deg,
-            } => {
+            Self::Bspline { degree, control_points, knots, weights, corner_angle_deg } => {
                 let corner = corner_angle(*corner_angle_deg)?;
                 if control_points.len() > super::nurbs::MAX_CONTROL_POINTS {
                     return Err(SolverError::input(
@@ -527,13 +476,7 @@ impl Curve {
                     ));
                 }
                 let (control, dimension) = points("curve.control_points", control_points)?;
-                let nurbs = Nurbs::new(
-                    *degree,
-                    &control,
-                    knots.as_deref(),
-                    weights.as_deref(),
-                    "curve",
-                )?;
+                let nurbs = Nurbs::new(*degree, &control, knots.as_deref(), weights.as_deref(), "curve")?;
                 if control.windows(2).all(|pair| pair[0] == pair[1]) {
                     return Err(SolverError::new(
                         "E_DEGENERATE_CURVE",
@@ -564,10 +507,7 @@ fn optional_tolerance(field: &str, value: Option<f64>) -> Result<Option<f64>, So
         return Ok(None);
     };
     if positive(field, value)? < MIN_TOLERANCE {
-        return Err(SolverError::input(
-            field,
-            format!("{field} must be at least {MIN_TOLERANCE} mm (got {value})"),
-        ));
+        return Err(SolverError::input(field, format!("{field} must be at least {MIN_TOLERANCE} mm (got {value})")));
     }
     Ok(Some(value))
 }
@@ -606,10 +546,7 @@ impl SegmentRequest {
     ///
     /// # Errors
     /// `E_INPUT` naming the field for a missing or bad value.
-    pub fn block_rule(
-        &self,
-        machine: Option<&MachineProfile>,
-    ) -> Result<(BlockRule, Vec<Warning>), SolverError> {
+    pub fn block_rule(&self, machine: Option<&MachineProfile>) -> Result<(BlockRule, Vec<Warning>), SolverError> {
         let settings = RuleSettings {
             feed: self.feed,
             block_time_ms: self.block_time_ms,
@@ -634,26 +571,14 @@ impl SegmentRequest {
             RadiusEstimate::ThreePoint => Estimate::ThreePoint,
             RadiusEstimate::Minimum => Estimate::Minimum,
         };
-        let min_radius = self
-            .min_radius
-            .map(|r| positive("min_radius", r))
-            .transpose()?;
+        let min_radius = self.min_radius.map(|r| positive("min_radius", r)).transpose()?;
         let plan = match (self.mode, self.rule) {
             (Mode::Window, Some(_)) => {
-                return Err(SolverError::input(
-                    "rule",
-                    "rule applies to mode \"curve\" only",
-                ));
+                return Err(SolverError::input("rule", "rule applies to mode \"curve\" only"));
             }
-            (Mode::Window, None) => Plan::Window {
-                length: window.unwrap_or(default_window),
-                estimate,
-            },
+            (Mode::Window, None) => Plan::Window { length: window.unwrap_or(default_window), estimate },
             (Mode::Curve, rule) => match rule.unwrap_or_default() {
-                CurveRule::Max => Plan::Max {
-                    length: window.unwrap_or(default_window),
-                    estimate,
-                },
+                CurveRule::Max => Plan::Max { length: window.unwrap_or(default_window), estimate },
                 other => {
                     if window.is_some() {
                         return Err(SolverError::input(
@@ -675,8 +600,7 @@ impl SegmentRequest {
                 }
             },
         };
-        if min_radius.is_some() && !matches!(plan, Plan::Extremes { .. } | Plan::NormalAccel { .. })
-        {
+        if min_radius.is_some() && !matches!(plan, Plan::Extremes { .. } | Plan::NormalAccel { .. }) {
             return Err(SolverError::input(
                 "min_radius",
                 "min_radius applies to mode \"curve\" with rule \"extremes\" or \"normal_accel\" only",
@@ -684,9 +608,7 @@ impl SegmentRequest {
         }
         let tolerance = optional_tolerance("tolerance", self.tolerance)?;
         let compare_tolerance = optional_tolerance("compare_tolerance", self.compare_tolerance)?;
-        let spindle_rpm = self
-            .spindle_rpm
-            .map_or(Ok(DEFAULT_SPINDLE_RPM), |rpm| positive("spindle_rpm", rpm))?;
+        let spindle_rpm = self.spindle_rpm.map_or(Ok(DEFAULT_SPINDLE_RPM), |rpm| positive("spindle_rpm", rpm))?;
         let safe_z = self.safe_z.map(|z| finite("safe_z", z)).transpose()?;
         let (shape, corners, dimension, curve_warnings) = self.curve.build()?;
         warnings.extend(curve_warnings);
@@ -700,18 +622,7 @@ impl SegmentRequest {
             }
         }
         spans.push((from, end));
-        Ok(Job {
-            shape,
-            spans,
-            dimension,
-            rule,
-            plan,
-            tolerance,
-            compare_tolerance,
-            spindle_rpm,
-            safe_z,
-            warnings,
-        })
+        Ok(Job { shape, spans, dimension, rule, plan, tolerance, compare_tolerance, spindle_rpm, safe_z, warnings })
     }
 }
 

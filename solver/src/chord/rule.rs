@@ -103,39 +103,19 @@ impl BlockRule {
     ) -> Result<(Self, Vec<Warning>), SolverError> {
         if let Some(profile) = machine {
             profile.validate().map_err(|error| {
-                SolverError::input(
-                    "machine",
-                    format!("the stored machine is invalid: {}", error.message()),
-                )
+                SolverError::input("machine", format!("the stored machine is invalid: {}", error.message()))
             })?;
         }
         let feed = settings
             .feed
             .or(machine.map(|m| m.max_feed))
-            .ok_or_else(|| {
-                SolverError::input(
-                    "feed",
-                    "feed is required (or name a machine: its max_feed is used)",
-                )
-            })?;
-        let block_time_ms = settings
-            .block_time_ms
-            .or(machine.map(|m| m.block_time_ms))
-            .ok_or_else(|| {
-                SolverError::input(
-                    "block_time_ms",
-                    "block_time_ms is required (or name a machine that has it)",
-                )
-            })?;
+            .ok_or_else(|| SolverError::input("feed", "feed is required (or name a machine: its max_feed is used)"))?;
+        let block_time_ms = settings.block_time_ms.or(machine.map(|m| m.block_time_ms)).ok_or_else(|| {
+            SolverError::input("block_time_ms", "block_time_ms is required (or name a machine that has it)")
+        })?;
         let mut rule = Self::new(feed, block_time_ms)?;
-        rule.margin = settings
-            .margin
-            .or(machine.and_then(|m| m.margin))
-            .unwrap_or(1.0);
-        rule.min_chord_error = settings
-            .min_chord_error
-            .or(machine.and_then(|m| m.min_chord_error))
-            .unwrap_or(0.0);
+        rule.margin = settings.margin.or(machine.and_then(|m| m.margin)).unwrap_or(1.0);
+        rule.min_chord_error = settings.min_chord_error.or(machine.and_then(|m| m.min_chord_error)).unwrap_or(0.0);
         adjust(&mut rule);
         let mut warnings = rule.validate(allow_unsafe)?;
         if let Some(profile) = machine
@@ -179,10 +159,7 @@ impl BlockRule {
     /// The same rule with the lower bound C_emin in mm (embodiment 6; e.g. 0.001).
     #[must_use]
     pub fn with_min_chord_error(self, min_chord_error: f64) -> Self {
-        Self {
-            min_chord_error,
-            ..self
-        }
+        Self { min_chord_error, ..self }
     }
 
     /// Checks every factor (chord.md §4, E6), naming the request field at fault: the margins
@@ -205,11 +182,7 @@ impl BlockRule {
         ];
         for (field, value, at_least_one) in factors {
             positive(field, value)?;
-            let unsafe_side = if at_least_one {
-                value < 1.0
-            } else {
-                value > 1.0
-            };
+            let unsafe_side = if at_least_one { value < 1.0 } else { value > 1.0 };
             if !unsafe_side {
                 continue;
             }
@@ -219,10 +192,7 @@ impl BlockRule {
                  shorter than the control can process at the feed"
             );
             if !allow_unsafe {
-                return Err(SolverError::input(
-                    field,
-                    format!("{why}; set allow_unsafe_margin to use it anyway"),
-                ));
+                return Err(SolverError::input(field, format!("{why}; set allow_unsafe_margin to use it anyway")));
             }
             warnings.push(Warning::new("W_UNSAFE_MARGIN", why));
         }
@@ -269,10 +239,7 @@ impl BlockRule {
             0.0
         } else if effective_radius.is_nan() || effective_radius < half {
             // A radius that is not a number is never feasible.
-            return Err(Infeasible {
-                radius,
-                feed_limit: self.feed_limit(radius),
-            });
+            return Err(Infeasible { radius, feed_limit: self.feed_limit(radius) });
         } else if self.sagitta_approximation {
             half * half / (2.0 * effective_radius)
         } else {
@@ -305,22 +272,14 @@ impl BlockRule {
     ///
     /// # Errors
     /// [`Infeasible`] when even the smallest radius cannot hold one block (E3).
-    pub fn normal_accel_chord_error(
-        &self,
-        min_radius: f64,
-    ) -> Result<(f64, ChordStatus), Infeasible> {
-        Self {
-            sagitta_approximation: true,
-            ..*self
-        }
-        .chord_error(min_radius)
+    pub fn normal_accel_chord_error(&self, min_radius: f64) -> Result<(f64, ChordStatus), Infeasible> {
+        Self { sagitta_approximation: true, ..*self }.chord_error(min_radius)
     }
 
     /// Largest feed (mm/min) at which one block still fits in a circle of `radius`: there the
     /// chord equals the diameter, `120000·r·k_r/(k_f·T_b,eff)` (E3). Infinite for a straight piece.
     pub fn feed_limit(&self, radius: f64) -> f64 {
-        2.0 * MS_PER_MIN * radius * self.radius_factor
-            / (self.margin * self.effective_block_time_ms())
+        2.0 * MS_PER_MIN * radius * self.radius_factor / (self.margin * self.effective_block_time_ms())
     }
 
     /// Largest feed (mm/min) at which the rule's chord error at `radius` stays within the accuracy
@@ -357,10 +316,7 @@ pub fn chord_length(radius: f64, chord_error: f64) -> f64 {
 ///
 /// # Errors
 /// `E_INPUT` when an argument is not a positive finite number.
-pub fn block_time_from_saturation(
-    test_block_length: f64,
-    saturated_feed: f64,
-) -> Result<f64, SolverError> {
+pub fn block_time_from_saturation(test_block_length: f64, saturated_feed: f64) -> Result<f64, SolverError> {
     let length = positive("test_block_length", test_block_length)?;
     let feed = positive("saturated_feed", saturated_feed)?;
     finite("block_time_ms", length / feed * MS_PER_MIN)
@@ -382,21 +338,14 @@ mod tests {
             let rule = BlockRule::new(10_000.0, 4.0).unwrap().with_margin(1.1);
             let (cep, status) = rule.chord_error(radius).unwrap();
             assert_eq!(status, ChordStatus::Surface);
-            assert_relative_eq!(
-                chord_length(radius, cep),
-                1.1 * 10_000.0 * 4.0 / 60_000.0,
-                max_relative = 1e-12
-            );
+            assert_relative_eq!(chord_length(radius, cep), 1.1 * 10_000.0 * 4.0 / 60_000.0, max_relative = 1e-12);
         }
     }
 
     #[test]
     fn margin_on_feed_equals_margin_on_block_time() {
         let on_feed = BlockRule::new(10_000.0, 4.0).unwrap().with_margin(1.1);
-        let on_time = BlockRule {
-            block_time_factor: 1.1,
-            ..BlockRule::new(10_000.0, 4.0).unwrap()
-        };
+        let on_time = BlockRule { block_time_factor: 1.1, ..BlockRule::new(10_000.0, 4.0).unwrap() };
         assert_relative_eq!(
             on_feed.chord_error(50.0).unwrap().0,
             on_time.chord_error(50.0).unwrap().0,
@@ -407,11 +356,7 @@ mod tests {
     #[test]
     fn embodiment_4_and_5_numbers() {
         let rule = BlockRule::new(10_000.0, 4.0).unwrap().with_margin(1.1);
-        assert_relative_eq!(
-            rule.chord_error(25.0).unwrap().0,
-            0.002_689_033_506_912_914_4,
-            max_relative = 1e-12
-        );
+        assert_relative_eq!(rule.chord_error(25.0).unwrap().0, 0.002_689_033_506_912_914_4, max_relative = 1e-12);
         assert_relative_eq!(
             rule.normal_accel_chord_error(25.0).unwrap().0,
             0.002_688_888_888_888_889,
@@ -430,18 +375,10 @@ mod tests {
     #[test]
     fn tolerance_feed_matches_e4() {
         let rule = BlockRule::new(10_000.0, 4.0).unwrap();
-        assert_relative_eq!(
-            rule.feed_for_tolerance(50.0, 0.0005),
-            6_708.187_168_669_395,
-            max_relative = 1e-9
-        );
+        assert_relative_eq!(rule.feed_for_tolerance(50.0, 0.0005), 6_708.187_168_669_395, max_relative = 1e-9);
         // At that feed the rule's chord error is the tolerance.
         let slower = BlockRule::new(rule.feed_for_tolerance(50.0, 0.0005), 4.0).unwrap();
-        assert_relative_eq!(
-            slower.chord_error(50.0).unwrap().0,
-            0.0005,
-            max_relative = 1e-12
-        );
+        assert_relative_eq!(slower.chord_error(50.0).unwrap().0, 0.0005, max_relative = 1e-12);
         assert_relative_eq!(rule.tolerance_for(50.0, Some(0.0005)).unwrap(), 0.0005);
     }
 
@@ -451,13 +388,7 @@ mod tests {
         assert_eq!(rule.validate(false).unwrap_err().field(), Some("margin"));
         let warnings = rule.validate(true).unwrap();
         assert_eq!(warnings[0].code, "W_UNSAFE_MARGIN");
-        let radius = BlockRule {
-            radius_factor: 1.2,
-            ..BlockRule::new(10_000.0, 4.0).unwrap()
-        };
-        assert_eq!(
-            radius.validate(false).unwrap_err().field(),
-            Some("radius_factor")
-        );
+        let radius = BlockRule { radius_factor: 1.2, ..BlockRule::new(10_000.0, 4.0).unwrap() };
+        assert_eq!(radius.validate(false).unwrap_err().field(), Some("radius_factor"));
     }
 }

@@ -113,11 +113,7 @@ pub(crate) struct Cutter<'a> {
 
 impl Cutter<'_> {
     fn vertex(&self, u: f64) -> Vertex {
-        Vertex {
-            u,
-            s: self.shape.s_at(u),
-            point: self.shape.point(u),
-        }
+        Vertex { u, s: self.shape.s_at(u), point: self.shape.point(u) }
     }
 
     /// `greedy_end` of chord.md §2.9: the end of the longest chord from `start` whose deviation
@@ -132,9 +128,7 @@ impl Cutter<'_> {
     ) -> Result<Vertex, SolverError> {
         let allowed = chord_error + EPS;
         let quarter = step_guess / 4.0;
-        if limit.s - start.s <= quarter
-            && self.shape.deviation_against(start.u, limit.u, allowed) <= allowed
-        {
+        if limit.s - start.s <= quarter && self.shape.deviation_against(start.u, limit.u, allowed) <= allowed {
             return Ok(*limit);
         }
         // Steps of a quarter guess of arc length, taken in the parameter with the local speed.
@@ -143,11 +137,7 @@ impl Cutter<'_> {
         let mut steps = 0;
         let (hi_u, hi_dev) = loop {
             let speed = self.shape.speed(lo_u);
-            let ahead = if speed > 0.0 {
-                lo_u + step / speed
-            } else {
-                limit.u
-            };
+            let ahead = if speed > 0.0 { lo_u + step / speed } else { limit.u };
             let hi_u = ahead.min(limit.u);
             let dev = self.shape.deviation_against(start.u, hi_u, allowed);
             if dev > allowed {
@@ -175,31 +165,16 @@ impl Cutter<'_> {
         } else {
             f64::EPSILON * hi_u.abs().max(f64::MIN_POSITIVE)
         };
-        let end = last_fitting(
-            g,
-            lo_u,
-            lo_dev.sqrt() - root,
-            hi_u,
-            hi_dev.sqrt() - root,
-            tol,
-        )
-        .ok_or_else(|| {
+        let end = last_fitting(g, lo_u, lo_dev.sqrt() - root, hi_u, hi_dev.sqrt() - root, tol).ok_or_else(|| {
             SolverError::new(
                 "E_NUMERIC_FAILURE",
-                format!(
-                    "the chord search did not converge at s = {:.6} mm (E14)",
-                    start.s
-                ),
+                format!("the chord search did not converge at s = {:.6} mm (E14)", start.s),
             )
             .at("curve")
         })?;
         let end = self.vertex(end);
         // A remainder below a nanometre is not a block: the chord takes it.
-        Ok(if limit.s - end.s < MIN_PROGRESS {
-            *limit
-        } else {
-            end
-        })
+        Ok(if limit.s - end.s < MIN_PROGRESS { *limit } else { end })
     }
 
     /// Appends a command point; `span_end` is the parameter where its span ends.
@@ -235,10 +210,7 @@ impl Cutter<'_> {
 
     fn start(&self) -> Option<Cut> {
         let &(first, _) = self.spans.first()?;
-        Some(Cut {
-            vertices: vec![self.vertex(first)],
-            ..Cut::default()
-        })
+        Some(Cut { vertices: vec![self.vertex(first)], ..Cut::default() })
     }
 
     /// Embodiments 3–5 and fixed tolerances: one chord error for the whole curve. `radius` is
@@ -296,9 +268,7 @@ impl Cutter<'_> {
                 );
                 let smallest = self.shape.min_radius(u0, u1, scale).0;
                 let radius = match estimate {
-                    Estimate::ThreePoint if three_point.is_finite() => {
-                        three_point.min(SPREAD_CAP * smallest)
-                    }
+                    Estimate::ThreePoint if three_point.is_finite() => three_point.min(SPREAD_CAP * smallest),
                     _ => smallest,
                 };
                 out.push((s0, radius));
@@ -332,11 +302,7 @@ impl Cutter<'_> {
             }
             loop {
                 let u0 = from.u;
-                let u1 = if last_window {
-                    u_end
-                } else {
-                    self.shape.u_at(s1)
-                };
+                let u1 = if last_window { u_end } else { self.shape.u_at(s1) };
                 let three_point = {
                     let middle = self.shape.point(self.shape.u_at(0.5 * (s0 + s1)));
                     circumradius(&from.point, &middle, &self.shape.point(u1))
@@ -358,10 +324,9 @@ impl Cutter<'_> {
                     Estimate::ThreePoint => three_point.min(SPREAD_CAP * smallest),
                     Estimate::Minimum => self.reach_radius(rule, smallest, s0, s1, u0, s_end)?,
                 };
-                let (rule_chord_error, surface) =
-                    rule.chord_error(radius).map_err(|infeasible| {
-                        CutError::Infeasible(InfeasibleAt { s: s0, infeasible })
-                    })?;
+                let (rule_chord_error, surface) = rule
+                    .chord_error(radius)
+                    .map_err(|infeasible| CutError::Infeasible(InfeasibleAt { s: s0, infeasible }))?;
                 let (chord_error, status) = classify(rule_chord_error, surface, radius, tolerance);
                 let guess = step_guess(radius, chord_error, window);
                 let mut blocks = 0;
@@ -423,9 +388,7 @@ impl Cutter<'_> {
             if reach <= s1 {
                 break;
             }
-            let (wider, _) = self
-                .shape
-                .min_radius(u0, self.shape.u_at(reach), rule.target_chord());
+            let (wider, _) = self.shape.min_radius(u0, self.shape.u_at(reach), rule.target_chord());
             if wider >= radius {
                 break;
             }
@@ -458,11 +421,7 @@ pub(crate) fn classify(
 /// The step guess of chord.md §2.9: the circle chord `2√(2rC − C²)`, or `fallback` (Δs, or the
 /// span) when the radius is infinite or the chord error zero.
 fn step_guess(radius: f64, chord_error: f64, fallback: f64) -> f64 {
-    if radius.is_finite() && chord_error > 0.0 {
-        chord_length(radius, chord_error)
-    } else {
-        fallback
-    }
+    if radius.is_finite() && chord_error > 0.0 { chord_length(radius, chord_error) } else { fallback }
 }
 
 #[cfg(test)]
@@ -471,25 +430,14 @@ mod tests {
     use crate::chord::shape::Arc;
 
     fn circle(radius: f64) -> Shape {
-        Shape::Arc(Arc {
-            centre: Vec3::zeros(),
-            radius,
-            start: 0.0,
-            sense: 1.0,
-            sweep: std::f64::consts::TAU,
-        })
+        Shape::Arc(Arc { centre: Vec3::zeros(), radius, start: 0.0, sense: 1.0, sweep: std::f64::consts::TAU })
     }
 
     #[test]
     fn the_block_limit_names_its_field() {
         let shape = circle(50.0);
         let spans = [shape.domain()];
-        let cutter = Cutter {
-            shape: &shape,
-            spans: &spans,
-            max_blocks: 10,
-            limit_field: "compare_tolerance",
-        };
+        let cutter = Cutter { shape: &shape, spans: &spans, max_blocks: 10, limit_field: "compare_tolerance" };
         let error = cutter.constant(0.001, 50.0).unwrap_err();
         assert_eq!(error.code(), "E_TOO_MANY_BLOCKS");
         assert_eq!(error.field(), Some("compare_tolerance"));
@@ -500,12 +448,7 @@ mod tests {
         // Chord error 0 on a 0.1 µm circle: the longest fitting chord is below 1 nm (E14).
         let shape = circle(1e-7);
         let spans = [shape.domain()];
-        let cutter = Cutter {
-            shape: &shape,
-            spans: &spans,
-            max_blocks: 1000,
-            limit_field: "tolerance",
-        };
+        let cutter = Cutter { shape: &shape, spans: &spans, max_blocks: 1000, limit_field: "tolerance" };
         let error = cutter.constant(0.0, f64::INFINITY).unwrap_err();
         assert_eq!(error.code(), "E_NUMERIC_FAILURE");
     }
@@ -514,12 +457,7 @@ mod tests {
     fn greedy_chords_on_a_circle_have_the_sagitta_length() {
         let shape = circle(50.0);
         let spans = [shape.domain()];
-        let cutter = Cutter {
-            shape: &shape,
-            spans: &spans,
-            max_blocks: 1000,
-            limit_field: "tolerance",
-        };
+        let cutter = Cutter { shape: &shape, spans: &spans, max_blocks: 1000, limit_field: "tolerance" };
         let cut = cutter.constant(0.01, 50.0).unwrap();
         assert_eq!(cut.vertices.len(), 159);
         let chord = (cut.vertices[1].point - cut.vertices[0].point).norm();

@@ -115,16 +115,10 @@ impl Spline {
     fn radius(&self, u: f64) -> f64 {
         let of = |[_, first, second]: [Vec3; 3]| {
             let bend = first.cross(&second).norm();
-            if bend == 0.0 {
-                f64::INFINITY
-            } else {
-                first.norm().powi(3) / bend
-            }
+            if bend == 0.0 { f64::INFINITY } else { first.norm().powi(3) / bend }
         };
         let right = of(self.nurbs.derivatives(u));
-        self.nurbs
-            .derivatives_from_left(u)
-            .map_or(right, |left| right.min(of(left)))
+        self.nurbs.derivatives_from_left(u).map_or(right, |left| right.min(of(left)))
     }
 }
 
@@ -132,20 +126,14 @@ impl Polyline {
     /// Index of the edge holding arc length `s`.
     fn edge(&self, s: f64) -> usize {
         let last_edge = self.vertices.len().saturating_sub(2);
-        self.stations
-            .partition_point(|&x| x <= s)
-            .saturating_sub(1)
-            .min(last_edge)
+        self.stations.partition_point(|&x| x <= s).saturating_sub(1).min(last_edge)
     }
 
     fn point(&self, s: f64) -> Vec3 {
         let k = self.edge(s);
-        let (Some(a), Some(b), Some(&s0), Some(&s1)) = (
-            self.vertices.get(k),
-            self.vertices.get(k + 1),
-            self.stations.get(k),
-            self.stations.get(k + 1),
-        ) else {
+        let (Some(a), Some(b), Some(&s0), Some(&s1)) =
+            (self.vertices.get(k), self.vertices.get(k + 1), self.stations.get(k), self.stations.get(k + 1))
+        else {
             return self.vertices.first().copied().unwrap_or_else(Vec3::zeros);
         };
         let fraction = ((s - s0) / (s1 - s0)).clamp(0.0, 1.0);
@@ -157,13 +145,7 @@ impl Polyline {
 /// `y` (the middle one the largest): successive parabolic interpolation, kept inside the
 /// bracket, until a step gains less than 1e-13 of the value or the `rounding` of the distances;
 /// Brent's method when the parabola has no peak inside the bracket or converges slowly.
-fn refine_maximum(
-    f: &impl Fn(f64) -> f64,
-    x: [f64; 3],
-    y: [f64; 3],
-    tol: f64,
-    rounding: f64,
-) -> f64 {
+fn refine_maximum(f: &impl Fn(f64) -> f64, x: [f64; 3], y: [f64; 3], tol: f64, rounding: f64) -> f64 {
     let ([mut a, mut b, mut c], [mut fa, mut fb, mut fc]) = (x, y);
     // A smooth maximum is found to 1e-13 in three or four steps (superlinear convergence from
     // a bracket of 1/16 of the chord); beyond that the values' rounding only moves the vertex.
@@ -387,18 +369,15 @@ impl Shape {
                 let half = 0.5 * scale;
                 if hi - lo <= scale {
                     let middle = 0.5 * (lo + hi);
-                    let radius =
-                        circumradius(&line.point(lo), &line.point(middle), &line.point(hi));
+                    let radius = circumradius(&line.point(lo), &line.point(middle), &line.point(hi));
                     return (radius, middle);
                 }
-                let count =
-                    (((hi - lo) / (0.25 * scale)).ceil() as usize).clamp(1, MAX_RADIUS_SAMPLES);
+                let count = (((hi - lo) / (0.25 * scale)).ceil() as usize).clamp(1, MAX_RADIUS_SAMPLES);
                 let step = (hi - lo - scale) / count as f64;
                 let mut best = (f64::INFINITY, lo + half);
                 for j in 0..=count {
                     let s = lo + half + step * j as f64;
-                    let radius =
-                        circumradius(&line.point(s - half), &line.point(s), &line.point(s + half));
+                    let radius = circumradius(&line.point(s - half), &line.point(s), &line.point(s + half));
                     if radius < best.0 {
                         best = (radius, s);
                     }
@@ -437,14 +416,9 @@ impl Shape {
     pub(crate) fn radius_pieces(&self, ua: f64, ub: f64, scale: f64) -> Vec<f64> {
         let mut out = vec![ua];
         match self {
-            Self::Spline(spline) => out.extend(
-                spline
-                    .nurbs
-                    .breaks()
-                    .iter()
-                    .map(|(knot, _)| *knot)
-                    .filter(|&knot| knot > ua && knot < ub),
-            ),
+            Self::Spline(spline) => {
+                out.extend(spline.nurbs.breaks().iter().map(|(knot, _)| *knot).filter(|&knot| knot > ua && knot < ub))
+            }
             Self::Polyline(_) => {
                 // At most 10 000 pieces, whatever the scale.
                 let piece = (1000.0 * scale).max((ub - ua) / 10_000.0);
@@ -488,8 +462,7 @@ impl Shape {
                 let mean_speed = spline.table.length() / (end - start);
                 let mut out = Vec::new();
                 for window in breaks.windows(3) {
-                    let (before, (knot, multiplicity), after) =
-                        (window[0].0, window[1], window[2].0);
+                    let (before, (knot, multiplicity), after) = (window[0].0, window[1], window[2].0);
                     // A tangent may break where the curve is only C0 (multiplicity ≥ degree) or
                     // where it stops (a cusp from `degree` coincident control points).
                     let stops = spline.speed(knot) <= 1e-9 * mean_speed;
@@ -541,8 +514,7 @@ mod tests {
     fn ellipse() -> Shape {
         let (a, b) = (100.0_f64, 50.0_f64);
         let speed = |t: f64| (a * t.sin()).hypot(b * t.cos());
-        let table = ArcLengthTable::build(&speed, &[0.0, std::f64::consts::FRAC_PI_2], 16, "curve")
-            .unwrap();
+        let table = ArcLengthTable::build(&speed, &[0.0, std::f64::consts::FRAC_PI_2], 16, "curve").unwrap();
         Shape::Ellipse(Ellipse {
             centre: Vec3::zeros(),
             semi_axes: [a, b],
@@ -557,11 +529,7 @@ mod tests {
     #[test]
     fn circumradius_of_points_on_a_circle() {
         let on = |angle: f64| Vec3::new(7.0 * angle.cos(), 7.0 * angle.sin(), 0.0);
-        assert_relative_eq!(
-            circumradius(&on(0.1), &on(0.5), &on(1.3)),
-            7.0,
-            max_relative = 1e-12
-        );
+        assert_relative_eq!(circumradius(&on(0.1), &on(0.5), &on(1.3)), 7.0, max_relative = 1e-12);
         let line = circumradius(&Vec3::zeros(), &Vec3::x(), &(2.0 * Vec3::x()));
         assert!(line.is_infinite());
     }
@@ -601,20 +569,12 @@ mod tests {
             sweep: std::f64::consts::TAU,
         });
         let exact = arc.deviation(1.0, 1.7);
-        assert_relative_eq!(
-            exact,
-            arc.sampled_deviation(1.0, 1.7, None),
-            max_relative = 1e-10
-        );
+        assert_relative_eq!(exact, arc.sampled_deviation(1.0, 1.7, None), max_relative = 1e-10);
     }
 
     #[test]
     fn polyline_deviation_is_the_farthest_vertex() {
-        let vertices = vec![
-            Vec3::zeros(),
-            Vec3::new(1.0, 0.2, 0.0),
-            Vec3::new(2.0, 0.0, 0.0),
-        ];
+        let vertices = vec![Vec3::zeros(), Vec3::new(1.0, 0.2, 0.0), Vec3::new(2.0, 0.0, 0.0)];
         let first = (vertices[1] - vertices[0]).norm();
         let stations = vec![0.0, first, 2.0 * first];
         let line = Shape::Polyline(Polyline { vertices, stations });

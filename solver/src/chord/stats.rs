@@ -67,11 +67,7 @@ pub struct BlockStats {
 ///
 /// # Errors
 /// `E_INPUT` when `feed` or `block_time_ms` is not a positive finite number.
-pub fn block_stats(
-    points: &[Vec3],
-    feed: f64,
-    block_time_ms: f64,
-) -> Result<BlockStats, SolverError> {
+pub fn block_stats(points: &[Vec3], feed: f64, block_time_ms: f64) -> Result<BlockStats, SolverError> {
     let feed = positive("feed", feed)?;
     let block_time_ms = positive("block_time_ms", block_time_ms)?;
     let last = points.len().saturating_sub(2);
@@ -79,18 +75,10 @@ pub fn block_stats(
 }
 
 /// [`block_stats`] with the span ends given as block indices (block i joins points i and i + 1).
-pub(crate) fn stats_with_ends(
-    points: &[Vec3],
-    feed: f64,
-    block_time_ms: f64,
-    span_ends: &[usize],
-) -> BlockStats {
+pub(crate) fn stats_with_ends(points: &[Vec3], feed: f64, block_time_ms: f64, span_ends: &[usize]) -> BlockStats {
     let block_length = feed * block_time_ms / MS_PER_MIN;
     let short_below = block_length * (1.0 - SHORT_SLACK);
-    let lengths: Vec<f64> = points
-        .windows(2)
-        .map(|pair| (pair[1] - pair[0]).norm())
-        .collect();
+    let lengths: Vec<f64> = points.windows(2).map(|pair| (pair[1] - pair[0]).norm()).collect();
     let (mut inner_min, mut all_min, mut max) = (f64::INFINITY, f64::INFINITY, 0.0_f64);
     let (mut short_blocks, mut short_end_blocks) = (0, 0);
     let mut estimated_time_s = 0.0;
@@ -135,10 +123,6 @@ pub(crate) fn stats_with_ends(
         estimated_time_s,
         path_time_s: path_length / feed * 60.0,
         max_vertex_angle_deg: angles.iter().copied().fold(0.0, f64::max),
-        mean_vertex_angle_deg: if angles.is_empty() {
-            0.0
-        } else {
-            angles.iter().sum::<f64>() / angles.len() as f64
-        },
+        mean_vertex_angle_deg: if angles.is_empty() { 0.0 } else { angles.iter().sum::<f64>() / angles.len() as f64 },
     }
 }
