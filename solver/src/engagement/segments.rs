@@ -478,8 +478,9 @@ mod tests {
     }
 
     #[test]
-    fn crossings_lie_at_the_reach() {
+    fn crossings_bracket_every_change_of_side() {
         let centre = P2::new(0.7, 0.4);
+        let (radius, reach) = (1.5, 1.0);
         for shape in [
             arc_quarter(),
             Shape::Line {
@@ -488,14 +489,29 @@ mod tests {
             },
         ] {
             let mut angles = Vec::new();
-            shape.crossings(1.0, centre, 1.5, &mut angles);
-            assert!(!angles.is_empty());
-            for angle in angles {
-                let q = centre + 1.5 * P2::new(angle.cos(), angle.sin());
-                // Each angle lies on one of the boundary pieces; the true boundary ones at 1.0.
-                let d = shape.distance(q);
-                assert!(d.is_finite());
+            shape.crossings(reach, centre, radius, &mut angles);
+            let side = |angle: f64| {
+                let q = centre + radius * P2::new(angle.cos(), angle.sin());
+                shape.distance(q) < reach
+            };
+            let steps = 20_000;
+            let mut changes = 0;
+            for i in 0..steps {
+                let a = -PI + TAU * f64::from(i) / f64::from(steps);
+                let b = a + TAU / f64::from(steps);
+                if side(a) != side(b) {
+                    changes += 1;
+                    let near = angles.iter().any(|c| {
+                        let d = (c - a).rem_euclid(TAU);
+                        d <= b - a + 1e-12 || d >= TAU - 1e-12
+                    });
+                    assert!(
+                        near,
+                        "{shape:?}: change between {a} and {b} not in {angles:?}"
+                    );
+                }
             }
+            assert!(changes >= 2, "{shape:?}");
         }
     }
 
