@@ -43,7 +43,7 @@ fn slot_ratio(k: u32) -> f64 {
     let k_f = f64::from(k);
     if k == 1 {
         1.0
-    } else if k % 2 == 0 {
+    } else if k.is_multiple_of(2) {
         1.0 / (PI / k_f).sin()
     } else {
         1.0 / (2.0 * (PI / (2.0 * k_f)).sin())
