@@ -622,10 +622,6 @@ fn read_ring(field: &str, points: &[[f64; 2]]) -> Result<Vec<P2>, SolverError> {
         )
         .at(field));
     }
-    let area = twice_signed_area(&ring).abs() / 2.0;
-    if area <= 1e-12 {
-        return Err(SolverError::new("E_STOCK", "the stock ring has zero area").at(field));
-    }
     Ok(ring)
 }
 
@@ -760,6 +756,14 @@ fn read_stock(
             return Err(
                 SolverError::new("E_STOCK", message).at(format!("{}[{vertex_a}]", name(ring_a)))
             );
+        }
+        // After the crossing test, so a bow tie is reported as crossing, not as flat.
+        for (ring, field) in rings.iter().zip(&fields) {
+            if twice_signed_area(ring).abs() <= 2e-12 {
+                return Err(
+                    SolverError::new("E_STOCK", "the stock ring has zero area").at(field.clone())
+                );
+            }
         }
         Base::Polygons { rings, edges }
     };
