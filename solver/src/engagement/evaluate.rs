@@ -195,7 +195,7 @@ pub(crate) fn runs(samples: &[EngagementSample], test: impl Fn(usize) -> bool) -
 fn stock_description(region: &Region) -> String {
     match &region.base {
         Base::Polygons { rings, .. } => format!(
-            "stock: {} ring(s), {} vertices",
+            "stock: polygon rings {}, vertices {}",
             rings.len(),
             rings.iter().map(Vec::len).sum::<usize>()
         ),

@@ -121,7 +121,8 @@ pub fn program(
             }
             Some(feed) => {
                 if raised {
-                    path.linear(Vec3::new(at.x, at.y, cut_z), feed);
+                    // Down into the cut no faster than the nominal feed.
+                    path.linear(Vec3::new(at.x, at.y, cut_z), feed.min(data.nominal_feed));
                     raised = false;
                 }
                 let points = piece.shape.portion(from, to).flatten(CHORD_TOLERANCE);
