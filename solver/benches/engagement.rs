@@ -77,7 +77,10 @@ fn bench(c: &mut Criterion) {
                 full / 8.0 / 1e6
             );
         }
-        eprintln!("{engine}: {samples} samples, path {:.1} mm", result.path_length);
+        eprintln!(
+            "{engine}: {samples} samples, path {:.1} mm",
+            result.path_length
+        );
         group.throughput(Throughput::Elements(samples));
         group.bench_function(engine, |b| {
             b.iter(|| engagement::solve(&request, &tool).unwrap());

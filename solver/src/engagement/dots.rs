@@ -12,32 +12,48 @@ use super::bbox_tree::BBox;
 use super::segments::Station;
 use super::stock::{Base, REACH_TOLERANCE, Region};
 
+/// An empty column span.
+const EMPTY: (i64, i64) = (0, -1);
+
 /// Relative slack of the disc test |p − c|² ≤ R²(1 + 1e-12) (§5.3.2).
 const DISC_SLACK: f64 = 1e-12;
 
 /// The workpiece dots: bit (i, j) is the dot at origin + ((i + ½)g, (j + ½)g); 1 = material.
+///
+/// The bits are stored in tiles of 8 × 8 dots per word, so the thin crescent a sample removes
+/// (one dot wide, 2R tall or wide) touches an eighth of the memory lines a row-major layout
+/// would.
 #[derive(Debug, Clone)]
 pub(crate) struct DotGrid {
     origin: P2,
     cell: f64,
     width: usize,
     height: usize,
-    words_per_row: usize,
+    /// Tiles per row of tiles.
+    tiles_across: usize,
     bits: Vec<u64>,
+    /// Column spans of the last removal's disc per row (valid over `cached_rows`), so the next
+    /// sample need not recompute them for its "previous circle".
+    spans: Vec<(i64, i64)>,
+    cached_rows: std::ops::Range<usize>,
+    cached_centre: Option<P2>,
 }
 
 impl DotGrid {
     /// The grid over `width` × `height` dots from `origin`, filled from `region` (even-odd,
     /// boundary inclusive; earlier cuts removed). The caller has checked the size limit.
     pub(crate) fn new(region: &Region, origin: P2, cell: f64, width: usize, height: usize) -> Self {
-        let words_per_row = width.div_ceil(64);
+        let tiles_across = width.div_ceil(8);
         let mut grid = Self {
             origin,
             cell,
             width,
             height,
-            words_per_row,
-            bits: vec![0; words_per_row * height],
+            tiles_across,
+            bits: vec![0; tiles_across * height.div_ceil(8)],
+            spans: vec![EMPTY; height],
+            cached_rows: 0..0,
+            cached_centre: None,
         };
         grid.fill(region);
         for cut in &region.cuts {
@@ -79,13 +95,11 @@ impl DotGrid {
         let Some((first, last)) = self.columns_between(x0, x1) else {
             return;
         };
-        let base = row * self.words_per_row;
-        for column in first..=last {
-            let word = &mut self.bits[base + column / 64];
+        for (index, mask) in self.masks(row, first, last) {
             if value {
-                *word |= 1 << (column % 64);
+                self.bits[index] |= mask;
             } else {
-                *word &= !(1 << (column % 64));
+                self.bits[index] &= !mask;
             }
         }
     }
@@ -144,7 +158,8 @@ impl DotGrid {
                     for column in 0..self.width {
                         let (i, j) = bitmap.cell_of(P2::new(self.x_of(column), y));
                         if bitmap.cell_is_material(i, j) {
-                            self.bits[row * self.words_per_row + column / 64] |= 1 << (column % 64);
+                            let (index, bit) = self.bit(column, row);
+                            self.bits[index] |= bit;
                         }
                     }
                 }
@@ -176,33 +191,36 @@ impl DotGrid {
             for column in first..=last {
                 let p = P2::new(self.x_of(column), y);
                 if super::polygon::distance_to_segment(p, a, b) < limit {
-                    self.bits[row * self.words_per_row + column / 64] &= !(1 << (column % 64));
+                    let (index, bit) = self.bit(column, row);
+                    self.bits[index] &= !bit;
                 }
             }
         }
     }
 
-    /// Column span of row `row` inside the disc (`centre`, R² = `limit`), exact for the test
-    /// (x − cx)² + dy² ≤ limit; `None` when empty.
-    fn disc_span(&self, centre: P2, limit: f64, row: usize) -> Option<(usize, usize)> {
+    /// Column span [first, last] of row `row` inside the disc (`centre`, R² = `limit`), exact
+    /// for the test (x − cx)² + dy² ≤ limit; empty when first > last.
+    #[inline]
+    fn disc_span(&self, centre: P2, limit: f64, row: usize) -> (i64, i64) {
         let dy = self.y_of(row) - centre.y;
         let rest = limit - dy * dy;
         if rest < 0.0 {
-            return None;
+            return EMPTY;
         }
         let half = rest.sqrt();
+        let width = self.width as i64;
         let inside = |column: i64| {
-            column >= 0 && (column as usize) < self.width && {
+            (0..width).contains(&column) && {
                 let dx = self.x_of(column as usize) - centre.x;
                 dx * dx + dy * dy <= limit
             }
         };
-        let mut first = (((centre.x - half - self.origin.x) / self.cell - 0.5).ceil())
-            .clamp(-1.0, self.width as f64) as i64;
-        let mut last = (((centre.x + half - self.origin.x) / self.cell - 0.5).floor())
-            .clamp(-1.0, self.width as f64) as i64;
-        first = first.max(0);
-        last = last.min(self.width as i64 - 1);
+        let bound = self.width as f64;
+        let low = ((centre.x - half - self.origin.x) / self.cell - 0.5).clamp(-1.0, bound);
+        let high = ((centre.x + half - self.origin.x) / self.cell - 0.5).clamp(-1.0, bound);
+        // ceil and floor by truncation (both values lie in [−1, width]).
+        let mut first = (low as i64 + i64::from((low as i64 as f64) < low)).max(0);
+        let mut last = (high as i64 - i64::from((high as i64 as f64) > high)).min(width - 1);
         // Rounding may put an end one dot off the exact test: settle it.
         while first <= last && !inside(first) {
             first += 1;
@@ -216,7 +234,7 @@ impl DotGrid {
         while inside(last + 1) {
             last += 1;
         }
-        (first <= last).then_some((first as usize, last as usize))
+        (first, last)
     }
 
     fn rows_near(&self, centre: P2, radius: f64) -> std::ops::Range<usize> {
@@ -237,51 +255,87 @@ impl DotGrid {
 
     /// Removes the material dots inside the circle at `centre` that were not inside the circle
     /// at `previous`, calling `visit` with each removed dot's centre.
-    pub(crate) fn remove(
+    pub(crate) fn remove<F: FnMut(P2)>(
         &mut self,
         centre: P2,
         previous: Option<P2>,
         radius: f64,
-        visit: &mut dyn FnMut(P2),
+        visit: &mut F,
     ) {
         let limit = radius * radius * (1.0 + DISC_SLACK);
-        for row in self.rows_near(centre, radius) {
-            let Some((first, last)) = self.disc_span(centre, limit, row) else {
+        let cached = previous.is_some() && previous == self.cached_centre;
+        let rows = self.rows_near(centre, radius);
+        for row in rows.clone() {
+            let (first, last) = self.disc_span(centre, limit, row);
+            let skip = if cached {
+                if self.cached_rows.contains(&row) {
+                    self.spans[row]
+                } else {
+                    EMPTY
+                }
+            } else {
+                previous.map_or(EMPTY, |p| self.disc_span(p, limit, row))
+            };
+            self.spans[row] = (first, last);
+            if first > last {
                 continue;
+            }
+            let (a, b) = skip;
+            let (left, right) = if a <= b && a <= last && b >= first {
+                ((first, a - 1), (b + 1, last))
+            } else {
+                ((first, last), EMPTY)
             };
-            let skip = previous.and_then(|p| self.disc_span(p, limit, row));
-            let (left, right) = match skip {
-                Some((a, b)) if a <= last && b >= first => (
-                    (first < a).then(|| (first, a - 1)),
-                    (b < last).then(|| (b + 1, last)),
-                ),
-                _ => (Some((first, last)), None),
-            };
-            for (start, end) in [left, right].into_iter().flatten() {
-                self.take(row, start, end, visit);
+            for (start, end) in [left, right] {
+                if start <= end {
+                    self.take(row, start as usize, end as usize, visit);
+                }
             }
         }
+        self.cached_rows = rows;
+        self.cached_centre = Some(centre);
+    }
+
+    /// Word index and bit of dot (column, row).
+    #[inline]
+    fn bit(&self, column: usize, row: usize) -> (usize, u64) {
+        (
+            (row / 8) * self.tiles_across + column / 8,
+            1 << ((row % 8) * 8 + column % 8),
+        )
+    }
+
+    /// The words and masks covering columns [start, end] of `row`.
+    #[inline]
+    fn masks(
+        &self,
+        row: usize,
+        start: usize,
+        end: usize,
+    ) -> impl Iterator<Item = (usize, u64)> + use<> {
+        let base = (row / 8) * self.tiles_across;
+        let shift = (row % 8) * 8;
+        (start / 8..=end / 8).map(move |tile| {
+            let low = if tile == start / 8 { start % 8 } else { 0 };
+            let high = if tile == end / 8 { end % 8 } else { 7 };
+            let mask = ((1_u64 << (high - low + 1)) - 1) << (low + shift);
+            (base + tile, mask)
+        })
     }
 
     /// Clears the set dots of `row` in columns [start, end], visiting each.
-    fn take(&mut self, row: usize, start: usize, end: usize, visit: &mut dyn FnMut(P2)) {
+    fn take<F: FnMut(P2)>(&mut self, row: usize, start: usize, end: usize, visit: &mut F) {
         let y = self.y_of(row);
-        let base = row * self.words_per_row;
-        for word_index in start / 64..=end / 64 {
-            let low = if word_index == start / 64 {
-                start % 64
-            } else {
-                0
-            };
-            let high = if word_index == end / 64 { end % 64 } else { 63 };
-            let mask = (u64::MAX >> (63 - high)) & (u64::MAX << low);
-            let word = &mut self.bits[base + word_index];
+        let shift = (row % 8) * 8;
+        for (index, mask) in self.masks(row, start, end) {
+            let word = &mut self.bits[index];
             let mut found = *word & mask;
             *word &= !mask;
+            let first_column = (index % self.tiles_across) * 8;
             while found != 0 {
-                let bit = found.trailing_zeros() as usize;
+                let bit = found.trailing_zeros() as usize - shift;
                 found &= found - 1;
-                visit(P2::new(self.x_of(word_index * 64 + bit), y));
+                visit(P2::new(self.x_of(first_column + bit), y));
             }
         }
     }
@@ -290,20 +344,11 @@ impl DotGrid {
     pub(crate) fn any_inside(&self, centre: P2, radius: f64) -> bool {
         let limit = radius * radius * (1.0 + DISC_SLACK);
         self.rows_near(centre, radius).any(|row| {
-            self.disc_span(centre, limit, row)
-                .is_some_and(|(start, end)| {
-                    let base = row * self.words_per_row;
-                    (start / 64..=end / 64).any(|word_index| {
-                        let low = if word_index == start / 64 {
-                            start % 64
-                        } else {
-                            0
-                        };
-                        let high = if word_index == end / 64 { end % 64 } else { 63 };
-                        let mask = (u64::MAX >> (63 - high)) & (u64::MAX << low);
-                        self.bits[base + word_index] & mask != 0
-                    })
-                })
+            let (start, end) = self.disc_span(centre, limit, row);
+            start <= end
+                && self
+                    .masks(row, start as usize, end as usize)
+                    .any(|(index, mask)| self.bits[index] & mask != 0)
         })
     }
 
@@ -350,52 +395,120 @@ fn capsule_row(a: P2, b: P2, radius: f64, y: f64) -> Option<(f64, f64)> {
 pub(crate) struct Contacts {
     pub front: Vec<f64>,
     pub back: Vec<f64>,
-    /// Contact angles of the removed dots, degrees (projected: ±acos(ℓ/R)).
+    /// Contact angles of the removed dots, degrees (projected: ±acos(ℓ/R)), when kept.
     pub angles: Vec<f64>,
+    /// Keep `angles` (for the scatter plot).
+    pub keep_angles: bool,
+    pub(crate) bins: Bins,
+}
+
+/// Per-bin smallest and largest lateral offset, reused between samples.
+#[derive(Debug, Default)]
+pub(crate) struct Bins {
+    low: Vec<f64>,
+    high: Vec<f64>,
+    stamp: Vec<u32>,
+    epoch: u32,
 }
 
 impl Contacts {
     /// Records a removed dot at `dot` for a tool at `station` that moved `step` since the last
     /// removal.
+    #[inline]
     pub(crate) fn record(&mut self, dot: P2, station: &Station, radius: f64, step: f64, cell: f64) {
         let d = dot - station.centre;
         let forward = station.tangent;
-        let right = P2::new(forward.y, -forward.x);
-        let (lateral, along) = (d.dot(&right), d.dot(&forward));
-        let angle = (lateral / radius).clamp(-1.0, 1.0).acos().to_degrees();
-        if along >= -(0.5 * step + cell) {
+        let lateral = d.x * forward.y - d.y * forward.x;
+        let along = d.x * forward.x + d.y * forward.y;
+        let front = along >= -(0.5 * step + cell);
+        if front {
             self.front.push(lateral);
-            self.angles.push(angle);
         } else {
             self.back.push(lateral);
-            self.angles.push(-angle);
         }
+        if self.keep_angles {
+            let angle = (lateral / radius).clamp(-1.0, 1.0).acos().to_degrees();
+            self.angles.push(if front { angle } else { -angle });
+        }
+    }
+
+    /// Whether any dot was removed.
+    pub(crate) fn touched(&self) -> bool {
+        !self.front.is_empty() || !self.back.is_empty()
     }
 
     /// The arcs rebuilt from the dots (§5.3.2 steps 1–5): clusters of lateral offsets split at
     /// gaps wider than τ = max(2g, 14g²/Δs), widened by g/2, turned into arcs.
+    ///
+    /// The offsets are binned τ wide instead of sorted: two offsets in one bin are never more
+    /// than τ apart, and the gap between neighbouring bins is taken from their exact extremes,
+    /// so the clusters are the same as after sorting.
     pub(crate) fn arcs(&mut self, radius: f64, cell: f64, step: f64) -> Vec<Arc> {
         let gap = (2.0 * cell).max(14.0 * cell * cell / step.max(cell));
+        let count = ((2.0 * radius + 2.0 * cell) / gap).ceil() as usize + 1;
         let mut arcs = Vec::new();
-        for (set, front) in [(&mut self.front, true), (&mut self.back, false)] {
-            set.sort_by(f64::total_cmp);
-            let mut start = 0;
-            for index in 0..set.len() {
-                let last = index + 1 == set.len();
-                if last || set[index + 1] - set[index] > gap {
-                    let low = (set[start] - 0.5 * cell).max(-radius);
-                    let high = (set[index] + 0.5 * cell).min(radius);
-                    let (a, b) = (
-                        (high / radius).clamp(-1.0, 1.0).acos().to_degrees(),
-                        (low / radius).clamp(-1.0, 1.0).acos().to_degrees(),
-                    );
-                    arcs.push(if front {
-                        Arc { from: a, to: b }
-                    } else {
-                        Arc { from: -b, to: -a }
-                    });
-                    start = index + 1;
+        for front in [true, false] {
+            let values = if front { &self.front } else { &self.back };
+            if values.is_empty() {
+                continue;
+            }
+            let bins = &mut self.bins;
+            if bins.stamp.len() < count {
+                *bins = Bins {
+                    low: vec![0.0; count],
+                    high: vec![0.0; count],
+                    stamp: vec![0; count],
+                    epoch: 0,
+                };
+            }
+            bins.epoch = bins.epoch.wrapping_add(1);
+            if bins.epoch == 0 {
+                bins.stamp.iter_mut().for_each(|s| *s = 0);
+                bins.epoch = 1;
+            }
+            let epoch = bins.epoch;
+            for &value in values {
+                let index =
+                    (((value + radius + cell) / gap).floor().max(0.0) as usize).min(count - 1);
+                if bins.stamp[index] == epoch {
+                    bins.low[index] = bins.low[index].min(value);
+                    bins.high[index] = bins.high[index].max(value);
+                } else {
+                    bins.stamp[index] = epoch;
+                    bins.low[index] = value;
+                    bins.high[index] = value;
                 }
+            }
+            let close = |low: f64, high: f64, arcs: &mut Vec<Arc>| {
+                let low = (low - 0.5 * cell).max(-radius);
+                let high = (high + 0.5 * cell).min(radius);
+                let (a, b) = (
+                    (high / radius).clamp(-1.0, 1.0).acos().to_degrees(),
+                    (low / radius).clamp(-1.0, 1.0).acos().to_degrees(),
+                );
+                arcs.push(if front {
+                    Arc { from: a, to: b }
+                } else {
+                    Arc { from: -b, to: -a }
+                });
+            };
+            let mut cluster: Option<(f64, f64)> = None;
+            for index in 0..count {
+                if bins.stamp[index] != epoch {
+                    continue;
+                }
+                let (low, high) = (bins.low[index], bins.high[index]);
+                cluster = match cluster {
+                    Some((start, end)) if low - end > gap => {
+                        close(start, end, &mut arcs);
+                        Some((low, high))
+                    }
+                    Some((start, end)) => Some((start, end.max(high))),
+                    None => Some((low, high)),
+                };
+            }
+            if let Some((start, end)) = cluster {
+                close(start, end, &mut arcs);
             }
         }
         normalise(&arcs)
@@ -456,6 +569,62 @@ mod tests {
         }
         assert_eq!(fast.count(), slow.count());
         assert!(fast.count() > 0);
+    }
+
+    /// The sorted form of §5.3.2's clustering, for comparison with the binned one.
+    fn sorted_clusters(values: &[f64], gap: f64) -> Vec<(f64, f64)> {
+        let mut sorted = values.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        let mut clusters: Vec<(f64, f64)> = Vec::new();
+        for v in sorted {
+            match clusters.last_mut() {
+                Some(last) if v - last.1 <= gap => last.1 = v,
+                _ => clusters.push((v, v)),
+            }
+        }
+        clusters
+    }
+
+    #[test]
+    fn binned_clusters_equal_sorted_clusters() {
+        let (radius, cell, step): (f64, f64, f64) = (5.0, 0.05, 0.2);
+        let gap = (2.0 * cell).max(14.0 * cell * cell / step);
+        let mut state = 12345_u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1_u64 << 53) as f64
+        };
+        let mut contacts = Contacts::default();
+        let mut splits = 0;
+        for _ in 0..200 {
+            contacts.clear();
+            let n = 1 + (next() * 60.0) as usize;
+            for _ in 0..n {
+                // Clumps with gaps near τ.
+                let spread = if next() < 0.5 { 1.0 } else { 0.3 };
+                let value = (next() * 10.0 - 5.0) * spread;
+                contacts.front.push(value.clamp(-radius, radius));
+            }
+            let clusters = sorted_clusters(&contacts.front, gap);
+            splits += clusters.len() - 1;
+            let expected: Vec<Arc> = normalise(
+                &clusters
+                    .iter()
+                    .map(|(low, high)| {
+                        let low = (low - 0.5 * cell).max(-radius);
+                        let high = (high + 0.5 * cell).min(radius);
+                        Arc {
+                            from: (high / radius).acos().to_degrees(),
+                            to: (low / radius).acos().to_degrees(),
+                        }
+                    })
+                    .collect::<Vec<_>>(),
+            );
+            assert_eq!(contacts.arcs(radius, cell, step), expected);
+        }
+        assert!(splits > 50, "the data should exercise the gap rule");
     }
 
     #[test]

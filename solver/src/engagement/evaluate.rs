@@ -109,7 +109,10 @@ fn run_dots(
     };
     let mut contacts = Vec::with_capacity(stations.len());
     let mut scatter = Vec::new();
-    let mut buffer = Contacts::default();
+    let mut buffer = Contacts {
+        keep_angles: job.contact_dots,
+        ..Contacts::default()
+    };
     let mut previous: Option<&Station> = None;
     for station in stations {
         let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
@@ -126,7 +129,7 @@ fn run_dots(
                 radius,
                 &mut |dot| buffer.record(dot, station, radius, step, cell),
             );
-            contact.plunge = previous.is_none() && !buffer.angles.is_empty();
+            contact.plunge = previous.is_none() && buffer.touched();
             if job.contact_dots {
                 let mut bins = [0_u64; 6];
                 for angle in &buffer.angles {
