@@ -220,6 +220,21 @@ fn grid_over_the_memory_limit_is_refused_with_the_limit() {
 }
 
 #[test]
+fn dots_work_over_the_limit_is_refused() {
+    // A tall strip of stock under a big tool at a fine grid: few dots, but 10⁵ rows per sample.
+    let request = with(json!({
+        "stock": {"polygon": [[0, 0], [1, 0], [1, 100], [0, 100]]},
+        "path": [[-60, 50], [61, 50]], "engine": "dots", "grid": 0.001, "step": 0.01,
+    }));
+    let error = engagement::solve(&request, &Tool::new(ToolKind::Flat, 50.0)).unwrap_err();
+    assert_eq!(
+        (error.code(), error.field()),
+        ("E_WORK_LIMIT", Some("grid"))
+    );
+    assert!(error.message().contains("5e8"), "{}", error.message());
+}
+
+#[test]
 fn too_many_samples_is_refused_with_the_limit() {
     let message = assert_refused(json!({"step": 1e-4}), "E_TOO_MANY_SAMPLES", "step");
     assert!(message.contains(&MAX_SAMPLES.to_string()), "{message}");

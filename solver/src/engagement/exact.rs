@@ -15,8 +15,8 @@ use super::segments::{Route, Shape, Station};
 use super::stock::{REACH_TOLERANCE, Region};
 use crate::error::SolverError;
 
-/// Boundary tests allowed per request before the engine gives up (a hang guard; the request
-/// limits keep real jobs far below it).
+/// Boundary and distance tests allowed per path before the engine gives up (a hang guard for
+/// pathological stock outlines; tens of seconds of work, far above real jobs).
 pub(crate) const MAX_TESTS: u64 = 4_000_000_000;
 
 /// Reusable buffers and the work counter.
@@ -54,15 +54,7 @@ impl ExactEngine {
         self.angles.sort_by(f64::total_cmp);
         self.angles.dedup_by(|a, b| (*a - *b).abs() <= 1e-13);
         self.tests += (self.angles.len() * (self.pieces.len() + 1)) as u64;
-        if self.tests > MAX_TESTS {
-            return Err(SolverError::new(
-                "E_WORK_LIMIT",
-                format!(
-                    "the exact engine exceeded its limit of {MAX_TESTS} boundary tests: use a larger step or a simpler stock"
-                ),
-            )
-            .at("step"));
-        }
+        self.check_budget()?;
         let limit = radius * (1.0 - REACH_TOLERANCE);
         let mut arcs = Vec::new();
         let count = self.angles.len();
@@ -74,8 +66,8 @@ impl ExactEngine {
             }
             let middle = 0.5 * (low + high);
             let q = centre + radius * (middle.cos() * right + middle.sin() * forward);
-            let engaged =
-                self.pieces.iter().all(|piece| piece.distance(q) >= limit) && region.contains(q);
+            let engaged = self.pieces.iter().all(|piece| piece.distance(q) >= limit)
+                && region.contains(q, &mut self.tests);
             if engaged {
                 arcs.push(Arc {
                     from: low.to_degrees(),
@@ -83,7 +75,22 @@ impl ExactEngine {
                 });
             }
         }
+        self.check_budget()?;
         Ok(normalise(&arcs))
+    }
+
+    /// Refuses once the work limit is spent.
+    fn check_budget(&self) -> Result<(), SolverError> {
+        if self.tests > MAX_TESTS {
+            return Err(SolverError::new(
+                "E_WORK_LIMIT",
+                format!(
+                    "the exact engine exceeded its limit of {MAX_TESTS} boundary tests: use a larger step or a simpler stock"
+                ),
+            )
+            .at("step"));
+        }
+        Ok(())
     }
 }
 

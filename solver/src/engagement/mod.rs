@@ -70,6 +70,9 @@ pub const MAX_CANDIDATES: usize = 16;
 pub const MAX_FLUTES: u32 = 32;
 /// Most dots of the `dots` engine's grid (and cells of a bitmap stock): 10⁹ bits = 125 MB.
 pub const MAX_GRID_DOTS: u64 = 1_000_000_000;
+/// Most grid rows the `dots` engine may scan over a request (samples × rows across the tool;
+/// about 25 s of work), refused past it with `E_WORK_LIMIT`.
+pub const MAX_DOT_ROWS: f64 = 5e8;
 /// Most samples over all candidate paths of one request.
 pub const MAX_SAMPLES: usize = 200_000;
 /// Most segments (or points) of one path.

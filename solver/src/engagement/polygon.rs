@@ -106,10 +106,12 @@ impl EdgeSet {
         }
     }
 
-    /// Even-odd containment, boundary inclusive within `tolerance`.
-    pub(crate) fn contains(&self, q: P2, tolerance: f64) -> bool {
+    /// Even-odd containment, boundary inclusive within `tolerance`; adds the number of edges
+    /// examined to `work`.
+    pub(crate) fn contains(&self, q: P2, tolerance: f64, work: &mut u64) -> bool {
         let mut on_boundary = false;
         self.tree.query(&BBox::around(q, tolerance), &mut |index| {
+            *work += 1;
             if let Some(edge) = self.edges.get(index)
                 && distance_to_segment(q, edge.from, edge.to) <= tolerance
             {
@@ -125,6 +127,7 @@ impl EdgeSet {
         };
         let mut inside = false;
         self.tree.query(&ray, &mut |index| {
+            *work += 1;
             if let Some(edge) = self.edges.get(index) {
                 let (a, b) = (edge.from, edge.to);
                 // Half-open in y so a vertex on the ray is counted once.
@@ -214,14 +217,14 @@ mod tests {
     fn even_odd_with_hole_and_inclusive_boundary() {
         let rings = vec![square(0.0, 0.0, 10.0), square(4.0, 4.0, 2.0)];
         let edges = EdgeSet::new(&rings);
-        assert!(edges.contains(P2::new(1.0, 1.0), 1e-9));
-        assert!(!edges.contains(P2::new(5.0, 5.0), 1e-9));
-        assert!(edges.contains(P2::new(4.0, 5.0), 1e-9));
-        assert!(edges.contains(P2::new(10.0, 3.0), 1e-9));
-        assert!(!edges.contains(P2::new(10.1, 3.0), 1e-9));
+        assert!(edges.contains(P2::new(1.0, 1.0), 1e-9, &mut 0));
+        assert!(!edges.contains(P2::new(5.0, 5.0), 1e-9, &mut 0));
+        assert!(edges.contains(P2::new(4.0, 5.0), 1e-9, &mut 0));
+        assert!(edges.contains(P2::new(10.0, 3.0), 1e-9, &mut 0));
+        assert!(!edges.contains(P2::new(10.1, 3.0), 1e-9, &mut 0));
         // A ray through a vertex is counted once.
-        assert!(edges.contains(P2::new(2.0, 4.0), 1e-9));
-        assert!(!edges.contains(P2::new(-1.0, 0.0 + 10.0), 1e-9));
+        assert!(edges.contains(P2::new(2.0, 4.0), 1e-9, &mut 0));
+        assert!(!edges.contains(P2::new(-1.0, 0.0 + 10.0), 1e-9, &mut 0));
     }
 
     #[test]

@@ -12,8 +12,8 @@ use super::polygon::{EdgeSet, twice_signed_area};
 use super::segments::{Route, Shape};
 use super::stock::{Base, Bitmap, Cut, Region, decode_base64};
 use super::{
-    DEFAULT_BURR_DISENGAGE_DEG, DEFAULT_CHIPPING_DISENGAGE_DEG, MAX_CANDIDATES, MAX_FLUTES,
-    MAX_GRID_DOTS, MAX_SAMPLES, MAX_SEGMENTS, MAX_STOCK_VERTICES, P2,
+    DEFAULT_BURR_DISENGAGE_DEG, DEFAULT_CHIPPING_DISENGAGE_DEG, MAX_CANDIDATES, MAX_DOT_ROWS,
+    MAX_FLUTES, MAX_GRID_DOTS, MAX_SAMPLES, MAX_SEGMENTS, MAX_STOCK_VERTICES, P2,
 };
 use crate::error::{SolverError, Warning, finite, non_negative, positive};
 use crate::tool::{Tool, ToolRef};
@@ -983,8 +983,20 @@ impl EngagementRequest {
             });
         }
         if let (Some(g), Some(stock_box)) = (grid, region.bbox()) {
+            let mut rows = 0.0;
             for candidate in &candidates {
-                check_grid(&candidate.route, stock_box, region.anchor(), radius, g)?;
+                let height = check_grid(&candidate.route, stock_box, region.anchor(), radius, g)?;
+                // Each sample scans the grid rows across the tool.
+                rows += candidate.route.station_count(step) * (2.0 * radius / g).min(height);
+            }
+            if rows > MAX_DOT_ROWS {
+                return Err(SolverError::new(
+                    "E_WORK_LIMIT",
+                    format!(
+                        "the dots engine would scan about {rows:.2e} grid rows (samples × rows across the tool); the limit is {MAX_DOT_ROWS:.0e}: use a larger grid or step, or engine \"exact\""
+                    ),
+                )
+                .at("grid"));
             }
         }
         if let (Engine::Exact, Base::Bitmap(bitmap)) = (self.engine, &region.base) {
@@ -1057,13 +1069,14 @@ pub(crate) fn grid_extent(
     Some((origin, width.min(1e18) as u64, height.min(1e18) as u64))
 }
 
+/// Refuses a grid past the memory limit; the grid's height in rows otherwise.
 fn check_grid(
     route: &Route,
     stock_box: BBox,
     anchor: P2,
     radius: f64,
     grid: f64,
-) -> Result<(), SolverError> {
+) -> Result<f64, SolverError> {
     if let Some((_, width, height)) = grid_extent(route, stock_box, anchor, radius, grid) {
         let dots = (width as f64) * (height as f64);
         if dots > MAX_GRID_DOTS as f64 {
@@ -1077,6 +1090,7 @@ fn check_grid(
             )
             .at("grid"));
         }
+        return Ok(height as f64);
     }
-    Ok(())
+    Ok(0.0)
 }

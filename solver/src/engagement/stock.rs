@@ -141,12 +141,14 @@ impl Cut {
         });
     }
 
-    /// Whether `q` is still material after this cut (closed: exactly `radius` away stays).
-    pub(crate) fn keeps(&self, q: P2) -> bool {
+    /// Whether `q` is still material after this cut (closed: exactly `radius` away stays);
+    /// adds the pieces examined to `work`.
+    pub(crate) fn keeps(&self, q: P2, work: &mut u64) -> bool {
         let limit = self.radius * (1.0 - REACH_TOLERANCE);
         let mut kept = true;
         self.tree
             .query(&BBox::around(q, self.radius), &mut |index| {
+                *work += 1;
                 if kept
                     && let Some(shape) = self.shapes.get(index)
                     && shape.distance(q) < limit
@@ -166,17 +168,14 @@ pub(crate) struct Region {
 }
 
 impl Region {
-    /// Whether `q` is material of the outline (before earlier cuts).
-    pub(crate) fn base_contains(&self, q: P2) -> bool {
-        match &self.base {
-            Base::Polygons { edges, .. } => edges.contains(q, BOUNDARY_TOLERANCE),
+    /// Whether `q` is material at the start of the operation (outline, less earlier cuts);
+    /// adds the edges and pieces examined to `work`.
+    pub(crate) fn contains(&self, q: P2, work: &mut u64) -> bool {
+        let in_outline = match &self.base {
+            Base::Polygons { edges, .. } => edges.contains(q, BOUNDARY_TOLERANCE, work),
             Base::Bitmap(bitmap) => bitmap.contains(q),
-        }
-    }
-
-    /// Whether `q` is material at the start of the operation.
-    pub(crate) fn contains(&self, q: P2) -> bool {
-        self.base_contains(q) && self.cuts.iter().all(|cut| cut.keeps(q))
+        };
+        in_outline && self.cuts.iter().all(|cut| cut.keeps(q, work))
     }
 
     /// Where the dot grid is anchored: the bitmap's origin, else the coordinate origin.
