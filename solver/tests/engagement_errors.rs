@@ -121,6 +121,9 @@ fn table_of_bad_inputs() {
         "flute_counts[2]",
     );
     assert_refused(json!({"flute_counts": []}), "E_INPUT", "flute_counts");
+    // Numbers out of range (coordinates beyond ±1 km, absurd feeds).
+    assert_refused(json!({"path": [[0, 0], [2e6, 0]]}), "E_INPUT", "path[1][0]");
+    assert_refused(json!({"feed_per_tooth": 1e5}), "E_INPUT", "feed_per_tooth");
     // Other numbers.
     assert_refused(json!({"step": 0}), "E_INPUT", "step");
     assert_refused(json!({"thickness_limit": -1}), "E_INPUT", "thickness_limit");

@@ -73,6 +73,9 @@ pub const MAX_GRID_DOTS: u64 = 1_000_000_000;
 /// Most grid rows the `dots` engine may scan over a request (samples × rows across the tool;
 /// about 25 s of work), refused past it with `E_WORK_LIMIT`.
 pub const MAX_DOT_ROWS: f64 = 5e8;
+/// Most chords when arcs are written as lines (the G-code program; earlier cuts in the dots
+/// engine).
+pub const MAX_CHORDS: f64 = 1e7;
 /// Most samples over all candidate paths of one request.
 pub const MAX_SAMPLES: usize = 200_000;
 /// Most segments (or points) of one path.

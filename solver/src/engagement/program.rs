@@ -97,6 +97,21 @@ pub fn program(
     let cut_z = data.stock_top_z - depth + lift;
     let safe_z = data.stock_top_z + data.clearance + lift;
     let route = &data.route.0;
+    let chords: f64 = route
+        .pieces
+        .iter()
+        .map(|p| p.shape.chord_count(CHORD_TOLERANCE))
+        .sum();
+    if chords > super::MAX_CHORDS {
+        return Err(SolverError::new(
+            "E_TOO_LARGE",
+            format!(
+                "the program would need {chords:.2e} moves for the arcs at {CHORD_TOLERANCE} mm; the limit is {:.0e}",
+                super::MAX_CHORDS
+            ),
+        )
+        .at("path"));
+    }
     let mut path = Toolpath::default();
     let Some(first) = route.pieces.first() else {
         return Err(SolverError::new("E_PATH", "the path is empty").at("path"));

@@ -12,8 +12,8 @@ use super::polygon::{EdgeSet, twice_signed_area};
 use super::segments::{Route, Shape};
 use super::stock::{Base, Bitmap, Cut, Region, decode_base64};
 use super::{
-    DEFAULT_BURR_DISENGAGE_DEG, DEFAULT_CHIPPING_DISENGAGE_DEG, MAX_CANDIDATES, MAX_DOT_ROWS,
-    MAX_FLUTES, MAX_GRID_DOTS, MAX_SAMPLES, MAX_SEGMENTS, MAX_STOCK_VERTICES, P2,
+    DEFAULT_BURR_DISENGAGE_DEG, DEFAULT_CHIPPING_DISENGAGE_DEG, MAX_CANDIDATES, MAX_CHORDS,
+    MAX_DOT_ROWS, MAX_FLUTES, MAX_GRID_DOTS, MAX_SAMPLES, MAX_SEGMENTS, MAX_STOCK_VERTICES, P2,
 };
 use crate::error::{SolverError, Warning, finite, non_negative, positive};
 use crate::tool::{Tool, ToolRef};
@@ -439,10 +439,32 @@ impl FeedMode {
     }
 }
 
+/// Largest coordinate magnitude accepted, mm (1 km: beyond any machine, and squares stay exact
+/// enough for the boundary tests).
+pub const MAX_COORDINATE: f64 = 1e6;
+
 fn point(field: &str, p: [f64; 2]) -> Result<P2, SolverError> {
-    finite(&format!("{field}[0]"), p[0])?;
-    finite(&format!("{field}[1]"), p[1])?;
+    for (axis, value) in [(0, p[0]), (1, p[1])] {
+        let name = format!("{field}[{axis}]");
+        if finite(&name, value)?.abs() > MAX_COORDINATE {
+            return Err(SolverError::input(
+                name,
+                format!("coordinates must lie within ±{MAX_COORDINATE} mm (got {value})"),
+            ));
+        }
+    }
     Ok(P2::new(p[0], p[1]))
+}
+
+/// `value` must be positive and at most `limit`.
+fn bounded(field: &str, value: f64, limit: f64) -> Result<f64, SolverError> {
+    if positive(field, value)? > limit {
+        return Err(SolverError::input(
+            field,
+            format!("{field} must be at most {limit} (got {value})"),
+        ));
+    }
+    Ok(value)
 }
 
 fn optional(
@@ -651,7 +673,7 @@ fn read_stock(
     }
     let base = if let Some(bitmap) = &stock.bitmap {
         let origin = point("stock.bitmap.origin", bitmap.origin)?;
-        let cell = positive("stock.bitmap.cell", bitmap.cell)?;
+        let cell = bounded("stock.bitmap.cell", bitmap.cell, MAX_COORDINATE)?;
         if bitmap.width == 0 || bitmap.height == 0 {
             return Err(SolverError::input(
                 "stock.bitmap.width",
@@ -771,7 +793,7 @@ fn read_stock(
     let mut cut_fields = Vec::new();
     for (index, previous) in stock.previous_cuts.iter().enumerate() {
         let field = format!("stock.previous_cuts[{index}]");
-        let radius = positive(&format!("{field}.radius"), previous.radius)?;
+        let radius = bounded(&format!("{field}.radius"), previous.radius, MAX_COORDINATE)?;
         let route = read_path(&previous.path, &format!("{field}.path"), warnings)?;
         let shapes = route
             .pieces
@@ -789,11 +811,11 @@ impl EngagementRequest {
     /// Validates the request against `tool` (already resolved from `self.tool`).
     pub(crate) fn validate(&self, tool: &Tool) -> Result<Job, SolverError> {
         tool.validate("tool.")?;
-        let radius = tool.radius;
-        let spindle_rpm = positive("spindle_rpm", self.spindle_rpm)?;
+        let radius = bounded("tool.radius", tool.radius, MAX_COORDINATE)?;
+        let spindle_rpm = bounded("spindle_rpm", self.spindle_rpm, 1e6)?;
         let feed_mode = match (self.feed_per_tooth, self.feed) {
-            (Some(fz), None) => FeedMode::PerTooth(positive("feed_per_tooth", fz)?),
-            (None, Some(vf)) => FeedMode::Rate(positive("feed", vf)?),
+            (Some(fz), None) => FeedMode::PerTooth(bounded("feed_per_tooth", fz, 1e3)?),
+            (None, Some(vf)) => FeedMode::Rate(bounded("feed", vf, 1e7)?),
             (Some(_), Some(_)) => {
                 return Err(SolverError::input(
                     "feed",
@@ -845,7 +867,7 @@ impl EngagementRequest {
         let thickness_limit = optional("thickness_limit", self.thickness_limit, positive)?;
         let time_limit = optional("time_limit_s", self.time_limit_s, positive)?;
         let step = match self.step {
-            Some(step) => positive("step", step)?,
+            Some(step) => bounded("step", step, MAX_COORDINATE)?,
             None => 2.0 * radius / 50.0,
         };
         let grid = match (self.engine, self.grid) {
@@ -856,7 +878,7 @@ impl EngagementRequest {
                 ));
             }
             (Engine::Exact, None) => None,
-            (Engine::Dots, Some(g)) => Some(positive("grid", g)?),
+            (Engine::Dots, Some(g)) => Some(bounded("grid", g, MAX_COORDINATE)?),
             (Engine::Dots, None) => Some(match &self.stock.bitmap {
                 Some(bitmap) if bitmap.cell.is_finite() && bitmap.cell > 0.0 => bitmap.cell,
                 _ => 2.0 * radius / 200.0,
@@ -895,21 +917,30 @@ impl EngagementRequest {
         }
         let spike_threshold = optional("spike_threshold_deg", self.spike_threshold_deg, positive)?;
         let min_feed_per_tooth = optional("min_feed_per_tooth", self.min_feed_per_tooth, positive)?;
-        let axial_depth = optional("axial_depth", self.axial_depth, positive)?;
+        let axial_depth = self
+            .axial_depth
+            .map(|d| bounded("axial_depth", d, MAX_COORDINATE))
+            .transpose()?;
         let stock_top_z = finite("stock_top_z", self.stock_top_z.unwrap_or(0.0))?;
-        let clearance = positive("clearance", self.clearance.unwrap_or(5.0))?;
+        if stock_top_z.abs() > MAX_COORDINATE {
+            return Err(SolverError::input(
+                "stock_top_z",
+                format!("stock_top_z must lie within ±{MAX_COORDINATE} mm"),
+            ));
+        }
+        let clearance = bounded("clearance", self.clearance.unwrap_or(5.0), MAX_COORDINATE)?;
         let plan = self
             .feed_plan
             .as_ref()
             .map(|plan| -> Result<PlanJob, SolverError> {
-                let target = positive("feed_plan.target_thickness", plan.target_thickness)?;
+                let target = bounded("feed_plan.target_thickness", plan.target_thickness, 1e3)?;
                 let max_feed = plan.max_feed.ok_or_else(|| {
                     SolverError::input(
                         "feed_plan.max_feed",
                         "feed_plan.max_feed (mm/min) is required unless the request names a machine",
                     )
                 })?;
-                let max_feed = positive("feed_plan.max_feed", max_feed)?;
+                let max_feed = bounded("feed_plan.max_feed", max_feed, 1e7)?;
                 let flute_count = plan.flute_count.unwrap_or(tool.flutes);
                 if !(1..=MAX_FLUTES).contains(&flute_count) {
                     return Err(SolverError::input(
@@ -981,6 +1012,24 @@ impl EngagementRequest {
                 route,
                 warnings,
             });
+        }
+        if let Some(g) = grid {
+            // The dots engine rasterises earlier cuts' arcs as chords within g/100.
+            let chords: f64 = region
+                .cuts
+                .iter()
+                .flat_map(|cut| cut.shapes.iter())
+                .map(|shape| shape.chord_count(g / 100.0))
+                .sum();
+            if chords > MAX_CHORDS {
+                return Err(SolverError::new(
+                    "E_WORK_LIMIT",
+                    format!(
+                        "the earlier cuts' arcs need {chords:.2e} chords at grid {g} mm; the limit is {MAX_CHORDS:.0e}: use a larger grid or engine \"exact\""
+                    ),
+                )
+                .at("stock.previous_cuts"));
+            }
         }
         if let (Some(g), Some(stock_box)) = (grid, region.bbox()) {
             let mut rows = 0.0;

@@ -91,23 +91,7 @@ impl Shape {
 
     /// The first `local` mm of the piece.
     pub(crate) fn truncated(&self, local: f64) -> Self {
-        match *self {
-            Self::Line { from, .. } => Self::Line {
-                from,
-                to: self.point(local),
-            },
-            Self::Arc {
-                centre,
-                radius,
-                start,
-                sweep,
-            } => Self::Arc {
-                centre,
-                radius,
-                start,
-                sweep: sweep.signum() * (local / radius).clamp(0.0, sweep.abs()),
-            },
-        }
+        self.portion(0.0, local)
     }
 
     /// The part of the piece from `from` to `to` mm along it.
@@ -223,20 +207,28 @@ impl Shape {
         }
     }
 
-    /// Points along the piece (first and last included) whose chords stay within `sagitta` of
-    /// it; a line gives its two ends.
-    pub(crate) fn flatten(&self, sagitta: f64) -> Vec<P2> {
+    /// Number of chords [`Self::flatten`] gives for `sagitta` (1 for a line).
+    pub(crate) fn chord_count(&self, sagitta: f64) -> f64 {
         match *self {
-            Self::Line { from, to } => vec![from, to],
+            Self::Line { .. } => 1.0,
             Self::Arc { radius, sweep, .. } => {
                 let half_angle = if sagitta >= radius {
                     PI / 2.0
                 } else {
                     (1.0 - sagitta / radius).acos()
                 };
-                let pieces = (sweep.abs() / (2.0 * half_angle.max(1e-6))).ceil().max(1.0);
-                // Bounded by the caller's limits on arcs and sagitta; keep a hard ceiling anyway.
-                let count = pieces.min(1e6) as usize;
+                (sweep.abs() / (2.0 * half_angle.max(1e-9))).ceil().max(1.0)
+            }
+        }
+    }
+
+    /// Points along the piece (first and last included) whose chords stay within `sagitta` of
+    /// it; a line gives its two ends. Callers bound the count with [`Self::chord_count`].
+    pub(crate) fn flatten(&self, sagitta: f64) -> Vec<P2> {
+        match *self {
+            Self::Line { from, to } => vec![from, to],
+            Self::Arc { .. } => {
+                let count = self.chord_count(sagitta).min(1e8) as usize;
                 let length = self.length();
                 (0..=count)
                     .map(|i| self.point(length * i as f64 / count as f64))
