@@ -200,7 +200,7 @@ pub enum SpindleDirection {
     Ccw,
 }
 
-/// How a tooth passes through one engaged arc (§5.4, [X]).
+/// How a tooth passes through one engaged arc (§5.4, an extension of the spec).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]

@@ -327,7 +327,11 @@ pub(crate) fn evaluate(
     if !statistic.iter().any(|s| *s) {
         warnings.push(Warning::new(
             "W_NO_CONTACT",
-            "no engagement: the tool never touches the stock along this path (check the stock and path coordinates); all series are zero",
+            if engaged_intervals.is_empty() {
+                "no engagement: the tool never touches the stock along this path (check the stock and path coordinates); all series are zero"
+            } else {
+                "no engagement to evaluate: the tool touches the stock only where it plunges; the statistics are zero"
+            },
         ));
     }
     if !plunges.is_empty() {

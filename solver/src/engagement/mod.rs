@@ -19,7 +19,7 @@
 //! * `teeth`: H_k and n_k with the exact phase maximisation (§5.6);
 //! * `flutes`: representative values, time, recommendation (§5.7–§5.9);
 //! * `feed`: chip-thinning feed plan (§11 item 3);
-//! * [`program`]: G-code with the planned F words.
+//! * [`program()`]: G-code with the planned F words.
 //!
 //! Choices where the spec is open (§13): `cw` rotation by default; constant f_z when
 //! `feed_per_tooth` is given, constant V_f when `feed` is; statistics over the engaged samples

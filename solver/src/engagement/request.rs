@@ -1,5 +1,5 @@
 //! The engagement request as clients send it (api.md, Engagement; engagement.md §2) and its
-//! validation into a [`Job`] before any heavy work (§9 `E_INPUT`, `E_PATH`, and the size limits).
+//! validation into a `Job` before any heavy work (§9 `E_INPUT`, `E_PATH`, and the size limits).
 
 use std::fmt;
 
