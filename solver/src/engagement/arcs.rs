@@ -109,7 +109,17 @@ pub(crate) fn normalise(arcs: &[Arc]) -> Vec<Arc> {
 
 /// Φ, the total engaged angle, degrees.
 pub(crate) fn engaged_deg(arcs: &[Arc]) -> f64 {
-    arcs.iter().map(Arc::span).sum()
+    // A fold from +0 so an empty set reads 0, not −0.
+    arcs.iter()
+        .map(Arc::span)
+        .fold(0.0, |total, span| total + span)
+}
+
+/// sin of an angle in degrees, with the rounding residue at 0° and 180° (1e-16) cleared so a
+/// tooth there reads exactly zero thickness.
+pub(crate) fn sin_deg(angle: f64) -> f64 {
+    let value = angle.to_radians().sin();
+    if value.abs() < 1e-12 { 0.0 } else { value }
 }
 
 /// a_e: the measure of the union of the arcs' lateral projections R·cos θ (§5.5).
@@ -235,7 +245,7 @@ pub(crate) fn arc_ends(arc: &Arc, direction: SpindleDirection) -> ArcEnds {
         SpindleDirection::Cw => (arc.to, arc.from),
         SpindleDirection::Ccw => (arc.from, arc.to),
     };
-    let (sin_in, sin_out) = (entry.to_radians().sin(), exit.to_radians().sin());
+    let (sin_in, sin_out) = (sin_deg(entry), sin_deg(exit));
     let (entry_ratio, exit_ratio) = (sin_in.max(0.0), sin_out.max(0.0));
     let mode = match (entry_ratio <= ZERO_THICKNESS, exit_ratio <= ZERO_THICKNESS) {
         (true, true) if (arc.span() - 180.0).abs() <= 1.0 && arc.from > -1.0 => MillingMode::Slot,
