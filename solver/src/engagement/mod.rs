@@ -1,1 +1,115 @@
-//! Tool–workpiece engagement over time and flute-count recommendation (spec: engagement.md; seed 003). Not built yet.
+//! Tool–workpiece engagement over time and flute-count recommendation (spec: engagement.md;
+//! seed 003).
+//!
+//! The tool's cutting circle moves along a 2-D tool-centre path over a plan-view stock. At each
+//! sample the solver finds the engaged arcs (angles of the circle touching material not yet
+//! removed, in the tool-angle convention of §4.1: 90° ahead, 0° right, 180° left of travel),
+//! and derives the radial depth, entry/exit angles, milling mode and burr/chipping flags, the
+//! summed chip thickness of k teeth maximised exactly over the tooth phase, the representative
+//! values and machining time per flute count, and the flute counts that meet a thickness and a
+//! time limit. Beyond the seed it returns the feed that holds a target chip thickness (per block
+//! and as G-code), the removal rate over time, and compares several candidate paths at once.
+//!
+//! * [`request`]: the request and its validation (§2, §9);
+//! * `segments`: the path of lines and arcs and its sampling (§5.2);
+//! * `stock`, `polygon`, `bbox_tree`: the material W₀ and its geometry;
+//! * `exact`: engine B, the exact boundary test (§5.3.3, default);
+//! * `dots`: engine A, the seed's dot removal (§5.3.2);
+//! * `arcs`: arc merging, a_e and the per-arc quantities (§5.4, §5.5, §5.10);
+//! * `teeth`: H_k and n_k with the exact phase maximisation (§5.6);
+//! * `flutes`: representative values, time, recommendation (§5.7–§5.9);
+//! * `feed`: chip-thinning feed plan (§11 item 3);
+//! * [`program()`]: G-code with the planned F words.
+//!
+//! Choices where the spec is open (§13): `cw` rotation by default; constant f_z when
+//! `feed_per_tooth` is given, constant V_f when `feed` is; statistics over the engaged samples
+//! (m ≥ 1, not a plunge, not a rapid), the mean weighted by sample spacing; machining time over
+//! feed moves only; θ in degrees; 2-D only (no axial depth or helix in the contact model). A
+//! path that never touches the stock is not an error: the answer is all zeros with
+//! `W_NO_CONTACT` (§9). The exact engine splits the circle at its exact boundary crossings
+//! instead of stepping θ, so it has no angle step and its arc ends are exact.
+//!
+//! G-code text as a path input is not built yet: [`PathInput`]'s map form is a struct whose
+//! fields are all optional, so a `gcode` field can be added next to `start`/`segments`.
+
+mod answer;
+mod arcs;
+mod bbox_tree;
+mod dots;
+mod evaluate;
+mod exact;
+mod feed;
+mod flutes;
+mod polygon;
+pub mod program;
+pub mod request;
+mod segments;
+mod stock;
+mod teeth;
+
+pub use answer::{
+    ArcDetail, Comparison, EngagementAnswer, EngagementSample, FeedBlock, FeedLimit, FeedPlan,
+    FluteResult, GridInfo, PathEngagement, SampleFlag,
+};
+pub use arcs::{MillingMode, SpindleDirection};
+pub use program::{Post, program};
+pub use request::{
+    ArcDirection, Candidate, EngagementRequest, Engine, FeedBasis, FeedPlanRequest, PathInput,
+    PathSegments, PreviousCut, Representative, SegmentInput, Stock, StockBitmap, StockPolygon,
+};
+
+use crate::error::SolverError;
+use crate::tool::Tool;
+
+/// A point or vector in the plane, mm.
+pub(crate) type P2 = nalgebra::Vector2<f64>;
+
+/// Most candidate paths in one request.
+pub const MAX_CANDIDATES: usize = 16;
+/// Largest flute count, and most flute counts in one request.
+pub const MAX_FLUTES: u32 = 32;
+/// Most dots of the `dots` engine's grid (and cells of a bitmap stock): 10⁹ bits = 125 MB.
+pub const MAX_GRID_DOTS: u64 = 1_000_000_000;
+/// Most grid rows the `dots` engine may scan over a request (samples × rows across the tool;
+/// about 25 s of work), refused past it with `E_WORK_LIMIT`.
+pub const MAX_DOT_ROWS: f64 = 5e8;
+/// Most chords when arcs are written as lines (the G-code program; earlier cuts in the dots
+/// engine).
+pub const MAX_CHORDS: f64 = 1e7;
+/// Most samples over all candidate paths of one request.
+pub const MAX_SAMPLES: usize = 200_000;
+/// Most segments (or points) of one path.
+pub const MAX_SEGMENTS: usize = 100_000;
+/// Most vertices of a polygon stock, all rings together.
+pub const MAX_STOCK_VERTICES: usize = 100_000;
+/// Most contact dots returned for the scatter plot; more are decimated.
+pub const MAX_CONTACT_DOTS: usize = 1_000_000;
+/// Most bitmap cell-edge tests of the exact engine over a request (about 8R/cell per sample).
+pub(crate) const MAX_BITMAP_CROSSINGS: f64 = 2e9;
+/// ψ_B default, degrees (§5.10).
+pub const DEFAULT_BURR_DISENGAGE_DEG: f64 = 80.0;
+/// ψ_C default, degrees (§5.10).
+pub const DEFAULT_CHIPPING_DISENGAGE_DEG: f64 = 20.0;
+
+/// Solves an engagement request with its resolved tool: one result for `path`, the candidates
+/// side by side for `paths`.
+///
+/// # Errors
+/// `E_INPUT` naming the field for bad numbers; `E_PATH` (empty path, arc centre not equidistant),
+/// `E_STOCK` (crossing or degenerate rings, bad bitmap), `E_TOO_LARGE`, `E_TOO_MANY_SAMPLES`,
+/// `E_GRID_MEMORY` (limits, with the limit in the message), `E_WORK_LIMIT`.
+pub fn solve(request: &EngagementRequest, tool: &Tool) -> Result<EngagementAnswer, SolverError> {
+    let job = request.validate(tool)?;
+    let mut results = Vec::with_capacity(job.candidates.len());
+    for candidate in &job.candidates {
+        results.push(evaluate::evaluate(&job, candidate, tool)?);
+    }
+    if job.single
+        && let Some(result) = results.pop()
+    {
+        return Ok(EngagementAnswer::Single(Box::new(result)));
+    }
+    Ok(EngagementAnswer::Comparison(Comparison {
+        candidates: results,
+    }))
+}

@@ -1,0 +1,302 @@
+//! What an engagement request answers (api.md, Engagement: `samples`, `flutes`, `recommended`;
+//! engagement.md §3.1 outputs and the [X] extras).
+
+use serde::Serialize;
+
+use super::arcs::MillingMode;
+use super::request::{Engine, FeedBasis};
+use super::segments::Route;
+use crate::error::Warning;
+
+/// One engaged arc with its entry and exit (engagement.md §5.4).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct ArcDetail {
+    /// θ_in: where a tooth enters the material, degrees.
+    pub entry_deg: f64,
+    /// θ_out: where it leaves, degrees.
+    pub exit_deg: f64,
+    /// φ = acos(sin θ_in): angle between the radius to the entry point and the travel direction.
+    pub engage_deg: f64,
+    /// ψ = acos(sin θ_out).
+    pub disengage_deg: f64,
+    /// h_in / f_z = max(0, sin θ_in).
+    pub entry_thickness_ratio: f64,
+    /// h_out / f_z = max(0, sin θ_out).
+    pub exit_thickness_ratio: f64,
+    /// `slot`, `climb` (down), `conventional` (up) or `interior`.
+    pub mode: MillingMode,
+}
+
+/// Marks on one sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum SampleFlag {
+    /// An exit with ψ ≥ ψ_B: the tooth leaves where the chip is thin (§5.10).
+    BurrRisk,
+    /// An exit with ψ ≤ ψ_C: the tooth leaves where the chip is thick (§5.10).
+    ChippingRisk,
+    /// The tool is in material where it starts cutting (path start or after a rapid); the
+    /// sample is left out of the statistics.
+    Plunge,
+    /// Engagement on the back half of the circle mid-path (ramp, reversal into stock).
+    BackContact,
+    /// a_e above `radial_depth_max`.
+    VibrationRisk,
+    /// 0 < a_e below `radial_depth_min`.
+    RubbingRisk,
+    /// On a rapid segment: not cutting, not timed.
+    Rapid,
+    /// A rapid segment passes through material.
+    Collision,
+}
+
+/// The state at one sample of the path (api.md: `s`, `t`, `arcs`, `engaged_deg`, `radial_depth`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct EngagementSample {
+    /// Path length from the start, mm.
+    pub s: f64,
+    /// Time from the start at the nominal feed of `time_flute_count` teeth, s (rapids untimed).
+    pub t: f64,
+    /// Tool centre [x, y], mm.
+    pub position: [f64; 2],
+    /// Direction of travel, degrees from +X (counter-clockwise).
+    pub heading_deg: f64,
+    /// Index of the path segment (for a point list, the segment from point `segment`).
+    pub segment: usize,
+    /// Engaged arcs `[[from_deg, to_deg], ...]`, tool angle of engagement.md §4.1 (90° ahead,
+    /// 0° right, 180° left of travel); from in [−180, 180), to in (from, from + 360], sorted.
+    pub arcs: Vec<[f64; 2]>,
+    /// Φ: total engaged angle, degrees.
+    pub engaged_deg: f64,
+    /// a_e: radial depth of cut, the measure of the arcs' lateral projection, mm.
+    pub radial_depth: f64,
+    /// Entry, exit and mode of each arc, in the order of `arcs`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub arc_details: Vec<ArcDetail>,
+    /// Mean undeformed chip thickness over the engaged angles at the feed per tooth of
+    /// `time_flute_count` teeth, mm (side milling: f_z·(a_e/R)/φ).
+    pub mean_chip_thickness: f64,
+    /// H_k, the largest summed chip thickness over the tooth phase, per flute count in the
+    /// order of `flutes`, mm.
+    pub thickness: Vec<f64>,
+    /// n_k, the most teeth strictly inside the arcs at once, per flute count.
+    pub teeth: Vec<u32>,
+    /// Material removal rate a_p·a_e·V_f at the nominal feed, mm³/min (with `axial_depth`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mrr: Option<f64>,
+    /// Risk and state marks.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub flags: Vec<SampleFlag>,
+}
+
+/// Results for one flute count (api.md: `max_thickness`, `mean_thickness`, `min_thickness`,
+/// `time_s`, `recommended`; engagement.md §5.7–§5.9).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct FluteResult {
+    /// k.
+    pub flute_count: u32,
+    /// f_z,k, mm/tooth.
+    pub feed_per_tooth: f64,
+    /// V_f,k, mm/min.
+    pub feed: f64,
+    /// Largest H_k over the engaged samples, mm.
+    pub max_thickness: f64,
+    /// Length-weighted mean of H_k over the engaged samples, mm.
+    pub mean_thickness: f64,
+    /// Smallest H_k over the engaged samples, mm (sampling dependent).
+    pub min_thickness: f64,
+    /// Median of H_k over the engaged samples, mm.
+    pub median_thickness: f64,
+    /// P_k = 60·L_feed/V_f,k, s.
+    pub time_s: f64,
+    /// Meets the given limits.
+    pub recommended: bool,
+    /// T1 minus the representative thickness, mm (negative: over the limit).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub thickness_margin: Option<f64>,
+    /// T2 minus the time, s (negative: too slow).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_margin_s: Option<f64>,
+    /// Most teeth in the cut at once anywhere on the path.
+    pub max_teeth: u32,
+    /// Path intervals `[[s_from, s_to], ...]` (sample positions) where two or more teeth cut at
+    /// once.
+    pub multi_tooth_intervals: Vec<[f64; 2]>,
+}
+
+/// Why a feed block has its feed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum FeedLimit {
+    /// The target chip thickness.
+    Thickness,
+    /// The machine's maximum feed.
+    Machine,
+}
+
+/// A stretch of the path programmed with one feed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct FeedBlock {
+    /// Path segment the block lies on.
+    pub segment: usize,
+    /// Start, path length, mm.
+    pub from_s: f64,
+    /// End, path length, mm.
+    pub to_s: f64,
+    /// Feed, mm/min (whole numbers, rounded down); absent on a rapid.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub feed: Option<f64>,
+    /// What sets the feed; absent on a rapid.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limited_by: Option<FeedLimit>,
+}
+
+/// Feeds that hold the target chip thickness (chip-thinning compensation, §11 item 3).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct FeedPlan {
+    /// Teeth of the cutter the feeds are for.
+    pub flute_count: u32,
+    /// h*, mm.
+    pub target_thickness: f64,
+    /// `tooth` or `sum`.
+    pub basis: FeedBasis,
+    /// Cap, mm/min.
+    pub max_feed: f64,
+    /// The path cut into blocks of one feed, in path order.
+    pub blocks: Vec<FeedBlock>,
+    /// Cutting time with these feeds, s.
+    pub time_s: f64,
+    /// Cutting time at the nominal feed of the same flute count, s.
+    pub nominal_time_s: f64,
+    /// Lowest and highest block feed, mm/min.
+    pub feed_range: [f64; 2],
+}
+
+/// The dot grid of the `dots` engine.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct GridInfo {
+    /// g, mm.
+    pub cell: f64,
+    /// Corner [x, y] of dot (0, 0)'s cell, mm.
+    pub origin: [f64; 2],
+    /// Dots across.
+    pub width: usize,
+    /// Dots up.
+    pub height: usize,
+    /// Memory of the bits, bytes.
+    pub bytes: usize,
+}
+
+/// The answer for one path.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct PathEngagement {
+    /// Candidate name, when given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// The contact-position series.
+    pub samples: Vec<EngagementSample>,
+    /// Per flute count, in the request's order.
+    pub flutes: Vec<FluteResult>,
+    /// Flute counts meeting the limits, fastest first (ties: fewer teeth first).
+    pub recommended: Vec<u32>,
+    /// Path length L, mm.
+    pub path_length: f64,
+    /// Length of the feed moves (rapids excluded), mm.
+    pub feed_length: f64,
+    /// The flute count `t` and `mrr` are computed for (the tool's `flutes`).
+    pub time_flute_count: u32,
+    /// Engine used.
+    pub engine: Engine,
+    /// Δs used, mm.
+    pub step: f64,
+    /// The dot grid (`dots` engine).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grid: Option<GridInfo>,
+    /// Path intervals `[[s_from, s_to], ...]` (sample positions) with contact.
+    pub engaged_intervals: Vec<[f64; 2]>,
+    /// Largest Φ over the path, degrees, and where (s).
+    pub max_engaged_deg: f64,
+    /// s of the largest Φ, mm.
+    pub max_engaged_at_s: f64,
+    /// Largest a_e, mm.
+    pub max_radial_depth: f64,
+    /// Largest removal rate, mm³/min (with `axial_depth`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_mrr: Option<f64>,
+    /// `dots` engine: removed dots as `[s, θ_deg]` (one per sample and 1° bin) for the scatter
+    /// plot of the seed's contact graph.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_dots: Option<Vec<[f64; 2]>>,
+    /// Feeds holding the target chip thickness, when asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub feed_plan: Option<FeedPlan>,
+    /// Everything worth knowing that did not stop the computation.
+    pub warnings: Vec<Warning>,
+    /// What the G-code post needs.
+    #[serde(skip)]
+    pub(crate) post: PostData,
+}
+
+/// Several candidate paths side by side.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct Comparison {
+    /// One result per entry of `paths`, in order.
+    pub candidates: Vec<PathEngagement>,
+}
+
+/// `POST /api/v1/engagement` answer: one path's result (request with `path`), or the candidates
+/// side by side (request with `paths`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(untagged)]
+pub enum EngagementAnswer {
+    /// The request gave `path`.
+    Single(Box<PathEngagement>),
+    /// The request gave `paths`.
+    Comparison(Comparison),
+}
+
+impl EngagementAnswer {
+    /// The results in request order (one for `path`).
+    pub fn candidates(&self) -> &[PathEngagement] {
+        match self {
+            Self::Single(result) => std::slice::from_ref(result.as_ref()),
+            Self::Comparison(comparison) => &comparison.candidates,
+        }
+    }
+}
+
+/// The geometry and settings the G-code program needs, kept out of the JSON.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct PostData {
+    pub route: RouteData,
+    pub nominal_feed: f64,
+    pub spindle_rpm: f64,
+    pub axial_depth: Option<f64>,
+    pub stock_top_z: f64,
+    pub clearance: f64,
+    pub tool_radius: f64,
+    /// Height of the end's rounding centre above the tip (ball: radius, bull: corner radius).
+    pub centre_height: f64,
+    pub description: Vec<String>,
+}
+
+/// The route, comparable so the answer can derive `PartialEq`.
+#[derive(Debug, Clone)]
+pub(crate) struct RouteData(pub Route);
+
+impl PartialEq for RouteData {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.pieces == other.0.pieces
+    }
+}

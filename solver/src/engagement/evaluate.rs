@@ -1,0 +1,576 @@
+//! One candidate path end to end: contact at every sample from the chosen engine, the
+//! per-sample quantities and flags (engagement.md §5.4, §5.5, §5.10), the diagnostics of §9, and
+//! the per-flute results, recommendation and feed plan.
+
+use super::answer::{
+    ArcDetail, EngagementSample, GridInfo, PathEngagement, PostData, RouteData, SampleFlag,
+};
+use super::arcs::{self, Arc};
+use super::dots::{Contacts, DotGrid};
+use super::exact::ExactEngine;
+use super::request::{CandidateJob, Engine, Job, grid_extent};
+use super::segments::{Route, Station};
+use super::stock::{Base, Region};
+use super::teeth::tooth_sum;
+use super::{MAX_CONTACT_DOTS, feed, flutes};
+use crate::error::{SolverError, Warning};
+use crate::tool::{Tool, ToolKind};
+
+/// Engagement on the back half deeper than this (degrees) marks `back_contact` (§9 W_PLUNGE).
+const BACK_TOLERANCE_DEG: f64 = 1.0;
+/// Φ at or above this is full immersion (§9 W_FULL_IMMERSION).
+const FULL_IMMERSION_DEG: f64 = 179.9;
+/// Intervals or positions listed in one warning before "and N more".
+const LISTED: usize = 6;
+
+/// What an engine found at one station.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Contact {
+    pub arcs: Vec<Arc>,
+    pub plunge: bool,
+    pub collision: bool,
+}
+
+/// The dots engine's extras.
+struct DotsOutput {
+    grid: Option<GridInfo>,
+    scatter: Vec<[f64; 2]>,
+}
+
+fn first_cut(route: &Route, stations: &[Station], index: usize) -> bool {
+    let Some(station) = stations.get(index) else {
+        return false;
+    };
+    let rapid = |s: &Station| route.pieces.get(s.piece).is_some_and(|p| p.rapid);
+    !rapid(station) && (index == 0 || stations.get(index - 1).is_some_and(rapid))
+}
+
+fn run_exact(job: &Job, route: &Route, stations: &[Station]) -> Result<Vec<Contact>, SolverError> {
+    let mut engine = ExactEngine::default();
+    let mut contacts = Vec::with_capacity(stations.len());
+    for (index, station) in stations.iter().enumerate() {
+        let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
+        let arcs = engine.arcs(route, &job.region, job.radius, station)?;
+        let mut contact = Contact::default();
+        if rapid {
+            contact.collision = !arcs.is_empty();
+        } else {
+            if first_cut(route, stations, index) {
+                // Contact where the cut begins (the piece's start): the tool enters in material.
+                let start = Station {
+                    local: 0.0,
+                    s: station.s - station.local,
+                    centre: route
+                        .pieces
+                        .get(station.piece)
+                        .map_or(station.centre, |p| p.shape.start_point()),
+                    ..*station
+                };
+                contact.plunge = !engine
+                    .arcs(route, &job.region, job.radius, &start)?
+                    .is_empty();
+            }
+            contact.arcs = arcs;
+        }
+        contacts.push(contact);
+    }
+    Ok(contacts)
+}
+
+fn run_dots(
+    job: &Job,
+    route: &Route,
+    stations: &[Station],
+    cell: f64,
+) -> (Vec<Contact>, DotsOutput) {
+    let radius = job.radius;
+    let extent = job
+        .region
+        .bbox()
+        .and_then(|stock_box| grid_extent(route, stock_box, job.region.anchor(), radius, cell));
+    let Some((origin, width, height)) = extent else {
+        return (
+            vec![Contact::default(); stations.len()],
+            DotsOutput {
+                grid: None,
+                scatter: Vec::new(),
+            },
+        );
+    };
+    // The request check bounds width·height by MAX_GRID_DOTS.
+    let mut grid = DotGrid::new(&job.region, origin, cell, width as usize, height as usize);
+    let (width, height) = grid.size();
+    let info = GridInfo {
+        cell,
+        origin: [grid.origin().x, grid.origin().y],
+        width,
+        height,
+        bytes: grid.bytes(),
+    };
+    let mut contacts = Vec::with_capacity(stations.len());
+    let mut scatter = Vec::new();
+    let mut buffer = Contacts {
+        keep_angles: job.contact_dots,
+        ..Contacts::default()
+    };
+    let mut previous: Option<&Station> = None;
+    for station in stations {
+        let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
+        let mut contact = Contact::default();
+        if rapid {
+            contact.collision = grid.any_inside(station.centre, radius);
+            previous = None;
+        } else {
+            let step = previous.map_or(job.step, |p| station.s - p.s);
+            buffer.clear();
+            grid.remove(
+                station.centre,
+                previous.map(|p| p.centre),
+                radius,
+                &mut |dot| buffer.record(dot, station, radius, step, cell),
+            );
+            contact.plunge = previous.is_none() && buffer.touched();
+            if job.contact_dots {
+                let mut bins = [0_u64; 6];
+                for angle in &buffer.angles {
+                    let bin = (angle.floor() + 180.0).clamp(0.0, 359.0) as usize;
+                    bins[bin / 64] |= 1 << (bin % 64);
+                }
+                for bin in 0..360 {
+                    if bins[bin / 64] & (1 << (bin % 64)) != 0 {
+                        scatter.push([station.s, bin as f64 - 180.0 + 0.5]);
+                    }
+                }
+            }
+            contact.arcs = buffer.arcs(radius, cell, step);
+            previous = Some(station);
+        }
+        contacts.push(contact);
+    }
+    (
+        contacts,
+        DotsOutput {
+            grid: Some(info),
+            scatter,
+        },
+    )
+}
+
+/// "s = a–b, c–d, … (N in all)".
+fn list_intervals(intervals: &[[f64; 2]]) -> String {
+    let shown: Vec<String> = intervals
+        .iter()
+        .take(LISTED)
+        .map(|[a, b]| {
+            if (b - a).abs() < 1e-9 {
+                format!("{a:.3}")
+            } else {
+                format!("{a:.3}–{b:.3}")
+            }
+        })
+        .collect();
+    let more = intervals.len().saturating_sub(LISTED);
+    if more > 0 {
+        format!("s = {} and {more} more", shown.join(", "))
+    } else {
+        format!("s = {}", shown.join(", "))
+    }
+}
+
+/// Runs of consecutive samples where `test` holds, as [s_first, s_last].
+pub(crate) fn runs(samples: &[EngagementSample], test: impl Fn(usize) -> bool) -> Vec<[f64; 2]> {
+    let mut intervals: Vec<[f64; 2]> = Vec::new();
+    let mut open = false;
+    for (index, sample) in samples.iter().enumerate() {
+        if test(index) {
+            match intervals.last_mut() {
+                Some(last) if open => last[1] = sample.s,
+                _ => intervals.push([sample.s, sample.s]),
+            }
+            open = true;
+        } else {
+            open = false;
+        }
+    }
+    intervals
+}
+
+fn stock_description(region: &Region) -> String {
+    match &region.base {
+        Base::Polygons { rings, .. } => format!(
+            "stock: polygon rings {}, vertices {}",
+            rings.len(),
+            rings.iter().map(Vec::len).sum::<usize>()
+        ),
+        Base::Bitmap(bitmap) => format!(
+            "stock: bitmap {} x {} cells of {} mm",
+            bitmap.width, bitmap.height, bitmap.cell
+        ),
+    }
+}
+
+/// Evaluates one candidate path.
+pub(crate) fn evaluate(
+    job: &Job,
+    candidate: &CandidateJob,
+    tool: &Tool,
+) -> Result<PathEngagement, SolverError> {
+    let route = &candidate.route;
+    let radius = job.radius;
+    let stations = route.stations(job.step);
+    let (contacts, dots) = match (job.engine, job.grid) {
+        (Engine::Dots, Some(cell)) => {
+            let (contacts, output) = run_dots(job, route, &stations, cell);
+            (contacts, Some(output))
+        }
+        _ => (run_exact(job, route, &stations)?, None),
+    };
+
+    let time_flutes = job.tool_flutes;
+    let nominal_feed = job.feed_mode.feed(time_flutes, job.spindle_rpm);
+    let nominal_fz = job.feed_mode.feed_per_tooth(time_flutes, job.spindle_rpm);
+    let mut samples = Vec::with_capacity(stations.len());
+    let mut statistic = Vec::with_capacity(stations.len());
+    let mut warnings = job.stock_warnings.clone();
+    warnings.extend(candidate.warnings.iter().cloned());
+    let mut plunges = Vec::new();
+    let mut back = Vec::new();
+    let mut collisions = Vec::new();
+    for (index, (station, contact)) in stations.iter().zip(&contacts).enumerate() {
+        let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
+        let arcs = &contact.arcs;
+        let radial_depth = arcs::radial_depth(arcs, radius);
+        let mut flags = Vec::new();
+        let mut details = Vec::with_capacity(arcs.len());
+        let (mut burr, mut chipping) = (false, false);
+        for arc in arcs {
+            let ends = arcs::arc_ends(arc, job.direction);
+            burr |= ends.disengage >= job.burr_disengage;
+            chipping |= ends.disengage <= job.chipping_disengage;
+            details.push(ArcDetail {
+                entry_deg: ends.entry,
+                exit_deg: ends.exit,
+                engage_deg: ends.engage,
+                disengage_deg: ends.disengage,
+                entry_thickness_ratio: ends.entry_ratio,
+                exit_thickness_ratio: ends.exit_ratio,
+                mode: ends.mode,
+            });
+        }
+        if burr {
+            flags.push(SampleFlag::BurrRisk);
+        }
+        if chipping {
+            flags.push(SampleFlag::ChippingRisk);
+        }
+        if contact.plunge {
+            flags.push(SampleFlag::Plunge);
+            plunges.push([station.s, station.s]);
+        }
+        let behind = arcs
+            .iter()
+            .any(|a| a.from < -BACK_TOLERANCE_DEG || a.to > 180.0 + BACK_TOLERANCE_DEG);
+        if behind && !contact.plunge && index > 0 {
+            flags.push(SampleFlag::BackContact);
+            back.push(station.s);
+        }
+        if !arcs.is_empty() {
+            if job.radial_depth_max.is_some_and(|high| radial_depth > high) {
+                flags.push(SampleFlag::VibrationRisk);
+            }
+            if job.radial_depth_min.is_some_and(|low| radial_depth < low) {
+                flags.push(SampleFlag::RubbingRisk);
+            }
+        }
+        if rapid {
+            flags.push(SampleFlag::Rapid);
+        }
+        if contact.collision {
+            flags.push(SampleFlag::Collision);
+            collisions.push(station.s);
+        }
+        let sums: Vec<_> = job
+            .flute_counts
+            .iter()
+            .map(|&k| tooth_sum(arcs, k))
+            .collect();
+        statistic.push(index > 0 && !rapid && !arcs.is_empty() && !contact.plunge);
+        samples.push(EngagementSample {
+            s: station.s,
+            t: 60.0 * station.feed_s / nominal_feed,
+            position: [station.centre.x, station.centre.y],
+            heading_deg: station.tangent.y.atan2(station.tangent.x).to_degrees(),
+            segment: route.pieces.get(station.piece).map_or(0, |p| p.source),
+            arcs: arcs.iter().map(|a| [a.from, a.to]).collect(),
+            engaged_deg: arcs::engaged_deg(arcs),
+            radial_depth,
+            arc_details: details,
+            mean_chip_thickness: nominal_fz * arcs::mean_thickness_ratio(arcs),
+            thickness: job
+                .flute_counts
+                .iter()
+                .zip(&sums)
+                .map(|(&k, sum)| job.feed_mode.feed_per_tooth(k, job.spindle_rpm) * sum.ratio)
+                .collect(),
+            teeth: sums.iter().map(|sum| sum.teeth).collect(),
+            mrr: job
+                .axial_depth
+                .map(|depth| depth * radial_depth * nominal_feed),
+            flags,
+        });
+    }
+
+    // Diagnostics (engagement.md §9).
+    let engaged_intervals = runs(&samples, |i| {
+        !samples[i].arcs.is_empty() && !samples[i].flags.contains(&SampleFlag::Rapid)
+    });
+    if !statistic.iter().any(|s| *s) {
+        warnings.push(Warning::new(
+            "W_NO_CONTACT",
+            if engaged_intervals.is_empty() {
+                "no engagement: the tool never touches the stock along this path (check the stock and path coordinates); all series are zero"
+            } else {
+                "no engagement to evaluate: the tool touches the stock only where it plunges; the statistics are zero"
+            },
+        ));
+    }
+    if !plunges.is_empty() {
+        warnings.push(Warning::new(
+            "W_PLUNGE",
+            format!(
+                "the tool is already in material where it starts cutting at {}: a plunge (those samples are left out of the statistics)",
+                list_intervals(&plunges)
+            ),
+        ));
+    }
+    if !back.is_empty() {
+        let intervals = runs(&samples, |i| {
+            samples[i].flags.contains(&SampleFlag::BackContact)
+        });
+        warnings.push(Warning::new(
+            "W_PLUNGE",
+            format!(
+                "engagement on the back half of the tool (ramp, reversal into stock) at {}",
+                list_intervals(&intervals)
+            ),
+        ));
+    }
+    if !collisions.is_empty() {
+        let intervals = runs(&samples, |i| {
+            samples[i].flags.contains(&SampleFlag::Collision)
+        });
+        warnings.push(Warning::new(
+            "W_RAPID_COLLISION",
+            format!(
+                "a rapid passes through material at {}: at cutting depth this is a collision (the G-code program retracts to the clearance plane for rapids)",
+                list_intervals(&intervals)
+            ),
+        ));
+    }
+    let immersion = runs(&samples, |i| samples[i].engaged_deg >= FULL_IMMERSION_DEG);
+    if !immersion.is_empty() {
+        warnings.push(Warning::new(
+            "W_FULL_IMMERSION",
+            format!(
+                "full immersion (slotting, Φ ≥ {FULL_IMMERSION_DEG}°) at {}",
+                list_intervals(&immersion)
+            ),
+        ));
+    }
+    let multi_arc = runs(&samples, |i| samples[i].arcs.len() >= 2);
+    if !multi_arc.is_empty() {
+        warnings.push(Warning::new(
+            "W_MULTI_ARC",
+            format!(
+                "two or more separate contact zones at {}",
+                list_intervals(&multi_arc)
+            ),
+        ));
+    }
+    if let Some(threshold) = job.spike_threshold {
+        let spikes = runs(&samples, |i| {
+            i > 0 && statistic[i] && statistic[i - 1] && {
+                let jump = (samples[i].engaged_deg - samples[i - 1].engaged_deg).abs();
+                jump > threshold
+            }
+        });
+        if !spikes.is_empty() {
+            warnings.push(Warning::new(
+                "W_ENGAGEMENT_SPIKE",
+                format!(
+                    "the engaged angle jumps by more than {threshold}° between samples at {} (inside corners: consider a fillet, a feed reduction or trochoidal clearing)",
+                    list_intervals(&spikes)
+                ),
+            ));
+        }
+    }
+    let vertices: Vec<String> = route
+        .pieces
+        .windows(2)
+        .filter_map(|pair| {
+            let out = pair[0].shape.tangent(pair[0].shape.length());
+            let into = pair[1].shape.tangent(0.0);
+            let turn = (out.x * into.y - out.y * into.x)
+                .atan2(out.dot(&into))
+                .to_degrees();
+            (turn.abs() > 1.0).then(|| format!("s = {:.3} ({turn:+.1}°)", pair[0].end_s()))
+        })
+        .collect();
+    if !vertices.is_empty() {
+        let more = vertices.len().saturating_sub(LISTED);
+        warnings.push(Warning::new(
+            "W_VERTEX",
+            format!(
+                "{} path vertices turn by more than 1°, each evaluated in the incoming direction: {}{}",
+                vertices.len(),
+                vertices.iter().take(LISTED).cloned().collect::<Vec<_>>().join(", "),
+                if more > 0 { format!(" and {more} more") } else { String::new() }
+            ),
+        ));
+    }
+    if let (Engine::Dots, Some(cell)) = (job.engine, job.grid) {
+        let step = job.step;
+        let mut notes = Vec::new();
+        if step < 4.0 * cell {
+            notes.push(format!(
+                "step {step} mm is below 4 × grid ({} mm): sampling gaps",
+                4.0 * cell
+            ));
+        }
+        if radius / cell < 50.0 {
+            notes.push(format!(
+                "R/grid = {:.1} is below 50: angles near 0°/180° resolve only to about {:.1}°",
+                radius / cell,
+                (1.0 - 2.0 * cell / radius)
+                    .clamp(-1.0, 1.0)
+                    .acos()
+                    .to_degrees()
+            ));
+        }
+        if step > radius / 10.0 {
+            notes.push(format!(
+                "step {step} mm is above R/10 ({} mm): coarse in time",
+                radius / 10.0
+            ));
+        }
+        if !notes.is_empty() {
+            warnings.push(Warning::new(
+                "W_RESOLUTION",
+                format!(
+                    "dots engine at grid {cell} mm, step {step} mm: {}",
+                    notes.join("; ")
+                ),
+            ));
+        }
+        if let Base::Polygons { rings, .. } = &job.region.base {
+            let short = rings
+                .iter()
+                .flat_map(|ring| ring.iter().zip(ring.iter().cycle().skip(1)))
+                .filter(|(a, b)| (*b - *a).norm() < 2.0 * cell)
+                .count();
+            if short > 0 {
+                warnings.push(Warning::new(
+                    "W_THIN_FEATURE",
+                    format!("{short} stock edge(s) are shorter than 2 × grid ({} mm): features that small blur or vanish in the dots", 2.0 * cell),
+                ));
+            }
+        }
+    }
+
+    let (flute_results, recommended, flute_warnings) =
+        flutes::results(job, &samples, &statistic, route.feed_length);
+    warnings.extend(flute_warnings);
+    let feed_plan = job
+        .plan
+        .as_ref()
+        .map(|plan| feed::plan(job, plan, route, &stations, &contacts));
+
+    let (max_engaged_deg, max_engaged_at_s) = samples
+        .iter()
+        .zip(&statistic)
+        .filter(|(_, s)| **s)
+        .map(|(sample, _)| (sample.engaged_deg, sample.s))
+        .fold(
+            (0.0, 0.0),
+            |best, (phi, s)| if phi > best.0 { (phi, s) } else { best },
+        );
+    let max_radial_depth = samples
+        .iter()
+        .zip(&statistic)
+        .filter(|(_, s)| **s)
+        .map(|(sample, _)| sample.radial_depth)
+        .fold(0.0, f64::max);
+    let (contact_dots, grid) = match dots {
+        Some(output) => {
+            let mut scatter = output.scatter;
+            if scatter.len() > MAX_CONTACT_DOTS {
+                let stride = scatter.len().div_ceil(MAX_CONTACT_DOTS);
+                warnings.push(Warning::new(
+                    "W_CONTACT_DOTS_DECIMATED",
+                    format!(
+                        "{} contact dots exceed the limit of {MAX_CONTACT_DOTS}: every {stride}th is returned",
+                        scatter.len()
+                    ),
+                ));
+                scatter = scatter.into_iter().step_by(stride).collect();
+            }
+            (job.contact_dots.then_some(scatter), output.grid)
+        }
+        None => (None, None),
+    };
+    let centre_height = match tool.kind {
+        ToolKind::Ball => tool.radius,
+        ToolKind::Bull => tool.corner_radius.unwrap_or(0.0),
+        ToolKind::Flat => 0.0,
+    };
+    let description = vec![
+        format!(
+            "engagement path{}: L {:.3} mm, feed length {:.3} mm",
+            candidate
+                .name
+                .as_ref()
+                .map(|n| format!(" {n}"))
+                .unwrap_or_default(),
+            route.length,
+            route.feed_length
+        ),
+        stock_description(&job.region),
+        format!(
+            "tool R {} mm, {} flutes, S {} rpm",
+            tool.radius, tool.flutes, job.spindle_rpm
+        ),
+    ];
+    Ok(PathEngagement {
+        name: candidate.name.clone(),
+        max_mrr: job
+            .axial_depth
+            .map(|depth| depth * max_radial_depth * nominal_feed),
+        samples,
+        flutes: flute_results,
+        recommended,
+        path_length: route.length,
+        feed_length: route.feed_length,
+        time_flute_count: time_flutes,
+        engine: job.engine,
+        step: job.step,
+        grid,
+        engaged_intervals,
+        max_engaged_deg,
+        max_engaged_at_s,
+        max_radial_depth,
+        contact_dots,
+        feed_plan,
+        warnings,
+        post: PostData {
+            route: RouteData(route.clone()),
+            nominal_feed,
+            spindle_rpm: job.spindle_rpm,
+            axial_depth: job.axial_depth,
+            stock_top_z: job.stock_top_z,
+            clearance: job.clearance,
+            tool_radius: tool.radius,
+            centre_height,
+            description,
+        },
+    })
+}

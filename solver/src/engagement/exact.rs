@@ -1,0 +1,101 @@
+//! Engine B, the exact boundary test (engagement.md §5.3.3): at each sample, the part of the
+//! tool circle that lies in the stock and at least R from the path travelled so far.
+//!
+//! Instead of stepping θ on a grid and bisecting, the circle is split where it crosses any
+//! boundary that can change the answer: the stock outline (or bitmap cell edges, or the edge of
+//! an earlier cut) and the R-offsets of the nearby travelled pieces (offset lines or circles and
+//! the end circles). Between two consecutive crossings membership cannot change, so one test at
+//! the middle decides the whole sub-arc and the arc ends are exact, with no δθ.
+
+use std::f64::consts::PI;
+
+use super::P2;
+use super::arcs::{Arc, normalise};
+use super::segments::{Route, Shape, Station};
+use super::stock::{REACH_TOLERANCE, Region};
+use crate::error::SolverError;
+
+/// Boundary and distance tests allowed per path before the engine gives up (a hang guard for
+/// pathological stock outlines; tens of seconds of work, far above real jobs).
+pub(crate) const MAX_TESTS: u64 = 4_000_000_000;
+
+/// Reusable buffers and the work counter.
+#[derive(Debug, Default)]
+pub(crate) struct ExactEngine {
+    pieces: Vec<Shape>,
+    angles: Vec<f64>,
+    tests: u64,
+}
+
+impl ExactEngine {
+    /// The engaged arcs at `station` (§5.3.1) for a tool of `radius`.
+    pub(crate) fn arcs(
+        &mut self,
+        route: &Route,
+        region: &Region,
+        radius: f64,
+        station: &Station,
+    ) -> Result<Vec<Arc>, SolverError> {
+        let centre = station.centre;
+        let forward = station.tangent;
+        let right = P2::new(forward.y, -forward.x);
+        route.swept_before(station, 2.0 * radius, &mut self.pieces);
+        self.angles.clear();
+        for piece in &self.pieces {
+            piece.crossings(radius, centre, radius, &mut self.angles);
+        }
+        region.crossings(centre, radius, &mut self.angles);
+        // Global polar angle γ ↦ tool angle θ = γ − angle of the right-hand normal (§4.1).
+        let right_angle = right.y.atan2(right.x);
+        for angle in &mut self.angles {
+            *angle = wrap_rad(*angle - right_angle);
+        }
+        self.angles.extend([-PI, -PI / 2.0, 0.0, PI / 2.0]);
+        self.angles.sort_by(f64::total_cmp);
+        self.angles.dedup_by(|a, b| (*a - *b).abs() <= 1e-13);
+        self.tests += (self.angles.len() * (self.pieces.len() + 1)) as u64;
+        self.check_budget()?;
+        let limit = radius * (1.0 - REACH_TOLERANCE);
+        let mut arcs = Vec::new();
+        let count = self.angles.len();
+        for index in 0..count {
+            let low = self.angles[index];
+            let high = self.angles.get(index + 1).copied().unwrap_or(PI);
+            if high - low <= 0.0 {
+                continue;
+            }
+            let middle = 0.5 * (low + high);
+            let q = centre + radius * (middle.cos() * right + middle.sin() * forward);
+            let engaged = self.pieces.iter().all(|piece| piece.distance(q) >= limit)
+                && region.contains(q, &mut self.tests);
+            if engaged {
+                arcs.push(Arc {
+                    from: low.to_degrees(),
+                    to: high.to_degrees(),
+                });
+            }
+        }
+        self.check_budget()?;
+        Ok(normalise(&arcs))
+    }
+
+    /// Refuses once the work limit is spent.
+    fn check_budget(&self) -> Result<(), SolverError> {
+        if self.tests > MAX_TESTS {
+            return Err(SolverError::new(
+                "E_WORK_LIMIT",
+                format!(
+                    "the exact engine exceeded its limit of {MAX_TESTS} boundary tests: use a larger step or a simpler stock"
+                ),
+            )
+            .at("step"));
+        }
+        Ok(())
+    }
+}
+
+/// Wraps radians into [−π, π).
+fn wrap_rad(angle: f64) -> f64 {
+    let wrapped = (angle + PI).rem_euclid(2.0 * PI) - PI;
+    if wrapped >= PI { -PI } else { wrapped }
+}

@@ -1,0 +1,171 @@
+//! The feed that holds a target chip thickness along the path (chip-thinning compensation,
+//! engagement.md §11 item 3), capped by the machine's feed, as blocks of one feed each.
+//!
+//! At every sample the feed per tooth that makes the thickest chip equal to h* is
+//! f_z' = h*/max sin θ (basis `tooth`) or h*_Σ/(H_k/f_z) (basis `sum`); the feed of the stretch
+//! between two samples is the lower of its two ends, and a block keeps the lowest feed of its
+//! stretches, so the chip never exceeds the target at any sample.
+
+use super::answer::{FeedBlock, FeedLimit, FeedPlan};
+use super::arcs::peak_thickness_ratio;
+use super::evaluate::Contact;
+use super::request::{FeedBasis, Job, PlanJob};
+use super::segments::{Route, Station};
+use super::teeth::tooth_sum;
+
+/// Feed needed at one sample, mm/min, and whether the machine cap set it.
+fn needed(job: &Job, plan: &PlanJob, contact: &Contact) -> (f64, bool) {
+    let ratio = match plan.basis {
+        FeedBasis::Tooth => peak_thickness_ratio(&contact.arcs),
+        FeedBasis::Sum => tooth_sum(&contact.arcs, plan.flute_count).ratio,
+    };
+    let per_tooth = if ratio > 1e-12 {
+        plan.target / ratio
+    } else {
+        f64::INFINITY
+    };
+    let feed = f64::from(plan.flute_count) * job.spindle_rpm * per_tooth;
+    if feed >= plan.max_feed {
+        (plan.max_feed, true)
+    } else {
+        (feed, false)
+    }
+}
+
+/// A stretch between consecutive samples.
+#[derive(Debug, Clone, Copy)]
+struct Stretch {
+    piece: usize,
+    from_s: f64,
+    to_s: f64,
+    /// Feed and cap flag; `None` on a rapid.
+    feed: Option<(f64, bool)>,
+}
+
+/// Rounds a feed down to whole mm/min (never below 1).
+fn whole(feed: f64) -> f64 {
+    feed.floor().max(1.0)
+}
+
+/// The feed plan for one path.
+pub(crate) fn plan(
+    job: &Job,
+    plan: &PlanJob,
+    route: &Route,
+    stations: &[Station],
+    contacts: &[Contact],
+) -> FeedPlan {
+    let feeds: Vec<Option<(f64, bool)>> = stations
+        .iter()
+        .zip(contacts)
+        .map(|(station, contact)| {
+            let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
+            (!rapid).then(|| needed(job, plan, contact))
+        })
+        .collect();
+    let mut stretches = Vec::new();
+    for index in 1..stations.len() {
+        let (before, here) = (&stations[index - 1], &stations[index]);
+        if here.s - before.s <= 0.0 {
+            continue;
+        }
+        let feed = match (feeds[index - 1], feeds[index]) {
+            (_, None) => None,
+            (None, Some(f)) => Some(f),
+            (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
+        };
+        stretches.push(Stretch {
+            piece: here.piece,
+            from_s: before.s,
+            to_s: here.s,
+            feed,
+        });
+    }
+
+    // Group stretches of one piece whose feeds lie within the tolerance band.
+    let mut blocks: Vec<(Stretch, f64)> = Vec::new();
+    for stretch in stretches {
+        if let Some((block, highest)) = blocks.last_mut()
+            && block.piece == stretch.piece
+        {
+            match (block.feed, stretch.feed) {
+                (None, None) => {
+                    block.to_s = stretch.to_s;
+                    continue;
+                }
+                (Some(low), Some(feed)) => {
+                    let new_low = if feed.0 < low.0 { feed } else { low };
+                    let new_high = highest.max(feed.0);
+                    if new_high <= new_low.0 * (1.0 + plan.tolerance) {
+                        block.feed = Some(new_low);
+                        block.to_s = stretch.to_s;
+                        *highest = new_high;
+                        continue;
+                    }
+                }
+                _ => {}
+            }
+        }
+        let high = stretch.feed.map_or(0.0, |f| f.0);
+        blocks.push((stretch, high));
+    }
+
+    // Merge blocks shorter than the minimum into their neighbour, at the lower feed.
+    let mut merged: Vec<Stretch> = Vec::with_capacity(blocks.len());
+    for (block, _) in blocks {
+        if let Some(last) = merged.last_mut()
+            && last.piece == block.piece
+            && last.feed.is_some() == block.feed.is_some()
+            && (last.to_s - last.from_s < plan.min_block_length
+                || block.to_s - block.from_s < plan.min_block_length)
+        {
+            last.to_s = block.to_s;
+            last.feed = match (last.feed, block.feed) {
+                (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
+                _ => None,
+            };
+            continue;
+        }
+        merged.push(block);
+    }
+
+    let mut time_s = 0.0;
+    let mut range = [f64::INFINITY, 0.0_f64];
+    let blocks: Vec<FeedBlock> = merged
+        .iter()
+        .map(|block| {
+            let feed = block.feed.map(|(f, _)| whole(f));
+            if let Some(f) = feed {
+                time_s += 60.0 * (block.to_s - block.from_s) / f;
+                range = [range[0].min(f), range[1].max(f)];
+            }
+            FeedBlock {
+                segment: route.pieces.get(block.piece).map_or(0, |p| p.source),
+                from_s: block.from_s,
+                to_s: block.to_s,
+                feed,
+                limited_by: block.feed.map(|(_, capped)| {
+                    if capped {
+                        FeedLimit::Machine
+                    } else {
+                        FeedLimit::Thickness
+                    }
+                }),
+            }
+        })
+        .collect();
+    if !range[0].is_finite() {
+        range = [0.0, 0.0];
+    }
+    FeedPlan {
+        flute_count: plan.flute_count,
+        target_thickness: plan.target,
+        basis: plan.basis,
+        max_feed: plan.max_feed,
+        blocks,
+        time_s,
+        nominal_time_s: 60.0 * route.feed_length
+            / job.feed_mode.feed(plan.flute_count, job.spindle_rpm),
+        feed_range: range,
+    }
+}

@@ -1,0 +1,188 @@
+//! Per flute count: representative values of H_k (engagement.md §5.7), machining time (§5.8),
+//! multi-tooth intervals, and the recommendation under the two limits (§5.9).
+
+use super::answer::{EngagementSample, FluteResult};
+use super::evaluate::runs;
+use super::request::{FeedMode, Job, Representative};
+use crate::error::Warning;
+
+/// Relative slack of the limit comparisons, so a value equal to its limit passes.
+const LIMIT_SLACK: f64 = 1e-9;
+
+/// Max, min, length-weighted mean and median of `values` with weights `weights`.
+fn statistics(values: &[f64], weights: &[f64]) -> (f64, f64, f64, f64) {
+    if values.is_empty() {
+        return (0.0, 0.0, 0.0, 0.0);
+    }
+    let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let total: f64 = weights.iter().sum();
+    let mean = if total > 0.0 {
+        values.iter().zip(weights).map(|(v, w)| v * w).sum::<f64>() / total
+    } else {
+        values.iter().sum::<f64>() / values.len() as f64
+    };
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let middle = sorted.len() / 2;
+    let median = if sorted.len() % 2 == 1 {
+        sorted[middle]
+    } else {
+        0.5 * (sorted[middle - 1] + sorted[middle])
+    };
+    (max, min, mean.clamp(min, max), median)
+}
+
+/// The flute results, the recommended counts (fastest first) and the warnings of §9
+/// (`W_MULTI_TOOTH`, `W_TINY_FZ`, `W_NO_RECOMMENDATION`, `W_THRESHOLD_MISSING`).
+pub(crate) fn results(
+    job: &Job,
+    samples: &[EngagementSample],
+    statistic: &[bool],
+    feed_length: f64,
+) -> (Vec<FluteResult>, Vec<u32>, Vec<Warning>) {
+    let mut warnings = Vec::new();
+    let weights: Vec<f64> = samples
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| statistic.get(*i).copied().unwrap_or(false))
+        .map(|(i, sample)| sample.s - samples.get(i.wrapping_sub(1)).map_or(sample.s, |p| p.s))
+        .collect();
+    let mut results = Vec::with_capacity(job.flute_counts.len());
+    let mut failures = Vec::new();
+    for (column, &k) in job.flute_counts.iter().enumerate() {
+        let values: Vec<f64> = samples
+            .iter()
+            .zip(statistic)
+            .filter(|(_, s)| **s)
+            .map(|(sample, _)| sample.thickness.get(column).copied().unwrap_or(0.0))
+            .collect();
+        let (max, min, mean, median) = statistics(&values, &weights);
+        let feed_per_tooth = job.feed_mode.feed_per_tooth(k, job.spindle_rpm);
+        let feed = job.feed_mode.feed(k, job.spindle_rpm);
+        let time_s = 60.0 * feed_length / feed;
+        let representative = match job.representative {
+            Representative::Max => max,
+            Representative::Mean => mean,
+            Representative::Median => median,
+        };
+        let thickness_margin = job.thickness_limit.map(|limit| limit - representative);
+        let time_margin_s = job.time_limit.map(|limit| limit - time_s);
+        let thickness_ok = job
+            .thickness_limit
+            .is_none_or(|limit| representative <= limit * (1.0 + LIMIT_SLACK));
+        let time_ok = job
+            .time_limit
+            .is_none_or(|limit| time_s <= limit * (1.0 + LIMIT_SLACK));
+        let recommended =
+            (job.thickness_limit.is_some() || job.time_limit.is_some()) && thickness_ok && time_ok;
+        let mut reasons = Vec::new();
+        if let (false, Some(limit)) = (thickness_ok, job.thickness_limit) {
+            reasons.push(format!("thickness {representative:.6} mm > {limit} mm"));
+        }
+        if let (false, Some(limit)) = (time_ok, job.time_limit) {
+            reasons.push(format!("time {time_s:.4} s > {limit} s"));
+        }
+        if !reasons.is_empty() {
+            failures.push(format!("k = {k}: {}", reasons.join(", ")));
+        }
+        let multi_tooth_intervals = runs(samples, |i| {
+            statistic.get(i).copied().unwrap_or(false)
+                && samples
+                    .get(i)
+                    .and_then(|s| s.teeth.get(column))
+                    .is_some_and(|n| *n >= 2)
+        });
+        if !multi_tooth_intervals.is_empty() {
+            warnings.push(Warning::new(
+                "W_MULTI_TOOTH",
+                format!(
+                    "k = {k}: two or more teeth cut at once over {} interval(s), first at s = {:.3}",
+                    multi_tooth_intervals.len(),
+                    multi_tooth_intervals.first().map_or(0.0, |i| i[0])
+                ),
+            ));
+        }
+        if let (FeedMode::Rate(_), Some(minimum)) = (job.feed_mode, job.min_feed_per_tooth)
+            && feed_per_tooth < minimum
+        {
+            warnings.push(Warning::new(
+                "W_TINY_FZ",
+                format!("k = {k}: the feed per tooth {feed_per_tooth:.6} mm is below {minimum} mm (rubbing)"),
+            ));
+        }
+        let max_teeth = samples
+            .iter()
+            .zip(statistic)
+            .filter(|(_, s)| **s)
+            .filter_map(|(sample, _)| sample.teeth.get(column).copied())
+            .max()
+            .unwrap_or(0);
+        results.push(FluteResult {
+            flute_count: k,
+            feed_per_tooth,
+            feed,
+            max_thickness: max,
+            mean_thickness: mean,
+            min_thickness: min,
+            median_thickness: median,
+            time_s,
+            recommended,
+            thickness_margin,
+            time_margin_s,
+            max_teeth,
+            multi_tooth_intervals,
+        });
+    }
+    let mut recommended: Vec<(f64, u32)> = results
+        .iter()
+        .filter(|r| r.recommended)
+        .map(|r| (r.time_s, r.flute_count))
+        .collect();
+    recommended.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    match (job.thickness_limit, job.time_limit) {
+        (None, None) => warnings.push(Warning::new(
+            "W_THRESHOLD_MISSING",
+            "neither thickness_limit nor time_limit is given: no flute count is recommended",
+        )),
+        (None, Some(_)) => warnings.push(Warning::new(
+            "W_THRESHOLD_MISSING",
+            "thickness_limit is not given: flute counts are recommended on time alone",
+        )),
+        (Some(_), None) => warnings.push(Warning::new(
+            "W_THRESHOLD_MISSING",
+            "time_limit_s is not given: flute counts are recommended on chip thickness alone",
+        )),
+        (Some(_), Some(_)) => {}
+    }
+    if recommended.is_empty() && (job.thickness_limit.is_some() || job.time_limit.is_some()) {
+        warnings.push(Warning::new(
+            "W_NO_RECOMMENDATION",
+            format!(
+                "no flute count satisfies the limits: {}",
+                failures.join("; ")
+            ),
+        ));
+    }
+    (
+        results,
+        recommended.into_iter().map(|(_, k)| k).collect(),
+        warnings,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::statistics;
+
+    #[test]
+    fn weighted_statistics() {
+        let (max, min, mean, median) = statistics(&[1.0, 3.0, 2.0, 10.0], &[1.0, 1.0, 1.0, 1.0]);
+        assert_eq!((max, min, median), (10.0, 1.0, 2.5));
+        assert!((mean - 4.0).abs() < 1e-12);
+        let (_, _, weighted, odd_median) = statistics(&[1.0, 3.0, 2.0], &[2.0, 1.0, 1.0]);
+        assert!((weighted - 7.0 / 4.0).abs() < 1e-12);
+        assert_eq!(odd_median, 2.0);
+        assert_eq!(statistics(&[], &[]), (0.0, 0.0, 0.0, 0.0));
+    }
+}

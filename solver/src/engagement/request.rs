@@ -1,0 +1,1145 @@
+//! The engagement request as clients send it (api.md, Engagement; engagement.md §2) and its
+//! validation into a `Job` before any heavy work (§9 `E_INPUT`, `E_PATH`, and the size limits).
+
+use std::fmt;
+
+use serde::de::{self, MapAccess, SeqAccess, Visitor};
+use serde::{Deserialize, Deserializer, Serialize};
+
+use super::arcs::SpindleDirection;
+use super::bbox_tree::BBox;
+use super::polygon::{EdgeSet, twice_signed_area};
+use super::segments::{Route, Shape};
+use super::stock::{Base, Bitmap, Cut, Region, decode_base64};
+use super::{
+    DEFAULT_BURR_DISENGAGE_DEG, DEFAULT_CHIPPING_DISENGAGE_DEG, MAX_CANDIDATES, MAX_CHORDS,
+    MAX_DOT_ROWS, MAX_FLUTES, MAX_GRID_DOTS, MAX_SAMPLES, MAX_SEGMENTS, MAX_STOCK_VERTICES, P2,
+};
+use crate::error::{SolverError, Warning, finite, non_negative, positive};
+use crate::tool::{Tool, ToolRef};
+
+/// Direction of a circular segment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum ArcDirection {
+    /// Counter-clockwise seen from +Z (G3).
+    Ccw,
+    /// Clockwise (G2).
+    Cw,
+}
+
+/// One move of a path given as `start` + `segments` (engagement.md §2.3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum SegmentInput {
+    /// Straight move to `to` (G1; G0 when `rapid`).
+    Line {
+        /// End point [x, y], mm.
+        to: [f64; 2],
+        /// A positioning move (G0): it does not cut and is not timed; touching material is
+        /// reported as a collision (engagement.md §5.8).
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        rapid: bool,
+    },
+    /// Circular move to `to` about `center` (G2 `cw` / G3 `ccw`); `to` equal to the start point
+    /// makes a full circle.
+    Arc {
+        /// End point [x, y], mm.
+        to: [f64; 2],
+        /// Arc centre [x, y], mm; its distances to the start and end points must agree within
+        /// 1e-6·r.
+        #[serde(alias = "centre")]
+        center: [f64; 2],
+        /// `ccw` (G3) or `cw` (G2).
+        #[serde(alias = "direction")]
+        dir: ArcDirection,
+    },
+}
+
+/// A path given as a start point and line/arc segments.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct PathSegments {
+    /// Start point of the tool centre [x, y], mm (required).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start: Option<[f64; 2]>,
+    /// The moves in order (required, at least one of non-zero length).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub segments: Option<Vec<SegmentInput>>,
+}
+
+/// A tool-centre path in the plane of the stock: a list of points joined by feed moves
+/// (`[[x, y], ...]`, as in api.md), or `{"start": [x, y], "segments": [...]}` with lines, arcs
+/// and rapids.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(untagged)]
+pub enum PathInput {
+    /// Feed moves (G1) through the points in order.
+    Points(Vec<[f64; 2]>),
+    /// Start point and line/arc segments.
+    Segments(PathSegments),
+}
+
+// Hand-written so that a bad segment reports its own error instead of serde's "did not match
+// any variant"; a future `{"gcode": "..."}` form is one more field of the map form.
+impl<'de> Deserialize<'de> for PathInput {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct PathVisitor;
+
+        impl<'de> Visitor<'de> for PathVisitor {
+            type Value = PathInput;
+
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(
+                    "a list of points [[x, y], ...] or {\"start\": [x, y], \"segments\": [...]}",
+                )
+            }
+
+            fn visit_seq<S: SeqAccess<'de>>(self, seq: S) -> Result<PathInput, S::Error> {
+                Vec::<[f64; 2]>::deserialize(de::value::SeqAccessDeserializer::new(seq))
+                    .map(PathInput::Points)
+            }
+
+            fn visit_map<M: MapAccess<'de>>(self, map: M) -> Result<PathInput, M::Error> {
+                PathSegments::deserialize(de::value::MapAccessDeserializer::new(map))
+                    .map(PathInput::Segments)
+            }
+        }
+
+        deserializer.deserialize_any(PathVisitor)
+    }
+}
+
+/// One candidate path of a comparison.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct Candidate {
+    /// Label shown beside the results (e.g. `straight`, `two bends`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// The tool-centre path.
+    pub path: PathInput,
+}
+
+/// One region of a polygon stock.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct StockPolygon {
+    /// Label (not used in the computation).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Outline [[x, y], ...], either orientation; the last point need not repeat the first.
+    pub outer: Vec<[f64; 2]>,
+    /// Holes, each a ring like `outer`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub holes: Vec<Vec<[f64; 2]>>,
+}
+
+/// A raster stock (engagement.md §2.2): cell (i, j) covers [x0 + i·cell, x0 + (i+1)·cell) ×
+/// [y0 + j·cell, ...).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct StockBitmap {
+    /// Corner [x0, y0] of cell (0, 0), mm.
+    pub origin: [f64; 2],
+    /// Cell side, mm.
+    pub cell: f64,
+    /// Cells per row.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// Base64 of the bits, row-major from row 0 (at y0) upwards, bit (i, j) = bit number
+    /// j·width + i, most significant bit of each byte first, rows not padded; 1 = material.
+    pub data: String,
+}
+
+/// Material already removed before this operation: everything within `radius` of `path`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct PreviousCut {
+    /// Tool-centre path of the earlier operation (rapid segments do not cut).
+    pub path: PathInput,
+    /// Cutter radius of the earlier operation, mm.
+    pub radius: f64,
+}
+
+/// The plan-view material W₀: give exactly one of `polygon` (with optional `holes`),
+/// `polygons` or `bitmap`; `previous_cuts` remove material from it (the stock left by earlier
+/// paths). Polygons use the even-odd rule with the boundary inclusive and must not cross.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct Stock {
+    /// One outline [[x, y], ...] (api.md form).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polygon: Option<Vec<[f64; 2]>>,
+    /// Holes of `polygon`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub holes: Vec<Vec<[f64; 2]>>,
+    /// Several regions, each an outline with holes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polygons: Option<Vec<StockPolygon>>,
+    /// A raster of material cells.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bitmap: Option<StockBitmap>,
+    /// Earlier cuts whose removed material is no longer there.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub previous_cuts: Vec<PreviousCut>,
+}
+
+/// Contact engine (engagement.md §5.3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Engine {
+    /// Engine B: the continuum definition evaluated against the real path and stock boundaries,
+    /// with arc ends computed exactly (default; for numbers).
+    #[default]
+    Exact,
+    /// Engine A, the seed's method: a grid of workpiece dots removed by the moving circle; also
+    /// returns the contact dots for the scatter plot.
+    Dots,
+}
+
+/// Statistic of H_k compared with `thickness_limit` (engagement.md §5.7).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Representative {
+    /// Largest summed chip thickness (default; the seed's).
+    #[default]
+    Max,
+    /// Length-weighted mean over the engaged samples.
+    Mean,
+    /// Median over the engaged samples.
+    Median,
+}
+
+/// What the chip-thinning compensation holds at the target (engagement.md §11 item 3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum FeedBasis {
+    /// The thickest chip of one tooth: f_z' = h* / max sin θ over the engaged arcs (default).
+    #[default]
+    Tooth,
+    /// The summed thickness of all teeth in the cut (torque proxy): f_z' = h*_Σ / (H_k/f_z).
+    Sum,
+}
+
+/// Ask for the feed that holds a target chip thickness along the path (engagement.md §11 item 3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct FeedPlanRequest {
+    /// h*: the chip thickness to hold, mm (per tooth, or summed with `basis: sum`).
+    pub target_thickness: f64,
+    /// Highest programmable feed, mm/min. Required unless the request names a `machine`, whose
+    /// `max_feed` the server puts here.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_feed: Option<f64>,
+    /// Flute count of the cutter that runs the program (default: the tool's `flutes`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flute_count: Option<u32>,
+    /// `tooth` (default) or `sum`.
+    #[serde(default)]
+    pub basis: FeedBasis,
+    /// Largest relative feed spread inside one feed block before a new F word starts
+    /// (default 0.05: blocks use the lowest feed they need, at most 5 % below the rest).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
+    /// Shortest feed block, mm (default 0.5): shorter blocks merge into a neighbour at the lower
+    /// feed, so the control is not starved of blocks.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_block_length: Option<f64>,
+}
+
+/// `POST /api/v1/engagement`: tool/workpiece contact along one path (`path`) or several
+/// candidate paths compared side by side (`paths`), chip thickness per flute count, machining
+/// time and the recommended flute counts (engagement.md).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct EngagementRequest {
+    /// A registered tool number or an inline tool; only its radius (the apparent rotation
+    /// circle) and `flutes` enter the 2-D model.
+    pub tool: ToolRef,
+    /// The plan-view material.
+    pub stock: Stock,
+    /// The tool-centre path (give this or `paths`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path: Option<PathInput>,
+    /// Several candidate paths for the same stock and tool, evaluated independently (give this
+    /// or `path`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub paths: Option<Vec<Candidate>>,
+    /// Spindle speed N, rpm.
+    pub spindle_rpm: f64,
+    /// Feed per tooth f_z, mm/tooth, kept for every flute count (constant f_z: V_f = k·f_z·N).
+    /// Give this or `feed`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feed_per_tooth: Option<f64>,
+    /// Feed rate V_f, mm/min, kept for every flute count (constant V_f: f_z = V_f/(k·N)).
+    /// Give this or `feed_per_tooth`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feed: Option<f64>,
+    /// Candidate flute counts k (1–32, distinct; default: the tool's `flutes`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flute_counts: Option<Vec<u32>>,
+    /// T1: upper limit on the representative summed chip thickness, mm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness_limit: Option<f64>,
+    /// T2: upper limit on the machining time, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_limit_s: Option<f64>,
+    /// Statistic compared with T1: `max` (default), `mean` or `median`.
+    #[serde(default)]
+    pub representative: Representative,
+    /// `cw` (default, M03) or `ccw`.
+    #[serde(default)]
+    pub spindle_direction: SpindleDirection,
+    /// `exact` (default) or `dots`.
+    #[serde(default)]
+    pub engine: Engine,
+    /// Δs, the sample spacing along the path, mm (default: tool diameter / 50).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step: Option<f64>,
+    /// g, the dot spacing of the `dots` engine, mm (default: tool diameter / 200, or the bitmap
+    /// cell for a bitmap stock).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grid: Option<f64>,
+    /// ψ_B: an exit whose disengage angle ψ is at least this is flagged `burr_risk` (default 80°).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub burr_disengage_deg: Option<f64>,
+    /// ψ_C: an exit whose disengage angle ψ is at most this is flagged `chipping_risk` (default 20°).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub chipping_disengage_deg: Option<f64>,
+    /// a_e below this is flagged `rubbing_risk`, mm (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radial_depth_min: Option<f64>,
+    /// a_e above this is flagged `vibration_risk`, mm (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radial_depth_max: Option<f64>,
+    /// Report `W_ENGAGEMENT_SPIKE` where the engaged angle jumps by more than this between
+    /// samples, degrees (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spike_threshold_deg: Option<f64>,
+    /// Report `W_TINY_FZ` for flute counts whose feed per tooth falls below this, mm (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_feed_per_tooth: Option<f64>,
+    /// a_p, the axial depth of cut, mm: gives the removal rate (MRR) and the cutting Z of the
+    /// G-code program (stock top − a_p).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axial_depth: Option<f64>,
+    /// Z of the stock top for the G-code program, mm (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stock_top_z: Option<f64>,
+    /// Height of the clearance plane above the stock top, mm (default 5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clearance: Option<f64>,
+    /// Compute the feed that holds a target chip thickness (per-segment feeds and G-code).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feed_plan: Option<FeedPlanRequest>,
+    /// `dots` engine: return the contact dots for the scatter plot (default true).
+    #[serde(default = "yes")]
+    pub contact_dots: bool,
+    /// A stored machine profile; the server resolves it (its `max_feed` fills
+    /// `feed_plan.max_feed` when that is absent). The solver itself does not read it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub machine: Option<String>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// How the flute counts share the feed (engagement.md §2.5).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum FeedMode {
+    /// Constant f_z (mm/tooth).
+    PerTooth(f64),
+    /// Constant V_f (mm/min).
+    Rate(f64),
+}
+
+/// A validated feed plan request.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct PlanJob {
+    pub target: f64,
+    pub max_feed: f64,
+    pub flute_count: u32,
+    pub basis: FeedBasis,
+    pub tolerance: f64,
+    pub min_block_length: f64,
+}
+
+/// One validated candidate path.
+#[derive(Debug, Clone)]
+pub(crate) struct CandidateJob {
+    pub name: Option<String>,
+    pub route: Route,
+    pub warnings: Vec<Warning>,
+}
+
+/// A validated request: every number finite and in range, the geometry built.
+#[derive(Debug, Clone)]
+pub(crate) struct Job {
+    pub radius: f64,
+    pub flute_counts: Vec<u32>,
+    pub tool_flutes: u32,
+    pub spindle_rpm: f64,
+    pub feed_mode: FeedMode,
+    pub thickness_limit: Option<f64>,
+    pub time_limit: Option<f64>,
+    pub representative: Representative,
+    pub direction: SpindleDirection,
+    pub engine: Engine,
+    pub step: f64,
+    pub grid: Option<f64>,
+    pub burr_disengage: f64,
+    pub chipping_disengage: f64,
+    pub radial_depth_min: Option<f64>,
+    pub radial_depth_max: Option<f64>,
+    pub spike_threshold: Option<f64>,
+    pub min_feed_per_tooth: Option<f64>,
+    pub axial_depth: Option<f64>,
+    pub stock_top_z: f64,
+    pub clearance: f64,
+    pub plan: Option<PlanJob>,
+    pub contact_dots: bool,
+    pub region: Region,
+    pub stock_warnings: Vec<Warning>,
+    pub candidates: Vec<CandidateJob>,
+    pub single: bool,
+}
+
+impl FeedMode {
+    /// f_z,k for `flutes` teeth at `spindle_rpm`.
+    pub(crate) fn feed_per_tooth(self, flutes: u32, spindle_rpm: f64) -> f64 {
+        match self {
+            Self::PerTooth(fz) => fz,
+            Self::Rate(vf) => vf / (f64::from(flutes) * spindle_rpm),
+        }
+    }
+
+    /// V_f,k for `flutes` teeth at `spindle_rpm`, mm/min.
+    pub(crate) fn feed(self, flutes: u32, spindle_rpm: f64) -> f64 {
+        match self {
+            Self::PerTooth(fz) => f64::from(flutes) * fz * spindle_rpm,
+            Self::Rate(vf) => vf,
+        }
+    }
+}
+
+/// Largest coordinate magnitude accepted, mm (1 km: beyond any machine, and squares stay exact
+/// enough for the boundary tests).
+pub const MAX_COORDINATE: f64 = 1e6;
+
+fn point(field: &str, p: [f64; 2]) -> Result<P2, SolverError> {
+    for (axis, value) in [(0, p[0]), (1, p[1])] {
+        let name = format!("{field}[{axis}]");
+        if finite(&name, value)?.abs() > MAX_COORDINATE {
+            return Err(SolverError::input(
+                name,
+                format!("coordinates must lie within ±{MAX_COORDINATE} mm (got {value})"),
+            ));
+        }
+    }
+    Ok(P2::new(p[0], p[1]))
+}
+
+/// `value` must be positive and at most `limit`.
+fn bounded(field: &str, value: f64, limit: f64) -> Result<f64, SolverError> {
+    if positive(field, value)? > limit {
+        return Err(SolverError::input(
+            field,
+            format!("{field} must be at most {limit} (got {value})"),
+        ));
+    }
+    Ok(value)
+}
+
+fn optional(
+    field: &str,
+    value: Option<f64>,
+    check: fn(&str, f64) -> Result<f64, SolverError>,
+) -> Result<Option<f64>, SolverError> {
+    value.map(|v| check(field, v)).transpose()
+}
+
+fn too_large(field: &str, what: &str, count: usize, limit: usize) -> SolverError {
+    SolverError::new(
+        "E_TOO_LARGE",
+        format!("{what}: {count} exceeds the limit of {limit}"),
+    )
+    .at(field)
+}
+
+/// A path's pieces, zero-length ones dropped with a warning (engagement.md §2.3).
+pub(crate) fn read_path(
+    input: &PathInput,
+    field: &str,
+    warnings: &mut Vec<Warning>,
+) -> Result<Route, SolverError> {
+    let mut shapes: Vec<(Shape, bool, usize)> = Vec::new();
+    let mut dropped = Vec::new();
+    match input {
+        PathInput::Points(points) => {
+            if points.len() > MAX_SEGMENTS + 1 {
+                return Err(too_large(
+                    field,
+                    "path points",
+                    points.len(),
+                    MAX_SEGMENTS + 1,
+                ));
+            }
+            let mut previous: Option<P2> = None;
+            for (index, p) in points.iter().enumerate() {
+                let here = point(&format!("{field}[{index}]"), *p)?;
+                if let Some(from) = previous {
+                    let shape = Shape::Line { from, to: here };
+                    if shape.length() <= 1e-9 {
+                        dropped.push(format!("{field}[{index}]"));
+                    } else {
+                        shapes.push((shape, false, index - 1));
+                    }
+                }
+                previous = Some(here);
+            }
+        }
+        PathInput::Segments(program) => {
+            let start = program.start.ok_or_else(|| {
+                SolverError::new("E_PATH", "the path needs a start point [x, y]")
+                    .at(format!("{field}.start"))
+            })?;
+            let segments = program.segments.as_ref().ok_or_else(|| {
+                SolverError::new("E_PATH", "the path needs segments")
+                    .at(format!("{field}.segments"))
+            })?;
+            if segments.len() > MAX_SEGMENTS {
+                return Err(too_large(
+                    &format!("{field}.segments"),
+                    "path segments",
+                    segments.len(),
+                    MAX_SEGMENTS,
+                ));
+            }
+            let mut from = point(&format!("{field}.start"), start)?;
+            for (index, segment) in segments.iter().enumerate() {
+                let here = format!("{field}.segments[{index}]");
+                match segment {
+                    SegmentInput::Line { to, rapid } => {
+                        let to = point(&format!("{here}.to"), *to)?;
+                        let shape = Shape::Line { from, to };
+                        if shape.length() <= 1e-9 {
+                            dropped.push(here);
+                        } else {
+                            shapes.push((shape, *rapid, index));
+                        }
+                        from = to;
+                    }
+                    SegmentInput::Arc { to, center, dir } => {
+                        let to = point(&format!("{here}.to"), *to)?;
+                        let centre = point(&format!("{here}.center"), *center)?;
+                        let (r0, r1) = ((from - centre).norm(), (to - centre).norm());
+                        if r0 <= 1e-9 {
+                            return Err(SolverError::new(
+                                "E_PATH",
+                                "the arc centre coincides with its start point",
+                            )
+                            .at(format!("{here}.center")));
+                        }
+                        if (r0 - r1).abs() > 1e-6 * r0.max(r1) {
+                            return Err(SolverError::new(
+                                "E_PATH",
+                                format!(
+                                    "the arc centre is {r0:.6} mm from the start point but {r1:.6} mm from the end point"
+                                ),
+                            )
+                            .at(format!("{here}.center")));
+                        }
+                        let start_angle = (from.y - centre.y).atan2(from.x - centre.x);
+                        let end_angle = (to.y - centre.y).atan2(to.x - centre.x);
+                        let turn = std::f64::consts::TAU;
+                        let full = (to - from).norm() <= 1e-9 * r0.max(1.0);
+                        let sweep = match (dir, full) {
+                            (_, true) => turn,
+                            (ArcDirection::Ccw, false) => {
+                                (end_angle - start_angle).rem_euclid(turn)
+                            }
+                            (ArcDirection::Cw, false) => (start_angle - end_angle).rem_euclid(turn),
+                        };
+                        let sweep = if *dir == ArcDirection::Cw {
+                            -sweep
+                        } else {
+                            sweep
+                        };
+                        shapes.push((
+                            Shape::Arc {
+                                centre,
+                                radius: r0,
+                                start: start_angle,
+                                sweep,
+                            },
+                            false,
+                            index,
+                        ));
+                        from = to;
+                    }
+                }
+            }
+        }
+    }
+    if shapes.is_empty() {
+        return Err(SolverError::new(
+            "E_PATH",
+            "the path is empty: it needs at least one move of non-zero length",
+        )
+        .at(field));
+    }
+    if let Some(first) = dropped.first() {
+        warnings.push(Warning::new(
+            "W_SEGMENT_ZERO",
+            format!(
+                "{} zero-length segment(s) dropped (first: {first})",
+                dropped.len()
+            ),
+        ));
+    }
+    Ok(Route::new(shapes))
+}
+
+/// A ring of distinct points (closing repeat and consecutive duplicates removed).
+fn read_ring(field: &str, points: &[[f64; 2]]) -> Result<Vec<P2>, SolverError> {
+    let mut ring: Vec<P2> = Vec::with_capacity(points.len());
+    for (index, p) in points.iter().enumerate() {
+        let q = point(&format!("{field}[{index}]"), *p)?;
+        if ring.last().is_none_or(|last| (q - last).norm() > 1e-12) {
+            ring.push(q);
+        }
+    }
+    while ring.len() > 1
+        && ring
+            .first()
+            .zip(ring.last())
+            .is_some_and(|(a, b)| (a - b).norm() <= 1e-12)
+    {
+        ring.pop();
+    }
+    if ring.len() < 3 {
+        return Err(SolverError::new(
+            "E_STOCK",
+            format!(
+                "a stock ring needs at least 3 distinct points (got {})",
+                ring.len()
+            ),
+        )
+        .at(field));
+    }
+    Ok(ring)
+}
+
+fn read_stock(
+    stock: &Stock,
+    warnings: &mut Vec<Warning>,
+) -> Result<(Region, Vec<String>), SolverError> {
+    let given = [
+        stock.polygon.is_some(),
+        stock.polygons.is_some(),
+        stock.bitmap.is_some(),
+    ]
+    .iter()
+    .filter(|g| **g)
+    .count();
+    if given != 1 {
+        return Err(SolverError::input(
+            "stock",
+            "give exactly one of stock.polygon, stock.polygons or stock.bitmap",
+        ));
+    }
+    if !stock.holes.is_empty() && stock.polygon.is_none() {
+        return Err(SolverError::input(
+            "stock.holes",
+            "holes belong to stock.polygon; with stock.polygons give each region's holes",
+        ));
+    }
+    let base = if let Some(bitmap) = &stock.bitmap {
+        let origin = point("stock.bitmap.origin", bitmap.origin)?;
+        let cell = bounded("stock.bitmap.cell", bitmap.cell, MAX_COORDINATE)?;
+        if bitmap.width == 0 || bitmap.height == 0 {
+            return Err(SolverError::input(
+                "stock.bitmap.width",
+                "the bitmap needs at least one row and one column",
+            ));
+        }
+        let cells = u64::from(bitmap.width) * u64::from(bitmap.height);
+        if cells > MAX_GRID_DOTS {
+            return Err(SolverError::new(
+                "E_GRID_MEMORY",
+                format!("the bitmap has {cells} cells; the limit is {MAX_GRID_DOTS}"),
+            )
+            .at("stock.bitmap"));
+        }
+        let bytes = decode_base64(&bitmap.data).ok_or_else(|| {
+            SolverError::new("E_STOCK", "stock.bitmap.data is not valid base64")
+                .at("stock.bitmap.data")
+        })?;
+        let needed = cells.div_ceil(8);
+        if bytes.len() as u64 != needed {
+            return Err(SolverError::new(
+                "E_STOCK",
+                format!(
+                    "stock.bitmap.data holds {} bytes; {} × {} cells need {needed}",
+                    bytes.len(),
+                    bitmap.width,
+                    bitmap.height
+                ),
+            )
+            .at("stock.bitmap.data"));
+        }
+        if bytes.iter().all(|b| *b == 0) {
+            warnings.push(Warning::new(
+                "W_STOCK_EMPTY",
+                "the bitmap holds no material",
+            ));
+        }
+        Base::Bitmap(Bitmap {
+            origin,
+            cell,
+            width: bitmap.width as usize,
+            height: bitmap.height as usize,
+            bytes,
+        })
+    } else {
+        let mut rings = Vec::new();
+        let mut fields = Vec::new();
+        let mut vertices = 0_usize;
+        let mut add = |field: String, points: &[[f64; 2]]| -> Result<(), SolverError> {
+            vertices += points.len();
+            if vertices > MAX_STOCK_VERTICES {
+                return Err(too_large(
+                    "stock",
+                    "stock vertices",
+                    vertices,
+                    MAX_STOCK_VERTICES,
+                ));
+            }
+            rings.push(read_ring(&field, points)?);
+            fields.push(field);
+            Ok(())
+        };
+        if let Some(outline) = &stock.polygon {
+            add("stock.polygon".to_owned(), outline)?;
+            for (index, hole) in stock.holes.iter().enumerate() {
+                add(format!("stock.holes[{index}]"), hole)?;
+            }
+        }
+        if let Some(polygons) = &stock.polygons {
+            if polygons.is_empty() {
+                return Err(
+                    SolverError::new("E_STOCK", "stock.polygons is empty").at("stock.polygons")
+                );
+            }
+            for (index, polygon) in polygons.iter().enumerate() {
+                add(format!("stock.polygons[{index}].outer"), &polygon.outer)?;
+                for (hole_index, hole) in polygon.holes.iter().enumerate() {
+                    add(format!("stock.polygons[{index}].holes[{hole_index}]"), hole)?;
+                }
+            }
+        }
+        let edges = EdgeSet::new(&rings);
+        if let Some(((ring_a, vertex_a), (ring_b, vertex_b))) = edges.first_crossing(&rings) {
+            let name = |ring: usize| {
+                fields
+                    .get(ring)
+                    .cloned()
+                    .unwrap_or_else(|| "stock".to_owned())
+            };
+            let message = if ring_a == ring_b {
+                format!(
+                    "the stock outline crosses itself: edges from vertex {vertex_a} and vertex {vertex_b} of {} meet",
+                    name(ring_a)
+                )
+            } else {
+                format!(
+                    "stock rings cross or touch: {}[{vertex_a}] and {}[{vertex_b}] (overlapping regions would cancel under the even-odd rule)",
+                    name(ring_a),
+                    name(ring_b)
+                )
+            };
+            return Err(
+                SolverError::new("E_STOCK", message).at(format!("{}[{vertex_a}]", name(ring_a)))
+            );
+        }
+        // After the crossing test, so a bow tie is reported as crossing, not as flat.
+        for (ring, field) in rings.iter().zip(&fields) {
+            if twice_signed_area(ring).abs() <= 2e-12 {
+                return Err(
+                    SolverError::new("E_STOCK", "the stock ring has zero area").at(field.clone())
+                );
+            }
+        }
+        Base::Polygons { rings, edges }
+    };
+    let mut cuts = Vec::new();
+    let mut cut_fields = Vec::new();
+    for (index, previous) in stock.previous_cuts.iter().enumerate() {
+        let field = format!("stock.previous_cuts[{index}]");
+        let radius = bounded(&format!("{field}.radius"), previous.radius, MAX_COORDINATE)?;
+        let route = read_path(&previous.path, &format!("{field}.path"), warnings)?;
+        let shapes = route
+            .pieces
+            .iter()
+            .filter(|p| !p.rapid)
+            .map(|p| p.shape)
+            .collect();
+        cuts.push(Cut::new(shapes, radius));
+        cut_fields.push(field);
+    }
+    Ok((Region { base, cuts }, cut_fields))
+}
+
+impl EngagementRequest {
+    /// Validates the request against `tool` (already resolved from `self.tool`).
+    pub(crate) fn validate(&self, tool: &Tool) -> Result<Job, SolverError> {
+        tool.validate("tool.")?;
+        let radius = bounded("tool.radius", tool.radius, MAX_COORDINATE)?;
+        let spindle_rpm = bounded("spindle_rpm", self.spindle_rpm, 1e6)?;
+        let feed_mode = match (self.feed_per_tooth, self.feed) {
+            (Some(fz), None) => FeedMode::PerTooth(bounded("feed_per_tooth", fz, 1e3)?),
+            (None, Some(vf)) => FeedMode::Rate(bounded("feed", vf, 1e7)?),
+            (Some(_), Some(_)) => {
+                return Err(SolverError::input(
+                    "feed",
+                    "give feed_per_tooth (constant f_z) or feed (constant V_f), not both",
+                ));
+            }
+            (None, None) => {
+                return Err(SolverError::input(
+                    "feed_per_tooth",
+                    "feed_per_tooth (mm/tooth) or feed (mm/min) is required",
+                ));
+            }
+        };
+        let flute_counts = match &self.flute_counts {
+            None => vec![tool.flutes],
+            Some(counts) => {
+                if counts.is_empty() {
+                    return Err(SolverError::input(
+                        "flute_counts",
+                        "flute_counts needs at least one flute count",
+                    ));
+                }
+                if counts.len() > MAX_FLUTES as usize {
+                    return Err(too_large(
+                        "flute_counts",
+                        "flute counts",
+                        counts.len(),
+                        MAX_FLUTES as usize,
+                    ));
+                }
+                for (index, k) in counts.iter().enumerate() {
+                    let field = format!("flute_counts[{index}]");
+                    if !(1..=MAX_FLUTES).contains(k) {
+                        return Err(SolverError::input(
+                            field,
+                            format!("a flute count must be 1 to {MAX_FLUTES} (got {k})"),
+                        ));
+                    }
+                    if counts[..index].contains(k) {
+                        return Err(SolverError::input(
+                            field,
+                            format!("flute count {k} is listed twice"),
+                        ));
+                    }
+                }
+                counts.clone()
+            }
+        };
+        let thickness_limit = optional("thickness_limit", self.thickness_limit, positive)?;
+        let time_limit = optional("time_limit_s", self.time_limit_s, positive)?;
+        let step = match self.step {
+            Some(step) => bounded("step", step, MAX_COORDINATE)?,
+            None => 2.0 * radius / 50.0,
+        };
+        let grid = match (self.engine, self.grid) {
+            (Engine::Exact, Some(_)) => {
+                return Err(SolverError::input(
+                    "grid",
+                    "grid applies only to engine \"dots\"",
+                ));
+            }
+            (Engine::Exact, None) => None,
+            (Engine::Dots, Some(g)) => Some(bounded("grid", g, MAX_COORDINATE)?),
+            (Engine::Dots, None) => Some(match &self.stock.bitmap {
+                Some(bitmap) if bitmap.cell.is_finite() && bitmap.cell > 0.0 => bitmap.cell,
+                _ => 2.0 * radius / 200.0,
+            }),
+        };
+        let angle = |field: &str, value: Option<f64>, default: f64| -> Result<f64, SolverError> {
+            let v = finite(field, value.unwrap_or(default))?;
+            if (0.0..=180.0).contains(&v) {
+                Ok(v)
+            } else {
+                Err(SolverError::input(
+                    field,
+                    format!("{field} must be in [0, 180] (got {v})"),
+                ))
+            }
+        };
+        let burr_disengage = angle(
+            "burr_disengage_deg",
+            self.burr_disengage_deg,
+            DEFAULT_BURR_DISENGAGE_DEG,
+        )?;
+        let chipping_disengage = angle(
+            "chipping_disengage_deg",
+            self.chipping_disengage_deg,
+            DEFAULT_CHIPPING_DISENGAGE_DEG,
+        )?;
+        let radial_depth_min = optional("radial_depth_min", self.radial_depth_min, non_negative)?;
+        let radial_depth_max = optional("radial_depth_max", self.radial_depth_max, positive)?;
+        if let (Some(low), Some(high)) = (radial_depth_min, radial_depth_max)
+            && low > high
+        {
+            return Err(SolverError::input(
+                "radial_depth_min",
+                format!("radial_depth_min {low} exceeds radial_depth_max {high}"),
+            ));
+        }
+        let spike_threshold = optional("spike_threshold_deg", self.spike_threshold_deg, positive)?;
+        let min_feed_per_tooth = optional("min_feed_per_tooth", self.min_feed_per_tooth, positive)?;
+        let axial_depth = self
+            .axial_depth
+            .map(|d| bounded("axial_depth", d, MAX_COORDINATE))
+            .transpose()?;
+        let stock_top_z = finite("stock_top_z", self.stock_top_z.unwrap_or(0.0))?;
+        if stock_top_z.abs() > MAX_COORDINATE {
+            return Err(SolverError::input(
+                "stock_top_z",
+                format!("stock_top_z must lie within ±{MAX_COORDINATE} mm"),
+            ));
+        }
+        let clearance = bounded("clearance", self.clearance.unwrap_or(5.0), MAX_COORDINATE)?;
+        let plan = self
+            .feed_plan
+            .as_ref()
+            .map(|plan| -> Result<PlanJob, SolverError> {
+                let target = bounded("feed_plan.target_thickness", plan.target_thickness, 1e3)?;
+                let max_feed = plan.max_feed.ok_or_else(|| {
+                    SolverError::input(
+                        "feed_plan.max_feed",
+                        "feed_plan.max_feed (mm/min) is required unless the request names a machine",
+                    )
+                })?;
+                let max_feed = bounded("feed_plan.max_feed", max_feed, 1e7)?;
+                let flute_count = plan.flute_count.unwrap_or(tool.flutes);
+                if !(1..=MAX_FLUTES).contains(&flute_count) {
+                    return Err(SolverError::input(
+                        "feed_plan.flute_count",
+                        format!("a flute count must be 1 to {MAX_FLUTES} (got {flute_count})"),
+                    ));
+                }
+                let tolerance = non_negative("feed_plan.tolerance", plan.tolerance.unwrap_or(0.05))?;
+                let min_block_length =
+                    non_negative("feed_plan.min_block_length", plan.min_block_length.unwrap_or(0.5))?;
+                Ok(PlanJob {
+                    target,
+                    max_feed,
+                    flute_count,
+                    basis: plan.basis,
+                    tolerance,
+                    min_block_length,
+                })
+            })
+            .transpose()?;
+
+        let mut stock_warnings = Vec::new();
+        let (region, _) = read_stock(&self.stock, &mut stock_warnings)?;
+
+        let inputs: Vec<(Option<String>, &PathInput, String)> = match (&self.path, &self.paths) {
+            (Some(path), None) => vec![(None, path, "path".to_owned())],
+            (None, Some(paths)) => {
+                if paths.is_empty() {
+                    return Err(SolverError::new("E_PATH", "paths is empty").at("paths"));
+                }
+                if paths.len() > MAX_CANDIDATES {
+                    return Err(too_large(
+                        "paths",
+                        "candidate paths",
+                        paths.len(),
+                        MAX_CANDIDATES,
+                    ));
+                }
+                paths
+                    .iter()
+                    .enumerate()
+                    .map(|(i, c)| (c.name.clone(), &c.path, format!("paths[{i}].path")))
+                    .collect()
+            }
+            (Some(_), Some(_)) => {
+                return Err(SolverError::input("paths", "give path or paths, not both"));
+            }
+            (None, None) => {
+                return Err(SolverError::new("E_PATH", "the request needs a path").at("path"));
+            }
+        };
+        let mut candidates = Vec::with_capacity(inputs.len());
+        let mut total_samples = 0.0;
+        for (name, input, field) in inputs {
+            let mut warnings = Vec::new();
+            let route = read_path(input, &field, &mut warnings)?;
+            total_samples += route.station_count(step);
+            if total_samples > MAX_SAMPLES as f64 {
+                return Err(SolverError::new(
+                    "E_TOO_MANY_SAMPLES",
+                    format!(
+                        "the path(s) would need about {total_samples:.0} samples at step {step} mm; the limit is {MAX_SAMPLES}: use a larger step"
+                    ),
+                )
+                .at("step"));
+            }
+            candidates.push(CandidateJob {
+                name,
+                route,
+                warnings,
+            });
+        }
+        if let Some(g) = grid {
+            // The dots engine rasterises earlier cuts' arcs as chords within g/100.
+            let chords: f64 = region
+                .cuts
+                .iter()
+                .flat_map(|cut| cut.shapes.iter())
+                .map(|shape| shape.chord_count(g / 100.0))
+                .sum();
+            if chords > MAX_CHORDS {
+                return Err(SolverError::new(
+                    "E_WORK_LIMIT",
+                    format!(
+                        "the earlier cuts' arcs need {chords:.2e} chords at grid {g} mm; the limit is {MAX_CHORDS:.0e}: use a larger grid or engine \"exact\""
+                    ),
+                )
+                .at("stock.previous_cuts"));
+            }
+        }
+        if let (Some(g), Some(stock_box)) = (grid, region.bbox()) {
+            let mut rows = 0.0;
+            for candidate in &candidates {
+                let height = check_grid(&candidate.route, stock_box, region.anchor(), radius, g)?;
+                // Each sample scans the grid rows across the tool.
+                rows += candidate.route.station_count(step) * (2.0 * radius / g).min(height);
+            }
+            if rows > MAX_DOT_ROWS {
+                return Err(SolverError::new(
+                    "E_WORK_LIMIT",
+                    format!(
+                        "the dots engine would scan about {rows:.2e} grid rows (samples × rows across the tool); the limit is {MAX_DOT_ROWS:.0e}: use a larger grid or step, or engine \"exact\""
+                    ),
+                )
+                .at("grid"));
+            }
+        }
+        if let (Engine::Exact, Base::Bitmap(bitmap)) = (self.engine, &region.base) {
+            // Every sample intersects the circle with about 8R/cell cell edges.
+            let work = total_samples * 8.0 * radius / bitmap.cell;
+            if work > super::MAX_BITMAP_CROSSINGS {
+                return Err(SolverError::new(
+                    "E_TOO_MANY_SAMPLES",
+                    format!(
+                        "a bitmap with cell {} mm seen by a tool of radius {radius} mm needs about {work:.2e} edge tests over the samples; the limit is {:.0e}: use a larger step, a coarser bitmap or engine \"dots\"",
+                        bitmap.cell,
+                        super::MAX_BITMAP_CROSSINGS
+                    ),
+                )
+                .at("step"));
+            }
+        }
+        Ok(Job {
+            radius,
+            flute_counts,
+            tool_flutes: tool.flutes,
+            spindle_rpm,
+            feed_mode,
+            thickness_limit,
+            time_limit,
+            representative: self.representative,
+            direction: self.spindle_direction,
+            engine: self.engine,
+            step,
+            grid,
+            burr_disengage,
+            chipping_disengage,
+            radial_depth_min,
+            radial_depth_max,
+            spike_threshold,
+            min_feed_per_tooth,
+            axial_depth,
+            stock_top_z,
+            clearance,
+            plan,
+            contact_dots: self.contact_dots,
+            region,
+            stock_warnings,
+            candidates,
+            single: self.path.is_some(),
+        })
+    }
+}
+
+/// The dot grid of a candidate: the stock's box cut to where the tool can reach, in cells of
+/// `grid`; refused past [`MAX_GRID_DOTS`] (engagement.md §9 `W_GRID_MEMORY`: refuse).
+/// Dots sit at `anchor` + (i + ½, j + ½)·`grid` (the bitmap's origin, so its cells and the dots
+/// line up).
+pub(crate) fn grid_extent(
+    route: &Route,
+    stock_box: BBox,
+    anchor: P2,
+    radius: f64,
+    grid: f64,
+) -> Option<(P2, u64, u64)> {
+    let reach = route.bbox()?.grown(radius * (1.0 + 1e-9) + grid);
+    let area = reach.intersection(&stock_box.grown(grid))?;
+    let origin = P2::new(
+        anchor.x + ((area.min.x - anchor.x) / grid).floor() * grid,
+        anchor.y + ((area.min.y - anchor.y) / grid).floor() * grid,
+    );
+    let width = ((area.max.x - origin.x) / grid).ceil().max(1.0);
+    let height = ((area.max.y - origin.y) / grid).ceil().max(1.0);
+    // Saturating: sizes far past the limit are refused by the caller anyway.
+    Some((origin, width.min(1e18) as u64, height.min(1e18) as u64))
+}
+
+/// Refuses a grid past the memory limit; the grid's height in rows otherwise.
+fn check_grid(
+    route: &Route,
+    stock_box: BBox,
+    anchor: P2,
+    radius: f64,
+    grid: f64,
+) -> Result<f64, SolverError> {
+    if let Some((_, width, height)) = grid_extent(route, stock_box, anchor, radius, grid) {
+        let dots = (width as f64) * (height as f64);
+        if dots > MAX_GRID_DOTS as f64 {
+            return Err(SolverError::new(
+                "E_GRID_MEMORY",
+                format!(
+                    "the dot grid would need {dots:.3e} dots ({width} × {height} at grid {grid} mm, {:.0} MB); the limit is {MAX_GRID_DOTS} dots ({} MB): use a larger grid",
+                    dots / 8.0 / 1e6,
+                    MAX_GRID_DOTS / 8 / 1_000_000
+                ),
+            )
+            .at("grid"));
+        }
+        return Ok(height as f64);
+    }
+    Ok(0.0)
+}

@@ -1,0 +1,290 @@
+//! The initial material W₀ (engagement.md §2.2): polygons with holes (even-odd, boundary
+//! inclusive), a bit-packed bitmap, and material already removed by earlier cuts (§5.3.3, prior
+//! operations); membership and the circle crossings the exact engine splits at.
+
+use super::P2;
+use super::bbox_tree::{BBox, BoxTree};
+use super::polygon::EdgeSet;
+use super::segments::{Shape, circle_segment};
+
+/// Boundary tolerance of the stock outline, mm (engagement.md §5.3.2: ±1e-9).
+pub(crate) const BOUNDARY_TOLERANCE: f64 = 1e-9;
+
+/// Relative tolerance of "at least R from the swept path" (§5.3.3: R·(1 − 1e-9)).
+pub(crate) const REACH_TOLERANCE: f64 = 1e-9;
+
+/// A bit-packed raster of material cells.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Bitmap {
+    pub origin: P2,
+    pub cell: f64,
+    pub width: usize,
+    pub height: usize,
+    /// Row-major from the origin row upwards, most significant bit first.
+    pub bytes: Vec<u8>,
+}
+
+impl Bitmap {
+    /// Whether cell (column, row) holds material; outside the raster is empty.
+    pub(crate) fn cell_is_material(&self, column: i64, row: i64) -> bool {
+        if column < 0 || row < 0 {
+            return false;
+        }
+        let (column, row) = (column as usize, row as usize);
+        if column >= self.width || row >= self.height {
+            return false;
+        }
+        let bit = row * self.width + column;
+        self.bytes
+            .get(bit / 8)
+            .is_some_and(|byte| byte & (0x80 >> (bit % 8)) != 0)
+    }
+
+    /// The cell containing `q`.
+    pub(crate) fn cell_of(&self, q: P2) -> (i64, i64) {
+        let column = ((q.x - self.origin.x) / self.cell).floor();
+        let row = ((q.y - self.origin.y) / self.cell).floor();
+        // Far-away points saturate to an index outside the raster.
+        (
+            column.clamp(-1.0, 1e15) as i64,
+            row.clamp(-1.0, 1e15) as i64,
+        )
+    }
+
+    fn contains(&self, q: P2) -> bool {
+        let (column, row) = self.cell_of(q);
+        self.cell_is_material(column, row)
+    }
+
+    fn bbox(&self) -> BBox {
+        BBox {
+            min: self.origin,
+            max: self.origin
+                + P2::new(
+                    self.width as f64 * self.cell,
+                    self.height as f64 * self.cell,
+                ),
+        }
+    }
+
+    /// Angles about `c` where the circle crosses a cell edge between material and empty.
+    fn crossings(&self, c: P2, radius: f64, out: &mut Vec<f64>) {
+        let cell = self.cell;
+        let first_column = ((c.x - radius - self.origin.x) / cell).ceil().max(0.0) as i64;
+        let last_column = ((c.x + radius - self.origin.x) / cell)
+            .floor()
+            .min(self.width as f64) as i64;
+        for column in first_column..=last_column {
+            let x = self.origin.x + column as f64 * cell;
+            let half = (radius * radius - (x - c.x) * (x - c.x)).max(0.0).sqrt();
+            for y in [c.y - half, c.y + half] {
+                let row = ((y - self.origin.y) / cell).floor() as i64;
+                if self.cell_is_material(column - 1, row) != self.cell_is_material(column, row) {
+                    out.push((y - c.y).atan2(x - c.x));
+                }
+            }
+        }
+        let first_row = ((c.y - radius - self.origin.y) / cell).ceil().max(0.0) as i64;
+        let last_row = ((c.y + radius - self.origin.y) / cell)
+            .floor()
+            .min(self.height as f64) as i64;
+        for row in first_row..=last_row {
+            let y = self.origin.y + row as f64 * cell;
+            let half = (radius * radius - (y - c.y) * (y - c.y)).max(0.0).sqrt();
+            for x in [c.x - half, c.x + half] {
+                let column = ((x - self.origin.x) / cell).floor() as i64;
+                if self.cell_is_material(column, row - 1) != self.cell_is_material(column, row) {
+                    out.push((y - c.y).atan2(x - c.x));
+                }
+            }
+        }
+    }
+}
+
+/// The outline of the initial material.
+#[derive(Debug, Clone)]
+pub(crate) enum Base {
+    /// Rings under the even-odd rule.
+    Polygons { rings: Vec<Vec<P2>>, edges: EdgeSet },
+    /// A raster.
+    Bitmap(Bitmap),
+}
+
+/// Material removed before this operation: everything within `radius` of `route`.
+#[derive(Debug, Clone)]
+pub(crate) struct Cut {
+    pub shapes: Vec<Shape>,
+    pub radius: f64,
+    pub tree: BoxTree,
+}
+
+impl Cut {
+    /// A cut along `shapes` by a cutter of `radius`.
+    pub(crate) fn new(shapes: Vec<Shape>, radius: f64) -> Self {
+        let boxes: Vec<BBox> = shapes.iter().map(Shape::bbox).collect();
+        Self {
+            tree: BoxTree::new(&boxes),
+            shapes,
+            radius,
+        }
+    }
+
+    /// Pieces that come within `reach` of `centre`.
+    pub(crate) fn near(&self, centre: P2, reach: f64, out: &mut Vec<Shape>) {
+        let limit = reach + self.radius;
+        self.tree.query(&BBox::around(centre, limit), &mut |index| {
+            if let Some(shape) = self.shapes.get(index)
+                && shape.distance(centre) < limit
+            {
+                out.push(*shape);
+            }
+        });
+    }
+
+    /// Whether `q` is still material after this cut (closed: exactly `radius` away stays);
+    /// adds the pieces examined to `work`.
+    pub(crate) fn keeps(&self, q: P2, work: &mut u64) -> bool {
+        let limit = self.radius * (1.0 - REACH_TOLERANCE);
+        let mut kept = true;
+        self.tree
+            .query(&BBox::around(q, self.radius), &mut |index| {
+                *work += 1;
+                if kept
+                    && let Some(shape) = self.shapes.get(index)
+                    && shape.distance(q) < limit
+                {
+                    kept = false;
+                }
+            });
+        kept
+    }
+}
+
+/// The material the operation starts from.
+#[derive(Debug, Clone)]
+pub(crate) struct Region {
+    pub base: Base,
+    pub cuts: Vec<Cut>,
+}
+
+impl Region {
+    /// Whether `q` is material at the start of the operation (outline, less earlier cuts);
+    /// adds the edges and pieces examined to `work`.
+    pub(crate) fn contains(&self, q: P2, work: &mut u64) -> bool {
+        let in_outline = match &self.base {
+            Base::Polygons { edges, .. } => edges.contains(q, BOUNDARY_TOLERANCE, work),
+            Base::Bitmap(bitmap) => bitmap.contains(q),
+        };
+        in_outline && self.cuts.iter().all(|cut| cut.keeps(q, work))
+    }
+
+    /// Where the dot grid is anchored: the bitmap's origin, else the coordinate origin.
+    pub(crate) fn anchor(&self) -> P2 {
+        match &self.base {
+            Base::Polygons { .. } => P2::new(0.0, 0.0),
+            Base::Bitmap(bitmap) => bitmap.origin,
+        }
+    }
+
+    /// Bounding box of the outline.
+    pub(crate) fn bbox(&self) -> Option<BBox> {
+        match &self.base {
+            Base::Polygons { rings, .. } => {
+                let mut points = rings.iter().flatten();
+                let first = *points.next()?;
+                let mut bbox = BBox::of(first, first);
+                for p in points {
+                    bbox.include(*p);
+                }
+                Some(bbox)
+            }
+            Base::Bitmap(bitmap) => Some(bitmap.bbox()),
+        }
+    }
+
+    /// Adds the polar angles about `c` where circle (`c`, `radius`) crosses the outline or the
+    /// boundary of an earlier cut.
+    pub(crate) fn crossings(&self, c: P2, radius: f64, out: &mut Vec<f64>) {
+        match &self.base {
+            Base::Polygons { edges, .. } => {
+                edges
+                    .tree
+                    .query(&BBox::around(c, radius * (1.0 + 1e-9)), &mut |index| {
+                        if let Some(edge) = edges.edges.get(index) {
+                            circle_segment(c, radius, edge.from, edge.to, out);
+                        }
+                    });
+            }
+            Base::Bitmap(bitmap) => bitmap.crossings(c, radius, out),
+        }
+        let mut near = Vec::new();
+        for cut in &self.cuts {
+            near.clear();
+            cut.near(c, radius, &mut near);
+            for shape in &near {
+                shape.crossings(cut.radius, c, radius, out);
+            }
+        }
+    }
+}
+
+/// Decodes standard base64 (padding optional, whitespace ignored); `None` on a bad character.
+pub(crate) fn decode_base64(text: &str) -> Option<Vec<u8>> {
+    let mut out = Vec::with_capacity(text.len() * 3 / 4);
+    let mut buffer = 0_u32;
+    let mut bits = 0;
+    for byte in text.bytes() {
+        let value = match byte {
+            b'A'..=b'Z' => byte - b'A',
+            b'a'..=b'z' => byte - b'a' + 26,
+            b'0'..=b'9' => byte - b'0' + 52,
+            b'+' => 62,
+            b'/' => 63,
+            b'=' | b' ' | b'\n' | b'\r' | b'\t' => continue,
+            _ => return None,
+        };
+        buffer = (buffer << 6) | u32::from(value);
+        bits += 6;
+        if bits >= 8 {
+            bits -= 8;
+            out.push((buffer >> bits) as u8);
+            buffer &= (1 << bits) - 1;
+        }
+    }
+    Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_round_trip_of_known_text() {
+        assert_eq!(decode_base64("TWFu").as_deref(), Some(&b"Man"[..]));
+        assert_eq!(decode_base64("TWE=").as_deref(), Some(&b"Ma"[..]));
+        assert_eq!(decode_base64("TQ").as_deref(), Some(&b"M"[..]));
+        assert_eq!(decode_base64("/w==").as_deref(), Some(&[255_u8][..]));
+        assert!(decode_base64("T*Q").is_none());
+    }
+
+    #[test]
+    fn bitmap_cells_and_crossings() {
+        // 4 × 2 raster, material in columns 1 and 2 of row 0 only: 0110 0000.
+        let bitmap = Bitmap {
+            origin: P2::new(0.0, 0.0),
+            cell: 1.0,
+            width: 4,
+            height: 2,
+            bytes: vec![0b0110_0000],
+        };
+        assert!(bitmap.contains(P2::new(1.5, 0.5)));
+        assert!(!bitmap.contains(P2::new(0.5, 0.5)));
+        assert!(!bitmap.contains(P2::new(1.5, 1.5)));
+        assert!(!bitmap.contains(P2::new(-3.0, 0.5)));
+        let mut angles = Vec::new();
+        bitmap.crossings(P2::new(2.0, 1.0), 0.8, &mut angles);
+        // The circle crosses x = 2 (inside the material row: no change), y = 1 at x = 1.2 and
+        // 2.8 (material below, empty above): two crossings.
+        assert_eq!(angles.len(), 2);
+    }
+}

@@ -1,0 +1,188 @@
+//! Summed chip thickness of k evenly spaced teeth, maximised exactly over the tooth phase, and
+//! the number of teeth in the cut (engagement.md §5.6).
+//!
+//! The active set of teeth changes only where a tooth sits on an arc end (or at 0°/180°, where
+//! the clamp max(0, sin θ) switches); between those breakpoints the sum is f_z·|C|·sin(β + arg C),
+//! so its maximum lies at a breakpoint or at β* = 90° − arg C.
+
+use super::arcs::Arc;
+
+/// Tolerance on arc ends, degrees (closed arcs: a tooth on an end counts, §9).
+const END_TOLERANCE: f64 = 1e-9;
+
+/// The maximised sum for one flute count at one sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ToothSum {
+    /// max over β of Σ max(0, sin θ_j) over the teeth on the arcs: H_k / f_z,k.
+    pub ratio: f64,
+    /// max over β of the number of teeth strictly inside the arcs: n_k.
+    pub teeth: u32,
+}
+
+fn on_arcs(arcs: &[Arc], angle: f64, tolerance: f64) -> bool {
+    arcs.iter().any(|arc| arc.contains(angle, tolerance))
+}
+
+fn clamped_sin(angle_deg: f64) -> f64 {
+    angle_deg.to_radians().sin().max(0.0)
+}
+
+/// H_k/f_z,k and n_k for `flutes` teeth on `arcs` (§5.6, exact maximisation).
+pub(crate) fn tooth_sum(arcs: &[Arc], flutes: u32) -> ToothSum {
+    if arcs.is_empty() || flutes == 0 {
+        return ToothSum {
+            ratio: 0.0,
+            teeth: 0,
+        };
+    }
+    let pitch = 360.0 / f64::from(flutes);
+    let mut breaks = vec![0.0, pitch];
+    for arc in arcs {
+        for end in [arc.from, arc.to] {
+            breaks.push(end.rem_euclid(pitch));
+        }
+    }
+    breaks.push(0.0_f64.rem_euclid(pitch));
+    breaks.push(180.0_f64.rem_euclid(pitch));
+    breaks.sort_by(f64::total_cmp);
+    breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-12);
+
+    let tooth = |phase: f64, j: u32| phase + f64::from(j) * pitch;
+    let mut best = 0.0_f64;
+    let mut teeth = 0_u32;
+    for &phase in &breaks {
+        let sum: f64 = (0..flutes)
+            .map(|j| tooth(phase, j))
+            .filter(|&angle| on_arcs(arcs, angle, END_TOLERANCE))
+            .map(clamped_sin)
+            .sum();
+        best = best.max(sum);
+    }
+    for pair in breaks.windows(2) {
+        let (low, high) = (pair[0], pair[1]);
+        if high - low <= 1e-12 {
+            continue;
+        }
+        let middle = 0.5 * (low + high);
+        let inside = (0..flutes)
+            .filter(|&j| on_arcs(arcs, tooth(middle, j), -END_TOLERANCE))
+            .count();
+        teeth = teeth.max(u32::try_from(inside).unwrap_or(u32::MAX));
+        // Teeth cutting throughout this interval: on an arc and in the front half.
+        let active: Vec<u32> = (0..flutes)
+            .filter(|&j| {
+                let angle = tooth(middle, j);
+                on_arcs(arcs, angle, 0.0) && angle.to_radians().sin() > 0.0
+            })
+            .collect();
+        let (mut cx, mut cy) = (0.0, 0.0);
+        for &j in &active {
+            let angle = (f64::from(j) * pitch).to_radians();
+            cx += angle.cos();
+            cy += angle.sin();
+        }
+        if cx.hypot(cy) <= 1e-12 {
+            continue;
+        }
+        let peak = 90.0 - cy.atan2(cx).to_degrees();
+        let phase = low + (peak - low).rem_euclid(360.0);
+        if phase < high {
+            let sum: f64 = active
+                .iter()
+                .map(|&j| tooth(phase, j).to_radians().sin())
+                .sum();
+            best = best.max(sum);
+        }
+    }
+    ToothSum { ratio: best, teeth }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn arc(from: f64, to: f64) -> Arc {
+        Arc { from, to }
+    }
+
+    /// Brute-force phase scan, for comparison.
+    fn sampled(arcs: &[Arc], flutes: u32, steps: u32) -> f64 {
+        let pitch = 360.0 / f64::from(flutes);
+        (0..steps)
+            .map(|i| {
+                let phase = pitch * f64::from(i) / f64::from(steps);
+                (0..flutes)
+                    .map(|j| phase + f64::from(j) * pitch)
+                    .filter(|&a| on_arcs(arcs, a, END_TOLERANCE))
+                    .map(clamped_sin)
+                    .sum::<f64>()
+            })
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn full_slot_closed_forms() {
+        // engagement.md §5.6 table, k = 1…10.
+        let expected = [
+            1.0,
+            1.0,
+            1.0,
+            std::f64::consts::SQRT_2,
+            1.618034,
+            2.0,
+            2.246980,
+            2.613126,
+            2.879385,
+            3.236068,
+        ];
+        for (k, value) in (1..=10).zip(expected) {
+            let sum = tooth_sum(&[arc(0.0, 180.0)], k);
+            assert!((sum.ratio - value).abs() < 1e-6, "k = {k}: {}", sum.ratio);
+        }
+        assert_eq!(tooth_sum(&[arc(0.0, 180.0)], 4).teeth, 2);
+        assert_eq!(tooth_sum(&[arc(0.0, 180.0)], 8).teeth, 4);
+    }
+
+    #[test]
+    fn down_milling_sixty_degrees() {
+        // §5.6: φ = 60°: k ≤ 6 → 0.866025; k = 7 → 1.015068; k = 8 → 1.124844; k = 10 → 1.272762.
+        for (k, value) in [
+            (3, 0.866025),
+            (6, 0.866025),
+            (7, 1.015068),
+            (8, 1.124844),
+            (10, 1.272762),
+        ] {
+            let sum = tooth_sum(&[arc(0.0, 60.0)], k);
+            assert!((sum.ratio - value).abs() < 1e-6, "k = {k}: {}", sum.ratio);
+        }
+    }
+
+    #[test]
+    fn agrees_with_a_phase_scan_including_back_arcs() {
+        let cases = [
+            vec![arc(-40.0, 20.0), arc(100.0, 130.0)],
+            vec![arc(16.26, 23.07), arc(156.93, 163.74)],
+            vec![arc(170.0, 250.0)],
+        ];
+        for arcs in &cases {
+            for k in 1..=10 {
+                let exact = tooth_sum(arcs, k).ratio;
+                let scan = sampled(arcs, k, 200_000);
+                assert!(exact >= scan - 1e-12, "{arcs:?} k = {k}: {exact} < {scan}");
+                assert!(exact - scan < 1e-3, "{arcs:?} k = {k}: {exact} vs {scan}");
+            }
+        }
+    }
+
+    #[test]
+    fn empty_arcs_give_zero() {
+        assert_eq!(
+            tooth_sum(&[], 4),
+            ToothSum {
+                ratio: 0.0,
+                teeth: 0
+            }
+        );
+    }
+}
