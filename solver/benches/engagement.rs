@@ -63,9 +63,7 @@ fn bench(c: &mut Criterion) {
     for engine in ["exact", "dots"] {
         let request = request(engine);
         let answer = engagement::solve(&request, &tool).unwrap();
-        let EngagementAnswer::Single(result) = &answer else {
-            unreachable!()
-        };
+        let EngagementAnswer::Single(result) = &answer else { unreachable!() };
         let samples = result.samples.len() as u64;
         if let Some(grid) = &result.grid {
             let full = (POCKET / 0.01) * (POCKET / 0.01);
@@ -77,10 +75,7 @@ fn bench(c: &mut Criterion) {
                 full / 8.0 / 1e6
             );
         }
-        eprintln!(
-            "{engine}: {samples} samples, path {:.1} mm",
-            result.path_length
-        );
+        eprintln!("{engine}: {samples} samples, path {:.1} mm", result.path_length);
         group.throughput(Throughput::Elements(samples));
         group.bench_function(engine, |b| {
             b.iter(|| engagement::solve(&request, &tool).unwrap());

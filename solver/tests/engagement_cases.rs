@@ -7,8 +7,7 @@
 use std::collections::BTreeSet;
 
 use kerf_solver::engagement::{
-    self, EngagementAnswer, EngagementRequest, EngagementSample, MillingMode, PathEngagement,
-    SampleFlag,
+    self, EngagementAnswer, EngagementRequest, EngagementSample, MillingMode, PathEngagement, SampleFlag,
 };
 use kerf_solver::tool::{Tool, ToolKind};
 use serde_json::{Value, json};
@@ -28,9 +27,7 @@ fn case(id_prefix: &str) -> Value {
 }
 
 fn num(value: &Value) -> f64 {
-    value
-        .as_f64()
-        .unwrap_or_else(|| panic!("not a number: {value}"))
+    value.as_f64().unwrap_or_else(|| panic!("not a number: {value}"))
 }
 
 fn tool(diameter: f64) -> Tool {
@@ -38,13 +35,7 @@ fn tool(diameter: f64) -> Tool {
 }
 
 /// Builds the API request from a fixture input block (stock and path pass through unchanged).
-fn request(
-    stock: &Value,
-    path: &Value,
-    cutting: &Value,
-    flutes: &Value,
-    extra: Value,
-) -> EngagementRequest {
+fn request(stock: &Value, path: &Value, cutting: &Value, flutes: &Value, extra: Value) -> EngagementRequest {
     let polygons: Vec<Value> = stock["polygons"]
         .as_array()
         .unwrap()
@@ -87,18 +78,11 @@ fn solve(request: &EngagementRequest, diameter: f64) -> PathEngagement {
 }
 
 fn sample_at(result: &PathEngagement, s: f64) -> &EngagementSample {
-    result
-        .samples
-        .iter()
-        .find(|sample| (sample.s - s).abs() < 1e-6)
-        .unwrap_or_else(|| panic!("no sample at s = {s}"))
+    result.samples.iter().find(|sample| (sample.s - s).abs() < 1e-6).unwrap_or_else(|| panic!("no sample at s = {s}"))
 }
 
 fn close(what: &str, got: f64, expected: f64, tolerance: f64) {
-    assert!(
-        (got - expected).abs() <= tolerance,
-        "{what}: got {got}, expected {expected} ± {tolerance}"
-    );
+    assert!((got - expected).abs() <= tolerance, "{what}: got {got}, expected {expected} ± {tolerance}");
 }
 
 fn close_rel(what: &str, got: f64, expected: f64, relative: f64) {
@@ -136,21 +120,11 @@ struct Tolerances {
 
 fn exact_tolerances() -> Tolerances {
     let t = &fixture()["tolerances"]["exact_engine"];
-    Tolerances {
-        angle: num(&t["angle_deg"]),
-        ae: num(&t["ae_mm"]),
-        h_rel: num(&t["H_rel"]),
-    }
+    Tolerances { angle: num(&t["angle_deg"]), ae: num(&t["ae_mm"]), h_rel: num(&t["H_rel"]) }
 }
 
 /// Compares one fixture checkpoint with the sample at its s.
-fn check_point(
-    label: &str,
-    result: &PathEngagement,
-    checkpoint: &Value,
-    flutes: &[u32],
-    tol: &Tolerances,
-) {
+fn check_point(label: &str, result: &PathEngagement, checkpoint: &Value, flutes: &[u32], tol: &Tolerances) {
     let s = num(&checkpoint["s"]);
     let sample = sample_at(result, s);
     let what = |field: &str| format!("{label} s={s} {field}");
@@ -159,96 +133,30 @@ fn check_point(
         close(&what("y"), sample.position[1], num(&pos[1]), 1e-3);
     }
     let arcs = checkpoint["arcs"].as_array().unwrap();
-    assert_eq!(
-        sample.arcs.len(),
-        arcs.len(),
-        "{}: {:?}",
-        what("arcs"),
-        sample.arcs
-    );
+    assert_eq!(sample.arcs.len(), arcs.len(), "{}: {:?}", what("arcs"), sample.arcs);
     for (got, expected) in sample.arcs.iter().zip(arcs) {
         close(&what("arc from"), got[0], num(&expected[0]), tol.angle);
         close(&what("arc to"), got[1], num(&expected[1]), tol.angle);
     }
-    close(
-        &what("engaged_deg"),
-        sample.engaged_deg,
-        num(&checkpoint["engaged_deg"]),
-        2.0 * tol.angle,
-    );
-    close(
-        &what("ae"),
-        sample.radial_depth,
-        num(&checkpoint["ae"]),
-        tol.ae,
-    );
+    close(&what("engaged_deg"), sample.engaged_deg, num(&checkpoint["engaged_deg"]), 2.0 * tol.angle);
+    close(&what("ae"), sample.radial_depth, num(&checkpoint["ae"]), tol.ae);
     let details = checkpoint["arc_details"].as_array().unwrap();
-    assert_eq!(
-        sample.arc_details.len(),
-        details.len(),
-        "{}",
-        what("arc_details")
-    );
+    assert_eq!(sample.arc_details.len(), details.len(), "{}", what("arc_details"));
     for (got, expected) in sample.arc_details.iter().zip(details) {
-        close(
-            &what("entry"),
-            got.entry_deg,
-            num(&expected["entry"]),
-            tol.angle,
-        );
-        close(
-            &what("exit"),
-            got.exit_deg,
-            num(&expected["exit"]),
-            tol.angle,
-        );
-        close(
-            &what("phi"),
-            got.engage_deg,
-            num(&expected["phi_engage"]),
-            tol.angle,
-        );
-        close(
-            &what("psi"),
-            got.disengage_deg,
-            num(&expected["psi_disengage"]),
-            tol.angle,
-        );
+        close(&what("entry"), got.entry_deg, num(&expected["entry"]), tol.angle);
+        close(&what("exit"), got.exit_deg, num(&expected["exit"]), tol.angle);
+        close(&what("phi"), got.engage_deg, num(&expected["phi_engage"]), tol.angle);
+        close(&what("psi"), got.disengage_deg, num(&expected["psi_disengage"]), tol.angle);
         // Ratios are printed to 4 decimals; 0.05° moves sin θ by at most 0.0009.
-        close(
-            &what("h_entry"),
-            got.entry_thickness_ratio,
-            num(&expected["h_entry_ratio"]),
-            1e-3,
-        );
-        close(
-            &what("h_exit"),
-            got.exit_thickness_ratio,
-            num(&expected["h_exit_ratio"]),
-            1e-3,
-        );
-        assert_eq!(
-            mode_name(got.mode),
-            expected["mode"].as_str().unwrap(),
-            "{}",
-            what("mode")
-        );
+        close(&what("h_entry"), got.entry_thickness_ratio, num(&expected["h_entry_ratio"]), 1e-3);
+        close(&what("h_exit"), got.exit_thickness_ratio, num(&expected["h_exit_ratio"]), 1e-3);
+        assert_eq!(mode_name(got.mode), expected["mode"].as_str().unwrap(), "{}", what("mode"));
     }
-    let flags: BTreeSet<&str> = checkpoint["flags"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|f| f.as_str().unwrap())
-        .collect();
+    let flags: BTreeSet<&str> = checkpoint["flags"].as_array().unwrap().iter().map(|f| f.as_str().unwrap()).collect();
     assert_eq!(flag_names(sample), flags, "{}", what("flags"));
     for (column, k) in flutes.iter().enumerate() {
         let key = k.to_string();
-        close_rel(
-            &what(&format!("H k={k}")),
-            sample.thickness[column],
-            num(&checkpoint["H_mm_by_k"][&key]),
-            tol.h_rel,
-        );
+        close_rel(&what(&format!("H k={k}")), sample.thickness[column], num(&checkpoint["H_mm_by_k"][&key]), tol.h_rel);
         assert_eq!(
             u64::from(sample.teeth[column]),
             checkpoint["n_max_by_k"][&key].as_u64().unwrap(),
@@ -259,12 +167,7 @@ fn check_point(
 }
 
 fn flute_list(value: &Value) -> Vec<u32> {
-    value
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|k| u32::try_from(k.as_u64().unwrap()).unwrap())
-        .collect()
+    value.as_array().unwrap().iter().map(|k| u32::try_from(k.as_u64().unwrap()).unwrap()).collect()
 }
 
 fn recommended_set(result: &PathEngagement) -> BTreeSet<u32> {
@@ -275,33 +178,14 @@ fn expected_set(value: &Value) -> BTreeSet<u32> {
     flute_list(value).into_iter().collect()
 }
 
-fn check_statistics(
-    label: &str,
-    result: &PathEngagement,
-    expected: &Value,
-    max_rel: f64,
-    mean_rel: f64,
-) {
+fn check_statistics(label: &str, result: &PathEngagement, expected: &Value, max_rel: f64, mean_rel: f64) {
     for flute in &result.flutes {
         let key = flute.flute_count.to_string();
         let row = &expected[&key];
-        close_rel(
-            &format!("{label} max k={key}"),
-            flute.max_thickness,
-            num(&row["max"]),
-            max_rel,
-        );
-        close_rel(
-            &format!("{label} mean k={key}"),
-            flute.mean_thickness,
-            num(&row["mean"]),
-            mean_rel,
-        );
+        close_rel(&format!("{label} max k={key}"), flute.max_thickness, num(&row["max"]), max_rel);
+        close_rel(&format!("{label} mean k={key}"), flute.mean_thickness, num(&row["mean"]), mean_rel);
         // Sampling-dependent: only the ordering is checked (fixture "min_and_median").
-        assert!(
-            flute.min_thickness <= flute.mean_thickness
-                && flute.mean_thickness <= flute.max_thickness
-        );
+        assert!(flute.min_thickness <= flute.mean_thickness && flute.mean_thickness <= flute.max_thickness);
         assert!((flute.min_thickness..=flute.max_thickness).contains(&flute.median_thickness));
     }
 }
@@ -328,13 +212,8 @@ fn c1_request(engine: &str) -> (EngagementRequest, Value) {
         json!({"step": sim["ds"], "thickness_limit": input["evaluation"]["T1_mm"],
                "time_limit_s": input["evaluation"]["T2_s"]})
     };
-    let request = request(
-        &input["stock"],
-        &input["path"],
-        &input["cutting"],
-        &input["tool"]["flute_candidates"],
-        extra,
-    );
+    let request =
+        request(&input["stock"], &input["path"], &input["cutting"], &input["tool"]["flute_candidates"], extra);
     (request, c)
 }
 
@@ -344,12 +223,7 @@ fn c1_exact_engine() {
     let expected = &c["expected"];
     let result = solve(&request, 10.0);
     let flutes = flute_list(&c["input"]["tool"]["flute_candidates"]);
-    close(
-        "path length",
-        result.path_length,
-        num(&expected["path_length"]),
-        1e-9,
-    );
+    close("path length", result.path_length, num(&expected["path_length"]), 1e-9);
     let tol = exact_tolerances();
     // s = 71.25 lies off the 0.1 mm grid: the checkpoints are read from a 0.05 mm run.
     let mut fine = request.clone();
@@ -361,17 +235,9 @@ fn c1_exact_engine() {
     check_statistics("C1", &result, &expected["representative_mm"], 0.002, 0.01);
     for flute in &result.flutes {
         let key = flute.flute_count.to_string();
-        close_rel(
-            &format!("time k={key}"),
-            flute.time_s,
-            num(&expected["machining_time_s"][&key]),
-            1e-4,
-        );
+        close_rel(&format!("time k={key}"), flute.time_s, num(&expected["machining_time_s"][&key]), 1e-4);
     }
-    assert_eq!(
-        recommended_set(&result),
-        expected_set(&expected["recommended_flutes"])
-    );
+    assert_eq!(recommended_set(&result), expected_set(&expected["recommended_flutes"]));
     // Fastest first.
     assert_eq!(result.recommended, vec![4, 3]);
     let continuum: Vec<[f64; 2]> = expected["engaged_intervals_s_continuum_open"]
@@ -380,12 +246,7 @@ fn c1_exact_engine() {
         .iter()
         .map(|i| [num(&i[0]), num(&i[1])])
         .collect();
-    check_intervals(
-        "C1 engaged",
-        &result.engaged_intervals,
-        &continuum,
-        num(&c["input"]["simulation"]["ds"]),
-    );
+    check_intervals("C1 engaged", &result.engaged_intervals, &continuum, num(&c["input"]["simulation"]["ds"]));
     // The full-slot samples carry the closed-form table of §5.6.
     let slot = sample_at(&result, 30.0);
     for (column, k) in flutes.iter().enumerate() {
@@ -397,10 +258,7 @@ fn c1_exact_engine() {
         );
     }
     let codes: Vec<&str> = result.warnings.iter().map(|w| w.code).collect();
-    assert!(
-        codes.contains(&"W_FULL_IMMERSION") && codes.contains(&"W_MULTI_ARC"),
-        "{codes:?}"
-    );
+    assert!(codes.contains(&"W_FULL_IMMERSION") && codes.contains(&"W_MULTI_ARC"), "{codes:?}");
     assert!(!codes.contains(&"W_PLUNGE"), "{codes:?}");
 }
 
@@ -452,24 +310,13 @@ fn c1_dots_engine() {
         num(&dots["representative_max_rel"]),
         num(&dots["representative_mean_rel"]),
     );
-    assert_eq!(
-        recommended_set(&result),
-        expected_set(&expected["recommended_flutes"])
-    );
+    assert_eq!(recommended_set(&result), expected_set(&expected["recommended_flutes"]));
     // a_e within 2g of the continuum somewhere in [s − Δs − g, s + g] (one step of lag).
     let ae_tolerance = 2.0 * grid;
     for sample in result.samples.iter().skip(1) {
-        let window =
-            (0..=200).map(|i| sample.s - step - grid + (step + 2.0 * grid) * f64::from(i) / 200.0);
-        let best = window
-            .map(|s| (c1_radial_depth(s) - sample.radial_depth).abs())
-            .fold(f64::INFINITY, f64::min);
-        assert!(
-            best <= ae_tolerance,
-            "dots a_e at s = {}: {} (off by {best})",
-            sample.s,
-            sample.radial_depth
-        );
+        let window = (0..=200).map(|i| sample.s - step - grid + (step + 2.0 * grid) * f64::from(i) / 200.0);
+        let best = window.map(|s| (c1_radial_depth(s) - sample.radial_depth).abs()).fold(f64::INFINITY, f64::min);
+        assert!(best <= ae_tolerance, "dots a_e at s = {}: {} (off by {best})", sample.s, sample.radial_depth);
     }
     // Steady phases: H within the dots engine's H tolerance.
     let h_rel = num(&dots["H_rel"]);
@@ -551,12 +398,7 @@ fn c2_part_b_inside_corner() {
         );
         let result = solve(&request, 10.0);
         let label = format!("C2B {name}");
-        close(
-            &format!("{label} length"),
-            result.path_length,
-            num(&expected["path_length"]),
-            1e-4,
-        );
+        close(&format!("{label} length"), result.path_length, num(&expected["path_length"]), 1e-4);
         for checkpoint in expected["checkpoints"].as_array().unwrap() {
             check_point(&label, &result, checkpoint, &flutes, &tol);
         }
@@ -566,31 +408,13 @@ fn c2_part_b_inside_corner() {
             num(&expected["max_engaged_deg"]),
             2.0 * tol.angle,
         );
-        let at = expected
-            .get("max_engaged_at_s")
-            .or_else(|| expected.get("max_engaged_at_s_approx"))
-            .unwrap();
-        close(
-            &format!("{label} max engaged at"),
-            result.max_engaged_at_s,
-            num(at),
-            0.1 + step,
-        );
+        let at = expected.get("max_engaged_at_s").or_else(|| expected.get("max_engaged_at_s_approx")).unwrap();
+        close(&format!("{label} max engaged at"), result.max_engaged_at_s, num(at), 0.1 + step);
         if let Some(max_ae) = expected.get("max_ae") {
-            close(
-                &format!("{label} max ae"),
-                result.max_radial_depth,
-                num(max_ae),
-                tol.ae,
-            );
+            close(&format!("{label} max ae"), result.max_radial_depth, num(max_ae), tol.ae);
         } else {
             let at_peak = sample_at(&result, result.max_engaged_at_s).radial_depth;
-            close(
-                &format!("{label} ae at max engagement"),
-                at_peak,
-                num(&expected["max_ae_at_that_s"]),
-                tol.ae,
-            );
+            close(&format!("{label} ae at max engagement"), at_peak, num(&expected["max_ae_at_that_s"]), tol.ae);
         }
         for flute in &result.flutes {
             let key = flute.flute_count.to_string();
@@ -603,21 +427,14 @@ fn c2_part_b_inside_corner() {
         }
         let codes: Vec<&str> = result.warnings.iter().map(|w| w.code).collect();
         if name == "sharp" {
-            assert!(
-                codes.contains(&"W_VERTEX") && codes.contains(&"W_ENGAGEMENT_SPIKE"),
-                "{codes:?}"
-            );
+            assert!(codes.contains(&"W_VERTEX") && codes.contains(&"W_ENGAGEMENT_SPIKE"), "{codes:?}");
         }
     }
 }
 
 // ---------------------------------------------------------------- C3
 
-fn c3_request(
-    cutting: &Value,
-    limits: Value,
-    engine: Option<(f64, f64)>,
-) -> (EngagementRequest, Value) {
+fn c3_request(cutting: &Value, limits: Value, engine: Option<(f64, f64)>) -> (EngagementRequest, Value) {
     let c = case("C3");
     let input = &c["input"];
     let mut extra = limits;
@@ -629,13 +446,7 @@ fn c3_request(
         }
         None => extra["step"] = input["simulation"]["ds"].clone(),
     }
-    let request = request(
-        &input["stock"],
-        &input["path"],
-        cutting,
-        &input["tool"]["flute_candidates"],
-        extra,
-    );
+    let request = request(&input["stock"], &input["path"], cutting, &input["tool"]["flute_candidates"], extra);
     (request, c)
 }
 
@@ -649,12 +460,7 @@ fn c3_exact_engine_constant_fz() {
     let result = solve(&request, 20.0);
     let flutes = flute_list(&input["tool"]["flute_candidates"]);
     let tol = exact_tolerances();
-    close(
-        "C3 length",
-        result.path_length,
-        num(&expected["path_length"]),
-        1e-9,
-    );
+    close("C3 length", result.path_length, num(&expected["path_length"]), 1e-9);
     for checkpoint in expected["checkpoints"].as_array().unwrap() {
         check_point("C3", &result, checkpoint, &flutes, &tol);
     }
@@ -679,17 +485,8 @@ fn c3_exact_engine_constant_fz() {
             1e-4,
         );
     }
-    check_statistics(
-        "C3",
-        &result,
-        &expected["representative_mm_constant_fz"],
-        0.002,
-        0.01,
-    );
-    assert_eq!(
-        recommended_set(&result),
-        expected_set(&expected["recommended_flutes_constant_fz"])
-    );
+    check_statistics("C3", &result, &expected["representative_mm_constant_fz"], 0.002, 0.01);
+    assert_eq!(recommended_set(&result), expected_set(&expected["recommended_flutes_constant_fz"]));
     let mut continuum: Vec<[f64; 2]> = expected["engaged_intervals_s_continuum"]
         .as_object()
         .unwrap()
@@ -697,12 +494,7 @@ fn c3_exact_engine_constant_fz() {
         .map(|i| [num(&i[0]), num(&i[1])])
         .collect();
     continuum.sort_by(|a, b| a[0].total_cmp(&b[0]));
-    check_intervals(
-        "C3 engaged",
-        &result.engaged_intervals,
-        &continuum,
-        num(&input["simulation"]["ds"]),
-    );
+    check_intervals("C3 engaged", &result.engaged_intervals, &continuum, num(&input["simulation"]["ds"]));
     // Simultaneous cutting: k = 4 and 8 on b, 6 on c, 5/8/10 on a.
     for k in [4_u32, 5, 6, 8, 10] {
         let flute = result.flutes.iter().find(|f| f.flute_count == k).unwrap();
@@ -727,46 +519,16 @@ fn c3_exact_engine_constant_vf() {
         for flute in &result.flutes {
             let k = flute.flute_count.to_string();
             let row = &expected["representative_mm"][&k];
-            close_rel(
-                &format!("vf fz k={k}"),
-                flute.feed_per_tooth,
-                num(&row["fz"]),
-                1e-5,
-            );
-            close_rel(
-                &format!("vf max k={k}"),
-                flute.max_thickness,
-                num(&row["max"]),
-                0.002,
-            );
-            close_rel(
-                &format!("vf mean k={k}"),
-                flute.mean_thickness,
-                num(&row["mean"]),
-                0.01,
-            );
-            close_rel(
-                &format!("vf time k={k}"),
-                flute.time_s,
-                num(&expected["machining_time_s_all_k"]),
-                1e-9,
-            );
+            close_rel(&format!("vf fz k={k}"), flute.feed_per_tooth, num(&row["fz"]), 1e-5);
+            close_rel(&format!("vf max k={k}"), flute.max_thickness, num(&row["max"]), 0.002);
+            close_rel(&format!("vf mean k={k}"), flute.mean_thickness, num(&row["mean"]), 0.01);
+            close_rel(&format!("vf time k={k}"), flute.time_s, num(&expected["machining_time_s_all_k"]), 1e-9);
         }
-        assert_eq!(
-            recommended_set(&result),
-            expected_set(&expected[key]),
-            "{key}"
-        );
-        let no_recommendation = result
-            .warnings
-            .iter()
-            .find(|w| w.code == "W_NO_RECOMMENDATION");
+        assert_eq!(recommended_set(&result), expected_set(&expected[key]), "{key}");
+        let no_recommendation = result.warnings.iter().find(|w| w.code == "W_NO_RECOMMENDATION");
         if key == "recommended_T2_20" {
             let message = &no_recommendation.expect("W_NO_RECOMMENDATION").message;
-            assert!(
-                message.contains("time 24") && message.contains("> 20 s"),
-                "{message}"
-            );
+            assert!(message.contains("time 24") && message.contains("> 20 s"), "{message}");
         } else {
             assert!(no_recommendation.is_none());
         }
@@ -781,11 +543,7 @@ fn c3_dots_engine() {
     let dots = &fixture()["tolerances"]["dot_engine"];
     let limits = json!({"thickness_limit": input["evaluation"]["T1_mm"], "time_limit_s": input["evaluation"]["T2_s"]});
     let settings = &input["simulation"]["dot_engine"];
-    let (request, _) = c3_request(
-        &input["cutting"],
-        limits,
-        Some((num(&settings["grid"]), num(&settings["ds"]))),
-    );
+    let (request, _) = c3_request(&input["cutting"], limits, Some((num(&settings["grid"]), num(&settings["ds"]))));
     let result = solve(&request, 20.0);
     check_statistics(
         "C3 dots",
@@ -794,10 +552,7 @@ fn c3_dots_engine() {
         num(&dots["representative_max_rel"]),
         num(&dots["representative_mean_rel"]),
     );
-    assert_eq!(
-        recommended_set(&result),
-        expected_set(&expected["recommended_flutes_constant_fz"])
-    );
+    assert_eq!(recommended_set(&result), expected_set(&expected["recommended_flutes_constant_fz"]));
     let tolerance = num(&settings["ds"]) + num(&settings["grid"]);
     let mut continuum: Vec<[f64; 2]> = expected["engaged_intervals_s_continuum"]
         .as_object()
@@ -806,10 +561,5 @@ fn c3_dots_engine() {
         .map(|i| [num(&i[0]), num(&i[1])])
         .collect();
     continuum.sort_by(|a, b| a[0].total_cmp(&b[0]));
-    check_intervals(
-        "C3 dots engaged",
-        &result.engaged_intervals,
-        &continuum,
-        tolerance + num(&settings["ds"]),
-    );
+    check_intervals("C3 dots engaged", &result.engaged_intervals, &continuum, tolerance + num(&settings["ds"]));
 }

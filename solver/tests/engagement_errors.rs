@@ -4,9 +4,8 @@
 //! many samples, and the other refusals; a path that never touches the stock is not an error
 //! (§9: all zeros with `W_NO_CONTACT`).
 
-use kerf_solver::engagement::{
-    self, EngagementAnswer, EngagementRequest, MAX_GRID_DOTS, MAX_SAMPLES, Post, program,
-};
+use kerf_solver::engagement::{self, EngagementAnswer, EngagementRequest, MAX_GRID_DOTS, MAX_SAMPLES, program};
+use kerf_solver::gcode::Post;
 use kerf_solver::gcode::{Dialect, Reference, ToolCall};
 use kerf_solver::tool::{Tool, ToolKind};
 use serde_json::{Value, json};
@@ -41,11 +40,7 @@ fn refused(request: &EngagementRequest) -> (String, Option<String>, String) {
     let Err(error) = engagement::solve(request, &tool()) else {
         panic!("should be refused");
     };
-    (
-        error.code().to_owned(),
-        error.field().map(str::to_owned),
-        error.message().to_owned(),
-    )
+    (error.code().to_owned(), error.field().map(str::to_owned), error.message().to_owned())
 }
 
 #[track_caller]
@@ -59,11 +54,7 @@ fn assert_refused(changes: Value, code: &str, field: &str) -> String {
 #[test]
 fn table_of_bad_inputs() {
     // Self-intersecting stock (a bow tie), and two regions that overlap.
-    assert_refused(
-        json!({"stock": {"polygon": [[0, 0], [60, 40], [60, 0], [0, 40]]}}),
-        "E_STOCK",
-        "stock.polygon[0]",
-    );
+    assert_refused(json!({"stock": {"polygon": [[0, 0], [60, 40], [60, 0], [0, 40]]}}), "E_STOCK", "stock.polygon[0]");
     assert_refused(
         json!({"stock": {"polygons": [
             {"outer": [[0, 0], [30, 0], [30, 30], [0, 30]]},
@@ -71,30 +62,14 @@ fn table_of_bad_inputs() {
         "E_STOCK",
         "stock.polygons[0].outer[1]",
     );
-    assert_refused(
-        json!({"stock": {"polygon": [[0, 0], [1, 1], [0, 0]]}}),
-        "E_STOCK",
-        "stock.polygon",
-    );
-    assert_refused(
-        json!({"stock": {"polygon": [[0, 0], [1, 1], [2, 2]]}}),
-        "E_STOCK",
-        "stock.polygon[0]",
-    );
+    assert_refused(json!({"stock": {"polygon": [[0, 0], [1, 1], [0, 0]]}}), "E_STOCK", "stock.polygon");
+    assert_refused(json!({"stock": {"polygon": [[0, 0], [1, 1], [2, 2]]}}), "E_STOCK", "stock.polygon[0]");
     // Empty paths.
     assert_refused(json!({"path": []}), "E_PATH", "path");
     assert_refused(json!({"path": [[1, 1]]}), "E_PATH", "path");
     assert_refused(json!({"path": [[1, 1], [1, 1]]}), "E_PATH", "path");
-    assert_refused(
-        json!({"path": {"start": [0, 0], "segments": []}}),
-        "E_PATH",
-        "path",
-    );
-    assert_refused(
-        json!({"path": {"segments": [{"type": "line", "to": [1, 0]}]}}),
-        "E_PATH",
-        "path.start",
-    );
+    assert_refused(json!({"path": {"start": [0, 0], "segments": []}}), "E_PATH", "path");
+    assert_refused(json!({"path": {"segments": [{"type": "line", "to": [1, 0]}]}}), "E_PATH", "path.start");
     assert_refused(json!({"path": null}), "E_PATH", "path");
     // Arc centre not equidistant (§2.3).
     assert_refused(
@@ -109,17 +84,9 @@ fn table_of_bad_inputs() {
     assert_refused(json!({"feed": 400}), "E_INPUT", "feed");
     assert_refused(json!({"spindle_rpm": 0}), "E_INPUT", "spindle_rpm");
     // Flute counts out of range, repeated or empty.
-    assert_refused(
-        json!({"flute_counts": [1, 0]}),
-        "E_INPUT",
-        "flute_counts[1]",
-    );
+    assert_refused(json!({"flute_counts": [1, 0]}), "E_INPUT", "flute_counts[1]");
     assert_refused(json!({"flute_counts": [33]}), "E_INPUT", "flute_counts[0]");
-    assert_refused(
-        json!({"flute_counts": [2, 4, 2]}),
-        "E_INPUT",
-        "flute_counts[2]",
-    );
+    assert_refused(json!({"flute_counts": [2, 4, 2]}), "E_INPUT", "flute_counts[2]");
     assert_refused(json!({"flute_counts": []}), "E_INPUT", "flute_counts");
     // Numbers out of range (coordinates beyond ±1 km, absurd feeds).
     assert_refused(json!({"path": [[0, 0], [2e6, 0]]}), "E_INPUT", "path[1][0]");
@@ -129,26 +96,14 @@ fn table_of_bad_inputs() {
     assert_refused(json!({"thickness_limit": -1}), "E_INPUT", "thickness_limit");
     assert_refused(json!({"grid": 0.1}), "E_INPUT", "grid");
     assert_refused(json!({"engine": "dots", "grid": 0}), "E_INPUT", "grid");
-    assert_refused(
-        json!({"burr_disengage_deg": 200}),
-        "E_INPUT",
-        "burr_disengage_deg",
-    );
-    assert_refused(
-        json!({"feed_plan": {"target_thickness": 0.05}}),
-        "E_INPUT",
-        "feed_plan.max_feed",
-    );
+    assert_refused(json!({"burr_disengage_deg": 200}), "E_INPUT", "burr_disengage_deg");
+    assert_refused(json!({"feed_plan": {"target_thickness": 0.05}}), "E_INPUT", "feed_plan.max_feed");
     assert_refused(
         json!({"feed_plan": {"target_thickness": 0, "max_feed": 5000}}),
         "E_INPUT",
         "feed_plan.target_thickness",
     );
-    assert_refused(
-        json!({"path": [[0, 0], [1, 1]], "paths": [{"path": [[0, 0], [1, 1]]}]}),
-        "E_INPUT",
-        "paths",
-    );
+    assert_refused(json!({"path": [[0, 0], [1, 1]], "paths": [{"path": [[0, 0], [1, 1]]}]}), "E_INPUT", "paths");
     assert_refused(
         json!({"path": null, "paths": [{"path": [[0, 0], [5, 0]]}, {"path": [[3, 3]]}]}),
         "E_PATH",
@@ -182,10 +137,7 @@ fn non_finite_numbers_name_their_field() {
     request.spindle_rpm = f64::NAN;
     assert_eq!(refused(&request).1.as_deref(), Some("spindle_rpm"));
     let mut request = with(json!({}));
-    request.path = Some(engagement::PathInput::Points(vec![
-        [0.0, 0.0],
-        [f64::INFINITY, 1.0],
-    ]));
+    request.path = Some(engagement::PathInput::Points(vec![[0.0, 0.0], [f64::INFINITY, 1.0]]));
     assert_eq!(refused(&request).1.as_deref(), Some("path[1][0]"));
     let mut request = with(json!({}));
     request.stock.polygon = Some(vec![[0.0, 0.0], [1.0, f64::NAN], [0.0, 1.0]]);
@@ -210,10 +162,7 @@ fn grid_over_the_memory_limit_is_refused_with_the_limit() {
         "stock": {"polygon": [[0, 0], [1000, 0], [1000, 1000], [0, 1000]]},
         "path": [[-10, -10], [1010, 1010]], "engine": "dots", "grid": 0.1, "step": 0.0001,
     })));
-    assert_eq!(
-        code, "E_TOO_MANY_SAMPLES",
-        "the grid passed, the samples did not"
-    );
+    assert_eq!(code, "E_TOO_MANY_SAMPLES", "the grid passed, the samples did not");
     let bitmap = assert_refused(
         json!({"stock": {"bitmap": {"origin": [0, 0], "cell": 0.001, "width": 100_000, "height": 100_000, "data": ""}}}),
         "E_GRID_MEMORY",
@@ -230,10 +179,7 @@ fn dots_work_over_the_limit_is_refused() {
         "path": [[-60, 50], [61, 50]], "engine": "dots", "grid": 0.001, "step": 0.01,
     }));
     let error = engagement::solve(&request, &Tool::new(ToolKind::Flat, 50.0)).unwrap_err();
-    assert_eq!(
-        (error.code(), error.field()),
-        ("E_WORK_LIMIT", Some("grid"))
-    );
+    assert_eq!((error.code(), error.field()), ("E_WORK_LIMIT", Some("grid")));
     assert!(error.message().contains("5e8"), "{}", error.message());
 }
 
@@ -242,11 +188,7 @@ fn too_many_samples_is_refused_with_the_limit() {
     let message = assert_refused(json!({"step": 1e-4}), "E_TOO_MANY_SAMPLES", "step");
     assert!(message.contains(&MAX_SAMPLES.to_string()), "{message}");
     let candidates: Vec<Value> = (0..17).map(|_| json!({"path": [[0, 0], [5, 0]]})).collect();
-    assert_refused(
-        json!({"path": null, "paths": candidates}),
-        "E_TOO_LARGE",
-        "paths",
-    );
+    assert_refused(json!({"path": null, "paths": candidates}), "E_TOO_LARGE", "paths");
 }
 
 #[test]
@@ -256,28 +198,10 @@ fn a_path_that_never_touches_the_stock_gives_zeros_and_a_warning() {
     let EngagementAnswer::Single(result) = answer else {
         panic!("single path expected");
     };
-    let warning = result
-        .warnings
-        .iter()
-        .find(|w| w.code == "W_NO_CONTACT")
-        .expect("W_NO_CONTACT");
-    assert!(
-        warning.message.contains("never touches"),
-        "{}",
-        warning.message
-    );
-    assert!(
-        result
-            .samples
-            .iter()
-            .all(|s| s.arcs.is_empty() && s.radial_depth == 0.0)
-    );
-    assert!(
-        result
-            .flutes
-            .iter()
-            .all(|f| f.max_thickness == 0.0 && f.mean_thickness == 0.0)
-    );
+    let warning = result.warnings.iter().find(|w| w.code == "W_NO_CONTACT").expect("W_NO_CONTACT");
+    assert!(warning.message.contains("never touches"), "{}", warning.message);
+    assert!(result.samples.iter().all(|s| s.arcs.is_empty() && s.radial_depth == 0.0));
+    assert!(result.flutes.iter().all(|f| f.max_thickness == 0.0 && f.mean_thickness == 0.0));
     assert!(result.engaged_intervals.is_empty());
     // T1 is trivially met; T2 = 20 s is met from k = 2 (L = 80 mm: 32 s / k).
     assert_eq!(result.recommended, vec![4, 3, 2]);
@@ -286,16 +210,9 @@ fn a_path_that_never_touches_the_stock_gives_zeros_and_a_warning() {
 #[test]
 fn program_needs_the_cutting_depth() {
     let answer = engagement::solve(&with(json!({})), &tool()).unwrap();
-    let post = Post {
-        dialect: Dialect::Fanuc,
-        reference: Reference::Tip,
-        tool: ToolCall::Table(3),
-    };
+    let post = Post { dialect: Dialect::Fanuc, reference: Reference::Tip, tool: ToolCall::Table(3) };
     let error = program(&answer, 0, &post).unwrap_err();
-    assert_eq!(
-        (error.code(), error.field()),
-        ("E_INPUT", Some("axial_depth"))
-    );
+    assert_eq!((error.code(), error.field()), ("E_INPUT", Some("axial_depth")));
     let error = program(&answer, 1, &post).unwrap_err();
     assert_eq!(error.field(), Some("candidate"));
 }
@@ -314,9 +231,6 @@ fn malformed_json_is_rejected_by_serde() {
         for (key, value) in bad.as_object().unwrap() {
             body[key] = value.clone();
         }
-        assert!(
-            serde_json::from_value::<EngagementRequest>(body).is_err(),
-            "{bad}"
-        );
+        assert!(serde_json::from_value::<EngagementRequest>(body).is_err(), "{bad}");
     }
 }

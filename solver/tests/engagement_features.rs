@@ -3,8 +3,9 @@
 //! never lets the chip exceed the target) and its G-code program, and determinism.
 
 use kerf_solver::engagement::{
-    self, EngagementAnswer, EngagementRequest, FeedLimit, PathEngagement, Post, SampleFlag, program,
+    self, EngagementAnswer, EngagementRequest, FeedLimit, PathEngagement, SampleFlag, program,
 };
+use kerf_solver::gcode::Post;
 use kerf_solver::gcode::{Dialect, Reference, ToolCall};
 use kerf_solver::tool::{Tool, ToolKind};
 use proptest::prelude::*;
@@ -42,13 +43,7 @@ fn api_example_answers_with_the_api_fields() {
     for key in ["s", "t", "arcs", "engaged_deg", "radial_depth"] {
         assert!(sample.get(key).is_some(), "sample misses {key}");
     }
-    for key in [
-        "max_thickness",
-        "mean_thickness",
-        "min_thickness",
-        "time_s",
-        "recommended",
-    ] {
+    for key in ["max_thickness", "mean_thickness", "min_thickness", "time_s", "recommended"] {
         assert!(text["flutes"][0].get(key).is_some(), "flute misses {key}");
     }
     // A full slot through a 60 mm block: H max is the slot table (§5.6); L = 80 mm, so
@@ -64,12 +59,8 @@ fn api_example_answers_with_the_api_fields() {
 
 #[test]
 fn same_request_same_bytes() {
-    let first =
-        serde_json::to_string(&engagement::solve(&request(api_example()), &tool()).unwrap())
-            .unwrap();
-    let second =
-        serde_json::to_string(&engagement::solve(&request(api_example()), &tool()).unwrap())
-            .unwrap();
+    let first = serde_json::to_string(&engagement::solve(&request(api_example()), &tool()).unwrap()).unwrap();
+    let second = serde_json::to_string(&engagement::solve(&request(api_example()), &tool()).unwrap()).unwrap();
     assert_eq!(first, second);
 }
 
@@ -117,17 +108,9 @@ fn stock_left_by_an_earlier_cut() {
         }
         let result = single(body);
         // Steady at X = 32.5 (s = 27.5): arc [0, 60], a_e = 2.5 (C1 checkpoint s = 100).
-        let sample = result
-            .samples
-            .iter()
-            .find(|s| (s.s - 27.5).abs() < 1e-9)
-            .unwrap();
+        let sample = result.samples.iter().find(|s| (s.s - 27.5).abs() < 1e-9).unwrap();
         let tolerance = if engine == "exact" { 1e-6 } else { 0.05 };
-        assert!(
-            (sample.radial_depth - 2.5).abs() < tolerance,
-            "{engine}: {}",
-            sample.radial_depth
-        );
+        assert!((sample.radial_depth - 2.5).abs() < tolerance, "{engine}: {}", sample.radial_depth);
         if engine == "exact" {
             assert_eq!(sample.arcs.len(), 1);
             assert!(sample.arcs[0][0].abs() < 1e-6 && (sample.arcs[0][1] - 60.0).abs() < 1e-6);
@@ -173,9 +156,8 @@ fn bitmap_of_block(
 #[test]
 fn bitmap_stock_matches_the_polygon_it_rasterises() {
     // The block [0, 60] × [0, 40] on 0.5 mm cells: the cell edges are the polygon's edges.
-    let stock = bitmap_of_block(0.5, [-5.0, -5.0], 140, 100, |x, y| {
-        (0.0..60.0).contains(&x) && (0.0..40.0).contains(&y)
-    });
+    let stock =
+        bitmap_of_block(0.5, [-5.0, -5.0], 140, 100, |x, y| (0.0..60.0).contains(&x) && (0.0..40.0).contains(&y));
     let mut body = api_example();
     body["path"] = json!([[-10, 3], [70, 3]]);
     let polygon = single(body.clone());
@@ -185,11 +167,7 @@ fn bitmap_stock_matches_the_polygon_it_rasterises() {
     for (a, b) in polygon.samples.iter().zip(&bitmap.samples) {
         assert_eq!(a.arcs.len(), b.arcs.len(), "s = {}", a.s);
         for (p, q) in a.arcs.iter().zip(&b.arcs) {
-            assert!(
-                (p[0] - q[0]).abs() < 1e-6 && (p[1] - q[1]).abs() < 1e-6,
-                "s = {}: {p:?} vs {q:?}",
-                a.s
-            );
+            assert!((p[0] - q[0]).abs() < 1e-6 && (p[1] - q[1]).abs() < 1e-6, "s = {}: {p:?} vs {q:?}", a.s);
         }
     }
     // The dots engine takes the bitmap's cells as its dots by default.
@@ -199,10 +177,7 @@ fn bitmap_stock_matches_the_polygon_it_rasterises() {
     assert_eq!(grid.cell, 0.5);
     for (origin, anchor) in grid.origin.iter().zip([-5.0, -5.0]) {
         let cells = (origin - anchor) / 0.5;
-        assert!(
-            (cells - cells.round()).abs() < 1e-9,
-            "dots line up with the bitmap cells"
-        );
+        assert!((cells - cells.round()).abs() < 1e-9, "dots line up with the bitmap cells");
     }
     let exact_max = polygon.flutes[3].max_thickness;
     assert!((dots.flutes[3].max_thickness - exact_max).abs() <= 0.02 * exact_max);
@@ -224,37 +199,16 @@ fn rapids_do_not_cut_and_collisions_are_reported() {
     assert!((result.feed_length - 120.0).abs() < 1e-9);
     let codes: Vec<&str> = result.warnings.iter().map(|w| w.code).collect();
     assert!(codes.contains(&"W_RAPID_COLLISION"), "{codes:?}");
-    assert!(
-        codes.contains(&"W_PLUNGE"),
-        "the feed after the rapid starts in material: {codes:?}"
-    );
-    let rapid = result
-        .samples
-        .iter()
-        .find(|s| (s.s - 130.0).abs() < 1e-9)
-        .unwrap();
-    assert!(
-        rapid.flags.contains(&SampleFlag::Rapid) && rapid.flags.contains(&SampleFlag::Collision)
-    );
+    assert!(codes.contains(&"W_PLUNGE"), "the feed after the rapid starts in material: {codes:?}");
+    let rapid = result.samples.iter().find(|s| (s.s - 130.0).abs() < 1e-9).unwrap();
+    assert!(rapid.flags.contains(&SampleFlag::Rapid) && rapid.flags.contains(&SampleFlag::Collision));
     assert!(rapid.arcs.is_empty());
     // Time stands still on rapids.
-    let before = result
-        .samples
-        .iter()
-        .find(|s| (s.s - 80.0).abs() < 1e-9)
-        .unwrap();
-    let after = result
-        .samples
-        .iter()
-        .find(|s| (s.s - 145.0).abs() < 1e-9)
-        .unwrap();
+    let before = result.samples.iter().find(|s| (s.s - 80.0).abs() < 1e-9).unwrap();
+    let after = result.samples.iter().find(|s| (s.s - 145.0).abs() < 1e-9).unwrap();
     assert!((after.t - before.t).abs() < 1e-9);
     // The rapid at cutting depth removed nothing: the last pass cuts a full slot.
-    let slot = result
-        .samples
-        .iter()
-        .find(|s| (s.s - 160.0).abs() < 1e-9)
-        .unwrap();
+    let slot = result.samples.iter().find(|s| (s.s - 160.0).abs() < 1e-9).unwrap();
     assert!((slot.engaged_deg - 180.0).abs() < 1e-6);
 }
 
@@ -264,11 +218,7 @@ fn peak_ratio(arcs: &[[f64; 2]]) -> f64 {
         .map(|[a, b]| {
             let steps = 2000;
             (0..=steps)
-                .map(|i| {
-                    (a + (b - a) * f64::from(i) / f64::from(steps))
-                        .to_radians()
-                        .sin()
-                })
+                .map(|i| (a + (b - a) * f64::from(i) / f64::from(steps)).to_radians().sin())
                 .chain([if *a <= 90.0 && 90.0 <= *b { 1.0 } else { 0.0 }])
                 .fold(0.0_f64, f64::max)
         })
@@ -330,11 +280,7 @@ fn program_carries_the_planned_feeds() {
     let answer = engagement::solve(&request(body), &tool()).unwrap();
     let result = &answer.candidates()[0];
     let plan = result.feed_plan.as_ref().unwrap();
-    let post = Post {
-        dialect: Dialect::Linuxcnc,
-        reference: Reference::Tip,
-        tool: ToolCall::Table(4),
-    };
+    let post = Post { dialect: Dialect::Linuxcnc, reference: Reference::Tip, tool: ToolCall::Table(4) };
     let text = program(&answer, 0, &post).unwrap();
     assert!(text.contains("T4 M06") && text.contains("S4000 M03") && text.ends_with("M30\n"));
     // Cutting at Z = 10 − 3, clearance at 15.
@@ -345,23 +291,17 @@ fn program_carries_the_planned_feeds() {
         .filter_map(|l| l.split_whitespace().find_map(|w| w.strip_prefix('F')))
         .map(|f| f.parse().unwrap())
         .collect();
-    let planned: std::collections::BTreeSet<u64> =
-        plan.blocks.iter().map(|b| b.feed.unwrap() as u64).collect();
+    let planned: std::collections::BTreeSet<u64> = plan.blocks.iter().map(|b| b.feed.unwrap() as u64).collect();
     assert!(feeds.len() >= 2, "{feeds:?}");
     // The descent into the cut runs at the nominal feed (2 flutes × 0.05 × 4000 = 400) at most.
     for feed in &feeds {
-        assert!(
-            planned.contains(&(*feed as u64)) || *feed == 400.0,
-            "F{feed} not in the plan {planned:?}"
-        );
+        assert!(planned.contains(&(*feed as u64)) || *feed == 400.0, "F{feed} not in the plan {planned:?}");
     }
     // The arc's chord points lie on the arc, within the chord tolerance.
     let mut on_arc = 0;
     for line in text.lines().filter(|l| l.starts_with("G01")) {
         let coordinate = |axis: char| -> Option<f64> {
-            line.split_whitespace()
-                .find_map(|w| w.strip_prefix(axis))
-                .and_then(|v| v.parse().ok())
+            line.split_whitespace().find_map(|w| w.strip_prefix(axis)).and_then(|v| v.parse().ok())
         };
         let (Some(x), Some(y)) = (coordinate('X'), coordinate('Y')) else {
             continue;
@@ -382,10 +322,7 @@ fn program_carries_the_planned_feeds() {
     });
     let answer = engagement::solve(&request(body), &tool()).unwrap();
     let text = program(&answer, 0, &post).unwrap();
-    let feed_words = text
-        .lines()
-        .filter(|l| l.starts_with("G01") && l.contains(" F"))
-        .count();
+    let feed_words = text.lines().filter(|l| l.starts_with("G01") && l.contains(" F")).count();
     assert_eq!(feed_words, 1, "{text}");
     assert!(text.contains("F400"));
 }

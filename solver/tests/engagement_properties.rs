@@ -181,9 +181,7 @@ fn exact_range(exact: &PathEngagement, from: f64, to: f64) -> (f64, f64) {
         .samples
         .iter()
         .filter(|s| s.s >= from - 1e-9 && s.s <= to + 1e-9)
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
-            (lo.min(s.radial_depth), hi.max(s.radial_depth))
-        })
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| (lo.min(s.radial_depth), hi.max(s.radial_depth)))
 }
 
 /// Lateral tolerance of the dots engine, in grids. The fixture states 2g ("worst observed 1.6g
@@ -202,28 +200,16 @@ fn on_arcs(arcs: &[[f64; 2]], angle: f64) -> bool {
 /// [from, to]: within 2° for 15° ≤ θ ≤ 165°, else within 2g in R·cos θ (fixture tolerance).
 /// Checked on exact samples: an exact end within the tolerance, or a boundary sweeping over
 /// the tolerance band between two consecutive exact samples (membership flips there).
-fn exact_end_near(
-    exact: &PathEngagement,
-    from: f64,
-    to: f64,
-    end: f64,
-    radius: f64,
-    grid: f64,
-) -> bool {
+fn exact_end_near(exact: &PathEngagement, from: f64, to: f64, end: f64, radius: f64, grid: f64) -> bool {
     let front = |a: f64| (-1e-9..=180.0 + 1e-9).contains(&a);
-    let window: Vec<&[[f64; 2]]> = exact
-        .samples
-        .iter()
-        .filter(|s| s.s >= from - 1e-9 && s.s <= to + 1e-9)
-        .map(|s| s.arcs.as_slice())
-        .collect();
+    let window: Vec<&[[f64; 2]]> =
+        exact.samples.iter().filter(|s| s.s >= from - 1e-9 && s.s <= to + 1e-9).map(|s| s.arcs.as_slice()).collect();
     let near = |other: f64| {
         front(other) == front(end)
             && if (15.0..=165.0).contains(&end) {
                 (other - end).abs() <= 2.0
             } else {
-                (radius * other.to_radians().cos() - radius * end.to_radians().cos()).abs()
-                    <= LATERAL * grid
+                (radius * other.to_radians().cos() - radius * end.to_radians().cos()).abs() <= LATERAL * grid
             }
     };
     let band: Vec<f64> = if (15.0..=165.0).contains(&end) {
@@ -236,13 +222,8 @@ fn exact_end_near(
             .map(|l| sign * (l / radius).clamp(-1.0, 1.0).acos().to_degrees())
             .collect()
     };
-    window
-        .iter()
-        .any(|arcs| arcs.iter().flat_map(|a| [a[0], a[1]]).any(near))
-        || window.windows(2).any(|pair| {
-            band.iter()
-                .any(|&a| on_arcs(pair[0], a) != on_arcs(pair[1], a))
-        })
+    window.iter().any(|arcs| arcs.iter().flat_map(|a| [a[0], a[1]]).any(near))
+        || window.windows(2).any(|pair| band.iter().any(|&a| on_arcs(pair[0], a) != on_arcs(pair[1], a)))
 }
 
 /// Both engines on the same request; the dots engine's a_e must lie within 2g of the
@@ -263,8 +244,7 @@ fn engines_agree(body: Value, radius: f64) -> Result<(), TestCaseError> {
     for sample in dots.samples.iter().skip(1) {
         let (low, high) = exact_range(&exact, sample.s - step - grid, sample.s + grid);
         prop_assert!(
-            sample.radial_depth >= low - LATERAL * grid
-                && sample.radial_depth <= high + LATERAL * grid,
+            sample.radial_depth >= low - LATERAL * grid && sample.radial_depth <= high + LATERAL * grid,
             "s = {}: dots a_e {} outside [{}, {}] ± 2.5g (g = {})",
             sample.s,
             sample.radial_depth,
@@ -275,14 +255,7 @@ fn engines_agree(body: Value, radius: f64) -> Result<(), TestCaseError> {
         for arc in &sample.arcs {
             for end in [arc[0], arc[1]] {
                 prop_assert!(
-                    exact_end_near(
-                        &exact,
-                        sample.s - step - grid,
-                        sample.s + grid,
-                        end,
-                        radius,
-                        grid
-                    ),
+                    exact_end_near(&exact, sample.s - step - grid, sample.s + grid, end, radius, grid),
                     "s = {}: dots arc end {} has no exact counterpart (arcs {:?})",
                     sample.s,
                     end,
@@ -322,17 +295,8 @@ fn arc_pass(radius: f64, bend: f64, depth: f64, ccw: bool) -> Value {
     let path_radius = bend * radius;
     let centre = [0.0, -path_radius + depth * 3.0 * radius];
     let (a0, a1) = (150.0_f64.to_radians(), 30.0_f64.to_radians());
-    let point = |a: f64| {
-        [
-            centre[0] + path_radius * a.cos(),
-            centre[1] + path_radius * a.sin(),
-        ]
-    };
-    let (start, end, dir) = if ccw {
-        (point(a1), point(a0), "ccw")
-    } else {
-        (point(a0), point(a1), "cw")
-    };
+    let point = |a: f64| [centre[0] + path_radius * a.cos(), centre[1] + path_radius * a.sin()];
+    let (start, end, dir) = if ccw { (point(a1), point(a0), "ccw") } else { (point(a0), point(a1), "cw") };
     let half = path_radius * 0.6;
     json!({
         "tool": 1,
@@ -363,15 +327,7 @@ fn straight_pass(radius: f64, heading: f64, offset: f64) -> Value {
 /// of nearly axis-parallel passes (about 2.2g).
 #[test]
 fn engines_agree_on_found_cases() {
-    engines_agree(
-        arc_pass(2.0, 7.806681381376496, 0.5922199446397842, false),
-        2.0,
-    )
-    .unwrap();
-    engines_agree(
-        arc_pass(2.0, 7.6240448377535905, 0.32772408123175595, false),
-        2.0,
-    )
-    .unwrap();
+    engines_agree(arc_pass(2.0, 7.806681381376496, 0.5922199446397842, false), 2.0).unwrap();
+    engines_agree(arc_pass(2.0, 7.6240448377535905, 0.32772408123175595, false), 2.0).unwrap();
     engines_agree(straight_pass(2.0, -0.1294726808083893, 0.0), 2.0).unwrap();
 }

@@ -53,15 +53,8 @@ pub(crate) fn normalise(arcs: &[Arc]) -> Vec<Arc> {
         .filter(|a| a.to.is_finite() && a.from.is_finite() && a.to > a.from)
         .map(|a| {
             let from = wrap_deg(a.from);
-            let to = if from == a.from {
-                a.to
-            } else {
-                from + a.span()
-            };
-            Arc {
-                from,
-                to: to.min(from + 360.0),
-            }
+            let to = if from == a.from { a.to } else { from + a.span() };
+            Arc { from, to: to.min(from + 360.0) }
         })
         .collect();
     pieces.sort_by(|a, b| a.from.total_cmp(&b.from));
@@ -89,10 +82,7 @@ pub(crate) fn normalise(arcs: &[Arc]) -> Vec<Arc> {
     let mut result = Vec::with_capacity(merged.len());
     for mut arc in merged {
         if arc.span() >= 360.0 - TOUCH_DEG {
-            return vec![Arc {
-                from: -180.0,
-                to: 180.0,
-            }];
+            return vec![Arc { from: -180.0, to: 180.0 }];
         }
         if (-SNAP_DEG..0.0).contains(&arc.from) {
             arc.from = 0.0;
@@ -110,9 +100,7 @@ pub(crate) fn normalise(arcs: &[Arc]) -> Vec<Arc> {
 /// Φ, the total engaged angle, degrees.
 pub(crate) fn engaged_deg(arcs: &[Arc]) -> f64 {
     // A fold from +0 so an empty set reads 0, not −0.
-    arcs.iter()
-        .map(Arc::span)
-        .fold(0.0, |total, span| total + span)
+    arcs.iter().map(Arc::span).fold(0.0, |total, span| total + span)
 }
 
 /// sin of an angle in degrees, with the rounding residue at 0° and 180° (1e-16) cleared so a
@@ -128,16 +116,8 @@ pub(crate) fn radial_depth(arcs: &[Arc], radius: f64) -> f64 {
         .iter()
         .map(|arc| {
             let (ca, cb) = (arc.from.to_radians().cos(), arc.to.to_radians().cos());
-            let high = if arc.contains(0.0, 0.0) {
-                1.0
-            } else {
-                ca.max(cb)
-            };
-            let low = if arc.contains(180.0, 0.0) {
-                -1.0
-            } else {
-                ca.min(cb)
-            };
+            let high = if arc.contains(0.0, 0.0) { 1.0 } else { ca.max(cb) };
+            let low = if arc.contains(180.0, 0.0) { -1.0 } else { ca.min(cb) };
             (radius * low, radius * high)
         })
         .collect();
@@ -167,11 +147,7 @@ pub(crate) fn peak_thickness_ratio(arcs: &[Arc]) -> f64 {
             if arc.contains(90.0, 0.0) {
                 1.0
             } else {
-                arc.from
-                    .to_radians()
-                    .sin()
-                    .max(arc.to.to_radians().sin())
-                    .max(0.0)
+                arc.from.to_radians().sin().max(arc.to.to_radians().sin()).max(0.0)
             }
         })
         .fold(0.0, f64::max)
@@ -281,15 +257,9 @@ mod tests {
     fn merging_wraps_and_snaps() {
         let merged = normalise(&[arc(170.0, 180.0), arc(-180.0, -170.0), arc(10.0, 20.0)]);
         assert_eq!(merged, vec![arc(10.0, 20.0), arc(170.0, 190.0)]);
-        assert_eq!(
-            normalise(&[arc(-0.005, 60.0), arc(100.0, 180.004)]),
-            vec![arc(0.0, 60.0), arc(100.0, 180.0)]
-        );
+        assert_eq!(normalise(&[arc(-0.005, 60.0), arc(100.0, 180.004)]), vec![arc(0.0, 60.0), arc(100.0, 180.0)]);
         assert_eq!(normalise(&[arc(5.0, 5.004)]), vec![]);
-        assert_eq!(
-            normalise(&[arc(-180.0, 0.0), arc(0.0, 180.0)]),
-            vec![arc(-180.0, 180.0)]
-        );
+        assert_eq!(normalise(&[arc(-180.0, 0.0), arc(0.0, 180.0)]), vec![arc(-180.0, 180.0)]);
     }
 
     #[test]
@@ -311,14 +281,8 @@ mod tests {
         let up = arc_ends(&arc(90.0, 180.0), SpindleDirection::Cw);
         assert_eq!(up.mode, MillingMode::Conventional);
         assert!(up.disengage.abs() < 1e-9);
-        assert_eq!(
-            arc_ends(&arc(0.0, 180.0), SpindleDirection::Cw).mode,
-            MillingMode::Slot
-        );
-        assert_eq!(
-            arc_ends(&arc(0.0, 60.0), SpindleDirection::Ccw).mode,
-            MillingMode::Conventional
-        );
+        assert_eq!(arc_ends(&arc(0.0, 180.0), SpindleDirection::Cw).mode, MillingMode::Slot);
+        assert_eq!(arc_ends(&arc(0.0, 60.0), SpindleDirection::Ccw).mode, MillingMode::Conventional);
         // C2 part A: a_e = 2.5, R = 5: h_m / f_z = 0.5 / (π/3).
         let ratio = mean_thickness_ratio(&[arc(0.0, 60.0)]);
         assert!((ratio - 0.5 / (std::f64::consts::PI / 3.0)).abs() < 1e-12);

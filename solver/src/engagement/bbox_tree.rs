@@ -13,18 +13,12 @@ pub(crate) struct BBox {
 impl BBox {
     /// The box spanned by two points.
     pub(crate) fn of(a: P2, b: P2) -> Self {
-        Self {
-            min: P2::new(a.x.min(b.x), a.y.min(b.y)),
-            max: P2::new(a.x.max(b.x), a.y.max(b.y)),
-        }
+        Self { min: P2::new(a.x.min(b.x), a.y.min(b.y)), max: P2::new(a.x.max(b.x), a.y.max(b.y)) }
     }
 
     /// The square of half-side `reach` around `centre`.
     pub(crate) fn around(centre: P2, reach: f64) -> Self {
-        Self {
-            min: P2::new(centre.x - reach, centre.y - reach),
-            max: P2::new(centre.x + reach, centre.y + reach),
-        }
+        Self { min: P2::new(centre.x - reach, centre.y - reach), max: P2::new(centre.x + reach, centre.y + reach) }
     }
 
     /// This box grown by `margin` on every side.
@@ -56,10 +50,7 @@ impl BBox {
 
     /// Whether the boxes share a point.
     pub(crate) fn overlaps(&self, other: &Self) -> bool {
-        self.min.x <= other.max.x
-            && other.min.x <= self.max.x
-            && self.min.y <= other.max.y
-            && other.min.y <= self.max.y
+        self.min.x <= other.max.x && other.min.x <= self.max.x && self.min.y <= other.max.y && other.min.y <= self.max.y
     }
 
     /// Grows the box to hold `p`.
@@ -109,20 +100,11 @@ impl BoxTree {
             bbox = bbox.union(&self.boxes[item]);
         }
         let index = self.nodes.len();
-        self.nodes.push(Node {
-            bbox,
-            first: start,
-            second: end,
-            leaf: true,
-        });
+        self.nodes.push(Node { bbox, first: start, second: end, leaf: true });
         if end - start > LEAF_SIZE {
             let wide = bbox.max.x - bbox.min.x >= bbox.max.y - bbox.min.y;
             let key = |b: &BBox| {
-                if wide {
-                    b.min.x + b.max.x
-                } else {
-                    b.min.y + b.max.y
-                }
+                if wide { b.min.x + b.max.x } else { b.min.y + b.max.y }
             };
             let middle = start + (end - start) / 2;
             let boxes = &self.boxes;
@@ -131,12 +113,7 @@ impl BoxTree {
             });
             let left = self.build(start, middle);
             let right = self.build(middle, end);
-            self.nodes[index] = Node {
-                bbox,
-                first: left,
-                second: right,
-                leaf: false,
-            };
+            self.nodes[index] = Node { bbox, first: left, second: right, leaf: false };
         }
         index
     }

@@ -107,9 +107,7 @@ impl DotGrid {
     /// Column range whose dot centres lie in [x0, x1], clipped to the grid.
     fn columns_between(&self, x0: f64, x1: f64) -> Option<(usize, usize)> {
         let first = ((x0 - self.origin.x) / self.cell - 0.5).ceil().max(0.0);
-        let last = ((x1 - self.origin.x) / self.cell - 0.5)
-            .floor()
-            .min(self.width as f64 - 1.0);
+        let last = ((x1 - self.origin.x) / self.cell - 0.5).floor().min(self.width as f64 - 1.0);
         (first <= last).then_some((first as usize, last as usize))
     }
 
@@ -171,12 +169,8 @@ impl DotGrid {
     fn clear_capsule(&mut self, a: P2, b: P2, radius: f64) {
         let limit = radius * (1.0 - REACH_TOLERANCE);
         let box_ = BBox::of(a, b).grown(radius);
-        let first_row = ((box_.min.y - self.origin.y) / self.cell - 0.5)
-            .ceil()
-            .max(0.0);
-        let last_row = ((box_.max.y - self.origin.y) / self.cell - 0.5)
-            .floor()
-            .min(self.height as f64 - 1.0);
+        let first_row = ((box_.min.y - self.origin.y) / self.cell - 0.5).ceil().max(0.0);
+        let last_row = ((box_.max.y - self.origin.y) / self.cell - 0.5).floor().min(self.height as f64 - 1.0);
         if first_row > last_row {
             return;
         }
@@ -240,39 +234,21 @@ impl DotGrid {
     fn rows_near(&self, centre: P2, radius: f64) -> std::ops::Range<usize> {
         // Widened like the disc test, so no row the test accepts is skipped.
         let radius = radius * (1.0 + DISC_SLACK);
-        let first = ((centre.y - radius - self.origin.y) / self.cell - 0.5)
-            .ceil()
-            .max(0.0);
-        let last = ((centre.y + radius - self.origin.y) / self.cell + 0.5)
-            .floor()
-            .min(self.height as f64);
-        if first >= last {
-            0..0
-        } else {
-            first as usize..last as usize
-        }
+        let first = ((centre.y - radius - self.origin.y) / self.cell - 0.5).ceil().max(0.0);
+        let last = ((centre.y + radius - self.origin.y) / self.cell + 0.5).floor().min(self.height as f64);
+        if first >= last { 0..0 } else { first as usize..last as usize }
     }
 
     /// Removes the material dots inside the circle at `centre` that were not inside the circle
     /// at `previous`, calling `visit` with each removed dot's centre.
-    pub(crate) fn remove<F: FnMut(P2)>(
-        &mut self,
-        centre: P2,
-        previous: Option<P2>,
-        radius: f64,
-        visit: &mut F,
-    ) {
+    pub(crate) fn remove<F: FnMut(P2)>(&mut self, centre: P2, previous: Option<P2>, radius: f64, visit: &mut F) {
         let limit = radius * radius * (1.0 + DISC_SLACK);
         let cached = previous.is_some() && previous == self.cached_centre;
         let rows = self.rows_near(centre, radius);
         for row in rows.clone() {
             let (first, last) = self.disc_span(centre, limit, row);
             let skip = if cached {
-                if self.cached_rows.contains(&row) {
-                    self.spans[row]
-                } else {
-                    EMPTY
-                }
+                if self.cached_rows.contains(&row) { self.spans[row] } else { EMPTY }
             } else {
                 previous.map_or(EMPTY, |p| self.disc_span(p, limit, row))
             };
@@ -299,20 +275,12 @@ impl DotGrid {
     /// Word index and bit of dot (column, row).
     #[inline]
     fn bit(&self, column: usize, row: usize) -> (usize, u64) {
-        (
-            (row / 8) * self.tiles_across + column / 8,
-            1 << ((row % 8) * 8 + column % 8),
-        )
+        ((row / 8) * self.tiles_across + column / 8, 1 << ((row % 8) * 8 + column % 8))
     }
 
     /// The words and masks covering columns [start, end] of `row`.
     #[inline]
-    fn masks(
-        &self,
-        row: usize,
-        start: usize,
-        end: usize,
-    ) -> impl Iterator<Item = (usize, u64)> + use<> {
+    fn masks(&self, row: usize, start: usize, end: usize) -> impl Iterator<Item = (usize, u64)> + use<> {
         let base = (row / 8) * self.tiles_across;
         let shift = (row % 8) * 8;
         (start / 8..=end / 8).map(move |tile| {
@@ -346,9 +314,7 @@ impl DotGrid {
         self.rows_near(centre, radius).any(|row| {
             let (start, end) = self.disc_span(centre, limit, row);
             start <= end
-                && self
-                    .masks(row, start as usize, end as usize)
-                    .any(|(index, mask)| self.bits[index] & mask != 0)
+                && self.masks(row, start as usize, end as usize).any(|(index, mask)| self.bits[index] & mask != 0)
         })
     }
 
@@ -454,12 +420,7 @@ impl Contacts {
             }
             let bins = &mut self.bins;
             if bins.stamp.len() < count {
-                *bins = Bins {
-                    low: vec![0.0; count],
-                    high: vec![0.0; count],
-                    stamp: vec![0; count],
-                    epoch: 0,
-                };
+                *bins = Bins { low: vec![0.0; count], high: vec![0.0; count], stamp: vec![0; count], epoch: 0 };
             }
             bins.epoch = bins.epoch.wrapping_add(1);
             if bins.epoch == 0 {
@@ -468,8 +429,7 @@ impl Contacts {
             }
             let epoch = bins.epoch;
             for &value in values {
-                let index =
-                    (((value + radius + cell) / gap).floor().max(0.0) as usize).min(count - 1);
+                let index = (((value + radius + cell) / gap).floor().max(0.0) as usize).min(count - 1);
                 if bins.stamp[index] == epoch {
                     bins.low[index] = bins.low[index].min(value);
                     bins.high[index] = bins.high[index].max(value);
@@ -486,11 +446,7 @@ impl Contacts {
                     (high / radius).clamp(-1.0, 1.0).acos().to_degrees(),
                     (low / radius).clamp(-1.0, 1.0).acos().to_degrees(),
                 );
-                arcs.push(if front {
-                    Arc { from: a, to: b }
-                } else {
-                    Arc { from: -b, to: -a }
-                });
+                arcs.push(if front { Arc { from: a, to: b } } else { Arc { from: -b, to: -a } });
             };
             let mut cluster: Option<(f64, f64)> = None;
             for index in 0..count {
@@ -530,19 +486,8 @@ mod tests {
     use crate::engagement::stock::Cut;
 
     fn block(x0: f64, y0: f64, x1: f64, y1: f64) -> Region {
-        let rings = vec![vec![
-            P2::new(x0, y0),
-            P2::new(x1, y0),
-            P2::new(x1, y1),
-            P2::new(x0, y1),
-        ]];
-        Region {
-            base: Base::Polygons {
-                edges: EdgeSet::new(&rings),
-                rings,
-            },
-            cuts: Vec::new(),
-        }
+        let rings = vec![vec![P2::new(x0, y0), P2::new(x1, y0), P2::new(x1, y1), P2::new(x0, y1)]];
+        Region { base: Base::Polygons { edges: EdgeSet::new(&rings), rings }, cuts: Vec::new() }
     }
 
     #[test]
@@ -591,9 +536,7 @@ mod tests {
         let gap = (2.0 * cell).max(14.0 * cell * cell / step);
         let mut state = 12345_u64;
         let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (state >> 11) as f64 / (1_u64 << 53) as f64
         };
         let mut contacts = Contacts::default();
@@ -615,10 +558,7 @@ mod tests {
                     .map(|(low, high)| {
                         let low = (low - 0.5 * cell).max(-radius);
                         let high = (high + 0.5 * cell).min(radius);
-                        Arc {
-                            from: (high / radius).acos().to_degrees(),
-                            to: (low / radius).acos().to_degrees(),
-                        }
+                        Arc { from: (high / radius).acos().to_degrees(), to: (low / radius).acos().to_degrees() }
                     })
                     .collect::<Vec<_>>(),
             );
@@ -630,13 +570,7 @@ mod tests {
     #[test]
     fn earlier_cut_clears_a_channel() {
         let mut region = block(0.0, 0.0, 10.0, 10.0);
-        region.cuts.push(Cut::new(
-            vec![Shape::Line {
-                from: P2::new(-1.0, 5.0),
-                to: P2::new(11.0, 5.0),
-            }],
-            1.0,
-        ));
+        region.cuts.push(Cut::new(vec![Shape::Line { from: P2::new(-1.0, 5.0), to: P2::new(11.0, 5.0) }], 1.0));
         let grid = DotGrid::new(&region, P2::new(0.0, 0.0), 0.1, 100, 100);
         // Rows with centres at 4.05 … 5.95 (within 1 of y = 5, strictly) are cleared: 20 rows.
         assert_eq!(grid.count(), 100 * 80);

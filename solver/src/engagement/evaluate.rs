@@ -2,9 +2,7 @@
 //! per-sample quantities and flags (engagement.md §5.4, §5.5, §5.10), the diagnostics of §9, and
 //! the per-flute results, recommendation and feed plan.
 
-use super::answer::{
-    ArcDetail, EngagementSample, GridInfo, PathEngagement, PostData, RouteData, SampleFlag,
-};
+use super::answer::{ArcDetail, EngagementSample, GridInfo, PathEngagement, PostData, RouteData, SampleFlag};
 use super::arcs::{self, Arc};
 use super::dots::{Contacts, DotGrid};
 use super::exact::ExactEngine;
@@ -60,15 +58,10 @@ fn run_exact(job: &Job, route: &Route, stations: &[Station]) -> Result<Vec<Conta
                 let start = Station {
                     local: 0.0,
                     s: station.s - station.local,
-                    centre: route
-                        .pieces
-                        .get(station.piece)
-                        .map_or(station.centre, |p| p.shape.start_point()),
+                    centre: route.pieces.get(station.piece).map_or(station.centre, |p| p.shape.start_point()),
                     ..*station
                 };
-                contact.plunge = !engine
-                    .arcs(route, &job.region, job.radius, &start)?
-                    .is_empty();
+                contact.plunge = !engine.arcs(route, &job.region, job.radius, &start)?.is_empty();
             }
             contact.arcs = arcs;
         }
@@ -77,42 +70,20 @@ fn run_exact(job: &Job, route: &Route, stations: &[Station]) -> Result<Vec<Conta
     Ok(contacts)
 }
 
-fn run_dots(
-    job: &Job,
-    route: &Route,
-    stations: &[Station],
-    cell: f64,
-) -> (Vec<Contact>, DotsOutput) {
+fn run_dots(job: &Job, route: &Route, stations: &[Station], cell: f64) -> (Vec<Contact>, DotsOutput) {
     let radius = job.radius;
-    let extent = job
-        .region
-        .bbox()
-        .and_then(|stock_box| grid_extent(route, stock_box, job.region.anchor(), radius, cell));
+    let extent =
+        job.region.bbox().and_then(|stock_box| grid_extent(route, stock_box, job.region.anchor(), radius, cell));
     let Some((origin, width, height)) = extent else {
-        return (
-            vec![Contact::default(); stations.len()],
-            DotsOutput {
-                grid: None,
-                scatter: Vec::new(),
-            },
-        );
+        return (vec![Contact::default(); stations.len()], DotsOutput { grid: None, scatter: Vec::new() });
     };
     // The request check bounds width·height by MAX_GRID_DOTS.
     let mut grid = DotGrid::new(&job.region, origin, cell, width as usize, height as usize);
     let (width, height) = grid.size();
-    let info = GridInfo {
-        cell,
-        origin: [grid.origin().x, grid.origin().y],
-        width,
-        height,
-        bytes: grid.bytes(),
-    };
+    let info = GridInfo { cell, origin: [grid.origin().x, grid.origin().y], width, height, bytes: grid.bytes() };
     let mut contacts = Vec::with_capacity(stations.len());
     let mut scatter = Vec::new();
-    let mut buffer = Contacts {
-        keep_angles: job.contact_dots,
-        ..Contacts::default()
-    };
+    let mut buffer = Contacts { keep_angles: job.contact_dots, ..Contacts::default() };
     let mut previous: Option<&Station> = None;
     for station in stations {
         let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
@@ -123,12 +94,9 @@ fn run_dots(
         } else {
             let step = previous.map_or(job.step, |p| station.s - p.s);
             buffer.clear();
-            grid.remove(
-                station.centre,
-                previous.map(|p| p.centre),
-                radius,
-                &mut |dot| buffer.record(dot, station, radius, step, cell),
-            );
+            grid.remove(station.centre, previous.map(|p| p.centre), radius, &mut |dot| {
+                buffer.record(dot, station, radius, step, cell)
+            });
             contact.plunge = previous.is_none() && buffer.touched();
             if job.contact_dots {
                 let mut bins = [0_u64; 6];
@@ -147,13 +115,7 @@ fn run_dots(
         }
         contacts.push(contact);
     }
-    (
-        contacts,
-        DotsOutput {
-            grid: Some(info),
-            scatter,
-        },
-    )
+    (contacts, DotsOutput { grid: Some(info), scatter })
 }
 
 /// "s = a–b, c–d, … (N in all)".
@@ -161,20 +123,10 @@ fn list_intervals(intervals: &[[f64; 2]]) -> String {
     let shown: Vec<String> = intervals
         .iter()
         .take(LISTED)
-        .map(|[a, b]| {
-            if (b - a).abs() < 1e-9 {
-                format!("{a:.3}")
-            } else {
-                format!("{a:.3}–{b:.3}")
-            }
-        })
+        .map(|[a, b]| if (b - a).abs() < 1e-9 { format!("{a:.3}") } else { format!("{a:.3}–{b:.3}") })
         .collect();
     let more = intervals.len().saturating_sub(LISTED);
-    if more > 0 {
-        format!("s = {} and {more} more", shown.join(", "))
-    } else {
-        format!("s = {}", shown.join(", "))
-    }
+    if more > 0 { format!("s = {} and {more} more", shown.join(", ")) } else { format!("s = {}", shown.join(", ")) }
 }
 
 /// Runs of consecutive samples where `test` holds, as [s_first, s_last].
@@ -197,24 +149,17 @@ pub(crate) fn runs(samples: &[EngagementSample], test: impl Fn(usize) -> bool) -
 
 fn stock_description(region: &Region) -> String {
     match &region.base {
-        Base::Polygons { rings, .. } => format!(
-            "stock: polygon rings {}, vertices {}",
-            rings.len(),
-            rings.iter().map(Vec::len).sum::<usize>()
-        ),
-        Base::Bitmap(bitmap) => format!(
-            "stock: bitmap {} x {} cells of {} mm",
-            bitmap.width, bitmap.height, bitmap.cell
-        ),
+        Base::Polygons { rings, .. } => {
+            format!("stock: polygon rings {}, vertices {}", rings.len(), rings.iter().map(Vec::len).sum::<usize>())
+        }
+        Base::Bitmap(bitmap) => {
+            format!("stock: bitmap {} x {} cells of {} mm", bitmap.width, bitmap.height, bitmap.cell)
+        }
     }
 }
 
 /// Evaluates one candidate path.
-pub(crate) fn evaluate(
-    job: &Job,
-    candidate: &CandidateJob,
-    tool: &Tool,
-) -> Result<PathEngagement, SolverError> {
+pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Result<PathEngagement, SolverError> {
     let route = &candidate.route;
     let radius = job.radius;
     let stations = route.stations(job.step);
@@ -267,9 +212,7 @@ pub(crate) fn evaluate(
             flags.push(SampleFlag::Plunge);
             plunges.push([station.s, station.s]);
         }
-        let behind = arcs
-            .iter()
-            .any(|a| a.from < -BACK_TOLERANCE_DEG || a.to > 180.0 + BACK_TOLERANCE_DEG);
+        let behind = arcs.iter().any(|a| a.from < -BACK_TOLERANCE_DEG || a.to > 180.0 + BACK_TOLERANCE_DEG);
         if behind && !contact.plunge && index > 0 {
             flags.push(SampleFlag::BackContact);
             back.push(station.s);
@@ -289,11 +232,7 @@ pub(crate) fn evaluate(
             flags.push(SampleFlag::Collision);
             collisions.push(station.s);
         }
-        let sums: Vec<_> = job
-            .flute_counts
-            .iter()
-            .map(|&k| tooth_sum(arcs, k))
-            .collect();
+        let sums: Vec<_> = job.flute_counts.iter().map(|&k| tooth_sum(arcs, k)).collect();
         statistic.push(index > 0 && !rapid && !arcs.is_empty() && !contact.plunge);
         samples.push(EngagementSample {
             s: station.s,
@@ -313,17 +252,14 @@ pub(crate) fn evaluate(
                 .map(|(&k, sum)| job.feed_mode.feed_per_tooth(k, job.spindle_rpm) * sum.ratio)
                 .collect(),
             teeth: sums.iter().map(|sum| sum.teeth).collect(),
-            mrr: job
-                .axial_depth
-                .map(|depth| depth * radial_depth * nominal_feed),
+            mrr: job.axial_depth.map(|depth| depth * radial_depth * nominal_feed),
             flags,
         });
     }
 
     // Diagnostics (engagement.md §9).
-    let engaged_intervals = runs(&samples, |i| {
-        !samples[i].arcs.is_empty() && !samples[i].flags.contains(&SampleFlag::Rapid)
-    });
+    let engaged_intervals =
+        runs(&samples, |i| !samples[i].arcs.is_empty() && !samples[i].flags.contains(&SampleFlag::Rapid));
     if !statistic.iter().any(|s| *s) {
         warnings.push(Warning::new(
             "W_NO_CONTACT",
@@ -344,9 +280,7 @@ pub(crate) fn evaluate(
         ));
     }
     if !back.is_empty() {
-        let intervals = runs(&samples, |i| {
-            samples[i].flags.contains(&SampleFlag::BackContact)
-        });
+        let intervals = runs(&samples, |i| samples[i].flags.contains(&SampleFlag::BackContact));
         warnings.push(Warning::new(
             "W_PLUNGE",
             format!(
@@ -356,9 +290,7 @@ pub(crate) fn evaluate(
         ));
     }
     if !collisions.is_empty() {
-        let intervals = runs(&samples, |i| {
-            samples[i].flags.contains(&SampleFlag::Collision)
-        });
+        let intervals = runs(&samples, |i| samples[i].flags.contains(&SampleFlag::Collision));
         warnings.push(Warning::new(
             "W_RAPID_COLLISION",
             format!(
@@ -371,20 +303,14 @@ pub(crate) fn evaluate(
     if !immersion.is_empty() {
         warnings.push(Warning::new(
             "W_FULL_IMMERSION",
-            format!(
-                "full immersion (slotting, Φ ≥ {FULL_IMMERSION_DEG}°) at {}",
-                list_intervals(&immersion)
-            ),
+            format!("full immersion (slotting, Φ ≥ {FULL_IMMERSION_DEG}°) at {}", list_intervals(&immersion)),
         ));
     }
     let multi_arc = runs(&samples, |i| samples[i].arcs.len() >= 2);
     if !multi_arc.is_empty() {
         warnings.push(Warning::new(
             "W_MULTI_ARC",
-            format!(
-                "two or more separate contact zones at {}",
-                list_intervals(&multi_arc)
-            ),
+            format!("two or more separate contact zones at {}", list_intervals(&multi_arc)),
         ));
     }
     if let Some(threshold) = job.spike_threshold {
@@ -410,9 +336,7 @@ pub(crate) fn evaluate(
         .filter_map(|pair| {
             let out = pair[0].shape.tangent(pair[0].shape.length());
             let into = pair[1].shape.tangent(0.0);
-            let turn = (out.x * into.y - out.y * into.x)
-                .atan2(out.dot(&into))
-                .to_degrees();
+            let turn = (out.x * into.y - out.y * into.x).atan2(out.dot(&into)).to_degrees();
             (turn.abs() > 1.0).then(|| format!("s = {:.3} ({turn:+.1}°)", pair[0].end_s()))
         })
         .collect();
@@ -432,34 +356,22 @@ pub(crate) fn evaluate(
         let step = job.step;
         let mut notes = Vec::new();
         if step < 4.0 * cell {
-            notes.push(format!(
-                "step {step} mm is below 4 × grid ({} mm): sampling gaps",
-                4.0 * cell
-            ));
+            notes.push(format!("step {step} mm is below 4 × grid ({} mm): sampling gaps", 4.0 * cell));
         }
         if radius / cell < 50.0 {
             notes.push(format!(
                 "R/grid = {:.1} is below 50: angles near 0°/180° resolve only to about {:.1}°",
                 radius / cell,
-                (1.0 - 2.0 * cell / radius)
-                    .clamp(-1.0, 1.0)
-                    .acos()
-                    .to_degrees()
+                (1.0 - 2.0 * cell / radius).clamp(-1.0, 1.0).acos().to_degrees()
             ));
         }
         if step > radius / 10.0 {
-            notes.push(format!(
-                "step {step} mm is above R/10 ({} mm): coarse in time",
-                radius / 10.0
-            ));
+            notes.push(format!("step {step} mm is above R/10 ({} mm): coarse in time", radius / 10.0));
         }
         if !notes.is_empty() {
             warnings.push(Warning::new(
                 "W_RESOLUTION",
-                format!(
-                    "dots engine at grid {cell} mm, step {step} mm: {}",
-                    notes.join("; ")
-                ),
+                format!("dots engine at grid {cell} mm, step {step} mm: {}", notes.join("; ")),
             ));
         }
         if let Base::Polygons { rings, .. } = &job.region.base {
@@ -477,29 +389,18 @@ pub(crate) fn evaluate(
         }
     }
 
-    let (flute_results, recommended, flute_warnings) =
-        flutes::results(job, &samples, &statistic, route.feed_length);
+    let (flute_results, recommended, flute_warnings) = flutes::results(job, &samples, &statistic, route.feed_length);
     warnings.extend(flute_warnings);
-    let feed_plan = job
-        .plan
-        .as_ref()
-        .map(|plan| feed::plan(job, plan, route, &stations, &contacts));
+    let feed_plan = job.plan.as_ref().map(|plan| feed::plan(job, plan, route, &stations, &contacts));
 
     let (max_engaged_deg, max_engaged_at_s) = samples
         .iter()
         .zip(&statistic)
         .filter(|(_, s)| **s)
         .map(|(sample, _)| (sample.engaged_deg, sample.s))
-        .fold(
-            (0.0, 0.0),
-            |best, (phi, s)| if phi > best.0 { (phi, s) } else { best },
-        );
-    let max_radial_depth = samples
-        .iter()
-        .zip(&statistic)
-        .filter(|(_, s)| **s)
-        .map(|(sample, _)| sample.radial_depth)
-        .fold(0.0, f64::max);
+        .fold((0.0, 0.0), |best, (phi, s)| if phi > best.0 { (phi, s) } else { best });
+    let max_radial_depth =
+        samples.iter().zip(&statistic).filter(|(_, s)| **s).map(|(sample, _)| sample.radial_depth).fold(0.0, f64::max);
     let (contact_dots, grid) = match dots {
         Some(output) => {
             let mut scatter = output.scatter;
@@ -526,25 +427,16 @@ pub(crate) fn evaluate(
     let description = vec![
         format!(
             "engagement path{}: L {:.3} mm, feed length {:.3} mm",
-            candidate
-                .name
-                .as_ref()
-                .map(|n| format!(" {n}"))
-                .unwrap_or_default(),
+            candidate.name.as_ref().map(|n| format!(" {n}")).unwrap_or_default(),
             route.length,
             route.feed_length
         ),
         stock_description(&job.region),
-        format!(
-            "tool R {} mm, {} flutes, S {} rpm",
-            tool.radius, tool.flutes, job.spindle_rpm
-        ),
+        format!("tool R {} mm, {} flutes, S {} rpm", tool.radius, tool.flutes, job.spindle_rpm),
     ];
     Ok(PathEngagement {
         name: candidate.name.clone(),
-        max_mrr: job
-            .axial_depth
-            .map(|depth| depth * max_radial_depth * nominal_feed),
+        max_mrr: job.axial_depth.map(|depth| depth * max_radial_depth * nominal_feed),
         samples,
         flutes: flute_results,
         recommended,

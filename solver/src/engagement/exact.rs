@@ -66,13 +66,10 @@ impl ExactEngine {
             }
             let middle = 0.5 * (low + high);
             let q = centre + radius * (middle.cos() * right + middle.sin() * forward);
-            let engaged = self.pieces.iter().all(|piece| piece.distance(q) >= limit)
-                && region.contains(q, &mut self.tests);
+            let engaged =
+                self.pieces.iter().all(|piece| piece.distance(q) >= limit) && region.contains(q, &mut self.tests);
             if engaged {
-                arcs.push(Arc {
-                    from: low.to_degrees(),
-                    to: high.to_degrees(),
-                });
+                arcs.push(Arc { from: low.to_degrees(), to: high.to_degrees() });
             }
         }
         self.check_budget()?;

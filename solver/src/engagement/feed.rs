@@ -19,17 +19,9 @@ fn needed(job: &Job, plan: &PlanJob, contact: &Contact) -> (f64, bool) {
         FeedBasis::Tooth => peak_thickness_ratio(&contact.arcs),
         FeedBasis::Sum => tooth_sum(&contact.arcs, plan.flute_count).ratio,
     };
-    let per_tooth = if ratio > 1e-12 {
-        plan.target / ratio
-    } else {
-        f64::INFINITY
-    };
+    let per_tooth = if ratio > 1e-12 { plan.target / ratio } else { f64::INFINITY };
     let feed = f64::from(plan.flute_count) * job.spindle_rpm * per_tooth;
-    if feed >= plan.max_feed {
-        (plan.max_feed, true)
-    } else {
-        (feed, false)
-    }
+    if feed >= plan.max_feed { (plan.max_feed, true) } else { (feed, false) }
 }
 
 /// A stretch between consecutive samples.
@@ -48,13 +40,7 @@ fn whole(feed: f64) -> f64 {
 }
 
 /// The feed plan for one path.
-pub(crate) fn plan(
-    job: &Job,
-    plan: &PlanJob,
-    route: &Route,
-    stations: &[Station],
-    contacts: &[Contact],
-) -> FeedPlan {
+pub(crate) fn plan(job: &Job, plan: &PlanJob, route: &Route, stations: &[Station], contacts: &[Contact]) -> FeedPlan {
     let feeds: Vec<Option<(f64, bool)>> = stations
         .iter()
         .zip(contacts)
@@ -74,12 +60,7 @@ pub(crate) fn plan(
             (None, Some(f)) => Some(f),
             (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
         };
-        stretches.push(Stretch {
-            piece: here.piece,
-            from_s: before.s,
-            to_s: here.s,
-            feed,
-        });
+        stretches.push(Stretch { piece: here.piece, from_s: before.s, to_s: here.s, feed });
     }
 
     // Group stretches of one piece whose feeds lie within the tolerance band.
@@ -116,8 +97,7 @@ pub(crate) fn plan(
         if let Some(last) = merged.last_mut()
             && last.piece == block.piece
             && last.feed.is_some() == block.feed.is_some()
-            && (last.to_s - last.from_s < plan.min_block_length
-                || block.to_s - block.from_s < plan.min_block_length)
+            && (last.to_s - last.from_s < plan.min_block_length || block.to_s - block.from_s < plan.min_block_length)
         {
             last.to_s = block.to_s;
             last.feed = match (last.feed, block.feed) {
@@ -144,13 +124,11 @@ pub(crate) fn plan(
                 from_s: block.from_s,
                 to_s: block.to_s,
                 feed,
-                limited_by: block.feed.map(|(_, capped)| {
-                    if capped {
-                        FeedLimit::Machine
-                    } else {
-                        FeedLimit::Thickness
-                    }
-                }),
+                limited_by: block.feed.map(
+                    |(_, capped)| {
+                        if capped { FeedLimit::Machine } else { FeedLimit::Thickness }
+                    },
+                ),
             }
         })
         .collect();
@@ -164,8 +142,7 @@ pub(crate) fn plan(
         max_feed: plan.max_feed,
         blocks,
         time_s,
-        nominal_time_s: 60.0 * route.feed_length
-            / job.feed_mode.feed(plan.flute_count, job.spindle_rpm),
+        nominal_time_s: 60.0 * route.feed_length / job.feed_mode.feed(plan.flute_count, job.spindle_rpm),
         feed_range: range,
     }
 }

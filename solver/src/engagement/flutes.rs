@@ -25,11 +25,7 @@ fn statistics(values: &[f64], weights: &[f64]) -> (f64, f64, f64, f64) {
     let mut sorted = values.to_vec();
     sorted.sort_by(f64::total_cmp);
     let middle = sorted.len() / 2;
-    let median = if sorted.len() % 2 == 1 {
-        sorted[middle]
-    } else {
-        0.5 * (sorted[middle - 1] + sorted[middle])
-    };
+    let median = if sorted.len() % 2 == 1 { sorted[middle] } else { 0.5 * (sorted[middle - 1] + sorted[middle]) };
     (max, min, mean.clamp(min, max), median)
 }
 
@@ -68,14 +64,9 @@ pub(crate) fn results(
         };
         let thickness_margin = job.thickness_limit.map(|limit| limit - representative);
         let time_margin_s = job.time_limit.map(|limit| limit - time_s);
-        let thickness_ok = job
-            .thickness_limit
-            .is_none_or(|limit| representative <= limit * (1.0 + LIMIT_SLACK));
-        let time_ok = job
-            .time_limit
-            .is_none_or(|limit| time_s <= limit * (1.0 + LIMIT_SLACK));
-        let recommended =
-            (job.thickness_limit.is_some() || job.time_limit.is_some()) && thickness_ok && time_ok;
+        let thickness_ok = job.thickness_limit.is_none_or(|limit| representative <= limit * (1.0 + LIMIT_SLACK));
+        let time_ok = job.time_limit.is_none_or(|limit| time_s <= limit * (1.0 + LIMIT_SLACK));
+        let recommended = (job.thickness_limit.is_some() || job.time_limit.is_some()) && thickness_ok && time_ok;
         let mut reasons = Vec::new();
         if let (false, Some(limit)) = (thickness_ok, job.thickness_limit) {
             reasons.push(format!("thickness {representative:.6} mm > {limit} mm"));
@@ -88,10 +79,7 @@ pub(crate) fn results(
         }
         let multi_tooth_intervals = runs(samples, |i| {
             statistic.get(i).copied().unwrap_or(false)
-                && samples
-                    .get(i)
-                    .and_then(|s| s.teeth.get(column))
-                    .is_some_and(|n| *n >= 2)
+                && samples.get(i).and_then(|s| s.teeth.get(column)).is_some_and(|n| *n >= 2)
         });
         if !multi_tooth_intervals.is_empty() {
             warnings.push(Warning::new(
@@ -134,11 +122,8 @@ pub(crate) fn results(
             multi_tooth_intervals,
         });
     }
-    let mut recommended: Vec<(f64, u32)> = results
-        .iter()
-        .filter(|r| r.recommended)
-        .map(|r| (r.time_s, r.flute_count))
-        .collect();
+    let mut recommended: Vec<(f64, u32)> =
+        results.iter().filter(|r| r.recommended).map(|r| (r.time_s, r.flute_count)).collect();
     recommended.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     match (job.thickness_limit, job.time_limit) {
         (None, None) => warnings.push(Warning::new(
@@ -158,17 +143,10 @@ pub(crate) fn results(
     if recommended.is_empty() && (job.thickness_limit.is_some() || job.time_limit.is_some()) {
         warnings.push(Warning::new(
             "W_NO_RECOMMENDATION",
-            format!(
-                "no flute count satisfies the limits: {}",
-                failures.join("; ")
-            ),
+            format!("no flute count satisfies the limits: {}", failures.join("; ")),
         ));
     }
-    (
-        results,
-        recommended.into_iter().map(|(_, k)| k).collect(),
-        warnings,
-    )
+    (results, recommended.into_iter().map(|(_, k)| k).collect(), warnings)
 }
 
 #[cfg(test)]

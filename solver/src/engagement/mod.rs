@@ -48,14 +48,14 @@ mod stock;
 mod teeth;
 
 pub use answer::{
-    ArcDetail, Comparison, EngagementAnswer, EngagementSample, FeedBlock, FeedLimit, FeedPlan,
-    FluteResult, GridInfo, PathEngagement, SampleFlag,
+    ArcDetail, Comparison, EngagementAnswer, EngagementSample, FeedBlock, FeedLimit, FeedPlan, FluteResult, GridInfo,
+    PathEngagement, SampleFlag,
 };
 pub use arcs::{MillingMode, SpindleDirection};
-pub use program::{Post, program};
+pub use program::program;
 pub use request::{
-    ArcDirection, Candidate, EngagementRequest, Engine, FeedBasis, FeedPlanRequest, PathInput,
-    PathSegments, PreviousCut, Representative, SegmentInput, Stock, StockBitmap, StockPolygon,
+    ArcDirection, Candidate, EngagementRequest, Engine, FeedBasis, FeedPlanRequest, PathInput, PathSegments,
+    PreviousCut, Representative, SegmentInput, Stock, StockBitmap, StockPolygon,
 };
 
 use crate::error::SolverError;
@@ -109,7 +109,5 @@ pub fn solve(request: &EngagementRequest, tool: &Tool) -> Result<EngagementAnswe
     {
         return Ok(EngagementAnswer::Single(Box::new(result)));
     }
-    Ok(EngagementAnswer::Comparison(Comparison {
-        candidates: results,
-    }))
+    Ok(EngagementAnswer::Comparison(Comparison { candidates: results }))
 }

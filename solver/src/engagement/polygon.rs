@@ -22,10 +22,7 @@ pub(crate) fn orient(a: P2, b: P2, c: P2) -> f64 {
 
 /// Whether the closed segments `[a0, a1]` and `[b0, b1]` share a point (touching counts).
 pub(crate) fn segments_intersect(a0: P2, a1: P2, b0: P2, b1: P2) -> bool {
-    let scale = [a0, a1, b0, b1]
-        .iter()
-        .fold(0.0_f64, |m, p| m.max(p.x.abs()).max(p.y.abs()))
-        .max(1.0);
+    let scale = [a0, a1, b0, b1].iter().fold(0.0_f64, |m, p| m.max(p.x.abs()).max(p.y.abs())).max(1.0);
     // Orientation values are areas: scale the zero test with the coordinates squared.
     let eps = 1e-12 * scale * scale;
     let sign = |v: f64| {
@@ -91,19 +88,11 @@ impl EdgeSet {
         let mut edges = Vec::new();
         for (ring_index, ring) in rings.iter().enumerate() {
             for (vertex, from) in ring.iter().enumerate() {
-                edges.push(Edge {
-                    from: *from,
-                    to: ring[(vertex + 1) % ring.len()],
-                    ring: ring_index,
-                    vertex,
-                });
+                edges.push(Edge { from: *from, to: ring[(vertex + 1) % ring.len()], ring: ring_index, vertex });
             }
         }
         let boxes: Vec<BBox> = edges.iter().map(|e| BBox::of(e.from, e.to)).collect();
-        Self {
-            tree: BoxTree::new(&boxes),
-            edges,
-        }
+        Self { tree: BoxTree::new(&boxes), edges }
     }
 
     /// Even-odd containment, boundary inclusive within `tolerance`; adds the number of edges
@@ -121,10 +110,7 @@ impl EdgeSet {
         if on_boundary {
             return true;
         }
-        let ray = BBox {
-            min: q,
-            max: P2::new(f64::INFINITY, q.y),
-        };
+        let ray = BBox { min: q, max: P2::new(f64::INFINITY, q.y) };
         let mut inside = false;
         self.tree.query(&ray, &mut |index| {
             *work += 1;
@@ -144,33 +130,28 @@ impl EdgeSet {
 
     /// The first pair of edges that cross or touch other than at the vertex two neighbours
     /// share, as (ring, vertex) of each; `None` when every ring is simple and no two rings meet.
-    pub(crate) fn first_crossing(
-        &self,
-        rings: &[Vec<P2>],
-    ) -> Option<((usize, usize), (usize, usize))> {
+    pub(crate) fn first_crossing(&self, rings: &[Vec<P2>]) -> Option<((usize, usize), (usize, usize))> {
         for (index, edge) in self.edges.iter().enumerate() {
             let mut found: Option<usize> = None;
-            self.tree
-                .query(&BBox::of(edge.from, edge.to).grown(1e-9), &mut |other| {
-                    if other <= index || found.is_some() {
-                        return;
-                    }
-                    let Some(second) = self.edges.get(other) else {
-                        return;
-                    };
-                    let length = rings.get(edge.ring).map_or(0, Vec::len);
-                    let adjacent = second.ring == edge.ring
-                        && (second.vertex == (edge.vertex + 1) % length
-                            || edge.vertex == (second.vertex + 1) % length);
-                    let crosses = if adjacent {
-                        folds_back(edge, second)
-                    } else {
-                        segments_intersect(edge.from, edge.to, second.from, second.to)
-                    };
-                    if crosses {
-                        found = Some(other);
-                    }
-                });
+            self.tree.query(&BBox::of(edge.from, edge.to).grown(1e-9), &mut |other| {
+                if other <= index || found.is_some() {
+                    return;
+                }
+                let Some(second) = self.edges.get(other) else {
+                    return;
+                };
+                let length = rings.get(edge.ring).map_or(0, Vec::len);
+                let adjacent = second.ring == edge.ring
+                    && (second.vertex == (edge.vertex + 1) % length || edge.vertex == (second.vertex + 1) % length);
+                let crosses = if adjacent {
+                    folds_back(edge, second)
+                } else {
+                    segments_intersect(edge.from, edge.to, second.from, second.to)
+                };
+                if crosses {
+                    found = Some(other);
+                }
+            });
             if let Some(other) = found.and_then(|o| self.edges.get(o)) {
                 return Some(((edge.ring, edge.vertex), (other.ring, other.vertex)));
             }
@@ -182,11 +163,8 @@ impl EdgeSet {
 /// Two neighbouring edges overlap when they are collinear and the second turns straight back
 /// (or a ring of two edges is degenerate).
 fn folds_back(first: &Edge, second: &Edge) -> bool {
-    let (shared, a, b) = if first.to == second.from {
-        (first.to, first.from, second.to)
-    } else {
-        (first.from, first.to, second.from)
-    };
+    let (shared, a, b) =
+        if first.to == second.from { (first.to, first.from, second.to) } else { (first.from, first.to, second.from) };
     let (u, v) = (a - shared, b - shared);
     let cross = u.x * v.y - u.y * v.x;
     cross.abs() <= 1e-12 * u.norm() * v.norm() && u.dot(&v) > 0.0
@@ -197,12 +175,7 @@ mod tests {
     use super::*;
 
     fn square(x0: f64, y0: f64, size: f64) -> Vec<P2> {
-        vec![
-            P2::new(x0, y0),
-            P2::new(x0 + size, y0),
-            P2::new(x0 + size, y0 + size),
-            P2::new(x0, y0 + size),
-        ]
+        vec![P2::new(x0, y0), P2::new(x0 + size, y0), P2::new(x0 + size, y0 + size), P2::new(x0, y0 + size)]
     }
 
     #[test]
@@ -229,12 +202,7 @@ mod tests {
 
     #[test]
     fn crossing_rings_are_found() {
-        let bow_tie = vec![vec![
-            P2::new(0.0, 0.0),
-            P2::new(2.0, 2.0),
-            P2::new(2.0, 0.0),
-            P2::new(0.0, 2.0),
-        ]];
+        let bow_tie = vec![vec![P2::new(0.0, 0.0), P2::new(2.0, 2.0), P2::new(2.0, 0.0), P2::new(0.0, 2.0)]];
         let edges = EdgeSet::new(&bow_tie);
         assert!(edges.first_crossing(&bow_tie).is_some());
         let simple = vec![square(0.0, 0.0, 1.0), square(3.0, 3.0, 1.0)];
@@ -242,12 +210,7 @@ mod tests {
         let overlapping = vec![square(0.0, 0.0, 2.0), square(1.0, 1.0, 2.0)];
         let found = EdgeSet::new(&overlapping).first_crossing(&overlapping);
         assert!(found.is_some());
-        let spike = vec![vec![
-            P2::new(0.0, 0.0),
-            P2::new(2.0, 0.0),
-            P2::new(1.0, 0.0),
-            P2::new(1.0, 1.0),
-        ]];
+        let spike = vec![vec![P2::new(0.0, 0.0), P2::new(2.0, 0.0), P2::new(1.0, 0.0), P2::new(1.0, 1.0)]];
         assert!(EdgeSet::new(&spike).first_crossing(&spike).is_some());
     }
 }

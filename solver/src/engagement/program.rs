@@ -5,23 +5,12 @@
 use super::answer::{EngagementAnswer, PathEngagement};
 use super::segments::Route;
 use crate::error::SolverError;
-use crate::gcode::{self, Dialect, Program, Reference, ToolCall};
+use crate::gcode::{self, Post, Program, Reference};
 use crate::geometry::Vec3;
 use crate::path::Toolpath;
 
 /// Largest distance of an arc from its chords in the program, mm.
 pub const CHORD_TOLERANCE: f64 = 0.001;
-
-/// How to post the program.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Post {
-    /// Control dialect.
-    pub dialect: Dialect,
-    /// Programmed point: tip or the centre of the end's rounding.
-    pub reference: Reference,
-    /// Tool selection.
-    pub tool: ToolCall,
-}
 
 /// A stretch of one piece at one feed (`None`: rapid).
 struct Run {
@@ -68,20 +57,10 @@ fn runs(result: &PathEngagement) -> Vec<Run> {
 /// # Errors
 /// `E_INPUT` at `candidate` for an index out of range, and at `axial_depth` when the request
 /// gave no axial depth (the cutting Z is `stock_top_z − axial_depth`).
-pub fn program(
-    answer: &EngagementAnswer,
-    candidate: usize,
-    post: &Post,
-) -> Result<String, SolverError> {
+pub fn program(answer: &EngagementAnswer, candidate: usize, post: &Post) -> Result<String, SolverError> {
     let candidates = answer.candidates();
     let result = candidates.get(candidate).ok_or_else(|| {
-        SolverError::input(
-            "candidate",
-            format!(
-                "candidate {candidate} does not exist ({} path(s))",
-                candidates.len()
-            ),
-        )
+        SolverError::input("candidate", format!("candidate {candidate} does not exist ({} path(s))", candidates.len()))
     })?;
     let data = &result.post;
     let depth = data.axial_depth.ok_or_else(|| {
@@ -97,11 +76,7 @@ pub fn program(
     let cut_z = data.stock_top_z - depth + lift;
     let safe_z = data.stock_top_z + data.clearance + lift;
     let route = &data.route.0;
-    let chords: f64 = route
-        .pieces
-        .iter()
-        .map(|p| p.shape.chord_count(CHORD_TOLERANCE))
-        .sum();
+    let chords: f64 = route.pieces.iter().map(|p| p.shape.chord_count(CHORD_TOLERANCE)).sum();
     if chords > super::MAX_CHORDS {
         return Err(SolverError::new(
             "E_TOO_LARGE",
@@ -149,12 +124,7 @@ pub fn program(
         }
     }
     let mut comments = data.description.clone();
-    comments.push(format!(
-        "cut Z {:.4}, clearance Z {:.4}, control point {}",
-        cut_z,
-        safe_z,
-        post.reference.as_str()
-    ));
+    comments.push(format!("cut Z {:.4}, clearance Z {:.4}, control point {}", cut_z, safe_z, post.reference.as_str()));
     if let Some(plan) = &result.feed_plan {
         comments.push(format!(
             "feeds hold {} mm chip thickness ({} basis) for {} flutes, max feed {}",

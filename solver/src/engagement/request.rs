@@ -12,8 +12,8 @@ use super::polygon::{EdgeSet, twice_signed_area};
 use super::segments::{Route, Shape};
 use super::stock::{Base, Bitmap, Cut, Region, decode_base64};
 use super::{
-    DEFAULT_BURR_DISENGAGE_DEG, DEFAULT_CHIPPING_DISENGAGE_DEG, MAX_CANDIDATES, MAX_CHORDS,
-    MAX_DOT_ROWS, MAX_FLUTES, MAX_GRID_DOTS, MAX_SAMPLES, MAX_SEGMENTS, MAX_STOCK_VERTICES, P2,
+    DEFAULT_BURR_DISENGAGE_DEG, DEFAULT_CHIPPING_DISENGAGE_DEG, MAX_CANDIDATES, MAX_CHORDS, MAX_DOT_ROWS, MAX_FLUTES,
+    MAX_GRID_DOTS, MAX_SAMPLES, MAX_SEGMENTS, MAX_STOCK_VERTICES, P2,
 };
 use crate::error::{SolverError, Warning, finite, non_negative, positive};
 use crate::tool::{Tool, ToolRef};
@@ -94,19 +94,15 @@ impl<'de> Deserialize<'de> for PathInput {
             type Value = PathInput;
 
             fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-                f.write_str(
-                    "a list of points [[x, y], ...] or {\"start\": [x, y], \"segments\": [...]}",
-                )
+                f.write_str("a list of points [[x, y], ...] or {\"start\": [x, y], \"segments\": [...]}")
             }
 
             fn visit_seq<S: SeqAccess<'de>>(self, seq: S) -> Result<PathInput, S::Error> {
-                Vec::<[f64; 2]>::deserialize(de::value::SeqAccessDeserializer::new(seq))
-                    .map(PathInput::Points)
+                Vec::<[f64; 2]>::deserialize(de::value::SeqAccessDeserializer::new(seq)).map(PathInput::Points)
             }
 
             fn visit_map<M: MapAccess<'de>>(self, map: M) -> Result<PathInput, M::Error> {
-                PathSegments::deserialize(de::value::MapAccessDeserializer::new(map))
-                    .map(PathInput::Segments)
+                PathSegments::deserialize(de::value::MapAccessDeserializer::new(map)).map(PathInput::Segments)
             }
         }
 
@@ -459,10 +455,7 @@ fn point(field: &str, p: [f64; 2]) -> Result<P2, SolverError> {
 /// `value` must be positive and at most `limit`.
 fn bounded(field: &str, value: f64, limit: f64) -> Result<f64, SolverError> {
     if positive(field, value)? > limit {
-        return Err(SolverError::input(
-            field,
-            format!("{field} must be at most {limit} (got {value})"),
-        ));
+        return Err(SolverError::input(field, format!("{field} must be at most {limit} (got {value})")));
     }
     Ok(value)
 }
@@ -476,30 +469,17 @@ fn optional(
 }
 
 fn too_large(field: &str, what: &str, count: usize, limit: usize) -> SolverError {
-    SolverError::new(
-        "E_TOO_LARGE",
-        format!("{what}: {count} exceeds the limit of {limit}"),
-    )
-    .at(field)
+    SolverError::new("E_TOO_LARGE", format!("{what}: {count} exceeds the limit of {limit}")).at(field)
 }
 
 /// A path's pieces, zero-length ones dropped with a warning (engagement.md §2.3).
-pub(crate) fn read_path(
-    input: &PathInput,
-    field: &str,
-    warnings: &mut Vec<Warning>,
-) -> Result<Route, SolverError> {
+pub(crate) fn read_path(input: &PathInput, field: &str, warnings: &mut Vec<Warning>) -> Result<Route, SolverError> {
     let mut shapes: Vec<(Shape, bool, usize)> = Vec::new();
     let mut dropped = Vec::new();
     match input {
         PathInput::Points(points) => {
             if points.len() > MAX_SEGMENTS + 1 {
-                return Err(too_large(
-                    field,
-                    "path points",
-                    points.len(),
-                    MAX_SEGMENTS + 1,
-                ));
+                return Err(too_large(field, "path points", points.len(), MAX_SEGMENTS + 1));
             }
             let mut previous: Option<P2> = None;
             for (index, p) in points.iter().enumerate() {
@@ -517,20 +497,14 @@ pub(crate) fn read_path(
         }
         PathInput::Segments(program) => {
             let start = program.start.ok_or_else(|| {
-                SolverError::new("E_PATH", "the path needs a start point [x, y]")
-                    .at(format!("{field}.start"))
+                SolverError::new("E_PATH", "the path needs a start point [x, y]").at(format!("{field}.start"))
             })?;
-            let segments = program.segments.as_ref().ok_or_else(|| {
-                SolverError::new("E_PATH", "the path needs segments")
-                    .at(format!("{field}.segments"))
-            })?;
+            let segments = program
+                .segments
+                .as_ref()
+                .ok_or_else(|| SolverError::new("E_PATH", "the path needs segments").at(format!("{field}.segments")))?;
             if segments.len() > MAX_SEGMENTS {
-                return Err(too_large(
-                    &format!("{field}.segments"),
-                    "path segments",
-                    segments.len(),
-                    MAX_SEGMENTS,
-                ));
+                return Err(too_large(&format!("{field}.segments"), "path segments", segments.len(), MAX_SEGMENTS));
             }
             let mut from = point(&format!("{field}.start"), start)?;
             for (index, segment) in segments.iter().enumerate() {
@@ -551,11 +525,8 @@ pub(crate) fn read_path(
                         let centre = point(&format!("{here}.center"), *center)?;
                         let (r0, r1) = ((from - centre).norm(), (to - centre).norm());
                         if r0 <= 1e-9 {
-                            return Err(SolverError::new(
-                                "E_PATH",
-                                "the arc centre coincides with its start point",
-                            )
-                            .at(format!("{here}.center")));
+                            return Err(SolverError::new("E_PATH", "the arc centre coincides with its start point")
+                                .at(format!("{here}.center")));
                         }
                         if (r0 - r1).abs() > 1e-6 * r0.max(r1) {
                             return Err(SolverError::new(
@@ -572,26 +543,11 @@ pub(crate) fn read_path(
                         let full = (to - from).norm() <= 1e-9 * r0.max(1.0);
                         let sweep = match (dir, full) {
                             (_, true) => turn,
-                            (ArcDirection::Ccw, false) => {
-                                (end_angle - start_angle).rem_euclid(turn)
-                            }
+                            (ArcDirection::Ccw, false) => (end_angle - start_angle).rem_euclid(turn),
                             (ArcDirection::Cw, false) => (start_angle - end_angle).rem_euclid(turn),
                         };
-                        let sweep = if *dir == ArcDirection::Cw {
-                            -sweep
-                        } else {
-                            sweep
-                        };
-                        shapes.push((
-                            Shape::Arc {
-                                centre,
-                                radius: r0,
-                                start: start_angle,
-                                sweep,
-                            },
-                            false,
-                            index,
-                        ));
+                        let sweep = if *dir == ArcDirection::Cw { -sweep } else { sweep };
+                        shapes.push((Shape::Arc { centre, radius: r0, start: start_angle, sweep }, false, index));
                         from = to;
                     }
                 }
@@ -599,19 +555,14 @@ pub(crate) fn read_path(
         }
     }
     if shapes.is_empty() {
-        return Err(SolverError::new(
-            "E_PATH",
-            "the path is empty: it needs at least one move of non-zero length",
-        )
-        .at(field));
+        return Err(
+            SolverError::new("E_PATH", "the path is empty: it needs at least one move of non-zero length").at(field)
+        );
     }
     if let Some(first) = dropped.first() {
         warnings.push(Warning::new(
             "W_SEGMENT_ZERO",
-            format!(
-                "{} zero-length segment(s) dropped (first: {first})",
-                dropped.len()
-            ),
+            format!("{} zero-length segment(s) dropped (first: {first})", dropped.len()),
         ));
     }
     Ok(Route::new(shapes))
@@ -626,44 +577,24 @@ fn read_ring(field: &str, points: &[[f64; 2]]) -> Result<Vec<P2>, SolverError> {
             ring.push(q);
         }
     }
-    while ring.len() > 1
-        && ring
-            .first()
-            .zip(ring.last())
-            .is_some_and(|(a, b)| (a - b).norm() <= 1e-12)
-    {
+    while ring.len() > 1 && ring.first().zip(ring.last()).is_some_and(|(a, b)| (a - b).norm() <= 1e-12) {
         ring.pop();
     }
     if ring.len() < 3 {
         return Err(SolverError::new(
             "E_STOCK",
-            format!(
-                "a stock ring needs at least 3 distinct points (got {})",
-                ring.len()
-            ),
+            format!("a stock ring needs at least 3 distinct points (got {})", ring.len()),
         )
         .at(field));
     }
     Ok(ring)
 }
 
-fn read_stock(
-    stock: &Stock,
-    warnings: &mut Vec<Warning>,
-) -> Result<(Region, Vec<String>), SolverError> {
-    let given = [
-        stock.polygon.is_some(),
-        stock.polygons.is_some(),
-        stock.bitmap.is_some(),
-    ]
-    .iter()
-    .filter(|g| **g)
-    .count();
+fn read_stock(stock: &Stock, warnings: &mut Vec<Warning>) -> Result<(Region, Vec<String>), SolverError> {
+    let given =
+        [stock.polygon.is_some(), stock.polygons.is_some(), stock.bitmap.is_some()].iter().filter(|g| **g).count();
     if given != 1 {
-        return Err(SolverError::input(
-            "stock",
-            "give exactly one of stock.polygon, stock.polygons or stock.bitmap",
-        ));
+        return Err(SolverError::input("stock", "give exactly one of stock.polygon, stock.polygons or stock.bitmap"));
     }
     if !stock.holes.is_empty() && stock.polygon.is_none() {
         return Err(SolverError::input(
@@ -675,10 +606,7 @@ fn read_stock(
         let origin = point("stock.bitmap.origin", bitmap.origin)?;
         let cell = bounded("stock.bitmap.cell", bitmap.cell, MAX_COORDINATE)?;
         if bitmap.width == 0 || bitmap.height == 0 {
-            return Err(SolverError::input(
-                "stock.bitmap.width",
-                "the bitmap needs at least one row and one column",
-            ));
+            return Err(SolverError::input("stock.bitmap.width", "the bitmap needs at least one row and one column"));
         }
         let cells = u64::from(bitmap.width) * u64::from(bitmap.height);
         if cells > MAX_GRID_DOTS {
@@ -689,8 +617,7 @@ fn read_stock(
             .at("stock.bitmap"));
         }
         let bytes = decode_base64(&bitmap.data).ok_or_else(|| {
-            SolverError::new("E_STOCK", "stock.bitmap.data is not valid base64")
-                .at("stock.bitmap.data")
+            SolverError::new("E_STOCK", "stock.bitmap.data is not valid base64").at("stock.bitmap.data")
         })?;
         let needed = cells.div_ceil(8);
         if bytes.len() as u64 != needed {
@@ -706,18 +633,9 @@ fn read_stock(
             .at("stock.bitmap.data"));
         }
         if bytes.iter().all(|b| *b == 0) {
-            warnings.push(Warning::new(
-                "W_STOCK_EMPTY",
-                "the bitmap holds no material",
-            ));
+            warnings.push(Warning::new("W_STOCK_EMPTY", "the bitmap holds no material"));
         }
-        Base::Bitmap(Bitmap {
-            origin,
-            cell,
-            width: bitmap.width as usize,
-            height: bitmap.height as usize,
-            bytes,
-        })
+        Base::Bitmap(Bitmap { origin, cell, width: bitmap.width as usize, height: bitmap.height as usize, bytes })
     } else {
         let mut rings = Vec::new();
         let mut fields = Vec::new();
@@ -725,12 +643,7 @@ fn read_stock(
         let mut add = |field: String, points: &[[f64; 2]]| -> Result<(), SolverError> {
             vertices += points.len();
             if vertices > MAX_STOCK_VERTICES {
-                return Err(too_large(
-                    "stock",
-                    "stock vertices",
-                    vertices,
-                    MAX_STOCK_VERTICES,
-                ));
+                return Err(too_large("stock", "stock vertices", vertices, MAX_STOCK_VERTICES));
             }
             rings.push(read_ring(&field, points)?);
             fields.push(field);
@@ -744,9 +657,7 @@ fn read_stock(
         }
         if let Some(polygons) = &stock.polygons {
             if polygons.is_empty() {
-                return Err(
-                    SolverError::new("E_STOCK", "stock.polygons is empty").at("stock.polygons")
-                );
+                return Err(SolverError::new("E_STOCK", "stock.polygons is empty").at("stock.polygons"));
             }
             for (index, polygon) in polygons.iter().enumerate() {
                 add(format!("stock.polygons[{index}].outer"), &polygon.outer)?;
@@ -757,12 +668,7 @@ fn read_stock(
         }
         let edges = EdgeSet::new(&rings);
         if let Some(((ring_a, vertex_a), (ring_b, vertex_b))) = edges.first_crossing(&rings) {
-            let name = |ring: usize| {
-                fields
-                    .get(ring)
-                    .cloned()
-                    .unwrap_or_else(|| "stock".to_owned())
-            };
+            let name = |ring: usize| fields.get(ring).cloned().unwrap_or_else(|| "stock".to_owned());
             let message = if ring_a == ring_b {
                 format!(
                     "the stock outline crosses itself: edges from vertex {vertex_a} and vertex {vertex_b} of {} meet",
@@ -775,16 +681,12 @@ fn read_stock(
                     name(ring_b)
                 )
             };
-            return Err(
-                SolverError::new("E_STOCK", message).at(format!("{}[{vertex_a}]", name(ring_a)))
-            );
+            return Err(SolverError::new("E_STOCK", message).at(format!("{}[{vertex_a}]", name(ring_a))));
         }
         // After the crossing test, so a bow tie is reported as crossing, not as flat.
         for (ring, field) in rings.iter().zip(&fields) {
             if twice_signed_area(ring).abs() <= 2e-12 {
-                return Err(
-                    SolverError::new("E_STOCK", "the stock ring has zero area").at(field.clone())
-                );
+                return Err(SolverError::new("E_STOCK", "the stock ring has zero area").at(field.clone()));
             }
         }
         Base::Polygons { rings, edges }
@@ -795,12 +697,7 @@ fn read_stock(
         let field = format!("stock.previous_cuts[{index}]");
         let radius = bounded(&format!("{field}.radius"), previous.radius, MAX_COORDINATE)?;
         let route = read_path(&previous.path, &format!("{field}.path"), warnings)?;
-        let shapes = route
-            .pieces
-            .iter()
-            .filter(|p| !p.rapid)
-            .map(|p| p.shape)
-            .collect();
+        let shapes = route.pieces.iter().filter(|p| !p.rapid).map(|p| p.shape).collect();
         cuts.push(Cut::new(shapes, radius));
         cut_fields.push(field);
     }
@@ -833,18 +730,10 @@ impl EngagementRequest {
             None => vec![tool.flutes],
             Some(counts) => {
                 if counts.is_empty() {
-                    return Err(SolverError::input(
-                        "flute_counts",
-                        "flute_counts needs at least one flute count",
-                    ));
+                    return Err(SolverError::input("flute_counts", "flute_counts needs at least one flute count"));
                 }
                 if counts.len() > MAX_FLUTES as usize {
-                    return Err(too_large(
-                        "flute_counts",
-                        "flute counts",
-                        counts.len(),
-                        MAX_FLUTES as usize,
-                    ));
+                    return Err(too_large("flute_counts", "flute counts", counts.len(), MAX_FLUTES as usize));
                 }
                 for (index, k) in counts.iter().enumerate() {
                     let field = format!("flute_counts[{index}]");
@@ -855,10 +744,7 @@ impl EngagementRequest {
                         ));
                     }
                     if counts[..index].contains(k) {
-                        return Err(SolverError::input(
-                            field,
-                            format!("flute count {k} is listed twice"),
-                        ));
+                        return Err(SolverError::input(field, format!("flute count {k} is listed twice")));
                     }
                 }
                 counts.clone()
@@ -872,10 +758,7 @@ impl EngagementRequest {
         };
         let grid = match (self.engine, self.grid) {
             (Engine::Exact, Some(_)) => {
-                return Err(SolverError::input(
-                    "grid",
-                    "grid applies only to engine \"dots\"",
-                ));
+                return Err(SolverError::input("grid", "grid applies only to engine \"dots\""));
             }
             (Engine::Exact, None) => None,
             (Engine::Dots, Some(g)) => Some(bounded("grid", g, MAX_COORDINATE)?),
@@ -889,22 +772,12 @@ impl EngagementRequest {
             if (0.0..=180.0).contains(&v) {
                 Ok(v)
             } else {
-                Err(SolverError::input(
-                    field,
-                    format!("{field} must be in [0, 180] (got {v})"),
-                ))
+                Err(SolverError::input(field, format!("{field} must be in [0, 180] (got {v})")))
             }
         };
-        let burr_disengage = angle(
-            "burr_disengage_deg",
-            self.burr_disengage_deg,
-            DEFAULT_BURR_DISENGAGE_DEG,
-        )?;
-        let chipping_disengage = angle(
-            "chipping_disengage_deg",
-            self.chipping_disengage_deg,
-            DEFAULT_CHIPPING_DISENGAGE_DEG,
-        )?;
+        let burr_disengage = angle("burr_disengage_deg", self.burr_disengage_deg, DEFAULT_BURR_DISENGAGE_DEG)?;
+        let chipping_disengage =
+            angle("chipping_disengage_deg", self.chipping_disengage_deg, DEFAULT_CHIPPING_DISENGAGE_DEG)?;
         let radial_depth_min = optional("radial_depth_min", self.radial_depth_min, non_negative)?;
         let radial_depth_max = optional("radial_depth_max", self.radial_depth_max, positive)?;
         if let (Some(low), Some(high)) = (radial_depth_min, radial_depth_max)
@@ -917,16 +790,10 @@ impl EngagementRequest {
         }
         let spike_threshold = optional("spike_threshold_deg", self.spike_threshold_deg, positive)?;
         let min_feed_per_tooth = optional("min_feed_per_tooth", self.min_feed_per_tooth, positive)?;
-        let axial_depth = self
-            .axial_depth
-            .map(|d| bounded("axial_depth", d, MAX_COORDINATE))
-            .transpose()?;
+        let axial_depth = self.axial_depth.map(|d| bounded("axial_depth", d, MAX_COORDINATE)).transpose()?;
         let stock_top_z = finite("stock_top_z", self.stock_top_z.unwrap_or(0.0))?;
         if stock_top_z.abs() > MAX_COORDINATE {
-            return Err(SolverError::input(
-                "stock_top_z",
-                format!("stock_top_z must lie within ±{MAX_COORDINATE} mm"),
-            ));
+            return Err(SolverError::input("stock_top_z", format!("stock_top_z must lie within ±{MAX_COORDINATE} mm")));
         }
         let clearance = bounded("clearance", self.clearance.unwrap_or(5.0), MAX_COORDINATE)?;
         let plan = self
@@ -951,14 +818,7 @@ impl EngagementRequest {
                 let tolerance = non_negative("feed_plan.tolerance", plan.tolerance.unwrap_or(0.05))?;
                 let min_block_length =
                     non_negative("feed_plan.min_block_length", plan.min_block_length.unwrap_or(0.5))?;
-                Ok(PlanJob {
-                    target,
-                    max_feed,
-                    flute_count,
-                    basis: plan.basis,
-                    tolerance,
-                    min_block_length,
-                })
+                Ok(PlanJob { target, max_feed, flute_count, basis: plan.basis, tolerance, min_block_length })
             })
             .transpose()?;
 
@@ -972,18 +832,9 @@ impl EngagementRequest {
                     return Err(SolverError::new("E_PATH", "paths is empty").at("paths"));
                 }
                 if paths.len() > MAX_CANDIDATES {
-                    return Err(too_large(
-                        "paths",
-                        "candidate paths",
-                        paths.len(),
-                        MAX_CANDIDATES,
-                    ));
+                    return Err(too_large("paths", "candidate paths", paths.len(), MAX_CANDIDATES));
                 }
-                paths
-                    .iter()
-                    .enumerate()
-                    .map(|(i, c)| (c.name.clone(), &c.path, format!("paths[{i}].path")))
-                    .collect()
+                paths.iter().enumerate().map(|(i, c)| (c.name.clone(), &c.path, format!("paths[{i}].path"))).collect()
             }
             (Some(_), Some(_)) => {
                 return Err(SolverError::input("paths", "give path or paths, not both"));
@@ -1007,20 +858,12 @@ impl EngagementRequest {
                 )
                 .at("step"));
             }
-            candidates.push(CandidateJob {
-                name,
-                route,
-                warnings,
-            });
+            candidates.push(CandidateJob { name, route, warnings });
         }
         if let Some(g) = grid {
             // The dots engine rasterises earlier cuts' arcs as chords within g/100.
-            let chords: f64 = region
-                .cuts
-                .iter()
-                .flat_map(|cut| cut.shapes.iter())
-                .map(|shape| shape.chord_count(g / 100.0))
-                .sum();
+            let chords: f64 =
+                region.cuts.iter().flat_map(|cut| cut.shapes.iter()).map(|shape| shape.chord_count(g / 100.0)).sum();
             if chords > MAX_CHORDS {
                 return Err(SolverError::new(
                     "E_WORK_LIMIT",
@@ -1119,13 +962,7 @@ pub(crate) fn grid_extent(
 }
 
 /// Refuses a grid past the memory limit; the grid's height in rows otherwise.
-fn check_grid(
-    route: &Route,
-    stock_box: BBox,
-    anchor: P2,
-    radius: f64,
-    grid: f64,
-) -> Result<f64, SolverError> {
+fn check_grid(route: &Route, stock_box: BBox, anchor: P2, radius: f64, grid: f64) -> Result<f64, SolverError> {
     if let Some((_, width, height)) = grid_extent(route, stock_box, anchor, radius, grid) {
         let dots = (width as f64) * (height as f64);
         if dots > MAX_GRID_DOTS as f64 {

@@ -12,12 +12,7 @@ pub(crate) enum Shape {
     /// Straight move.
     Line { from: P2, to: P2 },
     /// Circular move: `start` angle (rad) about `centre`, signed `sweep` (rad, positive ccw).
-    Arc {
-        centre: P2,
-        radius: f64,
-        start: f64,
-        sweep: f64,
-    },
+    Arc { centre: P2, radius: f64, start: f64, sweep: f64 },
 }
 
 impl Shape {
@@ -34,18 +29,9 @@ impl Shape {
         match *self {
             Self::Line { from, to } => {
                 let length = (to - from).norm();
-                if length == 0.0 {
-                    from
-                } else {
-                    from + (to - from) * (local / length).clamp(0.0, 1.0)
-                }
+                if length == 0.0 { from } else { from + (to - from) * (local / length).clamp(0.0, 1.0) }
             }
-            Self::Arc {
-                centre,
-                radius,
-                start,
-                sweep,
-            } => {
+            Self::Arc { centre, radius, start, sweep } => {
                 let angle = start + sweep.signum() * (local / radius).clamp(0.0, sweep.abs());
                 centre + radius * P2::new(angle.cos(), angle.sin())
             }
@@ -58,18 +44,9 @@ impl Shape {
             Self::Line { from, to } => {
                 let d = to - from;
                 let length = d.norm();
-                if length == 0.0 {
-                    P2::new(1.0, 0.0)
-                } else {
-                    d / length
-                }
+                if length == 0.0 { P2::new(1.0, 0.0) } else { d / length }
             }
-            Self::Arc {
-                radius,
-                start,
-                sweep,
-                ..
-            } => {
+            Self::Arc { radius, start, sweep, .. } => {
                 let angle = start + sweep.signum() * (local / radius).clamp(0.0, sweep.abs());
                 sweep.signum() * P2::new(-angle.sin(), angle.cos())
             }
@@ -97,16 +74,8 @@ impl Shape {
     /// The part of the piece from `from` to `to` mm along it.
     pub(crate) fn portion(&self, from: f64, to: f64) -> Self {
         match *self {
-            Self::Line { .. } => Self::Line {
-                from: self.point(from),
-                to: self.point(to),
-            },
-            Self::Arc {
-                centre,
-                radius,
-                start,
-                sweep,
-            } => {
+            Self::Line { .. } => Self::Line { from: self.point(from), to: self.point(to) },
+            Self::Arc { centre, radius, start, sweep } => {
                 let first = (from / radius).clamp(0.0, sweep.abs());
                 let last = (to / radius).clamp(first, sweep.abs());
                 Self::Arc {
@@ -121,11 +90,7 @@ impl Shape {
 
     /// Whether the polar angle `angle` about an arc's centre lies within its sweep.
     fn in_sweep(start: f64, sweep: f64, angle: f64) -> bool {
-        let offset = if sweep >= 0.0 {
-            (angle - start).rem_euclid(TAU)
-        } else {
-            (start - angle).rem_euclid(TAU)
-        };
+        let offset = if sweep >= 0.0 { (angle - start).rem_euclid(TAU) } else { (start - angle).rem_euclid(TAU) };
         offset <= sweep.abs() || sweep.abs() >= TAU
     }
 
@@ -133,16 +98,9 @@ impl Shape {
     pub(crate) fn distance(&self, q: P2) -> f64 {
         match *self {
             Self::Line { from, to } => super::polygon::distance_to_segment(q, from, to),
-            Self::Arc {
-                centre,
-                radius,
-                start,
-                sweep,
-            } => {
+            Self::Arc { centre, radius, start, sweep } => {
                 let d = q - centre;
-                let ends = (q - self.start_point())
-                    .norm()
-                    .min((q - self.end_point()).norm());
+                let ends = (q - self.start_point()).norm().min((q - self.end_point()).norm());
                 if d.norm_squared() > 0.0 && Self::in_sweep(start, sweep, d.y.atan2(d.x)) {
                     (d.norm() - radius).abs().min(ends)
                 } else if d.norm_squared() == 0.0 {
@@ -158,12 +116,7 @@ impl Shape {
     pub(crate) fn bbox(&self) -> BBox {
         match *self {
             Self::Line { from, to } => BBox::of(from, to),
-            Self::Arc {
-                centre,
-                radius,
-                start,
-                sweep,
-            } => {
+            Self::Arc { centre, radius, start, sweep } => {
                 let mut bbox = BBox::of(self.start_point(), self.end_point());
                 for quarter in 0..4 {
                     let angle = f64::from(quarter) * PI / 2.0;
@@ -192,11 +145,7 @@ impl Shape {
                 circle_circle(centre, radius, from, reach, out);
                 circle_circle(centre, radius, to, reach, out);
             }
-            Self::Arc {
-                centre: arc_centre,
-                radius: arc_radius,
-                ..
-            } => {
+            Self::Arc { centre: arc_centre, radius: arc_radius, .. } => {
                 circle_circle(centre, radius, arc_centre, arc_radius + reach, out);
                 if arc_radius > reach {
                     circle_circle(centre, radius, arc_centre, arc_radius - reach, out);
@@ -212,11 +161,7 @@ impl Shape {
         match *self {
             Self::Line { .. } => 1.0,
             Self::Arc { radius, sweep, .. } => {
-                let half_angle = if sagitta >= radius {
-                    PI / 2.0
-                } else {
-                    (1.0 - sagitta / radius).acos()
-                };
+                let half_angle = if sagitta >= radius { PI / 2.0 } else { (1.0 - sagitta / radius).acos() };
                 (sweep.abs() / (2.0 * half_angle.max(1e-9))).ceil().max(1.0)
             }
         }
@@ -230,9 +175,7 @@ impl Shape {
             Self::Arc { .. } => {
                 let count = self.chord_count(sagitta).min(1e8) as usize;
                 let length = self.length();
-                (0..=count)
-                    .map(|i| self.point(length * i as f64 / count as f64))
-                    .collect()
+                (0..=count).map(|i| self.point(length * i as f64 / count as f64)).collect()
             }
         }
     }
@@ -277,8 +220,7 @@ pub(crate) fn circle_circle(c: P2, radius: f64, other: P2, other_radius: f64, ou
     if distance > scale + slack || distance < (radius - other_radius).abs() - slack {
         return;
     }
-    let along =
-        (distance * distance + radius * radius - other_radius * other_radius) / (2.0 * distance);
+    let along = (distance * distance + radius * radius - other_radius * other_radius) / (2.0 * distance);
     let across = (radius * radius - along * along).max(0.0).sqrt();
     let axis = between / distance;
     let normal = P2::new(-axis.y, axis.x);
@@ -336,33 +278,19 @@ impl Route {
         let mut pieces = Vec::with_capacity(shapes.len());
         let (mut s, mut feed) = (0.0, 0.0);
         for (shape, rapid, source) in shapes {
-            pieces.push(Piece {
-                shape,
-                start_s: s,
-                start_feed: feed,
-                rapid,
-                source,
-            });
+            pieces.push(Piece { shape, start_s: s, start_feed: feed, rapid, source });
             s += shape.length();
             if !rapid {
                 feed += shape.length();
             }
         }
         let boxes: Vec<BBox> = pieces.iter().map(|p| p.shape.bbox()).collect();
-        Self {
-            tree: BoxTree::new(&boxes),
-            pieces,
-            length: s,
-            feed_length: feed,
-        }
+        Self { tree: BoxTree::new(&boxes), pieces, length: s, feed_length: feed }
     }
 
     /// Bounding box of the pieces (feed and rapid).
     pub(crate) fn bbox(&self) -> Option<BBox> {
-        self.pieces
-            .iter()
-            .map(|p| p.shape.bbox())
-            .reduce(|a, b| a.union(&b))
+        self.pieces.iter().map(|p| p.shape.bbox()).reduce(|a, b| a.union(&b))
     }
 
     /// Number of samples `stations(step)` gives, without building them.
@@ -417,12 +345,11 @@ impl Route {
             out.push(current.shape.truncated(station.local));
         }
         let mut earlier = Vec::new();
-        self.tree
-            .query(&BBox::around(station.centre, reach), &mut |index| {
-                if index < station.piece {
-                    earlier.push(index);
-                }
-            });
+        self.tree.query(&BBox::around(station.centre, reach), &mut |index| {
+            if index < station.piece {
+                earlier.push(index);
+            }
+        });
         earlier.sort_unstable_by(|a, b| b.cmp(a));
         for index in earlier {
             if let Some(piece) = self.pieces.get(index)
@@ -440,12 +367,7 @@ mod tests {
     use super::*;
 
     fn arc_quarter() -> Shape {
-        Shape::Arc {
-            centre: P2::new(0.0, 0.0),
-            radius: 2.0,
-            start: 0.0,
-            sweep: PI / 2.0,
-        }
+        Shape::Arc { centre: P2::new(0.0, 0.0), radius: 2.0, start: 0.0, sweep: PI / 2.0 }
     }
 
     #[test]
@@ -457,12 +379,7 @@ mod tests {
         assert!((arc.distance(P2::new(3.0, 3.0)) - (18.0_f64.sqrt() - 2.0)).abs() < 1e-12);
         // Outside the sweep the nearest point is an end.
         assert!((arc.distance(P2::new(0.0, -1.0)) - 5.0_f64.sqrt()).abs() < 1e-12);
-        let cw = Shape::Arc {
-            centre: P2::new(0.0, 0.0),
-            radius: 2.0,
-            start: PI / 2.0,
-            sweep: -PI / 2.0,
-        };
+        let cw = Shape::Arc { centre: P2::new(0.0, 0.0), radius: 2.0, start: PI / 2.0, sweep: -PI / 2.0 };
         assert!((cw.tangent(0.0) - P2::new(1.0, 0.0)).norm() < 1e-12);
         assert!((cw.end_point() - P2::new(2.0, 0.0)).norm() < 1e-12);
         let bbox = arc.bbox();
@@ -473,13 +390,7 @@ mod tests {
     fn crossings_bracket_every_change_of_side() {
         let centre = P2::new(0.7, 0.4);
         let (radius, reach) = (1.5, 1.0);
-        for shape in [
-            arc_quarter(),
-            Shape::Line {
-                from: P2::new(-1.0, 0.0),
-                to: P2::new(2.0, 0.5),
-            },
-        ] {
+        for shape in [arc_quarter(), Shape::Line { from: P2::new(-1.0, 0.0), to: P2::new(2.0, 0.5) }] {
             let mut angles = Vec::new();
             shape.crossings(reach, centre, radius, &mut angles);
             let side = |angle: f64| {
@@ -497,10 +408,7 @@ mod tests {
                         let d = (c - a).rem_euclid(TAU);
                         d <= b - a + 1e-12 || d >= TAU - 1e-12
                     });
-                    assert!(
-                        near,
-                        "{shape:?}: change between {a} and {b} not in {angles:?}"
-                    );
+                    assert!(near, "{shape:?}: change between {a} and {b} not in {angles:?}");
                 }
             }
             assert!(changes >= 2, "{shape:?}");
@@ -510,22 +418,8 @@ mod tests {
     #[test]
     fn stations_include_vertices_once() {
         let route = Route::new(vec![
-            (
-                Shape::Line {
-                    from: P2::new(0.0, 0.0),
-                    to: P2::new(1.0, 0.0),
-                },
-                false,
-                0,
-            ),
-            (
-                Shape::Line {
-                    from: P2::new(1.0, 0.0),
-                    to: P2::new(1.0, 0.25),
-                },
-                false,
-                1,
-            ),
+            (Shape::Line { from: P2::new(0.0, 0.0), to: P2::new(1.0, 0.0) }, false, 0),
+            (Shape::Line { from: P2::new(1.0, 0.0), to: P2::new(1.0, 0.25) }, false, 1),
         ]);
         let stations = route.stations(0.5);
         let s: Vec<f64> = stations.iter().map(|st| st.s).collect();

@@ -35,9 +35,7 @@ impl Bitmap {
             return false;
         }
         let bit = row * self.width + column;
-        self.bytes
-            .get(bit / 8)
-            .is_some_and(|byte| byte & (0x80 >> (bit % 8)) != 0)
+        self.bytes.get(bit / 8).is_some_and(|byte| byte & (0x80 >> (bit % 8)) != 0)
     }
 
     /// The cell containing `q`.
@@ -45,10 +43,7 @@ impl Bitmap {
         let column = ((q.x - self.origin.x) / self.cell).floor();
         let row = ((q.y - self.origin.y) / self.cell).floor();
         // Far-away points saturate to an index outside the raster.
-        (
-            column.clamp(-1.0, 1e15) as i64,
-            row.clamp(-1.0, 1e15) as i64,
-        )
+        (column.clamp(-1.0, 1e15) as i64, row.clamp(-1.0, 1e15) as i64)
     }
 
     fn contains(&self, q: P2) -> bool {
@@ -59,11 +54,7 @@ impl Bitmap {
     fn bbox(&self) -> BBox {
         BBox {
             min: self.origin,
-            max: self.origin
-                + P2::new(
-                    self.width as f64 * self.cell,
-                    self.height as f64 * self.cell,
-                ),
+            max: self.origin + P2::new(self.width as f64 * self.cell, self.height as f64 * self.cell),
         }
     }
 
@@ -71,9 +62,7 @@ impl Bitmap {
     fn crossings(&self, c: P2, radius: f64, out: &mut Vec<f64>) {
         let cell = self.cell;
         let first_column = ((c.x - radius - self.origin.x) / cell).ceil().max(0.0) as i64;
-        let last_column = ((c.x + radius - self.origin.x) / cell)
-            .floor()
-            .min(self.width as f64) as i64;
+        let last_column = ((c.x + radius - self.origin.x) / cell).floor().min(self.width as f64) as i64;
         for column in first_column..=last_column {
             let x = self.origin.x + column as f64 * cell;
             let half = (radius * radius - (x - c.x) * (x - c.x)).max(0.0).sqrt();
@@ -85,9 +74,7 @@ impl Bitmap {
             }
         }
         let first_row = ((c.y - radius - self.origin.y) / cell).ceil().max(0.0) as i64;
-        let last_row = ((c.y + radius - self.origin.y) / cell)
-            .floor()
-            .min(self.height as f64) as i64;
+        let last_row = ((c.y + radius - self.origin.y) / cell).floor().min(self.height as f64) as i64;
         for row in first_row..=last_row {
             let y = self.origin.y + row as f64 * cell;
             let half = (radius * radius - (y - c.y) * (y - c.y)).max(0.0).sqrt();
@@ -122,11 +109,7 @@ impl Cut {
     /// A cut along `shapes` by a cutter of `radius`.
     pub(crate) fn new(shapes: Vec<Shape>, radius: f64) -> Self {
         let boxes: Vec<BBox> = shapes.iter().map(Shape::bbox).collect();
-        Self {
-            tree: BoxTree::new(&boxes),
-            shapes,
-            radius,
-        }
+        Self { tree: BoxTree::new(&boxes), shapes, radius }
     }
 
     /// Pieces that come within `reach` of `centre`.
@@ -146,16 +129,15 @@ impl Cut {
     pub(crate) fn keeps(&self, q: P2, work: &mut u64) -> bool {
         let limit = self.radius * (1.0 - REACH_TOLERANCE);
         let mut kept = true;
-        self.tree
-            .query(&BBox::around(q, self.radius), &mut |index| {
-                *work += 1;
-                if kept
-                    && let Some(shape) = self.shapes.get(index)
-                    && shape.distance(q) < limit
-                {
-                    kept = false;
-                }
-            });
+        self.tree.query(&BBox::around(q, self.radius), &mut |index| {
+            *work += 1;
+            if kept
+                && let Some(shape) = self.shapes.get(index)
+                && shape.distance(q) < limit
+            {
+                kept = false;
+            }
+        });
         kept
     }
 }
@@ -207,13 +189,11 @@ impl Region {
     pub(crate) fn crossings(&self, c: P2, radius: f64, out: &mut Vec<f64>) {
         match &self.base {
             Base::Polygons { edges, .. } => {
-                edges
-                    .tree
-                    .query(&BBox::around(c, radius * (1.0 + 1e-9)), &mut |index| {
-                        if let Some(edge) = edges.edges.get(index) {
-                            circle_segment(c, radius, edge.from, edge.to, out);
-                        }
-                    });
+                edges.tree.query(&BBox::around(c, radius * (1.0 + 1e-9)), &mut |index| {
+                    if let Some(edge) = edges.edges.get(index) {
+                        circle_segment(c, radius, edge.from, edge.to, out);
+                    }
+                });
             }
             Base::Bitmap(bitmap) => bitmap.crossings(c, radius, out),
         }
@@ -270,13 +250,7 @@ mod tests {
     #[test]
     fn bitmap_cells_and_crossings() {
         // 4 × 2 raster, material in columns 1 and 2 of row 0 only: 0110 0000.
-        let bitmap = Bitmap {
-            origin: P2::new(0.0, 0.0),
-            cell: 1.0,
-            width: 4,
-            height: 2,
-            bytes: vec![0b0110_0000],
-        };
+        let bitmap = Bitmap { origin: P2::new(0.0, 0.0), cell: 1.0, width: 4, height: 2, bytes: vec![0b0110_0000] };
         assert!(bitmap.contains(P2::new(1.5, 0.5)));
         assert!(!bitmap.contains(P2::new(0.5, 0.5)));
         assert!(!bitmap.contains(P2::new(1.5, 1.5)));

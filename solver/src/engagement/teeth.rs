@@ -30,10 +30,7 @@ fn clamped_sin(angle_deg: f64) -> f64 {
 /// H_k/f_z,k and n_k for `flutes` teeth on `arcs` (§5.6, exact maximisation).
 pub(crate) fn tooth_sum(arcs: &[Arc], flutes: u32) -> ToothSum {
     if arcs.is_empty() || flutes == 0 {
-        return ToothSum {
-            ratio: 0.0,
-            teeth: 0,
-        };
+        return ToothSum { ratio: 0.0, teeth: 0 };
     }
     let pitch = 360.0 / f64::from(flutes);
     let mut breaks = vec![0.0, pitch];
@@ -64,9 +61,7 @@ pub(crate) fn tooth_sum(arcs: &[Arc], flutes: u32) -> ToothSum {
             continue;
         }
         let middle = 0.5 * (low + high);
-        let inside = (0..flutes)
-            .filter(|&j| on_arcs(arcs, tooth(middle, j), -END_TOLERANCE))
-            .count();
+        let inside = (0..flutes).filter(|&j| on_arcs(arcs, tooth(middle, j), -END_TOLERANCE)).count();
         teeth = teeth.max(u32::try_from(inside).unwrap_or(u32::MAX));
         // Teeth cutting throughout this interval: on an arc and in the front half.
         let active: Vec<u32> = (0..flutes)
@@ -87,10 +82,7 @@ pub(crate) fn tooth_sum(arcs: &[Arc], flutes: u32) -> ToothSum {
         let peak = 90.0 - cy.atan2(cx).to_degrees();
         let phase = low + (peak - low).rem_euclid(360.0);
         if phase < high {
-            let sum: f64 = active
-                .iter()
-                .map(|&j| tooth(phase, j).to_radians().sin())
-                .sum();
+            let sum: f64 = active.iter().map(|&j| tooth(phase, j).to_radians().sin()).sum();
             best = best.max(sum);
         }
     }
@@ -123,18 +115,7 @@ mod tests {
     #[test]
     fn full_slot_closed_forms() {
         // engagement.md §5.6 table, k = 1…10.
-        let expected = [
-            1.0,
-            1.0,
-            1.0,
-            std::f64::consts::SQRT_2,
-            1.618034,
-            2.0,
-            2.246980,
-            2.613126,
-            2.879385,
-            3.236068,
-        ];
+        let expected = [1.0, 1.0, 1.0, std::f64::consts::SQRT_2, 1.618034, 2.0, 2.246980, 2.613126, 2.879385, 3.236068];
         for (k, value) in (1..=10).zip(expected) {
             let sum = tooth_sum(&[arc(0.0, 180.0)], k);
             assert!((sum.ratio - value).abs() < 1e-6, "k = {k}: {}", sum.ratio);
@@ -146,13 +127,7 @@ mod tests {
     #[test]
     fn down_milling_sixty_degrees() {
         // §5.6: φ = 60°: k ≤ 6 → 0.866025; k = 7 → 1.015068; k = 8 → 1.124844; k = 10 → 1.272762.
-        for (k, value) in [
-            (3, 0.866025),
-            (6, 0.866025),
-            (7, 1.015068),
-            (8, 1.124844),
-            (10, 1.272762),
-        ] {
+        for (k, value) in [(3, 0.866025), (6, 0.866025), (7, 1.015068), (8, 1.124844), (10, 1.272762)] {
             let sum = tooth_sum(&[arc(0.0, 60.0)], k);
             assert!((sum.ratio - value).abs() < 1e-6, "k = {k}: {}", sum.ratio);
         }
@@ -177,12 +152,6 @@ mod tests {
 
     #[test]
     fn empty_arcs_give_zero() {
-        assert_eq!(
-            tooth_sum(&[], 4),
-            ToothSum {
-                ratio: 0.0,
-                teeth: 0
-            }
-        );
+        assert_eq!(tooth_sum(&[], 4), ToothSum { ratio: 0.0, teeth: 0 });
     }
 }
