@@ -110,6 +110,7 @@ fn request(
         block_delete: None,
         correction: None,
         history: None,
+        pass_range: None,
     }
 }
 

@@ -20,6 +20,8 @@ pub enum PassStatus {
     NoSurface,
     /// The ball never reaches the stock's footprint (E10).
     OutsideStock,
+    /// Outside the requested `pass_range`.
+    NotPredicted,
 }
 
 /// Remarks on a pass's prediction (§5).

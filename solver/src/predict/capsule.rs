@@ -52,6 +52,19 @@ impl Capsule {
     /// radius `r2`, if the ray meets it.
     #[inline]
     pub(crate) fn entry_z(&self, x: f64, y: f64, r2: f64) -> Option<f64> {
+        // Beyond R of the axis in xy the ray misses everything.
+        let (abx, aby) = (self.b.x - self.a.x, self.b.y - self.a.y);
+        let (apx, apy) = (x - self.a.x, y - self.a.y);
+        let length2 = abx * abx + aby * aby;
+        let t = if length2 > 0.0 {
+            ((apx * abx + apy * aby) / length2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let (dx, dy) = (apx - t * abx, apy - t * aby);
+        if dx * dx + dy * dy > r2 {
+            return None;
+        }
         let mut best = f64::INFINITY;
         for end in [&self.a, &self.b] {
             let (dx, dy) = (x - end.x, y - end.y);
@@ -91,7 +104,8 @@ impl Capsule {
     /// of its xy rectangle and its top)?
     pub(crate) fn may_cover_box(&self, lo: &Vec3, hi: &Vec3, r: f64, tie: f64) -> bool {
         let (cx, cy) = (0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y));
-        let half_diagonal = 0.5 * (hi.x - lo.x).hypot(hi.y - lo.y);
+        let (width, height) = (hi.x - lo.x, hi.y - lo.y);
+        let half_diagonal = 0.5 * (width * width + height * height).sqrt();
         let distance = (distance_2d(cx, cy, &self.a, &self.b) - half_diagonal).max(0.0);
         if distance >= r {
             return false;
@@ -117,7 +131,8 @@ fn distance_2d(x: f64, y: f64, a: &Vec3, b: &Vec3) -> f64 {
     } else {
         0.0
     };
-    (apx - t * abx).hypot(apy - t * aby)
+    let (dx, dy) = (apx - t * abx, apy - t * aby);
+    (dx * dx + dy * dy).sqrt()
 }
 
 #[cfg(test)]

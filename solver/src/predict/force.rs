@@ -182,7 +182,10 @@ pub(crate) fn engage(
     let width = radius * d_theta;
     let flute_shift = grid.steps / grid.flutes;
     let u = feed_direction;
-    let mut lists = TileLists::default();
+    // Tiles on the front of the ball that meet the stock, then the capsules near all of them.
+    let mut kept: Vec<(&Tile, Region, Vec3, Vec3)> = Vec::new();
+    let mut union_lo = Vec3::repeat(f64::INFINITY);
+    let mut union_hi = Vec3::repeat(f64::NEG_INFINITY);
     for tile in &grid.tiles {
         // Upper bound of ê_r·û over the tile.
         let front: f64 = (0..3)
@@ -193,11 +196,22 @@ pub(crate) fn engage(
         }
         let lo = radius * tile.lo - Vec3::repeat(scene.eps);
         let hi = radius * tile.hi + Vec3::repeat(scene.eps);
-        scene.tile(stock, &lo, &hi, false, &mut lists);
-        let Some(region) = lists.region else { continue };
+        let region = scene.region(stock, &lo, &hi);
         if region == Region::Outside {
             continue;
         }
+        union_lo = union_lo.inf(&lo);
+        union_hi = union_hi.sup(&hi);
+        kept.push((tile, region, lo, hi));
+    }
+    if kept.is_empty() {
+        return engagement;
+    }
+    let mut pool = TileLists::default();
+    scene.candidates(&union_lo, &union_hi, false, None, &mut pool);
+    let mut lists = TileLists::default();
+    for (tile, region, lo, hi) in kept {
+        scene.candidates(&lo, &hi, false, Some(&pool), &mut lists);
         let mut hint = 0usize;
         for k in tile.rings.0..tile.rings.1 {
             let (sin_t, cos_t) = grid.ring_angle[k];

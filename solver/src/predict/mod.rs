@@ -117,8 +117,7 @@ pub fn solve_with(
     let job = request.validate(tool, mesh)?;
     let context = Context::new(&job);
     let node_count = job.path.nodes.len();
-    let passes = job.path.passes.len();
-    let total_work = passes * job.iterations as usize;
+    let total_work = (job.pass_range.len() * job.iterations as usize).max(1);
     let done = AtomicUsize::new(0);
     let mut rounds: Vec<Vec<Outcome>> = Vec::new();
     let mut total = vec![Vec3::zeros(); node_count];

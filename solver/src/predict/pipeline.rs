@@ -167,6 +167,9 @@ pub(crate) fn run_round(
                 cancelled.store(true, Ordering::Relaxed);
                 return None;
             }
+            if !context.job.pass_range.contains(&index) {
+                return Some(Outcome::empty(PassStatus::NotPredicted));
+            }
             let outcome = predict_pass(context, path, index, scratch);
             let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
             if let Some(progress) = control.progress

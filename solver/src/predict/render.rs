@@ -82,8 +82,12 @@ pub(crate) fn render(scene: &Scene, stock: &StockModel, window: &Window) -> Imag
     };
     let rim_radius = radius - pixel;
     let mut finished: Vec<Finished> = Vec::new();
-    let mut lists = TileLists::default();
+    // Tiles on M's disc, below the ball centre and meeting the stock; then the capsules near
+    // all of them.
     let tiles = n.div_ceil(TILE);
+    let mut kept: Vec<(usize, usize, usize, usize, super::stock::Region, Vec3, Vec3)> = Vec::new();
+    let mut union_lo = Vec3::repeat(f64::INFINITY);
+    let mut union_hi = Vec3::repeat(f64::NEG_INFINITY);
     for tile_j in 0..tiles {
         for tile_i in 0..tiles {
             let (i0, i1) = (tile_i * TILE, ((tile_i + 1) * TILE).min(n));
@@ -113,10 +117,24 @@ pub(crate) fn render(scene: &Scene, stock: &StockModel, window: &Window) -> Imag
             if world_lo.z > scene.centre.z {
                 continue;
             }
-            scene.tile(stock, &lo, &hi, true, &mut lists);
-            if lists.region == Some(super::stock::Region::Outside) {
+            let region = scene.region(stock, &lo, &hi);
+            if region == super::stock::Region::Outside {
                 continue;
             }
+            union_lo = union_lo.inf(&lo);
+            union_hi = union_hi.sup(&hi);
+            kept.push((i0, i1, j0, j1, region, lo, hi));
+        }
+    }
+    let mut pool = TileLists::default();
+    if !kept.is_empty() {
+        scene.candidates(&union_lo, &union_hi, true, None, &mut pool);
+    }
+    let mut lists = TileLists::default();
+    for (i0, i1, j0, j1, region, lo, hi) in kept {
+        {
+            scene.candidates(&lo, &hi, true, Some(&pool), &mut lists);
+            lists.region = Some(region);
             let mut hints = [0usize; 2];
             for j in j0..j1 {
                 let y = coordinate(j, window.centre[1]);

@@ -177,6 +177,10 @@ pub struct PredictRequest {
     /// 100).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub history: Option<Vec<usize>>,
+    /// Predict only passes `[from, to)` (the whole path still sweeps the stock); the others get
+    /// status `not_predicted`. Lets a long job run in chunks.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pass_range: Option<[usize; 2]>,
 }
 
 /// Where each path node came from, for writing the corrected program.
@@ -215,6 +219,7 @@ pub(crate) struct Job {
     pub(crate) max_correction: f64,
     pub(crate) iterations: u32,
     pub(crate) history: Vec<usize>,
+    pub(crate) pass_range: std::ops::Range<usize>,
     pub(crate) spindle_speeds: Vec<f64>,
 }
 
@@ -458,6 +463,21 @@ impl PredictRequest {
                 ));
             }
         }
+        let pass_range = match self.pass_range {
+            None => 0..path.passes.len(),
+            Some([from, to]) => {
+                if from > to || to > path.passes.len() {
+                    return Err(SolverError::input(
+                        "pass_range",
+                        format!(
+                            "pass_range must satisfy from ≤ to ≤ {} (the pass count)",
+                            path.passes.len()
+                        ),
+                    ));
+                }
+                from..to
+            }
+        };
         let mut spindle_speeds: Vec<f64> =
             path.passes.iter().map(|p| p.source.spindle_rpm).collect();
         spindle_speeds.sort_by(f64::total_cmp);
@@ -495,6 +515,7 @@ impl PredictRequest {
             max_correction,
             iterations,
             history,
+            pass_range,
             spindle_speeds,
         })
     }

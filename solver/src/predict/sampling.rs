@@ -14,7 +14,7 @@
 //! largest region is the representative one (§5 E8).
 
 use super::scene::{SampleState, Scene, TileLists};
-use super::stock::StockModel;
+use super::stock::{Region, StockModel};
 use crate::geometry::Vec3;
 
 /// Samples per α tile.
@@ -63,6 +63,14 @@ struct Run {
     row: usize,
     start: f64,
     end: f64,
+}
+
+/// A tile of samples: its box (frame), place relative to the stock, and (row, sample) members.
+struct TileBox {
+    lo: Vec3,
+    hi: Vec3,
+    region: Region,
+    members: Vec<(usize, usize)>,
 }
 
 /// One row of the band.
@@ -191,7 +199,10 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
             .map(|r| vec![SampleState::Air; r.count])
             .collect();
         let mut tile_of: Vec<Vec<usize>> = block.iter().map(|r| vec![0; r.count]).collect();
-        let mut tile_lists: Vec<TileLists> = Vec::with_capacity(tile_count);
+        // Tile boxes and their place relative to the stock, then the capsules near all of them.
+        let mut boxes: Vec<Option<TileBox>> = Vec::with_capacity(tile_count);
+        let mut union_lo = Vec3::repeat(f64::INFINITY);
+        let mut union_hi = Vec3::repeat(f64::NEG_INFINITY);
         for tile in 0..tile_count {
             let (t_lo, t_hi) = (
                 alpha_min + tile as f64 * tile_width,
@@ -213,19 +224,46 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
                     members.push((r, i));
                 }
             }
-            if members.is_empty() {
-                tile_lists.push(TileLists::default());
-                continue;
-            }
             // Bisection points lie within one step of a sample.
             let margin = Vec3::repeat(band.spacing * 1.01 + scene.eps);
             let (lo, hi) = (lo - margin, hi + margin);
-            if lo.z > 0.0 {
-                tile_lists.push(TileLists::default());
+            if members.is_empty() || lo.z > 0.0 {
+                boxes.push(None);
                 continue;
             }
+            let region = scene.region(stock, &lo, &hi);
+            if region == Region::Outside {
+                boxes.push(None);
+                continue;
+            }
+            union_lo = union_lo.inf(&lo);
+            union_hi = union_hi.sup(&hi);
+            boxes.push(Some(TileBox {
+                lo,
+                hi,
+                region,
+                members,
+            }));
+        }
+        let mut pool = TileLists::default();
+        if union_lo.x.is_finite() {
+            scene.candidates(&union_lo, &union_hi, true, None, &mut pool);
+        }
+        let mut tile_lists: Vec<TileLists> = Vec::with_capacity(tile_count);
+        for (tile, entry) in boxes.into_iter().enumerate() {
+            let Some(TileBox {
+                lo,
+                hi,
+                region,
+                members,
+            }) = entry
+            else {
+                tile_lists.push(TileLists::default());
+                continue;
+            };
             let mut lists = TileLists::default();
-            scene.tile(stock, &lo, &hi, true, &mut lists);
+            scene.candidates(&lo, &hi, true, Some(&pool), &mut lists);
+            lists.region = Some(region);
             let mut hints = [0usize; 2];
             for &(r, i) in &members {
                 tile_of[r][i] = tile;

@@ -165,36 +165,49 @@ impl Scene {
         self.centre + self.rotation.transpose() * frame
     }
 
-    /// Fills `lists` for the frame box `[lo, hi]`: its place relative to the stock and the
-    /// capsules that may hide any of its points; `want_after` skips T2 when only K is needed.
-    pub(crate) fn tile(
+    /// Where the frame box `[lo, hi]` lies relative to the stock.
+    pub(crate) fn region(&self, stock: &StockModel, lo: &Vec3, hi: &Vec3) -> Region {
+        let (world_lo, world_hi) = self.world_box(lo, hi);
+        stock.classify(&world_lo, &world_hi, self.eps)
+    }
+
+    /// Fills `lists` with the capsules that may hide a point of the frame box `[lo, hi]`, taken
+    /// from `pool` (or from all capsules); `want_after` skips T2 when only K is needed. The
+    /// region is left to the caller.
+    pub(crate) fn candidates(
         &self,
-        stock: &StockModel,
         lo: &Vec3,
         hi: &Vec3,
         want_after: bool,
+        pool: Option<&TileLists>,
         lists: &mut TileLists,
     ) {
         lists.before.clear();
         lists.after.clear();
-        let (world_lo, world_hi) = self.world_box(lo, hi);
-        let region = stock.classify(&world_lo, &world_hi, self.eps);
-        lists.region = Some(region);
-        if region == Region::Outside {
-            return;
-        }
         let tie = self.eps;
-        for (index, capsule) in self.before.iter().enumerate() {
-            if capsule.may_cover_box(lo, hi, self.radius, tie) {
-                lists.before.push(index as u32);
-            }
-        }
+        let pick = |capsules: &[Capsule], from: Option<&[u32]>, out: &mut Vec<u32>| match from {
+            Some(indices) => out.extend(
+                indices
+                    .iter()
+                    .copied()
+                    .filter(|&i| capsules[i as usize].may_cover_box(lo, hi, self.radius, tie)),
+            ),
+            None => out.extend(
+                (0..capsules.len() as u32)
+                    .filter(|&i| capsules[i as usize].may_cover_box(lo, hi, self.radius, tie)),
+            ),
+        };
+        pick(
+            &self.before,
+            pool.map(|p| p.before.as_slice()),
+            &mut lists.before,
+        );
         if want_after {
-            for (index, capsule) in self.after.iter().enumerate() {
-                if capsule.may_cover_box(lo, hi, self.radius, tie) {
-                    lists.after.push(index as u32);
-                }
-            }
+            pick(
+                &self.after,
+                pool.map(|p| p.after.as_slice()),
+                &mut lists.after,
+            );
         }
     }
 
@@ -224,10 +237,15 @@ impl Scene {
             Side::After => &self.after,
         };
         let mut state = Cover::Open;
-        let count = list.len();
-        for k in 0..count {
-            let position = (*hint + k) % count;
-            let capsule = &capsules[list[position] as usize];
+        let start = (*hint).min(list.len());
+        let (tail, head) = list.split_at(start);
+        for (position, &index) in head
+            .iter()
+            .enumerate()
+            .map(|(k, i)| (k + start, i))
+            .chain(tail.iter().enumerate())
+        {
+            let capsule = &capsules[index as usize];
             if capsule.min_z - self.radius > q.z + self.eps {
                 continue;
             }
