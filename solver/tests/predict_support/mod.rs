@@ -149,3 +149,145 @@ pub fn raster_request(
     };
     (request, tool, moves)
 }
+
+/// A request with every option left to its default.
+pub fn bare_request(tool: &Tool, stock: Stock, path: PathInput) -> PredictRequest {
+    PredictRequest {
+        tool: ToolRef::Inline(tool.clone()),
+        stock,
+        path,
+        reference: Reference::Centre,
+        spindle_rpm: None,
+        spindle_direction: None,
+        feed: None,
+        cutting: None,
+        deflection: None,
+        method: Method::Sampling,
+        resolution: None,
+        tooth_feed_gap: None,
+        view_correction: None,
+        view_correction_deg: None,
+        flute_zero_deg: None,
+        samples_per_revolution: None,
+        edge_elements: None,
+        arc_tolerance: None,
+        block_delete: None,
+        correction: None,
+        history: None,
+        pass_range: None,
+    }
+}
+
+/// G-code of separate straight passes of ball centres, linked by rapids 100 mm above the
+/// highest pass end.
+pub fn passes_program(passes: &[([f64; 3], [f64; 3])], feed: f64) -> String {
+    let safe = passes
+        .iter()
+        .map(|(a, b)| a[2].max(b[2]))
+        .fold(f64::NEG_INFINITY, f64::max)
+        + 100.0;
+    let mut text = String::from("G21 G90 G17\nS6000 M03\n");
+    for (start, end) in passes {
+        text.push_str(&format!(
+            "G0 X{:.9} Y{:.9} Z{safe:.9}\nG0 Z{:.9}\nG1 X{:.9} Y{:.9} Z{:.9} F{feed}\nG0 Z{safe:.9}\n",
+            start[0], start[1], start[2], end[0], end[1], end[2]
+        ));
+    }
+    text.push_str("M30\n");
+    text
+}
+
+/// Ball radius, pick feed and tooth feed of a test case, mm.
+#[derive(Debug, Clone, Copy)]
+pub struct Conditions {
+    pub radius: f64,
+    pub pick: f64,
+    pub tooth_feed: f64,
+}
+
+/// Case B's conditions: R = 5, pick 0.5, f_t = 0.1.
+pub const FINE: Conditions = Conditions {
+    radius: 5.0,
+    pick: 0.5,
+    tooth_feed: 0.1,
+};
+
+/// The patent's Fig. 16 conditions (case C): R = 10, pick 0.63, f_t = 0.4.
+pub const PATENT: Conditions = Conditions {
+    radius: 10.0,
+    pick: 0.63,
+    tooth_feed: 0.4,
+};
+
+/// Contour passes (11 passes of 30 mm + 6R) on a plane rising at `slope_deg` toward azimuth
+/// `uphill_deg`, the whole case turned by `turn_deg` about Z and moved by `shift`; the stock is
+/// the plane plus 0.2 mm. Returns the request (force model, isotropic modal stiffness, 6000 rpm,
+/// 2 flutes) and the tool; pass 5 is the middle one.
+pub fn inclined_case(
+    slope_deg: f64,
+    uphill_deg: f64,
+    turn_deg: f64,
+    shift: [f64; 3],
+    method: Method,
+) -> (PredictRequest, Tool) {
+    inclined_case_with(FINE, slope_deg, uphill_deg, turn_deg, shift, method)
+}
+
+/// [`inclined_case`] under other conditions.
+pub fn inclined_case_with(
+    conditions: Conditions,
+    slope_deg: f64,
+    uphill_deg: f64,
+    turn_deg: f64,
+    shift: [f64; 3],
+    method: Method,
+) -> (PredictRequest, Tool) {
+    let radius = conditions.radius;
+    let half = 15.0 + 3.0 * radius;
+    let tool = finishing_tool(radius);
+    let (s, c) = slope_deg.to_radians().sin_cos();
+    let (sa, ca) = (uphill_deg + turn_deg).to_radians().sin_cos();
+    let normal = [-s * ca, -s * sa, c];
+    let uphill = [c * ca, c * sa, s];
+    let feed = [-sa, ca, 0.0];
+    let at = |k: f64, along: f64, lift: f64| {
+        let mut p = [0.0; 3];
+        for i in 0..3 {
+            p[i] = k * conditions.pick * uphill[i] + lift * normal[i] + along * feed[i] + shift[i];
+        }
+        p
+    };
+    let passes: Vec<([f64; 3], [f64; 3])> = (-5..=5)
+        .map(|k| {
+            (
+                at(f64::from(k), -half, radius),
+                at(f64::from(k), half, radius),
+            )
+        })
+        .collect();
+    let point = at(0.0, 0.0, 0.2);
+    let stock = Stock::Plane {
+        point,
+        normal,
+        min: [shift[0] - 1000.0, shift[1] - 1000.0],
+        max: [shift[0] + 1000.0, shift[1] + 1000.0],
+    };
+    let mut request = bare_request(
+        &tool,
+        stock,
+        PathInput::Gcode {
+            program: passes_program(&passes, conditions.tooth_feed * 6000.0 * 2.0),
+        },
+    );
+    request.cutting = Some(CuttingCoefficients {
+        ktc: 2000.0,
+        krc: 800.0,
+        kac: 300.0,
+        kte: 0.0,
+        kre: 0.0,
+        kae: 0.0,
+    });
+    request.method = method;
+    request.pass_range = Some([5, 6]);
+    (request, tool)
+}
