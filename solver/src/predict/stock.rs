@@ -61,7 +61,7 @@ pub enum Stock {
     },
     /// A closed triangle mesh (ASCII or binary STL) uploaded with the request: the solver entry
     /// takes its bytes separately.
-    Mesh,
+    Mesh {},
 }
 
 /// Where a box lies relative to the stock.
@@ -306,7 +306,7 @@ impl Stock {
                     *origin, spacing, heights, bottom,
                 )))
             }
-            Self::Mesh => {
+            Self::Mesh {} => {
                 let Some(bytes) = mesh else {
                     return Err(stock_error(
                         "stock",
@@ -535,7 +535,7 @@ mod tests {
             }
             .model(None)
             .unwrap(),
-            Stock::Mesh
+            Stock::Mesh {}
                 .model(Some(&super::super::stl::tests::binary_stl(&triangles)))
                 .unwrap(),
         ]
@@ -619,7 +619,7 @@ mod tests {
                 },
                 "stock.heights[1]",
             ),
-            (Stock::Mesh, "stock"),
+            (Stock::Mesh {}, "stock"),
         ];
         for (stock, field) in bad {
             assert_eq!(stock.model(None).unwrap_err().field(), Some(field));
