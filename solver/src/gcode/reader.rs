@@ -628,11 +628,19 @@ pub fn read(text: &str, field: &str, options: &ReadOptions) -> Result<ReadProgra
                         field,
                     )?,
                 };
+                // Missing axis words go right after the block's last axis word.
+                let insert_at = block
+                    .axes
+                    .iter()
+                    .flatten()
+                    .map(|w| w.span.end)
+                    .max()
+                    .unwrap_or(code_end);
                 let words = MoveWords {
                     axes: block.axes.map(|w| w.map(|w| w.span)),
                     offsets: block.offsets.map(|w| w.map(|w| w.span)),
                     radius: block.radius.map(|w| w.span),
-                    insert_at: code_end,
+                    insert_at,
                 };
                 moves.push(ReadMove {
                     line: line_number,
@@ -1051,26 +1059,22 @@ pub fn rewrite(
                 continue;
             };
             let span = read_move.words.axes[axis];
-            let value = match read_move.modal.distance {
-                Distance::Absolute => {
-                    if end == old_end {
-                        continue;
-                    }
-                    end / scale
-                }
+            let (value, old_value) = match read_move.modal.distance {
+                Distance::Absolute => (end / scale, old_end / scale),
                 Distance::Incremental => {
                     let (Some(start), Some(old_start)) = (new_from[axis], read_move.from[axis])
                     else {
                         continue;
                     };
-                    if end - start == old_end - old_start {
-                        continue;
-                    }
-                    (end - start) / scale
+                    ((end - start) / scale, (old_end - old_start) / scale)
                 }
             };
             let decimals = span.map_or(4, |s| s.decimals.max(4));
             let written = number(value, decimals);
+            // Unchanged at the written precision: keep the original text.
+            if written == number(old_value, decimals) {
+                continue;
+            }
             match span {
                 Some(span) => changes.push((span, written)),
                 None => inserts.push(format!("{}{written}", letters[axis])),
@@ -1177,13 +1181,27 @@ fn arc_words(
     };
     let scale = read_move.modal.units.scale();
     let words = &read_move.words;
+    let (
+        MoveKind::Arc {
+            centre: old_centre, ..
+        },
+        Some(old_from),
+    ) = (read_move.kind, read_move.from_xyz())
+    else {
+        return;
+    };
     if let Some(span) = words.radius {
         let radius = (from[a] - centre_a).hypot(from[b] - centre_b);
         // Keep the long/short choice of the original R sign.
         let cross = chord_a * (centre_b - from[b]) - chord_b * (centre_a - from[a]);
         let left = cross > 0.0;
         let signed = if left != clockwise { radius } else { -radius };
-        changes.push((span, number(signed / scale, span.decimals.max(4))));
+        let decimals = span.decimals.max(4);
+        let old_radius = (old_from[a] - old_centre[a]).hypot(old_from[b] - old_centre[b]);
+        let written = number(signed / scale, decimals);
+        if written.trim_start_matches('-') != number(old_radius / scale, decimals) {
+            changes.push((span, written));
+        }
         return;
     }
     let letters = ['I', 'J', 'K'];
@@ -1194,7 +1212,16 @@ fn arc_words(
             centre - from[axis]
         } / scale;
         let span = words.offsets[axis];
-        let written = number(value, span.map_or(4, |s| s.decimals.max(4)));
+        let decimals = span.map_or(4, |s| s.decimals.max(4));
+        let written = number(value, decimals);
+        let old_value = if read_move.modal.absolute_arc_centre {
+            old_centre[axis]
+        } else {
+            old_centre[axis] - old_from[axis]
+        } / scale;
+        if written == number(old_value, decimals) {
+            continue;
+        }
         match span {
             Some(span) => changes.push((span, written)),
             None => inserts.push(format!("{}{written}", letters[axis])),
