@@ -18,8 +18,13 @@ pub(crate) struct Capsule {
     /// Unit axis A→B (zero for a point).
     axis: Vec3,
     length: f64,
-    /// 1 − axis_z²: the cylinder term's quadratic coefficient; 0 for a segment along the view.
+    /// xy part of B − A and the inverse of its squared length (0 for a vertical segment).
+    ab_xy: (f64, f64),
+    inverse_xy: f64,
+    /// 1 − axis_z²: the cylinder term's quadratic coefficient, and its inverse (0 for a segment
+    /// along the view).
     denom: f64,
+    inverse_denom: f64,
     /// Lowest z of the axis segment.
     pub(crate) min_z: f64,
 }
@@ -34,16 +39,25 @@ impl Capsule {
             Vec3::zeros()
         };
         let denom = 1.0 - axis.z * axis.z;
+        let denom = if length > 0.0 && denom > 1e-12 {
+            denom
+        } else {
+            0.0
+        };
+        let length_xy2 = ab.x * ab.x + ab.y * ab.y;
         Self {
             a,
             b,
             axis,
             length,
-            denom: if length > 0.0 && denom > 1e-12 {
-                denom
+            ab_xy: (ab.x, ab.y),
+            inverse_xy: if length_xy2 > 0.0 {
+                1.0 / length_xy2
             } else {
                 0.0
             },
+            denom,
+            inverse_denom: if denom > 0.0 { 1.0 / denom } else { 0.0 },
             min_z: a.z.min(b.z),
         }
     }
@@ -53,17 +67,27 @@ impl Capsule {
     #[inline]
     pub(crate) fn entry_z(&self, x: f64, y: f64, r2: f64) -> Option<f64> {
         // Beyond R of the axis in xy the ray misses everything.
-        let (abx, aby) = (self.b.x - self.a.x, self.b.y - self.a.y);
+        let (abx, aby) = self.ab_xy;
         let (apx, apy) = (x - self.a.x, y - self.a.y);
-        let length2 = abx * abx + aby * aby;
-        let t = if length2 > 0.0 {
-            ((apx * abx + apy * aby) / length2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
+        let t = ((apx * abx + apy * aby) * self.inverse_xy).clamp(0.0, 1.0);
         let (dx, dy) = (apx - t * abx, apy - t * aby);
         if dx * dx + dy * dy > r2 {
             return None;
+        }
+        if self.denom > 0.0 {
+            // The end spheres lie inside the infinite cylinder: when the ray enters that cylinder
+            // within the segment's span, this is the capsule's entry.
+            let along = apx * self.axis.x + apy * self.axis.y;
+            let half_b = -along * self.axis.z;
+            let c = apx * apx + apy * apy - along * along - r2;
+            let disc = half_b * half_b - self.denom * c;
+            if disc >= 0.0 {
+                let t = (-half_b - disc.sqrt()) * self.inverse_denom;
+                let foot = along + t * self.axis.z;
+                if (0.0..=self.length).contains(&foot) {
+                    return Some(self.a.z + t);
+                }
+            }
         }
         let mut best = f64::INFINITY;
         for end in [&self.a, &self.b] {
@@ -71,20 +95,6 @@ impl Capsule {
             let d2 = dx * dx + dy * dy;
             if d2 <= r2 {
                 best = best.min(end.z - (r2 - d2).sqrt());
-            }
-        }
-        if self.denom > 0.0 {
-            let (hx, hy) = (x - self.a.x, y - self.a.y);
-            let along = hx * self.axis.x + hy * self.axis.y;
-            let half_b = -along * self.axis.z;
-            let c = hx * hx + hy * hy - along * along - r2;
-            let disc = half_b * half_b - self.denom * c;
-            if disc >= 0.0 {
-                let t = (-half_b - disc.sqrt()) / self.denom;
-                let foot = along + t * self.axis.z;
-                if (0.0..=self.length).contains(&foot) {
-                    best = best.min(self.a.z + t);
-                }
             }
         }
         best.is_finite().then_some(best)
@@ -102,16 +112,25 @@ impl Capsule {
 
     /// Conservative test: can the capsule cover any point of the box `[lo, hi]` (bounding circle
     /// of its xy rectangle and its top)?
+    #[inline]
     pub(crate) fn may_cover_box(&self, lo: &Vec3, hi: &Vec3, r: f64, tie: f64) -> bool {
+        let rise = self.min_z - hi.z - tie;
+        if rise > r {
+            return false;
+        }
         let (cx, cy) = (0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y));
         let (width, height) = (hi.x - lo.x, hi.y - lo.y);
         let half_diagonal = 0.5 * (width * width + height * height).sqrt();
-        let distance = (distance_2d(cx, cy, &self.a, &self.b) - half_diagonal).max(0.0);
+        let (abx, aby) = self.ab_xy;
+        let (apx, apy) = (cx - self.a.x, cy - self.a.y);
+        let t = ((apx * abx + apy * aby) * self.inverse_xy).clamp(0.0, 1.0);
+        let (dx, dy) = (apx - t * abx, apy - t * aby);
+        let distance = ((dx * dx + dy * dy).sqrt() - half_diagonal).max(0.0);
         if distance >= r {
             return false;
         }
-        let lowest = self.min_z - (r * r - distance * distance).sqrt();
-        lowest <= hi.z + tie
+        // Lowest point over the box: min_z − √(r² − distance²) ≤ top.
+        rise <= 0.0 || rise * rise <= r * r - distance * distance
     }
 
     /// xy distance from (x, y) to the axis segment's projection.

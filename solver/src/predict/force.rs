@@ -21,6 +21,9 @@ use crate::geometry::Vec3;
 const TILE_RINGS: usize = 6;
 /// Azimuth steps per engagement tile.
 const TILE_STEPS: usize = 12;
+/// Tiles per group (rings × steps) sharing a candidate pool.
+const GROUP_RINGS: usize = 2;
+const GROUP_STEPS: usize = 3;
 
 /// Specific cutting forces of the tool/material pair (error-prediction.md §1.2 I5, §3.7).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -209,9 +212,34 @@ pub(crate) fn engage(
     }
     let mut pool = TileLists::default();
     scene.candidates(&union_lo, &union_hi, false, None, &mut pool);
+    // A middle level: groups of neighbouring tiles share a narrower pool.
+    let group_of = |tile: &Tile| {
+        (
+            tile.rings.0 / (GROUP_RINGS * TILE_RINGS),
+            tile.steps.0 / (GROUP_STEPS * TILE_STEPS),
+        )
+    };
+    let mut groups: std::collections::BTreeMap<(usize, usize), (Vec3, Vec3)> =
+        std::collections::BTreeMap::new();
+    for (tile, _, lo, hi) in &kept {
+        let entry = groups
+            .entry(group_of(tile))
+            .or_insert((Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)));
+        entry.0 = entry.0.inf(lo);
+        entry.1 = entry.1.sup(hi);
+    }
+    kept.sort_by_key(|(tile, ..)| group_of(tile));
+    let mut group_pool = TileLists::default();
+    let mut current_group = None;
     let mut lists = TileLists::default();
     for (tile, region, lo, hi) in kept {
-        scene.candidates(&lo, &hi, false, Some(&pool), &mut lists);
+        let key = group_of(tile);
+        if current_group != Some(key) {
+            let (group_lo, group_hi) = groups[&key];
+            scene.candidates(&group_lo, &group_hi, false, Some(&pool), &mut group_pool);
+            current_group = Some(key);
+        }
+        scene.candidates(&lo, &hi, false, Some(&group_pool), &mut lists);
         let mut hint = 0usize;
         for k in tile.rings.0..tile.rings.1 {
             let (sin_t, cos_t) = grid.ring_angle[k];

@@ -9,7 +9,7 @@
 //! |a| ≥ g/2, so only that band is sampled; otherwise the whole zone range is.
 //!
 //! Rows (fixed a) are sampled at spacing Δ (the pixel size 2R/N) along α, then every run of
-//! surviving samples has both ends located by bisection to Δ/1024, and each row's run is
+//! surviving samples has both ends located by bisection to Δ/256, and each row's run is
 //! integrated in closed form. Runs overlapping in α on neighbouring rows form one region; the
 //! largest region is the representative one (§5 E8).
 
@@ -22,7 +22,7 @@ const TILE: usize = 32;
 /// Rows per tile block.
 const ROW_BLOCK: usize = 4;
 /// Bisection steps at each run end.
-const BISECTIONS: u32 = 10;
+const BISECTIONS: u32 = 8;
 /// Fewest rows across the band.
 const MIN_ROWS: usize = 8;
 
