@@ -141,6 +141,7 @@ impl Capsule {
 }
 
 /// Distance in the xy plane from (x, y) to the projection of the segment ab.
+#[cfg(test)]
 fn distance_2d(x: f64, y: f64, a: &Vec3, b: &Vec3) -> f64 {
     let (abx, aby) = (b.x - a.x, b.y - a.y);
     let (apx, apy) = (x - a.x, y - a.y);
