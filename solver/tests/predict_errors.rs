@@ -420,3 +420,27 @@ fn stl(triangles: &[[[f64; 3]; 3]]) -> Vec<u8> {
     text.push_str("endsolid stock\n");
     text.into_bytes()
 }
+
+#[test]
+fn rapids_through_uncut_stock_are_reported() {
+    let (request, tool) = flat_case();
+    let answer = predict::solve(&request, &tool, None).unwrap();
+    assert!(
+        !answer
+            .warnings
+            .iter()
+            .any(|w| w.code == "W_RAPID_COLLISION")
+    );
+    let mut crash = request.clone();
+    crash.path = PathInput::Gcode {
+        program: "G21 G90 S8000 M3\nG0 X-10 Y0 Z20\nG1 Z3 F1600\nX30\nG0 X10 Y-2 Z3\nG0 Z20\nM30\n"
+            .to_owned(),
+    };
+    let answer = predict::solve(&crash, &tool, None).unwrap();
+    let warning = answer
+        .warnings
+        .iter()
+        .find(|w| w.code == "W_RAPID_COLLISION")
+        .expect("the rapid to Y-2 at cutting depth crosses uncut stock");
+    assert!(warning.message.contains("line(s) 5"), "{}", warning.message);
+}

@@ -148,7 +148,88 @@ pub fn solve_with(
             current = Some(job.path.with_nodes(moved, job.radius));
         }
     }
-    Ok(assemble(&job, &rounds, &total, &clamped, &ambiguous))
+    let mut answer = assemble(&job, &rounds, &total, &clamped, &ambiguous);
+    answer.warnings.extend(rapid_collisions(&job));
+    Ok(answer)
+}
+
+/// Rapid moves whose ball enters stock that earlier motion has not removed (§5 E17): the ball's
+/// lowest point and four points at 60° from it are tested along each rapid, every R/2.
+fn rapid_collisions(job: &Job) -> Option<Warning> {
+    let path = &job.path;
+    let radius = job.radius;
+    let mut scratch = scene::Scratch::default();
+    let mut pieces = Vec::new();
+    let mut lines: Vec<usize> = Vec::new();
+    let (sin, cos) = 60f64.to_radians().sin_cos();
+    for (index, segment) in path.segments.iter().enumerate() {
+        let Some(line) = segment.rapid_line else {
+            continue;
+        };
+        if lines.last() == Some(&line) {
+            continue;
+        }
+        let (a, b) = path.ends(index);
+        let steps = ((segment.length / (0.5 * radius)).ceil() as usize).max(1);
+        scene::gather(
+            path,
+            &scene::Query {
+                centre: 0.5 * (a + b),
+                sigma: segment.sigma,
+                gap: 0.0,
+                radius,
+                reach: 0.5 * segment.length + 2.0 * radius,
+                any_view: true,
+            },
+            &mut scratch,
+            &mut pieces,
+        );
+        pieces.retain(|p| p.side == scene::Side::Before);
+        let earlier = scene::Scene::new(
+            &pieces,
+            Vec3::zeros(),
+            nalgebra::Matrix3::identity(),
+            radius,
+        );
+        let all: Vec<u32> = (0..earlier.before.len() as u32).collect();
+        let hits = (0..=steps).any(|k| {
+            let centre = a + (k as f64 / steps as f64) * (b - a);
+            [(0.0, 0.0)]
+                .into_iter()
+                .chain([0.0, 90.0, 180.0, 270.0].map(|phi: f64| {
+                    let (s, c) = phi.to_radians().sin_cos();
+                    (c, s)
+                }))
+                .any(|(c, s)| {
+                    let offset = if c == 0.0 && s == 0.0 {
+                        -radius * Vec3::z()
+                    } else {
+                        radius * Vec3::new(sin * c, sin * s, -cos)
+                    };
+                    let q = centre + offset;
+                    let mut hint = 0;
+                    job.stock.contains(&q, earlier.eps)
+                        && earlier.cover(&q, scene::Side::Before, &all, &mut hint)
+                            == scene::Cover::Open
+                })
+        });
+        if hits {
+            lines.push(line);
+        }
+    }
+    if lines.is_empty() {
+        return None;
+    }
+    let shown: Vec<String> = lines.iter().take(10).map(ToString::to_string).collect();
+    Some(Warning::new(
+        "W_RAPID_COLLISION",
+        format!(
+            "{} rapid move(s) run through uncut stock, at line(s) {}{}",
+            lines.len(),
+            shown.join(", "),
+            if lines.len() > 10 { ", …" } else { "" }
+        ),
+    ))
 }
 
 /// Node corrections of one round (unclamped when `limit` is infinite).

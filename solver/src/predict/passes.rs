@@ -18,6 +18,8 @@ pub(crate) struct Segment {
     pub(crate) length: f64,
     /// The pass this segment is, for feed moves.
     pub(crate) pass: Option<usize>,
+    /// NC line of a rapid move (feed moves carry theirs in the pass source).
+    pub(crate) rapid_line: Option<usize>,
 }
 
 /// Cutting conditions and origin of one pass.
@@ -80,8 +82,23 @@ impl PathBuilder {
         self.open_run = false;
     }
 
-    /// Moves on to `point`; returns the new node. Needs an open run.
+    /// Moves on to `point` by a feed move (`source`) or a rapid; returns the new node. Needs an
+    /// open run.
     pub(crate) fn to(&mut self, point: Vec3, source: Option<PassSource>) -> usize {
+        self.move_to(point, source, None)
+    }
+
+    /// A rapid move from NC line `line`.
+    pub(crate) fn rapid_to(&mut self, point: Vec3, line: usize) -> usize {
+        self.move_to(point, None, Some(line))
+    }
+
+    fn move_to(
+        &mut self,
+        point: Vec3,
+        source: Option<PassSource>,
+        rapid_line: Option<usize>,
+    ) -> usize {
         let start_node = self.nodes.len() - 1;
         let length = (point - self.nodes[start_node]).norm();
         self.nodes.push(point);
@@ -98,6 +115,7 @@ impl PathBuilder {
             sigma: self.sigma,
             length,
             pass,
+            rapid_line,
         });
         self.sigma += length;
         self.nodes.len() - 1

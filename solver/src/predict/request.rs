@@ -629,7 +629,11 @@ fn build_from_program(
             .at(field));
         }
         for (chord, p) in points.iter().enumerate() {
-            builder.to(centre_of(vec3(*p)), source);
+            if source.is_some() {
+                builder.to(centre_of(vec3(*p)), source);
+            } else {
+                builder.rapid_to(centre_of(vec3(*p)), line);
+            }
             node_sources.push(NodeSource {
                 item: index,
                 chord,
