@@ -160,15 +160,14 @@ pub(crate) fn run_round(
 ) -> Option<Vec<Outcome>> {
     let cancelled = AtomicBool::new(false);
     let report_every = (total_work / 200).max(1);
-    let outcomes: Vec<Option<Outcome>> = (0..path.passes.len())
+    let range = context.job.pass_range.clone();
+    let predicted: Vec<Option<Outcome>> = range
+        .clone()
         .into_par_iter()
         .map_init(Scratch::default, |scratch, index| {
             if control.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
                 cancelled.store(true, Ordering::Relaxed);
                 return None;
-            }
-            if !context.job.pass_range.contains(&index) {
-                return Some(Outcome::empty(PassStatus::NotPredicted));
             }
             let outcome = predict_pass(context, path, index, scratch);
             let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
@@ -183,7 +182,16 @@ pub(crate) fn run_round(
     if cancelled.load(Ordering::Relaxed) {
         return None;
     }
-    outcomes.into_iter().collect()
+    let mut predicted = predicted.into_iter();
+    (0..path.passes.len())
+        .map(|index| {
+            if range.contains(&index) {
+                predicted.next().flatten()
+            } else {
+                Some(Outcome::empty(PassStatus::NotPredicted))
+            }
+        })
+        .collect()
 }
 
 /// The cancellation error.
