@@ -444,3 +444,24 @@ fn rapids_through_uncut_stock_are_reported() {
         .expect("the rapid to Y-2 at cutting depth crosses uncut stock");
     assert!(warning.message.contains("line(s) 5"), "{}", warning.message);
 }
+
+#[test]
+fn a_retraced_spring_pass_gets_the_surface() {
+    let (mut request, tool) = flat_case();
+    // The middle line (N100 X28 at Y0.4) is cut twice: the second time is a spring pass.
+    request.path = PathInput::Gcode {
+        program: "G21 G90 S8000 M3\nG0 X-10 Y0 Z20\nG1 Z3 F1600\nX30\nY0.4\nX-10\nG0 Z20\nG0 X-10 Y0.4\nG1 Z3\nX30\n\
+                  Y0.8\nX-10\nG0 Z20\nM30\n"
+            .to_owned(),
+    };
+    let answer = predict::solve(&request, &tool, None).unwrap();
+    let first = answer.passes.iter().find(|p| p.line == Some(6)).unwrap();
+    let again = answer.passes.iter().find(|p| p.line == Some(10)).unwrap();
+    assert_eq!(first.status, PassStatus::NoSurface, "{first:?}");
+    assert_eq!(again.status, PassStatus::Ok, "{again:?}");
+    assert!(
+        again.flags.contains(&predict::PassFlag::Retraced),
+        "{:?}",
+        again.flags
+    );
+}

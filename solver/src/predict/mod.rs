@@ -302,8 +302,8 @@ fn assemble(
             error_deflection: outcome.error_deflection,
             error_shape: outcome.error_shape,
             contact_angle_deg: outcome.contact_angle.map(f64::to_degrees),
-            azimuth_deg: outcome.azimuth.map(|a| a.to_degrees().rem_euclid(360.0)),
-            rotation_angle_deg: outcome.rotation_angle.map(f64::to_degrees),
+            azimuth_deg: outcome.azimuth.map(degrees_0_360),
+            rotation_angle_deg: outcome.rotation_angle.map(degrees_0_360),
             generation_point: outcome.point.as_ref().map(array3),
             normal: outcome.normal.as_ref().map(array3),
             deflection: outcome.deflection,
@@ -371,6 +371,12 @@ fn assemble(
             reference_offset: job.reference_offset,
         },
     }
+}
+
+/// An angle in degrees in [0, 360) (a tiny negative angle would otherwise print as 360).
+fn degrees_0_360(radians: f64) -> f64 {
+    let degrees = radians.to_degrees().rem_euclid(360.0);
+    if degrees >= 360.0 { 0.0 } else { degrees }
 }
 
 fn rms(values: &[f64]) -> Option<f64> {
