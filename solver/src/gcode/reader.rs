@@ -1036,21 +1036,23 @@ pub fn rewrite(
         new_to[edit.index] = edit.to.map(Some);
         centres[edit.index] = edit.centre;
     }
-    // Start of each move after the edits: the previous move's new end, unless the program lost
-    // the position in between (then the original start, which is unknown or re-established).
+    // Where each move of the rewritten program really ends (written values are rounded), so
+    // incremental words and modal axes follow the control, not the exact edits.
+    let mut actual: Vec<Position> = Vec::with_capacity(count);
     let mut replacements: Vec<LineEdit> = Vec::new();
     for (index, read_move) in program.moves.iter().enumerate() {
-        let new_from = if index > 0 && program.moves[index - 1].to == read_move.from {
-            new_to[index - 1]
+        let continuous = index > 0 && program.moves[index - 1].to == read_move.from;
+        let start = if continuous {
+            actual[index - 1]
         } else {
             read_move.from
         };
-        let unchanged = new_from == read_move.from && new_to[index] == read_move.to;
-        if unchanged && centres[index].is_none() {
+        if start == read_move.from && new_to[index] == read_move.to && centres[index].is_none() {
+            actual.push(read_move.to);
             continue;
         }
-        let units = read_move.modal.units;
-        let scale = units.scale();
+        let scale = read_move.modal.units.scale();
+        let mut end_actual = read_move.to;
         let mut changes: Vec<(WordSpan, String)> = Vec::new();
         let mut inserts: Vec<String> = Vec::new();
         let letters = ['X', 'Y', 'Z'];
@@ -1059,22 +1061,29 @@ pub fn rewrite(
                 continue;
             };
             let span = read_move.words.axes[axis];
-            let (value, old_value) = match read_move.modal.distance {
-                Distance::Absolute => (end / scale, old_end / scale),
+            let decimals = span.map_or(4, |s| s.decimals.max(4));
+            // The value to write, what the line means now (kept), and where the axis lands if
+            // written.
+            let (value, kept_value, base) = match read_move.modal.distance {
+                Distance::Absolute => match (span, start[axis]) {
+                    // A word the line does not have leaves the axis where the move starts.
+                    (None, Some(from)) => (end / scale, from / scale, 0.0),
+                    (None, None) => continue,
+                    (Some(_), _) => (end / scale, old_end / scale, 0.0),
+                },
                 Distance::Incremental => {
-                    let (Some(start), Some(old_start)) = (new_from[axis], read_move.from[axis])
-                    else {
+                    let (Some(from), Some(old_from)) = (start[axis], read_move.from[axis]) else {
                         continue;
                     };
-                    ((end - start) / scale, (old_end - old_start) / scale)
+                    ((end - from) / scale, (old_end - old_from) / scale, from)
                 }
             };
-            let decimals = span.map_or(4, |s| s.decimals.max(4));
             let written = number(value, decimals);
-            // Unchanged at the written precision: keep the original text.
-            if written == number(old_value, decimals) {
+            if written == number(kept_value, decimals) {
+                end_actual[axis] = Some(base + kept_value * scale);
                 continue;
             }
+            end_actual[axis] = Some(base + written.parse::<f64>().unwrap_or(value) * scale);
             match span {
                 Some(span) => changes.push((span, written)),
                 None => inserts.push(format!("{}{written}", letters[axis])),
@@ -1083,7 +1092,7 @@ pub fn rewrite(
         if let MoveKind::Arc {
             centre, clockwise, ..
         } = read_move.kind
-            && let (Some(from), Some(to)) = (known(&new_from), known(&new_to[index]))
+            && let (Some(from), Some(to)) = (known(&start), known(&end_actual))
         {
             arc_words(
                 read_move,
@@ -1095,6 +1104,7 @@ pub fn rewrite(
                 &mut inserts,
             );
         }
+        actual.push(end_actual);
         if !changes.is_empty() || !inserts.is_empty() {
             replacements.push(LineEdit {
                 line: read_move.line,
