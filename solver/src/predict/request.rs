@@ -1,5 +1,5 @@
 //! The prediction request as clients send it (api.md, Error prediction) and its validation into
-//! a [`Job`]: tool, stock, tool path (points or G-code read into ball-centre passes), cutting
+//! a `Job`: tool, stock, tool path (points or G-code read into ball-centre passes), cutting
 //! conditions and method settings, with every limit checked before any heavy work.
 
 use serde::{Deserialize, Serialize};
