@@ -34,12 +34,7 @@ fn cpu_seconds() -> f64 {
         return 0.0;
     };
     let fields: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |i: usize| {
-        fields
-            .get(i)
-            .and_then(|f| f.parse::<f64>().ok())
-            .unwrap_or(0.0)
-    };
+    let ticks = |i: usize| fields.get(i).and_then(|f| f.parse::<f64>().ok()).unwrap_or(0.0);
     (ticks(11) + ticks(12)) / 100.0
 }
 
@@ -64,14 +59,10 @@ fn bench(c: &mut Criterion) {
         (Method::DepthBuffer, 256, "depth_buffer_N256"),
         (Method::Sampling, 512, "sampling_N512"),
     ] {
-        let (mut request, tool, moves) =
-            support::raster_request(160.0, 0.5, 0.5, method, resolution);
+        let (mut request, tool, moves) = support::raster_request(160.0, 0.5, 0.5, method, resolution);
         let middle = moves / 2;
         for threads in [1, 2] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             let label = format!("{name}_{threads}_threads");
             // Setup alone (reading 103 041 lines, the grids), then the slice.
             request.pass_range = Some([middle, middle]);
@@ -82,25 +73,17 @@ fn bench(c: &mut Criterion) {
             let (started, cpu) = (Instant::now(), cpu_seconds());
             let answer = pool.install(|| predict::solve(&request, &tool, None).unwrap());
             let (wall, cpu) = (started.elapsed().as_secs_f64(), cpu_seconds() - cpu);
-            assert_eq!(
-                answer.summary.predicted + answer.summary.no_cut + answer.summary.no_surface,
-                SLICE
-            );
-            eprintln!(
-                "{label}: setup {setup_wall:.3} s wall, {setup_cpu:.2} s CPU for {moves} passes"
-            );
+            assert_eq!(answer.summary.predicted + answer.summary.no_cut + answer.summary.no_surface, SLICE);
+            eprintln!("{label}: setup {setup_wall:.3} s wall, {setup_cpu:.2} s CPU for {moves} passes");
             report(&label, SLICE, wall - setup_wall, cpu - setup_cpu);
             group.bench_function(format!("{label}_{SLICE}_of_{moves}_passes"), |b| {
-                b.iter(|| {
-                    pool.install(|| black_box(predict::solve(&request, &tool, None).unwrap()))
-                });
+                b.iter(|| pool.install(|| black_box(predict::solve(&request, &tool, None).unwrap())));
             });
         }
     }
     group.finish();
     // The whole program once, on all threads.
-    let (mut request, tool, moves) =
-        support::raster_request(160.0, 0.5, 0.5, Method::Sampling, 256);
+    let (mut request, tool, moves) = support::raster_request(160.0, 0.5, 0.5, Method::Sampling, 256);
     request.pass_range = None;
     let (started, cpu) = (Instant::now(), cpu_seconds());
     let answer = predict::solve(&request, &tool, None).unwrap();
@@ -111,12 +94,7 @@ fn bench(c: &mut Criterion) {
         answer.summary.predicted,
         answer.summary.no_cut,
         answer.summary.no_surface,
-        answer
-            .summary
-            .max_error
-            .unwrap_or(0.0)
-            .abs()
-            .max(answer.summary.min_error.unwrap_or(0.0).abs()),
+        answer.summary.max_error.unwrap_or(0.0).abs().max(answer.summary.min_error.unwrap_or(0.0).abs()),
     );
     report("whole program", moves, wall, cpu);
 }

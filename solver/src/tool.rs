@@ -241,18 +241,11 @@ impl Tool {
     }
 }
 
-fn validate_shape_error(
-    table: &[ShapeErrorPoint],
-    radius: f64,
-    field: &str,
-) -> Result<(), SolverError> {
+fn validate_shape_error(table: &[ShapeErrorPoint], radius: f64, field: &str) -> Result<(), SolverError> {
     if table.is_empty() || table.len() > MAX_SHAPE_ERROR_ROWS {
         return Err(SolverError::input(
             field,
-            format!(
-                "shape_error needs 1 to {MAX_SHAPE_ERROR_ROWS} rows (got {})",
-                table.len()
-            ),
+            format!("shape_error needs 1 to {MAX_SHAPE_ERROR_ROWS} rows (got {})", table.len()),
         ));
     }
     let mut previous = f64::NEG_INFINITY;
@@ -270,10 +263,7 @@ fn validate_shape_error(
         if finite(&error_field, row.error)?.abs() >= radius {
             return Err(SolverError::input(
                 error_field,
-                format!(
-                    "a shape error of {} mm is not smaller than the tool radius",
-                    row.error
-                ),
+                format!("a shape error of {} mm is not smaller than the tool radius", row.error),
             ));
         }
     }
@@ -427,65 +417,31 @@ mod tests {
         )
         .unwrap();
         assert!(tool.validate("tool.").is_ok());
-        let round_trip: Tool =
-            serde_json::from_str(&serde_json::to_string(&tool).unwrap()).unwrap();
+        let round_trip: Tool = serde_json::from_str(&serde_json::to_string(&tool).unwrap()).unwrap();
         assert_eq!(round_trip, tool);
         tool.shape_error = Some(vec![
-            ShapeErrorPoint {
-                angle_deg: 30.0,
-                error: 0.0,
-            },
-            ShapeErrorPoint {
-                angle_deg: 30.0,
-                error: 0.0,
-            },
+            ShapeErrorPoint { angle_deg: 30.0, error: 0.0 },
+            ShapeErrorPoint { angle_deg: 30.0, error: 0.0 },
         ]);
-        assert_eq!(
-            tool.validate("tool.").unwrap_err().field(),
-            Some("tool.shape_error[1].angle_deg")
-        );
-        tool.shape_error = Some(vec![ShapeErrorPoint {
-            angle_deg: 95.0,
-            error: 0.0,
-        }]);
+        assert_eq!(tool.validate("tool.").unwrap_err().field(), Some("tool.shape_error[1].angle_deg"));
+        tool.shape_error = Some(vec![ShapeErrorPoint { angle_deg: 95.0, error: 0.0 }]);
         assert!(tool.validate("tool.").is_err());
         tool.shape_error = None;
         tool.stiffness = Some(Stiffness::Static { x: 5000.0, y: -1.0 });
-        assert_eq!(
-            tool.validate("tool.").unwrap_err().field(),
-            Some("tool.stiffness.y")
-        );
+        assert_eq!(tool.validate("tool.").unwrap_err().field(), Some("tool.stiffness.y"));
         tool.stiffness = Some(Stiffness::Modal {
-            x: vec![Mode {
-                stiffness: 1.0,
-                frequency_hz: 100.0,
-                damping_ratio: 1.5,
-            }],
+            x: vec![Mode { stiffness: 1.0, frequency_hz: 100.0, damping_ratio: 1.5 }],
             y: vec![],
         });
-        assert_eq!(
-            tool.validate("tool.").unwrap_err().field(),
-            Some("tool.stiffness.x[0].damping_ratio")
-        );
+        assert_eq!(tool.validate("tool.").unwrap_err().field(), Some("tool.stiffness.x[0].damping_ratio"));
         tool.stiffness = Some(Stiffness::Frf {
             x: vec![
-                FrfPoint {
-                    frequency_hz: 0.0,
-                    real: 1e-4,
-                    imag: 0.0,
-                },
-                FrfPoint {
-                    frequency_hz: 0.0,
-                    real: 1e-4,
-                    imag: 0.0,
-                },
+                FrfPoint { frequency_hz: 0.0, real: 1e-4, imag: 0.0 },
+                FrfPoint { frequency_hz: 0.0, real: 1e-4, imag: 0.0 },
             ],
             y: vec![],
         });
-        assert_eq!(
-            tool.validate("tool.").unwrap_err().field(),
-            Some("tool.stiffness.x[1].frequency_hz")
-        );
+        assert_eq!(tool.validate("tool.").unwrap_err().field(), Some("tool.stiffness.x[1].frequency_hz"));
         let plain: Tool = serde_json::from_str(r#"{"kind": "flat", "radius": 3}"#).unwrap();
         assert_eq!(plain.shape_error, None);
         assert_eq!(plain.stiffness, None);

@@ -18,13 +18,8 @@ fn flat_case() -> (PredictRequest, Tool) {
                    N5 G1 Z3.0 F1600\nN6 X30\nN7 Y0.4\nN8 X-10\nN9 Y0.8\nN10 X30 (LAST)\nN11 G0 Z20\nN12 M30\n%\n";
     let mut request = bare_request(
         &tool,
-        Stock::Box {
-            min: [0.0, -5.0, -10.0],
-            max: [20.0, 5.0, 0.1],
-        },
-        PathInput::Gcode {
-            program: program.to_owned(),
-        },
+        Stock::Box { min: [0.0, -5.0, -10.0], max: [20.0, 5.0, 0.1] },
+        PathInput::Gcode { program: program.to_owned() },
     );
     request.reference = kerf_solver::gcode::Reference::Centre;
     (request, tool)
@@ -60,62 +55,31 @@ fn the_flat_case_predicts() {
 #[test]
 fn unparsable_gcode_names_the_line() {
     let (mut request, tool) = flat_case();
-    request.path = PathInput::Gcode {
-        program: "G21 G90\nG0 X0 Y0 Z5\nG1 X5 Y$ F100\n".to_owned(),
-    };
-    let error = expect(
-        predict::solve(&request, &tool, None),
-        "E_GCODE_SYNTAX",
-        "path.program",
-    );
-    assert!(
-        error.message().starts_with("line 3:"),
-        "{}",
-        error.message()
-    );
+    request.path = PathInput::Gcode { program: "G21 G90\nG0 X0 Y0 Z5\nG1 X5 Y$ F100\n".to_owned() };
+    let error = expect(predict::solve(&request, &tool, None), "E_GCODE_SYNTAX", "path.program");
+    assert!(error.message().starts_with("line 3:"), "{}", error.message());
 }
 
 #[test]
 fn arcs_that_do_not_close_are_refused() {
     let (mut request, tool) = flat_case();
-    request.path = PathInput::Gcode {
-        program: "G21 G90 G17 S6000 M3\nG0 X10 Y0 Z3\nG2 X0 Y-10 I-10 J0.5 F500\n".to_owned(),
-    };
-    let error = expect(
-        predict::solve(&request, &tool, None),
-        "E_ARC_NOT_CLOSED",
-        "path.program",
-    );
-    assert!(
-        error.message().starts_with("line 3:"),
-        "{}",
-        error.message()
-    );
+    request.path =
+        PathInput::Gcode { program: "G21 G90 G17 S6000 M3\nG0 X10 Y0 Z3\nG2 X0 Y-10 I-10 J0.5 F500\n".to_owned() };
+    let error = expect(predict::solve(&request, &tool, None), "E_ARC_NOT_CLOSED", "path.program");
+    assert!(error.message().starts_with("line 3:"), "{}", error.message());
 }
 
 #[test]
 fn a_tool_without_shape_error_or_not_a_ball_is_refused() {
     let (request, mut tool) = flat_case();
     tool.shape_error = None;
-    expect(
-        predict::solve(&request, &tool, None),
-        "E_NO_SHAPE_ERROR",
-        "tool.shape_error",
-    );
+    expect(predict::solve(&request, &tool, None), "E_NO_SHAPE_ERROR", "tool.shape_error");
     let mut flat = finishing_tool(3.0);
     flat.kind = ToolKind::Flat;
-    expect(
-        predict::solve(&request, &flat, None),
-        "E_TOOL_KIND",
-        "tool.kind",
-    );
+    expect(predict::solve(&request, &flat, None), "E_TOOL_KIND", "tool.kind");
     let mut bad = finishing_tool(3.0);
     bad.radius = -1.0;
-    expect(
-        predict::solve(&request, &bad, None),
-        "E_INPUT",
-        "tool.radius",
-    );
+    expect(predict::solve(&request, &bad, None), "E_INPUT", "tool.radius");
     let _ = Tool::new(ToolKind::Ball, 1.0);
 }
 
@@ -124,27 +88,15 @@ fn a_depth_buffer_over_the_memory_limit_is_refused() {
     let (mut request, tool) = flat_case();
     request.method = Method::DepthBuffer;
     request.resolution = Some(4096);
-    let error = expect(
-        predict::solve(&request, &tool, None),
-        "E_RESOLUTION_LIMIT",
-        "resolution",
-    );
+    let error = expect(predict::solve(&request, &tool, None), "E_RESOLUTION_LIMIT", "resolution");
     assert!(error.message().contains("256 MiB"), "{}", error.message());
-    assert!(
-        error.message().contains("at most 2048"),
-        "{}",
-        error.message()
-    );
+    assert!(error.message().contains("at most 2048"), "{}", error.message());
     request.resolution = Some(2048);
     request.pass_range = Some([0, 0]);
     assert!(predict::solve(&request, &tool, None).is_ok());
     request.method = Method::Sampling;
     request.resolution = Some(100_000);
-    expect(
-        predict::solve(&request, &tool, None),
-        "E_INPUT",
-        "resolution",
-    );
+    expect(predict::solve(&request, &tool, None), "E_INPUT", "resolution");
 }
 
 #[test]
@@ -164,30 +116,16 @@ fn an_open_mesh_is_refused_and_a_closed_one_equals_the_box() {
         }
     }
     triangles.pop();
-    let error = expect(
-        predict::solve(&request, &tool, Some(&stl(&triangles))),
-        "E_MESH_NOT_CLOSED",
-        "stock",
-    );
-    assert!(
-        error.message().contains("not closed"),
-        "{}",
-        error.message()
-    );
-    expect(
-        predict::solve(&request, &tool, Some(b"garbage")),
-        "E_MESH_FORMAT",
-        "stock",
-    );
+    let error = expect(predict::solve(&request, &tool, Some(&stl(&triangles))), "E_MESH_NOT_CLOSED", "stock");
+    assert!(error.message().contains("not closed"), "{}", error.message());
+    expect(predict::solve(&request, &tool, Some(b"garbage")), "E_MESH_FORMAT", "stock");
 }
 
 #[test]
 fn inch_programs_are_converted() {
     let (request, tool) = flat_case();
     let metric = predict::solve(&request, &tool, None).unwrap();
-    let PathInput::Gcode { program } = &request.path else {
-        unreachable!()
-    };
+    let PathInput::Gcode { program } = &request.path else { unreachable!() };
     // The same program in inches (the block's geometry is exact in inches too).
     let inch = program
         .replace("G21", "G20")
@@ -212,43 +150,21 @@ fn inch_programs_are_converted() {
 #[test]
 fn missing_cutting_conditions_name_the_line() {
     let (mut request, tool) = flat_case();
-    request.path = PathInput::Gcode {
-        program: "G21 G90\nG0 X0 Y0 Z3\nG1 X5 F100\n".to_owned(),
-    };
-    let error = expect(
-        predict::solve(&request, &tool, None),
-        "E_NO_SPINDLE",
-        "path.program",
-    );
+    request.path = PathInput::Gcode { program: "G21 G90\nG0 X0 Y0 Z3\nG1 X5 F100\n".to_owned() };
+    let error = expect(predict::solve(&request, &tool, None), "E_NO_SPINDLE", "path.program");
     assert!(error.message().starts_with("line 3:"));
     request.spindle_rpm = Some(6000.0);
-    request.path = PathInput::Gcode {
-        program: "G21 G90\nG0 X0 Y0 Z3\nG1 X5\n".to_owned(),
-    };
-    expect(
-        predict::solve(&request, &tool, None),
-        "E_NO_FEED",
-        "path.program",
-    );
-    request.path = PathInput::Gcode {
-        program: "G21 G90\nG0 X0 Y0 Z3\n".to_owned(),
-    };
+    request.path = PathInput::Gcode { program: "G21 G90\nG0 X0 Y0 Z3\nG1 X5\n".to_owned() };
+    expect(predict::solve(&request, &tool, None), "E_NO_FEED", "path.program");
+    request.path = PathInput::Gcode { program: "G21 G90\nG0 X0 Y0 Z3\n".to_owned() };
     expect(predict::solve(&request, &tool, None), "E_NO_PASSES", "path");
-    request.path = PathInput::Points {
-        points: vec![[0.0, 0.0, 3.0], [5.0, 0.0, 3.0]],
-    };
+    request.path = PathInput::Points { points: vec![[0.0, 0.0, 3.0], [5.0, 0.0, 3.0]] };
     expect(predict::solve(&request, &tool, None), "E_INPUT", "feed");
     request.feed = Some(f64::NAN);
     expect(predict::solve(&request, &tool, None), "E_INPUT", "feed");
     request.feed = Some(800.0);
-    request.path = PathInput::Points {
-        points: vec![[0.0, 0.0, 3.0], [5.0, f64::INFINITY, 3.0]],
-    };
-    expect(
-        predict::solve(&request, &tool, None),
-        "E_INPUT",
-        "path.points[1][1]",
-    );
+    request.path = PathInput::Points { points: vec![[0.0, 0.0, 3.0], [5.0, f64::INFINITY, 3.0]] };
+    expect(predict::solve(&request, &tool, None), "E_INPUT", "path.points[1][1]");
 }
 
 #[test]
@@ -257,33 +173,19 @@ fn options_out_of_range_name_their_field() {
     type Change = Box<dyn Fn(&mut PredictRequest)>;
     let cases: Vec<(Change, &str)> = vec![
         (Box::new(|r| r.tooth_feed_gap = Some(4)), "tooth_feed_gap"),
-        (
-            Box::new(|r| r.view_correction_deg = Some(95.0)),
-            "view_correction_deg",
-        ),
-        (
-            Box::new(|r| r.samples_per_revolution = Some(10)),
-            "samples_per_revolution",
-        ),
+        (Box::new(|r| r.view_correction_deg = Some(95.0)), "view_correction_deg"),
+        (Box::new(|r| r.samples_per_revolution = Some(10)), "samples_per_revolution"),
         (Box::new(|r| r.edge_elements = Some(5000)), "edge_elements"),
         (Box::new(|r| r.arc_tolerance = Some(0.0)), "arc_tolerance"),
         (Box::new(|r| r.pass_range = Some([3, 99])), "pass_range"),
         (Box::new(|r| r.history = Some(vec![99])), "history[0]"),
         (
-            Box::new(|r| {
-                r.deflection = Some(predict::PrescribedDeflection {
-                    x: vec![0.0, 0.0],
-                    y: vec![0.0],
-                })
-            }),
+            Box::new(|r| r.deflection = Some(predict::PrescribedDeflection { x: vec![0.0, 0.0], y: vec![0.0] })),
             "deflection.y",
         ),
         (
             Box::new(|r| {
-                r.correction = Some(predict::CorrectionOptions {
-                    max_correction: Some(-1.0),
-                    iterations: None,
-                })
+                r.correction = Some(predict::CorrectionOptions { max_correction: Some(-1.0), iterations: None })
             }),
             "correction.max_correction",
         ),
@@ -317,10 +219,7 @@ fn json_requests_reject_unknown_fields() {
         r#"{"tool": 3, "stock": {"kind": "sphere"}, "path": {"kind": "gcode", "program": ""}}"#,
         r#"{"tool": 3, "stock": {"kind": "mesh", "file": "x"}, "path": {"kind": "gcode", "program": ""}}"#,
     ] {
-        assert!(
-            serde_json::from_str::<PredictRequest>(bad).is_err(),
-            "{bad}"
-        );
+        assert!(serde_json::from_str::<PredictRequest>(bad).is_err(), "{bad}");
     }
 }
 
@@ -330,10 +229,7 @@ fn progress_is_reported_and_cancellation_stops_the_run() {
     request.pass_range = None;
     let seen = Mutex::new(Vec::new());
     let record = |fraction: f64| seen.lock().unwrap().push(fraction);
-    let control = Control {
-        progress: Some(&record),
-        cancel: None,
-    };
+    let control = Control { progress: Some(&record), cancel: None };
     let answer = predict::solve_with(&request, &tool, None, &control).unwrap();
     assert_eq!(answer, predict::solve(&request, &tool, None).unwrap());
     let seen = seen.into_inner().unwrap();
@@ -341,15 +237,7 @@ fn progress_is_reported_and_cancellation_stops_the_run() {
     assert!((seen.iter().copied().fold(0.0, f64::max) - 1.0).abs() < 1e-12);
     assert!(seen.iter().all(|f| (0.0..=1.0).contains(f)));
     let stop = AtomicBool::new(true);
-    let cancelled = predict::solve_with(
-        &request,
-        &tool,
-        None,
-        &Control {
-            progress: None,
-            cancel: Some(&stop),
-        },
-    );
+    let cancelled = predict::solve_with(&request, &tool, None, &Control { progress: None, cancel: Some(&stop) });
     assert_eq!(cancelled.unwrap_err().code(), "E_CANCELLED");
 }
 
@@ -357,26 +245,12 @@ fn progress_is_reported_and_cancellation_stops_the_run() {
 fn a_grid_of_a_plane_equals_the_plane() {
     let (request, tool) = inclined_case(25.0, 30.0, 0.0, [0.0; 3], Method::Sampling);
     let plane = predict::solve(&request, &tool, None).unwrap();
-    let Stock::Plane { point, normal, .. } = request.stock.clone() else {
-        unreachable!()
-    };
-    let height = |x: f64, y: f64| {
-        point[2] - (normal[0] * (x - point[0]) + normal[1] * (y - point[1])) / normal[2]
-    };
-    let heights = (0..=120)
-        .map(|j| {
-            (0..=120)
-                .map(|i| height(-60.0 + f64::from(i), -60.0 + f64::from(j)))
-                .collect()
-        })
-        .collect();
+    let Stock::Plane { point, normal, .. } = request.stock.clone() else { unreachable!() };
+    let height = |x: f64, y: f64| point[2] - (normal[0] * (x - point[0]) + normal[1] * (y - point[1])) / normal[2];
+    let heights =
+        (0..=120).map(|j| (0..=120).map(|i| height(-60.0 + f64::from(i), -60.0 + f64::from(j))).collect()).collect();
     let mut gridded = request.clone();
-    gridded.stock = Stock::Grid {
-        origin: [-60.0, -60.0],
-        spacing: 1.0,
-        heights,
-        bottom: None,
-    };
+    gridded.stock = Stock::Grid { origin: [-60.0, -60.0], spacing: 1.0, heights, bottom: None };
     let grid = predict::solve(&gridded, &tool, None).unwrap();
     let (a, b) = (&plane.passes[5], &grid.passes[5]);
     assert!((a.contact_angle_deg.unwrap() - b.contact_angle_deg.unwrap()).abs() < 1e-6);
@@ -391,14 +265,7 @@ fn box_triangles(lo: [f64; 3], hi: [f64; 3]) -> Vec<[[f64; 3]; 3]> {
             if i & 4 == 0 { lo[2] } else { hi[2] },
         ]
     };
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     let mut triangles = Vec::new();
     for q in quads {
         triangles.push([corner(q[0]), corner(q[1]), corner(q[2])]);
@@ -425,16 +292,10 @@ fn stl(triangles: &[[[f64; 3]; 3]]) -> Vec<u8> {
 fn rapids_through_uncut_stock_are_reported() {
     let (request, tool) = flat_case();
     let answer = predict::solve(&request, &tool, None).unwrap();
-    assert!(
-        !answer
-            .warnings
-            .iter()
-            .any(|w| w.code == "W_RAPID_COLLISION")
-    );
+    assert!(!answer.warnings.iter().any(|w| w.code == "W_RAPID_COLLISION"));
     let mut crash = request.clone();
     crash.path = PathInput::Gcode {
-        program: "G21 G90 S8000 M3\nG0 X-10 Y0 Z20\nG1 Z3 F1600\nX30\nG0 X10 Y-2 Z3\nG0 Z20\nM30\n"
-            .to_owned(),
+        program: "G21 G90 S8000 M3\nG0 X-10 Y0 Z20\nG1 Z3 F1600\nX30\nG0 X10 Y-2 Z3\nG0 Z20\nM30\n".to_owned(),
     };
     let answer = predict::solve(&crash, &tool, None).unwrap();
     let warning = answer
@@ -459,9 +320,5 @@ fn a_retraced_spring_pass_gets_the_surface() {
     let again = answer.passes.iter().find(|p| p.line == Some(10)).unwrap();
     assert_eq!(first.status, PassStatus::NoSurface, "{first:?}");
     assert_eq!(again.status, PassStatus::Ok, "{again:?}");
-    assert!(
-        again.flags.contains(&predict::PassFlag::Retraced),
-        "{:?}",
-        again.flags
-    );
+    assert!(again.flags.contains(&predict::PassFlag::Retraced), "{:?}", again.flags);
 }

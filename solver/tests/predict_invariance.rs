@@ -9,10 +9,7 @@ use kerf_solver::predict::{self, Method, PredictedPass};
 use predict_support::{PATENT, inclined_case, inclined_case_with};
 use proptest::prelude::*;
 
-fn middle(
-    request: &kerf_solver::predict::PredictRequest,
-    tool: &kerf_solver::tool::Tool,
-) -> PredictedPass {
+fn middle(request: &kerf_solver::predict::PredictRequest, tool: &kerf_solver::tool::Tool) -> PredictedPass {
     let answer = predict::solve(request, tool, None).unwrap();
     answer.passes[5].clone()
 }
@@ -82,10 +79,7 @@ fn answers_do_not_depend_on_the_thread_count() {
     let (mut request, tool) = inclined_case(35.0, 20.0, 0.0, [0.0; 3], Method::Sampling);
     request.pass_range = None;
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| predict::solve(&request, &tool, None).unwrap())
     };
     let one = run(1);

@@ -7,8 +7,8 @@ mod predict_support;
 use kerf_solver::gcode::reader::{self, ReadOptions};
 use kerf_solver::gcode::{Dialect, Reference, ToolCall};
 use kerf_solver::predict::{
-    self, CorrectionOptions, PassFlag, PassStatus, PathInput, PredictRequest, PrescribedDeflection,
-    ProgramOptions, Stock,
+    self, CorrectionOptions, PassFlag, PassStatus, PathInput, PredictRequest, PrescribedDeflection, ProgramOptions,
+    Stock,
 };
 use kerf_solver::tool::Tool;
 use predict_support::{bare_request, finishing_tool};
@@ -23,27 +23,16 @@ fn request(program: &str) -> (PredictRequest, Tool) {
     let tool = finishing_tool(3.0);
     let mut request = bare_request(
         &tool,
-        Stock::Box {
-            min: [0.0, -5.0, -10.0],
-            max: [20.0, 5.0, 0.1],
-        },
-        PathInput::Gcode {
-            program: program.to_owned(),
-        },
+        Stock::Box { min: [0.0, -5.0, -10.0], max: [20.0, 5.0, 0.1] },
+        PathInput::Gcode { program: program.to_owned() },
     );
     request.reference = Reference::Tip;
-    request.deflection = Some(PrescribedDeflection {
-        x: vec![0.004],
-        y: vec![-0.006],
-    });
+    request.deflection = Some(PrescribedDeflection { x: vec![0.004], y: vec![-0.006] });
     (request, tool)
 }
 
 fn options() -> ProgramOptions {
-    ProgramOptions {
-        dialect: Dialect::Fanuc,
-        tool: ToolCall::Table(1),
-    }
+    ProgramOptions { dialect: Dialect::Fanuc, tool: ToolCall::Table(1) }
 }
 
 /// The line without its coordinate words.
@@ -56,10 +45,7 @@ fn skeleton(line: &str) -> String {
             in_comment = true;
         }
         if !in_comment && "XYZIJKR".contains(c) {
-            while chars
-                .peek()
-                .is_some_and(|d| d.is_ascii_digit() || *d == '.' || *d == '-')
-            {
+            while chars.peek().is_some_and(|d| d.is_ascii_digit() || *d == '.' || *d == '-') {
                 chars.next();
             }
             continue;
@@ -87,21 +73,12 @@ fn gcode_comes_back_with_only_coordinates_changed() {
     assert!(changed >= 3);
     // Every pass ends where the answer says, to the written precision.
     let read = reader::read(&corrected, "program", &ReadOptions::default()).unwrap();
-    let feed_moves: Vec<_> = read
-        .moves
-        .iter()
-        .filter(|m| !matches!(m.kind, reader::MoveKind::Rapid))
-        .collect();
+    let feed_moves: Vec<_> = read.moves.iter().filter(|m| !matches!(m.kind, reader::MoveKind::Rapid)).collect();
     assert_eq!(feed_moves.len(), answer.passes.len());
     for (pass, read_move) in answer.passes.iter().zip(feed_moves) {
         let end = read_move.to_xyz().unwrap();
         for k in 0..3 {
-            assert!(
-                (end[k] - pass.corrected[k]).abs() < 6e-5,
-                "pass {}: {end:?} vs {:?}",
-                pass.index,
-                pass.corrected
-            );
+            assert!((end[k] - pass.corrected[k]).abs() < 6e-5, "pass {}: {end:?} vs {:?}", pass.index, pass.corrected);
         }
         assert_eq!(Some(read_move.line), pass.line);
     }
@@ -110,11 +87,7 @@ fn gcode_comes_back_with_only_coordinates_changed() {
     assert_eq!(middle.status, PassStatus::Ok);
     let n = middle.normal.unwrap();
     let along: f64 = (0..3).map(|k| middle.correction[k] * n[k]).sum();
-    assert!(
-        (along + middle.error.unwrap()).abs() < 1e-9,
-        "{along} vs {:?}",
-        middle.error
-    );
+    assert!((along + middle.error.unwrap()).abs() < 1e-9, "{along} vs {:?}", middle.error);
 }
 
 #[test]
@@ -122,10 +95,7 @@ fn corrected_arcs_still_close() {
     let program = "G21 G90 G17\nS8000 M03\nG0 X6 Y0 Z20\nG1 Z0 F1000\nG2 X-6 Y0 I-6 J0\nG2 X6 Y0 R6\n\
                    G1 X5.6\nG3 X-5.6 Y0 I-5.6 J0\nG3 X5.6 Y0 I5.6 J0\nG0 Z20\nM30\n";
     let (mut request, tool) = request(program);
-    request.stock = Stock::Box {
-        min: [-20.0, -20.0, -10.0],
-        max: [20.0, 20.0, 0.1],
-    };
+    request.stock = Stock::Box { min: [-20.0, -20.0, -10.0], max: [20.0, 20.0, 0.1] };
     let answer = predict::solve(&request, &tool, None).unwrap();
     assert!(answer.summary.predicted > 10);
     let corrected = predict::corrected_program(&request, &answer, &options()).unwrap();
@@ -138,12 +108,7 @@ fn corrected_arcs_still_close() {
     let original = reader::read(program, "program", &ReadOptions::default()).unwrap();
     for (moved, read_move) in read.moves.iter().zip(&original.moves) {
         if matches!(read_move.kind, reader::MoveKind::Arc { .. }) {
-            let last_pass = answer
-                .passes
-                .iter()
-                .rev()
-                .find(|p| p.line == Some(read_move.line))
-                .unwrap();
+            let last_pass = answer.passes.iter().rev().find(|p| p.line == Some(read_move.line)).unwrap();
             let end = moved.to_xyz().unwrap();
             for (got, want) in end.iter().zip(last_pass.corrected) {
                 assert!((got - want).abs() < 6e-5);
@@ -157,19 +122,10 @@ fn points_become_a_complete_program() {
     let tool = finishing_tool(3.0);
     let mut request = bare_request(
         &tool,
-        Stock::Box {
-            min: [0.0, -5.0, -10.0],
-            max: [20.0, 5.0, 0.1],
-        },
+        Stock::Box { min: [0.0, -5.0, -10.0], max: [20.0, 5.0, 0.1] },
         PathInput::Points {
             points: (0..6)
-                .map(|k| {
-                    [
-                        if k % 2 == 0 { -8.0 } else { 28.0 },
-                        0.4 * f64::from(k / 2),
-                        0.0,
-                    ]
-                })
+                .map(|k| [if k % 2 == 0 { -8.0 } else { 28.0 }, 0.4 * f64::from(k / 2), 0.0])
                 .flat_map(|p| [p, [if p[0] < 0.0 { 28.0 } else { -8.0 }, p[1], 0.0]])
                 .collect(),
         },
@@ -188,26 +144,15 @@ fn points_become_a_complete_program() {
 #[test]
 fn iterations_and_the_clamp() {
     let (mut request, tool) = request(PROGRAM);
-    request.correction = Some(CorrectionOptions {
-        max_correction: None,
-        iterations: Some(2),
-    });
+    request.correction = Some(CorrectionOptions { max_correction: None, iterations: Some(2) });
     let answer = predict::solve(&request, &tool, None).unwrap();
     assert_eq!(answer.summary.rounds.len(), 2);
     assert!(answer.passes[5].residual_error.is_some());
-    request.correction = Some(CorrectionOptions {
-        max_correction: Some(0.001),
-        iterations: None,
-    });
+    request.correction = Some(CorrectionOptions { max_correction: Some(0.001), iterations: None });
     let clamped = predict::solve(&request, &tool, None).unwrap();
     assert!(clamped.summary.max_correction <= 0.001 + 1e-15);
     assert!(clamped.summary.clamped > 0);
-    assert!(
-        clamped
-            .passes
-            .iter()
-            .any(|p| p.flags.contains(&PassFlag::CorrectionClamped))
-    );
+    assert!(clamped.passes.iter().any(|p| p.flags.contains(&PassFlag::CorrectionClamped)));
 }
 
 #[test]

@@ -22,20 +22,12 @@ fn gcode_text() -> impl Strategy<Value = String> {
         Just("; tail".to_owned()),
         Just("%".to_owned()),
         Just("/".to_owned()),
-        (
-            prop::sample::select(vec![
-                'X', 'Y', 'Z', 'I', 'J', 'K', 'R', 'F', 'S', 'N', 'P', 'Q'
-            ]),
-            -50.0f64..50.0
-        )
+        (prop::sample::select(vec!['X', 'Y', 'Z', 'I', 'J', 'K', 'R', 'F', 'S', 'N', 'P', 'Q']), -50.0f64..50.0)
             .prop_map(|(letter, value)| format!("{letter}{value:.3}")),
         "[ -~]{0,3}",
     ];
-    prop::collection::vec(
-        prop::collection::vec(word, 0..6).prop_map(|w| w.join(" ")),
-        0..20,
-    )
-    .prop_map(|lines| lines.join("\n"))
+    prop::collection::vec(prop::collection::vec(word, 0..6).prop_map(|w| w.join(" ")), 0..20)
+        .prop_map(|lines| lines.join("\n"))
 }
 
 proptest! {

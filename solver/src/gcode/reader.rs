@@ -216,22 +216,14 @@ impl ReadMove {
     pub fn points(&self, chord_tolerance: f64) -> Option<Vec<[f64; 3]>> {
         let from = self.from_xyz()?;
         let to = self.to_xyz()?;
-        let MoveKind::Arc {
-            centre,
-            clockwise,
-            extra_turns,
-        } = self.kind
-        else {
+        let MoveKind::Arc { centre, clockwise, extra_turns } = self.kind else {
             return Some(vec![to]);
         };
         let (a, b, normal) = self.modal.plane.axes();
         let arc = ArcGeometry::new(from, to, centre, clockwise, extra_turns, (a, b));
         let tolerance = chord_tolerance.max(1e-9);
-        let max_step = if arc.radius > tolerance {
-            2.0 * (1.0 - tolerance / arc.radius).acos()
-        } else {
-            std::f64::consts::PI
-        };
+        let max_step =
+            if arc.radius > tolerance { 2.0 * (1.0 - tolerance / arc.radius).acos() } else { std::f64::consts::PI };
         let chords = ((arc.sweep.abs() / max_step).ceil() as usize).clamp(1, MAX_ARC_CHORDS);
         let mut points = Vec::with_capacity(chords);
         for index in 1..chords {
@@ -284,11 +276,7 @@ impl ArcGeometry {
             sweep = if clockwise { -tau } else { tau };
         }
         sweep += f64::from(extra_turns) * if clockwise { -tau } else { tau };
-        Self {
-            radius: sa.hypot(sb),
-            start_angle,
-            sweep,
-        }
+        Self { radius: sa.hypot(sb), start_angle, sweep }
     }
 }
 
@@ -306,11 +294,7 @@ pub struct ReadOptions {
 
 impl Default for ReadOptions {
     fn default() -> Self {
-        Self {
-            block_delete: false,
-            max_lines: DEFAULT_MAX_LINES,
-            start: [None; 3],
-        }
+        Self { block_delete: false, max_lines: DEFAULT_MAX_LINES, start: [None; 3] }
     }
 }
 
@@ -334,12 +318,7 @@ struct Word {
 }
 
 /// Splits a line into `words` and returns the byte offset after the last word.
-fn tokenize(
-    line: &str,
-    line_number: usize,
-    field: &str,
-    words: &mut Vec<Word>,
-) -> Result<usize, SolverError> {
+fn tokenize(line: &str, line_number: usize, field: &str, words: &mut Vec<Word>) -> Result<usize, SolverError> {
     let bytes = line.as_bytes();
     let mut index = 0;
     let mut code_end = 0;
@@ -387,27 +366,14 @@ fn tokenize(
                     index += 1;
                 }
                 if digits == 0 {
-                    return Err(fail(format!(
-                        "{} must be followed by a number",
-                        letter as char
-                    )));
+                    return Err(fail(format!("{} must be followed by a number", letter as char)));
                 }
                 let text = &line[start..index];
-                let value: f64 = text
-                    .parse()
-                    .map_err(|_| fail(format!("{}{text} is not a number", letter as char)))?;
+                let value: f64 = text.parse().map_err(|_| fail(format!("{}{text} is not a number", letter as char)))?;
                 if !value.is_finite() {
                     return Err(fail(format!("{}{text} is out of range", letter as char)));
                 }
-                words.push(Word {
-                    letter,
-                    value,
-                    span: WordSpan {
-                        start,
-                        end: index,
-                        decimals,
-                    },
-                });
+                words.push(Word { letter, value, span: WordSpan { start, end: index, decimals } });
                 code_end = index;
             }
             _ => {
@@ -430,8 +396,7 @@ fn unsupported(field: &str, line: usize, message: impl std::fmt::Display) -> Sol
 /// A `G` code as tenths (`G90.1` is 901, `G1` is 10), so codes compare exactly.
 fn g_tenths(value: f64) -> Option<u32> {
     let tenths = (value * 10.0).round();
-    ((tenths - value * 10.0).abs() < 1e-6 && (0.0..100_000.0).contains(&tenths))
-        .then_some(tenths as u32)
+    ((tenths - value * 10.0).abs() < 1e-6 && (0.0..100_000.0).contains(&tenths)).then_some(tenths as u32)
 }
 
 /// Modal groups of the `G` codes this reader knows, to refuse two codes of one group in a block.
@@ -494,10 +459,7 @@ pub fn read(text: &str, field: &str, options: &ReadOptions) -> Result<ReadProgra
         if line_number > options.max_lines {
             return Err(SolverError::new(
                 "E_TOO_MANY_LINES",
-                format!(
-                    "the program has more than {} lines, the limit",
-                    options.max_lines
-                ),
+                format!("the program has more than {} lines, the limit", options.max_lines),
             )
             .at(field));
         }
@@ -601,41 +563,19 @@ pub fn read(text: &str, field: &str, options: &ReadOptions) -> Result<ReadProgra
             }
             Some(_) | None if has_axes || matches!(block.motion, Some(20 | 30)) => {
                 let Some(code) = motion else {
-                    return Err(syntax(
-                        field,
-                        line_number,
-                        "axis words without a motion mode (G0, G1, G2 or G3)",
-                    ));
+                    return Err(syntax(field, line_number, "axis words without a motion mode (G0, G1, G2 or G3)"));
                 };
                 if code == 800 {
-                    return Err(syntax(
-                        field,
-                        line_number,
-                        "axis words while the motion mode is cancelled (G80)",
-                    ));
+                    return Err(syntax(field, line_number, "axis words while the motion mode is cancelled (G80)"));
                 }
                 let to = target(&position);
                 let kind = match code {
                     0 => MoveKind::Rapid,
                     10 => MoveKind::Linear,
-                    _ => arc_kind(
-                        &block,
-                        &modal,
-                        &position,
-                        &to,
-                        code == 20,
-                        line_number,
-                        field,
-                    )?,
+                    _ => arc_kind(&block, &modal, &position, &to, code == 20, line_number, field)?,
                 };
                 // Missing axis words go right after the block's last axis word.
-                let insert_at = block
-                    .axes
-                    .iter()
-                    .flatten()
-                    .map(|w| w.span.end)
-                    .max()
-                    .unwrap_or(code_end);
+                let insert_at = block.axes.iter().flatten().map(|w| w.span.end).max().unwrap_or(code_end);
                 let words = MoveWords {
                     axes: block.axes.map(|w| w.map(|w| w.span)),
                     offsets: block.offsets.map(|w| w.map(|w| w.span)),
@@ -659,11 +599,7 @@ pub fn read(text: &str, field: &str, options: &ReadOptions) -> Result<ReadProgra
             ended = true;
         }
     }
-    Ok(ReadProgram {
-        moves,
-        line_count,
-        modal,
-    })
+    Ok(ReadProgram { moves, line_count, modal })
 }
 
 fn parse_block(words: &[Word], line: usize, field: &str) -> Result<Block, SolverError> {
@@ -676,11 +612,7 @@ fn parse_block(words: &[Word], line: usize, field: &str) -> Result<Block, Solver
         let repeatable = matches!(letter, b'G' | b'M');
         if !repeatable {
             if seen[slot] {
-                return Err(syntax(
-                    field,
-                    line,
-                    format!("{} appears twice in one block", letter as char),
-                ));
+                return Err(syntax(field, line, format!("{} appears twice in one block", letter as char)));
             }
             seen[slot] = true;
         }
@@ -692,11 +624,7 @@ fn parse_block(words: &[Word], line: usize, field: &str) -> Result<Block, Solver
                 };
                 if let Some(group) = g_group(code) {
                     if groups.contains(&group) {
-                        return Err(syntax(
-                            field,
-                            line,
-                            "two G codes of the same modal group in one block",
-                        ));
+                        return Err(syntax(field, line, "two G codes of the same modal group in one block"));
                     }
                     groups.push(group);
                 }
@@ -713,11 +641,7 @@ fn parse_block(words: &[Word], line: usize, field: &str) -> Result<Block, Solver
                     60 => block.tool_change = true,
                     20 | 300 => block.end = true,
                     970 | 980 | 990 => {
-                        return Err(unsupported(
-                            field,
-                            line,
-                            "sub-program calls are not supported",
-                        ));
+                        return Err(unsupported(field, line, "sub-program calls are not supported"));
                     }
                     // Stops, coolant and machine-specific M codes do not move the tool.
                     _ => {}
@@ -729,41 +653,25 @@ fn parse_block(words: &[Word], line: usize, field: &str) -> Result<Block, Solver
             b'P' => block.turns = Some(*word),
             b'F' => {
                 if value <= 0.0 {
-                    return Err(syntax(
-                        field,
-                        line,
-                        format!("feed F{value} must be positive"),
-                    ));
+                    return Err(syntax(field, line, format!("feed F{value} must be positive")));
                 }
                 block.feed = Some(value);
             }
             b'S' => {
                 if value < 0.0 {
-                    return Err(syntax(
-                        field,
-                        line,
-                        format!("spindle speed S{value} is negative"),
-                    ));
+                    return Err(syntax(field, line, format!("spindle speed S{value} is negative")));
                 }
                 block.spindle_rpm = Some(value);
             }
             b'T' => {
                 if value < 0.0 || value.fract() != 0.0 || value > f64::from(u32::MAX) {
-                    return Err(syntax(
-                        field,
-                        line,
-                        format!("T{value} is not a tool number"),
-                    ));
+                    return Err(syntax(field, line, format!("T{value} is not a tool number")));
                 }
                 block.tool = Some(value as u32);
             }
             b'N' => {
                 if value < 0.0 || value.fract() != 0.0 || value > 1e15 {
-                    return Err(syntax(
-                        field,
-                        line,
-                        format!("N{value} is not a block number"),
-                    ));
+                    return Err(syntax(field, line, format!("N{value} is not a block number")));
                 }
                 block.block_number = Some(value as u64);
             }
@@ -841,22 +749,14 @@ fn apply_g(block: &mut Block, code: u32, line: usize, field: &str) -> Result<(),
             return Err(unsupported(field, line, "canned cycles are not supported"));
         }
         _ => {
-            return Err(unsupported(
-                field,
-                line,
-                format!("G{} is not supported", format_code(code)),
-            ));
+            return Err(unsupported(field, line, format!("G{} is not supported", format_code(code))));
         }
     }
     Ok(())
 }
 
 fn format_code(tenths: u32) -> String {
-    if tenths.is_multiple_of(10) {
-        format!("{}", tenths / 10)
-    } else {
-        format!("{}.{}", tenths / 10, tenths % 10)
-    }
+    if tenths.is_multiple_of(10) { format!("{}", tenths / 10) } else { format!("{}.{}", tenths / 10, tenths % 10) }
 }
 
 /// Centre and turns of a `G2`/`G3` block, checked for closure.
@@ -870,8 +770,7 @@ fn arc_kind(
     field: &str,
 ) -> Result<MoveKind, SolverError> {
     let (a, b, normal) = modal.plane.axes();
-    let (Some(start_a), Some(start_b), Some(end_a), Some(end_b)) = (from[a], from[b], to[a], to[b])
-    else {
+    let (Some(start_a), Some(start_b), Some(end_a), Some(end_b)) = (from[a], from[b], to[a], to[b]) else {
         return Err(SolverError::new(
             "E_GCODE_POSITION",
             format!("line {line}: arc from a position the program has not set yet"),
@@ -896,21 +795,13 @@ fn arc_kind(
     let offset_letters = ['I', 'J', 'K'];
     let (centre_a, centre_b) = if let Some(radius_word) = block.radius {
         if block.offsets.iter().any(Option::is_some) {
-            return Err(syntax(
-                field,
-                line,
-                "an arc takes either R or I/J/K, not both",
-            ));
+            return Err(syntax(field, line, "an arc takes either R or I/J/K, not both"));
         }
         let radius = radius_word.value * scale;
         let (dx, dy) = (end_a - start_a, end_b - start_b);
         let chord = dx.hypot(dy);
         if chord < 1e-9 {
-            return Err(syntax(
-                field,
-                line,
-                "a full circle cannot be given with R: use I/J/K",
-            ));
+            return Err(syntax(field, line, "a full circle cannot be given with R: use I/J/K"));
         }
         let half = chord / 2.0;
         if radius.abs() < half - ARC_CLOSURE_MM.max(ARC_CLOSURE_RELATIVE * half) {
@@ -930,10 +821,7 @@ fn arc_kind(
         let left = (radius >= 0.0) != clockwise;
         let side = if left { 1.0 } else { -1.0 };
         let (mid_a, mid_b) = ((start_a + end_a) / 2.0, (start_b + end_b) / 2.0);
-        (
-            mid_a - side * rise * dy / chord,
-            mid_b + side * rise * dx / chord,
-        )
+        (mid_a - side * rise * dy / chord, mid_b + side * rise * dx / chord)
     } else {
         let offset = |axis: usize| block.offsets[axis].map(|w| w.value * scale);
         let (oa, ob) = (offset(a), offset(b));
@@ -941,10 +829,7 @@ fn arc_kind(
             return Err(syntax(
                 field,
                 line,
-                format!(
-                    "{} is not an arc-centre word in the selected plane",
-                    offset_letters[normal]
-                ),
+                format!("{} is not an arc-centre word in the selected plane", offset_letters[normal]),
             ));
         }
         if oa.is_none() && ob.is_none() {
@@ -976,11 +861,7 @@ fn arc_kind(
     centre[a] = centre_a;
     centre[b] = centre_b;
     centre[normal] = from[normal].unwrap_or(0.0);
-    Ok(MoveKind::Arc {
-        centre,
-        clockwise,
-        extra_turns,
-    })
+    Ok(MoveKind::Arc { centre, clockwise, extra_turns })
 }
 
 /// New geometry for one move of a [`ReadProgram`], in mm, absolute.
@@ -1006,32 +887,16 @@ pub struct MoveEdit {
 ///
 /// # Errors
 /// `E_INPUT` for an edit that names no move, or a non-finite coordinate.
-pub fn rewrite(
-    text: &str,
-    program: &ReadProgram,
-    edits: &[MoveEdit],
-    field: &str,
-) -> Result<String, SolverError> {
+pub fn rewrite(text: &str, program: &ReadProgram, edits: &[MoveEdit], field: &str) -> Result<String, SolverError> {
     let count = program.moves.len();
     let mut new_to: Vec<Position> = program.moves.iter().map(|m| m.to).collect();
     let mut centres: Vec<Option<[f64; 3]>> = vec![None; count];
     for edit in edits {
         if edit.index >= count {
-            return Err(SolverError::input(
-                field,
-                format!("edit names move {} of {count}", edit.index),
-            ));
+            return Err(SolverError::input(field, format!("edit names move {} of {count}", edit.index)));
         }
-        if edit
-            .to
-            .iter()
-            .chain(edit.centre.iter().flatten())
-            .any(|v| !v.is_finite())
-        {
-            return Err(SolverError::input(
-                field,
-                "an edited coordinate is not finite",
-            ));
+        if edit.to.iter().chain(edit.centre.iter().flatten()).any(|v| !v.is_finite()) {
+            return Err(SolverError::input(field, "an edited coordinate is not finite"));
         }
         new_to[edit.index] = edit.to.map(Some);
         centres[edit.index] = edit.centre;
@@ -1042,11 +907,7 @@ pub fn rewrite(
     let mut replacements: Vec<LineEdit> = Vec::new();
     for (index, read_move) in program.moves.iter().enumerate() {
         let continuous = index > 0 && program.moves[index - 1].to == read_move.from;
-        let start = if continuous {
-            actual[index - 1]
-        } else {
-            read_move.from
-        };
+        let start = if continuous { actual[index - 1] } else { read_move.from };
         if start == read_move.from && new_to[index] == read_move.to && centres[index].is_none() {
             actual.push(read_move.to);
             continue;
@@ -1089,20 +950,10 @@ pub fn rewrite(
                 None => inserts.push(format!("{}{written}", letters[axis])),
             }
         }
-        if let MoveKind::Arc {
-            centre, clockwise, ..
-        } = read_move.kind
+        if let MoveKind::Arc { centre, clockwise, .. } = read_move.kind
             && let (Some(from), Some(to)) = (known(&start), known(&end_actual))
         {
-            arc_words(
-                read_move,
-                from,
-                to,
-                centres[index].unwrap_or(centre),
-                clockwise,
-                &mut changes,
-                &mut inserts,
-            );
+            arc_words(read_move, from, to, centres[index].unwrap_or(centre), clockwise, &mut changes, &mut inserts);
         }
         actual.push(end_actual);
         if !changes.is_empty() || !inserts.is_empty() {
@@ -1191,13 +1042,7 @@ fn arc_words(
     };
     let scale = read_move.modal.units.scale();
     let words = &read_move.words;
-    let (
-        MoveKind::Arc {
-            centre: old_centre, ..
-        },
-        Some(old_from),
-    ) = (read_move.kind, read_move.from_xyz())
-    else {
+    let (MoveKind::Arc { centre: old_centre, .. }, Some(old_from)) = (read_move.kind, read_move.from_xyz()) else {
         return;
     };
     if let Some(span) = words.radius {
@@ -1216,19 +1061,13 @@ fn arc_words(
     }
     let letters = ['I', 'J', 'K'];
     for (axis, centre) in [(a, centre_a), (b, centre_b)] {
-        let value = if read_move.modal.absolute_arc_centre {
-            centre
-        } else {
-            centre - from[axis]
-        } / scale;
+        let value = if read_move.modal.absolute_arc_centre { centre } else { centre - from[axis] } / scale;
         let span = words.offsets[axis];
         let decimals = span.map_or(4, |s| s.decimals.max(4));
         let written = number(value, decimals);
-        let old_value = if read_move.modal.absolute_arc_centre {
-            old_centre[axis]
-        } else {
-            old_centre[axis] - old_from[axis]
-        } / scale;
+        let old_value =
+            if read_move.modal.absolute_arc_centre { old_centre[axis] } else { old_centre[axis] - old_from[axis] }
+                / scale;
         if written == number(old_value, decimals) {
             continue;
         }
@@ -1242,11 +1081,7 @@ fn arc_words(
 /// A value with `decimals` decimals, never `-0.000…`.
 fn number(value: f64, decimals: usize) -> String {
     let text = format!("{value:.decimals$}");
-    if text.starts_with('-') && text[1..].bytes().all(|b| b == b'0' || b == b'.') {
-        text[1..].to_owned()
-    } else {
-        text
-    }
+    if text.starts_with('-') && text[1..].bytes().all(|b| b == b'0' || b == b'.') { text[1..].to_owned() } else { text }
 }
 
 #[cfg(test)]
@@ -1286,10 +1121,7 @@ mod tests {
         let skipped = read(
             "G0 X0 Y0 Z0\n/G1 X5 F100\nG1 Y5 F100\n",
             "program",
-            &ReadOptions {
-                block_delete: true,
-                ..ReadOptions::default()
-            },
+            &ReadOptions { block_delete: true, ..ReadOptions::default() },
         )
         .unwrap();
         assert_eq!(skipped.moves.len(), 2);
@@ -1322,10 +1154,7 @@ mod tests {
         let mut previous = [10.0, 0.0, 0.0];
         for point in &points {
             assert!(((point[0]).hypot(point[1]) - 10.0).abs() < 1e-9);
-            let mid = [
-                (previous[0] + point[0]) / 2.0,
-                (previous[1] + point[1]) / 2.0,
-            ];
+            let mid = [(previous[0] + point[0]) / 2.0, (previous[1] + point[1]) / 2.0];
             assert!(10.0 - mid[0].hypot(mid[1]) <= 0.001 + 1e-12);
             previous = *point;
         }
@@ -1355,28 +1184,12 @@ mod tests {
             ("G0 X0 Y0 Z0\nG1 X1 Y1 Q\n", "E_GCODE_SYNTAX", "line 2"),
             ("G0 X0 Y0 Z0\nG1 X1 (open\n", "E_GCODE_SYNTAX", "line 2"),
             ("G0 X0 Y0 Z0\nG1 X1 X2 F1\n", "E_GCODE_SYNTAX", "line 2"),
-            (
-                "G0 X0 Y0 Z0\n\nG41 D1 G1 X5 F100\n",
-                "E_GCODE_UNSUPPORTED",
-                "line 3",
-            ),
+            ("G0 X0 Y0 Z0\n\nG41 D1 G1 X5 F100\n", "E_GCODE_UNSUPPORTED", "line 3"),
             ("G81 X0 Y0 Z-1 R1 F100\n", "E_GCODE_UNSUPPORTED", "line 1"),
-            (
-                "G0 X0 Y0 Z0\nG1 A10 F100\n",
-                "E_GCODE_UNSUPPORTED",
-                "line 2",
-            ),
+            ("G0 X0 Y0 Z0\nG1 A10 F100\n", "E_GCODE_UNSUPPORTED", "line 2"),
             ("#1=5\n", "E_GCODE_UNSUPPORTED", "line 1"),
-            (
-                "G0 X10 Y0 Z0\nG2 X0 Y10 I-10 J1 F100\n",
-                "E_ARC_NOT_CLOSED",
-                "line 2",
-            ),
-            (
-                "G0 X10 Y0 Z0\nG2 X-10 Y0 R5 F100\n",
-                "E_ARC_RADIUS",
-                "line 2",
-            ),
+            ("G0 X10 Y0 Z0\nG2 X0 Y10 I-10 J1 F100\n", "E_ARC_NOT_CLOSED", "line 2"),
+            ("G0 X10 Y0 Z0\nG2 X-10 Y0 R5 F100\n", "E_ARC_RADIUS", "line 2"),
             ("G2 X0 Y10 I-10 J0 F100\n", "E_GCODE_POSITION", "line 1"),
             ("X10\n", "E_GCODE_SYNTAX", "line 1"),
             ("G0 G1 X1\n", "E_GCODE_SYNTAX", "line 1"),
@@ -1387,30 +1200,18 @@ mod tests {
         for (text, code, line) in cases {
             let error = read_err(text);
             assert_eq!(error.code(), code, "{text}: {}", error.message());
-            assert!(
-                error.message().starts_with(line),
-                "{text}: {}",
-                error.message()
-            );
+            assert!(error.message().starts_with(line), "{text}: {}", error.message());
             assert_eq!(error.field(), Some("program"));
         }
-        let limited = read(
-            "G0 X0\nG0 X1\nG0 X2\n",
-            "program",
-            &ReadOptions {
-                max_lines: 2,
-                ..ReadOptions::default()
-            },
-        )
-        .unwrap_err();
+        let limited = read("G0 X0\nG0 X1\nG0 X2\n", "program", &ReadOptions { max_lines: 2, ..ReadOptions::default() })
+            .unwrap_err();
         assert_eq!(limited.code(), "E_TOO_MANY_LINES");
     }
 
     #[test]
     fn non_geometric_words_and_home_returns_do_not_move_the_tool() {
-        let program = read_ok(
-            "G0 G54 G43 H1 X0 Y0 Z5\nG4 X2.5\nG10 L2 P1 X5\nG1 Z0 F100\nG91 G28 Z0\nG90 G0 X1\nG0 Y1 Z1\n",
-        );
+        let program =
+            read_ok("G0 G54 G43 H1 X0 Y0 Z5\nG4 X2.5\nG10 L2 P1 X5\nG1 Z0 F100\nG91 G28 Z0\nG90 G0 X1\nG0 Y1 Z1\n");
         assert_eq!(program.moves.len(), 4);
         assert_eq!(program.moves[1].to_xyz(), Some([0.0, 0.0, 0.0]));
         assert_eq!(program.moves[2].from, [None; 3]);
@@ -1427,16 +1228,8 @@ mod tests {
         let text = "%\nN10 G90 G0 X0 Y0 Z5 (START)\nN20 G1 Z0.000 F300\nN30 X10. ; cut\nN40 Y5\nN50 G0 Z5\n%\n";
         let program = read_ok(text);
         let edits = [
-            MoveEdit {
-                index: 2,
-                to: [10.0, 0.01, -0.002],
-                centre: None,
-            },
-            MoveEdit {
-                index: 3,
-                to: [10.0, 5.0, -0.001],
-                centre: None,
-            },
+            MoveEdit { index: 2, to: [10.0, 0.01, -0.002], centre: None },
+            MoveEdit { index: 3, to: [10.0, 5.0, -0.001], centre: None },
         ];
         let out = rewrite(text, &program, &edits, "program").unwrap();
         assert_eq!(
@@ -1453,11 +1246,7 @@ mod tests {
     fn incremental_rewrite_keeps_later_end_points() {
         let text = "G90 G0 X0 Y0 Z0\nG91 G1 X10 F100\nX10\nX10\n";
         let program = read_ok(text);
-        let edits = [MoveEdit {
-            index: 2,
-            to: [20.5, 0.0, 0.0],
-            centre: None,
-        }];
+        let edits = [MoveEdit { index: 2, to: [20.5, 0.0, 0.0], centre: None }];
         let out = rewrite(text, &program, &edits, "program").unwrap();
         assert_eq!(out, "G90 G0 X0 Y0 Z0\nG91 G1 X10 F100\nX10.5000\nX9.5000\n");
     }
@@ -1467,16 +1256,8 @@ mod tests {
         let text = "G0 X10 Y0 Z0\nG3 X0 Y10 I-10 J0 F100\nG3 X-10 Y0 R10\n";
         let program = read_ok(text);
         let edits = [
-            MoveEdit {
-                index: 1,
-                to: [0.0, 10.01, 0.0],
-                centre: None,
-            },
-            MoveEdit {
-                index: 2,
-                to: [-10.01, 0.0, 0.0],
-                centre: Some([0.0, 0.0, 0.0]),
-            },
+            MoveEdit { index: 1, to: [0.0, 10.01, 0.0], centre: None },
+            MoveEdit { index: 2, to: [-10.01, 0.0, 0.0], centre: Some([0.0, 0.0, 0.0]) },
         ];
         let out = rewrite(text, &program, &edits, "program").unwrap();
         let reread = read_ok(&out);
@@ -1485,17 +1266,9 @@ mod tests {
         assert!(out.lines().nth(2).unwrap().contains('R'));
         let inch = "G20 G0 X1 Y0 Z0\nG1 X2 F10\n";
         let program = read_ok(inch);
-        let out = rewrite(
-            inch,
-            &program,
-            &[MoveEdit {
-                index: 1,
-                to: [50.8 + 0.254, 0.0, 0.0],
-                centre: None,
-            }],
-            "program",
-        )
-        .unwrap();
+        let out =
+            rewrite(inch, &program, &[MoveEdit { index: 1, to: [50.8 + 0.254, 0.0, 0.0], centre: None }], "program")
+                .unwrap();
         assert_eq!(out, "G20 G0 X1 Y0 Z0\nG1 X2.0100 F10\n");
     }
 }

@@ -33,17 +33,9 @@ impl Capsule {
     pub(crate) fn new(a: Vec3, b: Vec3) -> Self {
         let ab = b - a;
         let length = ab.norm();
-        let axis = if length > 0.0 {
-            ab / length
-        } else {
-            Vec3::zeros()
-        };
+        let axis = if length > 0.0 { ab / length } else { Vec3::zeros() };
         let denom = 1.0 - axis.z * axis.z;
-        let denom = if length > 0.0 && denom > 1e-12 {
-            denom
-        } else {
-            0.0
-        };
+        let denom = if length > 0.0 && denom > 1e-12 { denom } else { 0.0 };
         let length_xy2 = ab.x * ab.x + ab.y * ab.y;
         Self {
             a,
@@ -51,11 +43,7 @@ impl Capsule {
             axis,
             length,
             ab_xy: (ab.x, ab.y),
-            inverse_xy: if length_xy2 > 0.0 {
-                1.0 / length_xy2
-            } else {
-                0.0
-            },
+            inverse_xy: if length_xy2 > 0.0 { 1.0 / length_xy2 } else { 0.0 },
             denom,
             inverse_denom: if denom > 0.0 { 1.0 / denom } else { 0.0 },
             min_z: a.z.min(b.z),
@@ -146,11 +134,7 @@ fn distance_2d(x: f64, y: f64, a: &Vec3, b: &Vec3) -> f64 {
     let (abx, aby) = (b.x - a.x, b.y - a.y);
     let (apx, apy) = (x - a.x, y - a.y);
     let length2 = abx * abx + aby * aby;
-    let t = if length2 > 0.0 {
-        ((apx * abx + apy * aby) / length2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
+    let t = if length2 > 0.0 { ((apx * abx + apy * aby) / length2).clamp(0.0, 1.0) } else { 0.0 };
     let (dx, dy) = (apx - t * abx, apy - t * aby);
     (dx * dx + dy * dy).sqrt()
 }
@@ -212,11 +196,7 @@ mod tests {
         for i in 0..12 {
             for j in 0..12 {
                 for k in 0..6 {
-                    let lo = Vec3::new(
-                        -2.0 + 0.5 * f64::from(i),
-                        -3.0 + 0.5 * f64::from(j),
-                        -2.5 + 0.5 * f64::from(k),
-                    );
+                    let lo = Vec3::new(-2.0 + 0.5 * f64::from(i), -3.0 + 0.5 * f64::from(j), -2.5 + 0.5 * f64::from(k));
                     let hi = lo + Vec3::new(0.4, 0.3, 0.2);
                     if capsule.may_cover_box(&lo, &hi, r, 0.0) {
                         continue;
@@ -224,12 +204,7 @@ mod tests {
                     for s in 0..5 {
                         for t in 0..5 {
                             for u in 0..3 {
-                                let q = lo
-                                    + Vec3::new(
-                                        0.1 * f64::from(s),
-                                        0.075 * f64::from(t),
-                                        0.1 * f64::from(u),
-                                    );
+                                let q = lo + Vec3::new(0.1 * f64::from(s), 0.075 * f64::from(t), 0.1 * f64::from(u));
                                 assert!(!capsule.covers(&q, r, r * r, 0.0), "{q:?}");
                             }
                         }

@@ -74,13 +74,7 @@ pub(crate) fn clamp(c: &mut Vec3, limit: f64) -> bool {
 /// Least-squares arc centre in the plane of axes (a, b) through the corrected ends, fitted to the
 /// corrected interior chord points: the centre lies on the ends' perpendicular bisector, and
 /// |p|² − |s|² − 2c·(p − s) = 0 is linear in the position along it.
-pub(crate) fn refit_centre(
-    start: &Vec3,
-    end: &Vec3,
-    interior: &[Vec3],
-    guess: &Vec3,
-    (a, b): (usize, usize),
-) -> Vec3 {
+pub(crate) fn refit_centre(start: &Vec3, end: &Vec3, interior: &[Vec3], guess: &Vec3, (a, b): (usize, usize)) -> Vec3 {
     let mid = [(start[a] + end[a]) / 2.0, (start[b] + end[b]) / 2.0];
     let chord = [end[a] - start[a], end[b] - start[b]];
     let length = chord[0].hypot(chord[1]);

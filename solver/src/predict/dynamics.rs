@@ -41,21 +41,12 @@ impl Compliance {
                     return (Complex::new(0.0, 0.0), true);
                 }
                 if frequency <= first.frequency_hz {
-                    return (
-                        Complex::new(first.real, first.imag),
-                        frequency < first.frequency_hz,
-                    );
+                    return (Complex::new(first.real, first.imag), frequency < first.frequency_hz);
                 }
                 let upper = rows.partition_point(|r| r.frequency_hz < frequency);
                 let (a, b) = (rows[upper - 1], rows[upper]);
                 let t = (frequency - a.frequency_hz) / (b.frequency_hz - a.frequency_hz);
-                (
-                    Complex::new(
-                        a.real + t * (b.real - a.real),
-                        a.imag + t * (b.imag - a.imag),
-                    ),
-                    false,
-                )
+                (Complex::new(a.real + t * (b.real - a.real), a.imag + t * (b.imag - a.imag)), false)
             }
         }
     }
@@ -66,8 +57,7 @@ fn modal(modes: &[Mode], omega: f64) -> Complex<f64> {
         .iter()
         .map(|m| {
             let ratio = omega / (std::f64::consts::TAU * m.frequency_hz);
-            Complex::new(1.0 / m.stiffness, 0.0)
-                / Complex::new(1.0 - ratio * ratio, 2.0 * m.damping_ratio * ratio)
+            Complex::new(1.0 / m.stiffness, 0.0) / Complex::new(1.0 - ratio * ratio, 2.0 * m.damping_ratio * ratio)
         })
         .sum()
 }
@@ -86,9 +76,8 @@ pub(crate) fn kernel(compliance: &Compliance, spindle_rpm: f64, steps: usize) ->
             g
         })
         .collect();
-    let table: Vec<(f64, f64)> = (0..steps)
-        .map(|k| (std::f64::consts::TAU * k as f64 / steps as f64).sin_cos())
-        .collect();
+    let table: Vec<(f64, f64)> =
+        (0..steps).map(|k| (std::f64::consts::TAU * k as f64 / steps as f64).sin_cos()).collect();
     let n = steps as f64;
     let kernel = (0..steps)
         .map(|t| {
@@ -120,11 +109,7 @@ fn convolve_at(kernel: &[f64], force: &[[f64; 3]], axis: usize, m: usize) -> f64
 }
 
 /// Deflection (D_x, D_y) at rotation angle `psi` (radians), interpolated linearly between steps.
-pub(crate) fn deflection_at(
-    kernels: &(Vec<f64>, Vec<f64>),
-    force: &[[f64; 3]],
-    psi: f64,
-) -> [f64; 2] {
+pub(crate) fn deflection_at(kernels: &(Vec<f64>, Vec<f64>), force: &[[f64; 3]], psi: f64) -> [f64; 2] {
     let steps = force.len();
     let position = psi.rem_euclid(std::f64::consts::TAU) / std::f64::consts::TAU * steps as f64;
     let m0 = (position.floor() as usize).min(steps - 1);
@@ -137,18 +122,8 @@ pub(crate) fn deflection_at(
 }
 
 /// The whole deflection history (D_x, D_y) over one revolution.
-pub(crate) fn deflection_history(
-    kernels: &(Vec<f64>, Vec<f64>),
-    force: &[[f64; 3]],
-) -> Vec<[f64; 2]> {
-    (0..force.len())
-        .map(|m| {
-            [
-                convolve_at(&kernels.0, force, 0, m),
-                convolve_at(&kernels.1, force, 1, m),
-            ]
-        })
-        .collect()
+pub(crate) fn deflection_history(kernels: &(Vec<f64>, Vec<f64>), force: &[[f64; 3]]) -> Vec<[f64; 2]> {
+    (0..force.len()).map(|m| [convolve_at(&kernels.0, force, 0, m), convolve_at(&kernels.1, force, 1, m)]).collect()
 }
 
 /// In-place discrete Fourier transform (forward: e^{−2πimn/N}; inverse without the 1/N):
@@ -207,18 +182,10 @@ pub fn steady_state_deflection(force: &[f64], spindle_rpm: f64, modes: &[Mode]) 
     let omega = std::f64::consts::TAU * spindle_rpm / 60.0;
     for (m, bin) in spectrum.iter_mut().enumerate() {
         // Bins above N/2 are the negative harmonics: G(−ω) = conj G(ω).
-        let harmonic = if 2 * m <= n {
-            m as f64
-        } else {
-            m as f64 - n as f64
-        };
+        let harmonic = if 2 * m <= n { m as f64 } else { m as f64 - n as f64 };
         let g = modal(modes, harmonic.abs() * omega);
         let g = if harmonic < 0.0 { g.conj() } else { g };
-        let g = if 2 * m == n {
-            Complex::new(g.re, 0.0)
-        } else {
-            g
-        };
+        let g = if 2 * m == n { Complex::new(g.re, 0.0) } else { g };
         *bin *= g;
     }
     dft(&mut spectrum, true);
@@ -231,9 +198,8 @@ mod tests {
 
     #[test]
     fn radix_two_and_direct_transforms_agree() {
-        let signal: Vec<Complex<f64>> = (0..16)
-            .map(|k| Complex::new((k as f64 * 0.7).sin(), (k as f64 * 0.3).cos()))
-            .collect();
+        let signal: Vec<Complex<f64>> =
+            (0..16).map(|k| Complex::new((k as f64 * 0.7).sin(), (k as f64 * 0.3).cos())).collect();
         let mut fast = signal.clone();
         dft(&mut fast, false);
         for (m, value) in fast.iter().enumerate() {
@@ -255,11 +221,7 @@ mod tests {
 
     #[test]
     fn kernel_convolution_equals_the_spectral_route() {
-        let modes = [Mode {
-            stiffness: 5000.0,
-            frequency_hz: 1370.0,
-            damping_ratio: 0.05,
-        }];
+        let modes = [Mode { stiffness: 5000.0, frequency_hz: 1370.0, damping_ratio: 0.05 }];
         let steps = 90;
         let force: Vec<[f64; 3]> = (0..steps)
             .map(|k| {
@@ -267,11 +229,7 @@ mod tests {
                 [x, 0.5 * x, 0.0]
             })
             .collect();
-        let spectral = steady_state_deflection(
-            &force.iter().map(|f| f[0]).collect::<Vec<_>>(),
-            6000.0,
-            &modes,
-        );
+        let spectral = steady_state_deflection(&force.iter().map(|f| f[0]).collect::<Vec<_>>(), 6000.0, &modes);
         let compliance = Compliance::Modal(modes.to_vec());
         let (h, outside) = kernel(&compliance, 6000.0, steps);
         assert!(!outside);
@@ -290,16 +248,8 @@ mod tests {
     #[test]
     fn table_compliance_interpolates_and_flags_the_band() {
         let table = Compliance::Table(vec![
-            FrfPoint {
-                frequency_hz: 0.0,
-                real: 2e-4,
-                imag: 0.0,
-            },
-            FrfPoint {
-                frequency_hz: 1000.0,
-                real: 0.0,
-                imag: -1e-3,
-            },
+            FrfPoint { frequency_hz: 0.0, real: 2e-4, imag: 0.0 },
+            FrfPoint { frequency_hz: 1000.0, real: 0.0, imag: -1e-3 },
         ]);
         let (g, out) = table.at(std::f64::consts::TAU * 500.0);
         assert!((g.re - 1e-4).abs() < 1e-15 && (g.im + 5e-4).abs() < 1e-15 && !out);

@@ -98,9 +98,7 @@ impl EdgeGrid {
         lag: impl Fn(f64) -> f64,
     ) -> Self {
         let d_theta = std::f64::consts::FRAC_PI_2 / rings as f64;
-        let ring_angle: Vec<(f64, f64)> = (0..rings)
-            .map(|k| ((k as f64 + 0.5) * d_theta).sin_cos())
-            .collect();
+        let ring_angle: Vec<(f64, f64)> = (0..rings).map(|k| ((k as f64 + 0.5) * d_theta).sin_cos()).collect();
         let mut azimuth = Vec::with_capacity(rings * steps);
         for k in 0..rings {
             let theta = (k as f64 + 0.5) * d_theta;
@@ -111,15 +109,7 @@ impl EdgeGrid {
                 azimuth.push((c, s));
             }
         }
-        let mut grid = Self {
-            rings,
-            steps,
-            flutes,
-            sign,
-            ring_angle,
-            azimuth,
-            tiles: Vec::new(),
-        };
+        let mut grid = Self { rings, steps, flutes, sign, ring_angle, azimuth, tiles: Vec::new() };
         for k0 in (0..rings).step_by(TILE_RINGS) {
             for i0 in (0..steps).step_by(TILE_STEPS) {
                 let rings = (k0, (k0 + TILE_RINGS).min(grid.rings));
@@ -133,12 +123,7 @@ impl EdgeGrid {
                         hi = hi.sup(&u);
                     }
                 }
-                grid.tiles.push(Tile {
-                    rings,
-                    steps,
-                    lo,
-                    hi,
-                });
+                grid.tiles.push(Tile { rings, steps, lo, hi });
             }
         }
         grid
@@ -175,11 +160,7 @@ pub(crate) fn engage(
     let radius = scene.radius;
     let mut engagement = Engagement {
         cut_elements: 0,
-        force: if coefficients.is_some() {
-            vec![[0.0; 3]; grid.steps]
-        } else {
-            Vec::new()
-        },
+        force: if coefficients.is_some() { vec![[0.0; 3]; grid.steps] } else { Vec::new() },
     };
     let d_theta = std::f64::consts::FRAC_PI_2 / grid.rings as f64;
     let width = radius * d_theta;
@@ -191,9 +172,7 @@ pub(crate) fn engage(
     let mut union_hi = Vec3::repeat(f64::NEG_INFINITY);
     for tile in &grid.tiles {
         // Upper bound of ê_r·û over the tile.
-        let front: f64 = (0..3)
-            .map(|c| (u[c] * tile.lo[c]).max(u[c] * tile.hi[c]))
-            .sum();
+        let front: f64 = (0..3).map(|c| (u[c] * tile.lo[c]).max(u[c] * tile.hi[c])).sum();
         if front <= 0.0 {
             continue;
         }
@@ -213,18 +192,11 @@ pub(crate) fn engage(
     let mut pool = TileLists::default();
     scene.candidates(&union_lo, &union_hi, false, None, &mut pool);
     // A middle level: groups of neighbouring tiles share a narrower pool.
-    let group_of = |tile: &Tile| {
-        (
-            tile.rings.0 / (GROUP_RINGS * TILE_RINGS),
-            tile.steps.0 / (GROUP_STEPS * TILE_STEPS),
-        )
-    };
-    let mut groups: std::collections::BTreeMap<(usize, usize), (Vec3, Vec3)> =
-        std::collections::BTreeMap::new();
+    let group_of = |tile: &Tile| (tile.rings.0 / (GROUP_RINGS * TILE_RINGS), tile.steps.0 / (GROUP_STEPS * TILE_STEPS));
+    let mut groups: std::collections::BTreeMap<(usize, usize), (Vec3, Vec3)> = std::collections::BTreeMap::new();
     for (tile, _, lo, hi) in &kept {
-        let entry = groups
-            .entry(group_of(tile))
-            .or_insert((Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)));
+        let entry =
+            groups.entry(group_of(tile)).or_insert((Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)));
         entry.0 = entry.0.inf(lo);
         entry.1 = entry.1.sup(hi);
     }
@@ -270,11 +242,8 @@ pub(crate) fn engage(
                 // Flute j is at this azimuth when ψ index m = i − s_rot·j·N_t/N_f.
                 for j in 0..grid.flutes {
                     let shift = (j * flute_shift) % grid.steps;
-                    let m = if grid.sign < 0.0 {
-                        (i + shift) % grid.steps
-                    } else {
-                        (i + grid.steps - shift) % grid.steps
-                    };
+                    let m =
+                        if grid.sign < 0.0 { (i + shift) % grid.steps } else { (i + grid.steps - shift) % grid.steps };
                     let slot = &mut engagement.force[m];
                     slot[0] += d_force.x;
                     slot[1] += d_force.y;

@@ -55,15 +55,10 @@ pub mod stock;
 
 use std::sync::atomic::AtomicUsize;
 
-pub use answer::{
-    PassFlag, PassHistory, PassStatus, Predict, PredictSummary, PredictedPass, RoundSummary,
-    WorstPass,
-};
+pub use answer::{PassFlag, PassHistory, PassStatus, Predict, PredictSummary, PredictedPass, RoundSummary, WorstPass};
 pub use force::CuttingCoefficients;
 pub use pipeline::Control;
-pub use request::{
-    CorrectionOptions, Method, PathInput, PredictRequest, PrescribedDeflection, SpindleDirection,
-};
+pub use request::{CorrectionOptions, Method, PathInput, PredictRequest, PrescribedDeflection, SpindleDirection};
 pub use stock::Stock;
 
 use answer::Corrections;
@@ -96,11 +91,7 @@ const CLEARANCE: f64 = 5.0;
 /// `E_GCODE_UNSUPPORTED`, `E_GCODE_POSITION`, `E_ARC_NOT_CLOSED`, `E_ARC_RADIUS`,
 /// `E_TOO_MANY_LINES`, with the line number), `E_NO_FEED`, `E_NO_SPINDLE`, `E_NO_PASSES`,
 /// `E_TOO_MANY_PASSES`, `E_TOO_MANY_SPINDLE_SPEEDS`.
-pub fn solve(
-    request: &PredictRequest,
-    tool: &Tool,
-    mesh: Option<&[u8]>,
-) -> Result<Predict, SolverError> {
+pub fn solve(request: &PredictRequest, tool: &Tool, mesh: Option<&[u8]>) -> Result<Predict, SolverError> {
     solve_with(request, tool, mesh, &Control::default())
 }
 
@@ -126,8 +117,8 @@ pub fn solve_with(
     let mut current: Option<PathModel> = None;
     for round in 0..job.iterations {
         let path = current.as_ref().unwrap_or(&job.path);
-        let outcomes = pipeline::run_round(&context, path, control, &done, total_work)
-            .ok_or_else(pipeline::cancelled)?;
+        let outcomes =
+            pipeline::run_round(&context, path, control, &done, total_work).ok_or_else(pipeline::cancelled)?;
         let (step, _, round_ambiguous) = node_corrections(path, &outcomes, f64::INFINITY);
         for node in 0..node_count {
             total[node] += step[node];
@@ -138,13 +129,7 @@ pub fn solve_with(
         }
         rounds.push(outcomes);
         if round + 1 < job.iterations {
-            let moved: Vec<Vec3> = job
-                .path
-                .nodes
-                .iter()
-                .zip(&total)
-                .map(|(n, c)| n + c)
-                .collect();
+            let moved: Vec<Vec3> = job.path.nodes.iter().zip(&total).map(|(n, c)| n + c).collect();
             current = Some(job.path.with_nodes(moved, job.radius));
         }
     }
@@ -185,12 +170,7 @@ fn rapid_collisions(job: &Job) -> Option<Warning> {
             &mut pieces,
         );
         pieces.retain(|p| p.side == scene::Side::Before);
-        let earlier = scene::Scene::new(
-            &pieces,
-            Vec3::zeros(),
-            nalgebra::Matrix3::identity(),
-            radius,
-        );
+        let earlier = scene::Scene::new(&pieces, Vec3::zeros(), nalgebra::Matrix3::identity(), radius);
         let all: Vec<u32> = (0..earlier.before.len() as u32).collect();
         let hits = (0..=steps).any(|k| {
             let centre = a + (k as f64 / steps as f64) * (b - a);
@@ -209,8 +189,7 @@ fn rapid_collisions(job: &Job) -> Option<Warning> {
                     let q = centre + offset;
                     let mut hint = 0;
                     job.stock.contains(&q, earlier.eps)
-                        && earlier.cover(&q, scene::Side::Before, &all, &mut hint)
-                            == scene::Cover::Open
+                        && earlier.cover(&q, scene::Side::Before, &all, &mut hint) == scene::Cover::Open
                 })
         });
         if hits {
@@ -233,11 +212,7 @@ fn rapid_collisions(job: &Job) -> Option<Warning> {
 }
 
 /// Node corrections of one round (unclamped when `limit` is infinite).
-fn node_corrections(
-    path: &PathModel,
-    outcomes: &[Outcome],
-    limit: f64,
-) -> (Vec<Vec3>, Vec<bool>, Vec<bool>) {
+fn node_corrections(path: &PathModel, outcomes: &[Outcome], limit: f64) -> (Vec<Vec3>, Vec<bool>, Vec<bool>) {
     let count = path.nodes.len();
     let mut previous: Vec<Option<PassError>> = vec![None; count];
     let mut next: Vec<Option<PassError>> = vec![None; count];
@@ -245,10 +220,7 @@ fn node_corrections(
         let error = segment.pass.and_then(|p| {
             let o = &outcomes[p];
             match (o.status, o.error, o.normal) {
-                (PassStatus::Ok, Some(error), Some(n)) => Some(PassError {
-                    error,
-                    normal: array3(&n),
-                }),
+                (PassStatus::Ok, Some(error), Some(n)) => Some(PassError { error, normal: array3(&n) }),
                 _ => None,
             }
         });
@@ -268,13 +240,7 @@ fn node_corrections(
     (offsets, clamped, ambiguous)
 }
 
-fn assemble(
-    job: &Job,
-    rounds: &[Vec<Outcome>],
-    total: &[Vec3],
-    clamped: &[bool],
-    ambiguous: &[bool],
-) -> Predict {
+fn assemble(job: &Job, rounds: &[Vec<Outcome>], total: &[Vec3], clamped: &[bool], ambiguous: &[bool]) -> Predict {
     let path = &job.path;
     let first = &rounds[0];
     let residual = rounds.get(1);
@@ -316,10 +282,7 @@ fn assemble(
             history: outcome.history.clone(),
         });
     }
-    let errors: Vec<(usize, f64)> = passes
-        .iter()
-        .filter_map(|p| p.error.map(|e| (p.index, e)))
-        .collect();
+    let errors: Vec<(usize, f64)> = passes.iter().filter_map(|p| p.error.map(|e| (p.index, e))).collect();
     let count_status = |status: PassStatus| passes.iter().filter(|p| p.status == status).count();
     let mut worst = errors.clone();
     worst.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()).then(a.0.cmp(&b.0)));
@@ -343,14 +306,7 @@ fn assemble(
         max_error: values.iter().copied().reduce(f64::max),
         mean_error: (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64),
         rms_error: rms(&values),
-        worst: worst
-            .iter()
-            .map(|&(index, error)| WorstPass {
-                index,
-                line: passes[index].line,
-                error,
-            })
-            .collect(),
+        worst: worst.iter().map(|&(index, error)| WorstPass { index, line: passes[index].line, error }).collect(),
         max_correction: total.iter().map(Vec3::norm).fold(0.0, f64::max),
         clamped: clamped.iter().filter(|c| **c).count(),
         rounds: rounds.iter().map(round_summary).collect(),
@@ -380,8 +336,7 @@ fn degrees_0_360(radians: f64) -> f64 {
 }
 
 fn rms(values: &[f64]) -> Option<f64> {
-    (!values.is_empty())
-        .then(|| (values.iter().map(|e| e * e).sum::<f64>() / values.len() as f64).sqrt())
+    (!values.is_empty()).then(|| (values.iter().map(|e| e * e).sum::<f64>() / values.len() as f64).sqrt())
 }
 
 fn warnings(job: &Job) -> Vec<Warning> {
@@ -391,15 +346,10 @@ fn warnings(job: &Job) -> Vec<Warning> {
             (true, true) => None,
             (false, true) => Some("the tool has no stiffness"),
             (true, false) => Some("the request has no cutting coefficients"),
-            (false, false) => {
-                Some("the tool has no stiffness and the request no cutting coefficients")
-            }
+            (false, false) => Some("the tool has no stiffness and the request no cutting coefficients"),
         };
         if let Some(missing) = missing {
-            warnings.push(Warning::new(
-                "W_NO_DEFLECTION",
-                format!("{missing}: errors are the shape error alone"),
-            ));
+            warnings.push(Warning::new("W_NO_DEFLECTION", format!("{missing}: errors are the shape error alone")));
         }
     }
     warnings
@@ -433,14 +383,11 @@ pub fn corrected_program(
     let mismatch = || SolverError::input("path", "this answer was not computed from this request");
     match &request.path {
         PathInput::Gcode { program: text } => {
-            let read_options = ReadOptions {
-                block_delete: request.block_delete.unwrap_or(false),
-                ..ReadOptions::default()
-            };
+            let read_options =
+                ReadOptions { block_delete: request.block_delete.unwrap_or(false), ..ReadOptions::default() };
             let program = reader::read(text, "path.program", &read_options)?;
-            let corrected = |node: usize| {
-                corrections.nodes[node] + corrections.offsets[node] + corrections.reference_offset
-            };
+            let corrected =
+                |node: usize| corrections.nodes[node] + corrections.offsets[node] + corrections.reference_offset;
             let mut edits = Vec::new();
             let mut node = 0;
             while node < corrections.sources.len() {
@@ -454,9 +401,7 @@ pub fn corrected_program(
                 let Some(read_move) = program.moves.get(source.item) else {
                     return Err(mismatch());
                 };
-                if last >= corrections.sources.len()
-                    || corrections.sources[last].item != source.item
-                {
+                if last >= corrections.sources.len() || corrections.sources[last].item != source.item {
                     return Err(mismatch());
                 }
                 let moved = (node..=last).any(|n| corrections.offsets[n] != Vec3::zeros())
@@ -467,22 +412,13 @@ pub fn corrected_program(
                         MoveKind::Arc { centre, .. } if node > 0 => {
                             let (a, b, _) = read_move.modal.plane.axes();
                             let interior: Vec<Vec3> = (node..last).map(corrected).collect();
-                            let fitted = correct::refit_centre(
-                                &corrected(node - 1),
-                                &new_to,
-                                &interior,
-                                &vec3(centre),
-                                (a, b),
-                            );
+                            let fitted =
+                                correct::refit_centre(&corrected(node - 1), &new_to, &interior, &vec3(centre), (a, b));
                             Some(array3(&fitted))
                         }
                         _ => None,
                     };
-                    edits.push(MoveEdit {
-                        index: source.item,
-                        to: array3(&new_to),
-                        centre,
-                    });
+                    edits.push(MoveEdit { index: source.item, to: array3(&new_to), centre });
                 }
                 node = last + 1;
             }
@@ -492,22 +428,11 @@ pub fn corrected_program(
             if points.len() != corrections.nodes.len() {
                 return Err(mismatch());
             }
-            let corrected: Vec<Vec3> = points
-                .iter()
-                .zip(&corrections.offsets)
-                .map(|(p, c)| vec3(*p) + c)
-                .collect();
-            let feed = request
-                .feed
-                .ok_or_else(|| SolverError::input("feed", "feed is needed"))?;
-            let spindle_rpm = request
-                .spindle_rpm
-                .ok_or_else(|| SolverError::input("spindle_rpm", "spindle_rpm is needed"))?;
-            let safe_z = corrected
-                .iter()
-                .map(|p| p.z)
-                .fold(f64::NEG_INFINITY, f64::max)
-                + CLEARANCE;
+            let corrected: Vec<Vec3> = points.iter().zip(&corrections.offsets).map(|(p, c)| vec3(*p) + c).collect();
+            let feed = request.feed.ok_or_else(|| SolverError::input("feed", "feed is needed"))?;
+            let spindle_rpm =
+                request.spindle_rpm.ok_or_else(|| SolverError::input("spindle_rpm", "spindle_rpm is needed"))?;
+            let safe_z = corrected.iter().map(|p| p.z).fold(f64::NEG_INFINITY, f64::max) + CLEARANCE;
             let mut path = Toolpath::default();
             let first = corrected[0];
             path.rapid(Vec3::new(first.x, first.y, safe_z));

@@ -93,20 +93,12 @@ impl PathBuilder {
         self.move_to(point, None, Some(line))
     }
 
-    fn move_to(
-        &mut self,
-        point: Vec3,
-        source: Option<PassSource>,
-        rapid_line: Option<usize>,
-    ) -> usize {
+    fn move_to(&mut self, point: Vec3, source: Option<PassSource>, rapid_line: Option<usize>) -> usize {
         let start_node = self.nodes.len() - 1;
         let length = (point - self.nodes[start_node]).norm();
         self.nodes.push(point);
         let pass = source.map(|source| {
-            self.passes.push(Pass {
-                segment: self.segments.len(),
-                source,
-            });
+            self.passes.push(Pass { segment: self.segments.len(), source });
             self.passes.len() - 1
         });
         self.segments.push(Segment {
@@ -132,12 +124,7 @@ impl PathBuilder {
     /// Finishes the path; `cell` is the preferred grid cell size (the ball radius).
     pub(crate) fn build(self, cell: f64) -> PathModel {
         let grid = SegmentGrid::new(&self.nodes, &self.segments, cell);
-        PathModel {
-            nodes: self.nodes,
-            segments: self.segments,
-            passes: self.passes,
-            grid,
-        }
+        PathModel { nodes: self.nodes, segments: self.segments, passes: self.passes, grid }
     }
 }
 
@@ -167,11 +154,7 @@ impl PathModel {
                 index = next;
             } else {
                 let (a, b) = self.ends(index);
-                let t = if s.length > 0.0 {
-                    (sigma - s.sigma) / s.length
-                } else {
-                    0.0
-                };
+                let t = if s.length > 0.0 { (sigma - s.sigma) / s.length } else { 0.0 };
                 return Some(a + t * (b - a));
             }
         }
@@ -181,17 +164,11 @@ impl PathModel {
     /// side `reach` about `centre`, each once; `stamps` is per-thread scratch.
     pub(crate) fn near(&self, centre: &Vec3, reach: f64, stamps: &mut Stamps, out: &mut Vec<u32>) {
         stamps.next(self.segments.len());
-        self.grid.visit(
-            centre.x - reach,
-            centre.y - reach,
-            centre.x + reach,
-            centre.y + reach,
-            |index| {
-                if stamps.first_visit(index) {
-                    out.push(index);
-                }
-            },
-        );
+        self.grid.visit(centre.x - reach, centre.y - reach, centre.x + reach, centre.y + reach, |index| {
+            if stamps.first_visit(index) {
+                out.push(index);
+            }
+        });
     }
 
     /// The same path with its nodes moved (same segments and passes).
@@ -204,12 +181,7 @@ impl PathModel {
             sigma += s.length;
         }
         let grid = SegmentGrid::new(&nodes, &segments, cell);
-        Self {
-            nodes,
-            segments,
-            passes: self.passes.clone(),
-            grid,
-        }
+        Self { nodes, segments, passes: self.passes.clone(), grid }
     }
 }
 
@@ -268,21 +240,10 @@ impl SegmentGrid {
         }
         let width = (hi[0] - lo[0]).max(1e-9);
         let height = (hi[1] - lo[1]).max(1e-9);
-        let cell = preferred_cell
-            .max((width * height / MAX_CELLS as f64).sqrt())
-            .max(1e-6);
+        let cell = preferred_cell.max((width * height / MAX_CELLS as f64).sqrt()).max(1e-6);
         let nx = ((width / cell).floor() as usize + 1).min(MAX_CELLS);
-        let ny = ((height / cell).floor() as usize + 1)
-            .min(MAX_CELLS / nx.max(1))
-            .max(1);
-        let mut grid = Self {
-            origin: lo,
-            cell,
-            nx,
-            ny,
-            start: vec![0; nx * ny + 1],
-            items: Vec::new(),
-        };
+        let ny = ((height / cell).floor() as usize + 1).min(MAX_CELLS / nx.max(1)).max(1);
+        let mut grid = Self { origin: lo, cell, nx, ny, start: vec![0; nx * ny + 1], items: Vec::new() };
         let boxes: Vec<(usize, usize, usize, usize)> = segments
             .iter()
             .map(|s| {
@@ -346,13 +307,7 @@ mod tests {
     use super::*;
 
     fn source() -> PassSource {
-        PassSource {
-            line: None,
-            block_number: None,
-            feed: 1000.0,
-            spindle_rpm: 6000.0,
-            rotation_sign: -1.0,
-        }
+        PassSource { line: None, block_number: None, feed: 1000.0, spindle_rpm: 6000.0, rotation_sign: -1.0 }
     }
 
     #[test]
@@ -366,11 +321,7 @@ mod tests {
         }
         let path = builder.build(1.0);
         let mut stamps = Stamps::default();
-        for probe in [
-            Vec3::new(2.0, 2.0, 0.0),
-            Vec3::new(9.0, 0.0, 0.0),
-            Vec3::new(-5.0, 1.0, 0.0),
-        ] {
+        for probe in [Vec3::new(2.0, 2.0, 0.0), Vec3::new(9.0, 0.0, 0.0), Vec3::new(-5.0, 1.0, 0.0)] {
             let mut found = Vec::new();
             path.near(&probe, 1.2, &mut stamps, &mut found);
             let mut sorted = found.clone();

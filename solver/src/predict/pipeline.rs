@@ -37,10 +37,7 @@ pub struct Control<'a> {
 
 impl std::fmt::Debug for Control<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Control")
-            .field("progress", &self.progress.is_some())
-            .field("cancel", &self.cancel)
-            .finish()
+        f.debug_struct("Control").field("progress", &self.progress.is_some()).field("cancel", &self.cancel).finish()
     }
 }
 
@@ -133,20 +130,10 @@ impl<'a> Context<'a> {
             for &rpm in &job.spindle_speeds {
                 let (kx, out_x) = dynamics::kernel(&cx, rpm, job.steps);
                 let (ky, out_y) = dynamics::kernel(&cy, rpm, job.steps);
-                kernels.insert(
-                    rpm.to_bits(),
-                    SpindleKernels {
-                        kernels: (kx, ky),
-                        outside: out_x || out_y,
-                    },
-                );
+                kernels.insert(rpm.to_bits(), SpindleKernels { kernels: (kx, ky), outside: out_x || out_y });
             }
         }
-        Self {
-            job,
-            grids,
-            kernels,
-        }
+        Self { job, grids, kernels }
     }
 }
 
@@ -200,12 +187,7 @@ pub(crate) fn cancelled() -> SolverError {
 }
 
 /// The full pipeline for one pass.
-pub(crate) fn predict_pass(
-    context: &Context<'_>,
-    path: &PathModel,
-    index: usize,
-    scratch: &mut Scratch,
-) -> Outcome {
+pub(crate) fn predict_pass(context: &Context<'_>, path: &PathModel, index: usize, scratch: &mut Scratch) -> Outcome {
     let job = context.job;
     let radius = job.radius;
     let pass = path.passes[index];
@@ -230,22 +212,14 @@ pub(crate) fn predict_pass(
     let Some(grid) = context.grids[sign_slot(source.rotation_sign)].as_ref() else {
         return Outcome::empty(PassStatus::NoCut);
     };
-    let coefficients = if job.deflection.is_none() {
-        job.cutting.as_ref()
-    } else {
-        None
-    };
+    let coefficients = if job.deflection.is_none() { job.cutting.as_ref() } else { None };
     let mut pieces = Vec::new();
     // Stations: the middle first, then alternately ahead and behind (§3.3).
     let step = tooth_feed.max(length / 16.0);
     let mut stations = vec![0.5 * length];
     for m in 1..MAX_STATIONS {
         let offset = step * m.div_ceil(2) as f64;
-        let s = if m % 2 == 1 {
-            0.5 * length + offset
-        } else {
-            0.5 * length - offset
-        };
+        let s = if m % 2 == 1 { 0.5 * length + offset } else { 0.5 * length - offset };
         if (0.0..=length).contains(&s) {
             stations.push(s);
         }
@@ -257,26 +231,12 @@ pub(crate) fn predict_pass(
         let sigma = segment.sigma + s;
         scene::gather(
             path,
-            &scene::Query {
-                centre,
-                sigma,
-                gap,
-                radius,
-                reach: 2.0 * radius,
-                any_view: false,
-            },
+            &scene::Query { centre, sigma, gap, radius, reach: 2.0 * radius, any_view: false },
             scratch,
             &mut pieces,
         );
         let below = Scene::new(&pieces, centre, Matrix3::identity(), radius);
-        let engagement = force::engage(
-            grid,
-            &below,
-            &job.stock,
-            &feed_direction,
-            tooth_feed,
-            coefficients,
-        );
+        let engagement = force::engage(grid, &below, &job.stock, &feed_direction, tooth_feed, coefficients);
         if engagement.cut_elements > 0 {
             chosen = Some((s, centre, below, engagement));
             break;
@@ -301,15 +261,7 @@ pub(crate) fn predict_pass(
     let pixel = 2.0 * radius / f64::from(job.resolution);
     let (point, tip) = match job.method {
         Method::Sampling => {
-            let band = band(
-                path,
-                pass.segment,
-                &centre,
-                &feed_direction,
-                sigma,
-                gap,
-                pixel,
-            );
+            let band = band(path, pass.segment, &centre, &feed_direction, sigma, gap, pixel);
             let surface = sampling::sample(&below, &job.stock, &band);
             outcome.cut_count = surface.cut_samples;
             outcome.finished_count = surface.finished_samples;
@@ -325,23 +277,12 @@ pub(crate) fn predict_pass(
             if surface.finished_samples < MIN_FINISHED_PIXELS && surface.point.is_some() {
                 outcome.flags.push(PassFlag::LowConfidence);
             }
-            let tip = surface
-                .point
-                .is_some_and(|c| (c - centre).xy().norm() < 0.5 * pixel);
+            let tip = surface.point.is_some_and(|c| (c - centre).xy().norm() < 0.5 * pixel);
             (surface.point, tip)
         }
         Method::DepthBuffer => {
-            let image = depth_buffer(
-                context,
-                path,
-                &pieces,
-                &centre,
-                &feed_direction,
-                sigma,
-                gap,
-                &mut outcome,
-                scratch,
-            );
+            let image =
+                depth_buffer(context, path, &pieces, &centre, &feed_direction, sigma, gap, &mut outcome, scratch);
             if no_engagement && !image.retraced {
                 return Outcome::empty(PassStatus::NoCut);
             }
@@ -366,12 +307,7 @@ pub(crate) fn predict_pass(
     } else {
         let offset = point - centre;
         let theta = (-offset.z / radius).clamp(-1.0, 1.0).acos();
-        (
-            point,
-            theta,
-            Some(offset.y.atan2(offset.x)),
-            -offset / radius,
-        )
+        (point, theta, Some(offset.y.atan2(offset.x)), -offset / radius)
     };
     let sign = source.rotation_sign;
     let rotation_angle = azimuth.map(|phi| {
@@ -387,37 +323,23 @@ pub(crate) fn predict_pass(
     let mut history_deflection: Option<Vec<[f64; 2]>> = None;
     let deflection: Option<[f64; 2]> = if let Some(prescribed) = &job.deflection {
         rotation_angle.map_or(Some([0.0, 0.0]), |psi| Some(prescribed_at(prescribed, psi)))
-    } else if let (Some(_), Some(spindle)) = (
-        coefficients,
-        context.kernels.get(&source.spindle_rpm.to_bits()),
-    ) {
+    } else if let (Some(_), Some(spindle)) = (coefficients, context.kernels.get(&source.spindle_rpm.to_bits())) {
         if spindle.outside {
             outcome.flags.push(PassFlag::OutsideFrfBand);
         }
-        if force_history
-            .iter()
-            .all(|f| f[0] == 0.0 && f[1] == 0.0 && f[2] == 0.0)
-        {
+        if force_history.iter().all(|f| f[0] == 0.0 && f[1] == 0.0 && f[2] == 0.0) {
             outcome.flags.push(PassFlag::NoLoad);
         }
         let kernels = &spindle.kernels;
         if job.history.contains(&index) {
             history_deflection = Some(dynamics::deflection_history(kernels, force_history));
         }
-        Some(rotation_angle.map_or([0.0, 0.0], |psi| {
-            dynamics::deflection_at(kernels, force_history, psi)
-        }))
+        Some(rotation_angle.map_or([0.0, 0.0], |psi| dynamics::deflection_at(kernels, force_history, psi)))
     } else {
         outcome.flags.push(PassFlag::NoDeflection);
         None
     };
-    let error_deflection = deflection.map(|d| {
-        if azimuth.is_none() {
-            0.0
-        } else {
-            d[0] * normal.x + d[1] * normal.y
-        }
-    });
+    let error_deflection = deflection.map(|d| if azimuth.is_none() { 0.0 } else { d[0] * normal.x + d[1] * normal.y });
     outcome.error_shape = Some(error_shape);
     outcome.error_deflection = error_deflection;
     outcome.error = Some(error_shape + error_deflection.unwrap_or(0.0));
@@ -444,10 +366,7 @@ fn prescribed_at(prescribed: &super::request::PrescribedDeflection, psi: f64) ->
     let k0 = (position.floor() as usize).min(n - 1);
     let k1 = (k0 + 1) % n;
     let t = position - k0 as f64;
-    [
-        (1.0 - t) * prescribed.x[k0] + t * prescribed.x[k1],
-        (1.0 - t) * prescribed.y[k0] + t * prescribed.y[k1],
-    ]
+    [(1.0 - t) * prescribed.x[k0] + t * prescribed.x[k1], (1.0 - t) * prescribed.y[k0] + t * prescribed.y[k1]]
 }
 
 /// The sampling band: |a| ≤ g/2 on each side where the path runs straight through the gap end
@@ -463,9 +382,8 @@ fn band(
 ) -> Band {
     let radius_scale = centre.norm().max(1.0);
     let straight = |sign: f64| {
-        path.point_at(segment, sigma + sign * gap).is_some_and(|p| {
-            (p - (centre + sign * gap * feed_direction)).norm() <= 1e-9 * radius_scale
-        })
+        path.point_at(segment, sigma + sign * gap)
+            .is_some_and(|p| (p - (centre + sign * gap * feed_direction)).norm() <= 1e-9 * radius_scale)
     };
     let (back, front) = (straight(-1.0), straight(1.0));
     let both = back && front;
@@ -473,11 +391,7 @@ fn band(
         axis: *feed_direction,
         a_lo: if back { -0.5 * gap } else { f64::NEG_INFINITY },
         a_hi: if front { 0.5 * gap } else { f64::INFINITY },
-        row_spacing: if both {
-            pixel
-        } else {
-            (0.5 * gap).clamp(pixel, 4.0 * pixel)
-        },
+        row_spacing: if both { pixel } else { (0.5 * gap).clamp(pixel, 4.0 * pixel) },
         spacing: pixel,
     }
 }
@@ -487,11 +401,7 @@ fn band(
 fn view_frame(view: &Vec3, feed_direction: &Vec3) -> Matrix3<f64> {
     let mut up = feed_direction - feed_direction.dot(view) * view;
     if up.norm() < 1e-9 {
-        let helper = if view.x.abs() < 0.9 {
-            Vec3::x()
-        } else {
-            Vec3::y()
-        };
+        let helper = if view.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
         up = helper - helper.dot(view) * view;
     }
     let up = up.normalize();
@@ -517,19 +427,12 @@ fn depth_buffer(
     let pixels = job.resolution as usize;
     let up = Vec3::z();
     let below_scene = Scene::new(pieces, *centre, view_frame(&up, feed_direction), radius);
-    let full = Window {
-        centre: [0.0, 0.0],
-        side: 2.0 * radius,
-        pixels,
-        area_weighted: false,
-    };
+    let full = Window { centre: [0.0, 0.0], side: 2.0 * radius, pixels, area_weighted: false };
     let below = render::render(&below_scene, &job.stock, &full);
     outcome.cut_count = below.cut_pixels;
     outcome.finished_count = below.finished_pixels;
     outcome.view = Some(up);
-    let theta = below
-        .point
-        .map(|c| (-(c - centre).z / radius).clamp(-1.0, 1.0).acos());
+    let theta = below.point.map(|c| (-(c - centre).z / radius).clamp(-1.0, 1.0).acos());
     let needs_correction = below.cut_pixels > 0
         && (below.point.is_none()
             || theta.is_some_and(|t| t > job.view_threshold)
@@ -552,22 +455,12 @@ fn depth_buffer(
     let mut wide = Vec::new();
     scene::gather(
         path,
-        &scene::Query {
-            centre: *centre,
-            sigma,
-            gap,
-            radius,
-            reach: 5.0 * radius,
-            any_view: true,
-        },
+        &scene::Query { centre: *centre, sigma, gap, radius, reach: 5.0 * radius, any_view: true },
         scratch,
         &mut wide,
     );
     let rotated_scene = Scene::new(&wide, *centre, view_frame(&view, feed_direction), radius);
-    let rotated_window = Window {
-        area_weighted: true,
-        ..full
-    };
+    let rotated_window = Window { area_weighted: true, ..full };
     let mut image = render::render(&rotated_scene, &job.stock, &rotated_window);
     outcome.flags.push(PassFlag::ViewCorrected);
     outcome.view = Some(view);

@@ -92,27 +92,17 @@ pub(crate) fn render(scene: &Scene, stock: &StockModel, window: &Window) -> Imag
         for tile_i in 0..tiles {
             let (i0, i1) = (tile_i * TILE, ((tile_i + 1) * TILE).min(n));
             let (j0, j1) = (tile_j * TILE, ((tile_j + 1) * TILE).min(n));
-            let (x_lo, x_hi) = (
-                coordinate(i0, window.centre[0]),
-                coordinate(i1 - 1, window.centre[0]),
-            );
-            let (y_lo, y_hi) = (
-                coordinate(j0, window.centre[1]),
-                coordinate(j1 - 1, window.centre[1]),
-            );
+            let (x_lo, x_hi) = (coordinate(i0, window.centre[0]), coordinate(i1 - 1, window.centre[0]));
+            let (y_lo, y_hi) = (coordinate(j0, window.centre[1]), coordinate(j1 - 1, window.centre[1]));
             let nearest_x = 0.0_f64.clamp(x_lo, x_hi);
             let nearest_y = 0.0_f64.clamp(y_lo, y_hi);
             let rho_min = nearest_x.hypot(nearest_y);
             if rho_min > radius {
                 continue;
             }
-            let rho_max = (x_lo.abs().max(x_hi.abs()))
-                .hypot(y_lo.abs().max(y_hi.abs()))
-                .min(radius);
-            let lo = Vec3::new(x_lo, y_lo, -(r2 - rho_min * rho_min).max(0.0).sqrt())
-                - Vec3::repeat(scene.eps);
-            let hi = Vec3::new(x_hi, y_hi, -(r2 - rho_max * rho_max).max(0.0).sqrt())
-                + Vec3::repeat(scene.eps);
+            let rho_max = (x_lo.abs().max(x_hi.abs())).hypot(y_lo.abs().max(y_hi.abs())).min(radius);
+            let lo = Vec3::new(x_lo, y_lo, -(r2 - rho_min * rho_min).max(0.0).sqrt()) - Vec3::repeat(scene.eps);
+            let hi = Vec3::new(x_hi, y_hi, -(r2 - rho_max * rho_max).max(0.0).sqrt()) + Vec3::repeat(scene.eps);
             let (world_lo, _) = scene.world_box(&lo, &hi);
             if world_lo.z > scene.centre.z {
                 continue;
@@ -165,11 +155,7 @@ pub(crate) fn render(scene: &Scene, stock: &StockModel, window: &Window) -> Imag
                         if rho2.sqrt() > rim_radius {
                             image.rim = true;
                         }
-                        let weight = if window.area_weighted {
-                            radius / (-z).max(1e-3 * radius)
-                        } else {
-                            1.0
-                        };
+                        let weight = if window.area_weighted { radius / (-z).max(1e-3 * radius) } else { 1.0 };
                         finished.push(Finished { i, j, x, y, weight });
                     }
                 }
@@ -181,11 +167,7 @@ pub(crate) fn render(scene: &Scene, stock: &StockModel, window: &Window) -> Imag
         return image;
     }
     // Regions of S: 4-connected pixel components; the largest is the representative (§5 E8).
-    let index: HashMap<(usize, usize), usize> = finished
-        .iter()
-        .enumerate()
-        .map(|(k, f)| ((f.i, f.j), k))
-        .collect();
+    let index: HashMap<(usize, usize), usize> = finished.iter().enumerate().map(|(k, f)| ((f.i, f.j), k)).collect();
     let mut parent: Vec<usize> = (0..finished.len()).collect();
     fn find(parent: &mut [usize], mut x: usize) -> usize {
         while parent[x] != x {
@@ -219,10 +201,7 @@ pub(crate) fn render(scene: &Scene, stock: &StockModel, window: &Window) -> Imag
         .filter(|&k| parent[k] == k)
         .max_by(|&a, &b| count_of[a].cmp(&count_of[b]).then(b.cmp(&a)))
         .unwrap_or(0);
-    let (x, y) = (
-        sum_of[best][0] / weight_of[best],
-        sum_of[best][1] / weight_of[best],
-    );
+    let (x, y) = (sum_of[best][0] / weight_of[best], sum_of[best][1] / weight_of[best]);
     let rho2 = (x * x + y * y).min(r2);
     let z = -(r2 - rho2).sqrt();
     image.centroid_offset = rho2.sqrt();

@@ -227,21 +227,12 @@ fn optional_positive(field: &str, value: Option<f64>, default: f64) -> Result<f6
     value.map_or(Ok(default), |v| positive(field, v))
 }
 
-fn range_u32(
-    field: &str,
-    value: Option<u32>,
-    default: u32,
-    lo: u32,
-    hi: u32,
-) -> Result<u32, SolverError> {
+fn range_u32(field: &str, value: Option<u32>, default: u32, lo: u32, hi: u32) -> Result<u32, SolverError> {
     let v = value.unwrap_or(default);
     if (lo..=hi).contains(&v) {
         Ok(v)
     } else {
-        Err(SolverError::input(
-            field,
-            format!("{field} must be {lo} to {hi} (got {v})"),
-        ))
+        Err(SolverError::input(field, format!("{field} must be {lo} to {hi} (got {v})")))
     }
 }
 
@@ -252,10 +243,7 @@ impl PredictRequest {
         if tool.kind != ToolKind::Ball {
             return Err(SolverError::new(
                 "E_TOOL_KIND",
-                format!(
-                    "error prediction needs a ball end mill, not a {} tool",
-                    tool.kind.as_str()
-                ),
+                format!("error prediction needs a ball end mill, not a {} tool", tool.kind.as_str()),
             )
             .at("tool.kind"));
         }
@@ -268,18 +256,11 @@ impl PredictRequest {
         };
         let radius = tool.radius;
         let method = self.method;
-        let resolution = range_u32(
-            "resolution",
-            self.resolution,
-            DEFAULT_RESOLUTION,
-            16,
-            MAX_SAMPLING_RESOLUTION,
-        )?;
+        let resolution = range_u32("resolution", self.resolution, DEFAULT_RESOLUTION, 16, MAX_SAMPLING_RESOLUTION)?;
         if method == Method::DepthBuffer {
             let bytes = u64::from(resolution).pow(2) * DEPTH_BUFFER_BYTES_PER_PIXEL;
             if bytes > MAX_DEPTH_BUFFER_BYTES {
-                let limit =
-                    ((MAX_DEPTH_BUFFER_BYTES / DEPTH_BUFFER_BYTES_PER_PIXEL) as f64).sqrt() as u64;
+                let limit = ((MAX_DEPTH_BUFFER_BYTES / DEPTH_BUFFER_BYTES_PER_PIXEL) as f64).sqrt() as u64;
                 return Err(SolverError::new(
                     "E_RESOLUTION_LIMIT",
                     format!(
@@ -296,10 +277,7 @@ impl PredictRequest {
             None => DEFAULT_VIEW_CORRECTION_DEG,
             Some(v) => {
                 if !(0.0..=90.0).contains(&finite("view_correction_deg", v)?) {
-                    return Err(SolverError::input(
-                        "view_correction_deg",
-                        "view_correction_deg must lie in [0, 90]",
-                    ));
+                    return Err(SolverError::input("view_correction_deg", "view_correction_deg must lie in [0, 90]"));
                 }
                 v
             }
@@ -307,38 +285,19 @@ impl PredictRequest {
         .to_radians();
         let flute_zero = finite("flute_zero_deg", self.flute_zero_deg.unwrap_or(0.0))?.to_radians();
         let flutes = tool.flutes as usize;
-        let steps = range_u32(
-            "samples_per_revolution",
-            self.samples_per_revolution,
-            DEFAULT_STEPS,
-            36,
-            4096,
-        )? as usize;
+        let steps = range_u32("samples_per_revolution", self.samples_per_revolution, DEFAULT_STEPS, 36, 4096)? as usize;
         let steps = steps.div_ceil(flutes) * flutes;
-        let edge_elements = range_u32(
-            "edge_elements",
-            self.edge_elements,
-            DEFAULT_EDGE_ELEMENTS,
-            9,
-            720,
-        )? as usize;
-        let arc_tolerance =
-            optional_positive("arc_tolerance", self.arc_tolerance, DEFAULT_ARC_TOLERANCE)?;
+        let edge_elements = range_u32("edge_elements", self.edge_elements, DEFAULT_EDGE_ELEMENTS, 9, 720)? as usize;
+        let arc_tolerance = optional_positive("arc_tolerance", self.arc_tolerance, DEFAULT_ARC_TOLERANCE)?;
         if let Some(cutting) = &self.cutting {
             cutting.validate("cutting")?;
         }
         if let Some(prescribed) = &self.deflection {
             if prescribed.x.is_empty() || prescribed.x.len() > 100_000 {
-                return Err(SolverError::input(
-                    "deflection.x",
-                    "give 1 to 100000 deflection values per revolution",
-                ));
+                return Err(SolverError::input("deflection.x", "give 1 to 100000 deflection values per revolution"));
             }
             if prescribed.y.len() != prescribed.x.len() {
-                return Err(SolverError::input(
-                    "deflection.y",
-                    "deflection.y needs as many values as deflection.x",
-                ));
+                return Err(SolverError::input("deflection.y", "deflection.y needs as many values as deflection.x"));
             }
             for (axis, values) in [("x", &prescribed.x), ("y", &prescribed.y)] {
                 for (k, v) in values.iter().enumerate() {
@@ -349,27 +308,17 @@ impl PredictRequest {
         let (max_correction, iterations) = match &self.correction {
             None => (DEFAULT_MAX_CORRECTION, 1),
             Some(c) => (
-                optional_positive(
-                    "correction.max_correction",
-                    c.max_correction,
-                    DEFAULT_MAX_CORRECTION,
-                )?,
+                optional_positive("correction.max_correction", c.max_correction, DEFAULT_MAX_CORRECTION)?,
                 range_u32("correction.iterations", c.iterations, 1, 1, 3)?,
             ),
         };
         let history = self.history.clone().unwrap_or_default();
         if history.len() > MAX_HISTORIES {
-            return Err(SolverError::input(
-                "history",
-                format!("ask for at most {MAX_HISTORIES} pass histories"),
-            ));
+            return Err(SolverError::input("history", format!("ask for at most {MAX_HISTORIES} pass histories")));
         }
         let defaults = Defaults {
             feed: self.feed.map(|f| positive("feed", f)).transpose()?,
-            spindle_rpm: self
-                .spindle_rpm
-                .map(|s| positive("spindle_rpm", s))
-                .transpose()?,
+            spindle_rpm: self.spindle_rpm.map(|s| positive("spindle_rpm", s)).transpose()?,
             sign: match self.spindle_direction.unwrap_or_default() {
                 SpindleDirection::Cw => -1.0,
                 SpindleDirection::Ccw => 1.0,
@@ -386,24 +335,15 @@ impl PredictRequest {
         match &self.path {
             PathInput::Points { points } => {
                 if points.len() < 2 || points.len() > MAX_PASSES + 1 {
-                    return Err(SolverError::input(
-                        "path.points",
-                        format!("give 2 to {} points", MAX_PASSES + 1),
-                    ));
+                    return Err(SolverError::input("path.points", format!("give 2 to {} points", MAX_PASSES + 1)));
                 }
-                let feed = defaults.feed.ok_or_else(|| {
-                    SolverError::input("feed", "a path of points needs feed (mm/min)")
-                })?;
-                let spindle_rpm = defaults.spindle_rpm.ok_or_else(|| {
-                    SolverError::input("spindle_rpm", "a path of points needs spindle_rpm")
-                })?;
-                let source = PassSource {
-                    line: None,
-                    block_number: None,
-                    feed,
-                    spindle_rpm,
-                    rotation_sign: defaults.sign,
-                };
+                let feed =
+                    defaults.feed.ok_or_else(|| SolverError::input("feed", "a path of points needs feed (mm/min)"))?;
+                let spindle_rpm = defaults
+                    .spindle_rpm
+                    .ok_or_else(|| SolverError::input("spindle_rpm", "a path of points needs spindle_rpm"))?;
+                let source =
+                    PassSource { line: None, block_number: None, feed, spindle_rpm, rotation_sign: defaults.sign };
                 for (index, p) in points.iter().enumerate() {
                     for (axis, v) in p.iter().enumerate() {
                         finite(&format!("path.points[{index}][{axis}]"), *v)?;
@@ -414,43 +354,25 @@ impl PredictRequest {
                     } else {
                         builder.to(centre, Some(source));
                     }
-                    node_sources.push(NodeSource {
-                        item: index,
-                        chord: 0,
-                        chords: 1,
-                    });
+                    node_sources.push(NodeSource { item: index, chord: 0, chords: 1 });
                 }
             }
             PathInput::Gcode { program: text } => {
-                let options = ReadOptions {
-                    block_delete: self.block_delete.unwrap_or(false),
-                    ..ReadOptions::default()
-                };
+                let options =
+                    ReadOptions { block_delete: self.block_delete.unwrap_or(false), ..ReadOptions::default() };
                 let read = reader::read(text, "path.program", &options)?;
-                build_from_program(
-                    &read,
-                    &defaults,
-                    arc_tolerance,
-                    &centre_of,
-                    &mut builder,
-                    &mut node_sources,
-                )?;
+                build_from_program(&read, &defaults, arc_tolerance, &centre_of, &mut builder, &mut node_sources)?;
             }
         }
         if builder.pass_count() == 0 {
-            return Err(SolverError::new(
-                "E_NO_PASSES",
-                "the tool path has no feed moves from a known position",
-            )
-            .at("path"));
+            return Err(
+                SolverError::new("E_NO_PASSES", "the tool path has no feed moves from a known position").at("path")
+            );
         }
         if builder.pass_count() > MAX_PASSES {
             return Err(SolverError::new(
                 "E_TOO_MANY_PASSES",
-                format!(
-                    "the tool path has {} passes; the limit is {MAX_PASSES}",
-                    builder.pass_count()
-                ),
+                format!("the tool path has {} passes; the limit is {MAX_PASSES}", builder.pass_count()),
             )
             .at("path"));
         }
@@ -469,26 +391,19 @@ impl PredictRequest {
                 if from > to || to > path.passes.len() {
                     return Err(SolverError::input(
                         "pass_range",
-                        format!(
-                            "pass_range must satisfy from ≤ to ≤ {} (the pass count)",
-                            path.passes.len()
-                        ),
+                        format!("pass_range must satisfy from ≤ to ≤ {} (the pass count)", path.passes.len()),
                     ));
                 }
                 from..to
             }
         };
-        let mut spindle_speeds: Vec<f64> =
-            path.passes.iter().map(|p| p.source.spindle_rpm).collect();
+        let mut spindle_speeds: Vec<f64> = path.passes.iter().map(|p| p.source.spindle_rpm).collect();
         spindle_speeds.sort_by(f64::total_cmp);
         spindle_speeds.dedup();
         if spindle_speeds.len() > MAX_SPINDLE_SPEEDS {
             return Err(SolverError::new(
                 "E_TOO_MANY_SPINDLE_SPEEDS",
-                format!(
-                    "the program uses {} spindle speeds; the limit is {MAX_SPINDLE_SPEEDS}",
-                    spindle_speeds.len()
-                ),
+                format!("the program uses {} spindle speeds; the limit is {MAX_SPINDLE_SPEEDS}", spindle_speeds.len()),
             )
             .at("path"));
         }
@@ -550,7 +465,9 @@ fn build_from_program(
             {
                 return Err(SolverError::new(
                     "E_GCODE_UNSUPPORTED",
-                    format!("line {line}: the program changes from tool {first} to tool {this}; predict one tool at a time"),
+                    format!(
+                        "line {line}: the program changes from tool {first} to tool {this}; predict one tool at a time"
+                    ),
                 )
                 .at(field));
             }
@@ -560,7 +477,9 @@ fn build_from_program(
             if cutting && read_move.to_xyz().is_none() {
                 return Err(SolverError::new(
                     "E_GCODE_POSITION",
-                    format!("line {line}: a feed move to a position the program has not fully set (give X, Y and Z first)"),
+                    format!(
+                        "line {line}: a feed move to a position the program has not fully set (give X, Y and Z first)"
+                    ),
                 )
                 .at(field));
             }
@@ -568,21 +487,13 @@ fn build_from_program(
             current = read_move.to_xyz();
             if let Some(to) = current {
                 builder.start(centre_of(vec3(to)));
-                node_sources.push(NodeSource {
-                    item: index,
-                    chord: 0,
-                    chords: 1,
-                });
+                node_sources.push(NodeSource { item: index, chord: 0, chords: 1 });
             }
             continue;
         };
         if current != Some(from) || !builder.is_open() {
             builder.start(centre_of(vec3(from)));
-            node_sources.push(NodeSource {
-                item: index,
-                chord: 0,
-                chords: 0,
-            });
+            node_sources.push(NodeSource { item: index, chord: 0, chords: 0 });
         }
         let source = if cutting {
             let feed = read_move.modal.feed.or(defaults.feed).ok_or_else(|| {
@@ -634,11 +545,7 @@ fn build_from_program(
             } else {
                 builder.rapid_to(centre_of(vec3(*p)), line);
             }
-            node_sources.push(NodeSource {
-                item: index,
-                chord,
-                chords,
-            });
+            node_sources.push(NodeSource { item: index, chord, chords });
         }
         debug_assert_eq!(node_sources.len(), builder.node_count());
         current = Some(to);

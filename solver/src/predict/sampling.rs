@@ -101,14 +101,7 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
     let a_lo = band.a_lo.max(-radius);
     let a_hi = band.a_hi.min(radius);
     let span = a_hi - a_lo;
-    let empty = Surface {
-        point: None,
-        cut_samples: 0,
-        finished_samples: 0,
-        area: 0.0,
-        regions: 0,
-        retraced: false,
-    };
+    let empty = Surface { point: None, cut_samples: 0, finished_samples: 0, area: 0.0, regions: 0, retraced: false };
     if span <= 0.0 {
         return empty;
     }
@@ -120,11 +113,7 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
             let rho = (radius * radius - a * a).max(0.0).sqrt();
             // Lower hemisphere: a·w_z − ρ·tilt·cos α ≤ 0.
             let (lo, hi, full) = if tilt < 1e-12 || rho <= 0.0 {
-                if a * w.z <= 0.0 {
-                    (-std::f64::consts::PI, std::f64::consts::PI, true)
-                } else {
-                    (0.0, 0.0, false)
-                }
+                if a * w.z <= 0.0 { (-std::f64::consts::PI, std::f64::consts::PI, true) } else { (0.0, 0.0, false) }
             } else {
                 let c = a * w.z / (rho * tilt);
                 if c > 1.0 {
@@ -136,28 +125,19 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
                     (-limit, limit, false)
                 }
             };
-            let count = if hi > lo && rho > 0.0 {
-                ((hi - lo) * rho / band.spacing).ceil().max(1.0) as usize
-            } else {
-                0
-            };
+            let count =
+                if hi > lo && rho > 0.0 { ((hi - lo) * rho / band.spacing).ceil().max(1.0) as usize } else { 0 };
             Row {
                 a,
                 rho,
                 alpha_lo: lo,
-                step: if count > 0 {
-                    (hi - lo) / count as f64
-                } else {
-                    0.0
-                },
+                step: if count > 0 { (hi - lo) / count as f64 } else { 0.0 },
                 count,
                 full_circle: full,
             }
         })
         .collect();
-    let point = |row: &Row, alpha: f64| -> Vec3 {
-        row.a * w + row.rho * (alpha.cos() * d0 + alpha.sin() * d1)
-    };
+    let point = |row: &Row, alpha: f64| -> Vec3 { row.a * w + row.rho * (alpha.cos() * d0 + alpha.sin() * d1) };
 
     let mut runs: Vec<Run> = Vec::new();
     let mut cut_samples = 0;
@@ -169,45 +149,25 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
         let block = &rows[block_start..(block_start + ROW_BLOCK).min(rows.len())];
         block_points.clear();
         for row in block {
-            block_points.push(
-                (0..row.count)
-                    .map(|i| point(row, row.alpha_lo + (i as f64 + 0.5) * row.step))
-                    .collect(),
-            );
+            block_points.push((0..row.count).map(|i| point(row, row.alpha_lo + (i as f64 + 0.5) * row.step)).collect());
         }
         // Tiles: the same α window across the block's rows.
-        let alpha_min = block
-            .iter()
-            .map(|r| r.alpha_lo)
-            .fold(f64::INFINITY, f64::min);
-        let alpha_max = block
-            .iter()
-            .map(|r| r.alpha_lo + r.step * r.count as f64)
-            .fold(f64::NEG_INFINITY, f64::max);
-        let step_min = block
-            .iter()
-            .filter(|r| r.count > 0)
-            .map(|r| r.step)
-            .fold(f64::INFINITY, f64::min);
+        let alpha_min = block.iter().map(|r| r.alpha_lo).fold(f64::INFINITY, f64::min);
+        let alpha_max = block.iter().map(|r| r.alpha_lo + r.step * r.count as f64).fold(f64::NEG_INFINITY, f64::max);
+        let step_min = block.iter().filter(|r| r.count > 0).map(|r| r.step).fold(f64::INFINITY, f64::min);
         if !step_min.is_finite() || alpha_max <= alpha_min {
             continue;
         }
         let tile_width = step_min * TILE as f64;
         let tile_count = ((alpha_max - alpha_min) / tile_width).ceil().max(1.0) as usize;
-        let mut row_states: Vec<Vec<SampleState>> = block
-            .iter()
-            .map(|r| vec![SampleState::Air; r.count])
-            .collect();
+        let mut row_states: Vec<Vec<SampleState>> = block.iter().map(|r| vec![SampleState::Air; r.count]).collect();
         let mut tile_of: Vec<Vec<usize>> = block.iter().map(|r| vec![0; r.count]).collect();
         // Tile boxes and their place relative to the stock, then the capsules near all of them.
         let mut boxes: Vec<Option<TileBox>> = Vec::with_capacity(tile_count);
         let mut union_lo = Vec3::repeat(f64::INFINITY);
         let mut union_hi = Vec3::repeat(f64::NEG_INFINITY);
         for tile in 0..tile_count {
-            let (t_lo, t_hi) = (
-                alpha_min + tile as f64 * tile_width,
-                alpha_min + (tile + 1) as f64 * tile_width,
-            );
+            let (t_lo, t_hi) = (alpha_min + tile as f64 * tile_width, alpha_min + (tile + 1) as f64 * tile_width);
             let mut lo = Vec3::repeat(f64::INFINITY);
             let mut hi = Vec3::repeat(f64::NEG_INFINITY);
             let mut members: Vec<(usize, usize)> = Vec::new();
@@ -216,8 +176,7 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
                     continue;
                 }
                 let first = (((t_lo - row.alpha_lo) / row.step).ceil().max(0.0)) as usize;
-                let last =
-                    (((t_hi - row.alpha_lo) / row.step).ceil().max(0.0) as usize).min(row.count);
+                let last = (((t_hi - row.alpha_lo) / row.step).ceil().max(0.0) as usize).min(row.count);
                 for (i, p) in block_points[r].iter().enumerate().take(last).skip(first) {
                     lo = lo.inf(p);
                     hi = hi.sup(p);
@@ -238,12 +197,7 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
             }
             union_lo = union_lo.inf(&lo);
             union_hi = union_hi.sup(&hi);
-            boxes.push(Some(TileBox {
-                lo,
-                hi,
-                region,
-                members,
-            }));
+            boxes.push(Some(TileBox { lo, hi, region, members }));
         }
         let mut pool = TileLists::default();
         if union_lo.x.is_finite() {
@@ -251,13 +205,7 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
         }
         let mut tile_lists: Vec<TileLists> = Vec::with_capacity(tile_count);
         for (tile, entry) in boxes.into_iter().enumerate() {
-            let Some(TileBox {
-                lo,
-                hi,
-                region,
-                members,
-            }) = entry
-            else {
+            let Some(TileBox { lo, hi, region, members }) = entry else {
                 tile_lists.push(TileLists::default());
                 continue;
             };
@@ -312,30 +260,18 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
                     }
                     0.5 * (good + bad)
                 };
-                let start = if first == 0 {
-                    row.alpha_lo
-                } else {
-                    refine(first, alpha_at(first - 1))
-                };
+                let start = if first == 0 { row.alpha_lo } else { refine(first, alpha_at(first - 1)) };
                 let end = if last + 1 == row.count {
                     row.alpha_lo + row.step * row.count as f64
                 } else {
                     refine(last, alpha_at(last + 1))
                 };
-                runs.push(Run {
-                    row: row_index,
-                    start,
-                    end,
-                });
+                runs.push(Run { row: row_index, start, end });
             }
         }
     }
     if runs.is_empty() {
-        return Surface {
-            cut_samples,
-            retraced,
-            ..empty
-        };
+        return Surface { cut_samples, retraced, ..empty };
     }
 
     // Regions: runs overlapping in α on neighbouring rows (and across ±π on full rows).
@@ -362,8 +298,7 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
             }
             let same_row_wrap = q.row == p.row
                 && rows[p.row].full_circle
-                && ((p.start <= -pi + 1e-12 && q.end >= pi - 1e-12)
-                    || (q.start <= -pi + 1e-12 && p.end >= pi - 1e-12));
+                && ((p.start <= -pi + 1e-12 && q.end >= pi - 1e-12) || (q.start <= -pi + 1e-12 && p.end >= pi - 1e-12));
             let neighbours = q.row == p.row + 1 && p.start < q.end && q.start < p.end;
             if same_row_wrap || neighbours {
                 union(&mut parent, i, j);
@@ -380,13 +315,9 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
         area_of[root] += weight * width;
         sum_of[root] += weight
             * (width * row.a * w
-                + row.rho
-                    * ((run.end.sin() - run.start.sin()) * d0
-                        + (run.start.cos() - run.end.cos()) * d1));
+                + row.rho * ((run.end.sin() - run.start.sin()) * d0 + (run.start.cos() - run.end.cos()) * d1));
     }
-    let regions = (0..runs.len())
-        .filter(|&i| find(&mut parent, i) == i)
-        .count();
+    let regions = (0..runs.len()).filter(|&i| find(&mut parent, i) == i).count();
     let best = (0..runs.len())
         .filter(|&i| parent[i] == i)
         .max_by(|&x, &y| area_of[x].total_cmp(&area_of[y]).then(y.cmp(&x)))
@@ -398,12 +329,5 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
     } else {
         Some(scene.centre - radius * Vec3::z())
     };
-    Surface {
-        point,
-        cut_samples,
-        finished_samples,
-        area,
-        regions,
-        retraced,
-    }
+    Surface { point, cut_samples, finished_samples, area, regions, retraced }
 }

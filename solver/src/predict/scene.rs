@@ -56,14 +56,7 @@ pub(crate) struct Query {
 /// part of the lower hemisphere seen from below (xy within 2R, lowest point below the ball
 /// centre), or for tilted views every piece within `reach` in 3-D.
 pub(crate) fn gather(path: &PathModel, query: &Query, scratch: &mut Scratch, out: &mut Vec<Piece>) {
-    let Query {
-        centre,
-        sigma,
-        gap,
-        radius,
-        reach,
-        any_view,
-    } = *query;
+    let Query { centre, sigma, gap, radius, reach, any_view } = *query;
     let centre = &centre;
     out.clear();
     scratch.indices.clear();
@@ -74,11 +67,7 @@ pub(crate) fn gather(path: &PathModel, query: &Query, scratch: &mut Scratch, out
         let (a, b) = path.ends(index as usize);
         let (start, end) = (segment.sigma, segment.sigma + segment.length);
         let point = |s: f64| {
-            if segment.length > 0.0 {
-                a + ((s - start) / segment.length).clamp(0.0, 1.0) * (b - a)
-            } else {
-                a
-            }
+            if segment.length > 0.0 { a + ((s - start) / segment.length).clamp(0.0, 1.0) * (b - a) } else { a }
         };
         let mut push = |p: Vec3, q: Vec3, side: Side| {
             let keep = if any_view {
@@ -142,22 +131,13 @@ impl Scene {
         let mut before = Vec::new();
         let mut after = Vec::new();
         for piece in pieces {
-            let capsule =
-                Capsule::new(rotation * (piece.a - centre), rotation * (piece.b - centre));
+            let capsule = Capsule::new(rotation * (piece.a - centre), rotation * (piece.b - centre));
             match piece.side {
                 Side::Before => before.push(capsule),
                 Side::After => after.push(capsule),
             }
         }
-        Self {
-            radius,
-            r2: radius * radius,
-            eps: 1e-9 * radius,
-            centre,
-            rotation,
-            before,
-            after,
-        }
+        Self { radius, r2: radius * radius, eps: 1e-9 * radius, centre, rotation, before, after }
     }
 
     /// World point of a frame point.
@@ -187,27 +167,15 @@ impl Scene {
         let tie = self.eps;
         let pick = |capsules: &[Capsule], from: Option<&[u32]>, out: &mut Vec<u32>| match from {
             Some(indices) => out.extend(
-                indices
-                    .iter()
-                    .copied()
-                    .filter(|&i| capsules[i as usize].may_cover_box(lo, hi, self.radius, tie)),
+                indices.iter().copied().filter(|&i| capsules[i as usize].may_cover_box(lo, hi, self.radius, tie)),
             ),
             None => out.extend(
-                (0..capsules.len() as u32)
-                    .filter(|&i| capsules[i as usize].may_cover_box(lo, hi, self.radius, tie)),
+                (0..capsules.len() as u32).filter(|&i| capsules[i as usize].may_cover_box(lo, hi, self.radius, tie)),
             ),
         };
-        pick(
-            &self.before,
-            pool.map(|p| p.before.as_slice()),
-            &mut lists.before,
-        );
+        pick(&self.before, pool.map(|p| p.before.as_slice()), &mut lists.before);
         if want_after {
-            pick(
-                &self.after,
-                pool.map(|p| p.after.as_slice()),
-                &mut lists.after,
-            );
+            pick(&self.after, pool.map(|p| p.after.as_slice()), &mut lists.after);
         }
     }
 
@@ -239,12 +207,7 @@ impl Scene {
         let mut state = Cover::Open;
         let start = (*hint).min(list.len());
         let (tail, head) = list.split_at(start);
-        for (position, &index) in head
-            .iter()
-            .enumerate()
-            .map(|(k, i)| (k + start, i))
-            .chain(tail.iter().enumerate())
-        {
+        for (position, &index) in head.iter().enumerate().map(|(k, i)| (k + start, i)).chain(tail.iter().enumerate()) {
             let capsule = &capsules[index as usize];
             if capsule.min_z - self.radius > q.z + self.eps {
                 continue;
@@ -295,17 +258,8 @@ pub(crate) struct PointTest {
 }
 
 impl Scene {
-    pub(crate) fn test(
-        &self,
-        stock: &StockModel,
-        lists: &TileLists,
-        q: &Vec3,
-        hints: &mut [usize; 2],
-    ) -> PointTest {
-        let air = PointTest {
-            state: SampleState::Air,
-            cut: false,
-        };
+    pub(crate) fn test(&self, stock: &StockModel, lists: &TileLists, q: &Vec3, hints: &mut [usize; 2]) -> PointTest {
+        let air = PointTest { state: SampleState::Air, cut: false };
         let Some(region) = lists.region else {
             return air;
         };
@@ -314,18 +268,11 @@ impl Scene {
         }
         let before = self.cover(q, Side::Before, &lists.before, &mut hints[0]);
         if before == Cover::Hidden {
-            return PointTest {
-                state: SampleState::CutBefore,
-                cut: false,
-            };
+            return PointTest { state: SampleState::CutBefore, cut: false };
         }
         let after = self.cover(q, Side::After, &lists.after, &mut hints[1]);
         PointTest {
-            state: if after == Cover::Open {
-                SampleState::Finished
-            } else {
-                SampleState::CutAfter
-            },
+            state: if after == Cover::Open { SampleState::Finished } else { SampleState::CutAfter },
             cut: before == Cover::Open,
         }
     }

@@ -68,17 +68,11 @@ pub fn shape_error_from_sections(
         }
     }
     let profile = |z: f64| -> f64 {
-        let upper = sections
-            .partition_point(|s| s.height < z)
-            .clamp(1, sections.len() - 1);
+        let upper = sections.partition_point(|s| s.height < z).clamp(1, sections.len() - 1);
         let (a, b) = (sections[upper - 1], sections[upper]);
         a.radius + (z - a.height) / (b.height - a.height) * (b.radius - a.radius)
     };
-    let nominal = |z: f64| {
-        (radius * radius - (radius - z) * (radius - z))
-            .max(0.0)
-            .sqrt()
-    };
+    let nominal = |z: f64| (radius * radius - (radius - z) * (radius - z)).max(0.0).sqrt();
     angles_deg
         .iter()
         .enumerate()
@@ -86,10 +80,7 @@ pub fn shape_error_from_sections(
             let field = format!("angles_deg[{index}]");
             let theta = finite(&field, angle)?.to_radians();
             if !(0.0..=std::f64::consts::FRAC_PI_2).contains(&theta) {
-                return Err(SolverError::input(
-                    field,
-                    "angles must lie in [0, 90] degrees",
-                ));
+                return Err(SolverError::input(field, "angles must lie in [0, 90] degrees"));
             }
             let (sin, cos) = theta.sin_cos();
             let error = match conversion {
@@ -111,10 +102,7 @@ pub fn shape_error_from_sections(
                         })?
                 }
             };
-            Ok(ShapeErrorPoint {
-                angle_deg: angle,
-                error,
-            })
+            Ok(ShapeErrorPoint { angle_deg: angle, error })
         })
         .collect()
 }
@@ -125,16 +113,8 @@ mod tests {
 
     #[test]
     fn interpolation_clamps_and_flags() {
-        let table = [
-            ShapeErrorPoint {
-                angle_deg: 10.0,
-                error: 0.01,
-            },
-            ShapeErrorPoint {
-                angle_deg: 50.0,
-                error: 0.03,
-            },
-        ];
+        let table =
+            [ShapeErrorPoint { angle_deg: 10.0, error: 0.01 }, ShapeErrorPoint { angle_deg: 50.0, error: 0.03 }];
         let (middle, outside) = delta(&table, 30.0);
         assert!((middle - 0.02).abs() < 1e-15 && !outside);
         assert_eq!(delta(&table, 5.0), (0.01, true));

@@ -74,23 +74,14 @@ fn parse_binary(bytes: &[u8], count: usize) -> Result<Vec<[Vec3; 3]>, SolverErro
     let mut triangles = Vec::with_capacity(count);
     for record in bytes[84..].chunks_exact(50) {
         let value = |offset: usize| {
-            f64::from(f32::from_le_bytes([
-                record[offset],
-                record[offset + 1],
-                record[offset + 2],
-                record[offset + 3],
-            ]))
+            f64::from(f32::from_le_bytes([record[offset], record[offset + 1], record[offset + 2], record[offset + 3]]))
         };
-        let vertex =
-            |k: usize| Vec3::new(value(12 + 12 * k), value(16 + 12 * k), value(20 + 12 * k));
+        let vertex = |k: usize| Vec3::new(value(12 + 12 * k), value(16 + 12 * k), value(20 + 12 * k));
         let triangle = [vertex(0), vertex(1), vertex(2)];
         if triangle.iter().any(|v| !v.iter().all(|c| c.is_finite())) {
             return Err(mesh_error(
                 "E_MESH_FORMAT",
-                format!(
-                    "triangle {} has a coordinate that is not finite",
-                    triangles.len()
-                ),
+                format!("triangle {} has a coordinate that is not finite", triangles.len()),
             ));
         }
         triangles.push(triangle);
@@ -107,19 +98,15 @@ fn parse_ascii(text: &str) -> Result<Vec<[Vec3; 3]>, SolverError> {
             Some("vertex") => {
                 let mut coordinates = [0.0; 3];
                 for coordinate in &mut coordinates {
-                    *coordinate = tokens
-                        .next()
-                        .and_then(|t| t.parse::<f64>().ok())
-                        .filter(|v| v.is_finite())
-                        .ok_or_else(|| {
-                            mesh_error(
-                                "E_MESH_FORMAT",
-                                format!(
-                                    "STL line {}: a vertex needs three finite numbers",
-                                    index + 1
-                                ),
-                            )
-                        })?;
+                    *coordinate =
+                        tokens.next().and_then(|t| t.parse::<f64>().ok()).filter(|v| v.is_finite()).ok_or_else(
+                            || {
+                                mesh_error(
+                                    "E_MESH_FORMAT",
+                                    format!("STL line {}: a vertex needs three finite numbers", index + 1),
+                                )
+                            },
+                        )?;
                 }
                 corners.push(Vec3::new(coordinates[0], coordinates[1], coordinates[2]));
             }
@@ -127,11 +114,7 @@ fn parse_ascii(text: &str) -> Result<Vec<[Vec3; 3]>, SolverError> {
                 if corners.len() != 3 {
                     return Err(mesh_error(
                         "E_MESH_FORMAT",
-                        format!(
-                            "STL line {}: a facet has {} vertices, not 3",
-                            index + 1,
-                            corners.len()
-                        ),
+                        format!("STL line {}: a facet has {} vertices, not 3", index + 1, corners.len()),
                     ));
                 }
                 triangles.push([corners[0], corners[1], corners[2]]);
@@ -139,9 +122,7 @@ fn parse_ascii(text: &str) -> Result<Vec<[Vec3; 3]>, SolverError> {
                 if triangles.len() > MAX_TRIANGLES {
                     return Err(mesh_error(
                         "E_MESH_TOO_LARGE",
-                        format!(
-                            "the stock mesh has more than {MAX_TRIANGLES} triangles, the limit"
-                        ),
+                        format!("the stock mesh has more than {MAX_TRIANGLES} triangles, the limit"),
                     ));
                 }
             }
@@ -155,10 +136,7 @@ fn parse_ascii(text: &str) -> Result<Vec<[Vec3; 3]>, SolverError> {
 /// vertices every edge is used exactly twice, once in each direction.
 pub(crate) fn check_closed(triangles: &[[Vec3; 3]]) -> Result<(), SolverError> {
     if triangles.is_empty() {
-        return Err(mesh_error(
-            "E_MESH_EMPTY",
-            "the stock mesh has no triangles",
-        ));
+        return Err(mesh_error("E_MESH_EMPTY", "the stock mesh has no triangles"));
     }
     let mut vertex_ids: HashMap<[u64; 3], u32> = HashMap::new();
     let mut id = |v: &Vec3| -> u32 {
@@ -182,10 +160,7 @@ pub(crate) fn check_closed(triangles: &[[Vec3; 3]]) -> Result<(), SolverError> {
         }
     }
     let open = edges.values().filter(|(uses, _)| *uses == 1).count();
-    let bad = edges
-        .values()
-        .filter(|(uses, balance)| *uses > 2 || (*uses == 2 && *balance != 0))
-        .count();
+    let bad = edges.values().filter(|(uses, balance)| *uses > 2 || (*uses == 2 && *balance != 0)).count();
     if open > 0 {
         return Err(mesh_error(
             "E_MESH_NOT_CLOSED",
@@ -232,20 +207,12 @@ impl Mesh {
             lo = lo.inf(&t_lo);
             hi = hi.sup(&t_hi);
             let p = if area >= 0.0 { [a, b, c] } else { [a, c, b] };
-            prepared.push(Triangle {
-                p,
-                vertical: area == 0.0,
-                lo: t_lo,
-                hi: t_hi,
-            });
+            prepared.push(Triangle { p, vertical: area == 0.0, lo: t_lo, hi: t_hi });
         }
         let width = (hi.x - lo.x).max(1e-9);
         let height = (hi.y - lo.y).max(1e-9);
         let target = prepared.len().clamp(1, MAX_BINS) as f64;
-        let bin_size = (width * height / target)
-            .sqrt()
-            .max(width / 1024.0)
-            .max(height / 1024.0);
+        let bin_size = (width * height / target).sqrt().max(width / 1024.0).max(height / 1024.0);
         let bins_x = ((width / bin_size).ceil() as usize).max(1);
         let bins_y = ((height / bin_size).ceil() as usize).max(1);
         let mut counts = vec![0u32; bins_x * bins_y + 1];
@@ -319,13 +286,7 @@ impl Mesh {
         let mut inside = false;
         for &index in self.bin_triangles(bin) {
             let t = &self.triangles[index as usize];
-            if t.vertical
-                || q.x < t.lo.x
-                || q.x > t.hi.x
-                || q.y < t.lo.y
-                || q.y > t.hi.y
-                || t.hi.z <= q.z
-            {
+            if t.vertical || q.x < t.lo.x || q.x > t.hi.x || q.y < t.lo.y || q.y > t.hi.y || t.hi.z <= q.z {
                 continue;
             }
             let [a, b, c] = &t.p;
@@ -357,14 +318,8 @@ impl Mesh {
         let clamp_bin = |v: f64, origin: f64, count: usize| {
             (((v - origin) / self.bin_size).floor().max(0.0) as usize).min(count - 1)
         };
-        let (x0, x1) = (
-            clamp_bin(lo.x, self.origin[0], self.bins_x),
-            clamp_bin(hi.x, self.origin[0], self.bins_x),
-        );
-        let (y0, y1) = (
-            clamp_bin(lo.y, self.origin[1], self.bins_y),
-            clamp_bin(hi.y, self.origin[1], self.bins_y),
-        );
+        let (x0, x1) = (clamp_bin(lo.x, self.origin[0], self.bins_x), clamp_bin(hi.x, self.origin[0], self.bins_x));
+        let (y0, y1) = (clamp_bin(lo.y, self.origin[1], self.bins_y), clamp_bin(hi.y, self.origin[1], self.bins_y));
         for y in y0..=y1 {
             for x in x0..=x1 {
                 for &index in self.bin_triangles(y * self.bins_x + x) {
@@ -398,14 +353,7 @@ pub(crate) mod tests {
                 if i & 4 == 0 { lo.z } else { hi.z },
             )
         };
-        let quads = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
+        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
         let mut triangles = Vec::new();
         for q in quads {
             triangles.push([corner(q[0]), corner(q[1]), corner(q[2])]);
@@ -467,23 +415,12 @@ pub(crate) mod tests {
     fn open_and_broken_meshes_are_refused() {
         let mut triangles = box_triangles(Vec3::zeros(), Vec3::new(1.0, 1.0, 1.0));
         triangles.pop();
-        assert_eq!(
-            check_closed(&triangles).unwrap_err().code(),
-            "E_MESH_NOT_CLOSED"
-        );
+        assert_eq!(check_closed(&triangles).unwrap_err().code(), "E_MESH_NOT_CLOSED");
         let mut flipped = box_triangles(Vec3::zeros(), Vec3::new(1.0, 1.0, 1.0));
         flipped[0].swap(1, 2);
-        assert_eq!(
-            check_closed(&flipped).unwrap_err().code(),
-            "E_MESH_NOT_CLOSED"
-        );
+        assert_eq!(check_closed(&flipped).unwrap_err().code(), "E_MESH_NOT_CLOSED");
         assert_eq!(check_closed(&[]).unwrap_err().code(), "E_MESH_EMPTY");
         assert_eq!(parse(b"not an stl").unwrap_err().code(), "E_MESH_FORMAT");
-        assert_eq!(
-            parse(b"solid x\nfacet\nouter loop\nvertex 1 2\nendloop\n")
-                .unwrap_err()
-                .code(),
-            "E_MESH_FORMAT"
-        );
+        assert_eq!(parse(b"solid x\nfacet\nouter loop\nvertex 1 2\nendloop\n").unwrap_err().code(), "E_MESH_FORMAT");
     }
 }

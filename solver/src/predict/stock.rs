@@ -75,22 +75,9 @@ pub(crate) enum Region {
 /// A validated stock, ready for queries.
 #[derive(Debug, Clone)]
 pub(crate) enum StockModel {
-    Box {
-        lo: Vec3,
-        hi: Vec3,
-    },
-    Plane {
-        point: Vec3,
-        normal: Vec3,
-        lo: [f64; 2],
-        hi: [f64; 2],
-    },
-    Cylinder {
-        start: Vec3,
-        axis: Vec3,
-        length: f64,
-        radius: f64,
-    },
+    Box { lo: Vec3, hi: Vec3 },
+    Plane { point: Vec3, normal: Vec3, lo: [f64; 2], hi: [f64; 2] },
+    Cylinder { start: Vec3, axis: Vec3, length: f64, radius: f64 },
     Grid(HeightGrid),
     Mesh(Box<Mesh>),
 }
@@ -126,17 +113,7 @@ impl HeightGrid {
                 block_max[b] = block_max[b].max(h);
             }
         }
-        Self {
-            origin,
-            spacing,
-            nx,
-            ny,
-            heights,
-            bottom,
-            blocks_x,
-            block_min,
-            block_max,
-        }
+        Self { origin, spacing, nx, ny, heights, bottom, blocks_x, block_min, block_max }
     }
 
     fn extent(&self) -> ([f64; 2], [f64; 2]) {
@@ -161,17 +138,12 @@ impl HeightGrid {
         let j = (v.floor() as usize).min(self.ny - 2);
         let (fu, fv) = (u - i as f64, v - j as f64);
         let h = |di: usize, dj: usize| self.heights[(j + dj) * self.nx + i + di];
-        Some(
-            (1.0 - fv) * ((1.0 - fu) * h(0, 0) + fu * h(1, 0))
-                + fv * ((1.0 - fu) * h(0, 1) + fu * h(1, 1)),
-        )
+        Some((1.0 - fv) * ((1.0 - fu) * h(0, 0) + fu * h(1, 0)) + fv * ((1.0 - fu) * h(0, 1) + fu * h(1, 1)))
     }
 
     /// Lowest and highest node heights that bound the surface over the rectangle.
     fn range(&self, lo: [f64; 2], hi: [f64; 2]) -> (f64, f64) {
-        let index = |v: f64, origin: f64, count: usize| {
-            ((v - origin) / self.spacing).clamp(0.0, (count - 1) as f64)
-        };
+        let index = |v: f64, origin: f64, count: usize| ((v - origin) / self.spacing).clamp(0.0, (count - 1) as f64);
         let i0 = index(lo[0], self.origin[0], self.nx).floor() as usize;
         let i1 = index(hi[0], self.origin[0], self.nx).ceil() as usize;
         let j0 = index(lo[1], self.origin[1], self.ny).floor() as usize;
@@ -205,19 +177,11 @@ impl Stock {
             Self::Box { min, max } => {
                 let (lo, hi) = (point("min", *min)?, point("max", *max)?);
                 if (0..3).any(|k| hi[k] <= lo[k]) {
-                    return Err(stock_error(
-                        "stock.max",
-                        "stock.max must exceed stock.min on every axis",
-                    ));
+                    return Err(stock_error("stock.max", "stock.max must exceed stock.min on every axis"));
                 }
                 Ok(StockModel::Box { lo, hi })
             }
-            Self::Plane {
-                point: p,
-                normal,
-                min,
-                max,
-            } => {
+            Self::Plane { point: p, normal, min, max } => {
                 let p = point("point", *p)?;
                 let n = point("normal", *normal)?;
                 let length = n.norm();
@@ -231,59 +195,33 @@ impl Stock {
                     finite(&format!("stock.min[{k}]"), min[k])?;
                     finite(&format!("stock.max[{k}]"), max[k])?;
                     if max[k] <= min[k] {
-                        return Err(stock_error(
-                            "stock.max",
-                            "the footprint's max must exceed its min in x and y",
-                        ));
+                        return Err(stock_error("stock.max", "the footprint's max must exceed its min in x and y"));
                     }
                 }
-                Ok(StockModel::Plane {
-                    point: p,
-                    normal: n / length,
-                    lo: *min,
-                    hi: *max,
-                })
+                Ok(StockModel::Plane { point: p, normal: n / length, lo: *min, hi: *max })
             }
             Self::Cylinder { start, end, radius } => {
                 let (a, b) = (point("start", *start)?, point("end", *end)?);
                 let radius = positive("stock.radius", *radius)?;
                 let length = (b - a).norm();
                 if length == 0.0 {
-                    return Err(stock_error(
-                        "stock.end",
-                        "the cylinder's end equals its start",
-                    ));
+                    return Err(stock_error("stock.end", "the cylinder's end equals its start"));
                 }
-                Ok(StockModel::Cylinder {
-                    start: a,
-                    axis: (b - a) / length,
-                    length,
-                    radius,
-                })
+                Ok(StockModel::Cylinder { start: a, axis: (b - a) / length, length, radius })
             }
-            Self::Grid {
-                origin,
-                spacing,
-                heights,
-                bottom,
-            } => {
+            Self::Grid { origin, spacing, heights, bottom } => {
                 finite("stock.origin[0]", origin[0])?;
                 finite("stock.origin[1]", origin[1])?;
                 let spacing = positive("stock.spacing", *spacing)?;
                 let ny = heights.len();
                 let nx = heights.first().map_or(0, Vec::len);
                 if nx < 2 || ny < 2 {
-                    return Err(stock_error(
-                        "stock.heights",
-                        "a height grid needs at least 2 × 2 nodes",
-                    ));
+                    return Err(stock_error("stock.heights", "a height grid needs at least 2 × 2 nodes"));
                 }
                 if nx.saturating_mul(ny) > MAX_GRID_NODES {
                     return Err(SolverError::new(
                         "E_GRID_TOO_LARGE",
-                        format!(
-                            "the height grid has {nx} × {ny} nodes; the limit is {MAX_GRID_NODES}"
-                        ),
+                        format!("the height grid has {nx} × {ny} nodes; the limit is {MAX_GRID_NODES}"),
                     )
                     .at("stock.heights"));
                 }
@@ -302,16 +240,11 @@ impl Stock {
                     Some(b) => finite("stock.bottom", *b)?,
                     None => f64::NEG_INFINITY,
                 };
-                Ok(StockModel::Grid(HeightGrid::new(
-                    *origin, spacing, heights, bottom,
-                )))
+                Ok(StockModel::Grid(HeightGrid::new(*origin, spacing, heights, bottom)))
             }
             Self::Mesh {} => {
                 let Some(bytes) = mesh else {
-                    return Err(stock_error(
-                        "stock",
-                        "a mesh stock needs its STL file uploaded with the request",
-                    ));
+                    return Err(stock_error("stock", "a mesh stock needs its STL file uploaded with the request"));
                 };
                 let triangles = stl::parse(bytes)?;
                 stl::check_closed(&triangles)?;
@@ -327,38 +260,17 @@ impl StockModel {
     pub(crate) fn contains(&self, q: &Vec3, margin: f64) -> bool {
         match self {
             Self::Box { lo, hi } => {
-                q.x > lo.x
-                    && q.x < hi.x
-                    && q.y > lo.y
-                    && q.y < hi.y
-                    && q.z > lo.z
-                    && q.z < hi.z - margin
+                q.x > lo.x && q.x < hi.x && q.y > lo.y && q.y < hi.y && q.z > lo.z && q.z < hi.z - margin
             }
-            Self::Plane {
-                point,
-                normal,
-                lo,
-                hi,
-            } => {
-                q.x > lo[0]
-                    && q.x < hi[0]
-                    && q.y > lo[1]
-                    && q.y < hi[1]
-                    && (q - point).dot(normal) < -margin * normal.z
+            Self::Plane { point, normal, lo, hi } => {
+                q.x > lo[0] && q.x < hi[0] && q.y > lo[1] && q.y < hi[1] && (q - point).dot(normal) < -margin * normal.z
             }
-            Self::Cylinder {
-                start,
-                axis,
-                length,
-                radius,
-            } => {
+            Self::Cylinder { start, axis, length, radius } => {
                 let d = q - start;
                 let t = d.dot(axis);
                 t > 0.0 && t < *length && (d - t * axis).norm() < radius - margin
             }
-            Self::Grid(grid) => grid
-                .top(q.x, q.y)
-                .is_some_and(|top| q.z < top - margin && q.z > grid.bottom),
+            Self::Grid(grid) => grid.top(q.x, q.y).is_some_and(|top| q.z < top - margin && q.z > grid.bottom),
             Self::Mesh(mesh) => mesh.contains(q, margin),
         }
     }
@@ -368,32 +280,15 @@ impl StockModel {
     pub(crate) fn classify(&self, lo: &Vec3, hi: &Vec3, margin: f64) -> Region {
         match self {
             Self::Box { lo: a, hi: b } => {
-                if hi.x <= a.x
-                    || lo.x >= b.x
-                    || hi.y <= a.y
-                    || lo.y >= b.y
-                    || hi.z <= a.z
-                    || lo.z >= b.z - margin
-                {
+                if hi.x <= a.x || lo.x >= b.x || hi.y <= a.y || lo.y >= b.y || hi.z <= a.z || lo.z >= b.z - margin {
                     Region::Outside
-                } else if lo.x > a.x
-                    && hi.x < b.x
-                    && lo.y > a.y
-                    && hi.y < b.y
-                    && lo.z > a.z
-                    && hi.z < b.z - margin
-                {
+                } else if lo.x > a.x && hi.x < b.x && lo.y > a.y && hi.y < b.y && lo.z > a.z && hi.z < b.z - margin {
                     Region::Inside
                 } else {
                     Region::Mixed
                 }
             }
-            Self::Plane {
-                point,
-                normal,
-                lo: a,
-                hi: b,
-            } => {
+            Self::Plane { point, normal, lo: a, hi: b } => {
                 if hi.x <= a[0] || lo.x >= b[0] || hi.y <= a[1] || lo.y >= b[1] {
                     return Region::Outside;
                 }
@@ -417,19 +312,13 @@ impl StockModel {
                     Region::Mixed
                 }
             }
-            Self::Cylinder {
-                start,
-                axis,
-                length,
-                radius,
-            } => {
+            Self::Cylinder { start, axis, length, radius } => {
                 let centre = 0.5 * (lo + hi);
                 let half = 0.5 * (hi - lo).norm();
                 let d = centre - start;
                 let t = d.dot(axis);
                 let to_line = (d - t * axis).norm();
-                let to_segment =
-                    crate::geometry::distance_to_segment(&centre, start, &(start + *length * axis));
+                let to_segment = crate::geometry::distance_to_segment(&centre, start, &(start + *length * axis));
                 if to_segment - half >= *radius {
                     Region::Outside
                 } else if to_line + half < radius - margin && t - half > 0.0 && t + half < *length {
@@ -470,12 +359,7 @@ impl StockModel {
         match self {
             Self::Box { lo, hi } => ([lo.x, lo.y], [hi.x, hi.y]),
             Self::Plane { lo, hi, .. } => (*lo, *hi),
-            Self::Cylinder {
-                start,
-                axis,
-                length,
-                radius,
-            } => {
+            Self::Cylinder { start, axis, length, radius } => {
                 let end = start + *length * axis;
                 let reach = |k: usize| radius * (1.0 - axis[k] * axis[k]).max(0.0).sqrt();
                 (
@@ -494,50 +378,17 @@ mod tests {
     use super::*;
 
     fn models() -> Vec<StockModel> {
-        let heights: Vec<Vec<f64>> = (0..21)
-            .map(|j| {
-                (0..31)
-                    .map(|i| 0.1 * f64::from(i) - 0.05 * f64::from(j))
-                    .collect()
-            })
-            .collect();
-        let triangles = super::super::stl::tests::box_triangles(
-            Vec3::new(-1.0, -2.0, -3.0),
-            Vec3::new(2.0, 1.0, 0.5),
-        );
+        let heights: Vec<Vec<f64>> =
+            (0..21).map(|j| (0..31).map(|i| 0.1 * f64::from(i) - 0.05 * f64::from(j)).collect()).collect();
+        let triangles = super::super::stl::tests::box_triangles(Vec3::new(-1.0, -2.0, -3.0), Vec3::new(2.0, 1.0, 0.5));
         vec![
-            Stock::Box {
-                min: [-1.0, -2.0, -3.0],
-                max: [2.0, 1.0, 0.5],
-            }
-            .model(None)
-            .unwrap(),
-            Stock::Plane {
-                point: [0.0, 0.0, 0.2],
-                normal: [-0.3, 0.2, 1.0],
-                min: [-2.0, -2.0],
-                max: [2.0, 2.0],
-            }
-            .model(None)
-            .unwrap(),
-            Stock::Cylinder {
-                start: [0.0, -2.0, 0.0],
-                end: [0.0, 2.0, 0.0],
-                radius: 1.5,
-            }
-            .model(None)
-            .unwrap(),
-            Stock::Grid {
-                origin: [-1.5, -1.0],
-                spacing: 0.1,
-                heights,
-                bottom: Some(-2.0),
-            }
-            .model(None)
-            .unwrap(),
-            Stock::Mesh {}
-                .model(Some(&super::super::stl::tests::binary_stl(&triangles)))
+            Stock::Box { min: [-1.0, -2.0, -3.0], max: [2.0, 1.0, 0.5] }.model(None).unwrap(),
+            Stock::Plane { point: [0.0, 0.0, 0.2], normal: [-0.3, 0.2, 1.0], min: [-2.0, -2.0], max: [2.0, 2.0] }
+                .model(None)
                 .unwrap(),
+            Stock::Cylinder { start: [0.0, -2.0, 0.0], end: [0.0, 2.0, 0.0], radius: 1.5 }.model(None).unwrap(),
+            Stock::Grid { origin: [-1.5, -1.0], spacing: 0.1, heights, bottom: Some(-2.0) }.model(None).unwrap(),
+            Stock::Mesh {}.model(Some(&super::super::stl::tests::binary_stl(&triangles))).unwrap(),
         ]
     }
 
@@ -586,30 +437,12 @@ mod tests {
     #[test]
     fn bad_stocks_name_their_field() {
         let bad = [
+            (Stock::Box { min: [0.0, 0.0, 0.0], max: [1.0, 1.0, 0.0] }, "stock.max"),
             (
-                Stock::Box {
-                    min: [0.0, 0.0, 0.0],
-                    max: [1.0, 1.0, 0.0],
-                },
-                "stock.max",
-            ),
-            (
-                Stock::Plane {
-                    point: [0.0; 3],
-                    normal: [0.0, 0.0, -1.0],
-                    min: [0.0, 0.0],
-                    max: [1.0, 1.0],
-                },
+                Stock::Plane { point: [0.0; 3], normal: [0.0, 0.0, -1.0], min: [0.0, 0.0], max: [1.0, 1.0] },
                 "stock.normal",
             ),
-            (
-                Stock::Cylinder {
-                    start: [0.0; 3],
-                    end: [0.0, 1.0, 0.0],
-                    radius: f64::NAN,
-                },
-                "stock.radius",
-            ),
+            (Stock::Cylinder { start: [0.0; 3], end: [0.0, 1.0, 0.0], radius: f64::NAN }, "stock.radius"),
             (
                 Stock::Grid {
                     origin: [0.0, 0.0],

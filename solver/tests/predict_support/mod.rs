@@ -25,22 +25,12 @@ pub fn finishing_tool(radius: f64) -> Tool {
         (0..=9)
             .map(|k| {
                 let angle = f64::from(k) * 10.0;
-                ShapeErrorPoint {
-                    angle_deg: angle,
-                    error: 0.003 + 0.004 * angle.to_radians().sin(),
-                }
+                ShapeErrorPoint { angle_deg: angle, error: 0.003 + 0.004 * angle.to_radians().sin() }
             })
             .collect(),
     );
-    let mode = Mode {
-        stiffness: 5000.0,
-        frequency_hz: 1370.0,
-        damping_ratio: 0.05,
-    };
-    tool.stiffness = Some(Stiffness::Modal {
-        x: vec![mode],
-        y: vec![mode],
-    });
+    let mode = Mode { stiffness: 5000.0, frequency_hz: 1370.0, damping_ratio: 0.05 };
+    tool.stiffness = Some(Stiffness::Modal { x: vec![mode], y: vec![mode] });
     tool
 }
 
@@ -54,11 +44,7 @@ pub fn raster_program(size: f64, pick: f64, step: f64, radius: f64, feed: f64) -
     text.push_str("%\nO1000 (RASTER FINISHING)\nG21 G90 G17 G40 G49 G80\nT1 M06\nS6000 M03\n");
     let tip = |x: f64, y: f64| {
         let (z, n) = surface(size, x, y);
-        [
-            x + radius * n[0],
-            y + radius * n[1],
-            z + radius * n[2] - radius,
-        ]
+        [x + radius * n[0], y + radius * n[1], z + radius * n[2] - radius]
     };
     let mut moves = 0;
     for line in 0..lines {
@@ -67,10 +53,7 @@ pub fn raster_program(size: f64, pick: f64, step: f64, radius: f64, feed: f64) -
             let i = if line % 2 == 0 { k } else { points - 1 - k };
             let p = tip(i as f64 * step, y);
             if line == 0 && k == 0 {
-                text.push_str(&format!(
-                    "G0 X{:.4} Y{:.4} Z60.0\nG1 Z{:.4} F{feed}\n",
-                    p[0], p[1], p[2]
-                ));
+                text.push_str(&format!("G0 X{:.4} Y{:.4} Z60.0\nG1 Z{:.4} F{feed}\n", p[0], p[1], p[2]));
             } else {
                 text.push_str(&format!("X{:.4} Y{:.4} Z{:.4}\n", p[0], p[1], p[2]));
             }
@@ -97,12 +80,7 @@ pub fn raster_stock(size: f64, radius: f64, allowance: f64, spacing: f64) -> Sto
                 .collect()
         })
         .collect();
-    Stock::Grid {
-        origin: [-margin, -margin],
-        spacing,
-        heights,
-        bottom: Some(-100.0),
-    }
+    Stock::Grid { origin: [-margin, -margin], spacing, heights, bottom: Some(-100.0) }
 }
 
 /// A complete prediction request for the raster (ball radius 5 mm, f_t = 0.1 mm, 6000 rpm).
@@ -124,14 +102,7 @@ pub fn raster_request(
         spindle_rpm: None,
         spindle_direction: None,
         feed: None,
-        cutting: Some(CuttingCoefficients {
-            ktc: 2000.0,
-            krc: 800.0,
-            kac: 300.0,
-            kte: 0.0,
-            kre: 0.0,
-            kae: 0.0,
-        }),
+        cutting: Some(CuttingCoefficients { ktc: 2000.0, krc: 800.0, kac: 300.0, kte: 0.0, kre: 0.0, kae: 0.0 }),
         deflection: None,
         method,
         resolution: Some(resolution),
@@ -181,11 +152,7 @@ pub fn bare_request(tool: &Tool, stock: Stock, path: PathInput) -> PredictReques
 /// G-code of separate straight passes of ball centres, linked by rapids 100 mm above the
 /// highest pass end.
 pub fn passes_program(passes: &[([f64; 3], [f64; 3])], feed: f64) -> String {
-    let safe = passes
-        .iter()
-        .map(|(a, b)| a[2].max(b[2]))
-        .fold(f64::NEG_INFINITY, f64::max)
-        + 100.0;
+    let safe = passes.iter().map(|(a, b)| a[2].max(b[2])).fold(f64::NEG_INFINITY, f64::max) + 100.0;
     let mut text = String::from("G21 G90 G17\nS6000 M03\n");
     for (start, end) in passes {
         text.push_str(&format!(
@@ -206,18 +173,10 @@ pub struct Conditions {
 }
 
 /// Case B's conditions: R = 5, pick 0.5, f_t = 0.1.
-pub const FINE: Conditions = Conditions {
-    radius: 5.0,
-    pick: 0.5,
-    tooth_feed: 0.1,
-};
+pub const FINE: Conditions = Conditions { radius: 5.0, pick: 0.5, tooth_feed: 0.1 };
 
 /// The patent's Fig. 16 conditions (case C): R = 10, pick 0.63, f_t = 0.4.
-pub const PATENT: Conditions = Conditions {
-    radius: 10.0,
-    pick: 0.63,
-    tooth_feed: 0.4,
-};
+pub const PATENT: Conditions = Conditions { radius: 10.0, pick: 0.63, tooth_feed: 0.4 };
 
 /// Contour passes (11 passes of 30 mm + 6R) on a plane rising at `slope_deg` toward azimuth
 /// `uphill_deg`, the whole case turned by `turn_deg` about Z and moved by `shift`; the stock is
@@ -257,14 +216,8 @@ pub fn inclined_case_with(
         }
         p
     };
-    let passes: Vec<([f64; 3], [f64; 3])> = (-5..=5)
-        .map(|k| {
-            (
-                at(f64::from(k), -half, radius),
-                at(f64::from(k), half, radius),
-            )
-        })
-        .collect();
+    let passes: Vec<([f64; 3], [f64; 3])> =
+        (-5..=5).map(|k| (at(f64::from(k), -half, radius), at(f64::from(k), half, radius))).collect();
     let point = at(0.0, 0.0, 0.2);
     let stock = Stock::Plane {
         point,
@@ -275,18 +228,9 @@ pub fn inclined_case_with(
     let mut request = bare_request(
         &tool,
         stock,
-        PathInput::Gcode {
-            program: passes_program(&passes, conditions.tooth_feed * 6000.0 * 2.0),
-        },
+        PathInput::Gcode { program: passes_program(&passes, conditions.tooth_feed * 6000.0 * 2.0) },
     );
-    request.cutting = Some(CuttingCoefficients {
-        ktc: 2000.0,
-        krc: 800.0,
-        kac: 300.0,
-        kte: 0.0,
-        kre: 0.0,
-        kae: 0.0,
-    });
+    request.cutting = Some(CuttingCoefficients { ktc: 2000.0, krc: 800.0, kac: 300.0, kte: 0.0, kre: 0.0, kae: 0.0 });
     request.method = method;
     request.pass_range = Some([5, 6]);
     (request, tool)
