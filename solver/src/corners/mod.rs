@@ -72,4 +72,4 @@ pub use request::{
     ContourRequest, ControllerModel, CornerLoop, CornerOverride, CutDirection, Depths, Join, LoopStyle, PassSpec,
     Relief, Side, TboneEdge, Tilt,
 };
-pub use solve::{Plan, plan, solve};
+pub use solve::{Plan, plan, solve, solve_within};

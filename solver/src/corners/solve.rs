@@ -89,6 +89,18 @@ pub fn plan(request: &ContourRequest, tool: &Tool) -> Result<Plan, SolverError> 
 /// codes `E_OFFSET_COLLAPSE` and `E_OFFSET_SELF_INTERSECTION` (naming `contour[k]`); limits
 /// `E_TOO_MANY_POINTS`, `E_TOO_MANY_LAYERS`, `E_TOO_MANY_MOVES`, `E_TOO_COMPLEX`.
 pub fn solve(request: &ContourRequest, tool: &Tool) -> Result<ContourAnswer, SolverError> {
+    solve_within(request, tool, MAX_MOVES)
+}
+
+/// [`solve`] with a smaller move budget than [`MAX_MOVES`] (a JSON answer, which the server
+/// limits further than a G-code program): `E_TOO_MANY_MOVES` at `depths.step` when the layers
+/// would hold more than `max_moves` moves, decided from the first layer's plan before the
+/// layers are built (and checked again on the exact count).
+///
+/// # Errors
+/// As [`solve`].
+pub fn solve_within(request: &ContourRequest, tool: &Tool, max_moves: usize) -> Result<ContourAnswer, SolverError> {
+    let max_moves = max_moves.min(MAX_MOVES);
     let job = request.validate(tool)?;
     let setup = Setup::new(&job);
     let first_z = job.layers.first().copied().unwrap_or(job.bottom);
@@ -96,15 +108,8 @@ pub fn solve(request: &ContourRequest, tool: &Tool) -> Result<ContourAnswer, Sol
     let first_passes = plan_passes(&job, &setup, &first_layer)?;
     let per_layer = layer_move_count(&first_passes, job.tolerance);
     let total = per_layer.saturating_mul(job.layers.len());
-    if total > MAX_MOVES {
-        return Err(SolverError::new(
-            "E_TOO_MANY_MOVES",
-            format!(
-                "{} layers of about {per_layer} moves make {total} moves; the limit is {MAX_MOVES}: use a larger depths.step, tolerance or fewer points",
-                job.layers.len()
-            ),
-        )
-        .at("depths.step"));
+    if total > max_moves {
+        return Err(too_many_moves(job.layers.len(), per_layer, total, max_moves));
     }
     if job.tilt.is_some() && job.layers.len().saturating_mul(first_layer.len()) > MAX_TILTED_VERTEX_LAYERS {
         return Err(SolverError::new(
@@ -174,6 +179,9 @@ pub fn solve(request: &ContourRequest, tool: &Tool) -> Result<ContourAnswer, Sol
         }
         moves += layer.moves.len();
     }
+    if moves > max_moves {
+        return Err(too_many_moves(layers.len(), moves / layers.len().max(1), moves, max_moves));
+    }
     let loop_feed = job.loop_feed.unwrap_or(job.feed);
     let summary = ContourSummary {
         side: job.side,
@@ -209,6 +217,16 @@ pub fn solve(request: &ContourRequest, tool: &Tool) -> Result<ContourAnswer, Sol
         description,
         tilted: job.tilt.is_some(),
     })
+}
+
+fn too_many_moves(layers: usize, per_layer: usize, total: usize, limit: usize) -> SolverError {
+    SolverError::new(
+        "E_TOO_MANY_MOVES",
+        format!(
+            "{layers} layers of about {per_layer} moves make {total} moves; the limit is {limit}: use a larger depths.step, tolerance or fewer points"
+        ),
+    )
+    .at("depths.step")
 }
 
 /// The layer's contour at height `z` (tilted walls move with z).
