@@ -6,11 +6,11 @@ use axum::Json;
 use axum::extract::State;
 use axum::http::HeaderMap;
 use axum::response::{IntoResponse, Response};
-use kerf_solver::SolverError;
 use kerf_solver::corners::detect::{self, DetectMode, MaterialSide, PathLoopAnswer, PathLoopRequest};
 use kerf_solver::corners::{self, ContourAnswer, ContourRequest, CornerLoop};
 use kerf_solver::gcode::{Dialect, Post, Reference, ToolCall};
 use kerf_solver::tool::{Tool, ToolRef};
+use kerf_solver::{SolverError, Warning};
 use serde::{Deserialize, Serialize};
 use utoipa::{IntoParams, ToSchema};
 use utoipa_axum::router::OpenApiRouter;
@@ -94,6 +94,37 @@ fn json_limit_advice(error: SolverError) -> SolverError {
 pub fn run(request: &ContourRequest, tool: Tool, max_moves: usize) -> Result<ContourResult, SolverError> {
     let result = corners::solve_within(request, &tool, max_moves)?;
     Ok(ContourResult { tool, result })
+}
+
+/// Keeps a stored JSON result (a job's) within [`MAX_JSON_MOVES`]: from the first layer that
+/// would pass the limit on, layers keep their `z` but lose their moves, and a
+/// `W_MOVES_NOT_STORED` warning says so (the G-code program, written before, has every move).
+pub fn limit_stored_moves(answer: &mut ContourResult) {
+    let total = answer.result.summary.moves;
+    if total <= MAX_JSON_MOVES {
+        return;
+    }
+    let mut kept = 0;
+    let mut first_dropped = None;
+    for (index, layer) in answer.result.layers.iter_mut().enumerate() {
+        if first_dropped.is_some() || kept + layer.moves.len() > MAX_JSON_MOVES {
+            first_dropped.get_or_insert(index);
+            layer.moves = Vec::new();
+        } else {
+            kept += layer.moves.len();
+        }
+    }
+    if let Some(first) = first_dropped {
+        let layers = answer.result.layers.len();
+        answer.result.warnings.push(Warning::new(
+            "W_MOVES_NOT_STORED",
+            format!(
+                "the answer has {total} moves, more than the {MAX_JSON_MOVES} a stored JSON result holds: layers {first} to \
+                 {} are listed without their moves; the G-code program has every move",
+                layers - 1
+            ),
+        ));
+    }
 }
 
 /// The G-code program of a solved contour request.

@@ -3,7 +3,7 @@
 //! LinuxCNC's `rs274` with its end points equal to the JSON moves, a table of bad requests with
 //! the database unchanged, the JSON move limit, and byte-identical answers.
 
-use kerf_tests::{TestApp, external_program, json_with, problem, rs274_moves};
+use kerf_tests::{TestApp, external_program, finished, json_with, poll_job, problem, rs274_moves};
 use serde_json::{Value, json};
 
 const FIXTURE: &str = include_str!("../../../solver/tests/fixtures/corners.json");
@@ -704,4 +704,38 @@ async fn loops_on_an_existing_path_repeat_the_contour_loops() {
     let twice =
         app.client.post(app.url("/api/v1/contour/loops")).json(&body).send().await.unwrap().bytes().await.unwrap();
     assert_eq!(once, twice);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn jobs_store_what_fits_and_refusals_name_the_field() {
+    let app = app_with_tools().await;
+    let submit = |job: Value| {
+        app.client.post(app.url("/api/v1/jobs")).header("content-type", "application/json").body(job.to_string()).send()
+    };
+    // About 606 000 moves: the program has them all, the stored JSON the layers that fit.
+    let mut big = json!({
+        "operation": "contour", "tool": 3, "contour": circle(600), "side": "outside",
+        "depths": {"top": 0, "bottom": -100, "step": 0.1}, "feed": 800
+    });
+    let submitted = json_with(submit(json!({"name": "big", "operations": [big.clone()]})).await.unwrap(), 202).await;
+    let job = poll_job(&app.client, &app.base, submitted["id"].as_i64().unwrap(), 120, finished).await;
+    assert_eq!(job["status"], "done", "{}", &job.to_string()[..job.to_string().len().min(500)]);
+    let result = &job["results"][0]["result"];
+    let total = result["summary"]["moves"].as_u64().unwrap() as usize;
+    assert!(total > 500_000);
+    let stored: usize = result["layers"].as_array().unwrap().iter().map(|l| l["moves"].as_array().unwrap().len()).sum();
+    assert!(stored <= 500_000 && stored > 400_000, "{stored} moves stored");
+    assert_eq!(result["layers"].as_array().unwrap().len(), 1000, "every layer is listed");
+    assert!(result["warnings"].as_array().unwrap().iter().any(|w| w["code"] == "W_MOVES_NOT_STORED"));
+    let program = app.get(&format!("/api/v1/jobs/{}/gcode", submitted["id"])).await.text().await.unwrap();
+    let blocks = program.lines().filter(|l| l.starts_with("G01") || l.starts_with("G00")).count();
+    assert_eq!(blocks, total + 2, "the length-offset block, every move and the final retract");
+
+    // A contour the solver refuses fails the job with the field at fault.
+    big["contour"] = json!([[0, 0], [10, 10], [10, 0], [0, 10]]);
+    let submitted = json_with(submit(json!({"operations": [big]})).await.unwrap(), 202).await;
+    let job = poll_job(&app.client, &app.base, submitted["id"].as_i64().unwrap(), 60, finished).await;
+    assert_eq!(job["status"], "failed");
+    assert_eq!(job["error_field"], "operations[0].contour[2]");
+    assert!(job["error"].as_str().unwrap().contains("E_SELF_INTERSECTION"));
 }
