@@ -251,7 +251,14 @@ async fn gcode_of_both_dialects_matches_the_json_moves() {
     let mut ball = reference_request("C3");
     ball["tool"] = json!(4);
     ball["depths"] = json!({"top": 0, "bottom": -3, "step": 1.5});
-    let jobs = [("pocket", pocket_request(), 0.0), ("c3_ball", ball, 2.0), ("c2_inline", reference_request("C2"), 0.0)];
+    let mut blocks = pocket_request();
+    blocks["block_time_ms"] = json!(4);
+    let jobs = [
+        ("pocket", pocket_request(), 0.0),
+        ("pocket_block_time", blocks, 0.0),
+        ("c3_ball", ball, 2.0),
+        ("c2_inline", reference_request("C2"), 0.0),
+    ];
     for (name, body, centre_height) in jobs {
         let answer = json_with(app.post_json("/api/v1/contour", &body).await, 200).await;
         for dialect in ["fanuc", "linuxcnc"] {
@@ -489,6 +496,9 @@ fn contour_cases() -> Vec<Case> {
             "E_TOO_MANY_LAYERS",
         ),
         ("zero feed", url, with(json!({"feed": 0})), 422, "feed", "E_INPUT"),
+        ("zero block time", url, with(json!({"block_time_ms": 0})), 422, "block_time_ms", "E_INPUT"),
+        ("negative block time", url, with(json!({"block_time_ms": -4})), 422, "block_time_ms", "E_INPUT"),
+        ("block time as a string", url, with(json!({"block_time_ms": "4"})), 400, "block_time_ms", "E_JSON"),
         ("negative loop feed", url, with(json!({"loop_feed": -5})), 422, "loop_feed", "E_INPUT"),
         (
             "loop radius limits crossed",
@@ -738,4 +748,45 @@ async fn jobs_store_what_fits_and_refusals_name_the_field() {
     assert_eq!(job["status"], "failed");
     assert_eq!(job["error_field"], "operations[0].contour[2]");
     assert!(job["error"].as_str().unwrap().contains("E_SELF_INTERSECTION"));
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn block_time_rule_chooses_the_arc_chords_and_reports_the_blocks() {
+    let app = app_with_tools().await;
+    let plain = json_with(app.post_json("/api/v1/contour", &reference_request("C1")).await, 200).await;
+    assert!(plain["summary"].get("blocks").is_none(), "no block figures without a block time");
+    let mut body = reference_request("C1");
+    body["block_time_ms"] = json!(4);
+    let ruled = json_with(app.post_json("/api/v1/contour", &body).await, 200).await;
+    let blocks = &ruled["summary"]["blocks"];
+    // 800 mm/min on a 4 ms control: blocks of at least 0.05333 mm.
+    let block_length = 800.0 * 4.0 / 60_000.0;
+    close("block length", &blocks["block_length"], block_length);
+    assert_eq!(blocks["block_time_ms"], 4.0);
+    assert_eq!(blocks["short_blocks"], 0, "{}", ruled["warnings"]);
+    assert!(number(&blocks["min_block_length"]) >= block_length * (1.0 - 1e-9));
+    let feed_moves = answer_moves(&ruled, 0.0).iter().filter(|m| m.0).count();
+    assert_eq!(blocks["blocks"], feed_moves);
+    assert!(number(&blocks["estimated_time_s"]) >= number(&ruled["summary"]["estimated_time_s"]));
+    // The loops are chorded finer than the 0.01 mm tolerance (the rule's chord error for ρ = 1
+    // at 800 mm/min and 4 ms is 0.000356 mm), so there are more loop moves than without the rule.
+    let finest = number(&blocks["finest_arc_tolerance"]);
+    assert!((finest - 0.000_355_6).abs() < 1e-7, "{finest}");
+    let loops = |answer: &Value| {
+        answer["layers"][0]["moves"].as_array().unwrap().iter().filter(|m| m["kind"] == "loop").count()
+    };
+    assert!(loops(&ruled) > 2 * loops(&plain), "{} vs {}", loops(&ruled), loops(&plain));
+    // The corners, loops and material are those of the plain answer.
+    assert_eq!(ruled["corners"], plain["corners"]);
+
+    // A feed the 1 mm legs cannot keep up with is reported, not refused.
+    body["feed"] = json!(10_000);
+    body["block_time_ms"] = json!(10);
+    let fast = json_with(app.post_json("/api/v1/contour", &body).await, 200).await;
+    let codes: Vec<&str> = fast["warnings"].as_array().unwrap().iter().map(|w| w["code"].as_str().unwrap()).collect();
+    assert!(
+        codes.contains(&"W_BLOCK_TIME_VIOLATION") && codes.contains(&"W_CHORD_ERROR_EXCEEDS_TOLERANCE"),
+        "{codes:?}"
+    );
+    assert!(fast["summary"]["blocks"]["short_blocks"].as_u64().unwrap() > 0);
 }
