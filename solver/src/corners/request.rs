@@ -1,4 +1,4 @@
-//! The contour request as clients send it (api.md, Contour) and its validation into a [`Job`]
+//! The contour request as clients send it (api.md, Contour) and its validation into a `Job`
 //! (corners.md §1.4 inputs, §3.1 preparation, §5 input codes).
 
 use serde::{Deserialize, Serialize};

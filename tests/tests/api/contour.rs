@@ -301,7 +301,9 @@ async fn gcode_of_both_dialects_matches_the_json_moves() {
 #[tokio::test(flavor = "multi_thread")]
 async fn answers_are_byte_identical() {
     let app = app_with_tools().await;
-    for body in [pocket_request(), reference_request("C2")] {
+    let mut blocks = pocket_request();
+    blocks["block_time_ms"] = json!(4);
+    for body in [pocket_request(), reference_request("C2"), blocks] {
         let mut answers = Vec::new();
         for accept in ["application/json", "application/json", "text/x-gcode", "text/x-gcode"] {
             let response =
