@@ -15,7 +15,8 @@ use utoipa::OpenApi;
     tags(
         (name = "service", description = "Health"),
         (name = "tools", description = "The tool table, keyed by tool number"),
-        (name = "deburr", description = "Cross-hole deburring with a ball end mill (deburr.md)")
+        (name = "deburr", description = "Cross-hole deburring with a ball end mill (deburr.md)"),
+        (name = "contour", description = "Layered contour milling with corner loops and inside-corner relief (corners.md)")
     )
 )]
 pub struct ApiDoc;

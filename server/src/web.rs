@@ -29,6 +29,7 @@ const ASSETS: &[Asset] = &[
     asset!("/style.css", CSS),
     asset!("/app.js", JS),
     asset!("/plot3d.js", JS),
+    asset!("/views/contour.js", JS),
     asset!("/views/deburr.js", JS),
     asset!("/views/jobs.js", JS),
     asset!("/views/tools.js", JS),

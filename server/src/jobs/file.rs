@@ -20,6 +20,7 @@
 //! hole = { shape = "round", radius = 5 }
 //! ```
 
+use kerf_solver::corners::ContourRequest;
 use kerf_solver::deburr::DeburrRequest;
 use kerf_solver::gcode::{Dialect, Reference};
 use kerf_solver::tool::{Tool, ToolRef};
@@ -71,6 +72,8 @@ pub struct OutputOptions {
 pub enum Operation {
     /// `POST /api/v1/deburr`.
     Deburr(DeburrRequest),
+    /// `POST /api/v1/contour`.
+    Contour(ContourRequest),
 }
 
 /// The names `operation` may take.
@@ -78,6 +81,7 @@ pub enum Operation {
 #[serde(rename_all = "snake_case")]
 enum OperationKind {
     Deburr,
+    Contour,
 }
 
 impl OperationKind {
@@ -85,6 +89,7 @@ impl OperationKind {
     fn read<'de, D: serde::Deserializer<'de>>(self, fields: D) -> Result<Operation, D::Error> {
         match self {
             Self::Deburr => DeburrRequest::deserialize(fields).map(Operation::Deburr),
+            Self::Contour => ContourRequest::deserialize(fields).map(Operation::Contour),
         }
     }
 }
@@ -133,6 +138,7 @@ impl Operation {
     pub fn kind(&self) -> &'static str {
         match self {
             Self::Deburr(_) => "deburr",
+            Self::Contour(_) => "contour",
         }
     }
 
@@ -140,6 +146,7 @@ impl Operation {
     fn tool_mut(&mut self) -> Option<&mut ToolRef> {
         match self {
             Self::Deburr(request) => Some(&mut request.tool),
+            Self::Contour(request) => Some(&mut request.tool),
         }
     }
 }
