@@ -15,7 +15,9 @@ use utoipa::OpenApi;
     tags(
         (name = "service", description = "Health"),
         (name = "tools", description = "The tool table, keyed by tool number"),
-        (name = "deburr", description = "Cross-hole deburring with a ball end mill (deburr.md)")
+        (name = "deburr", description = "Cross-hole deburring with a ball end mill (deburr.md)"),
+        (name = "engagement", description = "Tool–workpiece engagement along a path, chip thickness per flute count and \
+                                              the recommended flute counts (engagement.md)")
     )
 )]
 pub struct ApiDoc;

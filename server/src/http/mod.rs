@@ -1,6 +1,7 @@
 //! HTTP routes, one module per resource, each with a `router()`.
 
 pub mod deburr;
+pub mod engagement;
 pub mod health;
 pub mod jobs;
 pub mod output;
