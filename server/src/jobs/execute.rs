@@ -78,6 +78,26 @@ pub fn execute(
                     gcode: program.ok(),
                 }
             }
+            Operation::Engagement(request) => {
+                let ToolRef::Inline(tool) = &request.tool else {
+                    return Err(JobFailure::Refused {
+                        message: format!("operation {index}: the tool was not resolved"),
+                        field: Some(format!("operations[{index}].tool")),
+                    });
+                };
+                let answer = http::engagement::run(request, tool.clone()).map_err(|e| refused(index, &e))?;
+                // One program per operation: the first path's.
+                let program = http::engagement::program(&answer, 0, job.output.dialect, job.output.reference);
+                OperationOutput {
+                    operation: operation.kind().to_owned(),
+                    result: serde_json::to_value(&answer).map_err(|e| JobFailure::Refused {
+                        message: format!("operation {index}: result not serialisable: {e}"),
+                        field: None,
+                    })?,
+                    gcode_problem: program.as_ref().err().map(|e| format!("{} ({})", e.message(), e.code())),
+                    gcode: program.ok(),
+                }
+            }
         };
         outputs.push(output);
         progress((index + 1) as f64 / count as f64);

@@ -21,6 +21,7 @@
 //! ```
 
 use kerf_solver::deburr::DeburrRequest;
+use kerf_solver::engagement::EngagementRequest;
 use kerf_solver::gcode::{Dialect, Reference};
 use kerf_solver::tool::{Tool, ToolRef};
 use serde::{Deserialize, Serialize};
@@ -68,9 +69,12 @@ pub struct OutputOptions {
 /// One operation: `operation` names it, the other fields are its endpoint's request.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[serde(tag = "operation", rename_all = "snake_case")]
+#[allow(clippy::large_enum_variant, reason = "a job holds at most 100 operations, read once")]
 pub enum Operation {
     /// `POST /api/v1/deburr`.
     Deburr(DeburrRequest),
+    /// `POST /api/v1/engagement`; the job's program is that of `path` (or `paths[0]`).
+    Engagement(EngagementRequest),
 }
 
 /// The names `operation` may take.
@@ -78,6 +82,7 @@ pub enum Operation {
 #[serde(rename_all = "snake_case")]
 enum OperationKind {
     Deburr,
+    Engagement,
 }
 
 impl OperationKind {
@@ -85,6 +90,7 @@ impl OperationKind {
     fn read<'de, D: serde::Deserializer<'de>>(self, fields: D) -> Result<Operation, D::Error> {
         match self {
             Self::Deburr => DeburrRequest::deserialize(fields).map(Operation::Deburr),
+            Self::Engagement => EngagementRequest::deserialize(fields).map(Operation::Engagement),
         }
     }
 }
@@ -133,6 +139,7 @@ impl Operation {
     pub fn kind(&self) -> &'static str {
         match self {
             Self::Deburr(_) => "deburr",
+            Self::Engagement(_) => "engagement",
         }
     }
 
@@ -140,6 +147,7 @@ impl Operation {
     fn tool_mut(&mut self) -> Option<&mut ToolRef> {
         match self {
             Self::Deburr(request) => Some(&mut request.tool),
+            Self::Engagement(request) => Some(&mut request.tool),
         }
     }
 }

@@ -6,7 +6,7 @@
 
 use std::collections::BTreeSet;
 
-use kerf_tests::{TestApp, external_program, json_with, problem, rs274_moves};
+use kerf_tests::{TestApp, external_program, finished, json_with, poll_job, problem, rs274_moves};
 use serde_json::{Value, json};
 
 const URL: &str = "/api/v1/engagement";
@@ -448,6 +448,64 @@ async fn a_named_machine_is_refused_unless_its_value_is_given() {
     let answer = json_with(app.post_json(URL, &body).await, 200).await;
     assert!(answer["warnings"].as_array().unwrap().iter().any(|w| w["code"] == "W_MACHINE_NOT_APPLIED"));
     assert_eq!(answer["feed_plan"]["max_feed"], 2000.0);
+}
+
+/// The example job's engagement operation gives exactly the endpoint's answer for the same
+/// request, and its program is the endpoint's for the first path in the job's output options.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_job_answers_like_the_endpoint() {
+    let app = TestApp::spawn().await;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/engagement-pocket.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let file: Value = toml::from_str(&text).unwrap();
+    let response = app
+        .client
+        .post(app.url("/api/v1/jobs"))
+        .header("content-type", "application/toml")
+        .body(text)
+        .send()
+        .await
+        .unwrap();
+    let id = json_with(response, 202).await["id"].as_i64().unwrap();
+    let job = poll_job(&app.client, &app.base, id, 60, finished).await;
+    assert_eq!(job["status"], "done", "{job}");
+    let mut request = file["operations"][0].clone();
+    request.as_object_mut().unwrap().remove("operation");
+    request["tool"] = file["tools"][0].clone();
+    let answer = json_with(app.post_json(URL, &request).await, 200).await;
+    assert_eq!(job["results"][0]["operation"], "engagement");
+    assert_eq!(job["results"][0]["result"], answer, "the job's result is the endpoint's answer");
+    let candidates = answer["candidates"].as_array().unwrap();
+    assert_eq!(candidates.len(), 3);
+    assert!(candidates.iter().all(|c| c["flutes"].as_array().unwrap().len() == 8));
+    let from_job = app.get(&format!("/api/v1/jobs/{id}/gcode")).await.text().await.unwrap();
+    let url = app.url(&format!("{URL}?format=gcode&dialect=linuxcnc&candidate=0"));
+    let from_endpoint = app.client.post(url).json(&request).send().await.unwrap().text().await.unwrap();
+    assert_eq!(from_job, from_endpoint);
+    assert!(from_job.contains("G64 P") && from_job.contains("T5 M06"));
+}
+
+/// A bad value in an engagement job file names its line and field (400); an operation the solver
+/// refuses fails the job with the field at fault.
+#[tokio::test(flavor = "multi_thread")]
+async fn engagement_job_errors_name_the_line_and_field() {
+    let app = TestApp::spawn().await;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/engagement-pocket.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let upload = |body: String| {
+        app.client.post(app.url("/api/v1/jobs")).header("content-type", "application/toml").body(body).send()
+    };
+    let bad_type = text.replace("thickness_limit = 0.06", "thickness_limit = \"thin\"");
+    let line = bad_type.lines().position(|l| l.starts_with("thickness_limit")).unwrap() + 1;
+    let answer = problem(upload(bad_type).await.unwrap(), 400).await;
+    assert_eq!(answer["errors"][0]["path"], "operations[0].thickness_limit");
+    assert!(answer["detail"].as_str().unwrap().starts_with(&format!("line {line},")), "{answer}");
+    let refused = text.replace("flute_counts = [1, 2, 3, 4, 5, 6, 7, 8]", "flute_counts = [1, 2, 40]");
+    let id = json_with(upload(refused).await.unwrap(), 202).await["id"].as_i64().unwrap();
+    let job = poll_job(&app.client, &app.base, id, 60, finished).await;
+    assert_eq!(job["status"], "failed", "{job}");
+    assert_eq!(job["error_field"], "operations[0].flute_counts[2]");
+    assert!(job["error"].as_str().unwrap().contains("E_INPUT"), "{job}");
 }
 
 // ---------------------------------------------------------------- G-code
