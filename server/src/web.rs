@@ -30,6 +30,7 @@ const ASSETS: &[Asset] = &[
     asset!("/app.js", JS),
     asset!("/plot3d.js", JS),
     asset!("/views/deburr.js", JS),
+    asset!("/views/engagement.js", JS),
     asset!("/views/jobs.js", JS),
     asset!("/views/tools.js", JS),
 ];
