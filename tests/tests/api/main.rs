@@ -9,6 +9,7 @@ mod engagement;
 mod gcode;
 mod job_fuzz;
 mod jobs;
+mod limits;
 mod load;
 mod openapi;
 mod tools;
