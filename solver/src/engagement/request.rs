@@ -77,6 +77,8 @@ pub struct PathSegments {
 /// and rapids.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+// Named apart from `predict`'s own path input in the OpenAPI document.
+#[cfg_attr(feature = "schema", schema(as = EngagementPath))]
 #[serde(untagged)]
 pub enum PathInput {
     /// Feed moves (G1) through the points in order.
@@ -173,6 +175,8 @@ pub struct PreviousCut {
 /// paths). Polygons use the even-odd rule with the boundary inclusive and must not cross.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+// Named apart from `predict`'s own stock in the OpenAPI document.
+#[cfg_attr(feature = "schema", schema(as = EngagementStock))]
 #[serde(deny_unknown_fields)]
 pub struct Stock {
     /// One outline [[x, y], ...] (api.md form).
