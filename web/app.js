@@ -1,10 +1,11 @@
 // kerf page shell: tabs, the API helper, problem display and downloads shared by the views.
 import { contourView } from '/views/contour.js';
 import { deburrView } from '/views/deburr.js';
+import { engagementView } from '/views/engagement.js';
 import { jobsView } from '/views/jobs.js';
 import { toolsView } from '/views/tools.js';
 
-const views = [deburrView, contourView, jobsView, toolsView];
+const views = [deburrView, contourView, engagementView, jobsView, toolsView];
 
 // The API token (KERF_API_TOKEN), kept in this browser once entered.
 function token() {

@@ -5,7 +5,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use kerf_solver::SolverError;
-use kerf_solver::tool::ToolRef;
+use kerf_solver::tool::{Tool, ToolRef};
 use serde::Serialize;
 use utoipa::ToSchema;
 
@@ -46,6 +46,35 @@ fn refused(index: usize, error: &SolverError) -> JobFailure {
     }
 }
 
+/// The tool of operation `index`, which resolution has made inline.
+fn resolved_tool(index: usize, tool: &ToolRef) -> Result<Tool, JobFailure> {
+    match tool {
+        ToolRef::Inline(tool) => Ok(tool.clone()),
+        ToolRef::Number(_) => Err(JobFailure::Refused {
+            message: format!("operation {index}: the tool was not resolved"),
+            field: Some(format!("operations[{index}].tool")),
+        }),
+    }
+}
+
+/// The stored output of operation `index`: its answer as JSON and its program, or why none.
+fn output<T: Serialize>(
+    index: usize,
+    operation: &Operation,
+    answer: &T,
+    program: Result<String, SolverError>,
+) -> Result<OperationOutput, JobFailure> {
+    Ok(OperationOutput {
+        operation: operation.kind().to_owned(),
+        result: serde_json::to_value(answer).map_err(|e| JobFailure::Refused {
+            message: format!("operation {index}: result not serialisable: {e}"),
+            field: None,
+        })?,
+        gcode_problem: program.as_ref().err().map(|e| format!("{} ({})", e.message(), e.code())),
+        gcode: program.ok(),
+    })
+}
+
 /// Runs `job` (already resolved: tools inline). `progress` receives the fraction done (0–1).
 pub fn execute(
     job: &JobFile,
@@ -60,45 +89,26 @@ pub fn execute(
         }
         let output = match operation {
             Operation::Deburr(request) => {
-                let ToolRef::Inline(tool) = &request.tool else {
-                    return Err(JobFailure::Refused {
-                        message: format!("operation {index}: the tool was not resolved"),
-                        field: Some(format!("operations[{index}].tool")),
-                    });
-                };
-                let answer = http::deburr::run(request, tool.clone()).map_err(|e| refused(index, &e))?;
+                let answer =
+                    http::deburr::run(request, resolved_tool(index, &request.tool)?).map_err(|e| refused(index, &e))?;
                 let program = http::deburr::program(&answer, job.output.dialect, job.output.reference);
-                OperationOutput {
-                    operation: operation.kind().to_owned(),
-                    result: serde_json::to_value(&answer).map_err(|e| JobFailure::Refused {
-                        message: format!("operation {index}: result not serialisable: {e}"),
-                        field: None,
-                    })?,
-                    gcode_problem: program.as_ref().err().map(|e| format!("{} ({})", e.message(), e.code())),
-                    gcode: program.ok(),
-                }
+                output(index, operation, &answer, program)?
             }
             Operation::Contour(request) => {
-                let ToolRef::Inline(tool) = &request.tool else {
-                    return Err(JobFailure::Refused {
-                        message: format!("operation {index}: the tool was not resolved"),
-                        field: Some(format!("operations[{index}].tool")),
-                    });
-                };
                 // A job goes up to the solver's move limit; its stored JSON keeps what fits.
-                let mut answer = http::contour::run(request, tool.clone(), kerf_solver::corners::request::MAX_MOVES)
+                let tool = resolved_tool(index, &request.tool)?;
+                let mut answer = http::contour::run(request, tool, kerf_solver::corners::request::MAX_MOVES)
                     .map_err(|e| refused(index, &e))?;
                 let program = http::contour::program(&answer, job.output.dialect, job.output.reference);
                 http::contour::limit_stored_moves(&mut answer);
-                OperationOutput {
-                    operation: operation.kind().to_owned(),
-                    result: serde_json::to_value(&answer).map_err(|e| JobFailure::Refused {
-                        message: format!("operation {index}: result not serialisable: {e}"),
-                        field: None,
-                    })?,
-                    gcode_problem: program.as_ref().err().map(|e| format!("{} ({})", e.message(), e.code())),
-                    gcode: program.ok(),
-                }
+                output(index, operation, &answer, program)?
+            }
+            Operation::Engagement(request) => {
+                let tool = resolved_tool(index, &request.tool)?;
+                let answer = http::engagement::run(request, tool).map_err(|e| refused(index, &e))?;
+                // One program per operation: the first path's.
+                let program = http::engagement::program(&answer, 0, job.output.dialect, job.output.reference);
+                output(index, operation, &answer, program)?
             }
         };
         outputs.push(output);

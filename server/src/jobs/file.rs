@@ -22,6 +22,7 @@
 
 use kerf_solver::corners::ContourRequest;
 use kerf_solver::deburr::DeburrRequest;
+use kerf_solver::engagement::EngagementRequest;
 use kerf_solver::gcode::{Dialect, Reference};
 use kerf_solver::tool::{Tool, ToolRef};
 use serde::{Deserialize, Serialize};
@@ -69,11 +70,14 @@ pub struct OutputOptions {
 /// One operation: `operation` names it, the other fields are its endpoint's request.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[serde(tag = "operation", rename_all = "snake_case")]
+#[allow(clippy::large_enum_variant, reason = "a job holds at most 100 operations, read once")]
 pub enum Operation {
     /// `POST /api/v1/deburr`.
     Deburr(DeburrRequest),
     /// `POST /api/v1/contour`.
     Contour(ContourRequest),
+    /// `POST /api/v1/engagement`; the job's program is that of `path` (or `paths[0]`).
+    Engagement(EngagementRequest),
 }
 
 /// The names `operation` may take.
@@ -82,6 +86,7 @@ pub enum Operation {
 enum OperationKind {
     Deburr,
     Contour,
+    Engagement,
 }
 
 impl OperationKind {
@@ -90,6 +95,7 @@ impl OperationKind {
         match self {
             Self::Deburr => DeburrRequest::deserialize(fields).map(Operation::Deburr),
             Self::Contour => ContourRequest::deserialize(fields).map(Operation::Contour),
+            Self::Engagement => EngagementRequest::deserialize(fields).map(Operation::Engagement),
         }
     }
 }
@@ -139,6 +145,7 @@ impl Operation {
         match self {
             Self::Deburr(_) => "deburr",
             Self::Contour(_) => "contour",
+            Self::Engagement(_) => "engagement",
         }
     }
 
@@ -147,6 +154,7 @@ impl Operation {
         match self {
             Self::Deburr(request) => Some(&mut request.tool),
             Self::Contour(request) => Some(&mut request.tool),
+            Self::Engagement(request) => Some(&mut request.tool),
         }
     }
 }

@@ -6,6 +6,7 @@ mod browser;
 mod cli;
 mod contour;
 mod deburr;
+mod engagement;
 mod gcode;
 mod job_fuzz;
 mod jobs;
