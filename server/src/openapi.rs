@@ -15,7 +15,8 @@ use utoipa::OpenApi;
     tags(
         (name = "service", description = "Health"),
         (name = "tools", description = "The tool table, keyed by tool number"),
-        (name = "deburr", description = "Cross-hole deburring with a ball end mill (deburr.md)")
+        (name = "deburr", description = "Cross-hole deburring with a ball end mill (deburr.md)"),
+        (name = "machines", description = "Controller profiles (block processing time, feed limit, dialect), keyed by name (chord.md)")
     )
 )]
 pub struct ApiDoc;

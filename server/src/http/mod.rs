@@ -3,5 +3,6 @@
 pub mod deburr;
 pub mod health;
 pub mod jobs;
+pub mod machines;
 pub mod output;
 pub mod tools;

@@ -10,5 +10,6 @@ mod job_fuzz;
 mod jobs;
 mod limits;
 mod load;
+mod machines;
 mod openapi;
 mod tools;
