@@ -44,6 +44,7 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
         .merge(http::deburr::router())
         .merge(http::jobs::router())
         .merge(http::machines::router())
+        .merge(http::segment::router())
         .split_for_parts()
 }
 

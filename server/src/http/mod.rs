@@ -5,4 +5,5 @@ pub mod health;
 pub mod jobs;
 pub mod machines;
 pub mod output;
+pub mod segment;
 pub mod tools;

@@ -12,4 +12,5 @@ mod limits;
 mod load;
 mod machines;
 mod openapi;
+mod segment;
 mod tools;
