@@ -46,6 +46,14 @@ fn refused(index: usize, error: &SolverError) -> JobFailure {
     }
 }
 
+/// An operation whose `field` (tool or machine) was not resolved at submission.
+fn unresolved(index: usize, field: &str) -> JobFailure {
+    JobFailure::Refused {
+        message: format!("operation {index}: the {field} was not resolved"),
+        field: Some(format!("operations[{index}].{field}")),
+    }
+}
+
 /// Runs `job` (already resolved: tools inline). `progress` receives the fraction done (0–1).
 pub fn execute(
     job: &JobFile,
@@ -68,6 +76,28 @@ pub fn execute(
                 };
                 let answer = http::deburr::run(request, tool.clone()).map_err(|e| refused(index, &e))?;
                 let program = http::deburr::program(&answer, job.output.dialect, job.output.reference);
+                OperationOutput {
+                    operation: operation.kind().to_owned(),
+                    result: serde_json::to_value(&answer).map_err(|e| JobFailure::Refused {
+                        message: format!("operation {index}: result not serialisable: {e}"),
+                        field: None,
+                    })?,
+                    gcode_problem: program.as_ref().err().map(|e| format!("{} ({})", e.message(), e.code())),
+                    gcode: program.ok(),
+                }
+            }
+            Operation::Segment(request) => {
+                let tool = match &request.tool {
+                    None => None,
+                    Some(ToolRef::Inline(tool)) => Some(tool.clone()),
+                    Some(ToolRef::Number(_)) => return Err(unresolved(index, "tool")),
+                };
+                let machine = match &request.machine {
+                    None => None,
+                    Some(name) => Some(job.machine(name).cloned().ok_or_else(|| unresolved(index, "machine"))?),
+                };
+                let answer = http::segment::run(request, machine, tool).map_err(|e| refused(index, &e))?;
+                let program = http::segment::program(&answer, job.output.dialect);
                 OperationOutput {
                     operation: operation.kind().to_owned(),
                     result: serde_json::to_value(&answer).map_err(|e| JobFailure::Refused {

@@ -552,3 +552,93 @@ async fn bad_segment_requests() {
     assert_eq!(json_with(app.get("/api/v1/tools").await, 200).await, tools_before, "tools unchanged");
     assert_eq!(json_with(app.get("/api/v1/machines").await, 200).await, machines_before, "machines unchanged");
 }
+
+async fn submit(app: &TestApp, body: String, media_type: &str) -> reqwest::Response {
+    app.client.post(app.url("/api/v1/jobs")).header("content-type", media_type).body(body).send().await.unwrap()
+}
+
+async fn run_job(app: &TestApp, body: String, media_type: &str) -> Value {
+    let submitted = json_with(submit(app, body, media_type).await, 202).await;
+    kerf_tests::poll_job(&app.client, &app.base, submitted["id"].as_i64().unwrap(), 60, kerf_tests::finished).await
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn jobs_carry_machines_from_the_file_or_the_registry() {
+    let app = TestApp::spawn().await;
+    let circle = json!({"kind": "circle", "centre": [0, 0], "radius": 50});
+    // A machine in the file is used before the registry's machine of the same name.
+    json_with(app.put_json("/api/v1/machines/hsc", &json!({"block_time_ms": 8, "max_feed": 5000})).await, 201).await;
+    let in_file = json!({
+        "name": "file machine",
+        "machines": [{"name": "hsc", "block_time_ms": 4, "max_feed": 10000, "dialect": "linuxcnc"}],
+        "operations": [{"operation": "segment", "machine": "hsc", "curve": circle}]
+    });
+    let job = run_job(&app, in_file.to_string(), "application/json").await;
+    assert_eq!(job["status"], "done", "{job}");
+    let result = &job["results"][0]["result"];
+    assert_eq!(
+        (&result["feed"], &result["block_time_ms"], &result["blocks"]),
+        (&json!(10000.0), &json!(4.0), &json!(472))
+    );
+    let id = job["id"].as_i64().unwrap();
+    let program = app.get(&format!("/api/v1/jobs/{id}/gcode")).await.text().await.unwrap();
+    assert!(program.contains("G01 X49.9956 Y0.6667 Z0.0000"), "{program}");
+
+    // A machine only in the registry is resolved at submission and stored with the job.
+    let from_registry = "name = \"registry machine\"\n[[operations]]\noperation = \"segment\"\nmachine = \"hsc\"\n\
+                         curve = { kind = \"circle\", centre = [0, 0], radius = 50 }\n"
+        .to_owned();
+    let job = run_job(&app, from_registry.clone(), "application/toml").await;
+    assert_eq!(job["status"], "done", "{job}");
+    assert_eq!(
+        (&job["results"][0]["result"]["feed"], &job["results"][0]["result"]["block_time_ms"]),
+        (&json!(5000.0), &json!(8.0))
+    );
+    // The same file after the machine changed is a different job, not the earlier result.
+    json_with(app.put_json("/api/v1/machines/hsc", &json!({"block_time_ms": 4, "max_feed": 5000})).await, 200).await;
+    let submitted = json_with(submit(&app, from_registry.clone(), "application/toml").await, 202).await;
+    assert_ne!(submitted["id"], job["id"]);
+    // Without the machine, the submission is refused naming the operation's field.
+    assert_eq!(app.delete("/api/v1/machines/hsc").await.status(), 204);
+    let answer = problem(submit(&app, from_registry, "application/toml").await, 404).await;
+    assert_eq!(answer["errors"][0]["path"], "operations[0].machine");
+
+    // Bad machines in a file, and NaN (TOML has it; JSON has not) reaching the solver.
+    let good_op = "[[operations]]\noperation = \"segment\"\nmachine = \"m\"\ncurve = { kind = \"circle\", centre = [0, 0], radius = 50 }\n";
+    let cases = [
+        ("[[machines]]\nblock_time_ms = 4\nmax_feed = 1000\n", 400, "machines[0].name"),
+        ("[[machines]]\nname = \"m\"\nblock_time_ms = 0\nmax_feed = 1000\n", 422, "machines[0].block_time_ms"),
+        ("[[machines]]\nname = \"m\"\nblock_time_ms = nan\nmax_feed = 1000\n", 400, "machines[0].block_time_ms"),
+        ("[[machines]]\nname = \"a b\"\nblock_time_ms = 4\nmax_feed = 1000\n", 422, "machines[0].name"),
+        (
+            "[[machines]]\nname = \"m\"\nblock_time_ms = 4\nmax_feed = 1000\n[[machines]]\nname = \"m\"\nblock_time_ms = 2\nmax_feed = 1000\n",
+            400,
+            "machines[1].name",
+        ),
+        ("[[machines]]\nname = \"m\"\nblock_time_ms = 4\nmax_feed = 1000\naxes = 5\n", 400, "machines[0].axes"),
+        ("[[machines]]\nname = \"other\"\nblock_time_ms = 4\nmax_feed = 1000\n", 404, "operations[0].machine"),
+    ];
+    for (machines, status, field) in cases {
+        let answer = problem(submit(&app, format!("{machines}{good_op}"), "application/toml").await, status).await;
+        assert_eq!(answer["errors"][0]["path"], field, "{machines}: {answer}");
+    }
+    // TOML has nan and inf, JSON has not: refused at submission with the line and field.
+    let circle = "curve = { kind = \"circle\", centre = [0, 0], radius = 50 }";
+    let cases = [
+        (format!("feed = nan\nblock_time_ms = 4\n{circle}"), "operations[0].feed", "line 3,"),
+        (format!("feed = 1000\nblock_time_ms = -inf\n{circle}"), "operations[0].block_time_ms", "line 4,"),
+        (
+            "feed = 1000\nblock_time_ms = 4\ncurve = { kind = \"circle\", centre = [0, +nan], radius = 5e1 }"
+                .to_owned(),
+            "operations[0].curve.centre[1]",
+            "line 5,",
+        ),
+    ];
+    for (fields, field, line) in cases {
+        let text = format!("[[operations]]\noperation = \"segment\"\n{fields}\n");
+        let answer = problem(submit(&app, text, "application/toml").await, 400).await;
+        assert_eq!(answer["errors"][0]["path"], field, "{answer}");
+        assert!(answer["detail"].as_str().unwrap().starts_with(line), "{answer}");
+    }
+    assert_eq!(json_with(app.get("/api/v1/machines").await, 200).await, json!([]), "registry unchanged");
+}
