@@ -7,6 +7,7 @@ use axum::extract::State;
 use axum::http::StatusCode;
 use kerf_solver::SolverError;
 use kerf_solver::chord::{MachineProfile, validate_machine_name};
+use kerf_solver::gcode::Dialect;
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
@@ -89,6 +90,11 @@ async fn put_machine(
 async fn delete_machine(State(state): State<AppState>, AppPath(name): AppPath<MachineName>) -> AppResult<StatusCode> {
     let name = checked_name(name)?;
     if store::machines::delete(&state.db, &name).await? { Ok(StatusCode::NO_CONTENT) } else { Err(unknown(&name)) }
+}
+
+/// The dialect of a program: the one the query asks for, else the machine's, else Fanuc.
+pub fn dialect(asked: Option<Dialect>, machine: Option<&MachineProfile>) -> Dialect {
+    asked.or(machine.map(|m| m.dialect)).unwrap_or_default()
 }
 
 /// Routes of this module.

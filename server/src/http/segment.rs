@@ -67,14 +67,10 @@ async fn post_segment(
     };
     let answer = state.solve(move || run(&request, machine, tool)).await??;
     if output.gcode {
-        return Ok(gcode_response(program(&answer, dialect(output.dialect, answer.machine.as_ref()))?));
+        let dialect = super::machines::dialect(output.dialect, answer.machine.as_ref());
+        return Ok(gcode_response(program(&answer, dialect)?));
     }
     Ok(Json(answer).into_response())
-}
-
-/// The dialect of a program: the one asked for, else the machine's, else Fanuc.
-pub fn dialect(asked: Option<Dialect>, machine: Option<&MachineProfile>) -> Dialect {
-    asked.or(machine.map(|m| m.dialect)).unwrap_or_default()
 }
 
 /// Solves a segment request with its resolved machine and tool (used by the route and by jobs).

@@ -74,7 +74,11 @@ pub fn execute(
                         field: Some(format!("operations[{index}].tool")),
                     });
                 };
-                let answer = http::deburr::run(request, tool.clone()).map_err(|e| refused(index, &e))?;
+                let machine = match &request.machine {
+                    None => None,
+                    Some(name) => Some(job.machine(name).cloned().ok_or_else(|| unresolved(index, "machine"))?),
+                };
+                let answer = http::deburr::run(request, tool.clone(), machine).map_err(|e| refused(index, &e))?;
                 let program = http::deburr::program(&answer, job.output.dialect, job.output.reference);
                 OperationOutput {
                     operation: operation.kind().to_owned(),

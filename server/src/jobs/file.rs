@@ -161,8 +161,8 @@ impl Operation {
     /// The machine the operation names, for operations that take one.
     fn machine_name(&self) -> Option<&str> {
         match self {
+            Self::Deburr(request) => request.machine.as_deref(),
             Self::Segment(request) => request.machine.as_deref(),
-            Self::Deburr(_) => None,
         }
     }
 }

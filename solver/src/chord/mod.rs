@@ -27,7 +27,7 @@
 //!   `E_NUMERIC_FAILURE`: all 422.
 //! * Machines: store a validated ([`MachineProfile::validate`]) profile as JSON under a name
 //!   checked by [`validate_machine_name`].
-//! * Another path solver (deburr, contour) with `machine`, `feed`, `block_time_ms` and a
+//! * Another path solver (deburr does, contour) with `machine`, `feed`, `block_time_ms` and a
 //!   `tolerance`: [`BlockRule::resolve`] gives the rule; [`BlockRule::tolerance_for`]`(r, tol)`
 //!   the chord tolerance at a local radius (never coarser than `tol`), or for the whole path
 //!   `tolerance_for(r_min, tol)` (embodiment 4); [`block_stats`] reports any polyline's blocks,

@@ -5,6 +5,7 @@ mod bad_requests;
 mod browser;
 mod cli;
 mod deburr;
+mod deburr_machine;
 mod gcode;
 mod job_fuzz;
 mod jobs;
