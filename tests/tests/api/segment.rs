@@ -642,3 +642,24 @@ async fn jobs_carry_machines_from_the_file_or_the_registry() {
     }
     assert_eq!(json_with(app.get("/api/v1/machines").await, 200).await, json!([]), "registry unchanged");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn segment_page_plots_compares_and_uses_a_machine() {
+    let app = TestApp::spawn().await;
+    let Some(result) = crate::browser::run_scenario(&app, "segment", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert_eq!(result["segments"], 472, "{result}");
+    // R50 at 12 000 mm/min with k_f 1.1: blocks of 0.88 mm, 357 of them with the remainder.
+    assert!(result["machineBlocks"].as_u64().unwrap() < 472, "{result}");
+    // The machine the page registered is gone again.
+    assert_eq!(json_with(app.get("/api/v1/machines").await, 200).await, json!([]));
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn jobs_page_shows_segment_results() {
+    let app = TestApp::spawn().await;
+    let example = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/segment-machine.toml");
+    let Some(result) = crate::browser::run_scenario(&app, "jobs", &[example.to_str().unwrap()]) else { return };
+    assert_eq!(result["ok"], true);
+    assert_eq!(result["plots"], 6, "plan, chord error and block length per operation: {result}");
+}
