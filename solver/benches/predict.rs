@@ -1,3 +1,103 @@
-//! Benchmarks for solver::predict (not written yet).
+//! Benchmarks for solver::predict: passes per second per core and on both cores for a realistic
+//! finishing program, as a ratio against the seed's 0.070 s per pass (patent Fig. 21).
+//!
+//! The program (tests/predict_support): a ball end mill Ø10 finishing a double-wave surface
+//! (slopes up to 26°) by a zig-zag raster, pick 0.5 mm, 0.5 mm segments, 103 041 feed passes,
+//! f_t = 0.1 mm at 6000 rpm, force model with modal stiffness; stock = surface + 0.2 mm as a
+//! height grid. Resolution N = 256 gives the seed's pixel size 0.039 mm; N = 512 is twice as fine.
+//!
+//! Each criterion sample predicts a slice of 1000 passes in the middle of the program (the whole
+//! program still sweeps the stock): ms per pass = sample time / 1000. Before each group the bench
+//! prints one measured slice with wall and process CPU time (the machine is shared, so CPU time
+//! per pass is the per-core figure), and once the whole program on all threads.
 
-fn main() {}
+use std::hint::black_box;
+use std::time::Instant;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use kerf_solver::predict::{self, Method};
+
+#[path = "../tests/predict_support/mod.rs"]
+mod support;
+
+/// The seed's time per pass (patent Fig. 21, GPU, 2009).
+const SEED_SECONDS_PER_PASS: f64 = 0.070;
+/// Passes per criterion sample.
+const SLICE: usize = 1000;
+
+/// Process CPU time (user + system) in seconds, from /proc (0 where unavailable).
+fn cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    let Some(rest) = stat.rsplit(')').next() else {
+        return 0.0;
+    };
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i).and_then(|f| f.parse::<f64>().ok()).unwrap_or(0.0);
+    (ticks(11) + ticks(12)) / 100.0
+}
+
+fn report(label: &str, passes: usize, wall: f64, cpu: f64) {
+    let per_pass = wall / passes as f64;
+    let cpu_per_pass = cpu / passes as f64;
+    eprintln!(
+        "{label}: {passes} passes, wall {:.3} ms/pass ({:.0} passes/s, {:.0}× the seed), CPU {:.3} ms/pass per core ({:.0}× the seed per core)",
+        per_pass * 1e3,
+        1.0 / per_pass,
+        SEED_SECONDS_PER_PASS / per_pass,
+        cpu_per_pass * 1e3,
+        SEED_SECONDS_PER_PASS / cpu_per_pass,
+    );
+}
+
+fn bench(c: &mut Criterion) {
+    let mut group = c.benchmark_group("predict");
+    group.sample_size(10);
+    for (method, resolution, name) in [
+        (Method::Sampling, 256, "sampling_N256"),
+        (Method::DepthBuffer, 256, "depth_buffer_N256"),
+        (Method::Sampling, 512, "sampling_N512"),
+    ] {
+        let (mut request, tool, moves) = support::raster_request(160.0, 0.5, 0.5, method, resolution);
+        let middle = moves / 2;
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let label = format!("{name}_{threads}_threads");
+            // Setup alone (reading 103 041 lines, the grids), then the slice.
+            request.pass_range = Some([middle, middle]);
+            let (started, cpu) = (Instant::now(), cpu_seconds());
+            pool.install(|| predict::solve(&request, &tool, None).unwrap());
+            let (setup_wall, setup_cpu) = (started.elapsed().as_secs_f64(), cpu_seconds() - cpu);
+            request.pass_range = Some([middle, middle + SLICE]);
+            let (started, cpu) = (Instant::now(), cpu_seconds());
+            let answer = pool.install(|| predict::solve(&request, &tool, None).unwrap());
+            let (wall, cpu) = (started.elapsed().as_secs_f64(), cpu_seconds() - cpu);
+            assert_eq!(answer.summary.predicted + answer.summary.no_cut + answer.summary.no_surface, SLICE);
+            eprintln!("{label}: setup {setup_wall:.3} s wall, {setup_cpu:.2} s CPU for {moves} passes");
+            report(&label, SLICE, wall - setup_wall, cpu - setup_cpu);
+            group.bench_function(format!("{label}_{SLICE}_of_{moves}_passes"), |b| {
+                b.iter(|| pool.install(|| black_box(predict::solve(&request, &tool, None).unwrap())));
+            });
+        }
+    }
+    group.finish();
+    // The whole program once, on all threads.
+    let (mut request, tool, moves) = support::raster_request(160.0, 0.5, 0.5, Method::Sampling, 256);
+    request.pass_range = None;
+    let (started, cpu) = (Instant::now(), cpu_seconds());
+    let answer = predict::solve(&request, &tool, None).unwrap();
+    let (wall, cpu) = (started.elapsed().as_secs_f64(), cpu_seconds() - cpu);
+    eprintln!(
+        "whole program, sampling N = 256, {} threads: {moves} passes in {wall:.1} s wall, {cpu:.1} s CPU; predicted {}, no_cut {}, no_surface {}, max |e| {:.4} mm",
+        rayon::current_num_threads(),
+        answer.summary.predicted,
+        answer.summary.no_cut,
+        answer.summary.no_surface,
+        answer.summary.max_error.unwrap_or(0.0).abs().max(answer.summary.min_error.unwrap_or(0.0).abs()),
+    );
+    report("whole program", moves, wall, cpu);
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

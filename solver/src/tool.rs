@@ -65,7 +65,91 @@ pub struct Tool {
     /// wide as the cutter.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub neck_radius: Option<f64>,
+    /// Shape-error table δ(θ) of the rotating cutting edge (error-prediction.md §3.13): the
+    /// outward deviation of the edge envelope from the nominal ball along its normal, in mm, at
+    /// contact angles θ from 0° (tip) to 90° (equator), angles strictly increasing. Linear
+    /// interpolation between rows.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape_error: Option<Vec<ShapeErrorPoint>>,
+    /// Tool-tip stiffness in X and Y (error-prediction.md §3.8): static, modal or a measured
+    /// frequency-response table.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness: Option<Stiffness>,
 }
+
+/// One row of a tool's shape-error table.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct ShapeErrorPoint {
+    /// Contact angle θ in degrees: 0 at the tip, 90 at the equator.
+    pub angle_deg: f64,
+    /// δ(θ) in mm: positive where the rotating edge reaches outside the nominal ball (the tool
+    /// cuts too deep there).
+    pub error: f64,
+}
+
+/// One vibration mode of the tool tip: G(ω) = (1/k) / (1 − (ω/ωn)² + 2iζ ω/ωn).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct Mode {
+    /// Modal stiffness k in N/mm (> 0).
+    pub stiffness: f64,
+    /// Natural frequency in Hz (> 0).
+    pub frequency_hz: f64,
+    /// Damping ratio ζ (0 < ζ < 1).
+    pub damping_ratio: f64,
+}
+
+/// One row of a measured tool-tip compliance (receptance) table, e.g. from an impact test.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct FrfPoint {
+    /// Frequency in Hz (≥ 0, strictly increasing).
+    pub frequency_hz: f64,
+    /// Real part of the compliance, mm/N.
+    pub real: f64,
+    /// Imaginary part of the compliance, mm/N.
+    pub imag: f64,
+}
+
+/// Tool-tip stiffness in the machine X and Y directions (no cross terms, no Z: the patent's model).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Stiffness {
+    /// Static stiffness: deflection = force / k (the less accurate alternative).
+    Static {
+        /// k_x in N/mm.
+        x: f64,
+        /// k_y in N/mm.
+        y: f64,
+    },
+    /// Sum of modes per direction (1–32 modes each).
+    Modal {
+        /// Modes in X.
+        x: Vec<Mode>,
+        /// Modes in Y.
+        y: Vec<Mode>,
+    },
+    /// Measured compliance tables per direction (2–100 000 rows each), interpolated linearly in
+    /// real and imaginary parts; zero above the last frequency.
+    Frf {
+        /// Table in X.
+        x: Vec<FrfPoint>,
+        /// Table in Y.
+        y: Vec<FrfPoint>,
+    },
+}
+
+/// Most rows of a shape-error table.
+pub const MAX_SHAPE_ERROR_ROWS: usize = 1000;
+/// Most modes per direction.
+pub const MAX_MODES: usize = 32;
+/// Most rows of a compliance table per direction.
+pub const MAX_FRF_ROWS: usize = 100_000;
 
 fn default_flutes() -> u32 {
     2
@@ -87,6 +171,8 @@ impl Tool {
             helix_deg: None,
             stickout: None,
             neck_radius: None,
+            shape_error: None,
+            stiffness: None,
         }
     }
 
@@ -143,6 +229,102 @@ impl Tool {
                     field("neck_radius"),
                     format!("neck_radius {neck} must be smaller than radius {}", self.radius),
                 ));
+            }
+        }
+        if let Some(table) = &self.shape_error {
+            validate_shape_error(table, self.radius, &field("shape_error"))?;
+        }
+        if let Some(stiffness) = &self.stiffness {
+            stiffness.validate(&field("stiffness"))?;
+        }
+        Ok(())
+    }
+}
+
+fn validate_shape_error(table: &[ShapeErrorPoint], radius: f64, field: &str) -> Result<(), SolverError> {
+    if table.is_empty() || table.len() > MAX_SHAPE_ERROR_ROWS {
+        return Err(SolverError::input(
+            field,
+            format!("shape_error needs 1 to {MAX_SHAPE_ERROR_ROWS} rows (got {})", table.len()),
+        ));
+    }
+    let mut previous = f64::NEG_INFINITY;
+    for (index, row) in table.iter().enumerate() {
+        let angle_field = format!("{field}[{index}].angle_deg");
+        let angle = finite(&angle_field, row.angle_deg)?;
+        if !(0.0..=90.0).contains(&angle) || angle <= previous {
+            return Err(SolverError::input(
+                angle_field,
+                "shape_error angles must lie in [0, 90] degrees and increase strictly",
+            ));
+        }
+        previous = angle;
+        let error_field = format!("{field}[{index}].error");
+        if finite(&error_field, row.error)?.abs() >= radius {
+            return Err(SolverError::input(
+                error_field,
+                format!("a shape error of {} mm is not smaller than the tool radius", row.error),
+            ));
+        }
+    }
+    Ok(())
+}
+
+impl Stiffness {
+    /// Checks every number; `field` is the stiffness's own path (e.g. `tool.stiffness`).
+    pub fn validate(&self, field: &str) -> Result<(), SolverError> {
+        match self {
+            Self::Static { x, y } => {
+                positive(&format!("{field}.x"), *x)?;
+                positive(&format!("{field}.y"), *y)?;
+            }
+            Self::Modal { x, y } => {
+                for (axis, modes) in [("x", x), ("y", y)] {
+                    let axis_field = format!("{field}.{axis}");
+                    if modes.is_empty() || modes.len() > MAX_MODES {
+                        return Err(SolverError::input(
+                            axis_field,
+                            format!("give 1 to {MAX_MODES} modes per direction"),
+                        ));
+                    }
+                    for (index, mode) in modes.iter().enumerate() {
+                        let at = format!("{axis_field}[{index}]");
+                        positive(&format!("{at}.stiffness"), mode.stiffness)?;
+                        positive(&format!("{at}.frequency_hz"), mode.frequency_hz)?;
+                        let damping = positive(&format!("{at}.damping_ratio"), mode.damping_ratio)?;
+                        if damping >= 1.0 {
+                            return Err(SolverError::input(
+                                format!("{at}.damping_ratio"),
+                                "damping_ratio must be below 1 (an underdamped mode)",
+                            ));
+                        }
+                    }
+                }
+            }
+            Self::Frf { x, y } => {
+                for (axis, rows) in [("x", x), ("y", y)] {
+                    let axis_field = format!("{field}.{axis}");
+                    if rows.len() < 2 || rows.len() > MAX_FRF_ROWS {
+                        return Err(SolverError::input(
+                            axis_field,
+                            format!("give 2 to {MAX_FRF_ROWS} rows per direction"),
+                        ));
+                    }
+                    let mut previous = f64::NEG_INFINITY;
+                    for (index, row) in rows.iter().enumerate() {
+                        let at = format!("{axis_field}[{index}]");
+                        let frequency = finite(&format!("{at}.frequency_hz"), row.frequency_hz)?;
+                        if frequency < 0.0 || frequency <= previous {
+                            return Err(SolverError::input(
+                                format!("{at}.frequency_hz"),
+                                "frequencies must be at least 0 and increase strictly",
+                            ));
+                        }
+                        previous = frequency;
+                        finite(&format!("{at}.real"), row.real)?;
+                        finite(&format!("{at}.imag"), row.imag)?;
+                    }
+                }
             }
         }
         Ok(())
@@ -222,6 +404,47 @@ mod tests {
         tool.neck_radius = None;
         tool.flutes = 0;
         assert_eq!(tool.validate("").unwrap_err().field(), Some("flutes"));
+    }
+
+    #[test]
+    fn prediction_data_is_validated() {
+        let mut tool: Tool = serde_json::from_str(
+            r#"{"kind": "ball", "radius": 5,
+                "shape_error": [{"angle_deg": 0, "error": 0.005}, {"angle_deg": 90, "error": 0.015}],
+                "stiffness": {"kind": "modal",
+                              "x": [{"stiffness": 5000, "frequency_hz": 1370, "damping_ratio": 0.05}],
+                              "y": [{"stiffness": 5000, "frequency_hz": 1370, "damping_ratio": 0.05}]}}"#,
+        )
+        .unwrap();
+        assert!(tool.validate("tool.").is_ok());
+        let round_trip: Tool = serde_json::from_str(&serde_json::to_string(&tool).unwrap()).unwrap();
+        assert_eq!(round_trip, tool);
+        tool.shape_error = Some(vec![
+            ShapeErrorPoint { angle_deg: 30.0, error: 0.0 },
+            ShapeErrorPoint { angle_deg: 30.0, error: 0.0 },
+        ]);
+        assert_eq!(tool.validate("tool.").unwrap_err().field(), Some("tool.shape_error[1].angle_deg"));
+        tool.shape_error = Some(vec![ShapeErrorPoint { angle_deg: 95.0, error: 0.0 }]);
+        assert!(tool.validate("tool.").is_err());
+        tool.shape_error = None;
+        tool.stiffness = Some(Stiffness::Static { x: 5000.0, y: -1.0 });
+        assert_eq!(tool.validate("tool.").unwrap_err().field(), Some("tool.stiffness.y"));
+        tool.stiffness = Some(Stiffness::Modal {
+            x: vec![Mode { stiffness: 1.0, frequency_hz: 100.0, damping_ratio: 1.5 }],
+            y: vec![],
+        });
+        assert_eq!(tool.validate("tool.").unwrap_err().field(), Some("tool.stiffness.x[0].damping_ratio"));
+        tool.stiffness = Some(Stiffness::Frf {
+            x: vec![
+                FrfPoint { frequency_hz: 0.0, real: 1e-4, imag: 0.0 },
+                FrfPoint { frequency_hz: 0.0, real: 1e-4, imag: 0.0 },
+            ],
+            y: vec![],
+        });
+        assert_eq!(tool.validate("tool.").unwrap_err().field(), Some("tool.stiffness.x[1].frequency_hz"));
+        let plain: Tool = serde_json::from_str(r#"{"kind": "flat", "radius": 3}"#).unwrap();
+        assert_eq!(plain.shape_error, None);
+        assert_eq!(plain.stiffness, None);
     }
 
     #[test]

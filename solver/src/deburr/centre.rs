@@ -138,12 +138,16 @@ impl Construction {
         let surface = |q: Vec3| {
             if on_wall { profile.signed_distance(q.x, q.y).0 } else { self.cylinder(&q) }
         };
-        let start = near.dot(&b2).atan2(near.dot(&b1));
-        // Newton from the tangent-line estimate converges in a few steps; the bracketing search
-        // below is the fallback for strongly curved cases.
-        let mut angle = start;
+        // Newton from the tangent-line estimate converges in two or three steps. It turns the unit
+        // vector (cos, sin) by each step instead of calling the trigonometric functions, which
+        // would cost more than the rest of the construction; the bracketing search below is the
+        // fallback for strongly curved cases.
+        let (along_b1, along_b2) = (near.dot(&b1), near.dot(&b2));
+        let length = (along_b1 * along_b1 + along_b2 * along_b2).sqrt();
+        let (mut cos, mut sin) = (along_b1 / length, along_b2 / length);
+        let mut turned = 0.0_f64;
         for _ in 0..12 {
-            let q = at(angle);
+            let q = centre + radius * (cos * b1 + sin * b2);
             let value = surface(q);
             if value.abs() < 1e-14 {
                 return Some(q);
@@ -154,15 +158,25 @@ impl Construction {
             } else {
                 Self::cylinder_gradient(&q)
             };
-            let slope = gradient.dot(&(radius * (-angle.sin() * b1 + angle.cos() * b2)));
+            let slope = gradient.dot(&(radius * (cos * b2 - sin * b1)));
             if slope.abs() < 1e-12 {
                 break;
             }
-            angle -= value / slope;
-            if (angle - start).abs() > 1.0 {
+            let step = -value / slope;
+            turned += step;
+            if turned.abs() > 1.0 {
                 break;
             }
+            let (step_sin, step_cos) = if step.abs() < 1e-3 {
+                // Series to the terms that matter at |step| < 1e-3 (remainders below 1e-17).
+                let squared = step * step;
+                (step * (1.0 - squared / 6.0), 1.0 - squared / 2.0 + squared * squared / 24.0)
+            } else {
+                step.sin_cos()
+            };
+            (cos, sin) = (cos * step_cos - sin * step_sin, sin * step_cos + cos * step_sin);
         }
+        let start = along_b2.atan2(along_b1);
         let angle = root_near(|a| surface(at(a)), start, 1e-3, 1.2, 1e-15)?;
         Some(at(angle))
     }

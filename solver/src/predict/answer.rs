@@ -1,0 +1,220 @@
+//! What a prediction request answers (api.md, Error prediction): one record per pass in path
+//! order, statistics, warnings, and (not serialised) what the corrected program needs.
+
+use serde::Serialize;
+
+use super::request::{Method, NodeSource};
+use crate::error::Warning;
+use crate::geometry::Vec3;
+
+/// What happened at a pass (§5).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum PassStatus {
+    /// Predicted.
+    Ok,
+    /// The pass removes nothing (air, or already cut) at every position tried (E1, E3).
+    NoCut,
+    /// It cuts, but later motion removes everything it leaves (E4).
+    NoSurface,
+    /// The ball never reaches the stock's footprint (E10).
+    OutsideStock,
+    /// Outside the requested `pass_range`.
+    NotPredicted,
+}
+
+/// Remarks on a pass's prediction (§5).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum PassFlag {
+    /// The depth buffer looked from the rotated (or zoomed) view (E5, E6).
+    ViewCorrected,
+    /// The finished region touches the outermost ring of pixels (E5).
+    RimLimited,
+    /// Fewer than 4 pixels or samples, or rim-limited (E5).
+    LowConfidence,
+    /// Generation at the tip: azimuth and rotation angle undefined (E7).
+    AtTip,
+    /// The finished surface has several disjoint pieces; the largest is reported (E8).
+    SeveralRegions,
+    /// Retraced motion: the surface is credited to this (later) pass (E11).
+    Retraced,
+    /// The surface survives but the cutting force is zero (E12).
+    NoLoad,
+    /// No deflection data (stiffness and cutting coefficients, or a prescribed history): the
+    /// error is the shape error alone (E13).
+    NoDeflection,
+    /// The contact angle is outside the shape-error table; its end value was used (E14).
+    Extrapolated,
+    /// Some force harmonic is outside the measured compliance table (E21).
+    OutsideFrfBand,
+    /// The correction of the pass's end node was clamped (E20).
+    CorrectionClamped,
+    /// The neighbouring errors cancel: the end node was not moved.
+    CorrectionAmbiguous,
+}
+
+/// Force and deflection over one revolution (§1.3 O2).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct PassHistory {
+    /// Rotation step, degrees (ψ_m = m·step).
+    pub step_deg: f64,
+    /// Force on the tool (F_x, F_y, F_z), N, per step.
+    pub force: Vec<[f64; 3]>,
+    /// Tool-tip deflection (D_x, D_y), mm, per step.
+    pub deflection: Vec<[f64; 2]>,
+}
+
+/// The prediction for one pass.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct PredictedPass {
+    /// Pass index (feed moves and arc chords in path order, from 0).
+    pub index: usize,
+    /// NC line (1-based) of G-code paths.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub line: Option<usize>,
+    /// `N` number of that block.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub block_number: Option<u64>,
+    /// Outcome.
+    pub status: PassStatus,
+    /// Remarks.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub flags: Vec<PassFlag>,
+    /// Distance of the prediction position from the pass start, mm.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub position: Option<f64>,
+    /// Ball centre O at the prediction position.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub centre: Option<[f64; 3]>,
+    /// e = e_D + e_S, mm along the normal; > 0 leaves material (undercut), < 0 overcuts.
+    pub error: Option<f64>,
+    /// e_D: from the deflection at the generation instant, mm.
+    pub error_deflection: Option<f64>,
+    /// e_S = −δ(θ_c): from the shape error, mm.
+    pub error_shape: Option<f64>,
+    /// θ_c: angle between C→O and the tool axis, degrees (0 at the tip).
+    pub contact_angle_deg: Option<f64>,
+    /// φ_c: azimuth of C about the tool axis, degrees counter-clockwise from +X.
+    pub azimuth_deg: Option<f64>,
+    /// ψ_c: rotation angle of flute 0 when it generates C, degrees.
+    pub rotation_angle_deg: Option<f64>,
+    /// Generation point C.
+    pub generation_point: Option<[f64; 3]>,
+    /// Unit surface normal n = (O − C)/R, out of the material.
+    pub normal: Option<[f64; 3]>,
+    /// Tool deflection (D_x, D_y) at the generation instant, mm.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub deflection: Option<[f64; 2]>,
+    /// Pixels (depth buffer) or surface samples (sampling) of the cutting region K.
+    pub cut_count: usize,
+    /// Pixels or samples of the finished region S.
+    pub finished_count: usize,
+    /// View direction of the final depth-buffer view.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub view: Option<[f64; 3]>,
+    /// Predicted error of the once-corrected path (with `iterations` ≥ 2).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residual_error: Option<f64>,
+    /// Move of the pass's end node, mm.
+    pub correction: [f64; 3],
+    /// Corrected end point of the pass (programmed point, in the request's reference).
+    pub corrected: [f64; 3],
+    /// Force and deflection over one revolution, when asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub history: Option<PassHistory>,
+}
+
+/// One worst pass.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct WorstPass {
+    /// Pass index.
+    pub index: usize,
+    /// NC line.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub line: Option<usize>,
+    /// e, mm.
+    pub error: f64,
+}
+
+/// Error statistics of one prediction round.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct RoundSummary {
+    /// Passes with a predicted error.
+    pub predicted: usize,
+    /// Largest |e|, mm.
+    pub max_abs_error: Option<f64>,
+    /// Root mean square of e, mm.
+    pub rms_error: Option<f64>,
+}
+
+/// Statistics over the whole path (no timings: the server measures time).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct PredictSummary {
+    /// Passes.
+    pub passes: usize,
+    /// Passes with status `ok`.
+    pub predicted: usize,
+    /// Passes with status `no_cut`.
+    pub no_cut: usize,
+    /// Passes with status `no_surface`.
+    pub no_surface: usize,
+    /// Passes with status `outside_stock`.
+    pub outside_stock: usize,
+    /// Smallest e, mm.
+    pub min_error: Option<f64>,
+    /// Largest e, mm.
+    pub max_error: Option<f64>,
+    /// Mean e, mm.
+    pub mean_error: Option<f64>,
+    /// Root mean square of e, mm.
+    pub rms_error: Option<f64>,
+    /// The 20 passes with the largest |e|, worst first.
+    pub worst: Vec<WorstPass>,
+    /// Largest node correction, mm.
+    pub max_correction: f64,
+    /// Nodes whose correction was clamped.
+    pub clamped: usize,
+    /// Per prediction round (1 to `iterations`).
+    pub rounds: Vec<RoundSummary>,
+    /// Method used.
+    pub method: Method,
+    /// N.
+    pub resolution: u32,
+    /// Pixel size (sample spacing) 2R/N, mm.
+    pub pixel_size: f64,
+    /// N_t used.
+    pub samples_per_revolution: usize,
+    /// N_θ used.
+    pub edge_elements: usize,
+}
+
+/// The answer of `POST /api/v1/predict`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct Predict {
+    /// One record per pass, in path order.
+    pub passes: Vec<PredictedPass>,
+    /// Statistics.
+    pub summary: PredictSummary,
+    /// Things to know about the whole request.
+    pub warnings: Vec<Warning>,
+    #[serde(skip)]
+    pub(crate) corrections: Corrections,
+}
+
+/// Node corrections and where the nodes came from, for [`super::corrected_program`].
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct Corrections {
+    pub(crate) nodes: Vec<Vec3>,
+    pub(crate) offsets: Vec<Vec3>,
+    pub(crate) sources: Vec<NodeSource>,
+    pub(crate) reference_offset: Vec3,
+}

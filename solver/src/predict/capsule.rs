@@ -1,0 +1,216 @@
+//! Swept volume of a ball end mill on one straight segment (a capsule) and where a ray along the
+//! view direction first enters it: the closed forms of error-prediction.md §3.5 and §6.3.
+//!
+//! Everything here works in a view frame whose +z is the view direction v̂ (from the material
+//! toward the tool): a ray through a point (x, y) travels along +z, and the capsule's "entry
+//! depth" at (x, y) is the smallest z at which it is inside the capsule. For the view from below
+//! the frame is the machine frame, and the entry depth equals the lowest point of the tool
+//! (ball and shank) over (x, y), so the same test serves the depth buffer and the point test of
+//! the surface-sampling method (§6.6, 3-axis with a vertical shank).
+
+use crate::geometry::Vec3;
+
+/// A capsule of radius R about the segment AB, in view-frame coordinates.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Capsule {
+    a: Vec3,
+    b: Vec3,
+    /// Unit axis A→B (zero for a point).
+    axis: Vec3,
+    length: f64,
+    /// xy part of B − A and the inverse of its squared length (0 for a vertical segment).
+    ab_xy: (f64, f64),
+    inverse_xy: f64,
+    /// 1 − axis_z²: the cylinder term's quadratic coefficient, and its inverse (0 for a segment
+    /// along the view).
+    denom: f64,
+    inverse_denom: f64,
+    /// Lowest z of the axis segment.
+    pub(crate) min_z: f64,
+}
+
+impl Capsule {
+    pub(crate) fn new(a: Vec3, b: Vec3) -> Self {
+        let ab = b - a;
+        let length = ab.norm();
+        let axis = if length > 0.0 { ab / length } else { Vec3::zeros() };
+        let denom = 1.0 - axis.z * axis.z;
+        let denom = if length > 0.0 && denom > 1e-12 { denom } else { 0.0 };
+        let length_xy2 = ab.x * ab.x + ab.y * ab.y;
+        Self {
+            a,
+            b,
+            axis,
+            length,
+            ab_xy: (ab.x, ab.y),
+            inverse_xy: if length_xy2 > 0.0 { 1.0 / length_xy2 } else { 0.0 },
+            denom,
+            inverse_denom: if denom > 0.0 { 1.0 / denom } else { 0.0 },
+            min_z: a.z.min(b.z),
+        }
+    }
+
+    /// The smallest z at which the ray along +z through (x, y) is inside the capsule of squared
+    /// radius `r2`, if the ray meets it.
+    #[inline]
+    pub(crate) fn entry_z(&self, x: f64, y: f64, r2: f64) -> Option<f64> {
+        // Beyond R of the axis in xy the ray misses everything.
+        let (abx, aby) = self.ab_xy;
+        let (apx, apy) = (x - self.a.x, y - self.a.y);
+        let t = ((apx * abx + apy * aby) * self.inverse_xy).clamp(0.0, 1.0);
+        let (dx, dy) = (apx - t * abx, apy - t * aby);
+        if dx * dx + dy * dy > r2 {
+            return None;
+        }
+        if self.denom > 0.0 {
+            // The end spheres lie inside the infinite cylinder: when the ray enters that cylinder
+            // within the segment's span, this is the capsule's entry.
+            let along = apx * self.axis.x + apy * self.axis.y;
+            let half_b = -along * self.axis.z;
+            let c = apx * apx + apy * apy - along * along - r2;
+            let disc = half_b * half_b - self.denom * c;
+            if disc >= 0.0 {
+                let t = (-half_b - disc.sqrt()) * self.inverse_denom;
+                let foot = along + t * self.axis.z;
+                if (0.0..=self.length).contains(&foot) {
+                    return Some(self.a.z + t);
+                }
+            }
+        }
+        let mut best = f64::INFINITY;
+        for end in [&self.a, &self.b] {
+            let (dx, dy) = (x - end.x, y - end.y);
+            let d2 = dx * dx + dy * dy;
+            if d2 <= r2 {
+                best = best.min(end.z - (r2 - d2).sqrt());
+            }
+        }
+        best.is_finite().then_some(best)
+    }
+
+    /// Whether the ray through `q` (along +z) has entered the capsule by the time it reaches `q`
+    /// (within `tie`).
+    #[cfg(test)]
+    pub(crate) fn covers(&self, q: &Vec3, r: f64, r2: f64, tie: f64) -> bool {
+        if self.min_z - r > q.z + tie {
+            return false;
+        }
+        self.entry_z(q.x, q.y, r2).is_some_and(|z| z <= q.z + tie)
+    }
+
+    /// Conservative test: can the capsule cover any point of the box `[lo, hi]` (bounding circle
+    /// of its xy rectangle and its top)?
+    #[inline]
+    pub(crate) fn may_cover_box(&self, lo: &Vec3, hi: &Vec3, r: f64, tie: f64) -> bool {
+        let rise = self.min_z - hi.z - tie;
+        if rise > r {
+            return false;
+        }
+        let (cx, cy) = (0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y));
+        let (width, height) = (hi.x - lo.x, hi.y - lo.y);
+        let half_diagonal = 0.5 * (width * width + height * height).sqrt();
+        let (abx, aby) = self.ab_xy;
+        let (apx, apy) = (cx - self.a.x, cy - self.a.y);
+        let t = ((apx * abx + apy * aby) * self.inverse_xy).clamp(0.0, 1.0);
+        let (dx, dy) = (apx - t * abx, apy - t * aby);
+        let distance = ((dx * dx + dy * dy).sqrt() - half_diagonal).max(0.0);
+        if distance >= r {
+            return false;
+        }
+        // Lowest point over the box: min_z − √(r² − distance²) ≤ top.
+        rise <= 0.0 || rise * rise <= r * r - distance * distance
+    }
+
+    /// xy distance from (x, y) to the axis segment's projection.
+    #[cfg(test)]
+    pub(crate) fn distance_xy(&self, x: f64, y: f64) -> f64 {
+        distance_2d(x, y, &self.a, &self.b)
+    }
+}
+
+/// Distance in the xy plane from (x, y) to the projection of the segment ab.
+#[cfg(test)]
+fn distance_2d(x: f64, y: f64, a: &Vec3, b: &Vec3) -> f64 {
+    let (abx, aby) = (b.x - a.x, b.y - a.y);
+    let (apx, apy) = (x - a.x, y - a.y);
+    let length2 = abx * abx + aby * aby;
+    let t = if length2 > 0.0 { ((apx * abx + apy * aby) / length2).clamp(0.0, 1.0) } else { 0.0 };
+    let (dx, dy) = (apx - t * abx, apy - t * aby);
+    (dx * dx + dy * dy).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::distance_to_segment;
+
+    /// Brute force: march z upward until the point is within R of the segment.
+    fn brute_entry(a: &Vec3, b: &Vec3, x: f64, y: f64, r: f64) -> Option<f64> {
+        let mut z = a.z.min(b.z) - r - 1.0;
+        let top = a.z.max(b.z) + r + 1.0;
+        let step = 1e-4;
+        while z < top {
+            if distance_to_segment(&Vec3::new(x, y, z), a, b) <= r {
+                return Some(z);
+            }
+            z += step;
+        }
+        None
+    }
+
+    #[test]
+    fn capsule_entry_matches_brute_force() {
+        let r = 2.0;
+        let segments = [
+            (Vec3::new(0.0, 0.0, 0.0), Vec3::new(5.0, 1.0, 2.0)),
+            (Vec3::new(1.0, 1.0, 1.0), Vec3::new(1.0, 1.0, 4.0)),
+            (Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 0.0)),
+            (Vec3::new(-1.0, 2.0, 3.0), Vec3::new(3.0, -2.0, 3.0)),
+        ];
+        for (a, b) in segments {
+            let capsule = Capsule::new(a, b);
+            for i in 0..25 {
+                for j in 0..25 {
+                    let x = -3.0 + 0.41 * f64::from(i);
+                    let y = -4.0 + 0.43 * f64::from(j);
+                    let exact = capsule.entry_z(x, y, r * r);
+                    let brute = brute_entry(&a, &b, x, y, r);
+                    match (exact, brute) {
+                        (Some(e), Some(f)) => assert!((e - f).abs() < 2e-4, "{e} vs {f}"),
+                        (None, None) => {}
+                        (e, f) => {
+                            // Grazing rays may differ by the brute-force step.
+                            let d = capsule.distance_xy(x, y);
+                            assert!((d - r).abs() < 1e-3, "{e:?} vs {f:?} at distance {d}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn box_test_is_conservative() {
+        let r = 1.5;
+        let capsule = Capsule::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(3.0, 0.5, -0.5));
+        for i in 0..12 {
+            for j in 0..12 {
+                for k in 0..6 {
+                    let lo = Vec3::new(-2.0 + 0.5 * f64::from(i), -3.0 + 0.5 * f64::from(j), -2.5 + 0.5 * f64::from(k));
+                    let hi = lo + Vec3::new(0.4, 0.3, 0.2);
+                    if capsule.may_cover_box(&lo, &hi, r, 0.0) {
+                        continue;
+                    }
+                    for s in 0..5 {
+                        for t in 0..5 {
+                            for u in 0..3 {
+                                let q = lo + Vec3::new(0.1 * f64::from(s), 0.075 * f64::from(t), 0.1 * f64::from(u));
+                                assert!(!capsule.covers(&q, r, r * r, 0.0), "{q:?}");
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,500 @@
+//! The per-pass prediction of error-prediction.md §3.1 (S1–S11) and its run over all passes in
+//! parallel (rayon, results in pass order): prediction position (§3.3), cutting region and force
+//! (§3.6–3.7), deflection (§3.8), finished surface and generation point by sampling (§6.6) or by
+//! the depth buffer with view correction (§3.9–3.11), and the errors (§3.12).
+
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+use nalgebra::Matrix3;
+use rayon::prelude::*;
+
+use super::answer::{PassFlag, PassHistory, PassStatus};
+use super::dynamics::{self, Compliance};
+use super::force::{self, EdgeGrid, Engagement};
+use super::passes::PathModel;
+use super::render::{self, Image, Window};
+use super::request::{Job, Method};
+use super::sampling::{self, Band};
+use super::scene::{self, Scene, Scratch};
+use super::shape;
+use crate::error::SolverError;
+use crate::geometry::Vec3;
+
+/// Most prediction positions tried along one pass (§3.3).
+const MAX_STATIONS: usize = 17;
+/// Fewest finished pixels before the view is corrected (§5 E5).
+const MIN_FINISHED_PIXELS: usize = 4;
+
+/// Progress reporting and cancellation for long runs.
+#[derive(Clone, Copy, Default)]
+pub struct Control<'a> {
+    /// Called with the fraction done (0–1), from worker threads, about every 0.5 %.
+    pub progress: Option<&'a (dyn Fn(f64) + Sync)>,
+    /// Set to stop: the run ends with `E_CANCELLED`.
+    pub cancel: Option<&'a AtomicBool>,
+}
+
+impl std::fmt::Debug for Control<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Control").field("progress", &self.progress.is_some()).field("cancel", &self.cancel).finish()
+    }
+}
+
+/// What one pass gives.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Outcome {
+    pub(crate) status: PassStatus,
+    pub(crate) flags: Vec<PassFlag>,
+    pub(crate) position: Option<f64>,
+    pub(crate) centre: Option<Vec3>,
+    pub(crate) error: Option<f64>,
+    pub(crate) error_deflection: Option<f64>,
+    pub(crate) error_shape: Option<f64>,
+    pub(crate) contact_angle: Option<f64>,
+    pub(crate) azimuth: Option<f64>,
+    pub(crate) rotation_angle: Option<f64>,
+    pub(crate) point: Option<Vec3>,
+    pub(crate) normal: Option<Vec3>,
+    pub(crate) deflection: Option<[f64; 2]>,
+    pub(crate) cut_count: usize,
+    pub(crate) finished_count: usize,
+    pub(crate) view: Option<Vec3>,
+    pub(crate) history: Option<PassHistory>,
+}
+
+impl Outcome {
+    fn empty(status: PassStatus) -> Self {
+        Self {
+            status,
+            flags: Vec::new(),
+            position: None,
+            centre: None,
+            error: None,
+            error_deflection: None,
+            error_shape: None,
+            contact_angle: None,
+            azimuth: None,
+            rotation_angle: None,
+            point: None,
+            normal: None,
+            deflection: None,
+            cut_count: 0,
+            finished_count: 0,
+            view: None,
+            history: None,
+        }
+    }
+}
+
+/// Everything shared by the passes of one round.
+pub(crate) struct Context<'a> {
+    pub(crate) job: &'a Job,
+    grids: [Option<EdgeGrid>; 2],
+    kernels: HashMap<u64, SpindleKernels>,
+}
+
+/// Impulse responses in X and Y at one spindle speed, and whether a harmonic left the table.
+struct SpindleKernels {
+    kernels: (Vec<f64>, Vec<f64>),
+    outside: bool,
+}
+
+fn sign_slot(sign: f64) -> usize {
+    usize::from(sign > 0.0)
+}
+
+impl<'a> Context<'a> {
+    pub(crate) fn new(job: &'a Job) -> Self {
+        let helix = job.helix.tan();
+        let mut grids = [None, None];
+        for pass in &job.path.passes {
+            let slot = sign_slot(pass.source.rotation_sign);
+            if grids[slot].is_none() {
+                grids[slot] = Some(EdgeGrid::new(
+                    job.edge_elements,
+                    job.steps,
+                    job.flutes,
+                    pass.source.rotation_sign,
+                    job.flute_zero,
+                    |theta| (1.0 - theta.cos()) * helix,
+                ));
+            }
+        }
+        let mut kernels = HashMap::new();
+        if job.deflection.is_none()
+            && job.cutting.is_some()
+            && let Some(stiffness) = &job.stiffness
+        {
+            let (cx, cy) = Compliance::pair(stiffness);
+            for &rpm in &job.spindle_speeds {
+                let (kx, out_x) = dynamics::kernel(&cx, rpm, job.steps);
+                let (ky, out_y) = dynamics::kernel(&cy, rpm, job.steps);
+                kernels.insert(rpm.to_bits(), SpindleKernels { kernels: (kx, ky), outside: out_x || out_y });
+            }
+        }
+        Self { job, grids, kernels }
+    }
+}
+
+/// Runs every pass of `path` in parallel; `None` when cancelled.
+pub(crate) fn run_round(
+    context: &Context<'_>,
+    path: &PathModel,
+    control: &Control<'_>,
+    done: &AtomicUsize,
+    total_work: usize,
+) -> Option<Vec<Outcome>> {
+    let cancelled = AtomicBool::new(false);
+    let report_every = (total_work / 200).max(1);
+    let range = context.job.pass_range.clone();
+    let predicted: Vec<Option<Outcome>> = range
+        .clone()
+        .into_par_iter()
+        .map_init(Scratch::default, |scratch, index| {
+            if control.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+                cancelled.store(true, Ordering::Relaxed);
+                return None;
+            }
+            let outcome = predict_pass(context, path, index, scratch);
+            let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
+            if let Some(progress) = control.progress
+                && (finished.is_multiple_of(report_every) || finished == total_work)
+            {
+                progress(finished as f64 / total_work as f64);
+            }
+            Some(outcome)
+        })
+        .collect();
+    if cancelled.load(Ordering::Relaxed) {
+        return None;
+    }
+    let mut predicted = predicted.into_iter();
+    (0..path.passes.len())
+        .map(|index| {
+            if range.contains(&index) {
+                predicted.next().flatten()
+            } else {
+                Some(Outcome::empty(PassStatus::NotPredicted))
+            }
+        })
+        .collect()
+}
+
+/// The cancellation error.
+pub(crate) fn cancelled() -> SolverError {
+    SolverError::new("E_CANCELLED", "the prediction was cancelled")
+}
+
+/// The full pipeline for one pass.
+pub(crate) fn predict_pass(context: &Context<'_>, path: &PathModel, index: usize, scratch: &mut Scratch) -> Outcome {
+    let job = context.job;
+    let radius = job.radius;
+    let pass = path.passes[index];
+    let segment = path.segments[pass.segment];
+    let (start, end) = path.ends(pass.segment);
+    let length = segment.length;
+    if length <= 0.0 {
+        return Outcome::empty(PassStatus::NoCut);
+    }
+    let (foot_lo, foot_hi) = job.stock.footprint();
+    if start.x.min(end.x) - radius >= foot_hi[0]
+        || start.x.max(end.x) + radius <= foot_lo[0]
+        || start.y.min(end.y) - radius >= foot_hi[1]
+        || start.y.max(end.y) + radius <= foot_lo[1]
+    {
+        return Outcome::empty(PassStatus::OutsideStock);
+    }
+    let feed_direction = (end - start) / length;
+    let source = pass.source;
+    let tooth_feed = source.feed / (source.spindle_rpm * job.flutes as f64);
+    let gap = job.tooth_feed_gap * tooth_feed;
+    let Some(grid) = context.grids[sign_slot(source.rotation_sign)].as_ref() else {
+        return Outcome::empty(PassStatus::NoCut);
+    };
+    let coefficients = if job.deflection.is_none() { job.cutting.as_ref() } else { None };
+    let mut pieces = Vec::new();
+    // Stations: the middle first, then alternately ahead and behind (§3.3).
+    let step = tooth_feed.max(length / 16.0);
+    let mut stations = vec![0.5 * length];
+    for m in 1..MAX_STATIONS {
+        let offset = step * m.div_ceil(2) as f64;
+        let s = if m % 2 == 1 { 0.5 * length + offset } else { 0.5 * length - offset };
+        if (0.0..=length).contains(&s) {
+            stations.push(s);
+        }
+    }
+    let mut chosen: Option<(f64, Vec3, Scene, Engagement)> = None;
+    let mut retraced: Option<(f64, Vec3, Scene, Engagement)> = None;
+    for (try_index, &s) in stations.iter().enumerate() {
+        let centre = start + s * feed_direction;
+        let sigma = segment.sigma + s;
+        scene::gather(
+            path,
+            &scene::Query { centre, sigma, gap, radius, reach: 2.0 * radius, any_view: false },
+            scratch,
+            &mut pieces,
+        );
+        let below = Scene::new(&pieces, centre, Matrix3::identity(), radius);
+        let engagement = force::engage(grid, &below, &job.stock, &feed_direction, tooth_feed, coefficients);
+        if engagement.cut_elements > 0 {
+            chosen = Some((s, centre, below, engagement));
+            break;
+        }
+        if try_index == 0 {
+            retraced = Some((s, centre, below, engagement));
+        }
+    }
+    let mut outcome = Outcome::empty(PassStatus::Ok);
+    let found = match chosen {
+        Some(c) => Some((c, false)),
+        None => retraced.map(|r| (r, true)),
+    };
+    let Some(((s, centre, below, engagement), no_engagement)) = found else {
+        return Outcome::empty(PassStatus::NoCut);
+    };
+    outcome.position = Some(s);
+    outcome.centre = Some(centre);
+    let sigma = segment.sigma + s;
+
+    // The finished surface and the generation point.
+    let pixel = 2.0 * radius / f64::from(job.resolution);
+    let (point, tip) = match job.method {
+        Method::Sampling => {
+            let band = band(path, pass.segment, &centre, &feed_direction, sigma, gap, pixel);
+            let surface = sampling::sample(&below, &job.stock, &band);
+            outcome.cut_count = surface.cut_samples;
+            outcome.finished_count = surface.finished_samples;
+            if surface.regions > 1 {
+                outcome.flags.push(PassFlag::SeveralRegions);
+            }
+            if no_engagement && !surface.retraced {
+                return Outcome::empty(PassStatus::NoCut);
+            }
+            if surface.retraced {
+                outcome.flags.push(PassFlag::Retraced);
+            }
+            if surface.finished_samples < MIN_FINISHED_PIXELS && surface.point.is_some() {
+                outcome.flags.push(PassFlag::LowConfidence);
+            }
+            let tip = surface.point.is_some_and(|c| (c - centre).xy().norm() < 0.5 * pixel);
+            (surface.point, tip)
+        }
+        Method::DepthBuffer => {
+            let image =
+                depth_buffer(context, path, &pieces, &centre, &feed_direction, sigma, gap, &mut outcome, scratch);
+            if no_engagement && !image.retraced {
+                return Outcome::empty(PassStatus::NoCut);
+            }
+            if image.retraced {
+                outcome.flags.push(PassFlag::Retraced);
+            }
+            let tip = !outcome.flags.contains(&PassFlag::ViewCorrected)
+                && image.point.is_some()
+                && image.centroid_offset < 0.5 * image.pixel;
+            (image.point, tip)
+        }
+    };
+    let Some(point) = point else {
+        outcome.status = PassStatus::NoSurface;
+        return outcome;
+    };
+
+    // Angles and normal (§3.11), errors (§3.12).
+    let (point, contact_angle, azimuth, normal) = if tip {
+        outcome.flags.push(PassFlag::AtTip);
+        (centre - radius * Vec3::z(), 0.0, None, Vec3::z())
+    } else {
+        let offset = point - centre;
+        let theta = (-offset.z / radius).clamp(-1.0, 1.0).acos();
+        (point, theta, Some(offset.y.atan2(offset.x)), -offset / radius)
+    };
+    let sign = source.rotation_sign;
+    let rotation_angle = azimuth.map(|phi| {
+        (sign * (phi - job.flute_zero) + (1.0 - contact_angle.cos()) * job.helix.tan())
+            .rem_euclid(std::f64::consts::TAU)
+    });
+    let (delta, extrapolated) = shape::delta(&job.shape_error, contact_angle.to_degrees());
+    if extrapolated {
+        outcome.flags.push(PassFlag::Extrapolated);
+    }
+    let error_shape = -delta;
+    let force_history = &engagement.force;
+    let mut history_deflection: Option<Vec<[f64; 2]>> = None;
+    let deflection: Option<[f64; 2]> = if let Some(prescribed) = &job.deflection {
+        rotation_angle.map_or(Some([0.0, 0.0]), |psi| Some(prescribed_at(prescribed, psi)))
+    } else if let (Some(_), Some(spindle)) = (coefficients, context.kernels.get(&source.spindle_rpm.to_bits())) {
+        if spindle.outside {
+            outcome.flags.push(PassFlag::OutsideFrfBand);
+        }
+        if force_history.iter().all(|f| f[0] == 0.0 && f[1] == 0.0 && f[2] == 0.0) {
+            outcome.flags.push(PassFlag::NoLoad);
+        }
+        let kernels = &spindle.kernels;
+        if job.history.contains(&index) {
+            history_deflection = Some(dynamics::deflection_history(kernels, force_history));
+        }
+        Some(rotation_angle.map_or([0.0, 0.0], |psi| dynamics::deflection_at(kernels, force_history, psi)))
+    } else {
+        outcome.flags.push(PassFlag::NoDeflection);
+        None
+    };
+    let error_deflection = deflection.map(|d| if azimuth.is_none() { 0.0 } else { d[0] * normal.x + d[1] * normal.y });
+    outcome.error_shape = Some(error_shape);
+    outcome.error_deflection = error_deflection;
+    outcome.error = Some(error_shape + error_deflection.unwrap_or(0.0));
+    outcome.contact_angle = Some(contact_angle);
+    outcome.azimuth = azimuth;
+    outcome.rotation_angle = rotation_angle;
+    outcome.point = Some(point);
+    outcome.normal = Some(normal);
+    outcome.deflection = deflection;
+    if job.history.contains(&index) && !force_history.is_empty() {
+        outcome.history = Some(PassHistory {
+            step_deg: 360.0 / force_history.len() as f64,
+            force: force_history.clone(),
+            deflection: history_deflection.unwrap_or_default(),
+        });
+    }
+    outcome
+}
+
+/// D(ψ) of a prescribed history, periodic, linear between samples.
+fn prescribed_at(prescribed: &super::request::PrescribedDeflection, psi: f64) -> [f64; 2] {
+    let n = prescribed.x.len();
+    let position = psi.rem_euclid(std::f64::consts::TAU) / std::f64::consts::TAU * n as f64;
+    let k0 = (position.floor() as usize).min(n - 1);
+    let k1 = (k0 + 1) % n;
+    let t = position - k0 as f64;
+    [(1.0 - t) * prescribed.x[k0] + t * prescribed.x[k1], (1.0 - t) * prescribed.y[k0] + t * prescribed.y[k1]]
+}
+
+/// The sampling band: |a| ≤ g/2 on each side where the path runs straight through the gap end
+/// (the ball there hides the rest), the whole zone range otherwise.
+fn band(
+    path: &PathModel,
+    segment: usize,
+    centre: &Vec3,
+    feed_direction: &Vec3,
+    sigma: f64,
+    gap: f64,
+    pixel: f64,
+) -> Band {
+    let radius_scale = centre.norm().max(1.0);
+    let straight = |sign: f64| {
+        path.point_at(segment, sigma + sign * gap)
+            .is_some_and(|p| (p - (centre + sign * gap * feed_direction)).norm() <= 1e-9 * radius_scale)
+    };
+    let (back, front) = (straight(-1.0), straight(1.0));
+    let both = back && front;
+    Band {
+        axis: *feed_direction,
+        a_lo: if back { -0.5 * gap } else { f64::NEG_INFINITY },
+        a_hi: if front { 0.5 * gap } else { f64::INFINITY },
+        row_spacing: if both { pixel } else { (0.5 * gap).clamp(pixel, 4.0 * pixel) },
+        spacing: pixel,
+    }
+}
+
+/// The image-plane frame: rows ê₁, ê₂, v̂ with ê₂ the feed direction projected on the image
+/// plane and ê₁ = ê₂ × v̂ (§3.5).
+fn view_frame(view: &Vec3, feed_direction: &Vec3) -> Matrix3<f64> {
+    let mut up = feed_direction - feed_direction.dot(view) * view;
+    if up.norm() < 1e-9 {
+        let helper = if view.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
+        up = helper - helper.dot(view) * view;
+    }
+    let up = up.normalize();
+    let right = up.cross(view);
+    Matrix3::from_rows(&[right.transpose(), up.transpose(), view.transpose()])
+}
+
+/// The depth-buffer method: from below, then the rotated and zoomed views when needed (§3.10).
+#[allow(clippy::too_many_arguments)]
+fn depth_buffer(
+    context: &Context<'_>,
+    path: &PathModel,
+    pieces: &[scene::Piece],
+    centre: &Vec3,
+    feed_direction: &Vec3,
+    sigma: f64,
+    gap: f64,
+    outcome: &mut Outcome,
+    scratch: &mut Scratch,
+) -> Image {
+    let job = context.job;
+    let radius = job.radius;
+    let pixels = job.resolution as usize;
+    let up = Vec3::z();
+    let below_scene = Scene::new(pieces, *centre, view_frame(&up, feed_direction), radius);
+    let full = Window { centre: [0.0, 0.0], side: 2.0 * radius, pixels, area_weighted: false };
+    let below = render::render(&below_scene, &job.stock, &full);
+    outcome.cut_count = below.cut_pixels;
+    outcome.finished_count = below.finished_pixels;
+    outcome.view = Some(up);
+    let theta = below.point.map(|c| (-(c - centre).z / radius).clamp(-1.0, 1.0).acos());
+    let needs_correction = below.cut_pixels > 0
+        && (below.point.is_none()
+            || theta.is_some_and(|t| t > job.view_threshold)
+            || below.rim
+            || below.finished_pixels < MIN_FINISHED_PIXELS);
+    if !needs_correction || !job.view_correction || below.cut_inward.norm() == 0.0 {
+        if below.rim {
+            outcome.flags.push(PassFlag::RimLimited);
+        }
+        if below.point.is_some() && (below.rim || below.finished_pixels < MIN_FINISHED_PIXELS) {
+            outcome.flags.push(PassFlag::LowConfidence);
+        }
+        if below.regions > 1 {
+            outcome.flags.push(PassFlag::SeveralRegions);
+        }
+        return below;
+    }
+    // (a) Look along the mean inward normal of the cutting region.
+    let view = below.cut_inward.normalize();
+    let mut wide = Vec::new();
+    scene::gather(
+        path,
+        &scene::Query { centre: *centre, sigma, gap, radius, reach: 5.0 * radius, any_view: true },
+        scratch,
+        &mut wide,
+    );
+    let rotated_scene = Scene::new(&wide, *centre, view_frame(&view, feed_direction), radius);
+    let rotated_window = Window { area_weighted: true, ..full };
+    let mut image = render::render(&rotated_scene, &job.stock, &rotated_window);
+    outcome.flags.push(PassFlag::ViewCorrected);
+    outcome.view = Some(view);
+    // (b) Zoom on the cutting region, then halve the window up to three times.
+    if image.point.is_none()
+        && let Some(b) = image.cut_box
+    {
+        let margin = 2.0 * image.pixel;
+        let mut window = Window {
+            centre: [0.5 * (b[0] + b[2]), 0.5 * (b[1] + b[3])],
+            side: (b[2] - b[0]).max(b[3] - b[1]) + 2.0 * margin,
+            pixels,
+            area_weighted: true,
+        };
+        for _ in 0..4 {
+            let zoomed = render::render(&rotated_scene, &job.stock, &window);
+            let found = zoomed.point.is_some();
+            image = zoomed;
+            if found {
+                break;
+            }
+            window.side *= 0.5;
+        }
+    }
+    outcome.cut_count = image.cut_pixels;
+    outcome.finished_count = image.finished_pixels;
+    if image.rim {
+        outcome.flags.push(PassFlag::RimLimited);
+    }
+    if image.point.is_some() && (image.rim || image.finished_pixels < MIN_FINISHED_PIXELS) {
+        outcome.flags.push(PassFlag::LowConfidence);
+    }
+    if image.regions > 1 {
+        outcome.flags.push(PassFlag::SeveralRegions);
+    }
+    image
+}

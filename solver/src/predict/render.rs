@@ -1,0 +1,210 @@
+//! The software depth buffer (error-prediction.md §3.5, §3.6, §3.9–3.11, §6.2): an orthographic
+//! N × N view of the lower hemisphere M, the swept volumes and the stock along v̂, evaluated
+//! analytically per pixel. From below (v̂ = +Z) or from a rotated or zoomed view (§3.10).
+//!
+//! The image is processed in 16 × 16 pixel tiles; a tile whose box misses the stock, lies off the
+//! disc of M or above the ball centre is skipped whole, and the capsule candidates are pruned per
+//! tile, so only the pixels where M is in the material pay for capsule tests.
+
+use std::collections::HashMap;
+
+use super::scene::{SampleState, Scene, TileLists};
+use super::stock::StockModel;
+use crate::geometry::Vec3;
+
+/// Pixels per tile side.
+const TILE: usize = 16;
+
+/// The window: square of side `window` in the image plane of the scene's frame, centred at
+/// `centre` (image-plane coordinates relative to the ball centre), N × N pixels.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Window {
+    pub(crate) centre: [f64; 2],
+    pub(crate) side: f64,
+    pub(crate) pixels: usize,
+    /// Weight pixels by 1/|n·v̂| (their true area) for the centroid.
+    pub(crate) area_weighted: bool,
+}
+
+/// What one rendering shows.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Image {
+    /// Pixels of the cutting region K.
+    pub(crate) cut_pixels: usize,
+    /// Pixels of the finished region S (all regions).
+    pub(crate) finished_pixels: usize,
+    /// Disjoint regions of S.
+    pub(crate) regions: usize,
+    /// Some pixel of S lies in the outermost ring of M's disc (§5 E5).
+    pub(crate) rim: bool,
+    /// Generation point C (world) of the largest region of S.
+    pub(crate) point: Option<Vec3>,
+    /// Distance of the centroid from the view axis through O, mm (for the tip test, §5 E7).
+    pub(crate) centroid_offset: f64,
+    /// Pixel size, mm.
+    pub(crate) pixel: f64,
+    /// Sum over K of −ê_r (world), for the rotated view direction (§3.10 a).
+    pub(crate) cut_inward: Vec3,
+    /// Image-plane bounding box of K: [x_lo, y_lo, x_hi, y_hi].
+    pub(crate) cut_box: Option<[f64; 4]>,
+    /// Some surviving pixel was hidden by T1 only through a tie (§5 E11).
+    pub(crate) retraced: bool,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Finished {
+    i: usize,
+    j: usize,
+    x: f64,
+    y: f64,
+    weight: f64,
+}
+
+/// Renders the scene through `window`.
+pub(crate) fn render(scene: &Scene, stock: &StockModel, window: &Window) -> Image {
+    let n = window.pixels;
+    let pixel = window.side / n as f64;
+    let radius = scene.radius;
+    let r2 = scene.r2;
+    let coordinate = |k: usize, c: f64| c + (k as f64 + 0.5 - n as f64 / 2.0) * pixel;
+    let back = scene.rotation.transpose();
+    let mut image = Image {
+        cut_pixels: 0,
+        finished_pixels: 0,
+        regions: 0,
+        rim: false,
+        point: None,
+        centroid_offset: 0.0,
+        pixel,
+        cut_inward: Vec3::zeros(),
+        cut_box: None,
+        retraced: false,
+    };
+    let rim_radius = radius - pixel;
+    let mut finished: Vec<Finished> = Vec::new();
+    // Tiles on M's disc, below the ball centre and meeting the stock; then the capsules near
+    // all of them.
+    let tiles = n.div_ceil(TILE);
+    let mut kept: Vec<(usize, usize, usize, usize, super::stock::Region, Vec3, Vec3)> = Vec::new();
+    let mut union_lo = Vec3::repeat(f64::INFINITY);
+    let mut union_hi = Vec3::repeat(f64::NEG_INFINITY);
+    for tile_j in 0..tiles {
+        for tile_i in 0..tiles {
+            let (i0, i1) = (tile_i * TILE, ((tile_i + 1) * TILE).min(n));
+            let (j0, j1) = (tile_j * TILE, ((tile_j + 1) * TILE).min(n));
+            let (x_lo, x_hi) = (coordinate(i0, window.centre[0]), coordinate(i1 - 1, window.centre[0]));
+            let (y_lo, y_hi) = (coordinate(j0, window.centre[1]), coordinate(j1 - 1, window.centre[1]));
+            let nearest_x = 0.0_f64.clamp(x_lo, x_hi);
+            let nearest_y = 0.0_f64.clamp(y_lo, y_hi);
+            let rho_min = nearest_x.hypot(nearest_y);
+            if rho_min > radius {
+                continue;
+            }
+            let rho_max = (x_lo.abs().max(x_hi.abs())).hypot(y_lo.abs().max(y_hi.abs())).min(radius);
+            let lo = Vec3::new(x_lo, y_lo, -(r2 - rho_min * rho_min).max(0.0).sqrt()) - Vec3::repeat(scene.eps);
+            let hi = Vec3::new(x_hi, y_hi, -(r2 - rho_max * rho_max).max(0.0).sqrt()) + Vec3::repeat(scene.eps);
+            let (world_lo, _) = scene.world_box(&lo, &hi);
+            if world_lo.z > scene.centre.z {
+                continue;
+            }
+            let region = scene.region(stock, &lo, &hi);
+            if region == super::stock::Region::Outside {
+                continue;
+            }
+            union_lo = union_lo.inf(&lo);
+            union_hi = union_hi.sup(&hi);
+            kept.push((i0, i1, j0, j1, region, lo, hi));
+        }
+    }
+    let mut pool = TileLists::default();
+    if !kept.is_empty() {
+        scene.candidates(&union_lo, &union_hi, true, None, &mut pool);
+    }
+    let mut lists = TileLists::default();
+    for (i0, i1, j0, j1, region, lo, hi) in kept {
+        {
+            scene.candidates(&lo, &hi, true, Some(&pool), &mut lists);
+            lists.region = Some(region);
+            let mut hints = [0usize; 2];
+            for j in j0..j1 {
+                let y = coordinate(j, window.centre[1]);
+                for i in i0..i1 {
+                    let x = coordinate(i, window.centre[0]);
+                    let rho2 = x * x + y * y;
+                    if rho2 > r2 {
+                        continue;
+                    }
+                    let z = -(r2 - rho2).sqrt();
+                    let q = Vec3::new(x, y, z);
+                    let offset = back * q;
+                    // Only the lower hemisphere is M (§3.5).
+                    if offset.z > 0.0 {
+                        continue;
+                    }
+                    let test = scene.test(stock, &lists, &q, &mut hints);
+                    if test.cut {
+                        image.cut_pixels += 1;
+                        image.cut_inward -= offset / radius;
+                        let b = image.cut_box.get_or_insert([x, y, x, y]);
+                        *b = [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)];
+                    }
+                    if test.state == SampleState::Finished {
+                        if !test.cut {
+                            image.retraced = true;
+                        }
+                        if rho2.sqrt() > rim_radius {
+                            image.rim = true;
+                        }
+                        let weight = if window.area_weighted { radius / (-z).max(1e-3 * radius) } else { 1.0 };
+                        finished.push(Finished { i, j, x, y, weight });
+                    }
+                }
+            }
+        }
+    }
+    image.finished_pixels = finished.len();
+    if finished.is_empty() {
+        return image;
+    }
+    // Regions of S: 4-connected pixel components; the largest is the representative (§5 E8).
+    let index: HashMap<(usize, usize), usize> = finished.iter().enumerate().map(|(k, f)| ((f.i, f.j), k)).collect();
+    let mut parent: Vec<usize> = (0..finished.len()).collect();
+    fn find(parent: &mut [usize], mut x: usize) -> usize {
+        while parent[x] != x {
+            parent[x] = parent[parent[x]];
+            x = parent[x];
+        }
+        x
+    }
+    for (k, f) in finished.iter().enumerate() {
+        for neighbour in [(f.i + 1, f.j), (f.i, f.j + 1)] {
+            if let Some(&other) = index.get(&neighbour) {
+                let (a, b) = (find(&mut parent, k), find(&mut parent, other));
+                if a != b {
+                    parent[a.max(b)] = a.min(b);
+                }
+            }
+        }
+    }
+    let mut weight_of = vec![0.0; finished.len()];
+    let mut count_of = vec![0usize; finished.len()];
+    let mut sum_of = vec![[0.0; 2]; finished.len()];
+    for (k, f) in finished.iter().enumerate() {
+        let root = find(&mut parent, k);
+        count_of[root] += 1;
+        weight_of[root] += f.weight;
+        sum_of[root][0] += f.weight * f.x;
+        sum_of[root][1] += f.weight * f.y;
+    }
+    image.regions = (0..finished.len()).filter(|&k| parent[k] == k).count();
+    let best = (0..finished.len())
+        .filter(|&k| parent[k] == k)
+        .max_by(|&a, &b| count_of[a].cmp(&count_of[b]).then(b.cmp(&a)))
+        .unwrap_or(0);
+    let (x, y) = (sum_of[best][0] / weight_of[best], sum_of[best][1] / weight_of[best]);
+    let rho2 = (x * x + y * y).min(r2);
+    let z = -(r2 - rho2).sqrt();
+    image.centroid_offset = rho2.sqrt();
+    image.point = Some(scene.world(&Vec3::new(x, y, z)));
+    image
+}

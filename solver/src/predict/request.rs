@@ -1,0 +1,554 @@
+//! The prediction request as clients send it (api.md, Error prediction) and its validation into
+//! a `Job`: tool, stock, tool path (points or G-code read into ball-centre passes), cutting
+//! conditions and method settings, with every limit checked before any heavy work.
+
+use serde::{Deserialize, Serialize};
+
+use super::force::CuttingCoefficients;
+use super::passes::{PassSource, PathBuilder, PathModel};
+use super::stock::{Stock, StockModel};
+use crate::error::{SolverError, finite, positive};
+use crate::gcode::Reference;
+use crate::gcode::reader::{self, MoveKind, ReadOptions, ReadProgram, Spindle};
+use crate::geometry::{Vec3, vec3};
+use crate::tool::{ShapeErrorPoint, Stiffness, Tool, ToolKind, ToolRef};
+
+/// Default pixels per side N (the patent's 512 × 512).
+pub const DEFAULT_RESOLUTION: u32 = 512;
+/// Largest N for the surface-sampling method.
+pub const MAX_SAMPLING_RESOLUTION: u32 = 8192;
+/// Memory one worker may use for a depth buffer, bytes.
+pub const MAX_DEPTH_BUFFER_BYTES: u64 = 256 << 20;
+/// Worst-case bytes per pixel of the depth buffer (finished-pixel records and their index).
+pub const DEPTH_BUFFER_BYTES_PER_PIXEL: u64 = 64;
+/// Default rotation steps per revolution N_t (§3.7).
+pub const DEFAULT_STEPS: u32 = 360;
+/// Default edge elements N_θ (§3.7).
+pub const DEFAULT_EDGE_ELEMENTS: u32 = 90;
+/// Default chord tolerance for arcs, mm.
+pub const DEFAULT_ARC_TOLERANCE: f64 = 0.001;
+/// Default view-correction threshold θ_v, degrees (§3.10).
+pub const DEFAULT_VIEW_CORRECTION_DEG: f64 = 60.0;
+/// Default largest node correction, mm (§3.14 clamp).
+pub const DEFAULT_MAX_CORRECTION: f64 = 0.1;
+/// Most passes a request may have.
+pub const MAX_PASSES: usize = 2_000_000;
+/// Most passes whose force and deflection history a request may ask for.
+pub const MAX_HISTORIES: usize = 100;
+/// Most distinct spindle speeds in one program.
+pub const MAX_SPINDLE_SPEEDS: usize = 1000;
+
+/// The tool path.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum PathInput {
+    /// Points of the programmed point in cutting order, joined by feed moves at `feed`.
+    Points {
+        /// `[x, y, z]`, mm; at least 2, at most 2 000 000.
+        points: Vec<[f64; 3]>,
+    },
+    /// A G-code program (G0/G1/G2/G3, G17–G19, G20/G21, G90/G91, F, S, M3/M4/M5; see the
+    /// reader's documentation). Feed moves are the passes; inch programs are converted.
+    Gcode {
+        /// The program text.
+        program: String,
+    },
+}
+
+/// Spindle sense.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum SpindleDirection {
+    /// M03: clockwise seen from above (s_rot = −1).
+    #[default]
+    Cw,
+    /// M04: counter-clockwise (s_rot = +1).
+    Ccw,
+}
+
+/// How the finished surface and the generation point are found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// Resolution-free surface sampling with area weighting (§6.6): the default, as accurate or
+    /// more at every contact angle and needing no view correction.
+    #[default]
+    Sampling,
+    /// The patent's depth buffer from below with the view correction of §3.10.
+    DepthBuffer,
+}
+
+/// A deflection history prescribed instead of the force model (what-if studies, §7 cases B, C).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct PrescribedDeflection {
+    /// D_x at equal steps of flute 0's rotation angle ψ over one revolution (ψ = 360°·k/len),
+    /// mm; one value means constant. 1–100 000 values.
+    pub x: Vec<f64>,
+    /// D_y, same steps as `x`.
+    pub y: Vec<f64>,
+}
+
+/// Path-correction settings (§3.14).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct CorrectionOptions {
+    /// Largest move of one node, mm (default 0.1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_correction: Option<f64>,
+    /// Prediction rounds: 1 (the patent's single correction, default), 2 or 3 (predict again on
+    /// the corrected path and correct the rest).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub iterations: Option<u32>,
+}
+
+/// `POST /api/v1/predict`: predict the machining error of a ball-end-mill finishing path from
+/// the tool's shape error and deflection, and correct the path (error-prediction.md).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct PredictRequest {
+    /// A ball end mill carrying its `shape_error` table (and `stiffness` for the deflection).
+    pub tool: ToolRef,
+    /// The stock before this operation.
+    pub stock: Stock,
+    /// The tool path.
+    pub path: PathInput,
+    /// Which point of the tool the path coordinates describe: `tip` (default) or `centre`.
+    #[serde(default)]
+    pub reference: Reference,
+    /// Spindle speed in rpm where the program sets none (needed for `points`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spindle_rpm: Option<f64>,
+    /// Spindle sense where the program sets none (default `cw`, M03).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spindle_direction: Option<SpindleDirection>,
+    /// Feed in mm/min where the program sets none (needed for `points`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feed: Option<f64>,
+    /// Cutting-force coefficients of the tool/material pair; with the tool's `stiffness` they give
+    /// the deflection.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cutting: Option<CuttingCoefficients>,
+    /// A prescribed deflection history, used instead of force and stiffness.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deflection: Option<PrescribedDeflection>,
+    /// `sampling` (default) or `depth_buffer`.
+    #[serde(default)]
+    pub method: Method,
+    /// Pixels per side N over the tool diameter (default 512; pixel size 2R/N); for `sampling`
+    /// the sample spacing is the same 2R/N.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub resolution: Option<u32>,
+    /// Tooth-feed gap n_g of T1/T2 (1–3, default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tooth_feed_gap: Option<u32>,
+    /// Correct the view past the threshold (`depth_buffer` only; default true).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub view_correction: Option<bool>,
+    /// View-correction threshold θ_v in degrees (default 60).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub view_correction_deg: Option<f64>,
+    /// Φ₀: azimuth of flute 0 at rotation angle 0, degrees counter-clockwise from +X (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flute_zero_deg: Option<f64>,
+    /// Rotation steps per revolution N_t (36–4096, default 360; rounded up to a multiple of the
+    /// flute count).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub samples_per_revolution: Option<u32>,
+    /// Edge elements N_θ from tip to equator (9–720, default 90).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edge_elements: Option<u32>,
+    /// Chord tolerance for G2/G3 arcs, mm (default 0.001).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arc_tolerance: Option<f64>,
+    /// Skip G-code blocks starting with `/` (default false: they run).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub block_delete: Option<bool>,
+    /// Path-correction settings.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub correction: Option<CorrectionOptions>,
+    /// Indices of passes whose force and deflection over one revolution are returned (at most
+    /// 100).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub history: Option<Vec<usize>>,
+    /// Predict only passes `[from, to)` (the whole path still sweeps the stock); the others get
+    /// status `not_predicted`. Lets a long job run in chunks.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pass_range: Option<[usize; 2]>,
+}
+
+/// Where each path node came from, for writing the corrected program.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct NodeSource {
+    /// Index of the G-code move (or of the point) that ends at this node.
+    pub(crate) item: usize,
+    /// Chord of that move (arcs have several), and their count.
+    pub(crate) chord: usize,
+    pub(crate) chords: usize,
+}
+
+/// A validated request.
+#[derive(Debug)]
+pub(crate) struct Job {
+    pub(crate) radius: f64,
+    pub(crate) flutes: usize,
+    pub(crate) helix: f64,
+    pub(crate) shape_error: Vec<ShapeErrorPoint>,
+    pub(crate) stiffness: Option<Stiffness>,
+    pub(crate) stock: StockModel,
+    pub(crate) path: PathModel,
+    pub(crate) node_sources: Vec<NodeSource>,
+    /// Offset from ball centre to programmed point.
+    pub(crate) reference_offset: Vec3,
+    pub(crate) method: Method,
+    pub(crate) resolution: u32,
+    pub(crate) tooth_feed_gap: f64,
+    pub(crate) view_correction: bool,
+    pub(crate) view_threshold: f64,
+    pub(crate) flute_zero: f64,
+    pub(crate) steps: usize,
+    pub(crate) edge_elements: usize,
+    pub(crate) cutting: Option<CuttingCoefficients>,
+    pub(crate) deflection: Option<PrescribedDeflection>,
+    pub(crate) max_correction: f64,
+    pub(crate) iterations: u32,
+    pub(crate) history: Vec<usize>,
+    pub(crate) pass_range: std::ops::Range<usize>,
+    pub(crate) spindle_speeds: Vec<f64>,
+}
+
+fn optional_positive(field: &str, value: Option<f64>, default: f64) -> Result<f64, SolverError> {
+    value.map_or(Ok(default), |v| positive(field, v))
+}
+
+fn range_u32(field: &str, value: Option<u32>, default: u32, lo: u32, hi: u32) -> Result<u32, SolverError> {
+    let v = value.unwrap_or(default);
+    if (lo..=hi).contains(&v) {
+        Ok(v)
+    } else {
+        Err(SolverError::input(field, format!("{field} must be {lo} to {hi} (got {v})")))
+    }
+}
+
+impl PredictRequest {
+    /// Checks everything and reads the path; `mesh` holds the STL bytes of a `mesh` stock.
+    pub(crate) fn validate(&self, tool: &Tool, mesh: Option<&[u8]>) -> Result<Job, SolverError> {
+        tool.validate("tool.")?;
+        if tool.kind != ToolKind::Ball {
+            return Err(SolverError::new(
+                "E_TOOL_KIND",
+                format!("error prediction needs a ball end mill, not a {} tool", tool.kind.as_str()),
+            )
+            .at("tool.kind"));
+        }
+        let Some(shape_error) = tool.shape_error.clone() else {
+            return Err(SolverError::new(
+                "E_NO_SHAPE_ERROR",
+                "the tool has no shape-error table: add shape_error (a list of {\"angle_deg\", \"error\"}) to the tool",
+            )
+            .at("tool.shape_error"));
+        };
+        let radius = tool.radius;
+        let method = self.method;
+        let resolution = range_u32("resolution", self.resolution, DEFAULT_RESOLUTION, 16, MAX_SAMPLING_RESOLUTION)?;
+        if method == Method::DepthBuffer {
+            let bytes = u64::from(resolution).pow(2) * DEPTH_BUFFER_BYTES_PER_PIXEL;
+            if bytes > MAX_DEPTH_BUFFER_BYTES {
+                let limit = ((MAX_DEPTH_BUFFER_BYTES / DEPTH_BUFFER_BYTES_PER_PIXEL) as f64).sqrt() as u64;
+                return Err(SolverError::new(
+                    "E_RESOLUTION_LIMIT",
+                    format!(
+                        "resolution {resolution} needs a depth buffer of up to {} MiB per worker; the limit is {} MiB (resolution at most {limit})",
+                        bytes >> 20,
+                        MAX_DEPTH_BUFFER_BYTES >> 20
+                    ),
+                )
+                .at("resolution"));
+            }
+        }
+        let tooth_feed_gap = f64::from(range_u32("tooth_feed_gap", self.tooth_feed_gap, 1, 1, 3)?);
+        let view_threshold = match self.view_correction_deg {
+            None => DEFAULT_VIEW_CORRECTION_DEG,
+            Some(v) => {
+                if !(0.0..=90.0).contains(&finite("view_correction_deg", v)?) {
+                    return Err(SolverError::input("view_correction_deg", "view_correction_deg must lie in [0, 90]"));
+                }
+                v
+            }
+        }
+        .to_radians();
+        let flute_zero = finite("flute_zero_deg", self.flute_zero_deg.unwrap_or(0.0))?.to_radians();
+        let flutes = tool.flutes as usize;
+        let steps = range_u32("samples_per_revolution", self.samples_per_revolution, DEFAULT_STEPS, 36, 4096)? as usize;
+        let steps = steps.div_ceil(flutes) * flutes;
+        let edge_elements = range_u32("edge_elements", self.edge_elements, DEFAULT_EDGE_ELEMENTS, 9, 720)? as usize;
+        let arc_tolerance = optional_positive("arc_tolerance", self.arc_tolerance, DEFAULT_ARC_TOLERANCE)?;
+        if let Some(cutting) = &self.cutting {
+            cutting.validate("cutting")?;
+        }
+        if let Some(prescribed) = &self.deflection {
+            if prescribed.x.is_empty() || prescribed.x.len() > 100_000 {
+                return Err(SolverError::input("deflection.x", "give 1 to 100000 deflection values per revolution"));
+            }
+            if prescribed.y.len() != prescribed.x.len() {
+                return Err(SolverError::input("deflection.y", "deflection.y needs as many values as deflection.x"));
+            }
+            for (axis, values) in [("x", &prescribed.x), ("y", &prescribed.y)] {
+                for (k, v) in values.iter().enumerate() {
+                    finite(&format!("deflection.{axis}[{k}]"), *v)?;
+                }
+            }
+        }
+        let (max_correction, iterations) = match &self.correction {
+            None => (DEFAULT_MAX_CORRECTION, 1),
+            Some(c) => (
+                optional_positive("correction.max_correction", c.max_correction, DEFAULT_MAX_CORRECTION)?,
+                range_u32("correction.iterations", c.iterations, 1, 1, 3)?,
+            ),
+        };
+        let history = self.history.clone().unwrap_or_default();
+        if history.len() > MAX_HISTORIES {
+            return Err(SolverError::input("history", format!("ask for at most {MAX_HISTORIES} pass histories")));
+        }
+        let defaults = Defaults {
+            feed: self.feed.map(|f| positive("feed", f)).transpose()?,
+            spindle_rpm: self.spindle_rpm.map(|s| positive("spindle_rpm", s)).transpose()?,
+            sign: match self.spindle_direction.unwrap_or_default() {
+                SpindleDirection::Cw => -1.0,
+                SpindleDirection::Ccw => 1.0,
+            },
+        };
+        let stock = self.stock.model(mesh)?;
+        let reference_offset = match self.reference {
+            Reference::Tip => -radius * Vec3::z(),
+            Reference::Centre => Vec3::zeros(),
+        };
+        let centre_of = |p: Vec3| p - reference_offset;
+        let mut builder = PathBuilder::default();
+        let mut node_sources = Vec::new();
+        match &self.path {
+            PathInput::Points { points } => {
+                if points.len() < 2 || points.len() > MAX_PASSES + 1 {
+                    return Err(SolverError::input("path.points", format!("give 2 to {} points", MAX_PASSES + 1)));
+                }
+                let feed =
+                    defaults.feed.ok_or_else(|| SolverError::input("feed", "a path of points needs feed (mm/min)"))?;
+                let spindle_rpm = defaults
+                    .spindle_rpm
+                    .ok_or_else(|| SolverError::input("spindle_rpm", "a path of points needs spindle_rpm"))?;
+                let source =
+                    PassSource { line: None, block_number: None, feed, spindle_rpm, rotation_sign: defaults.sign };
+                for (index, p) in points.iter().enumerate() {
+                    for (axis, v) in p.iter().enumerate() {
+                        finite(&format!("path.points[{index}][{axis}]"), *v)?;
+                    }
+                    let centre = centre_of(vec3(*p));
+                    if index == 0 {
+                        builder.start(centre);
+                    } else {
+                        builder.to(centre, Some(source));
+                    }
+                    node_sources.push(NodeSource { item: index, chord: 0, chords: 1 });
+                }
+            }
+            PathInput::Gcode { program: text } => {
+                let options =
+                    ReadOptions { block_delete: self.block_delete.unwrap_or(false), ..ReadOptions::default() };
+                let read = reader::read(text, "path.program", &options)?;
+                build_from_program(&read, &defaults, arc_tolerance, &centre_of, &mut builder, &mut node_sources)?;
+            }
+        }
+        if builder.pass_count() == 0 {
+            return Err(
+                SolverError::new("E_NO_PASSES", "the tool path has no feed moves from a known position").at("path")
+            );
+        }
+        if builder.pass_count() > MAX_PASSES {
+            return Err(SolverError::new(
+                "E_TOO_MANY_PASSES",
+                format!("the tool path has {} passes; the limit is {MAX_PASSES}", builder.pass_count()),
+            )
+            .at("path"));
+        }
+        let path = builder.build(radius);
+        for (k, &index) in history.iter().enumerate() {
+            if index >= path.passes.len() {
+                return Err(SolverError::input(
+                    format!("history[{k}]"),
+                    format!("the path has {} passes (indices from 0)", path.passes.len()),
+                ));
+            }
+        }
+        let pass_range = match self.pass_range {
+            None => 0..path.passes.len(),
+            Some([from, to]) => {
+                if from > to || to > path.passes.len() {
+                    return Err(SolverError::input(
+                        "pass_range",
+                        format!("pass_range must satisfy from ≤ to ≤ {} (the pass count)", path.passes.len()),
+                    ));
+                }
+                from..to
+            }
+        };
+        let mut spindle_speeds: Vec<f64> = path.passes.iter().map(|p| p.source.spindle_rpm).collect();
+        spindle_speeds.sort_by(f64::total_cmp);
+        spindle_speeds.dedup();
+        if spindle_speeds.len() > MAX_SPINDLE_SPEEDS {
+            return Err(SolverError::new(
+                "E_TOO_MANY_SPINDLE_SPEEDS",
+                format!("the program uses {} spindle speeds; the limit is {MAX_SPINDLE_SPEEDS}", spindle_speeds.len()),
+            )
+            .at("path"));
+        }
+        Ok(Job {
+            radius,
+            flutes,
+            helix: tool.helix_deg.unwrap_or(0.0).to_radians(),
+            shape_error,
+            stiffness: tool.stiffness.clone(),
+            stock,
+            path,
+            node_sources,
+            reference_offset,
+            method,
+            resolution,
+            tooth_feed_gap,
+            view_correction: self.view_correction.unwrap_or(true),
+            view_threshold,
+            flute_zero,
+            steps,
+            edge_elements,
+            cutting: self.cutting,
+            deflection: self.deflection.clone(),
+            max_correction,
+            iterations,
+            history,
+            pass_range,
+            spindle_speeds,
+        })
+    }
+}
+
+/// Cutting conditions used where the program sets none.
+struct Defaults {
+    feed: Option<f64>,
+    spindle_rpm: Option<f64>,
+    sign: f64,
+}
+
+/// Turns the program's moves into path nodes: every known move continues the path; a move from
+/// an unknown position starts a new run at its end.
+fn build_from_program(
+    program: &ReadProgram,
+    defaults: &Defaults,
+    arc_tolerance: f64,
+    centre_of: &impl Fn(Vec3) -> Vec3,
+    builder: &mut PathBuilder,
+    node_sources: &mut Vec<NodeSource>,
+) -> Result<(), SolverError> {
+    let field = "path.program";
+    let mut current: Option<[f64; 3]> = None;
+    let mut tool_number: Option<u32> = None;
+    for (index, read_move) in program.moves.iter().enumerate() {
+        let line = read_move.line;
+        let cutting = !matches!(read_move.kind, MoveKind::Rapid);
+        if cutting {
+            if let (Some(first), Some(this)) = (tool_number, read_move.modal.tool)
+                && first != this
+            {
+                return Err(SolverError::new(
+                    "E_GCODE_UNSUPPORTED",
+                    format!(
+                        "line {line}: the program changes from tool {first} to tool {this}; predict one tool at a time"
+                    ),
+                )
+                .at(field));
+            }
+            tool_number = tool_number.or(read_move.modal.tool);
+        }
+        let (Some(from), Some(to)) = (read_move.from_xyz(), read_move.to_xyz()) else {
+            if cutting && read_move.to_xyz().is_none() {
+                return Err(SolverError::new(
+                    "E_GCODE_POSITION",
+                    format!(
+                        "line {line}: a feed move to a position the program has not fully set (give X, Y and Z first)"
+                    ),
+                )
+                .at(field));
+            }
+            builder.break_run();
+            current = read_move.to_xyz();
+            if let Some(to) = current {
+                builder.start(centre_of(vec3(to)));
+                node_sources.push(NodeSource { item: index, chord: 0, chords: 1 });
+            }
+            continue;
+        };
+        if current != Some(from) || !builder.is_open() {
+            builder.start(centre_of(vec3(from)));
+            node_sources.push(NodeSource { item: index, chord: 0, chords: 0 });
+        }
+        let source = if cutting {
+            let feed = read_move.modal.feed.or(defaults.feed).ok_or_else(|| {
+                SolverError::new(
+                    "E_NO_FEED",
+                    format!("line {line}: feed move without a feed rate (F) and no default feed in the request"),
+                )
+                .at(field)
+            })?;
+            let spindle_rpm = read_move
+                .modal
+                .spindle_rpm
+                .filter(|s| *s > 0.0)
+                .or(defaults.spindle_rpm)
+                .ok_or_else(|| {
+                    SolverError::new(
+                        "E_NO_SPINDLE",
+                        format!("line {line}: feed move without a spindle speed (S) and no default spindle_rpm in the request"),
+                    )
+                    .at(field)
+                })?;
+            let rotation_sign = match read_move.modal.spindle {
+                Spindle::Clockwise => -1.0,
+                Spindle::CounterClockwise => 1.0,
+                Spindle::Off => defaults.sign,
+            };
+            Some(PassSource {
+                line: Some(line),
+                block_number: read_move.block_number,
+                feed,
+                spindle_rpm,
+                rotation_sign,
+            })
+        } else {
+            None
+        };
+        let points = read_move.points(arc_tolerance).unwrap_or_else(|| vec![to]);
+        let chords = points.len();
+        if builder.pass_count() + chords > MAX_PASSES {
+            return Err(SolverError::new(
+                "E_TOO_MANY_PASSES",
+                format!("line {line}: the tool path has more than {MAX_PASSES} passes, the limit"),
+            )
+            .at(field));
+        }
+        for (chord, p) in points.iter().enumerate() {
+            if source.is_some() {
+                builder.to(centre_of(vec3(*p)), source);
+            } else {
+                builder.rapid_to(centre_of(vec3(*p)), line);
+            }
+            node_sources.push(NodeSource { item: index, chord, chords });
+        }
+        debug_assert_eq!(node_sources.len(), builder.node_count());
+        current = Some(to);
+    }
+    Ok(())
+}

@@ -1,0 +1,279 @@
+//! What one prediction position sees (error-prediction.md §3.5, §6.1–6.2): the nearby swept
+//! volumes split into T1 (motion before s₀ − n_g·f_t) and T2 (after s₀ + n_g·f_t) as capsules in
+//! a view frame, per-tile candidate lists, and the point test every method shares: is a point of
+//! M in the stock, and is it behind a swept volume along the view direction?
+
+use nalgebra::Matrix3;
+
+use super::capsule::Capsule;
+use super::passes::{PathModel, Stamps};
+use super::stock::{Region, StockModel};
+use crate::geometry::Vec3;
+
+/// Which swept volumes a capsule belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Side {
+    /// T1: before the prediction position.
+    Before,
+    /// T2: after it.
+    After,
+}
+
+/// A piece of nearby motion in world coordinates.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Piece {
+    pub(crate) a: Vec3,
+    pub(crate) b: Vec3,
+    pub(crate) side: Side,
+}
+
+/// Per-thread scratch buffers.
+#[derive(Debug, Default)]
+pub(crate) struct Scratch {
+    pub(crate) stamps: Stamps,
+    pub(crate) indices: Vec<u32>,
+}
+
+/// Which motion one prediction position needs.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Query {
+    /// Ball centre O.
+    pub(crate) centre: Vec3,
+    /// Global arclength of O.
+    pub(crate) sigma: f64,
+    /// Half-width of the excluded gap, n_g·f_t.
+    pub(crate) gap: f64,
+    /// Ball radius R.
+    pub(crate) radius: f64,
+    /// xy search reach (and 3-D reach for `any_view`).
+    pub(crate) reach: f64,
+    /// Keep every piece within `reach` in 3-D (tilted views) instead of those that can hide
+    /// the lower hemisphere from below.
+    pub(crate) any_view: bool,
+}
+
+/// Collects the motion near the ball minus the gap (σ − gap, σ + gap), as pieces that can hide
+/// part of the lower hemisphere seen from below (xy within 2R, lowest point below the ball
+/// centre), or for tilted views every piece within `reach` in 3-D.
+pub(crate) fn gather(path: &PathModel, query: &Query, scratch: &mut Scratch, out: &mut Vec<Piece>) {
+    let Query { centre, sigma, gap, radius, reach, any_view } = *query;
+    let centre = &centre;
+    out.clear();
+    scratch.indices.clear();
+    path.near(centre, reach, &mut scratch.stamps, &mut scratch.indices);
+    scratch.indices.sort_unstable();
+    for &index in &scratch.indices {
+        let segment = &path.segments[index as usize];
+        let (a, b) = path.ends(index as usize);
+        let (start, end) = (segment.sigma, segment.sigma + segment.length);
+        let point = |s: f64| {
+            if segment.length > 0.0 { a + ((s - start) / segment.length).clamp(0.0, 1.0) * (b - a) } else { a }
+        };
+        let mut push = |p: Vec3, q: Vec3, side: Side| {
+            let keep = if any_view {
+                crate::geometry::distance_to_segment(centre, &p, &q) < reach
+            } else {
+                p.z.min(q.z) - radius < centre.z && distance_xy(centre, &p, &q) < 2.0 * radius
+            };
+            if keep {
+                out.push(Piece { a: p, b: q, side });
+            }
+        };
+        if start < sigma - gap || (segment.length == 0.0 && start <= sigma - gap) {
+            push(a, point(end.min(sigma - gap)), Side::Before);
+        }
+        if end > sigma + gap || (segment.length == 0.0 && start >= sigma + gap) {
+            push(point(start.max(sigma + gap)), b, Side::After);
+        }
+    }
+}
+
+fn distance_xy(p: &Vec3, a: &Vec3, b: &Vec3) -> f64 {
+    let flat = |v: &Vec3| Vec3::new(v.x, v.y, 0.0);
+    crate::geometry::distance_to_segment(&flat(p), &flat(a), &flat(b))
+}
+
+/// The pieces as capsules in a view frame centred on the ball centre O.
+#[derive(Debug, Clone)]
+pub(crate) struct Scene {
+    pub(crate) radius: f64,
+    pub(crate) r2: f64,
+    /// Depth tolerance ε (§3.5).
+    pub(crate) eps: f64,
+    pub(crate) centre: Vec3,
+    /// World → frame (rows ê₁, ê₂, v̂).
+    pub(crate) rotation: Matrix3<f64>,
+    pub(crate) before: Vec<Capsule>,
+    pub(crate) after: Vec<Capsule>,
+}
+
+/// Whether a ray has entered a swept volume by the time it reaches a point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) enum Cover {
+    /// Not entered.
+    Open,
+    /// Entered within ±ε: a tie (retraced motion, §5 E11).
+    Tie,
+    /// Entered more than ε before.
+    Hidden,
+}
+
+/// Candidate capsules of one tile.
+#[derive(Debug, Default, Clone)]
+pub(crate) struct TileLists {
+    pub(crate) region: Option<Region>,
+    pub(crate) before: Vec<u32>,
+    pub(crate) after: Vec<u32>,
+}
+
+impl Scene {
+    pub(crate) fn new(pieces: &[Piece], centre: Vec3, rotation: Matrix3<f64>, radius: f64) -> Self {
+        let mut before = Vec::new();
+        let mut after = Vec::new();
+        for piece in pieces {
+            let capsule = Capsule::new(rotation * (piece.a - centre), rotation * (piece.b - centre));
+            match piece.side {
+                Side::Before => before.push(capsule),
+                Side::After => after.push(capsule),
+            }
+        }
+        Self { radius, r2: radius * radius, eps: 1e-9 * radius, centre, rotation, before, after }
+    }
+
+    /// World point of a frame point.
+    pub(crate) fn world(&self, frame: &Vec3) -> Vec3 {
+        self.centre + self.rotation.transpose() * frame
+    }
+
+    /// Where the frame box `[lo, hi]` lies relative to the stock.
+    pub(crate) fn region(&self, stock: &StockModel, lo: &Vec3, hi: &Vec3) -> Region {
+        let (world_lo, world_hi) = self.world_box(lo, hi);
+        stock.classify(&world_lo, &world_hi, self.eps)
+    }
+
+    /// Fills `lists` with the capsules that may hide a point of the frame box `[lo, hi]`, taken
+    /// from `pool` (or from all capsules); `want_after` skips T2 when only K is needed. The
+    /// region is left to the caller.
+    pub(crate) fn candidates(
+        &self,
+        lo: &Vec3,
+        hi: &Vec3,
+        want_after: bool,
+        pool: Option<&TileLists>,
+        lists: &mut TileLists,
+    ) {
+        lists.before.clear();
+        lists.after.clear();
+        let tie = self.eps;
+        let pick = |capsules: &[Capsule], from: Option<&[u32]>, out: &mut Vec<u32>| match from {
+            Some(indices) => out.extend(
+                indices.iter().copied().filter(|&i| capsules[i as usize].may_cover_box(lo, hi, self.radius, tie)),
+            ),
+            None => out.extend(
+                (0..capsules.len() as u32).filter(|&i| capsules[i as usize].may_cover_box(lo, hi, self.radius, tie)),
+            ),
+        };
+        pick(&self.before, pool.map(|p| p.before.as_slice()), &mut lists.before);
+        if want_after {
+            pick(&self.after, pool.map(|p| p.after.as_slice()), &mut lists.after);
+        }
+    }
+
+    /// World bounding box of a frame box.
+    pub(crate) fn world_box(&self, lo: &Vec3, hi: &Vec3) -> (Vec3, Vec3) {
+        let back = self.rotation.transpose();
+        let mut world_lo = Vec3::repeat(f64::INFINITY);
+        let mut world_hi = Vec3::repeat(f64::NEG_INFINITY);
+        for corner in 0..8 {
+            let c = Vec3::new(
+                if corner & 1 == 0 { lo.x } else { hi.x },
+                if corner & 2 == 0 { lo.y } else { hi.y },
+                if corner & 4 == 0 { lo.z } else { hi.z },
+            );
+            let w = self.centre + back * c;
+            world_lo = world_lo.inf(&w);
+            world_hi = world_hi.sup(&w);
+        }
+        (world_lo, world_hi)
+    }
+
+    /// How the frame point `q` is covered by the listed capsules of one side; `hint` is the
+    /// list position that covered the previous point (tried first).
+    pub(crate) fn cover(&self, q: &Vec3, side: Side, list: &[u32], hint: &mut usize) -> Cover {
+        let capsules = match side {
+            Side::Before => &self.before,
+            Side::After => &self.after,
+        };
+        let mut state = Cover::Open;
+        let start = (*hint).min(list.len());
+        let (tail, head) = list.split_at(start);
+        for (position, &index) in head.iter().enumerate().map(|(k, i)| (k + start, i)).chain(tail.iter().enumerate()) {
+            let capsule = &capsules[index as usize];
+            if capsule.min_z - self.radius > q.z + self.eps {
+                continue;
+            }
+            if let Some(entry) = capsule.entry_z(q.x, q.y, self.r2) {
+                if entry < q.z - self.eps {
+                    *hint = position;
+                    return Cover::Hidden;
+                }
+                if entry <= q.z + self.eps {
+                    state = Cover::Tie;
+                }
+            }
+        }
+        state
+    }
+
+    /// In the stock, given the tile's region.
+    pub(crate) fn in_stock(&self, stock: &StockModel, region: Region, frame: &Vec3) -> bool {
+        match region {
+            Region::Outside => false,
+            Region::Inside => true,
+            Region::Mixed => stock.contains(&self.world(frame), self.eps),
+        }
+    }
+}
+
+/// The state of one sample of M.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum SampleState {
+    /// Not in the stock (or not on the lower hemisphere).
+    Air,
+    /// In the stock but hidden by T1: cut before.
+    CutBefore,
+    /// In the cutting region K, hidden by T2: cut again later.
+    CutAfter,
+    /// In K and not hidden by T2: finished surface S.
+    Finished,
+}
+
+/// Full point test of a frame point `q` on M: stock, T1 (a tie counts as hidden for K but the
+/// surface is credited to the later of two identical passes, §5 E11) and T2.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct PointTest {
+    pub(crate) state: SampleState,
+    /// In K with the strict rule (a tie with T1 hides).
+    pub(crate) cut: bool,
+}
+
+impl Scene {
+    pub(crate) fn test(&self, stock: &StockModel, lists: &TileLists, q: &Vec3, hints: &mut [usize; 2]) -> PointTest {
+        let air = PointTest { state: SampleState::Air, cut: false };
+        let Some(region) = lists.region else {
+            return air;
+        };
+        if !self.in_stock(stock, region, q) {
+            return air;
+        }
+        let before = self.cover(q, Side::Before, &lists.before, &mut hints[0]);
+        if before == Cover::Hidden {
+            return PointTest { state: SampleState::CutBefore, cut: false };
+        }
+        let after = self.cover(q, Side::After, &lists.after, &mut hints[1]);
+        PointTest {
+            state: if after == Cover::Open { SampleState::Finished } else { SampleState::CutAfter },
+            cut: before == Cover::Open,
+        }
+    }
+}
