@@ -30,6 +30,7 @@ const ASSETS: &[Asset] = &[
     asset!("/app.js", JS),
     asset!("/plot3d.js", JS),
     asset!("/plot2d.js", JS),
+    asset!("/views/contour.js", JS),
     asset!("/views/deburr.js", JS),
     asset!("/views/jobs.js", JS),
     asset!("/views/machines.js", JS),

@@ -1,6 +1,7 @@
 // Browser checks of the kerf page, driven by cargo test (tests/tests/api/browser.rs).
 // Usage: node run.mjs <scenario> <base-url> <screenshot.png> [job-file]
 // Prints one JSON line with what it saw; exits non-zero with the reason when a check fails.
+import { readFileSync } from 'node:fs';
 import { chromium } from 'playwright-core';
 
 const [scenario, base, screenshot, jobFile] = process.argv.slice(2);
@@ -27,6 +28,18 @@ async function inkedPixels(selector) {
     }
     return inked;
   });
+}
+
+// Counts plot pixels within 40 of the colour [r, g, b].
+async function colouredPixels(selector, colour) {
+  return page.$eval(selector, (canvas, [r, g, b]) => {
+    const data = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
+    let found = 0;
+    for (let i = 0; i < data.length; i += 4) {
+      if (Math.abs(data[i] - r) + Math.abs(data[i + 1] - g) + Math.abs(data[i + 2] - b) < 40) found++;
+    }
+    return found;
+  }, colour);
 }
 
 const scenarios = {
@@ -114,6 +127,63 @@ const scenarios = {
     await page.click('#machine-rows tr[data-machine="hsc-page"] button:has-text("Delete")');
     await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { state: 'detached', timeout: 15000 });
     return { segments, inked, chartInked, lengthsInked, machineBlocks };
+  },
+
+  // Computes the sample contour, checks the plot (loops and reliefs in their colours), the
+  // corner table and the layer selector, downloads the G-code, and reports bad input on the
+  // right field.
+  async contour() {
+    await page.goto(`${base}/#contour`);
+    await page.click('#contour-compute');
+    await page.waitForSelector('#contour-plot[data-state="drawn"]', { timeout: 15000 });
+    const segments = Number(await page.getAttribute('#contour-plot', 'data-segments'));
+    const inked = await inkedPixels('#contour-plot');
+    const loopPixels = await colouredPixels('#contour-plot', [224, 112, 0]);
+    const reliefPixels = await colouredPixels('#contour-plot', [142, 36, 170]);
+    const actions = await page.$$eval('#contour-result table.corners td.action', (l) => l.map((e) => e.textContent));
+    const summary = await page.textContent('#contour-result .summary');
+    if (segments < 50) throw new Error(`only ${segments} segments drawn`);
+    if (inked < 2000) throw new Error(`plot nearly blank: ${inked} inked pixels`);
+    if (loopPixels < 100 || reliefPixels < 20) throw new Error(`loops ${loopPixels} / reliefs ${reliefPixels} pixels`);
+    if (actions.filter((a) => a === 'arc loop').length !== 5 || actions.filter((a) => a === 'dogbone').length !== 2) {
+      throw new Error(`corner actions: ${actions}`);
+    }
+    if (!/layers × passes\s*3 × 2/.test(summary)) throw new Error(`summary: ${summary}`);
+    if (screenshot) await page.screenshot({ path: screenshot.replace(/\.png$/, '-first.png'), fullPage: true });
+    const fitted = Number(await page.getAttribute('#contour-plot', 'data-scale'));
+
+    // The last layer, then a corner zoomed in from the table.
+    await page.selectOption('#contour-result select[name="layer"]', '2');
+    await page.waitForSelector('#contour-plot[data-layer="2"][data-state="drawn"]', { timeout: 5000 });
+    await page.click('#contour-result table.corners tbody tr[data-corner="3"]');
+    const zoomed = Number(await page.getAttribute('#contour-plot', 'data-scale'));
+    const zoomedLoop = await colouredPixels('#contour-plot', [224, 112, 0]);
+    if (zoomed < 2 * fitted || zoomedLoop < 500) throw new Error(`zoom to the tip: scale ${fitted} → ${zoomed}, loop ${zoomedLoop} px`);
+
+    // The G-code download.
+    await page.selectOption('#contour-form select[name="dialect"]', 'linuxcnc');
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('#contour-gcode')]);
+    const program = readFileSync(await download.path(), 'utf8');
+    if (!program.includes('G64 P') || !program.trim().endsWith('M30')) throw new Error(`program: ${program.slice(0, 200)}`);
+
+    // A bad step is reported on its field; a crossing contour on the points box; a line that is
+    // not "x, y" before anything is sent.
+    await page.fill('#contour-form input[name="step"]', '0');
+    await page.click('#contour-compute');
+    await page.waitForSelector('#contour-messages .message.error', { timeout: 15000 });
+    const invalidStep = await page.$$eval('#contour-form .invalid', (l) => l.map((e) => e.name));
+    if (!invalidStep.includes('step')) throw new Error(`step not highlighted: ${invalidStep}`);
+    await page.fill('#contour-form input[name="step"]', '3');
+    await page.fill('#contour-form textarea[name="points"]', '0, 0\n10, 10\n10, 0\n0, 10');
+    await page.click('#contour-compute');
+    await page.waitForFunction(() => /E_SELF_INTERSECTION/.test(document.querySelector('#contour-messages').textContent), null, { timeout: 15000 });
+    const invalidPoints = await page.$$eval('#contour-form .invalid', (l) => l.map((e) => e.name));
+    if (!invalidPoints.includes('points')) throw new Error(`points not highlighted: ${invalidPoints}`);
+    await page.fill('#contour-form textarea[name="points"]', '0, 0\n10 0 5\n10, 10');
+    await page.click('#contour-compute');
+    const local = await page.textContent('#contour-messages');
+    if (!/line 2/.test(local)) throw new Error(`local check: ${local}`);
+    return { segments, inked, loopPixels, reliefPixels, zoomed: zoomed / fitted };
   },
 
   // Uploads a job file on the Jobs page, waits for it to finish, opens it, and checks each

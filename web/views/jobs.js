@@ -1,11 +1,12 @@
 // Jobs workbench: drop or pick a job file, watch it queue and run, browse past jobs, open a
 // result with the view of its operation, download G-code and JSON (api.md, Jobs).
 import { api, download, message, showProblem } from '/app.js';
+import { contourResult } from '/views/contour.js';
 import { deburrResult } from '/views/deburr.js';
 import { segmentResult } from '/views/segment.js';
 
 // How each operation's result is shown; later capabilities add theirs here.
-const resultViews = { deburr: deburrResult, segment: segmentResult };
+const resultViews = { deburr: deburrResult, segment: segmentResult, contour: contourResult };
 
 const LAYOUT = `
 <section>

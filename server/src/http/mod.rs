@@ -1,5 +1,6 @@
 //! HTTP routes, one module per resource, each with a `router()`.
 
+pub mod contour;
 pub mod deburr;
 pub mod health;
 pub mod jobs;

@@ -112,6 +112,28 @@ pub fn execute(
                     gcode: program.ok(),
                 }
             }
+            Operation::Contour(request) => {
+                let ToolRef::Inline(tool) = &request.tool else {
+                    return Err(JobFailure::Refused {
+                        message: format!("operation {index}: the tool was not resolved"),
+                        field: Some(format!("operations[{index}].tool")),
+                    });
+                };
+                // A job goes up to the solver's move limit; its stored JSON keeps what fits.
+                let mut answer = http::contour::run(request, tool.clone(), kerf_solver::corners::request::MAX_MOVES)
+                    .map_err(|e| refused(index, &e))?;
+                let program = http::contour::program(&answer, job.output.dialect, job.output.reference);
+                http::contour::limit_stored_moves(&mut answer);
+                OperationOutput {
+                    operation: operation.kind().to_owned(),
+                    result: serde_json::to_value(&answer).map_err(|e| JobFailure::Refused {
+                        message: format!("operation {index}: result not serialisable: {e}"),
+                        field: None,
+                    })?,
+                    gcode_problem: program.as_ref().err().map(|e| format!("{} ({})", e.message(), e.code())),
+                    gcode: program.ok(),
+                }
+            }
         };
         outputs.push(output);
         progress((index + 1) as f64 / count as f64);

@@ -24,6 +24,7 @@
 //! machines registry when an operation names a `machine`.
 
 use kerf_solver::chord::{MachineProfile, SegmentRequest, validate_machine_name};
+use kerf_solver::corners::ContourRequest;
 use kerf_solver::deburr::DeburrRequest;
 use kerf_solver::gcode::{Dialect, Reference};
 use kerf_solver::tool::{Tool, ToolRef};
@@ -82,6 +83,8 @@ pub enum Operation {
     Deburr(DeburrRequest),
     /// `POST /api/v1/segment`.
     Segment(SegmentRequest),
+    /// `POST /api/v1/contour`.
+    Contour(ContourRequest),
 }
 
 /// The names `operation` may take.
@@ -90,6 +93,7 @@ pub enum Operation {
 enum OperationKind {
     Deburr,
     Segment,
+    Contour,
 }
 
 impl OperationKind {
@@ -98,6 +102,7 @@ impl OperationKind {
         match self {
             Self::Deburr => DeburrRequest::deserialize(fields).map(Operation::Deburr),
             Self::Segment => SegmentRequest::deserialize(fields).map(Operation::Segment),
+            Self::Contour => ContourRequest::deserialize(fields).map(Operation::Contour),
         }
     }
 }
@@ -147,6 +152,7 @@ impl Operation {
         match self {
             Self::Deburr(_) => "deburr",
             Self::Segment(_) => "segment",
+            Self::Contour(_) => "contour",
         }
     }
 
@@ -155,6 +161,7 @@ impl Operation {
         match self {
             Self::Deburr(request) => Some(&mut request.tool),
             Self::Segment(request) => request.tool.as_mut(),
+            Self::Contour(request) => Some(&mut request.tool),
         }
     }
 
@@ -163,6 +170,7 @@ impl Operation {
         match self {
             Self::Deburr(request) => request.machine.as_deref(),
             Self::Segment(request) => request.machine.as_deref(),
+            Self::Contour(_) => None,
         }
     }
 }

@@ -55,3 +55,20 @@ async fn jobs_page_runs_an_uploaded_example() {
     assert_eq!(result["plots"], 2, "one plot per operation: {result}");
     eprintln!("upload to result on the page: {} s", result["seconds"]);
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn contour_page_plots_the_sample_and_downloads_gcode() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "contour", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["segments"].as_u64().unwrap() >= 50, "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn jobs_page_shows_the_contour_example() {
+    let app = TestApp::spawn().await;
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/contour-arrow.toml");
+    let Some(result) = run_scenario(&app, "jobs", &[example.to_str().unwrap()]) else { return };
+    assert_eq!(result["ok"], true);
+    assert_eq!(result["plots"], 1, "one plot for the one operation: {result}");
+}

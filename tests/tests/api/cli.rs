@@ -34,7 +34,11 @@ fn runs_each_example_locally() {
                 &std::fs::read_to_string(out.path().join(format!("{index:02}-{name}.json"))).unwrap(),
             )
             .unwrap();
-            assert!(result["points"].as_array().unwrap().len() > 8);
+            match name {
+                "deburr" | "segment" => assert!(result["points"].as_array().unwrap().len() > 8),
+                "contour" => assert!(!result["layers"].as_array().unwrap().is_empty()),
+                _ => assert!(result.as_object().is_some_and(|o| !o.is_empty())),
+            }
             let program = std::fs::read_to_string(out.path().join(format!("{index:02}-{name}.nc"))).unwrap();
             assert!(program.contains("M30"));
         }

@@ -4,6 +4,7 @@ mod auth;
 mod bad_requests;
 mod browser;
 mod cli;
+mod contour;
 mod deburr;
 mod deburr_machine;
 mod gcode;
