@@ -32,6 +32,7 @@ const ASSETS: &[Asset] = &[
     asset!("/plot2d.js", JS),
     asset!("/views/contour.js", JS),
     asset!("/views/deburr.js", JS),
+    asset!("/views/engagement.js", JS),
     asset!("/views/jobs.js", JS),
     asset!("/views/machines.js", JS),
     asset!("/views/segment.js", JS),

@@ -186,6 +186,51 @@ const scenarios = {
     return { segments, inked, loopPixels, reliefPixels, zoomed: zoomed / fitted };
   },
 
+  // The Engagement view: computes its three sample paths side by side, checks every chart is
+  // drawn, moves the cursor over a contact graph and sees the tool marked on the path, downloads
+  // the G-code of the second path, and highlights a bad flute count.
+  async engagement() {
+    await page.goto(`${base}/#engagement`);
+    await page.click('#engagement-compute');
+    await page.waitForSelector('#engagement-result[data-state="drawn"]', { timeout: 30000 });
+    const columns = await page.$$eval('#engagement-result .candidate', (list) => list.length);
+    const states = await page.$$eval('#engagement-result canvas', (list) => list.map((c) => c.dataset.state));
+    if (states.some((s) => s !== 'drawn')) throw new Error(`charts not drawn: ${states}`);
+    const contactGraph = '#engagement-result .candidate canvas[aria-label^="Contact position"]';
+    const inked = await inkedPixels(contactGraph);
+    if (inked < 2000) throw new Error(`contact graph nearly blank: ${inked} inked pixels`);
+    const recommendation = await page.textContent('#engagement-result .recommendation');
+    // A cursor on the contact graph marks the tool on the path.
+    const box = await (await page.$(contactGraph)).boundingBox();
+    const plan = '#engagement-result .candidate canvas.plan';
+    const before = await inkedPixels(plan);
+    await page.mouse.move(box.x + box.width * 0.45, box.y + box.height / 2);
+    const cursor = Number(await page.getAttribute(plan, 'data-cursor'));
+    const after = await inkedPixels(plan);
+    const readout = await page.textContent('#engagement-result .cursor-readout');
+    if (!Number.isInteger(cursor) || cursor <= 0) throw new Error(`no cursor on the path: ${cursor}`);
+    if (after <= before) throw new Error(`tool circle not drawn: ${before} -> ${after} inked pixels`);
+    if (!/s = [\d.]+ mm/.test(readout)) throw new Error(`no readout: ${readout}`);
+    // The x axis switches to time; every chart is drawn again.
+    await page.selectOption('#engagement-result select[aria-label="x axis"]', 'time');
+    const redrawn = await page.$$eval('#engagement-result canvas', (list) => list.filter((c) => c.dataset.state === 'drawn').length);
+    if (redrawn !== states.length) throw new Error(`after switching to time: ${redrawn} of ${states.length} charts drawn`);
+    // G-code of the second path.
+    await page.selectOption('select[name="candidate"]', '1');
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('#engagement-gcode')]);
+    const { readFile } = await import('node:fs/promises');
+    const program = await readFile(await download.path(), 'utf8');
+    const feeds = new Set([...program.matchAll(/ F(\d+(?:\.\d)?)/g)].map((m) => m[1]));
+    if (!program.includes('M30') || feeds.size < 2) throw new Error(`program without its feed plan: ${program.slice(0, 400)}`);
+    // A flute count out of range is refused with the field highlighted.
+    await page.fill('input[name="flute_counts"]', '2, 40');
+    await page.click('#engagement-compute');
+    await page.waitForSelector('#engagement-messages .message.error', { timeout: 15000 });
+    const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
+    if (!highlighted.includes('flute_counts')) throw new Error(`field not highlighted: ${highlighted}`);
+    return { columns, charts: states.length, inked, cursor, recommendation, feeds: feeds.size, file: download.suggestedFilename() };
+  },
+
   // Uploads a job file on the Jobs page, waits for it to finish, opens it, and checks each
   // operation's plot.
   async jobs() {

@@ -2,6 +2,7 @@
 
 pub mod contour;
 pub mod deburr;
+pub mod engagement;
 pub mod health;
 pub mod jobs;
 pub mod machines;

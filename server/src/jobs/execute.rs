@@ -5,7 +5,8 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use kerf_solver::SolverError;
-use kerf_solver::tool::ToolRef;
+use kerf_solver::chord::MachineProfile;
+use kerf_solver::tool::{Tool, ToolRef};
 use serde::Serialize;
 use utoipa::ToSchema;
 
@@ -46,12 +47,42 @@ fn refused(index: usize, error: &SolverError) -> JobFailure {
     }
 }
 
-/// An operation whose `field` (tool or machine) was not resolved at submission.
-fn unresolved(index: usize, field: &str) -> JobFailure {
-    JobFailure::Refused {
-        message: format!("operation {index}: the {field} was not resolved"),
-        field: Some(format!("operations[{index}].{field}")),
+/// The tool of operation `index`, which resolution has made inline.
+fn resolved_tool(index: usize, tool: &ToolRef) -> Result<Tool, JobFailure> {
+    match tool {
+        ToolRef::Inline(tool) => Ok(tool.clone()),
+        ToolRef::Number(_) => Err(JobFailure::Refused {
+            message: format!("operation {index}: the tool was not resolved"),
+            field: Some(format!("operations[{index}].tool")),
+        }),
     }
+}
+
+/// The stored output of operation `index`: its answer as JSON and its program, or why none.
+fn output<T: Serialize>(
+    index: usize,
+    operation: &Operation,
+    answer: &T,
+    program: Result<String, SolverError>,
+) -> Result<OperationOutput, JobFailure> {
+    Ok(OperationOutput {
+        operation: operation.kind().to_owned(),
+        result: serde_json::to_value(answer).map_err(|e| JobFailure::Refused {
+            message: format!("operation {index}: result not serialisable: {e}"),
+            field: None,
+        })?,
+        gcode_problem: program.as_ref().err().map(|e| format!("{} ({})", e.message(), e.code())),
+        gcode: program.ok(),
+    })
+}
+
+/// The machine operation `index` names, which resolution has put in the job's `machines`.
+fn resolved_machine(job: &JobFile, index: usize, name: Option<&str>) -> Result<Option<MachineProfile>, JobFailure> {
+    let Some(name) = name else { return Ok(None) };
+    job.machine(name).cloned().map(Some).ok_or_else(|| JobFailure::Refused {
+        message: format!("operation {index}: the machine {name:?} was not resolved"),
+        field: Some(format!("operations[{index}].machine")),
+    })
 }
 
 /// Runs `job` (already resolved: tools inline). `progress` receives the fraction done (0–1).
@@ -68,71 +99,34 @@ pub fn execute(
         }
         let output = match operation {
             Operation::Deburr(request) => {
-                let ToolRef::Inline(tool) = &request.tool else {
-                    return Err(JobFailure::Refused {
-                        message: format!("operation {index}: the tool was not resolved"),
-                        field: Some(format!("operations[{index}].tool")),
-                    });
-                };
-                let machine = match &request.machine {
-                    None => None,
-                    Some(name) => Some(job.machine(name).cloned().ok_or_else(|| unresolved(index, "machine"))?),
-                };
-                let answer = http::deburr::run(request, tool.clone(), machine).map_err(|e| refused(index, &e))?;
+                let machine = resolved_machine(job, index, request.machine.as_deref())?;
+                let answer = http::deburr::run(request, resolved_tool(index, &request.tool)?, machine)
+                    .map_err(|e| refused(index, &e))?;
                 let program = http::deburr::program(&answer, job.output.dialect, job.output.reference);
-                OperationOutput {
-                    operation: operation.kind().to_owned(),
-                    result: serde_json::to_value(&answer).map_err(|e| JobFailure::Refused {
-                        message: format!("operation {index}: result not serialisable: {e}"),
-                        field: None,
-                    })?,
-                    gcode_problem: program.as_ref().err().map(|e| format!("{} ({})", e.message(), e.code())),
-                    gcode: program.ok(),
-                }
+                output(index, operation, &answer, program)?
             }
             Operation::Segment(request) => {
-                let tool = match &request.tool {
-                    None => None,
-                    Some(ToolRef::Inline(tool)) => Some(tool.clone()),
-                    Some(ToolRef::Number(_)) => return Err(unresolved(index, "tool")),
-                };
-                let machine = match &request.machine {
-                    None => None,
-                    Some(name) => Some(job.machine(name).cloned().ok_or_else(|| unresolved(index, "machine"))?),
-                };
+                let tool = request.tool.as_ref().map(|tool| resolved_tool(index, tool)).transpose()?;
+                let machine = resolved_machine(job, index, request.machine.as_deref())?;
                 let answer = http::segment::run(request, machine, tool).map_err(|e| refused(index, &e))?;
                 let program = http::segment::program(&answer, job.output.dialect);
-                OperationOutput {
-                    operation: operation.kind().to_owned(),
-                    result: serde_json::to_value(&answer).map_err(|e| JobFailure::Refused {
-                        message: format!("operation {index}: result not serialisable: {e}"),
-                        field: None,
-                    })?,
-                    gcode_problem: program.as_ref().err().map(|e| format!("{} ({})", e.message(), e.code())),
-                    gcode: program.ok(),
-                }
+                output(index, operation, &answer, program)?
             }
             Operation::Contour(request) => {
-                let ToolRef::Inline(tool) = &request.tool else {
-                    return Err(JobFailure::Refused {
-                        message: format!("operation {index}: the tool was not resolved"),
-                        field: Some(format!("operations[{index}].tool")),
-                    });
-                };
                 // A job goes up to the solver's move limit; its stored JSON keeps what fits.
-                let mut answer = http::contour::run(request, tool.clone(), kerf_solver::corners::request::MAX_MOVES)
+                let tool = resolved_tool(index, &request.tool)?;
+                let mut answer = http::contour::run(request, tool, kerf_solver::corners::request::MAX_MOVES)
                     .map_err(|e| refused(index, &e))?;
                 let program = http::contour::program(&answer, job.output.dialect, job.output.reference);
                 http::contour::limit_stored_moves(&mut answer);
-                OperationOutput {
-                    operation: operation.kind().to_owned(),
-                    result: serde_json::to_value(&answer).map_err(|e| JobFailure::Refused {
-                        message: format!("operation {index}: result not serialisable: {e}"),
-                        field: None,
-                    })?,
-                    gcode_problem: program.as_ref().err().map(|e| format!("{} ({})", e.message(), e.code())),
-                    gcode: program.ok(),
-                }
+                output(index, operation, &answer, program)?
+            }
+            Operation::Engagement(request) => {
+                let tool = resolved_tool(index, &request.tool)?;
+                let answer = http::engagement::run(request, tool).map_err(|e| refused(index, &e))?;
+                // One program per operation: the first path's.
+                let program = http::engagement::program(&answer, 0, job.output.dialect, job.output.reference);
+                output(index, operation, &answer, program)?
             }
         };
         outputs.push(output);

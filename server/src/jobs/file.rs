@@ -26,6 +26,7 @@
 use kerf_solver::chord::{MachineProfile, SegmentRequest, validate_machine_name};
 use kerf_solver::corners::ContourRequest;
 use kerf_solver::deburr::DeburrRequest;
+use kerf_solver::engagement::EngagementRequest;
 use kerf_solver::gcode::{Dialect, Reference};
 use kerf_solver::tool::{Tool, ToolRef};
 use serde::{Deserialize, Serialize};
@@ -78,6 +79,7 @@ pub struct OutputOptions {
 /// One operation: `operation` names it, the other fields are its endpoint's request.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[serde(tag = "operation", rename_all = "snake_case")]
+#[allow(clippy::large_enum_variant, reason = "a job holds at most 100 operations, read once")]
 pub enum Operation {
     /// `POST /api/v1/deburr`.
     Deburr(DeburrRequest),
@@ -85,6 +87,8 @@ pub enum Operation {
     Segment(SegmentRequest),
     /// `POST /api/v1/contour`.
     Contour(ContourRequest),
+    /// `POST /api/v1/engagement`; the job's program is that of `path` (or `paths[0]`).
+    Engagement(EngagementRequest),
 }
 
 /// The names `operation` may take.
@@ -94,6 +98,7 @@ enum OperationKind {
     Deburr,
     Segment,
     Contour,
+    Engagement,
 }
 
 impl OperationKind {
@@ -103,6 +108,7 @@ impl OperationKind {
             Self::Deburr => DeburrRequest::deserialize(fields).map(Operation::Deburr),
             Self::Segment => SegmentRequest::deserialize(fields).map(Operation::Segment),
             Self::Contour => ContourRequest::deserialize(fields).map(Operation::Contour),
+            Self::Engagement => EngagementRequest::deserialize(fields).map(Operation::Engagement),
         }
     }
 }
@@ -153,6 +159,7 @@ impl Operation {
             Self::Deburr(_) => "deburr",
             Self::Segment(_) => "segment",
             Self::Contour(_) => "contour",
+            Self::Engagement(_) => "engagement",
         }
     }
 
@@ -162,6 +169,7 @@ impl Operation {
             Self::Deburr(request) => Some(&mut request.tool),
             Self::Segment(request) => request.tool.as_mut(),
             Self::Contour(request) => Some(&mut request.tool),
+            Self::Engagement(request) => Some(&mut request.tool),
         }
     }
 
@@ -170,7 +178,7 @@ impl Operation {
         match self {
             Self::Deburr(request) => request.machine.as_deref(),
             Self::Segment(request) => request.machine.as_deref(),
-            Self::Contour(_) => None,
+            Self::Contour(_) | Self::Engagement(_) => None,
         }
     }
 }

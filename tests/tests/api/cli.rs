@@ -37,6 +37,13 @@ fn runs_each_example_locally() {
             match name {
                 "deburr" | "segment" => assert!(result["points"].as_array().unwrap().len() > 8),
                 "contour" => assert!(!result["layers"].as_array().unwrap().is_empty()),
+                "engagement" => assert!(
+                    result["candidates"]
+                        .as_array()
+                        .unwrap()
+                        .iter()
+                        .all(|c| c["samples"].as_array().unwrap().len() > 100)
+                ),
                 _ => assert!(result.as_object().is_some_and(|o| !o.is_empty())),
             }
             let program = std::fs::read_to_string(out.path().join(format!("{index:02}-{name}.nc"))).unwrap();

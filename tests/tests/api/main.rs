@@ -7,6 +7,7 @@ mod cli;
 mod contour;
 mod deburr;
 mod deburr_machine;
+mod engagement;
 mod gcode;
 mod job_fuzz;
 mod jobs;
