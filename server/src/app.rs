@@ -45,6 +45,8 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
         .merge(http::contour::router())
         .merge(http::engagement::router())
         .merge(http::jobs::router())
+        .merge(http::machines::router())
+        .merge(http::segment::router())
         .split_for_parts()
 }
 

@@ -43,7 +43,8 @@ pub struct RunArgs {
     /// Folder for the results (created if missing).
     #[arg(short, long, default_value = "kerf-out")]
     pub out: PathBuf,
-    /// Tool table to resolve tool numbers the job file does not define (read only; used if it exists).
+    /// Tool table and machines registry to resolve the tool numbers and machine names the job file
+    /// does not define (read only; used if it exists).
     #[arg(long, env = "KERF_DATABASE", default_value = "kerf.db")]
     pub database: PathBuf,
 }

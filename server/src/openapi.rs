@@ -16,6 +16,8 @@ use utoipa::OpenApi;
         (name = "service", description = "Health"),
         (name = "tools", description = "The tool table, keyed by tool number"),
         (name = "deburr", description = "Cross-hole deburring with a ball end mill (deburr.md)"),
+        (name = "machines", description = "Controller profiles (block processing time, feed limit, dialect), keyed by name (chord.md)"),
+        (name = "segment", description = "Line-segment approximation with the chord error from the block processing time (chord.md)"),
         (name = "contour", description = "Layered contour milling with corner loops and inside-corner relief (corners.md)"),
         (name = "engagement", description = "Tool–workpiece engagement along a path, chip thickness per flute count and \
                                               the recommended flute counts (engagement.md)")

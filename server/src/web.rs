@@ -29,10 +29,13 @@ const ASSETS: &[Asset] = &[
     asset!("/style.css", CSS),
     asset!("/app.js", JS),
     asset!("/plot3d.js", JS),
+    asset!("/plot2d.js", JS),
     asset!("/views/contour.js", JS),
     asset!("/views/deburr.js", JS),
     asset!("/views/engagement.js", JS),
     asset!("/views/jobs.js", JS),
+    asset!("/views/machines.js", JS),
+    asset!("/views/segment.js", JS),
     asset!("/views/tools.js", JS),
 ];
 

@@ -229,6 +229,7 @@ fn too_many_windows_are_refused_before_the_work() {
 #[test]
 fn machine_values_are_defaults_the_request_overrides() {
     let machine = MachineProfile {
+        name: None,
         block_time_ms: 4.0,
         max_feed: 10_000.0,
         dialect: Dialect::Linuxcnc,

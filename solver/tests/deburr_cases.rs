@@ -83,6 +83,8 @@ fn request(case: &Value) -> (DeburrRequest, Tool) {
         clearance: None,
         lead_distance: None,
         safe_z: None,
+        machine: None,
+        block_time_ms: None,
     };
     (request, tool)
 }

@@ -88,6 +88,8 @@ fn case() -> impl Strategy<Value = Case> {
                 clearance: None,
                 lead_distance: None,
                 safe_z: None,
+                machine: None,
+                block_time_ms: None,
             };
             Case { request, tool, cylinder_radius: r1, width }
         })
@@ -218,6 +220,8 @@ proptest! {
             clearance: None,
             lead_distance: None,
             safe_z: None,
+            machine: None,
+            block_time_ms: None,
         };
         match deburr::solve(&request, &tool) {
             Ok(result) => {

@@ -64,6 +64,71 @@ const scenarios = {
     return { segments, inked };
   },
 
+  // The Segment view with its sample (the patent's R50 circle at 10 m/min, 4 ms): plan, charts,
+  // the comparison with a fixed 0.01 mm, a bad value highlighted, a machine registered on the
+  // Machines view and used, the G-code downloaded, the machine deleted.
+  async segment() {
+    await page.goto(`${base}/#segment`);
+    await page.click('#segment-compute');
+    await page.waitForSelector('#segment-plot[data-state="drawn"]', { timeout: 15000 });
+    await page.waitForSelector('#segment-chart[data-state="drawn"]', { timeout: 15000 });
+    await page.waitForSelector('#segment-lengths[data-state="drawn"]', { timeout: 15000 });
+    const segments = Number(await page.getAttribute('#segment-plot', 'data-segments'));
+    const inked = await inkedPixels('#segment-plot');
+    const chartInked = await inkedPixels('#segment-chart');
+    const lengthsInked = await inkedPixels('#segment-lengths');
+    const summary = await page.textContent('#segment-result .summary');
+    const comparison = await page.$$eval('table.comparison tbody tr:first-child td', (cells) => cells.map((c) => c.textContent));
+    if (segments !== 472) throw new Error(`expected 472 blocks drawn, got ${segments}`);
+    if (inked < 500 || chartInked < 300 || lengthsInked < 300) throw new Error(`plots nearly blank: ${inked}, ${chartInked}, ${lengthsInked}`);
+    if (!/blocks\s*472/.test(summary)) throw new Error(`no summary: ${summary}`);
+    if (comparison.join('|') !== 'blocks|472|158') throw new Error(`comparison: ${comparison}`);
+
+    // The G-code download.
+    const [file] = await Promise.all([page.waitForEvent('download'), page.click('#segment-gcode')]);
+    const program = await new Promise((resolve, reject) => {
+      file.createReadStream().then((stream) => {
+        let text = '';
+        stream.on('data', (chunk) => { text += chunk; });
+        stream.on('end', () => resolve(text));
+        stream.on('error', reject);
+      }, reject);
+    });
+    if (!program.includes('G01 X49.9956 Y0.6667 Z0.0000') || !program.includes('M30')) throw new Error(`program: ${program.slice(0, 400)}`);
+
+    // A bad value is reported with the field highlighted.
+    await page.fill('input[name="feed"]', '-1');
+    await page.click('#segment-compute');
+    await page.waitForSelector('#segment-messages .message.error', { timeout: 15000 });
+    const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
+    if (!highlighted.includes('feed')) throw new Error(`field not highlighted: ${highlighted}`);
+
+    // Register a machine, then cut the curve with its values.
+    await page.click('#tabs button[data-view="machines"]');
+    await page.fill('#machine-form input[name="name"]', 'hsc-page');
+    await page.fill('#machine-form input[name="max_feed"]', '12000');
+    await page.fill('#machine-form input[name="margin"]', '1.1');
+    await page.selectOption('#machine-form select[name="dialect"]', 'linuxcnc');
+    await page.click('#machine-save');
+    await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { timeout: 15000 });
+    await page.click('#tabs button[data-view="segment"]');
+    await page.waitForSelector('#segment-form select[name="machine"] option[value="hsc-page"]', { state: 'attached', timeout: 15000 });
+    await page.selectOption('#segment-form select[name="machine"]', 'hsc-page');
+    for (const name of ['feed', 'block_time_ms', 'margin', 'min_chord_error']) await page.fill(`#segment-form input[name="${name}"]`, '');
+    await page.click('#segment-compute');
+    await page.waitForSelector('#segment-plot[data-state="drawn"]', { timeout: 15000 });
+    const withMachine = await page.textContent('#segment-result .summary');
+    if (!/hsc-page/.test(withMachine) || !/12000 mm\/min/.test(withMachine)) throw new Error(`machine not used: ${withMachine}`);
+    const machineBlocks = Number(await page.getAttribute('#segment-plot', 'data-segments'));
+
+    // Delete it again.
+    await page.click('#tabs button[data-view="machines"]');
+    await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { timeout: 15000 });
+    await page.click('#machine-rows tr[data-machine="hsc-page"] button:has-text("Delete")');
+    await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { state: 'detached', timeout: 15000 });
+    return { segments, inked, chartInked, lengthsInked, machineBlocks };
+  },
+
   // Computes the sample contour, checks the plot (loops and reliefs in their colours), the
   // corner table and the layer selector, downloads the G-code, and reports bad input on the
   // right field.

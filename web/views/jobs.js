@@ -4,9 +4,10 @@ import { api, download, message, showProblem } from '/app.js';
 import { contourResult } from '/views/contour.js';
 import { deburrResult } from '/views/deburr.js';
 import { engagementResult } from '/views/engagement.js';
+import { segmentResult } from '/views/segment.js';
 
 // How each operation's result is shown; later capabilities add theirs here.
-const resultViews = { deburr: deburrResult, contour: contourResult, engagement: engagementResult };
+const resultViews = { deburr: deburrResult, segment: segmentResult, contour: contourResult, engagement: engagementResult };
 
 const LAYOUT = `
 <section>

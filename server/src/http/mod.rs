@@ -5,5 +5,7 @@ pub mod deburr;
 pub mod engagement;
 pub mod health;
 pub mod jobs;
+pub mod machines;
 pub mod output;
+pub mod segment;
 pub mod tools;

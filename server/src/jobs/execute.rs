@@ -5,6 +5,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use kerf_solver::SolverError;
+use kerf_solver::chord::MachineProfile;
 use kerf_solver::tool::{Tool, ToolRef};
 use serde::Serialize;
 use utoipa::ToSchema;
@@ -75,6 +76,15 @@ fn output<T: Serialize>(
     })
 }
 
+/// The machine operation `index` names, which resolution has put in the job's `machines`.
+fn resolved_machine(job: &JobFile, index: usize, name: Option<&str>) -> Result<Option<MachineProfile>, JobFailure> {
+    let Some(name) = name else { return Ok(None) };
+    job.machine(name).cloned().map(Some).ok_or_else(|| JobFailure::Refused {
+        message: format!("operation {index}: the machine {name:?} was not resolved"),
+        field: Some(format!("operations[{index}].machine")),
+    })
+}
+
 /// Runs `job` (already resolved: tools inline). `progress` receives the fraction done (0–1).
 pub fn execute(
     job: &JobFile,
@@ -89,9 +99,17 @@ pub fn execute(
         }
         let output = match operation {
             Operation::Deburr(request) => {
-                let answer =
-                    http::deburr::run(request, resolved_tool(index, &request.tool)?).map_err(|e| refused(index, &e))?;
+                let machine = resolved_machine(job, index, request.machine.as_deref())?;
+                let answer = http::deburr::run(request, resolved_tool(index, &request.tool)?, machine)
+                    .map_err(|e| refused(index, &e))?;
                 let program = http::deburr::program(&answer, job.output.dialect, job.output.reference);
+                output(index, operation, &answer, program)?
+            }
+            Operation::Segment(request) => {
+                let tool = request.tool.as_ref().map(|tool| resolved_tool(index, tool)).transpose()?;
+                let machine = resolved_machine(job, index, request.machine.as_deref())?;
+                let answer = http::segment::run(request, machine, tool).map_err(|e| refused(index, &e))?;
+                let program = http::segment::program(&answer, job.output.dialect);
                 output(index, operation, &answer, program)?
             }
             Operation::Contour(request) => {

@@ -19,7 +19,11 @@
 //! workpiece = { kind = "tube", origin = [0, 0, 0], inner_radius = 15, outer_radius = 25 }
 //! hole = { shape = "round", radius = 5 }
 //! ```
+//!
+//! Machines work like tools: `[[machines]]` entries (each with its `name`) are used before the
+//! machines registry when an operation names a `machine`.
 
+use kerf_solver::chord::{MachineProfile, SegmentRequest, validate_machine_name};
 use kerf_solver::corners::ContourRequest;
 use kerf_solver::deburr::DeburrRequest;
 use kerf_solver::engagement::EngagementRequest;
@@ -48,6 +52,11 @@ pub struct JobFile {
     /// Tools the operations may name by number; they take precedence over the tool table.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub tools: Vec<Tool>,
+    /// Machines (controller profiles, each with its `name`) the operations may name; they take
+    /// precedence over the machines registry. Once submitted, the job holds exactly the machines
+    /// its operations name, from the file or the registry.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub machines: Vec<MachineProfile>,
     /// How the G-code of every operation is written.
     #[serde(default)]
     pub output: OutputOptions,
@@ -74,6 +83,8 @@ pub struct OutputOptions {
 pub enum Operation {
     /// `POST /api/v1/deburr`.
     Deburr(DeburrRequest),
+    /// `POST /api/v1/segment`.
+    Segment(SegmentRequest),
     /// `POST /api/v1/contour`.
     Contour(ContourRequest),
     /// `POST /api/v1/engagement`; the job's program is that of `path` (or `paths[0]`).
@@ -85,6 +96,7 @@ pub enum Operation {
 #[serde(rename_all = "snake_case")]
 enum OperationKind {
     Deburr,
+    Segment,
     Contour,
     Engagement,
 }
@@ -94,6 +106,7 @@ impl OperationKind {
     fn read<'de, D: serde::Deserializer<'de>>(self, fields: D) -> Result<Operation, D::Error> {
         match self {
             Self::Deburr => DeburrRequest::deserialize(fields).map(Operation::Deburr),
+            Self::Segment => SegmentRequest::deserialize(fields).map(Operation::Segment),
             Self::Contour => ContourRequest::deserialize(fields).map(Operation::Contour),
             Self::Engagement => EngagementRequest::deserialize(fields).map(Operation::Engagement),
         }
@@ -144,6 +157,7 @@ impl Operation {
     pub fn kind(&self) -> &'static str {
         match self {
             Self::Deburr(_) => "deburr",
+            Self::Segment(_) => "segment",
             Self::Contour(_) => "contour",
             Self::Engagement(_) => "engagement",
         }
@@ -153,8 +167,18 @@ impl Operation {
     fn tool_mut(&mut self) -> Option<&mut ToolRef> {
         match self {
             Self::Deburr(request) => Some(&mut request.tool),
+            Self::Segment(request) => request.tool.as_mut(),
             Self::Contour(request) => Some(&mut request.tool),
             Self::Engagement(request) => Some(&mut request.tool),
+        }
+    }
+
+    /// The machine the operation names, for operations that take one.
+    fn machine_name(&self) -> Option<&str> {
+        match self {
+            Self::Deburr(request) => request.machine.as_deref(),
+            Self::Segment(request) => request.machine.as_deref(),
+            Self::Contour(_) | Self::Engagement(_) => None,
         }
     }
 }
@@ -223,6 +247,49 @@ fn nesting(text: &str) -> usize {
     deepest
 }
 
+/// TOML has `nan` and `inf`, which no request accepts and JSON (the stored job) cannot hold:
+/// the first one is refused with its line and field before anything else. Syntax errors are left
+/// to the parse that follows.
+fn reject_non_finite(text: &str) -> AppResult<()> {
+    use toml::de::{DeTable, DeValue};
+
+    fn walk(value: &toml::Spanned<DeValue<'_>>, path: String, first: &mut Option<(usize, String, String)>) {
+        match value.get_ref() {
+            DeValue::Float(float) => {
+                let number: f64 = float.as_str().replace('_', "").parse().unwrap_or(f64::NAN);
+                let start = value.span().start;
+                if !number.is_finite() && first.as_ref().is_none_or(|(at, _, _)| start < *at) {
+                    *first = Some((start, path, float.as_str().to_owned()));
+                }
+            }
+            DeValue::Array(items) => {
+                for (index, item) in items.iter().enumerate() {
+                    walk(item, format!("{path}[{index}]"), first);
+                }
+            }
+            DeValue::Table(table) => {
+                for (key, item) in table {
+                    let key = key.get_ref();
+                    walk(item, if path.is_empty() { key.to_string() } else { format!("{path}.{key}") }, first);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    let Ok(document) = DeTable::parse(text) else { return Ok(()) };
+    let mut first = None;
+    for (key, item) in document.get_ref() {
+        walk(item, key.get_ref().to_string(), &mut first);
+    }
+    match first {
+        Some((start, path, raw)) => {
+            Err(file_error(&path, Some(line_column(text, start)), &format!("numbers must be finite (got {raw})")))
+        }
+        None => Ok(()),
+    }
+}
+
 /// Parses and checks a job file. Errors are 400 with the field path and, where known, the line.
 pub fn parse(text: &str, format: Format) -> AppResult<JobFile> {
     if nesting(text) > MAX_NESTING {
@@ -243,6 +310,7 @@ pub fn parse(text: &str, format: Format) -> AppResult<JobFile> {
             job
         }
         Format::Toml => {
+            reject_non_finite(text)?;
             let deserializer = toml::de::Deserializer::parse(text).map_err(|error| {
                 let line = error.span().map(|span| line_column(text, span.start));
                 file_error("file", line, error.message())
@@ -271,6 +339,26 @@ fn check(job: &JobFile) -> AppResult<()> {
         tool.validate(&format!("{field}."))?;
         if job.tools[..index].iter().any(|t| t.number == Some(number)) {
             return Err(file_error(&format!("{field}.number"), None, &format!("tool {number} is defined twice")));
+        }
+    }
+    check_machines(&job.machines)
+}
+
+/// Every machine of a job file has a valid name, once, and valid values (422 like a PUT).
+fn check_machines(machines: &[MachineProfile]) -> AppResult<()> {
+    for (index, machine) in machines.iter().enumerate() {
+        let field = format!("machines[{index}]");
+        let Some(name) = &machine.name else {
+            return Err(file_error(&format!("{field}.name"), None, "machines in a job file need their name"));
+        };
+        let prefixed = |error: kerf_solver::SolverError| {
+            let at = error.field().map_or_else(|| field.clone(), |inner| format!("{field}.{inner}"));
+            error.at(at)
+        };
+        validate_machine_name(name).map_err(prefixed)?;
+        machine.validate().map_err(prefixed)?;
+        if machines[..index].iter().any(|m| m.name == machine.name) {
+            return Err(file_error(&format!("{field}.name"), None, &format!("machine {name:?} is defined twice")));
         }
     }
     Ok(())
@@ -304,9 +392,47 @@ impl JobFile {
         Ok(self)
     }
 
+    /// The job with exactly the machines its operations name, each from the file's `machines`,
+    /// else the registry (`lookup`), so it runs anywhere without the database.
+    pub async fn resolve_machines_with<F, Fut>(mut self, lookup: F) -> AppResult<Self>
+    where
+        F: Fn(String) -> Fut,
+        Fut: std::future::Future<Output = AppResult<Option<MachineProfile>>>,
+    {
+        let local = std::mem::take(&mut self.machines);
+        for (index, operation) in self.operations.iter().enumerate() {
+            let Some(name) = operation.machine_name() else { continue };
+            if self.machines.iter().any(|m| m.name.as_deref() == Some(name)) {
+                continue;
+            }
+            let found = match local.iter().find(|m| m.name.as_deref() == Some(name)) {
+                Some(machine) => Some(machine.clone()),
+                None => lookup(name.to_owned())
+                    .await?
+                    .map(|machine| MachineProfile { name: Some(name.to_owned()), ..machine }),
+            };
+            let found = found.ok_or_else(|| {
+                AppError::unknown(
+                    format!("operations[{index}].machine"),
+                    format!("machine {name:?} is neither in the job file nor in the machines registry"),
+                )
+            })?;
+            self.machines.push(found);
+        }
+        Ok(self)
+    }
+
+    /// The resolved machine called `name`.
+    pub fn machine(&self, name: &str) -> Option<&MachineProfile> {
+        self.machines.iter().find(|m| m.name.as_deref() == Some(name))
+    }
+
     /// [`Self::resolve_with`] against the server's tool table.
     pub async fn resolve(self, db: &SqlitePool) -> AppResult<Self> {
-        self.resolve_with(|number| store::tools::get(db, number)).await
+        self.resolve_with(|number| store::tools::get(db, number))
+            .await?
+            .resolve_machines_with(|name| async move { store::machines::get(db, &name).await })
+            .await
     }
 
     /// SHA-256 of the resolved job's canonical JSON: identical jobs have identical hashes.
@@ -391,6 +517,19 @@ hole = { shape = "round", radius = 5 }
         let (path, detail) = path_and_detail(parse(&missing, Format::Toml).unwrap_err());
         assert_eq!(path, "operations[0]");
         assert!(detail.contains("missing field `operation`"), "{detail}");
+    }
+
+    #[test]
+    fn non_finite_numbers_point_at_line_and_field() {
+        let bad = TOML_JOB.replace("cut_amount = 0.2", "cut_amount = -inf");
+        let (path, detail) = path_and_detail(parse(&bad, Format::Toml).unwrap_err());
+        assert_eq!(path, "operations[0].cut_amount");
+        assert!(detail.starts_with("line 12,") && detail.contains("-inf"), "{detail}");
+        let bad = TOML_JOB.replace("origin = [0, 0, 0]", "origin = [0, nan, 0]");
+        let (path, _) = path_and_detail(parse(&bad, Format::Toml).unwrap_err());
+        assert_eq!(path, "operations[0].workpiece.origin[1]");
+        let fine = TOML_JOB.replace("cut_amount = 0.2", "cut_amount = 2_0.0e-2");
+        assert!(parse(&fine, Format::Toml).is_ok());
     }
 
     #[test]

@@ -32,9 +32,9 @@ async fn open_tools(database: &Path) -> anyhow::Result<SqlitePool> {
     Ok(SqlitePoolOptions::new().max_connections(1).connect_with(options).await?)
 }
 
-/// Runs the job file at `path`, resolving tool numbers against `database` when it exists, and
-/// writes `job.json`, one `NN-operation.json` per operation and its `NN-operation.nc` program
-/// into `out`.
+/// Runs the job file at `path`, resolving tool numbers (and machine names) against `database`
+/// when it exists, and writes `job.json`, one `NN-operation.json` per operation and its
+/// `NN-operation.nc` program into `out`.
 ///
 /// # Errors
 /// When the file cannot be read or parsed, a tool is unknown, an operation is refused, or the
@@ -53,6 +53,18 @@ pub async fn run(path: &Path, out: &Path, database: Option<&Path>) -> anyhow::Re
             async move {
                 match pool {
                     Some(pool) => store::tools::get(&pool, number).await,
+                    None => Ok(None),
+                }
+            }
+        })
+        .await
+        .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), describe(&e)))?;
+    let job = job
+        .resolve_machines_with(|name| {
+            let pool = pool.clone();
+            async move {
+                match pool {
+                    Some(pool) => store::machines::get(&pool, &name).await,
                     None => Ok(None),
                 }
             }

@@ -17,6 +17,10 @@ pub const MAX_DESCRIPTION_CHARS: usize = 200;
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(deny_unknown_fields)]
 pub struct MachineProfile {
+    /// The name it is registered under (`/api/v1/machines/{name}`; a body may repeat it, and a
+    /// job file's `machines` entries need it). Not used by the solver.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
     /// T_b: time the control needs to read and prepare one block, ms (> 0). Measure it with a
     /// run of short blocks: T_b = block length / saturated speed × 60000 (chord.md §2.1, Eq. 1).
     pub block_time_ms: f64,
@@ -41,9 +45,12 @@ impl MachineProfile {
     /// Checks every value, naming the field as written in the machine's JSON.
     ///
     /// # Errors
-    /// `E_INPUT` for a block time or feed that is not positive, a margin below 1, a negative
-    /// minimum chord error or a description over 200 characters.
+    /// `E_INPUT` for a bad name, a block time or feed that is not positive, a margin below 1, a
+    /// negative minimum chord error or a description over 200 characters.
     pub fn validate(&self) -> Result<(), SolverError> {
+        if let Some(name) = &self.name {
+            validate_machine_name(name)?;
+        }
         positive("block_time_ms", self.block_time_ms)?;
         positive("max_feed", self.max_feed)?;
         if let Some(margin) = self.margin
@@ -103,8 +110,10 @@ mod tests {
         assert_eq!(serde_json::from_str::<MachineProfile>(&text).unwrap(), machine);
         let bad = MachineProfile { margin: Some(0.9), ..machine.clone() };
         assert_eq!(bad.validate().unwrap_err().field(), Some("margin"));
-        let bad = MachineProfile { block_time_ms: 0.0, ..machine };
+        let bad = MachineProfile { block_time_ms: 0.0, ..machine.clone() };
         assert_eq!(bad.validate().unwrap_err().field(), Some("block_time_ms"));
+        let bad = MachineProfile { name: Some("a b".to_owned()), ..machine };
+        assert_eq!(bad.validate().unwrap_err().field(), Some("name"));
         assert!(serde_json::from_str::<MachineProfile>(r#"{"block_time_ms": 4, "max_feed": 1, "x": 1}"#).is_err());
     }
 

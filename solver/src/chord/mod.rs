@@ -21,12 +21,13 @@
 //! * `POST /api/v1/segment`: parse a [`SegmentRequest`], resolve its `machine` name to a
 //!   [`MachineProfile`] (404 if unknown), call [`solve`]`(&request, machine.as_ref())` and answer
 //!   the [`SegmentAnswer`] as JSON, or [`fn@program`]`(&answer, &`[`Post`]`)` for G-code (the dialect
-//!   from the query, else the machine's). Errors: `E_INPUT`, `E_DEGENERATE_CURVE`,
+//!   from the query, else the machine's; the tool call from the request's optional `tool`, which the
+//!   solver itself ignores). Errors: `E_INPUT`, `E_DEGENERATE_CURVE`,
 //!   `E_INFEASIBLE_FEED_FOR_RADIUS`, `E_TOO_MANY_BLOCKS`, `E_TOO_MANY_POINTS`,
 //!   `E_NUMERIC_FAILURE`: all 422.
 //! * Machines: store a validated ([`MachineProfile::validate`]) profile as JSON under a name
 //!   checked by [`validate_machine_name`].
-//! * Another path solver (deburr, contour) with `machine`, `feed`, `block_time_ms` and a
+//! * Another path solver (deburr does, contour) with `machine`, `feed`, `block_time_ms` and a
 //!   `tolerance`: [`BlockRule::resolve`] gives the rule; [`BlockRule::tolerance_for`]`(r, tol)`
 //!   the chord tolerance at a local radius (never coarser than `tol`), or for the whole path
 //!   `tolerance_for(r_min, tol)` (embodiment 4); [`block_stats`] reports any polyline's blocks,

@@ -11,6 +11,7 @@ use super::segment::Estimate;
 use super::shape::{Arc, Ellipse, Polyline, Shape, Spline, require_length};
 use crate::error::{SolverError, Warning, finite, positive};
 use crate::geometry::Vec3;
+use crate::tool::ToolRef;
 
 /// Most polyline points accepted.
 pub const MAX_POLYLINE_POINTS: usize = 1_000_000;
@@ -227,6 +228,11 @@ pub struct SegmentRequest {
     /// A registered machine whose values are the defaults of this request.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub machine: Option<String>,
+    /// The tool the G-code program calls (`T n M06`, `G43 H n`): a registered number or an
+    /// inline tool. The curve is the programmed point, whatever the tool; without one the program
+    /// stops (`M00`) for the operator to load it. Not used by the solver.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tool: Option<ToolRef>,
     /// Spindle speed for the G-code program, rpm (default 6000).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spindle_rpm: Option<f64>,
@@ -536,6 +542,7 @@ impl SegmentRequest {
             tolerance: None,
             compare_tolerance: None,
             machine: None,
+            tool: None,
             spindle_rpm: None,
             safe_z: None,
         }

@@ -90,8 +90,25 @@ pub struct DeburrSummary {
     /// Z of the ball centre at the clearance plane, if it is known.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub safe_centre_z: Option<f64>,
-    /// Time of the feed moves (loop and leads) at `feed`, s.
+    /// Time of the feed moves (loop and leads) at `feed`, s; with a block time the block-limited
+    /// time Σ max(Lᵢ/F, T_b) (chord.md §6.3).
     pub estimated_time_s: f64,
+    /// With a block time (the request's or the machine's): the block processing time, ms.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub block_time_ms: Option<f64>,
+    /// With a block time: feed × block time, the shortest block the control digests at the feed, mm.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub block_length: Option<f64>,
+    /// With a block time: blocks of the loop.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blocks: Option<usize>,
+    /// With a block time: the shortest block of the loop, mm.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub min_block_length: Option<f64>,
+    /// With a block time: blocks of the loop shorter than `block_length` (0 unless a warning says
+    /// why: the tolerance, a radius too small for the feed, or a piece shorter than one block).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub short_blocks: Option<usize>,
 }
 
 /// The answer: the closed loop of centres, the approach and way out, a summary and warnings.

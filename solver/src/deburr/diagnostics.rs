@@ -63,7 +63,9 @@ pub fn construction_at(
     segment: &str,
     parameter: f64,
 ) -> Result<PointConstruction, SolverError> {
-    let job = request.validate(tool)?;
+    // The geometry only: the block-time settings do not change the construction.
+    let geometry = DeburrRequest { machine: None, block_time_ms: None, ..request.clone() };
+    let job = geometry.validate(tool, None)?;
     checks::ridge(&job)?;
     let profile = &job.profile;
     let Some(piece) = profile.segments.iter().find(|s| s.name == segment) else {

@@ -10,7 +10,8 @@
 //! * `frame`: local frame and its map to the machine (§1.3);
 //! * `profile`: hole cross-sections (§2.8);
 //! * `centre`: the ball-centre construction (§2.5, §2.7) and the exact variant;
-//! * `tolerance`: the target points from TA (§3);
+//! * `tolerance`: the target points from TA (§3), or with a block time from the block-time rule
+//!   per interval, never coarser than TA (issue 3, chord.md);
 //! * `checks`: validity limits and warnings (§4);
 //! * [`program`]: lead moves and G-code (§6.3).
 
@@ -30,8 +31,10 @@ pub use program::program;
 pub use request::{CentreDistance, DeburrRequest, Direction, Edge, Hole, HoleShape, Method, Workpiece};
 
 use centre::{Construction, RidgeCentre};
-use tolerance::Target;
+use tolerance::{IntervalLimit, Limit, Spacing, Target};
 
+use crate::chord::MachineProfile;
+use crate::chord::stats::{BlockStats, stats_with_ends};
 use crate::error::{SolverError, Warning};
 use crate::geometry::{Vec3, array3};
 use crate::tool::Tool;
@@ -45,12 +48,27 @@ const TRUE_WIDTH_SAMPLES: usize = 1024;
 /// Relative chamfer-width error of the tangent-line method above which `W_APPROX` is raised (§4).
 const APPROX_LIMIT: f64 = 0.05;
 
-/// Solves a deburr request with its resolved tool.
+/// Solves a deburr request with its resolved tool (a request that names no machine).
 ///
 /// # Errors
 /// Every failure of deburr.md §4 with its code, and `E_INPUT` naming the field for bad numbers.
 pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError> {
-    let job = request.validate(tool)?;
+    solve_with(request, tool, None)
+}
+
+/// Solves a deburr request with its resolved tool and machine (the profile its `machine`
+/// names). With a block time (the request's or the machine's) the points follow the block-time
+/// rule at `feed`, never coarser than `tolerance`, and the summary reports the blocks.
+///
+/// # Errors
+/// As [`solve`]; `E_INPUT` at `machine` when the request names a machine and none is given, at
+/// `block_time_ms` for a bad block time.
+pub fn solve_with(
+    request: &DeburrRequest,
+    tool: &Tool,
+    machine: Option<&MachineProfile>,
+) -> Result<Deburr, SolverError> {
+    let job = request.validate(tool, machine)?;
     let mut warnings = checks::ridge(&job)?;
     let ball = job.tool.radius;
     let construction = Construction::for_job(&job);
@@ -75,12 +93,14 @@ pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError
         }
     };
 
-    let mut bisected = tolerance::targets(profile, job.tolerance, MAX_POINTS, centre_at)?;
+    let spacing = Spacing::new(job.tolerance, job.rule, request::MIN_TOLERANCE);
+    let mut bisected = tolerance::targets(profile, &spacing, MAX_POINTS, centre_at)?;
     // The loop ends where it starts: the closing target (end of the last segment) is the start
     // point, which evaluates differently only by rounding (sin 2π ≠ 0).
     let last = bisected.centres.len() - 1;
     bisected.centres[last] = bisected.centres[0];
-    let (mut targets, mut centres, max_deviation) = tolerance::refine(&bisected, job.tolerance, MAX_POINTS, centre_at)?;
+    let refined = tolerance::refine(&bisected, &spacing, MAX_POINTS, centre_at)?;
+    let (mut targets, mut centres, max_deviation) = (refined.targets, refined.centres, refined.max_deviation);
 
     let mut ridges: Vec<RidgeCentre> = Vec::with_capacity(targets.len());
     let mut exact_offset: Option<f64> = None;
@@ -157,6 +177,15 @@ pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError
     }
     let lead_feed_length: f64 = lead_feed_length(&lead_in, frame.point(&centres[0]))
         + lead_feed_length(&lead_out, frame.point(&centres[centres.len() - 1]));
+    let blocks = job.rule.map(|rule| {
+        // The loop continues into the way out: no block of it ends a span.
+        let stats = stats_with_ends(&centres, rule.feed, rule.block_time_ms, &[]);
+        warnings.extend(job.rule_warnings.iter().cloned());
+        warnings.extend(block_warnings(&job, &stats, &refined.limits));
+        let lead_time = lead_block_time(&lead_in, frame.point(&centres[0]), &rule)
+            + lead_block_time(&lead_out, frame.point(&centres[centres.len() - 1]), &rule);
+        (stats, lead_time)
+    });
     let wedge = ridges.iter().map(|r| r.wedge_angle().to_degrees());
     let summary = DeburrSummary {
         count: targets.len() - 1,
@@ -173,7 +202,15 @@ pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError
         feed: job.feed,
         spindle_rpm: job.spindle_rpm,
         safe_centre_z: safe_centre_z.ok(),
-        estimated_time_s: (path_length + lead_feed_length) / job.feed * 60.0,
+        estimated_time_s: match &blocks {
+            Some((stats, lead_time)) => stats.estimated_time_s + lead_time,
+            None => (path_length + lead_feed_length) / job.feed * 60.0,
+        },
+        block_time_ms: job.rule.map(|rule| rule.block_time_ms),
+        block_length: job.rule.map(|rule| rule.block_length()),
+        blocks: blocks.as_ref().map(|(stats, _)| stats.blocks),
+        min_block_length: blocks.as_ref().map(|(stats, _)| stats.min_block_length),
+        short_blocks: blocks.as_ref().map(|(stats, _)| stats.short_blocks),
     };
     let description = describe(request, &job, &summary);
     Ok(Deburr {
@@ -188,6 +225,77 @@ pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError
         description,
         ball_radius: ball,
     })
+}
+
+/// Block-limited time of the feed moves of a lead, starting from `start`: Σ max(L/F, T_b), s.
+fn lead_block_time(moves: &[LeadMove], start: Vec3, rule: &crate::chord::BlockRule) -> f64 {
+    let mut from = start;
+    let mut time = 0.0;
+    for step in moves {
+        let to = crate::geometry::vec3(step.centre);
+        if step.motion == LeadMotion::Feed {
+            time += ((to - from).norm() / rule.feed * 60.0).max(rule.block_time_ms / 1000.0);
+        }
+        from = to;
+    }
+    time
+}
+
+/// Warnings about blocks shorter than feed × block time, with why they are (issue 3): the
+/// tolerance forbids longer chords, the radius is too small for the feed, or a piece of the
+/// profile is shorter than one block.
+fn block_warnings(job: &Job, stats: &BlockStats, limits: &[IntervalLimit]) -> Vec<Warning> {
+    let Some(rule) = job.rule else { return Vec::new() };
+    let mut warnings = Vec::new();
+    let smallest = |why: Limit| limits.iter().filter(|l| l.why == why).map(|l| l.radius).fold(f64::INFINITY, f64::min);
+    let reach = crate::chord::BlockRule { margin: rule.margin * tolerance::BISECTION_REACH, ..rule };
+    let by_tolerance = smallest(Limit::Tolerance);
+    if by_tolerance.is_finite() && stats.short_blocks > 0 {
+        warnings.push(Warning::new(
+            "W_CHORD_ERROR_EXCEEDS_TOLERANCE",
+            format!(
+                "the tolerance {} mm is finer than the block-time rule needs at {} mm/min on the centre path (radius \
+                 down to {:.3} mm): it forbids blocks of one block time there. At most {:.0} mm/min would meet both",
+                job.tolerance,
+                rule.feed,
+                by_tolerance,
+                reach.feed_for_tolerance(by_tolerance, job.tolerance).floor()
+            ),
+        ));
+    }
+    let tight = smallest(Limit::Tight).min(smallest(Limit::Infeasible));
+    if tight.is_finite() && stats.short_blocks > 0 {
+        warnings.push(Warning::new(
+            "W_FEED_TOO_HIGH_FOR_RADIUS",
+            format!(
+                "the centre path turns on a radius of {tight:.3} mm, too tight for blocks of {:.4} mm at {} mm/min: \
+                 at most {:.0} mm/min keeps them one block time long there",
+                rule.block_length(),
+                rule.feed,
+                reach.feed_limit(tight).floor()
+            ),
+        ));
+    }
+    if stats.short_blocks > 0 {
+        warnings.push(Warning::new(
+            "W_BLOCK_TIME_VIOLATION",
+            format!(
+                "{} of {} blocks are shorter than one block time at the feed ({:.4} mm), the shortest {:.6} mm \
+                 ({:.1} % of it): the control slows down there{}",
+                stats.short_blocks,
+                stats.blocks,
+                stats.block_length,
+                stats.min_block_length,
+                stats.min_block_ratio * 100.0,
+                if warnings.is_empty() {
+                    "; the profile has pieces shorter than one block (short straight sides or small arcs)"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    warnings
 }
 
 /// Length of the feed moves of a lead, starting from `start`.
@@ -340,4 +448,17 @@ fn describe(request: &DeburrRequest, job: &Job, summary: &DeburrSummary) -> Vec<
         ),
         format!("feed {} mm/min spindle {} rpm", job.feed, job.spindle_rpm),
     ]
+    .into_iter()
+    .chain(job.rule.map(|rule| {
+        format!(
+            "block time {} ms margin {}: {} blocks, shortest {:.4} mm, {} shorter than {:.4} mm",
+            rule.block_time_ms,
+            rule.margin,
+            summary.blocks.unwrap_or(0),
+            summary.min_block_length.unwrap_or(0.0),
+            summary.short_blocks.unwrap_or(0),
+            rule.block_length()
+        )
+    }))
+    .collect()
 }

@@ -5,7 +5,8 @@ use serde::{Deserialize, Serialize};
 
 use super::frame::Frame;
 use super::profile::Profile;
-use crate::error::{SolverError, finite, non_negative, positive};
+use crate::chord::{BlockRule, MachineProfile, RuleSettings};
+use crate::error::{SolverError, Warning, finite, non_negative, positive};
 use crate::geometry::vec3;
 use crate::tool::{Tool, ToolKind, ToolRef};
 
@@ -186,6 +187,17 @@ pub struct DeburrRequest {
     /// Absolute Z of the clearance plane of the ball centre, overriding the computed one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub safe_z: Option<f64>,
+    /// A registered machine (controller profile): its block time, margin and minimum chord error
+    /// make the points follow the block-time rule (like `block_time_ms`), its dialect is the
+    /// G-code default. Its `max_feed` is not the deburring feed (`feed` keeps its default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub machine: Option<String>,
+    /// T_b: the control's block processing time, ms (default: the machine's). With it the points
+    /// are spaced by the block-time rule (chord.md): per interval the chord error that keeps its
+    /// block at least `feed` × `block_time_ms` long on the local radius of the centre path, never
+    /// coarser than `tolerance`; the summary then reports the blocks.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub block_time_ms: Option<f64>,
 }
 
 /// A validated deburr job: every number finite and in range, the frame and profile built.
@@ -211,6 +223,10 @@ pub(crate) struct Job {
     pub clearance: f64,
     pub lead_distance: f64,
     pub safe_z: Option<f64>,
+    /// The block-time rule at `feed`, when a block time is known (request or machine).
+    pub rule: Option<BlockRule>,
+    /// Warnings from resolving the rule (`W_FEED_ABOVE_MACHINE_MAX`).
+    pub rule_warnings: Vec<Warning>,
 }
 
 fn point(field: &str, p: [f64; 3]) -> Result<[f64; 3], SolverError> {
@@ -225,8 +241,9 @@ fn optional_positive(field: &str, value: Option<f64>, default: f64) -> Result<f6
 }
 
 impl DeburrRequest {
-    /// Validates the request against `tool` (already resolved from `self.tool`).
-    pub(crate) fn validate(&self, tool: &Tool) -> Result<Job, SolverError> {
+    /// Validates the request against `tool` (already resolved from `self.tool`) and `machine`
+    /// (resolved from `self.machine`).
+    pub(crate) fn validate(&self, tool: &Tool, machine: Option<&MachineProfile>) -> Result<Job, SolverError> {
         tool.validate("tool.")?;
         if tool.kind != ToolKind::Ball {
             return Err(SolverError::new(
@@ -333,6 +350,23 @@ impl DeburrRequest {
             .at("tolerance"));
         }
         let safe_z = self.safe_z.map(|z| finite("safe_z", z)).transpose()?;
+        let feed = optional_positive("feed", self.feed, DEFAULT_FEED)?;
+        if let Some(name) = &self.machine
+            && machine.is_none()
+        {
+            return Err(SolverError::input(
+                "machine",
+                format!("machine {name:?} was not resolved: pass its profile (deburr::solve_with)"),
+            ));
+        }
+        let (rule, rule_warnings) = if self.block_time_ms.is_some() || machine.is_some() {
+            let settings =
+                RuleSettings { feed: Some(feed), block_time_ms: self.block_time_ms, ..RuleSettings::default() };
+            let (rule, warnings) = BlockRule::resolve(&settings, machine)?;
+            (Some(rule), warnings)
+        } else {
+            (None, Vec::new())
+        };
         Ok(Job {
             frame,
             profile,
@@ -346,11 +380,13 @@ impl DeburrRequest {
             method: self.method,
             direction: self.direction,
             tool: tool.clone(),
-            feed: optional_positive("feed", self.feed, DEFAULT_FEED)?,
+            feed,
             spindle_rpm: optional_positive("spindle_rpm", self.spindle_rpm, DEFAULT_SPINDLE_RPM)?,
             clearance: optional_positive("clearance", self.clearance, DEFAULT_CLEARANCE)?,
             lead_distance: optional_positive("lead_distance", self.lead_distance, DEFAULT_LEAD_DISTANCE)?,
             safe_z,
+            rule,
+            rule_warnings,
         })
     }
 }

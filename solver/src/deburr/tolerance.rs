@@ -1,10 +1,110 @@
 //! Target points from the tolerance TA: the adaptive bisection of deburr.md §3, exactly as
 //! specified (K = 8 sub-samples, depth ≤ 20, strict `>`, left first), so point counts match the
 //! reference cases.
+//!
+//! With a block time (issue 3, chord.md) the same bisection runs with a tolerance per interval:
+//! the block-time rule's chord error at the interval's own radius of curvature, never coarser
+//! than TA ([`Spacing::Rule`]).
 
 use super::profile::Profile;
+use crate::chord::BlockRule;
 use crate::error::SolverError;
 use crate::geometry::{Vec3, distance_to_segment};
+
+/// How far the bisection aims beyond the rule's target chord. Halving an interval whose chord
+/// is just above what it aims at leaves two halves of just over half of it: aiming at 2.1 target
+/// chords keeps every half at least one target chord long even where the two halves differ by up
+/// to 4 %.
+pub(crate) const BISECTION_REACH: f64 = 2.1;
+
+/// How the bisection decides that an interval is fine enough.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Spacing {
+    /// The fixed tolerance TA (deburr.md §3).
+    Fixed(f64),
+    /// The block-time rule (issue 3): per interval the rule's chord error at the interval's radius.
+    Rule(RuleSpacing),
+}
+
+/// The block-time spacing: the interval's radius of curvature is estimated from its chord c and
+/// its deviation d (the circle through both ends with sagitta d: r = c²/8d + d/2); its tolerance
+/// is `reach.tolerance_for(r, TA)`, which on that circle holds exactly the chords up to
+/// `BISECTION_REACH` target chords, so the halves the bisection keeps are at least one target
+/// chord (margin × feed × block time) long. Where the radius is too small for that, the plain
+/// rule's chord error; where it is too small even for one block, TA. Never below `floor`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct RuleSpacing {
+    /// The rule with its margin times [`BISECTION_REACH`].
+    pub reach: BlockRule,
+    /// The rule itself.
+    pub plain: BlockRule,
+    /// TA.
+    pub tolerance: f64,
+    /// Smallest tolerance used (the smallest accepted TA, or TA when smaller).
+    pub floor: f64,
+}
+
+/// Why an interval was accepted with its tolerance.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Limit {
+    /// The fixed TA.
+    Fixed,
+    /// The rule (on the reach surface, or raised to `min_chord_error`).
+    Rule,
+    /// TA, finer than the rule's chord error: the accuracy bound forbids longer blocks.
+    Tolerance,
+    /// The radius is too small for the reach: the plain rule's chord error.
+    Tight,
+    /// The radius is too small for one block at the feed: TA.
+    Infeasible,
+}
+
+impl Spacing {
+    /// The spacing for TA `tolerance`, with the block-time rule when there is one.
+    pub fn new(tolerance: f64, rule: Option<BlockRule>, floor: f64) -> Self {
+        match rule {
+            None => Self::Fixed(tolerance),
+            Some(plain) => Self::Rule(RuleSpacing {
+                reach: BlockRule { margin: plain.margin * BISECTION_REACH, ..plain },
+                plain,
+                tolerance,
+                floor: floor.min(tolerance),
+            }),
+        }
+    }
+
+    /// TA.
+    pub fn tolerance(&self) -> f64 {
+        match self {
+            Self::Fixed(tolerance) => *tolerance,
+            Self::Rule(rule) => rule.tolerance,
+        }
+    }
+
+    /// The tolerance of an interval with `chord` and `deviation`, and why.
+    pub fn limit(&self, chord: f64, deviation: f64) -> (f64, Limit) {
+        let Self::Rule(rule) = self else {
+            return (self.tolerance(), Limit::Fixed);
+        };
+        let radius = estimated_radius(chord, deviation);
+        let (limit, why) = match rule.reach.chord_error(radius) {
+            Ok((chord_error, _)) if chord_error > rule.tolerance => (rule.tolerance, Limit::Tolerance),
+            Ok((chord_error, _)) => (chord_error, Limit::Rule),
+            Err(_) => match rule.plain.chord_error(radius) {
+                Ok((chord_error, _)) if chord_error > rule.tolerance => (rule.tolerance, Limit::Tolerance),
+                Ok((chord_error, _)) => (chord_error, Limit::Tight),
+                Err(_) => (rule.tolerance, Limit::Infeasible),
+            },
+        };
+        (limit.max(rule.floor), why)
+    }
+}
+
+/// Radius of the circle through the ends of a chord of length `chord` whose arc is `deviation`
+/// away from it at the middle: c²/8d + d/2 (infinite for a straight piece).
+pub(crate) fn estimated_radius(chord: f64, deviation: f64) -> f64 {
+    if deviation > 0.0 { chord * chord / (8.0 * deviation) + 0.5 * deviation } else { f64::INFINITY }
+}
 
 /// Deepest bisection level (§3).
 const MAX_DEPTH: u32 = 20;
@@ -23,14 +123,14 @@ pub(crate) struct Target {
 /// `E_TOO_MANY_POINTS` past `max_points`, or with `centre`'s own error.
 pub(crate) fn targets<F>(
     profile: &Profile,
-    tolerance: f64,
+    spacing: &Spacing,
     max_points: usize,
     centre: F,
 ) -> Result<Bisected, SolverError>
 where
     F: FnMut(usize, f64) -> Result<Vec3, SolverError>,
 {
-    let mut bisection = Bisection { centre, tolerance, max_points, segment: 0, out: Bisected::default() };
+    let mut bisection = Bisection { centre, spacing: *spacing, max_points, segment: 0, out: Bisected::default() };
     let first = (bisection.centre)(0, 0.0)?;
     bisection.out.targets.push(Target { segment: 0, parameter: 0.0 });
     bisection.out.centres.push(first);
@@ -70,7 +170,7 @@ pub(crate) struct Bisected {
 
 struct Bisection<F> {
     centre: F,
-    tolerance: f64,
+    spacing: Spacing,
     max_points: usize,
     segment: usize,
     out: Bisected,
@@ -127,13 +227,17 @@ where
         depth: u32,
     ) -> Result<(), SolverError> {
         let deviation = inner.iter().map(|p| distance_to_segment(p, start, end)).fold(0.0, f64::max);
-        if deviation <= self.tolerance {
+        let limit = match self.spacing {
+            Spacing::Fixed(tolerance) => tolerance,
+            Spacing::Rule(_) => self.spacing.limit((end - start).norm(), deviation).0,
+        };
+        if deviation <= limit {
             return self.emit(b, *end, Some(*inner), deviation);
         }
         if depth >= MAX_DEPTH {
             return Err(SolverError::new(
                 "E_TOL",
-                format!("tolerance {} not reached after {MAX_DEPTH} bisections", self.tolerance),
+                format!("tolerance {} not reached after {MAX_DEPTH} bisections", self.spacing.tolerance()),
             )
             .at("tolerance"));
         }
@@ -153,17 +257,20 @@ const DENSE_SAMPLES: u32 = 16;
 /// The dense check that follows the bisection: measures every interval's deviation at 15 points
 /// and refines the peak by a parabola through the largest sample and its neighbours; an interval
 /// still above `tolerance` (a peak between the 7 sub-samples of §3) is halved until it is not.
-/// Returns the refined targets and centres and the largest deviation (the summary's
-/// `max_deviation`). For the reference cases nothing is refined, so their counts stay those of §3.
+/// Returns the refined targets and centres, the largest deviation (the summary's
+/// `max_deviation`) and how each interval's tolerance came about. For the reference cases
+/// nothing is refined, so their counts stay those of §3.
 pub(crate) fn refine<F>(
     bisected: &Bisected,
-    tolerance: f64,
+    spacing: &Spacing,
     max_points: usize,
     mut centre: F,
-) -> Result<(Vec<Target>, Vec<Vec3>, f64), SolverError>
+) -> Result<Refined, SolverError>
 where
     F: FnMut(usize, f64) -> Result<Vec3, SolverError>,
 {
+    let tolerance = spacing.tolerance();
+    let mut limits = Vec::with_capacity(bisected.targets.len());
     let (targets, centres) = (&bisected.targets, &bisected.centres);
     let mut out_targets = Vec::with_capacity(targets.len());
     let mut out_centres = Vec::with_capacity(centres.len());
@@ -175,10 +282,14 @@ where
         let start = if previous.segment == current.segment { previous.parameter } else { 0.0 };
         // To leading order an interval's deviation from its chord is a parabola, and the 7
         // sub-samples at j/8 find its peak within 4·(1/16)² ≈ 1.6 %. So only an interval sampled
-        // above TA/1.016 can hide a violation; below 0.9·TA the sampled value stands.
+        // above TA/1.016 can hide a violation; below 0.9·TA the sampled value stands (with the
+        // block-time rule, 0.9 times the interval's own tolerance).
         let sampled = bisected.deviations[index + 1];
-        if sampled <= 0.9 * tolerance {
+        let chord = (ends[1] - ends[0]).norm();
+        let (limit, why) = spacing.limit(chord, sampled);
+        if sampled <= 0.9 * limit {
             worst = worst.max(sampled);
+            limits.push(IntervalLimit { why, limit, radius: estimated_radius(chord, sampled) });
             out_targets.push(current);
             out_centres.push(ends[1]);
             continue;
@@ -189,14 +300,16 @@ where
         while let Some((a, b, start_centre, end_centre, depth)) = stack.pop() {
             let deviation =
                 interval_deviation(current.segment, a, b, &start_centre, &end_centre, known.take(), &mut centre)?;
-            if deviation > tolerance && depth < MAX_DEPTH {
+            let chord = (end_centre - start_centre).norm();
+            let (limit, why) = spacing.limit(chord, deviation);
+            if deviation > limit && depth < MAX_DEPTH {
                 let middle = 0.5 * (a + b);
                 let middle_centre = centre(current.segment, middle)?;
                 stack.push((middle, b, middle_centre, end_centre, depth + 1));
                 stack.push((a, middle, start_centre, middle_centre, depth + 1));
                 continue;
             }
-            if deviation > tolerance {
+            if deviation > limit {
                 return Err(SolverError::new(
                     "E_TOL",
                     format!("tolerance {tolerance} not reached after {MAX_DEPTH} bisections"),
@@ -204,6 +317,7 @@ where
                 .at("tolerance"));
             }
             worst = worst.max(deviation);
+            limits.push(IntervalLimit { why, limit, radius: estimated_radius(chord, deviation) });
             if out_targets.len() > max_points {
                 return Err(SolverError::new(
                     "E_TOO_MANY_POINTS",
@@ -215,7 +329,28 @@ where
             out_centres.push(end_centre);
         }
     }
-    Ok((out_targets, out_centres, worst))
+    Ok(Refined { targets: out_targets, centres: out_centres, max_deviation: worst, limits })
+}
+
+/// The tolerance of one final interval and why.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct IntervalLimit {
+    pub why: Limit,
+    /// The tolerance it was accepted with, mm.
+    pub limit: f64,
+    /// Its estimated radius of curvature, mm.
+    pub radius: f64,
+}
+
+/// What [`refine`] returns.
+#[derive(Debug)]
+pub(crate) struct Refined {
+    pub targets: Vec<Target>,
+    pub centres: Vec<Vec3>,
+    /// Largest deviation of the ideal centre path from the polyline (dense check).
+    pub max_deviation: f64,
+    /// One per interval (between consecutive targets).
+    pub limits: Vec<IntervalLimit>,
 }
 
 /// Largest distance of the ideal centre path on `[a, b]` of `segment` from the chord between its

@@ -35,7 +35,7 @@ fn runs_each_example_locally() {
             )
             .unwrap();
             match name {
-                "deburr" => assert!(result["points"].as_array().unwrap().len() > 8),
+                "deburr" | "segment" => assert!(result["points"].as_array().unwrap().len() > 8),
                 "contour" => assert!(!result["layers"].as_array().unwrap().is_empty()),
                 "engagement" => assert!(
                     result["candidates"]

@@ -1,0 +1,103 @@
+//! The machines registry over HTTP (api.md, Machines): `PUT/GET/DELETE /api/v1/machines/{name}`,
+//! list. A machine is a controller profile (block processing time, feed limit, dialect, margins);
+//! a solver request that names it takes its values as defaults.
+
+use axum::Json;
+use axum::extract::State;
+use axum::http::StatusCode;
+use kerf_solver::SolverError;
+use kerf_solver::chord::{MachineProfile, validate_machine_name};
+use kerf_solver::gcode::Dialect;
+use utoipa_axum::router::OpenApiRouter;
+use utoipa_axum::routes;
+
+use crate::error::{AppError, AppResult, Problem};
+use crate::extract::{AppJson, AppPath};
+use crate::state::AppState;
+use crate::store;
+
+/// The `{name}` path parameter.
+#[derive(Debug, serde::Deserialize)]
+struct MachineName {
+    name: String,
+}
+
+fn checked_name(MachineName { name }: MachineName) -> AppResult<String> {
+    validate_machine_name(&name)?;
+    Ok(name)
+}
+
+fn unknown(name: &str) -> AppError {
+    AppError::not_found(format!("machine {name:?} is not registered"))
+}
+
+/// All registered machines, ordered by name.
+#[utoipa::path(get, path = "/api/v1/machines", tag = "machines",
+    responses((status = 200, body = Vec<MachineProfile>)))]
+async fn list_machines(State(state): State<AppState>) -> AppResult<Json<Vec<MachineProfile>>> {
+    Ok(Json(store::machines::list(&state.db).await?))
+}
+
+/// One machine.
+#[utoipa::path(get, path = "/api/v1/machines/{name}", tag = "machines",
+    params(("name" = String, Path, description = "Machine name: 1–64 letters, digits, `-`, `_`, `.`, not starting with `.`")),
+    responses(
+        (status = 200, body = MachineProfile),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "Bad name", body = Problem, content_type = "application/problem+json")))]
+async fn get_machine(
+    State(state): State<AppState>,
+    AppPath(name): AppPath<MachineName>,
+) -> AppResult<Json<MachineProfile>> {
+    let name = checked_name(name)?;
+    store::machines::get(&state.db, &name).await?.map(Json).ok_or_else(|| unknown(&name))
+}
+
+/// Registers or replaces a machine: 201 when new, 200 when replaced.
+#[utoipa::path(put, path = "/api/v1/machines/{name}", tag = "machines",
+    params(("name" = String, Path, description = "Machine name: 1–64 letters, digits, `-`, `_`, `.`, not starting with `.`")),
+    request_body = MachineProfile,
+    responses(
+        (status = 201, description = "Created", body = MachineProfile),
+        (status = 200, description = "Replaced", body = MachineProfile),
+        (status = 400, body = Problem, content_type = "application/problem+json"),
+        (status = 413, body = Problem, content_type = "application/problem+json"),
+        (status = 415, body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "Bad name or value", body = Problem, content_type = "application/problem+json")))]
+async fn put_machine(
+    State(state): State<AppState>,
+    AppPath(name): AppPath<MachineName>,
+    AppJson(mut machine): AppJson<MachineProfile>,
+) -> AppResult<(StatusCode, Json<MachineProfile>)> {
+    let name = checked_name(name)?;
+    if machine.name.as_ref().is_some_and(|given| *given != name) {
+        return Err(SolverError::input("name", format!("body name differs from the path's {name:?}")).into());
+    }
+    machine.name = Some(name);
+    machine.validate()?;
+    let created = store::machines::put(&state.db, &machine).await?;
+    let status = if created { StatusCode::CREATED } else { StatusCode::OK };
+    Ok((status, Json(machine)))
+}
+
+/// Removes a machine. Jobs already submitted keep the profile they were resolved with.
+#[utoipa::path(delete, path = "/api/v1/machines/{name}", tag = "machines",
+    params(("name" = String, Path, description = "Machine name")),
+    responses(
+        (status = 204, description = "Deleted"),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "Bad name", body = Problem, content_type = "application/problem+json")))]
+async fn delete_machine(State(state): State<AppState>, AppPath(name): AppPath<MachineName>) -> AppResult<StatusCode> {
+    let name = checked_name(name)?;
+    if store::machines::delete(&state.db, &name).await? { Ok(StatusCode::NO_CONTENT) } else { Err(unknown(&name)) }
+}
+
+/// The dialect of a program: the one the query asks for, else the machine's, else Fanuc.
+pub fn dialect(asked: Option<Dialect>, machine: Option<&MachineProfile>) -> Dialect {
+    asked.or(machine.map(|m| m.dialect)).unwrap_or_default()
+}
+
+/// Routes of this module.
+pub fn router() -> OpenApiRouter<AppState> {
+    OpenApiRouter::new().routes(routes!(list_machines)).routes(routes!(get_machine, put_machine, delete_machine))
+}
