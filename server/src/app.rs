@@ -42,6 +42,7 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
         .merge(http::health::router())
         .merge(http::tools::router())
         .merge(http::deburr::router())
+        .merge(http::predict::router())
         .merge(http::jobs::router())
         .split_for_parts()
 }

@@ -15,7 +15,8 @@ use utoipa::OpenApi;
     tags(
         (name = "service", description = "Health"),
         (name = "tools", description = "The tool table, keyed by tool number"),
-        (name = "deburr", description = "Cross-hole deburring with a ball end mill (deburr.md)")
+        (name = "deburr", description = "Cross-hole deburring with a ball end mill (deburr.md)"),
+        (name = "predict", description = "Machining-error prediction and path correction for ball-end-mill finishing (error-prediction.md)")
     )
 )]
 pub struct ApiDoc;

@@ -4,4 +4,5 @@ pub mod deburr;
 pub mod health;
 pub mod jobs;
 pub mod output;
+pub mod predict;
 pub mod tools;

@@ -11,4 +11,5 @@ mod jobs;
 mod limits;
 mod load;
 mod openapi;
+mod predict;
 mod tools;
