@@ -3,8 +3,10 @@
 //! server's workers and in `kerf run`.
 
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Mutex, PoisonError};
 
 use kerf_solver::SolverError;
+use kerf_solver::predict::Control;
 use kerf_solver::tool::ToolRef;
 use serde::Serialize;
 use utoipa::ToSchema;
@@ -46,10 +48,11 @@ fn refused(index: usize, error: &SolverError) -> JobFailure {
     }
 }
 
-/// Runs `job` (already resolved: tools inline). `progress` receives the fraction done (0–1).
+/// Runs `job` (already resolved: tools inline). `progress` receives the fraction done (0–1),
+/// also within long operations (from their worker threads).
 pub fn execute(
     job: &JobFile,
-    progress: &dyn Fn(f64),
+    progress: &(dyn Fn(f64) + Sync),
     cancelled: &AtomicBool,
 ) -> Result<Vec<OperationOutput>, JobFailure> {
     let count = job.operations.len();
@@ -68,6 +71,40 @@ pub fn execute(
                 };
                 let answer = http::deburr::run(request, tool.clone()).map_err(|e| refused(index, &e))?;
                 let program = http::deburr::program(&answer, job.output.dialect, job.output.reference);
+                OperationOutput {
+                    operation: operation.kind().to_owned(),
+                    result: serde_json::to_value(&answer).map_err(|e| JobFailure::Refused {
+                        message: format!("operation {index}: result not serialisable: {e}"),
+                        field: None,
+                    })?,
+                    gcode_problem: program.as_ref().err().map(|e| format!("{} ({})", e.message(), e.code())),
+                    gcode: program.ok(),
+                }
+            }
+            Operation::Predict(request) => {
+                let ToolRef::Inline(tool) = &request.tool else {
+                    return Err(JobFailure::Refused {
+                        message: format!("operation {index}: the tool was not resolved"),
+                        field: Some(format!("operations[{index}].tool")),
+                    });
+                };
+                // The solver reports from its worker threads, not always in order: pass on
+                // increases only, scaled into this operation's share of the job.
+                let reached = Mutex::new(0.0_f64);
+                let within = |fraction: f64| {
+                    let mut reached = reached.lock().unwrap_or_else(PoisonError::into_inner);
+                    if fraction > *reached {
+                        *reached = fraction;
+                        progress((index as f64 + fraction) / count as f64);
+                    }
+                };
+                let control = Control { progress: Some(&within), cancel: Some(cancelled) };
+                let answer = match http::predict::run(request, tool.clone(), None, &control) {
+                    Ok(answer) => answer,
+                    Err(error) if error.code() == "E_CANCELLED" => return Err(JobFailure::Cancelled),
+                    Err(error) => return Err(refused(index, &error)),
+                };
+                let program = http::predict::job_program(request, &answer, job.output.dialect, job.output.reference);
                 OperationOutput {
                     operation: operation.kind().to_owned(),
                     result: serde_json::to_value(&answer).map_err(|e| JobFailure::Refused {

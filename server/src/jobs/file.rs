@@ -22,6 +22,7 @@
 
 use kerf_solver::deburr::DeburrRequest;
 use kerf_solver::gcode::{Dialect, Reference};
+use kerf_solver::predict::{PredictRequest, Stock};
 use kerf_solver::tool::{Tool, ToolRef};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -71,6 +72,8 @@ pub struct OutputOptions {
 pub enum Operation {
     /// `POST /api/v1/deburr`.
     Deburr(DeburrRequest),
+    /// `POST /api/v1/predict` (a job file cannot carry an STL file: no `mesh` stock).
+    Predict(PredictRequest),
 }
 
 /// The names `operation` may take.
@@ -78,6 +81,7 @@ pub enum Operation {
 #[serde(rename_all = "snake_case")]
 enum OperationKind {
     Deburr,
+    Predict,
 }
 
 impl OperationKind {
@@ -85,6 +89,7 @@ impl OperationKind {
     fn read<'de, D: serde::Deserializer<'de>>(self, fields: D) -> Result<Operation, D::Error> {
         match self {
             Self::Deburr => DeburrRequest::deserialize(fields).map(Operation::Deburr),
+            Self::Predict => PredictRequest::deserialize(fields).map(Operation::Predict),
         }
     }
 }
@@ -133,6 +138,7 @@ impl Operation {
     pub fn kind(&self) -> &'static str {
         match self {
             Self::Deburr(_) => "deburr",
+            Self::Predict(_) => "predict",
         }
     }
 
@@ -140,6 +146,7 @@ impl Operation {
     fn tool_mut(&mut self) -> Option<&mut ToolRef> {
         match self {
             Self::Deburr(request) => Some(&mut request.tool),
+            Self::Predict(request) => Some(&mut request.tool),
         }
     }
 }
@@ -256,6 +263,18 @@ fn check(job: &JobFile) -> AppResult<()> {
         tool.validate(&format!("{field}."))?;
         if job.tools[..index].iter().any(|t| t.number == Some(number)) {
             return Err(file_error(&format!("{field}.number"), None, &format!("tool {number} is defined twice")));
+        }
+    }
+    for (index, operation) in job.operations.iter().enumerate() {
+        if let Operation::Predict(request) = operation
+            && matches!(request.stock, Stock::Mesh {})
+        {
+            return Err(file_error(
+                &format!("operations[{index}].stock.kind"),
+                None,
+                "a job file cannot carry the STL file of a mesh stock: use a box, plane, cylinder or height grid \
+                 stock, or send the request to POST /api/v1/predict as multipart/form-data",
+            ));
         }
     }
     Ok(())

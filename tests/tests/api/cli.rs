@@ -28,13 +28,18 @@ fn runs_each_example_locally() {
             serde_json::from_str(&std::fs::read_to_string(out.path().join("job.json")).unwrap()).unwrap();
         let operations = summary["operations"].as_array().unwrap();
         assert!(!operations.is_empty());
-        for index in 0..operations.len() {
+        for (index, operation) in operations.iter().enumerate() {
+            let name = operation["operation"].as_str().unwrap();
             let result: serde_json::Value = serde_json::from_str(
-                &std::fs::read_to_string(out.path().join(format!("{index:02}-deburr.json"))).unwrap(),
+                &std::fs::read_to_string(out.path().join(format!("{index:02}-{name}.json"))).unwrap(),
             )
             .unwrap();
-            assert!(result["points"].as_array().unwrap().len() > 8);
-            let program = std::fs::read_to_string(out.path().join(format!("{index:02}-deburr.nc"))).unwrap();
+            match name {
+                "deburr" => assert!(result["points"].as_array().unwrap().len() > 8),
+                "predict" => assert!(result["passes"].as_array().unwrap().len() > 8),
+                _ => assert!(result.as_object().is_some_and(|o| !o.is_empty())),
+            }
+            let program = std::fs::read_to_string(out.path().join(format!("{index:02}-{name}.nc"))).unwrap();
             assert!(program.contains("M30"));
         }
         let listed = String::from_utf8_lossy(&output.stdout);

@@ -900,3 +900,164 @@ async fn bad_predict_requests() {
     assert_eq!(json_with(app.get("/api/v1/tools").await, 200).await, tools_before, "tools unchanged");
     assert_eq!(json_with(app.get("/api/v1/jobs").await, 200).await, jobs_before, "jobs unchanged");
 }
+
+/// A job file with one prediction operation.
+fn predict_job(name: &str, request: &Value) -> Value {
+    let mut operation = request.clone();
+    operation.as_object_mut().unwrap().insert("operation".into(), json!("predict"));
+    json!({"name": name, "operations": [operation]})
+}
+
+/// A prediction that takes a while: 3240 passes at N = 1024.
+fn long_request() -> Value {
+    let mut long = raster_request(finishing_tool(), 40, 81);
+    long["resolution"] = json!(1024);
+    long
+}
+
+/// Collects where `a` and `b` differ; numbers may differ by a few units in the last place (the job
+/// result is stored as JSON text and read back, and serde_json's default float parsing is not
+/// always correctly rounded).
+fn same_json(path: &str, a: &Value, b: &Value, differences: &mut Vec<String>) {
+    match (a, b) {
+        (Value::Object(x), Value::Object(y)) => {
+            let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
+            for key in keys {
+                same_json(
+                    &format!("{path}.{key}"),
+                    &x.get(key).cloned().unwrap_or(Value::Null),
+                    &y.get(key).cloned().unwrap_or(Value::Null),
+                    differences,
+                );
+            }
+        }
+        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => {
+            for (k, (p, q)) in x.iter().zip(y).enumerate() {
+                same_json(&format!("{path}[{k}]"), p, q, differences);
+            }
+        }
+        (Value::Number(x), Value::Number(y)) => {
+            let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
+            if (x - y).abs() > 1e-14 * x.abs().max(y.abs()).max(1e-300) {
+                differences.push(format!("{path}: {x} vs {y}"));
+            }
+        }
+        _ if a == b => {}
+        _ => differences.push(format!("{path}: {a} vs {b}")),
+    }
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn job_results_equal_the_endpoints_answer() {
+    let app = TestApp::spawn().await;
+    let request = raster_request(finishing_tool(), 6, 9);
+    let submitted = json_with(app.post_json("/api/v1/jobs", &predict_job("raster", &request)).await, 202).await;
+    let id = submitted["id"].as_i64().unwrap();
+    let job = kerf_tests::poll_job(&app.client, &app.base, id, 60, kerf_tests::finished).await;
+    assert_eq!(job["status"], "done", "{job}");
+    let mut result = job["results"][0]["result"].clone();
+    let timings = result.as_object_mut().unwrap().remove("timings").expect("job results carry timings");
+    assert!(timings["passes"].as_u64().unwrap() > 0 && number(&timings["passes_per_s"]) > 0.0, "{timings}");
+    let direct = predict(&app, &request).await;
+    let mut differences = Vec::new();
+    same_json("", &result, &direct, &mut differences);
+    assert!(differences.is_empty(), "the job's result is the endpoint's answer: {differences:?}");
+    let program = app.get(&format!("/api/v1/jobs/{id}/gcode")).await.text().await.unwrap();
+    let direct = app
+        .client
+        .post(app.url("/api/v1/predict?format=gcode"))
+        .json(&request)
+        .send()
+        .await
+        .unwrap()
+        .text()
+        .await
+        .unwrap();
+    assert_eq!(program, direct, "the job's program is the endpoint's");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn job_files_cannot_carry_a_mesh_stock() {
+    let app = TestApp::spawn().await;
+    let mut request = raster_request(finishing_tool(), 3, 5);
+    request["stock"] = json!({"kind": "mesh"});
+    let answer = problem(app.post_json("/api/v1/jobs", &predict_job("mesh", &request)).await, 400).await;
+    assert_eq!(answer["code"], "E_JOB_FILE");
+    assert_eq!(answer["errors"][0]["path"], "operations[0].stock.kind");
+    assert!(answer["detail"].as_str().unwrap().contains("STL"), "{answer}");
+    // A G-code error in a job fails it with the line and the field.
+    let mut bad = raster_request(finishing_tool(), 3, 5);
+    bad["path"]["program"] = json!("G21 G90\nG0 X0 Y0 Z5\nG1 Z0 F500 Q\nM30\n");
+    let id =
+        json_with(app.post_json("/api/v1/jobs", &predict_job("bad", &bad)).await, 202).await["id"].as_i64().unwrap();
+    let job = kerf_tests::poll_job(&app.client, &app.base, id, 30, kerf_tests::finished).await;
+    assert_eq!(job["status"], "failed");
+    assert_eq!(job["error_field"], "operations[0].path.program");
+    assert!(job["error"].as_str().unwrap().contains("line 3"), "{job}");
+    assert_eq!(json_with(app.get("/api/v1/jobs").await, 200).await["jobs"].as_array().unwrap().len(), 1);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn long_prediction_job_reports_progress_and_cancels_promptly() {
+    let app = TestApp::spawn_configured(|config| {
+        config.solver_slots = 1;
+        config.job_workers = 1;
+    })
+    .await;
+    let submitted = json_with(app.post_json("/api/v1/jobs", &predict_job("long", &long_request())).await, 202).await;
+    let id = submitted["id"].as_i64().unwrap();
+    // Progress between 0 and 1 while it runs, never going back.
+    let mut seen = Vec::new();
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while seen.len() < 3 && Instant::now() < deadline {
+        let job = json_with(app.get(&format!("/api/v1/jobs/{id}")).await, 200).await;
+        assert_eq!(job["status"].as_str().map(|s| s == "done" || s == "failed"), Some(false), "still running: {job}");
+        let progress = number(&job["progress"]);
+        if job["status"] == "running" && progress > 0.0 && seen.last().is_none_or(|last| progress > *last) {
+            assert!(progress < 1.0, "{job}");
+            seen.push(progress);
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+    assert!(seen.len() >= 3, "progress reported while running: {seen:?}");
+    // Cancelled at once, and the only worker and solver slot are free again promptly.
+    let cancelled = json_with(app.delete(&format!("/api/v1/jobs/{id}")).await, 200).await;
+    assert_eq!(cancelled["status"], "cancelled");
+    let stopped = Instant::now();
+    let quick = json_with(
+        app.post_json("/api/v1/jobs", &predict_job("quick", &raster_request(finishing_tool(), 2, 3))).await,
+        202,
+    )
+    .await;
+    let job =
+        kerf_tests::poll_job(&app.client, &app.base, quick["id"].as_i64().unwrap(), 30, kerf_tests::finished).await;
+    assert_eq!(job["status"], "done", "{job}");
+    assert!(stopped.elapsed() < Duration::from_secs(5), "the cancelled job let go after {:?}", stopped.elapsed());
+    let job = json_with(app.get(&format!("/api/v1/jobs/{id}")).await, 200).await;
+    assert_eq!(job["status"], "cancelled", "cancelled, not failed: {job}");
+}
+
+#[test]
+fn a_cancelled_prediction_is_a_cancelled_job_not_a_failure() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+
+    use kerf_server::jobs::execute::{JobFailure, execute};
+    use kerf_server::jobs::file::{self, Format};
+
+    let job = file::parse(&predict_job("long", &long_request()).to_string(), Format::Json).unwrap();
+    let cancel = AtomicBool::new(false);
+    let reports = std::sync::Mutex::new(Vec::new());
+    let started = Instant::now();
+    let outcome = std::thread::scope(|scope| {
+        scope.spawn(|| {
+            std::thread::sleep(Duration::from_millis(500));
+            cancel.store(true, Ordering::Relaxed);
+        });
+        execute(&job, &|fraction| reports.lock().unwrap().push(fraction), &cancel)
+    });
+    assert_eq!(outcome.unwrap_err(), JobFailure::Cancelled);
+    assert!(started.elapsed() < Duration::from_secs(5), "stopped after {:?}", started.elapsed());
+    let reports = reports.into_inner().unwrap();
+    assert!(!reports.is_empty() && reports.iter().all(|f| *f > 0.0 && *f < 1.0), "{reports:?}");
+    assert!(reports.windows(2).all(|w| w[0] < w[1]), "increasing: {reports:?}");
+}
