@@ -31,6 +31,7 @@ const ASSETS: &[Asset] = &[
     asset!("/plot3d.js", JS),
     asset!("/views/deburr.js", JS),
     asset!("/views/jobs.js", JS),
+    asset!("/views/predict.js", JS),
     asset!("/views/tools.js", JS),
 ];
 

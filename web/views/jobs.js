@@ -2,9 +2,10 @@
 // result with the view of its operation, download G-code and JSON (api.md, Jobs).
 import { api, download, message, showProblem } from '/app.js';
 import { deburrResult } from '/views/deburr.js';
+import { predictResult } from '/views/predict.js';
 
 // How each operation's result is shown; later capabilities add theirs here.
-const resultViews = { deburr: deburrResult };
+const resultViews = { deburr: deburrResult, predict: predictResult };
 
 const LAYOUT = `
 <section>
