@@ -1061,3 +1061,45 @@ fn a_cancelled_prediction_is_a_cancelled_job_not_a_failure() {
     assert!(!reports.is_empty() && reports.iter().all(|f| *f > 0.0 && *f < 1.0), "{reports:?}");
     assert!(reports.windows(2).all(|w| w[0] < w[1]), "increasing: {reports:?}");
 }
+
+/// Case F's rule over HTTP: every end node moves by the §3.14 node rule applied to the predicted
+/// errors and normals of the passes on either side of it (cases E and G are solver functions with
+/// no HTTP surface: `solver/tests/predict_cases.rs` checks them).
+#[tokio::test(flavor = "multi_thread")]
+async fn corrections_follow_the_node_rule_of_case_f() {
+    use kerf_solver::predict::correct::{PassError, node_correction};
+
+    let app = TestApp::spawn().await;
+    let mut request = raster_request(finishing_tool(), 6, 9);
+    request["correction"] = json!({"max_correction": 1.0});
+    let answer = predict(&app, &request).await;
+    let passes = answer["passes"].as_array().unwrap();
+    let error = |pass: &Value| {
+        (pass["status"] == "ok").then(|| PassError { error: number(&pass["error"]), normal: triple(&pass["normal"]) })
+    };
+    let mut moved = 0;
+    for (index, pass) in passes.iter().enumerate() {
+        let next = passes.get(index + 1).filter(|n| n["line"].as_u64() == pass["line"].as_u64().map(|l| l + 1));
+        let (expected, _) = node_correction(error(pass), next.and_then(error));
+        let got = triple(&pass["correction"]);
+        for k in 0..3 {
+            close(&format!("correction of pass {index}"), got[k], expected[k], 1e-12);
+        }
+        let end = triple(&pass["corrected"]);
+        moved += usize::from(expected.iter().any(|c| c.abs() > 1e-6));
+        assert!(end.iter().all(|c| c.is_finite()));
+    }
+    assert!(moved > passes.len() / 2, "most nodes move: {moved} of {}", passes.len());
+    // The whole case F polyline: the rule of `polyline_corrections` as published.
+    let case = case("F_");
+    let to_error = |p: &Value| Some(PassError { error: number(&p["e"]), normal: triple(&p["n"]) });
+    let errors: Vec<Option<PassError>> =
+        case["inputs"]["pass_errors"].as_array().unwrap().iter().map(to_error).collect();
+    let offsets = kerf_solver::predict::correct::polyline_corrections(&errors);
+    for (got, want) in offsets.iter().zip(case["expected"]["node_offsets"].as_array().unwrap()) {
+        let want = triple(want);
+        for k in 0..3 {
+            close("case F offset", got[k], want[k], number(&case["tolerances"]["offset"]));
+        }
+    }
+}
