@@ -1,10 +1,12 @@
 // kerf page shell: tabs, the API helper, problem display and downloads shared by the views.
+import { contourView } from '/views/contour.js';
 import { deburrView } from '/views/deburr.js';
+import { engagementView } from '/views/engagement.js';
 import { jobsView } from '/views/jobs.js';
 import { predictView } from '/views/predict.js';
 import { toolsView } from '/views/tools.js';
 
-const views = [deburrView, predictView, jobsView, toolsView];
+const views = [deburrView, contourView, engagementView, predictView, jobsView, toolsView];
 
 // The API token (KERF_API_TOKEN), kept in this browser once entered.
 function token() {

@@ -42,6 +42,8 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
         .merge(http::health::router())
         .merge(http::tools::router())
         .merge(http::deburr::router())
+        .merge(http::contour::router())
+        .merge(http::engagement::router())
         .merge(http::predict::router())
         .merge(http::jobs::router())
         .split_for_parts()

@@ -16,6 +16,9 @@ use utoipa::OpenApi;
         (name = "service", description = "Health"),
         (name = "tools", description = "The tool table, keyed by tool number"),
         (name = "deburr", description = "Cross-hole deburring with a ball end mill (deburr.md)"),
+        (name = "contour", description = "Layered contour milling with corner loops and inside-corner relief (corners.md)"),
+        (name = "engagement", description = "Tool–workpiece engagement along a path, chip thickness per flute count and \
+                                              the recommended flute counts (engagement.md)"),
         (name = "predict", description = "Machining-error prediction and path correction for ball-end-mill finishing (error-prediction.md)")
     )
 )]

@@ -20,7 +20,7 @@ pub mod arc;
 pub mod area;
 pub mod grid;
 
-pub use arc::{arc_steps, circumscribed_arc};
+pub use arc::{arc_max_step, arc_steps, circumscribed_arc, circumscribed_arc_steps};
 pub use area::{capsule_convex_area, clip_half_plane, disk_polygon_area};
 pub use grid::{GridBudgetExceeded, SegmentGrid, find_self_intersection};
 

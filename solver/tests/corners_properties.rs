@@ -6,7 +6,9 @@
 //! * every looped corner point is passed twice, each time in a straight line (incoming and
 //!   outgoing moves collinear, along one of the corner's faces, a different face each time);
 //! * every pass and every layer is closed;
-//! * the same request gives byte-identical answers.
+//! * the same request gives byte-identical answers;
+//!
+//! each with and without the block-time rule (`block_time_ms`).
 //!
 //! Solver refusals are allowed only with the tool-fit codes (random polygons have notches the
 //! tool cannot enter).
@@ -56,6 +58,8 @@ struct Setup {
     two_passes: bool,
     round: bool,
     max_angle_deg: f64,
+    /// With the block-time rule (arcs chorded by it, their end segments merged).
+    block_time: Option<f64>,
 }
 
 fn setup() -> impl Strategy<Value = Setup> {
@@ -68,8 +72,9 @@ fn setup() -> impl Strategy<Value = Setup> {
         any::<bool>(),
         any::<bool>(),
         100.0f64..179.0,
+        prop::option::of(0.5f64..8.0),
     )
-        .prop_map(|(contour, radius, outside, climb, style, two_passes, round, max_angle_deg)| Setup {
+        .prop_map(|(contour, radius, outside, climb, style, two_passes, round, max_angle_deg, block_time)| Setup {
             contour,
             radius,
             outside,
@@ -78,6 +83,7 @@ fn setup() -> impl Strategy<Value = Setup> {
             two_passes,
             round,
             max_angle_deg,
+            block_time,
         })
 }
 
@@ -90,7 +96,7 @@ fn request(setup: &Setup) -> ContourRequest {
     } else {
         json!([{"allowance": 0.0}])
     };
-    serde_json::from_value(json!({
+    let mut body = json!({
         "tool": {"kind": "flat", "radius": setup.radius},
         "contour": setup.contour,
         "side": if setup.outside { "outside" } else { "inside" },
@@ -101,8 +107,11 @@ fn request(setup: &Setup) -> ContourRequest {
         "feed": 600,
         "loop_feed": 2000,
         "tolerance": 0.005
-    }))
-    .unwrap()
+    });
+    if let Some(block_time) = setup.block_time {
+        body["block_time_ms"] = json!(block_time);
+    }
+    serde_json::from_value(body).unwrap()
 }
 
 fn solve(setup: &Setup) -> Option<ContourAnswer> {

@@ -1,6 +1,7 @@
 // Browser checks of the kerf page, driven by cargo test (tests/tests/api/browser.rs).
 // Usage: node run.mjs <scenario> <base-url> <screenshot.png> [job-file]
 // Prints one JSON line with what it saw; exits non-zero with the reason when a check fails.
+import { readFileSync } from 'node:fs';
 import { chromium } from 'playwright-core';
 
 const [scenario, base, screenshot, jobFile] = process.argv.slice(2);
@@ -29,6 +30,18 @@ async function inkedPixels(selector) {
   });
 }
 
+// Counts plot pixels within 40 of the colour [r, g, b].
+async function colouredPixels(selector, colour) {
+  return page.$eval(selector, (canvas, [r, g, b]) => {
+    const data = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
+    let found = 0;
+    for (let i = 0; i < data.length; i += 4) {
+      if (Math.abs(data[i] - r) + Math.abs(data[i + 1] - g) + Math.abs(data[i + 2] - b) < 40) found++;
+    }
+    return found;
+  }, colour);
+}
+
 const scenarios = {
   // Loads the page, submits the sample deburr job with the button, waits for the plot.
   async deburr() {
@@ -49,6 +62,108 @@ const scenarios = {
     const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
     if (!highlighted.includes('hole_radius')) throw new Error(`field not highlighted: ${highlighted}`);
     return { segments, inked };
+  },
+
+  // Computes the sample contour, checks the plot (loops and reliefs in their colours), the
+  // corner table and the layer selector, downloads the G-code, and reports bad input on the
+  // right field.
+  async contour() {
+    await page.goto(`${base}/#contour`);
+    await page.click('#contour-compute');
+    await page.waitForSelector('#contour-plot[data-state="drawn"]', { timeout: 15000 });
+    const segments = Number(await page.getAttribute('#contour-plot', 'data-segments'));
+    const inked = await inkedPixels('#contour-plot');
+    const loopPixels = await colouredPixels('#contour-plot', [224, 112, 0]);
+    const reliefPixels = await colouredPixels('#contour-plot', [142, 36, 170]);
+    const actions = await page.$$eval('#contour-result table.corners td.action', (l) => l.map((e) => e.textContent));
+    const summary = await page.textContent('#contour-result .summary');
+    if (segments < 50) throw new Error(`only ${segments} segments drawn`);
+    if (inked < 2000) throw new Error(`plot nearly blank: ${inked} inked pixels`);
+    if (loopPixels < 100 || reliefPixels < 20) throw new Error(`loops ${loopPixels} / reliefs ${reliefPixels} pixels`);
+    if (actions.filter((a) => a === 'arc loop').length !== 5 || actions.filter((a) => a === 'dogbone').length !== 2) {
+      throw new Error(`corner actions: ${actions}`);
+    }
+    if (!/layers × passes\s*3 × 2/.test(summary)) throw new Error(`summary: ${summary}`);
+    if (screenshot) await page.screenshot({ path: screenshot.replace(/\.png$/, '-first.png'), fullPage: true });
+    const fitted = Number(await page.getAttribute('#contour-plot', 'data-scale'));
+
+    // The last layer, then a corner zoomed in from the table.
+    await page.selectOption('#contour-result select[name="layer"]', '2');
+    await page.waitForSelector('#contour-plot[data-layer="2"][data-state="drawn"]', { timeout: 5000 });
+    await page.click('#contour-result table.corners tbody tr[data-corner="3"]');
+    const zoomed = Number(await page.getAttribute('#contour-plot', 'data-scale'));
+    const zoomedLoop = await colouredPixels('#contour-plot', [224, 112, 0]);
+    if (zoomed < 2 * fitted || zoomedLoop < 500) throw new Error(`zoom to the tip: scale ${fitted} → ${zoomed}, loop ${zoomedLoop} px`);
+
+    // The G-code download.
+    await page.selectOption('#contour-form select[name="dialect"]', 'linuxcnc');
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('#contour-gcode')]);
+    const program = readFileSync(await download.path(), 'utf8');
+    if (!program.includes('G64 P') || !program.trim().endsWith('M30')) throw new Error(`program: ${program.slice(0, 200)}`);
+
+    // A bad step is reported on its field; a crossing contour on the points box; a line that is
+    // not "x, y" before anything is sent.
+    await page.fill('#contour-form input[name="step"]', '0');
+    await page.click('#contour-compute');
+    await page.waitForSelector('#contour-messages .message.error', { timeout: 15000 });
+    const invalidStep = await page.$$eval('#contour-form .invalid', (l) => l.map((e) => e.name));
+    if (!invalidStep.includes('step')) throw new Error(`step not highlighted: ${invalidStep}`);
+    await page.fill('#contour-form input[name="step"]', '3');
+    await page.fill('#contour-form textarea[name="points"]', '0, 0\n10, 10\n10, 0\n0, 10');
+    await page.click('#contour-compute');
+    await page.waitForFunction(() => /E_SELF_INTERSECTION/.test(document.querySelector('#contour-messages').textContent), null, { timeout: 15000 });
+    const invalidPoints = await page.$$eval('#contour-form .invalid', (l) => l.map((e) => e.name));
+    if (!invalidPoints.includes('points')) throw new Error(`points not highlighted: ${invalidPoints}`);
+    await page.fill('#contour-form textarea[name="points"]', '0, 0\n10 0 5\n10, 10');
+    await page.click('#contour-compute');
+    const local = await page.textContent('#contour-messages');
+    if (!/line 2/.test(local)) throw new Error(`local check: ${local}`);
+    return { segments, inked, loopPixels, reliefPixels, zoomed: zoomed / fitted };
+  },
+
+  // The Engagement view: computes its three sample paths side by side, checks every chart is
+  // drawn, moves the cursor over a contact graph and sees the tool marked on the path, downloads
+  // the G-code of the second path, and highlights a bad flute count.
+  async engagement() {
+    await page.goto(`${base}/#engagement`);
+    await page.click('#engagement-compute');
+    await page.waitForSelector('#engagement-result[data-state="drawn"]', { timeout: 30000 });
+    const columns = await page.$$eval('#engagement-result .candidate', (list) => list.length);
+    const states = await page.$$eval('#engagement-result canvas', (list) => list.map((c) => c.dataset.state));
+    if (states.some((s) => s !== 'drawn')) throw new Error(`charts not drawn: ${states}`);
+    const contactGraph = '#engagement-result .candidate canvas[aria-label^="Contact position"]';
+    const inked = await inkedPixels(contactGraph);
+    if (inked < 2000) throw new Error(`contact graph nearly blank: ${inked} inked pixels`);
+    const recommendation = await page.textContent('#engagement-result .recommendation');
+    // A cursor on the contact graph marks the tool on the path.
+    const box = await (await page.$(contactGraph)).boundingBox();
+    const plan = '#engagement-result .candidate canvas.plan';
+    const before = await inkedPixels(plan);
+    await page.mouse.move(box.x + box.width * 0.45, box.y + box.height / 2);
+    const cursor = Number(await page.getAttribute(plan, 'data-cursor'));
+    const after = await inkedPixels(plan);
+    const readout = await page.textContent('#engagement-result .cursor-readout');
+    if (!Number.isInteger(cursor) || cursor <= 0) throw new Error(`no cursor on the path: ${cursor}`);
+    if (after <= before) throw new Error(`tool circle not drawn: ${before} -> ${after} inked pixels`);
+    if (!/s = [\d.]+ mm/.test(readout)) throw new Error(`no readout: ${readout}`);
+    // The x axis switches to time; every chart is drawn again.
+    await page.selectOption('#engagement-result select[aria-label="x axis"]', 'time');
+    const redrawn = await page.$$eval('#engagement-result canvas', (list) => list.filter((c) => c.dataset.state === 'drawn').length);
+    if (redrawn !== states.length) throw new Error(`after switching to time: ${redrawn} of ${states.length} charts drawn`);
+    // G-code of the second path.
+    await page.selectOption('select[name="candidate"]', '1');
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('#engagement-gcode')]);
+    const { readFile } = await import('node:fs/promises');
+    const program = await readFile(await download.path(), 'utf8');
+    const feeds = new Set([...program.matchAll(/ F(\d+(?:\.\d)?)/g)].map((m) => m[1]));
+    if (!program.includes('M30') || feeds.size < 2) throw new Error(`program without its feed plan: ${program.slice(0, 400)}`);
+    // A flute count out of range is refused with the field highlighted.
+    await page.fill('input[name="flute_counts"]', '2, 40');
+    await page.click('#engagement-compute');
+    await page.waitForSelector('#engagement-messages .message.error', { timeout: 15000 });
+    const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
+    if (!highlighted.includes('flute_counts')) throw new Error(`field not highlighted: ${highlighted}`);
+    return { columns, charts: states.length, inked, cursor, recommendation, feeds: feeds.size, file: download.suggestedFilename() };
   },
 
   // Predict page: runs the sample raster over the dome, checks the path coloured by error (several

@@ -247,6 +247,10 @@ pub fn rs274_moves(program: &str, folder: &Path, name: &str) -> Option<Vec<(bool
     std::fs::write(&file, program).expect("write program");
     let table = folder.join("rs274-tools.tbl");
     std::fs::write(&table, rs274_tool_table()).expect("write tool table");
+    // rs274 instances running at once share LinuxCNC state and crash or lose the tool table (a
+    // bus error, "tool not found"): one at a time on this machine, across test processes too.
+    let lock = std::fs::File::create(std::env::temp_dir().join("kerf-rs274.lock")).expect("rs274 lock file");
+    lock.lock().expect("rs274 lock");
     let output = std::process::Command::new(rs274)
         .arg("-t")
         .arg(&table)
@@ -255,6 +259,7 @@ pub fn rs274_moves(program: &str, folder: &Path, name: &str) -> Option<Vec<(bool
         .stdin(std::process::Stdio::null())
         .output()
         .expect("rs274 runs");
+    drop(lock);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "rs274 rejected {name}: {stderr}\n{program}");
     let complaints: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty() && l.trim() != "executing").collect();

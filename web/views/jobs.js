@@ -1,11 +1,13 @@
 // Jobs workbench: drop or pick a job file, watch it queue and run, browse past jobs, open a
 // result with the view of its operation, download G-code and JSON (api.md, Jobs).
 import { api, download, message, showProblem } from '/app.js';
+import { contourResult } from '/views/contour.js';
 import { deburrResult } from '/views/deburr.js';
+import { engagementResult } from '/views/engagement.js';
 import { predictResult } from '/views/predict.js';
 
 // How each operation's result is shown; later capabilities add theirs here.
-const resultViews = { deburr: deburrResult, predict: predictResult };
+const resultViews = { deburr: deburrResult, contour: contourResult, engagement: engagementResult, predict: predictResult };
 
 const LAYOUT = `
 <section>

@@ -72,7 +72,7 @@ const FORM = `
         <label>Ball radius, mm <input name="radius" type="number" step="any" value="3" data-field="tool.radius"></label>
         <label>Flutes <input name="flutes" type="number" value="2" data-field="tool.flutes"></label>
         <label>Helix, ° <input name="helix" type="number" step="any" value="30" data-field="tool.helix_deg"></label>
-        <label class="wide">Shape error δ(θ): angle °, error mm per row<textarea name="shape_error" rows="4" data-field="tool.shape_error" title="one row per contact angle: angle in degrees (0 = tip, 90 = equator), error in mm">0 0.004
+        <label class="stacked">Shape error δ(θ): angle °, error mm per row<textarea name="shape_error" rows="4" data-field="tool.shape_error" title="one row per contact angle: angle in degrees (0 = tip, 90 = equator), error in mm">0 0.004
 30 0.005
 60 0.007
 90 0.009</textarea></label>
@@ -101,11 +101,11 @@ const FORM = `
         <input name="origin_y" type="number" step="any" data-field="stock.origin"></span></label>
       <label data-stock="grid">Spacing, mm <input name="spacing" type="number" step="any" value="1" data-field="stock.spacing"></label>
       <label data-stock="grid">Bottom z <input name="bottom" type="number" step="any" value="-20" data-field="stock.bottom"></label>
-      <label class="wide" data-stock="grid">Heights, mm (a row per y, along x)<textarea name="heights" rows="4" data-field="stock.heights" title="one row per y, heights along x"></textarea></label>
+      <label class="stacked" data-stock="grid">Heights, mm (a row per y, along x)<textarea name="heights" rows="4" data-field="stock.heights" title="one row per y, heights along x"></textarea></label>
       <label data-stock="mesh">STL file <input name="stock_file" type="file" accept=".stl,model/stl,application/sla" data-field="stock"></label>
     </fieldset>
     <fieldset><legend>Path</legend>
-      <label class="wide">G-code program<textarea name="program" rows="14" spellcheck="false" class="code" data-field="path.program"></textarea></label>
+      <label class="stacked">G-code program<textarea name="program" rows="14" spellcheck="false" class="code" data-field="path.program"></textarea></label>
       <label>Open a file <input name="program_file" type="file" accept=".nc,.ngc,.tap,.gcode,.txt"></label>
       <label>Programmed point <select name="reference" data-field="reference"><option value="tip">tool tip</option><option value="centre">ball centre</option></select></label>
     </fieldset>
@@ -488,7 +488,7 @@ export const predictView = {
       try {
         const answer = await api('POST', '/api/v1/predict?timings=true', payload(predictRequest(form)));
         const seconds = (performance.now() - started) / 1000;
-        messages.replaceChildren(message('done', `${answer.summary.passes} passes in ${seconds.toFixed(2)} s`));
+        messages.replaceChildren(message('ok', `${answer.summary.passes} passes in ${seconds.toFixed(2)} s`));
         predictResult(result, answer).id = 'predict-plot';
         result.querySelector('canvas.histogram').id = 'predict-histogram';
       } catch (problem) {
@@ -511,7 +511,7 @@ export const predictView = {
       const slot = value(form, 'save_number');
       try {
         await api('PUT', `/api/v1/tools/${encodeURIComponent(slot)}`, { ...body.tool, name: `R${body.tool.radius} ball, shape error` });
-        messages.replaceChildren(message('done', `tool ${slot} saved with its shape-error table`));
+        messages.replaceChildren(message('ok', `tool ${slot} saved with its shape-error table`));
         await loadTools(form.elements.tool_choice);
       } catch (problem) {
         fail(problem);

@@ -1,6 +1,8 @@
 //! HTTP routes, one module per resource, each with a `router()`.
 
+pub mod contour;
 pub mod deburr;
+pub mod engagement;
 pub mod health;
 pub mod jobs;
 pub mod output;

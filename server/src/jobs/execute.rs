@@ -7,7 +7,7 @@ use std::sync::{Mutex, PoisonError};
 
 use kerf_solver::SolverError;
 use kerf_solver::predict::Control;
-use kerf_solver::tool::ToolRef;
+use kerf_solver::tool::{Tool, ToolRef};
 use serde::Serialize;
 use utoipa::ToSchema;
 
@@ -48,6 +48,35 @@ fn refused(index: usize, error: &SolverError) -> JobFailure {
     }
 }
 
+/// The tool of operation `index`, which resolution has made inline.
+fn resolved_tool(index: usize, tool: &ToolRef) -> Result<Tool, JobFailure> {
+    match tool {
+        ToolRef::Inline(tool) => Ok(tool.clone()),
+        ToolRef::Number(_) => Err(JobFailure::Refused {
+            message: format!("operation {index}: the tool was not resolved"),
+            field: Some(format!("operations[{index}].tool")),
+        }),
+    }
+}
+
+/// The stored output of operation `index`: its answer as JSON and its program, or why none.
+fn output<T: Serialize>(
+    index: usize,
+    operation: &Operation,
+    answer: &T,
+    program: Result<String, SolverError>,
+) -> Result<OperationOutput, JobFailure> {
+    Ok(OperationOutput {
+        operation: operation.kind().to_owned(),
+        result: serde_json::to_value(answer).map_err(|e| JobFailure::Refused {
+            message: format!("operation {index}: result not serialisable: {e}"),
+            field: None,
+        })?,
+        gcode_problem: program.as_ref().err().map(|e| format!("{} ({})", e.message(), e.code())),
+        gcode: program.ok(),
+    })
+}
+
 /// Runs `job` (already resolved: tools inline). `progress` receives the fraction done (0–1),
 /// also within long operations (from their worker threads).
 pub fn execute(
@@ -63,31 +92,29 @@ pub fn execute(
         }
         let output = match operation {
             Operation::Deburr(request) => {
-                let ToolRef::Inline(tool) = &request.tool else {
-                    return Err(JobFailure::Refused {
-                        message: format!("operation {index}: the tool was not resolved"),
-                        field: Some(format!("operations[{index}].tool")),
-                    });
-                };
-                let answer = http::deburr::run(request, tool.clone()).map_err(|e| refused(index, &e))?;
+                let answer =
+                    http::deburr::run(request, resolved_tool(index, &request.tool)?).map_err(|e| refused(index, &e))?;
                 let program = http::deburr::program(&answer, job.output.dialect, job.output.reference);
-                OperationOutput {
-                    operation: operation.kind().to_owned(),
-                    result: serde_json::to_value(&answer).map_err(|e| JobFailure::Refused {
-                        message: format!("operation {index}: result not serialisable: {e}"),
-                        field: None,
-                    })?,
-                    gcode_problem: program.as_ref().err().map(|e| format!("{} ({})", e.message(), e.code())),
-                    gcode: program.ok(),
-                }
+                output(index, operation, &answer, program)?
+            }
+            Operation::Contour(request) => {
+                // A job goes up to the solver's move limit; its stored JSON keeps what fits.
+                let tool = resolved_tool(index, &request.tool)?;
+                let mut answer = http::contour::run(request, tool, kerf_solver::corners::request::MAX_MOVES)
+                    .map_err(|e| refused(index, &e))?;
+                let program = http::contour::program(&answer, job.output.dialect, job.output.reference);
+                http::contour::limit_stored_moves(&mut answer);
+                output(index, operation, &answer, program)?
+            }
+            Operation::Engagement(request) => {
+                let tool = resolved_tool(index, &request.tool)?;
+                let answer = http::engagement::run(request, tool).map_err(|e| refused(index, &e))?;
+                // One program per operation: the first path's.
+                let program = http::engagement::program(&answer, 0, job.output.dialect, job.output.reference);
+                output(index, operation, &answer, program)?
             }
             Operation::Predict(request) => {
-                let ToolRef::Inline(tool) = &request.tool else {
-                    return Err(JobFailure::Refused {
-                        message: format!("operation {index}: the tool was not resolved"),
-                        field: Some(format!("operations[{index}].tool")),
-                    });
-                };
+                let tool = resolved_tool(index, &request.tool)?;
                 // The solver reports from its worker threads, not always in order: pass on
                 // increases only, scaled into this operation's share of the job.
                 let reached = Mutex::new(0.0_f64);
@@ -99,21 +126,13 @@ pub fn execute(
                     }
                 };
                 let control = Control { progress: Some(&within), cancel: Some(cancelled) };
-                let answer = match http::predict::run(request, tool.clone(), None, &control) {
+                let answer = match http::predict::run(request, tool, None, &control) {
                     Ok(answer) => answer,
                     Err(error) if error.code() == "E_CANCELLED" => return Err(JobFailure::Cancelled),
                     Err(error) => return Err(refused(index, &error)),
                 };
                 let program = http::predict::job_program(request, &answer, job.output.dialect, job.output.reference);
-                OperationOutput {
-                    operation: operation.kind().to_owned(),
-                    result: serde_json::to_value(&answer).map_err(|e| JobFailure::Refused {
-                        message: format!("operation {index}: result not serialisable: {e}"),
-                        field: None,
-                    })?,
-                    gcode_problem: program.as_ref().err().map(|e| format!("{} ({})", e.message(), e.code())),
-                    gcode: program.ok(),
-                }
+                output(index, operation, &answer, program)?
             }
         };
         outputs.push(output);

@@ -20,7 +20,9 @@
 //! hole = { shape = "round", radius = 5 }
 //! ```
 
+use kerf_solver::corners::ContourRequest;
 use kerf_solver::deburr::DeburrRequest;
+use kerf_solver::engagement::EngagementRequest;
 use kerf_solver::gcode::{Dialect, Reference};
 use kerf_solver::predict::{PredictRequest, Stock};
 use kerf_solver::tool::{Tool, ToolRef};
@@ -69,9 +71,14 @@ pub struct OutputOptions {
 /// One operation: `operation` names it, the other fields are its endpoint's request.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[serde(tag = "operation", rename_all = "snake_case")]
+#[allow(clippy::large_enum_variant, reason = "a job holds at most 100 operations, read once")]
 pub enum Operation {
     /// `POST /api/v1/deburr`.
     Deburr(DeburrRequest),
+    /// `POST /api/v1/contour`.
+    Contour(ContourRequest),
+    /// `POST /api/v1/engagement`; the job's program is that of `path` (or `paths[0]`).
+    Engagement(EngagementRequest),
     /// `POST /api/v1/predict` (a job file cannot carry an STL file: no `mesh` stock).
     Predict(PredictRequest),
 }
@@ -81,6 +88,8 @@ pub enum Operation {
 #[serde(rename_all = "snake_case")]
 enum OperationKind {
     Deburr,
+    Contour,
+    Engagement,
     Predict,
 }
 
@@ -89,6 +98,8 @@ impl OperationKind {
     fn read<'de, D: serde::Deserializer<'de>>(self, fields: D) -> Result<Operation, D::Error> {
         match self {
             Self::Deburr => DeburrRequest::deserialize(fields).map(Operation::Deburr),
+            Self::Contour => ContourRequest::deserialize(fields).map(Operation::Contour),
+            Self::Engagement => EngagementRequest::deserialize(fields).map(Operation::Engagement),
             Self::Predict => PredictRequest::deserialize(fields).map(Operation::Predict),
         }
     }
@@ -138,6 +149,8 @@ impl Operation {
     pub fn kind(&self) -> &'static str {
         match self {
             Self::Deburr(_) => "deburr",
+            Self::Contour(_) => "contour",
+            Self::Engagement(_) => "engagement",
             Self::Predict(_) => "predict",
         }
     }
@@ -146,6 +159,8 @@ impl Operation {
     fn tool_mut(&mut self) -> Option<&mut ToolRef> {
         match self {
             Self::Deburr(request) => Some(&mut request.tool),
+            Self::Contour(request) => Some(&mut request.tool),
+            Self::Engagement(request) => Some(&mut request.tool),
             Self::Predict(request) => Some(&mut request.tool),
         }
     }

@@ -245,6 +245,9 @@ pub struct ContourSummary {
     pub tolerance: f64,
     /// Time of the feed moves, s (rapids excluded).
     pub estimated_time_s: f64,
+    /// With `block_time_ms`: the blocks, the shortest, the short ones and the block-limited time.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blocks: Option<super::blocks::ContourBlocks>,
 }
 
 /// The answer of `POST /api/v1/contour`.

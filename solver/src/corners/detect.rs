@@ -180,8 +180,20 @@ pub struct PathLoopAnswer {
 ///
 /// # Errors
 /// `E_INPUT` for bad numbers, `E_DEGENERATE` for fewer than 3 distinct points,
-/// `E_TOO_MANY_POINTS`.
+/// `E_TOO_MANY_POINTS`, `E_TOO_MANY_MOVES` (over the contour's move limit).
 pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, crate::error::SolverError> {
+    loop_path_within(request, super::request::MAX_MOVES)
+}
+
+/// [`loop_path`] with a smaller move budget: `E_TOO_MANY_MOVES` at `path` as soon as the looped
+/// path holds more than `max_moves` moves (huge loops chorded finely on many corners).
+///
+/// # Errors
+/// As [`loop_path`].
+pub fn loop_path_within(
+    request: &PathLoopRequest,
+    max_moves: usize,
+) -> Result<PathLoopAnswer, crate::error::SolverError> {
     use super::element::ElementKind;
     use super::loops::{self, LoopShape};
     use super::pass::MAX_ARC_STEPS;
@@ -211,6 +223,11 @@ pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, crate::err
     let n = points.len();
     if n < 3 {
         return Err(SolverError::new("E_DEGENERATE", "the path needs at least 3 distinct points").at("path"));
+    }
+    if n > max_moves {
+        return Err(
+            SolverError::new("E_TOO_MANY_MOVES", format!("the path alone has more than {max_moves} moves")).at("path")
+        );
     }
     let tolerance = request.tolerance.unwrap_or(contour_request::DEFAULT_TOLERANCE);
     if finite("tolerance", tolerance)? < contour_request::MIN_TOLERANCE {
@@ -331,7 +348,17 @@ pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, crate::err
         };
         looped[k] = true;
         visits.push(route.len() - 1);
-        for (_, to, kind) in loop_moves(&shape, &p) {
+        let looped_moves = loop_moves(&shape, &p);
+        if moves.len() + looped_moves.len() + (n - step) > max_moves {
+            return Err(SolverError::new(
+                "E_TOO_MANY_MOVES",
+                format!(
+                    "the looped path needs more than {max_moves} moves: use a coarser tolerance, smaller loops or fewer points"
+                ),
+            )
+            .at("path"));
+        }
+        for (_, to, kind) in looped_moves {
             let kind = if kind == ElementKind::Loop { super::answer::MoveKind::Loop } else { cut };
             moves.push(PathMove { kind, to: [to.x, to.y] });
             route.push(to);

@@ -23,7 +23,8 @@
 //!   §3.7);
 //! * [`detect`]: corner detection on an existing CL point list (§3.4, claims 8–9), and loops
 //!   added to such a path ([`detect::loop_path`]);
-//! * [`program`](mod@program): G-code.
+//! * [`program`](mod@program): G-code;
+//! * `blocks`: with `block_time_ms`, the block figures of the answer (issue 3).
 //!
 //! Choices where the spec is open (see also the module docs):
 //! * `direction` `climb` (default) puts the material on the right of travel (σ = −1);
@@ -44,8 +45,16 @@
 //!   predicted under blending (M1) and servo lag (M2); convex corners lose nothing ideally.
 //! * The effective radius is the tool's `radius` for every kind (its widest part cuts the
 //!   vertical wall); ball and bull tools differ only in the G-code reference point.
+//! * With `block_time_ms` (chord.md, issue 3) every arc is chorded at the block-time rule's chord
+//!   error for its radius, never coarser than `tolerance`: cutting arcs (round joins) at `feed`,
+//!   loop arcs at the larger of `feed` and `loop_feed` (a loop runs at one or the other, and a
+//!   block longer than needed never starves the control). An arc too tight for one block keeps
+//!   `tolerance` and is reported (`W_INFEASIBLE_FEED_FOR_RADIUS`) instead of refusing the
+//!   contour: the loops and joins are kerf's own, not the part's. Straight moves are the part's
+//!   edges and stay as they are; `summary.blocks` counts the short ones.
 
 pub mod answer;
+mod blocks;
 pub mod detect;
 pub mod division;
 mod element;
@@ -64,6 +73,7 @@ pub use answer::{
     ContourAnswer, ContourCorner, ContourLayer, ContourMove, ContourSummary, Convexity, CornerAction, LoopReport,
     MaterialReport, MoveKind, PassReport, ReliefReport,
 };
+pub use blocks::ContourBlocks;
 pub use element::{Element, ElementKind};
 pub use pass::{Action, CornerPlan, ElementMeta, PassPlan};
 pub use program::program;
@@ -72,4 +82,4 @@ pub use request::{
     ContourRequest, ControllerModel, CornerLoop, CornerOverride, CutDirection, Depths, Join, LoopStyle, PassSpec,
     Relief, Side, TboneEdge, Tilt,
 };
-pub use solve::{Plan, plan, solve};
+pub use solve::{Plan, plan, solve, solve_within};

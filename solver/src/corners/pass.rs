@@ -3,7 +3,7 @@
 //! its validity (O4, O5, global clearance), the action at every corner, and the element list from
 //! S round to S.
 
-use super::element::{Element, ElementKind};
+use super::element::{Chording, Element, ElementKind};
 use super::layer::{Class, Layer};
 use super::loops::{self, LoopShape};
 use super::offset::{self, Offset};
@@ -177,7 +177,7 @@ pub(crate) struct PassInput<'a> {
     /// Per traversal vertex: whether "previous" in request order is the traversal's previous
     /// edge.
     pub request_order: bool,
-    pub tolerance: f64,
+    pub chording: Chording,
     pub stock: Option<&'a Stock>,
     /// Request index of every traversal vertex.
     pub source: Vec<usize>,
@@ -454,7 +454,7 @@ fn check_loop_budget(layer: &Layer, offset: &Offset, input: &PassInput<'_>) -> R
             moves += shape
                 .elements(&offset.cl[k])
                 .iter()
-                .map(|e| e.chord_count(input.tolerance, MAX_ARC_STEPS))
+                .map(|e| e.chords_count(&input.chording, MAX_ARC_STEPS))
                 .sum::<usize>();
         }
         if moves > super::request::MAX_MOVES {
@@ -538,7 +538,7 @@ fn gouge_fallbacks(
         if attempt == 5 {
             candidate = LoopShape::triangle(p, d1, d2, candidate.leg);
         }
-        let clearance = loop_clearance(layer, &candidate, p, vertex, clear, input.tolerance, scratch);
+        let clearance = loop_clearance(layer, &candidate, p, vertex, clear, &input.chording, scratch);
         if clearance >= -GOUGE_TOLERANCE {
             return Ok((candidate, clearance));
         }
@@ -551,11 +551,11 @@ fn gouge_fallbacks(
 }
 
 /// The straight moves of a loop (exit, chorded loop, entry) from P.
-fn loop_moves(shape: &LoopShape, p: &Vec2, tolerance: f64) -> Vec<(Vec2, Vec2)> {
+fn loop_moves(shape: &LoopShape, p: &Vec2, chording: &Chording) -> Vec<(Vec2, Vec2)> {
     let mut moves = Vec::new();
     let mut from = *p;
     for element in shape.elements(p) {
-        for to in element.chord(tolerance, MAX_ARC_STEPS) {
+        for to in element.chords(chording, MAX_ARC_STEPS) {
             moves.push((from, to));
             from = to;
         }
@@ -571,11 +571,11 @@ fn loop_clearance(
     p: &Vec2,
     vertex: &Vec2,
     clear: f64,
-    tolerance: f64,
+    chording: &Chording,
     scratch: &mut Vec<usize>,
 ) -> f64 {
     let radius = (p - vertex).norm().max(clear) + 1e-6;
-    loop_moves(shape, p, tolerance)
+    loop_moves(shape, p, chording)
         .iter()
         .filter_map(|(a, b)| layer.grid.nearest(a, b, radius, scratch, |_| false))
         .map(|(distance, _)| distance)
@@ -593,7 +593,7 @@ fn stock_clearance(
     scratch: &mut Vec<usize>,
 ) -> f64 {
     let radius = (p - vertex).norm() + input.radius + 1.0;
-    let moves = loop_moves(shape, p, input.tolerance);
+    let moves = loop_moves(shape, p, &input.chording);
     let mut best = f64::INFINITY;
     for (grid, inset) in &stock.parts {
         for (a, b) in &moves {
@@ -616,7 +616,7 @@ fn check_clearance(
 ) -> Result<(), SolverError> {
     for element in elements.iter().filter(|e| e.kind() == ElementKind::Cut) {
         let mut from = element.start();
-        for to in element.chord(input.tolerance, MAX_ARC_STEPS) {
+        for to in element.chords(&input.chording, MAX_ARC_STEPS) {
             if let Some((distance, edge)) = layer.grid.nearest(&from, &to, clear - GOUGE_TOLERANCE, scratch, |_| false)
             {
                 let source = input.edge_source[edge];

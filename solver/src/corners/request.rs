@@ -1,9 +1,11 @@
-//! The contour request as clients send it (api.md, Contour) and its validation into a [`Job`]
+//! The contour request as clients send it (api.md, Contour) and its validation into a `Job`
 //! (corners.md §1.4 inputs, §3.1 preparation, §5 input codes).
 
 use serde::{Deserialize, Serialize};
 
+use super::element::Chording;
 use super::prepare::{self, Contour};
+use crate::chord::{BlockRule, RuleSettings};
 use crate::error::{SolverError, Warning, finite, non_negative, positive};
 use crate::tool::{Tool, ToolKind, ToolRef};
 
@@ -316,9 +318,16 @@ pub struct ContourRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub start_edge: Option<usize>,
     /// Chord tolerance for arcs (loop arcs, round joins), mm (default 0.01). Arcs are chorded from
-    /// outside, so the tool never cuts inside them.
+    /// outside, so the tool never cuts inside them. With `block_time_ms` it is the upper bound of
+    /// the block-time rule's chord error.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tolerance: Option<f64>,
+    /// Block processing time of the control, ms (chord.md). With it every arc is chorded at the
+    /// chord error whose chords last one block time at the arc's feed (`feed`; loops at the
+    /// larger of `feed` and `loop_feed`), never coarser than `tolerance`, and the summary reports
+    /// the blocks (`summary.blocks`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub block_time_ms: Option<f64>,
     /// Spindle speed, rpm (default 6000).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spindle_rpm: Option<f64>,
@@ -386,6 +395,8 @@ pub(crate) struct Job {
     pub safe_z: f64,
     pub lead: f64,
     pub tolerance: f64,
+    /// How arcs become chords: `tolerance`, or the block-time rule within it.
+    pub chording: Chording,
     pub spindle_rpm: f64,
     pub stock_allowance: Option<f64>,
     /// Tilt per prepared edge, radians; `None` when every wall is vertical.
@@ -431,6 +442,19 @@ impl ContourRequest {
                 format!("tolerance must be at least {MIN_TOLERANCE} mm (got {tolerance})"),
             ));
         }
+        let mut rule_warnings = Vec::new();
+        let rules = match self.block_time_ms {
+            None => None,
+            Some(block_time_ms) => {
+                let settings =
+                    RuleSettings { feed: Some(feed), block_time_ms: Some(block_time_ms), ..RuleSettings::default() };
+                let (rule, warnings) = BlockRule::resolve(&settings, None)?;
+                rule_warnings = warnings;
+                let loops = BlockRule { feed: feed.max(loop_feed.unwrap_or(feed)), ..rule };
+                Some((rule, loops))
+            }
+        };
+        let chording = Chording { tolerance, rules };
         let spindle_rpm = positive("spindle_rpm", self.spindle_rpm.unwrap_or(DEFAULT_SPINDLE_RPM))?;
         let clearance = non_negative("clearance", self.clearance.unwrap_or(DEFAULT_CLEARANCE))?;
         let safe_z = match self.safe_z {
@@ -455,6 +479,7 @@ impl ContourRequest {
         }
         let loop_config = self.corner_loop.config(radius)?;
         let (contour, mut warnings) = prepare::prepare(&self.contour, self.fix_orientation)?;
+        warnings.extend(rule_warnings);
         let start_edge = match self.start_edge {
             None => contour.edge_containing(0),
             Some(k) if k < self.contour.len() => contour.edge_containing(k),
@@ -501,6 +526,7 @@ impl ContourRequest {
             safe_z,
             lead,
             tolerance,
+            chording,
             spindle_rpm,
             stock_allowance,
             tilt,

@@ -7,7 +7,8 @@ use super::answer::{
     ContourAnswer, ContourCorner, ContourLayer, ContourMove, ContourSummary, Convexity, CornerAction, LoopReport,
     MaterialReport, MoveKind, PassReport, ReliefReport,
 };
-use super::element::ElementKind;
+use super::blocks;
+use super::element::{Chording, Element, ElementKind};
 use super::layer::Layer;
 use super::material::{self, Material};
 use super::pass::{self, Action, GOUGE_TOLERANCE, MAX_ARC_STEPS, PassInput, PassPlan, Stock};
@@ -15,7 +16,7 @@ use super::prepare::list_indices;
 use super::request::{ContourRequest, CutDirection, Job, Join, LoopStyle, MAX_MOVES, Side};
 use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
-use crate::planar::{SegmentGrid, Vec2, array2, miter_point};
+use crate::planar::{SegmentGrid, Vec2, array2, cross, miter_point};
 use crate::tool::{Tool, ToolKind};
 
 /// Largest number of vertex-layers planned one by one (tilted walls plan every layer).
@@ -89,22 +90,27 @@ pub fn plan(request: &ContourRequest, tool: &Tool) -> Result<Plan, SolverError> 
 /// codes `E_OFFSET_COLLAPSE` and `E_OFFSET_SELF_INTERSECTION` (naming `contour[k]`); limits
 /// `E_TOO_MANY_POINTS`, `E_TOO_MANY_LAYERS`, `E_TOO_MANY_MOVES`, `E_TOO_COMPLEX`.
 pub fn solve(request: &ContourRequest, tool: &Tool) -> Result<ContourAnswer, SolverError> {
+    solve_within(request, tool, MAX_MOVES)
+}
+
+/// [`solve`] with a smaller move budget than [`MAX_MOVES`] (a JSON answer, which the server
+/// limits further than a G-code program): `E_TOO_MANY_MOVES` at `depths.step` when the layers
+/// would hold more than `max_moves` moves, decided from the first layer's plan before the
+/// layers are built (and checked again on the exact count).
+///
+/// # Errors
+/// As [`solve`].
+pub fn solve_within(request: &ContourRequest, tool: &Tool, max_moves: usize) -> Result<ContourAnswer, SolverError> {
+    let max_moves = max_moves.min(MAX_MOVES);
     let job = request.validate(tool)?;
     let setup = Setup::new(&job);
     let first_z = job.layers.first().copied().unwrap_or(job.bottom);
     let first_layer = build_layer(&job, &setup, first_z)?;
     let first_passes = plan_passes(&job, &setup, &first_layer)?;
-    let per_layer = layer_move_count(&first_passes, job.tolerance);
+    let per_layer = layer_move_count(&first_passes, &job.chording);
     let total = per_layer.saturating_mul(job.layers.len());
-    if total > MAX_MOVES {
-        return Err(SolverError::new(
-            "E_TOO_MANY_MOVES",
-            format!(
-                "{} layers of about {per_layer} moves make {total} moves; the limit is {MAX_MOVES}: use a larger depths.step, tolerance or fewer points",
-                job.layers.len()
-            ),
-        )
-        .at("depths.step"));
+    if total > max_moves {
+        return Err(too_many_moves(job.layers.len(), per_layer, total, max_moves));
     }
     if job.tilt.is_some() && job.layers.len().saturating_mul(first_layer.len()) > MAX_TILTED_VERTEX_LAYERS {
         return Err(SolverError::new(
@@ -174,6 +180,19 @@ pub fn solve(request: &ContourRequest, tool: &Tool) -> Result<ContourAnswer, Sol
         }
         moves += layer.moves.len();
     }
+    if moves > max_moves {
+        return Err(too_many_moves(layers.len(), moves / layers.len().max(1), moves, max_moves));
+    }
+    let blocks = match &job.chording.rules {
+        None => None,
+        Some((rule, _)) => {
+            let (finest, arc_warnings) = blocks::arc_report(&first_passes, &job.chording);
+            warnings.extend(arc_warnings);
+            let figures = blocks::figures(&layers, rule.block_time_ms, job.feed, finest)?;
+            warnings.extend(blocks::short_block_warning(&figures, rule));
+            Some(figures)
+        }
+    };
     let loop_feed = job.loop_feed.unwrap_or(job.feed);
     let summary = ContourSummary {
         side: job.side,
@@ -191,6 +210,7 @@ pub fn solve(request: &ContourRequest, tool: &Tool) -> Result<ContourAnswer, Sol
         lead: lead_used,
         tolerance: job.tolerance,
         estimated_time_s: time_min * 60.0,
+        blocks,
     };
     let description = describe(&job, &summary);
     let centre_height = match job.tool.kind {
@@ -209,6 +229,16 @@ pub fn solve(request: &ContourRequest, tool: &Tool) -> Result<ContourAnswer, Sol
         description,
         tilted: job.tilt.is_some(),
     })
+}
+
+fn too_many_moves(layers: usize, per_layer: usize, total: usize, limit: usize) -> SolverError {
+    SolverError::new(
+        "E_TOO_MANY_MOVES",
+        format!(
+            "{layers} layers of about {per_layer} moves make {total} moves; the limit is {limit}: use a larger depths.step, tolerance or fewer points"
+        ),
+    )
+    .at("depths.step")
 }
 
 /// The layer's contour at height `z` (tilted walls move with z).
@@ -241,7 +271,7 @@ fn plan_passes(job: &Job, setup: &Setup, layer: &Layer) -> Result<Vec<PassPlan>,
             loop_config: &job.loop_config,
             choices: choices.clone(),
             request_order: setup.request_order,
-            tolerance: job.tolerance,
+            chording: job.chording,
             stock: stock.as_ref(),
             source: source.clone(),
             edge_source: edge_source.clone(),
@@ -297,10 +327,10 @@ fn stock_before(job: &Job, layer: &Layer, previous: Option<&PassPlan>) -> Option
 }
 
 /// Moves of one layer, without the layer links.
-fn layer_move_count(passes: &[PassPlan], tolerance: f64) -> usize {
+fn layer_move_count(passes: &[PassPlan], chording: &Chording) -> usize {
     passes
         .iter()
-        .map(|pass| pass.elements.iter().map(|e| e.chord_count(tolerance, MAX_ARC_STEPS)).sum::<usize>() + 2)
+        .map(|pass| pass.elements.iter().map(|e| e.chords_count(chording, MAX_ARC_STEPS)).sum::<usize>() + 2)
         .sum::<usize>()
         + 4
 }
@@ -341,6 +371,15 @@ fn axis(job: &Job, layer: &Layer, edge: usize) -> Option<Vec3> {
     let beta = tilt.get(layer.prepared_edge.get(edge).copied()?).copied()?;
     let normal = layer.air_normal(edge);
     Some(Vec3::new(beta.sin() * normal.x, beta.sin() * normal.y, beta.cos()))
+}
+
+/// Whether `line` is a straight element of some length that lies on the line from `a` to `b`
+/// and runs the same way (an arc's end tangent it continues).
+fn continues(line: &Element, a: &Vec2, b: &Vec2) -> bool {
+    let Element::Line { start, end, .. } = line else { return false };
+    let (along, tangent) = (end - start, b - a);
+    let scale = along.norm() * tangent.norm();
+    along.norm() > 1e-9 && scale > 0.0 && along.dot(&tangent) > 0.0 && cross(&along, &tangent).abs() <= 1e-9 * scale
 }
 
 /// Every move of one layer: down from the clearance plane at the lead point, each pass with its
@@ -389,14 +428,32 @@ fn layer_moves(
                 moves.push(step(MoveKind::Link, at(&pass.start, z), Some(job.feed)));
             }
         }
-        for (element, meta) in pass.elements.iter().zip(&pass.meta) {
+        let merge = job.chording.rules.is_some();
+        for (position, (element, meta)) in pass.elements.iter().zip(&pass.meta).enumerate() {
             let kind = if element.kind() == ElementKind::Loop { MoveKind::Loop } else { MoveKind::Cut };
             let feed = if meta.fast { loop_feed } else { job.feed };
-            let points = element.chord(job.tolerance, MAX_ARC_STEPS);
+            let points = element.chords(&job.chording, MAX_ARC_STEPS);
             let count = points.len() as f64;
             let from_axis = axis(job, layer, meta.from_edge);
             let to_axis = axis(job, layer, meta.to_edge);
-            for (index, point) in points.iter().enumerate() {
+            // Under the block-time rule an arc's half-length end segments (along its end
+            // tangents) join the straight moves they continue, so no block is half a block.
+            let (mut first, mut last) = (0, points.len());
+            if merge && matches!(element, Element::Arc { .. }) && points.len() > 1 {
+                let before = position.checked_sub(1).and_then(|k| pass.elements.get(k));
+                if before.is_some_and(|line| continues(line, &element.start(), &points[0]))
+                    && let Some(previous) = moves.last_mut()
+                    && previous.to == at(&element.start(), z)
+                {
+                    previous.to = at(&points[0], z);
+                    first = 1;
+                }
+                let after = pass.elements.get(position + 1);
+                if after.is_some_and(|line| continues(line, &points[points.len() - 2], &element.end())) {
+                    last -= 1;
+                }
+            }
+            for (index, point) in points.iter().enumerate().take(last).skip(first) {
                 let axis = from_axis.zip(to_axis).map(|(a, b)| {
                     let s = (index as f64 + 1.0) / count;
                     let mixed = (a * (1.0 - s) + b * s).try_normalize(0.0).unwrap_or(b);

@@ -1,5 +1,9 @@
-//! A static bounding-box tree: which path pieces or stock edges can reach a query box (the
-//! pruning of engagement.md §5.3.3, for long paths and detailed stock outlines).
+//! A static bounding-box tree: which path pieces (of the path and of earlier cuts) can reach a
+//! query box (the pruning of engagement.md §5.3.3, for long paths).
+//!
+//! The stock outline's edges use `planar::SegmentGrid` instead (see `outline`); the path keeps
+//! this tree because its pieces are arcs as well as lines, and the grid indexes straight
+//! segments only (an arc would have to be chorded, which the exact engine must not do).
 
 use super::P2;
 

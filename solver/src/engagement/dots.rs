@@ -11,6 +11,7 @@ use super::arcs::{Arc, normalise};
 use super::bbox_tree::BBox;
 use super::segments::Station;
 use super::stock::{Base, REACH_TOLERANCE, Region};
+use crate::planar::point_segment_distance;
 
 /// An empty column span.
 const EMPTY: (i64, i64) = (0, -1);
@@ -113,23 +114,25 @@ impl DotGrid {
 
     fn fill(&mut self, region: &Region) {
         match &region.base {
-            Base::Polygons { edges, .. } => {
+            Base::Polygons(outline) => {
                 let tolerance = super::stock::BOUNDARY_TOLERANCE;
+                // Scanline sweep: edges sorted by their lowest y enter the active list when the
+                // row reaches them and leave it once the row has passed their highest y.
+                let mut edges: Vec<(P2, P2)> = outline.edges().collect();
+                edges.sort_by(|p, q| p.0.y.min(p.1.y).total_cmp(&q.0.y.min(q.1.y)));
+                let mut pending = edges.into_iter().peekable();
+                let mut active: Vec<(P2, P2)> = Vec::new();
                 let mut crossings = Vec::new();
                 let mut flats = Vec::new();
                 for row in 0..self.height {
                     let y = self.y_of(row);
                     crossings.clear();
                     flats.clear();
-                    let line = BBox {
-                        min: P2::new(f64::NEG_INFINITY, y - tolerance),
-                        max: P2::new(f64::INFINITY, y + tolerance),
-                    };
-                    edges.tree.query(&line, &mut |index| {
-                        let Some(edge) = edges.edges.get(index) else {
-                            return;
-                        };
-                        let (a, b) = (edge.from, edge.to);
+                    while let Some(edge) = pending.next_if(|(a, b)| a.y.min(b.y) <= y + tolerance) {
+                        active.push(edge);
+                    }
+                    active.retain(|(a, b)| a.y.max(b.y) >= y - tolerance);
+                    for &(a, b) in &active {
                         if (a.y > y) != (b.y > y) {
                             crossings.push(a.x + (y - a.y) / (b.y - a.y) * (b.x - a.x));
                         }
@@ -140,7 +143,7 @@ impl DotGrid {
                         {
                             flats.push((a.x.min(b.x), a.x.max(b.x)));
                         }
-                    });
+                    }
                     crossings.sort_by(f64::total_cmp);
                     for pair in crossings.chunks_exact(2) {
                         self.set_span(row, pair[0] - tolerance, pair[1] + tolerance, true);
@@ -184,7 +187,7 @@ impl DotGrid {
             };
             for column in first..=last {
                 let p = P2::new(self.x_of(column), y);
-                if super::polygon::distance_to_segment(p, a, b) < limit {
+                if point_segment_distance(&p, &a, &b) < limit {
                     let (index, bit) = self.bit(column, row);
                     self.bits[index] &= !bit;
                 }
@@ -481,13 +484,13 @@ impl Contacts {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engagement::polygon::EdgeSet;
+    use crate::engagement::outline::Outline;
     use crate::engagement::segments::Shape;
     use crate::engagement::stock::Cut;
 
     fn block(x0: f64, y0: f64, x1: f64, y1: f64) -> Region {
         let rings = vec![vec![P2::new(x0, y0), P2::new(x1, y0), P2::new(x1, y1), P2::new(x0, y1)]];
-        Region { base: Base::Polygons { edges: EdgeSet::new(&rings), rings }, cuts: Vec::new() }
+        Region { base: Base::Polygons(Outline::new(rings, 1.0)), cuts: Vec::new() }
     }
 
     #[test]

@@ -12,6 +12,7 @@ use super::stock::{Base, Region};
 use super::teeth::tooth_sum;
 use super::{MAX_CONTACT_DOTS, feed, flutes};
 use crate::error::{SolverError, Warning};
+use crate::planar::turn_angle;
 use crate::tool::{Tool, ToolKind};
 
 /// Engagement on the back half deeper than this (degrees) marks `back_contact` (§9 W_PLUNGE).
@@ -149,7 +150,8 @@ pub(crate) fn runs(samples: &[EngagementSample], test: impl Fn(usize) -> bool) -
 
 fn stock_description(region: &Region) -> String {
     match &region.base {
-        Base::Polygons { rings, .. } => {
+        Base::Polygons(outline) => {
+            let rings = outline.rings();
             format!("stock: polygon rings {}, vertices {}", rings.len(), rings.iter().map(Vec::len).sum::<usize>())
         }
         Base::Bitmap(bitmap) => {
@@ -336,7 +338,7 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
         .filter_map(|pair| {
             let out = pair[0].shape.tangent(pair[0].shape.length());
             let into = pair[1].shape.tangent(0.0);
-            let turn = (out.x * into.y - out.y * into.x).atan2(out.dot(&into)).to_degrees();
+            let turn = turn_angle(&out, &into).to_degrees();
             (turn.abs() > 1.0).then(|| format!("s = {:.3} ({turn:+.1}°)", pair[0].end_s()))
         })
         .collect();
@@ -374,8 +376,9 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
                 format!("dots engine at grid {cell} mm, step {step} mm: {}", notes.join("; ")),
             ));
         }
-        if let Base::Polygons { rings, .. } = &job.region.base {
-            let short = rings
+        if let Base::Polygons(outline) = &job.region.base {
+            let short = outline
+                .rings()
                 .iter()
                 .flat_map(|ring| ring.iter().zip(ring.iter().cycle().skip(1)))
                 .filter(|(a, b)| (*b - *a).norm() < 2.0 * cell)

@@ -9,11 +9,11 @@
 
 use std::f64::consts::PI;
 
-use super::P2;
 use super::arcs::{Arc, normalise};
 use super::segments::{Route, Shape, Station};
 use super::stock::{REACH_TOLERANCE, Region};
 use crate::error::SolverError;
+use crate::planar::right_normal;
 
 /// Boundary and distance tests allowed per path before the engine gives up (a hang guard for
 /// pathological stock outlines; tens of seconds of work, far above real jobs).
@@ -38,7 +38,7 @@ impl ExactEngine {
     ) -> Result<Vec<Arc>, SolverError> {
         let centre = station.centre;
         let forward = station.tangent;
-        let right = P2::new(forward.y, -forward.x);
+        let right = right_normal(&forward);
         route.swept_before(station, 2.0 * radius, &mut self.pieces);
         self.angles.clear();
         for piece in &self.pieces {

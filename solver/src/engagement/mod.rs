@@ -12,7 +12,8 @@
 //!
 //! * [`request`]: the request and its validation (§2, §9);
 //! * `segments`: the path of lines and arcs and its sampling (§5.2);
-//! * `stock`, `polygon`, `bbox_tree`: the material W₀ and its geometry;
+//! * `stock`, `outline`, `bbox_tree`: the material W₀ and the indexes over it and the path (the
+//!   plane geometry itself is [`crate::planar`]'s);
 //! * `exact`: engine B, the exact boundary test (§5.3.3, default);
 //! * `dots`: engine A, the seed's dot removal (§5.3.2);
 //! * `arcs`: arc merging, a_e and the per-arc quantities (§5.4, §5.5, §5.10);
@@ -40,7 +41,7 @@ mod evaluate;
 mod exact;
 mod feed;
 mod flutes;
-mod polygon;
+mod outline;
 pub mod program;
 pub mod request;
 mod segments;

@@ -8,7 +8,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 
 use super::arcs::SpindleDirection;
 use super::bbox_tree::BBox;
-use super::polygon::{EdgeSet, twice_signed_area};
+use super::outline::Outline;
 use super::segments::{Route, Shape};
 use super::stock::{Base, Bitmap, Cut, Region, decode_base64};
 use super::{
@@ -16,6 +16,7 @@ use super::{
     MAX_GRID_DOTS, MAX_SAMPLES, MAX_SEGMENTS, MAX_STOCK_VERTICES, P2,
 };
 use crate::error::{SolverError, Warning, finite, non_negative, positive};
+use crate::planar::signed_area;
 use crate::tool::{Tool, ToolRef};
 
 /// Direction of a circular segment.
@@ -76,6 +77,8 @@ pub struct PathSegments {
 /// and rapids.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+// Named apart from `predict`'s own path input in the OpenAPI document.
+#[cfg_attr(feature = "schema", schema(as = EngagementPath))]
 #[serde(untagged)]
 pub enum PathInput {
     /// Feed moves (G1) through the points in order.
@@ -172,6 +175,8 @@ pub struct PreviousCut {
 /// paths). Polygons use the even-odd rule with the boundary inclusive and must not cross.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+// Named apart from `predict`'s own stock in the OpenAPI document.
+#[cfg_attr(feature = "schema", schema(as = EngagementStock))]
 #[serde(deny_unknown_fields)]
 pub struct Stock {
     /// One outline [[x, y], ...] (api.md form).
@@ -590,7 +595,8 @@ fn read_ring(field: &str, points: &[[f64; 2]]) -> Result<Vec<P2>, SolverError> {
     Ok(ring)
 }
 
-fn read_stock(stock: &Stock, warnings: &mut Vec<Warning>) -> Result<(Region, Vec<String>), SolverError> {
+/// The stock; `radius` (the tool's) sizes the index of the outline's edges.
+fn read_stock(stock: &Stock, radius: f64, warnings: &mut Vec<Warning>) -> Result<(Region, Vec<String>), SolverError> {
     let given =
         [stock.polygon.is_some(), stock.polygons.is_some(), stock.bitmap.is_some()].iter().filter(|g| **g).count();
     if given != 1 {
@@ -666,8 +672,15 @@ fn read_stock(stock: &Stock, warnings: &mut Vec<Warning>) -> Result<(Region, Vec
                 }
             }
         }
-        let edges = EdgeSet::new(&rings);
-        if let Some(((ring_a, vertex_a), (ring_b, vertex_b))) = edges.first_crossing(&rings) {
+        let outline = Outline::new(rings, radius);
+        let crossing = outline.first_crossing().map_err(|_| {
+            SolverError::new(
+                "E_TOO_LARGE",
+                "the stock outline crowds too many edges into the same place to check it for crossings",
+            )
+            .at("stock")
+        })?;
+        if let Some(((ring_a, vertex_a), (ring_b, vertex_b))) = crossing {
             let name = |ring: usize| fields.get(ring).cloned().unwrap_or_else(|| "stock".to_owned());
             let message = if ring_a == ring_b {
                 format!(
@@ -684,12 +697,12 @@ fn read_stock(stock: &Stock, warnings: &mut Vec<Warning>) -> Result<(Region, Vec
             return Err(SolverError::new("E_STOCK", message).at(format!("{}[{vertex_a}]", name(ring_a))));
         }
         // After the crossing test, so a bow tie is reported as crossing, not as flat.
-        for (ring, field) in rings.iter().zip(&fields) {
-            if twice_signed_area(ring).abs() <= 2e-12 {
+        for (ring, field) in outline.rings().iter().zip(&fields) {
+            if signed_area(ring).abs() <= 1e-12 {
                 return Err(SolverError::new("E_STOCK", "the stock ring has zero area").at(field.clone()));
             }
         }
-        Base::Polygons { rings, edges }
+        Base::Polygons(outline)
     };
     let mut cuts = Vec::new();
     let mut cut_fields = Vec::new();
@@ -823,7 +836,7 @@ impl EngagementRequest {
             .transpose()?;
 
         let mut stock_warnings = Vec::new();
-        let (region, _) = read_stock(&self.stock, &mut stock_warnings)?;
+        let (region, _) = read_stock(&self.stock, radius, &mut stock_warnings)?;
 
         let inputs: Vec<(Option<String>, &PathInput, String)> = match (&self.path, &self.paths) {
             (Some(path), None) => vec![(None, path, "path".to_owned())],

@@ -5,6 +5,7 @@ use std::f64::consts::{PI, TAU};
 
 use super::P2;
 use super::bbox_tree::{BBox, BoxTree};
+use crate::planar::point_segment_distance;
 
 /// One geometric piece of a path.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -97,7 +98,7 @@ impl Shape {
     /// Euclidean distance from `q` to the piece (engagement.md §5.3.3, distance helpers).
     pub(crate) fn distance(&self, q: P2) -> f64 {
         match *self {
-            Self::Line { from, to } => super::polygon::distance_to_segment(q, from, to),
+            Self::Line { from, to } => point_segment_distance(&q, &from, &to),
             Self::Arc { centre, radius, start, sweep } => {
                 let d = q - centre;
                 let ends = (q - self.start_point()).norm().min((q - self.end_point()).norm());

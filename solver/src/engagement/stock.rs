@@ -4,7 +4,7 @@
 
 use super::P2;
 use super::bbox_tree::{BBox, BoxTree};
-use super::polygon::EdgeSet;
+use super::outline::Outline;
 use super::segments::{Shape, circle_segment};
 
 /// Boundary tolerance of the stock outline, mm (engagement.md §5.3.2: ±1e-9).
@@ -92,7 +92,7 @@ impl Bitmap {
 #[derive(Debug, Clone)]
 pub(crate) enum Base {
     /// Rings under the even-odd rule.
-    Polygons { rings: Vec<Vec<P2>>, edges: EdgeSet },
+    Polygons(Outline),
     /// A raster.
     Bitmap(Bitmap),
 }
@@ -154,7 +154,7 @@ impl Region {
     /// adds the edges and pieces examined to `work`.
     pub(crate) fn contains(&self, q: P2, work: &mut u64) -> bool {
         let in_outline = match &self.base {
-            Base::Polygons { edges, .. } => edges.contains(q, BOUNDARY_TOLERANCE, work),
+            Base::Polygons(outline) => outline.contains(q, BOUNDARY_TOLERANCE, work),
             Base::Bitmap(bitmap) => bitmap.contains(q),
         };
         in_outline && self.cuts.iter().all(|cut| cut.keeps(q, work))
@@ -171,8 +171,8 @@ impl Region {
     /// Bounding box of the outline.
     pub(crate) fn bbox(&self) -> Option<BBox> {
         match &self.base {
-            Base::Polygons { rings, .. } => {
-                let mut points = rings.iter().flatten();
+            Base::Polygons(outline) => {
+                let mut points = outline.rings().iter().flatten();
                 let first = *points.next()?;
                 let mut bbox = BBox::of(first, first);
                 for p in points {
@@ -188,12 +188,9 @@ impl Region {
     /// boundary of an earlier cut.
     pub(crate) fn crossings(&self, c: P2, radius: f64, out: &mut Vec<f64>) {
         match &self.base {
-            Base::Polygons { edges, .. } => {
-                edges.tree.query(&BBox::around(c, radius * (1.0 + 1e-9)), &mut |index| {
-                    if let Some(edge) = edges.edges.get(index) {
-                        circle_segment(c, radius, edge.from, edge.to, out);
-                    }
-                });
+            Base::Polygons(outline) => {
+                // Repeated edges add the same angles, which the engine merges.
+                outline.edges_near(c, radius * (1.0 + 1e-9), |from, to| circle_segment(c, radius, from, to, out));
             }
             Base::Bitmap(bitmap) => bitmap.crossings(c, radius, out),
         }

@@ -12,12 +12,19 @@ use super::{Vec2, direction};
 /// `max_error` (at least 1), capped at `max_steps`.
 pub fn circumscribed_arc(centre: &Vec2, start: &Vec2, sweep: f64, max_error: f64, max_steps: usize) -> Vec<Vec2> {
     let radius = (start - centre).norm();
+    circumscribed_arc_steps(centre, start, sweep, arc_steps(radius, sweep, max_error).min(max_steps.max(1)))
+}
+
+/// [`circumscribed_arc`] with `steps` equal sub-arcs (at least 1): the full segments are
+/// `2R·tan(Δ/2)` long, the first and last (along the end tangents) half that.
+pub fn circumscribed_arc_steps(centre: &Vec2, start: &Vec2, sweep: f64, steps: usize) -> Vec<Vec2> {
+    let radius = (start - centre).norm();
     let start_angle = (start.y - centre.y).atan2(start.x - centre.x);
     let end = centre + radius * direction(start_angle + sweep);
     if radius == 0.0 || sweep == 0.0 {
         return vec![end];
     }
-    let steps = arc_steps(radius, sweep, max_error).min(max_steps.max(1));
+    let steps = steps.max(1);
     let step = sweep / steps as f64;
     let outer = radius / (0.5 * step).cos();
     let mut points: Vec<Vec2> =
@@ -26,11 +33,17 @@ pub fn circumscribed_arc(centre: &Vec2, start: &Vec2, sweep: f64, max_error: f64
     points
 }
 
+/// The largest sub-arc angle (radians) whose circumscribed vertex lies within `max_error` of an
+/// arc of `radius`: `2·acos(R / (R + max_error))`, at most 120°; 0 for a degenerate input.
+pub fn arc_max_step(radius: f64, max_error: f64) -> f64 {
+    if max_error > 0.0 && radius > 0.0 { 2.0 * (radius / (radius + max_error)).acos() } else { 0.0 }
+        .min(std::f64::consts::TAU / 3.0)
+}
+
 /// Sub-arcs needed so that the circumscribed polyline stays within `max_error` of the arc:
 /// `R (1/cos(Δ/2) − 1) ≤ max_error`, and at most 120° per sub-arc.
 pub fn arc_steps(radius: f64, sweep: f64, max_error: f64) -> usize {
-    let max_step = if max_error > 0.0 && radius > 0.0 { 2.0 * (radius / (radius + max_error)).acos() } else { 0.0 }
-        .min(std::f64::consts::TAU / 3.0);
+    let max_step = arc_max_step(radius, max_error);
     if max_step <= 0.0 {
         return 1;
     }

@@ -57,6 +57,43 @@ async fn jobs_page_runs_an_uploaded_example() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+async fn contour_page_plots_the_sample_and_downloads_gcode() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "contour", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["segments"].as_u64().unwrap() >= 50, "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn jobs_page_shows_the_contour_example() {
+    let app = TestApp::spawn().await;
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/contour-arrow.toml");
+    let Some(result) = run_scenario(&app, "jobs", &[example.to_str().unwrap()]) else { return };
+    assert_eq!(result["ok"], true);
+    assert_eq!(result["plots"], 1, "one plot for the one operation: {result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn engagement_page_compares_the_sample_paths() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "engagement", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert_eq!(result["columns"], 3, "three candidate paths side by side: {result}");
+    assert!(result["charts"].as_u64().unwrap() >= 3 * 7, "{result}");
+    assert!(result["recommendation"].as_str().unwrap().contains("Recommended flute counts"), "{result}");
+    assert_eq!(result["file"], "engagement-1-fanuc.nc");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn jobs_page_shows_an_engagement_job() {
+    let app = TestApp::spawn().await;
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/engagement-pocket.toml");
+    let Some(result) = run_scenario(&app, "jobs", &[example.to_str().unwrap()]) else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["plots"].as_u64().unwrap() >= 3 * 7, "every chart of the three paths: {result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
 async fn predict_page_colours_the_path_by_error() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "predict", &[]) else { return };

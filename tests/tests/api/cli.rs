@@ -36,6 +36,14 @@ fn runs_each_example_locally() {
             .unwrap();
             match name {
                 "deburr" => assert!(result["points"].as_array().unwrap().len() > 8),
+                "contour" => assert!(!result["layers"].as_array().unwrap().is_empty()),
+                "engagement" => assert!(
+                    result["candidates"]
+                        .as_array()
+                        .unwrap()
+                        .iter()
+                        .all(|c| c["samples"].as_array().unwrap().len() > 100)
+                ),
                 "predict" => assert!(result["passes"].as_array().unwrap().len() > 8),
                 _ => assert!(result.as_object().is_some_and(|o| !o.is_empty())),
             }

@@ -9,7 +9,15 @@ async fn document_covers_every_route_and_docs_are_served() {
     let (_, built) = kerf_server::app::api();
     assert_eq!(document, serde_json::to_value(&built).unwrap(), "served document is the built one");
     let paths = document["paths"].as_object().unwrap();
-    for path in ["/healthz", "/api/v1/tools", "/api/v1/tools/{number}", "/api/v1/deburr", "/api/v1/predict"] {
+    for path in [
+        "/healthz",
+        "/api/v1/tools",
+        "/api/v1/tools/{number}",
+        "/api/v1/deburr",
+        "/api/v1/contour",
+        "/api/v1/contour/loops",
+        "/api/v1/predict",
+    ] {
         assert!(paths.contains_key(path), "{path} documented");
     }
     let docs = app.get("/docs/").await;

@@ -1,0 +1,840 @@
+//! `POST /api/v1/engagement` over HTTP: the api.md example, the reference cases C1–C3 of
+//! `shared/cases/engagement.json` to their tolerances (C2 part B as two candidate paths side by
+//! side), the dots engine, G-code of the feed plan in both dialects through LinuxCNC's `rs274`
+//! (moves equal to the JSON positions within 1e-4, F words equal to the plan's feeds), and a
+//! table of bad requests answered with the field at fault and the database unchanged.
+
+use std::collections::BTreeSet;
+
+use kerf_tests::{TestApp, external_program, finished, json_with, poll_job, problem, rs274_moves};
+use serde_json::{Value, json};
+
+const URL: &str = "/api/v1/engagement";
+
+/// The api.md example.
+pub fn api_example() -> Value {
+    json!({
+        "tool": {"kind": "flat", "radius": 5}, "stock": {"polygon": [[0,0],[60,0],[60,40],[0,40]]},
+        "path": [[-10,20],[70,20]], "spindle_rpm": 3000, "feed_per_tooth": 0.05,
+        "flute_counts": [1,2,3,4,5,6,7,8], "thickness_limit": 0.075, "time_limit_s": 20
+    })
+}
+
+fn fixture() -> Value {
+    serde_json::from_str(include_str!("../../../solver/tests/fixtures/engagement.json")).expect("fixture")
+}
+
+fn case(prefix: &str) -> Value {
+    fixture()["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["id"].as_str().unwrap().starts_with(prefix))
+        .unwrap()
+        .clone()
+}
+
+fn num(value: &Value) -> f64 {
+    value.as_f64().unwrap_or_else(|| panic!("not a number: {value}"))
+}
+
+fn close(what: &str, got: f64, expected: f64, tolerance: f64) {
+    assert!((got - expected).abs() <= tolerance + 1e-12, "{what}: got {got}, expected {expected} ± {tolerance}");
+}
+
+fn close_rel(what: &str, got: f64, expected: f64, relative: f64) {
+    close(what, got, expected, relative * expected.abs() + 1e-9);
+}
+
+/// The request body for a fixture input block (its stock polygons and path pass unchanged).
+fn fixture_request(stock: &Value, path: &Value, cutting: &Value, flutes: &Value, diameter: f64, extra: Value) -> Value {
+    let polygons: Vec<Value> = stock["polygons"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            let mut p = p.clone();
+            if p["holes"].as_array().is_some_and(Vec::is_empty) {
+                p.as_object_mut().unwrap().remove("holes");
+            }
+            p
+        })
+        .collect();
+    let mut body = json!({
+        "tool": {"kind": "flat", "radius": diameter / 2.0},
+        "stock": {"polygons": polygons}, "path": path,
+        "spindle_rpm": cutting["spindle_rpm"], "flute_counts": flutes,
+    });
+    if cutting["feed_mode"] == "constant_vf" {
+        body["feed"] = cutting["vf_mm_per_min"].clone();
+    } else {
+        body["feed_per_tooth"] = cutting["fz"].clone();
+    }
+    for (key, value) in extra.as_object().unwrap() {
+        body[key] = value.clone();
+    }
+    body
+}
+
+fn sample_at(result: &Value, s: f64) -> &Value {
+    result["samples"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|sample| (num(&sample["s"]) - s).abs() < 1e-6)
+        .unwrap_or_else(|| panic!("no sample at s = {s}"))
+}
+
+fn flute_list(value: &Value) -> Vec<u64> {
+    value.as_array().unwrap().iter().map(|k| k.as_u64().unwrap()).collect()
+}
+
+fn recommended(result: &Value) -> Vec<u64> {
+    flute_list(&result["recommended"])
+}
+
+/// One fixture checkpoint against the sample at its s (exact-engine tolerances).
+fn check_point(label: &str, result: &Value, checkpoint: &Value, flutes: &[u64]) {
+    let s = num(&checkpoint["s"]);
+    let sample = sample_at(result, s);
+    let what = |field: &str| format!("{label} s={s} {field}");
+    let arcs = checkpoint["arcs"].as_array().unwrap();
+    let got = sample["arcs"].as_array().unwrap();
+    assert_eq!(got.len(), arcs.len(), "{}: {got:?}", what("arcs"));
+    for (g, e) in got.iter().zip(arcs) {
+        close(&what("arc from"), num(&g[0]), num(&e[0]), 0.05);
+        close(&what("arc to"), num(&g[1]), num(&e[1]), 0.05);
+    }
+    close(&what("engaged_deg"), num(&sample["engaged_deg"]), num(&checkpoint["engaged_deg"]), 0.1);
+    close(&what("radial_depth"), num(&sample["radial_depth"]), num(&checkpoint["ae"]), 0.005);
+    for (column, k) in flutes.iter().enumerate() {
+        let key = k.to_string();
+        close_rel(
+            &what(&format!("H k={k}")),
+            num(&sample["thickness"][column]),
+            num(&checkpoint["H_mm_by_k"][&key]),
+            0.002,
+        );
+        assert_eq!(sample["teeth"][column], checkpoint["n_max_by_k"][&key], "{}", what(&format!("n k={k}")));
+    }
+}
+
+fn check_statistics(label: &str, result: &Value, expected: &Value, max_rel: f64, mean_rel: f64) {
+    for flute in result["flutes"].as_array().unwrap() {
+        let key = flute["flute_count"].to_string();
+        close_rel(&format!("{label} max k={key}"), num(&flute["max_thickness"]), num(&expected[&key]["max"]), max_rel);
+        close_rel(
+            &format!("{label} mean k={key}"),
+            num(&flute["mean_thickness"]),
+            num(&expected[&key]["mean"]),
+            mean_rel,
+        );
+        let (low, mean, high) =
+            (num(&flute["min_thickness"]), num(&flute["mean_thickness"]), num(&flute["max_thickness"]));
+        assert!(low <= mean && mean <= high, "{label} k={key}: min ≤ mean ≤ max");
+    }
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn api_example_over_http() {
+    let app = TestApp::spawn().await;
+    let body = api_example();
+    let answer = json_with(app.post_json(URL, &body).await, 200).await;
+    assert_eq!(answer["tool"]["radius"], 5.0);
+    assert_eq!(
+        answer["stock"],
+        json!({"polygon": [[0.0, 0.0], [60.0, 0.0], [60.0, 40.0], [0.0, 40.0]]}),
+        "the stock is echoed"
+    );
+    assert_eq!(answer["thickness_limit"], 0.075);
+    assert_eq!(answer["time_limit_s"], 20.0);
+    // L = 80 mm: P_k = 60·80/(k·0.05·3000) = 32/k s; the slot's H_k/f_z is 1, 1, 1, √2, 1.618, ...
+    close("path length", num(&answer["path_length"]), 80.0, 1e-9);
+    // Full slot (engagement.md §5.6): H_k/f_z = 1 for k = 1, 1/sin(π/k) for even k,
+    // 1/(2 sin(π/2k)) for odd k ≥ 3.
+    let slot_ratio = |k: f64| {
+        let pi = std::f64::consts::PI;
+        if k == 1.0 {
+            1.0
+        } else if k % 2.0 == 0.0 {
+            1.0 / (pi / k).sin()
+        } else {
+            1.0 / (2.0 * (pi / (2.0 * k)).sin())
+        }
+    };
+    for (index, flute) in answer["flutes"].as_array().unwrap().iter().enumerate() {
+        let k = (index + 1) as f64;
+        assert_eq!(flute["flute_count"], index + 1);
+        close("time", num(&flute["time_s"]), 32.0 / k, 1e-9);
+        close_rel("max H", num(&flute["max_thickness"]), 0.05 * slot_ratio(k), 1e-9);
+        let meets = num(&flute["max_thickness"]) <= 0.075 && num(&flute["time_s"]) <= 20.0;
+        assert_eq!(flute["recommended"], meets, "k = {k}");
+    }
+    // T1 = 0.075 keeps k ≤ 4, T2 = 20 s needs k ≥ 2: fastest first.
+    assert_eq!(recommended(&answer), vec![4, 3, 2]);
+    let slot = sample_at(&answer, 30.0);
+    assert_eq!(slot["arcs"], json!([[0.0, 180.0]]));
+    assert_eq!(slot["engaged_deg"], 180.0);
+    assert_eq!(slot["radial_depth"], 10.0);
+    close("t at s = 30", num(&slot["t"]), 60.0 * 30.0 / 300.0, 1e-9);
+    assert_eq!(sample_at(&answer, 0.0)["arcs"], json!([]));
+    // Determinism: byte-identical answers.
+    let once = app.client.post(app.url(URL)).json(&body).send().await.unwrap().bytes().await.unwrap();
+    let again = app.client.post(app.url(URL)).json(&body).send().await.unwrap().bytes().await.unwrap();
+    assert_eq!(once, again);
+    // A registered tool by number gives the same numbers.
+    app.register_tool(3, &json!({"kind": "flat", "radius": 5, "flutes": 4})).await;
+    let mut by_number = body.clone();
+    by_number["tool"] = json!(3);
+    let numbered = json_with(app.post_json(URL, &by_number).await, 200).await;
+    assert_eq!(numbered["tool"]["number"], 3);
+    assert_eq!(numbered["flutes"], answer["flutes"]);
+    assert_eq!(numbered["time_flute_count"], 4);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn c1_slot_then_side_milling() {
+    let app = TestApp::spawn().await;
+    let c = case("C1");
+    let input = &c["input"];
+    let expected = &c["expected"];
+    let flutes = flute_list(&input["tool"]["flute_candidates"]);
+    let limits = json!({"thickness_limit": input["evaluation"]["T1_mm"], "time_limit_s": input["evaluation"]["T2_s"]});
+    let body = |extra: Value| {
+        let mut extra_all = limits.clone();
+        for (key, value) in extra.as_object().unwrap() {
+            extra_all[key] = value.clone();
+        }
+        fixture_request(
+            &input["stock"],
+            &input["path"],
+            &input["cutting"],
+            &input["tool"]["flute_candidates"],
+            10.0,
+            extra_all,
+        )
+    };
+    let ds = num(&input["simulation"]["ds"]);
+    let started = std::time::Instant::now();
+    let result = json_with(app.post_json(URL, &body(json!({"step": ds}))).await, 200).await;
+    eprintln!(
+        "C1 exact at Δs = {ds}: {} samples in {:?}",
+        result["samples"].as_array().unwrap().len(),
+        started.elapsed()
+    );
+    close("path length", num(&result["path_length"]), 142.5, 1e-9);
+    check_statistics("C1", &result, &expected["representative_mm"], 0.002, 0.01);
+    for flute in result["flutes"].as_array().unwrap() {
+        let key = flute["flute_count"].to_string();
+        close_rel(&format!("time k={key}"), num(&flute["time_s"]), num(&expected["machining_time_s"][&key]), 1e-4);
+    }
+    let set: BTreeSet<u64> = recommended(&result).into_iter().collect();
+    assert_eq!(set, flute_list(&expected["recommended_flutes"]).into_iter().collect());
+    assert_eq!(recommended(&result), vec![4, 3], "fastest first");
+    let intervals = result["engaged_intervals"].as_array().unwrap();
+    let continuum = expected["engaged_intervals_s_continuum_open"].as_array().unwrap();
+    assert_eq!(intervals.len(), continuum.len(), "{intervals:?}");
+    for (got, want) in intervals.iter().zip(continuum) {
+        close("interval from", num(&got[0]), num(&want[0]), ds);
+        close("interval to", num(&got[1]), num(&want[1]), ds);
+    }
+    // Checkpoints (s = 71.25 lies off the 0.1 mm grid: read them from a 0.05 mm run).
+    let fine = json_with(app.post_json(URL, &body(json!({"step": 0.05}))).await, 200).await;
+    for checkpoint in expected["checkpoints"].as_array().unwrap() {
+        check_point("C1", &fine, checkpoint, &flutes);
+    }
+
+    // The dots engine over HTTP, at the fixture's grid and step: the seed's contact dots and
+    // the representative values within its tolerances.
+    let dots_settings = &input["simulation"]["dot_engine"];
+    let dots = json_with(
+        app.post_json(
+            URL,
+            &body(json!({"engine": "dots", "grid": dots_settings["grid"], "step": dots_settings["ds"]})),
+        )
+        .await,
+        200,
+    )
+    .await;
+    assert_eq!(dots["engine"], "dots");
+    assert_eq!(dots["grid"]["cell"], dots_settings["grid"]);
+    assert!(dots["contact_dots"].as_array().is_some_and(|d| d.len() > 1000), "contact dots for the scatter");
+    check_statistics("C1 dots", &dots, &expected["representative_mm"], 0.01, 0.02);
+    let set: BTreeSet<u64> = recommended(&dots).into_iter().collect();
+    assert_eq!(set, flute_list(&expected["recommended_flutes"]).into_iter().collect());
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn c2_side_milling_and_inside_corner_side_by_side() {
+    let app = TestApp::spawn().await;
+    let c = case("C2");
+    // Part A: each row a straight pass at a known radial depth, checked at its checkpoint.
+    let part_a = &c["part_A"];
+    let input = &part_a["input"];
+    let flutes = flute_list(&input["tool"]["flute_candidates"]);
+    for row in part_a["rows"].as_array().unwrap() {
+        let body = fixture_request(
+            &input["stock"],
+            &row["path"],
+            &input["cutting"],
+            &input["tool"]["flute_candidates"],
+            10.0,
+            json!({"step": input["simulation"]["ds"]}),
+        );
+        let result = json_with(app.post_json(URL, &body).await, 200).await;
+        let label = format!("C2A a_e={} {}", row["ae"], row["side"]);
+        let checkpoint = json!({"s": row["checkpoint_s"], "arcs": row["arcs"], "engaged_deg": row["engaged_deg"],
+            "ae": row["ae_measured"], "H_mm_by_k": row["H_mm_by_k"], "n_max_by_k": row["n_max_by_k"]});
+        check_point(&label, &result, &checkpoint, &flutes);
+        let sample = sample_at(&result, num(&row["checkpoint_s"]));
+        close(&label, num(&sample["mean_chip_thickness"]), num(&row["mean_chip_thickness_mm"]), 1e-5);
+        let mode = sample["arc_details"][0]["mode"].as_str().unwrap();
+        let expected_mode = match row["mode"].as_str().unwrap() {
+            "down" => "climb",
+            "up" => "conventional",
+            other => other,
+        };
+        assert_eq!(mode, expected_mode, "{label}");
+    }
+
+    // Part B: the sharp corner and the 3 mm fillet as two candidate paths of one request.
+    let part_b = &c["part_B"];
+    let input = &part_b["input"];
+    let mut body = fixture_request(
+        &input["stock"],
+        &Value::Null,
+        &input["cutting"],
+        &input["tool"]["flute_candidates"],
+        10.0,
+        json!({"step": input["simulation"]["ds"]}),
+    );
+    body.as_object_mut().unwrap().remove("path");
+    body["paths"] = json!([
+        {"name": "sharp", "path": input["paths"]["sharp"]},
+        {"name": "fillet 3", "path": input["paths"]["fillet3"]},
+    ]);
+    let answer = json_with(app.post_json(URL, &body).await, 200).await;
+    let candidates = answer["candidates"].as_array().unwrap();
+    assert_eq!(candidates.len(), 2);
+    assert_eq!(candidates[0]["name"], "sharp");
+    assert_eq!(candidates[1]["name"], "fillet 3");
+    let expected = &part_b["expected"];
+    let sharp = &expected["sharp"];
+    close("sharp length", num(&candidates[0]["path_length"]), num(&sharp["path_length"]), 1e-9);
+    close("sharp max Φ", num(&candidates[0]["max_engaged_deg"]), num(&sharp["max_engaged_deg"]), 0.1);
+    close("sharp max Φ at", num(&candidates[0]["max_engaged_at_s"]), num(&sharp["max_engaged_at_s"]), 1e-6);
+    close("sharp max a_e", num(&candidates[0]["max_radial_depth"]), num(&sharp["max_ae"]), 0.005);
+    let fillet = &expected["fillet3"];
+    close("fillet length", num(&candidates[1]["path_length"]), num(&fillet["path_length"]), 1e-3);
+    close("fillet max Φ", num(&candidates[1]["max_engaged_deg"]), num(&fillet["max_engaged_deg"]), 0.1);
+    for (candidate, expected) in candidates.iter().zip([sharp, fillet]) {
+        for flute in candidate["flutes"].as_array().unwrap() {
+            let key = flute["flute_count"].to_string();
+            close_rel(
+                &format!("{} H max k={key}", candidate["name"]),
+                num(&flute["max_thickness"]),
+                num(&expected["H_max_mm_by_k_over_path"][&key]),
+                0.002,
+            );
+        }
+        for checkpoint in expected["checkpoints"].as_array().unwrap() {
+            check_point(candidate["name"].as_str().unwrap(), candidate, checkpoint, &flutes);
+        }
+    }
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn c3_pair_blocks_and_flute_selection() {
+    let app = TestApp::spawn().await;
+    let c = case("C3");
+    let input = &c["input"];
+    let expected = &c["expected"];
+    let flutes = flute_list(&input["tool"]["flute_candidates"]);
+    let evaluation = &input["evaluation"];
+    let body = fixture_request(
+        &input["stock"],
+        &input["path"],
+        &input["cutting"],
+        &input["tool"]["flute_candidates"],
+        20.0,
+        json!({"step": input["simulation"]["ds"], "thickness_limit": evaluation["T1_mm"], "time_limit_s": evaluation["T2_s"]}),
+    );
+    let result = json_with(app.post_json(URL, &body).await, 200).await;
+    for flute in result["flutes"].as_array().unwrap() {
+        let key = flute["flute_count"].to_string();
+        close_rel(
+            &format!("H/fz k={key}"),
+            num(&flute["max_thickness"]) / 0.1,
+            num(&expected["H_over_fz_max_by_k"][&key]),
+            0.002,
+        );
+        assert_eq!(flute["max_teeth"], expected["n_max_by_k_over_path"][&key], "n_max k={key}");
+        close_rel(
+            &format!("time k={key}"),
+            num(&flute["time_s"]),
+            num(&expected["machining_time_s_constant_fz"][&key]),
+            1e-4,
+        );
+    }
+    check_statistics("C3", &result, &expected["representative_mm_constant_fz"], 0.002, 0.01);
+    let set: BTreeSet<u64> = recommended(&result).into_iter().collect();
+    assert_eq!(set, flute_list(&expected["recommended_flutes_constant_fz"]).into_iter().collect());
+    assert_eq!(recommended(&result), vec![10, 9, 7, 5], "fastest first");
+    for checkpoint in expected["checkpoints"].as_array().unwrap() {
+        check_point("C3", &result, checkpoint, &flutes);
+    }
+
+    // Constant V_f: 24 s for every k; T2 = 30 s admits k = 5…10, T2 = 20 s none.
+    let variant = &expected["constant_vf_variant"];
+    for (limits, want) in input["evaluation_variant_constant_vf"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip([flute_list(&variant["recommended_T2_30"]), flute_list(&variant["recommended_T2_20"])])
+    {
+        let body = fixture_request(
+            &input["stock"],
+            &input["path"],
+            &input["cutting_variant_constant_vf"],
+            &input["tool"]["flute_candidates"],
+            20.0,
+            json!({"step": input["simulation"]["ds"], "thickness_limit": limits["T1_mm"], "time_limit_s": limits["T2_s"]}),
+        );
+        let result = json_with(app.post_json(URL, &body).await, 200).await;
+        for flute in result["flutes"].as_array().unwrap() {
+            close("constant V_f time", num(&flute["time_s"]), 24.0, 1e-9);
+        }
+        let got: BTreeSet<u64> = recommended(&result).into_iter().collect();
+        assert_eq!(got, want.into_iter().collect(), "T2 = {}", limits["T2_s"]);
+        if got.is_empty() {
+            assert!(result["warnings"].as_array().unwrap().iter().any(|w| w["code"] == "W_NO_RECOMMENDATION"));
+        }
+    }
+}
+
+/// A path that never touches the stock is not an error (engagement.md §9 `W_NO_CONTACT`): all
+/// series zero, T1 trivially met, and the answer says so.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_path_that_never_touches_the_stock_is_a_warning() {
+    let app = TestApp::spawn().await;
+    let mut body = api_example();
+    body["path"] = json!([[-10, 60], [70, 60]]);
+    let answer = json_with(app.post_json(URL, &body).await, 200).await;
+    let warning =
+        answer["warnings"].as_array().unwrap().iter().find(|w| w["code"] == "W_NO_CONTACT").expect("W_NO_CONTACT");
+    assert!(warning["message"].as_str().unwrap().contains("never touches"), "{warning}");
+    assert!(answer["samples"].as_array().unwrap().iter().all(|s| s["arcs"] == json!([]) && s["radial_depth"] == 0.0));
+    assert!(answer["flutes"].as_array().unwrap().iter().all(|f| f["max_thickness"] == 0.0));
+    assert_eq!(answer["engaged_intervals"], json!([]));
+    // L = 80 mm: P_k = 32/k s, so T2 = 20 s admits k ≥ 2; T1 is met by every k.
+    assert_eq!(recommended(&answer), vec![8, 7, 6, 5, 4, 3, 2], "only T2 decides");
+}
+
+/// A request naming a machine: refused at `machine` until machine profiles reach engagement,
+/// unless `feed_plan.max_feed` (the one value a machine would give) is in the request.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_named_machine_is_refused_unless_its_value_is_given() {
+    let app = TestApp::spawn().await;
+    let mut body = api_example();
+    body["machine"] = json!("vmc-1");
+    let refused = problem(app.post_json(URL, &body).await, 422).await;
+    assert_eq!(refused["code"], "E_MACHINE_NOT_APPLIED");
+    assert_eq!(refused["errors"][0]["path"], "machine");
+    assert!(refused["detail"].as_str().unwrap().contains("not yet applied to engagement"), "{refused}");
+    body["feed_plan"] = json!({"target_thickness": 0.05});
+    let refused = problem(app.post_json(URL, &body).await, 422).await;
+    assert_eq!(refused["errors"][0]["path"], "machine");
+    body["feed_plan"]["max_feed"] = json!(2000);
+    let answer = json_with(app.post_json(URL, &body).await, 200).await;
+    assert!(answer["warnings"].as_array().unwrap().iter().any(|w| w["code"] == "W_MACHINE_NOT_APPLIED"));
+    assert_eq!(answer["feed_plan"]["max_feed"], 2000.0);
+}
+
+/// The example job's engagement operation gives exactly the endpoint's answer for the same
+/// request, and its program is the endpoint's for the first path in the job's output options.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_job_answers_like_the_endpoint() {
+    let app = TestApp::spawn().await;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/engagement-pocket.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let file: Value = toml::from_str(&text).unwrap();
+    let response = app
+        .client
+        .post(app.url("/api/v1/jobs"))
+        .header("content-type", "application/toml")
+        .body(text)
+        .send()
+        .await
+        .unwrap();
+    let id = json_with(response, 202).await["id"].as_i64().unwrap();
+    let job = poll_job(&app.client, &app.base, id, 60, finished).await;
+    assert_eq!(job["status"], "done", "{job}");
+    let mut request = file["operations"][0].clone();
+    request.as_object_mut().unwrap().remove("operation");
+    request["tool"] = file["tools"][0].clone();
+    let answer = json_with(app.post_json(URL, &request).await, 200).await;
+    assert_eq!(job["results"][0]["operation"], "engagement");
+    assert_eq!(job["results"][0]["result"], answer, "the job's result is the endpoint's answer");
+    let candidates = answer["candidates"].as_array().unwrap();
+    assert_eq!(candidates.len(), 3);
+    assert!(candidates.iter().all(|c| c["flutes"].as_array().unwrap().len() == 8));
+    let from_job = app.get(&format!("/api/v1/jobs/{id}/gcode")).await.text().await.unwrap();
+    let url = app.url(&format!("{URL}?format=gcode&dialect=linuxcnc&candidate=0"));
+    let from_endpoint = app.client.post(url).json(&request).send().await.unwrap().text().await.unwrap();
+    assert_eq!(from_job, from_endpoint);
+    assert!(from_job.contains("G64 P") && from_job.contains("T5 M06"));
+}
+
+/// A bad value in an engagement job file names its line and field (400); an operation the solver
+/// refuses fails the job with the field at fault.
+#[tokio::test(flavor = "multi_thread")]
+async fn engagement_job_errors_name_the_line_and_field() {
+    let app = TestApp::spawn().await;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/engagement-pocket.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let upload = |body: String| {
+        app.client.post(app.url("/api/v1/jobs")).header("content-type", "application/toml").body(body).send()
+    };
+    let bad_type = text.replace("thickness_limit = 0.06", "thickness_limit = \"thin\"");
+    let line = bad_type.lines().position(|l| l.starts_with("thickness_limit")).unwrap() + 1;
+    let answer = problem(upload(bad_type).await.unwrap(), 400).await;
+    assert_eq!(answer["errors"][0]["path"], "operations[0].thickness_limit");
+    assert!(answer["detail"].as_str().unwrap().starts_with(&format!("line {line},")), "{answer}");
+    let refused = text.replace("flute_counts = [1, 2, 3, 4, 5, 6, 7, 8]", "flute_counts = [1, 2, 40]");
+    let id = json_with(upload(refused).await.unwrap(), 202).await["id"].as_i64().unwrap();
+    let job = poll_job(&app.client, &app.base, id, 60, finished).await;
+    assert_eq!(job["status"], "failed", "{job}");
+    assert_eq!(job["error_field"], "operations[0].flute_counts[2]");
+    assert!(job["error"].as_str().unwrap().contains("E_INPUT"), "{job}");
+}
+
+// ---------------------------------------------------------------- G-code
+
+/// The moves the JSON answer describes after the tool change, with their feeds: rapid above the
+/// start, feed down to the cutting depth, then one feed move to the end of every plan block (the
+/// block ends are sample positions; the paths here are straight lines).
+fn expected_moves(result: &Value, cut_z: f64, safe_z: f64) -> Vec<(bool, [f64; 3], Option<f64>)> {
+    let samples = result["samples"].as_array().unwrap();
+    let position = |s: f64| {
+        let sample = samples.iter().find(|sample| (num(&sample["s"]) - s).abs() < 1e-9).expect("block end at a sample");
+        [num(&sample["position"][0]), num(&sample["position"][1])]
+    };
+    let start = position(0.0);
+    let blocks = result["feed_plan"]["blocks"].as_array().unwrap();
+    // The plunge runs no faster than the nominal feed of the tool's flutes (f_z = 0.05, N = 3000).
+    let nominal = num(&result["time_flute_count"]) * 0.05 * 3000.0;
+    let first_feed = num(&blocks[0]["feed"]);
+    let mut moves = vec![
+        (false, [start[0], start[1], safe_z], None),
+        (true, [start[0], start[1], cut_z], Some(first_feed.min(nominal))),
+    ];
+    for block in blocks {
+        let end = position(num(&block["to_s"]));
+        moves.push((true, [end[0], end[1], cut_z], Some(num(&block["feed"]))));
+    }
+    moves
+}
+
+/// The modal feed of every G00/G01 line of `program`, in order (`None` for rapids).
+fn program_feeds(program: &str) -> Vec<Option<f64>> {
+    let mut modal = None;
+    program
+        .lines()
+        .filter(|line| line.starts_with("G00 X") || line.starts_with("G01 "))
+        .map(|line| {
+            if let Some(word) = line.split_whitespace().find(|w| w.starts_with('F')) {
+                modal = word[1..].parse::<f64>().ok();
+            }
+            line.starts_with("G01").then_some(modal).flatten()
+        })
+        .collect()
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn gcode_of_the_feed_plan_in_both_dialects() {
+    let app = TestApp::spawn().await;
+    app.register_tool(3, &json!({"kind": "flat", "radius": 5, "flutes": 3})).await;
+    app.register_tool(6, &json!({"kind": "ball", "radius": 5, "flutes": 2})).await;
+    let mut body = api_example();
+    body["tool"] = json!(3);
+    body.as_object_mut().unwrap().remove("path");
+    // A slot, a side cut at a_e = 2.5 (climb) and a pass through the air: the chip-thinning
+    // plan raises the feed where the engagement is thin.
+    body["paths"] = json!([
+        {"name": "slot then side", "path": [[-10, 20], [70, 20], [70, 27.5], [-10, 27.5]]},
+        {"name": "side only", "path": [[70, 42.5], [-10, 42.5]]},
+    ]);
+    body["axial_depth"] = json!(3);
+    body["stock_top_z"] = json!(1);
+    body["feed_plan"] = json!({"target_thickness": 0.05, "max_feed": 1500});
+    let answer = json_with(app.post_json(URL, &body).await, 200).await;
+    let external = external_program("rs274", "the LinuxCNC G-code check").is_some();
+    for (tool, reference, lift) in [(3, "tip", 0.0), (3, "centre", 0.0), (6, "centre", 5.0)] {
+        let mut body = body.clone();
+        body["tool"] = json!(tool);
+        let answer = if tool == 3 { answer.clone() } else { json_with(app.post_json(URL, &body).await, 200).await };
+        for (candidate, result) in answer["candidates"].as_array().unwrap().iter().enumerate() {
+            let plan = &result["feed_plan"];
+            let feeds: BTreeSet<u64> =
+                plan["blocks"].as_array().unwrap().iter().map(|b| num(&b["feed"]) as u64).collect();
+            assert!(feeds.len() >= 2, "the plan changes the feed: {feeds:?}");
+            assert!(feeds.contains(&1500), "capped at the max feed in the air: {feeds:?}");
+            for dialect in ["fanuc", "linuxcnc"] {
+                let url = app
+                    .url(&format!("{URL}?format=gcode&dialect={dialect}&reference={reference}&candidate={candidate}"));
+                let response = app.client.post(url).json(&body).send().await.unwrap();
+                assert_eq!(response.status(), 200);
+                assert!(response.headers()["content-type"].to_str().unwrap().starts_with("text/x-gcode"));
+                let program = response.text().await.unwrap();
+                assert!(program.contains(&format!("T{tool} M06")), "{program}");
+                if dialect == "fanuc" {
+                    assert!(program.starts_with("%\n") && program.contains("O1000"));
+                } else {
+                    assert!(program.contains("G64 P"));
+                }
+                let expected = expected_moves(result, 1.0 - 3.0 + lift, 1.0 + 5.0 + lift);
+                let feeds = program_feeds(&program);
+                assert_eq!(feeds.len(), expected.len(), "{program}");
+                for (index, (got, want)) in feeds.iter().zip(&expected).enumerate() {
+                    // F words carry at most one decimal (the nominal feed k·f_z·N may not be whole).
+                    let same = match (got, want.2) {
+                        (Some(g), Some(w)) => (g - w).abs() <= 0.05,
+                        (g, w) => *g == w,
+                    };
+                    assert!(same, "F word of move {index}: {got:?} vs {:?}\n{program}", want.2);
+                }
+                let label = format!("engagement_{tool}_{reference}_{candidate}_{dialect}");
+                let Some(mut interpreted) = rs274_moves(&program, app.directory(), &label) else {
+                    assert!(!external);
+                    continue;
+                };
+                // The first traverse is the length-offset block; the last the final retract.
+                let first_rapid = interpreted.iter().position(|m| !m.0).unwrap();
+                interpreted.drain(..=first_rapid);
+                interpreted.pop();
+                assert_eq!(interpreted.len(), expected.len(), "{label}: move count");
+                for (index, (got, want)) in interpreted.iter().zip(&expected).enumerate() {
+                    assert_eq!(got.0, want.0, "{label}: move {index} kind");
+                    for axis in 0..3 {
+                        assert!(
+                            (got.1[axis] - want.1[axis]).abs() <= 1e-4,
+                            "{label}: move {index} {got:?} vs {want:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    // Without a feed plan every cutting move runs at the nominal feed of the tool's flutes.
+    let mut nominal = api_example();
+    nominal["axial_depth"] = json!(2);
+    let program = app
+        .client
+        .post(app.url(&format!("{URL}?format=gcode")))
+        .json(&nominal)
+        .send()
+        .await
+        .unwrap()
+        .text()
+        .await
+        .unwrap();
+    assert!(program_feeds(&program).iter().flatten().all(|f| (*f - 300.0).abs() <= 0.05), "{program}");
+    if let Some(moves) = rs274_moves(&program, app.directory(), "engagement_nominal") {
+        assert!(moves.iter().any(|m| m.0 && (m.1[0] - 70.0).abs() < 1e-9 && (m.1[2] + 2.0).abs() < 1e-9));
+    }
+    // An arc path is written as chords the interpreter accepts; Accept: text/x-gcode works too.
+    let mut arc = api_example();
+    arc["path"] = json!({"start": [-10, 20], "segments": [
+        {"type": "line", "to": [20, 20]},
+        {"type": "arc", "to": [40, 20], "center": [30, 20], "dir": "cw"},
+        {"type": "line", "to": [70, 20]}]});
+    arc["axial_depth"] = json!(2);
+    let response = app.client.post(app.url(URL)).header("accept", "text/x-gcode").json(&arc).send().await.unwrap();
+    assert_eq!(response.status(), 200);
+    let program = response.text().await.unwrap();
+    if let Some(moves) = rs274_moves(&program, app.directory(), "engagement_arc") {
+        assert!(moves.len() > 20, "the arc as chords");
+    }
+}
+
+// ---------------------------------------------------------------- bad requests
+
+fn with(changes: Value) -> Value {
+    let mut body = api_example();
+    for (key, value) in changes.as_object().unwrap() {
+        if value.is_null() {
+            body.as_object_mut().unwrap().remove(key);
+        } else {
+            body[key] = value.clone();
+        }
+    }
+    body
+}
+
+/// (what, body, query, expected status, expected field path, expected code)
+fn bad_cases() -> Vec<(&'static str, Value, &'static str, u16, &'static str, &'static str)> {
+    vec![
+        (
+            "self-intersecting stock",
+            with(json!({"stock": {"polygon": [[0, 0], [60, 40], [60, 0], [0, 40]]}})),
+            "",
+            422,
+            "stock.polygon[0]",
+            "E_STOCK",
+        ),
+        (
+            "overlapping stock regions",
+            with(json!({"stock": {"polygons": [
+                {"outer": [[0, 0], [30, 0], [30, 30], [0, 30]]}, {"outer": [[20, 20], [50, 20], [50, 50], [20, 50]]}]}})),
+            "",
+            422,
+            "stock.polygons[0].outer[1]",
+            "E_STOCK",
+        ),
+        (
+            "flat stock ring",
+            with(json!({"stock": {"polygon": [[0, 0], [1, 1], [2, 2]]}})),
+            "",
+            422,
+            "stock.polygon[0]",
+            "E_STOCK",
+        ),
+        (
+            "stock with two points",
+            with(json!({"stock": {"polygon": [[0, 0], [1, 1]]}})),
+            "",
+            422,
+            "stock.polygon",
+            "E_STOCK",
+        ),
+        ("no stock shape", with(json!({"stock": {}})), "", 422, "stock", "E_INPUT"),
+        ("empty path", with(json!({"path": []})), "", 422, "path", "E_PATH"),
+        ("one-point path", with(json!({"path": [[1, 1]]})), "", 422, "path", "E_PATH"),
+        ("zero-length path", with(json!({"path": [[1, 1], [1, 1]]})), "", 422, "path", "E_PATH"),
+        ("path without segments", with(json!({"path": {"start": [0, 0], "segments": []}})), "", 422, "path", "E_PATH"),
+        ("no path at all", with(json!({"path": null})), "", 422, "path", "E_PATH"),
+        (
+            "arc centre not equidistant",
+            with(
+                json!({"path": {"start": [0, 0], "segments": [{"type": "arc", "to": [10, 0], "center": [4, 1], "dir": "ccw"}]}}),
+            ),
+            "",
+            422,
+            "path.segments[0].center",
+            "E_PATH",
+        ),
+        ("zero feed per tooth", with(json!({"feed_per_tooth": 0})), "", 422, "feed_per_tooth", "E_INPUT"),
+        ("negative feed per tooth", with(json!({"feed_per_tooth": -0.05})), "", 422, "feed_per_tooth", "E_INPUT"),
+        ("no feed", with(json!({"feed_per_tooth": null})), "", 422, "feed_per_tooth", "E_INPUT"),
+        ("both feeds", with(json!({"feed": 600})), "", 422, "feed", "E_INPUT"),
+        ("zero spindle", with(json!({"spindle_rpm": 0})), "", 422, "spindle_rpm", "E_INPUT"),
+        ("flute count zero", with(json!({"flute_counts": [1, 0]})), "", 422, "flute_counts[1]", "E_INPUT"),
+        ("flute count 33", with(json!({"flute_counts": [33]})), "", 422, "flute_counts[0]", "E_INPUT"),
+        ("flute count twice", with(json!({"flute_counts": [2, 4, 2]})), "", 422, "flute_counts[2]", "E_INPUT"),
+        ("no flute counts", with(json!({"flute_counts": []})), "", 422, "flute_counts", "E_INPUT"),
+        ("negative flute count", with(json!({"flute_counts": [-1]})), "", 400, "flute_counts[0]", "E_JSON"),
+        ("zero thickness limit", with(json!({"thickness_limit": 0})), "", 422, "thickness_limit", "E_INPUT"),
+        ("coordinates beyond 1 km", with(json!({"path": [[0, 0], [2e6, 0]]})), "", 422, "path[1][0]", "E_INPUT"),
+        ("grid with the exact engine", with(json!({"grid": 0.1})), "", 422, "grid", "E_INPUT"),
+        ("step zero", with(json!({"step": 0})), "", 422, "step", "E_INPUT"),
+        ("too many samples", with(json!({"step": 1e-4})), "", 422, "step", "E_TOO_MANY_SAMPLES"),
+        (
+            "grid over the memory limit",
+            with(json!({"engine": "dots", "grid": 0.0005})),
+            "",
+            422,
+            "grid",
+            "E_GRID_MEMORY",
+        ),
+        ("path and paths", with(json!({"paths": [{"path": [[0, 0], [5, 0]]}]})), "", 422, "paths", "E_INPUT"),
+        (
+            "empty candidate path",
+            with(json!({"path": null, "paths": [{"path": [[0, 0], [5, 0]]}, {"path": [[3, 3]]}]})),
+            "",
+            422,
+            "paths[1].path",
+            "E_PATH",
+        ),
+        (
+            "17 candidate paths",
+            with(json!({"path": null, "paths": vec![json!({"path": [[0, 0], [5, 0]]}); 17]})),
+            "",
+            422,
+            "paths",
+            "E_TOO_LARGE",
+        ),
+        (
+            "bitmap of the wrong size",
+            with(json!({"stock": {"bitmap": {"origin": [0, 0], "cell": 1, "width": 4, "height": 4, "data": "/w=="}}})),
+            "",
+            422,
+            "stock.bitmap.data",
+            "E_STOCK",
+        ),
+        (
+            "feed plan without max feed",
+            with(json!({"feed_plan": {"target_thickness": 0.05}})),
+            "",
+            422,
+            "feed_plan.max_feed",
+            "E_INPUT",
+        ),
+        ("machine named", with(json!({"machine": "vmc-1"})), "", 422, "machine", "E_MACHINE_NOT_APPLIED"),
+        ("unknown tool", with(json!({"tool": 4242})), "", 404, "tool", "E_NOT_FOUND"),
+        (
+            "inline tool of radius zero",
+            with(json!({"tool": {"kind": "flat", "radius": 0}})),
+            "",
+            422,
+            "tool.radius",
+            "E_INPUT",
+        ),
+        ("unknown field", with(json!({"colour": "red"})), "", 400, "colour", "E_JSON"),
+        ("point with three coordinates", with(json!({"path": [[0, 0, 0], [5, 0, 0]]})), "", 400, "path[0]", "E_JSON"),
+        ("unknown engine", with(json!({"engine": "voxels"})), "", 400, "engine", "E_JSON"),
+        (
+            "unknown segment type",
+            with(json!({"path": {"start": [0, 0], "segments": [{"type": "spline", "to": [1, 0]}]}})),
+            "",
+            400,
+            "path.segments[0].type",
+            "E_JSON",
+        ),
+        ("G-code without axial depth", api_example(), "?format=gcode", 422, "axial_depth", "E_INPUT"),
+        (
+            "G-code of a missing candidate",
+            with(json!({"axial_depth": 2})),
+            "?format=gcode&candidate=1",
+            422,
+            "candidate",
+            "E_INPUT",
+        ),
+        ("candidate not a number", api_example(), "?format=gcode&candidate=first", 400, "candidate", "E_QUERY"),
+        ("unknown query parameter", api_example(), "?colour=red", 400, "colour", "E_QUERY"),
+        ("bad dialect", api_example(), "?format=gcode&dialect=heidenhain", 400, "dialect", "E_QUERY"),
+    ]
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn bad_engagement_requests() {
+    let app = TestApp::spawn().await;
+    app.register_tool(3, &json!({"kind": "flat", "radius": 5})).await;
+    let tools_before = json_with(app.get("/api/v1/tools").await, 200).await;
+    let jobs_before = json_with(app.get("/api/v1/jobs").await, 200).await;
+    let mut mismatches = Vec::new();
+    for (what, body, query, status, field, code) in bad_cases() {
+        let response = app.client.post(app.url(&format!("{URL}{query}"))).json(&body).send().await.unwrap();
+        let answer = problem(response, status).await;
+        if answer["code"] != code || answer["errors"][0]["path"] != field {
+            mismatches.push(format!("{what}: expected {code} at {field}, got {answer}"));
+        }
+        if what == "grid over the memory limit" {
+            let detail = answer["detail"].as_str().unwrap();
+            assert!(detail.contains("the limit is 1000000000 dots"), "the limit is named: {detail}");
+        }
+    }
+    assert!(mismatches.is_empty(), "{}", mismatches.join("\n"));
+    assert_eq!(json_with(app.get("/api/v1/tools").await, 200).await, tools_before, "tools unchanged");
+    assert_eq!(json_with(app.get("/api/v1/jobs").await, 200).await, jobs_before, "no job created");
+}

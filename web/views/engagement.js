@@ -1,0 +1,964 @@
+// Engagement view: tool–workpiece contact along one or several candidate paths (api.md,
+// Engagement; engagement.md §3). A form for the tool, stock, paths, cutting conditions and
+// limits; per path the plan view coloured by engagement, the contact-position graph, a_e, the
+// summed chip thickness per flute count with the threshold, representative values and time per
+// k with the recommended k highlighted, and the feed plan; a cursor on any chart marks the tool
+// on the path. The result renderer is shared with the Jobs view.
+import { api, download, message, number, showProblem } from '/app.js';
+
+const SAMPLE_PATHS = [
+  { name: 'straight', text: '-10 20\n70 20' },
+  { name: 'two bends', text: '-10 10\n30 10\n30 30\n70 30' },
+  { name: 'U-shaped', text: '-10 10\n45 10\n45 30\n-10 30' },
+];
+
+const FORM = `
+<div class="layout">
+  <form id="engagement-form" novalidate>
+    <fieldset><legend>Tool</legend>
+      <label>Tool <select name="tool_choice" data-field="tool"></select></label>
+      <label data-inline-tool>Radius, mm <input name="tool_radius" type="number" step="any" value="5" data-field="tool.radius"></label>
+      <label data-inline-tool>Flutes <input name="tool_flutes" type="number" step="1" value="2" data-field="tool.flutes"></label>
+    </fieldset>
+    <fieldset><legend>Stock (plan view)</legend>
+      <label>Outline x y <textarea name="stock_polygon" rows="4" data-field="stock.polygon" spellcheck="false">0 0
+60 0
+60 40
+0 40</textarea></label>
+      <label>Holes <textarea name="stock_holes" rows="2" data-field="stock.holes" spellcheck="false" placeholder="x y per line; blank line between holes"></textarea></label>
+    </fieldset>
+    <fieldset><legend>Tool-centre paths</legend>
+      <p class="hint">Points "x y" per line (feed moves), or JSON: <code>[[x, y], ...]</code> or <code>{"start": [x, y], "segments": [{"type": "arc", "to": [x, y], "center": [x, y], "dir": "ccw"}]}</code>.</p>
+      <div id="engagement-paths"></div>
+      <div class="actions"><button class="secondary" type="button" id="engagement-add-path">Add path</button></div>
+    </fieldset>
+    <fieldset><legend>Cutting</legend>
+      <label>Spindle, rpm <input name="spindle_rpm" type="number" step="any" value="3000" data-field="spindle_rpm"></label>
+      <label>Feed per tooth, mm <input name="feed_per_tooth" type="number" step="any" value="0.05" data-field="feed_per_tooth"></label>
+      <label>Flute counts <input name="flute_counts" type="text" value="1-8" data-field="flute_counts" title="e.g. 1-8 or 2,3,4"></label>
+      <label>Rotation <select name="spindle_direction" data-field="spindle_direction"><option value="cw">cw (M03)</option><option value="ccw">ccw (M04)</option></select></label>
+    </fieldset>
+    <fieldset><legend>Limits</legend>
+      <label>Thickness T1, mm <input name="thickness_limit" type="number" step="any" value="0.075" data-field="thickness_limit"></label>
+      <label>Time T2, s <input name="time_limit_s" type="number" step="any" value="20" data-field="time_limit_s"></label>
+      <label>Statistic <select name="representative" data-field="representative"><option value="max">max</option><option value="mean">mean</option><option value="median">median</option></select></label>
+    </fieldset>
+    <fieldset><legend>Simulation</legend>
+      <label>Engine <select name="engine" data-field="engine"><option value="exact">exact boundary</option><option value="dots">dots (seed)</option></select></label>
+      <label>Step Δs, mm <input name="step" type="number" step="any" placeholder="D/50" data-field="step"></label>
+      <label data-engine="dots">Grid g, mm <input name="grid" type="number" step="any" placeholder="D/200" data-field="grid"></label>
+    </fieldset>
+    <fieldset><legend>G-code and feed plan</legend>
+      <label>Axial depth a_p, mm <input name="axial_depth" type="number" step="any" value="2" data-field="axial_depth"></label>
+      <label>Target chip h*, mm <input name="target_thickness" type="number" step="any" value="0.05" data-field="feed_plan.target_thickness" title="empty: no feed plan, nominal feed"></label>
+      <label>Max feed, mm/min <input name="max_feed" type="number" step="any" value="2000" data-field="feed_plan.max_feed"></label>
+    </fieldset>
+    <div class="actions">
+      <button class="primary" type="submit" id="engagement-compute">Compute</button>
+      <select name="dialect" aria-label="G-code dialect"><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select>
+      <select name="reference" aria-label="Programmed point"><option value="tip">tip</option><option value="centre">centre</option></select>
+      <select name="candidate" aria-label="Path to program" data-field="candidate"></select>
+      <button class="secondary" type="button" id="engagement-gcode">G-code</button>
+    </div>
+  </form>
+  <section>
+    <div id="engagement-messages"></div>
+    <div id="engagement-result"></div>
+  </section>
+</div>`;
+
+// ---------------------------------------------------------------------------------------------
+// Request from the form
+
+class InputError {
+  constructor(field, detail) {
+    this.status = 400;
+    this.title = 'Bad input';
+    this.detail = detail;
+    this.errors = [{ path: field, message: detail }];
+  }
+}
+
+function value(form, name) {
+  return form.elements[name].value;
+}
+
+function numeric(form, name) {
+  const text = value(form, name).trim();
+  return text === '' ? undefined : Number(text);
+}
+
+// "x y" per line (or "x, y"), or JSON. Returns the JSON value or a list of points.
+function parsePoints(text, field) {
+  const trimmed = text.trim();
+  if (trimmed.startsWith('[') || trimmed.startsWith('{')) {
+    try {
+      return JSON.parse(trimmed);
+    } catch (error) {
+      throw new InputError(field, `not valid JSON: ${error.message}`);
+    }
+  }
+  return trimmed.split('\n').map((l) => l.trim()).filter(Boolean).map((line, index) => {
+    const numbers = line.split(/[\s,;]+/).filter(Boolean).map(Number);
+    if (numbers.length !== 2 || numbers.some((n) => !Number.isFinite(n))) {
+      throw new InputError(field, `line ${index + 1}: expected two numbers "x y", got "${line}"`);
+    }
+    return numbers;
+  });
+}
+
+function parseFlutes(text) {
+  const counts = [];
+  for (const part of text.split(/[\s,;]+/).filter(Boolean)) {
+    const range = part.match(/^(\d+)\s*-\s*(\d+)$/);
+    if (range) {
+      for (let k = Number(range[1]); k <= Number(range[2]) && counts.length < 64; k++) counts.push(k);
+    } else if (/^-?\d+$/.test(part)) {
+      counts.push(Number(part));
+    } else {
+      throw new InputError('flute_counts', `"${part}" is not a flute count or a range like 1-8`);
+    }
+  }
+  return counts;
+}
+
+function pathBoxes(form) {
+  return [...form.querySelectorAll('.engagement-path')];
+}
+
+// The request body from the form (field names as api.md).
+export function engagementRequest(form) {
+  const choice = value(form, 'tool_choice');
+  const tool = choice === 'inline'
+    ? { kind: 'flat', radius: numeric(form, 'tool_radius'), flutes: numeric(form, 'tool_flutes') }
+    : Number(choice);
+  const stock = { polygon: parsePoints(value(form, 'stock_polygon'), 'stock.polygon') };
+  const holes = value(form, 'stock_holes').trim();
+  if (holes) stock.holes = holes.split(/\n\s*\n/).map((block, i) => parsePoints(block, `stock.holes[${i}]`));
+  const boxes = pathBoxes(form);
+  const body = { tool, stock };
+  const paths = boxes.map((box, index) => {
+    const field = boxes.length > 1 ? `paths[${index}].path` : 'path';
+    return { name: box.querySelector('input').value.trim() || undefined, path: parsePoints(box.querySelector('textarea').value, field) };
+  });
+  if (paths.length === 1) body.path = paths[0].path;
+  else body.paths = paths;
+  Object.assign(body, {
+    spindle_rpm: numeric(form, 'spindle_rpm'),
+    feed_per_tooth: numeric(form, 'feed_per_tooth'),
+    flute_counts: parseFlutes(value(form, 'flute_counts')),
+    spindle_direction: value(form, 'spindle_direction'),
+    thickness_limit: numeric(form, 'thickness_limit'),
+    time_limit_s: numeric(form, 'time_limit_s'),
+    representative: value(form, 'representative'),
+    engine: value(form, 'engine'),
+    step: numeric(form, 'step'),
+    axial_depth: numeric(form, 'axial_depth'),
+  });
+  if (body.engine === 'dots') body.grid = numeric(form, 'grid');
+  const target = numeric(form, 'target_thickness');
+  if (target !== undefined) body.feed_plan = { target_thickness: target, max_feed: numeric(form, 'max_feed') };
+  return body;
+}
+
+// Marks inputs whose data-field is the error's path or a parent of it (`stock.polygon` for
+// `stock.polygon[3][0]`).
+function markFields(form, problem) {
+  for (const error of problem.errors || []) {
+    for (const element of form.querySelectorAll('[data-field]')) {
+      const field = element.dataset.field;
+      if (error.path === field || error.path.startsWith(`${field}.`) || error.path.startsWith(`${field}[`)) {
+        element.classList.add('invalid');
+      }
+    }
+  }
+}
+
+function addPath(form, name = '', text = '') {
+  const box = document.createElement('div');
+  box.className = 'engagement-path';
+  box.innerHTML = `<label>Name <input type="text"></label>
+    <label>Points <textarea rows="4" spellcheck="false"></textarea></label>
+    <div class="actions"><button class="secondary" type="button">Remove</button></div>`;
+  box.querySelector('input').value = name;
+  box.querySelector('textarea').value = text;
+  box.querySelector('button').addEventListener('click', () => {
+    if (pathBoxes(form).length > 1) box.remove();
+    numberPaths(form);
+  });
+  form.querySelector('#engagement-paths').append(box);
+  numberPaths(form);
+}
+
+// data-field of each path box: `path` for one, `paths[i].path` / `paths[i].name` for several.
+function numberPaths(form) {
+  const boxes = pathBoxes(form);
+  boxes.forEach((box, index) => {
+    box.querySelector('textarea').dataset.field = boxes.length > 1 ? `paths[${index}].path` : 'path';
+    box.querySelector('input').dataset.field = boxes.length > 1 ? `paths[${index}].name` : 'name';
+  });
+}
+
+async function loadTools(select) {
+  select.replaceChildren(new Option('inline flat end mill (below)', 'inline'));
+  try {
+    for (const tool of await api('GET', '/api/v1/tools')) {
+      select.append(new Option(`T${tool.number} ${tool.kind} R${tool.radius} z${tool.flutes}${tool.name ? ' ' + tool.name : ''}`, String(tool.number)));
+    }
+  } catch (problem) {
+    // The inline tool still works without the table.
+  }
+}
+
+function syncVisibility(form) {
+  form.querySelectorAll('[data-inline-tool]').forEach((e) => { e.hidden = value(form, 'tool_choice') !== 'inline'; });
+  form.querySelectorAll('[data-engine]').forEach((e) => { e.hidden = e.dataset.engine !== value(form, 'engine'); });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Drawing helpers
+
+const KCOLOURS = ['#0b63b6', '#c23b22', '#2e8b57', '#8e44ad', '#d35400', '#16a085', '#7f8c8d', '#b7950b',
+  '#2c3e50', '#e84393'];
+const RECOMMENDED = '#1e8b3a';
+const REJECTED = '#9aa5ae';
+const LIMIT = '#b3261e';
+
+function kColour(index) {
+  return KCOLOURS[index % KCOLOURS.length];
+}
+
+// Engagement colour: grey for none, then blue → orange → red up to 180° and beyond.
+function engagementColour(deg) {
+  if (!(deg > 0)) return '#b8c2cb';
+  const t = Math.min(1, deg / 180);
+  const stops = [[11, 99, 182], [230, 150, 20], [200, 30, 30]];
+  const [a, b, u] = t < 0.5 ? [stops[0], stops[1], t / 0.5] : [stops[1], stops[2], (t - 0.5) / 0.5];
+  const c = a.map((v, i) => Math.round(v + (b[i] - v) * u));
+  return `rgb(${c[0]},${c[1]},${c[2]})`;
+}
+
+function niceStep(span, count) {
+  const raw = span / Math.max(1, count);
+  const power = 10 ** Math.floor(Math.log10(raw));
+  return [1, 2, 2.5, 5, 10].map((m) => m * power).find((s) => s >= raw) || raw;
+}
+
+function formatTick(v, step) {
+  const digits = Math.max(0, Math.min(4, -Math.floor(Math.log10(step) + 1e-9)));
+  return v.toFixed(digits);
+}
+
+// Sizes a canvas to its box and returns its 2-D context in CSS pixels.
+function prepare(canvas, height) {
+  const ratio = window.devicePixelRatio || 1;
+  const width = Math.max(280, canvas.clientWidth || canvas.parentElement?.clientWidth || 600);
+  canvas.style.height = `${height}px`;
+  canvas.width = Math.round(width * ratio);
+  canvas.height = Math.round(height * ratio);
+  const ctx = canvas.getContext('2d');
+  ctx.setTransform(ratio, 0, 0, ratio, 0, 0);
+  ctx.fillStyle = '#fff';
+  ctx.fillRect(0, 0, width, height);
+  return { ctx, width, height, ratio };
+}
+
+// A chart frame: axes, grid, ticks and labels; returns x/y mapping functions.
+function frame(ctx, box, range, labels) {
+  const { left, top, right, bottom } = box;
+  const [x0, x1, y0, y1] = range;
+  const x = (v) => left + (v - x0) / (x1 - x0 || 1) * (right - left);
+  const y = (v) => bottom - (v - y0) / (y1 - y0 || 1) * (bottom - top);
+  ctx.save();
+  ctx.font = '12px system-ui, sans-serif';
+  ctx.strokeStyle = '#e3e7eb';
+  ctx.fillStyle = '#5b6670';
+  ctx.lineWidth = 1;
+  const xs = labels.xticks || niceStep(x1 - x0, 8);
+  ctx.textAlign = 'center';
+  ctx.textBaseline = 'top';
+  for (let v = Math.ceil(x0 / xs - 1e-9) * xs; v <= x1 + 1e-9; v += xs) {
+    ctx.beginPath();
+    ctx.moveTo(x(v), top);
+    ctx.lineTo(x(v), bottom);
+    ctx.stroke();
+    ctx.fillText(labels.xformat ? labels.xformat(v) : formatTick(v, xs), x(v), bottom + 3);
+  }
+  const ys = labels.yticks || niceStep(y1 - y0, 5);
+  ctx.textAlign = 'right';
+  ctx.textBaseline = 'middle';
+  for (let v = Math.ceil(y0 / ys - 1e-9) * ys; v <= y1 + 1e-9; v += ys) {
+    ctx.beginPath();
+    ctx.moveTo(left, y(v));
+    ctx.lineTo(right, y(v));
+    ctx.stroke();
+    ctx.fillText(formatTick(v, ys), left - 4, y(v));
+  }
+  ctx.strokeStyle = '#5b6670';
+  ctx.strokeRect(left, top, right - left, bottom - top);
+  ctx.fillStyle = '#1d2327';
+  ctx.font = '13px system-ui, sans-serif';
+  ctx.textAlign = 'left';
+  ctx.textBaseline = 'bottom';
+  ctx.fillText(labels.title, left, top - 4);
+  ctx.textAlign = 'right';
+  ctx.textBaseline = 'bottom';
+  if (labels.x) ctx.fillText(labels.x, right, box.height - 2);
+  ctx.restore();
+  return { x, y };
+}
+
+function dashedLine(ctx, x0, y0, x1, y1, colour, label) {
+  ctx.save();
+  ctx.strokeStyle = colour;
+  ctx.lineWidth = 2;
+  ctx.setLineDash([6, 4]);
+  ctx.beginPath();
+  ctx.moveTo(x0, y0);
+  ctx.lineTo(x1, y1);
+  ctx.stroke();
+  if (label) {
+    ctx.setLineDash([]);
+    ctx.fillStyle = colour;
+    ctx.font = '12px system-ui, sans-serif';
+    ctx.textAlign = 'right';
+    ctx.textBaseline = 'bottom';
+    ctx.fillText(label, x1 - 2, y0 - 2);
+  }
+  ctx.restore();
+}
+
+function finish(canvas, view) {
+  view.image = view.ctx.getImageData(0, 0, canvas.width, canvas.height);
+  canvas.dataset.state = 'drawn';
+}
+
+// Redraws the stored image and a vertical cursor at x.
+function cursorLine(view, xPixel) {
+  const { ctx } = view;
+  ctx.putImageData(view.image, 0, 0);
+  if (xPixel === undefined) return;
+  ctx.save();
+  ctx.strokeStyle = '#1d2327';
+  ctx.lineWidth = 1.5;
+  ctx.beginPath();
+  ctx.moveTo(xPixel, view.box.top);
+  ctx.lineTo(xPixel, view.box.bottom);
+  ctx.stroke();
+  ctx.restore();
+}
+
+// Index of the sample nearest to `v` on the axis `key` (sorted ascending).
+function nearestIndex(samples, key, v) {
+  let low = 0;
+  let high = samples.length - 1;
+  while (high - low > 1) {
+    const mid = (low + high) >> 1;
+    if (samples[mid][key] < v) low = mid; else high = mid;
+  }
+  return Math.abs(samples[low][key] - v) <= Math.abs(samples[high][key] - v) ? low : high;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Plan view: stock, path coloured by engagement, tool circle at the cursor
+
+function base64Bits(text) {
+  const binary = atob(text.replace(/\s/g, ''));
+  const bytes = new Uint8Array(binary.length);
+  for (let i = 0; i < binary.length; i++) bytes[i] = binary.charCodeAt(i);
+  return bytes;
+}
+
+// Points of a path input ([[x, y], ...] or {start, segments}) as a polyline, arcs chorded.
+function pathPolyline(path) {
+  if (Array.isArray(path)) return path;
+  if (!path || !path.start) return [];
+  const points = [path.start];
+  let at = path.start;
+  for (const segment of path.segments || []) {
+    if (segment.type === 'arc') {
+      const c = segment.center || segment.centre;
+      const r = Math.hypot(at[0] - c[0], at[1] - c[1]);
+      const a0 = Math.atan2(at[1] - c[1], at[0] - c[0]);
+      let a1 = Math.atan2(segment.to[1] - c[1], segment.to[0] - c[0]);
+      const ccw = (segment.dir || segment.direction) !== 'cw';
+      if (ccw && a1 <= a0) a1 += 2 * Math.PI;
+      if (!ccw && a1 >= a0) a1 -= 2 * Math.PI;
+      const steps = Math.max(4, Math.ceil(Math.abs(a1 - a0) / 0.1));
+      for (let i = 1; i <= steps; i++) {
+        const a = a0 + (a1 - a0) * i / steps;
+        points.push([c[0] + r * Math.cos(a), c[1] + r * Math.sin(a)]);
+      }
+    } else {
+      points.push(segment.to);
+    }
+    at = segment.to;
+  }
+  return points;
+}
+
+function stockRings(stock) {
+  if (!stock) return [];
+  if (stock.polygon) return [stock.polygon, ...(stock.holes || [])];
+  if (stock.polygons) return stock.polygons.flatMap((p) => [p.outer, ...(p.holes || [])]);
+  return [];
+}
+
+class PlanView {
+  constructor(canvas, result, answer) {
+    this.canvas = canvas;
+    this.result = result;
+    this.stock = answer.stock;
+    this.radius = answer.tool?.radius ?? 0;
+    const low = [Infinity, Infinity];
+    const high = [-Infinity, -Infinity];
+    const include = (p) => {
+      low[0] = Math.min(low[0], p[0]); low[1] = Math.min(low[1], p[1]);
+      high[0] = Math.max(high[0], p[0]); high[1] = Math.max(high[1], p[1]);
+    };
+    stockRings(this.stock).flat().forEach(include);
+    const bitmap = this.stock?.bitmap;
+    if (bitmap) {
+      include(bitmap.origin);
+      include([bitmap.origin[0] + bitmap.width * bitmap.cell, bitmap.origin[1] + bitmap.height * bitmap.cell]);
+    }
+    for (const s of result.samples) include(s.position);
+    this.low = [low[0] - this.radius, low[1] - this.radius];
+    this.high = [high[0] + this.radius, high[1] + this.radius];
+  }
+
+  draw() {
+    const width = Math.max(280, this.canvas.clientWidth || 600);
+    const spanX = this.high[0] - this.low[0] || 1;
+    const spanY = this.high[1] - this.low[1] || 1;
+    const height = Math.max(180, Math.min(520, width * spanY / spanX + 20));
+    const view = prepare(this.canvas, height);
+    const { ctx } = view;
+    const pad = 10;
+    const scale = Math.min((view.width - 2 * pad) / spanX, (view.height - 2 * pad - 16) / spanY);
+    const ox = pad + ((view.width - 2 * pad) - spanX * scale) / 2;
+    const oy = view.height - pad - ((view.height - 2 * pad - 16) - spanY * scale) / 2;
+    this.map = (p) => [ox + (p[0] - this.low[0]) * scale, oy - (p[1] - this.low[1]) * scale];
+    this.scale = scale;
+    // Stock: rings under even-odd, or the bitmap's material cells.
+    ctx.fillStyle = '#d9dfe5';
+    ctx.strokeStyle = '#5b6670';
+    ctx.lineWidth = 1;
+    const rings = stockRings(this.stock);
+    if (rings.length) {
+      ctx.beginPath();
+      for (const ring of rings) {
+        ring.forEach((p, i) => { const [x, y] = this.map(p); if (i) ctx.lineTo(x, y); else ctx.moveTo(x, y); });
+        ctx.closePath();
+      }
+      ctx.fill('evenodd');
+      ctx.stroke();
+    }
+    const bitmap = this.stock?.bitmap;
+    if (bitmap && bitmap.width * bitmap.height <= 4e6) {
+      const bits = base64Bits(bitmap.data);
+      for (let j = 0; j < bitmap.height; j++) {
+        for (let i = 0; i < bitmap.width; i++) {
+          const bit = j * bitmap.width + i;
+          if (bits[bit >> 3] & (0x80 >> (bit & 7))) {
+            const [x, y] = this.map([bitmap.origin[0] + i * bitmap.cell, bitmap.origin[1] + (j + 1) * bitmap.cell]);
+            ctx.fillRect(x, y, Math.max(1, bitmap.cell * scale), Math.max(1, bitmap.cell * scale));
+          }
+        }
+      }
+    }
+    // Material already removed by earlier cuts.
+    for (const cut of this.stock?.previous_cuts || []) {
+      const points = pathPolyline(cut.path);
+      ctx.save();
+      ctx.strokeStyle = '#fff';
+      ctx.lineCap = 'round';
+      ctx.lineJoin = 'round';
+      ctx.lineWidth = Math.max(1, 2 * cut.radius * scale);
+      ctx.beginPath();
+      points.forEach((p, i) => { const [x, y] = this.map(p); if (i) ctx.lineTo(x, y); else ctx.moveTo(x, y); });
+      ctx.stroke();
+      ctx.restore();
+    }
+    // The path, each stretch coloured by the engaged angle at its end.
+    const samples = this.result.samples;
+    ctx.lineWidth = 3;
+    ctx.lineCap = 'round';
+    for (let i = 1; i < samples.length; i++) {
+      const rapid = (samples[i].flags || []).includes('rapid');
+      ctx.strokeStyle = rapid ? '#9aa5ae' : engagementColour(samples[i].engaged_deg);
+      ctx.setLineDash(rapid ? [4, 4] : []);
+      const [x0, y0] = this.map(samples[i - 1].position);
+      const [x1, y1] = this.map(samples[i].position);
+      ctx.beginPath();
+      ctx.moveTo(x0, y0);
+      ctx.lineTo(x1, y1);
+      ctx.stroke();
+    }
+    ctx.setLineDash([]);
+    if (samples.length) {
+      const [x, y] = this.map(samples[0].position);
+      ctx.fillStyle = '#1d2327';
+      ctx.beginPath();
+      ctx.arc(x, y, 4, 0, 2 * Math.PI);
+      ctx.fill();
+    }
+    // Legend of the colour scale.
+    ctx.font = '12px system-ui, sans-serif';
+    ctx.textBaseline = 'top';
+    let lx = pad;
+    for (const [deg, text] of [[0, 'no contact'], [45, '45°'], [90, '90°'], [135, '135°'], [180, '≥180° engaged']]) {
+      ctx.fillStyle = engagementColour(deg);
+      ctx.fillRect(lx, 4, 14, 10);
+      ctx.fillStyle = '#1d2327';
+      ctx.fillText(text, lx + 17, 3);
+      lx += ctx.measureText(text).width + 30;
+    }
+    this.view = view;
+    this.view.box = { top: 0, bottom: view.height };
+    finish(this.canvas, this.view);
+  }
+
+  // The tool circle at sample `index`, its engaged arcs in red and the travel direction.
+  cursor(index) {
+    const { ctx } = this.view;
+    ctx.putImageData(this.view.image, 0, 0);
+    if (index === undefined) {
+      delete this.canvas.dataset.cursor;
+      return;
+    }
+    this.canvas.dataset.cursor = String(index);
+    const sample = this.result.samples[index];
+    const [cx, cy] = this.map(sample.position);
+    const r = this.radius * this.scale;
+    const heading = sample.heading_deg * Math.PI / 180;
+    const t = [Math.cos(heading), Math.sin(heading)];
+    const right = [t[1], -t[0]];
+    // Tool angle θ → global angle γ = θ + angle of the right-hand normal; canvas y is down.
+    const rightAngle = Math.atan2(right[1], right[0]);
+    ctx.save();
+    ctx.strokeStyle = '#1d2327';
+    ctx.lineWidth = 1.5;
+    ctx.beginPath();
+    ctx.arc(cx, cy, r, 0, 2 * Math.PI);
+    ctx.stroke();
+    ctx.strokeStyle = '#d0021b';
+    ctx.lineWidth = 5;
+    for (const [from, to] of sample.arcs) {
+      ctx.beginPath();
+      ctx.arc(cx, cy, r, -(rightAngle + from * Math.PI / 180), -(rightAngle + to * Math.PI / 180), true);
+      ctx.stroke();
+    }
+    ctx.strokeStyle = '#1d2327';
+    ctx.lineWidth = 2;
+    ctx.beginPath();
+    ctx.moveTo(cx, cy);
+    ctx.lineTo(cx + t[0] * r * 1.3, cy - t[1] * r * 1.3);
+    ctx.stroke();
+    ctx.restore();
+  }
+
+  nearest(event) {
+    const rect = this.canvas.getBoundingClientRect();
+    const mx = event.clientX - rect.left;
+    const my = event.clientY - rect.top;
+    let best = 0;
+    let bestDistance = Infinity;
+    this.result.samples.forEach((s, i) => {
+      const [x, y] = this.map(s.position);
+      const d = (x - mx) ** 2 + (y - my) ** 2;
+      if (d < bestDistance) { bestDistance = d; best = i; }
+    });
+    return bestDistance < 400 ? best : undefined;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Charts over the path (x = s or t), sharing a cursor
+
+function seriesCharts(column, result, answer, axis, onCursor) {
+  const samples = result.samples;
+  const key = axis === 'time' ? 't' : 's';
+  const last = samples[samples.length - 1] || { s: 0, t: 0 };
+  const xRange = [0, Math.max(1e-9, last[key])];
+  const xLabel = axis === 'time' ? `time, s (${result.time_flute_count} flutes)` : 'path length s, mm';
+  const charts = [];
+  const box = (width, height) => ({ left: 54, right: width - 10, top: 20, bottom: height - 34, height });
+
+  const make = (label, height, draw) => {
+    const canvas = document.createElement('canvas');
+    canvas.className = 'chart';
+    canvas.setAttribute('aria-label', label);
+    column.append(canvas);
+    const view = prepare(canvas, height);
+    view.box = box(view.width, view.height);
+    draw(view);
+    finish(canvas, view);
+    const chart = { canvas, view, map: view.map };
+    canvas.addEventListener('pointermove', (event) => {
+      const rect = canvas.getBoundingClientRect();
+      const px = event.clientX - rect.left;
+      if (px < view.box.left || px > view.box.right || !samples.length) return;
+      const v = xRange[0] + (px - view.box.left) / (view.box.right - view.box.left) * (xRange[1] - xRange[0]);
+      onCursor(nearestIndex(samples, key, v));
+    });
+    canvas.addEventListener('pointerleave', () => onCursor(undefined));
+    charts.push(chart);
+    return chart;
+  };
+
+  // Contact-position graph (engagement.md §3.1, 410): engaged arcs at every sample.
+  const back = samples.some((s) => s.arcs.some(([from]) => from < -1e-9));
+  const thetaRange = back ? [-180, 180] : [0, 180];
+  make('Contact position over the path', 300, (view) => {
+    const { ctx } = view;
+    const map = frame(ctx, view.box, [...xRange, ...thetaRange],
+      { title: 'contact θ, ° (90 ahead, 0 right, 180 left)', x: xLabel, yticks: back ? 45 : 30 });
+    view.map = map;
+    ctx.fillStyle = '#0b3d91';
+    // Each sample's arcs span from its x to the next sample's, on whole pixels (no moiré).
+    samples.forEach((sample, i) => {
+      const next = samples[i + 1];
+      const x0 = Math.floor(map.x(sample[key]));
+      const w = Math.max(1, (next ? Math.floor(map.x(next[key])) : x0 + 1) - x0);
+      for (const [from, to] of sample.arcs) {
+        const pieces = to > 180 ? [[from, 180], [-180, to - 360]] : [[from, to]];
+        for (const [a, b] of pieces) {
+          const lo = Math.max(thetaRange[0], a);
+          const hi = Math.min(thetaRange[1], b);
+          if (hi < lo) continue;
+          ctx.fillRect(x0, Math.floor(map.y(hi)), w, Math.max(1, Math.ceil(map.y(lo) - map.y(hi))));
+        }
+      }
+    });
+    if (result.contact_dots && key === 's') {
+      // The dots engine's removed dots (the seed's scatter).
+      ctx.fillStyle = 'rgba(230, 120, 0, 0.35)';
+      for (const [s, theta] of result.contact_dots) ctx.fillRect(Math.floor(map.x(s)), Math.floor(map.y(theta)), 1, 1);
+    }
+  });
+
+  // Radial depth of cut (420).
+  const aeMax = samples.reduce((m, s) => Math.max(m, s.radial_depth), 1e-6);
+  make('Radial depth of cut over the path', 150, (view) => {
+    const { ctx } = view;
+    const map = frame(ctx, view.box, [...xRange, 0, aeMax * 1.08], { title: 'radial depth a_e, mm', x: xLabel });
+    view.map = map;
+    ctx.strokeStyle = '#2e8b57';
+    ctx.lineWidth = 1.5;
+    ctx.beginPath();
+    samples.forEach((s, i) => { if (i) ctx.lineTo(map.x(s[key]), map.y(s.radial_depth)); else ctx.moveTo(map.x(s[key]), map.y(s.radial_depth)); });
+    ctx.stroke();
+  });
+
+  // Summed chip thickness per flute count (430) with T1.
+  const limit = answer.thickness_limit;
+  const hMax = Math.max(1e-6, limit || 0, ...result.flutes.map((f) => f.max_thickness));
+  make('Summed chip thickness per flute count over the path', 240, (view) => {
+    const { ctx } = view;
+    const map = frame(ctx, view.box, [...xRange, 0, hMax * 1.1], { title: 'summed chip thickness H_k, mm', x: xLabel });
+    view.map = map;
+    result.flutes.forEach((flute, k) => {
+      ctx.strokeStyle = kColour(k);
+      ctx.lineWidth = flute.recommended ? 2.2 : 1;
+      ctx.beginPath();
+      samples.forEach((s, i) => {
+        const h = s.thickness[k];
+        if (i) ctx.lineTo(map.x(s[key]), map.y(h)); else ctx.moveTo(map.x(s[key]), map.y(h));
+      });
+      ctx.stroke();
+    });
+    if (limit !== undefined) dashedLine(ctx, view.box.left, map.y(limit), view.box.right, map.y(limit), LIMIT, `T1 = ${limit} mm`);
+    ctx.font = '12px system-ui, sans-serif';
+    ctx.textBaseline = 'top';
+    let lx = view.box.left + 4;
+    result.flutes.forEach((flute, k) => {
+      ctx.fillStyle = kColour(k);
+      const text = `k=${flute.flute_count}${flute.recommended ? '✓' : ''}`;
+      ctx.fillText(text, lx, view.box.top + 3);
+      lx += ctx.measureText(text).width + 8;
+    });
+  });
+
+  // The feed plan's F words along the path.
+  const plan = result.feed_plan;
+  if (plan && plan.blocks.length) {
+    const fMax = Math.max(1, plan.max_feed, ...plan.blocks.map((b) => b.feed || 0));
+    make('Planned feed over the path', 150, (view) => {
+      const { ctx } = view;
+      const map = frame(ctx, view.box, [...xRange, 0, fMax * 1.1],
+        { title: `planned feed F, mm/min (h* ${plan.target_thickness}, k ${plan.flute_count})`, x: xLabel });
+      view.map = map;
+      const toX = (s) => (key === 's' ? map.x(s) : map.x(samples[nearestIndex(samples, 's', s)].t));
+      ctx.strokeStyle = '#8e44ad';
+      ctx.lineWidth = 2;
+      for (const block of plan.blocks) {
+        if (block.feed === undefined) continue;
+        ctx.beginPath();
+        ctx.moveTo(toX(block.from_s), map.y(block.feed));
+        ctx.lineTo(toX(block.to_s), map.y(block.feed));
+        ctx.stroke();
+      }
+      dashedLine(ctx, view.box.left, map.y(plan.max_feed), view.box.right, map.y(plan.max_feed), LIMIT, `max feed ${plan.max_feed}`);
+    });
+  }
+  return {
+    charts,
+    cursor(index) {
+      for (const chart of charts) {
+        cursorLine(chart.view, index === undefined ? undefined : chart.view.map.x(samples[index][key]));
+      }
+    },
+  };
+}
+
+// ---------------------------------------------------------------------------------------------
+// Per flute count: representative values (440) and time (450), recommended k highlighted
+
+function fluteCharts(column, result, answer) {
+  const flutes = result.flutes;
+  const best = result.recommended[0];
+  const row = document.createElement('div');
+  row.className = 'chart-row';
+  column.append(row);
+  const bars = (label, title, values, limit, limitLabel, draw) => {
+    const canvas = document.createElement('canvas');
+    canvas.className = 'chart';
+    canvas.setAttribute('aria-label', label);
+    row.append(canvas);
+    const view = prepare(canvas, 230);
+    view.box = { left: 54, right: view.width - 10, top: 20, bottom: view.height - 34, height: view.height };
+    const top = Math.max(1e-6, limit || 0, ...values) * 1.12;
+    const n = flutes.length;
+    const map = frame(view.ctx, view.box, [-0.5, n - 0.5, 0, top], {
+      title, x: 'flute count k', xticks: 1, xformat: (v) => (v >= 0 && v < n ? String(flutes[Math.round(v)].flute_count) : ''),
+    });
+    draw(view.ctx, map, (i) => map.x(i));
+    if (limit !== undefined) dashedLine(view.ctx, view.box.left, map.y(limit), view.box.right, map.y(limit), LIMIT, limitLabel);
+    finish(canvas, view);
+  };
+  const colour = (f) => (f.recommended ? RECOMMENDED : REJECTED);
+  const markBest = (ctx, x, y, f) => {
+    if (f.flute_count !== best) return;
+    ctx.save();
+    ctx.fillStyle = RECOMMENDED;
+    ctx.font = 'bold 15px system-ui, sans-serif';
+    ctx.textAlign = 'center';
+    ctx.textBaseline = 'bottom';
+    ctx.fillText('★', x, y - 2);
+    ctx.restore();
+  };
+  bars('Chip thickness per flute count', 'H_k per k, mm: max bar, mean ▬, min ▭',
+    flutes.map((f) => f.max_thickness), answer.thickness_limit, answer.thickness_limit !== undefined ? `T1 = ${answer.thickness_limit}` : '',
+    (ctx, map, xc) => {
+      const w = Math.max(6, (map.x(1) - map.x(0)) * 0.6);
+      flutes.forEach((f, i) => {
+        ctx.fillStyle = colour(f);
+        ctx.fillRect(xc(i) - w / 2, map.y(f.max_thickness), w, map.y(0) - map.y(f.max_thickness));
+        ctx.fillStyle = '#1d2327';
+        ctx.fillRect(xc(i) - w / 2, map.y(f.mean_thickness) - 1.5, w, 3);
+        ctx.strokeStyle = '#1d2327';
+        ctx.strokeRect(xc(i) - w / 2, map.y(f.min_thickness) - 1, w, 2);
+        markBest(ctx, xc(i), map.y(f.max_thickness), f);
+      });
+    });
+  bars('Machining time per flute count', 'machining time P_k, s',
+    flutes.map((f) => f.time_s), answer.time_limit_s, answer.time_limit_s !== undefined ? `T2 = ${answer.time_limit_s} s` : '',
+    (ctx, map, xc) => {
+      const w = Math.max(6, (map.x(1) - map.x(0)) * 0.6);
+      flutes.forEach((f, i) => {
+        ctx.fillStyle = colour(f);
+        ctx.fillRect(xc(i) - w / 2, map.y(f.time_s), w, map.y(0) - map.y(f.time_s));
+        markBest(ctx, xc(i), map.y(f.time_s), f);
+      });
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Result renderer (form and Jobs view)
+
+function summaryItem(name, text) {
+  const div = document.createElement('div');
+  div.append(name);
+  const b = document.createElement('b');
+  b.textContent = String(text);
+  div.append(b);
+  return div;
+}
+
+function fluteTable(result) {
+  const table = document.createElement('table');
+  table.className = 'flutes';
+  table.innerHTML = '<thead><tr><th>k</th><th>f_z, mm</th><th>V_f, mm/min</th><th>max H, mm</th><th>mean H</th><th>min H</th><th>median H</th><th>time, s</th><th>teeth at once</th><th>recommended</th></tr></thead>';
+  const body = document.createElement('tbody');
+  for (const f of result.flutes) {
+    const tr = document.createElement('tr');
+    if (f.recommended) tr.className = 'recommended';
+    if (f.flute_count === result.recommended[0]) tr.classList.add('best');
+    for (const text of [f.flute_count, number(f.feed_per_tooth, 4), number(f.feed, 0), number(f.max_thickness, 5),
+      number(f.mean_thickness, 5), number(f.min_thickness, 5), number(f.median_thickness, 5), number(f.time_s, 2),
+      f.max_teeth, f.recommended ? (f.flute_count === result.recommended[0] ? '★ yes (fastest)' : 'yes') : 'no']) {
+      const td = document.createElement('td');
+      td.textContent = String(text);
+      tr.append(td);
+    }
+    body.append(tr);
+  }
+  table.append(body);
+  return table;
+}
+
+function readout(sample, result) {
+  if (!sample) return 'Move over a chart or the path to place the tool.';
+  const arcs = sample.arcs.map(([a, b]) => `[${a.toFixed(1)}°, ${b.toFixed(1)}°]`).join(' ') || 'none';
+  const h = result.flutes.map((f, k) => `k${f.flute_count} ${sample.thickness[k].toFixed(4)}`).join(', ');
+  return `s = ${sample.s.toFixed(3)} mm, t = ${sample.t.toFixed(2)} s, at (${sample.position[0].toFixed(3)}, ${sample.position[1].toFixed(3)}): arcs ${arcs}, Φ = ${sample.engaged_deg.toFixed(1)}°, a_e = ${sample.radial_depth.toFixed(3)} mm; H: ${h}`;
+}
+
+function renderColumn(column, result, answer, axis) {
+  column.replaceChildren();
+  const heading = document.createElement('h3');
+  heading.textContent = result.name || 'path';
+  const rec = result.recommended;
+  const verdict = message(rec.length ? 'ok' : 'warning', rec.length
+    ? `Recommended flute counts: ${rec.join(', ')} (fastest first; ★ = ${rec[0]})`
+    : 'No flute count meets the limits');
+  verdict.classList.add('recommendation');
+  const summary = document.createElement('div');
+  summary.className = 'summary';
+  const items = [
+    ['path length, mm', number(result.path_length, 2)],
+    ['feed length, mm', number(result.feed_length, 2)],
+    ['max engaged Φ, °', `${number(result.max_engaged_deg, 1)} at s ${number(result.max_engaged_at_s, 2)}`],
+    ['max radial depth, mm', number(result.max_radial_depth, 3)],
+    ['engine, step', `${result.engine}, ${result.step} mm`],
+    ['samples', result.samples.length],
+  ];
+  if (result.feed_plan) {
+    const plan = result.feed_plan;
+    items.push(['feed plan time, s', `${number(plan.time_s, 2)} (nominal ${number(plan.nominal_time_s, 2)})`]);
+    items.push(['planned feeds, mm/min', `${plan.feed_range[0]} – ${plan.feed_range[1]}`]);
+  }
+  if (result.max_mrr !== undefined) items.push(['max MRR, mm³/min', number(result.max_mrr, 0)]);
+  summary.replaceChildren(...items.map(([n, t]) => summaryItem(n, t)));
+  const plan = document.createElement('canvas');
+  plan.className = 'chart plan';
+  plan.setAttribute('aria-label', 'Plan view: stock and path coloured by engagement');
+  const info = document.createElement('p');
+  info.className = 'hint cursor-readout';
+  column.append(heading, verdict, summary, plan, info);
+  const planView = new PlanView(plan, result, answer);
+  planView.draw();
+  let series;
+  const setCursor = (index) => {
+    planView.cursor(index);
+    series.cursor(index);
+    info.textContent = readout(index === undefined ? undefined : result.samples[index], result);
+  };
+  series = seriesCharts(column, result, answer, axis, setCursor);
+  plan.addEventListener('pointermove', (event) => setCursor(planView.nearest(event)));
+  plan.addEventListener('pointerleave', () => setCursor(undefined));
+  info.textContent = readout(undefined, result);
+  fluteCharts(column, result, answer);
+  const scroll = document.createElement('div');
+  scroll.className = 'table-scroll';
+  scroll.append(fluteTable(result));
+  column.append(scroll);
+  if (result.warnings.length) {
+    // Warnings folded under their codes, so the columns stay comparable.
+    const details = document.createElement('details');
+    details.className = 'warnings';
+    const counts = new Map();
+    for (const w of result.warnings) counts.set(w.code, (counts.get(w.code) || 0) + 1);
+    const summaryLine = document.createElement('summary');
+    summaryLine.textContent = `Warnings: ${[...counts].map(([code, n]) => (n > 1 ? `${code} ×${n}` : code)).join(', ')}`;
+    details.append(summaryLine, ...result.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
+    column.append(details);
+  }
+  column.cursor = setCursor;
+}
+
+// Shows an engagement answer in `container`: one column per candidate path, side by side.
+// Used by the form and by job results.
+export function engagementResult(container, answer) {
+  container.replaceChildren();
+  const candidates = answer.candidates || [answer];
+  const controls = document.createElement('div');
+  controls.className = 'actions';
+  const axis = document.createElement('select');
+  axis.setAttribute('aria-label', 'x axis');
+  axis.append(new Option('x axis: path length', 'length'), new Option('x axis: time', 'time'));
+  controls.append(axis);
+  const columns = document.createElement('div');
+  columns.className = 'candidates';
+  columns.style.gridTemplateColumns = `repeat(${candidates.length}, minmax(320px, 1fr))`;
+  container.append(controls, columns);
+  const cells = candidates.map(() => {
+    const column = document.createElement('div');
+    column.className = 'candidate';
+    columns.append(column);
+    return column;
+  });
+  const render = () => candidates.forEach((result, i) => renderColumn(cells[i], result, answer, axis.value));
+  axis.addEventListener('change', render);
+  render();
+  return cells;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+export const engagementView = {
+  id: 'engagement',
+  title: 'Engagement',
+  mount(root) {
+    root.innerHTML = FORM;
+    const form = root.querySelector('#engagement-form');
+    const messages = root.querySelector('#engagement-messages');
+    const result = root.querySelector('#engagement-result');
+    for (const sample of SAMPLE_PATHS) addPath(form, sample.name, sample.text);
+    root.querySelector('#engagement-add-path').addEventListener('click', () => addPath(form, `path ${pathBoxes(form).length + 1}`, ''));
+    form.addEventListener('change', () => syncVisibility(form));
+    loadTools(form.elements.tool_choice).then(() => syncVisibility(form));
+    syncVisibility(form);
+    const fail = (problem) => {
+      showProblem(messages, form, problem);
+      markFields(form, problem);
+    };
+    const fillCandidates = () => {
+      const select = form.elements.candidate;
+      const previous = select.value;
+      select.replaceChildren(...pathBoxes(form).map((box, i) => new Option(`path ${i}: ${box.querySelector('input').value || 'unnamed'}`, String(i))));
+      if (previous && Number(previous) < select.options.length) select.value = previous;
+    };
+    fillCandidates();
+    form.addEventListener('input', fillCandidates);
+    form.addEventListener('submit', async (event) => {
+      event.preventDefault();
+      form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+      fillCandidates();
+      try {
+        const body = engagementRequest(form);
+        messages.replaceChildren(message('warning', 'computing…'));
+        const answer = await api('POST', '/api/v1/engagement', body);
+        messages.replaceChildren();
+        engagementResult(result, answer);
+        result.dataset.state = 'drawn';
+      } catch (problem) {
+        result.replaceChildren();
+        fail(problem);
+      }
+    });
+    root.querySelector('#engagement-gcode').addEventListener('click', async () => {
+      form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+      const candidate = value(form, 'candidate') || '0';
+      const query = `?format=gcode&dialect=${value(form, 'dialect')}&reference=${value(form, 'reference')}&candidate=${candidate}`;
+      try {
+        const program = await api('POST', `/api/v1/engagement${query}`, engagementRequest(form), 'text/x-gcode');
+        download(`engagement-${candidate}-${value(form, 'dialect')}.nc`, program);
+        messages.replaceChildren();
+      } catch (problem) {
+        fail(problem);
+      }
+    });
+  },
+};
