@@ -64,7 +64,8 @@ pub struct EngagementSample {
     pub position: [f64; 2],
     /// Direction of travel, degrees from +X (counter-clockwise).
     pub heading_deg: f64,
-    /// Index of the path segment (for a point list, the segment from point `segment`).
+    /// Index of the path segment (for a point list, the segment from point `segment`; for a
+    /// G-code path, the program line of the move).
     pub segment: usize,
     /// Engaged arcs `[[from_deg, to_deg], ...]`, tool angle of engagement.md §4.1 (90° ahead,
     /// 0° right, 180° left of travel); from in [−180, 180), to in (from, from + 360], sorted.

@@ -30,8 +30,8 @@
 //! `W_NO_CONTACT` (§9). The exact engine splits the circle at its exact boundary crossings
 //! instead of stepping θ, so it has no angle step and its arc ends are exact.
 //!
-//! G-code text as a path input is not built yet: [`PathInput`]'s map form is a struct whose
-//! fields are all optional, so a `gcode` field can be added next to `start`/`segments`.
+//! A path may also be G-code text (`{"gcode": "..."}`), read by the shared
+//! [`crate::gcode::reader`]: its XY moves, lines and arcs, from the first known position on.
 
 mod answer;
 mod arcs;

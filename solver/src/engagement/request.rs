@@ -16,6 +16,7 @@ use super::{
     MAX_GRID_DOTS, MAX_SAMPLES, MAX_SEGMENTS, MAX_STOCK_VERTICES, P2,
 };
 use crate::error::{SolverError, Warning, finite, non_negative, positive};
+use crate::gcode::reader::{MoveKind, Plane, ReadOptions, read as read_program};
 use crate::planar::signed_area;
 use crate::tool::{Tool, ToolRef};
 
@@ -59,17 +60,22 @@ pub enum SegmentInput {
     },
 }
 
-/// A path given as a start point and line/arc segments.
+/// A path given as a start point and line/arc segments, or as G-code text.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(deny_unknown_fields)]
 pub struct PathSegments {
-    /// Start point of the tool centre [x, y], mm (required).
+    /// Start point of the tool centre [x, y], mm (required with `segments`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub start: Option<[f64; 2]>,
-    /// The moves in order (required, at least one of non-zero length).
+    /// The moves in order (at least one of non-zero length).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub segments: Option<Vec<SegmentInput>>,
+    /// The path as a G-code program instead of `start`/`segments` (G0/G1/G2/G3 in G17, G20/G21,
+    /// G90/G91): its XY moves from the first fully known position on; Z moves and F words do not
+    /// matter here (the feed is the request's). Errors name the line.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gcode: Option<String>,
 }
 
 /// A tool-centre path in the plane of the stock: a list of points joined by feed moves
@@ -500,6 +506,13 @@ pub(crate) fn read_path(input: &PathInput, field: &str, warnings: &mut Vec<Warni
                 previous = Some(here);
             }
         }
+        PathInput::Segments(PathSegments { gcode: Some(text), start, segments }) => {
+            if start.is_some() || segments.is_some() {
+                return Err(SolverError::new("E_PATH", "give the path as gcode or as start and segments, not both")
+                    .at(format!("{field}.gcode")));
+            }
+            read_gcode_path(text, &format!("{field}.gcode"), &mut shapes, &mut dropped)?;
+        }
         PathInput::Segments(program) => {
             let start = program.start.ok_or_else(|| {
                 SolverError::new("E_PATH", "the path needs a start point [x, y]").at(format!("{field}.start"))
@@ -528,31 +541,11 @@ pub(crate) fn read_path(input: &PathInput, field: &str, warnings: &mut Vec<Warni
                     SegmentInput::Arc { to, center, dir } => {
                         let to = point(&format!("{here}.to"), *to)?;
                         let centre = point(&format!("{here}.center"), *center)?;
-                        let (r0, r1) = ((from - centre).norm(), (to - centre).norm());
-                        if r0 <= 1e-9 {
-                            return Err(SolverError::new("E_PATH", "the arc centre coincides with its start point")
-                                .at(format!("{here}.center")));
-                        }
-                        if (r0 - r1).abs() > 1e-6 * r0.max(r1) {
-                            return Err(SolverError::new(
-                                "E_PATH",
-                                format!(
-                                    "the arc centre is {r0:.6} mm from the start point but {r1:.6} mm from the end point"
-                                ),
-                            )
-                            .at(format!("{here}.center")));
-                        }
-                        let start_angle = (from.y - centre.y).atan2(from.x - centre.x);
-                        let end_angle = (to.y - centre.y).atan2(to.x - centre.x);
-                        let turn = std::f64::consts::TAU;
-                        let full = (to - from).norm() <= 1e-9 * r0.max(1.0);
-                        let sweep = match (dir, full) {
-                            (_, true) => turn,
-                            (ArcDirection::Ccw, false) => (end_angle - start_angle).rem_euclid(turn),
-                            (ArcDirection::Cw, false) => (start_angle - end_angle).rem_euclid(turn),
-                        };
-                        let sweep = if *dir == ArcDirection::Cw { -sweep } else { sweep };
-                        shapes.push((Shape::Arc { centre, radius: r0, start: start_angle, sweep }, false, index));
+                        shapes.push((
+                            arc_shape(from, to, centre, *dir == ArcDirection::Cw, 0, &format!("{here}.center"))?,
+                            false,
+                            index,
+                        ));
                         from = to;
                     }
                 }
@@ -571,6 +564,80 @@ pub(crate) fn read_path(input: &PathInput, field: &str, warnings: &mut Vec<Warni
         ));
     }
     Ok(Route::new(shapes))
+}
+
+/// The arc from `from` to `to` about `centre` (a full turn when they coincide), plus
+/// `extra_turns`; refused when the centre is not equidistant from both ends.
+fn arc_shape(
+    from: P2,
+    to: P2,
+    centre: P2,
+    clockwise: bool,
+    extra_turns: u32,
+    field: &str,
+) -> Result<Shape, SolverError> {
+    let (r0, r1) = ((from - centre).norm(), (to - centre).norm());
+    if r0 <= 1e-9 {
+        return Err(SolverError::new("E_PATH", "the arc centre coincides with its start point").at(field));
+    }
+    if (r0 - r1).abs() > 1e-6 * r0.max(r1) {
+        return Err(SolverError::new(
+            "E_PATH",
+            format!("the arc centre is {r0:.6} mm from the start point but {r1:.6} mm from the end point"),
+        )
+        .at(field));
+    }
+    let start_angle = (from.y - centre.y).atan2(from.x - centre.x);
+    let end_angle = (to.y - centre.y).atan2(to.x - centre.x);
+    let turn = std::f64::consts::TAU;
+    let full = (to - from).norm() <= 1e-9 * r0.max(1.0);
+    let sweep = match (clockwise, full) {
+        (_, true) => turn,
+        (false, false) => (end_angle - start_angle).rem_euclid(turn),
+        (true, false) => (start_angle - end_angle).rem_euclid(turn),
+    } + turn * f64::from(extra_turns);
+    let sweep = if clockwise { -sweep } else { sweep };
+    Ok(Shape::Arc { centre, radius: r0, start: start_angle, sweep })
+}
+
+/// The XY moves of a G-code program (read by the shared reader) as path pieces, each numbered by
+/// its program line (the samples' `segment`). Moves before the first fully known XY position are
+/// skipped (the tool's position is unknown there); pure Z moves have no length in the plane and
+/// are dropped like other zero-length segments.
+fn read_gcode_path(
+    text: &str,
+    field: &str,
+    shapes: &mut Vec<(Shape, bool, usize)>,
+    dropped: &mut Vec<String>,
+) -> Result<(), SolverError> {
+    let program = read_program(text, field, &ReadOptions { max_lines: MAX_SEGMENTS, ..ReadOptions::default() })?;
+    for step in &program.moves {
+        let (Some(fx), Some(fy), Some(tx), Some(ty)) = (step.from[0], step.from[1], step.to[0], step.to[1]) else {
+            continue;
+        };
+        let (from, to) = (P2::new(fx, fy), P2::new(tx, ty));
+        let here = format!("{field} (line {})", step.line);
+        let (shape, rapid) = match step.kind {
+            MoveKind::Rapid => (Shape::Line { from, to }, true),
+            MoveKind::Linear => (Shape::Line { from, to }, false),
+            MoveKind::Arc { centre, clockwise, extra_turns } => {
+                if step.modal.plane != Plane::Xy {
+                    return Err(SolverError::new(
+                        "E_PATH",
+                        format!("line {}: arcs must be in the XY plane (G17) for an engagement path", step.line),
+                    )
+                    .at(field));
+                }
+                (arc_shape(from, to, P2::new(centre[0], centre[1]), clockwise, extra_turns, field)?, false)
+            }
+        };
+        if shape.length() <= 1e-9 {
+            dropped.push(here);
+        } else {
+            shapes.push((shape, rapid, step.line));
+        }
+    }
+    Ok(())
 }
 
 /// A ring of distinct points (closing repeat and consecutive duplicates removed).

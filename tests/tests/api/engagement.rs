@@ -838,3 +838,20 @@ async fn bad_engagement_requests() {
     assert_eq!(json_with(app.get("/api/v1/tools").await, 200).await, tools_before, "tools unchanged");
     assert_eq!(json_with(app.get("/api/v1/jobs").await, 200).await, jobs_before, "no job created");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn path_given_as_gcode_text() {
+    let app = kerf_tests::TestApp::spawn().await;
+    let mut body = serde_json::json!({
+        "tool": {"kind": "flat", "radius": 5}, "stock": {"polygon": [[0, 0], [60, 0], [60, 40], [0, 40]]},
+        "path": {"gcode": "G21 G90 G17\nG0 X-10 Y20\nG1 X70 F600\nM30\n"},
+        "spindle_rpm": 3000, "feed_per_tooth": 0.05, "flute_counts": [2, 4]});
+    let answer = kerf_tests::json_with(app.post_json("/api/v1/engagement", &body).await, 200).await;
+    let straight = answer["samples"].as_array().unwrap();
+    assert!(straight.iter().any(|s| s["engaged_deg"].as_f64().unwrap() > 179.0), "a full slot through the block");
+    assert!(straight.iter().all(|s| s["segment"] == 3), "samples name the program line");
+    body["path"] = serde_json::json!({"gcode": "G21 G90\nG0 X-10 Y20\nG1 X70 Y# F600\n"});
+    let problem = kerf_tests::problem(app.post_json("/api/v1/engagement", &body).await, 422).await;
+    assert_eq!(problem["errors"][0]["path"], "path.gcode");
+    assert!(problem["detail"].as_str().unwrap().contains("line 3"), "{problem}");
+}
