@@ -4,10 +4,11 @@ import { deburrView } from '/views/deburr.js';
 import { engagementView } from '/views/engagement.js';
 import { jobsView } from '/views/jobs.js';
 import { machinesView } from '/views/machines.js';
+import { predictView } from '/views/predict.js';
 import { segmentView } from '/views/segment.js';
 import { toolsView } from '/views/tools.js';
 
-const views = [deburrView, segmentView, contourView, engagementView, jobsView, toolsView, machinesView];
+const views = [deburrView, segmentView, contourView, engagementView, predictView, jobsView, toolsView, machinesView];
 
 // The API token (KERF_API_TOKEN), kept in this browser once entered.
 function token() {

@@ -44,7 +44,8 @@ export class Plot3D {
     this.panY = 0;
   }
 
-  // series: [{label, points: [[x, y, z], ...], colour, width, dash, marks}]
+  // series: [{label, points: [[x, y, z], ...], colour, width, dash, marks, colours}]; with
+  // `colours` (one per point) each segment and mark takes the colour of the point it ends at.
   setSeries(series) {
     this.series = series;
     const all = series.flatMap((s) => s.points);
@@ -118,17 +119,34 @@ export class Plot3D {
       g.fillStyle = s.colour;
       g.lineWidth = s.width || 1.5;
       g.setLineDash(s.dash || []);
-      g.beginPath();
-      s.points.forEach((p, i) => {
-        const [sx, sy] = this.project(p);
-        if (i === 0) g.moveTo(sx, sy); else { g.lineTo(sx, sy); segments++; }
-      });
-      g.stroke();
-      if (s.marks) {
-        for (const p of s.points) {
+      if (s.colours) {
+        let last = null;
+        s.points.forEach((p, i) => {
+          const at = this.project(p);
+          if (last) {
+            g.strokeStyle = s.colours[i];
+            g.beginPath();
+            g.moveTo(last[0], last[1]);
+            g.lineTo(at[0], at[1]);
+            g.stroke();
+            segments++;
+          }
+          last = at;
+        });
+      } else {
+        g.beginPath();
+        s.points.forEach((p, i) => {
           const [sx, sy] = this.project(p);
+          if (i === 0) g.moveTo(sx, sy); else { g.lineTo(sx, sy); segments++; }
+        });
+        g.stroke();
+      }
+      if (s.marks) {
+        s.points.forEach((p, i) => {
+          const [sx, sy] = this.project(p);
+          if (s.colours) g.fillStyle = s.colours[i];
           g.fillRect(sx - 1.5, sy - 1.5, 3, 3);
-        }
+        });
       }
     }
     g.setLineDash([]);

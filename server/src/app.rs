@@ -44,6 +44,7 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
         .merge(http::deburr::router())
         .merge(http::contour::router())
         .merge(http::engagement::router())
+        .merge(http::predict::router())
         .merge(http::jobs::router())
         .merge(http::machines::router())
         .merge(http::segment::router())

@@ -61,6 +61,9 @@ pub struct ServeArgs {
     /// Largest accepted request body, bytes.
     #[arg(long, env = "KERF_MAX_BODY_BYTES", default_value_t = Limits::default().max_body_bytes)]
     pub max_body_bytes: usize,
+    /// Largest accepted body of upload routes (`POST /api/v1/predict`: STL stock, long programs), bytes.
+    #[arg(long, env = "KERF_MAX_UPLOAD_BYTES", default_value_t = Limits::default().max_upload_bytes)]
+    pub max_upload_bytes: usize,
     /// Longest synchronous solver call, seconds, before the client is told to submit a job.
     #[arg(long, env = "KERF_SOLVER_TIME_LIMIT_S", default_value_t = Limits::default().solver_time_limit.as_secs())]
     pub solver_time_limit_s: u64,
@@ -86,6 +89,7 @@ impl ServeArgs {
             database: self.database.clone(),
             limits: Limits {
                 max_body_bytes: self.max_body_bytes,
+                max_upload_bytes: self.max_upload_bytes,
                 solver_time_limit: Duration::from_secs(self.solver_time_limit_s.max(1)),
                 ..Limits::default()
             },

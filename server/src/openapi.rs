@@ -20,7 +20,8 @@ use utoipa::OpenApi;
         (name = "segment", description = "Line-segment approximation with the chord error from the block processing time (chord.md)"),
         (name = "contour", description = "Layered contour milling with corner loops and inside-corner relief (corners.md)"),
         (name = "engagement", description = "Tool–workpiece engagement along a path, chip thickness per flute count and \
-                                              the recommended flute counts (engagement.md)")
+                                              the recommended flute counts (engagement.md)"),
+        (name = "predict", description = "Machining-error prediction and path correction for ball-end-mill finishing (error-prediction.md)")
     )
 )]
 pub struct ApiDoc;

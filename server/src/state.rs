@@ -16,6 +16,9 @@ use crate::jobs::queue::JobRunner;
 pub struct Limits {
     /// Largest accepted request body, bytes.
     pub max_body_bytes: usize,
+    /// Largest body of the routes that take file uploads (`POST /api/v1/predict` with its STL
+    /// stock or a long G-code program), bytes.
+    pub max_upload_bytes: usize,
     /// Longest a synchronous solver call may run before the client is told to submit a job.
     pub solver_time_limit: Duration,
     /// How long a request waits for a free solver slot before it gets 429.
@@ -26,6 +29,7 @@ impl Default for Limits {
     fn default() -> Self {
         Self {
             max_body_bytes: 8 * 1024 * 1024,
+            max_upload_bytes: 128 * 1024 * 1024,
             solver_time_limit: Duration::from_secs(30),
             solver_queue_wait: Duration::from_secs(5),
         }

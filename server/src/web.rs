@@ -36,6 +36,7 @@ const ASSETS: &[Asset] = &[
     asset!("/views/jobs.js", JS),
     asset!("/views/machines.js", JS),
     asset!("/views/segment.js", JS),
+    asset!("/views/predict.js", JS),
     asset!("/views/tools.js", JS),
 ];
 

@@ -231,6 +231,52 @@ const scenarios = {
     return { columns, charts: states.length, inked, cursor, recommendation, feeds: feeds.size, file: download.suggestedFilename() };
   },
 
+  // Predict page: runs the sample raster over the dome, checks the path coloured by error (several
+  // colours), the colour scale, the histogram, the worst passes with NC lines, the download of the
+  // corrected program, and a G-code error with its line.
+  async predict() {
+    await page.goto(`${base}/#predict`);
+    await page.click('#predict-compute');
+    await page.waitForSelector('#predict-plot[data-state="drawn"]', { timeout: 30000 });
+    await page.waitForSelector('#predict-histogram[data-state="drawn"]', { timeout: 5000 });
+    const segments = Number(await page.getAttribute('#predict-plot', 'data-segments'));
+    const inked = await inkedPixels('#predict-plot');
+    const histogram = await inkedPixels('#predict-histogram');
+    const scale = await inkedPixels('#predict-result canvas.scale');
+    const colours = await page.$eval('#predict-plot', (canvas) => {
+      const data = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
+      const seen = new Set();
+      for (let i = 0; i < data.length; i += 4) {
+        const [r, g, b] = [data[i], data[i + 1], data[i + 2]];
+        if (Math.max(r, g, b) - Math.min(r, g, b) > 60) seen.add(`${r >> 5},${g >> 5},${b >> 5}`);
+      }
+      return seen.size;
+    });
+    const lines = await page.$$eval('#predict-result table.worst tr[data-line]', (rows) => rows.map((r) => Number(r.dataset.line)));
+    const summary = await page.textContent('#predict-result .summary');
+    if (segments < 100) throw new Error(`only ${segments} segments drawn`);
+    if (inked < 1000) throw new Error(`plot nearly blank: ${inked} inked pixels`);
+    if (histogram < 500 || scale < 500) throw new Error(`histogram ${histogram}, scale ${scale} inked pixels`);
+    if (colours < 4) throw new Error(`the path is not coloured by error: ${colours} colours`);
+    if (lines.length < 10 || !lines.every((l) => l > 6)) throw new Error(`worst passes: ${lines}`);
+    if (!/441 of 441 predicted/.test(summary)) throw new Error(`summary: ${summary}`);
+
+    // The corrected program downloads with the input's lines.
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('#predict-gcode')]);
+    const program = await (await import('node:fs/promises')).readFile(await download.path(), 'utf8');
+    if (!program.includes('M30') || !program.includes('O3100')) throw new Error(`corrected program: ${program.slice(0, 200)}`);
+
+    // A G-code error names its line and marks the program.
+    await page.fill('textarea[name="program"]', 'G21 G90\nG0 X0 Y0 Z5\nG1 Z0 F500 Q1\nM30\n');
+    await page.click('#predict-compute');
+    await page.waitForSelector('#predict-messages .message.error', { timeout: 15000 });
+    const error = await page.textContent('#predict-messages .message.error');
+    if (!/line 3/.test(error)) throw new Error(`error without its line: ${error}`);
+    const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
+    if (!highlighted.includes('program')) throw new Error(`program not highlighted: ${highlighted}`);
+    return { segments, inked, histogram, colours, worst: lines.length, programLines: program.split('\n').length };
+  },
+
   // Uploads a job file on the Jobs page, waits for it to finish, opens it, and checks each
   // operation's plot.
   async jobs() {

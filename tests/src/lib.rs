@@ -238,7 +238,9 @@ fn rs274_tool_table() -> String {
 
 /// Runs `program` through LinuxCNC's `rs274` (writing it to `folder/name.ngc`), asserts that the
 /// interpreter accepts it to its end without complaint, and returns its canonical moves:
-/// (is a feed move, end point). `None` when `rs274` is missing (see [`external_program`]).
+/// (is a feed move, end point). Arcs (`ARC_FEED`) count as feed moves to their end point, in the
+/// plane the program selected. Coordinates are in the program's units. `None` when `rs274` is
+/// missing (see [`external_program`]).
 pub fn rs274_moves(program: &str, folder: &Path, name: &str) -> Option<Vec<(bool, [f64; 3])>> {
     let rs274 = external_program("rs274", "the LinuxCNC G-code check")?;
     let file = folder.join(format!("{name}.ngc"));
@@ -264,17 +266,36 @@ pub fn rs274_moves(program: &str, folder: &Path, name: &str) -> Option<Vec<(bool
     assert!(complaints.is_empty(), "rs274 complained about {name}: {complaints:?}");
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(stdout.contains("PROGRAM_END"), "{name} runs to its end");
+    // Axis indices (first, second, normal) of ARC_FEED's end point in the selected plane.
+    let mut plane = [0, 1, 2];
     Some(
         stdout
             .lines()
             .filter_map(|line| {
+                if line.contains("SELECT_PLANE(") {
+                    plane = if line.contains("CANON_PLANE_XZ") {
+                        [2, 0, 1]
+                    } else if line.contains("CANON_PLANE_YZ") {
+                        [1, 2, 0]
+                    } else {
+                        [0, 1, 2]
+                    };
+                    return None;
+                }
+                let inside = line.split('(').nth(1)?.split(')').next()?;
+                let numbers: Vec<f64> = inside.split(',').take(6).filter_map(|n| n.trim().parse().ok()).collect();
+                if line.contains("ARC_FEED(") && numbers.len() == 6 {
+                    let mut end = [0.0; 3];
+                    end[plane[0]] = numbers[0];
+                    end[plane[1]] = numbers[1];
+                    end[plane[2]] = numbers[5];
+                    return Some((true, end));
+                }
                 let feed = line.contains("STRAIGHT_FEED(");
                 if !feed && !line.contains("STRAIGHT_TRAVERSE(") {
                     return None;
                 }
-                let inside = line.split('(').nth(1)?.split(')').next()?;
-                let numbers: Vec<f64> = inside.split(',').take(3).filter_map(|n| n.trim().parse().ok()).collect();
-                (numbers.len() == 3).then(|| (feed, [numbers[0], numbers[1], numbers[2]]))
+                (numbers.len() >= 3).then(|| (feed, [numbers[0], numbers[1], numbers[2]]))
             })
             .collect(),
     )

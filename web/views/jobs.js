@@ -4,10 +4,13 @@ import { api, download, message, showProblem } from '/app.js';
 import { contourResult } from '/views/contour.js';
 import { deburrResult } from '/views/deburr.js';
 import { engagementResult } from '/views/engagement.js';
+import { predictResult } from '/views/predict.js';
 import { segmentResult } from '/views/segment.js';
 
 // How each operation's result is shown; later capabilities add theirs here.
-const resultViews = { deburr: deburrResult, segment: segmentResult, contour: contourResult, engagement: engagementResult };
+const resultViews = {
+  deburr: deburrResult, segment: segmentResult, contour: contourResult, engagement: engagementResult, predict: predictResult,
+};
 
 const LAYOUT = `
 <section>

@@ -7,5 +7,6 @@ pub mod health;
 pub mod jobs;
 pub mod machines;
 pub mod output;
+pub mod predict;
 pub mod segment;
 pub mod tools;

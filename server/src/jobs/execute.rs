@@ -3,9 +3,11 @@
 //! server's workers and in `kerf run`.
 
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Mutex, PoisonError};
 
 use kerf_solver::SolverError;
 use kerf_solver::chord::MachineProfile;
+use kerf_solver::predict::Control;
 use kerf_solver::tool::{Tool, ToolRef};
 use serde::Serialize;
 use utoipa::ToSchema;
@@ -85,10 +87,11 @@ fn resolved_machine(job: &JobFile, index: usize, name: Option<&str>) -> Result<O
     })
 }
 
-/// Runs `job` (already resolved: tools inline). `progress` receives the fraction done (0–1).
+/// Runs `job` (already resolved: tools inline). `progress` receives the fraction done (0–1),
+/// also within long operations (from their worker threads).
 pub fn execute(
     job: &JobFile,
-    progress: &dyn Fn(f64),
+    progress: &(dyn Fn(f64) + Sync),
     cancelled: &AtomicBool,
 ) -> Result<Vec<OperationOutput>, JobFailure> {
     let count = job.operations.len();
@@ -126,6 +129,27 @@ pub fn execute(
                 let answer = http::engagement::run(request, tool).map_err(|e| refused(index, &e))?;
                 // One program per operation: the first path's.
                 let program = http::engagement::program(&answer, 0, job.output.dialect, job.output.reference);
+                output(index, operation, &answer, program)?
+            }
+            Operation::Predict(request) => {
+                let tool = resolved_tool(index, &request.tool)?;
+                // The solver reports from its worker threads, not always in order: pass on
+                // increases only, scaled into this operation's share of the job.
+                let reached = Mutex::new(0.0_f64);
+                let within = |fraction: f64| {
+                    let mut reached = reached.lock().unwrap_or_else(PoisonError::into_inner);
+                    if fraction > *reached {
+                        *reached = fraction;
+                        progress((index as f64 + fraction) / count as f64);
+                    }
+                };
+                let control = Control { progress: Some(&within), cancel: Some(cancelled) };
+                let answer = match http::predict::run(request, tool, None, &control) {
+                    Ok(answer) => answer,
+                    Err(error) if error.code() == "E_CANCELLED" => return Err(JobFailure::Cancelled),
+                    Err(error) => return Err(refused(index, &error)),
+                };
+                let program = http::predict::job_program(request, &answer, job.output.dialect, job.output.reference);
                 output(index, operation, &answer, program)?
             }
         };

@@ -28,6 +28,7 @@ use kerf_solver::corners::ContourRequest;
 use kerf_solver::deburr::DeburrRequest;
 use kerf_solver::engagement::EngagementRequest;
 use kerf_solver::gcode::{Dialect, Reference};
+use kerf_solver::predict::{PredictRequest, Stock};
 use kerf_solver::tool::{Tool, ToolRef};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -89,6 +90,8 @@ pub enum Operation {
     Contour(ContourRequest),
     /// `POST /api/v1/engagement`; the job's program is that of `path` (or `paths[0]`).
     Engagement(EngagementRequest),
+    /// `POST /api/v1/predict` (a job file cannot carry an STL file: no `mesh` stock).
+    Predict(PredictRequest),
 }
 
 /// The names `operation` may take.
@@ -99,6 +102,7 @@ enum OperationKind {
     Segment,
     Contour,
     Engagement,
+    Predict,
 }
 
 impl OperationKind {
@@ -109,6 +113,7 @@ impl OperationKind {
             Self::Segment => SegmentRequest::deserialize(fields).map(Operation::Segment),
             Self::Contour => ContourRequest::deserialize(fields).map(Operation::Contour),
             Self::Engagement => EngagementRequest::deserialize(fields).map(Operation::Engagement),
+            Self::Predict => PredictRequest::deserialize(fields).map(Operation::Predict),
         }
     }
 }
@@ -160,6 +165,7 @@ impl Operation {
             Self::Segment(_) => "segment",
             Self::Contour(_) => "contour",
             Self::Engagement(_) => "engagement",
+            Self::Predict(_) => "predict",
         }
     }
 
@@ -170,6 +176,7 @@ impl Operation {
             Self::Segment(request) => request.tool.as_mut(),
             Self::Contour(request) => Some(&mut request.tool),
             Self::Engagement(request) => Some(&mut request.tool),
+            Self::Predict(request) => Some(&mut request.tool),
         }
     }
 
@@ -178,7 +185,7 @@ impl Operation {
         match self {
             Self::Deburr(request) => request.machine.as_deref(),
             Self::Segment(request) => request.machine.as_deref(),
-            Self::Contour(_) | Self::Engagement(_) => None,
+            Self::Contour(_) | Self::Engagement(_) | Self::Predict(_) => None,
         }
     }
 }
@@ -339,6 +346,18 @@ fn check(job: &JobFile) -> AppResult<()> {
         tool.validate(&format!("{field}."))?;
         if job.tools[..index].iter().any(|t| t.number == Some(number)) {
             return Err(file_error(&format!("{field}.number"), None, &format!("tool {number} is defined twice")));
+        }
+    }
+    for (index, operation) in job.operations.iter().enumerate() {
+        if let Operation::Predict(request) = operation
+            && matches!(request.stock, Stock::Mesh {})
+        {
+            return Err(file_error(
+                &format!("operations[{index}].stock.kind"),
+                None,
+                "a job file cannot carry the STL file of a mesh stock: use a box, plane, cylinder or height grid \
+                 stock, or send the request to POST /api/v1/predict as multipart/form-data",
+            ));
         }
     }
     check_machines(&job.machines)

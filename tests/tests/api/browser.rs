@@ -92,3 +92,21 @@ async fn jobs_page_shows_an_engagement_job() {
     assert_eq!(result["ok"], true);
     assert!(result["plots"].as_u64().unwrap() >= 3 * 7, "every chart of the three paths: {result}");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn predict_page_colours_the_path_by_error() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "predict", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["colours"].as_u64().unwrap() >= 4, "{result}");
+    assert_eq!(result["worst"], 20, "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn jobs_page_shows_a_prediction_job() {
+    let app = TestApp::spawn().await;
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/predict-raster.toml");
+    let Some(result) = run_scenario(&app, "jobs", &[example.to_str().unwrap()]) else { return };
+    assert_eq!(result["ok"], true);
+    assert_eq!(result["plots"], 3, "path, colour scale and histogram: {result}");
+}

@@ -44,6 +44,7 @@ fn runs_each_example_locally() {
                         .iter()
                         .all(|c| c["samples"].as_array().unwrap().len() > 100)
                 ),
+                "predict" => assert!(result["passes"].as_array().unwrap().len() > 8),
                 _ => assert!(result.as_object().is_some_and(|o| !o.is_empty())),
             }
             let program = std::fs::read_to_string(out.path().join(format!("{index:02}-{name}.nc"))).unwrap();

@@ -15,5 +15,6 @@ mod limits;
 mod load;
 mod machines;
 mod openapi;
+mod predict;
 mod segment;
 mod tools;

@@ -16,6 +16,7 @@ async fn document_covers_every_route_and_docs_are_served() {
         "/api/v1/deburr",
         "/api/v1/contour",
         "/api/v1/contour/loops",
+        "/api/v1/predict",
     ] {
         assert!(paths.contains_key(path), "{path} documented");
     }

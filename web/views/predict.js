@@ -1,0 +1,521 @@
+// Predict view: machining-error prediction and path correction for ball-end-mill finishing
+// (api.md, Error prediction). A form (tool with its shape-error table and stiffness, stock, the
+// G-code program, cutting conditions, method), the path coloured by predicted error with a colour
+// scale, a histogram of the errors, the worst passes with their NC lines, warnings, and the
+// corrected program. `predictResult` also shows prediction jobs.
+import { api, download, message, number, showProblem } from '/app.js';
+import { Plot3D } from '/plot3d.js';
+
+// The sample: a raster finishing program over a gentle dome (20 × 20 mm, 2 mm high) with an R3
+// ball, and the dome plus a 0.2 mm allowance as a height grid (as examples/predict-raster.toml).
+const SAMPLE = { radius: 3, size: 20, pick: 1, step: 1, allowance: 0.2 };
+
+function dome(x, y) {
+  const k = Math.PI / SAMPLE.size;
+  const a = 2;
+  const z = a * Math.sin(k * x) * Math.sin(k * y);
+  const dx = a * k * Math.cos(k * x) * Math.sin(k * y);
+  const dy = a * k * Math.sin(k * x) * Math.cos(k * y);
+  const l = Math.hypot(dx, dy, 1);
+  return { z, n: [-dx / l, -dy / l, 1 / l] };
+}
+
+function mm(v) {
+  const text = v.toFixed(4);
+  return text === '-0.0000' ? '0.0000' : text;
+}
+
+export function sampleProgram() {
+  const { radius: r, size, pick, step } = SAMPLE;
+  const lines = Math.round(size / pick) + 1;
+  const points = Math.round(size / step) + 1;
+  const out = ['%', 'O3100 (DOME RASTER FINISHING R3 BALL)', 'G21 G90 G17 G40 G49 G80 G94', 'T3 M06', 'G00 G43 H3 Z20.', 'S8000 M03'];
+  for (let j = 0; j < lines; j++) {
+    for (let k = 0; k < points; k++) {
+      const i = j % 2 === 0 ? k : points - 1 - k;
+      const x = i * step;
+      const y = j * pick;
+      const { z, n } = dome(x, y);
+      const tip = [x + r * n[0], y + r * n[1], z + r * n[2] - r];
+      if (j === 0 && k === 0) {
+        out.push(`G00 X${mm(tip[0])} Y${mm(tip[1])} Z5.`, `G01 Z${mm(tip[2])} F1600`);
+      } else {
+        out.push(`X${mm(tip[0])} Y${mm(tip[1])} Z${mm(tip[2])}`);
+      }
+    }
+  }
+  out.push('G00 Z20.', 'M05', 'M30', '%');
+  return out.join('\n') + '\n';
+}
+
+function sampleGrid() {
+  const margin = 2 * SAMPLE.radius;
+  const count = Math.round((SAMPLE.size + 2 * margin) / 1) + 1;
+  const rows = [];
+  for (let j = 0; j < count; j++) {
+    const row = [];
+    for (let i = 0; i < count; i++) {
+      const { z, n } = dome(-margin + i, -margin + j);
+      row.push((z + SAMPLE.allowance / n[2]).toFixed(4));
+    }
+    rows.push(row.join(' '));
+  }
+  return { origin: -margin, heights: rows.join('\n') };
+}
+
+const FORM = `
+<div class="layout">
+  <form id="predict-form" novalidate>
+    <fieldset><legend>Tool (ball end mill)</legend>
+      <label>Tool <select name="tool_choice" data-field="tool"></select></label>
+      <div data-inline-tool>
+        <label>Ball radius, mm <input name="radius" type="number" step="any" value="3" data-field="tool.radius"></label>
+        <label>Flutes <input name="flutes" type="number" value="2" data-field="tool.flutes"></label>
+        <label>Helix, ° <input name="helix" type="number" step="any" value="30" data-field="tool.helix_deg"></label>
+        <label class="stacked">Shape error δ(θ): angle °, error mm per row<textarea name="shape_error" rows="4" data-field="tool.shape_error" title="one row per contact angle: angle in degrees (0 = tip, 90 = equator), error in mm">0 0.004
+30 0.005
+60 0.007
+90 0.009</textarea></label>
+        <label>Stiffness <select name="stiffness_kind" data-field="tool.stiffness">
+          <option value="modal">one mode (X = Y)</option><option value="static">static (X = Y)</option><option value="none">none</option></select></label>
+        <label data-stiffness="modal static">k, N/mm <input name="k" type="number" step="any" value="3000" data-field="tool.stiffness"></label>
+        <label data-stiffness="modal"><span>f<sub>n</sub>, Hz</span> <input name="fn" type="number" step="any" value="1800" data-field="tool.stiffness"></label>
+        <label data-stiffness="modal">Damping ζ <input name="zeta" type="number" step="any" value="0.04" data-field="tool.stiffness"></label>
+        <div class="actions"><label class="inline">Save as T <input name="save_number" type="number" min="1" max="9999" value="3" aria-label="tool number" style="width: 5rem"></label>
+          <button class="secondary" type="button" id="predict-save-tool">Save tool</button></div>
+      </div>
+    </fieldset>
+    <fieldset><legend>Stock</legend>
+      <label>Kind <select name="stock_kind" data-field="stock.kind">
+        <option value="grid">height grid</option><option value="box">box</option><option value="mesh">STL file</option></select></label>
+      <label data-stock="box">Min x y z <span class="triple">
+        <input name="min_x" type="number" step="any" value="-5" data-field="stock.min">
+        <input name="min_y" type="number" step="any" value="-5" data-field="stock.min">
+        <input name="min_z" type="number" step="any" value="-10" data-field="stock.min"></span></label>
+      <label data-stock="box">Max x y z <span class="triple">
+        <input name="max_x" type="number" step="any" value="25" data-field="stock.max">
+        <input name="max_y" type="number" step="any" value="25" data-field="stock.max">
+        <input name="max_z" type="number" step="any" value="2.2" data-field="stock.max"></span></label>
+      <label data-stock="grid">Origin x y <span class="pair">
+        <input name="origin_x" type="number" step="any" data-field="stock.origin">
+        <input name="origin_y" type="number" step="any" data-field="stock.origin"></span></label>
+      <label data-stock="grid">Spacing, mm <input name="spacing" type="number" step="any" value="1" data-field="stock.spacing"></label>
+      <label data-stock="grid">Bottom z <input name="bottom" type="number" step="any" value="-20" data-field="stock.bottom"></label>
+      <label class="stacked" data-stock="grid">Heights, mm (a row per y, along x)<textarea name="heights" rows="4" data-field="stock.heights" title="one row per y, heights along x"></textarea></label>
+      <label data-stock="mesh">STL file <input name="stock_file" type="file" accept=".stl,model/stl,application/sla" data-field="stock"></label>
+    </fieldset>
+    <fieldset><legend>Path</legend>
+      <label class="stacked">G-code program<textarea name="program" rows="14" spellcheck="false" class="code" data-field="path.program"></textarea></label>
+      <label>Open a file <input name="program_file" type="file" accept=".nc,.ngc,.tap,.gcode,.txt"></label>
+      <label>Programmed point <select name="reference" data-field="reference"><option value="tip">tool tip</option><option value="centre">ball centre</option></select></label>
+    </fieldset>
+    <fieldset><legend>Cutting</legend>
+      <label>Spindle, rpm <input name="spindle_rpm" type="number" step="any" placeholder="from the program" data-field="spindle_rpm"></label>
+      <label>Feed, mm/min <input name="feed" type="number" step="any" placeholder="from the program" data-field="feed"></label>
+      <label><span>K<sub>tc</sub> K<sub>rc</sub> K<sub>ac</sub>, N/mm²</span> <span class="triple">
+        <input name="ktc" type="number" step="any" value="2000" data-field="cutting.ktc" title="N/mm²">
+        <input name="krc" type="number" step="any" value="800" data-field="cutting.krc" title="N/mm²">
+        <input name="kac" type="number" step="any" value="300" data-field="cutting.kac" title="N/mm²"></span></label>
+      <label>Method <select name="method" data-field="method"><option value="sampling">surface sampling</option><option value="depth_buffer">depth buffer (patent)</option></select></label>
+      <label>Resolution N <input name="resolution" type="number" value="256" data-field="resolution"></label>
+      <label>Max correction, mm <input name="max_correction" type="number" step="any" value="0.05" data-field="correction.max_correction"></label>
+    </fieldset>
+    <div class="actions">
+      <button class="primary" type="submit" id="predict-compute">Predict</button>
+      <button class="secondary" type="button" id="predict-gcode">Corrected program</button>
+    </div>
+  </form>
+  <section>
+    <div id="predict-messages"></div>
+    <div id="predict-result"></div>
+  </section>
+</div>`;
+
+function value(form, name) {
+  return form.elements[name].value;
+}
+
+function numeric(form, name) {
+  const text = value(form, name).trim();
+  return text === '' ? undefined : Number(text);
+}
+
+function rows(text) {
+  return text.split('\n').map((l) => l.trim()).filter((l) => l !== '').map((l) => l.split(/[\s,;]+/).map(Number));
+}
+
+// The request body from the form (field names as api.md) and, for an STL stock, the file.
+export function predictRequest(form) {
+  const choice = value(form, 'tool_choice');
+  let tool = Number(choice);
+  if (choice === 'inline') {
+    tool = { kind: 'ball', radius: numeric(form, 'radius'), flutes: numeric(form, 'flutes') ?? 2, helix_deg: numeric(form, 'helix') };
+    tool.shape_error = rows(value(form, 'shape_error')).map(([angle, error]) => ({ angle_deg: angle, error }));
+    const kind = value(form, 'stiffness_kind');
+    const k = numeric(form, 'k');
+    if (kind === 'static') tool.stiffness = { kind, x: k, y: k };
+    if (kind === 'modal') {
+      const mode = { stiffness: k, frequency_hz: numeric(form, 'fn'), damping_ratio: numeric(form, 'zeta') };
+      tool.stiffness = { kind, x: [mode], y: [mode] };
+    }
+  }
+  const kind = value(form, 'stock_kind');
+  let stock = { kind };
+  let file = null;
+  if (kind === 'box') {
+    stock.min = ['min_x', 'min_y', 'min_z'].map((n) => numeric(form, n));
+    stock.max = ['max_x', 'max_y', 'max_z'].map((n) => numeric(form, n));
+  } else if (kind === 'grid') {
+    stock = { kind, origin: [numeric(form, 'origin_x'), numeric(form, 'origin_y')], spacing: numeric(form, 'spacing'), heights: rows(value(form, 'heights')), bottom: numeric(form, 'bottom') };
+  } else {
+    file = form.elements.stock_file.files[0] || null;
+  }
+  const body = {
+    tool, stock,
+    path: { kind: 'gcode', program: value(form, 'program') },
+    reference: value(form, 'reference'),
+    spindle_rpm: numeric(form, 'spindle_rpm'),
+    feed: numeric(form, 'feed'),
+    method: value(form, 'method'),
+    resolution: numeric(form, 'resolution'),
+    correction: { max_correction: numeric(form, 'max_correction') },
+  };
+  const cutting = { ktc: numeric(form, 'ktc'), krc: numeric(form, 'krc'), kac: numeric(form, 'kac') };
+  if (Object.values(cutting).some((v) => v !== undefined)) body.cutting = cutting;
+  return { body, file };
+}
+
+// The body to send: JSON, or a form with the JSON and the STL file.
+function payload({ body, file }) {
+  if (!file) return body;
+  const form = new FormData();
+  form.append('request', new Blob([JSON.stringify(body)], { type: 'application/json' }));
+  form.append('stock', file, file.name);
+  return form;
+}
+
+function syncVisibility(form) {
+  const kind = value(form, 'stock_kind');
+  form.querySelectorAll('[data-stock]').forEach((e) => { e.hidden = e.dataset.stock !== kind; });
+  form.querySelector('[data-inline-tool]').hidden = value(form, 'tool_choice') !== 'inline';
+  const stiffness = value(form, 'stiffness_kind');
+  form.querySelectorAll('[data-stiffness]').forEach((e) => { e.hidden = !e.dataset.stiffness.split(' ').includes(stiffness); });
+}
+
+async function loadTools(select) {
+  const chosen = select.value;
+  select.replaceChildren(new Option('inline ball (below)', 'inline'));
+  try {
+    for (const tool of await api('GET', '/api/v1/tools')) {
+      if (tool.kind !== 'ball') continue;
+      const note = tool.shape_error ? `${tool.shape_error.length}-row shape error${tool.stiffness ? ', stiffness' : ''}` : 'no shape-error table';
+      select.append(new Option(`T${tool.number} ball R${tool.radius}${tool.name ? ' ' + tool.name : ''} (${note})`, String(tool.number)));
+    }
+  } catch (problem) {
+    // The inline tool still works without the table.
+  }
+  if ([...select.options].some((o) => o.value === chosen)) select.value = chosen;
+}
+
+// Marks the inputs of every error path, also nested ones (`tool.shape_error[2].error` marks the
+// table), and puts the cursor on the program line a G-code error names.
+function markProblem(form, problem) {
+  for (const { path } of problem.errors || []) {
+    form.querySelectorAll('[data-field]').forEach((e) => {
+      const field = e.dataset.field;
+      if (path === field || path.startsWith(`${field}.`) || path.startsWith(`${field}[`)) e.classList.add('invalid');
+    });
+    const line = /line (\d+)/.exec(problem.detail || '');
+    if (path === 'path.program' && line) {
+      const area = form.elements.program;
+      const lines = area.value.split('\n');
+      const at = Math.min(Number(line[1]), lines.length) - 1;
+      const start = lines.slice(0, at).reduce((n, l) => n + l.length + 1, 0);
+      area.focus();
+      area.setSelectionRange(start, start + (lines[at] || '').length);
+      area.scrollTop = Math.max(0, (at - 3) * (area.scrollHeight / lines.length));
+    }
+  }
+}
+
+// Colour scale from the most negative to the most positive error (perceptually ordered).
+const STOPS = ['#30123b', '#4686fb', '#1ae4b6', '#a2fc3c', '#faba39', '#e4460a', '#7a0403'];
+
+function rgb(hex) {
+  return [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16));
+}
+
+export function colourFor(t) {
+  const x = Math.max(0, Math.min(1, Number.isFinite(t) ? t : 0.5)) * (STOPS.length - 1);
+  const i = Math.min(STOPS.length - 2, Math.floor(x));
+  const [a, b] = [rgb(STOPS[i]), rgb(STOPS[i + 1])];
+  const f = x - i;
+  return `rgb(${a.map((v, k) => Math.round(v + (b[k] - v) * f)).join(',')})`;
+}
+
+function microns(e) {
+  return Number.isFinite(e) ? (e * 1000).toFixed(1) : '–';
+}
+
+// The programmed path as runs of contiguous passes: each pass ends at its programmed end point
+// (corrected − correction); a pass starts a new run when lines were skipped (a rapid between).
+function runs(passes) {
+  const out = [];
+  let run = null;
+  let previous = null;
+  for (const pass of passes) {
+    const end = pass.corrected.map((c, k) => c - pass.correction[k]);
+    const contiguous = previous && (pass.line === undefined || previous.line === undefined || pass.line - previous.line <= 1);
+    if (!contiguous) {
+      run = { points: [], errors: [] };
+      out.push(run);
+    }
+    run.points.push(end);
+    run.errors.push(pass.error);
+    previous = pass;
+  }
+  return out;
+}
+
+function drawScale(canvas, low, high) {
+  const width = canvas.clientWidth;
+  const height = canvas.clientHeight;
+  const ratio = window.devicePixelRatio || 1;
+  canvas.width = Math.round(width * ratio);
+  canvas.height = Math.round(height * ratio);
+  const g = canvas.getContext('2d');
+  g.setTransform(ratio, 0, 0, ratio, 0, 0);
+  g.fillStyle = '#fff';
+  g.fillRect(0, 0, width, height);
+  const left = 10;
+  const right = width - 10;
+  for (let x = left; x < right; x++) {
+    g.fillStyle = colourFor((x - left) / (right - left));
+    g.fillRect(x, 4, 1, 22);
+  }
+  g.fillStyle = '#1d2327';
+  g.font = '15px sans-serif';
+  g.textBaseline = 'top';
+  g.textAlign = 'left';
+  g.fillText(`${microns(low)} µm`, left, 30);
+  g.textAlign = 'right';
+  g.fillText(`${microns(high)} µm`, right, 30);
+  if (low < 0 && high > 0) {
+    const zero = left + (right - left) * (-low / (high - low));
+    g.fillRect(zero, 0, 2, 28);
+    g.textAlign = 'center';
+    g.fillText('0', zero, 30);
+  }
+  canvas.dataset.state = 'drawn';
+}
+
+function drawHistogram(canvas, errors, low, high) {
+  const width = canvas.clientWidth;
+  const height = canvas.clientHeight;
+  const ratio = window.devicePixelRatio || 1;
+  canvas.width = Math.round(width * ratio);
+  canvas.height = Math.round(height * ratio);
+  const g = canvas.getContext('2d');
+  g.setTransform(ratio, 0, 0, ratio, 0, 0);
+  g.fillStyle = '#fff';
+  g.fillRect(0, 0, width, height);
+  if (!errors.length) {
+    canvas.dataset.state = 'empty';
+    return;
+  }
+  const bins = 30;
+  const span = high - low || 1e-9;
+  const counts = new Array(bins).fill(0);
+  for (const e of errors) counts[Math.min(bins - 1, Math.floor(((e - low) / span) * bins))]++;
+  const most = Math.max(...counts);
+  const [left, right, top, bottom] = [50, width - 12, 12, height - 34];
+  g.strokeStyle = '#5b6670';
+  g.beginPath();
+  g.moveTo(left, top);
+  g.lineTo(left, bottom);
+  g.lineTo(right, bottom);
+  g.stroke();
+  const w = (right - left) / bins;
+  counts.forEach((count, i) => {
+    const h = (count / most) * (bottom - top);
+    g.fillStyle = colourFor((i + 0.5) / bins);
+    g.fillRect(left + i * w + 1, bottom - h, Math.max(1, w - 2), h);
+  });
+  g.fillStyle = '#1d2327';
+  g.font = '14px sans-serif';
+  g.textAlign = 'right';
+  g.textBaseline = 'middle';
+  g.fillText(String(most), left - 6, top + 4);
+  g.fillText('0', left - 6, bottom);
+  g.textBaseline = 'top';
+  g.textAlign = 'left';
+  g.fillText(`${microns(low)}`, left, bottom + 6);
+  g.textAlign = 'right';
+  g.fillText(`${microns(high)} µm`, right, bottom + 6);
+  g.textAlign = 'center';
+  g.fillText('passes per error', (left + right) / 2, bottom + 6);
+  canvas.dataset.state = 'drawn';
+  canvas.dataset.bins = String(counts.filter((c) => c > 0).length);
+}
+
+function summaryItems(box, items) {
+  box.replaceChildren(...items.map(([name, v]) => {
+    const div = document.createElement('div');
+    div.append(name);
+    const b = document.createElement('b');
+    b.textContent = String(v);
+    div.append(b);
+    return div;
+  }));
+}
+
+// Shows a prediction in `container`: path coloured by error with its scale, histogram, summary,
+// worst passes and warnings. Used by the form and by job results.
+export function predictResult(container, answer) {
+  container.replaceChildren();
+  const warnings = document.createElement('div');
+  const canvas = document.createElement('canvas');
+  canvas.className = 'plot';
+  canvas.setAttribute('aria-label', 'Tool path coloured by predicted error');
+  const scale = document.createElement('canvas');
+  scale.className = 'scale';
+  scale.setAttribute('aria-label', 'Colour scale of the predicted error');
+  const caption = document.createElement('p');
+  caption.className = 'hint';
+  caption.textContent = 'Programmed path coloured by the predicted error e (µm along the surface normal; < 0 cuts too deep, > 0 leaves material). Drag to rotate, shift-drag to pan, wheel to zoom, double-click to reset.';
+  const summaryBox = document.createElement('div');
+  summaryBox.className = 'summary';
+  const histogram = document.createElement('canvas');
+  histogram.className = 'histogram';
+  histogram.setAttribute('aria-label', 'Histogram of the predicted errors');
+  const worstTitle = document.createElement('h3');
+  worstTitle.textContent = 'Worst passes';
+  const worst = document.createElement('table');
+  worst.className = 'worst';
+  container.append(warnings, canvas, scale, caption, summaryBox, histogram, worstTitle, worst);
+
+  const errors = answer.passes.map((p) => p.error).filter(Number.isFinite);
+  const low = errors.length ? Math.min(...errors) : 0;
+  const high = errors.length ? Math.max(...errors) : 0;
+  const position = (e) => (high > low ? (e - low) / (high - low) : 0.5);
+  const grey = '#9aa4ad';
+  const series = runs(answer.passes).map((run) => ({
+    label: '',
+    points: run.points,
+    colour: grey,
+    colours: run.errors.map((e) => (Number.isFinite(e) ? colourFor(position(e)) : grey)),
+    width: 3,
+    marks: run.points.length < 3,
+  }));
+  new Plot3D(canvas).setSeries(series);
+  const redraw = () => {
+    drawScale(scale, low, high);
+    drawHistogram(histogram, errors, low, high);
+  };
+  redraw();
+  new ResizeObserver(redraw).observe(histogram);
+
+  const s = answer.summary;
+  summaryBox.replaceChildren();
+  summaryItems(summaryBox, [
+    ['passes', `${s.predicted} of ${s.passes} predicted`],
+    ['error range, µm', `${microns(s.min_error)} … ${microns(s.max_error)}`],
+    ['mean / RMS error, µm', `${microns(s.mean_error)} / ${microns(s.rms_error)}`],
+    ['largest correction, µm', `${microns(s.max_correction)}${s.clamped ? ` (${s.clamped} clamped)` : ''}`],
+    ['no cut / no surface / outside', `${s.no_cut} / ${s.no_surface} / ${s.outside_stock}`],
+    ['method', `${s.method.replace('_', ' ')}, N ${s.resolution} (${number(s.pixel_size * 1000, 1)} µm)`],
+    ['tool', `${answer.tool.number ? 'T' + answer.tool.number + ' ' : ''}ball R${answer.tool.radius}`],
+  ].concat(answer.timings ? [['time', `${number(answer.timings.solve_ms / 1000, 2)} s (${Math.round(answer.timings.passes_per_s)} passes/s)`]] : []));
+
+  const head = document.createElement('tr');
+  for (const title of ['#', 'pass', 'NC line', 'error, µm', 'contact angle, °', 'flags']) {
+    const th = document.createElement('th');
+    th.textContent = title;
+    head.append(th);
+  }
+  const body = s.worst.map((w, rank) => {
+    const pass = answer.passes[w.index] || {};
+    const tr = document.createElement('tr');
+    tr.dataset.line = String(w.line ?? '');
+    const swatch = document.createElement('span');
+    swatch.className = 'swatch';
+    swatch.style.background = colourFor(position(w.error));
+    const cells = [String(rank + 1), String(w.index), w.line === undefined ? '–' : String(w.line), microns(w.error),
+      number(pass.contact_angle_deg, 1), (pass.flags || []).join(', ')];
+    cells.forEach((text, k) => {
+      const td = document.createElement('td');
+      if (k === 3) td.append(swatch, ' ');
+      td.append(text);
+      tr.append(td);
+    });
+    return tr;
+  });
+  worst.replaceChildren(head, ...body);
+  warnings.replaceChildren(...answer.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
+  return canvas;
+}
+
+export const predictView = {
+  id: 'predict',
+  title: 'Predict',
+  mount(root) {
+    root.innerHTML = FORM;
+    const form = root.querySelector('#predict-form');
+    const messages = root.querySelector('#predict-messages');
+    const result = root.querySelector('#predict-result');
+    const grid = sampleGrid();
+    form.elements.program.value = sampleProgram();
+    form.elements.heights.value = grid.heights;
+    form.elements.origin_x.value = grid.origin;
+    form.elements.origin_y.value = grid.origin;
+    form.addEventListener('change', () => syncVisibility(form));
+    loadTools(form.elements.tool_choice).then(() => syncVisibility(form));
+    syncVisibility(form);
+    form.elements.program_file.addEventListener('change', async (event) => {
+      const file = event.target.files[0];
+      if (file) form.elements.program.value = await file.text();
+    });
+    const clear = () => form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+    const fail = (problem) => {
+      showProblem(messages, form, problem);
+      markProblem(form, problem);
+    };
+    form.addEventListener('submit', async (event) => {
+      event.preventDefault();
+      clear();
+      messages.replaceChildren(message('warning', 'predicting…'));
+      const started = performance.now();
+      try {
+        const answer = await api('POST', '/api/v1/predict?timings=true', payload(predictRequest(form)));
+        const seconds = (performance.now() - started) / 1000;
+        messages.replaceChildren(message('ok', `${answer.summary.passes} passes in ${seconds.toFixed(2)} s`));
+        predictResult(result, answer).id = 'predict-plot';
+        result.querySelector('canvas.histogram').id = 'predict-histogram';
+      } catch (problem) {
+        result.replaceChildren();
+        fail(problem);
+      }
+    });
+    root.querySelector('#predict-gcode').addEventListener('click', async () => {
+      clear();
+      try {
+        const program = await api('POST', '/api/v1/predict?format=gcode', payload(predictRequest(form)), 'text/x-gcode');
+        download('corrected.nc', program);
+      } catch (problem) {
+        fail(problem);
+      }
+    });
+    root.querySelector('#predict-save-tool').addEventListener('click', async () => {
+      clear();
+      const { body } = predictRequest(form);
+      const slot = value(form, 'save_number');
+      try {
+        await api('PUT', `/api/v1/tools/${encodeURIComponent(slot)}`, { ...body.tool, name: `R${body.tool.radius} ball, shape error` });
+        messages.replaceChildren(message('ok', `tool ${slot} saved with its shape-error table`));
+        await loadTools(form.elements.tool_choice);
+      } catch (problem) {
+        fail(problem);
+      }
+    });
+  },
+};
