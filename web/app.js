@@ -71,6 +71,51 @@ export function download(name, text, type = 'text/plain') {
   setTimeout(() => URL.revokeObjectURL(url), 1000);
 }
 
+// Fills a tool <select> with an "inline" entry and the table's tools that `accepts`, keeping
+// the choice when it is still there. Without the table the inline tool still works.
+export async function loadTools(select, inlineLabel, accepts = () => true, describe = toolLabel) {
+  const chosen = select.value;
+  select.replaceChildren(new Option(inlineLabel, 'inline'));
+  try {
+    for (const tool of await api('GET', '/api/v1/tools')) {
+      if (accepts(tool)) select.append(new Option(describe(tool), String(tool.number)));
+    }
+  } catch (problem) {
+    // The inline tool still works without the table.
+  }
+  if ([...select.options].some((o) => o.value === chosen)) select.value = chosen;
+}
+
+export function toolLabel(tool) {
+  return `T${tool.number} ${tool.kind} R${tool.radius}${tool.name ? ' ' + tool.name : ''}`;
+}
+
+// Fills a machine <select> with "none" and the registered machines, keeping the choice.
+export async function loadMachines(select, noneLabel = 'none') {
+  const chosen = select.value;
+  select.replaceChildren(new Option(noneLabel, ''));
+  try {
+    for (const machine of await api('GET', '/api/v1/machines')) {
+      select.append(new Option(`${machine.name}: ${machine.block_time_ms} ms, ${machine.max_feed} mm/min, ${machine.dialect}`, machine.name));
+    }
+  } catch (problem) {
+    // The form's own values still work without the registry.
+  }
+  if ([...select.options].some((o) => o.value === chosen)) select.value = chosen;
+}
+
+// The G-code query of a form with a `dialect` select ('' = the machine's, else Fanuc) and a
+// `reference` select.
+export function gcodeQuery(form) {
+  const dialect = form.elements.dialect.value;
+  return `?format=gcode${dialect ? `&dialect=${dialect}` : ''}&reference=${form.elements.reference.value}`;
+}
+
+// The download name of a program: `kind-dialect.nc`, or the machine's name for its dialect.
+export function programName(kind, form) {
+  return `${kind}-${form.elements.dialect.value || form.elements.machine?.value || 'fanuc'}.nc`;
+}
+
 export function number(value, digits = 4) {
   return Number.isFinite(value) ? value.toFixed(digits) : '–';
 }

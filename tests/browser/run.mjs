@@ -54,7 +54,22 @@ const scenarios = {
     if (segments < 10) throw new Error(`only ${segments} segments drawn`);
     if (inked < 500) throw new Error(`plot nearly blank: ${inked} inked pixels`);
     if (!/points\s*\d+/.test(summary)) throw new Error(`no summary: ${summary}`);
-    
+
+    // A machine registered through the API and chosen on the form spaces the points by its block
+    // time: the summary reports the blocks and the machine.
+    await page.evaluate(async (url) => {
+      const body = JSON.stringify({ block_time_ms: 4, max_feed: 6000, dialect: 'linuxcnc' });
+      const response = await fetch(url, { method: 'PUT', headers: { 'content-type': 'application/json' }, body });
+      if (!response.ok) throw new Error(`machine not stored: ${response.status}`);
+    }, `${base}/api/v1/machines/page-4ms`);
+    await page.goto(`${base}/`);
+    await page.waitForSelector('#deburr-form select[name="machine"] option[value="page-4ms"]', { state: 'attached', timeout: 15000 });
+    await page.selectOption('#deburr-form select[name="machine"]', 'page-4ms');
+    await page.click('#deburr-compute');
+    await page.waitForFunction(() => /page-4ms/.test(document.querySelector('#deburr-result .summary')?.textContent ?? ''), null, { timeout: 15000 });
+    const withMachine = await page.textContent('#deburr-result .summary');
+    if (!/blocks \(short\)\d+ \(0\)/.test(withMachine)) throw new Error(`no block figures: ${withMachine}`);
+
     // A bad value is reported with the field highlighted.
     await page.fill('input[name="hole_radius"]', '-1');
     await page.click('#deburr-compute');

@@ -3,7 +3,7 @@
 // selector; loops, reliefs, links and corners in their own colours; wheel to zoom, drag to pan,
 // double-click to fit), the corner table with the material left or over-cut, the summary, the
 // warnings and the G-code download. `contourResult` also renders job results.
-import { api, download, message, number, showProblem } from '/app.js';
+import { api, download, gcodeQuery, loadMachines, loadTools, message, number, programName, showProblem } from '/app.js';
 
 // An arrow-shaped island: five protruding corners (a 64° tip among them) and two inside corners.
 const SAMPLE = `# x, y in mm, counter-clockwise; one point a line
@@ -46,12 +46,13 @@ const FORM = `
       <label>Feed, mm/min <input name="feed" type="number" step="any" value="800" data-field="feed"></label>
       <label>Loop feed <input name="loop_feed" type="number" step="any" value="2000" data-field="loop_feed"></label>
       <label>Stock allowance <input name="stock_allowance" type="number" step="any" value="0.5" data-field="stock_allowance"></label>
-      <label>Block time, ms <input name="block_time_ms" type="number" step="any" placeholder="off" data-field="block_time_ms"></label>
+      <label>Machine <select name="machine" data-field="machine"></select></label>
+      <label>Block time, ms <input name="block_time_ms" type="number" step="any" placeholder="machine's, else off" data-field="block_time_ms"></label>
       <label>Tolerance, mm <input name="tolerance" type="number" step="any" value="0.01" data-field="tolerance"></label>
     </fieldset>
     <div class="actions">
       <button class="primary" type="submit" id="contour-compute">Compute</button>
-      <select name="dialect" aria-label="G-code dialect"><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select>
+      <select name="dialect" aria-label="G-code dialect"><option value="">machine's dialect (else Fanuc)</option><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select>
       <select name="reference" aria-label="Programmed point"><option value="tip">tip</option><option value="centre">centre</option></select>
       <button class="secondary" type="button" id="contour-gcode">G-code</button>
     </div>
@@ -110,6 +111,7 @@ export function contourRequest(form) {
     inside_corner_relief: value(form, 'relief'),
     feed: numeric(form, 'feed'),
   };
+  if (value(form, 'machine')) body.machine = value(form, 'machine');
   for (const name of ['loop_feed', 'stock_allowance', 'block_time_ms', 'tolerance']) {
     const v = numeric(form, name);
     if (v !== undefined) body[name] = v;
@@ -119,16 +121,6 @@ export function contourRequest(form) {
   return body;
 }
 
-async function loadTools(select) {
-  select.replaceChildren(new Option('inline flat end mill (radius below)', 'inline'));
-  try {
-    for (const tool of await api('GET', '/api/v1/tools')) {
-      select.append(new Option(`T${tool.number} ${tool.kind} R${tool.radius}${tool.name ? ' ' + tool.name : ''}`, String(tool.number)));
-    }
-  } catch (problem) {
-    // The inline tool still works without the table.
-  }
-}
 
 // A 2-D plot on a canvas: y up, equal scales, wheel zoom about the pointer, drag to pan,
 // double-click to fit. scene = {material: {polygon, inside}, lines: [{points, colour, width,
@@ -505,7 +497,8 @@ export const contourView = {
     form.elements.points.value = SAMPLE;
     const sync = () => { form.querySelector('[data-inline-tool]').hidden = value(form, 'tool_choice') !== 'inline'; };
     form.addEventListener('change', sync);
-    loadTools(form.elements.tool_choice).then(sync);
+    loadTools(form.elements.tool_choice, 'inline flat end mill (radius below)').then(sync);
+    loadMachines(form.elements.machine);
     sync();
     const request = () => {
       form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
@@ -535,10 +528,9 @@ export const contourView = {
     root.querySelector('#contour-gcode').addEventListener('click', async () => {
       const body = request();
       if (!body) return;
-      const query = `?format=gcode&dialect=${value(form, 'dialect')}&reference=${value(form, 'reference')}`;
       try {
-        const program = await api('POST', `/api/v1/contour${query}`, body, 'text/x-gcode');
-        download(`contour-${value(form, 'dialect')}.nc`, program);
+        const program = await api('POST', `/api/v1/contour${gcodeQuery(form)}`, body, 'text/x-gcode');
+        download(programName('contour', form), program);
       } catch (problem) {
         showProblem(messages, form, problem);
         markContour(form, messages, problem);

@@ -1,6 +1,6 @@
 // Deburr view: a form for one cross-hole ridge, the 3-D plot of ridge and ball-centre path,
 // the summary, warnings and the G-code download (api.md, Deburr).
-import { api, download, message, number, showProblem } from '/app.js';
+import { api, download, gcodeQuery, loadMachines, loadTools, message, number, programName, showProblem } from '/app.js';
 import { Plot3D } from '/plot3d.js';
 
 const FORM = `
@@ -42,10 +42,12 @@ const FORM = `
       <label>Direction <select name="direction" data-field="direction"><option value="ccw">ccw (climb)</option><option value="cw">cw</option></select></label>
       <label>Feed, mm/min <input name="feed" type="number" step="any" value="300" data-field="feed"></label>
       <label>Spindle, rpm <input name="spindle_rpm" type="number" step="any" value="6000" data-field="spindle_rpm"></label>
+      <label>Machine <select name="machine" data-field="machine"></select></label>
+      <label>Block time, ms <input name="block_time_ms" type="number" step="any" placeholder="machine's, else off" data-field="block_time_ms"></label>
     </fieldset>
     <div class="actions">
       <button class="primary" type="submit" id="deburr-compute">Compute</button>
-      <select name="dialect" aria-label="G-code dialect"><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select>
+      <select name="dialect" aria-label="G-code dialect"><option value="">machine's dialect (else Fanuc)</option><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select>
       <select name="reference" aria-label="Programmed point"><option value="tip">tip</option><option value="centre">ball centre</option></select>
       <button class="secondary" type="button" id="deburr-gcode">G-code</button>
     </div>
@@ -87,6 +89,8 @@ export function deburrRequest(form) {
     direction: value(form, 'direction'),
     feed: numeric(form, 'feed'),
     spindle_rpm: numeric(form, 'spindle_rpm'),
+    machine: value(form, 'machine') || undefined,
+    block_time_ms: numeric(form, 'block_time_ms'),
   };
 }
 
@@ -99,16 +103,6 @@ function syncVisibility(form) {
   if (kind === 'bore_block') form.elements.edge.value = 'inner';
 }
 
-async function loadTools(select) {
-  select.replaceChildren(new Option('inline ball (radius below)', 'inline'));
-  try {
-    for (const tool of await api('GET', '/api/v1/tools')) {
-      if (tool.kind === 'ball') select.append(new Option(`T${tool.number} ball R${tool.radius}${tool.name ? ' ' + tool.name : ''}`, String(tool.number)));
-    }
-  } catch (problem) {
-    // The inline tool still works without the table.
-  }
-}
 
 // Shows a deburr answer in `container`: plot of ridge, centres and leads, summary, warnings.
 // Used by the form and by job results.
@@ -142,6 +136,10 @@ export function deburrResult(container, answer) {
     ['est. time, s', number(s.estimated_time_s, 1)],
   ];
   if (s.max_exact_offset !== undefined) items.push(['exact vs seed, mm', number(s.max_exact_offset, 5)]);
+  if (s.blocks !== undefined) {
+    items.push(['blocks (short)', `${s.blocks} (${s.short_blocks})`], ['block length, mm', number(s.block_length, 4)]);
+  }
+  if (answer.machine) items.push(['machine', `${answer.machine.name} (${answer.machine.dialect})`]);
   summaryBox.replaceChildren(...items.map(([name, v]) => {
     const div = document.createElement('div');
     div.append(name);
@@ -163,7 +161,8 @@ export const deburrView = {
     const messages = root.querySelector('#deburr-messages');
     const result = root.querySelector('#deburr-result');
     form.addEventListener('change', () => syncVisibility(form));
-    loadTools(form.elements.tool_choice).then(() => syncVisibility(form));
+    loadTools(form.elements.tool_choice, 'inline ball (radius below)', (tool) => tool.kind === 'ball').then(() => syncVisibility(form));
+    loadMachines(form.elements.machine);
     syncVisibility(form);
     form.addEventListener('submit', async (event) => {
       event.preventDefault();
@@ -179,10 +178,9 @@ export const deburrView = {
       }
     });
     root.querySelector('#deburr-gcode').addEventListener('click', async () => {
-      const query = `?format=gcode&dialect=${value(form, 'dialect')}&reference=${value(form, 'reference')}`;
       try {
-        const program = await api('POST', `/api/v1/deburr${query}`, deburrRequest(form), 'text/x-gcode');
-        download(`deburr-${value(form, 'dialect')}.nc`, program);
+        const program = await api('POST', `/api/v1/deburr${gcodeQuery(form)}`, deburrRequest(form), 'text/x-gcode');
+        download(programName('deburr', form), program);
       } catch (problem) {
         showProblem(messages, form, problem);
       }

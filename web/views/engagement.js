@@ -4,7 +4,7 @@
 // summed chip thickness per flute count with the threshold, representative values and time per
 // k with the recommended k highlighted, and the feed plan; a cursor on any chart marks the tool
 // on the path. The result renderer is shared with the Jobs view.
-import { api, download, message, number, showProblem } from '/app.js';
+import { api, download, gcodeQuery, loadMachines, loadTools, message, number, programName, showProblem, toolLabel } from '/app.js';
 
 const SAMPLE_PATHS = [
   { name: 'straight', text: '-10 20\n70 20' },
@@ -51,11 +51,12 @@ const FORM = `
     <fieldset><legend>G-code and feed plan</legend>
       <label>Axial depth a_p, mm <input name="axial_depth" type="number" step="any" value="2" data-field="axial_depth"></label>
       <label>Target chip h*, mm <input name="target_thickness" type="number" step="any" value="0.05" data-field="feed_plan.target_thickness" title="empty: no feed plan, nominal feed"></label>
-      <label>Max feed, mm/min <input name="max_feed" type="number" step="any" value="2000" data-field="feed_plan.max_feed"></label>
+      <label>Max feed, mm/min <input name="max_feed" type="number" step="any" value="2000" placeholder="machine's" data-field="feed_plan.max_feed"></label>
+      <label>Machine <select name="machine" data-field="machine"></select></label>
     </fieldset>
     <div class="actions">
       <button class="primary" type="submit" id="engagement-compute">Compute</button>
-      <select name="dialect" aria-label="G-code dialect"><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select>
+      <select name="dialect" aria-label="G-code dialect"><option value="">machine's dialect (else Fanuc)</option><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select>
       <select name="reference" aria-label="Programmed point"><option value="tip">tip</option><option value="centre">centre</option></select>
       <select name="candidate" aria-label="Path to program" data-field="candidate"></select>
       <button class="secondary" type="button" id="engagement-gcode">G-code</button>
@@ -158,6 +159,7 @@ export function engagementRequest(form) {
   if (body.engine === 'dots') body.grid = numeric(form, 'grid');
   const target = numeric(form, 'target_thickness');
   if (target !== undefined) body.feed_plan = { target_thickness: target, max_feed: numeric(form, 'max_feed') };
+  if (value(form, 'machine')) body.machine = value(form, 'machine');
   return body;
 }
 
@@ -199,16 +201,6 @@ function numberPaths(form) {
   });
 }
 
-async function loadTools(select) {
-  select.replaceChildren(new Option('inline flat end mill (below)', 'inline'));
-  try {
-    for (const tool of await api('GET', '/api/v1/tools')) {
-      select.append(new Option(`T${tool.number} ${tool.kind} R${tool.radius} z${tool.flutes}${tool.name ? ' ' + tool.name : ''}`, String(tool.number)));
-    }
-  } catch (problem) {
-    // The inline tool still works without the table.
-  }
-}
 
 function syncVisibility(form) {
   form.querySelectorAll('[data-inline-tool]').forEach((e) => { e.hidden = value(form, 'tool_choice') !== 'inline'; });
@@ -918,7 +910,8 @@ export const engagementView = {
     for (const sample of SAMPLE_PATHS) addPath(form, sample.name, sample.text);
     root.querySelector('#engagement-add-path').addEventListener('click', () => addPath(form, `path ${pathBoxes(form).length + 1}`, ''));
     form.addEventListener('change', () => syncVisibility(form));
-    loadTools(form.elements.tool_choice).then(() => syncVisibility(form));
+    loadTools(form.elements.tool_choice, 'inline flat end mill (below)', () => true, (tool) => `${toolLabel(tool)} z${tool.flutes}`).then(() => syncVisibility(form));
+    loadMachines(form.elements.machine);
     syncVisibility(form);
     const fail = (problem) => {
       showProblem(messages, form, problem);
@@ -951,10 +944,9 @@ export const engagementView = {
     root.querySelector('#engagement-gcode').addEventListener('click', async () => {
       form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
       const candidate = value(form, 'candidate') || '0';
-      const query = `?format=gcode&dialect=${value(form, 'dialect')}&reference=${value(form, 'reference')}&candidate=${candidate}`;
       try {
-        const program = await api('POST', `/api/v1/engagement${query}`, engagementRequest(form), 'text/x-gcode');
-        download(`engagement-${candidate}-${value(form, 'dialect')}.nc`, program);
+        const program = await api('POST', `/api/v1/engagement${gcodeQuery(form)}&candidate=${candidate}`, engagementRequest(form), 'text/x-gcode');
+        download(programName(`engagement-${candidate}`, form), program);
         messages.replaceChildren();
       } catch (problem) {
         fail(problem);

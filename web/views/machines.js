@@ -25,7 +25,7 @@ const FORM = `
     <div id="machine-messages"></div>
     <table><thead><tr><th>name</th><th>block time, ms</th><th>max feed</th><th>dialect</th><th>margin</th><th>min chord error</th><th>description</th><th></th></tr></thead>
       <tbody id="machine-rows"></tbody></table>
-    <p class="hint">A request that names a machine takes its values as defaults (Segment view, or <code>"machine"</code> in a deburr or segment request).</p>
+    <p class="hint">A request that names a machine takes its values as defaults: block time and margin for deburr, segment and contour, <code>max_feed</code> for segment and the engagement feed plan, the dialect for G-code.</p>
   </section>
 </div>`;
 

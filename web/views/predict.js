@@ -3,7 +3,7 @@
 // G-code program, cutting conditions, method), the path coloured by predicted error with a colour
 // scale, a histogram of the errors, the worst passes with their NC lines, warnings, and the
 // corrected program. `predictResult` also shows prediction jobs.
-import { api, download, message, number, showProblem } from '/app.js';
+import { api, download, loadTools, message, number, showProblem, toolLabel } from '/app.js';
 import { Plot3D } from '/plot3d.js';
 
 // The sample: a raster finishing program over a gentle dome (20 × 20 mm, 2 mm high) with an R3
@@ -194,6 +194,14 @@ function payload({ body, file }) {
   return form;
 }
 
+const isBall = (tool) => tool.kind === 'ball';
+
+// A ball's label with whether it has what a prediction needs.
+function predictToolLabel(tool) {
+  const note = tool.shape_error ? `${tool.shape_error.length}-row shape error${tool.stiffness ? ', stiffness' : ''}` : 'no shape-error table';
+  return `${toolLabel(tool)} (${note})`;
+}
+
 function syncVisibility(form) {
   const kind = value(form, 'stock_kind');
   form.querySelectorAll('[data-stock]').forEach((e) => { e.hidden = e.dataset.stock !== kind; });
@@ -202,20 +210,6 @@ function syncVisibility(form) {
   form.querySelectorAll('[data-stiffness]').forEach((e) => { e.hidden = !e.dataset.stiffness.split(' ').includes(stiffness); });
 }
 
-async function loadTools(select) {
-  const chosen = select.value;
-  select.replaceChildren(new Option('inline ball (below)', 'inline'));
-  try {
-    for (const tool of await api('GET', '/api/v1/tools')) {
-      if (tool.kind !== 'ball') continue;
-      const note = tool.shape_error ? `${tool.shape_error.length}-row shape error${tool.stiffness ? ', stiffness' : ''}` : 'no shape-error table';
-      select.append(new Option(`T${tool.number} ball R${tool.radius}${tool.name ? ' ' + tool.name : ''} (${note})`, String(tool.number)));
-    }
-  } catch (problem) {
-    // The inline tool still works without the table.
-  }
-  if ([...select.options].some((o) => o.value === chosen)) select.value = chosen;
-}
 
 // Marks the inputs of every error path, also nested ones (`tool.shape_error[2].error` marks the
 // table), and puts the cursor on the program line a G-code error names.
@@ -469,7 +463,7 @@ export const predictView = {
     form.elements.origin_x.value = grid.origin;
     form.elements.origin_y.value = grid.origin;
     form.addEventListener('change', () => syncVisibility(form));
-    loadTools(form.elements.tool_choice).then(() => syncVisibility(form));
+    loadTools(form.elements.tool_choice, 'inline ball (below)', isBall, predictToolLabel).then(() => syncVisibility(form));
     syncVisibility(form);
     form.elements.program_file.addEventListener('change', async (event) => {
       const file = event.target.files[0];
@@ -512,7 +506,7 @@ export const predictView = {
       try {
         await api('PUT', `/api/v1/tools/${encodeURIComponent(slot)}`, { ...body.tool, name: `R${body.tool.radius} ball, shape error` });
         messages.replaceChildren(message('ok', `tool ${slot} saved with its shape-error table`));
-        await loadTools(form.elements.tool_choice);
+        await loadTools(form.elements.tool_choice, 'inline ball (below)', isBall, predictToolLabel);
       } catch (problem) {
         fail(problem);
       }

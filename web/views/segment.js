@@ -1,7 +1,7 @@
 // Segment view: cut a curve into G01 blocks by the control's block time (api.md, Segment;
 // chord.md). A form for the curve and the rule, the curve with its blocks, the chord error and the
 // block length along the curve, the rule side by side with a fixed tolerance, G-code download.
-import { api, download, message, number, showProblem } from '/app.js';
+import { api, download, loadMachines, message, number, showProblem } from '/app.js';
 import { PlanPlot, drawChart } from '/plot2d.js';
 
 const FORM = `
@@ -123,18 +123,6 @@ function syncVisibility(form) {
   form.querySelectorAll('[data-mode]').forEach((e) => { e.hidden = e.dataset.mode !== mode; });
 }
 
-async function loadMachines(select) {
-  const chosen = select.value;
-  select.replaceChildren(new Option('none (values below)', ''));
-  try {
-    for (const machine of await api('GET', '/api/v1/machines')) {
-      select.append(new Option(`${machine.name}: ${machine.block_time_ms} ms, ${machine.max_feed} mm/min, ${machine.dialect}`, machine.name));
-    }
-  } catch (problem) {
-    // The values of the form still work without the registry.
-  }
-  select.value = chosen;
-}
 
 // Marks inputs whose data-field is a prefix of an error path (curve.points[3] → curve.points).
 function highlightPrefixes(form, problem) {
@@ -364,7 +352,7 @@ export const segmentView = {
     }).join('\n');
     form.addEventListener('change', () => syncVisibility(form));
     syncVisibility(form);
-    loadMachines(form.elements.machine);
+    loadMachines(form.elements.machine, 'none (values below)');
     const request = () => {
       form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
       try {

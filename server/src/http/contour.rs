@@ -6,6 +6,7 @@ use axum::Json;
 use axum::extract::State;
 use axum::http::HeaderMap;
 use axum::response::{IntoResponse, Response};
+use kerf_solver::chord::MachineProfile;
 use kerf_solver::corners::detect::{self, DetectMode, MaterialSide, PathLoopAnswer, PathLoopRequest};
 use kerf_solver::corners::{self, ContourAnswer, ContourRequest, CornerLoop};
 use kerf_solver::gcode::{Dialect, Post, Reference, ToolCall};
@@ -31,6 +32,10 @@ pub const MAX_JSON_MOVES: usize = 500_000;
 pub struct ContourResult {
     /// The tool, as resolved from the table or given inline.
     pub tool: Tool,
+    /// The machine the request named, as registered: its block time (and margin, minimum chord
+    /// error) chorded the arcs, its dialect is the G-code default.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub machine: Option<MachineProfile>,
     /// Layers with their moves, corners, passes, summary and warnings.
     #[serde(flatten)]
     pub result: ContourAnswer,
@@ -41,7 +46,9 @@ pub struct ContourResult {
 ///
 /// Returns the layers' moves, the corners with their actions and the material left or cut
 /// (JSON, at most 500 000 moves), or with `Accept: text/x-gcode` / `?format=gcode` a complete
-/// program (up to the solver's limit of 6 000 000 moves).
+/// program (up to the solver's limit of 6 000 000 moves; dialect from `?dialect=`, else the
+/// named machine's, else Fanuc). With `block_time_ms` or a `machine` the arcs are chorded by the
+/// block-time rule and the summary reports the blocks.
 #[utoipa::path(post, path = "/api/v1/contour", tag = "contour",
     params(OutputQuery),
     request_body = ContourRequest,
@@ -49,7 +56,7 @@ pub struct ContourResult {
         (status = 200, description = "The path as JSON", body = ContourResult),
         (status = 200, description = "The program (`?format=gcode`)", body = String, content_type = "text/x-gcode"),
         (status = 400, body = Problem, content_type = "application/problem+json"),
-        (status = 404, description = "Unknown tool number", body = Problem, content_type = "application/problem+json"),
+        (status = 404, description = "Unknown tool number or machine", body = Problem, content_type = "application/problem+json"),
         (status = 413, body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
         (status = 422, description = "Impossible contour or over a limit (codes in corners.md §5; `E_TOO_MANY_MOVES` for answers over the move limit)", body = Problem, content_type = "application/problem+json"),
@@ -62,11 +69,13 @@ async fn post_contour(
 ) -> AppResult<Response> {
     let output = Output::negotiate(&headers, &query);
     let tool = store::tools::resolve(&state.db, &request.tool).await?;
+    let machine = store::machines::resolve(&state.db, request.machine.as_deref()).await?;
     if output.gcode {
-        let answer = state.solve(move || run(&request, tool, corners::request::MAX_MOVES)).await??;
-        return Ok(gcode_response(program(&answer, output.dialect.unwrap_or_default(), output.reference)?));
+        let answer = state.solve(move || run(&request, tool, machine, corners::request::MAX_MOVES)).await??;
+        let dialect = super::machines::dialect(output.dialect, answer.machine.as_ref());
+        return Ok(gcode_response(program(&answer, dialect, output.reference)?));
     }
-    let answer = state.solve(move || run(&request, tool, MAX_JSON_MOVES)).await?.map_err(json_limit_advice)?;
+    let answer = state.solve(move || run(&request, tool, machine, MAX_JSON_MOVES)).await?.map_err(json_limit_advice)?;
     Ok(Json(answer).into_response())
 }
 
@@ -89,11 +98,16 @@ fn json_limit_advice(error: SolverError) -> SolverError {
     }
 }
 
-/// Solves a contour request with its resolved tool, refusing answers over `max_moves` moves
-/// (used by the route and by jobs).
-pub fn run(request: &ContourRequest, tool: Tool, max_moves: usize) -> Result<ContourResult, SolverError> {
-    let result = corners::solve_within(request, &tool, max_moves)?;
-    Ok(ContourResult { tool, result })
+/// Solves a contour request with its resolved tool and machine, refusing answers over
+/// `max_moves` moves (used by the route and by jobs).
+pub fn run(
+    request: &ContourRequest,
+    tool: Tool,
+    machine: Option<MachineProfile>,
+    max_moves: usize,
+) -> Result<ContourResult, SolverError> {
+    let result = corners::solve_with(request, &tool, machine.as_ref(), max_moves)?;
+    Ok(ContourResult { tool, machine, result })
 }
 
 /// Keeps a stored JSON result (a job's) within [`MAX_JSON_MOVES`]: from the first layer that

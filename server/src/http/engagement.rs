@@ -6,7 +6,10 @@ use axum::Json;
 use axum::extract::State;
 use axum::http::HeaderMap;
 use axum::response::{IntoResponse, Response};
+use std::borrow::Cow;
+
 use kerf_solver::SolverError;
+use kerf_solver::chord::MachineProfile;
 use kerf_solver::engagement::{self, EngagementAnswer, EngagementRequest, Stock};
 use kerf_solver::error::Warning;
 use kerf_solver::gcode::{Dialect, Post, Reference, ToolCall};
@@ -30,6 +33,10 @@ use crate::store;
 pub struct EngagementResponse {
     /// The tool, as resolved from the table or given inline.
     pub tool: Tool,
+    /// The machine the request named, as registered: its `max_feed` caps the feed plan unless
+    /// `feed_plan.max_feed` is given, its dialect is the G-code default.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub machine: Option<MachineProfile>,
     /// The stock, as given.
     pub stock: Stock,
     /// T1 as given, mm.
@@ -50,7 +57,7 @@ pub struct EngagementResponse {
 pub struct EngagementQuery {
     /// `json` (default) or `gcode`; `Accept: text/x-gcode` also selects G-code.
     pub format: Option<Format>,
-    /// G-code dialect: `fanuc` (default) or `linuxcnc`.
+    /// G-code dialect: `fanuc` or `linuxcnc` (default: the named machine's, else `fanuc`).
     pub dialect: Option<Dialect>,
     /// Programmed point: `tip` (default; length offset to the tool tip) or `centre` (the centre
     /// of the tool's end rounding: the ball centre, the bull-nose corner centre, the tip for a
@@ -69,7 +76,8 @@ pub struct EngagementQuery {
 /// thicknesses, the machining time and whether it meets `thickness_limit` and `time_limit_s`.
 /// `paths` compares several candidate paths side by side. With `Accept: text/x-gcode` or
 /// `?format=gcode` (and `axial_depth`) it returns the program of one path (`?candidate=`) at the
-/// feeds of `feed_plan` (chip-thinning compensation) or at the nominal feed.
+/// feeds of `feed_plan` (chip-thinning compensation) or at the nominal feed. A `machine`
+/// supplies `feed_plan.max_feed` and the dialect.
 #[utoipa::path(post, path = "/api/v1/engagement", tag = "engagement",
     params(EngagementQuery),
     request_body = EngagementRequest,
@@ -77,11 +85,11 @@ pub struct EngagementQuery {
         (status = 200, description = "The engagement analysis as JSON", body = EngagementResponse),
         (status = 200, description = "The program of one path (`?format=gcode`)", body = String, content_type = "text/x-gcode"),
         (status = 400, body = Problem, content_type = "application/problem+json"),
-        (status = 404, description = "Unknown tool number", body = Problem, content_type = "application/problem+json"),
+        (status = 404, description = "Unknown tool number or machine", body = Problem, content_type = "application/problem+json"),
         (status = 413, body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
         (status = 422, description = "Impossible or over a limit: `E_INPUT`, `E_PATH`, `E_STOCK`, `E_TOO_LARGE`, \
-            `E_TOO_MANY_SAMPLES`, `E_GRID_MEMORY`, `E_WORK_LIMIT`, `E_MACHINE_NOT_APPLIED` (engagement.md §9)",
+            `E_TOO_MANY_SAMPLES`, `E_GRID_MEMORY`, `E_WORK_LIMIT` (engagement.md §9)",
             body = Problem, content_type = "application/problem+json"),
         (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json"),
         (status = 503, description = "Over the synchronous time limit: submit a job", body = Problem, content_type = "application/problem+json")))]
@@ -96,43 +104,61 @@ async fn post_engagement(
         &OutputQuery { format: query.format, dialect: query.dialect, reference: query.reference },
     );
     let tool = store::tools::resolve(&state.db, &request.tool).await?;
-    let answer = state.solve(move || run(&request, tool)).await??;
+    let machine = store::machines::resolve(&state.db, request.machine.as_deref()).await?;
+    let answer = state.solve(move || run(&request, tool, machine)).await??;
     if output.gcode {
         let candidate = query.candidate.unwrap_or(0);
-        return Ok(gcode_response(program(&answer, candidate, output.dialect.unwrap_or_default(), output.reference)?));
+        let dialect = super::machines::dialect(output.dialect, answer.machine.as_ref());
+        return Ok(gcode_response(program(&answer, candidate, dialect, output.reference)?));
     }
     Ok(Json(answer).into_response())
 }
 
-/// Refuses a request that names a machine whose values it would need: machine profiles are
-/// not applied to engagement yet (only `feed_plan.max_feed` would come from one).
-fn check_machine(request: &EngagementRequest) -> Result<Option<Warning>, SolverError> {
-    let Some(machine) = &request.machine else {
-        return Ok(None);
+/// The request with the machine's values as defaults: its `max_feed` fills an absent
+/// `feed_plan.max_feed`; a larger `feed_plan.max_feed` is kept with `W_FEED_ABOVE_MACHINE_MAX`.
+fn with_machine<'a>(
+    request: &'a EngagementRequest,
+    machine: Option<&MachineProfile>,
+) -> Result<(Cow<'a, EngagementRequest>, Option<Warning>), SolverError> {
+    let Some(machine) = machine else {
+        if let Some(name) = &request.machine {
+            return Err(SolverError::input("machine", format!("machine {name:?} was not resolved")));
+        }
+        return Ok((Cow::Borrowed(request), None));
     };
-    if request.feed_plan.as_ref().is_some_and(|plan| plan.max_feed.is_some()) {
-        return Ok(Some(Warning::new(
-            "W_MACHINE_NOT_APPLIED",
-            format!(
-                "machine \"{machine}\" was not applied: machine profiles are not yet applied to engagement; \
-                 the request's own values (feed_plan.max_feed, ?dialect=) were used"
-            ),
-        )));
+    let Some(plan) = &request.feed_plan else { return Ok((Cow::Borrowed(request), None)) };
+    match plan.max_feed {
+        None => {
+            let mut filled = request.clone();
+            if let Some(plan) = &mut filled.feed_plan {
+                plan.max_feed = Some(machine.max_feed);
+            }
+            Ok((Cow::Owned(filled), None))
+        }
+        Some(max_feed) if max_feed > machine.max_feed => Ok((
+            Cow::Borrowed(request),
+            Some(Warning::new(
+                "W_FEED_ABOVE_MACHINE_MAX",
+                format!(
+                    "feed_plan.max_feed {max_feed} mm/min is above the machine's max_feed {} mm/min: the control \
+                     will not reach it",
+                    machine.max_feed
+                ),
+            )),
+        )),
+        Some(_) => Ok((Cow::Borrowed(request), None)),
     }
-    Err(SolverError::new(
-        "E_MACHINE_NOT_APPLIED",
-        format!(
-            "machine profiles are not yet applied to engagement: remove \"machine\" (\"{machine}\") and give \
-             feed_plan.max_feed (mm/min) instead, or keep it and give feed_plan.max_feed"
-        ),
-    )
-    .at("machine"))
 }
 
-/// Solves an engagement request with its resolved tool (used by the route and by jobs).
-pub fn run(request: &EngagementRequest, tool: Tool) -> Result<EngagementResponse, SolverError> {
-    let machine_warning = check_machine(request)?;
-    let mut result = engagement::solve(request, &tool)?;
+/// Solves an engagement request with its resolved tool and machine (used by the route and by
+/// jobs).
+pub fn run(
+    request: &EngagementRequest,
+    tool: Tool,
+    machine: Option<MachineProfile>,
+) -> Result<EngagementResponse, SolverError> {
+    let (request, machine_warning) = with_machine(request, machine.as_ref())?;
+    let mut result = engagement::solve(&request, &tool)?;
     if let Some(warning) = machine_warning {
         match &mut result {
             EngagementAnswer::Single(single) => single.warnings.push(warning),
@@ -145,6 +171,7 @@ pub fn run(request: &EngagementRequest, tool: Tool) -> Result<EngagementResponse
     }
     Ok(EngagementResponse {
         tool,
+        machine,
         stock: request.stock.clone(),
         thickness_limit: request.thickness_limit,
         time_limit_s: request.time_limit_s,

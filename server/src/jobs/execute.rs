@@ -118,7 +118,8 @@ pub fn execute(
             Operation::Contour(request) => {
                 // A job goes up to the solver's move limit; its stored JSON keeps what fits.
                 let tool = resolved_tool(index, &request.tool)?;
-                let mut answer = http::contour::run(request, tool, kerf_solver::corners::request::MAX_MOVES)
+                let machine = resolved_machine(job, index, request.machine.as_deref())?;
+                let mut answer = http::contour::run(request, tool, machine, kerf_solver::corners::request::MAX_MOVES)
                     .map_err(|e| refused(index, &e))?;
                 let program = http::contour::program(&answer, job.output.dialect, job.output.reference);
                 http::contour::limit_stored_moves(&mut answer);
@@ -126,7 +127,8 @@ pub fn execute(
             }
             Operation::Engagement(request) => {
                 let tool = resolved_tool(index, &request.tool)?;
-                let answer = http::engagement::run(request, tool).map_err(|e| refused(index, &e))?;
+                let machine = resolved_machine(job, index, request.machine.as_deref())?;
+                let answer = http::engagement::run(request, tool, machine).map_err(|e| refused(index, &e))?;
                 // One program per operation: the first path's.
                 let program = http::engagement::program(&answer, 0, job.output.dialect, job.output.reference);
                 output(index, operation, &answer, program)?

@@ -185,7 +185,9 @@ impl Operation {
         match self {
             Self::Deburr(request) => request.machine.as_deref(),
             Self::Segment(request) => request.machine.as_deref(),
-            Self::Contour(_) | Self::Engagement(_) | Self::Predict(_) => None,
+            Self::Contour(request) => request.machine.as_deref(),
+            Self::Engagement(request) => request.machine.as_deref(),
+            Self::Predict(_) => None,
         }
     }
 }

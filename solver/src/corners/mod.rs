@@ -82,4 +82,4 @@ pub use request::{
     ContourRequest, ControllerModel, CornerLoop, CornerOverride, CutDirection, Depths, Join, LoopStyle, PassSpec,
     Relief, Side, TboneEdge, Tilt,
 };
-pub use solve::{Plan, plan, solve, solve_within};
+pub use solve::{Plan, plan, solve, solve_with, solve_within};

@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::element::Chording;
 use super::prepare::{self, Contour};
-use crate::chord::{BlockRule, RuleSettings};
+use crate::chord::{BlockRule, MachineProfile, RuleSettings};
 use crate::error::{SolverError, Warning, finite, non_negative, positive};
 use crate::tool::{Tool, ToolKind, ToolRef};
 
@@ -322,12 +322,17 @@ pub struct ContourRequest {
     /// the block-time rule's chord error.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tolerance: Option<f64>,
-    /// Block processing time of the control, ms (chord.md). With it every arc is chorded at the
-    /// chord error whose chords last one block time at the arc's feed (`feed`; loops at the
-    /// larger of `feed` and `loop_feed`), never coarser than `tolerance`, and the summary reports
-    /// the blocks (`summary.blocks`).
+    /// Block processing time of the control, ms (chord.md; default: the machine's). With it every
+    /// arc is chorded at the chord error whose chords last one block time at the arc's feed
+    /// (`feed`; loops at the larger of `feed` and `loop_feed`), never coarser than `tolerance`,
+    /// and the summary reports the blocks (`summary.blocks`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub block_time_ms: Option<f64>,
+    /// A registered machine (controller profile): its block time, margin and minimum chord error
+    /// chord the arcs as `block_time_ms` does, and its dialect is the G-code default. The server
+    /// resolves it; the request's own `block_time_ms` wins.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub machine: Option<String>,
     /// Spindle speed, rpm (default 6000).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spindle_rpm: Option<f64>,
@@ -407,8 +412,8 @@ pub(crate) struct Job {
 }
 
 impl ContourRequest {
-    /// Checks every field and prepares the contour.
-    pub(crate) fn validate(&self, tool: &Tool) -> Result<Job, SolverError> {
+    /// Checks every field and prepares the contour, with `machine` resolved from `self.machine`.
+    pub(crate) fn validate(&self, tool: &Tool, machine: Option<&MachineProfile>) -> Result<Job, SolverError> {
         tool.validate("tool.")?;
         let radius = tool.radius;
         let feed = positive("feed", self.feed)?;
@@ -443,16 +448,23 @@ impl ContourRequest {
             ));
         }
         let mut rule_warnings = Vec::new();
-        let rules = match self.block_time_ms {
-            None => None,
-            Some(block_time_ms) => {
-                let settings =
-                    RuleSettings { feed: Some(feed), block_time_ms: Some(block_time_ms), ..RuleSettings::default() };
-                let (rule, warnings) = BlockRule::resolve(&settings, None)?;
-                rule_warnings = warnings;
-                let loops = BlockRule { feed: feed.max(loop_feed.unwrap_or(feed)), ..rule };
-                Some((rule, loops))
-            }
+        if let Some(name) = &self.machine
+            && machine.is_none()
+        {
+            return Err(SolverError::input(
+                "machine",
+                format!("machine {name:?} was not resolved: pass its profile (corners::solve_with)"),
+            ));
+        }
+        let rules = if self.block_time_ms.is_some() || machine.is_some() {
+            let settings =
+                RuleSettings { feed: Some(feed), block_time_ms: self.block_time_ms, ..RuleSettings::default() };
+            let (rule, warnings) = BlockRule::resolve(&settings, machine)?;
+            rule_warnings = warnings;
+            let loops = BlockRule { feed: feed.max(loop_feed.unwrap_or(feed)), ..rule };
+            Some((rule, loops))
+        } else {
+            None
         };
         let chording = Chording { tolerance, rules };
         let spindle_rpm = positive("spindle_rpm", self.spindle_rpm.unwrap_or(DEFAULT_SPINDLE_RPM))?;

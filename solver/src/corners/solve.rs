@@ -14,6 +14,7 @@ use super::material::{self, Material};
 use super::pass::{self, Action, GOUGE_TOLERANCE, MAX_ARC_STEPS, PassInput, PassPlan, Stock};
 use super::prepare::list_indices;
 use super::request::{ContourRequest, CutDirection, Job, Join, LoopStyle, MAX_MOVES, Side};
+use crate::chord::MachineProfile;
 use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
 use crate::planar::{SegmentGrid, Vec2, array2, cross, miter_point};
@@ -70,7 +71,7 @@ impl Setup {
 /// # Errors
 /// As [`solve`].
 pub fn plan(request: &ContourRequest, tool: &Tool) -> Result<Plan, SolverError> {
-    let job = request.validate(tool)?;
+    let job = request.validate(tool, None)?;
     let setup = Setup::new(&job);
     let z = job.layers.first().copied().unwrap_or(job.bottom);
     let layer = build_layer(&job, &setup, z)?;
@@ -101,8 +102,23 @@ pub fn solve(request: &ContourRequest, tool: &Tool) -> Result<ContourAnswer, Sol
 /// # Errors
 /// As [`solve`].
 pub fn solve_within(request: &ContourRequest, tool: &Tool, max_moves: usize) -> Result<ContourAnswer, SolverError> {
+    solve_with(request, tool, None, max_moves)
+}
+
+/// [`solve_within`] for a request that names a machine: `machine` is the profile its
+/// `machine` names (block time, margin and minimum chord error as defaults of the block-time
+/// rule; `W_FEED_ABOVE_MACHINE_MAX` when `feed` is above its `max_feed`).
+///
+/// # Errors
+/// As [`solve`]; `E_INPUT` at `machine` when the request names a machine and none is given.
+pub fn solve_with(
+    request: &ContourRequest,
+    tool: &Tool,
+    machine: Option<&MachineProfile>,
+    max_moves: usize,
+) -> Result<ContourAnswer, SolverError> {
     let max_moves = max_moves.min(MAX_MOVES);
-    let job = request.validate(tool)?;
+    let job = request.validate(tool, machine)?;
     let setup = Setup::new(&job);
     let first_z = job.layers.first().copied().unwrap_or(job.bottom);
     let first_layer = build_layer(&job, &setup, first_z)?;

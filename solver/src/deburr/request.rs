@@ -229,9 +229,32 @@ pub(crate) struct Job {
     pub rule_warnings: Vec<Warning>,
 }
 
+/// Largest length or coordinate accepted, mm (100 m: beyond any part, and far enough from the
+/// float range that squares and the bisection stay exact).
+pub const MAX_LENGTH: f64 = 1e5;
+/// Smallest radius, cut amount or width accepted, mm (0.1 µm: below any tool or feature).
+pub const MIN_LENGTH: f64 = 1e-4;
+
+/// A finite value within ±[`MAX_LENGTH`].
+fn bounded(field: &str, value: f64) -> Result<f64, SolverError> {
+    if finite(field, value)?.abs() > MAX_LENGTH {
+        return Err(SolverError::input(field, format!("{field} must lie within ±{MAX_LENGTH} mm (got {value})")));
+    }
+    Ok(value)
+}
+
+/// A size: finite, from [`MIN_LENGTH`] to [`MAX_LENGTH`].
+fn size(field: &str, value: f64) -> Result<f64, SolverError> {
+    let value = bounded(field, positive(field, value)?)?;
+    if value < MIN_LENGTH {
+        return Err(SolverError::input(field, format!("{field} must be at least {MIN_LENGTH} mm (got {value})")));
+    }
+    Ok(value)
+}
+
 fn point(field: &str, p: [f64; 3]) -> Result<[f64; 3], SolverError> {
     for (axis, value) in ["0", "1", "2"].iter().zip(p) {
-        finite(&format!("{field}[{axis}]"), value)?;
+        bounded(&format!("{field}[{axis}]"), value)?;
     }
     Ok(p)
 }
@@ -245,6 +268,7 @@ impl DeburrRequest {
     /// (resolved from `self.machine`).
     pub(crate) fn validate(&self, tool: &Tool, machine: Option<&MachineProfile>) -> Result<Job, SolverError> {
         tool.validate("tool.")?;
+        size("tool.radius", tool.radius)?;
         if tool.kind != ToolKind::Ball {
             return Err(SolverError::new(
                 "E_TOOL_KIND",
@@ -254,8 +278,8 @@ impl DeburrRequest {
         }
         let (origin, arrangement, cylinder_radius, tube_radii, top_distance) = match &self.workpiece {
             Workpiece::Tube { origin, arrangement_angle_deg, inner_radius, outer_radius } => {
-                let inner = positive("workpiece.inner_radius", *inner_radius)?;
-                let outer = positive("workpiece.outer_radius", *outer_radius)?;
+                let inner = size("workpiece.inner_radius", *inner_radius)?;
+                let outer = size("workpiece.outer_radius", *outer_radius)?;
                 if inner >= outer {
                     return Err(SolverError::new(
                         "E_NOT_THROUGH",
@@ -267,12 +291,12 @@ impl DeburrRequest {
                 (origin, arrangement_angle_deg, r1, Some((inner, outer)), Some(outer))
             }
             Workpiece::BoreBlock { origin, arrangement_angle_deg, bore_radius, face_distance } => {
-                let bore = positive("workpiece.bore_radius", *bore_radius)?;
+                let bore = size("workpiece.bore_radius", *bore_radius)?;
                 if self.edge != Edge::Inner {
                     return Err(SolverError::input("edge", "a bore_block has only an inner edge (edge: \"inner\")"));
                 }
                 if let Some(face) = face_distance {
-                    positive("workpiece.face_distance", *face)?;
+                    size("workpiece.face_distance", *face)?;
                     if *face <= bore {
                         return Err(SolverError::input(
                             "workpiece.face_distance",
@@ -287,25 +311,25 @@ impl DeburrRequest {
         let arrangement = finite("workpiece.arrangement_angle_deg", *arrangement)?;
 
         let hole = &self.hole;
-        let radius = positive("hole.radius", hole.radius)?;
+        let radius = size("hole.radius", hole.radius)?;
         let penetration = finite("hole.penetration_angle_deg", hole.penetration_angle_deg)?;
         let start = finite("start_deg", self.start_deg)?;
         if start != 0.0 && hole.shape != HoleShape::Round {
             return Err(SolverError::input("start_deg", "start_deg applies only to round holes"));
         }
-        let eccentricity = hole.eccentricity.map(|f| finite("hole.eccentricity", f)).transpose()?;
+        let eccentricity = hole.eccentricity.map(|f| bounded("hole.eccentricity", f)).transpose()?;
         let axis_point = hole.axis_point.map(|p| point("hole.axis_point", p)).transpose()?.map(vec3);
         let (frame, eccentricity) = Frame::resolve(origin, arrangement, penetration, axis_point, eccentricity)?;
 
         let profile = match (hole.shape, hole.centre_distance) {
             (HoleShape::Round, None) => Profile::round(radius, eccentricity, start.to_radians()),
             (HoleShape::Slot, Some(CentreDistance::Along(length))) => {
-                let length = non_negative("hole.centre_distance", length)?;
+                let length = bounded("hole.centre_distance", non_negative("hole.centre_distance", length)?)?;
                 Profile::rounded_rect(radius, eccentricity, 0.0, length / 2.0, true)
             }
             (HoleShape::RoundedRect, Some(CentreDistance::AcrossAlong([across, along]))) => {
-                let across = non_negative("hole.centre_distance[0]", across)?;
-                let along = non_negative("hole.centre_distance[1]", along)?;
+                let across = bounded("hole.centre_distance[0]", non_negative("hole.centre_distance[0]", across)?)?;
+                let along = bounded("hole.centre_distance[1]", non_negative("hole.centre_distance[1]", along)?)?;
                 Profile::rounded_rect(radius, eccentricity, across / 2.0, along / 2.0, false)
             }
             (HoleShape::Round, Some(_)) => {
@@ -327,11 +351,11 @@ impl DeburrRequest {
 
         let (width, cut_amount) = match (self.cut_amount, self.width) {
             (Some(q), None) => {
-                let q = positive("cut_amount", q)?;
+                let q = size("cut_amount", q)?;
                 (q * std::f64::consts::SQRT_2, q)
             }
             (None, Some(w)) => {
-                let w = positive("width", w)?;
+                let w = size("width", w)?;
                 (w, w / std::f64::consts::SQRT_2)
             }
             (Some(_), Some(_)) => {
@@ -349,7 +373,7 @@ impl DeburrRequest {
             )
             .at("tolerance"));
         }
-        let safe_z = self.safe_z.map(|z| finite("safe_z", z)).transpose()?;
+        let safe_z = self.safe_z.map(|z| bounded("safe_z", z)).transpose()?;
         let feed = optional_positive("feed", self.feed, DEFAULT_FEED)?;
         if let Some(name) = &self.machine
             && machine.is_none()
@@ -382,8 +406,11 @@ impl DeburrRequest {
             tool: tool.clone(),
             feed,
             spindle_rpm: optional_positive("spindle_rpm", self.spindle_rpm, DEFAULT_SPINDLE_RPM)?,
-            clearance: optional_positive("clearance", self.clearance, DEFAULT_CLEARANCE)?,
-            lead_distance: optional_positive("lead_distance", self.lead_distance, DEFAULT_LEAD_DISTANCE)?,
+            clearance: bounded("clearance", optional_positive("clearance", self.clearance, DEFAULT_CLEARANCE)?)?,
+            lead_distance: bounded(
+                "lead_distance",
+                optional_positive("lead_distance", self.lead_distance, DEFAULT_LEAD_DISTANCE)?,
+            )?,
             safe_z,
             rule,
             rule_warnings,

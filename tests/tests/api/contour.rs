@@ -792,3 +792,48 @@ async fn block_time_rule_chooses_the_arc_chords_and_reports_the_blocks() {
     );
     assert!(fast["summary"]["blocks"]["short_blocks"].as_u64().unwrap() > 0);
 }
+
+/// A named machine gives the block time (and margin) of the rule, its dialect is the G-code
+/// default, the request's `block_time_ms` wins over it, and jobs resolve it like the endpoint.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_named_machine_gives_the_block_time_and_dialect() {
+    let app = app_with_tools().await;
+    let mut body = reference_request("C1");
+    body["machine"] = json!("mill-4ms");
+    let unknown = problem(app.post_json("/api/v1/contour", &body).await, 404).await;
+    assert_eq!(unknown["errors"][0]["path"], "machine");
+
+    let machine = json!({"block_time_ms": 4, "max_feed": 600, "dialect": "linuxcnc"});
+    json_with(app.put_json("/api/v1/machines/mill-4ms", &machine).await, 201).await;
+    let from_machine = json_with(app.post_json("/api/v1/contour", &body).await, 200).await;
+    assert_eq!(from_machine["machine"]["block_time_ms"], 4.0);
+    assert_eq!(from_machine["summary"]["blocks"]["block_time_ms"], 4.0);
+    let codes: Vec<&str> =
+        from_machine["warnings"].as_array().unwrap().iter().map(|w| w["code"].as_str().unwrap()).collect();
+    assert!(codes.contains(&"W_FEED_ABOVE_MACHINE_MAX"), "feed 800 over the machine's 600: {codes:?}");
+    let mut explicit = reference_request("C1");
+    explicit["block_time_ms"] = json!(4);
+    let explicit = json_with(app.post_json("/api/v1/contour", &explicit).await, 200).await;
+    assert_eq!(from_machine["layers"], explicit["layers"], "the machine's block time chords as the request's");
+
+    body["block_time_ms"] = json!(10);
+    let overridden = json_with(app.post_json("/api/v1/contour", &body).await, 200).await;
+    assert_eq!(overridden["summary"]["blocks"]["block_time_ms"], 10.0);
+
+    let response = app.client.post(app.url("/api/v1/contour?format=gcode")).json(&body).send().await.unwrap();
+    assert_eq!(response.status(), 200);
+    let program = response.text().await.unwrap();
+    assert!(!program.starts_with('%') && program.contains("G64"), "linuxcnc from the machine:\n{program}");
+
+    let mut operation = body.clone();
+    operation["operation"] = json!("contour");
+    let job = json!({"operations": [operation]});
+    let response =
+        app.client.post(app.url("/api/v1/jobs")).header("content-type", "application/json").body(job.to_string());
+    let submitted = json_with(response.send().await.unwrap(), 202).await;
+    let job = poll_job(&app.client, &app.base, submitted["id"].as_i64().unwrap(), 60, finished).await;
+    assert_eq!(job["status"], "done", "{job}");
+    let result = &job["results"][0]["result"];
+    assert_eq!(result["machine"]["name"], "mill-4ms");
+    assert_eq!(result["layers"], overridden["layers"], "the job's answer is the endpoint's");
+}

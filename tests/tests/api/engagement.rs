@@ -430,24 +430,36 @@ async fn a_path_that_never_touches_the_stock_is_a_warning() {
     assert_eq!(recommended(&answer), vec![8, 7, 6, 5, 4, 3, 2], "only T2 decides");
 }
 
-/// A request naming a machine: refused at `machine` until machine profiles reach engagement,
-/// unless `feed_plan.max_feed` (the one value a machine would give) is in the request.
+/// A request naming a machine takes its `max_feed` as the feed plan's cap and its dialect for
+/// G-code; a cap above the machine's is kept with a warning; an unknown machine is 404.
 #[tokio::test(flavor = "multi_thread")]
-async fn a_named_machine_is_refused_unless_its_value_is_given() {
+async fn a_named_machine_caps_the_feed_plan_and_sets_the_dialect() {
     let app = TestApp::spawn().await;
     let mut body = api_example();
     body["machine"] = json!("vmc-1");
-    let refused = problem(app.post_json(URL, &body).await, 422).await;
-    assert_eq!(refused["code"], "E_MACHINE_NOT_APPLIED");
-    assert_eq!(refused["errors"][0]["path"], "machine");
-    assert!(refused["detail"].as_str().unwrap().contains("not yet applied to engagement"), "{refused}");
     body["feed_plan"] = json!({"target_thickness": 0.05});
-    let refused = problem(app.post_json(URL, &body).await, 422).await;
-    assert_eq!(refused["errors"][0]["path"], "machine");
-    body["feed_plan"]["max_feed"] = json!(2000);
+    let unknown = problem(app.post_json(URL, &body).await, 404).await;
+    assert_eq!(unknown["errors"][0]["path"], "machine");
+
+    let machine = json!({"block_time_ms": 4, "max_feed": 900, "dialect": "linuxcnc"});
+    json_with(app.put_json("/api/v1/machines/vmc-1", &machine).await, 201).await;
     let answer = json_with(app.post_json(URL, &body).await, 200).await;
-    assert!(answer["warnings"].as_array().unwrap().iter().any(|w| w["code"] == "W_MACHINE_NOT_APPLIED"));
-    assert_eq!(answer["feed_plan"]["max_feed"], 2000.0);
+    assert_eq!(answer["machine"]["max_feed"], 900.0);
+    assert_eq!(answer["feed_plan"]["max_feed"], 900.0, "{}", answer["feed_plan"]);
+    let feeds: Vec<f64> =
+        answer["feed_plan"]["blocks"].as_array().unwrap().iter().map(|block| num(&block["feed"])).collect();
+    assert!(!feeds.is_empty() && feeds.iter().all(|&feed| feed <= 900.0 + 1e-9), "{feeds:?}");
+
+    body["axial_depth"] = json!(2);
+    let response = app.client.post(app.url(&format!("{URL}?format=gcode"))).json(&body).send().await.unwrap();
+    assert_eq!(response.status(), 200);
+    let program = response.text().await.unwrap();
+    assert!(!program.starts_with('%') && program.contains("G64"), "linuxcnc from the machine:\n{program}");
+
+    body["feed_plan"]["max_feed"] = json!(5000);
+    let answer = json_with(app.post_json(URL, &body).await, 200).await;
+    assert_eq!(answer["feed_plan"]["max_feed"], 5000.0);
+    assert!(answer["warnings"].as_array().unwrap().iter().any(|w| w["code"] == "W_FEED_ABOVE_MACHINE_MAX"));
 }
 
 /// The example job's engagement operation gives exactly the endpoint's answer for the same
@@ -780,7 +792,7 @@ fn bad_cases() -> Vec<(&'static str, Value, &'static str, u16, &'static str, &'s
             "feed_plan.max_feed",
             "E_INPUT",
         ),
-        ("machine named", with(json!({"machine": "vmc-1"})), "", 422, "machine", "E_MACHINE_NOT_APPLIED"),
+        ("unknown machine", with(json!({"machine": "vmc-1"})), "", 404, "machine", "E_NOT_FOUND"),
         ("unknown tool", with(json!({"tool": 4242})), "", 404, "tool", "E_NOT_FOUND"),
         (
             "inline tool of radius zero",
