@@ -71,6 +71,17 @@ export function download(name, text, type = 'text/plain') {
   setTimeout(() => URL.revokeObjectURL(url), 1000);
 }
 
+// The text of form control `name`.
+export function value(form, name) {
+  return form.elements[name].value;
+}
+
+// The number in form control `name`, or undefined when it is empty.
+export function numeric(form, name) {
+  const text = value(form, name).trim();
+  return text === '' ? undefined : Number(text);
+}
+
 // Fills a tool <select> with an "inline" entry and the table's tools that `accepts`, keeping
 // the choice when it is still there. Without the table the inline tool still works.
 export async function loadTools(select, inlineLabel, accepts = () => true, describe = toolLabel) {

@@ -3,7 +3,7 @@
 // selector; loops, reliefs, links and corners in their own colours; wheel to zoom, drag to pan,
 // double-click to fit), the corner table with the material left or over-cut, the summary, the
 // warnings and the G-code download. `contourResult` also renders job results.
-import { api, download, gcodeQuery, loadMachines, loadTools, message, number, programName, showProblem } from '/app.js';
+import { api, download, gcodeQuery, loadMachines, loadTools, message, number, numeric, programName, showProblem, value } from '/app.js';
 
 // An arrow-shaped island: five protruding corners (a 64° tip among them) and two inside corners.
 const SAMPLE = `# x, y in mm, counter-clockwise; one point a line
@@ -84,15 +84,6 @@ export function parsePoints(text) {
     points.push(values);
   }
   return { points };
-}
-
-function value(form, name) {
-  return form.elements[name].value;
-}
-
-function numeric(form, name) {
-  const text = value(form, name).trim();
-  return text === '' ? undefined : Number(text);
 }
 
 // The request body from the form (field names as api.md); throws {error, line} for bad points.

@@ -1,6 +1,6 @@
 // Deburr view: a form for one cross-hole ridge, the 3-D plot of ridge and ball-centre path,
 // the summary, warnings and the G-code download (api.md, Deburr).
-import { api, download, gcodeQuery, loadMachines, loadTools, message, number, programName, showProblem } from '/app.js';
+import { api, download, gcodeQuery, loadMachines, loadTools, message, number, numeric, programName, showProblem, value } from '/app.js';
 import { Plot3D } from '/plot3d.js';
 
 const FORM = `
@@ -57,15 +57,6 @@ const FORM = `
     <div id="deburr-result"></div>
   </section>
 </div>`;
-
-function value(form, name) {
-  return form.elements[name].value;
-}
-
-function numeric(form, name) {
-  const text = value(form, name).trim();
-  return text === '' ? undefined : Number(text);
-}
 
 // The request body from the form (field names as api.md).
 export function deburrRequest(form) {

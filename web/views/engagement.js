@@ -4,7 +4,7 @@
 // summed chip thickness per flute count with the threshold, representative values and time per
 // k with the recommended k highlighted, and the feed plan; a cursor on any chart marks the tool
 // on the path. The result renderer is shared with the Jobs view.
-import { api, download, gcodeQuery, loadMachines, loadTools, message, number, programName, showProblem, toolLabel } from '/app.js';
+import { api, download, gcodeQuery, loadMachines, loadTools, message, number, numeric, programName, showProblem, toolLabel, value } from '/app.js';
 
 const SAMPLE_PATHS = [
   { name: 'straight', text: '-10 20\n70 20' },
@@ -78,15 +78,6 @@ class InputError {
     this.detail = detail;
     this.errors = [{ path: field, message: detail }];
   }
-}
-
-function value(form, name) {
-  return form.elements[name].value;
-}
-
-function numeric(form, name) {
-  const text = value(form, name).trim();
-  return text === '' ? undefined : Number(text);
 }
 
 // "x y" per line (or "x, y"), or JSON. Returns the JSON value or a list of points.

@@ -3,7 +3,7 @@
 // G-code program, cutting conditions, method), the path coloured by predicted error with a colour
 // scale, a histogram of the errors, the worst passes with their NC lines, warnings, and the
 // corrected program. `predictResult` also shows prediction jobs.
-import { api, download, loadTools, message, number, showProblem, toolLabel } from '/app.js';
+import { api, download, loadTools, message, number, numeric, showProblem, toolLabel, value } from '/app.js';
 import { Plot3D } from '/plot3d.js';
 
 // The sample: a raster finishing program over a gentle dome (20 × 20 mm, 2 mm high) with an R3
@@ -130,15 +130,6 @@ const FORM = `
     <div id="predict-result"></div>
   </section>
 </div>`;
-
-function value(form, name) {
-  return form.elements[name].value;
-}
-
-function numeric(form, name) {
-  const text = value(form, name).trim();
-  return text === '' ? undefined : Number(text);
-}
 
 function rows(text) {
   return text.split('\n').map((l) => l.trim()).filter((l) => l !== '').map((l) => l.split(/[\s,;]+/).map(Number));

@@ -1,7 +1,7 @@
 // Segment view: cut a curve into G01 blocks by the control's block time (api.md, Segment;
 // chord.md). A form for the curve and the rule, the curve with its blocks, the chord error and the
 // block length along the curve, the rule side by side with a fixed tolerance, G-code download.
-import { api, download, loadMachines, message, number, showProblem } from '/app.js';
+import { api, download, loadMachines, message, number, numeric, showProblem, value } from '/app.js';
 import { PlanPlot, drawChart } from '/plot2d.js';
 
 const FORM = `
@@ -57,15 +57,6 @@ const FORM = `
     <div id="segment-result"></div>
   </section>
 </div>`;
-
-function value(form, name) {
-  return form.elements[name].value;
-}
-
-function numeric(form, name) {
-  const text = value(form, name).trim();
-  return text === '' ? undefined : Number(text);
-}
 
 // "x y [z]" per line (commas or spaces), or a JSON array.
 function pointList(text) {
