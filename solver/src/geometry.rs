@@ -1,7 +1,31 @@
-//! Shared geometry: vector aliases, rotations, point-to-segment distance and a safeguarded
-//! one-dimensional root finder.
+//! Shared geometry: vector aliases, rotations, the sense of travel, point-to-segment distance
+//! and a safeguarded one-dimensional root finder.
 
 use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// Sense of travel round a loop or along an arc, seen from the side the field using it names
+/// (+Z for curves and arcs in XY).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Direction {
+    /// Counter-clockwise (increasing angle; G3 for an arc).
+    #[default]
+    Ccw,
+    /// Clockwise (G2 for an arc).
+    Cw,
+}
+
+impl Direction {
+    /// +1 counter-clockwise, −1 clockwise.
+    pub fn sign(self) -> f64 {
+        match self {
+            Self::Ccw => 1.0,
+            Self::Cw => -1.0,
+        }
+    }
+}
 
 /// A 3-D point or free vector in millimetres.
 pub type Vec3 = Vector3<f64>;

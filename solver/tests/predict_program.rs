@@ -5,7 +5,7 @@
 mod predict_support;
 
 use kerf_solver::gcode::reader::{self, ReadOptions};
-use kerf_solver::gcode::{Dialect, Reference, ToolCall};
+use kerf_solver::gcode::{Dialect, Reference, SpindleDirection, ToolCall};
 use kerf_solver::predict::{
     self, CorrectionOptions, PassFlag, PassStatus, PathInput, PredictRequest, PrescribedDeflection, ProgramOptions,
     Stock,
@@ -139,6 +139,11 @@ fn points_become_a_complete_program() {
     assert!(text.contains("S8000 M03"));
     assert!(text.contains("G01 X"));
     assert!(text.ends_with("M30\n%\n"));
+    // A counter-clockwise spindle (which the prediction assumed) is started with M04.
+    request.spindle_direction = Some(SpindleDirection::Ccw);
+    let answer = predict::solve(&request, &tool, None).unwrap();
+    let text = predict::corrected_program(&request, &answer, &options()).unwrap();
+    assert!(text.contains("S8000 M04") && !text.contains("M03"), "{text}");
 }
 
 #[test]

@@ -8,7 +8,7 @@
 
 use super::answer::SegmentAnswer;
 use crate::error::SolverError;
-use crate::gcode::{self, Post, Program};
+use crate::gcode::{self, Post, Program, SpindleDirection};
 use crate::geometry::Vec3;
 use crate::path::Toolpath;
 
@@ -48,6 +48,7 @@ pub fn program(answer: &SegmentAnswer, post: &Post) -> Result<String, SolverErro
         comments: answer.description.clone(),
         tool: post.tool.clone(),
         spindle_rpm: answer.spindle_rpm,
+        spindle_direction: SpindleDirection::Cw,
         safe_z: answer.safe_z,
         blend_tolerance: answer.chord_error.max(1e-4),
         path: &path,

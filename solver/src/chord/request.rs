@@ -1,6 +1,7 @@
 //! The segment request as clients send it (api.md, Segment) and its validation into a `Job`
 //! with the machine's defaults applied (chord.md §1.2 inputs, §4 E6 and E16).
 
+pub use crate::geometry::Direction;
 use serde::{Deserialize, Serialize};
 
 use super::arclength::ArcLengthTable;
@@ -27,18 +28,6 @@ pub const DEFAULT_WINDOW_CHORDS: f64 = 5.0;
 pub const DEFAULT_SPINDLE_RPM: f64 = 6000.0;
 /// Default height of the clearance plane above the curve's highest point, mm.
 pub const DEFAULT_CLEARANCE: f64 = 5.0;
-
-/// Travel direction, seen from +Z.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
-#[serde(rename_all = "snake_case")]
-pub enum Direction {
-    /// Counter-clockwise (increasing angle).
-    #[default]
-    Ccw,
-    /// Clockwise.
-    Cw,
-}
 
 /// The target curve. Points are `[x, y]` (the XY plane) or `[x, y, z]`; circles, arcs and
 /// ellipses lie in a plane parallel to XY at the centre's z.
@@ -325,13 +314,6 @@ fn sweep(start_deg: f64, end_deg: f64, direction: Direction) -> f64 {
     if wrapped == 0.0 && forward != 0.0 { std::f64::consts::TAU } else { wrapped.to_radians() }
 }
 
-fn sense(direction: Direction) -> f64 {
-    match direction {
-        Direction::Ccw => 1.0,
-        Direction::Cw => -1.0,
-    }
-}
-
 fn corner_angle(value: Option<f64>) -> Result<f64, SolverError> {
     let field = "curve.corner_angle_deg";
     let degrees = value.unwrap_or(DEFAULT_CORNER_ANGLE_DEG);
@@ -352,7 +334,7 @@ impl Curve {
                     centre: c,
                     radius: radius("curve.radius", *r)?,
                     start: finite("curve.start_deg", *start_deg)?.to_radians(),
-                    sense: sense(*direction),
+                    sense: direction.sign(),
                     sweep: std::f64::consts::TAU,
                 });
                 (shape, Vec::new(), centre.len())
@@ -373,7 +355,7 @@ impl Curve {
                     centre: c,
                     radius: radius("curve.radius", *r)?,
                     start: start.to_radians(),
-                    sense: sense(*direction),
+                    sense: direction.sign(),
                     sweep: swept,
                 });
                 (shape, Vec::new(), centre.len())
@@ -396,7 +378,7 @@ impl Curve {
                     .at("curve.end_deg"));
                 }
                 let start = start.to_radians();
-                let sense = sense(*direction);
+                let sense = direction.sign();
                 let speed = |u: f64| {
                     let t = start + sense * u;
                     (a * t.sin()).hypot(b * t.cos())

@@ -4,8 +4,8 @@
 
 use super::answer::{ContourAnswer, MoveKind};
 use crate::error::SolverError;
-use crate::gcode::Post;
-use crate::gcode::{self, Program, Reference};
+
+use crate::gcode::{self, Post, Program, Reference, SpindleDirection};
 use crate::geometry::Vec3;
 use crate::path::Toolpath;
 
@@ -46,6 +46,7 @@ pub fn program(answer: &ContourAnswer, post: &Post) -> Result<String, SolverErro
         comments,
         tool: post.tool.clone(),
         spindle_rpm: answer.summary.spindle_rpm,
+        spindle_direction: SpindleDirection::Cw,
         safe_z: answer.summary.safe_z + lift,
         blend_tolerance: answer.summary.tolerance,
         path: &path,

@@ -10,7 +10,7 @@ use super::answer::{Deburr, LeadMotion, LeadMove};
 use super::frame::Frame;
 use super::request::{Edge, Job};
 use crate::error::SolverError;
-use crate::gcode::{self, Post, Program, Reference};
+use crate::gcode::{self, Post, Program, Reference, SpindleDirection};
 use crate::geometry::{Vec3, array3, vec3};
 use crate::path::Toolpath;
 
@@ -127,6 +127,7 @@ pub fn program(deburr: &Deburr, post: &Post) -> Result<String, SolverError> {
         comments,
         tool: post.tool.clone(),
         spindle_rpm: deburr.summary.spindle_rpm,
+        spindle_direction: SpindleDirection::Cw,
         safe_z: safe_centre_z + offset.z,
         blend_tolerance: deburr.summary.tolerance,
         path: &path,

@@ -1,6 +1,7 @@
 //! The deburr request as clients send it (api.md, Deburr) and its validation into a [`Job`]
 //! (deburr.md §1.4 inputs, §4 `E_INPUT`/`E_NOT_THROUGH`/`E_INCONSISTENT_ECC`).
 
+pub use crate::geometry::Direction;
 use serde::{Deserialize, Serialize};
 
 use super::frame::Frame;
@@ -129,18 +130,6 @@ pub enum Method {
     Exact,
 }
 
-/// Travel direction seen from +z_L (outside the hole, looking down its axis).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
-#[serde(rename_all = "snake_case")]
-pub enum Direction {
-    /// Counter-clockwise (increasing φ): climb milling with M03 on both ridges.
-    #[default]
-    Ccw,
-    /// Clockwise: conventional milling.
-    Cw,
-}
-
 /// `POST /api/v1/deburr`: deburr one ridge of a cross hole with a ball end mill.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
@@ -169,7 +158,8 @@ pub struct DeburrRequest {
     /// φ_0: where a round hole's loop starts, degrees from +x_L (round holes only).
     #[serde(default)]
     pub start_deg: f64,
-    /// `ccw` (default, climb milling with M03) or `cw`.
+    /// Travel seen from +z_L (outside the hole, looking down its axis): `ccw` (default,
+    /// increasing φ: climb milling with M03 on both ridges) or `cw` (conventional milling).
     #[serde(default)]
     pub direction: Direction,
     /// Cutting feed, mm/min (default 300).

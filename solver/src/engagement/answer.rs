@@ -283,6 +283,7 @@ pub(crate) struct PostData {
     pub route: RouteData,
     pub nominal_feed: f64,
     pub spindle_rpm: f64,
+    pub spindle_direction: crate::gcode::SpindleDirection,
     pub axial_depth: Option<f64>,
     pub stock_top_z: f64,
     pub clearance: f64,

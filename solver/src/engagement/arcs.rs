@@ -1,7 +1,8 @@
 //! Engaged arcs on the tool circle in the angle convention of engagement.md §4.1: merging and
 //! the numeric rules of §9, radial depth (§5.5), and the per-arc quantities of §5.4 and §5.10.
 
-use serde::{Deserialize, Serialize};
+pub use crate::gcode::SpindleDirection;
+use serde::Serialize;
 
 /// Two arc ends closer than this (degrees) touch.
 const TOUCH_DEG: f64 = 1e-9;
@@ -172,18 +173,6 @@ pub(crate) fn mean_thickness_ratio(arcs: &[Arc]) -> f64 {
         }
     }
     integral / total
-}
-
-/// Spindle rotation seen from the spindle (§4.2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
-#[serde(rename_all = "snake_case")]
-pub enum SpindleDirection {
-    /// M03, right-hand cutter: teeth run 180° → 90° → 0°; material right of travel is climb cut.
-    #[default]
-    Cw,
-    /// M04: teeth run 0° → 90° → 180°.
-    Ccw,
 }
 
 /// How a tooth passes through one engaged arc (§5.4, an extension of the spec).

@@ -460,6 +460,7 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
             route: RouteData(route.clone()),
             nominal_feed,
             spindle_rpm: job.spindle_rpm,
+            spindle_direction: job.direction,
             axial_depth: job.axial_depth,
             stock_top_z: job.stock_top_z,
             clearance: job.clearance,

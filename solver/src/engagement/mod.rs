@@ -48,6 +48,7 @@ mod segments;
 mod stock;
 mod teeth;
 
+pub use crate::geometry::Direction;
 pub use answer::{
     ArcDetail, Comparison, EngagementAnswer, EngagementSample, FeedBlock, FeedLimit, FeedPlan, FluteResult, GridInfo,
     PathEngagement, SampleFlag,
@@ -55,8 +56,8 @@ pub use answer::{
 pub use arcs::{MillingMode, SpindleDirection};
 pub use program::program;
 pub use request::{
-    ArcDirection, Candidate, EngagementRequest, Engine, FeedBasis, FeedPlanRequest, PathInput, PathSegments,
-    PreviousCut, Representative, SegmentInput, Stock, StockBitmap, StockPolygon,
+    Candidate, EngagementRequest, Engine, FeedBasis, FeedPlanRequest, PathInput, PathSegments, PreviousCut,
+    Representative, SegmentInput, Stock, StockBitmap, StockPolygon,
 };
 
 use crate::error::SolverError;

@@ -144,6 +144,7 @@ pub fn program(answer: &EngagementAnswer, candidate: usize, post: &Post) -> Resu
         comments,
         tool: post.tool.clone(),
         spindle_rpm: data.spindle_rpm,
+        spindle_direction: data.spindle_direction,
         safe_z,
         blend_tolerance: CHORD_TOLERANCE * 5.0,
         path: &path,

@@ -1,6 +1,7 @@
 //! The engagement request as clients send it (api.md, Engagement; engagement.md §2) and its
 //! validation into a `Job` before any heavy work (§9 `E_INPUT`, `E_PATH`, and the size limits).
 
+pub use crate::geometry::Direction;
 use std::fmt;
 
 use serde::de::{self, MapAccess, SeqAccess, Visitor};
@@ -19,17 +20,6 @@ use crate::error::{SolverError, Warning, finite, non_negative, positive};
 use crate::gcode::reader::{MoveKind, Plane, ReadOptions, read as read_program};
 use crate::planar::signed_area;
 use crate::tool::{Tool, ToolRef};
-
-/// Direction of a circular segment.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
-#[serde(rename_all = "snake_case")]
-pub enum ArcDirection {
-    /// Counter-clockwise seen from +Z (G3).
-    Ccw,
-    /// Clockwise (G2).
-    Cw,
-}
 
 /// One move of a path given as `start` + `segments` (engagement.md §2.3).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -56,7 +46,7 @@ pub enum SegmentInput {
         center: [f64; 2],
         /// `ccw` (G3) or `cw` (G2).
         #[serde(alias = "direction")]
-        dir: ArcDirection,
+        dir: Direction,
     },
 }
 
@@ -310,7 +300,9 @@ pub struct EngagementRequest {
     /// Statistic compared with T1: `max` (default), `mean` or `median`.
     #[serde(default)]
     pub representative: Representative,
-    /// `cw` (default, M03) or `ccw`.
+    /// `cw` (default, M03; right-hand cutter, teeth run 180° → 90° → 0° of the tool angle, so
+    /// material right of travel is climb cut) or `ccw` (M04; teeth run 0° → 90° → 180°). The
+    /// G-code program starts the spindle this way.
     #[serde(default)]
     pub spindle_direction: SpindleDirection,
     /// `exact` (default) or `dots`.
@@ -542,7 +534,7 @@ pub(crate) fn read_path(input: &PathInput, field: &str, warnings: &mut Vec<Warni
                         let to = point(&format!("{here}.to"), *to)?;
                         let centre = point(&format!("{here}.center"), *center)?;
                         shapes.push((
-                            arc_shape(from, to, centre, *dir == ArcDirection::Cw, 0, &format!("{here}.center"))?,
+                            arc_shape(from, to, centre, *dir == Direction::Cw, 0, &format!("{here}.center"))?,
                             false,
                             index,
                         ));

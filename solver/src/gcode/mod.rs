@@ -93,14 +93,38 @@ pub struct Program<'a> {
     pub comments: Vec<String>,
     /// The tool.
     pub tool: ToolCall,
-    /// Spindle speed, rpm (clockwise, M03).
+    /// Spindle speed, rpm.
     pub spindle_rpm: f64,
+    /// Spindle rotation (M03 or M04).
+    pub spindle_direction: SpindleDirection,
     /// Z of the clearance plane the program starts and ends at.
     pub safe_z: f64,
     /// Path blending tolerance for LinuxCNC's `G64 P`, mm.
     pub blend_tolerance: f64,
     /// The moves; the first should start from the clearance plane.
     pub path: &'a Toolpath,
+}
+
+/// Spindle rotation seen from the spindle, looking down the tool at the workpiece.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum SpindleDirection {
+    /// M03, clockwise: a right-hand cutter cuts.
+    #[default]
+    Cw,
+    /// M04, counter-clockwise.
+    Ccw,
+}
+
+impl SpindleDirection {
+    /// The M code that starts the spindle this way.
+    pub fn m_code(self) -> &'static str {
+        match self {
+            Self::Cw => "M03",
+            Self::Ccw => "M04",
+        }
+    }
 }
 
 /// A coordinate or value in mm with 4 decimals, never printed as `-0.0000`.
@@ -147,7 +171,7 @@ pub fn write(program: &Program<'_>) -> String {
             let _ = writeln!(out, "G00 Z{}", mm(program.safe_z));
         }
     }
-    let _ = writeln!(out, "S{} M03", program.spindle_rpm.round());
+    let _ = writeln!(out, "S{} {}", program.spindle_rpm.round(), program.spindle_direction.m_code());
     let mut current_feed: Option<f64> = None;
     for step in &program.path.moves {
         let (x, y, z) = (mm(step.to.x), mm(step.to.y), mm(step.to.z));
@@ -212,6 +236,7 @@ mod tests {
             comments: vec!["tool t7".to_owned()],
             tool: ToolCall::Table(7),
             spindle_rpm: 6000.0,
+            spindle_direction: SpindleDirection::Cw,
             safe_z: 50.0,
             blend_tolerance: 0.01,
             path: &path,

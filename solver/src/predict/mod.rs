@@ -455,6 +455,7 @@ pub fn corrected_program(
                 ],
                 tool: options.tool.clone(),
                 spindle_rpm,
+                spindle_direction: request.spindle_direction.unwrap_or_default(),
                 safe_z,
                 blend_tolerance: 0.001,
                 path: &path,

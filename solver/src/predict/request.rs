@@ -2,6 +2,7 @@
 //! a `Job`: tool, stock, tool path (points or G-code read into ball-centre passes), cutting
 //! conditions and method settings, with every limit checked before any heavy work.
 
+pub use crate::gcode::SpindleDirection;
 use serde::{Deserialize, Serialize};
 
 use super::force::CuttingCoefficients;
@@ -54,18 +55,6 @@ pub enum PathInput {
         /// The program text.
         program: String,
     },
-}
-
-/// Spindle sense.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
-#[serde(rename_all = "snake_case")]
-pub enum SpindleDirection {
-    /// M03: clockwise seen from above (s_rot = −1).
-    #[default]
-    Cw,
-    /// M04: counter-clockwise (s_rot = +1).
-    Ccw,
 }
 
 /// How the finished surface and the generation point are found.

@@ -462,6 +462,21 @@ async fn a_named_machine_caps_the_feed_plan_and_sets_the_dialect() {
     assert!(answer["warnings"].as_array().unwrap().iter().any(|w| w["code"] == "W_FEED_ABOVE_MACHINE_MAX"));
 }
 
+/// The program starts the spindle the way the analysis assumed: M03 for `cw`, M04 for `ccw`.
+#[tokio::test(flavor = "multi_thread")]
+async fn the_program_turns_the_spindle_as_analysed() {
+    let app = TestApp::spawn().await;
+    let mut body = api_example();
+    body["axial_depth"] = json!(2);
+    for (direction, code, other) in [("cw", "S3000 M03", "M04"), ("ccw", "S3000 M04", "M03")] {
+        body["spindle_direction"] = json!(direction);
+        let response = app.client.post(app.url(&format!("{URL}?format=gcode"))).json(&body).send().await.unwrap();
+        assert_eq!(response.status(), 200);
+        let program = response.text().await.unwrap();
+        assert!(program.contains(code) && !program.contains(other), "{direction}:\n{program}");
+    }
+}
+
 /// The example job's engagement operation gives exactly the endpoint's answer for the same
 /// request, and its program is the endpoint's for the first path in the job's output options.
 #[tokio::test(flavor = "multi_thread")]
