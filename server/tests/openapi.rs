@@ -6,3 +6,53 @@ fn openapi_document_snapshot() {
     let (_, document) = kerf_server::app::api();
     insta::assert_json_snapshot!("openapi", document);
 }
+
+/// utoipa names a schema after its type, so two types of one name in different modules would
+/// silently share one entry. Every type that derives `ToSchema` must have its own name (its
+/// `schema(as = ...)` name where it has one).
+#[test]
+fn schema_names_are_unique() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut names: std::collections::BTreeMap<String, Vec<String>> = std::collections::BTreeMap::new();
+    let mut folders = vec![root.join("solver/src"), root.join("server/src")];
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(&folder).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                folders.push(path);
+                continue;
+            }
+            if path.extension().is_none_or(|e| e != "rs") {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).unwrap();
+            let lines: Vec<&str> = text.lines().collect();
+            for (index, line) in lines.iter().enumerate() {
+                if !line.contains("ToSchema") || !line.trim_start().starts_with("#[") {
+                    continue;
+                }
+                let mut alias = None;
+                for following in &lines[index + 1..] {
+                    let following = following.trim_start();
+                    if let Some(rest) = following.split("schema(as = ").nth(1) {
+                        alias = rest.split(')').next().map(str::to_owned);
+                    }
+                    let declared = following
+                        .strip_prefix("pub struct ")
+                        .or_else(|| following.strip_prefix("pub enum "))
+                        .or_else(|| following.strip_prefix("struct "))
+                        .or_else(|| following.strip_prefix("enum "));
+                    if let Some(declared) = declared {
+                        let name: String = declared.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+                        let place = format!("{}:{}", path.display(), index + 1);
+                        names.entry(alias.clone().unwrap_or(name)).or_default().push(place);
+                        break;
+                    }
+                }
+            }
+        }
+    }
+    assert!(names.len() > 50, "found only {} schema types", names.len());
+    let shared: Vec<_> = names.iter().filter(|(_, places)| places.len() > 1).collect();
+    assert!(shared.is_empty(), "schema names used by more than one type: {shared:#?}");
+}

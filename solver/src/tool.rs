@@ -92,6 +92,8 @@ pub struct ShapeErrorPoint {
 /// One vibration mode of the tool tip: G(ω) = (1/k) / (1 − (ω/ωn)² + 2iζ ω/ωn).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+// Named apart from segment's mode in the OpenAPI document.
+#[cfg_attr(feature = "schema", schema(as = VibrationMode))]
 #[serde(deny_unknown_fields)]
 pub struct Mode {
     /// Modal stiffness k in N/mm (> 0).

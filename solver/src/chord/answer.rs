@@ -43,6 +43,8 @@ pub struct SegmentWindow {
 /// The same curve cut with a plain fixed chord error (`compare_tolerance`), for comparison.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+// Named apart from engagement's comparison of paths in the OpenAPI document.
+#[cfg_attr(feature = "schema", schema(as = SegmentComparison))]
 pub struct Comparison {
     /// The fixed chord error, mm.
     pub tolerance: f64,

@@ -116,6 +116,8 @@ pub enum Curve {
 /// Where the chord error comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+// Named apart from the tool's vibration mode in the OpenAPI document.
+#[cfg_attr(feature = "schema", schema(as = SegmentMode))]
 #[serde(rename_all = "snake_case")]
 pub enum Mode {
     /// Per curvature window of length `window` (embodiments 1, 2 and 6; Fig. 7).

@@ -121,6 +121,8 @@ pub enum Edge {
 /// How the band edges are placed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+// Named apart from predict's method in the OpenAPI document.
+#[cfg_attr(feature = "schema", schema(as = DeburrMethod))]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
     /// The seed's closed form: band edges on the tangent lines at P (deburr.md §2.5).

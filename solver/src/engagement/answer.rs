@@ -250,6 +250,8 @@ pub struct PathEngagement {
 /// Several candidate paths side by side.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+// Named apart from segment's comparison with a fixed tolerance in the OpenAPI document.
+#[cfg_attr(feature = "schema", schema(as = EngagementComparison))]
 pub struct Comparison {
     /// One result per entry of `paths`, in order.
     pub candidates: Vec<PathEngagement>,

@@ -60,6 +60,8 @@ pub enum PathInput {
 /// How the finished surface and the generation point are found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+// Named apart from deburr's method in the OpenAPI document.
+#[cfg_attr(feature = "schema", schema(as = PredictMethod))]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
     /// Resolution-free surface sampling with area weighting (§6.6): the default, as accurate or
