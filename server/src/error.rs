@@ -66,7 +66,8 @@ pub enum AppError {
     /// 429: the service is saturated; try again.
     #[error("{0}")]
     TooManyRequests(String),
-    /// 503: the synchronous time limit was hit; submit a job instead.
+    /// 422 `E_TIMEOUT`: the synchronous time limit was hit; submit a job instead. Not a 5xx:
+    /// the request is well-formed but too long for a synchronous answer (api.md: a 5xx is a bug).
     #[error("{0}")]
     Timeout(String),
     /// 500: a bug or an infrastructure failure. The cause is logged, not sent.
@@ -101,7 +102,7 @@ impl AppError {
             Self::UnsupportedMediaType(_) => (StatusCode::UNSUPPORTED_MEDIA_TYPE, "Unsupported media type"),
             Self::Unprocessable(_) => (StatusCode::UNPROCESSABLE_ENTITY, "Unprocessable request"),
             Self::TooManyRequests(_) => (StatusCode::TOO_MANY_REQUESTS, "Too many requests"),
-            Self::Timeout(_) => (StatusCode::SERVICE_UNAVAILABLE, "Time limit exceeded"),
+            Self::Timeout(_) => (StatusCode::UNPROCESSABLE_ENTITY, "Over the synchronous time limit"),
             Self::Internal(_) => (StatusCode::INTERNAL_SERVER_ERROR, "Internal error"),
         }
     }

@@ -59,8 +59,7 @@ pub struct ContourResult {
         (status = 404, description = "Unknown tool number or machine", body = Problem, content_type = "application/problem+json"),
         (status = 413, body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
-        (status = 422, description = "Impossible contour or over a limit (codes in corners.md §5; `E_TOO_MANY_MOVES` for answers over the move limit)", body = Problem, content_type = "application/problem+json"),
-        (status = 503, description = "Over the synchronous time limit: submit a job", body = Problem, content_type = "application/problem+json")))]
+        (status = 422, description = "Impossible contour or over a limit (codes in corners.md §5; `E_TOO_MANY_MOVES` for answers over the move limit); `E_TIMEOUT` over the synchronous time limit: submit a job", body = Problem, content_type = "application/problem+json")))]
 async fn post_contour(
     State(state): State<AppState>,
     headers: HeaderMap,
@@ -217,8 +216,7 @@ pub struct LoopsResult {
         (status = 404, description = "Unknown tool number", body = Problem, content_type = "application/problem+json"),
         (status = 413, body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
-        (status = 422, description = "Bad numbers, a degenerate path, or over a limit", body = Problem, content_type = "application/problem+json"),
-        (status = 503, description = "Over the synchronous time limit", body = Problem, content_type = "application/problem+json")))]
+        (status = 422, description = "Bad numbers, a degenerate path, or over a limit; `E_TIMEOUT` over the synchronous time limit", body = Problem, content_type = "application/problem+json")))]
 async fn post_loops(
     State(state): State<AppState>,
     AppQuery(_query): AppQuery<LoopsQuery>,

@@ -50,7 +50,7 @@ pub struct DeburrAnswer {
         (status = 404, description = "Unknown tool number or machine", body = Problem, content_type = "application/problem+json"),
         (status = 413, body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
-        (status = 422, description = "Impossible geometry (codes in deburr.md §4)", body = Problem, content_type = "application/problem+json")))]
+        (status = 422, description = "Impossible geometry (codes in deburr.md §4); `E_TIMEOUT` over the synchronous time limit: submit a job", body = Problem, content_type = "application/problem+json")))]
 async fn post_deburr(
     State(state): State<AppState>,
     headers: HeaderMap,

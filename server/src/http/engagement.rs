@@ -89,10 +89,10 @@ pub struct EngagementQuery {
         (status = 413, body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
         (status = 422, description = "Impossible or over a limit: `E_INPUT`, `E_PATH`, `E_STOCK`, `E_TOO_LARGE`, \
-            `E_TOO_MANY_SAMPLES`, `E_GRID_MEMORY`, `E_WORK_LIMIT` (engagement.md §9)",
+            `E_TOO_MANY_SAMPLES`, `E_GRID_MEMORY`, `E_WORK_LIMIT` (engagement.md §9); `E_TIMEOUT` over the synchronous \
+            time limit: submit a job",
             body = Problem, content_type = "application/problem+json"),
-        (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json"),
-        (status = 503, description = "Over the synchronous time limit: submit a job", body = Problem, content_type = "application/problem+json")))]
+        (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json")))]
 async fn post_engagement(
     State(state): State<AppState>,
     headers: HeaderMap,

@@ -183,7 +183,7 @@ fn server_timing(response: &mut Response, solve_ms: f64) {
 /// normal, flags, corrected end point), a summary with the worst passes and warnings (JSON), or
 /// with `Accept: text/x-gcode` / `?format=gcode` the corrected program. The body is JSON, or a
 /// form with the JSON in part `request` and the STL stock in part `stock`. Long paths exceed the
-/// synchronous time limit (503): submit them as a job (`operation = "predict"`).
+/// synchronous time limit (422 `E_TIMEOUT`): submit them as a job (`operation = "predict"`).
 #[utoipa::path(post, path = "/api/v1/predict", tag = "predict",
     params(PredictQuery),
     request_body(description = "The request as JSON, or a form with it in part `request` and the STL stock in part `stock`.",
@@ -197,9 +197,8 @@ fn server_timing(response: &mut Response, solve_ms: f64) {
         (status = 404, description = "Unknown tool number", body = Problem, content_type = "application/problem+json"),
         (status = 413, description = "Body over the upload limit", body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
-        (status = 422, description = "Impossible or over a limit: tool kind, no shape-error table, G-code errors with the line, open mesh, resolution over the memory limit", body = Problem, content_type = "application/problem+json"),
-        (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json"),
-        (status = 503, description = "Over the synchronous time limit: submit a job", body = Problem, content_type = "application/problem+json")))]
+        (status = 422, description = "Impossible or over a limit: tool kind, no shape-error table, G-code errors with the line, open mesh, resolution over the memory limit; `E_TIMEOUT` over the synchronous time limit: submit a job", body = Problem, content_type = "application/problem+json"),
+        (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json")))]
 async fn post_predict(
     State(state): State<AppState>,
     headers: HeaderMap,

@@ -51,8 +51,7 @@ pub struct SegmentResult {
         (status = 404, description = "Unknown machine or tool number", body = Problem, content_type = "application/problem+json"),
         (status = 413, body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
-        (status = 422, description = "Impossible request: `E_INPUT`, `E_DEGENERATE_CURVE`, `E_INFEASIBLE_FEED_FOR_RADIUS` (the message gives the largest feasible feed), `E_TOO_MANY_BLOCKS`, `E_TOO_MANY_POINTS`, `E_NUMERIC_FAILURE`", body = Problem, content_type = "application/problem+json"),
-        (status = 503, description = "Over the synchronous time limit: submit a job", body = Problem, content_type = "application/problem+json")))]
+        (status = 422, description = "Impossible request: `E_INPUT`, `E_DEGENERATE_CURVE`, `E_INFEASIBLE_FEED_FOR_RADIUS` (the message gives the largest feasible feed), `E_TOO_MANY_BLOCKS`, `E_TOO_MANY_POINTS`, `E_NUMERIC_FAILURE`; `E_TIMEOUT` over the synchronous time limit: submit a job", body = Problem, content_type = "application/problem+json")))]
 async fn post_segment(
     State(state): State<AppState>,
     headers: HeaderMap,

@@ -1,5 +1,5 @@
 //! Holding up under slow or bursty work: a synchronous solver call over the time limit is told to
-//! submit a job (503), a burst beyond the solver slots gets 429 instead of piling up, and the
+//! submit a job (422 `E_TIMEOUT`, not a 5xx), a burst beyond the solver slots gets 429 instead of piling up, and the
 //! service answers normally afterwards.
 
 use std::time::Duration;
@@ -19,7 +19,7 @@ fn slow_request() -> serde_json::Value {
 #[tokio::test(flavor = "multi_thread")]
 async fn slow_synchronous_call_is_told_to_submit_a_job() {
     let app = TestApp::spawn_with(Limits { solver_time_limit: Duration::from_millis(20), ..Limits::default() }).await;
-    let answer = problem(app.post_json("/api/v1/deburr", &slow_request()).await, 503).await;
+    let answer = problem(app.post_json("/api/v1/deburr", &slow_request()).await, 422).await;
     assert_eq!(answer["code"], "E_TIMEOUT");
     assert!(answer["detail"].as_str().unwrap().contains("/api/v1/jobs"), "{answer}");
     // The same work as a job runs to the end.

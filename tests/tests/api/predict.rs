@@ -478,7 +478,7 @@ async fn upload_limit_is_the_routes_own() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
-async fn over_the_time_limit_is_503_and_frees_the_slot() {
+async fn over_the_time_limit_is_422_and_frees_the_slot() {
     let app = TestApp::spawn_configured(|config| {
         config.solver_slots = 1;
         config.limits.solver_time_limit = Duration::from_millis(300);
@@ -486,7 +486,7 @@ async fn over_the_time_limit_is_503_and_frees_the_slot() {
     .await;
     let mut long = raster_request(finishing_tool(), 40, 81);
     long["resolution"] = json!(1024);
-    let answer = problem(app.post_json("/api/v1/predict", &long).await, 503).await;
+    let answer = problem(app.post_json("/api/v1/predict", &long).await, 422).await;
     assert_eq!(answer["code"], "E_TIMEOUT");
     assert!(answer["detail"].as_str().unwrap().contains("/api/v1/jobs"), "{answer}");
     // The abandoned prediction stops: the only solver slot is free again at once.
