@@ -109,6 +109,23 @@ fn curves_are_checked_with_field_paths() {
             "curve.end_deg",
         ),
         (json!({"kind": "ellipse", "centre": [0, 0], "semi_axes": [10, -1]}), "E_INPUT", "curve.semi_axes[1]"),
+        // Found by fuzzing over HTTP: at 2⁶³ degrees the quarter-turn search could not advance.
+        (
+            json!({"kind": "ellipse", "centre": [0, 0], "semi_axes": [100, 50], "start_deg": 9.223372036854776e18,
+                   "end_deg": 90}),
+            "E_INPUT",
+            "curve.start_deg",
+        ),
+        (
+            json!({"kind": "ellipse", "centre": [0, 0], "semi_axes": [100, 50], "rotation_deg": -2e6}),
+            "E_INPUT",
+            "curve.rotation_deg",
+        ),
+        (
+            json!({"kind": "arc", "centre": [0, 0], "radius": 5, "start_deg": 0, "end_deg": 1e7}),
+            "E_INPUT",
+            "curve.end_deg",
+        ),
         (json!({"kind": "polyline", "points": [[0, 0], [1, 1, 1]]}), "E_INPUT", "curve.points[1]"),
         (json!({"kind": "polyline", "points": [[0, 0, 0, 1], [1, 1, 1, 1]]}), "E_INPUT", "curve.points[0]"),
         (json!({"kind": "polyline", "points": [[1, 1], [1, 1], [1, 1]]}), "E_DEGENERATE_CURVE", "curve.points"),

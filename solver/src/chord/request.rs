@@ -305,6 +305,18 @@ fn radius(field: &str, value: f64) -> Result<f64, SolverError> {
     Ok(value)
 }
 
+/// Largest angle accepted, degrees (about 2 800 turns): beyond it the angle's rounding in
+/// radians exceeds a micro-radian, and a quarter-turn search could no longer advance.
+const MAX_ANGLE_DEG: f64 = 1e6;
+
+/// A finite angle in degrees within ±[`MAX_ANGLE_DEG`].
+fn angle(field: &str, value: f64) -> Result<f64, SolverError> {
+    if finite(field, value)?.abs() > MAX_ANGLE_DEG {
+        return Err(SolverError::input(field, format!("{field} must lie within ±{MAX_ANGLE_DEG}° (got {value})")));
+    }
+    Ok(value)
+}
+
 /// Swept angle in radians from start to end in the direction: in (0, 2π], a full turn when the
 /// angles differ by a non-zero multiple of 360°.
 fn sweep(start_deg: f64, end_deg: f64, direction: Direction) -> f64 {
@@ -335,7 +347,7 @@ impl Curve {
                 let shape = Shape::Arc(Arc {
                     centre: c,
                     radius: radius("curve.radius", *r)?,
-                    start: finite("curve.start_deg", *start_deg)?.to_radians(),
+                    start: angle("curve.start_deg", *start_deg)?.to_radians(),
                     sense: direction.sign(),
                     sweep: std::f64::consts::TAU,
                 });
@@ -343,8 +355,8 @@ impl Curve {
             }
             Self::Arc { centre, radius: r, start_deg, end_deg, direction } => {
                 let c = point("curve.centre", centre)?;
-                let start = finite("curve.start_deg", *start_deg)?;
-                let end = finite("curve.end_deg", *end_deg)?;
+                let start = angle("curve.start_deg", *start_deg)?;
+                let end = angle("curve.end_deg", *end_deg)?;
                 let swept = sweep(start, end, *direction);
                 if swept == 0.0 {
                     return Err(SolverError::new(
@@ -366,9 +378,9 @@ impl Curve {
                 let c = point("curve.centre", centre)?;
                 let a = radius("curve.semi_axes[0]", semi_axes[0])?;
                 let b = radius("curve.semi_axes[1]", semi_axes[1])?;
-                let start = finite("curve.start_deg", *start_deg)?;
+                let start = angle("curve.start_deg", *start_deg)?;
                 let end = match end_deg {
-                    Some(end) => finite("curve.end_deg", *end)?,
+                    Some(end) => angle("curve.end_deg", *end)?,
                     None => start + 360.0,
                 };
                 let swept = sweep(start, end, *direction);
@@ -403,7 +415,7 @@ impl Curve {
                 let shape = Shape::Ellipse(Ellipse {
                     centre: c,
                     semi_axes: [a, b],
-                    rotation: finite("curve.rotation_deg", *rotation_deg)?.to_radians(),
+                    rotation: angle("curve.rotation_deg", *rotation_deg)?.to_radians(),
                     start,
                     sense,
                     sweep: swept,

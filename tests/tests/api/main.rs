@@ -16,5 +16,6 @@ mod load;
 mod machines;
 mod openapi;
 mod predict;
+mod request_fuzz;
 mod segment;
 mod tools;
