@@ -6,12 +6,9 @@ use axum::Json;
 use axum::extract::State;
 use axum::http::HeaderMap;
 use axum::response::{IntoResponse, Response};
-use std::borrow::Cow;
-
 use kerf_solver::SolverError;
 use kerf_solver::chord::MachineProfile;
 use kerf_solver::engagement::{self, EngagementAnswer, EngagementRequest, Stock};
-use kerf_solver::error::Warning;
 use kerf_solver::gcode::{Dialect, Post, Reference, ToolCall};
 use kerf_solver::tool::Tool;
 use serde::{Deserialize, Serialize};
@@ -114,42 +111,6 @@ async fn post_engagement(
     Ok(Json(answer).into_response())
 }
 
-/// The request with the machine's values as defaults: its `max_feed` fills an absent
-/// `feed_plan.max_feed`; a larger `feed_plan.max_feed` is kept with `W_FEED_ABOVE_MACHINE_MAX`.
-fn with_machine<'a>(
-    request: &'a EngagementRequest,
-    machine: Option<&MachineProfile>,
-) -> Result<(Cow<'a, EngagementRequest>, Option<Warning>), SolverError> {
-    let Some(machine) = machine else {
-        if let Some(name) = &request.machine {
-            return Err(SolverError::input("machine", format!("machine {name:?} was not resolved")));
-        }
-        return Ok((Cow::Borrowed(request), None));
-    };
-    let Some(plan) = &request.feed_plan else { return Ok((Cow::Borrowed(request), None)) };
-    match plan.max_feed {
-        None => {
-            let mut filled = request.clone();
-            if let Some(plan) = &mut filled.feed_plan {
-                plan.max_feed = Some(machine.max_feed);
-            }
-            Ok((Cow::Owned(filled), None))
-        }
-        Some(max_feed) if max_feed > machine.max_feed => Ok((
-            Cow::Borrowed(request),
-            Some(Warning::new(
-                "W_FEED_ABOVE_MACHINE_MAX",
-                format!(
-                    "feed_plan.max_feed {max_feed} mm/min is above the machine's max_feed {} mm/min: the control \
-                     will not reach it",
-                    machine.max_feed
-                ),
-            )),
-        )),
-        Some(_) => Ok((Cow::Borrowed(request), None)),
-    }
-}
-
 /// Solves an engagement request with its resolved tool and machine (used by the route and by
 /// jobs).
 pub fn run(
@@ -157,18 +118,7 @@ pub fn run(
     tool: Tool,
     machine: Option<MachineProfile>,
 ) -> Result<EngagementResponse, SolverError> {
-    let (request, machine_warning) = with_machine(request, machine.as_ref())?;
-    let mut result = engagement::solve(&request, &tool)?;
-    if let Some(warning) = machine_warning {
-        match &mut result {
-            EngagementAnswer::Single(single) => single.warnings.push(warning),
-            EngagementAnswer::Comparison(comparison) => {
-                for candidate in &mut comparison.candidates {
-                    candidate.warnings.push(warning.clone());
-                }
-            }
-        }
-    }
+    let result = engagement::solve_with(request, &tool, machine.as_ref())?;
     Ok(EngagementResponse {
         tool,
         machine,

@@ -178,7 +178,7 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
     let nominal_fz = job.feed_mode.feed_per_tooth(time_flutes, job.spindle_rpm);
     let mut samples = Vec::with_capacity(stations.len());
     let mut statistic = Vec::with_capacity(stations.len());
-    let mut warnings = job.stock_warnings.clone();
+    let mut warnings = job.shared_warnings.clone();
     warnings.extend(candidate.warnings.iter().cloned());
     let mut plunges = Vec::new();
     let mut back = Vec::new();

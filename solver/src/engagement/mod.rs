@@ -60,6 +60,7 @@ pub use request::{
     Representative, SegmentInput, Stock, StockBitmap, StockPolygon,
 };
 
+use crate::chord::MachineProfile;
 use crate::error::SolverError;
 use crate::tool::Tool;
 
@@ -101,7 +102,21 @@ pub const DEFAULT_CHIPPING_DISENGAGE_DEG: f64 = 20.0;
 /// `E_STOCK` (crossing or degenerate rings, bad bitmap), `E_TOO_LARGE`, `E_TOO_MANY_SAMPLES`,
 /// `E_GRID_MEMORY` (limits, with the limit in the message), `E_WORK_LIMIT`.
 pub fn solve(request: &EngagementRequest, tool: &Tool) -> Result<EngagementAnswer, SolverError> {
-    let job = request.validate(tool)?;
+    solve_with(request, tool, None)
+}
+
+/// [`solve`] for a request that names a machine: `machine` is the profile its `machine` names
+/// (its `max_feed` fills an absent `feed_plan.max_feed`; `W_FEED_ABOVE_MACHINE_MAX` when the
+/// request's is larger).
+///
+/// # Errors
+/// As [`solve`]; `E_INPUT` at `machine` when the request names a machine and none is given.
+pub fn solve_with(
+    request: &EngagementRequest,
+    tool: &Tool,
+    machine: Option<&MachineProfile>,
+) -> Result<EngagementAnswer, SolverError> {
+    let job = request.validate(tool, machine)?;
     let mut results = Vec::with_capacity(job.candidates.len());
     for candidate in &job.candidates {
         results.push(evaluate::evaluate(&job, candidate, tool)?);

@@ -16,6 +16,7 @@ use super::{
     DEFAULT_BURR_DISENGAGE_DEG, DEFAULT_CHIPPING_DISENGAGE_DEG, MAX_CANDIDATES, MAX_CHORDS, MAX_DOT_ROWS, MAX_FLUTES,
     MAX_GRID_DOTS, MAX_SAMPLES, MAX_SEGMENTS, MAX_STOCK_VERTICES, P2,
 };
+use crate::chord::MachineProfile;
 use crate::error::{SolverError, Warning, finite, non_negative, positive};
 use crate::gcode::reader::{MoveKind, Plane, ReadOptions, read as read_program};
 use crate::planar::signed_area;
@@ -350,8 +351,9 @@ pub struct EngagementRequest {
     /// `dots` engine: return the contact dots for the scatter plot (default true).
     #[serde(default = "yes")]
     pub contact_dots: bool,
-    /// A stored machine profile; the server resolves it (its `max_feed` fills
-    /// `feed_plan.max_feed` when that is absent). The solver itself does not read it.
+    /// A stored machine profile, resolved by the server: its `max_feed` fills an absent
+    /// `feed_plan.max_feed` (a larger one is kept with `W_FEED_ABOVE_MACHINE_MAX`), its dialect
+    /// is the G-code default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub machine: Option<String>,
 }
@@ -415,7 +417,8 @@ pub(crate) struct Job {
     pub plan: Option<PlanJob>,
     pub contact_dots: bool,
     pub region: Region,
-    pub stock_warnings: Vec<Warning>,
+    /// Warnings of the stock and the machine, for every candidate.
+    pub shared_warnings: Vec<Warning>,
     pub candidates: Vec<CandidateJob>,
     pub single: bool,
 }
@@ -778,8 +781,17 @@ fn read_stock(stock: &Stock, radius: f64, warnings: &mut Vec<Warning>) -> Result
 
 impl EngagementRequest {
     /// Validates the request against `tool` (already resolved from `self.tool`).
-    pub(crate) fn validate(&self, tool: &Tool) -> Result<Job, SolverError> {
+    /// Checks every field, with `machine` resolved from `self.machine`.
+    pub(crate) fn validate(&self, tool: &Tool, machine: Option<&MachineProfile>) -> Result<Job, SolverError> {
         tool.validate("tool.")?;
+        if let Some(name) = &self.machine
+            && machine.is_none()
+        {
+            return Err(SolverError::input(
+                "machine",
+                format!("machine {name:?} was not resolved: pass its profile (engagement::solve_with)"),
+            ));
+        }
         let radius = bounded("tool.radius", tool.radius, MAX_COORDINATE)?;
         let spindle_rpm = bounded("spindle_rpm", self.spindle_rpm, 1e6)?;
         let feed_mode = match (self.feed_per_tooth, self.feed) {
@@ -868,18 +880,32 @@ impl EngagementRequest {
             return Err(SolverError::input("stock_top_z", format!("stock_top_z must lie within ±{MAX_COORDINATE} mm")));
         }
         let clearance = bounded("clearance", self.clearance.unwrap_or(5.0), MAX_COORDINATE)?;
+        // Warnings of the whole request, repeated in every candidate's answer.
+        let mut shared_warnings = Vec::new();
         let plan = self
             .feed_plan
             .as_ref()
             .map(|plan| -> Result<PlanJob, SolverError> {
                 let target = bounded("feed_plan.target_thickness", plan.target_thickness, 1e3)?;
-                let max_feed = plan.max_feed.ok_or_else(|| {
+                let max_feed = plan.max_feed.or(machine.map(|m| m.max_feed)).ok_or_else(|| {
                     SolverError::input(
                         "feed_plan.max_feed",
                         "feed_plan.max_feed (mm/min) is required unless the request names a machine",
                     )
                 })?;
                 let max_feed = bounded("feed_plan.max_feed", max_feed, 1e7)?;
+                if let Some(machine) = machine
+                    && max_feed > machine.max_feed
+                {
+                    shared_warnings.push(Warning::new(
+                        "W_FEED_ABOVE_MACHINE_MAX",
+                        format!(
+                            "feed_plan.max_feed {max_feed} mm/min is above the machine's max_feed {} mm/min: the \
+                             control will not reach it",
+                            machine.max_feed
+                        ),
+                    ));
+                }
                 let flute_count = plan.flute_count.unwrap_or(tool.flutes);
                 if !(1..=MAX_FLUTES).contains(&flute_count) {
                     return Err(SolverError::input(
@@ -894,8 +920,7 @@ impl EngagementRequest {
             })
             .transpose()?;
 
-        let mut stock_warnings = Vec::new();
-        let (region, _) = read_stock(&self.stock, radius, &mut stock_warnings)?;
+        let (region, _) = read_stock(&self.stock, radius, &mut shared_warnings)?;
 
         let inputs: Vec<(Option<String>, &PathInput, String)> = match (&self.path, &self.paths) {
             (Some(path), None) => vec![(None, path, "path".to_owned())],
@@ -1003,7 +1028,7 @@ impl EngagementRequest {
             plan,
             contact_dots: self.contact_dots,
             region,
-            stock_warnings,
+            shared_warnings,
             candidates,
             single: self.path.is_some(),
         })
