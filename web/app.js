@@ -71,6 +71,17 @@ export function download(name, text, type = 'text/plain') {
   setTimeout(() => URL.revokeObjectURL(url), 1000);
 }
 
+// Fills a summary box with [name, value] pairs, each a line with the value in bold.
+export function showSummary(box, items) {
+  box.replaceChildren(...items.map(([name, value]) => {
+    const div = document.createElement('div');
+    const b = document.createElement('b');
+    b.textContent = String(value);
+    div.append(name, b);
+    return div;
+  }));
+}
+
 // The text of form control `name`.
 export function value(form, name) {
   return form.elements[name].value;

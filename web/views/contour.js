@@ -3,7 +3,7 @@
 // selector; loops, reliefs, links and corners in their own colours; wheel to zoom, drag to pan,
 // double-click to fit), the corner table with the material left or over-cut, the summary, the
 // warnings and the G-code download. `contourResult` also renders job results.
-import { api, download, gcodeQuery, loadMachines, loadTools, message, number, numeric, programName, showProblem, value } from '/app.js';
+import { api, download, gcodeQuery, loadMachines, loadTools, message, number, numeric, programName, showProblem, showSummary, value } from '/app.js';
 
 // An arrow-shaped island: five protruding corners (a 64° tip among them) and two inside corners.
 const SAMPLE = `# x, y in mm, counter-clockwise; one point a line
@@ -396,14 +396,7 @@ function summaryItems(answer) {
       ['shortest block, mm', number(b.min_block_length, 4)], ['short blocks', `${b.short_blocks} (+${b.short_end_blocks} at ends)`],
       ['block-limited time, s', number(b.estimated_time_s, 1)]);
   }
-  return items.map(([name, v]) => {
-    const div = document.createElement('div');
-    div.append(name);
-    const bold = document.createElement('b');
-    bold.textContent = String(v);
-    div.append(bold);
-    return div;
-  });
+  return items;
 }
 
 // Shows a contour answer in `container`: layer selector, plot, corner table, summary, warnings.
@@ -458,7 +451,7 @@ export function contourResult(container, answer) {
   select.addEventListener('change', () => show(Number(select.value), true));
   show(0, false);
 
-  summary.replaceChildren(...summaryItems(answer));
+  showSummary(summary, summaryItems(answer));
   warnings.replaceChildren(...answer.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
   container.append(cornerTable(answer, plot));
   return canvas;

@@ -1,6 +1,6 @@
 // Deburr view: a form for one cross-hole ridge, the 3-D plot of ridge and ball-centre path,
 // the summary, warnings and the G-code download (api.md, Deburr).
-import { api, download, gcodeQuery, loadMachines, loadTools, message, number, numeric, programName, showProblem, value } from '/app.js';
+import { api, download, gcodeQuery, loadMachines, loadTools, message, number, numeric, programName, showProblem, showSummary, value } from '/app.js';
 import { Plot3D } from '/plot3d.js';
 
 const FORM = `
@@ -131,14 +131,7 @@ export function deburrResult(container, answer) {
     items.push(['blocks (short)', `${s.blocks} (${s.short_blocks})`], ['block length, mm', number(s.block_length, 4)]);
   }
   if (answer.machine) items.push(['machine', `${answer.machine.name} (${answer.machine.dialect})`]);
-  summaryBox.replaceChildren(...items.map(([name, v]) => {
-    const div = document.createElement('div');
-    div.append(name);
-    const b = document.createElement('b');
-    b.textContent = String(v);
-    div.append(b);
-    return div;
-  }));
+  showSummary(summaryBox, items);
   warnings.replaceChildren(...answer.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
   return canvas;
 }

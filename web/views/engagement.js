@@ -4,7 +4,7 @@
 // summed chip thickness per flute count with the threshold, representative values and time per
 // k with the recommended k highlighted, and the feed plan; a cursor on any chart marks the tool
 // on the path. The result renderer is shared with the Jobs view.
-import { api, download, gcodeQuery, loadMachines, loadTools, message, number, numeric, programName, showProblem, toolLabel, value } from '/app.js';
+import { api, download, gcodeQuery, loadMachines, loadTools, message, number, numeric, programName, showProblem, showSummary, toolLabel, value } from '/app.js';
 
 const SAMPLE_PATHS = [
   { name: 'straight', text: '-10 20\n70 20' },
@@ -760,15 +760,6 @@ function fluteCharts(column, result, answer) {
 // ---------------------------------------------------------------------------------------------
 // Result renderer (form and Jobs view)
 
-function summaryItem(name, text) {
-  const div = document.createElement('div');
-  div.append(name);
-  const b = document.createElement('b');
-  b.textContent = String(text);
-  div.append(b);
-  return div;
-}
-
 function fluteTable(result) {
   const table = document.createElement('table');
   table.className = 'flutes';
@@ -823,7 +814,7 @@ function renderColumn(column, result, answer, axis) {
     items.push(['planned feeds, mm/min', `${plan.feed_range[0]} – ${plan.feed_range[1]}`]);
   }
   if (result.max_mrr !== undefined) items.push(['max MRR, mm³/min', number(result.max_mrr, 0)]);
-  summary.replaceChildren(...items.map(([n, t]) => summaryItem(n, t)));
+  showSummary(summary, items);
   const plan = document.createElement('canvas');
   plan.className = 'chart plan';
   plan.setAttribute('aria-label', 'Plan view: stock and path coloured by engagement');

@@ -3,7 +3,7 @@
 // G-code program, cutting conditions, method), the path coloured by predicted error with a colour
 // scale, a histogram of the errors, the worst passes with their NC lines, warnings, and the
 // corrected program. `predictResult` also shows prediction jobs.
-import { api, download, loadTools, message, number, numeric, showProblem, toolLabel, value } from '/app.js';
+import { api, download, loadTools, message, number, numeric, showProblem, showSummary, toolLabel, value } from '/app.js';
 import { Plot3D } from '/plot3d.js';
 
 // The sample: a raster finishing program over a gentle dome (20 × 20 mm, 2 mm high) with an R3
@@ -343,17 +343,6 @@ function drawHistogram(canvas, errors, low, high) {
   canvas.dataset.bins = String(counts.filter((c) => c > 0).length);
 }
 
-function summaryItems(box, items) {
-  box.replaceChildren(...items.map(([name, v]) => {
-    const div = document.createElement('div');
-    div.append(name);
-    const b = document.createElement('b');
-    b.textContent = String(v);
-    div.append(b);
-    return div;
-  }));
-}
-
 // Shows a prediction in `container`: path coloured by error with its scale, histogram, summary,
 // worst passes and warnings. Used by the form and by job results.
 export function predictResult(container, answer) {
@@ -402,7 +391,7 @@ export function predictResult(container, answer) {
 
   const s = answer.summary;
   summaryBox.replaceChildren();
-  summaryItems(summaryBox, [
+  showSummary(summaryBox, [
     ['passes', `${s.predicted} of ${s.passes} predicted`],
     ['error range, µm', `${microns(s.min_error)} … ${microns(s.max_error)}`],
     ['mean / RMS error, µm', `${microns(s.mean_error)} / ${microns(s.rms_error)}`],

@@ -1,7 +1,7 @@
 // Segment view: cut a curve into G01 blocks by the control's block time (api.md, Segment;
 // chord.md). A form for the curve and the rule, the curve with its blocks, the chord error and the
 // block length along the curve, the rule side by side with a fixed tolerance, G-code download.
-import { api, download, loadMachines, message, number, numeric, showProblem, value } from '/app.js';
+import { api, download, loadMachines, message, number, numeric, showProblem, showSummary, value } from '/app.js';
 import { PlanPlot, drawChart } from '/plot2d.js';
 
 const FORM = `
@@ -202,17 +202,6 @@ function nurbsPoints(curve, count) {
   });
 }
 
-function summaryItems(box, items) {
-  box.replaceChildren(...items.map(([name, v]) => {
-    const div = document.createElement('div');
-    div.append(name);
-    const b = document.createElement('b');
-    b.textContent = String(v);
-    div.append(b);
-    return div;
-  }));
-}
-
 // The rule side by side with the fixed tolerance.
 function comparisonTable(answer) {
   const table = document.createElement('table');
@@ -311,7 +300,7 @@ export function segmentResult(container, answer, request) {
   ], { xLabel: 'arc length s, mm', yLabel: 'block length, mm' });
 
   const machine = answer.machine ? `${answer.machine.name} (${answer.machine.dialect})` : 'none';
-  summaryItems(summaryBox, [
+  showSummary(summaryBox, [
     ['blocks', answer.blocks],
     ['chord error, mm', `${number(answer.min_window_chord_error, 6)} – ${number(answer.chord_error, 6)}`],
     ['block length F·T_b, mm', number(answer.block_length, 4)],
