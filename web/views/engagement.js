@@ -813,6 +813,10 @@ function renderColumn(column, result, answer, axis) {
     items.push(['feed plan time, s', `${number(plan.time_s, 2)} (nominal ${number(plan.nominal_time_s, 2)})`]);
     items.push(['planned feeds, mm/min', `${plan.feed_range[0]} – ${plan.feed_range[1]}`]);
   }
+  if (result.blocks) {
+    const b = result.blocks;
+    items.push(['program blocks (short)', `${b.blocks} (${b.short_blocks})`], ['block-limited time, s', number(b.estimated_time_s, 2)]);
+  }
   if (result.max_mrr !== undefined) items.push(['max MRR, mm³/min', number(result.max_mrr, 0)]);
   showSummary(summary, items);
   const plan = document.createElement('canvas');

@@ -71,7 +71,7 @@ pub use nurbs::{MAX_CONTROL_POINTS, MAX_DEGREE};
 pub use program::program;
 pub use request::{Curve, CurveRule, Direction, Mode, RadiusEstimate, SegmentRequest};
 pub use rule::{BlockRule, ChordStatus, Infeasible, RuleSettings, block_time_from_saturation, chord_length};
-pub use stats::{BlockStats, block_stats};
+pub use stats::{BlockStats, PathBlocks, block_stats, path_blocks, short_block_warning};
 
 use request::{Job, Plan};
 use segment::{Cut, CutError, Cutter, InfeasibleAt, Status};

@@ -1,12 +1,12 @@
 //! Block statistics of any polyline at a feed and block time (chord.md §6.2–§6.3, E8, E9): the
 //! figures a CAM engineer checks before sending a program to a control with a block processing
 //! time: how many blocks, the shortest, how many starve the control, and a cycle time that
-//! accounts for the block limit.
+//! accounts for the block limit; and the same over a whole path of feed moves and rapids.
 
 use serde::Serialize;
 
-use super::rule::MS_PER_MIN;
-use crate::error::{SolverError, positive};
+use super::rule::{BlockRule, MS_PER_MIN};
+use crate::error::{SolverError, Warning, positive};
 use crate::geometry::Vec3;
 
 /// A block counts as short when it is below `F·T_b/60000` by more than this fraction (rounding
@@ -125,4 +125,146 @@ pub(crate) fn stats_with_ends(points: &[Vec3], feed: f64, block_time_ms: f64, sp
         max_vertex_angle_deg: angles.iter().copied().fold(0.0, f64::max),
         mean_vertex_angle_deg: if angles.is_empty() { 0.0 } else { angles.iter().sum::<f64>() / angles.len() as f64 },
     }
+}
+
+/// The blocks of a path's feed moves (a contour's layers, an engagement program) on a control
+/// with a block processing time.
+///
+/// A *span* is a run of feed moves between two rapids; its last block ends where the control
+/// stops anyway (a retract follows), so a short one there is counted apart.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct PathBlocks {
+    /// Block processing time T_b of the control, ms.
+    pub block_time_ms: f64,
+    /// feed × T_b / 60000 at the cutting feed: the shortest block the control digests at full
+    /// feed, mm.
+    pub block_length: f64,
+    /// Feed blocks (G01).
+    pub blocks: usize,
+    /// Shortest feed block that does not end a span, mm (the shortest of all when every block
+    /// ends one).
+    pub min_block_length: f64,
+    /// Feed blocks shorter than their feed × T_b that do not end a span: the control slows down
+    /// there. Arcs never add any unless reported in the warnings; short straight moves can.
+    pub short_blocks: usize,
+    /// Short blocks at the end of a span (before a retract): harmless.
+    pub short_end_blocks: usize,
+    /// Σ max(L / F, T_b) over the feed blocks at their feeds, s: the feed time with the block
+    /// limit (no acceleration modelled). Compare `estimated_time_s` of the summary.
+    pub estimated_time_s: f64,
+    /// Finest chord tolerance the rule gave an arc, mm (absent without arcs; a contour's: of its
+    /// first layer).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub finest_arc_tolerance: Option<f64>,
+}
+
+/// Adds the figures of one run of blocks at one feed.
+#[derive(Default)]
+struct Tally {
+    blocks: usize,
+    inner_min: f64,
+    end_min: f64,
+    short: usize,
+    short_end: usize,
+    time_s: f64,
+}
+
+impl Tally {
+    fn add(&mut self, stats: &BlockStats, ends_span: bool) {
+        self.blocks += stats.blocks;
+        if stats.blocks > 1 {
+            self.inner_min = self.inner_min.min(stats.min_block_length);
+        }
+        // `block_stats` counts the run's last block as an end; a run that ends at a feed change
+        // goes on, so its last block is an inner one.
+        if ends_span {
+            self.end_min = self.end_min.min(stats.last_block_length);
+            self.short_end += stats.short_end_blocks;
+        } else {
+            self.inner_min = self.inner_min.min(stats.last_block_length);
+            self.short += stats.short_end_blocks;
+        }
+        self.short += stats.short_blocks;
+        self.time_s += stats.estimated_time_s;
+    }
+}
+
+/// The block figures of `moves` (end point and feed, `None` for a rapid, in machining order)
+/// for `block_time_ms`; `feed` is the cutting feed `block_length` is given for.
+///
+/// # Errors
+/// `E_INPUT` when a feed or the block time is not positive (validated before).
+pub fn path_blocks(
+    moves: impl IntoIterator<Item = (Vec3, Option<f64>)>,
+    block_time_ms: f64,
+    feed: f64,
+    finest_arc_tolerance: Option<f64>,
+) -> Result<PathBlocks, SolverError> {
+    let mut tally = Tally { inner_min: f64::INFINITY, end_min: f64::INFINITY, ..Tally::default() };
+    let mut from: Option<Vec3> = None;
+    let mut run: Vec<Vec3> = Vec::new();
+    let mut run_feed: Option<f64> = None;
+    let mut flush = |run: &mut Vec<Vec3>, feed: Option<f64>, ends_span: bool| -> Result<(), SolverError> {
+        if let (Some(feed), true) = (feed, run.len() > 1) {
+            tally.add(&block_stats(run, feed, block_time_ms)?, ends_span);
+        }
+        let last = run.last().copied();
+        run.clear();
+        if !ends_span && let Some(last) = last {
+            run.push(last);
+        }
+        Ok(())
+    };
+    for (to, step_feed) in moves {
+        match step_feed {
+            None => flush(&mut run, run_feed, true)?,
+            Some(step_feed) => {
+                if run_feed != Some(step_feed) && run.len() > 1 {
+                    flush(&mut run, run_feed, false)?;
+                }
+                if run.is_empty() {
+                    run.push(from.unwrap_or(to));
+                }
+                run.push(to);
+                run_feed = Some(step_feed);
+            }
+        }
+        from = Some(to);
+    }
+    flush(&mut run, run_feed, true)?;
+    let min_block_length = if tally.inner_min.is_finite() {
+        tally.inner_min
+    } else if tally.end_min.is_finite() {
+        tally.end_min
+    } else {
+        0.0
+    };
+    Ok(PathBlocks {
+        block_time_ms,
+        block_length: feed * block_time_ms / MS_PER_MIN,
+        blocks: tally.blocks,
+        min_block_length,
+        short_blocks: tally.short,
+        short_end_blocks: tally.short_end,
+        estimated_time_s: tally.time_s,
+        finest_arc_tolerance,
+    })
+}
+
+/// `W_BLOCK_TIME_VIOLATION` (chord.md E9) when inner blocks of `blocks` are short.
+pub fn short_block_warning(blocks: &PathBlocks, rule: &BlockRule) -> Option<Warning> {
+    (blocks.short_blocks > 0).then(|| {
+        Warning::new(
+            "W_BLOCK_TIME_VIOLATION",
+            format!(
+                "{} feed blocks are shorter than feed × block time (the shortest {:.4} mm, {:.4} mm needed at {} mm/min): \
+                 short straight moves (edges, leads, loop legs) the rule cannot lengthen; the control slows down there",
+                blocks.short_blocks,
+                blocks.min_block_length,
+                rule.block_length(),
+                rule.feed
+            ),
+        )
+    })
 }

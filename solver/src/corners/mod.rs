@@ -73,7 +73,6 @@ pub use answer::{
     ContourAnswer, ContourCorner, ContourLayer, ContourMove, ContourSummary, Convexity, CornerAction, LoopReport,
     MaterialReport, MoveKind, PassReport, ReliefReport,
 };
-pub use blocks::ContourBlocks;
 pub use element::{Element, ElementKind};
 pub use pass::{Action, CornerPlan, ElementMeta, PassPlan};
 pub use program::program;

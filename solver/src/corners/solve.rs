@@ -204,8 +204,9 @@ pub fn solve_with(
         Some((rule, _)) => {
             let (finest, arc_warnings) = blocks::arc_report(&first_passes, &job.chording);
             warnings.extend(arc_warnings);
-            let figures = blocks::figures(&layers, rule.block_time_ms, job.feed, finest)?;
-            warnings.extend(blocks::short_block_warning(&figures, rule));
+            let moves = layers.iter().flat_map(|layer| &layer.moves).map(|step| (Vec3::from(step.to), step.feed));
+            let figures = crate::chord::path_blocks(moves, rule.block_time_ms, job.feed, finest)?;
+            warnings.extend(crate::chord::short_block_warning(&figures, rule));
             Some(figures)
         }
     };

@@ -240,6 +240,10 @@ pub struct PathEngagement {
     /// Feeds holding the target chip thickness, when asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub feed_plan: Option<FeedPlan>,
+    /// With a block time (`block_time_ms` or a machine) and `axial_depth`: the blocks of this
+    /// path's program, the shortest, the short ones and the block-limited time.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blocks: Option<crate::chord::PathBlocks>,
     /// Everything worth knowing that did not stop the computation.
     pub warnings: Vec<Warning>,
     /// What the G-code post needs.
@@ -286,6 +290,8 @@ pub(crate) struct PostData {
     pub nominal_feed: f64,
     pub spindle_rpm: f64,
     pub spindle_direction: crate::gcode::SpindleDirection,
+    /// The block-time rule the program's arcs are chorded by (its feed replaced by each block's).
+    pub rule: Option<crate::chord::BlockRule>,
     pub axial_depth: Option<f64>,
     pub stock_top_z: f64,
     pub clearance: f64,

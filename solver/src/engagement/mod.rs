@@ -119,7 +119,12 @@ pub fn solve_with(
     let job = request.validate(tool, machine)?;
     let mut results = Vec::with_capacity(job.candidates.len());
     for candidate in &job.candidates {
-        results.push(evaluate::evaluate(&job, candidate, tool)?);
+        let mut result = evaluate::evaluate(&job, candidate, tool)?;
+        if let Some((blocks, warnings)) = program::blocks(&result)? {
+            result.blocks = Some(blocks);
+            result.warnings.extend(warnings);
+        }
+        results.push(result);
     }
     if job.single
         && let Some(result) = results.pop()

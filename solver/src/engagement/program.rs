@@ -1,13 +1,15 @@
 //! The G-code program of one evaluated path (engagement.md §3.2 adoption, §11 items 3 and 12):
 //! the path at the cutting depth with the feed plan's F words (or the nominal feed), rapids
-//! lifted to the clearance plane, arcs as chords.
+//! lifted to the clearance plane, arcs as chords (with a block time, by the block-time rule of
+//! chord.md); and the block figures of that program for the answer.
 
 use super::answer::{EngagementAnswer, PathEngagement};
-use super::segments::Route;
-use crate::error::SolverError;
+use super::segments::{Route, Shape};
+use crate::chord::{BlockRule, PathBlocks, path_blocks, short_block_warning};
+use crate::error::{SolverError, Warning};
 use crate::gcode::{self, Post, Program, Reference};
 use crate::geometry::Vec3;
-use crate::path::Toolpath;
+use crate::path::{Motion, Toolpath};
 
 /// Largest distance of an arc from its chords in the program, mm.
 pub const CHORD_TOLERANCE: f64 = 0.001;
@@ -63,30 +65,70 @@ pub fn program(answer: &EngagementAnswer, candidate: usize, post: &Post) -> Resu
         SolverError::input("candidate", format!("candidate {candidate} does not exist ({} path(s))", candidates.len()))
     })?;
     let data = &result.post;
+    let lift = match post.reference {
+        Reference::Tip => 0.0,
+        Reference::Centre => data.centre_height,
+    };
+    let Cut { path, cut_z, safe_z, .. } = cut(result, lift)?;
+    let mut comments = data.description.clone();
+    comments.push(format!("cut Z {:.4}, clearance Z {:.4}, control point {}", cut_z, safe_z, post.reference.as_str()));
+    if let Some(plan) = &result.feed_plan {
+        comments.push(format!(
+            "feeds hold {} mm chip thickness ({} basis) for {} flutes, max feed {}",
+            plan.target_thickness,
+            match plan.basis {
+                super::request::FeedBasis::Tooth => "tooth",
+                super::request::FeedBasis::Sum => "sum",
+            },
+            plan.flute_count,
+            plan.max_feed
+        ));
+    }
+    if let Some(rule) = &data.rule {
+        comments.push(format!("arcs chorded for a {} ms block time", rule.block_time_ms));
+    }
+    Ok(gcode::write(&Program {
+        dialect: post.dialect,
+        number: 1000,
+        title: "kerf engagement",
+        comments,
+        tool: post.tool.clone(),
+        spindle_rpm: data.spindle_rpm,
+        spindle_direction: data.spindle_direction,
+        safe_z,
+        blend_tolerance: CHORD_TOLERANCE * 5.0,
+        path: &path,
+    }))
+}
+
+/// The moves of a program and what the block-time rule did to its arcs.
+struct Cut {
+    path: Toolpath,
+    cut_z: f64,
+    safe_z: f64,
+    /// Finest chord tolerance of an arc, mm (None without arcs).
+    finest_arc_tolerance: Option<f64>,
+    /// Arcs too tight for one block at their feed: count, smallest radius, largest feasible feed.
+    infeasible: (usize, f64, f64),
+    /// Arcs whose [`CHORD_TOLERANCE`] needs chords shorter than a block (chord.md E4).
+    overridden_arcs: usize,
+}
+
+/// The tool path of `result` with the control point `lift` above the tip: the cut at
+/// `stock_top_z − axial_depth`, rapids at the clearance plane, arcs as chords within
+/// [`CHORD_TOLERANCE`], or with a block time at the block-time rule's chord error for the arc's
+/// radius and feed (chords of one block), never coarser than that.
+fn cut(result: &PathEngagement, lift: f64) -> Result<Cut, SolverError> {
+    let data = &result.post;
     let depth = data.axial_depth.ok_or_else(|| {
         SolverError::input(
             "axial_depth",
             "the G-code program needs axial_depth: it cuts at Z = stock_top_z − axial_depth",
         )
     })?;
-    let lift = match post.reference {
-        Reference::Tip => 0.0,
-        Reference::Centre => data.centre_height,
-    };
     let cut_z = data.stock_top_z - depth + lift;
     let safe_z = data.stock_top_z + data.clearance + lift;
     let route = &data.route.0;
-    let chords: f64 = route.pieces.iter().map(|p| p.shape.chord_count(CHORD_TOLERANCE)).sum();
-    if chords > super::MAX_CHORDS {
-        return Err(SolverError::new(
-            "E_TOO_LARGE",
-            format!(
-                "the program would need {chords:.2e} moves for the arcs at {CHORD_TOLERANCE} mm; the limit is {:.0e}",
-                super::MAX_CHORDS
-            ),
-        )
-        .at("path"));
-    }
     let mut path = Toolpath::default();
     let Some(first) = route.pieces.first() else {
         return Err(SolverError::new("E_PATH", "the path is empty").at("path"));
@@ -95,6 +137,10 @@ pub fn program(answer: &EngagementAnswer, candidate: usize, post: &Post) -> Resu
     path.rapid(Vec3::new(start.x, start.y, safe_z));
     let mut raised = true;
     let mut at = start;
+    let mut finest_arc_tolerance: Option<f64> = None;
+    let mut infeasible = (0, f64::INFINITY, f64::INFINITY);
+    let mut overridden_arcs = 0;
+    let mut chords = 0.0;
     for run in runs(result) {
         let Some(piece) = route.pieces.get(run.piece) else {
             continue;
@@ -115,38 +161,90 @@ pub fn program(answer: &EngagementAnswer, candidate: usize, post: &Post) -> Resu
                     path.linear(Vec3::new(at.x, at.y, cut_z), feed.min(data.nominal_feed));
                     raised = false;
                 }
-                let points = piece.shape.portion(from, to).flatten(CHORD_TOLERANCE);
-                for p in points.into_iter().skip(1) {
+                let portion = piece.shape.portion(from, to);
+                let count = match (portion, &data.rule) {
+                    (Shape::Arc { radius, .. }, Some(rule)) => {
+                        let rule = BlockRule { feed, ..*rule };
+                        match portion.rule_chords(&rule, CHORD_TOLERANCE) {
+                            Ok((count, overridden)) => {
+                                let tolerance =
+                                    rule.tolerance_for(radius, Some(CHORD_TOLERANCE)).unwrap_or(CHORD_TOLERANCE);
+                                finest_arc_tolerance =
+                                    Some(finest_arc_tolerance.map_or(tolerance, |f: f64| f.min(tolerance)));
+                                overridden_arcs += usize::from(overridden);
+                                count
+                            }
+                            Err(error) => {
+                                infeasible.0 += 1;
+                                infeasible.1 = infeasible.1.min(radius);
+                                infeasible.2 = infeasible.2.min(error.feed_limit);
+                                finest_arc_tolerance =
+                                    Some(finest_arc_tolerance.map_or(CHORD_TOLERANCE, |f: f64| f.min(CHORD_TOLERANCE)));
+                                portion.chord_count(CHORD_TOLERANCE) as usize
+                            }
+                        }
+                    }
+                    _ => portion.chord_count(CHORD_TOLERANCE) as usize,
+                };
+                chords += count as f64;
+                if chords > super::MAX_CHORDS {
+                    return Err(SolverError::new(
+                        "E_TOO_LARGE",
+                        format!(
+                            "the program would need more than {:.0e} moves for its arcs; the limit is {:.0e}",
+                            super::MAX_CHORDS,
+                            super::MAX_CHORDS
+                        ),
+                    )
+                    .at("path"));
+                }
+                for p in portion.flatten_into(count).into_iter().skip(1) {
                     path.linear(Vec3::new(p.x, p.y, cut_z), feed);
                     at = p;
                 }
             }
         }
     }
-    let mut comments = data.description.clone();
-    comments.push(format!("cut Z {:.4}, clearance Z {:.4}, control point {}", cut_z, safe_z, post.reference.as_str()));
-    if let Some(plan) = &result.feed_plan {
-        comments.push(format!(
-            "feeds hold {} mm chip thickness ({} basis) for {} flutes, max feed {}",
-            plan.target_thickness,
-            match plan.basis {
-                super::request::FeedBasis::Tooth => "tooth",
-                super::request::FeedBasis::Sum => "sum",
-            },
-            plan.flute_count,
-            plan.max_feed
+    Ok(Cut { path, cut_z, safe_z, finest_arc_tolerance, infeasible, overridden_arcs })
+}
+
+/// With a block time and an axial depth: the block figures of the program's feed moves and the
+/// warnings that explain short ones (arcs too tight for one block at their feed, chord.md E3;
+/// short straight moves, E9).
+///
+/// # Errors
+/// As the program: `E_TOO_LARGE` for a program over the move limit.
+pub(crate) fn blocks(result: &PathEngagement) -> Result<Option<(PathBlocks, Vec<Warning>)>, SolverError> {
+    let (Some(rule), Some(_)) = (&result.post.rule, result.post.axial_depth) else {
+        return Ok(None);
+    };
+    let cut = cut(result, 0.0)?;
+    let moves = cut.path.moves.iter().map(|step| match step.motion {
+        Motion::Rapid => (step.to, None),
+        Motion::Linear { feed } => (step.to, Some(feed)),
+    });
+    let figures = path_blocks(moves, rule.block_time_ms, rule.feed, cut.finest_arc_tolerance)?;
+    let mut warnings = Vec::new();
+    let (count, radius, feed_limit) = cut.infeasible;
+    if count > 0 {
+        warnings.push(Warning::new(
+            "W_INFEASIBLE_FEED_FOR_RADIUS",
+            format!(
+                "{count} arcs (smallest radius {radius:.4} mm) cannot hold one block at their feed: they are chorded at \
+                 {CHORD_TOLERANCE} mm and their blocks are short; {feed_limit:.0} mm/min is the largest feed for them"
+            ),
         ));
     }
-    Ok(gcode::write(&Program {
-        dialect: post.dialect,
-        number: 1000,
-        title: "kerf engagement",
-        comments,
-        tool: post.tool.clone(),
-        spindle_rpm: data.spindle_rpm,
-        spindle_direction: data.spindle_direction,
-        safe_z,
-        blend_tolerance: CHORD_TOLERANCE * 5.0,
-        path: &path,
-    }))
+    if cut.overridden_arcs > 0 {
+        warnings.push(Warning::new(
+            "W_CHORD_ERROR_EXCEEDS_TOLERANCE",
+            format!(
+                "{} arcs need a chord error above {CHORD_TOLERANCE} mm for blocks of one block time: the tolerance \
+                 wins and their blocks are short",
+                cut.overridden_arcs
+            ),
+        ));
+    }
+    warnings.extend(short_block_warning(&figures, rule));
+    Ok(Some((figures, warnings)))
 }

@@ -16,7 +16,7 @@ use super::{
     DEFAULT_BURR_DISENGAGE_DEG, DEFAULT_CHIPPING_DISENGAGE_DEG, MAX_CANDIDATES, MAX_CHORDS, MAX_DOT_ROWS, MAX_FLUTES,
     MAX_GRID_DOTS, MAX_SAMPLES, MAX_SEGMENTS, MAX_STOCK_VERTICES, P2,
 };
-use crate::chord::MachineProfile;
+use crate::chord::{BlockRule, MachineProfile, RuleSettings};
 use crate::error::{SolverError, Warning, finite, non_negative, positive};
 use crate::gcode::reader::{MoveKind, Plane, ReadOptions, read as read_program};
 use crate::planar::signed_area;
@@ -351,6 +351,12 @@ pub struct EngagementRequest {
     /// `dots` engine: return the contact dots for the scatter plot (default true).
     #[serde(default = "yes")]
     pub contact_dots: bool,
+    /// Block processing time of the control, ms (chord.md; default: the machine's). With it the
+    /// G-code program chords arcs at the block-time rule's chord error for their radius and
+    /// feed (chords of one block; never coarser than 0.001 mm), and with `axial_depth` the
+    /// answer reports the program's `blocks`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub block_time_ms: Option<f64>,
     /// A stored machine profile, resolved by the server: its `max_feed` fills an absent
     /// `feed_plan.max_feed` (a larger one is kept with `W_FEED_ABOVE_MACHINE_MAX`), its dialect
     /// is the G-code default.
@@ -415,6 +421,8 @@ pub(crate) struct Job {
     pub stock_top_z: f64,
     pub clearance: f64,
     pub plan: Option<PlanJob>,
+    /// The block-time rule of the program, at the nominal feed of the tool's flute count.
+    pub rule: Option<BlockRule>,
     pub contact_dots: bool,
     pub region: Region,
     /// Warnings of the stock and the machine, for every candidate.
@@ -920,6 +928,16 @@ impl EngagementRequest {
             })
             .transpose()?;
 
+        let rule = if self.block_time_ms.is_some() || machine.is_some() {
+            let feed = feed_mode.feed(tool.flutes, spindle_rpm);
+            let settings =
+                RuleSettings { feed: Some(feed), block_time_ms: self.block_time_ms, ..RuleSettings::default() };
+            let (rule, warnings) = BlockRule::resolve(&settings, machine)?;
+            shared_warnings.extend(warnings);
+            Some(rule)
+        } else {
+            None
+        };
         let (region, _) = read_stock(&self.stock, radius, &mut shared_warnings)?;
 
         let inputs: Vec<(Option<String>, &PathInput, String)> = match (&self.path, &self.paths) {
@@ -1026,6 +1044,7 @@ impl EngagementRequest {
             stock_top_z,
             clearance,
             plan,
+            rule,
             contact_dots: self.contact_dots,
             region,
             shared_warnings,

@@ -5,6 +5,7 @@ use std::f64::consts::{PI, TAU};
 
 use super::P2;
 use super::bbox_tree::{BBox, BoxTree};
+use crate::chord::{BlockRule, Infeasible};
 use crate::planar::point_segment_distance;
 
 /// One geometric piece of a path.
@@ -171,14 +172,37 @@ impl Shape {
     /// Points along the piece (first and last included) whose chords stay within `sagitta` of
     /// it; a line gives its two ends. Callers bound the count with [`Self::chord_count`].
     pub(crate) fn flatten(&self, sagitta: f64) -> Vec<P2> {
+        self.flatten_into(self.chord_count(sagitta).min(1e8) as usize)
+    }
+
+    /// Points along the piece (first and last included) in `count` equal chords; a line gives its
+    /// two ends.
+    pub(crate) fn flatten_into(&self, count: usize) -> Vec<P2> {
         match *self {
             Self::Line { from, to } => vec![from, to],
             Self::Arc { .. } => {
-                let count = self.chord_count(sagitta).min(1e8) as usize;
+                let count = count.max(1);
                 let length = self.length();
                 (0..=count).map(|i| self.point(length * i as f64 / count as f64)).collect()
             }
         }
+    }
+
+    /// Chords of an arc under the block-time rule `rule`: as few as keep each chord's sagitta
+    /// within the rule's chord error (the floor: every chord at least one block long), and at
+    /// least as many as `tolerance` needs (the ceiling there: the accuracy bound wins, and the
+    /// second value says so). A line is one chord.
+    ///
+    /// # Errors
+    /// [`Infeasible`] when the arc cannot hold one block at the rule's feed (chord.md E3).
+    pub(crate) fn rule_chords(&self, rule: &BlockRule, tolerance: f64) -> Result<(usize, bool), Infeasible> {
+        let Self::Arc { radius, sweep, .. } = *self else { return Ok((1, false)) };
+        let (chord_error, _) = rule.chord_error(radius)?;
+        let tolerance_chords = self.chord_count(tolerance) as usize;
+        let half_angle = if chord_error >= radius { PI / 2.0 } else { (1.0 - chord_error / radius).acos() };
+        // Saturating float → integer conversion; the program caps the count.
+        let block_chords = ((sweep.abs() / (2.0 * half_angle.max(1e-9))).floor() as usize).max(1);
+        Ok((block_chords.max(tolerance_chords), tolerance_chords > block_chords))
     }
 }
 

@@ -477,6 +477,58 @@ async fn the_program_turns_the_spindle_as_analysed() {
     }
 }
 
+/// With a block time the program's arcs are chorded into blocks of one block time at their
+/// feed, and the answer reports the program's blocks; an arc too tight for one block is
+/// reported, not refused.
+#[tokio::test(flavor = "multi_thread")]
+async fn block_time_chords_the_program_and_reports_its_blocks() {
+    let app = TestApp::spawn().await;
+    let mut body = api_example();
+    body["path"] = json!({"start": [-10, 20], "segments": [
+        {"type": "line", "to": [30, 20]},
+        {"type": "arc", "to": [40, 30], "center": [30, 30], "dir": "ccw"},
+        {"type": "line", "to": [40, 60]}]});
+    body["axial_depth"] = json!(2);
+    let gcode_moves = |program: &str| program.lines().filter(|l| l.starts_with("G01")).count();
+    let program_of = |body: Value| {
+        let request = app.client.post(app.url(&format!("{URL}?format=gcode"))).json(&body);
+        async move { request.send().await.unwrap().text().await.unwrap() }
+    };
+    let plain = json_with(app.post_json(URL, &body).await, 200).await;
+    assert!(plain.get("blocks").is_none(), "no block figures without a block time");
+    let plain_moves = gcode_moves(&program_of(body.clone()).await);
+
+    body["block_time_ms"] = json!(4);
+    let ruled = json_with(app.post_json(URL, &body).await, 200).await;
+    let blocks = &ruled["blocks"];
+    assert_eq!(blocks["block_time_ms"], 4.0);
+    // 2 flutes × 0.05 mm × 3000 rpm = 300 mm/min: blocks of 0.02 mm on a 4 ms control.
+    let block_length = 300.0 * 4.0 / 60_000.0;
+    assert!((num(&blocks["block_length"]) - block_length).abs() < 1e-12, "{blocks}");
+    assert_eq!(blocks["short_blocks"], 0, "{}", ruled["warnings"]);
+    assert!(num(&blocks["min_block_length"]) >= block_length * (1.0 - 1e-9), "{blocks}");
+    let program = program_of(body.clone()).await;
+    assert_eq!(gcode_moves(&program), blocks["blocks"].as_u64().unwrap() as usize, "every feed block is a G01");
+    // The R10 quarter arc (15.7 mm) in chords of one 0.02 mm block instead of 0.28 mm ones.
+    assert!(gcode_moves(&program) > plain_moves + 700, "{} vs {plain_moves}", gcode_moves(&program));
+    assert_eq!(ruled["samples"], plain["samples"], "the analysis does not change");
+
+    // 20 m/min on a 10 ms control wants 3.3 mm blocks: an R1 arc cannot hold one.
+    body["feed_per_tooth"] = Value::Null;
+    body["feed"] = json!(20_000);
+    body["block_time_ms"] = json!(10);
+    body["path"]["segments"][1] = json!({"type": "arc", "to": [31, 21], "center": [30, 21], "dir": "ccw"});
+    body["path"]["segments"][2] = json!({"type": "line", "to": [31, 60]});
+    let tight = json_with(app.post_json(URL, &body).await, 200).await;
+    let codes: Vec<&str> = tight["warnings"].as_array().unwrap().iter().map(|w| w["code"].as_str().unwrap()).collect();
+    assert!(codes.contains(&"W_INFEASIBLE_FEED_FOR_RADIUS") && codes.contains(&"W_BLOCK_TIME_VIOLATION"), "{codes:?}");
+    assert!(tight["blocks"]["short_blocks"].as_u64().unwrap() > 0);
+
+    body["block_time_ms"] = json!(0);
+    let refused = problem(app.post_json(URL, &body).await, 422).await;
+    assert_eq!(refused["errors"][0]["path"], "block_time_ms");
+}
+
 /// The example job's engagement operation gives exactly the endpoint's answer for the same
 /// request, and its program is the endpoint's for the first path in the job's output options.
 #[tokio::test(flavor = "multi_thread")]
