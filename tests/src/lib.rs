@@ -236,6 +236,18 @@ fn rs274_tool_table() -> String {
     (1..100).map(|n| format!("T{n} P{n} D6.0 Z0 ;test tool\n")).collect()
 }
 
+/// Asserts that the moves `rs274` interpreted are `expected` (is a feed move, end point), in
+/// count, kind and end point within 1e-4 mm; `label` names the program in the messages.
+pub fn assert_moves_match(label: &str, interpreted: &[(bool, [f64; 3])], expected: &[(bool, [f64; 3])]) {
+    assert_eq!(interpreted.len(), expected.len(), "{label}: move count");
+    for (index, (got, want)) in interpreted.iter().zip(expected).enumerate() {
+        assert_eq!(got.0, want.0, "{label}: move {index} kind");
+        for axis in 0..3 {
+            assert!((got.1[axis] - want.1[axis]).abs() <= 1e-4, "{label}: move {index} {got:?} vs {want:?}");
+        }
+    }
+}
+
 /// Runs `program` through LinuxCNC's `rs274` (writing it to `folder/name.ngc`), asserts that the
 /// interpreter accepts it to its end without complaint, and returns its canonical moves:
 /// (is a feed move, end point). Arcs (`ARC_FEED`) count as feed moves to their end point, in the

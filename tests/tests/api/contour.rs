@@ -3,7 +3,7 @@
 //! LinuxCNC's `rs274` with its end points equal to the JSON moves, a table of bad requests with
 //! the database unchanged, the JSON move limit, and byte-identical answers.
 
-use kerf_tests::{TestApp, external_program, finished, json_with, poll_job, problem, rs274_moves};
+use kerf_tests::{TestApp, assert_moves_match, external_program, finished, json_with, poll_job, problem, rs274_moves};
 use serde_json::{Value, json};
 
 const FIXTURE: &str = include_str!("../../../solver/tests/fixtures/corners.json");
@@ -275,16 +275,7 @@ async fn gcode_of_both_dialects_matches_the_json_moves() {
                 interpreted.pop();
                 let lift = if reference == "centre" { centre_height } else { 0.0 };
                 let expected = answer_moves(&answer, lift);
-                assert_eq!(interpreted.len(), expected.len(), "{label}: move count");
-                for (index, (got, want)) in interpreted.iter().zip(&expected).enumerate() {
-                    assert_eq!(got.0, want.0, "{label}: move {index} kind");
-                    for axis in 0..3 {
-                        assert!(
-                            (got.1[axis] - want.1[axis]).abs() <= 1e-4,
-                            "{label}: move {index} {got:?} vs {want:?}"
-                        );
-                    }
-                }
+                assert_moves_match(&label, &interpreted, &expected);
                 if dialect == "linuxcnc" {
                     assert!(program.contains("G64 P"), "{label}: blending tolerance");
                 } else {

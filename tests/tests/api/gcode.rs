@@ -2,7 +2,7 @@
 //! dialects, both references, several jobs) and its feed and rapid end points must equal the JSON
 //! answer's moves within 1e-4 mm.
 
-use kerf_tests::{TestApp, external_program, json_with, rs274_moves};
+use kerf_tests::{TestApp, assert_moves_match, external_program, json_with, rs274_moves};
 use serde_json::{Value, json};
 
 /// The moves the JSON answer describes after the tool change, in `reference` coordinates.
@@ -72,16 +72,7 @@ async fn programs_pass_rs274_and_match_json() {
                 interpreted.drain(..=first_rapid);
                 // The last traverse is the program's final return to the clearance plane.
                 interpreted.pop();
-                assert_eq!(interpreted.len(), expected.len(), "{label}: move count");
-                for (index, (got, want)) in interpreted.iter().zip(&expected).enumerate() {
-                    assert_eq!(got.0, want.0, "{label}: move {index} kind");
-                    for axis in 0..3 {
-                        assert!(
-                            (got.1[axis] - want.1[axis]).abs() <= 1e-4,
-                            "{label}: move {index} {got:?} vs {want:?}"
-                        );
-                    }
-                }
+                assert_moves_match(&label, &interpreted, &expected);
                 if name == "inline_tool_exact" {
                     assert!(program.contains("M00"), "an inline tool without a number stops for a manual change");
                 }
