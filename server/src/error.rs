@@ -4,11 +4,11 @@
 use axum::http::{HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 use kerf_solver::SolverError;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 /// One field-level complaint inside a problem document.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, ToSchema)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
 pub struct FieldProblem {
     /// Dotted JSON path of the field (`hole.radius`, `tool`, `contour[3]`), or the query/path
     /// parameter name.
@@ -18,13 +18,13 @@ pub struct FieldProblem {
 }
 
 /// An RFC 9457 problem document, as every error answer carries.
-#[derive(Debug, Clone, Serialize, ToSchema)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
 pub struct Problem {
     /// Always `about:blank`: the status code and `code` say what happened.
     #[serde(rename = "type")]
-    pub kind: &'static str,
+    pub kind: String,
     /// Short, human-readable summary of the status.
-    pub title: &'static str,
+    pub title: String,
     /// HTTP status code.
     pub status: u16,
     /// Human-readable explanation specific to this request.
@@ -32,7 +32,7 @@ pub struct Problem {
     /// Stable machine-readable code (e.g. `E_HOLE_TOO_LARGE`, `E_JSON`, `E_NOT_FOUND`).
     pub code: String,
     /// The fields at fault.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub errors: Vec<FieldProblem>,
 }
 
@@ -91,6 +91,22 @@ impl AppError {
         Self::NotFound { detail: detail.into(), field: Some(field.into()) }
     }
 
+    /// The same error with its field path under `prefix` (`operations[2]` + `hole.radius` →
+    /// `operations[2].hole.radius`); an error without a field points at `prefix` itself.
+    #[must_use]
+    pub fn under(self, prefix: &str) -> Self {
+        let join = |field: Option<String>| Some(field.map_or_else(|| prefix.to_owned(), |f| format!("{prefix}.{f}")));
+        match self {
+            Self::BadRequest { code, detail, field } => Self::BadRequest { code, detail, field: join(field) },
+            Self::NotFound { detail, field } => Self::NotFound { detail, field: join(field) },
+            Self::Unprocessable(error) => {
+                let field = join(error.field().map(str::to_owned)).unwrap_or_default();
+                Self::Unprocessable(error.at(field))
+            }
+            other => other,
+        }
+    }
+
     fn status_title(&self) -> (StatusCode, &'static str) {
         match self {
             Self::BadRequest { .. } => (StatusCode::BAD_REQUEST, "Bad request"),
@@ -131,7 +147,14 @@ impl AppError {
             }
         };
         let errors = field.map(|path| vec![FieldProblem { path, message: detail.clone() }]).unwrap_or_default();
-        Problem { kind: "about:blank", title, status: status.as_u16(), detail, code, errors }
+        Problem {
+            kind: "about:blank".to_owned(),
+            title: title.to_owned(),
+            status: status.as_u16(),
+            detail,
+            code,
+            errors,
+        }
     }
 }
 

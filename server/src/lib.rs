@@ -5,6 +5,7 @@
 
 pub mod app;
 pub mod auth;
+pub mod capabilities;
 pub mod cli;
 pub mod db;
 pub mod error;

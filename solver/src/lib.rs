@@ -5,10 +5,12 @@
 //! call can run on any thread or worker. The server crate does HTTP, storage and jobs.
 //!
 //! Modules: [`geometry`] (vectors and small numeric helpers), [`tool`] (the cutter),
-//! [`path`] (typed moves), [`gcode`] (posts for the supported dialects), and one module per
-//! capability: [`deburr`], [`chord`], [`corners`], [`engagement`], [`predict`].
+//! [`path`] (typed moves), [`gcode`] (posts for the supported dialects), [`capability`] (the seam
+//! every way in dispatches through), and one module per capability: [`deburr`], [`chord`],
+//! [`corners`], [`engagement`], [`predict`].
 #![deny(missing_docs)]
 
+pub mod capability;
 pub mod chord;
 pub mod corners;
 pub mod deburr;

@@ -70,7 +70,9 @@ function row(job, root) {
     cell(job.submitted_at.replace('T', ' ').slice(0, 19)), actions);
   if (job.status === 'failed' && job.error) {
     const detail = document.createElement('tr');
-    const td = cell(`${job.error}${job.error_field ? ` [${job.error_field}]` : ''}`);
+    const field = job.error.errors?.[0]?.path;
+    const td = cell(`${job.error.detail}${field ? ` [${field}]` : ''}`);
+    td.title = job.error.code;
     td.colSpan = 7;
     td.className = 'error-line';
     detail.append(td);

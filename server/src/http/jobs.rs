@@ -34,8 +34,9 @@ pub struct Submitted {
 pub struct JobResult {
     /// The operation's name.
     pub operation: String,
-    /// Its answer, as its endpoint answers JSON.
-    pub result: serde_json::Value,
+    /// Its answer, byte for byte as its endpoint answers JSON.
+    #[schema(value_type = Object)]
+    pub result: Box<serde_json::value::RawValue>,
     /// Whether `GET /api/v1/jobs/{id}/gcode?operation=N` has a program for it.
     pub gcode: bool,
     /// Why no program could be written, if so.
@@ -167,7 +168,7 @@ fn located(id: i64, status: StatusCode, body: &Submitted) -> Response {
         (status = 422, body = Problem, content_type = "application/problem+json")))]
 async fn submit(State(state): State<AppState>, request: Request) -> AppResult<Response> {
     let (text, format) = upload(&state, request).await?;
-    let job = file::parse(&text, format)?.resolve(&state.db).await?;
+    let job = file::parse(&text, format)?.resolve(Some(&state.db)).await?;
     let hash = job.content_hash();
     if let Some(id) = store::jobs::find_done(&state.db, &hash).await? {
         return Ok(located(id, StatusCode::OK, &Submitted { id, status: JobStatus::Done, reused: true }));
@@ -206,7 +207,7 @@ async fn show(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobI
         let rows = store::jobs::results(&state.db, id).await?;
         let mut results = Vec::with_capacity(rows.len());
         for (operation, json, gcode, gcode_problem) in rows {
-            let result = serde_json::from_str(&json).map_err(|e| AppError::Internal(e.into()))?;
+            let result = serde_json::value::RawValue::from_string(json).map_err(|e| AppError::Internal(e.into()))?;
             results.push(JobResult { operation, result, gcode, gcode_problem });
         }
         Some(results)

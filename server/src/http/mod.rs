@@ -9,4 +9,5 @@ pub mod machines;
 pub mod output;
 pub mod predict;
 pub mod segment;
+pub mod solve;
 pub mod tools;

@@ -4,6 +4,7 @@
 
 use axum::http::{HeaderMap, HeaderValue, header};
 use axum::response::{IntoResponse, Response};
+use kerf_solver::capability::OutputOptions;
 use kerf_solver::gcode::{Dialect, Reference};
 use serde::Deserialize;
 use utoipa::{IntoParams, ToSchema};
@@ -34,31 +35,39 @@ pub struct OutputQuery {
     pub reference: Option<Reference>,
 }
 
-/// What the client asked for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Output {
+/// What the client asked for: JSON, or the program with its output options.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Ask {
     /// G-code instead of JSON.
     pub gcode: bool,
-    /// Dialect, if the client chose one (else the machine's, else Fanuc).
-    pub dialect: Option<Dialect>,
-    /// Programmed point.
-    pub reference: Reference,
+    /// How the program is written (what is left open takes the machine's or capability's default).
+    pub output: OutputOptions,
+    /// Add the solve time to answers that report it (`?timings=true`).
+    pub timings: bool,
 }
 
-impl Output {
-    /// Reads the query and the `Accept` header; an explicit `format` wins over `Accept`.
+impl Ask {
+    /// Reads the output query and the `Accept` header; an explicit `format` wins over `Accept`.
     pub fn negotiate(headers: &HeaderMap, query: &OutputQuery) -> Self {
-        let accepts_gcode = headers
-            .get_all(header::ACCEPT)
-            .iter()
-            .filter_map(|value| value.to_str().ok())
-            .flat_map(|value| value.split(','))
-            .any(|item| item.split(';').next().unwrap_or_default().trim().eq_ignore_ascii_case(GCODE_MEDIA_TYPE));
-        let gcode = match query.format {
-            Some(format) => format == Format::Gcode,
-            None => accepts_gcode,
-        };
-        Self { gcode, dialect: query.dialect, reference: query.reference.unwrap_or_default() }
+        Self {
+            gcode: wants_gcode(headers, query.format),
+            output: OutputOptions { dialect: query.dialect, reference: query.reference, candidate: None },
+            timings: false,
+        }
+    }
+}
+
+/// Whether the client wants G-code: `format` if given, else the `Accept` header.
+pub fn wants_gcode(headers: &HeaderMap, format: Option<Format>) -> bool {
+    let accepts_gcode = headers
+        .get_all(header::ACCEPT)
+        .iter()
+        .filter_map(|value| value.to_str().ok())
+        .flat_map(|value| value.split(','))
+        .any(|item| item.split(';').next().unwrap_or_default().trim().eq_ignore_ascii_case(GCODE_MEDIA_TYPE));
+    match format {
+        Some(format) => format == Format::Gcode,
+        None => accepts_gcode,
     }
 }
 

@@ -1,39 +1,17 @@
 //! `POST /api/v1/segment` (api.md, Segment; chord.md): a curve cut into G01 blocks whose chord
 //! error follows the control's block processing time, as JSON or G-code.
 
-use axum::Json;
 use axum::extract::State;
 use axum::http::HeaderMap;
-use axum::response::{IntoResponse, Response};
-use kerf_solver::SolverError;
-use kerf_solver::chord::{self, MachineProfile, SegmentAnswer, SegmentRequest};
-use kerf_solver::gcode::{Dialect, Post, Reference, ToolCall};
-use kerf_solver::tool::Tool;
-use serde::Serialize;
-use utoipa::ToSchema;
+use axum::response::Response;
+use kerf_solver::chord::{SegmentCapability, SegmentRequest, SegmentResult};
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
-use super::output::{Output, OutputQuery, gcode_response};
+use super::output::{Ask, OutputQuery};
 use crate::error::{AppResult, Problem};
 use crate::extract::{AppJson, AppQuery};
 use crate::state::AppState;
-use crate::store;
-
-/// The segment answer: the machine and tool used, and the solver's result.
-#[derive(Debug, Serialize, ToSchema)]
-pub struct SegmentResult {
-    /// The machine the request named, as registered: its values are the defaults the request
-    /// overrode or used (the values used are `feed`, `block_time_ms`, `margin`, `min_chord_error`).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub machine: Option<MachineProfile>,
-    /// The tool the program calls, as resolved from the table or given inline.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub tool: Option<Tool>,
-    /// Windows, command points, block figures, the comparison and warnings.
-    #[serde(flatten)]
-    pub result: SegmentAnswer,
-}
 
 /// Cuts a curve into G01 blocks by the block-time rule.
 ///
@@ -58,40 +36,7 @@ async fn post_segment(
     AppQuery(query): AppQuery<OutputQuery>,
     AppJson(request): AppJson<SegmentRequest>,
 ) -> AppResult<Response> {
-    let output = Output::negotiate(&headers, &query);
-    let machine = store::machines::resolve(&state.db, request.machine.as_deref()).await?;
-    let tool = match &request.tool {
-        Some(tool) => Some(store::tools::resolve(&state.db, tool).await?),
-        None => None,
-    };
-    let answer = state.solve(move || run(&request, machine, tool)).await??;
-    if output.gcode {
-        let dialect = super::machines::dialect(output.dialect, answer.machine.as_ref());
-        return Ok(gcode_response(program(&answer, dialect)?));
-    }
-    Ok(Json(answer).into_response())
-}
-
-/// Solves a segment request with its resolved machine and tool (used by the route and by jobs).
-pub fn run(
-    request: &SegmentRequest,
-    machine: Option<MachineProfile>,
-    tool: Option<Tool>,
-) -> Result<SegmentResult, SolverError> {
-    if let Some(tool) = &tool {
-        tool.validate("tool.")?;
-    }
-    let result = chord::solve(request, machine.as_ref())?;
-    Ok(SegmentResult { machine, tool, result })
-}
-
-/// The G-code program of a solved segment request.
-pub fn program(answer: &SegmentResult, dialect: Dialect) -> Result<String, SolverError> {
-    let tool = match &answer.tool {
-        Some(tool) => ToolCall::for_tool(tool),
-        None => ToolCall::Manual("none named in the request".to_owned()),
-    };
-    chord::program(&answer.result, &Post { dialect, reference: Reference::Tip, tool })
+    super::solve::answer::<SegmentCapability>(&state, request, None, Ask::negotiate(&headers, &query)).await
 }
 
 /// Routes of this module.

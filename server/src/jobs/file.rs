@@ -23,18 +23,17 @@
 //! Machines work like tools: `[[machines]]` entries (each with its `name`) are used before the
 //! machines registry when an operation names a `machine`.
 
-use kerf_solver::chord::{MachineProfile, SegmentRequest, validate_machine_name};
-use kerf_solver::corners::ContourRequest;
-use kerf_solver::deburr::DeburrRequest;
-use kerf_solver::engagement::EngagementRequest;
+use kerf_solver::capability::{self, Lookup};
+use kerf_solver::chord::{MachineProfile, validate_machine_name};
 use kerf_solver::gcode::{Dialect, Reference};
-use kerf_solver::predict::{PredictRequest, Stock};
+use kerf_solver::predict::Stock;
 use kerf_solver::tool::{Tool, ToolRef};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use sqlx::SqlitePool;
 use utoipa::ToSchema;
 
+use crate::capabilities::{Catalog, Operation, machine_in, tool_in};
 use crate::error::{AppError, AppResult};
 use crate::store;
 
@@ -50,7 +49,9 @@ pub struct JobFile {
     /// Free-text name shown in job lists.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
-    /// Tools the operations may name by number; they take precedence over the tool table.
+    /// Tools the operations may name by number; they take precedence over the tool table. Once
+    /// submitted, the job holds exactly the tools its operations name by number, from the file or
+    /// the tool table.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub tools: Vec<Tool>,
     /// Machines (controller profiles, each with its `name`) the operations may name; they take
@@ -69,126 +70,18 @@ pub struct JobFile {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct OutputOptions {
-    /// `fanuc` (default) or `linuxcnc`.
-    #[serde(default)]
-    pub dialect: Dialect,
-    /// `tip` (default) or `centre`.
-    #[serde(default)]
-    pub reference: Reference,
+    /// `fanuc` or `linuxcnc`; default: each operation's machine's, else `fanuc`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dialect: Option<Dialect>,
+    /// `tip` or `centre`; default `tip` (a predict operation's G-code path keeps its own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference: Option<Reference>,
 }
 
-/// One operation: `operation` names it, the other fields are its endpoint's request.
-#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
-#[serde(tag = "operation", rename_all = "snake_case")]
-#[allow(clippy::large_enum_variant, reason = "a job holds at most 100 operations, read once")]
-pub enum Operation {
-    /// `POST /api/v1/deburr`.
-    Deburr(DeburrRequest),
-    /// `POST /api/v1/segment`.
-    Segment(SegmentRequest),
-    /// `POST /api/v1/contour`.
-    Contour(ContourRequest),
-    /// `POST /api/v1/engagement`; the job's program is that of `path` (or `paths[0]`).
-    Engagement(EngagementRequest),
-    /// `POST /api/v1/predict` (a job file cannot carry an STL file: no `mesh` stock).
-    Predict(PredictRequest),
-}
-
-/// The names `operation` may take.
-#[derive(Debug, Clone, Copy, Deserialize)]
-#[serde(rename_all = "snake_case")]
-enum OperationKind {
-    Deburr,
-    Segment,
-    Contour,
-    Engagement,
-    Predict,
-}
-
-impl OperationKind {
-    /// Reads the operation's request from `fields` (the table without `operation`).
-    fn read<'de, D: serde::Deserializer<'de>>(self, fields: D) -> Result<Operation, D::Error> {
-        match self {
-            Self::Deburr => DeburrRequest::deserialize(fields).map(Operation::Deburr),
-            Self::Segment => SegmentRequest::deserialize(fields).map(Operation::Segment),
-            Self::Contour => ContourRequest::deserialize(fields).map(Operation::Contour),
-            Self::Engagement => EngagementRequest::deserialize(fields).map(Operation::Engagement),
-            Self::Predict => PredictRequest::deserialize(fields).map(Operation::Predict),
-        }
-    }
-}
-
-// Hand-written instead of serde's internally tagged enum, which buffers the table and so loses
-// the field path and line of errors inside it. When `operation` is the first key (as in every
-// example) the rest of the table is read in place; otherwise it is buffered and dispatched.
-impl<'de> Deserialize<'de> for Operation {
-    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        struct OperationVisitor;
-
-        impl<'de> serde::de::Visitor<'de> for OperationVisitor {
-            type Value = Operation;
-
-            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-                f.write_str("an operation table with `operation` and its request's fields")
-            }
-
-            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Operation, A::Error> {
-                use serde::de::Error;
-                let Some(first) = map.next_key::<String>()? else {
-                    return Err(A::Error::missing_field("operation"));
-                };
-                if first == "operation" {
-                    let kind: OperationKind = map.next_value()?;
-                    return kind.read(serde::de::value::MapAccessDeserializer::new(map));
-                }
-                let mut fields = serde_json::Map::new();
-                fields.insert(first, map.next_value()?);
-                while let Some(key) = map.next_key::<String>()? {
-                    let value = map.next_value()?;
-                    fields.insert(key, value);
-                }
-                let kind = fields.remove("operation").ok_or_else(|| A::Error::missing_field("operation"))?;
-                let kind: OperationKind = serde_json::from_value(kind).map_err(A::Error::custom)?;
-                kind.read(serde_json::Value::Object(fields)).map_err(A::Error::custom)
-            }
-        }
-
-        deserializer.deserialize_map(OperationVisitor)
-    }
-}
-
-impl Operation {
-    /// The operation's name.
-    pub fn kind(&self) -> &'static str {
-        match self {
-            Self::Deburr(_) => "deburr",
-            Self::Segment(_) => "segment",
-            Self::Contour(_) => "contour",
-            Self::Engagement(_) => "engagement",
-            Self::Predict(_) => "predict",
-        }
-    }
-
-    /// The tool reference, for operations that use a tool.
-    fn tool_mut(&mut self) -> Option<&mut ToolRef> {
-        match self {
-            Self::Deburr(request) => Some(&mut request.tool),
-            Self::Segment(request) => request.tool.as_mut(),
-            Self::Contour(request) => Some(&mut request.tool),
-            Self::Engagement(request) => Some(&mut request.tool),
-            Self::Predict(request) => Some(&mut request.tool),
-        }
-    }
-
-    /// The machine the operation names, for operations that take one.
-    fn machine_name(&self) -> Option<&str> {
-        match self {
-            Self::Deburr(request) => request.machine.as_deref(),
-            Self::Segment(request) => request.machine.as_deref(),
-            Self::Contour(request) => request.machine.as_deref(),
-            Self::Engagement(request) => request.machine.as_deref(),
-            Self::Predict(_) => None,
-        }
+impl OutputOptions {
+    /// The options every operation's program is written with.
+    pub fn for_programs(&self) -> capability::OutputOptions {
+        capability::OutputOptions { dialect: self.dialect, reference: self.reference, candidate: None }
     }
 }
 
@@ -386,80 +279,53 @@ fn check_machines(machines: &[MachineProfile]) -> AppResult<()> {
 }
 
 impl JobFile {
-    /// The job with every tool reference replaced by the tool itself (from the file's `tools`,
-    /// else the tool table), so it runs anywhere without the database. `lookup` finds a number.
-    pub async fn resolve_with<F, Fut>(mut self, lookup: F) -> AppResult<Self>
-    where
-        F: Fn(u32) -> Fut,
-        Fut: std::future::Future<Output = AppResult<Option<Tool>>>,
-    {
-        let local = std::mem::take(&mut self.tools);
-        for (index, operation) in self.operations.iter_mut().enumerate() {
-            let Some(tool) = operation.tool_mut() else { continue };
-            if let ToolRef::Number(number) = *tool {
-                let found = match local.iter().find(|t| t.number == Some(number)) {
-                    Some(tool) => Some(tool.clone()),
-                    None => lookup(number).await?,
-                };
-                let found = found.ok_or_else(|| {
-                    AppError::unknown(
-                        format!("operations[{index}].tool"),
-                        format!("tool {number} is neither in the job file nor in the tool table"),
-                    )
-                })?;
-                *tool = ToolRef::Inline(found);
-            }
-        }
-        Ok(self)
-    }
-
-    /// The job with exactly the machines its operations name, each from the file's `machines`,
-    /// else the registry (`lookup`), so it runs anywhere without the database.
-    pub async fn resolve_machines_with<F, Fut>(mut self, lookup: F) -> AppResult<Self>
-    where
-        F: Fn(String) -> Fut,
-        Fut: std::future::Future<Output = AppResult<Option<MachineProfile>>>,
-    {
-        let local = std::mem::take(&mut self.machines);
+    /// The job with exactly the tools and machines its operations name, each from the file, else
+    /// the tool table and machines registry of `db` (when given), so it runs anywhere without the
+    /// database. Every reference is resolved here once, with the capability's own resolution.
+    ///
+    /// # Errors
+    /// 404 naming `operations[i].tool` or `operations[i].machine` for an unknown reference.
+    pub async fn resolve(mut self, db: Option<&SqlitePool>) -> AppResult<Self> {
+        let given = Catalog { tools: std::mem::take(&mut self.tools), machines: std::mem::take(&mut self.machines) };
+        let found = match db {
+            Some(db) => store::catalog(db, self.operations.iter().map(Operation::refs), given).await?,
+            None => given,
+        };
         for (index, operation) in self.operations.iter().enumerate() {
-            let Some(name) = operation.machine_name() else { continue };
-            if self.machines.iter().any(|m| m.name.as_deref() == Some(name)) {
-                continue;
-            }
-            let found = match local.iter().find(|m| m.name.as_deref() == Some(name)) {
-                Some(machine) => Some(machine.clone()),
-                None => lookup(name.to_owned())
-                    .await?
-                    .map(|machine| MachineProfile { name: Some(name.to_owned()), ..machine }),
-            };
-            let found = found.ok_or_else(|| {
-                AppError::unknown(
-                    format!("operations[{index}].machine"),
-                    format!("machine {name:?} is neither in the job file nor in the machines registry"),
-                )
-            })?;
-            self.machines.push(found);
+            operation.check_refs(&found).map_err(|error| error.under(&format!("operations[{index}]")))?;
         }
+        let refs: Vec<_> = self.operations.iter().map(Operation::refs).collect();
+        let numbers: Vec<u32> = refs
+            .iter()
+            .filter_map(|r| match r.tool {
+                Some(ToolRef::Number(number)) => Some(*number),
+                _ => None,
+            })
+            .collect();
+        let names: Vec<&str> = refs.iter().filter_map(|r| r.machine).collect();
+        let tools = found.tools.into_iter().filter(|t| t.number.is_some_and(|n| numbers.contains(&n))).collect();
+        let machines =
+            found.machines.into_iter().filter(|m| m.name.as_deref().is_some_and(|n| names.contains(&n))).collect();
+        self.tools = tools;
+        self.machines = machines;
         Ok(self)
-    }
-
-    /// The resolved machine called `name`.
-    pub fn machine(&self, name: &str) -> Option<&MachineProfile> {
-        self.machines.iter().find(|m| m.name.as_deref() == Some(name))
-    }
-
-    /// [`Self::resolve_with`] against the server's tool table.
-    pub async fn resolve(self, db: &SqlitePool) -> AppResult<Self> {
-        self.resolve_with(|number| store::tools::get(db, number))
-            .await?
-            .resolve_machines_with(|name| async move { store::machines::get(db, &name).await })
-            .await
     }
 
     /// SHA-256 of the resolved job's canonical JSON: identical jobs have identical hashes.
     pub fn content_hash(&self) -> String {
         let bytes = serde_json::to_vec(self).unwrap_or_default();
         Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
+    }
+}
+
+/// A resolved job is its own lookup: its operations find their tools and machines in it.
+impl Lookup for JobFile {
+    fn tool(&self, number: u32) -> Option<Tool> {
+        tool_in(&self.tools, number)
+    }
+
+    fn machine(&self, name: &str) -> Option<MachineProfile> {
+        machine_in(&self.machines, name)
     }
 }
 
@@ -493,7 +359,7 @@ hole = { shape = "round", radius = 5 }
         let from_toml = parse(TOML_JOB, Format::Toml).unwrap();
         let json = serde_json::to_string(&from_toml).unwrap();
         assert_eq!(parse(&json, Format::Json).unwrap(), from_toml);
-        assert_eq!(from_toml.operations[0].kind(), "deburr");
+        assert_eq!(from_toml.operations[0].name(), "deburr");
     }
 
     #[test]

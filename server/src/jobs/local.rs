@@ -13,7 +13,6 @@ use sqlx::sqlite::{SqliteConnectOptions, SqlitePoolOptions};
 use super::execute::{JobFailure, execute};
 use super::file::{self, Format};
 use crate::error::AppError;
-use crate::store;
 
 /// What `kerf run` wrote.
 #[derive(Debug)]
@@ -47,30 +46,7 @@ pub async fn run(path: &Path, out: &Path, database: Option<&Path>) -> anyhow::Re
         Some(database) if database.exists() => Some(open_tools(database).await?),
         _ => None,
     };
-    let job = job
-        .resolve_with(|number| {
-            let pool = pool.clone();
-            async move {
-                match pool {
-                    Some(pool) => store::tools::get(&pool, number).await,
-                    None => Ok(None),
-                }
-            }
-        })
-        .await
-        .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), describe(&e)))?;
-    let job = job
-        .resolve_machines_with(|name| {
-            let pool = pool.clone();
-            async move {
-                match pool {
-                    Some(pool) => store::machines::get(&pool, &name).await,
-                    None => Ok(None),
-                }
-            }
-        })
-        .await
-        .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), describe(&e)))?;
+    let job = job.resolve(pool.as_ref()).await.map_err(|e| anyhow::anyhow!("{}: {}", path.display(), describe(&e)))?;
 
     let terminal = std::io::stderr().is_terminal();
     let show = move |fraction: f64| {
@@ -89,8 +65,9 @@ pub async fn run(path: &Path, out: &Path, database: Option<&Path>) -> anyhow::Re
     let outputs = match outputs {
         Ok(outputs) => outputs,
         Err(JobFailure::Cancelled) => bail!("cancelled"),
-        Err(JobFailure::Refused { message, field }) => {
-            bail!("{message}{}", field.map(|f| format!(" [field {f}]")).unwrap_or_default())
+        Err(JobFailure::Refused(problem)) => {
+            let field = problem.errors.first().map(|error| format!(" [field {}]", error.path)).unwrap_or_default();
+            bail!("{} ({}){field}", problem.detail, problem.code)
         }
     };
 
@@ -110,7 +87,8 @@ pub async fn run(path: &Path, out: &Path, database: Option<&Path>) -> anyhow::Re
     });
     write("job.json".to_owned(), &serde_json::to_string_pretty(&summary)?)?;
     for (index, output) in outputs.iter().enumerate() {
-        write(format!("{index:02}-{}.json", output.operation), &serde_json::to_string_pretty(&output.result)?)?;
+        // The answer exactly as the endpoint gives it.
+        write(format!("{index:02}-{}.json", output.operation), output.result.get())?;
         if let Some(program) = &output.gcode {
             write(format!("{index:02}-{}.nc", output.operation), program)?;
         }

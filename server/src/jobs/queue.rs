@@ -11,6 +11,7 @@ use sqlx::SqlitePool;
 use tokio::sync::{Notify, Semaphore};
 
 use super::execute::{JobFailure, execute};
+use crate::error::AppError;
 use crate::store;
 
 /// How often a running job's progress and heartbeat are written.
@@ -100,10 +101,11 @@ async fn run(runner: &JobRunner, db: &SqlitePool, slots: &Arc<Semaphore>, id: i6
     let stored = match outcome {
         Ok(Ok(outputs)) => store::jobs::finish(db, id, &outputs).await.map(|_| ()),
         Ok(Err(JobFailure::Cancelled)) => Ok(()),
-        Ok(Err(JobFailure::Refused { message, field })) => store::jobs::fail(db, id, &message, field.as_deref()).await,
+        Ok(Err(JobFailure::Refused(problem))) => store::jobs::fail(db, id, &problem).await,
         Err(join_error) => {
             tracing::error!(id, %join_error, "job task failed");
-            store::jobs::fail(db, id, "internal error while running the job; it has been logged", None).await
+            let internal = AppError::Internal(anyhow::anyhow!("the job's task failed"));
+            store::jobs::fail(db, id, &internal.problem()).await
         }
     };
     if let Err(error) = stored {

@@ -5,8 +5,8 @@ use serde::Serialize;
 use sqlx::SqlitePool;
 use utoipa::ToSchema;
 
-use crate::error::{AppError, AppResult};
-use crate::jobs::execute::OperationOutput;
+use crate::capabilities::Stored;
+use crate::error::{AppError, AppResult, FieldProblem, Problem};
 use crate::jobs::file::JobFile;
 
 /// Attempts a job gets: one retry after a server stop interrupted it.
@@ -32,7 +32,7 @@ pub enum JobStatus {
 }
 
 /// A job as listed and shown.
-#[derive(Debug, Clone, Serialize, ToSchema, sqlx::FromRow)]
+#[derive(Debug, Clone, Serialize, ToSchema)]
 pub struct JobRecord {
     /// Job id.
     pub id: i64,
@@ -43,14 +43,13 @@ pub struct JobRecord {
     /// Fraction done, 0–1.
     pub progress: f64,
     /// The operations' names, in order.
-    #[sqlx(json)]
     pub operations: Vec<String>,
     /// Times it was started (a server stop while running re-queues it once).
     pub attempts: i64,
-    /// Why it failed.
-    pub error: Option<String>,
-    /// The job-file field at fault, if any (e.g. `operations[1].hole.radius`).
-    pub error_field: Option<String>,
+    /// Why it failed or stopped: the problem object its endpoint would answer for the refused
+    /// operation (`code`, `errors[0].path` under `operations[i]`), `E_INTERRUPTED` after
+    /// repeated server stops, `E_CANCELLED` when cancelled.
+    pub error: Option<Problem>,
     /// UTC timestamps.
     pub submitted_at: String,
     /// When a worker started it.
@@ -59,13 +58,80 @@ pub struct JobRecord {
     pub finished_at: Option<String>,
 }
 
+/// A row of `jobs` as stored.
+#[derive(sqlx::FromRow)]
+struct JobRow {
+    id: i64,
+    name: Option<String>,
+    status: JobStatus,
+    progress: f64,
+    #[sqlx(json)]
+    operations: Vec<String>,
+    attempts: i64,
+    error: Option<String>,
+    error_field: Option<String>,
+    submitted_at: String,
+    started_at: Option<String>,
+    finished_at: Option<String>,
+}
+
+impl From<JobRow> for JobRecord {
+    fn from(row: JobRow) -> Self {
+        let error = row.error.map(|text| stored_problem(&text, row.error_field));
+        Self {
+            id: row.id,
+            name: row.name,
+            status: row.status,
+            progress: row.progress,
+            operations: row.operations,
+            attempts: row.attempts,
+            error,
+            submitted_at: row.submitted_at,
+            started_at: row.started_at,
+            finished_at: row.finished_at,
+        }
+    }
+}
+
+/// A stored error: a problem object, or the prose that jobs stored before problems were.
+fn stored_problem(text: &str, field: Option<String>) -> Problem {
+    if let Ok(problem) = serde_json::from_str::<Problem>(text) {
+        return problem;
+    }
+    let errors = field.map(|path| vec![FieldProblem { path, message: text.to_owned() }]).unwrap_or_default();
+    Problem {
+        kind: "about:blank".to_owned(),
+        title: "Job failed".to_owned(),
+        status: 422,
+        detail: text.to_owned(),
+        code: "E_JOB_FAILED".to_owned(),
+        errors,
+    }
+}
+
+/// A problem for a job that stopped for a reason of its own (not an operation's refusal).
+fn job_problem(status: u16, title: &str, code: &str, detail: &str) -> Problem {
+    Problem {
+        kind: "about:blank".to_owned(),
+        title: title.to_owned(),
+        status,
+        detail: detail.to_owned(),
+        code: code.to_owned(),
+        errors: Vec::new(),
+    }
+}
+
+fn problem_json(problem: &Problem) -> AppResult<String> {
+    serde_json::to_string(problem).map_err(|e| AppError::Internal(e.into()))
+}
+
 const COLUMNS: &str =
     "id, name, status, progress, operations, attempts, error, error_field, submitted_at, started_at, finished_at";
 
 /// Stores a new queued job; returns its id.
 pub async fn insert(db: &SqlitePool, job: &JobFile, hash: &str) -> AppResult<i64> {
     let json = serde_json::to_string(job).map_err(|e| AppError::Internal(e.into()))?;
-    let operations: Vec<&str> = job.operations.iter().map(|o| o.kind()).collect();
+    let operations: Vec<&str> = job.operations.iter().map(|o| o.name()).collect();
     let operations = serde_json::to_string(&operations).map_err(|e| AppError::Internal(e.into()))?;
     let (id,): (i64,) = sqlx::query_as(
         "INSERT INTO jobs (name, status, content_hash, job_json, operations) VALUES (?, 'queued', ?, ?, ?) RETURNING id",
@@ -91,16 +157,20 @@ pub async fn find_done(db: &SqlitePool, hash: &str) -> AppResult<Option<i64>> {
 
 /// One job.
 pub async fn get(db: &SqlitePool, id: i64) -> AppResult<Option<JobRecord>> {
-    Ok(sqlx::query_as(&format!("SELECT {COLUMNS} FROM jobs WHERE id = ?")).bind(id).fetch_optional(db).await?)
+    let row: Option<JobRow> =
+        sqlx::query_as(&format!("SELECT {COLUMNS} FROM jobs WHERE id = ?")).bind(id).fetch_optional(db).await?;
+    Ok(row.map(JobRecord::from))
 }
 
 /// Up to `limit` jobs with ids below `before`, newest first.
 pub async fn list(db: &SqlitePool, limit: i64, before: Option<i64>) -> AppResult<Vec<JobRecord>> {
-    Ok(sqlx::query_as(&format!("SELECT {COLUMNS} FROM jobs WHERE id < ? ORDER BY id DESC LIMIT ?"))
-        .bind(before.unwrap_or(i64::MAX))
-        .bind(limit)
-        .fetch_all(db)
-        .await?)
+    let rows: Vec<JobRow> =
+        sqlx::query_as(&format!("SELECT {COLUMNS} FROM jobs WHERE id < ? ORDER BY id DESC LIMIT ?"))
+            .bind(before.unwrap_or(i64::MAX))
+            .bind(limit)
+            .fetch_all(db)
+            .await?;
+    Ok(rows.into_iter().map(JobRecord::from).collect())
 }
 
 /// Claims the oldest queued job for a worker: marks it running and returns it.
@@ -117,7 +187,8 @@ pub async fn claim(db: &SqlitePool) -> AppResult<Option<(i64, JobFile)>> {
     match serde_json::from_str(&json) {
         Ok(job) => Ok(Some((id, job))),
         Err(error) => {
-            fail(db, id, &format!("stored job is unreadable: {error}"), None).await?;
+            let detail = format!("the stored job is unreadable: {error}");
+            fail(db, id, &job_problem(422, "Job failed", "E_JOB_FILE", &detail)).await?;
             Ok(None)
         }
     }
@@ -135,7 +206,7 @@ pub async fn heartbeat(db: &SqlitePool, id: i64, progress: f64) -> AppResult<()>
 
 /// Stores the results and marks the job done, in one transaction, unless it was cancelled
 /// meanwhile. Returns whether it was stored.
-pub async fn finish(db: &SqlitePool, id: i64, outputs: &[OperationOutput]) -> AppResult<bool> {
+pub async fn finish(db: &SqlitePool, id: i64, outputs: &[Stored]) -> AppResult<bool> {
     let mut transaction = db.begin().await?;
     let updated = sqlx::query(&format!(
         "UPDATE jobs SET status = 'done', progress = 1, finished_at = {NOW} WHERE id = ? AND status = 'running'"
@@ -148,7 +219,7 @@ pub async fn finish(db: &SqlitePool, id: i64, outputs: &[OperationOutput]) -> Ap
         return Ok(false);
     }
     for (position, output) in outputs.iter().enumerate() {
-        let result = serde_json::to_string(&output.result).map_err(|e| AppError::Internal(e.into()))?;
+        let result = output.result.get();
         sqlx::query(
             "INSERT INTO job_results (job_id, position, operation, result_json, gcode, gcode_problem)
              VALUES (?, ?, ?, ?, ?, ?)",
@@ -166,13 +237,15 @@ pub async fn finish(db: &SqlitePool, id: i64, outputs: &[OperationOutput]) -> Ap
     Ok(true)
 }
 
-/// Marks a running job failed with the reason.
-pub async fn fail(db: &SqlitePool, id: i64, message: &str, field: Option<&str>) -> AppResult<()> {
+/// Marks a running job failed with the problem.
+pub async fn fail(db: &SqlitePool, id: i64, problem: &Problem) -> AppResult<()> {
+    let json = problem_json(problem)?;
+    let field = problem.errors.first().map(|error| error.path.clone());
     sqlx::query(&format!(
         "UPDATE jobs SET status = 'failed', error = ?, error_field = ?, finished_at = {NOW}
          WHERE id = ? AND status = 'running'"
     ))
-    .bind(message)
+    .bind(json)
     .bind(field)
     .bind(id)
     .execute(db)
@@ -189,12 +262,11 @@ pub async fn cancel(db: &SqlitePool, id: i64) -> AppResult<Option<(JobStatus, bo
     let Some((status,)) = row else { return Ok(None) };
     let cancellable = matches!(status, JobStatus::Queued | JobStatus::Running);
     if cancellable {
-        sqlx::query(&format!(
-            "UPDATE jobs SET status = 'cancelled', finished_at = {NOW}, error = 'cancelled by request' WHERE id = ?"
-        ))
-        .bind(id)
-        .execute(&mut *transaction)
-        .await?;
+        sqlx::query(&format!("UPDATE jobs SET status = 'cancelled', finished_at = {NOW}, error = ? WHERE id = ?"))
+            .bind(problem_json(&job_problem(409, "Cancelled", "E_CANCELLED", "cancelled by request"))?)
+            .bind(id)
+            .execute(&mut *transaction)
+            .await?;
     }
     transaction.commit().await?;
     Ok(Some((status, cancellable)))
@@ -224,10 +296,15 @@ pub async fn programs(db: &SqlitePool, id: i64) -> AppResult<Vec<(Option<String>
 /// or failed with the reason once it has used its attempts. Returns (re-queued, failed).
 pub async fn recover(db: &SqlitePool) -> AppResult<(u64, u64)> {
     let failed = sqlx::query(&format!(
-        "UPDATE jobs SET status = 'failed', finished_at = {NOW},
-                error = 'interrupted by a server stop on each of its ' || attempts || ' attempts; not retried'
+        "UPDATE jobs SET status = 'failed', finished_at = {NOW}, error = ?
          WHERE status = 'running' AND attempts >= ?"
     ))
+    .bind(problem_json(&job_problem(
+        503,
+        "Job interrupted",
+        "E_INTERRUPTED",
+        &format!("interrupted by a server stop on each of its {MAX_ATTEMPTS} attempts; not retried"),
+    ))?)
     .bind(MAX_ATTEMPTS)
     .execute(db)
     .await?

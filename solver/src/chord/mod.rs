@@ -54,6 +54,7 @@
 
 mod answer;
 mod arclength;
+mod capability;
 pub mod machine;
 mod numeric;
 mod nurbs;
@@ -66,6 +67,7 @@ mod shape;
 pub mod stats;
 
 pub use answer::{Comparison, SegmentAnswer, SegmentWindow, WindowStatus};
+pub use capability::{SegmentCapability, SegmentResult};
 pub use machine::{MachineProfile, validate_machine_name};
 pub use nurbs::{MAX_CONTROL_POINTS, MAX_DEGREE};
 pub use program::program;

@@ -55,6 +55,7 @@
 
 pub mod answer;
 mod blocks;
+mod capability;
 pub mod detect;
 pub mod division;
 mod element;
@@ -73,6 +74,7 @@ pub use answer::{
     ContourAnswer, ContourCorner, ContourLayer, ContourMove, ContourSummary, Convexity, CornerAction, LoopReport,
     MaterialReport, MoveKind, PassReport, ReliefReport,
 };
+pub use capability::{ContourCapability, ContourResult, LoopsRequest, LoopsResult, MAX_JSON_MOVES};
 pub use element::{Element, ElementKind};
 pub use pass::{Action, CornerPlan, ElementMeta, PassPlan};
 pub use program::program;

@@ -16,6 +16,7 @@
 //! * [`program`]: lead moves and G-code (§6.3).
 
 mod answer;
+mod capability;
 mod centre;
 mod checks;
 mod diagnostics;
@@ -26,6 +27,7 @@ pub mod request;
 mod tolerance;
 
 pub use answer::{Deburr, DeburrPoint, DeburrSummary, LeadMotion, LeadMove};
+pub use capability::{DeburrAnswer, DeburrCapability};
 pub use diagnostics::{ExactConstruction, PointConstruction, construction_at};
 pub use program::program;
 pub use request::{CentreDistance, DeburrRequest, Direction, Edge, Hole, HoleShape, Method, Workpiece};

@@ -36,6 +36,7 @@
 mod answer;
 mod arcs;
 mod bbox_tree;
+mod capability;
 mod dots;
 mod evaluate;
 mod exact;
@@ -54,6 +55,7 @@ pub use answer::{
     PathEngagement, SampleFlag,
 };
 pub use arcs::{MillingMode, SpindleDirection};
+pub use capability::{EngagementCapability, EngagementResponse};
 pub use program::program;
 pub use request::{
     Candidate, EngagementRequest, Engine, FeedBasis, FeedPlanRequest, PathInput, PathSegments, PreviousCut,

@@ -362,6 +362,10 @@ pub struct EngagementRequest {
     /// is the G-code default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub machine: Option<String>,
+    /// Which entry of `paths` the G-code program follows (0-based, default 0; a request with
+    /// `path` has only 0). The endpoint's `?candidate=` overrides it; a job's program uses it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub candidate: Option<usize>,
 }
 
 fn yes() -> bool {

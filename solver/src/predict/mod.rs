@@ -39,6 +39,7 @@
 //!   an input); the clamp limits every node move.
 
 pub mod answer;
+mod capability;
 mod capsule;
 pub mod correct;
 pub mod dynamics;
@@ -55,9 +56,10 @@ pub mod stock;
 
 use std::sync::atomic::AtomicUsize;
 
+pub use crate::capability::Control;
 pub use answer::{PassFlag, PassHistory, PassStatus, Predict, PredictSummary, PredictedPass, RoundSummary, WorstPass};
+pub use capability::{PredictAnswer, PredictCapability, Timings};
 pub use force::CuttingCoefficients;
-pub use pipeline::Control;
 pub use request::{CorrectionOptions, Method, PathInput, PredictRequest, PrescribedDeflection, SpindleDirection};
 pub use stock::Stock;
 

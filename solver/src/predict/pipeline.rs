@@ -18,6 +18,7 @@ use super::request::{Job, Method};
 use super::sampling::{self, Band};
 use super::scene::{self, Scene, Scratch};
 use super::shape;
+use crate::capability::Control;
 use crate::error::SolverError;
 use crate::geometry::Vec3;
 
@@ -25,21 +26,6 @@ use crate::geometry::Vec3;
 const MAX_STATIONS: usize = 17;
 /// Fewest finished pixels before the view is corrected (§5 E5).
 const MIN_FINISHED_PIXELS: usize = 4;
-
-/// Progress reporting and cancellation for long runs.
-#[derive(Clone, Copy, Default)]
-pub struct Control<'a> {
-    /// Called with the fraction done (0–1), from worker threads, about every 0.5 %.
-    pub progress: Option<&'a (dyn Fn(f64) + Sync)>,
-    /// Set to stop: the run ends with `E_CANCELLED`.
-    pub cancel: Option<&'a AtomicBool>,
-}
-
-impl std::fmt::Debug for Control<'_> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Control").field("progress", &self.progress.is_some()).field("cancel", &self.cancel).finish()
-    }
-}
 
 /// What one pass gives.
 #[derive(Debug, Clone, PartialEq)]

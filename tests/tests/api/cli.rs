@@ -80,3 +80,50 @@ fn bad_file_names_line_and_field() {
     assert!(message.contains("operations[0].cut_amount"), "a refused operation names its field: {message}");
     assert!(!folder.path().join("out").exists(), "nothing written for a failed job");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn kerf_run_and_the_service_write_the_same_programs() {
+    let app = kerf_tests::TestApp::spawn().await;
+    for example in examples() {
+        let out = tempfile::tempdir().unwrap();
+        let output = Command::new(program())
+            .arg("run")
+            .arg(&example)
+            .arg("-o")
+            .arg(out.path())
+            .arg("--database")
+            .arg(out.path().join("no-such.db"))
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}: {}", example.display(), String::from_utf8_lossy(&output.stderr));
+        let media =
+            if example.extension().is_some_and(|e| e == "toml") { "application/toml" } else { "application/json" };
+        let submitted = app
+            .client
+            .post(app.url("/api/v1/jobs"))
+            .header("content-type", media)
+            .body(std::fs::read(&example).unwrap())
+            .send()
+            .await
+            .unwrap();
+        let id = kerf_tests::json_with(submitted, 202).await["id"].as_i64().unwrap();
+        let job = kerf_tests::poll_job(&app.client, &app.base, id, 120, kerf_tests::finished).await;
+        assert_eq!(job["status"], "done", "{}: {job}", example.display());
+        for (index, name) in job["operations"].as_array().unwrap().iter().enumerate() {
+            let name = name.as_str().unwrap();
+            let local = std::fs::read_to_string(out.path().join(format!("{index:02}-{name}.nc"))).unwrap();
+            let served = app.get(&format!("/api/v1/jobs/{id}/gcode?operation={index}")).await.text().await.unwrap();
+            assert_eq!(local, served, "{} operation {index}: kerf run and the service differ", example.display());
+            let local = std::fs::read_to_string(out.path().join(format!("{index:02}-{name}.json"))).unwrap();
+            let served: serde_json::Value = app.get(&format!("/api/v1/jobs/{id}")).await.json().await.unwrap();
+            let served: serde_json::Value = served["results"][index]["result"].clone();
+            let local: serde_json::Value = serde_json::from_str(&local).unwrap();
+            // Timings are wall time: the only part that differs from run to run.
+            let strip = |mut value: serde_json::Value| {
+                value.as_object_mut().unwrap().remove("timings");
+                value
+            };
+            assert_eq!(strip(local), strip(served), "{} operation {index}: results differ", example.display());
+        }
+    }
+}

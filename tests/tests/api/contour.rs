@@ -739,8 +739,8 @@ async fn jobs_store_what_fits_and_refusals_name_the_field() {
     let submitted = json_with(submit(json!({"operations": [big]})).await.unwrap(), 202).await;
     let job = poll_job(&app.client, &app.base, submitted["id"].as_i64().unwrap(), 60, finished).await;
     assert_eq!(job["status"], "failed");
-    assert_eq!(job["error_field"], "operations[0].contour[2]");
-    assert!(job["error"].as_str().unwrap().contains("E_SELF_INTERSECTION"));
+    assert_eq!(job["error"]["errors"][0]["path"], "operations[0].contour[2]");
+    assert_eq!(job["error"]["code"], "E_SELF_INTERSECTION");
 }
 
 #[tokio::test(flavor = "multi_thread")]

@@ -583,8 +583,8 @@ async fn engagement_job_errors_name_the_line_and_field() {
     let id = json_with(upload(refused).await.unwrap(), 202).await["id"].as_i64().unwrap();
     let job = poll_job(&app.client, &app.base, id, 60, finished).await;
     assert_eq!(job["status"], "failed", "{job}");
-    assert_eq!(job["error_field"], "operations[0].flute_counts[2]");
-    assert!(job["error"].as_str().unwrap().contains("E_INPUT"), "{job}");
+    assert_eq!(job["error"]["errors"][0]["path"], "operations[0].flute_counts[2]");
+    assert_eq!(job["error"]["code"], "E_INPUT", "{job}");
 }
 
 // ---------------------------------------------------------------- G-code

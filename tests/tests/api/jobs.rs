@@ -115,9 +115,18 @@ async fn raw_uploads_run_and_refusals_name_the_field() {
     let submitted = json_with(upload_raw(&app, bad.to_string(), "application/json").await, 202).await;
     let job = poll_job(&app.client, &app.base, submitted["id"].as_i64().unwrap(), 30, finished).await;
     assert_eq!(job["status"], "failed");
-    assert_eq!(job["error_field"], "operations[0].hole.radius");
-    assert!(job["error"].as_str().unwrap().contains("E_HOLE_TOO_LARGE"));
     assert!(job.get("results").is_none());
+    // The job's error is the problem the endpoint answers for the same request, under its index.
+    let mut request = bad["operations"][0].clone();
+    request.as_object_mut().unwrap().remove("operation");
+    let direct = kerf_tests::problem(app.post_json("/api/v1/deburr", &request).await, 422).await;
+    let error = &job["error"];
+    assert_eq!(error["code"], "E_HOLE_TOO_LARGE", "{job}");
+    assert_eq!(error["code"], direct["code"]);
+    assert_eq!(error["status"], 422);
+    assert_eq!(error["detail"], direct["detail"]);
+    assert_eq!(error["errors"][0]["path"], "operations[0].hole.radius");
+    assert_eq!(error["errors"][0]["path"], format!("operations[0].{}", direct["errors"][0]["path"].as_str().unwrap()));
 }
 
 #[tokio::test(flavor = "multi_thread")]
@@ -302,6 +311,76 @@ async fn killed_server_loses_no_job() {
     let failed =
         json_with(client.get(format!("{}/api/v1/jobs/{second}", server.base)).send().await.unwrap(), 200).await;
     assert_eq!(failed["status"], "failed", "{failed}");
-    assert!(failed["error"].as_str().unwrap().contains("interrupted"), "{failed}");
+    assert_eq!(failed["error"]["code"], "E_INTERRUPTED", "{failed}");
+    assert!(failed["error"]["detail"].as_str().unwrap().contains("interrupted"), "{failed}");
     drop(server);
+}
+
+/// The raw text of every operation's `result` in a job's JSON answer, as served.
+fn raw_results(job_text: &str) -> Vec<String> {
+    use std::collections::BTreeMap;
+
+    use serde_json::value::RawValue;
+    let job: BTreeMap<String, Box<RawValue>> = serde_json::from_str(job_text).unwrap();
+    let results: Vec<BTreeMap<String, Box<RawValue>>> = serde_json::from_str(job["results"].get()).unwrap();
+    results.iter().map(|result| result["result"].get().to_owned()).collect()
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn jobs_answer_as_the_endpoints_do() {
+    let app = TestApp::spawn().await;
+    let machine = json!({"block_time_ms": 4, "max_feed": 12000, "dialect": "linuxcnc"});
+    json_with(app.put_json("/api/v1/machines/lcnc", &machine).await, 201).await;
+    let deburr = json!({
+        "tool": {"kind": "ball", "radius": 3, "number": 7}, "machine": "lcnc",
+        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 15, "outer_radius": 25},
+        "hole": {"shape": "round", "radius": 5}, "edge": "outer", "cut_amount": 0.2, "feed": 300.7
+    });
+    let engagement = json!({
+        "tool": {"kind": "flat", "radius": 5, "flutes": 4, "number": 5}, "spindle_rpm": 8000,
+        "feed_per_tooth": 0.04, "flute_counts": [2, 4], "axial_depth": 3, "candidate": 1,
+        "stock": {"polygon": [[0, 0], [100, 0], [100, 80], [0, 80]]},
+        "paths": [
+            {"name": "a", "path": [[-10, 20], [110, 20]]},
+            {"name": "b", "path": [[-10, 40], [110, 40], [110, 50]]}
+        ]
+    });
+    let mut operations = Vec::new();
+    for (name, request) in [("deburr", &deburr), ("engagement", &engagement)] {
+        let mut operation = json!({"operation": name});
+        operation.as_object_mut().unwrap().extend(request.as_object().unwrap().clone());
+        operations.push(operation);
+    }
+    // No [output] dialect: each program takes its machine's (deburr: LinuxCNC), else Fanuc.
+    let submitted = json_with(app.post_json("/api/v1/jobs", &json!({"operations": operations})).await, 202).await;
+    let id = submitted["id"].as_i64().unwrap();
+    let job = poll_job(&app.client, &app.base, id, 60, finished).await;
+    assert_eq!(job["status"], "done", "{job}");
+    let job_text = app.get(&format!("/api/v1/jobs/{id}")).await.text().await.unwrap();
+    let stored = raw_results(&job_text);
+
+    for (index, (name, request)) in [("deburr", &deburr), ("engagement", &engagement)].into_iter().enumerate() {
+        let answer = app.post_json(&format!("/api/v1/{name}"), request).await;
+        assert_eq!(answer.status(), 200);
+        let answer = answer.text().await.unwrap();
+        assert_eq!(stored[index], answer, "{name}: the stored result is the endpoint's answer byte for byte");
+        let direct = app
+            .client
+            .post(app.url(&format!("/api/v1/{name}")))
+            .header("accept", "text/x-gcode")
+            .json(request)
+            .send()
+            .await
+            .unwrap()
+            .text()
+            .await
+            .unwrap();
+        let from_job = app.get(&format!("/api/v1/jobs/{id}/gcode?operation={index}")).await.text().await.unwrap();
+        assert_eq!(from_job, direct, "{name}: the job's program is the endpoint's");
+    }
+    let deburr_program = app.get(&format!("/api/v1/jobs/{id}/gcode?operation=0")).await.text().await.unwrap();
+    assert!(deburr_program.contains("G64 P"), "a LinuxCNC program: {deburr_program}");
+    let engagement_program = app.get(&format!("/api/v1/jobs/{id}/gcode?operation=1")).await.text().await.unwrap();
+    assert!(engagement_program.contains("Y40.0000"), "the second candidate's path: {engagement_program}");
+    assert!(!engagement_program.contains("Y20.0000"), "not the first candidate's path");
 }

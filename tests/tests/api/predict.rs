@@ -992,8 +992,8 @@ async fn job_files_cannot_carry_a_mesh_stock() {
         json_with(app.post_json("/api/v1/jobs", &predict_job("bad", &bad)).await, 202).await["id"].as_i64().unwrap();
     let job = kerf_tests::poll_job(&app.client, &app.base, id, 30, kerf_tests::finished).await;
     assert_eq!(job["status"], "failed");
-    assert_eq!(job["error_field"], "operations[0].path.program");
-    assert!(job["error"].as_str().unwrap().contains("line 3"), "{job}");
+    assert_eq!(job["error"]["errors"][0]["path"], "operations[0].path.program");
+    assert!(job["error"]["detail"].as_str().unwrap().contains("line 3"), "{job}");
     assert_eq!(json_with(app.get("/api/v1/jobs").await, 200).await["jobs"].as_array().unwrap().len(), 1);
 }
 

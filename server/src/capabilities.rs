@@ -1,0 +1,287 @@
+//! The capability registry: the one list of kerf's capabilities (the seam of engineering.md,
+//! `kerf_solver::capability`). From it come the job `Operation` enum with its names, reading and
+//! dispatch, and the names the page and the OpenAPI document list. HTTP handlers, the job
+//! executor, `kerf run` and the workers all solve through [`solve`] here.
+
+use std::time::Instant;
+
+use kerf_solver::SolverError;
+use kerf_solver::capability::{self, Capability, Lookup, OutputOptions, Refs, Resolved, Run, ToolNeed};
+use kerf_solver::chord::{MachineProfile, SegmentCapability, SegmentRequest};
+use kerf_solver::corners::{ContourCapability, ContourRequest};
+use kerf_solver::deburr::{DeburrCapability, DeburrRequest};
+use kerf_solver::engagement::{EngagementCapability, EngagementRequest};
+use kerf_solver::predict::{PredictCapability, PredictRequest};
+use kerf_solver::tool::Tool;
+use serde::{Deserialize, Serialize};
+use serde_json::value::RawValue;
+use utoipa::ToSchema;
+
+use crate::error::AppError;
+
+/// The registry: one line per capability: the variant of [`Operation`], the capability type, its
+/// request type (named so the OpenAPI document shows the concrete schema; the compiler checks that
+/// it is the capability's) and the operation's description in the OpenAPI document.
+macro_rules! registry {
+    ($($variant:ident => $capability:ty, $request:ty, $doc:literal);+ $(;)?) => {
+        $(const _: fn(<$capability as Capability>::Request) -> $request = |request| request;)+
+
+        /// One job operation: `operation` names the capability, the other fields are its
+        /// endpoint's request.
+        #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+        #[serde(tag = "operation", rename_all = "snake_case")]
+        #[allow(clippy::large_enum_variant, reason = "a job holds at most 100 operations, read once")]
+        pub enum Operation {
+            $(
+                #[doc = $doc]
+                $variant($request),
+            )+
+        }
+
+        /// Every capability's name, in registry order: endpoints, job operations, page views.
+        pub const NAMES: &[&str] = &[$(<$capability as Capability>::NAME),+];
+
+        impl Operation {
+            /// The capability's name (`deburr`, ...).
+            pub fn name(&self) -> &'static str {
+                match self {
+                    $(Self::$variant(_) => <$capability as Capability>::NAME,)+
+                }
+            }
+
+            /// The tool and machine the operation refers to.
+            pub fn refs(&self) -> Refs<'_> {
+                match self {
+                    $(Self::$variant(request) => <$capability as Capability>::refs(request),)+
+                }
+            }
+
+            /// Checks that the operation's references resolve against `lookup`.
+            ///
+            /// # Errors
+            /// The 404 naming the field of an unknown tool or machine.
+            pub fn check_refs(&self, lookup: &impl Lookup) -> Result<(), AppError> {
+                match self {
+                    $(Self::$variant(request) => resolve::<$capability>(request, lookup).map(drop),)+
+                }
+            }
+
+            /// Solves the operation as a job does: resolved against `lookup`, its program written
+            /// with `output`, its answer trimmed for storage.
+            ///
+            /// # Errors
+            /// The problem of the refusal (cancellation is `E_CANCELLED`).
+            pub fn run(&self, lookup: &impl Lookup, run: &Run<'_>, output: &OutputOptions) -> Result<Stored, AppError> {
+                match self {
+                    $(Self::$variant(request) => store_output::<$capability>(request, lookup, run, output),)+
+                }
+            }
+
+            /// Reads the request of the capability called `name` from `fields`.
+            fn read<'de, D: serde::Deserializer<'de>>(name: &str, fields: D) -> Result<Self, D::Error> {
+                $(
+                    if name == <$capability as Capability>::NAME {
+                        return <$request>::deserialize(fields).map(Self::$variant);
+                    }
+                )+
+                Err(serde::de::Error::unknown_variant(name, NAMES))
+            }
+        }
+    };
+}
+
+registry! {
+    Deburr => DeburrCapability, DeburrRequest, "`POST /api/v1/deburr`.";
+    Segment => SegmentCapability, SegmentRequest, "`POST /api/v1/segment`.";
+    Contour => ContourCapability, ContourRequest, "`POST /api/v1/contour`.";
+    Engagement => EngagementCapability, EngagementRequest,
+        "`POST /api/v1/engagement`; the job's program is that of the request's `candidate` path (default the first).";
+    Predict => PredictCapability, PredictRequest,
+        "`POST /api/v1/predict` (a job file cannot carry an STL file: no `mesh` stock).";
+}
+
+// Hand-written instead of serde's internally tagged enum, which buffers the table and so loses
+// the field path and line of errors inside it. When `operation` is the first key (as in every
+// example) the rest of the table is read in place; otherwise it is buffered and dispatched.
+impl<'de> Deserialize<'de> for Operation {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct OperationVisitor;
+
+        impl<'de> serde::de::Visitor<'de> for OperationVisitor {
+            type Value = Operation;
+
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("an operation table with `operation` and its request's fields")
+            }
+
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Operation, A::Error> {
+                use serde::de::Error;
+                let Some(first) = map.next_key::<String>()? else {
+                    return Err(A::Error::missing_field("operation"));
+                };
+                if first == "operation" {
+                    let OperationName(name) = map.next_value()?;
+                    return Operation::read(name, serde::de::value::MapAccessDeserializer::new(map));
+                }
+                let mut fields = serde_json::Map::new();
+                fields.insert(first, map.next_value()?);
+                while let Some(key) = map.next_key::<String>()? {
+                    let value = map.next_value()?;
+                    fields.insert(key, value);
+                }
+                let name = fields.remove("operation").ok_or_else(|| A::Error::missing_field("operation"))?;
+                let OperationName(name) = serde_json::from_value(name).map_err(A::Error::custom)?;
+                Operation::read(name, serde_json::Value::Object(fields)).map_err(A::Error::custom)
+            }
+        }
+
+        deserializer.deserialize_map(OperationVisitor)
+    }
+}
+
+/// The value of `operation`: one of [`NAMES`] (an unknown one is reported at `operation` itself).
+struct OperationName(&'static str);
+
+impl<'de> Deserialize<'de> for OperationName {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(deserializer)?;
+        NAMES
+            .iter()
+            .find(|known| **known == name)
+            .map(|known| Self(known))
+            .ok_or_else(|| serde::de::Error::unknown_variant(&name, NAMES))
+    }
+}
+
+/// Tools and machines found for a set of references: what a request or a job refers to, fetched
+/// from the store or given in a job file. Resolution looks things up here only.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Catalog {
+    /// Tools, each with its number.
+    pub tools: Vec<Tool>,
+    /// Machines, each with its name.
+    pub machines: Vec<MachineProfile>,
+}
+
+impl Lookup for Catalog {
+    fn tool(&self, number: u32) -> Option<Tool> {
+        tool_in(&self.tools, number)
+    }
+
+    fn machine(&self, name: &str) -> Option<MachineProfile> {
+        machine_in(&self.machines, name)
+    }
+}
+
+/// The tool numbered `number` in `tools`.
+pub fn tool_in(tools: &[Tool], number: u32) -> Option<Tool> {
+    tools.iter().find(|tool| tool.number == Some(number)).cloned()
+}
+
+/// The machine called `name` in `machines`.
+pub fn machine_in(machines: &[MachineProfile], name: &str) -> Option<MachineProfile> {
+    machines.iter().find(|machine| machine.name.as_deref() == Some(name)).cloned()
+}
+
+/// The one resolution step, for capability `C`: its request's references from `lookup`.
+///
+/// # Errors
+/// 404 naming `tool` or `machine` when a reference is unknown.
+pub fn resolve<C: Capability>(request: &C::Request, lookup: &impl Lookup) -> Result<Resolved<C::Tool>, AppError> {
+    resolve_refs(C::refs(request), lookup)
+}
+
+/// [`resolve`] for references outside a capability (the contour loops endpoint).
+///
+/// # Errors
+/// As [`resolve`].
+pub fn resolve_refs<T: ToolNeed>(refs: Refs<'_>, lookup: &impl Lookup) -> Result<Resolved<T>, AppError> {
+    capability::resolve(refs, lookup).map_err(|unresolved| AppError::unknown(unresolved.field, unresolved.message))
+}
+
+/// What a solve gives its caller: the answer as JSON, or the program.
+#[derive(Debug)]
+pub enum Delivered {
+    /// The JSON answer.
+    Json(Vec<u8>),
+    /// The G-code program.
+    Program(String),
+}
+
+/// Solves a resolved request of capability `C` and delivers the JSON answer, or the program
+/// when `program` gives its output options. `timings` adds the solve time to answers that report
+/// it. Returns the delivery and the seconds the solve took. Runs on a blocking thread.
+///
+/// # Errors
+/// The solver's refusal, or a failure to serialise.
+pub fn solve<C: Capability>(
+    request: &C::Request,
+    resolved: Resolved<C::Tool>,
+    run: &Run<'_>,
+    program: Option<&OutputOptions>,
+    timings: bool,
+) -> Result<(Delivered, f64), AppError> {
+    let started = Instant::now();
+    let mut answer = C::solve(request, resolved, run)?;
+    let seconds = started.elapsed().as_secs_f64();
+    if let Some(output) = program {
+        return Ok((Delivered::Program(capability::program::<C>(request, &answer, output)?), seconds));
+    }
+    if timings {
+        C::record_time(&mut answer, seconds);
+    }
+    let bytes = serde_json::to_vec(&answer).map_err(|error| AppError::Internal(error.into()))?;
+    Ok((Delivered::Json(bytes), seconds))
+}
+
+/// One operation's stored output.
+#[derive(Debug, Clone, Serialize, ToSchema)]
+pub struct Stored {
+    /// The operation's name (`deburr`, ...).
+    pub operation: String,
+    /// Its answer, exactly as its endpoint answers JSON (kept as text, so served byte for byte).
+    #[schema(value_type = Object)]
+    pub result: Box<RawValue>,
+    /// Its G-code program, when one could be written.
+    #[serde(skip)]
+    pub gcode: Option<String>,
+    /// Why no program could be written, if so.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gcode_problem: Option<String>,
+}
+
+fn store_output<C: Capability>(
+    request: &C::Request,
+    lookup: &impl Lookup,
+    run: &Run<'_>,
+    output: &OutputOptions,
+) -> Result<Stored, AppError> {
+    let resolved = resolve::<C>(request, lookup)?;
+    let started = Instant::now();
+    let mut answer = C::solve(request, resolved, run)?;
+    C::record_time(&mut answer, started.elapsed().as_secs_f64());
+    let program = capability::program::<C>(request, &answer, output);
+    C::for_storage(&mut answer);
+    let result = serde_json::value::to_raw_value(&answer).map_err(|error| AppError::Internal(error.into()))?;
+    Ok(Stored {
+        operation: C::NAME.to_owned(),
+        result,
+        gcode_problem: program.as_ref().err().map(|e: &SolverError| format!("{} ({})", e.message(), e.code())),
+        gcode: program.ok(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_match_the_operation_tags() {
+        for name in NAMES {
+            let json = serde_json::json!({ "operation": name });
+            let error = serde_json::from_value::<Operation>(json).unwrap_err().to_string();
+            assert!(!error.contains("unknown variant"), "{name}: {error}");
+        }
+        assert_eq!(NAMES, ["deburr", "segment", "contour", "engagement", "predict"]);
+    }
+}

@@ -1,0 +1,220 @@
+//! The capability seam (engineering.md, "The capability seam"): one trait that every capability
+//! implements and every way in dispatches through: the HTTP handlers, the job executor, `kerf
+//! run` and the job workers. A capability declares its name, its request and answer types, the
+//! tool and machine it refers to, how it solves a resolved request and how it writes its program.
+//!
+//! The server resolves references (a tool number, a machine name) once, with [`resolve`], into a
+//! [`Resolved`] context; the solver never sees an unresolved reference.
+
+use std::sync::atomic::AtomicBool;
+
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+
+use crate::chord::MachineProfile;
+use crate::error::SolverError;
+use crate::gcode::{Dialect, Reference};
+use crate::tool::{Tool, ToolRef};
+
+/// One capability: deburr, segment, contour, engagement, predict.
+pub trait Capability {
+    /// Its name: the endpoint (`/api/v1/{NAME}`), the job `operation` and the page's view id.
+    const NAME: &'static str;
+    /// The request, as its endpoint takes it and as a job operation holds it.
+    type Request: Serialize + DeserializeOwned + Clone + Send + Sync + 'static;
+    /// The answer, as its endpoint returns it as JSON and as a job stores it.
+    type Answer: Serialize + Send + 'static;
+    /// What the capability needs of a tool: [`Tool`] when it always cuts with one, `Option<Tool>`
+    /// when the request may name none.
+    type Tool: ToolNeed;
+
+    /// The tool and machine the request refers to.
+    fn refs(request: &Self::Request) -> Refs<'_>;
+
+    /// Checks the output options before any work, so a program that cannot be written is refused
+    /// at once instead of after the computation.
+    ///
+    /// # Errors
+    /// `E_INPUT` naming the option.
+    fn check_output(_request: &Self::Request, _output: &OutputOptions) -> Result<(), SolverError> {
+        Ok(())
+    }
+
+    /// Solves the request in its resolved context.
+    ///
+    /// # Errors
+    /// The capability's refusals, each with its code and the field at fault.
+    fn solve(
+        request: &Self::Request,
+        context: Resolved<Self::Tool>,
+        run: &Run<'_>,
+    ) -> Result<Self::Answer, SolverError>;
+
+    /// Writes the G-code program of a solved request.
+    ///
+    /// # Errors
+    /// When the answer has no program (e.g. `E_NO_PROGRAM`) or an option does not apply.
+    fn program(request: &Self::Request, answer: &Self::Answer, output: &OutputOptions) -> Result<String, SolverError>;
+
+    /// The machine the answer was computed for (its dialect is the program's default).
+    fn machine(answer: &Self::Answer) -> Option<&MachineProfile>;
+
+    /// Trims an answer before a job stores it (the program, written before, keeps everything).
+    fn for_storage(_answer: &mut Self::Answer) {}
+
+    /// Records how long the solve took, for capabilities whose answer reports it.
+    fn record_time(_answer: &mut Self::Answer, _seconds: f64) {}
+}
+
+/// The references a request makes, to be resolved before it is solved.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Refs<'a> {
+    /// The tool: a number in the tool table or the tool itself.
+    pub tool: Option<&'a ToolRef>,
+    /// The name of a registered machine.
+    pub machine: Option<&'a str>,
+}
+
+/// Where resolution finds what a request refers to: the tool table and machines registry (the
+/// server's store), or a job's own tools and machines.
+pub trait Lookup {
+    /// The tool with `number`, if any.
+    fn tool(&self, number: u32) -> Option<Tool>;
+    /// The machine called `name`, if any.
+    fn machine(&self, name: &str) -> Option<MachineProfile>;
+}
+
+/// A request's references, resolved.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Resolved<T> {
+    /// The tool ([`Tool`] or `Option<Tool>`, as the capability needs).
+    pub tool: T,
+    /// The machine the request names, if any.
+    pub machine: Option<MachineProfile>,
+}
+
+/// How a capability's tool need is met by what resolution found.
+pub trait ToolNeed: Sized + Send + 'static {
+    /// The tool as the capability takes it, or `None` when the need is not met.
+    fn from_found(found: Option<Tool>) -> Option<Self>;
+}
+
+impl ToolNeed for Tool {
+    fn from_found(found: Option<Tool>) -> Option<Self> {
+        found
+    }
+}
+
+impl ToolNeed for Option<Tool> {
+    fn from_found(found: Option<Tool>) -> Option<Self> {
+        Some(found)
+    }
+}
+
+/// Why a reference could not be resolved: the field and what is missing.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Unresolved {
+    /// The request field that refers to it (`tool`, `machine`).
+    pub field: &'static str,
+    /// What is missing.
+    pub message: String,
+}
+
+/// The one resolution step: the tool and machine `refs` names, from `lookup`. Inline tools are
+/// taken as given (the capability validates them).
+///
+/// # Errors
+/// [`Unresolved`] naming the field of an unknown tool number or machine name.
+pub fn resolve<T: ToolNeed>(refs: Refs<'_>, lookup: &impl Lookup) -> Result<Resolved<T>, Unresolved> {
+    let found =
+        match refs.tool {
+            None => None,
+            Some(ToolRef::Inline(tool)) => Some(tool.clone()),
+            Some(ToolRef::Number(number)) => Some(lookup.tool(*number).ok_or_else(|| Unresolved {
+                field: "tool",
+                message: format!("tool {number} is not in the tool table"),
+            })?),
+        };
+    let tool =
+        T::from_found(found).ok_or_else(|| Unresolved { field: "tool", message: "a tool is needed".to_owned() })?;
+    let machine = match refs.machine {
+        None => None,
+        Some(name) => Some(lookup.machine(name).ok_or_else(|| Unresolved {
+            field: "machine",
+            message: format!("machine {name:?} is not registered (GET /api/v1/machines)"),
+        })?),
+    };
+    Ok(Resolved { tool, machine })
+}
+
+/// Progress reporting and cancellation for long runs.
+#[derive(Clone, Copy, Default)]
+pub struct Control<'a> {
+    /// Called with the fraction done (0–1), from worker threads, about every 0.5 %.
+    pub progress: Option<&'a (dyn Fn(f64) + Sync)>,
+    /// Set to stop: the run ends with `E_CANCELLED`.
+    pub cancel: Option<&'a AtomicBool>,
+}
+
+impl std::fmt::Debug for Control<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Control").field("progress", &self.progress.is_some()).field("cancel", &self.cancel).finish()
+    }
+}
+
+/// What the answer is for: limits differ between a JSON answer, a program and a stored job.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Purpose {
+    /// A JSON answer to a request.
+    #[default]
+    Json,
+    /// A G-code program answering a request.
+    Program,
+    /// A job: the program and a stored JSON result.
+    Job,
+}
+
+/// How a solve runs: progress and cancellation, an uploaded file, and what the answer is for.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Run<'a> {
+    /// Progress and cancellation.
+    pub control: Control<'a>,
+    /// A file uploaded with the request (predict's STL stock), if any.
+    pub upload: Option<&'a [u8]>,
+    /// What the answer is for.
+    pub purpose: Purpose,
+}
+
+/// How a program is written: the caller's choices; what is left open takes the capability's or
+/// the machine's default.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct OutputOptions {
+    /// Dialect; `None`: the machine's, else Fanuc.
+    pub dialect: Option<Dialect>,
+    /// Programmed point; `None`: the capability's default (the tool tip; predict's G-code path
+    /// keeps its own).
+    pub reference: Option<Reference>,
+    /// Which candidate path to program (engagement `paths`); `None`: the request's choice, else 0.
+    pub candidate: Option<usize>,
+}
+
+impl OutputOptions {
+    /// The dialect of the program: the one asked for, else the machine's, else Fanuc.
+    pub fn dialect_for(&self, machine: Option<&MachineProfile>) -> Dialect {
+        self.dialect.or(machine.map(|m| m.dialect)).unwrap_or_default()
+    }
+}
+
+/// The program of a solved request with its output options, the dialect defaulting to the
+/// machine's: the one way every caller writes a capability's program.
+///
+/// # Errors
+/// As [`Capability::program`].
+pub fn program<C: Capability>(
+    request: &C::Request,
+    answer: &C::Answer,
+    output: &OutputOptions,
+) -> Result<String, SolverError> {
+    let output = OutputOptions { dialect: Some(output.dialect_for(C::machine(answer))), ..*output };
+    C::program(request, answer, &output)
+}

@@ -1,0 +1,71 @@
+//! Segmentation as a capability (the seam of engineering.md): `POST /api/v1/segment`, job
+//! operation `segment`.
+
+use serde::Serialize;
+
+use super::{MachineProfile, SegmentAnswer, SegmentRequest};
+use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
+use crate::error::SolverError;
+use crate::gcode::{Post, Reference, ToolCall};
+use crate::tool::Tool;
+
+/// The segment capability.
+#[derive(Debug, Clone, Copy)]
+pub struct SegmentCapability;
+
+/// The segment answer: the machine and tool used, and the solver's result.
+#[derive(Debug, Clone, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct SegmentResult {
+    /// The machine the request named, as registered: its values are the defaults the request
+    /// overrode or used (the values used are `feed`, `block_time_ms`, `margin`, `min_chord_error`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub machine: Option<MachineProfile>,
+    /// The tool the program calls, as resolved from the table or given inline.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tool: Option<Tool>,
+    /// Windows, command points, block figures, the comparison and warnings.
+    #[serde(flatten)]
+    pub result: SegmentAnswer,
+}
+
+impl Capability for SegmentCapability {
+    const NAME: &'static str = "segment";
+    type Request = SegmentRequest;
+    type Answer = SegmentResult;
+    type Tool = Option<Tool>;
+
+    fn refs(request: &SegmentRequest) -> Refs<'_> {
+        Refs { tool: request.tool.as_ref(), machine: request.machine.as_deref() }
+    }
+
+    fn solve(
+        request: &SegmentRequest,
+        context: Resolved<Option<Tool>>,
+        _run: &Run<'_>,
+    ) -> Result<SegmentResult, SolverError> {
+        if let Some(tool) = &context.tool {
+            tool.validate("tool.")?;
+        }
+        let result = super::solve(request, context.machine.as_ref())?;
+        Ok(SegmentResult { machine: context.machine, tool: context.tool, result })
+    }
+
+    /// The curve is the programmed point: `reference` does not apply.
+    fn program(
+        _request: &SegmentRequest,
+        answer: &SegmentResult,
+        output: &OutputOptions,
+    ) -> Result<String, SolverError> {
+        let tool = match &answer.tool {
+            Some(tool) => ToolCall::for_tool(tool),
+            None => ToolCall::Manual("none named in the request".to_owned()),
+        };
+        let post = Post { dialect: output.dialect_for(answer.machine.as_ref()), reference: Reference::Tip, tool };
+        super::program(&answer.result, &post)
+    }
+
+    fn machine(answer: &SegmentResult) -> Option<&MachineProfile> {
+        answer.machine.as_ref()
+    }
+}

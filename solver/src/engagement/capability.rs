@@ -1,0 +1,87 @@
+//! Engagement analysis as a capability (the seam of engineering.md): `POST /api/v1/engagement`,
+//! job operation `engagement`.
+
+use serde::Serialize;
+
+use super::{EngagementAnswer, EngagementRequest, Stock};
+use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
+use crate::chord::MachineProfile;
+use crate::error::SolverError;
+use crate::gcode::{Post, ToolCall};
+use crate::tool::Tool;
+
+/// The engagement capability.
+#[derive(Debug, Clone, Copy)]
+pub struct EngagementCapability;
+
+/// The engagement answer: the tool used, the stock and limits it was judged against (so the
+/// answer can be plotted on its own, as the page does for job results), and the solver's result
+/// (one path's fields at the top level for a request with `path`, `candidates` for a request
+/// with `paths`).
+#[derive(Debug, Clone, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct EngagementResponse {
+    /// The tool, as resolved from the table or given inline.
+    pub tool: Tool,
+    /// The machine the request named, as registered: its `max_feed` caps the feed plan unless
+    /// `feed_plan.max_feed` is given, its dialect is the G-code default.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub machine: Option<MachineProfile>,
+    /// The stock, as given.
+    pub stock: Stock,
+    /// T1 as given, mm.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub thickness_limit: Option<f64>,
+    /// T2 as given, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_limit_s: Option<f64>,
+    /// Samples, flute counts and recommendation (or `candidates`, one such result per path).
+    #[serde(flatten)]
+    pub result: EngagementAnswer,
+}
+
+impl Capability for EngagementCapability {
+    const NAME: &'static str = "engagement";
+    type Request = EngagementRequest;
+    type Answer = EngagementResponse;
+    type Tool = Tool;
+
+    fn refs(request: &EngagementRequest) -> Refs<'_> {
+        Refs { tool: Some(&request.tool), machine: request.machine.as_deref() }
+    }
+
+    fn solve(
+        request: &EngagementRequest,
+        context: Resolved<Tool>,
+        _run: &Run<'_>,
+    ) -> Result<EngagementResponse, SolverError> {
+        let result = super::solve_with(request, &context.tool, context.machine.as_ref())?;
+        Ok(EngagementResponse {
+            tool: context.tool,
+            machine: context.machine,
+            stock: request.stock.clone(),
+            thickness_limit: request.thickness_limit,
+            time_limit_s: request.time_limit_s,
+            result,
+        })
+    }
+
+    /// The program of one path: `output.candidate`, else the request's `candidate`, else 0.
+    fn program(
+        request: &EngagementRequest,
+        answer: &EngagementResponse,
+        output: &OutputOptions,
+    ) -> Result<String, SolverError> {
+        let post = Post {
+            dialect: output.dialect_for(answer.machine.as_ref()),
+            reference: output.reference.unwrap_or_default(),
+            tool: ToolCall::for_tool(&answer.tool),
+        };
+        let candidate = output.candidate.or(request.candidate).unwrap_or(0);
+        super::program(&answer.result, candidate, &post)
+    }
+
+    fn machine(answer: &EngagementResponse) -> Option<&MachineProfile> {
+        answer.machine.as_ref()
+    }
+}
