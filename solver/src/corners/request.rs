@@ -448,14 +448,6 @@ impl ContourRequest {
             ));
         }
         let mut rule_warnings = Vec::new();
-        if let Some(name) = &self.machine
-            && machine.is_none()
-        {
-            return Err(SolverError::input(
-                "machine",
-                format!("machine {name:?} was not resolved: pass its profile (corners::solve_with)"),
-            ));
-        }
         let rules = if self.block_time_ms.is_some() || machine.is_some() {
             let settings =
                 RuleSettings { feed: Some(feed), block_time_ms: self.block_time_ms, ..RuleSettings::default() };

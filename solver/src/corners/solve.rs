@@ -110,7 +110,8 @@ pub fn solve_within(request: &ContourRequest, tool: &Tool, max_moves: usize) -> 
 /// rule; `W_FEED_ABOVE_MACHINE_MAX` when `feed` is above its `max_feed`).
 ///
 /// # Errors
-/// As [`solve`]; `E_INPUT` at `machine` when the request names a machine and none is given.
+/// As [`solve`]. `machine` is the profile the request's `machine` names, resolved by the caller
+/// (`capability::resolve`).
 pub fn solve_with(
     request: &ContourRequest,
     tool: &Tool,

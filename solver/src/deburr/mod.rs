@@ -63,8 +63,8 @@ pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError
 /// rule at `feed`, never coarser than `tolerance`, and the summary reports the blocks.
 ///
 /// # Errors
-/// As [`solve`]; `E_INPUT` at `machine` when the request names a machine and none is given, at
-/// `block_time_ms` for a bad block time.
+/// As [`solve`] and `E_INPUT` at `block_time_ms` for a bad block time. `machine` is the profile the
+/// request's `machine` names, resolved by the caller (`capability::resolve`).
 pub fn solve_with(
     request: &DeburrRequest,
     tool: &Tool,

@@ -367,14 +367,6 @@ impl DeburrRequest {
         }
         let safe_z = self.safe_z.map(|z| bounded("safe_z", z)).transpose()?;
         let feed = optional_positive("feed", self.feed, DEFAULT_FEED)?;
-        if let Some(name) = &self.machine
-            && machine.is_none()
-        {
-            return Err(SolverError::input(
-                "machine",
-                format!("machine {name:?} was not resolved: pass its profile (deburr::solve_with)"),
-            ));
-        }
         let (rule, rule_warnings) = if self.block_time_ms.is_some() || machine.is_some() {
             let settings =
                 RuleSettings { feed: Some(feed), block_time_ms: self.block_time_ms, ..RuleSettings::default() };

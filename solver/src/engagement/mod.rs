@@ -112,7 +112,8 @@ pub fn solve(request: &EngagementRequest, tool: &Tool) -> Result<EngagementAnswe
 /// request's is larger).
 ///
 /// # Errors
-/// As [`solve`]; `E_INPUT` at `machine` when the request names a machine and none is given.
+/// As [`solve`]. `machine` is the profile the request's `machine` names, resolved by the caller
+/// (`capability::resolve`).
 pub fn solve_with(
     request: &EngagementRequest,
     tool: &Tool,

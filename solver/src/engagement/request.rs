@@ -796,14 +796,6 @@ impl EngagementRequest {
     /// Checks every field, with `machine` resolved from `self.machine`.
     pub(crate) fn validate(&self, tool: &Tool, machine: Option<&MachineProfile>) -> Result<Job, SolverError> {
         tool.validate("tool.")?;
-        if let Some(name) = &self.machine
-            && machine.is_none()
-        {
-            return Err(SolverError::input(
-                "machine",
-                format!("machine {name:?} was not resolved: pass its profile (engagement::solve_with)"),
-            ));
-        }
         let radius = bounded("tool.radius", tool.radius, MAX_COORDINATE)?;
         let spindle_rpm = bounded("spindle_rpm", self.spindle_rpm, 1e6)?;
         let feed_mode = match (self.feed_per_tooth, self.feed) {
