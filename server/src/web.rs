@@ -1,10 +1,14 @@
 //! The web page (`web/`), compiled into the binary so a shop-floor PC needs only the executable.
-//! Only the files listed here are served: nothing outside `web/` can be reached.
+//! Only the files listed here are served: nothing outside `web/` can be reached. Each file has a
+//! strong ETag (a hash of its bytes): the browser revalidates and gets 304 while the binary is the
+//! same; answers are gzip-compressed when the browser accepts it.
 
 use axum::Router;
-use axum::http::{HeaderValue, header};
+use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
 use axum::response::IntoResponse;
 use axum::routing::get;
+use sha2::{Digest, Sha256};
+use tower_http::compression::CompressionLayer;
 
 /// One served file.
 struct Asset {
@@ -40,21 +44,36 @@ const ASSETS: &[Asset] = &[
     asset!("/views/tools.js", JS),
 ];
 
+/// The strong ETag of `body`: a quoted hash of its bytes.
+fn etag(body: &[u8]) -> HeaderValue {
+    let digest = Sha256::digest(body);
+    let hex: String = digest.iter().take(12).map(|b| format!("{b:02x}")).collect();
+    HeaderValue::from_str(&format!("\"{hex}\"")).unwrap_or_else(|_| HeaderValue::from_static("\"0\""))
+}
+
+/// Whether `If-None-Match` names `tag` (or `*`).
+fn not_modified(headers: &HeaderMap, tag: &HeaderValue) -> bool {
+    let Some(Ok(asked)) = headers.get(header::IF_NONE_MATCH).map(HeaderValue::to_str) else { return false };
+    let tag = tag.to_str().unwrap_or_default();
+    asked.split(',').map(|t| t.trim().trim_start_matches("W/")).any(|t| t == "*" || t == tag)
+}
+
 /// Routes for the page's files.
 pub fn router<S: Clone + Send + Sync + 'static>() -> Router<S> {
-    ASSETS.iter().fold(Router::new(), |router, asset| {
+    let routes = ASSETS.iter().fold(Router::new(), |router, asset| {
+        let tag = etag(asset.body);
         router.route(
             asset.path,
-            get(move || async move {
-                (
-                    [
-                        (header::CONTENT_TYPE, HeaderValue::from_static(asset.media_type)),
-                        (header::CACHE_CONTROL, HeaderValue::from_static("no-cache")),
-                    ],
-                    asset.body,
-                )
+            get(move |headers: HeaderMap| async move {
+                let common =
+                    [(header::ETAG, tag.clone()), (header::CACHE_CONTROL, HeaderValue::from_static("no-cache"))];
+                if not_modified(&headers, &tag) {
+                    return (StatusCode::NOT_MODIFIED, common).into_response();
+                }
+                (common, [(header::CONTENT_TYPE, HeaderValue::from_static(asset.media_type))], asset.body)
                     .into_response()
             }),
         )
-    })
+    });
+    routes.layer(CompressionLayer::new())
 }

@@ -19,3 +19,4 @@ mod predict;
 mod request_fuzz;
 mod segment;
 mod tools;
+mod web;
