@@ -38,7 +38,7 @@ pub struct Config {
 
 /// The OpenAPI document and the API routes.
 pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
-    OpenApiRouter::with_openapi(ApiDoc::openapi())
+    let (routes, document) = OpenApiRouter::with_openapi(ApiDoc::openapi())
         .merge(http::health::router())
         .merge(http::tools::router())
         .merge(http::deburr::router())
@@ -48,7 +48,10 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
         .merge(http::jobs::router())
         .merge(http::machines::router())
         .merge(http::segment::router())
-        .split_for_parts()
+        .split_for_parts();
+    let mut document = document;
+    crate::openapi::describe_responses(&mut document);
+    (routes, document)
 }
 
 /// The whole service over `state`.

@@ -25,3 +25,28 @@ use utoipa::OpenApi;
     )
 )]
 pub struct ApiDoc;
+
+/// Gives every response without a description its status's reason phrase: OpenAPI requires a
+/// description on every response, and utoipa leaves out the empty ones.
+pub fn describe_responses(document: &mut utoipa::openapi::OpenApi) {
+    use utoipa::openapi::RefOr;
+    for item in document.paths.paths.values_mut() {
+        let operations =
+            [&mut item.get, &mut item.put, &mut item.post, &mut item.delete, &mut item.patch, &mut item.head];
+        for operation in operations.into_iter().flatten() {
+            for (status, response) in &mut operation.responses.responses {
+                if let RefOr::T(response) = response
+                    && response.description.is_empty()
+                {
+                    let reason = status
+                        .parse::<u16>()
+                        .ok()
+                        .and_then(|code| axum::http::StatusCode::from_u16(code).ok())
+                        .and_then(|code| code.canonical_reason())
+                        .unwrap_or("Response");
+                    reason.clone_into(&mut response.description);
+                }
+            }
+        }
+    }
+}

@@ -56,3 +56,18 @@ fn schema_names_are_unique() {
     let shared: Vec<_> = names.iter().filter(|(_, places)| places.len() > 1).collect();
     assert!(shared.is_empty(), "schema names used by more than one type: {shared:#?}");
 }
+
+/// OpenAPI requires a description on every response.
+#[test]
+fn every_response_has_a_description() {
+    let (_, document) = kerf_server::app::api();
+    let json = serde_json::to_value(&document).unwrap();
+    for (path, item) in json["paths"].as_object().unwrap() {
+        for (method, operation) in item.as_object().unwrap() {
+            for (status, response) in operation["responses"].as_object().unwrap() {
+                let description = response["description"].as_str().unwrap_or_default();
+                assert!(!description.is_empty(), "{method} {path} {status} has no description");
+            }
+        }
+    }
+}

@@ -201,8 +201,9 @@ fn machine_values_and_bad_block_times() {
     // The request's block time overrides the machine's.
     let own = request(tube(json!({"machine": "hsc", "feed": 1000, "block_time_ms": 2})));
     assert_eq!(deburr::solve_with(&own, &tool, Some(&machine)).unwrap().summary.block_time_ms, Some(2.0));
-    // Naming a machine without its profile, and bad block times.
-    assert_eq!(deburr::solve(&named, &tool).unwrap_err().field(), Some("machine"));
+    // Resolution is the caller's (capability::resolve): a name without its profile applies no
+    // machine. And bad block times.
+    assert_eq!(deburr::solve(&named, &tool).unwrap().summary.block_time_ms, None);
     for bad in [0.0, -4.0, f64::NAN, f64::INFINITY] {
         let mut body = request(tube(json!({"feed": 1000})));
         body.block_time_ms = Some(bad);

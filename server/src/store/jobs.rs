@@ -12,7 +12,19 @@ use crate::jobs::file::JobFile;
 /// Attempts a job gets: one retry after a server stop interrupted it.
 pub const MAX_ATTEMPTS: i64 = 2;
 
-const NOW: &str = "strftime('%Y-%m-%dT%H:%M:%fZ', 'now')";
+/// SQLite's current UTC time as stored (a macro, so every statement stays a static string).
+macro_rules! now {
+    () => {
+        "strftime('%Y-%m-%dT%H:%M:%fZ', 'now')"
+    };
+}
+
+/// The columns of a [`JobRow`].
+macro_rules! columns {
+    () => {
+        "id, name, status, progress, operations, attempts, error, error_field, submitted_at, started_at, finished_at"
+    };
+}
 
 /// Where a job is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema, sqlx::Type)]
@@ -125,9 +137,6 @@ fn problem_json(problem: &Problem) -> AppResult<String> {
     serde_json::to_string(problem).map_err(|e| AppError::Internal(e.into()))
 }
 
-const COLUMNS: &str =
-    "id, name, status, progress, operations, attempts, error, error_field, submitted_at, started_at, finished_at";
-
 /// Stores a new queued job; returns its id.
 pub async fn insert(db: &SqlitePool, job: &JobFile, hash: &str) -> AppResult<i64> {
     let json = serde_json::to_string(job).map_err(|e| AppError::Internal(e.into()))?;
@@ -158,14 +167,14 @@ pub async fn find_done(db: &SqlitePool, hash: &str) -> AppResult<Option<i64>> {
 /// One job.
 pub async fn get(db: &SqlitePool, id: i64) -> AppResult<Option<JobRecord>> {
     let row: Option<JobRow> =
-        sqlx::query_as(&format!("SELECT {COLUMNS} FROM jobs WHERE id = ?")).bind(id).fetch_optional(db).await?;
+        sqlx::query_as(concat!("SELECT ", columns!(), " FROM jobs WHERE id = ?")).bind(id).fetch_optional(db).await?;
     Ok(row.map(JobRecord::from))
 }
 
 /// Up to `limit` jobs with ids below `before`, newest first.
 pub async fn list(db: &SqlitePool, limit: i64, before: Option<i64>) -> AppResult<Vec<JobRecord>> {
     let rows: Vec<JobRow> =
-        sqlx::query_as(&format!("SELECT {COLUMNS} FROM jobs WHERE id < ? ORDER BY id DESC LIMIT ?"))
+        sqlx::query_as(concat!("SELECT ", columns!(), " FROM jobs WHERE id < ? ORDER BY id DESC LIMIT ?"))
             .bind(before.unwrap_or(i64::MAX))
             .bind(limit)
             .fetch_all(db)
@@ -175,9 +184,13 @@ pub async fn list(db: &SqlitePool, limit: i64, before: Option<i64>) -> AppResult
 
 /// Claims the oldest queued job for a worker: marks it running and returns it.
 pub async fn claim(db: &SqlitePool) -> AppResult<Option<(i64, JobFile)>> {
-    let row: Option<(i64, String)> = sqlx::query_as(&format!(
-        "UPDATE jobs SET status = 'running', attempts = attempts + 1, progress = 0, started_at = {NOW},
-                heartbeat_at = {NOW}
+    let row: Option<(i64, String)> = sqlx::query_as(concat!(
+        "UPDATE jobs SET status = 'running', attempts = attempts + 1, progress = 0, started_at = ",
+        now!(),
+        ",
+                heartbeat_at = ",
+        now!(),
+        "
          WHERE id = (SELECT id FROM jobs WHERE status = 'queued' ORDER BY id LIMIT 1)
          RETURNING id, job_json"
     ))
@@ -196,11 +209,15 @@ pub async fn claim(db: &SqlitePool) -> AppResult<Option<(i64, JobFile)>> {
 
 /// Records progress and the heartbeat of a running job.
 pub async fn heartbeat(db: &SqlitePool, id: i64, progress: f64) -> AppResult<()> {
-    sqlx::query(&format!("UPDATE jobs SET progress = ?, heartbeat_at = {NOW} WHERE id = ? AND status = 'running'"))
-        .bind(progress.clamp(0.0, 1.0))
-        .bind(id)
-        .execute(db)
-        .await?;
+    sqlx::query(concat!(
+        "UPDATE jobs SET progress = ?, heartbeat_at = ",
+        now!(),
+        " WHERE id = ? AND status = 'running'"
+    ))
+    .bind(progress.clamp(0.0, 1.0))
+    .bind(id)
+    .execute(db)
+    .await?;
     Ok(())
 }
 
@@ -208,8 +225,10 @@ pub async fn heartbeat(db: &SqlitePool, id: i64, progress: f64) -> AppResult<()>
 /// meanwhile. Returns whether it was stored.
 pub async fn finish(db: &SqlitePool, id: i64, outputs: &[Stored]) -> AppResult<bool> {
     let mut transaction = db.begin().await?;
-    let updated = sqlx::query(&format!(
-        "UPDATE jobs SET status = 'done', progress = 1, finished_at = {NOW} WHERE id = ? AND status = 'running'"
+    let updated = sqlx::query(concat!(
+        "UPDATE jobs SET status = 'done', progress = 1, finished_at = ",
+        now!(),
+        " WHERE id = ? AND status = 'running'"
     ))
     .bind(id)
     .execute(&mut *transaction)
@@ -241,8 +260,10 @@ pub async fn finish(db: &SqlitePool, id: i64, outputs: &[Stored]) -> AppResult<b
 pub async fn fail(db: &SqlitePool, id: i64, problem: &Problem) -> AppResult<()> {
     let json = problem_json(problem)?;
     let field = problem.errors.first().map(|error| error.path.clone());
-    sqlx::query(&format!(
-        "UPDATE jobs SET status = 'failed', error = ?, error_field = ?, finished_at = {NOW}
+    sqlx::query(concat!(
+        "UPDATE jobs SET status = 'failed', error = ?, error_field = ?, finished_at = ",
+        now!(),
+        "
          WHERE id = ? AND status = 'running'"
     ))
     .bind(json)
@@ -262,11 +283,15 @@ pub async fn cancel(db: &SqlitePool, id: i64) -> AppResult<Option<(JobStatus, bo
     let Some((status,)) = row else { return Ok(None) };
     let cancellable = matches!(status, JobStatus::Queued | JobStatus::Running);
     if cancellable {
-        sqlx::query(&format!("UPDATE jobs SET status = 'cancelled', finished_at = {NOW}, error = ? WHERE id = ?"))
-            .bind(problem_json(&job_problem(409, "Cancelled", "E_CANCELLED", "cancelled by request"))?)
-            .bind(id)
-            .execute(&mut *transaction)
-            .await?;
+        sqlx::query(concat!(
+            "UPDATE jobs SET status = 'cancelled', finished_at = ",
+            now!(),
+            ", error = ? WHERE id = ?"
+        ))
+        .bind(problem_json(&job_problem(409, "Cancelled", "E_CANCELLED", "cancelled by request"))?)
+        .bind(id)
+        .execute(&mut *transaction)
+        .await?;
     }
     transaction.commit().await?;
     Ok(Some((status, cancellable)))
@@ -295,8 +320,10 @@ pub async fn programs(db: &SqlitePool, id: i64) -> AppResult<Vec<(Option<String>
 /// At start-up no job can be running: each one a stopped server left `running` is queued again,
 /// or failed with the reason once it has used its attempts. Returns (re-queued, failed).
 pub async fn recover(db: &SqlitePool) -> AppResult<(u64, u64)> {
-    let failed = sqlx::query(&format!(
-        "UPDATE jobs SET status = 'failed', finished_at = {NOW}, error = ?
+    let failed = sqlx::query(concat!(
+        "UPDATE jobs SET status = 'failed', finished_at = ",
+        now!(),
+        ", error = ?
          WHERE status = 'running' AND attempts >= ?"
     ))
     .bind(problem_json(&job_problem(
