@@ -3,7 +3,8 @@
 // selector; loops, reliefs, links and corners in their own colours; wheel to zoom, drag to pan,
 // double-click to fit), the corner table with the material left or over-cut, the summary, the
 // warnings and the G-code download. `contourResult` also renders job results.
-import { api, download, gcodeQuery, loadMachines, loadTools, message, number, numeric, programName, showProblem, showSummary, value } from '/app.js';
+import { api } from '/api.js';
+import { clearProblem, computed, computing, download, gcodeQuery, keepForm, loadMachines, loadTools, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
 
 // An arrow-shaped island: five protruding corners (a 64° tip among them) and two inside corners.
 const SAMPLE = `# x, y in mm, counter-clockwise; one point a line
@@ -452,7 +453,7 @@ export function contourResult(container, answer) {
   show(0, false);
 
   showSummary(summary, summaryItems(answer));
-  warnings.replaceChildren(...answer.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
+  warnings.replaceChildren(...warningMessages(answer.warnings));
   container.append(cornerTable(answer, plot));
   return canvas;
 }
@@ -471,14 +472,12 @@ function markContour(form, messages, problem) {
 }
 
 export const contourView = {
-  id: 'contour',
-  title: 'Contour',
-  mount(root) {
+  mount(root, id) {
     root.innerHTML = FORM;
     const form = root.querySelector('#contour-form');
     const messages = root.querySelector('#contour-messages');
     const result = root.querySelector('#contour-result');
-    form.elements.points.value = SAMPLE;
+    form.elements.points.defaultValue = SAMPLE;
     const sync = () => { form.querySelector('[data-inline-tool]').hidden = value(form, 'tool_choice') !== 'inline'; };
     form.addEventListener('change', sync);
     loadTools(form.elements.tool_choice, 'inline flat end mill (radius below)').then(sync);
@@ -498,13 +497,14 @@ export const contourView = {
       event.preventDefault();
       const body = request();
       if (!body) return;
-      messages.replaceChildren(message('warning', 'computing…'));
+      computing(messages, result);
       try {
         const answer = await api('POST', '/api/v1/contour', body);
-        messages.replaceChildren();
+        computed(messages, result);
+        markComputed(form);
+        clearProblem(form);
         contourResult(result, answer).id = 'contour-plot';
       } catch (problem) {
-        result.replaceChildren();
         showProblem(messages, form, problem);
         markContour(form, messages, problem);
       }
@@ -520,5 +520,6 @@ export const contourView = {
         markContour(form, messages, problem);
       }
     });
+    keepForm(id, form);
   },
 };

@@ -4,7 +4,8 @@
 // summed chip thickness per flute count with the threshold, representative values and time per
 // k with the recommended k highlighted, and the feed plan; a cursor on any chart marks the tool
 // on the path. The result renderer is shared with the Jobs view.
-import { api, download, gcodeQuery, loadMachines, loadTools, message, number, numeric, programName, showProblem, showSummary, toolLabel, value } from '/app.js';
+import { api } from '/api.js';
+import { clearProblem, computed, computing, download, gcodeQuery, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
   { name: 'straight', text: '-10 20\n70 20' },
@@ -850,7 +851,7 @@ function renderColumn(column, result, answer, axis) {
     for (const w of result.warnings) counts.set(w.code, (counts.get(w.code) || 0) + 1);
     const summaryLine = document.createElement('summary');
     summaryLine.textContent = `Warnings: ${[...counts].map(([code, n]) => (n > 1 ? `${code} ×${n}` : code)).join(', ')}`;
-    details.append(summaryLine, ...result.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
+    details.append(summaryLine, ...warningMessages(result.warnings));
     column.append(details);
   }
   column.cursor = setCursor;
@@ -886,9 +887,7 @@ export function engagementResult(container, answer) {
 // ---------------------------------------------------------------------------------------------
 
 export const engagementView = {
-  id: 'engagement',
-  title: 'Engagement',
-  mount(root) {
+  mount(root, id) {
     root.innerHTML = FORM;
     const form = root.querySelector('#engagement-form');
     const messages = root.querySelector('#engagement-messages');
@@ -898,6 +897,7 @@ export const engagementView = {
     form.addEventListener('change', () => syncVisibility(form));
     loadTools(form.elements.tool_choice, 'inline flat end mill (below)', () => true, (tool) => `${toolLabel(tool)} z${tool.flutes}`).then(() => syncVisibility(form));
     loadMachines(form.elements.machine);
+    machineFields(form, { max_feed: 'max_feed' });
     syncVisibility(form);
     const fail = (problem) => {
       showProblem(messages, form, problem);
@@ -917,13 +917,14 @@ export const engagementView = {
       fillCandidates();
       try {
         const body = engagementRequest(form);
-        messages.replaceChildren(message('warning', 'computing…'));
+        computing(messages, result);
         const answer = await api('POST', '/api/v1/engagement', body);
-        messages.replaceChildren();
+        computed(messages, result);
+        markComputed(form);
+        clearProblem(form);
         engagementResult(result, answer);
         result.dataset.state = 'drawn';
       } catch (problem) {
-        result.replaceChildren();
         fail(problem);
       }
     });
@@ -937,6 +938,22 @@ export const engagementView = {
       } catch (problem) {
         fail(problem);
       }
+    });
+    keepForm(id, form, {
+      more: {
+        save: () => pathBoxes(form).map((box) => ({ name: box.querySelector('input').value, text: box.querySelector('textarea').value })),
+        restore: (paths) => {
+          if (!Array.isArray(paths) || !paths.length) return;
+          pathBoxes(form).forEach((box) => box.remove());
+          for (const path of paths) addPath(form, path.name, path.text);
+          fillCandidates();
+        },
+      },
+      onReset: (clear) => {
+        pathBoxes(form).forEach((box) => box.remove());
+        for (const sample of clear ? [{ name: 'path 1', text: '' }] : SAMPLE_PATHS) addPath(form, sample.name, sample.text);
+        fillCandidates();
+      },
     });
   },
 };

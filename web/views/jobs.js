@@ -1,16 +1,8 @@
 // Jobs workbench: drop or pick a job file, watch it queue and run, browse past jobs, open a
 // result with the view of its operation, download G-code and JSON (api.md, Jobs).
-import { api, download, message, showProblem } from '/app.js';
-import { contourResult } from '/views/contour.js';
-import { deburrResult } from '/views/deburr.js';
-import { engagementResult } from '/views/engagement.js';
-import { predictResult } from '/views/predict.js';
-import { segmentResult } from '/views/segment.js';
-
-// How each operation's result is shown; later capabilities add theirs here.
-const resultViews = {
-  deburr: deburrResult, segment: segmentResult, contour: contourResult, engagement: engagementResult, predict: predictResult,
-};
+import { api } from '/api.js';
+import { download, message, showProblem } from '/form.js';
+import { resultView } from '/views.js';
 
 const LAYOUT = `
 <section>
@@ -142,7 +134,7 @@ async function openJob(id, root) {
       const view = document.createElement('div');
       section.append(heading, actions, view);
       box.append(section);
-      (resultViews[result.operation] || ((c, r) => { c.textContent = JSON.stringify(r).slice(0, 2000); }))(view, result.result);
+      (resultView(result.operation) || ((c, r) => { c.textContent = JSON.stringify(r).slice(0, 2000); }))(view, result.result);
     });
     box.scrollIntoView({ behavior: 'smooth', block: 'start' });
   } catch (problem) {
@@ -167,8 +159,6 @@ async function submit(file, root) {
 }
 
 export const jobsView = {
-  id: 'jobs',
-  title: 'Jobs',
   mount(root) {
     root.innerHTML = LAYOUT;
     state.jobs.clear();

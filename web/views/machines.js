@@ -1,6 +1,7 @@
 // Machines view: the controller profiles (api.md, Machines): list, register or replace, delete,
 // and the block time from a saturation test (chord.md §2.1, Eq. 1).
-import { api, message, showProblem } from '/app.js';
+import { api } from '/api.js';
+import { message, showProblem } from '/form.js';
 
 const FORM = `
 <div class="layout">
@@ -60,7 +61,7 @@ async function refresh(root) {
       remove.addEventListener('click', async () => {
         try {
           await api('DELETE', `/api/v1/machines/${encodeURIComponent(machine.name)}`);
-          messages.replaceChildren(message('warning', `machine ${machine.name} deleted`));
+          messages.replaceChildren(message('ok', `Machine ${machine.name} deleted.`));
           refresh(root);
         } catch (problem) {
           showProblem(messages, null, problem);
@@ -76,8 +77,6 @@ async function refresh(root) {
 }
 
 export const machinesView = {
-  id: 'machines',
-  title: 'Machines',
   mount(root) {
     root.innerHTML = FORM;
     const form = root.querySelector('#machine-form');
@@ -103,7 +102,7 @@ export const machinesView = {
       try {
         await api('PUT', `/api/v1/machines/${encodeURIComponent(name || ' ')}`, machine);
         form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
-        messages.replaceChildren(message('warning', `machine ${name} saved`));
+        messages.replaceChildren(message('ok', `Machine ${name} saved.`));
         refresh(root);
       } catch (problem) {
         showProblem(messages, form, problem);

@@ -3,8 +3,9 @@
 // G-code program, cutting conditions, method), the path coloured by predicted error with a colour
 // scale, a histogram of the errors, the worst passes with their NC lines, warnings, and the
 // corrected program. `predictResult` also shows prediction jobs.
-import { api, download, loadTools, message, number, numeric, showProblem, showSummary, toolLabel, value } from '/app.js';
-import { Plot3D } from '/plot3d.js';
+import { api } from '/api.js';
+import { clearProblem, computed, computing, download, keepForm, loadTools, markComputed, message, number, numeric, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
+import { Scene3D, THREE, css, diverging } from '/plot.js';
 
 // The sample: a raster finishing program over a gentle dome (20 × 20 mm, 2 mm high) with an R3
 // ball, and the dome plus a 0.2 mm allowance as a height grid (as examples/predict-raster.toml).
@@ -223,19 +224,10 @@ function markProblem(form, problem) {
   }
 }
 
-// Colour scale from the most negative to the most positive error (perceptually ordered).
-const STOPS = ['#30123b', '#4686fb', '#1ae4b6', '#a2fc3c', '#faba39', '#e4460a', '#7a0403'];
-
-function rgb(hex) {
-  return [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16));
-}
-
-export function colourFor(t) {
-  const x = Math.max(0, Math.min(1, Number.isFinite(t) ? t : 0.5)) * (STOPS.length - 1);
-  const i = Math.min(STOPS.length - 2, Math.floor(x));
-  const [a, b] = [rgb(STOPS[i]), rgb(STOPS[i + 1])];
-  const f = x - i;
-  return `rgb(${a.map((v, k) => Math.round(v + (b[k] - v) * f)).join(',')})`;
+// The error colour: a diverging scale centred on zero with symmetric limits ±limit (blue: cuts
+// too deep, white: on size, red: leaves material).
+function colourOf(error, limit) {
+  return Number.isFinite(error) ? css(diverging(error, limit)) : '#9aa4ad';
 }
 
 function microns(e) {
@@ -262,7 +254,8 @@ function runs(passes) {
   return out;
 }
 
-function drawScale(canvas, low, high) {
+function drawScale(canvas, limit) {
+  const [low, high] = [-limit, limit];
   const width = canvas.clientWidth;
   const height = canvas.clientHeight;
   const ratio = window.devicePixelRatio || 1;
@@ -275,7 +268,7 @@ function drawScale(canvas, low, high) {
   const left = 10;
   const right = width - 10;
   for (let x = left; x < right; x++) {
-    g.fillStyle = colourFor((x - left) / (right - left));
+    g.fillStyle = colourOf(low + (high - low) * (x - left) / (right - left), limit);
     g.fillRect(x, 4, 1, 22);
   }
   g.fillStyle = '#1d2327';
@@ -294,7 +287,7 @@ function drawScale(canvas, low, high) {
   canvas.dataset.state = 'drawn';
 }
 
-function drawHistogram(canvas, errors, low, high) {
+function drawHistogram(canvas, errors, low, high, limit) {
   const width = canvas.clientWidth;
   const height = canvas.clientHeight;
   const ratio = window.devicePixelRatio || 1;
@@ -323,7 +316,7 @@ function drawHistogram(canvas, errors, low, high) {
   const w = (right - left) / bins;
   counts.forEach((count, i) => {
     const h = (count / most) * (bottom - top);
-    g.fillStyle = colourFor((i + 0.5) / bins);
+    g.fillStyle = colourOf(low + span * (i + 0.5) / bins, limit);
     g.fillRect(left + i * w + 1, bottom - h, Math.max(1, w - 2), h);
   });
   g.fillStyle = '#1d2327';
@@ -345,18 +338,16 @@ function drawHistogram(canvas, errors, low, high) {
 
 // Shows a prediction in `container`: path coloured by error with its scale, histogram, summary,
 // worst passes and warnings. Used by the form and by job results.
-export function predictResult(container, answer) {
+export function predictResult(container, answer, request) {
   container.replaceChildren();
   const warnings = document.createElement('div');
-  const canvas = document.createElement('canvas');
-  canvas.className = 'plot';
-  canvas.setAttribute('aria-label', 'Tool path coloured by predicted error');
+  const sceneBox = document.createElement('div');
   const scale = document.createElement('canvas');
   scale.className = 'scale';
   scale.setAttribute('aria-label', 'Colour scale of the predicted error');
   const caption = document.createElement('p');
   caption.className = 'hint';
-  caption.textContent = 'Programmed path coloured by the predicted error e (µm along the surface normal; < 0 cuts too deep, > 0 leaves material). Drag to rotate, shift-drag to pan, wheel to zoom, double-click to reset.';
+  caption.textContent = 'Programmed path coloured by the predicted error along the surface normal: blue cuts too deep (below 0), white is on size, red leaves material (above 0); the scale is symmetric about zero. Drag to rotate, right-drag to pan, wheel to zoom. Click a worst pass to put the tool there.';
   const summaryBox = document.createElement('div');
   summaryBox.className = 'summary';
   const histogram = document.createElement('canvas');
@@ -366,25 +357,30 @@ export function predictResult(container, answer) {
   worstTitle.textContent = 'Worst passes';
   const worst = document.createElement('table');
   worst.className = 'worst';
-  container.append(warnings, canvas, scale, caption, summaryBox, histogram, worstTitle, worst);
+  container.append(warnings, sceneBox, scale, caption, summaryBox, histogram, worstTitle, worst);
 
   const errors = answer.passes.map((p) => p.error).filter(Number.isFinite);
   const low = errors.length ? Math.min(...errors) : 0;
   const high = errors.length ? Math.max(...errors) : 0;
-  const position = (e) => (high > low ? (e - low) / (high - low) : 0.5);
-  const grey = '#9aa4ad';
-  const series = runs(answer.passes).map((run) => ({
-    label: '',
-    points: run.points,
-    colour: grey,
-    colours: run.errors.map((e) => (Number.isFinite(e) ? colourFor(position(e)) : grey)),
-    width: 3,
-    marks: run.points.length < 3,
-  }));
-  new Plot3D(canvas).setSeries(series);
+  const limit = Math.max(Math.abs(low), Math.abs(high), 1e-9);
+  const scene = new Scene3D(sceneBox, { label: 'Tool path coloured by predicted error, with the stock' });
+  if (request?.stock?.kind === 'box' && [...request.stock.min, ...request.stock.max].every(Number.isFinite)) {
+    const [min, max] = [request.stock.min, request.stock.max];
+    const box = new THREE.BoxGeometry(max[0] - min[0], max[1] - min[1], max[2] - min[2]);
+    box.translate((min[0] + max[0]) / 2, (min[1] + max[1]) / 2, (min[2] + max[2]) / 2);
+    scene.solid('stock', box, { legend: 'stock', opacity: 0.15 });
+  }
+  runs(answer.passes).forEach((run, i) => {
+    const colours = run.errors.map((e) => colourOf(e, limit));
+    if (run.points.length > 1) scene.path('path', run.points, { colours, legend: i === 0 ? 'path, coloured by error' : undefined, colour: '#9aa4ad' });
+    else scene.dots('path', run.points, { colour: colours[0] });
+  });
+  scene.tool({ radius: answer.tool.radius || 1 });
+  scene.finish();
+  const end = (pass) => pass.corrected.map((c, k) => c - pass.correction[k]);
   const redraw = () => {
-    drawScale(scale, low, high);
-    drawHistogram(histogram, errors, low, high);
+    drawScale(scale, limit);
+    drawHistogram(histogram, errors, low, high, limit);
   };
   redraw();
   new ResizeObserver(redraw).observe(histogram);
@@ -413,7 +409,15 @@ export function predictResult(container, answer) {
     tr.dataset.line = String(w.line ?? '');
     const swatch = document.createElement('span');
     swatch.className = 'swatch';
-    swatch.style.background = colourFor(position(w.error));
+    swatch.style.background = colourOf(w.error, limit);
+    tr.tabIndex = 0;
+    const select = () => {
+      worst.querySelectorAll('[aria-selected]').forEach((r) => r.removeAttribute('aria-selected'));
+      tr.setAttribute('aria-selected', 'true');
+      if (pass.corrected) scene.moveTool(end(pass).map((v, k) => v + (k === 2 && request?.reference !== 'centre' ? answer.tool.radius : 0)));
+    };
+    tr.addEventListener('click', select);
+    tr.addEventListener('keydown', (e) => { if (e.key === 'Enter' || e.key === ' ') { e.preventDefault(); select(); } });
     const cells = [String(rank + 1), String(w.index), w.line === undefined ? '–' : String(w.line), microns(w.error),
       number(pass.contact_angle_deg, 1), (pass.flags || []).join(', ')];
     cells.forEach((text, k) => {
@@ -425,23 +429,21 @@ export function predictResult(container, answer) {
     return tr;
   });
   worst.replaceChildren(head, ...body);
-  warnings.replaceChildren(...answer.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
-  return canvas;
+  warnings.replaceChildren(...warningMessages(answer.warnings));
+  return scene.root;
 }
 
 export const predictView = {
-  id: 'predict',
-  title: 'Predict',
-  mount(root) {
+  mount(root, id) {
     root.innerHTML = FORM;
     const form = root.querySelector('#predict-form');
     const messages = root.querySelector('#predict-messages');
     const result = root.querySelector('#predict-result');
     const grid = sampleGrid();
-    form.elements.program.value = sampleProgram();
-    form.elements.heights.value = grid.heights;
-    form.elements.origin_x.value = grid.origin;
-    form.elements.origin_y.value = grid.origin;
+    form.elements.program.defaultValue = sampleProgram();
+    form.elements.heights.defaultValue = grid.heights;
+    form.elements.origin_x.defaultValue = grid.origin;
+    form.elements.origin_y.defaultValue = grid.origin;
     form.addEventListener('change', () => syncVisibility(form));
     loadTools(form.elements.tool_choice, 'inline ball (below)', isBall, predictToolLabel).then(() => syncVisibility(form));
     syncVisibility(form);
@@ -457,16 +459,17 @@ export const predictView = {
     form.addEventListener('submit', async (event) => {
       event.preventDefault();
       clear();
-      messages.replaceChildren(message('warning', 'predicting…'));
+      computing(messages, result);
       const started = performance.now();
       try {
         const answer = await api('POST', '/api/v1/predict?timings=true', payload(predictRequest(form)));
         const seconds = (performance.now() - started) / 1000;
-        messages.replaceChildren(message('ok', `${answer.summary.passes} passes in ${seconds.toFixed(2)} s`));
-        predictResult(result, answer).id = 'predict-plot';
+        computed(messages, result, `${answer.summary.passes} passes predicted in ${seconds.toFixed(2)} s.`);
+        markComputed(form);
+        clearProblem(form);
+        predictResult(result, answer, predictRequest(form).body).id = 'predict-plot';
         result.querySelector('canvas.histogram').id = 'predict-histogram';
       } catch (problem) {
-        result.replaceChildren();
         fail(problem);
       }
     });
@@ -491,5 +494,6 @@ export const predictView = {
         fail(problem);
       }
     });
+    keepForm(id, form);
   },
 };

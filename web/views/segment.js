@@ -1,8 +1,9 @@
 // Segment view: cut a curve into G01 blocks by the control's block time (api.md, Segment;
 // chord.md). A form for the curve and the rule, the curve with its blocks, the chord error and the
 // block length along the curve, the rule side by side with a fixed tolerance, G-code download.
-import { api, download, loadMachines, message, number, numeric, showProblem, showSummary, value } from '/app.js';
-import { PlanPlot, drawChart } from '/plot2d.js';
+import { api } from '/api.js';
+import { clearProblem, computed, computing, download, keepForm, loadMachines, machineFields, machineNote, markComputed, message, number, numeric, showProblem, showSummary, value, warningMessages } from '/form.js';
+import { PlanPlot, drawChart } from '/plot.js';
 
 const FORM = `
 <div class="layout">
@@ -40,7 +41,7 @@ const FORM = `
       <label>Mode <select name="mode" data-field="mode"><option value="window">per window</option><option value="curve">whole curve</option></select></label>
       <label data-mode="window">Window, mm <input name="window" type="number" step="any" placeholder="5 target chords" data-field="window"></label>
       <label data-mode="curve">Rule <select name="rule" data-field="rule"><option value="extremes">smallest radius</option><option value="max">largest window value</option><option value="normal_accel">normal acceleration</option></select></label>
-      <label>Margin k_f <input name="margin" type="number" step="any" value="1" data-field="margin"></label>
+      <label><span>Block margin <abbr class="symbol" title="k_f in chord.md">k_f</abbr></span> <input name="margin" type="number" step="any" value="1" data-field="margin"></label>
       <label>Min chord error, mm <input name="min_chord_error" type="number" step="any" value="0" data-field="min_chord_error"></label>
       <label>Tolerance, mm <input name="tolerance" type="number" step="any" placeholder="none" data-field="tolerance"></label>
       <label>Compare with fixed, mm <input name="compare_tolerance" type="number" step="any" value="0.01" data-field="compare_tolerance"></label>
@@ -50,7 +51,7 @@ const FORM = `
       <select name="dialect" aria-label="G-code dialect"><option value="">machine's dialect</option><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select>
       <button class="secondary" type="button" id="segment-gcode">G-code</button>
     </div>
-    <p class="hint">Empty feed, block time, margin or minimum chord error take the machine's values.</p>
+    <p class="hint">With a machine chosen, its values show greyed in the empty fields and are used; type a value to override it.</p>
   </form>
   <section>
     <div id="segment-messages"></div>
@@ -254,7 +255,7 @@ function heading(text) {
 // Shows a segment answer in `container`: summary, comparison, plan of the curve and its blocks,
 // chord error and block length along the curve, warnings. `request` (the form view's) adds the
 // target curve to the plan. Used by the form and by job results.
-export function segmentResult(container, answer, request) {
+export function segmentResult(container, answer, request, machine) {
   container.replaceChildren();
   const warnings = document.createElement('div');
   const summaryBox = document.createElement('div');
@@ -299,7 +300,7 @@ export function segmentResult(container, answer, request) {
     { label: `feed × block time = ${number(answer.block_length, 4)} mm`, points: level(answer.block_length), colour: '#b3261e', width: 1.5, dash: [6, 4] },
   ], { xLabel: 'arc length s, mm', yLabel: 'block length, mm' });
 
-  const machine = answer.machine ? `${answer.machine.name} (${answer.machine.dialect})` : 'none';
+  const machineName = answer.machine ? `${answer.machine.name} (${answer.machine.dialect})` : 'none';
   showSummary(summaryBox, [
     ['blocks', answer.blocks],
     ['chord error, mm', `${number(answer.min_window_chord_error, 6)} – ${number(answer.chord_error, 6)}`],
@@ -311,28 +312,29 @@ export function segmentResult(container, answer, request) {
     ['curve length, mm', number(answer.curve_length, 3)],
     ['smallest radius, mm', answer.min_radius == null ? 'straight' : number(answer.min_radius, 3)],
     ['feed limit, mm/min', answer.feed_limit == null ? '–' : number(answer.feed_limit, 0)],
-    ['feed / block time', `${answer.feed} mm/min / ${answer.block_time_ms} ms`],
-    ['margin / machine', `${answer.margin} / ${machine}`],
+    ['feed', machineNote(answer.feed, 'mm/min', request, 'feed', machine, 'max_feed')],
+    ['block time', machineNote(answer.block_time_ms, 'ms', request, 'block_time_ms', machine)],
+    ['margin', machineNote(answer.margin, '', request, 'margin', machine)],
+    ['machine', machineName],
   ]);
-  warnings.replaceChildren(...answer.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
+  warnings.replaceChildren(...warningMessages(answer.warnings));
   return plan;
 }
 
 export const segmentView = {
-  id: 'segment',
-  title: 'Segment',
-  mount(root) {
+  mount(root, id) {
     root.innerHTML = FORM;
     const form = root.querySelector('#segment-form');
     const messages = root.querySelector('#segment-messages');
     const result = root.querySelector('#segment-result');
-    form.elements.points.value = Array.from({ length: 91 }, (_, i) => {
+    form.elements.points.defaultValue = Array.from({ length: 91 }, (_, i) => {
       const t = i * Math.PI / 180;
       return `${(30 * Math.cos(t)).toFixed(4)} ${(20 * Math.sin(t)).toFixed(4)}`;
     }).join('\n');
     form.addEventListener('change', () => syncVisibility(form));
     syncVisibility(form);
     loadMachines(form.elements.machine, 'none (values below)');
+    machineFields(form, { feed: 'max_feed', block_time_ms: 'block_time_ms', margin: 'margin', min_chord_error: 'min_chord_error' });
     const request = () => {
       form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
       try {
@@ -346,16 +348,17 @@ export const segmentView = {
       event.preventDefault();
       const body = request();
       if (!body) return;
-      messages.replaceChildren(message('warning', 'computing…'));
+      computing(messages, result);
       try {
         const answer = await api('POST', '/api/v1/segment', body);
-        messages.replaceChildren();
-        segmentResult(result, answer, body).id = 'segment-plot';
+        computed(messages, result);
+        markComputed(form);
+        clearProblem(form);
+        segmentResult(result, answer, body, form.elements.machine.machines?.get(body.machine)).id = 'segment-plot';
         const charts = result.querySelectorAll('canvas.chart');
         charts[0].id = 'segment-chart';
         charts[1].id = 'segment-lengths';
       } catch (problem) {
-        result.replaceChildren();
         showProblem(messages, form, problem);
         highlightPrefixes(form, problem);
       }
@@ -373,5 +376,6 @@ export const segmentView = {
         highlightPrefixes(form, problem);
       }
     });
+    keepForm(id, form);
   },
 };

@@ -1,5 +1,6 @@
 // Tool table view: list, register or replace, delete (api.md, Tools).
-import { api, message, showProblem } from '/app.js';
+import { api } from '/api.js';
+import { message, showProblem } from '/form.js';
 
 const FORM = `
 <div class="layout">
@@ -54,8 +55,6 @@ async function refresh(rows, messages) {
 }
 
 export const toolsView = {
-  id: 'tools',
-  title: 'Tools',
   mount(root) {
     root.innerHTML = FORM;
     const form = root.querySelector('#tool-form');
@@ -76,7 +75,7 @@ export const toolsView = {
       try {
         await api('PUT', `/api/v1/tools/${encodeURIComponent(form.elements.number.value)}`, tool);
         form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
-        messages.replaceChildren(message('warning', `tool ${form.elements.number.value} saved`));
+        messages.replaceChildren(message('ok', `Tool ${form.elements.number.value} saved.`));
         refresh(rows, messages);
       } catch (problem) {
         showProblem(messages, form, problem);
