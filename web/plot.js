@@ -272,6 +272,231 @@ function formatTick(v) {
   return String(Number(v.toPrecision(4)));
 }
 
+// A plan plot of a contour (layered milling): y up, equal scales, wheel zoom about the pointer, drag to pan,
+// double-click to fit. scene = {material: {polygon, inside}, lines: [{points, colour, width,
+// dash}], marks: [{at, colour, size, ring}]}.
+export class Plot2D {
+  constructor(canvas) {
+    this.canvas = canvas;
+    this.scene = null;
+    this.view = null;
+    this.drag = null;
+    canvas.addEventListener('pointerdown', (e) => {
+      this.drag = { x: e.clientX, y: e.clientY };
+      canvas.setPointerCapture(e.pointerId);
+    });
+    canvas.addEventListener('pointermove', (e) => {
+      if (!this.drag || !this.view) return;
+      this.view.cx -= (e.clientX - this.drag.x) / this.view.scale;
+      this.view.cy += (e.clientY - this.drag.y) / this.view.scale;
+      this.drag = { x: e.clientX, y: e.clientY };
+      this.draw();
+    });
+    canvas.addEventListener('pointerup', () => { this.drag = null; });
+    canvas.addEventListener('wheel', (e) => {
+      if (!this.view) return;
+      e.preventDefault();
+      const rect = canvas.getBoundingClientRect();
+      const before = this.toWorld(e.clientX - rect.left, e.clientY - rect.top);
+      this.view.scale *= Math.exp(-e.deltaY * 0.0015);
+      const after = this.toWorld(e.clientX - rect.left, e.clientY - rect.top);
+      this.view.cx += before[0] - after[0];
+      this.view.cy += before[1] - after[1];
+      this.draw();
+    }, { passive: false });
+    canvas.addEventListener('dblclick', () => { this.fit(); this.draw(); });
+    new ResizeObserver(() => this.draw()).observe(canvas);
+  }
+
+  setScene(scene, keepView = false) {
+    this.scene = scene;
+    if (!keepView || !this.view) this.fit();
+    this.draw();
+  }
+
+  bounds() {
+    const low = [Infinity, Infinity];
+    const high = [-Infinity, -Infinity];
+    const add = (p) => {
+      low[0] = Math.min(low[0], p[0]); low[1] = Math.min(low[1], p[1]);
+      high[0] = Math.max(high[0], p[0]); high[1] = Math.max(high[1], p[1]);
+    };
+    this.scene.material?.polygon.forEach(add);
+    this.scene.lines.forEach((l) => l.points.forEach(add));
+    return { low, high };
+  }
+
+  fit() {
+    if (!this.scene) return;
+    const { low, high } = this.bounds();
+    const width = this.canvas.clientWidth || 600;
+    const height = this.canvas.clientHeight || 400;
+    const span = [Math.max(high[0] - low[0], 1e-6), Math.max(high[1] - low[1], 1e-6)];
+    this.view = { cx: (low[0] + high[0]) / 2, cy: (low[1] + high[1]) / 2, scale: 0.9 * Math.min(width / span[0], height / span[1]) };
+  }
+
+  // Centres the view on `point` with `span` mm across the smaller side.
+  focus(point, span) {
+    const size = Math.min(this.canvas.clientWidth, this.canvas.clientHeight) || 400;
+    this.view = { cx: point[0], cy: point[1], scale: size / span };
+    this.draw();
+  }
+
+  toScreen(p) {
+    return [this.width / 2 + (p[0] - this.view.cx) * this.view.scale, this.height / 2 - (p[1] - this.view.cy) * this.view.scale];
+  }
+
+  toWorld(x, y) {
+    return [this.view.cx + (x - this.width / 2) / this.view.scale, this.view.cy - (y - this.height / 2) / this.view.scale];
+  }
+
+  draw() {
+    const canvas = this.canvas;
+    const ratio = window.devicePixelRatio || 1;
+    this.width = canvas.clientWidth;
+    this.height = canvas.clientHeight;
+    if (canvas.width !== Math.round(this.width * ratio) || canvas.height !== Math.round(this.height * ratio)) {
+      canvas.width = Math.round(this.width * ratio);
+      canvas.height = Math.round(this.height * ratio);
+    }
+    const g = canvas.getContext('2d');
+    g.setTransform(ratio, 0, 0, ratio, 0, 0);
+    g.fillStyle = '#ffffff';
+    g.fillRect(0, 0, this.width, this.height);
+    if (!this.scene || !this.view) {
+      canvas.dataset.state = 'empty';
+      return;
+    }
+    const material = this.scene.material;
+    if (material && material.polygon.length > 2) {
+      g.beginPath();
+      if (material.inside) g.rect(0, 0, this.width, this.height); // a pocket: material all round
+      material.polygon.forEach((p, i) => {
+        const [x, y] = this.toScreen(p);
+        if (i === 0) g.moveTo(x, y); else g.lineTo(x, y);
+      });
+      g.closePath();
+      g.fillStyle = (this.scene.material.colour || '#d9dde2');
+      g.fill('evenodd');
+      g.strokeStyle = (this.scene.material.outline || '#1d2327');
+      g.lineWidth = 2;
+      g.stroke();
+    }
+    let segments = 0;
+    for (const line of this.scene.lines) {
+      if (line.points.length < 2) continue;
+      g.strokeStyle = line.colour;
+      g.lineWidth = line.width || 2;
+      g.setLineDash(line.dash || []);
+      g.beginPath();
+      line.points.forEach((p, i) => {
+        const [x, y] = this.toScreen(p);
+        if (i === 0) g.moveTo(x, y); else { g.lineTo(x, y); segments++; }
+      });
+      g.stroke();
+      if (line.arrows) this.drawArrows(g, line);
+    }
+    g.setLineDash([]);
+    if (this.tool) {
+      const [x, y] = this.toScreen(this.tool.at);
+      const [edge] = this.toScreen([this.tool.at[0] + this.tool.radius, this.tool.at[1]]);
+      g.beginPath();
+      g.arc(x, y, Math.max(3, Math.abs(edge - x)), 0, 2 * Math.PI);
+      g.fillStyle = 'rgba(196, 127, 23, 0.35)';
+      g.fill();
+      g.strokeStyle = '#c47f17';
+      g.lineWidth = 2;
+      g.stroke();
+    }
+    for (const mark of this.scene.marks) {
+      const [x, y] = this.toScreen(mark.at);
+      g.beginPath();
+      g.arc(x, y, mark.size || 5, 0, 2 * Math.PI);
+      if (mark.ring) {
+        g.strokeStyle = mark.colour;
+        g.lineWidth = 2.5;
+        g.stroke();
+      } else {
+        g.fillStyle = mark.colour;
+        g.fill();
+      }
+    }
+    this.drawLegend(g);
+    this.drawScale(g);
+    canvas.dataset.state = 'drawn';
+    canvas.dataset.segments = String(segments);
+    canvas.dataset.scale = this.view.scale.toFixed(3);
+  }
+
+  // The tool (a circle of `radius` at `at`, plan coordinates), or none for null.
+  setTool(at, radius) {
+    this.tool = at ? { at, radius } : null;
+    this.canvas.dataset.tool = at ? at.map((v) => v.toFixed(3)).join(' ') : '';
+    this.draw();
+  }
+
+  // Arrowheads along a line about every 90 px, pointing the way it is cut.
+  drawArrows(g, line) {
+    let travelled = 45;
+    g.fillStyle = line.colour;
+    for (let i = 1; i < line.points.length; i++) {
+      const [ax, ay] = this.toScreen(line.points[i - 1]);
+      const [bx, by] = this.toScreen(line.points[i]);
+      const length = Math.hypot(bx - ax, by - ay);
+      let at = 90 - travelled;
+      while (at <= length) {
+        const [ux, uy] = [(bx - ax) / length, (by - ay) / length];
+        const [x, y] = [ax + ux * at, ay + uy * at];
+        g.beginPath();
+        g.moveTo(x + ux * 6, y + uy * 6);
+        g.lineTo(x - ux * 5 - uy * 5, y - uy * 5 + ux * 5);
+        g.lineTo(x - ux * 5 + uy * 5, y - uy * 5 - ux * 5);
+        g.closePath();
+        g.fill();
+        at += 90;
+      }
+      travelled = (travelled + length) % 90;
+    }
+  }
+
+  drawLegend(g) {
+    g.font = '15px sans-serif';
+    let y = 22;
+    for (const [label, colour, dash] of this.scene.legend || []) {
+      g.strokeStyle = colour;
+      g.lineWidth = 4;
+      g.setLineDash(dash || []);
+      g.beginPath();
+      g.moveTo(12, y - 5);
+      g.lineTo(34, y - 5);
+      g.stroke();
+      g.setLineDash([]);
+      g.fillStyle = '#1d2327';
+      g.fillText(label, 42, y);
+      y += 21;
+    }
+  }
+
+  // A scale bar of a round length at the bottom right.
+  drawScale(g) {
+    const target = 120 / this.view.scale;
+    const power = 10 ** Math.floor(Math.log10(target));
+    const length = [1, 2, 5, 10].map((k) => k * power).filter((l) => l <= target).pop() || power;
+    const pixels = length * this.view.scale;
+    const x = this.width - 20 - pixels;
+    const y = this.height - 20;
+    g.strokeStyle = '#1d2327';
+    g.lineWidth = 3;
+    g.beginPath();
+    g.moveTo(x, y);
+    g.lineTo(x + pixels, y);
+    g.stroke();
+    g.fillStyle = '#1d2327';
+    g.font = '14px sans-serif';
+    g.fillText(`${length} mm`, x, y - 7);
+  }
+}
+
 // ---------------------------------------------------------------- colour scales
 
 // A diverging scale centred on zero: blue below, white at zero, red above, symmetric limits

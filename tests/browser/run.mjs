@@ -320,7 +320,7 @@ const scenarios = {
     await page.fill('#contour-form textarea[name="points"]', '0, 0\n10 0 5\n10, 10');
     await page.click('#contour-compute');
     const local = await page.textContent('#contour-messages');
-    if (!/line 2/.test(local)) throw new Error(`local check: ${local}`);
+    if (!/line 2/i.test(local)) throw new Error(`local check: ${local}`);
     return { segments, inked, loopPixels, reliefPixels, zoomed: zoomed / fitted };
   },
 

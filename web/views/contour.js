@@ -3,7 +3,9 @@
 // selector; loops, reliefs, links and corners in their own colours; wheel to zoom, drag to pan,
 // double-click to fit), the corner table with the material left or over-cut, the summary, the
 // warnings and the G-code download. `contourResult` also renders job results.
-import { api } from '/api.js';
+import { api, program as programOf, sentence } from '/api.js';
+import { Timeline } from '/timeline.js';
+import { Plot2D } from '/plot.js';
 import { clearProblem, computed, computing, download, gcodeQuery, keepForm, loadMachines, loadTools, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
 
 // An arrow-shaped island: five protruding corners (a 64° tip among them) and two inside corners.
@@ -114,187 +116,6 @@ export function contourRequest(form) {
 }
 
 
-// A 2-D plot on a canvas: y up, equal scales, wheel zoom about the pointer, drag to pan,
-// double-click to fit. scene = {material: {polygon, inside}, lines: [{points, colour, width,
-// dash}], marks: [{at, colour, size, ring}]}.
-class Plot2D {
-  constructor(canvas) {
-    this.canvas = canvas;
-    this.scene = null;
-    this.view = null;
-    this.drag = null;
-    canvas.addEventListener('pointerdown', (e) => {
-      this.drag = { x: e.clientX, y: e.clientY };
-      canvas.setPointerCapture(e.pointerId);
-    });
-    canvas.addEventListener('pointermove', (e) => {
-      if (!this.drag || !this.view) return;
-      this.view.cx -= (e.clientX - this.drag.x) / this.view.scale;
-      this.view.cy += (e.clientY - this.drag.y) / this.view.scale;
-      this.drag = { x: e.clientX, y: e.clientY };
-      this.draw();
-    });
-    canvas.addEventListener('pointerup', () => { this.drag = null; });
-    canvas.addEventListener('wheel', (e) => {
-      if (!this.view) return;
-      e.preventDefault();
-      const rect = canvas.getBoundingClientRect();
-      const before = this.toWorld(e.clientX - rect.left, e.clientY - rect.top);
-      this.view.scale *= Math.exp(-e.deltaY * 0.0015);
-      const after = this.toWorld(e.clientX - rect.left, e.clientY - rect.top);
-      this.view.cx += before[0] - after[0];
-      this.view.cy += before[1] - after[1];
-      this.draw();
-    }, { passive: false });
-    canvas.addEventListener('dblclick', () => { this.fit(); this.draw(); });
-    new ResizeObserver(() => this.draw()).observe(canvas);
-  }
-
-  setScene(scene, keepView = false) {
-    this.scene = scene;
-    if (!keepView || !this.view) this.fit();
-    this.draw();
-  }
-
-  bounds() {
-    const low = [Infinity, Infinity];
-    const high = [-Infinity, -Infinity];
-    const add = (p) => {
-      low[0] = Math.min(low[0], p[0]); low[1] = Math.min(low[1], p[1]);
-      high[0] = Math.max(high[0], p[0]); high[1] = Math.max(high[1], p[1]);
-    };
-    this.scene.material?.polygon.forEach(add);
-    this.scene.lines.forEach((l) => l.points.forEach(add));
-    return { low, high };
-  }
-
-  fit() {
-    if (!this.scene) return;
-    const { low, high } = this.bounds();
-    const width = this.canvas.clientWidth || 600;
-    const height = this.canvas.clientHeight || 400;
-    const span = [Math.max(high[0] - low[0], 1e-6), Math.max(high[1] - low[1], 1e-6)];
-    this.view = { cx: (low[0] + high[0]) / 2, cy: (low[1] + high[1]) / 2, scale: 0.9 * Math.min(width / span[0], height / span[1]) };
-  }
-
-  // Centres the view on `point` with `span` mm across the smaller side.
-  focus(point, span) {
-    const size = Math.min(this.canvas.clientWidth, this.canvas.clientHeight) || 400;
-    this.view = { cx: point[0], cy: point[1], scale: size / span };
-    this.draw();
-  }
-
-  toScreen(p) {
-    return [this.width / 2 + (p[0] - this.view.cx) * this.view.scale, this.height / 2 - (p[1] - this.view.cy) * this.view.scale];
-  }
-
-  toWorld(x, y) {
-    return [this.view.cx + (x - this.width / 2) / this.view.scale, this.view.cy - (y - this.height / 2) / this.view.scale];
-  }
-
-  draw() {
-    const canvas = this.canvas;
-    const ratio = window.devicePixelRatio || 1;
-    this.width = canvas.clientWidth;
-    this.height = canvas.clientHeight;
-    if (canvas.width !== Math.round(this.width * ratio) || canvas.height !== Math.round(this.height * ratio)) {
-      canvas.width = Math.round(this.width * ratio);
-      canvas.height = Math.round(this.height * ratio);
-    }
-    const g = canvas.getContext('2d');
-    g.setTransform(ratio, 0, 0, ratio, 0, 0);
-    g.fillStyle = '#ffffff';
-    g.fillRect(0, 0, this.width, this.height);
-    if (!this.scene || !this.view) {
-      canvas.dataset.state = 'empty';
-      return;
-    }
-    const material = this.scene.material;
-    if (material && material.polygon.length > 2) {
-      g.beginPath();
-      if (material.inside) g.rect(0, 0, this.width, this.height); // a pocket: material all round
-      material.polygon.forEach((p, i) => {
-        const [x, y] = this.toScreen(p);
-        if (i === 0) g.moveTo(x, y); else g.lineTo(x, y);
-      });
-      g.closePath();
-      g.fillStyle = COLOUR.material;
-      g.fill('evenodd');
-      g.strokeStyle = COLOUR.contour;
-      g.lineWidth = 2;
-      g.stroke();
-    }
-    let segments = 0;
-    for (const line of this.scene.lines) {
-      if (line.points.length < 2) continue;
-      g.strokeStyle = line.colour;
-      g.lineWidth = line.width || 2;
-      g.setLineDash(line.dash || []);
-      g.beginPath();
-      line.points.forEach((p, i) => {
-        const [x, y] = this.toScreen(p);
-        if (i === 0) g.moveTo(x, y); else { g.lineTo(x, y); segments++; }
-      });
-      g.stroke();
-    }
-    g.setLineDash([]);
-    for (const mark of this.scene.marks) {
-      const [x, y] = this.toScreen(mark.at);
-      g.beginPath();
-      g.arc(x, y, mark.size || 5, 0, 2 * Math.PI);
-      if (mark.ring) {
-        g.strokeStyle = mark.colour;
-        g.lineWidth = 2.5;
-        g.stroke();
-      } else {
-        g.fillStyle = mark.colour;
-        g.fill();
-      }
-    }
-    this.drawLegend(g);
-    this.drawScale(g);
-    canvas.dataset.state = 'drawn';
-    canvas.dataset.segments = String(segments);
-    canvas.dataset.scale = this.view.scale.toFixed(3);
-  }
-
-  drawLegend(g) {
-    g.font = '15px sans-serif';
-    let y = 22;
-    for (const [label, colour, dash] of this.scene.legend || []) {
-      g.strokeStyle = colour;
-      g.lineWidth = 4;
-      g.setLineDash(dash || []);
-      g.beginPath();
-      g.moveTo(12, y - 5);
-      g.lineTo(34, y - 5);
-      g.stroke();
-      g.setLineDash([]);
-      g.fillStyle = '#1d2327';
-      g.fillText(label, 42, y);
-      y += 21;
-    }
-  }
-
-  // A scale bar of a round length at the bottom right.
-  drawScale(g) {
-    const target = 120 / this.view.scale;
-    const power = 10 ** Math.floor(Math.log10(target));
-    const length = [1, 2, 5, 10].map((k) => k * power).filter((l) => l <= target).pop() || power;
-    const pixels = length * this.view.scale;
-    const x = this.width - 20 - pixels;
-    const y = this.height - 20;
-    g.strokeStyle = '#1d2327';
-    g.lineWidth = 3;
-    g.beginPath();
-    g.moveTo(x, y);
-    g.lineTo(x + pixels, y);
-    g.stroke();
-    g.fillStyle = '#1d2327';
-    g.font = '14px sans-serif';
-    g.fillText(`${length} mm`, x, y - 7);
-  }
-}
 
 // The lines of one layer's moves, one polyline per run of moves of the same kind.
 function layerLines(layer, start) {
@@ -308,7 +129,7 @@ function layerLines(layer, start) {
     const to = [step.to[0], step.to[1]];
     if (!current || current.kind !== step.kind) {
       const [colour, width, dash] = style[step.kind] || style.cut;
-      current = { kind: step.kind, colour, width, dash, points: here ? [here] : [] };
+      current = { kind: step.kind, colour, width, dash, arrows: step.kind === 'cut', points: here ? [here] : [] };
       lines.push(current);
     }
     current.points.push(to);
@@ -402,7 +223,7 @@ function summaryItems(answer) {
 
 // Shows a contour answer in `container`: layer selector, plot, corner table, summary, warnings.
 // Used by the form and by job results. Returns the canvas.
-export function contourResult(container, answer) {
+export function contourResult(container, answer, { program } = {}) {
   container.replaceChildren();
   const bar = document.createElement('div');
   bar.className = 'actions layer-bar';
@@ -455,6 +276,22 @@ export function contourResult(container, answer) {
   showSummary(summary, summaryItems(answer));
   warnings.replaceChildren(...warningMessages(answer.warnings));
   container.append(cornerTable(answer, plot));
+  if (program) {
+    // The timeline walks the program; the plot follows it from layer to layer.
+    const radius = answer.tool?.radius || 0;
+    const timeline = new Timeline(bar.parentElement, program, {
+      onMove: (move) => {
+        const [x, y, z] = move.position;
+        const layer = answer.layers.findIndex((l) => Math.abs(l.z - z) < 1e-6);
+        if (layer >= 0 && String(layer) !== select.value) {
+          select.value = String(layer);
+          show(layer, true);
+        }
+        plot.setTool([x, y], radius);
+      },
+    });
+    canvas.after(timeline.root);
+  }
   return canvas;
 }
 
@@ -488,8 +325,7 @@ export const contourView = {
       try {
         return contourRequest(form);
       } catch (bad) {
-        form.elements.points.classList.add('invalid');
-        messages.replaceChildren(message('error', `Points: ${bad.error}`));
+        showProblem(messages, form, { status: 400, title: 'Bad input', errors: [{ path: 'contour', message: bad.error }] });
         return null;
       }
     };
@@ -503,7 +339,14 @@ export const contourView = {
         computed(messages, result);
         markComputed(form);
         clearProblem(form);
-        contourResult(result, answer).id = 'contour-plot';
+        let program = null;
+        try {
+          program = await programOf('/api/v1/contour', body, gcodeQuery(form));
+        } catch (refused) {
+          messages.append(message('error', `No G-code for this path. ${sentence(refused.detail || refused.title)}`, refused.code));
+        }
+        root.querySelector('#contour-gcode').disabled = !program;
+        contourResult(result, answer, { program }).id = 'contour-plot';
       } catch (problem) {
         showProblem(messages, form, problem);
         markContour(form, messages, problem);

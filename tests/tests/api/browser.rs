@@ -52,6 +52,14 @@ async fn deburr_page_plots_the_sample_job() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+async fn segment_page_cuts_the_sample_and_uses_a_registered_machine() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "segment", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert_eq!(result["segments"], 472, "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
 async fn workbench_keeps_state_honours_the_machine_and_fits_the_window() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "workbench", &[]) else { return };
