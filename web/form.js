@@ -380,3 +380,39 @@ export function keepForm(view, form, { onReset, more } = {}) {
 export function markComputed(form) {
   form.dispatchEvent(new Event('kerf:computed'));
 }
+
+// ---------------------------------------------------------------- confirmation
+
+// A button that asks before it acts: "Delete" becomes "Delete T3? [Yes, delete] [Cancel]".
+export function confirmButton(text, question, action) {
+  const box = document.createElement('span');
+  box.className = 'confirm';
+  const make = (label, className) => {
+    const b = document.createElement('button');
+    b.type = 'button';
+    b.className = className;
+    b.textContent = label;
+    return b;
+  };
+  const ask = make(text, 'secondary small');
+  const prompt = document.createElement('span');
+  prompt.setAttribute('role', 'group');
+  prompt.setAttribute('aria-label', question);
+  const yes = make(`Yes, ${text.toLowerCase()}`, 'danger small');
+  const no = make('Cancel', 'secondary small');
+  prompt.append(`${question} `, yes, ' ', no);
+  prompt.hidden = true;
+  ask.addEventListener('click', () => {
+    ask.hidden = true;
+    prompt.hidden = false;
+    no.focus();
+  });
+  no.addEventListener('click', () => {
+    prompt.hidden = true;
+    ask.hidden = false;
+    ask.focus();
+  });
+  yes.addEventListener('click', action);
+  box.append(ask, prompt);
+  return box;
+}

@@ -186,6 +186,22 @@ const scenarios = {
       throw new Error('load example did not restore the sample');
     }
 
+    // Tools: save one by diameter, edit it, delete it only after confirming.
+    await page.click('#tabs a[data-view="tools"]');
+    await page.fill('#tool-form input[name="number"]', '12');
+    await page.fill('#tool-form input[name="size"]', '8');
+    await page.fill('#tool-form input[name="neck_radius"]', '2.5');
+    await page.click('#tool-save');
+    await page.waitForSelector('#tool-rows tr[data-tool="12"]', { timeout: 15000 });
+    const stored = await page.evaluate(async () => (await (await fetch('/api/v1/tools/12')).json()));
+    if (stored.radius !== 4 || stored.neck_radius !== 2.5) throw new Error(`tool by diameter: ${JSON.stringify(stored)}`);
+    await page.click('#tool-rows tr[data-tool="12"] button:has-text("Edit")');
+    if (await page.inputValue('#tool-form input[name="size"]') !== '8') throw new Error('edit did not fill the form');
+    await page.click('#tool-rows tr[data-tool="12"] button:has-text("Delete")');
+    if (!(await page.$('#tool-rows tr[data-tool="12"]'))) throw new Error('deleted without asking');
+    await page.click('#tool-rows tr[data-tool="12"] button:has-text("Yes, delete")');
+    await page.waitForSelector('#tool-rows tr[data-tool="12"]', { state: 'detached', timeout: 15000 });
+
     // No sideways scrolling, with the deburr scene drawn, at three sizes.
     await page.goto(`${base}/#/deburr`);
     await page.click('#deburr-compute');
@@ -263,6 +279,7 @@ const scenarios = {
     await page.click('#tabs a[data-view="machines"]');
     await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { timeout: 15000 });
     await page.click('#machine-rows tr[data-machine="hsc-page"] button:has-text("Delete")');
+    await page.click('#machine-rows tr[data-machine="hsc-page"] button:has-text("Yes, delete")');
     await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { state: 'detached', timeout: 15000 });
     return { segments, inked, chartInked, lengthsInked, machineBlocks };
   },
