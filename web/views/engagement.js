@@ -29,7 +29,7 @@ const FORM = `
       <label>Holes <textarea name="stock_holes" rows="2" data-field="stock.holes" spellcheck="false" placeholder="x y per line; blank line between holes"></textarea></label>
     </fieldset>
     <fieldset><legend>Tool-centre paths</legend>
-      <p class="hint">Points "x y" per line (feed moves), or JSON: <code>[[x, y], ...]</code> or <code>{"start": [x, y], "segments": [{"type": "arc", "to": [x, y], "center": [x, y], "dir": "ccw"}]}</code>.</p>
+      <p class="hint">Points "x y" per line (feed moves), a G-code program (pasted or opened; its XY moves), or JSON: <code>[[x, y], ...]</code> or <code>{"start": [x, y], "segments": [{"type": "arc", "to": [x, y], "center": [x, y], "dir": "ccw"}]}</code>.</p>
       <div id="engagement-paths"></div>
       <div class="actions"><button class="secondary" type="button" id="engagement-add-path">Add path</button></div>
     </fieldset>
@@ -82,6 +82,11 @@ class InputError {
 }
 
 // "x y" per line (or "x, y"), or JSON. Returns the JSON value or a list of points.
+// Whether a path box holds a G-code program (words like G1, X10) rather than "x y" lines.
+function isGcode(text) {
+  return /^\s*%|(^|\s)[GXYNO]\s*[-+]?\d/im.test(text) && !/^\s*[[{]/.test(text);
+}
+
 function parsePoints(text, field) {
   const trimmed = text.trim();
   if (trimmed.startsWith('[') || trimmed.startsWith('{')) {
@@ -132,7 +137,8 @@ export function engagementRequest(form) {
   const body = { tool, stock };
   const paths = boxes.map((box, index) => {
     const field = boxes.length > 1 ? `paths[${index}].path` : 'path';
-    return { name: box.querySelector('input').value.trim() || undefined, path: parsePoints(box.querySelector('textarea').value, field) };
+    const text = box.querySelector('textarea').value;
+    return { name: box.querySelector('input').value.trim() || undefined, path: isGcode(text) ? { gcode: text } : parsePoints(text, field) };
   });
   if (paths.length === 1) body.path = paths[0].path;
   else body.paths = paths;
@@ -172,8 +178,17 @@ function addPath(form, name = '', text = '') {
   const box = document.createElement('div');
   box.className = 'engagement-path';
   box.innerHTML = `<label>Name <input type="text"></label>
-    <label>Points <textarea rows="4" spellcheck="false"></textarea></label>
-    <div class="actions"><button class="secondary" type="button">Remove</button></div>`;
+    <label>Points or G-code <textarea rows="4" spellcheck="false"></textarea></label>
+    <div class="actions"><label class="pick secondary">Open a G-code file<input type="file" accept=".nc,.ngc,.tap,.gcode,.cnc,.txt"></label>
+      <button class="secondary" type="button">Remove</button></div>`;
+  box.querySelector('input[type="file"]').addEventListener('change', async (event) => {
+    const file = event.target.files[0];
+    if (!file) return;
+    box.querySelector('textarea').value = await file.text();
+    if (!box.querySelector('input[type="text"]').value) box.querySelector('input[type="text"]').value = file.name;
+    event.target.value = '';
+    form.dispatchEvent(new Event('input'));
+  });
   box.querySelector('input').value = name;
   box.querySelector('textarea').value = text;
   box.querySelector('button').addEventListener('click', () => {
@@ -859,7 +874,10 @@ function renderColumn(column, result, answer, axis) {
 
 // Shows an engagement answer in `container`: one column per candidate path, side by side.
 // Used by the form and by job results.
-export function engagementResult(container, answer) {
+// Shows an engagement answer in `container`: one candidate path at a time, chosen with tabs that
+// name each path's best flute count; the charts take the width of the result column.
+// `onSelect(index)` hears which candidate is shown (the form's G-code choice follows it).
+export function engagementResult(container, answer, { onSelect } = {}) {
   container.replaceChildren();
   const candidates = answer.candidates || [answer];
   const controls = document.createElement('div');
@@ -867,20 +885,54 @@ export function engagementResult(container, answer) {
   const axis = document.createElement('select');
   axis.setAttribute('aria-label', 'x axis');
   axis.append(new Option('x axis: path length', 'length'), new Option('x axis: time', 'time'));
-  controls.append(axis);
+  const tabs = document.createElement('div');
+  tabs.setAttribute('role', 'tablist');
+  tabs.setAttribute('aria-label', 'Candidate paths');
+  tabs.className = 'tabs';
+  controls.append(tabs, axis);
   const columns = document.createElement('div');
   columns.className = 'candidates';
-  columns.style.gridTemplateColumns = `repeat(${candidates.length}, minmax(320px, 1fr))`;
   container.append(controls, columns);
-  const cells = candidates.map(() => {
+  const id = `candidate-${Math.random().toString(36).slice(2, 8)}`;
+  const cells = candidates.map((result, i) => {
     const column = document.createElement('div');
     column.className = 'candidate';
+    column.id = `${id}-${i}`;
+    column.setAttribute('role', 'tabpanel');
+    const tab = document.createElement('button');
+    tab.type = 'button';
+    tab.setAttribute('role', 'tab');
+    tab.setAttribute('aria-controls', column.id);
+    const best = result.recommended?.[0];
+    tab.textContent = `${result.name || `path ${i}`}${best ? ` · best ${best} flutes` : ' · no flute count fits'}`;
+    tab.addEventListener('click', () => select(i));
+    tab.addEventListener('keydown', (e) => {
+      const step = { ArrowRight: 1, ArrowLeft: -1 }[e.key];
+      if (!step) return;
+      e.preventDefault();
+      select((i + step + candidates.length) % candidates.length);
+      tabs.children[(i + step + candidates.length) % candidates.length].focus();
+    });
+    tabs.append(tab);
     columns.append(column);
     return column;
   });
+  let shown = 0;
+  const select = (index) => {
+    shown = index;
+    cells.forEach((cell, i) => {
+      cell.hidden = i !== index;
+      tabs.children[i].setAttribute('aria-selected', String(i === index));
+      tabs.children[i].tabIndex = i === index ? 0 : -1;
+    });
+    // Drawn again now that it has its width.
+    renderColumn(cells[index], candidates[index], answer, axis.value);
+    onSelect?.(index);
+  };
   const render = () => candidates.forEach((result, i) => renderColumn(cells[i], result, answer, axis.value));
   axis.addEventListener('change', render);
   render();
+  select(shown);
   return cells;
 }
 
@@ -922,7 +974,7 @@ export const engagementView = {
         computed(messages, result);
         markComputed(form);
         clearProblem(form);
-        engagementResult(result, answer);
+        engagementResult(result, answer, { onSelect: (i) => { form.elements.candidate.value = String(i); } });
         result.dataset.state = 'drawn';
       } catch (problem) {
         fail(problem);
