@@ -632,14 +632,13 @@ export class Scene3D {
   }
 
   // A see-through solid (BufferGeometry in machine coordinates, or with `matrix`).
-  solid(name, geometry, { colour = '#8fa3b5', opacity = 0.25, legend, matrix } = {}) {
+  solid(name, geometry, { colour = '#8fa3b5', opacity = 0.25, legend, matrix, edges = true } = {}) {
     if (!this.scene) return null;
     const mesh = new THREE.Mesh(geometry, new THREE.MeshStandardMaterial({
       color: colour, transparent: true, opacity, side: THREE.DoubleSide, depthWrite: false, roughness: 0.8,
     }));
     if (matrix) mesh.applyMatrix4(matrix);
-    const edges = new THREE.LineSegments(new THREE.EdgesGeometry(geometry, 30), new THREE.LineBasicMaterial({ color: colour, transparent: true, opacity: Math.min(1, opacity * 2.5) }));
-    mesh.add(edges);
+    if (edges) mesh.add(new THREE.LineSegments(new THREE.EdgesGeometry(geometry, 30), new THREE.LineBasicMaterial({ color: colour, transparent: true, opacity: Math.min(1, opacity * 2.5) })));
     return this.add(name, mesh, legend, colour);
   }
 

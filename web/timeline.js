@@ -118,6 +118,14 @@ export class Timeline {
     this.onMove(move);
   }
 
+  // Moves the cursor to the move on program line `number` (1-based), or the last one before it.
+  goToLine(number) {
+    let found = -1;
+    this.moves.forEach((move, i) => { if (move.line <= number - 1) found = i; });
+    if (found >= 0) this.go(found);
+    this.items[number - 1]?.scrollIntoView({ block: 'nearest' });
+  }
+
   toggle() {
     if (this.timer) {
       clearInterval(this.timer);

@@ -417,6 +417,15 @@ const scenarios = {
     if (lines.length < 10 || !lines.every((l) => l > 6)) throw new Error(`worst passes: ${lines}`);
     if (!/441 of 441 predicted/.test(summary)) throw new Error(`summary: ${summary}`);
 
+    // A worst pass selects its line in the listing and puts the tool there.
+    await page.click('#predict-result table.worst tr[data-line]:nth-child(3)');
+    const wanted = Number(await page.getAttribute('#predict-result table.worst tr[aria-selected="true"]', 'data-line'));
+    const currentLine = Number(await page.getAttribute('#predict-result .timeline', 'data-line'));
+    const tool = await page.getAttribute('#predict-plot', 'data-tool');
+    if (currentLine !== wanted || !tool) throw new Error(`worst pass on line ${wanted}, listing at ${currentLine}, tool ${tool}`);
+    const scene = (await page.getAttribute('#predict-plot', 'data-objects')).split(' ');
+    if (!scene.includes('stock') || !scene.includes('tool')) throw new Error(`predict scene: ${scene}`);
+
     // The corrected program downloads with the input's lines.
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#predict-gcode')]);
     const program = await (await import('node:fs/promises')).readFile(await download.path(), 'utf8');

@@ -6,6 +6,7 @@
 import { api } from '/api.js';
 import { clearProblem, computed, computing, download, keepForm, loadTools, markComputed, message, number, numeric, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
 import { Scene3D, THREE, css, diverging } from '/plot.js';
+import { Timeline } from '/timeline.js';
 
 // The sample: a raster finishing program over a gentle dome (20 × 20 mm, 2 mm high) with an R3
 // ball, and the dome plus a 0.2 mm allowance as a height grid (as examples/predict-raster.toml).
@@ -234,6 +235,30 @@ function microns(e) {
   return Number.isFinite(e) ? (e * 1000).toFixed(1) : '–';
 }
 
+// A height-grid stock as a see-through surface (heights: a row per y, along x).
+function gridSurface(scene, stock) {
+  const rows = stock.heights;
+  const [x0, y0] = stock.origin;
+  const step = stock.spacing;
+  if (!rows?.length || !rows[0]?.length || !(step > 0) || ![x0, y0].every(Number.isFinite)) return;
+  const nx = rows[0].length;
+  const ny = rows.length;
+  const positions = [];
+  for (let j = 0; j < ny; j++) for (let i = 0; i < nx; i++) positions.push(x0 + i * step, y0 + j * step, rows[j][i] ?? 0);
+  const index = [];
+  for (let j = 0; j + 1 < ny; j++) {
+    for (let i = 0; i + 1 < nx; i++) {
+      const a = j * nx + i;
+      index.push(a, a + 1, a + nx, a + 1, a + nx + 1, a + nx);
+    }
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.Float32BufferAttribute(positions, 3));
+  geometry.setIndex(index);
+  geometry.computeVertexNormals();
+  scene.solid('stock', geometry, { legend: 'stock (height grid)', opacity: 0.3, colour: '#8fa3b5', edges: false });
+}
+
 // The programmed path as runs of contiguous passes: each pass ends at its programmed end point
 // (corrected − correction); a pass starts a new run when lines were skipped (a rapid between).
 function runs(passes) {
@@ -342,6 +367,7 @@ export function predictResult(container, answer, request) {
   container.replaceChildren();
   const warnings = document.createElement('div');
   const sceneBox = document.createElement('div');
+  const timelineBox = document.createElement('div');
   const scale = document.createElement('canvas');
   scale.className = 'scale';
   scale.setAttribute('aria-label', 'Colour scale of the predicted error');
@@ -357,7 +383,7 @@ export function predictResult(container, answer, request) {
   worstTitle.textContent = 'Worst passes';
   const worst = document.createElement('table');
   worst.className = 'worst';
-  container.append(warnings, sceneBox, scale, caption, summaryBox, histogram, worstTitle, worst);
+  container.append(warnings, sceneBox, scale, caption, timelineBox, summaryBox, histogram, worstTitle, worst);
 
   const errors = answer.passes.map((p) => p.error).filter(Number.isFinite);
   const low = errors.length ? Math.min(...errors) : 0;
@@ -375,8 +401,15 @@ export function predictResult(container, answer, request) {
     if (run.points.length > 1) scene.path('path', run.points, { colours, legend: i === 0 ? 'path, coloured by error' : undefined, colour: '#9aa4ad' });
     else scene.dots('path', run.points, { colour: colours[0] });
   });
+  if (request?.stock?.kind === 'grid') gridSurface(scene, request.stock);
   scene.tool({ radius: answer.tool.radius || 1 });
   scene.finish();
+  // With the program (the form view), the timeline walks it and a worst pass goes to its line.
+  const lift = request?.reference === 'centre' ? 0 : answer.tool.radius;
+  const program = request?.path?.program;
+  const timeline = program ? new Timeline(timelineBox, program, {
+    onMove: (move) => scene.moveTool([move.position[0], move.position[1], move.position[2] + lift]),
+  }) : null;
   const end = (pass) => pass.corrected.map((c, k) => c - pass.correction[k]);
   const redraw = () => {
     drawScale(scale, limit);
@@ -414,7 +447,8 @@ export function predictResult(container, answer, request) {
     const select = () => {
       worst.querySelectorAll('[aria-selected]').forEach((r) => r.removeAttribute('aria-selected'));
       tr.setAttribute('aria-selected', 'true');
-      if (pass.corrected) scene.moveTool(end(pass).map((v, k) => v + (k === 2 && request?.reference !== 'centre' ? answer.tool.radius : 0)));
+      if (timeline && w.line !== undefined) timeline.goToLine(w.line);
+      else if (pass.corrected) scene.moveTool(end(pass).map((v, k) => v + (k === 2 ? lift : 0)));
     };
     tr.addEventListener('click', select);
     tr.addEventListener('keydown', (e) => { if (e.key === 'Enter' || e.key === ' ') { e.preventDefault(); select(); } });
