@@ -92,6 +92,13 @@ export class PlanPlot {
     this.draw();
   }
 
+  // Marks the point `at` (the timeline's position), or nothing for null.
+  setMarker(at) {
+    this.marker = at;
+    this.canvas.dataset.tool = at ? at.map((v) => v.toFixed(3)).join(' ') : '';
+    this.draw();
+  }
+
   project(p) {
     const scale = this.scale * this.zoom;
     return [this.width / 2 + this.panX + (p[0] - this.mid[0]) * scale, this.height / 2 + this.shiftY + this.panY - (p[1] - this.mid[1]) * scale];
@@ -142,6 +149,16 @@ export class PlanPlot {
           if (x > -size && y > -size && x < width + size && y < height + size) g.fillRect(x - size / 2, y - size / 2, size, size);
         }
       }
+    }
+    if (this.marker) {
+      const [x, y] = this.project(this.marker);
+      g.beginPath();
+      g.arc(x, y, 7, 0, 2 * Math.PI);
+      g.fillStyle = 'rgba(196, 127, 23, 0.4)';
+      g.fill();
+      g.strokeStyle = '#c47f17';
+      g.lineWidth = 2.5;
+      g.stroke();
     }
     this.drawScale(g);
     legend(g, this.series);

@@ -1,7 +1,8 @@
 // Segment view: cut a curve into G01 blocks by the control's block time (api.md, Segment;
 // chord.md). A form for the curve and the rule, the curve with its blocks, the chord error and the
 // block length along the curve, the rule side by side with a fixed tolerance, G-code download.
-import { api } from '/api.js';
+import { api, program as programOf, sentence } from '/api.js';
+import { Timeline } from '/timeline.js';
 import { clearProblem, computed, computing, download, keepForm, loadMachines, machineFields, machineNote, markComputed, message, number, numeric, showProblem, showSummary, value, warningMessages } from '/form.js';
 import { PlanPlot, drawChart } from '/plot.js';
 
@@ -58,6 +59,12 @@ const FORM = `
     <div id="segment-result"></div>
   </section>
 </div>`;
+
+// The G-code query: the chosen dialect, else the machine's.
+function segmentQuery(form) {
+  const dialect = value(form, 'dialect');
+  return `?format=gcode${dialect ? `&dialect=${dialect}` : ''}`;
+}
 
 // "x y [z]" per line (commas or spaces), or a JSON array.
 function pointList(text) {
@@ -255,7 +262,7 @@ function heading(text) {
 // Shows a segment answer in `container`: summary, comparison, plan of the curve and its blocks,
 // chord error and block length along the curve, warnings. `request` (the form view's) adds the
 // target curve to the plan. Used by the form and by job results.
-export function segmentResult(container, answer, request, machine) {
+export function segmentResult(container, answer, request, machine, program) {
   container.replaceChildren();
   const warnings = document.createElement('div');
   const summaryBox = document.createElement('div');
@@ -277,7 +284,13 @@ export function segmentResult(container, answer, request, machine) {
   if (request?.curve) series.push({ label: 'target curve', points: curvePoints(request.curve), colour: '#9aa5ae', width: 1 });
   series.push({ label: `${answer.blocks} blocks`, points, colour: '#0b63b6', width: 2, marks: points.length > 4000 ? 0 : 4, count: true });
   if (short.length) series.push({ label: `shorter than one block time: ${short.length} (${answer.short_end_blocks} of them remainders at ends)`, points, segments: short, colour: '#b3261e', width: 3.5 });
-  new PlanPlot(plan).setSeries(series);
+  const planPlot = new PlanPlot(plan);
+  planPlot.setSeries(series);
+  if (program) {
+    // The timeline walks the program block by block: feed, block length and time per block.
+    const timeline = new Timeline(container, program, { onMove: (move) => planPlot.setMarker(move.position) });
+    hint.after(timeline.root);
+  }
 
   // Chord error per window as steps along s (each window until the next one starts: windows
   // overlap where a window's last chord runs past its end), the rule's own value, the bounds and
@@ -354,7 +367,14 @@ export const segmentView = {
         computed(messages, result);
         markComputed(form);
         clearProblem(form);
-        segmentResult(result, answer, body, form.elements.machine.machines?.get(body.machine)).id = 'segment-plot';
+        let program = null;
+        try {
+          program = await programOf('/api/v1/segment', body, segmentQuery(form));
+        } catch (refused) {
+          messages.append(message('error', `No G-code for these blocks. ${sentence(refused.detail || refused.title)}`, refused.code));
+        }
+        root.querySelector('#segment-gcode').disabled = !program;
+        segmentResult(result, answer, body, form.elements.machine.machines?.get(body.machine), program).id = 'segment-plot';
         const charts = result.querySelectorAll('canvas.chart');
         charts[0].id = 'segment-chart';
         charts[1].id = 'segment-lengths';
@@ -367,7 +387,7 @@ export const segmentView = {
       const body = request();
       if (!body) return;
       const dialect = value(form, 'dialect');
-      const query = `?format=gcode${dialect ? `&dialect=${dialect}` : ''}`;
+      const query = segmentQuery(form);
       try {
         const program = await api('POST', `/api/v1/segment${query}`, body, 'text/x-gcode');
         download(`segment-${dialect || body.machine || 'fanuc'}.nc`, program);
