@@ -800,7 +800,7 @@ export class Scene3D {
     if (!width || !height) return;
     const size = this.renderer.getSize(new THREE.Vector2());
     if (size.x !== width || size.y !== height) this.renderer.setSize(width, height, false);
-    const r = (this.radius || 1) * 1.1;
+    const r = (this.radius || 1) * 1.2;
     const aspect = width / height;
     Object.assign(this.camera, aspect > 1
       ? { left: -r * aspect, right: r * aspect, top: r, bottom: -r }

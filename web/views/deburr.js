@@ -134,8 +134,10 @@ function addWorkpiece(scene, request) {
   wall.absarc(f - a, b, r, Math.PI / 2, Math.PI, false);
   wall.absarc(f - a, -b, r, Math.PI, 1.5 * Math.PI, false);
   wall.absarc(f + a, -b, r, 1.5 * Math.PI, 2 * Math.PI, false);
-  const depth = outer * 1.15;
-  const hollow = new THREE.ExtrudeGeometry(wall, { depth, bevelEnabled: false, curveSegments: 48 });
+  // Through the wall only: from just inside the bore to just outside the outer surface or face.
+  const [from, to] = [inner * 0.8, outer * 1.1];
+  const hollow = new THREE.ExtrudeGeometry(wall, { depth: to - from, bevelEnabled: false, curveSegments: 48 });
+  hollow.translate(0, 0, from);
   scene.solid('hole', hollow, { colour: '#37474f', opacity: 0.22, matrix, legend: 'hole wall' });
 }
 
