@@ -295,16 +295,14 @@ export function contourResult(container, answer, { program } = {}) {
   return canvas;
 }
 
-// Marks the points box when an error names the contour or one of its points.
+// When an error names one point of the contour, says which line of the points box it is.
 function markContour(form, messages, problem) {
   const paths = (problem.errors || []).map((e) => e.path);
   const hit = paths.map((p) => /^contour(?:\[(\d+)\])?/.exec(p)).find(Boolean);
   if (!hit) return;
-  const box = form.elements.points;
-  box.classList.add('invalid');
   if (hit[1] !== undefined) {
     const index = Number(hit[1]);
-    messages.append(message('error', `See contour[${index}]: point ${index + 1} of the list (comments and blank lines not counted).`));
+    messages.append(message('error', `It is point ${index + 1} of the list (comments and blank lines not counted).`, `contour[${index}]`));
   }
 }
 
@@ -321,7 +319,7 @@ export const contourView = {
     loadMachines(form.elements.machine);
     sync();
     const request = () => {
-      form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+      clearProblem(form);
       try {
         return contourRequest(form);
       } catch (bad) {

@@ -161,19 +161,6 @@ export function engagementRequest(form) {
   return body;
 }
 
-// Marks inputs whose data-field is the error's path or a parent of it (`stock.polygon` for
-// `stock.polygon[3][0]`).
-function markFields(form, problem) {
-  for (const error of problem.errors || []) {
-    for (const element of form.querySelectorAll('[data-field]')) {
-      const field = element.dataset.field;
-      if (error.path === field || error.path.startsWith(`${field}.`) || error.path.startsWith(`${field}[`)) {
-        element.classList.add('invalid');
-      }
-    }
-  }
-}
-
 function addPath(form, name = '', text = '') {
   const box = document.createElement('div');
   box.className = 'engagement-path';
@@ -953,7 +940,6 @@ export const engagementView = {
     syncVisibility(form);
     const fail = (problem) => {
       showProblem(messages, form, problem);
-      markFields(form, problem);
     };
     const fillCandidates = () => {
       const select = form.elements.candidate;
@@ -965,7 +951,7 @@ export const engagementView = {
     form.addEventListener('input', fillCandidates);
     form.addEventListener('submit', async (event) => {
       event.preventDefault();
-      form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+      clearProblem(form);
       fillCandidates();
       try {
         const body = engagementRequest(form);
@@ -981,7 +967,7 @@ export const engagementView = {
       }
     });
     root.querySelector('#engagement-gcode').addEventListener('click', async () => {
-      form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+      clearProblem(form);
       const candidate = value(form, 'candidate') || '0';
       try {
         const program = await api('POST', `/api/v1/engagement${gcodeQuery(form)}&candidate=${candidate}`, engagementRequest(form), 'text/x-gcode');

@@ -1,7 +1,7 @@
 // Machines view: the controller profiles (api.md, Machines): list, register or replace, delete,
 // and the block time from a saturation test (chord.md §2.1, Eq. 1).
 import { api } from '/api.js';
-import { confirmButton, message, showProblem } from '/form.js';
+import { clearProblem, confirmButton, message, showProblem } from '/form.js';
 
 const FORM = `
 <div class="layout">
@@ -100,7 +100,7 @@ export const machinesView = {
       };
       try {
         await api('PUT', `/api/v1/machines/${encodeURIComponent(name || ' ')}`, machine);
-        form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+        clearProblem(form);
         messages.replaceChildren(message('ok', `Machine ${name} saved.`));
         refresh(root);
       } catch (problem) {

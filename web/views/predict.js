@@ -204,14 +204,9 @@ function syncVisibility(form) {
 }
 
 
-// Marks the inputs of every error path, also nested ones (`tool.shape_error[2].error` marks the
-// table), and puts the cursor on the program line a G-code error names.
+// Puts the cursor on the program line a G-code error names (showProblem marks the fields).
 function markProblem(form, problem) {
   for (const { path } of problem.errors || []) {
-    form.querySelectorAll('[data-field]').forEach((e) => {
-      const field = e.dataset.field;
-      if (path === field || path.startsWith(`${field}.`) || path.startsWith(`${field}[`)) e.classList.add('invalid');
-    });
     const line = /line (\d+)/.exec(problem.detail || '');
     if (path === 'path.program' && line) {
       const area = form.elements.program;
@@ -485,7 +480,7 @@ export const predictView = {
       const file = event.target.files[0];
       if (file) form.elements.program.value = await file.text();
     });
-    const clear = () => form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+    const clear = () => clearProblem(form);
     const fail = (problem) => {
       showProblem(messages, form, problem);
       markProblem(form, problem);

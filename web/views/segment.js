@@ -123,16 +123,6 @@ function syncVisibility(form) {
 }
 
 
-// Marks inputs whose data-field is a prefix of an error path (curve.points[3] → curve.points).
-function highlightPrefixes(form, problem) {
-  for (const { path } of problem.errors || []) {
-    form.querySelectorAll('[data-field]').forEach((e) => {
-      const field = e.dataset.field;
-      if (path === field || path.startsWith(`${field}[`) || path.startsWith(`${field}.`)) e.classList.add('invalid');
-    });
-  }
-}
-
 // Points of the target curve for the plot, when the request is known (the form view).
 function curvePoints(curve) {
   const steps = 720;
@@ -349,7 +339,7 @@ export const segmentView = {
     loadMachines(form.elements.machine, 'none (values below)');
     machineFields(form, { feed: 'max_feed', block_time_ms: 'block_time_ms', margin: 'margin', min_chord_error: 'min_chord_error' });
     const request = () => {
-      form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+      clearProblem(form);
       try {
         return segmentRequest(form);
       } catch (error) {
@@ -380,7 +370,6 @@ export const segmentView = {
         charts[1].id = 'segment-lengths';
       } catch (problem) {
         showProblem(messages, form, problem);
-        highlightPrefixes(form, problem);
       }
     });
     root.querySelector('#segment-gcode').addEventListener('click', async () => {
@@ -393,7 +382,6 @@ export const segmentView = {
         download(`segment-${dialect || body.machine || 'fanuc'}.nc`, program);
       } catch (problem) {
         showProblem(messages, form, problem);
-        highlightPrefixes(form, problem);
       }
     });
     keepForm(id, form);
