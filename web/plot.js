@@ -22,6 +22,24 @@ function sizeCanvas(canvas) {
   return [g, width, height];
 }
 
+// Makes a 2-D plot usable from the keyboard: focusable; arrow keys pan, + and − zoom, 0 fits.
+function keyboard(canvas, { pan, zoom, reset, ready, draw }) {
+  canvas.tabIndex = 0;
+  const label = canvas.getAttribute('aria-label');
+  if (label && !/arrow keys/.test(label)) canvas.setAttribute('aria-label', `${label}. Arrow keys pan, + and − zoom, 0 fits.`);
+  canvas.addEventListener('keydown', (event) => {
+    if (!ready()) return;
+    const step = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, -1], ArrowDown: [0, 1] }[event.key];
+    if (step) pan(...step);
+    else if (event.key === '+' || event.key === '=') zoom(1.25);
+    else if (event.key === '-') zoom(1 / 1.25);
+    else if (event.key === '0') reset();
+    else return;
+    event.preventDefault();
+    draw();
+  });
+}
+
 function legend(g, items, x = 12, y = 20) {
   g.font = FONT;
   for (const item of items) {
@@ -74,6 +92,13 @@ export class PlanPlot {
       this.draw();
     }, { passive: false });
     canvas.addEventListener('dblclick', () => { this.reset(); this.draw(); });
+    keyboard(canvas, {
+      pan: (dx, dy) => { this.panX -= dx * 40; this.panY -= dy * 40; },
+      zoom: (factor) => { this.zoom *= factor; },
+      reset: () => this.reset(),
+      ready: () => this.series.length > 0,
+      draw: () => this.draw(),
+    });
     new ResizeObserver(() => this.draw()).observe(canvas);
   }
 
@@ -322,6 +347,13 @@ export class Plot2D {
       this.draw();
     }, { passive: false });
     canvas.addEventListener('dblclick', () => { this.fit(); this.draw(); });
+    keyboard(canvas, {
+      pan: (dx, dy) => { this.view.cx += dx * 40 / this.view.scale; this.view.cy -= dy * 40 / this.view.scale; },
+      zoom: (factor) => { this.view.scale *= factor; },
+      reset: () => this.fit(),
+      ready: () => Boolean(this.view),
+      draw: () => this.draw(),
+    });
     new ResizeObserver(() => this.draw()).observe(canvas);
   }
 

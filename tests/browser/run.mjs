@@ -270,7 +270,8 @@ const scenarios = {
     await page.selectOption('#segment-form select[name="machine"]', 'hsc-page');
     for (const name of ['feed', 'block_time_ms', 'margin', 'min_chord_error']) await page.fill(`#segment-form input[name="${name}"]`, '');
     await page.click('#segment-compute');
-    await page.waitForSelector('#segment-plot[data-state="drawn"]', { timeout: 15000 });
+    // The earlier result stays on the page: wait for the one that names the machine.
+    await page.waitForFunction(() => /hsc-page/.test(document.querySelector('#segment-result .summary')?.textContent ?? ''), null, { timeout: 15000 });
     const withMachine = await page.textContent('#segment-result .summary');
     if (!/hsc-page/.test(withMachine) || !/12000 mm\/min/.test(withMachine)) throw new Error(`machine not used: ${withMachine}`);
     const machineBlocks = Number(await page.getAttribute('#segment-plot', 'data-segments'));

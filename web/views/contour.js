@@ -6,7 +6,7 @@
 import { api, program as programOf, sentence } from '/api.js';
 import { Timeline } from '/timeline.js';
 import { Plot2D } from '/plot.js';
-import { clearProblem, computed, computing, download, gcodeQuery, keepForm, loadMachines, loadTools, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
+import { clearProblem, computed, computing, download, gcodeQuery, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
 
 // An arrow-shaped island: five protruding corners (a 64° tip among them) and two inside corners.
 const SAMPLE = `# x, y in mm, counter-clockwise; one point a line
@@ -23,19 +23,19 @@ const FORM = `
   <form id="contour-form" novalidate>
     <fieldset><legend>Tool</legend>
       <label>Tool <select name="tool_choice" data-field="tool"></select></label>
-      <label data-inline-tool>Radius, mm <input name="tool_radius" type="number" step="any" value="3" data-field="tool.radius"></label>
+      <label data-inline-tool>Tool radius, mm <input name="tool_radius" type="number" step="any" value="3" data-field="tool.radius"></label>
     </fieldset>
     <fieldset><legend>Contour</legend>
       <label class="stacked">Points <span class="hint">x, y a line; # comments</span>
         <textarea name="points" rows="9" spellcheck="false" data-field="contour"></textarea></label>
       <label>Side <select name="side" data-field="side">
         <option value="outside">outside (island, outer profile)</option><option value="inside">inside (pocket)</option></select></label>
-      <label>Direction <select name="direction" data-field="direction"><option value="climb">climb</option><option value="conventional">conventional</option></select></label>
+      <label>Cutting direction <select name="direction" data-field="direction"><option value="climb">climb</option><option value="conventional">conventional</option></select></label>
     </fieldset>
     <fieldset><legend>Depths</legend>
-      <label>Top Z <input name="top" type="number" step="any" value="0" data-field="depths.top"></label>
-      <label>Bottom Z <input name="bottom" type="number" step="any" value="-9" data-field="depths.bottom"></label>
-      <label>Step <input name="step" type="number" step="any" value="3" data-field="depths.step"></label>
+      <label>Top Z, mm <input name="top" type="number" step="any" value="0" data-field="depths.top"></label>
+      <label>Bottom Z, mm <input name="bottom" type="number" step="any" value="-9" data-field="depths.bottom"></label>
+      <label>Depth per layer, mm <input name="step" type="number" step="any" value="3" data-field="depths.step"></label>
     </fieldset>
     <fieldset><legend>Corners</legend>
       <label>Loop style <select name="loop_style" data-field="corner_loop.style">
@@ -47,8 +47,8 @@ const FORM = `
     </fieldset>
     <fieldset><legend>Feeds</legend>
       <label>Feed, mm/min <input name="feed" type="number" step="any" value="800" data-field="feed"></label>
-      <label>Loop feed <input name="loop_feed" type="number" step="any" value="2000" data-field="loop_feed"></label>
-      <label>Stock allowance <input name="stock_allowance" type="number" step="any" value="0.5" data-field="stock_allowance"></label>
+      <label>Loop feed, mm/min <input name="loop_feed" type="number" step="any" value="2000" data-field="loop_feed"></label>
+      <label>Roughing allowance, mm <input name="stock_allowance" type="number" step="any" value="0.5" data-field="stock_allowance"></label>
       <label>Machine <select name="machine" data-field="machine"></select></label>
       <label>Block time, ms <input name="block_time_ms" type="number" step="any" placeholder="machine's, else off" data-field="block_time_ms"></label>
       <label>Tolerance, mm <input name="tolerance" type="number" step="any" value="0.01" data-field="tolerance"></label>
@@ -317,6 +317,7 @@ export const contourView = {
     form.addEventListener('change', sync);
     loadTools(form.elements.tool_choice, 'inline flat end mill (radius below)').then(sync);
     loadMachines(form.elements.machine);
+    machineFields(form, { block_time_ms: 'block_time_ms' });
     sync();
     const request = () => {
       clearProblem(form);

@@ -18,15 +18,15 @@ const FORM = `
   <form id="engagement-form" novalidate>
     <fieldset><legend>Tool</legend>
       <label>Tool <select name="tool_choice" data-field="tool"></select></label>
-      <label data-inline-tool>Radius, mm <input name="tool_radius" type="number" step="any" value="5" data-field="tool.radius"></label>
+      <label data-inline-tool>Tool radius, mm <input name="tool_radius" type="number" step="any" value="5" data-field="tool.radius"></label>
       <label data-inline-tool>Flutes <input name="tool_flutes" type="number" step="1" value="2" data-field="tool.flutes"></label>
     </fieldset>
     <fieldset><legend>Stock (plan view)</legend>
-      <label>Outline x y <textarea name="stock_polygon" rows="4" data-field="stock.polygon" spellcheck="false">0 0
+      <label>Outline, x y in mm per line <textarea name="stock_polygon" rows="4" data-field="stock.polygon" spellcheck="false">0 0
 60 0
 60 40
 0 40</textarea></label>
-      <label>Holes <textarea name="stock_holes" rows="2" data-field="stock.holes" spellcheck="false" placeholder="x y per line; blank line between holes"></textarea></label>
+      <label>Holes, mm <textarea name="stock_holes" rows="2" data-field="stock.holes" spellcheck="false" placeholder="x y per line; blank line between holes"></textarea></label>
     </fieldset>
     <fieldset><legend>Tool-centre paths</legend>
       <p class="hint">Points "x y" per line (feed moves), a G-code program (pasted or opened; its XY moves), or JSON: <code>[[x, y], ...]</code> or <code>{"start": [x, y], "segments": [{"type": "arc", "to": [x, y], "center": [x, y], "dir": "ccw"}]}</code>.</p>
@@ -36,22 +36,22 @@ const FORM = `
     <fieldset><legend>Cutting</legend>
       <label>Spindle, rpm <input name="spindle_rpm" type="number" step="any" value="3000" data-field="spindle_rpm"></label>
       <label>Feed per tooth, mm <input name="feed_per_tooth" type="number" step="any" value="0.05" data-field="feed_per_tooth"></label>
-      <label>Flute counts <input name="flute_counts" type="text" value="1-8" data-field="flute_counts" title="e.g. 1-8 or 2,3,4"></label>
-      <label>Rotation <select name="spindle_direction" data-field="spindle_direction"><option value="cw">cw (M03)</option><option value="ccw">ccw (M04)</option></select></label>
+      <label>Flute counts to compare <input name="flute_counts" type="text" value="1-8" data-field="flute_counts" title="e.g. 1-8 or 2,3,4"></label>
+      <label>Spindle rotation <select name="spindle_direction" data-field="spindle_direction"><option value="cw">cw (M03)</option><option value="ccw">ccw (M04)</option></select></label>
     </fieldset>
     <fieldset><legend>Limits</legend>
-      <label>Thickness T1, mm <input name="thickness_limit" type="number" step="any" value="0.075" data-field="thickness_limit"></label>
-      <label>Time T2, s <input name="time_limit_s" type="number" step="any" value="20" data-field="time_limit_s"></label>
-      <label>Statistic <select name="representative" data-field="representative"><option value="max">max</option><option value="mean">mean</option><option value="median">median</option></select></label>
+      <label><span>Chip thickness limit, mm <abbr class="symbol" title="T1 in engagement.md">T1</abbr></span> <input name="thickness_limit" type="number" step="any" value="0.075" data-field="thickness_limit"></label>
+      <label><span>Machining time limit, s <abbr class="symbol" title="T2 in engagement.md">T2</abbr></span> <input name="time_limit_s" type="number" step="any" value="20" data-field="time_limit_s"></label>
+      <label>Chip thickness judged by <select name="representative" data-field="representative"><option value="max">largest</option><option value="mean">mean</option><option value="median">median</option></select></label>
     </fieldset>
     <fieldset><legend>Simulation</legend>
-      <label>Engine <select name="engine" data-field="engine"><option value="exact">exact boundary</option><option value="dots">dots (seed)</option></select></label>
-      <label>Step Δs, mm <input name="step" type="number" step="any" placeholder="D/50" data-field="step"></label>
-      <label data-engine="dots">Grid g, mm <input name="grid" type="number" step="any" placeholder="D/200" data-field="grid"></label>
+      <label>Engine <select name="engine" data-field="engine"><option value="exact">exact boundary</option><option value="dots">dot grid (patent method)</option></select></label>
+      <label><span>Step along the path, mm <abbr class="symbol" title="Δs">Δs</abbr></span> <input name="step" type="number" step="any" placeholder="D/50" data-field="step"></label>
+      <label data-engine="dots"><span>Dot spacing, mm <abbr class="symbol" title="g">g</abbr></span> <input name="grid" type="number" step="any" placeholder="D/200" data-field="grid"></label>
     </fieldset>
     <fieldset><legend>G-code and feed plan</legend>
-      <label>Axial depth a_p, mm <input name="axial_depth" type="number" step="any" value="2" data-field="axial_depth"></label>
-      <label>Target chip h*, mm <input name="target_thickness" type="number" step="any" value="0.05" data-field="feed_plan.target_thickness" title="empty: no feed plan, nominal feed"></label>
+      <label><span>Depth of cut, mm <abbr class="symbol" title="axial depth a_p">a_p</abbr></span> <input name="axial_depth" type="number" step="any" value="2" data-field="axial_depth"></label>
+      <label><span>Target chip thickness, mm <abbr class="symbol" title="h*">h*</abbr></span> <input name="target_thickness" type="number" step="any" value="0.05" data-field="feed_plan.target_thickness" title="empty: no feed plan, nominal feed"></label>
       <label>Max feed, mm/min <input name="max_feed" type="number" step="any" value="2000" placeholder="machine's" data-field="feed_plan.max_feed"></label>
       <label>Machine <select name="machine" data-field="machine"></select></label>
     </fieldset>

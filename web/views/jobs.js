@@ -1,6 +1,6 @@
 // Jobs workbench: drop or pick a job file, watch it queue and run, browse past jobs, open a
 // result with the view of its operation, download G-code and JSON (api.md, Jobs).
-import { api } from '/api.js';
+import { api, sentence } from '/api.js';
 import { download, message, showProblem } from '/form.js';
 import { resultView } from '/views.js';
 
@@ -84,6 +84,14 @@ async function refresh(root) {
     for (const job of page.jobs) state.jobs.set(job.id, job);
     if (state.next === null && page.next_before !== undefined) state.next = page.next_before;
     render(root);
+    // The "queued" banner of a job that has finished says how it ended.
+    const banner = root.querySelector('#job-messages .message[data-job]');
+    const watched = banner && state.jobs.get(Number(banner.dataset.job));
+    if (watched && !['queued', 'running'].includes(watched.status)) {
+      const done = watched.status === 'done';
+      const text = `Job #${watched.id} ${done ? 'is done: open it below' : watched.status}${watched.error ? `: ${watched.error}` : ''}.`;
+      root.querySelector('#job-messages').replaceChildren(message(done ? 'ok' : 'error', text));
+    }
     const active = page.jobs.some((j) => j.status === 'queued' || j.status === 'running');
     clearTimeout(state.timer);
     if (active && document.body.contains(root)) state.timer = setTimeout(() => refresh(root), 700);
@@ -129,7 +137,7 @@ async function openJob(id, root) {
         });
         actions.append(gcode);
       } else if (result.gcode_problem) {
-        actions.append(message('warning', `no G-code: ${result.gcode_problem}`));
+        actions.append(message('warning', `No G-code: ${sentence(result.gcode_problem)}`));
       }
       const view = document.createElement('div');
       section.append(heading, actions, view);
@@ -148,9 +156,11 @@ async function submit(file, root) {
   form.append('file', file, file.name);
   try {
     const answer = await api('POST', '/api/v1/jobs', form);
-    messages.replaceChildren(message('warning', answer.reused
-      ? `${file.name}: identical to job #${answer.id}, reusing its result`
-      : `${file.name}: queued as job #${answer.id}`));
+    const banner = message(answer.reused ? 'ok' : 'info', answer.reused
+      ? `${file.name}: identical to job #${answer.id}, reusing its result.`
+      : `${file.name}: queued as job #${answer.id}.`);
+    if (!answer.reused) banner.dataset.job = String(answer.id);
+    messages.replaceChildren(banner);
     await refresh(root);
     if (answer.reused) openJob(answer.id, root);
   } catch (problem) {

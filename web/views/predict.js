@@ -73,16 +73,16 @@ const FORM = `
       <div data-inline-tool>
         <label>Ball radius, mm <input name="radius" type="number" step="any" value="3" data-field="tool.radius"></label>
         <label>Flutes <input name="flutes" type="number" value="2" data-field="tool.flutes"></label>
-        <label>Helix, ° <input name="helix" type="number" step="any" value="30" data-field="tool.helix_deg"></label>
-        <label class="stacked">Shape error δ(θ): angle °, error mm per row<textarea name="shape_error" rows="4" data-field="tool.shape_error" title="one row per contact angle: angle in degrees (0 = tip, 90 = equator), error in mm">0 0.004
+        <label>Helix angle, ° <input name="helix" type="number" step="any" value="30" data-field="tool.helix_deg"></label>
+        <label class="stacked"><span>Shape error: contact angle in ° (0 = tip, 90 = equator) and error in mm, one pair a line <abbr class="symbol" title="δ(θ)">δ(θ)</abbr></span><textarea name="shape_error" rows="4" data-field="tool.shape_error" title="one row per contact angle: angle in degrees (0 = tip, 90 = equator), error in mm">0 0.004
 30 0.005
 60 0.007
 90 0.009</textarea></label>
         <label>Stiffness <select name="stiffness_kind" data-field="tool.stiffness">
           <option value="modal">one mode (X = Y)</option><option value="static">static (X = Y)</option><option value="none">none</option></select></label>
-        <label data-stiffness="modal static">k, N/mm <input name="k" type="number" step="any" value="3000" data-field="tool.stiffness"></label>
-        <label data-stiffness="modal"><span>f<sub>n</sub>, Hz</span> <input name="fn" type="number" step="any" value="1800" data-field="tool.stiffness"></label>
-        <label data-stiffness="modal">Damping ζ <input name="zeta" type="number" step="any" value="0.04" data-field="tool.stiffness"></label>
+        <label data-stiffness="modal static"><span>Stiffness, N/mm <abbr class="symbol" title="k">k</abbr></span> <input name="k" type="number" step="any" value="3000" data-field="tool.stiffness"></label>
+        <label data-stiffness="modal"><span>Natural frequency, Hz <abbr class="symbol" title="f_n">f<sub>n</sub></abbr></span> <input name="fn" type="number" step="any" value="1800" data-field="tool.stiffness"></label>
+        <label data-stiffness="modal"><span>Damping ratio <abbr class="symbol" title="ζ">ζ</abbr></span> <input name="zeta" type="number" step="any" value="0.04" data-field="tool.stiffness"></label>
         <div class="actions"><label class="inline">Save as T <input name="save_number" type="number" min="1" max="9999" value="3" aria-label="tool number" style="width: 5rem"></label>
           <button class="secondary" type="button" id="predict-save-tool">Save tool</button></div>
       </div>
@@ -90,19 +90,19 @@ const FORM = `
     <fieldset><legend>Stock</legend>
       <label>Kind <select name="stock_kind" data-field="stock.kind">
         <option value="grid">height grid</option><option value="box">box</option><option value="mesh">STL file</option></select></label>
-      <label data-stock="box">Min x y z <span class="triple">
+      <label data-stock="box">Lowest corner x y z, mm <span class="triple">
         <input name="min_x" type="number" step="any" value="-5" data-field="stock.min">
         <input name="min_y" type="number" step="any" value="-5" data-field="stock.min">
         <input name="min_z" type="number" step="any" value="-10" data-field="stock.min"></span></label>
-      <label data-stock="box">Max x y z <span class="triple">
+      <label data-stock="box">Highest corner x y z, mm <span class="triple">
         <input name="max_x" type="number" step="any" value="25" data-field="stock.max">
         <input name="max_y" type="number" step="any" value="25" data-field="stock.max">
         <input name="max_z" type="number" step="any" value="2.2" data-field="stock.max"></span></label>
-      <label data-stock="grid">Origin x y <span class="pair">
+      <label data-stock="grid">Grid origin x y, mm <span class="pair">
         <input name="origin_x" type="number" step="any" data-field="stock.origin">
         <input name="origin_y" type="number" step="any" data-field="stock.origin"></span></label>
-      <label data-stock="grid">Spacing, mm <input name="spacing" type="number" step="any" value="1" data-field="stock.spacing"></label>
-      <label data-stock="grid">Bottom z <input name="bottom" type="number" step="any" value="-20" data-field="stock.bottom"></label>
+      <label data-stock="grid">Grid spacing, mm <input name="spacing" type="number" step="any" value="1" data-field="stock.spacing"></label>
+      <label data-stock="grid">Bottom z, mm <input name="bottom" type="number" step="any" value="-20" data-field="stock.bottom"></label>
       <label class="stacked" data-stock="grid">Heights, mm (a row per y, along x)<textarea name="heights" rows="4" data-field="stock.heights" title="one row per y, heights along x"></textarea></label>
       <label data-stock="mesh">STL file <input name="stock_file" type="file" accept=".stl,model/stl,application/sla" data-field="stock"></label>
     </fieldset>
@@ -114,13 +114,13 @@ const FORM = `
     <fieldset><legend>Cutting</legend>
       <label>Spindle, rpm <input name="spindle_rpm" type="number" step="any" placeholder="from the program" data-field="spindle_rpm"></label>
       <label>Feed, mm/min <input name="feed" type="number" step="any" placeholder="from the program" data-field="feed"></label>
-      <label><span>K<sub>tc</sub> K<sub>rc</sub> K<sub>ac</sub>, N/mm²</span> <span class="triple">
+      <label><span>Cutting force coefficients (tangential, radial, axial), N/mm² <abbr class="symbol" title="K_tc K_rc K_ac">K<sub>tc</sub> K<sub>rc</sub> K<sub>ac</sub></abbr></span> <span class="triple">
         <input name="ktc" type="number" step="any" value="2000" data-field="cutting.ktc" title="N/mm²">
         <input name="krc" type="number" step="any" value="800" data-field="cutting.krc" title="N/mm²">
         <input name="kac" type="number" step="any" value="300" data-field="cutting.kac" title="N/mm²"></span></label>
       <label>Method <select name="method" data-field="method"><option value="sampling">surface sampling</option><option value="depth_buffer">depth buffer (patent)</option></select></label>
-      <label>Resolution N <input name="resolution" type="number" value="256" data-field="resolution"></label>
-      <label>Max correction, mm <input name="max_correction" type="number" step="any" value="0.05" data-field="correction.max_correction"></label>
+      <label><span>Resolution, cells across <abbr class="symbol" title="N">N</abbr></span> <input name="resolution" type="number" value="256" data-field="resolution"></label>
+      <label>Largest correction, mm <input name="max_correction" type="number" step="any" value="0.05" data-field="correction.max_correction"></label>
     </fieldset>
     <div class="actions">
       <button class="primary" type="submit" id="predict-compute">Predict</button>

@@ -10,7 +10,7 @@ const FORM = `
 <div class="layout">
   <form id="segment-form" novalidate>
     <fieldset><legend>Curve</legend>
-      <label>Kind <select name="kind" data-field="curve.kind">
+      <label>Curve <select name="kind" data-field="curve.kind">
         <option value="circle">circle</option><option value="arc">arc</option><option value="ellipse">ellipse</option>
         <option value="polyline">polyline (points)</option><option value="bspline">B-spline / NURBS</option></select></label>
       <label data-kinds="circle arc ellipse">Centre x, y <span class="pair">
@@ -39,13 +39,13 @@ const FORM = `
       <label>Machine <select name="machine" data-field="machine"></select></label>
       <label>Feed, mm/min <input name="feed" type="number" step="any" value="10000" data-field="feed"></label>
       <label>Block time, ms <input name="block_time_ms" type="number" step="any" value="4" data-field="block_time_ms"></label>
-      <label>Mode <select name="mode" data-field="mode"><option value="window">per window</option><option value="curve">whole curve</option></select></label>
-      <label data-mode="window">Window, mm <input name="window" type="number" step="any" placeholder="5 target chords" data-field="window"></label>
+      <label>Chord error chosen <select name="mode" data-field="mode"><option value="window">per window</option><option value="curve">whole curve</option></select></label>
+      <label data-mode="window">Window length, mm <input name="window" type="number" step="any" placeholder="5 target chords" data-field="window"></label>
       <label data-mode="curve">Rule <select name="rule" data-field="rule"><option value="extremes">smallest radius</option><option value="max">largest window value</option><option value="normal_accel">normal acceleration</option></select></label>
       <label><span>Block margin <abbr class="symbol" title="k_f in chord.md">k_f</abbr></span> <input name="margin" type="number" step="any" value="1" data-field="margin"></label>
-      <label>Min chord error, mm <input name="min_chord_error" type="number" step="any" value="0" data-field="min_chord_error"></label>
+      <label>Smallest chord error, mm <input name="min_chord_error" type="number" step="any" value="0" data-field="min_chord_error"></label>
       <label>Tolerance, mm <input name="tolerance" type="number" step="any" placeholder="none" data-field="tolerance"></label>
-      <label>Compare with fixed, mm <input name="compare_tolerance" type="number" step="any" value="0.01" data-field="compare_tolerance"></label>
+      <label>Compare with a fixed tolerance, mm <input name="compare_tolerance" type="number" step="any" value="0.01" data-field="compare_tolerance"></label>
     </fieldset>
     <div class="actions">
       <button class="primary" type="submit" id="segment-compute">Compute</button>
