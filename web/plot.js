@@ -683,8 +683,8 @@ export class Scene3D {
   // A see-through solid (BufferGeometry in machine coordinates, or with `matrix`).
   solid(name, geometry, { colour = '#8fa3b5', opacity = 0.25, legend, matrix, edges = true } = {}) {
     if (!this.scene) return null;
-    const mesh = new THREE.Mesh(geometry, new THREE.MeshStandardMaterial({
-      color: colour, transparent: true, opacity, side: THREE.DoubleSide, depthWrite: false, roughness: 0.8,
+    const mesh = new THREE.Mesh(geometry, new THREE.MeshLambertMaterial({
+      color: colour, transparent: true, opacity, side: THREE.DoubleSide, depthWrite: false,
     }));
     if (matrix) mesh.applyMatrix4(matrix);
     if (edges) mesh.add(new THREE.LineSegments(new THREE.EdgesGeometry(geometry, 30), new THREE.LineBasicMaterial({ color: colour, transparent: true, opacity: Math.min(1, opacity * 2.5) })));
@@ -722,8 +722,9 @@ export class Scene3D {
   tool({ radius, kind = 'ball', neck, neckLength, shank, shankLength }) {
     if (!this.scene) return;
     const group = new THREE.Group();
-    const metal = new THREE.MeshStandardMaterial({ color: '#c47f17', metalness: 0.3, roughness: 0.45 });
-    const steel = new THREE.MeshStandardMaterial({ color: '#6b7780', metalness: 0.4, roughness: 0.5, transparent: true, opacity: 0.85 });
+    // Lambert shading: cheap enough for software WebGL, which is what a PC without a GPU driver has.
+    const metal = new THREE.MeshLambertMaterial({ color: '#c47f17' });
+    const steel = new THREE.MeshLambertMaterial({ color: '#6b7780', transparent: true, opacity: 0.85 });
     const upright = (geometry, z) => {
       geometry.rotateX(Math.PI / 2);
       geometry.translate(0, 0, z);
