@@ -205,6 +205,8 @@ export function loadTools(select, inlineLabel, accepts = () => true, describe = 
     select.tools = table;
     restoreChoice(select, chosen);
   };
+  // The inline choice is there at once, so a form sent before the table arrives is still whole.
+  if (!select.options.length) select.append(new Option(inlineLabel, 'inline'));
   onShow(select, fill);
   return track(select.form, fill());
 }
@@ -223,6 +225,7 @@ export function loadMachines(select, noneLabel = 'none') {
     restoreChoice(select, chosen);
     select.dispatchEvent(new Event('kerf:machines'));
   };
+  if (!select.options.length) select.append(new Option(noneLabel, ''));
   onShow(select, fill);
   return track(select.form, fill());
 }

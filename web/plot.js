@@ -659,7 +659,7 @@ export class Scene3D {
 
   // Names of what the scene shows, for tests and assistive text.
   note(name, legend, colour) {
-    this.names.push(name);
+    if (!this.names.includes(name)) this.names.push(name);
     this.root.dataset.objects = this.names.join(' ');
     if (legend) {
       const item = document.createElement('li');

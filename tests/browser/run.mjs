@@ -339,7 +339,20 @@ const scenarios = {
     await page.click('#contour-compute');
     const local = await page.textContent('#contour-messages');
     if (!/line 2/i.test(local)) throw new Error(`local check: ${local}`);
-    return { segments, inked, loopPixels, reliefPixels, zoomed: zoomed / fitted };
+    // Every layer in 3-D, and the timeline moves the tool there too.
+    await page.fill('#contour-form input[name="points"], #contour-form textarea[name="points"]', '0, 10\n40, 10\n40, 0\n80, 25\n40, 50\n40, 40\n0, 40');
+    await page.click('#contour-compute');
+    await page.waitForSelector('#contour-result:not(.stale) #contour-plot[data-state="drawn"]', { timeout: 15000 });
+    await page.selectOption('#contour-result select[aria-label="View"]', '3d');
+    await page.waitForSelector('#contour-plot-3d[data-state="drawn"]', { timeout: 15000 });
+    const objects = (await page.getAttribute('#contour-plot-3d', 'data-objects')).split(' ');
+    if (!['part', 'cut', 'loop', 'tool'].every((o) => objects.includes(o))) throw new Error(`3-D contour: ${objects}`);
+    const slider = page.getByRole('slider', { name: /Timeline/ });
+    await slider.focus();
+    for (let i = 0; i < 30; i++) await page.keyboard.press('ArrowRight');
+    const tool3d = await page.getAttribute('#contour-plot-3d', 'data-tool');
+    if (!tool3d) throw new Error('no tool in the 3-D contour');
+    return { segments, inked, loopPixels, reliefPixels, zoomed: zoomed / fitted, objects };
   },
 
   // The Engagement view: computes its three sample paths side by side, checks every chart is

@@ -5,7 +5,7 @@
 // warnings and the G-code download. `contourResult` also renders job results.
 import { api, program as programOf, sentence } from '/api.js';
 import { Timeline } from '/timeline.js';
-import { Plot2D } from '/plot.js';
+import { Plot2D, Scene3D, THREE } from '/plot.js';
 import { clearProblem, computed, computing, download, gcodeQuery, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
 
 // An arrow-shaped island: five protruding corners (a 64° tip among them) and two inside corners.
@@ -276,9 +276,31 @@ export function contourResult(container, answer, { program } = {}) {
   showSummary(summary, summaryItems(answer));
   warnings.replaceChildren(...warningMessages(answer.warnings));
   container.append(cornerTable(answer, plot));
+  // Plan (one layer) or 3-D (every layer): the 3-D scene is built the first time it is asked for.
+  const radius = answer.summary.tool_radius || answer.tool?.radius || 0;
+  const mode = document.createElement('select');
+  mode.setAttribute('aria-label', 'View');
+  mode.append(new Option('plan, one layer', 'plan'), new Option('3-D, all layers', '3d'));
+  bar.append(mode);
+  const sceneBox = document.createElement('div');
+  sceneBox.hidden = true;
+  canvas.after(sceneBox);
+  let scene = null;
+  let toolAt = null;
+  mode.addEventListener('change', () => {
+    const threeD = mode.value === '3d';
+    canvas.hidden = threeD;
+    hint.hidden = threeD;
+    label.hidden = threeD;
+    sceneBox.hidden = !threeD;
+    if (threeD && !scene) {
+      scene = contourScene(sceneBox, answer, contour, radius);
+      scene.root.id = `${canvas.id || 'contour-plot'}-3d`;
+    }
+    scene?.moveTool(toolAt);
+  });
   if (program) {
-    // The timeline walks the program; the plot follows it from layer to layer.
-    const radius = answer.tool?.radius || 0;
+    // The timeline walks the program; the plan follows it from layer to layer.
     const timeline = new Timeline(bar.parentElement, program, {
       onMove: (move) => {
         const [x, y, z] = move.position;
@@ -288,11 +310,50 @@ export function contourResult(container, answer, { program } = {}) {
           show(layer, true);
         }
         plot.setTool([x, y], radius);
+        toolAt = move.position;
+        if (scene && !sceneBox.hidden) scene.moveTool(toolAt);
       },
     });
-    canvas.after(timeline.root);
+    sceneBox.after(timeline.root);
   }
   return canvas;
+}
+
+// Every layer in 3-D: the part's outline as a see-through prism from the lowest layer to the top,
+// the moves coloured by kind, and the flat tool (its tip at the timeline's move).
+function contourScene(box, answer, contour, radius) {
+  const scene = new Scene3D(box, { label: 'Contour, every layer and the tool in 3-D' });
+  const zs = answer.layers.map((l) => l.z);
+  const top = Math.max(...zs, 0);
+  const bottom = Math.min(...zs);
+  if (contour.length > 2 && top > bottom) {
+    const shape = new THREE.Shape(contour.map(([x, y]) => new THREE.Vector2(x, y)));
+    const prism = new THREE.ExtrudeGeometry(shape, { depth: top - bottom, bevelEnabled: false });
+    prism.translate(0, 0, bottom);
+    scene.solid('part', prism, { legend: answer.summary.side === 'inside' ? 'pocket outline' : 'part outline', opacity: 0.2 });
+  }
+  const seen = new Set();
+  let here = null;
+  for (const layer of answer.layers) {
+    let run = null;
+    for (const move of layer.moves) {
+      if (!run || run.kind !== move.kind) {
+        if (run && run.points.length > 1) draw(run);
+        run = { kind: move.kind, points: here ? [here] : [] };
+      }
+      run.points.push(move.to);
+      here = move.to;
+    }
+    if (run && run.points.length > 1) draw(run);
+  }
+  function draw(run) {
+    const legend = seen.has(run.kind) ? undefined : run.kind;
+    seen.add(run.kind);
+    scene.path(run.kind, run.points, { colour: COLOUR[run.kind] || COLOUR.cut, dashed: run.kind === 'link' || run.kind === 'rapid', legend });
+  }
+  scene.tool({ radius, kind: 'flat' });
+  scene.finish();
+  return scene;
 }
 
 // When an error names one point of the contour, says which line of the points box it is.
