@@ -115,6 +115,7 @@ async function openJob(id, root) {
     const title = document.createElement('h2');
     title.textContent = `Job #${job.id}${job.name ? ': ' + job.name : ''}`;
     box.append(title);
+    const shown = [];
     job.results.forEach((result, index) => {
       const section = document.createElement('section');
       section.className = 'job-operation';
@@ -142,8 +143,16 @@ async function openJob(id, root) {
       const view = document.createElement('div');
       section.append(heading, actions, view);
       box.append(section);
-      (resultView(result.operation) || ((c, r) => { c.textContent = JSON.stringify(r).slice(0, 2000); }))(view, result.result);
+      const show = resultView(result.operation) || ((c, r) => { c.textContent = JSON.stringify(r).slice(0, 2000); });
+      shown.push((async () => {
+        // With its program, the result gets the timeline and listing too.
+        const program = result.gcode
+          ? await api('GET', `/api/v1/jobs/${id}/gcode?operation=${index}`, undefined, 'text/x-gcode').catch(() => null)
+          : null;
+        show(view, result.result, program ? { program } : {});
+      })());
     });
+    await Promise.all(shown);
     box.scrollIntoView({ behavior: 'smooth', block: 'start' });
   } catch (problem) {
     showProblem(root.querySelector('#job-messages'), null, problem);

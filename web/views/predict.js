@@ -357,8 +357,9 @@ function drawHistogram(canvas, errors, low, high, limit) {
 }
 
 // Shows a prediction in `container`: path coloured by error with its scale, histogram, summary,
-// worst passes and warnings. Used by the form and by job results.
-export function predictResult(container, answer, request) {
+// worst passes and warnings. `context`: the `request` adds the stock, the `program` the timeline
+// (a worst pass goes to its line). Used by the form and by job results.
+export function predictResult(container, answer, { request, program } = {}) {
   container.replaceChildren();
   const warnings = document.createElement('div');
   const sceneBox = document.createElement('div');
@@ -401,7 +402,6 @@ export function predictResult(container, answer, request) {
   scene.finish();
   // With the program (the form view), the timeline walks it and a worst pass goes to its line.
   const lift = request?.reference === 'centre' ? 0 : answer.tool.radius;
-  const program = request?.path?.program;
   const timeline = program ? new Timeline(timelineBox, program, {
     onMove: (move) => scene.moveTool([move.position[0], move.position[1], move.position[2] + lift]),
   }) : null;
@@ -496,7 +496,8 @@ export const predictView = {
         computed(messages, result, `${answer.summary.passes} passes predicted in ${seconds.toFixed(2)} s.`);
         markComputed(form);
         clearProblem(form);
-        predictResult(result, answer, predictRequest(form).body).id = 'predict-plot';
+        const sent = predictRequest(form).body;
+        predictResult(result, answer, { request: sent, program: sent.path.program }).id = 'predict-plot';
         result.querySelector('canvas.histogram').id = 'predict-histogram';
       } catch (problem) {
         fail(problem);

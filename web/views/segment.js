@@ -250,9 +250,10 @@ function heading(text) {
 }
 
 // Shows a segment answer in `container`: summary, comparison, plan of the curve and its blocks,
-// chord error and block length along the curve, warnings. `request` (the form view's) adds the
-// target curve to the plan. Used by the form and by job results.
-export function segmentResult(container, answer, request, machine, program) {
+// chord error and block length along the curve, warnings. `context`: the form view's `request`
+// adds the target curve, `machine` names the machine's values, `program` adds the timeline.
+// Used by the form and by job results.
+export function segmentResult(container, answer, { request, machine, program } = {}) {
   container.replaceChildren();
   const warnings = document.createElement('div');
   const summaryBox = document.createElement('div');
@@ -364,7 +365,7 @@ export const segmentView = {
           messages.append(message('error', `No G-code for these blocks. ${sentence(refused.detail || refused.title)}`, refused.code));
         }
         root.querySelector('#segment-gcode').disabled = !program;
-        segmentResult(result, answer, body, form.elements.machine.machines?.get(body.machine), program).id = 'segment-plot';
+        segmentResult(result, answer, { request: body, machine: form.elements.machine.machines?.get(body.machine), program }).id = 'segment-plot';
         const charts = result.querySelectorAll('canvas.chart');
         charts[0].id = 'segment-chart';
         charts[1].id = 'segment-lengths';
