@@ -431,6 +431,11 @@ const scenarios = {
     if (lines.length < 10 || !lines.every((l) => l > 6)) throw new Error(`worst passes: ${lines}`);
     if (!/441 of 441 predicted/.test(summary)) throw new Error(`summary: ${summary}`);
 
+    // A tolerance band of ±5 µm counts the passes outside it.
+    await page.fill('#predict-result input[name="tolerance_band"]', '5');
+    const outside = await page.textContent('#predict-result output');
+    if (!/^\d+ of 441 passes outside ±5 µm\.$/.test(outside)) throw new Error(`tolerance band: ${outside}`);
+
     // A worst pass selects its line in the listing and puts the tool there.
     await page.click('#predict-result table.worst tr[data-line]:nth-child(3)');
     const wanted = Number(await page.getAttribute('#predict-result table.worst tr[aria-selected="true"]', 'data-line'));

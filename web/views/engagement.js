@@ -920,6 +920,15 @@ export function engagementResult(container, answer, { onSelect } = {}) {
   axis.addEventListener('change', render);
   render();
   select(shown);
+  // Charts follow the width of the result column (a window resized, columns stacked).
+  let width = columns.clientWidth;
+  let timer = null;
+  new ResizeObserver(() => {
+    if (!columns.isConnected || !columns.clientWidth || Math.abs(columns.clientWidth - width) < 20) return;
+    width = columns.clientWidth;
+    clearTimeout(timer);
+    timer = setTimeout(() => renderColumn(cells[shown], candidates[shown], answer, axis.value), 150);
+  }).observe(columns);
   return cells;
 }
 

@@ -274,7 +274,7 @@ function runs(passes) {
   return out;
 }
 
-function drawScale(canvas, limit) {
+function drawScale(canvas, limit, band) {
   const [low, high] = [-limit, limit];
   const width = canvas.clientWidth;
   const height = canvas.clientHeight;
@@ -304,10 +304,19 @@ function drawScale(canvas, limit) {
     g.textAlign = 'center';
     g.fillText('0', zero, 30);
   }
+  if (band > 0) {
+    // The tolerance band: a dashed box over the scale from −band to +band.
+    const at = (e) => left + (right - left) * ((Math.max(low, Math.min(high, e)) - low) / (high - low));
+    g.strokeStyle = '#1d2327';
+    g.lineWidth = 2;
+    g.setLineDash([5, 3]);
+    g.strokeRect(at(-band), 2, at(band) - at(-band), 26);
+    g.setLineDash([]);
+  }
   canvas.dataset.state = 'drawn';
 }
 
-function drawHistogram(canvas, errors, low, high, limit) {
+function drawHistogram(canvas, errors, low, high, limit, band) {
   const width = canvas.clientWidth;
   const height = canvas.clientHeight;
   const ratio = window.devicePixelRatio || 1;
@@ -352,6 +361,19 @@ function drawHistogram(canvas, errors, low, high, limit) {
   g.fillText(`${microns(high)} µm`, right, bottom + 6);
   g.textAlign = 'center';
   g.fillText('passes per error', (left + right) / 2, bottom + 6);
+  if (band > 0) {
+    g.strokeStyle = '#1d2327';
+    g.setLineDash([5, 3]);
+    for (const e of [-band, band]) {
+      if (e < low || e > high) continue;
+      const x = left + (right - left) * ((e - low) / span);
+      g.beginPath();
+      g.moveTo(x, top);
+      g.lineTo(x, bottom);
+      g.stroke();
+    }
+    g.setLineDash([]);
+  }
   canvas.dataset.state = 'drawn';
   canvas.dataset.bins = String(counts.filter((c) => c > 0).length);
 }
@@ -364,6 +386,21 @@ export function predictResult(container, answer, { request, program } = {}) {
   const warnings = document.createElement('div');
   const sceneBox = document.createElement('div');
   const timelineBox = document.createElement('div');
+  // An optional tolerance band, drawn on the scale and the histogram, with the passes outside it.
+  const bandBox = document.createElement('div');
+  bandBox.className = 'actions';
+  const bandLabel = document.createElement('label');
+  bandLabel.className = 'inline';
+  const bandInput = document.createElement('input');
+  bandInput.type = 'number';
+  bandInput.step = 'any';
+  bandInput.min = '0';
+  bandInput.placeholder = 'none';
+  bandInput.name = 'tolerance_band';
+  bandInput.style.width = '6rem';
+  bandLabel.append('Tolerance band ±', bandInput, 'µm');
+  const bandCount = document.createElement('output');
+  bandBox.append(bandLabel, bandCount);
   const scale = document.createElement('canvas');
   scale.className = 'scale';
   scale.setAttribute('aria-label', 'Colour scale of the predicted error');
@@ -379,7 +416,7 @@ export function predictResult(container, answer, { request, program } = {}) {
   worstTitle.textContent = 'Worst passes';
   const worst = document.createElement('table');
   worst.className = 'worst';
-  container.append(warnings, sceneBox, scale, caption, timelineBox, summaryBox, histogram, worstTitle, worst);
+  container.append(warnings, sceneBox, scale, bandBox, caption, timelineBox, summaryBox, histogram, worstTitle, worst);
 
   const errors = answer.passes.map((p) => p.error).filter(Number.isFinite);
   const low = errors.length ? Math.min(...errors) : 0;
@@ -407,9 +444,13 @@ export function predictResult(container, answer, { request, program } = {}) {
   }) : null;
   const end = (pass) => pass.corrected.map((c, k) => c - pass.correction[k]);
   const redraw = () => {
-    drawScale(scale, limit);
-    drawHistogram(histogram, errors, low, high, limit);
+    const band = Number(bandInput.value) / 1000;
+    drawScale(scale, limit, band);
+    drawHistogram(histogram, errors, low, high, limit, band);
+    const outside = band > 0 ? errors.filter((e) => Math.abs(e) > band).length : null;
+    bandCount.textContent = outside === null ? '' : `${outside} of ${errors.length} passes outside ±${bandInput.value} µm.`;
   };
+  bandInput.addEventListener('input', redraw);
   redraw();
   new ResizeObserver(redraw).observe(histogram);
 
