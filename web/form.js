@@ -124,6 +124,8 @@ function withoutPath(text, path) {
   return path && message.startsWith(path) ? message.slice(path.length).replace(/^[:\s]+/, '') : message;
 }
 
+let noteCount = 0;
+
 // Shows a problem document: each field error under its field (aria-invalid, aria-describedby),
 // a plain headline in `box` with the API's words as a tooltip, focus on the first bad field.
 // The last good result stays, dimmed, until the next success.
@@ -139,16 +141,20 @@ export function showProblem(box, form, problem) {
       lines.push(text);
       continue;
     }
+    // One message under each field; a second error on the same field adds to it.
     const label = controls[0].closest('label') || controls[0];
-    const id = `error-${form.id || 'form'}-${controls[0].name || 'field'}`;
-    if (!document.getElementById(id)) {
-      const note = document.createElement('p');
+    let note = label.nextElementSibling?.classList.contains('field-error') ? label.nextElementSibling : null;
+    if (note) {
+      note.textContent += ` ${text}`;
+    } else {
+      note = document.createElement('p');
       note.className = 'field-error';
-      note.id = id;
+      note.id = `error-${form.id || 'form'}-${++noteCount}`;
       note.textContent = text;
       note.title = [error.path, problem.code].filter(Boolean).join(' · ');
       label.after(note);
     }
+    const id = note.id;
     for (const control of controls) {
       control.setAttribute('aria-invalid', 'true');
       control.classList.add('invalid');
@@ -160,13 +166,13 @@ export function showProblem(box, form, problem) {
   }
   if (!errors.length) lines.push(sentence(problem.detail || problem.title));
   const headline = first ? 'Check the marked field' + (lines.length > 1 ? 's' : '') : plainTitle(problem);
-  const box_ = message('error', `${headline}. ${lines.join(' ')}`, technical(problem));
-  box?.replaceChildren(box_);
+  const alert = message('error', `${headline}. ${lines.join(' ')}`, technical(problem));
+  box?.replaceChildren(alert);
   if (first) {
     first.focus({ preventScroll: true });
     first.scrollIntoView({ block: 'center' });
   } else {
-    box_.scrollIntoView?.({ block: 'nearest' });
+    alert.scrollIntoView({ block: 'nearest' });
   }
 }
 
