@@ -64,8 +64,9 @@ export async function tools() {
 }
 
 // One sentence from an API message: capital first letter, a full stop, no Rust quoting.
+// References to the specification's edge cases ("(E8)") stay out: they are in the tooltip.
 export function sentence(text) {
-  const plain = String(text ?? '').replace(/`([^`]*)`/g, '“$1”').trim();
+  const plain = String(text ?? '').replace(/`([^`]*)`/g, '“$1”').replace(/\s*\(E\d+[a-z]?\)/g, '').trim();
   if (!plain) return '';
   const first = plain[0].toUpperCase() + plain.slice(1);
   return /[.!?]$/.test(first) ? first : `${first}.`;

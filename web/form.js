@@ -34,7 +34,7 @@ export function message(kind, text, tooltip) {
 
 // The answer's warnings as sentences, the code as a tooltip.
 export function warningMessages(warnings = []) {
-  return warnings.map((w) => message('warning', sentence(w.message), w.code));
+  return warnings.map((w) => message('warning', sentence(w.message), `${w.code}: ${w.message}`));
 }
 
 // Shows "computing…" and dims the last result until the answer comes.
@@ -255,7 +255,9 @@ export function machineFields(form, fields) {
       input.dataset.placeholder ??= input.placeholder;
       if (machine) {
         if (input.dataset.dirty !== 'true') input.value = '';
-        input.placeholder = machine[key] == null ? input.dataset.placeholder : `${machine[key]} (machine)`;
+        // A value the machine does not set: the service's default, which is the example's.
+        const fallback = input.defaultValue ? `${input.defaultValue} (default)` : input.dataset.placeholder;
+        input.placeholder = machine[key] == null ? fallback : `${machine[key]} (machine)`;
       } else {
         input.placeholder = input.dataset.placeholder;
         if (input.dataset.dirty !== 'true' && input.value === '') input.value = input.defaultValue;

@@ -852,7 +852,9 @@ function renderColumn(column, result, answer, axis) {
     const counts = new Map();
     for (const w of result.warnings) counts.set(w.code, (counts.get(w.code) || 0) + 1);
     const summaryLine = document.createElement('summary');
-    summaryLine.textContent = `Warnings: ${[...counts].map(([code, n]) => (n > 1 ? `${code} ×${n}` : code)).join(', ')}`;
+    const words = (code) => code.replace(/^W_/, '').toLowerCase().replace(/_/g, ' ');
+    summaryLine.textContent = `Warnings: ${[...counts].map(([code, n]) => (n > 1 ? `${words(code)} ×${n}` : words(code))).join(', ')}`;
+    summaryLine.title = [...counts.keys()].join(', ');
     details.append(summaryLine, ...warningMessages(result.warnings));
     column.append(details);
   }
