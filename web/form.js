@@ -73,15 +73,15 @@ export function download(name, text, type = 'text/plain') {
 
 // ---------------------------------------------------------------- errors at the field
 
-// The visible label text of a control (its label's own text, without the control's).
+// The visible label text of a control: its label's words without the controls and the
+// patent's symbols.
 export function labelText(control) {
   const label = control.closest('label');
   if (!label) return control.getAttribute('aria-label') || control.name;
   let text = '';
   for (const node of label.childNodes) {
     if (node.nodeType === Node.TEXT_NODE) text += node.textContent;
-    else if (node.matches?.('.symbol, abbr')) text += '';
-    else if (node.nodeType === Node.ELEMENT_NODE && !node.matches('input, select, textarea, span.pair, span.triple, .field-error')) {
+    else if (node.nodeType === Node.ELEMENT_NODE && !node.matches('abbr, input, select, textarea, span.pair, span.triple, .field-error')) {
       const copy = node.cloneNode(true);
       copy.querySelectorAll('abbr, input, select, textarea').forEach((e) => e.remove());
       text += copy.textContent;

@@ -114,6 +114,7 @@ export class Timeline {
     this.readout.textContent = `Move ${i + 1} of ${this.moves.length}, line ${move.line + 1}: ${kind} to X ${x} Y ${y} Z ${z} mm`
       + `${move.feed ? `, feed ${move.feed} mm/min` : ''}${move.length != null ? `, block ${move.length.toFixed(4)} mm` : ''}`
       + `${move.feed && move.length ? `, ${(move.length / move.feed * 60000).toFixed(2)} ms` : ''}.`;
+    this.slider.setAttribute('aria-valuetext', `move ${i + 1} of ${this.moves.length}, line ${move.line + 1}`);
     this.root.dataset.line = String(move.line + 1);
     this.onMove(move);
   }
