@@ -275,7 +275,10 @@ export function contourResult(container, answer, { program } = {}) {
 
   showSummary(summary, summaryItems(answer));
   warnings.replaceChildren(...warningMessages(answer.warnings));
-  container.append(cornerTable(answer, plot));
+  const corners = document.createElement('div');
+  corners.className = 'table-scroll';
+  corners.append(cornerTable(answer, plot));
+  container.append(corners);
   // Plan (one layer) or 3-D (every layer): the 3-D scene is built the first time it is asked for.
   const radius = answer.summary.tool_radius || answer.tool?.radius || 0;
   const mode = document.createElement('select');

@@ -10,8 +10,8 @@ const LAYOUT = `
     <p><b>Drop a job file here</b> (JSON or TOML) or <label class="pick">choose one<input id="job-file" type="file" accept=".json,.toml,application/json,application/toml"></label></p>
   </div>
   <div id="job-messages"></div>
-  <table class="jobs"><thead><tr><th>job</th><th>name</th><th>operations</th><th>status</th><th>progress</th><th>submitted</th><th></th></tr></thead>
-    <tbody id="job-rows"></tbody></table>
+  <div class="table-scroll"><table class="jobs"><thead><tr><th>job</th><th>name</th><th>operations</th><th>status</th><th>progress</th><th>submitted</th><th></th></tr></thead>
+    <tbody id="job-rows"></tbody></table></div>
   <div class="actions"><button class="secondary" id="job-older" type="button" hidden>Older jobs</button></div>
   <div id="job-result"></div>
 </section>`;
