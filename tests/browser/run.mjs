@@ -215,6 +215,16 @@ const scenarios = {
       if (screenshot) await page.screenshot({ path: screenshot.replace(/\.png$/, `-${width}.png`), fullPage: false });
       if (overflow > 0) throw new Error(`sideways scrolling at ${width}×${height}: ${overflow} px`);
     }
+    // At phone width, the views with wide tables too (contour's corners, the jobs list).
+    await page.click('#tabs a[data-view="contour"]');
+    await page.click('#contour-compute');
+    await page.waitForSelector('#contour-result:not(.stale) #contour-plot[data-state="drawn"]', { timeout: 15000 });
+    for (const view of ['contour', 'jobs', 'tools', 'machines', 'engagement', 'predict', 'segment']) {
+      await page.click(`#tabs a[data-view="${view}"]`);
+      await page.waitForTimeout(100);
+      const overflow = await page.evaluate(() => document.documentElement.scrollWidth - document.documentElement.clientWidth);
+      if (overflow > 0) throw new Error(`sideways scrolling on ${view} at 390 px: ${overflow} px`);
+    }
     return { overflow: widths, placeholder };
   },
 
