@@ -16,6 +16,11 @@ export function numeric(form, name) {
   return text === '' ? undefined : Number(text);
 }
 
+// Half of a diameter entered in a form (the API takes radii), or undefined when empty.
+export function half(diameter) {
+  return diameter === undefined ? undefined : diameter / 2;
+}
+
 export function number(value, digits = 4) {
   return Number.isFinite(value) ? value.toFixed(digits) : '–';
 }

@@ -6,7 +6,7 @@
 import { api, program as programOf, sentence } from '/api.js';
 import { Timeline } from '/timeline.js';
 import { Plot2D, Scene3D, THREE } from '/plot.js';
-import { clearProblem, computed, computing, download, gcodeQuery, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
+import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
 
 // An arrow-shaped island: five protruding corners (a 64° tip among them) and two inside corners.
 const SAMPLE = `# x, y in mm, counter-clockwise; one point a line
@@ -23,7 +23,7 @@ const FORM = `
   <form id="contour-form" novalidate>
     <fieldset><legend>Tool</legend>
       <label>Tool <select name="tool_choice" data-field="tool"></select></label>
-      <label data-inline-tool>Tool radius, mm <input name="tool_radius" type="number" step="any" value="3" data-field="tool.radius"></label>
+      <label data-inline-tool>Tool diameter Ø, mm <input name="tool_diameter" type="number" step="any" value="6" data-field="tool.radius"></label>
     </fieldset>
     <fieldset><legend>Contour</legend>
       <label class="stacked">Points <span class="hint">x, y a line; # comments</span>
@@ -94,7 +94,7 @@ export function contourRequest(form) {
   const parsed = parsePoints(value(form, 'points'));
   if (parsed.error) throw parsed;
   const choice = value(form, 'tool_choice');
-  const tool = choice === 'inline' ? { kind: 'flat', radius: numeric(form, 'tool_radius') } : Number(choice);
+  const tool = choice === 'inline' ? { kind: 'flat', radius: half(numeric(form, 'tool_diameter')) } : Number(choice);
   const body = {
     tool,
     contour: parsed.points,
@@ -207,7 +207,7 @@ function cornerTable(answer, plot) {
 function summaryItems(answer) {
   const s = answer.summary;
   const items = [
-    ['side', `${s.side}, ${s.direction}`], ['tool radius, mm', number(s.tool_radius, 3)], ['corners', s.corners],
+    ['side', `${s.side}, ${s.direction}`], ['tool Ø, mm', number(2 * s.tool_radius, 3)], ['corners', s.corners],
     ['layers × passes', `${s.layers} × ${s.passes}`], ['moves', s.moves], ['feed path, mm', number(s.feed_length, 1)],
     ['feed / loop feed', `${s.feed} / ${s.loop_feed}`], ['est. time, s', number(s.estimated_time_s, 1)],
     ['safe Z', number(s.safe_z, 3)], ['tolerance, mm', s.tolerance],
@@ -379,7 +379,7 @@ export const contourView = {
     form.elements.points.defaultValue = SAMPLE;
     const sync = () => { form.querySelector('[data-inline-tool]').hidden = value(form, 'tool_choice') !== 'inline'; };
     form.addEventListener('change', sync);
-    loadTools(form.elements.tool_choice, 'inline flat end mill (radius below)').then(sync);
+    loadTools(form.elements.tool_choice, 'inline flat end mill (size below)').then(sync);
     loadMachines(form.elements.machine);
     machineFields(form, { block_time_ms: 'block_time_ms' });
     sync();

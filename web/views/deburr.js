@@ -1,7 +1,7 @@
 // Deburr view: a form for one cross-hole ridge, the 3-D plot of ridge and ball-centre path,
 // the summary, warnings and the G-code download (api.md, Deburr).
 import { api, program as programOf, sentence } from '/api.js';
-import { clearProblem, computed, computing, download, gcodeQuery, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
+import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
 import { Scene3D, THREE } from '/plot.js';
 import { Timeline } from '/timeline.js';
 
@@ -10,7 +10,7 @@ const FORM = `
   <form id="deburr-form" novalidate>
     <fieldset><legend>Tool</legend>
       <label>Tool <select name="tool_choice" data-field="tool"></select></label>
-      <label data-inline-tool>Ball radius, mm <input name="ball_radius" type="number" step="any" value="2" data-field="tool.radius"></label>
+      <label data-inline-tool>Ball diameter Ø, mm <input name="ball_diameter" type="number" step="any" value="4" data-field="tool.radius"></label>
     </fieldset>
     <fieldset><legend>Workpiece</legend>
       <label>Kind <select name="workpiece_kind" data-field="workpiece.kind">
@@ -63,7 +63,7 @@ const FORM = `
 // The request body from the form (field names as api.md).
 export function deburrRequest(form) {
   const choice = value(form, 'tool_choice');
-  const tool = choice === 'inline' ? { kind: 'ball', radius: numeric(form, 'ball_radius') } : Number(choice);
+  const tool = choice === 'inline' ? { kind: 'ball', radius: half(numeric(form, 'ball_diameter')) } : Number(choice);
   const origin = [numeric(form, 'ox') ?? 0, numeric(form, 'oy') ?? 0, numeric(form, 'oz') ?? 0];
   const kind = value(form, 'workpiece_kind');
   const workpiece = kind === 'tube'

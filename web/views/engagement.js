@@ -5,7 +5,7 @@
 // k with the recommended k highlighted, and the feed plan; a cursor on any chart marks the tool
 // on the path. The result renderer is shared with the Jobs view.
 import { api } from '/api.js';
-import { clearProblem, computed, computing, download, gcodeQuery, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
+import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
   { name: 'straight', text: '-10 20\n70 20' },
@@ -18,7 +18,7 @@ const FORM = `
   <form id="engagement-form" novalidate>
     <fieldset><legend>Tool</legend>
       <label>Tool <select name="tool_choice" data-field="tool"></select></label>
-      <label data-inline-tool>Tool radius, mm <input name="tool_radius" type="number" step="any" value="5" data-field="tool.radius"></label>
+      <label data-inline-tool>Tool diameter Ø, mm <input name="tool_diameter" type="number" step="any" value="10" data-field="tool.radius"></label>
       <label data-inline-tool>Flutes <input name="tool_flutes" type="number" step="1" value="2" data-field="tool.flutes"></label>
     </fieldset>
     <fieldset><legend>Stock (plan view)</legend>
@@ -128,7 +128,7 @@ function pathBoxes(form) {
 export function engagementRequest(form) {
   const choice = value(form, 'tool_choice');
   const tool = choice === 'inline'
-    ? { kind: 'flat', radius: numeric(form, 'tool_radius'), flutes: numeric(form, 'tool_flutes') }
+    ? { kind: 'flat', radius: half(numeric(form, 'tool_diameter')), flutes: numeric(form, 'tool_flutes') }
     : Number(choice);
   const stock = { polygon: parsePoints(value(form, 'stock_polygon'), 'stock.polygon') };
   const holes = value(form, 'stock_holes').trim();
@@ -945,7 +945,7 @@ export const engagementView = {
     for (const sample of SAMPLE_PATHS) addPath(form, sample.name, sample.text);
     root.querySelector('#engagement-add-path').addEventListener('click', () => addPath(form, `path ${pathBoxes(form).length + 1}`, ''));
     form.addEventListener('change', () => syncVisibility(form));
-    loadTools(form.elements.tool_choice, 'inline flat end mill (below)', () => true, (tool) => `${toolLabel(tool)} z${tool.flutes}`).then(() => syncVisibility(form));
+    loadTools(form.elements.tool_choice, 'inline flat end mill (size below)', () => true, (tool) => `${toolLabel(tool)} z${tool.flutes}`).then(() => syncVisibility(form));
     loadMachines(form.elements.machine);
     machineFields(form, { max_feed: 'max_feed' });
     syncVisibility(form);
