@@ -16,7 +16,9 @@ const problems = [];
 page.on('pageerror', (error) => problems.push(`page error: ${error.message}`));
 // Nothing may leave the machine: every request goes to the service under test on 127.0.0.1
 // (or is a data:/blob: URL the page makes itself).
+const requested = [];
 page.on('request', (request) => {
+  requested.push(request.url());
   const url = new URL(request.url());
   if (!['data:', 'blob:'].includes(url.protocol) && url.hostname !== '127.0.0.1') problems.push(`request left 127.0.0.1: ${request.url()}`);
 });
@@ -79,6 +81,7 @@ const scenarios = {
       if (!objects.includes(name)) throw new Error(`the scene has no ${name}: ${objects}`);
     }
     if (inked < 5000) throw new Error(`scene nearly blank: ${inked} inked pixels`);
+    if (!requested.some((u) => u.endsWith('/vendor/three/three.core.js'))) throw new Error('three.js was not loaded from /vendor');
     if (!/points\s*\d+/.test(summary)) throw new Error(`no summary: ${summary}`);
 
     // The timeline: a slider named "Timeline…"; arrow keys step it; the tool follows and the
