@@ -718,12 +718,13 @@ export class Scene3D {
   }
 
   // The tool: a ball of `radius` (or a flat end of that radius), a neck of `neck` radius and
-  // `neckLength`, a shank above; drawn with its ball centre (or tip for a flat) at `at`.
-  tool({ radius, kind = 'ball', neck, neckLength, shank, shankLength }) {
+  // `neckLength`, a shank above, its head in `colour` (red for a refused program); `moveTool`
+  // puts its ball centre (or a flat tool's tip) at a point.
+  tool({ radius, kind = 'ball', neck, neckLength, shank, shankLength, colour = '#c47f17' }) {
     if (!this.scene) return;
     const group = new THREE.Group();
     // Lambert shading: cheap enough for software WebGL, which is what a PC without a GPU driver has.
-    const metal = new THREE.MeshLambertMaterial({ color: '#c47f17' });
+    const metal = new THREE.MeshLambertMaterial({ color: colour });
     const steel = new THREE.MeshLambertMaterial({ color: '#6b7780', transparent: true, opacity: 0.85 });
     const upright = (geometry, z) => {
       geometry.rotateX(Math.PI / 2);
@@ -744,7 +745,7 @@ export class Scene3D {
     const shankTall = shankLength ?? 6 * radius;
     group.add(new THREE.Mesh(upright(new THREE.CylinderGeometry(shankRadius, shankRadius, shankTall, 24), z + neckTall + shankTall / 2), steel));
     group.visible = false;
-    this.toolObject = this.add('tool', group, kind === 'ball' ? 'tool (ball, neck, shank)' : 'tool', '#c47f17');
+    this.toolObject = this.add('tool', group, kind === 'ball' ? 'tool (ball, neck, shank)' : 'tool', colour);
   }
 
   // Puts the tool's ball centre (flat: tip) at `p`, or hides it for null.

@@ -119,6 +119,20 @@ const scenarios = {
     const withMachine = await page.textContent('#deburr-result .summary');
     if (!/blocks \(short\)\d+ \(0\)/.test(withMachine)) throw new Error(`no block figures: ${withMachine}`);
 
+    // A path without a program (the ball cannot pass the hole to reach the inner edge): the
+    // G-code button is off and the scene shows the approach and the tool in red.
+    await page.selectOption('#deburr-form select[name="machine"]', '');
+    await page.selectOption('#deburr-form select[name="edge"]', 'inner');
+    await page.fill('#deburr-form input[name="ball_diameter"]', '10.4');
+    await page.click('#deburr-compute');
+    await page.waitForSelector('#deburr-plot[data-refused="true"]', { timeout: 15000 });
+    if (!(await page.isDisabled('#deburr-gcode'))) throw new Error('G-code button enabled without a program');
+    await page.selectOption('#deburr-form select[name="edge"]', 'outer');
+    await page.fill('#deburr-form input[name="ball_diameter"]', '4');
+    await page.click('#deburr-compute');
+    await page.waitForSelector('#deburr-plot[data-refused="false"]', { timeout: 15000 });
+    if (await page.isDisabled('#deburr-gcode')) throw new Error('G-code button still off');
+
     // A bad value: its message under the field, aria-invalid, aria-describedby naming the message,
     // focus on the field, the last result still there but dimmed.
     await page.fill('input[name="hole_radius"]', '-1');

@@ -167,7 +167,8 @@ export function deburrResult(container, answer, context = {}) {
   scene.path('lead-in', centres(answer.lead_in), { ...lead, legend: refused ? 'approach / retract (refused, see above)' : 'approach / retract' });
   if (answer.lead_out.length) scene.path('lead-out', [points[points.length - 1].centre, ...centres(answer.lead_out)], lead);
   const tool = answer.tool || {};
-  scene.tool({ radius: tool.radius || 1, neck: tool.neck_radius, shankLength: tool.stickout });
+  scene.tool({ radius: tool.radius || 1, neck: tool.neck_radius, shankLength: tool.stickout, colour: refused ? '#b3261e' : undefined });
+  scene.root.dataset.refused = String(refused);
   scene.finish();
   scene.moveTool(points[0].centre);
   if (program) {
@@ -231,7 +232,10 @@ export const deburrView = {
       gcode.disabled = !program;
       gcode.title = program ? '' : `No program: ${sentence(problem?.detail || problem?.title)}`;
       deburrResult(result, last.answer, { request: last.request, program, problem, reference }).id = 'deburr-plot';
-      if (problem) messages.append(message('error', `No G-code for this path. ${sentence(problem.detail || problem.title)}`, problem.code));
+      // The answer says so itself when it carries W_NO_PROGRAM.
+      if (problem && !last.answer.warnings.some((w) => w.code === 'W_NO_PROGRAM')) {
+        messages.append(message('error', `No G-code for this path. ${sentence(problem.detail || problem.title)}`, problem.code));
+      }
     };
     form.elements.dialect.addEventListener('change', draw);
     form.elements.reference.addEventListener('change', draw);
