@@ -691,8 +691,9 @@ export class Scene3D {
     return this.add(name, mesh, legend, colour);
   }
 
-  // A polyline; `colours` (one CSS colour per point) colours each segment by its end point.
-  path(name, points, { colour = '#0b63b6', colours, dashed = false, legend } = {}) {
+  // A polyline; `colours` (one CSS colour per point) colours each segment by its end point;
+  // `arrows` (a spacing in mm) adds cones pointing the way the path runs.
+  path(name, points, { colour = '#0b63b6', colours, dashed = false, legend, arrows } = {}) {
     if (!this.scene || points.length < 2) return null;
     const geometry = new THREE.BufferGeometry().setFromPoints(points.map(vector));
     let material;
@@ -706,8 +707,29 @@ export class Scene3D {
     }
     const line = new THREE.Line(geometry, material);
     if (dashed) line.computeLineDistances();
+    if (arrows > 0) this.arrows(line, points, arrows, colour);
     this.segments += points.length - 1;
     return this.add(name, line, legend, colour);
+  }
+
+  // Cones every `spacing` mm along `points`, children of `line`.
+  arrows(line, points, spacing, colour) {
+    const material = new THREE.MeshLambertMaterial({ color: colour });
+    const cone = new THREE.ConeGeometry(spacing / 7, spacing / 2.5, 12);
+    const up = new THREE.Vector3(0, 1, 0);
+    let travelled = spacing / 2;
+    for (let i = 1; i < points.length; i++) {
+      const [a, b] = [vector(points[i - 1]), vector(points[i])];
+      const length = a.distanceTo(b);
+      const direction = b.clone().sub(a).normalize();
+      for (let at = spacing - travelled; at <= length; at += spacing) {
+        const arrow = new THREE.Mesh(cone, material);
+        arrow.position.copy(a).addScaledVector(direction, at);
+        arrow.quaternion.setFromUnitVectors(up, direction);
+        line.add(arrow);
+      }
+      travelled = (travelled + length) % spacing;
+    }
   }
 
   // Small dots at points.

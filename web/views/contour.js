@@ -323,7 +323,8 @@ export function contourResult(container, answer, { program } = {}) {
 }
 
 // Every layer in 3-D: the part's outline as a see-through prism from the lowest layer to the top,
-// the moves coloured by kind, and the flat tool (its tip at the timeline's move).
+// the moves coloured by kind with arrows along the cuts, and the flat tool (its tip at the
+// timeline's move).
 function contourScene(box, answer, contour, radius) {
   const scene = new Scene3D(box, { label: 'Contour, every layer and the tool in 3-D' });
   const zs = answer.layers.map((l) => l.z);
@@ -337,6 +338,10 @@ function contourScene(box, answer, contour, radius) {
   }
   const seen = new Set();
   let here = null;
+  // Direction arrows about 12 along the longest side of the part.
+  const xs = contour.map((p) => p[0]);
+  const ys = contour.map((p) => p[1]);
+  const arrowSpacing = Math.max(Math.max(...xs) - Math.min(...xs), Math.max(...ys) - Math.min(...ys), 1) / 12;
   for (const layer of answer.layers) {
     let run = null;
     for (const move of layer.moves) {
@@ -352,7 +357,10 @@ function contourScene(box, answer, contour, radius) {
   function draw(run) {
     const legend = seen.has(run.kind) ? undefined : run.kind;
     seen.add(run.kind);
-    scene.path(run.kind, run.points, { colour: COLOUR[run.kind] || COLOUR.cut, dashed: run.kind === 'link' || run.kind === 'rapid', legend });
+    scene.path(run.kind, run.points, {
+      colour: COLOUR[run.kind] || COLOUR.cut, dashed: run.kind === 'link' || run.kind === 'rapid', legend,
+      arrows: run.kind === 'cut' ? arrowSpacing : undefined,
+    });
   }
   scene.tool({ radius, kind: 'flat' });
   scene.finish();
