@@ -11,8 +11,16 @@ function routed() {
 }
 
 function show(view) {
-  for (const link of document.querySelectorAll('#tabs a')) {
-    if (link.dataset.view === view.id) link.setAttribute('aria-current', 'page'); else link.removeAttribute('aria-current');
+  const tabs = document.getElementById('tabs');
+  for (const link of tabs.querySelectorAll('a')) {
+    if (link.dataset.view !== view.id) {
+      link.removeAttribute('aria-current');
+      continue;
+    }
+    link.setAttribute('aria-current', 'page');
+    // On a phone the tabs scroll sideways in their row: bring the current one into the middle.
+    const [row, tab] = [tabs.getBoundingClientRect(), link.getBoundingClientRect()];
+    tabs.scrollLeft += tab.left - row.left - (row.width - tab.width) / 2;
   }
   const main = document.getElementById('view');
   for (const section of main.children) section.hidden = section.dataset.viewRoot !== view.id;
