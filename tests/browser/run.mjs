@@ -408,6 +408,13 @@ const scenarios = {
     if (!Number.isInteger(cursor) || cursor <= 0) throw new Error(`no cursor on the path: ${cursor}`);
     if (after <= before) throw new Error(`tool circle not drawn: ${before} -> ${after} inked pixels`);
     if (!/s = [\d.]+ mm/.test(readout)) throw new Error(`no readout: ${readout}`);
+    // The timeline slider moves the same cursor from the keyboard.
+    const timeline = page.getByRole('slider', { name: /Timeline along straight/ });
+    await timeline.focus();
+    await page.keyboard.press('Home');
+    for (let i = 0; i < 50; i++) await page.keyboard.press('ArrowRight');
+    const stepped = Number(await page.getAttribute(plan, 'data-cursor'));
+    if (stepped !== 50) throw new Error(`timeline moved the cursor to ${stepped}`);
     // The x axis switches to time; every chart is drawn again.
     await page.selectOption('#engagement-result select[aria-label="x axis"]', 'time');
     const redrawn = await page.$$eval('#engagement-result canvas', (list) => list.filter((c) => c.dataset.state === 'drawn').length);

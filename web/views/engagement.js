@@ -831,10 +831,21 @@ function renderColumn(column, result, answer, axis) {
   const planView = new PlanView(plan, result, answer);
   planView.draw();
   let series;
+  // The timeline along the samples: the same cursor from the keyboard (arrow keys step).
+  const slider = document.createElement('input');
+  slider.type = 'range';
+  slider.min = '0';
+  slider.max = String(Math.max(0, result.samples.length - 1));
+  slider.value = '0';
+  slider.className = 'sample-timeline';
+  slider.setAttribute('aria-label', `Timeline along ${result.name || 'the path'} (tool position)`);
+  slider.addEventListener('input', () => setCursor(Number(slider.value)));
+  info.before(slider);
   const setCursor = (index) => {
     planView.cursor(index);
     series.cursor(index);
     info.textContent = readout(index === undefined ? undefined : result.samples[index], result);
+    if (index !== undefined) slider.value = String(index);
   };
   series = seriesCharts(column, result, answer, axis, setCursor);
   plan.addEventListener('pointermove', (event) => setCursor(planView.nearest(event)));
