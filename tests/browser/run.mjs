@@ -7,53 +7,101 @@ import { chromium } from 'playwright-core';
 const [scenario, base, screenshot, jobFile] = process.argv.slice(2);
 const browser = await chromium.launch({
   executablePath: process.env.KERF_CHROMIUM || '/usr/bin/chromium',
+  // WebGL without a GPU: SwiftShader, which Chromium needs asked for by name.
   args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-    '--disable-component-update', '--disable-sync'],
+    '--disable-component-update', '--disable-sync', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
 });
 const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
 const problems = [];
 page.on('pageerror', (error) => problems.push(`page error: ${error.message}`));
+// Nothing may leave the machine: every request goes to the service under test on 127.0.0.1
+// (or is a data:/blob: URL the page makes itself).
+const requested = [];
+page.on('request', (request) => {
+  requested.push(request.url());
+  const url = new URL(request.url());
+  if (!['data:', 'blob:'].includes(url.protocol) && url.hostname !== '127.0.0.1') problems.push(`request left 127.0.0.1: ${request.url()}`);
+});
 // Chromium logs every non-2xx fetch as a console error; the API's 4xx answers are expected here.
 page.on('console', (m) => {
   if (m.type() === 'error' && !/status of 4\d\d/.test(m.text())) problems.push(`console error: ${m.text()}`);
 });
 
+// The RGBA pixels of a canvas, 2-D or WebGL (copied through a 2-D canvas), in the page.
+const PIXELS = `(canvas) => {
+  const copy = document.createElement('canvas');
+  copy.width = canvas.width;
+  copy.height = canvas.height;
+  const g = copy.getContext('2d');
+  g.drawImage(canvas, 0, 0);
+  return g.getImageData(0, 0, copy.width, copy.height).data;
+}`;
+
 // Counts plot pixels that differ from the white background.
 async function inkedPixels(selector) {
-  return page.$eval(selector, (canvas) => {
-    const data = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
+  return page.$eval(selector, (canvas, pixels) => {
+    const data = eval(pixels)(canvas);
     let inked = 0;
     for (let i = 0; i < data.length; i += 4) {
       if (data[i] < 200 || data[i + 1] < 200 || data[i + 2] < 200) inked++;
     }
     return inked;
-  });
+  }, PIXELS);
 }
 
 // Counts plot pixels within 40 of the colour [r, g, b].
 async function colouredPixels(selector, colour) {
-  return page.$eval(selector, (canvas, [r, g, b]) => {
-    const data = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
+  return page.$eval(selector, (canvas, [[r, g, b], pixels]) => {
+    const data = eval(pixels)(canvas);
     let found = 0;
     for (let i = 0; i < data.length; i += 4) {
       if (Math.abs(data[i] - r) + Math.abs(data[i + 1] - g) + Math.abs(data[i + 2] - b) < 40) found++;
     }
     return found;
-  }, colour);
+  }, [colour, PIXELS]);
 }
 
 const scenarios = {
-  // Loads the page, submits the sample deburr job with the button, waits for the plot.
+  // Loads the page, submits the sample deburr job with the button, waits for the 3-D scene: the
+  // tube, the hole and the tool are in it; the timeline moves the tool and marks the G-code line
+  // it is on; a machine spaces the points by its block time; a bad value is reported under its
+  // field with aria-invalid while the last good result stays, dimmed.
   async deburr() {
+    const started = Date.now();
     await page.goto(`${base}/`);
     await page.click('#deburr-compute');
     await page.waitForSelector('#deburr-plot[data-state="drawn"]', { timeout: 15000 });
+    const firstPlot = (Date.now() - started) / 1000;
     const segments = Number(await page.getAttribute('#deburr-plot', 'data-segments'));
-    const inked = await inkedPixels('#deburr-plot');
+    const objects = (await page.getAttribute('#deburr-plot', 'data-objects')).split(' ');
+    const inked = await inkedPixels('#deburr-plot canvas');
     const summary = await page.textContent('#deburr-result .summary');
     if (segments < 10) throw new Error(`only ${segments} segments drawn`);
-    if (inked < 500) throw new Error(`plot nearly blank: ${inked} inked pixels`);
+    for (const name of ['tube', 'hole', 'ridge', 'centres', 'tool', 'grid']) {
+      if (!objects.includes(name)) throw new Error(`the scene has no ${name}: ${objects}`);
+    }
+    if (inked < 5000) throw new Error(`scene nearly blank: ${inked} inked pixels`);
+    if (!requested.some((u) => u.endsWith('/vendor/three/three.core.js'))) throw new Error('three.js was not loaded from /vendor');
     if (!/points\s*\d+/.test(summary)) throw new Error(`no summary: ${summary}`);
+
+    // The timeline: a slider named "Timeline…"; arrow keys step it; the tool follows and the
+    // listing marks the line of the move (the tool's ball centre is the programmed tip + radius).
+    const slider = page.getByRole('slider', { name: /Timeline/ });
+    await slider.focus();
+    const toolBefore = await page.getAttribute('#deburr-plot', 'data-tool');
+    for (let i = 0; i < 12; i++) await page.keyboard.press('ArrowRight');
+    const step = Number(await slider.inputValue());
+    const toolAfter = await page.getAttribute('#deburr-plot', 'data-tool');
+    const current = await page.$$eval('#deburr-result .listing li[aria-current="true"]', (l) => l.map((e) => e.textContent));
+    if (step !== 12) throw new Error(`arrow keys moved the timeline to ${step}`);
+    if (current.length !== 1) throw new Error(`${current.length} current G-code lines`);
+    if (toolAfter === toolBefore) throw new Error(`the tool did not move: ${toolAfter}`);
+    const word = (letter) => Number(new RegExp(`${letter}(-?[\\d.]+)`).exec(current[0])?.[1]);
+    const [tx, ty, tz] = toolAfter.split(' ').map(Number);
+    const radius = 2;
+    if ([Math.abs(tx - word('X')), Math.abs(ty - word('Y')), Math.abs(tz - radius - word('Z'))].some((d) => !(d < 1e-3))) {
+      throw new Error(`tool at ${toolAfter} but the current line is ${current[0]}`);
+    }
 
     // A machine registered through the API and chosen on the form spaces the points by its block
     // time: the summary reports the blocks and the machine.
@@ -62,7 +110,8 @@ const scenarios = {
       const response = await fetch(url, { method: 'PUT', headers: { 'content-type': 'application/json' }, body });
       if (!response.ok) throw new Error(`machine not stored: ${response.status}`);
     }, `${base}/api/v1/machines/page-4ms`);
-    await page.goto(`${base}/`);
+    await page.goto(`${base}/#/deburr`);
+    await page.reload();
     await page.waitForSelector('#deburr-form select[name="machine"] option[value="page-4ms"]', { state: 'attached', timeout: 15000 });
     await page.selectOption('#deburr-form select[name="machine"]', 'page-4ms');
     await page.click('#deburr-compute');
@@ -70,13 +119,130 @@ const scenarios = {
     const withMachine = await page.textContent('#deburr-result .summary');
     if (!/blocks \(short\)\d+ \(0\)/.test(withMachine)) throw new Error(`no block figures: ${withMachine}`);
 
-    // A bad value is reported with the field highlighted.
+    // A path without a program (the ball cannot pass the hole to reach the inner edge): the
+    // G-code button is off and the scene shows the approach and the tool in red.
+    await page.selectOption('#deburr-form select[name="machine"]', '');
+    await page.selectOption('#deburr-form select[name="edge"]', 'inner');
+    await page.fill('#deburr-form input[name="ball_diameter"]', '10.4');
+    await page.click('#deburr-compute');
+    await page.waitForSelector('#deburr-plot[data-refused="true"]', { timeout: 15000 });
+    if (!(await page.isDisabled('#deburr-gcode'))) throw new Error('G-code button enabled without a program');
+    await page.selectOption('#deburr-form select[name="edge"]', 'outer');
+    await page.fill('#deburr-form input[name="ball_diameter"]', '4');
+    await page.click('#deburr-compute');
+    await page.waitForSelector('#deburr-plot[data-refused="false"]', { timeout: 15000 });
+    if (await page.isDisabled('#deburr-gcode')) throw new Error('G-code button still off');
+
+    // A bad value: its message under the field, aria-invalid, aria-describedby naming the message,
+    // focus on the field, the last result still there but dimmed.
     await page.fill('input[name="hole_radius"]', '-1');
     await page.click('#deburr-compute');
-    await page.waitForSelector('#deburr-messages .message.error', { timeout: 15000 });
-    const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
-    if (!highlighted.includes('hole_radius')) throw new Error(`field not highlighted: ${highlighted}`);
-    return { segments, inked };
+    await page.waitForSelector('#deburr-form [aria-invalid="true"]', { timeout: 15000 });
+    const bad = await page.$eval('#deburr-form [aria-invalid="true"]', (e) => {
+      const note = document.getElementById(e.getAttribute('aria-describedby'));
+      const field = e.getBoundingClientRect();
+      const under = note?.getBoundingClientRect();
+      return { name: e.name, note: note?.textContent, below: under ? under.top >= field.bottom - 1 : false, focused: document.activeElement === e };
+    });
+    if (bad.name !== 'hole_radius' || !bad.note || !bad.below || !bad.focused) throw new Error(`field error: ${JSON.stringify(bad)}`);
+    const kept = await page.$$eval('#deburr-result.stale #deburr-plot', (l) => l.length);
+    if (kept !== 1) throw new Error('the last good result was not kept dimmed');
+    return { segments, inked, objects, firstPlot, note: bad.note };
+  },
+
+  // The workbench: routes with Back, state kept across a view switch and a reload, a machine's
+  // values honoured by Segment (the request leaves them out; an override is sent and named), and
+  // no sideways scrolling at three window sizes.
+  async workbench() {
+    await page.goto(`${base}/#/segment`);
+    await page.evaluate(async () => {
+      const body = JSON.stringify({ block_time_ms: 2, max_feed: 15000, dialect: 'fanuc' });
+      const response = await fetch('/api/v1/machines/fast-2ms', { method: 'PUT', headers: { 'content-type': 'application/json' }, body });
+      if (!response.ok) throw new Error(`machine not stored: ${response.status}`);
+    });
+    await page.reload();
+    await page.waitForSelector('#segment-form select[name="machine"] option[value="fast-2ms"]', { state: 'attached', timeout: 15000 });
+    await page.selectOption('#segment-form select[name="machine"]', 'fast-2ms');
+    const placeholder = await page.getAttribute('#segment-form input[name="block_time_ms"]', 'placeholder');
+    let [request] = await Promise.all([page.waitForRequest((r) => r.url().endsWith('/api/v1/segment')), page.click('#segment-compute')]);
+    let body = request.postDataJSON();
+    const sent = ['feed', 'block_time_ms', 'margin', 'min_chord_error'].filter((k) => k in body);
+    if (sent.length || body.machine !== 'fast-2ms') throw new Error(`the request overrides the machine: ${JSON.stringify(body)}`);
+    await page.waitForSelector('#segment-plot[data-state="drawn"]', { timeout: 15000 });
+    let summary = await page.textContent('#segment-result .summary');
+    if (!/block time2 ms \(machine\)/.test(summary) || !/15000 mm\/min \(machine\)/.test(summary)) throw new Error(`machine values not used: ${summary}`);
+    await page.fill('#segment-form input[name="block_time_ms"]', '4');
+    [request] = await Promise.all([page.waitForRequest((r) => r.url().endsWith('/api/v1/segment')), page.click('#segment-compute')]);
+    body = request.postDataJSON();
+    if (body.block_time_ms !== 4 || 'feed' in body) throw new Error(`override: ${JSON.stringify(body)}`);
+    await page.waitForFunction(() => /overridden/.test(document.querySelector('#segment-result .summary')?.textContent ?? ''), null, { timeout: 15000 });
+    summary = await page.textContent('#segment-result .summary');
+    if (!/block time4 ms \(machine: 2 ms, overridden\)/.test(summary)) throw new Error(`override not named: ${summary}`);
+
+    // Another view and Back: the form and the result are still there.
+    await page.click('#tabs a[data-view="contour"]');
+    await page.waitForSelector('#contour-form', { state: 'visible' });
+    if (!page.url().endsWith('#/contour')) throw new Error(`route: ${page.url()}`);
+    await page.goBack();
+    await page.waitForSelector('#segment-form', { state: 'visible' });
+    const afterSwitch = await page.inputValue('#segment-form input[name="block_time_ms"]');
+    const plotAfterSwitch = await page.$$eval('#segment-plot[data-state="drawn"]', (l) => l.length);
+    if (afterSwitch !== '4' || plotAfterSwitch !== 1) throw new Error(`after switching back: ${afterSwitch}, ${plotAfterSwitch} plot`);
+
+    // A reload: the same form (machine, override) and the result again.
+    await page.reload();
+    await page.waitForSelector('#segment-plot[data-state="drawn"]', { timeout: 15000 });
+    const machine = await page.inputValue('#segment-form select[name="machine"]');
+    const blockTime = await page.inputValue('#segment-form input[name="block_time_ms"]');
+    summary = await page.textContent('#segment-result .summary');
+    if (machine !== 'fast-2ms' || blockTime !== '4' || !/overridden/.test(summary)) throw new Error(`after reload: ${machine}, ${blockTime}, ${summary}`);
+
+    // Load example puts the sample back.
+    await page.click('#segment-form button:has-text("Load example")');
+    if (await page.inputValue('#segment-form input[name="block_time_ms"]') !== '4' || await page.inputValue('#segment-form select[name="machine"]') !== '') {
+      throw new Error('load example did not restore the sample');
+    }
+
+    // Tools: save one by diameter, edit it, delete it only after confirming.
+    await page.click('#tabs a[data-view="tools"]');
+    await page.fill('#tool-form input[name="number"]', '12');
+    await page.fill('#tool-form input[name="size"]', '8');
+    await page.fill('#tool-form input[name="neck_radius"]', '2.5');
+    await page.click('#tool-save');
+    await page.waitForSelector('#tool-rows tr[data-tool="12"]', { timeout: 15000 });
+    const stored = await page.evaluate(async () => (await (await fetch('/api/v1/tools/12')).json()));
+    if (stored.radius !== 4 || stored.neck_radius !== 2.5) throw new Error(`tool by diameter: ${JSON.stringify(stored)}`);
+    await page.click('#tool-rows tr[data-tool="12"] button:has-text("Edit")');
+    if (await page.inputValue('#tool-form input[name="size"]') !== '8') throw new Error('edit did not fill the form');
+    await page.click('#tool-rows tr[data-tool="12"] button:has-text("Delete")');
+    if (!(await page.$('#tool-rows tr[data-tool="12"]'))) throw new Error('deleted without asking');
+    await page.click('#tool-rows tr[data-tool="12"] button:has-text("Yes, delete")');
+    await page.waitForSelector('#tool-rows tr[data-tool="12"]', { state: 'detached', timeout: 15000 });
+
+    // No sideways scrolling, with the deburr scene drawn, at three sizes.
+    await page.goto(`${base}/#/deburr`);
+    await page.click('#deburr-compute');
+    await page.waitForSelector('#deburr-plot[data-state="drawn"]', { timeout: 15000 });
+    const widths = {};
+    for (const [width, height] of [[1440, 900], [1280, 720], [390, 844]]) {
+      await page.setViewportSize({ width, height });
+      await page.waitForTimeout(200);
+      const overflow = await page.evaluate(() => document.documentElement.scrollWidth - document.documentElement.clientWidth);
+      widths[`${width}x${height}`] = overflow;
+      if (screenshot) await page.screenshot({ path: screenshot.replace(/\.png$/, `-${width}.png`), fullPage: false });
+      if (overflow > 0) throw new Error(`sideways scrolling at ${width}×${height}: ${overflow} px`);
+    }
+    // At phone width, the views with wide tables too (contour's corners, the jobs list).
+    await page.click('#tabs a[data-view="contour"]');
+    await page.click('#contour-compute');
+    await page.waitForSelector('#contour-result:not(.stale) #contour-plot[data-state="drawn"]', { timeout: 15000 });
+    for (const view of ['contour', 'jobs', 'tools', 'machines', 'engagement', 'predict', 'segment']) {
+      await page.click(`#tabs a[data-view="${view}"]`);
+      await page.waitForTimeout(100);
+      const overflow = await page.evaluate(() => document.documentElement.scrollWidth - document.documentElement.clientWidth);
+      if (overflow > 0) throw new Error(`sideways scrolling on ${view} at 390 px: ${overflow} px`);
+    }
+    return { overflow: widths, placeholder };
   },
 
   // The Segment view with its sample (the patent's R50 circle at 10 m/min, 4 ms): plan, charts,
@@ -119,27 +285,29 @@ const scenarios = {
     if (!highlighted.includes('feed')) throw new Error(`field not highlighted: ${highlighted}`);
 
     // Register a machine, then cut the curve with its values.
-    await page.click('#tabs button[data-view="machines"]');
+    await page.click('#tabs a[data-view="machines"]');
     await page.fill('#machine-form input[name="name"]', 'hsc-page');
     await page.fill('#machine-form input[name="max_feed"]', '12000');
     await page.fill('#machine-form input[name="margin"]', '1.1');
     await page.selectOption('#machine-form select[name="dialect"]', 'linuxcnc');
     await page.click('#machine-save');
     await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { timeout: 15000 });
-    await page.click('#tabs button[data-view="segment"]');
+    await page.click('#tabs a[data-view="segment"]');
     await page.waitForSelector('#segment-form select[name="machine"] option[value="hsc-page"]', { state: 'attached', timeout: 15000 });
     await page.selectOption('#segment-form select[name="machine"]', 'hsc-page');
     for (const name of ['feed', 'block_time_ms', 'margin', 'min_chord_error']) await page.fill(`#segment-form input[name="${name}"]`, '');
     await page.click('#segment-compute');
-    await page.waitForSelector('#segment-plot[data-state="drawn"]', { timeout: 15000 });
+    // The earlier result stays on the page: wait for the one that names the machine.
+    await page.waitForFunction(() => /hsc-page/.test(document.querySelector('#segment-result .summary')?.textContent ?? ''), null, { timeout: 15000 });
     const withMachine = await page.textContent('#segment-result .summary');
     if (!/hsc-page/.test(withMachine) || !/12000 mm\/min/.test(withMachine)) throw new Error(`machine not used: ${withMachine}`);
     const machineBlocks = Number(await page.getAttribute('#segment-plot', 'data-segments'));
 
     // Delete it again.
-    await page.click('#tabs button[data-view="machines"]');
+    await page.click('#tabs a[data-view="machines"]');
     await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { timeout: 15000 });
     await page.click('#machine-rows tr[data-machine="hsc-page"] button:has-text("Delete")');
+    await page.click('#machine-rows tr[data-machine="hsc-page"] button:has-text("Yes, delete")');
     await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { state: 'detached', timeout: 15000 });
     return { segments, inked, chartInked, lengthsInked, machineBlocks };
   },
@@ -191,14 +359,27 @@ const scenarios = {
     await page.fill('#contour-form input[name="step"]', '3');
     await page.fill('#contour-form textarea[name="points"]', '0, 0\n10, 10\n10, 0\n0, 10');
     await page.click('#contour-compute');
-    await page.waitForFunction(() => /E_SELF_INTERSECTION/.test(document.querySelector('#contour-messages').textContent), null, { timeout: 15000 });
+    await page.waitForFunction(() => /E_SELF_INTERSECTION/.test(document.querySelector('#contour-messages .message.error')?.title ?? ''), null, { timeout: 15000 });
     const invalidPoints = await page.$$eval('#contour-form .invalid', (l) => l.map((e) => e.name));
     if (!invalidPoints.includes('points')) throw new Error(`points not highlighted: ${invalidPoints}`);
     await page.fill('#contour-form textarea[name="points"]', '0, 0\n10 0 5\n10, 10');
     await page.click('#contour-compute');
     const local = await page.textContent('#contour-messages');
-    if (!/line 2/.test(local)) throw new Error(`local check: ${local}`);
-    return { segments, inked, loopPixels, reliefPixels, zoomed: zoomed / fitted };
+    if (!/line 2/i.test(local)) throw new Error(`local check: ${local}`);
+    // Every layer in 3-D, and the timeline moves the tool there too.
+    await page.fill('#contour-form input[name="points"], #contour-form textarea[name="points"]', '0, 10\n40, 10\n40, 0\n80, 25\n40, 50\n40, 40\n0, 40');
+    await page.click('#contour-compute');
+    await page.waitForSelector('#contour-result:not(.stale) #contour-plot[data-state="drawn"]', { timeout: 15000 });
+    await page.selectOption('#contour-result select[aria-label="View"]', '3d');
+    await page.waitForSelector('#contour-plot-3d[data-state="drawn"]', { timeout: 15000 });
+    const objects = (await page.getAttribute('#contour-plot-3d', 'data-objects')).split(' ');
+    if (!['part', 'cut', 'loop', 'tool'].every((o) => objects.includes(o))) throw new Error(`3-D contour: ${objects}`);
+    const slider = page.getByRole('slider', { name: /Timeline/ });
+    await slider.focus();
+    for (let i = 0; i < 30; i++) await page.keyboard.press('ArrowRight');
+    const tool3d = await page.getAttribute('#contour-plot-3d', 'data-tool');
+    if (!tool3d) throw new Error('no tool in the 3-D contour');
+    return { segments, inked, loopPixels, reliefPixels, zoomed: zoomed / fitted, objects };
   },
 
   // The Engagement view: computes its three sample paths side by side, checks every chart is
@@ -216,6 +397,7 @@ const scenarios = {
     if (inked < 2000) throw new Error(`contact graph nearly blank: ${inked} inked pixels`);
     const recommendation = await page.textContent('#engagement-result .recommendation');
     // A cursor on the contact graph marks the tool on the path.
+    await page.locator(contactGraph).first().scrollIntoViewIfNeeded();
     const box = await (await page.$(contactGraph)).boundingBox();
     const plan = '#engagement-result .candidate canvas.plan';
     const before = await inkedPixels(plan);
@@ -226,6 +408,13 @@ const scenarios = {
     if (!Number.isInteger(cursor) || cursor <= 0) throw new Error(`no cursor on the path: ${cursor}`);
     if (after <= before) throw new Error(`tool circle not drawn: ${before} -> ${after} inked pixels`);
     if (!/s = [\d.]+ mm/.test(readout)) throw new Error(`no readout: ${readout}`);
+    // The timeline slider moves the same cursor from the keyboard.
+    const timeline = page.getByRole('slider', { name: /Timeline along straight/ });
+    await timeline.focus();
+    await page.keyboard.press('Home');
+    for (let i = 0; i < 50; i++) await page.keyboard.press('ArrowRight');
+    const stepped = Number(await page.getAttribute(plan, 'data-cursor'));
+    if (stepped !== 50) throw new Error(`timeline moved the cursor to ${stepped}`);
     // The x axis switches to time; every chart is drawn again.
     await page.selectOption('#engagement-result select[aria-label="x axis"]', 'time');
     const redrawn = await page.$$eval('#engagement-result canvas', (list) => list.filter((c) => c.dataset.state === 'drawn').length);
@@ -255,18 +444,18 @@ const scenarios = {
     await page.waitForSelector('#predict-plot[data-state="drawn"]', { timeout: 30000 });
     await page.waitForSelector('#predict-histogram[data-state="drawn"]', { timeout: 5000 });
     const segments = Number(await page.getAttribute('#predict-plot', 'data-segments'));
-    const inked = await inkedPixels('#predict-plot');
+    const inked = await inkedPixels('#predict-plot canvas');
     const histogram = await inkedPixels('#predict-histogram');
     const scale = await inkedPixels('#predict-result canvas.scale');
-    const colours = await page.$eval('#predict-plot', (canvas) => {
-      const data = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
+    const colours = await page.$eval('#predict-plot canvas', (canvas, pixels) => {
+      const data = eval(pixels)(canvas);
       const seen = new Set();
       for (let i = 0; i < data.length; i += 4) {
         const [r, g, b] = [data[i], data[i + 1], data[i + 2]];
         if (Math.max(r, g, b) - Math.min(r, g, b) > 60) seen.add(`${r >> 5},${g >> 5},${b >> 5}`);
       }
       return seen.size;
-    });
+    }, PIXELS);
     const lines = await page.$$eval('#predict-result table.worst tr[data-line]', (rows) => rows.map((r) => Number(r.dataset.line)));
     const summary = await page.textContent('#predict-result .summary');
     if (segments < 100) throw new Error(`only ${segments} segments drawn`);
@@ -275,6 +464,20 @@ const scenarios = {
     if (colours < 4) throw new Error(`the path is not coloured by error: ${colours} colours`);
     if (lines.length < 10 || !lines.every((l) => l > 6)) throw new Error(`worst passes: ${lines}`);
     if (!/441 of 441 predicted/.test(summary)) throw new Error(`summary: ${summary}`);
+
+    // A tolerance band of ±5 µm counts the passes outside it.
+    await page.fill('#predict-result input[name="tolerance_band"]', '5');
+    const outside = await page.textContent('#predict-result output');
+    if (!/^\d+ of 441 passes outside ±5 µm\.$/.test(outside)) throw new Error(`tolerance band: ${outside}`);
+
+    // A worst pass selects its line in the listing and puts the tool there.
+    await page.click('#predict-result table.worst tr[data-line]:nth-child(3)');
+    const wanted = Number(await page.getAttribute('#predict-result table.worst tr[aria-selected="true"]', 'data-line'));
+    const currentLine = Number(await page.getAttribute('#predict-result .timeline', 'data-line'));
+    const tool = await page.getAttribute('#predict-plot', 'data-tool');
+    if (currentLine !== wanted || !tool) throw new Error(`worst pass on line ${wanted}, listing at ${currentLine}, tool ${tool}`);
+    const scene = (await page.getAttribute('#predict-plot', 'data-objects')).split(' ');
+    if (!scene.includes('stock') || !scene.includes('tool')) throw new Error(`predict scene: ${scene}`);
 
     // The corrected program downloads with the input's lines.
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#predict-gcode')]);
@@ -286,7 +489,7 @@ const scenarios = {
     await page.click('#predict-compute');
     await page.waitForSelector('#predict-messages .message.error', { timeout: 15000 });
     const error = await page.textContent('#predict-messages .message.error');
-    if (!/line 3/.test(error)) throw new Error(`error without its line: ${error}`);
+    if (!/line 3/i.test(error)) throw new Error(`error without its line: ${error}`);
     const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
     if (!highlighted.includes('program')) throw new Error(`program not highlighted: ${highlighted}`);
     return { segments, inked, histogram, colours, worst: lines.length, programLines: program.split('\n').length };
@@ -301,7 +504,7 @@ const scenarios = {
     await page.waitForSelector('#job-rows tr[data-status="done"]', { timeout: 60000 });
     const seconds = (Date.now() - started) / 1000;
     await page.click('#job-rows tr[data-status="done"] button');
-    await page.waitForSelector('#job-result canvas[data-state="drawn"]', { timeout: 15000 });
+    await page.waitForSelector('#job-result [data-state="drawn"]', { timeout: 15000 });
     const plots = await page.$$eval('#job-result canvas', (list) => list.length);
     const inked = await inkedPixels('#job-result canvas');
     const downloads = await page.$$eval('#job-result button', (list) => list.map((b) => b.textContent));

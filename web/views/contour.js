@@ -3,7 +3,10 @@
 // selector; loops, reliefs, links and corners in their own colours; wheel to zoom, drag to pan,
 // double-click to fit), the corner table with the material left or over-cut, the summary, the
 // warnings and the G-code download. `contourResult` also renders job results.
-import { api, download, gcodeQuery, loadMachines, loadTools, message, number, numeric, programName, showProblem, showSummary, value } from '/app.js';
+import { api, program as programOf, sentence } from '/api.js';
+import { Timeline } from '/timeline.js';
+import { Plot2D, Scene3D, THREE } from '/plot.js';
+import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
 
 // An arrow-shaped island: five protruding corners (a 64° tip among them) and two inside corners.
 const SAMPLE = `# x, y in mm, counter-clockwise; one point a line
@@ -20,19 +23,19 @@ const FORM = `
   <form id="contour-form" novalidate>
     <fieldset><legend>Tool</legend>
       <label>Tool <select name="tool_choice" data-field="tool"></select></label>
-      <label data-inline-tool>Radius, mm <input name="tool_radius" type="number" step="any" value="3" data-field="tool.radius"></label>
+      <label data-inline-tool>Tool diameter Ø, mm <input name="tool_diameter" type="number" step="any" value="6" data-field="tool.radius"></label>
     </fieldset>
     <fieldset><legend>Contour</legend>
       <label class="stacked">Points <span class="hint">x, y a line; # comments</span>
         <textarea name="points" rows="9" spellcheck="false" data-field="contour"></textarea></label>
       <label>Side <select name="side" data-field="side">
         <option value="outside">outside (island, outer profile)</option><option value="inside">inside (pocket)</option></select></label>
-      <label>Direction <select name="direction" data-field="direction"><option value="climb">climb</option><option value="conventional">conventional</option></select></label>
+      <label>Cutting direction <select name="direction" data-field="direction"><option value="climb">climb</option><option value="conventional">conventional</option></select></label>
     </fieldset>
     <fieldset><legend>Depths</legend>
-      <label>Top Z <input name="top" type="number" step="any" value="0" data-field="depths.top"></label>
-      <label>Bottom Z <input name="bottom" type="number" step="any" value="-9" data-field="depths.bottom"></label>
-      <label>Step <input name="step" type="number" step="any" value="3" data-field="depths.step"></label>
+      <label>Top Z, mm <input name="top" type="number" step="any" value="0" data-field="depths.top"></label>
+      <label>Bottom Z, mm <input name="bottom" type="number" step="any" value="-9" data-field="depths.bottom"></label>
+      <label>Depth per layer, mm <input name="step" type="number" step="any" value="3" data-field="depths.step"></label>
     </fieldset>
     <fieldset><legend>Corners</legend>
       <label>Loop style <select name="loop_style" data-field="corner_loop.style">
@@ -44,8 +47,8 @@ const FORM = `
     </fieldset>
     <fieldset><legend>Feeds</legend>
       <label>Feed, mm/min <input name="feed" type="number" step="any" value="800" data-field="feed"></label>
-      <label>Loop feed <input name="loop_feed" type="number" step="any" value="2000" data-field="loop_feed"></label>
-      <label>Stock allowance <input name="stock_allowance" type="number" step="any" value="0.5" data-field="stock_allowance"></label>
+      <label>Loop feed, mm/min <input name="loop_feed" type="number" step="any" value="2000" data-field="loop_feed"></label>
+      <label>Roughing allowance, mm <input name="stock_allowance" type="number" step="any" value="0.5" data-field="stock_allowance"></label>
       <label>Machine <select name="machine" data-field="machine"></select></label>
       <label>Block time, ms <input name="block_time_ms" type="number" step="any" placeholder="machine's, else off" data-field="block_time_ms"></label>
       <label>Tolerance, mm <input name="tolerance" type="number" step="any" value="0.01" data-field="tolerance"></label>
@@ -91,7 +94,7 @@ export function contourRequest(form) {
   const parsed = parsePoints(value(form, 'points'));
   if (parsed.error) throw parsed;
   const choice = value(form, 'tool_choice');
-  const tool = choice === 'inline' ? { kind: 'flat', radius: numeric(form, 'tool_radius') } : Number(choice);
+  const tool = choice === 'inline' ? { kind: 'flat', radius: half(numeric(form, 'tool_diameter')) } : Number(choice);
   const body = {
     tool,
     contour: parsed.points,
@@ -113,187 +116,6 @@ export function contourRequest(form) {
 }
 
 
-// A 2-D plot on a canvas: y up, equal scales, wheel zoom about the pointer, drag to pan,
-// double-click to fit. scene = {material: {polygon, inside}, lines: [{points, colour, width,
-// dash}], marks: [{at, colour, size, ring}]}.
-class Plot2D {
-  constructor(canvas) {
-    this.canvas = canvas;
-    this.scene = null;
-    this.view = null;
-    this.drag = null;
-    canvas.addEventListener('pointerdown', (e) => {
-      this.drag = { x: e.clientX, y: e.clientY };
-      canvas.setPointerCapture(e.pointerId);
-    });
-    canvas.addEventListener('pointermove', (e) => {
-      if (!this.drag || !this.view) return;
-      this.view.cx -= (e.clientX - this.drag.x) / this.view.scale;
-      this.view.cy += (e.clientY - this.drag.y) / this.view.scale;
-      this.drag = { x: e.clientX, y: e.clientY };
-      this.draw();
-    });
-    canvas.addEventListener('pointerup', () => { this.drag = null; });
-    canvas.addEventListener('wheel', (e) => {
-      if (!this.view) return;
-      e.preventDefault();
-      const rect = canvas.getBoundingClientRect();
-      const before = this.toWorld(e.clientX - rect.left, e.clientY - rect.top);
-      this.view.scale *= Math.exp(-e.deltaY * 0.0015);
-      const after = this.toWorld(e.clientX - rect.left, e.clientY - rect.top);
-      this.view.cx += before[0] - after[0];
-      this.view.cy += before[1] - after[1];
-      this.draw();
-    }, { passive: false });
-    canvas.addEventListener('dblclick', () => { this.fit(); this.draw(); });
-    new ResizeObserver(() => this.draw()).observe(canvas);
-  }
-
-  setScene(scene, keepView = false) {
-    this.scene = scene;
-    if (!keepView || !this.view) this.fit();
-    this.draw();
-  }
-
-  bounds() {
-    const low = [Infinity, Infinity];
-    const high = [-Infinity, -Infinity];
-    const add = (p) => {
-      low[0] = Math.min(low[0], p[0]); low[1] = Math.min(low[1], p[1]);
-      high[0] = Math.max(high[0], p[0]); high[1] = Math.max(high[1], p[1]);
-    };
-    this.scene.material?.polygon.forEach(add);
-    this.scene.lines.forEach((l) => l.points.forEach(add));
-    return { low, high };
-  }
-
-  fit() {
-    if (!this.scene) return;
-    const { low, high } = this.bounds();
-    const width = this.canvas.clientWidth || 600;
-    const height = this.canvas.clientHeight || 400;
-    const span = [Math.max(high[0] - low[0], 1e-6), Math.max(high[1] - low[1], 1e-6)];
-    this.view = { cx: (low[0] + high[0]) / 2, cy: (low[1] + high[1]) / 2, scale: 0.9 * Math.min(width / span[0], height / span[1]) };
-  }
-
-  // Centres the view on `point` with `span` mm across the smaller side.
-  focus(point, span) {
-    const size = Math.min(this.canvas.clientWidth, this.canvas.clientHeight) || 400;
-    this.view = { cx: point[0], cy: point[1], scale: size / span };
-    this.draw();
-  }
-
-  toScreen(p) {
-    return [this.width / 2 + (p[0] - this.view.cx) * this.view.scale, this.height / 2 - (p[1] - this.view.cy) * this.view.scale];
-  }
-
-  toWorld(x, y) {
-    return [this.view.cx + (x - this.width / 2) / this.view.scale, this.view.cy - (y - this.height / 2) / this.view.scale];
-  }
-
-  draw() {
-    const canvas = this.canvas;
-    const ratio = window.devicePixelRatio || 1;
-    this.width = canvas.clientWidth;
-    this.height = canvas.clientHeight;
-    if (canvas.width !== Math.round(this.width * ratio) || canvas.height !== Math.round(this.height * ratio)) {
-      canvas.width = Math.round(this.width * ratio);
-      canvas.height = Math.round(this.height * ratio);
-    }
-    const g = canvas.getContext('2d');
-    g.setTransform(ratio, 0, 0, ratio, 0, 0);
-    g.fillStyle = '#ffffff';
-    g.fillRect(0, 0, this.width, this.height);
-    if (!this.scene || !this.view) {
-      canvas.dataset.state = 'empty';
-      return;
-    }
-    const material = this.scene.material;
-    if (material && material.polygon.length > 2) {
-      g.beginPath();
-      if (material.inside) g.rect(0, 0, this.width, this.height); // a pocket: material all round
-      material.polygon.forEach((p, i) => {
-        const [x, y] = this.toScreen(p);
-        if (i === 0) g.moveTo(x, y); else g.lineTo(x, y);
-      });
-      g.closePath();
-      g.fillStyle = COLOUR.material;
-      g.fill('evenodd');
-      g.strokeStyle = COLOUR.contour;
-      g.lineWidth = 2;
-      g.stroke();
-    }
-    let segments = 0;
-    for (const line of this.scene.lines) {
-      if (line.points.length < 2) continue;
-      g.strokeStyle = line.colour;
-      g.lineWidth = line.width || 2;
-      g.setLineDash(line.dash || []);
-      g.beginPath();
-      line.points.forEach((p, i) => {
-        const [x, y] = this.toScreen(p);
-        if (i === 0) g.moveTo(x, y); else { g.lineTo(x, y); segments++; }
-      });
-      g.stroke();
-    }
-    g.setLineDash([]);
-    for (const mark of this.scene.marks) {
-      const [x, y] = this.toScreen(mark.at);
-      g.beginPath();
-      g.arc(x, y, mark.size || 5, 0, 2 * Math.PI);
-      if (mark.ring) {
-        g.strokeStyle = mark.colour;
-        g.lineWidth = 2.5;
-        g.stroke();
-      } else {
-        g.fillStyle = mark.colour;
-        g.fill();
-      }
-    }
-    this.drawLegend(g);
-    this.drawScale(g);
-    canvas.dataset.state = 'drawn';
-    canvas.dataset.segments = String(segments);
-    canvas.dataset.scale = this.view.scale.toFixed(3);
-  }
-
-  drawLegend(g) {
-    g.font = '15px sans-serif';
-    let y = 22;
-    for (const [label, colour, dash] of this.scene.legend || []) {
-      g.strokeStyle = colour;
-      g.lineWidth = 4;
-      g.setLineDash(dash || []);
-      g.beginPath();
-      g.moveTo(12, y - 5);
-      g.lineTo(34, y - 5);
-      g.stroke();
-      g.setLineDash([]);
-      g.fillStyle = '#1d2327';
-      g.fillText(label, 42, y);
-      y += 21;
-    }
-  }
-
-  // A scale bar of a round length at the bottom right.
-  drawScale(g) {
-    const target = 120 / this.view.scale;
-    const power = 10 ** Math.floor(Math.log10(target));
-    const length = [1, 2, 5, 10].map((k) => k * power).filter((l) => l <= target).pop() || power;
-    const pixels = length * this.view.scale;
-    const x = this.width - 20 - pixels;
-    const y = this.height - 20;
-    g.strokeStyle = '#1d2327';
-    g.lineWidth = 3;
-    g.beginPath();
-    g.moveTo(x, y);
-    g.lineTo(x + pixels, y);
-    g.stroke();
-    g.fillStyle = '#1d2327';
-    g.font = '14px sans-serif';
-    g.fillText(`${length} mm`, x, y - 7);
-  }
-}
 
 // The lines of one layer's moves, one polyline per run of moves of the same kind.
 function layerLines(layer, start) {
@@ -307,7 +129,7 @@ function layerLines(layer, start) {
     const to = [step.to[0], step.to[1]];
     if (!current || current.kind !== step.kind) {
       const [colour, width, dash] = style[step.kind] || style.cut;
-      current = { kind: step.kind, colour, width, dash, points: here ? [here] : [] };
+      current = { kind: step.kind, colour, width, dash, arrows: step.kind === 'cut', points: here ? [here] : [] };
       lines.push(current);
     }
     current.points.push(to);
@@ -385,7 +207,7 @@ function cornerTable(answer, plot) {
 function summaryItems(answer) {
   const s = answer.summary;
   const items = [
-    ['side', `${s.side}, ${s.direction}`], ['tool radius, mm', number(s.tool_radius, 3)], ['corners', s.corners],
+    ['side', `${s.side}, ${s.direction}`], ['tool Ø, mm', number(2 * s.tool_radius, 3)], ['corners', s.corners],
     ['layers × passes', `${s.layers} × ${s.passes}`], ['moves', s.moves], ['feed path, mm', number(s.feed_length, 1)],
     ['feed / loop feed', `${s.feed} / ${s.loop_feed}`], ['est. time, s', number(s.estimated_time_s, 1)],
     ['safe Z', number(s.safe_z, 3)], ['tolerance, mm', s.tolerance],
@@ -401,7 +223,7 @@ function summaryItems(answer) {
 
 // Shows a contour answer in `container`: layer selector, plot, corner table, summary, warnings.
 // Used by the form and by job results. Returns the canvas.
-export function contourResult(container, answer) {
+export function contourResult(container, answer, { program } = {}) {
   container.replaceChildren();
   const bar = document.createElement('div');
   bar.className = 'actions layer-bar';
@@ -452,45 +274,129 @@ export function contourResult(container, answer) {
   show(0, false);
 
   showSummary(summary, summaryItems(answer));
-  warnings.replaceChildren(...answer.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
-  container.append(cornerTable(answer, plot));
+  warnings.replaceChildren(...warningMessages(answer.warnings));
+  const corners = document.createElement('div');
+  corners.className = 'table-scroll';
+  corners.append(cornerTable(answer, plot));
+  container.append(corners);
+  // Plan (one layer) or 3-D (every layer): the 3-D scene is built the first time it is asked for.
+  const radius = answer.summary.tool_radius || answer.tool?.radius || 0;
+  const mode = document.createElement('select');
+  mode.setAttribute('aria-label', 'View');
+  mode.append(new Option('plan, one layer', 'plan'), new Option('3-D, all layers', '3d'));
+  bar.append(mode);
+  const sceneBox = document.createElement('div');
+  sceneBox.hidden = true;
+  canvas.after(sceneBox);
+  let scene = null;
+  let toolAt = null;
+  mode.addEventListener('change', () => {
+    const threeD = mode.value === '3d';
+    canvas.hidden = threeD;
+    hint.hidden = threeD;
+    label.hidden = threeD;
+    sceneBox.hidden = !threeD;
+    if (threeD && !scene) {
+      scene = contourScene(sceneBox, answer, contour, radius);
+      scene.root.id = `${canvas.id || 'contour-plot'}-3d`;
+    }
+    scene?.moveTool(toolAt);
+  });
+  if (program) {
+    // The timeline walks the program; the plan follows it from layer to layer.
+    const timeline = new Timeline(bar.parentElement, program, {
+      onMove: (move) => {
+        const [x, y, z] = move.position;
+        const layer = answer.layers.findIndex((l) => Math.abs(l.z - z) < 1e-6);
+        if (layer >= 0 && String(layer) !== select.value) {
+          select.value = String(layer);
+          show(layer, true);
+        }
+        plot.setTool([x, y], radius);
+        toolAt = move.position;
+        if (scene && !sceneBox.hidden) scene.moveTool(toolAt);
+      },
+    });
+    sceneBox.after(timeline.root);
+  }
   return canvas;
 }
 
-// Marks the points box when an error names the contour or one of its points.
+// Every layer in 3-D: the part's outline as a see-through prism from the lowest layer to the top,
+// the moves coloured by kind with arrows along the cuts, and the flat tool (its tip at the
+// timeline's move).
+function contourScene(box, answer, contour, radius) {
+  const scene = new Scene3D(box, { label: 'Contour, every layer and the tool in 3-D' });
+  const zs = answer.layers.map((l) => l.z);
+  const top = Math.max(...zs, 0);
+  const bottom = Math.min(...zs);
+  if (contour.length > 2 && top > bottom) {
+    const shape = new THREE.Shape(contour.map(([x, y]) => new THREE.Vector2(x, y)));
+    const prism = new THREE.ExtrudeGeometry(shape, { depth: top - bottom, bevelEnabled: false });
+    prism.translate(0, 0, bottom);
+    scene.solid('part', prism, { legend: answer.summary.side === 'inside' ? 'pocket outline' : 'part outline', opacity: 0.2 });
+  }
+  const seen = new Set();
+  let here = null;
+  // Direction arrows about 12 along the longest side of the part.
+  const xs = contour.map((p) => p[0]);
+  const ys = contour.map((p) => p[1]);
+  const arrowSpacing = Math.max(Math.max(...xs) - Math.min(...xs), Math.max(...ys) - Math.min(...ys), 1) / 12;
+  for (const layer of answer.layers) {
+    let run = null;
+    for (const move of layer.moves) {
+      if (!run || run.kind !== move.kind) {
+        if (run && run.points.length > 1) draw(run);
+        run = { kind: move.kind, points: here ? [here] : [] };
+      }
+      run.points.push(move.to);
+      here = move.to;
+    }
+    if (run && run.points.length > 1) draw(run);
+  }
+  function draw(run) {
+    const legend = seen.has(run.kind) ? undefined : run.kind;
+    seen.add(run.kind);
+    scene.path(run.kind, run.points, {
+      colour: COLOUR[run.kind] || COLOUR.cut, dashed: run.kind === 'link' || run.kind === 'rapid', legend,
+      arrows: run.kind === 'cut' ? arrowSpacing : undefined,
+    });
+  }
+  scene.tool({ radius, kind: 'flat' });
+  scene.finish();
+  return scene;
+}
+
+// When an error names one point of the contour, says which line of the points box it is.
 function markContour(form, messages, problem) {
   const paths = (problem.errors || []).map((e) => e.path);
   const hit = paths.map((p) => /^contour(?:\[(\d+)\])?/.exec(p)).find(Boolean);
   if (!hit) return;
-  const box = form.elements.points;
-  box.classList.add('invalid');
   if (hit[1] !== undefined) {
     const index = Number(hit[1]);
-    messages.append(message('error', `See contour[${index}]: point ${index + 1} of the list (comments and blank lines not counted).`));
+    messages.append(message('error', `It is point ${index + 1} of the list (comments and blank lines not counted).`, `contour[${index}]`));
   }
 }
 
 export const contourView = {
-  id: 'contour',
-  title: 'Contour',
-  mount(root) {
+  mount(root, id) {
     root.innerHTML = FORM;
     const form = root.querySelector('#contour-form');
     const messages = root.querySelector('#contour-messages');
     const result = root.querySelector('#contour-result');
-    form.elements.points.value = SAMPLE;
+    form.elements.points.defaultValue = SAMPLE;
     const sync = () => { form.querySelector('[data-inline-tool]').hidden = value(form, 'tool_choice') !== 'inline'; };
     form.addEventListener('change', sync);
-    loadTools(form.elements.tool_choice, 'inline flat end mill (radius below)').then(sync);
+    loadTools(form.elements.tool_choice, 'inline flat end mill (size below)').then(sync);
     loadMachines(form.elements.machine);
+    machineFields(form, { block_time_ms: 'block_time_ms' });
     sync();
     const request = () => {
-      form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+      clearProblem(form);
       try {
         return contourRequest(form);
       } catch (bad) {
-        form.elements.points.classList.add('invalid');
-        messages.replaceChildren(message('error', `Points: ${bad.error}`));
+        showProblem(messages, form, { status: 400, title: 'Bad input', errors: [{ path: 'contour', message: bad.error }] });
         return null;
       }
     };
@@ -498,13 +404,21 @@ export const contourView = {
       event.preventDefault();
       const body = request();
       if (!body) return;
-      messages.replaceChildren(message('warning', 'computing…'));
+      computing(messages, result);
       try {
         const answer = await api('POST', '/api/v1/contour', body);
-        messages.replaceChildren();
-        contourResult(result, answer).id = 'contour-plot';
+        computed(messages, result);
+        markComputed(form);
+        clearProblem(form);
+        let program = null;
+        try {
+          program = await programOf('/api/v1/contour', body, gcodeQuery(form));
+        } catch (refused) {
+          messages.append(message('error', `No G-code for this path. ${sentence(refused.detail || refused.title)}`, refused.code));
+        }
+        root.querySelector('#contour-gcode').disabled = !program;
+        contourResult(result, answer, { program }).id = 'contour-plot';
       } catch (problem) {
-        result.replaceChildren();
         showProblem(messages, form, problem);
         markContour(form, messages, problem);
       }
@@ -520,5 +434,6 @@ export const contourView = {
         markContour(form, messages, problem);
       }
     });
+    keepForm(id, form);
   },
 };

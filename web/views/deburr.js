@@ -1,45 +1,47 @@
 // Deburr view: a form for one cross-hole ridge, the 3-D plot of ridge and ball-centre path,
 // the summary, warnings and the G-code download (api.md, Deburr).
-import { api, download, gcodeQuery, loadMachines, loadTools, message, number, numeric, programName, showProblem, showSummary, value } from '/app.js';
-import { Plot3D } from '/plot3d.js';
+import { api, program as programOf, sentence } from '/api.js';
+import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
+import { Scene3D, THREE } from '/plot.js';
+import { Timeline } from '/timeline.js';
 
 const FORM = `
 <div class="layout">
   <form id="deburr-form" novalidate>
     <fieldset><legend>Tool</legend>
       <label>Tool <select name="tool_choice" data-field="tool"></select></label>
-      <label data-inline-tool>Ball radius, mm <input name="ball_radius" type="number" step="any" value="2" data-field="tool.radius"></label>
+      <label data-inline-tool>Ball diameter Ø, mm <input name="ball_diameter" type="number" step="any" value="4" data-field="tool.radius"></label>
     </fieldset>
     <fieldset><legend>Workpiece</legend>
       <label>Kind <select name="workpiece_kind" data-field="workpiece.kind">
         <option value="tube">tube</option><option value="bore_block">block with bore</option></select></label>
-      <label>Origin on axis <span class="triple">
+      <label>Point on tube axis x, y, z, mm <span class="triple">
         <input name="ox" type="number" step="any" value="0" data-field="workpiece.origin">
         <input name="oy" type="number" step="any" value="0" data-field="workpiece.origin">
         <input name="oz" type="number" step="any" value="0" data-field="workpiece.origin"></span></label>
-      <label>Arrangement, ° <input name="arrangement" type="number" step="any" value="0" data-field="workpiece.arrangement_angle_deg"></label>
-      <label data-kind="tube">Inner radius <input name="inner_radius" type="number" step="any" value="15" data-field="workpiece.inner_radius"></label>
-      <label data-kind="tube">Outer radius <input name="outer_radius" type="number" step="any" value="25" data-field="workpiece.outer_radius"></label>
-      <label data-kind="bore_block">Bore radius <input name="bore_radius" type="number" step="any" value="20" data-field="workpiece.bore_radius"></label>
-      <label data-kind="bore_block">Face distance <input name="face_distance" type="number" step="any" value="40" data-field="workpiece.face_distance"></label>
+      <label><span>Axis angle from +Y, ° <abbr class="symbol" title="arrangement angle θ_A">θA</abbr></span> <input name="arrangement" type="number" step="any" value="0" data-field="workpiece.arrangement_angle_deg"></label>
+      <label data-kind="tube">Inner radius, mm <input name="inner_radius" type="number" step="any" value="15" data-field="workpiece.inner_radius"></label>
+      <label data-kind="tube">Outer radius, mm <input name="outer_radius" type="number" step="any" value="25" data-field="workpiece.outer_radius"></label>
+      <label data-kind="bore_block">Bore radius, mm <input name="bore_radius" type="number" step="any" value="20" data-field="workpiece.bore_radius"></label>
+      <label data-kind="bore_block">Axis to face, mm <input name="face_distance" type="number" step="any" value="40" data-field="workpiece.face_distance"></label>
     </fieldset>
     <fieldset><legend>Hole</legend>
       <label>Shape <select name="shape" data-field="hole.shape">
         <option value="round">round</option><option value="slot">slot</option><option value="rounded_rect">rounded rectangle</option></select></label>
-      <label>Radius R2 <input name="hole_radius" type="number" step="any" value="5" data-field="hole.radius"></label>
-      <label data-shape="slot">Centre distance <input name="slot_length" type="number" step="any" value="10" data-field="hole.centre_distance"></label>
-      <label data-shape="rounded_rect">Centres across, along <span class="pair">
+      <label><span>Hole radius, mm <abbr class="symbol" title="R2 in the patent">R2</abbr></span> <input name="hole_radius" type="number" step="any" value="5" data-field="hole.radius"></label>
+      <label data-shape="slot">Slot centre distance, mm <input name="slot_length" type="number" step="any" value="10" data-field="hole.centre_distance"></label>
+      <label data-shape="rounded_rect">Corner centres across, along, mm <span class="pair">
         <input name="rect_across" type="number" step="any" value="8" data-field="hole.centre_distance">
         <input name="rect_along" type="number" step="any" value="12" data-field="hole.centre_distance"></span></label>
-      <label>Eccentricity f <input name="eccentricity" type="number" step="any" value="0" data-field="hole.eccentricity"></label>
-      <label>Penetration, ° <input name="penetration" type="number" step="any" value="0" data-field="hole.penetration_angle_deg"></label>
+      <label><span>Hole offset from axis, mm <abbr class="symbol" title="eccentricity f">f</abbr></span> <input name="eccentricity" type="number" step="any" value="0" data-field="hole.eccentricity"></label>
+      <label><span>Hole tilt from +Z, ° <abbr class="symbol" title="penetration angle θ_P">θP</abbr></span> <input name="penetration" type="number" step="any" value="0" data-field="hole.penetration_angle_deg"></label>
     </fieldset>
     <fieldset><legend>Cut</legend>
-      <label>Edge <select name="edge" data-field="edge"><option value="outer">outer</option><option value="inner">inner</option></select></label>
-      <label>Amount Q, mm <input name="cut_amount" type="number" step="any" value="0.2" data-field="cut_amount"></label>
-      <label>Tolerance TA, mm <input name="tolerance" type="number" step="any" value="0.01" data-field="tolerance"></label>
-      <label>Method <select name="method" data-field="method"><option value="tangent">tangent (seed)</option><option value="exact">exact width</option></select></label>
-      <label>Direction <select name="direction" data-field="direction"><option value="ccw">ccw (climb)</option><option value="cw">cw</option></select></label>
+      <label>Which edge <select name="edge" data-field="edge"><option value="outer">outer (tube outside)</option><option value="inner">inner (bore)</option></select></label>
+      <label><span>Chamfer size, mm <abbr class="symbol" title="cut amount Q; width W = √2·Q">Q</abbr></span> <input name="cut_amount" type="number" step="any" value="0.2" data-field="cut_amount"></label>
+      <label><span>Path tolerance, mm <abbr class="symbol" title="TA">TA</abbr></span> <input name="tolerance" type="number" step="any" value="0.01" data-field="tolerance"></label>
+      <label>Method <select name="method" data-field="method"><option value="tangent">tangent construction</option><option value="exact">exact chamfer width</option></select></label>
+      <label>Cutting direction <select name="direction" data-field="direction"><option value="ccw">ccw (climb)</option><option value="cw">cw</option></select></label>
       <label>Feed, mm/min <input name="feed" type="number" step="any" value="300" data-field="feed"></label>
       <label>Spindle, rpm <input name="spindle_rpm" type="number" step="any" value="6000" data-field="spindle_rpm"></label>
       <label>Machine <select name="machine" data-field="machine"></select></label>
@@ -61,7 +63,7 @@ const FORM = `
 // The request body from the form (field names as api.md).
 export function deburrRequest(form) {
   const choice = value(form, 'tool_choice');
-  const tool = choice === 'inline' ? { kind: 'ball', radius: numeric(form, 'ball_radius') } : Number(choice);
+  const tool = choice === 'inline' ? { kind: 'ball', radius: half(numeric(form, 'ball_diameter')) } : Number(choice);
   const origin = [numeric(form, 'ox') ?? 0, numeric(form, 'oy') ?? 0, numeric(form, 'oz') ?? 0];
   const kind = value(form, 'workpiece_kind');
   const workpiece = kind === 'tube'
@@ -95,79 +97,170 @@ function syncVisibility(form) {
 }
 
 
-// Shows a deburr answer in `container`: plot of ridge, centres and leads, summary, warnings.
-// Used by the form and by job results.
-export function deburrResult(container, answer) {
+// The solids of the request in machine coordinates (deburr.md §1.3: local y along the cylinder
+// axis A1, z along the hole axis A2, g = O + R_z(θ_A)·R_y(θ_P)·l): the tube or bored block and the
+// hole's wall, drawn see-through.
+function addWorkpiece(scene, request) {
+  const { workpiece, hole } = request;
+  const deg = Math.PI / 180;
+  const matrix = new THREE.Matrix4().makeRotationZ((workpiece.arrangement_angle_deg || 0) * deg)
+    .multiply(new THREE.Matrix4().makeRotationY((hole.penetration_angle_deg || 0) * deg))
+    .setPosition(...workpiece.origin);
+  const outer = workpiece.kind === 'tube' ? workpiece.outer_radius : workpiece.face_distance ?? workpiece.bore_radius * 2;
+  const inner = workpiece.kind === 'tube' ? workpiece.inner_radius : workpiece.bore_radius;
+  if (![outer, inner, hole.radius].every((v) => Number.isFinite(v) && v > 0)) return;
+  const along = Array.isArray(hole.centre_distance) ? hole.centre_distance[1] : hole.centre_distance || 0;
+  const across = Array.isArray(hole.centre_distance) ? hole.centre_distance[0] : 0;
+  const length = Math.max(2.4 * outer, 4 * hole.radius + 2 * along);
+  // Cross-sections in the x_L–z_L plane, extruded along z then turned so z becomes y_L (A1).
+  const section = new THREE.Shape();
+  if (workpiece.kind === 'tube') section.absarc(0, 0, outer, 0, 2 * Math.PI, false);
+  else section.moveTo(-outer, -outer).lineTo(outer, -outer).lineTo(outer, outer).lineTo(-outer, outer).closePath();
+  const bore = new THREE.Path();
+  bore.absarc(0, 0, inner, 0, 2 * Math.PI, true);
+  section.holes.push(bore);
+  const body = new THREE.ExtrudeGeometry(section, { depth: length, bevelEnabled: false, curveSegments: 72 });
+  body.translate(0, 0, -length / 2);
+  body.rotateX(-Math.PI / 2);
+  body.scale(1, 1, -1);
+  scene.solid(workpiece.kind, body, { colour: '#7f97ad', opacity: 0.18, matrix, legend: workpiece.kind === 'tube' ? 'tube' : 'block with bore' });
+  // The hole seen along A2: circle, slot (straight sides along A1) or rounded rectangle.
+  const f = hole.eccentricity || 0;
+  const r = hole.radius;
+  const a = across / 2;
+  const b = along / 2;
+  const wall = new THREE.Shape();
+  wall.absarc(f + a, b, r, 0, Math.PI / 2, false);
+  wall.absarc(f - a, b, r, Math.PI / 2, Math.PI, false);
+  wall.absarc(f - a, -b, r, Math.PI, 1.5 * Math.PI, false);
+  wall.absarc(f + a, -b, r, 1.5 * Math.PI, 2 * Math.PI, false);
+  // Through the wall only: from just inside the bore to just outside the outer surface or face.
+  const [from, to] = [inner * 0.8, outer * 1.1];
+  const hollow = new THREE.ExtrudeGeometry(wall, { depth: to - from, bevelEnabled: false, curveSegments: 48 });
+  hollow.translate(0, 0, from);
+  scene.solid('hole', hollow, { colour: '#37474f', opacity: 0.22, matrix, legend: 'hole wall' });
+}
+
+// Shows a deburr answer in `container`: the 3-D scene (solids when the request is known, ridge,
+// ball-centre path, approach and retract, the tool at the timeline's move), summary, warnings,
+// and with a program the timeline and its listing. `context`: {request, program, problem,
+// reference}. Used by the form and by job results.
+export function deburrResult(container, answer, context = {}) {
   container.replaceChildren();
-  const canvas = document.createElement('canvas');
-  canvas.className = 'plot';
-  canvas.setAttribute('aria-label', 'Ridge line and tool-centre path');
-  const hint = document.createElement('p');
-  hint.className = 'hint';
-  hint.textContent = 'Drag to rotate, shift-drag to pan, wheel to zoom, double-click to reset.';
+  const { request, program, problem, reference = 'tip' } = context;
   const warnings = document.createElement('div');
   const summaryBox = document.createElement('div');
   summaryBox.className = 'summary';
-  container.append(canvas, hint, warnings, summaryBox);
-
+  const sceneBox = document.createElement('div');
+  container.append(summaryBox, warnings, sceneBox);
   const points = answer.points;
   const centres = (moves) => moves.map((m) => m.centre);
-  new Plot3D(canvas).setSeries([
-    { label: 'ridge (targets)', points: points.map((p) => p.target), colour: '#555', width: 1.5 },
-    { label: 'ball centres', points: points.map((p) => p.centre), colour: '#0b63b6', width: 2, marks: true },
-    { label: 'approach / retract', points: centres(answer.lead_in), colour: '#c77700', width: 1.5, dash: [5, 4] },
-    { label: '', points: answer.lead_out.length ? [points[points.length - 1].centre, ...centres(answer.lead_out)] : [], colour: '#c77700', width: 1.5, dash: [5, 4] },
-  ]);
+  const scene = new Scene3D(sceneBox, {
+    label: 'Tube, hole, ridge line and tool-centre path in 3-D',
+    presets: request ? [{ label: 'Along hole axis', direction: holeAxis(request) }] : [],
+  });
+  if (request) addWorkpiece(scene, request);
+  scene.path('ridge', points.map((p) => p.target), { colour: '#555555', legend: 'ridge (where the edges meet)' });
+  scene.path('centres', [...points.map((p) => p.centre), points[0].centre], { colour: '#0b63b6', legend: 'ball-centre path' });
+  const refused = Boolean(problem);
+  const lead = { colour: refused ? '#b3261e' : '#c77700', dashed: true };
+  scene.path('lead-in', centres(answer.lead_in), { ...lead, legend: refused ? 'approach / retract (refused, see above)' : 'approach / retract' });
+  if (answer.lead_out.length) scene.path('lead-out', [points[points.length - 1].centre, ...centres(answer.lead_out)], lead);
+  const tool = answer.tool || {};
+  scene.tool({ radius: tool.radius || 1, neck: tool.neck_radius, shankLength: tool.stickout, colour: refused ? '#b3261e' : undefined });
+  scene.root.dataset.refused = String(refused);
+  scene.finish();
+  scene.moveTool(points[0].centre);
+  if (program) {
+    const lift = reference === 'tip' ? tool.radius || 0 : 0;
+    new Timeline(container, program, {
+      label: 'Timeline',
+      onMove: (move) => scene.moveTool([move.position[0], move.position[1], move.position[2] + lift]),
+    });
+  }
   const s = answer.summary;
   const items = [
-    ['edge', `${answer.edge} (${answer.method})`], ['points', s.count], ['path length, mm', number(s.path_length, 3)],
-    ['max deviation, mm', number(s.max_deviation, 5)], ['width W, mm', number(s.width)],
+    ['edge', `${answer.edge} (${answer.method === 'exact' ? 'exact width' : 'tangent construction'})`], ['points', s.count], ['path length, mm', number(s.path_length, 3)],
+    ['largest deviation, mm', number(s.max_deviation, 5)], ['chamfer width W, mm', number(s.width)],
     ['true width, mm', `${number(s.true_width_min)} – ${number(s.true_width_max)}`],
     ['wedge angle, °', `${number(s.wedge_angle_min_deg, 2)} – ${number(s.wedge_angle_max_deg, 2)}`],
-    ['est. time, s', number(s.estimated_time_s, 1)],
+    ['estimated time, s', number(s.estimated_time_s, 1)],
   ];
-  if (s.max_exact_offset !== undefined) items.push(['exact vs seed, mm', number(s.max_exact_offset, 5)]);
+  if (s.max_exact_offset !== undefined) items.push(['exact vs tangent, mm', number(s.max_exact_offset, 5)]);
   if (s.blocks !== undefined) {
     items.push(['blocks (short)', `${s.blocks} (${s.short_blocks})`], ['block length, mm', number(s.block_length, 4)]);
   }
   if (answer.machine) items.push(['machine', `${answer.machine.name} (${answer.machine.dialect})`]);
   showSummary(summaryBox, items);
-  warnings.replaceChildren(...answer.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
-  return canvas;
+  warnings.replaceChildren(...warningMessages(answer.warnings));
+  return scene.root;
+}
+
+// The direction the hole axis A2 points (the view "along the hole axis" looks down it).
+function holeAxis(request) {
+  const deg = Math.PI / 180;
+  const ta = (request.workpiece.arrangement_angle_deg || 0) * deg;
+  const tp = (request.hole.penetration_angle_deg || 0) * deg;
+  return [Math.cos(ta) * Math.sin(tp), Math.sin(ta) * Math.sin(tp), Math.cos(tp)];
 }
 
 export const deburrView = {
-  id: 'deburr',
-  title: 'Deburr',
-  mount(root) {
+  mount(root, id) {
     root.innerHTML = FORM;
     const form = root.querySelector('#deburr-form');
     const messages = root.querySelector('#deburr-messages');
     const result = root.querySelector('#deburr-result');
+    const gcode = root.querySelector('#deburr-gcode');
     form.addEventListener('change', () => syncVisibility(form));
-    loadTools(form.elements.tool_choice, 'inline ball (radius below)', (tool) => tool.kind === 'ball').then(() => syncVisibility(form));
+    loadTools(form.elements.tool_choice, 'inline ball (size below)', (tool) => tool.kind === 'ball').then(() => syncVisibility(form));
     loadMachines(form.elements.machine);
+    machineFields(form, { block_time_ms: 'block_time_ms' });
     syncVisibility(form);
+    let last = null;
+    // Draws the answer with the program in the chosen dialect and reference; without a program
+    // (the service refuses it, e.g. a neck collision) the G-code button is off and says why.
+    const draw = async () => {
+      if (!last) return;
+      const reference = value(form, 'reference');
+      let program = null;
+      let problem = null;
+      try {
+        program = await programOf('/api/v1/deburr', last.request, gcodeQuery(form));
+      } catch (refused) {
+        problem = refused;
+      }
+      gcode.disabled = !program;
+      gcode.title = program ? '' : `No program: ${sentence(problem?.detail || problem?.title)}`;
+      deburrResult(result, last.answer, { request: last.request, program, problem, reference }).id = 'deburr-plot';
+      // The answer says so itself when it carries W_NO_PROGRAM.
+      if (problem && !last.answer.warnings.some((w) => w.code === 'W_NO_PROGRAM')) {
+        messages.append(message('error', `No G-code for this path. ${sentence(problem.detail || problem.title)}`, problem.code));
+      }
+    };
+    form.elements.dialect.addEventListener('change', draw);
+    form.elements.reference.addEventListener('change', draw);
     form.addEventListener('submit', async (event) => {
       event.preventDefault();
-      form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
-      messages.replaceChildren(message('warning', 'computing…'));
+      computing(messages, result);
+      const request = deburrRequest(form);
       try {
-        const answer = await api('POST', '/api/v1/deburr', deburrRequest(form));
-        messages.replaceChildren();
-        deburrResult(result, answer).id = 'deburr-plot';
-      } catch (problem) {
-        result.replaceChildren();
-        showProblem(messages, form, problem);
-      }
-    });
-    root.querySelector('#deburr-gcode').addEventListener('click', async () => {
-      try {
-        const program = await api('POST', `/api/v1/deburr${gcodeQuery(form)}`, deburrRequest(form), 'text/x-gcode');
-        download(programName('deburr', form), program);
+        const answer = await api('POST', '/api/v1/deburr', request);
+        clearProblem(form);
+        computed(messages, result);
+        markComputed(form);
+        last = { request, answer };
+        await draw();
       } catch (problem) {
         showProblem(messages, form, problem);
       }
     });
+    gcode.addEventListener('click', async () => {
+      try {
+        download(programName('deburr', form), await programOf('/api/v1/deburr', deburrRequest(form), gcodeQuery(form)));
+      } catch (problem) {
+        showProblem(messages, form, problem);
+      }
+    });
+    keepForm(id, form);
   },
 };

@@ -4,7 +4,8 @@
 // summed chip thickness per flute count with the threshold, representative values and time per
 // k with the recommended k highlighted, and the feed plan; a cursor on any chart marks the tool
 // on the path. The result renderer is shared with the Jobs view.
-import { api, download, gcodeQuery, loadMachines, loadTools, message, number, numeric, programName, showProblem, showSummary, toolLabel, value } from '/app.js';
+import { api } from '/api.js';
+import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
   { name: 'straight', text: '-10 20\n70 20' },
@@ -17,40 +18,40 @@ const FORM = `
   <form id="engagement-form" novalidate>
     <fieldset><legend>Tool</legend>
       <label>Tool <select name="tool_choice" data-field="tool"></select></label>
-      <label data-inline-tool>Radius, mm <input name="tool_radius" type="number" step="any" value="5" data-field="tool.radius"></label>
+      <label data-inline-tool>Tool diameter Ø, mm <input name="tool_diameter" type="number" step="any" value="10" data-field="tool.radius"></label>
       <label data-inline-tool>Flutes <input name="tool_flutes" type="number" step="1" value="2" data-field="tool.flutes"></label>
     </fieldset>
     <fieldset><legend>Stock (plan view)</legend>
-      <label>Outline x y <textarea name="stock_polygon" rows="4" data-field="stock.polygon" spellcheck="false">0 0
+      <label>Outline, x y in mm per line <textarea name="stock_polygon" rows="4" data-field="stock.polygon" spellcheck="false">0 0
 60 0
 60 40
 0 40</textarea></label>
-      <label>Holes <textarea name="stock_holes" rows="2" data-field="stock.holes" spellcheck="false" placeholder="x y per line; blank line between holes"></textarea></label>
+      <label>Holes, mm <textarea name="stock_holes" rows="2" data-field="stock.holes" spellcheck="false" placeholder="x y per line; blank line between holes"></textarea></label>
     </fieldset>
     <fieldset><legend>Tool-centre paths</legend>
-      <p class="hint">Points "x y" per line (feed moves), or JSON: <code>[[x, y], ...]</code> or <code>{"start": [x, y], "segments": [{"type": "arc", "to": [x, y], "center": [x, y], "dir": "ccw"}]}</code>.</p>
+      <p class="hint">Points "x y" per line (feed moves), a G-code program (pasted or opened; its XY moves), or JSON: <code>[[x, y], ...]</code> or <code>{"start": [x, y], "segments": [{"type": "arc", "to": [x, y], "center": [x, y], "dir": "ccw"}]}</code>.</p>
       <div id="engagement-paths"></div>
       <div class="actions"><button class="secondary" type="button" id="engagement-add-path">Add path</button></div>
     </fieldset>
     <fieldset><legend>Cutting</legend>
       <label>Spindle, rpm <input name="spindle_rpm" type="number" step="any" value="3000" data-field="spindle_rpm"></label>
       <label>Feed per tooth, mm <input name="feed_per_tooth" type="number" step="any" value="0.05" data-field="feed_per_tooth"></label>
-      <label>Flute counts <input name="flute_counts" type="text" value="1-8" data-field="flute_counts" title="e.g. 1-8 or 2,3,4"></label>
-      <label>Rotation <select name="spindle_direction" data-field="spindle_direction"><option value="cw">cw (M03)</option><option value="ccw">ccw (M04)</option></select></label>
+      <label>Flute counts to compare <input name="flute_counts" type="text" value="1-8" data-field="flute_counts" title="e.g. 1-8 or 2,3,4"></label>
+      <label>Spindle rotation <select name="spindle_direction" data-field="spindle_direction"><option value="cw">cw (M03)</option><option value="ccw">ccw (M04)</option></select></label>
     </fieldset>
     <fieldset><legend>Limits</legend>
-      <label>Thickness T1, mm <input name="thickness_limit" type="number" step="any" value="0.075" data-field="thickness_limit"></label>
-      <label>Time T2, s <input name="time_limit_s" type="number" step="any" value="20" data-field="time_limit_s"></label>
-      <label>Statistic <select name="representative" data-field="representative"><option value="max">max</option><option value="mean">mean</option><option value="median">median</option></select></label>
+      <label><span>Chip thickness limit, mm <abbr class="symbol" title="T1 in engagement.md">T1</abbr></span> <input name="thickness_limit" type="number" step="any" value="0.075" data-field="thickness_limit"></label>
+      <label><span>Machining time limit, s <abbr class="symbol" title="T2 in engagement.md">T2</abbr></span> <input name="time_limit_s" type="number" step="any" value="20" data-field="time_limit_s"></label>
+      <label>Chip thickness judged by <select name="representative" data-field="representative"><option value="max">largest</option><option value="mean">mean</option><option value="median">median</option></select></label>
     </fieldset>
     <fieldset><legend>Simulation</legend>
-      <label>Engine <select name="engine" data-field="engine"><option value="exact">exact boundary</option><option value="dots">dots (seed)</option></select></label>
-      <label>Step Δs, mm <input name="step" type="number" step="any" placeholder="D/50" data-field="step"></label>
-      <label data-engine="dots">Grid g, mm <input name="grid" type="number" step="any" placeholder="D/200" data-field="grid"></label>
+      <label>Engine <select name="engine" data-field="engine"><option value="exact">exact boundary</option><option value="dots">dot grid (patent method)</option></select></label>
+      <label><span>Step along the path, mm <abbr class="symbol" title="Δs">Δs</abbr></span> <input name="step" type="number" step="any" placeholder="D/50" data-field="step"></label>
+      <label data-engine="dots"><span>Dot spacing, mm <abbr class="symbol" title="g">g</abbr></span> <input name="grid" type="number" step="any" placeholder="D/200" data-field="grid"></label>
     </fieldset>
     <fieldset><legend>G-code and feed plan</legend>
-      <label>Axial depth a_p, mm <input name="axial_depth" type="number" step="any" value="2" data-field="axial_depth"></label>
-      <label>Target chip h*, mm <input name="target_thickness" type="number" step="any" value="0.05" data-field="feed_plan.target_thickness" title="empty: no feed plan, nominal feed"></label>
+      <label><span>Depth of cut, mm <abbr class="symbol" title="axial depth a_p">a_p</abbr></span> <input name="axial_depth" type="number" step="any" value="2" data-field="axial_depth"></label>
+      <label><span>Target chip thickness, mm <abbr class="symbol" title="h*">h*</abbr></span> <input name="target_thickness" type="number" step="any" value="0.05" data-field="feed_plan.target_thickness" title="empty: no feed plan, nominal feed"></label>
       <label>Max feed, mm/min <input name="max_feed" type="number" step="any" value="2000" placeholder="machine's" data-field="feed_plan.max_feed"></label>
       <label>Machine <select name="machine" data-field="machine"></select></label>
     </fieldset>
@@ -81,6 +82,11 @@ class InputError {
 }
 
 // "x y" per line (or "x, y"), or JSON. Returns the JSON value or a list of points.
+// Whether a path box holds a G-code program (words like G1, X10) rather than "x y" lines.
+function isGcode(text) {
+  return /^\s*%|(^|\s)[GXYNO]\s*[-+]?\d/im.test(text) && !/^\s*[[{]/.test(text);
+}
+
 function parsePoints(text, field) {
   const trimmed = text.trim();
   if (trimmed.startsWith('[') || trimmed.startsWith('{')) {
@@ -122,7 +128,7 @@ function pathBoxes(form) {
 export function engagementRequest(form) {
   const choice = value(form, 'tool_choice');
   const tool = choice === 'inline'
-    ? { kind: 'flat', radius: numeric(form, 'tool_radius'), flutes: numeric(form, 'tool_flutes') }
+    ? { kind: 'flat', radius: half(numeric(form, 'tool_diameter')), flutes: numeric(form, 'tool_flutes') }
     : Number(choice);
   const stock = { polygon: parsePoints(value(form, 'stock_polygon'), 'stock.polygon') };
   const holes = value(form, 'stock_holes').trim();
@@ -131,7 +137,8 @@ export function engagementRequest(form) {
   const body = { tool, stock };
   const paths = boxes.map((box, index) => {
     const field = boxes.length > 1 ? `paths[${index}].path` : 'path';
-    return { name: box.querySelector('input').value.trim() || undefined, path: parsePoints(box.querySelector('textarea').value, field) };
+    const text = box.querySelector('textarea').value;
+    return { name: box.querySelector('input').value.trim() || undefined, path: isGcode(text) ? { gcode: text } : parsePoints(text, field) };
   });
   if (paths.length === 1) body.path = paths[0].path;
   else body.paths = paths;
@@ -154,25 +161,21 @@ export function engagementRequest(form) {
   return body;
 }
 
-// Marks inputs whose data-field is the error's path or a parent of it (`stock.polygon` for
-// `stock.polygon[3][0]`).
-function markFields(form, problem) {
-  for (const error of problem.errors || []) {
-    for (const element of form.querySelectorAll('[data-field]')) {
-      const field = element.dataset.field;
-      if (error.path === field || error.path.startsWith(`${field}.`) || error.path.startsWith(`${field}[`)) {
-        element.classList.add('invalid');
-      }
-    }
-  }
-}
-
 function addPath(form, name = '', text = '') {
   const box = document.createElement('div');
   box.className = 'engagement-path';
   box.innerHTML = `<label>Name <input type="text"></label>
-    <label>Points <textarea rows="4" spellcheck="false"></textarea></label>
-    <div class="actions"><button class="secondary" type="button">Remove</button></div>`;
+    <label>Points or G-code <textarea rows="4" spellcheck="false"></textarea></label>
+    <div class="actions"><label class="pick secondary">Open a G-code file<input type="file" accept=".nc,.ngc,.tap,.gcode,.cnc,.txt"></label>
+      <button class="secondary" type="button">Remove</button></div>`;
+  box.querySelector('input[type="file"]').addEventListener('change', async (event) => {
+    const file = event.target.files[0];
+    if (!file) return;
+    box.querySelector('textarea').value = await file.text();
+    if (!box.querySelector('input[type="text"]').value) box.querySelector('input[type="text"]').value = file.name;
+    event.target.value = '';
+    form.dispatchEvent(new Event('input'));
+  });
   box.querySelector('input').value = name;
   box.querySelector('textarea').value = text;
   box.querySelector('button').addEventListener('click', () => {
@@ -828,10 +831,21 @@ function renderColumn(column, result, answer, axis) {
   const planView = new PlanView(plan, result, answer);
   planView.draw();
   let series;
+  // The timeline along the samples: the same cursor from the keyboard (arrow keys step).
+  const slider = document.createElement('input');
+  slider.type = 'range';
+  slider.min = '0';
+  slider.max = String(Math.max(0, result.samples.length - 1));
+  slider.value = '0';
+  slider.className = 'sample-timeline';
+  slider.setAttribute('aria-label', `Timeline along ${result.name || 'the path'} (tool position)`);
+  slider.addEventListener('input', () => setCursor(Number(slider.value)));
+  info.before(slider);
   const setCursor = (index) => {
     planView.cursor(index);
     series.cursor(index);
     info.textContent = readout(index === undefined ? undefined : result.samples[index], result);
+    if (index !== undefined) slider.value = String(index);
   };
   series = seriesCharts(column, result, answer, axis, setCursor);
   plan.addEventListener('pointermove', (event) => setCursor(planView.nearest(event)));
@@ -849,8 +863,10 @@ function renderColumn(column, result, answer, axis) {
     const counts = new Map();
     for (const w of result.warnings) counts.set(w.code, (counts.get(w.code) || 0) + 1);
     const summaryLine = document.createElement('summary');
-    summaryLine.textContent = `Warnings: ${[...counts].map(([code, n]) => (n > 1 ? `${code} ×${n}` : code)).join(', ')}`;
-    details.append(summaryLine, ...result.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
+    const words = (code) => code.replace(/^W_/, '').toLowerCase().replace(/_/g, ' ');
+    summaryLine.textContent = `Warnings: ${[...counts].map(([code, n]) => (n > 1 ? `${words(code)} ×${n}` : words(code))).join(', ')}`;
+    summaryLine.title = [...counts.keys()].join(', ');
+    details.append(summaryLine, ...warningMessages(result.warnings));
     column.append(details);
   }
   column.cursor = setCursor;
@@ -858,7 +874,10 @@ function renderColumn(column, result, answer, axis) {
 
 // Shows an engagement answer in `container`: one column per candidate path, side by side.
 // Used by the form and by job results.
-export function engagementResult(container, answer) {
+// Shows an engagement answer in `container`: one candidate path at a time, chosen with tabs that
+// name each path's best flute count; the charts take the width of the result column.
+// `onSelect(index)` hears which candidate is shown (the form's G-code choice follows it).
+export function engagementResult(container, answer, { onSelect } = {}) {
   container.replaceChildren();
   const candidates = answer.candidates || [answer];
   const controls = document.createElement('div');
@@ -866,29 +885,70 @@ export function engagementResult(container, answer) {
   const axis = document.createElement('select');
   axis.setAttribute('aria-label', 'x axis');
   axis.append(new Option('x axis: path length', 'length'), new Option('x axis: time', 'time'));
-  controls.append(axis);
+  const tabs = document.createElement('div');
+  tabs.setAttribute('role', 'tablist');
+  tabs.setAttribute('aria-label', 'Candidate paths');
+  tabs.className = 'tabs';
+  controls.append(tabs, axis);
   const columns = document.createElement('div');
   columns.className = 'candidates';
-  columns.style.gridTemplateColumns = `repeat(${candidates.length}, minmax(320px, 1fr))`;
   container.append(controls, columns);
-  const cells = candidates.map(() => {
+  const id = `candidate-${Math.random().toString(36).slice(2, 8)}`;
+  const cells = candidates.map((result, i) => {
     const column = document.createElement('div');
     column.className = 'candidate';
+    column.id = `${id}-${i}`;
+    column.setAttribute('role', 'tabpanel');
+    const tab = document.createElement('button');
+    tab.type = 'button';
+    tab.setAttribute('role', 'tab');
+    tab.setAttribute('aria-controls', column.id);
+    const best = result.recommended?.[0];
+    tab.textContent = `${result.name || `path ${i}`}${best ? ` · best ${best} flutes` : ' · no flute count fits'}`;
+    tab.addEventListener('click', () => select(i));
+    tab.addEventListener('keydown', (e) => {
+      const step = { ArrowRight: 1, ArrowLeft: -1 }[e.key];
+      if (!step) return;
+      e.preventDefault();
+      select((i + step + candidates.length) % candidates.length);
+      tabs.children[(i + step + candidates.length) % candidates.length].focus();
+    });
+    tabs.append(tab);
     columns.append(column);
     return column;
   });
+  let shown = 0;
+  const select = (index) => {
+    shown = index;
+    cells.forEach((cell, i) => {
+      cell.hidden = i !== index;
+      tabs.children[i].setAttribute('aria-selected', String(i === index));
+      tabs.children[i].tabIndex = i === index ? 0 : -1;
+    });
+    // Drawn again now that it has its width.
+    renderColumn(cells[index], candidates[index], answer, axis.value);
+    onSelect?.(index);
+  };
   const render = () => candidates.forEach((result, i) => renderColumn(cells[i], result, answer, axis.value));
   axis.addEventListener('change', render);
   render();
+  select(shown);
+  // Charts follow the width of the result column (a window resized, columns stacked).
+  let width = columns.clientWidth;
+  let timer = null;
+  new ResizeObserver(() => {
+    if (!columns.isConnected || !columns.clientWidth || Math.abs(columns.clientWidth - width) < 20) return;
+    width = columns.clientWidth;
+    clearTimeout(timer);
+    timer = setTimeout(() => renderColumn(cells[shown], candidates[shown], answer, axis.value), 150);
+  }).observe(columns);
   return cells;
 }
 
 // ---------------------------------------------------------------------------------------------
 
 export const engagementView = {
-  id: 'engagement',
-  title: 'Engagement',
-  mount(root) {
+  mount(root, id) {
     root.innerHTML = FORM;
     const form = root.querySelector('#engagement-form');
     const messages = root.querySelector('#engagement-messages');
@@ -896,12 +956,12 @@ export const engagementView = {
     for (const sample of SAMPLE_PATHS) addPath(form, sample.name, sample.text);
     root.querySelector('#engagement-add-path').addEventListener('click', () => addPath(form, `path ${pathBoxes(form).length + 1}`, ''));
     form.addEventListener('change', () => syncVisibility(form));
-    loadTools(form.elements.tool_choice, 'inline flat end mill (below)', () => true, (tool) => `${toolLabel(tool)} z${tool.flutes}`).then(() => syncVisibility(form));
+    loadTools(form.elements.tool_choice, 'inline flat end mill (size below)', () => true, (tool) => `${toolLabel(tool)} z${tool.flutes}`).then(() => syncVisibility(form));
     loadMachines(form.elements.machine);
+    machineFields(form, { max_feed: 'max_feed' });
     syncVisibility(form);
     const fail = (problem) => {
       showProblem(messages, form, problem);
-      markFields(form, problem);
     };
     const fillCandidates = () => {
       const select = form.elements.candidate;
@@ -913,22 +973,23 @@ export const engagementView = {
     form.addEventListener('input', fillCandidates);
     form.addEventListener('submit', async (event) => {
       event.preventDefault();
-      form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+      clearProblem(form);
       fillCandidates();
       try {
         const body = engagementRequest(form);
-        messages.replaceChildren(message('warning', 'computing…'));
+        computing(messages, result);
         const answer = await api('POST', '/api/v1/engagement', body);
-        messages.replaceChildren();
-        engagementResult(result, answer);
+        computed(messages, result);
+        markComputed(form);
+        clearProblem(form);
+        engagementResult(result, answer, { onSelect: (i) => { form.elements.candidate.value = String(i); } });
         result.dataset.state = 'drawn';
       } catch (problem) {
-        result.replaceChildren();
         fail(problem);
       }
     });
     root.querySelector('#engagement-gcode').addEventListener('click', async () => {
-      form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+      clearProblem(form);
       const candidate = value(form, 'candidate') || '0';
       try {
         const program = await api('POST', `/api/v1/engagement${gcodeQuery(form)}&candidate=${candidate}`, engagementRequest(form), 'text/x-gcode');
@@ -937,6 +998,22 @@ export const engagementView = {
       } catch (problem) {
         fail(problem);
       }
+    });
+    keepForm(id, form, {
+      more: {
+        save: () => pathBoxes(form).map((box) => ({ name: box.querySelector('input').value, text: box.querySelector('textarea').value })),
+        restore: (paths) => {
+          if (!Array.isArray(paths) || !paths.length) return;
+          pathBoxes(form).forEach((box) => box.remove());
+          for (const path of paths) addPath(form, path.name, path.text);
+          fillCandidates();
+        },
+      },
+      onReset: (clear) => {
+        pathBoxes(form).forEach((box) => box.remove());
+        for (const sample of clear ? [{ name: 'path 1', text: '' }] : SAMPLE_PATHS) addPath(form, sample.name, sample.text);
+        fillCandidates();
+      },
     });
   },
 };

@@ -1,16 +1,8 @@
 // Jobs workbench: drop or pick a job file, watch it queue and run, browse past jobs, open a
 // result with the view of its operation, download G-code and JSON (api.md, Jobs).
-import { api, download, message, showProblem } from '/app.js';
-import { contourResult } from '/views/contour.js';
-import { deburrResult } from '/views/deburr.js';
-import { engagementResult } from '/views/engagement.js';
-import { predictResult } from '/views/predict.js';
-import { segmentResult } from '/views/segment.js';
-
-// How each operation's result is shown; later capabilities add theirs here.
-const resultViews = {
-  deburr: deburrResult, segment: segmentResult, contour: contourResult, engagement: engagementResult, predict: predictResult,
-};
+import { api, sentence } from '/api.js';
+import { download, message, showProblem } from '/form.js';
+import { resultView } from '/views.js';
 
 const LAYOUT = `
 <section>
@@ -18,8 +10,8 @@ const LAYOUT = `
     <p><b>Drop a job file here</b> (JSON or TOML) or <label class="pick">choose one<input id="job-file" type="file" accept=".json,.toml,application/json,application/toml"></label></p>
   </div>
   <div id="job-messages"></div>
-  <table class="jobs"><thead><tr><th>job</th><th>name</th><th>operations</th><th>status</th><th>progress</th><th>submitted</th><th></th></tr></thead>
-    <tbody id="job-rows"></tbody></table>
+  <div class="table-scroll"><table class="jobs"><thead><tr><th>job</th><th>name</th><th>operations</th><th>status</th><th>progress</th><th>submitted</th><th></th></tr></thead>
+    <tbody id="job-rows"></tbody></table></div>
   <div class="actions"><button class="secondary" id="job-older" type="button" hidden>Older jobs</button></div>
   <div id="job-result"></div>
 </section>`;
@@ -94,6 +86,14 @@ async function refresh(root) {
     for (const job of page.jobs) state.jobs.set(job.id, job);
     if (state.next === null && page.next_before !== undefined) state.next = page.next_before;
     render(root);
+    // The "queued" banner of a job that has finished says how it ended.
+    const banner = root.querySelector('#job-messages .message[data-job]');
+    const watched = banner && state.jobs.get(Number(banner.dataset.job));
+    if (watched && !['queued', 'running'].includes(watched.status)) {
+      const done = watched.status === 'done';
+      const text = `Job #${watched.id} ${done ? 'is done: open it below' : watched.status}${watched.error ? `: ${watched.error}` : ''}.`;
+      root.querySelector('#job-messages').replaceChildren(message(done ? 'ok' : 'error', text));
+    }
     const active = page.jobs.some((j) => j.status === 'queued' || j.status === 'running');
     clearTimeout(state.timer);
     if (active && document.body.contains(root)) state.timer = setTimeout(() => refresh(root), 700);
@@ -117,6 +117,7 @@ async function openJob(id, root) {
     const title = document.createElement('h2');
     title.textContent = `Job #${job.id}${job.name ? ': ' + job.name : ''}`;
     box.append(title);
+    const shown = [];
     job.results.forEach((result, index) => {
       const section = document.createElement('section');
       section.className = 'job-operation';
@@ -139,13 +140,21 @@ async function openJob(id, root) {
         });
         actions.append(gcode);
       } else if (result.gcode_problem) {
-        actions.append(message('warning', `no G-code: ${result.gcode_problem}`));
+        actions.append(message('warning', `No G-code: ${sentence(result.gcode_problem)}`));
       }
       const view = document.createElement('div');
       section.append(heading, actions, view);
       box.append(section);
-      (resultViews[result.operation] || ((c, r) => { c.textContent = JSON.stringify(r).slice(0, 2000); }))(view, result.result);
+      const show = resultView(result.operation) || ((c, r) => { c.textContent = JSON.stringify(r).slice(0, 2000); });
+      shown.push((async () => {
+        // With its program, the result gets the timeline and listing too.
+        const program = result.gcode
+          ? await api('GET', `/api/v1/jobs/${id}/gcode?operation=${index}`, undefined, 'text/x-gcode').catch(() => null)
+          : null;
+        show(view, result.result, program ? { program } : {});
+      })());
     });
+    await Promise.all(shown);
     box.scrollIntoView({ behavior: 'smooth', block: 'start' });
   } catch (problem) {
     showProblem(root.querySelector('#job-messages'), null, problem);
@@ -158,9 +167,11 @@ async function submit(file, root) {
   form.append('file', file, file.name);
   try {
     const answer = await api('POST', '/api/v1/jobs', form);
-    messages.replaceChildren(message('warning', answer.reused
-      ? `${file.name}: identical to job #${answer.id}, reusing its result`
-      : `${file.name}: queued as job #${answer.id}`));
+    const banner = message(answer.reused ? 'ok' : 'info', answer.reused
+      ? `${file.name}: identical to job #${answer.id}, reusing its result.`
+      : `${file.name}: queued as job #${answer.id}.`);
+    if (!answer.reused) banner.dataset.job = String(answer.id);
+    messages.replaceChildren(banner);
     await refresh(root);
     if (answer.reused) openJob(answer.id, root);
   } catch (problem) {
@@ -169,8 +180,6 @@ async function submit(file, root) {
 }
 
 export const jobsView = {
-  id: 'jobs',
-  title: 'Jobs',
   mount(root) {
     root.innerHTML = LAYOUT;
     state.jobs.clear();

@@ -1,6 +1,7 @@
 // Machines view: the controller profiles (api.md, Machines): list, register or replace, delete,
 // and the block time from a saturation test (chord.md §2.1, Eq. 1).
-import { api, message, showProblem } from '/app.js';
+import { api } from '/api.js';
+import { clearProblem, confirmButton, message, showProblem } from '/form.js';
 
 const FORM = `
 <div class="layout">
@@ -10,7 +11,7 @@ const FORM = `
       <label>Block time, ms <input name="block_time_ms" type="number" step="any" value="4" data-field="block_time_ms"></label>
       <label>Max feed, mm/min <input name="max_feed" type="number" step="any" value="10000" data-field="max_feed"></label>
       <label>Dialect <select name="dialect" data-field="dialect"><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select></label>
-      <label>Margin k_f <input name="margin" type="number" step="any" placeholder="1" data-field="margin"></label>
+      <label><span>Block margin <abbr class="symbol" title="k_f in chord.md">k_f</abbr></span> <input name="margin" type="number" step="any" placeholder="1" data-field="margin"></label>
       <label>Min chord error, mm <input name="min_chord_error" type="number" step="any" placeholder="0" data-field="min_chord_error"></label>
       <label>Description <input name="description" type="text" placeholder="control, mode, date" data-field="description"></label>
     </fieldset>
@@ -23,8 +24,8 @@ const FORM = `
   </form>
   <section>
     <div id="machine-messages"></div>
-    <table><thead><tr><th>name</th><th>block time, ms</th><th>max feed</th><th>dialect</th><th>margin</th><th>min chord error</th><th>description</th><th></th></tr></thead>
-      <tbody id="machine-rows"></tbody></table>
+    <div class="table-scroll"><table><thead><tr><th>name</th><th>block time, ms</th><th>max feed</th><th>dialect</th><th>margin</th><th>min chord error</th><th>description</th><th></th></tr></thead>
+      <tbody id="machine-rows"></tbody></table></div>
     <p class="hint">A request that names a machine takes its values as defaults: block time and margin for deburr, segment and contour, <code>max_feed</code> for segment and the engagement feed plan, the dialect for G-code.</p>
   </section>
 </div>`;
@@ -51,17 +52,16 @@ async function refresh(root) {
       }
       const td = document.createElement('td');
       const edit = document.createElement('button');
-      edit.className = 'secondary';
+      edit.type = 'button';
+      edit.className = 'secondary small';
       edit.textContent = 'Edit';
       edit.addEventListener('click', () => fill(form, machine));
-      const remove = document.createElement('button');
-      remove.className = 'secondary';
-      remove.textContent = 'Delete';
-      remove.addEventListener('click', async () => {
+      const remove = confirmButton('Delete', `Delete machine ${machine.name}?`, async () => {
         try {
           await api('DELETE', `/api/v1/machines/${encodeURIComponent(machine.name)}`);
-          messages.replaceChildren(message('warning', `machine ${machine.name} deleted`));
-          refresh(root);
+          messages.replaceChildren(message('ok', `Machine ${machine.name} deleted.`));
+          root.addEventListener('kerf:show', () => refresh(root));
+    refresh(root);
         } catch (problem) {
           showProblem(messages, null, problem);
         }
@@ -76,8 +76,6 @@ async function refresh(root) {
 }
 
 export const machinesView = {
-  id: 'machines',
-  title: 'Machines',
   mount(root) {
     root.innerHTML = FORM;
     const form = root.querySelector('#machine-form');
@@ -102,8 +100,8 @@ export const machinesView = {
       };
       try {
         await api('PUT', `/api/v1/machines/${encodeURIComponent(name || ' ')}`, machine);
-        form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
-        messages.replaceChildren(message('warning', `machine ${name} saved`));
+        clearProblem(form);
+        messages.replaceChildren(message('ok', `Machine ${name} saved.`));
         refresh(root);
       } catch (problem) {
         showProblem(messages, form, problem);

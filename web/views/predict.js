@@ -3,8 +3,10 @@
 // G-code program, cutting conditions, method), the path coloured by predicted error with a colour
 // scale, a histogram of the errors, the worst passes with their NC lines, warnings, and the
 // corrected program. `predictResult` also shows prediction jobs.
-import { api, download, loadTools, message, number, numeric, showProblem, showSummary, toolLabel, value } from '/app.js';
-import { Plot3D } from '/plot3d.js';
+import { api } from '/api.js';
+import { clearProblem, computed, computing, download, keepForm, loadTools, markComputed, message, number, numeric, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
+import { Scene3D, THREE, css, diverging } from '/plot.js';
+import { Timeline } from '/timeline.js';
 
 // The sample: a raster finishing program over a gentle dome (20 × 20 mm, 2 mm high) with an R3
 // ball, and the dome plus a 0.2 mm allowance as a height grid (as examples/predict-raster.toml).
@@ -71,16 +73,16 @@ const FORM = `
       <div data-inline-tool>
         <label>Ball radius, mm <input name="radius" type="number" step="any" value="3" data-field="tool.radius"></label>
         <label>Flutes <input name="flutes" type="number" value="2" data-field="tool.flutes"></label>
-        <label>Helix, ° <input name="helix" type="number" step="any" value="30" data-field="tool.helix_deg"></label>
-        <label class="stacked">Shape error δ(θ): angle °, error mm per row<textarea name="shape_error" rows="4" data-field="tool.shape_error" title="one row per contact angle: angle in degrees (0 = tip, 90 = equator), error in mm">0 0.004
+        <label>Helix angle, ° <input name="helix" type="number" step="any" value="30" data-field="tool.helix_deg"></label>
+        <label class="stacked"><span>Shape error: contact angle in ° (0 = tip, 90 = equator) and error in mm, one pair a line <abbr class="symbol" title="δ(θ)">δ(θ)</abbr></span><textarea name="shape_error" rows="4" data-field="tool.shape_error" title="one row per contact angle: angle in degrees (0 = tip, 90 = equator), error in mm">0 0.004
 30 0.005
 60 0.007
 90 0.009</textarea></label>
         <label>Stiffness <select name="stiffness_kind" data-field="tool.stiffness">
           <option value="modal">one mode (X = Y)</option><option value="static">static (X = Y)</option><option value="none">none</option></select></label>
-        <label data-stiffness="modal static">k, N/mm <input name="k" type="number" step="any" value="3000" data-field="tool.stiffness"></label>
-        <label data-stiffness="modal"><span>f<sub>n</sub>, Hz</span> <input name="fn" type="number" step="any" value="1800" data-field="tool.stiffness"></label>
-        <label data-stiffness="modal">Damping ζ <input name="zeta" type="number" step="any" value="0.04" data-field="tool.stiffness"></label>
+        <label data-stiffness="modal static"><span>Stiffness, N/mm <abbr class="symbol" title="k">k</abbr></span> <input name="k" type="number" step="any" value="3000" data-field="tool.stiffness"></label>
+        <label data-stiffness="modal"><span>Natural frequency, Hz <abbr class="symbol" title="f_n">f<sub>n</sub></abbr></span> <input name="fn" type="number" step="any" value="1800" data-field="tool.stiffness"></label>
+        <label data-stiffness="modal"><span>Damping ratio <abbr class="symbol" title="ζ">ζ</abbr></span> <input name="zeta" type="number" step="any" value="0.04" data-field="tool.stiffness"></label>
         <div class="actions"><label class="inline">Save as T <input name="save_number" type="number" min="1" max="9999" value="3" aria-label="tool number" style="width: 5rem"></label>
           <button class="secondary" type="button" id="predict-save-tool">Save tool</button></div>
       </div>
@@ -88,19 +90,19 @@ const FORM = `
     <fieldset><legend>Stock</legend>
       <label>Kind <select name="stock_kind" data-field="stock.kind">
         <option value="grid">height grid</option><option value="box">box</option><option value="mesh">STL file</option></select></label>
-      <label data-stock="box">Min x y z <span class="triple">
+      <label data-stock="box">Lowest corner x y z, mm <span class="triple">
         <input name="min_x" type="number" step="any" value="-5" data-field="stock.min">
         <input name="min_y" type="number" step="any" value="-5" data-field="stock.min">
         <input name="min_z" type="number" step="any" value="-10" data-field="stock.min"></span></label>
-      <label data-stock="box">Max x y z <span class="triple">
+      <label data-stock="box">Highest corner x y z, mm <span class="triple">
         <input name="max_x" type="number" step="any" value="25" data-field="stock.max">
         <input name="max_y" type="number" step="any" value="25" data-field="stock.max">
         <input name="max_z" type="number" step="any" value="2.2" data-field="stock.max"></span></label>
-      <label data-stock="grid">Origin x y <span class="pair">
+      <label data-stock="grid">Grid origin x y, mm <span class="pair">
         <input name="origin_x" type="number" step="any" data-field="stock.origin">
         <input name="origin_y" type="number" step="any" data-field="stock.origin"></span></label>
-      <label data-stock="grid">Spacing, mm <input name="spacing" type="number" step="any" value="1" data-field="stock.spacing"></label>
-      <label data-stock="grid">Bottom z <input name="bottom" type="number" step="any" value="-20" data-field="stock.bottom"></label>
+      <label data-stock="grid">Grid spacing, mm <input name="spacing" type="number" step="any" value="1" data-field="stock.spacing"></label>
+      <label data-stock="grid">Bottom z, mm <input name="bottom" type="number" step="any" value="-20" data-field="stock.bottom"></label>
       <label class="stacked" data-stock="grid">Heights, mm (a row per y, along x)<textarea name="heights" rows="4" data-field="stock.heights" title="one row per y, heights along x"></textarea></label>
       <label data-stock="mesh">STL file <input name="stock_file" type="file" accept=".stl,model/stl,application/sla" data-field="stock"></label>
     </fieldset>
@@ -112,13 +114,13 @@ const FORM = `
     <fieldset><legend>Cutting</legend>
       <label>Spindle, rpm <input name="spindle_rpm" type="number" step="any" placeholder="from the program" data-field="spindle_rpm"></label>
       <label>Feed, mm/min <input name="feed" type="number" step="any" placeholder="from the program" data-field="feed"></label>
-      <label><span>K<sub>tc</sub> K<sub>rc</sub> K<sub>ac</sub>, N/mm²</span> <span class="triple">
+      <label><span>Cutting force coefficients (tangential, radial, axial), N/mm² <abbr class="symbol" title="K_tc K_rc K_ac">K<sub>tc</sub> K<sub>rc</sub> K<sub>ac</sub></abbr></span> <span class="triple">
         <input name="ktc" type="number" step="any" value="2000" data-field="cutting.ktc" title="N/mm²">
         <input name="krc" type="number" step="any" value="800" data-field="cutting.krc" title="N/mm²">
         <input name="kac" type="number" step="any" value="300" data-field="cutting.kac" title="N/mm²"></span></label>
       <label>Method <select name="method" data-field="method"><option value="sampling">surface sampling</option><option value="depth_buffer">depth buffer (patent)</option></select></label>
-      <label>Resolution N <input name="resolution" type="number" value="256" data-field="resolution"></label>
-      <label>Max correction, mm <input name="max_correction" type="number" step="any" value="0.05" data-field="correction.max_correction"></label>
+      <label><span>Resolution, cells across <abbr class="symbol" title="N">N</abbr></span> <input name="resolution" type="number" value="256" data-field="resolution"></label>
+      <label>Largest correction, mm <input name="max_correction" type="number" step="any" value="0.05" data-field="correction.max_correction"></label>
     </fieldset>
     <div class="actions">
       <button class="primary" type="submit" id="predict-compute">Predict</button>
@@ -202,14 +204,9 @@ function syncVisibility(form) {
 }
 
 
-// Marks the inputs of every error path, also nested ones (`tool.shape_error[2].error` marks the
-// table), and puts the cursor on the program line a G-code error names.
+// Puts the cursor on the program line a G-code error names (showProblem marks the fields).
 function markProblem(form, problem) {
   for (const { path } of problem.errors || []) {
-    form.querySelectorAll('[data-field]').forEach((e) => {
-      const field = e.dataset.field;
-      if (path === field || path.startsWith(`${field}.`) || path.startsWith(`${field}[`)) e.classList.add('invalid');
-    });
     const line = /line (\d+)/.exec(problem.detail || '');
     if (path === 'path.program' && line) {
       const area = form.elements.program;
@@ -223,23 +220,38 @@ function markProblem(form, problem) {
   }
 }
 
-// Colour scale from the most negative to the most positive error (perceptually ordered).
-const STOPS = ['#30123b', '#4686fb', '#1ae4b6', '#a2fc3c', '#faba39', '#e4460a', '#7a0403'];
-
-function rgb(hex) {
-  return [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16));
-}
-
-export function colourFor(t) {
-  const x = Math.max(0, Math.min(1, Number.isFinite(t) ? t : 0.5)) * (STOPS.length - 1);
-  const i = Math.min(STOPS.length - 2, Math.floor(x));
-  const [a, b] = [rgb(STOPS[i]), rgb(STOPS[i + 1])];
-  const f = x - i;
-  return `rgb(${a.map((v, k) => Math.round(v + (b[k] - v) * f)).join(',')})`;
+// The error colour: a diverging scale centred on zero with symmetric limits ±limit (blue: cuts
+// too deep, white: on size, red: leaves material).
+function colourOf(error, limit) {
+  return Number.isFinite(error) ? css(diverging(error, limit)) : '#9aa4ad';
 }
 
 function microns(e) {
   return Number.isFinite(e) ? (e * 1000).toFixed(1) : '–';
+}
+
+// A height-grid stock as a see-through surface (heights: a row per y, along x).
+function gridSurface(scene, stock) {
+  const rows = stock.heights;
+  const [x0, y0] = stock.origin;
+  const step = stock.spacing;
+  if (!rows?.length || !rows[0]?.length || !(step > 0) || ![x0, y0].every(Number.isFinite)) return;
+  const nx = rows[0].length;
+  const ny = rows.length;
+  const positions = [];
+  for (let j = 0; j < ny; j++) for (let i = 0; i < nx; i++) positions.push(x0 + i * step, y0 + j * step, rows[j][i] ?? 0);
+  const index = [];
+  for (let j = 0; j + 1 < ny; j++) {
+    for (let i = 0; i + 1 < nx; i++) {
+      const a = j * nx + i;
+      index.push(a, a + 1, a + nx, a + 1, a + nx + 1, a + nx);
+    }
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.Float32BufferAttribute(positions, 3));
+  geometry.setIndex(index);
+  geometry.computeVertexNormals();
+  scene.solid('stock', geometry, { legend: 'stock (height grid)', opacity: 0.3, colour: '#8fa3b5', edges: false });
 }
 
 // The programmed path as runs of contiguous passes: each pass ends at its programmed end point
@@ -262,7 +274,8 @@ function runs(passes) {
   return out;
 }
 
-function drawScale(canvas, low, high) {
+function drawScale(canvas, limit, band) {
+  const [low, high] = [-limit, limit];
   const width = canvas.clientWidth;
   const height = canvas.clientHeight;
   const ratio = window.devicePixelRatio || 1;
@@ -275,7 +288,7 @@ function drawScale(canvas, low, high) {
   const left = 10;
   const right = width - 10;
   for (let x = left; x < right; x++) {
-    g.fillStyle = colourFor((x - left) / (right - left));
+    g.fillStyle = colourOf(low + (high - low) * (x - left) / (right - left), limit);
     g.fillRect(x, 4, 1, 22);
   }
   g.fillStyle = '#1d2327';
@@ -291,10 +304,19 @@ function drawScale(canvas, low, high) {
     g.textAlign = 'center';
     g.fillText('0', zero, 30);
   }
+  if (band > 0) {
+    // The tolerance band: a dashed box over the scale from −band to +band.
+    const at = (e) => left + (right - left) * ((Math.max(low, Math.min(high, e)) - low) / (high - low));
+    g.strokeStyle = '#1d2327';
+    g.lineWidth = 2;
+    g.setLineDash([5, 3]);
+    g.strokeRect(at(-band), 2, at(band) - at(-band), 26);
+    g.setLineDash([]);
+  }
   canvas.dataset.state = 'drawn';
 }
 
-function drawHistogram(canvas, errors, low, high) {
+function drawHistogram(canvas, errors, low, high, limit, band) {
   const width = canvas.clientWidth;
   const height = canvas.clientHeight;
   const ratio = window.devicePixelRatio || 1;
@@ -323,7 +345,7 @@ function drawHistogram(canvas, errors, low, high) {
   const w = (right - left) / bins;
   counts.forEach((count, i) => {
     const h = (count / most) * (bottom - top);
-    g.fillStyle = colourFor((i + 0.5) / bins);
+    g.fillStyle = colourOf(low + span * (i + 0.5) / bins, limit);
     g.fillRect(left + i * w + 1, bottom - h, Math.max(1, w - 2), h);
   });
   g.fillStyle = '#1d2327';
@@ -339,24 +361,52 @@ function drawHistogram(canvas, errors, low, high) {
   g.fillText(`${microns(high)} µm`, right, bottom + 6);
   g.textAlign = 'center';
   g.fillText('passes per error', (left + right) / 2, bottom + 6);
+  if (band > 0) {
+    g.strokeStyle = '#1d2327';
+    g.setLineDash([5, 3]);
+    for (const e of [-band, band]) {
+      if (e < low || e > high) continue;
+      const x = left + (right - left) * ((e - low) / span);
+      g.beginPath();
+      g.moveTo(x, top);
+      g.lineTo(x, bottom);
+      g.stroke();
+    }
+    g.setLineDash([]);
+  }
   canvas.dataset.state = 'drawn';
   canvas.dataset.bins = String(counts.filter((c) => c > 0).length);
 }
 
 // Shows a prediction in `container`: path coloured by error with its scale, histogram, summary,
-// worst passes and warnings. Used by the form and by job results.
-export function predictResult(container, answer) {
+// worst passes and warnings. `context`: the `request` adds the stock, the `program` the timeline
+// (a worst pass goes to its line). Used by the form and by job results.
+export function predictResult(container, answer, { request, program } = {}) {
   container.replaceChildren();
   const warnings = document.createElement('div');
-  const canvas = document.createElement('canvas');
-  canvas.className = 'plot';
-  canvas.setAttribute('aria-label', 'Tool path coloured by predicted error');
+  const sceneBox = document.createElement('div');
+  const timelineBox = document.createElement('div');
+  // An optional tolerance band, drawn on the scale and the histogram, with the passes outside it.
+  const bandBox = document.createElement('div');
+  bandBox.className = 'actions';
+  const bandLabel = document.createElement('label');
+  bandLabel.className = 'inline';
+  const bandInput = document.createElement('input');
+  bandInput.type = 'number';
+  bandInput.step = 'any';
+  bandInput.min = '0';
+  bandInput.placeholder = 'none';
+  bandInput.name = 'tolerance_band';
+  bandInput.style.width = '6rem';
+  bandLabel.append('Tolerance band ±', bandInput, 'µm');
+  const bandCount = document.createElement('output');
+  bandBox.append(bandLabel, bandCount);
   const scale = document.createElement('canvas');
   scale.className = 'scale';
   scale.setAttribute('aria-label', 'Colour scale of the predicted error');
   const caption = document.createElement('p');
   caption.className = 'hint';
-  caption.textContent = 'Programmed path coloured by the predicted error e (µm along the surface normal; < 0 cuts too deep, > 0 leaves material). Drag to rotate, shift-drag to pan, wheel to zoom, double-click to reset.';
+  caption.textContent = 'Programmed path coloured by the predicted error along the surface normal: blue cuts too deep (below 0), white is on size, red leaves material (above 0); the scale is symmetric about zero. Drag to rotate, right-drag to pan, wheel to zoom. Click a worst pass to put the tool there.';
   const summaryBox = document.createElement('div');
   summaryBox.className = 'summary';
   const histogram = document.createElement('canvas');
@@ -366,26 +416,41 @@ export function predictResult(container, answer) {
   worstTitle.textContent = 'Worst passes';
   const worst = document.createElement('table');
   worst.className = 'worst';
-  container.append(warnings, canvas, scale, caption, summaryBox, histogram, worstTitle, worst);
+  container.append(warnings, sceneBox, scale, bandBox, caption, timelineBox, summaryBox, histogram, worstTitle, worst);
 
   const errors = answer.passes.map((p) => p.error).filter(Number.isFinite);
   const low = errors.length ? Math.min(...errors) : 0;
   const high = errors.length ? Math.max(...errors) : 0;
-  const position = (e) => (high > low ? (e - low) / (high - low) : 0.5);
-  const grey = '#9aa4ad';
-  const series = runs(answer.passes).map((run) => ({
-    label: '',
-    points: run.points,
-    colour: grey,
-    colours: run.errors.map((e) => (Number.isFinite(e) ? colourFor(position(e)) : grey)),
-    width: 3,
-    marks: run.points.length < 3,
-  }));
-  new Plot3D(canvas).setSeries(series);
+  const limit = Math.max(Math.abs(low), Math.abs(high), 1e-9);
+  const scene = new Scene3D(sceneBox, { label: 'Tool path coloured by predicted error, with the stock' });
+  if (request?.stock?.kind === 'box' && [...request.stock.min, ...request.stock.max].every(Number.isFinite)) {
+    const [min, max] = [request.stock.min, request.stock.max];
+    const box = new THREE.BoxGeometry(max[0] - min[0], max[1] - min[1], max[2] - min[2]);
+    box.translate((min[0] + max[0]) / 2, (min[1] + max[1]) / 2, (min[2] + max[2]) / 2);
+    scene.solid('stock', box, { legend: 'stock', opacity: 0.15 });
+  }
+  runs(answer.passes).forEach((run, i) => {
+    const colours = run.errors.map((e) => colourOf(e, limit));
+    if (run.points.length > 1) scene.path('path', run.points, { colours, legend: i === 0 ? 'path, coloured by error' : undefined, colour: '#9aa4ad' });
+    else scene.dots('path', run.points, { colour: colours[0] });
+  });
+  if (request?.stock?.kind === 'grid') gridSurface(scene, request.stock);
+  scene.tool({ radius: answer.tool.radius || 1 });
+  scene.finish();
+  // With the program (the form view), the timeline walks it and a worst pass goes to its line.
+  const lift = request?.reference === 'centre' ? 0 : answer.tool.radius;
+  const timeline = program ? new Timeline(timelineBox, program, {
+    onMove: (move) => scene.moveTool([move.position[0], move.position[1], move.position[2] + lift]),
+  }) : null;
+  const end = (pass) => pass.corrected.map((c, k) => c - pass.correction[k]);
   const redraw = () => {
-    drawScale(scale, low, high);
-    drawHistogram(histogram, errors, low, high);
+    const band = Number(bandInput.value) / 1000;
+    drawScale(scale, limit, band);
+    drawHistogram(histogram, errors, low, high, limit, band);
+    const outside = band > 0 ? errors.filter((e) => Math.abs(e) > band).length : null;
+    bandCount.textContent = outside === null ? '' : `${outside} of ${errors.length} passes outside ±${bandInput.value} µm.`;
   };
+  bandInput.addEventListener('input', redraw);
   redraw();
   new ResizeObserver(redraw).observe(histogram);
 
@@ -413,7 +478,16 @@ export function predictResult(container, answer) {
     tr.dataset.line = String(w.line ?? '');
     const swatch = document.createElement('span');
     swatch.className = 'swatch';
-    swatch.style.background = colourFor(position(w.error));
+    swatch.style.background = colourOf(w.error, limit);
+    tr.tabIndex = 0;
+    const select = () => {
+      worst.querySelectorAll('[aria-selected]').forEach((r) => r.removeAttribute('aria-selected'));
+      tr.setAttribute('aria-selected', 'true');
+      if (timeline && w.line !== undefined) timeline.goToLine(w.line);
+      else if (pass.corrected) scene.moveTool(end(pass).map((v, k) => v + (k === 2 ? lift : 0)));
+    };
+    tr.addEventListener('click', select);
+    tr.addEventListener('keydown', (e) => { if (e.key === 'Enter' || e.key === ' ') { e.preventDefault(); select(); } });
     const cells = [String(rank + 1), String(w.index), w.line === undefined ? '–' : String(w.line), microns(w.error),
       number(pass.contact_angle_deg, 1), (pass.flags || []).join(', ')];
     cells.forEach((text, k) => {
@@ -425,23 +499,21 @@ export function predictResult(container, answer) {
     return tr;
   });
   worst.replaceChildren(head, ...body);
-  warnings.replaceChildren(...answer.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
-  return canvas;
+  warnings.replaceChildren(...warningMessages(answer.warnings));
+  return scene.root;
 }
 
 export const predictView = {
-  id: 'predict',
-  title: 'Predict',
-  mount(root) {
+  mount(root, id) {
     root.innerHTML = FORM;
     const form = root.querySelector('#predict-form');
     const messages = root.querySelector('#predict-messages');
     const result = root.querySelector('#predict-result');
     const grid = sampleGrid();
-    form.elements.program.value = sampleProgram();
-    form.elements.heights.value = grid.heights;
-    form.elements.origin_x.value = grid.origin;
-    form.elements.origin_y.value = grid.origin;
+    form.elements.program.defaultValue = sampleProgram();
+    form.elements.heights.defaultValue = grid.heights;
+    form.elements.origin_x.defaultValue = grid.origin;
+    form.elements.origin_y.defaultValue = grid.origin;
     form.addEventListener('change', () => syncVisibility(form));
     loadTools(form.elements.tool_choice, 'inline ball (below)', isBall, predictToolLabel).then(() => syncVisibility(form));
     syncVisibility(form);
@@ -449,7 +521,7 @@ export const predictView = {
       const file = event.target.files[0];
       if (file) form.elements.program.value = await file.text();
     });
-    const clear = () => form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+    const clear = () => clearProblem(form);
     const fail = (problem) => {
       showProblem(messages, form, problem);
       markProblem(form, problem);
@@ -457,16 +529,18 @@ export const predictView = {
     form.addEventListener('submit', async (event) => {
       event.preventDefault();
       clear();
-      messages.replaceChildren(message('warning', 'predicting…'));
+      computing(messages, result);
       const started = performance.now();
       try {
         const answer = await api('POST', '/api/v1/predict?timings=true', payload(predictRequest(form)));
         const seconds = (performance.now() - started) / 1000;
-        messages.replaceChildren(message('ok', `${answer.summary.passes} passes in ${seconds.toFixed(2)} s`));
-        predictResult(result, answer).id = 'predict-plot';
+        computed(messages, result, `${answer.summary.passes} passes predicted in ${seconds.toFixed(2)} s.`);
+        markComputed(form);
+        clearProblem(form);
+        const sent = predictRequest(form).body;
+        predictResult(result, answer, { request: sent, program: sent.path.program }).id = 'predict-plot';
         result.querySelector('canvas.histogram').id = 'predict-histogram';
       } catch (problem) {
-        result.replaceChildren();
         fail(problem);
       }
     });
@@ -491,5 +565,6 @@ export const predictView = {
         fail(problem);
       }
     });
+    keepForm(id, form);
   },
 };

@@ -1,14 +1,16 @@
 // Segment view: cut a curve into G01 blocks by the control's block time (api.md, Segment;
 // chord.md). A form for the curve and the rule, the curve with its blocks, the chord error and the
 // block length along the curve, the rule side by side with a fixed tolerance, G-code download.
-import { api, download, loadMachines, message, number, numeric, showProblem, showSummary, value } from '/app.js';
-import { PlanPlot, drawChart } from '/plot2d.js';
+import { api, program as programOf, sentence } from '/api.js';
+import { Timeline } from '/timeline.js';
+import { clearProblem, computed, computing, download, keepForm, loadMachines, machineFields, machineNote, markComputed, message, number, numeric, showProblem, showSummary, value, warningMessages } from '/form.js';
+import { PlanPlot, drawChart } from '/plot.js';
 
 const FORM = `
 <div class="layout">
   <form id="segment-form" novalidate>
     <fieldset><legend>Curve</legend>
-      <label>Kind <select name="kind" data-field="curve.kind">
+      <label>Curve <select name="kind" data-field="curve.kind">
         <option value="circle">circle</option><option value="arc">arc</option><option value="ellipse">ellipse</option>
         <option value="polyline">polyline (points)</option><option value="bspline">B-spline / NURBS</option></select></label>
       <label data-kinds="circle arc ellipse">Centre x, y <span class="pair">
@@ -37,26 +39,32 @@ const FORM = `
       <label>Machine <select name="machine" data-field="machine"></select></label>
       <label>Feed, mm/min <input name="feed" type="number" step="any" value="10000" data-field="feed"></label>
       <label>Block time, ms <input name="block_time_ms" type="number" step="any" value="4" data-field="block_time_ms"></label>
-      <label>Mode <select name="mode" data-field="mode"><option value="window">per window</option><option value="curve">whole curve</option></select></label>
-      <label data-mode="window">Window, mm <input name="window" type="number" step="any" placeholder="5 target chords" data-field="window"></label>
+      <label>Chord error chosen <select name="mode" data-field="mode"><option value="window">per window</option><option value="curve">whole curve</option></select></label>
+      <label data-mode="window">Window length, mm <input name="window" type="number" step="any" placeholder="5 target chords" data-field="window"></label>
       <label data-mode="curve">Rule <select name="rule" data-field="rule"><option value="extremes">smallest radius</option><option value="max">largest window value</option><option value="normal_accel">normal acceleration</option></select></label>
-      <label>Margin k_f <input name="margin" type="number" step="any" value="1" data-field="margin"></label>
-      <label>Min chord error, mm <input name="min_chord_error" type="number" step="any" value="0" data-field="min_chord_error"></label>
+      <label><span>Block margin <abbr class="symbol" title="k_f in chord.md">k_f</abbr></span> <input name="margin" type="number" step="any" value="1" data-field="margin"></label>
+      <label>Smallest chord error, mm <input name="min_chord_error" type="number" step="any" value="0" data-field="min_chord_error"></label>
       <label>Tolerance, mm <input name="tolerance" type="number" step="any" placeholder="none" data-field="tolerance"></label>
-      <label>Compare with fixed, mm <input name="compare_tolerance" type="number" step="any" value="0.01" data-field="compare_tolerance"></label>
+      <label>Compare with a fixed tolerance, mm <input name="compare_tolerance" type="number" step="any" value="0.01" data-field="compare_tolerance"></label>
     </fieldset>
     <div class="actions">
       <button class="primary" type="submit" id="segment-compute">Compute</button>
       <select name="dialect" aria-label="G-code dialect"><option value="">machine's dialect</option><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select>
       <button class="secondary" type="button" id="segment-gcode">G-code</button>
     </div>
-    <p class="hint">Empty feed, block time, margin or minimum chord error take the machine's values.</p>
+    <p class="hint">With a machine chosen, its values show greyed in the empty fields and are used; type a value to override it.</p>
   </form>
   <section>
     <div id="segment-messages"></div>
     <div id="segment-result"></div>
   </section>
 </div>`;
+
+// The G-code query: the chosen dialect, else the machine's.
+function segmentQuery(form) {
+  const dialect = value(form, 'dialect');
+  return `?format=gcode${dialect ? `&dialect=${dialect}` : ''}`;
+}
 
 // "x y [z]" per line (commas or spaces), or a JSON array.
 function pointList(text) {
@@ -114,16 +122,6 @@ function syncVisibility(form) {
   form.querySelectorAll('[data-mode]').forEach((e) => { e.hidden = e.dataset.mode !== mode; });
 }
 
-
-// Marks inputs whose data-field is a prefix of an error path (curve.points[3] → curve.points).
-function highlightPrefixes(form, problem) {
-  for (const { path } of problem.errors || []) {
-    form.querySelectorAll('[data-field]').forEach((e) => {
-      const field = e.dataset.field;
-      if (path === field || path.startsWith(`${field}[`) || path.startsWith(`${field}.`)) e.classList.add('invalid');
-    });
-  }
-}
 
 // Points of the target curve for the plot, when the request is known (the form view).
 function curvePoints(curve) {
@@ -252,9 +250,10 @@ function heading(text) {
 }
 
 // Shows a segment answer in `container`: summary, comparison, plan of the curve and its blocks,
-// chord error and block length along the curve, warnings. `request` (the form view's) adds the
-// target curve to the plan. Used by the form and by job results.
-export function segmentResult(container, answer, request) {
+// chord error and block length along the curve, warnings. `context`: the form view's `request`
+// adds the target curve, `machine` names the machine's values, `program` adds the timeline.
+// Used by the form and by job results.
+export function segmentResult(container, answer, { request, machine, program } = {}) {
   container.replaceChildren();
   const warnings = document.createElement('div');
   const summaryBox = document.createElement('div');
@@ -276,7 +275,13 @@ export function segmentResult(container, answer, request) {
   if (request?.curve) series.push({ label: 'target curve', points: curvePoints(request.curve), colour: '#9aa5ae', width: 1 });
   series.push({ label: `${answer.blocks} blocks`, points, colour: '#0b63b6', width: 2, marks: points.length > 4000 ? 0 : 4, count: true });
   if (short.length) series.push({ label: `shorter than one block time: ${short.length} (${answer.short_end_blocks} of them remainders at ends)`, points, segments: short, colour: '#b3261e', width: 3.5 });
-  new PlanPlot(plan).setSeries(series);
+  const planPlot = new PlanPlot(plan);
+  planPlot.setSeries(series);
+  if (program) {
+    // The timeline walks the program block by block: feed, block length and time per block.
+    const timeline = new Timeline(container, program, { onMove: (move) => planPlot.setMarker(move.position) });
+    hint.after(timeline.root);
+  }
 
   // Chord error per window as steps along s (each window until the next one starts: windows
   // overlap where a window's last chord runs past its end), the rule's own value, the bounds and
@@ -299,7 +304,7 @@ export function segmentResult(container, answer, request) {
     { label: `feed × block time = ${number(answer.block_length, 4)} mm`, points: level(answer.block_length), colour: '#b3261e', width: 1.5, dash: [6, 4] },
   ], { xLabel: 'arc length s, mm', yLabel: 'block length, mm' });
 
-  const machine = answer.machine ? `${answer.machine.name} (${answer.machine.dialect})` : 'none';
+  const machineName = answer.machine ? `${answer.machine.name} (${answer.machine.dialect})` : 'none';
   showSummary(summaryBox, [
     ['blocks', answer.blocks],
     ['chord error, mm', `${number(answer.min_window_chord_error, 6)} – ${number(answer.chord_error, 6)}`],
@@ -311,30 +316,31 @@ export function segmentResult(container, answer, request) {
     ['curve length, mm', number(answer.curve_length, 3)],
     ['smallest radius, mm', answer.min_radius == null ? 'straight' : number(answer.min_radius, 3)],
     ['feed limit, mm/min', answer.feed_limit == null ? '–' : number(answer.feed_limit, 0)],
-    ['feed / block time', `${answer.feed} mm/min / ${answer.block_time_ms} ms`],
-    ['margin / machine', `${answer.margin} / ${machine}`],
+    ['feed', machineNote(answer.feed, 'mm/min', request, 'feed', machine, 'max_feed')],
+    ['block time', machineNote(answer.block_time_ms, 'ms', request, 'block_time_ms', machine)],
+    ['margin', machineNote(answer.margin, '', request, 'margin', machine)],
+    ['machine', machineName],
   ]);
-  warnings.replaceChildren(...answer.warnings.map((w) => message('warning', `${w.code}: ${w.message}`)));
+  warnings.replaceChildren(...warningMessages(answer.warnings));
   return plan;
 }
 
 export const segmentView = {
-  id: 'segment',
-  title: 'Segment',
-  mount(root) {
+  mount(root, id) {
     root.innerHTML = FORM;
     const form = root.querySelector('#segment-form');
     const messages = root.querySelector('#segment-messages');
     const result = root.querySelector('#segment-result');
-    form.elements.points.value = Array.from({ length: 91 }, (_, i) => {
+    form.elements.points.defaultValue = Array.from({ length: 91 }, (_, i) => {
       const t = i * Math.PI / 180;
       return `${(30 * Math.cos(t)).toFixed(4)} ${(20 * Math.sin(t)).toFixed(4)}`;
     }).join('\n');
     form.addEventListener('change', () => syncVisibility(form));
     syncVisibility(form);
     loadMachines(form.elements.machine, 'none (values below)');
+    machineFields(form, { feed: 'max_feed', block_time_ms: 'block_time_ms', margin: 'margin', min_chord_error: 'min_chord_error' });
     const request = () => {
-      form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
+      clearProblem(form);
       try {
         return segmentRequest(form);
       } catch (error) {
@@ -346,32 +352,39 @@ export const segmentView = {
       event.preventDefault();
       const body = request();
       if (!body) return;
-      messages.replaceChildren(message('warning', 'computing…'));
+      computing(messages, result);
       try {
         const answer = await api('POST', '/api/v1/segment', body);
-        messages.replaceChildren();
-        segmentResult(result, answer, body).id = 'segment-plot';
+        computed(messages, result);
+        markComputed(form);
+        clearProblem(form);
+        let program = null;
+        try {
+          program = await programOf('/api/v1/segment', body, segmentQuery(form));
+        } catch (refused) {
+          messages.append(message('error', `No G-code for these blocks. ${sentence(refused.detail || refused.title)}`, refused.code));
+        }
+        root.querySelector('#segment-gcode').disabled = !program;
+        segmentResult(result, answer, { request: body, machine: form.elements.machine.machines?.get(body.machine), program }).id = 'segment-plot';
         const charts = result.querySelectorAll('canvas.chart');
         charts[0].id = 'segment-chart';
         charts[1].id = 'segment-lengths';
       } catch (problem) {
-        result.replaceChildren();
         showProblem(messages, form, problem);
-        highlightPrefixes(form, problem);
       }
     });
     root.querySelector('#segment-gcode').addEventListener('click', async () => {
       const body = request();
       if (!body) return;
       const dialect = value(form, 'dialect');
-      const query = `?format=gcode${dialect ? `&dialect=${dialect}` : ''}`;
+      const query = segmentQuery(form);
       try {
         const program = await api('POST', `/api/v1/segment${query}`, body, 'text/x-gcode');
         download(`segment-${dialect || body.machine || 'fanuc'}.nc`, program);
       } catch (problem) {
         showProblem(messages, form, problem);
-        highlightPrefixes(form, problem);
       }
     });
+    keepForm(id, form);
   },
 };

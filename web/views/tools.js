@@ -1,50 +1,126 @@
-// Tool table view: list, register or replace, delete (api.md, Tools).
-import { api, message, showProblem } from '/app.js';
+// Tool table view: list, register or replace, edit and delete (with a confirmation) the tools
+// (api.md, Tools). Sizes by diameter or radius; the optional data later capabilities need:
+// neck, stickout, helix, shape-error table and a static stiffness.
+import { api } from '/api.js';
+import { clearProblem, confirmButton, message, numeric, showProblem, value } from '/form.js';
 
 const FORM = `
 <div class="layout">
   <form id="tool-form" novalidate>
     <fieldset><legend>Register or replace a tool</legend>
-      <label>Number <input name="number" type="number" min="1" max="9999" value="1" data-field="number"></label>
-      <label>Kind <select name="kind" data-field="kind"><option>ball</option><option>flat</option><option>bull</option></select></label>
-      <label>Radius, mm <input name="radius" type="number" step="any" value="3" data-field="radius"></label>
-      <label>Corner radius <input name="corner_radius" type="number" step="any" data-field="corner_radius"></label>
-      <label>Neck radius <input name="neck_radius" type="number" step="any" data-field="neck_radius"></label>
-      <label>Flutes <input name="flutes" type="number" value="2" data-field="flutes"></label>
-      <label>Name <input name="name" type="text" data-field="name"></label>
+      <label>Tool number <input name="number" type="number" min="1" max="9999" value="1" data-field="number"></label>
+      <label>Kind <select name="kind" data-field="kind"><option value="ball">ball end mill</option><option value="flat">flat end mill</option><option value="bull">bull nose (corner radius)</option></select></label>
+      <label>Size entered as <select name="size_as"><option value="diameter">diameter Ø</option><option value="radius">radius</option></select></label>
+      <label><span data-size-label>Diameter Ø, mm</span> <input name="size" type="number" step="any" value="6" data-field="radius"></label>
+      <label data-kind="bull">Corner radius, mm <input name="corner_radius" type="number" step="any" data-field="corner_radius"></label>
+      <label>Flutes <input name="flutes" type="number" step="1" value="2" data-field="flutes"></label>
+      <label>Name <input name="name" type="text" placeholder="e.g. lollipop Ø6" data-field="name"></label>
     </fieldset>
-    <div class="actions"><button class="primary" type="submit">Save</button></div>
+    <fieldset><legend>Optional data</legend>
+      <label>Neck radius, mm <input name="neck_radius" type="number" step="any" placeholder="none (shank as big as the head)" data-field="neck_radius"></label>
+      <label>Stickout, mm <input name="stickout" type="number" step="any" placeholder="none" data-field="stickout"></label>
+      <label>Helix angle, ° <input name="helix_deg" type="number" step="any" placeholder="none" data-field="helix_deg"></label>
+      <label class="stacked">Shape error: angle in °, error in mm, one pair a line <textarea name="shape_error" rows="4" spellcheck="false" placeholder="0 0.004&#10;45 0.006&#10;90 0.009" data-field="shape_error"></textarea></label>
+      <label>Stiffness (static, X = Y), N/mm <input name="stiffness" type="number" step="any" placeholder="none" data-field="stiffness"></label>
+      <p class="hint" data-kept-stiffness hidden>This tool has a measured (modal) stiffness; it is kept unless you enter a static one.</p>
+    </fieldset>
+    <div class="actions"><button class="primary" type="submit" id="tool-save">Save tool</button></div>
   </form>
   <section>
     <div id="tool-messages"></div>
-    <table><thead><tr><th>T</th><th>kind</th><th>radius</th><th>corner</th><th>neck</th><th>flutes</th><th>name</th><th></th></tr></thead>
-      <tbody id="tool-rows"></tbody></table>
+    <div class="table-scroll"><table><thead><tr><th>T</th><th>kind</th><th>Ø, mm</th><th>corner, mm</th><th>neck radius, mm</th><th>flutes</th><th>extra data</th><th>name</th><th></th></tr></thead>
+      <tbody id="tool-rows"></tbody></table></div>
   </section>
 </div>`;
 
-async function refresh(rows, messages) {
+function syncForm(form) {
+  form.querySelector('[data-size-label]').textContent = value(form, 'size_as') === 'diameter' ? 'Diameter Ø, mm' : 'Radius, mm';
+  form.querySelectorAll('[data-kind]').forEach((e) => { e.hidden = e.dataset.kind !== value(form, 'kind'); });
+}
+
+// "angle error" lines into the API's table.
+function shapeError(text) {
+  const rows = text.split('\n').map((l) => l.trim()).filter(Boolean);
+  if (!rows.length) return undefined;
+  return rows.map((line) => {
+    const [angle, error] = line.split(/[\s,;]+/).map(Number);
+    return { angle_deg: angle, error };
+  });
+}
+
+// The tool in the form, as the API takes it (`keep`: data of the edited tool the form does not show).
+function toolFrom(form, keep = {}) {
+  const size = numeric(form, 'size');
+  const radius = size === undefined ? undefined : value(form, 'size_as') === 'diameter' ? size / 2 : size;
+  const k = numeric(form, 'stiffness');
+  return {
+    ...keep,
+    kind: value(form, 'kind'),
+    radius,
+    corner_radius: value(form, 'kind') === 'bull' ? numeric(form, 'corner_radius') : undefined,
+    neck_radius: numeric(form, 'neck_radius'),
+    stickout: numeric(form, 'stickout'),
+    helix_deg: numeric(form, 'helix_deg'),
+    flutes: numeric(form, 'flutes'),
+    name: value(form, 'name').trim() || undefined,
+    shape_error: shapeError(value(form, 'shape_error')),
+    stiffness: k === undefined ? keep.stiffness : { kind: 'static', x: k, y: k },
+  };
+}
+
+// Puts a stored tool into the form for editing.
+function edit(form, tool) {
+  clearProblem(form);
+  form.elements.number.value = tool.number;
+  form.elements.kind.value = tool.kind;
+  form.elements.size_as.value = 'diameter';
+  form.elements.size.value = String(2 * tool.radius);
+  for (const name of ['corner_radius', 'neck_radius', 'stickout', 'helix_deg', 'flutes', 'name']) form.elements[name].value = tool[name] ?? '';
+  form.elements.shape_error.value = (tool.shape_error || []).map((p) => `${p.angle_deg} ${p.error}`).join('\n');
+  const stiffness = tool.stiffness;
+  form.elements.stiffness.value = stiffness?.kind === 'static' && stiffness.x === stiffness.y ? stiffness.x : '';
+  form.querySelector('[data-kept-stiffness]').hidden = !stiffness || form.elements.stiffness.value !== '';
+  form.kept = stiffness && form.elements.stiffness.value === '' ? { stiffness } : {};
+  syncForm(form);
+  form.elements.size.focus();
+}
+
+function extras(tool) {
+  return [tool.stickout && `stickout ${tool.stickout}`, tool.helix_deg && `helix ${tool.helix_deg}°`,
+    tool.shape_error && `shape error (${tool.shape_error.length})`, tool.stiffness && `stiffness (${tool.stiffness.kind})`]
+    .filter(Boolean).join(', ');
+}
+
+async function refresh(root) {
+  const rows = root.querySelector('#tool-rows');
+  const messages = root.querySelector('#tool-messages');
+  const form = root.querySelector('#tool-form');
   try {
     const tools = await api('GET', '/api/v1/tools');
     rows.replaceChildren(...tools.map((tool) => {
       const tr = document.createElement('tr');
-      for (const cell of [tool.number, tool.kind, tool.radius, tool.corner_radius ?? '', tool.neck_radius ?? '', tool.flutes, tool.name ?? '']) {
+      tr.dataset.tool = String(tool.number);
+      for (const cell of [`T${tool.number}`, tool.kind, 2 * tool.radius, tool.corner_radius ?? '', tool.neck_radius ?? '', tool.flutes, extras(tool), tool.name ?? '']) {
         const td = document.createElement('td');
         td.textContent = String(cell);
         tr.append(td);
       }
       const td = document.createElement('td');
-      const remove = document.createElement('button');
-      remove.className = 'secondary';
-      remove.textContent = 'Delete';
-      remove.addEventListener('click', async () => {
+      const change = document.createElement('button');
+      change.type = 'button';
+      change.className = 'secondary small';
+      change.textContent = 'Edit';
+      change.addEventListener('click', () => edit(form, tool));
+      const remove = confirmButton('Delete', `Delete T${tool.number}?`, async () => {
         try {
           await api('DELETE', `/api/v1/tools/${tool.number}`);
-          refresh(rows, messages);
+          messages.replaceChildren(message('ok', `Tool T${tool.number} deleted.`));
+          refresh(root);
         } catch (problem) {
           showProblem(messages, null, problem);
         }
       });
-      td.append(remove);
+      td.append(change, ' ', remove);
       tr.append(td);
       return tr;
     }));
@@ -54,30 +130,23 @@ async function refresh(rows, messages) {
 }
 
 export const toolsView = {
-  id: 'tools',
-  title: 'Tools',
   mount(root) {
     root.innerHTML = FORM;
     const form = root.querySelector('#tool-form');
-    const rows = root.querySelector('#tool-rows');
     const messages = root.querySelector('#tool-messages');
-    refresh(rows, messages);
+    form.kept = {};
+    form.addEventListener('change', () => syncForm(form));
+    syncForm(form);
+    root.addEventListener('kerf:show', () => refresh(root));
+    refresh(root);
     form.addEventListener('submit', async (event) => {
       event.preventDefault();
-      const optional = (name) => (form.elements[name].value.trim() === '' ? undefined : Number(form.elements[name].value));
-      const tool = {
-        kind: form.elements.kind.value,
-        radius: Number(form.elements.radius.value),
-        corner_radius: optional('corner_radius'),
-        neck_radius: optional('neck_radius'),
-        flutes: Number(form.elements.flutes.value),
-        name: form.elements.name.value.trim() || undefined,
-      };
+      const number = value(form, 'number');
       try {
-        await api('PUT', `/api/v1/tools/${encodeURIComponent(form.elements.number.value)}`, tool);
-        form.querySelectorAll('.invalid').forEach((e) => e.classList.remove('invalid'));
-        messages.replaceChildren(message('warning', `tool ${form.elements.number.value} saved`));
-        refresh(rows, messages);
+        await api('PUT', `/api/v1/tools/${encodeURIComponent(number)}`, toolFrom(form, form.kept));
+        clearProblem(form);
+        messages.replaceChildren(message('ok', `Tool T${number} saved.`));
+        refresh(root);
       } catch (problem) {
         showProblem(messages, form, problem);
       }

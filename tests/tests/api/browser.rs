@@ -1,5 +1,7 @@
 //! The page in real headless Chromium (Debian's `chromium`, driven by playwright-core from
-//! `tests/browser/`): it loads, submits the sample job with its button, and plots.
+//! `tests/browser/`): it loads, submits the sample job with its button, and plots; the workbench
+//! keeps state, honours machines, reports errors at the field and never scrolls sideways. Every
+//! scenario also fails on a console error or a request that leaves 127.0.0.1.
 
 use std::path::Path;
 use std::process::Command;
@@ -44,6 +46,25 @@ async fn deburr_page_plots_the_sample_job() {
     let Some(result) = run_scenario(&app, "deburr", &[]) else { return };
     assert_eq!(result["ok"], true);
     assert!(result["segments"].as_u64().unwrap() >= 10, "{result}");
+    let objects = result["objects"].as_array().unwrap();
+    assert!(objects.contains(&"tube".into()) && objects.contains(&"tool".into()), "{result}");
+    eprintln!("load to first deburr plot: {} s", result["firstPlot"]);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn segment_page_cuts_the_sample_and_uses_a_registered_machine() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "segment", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert_eq!(result["segments"], 472, "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn workbench_keeps_state_honours_the_machine_and_fits_the_window() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "workbench", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert_eq!(result["placeholder"], "2 (machine)", "{result}");
 }
 
 #[tokio::test(flavor = "multi_thread")]

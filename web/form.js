@@ -1,0 +1,434 @@
+// kerf form helpers shared by the views: reading fields, the tool and machine choices (machine
+// values as placeholders, only overrides sent), errors at the field, warnings as sentences, the
+// per-view state kept in local storage, summaries and downloads.
+import { machines, plainFieldMessage, plainTitle, sentence, technical, tools } from '/api.js';
+
+// ---------------------------------------------------------------- reading fields
+
+// The text of form control `name`.
+export function value(form, name) {
+  return form.elements[name].value;
+}
+
+// The number in form control `name`, or undefined when it is empty.
+export function numeric(form, name) {
+  const text = value(form, name).trim();
+  return text === '' ? undefined : Number(text);
+}
+
+// Half of a diameter entered in a form (the API takes radii), or undefined when empty.
+export function half(diameter) {
+  return diameter === undefined ? undefined : diameter / 2;
+}
+
+export function number(value, digits = 4) {
+  return Number.isFinite(value) ? value.toFixed(digits) : '–';
+}
+
+// ---------------------------------------------------------------- messages
+
+// A message box: kind is 'error', 'warning', 'ok' (green) or 'info'.
+export function message(kind, text, tooltip) {
+  const div = document.createElement('div');
+  div.className = `message ${kind}`;
+  div.setAttribute('role', kind === 'error' ? 'alert' : 'status');
+  div.textContent = text;
+  if (tooltip) div.title = tooltip;
+  return div;
+}
+
+// The answer's warnings as sentences, the code as a tooltip.
+export function warningMessages(warnings = []) {
+  return warnings.map((w) => message('warning', sentence(w.message), `${w.code}: ${w.message}`));
+}
+
+// Shows "computing…" and dims the last result until the answer comes.
+export function computing(messages, result) {
+  messages.replaceChildren(message('info', 'Computing…'));
+  result?.classList.add('stale');
+}
+
+// Shows success in green and undims the result.
+export function computed(messages, result, text = 'Computed.') {
+  messages.replaceChildren(message('ok', text));
+  result?.classList.remove('stale');
+}
+
+// Fills a summary box with [name, value] pairs, each a line with the value in bold.
+export function showSummary(box, items) {
+  box.replaceChildren(...items.map(([name, value]) => {
+    const div = document.createElement('div');
+    const b = document.createElement('b');
+    b.textContent = String(value);
+    div.append(name, b);
+    return div;
+  }));
+}
+
+export function download(name, text, type = 'text/plain') {
+  const url = URL.createObjectURL(new Blob([text], { type }));
+  const link = document.createElement('a');
+  link.href = url;
+  link.download = name;
+  document.body.append(link);
+  link.click();
+  link.remove();
+  setTimeout(() => URL.revokeObjectURL(url), 1000);
+}
+
+// ---------------------------------------------------------------- errors at the field
+
+// The visible label text of a control: its label's words without the controls and the
+// patent's symbols.
+export function labelText(control) {
+  const label = control.closest('label');
+  if (!label) return control.getAttribute('aria-label') || control.name;
+  let text = '';
+  for (const node of label.childNodes) {
+    if (node.nodeType === Node.TEXT_NODE) text += node.textContent;
+    else if (node.nodeType === Node.ELEMENT_NODE && !node.matches('abbr, input, select, textarea, span.pair, span.triple, .field-error')) {
+      const copy = node.cloneNode(true);
+      copy.querySelectorAll('abbr, input, select, textarea').forEach((e) => e.remove());
+      text += copy.textContent;
+    }
+  }
+  return text.replace(/\s+/g, ' ').trim() || control.name;
+}
+
+// Removes the marks of an earlier problem.
+export function clearProblem(form) {
+  if (!form) return;
+  form.querySelectorAll('[aria-invalid]').forEach((e) => {
+    e.removeAttribute('aria-invalid');
+    e.classList.remove('invalid');
+    const ids = (e.getAttribute('aria-describedby') || '').split(' ').filter((id) => id && !id.startsWith('error-'));
+    if (ids.length) e.setAttribute('aria-describedby', ids.join(' ')); else e.removeAttribute('aria-describedby');
+  });
+  form.querySelectorAll('.field-error').forEach((e) => e.remove());
+}
+
+// The controls an error path names: data-field equal to the path or a prefix of it
+// (curve.points[3] → curve.points); serde's "missing field `radius`" at `hole` names hole.radius.
+function controlsFor(form, error) {
+  const paths = [error.path];
+  const missing = /missing field `([^`]+)`/.exec(error.message || '');
+  if (missing) paths.unshift(error.path === 'body' ? missing[1] : `${error.path}.${missing[1]}`);
+  for (const path of paths) {
+    const found = [...form.querySelectorAll('[data-field]')].filter((e) => {
+      const field = e.dataset.field;
+      return !e.closest('[hidden]') && (path === field || path.startsWith(`${field}[`) || path.startsWith(`${field}.`));
+    });
+    if (found.length) return found;
+  }
+  return [];
+}
+
+// The API's message without its leading field path ("hole.radius must be …" → "must be …").
+function withoutPath(text, path) {
+  const message = String(text ?? '');
+  return path && message.startsWith(path) ? message.slice(path.length).replace(/^[:\s]+/, '') : message;
+}
+
+let noteCount = 0;
+
+// Shows a problem document: each field error under its field (aria-invalid, aria-describedby),
+// a plain headline in `box` with the API's words as a tooltip, focus on the first bad field.
+// The last good result stays, dimmed, until the next success.
+export function showProblem(box, form, problem) {
+  clearProblem(form);
+  const errors = problem.errors || [];
+  const lines = [];
+  let first = null;
+  for (const error of errors) {
+    const controls = form ? controlsFor(form, error) : [];
+    const text = plainFieldMessage(withoutPath(error.message || problem.detail, error.path));
+    if (!controls.length) {
+      lines.push(text);
+      continue;
+    }
+    // One message under each field; a second error on the same field adds to it.
+    const label = controls[0].closest('label') || controls[0];
+    let note = label.nextElementSibling?.classList.contains('field-error') ? label.nextElementSibling : null;
+    if (note) {
+      note.textContent += ` ${text}`;
+    } else {
+      note = document.createElement('p');
+      note.className = 'field-error';
+      note.id = `error-${form.id || 'form'}-${++noteCount}`;
+      note.textContent = text;
+      note.title = [error.path, problem.code].filter(Boolean).join(' · ');
+      label.after(note);
+    }
+    const id = note.id;
+    for (const control of controls) {
+      control.setAttribute('aria-invalid', 'true');
+      control.classList.add('invalid');
+      const described = (control.getAttribute('aria-describedby') || '').split(' ').filter(Boolean);
+      if (!described.includes(id)) control.setAttribute('aria-describedby', [...described, id].join(' '));
+    }
+    lines.push(`${labelText(controls[0])}: ${text}`);
+    first ??= controls[0];
+  }
+  if (!errors.length) lines.push(sentence(problem.detail || problem.title));
+  const headline = first ? 'Check the marked field' + (lines.length > 1 ? 's' : '') : plainTitle(problem);
+  const alert = message('error', `${headline}. ${lines.join(' ')}`, technical(problem));
+  box?.replaceChildren(alert);
+  if (first) {
+    first.focus({ preventScroll: true });
+    first.scrollIntoView({ block: 'center' });
+  } else {
+    alert.scrollIntoView({ block: 'nearest' });
+  }
+}
+
+// ---------------------------------------------------------------- tools and machines
+
+export function toolLabel(tool) {
+  const size = tool.kind === 'ball' ? `Ø${2 * tool.radius} ball` : `Ø${2 * tool.radius} ${tool.kind}`;
+  return `T${tool.number} ${size}${tool.name ? ` – ${tool.name}` : ''}`;
+}
+
+// Re-runs `fill` each time the view is shown again (another view may have changed the tables).
+function onShow(element, fill) {
+  element.closest('[data-view-root]')?.addEventListener('kerf:show', fill);
+}
+
+// Puts back a choice restored from storage before the options were there.
+function restoreChoice(select, chosen) {
+  const wanted = select.dataset.wanted ?? chosen;
+  if ([...select.options].some((o) => o.value === wanted)) {
+    select.value = wanted;
+    delete select.dataset.wanted;
+  }
+  if (select.value !== chosen) select.dispatchEvent(new Event('change', { bubbles: true }));
+}
+
+// Fills a tool <select> with an "inline" entry and the table's tools that `accepts`, keeping
+// the choice when it is still there. Without the table the inline tool still works.
+export function loadTools(select, inlineLabel, accepts = () => true, describe = toolLabel) {
+  const fill = async () => {
+    const chosen = select.value;
+    const table = await tools();
+    select.replaceChildren(new Option(inlineLabel, 'inline'));
+    for (const tool of table.values()) {
+      if (accepts(tool)) select.append(new Option(describe(tool), String(tool.number)));
+    }
+    select.tools = table;
+    restoreChoice(select, chosen);
+  };
+  // The inline choice is there at once, so a form sent before the table arrives is still whole.
+  if (!select.options.length) select.append(new Option(inlineLabel, 'inline'));
+  onShow(select, fill);
+  return track(select.form, fill());
+}
+
+// Fills a machine <select> with "none" and the registered machines, keeping the choice.
+// The chosen machine is `select.machine` (its profile) for placeholders and summaries.
+export function loadMachines(select, noneLabel = 'none') {
+  const fill = async () => {
+    const chosen = select.value;
+    const table = await machines();
+    select.replaceChildren(new Option(noneLabel, ''));
+    for (const machine of table.values()) {
+      select.append(new Option(`${machine.name}: ${machine.block_time_ms} ms, ${machine.max_feed} mm/min, ${machine.dialect}`, machine.name));
+    }
+    select.machines = table;
+    restoreChoice(select, chosen);
+    select.dispatchEvent(new Event('kerf:machines'));
+  };
+  if (!select.options.length) select.append(new Option(noneLabel, ''));
+  onShow(select, fill);
+  return track(select.form, fill());
+}
+
+// Remembers a form's pending loads, so a restored form computes only once its choices are there.
+function track(form, promise) {
+  if (form) (form.loading ??= []).push(promise);
+  return promise;
+}
+
+// Machine-backed fields: `fields` maps a control name to the machine profile's key. With a
+// machine chosen, every field the user has not typed in is emptied and shows the machine's value
+// as its placeholder (so the request leaves it out and the service takes the machine's); what the
+// user types is an override. Without a machine the example values come back.
+export function machineFields(form, fields) {
+  const select = form.elements.machine;
+  const apply = () => {
+    const machine = select.machines?.get(select.value);
+    for (const [name, key] of Object.entries(fields)) {
+      const input = form.elements[name];
+      input.dataset.placeholder ??= input.placeholder;
+      if (machine) {
+        if (input.dataset.dirty !== 'true') input.value = '';
+        // A value the machine does not set: the service's default, which is the example's.
+        const fallback = input.defaultValue ? `${input.defaultValue} (default)` : input.dataset.placeholder;
+        input.placeholder = machine[key] == null ? fallback : `${machine[key]} (machine)`;
+      } else {
+        input.placeholder = input.dataset.placeholder;
+        if (input.dataset.dirty !== 'true' && input.value === '') input.value = input.defaultValue;
+      }
+    }
+  };
+  select.addEventListener('change', apply);
+  select.addEventListener('kerf:machines', apply);
+}
+
+// How a summary states a value that a machine may supply: "4 ms (machine: 2 ms, overridden)",
+// "2 ms (machine)" or "4 ms".
+export function machineNote(used, unit, request, field, machine, key = field) {
+  const shown = `${used} ${unit}`.trim();
+  if (!machine || machine[key] == null) return shown;
+  if (request && request[field] !== undefined) return `${shown} (machine: ${machine[key]} ${unit}, overridden)`.replace(' ,', ',');
+  return `${shown} (machine)`;
+}
+
+// ---------------------------------------------------------------- G-code options
+
+// The G-code query of a form with a `dialect` select ('' = the machine's, else Fanuc) and a
+// `reference` select.
+export function gcodeQuery(form) {
+  const dialect = form.elements.dialect.value;
+  const reference = form.elements.reference ? `&reference=${form.elements.reference.value}` : '';
+  return `?format=gcode${dialect ? `&dialect=${dialect}` : ''}${reference}`;
+}
+
+// The download name of a program: `kind-dialect.nc`, or the machine's name for its dialect.
+export function programName(kind, form) {
+  return `${kind}-${form.elements.dialect.value || form.elements.machine?.value || 'fanuc'}.nc`;
+}
+
+// ---------------------------------------------------------------- state per view
+
+const STATE_VERSION = 1;
+const stateKey = (view) => `kerf.v${STATE_VERSION}.${view}`;
+
+function readState(view) {
+  try {
+    const state = JSON.parse(localStorage.getItem(stateKey(view)) || 'null');
+    return state && state.version === STATE_VERSION ? state : null;
+  } catch (error) {
+    return null;
+  }
+}
+
+function writeState(view, state) {
+  try {
+    localStorage.setItem(stateKey(view), JSON.stringify({ ...state, version: STATE_VERSION }));
+  } catch (error) {
+    // Storage full or off: the page still works, it only forgets.
+  }
+}
+
+function controls(form) {
+  return [...form.elements].filter((e) => e.name && !['button', 'submit', 'file'].includes(e.type));
+}
+
+function snapshot(form) {
+  const fields = {};
+  const dirty = [];
+  for (const e of controls(form)) {
+    fields[e.name] = e.type === 'checkbox' || e.type === 'radio' ? e.checked : e.value;
+    if (e.dataset.dirty === 'true') dirty.push(e.name);
+  }
+  return { fields, dirty };
+}
+
+function restore(form, { fields = {}, dirty = [] }) {
+  for (const e of controls(form)) {
+    if (!(e.name in fields)) continue;
+    if (e.type === 'checkbox' || e.type === 'radio') e.checked = fields[e.name];
+    else if (e.tagName === 'SELECT' && ![...e.options].some((o) => o.value === fields[e.name])) e.dataset.wanted = fields[e.name];
+    else e.value = fields[e.name];
+    if (dirty.includes(e.name)) e.dataset.dirty = 'true';
+  }
+}
+
+// Keeps `form` of view `view` across reloads: its fields (and which ones the user typed) after
+// every change, and whether it had a result, in which case the restored form computes again
+// (the service is deterministic, so this is the same result). Adds "Load example" and "Reset".
+// `more` ({save, restore}) keeps what has no form control name (e.g. a list of path boxes).
+export function keepForm(view, form, { onReset, more } = {}) {
+  const saved = readState(view);
+  const save = (extra = {}) => writeState(view, { ...(readState(view) || {}), ...snapshot(form), more: more?.save(), ...extra });
+  form.addEventListener('input', (event) => {
+    if (event.target.name) event.target.dataset.dirty = 'true';
+    save();
+  });
+  form.addEventListener('change', () => save());
+  form.addEventListener('kerf:computed', () => save({ computed: true }));
+
+  const bar = document.createElement('div');
+  bar.className = 'actions form-tools';
+  const example = document.createElement('button');
+  example.type = 'button';
+  example.className = 'link';
+  example.textContent = 'Load example';
+  const reset = document.createElement('button');
+  reset.type = 'button';
+  reset.className = 'link';
+  reset.textContent = 'Reset';
+  bar.append(example, reset);
+  form.prepend(bar);
+  const startOver = (clear) => {
+    clearProblem(form);
+    form.reset();
+    for (const e of controls(form)) {
+      delete e.dataset.dirty;
+      if (clear && e.tagName !== 'SELECT' && e.type !== 'checkbox' && e.type !== 'radio') e.value = '';
+    }
+    form.elements.machine?.dispatchEvent(new Event('change', { bubbles: true }));
+    form.dispatchEvent(new Event('change'));
+    onReset?.(clear);
+    writeState(view, { ...snapshot(form), more: more?.save(), computed: false });
+  };
+  example.addEventListener('click', () => startOver(false));
+  reset.addEventListener('click', () => startOver(true));
+
+  if (saved) {
+    if (saved.more !== undefined) more?.restore(saved.more);
+    restore(form, saved);
+    form.dispatchEvent(new Event('change'));
+    if (saved.computed) Promise.all(form.loading || []).then(() => form.requestSubmit());
+  }
+}
+
+// Tells keepForm that the form's request gave a result.
+export function markComputed(form) {
+  form.dispatchEvent(new Event('kerf:computed'));
+}
+
+// ---------------------------------------------------------------- confirmation
+
+// A button that asks before it acts: "Delete" becomes "Delete T3? [Yes, delete] [Cancel]".
+export function confirmButton(text, question, action) {
+  const box = document.createElement('span');
+  box.className = 'confirm';
+  const make = (label, className) => {
+    const b = document.createElement('button');
+    b.type = 'button';
+    b.className = className;
+    b.textContent = label;
+    return b;
+  };
+  const ask = make(text, 'secondary small');
+  const prompt = document.createElement('span');
+  prompt.setAttribute('role', 'group');
+  prompt.setAttribute('aria-label', question);
+  const yes = make(`Yes, ${text.toLowerCase()}`, 'danger small');
+  const no = make('Cancel', 'secondary small');
+  prompt.append(`${question} `, yes, ' ', no);
+  prompt.hidden = true;
+  ask.addEventListener('click', () => {
+    ask.hidden = true;
+    prompt.hidden = false;
+    no.focus();
+  });
+  no.addEventListener('click', () => {
+    prompt.hidden = true;
+    ask.hidden = false;
+    ask.focus();
+  });
+  yes.addEventListener('click', action);
+  box.append(ask, prompt);
+  return box;
+}
