@@ -1,5 +1,6 @@
 //! The web page (`web/`), compiled into the binary so a shop-floor PC needs only the executable.
-//! Only the files listed here are served: nothing outside `web/` can be reached. Each file has a
+//! Every file of `web/` is served at its own path (listed at build time by `build.rs`), and
+//! nothing outside `web/` can be reached. Each file has a
 //! strong ETag (a hash of its bytes): the browser revalidates and gets 304 while the binary is the
 //! same; answers are gzip-compressed when the browser accepts it.
 
@@ -17,32 +18,8 @@ struct Asset {
     body: &'static [u8],
 }
 
-const HTML: &str = "text/html; charset=utf-8";
-const CSS: &str = "text/css; charset=utf-8";
-const JS: &str = "text/javascript; charset=utf-8";
-
-/// A file of `web/` served at its own path.
-macro_rules! asset {
-    ($path:literal, $media_type:expr) => {
-        Asset { path: $path, media_type: $media_type, body: include_bytes!(concat!("../../web", $path)) }
-    };
-}
-
-const ASSETS: &[Asset] = &[
-    Asset { path: "/", media_type: HTML, body: include_bytes!("../../web/index.html") },
-    asset!("/style.css", CSS),
-    asset!("/app.js", JS),
-    asset!("/plot3d.js", JS),
-    asset!("/plot2d.js", JS),
-    asset!("/views/contour.js", JS),
-    asset!("/views/deburr.js", JS),
-    asset!("/views/engagement.js", JS),
-    asset!("/views/jobs.js", JS),
-    asset!("/views/machines.js", JS),
-    asset!("/views/segment.js", JS),
-    asset!("/views/predict.js", JS),
-    asset!("/views/tools.js", JS),
-];
+/// Every file of `web/` (`index.html` at `/`), listed by `build.rs`.
+const ASSETS: &[Asset] = include!(concat!(env!("OUT_DIR"), "/web_assets.rs"));
 
 /// The strong ETag of `body`: a quoted hash of its bytes.
 fn etag(body: &[u8]) -> HeaderValue {
