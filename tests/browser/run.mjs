@@ -70,7 +70,7 @@ const scenarios = {
     const started = Date.now();
     await page.goto(`${base}/`);
     await page.click('#deburr-compute');
-    await page.waitForSelector('#deburr-plot[data-state="drawn"]', { timeout: 15000 });
+    await page.waitForSelector('#deburr-plot[data-state="drawn"]', { timeout: 60000 });
     const firstPlot = (Date.now() - started) / 1000;
     const segments = Number(await page.getAttribute('#deburr-plot', 'data-segments'));
     const objects = (await page.getAttribute('#deburr-plot', 'data-objects')).split(' ');
@@ -112,10 +112,10 @@ const scenarios = {
     }, `${base}/api/v1/machines/page-4ms`);
     await page.goto(`${base}/#/deburr`);
     await page.reload();
-    await page.waitForSelector('#deburr-form select[name="machine"] option[value="page-4ms"]', { state: 'attached', timeout: 15000 });
+    await page.waitForSelector('#deburr-form select[name="machine"] option[value="page-4ms"]', { state: 'attached', timeout: 60000 });
     await page.selectOption('#deburr-form select[name="machine"]', 'page-4ms');
     await page.click('#deburr-compute');
-    await page.waitForFunction(() => /page-4ms/.test(document.querySelector('#deburr-result .summary')?.textContent ?? ''), null, { timeout: 15000 });
+    await page.waitForFunction(() => /page-4ms/.test(document.querySelector('#deburr-result .summary')?.textContent ?? ''), null, { timeout: 60000 });
     const withMachine = await page.textContent('#deburr-result .summary');
     if (!/blocks \(short\)\d+ \(0\)/.test(withMachine)) throw new Error(`no block figures: ${withMachine}`);
 
@@ -125,19 +125,19 @@ const scenarios = {
     await page.selectOption('#deburr-form select[name="edge"]', 'inner');
     await page.fill('#deburr-form input[name="ball_diameter"]', '10.4');
     await page.click('#deburr-compute');
-    await page.waitForSelector('#deburr-plot[data-refused="true"]', { timeout: 15000 });
+    await page.waitForSelector('#deburr-plot[data-refused="true"]', { timeout: 60000 });
     if (!(await page.isDisabled('#deburr-gcode'))) throw new Error('G-code button enabled without a program');
     await page.selectOption('#deburr-form select[name="edge"]', 'outer');
     await page.fill('#deburr-form input[name="ball_diameter"]', '4');
     await page.click('#deburr-compute');
-    await page.waitForSelector('#deburr-plot[data-refused="false"]', { timeout: 15000 });
+    await page.waitForSelector('#deburr-plot[data-refused="false"]', { timeout: 60000 });
     if (await page.isDisabled('#deburr-gcode')) throw new Error('G-code button still off');
 
     // A bad value: its message under the field, aria-invalid, aria-describedby naming the message,
     // focus on the field, the last result still there but dimmed.
     await page.fill('input[name="hole_radius"]', '-1');
     await page.click('#deburr-compute');
-    await page.waitForSelector('#deburr-form [aria-invalid="true"]', { timeout: 15000 });
+    await page.waitForSelector('#deburr-form [aria-invalid="true"]', { timeout: 60000 });
     const bad = await page.$eval('#deburr-form [aria-invalid="true"]', (e) => {
       const note = document.getElementById(e.getAttribute('aria-describedby'));
       const field = e.getBoundingClientRect();
@@ -161,21 +161,21 @@ const scenarios = {
       if (!response.ok) throw new Error(`machine not stored: ${response.status}`);
     });
     await page.reload();
-    await page.waitForSelector('#segment-form select[name="machine"] option[value="fast-2ms"]', { state: 'attached', timeout: 15000 });
+    await page.waitForSelector('#segment-form select[name="machine"] option[value="fast-2ms"]', { state: 'attached', timeout: 60000 });
     await page.selectOption('#segment-form select[name="machine"]', 'fast-2ms');
     const placeholder = await page.getAttribute('#segment-form input[name="block_time_ms"]', 'placeholder');
     let [request] = await Promise.all([page.waitForRequest((r) => r.url().endsWith('/api/v1/segment')), page.click('#segment-compute')]);
     let body = request.postDataJSON();
     const sent = ['feed', 'block_time_ms', 'margin', 'min_chord_error'].filter((k) => k in body);
     if (sent.length || body.machine !== 'fast-2ms') throw new Error(`the request overrides the machine: ${JSON.stringify(body)}`);
-    await page.waitForSelector('#segment-plot[data-state="drawn"]', { timeout: 15000 });
+    await page.waitForSelector('#segment-plot[data-state="drawn"]', { timeout: 60000 });
     let summary = await page.textContent('#segment-result .summary');
     if (!/block time2 ms \(machine\)/.test(summary) || !/15000 mm\/min \(machine\)/.test(summary)) throw new Error(`machine values not used: ${summary}`);
     await page.fill('#segment-form input[name="block_time_ms"]', '4');
     [request] = await Promise.all([page.waitForRequest((r) => r.url().endsWith('/api/v1/segment')), page.click('#segment-compute')]);
     body = request.postDataJSON();
     if (body.block_time_ms !== 4 || 'feed' in body) throw new Error(`override: ${JSON.stringify(body)}`);
-    await page.waitForFunction(() => /overridden/.test(document.querySelector('#segment-result .summary')?.textContent ?? ''), null, { timeout: 15000 });
+    await page.waitForFunction(() => /overridden/.test(document.querySelector('#segment-result .summary')?.textContent ?? ''), null, { timeout: 60000 });
     summary = await page.textContent('#segment-result .summary');
     if (!/block time4 ms \(machine: 2 ms, overridden\)/.test(summary)) throw new Error(`override not named: ${summary}`);
 
@@ -191,7 +191,7 @@ const scenarios = {
 
     // A reload: the same form (machine, override) and the result again.
     await page.reload();
-    await page.waitForSelector('#segment-plot[data-state="drawn"]', { timeout: 15000 });
+    await page.waitForSelector('#segment-plot[data-state="drawn"]', { timeout: 60000 });
     const machine = await page.inputValue('#segment-form select[name="machine"]');
     const blockTime = await page.inputValue('#segment-form input[name="block_time_ms"]');
     summary = await page.textContent('#segment-result .summary');
@@ -209,7 +209,7 @@ const scenarios = {
     await page.fill('#tool-form input[name="size"]', '8');
     await page.fill('#tool-form input[name="neck_radius"]', '2.5');
     await page.click('#tool-save');
-    await page.waitForSelector('#tool-rows tr[data-tool="12"]', { timeout: 15000 });
+    await page.waitForSelector('#tool-rows tr[data-tool="12"]', { timeout: 60000 });
     const stored = await page.evaluate(async () => (await (await fetch('/api/v1/tools/12')).json()));
     if (stored.radius !== 4 || stored.neck_radius !== 2.5) throw new Error(`tool by diameter: ${JSON.stringify(stored)}`);
     await page.click('#tool-rows tr[data-tool="12"] button:has-text("Edit")');
@@ -217,12 +217,12 @@ const scenarios = {
     await page.click('#tool-rows tr[data-tool="12"] button:has-text("Delete")');
     if (!(await page.$('#tool-rows tr[data-tool="12"]'))) throw new Error('deleted without asking');
     await page.click('#tool-rows tr[data-tool="12"] button:has-text("Yes, delete")');
-    await page.waitForSelector('#tool-rows tr[data-tool="12"]', { state: 'detached', timeout: 15000 });
+    await page.waitForSelector('#tool-rows tr[data-tool="12"]', { state: 'detached', timeout: 60000 });
 
     // No sideways scrolling, with the deburr scene drawn, at three sizes.
     await page.goto(`${base}/#/deburr`);
     await page.click('#deburr-compute');
-    await page.waitForSelector('#deburr-plot[data-state="drawn"]', { timeout: 15000 });
+    await page.waitForSelector('#deburr-plot[data-state="drawn"]', { timeout: 60000 });
     const widths = {};
     for (const [width, height] of [[1440, 900], [1280, 720], [390, 844]]) {
       await page.setViewportSize({ width, height });
@@ -235,7 +235,7 @@ const scenarios = {
     // At phone width, the views with wide tables too (contour's corners, the jobs list).
     await page.click('#tabs a[data-view="contour"]');
     await page.click('#contour-compute');
-    await page.waitForSelector('#contour-result:not(.stale) #contour-plot[data-state="drawn"]', { timeout: 15000 });
+    await page.waitForSelector('#contour-result:not(.stale) #contour-plot[data-state="drawn"]', { timeout: 60000 });
     for (const view of ['contour', 'jobs', 'tools', 'machines', 'engagement', 'predict', 'segment']) {
       await page.click(`#tabs a[data-view="${view}"]`);
       await page.waitForTimeout(100);
@@ -251,9 +251,9 @@ const scenarios = {
   async segment() {
     await page.goto(`${base}/#segment`);
     await page.click('#segment-compute');
-    await page.waitForSelector('#segment-plot[data-state="drawn"]', { timeout: 15000 });
-    await page.waitForSelector('#segment-chart[data-state="drawn"]', { timeout: 15000 });
-    await page.waitForSelector('#segment-lengths[data-state="drawn"]', { timeout: 15000 });
+    await page.waitForSelector('#segment-plot[data-state="drawn"]', { timeout: 60000 });
+    await page.waitForSelector('#segment-chart[data-state="drawn"]', { timeout: 60000 });
+    await page.waitForSelector('#segment-lengths[data-state="drawn"]', { timeout: 60000 });
     const segments = Number(await page.getAttribute('#segment-plot', 'data-segments'));
     const inked = await inkedPixels('#segment-plot');
     const chartInked = await inkedPixels('#segment-chart');
@@ -280,7 +280,7 @@ const scenarios = {
     // A bad value is reported with the field highlighted.
     await page.fill('input[name="feed"]', '-1');
     await page.click('#segment-compute');
-    await page.waitForSelector('#segment-messages .message.error', { timeout: 15000 });
+    await page.waitForSelector('#segment-messages .message.error', { timeout: 60000 });
     const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
     if (!highlighted.includes('feed')) throw new Error(`field not highlighted: ${highlighted}`);
 
@@ -291,24 +291,24 @@ const scenarios = {
     await page.fill('#machine-form input[name="margin"]', '1.1');
     await page.selectOption('#machine-form select[name="dialect"]', 'linuxcnc');
     await page.click('#machine-save');
-    await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { timeout: 15000 });
+    await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { timeout: 60000 });
     await page.click('#tabs a[data-view="segment"]');
-    await page.waitForSelector('#segment-form select[name="machine"] option[value="hsc-page"]', { state: 'attached', timeout: 15000 });
+    await page.waitForSelector('#segment-form select[name="machine"] option[value="hsc-page"]', { state: 'attached', timeout: 60000 });
     await page.selectOption('#segment-form select[name="machine"]', 'hsc-page');
     for (const name of ['feed', 'block_time_ms', 'margin', 'min_chord_error']) await page.fill(`#segment-form input[name="${name}"]`, '');
     await page.click('#segment-compute');
     // The earlier result stays on the page: wait for the one that names the machine.
-    await page.waitForFunction(() => /hsc-page/.test(document.querySelector('#segment-result .summary')?.textContent ?? ''), null, { timeout: 15000 });
+    await page.waitForFunction(() => /hsc-page/.test(document.querySelector('#segment-result .summary')?.textContent ?? ''), null, { timeout: 60000 });
     const withMachine = await page.textContent('#segment-result .summary');
     if (!/hsc-page/.test(withMachine) || !/12000 mm\/min/.test(withMachine)) throw new Error(`machine not used: ${withMachine}`);
     const machineBlocks = Number(await page.getAttribute('#segment-plot', 'data-segments'));
 
     // Delete it again.
     await page.click('#tabs a[data-view="machines"]');
-    await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { timeout: 15000 });
+    await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { timeout: 60000 });
     await page.click('#machine-rows tr[data-machine="hsc-page"] button:has-text("Delete")');
     await page.click('#machine-rows tr[data-machine="hsc-page"] button:has-text("Yes, delete")');
-    await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { state: 'detached', timeout: 15000 });
+    await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { state: 'detached', timeout: 60000 });
     return { segments, inked, chartInked, lengthsInked, machineBlocks };
   },
 
@@ -318,7 +318,7 @@ const scenarios = {
   async contour() {
     await page.goto(`${base}/#contour`);
     await page.click('#contour-compute');
-    await page.waitForSelector('#contour-plot[data-state="drawn"]', { timeout: 15000 });
+    await page.waitForSelector('#contour-plot[data-state="drawn"]', { timeout: 60000 });
     const segments = Number(await page.getAttribute('#contour-plot', 'data-segments'));
     const inked = await inkedPixels('#contour-plot');
     const loopPixels = await colouredPixels('#contour-plot', [224, 112, 0]);
@@ -353,13 +353,13 @@ const scenarios = {
     // not "x, y" before anything is sent.
     await page.fill('#contour-form input[name="step"]', '0');
     await page.click('#contour-compute');
-    await page.waitForSelector('#contour-messages .message.error', { timeout: 15000 });
+    await page.waitForSelector('#contour-messages .message.error', { timeout: 60000 });
     const invalidStep = await page.$$eval('#contour-form .invalid', (l) => l.map((e) => e.name));
     if (!invalidStep.includes('step')) throw new Error(`step not highlighted: ${invalidStep}`);
     await page.fill('#contour-form input[name="step"]', '3');
     await page.fill('#contour-form textarea[name="points"]', '0, 0\n10, 10\n10, 0\n0, 10');
     await page.click('#contour-compute');
-    await page.waitForFunction(() => /E_SELF_INTERSECTION/.test(document.querySelector('#contour-messages .message.error')?.title ?? ''), null, { timeout: 15000 });
+    await page.waitForFunction(() => /E_SELF_INTERSECTION/.test(document.querySelector('#contour-messages .message.error')?.title ?? ''), null, { timeout: 60000 });
     const invalidPoints = await page.$$eval('#contour-form .invalid', (l) => l.map((e) => e.name));
     if (!invalidPoints.includes('points')) throw new Error(`points not highlighted: ${invalidPoints}`);
     await page.fill('#contour-form textarea[name="points"]', '0, 0\n10 0 5\n10, 10');
@@ -369,9 +369,9 @@ const scenarios = {
     // Every layer in 3-D, and the timeline moves the tool there too.
     await page.fill('#contour-form input[name="points"], #contour-form textarea[name="points"]', '0, 10\n40, 10\n40, 0\n80, 25\n40, 50\n40, 40\n0, 40');
     await page.click('#contour-compute');
-    await page.waitForSelector('#contour-result:not(.stale) #contour-plot[data-state="drawn"]', { timeout: 15000 });
+    await page.waitForSelector('#contour-result:not(.stale) #contour-plot[data-state="drawn"]', { timeout: 60000 });
     await page.selectOption('#contour-result select[aria-label="View"]', '3d');
-    await page.waitForSelector('#contour-plot-3d[data-state="drawn"]', { timeout: 15000 });
+    await page.waitForSelector('#contour-plot-3d[data-state="drawn"]', { timeout: 60000 });
     const objects = (await page.getAttribute('#contour-plot-3d', 'data-objects')).split(' ');
     if (!['part', 'cut', 'loop', 'tool'].every((o) => objects.includes(o))) throw new Error(`3-D contour: ${objects}`);
     const slider = page.getByRole('slider', { name: /Timeline/ });
@@ -429,7 +429,7 @@ const scenarios = {
     // A flute count out of range is refused with the field highlighted.
     await page.fill('input[name="flute_counts"]', '2, 40');
     await page.click('#engagement-compute');
-    await page.waitForSelector('#engagement-messages .message.error', { timeout: 15000 });
+    await page.waitForSelector('#engagement-messages .message.error', { timeout: 60000 });
     const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
     if (!highlighted.includes('flute_counts')) throw new Error(`field not highlighted: ${highlighted}`);
     return { columns, charts: states.length, inked, cursor, recommendation, feeds: feeds.size, file: download.suggestedFilename() };
@@ -487,7 +487,7 @@ const scenarios = {
     // A G-code error names its line and marks the program.
     await page.fill('textarea[name="program"]', 'G21 G90\nG0 X0 Y0 Z5\nG1 Z0 F500 Q1\nM30\n');
     await page.click('#predict-compute');
-    await page.waitForSelector('#predict-messages .message.error', { timeout: 15000 });
+    await page.waitForSelector('#predict-messages .message.error', { timeout: 60000 });
     const error = await page.textContent('#predict-messages .message.error');
     if (!/line 3/i.test(error)) throw new Error(`error without its line: ${error}`);
     const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
@@ -504,7 +504,7 @@ const scenarios = {
     await page.waitForSelector('#job-rows tr[data-status="done"]', { timeout: 60000 });
     const seconds = (Date.now() - started) / 1000;
     await page.click('#job-rows tr[data-status="done"] button');
-    await page.waitForSelector('#job-result [data-state="drawn"]', { timeout: 15000 });
+    await page.waitForSelector('#job-result [data-state="drawn"]', { timeout: 60000 });
     const plots = await page.$$eval('#job-result canvas', (list) => list.length);
     const inked = await inkedPixels('#job-result canvas');
     const downloads = await page.$$eval('#job-result button', (list) => list.map((b) => b.textContent));
