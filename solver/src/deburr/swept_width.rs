@@ -1,0 +1,141 @@
+//! The chamfer width the emitted moves really cut (issue 19; deburr.md §2.9, measured "on the
+//! swept-sphere characteristic circle"): the ball swept along the straight moves between the
+//! centres removes everything within D of the centre polyline, so in the ridge's normal plane VP
+//! at a ridge point the band edges are where the true cylinder surface and the true hole wall,
+//! cut by VP, come to distance D from the polyline. Measured at targets and in the middle of the
+//! intervals between them, where the moves stray furthest from the ideal centre path.
+
+use std::cell::Cell;
+
+use super::centre::{Construction, RidgeCentre};
+use super::profile::Profile;
+use super::tolerance::Target;
+use crate::geometry::{Vec3, distance_to_segment, root_near};
+
+/// Most intervals of a loop at which the swept width is measured (at its end target and its
+/// middle); denser loops are measured at intervals spread evenly.
+const MAX_MEASURED_INTERVALS: usize = 1024;
+
+/// The range of the swept width and where it is furthest from W.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SweptWidths {
+    pub min: f64,
+    pub max: f64,
+    /// The measurement furthest from W: segment, parameter and width.
+    pub worst: Option<(usize, f64, f64)>,
+}
+
+/// The closed centre polyline (local frame; the last centre repeats the first).
+struct Polyline<'a> {
+    centres: &'a [Vec3],
+}
+
+impl Polyline<'_> {
+    /// Distance from `point` to the polyline near vertex `hint`, which moves to the nearest vertex.
+    /// Only the local part of the loop counts: a far part within reach is E_FAR_GOUGE's business.
+    fn distance(&self, point: &Vec3, hint: &Cell<usize>) -> f64 {
+        let count = self.centres.len() - 1;
+        let vertex = |k: usize| &self.centres[k % count];
+        let squared = |k: usize| (vertex(k) - point).norm_squared();
+        let mut index = hint.get() % count;
+        while squared(index + 1) < squared(index) {
+            index = (index + 1) % count;
+        }
+        while squared(index + count - 1) < squared(index) {
+            index = (index + count - 1) % count;
+        }
+        hint.set(index);
+        // Two moves either side of the nearest vertex: a long straight move next to short ones
+        // can hold the nearest point while its far end is not the nearest vertex.
+        (0..4)
+            .map(|k| {
+                let from = index + 2 * count + k - 2;
+                distance_to_segment(point, vertex(from), vertex(from + 1))
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+}
+
+/// The swept width at one ridge point: where the true section curves in VP leave the cut
+/// volume. `None` when a band edge cannot be found (a section circle misses its surface).
+fn width_at(
+    construction: &Construction,
+    profile: &Profile,
+    ridge: &RidgeCentre,
+    polyline: &Polyline<'_>,
+    hint: usize,
+) -> Option<f64> {
+    let plane = ridge.plane_basis();
+    let target = ridge.target;
+    let (tangent_g1, tangent_g2) = ridge.band_edges(construction.half_width);
+    let ball = construction.ball_radius;
+    let mut edges = [Vec3::zeros(); 2];
+    for (edge, (near, on_wall)) in edges.iter_mut().zip([(tangent_g1 - target, false), (tangent_g2 - target, true)]) {
+        let hint = Cell::new(hint);
+        // The point of the true section curve at `leg` from P, and how far outside the cut it is.
+        let on_curve = |leg: f64| construction.circle_meets_surface(profile, plane, &target, leg, &near, on_wall);
+        let outside = |leg: f64| on_curve(leg).map_or(f64::NAN, |q| polyline.distance(&q, &hint) - ball);
+        let start = near.norm();
+        let leg = secant_root(&outside, start)
+            .or_else(|| root_near(outside, start, 0.05 * start, 0.95 * start, 1e-14 * start))?;
+        *edge = on_curve(leg)?;
+    }
+    Some((edges[0] - edges[1]).norm())
+}
+
+/// Root of `f` by secant steps from `start` and 1.01·start; `None` unless it converges.
+fn secant_root(f: &impl Fn(f64) -> f64, start: f64) -> Option<f64> {
+    let (mut a, mut b) = (start, start * 1.01);
+    let (mut fa, mut fb) = (f(a), f(b));
+    for _ in 0..40 {
+        if !(fa.is_finite() && fb.is_finite()) || fa == fb {
+            return None;
+        }
+        let next = b - fb * (b - a) / (fb - fa);
+        if !(next > 0.0 && next < 4.0 * start) {
+            return None;
+        }
+        (a, fa) = (b, fb);
+        b = next;
+        fb = f(b);
+        if fb.abs() < 1e-13 * start.max(1.0) || (b - a).abs() < 1e-15 * start {
+            return Some(b);
+        }
+    }
+    None
+}
+
+/// The swept width of the loop through `centres` (in machining order, counter-clockwise, local
+/// frame, closed) at the targets and interval middles, and the place furthest from W.
+pub(crate) fn swept_widths(
+    construction: &Construction,
+    profile: &Profile,
+    targets: &[Target],
+    centres: &[Vec3],
+) -> SweptWidths {
+    let polyline = Polyline { centres };
+    let width = 2.0 * construction.half_width;
+    let intervals = targets.len() - 1;
+    let stride = intervals.div_ceil(MAX_MEASURED_INTERVALS).max(1);
+    let mut out = SweptWidths { min: f64::INFINITY, max: f64::NEG_INFINITY, worst: None };
+    for index in (0..intervals).step_by(stride) {
+        let (previous, current) = (targets[index], targets[index + 1]);
+        let start = if previous.segment == current.segment { previous.parameter } else { 0.0 };
+        for parameter in [0.5 * (start + current.parameter), current.parameter] {
+            let point = profile.segments[current.segment].point(profile.radius, parameter);
+            let ridge = construction.tangent(&point);
+            let Some(swept) = width_at(construction, profile, &ridge, &polyline, index + 1) else {
+                continue;
+            };
+            out.min = out.min.min(swept);
+            out.max = out.max.max(swept);
+            if out.worst.is_none_or(|(_, _, w)| (swept - width).abs() > (w - width).abs()) {
+                out.worst = Some((current.segment, parameter, swept));
+            }
+        }
+    }
+    if !out.min.is_finite() {
+        (out.min, out.max) = (width, width);
+    }
+    out
+}
