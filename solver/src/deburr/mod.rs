@@ -144,7 +144,11 @@ fn solve_centred(
     // point, which evaluates differently only by rounding (sin 2π ≠ 0).
     let last = bisected.centres.len() - 1;
     bisected.centres[last] = bisected.centres[0];
-    let refined = tolerance::refine(&bisected, &spacing, MAX_POINTS, centre_at)?;
+    let mut refined = tolerance::refine(&bisected, &spacing, MAX_POINTS, centre_at)?;
+    if envelope.is_some() {
+        let band = WIDTH_TOLERANCE.max(job.tolerance);
+        swept_width::refine_for_width(&construction, profile, &mut refined, band, MAX_POINTS, centre_at)?;
+    }
     let (mut targets, mut centres, max_deviation) = (refined.targets, refined.centres, refined.max_deviation);
 
     let mut ridges: Vec<RidgeCentre> = Vec::with_capacity(targets.len());

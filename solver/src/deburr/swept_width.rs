@@ -9,12 +9,99 @@ use std::cell::Cell;
 
 use super::centre::{Construction, RidgeCentre};
 use super::profile::Profile;
-use super::tolerance::Target;
+use super::tolerance::{IntervalLimit, Refined, Target, interval_deviation};
+use crate::error::SolverError;
 use crate::geometry::{Vec3, distance_to_segment, root_near};
 
 /// Most intervals of a loop at which the swept width is measured (at its end target and its
 /// middle); denser loops are measured at intervals spread evenly.
 const MAX_MEASURED_INTERVALS: usize = 1024;
+
+/// Most rounds of [`refine_for_width`]: each halves the offending intervals, cutting their sag
+/// to a quarter.
+const MAX_WIDTH_ROUNDS: usize = 4;
+
+/// How much a straight move's sag can change the swept width, at most, per mm of sag: the band
+/// edges move by the sag over the sine of the angle at which the ball meets a surface, on both
+/// edges. Intervals whose sag times this stays inside the band are not measured.
+const SAG_TO_WIDTH: f64 = 4.0;
+
+/// The TA placement measured on the swept result (issue 19): a straight move cuts the corner of
+/// the ideal centre path by up to TA, which narrows the swept chamfer between targets. Intervals
+/// whose middle is swept more than `band` off W while their end targets are not are halved
+/// (at most [`MAX_WIDTH_ROUNDS`] times), so the moves keep W ± band wherever the ideal path does.
+/// Returns how many targets were added.
+///
+/// # Errors
+/// `E_TOO_MANY_POINTS` past `max_points`, or `centre`'s own error.
+pub(crate) fn refine_for_width<F>(
+    construction: &Construction,
+    profile: &Profile,
+    refined: &mut Refined,
+    band: f64,
+    max_points: usize,
+    mut centre: F,
+) -> Result<usize, SolverError>
+where
+    F: FnMut(usize, f64) -> Result<Vec3, SolverError>,
+{
+    let width = 2.0 * construction.half_width;
+    let mut added = 0;
+    for _ in 0..MAX_WIDTH_ROUNDS {
+        // Whether the swept width at `parameter` of `at` is off by more than the band; `near` is
+        // a vertex near it.
+        let off = |at: usize, parameter: f64, polyline: &Polyline<'_>, near: usize| {
+            let point = profile.segments[at].point(profile.radius, parameter);
+            width_at(construction, profile, &construction.tangent(&point), polyline, near)
+                .is_some_and(|swept| (swept - width).abs() > band)
+        };
+        let mut splits = Vec::new();
+        {
+            let polyline = Polyline { centres: &refined.centres };
+            for index in 0..refined.targets.len() - 1 {
+                if refined.limits[index].deviation * SAG_TO_WIDTH <= band {
+                    continue;
+                }
+                let (previous, current) = (refined.targets[index], refined.targets[index + 1]);
+                let start = if previous.segment == current.segment { previous.parameter } else { 0.0 };
+                let (at, middle) = (current.segment, 0.5 * (start + current.parameter));
+                if off(at, middle, &polyline, index)
+                    && !off(at, start, &polyline, index)
+                    && !off(at, current.parameter, &polyline, index + 1)
+                {
+                    splits.push((index, start, middle));
+                }
+            }
+        }
+        if splits.is_empty() {
+            break;
+        }
+        if refined.targets.len() + splits.len() > max_points {
+            return Err(SolverError::new(
+                "E_TOO_MANY_POINTS",
+                format!("the chamfer width needs more than {max_points} points; raise the tolerance"),
+            )
+            .at("tolerance"));
+        }
+        // Insert from the end so the earlier indices stay valid.
+        for &(index, start, middle) in splits.iter().rev() {
+            let current = refined.targets[index + 1];
+            let (from, to) = (refined.centres[index], refined.centres[index + 1]);
+            let halfway = centre(current.segment, middle)?;
+            let left = interval_deviation(current.segment, start, middle, &from, &halfway, None, &mut centre)?;
+            let right =
+                interval_deviation(current.segment, middle, current.parameter, &halfway, &to, None, &mut centre)?;
+            let limit = refined.limits[index];
+            refined.targets.insert(index + 1, Target { segment: current.segment, parameter: middle });
+            refined.centres.insert(index + 1, halfway);
+            refined.limits[index] = IntervalLimit { deviation: left, ..limit };
+            refined.limits.insert(index + 1, IntervalLimit { deviation: right, ..limit });
+        }
+        added += splits.len();
+        refined.max_deviation = refined.limits.iter().map(|l| l.deviation).fold(0.0, f64::max);
+    }
+    Ok(added)
+}
 
 /// The range of the swept width and where it is furthest from W.
 #[derive(Debug, Clone, Copy, PartialEq)]
