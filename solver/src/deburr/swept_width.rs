@@ -152,20 +152,37 @@ fn width_at(
     polyline: &Polyline<'_>,
     hint: usize,
 ) -> Option<f64> {
+    width_from(construction, profile, ridge, polyline, hint, &mut [None; 2])
+}
+
+/// [`width_at`] starting the leg searches from `legs` where given (a neighbouring measurement's
+/// legs, which saves secant steps), and leaving the legs found there.
+fn width_from(
+    construction: &Construction,
+    profile: &Profile,
+    ridge: &RidgeCentre,
+    polyline: &Polyline<'_>,
+    hint: usize,
+    legs: &mut [Option<f64>; 2],
+) -> Option<f64> {
     let plane = ridge.plane_basis();
     let target = ridge.target;
     let (tangent_g1, tangent_g2) = ridge.band_edges(construction.half_width);
     let ball = construction.ball_radius;
     let mut edges = [Vec3::zeros(); 2];
-    for (edge, (near, on_wall)) in edges.iter_mut().zip([(tangent_g1 - target, false), (tangent_g2 - target, true)]) {
+    for ((edge, known), (near, on_wall)) in
+        edges.iter_mut().zip(legs.iter_mut()).zip([(tangent_g1 - target, false), (tangent_g2 - target, true)])
+    {
         let hint = Cell::new(hint);
         // The point of the true section curve at `leg` from P, and how far outside the cut it is.
         let on_curve = |leg: f64| construction.circle_meets_surface(profile, plane, &target, leg, &near, on_wall);
         let outside = |leg: f64| on_curve(leg).map_or(f64::NAN, |q| polyline.distance(&q, &hint) - ball);
-        let start = near.norm();
+        let tangent_leg = near.norm();
+        let start = known.unwrap_or(tangent_leg);
         let leg = secant_root(&outside, start)
-            .or_else(|| root_near(outside, start, 0.05 * start, 0.95 * start, 1e-14 * start))?;
-        *edge = on_curve(leg)?;
+            .or_else(|| root_near(outside, tangent_leg, 0.05 * tangent_leg, 0.95 * tangent_leg, 1e-14 * tangent_leg));
+        *known = leg;
+        *edge = on_curve(leg?)?;
     }
     Some((edges[0] - edges[1]).norm())
 }
@@ -205,13 +222,14 @@ pub(crate) fn swept_widths(
     let intervals = targets.len() - 1;
     let stride = intervals.div_ceil(MAX_MEASURED_INTERVALS).max(1);
     let mut out = SweptWidths { min: f64::INFINITY, max: f64::NEG_INFINITY, worst: None };
+    let mut legs = [None; 2];
     for index in (0..intervals).step_by(stride) {
         let (previous, current) = (targets[index], targets[index + 1]);
         let start = if previous.segment == current.segment { previous.parameter } else { 0.0 };
         for parameter in [0.5 * (start + current.parameter), current.parameter] {
             let point = profile.segments[current.segment].point(profile.radius, parameter);
             let ridge = construction.tangent(&point);
-            let Some(swept) = width_at(construction, profile, &ridge, &polyline, index + 1) else {
+            let Some(swept) = width_from(construction, profile, &ridge, &polyline, index + 1, &mut legs) else {
                 continue;
             };
             out.min = out.min.min(swept);
