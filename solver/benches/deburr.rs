@@ -1,5 +1,8 @@
-//! Deburr throughput: ball centres per second for a ~10 000-point job (single core), for the
-//! seed's tangent method and the exact method, and a typical 92-point job (reference case 1).
+//! Deburr throughput: ball centres per second for a ~10 000-point job (single core) and a typical
+//! 92-point job (reference case 1), for the seed's tangent method, the exact method (issue 19:
+//! centres whose swept chamfer is W wide) and, for comparison, the exact method before issue 19
+//! (each centre from its own ball section, `solve_single_section`). The cost per centre is one
+//! over the throughput; the ratio exact / single-section is the price of the swept solve.
 //!
 //! `cargo bench -p kerf-solver --bench deburr`
 
@@ -17,19 +20,35 @@ fn request(tolerance: f64, method: &str) -> DeburrRequest {
     .expect("valid request")
 }
 
+/// Which solver entry a bench runs.
+#[derive(Clone, Copy)]
+enum Entry {
+    /// `deburr::solve` (tangent, or exact with the swept solve).
+    Solve,
+    /// The exact method before issue 19.
+    SingleSection,
+}
+
 fn bench(c: &mut Criterion) {
-    let tool = Tool::new(ToolKind::Ball, 3.0);
+    let tool = &Tool::new(ToolKind::Ball, 3.0);
     let mut group = c.benchmark_group("deburr");
-    for (name, tolerance, method) in [
-        ("typical_case1_tangent", 0.01, "tangent"),
-        ("10k_points_tangent", 1e-6, "tangent"),
-        ("10k_points_exact", 1e-6, "exact"),
+    for (name, tolerance, method, entry) in [
+        ("typical_case1_tangent", 0.01, "tangent", Entry::Solve),
+        ("typical_case1_exact", 0.01, "exact", Entry::Solve),
+        ("typical_case1_exact_single_section", 0.01, "exact", Entry::SingleSection),
+        ("10k_points_tangent", 1e-6, "tangent", Entry::Solve),
+        ("10k_points_exact", 1e-6, "exact", Entry::Solve),
+        ("10k_points_exact_single_section", 1e-6, "exact", Entry::SingleSection),
     ] {
         let job = request(tolerance, method);
-        let count = deburr::solve(&job, &tool).expect("solves").summary.count;
+        let run = move |job: &DeburrRequest| match entry {
+            Entry::Solve => deburr::solve(job, tool),
+            Entry::SingleSection => deburr::solve_single_section(job, tool),
+        };
+        let count = run(&job).expect("solves").summary.count;
         eprintln!("{name}: {count} points");
         group.throughput(Throughput::Elements(count as u64));
-        group.bench_function(name, |b| b.iter(|| deburr::solve(std::hint::black_box(&job), &tool).expect("solves")));
+        group.bench_function(name, |b| b.iter(|| run(std::hint::black_box(&job)).expect("solves")));
     }
     group.finish();
 }

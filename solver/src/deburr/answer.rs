@@ -70,11 +70,20 @@ pub struct DeburrSummary {
     pub cut_amount: f64,
     /// W = √2·Q, the nominal chamfer width, mm.
     pub width: f64,
-    /// Smallest and largest chamfer width really cut, measured on the true surfaces at the
-    /// points (at up to 1024 of them, spread evenly, on denser loops), mm (W for `exact`).
+    /// Smallest and largest chamfer width cut by one ball section: where the ball at each emitted
+    /// centre, cut by the ridge's normal plane, meets the true surfaces (at up to 1024 points,
+    /// spread evenly, on denser loops), mm. The seed's single-section figure; the swept figures
+    /// below are what the moves really cut.
     pub true_width_min: f64,
     /// See `true_width_min`.
     pub true_width_max: f64,
+    /// Smallest and largest chamfer width swept by the ball along the emitted moves: in the
+    /// ridge's normal plane at the targets and between them (up to 1024 intervals, spread evenly),
+    /// the distance between where the true surfaces leave the swept volume, mm. `exact` keeps it
+    /// within W ± max(0.005 mm, `tolerance`) or warns `W_WIDTH_OFF`.
+    pub swept_width_min: f64,
+    /// See `swept_width_min`.
+    pub swept_width_max: f64,
     /// Smallest wedge angle β along the ridge, degrees.
     pub wedge_angle_min_deg: f64,
     /// Largest wedge angle β, degrees.

@@ -57,7 +57,7 @@ impl RidgeCentre {
     }
 
     /// Unit vectors spanning the normal plane VP: the wall normal m2 and the wall tangent d3.
-    fn plane_basis(&self) -> (Vec3, Vec3) {
+    pub(super) fn plane_basis(&self) -> (Vec3, Vec3) {
         let cos_wedge = self.cylinder_normal.dot(&self.wall_normal);
         (self.wall_normal, (self.cylinder_normal - cos_wedge * self.wall_normal).normalize())
     }
@@ -124,7 +124,7 @@ impl Construction {
 
     /// Where the circle of radius `radius` around `centre` in VP meets the cylinder surface
     /// (`on_wall` false) or the hole wall (`on_wall` true), nearest to direction `near`.
-    fn circle_meets_surface(
+    pub(super) fn circle_meets_surface(
         &self,
         profile: &Profile,
         plane: (Vec3, Vec3),

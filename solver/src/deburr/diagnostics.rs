@@ -5,6 +5,7 @@ use serde::Serialize;
 
 use super::centre::Construction;
 use super::checks;
+use super::envelope::EnvelopePath;
 use super::request::{DeburrRequest, Method};
 use crate::error::SolverError;
 use crate::geometry::array3;
@@ -40,7 +41,9 @@ pub struct PointConstruction {
     pub exact: Option<ExactConstruction>,
 }
 
-/// Band edges on the true surfaces and the centre they give.
+/// The single-section exact construction: band edges on the true surfaces, in VP, and the centre
+/// whose own ball section meets them W apart. `method: exact` aims its swept chamfer at these
+/// band edges; its centres are not this one's but those of [`ideal_centres`] (issue 19).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct ExactConstruction {
@@ -107,4 +110,40 @@ pub fn construction_at(
         centre_offset: ridge.centre_offset,
         exact,
     })
+}
+
+/// The ideal centre path of the request's method at `places` (segment name and parameter),
+/// machine coordinates: the seed's closed form for `tangent`; for `exact` the path whose swept
+/// chamfer meets the true surfaces W apart (issue 19), solved once for all places. The emitted
+/// centres are points of it, and the tolerance bounds the moves' distance from it.
+///
+/// # Errors
+/// The request's validation errors, or `E_INPUT` for an unknown segment or parameter.
+pub fn ideal_centres(
+    request: &DeburrRequest,
+    tool: &Tool,
+    places: &[(&str, f64)],
+) -> Result<Vec<[f64; 3]>, SolverError> {
+    let geometry = DeburrRequest { machine: None, block_time_ms: None, ..request.clone() };
+    let job = geometry.validate(tool, None)?;
+    checks::ridge(&job)?;
+    let profile = &job.profile;
+    let construction = Construction::for_job(&job);
+    let envelope = (job.method == Method::Exact).then(|| EnvelopePath::solve(&construction, profile));
+    places
+        .iter()
+        .map(|&(segment, parameter)| {
+            let Some(index) = profile.segments.iter().position(|s| s.name == segment) else {
+                return Err(SolverError::input("segment", format!("this hole has no segment {segment}")));
+            };
+            if !(0.0..=1.0).contains(&parameter) {
+                return Err(SolverError::input("parameter", "parameter must be in [0, 1]"));
+            }
+            let centre = match &envelope {
+                Some(path) => path.centre(&construction, profile, index, parameter),
+                None => construction.tangent_centre(&profile.segments[index].point(profile.radius, parameter)),
+            };
+            Ok(array3(&job.frame.point(&centre)))
+        })
+        .collect()
 }

@@ -9,7 +9,10 @@
 //! * [`request`]: the request and its validation (§1.4);
 //! * `frame`: local frame and its map to the machine (§1.3);
 //! * `profile`: hole cross-sections (§2.8);
-//! * `centre`: the ball-centre construction (§2.5, §2.7) and the exact variant;
+//! * `centre`: the ball-centre construction (§2.5, §2.7) and the single-section exact variant;
+//! * `envelope`: the `exact` centre path, whose swept envelope meets the true surfaces W apart
+//!   (issue 19);
+//! * `swept_width`: the chamfer width the emitted moves really cut (issue 19);
 //! * `tolerance`: the target points from TA (§3), or with a block time from the block-time rule
 //!   per interval, never coarser than TA (issue 3, chord.md);
 //! * `checks`: validity limits and warnings (§4);
@@ -20,19 +23,23 @@ mod capability;
 mod centre;
 mod checks;
 mod diagnostics;
+mod envelope;
 mod frame;
 mod profile;
 pub mod program;
 pub mod request;
+mod swept_width;
 mod tolerance;
 
 pub use answer::{Deburr, DeburrPoint, DeburrSummary, LeadMotion, LeadMove};
 pub use capability::{DeburrAnswer, DeburrCapability};
-pub use diagnostics::{ExactConstruction, PointConstruction, construction_at};
+pub use diagnostics::{ExactConstruction, PointConstruction, construction_at, ideal_centres};
 pub use program::program;
 pub use request::{CentreDistance, DeburrRequest, Direction, Edge, Hole, HoleShape, Method, Workpiece};
 
 use centre::{Construction, RidgeCentre};
+use envelope::EnvelopePath;
+use swept_width::SweptWidths;
 use tolerance::{IntervalLimit, Limit, Spacing, Target};
 
 use crate::chord::MachineProfile;
@@ -49,6 +56,11 @@ const TRUE_WIDTH_SAMPLES: usize = 1024;
 
 /// Relative chamfer-width error of the tangent-line method above which `W_APPROX` is raised (§4).
 const APPROX_LIMIT: f64 = 0.05;
+
+/// Smallest band of the swept chamfer width around W that `method: exact` promises, mm: the
+/// band is ±max(this, TA), since the straight moves stray from the ideal centre path by up to
+/// TA and the swept chamfer with them (`W_WIDTH_OFF`, issue 19).
+pub const WIDTH_TOLERANCE: f64 = 0.005;
 
 /// Solves a deburr request with its resolved tool (a request that names no machine).
 ///
@@ -70,12 +82,42 @@ pub fn solve_with(
     tool: &Tool,
     machine: Option<&MachineProfile>,
 ) -> Result<Deburr, SolverError> {
+    solve_centred(request, tool, machine, ExactCentres::Swept)
+}
+
+/// What `method: exact` places the centres by.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum ExactCentres {
+    /// The swept envelope meets the true surfaces W apart (issue 19).
+    Swept,
+    /// One ball section in VP meets them W apart: the exact method before issue 19, kept for
+    /// the bench's cost comparison.
+    SingleSection,
+}
+
+/// [`solve`] with `method: exact` placing each centre by its own ball section in VP only (the
+/// method before issue 19, whose swept chamfer is wider than W on tightly curved ridges). For
+/// the bench's cost comparison, not for machining.
+///
+/// # Errors
+/// As [`solve`], and `E_EXACT_NO_SOLUTION` where a section has no band edges on the true surfaces.
+#[doc(hidden)]
+pub fn solve_single_section(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError> {
+    solve_centred(request, tool, None, ExactCentres::SingleSection)
+}
+
+fn solve_centred(
+    request: &DeburrRequest,
+    tool: &Tool,
+    machine: Option<&MachineProfile>,
+    exact_centres: ExactCentres,
+) -> Result<Deburr, SolverError> {
     let job = request.validate(tool, machine)?;
     let mut warnings = checks::ridge(&job)?;
     let ball = job.tool.radius;
     let construction = Construction::for_job(&job);
     let profile = &job.profile;
-    let exact_centre = |segment: usize, s: f64, ridge: &RidgeCentre| {
+    let single_section = |segment: usize, s: f64, ridge: &RidgeCentre| {
         construction.exact(profile, ridge).map(|(c, _, _)| c).ok_or_else(|| {
             SolverError::new(
                 "E_EXACT_NO_SOLUTION",
@@ -87,11 +129,14 @@ pub fn solve_with(
             .at("method")
         })
     };
+    let envelope = (job.method == Method::Exact && exact_centres == ExactCentres::Swept)
+        .then(|| EnvelopePath::solve(&construction, profile));
     let centre_at = |segment: usize, s: f64| -> Result<Vec3, SolverError> {
         let point = profile.segments[segment].point(profile.radius, s);
-        match job.method {
-            Method::Tangent => Ok(construction.tangent_centre(&point)),
-            Method::Exact => exact_centre(segment, s, &construction.tangent(&point)),
+        match (job.method, &envelope) {
+            (Method::Tangent, _) => Ok(construction.tangent_centre(&point)),
+            (Method::Exact, Some(path)) => Ok(path.centre(&construction, profile, segment, s)),
+            (Method::Exact, None) => single_section(segment, s, &construction.tangent(&point)),
         }
     };
 
@@ -101,7 +146,11 @@ pub fn solve_with(
     // point, which evaluates differently only by rounding (sin 2π ≠ 0).
     let last = bisected.centres.len() - 1;
     bisected.centres[last] = bisected.centres[0];
-    let refined = tolerance::refine(&bisected, &spacing, MAX_POINTS, centre_at)?;
+    let mut refined = tolerance::refine(&bisected, &spacing, MAX_POINTS, centre_at)?;
+    if envelope.is_some() {
+        let band = WIDTH_TOLERANCE.max(job.tolerance);
+        swept_width::refine_for_width(&construction, profile, &mut refined, band, MAX_POINTS, centre_at)?;
+    }
     let (mut targets, mut centres, max_deviation) = (refined.targets, refined.centres, refined.max_deviation);
 
     let mut ridges: Vec<RidgeCentre> = Vec::with_capacity(targets.len());
@@ -123,14 +172,12 @@ pub fn solve_with(
     ridges[last] = ridges[0];
 
     warnings.extend(point_checks(&job, &targets, &ridges)?);
-    let (true_width_min, true_width_max) = match job.method {
-        Method::Exact => (job.width, job.width),
-        Method::Tangent => {
-            let (low, high, worst) = true_widths(&construction, &job, &targets, &ridges);
-            warnings.extend(worst);
-            (low, high)
-        }
-    };
+    let (true_width_min, true_width_max, approx) = true_widths(&construction, &job, &targets, &ridges);
+    let swept = swept_width::swept_widths(&construction, profile, &targets, &centres);
+    match job.method {
+        Method::Tangent => warnings.extend(approx.or_else(|| swept_approx(&job, &swept))),
+        Method::Exact => warnings.extend(width_off(&job, &swept, envelope.as_ref())),
+    }
     checks::far_gouge(&job, &targets, &centres)?;
     let shank_direction = job.frame.local_vector(&Vec3::z());
     let (access_warnings, mut program_blocker) = checks::inner_access(&job, &ridges, &shank_direction);
@@ -198,6 +245,8 @@ pub fn solve_with(
         width: job.width,
         true_width_min,
         true_width_max,
+        swept_width_min: swept.min,
+        swept_width_max: swept.max,
         wedge_angle_min_deg: wedge.clone().fold(f64::INFINITY, f64::min),
         wedge_angle_max_deg: wedge.fold(f64::NEG_INFINITY, f64::max),
         max_exact_offset: exact_offset,
@@ -369,8 +418,8 @@ fn point_checks(job: &Job, targets: &[Target], ridges: &[RidgeCentre]) -> Result
 
 use request::Job;
 
-/// Range of the chamfer width really cut by the tangent-line centres, and W_APPROX if the worst
-/// is more than 5 % off W (§2.9, §4).
+/// Range of the chamfer width really cut by one ball section in VP at the emitted centres, and
+/// W_APPROX if the worst is more than 5 % off W (§2.9, §4).
 fn true_widths(
     construction: &Construction,
     job: &Job,
@@ -409,6 +458,73 @@ fn true_widths(
         )
     });
     (low, high, warning)
+}
+
+/// Where on the ridge a measurement was taken, for messages: segment, s and φ on arcs.
+fn place(job: &Job, segment: usize, parameter: f64) -> String {
+    let piece = &job.profile.segments[segment];
+    let phi = piece.point(job.profile.radius, parameter).phi;
+    match phi {
+        Some(phi) => format!("{} s = {parameter:.4} (φ = {:.2}°)", piece.name, phi.to_degrees()),
+        None => format!("{} s = {parameter:.4}", piece.name),
+    }
+}
+
+/// W_APPROX for the tangent method when the swept chamfer (not one section) is more than 5 % off W.
+fn swept_approx(job: &Job, swept: &SweptWidths) -> Option<Warning> {
+    let (segment, parameter, width) = swept.worst?;
+    let error = (width / job.width - 1.0).abs();
+    (error > APPROX_LIMIT).then(|| {
+        Warning::new(
+            "W_APPROX",
+            format!(
+                "the tangent-line centres sweep a chamfer {:.1} % off W at {}; use method \"exact\"",
+                error * 100.0,
+                place(job, segment, parameter)
+            ),
+        )
+    })
+}
+
+/// W_WIDTH_OFF (issue 19): the exact method's swept chamfer leaves W ± max(0.005 mm, TA) (the
+/// moves stray from the ideal centre path by up to TA), with the worst place, and why when the
+/// coupled solve found no placement that gives W there.
+fn width_off(job: &Job, swept: &SweptWidths, envelope: Option<&EnvelopePath>) -> Option<Warning> {
+    let (segment, parameter, width) = swept.worst?;
+    let band = WIDTH_TOLERANCE.max(job.tolerance);
+    if (width - job.width).abs() <= band {
+        return None;
+    }
+    let why = match envelope {
+        Some(path) if path.approximate_edges > 0 => format!(
+            "; at {} of the ridge's nodes the true surfaces, cut by the normal plane, have no band edges W apart \
+             (the ridge turns too tightly for this W), so the tangent-line edges were aimed at there",
+            path.approximate_edges
+        ),
+        Some(path) if path.shortfall > 0.1 * band => format!(
+            "; the ridge turns too tightly for the ball near {}: a ball reaching the band edges there would cut \
+             past them nearby, so the balls bridge the bend, staying up to {:.4} mm short of the band edges, and the \
+             chamfer is narrower there: the closest to W without cutting wider than W anywhere",
+            place(job, path.shortfall_at.0, path.shortfall_at.1),
+            path.shortfall
+        ),
+        Some(path) if path.residual > 0.1 * band => format!(
+            "; no ball placement gives W there: the swept envelope stays {:.4} mm off the band edges near {} \
+             (the ball is too small or the ridge turns too tightly), this is the closest found",
+            path.residual,
+            place(job, path.residual_at.0, path.residual_at.1)
+        ),
+        _ => String::new(),
+    };
+    Some(Warning::new(
+        "W_WIDTH_OFF",
+        format!(
+            "the swept chamfer is {width:.4} mm wide at {} where W = {:.4} mm ({:+.4} mm, beyond ±{band} mm){why}",
+            place(job, segment, parameter),
+            job.width,
+            width - job.width
+        ),
+    ))
 }
 
 /// Header lines naming the job parameters for the G-code program.

@@ -128,7 +128,8 @@ pub enum Method {
     /// The seed's closed form: band edges on the tangent lines at P (deburr.md §2.5).
     #[default]
     Tangent,
-    /// Band edges on the true surfaces, so the cut chamfer is really W wide.
+    /// Band edges on the true surfaces, and the chamfer the ball sweeps along the moves is W wide
+    /// there (within max(0.005 mm, `tolerance`), else `W_WIDTH_OFF`).
     Exact,
 }
 

@@ -289,7 +289,7 @@ where
         let (limit, why) = spacing.limit(chord, sampled);
         if sampled <= 0.9 * limit {
             worst = worst.max(sampled);
-            limits.push(IntervalLimit { why, limit, radius: estimated_radius(chord, sampled) });
+            limits.push(IntervalLimit { why, limit, radius: estimated_radius(chord, sampled), deviation: sampled });
             out_targets.push(current);
             out_centres.push(ends[1]);
             continue;
@@ -317,7 +317,7 @@ where
                 .at("tolerance"));
             }
             worst = worst.max(deviation);
-            limits.push(IntervalLimit { why, limit, radius: estimated_radius(chord, deviation) });
+            limits.push(IntervalLimit { why, limit, radius: estimated_radius(chord, deviation), deviation });
             if out_targets.len() > max_points {
                 return Err(SolverError::new(
                     "E_TOO_MANY_POINTS",
@@ -340,6 +340,8 @@ pub(crate) struct IntervalLimit {
     pub limit: f64,
     /// Its estimated radius of curvature, mm.
     pub radius: f64,
+    /// Its deviation from the ideal centre path as measured, mm.
+    pub deviation: f64,
 }
 
 /// What [`refine`] returns.
@@ -356,7 +358,7 @@ pub(crate) struct Refined {
 /// Largest distance of the ideal centre path on `[a, b]` of `segment` from the chord between its
 /// end centres: 15 samples, then a parabola through the largest and its neighbours. `known` are
 /// the centres at j/8 from the bisection, which are the even sixteenths.
-fn interval_deviation<F>(
+pub(crate) fn interval_deviation<F>(
     segment: usize,
     a: f64,
     b: f64,

@@ -105,13 +105,18 @@ async fn reference_case_1_over_http() {
     let backward_points = backwards["points"].as_array().unwrap();
     assert_eq!(forward_points[1]["centre"], backward_points[backward_points.len() - 2]["centre"]);
 
-    // The exact method puts the band on the true surfaces and says how far the seed is off.
+    // The exact method sweeps a chamfer W wide on the true surfaces (within max(0.005 mm, TA))
+    // and says how far the seed is off.
     let mut exact = body.clone();
     exact["method"] = json!("exact");
     let exact_answer = json_with(app.post_json("/api/v1/deburr", &exact).await, 200).await;
     let offset = exact_answer["summary"]["max_exact_offset"].as_f64().unwrap();
     assert!(offset > 1e-5 && offset < 0.05, "exact offset {offset}");
-    assert_eq!(exact_answer["summary"]["true_width_min"], exact_answer["summary"]["width"]);
+    let width = exact_answer["summary"]["width"].as_f64().unwrap();
+    for field in ["swept_width_min", "swept_width_max"] {
+        let swept = exact_answer["summary"][field].as_f64().unwrap();
+        assert!((swept - width).abs() <= 0.01, "{field} {swept}, W {width}");
+    }
     check_answer(&exact_answer, 3.0);
 
     // The same job by width instead of Q gives the same loop.
