@@ -2,10 +2,13 @@
 //! per-sample quantities and flags (engagement.md §5.4, §5.5, §5.10), the diagnostics of §9, and
 //! the per-flute results, recommendation and feed plan.
 
-use super::answer::{ArcDetail, EngagementSample, GridInfo, PathEngagement, PostData, RouteData, SampleFlag};
+use super::answer::{
+    ArcDetail, EngagementSample, ForceInfo, GridInfo, PathEngagement, PostData, RouteData, SampleFlag,
+};
 use super::arcs::{self, Arc};
 use super::dots::{Contacts, DotGrid};
 use super::exact::ExactEngine;
+use super::force::{SampleTorque, power_kw};
 use super::request::{CandidateJob, Engine, Job, grid_extent};
 use super::segments::{Route, Station};
 use super::stock::{Base, Region};
@@ -235,6 +238,13 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
             collisions.push(station.s);
         }
         let sums: Vec<_> = job.flute_counts.iter().map(|&k| tooth_sum(arcs, k)).collect();
+        let torques: Vec<SampleTorque> = job.force.as_ref().map_or_else(Vec::new, |model| {
+            let integral = model.engaged_integral(arcs);
+            job.flute_counts
+                .iter()
+                .map(|&k| model.torque(arcs, integral, k, radius, job.feed_mode.feed_per_tooth(k, job.spindle_rpm)))
+                .collect()
+        });
         statistic.push(index > 0 && !rapid && !arcs.is_empty() && !contact.plunge);
         samples.push(EngagementSample {
             s: station.s,
@@ -254,6 +264,9 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
                 .map(|(&k, sum)| job.feed_mode.feed_per_tooth(k, job.spindle_rpm) * sum.ratio)
                 .collect(),
             teeth: sums.iter().map(|sum| sum.teeth).collect(),
+            torque_nm: torques.iter().map(|t| t.mean).collect(),
+            peak_torque_nm: torques.iter().map(|t| t.peak).collect(),
+            power_kw: torques.iter().map(|t| power_kw(t.mean, job.spindle_rpm)).collect(),
             mrr: job.axial_depth.map(|depth| depth * radial_depth * nominal_feed),
             flags,
         });
@@ -454,6 +467,15 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
         max_engaged_at_s,
         max_radial_depth,
         contact_dots,
+        forces: job.force.as_ref().map(|model| ForceInfo {
+            kc11: model.kc11,
+            mc: model.mc,
+            axial_depth: model.axial_depth,
+            helix_lag_deg: model.lag_deg,
+            spindle_power_kw: job.spindle.spindle_power_kw,
+            spindle_torque_nm: job.spindle.spindle_torque_nm,
+            natural_frequencies_hz: job.natural.iter().map(|(f, _)| *f).collect(),
+        }),
         feed_plan,
         blocks: None,
         warnings,

@@ -19,7 +19,11 @@
 //! * `arcs`: arc merging, a_e and the per-arc quantities (§5.4, §5.5, §5.10);
 //! * `teeth`: H_k and n_k with the exact phase maximisation (§5.6);
 //! * `flutes`: representative values, time, recommendation (§5.7–§5.9);
-//! * `feed`: chip-thinning feed plan (§11 item 3);
+//! * `feed`: chip-thinning feed plan (§11 item 3), capped by the spindle's power and torque;
+//! * `kienzle`, `force`: Kienzle's law, spindle torque and power with the helix lag (§11 items
+//!   4, 5);
+//! * `limits`: the spindle's ratings and the tooth-passing frequency against the tool's natural
+//!   frequencies (§11 items 4, 9);
 //! * [`program()`]: G-code with the planned F words.
 //!
 //! Choices where the spec is open (§13): `cw` rotation by default; constant f_z when
@@ -41,6 +45,9 @@ mod evaluate;
 mod exact;
 mod feed;
 mod flutes;
+mod force;
+mod kienzle;
+mod limits;
 mod outline;
 pub mod program;
 pub mod request;
@@ -50,13 +57,15 @@ mod teeth;
 
 pub use crate::geometry::Direction;
 pub use answer::{
-    ArcDetail, Comparison, EngagementAnswer, EngagementSample, FeedBlock, FeedLimit, FeedPlan, FluteResult, GridInfo,
-    PathEngagement, SampleFlag,
+    ArcDetail, Comparison, EngagementAnswer, EngagementSample, FeedBlock, FeedLimit, FeedPlan, FluteResult, ForceInfo,
+    GridInfo, PathEngagement, SampleFlag,
 };
 pub use arcs::{MillingMode, SpindleDirection};
+pub use kienzle::Kienzle;
+pub use limits::{RESONANCE_BAND, SpindleLimits};
 pub use program::program;
 pub use request::{
-    Candidate, EngagementRequest, Engine, FeedBasis, FeedPlanRequest, PathInput, PathSegments, PreviousCut,
+    Candidate, EngagementRequest, Engine, FeedBasis, FeedPlanRequest, PathInput, PathSegments, Physics, PreviousCut,
     Representative, SegmentInput, Stock, StockBitmap, StockPolygon,
 };
 
@@ -116,7 +125,24 @@ pub fn solve_with(
     tool: &Tool,
     machine: Option<&MachineProfile>,
 ) -> Result<EngagementAnswer, SolverError> {
-    let job = request.validate(tool, machine)?;
+    solve_in(request, tool, machine, &Physics::default())
+}
+
+/// [`solve_with`] with what the server resolved for the cutting physics: the Kienzle values of
+/// the request's `material` and the machine's spindle limits (engagement.md §11 item 4). The
+/// limits are checked only when the request gives `kienzle` or `material`.
+///
+/// # Errors
+/// As [`solve_with`]; `E_INPUT` at `material` when the request names a material and
+/// `physics.material` is absent, at `axial_depth` when forces are asked for without it, and for
+/// bad Kienzle values or limits.
+pub fn solve_in(
+    request: &EngagementRequest,
+    tool: &Tool,
+    machine: Option<&MachineProfile>,
+    physics: &Physics,
+) -> Result<EngagementAnswer, SolverError> {
+    let job = request.validate(tool, machine, physics)?;
     let mut results = Vec::with_capacity(job.candidates.len());
     for candidate in &job.candidates {
         let mut result = evaluate::evaluate(&job, candidate, tool)?;

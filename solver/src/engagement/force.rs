@@ -1,0 +1,268 @@
+//! Spindle torque and power along the path from Kienzle's law (engagement.md §11 items 4 and 5):
+//! per tooth F_t = k_c1.1·a_p·h^(1−m_c), torque M = R·ΣF_t, power P = 2πNM/60, with the helix
+//! lag 2a_p·tan λ/D spreading each tooth's cut over that angle.
+//!
+//! At one sample the torque depends on the tooth phase β. Its mean over β is closed:
+//! M̄ = R·k_c1.1·a_p·f_z^a·(k/2π)·∫_E max(0, sin θ)^a dθ (a = 1 − m_c; the helix does not change
+//! it, it only averages the torque over a window of β). Its peak over β is found numerically:
+//! between breakpoints (a tooth, or the top of its helical edge, on an arc end or at 0°/180°)
+//! the torque is smooth, and without a helix a sum of concave terms, so a coarse scan and a
+//! golden-section refinement of each piece find it.
+
+use super::arcs::{Arc, SpindleDirection};
+use super::kienzle::SinPower;
+
+/// Tooth on an arc end counts as inside, degrees (closed arcs, as in `teeth`).
+const END_TOLERANCE: f64 = 1e-9;
+/// Scan points per breakpoint interval before the golden-section refinement.
+const SCAN: usize = 4;
+/// Golden-section steps: the bracket shrinks to 0.618^40 ≈ 4e-9 of a scan step.
+const GOLDEN_STEPS: usize = 40;
+
+/// A validated force model for one request.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct ForceModel {
+    pub kc11: f64,
+    pub mc: f64,
+    /// a_p, mm.
+    pub axial_depth: f64,
+    /// Λ = 2a_p·tan λ/D, degrees (0 without a helix).
+    pub lag_deg: f64,
+    pub direction: SpindleDirection,
+    pub table: SinPower,
+}
+
+/// Torque at one sample for one flute count, N·m.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SampleTorque {
+    /// Mean over the tooth phase.
+    pub mean: f64,
+    /// Largest over the tooth phase.
+    pub peak: f64,
+}
+
+impl ForceModel {
+    /// ∫ over the arcs of max(0, sin θ)^a dθ (θ in radians): the phase-mean term.
+    pub(crate) fn engaged_integral(&self, arcs: &[Arc]) -> f64 {
+        arcs.iter().map(|arc| self.table.between(arc.from.to_radians(), arc.to.to_radians())).sum()
+    }
+
+    /// N·m of torque per unit of the sin^a term for a feed per tooth `fz` and tool radius `radius`:
+    /// R·k_c1.1·a_p·f_z^a / 1000.
+    fn scale(&self, radius: f64, fz: f64) -> f64 {
+        radius * self.kc11 * self.axial_depth * fz.powf(self.table.exponent()) / 1000.0
+    }
+
+    /// Mean torque over the tooth phase from the engaged integral, N·m.
+    pub(crate) fn mean_torque(&self, integral: f64, flutes: u32, radius: f64, fz: f64) -> f64 {
+        self.scale(radius, fz) * f64::from(flutes) * integral / std::f64::consts::TAU
+    }
+
+    /// Feed per tooth at which the phase-mean torque equals `torque` (N·m); infinite without
+    /// engagement.
+    pub(crate) fn feed_for_torque(&self, torque: f64, integral: f64, flutes: u32, radius: f64) -> f64 {
+        let unit = self.mean_torque(integral, flutes, radius, 1.0);
+        if unit <= 0.0 { f64::INFINITY } else { (torque / unit).powf(1.0 / self.table.exponent()) }
+    }
+
+    /// Mean and peak torque over the tooth phase, N·m.
+    pub(crate) fn torque(&self, arcs: &[Arc], integral: f64, flutes: u32, radius: f64, fz: f64) -> SampleTorque {
+        if arcs.is_empty() {
+            return SampleTorque { mean: 0.0, peak: 0.0 };
+        }
+        let mean = self.mean_torque(integral, flutes, radius, fz);
+        let peak = self.scale(radius, fz) * self.peak_sum(arcs, flutes);
+        // The peak of a function is never below its mean; the numeric search may miss by 1e-12.
+        SampleTorque { mean, peak: peak.max(mean) }
+    }
+
+    /// One tooth's sin^a term with its tip at `tip` (degrees): the value on the arcs, or with a
+    /// helix the mean over the lag window behind the tip.
+    pub(crate) fn tooth(&self, arcs: &[Arc], tip: f64) -> f64 {
+        if self.lag_deg <= 0.0 {
+            return if arcs.iter().any(|a| a.contains(tip, END_TOLERANCE)) {
+                self.table.integrand(tip.to_radians())
+            } else {
+                0.0
+            };
+        }
+        // The edge above the tip trails it: cw teeth run towards smaller θ, so the trailing
+        // edge sits at larger θ; ccw the other way.
+        let (low, high) = match self.direction {
+            SpindleDirection::Cw => (tip, tip + self.lag_deg),
+            SpindleDirection::Ccw => (tip - self.lag_deg, tip),
+        };
+        let mut total = 0.0;
+        for arc in arcs {
+            // Copies of the arc, one turn apart, that overlap the window.
+            let first = ((low - arc.to) / 360.0).floor() as i64;
+            let last = ((high - arc.from) / 360.0).ceil() as i64;
+            for turn in first..=last {
+                let shift = 360.0 * turn as f64;
+                let (a, b) = ((arc.from + shift).max(low), (arc.to + shift).min(high));
+                if b > a {
+                    total += self.table.between(a.to_radians(), b.to_radians());
+                }
+            }
+        }
+        total / self.lag_deg.to_radians()
+    }
+
+    fn sum(&self, arcs: &[Arc], flutes: u32, phase: f64) -> f64 {
+        let pitch = 360.0 / f64::from(flutes);
+        (0..flutes).map(|j| self.tooth(arcs, phase + f64::from(j) * pitch)).sum()
+    }
+
+    /// max over the phase β of Σ_j tooth(β + j·360°/k).
+    pub(crate) fn peak_sum(&self, arcs: &[Arc], flutes: u32) -> f64 {
+        let pitch = 360.0 / f64::from(flutes);
+        let mut breaks = vec![0.0, pitch];
+        let mut ends: Vec<f64> = arcs.iter().flat_map(|a| [a.from, a.to]).chain([0.0, 180.0]).collect();
+        if self.lag_deg > 0.0 {
+            let shift = match self.direction {
+                SpindleDirection::Cw => -self.lag_deg,
+                SpindleDirection::Ccw => self.lag_deg,
+            };
+            ends.extend(ends.clone().iter().map(|e| e + shift));
+        }
+        breaks.extend(ends.iter().map(|e| e.rem_euclid(pitch)));
+        breaks.sort_by(f64::total_cmp);
+        breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-12);
+        let value = |phase: f64| self.sum(arcs, flutes, phase);
+        let mut best = breaks.iter().map(|&b| value(b)).fold(0.0, f64::max);
+        for pair in breaks.windows(2) {
+            let (low, high) = (pair[0], pair[1]);
+            if high - low <= 1e-9 {
+                continue;
+            }
+            let step = (high - low) / SCAN as f64;
+            // Interior scan points; the ends are breakpoints, already evaluated.
+            let scanned: Vec<(f64, f64)> = (1..SCAN)
+                .map(|i| {
+                    let phase = low + step * i as f64;
+                    (phase, value(phase))
+                })
+                .collect();
+            let Some(&(centre, centre_value)) = scanned.iter().max_by(|a, b| a.1.total_cmp(&b.1)) else {
+                continue;
+            };
+            best = best.max(centre_value);
+            best = best.max(golden(&value, centre - step, centre + step));
+        }
+        best
+    }
+}
+
+/// Largest value of `f` found by golden-section search on [a, b] (exact for a unimodal f).
+fn golden(f: &impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
+    let ratio = 0.5 * (5.0_f64.sqrt() - 1.0);
+    let mut c = b - ratio * (b - a);
+    let mut d = a + ratio * (b - a);
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..GOLDEN_STEPS {
+        if fc >= fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - ratio * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + ratio * (b - a);
+            fd = f(d);
+        }
+    }
+    fc.max(fd)
+}
+
+/// Spindle power for a torque, kW: P = 2πN·M/60.
+pub(crate) fn power_kw(torque_nm: f64, spindle_rpm: f64) -> f64 {
+    std::f64::consts::TAU * spindle_rpm * torque_nm / 60.0 / 1000.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn model(mc: f64, lag_deg: f64, direction: SpindleDirection) -> ForceModel {
+        ForceModel { kc11: 1800.0, mc, axial_depth: 2.0, lag_deg, direction, table: SinPower::new(1.0 - mc) }
+    }
+
+    fn arc(from: f64, to: f64) -> Arc {
+        Arc { from, to }
+    }
+
+    /// Brute-force phase scan.
+    fn scanned(model: &ForceModel, arcs: &[Arc], flutes: u32) -> f64 {
+        let pitch = 360.0 / f64::from(flutes);
+        (0..=100_000).map(|i| model.sum(arcs, flutes, pitch * f64::from(i) / 100_000.0)).fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn peak_matches_a_fine_scan() {
+        let cases = [vec![arc(0.0, 180.0)], vec![arc(0.0, 60.0)], vec![arc(16.0, 23.0), arc(157.0, 164.0)]];
+        for lag in [0.0, 25.0] {
+            let m = model(0.25, lag, SpindleDirection::Cw);
+            for arcs in &cases {
+                for k in [1, 2, 3, 4, 7] {
+                    let exact = m.peak_sum(arcs, k);
+                    let scan = scanned(&m, arcs, k);
+                    assert!(exact >= scan - 1e-9, "lag {lag} {arcs:?} k {k}: {exact} < {scan}");
+                    // The scan's step of 0.0036° misses a peak on a jump by up to 3e-5 of it.
+                    assert!(exact - scan < 1e-4 * scan.max(1e-9), "lag {lag} {arcs:?} k {k}: {exact} vs {scan}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn helix_lag_delays_the_exit_by_the_lag_angle() {
+        // A cw tooth runs from 120° down to 30° on the arc: its tip cuts over [30°, 120°]; with a
+        // lag of 20° its top leaves 20° later, at tip angle 10°, and enters 20° after the tip.
+        let lag = 20.0;
+        let arcs = [arc(30.0, 120.0)];
+        let flat = model(0.25, 0.0, SpindleDirection::Cw);
+        let helix = model(0.25, lag, SpindleDirection::Cw);
+        assert_eq!(helix.tooth(&arcs, 120.0 + 1e-6), 0.0);
+        assert!(helix.tooth(&arcs, 120.0 - 1e-3) > 0.0);
+        assert!(helix.tooth(&arcs, 30.0 - lag + 1e-3) > 0.0);
+        assert_eq!(helix.tooth(&arcs, 30.0 - lag - 1e-6), 0.0);
+        assert_eq!(flat.tooth(&arcs, 30.0 - 1e-6), 0.0);
+        // Fully in the cut (tip from 100° down to 30°) the helical tooth is the window mean.
+        let tip: f64 = 60.0;
+        let mean = flat.table.between(tip.to_radians(), (tip + lag).to_radians()) / lag.to_radians();
+        assert!((helix.tooth(&arcs, tip) - mean).abs() < 1e-12);
+        // ccw teeth trail on the other side.
+        let ccw = model(0.25, lag, SpindleDirection::Ccw);
+        assert!(ccw.tooth(&arcs, 120.0 + lag - 1e-3) > 0.0);
+        assert_eq!(ccw.tooth(&arcs, 120.0 + lag + 1e-6), 0.0);
+        assert_eq!(ccw.tooth(&arcs, 30.0 - 1e-6), 0.0);
+    }
+
+    #[test]
+    fn helix_keeps_the_mean_and_lowers_the_peak() {
+        let arcs = [arc(0.0, 60.0)];
+        let flat = model(0.2, 0.0, SpindleDirection::Cw);
+        for lag in [10.0, 45.0, 400.0] {
+            let helix = model(0.2, lag, SpindleDirection::Cw);
+            for k in [1, 2, 4] {
+                // Mean over the phase by a fine scan equals the closed form for both.
+                let pitch = 360.0 / f64::from(k);
+                let n = 20_000;
+                let scan_mean: f64 =
+                    (0..n).map(|i| helix.sum(&arcs, k, pitch * (f64::from(i) + 0.5) / f64::from(n))).sum::<f64>()
+                        / f64::from(n);
+                let closed = f64::from(k) * flat.engaged_integral(&arcs) / std::f64::consts::TAU;
+                assert!((scan_mean - closed).abs() < 1e-4 * closed, "lag {lag} k {k}: {scan_mean} vs {closed}");
+                assert!(helix.peak_sum(&arcs, k) <= flat.peak_sum(&arcs, k) + 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn power_is_two_pi_n_m_over_sixty() {
+        assert!((power_kw(10.0, 6000.0) - std::f64::consts::TAU * 100.0 * 10.0 / 1000.0).abs() < 1e-12);
+    }
+}
