@@ -321,3 +321,75 @@ fn without_kienzle_the_answer_has_no_force_fields() {
         assert!(!text.contains(key), "{key} in an answer without kienzle");
     }
 }
+
+/// The chip per f_z at tool angle θ (degrees) from the geometry: the edge point's distance ρ
+/// from the path's centre over r_path, times sin θ.
+fn edge_ratio(position: [f64; 2], heading_deg: f64, centre: [f64; 2], theta: f64) -> f64 {
+    let (t, th) = (heading_deg.to_radians(), theta.to_radians());
+    let (tangent, right) = ([t.cos(), t.sin()], [t.sin(), -t.cos()]);
+    let q = [
+        position[0] + RADIUS * (th.cos() * right[0] + th.sin() * tangent[0]),
+        position[1] + RADIUS * (th.cos() * right[1] + th.sin() * tangent[1]),
+    ];
+    let rho = (q[0] - centre[0]).hypot(q[1] - centre[1]);
+    let r_path = (position[0] - centre[0]).hypot(position[1] - centre[1]);
+    rho / r_path * th.sin().max(0.0)
+}
+
+#[test]
+fn arc_feed_correction_uses_the_feed_at_the_edge() {
+    // Widening a Ø30 hole (left by an earlier circle of radius 10) by 1 mm: the tool centre
+    // runs a ccw half circle of radius 11, the material outside the turn (climb, right).
+    let mc = 0.25;
+    let body = |correct: bool| {
+        json!({
+            "tool": 1, "stock": {"polygon": [[-40, -40], [40, -40], [40, 40], [-40, 40]],
+                "previous_cuts": [{"path": {"start": [10, 0], "segments": [
+                    {"type": "arc", "to": [10, 0], "center": [0, 0], "dir": "ccw"}]}, "radius": RADIUS}]},
+            "path": {"start": [11, 0], "segments": [{"type": "arc", "to": [-11, 0], "center": [0, 0], "dir": "ccw"}]},
+            "spindle_rpm": RPM, "feed_per_tooth": FZ, "flute_counts": [1, 3], "step": 0.2,
+            "axial_depth": AP, "kienzle": {"kc11": KC11, "mc": mc}, "arc_feed_correction": correct,
+        })
+    };
+    let plain = solve(body(false));
+    let corrected = solve(body(true));
+    let mut checked = 0;
+    for (a, b) in plain.samples.iter().zip(&corrected.samples) {
+        let angle = b.position[1].atan2(b.position[0]).to_degrees();
+        if !(60.0..150.0).contains(&angle) {
+            continue;
+        }
+        checked += 1;
+        assert_eq!(a.arcs, b.arcs);
+        let [from, to] = b.arcs[0];
+        assert!(from >= -1e-9 && to < 90.0, "{:?}", b.arcs);
+        // Thickest chip of one tooth: the largest geometric ratio over the arc, densely.
+        let n = 20_000;
+        let dense: Vec<f64> = (0..=n)
+            .map(|i| {
+                edge_ratio(b.position, b.heading_deg, [0.0, 0.0], from + (to - from) * f64::from(i) / f64::from(n))
+            })
+            .collect();
+        let peak = dense.iter().copied().fold(0.0, f64::max);
+        close_rel("corrected H k=1", b.thickness[0], FZ * peak, 1e-4);
+        // Outside the turn the edge runs faster than the centre: (11 + 5)/11 at the wall.
+        assert!(b.thickness[0] > a.thickness[0] * 1.3, "{} vs {}", b.thickness[0], a.thickness[0]);
+        // Phase-mean torque: R·k_c·a_p·f_z^a/(2π)·∫ (c·sin)^a over the arc, by the midpoint rule.
+        let width = (to - from).to_radians() / f64::from(n);
+        let integral: f64 = (0..n)
+            .map(|i| {
+                let theta = from + (to - from) * (f64::from(i) + 0.5) / f64::from(n);
+                edge_ratio(b.position, b.heading_deg, [0.0, 0.0], theta).powf(1.0 - mc) * width
+            })
+            .sum();
+        let expected = KC11 * AP * FZ.powf(1.0 - mc) * RADIUS * integral / TAU / 1000.0;
+        close_rel("corrected torque k=1", b.torque_nm[0], expected, 1e-4);
+    }
+    assert!(checked > 50);
+    // Straight paths are not touched by the switch.
+    let mut straight = slot(mc, &[3]);
+    let unswitched = solve(straight.clone());
+    straight["arc_feed_correction"] = json!(true);
+    let switched = solve(straight);
+    assert_eq!(unswitched.samples, switched.samples);
+}

@@ -5,6 +5,7 @@
 use super::answer::{
     ArcDetail, EngagementSample, ForceInfo, GridInfo, PathEngagement, PostData, RouteData, SampleFlag,
 };
+use super::arcfeed::ArcFeed;
 use super::arcs::{self, Arc};
 use super::dots::{Contacts, DotGrid};
 use super::exact::ExactEngine;
@@ -238,11 +239,19 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
             collisions.push(station.s);
         }
         let sums: Vec<_> = job.flute_counts.iter().map(|&k| tooth_sum(arcs, k)).collect();
+        let edge_feed = if job.arc_feed { ArcFeed::at(route, station, radius) } else { None };
+        let ratios: Vec<f64> = match &edge_feed {
+            Some(feed) => job.flute_counts.iter().map(|&k| feed.tooth_sum(arcs, k)).collect(),
+            None => sums.iter().map(|sum| sum.ratio).collect(),
+        };
         let torques: Vec<SampleTorque> = job.force.as_ref().map_or_else(Vec::new, |model| {
-            let integral = model.engaged_integral(arcs);
+            let integral = model.engaged_integral(arcs, edge_feed.as_ref());
             job.flute_counts
                 .iter()
-                .map(|&k| model.torque(arcs, integral, k, radius, job.feed_mode.feed_per_tooth(k, job.spindle_rpm)))
+                .map(|&k| {
+                    let fz = job.feed_mode.feed_per_tooth(k, job.spindle_rpm);
+                    model.torque(arcs, edge_feed.as_ref(), integral, k, radius, fz)
+                })
                 .collect()
         });
         statistic.push(index > 0 && !rapid && !arcs.is_empty() && !contact.plunge);
@@ -256,12 +265,13 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
             engaged_deg: arcs::engaged_deg(arcs),
             radial_depth,
             arc_details: details,
-            mean_chip_thickness: nominal_fz * arcs::mean_thickness_ratio(arcs),
+            mean_chip_thickness: nominal_fz
+                * edge_feed.as_ref().map_or_else(|| arcs::mean_thickness_ratio(arcs), |feed| feed.mean_ratio(arcs)),
             thickness: job
                 .flute_counts
                 .iter()
-                .zip(&sums)
-                .map(|(&k, sum)| job.feed_mode.feed_per_tooth(k, job.spindle_rpm) * sum.ratio)
+                .zip(&ratios)
+                .map(|(&k, ratio)| job.feed_mode.feed_per_tooth(k, job.spindle_rpm) * ratio)
                 .collect(),
             teeth: sums.iter().map(|sum| sum.teeth).collect(),
             torque_nm: torques.iter().map(|t| t.mean).collect(),

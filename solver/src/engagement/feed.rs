@@ -9,6 +9,7 @@
 //! torque would exceed them (engagement.md §11 item 4).
 
 use super::answer::{FeedBlock, FeedLimit, FeedPlan};
+use super::arcfeed::ArcFeed;
 use super::arcs::peak_thickness_ratio;
 use super::evaluate::Contact;
 use super::request::{FeedBasis, Job, PlanJob};
@@ -16,10 +17,12 @@ use super::segments::{Route, Station};
 use super::teeth::tooth_sum;
 
 /// Feed needed at one sample, mm/min, and what set it.
-fn needed(job: &Job, plan: &PlanJob, contact: &Contact) -> (f64, FeedLimit) {
-    let ratio = match plan.basis {
-        FeedBasis::Tooth => peak_thickness_ratio(&contact.arcs),
-        FeedBasis::Sum => tooth_sum(&contact.arcs, plan.flute_count).ratio,
+fn needed(job: &Job, plan: &PlanJob, contact: &Contact, edge_feed: Option<&ArcFeed>) -> (f64, FeedLimit) {
+    let ratio = match (plan.basis, edge_feed) {
+        (FeedBasis::Tooth, None) => peak_thickness_ratio(&contact.arcs),
+        (FeedBasis::Sum, None) => tooth_sum(&contact.arcs, plan.flute_count).ratio,
+        (FeedBasis::Tooth, Some(feed)) => feed.peak_ratio(&contact.arcs),
+        (FeedBasis::Sum, Some(feed)) => feed.tooth_sum(&contact.arcs, plan.flute_count),
     };
     let per_tooth = if ratio > 1e-12 { plan.target / ratio } else { f64::INFINITY };
     let to_feed = |fz: f64| f64::from(plan.flute_count) * job.spindle_rpm * fz;
@@ -27,7 +30,7 @@ fn needed(job: &Job, plan: &PlanJob, contact: &Contact) -> (f64, FeedLimit) {
     // The spindle: the phase-mean torque grows as f_z^(1−m_c), so the feed per tooth that
     // meets the cap is closed.
     if let (Some(model), Some((torque, by_power))) = (&job.force, job.spindle.torque_cap(job.spindle_rpm)) {
-        let integral = model.engaged_integral(&contact.arcs);
+        let integral = model.engaged_integral(&contact.arcs, edge_feed);
         let feed = to_feed(model.feed_for_torque(torque, integral, plan.flute_count, job.radius));
         if feed < best.0 {
             best = (feed, if by_power { FeedLimit::Power } else { FeedLimit::Torque });
@@ -58,7 +61,8 @@ pub(crate) fn plan(job: &Job, plan: &PlanJob, route: &Route, stations: &[Station
         .zip(contacts)
         .map(|(station, contact)| {
             let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
-            (!rapid).then(|| needed(job, plan, contact))
+            let edge_feed = if job.arc_feed { ArcFeed::at(route, station, job.radius) } else { None };
+            (!rapid).then(|| needed(job, plan, contact, edge_feed.as_ref()))
         })
         .collect();
     let mut stretches = Vec::new();

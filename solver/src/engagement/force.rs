@@ -6,18 +6,20 @@
 //! M̄ = R·k_c1.1·a_p·f_z^a·(k/2π)·∫_E max(0, sin θ)^a dθ (a = 1 − m_c; the helix does not change
 //! it, it only averages the torque over a window of β). Its peak over β is found numerically:
 //! between breakpoints (a tooth, or the top of its helical edge, on an arc end or at 0°/180°)
-//! the torque is smooth, and without a helix a sum of concave terms, so a coarse scan and a
-//! golden-section refinement of each piece find it.
+//! the torque is smooth, and without a helix a sum of concave terms ([`phase::peak`]). On a
+//! curved path with the arc-feed correction (§11 item 6) the chip is f_z·c(θ)·sin θ, so the
+//! terms carry c(θ)^(1−m_c).
 
+use super::arcfeed::ArcFeed;
 use super::arcs::{Arc, SpindleDirection};
 use super::kienzle::SinPower;
+use super::phase;
 
 /// Tooth on an arc end counts as inside, degrees (closed arcs, as in `teeth`).
 const END_TOLERANCE: f64 = 1e-9;
-/// Scan points per breakpoint interval before the golden-section refinement.
-const SCAN: usize = 4;
-/// Golden-section steps: the bracket shrinks to 0.618^40 ≈ 4e-9 of a scan step.
-const GOLDEN_STEPS: usize = 40;
+/// Longest piece of an arc over which the arc-feed factor is taken as constant, degrees: the
+/// factor is smooth, so the error is about (1°)²/24 of its curvature, below 1e-5.
+const FACTOR_PIECE_DEG: f64 = 1.0;
 
 /// A validated force model for one request.
 #[derive(Debug, Clone, PartialEq)]
@@ -42,9 +44,25 @@ pub(crate) struct SampleTorque {
 }
 
 impl ForceModel {
-    /// ∫ over the arcs of max(0, sin θ)^a dθ (θ in radians): the phase-mean term.
-    pub(crate) fn engaged_integral(&self, arcs: &[Arc]) -> f64 {
-        arcs.iter().map(|arc| self.table.between(arc.from.to_radians(), arc.to.to_radians())).sum()
+    /// ∫ over [from, to] (degrees) of (c(θ)·max(0, sin θ))^a dθ, θ in radians.
+    fn between(&self, from: f64, to: f64, feed: Option<&ArcFeed>) -> f64 {
+        let Some(feed) = feed else {
+            return self.table.between(from.to_radians(), to.to_radians());
+        };
+        let pieces = ((to - from) / FACTOR_PIECE_DEG).ceil().max(1.0);
+        let width = (to - from) / pieces;
+        (0..pieces as usize)
+            .map(|i| {
+                let low = from + width * i as f64;
+                let factor = feed.factor(low + 0.5 * width).powf(self.table.exponent());
+                factor * self.table.between(low.to_radians(), (low + width).to_radians())
+            })
+            .sum()
+    }
+
+    /// ∫ over the arcs of (c(θ)·max(0, sin θ))^a dθ (θ in radians): the phase-mean term.
+    pub(crate) fn engaged_integral(&self, arcs: &[Arc], feed: Option<&ArcFeed>) -> f64 {
+        arcs.iter().map(|arc| self.between(arc.from, arc.to, feed)).sum()
     }
 
     /// N·m of torque per unit of the sin^a term for a feed per tooth `fz` and tool radius `radius`:
@@ -66,25 +84,33 @@ impl ForceModel {
     }
 
     /// Mean and peak torque over the tooth phase, N·m.
-    pub(crate) fn torque(&self, arcs: &[Arc], integral: f64, flutes: u32, radius: f64, fz: f64) -> SampleTorque {
+    pub(crate) fn torque(
+        &self,
+        arcs: &[Arc],
+        feed: Option<&ArcFeed>,
+        integral: f64,
+        flutes: u32,
+        radius: f64,
+        fz: f64,
+    ) -> SampleTorque {
         if arcs.is_empty() {
             return SampleTorque { mean: 0.0, peak: 0.0 };
         }
         let mean = self.mean_torque(integral, flutes, radius, fz);
-        let peak = self.scale(radius, fz) * self.peak_sum(arcs, flutes);
+        let peak = self.scale(radius, fz) * self.peak_sum(arcs, flutes, feed);
         // The peak of a function is never below its mean; the numeric search may miss by 1e-12.
         SampleTorque { mean, peak: peak.max(mean) }
     }
 
     /// One tooth's sin^a term with its tip at `tip` (degrees): the value on the arcs, or with a
     /// helix the mean over the lag window behind the tip.
-    pub(crate) fn tooth(&self, arcs: &[Arc], tip: f64) -> f64 {
+    pub(crate) fn tooth(&self, arcs: &[Arc], tip: f64, feed: Option<&ArcFeed>) -> f64 {
         if self.lag_deg <= 0.0 {
-            return if arcs.iter().any(|a| a.contains(tip, END_TOLERANCE)) {
-                self.table.integrand(tip.to_radians())
-            } else {
-                0.0
-            };
+            if !arcs.iter().any(|a| a.contains(tip, END_TOLERANCE)) {
+                return 0.0;
+            }
+            let factor = feed.map_or(1.0, |f| f.factor(tip).powf(self.table.exponent()));
+            return factor * self.table.integrand(tip.to_radians());
         }
         // The edge above the tip trails it: cw teeth run towards smaller θ, so the trailing
         // edge sits at larger θ; ccw the other way.
@@ -101,80 +127,26 @@ impl ForceModel {
                 let shift = 360.0 * turn as f64;
                 let (a, b) = ((arc.from + shift).max(low), (arc.to + shift).min(high));
                 if b > a {
-                    total += self.table.between(a.to_radians(), b.to_radians());
+                    total += self.between(a, b, feed);
                 }
             }
         }
         total / self.lag_deg.to_radians()
     }
 
-    fn sum(&self, arcs: &[Arc], flutes: u32, phase: f64) -> f64 {
-        let pitch = 360.0 / f64::from(flutes);
-        (0..flutes).map(|j| self.tooth(arcs, phase + f64::from(j) * pitch)).sum()
-    }
-
     /// max over the phase β of Σ_j tooth(β + j·360°/k).
-    pub(crate) fn peak_sum(&self, arcs: &[Arc], flutes: u32) -> f64 {
-        let pitch = 360.0 / f64::from(flutes);
-        let mut breaks = vec![0.0, pitch];
+    pub(crate) fn peak_sum(&self, arcs: &[Arc], flutes: u32, feed: Option<&ArcFeed>) -> f64 {
         let mut ends: Vec<f64> = arcs.iter().flat_map(|a| [a.from, a.to]).chain([0.0, 180.0]).collect();
         if self.lag_deg > 0.0 {
+            // The top of the edge crossing the same places.
             let shift = match self.direction {
                 SpindleDirection::Cw => -self.lag_deg,
                 SpindleDirection::Ccw => self.lag_deg,
             };
             ends.extend(ends.clone().iter().map(|e| e + shift));
         }
-        breaks.extend(ends.iter().map(|e| e.rem_euclid(pitch)));
-        breaks.sort_by(f64::total_cmp);
-        breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-12);
-        let value = |phase: f64| self.sum(arcs, flutes, phase);
-        let mut best = breaks.iter().map(|&b| value(b)).fold(0.0, f64::max);
-        for pair in breaks.windows(2) {
-            let (low, high) = (pair[0], pair[1]);
-            if high - low <= 1e-9 {
-                continue;
-            }
-            let step = (high - low) / SCAN as f64;
-            // Interior scan points; the ends are breakpoints, already evaluated.
-            let scanned: Vec<(f64, f64)> = (1..SCAN)
-                .map(|i| {
-                    let phase = low + step * i as f64;
-                    (phase, value(phase))
-                })
-                .collect();
-            let Some(&(centre, centre_value)) = scanned.iter().max_by(|a, b| a.1.total_cmp(&b.1)) else {
-                continue;
-            };
-            best = best.max(centre_value);
-            best = best.max(golden(&value, centre - step, centre + step));
-        }
-        best
+        phase::peak(flutes, &ends, |tip| self.tooth(arcs, tip, feed))
     }
-}
-
-/// Largest value of `f` found by golden-section search on [a, b] (exact for a unimodal f).
-fn golden(f: &impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
-    let ratio = 0.5 * (5.0_f64.sqrt() - 1.0);
-    let mut c = b - ratio * (b - a);
-    let mut d = a + ratio * (b - a);
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..GOLDEN_STEPS {
-        if fc >= fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - ratio * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + ratio * (b - a);
-            fd = f(d);
-        }
-    }
-    fc.max(fd)
 }
 
 /// Spindle power for a torque, kW: P = 2πN·M/60.
@@ -194,10 +166,15 @@ mod tests {
         Arc { from, to }
     }
 
+    fn sum(model: &ForceModel, arcs: &[Arc], flutes: u32, phase: f64) -> f64 {
+        let pitch = 360.0 / f64::from(flutes);
+        (0..flutes).map(|j| model.tooth(arcs, phase + f64::from(j) * pitch, None)).sum()
+    }
+
     /// Brute-force phase scan.
     fn scanned(model: &ForceModel, arcs: &[Arc], flutes: u32) -> f64 {
         let pitch = 360.0 / f64::from(flutes);
-        (0..=100_000).map(|i| model.sum(arcs, flutes, pitch * f64::from(i) / 100_000.0)).fold(0.0, f64::max)
+        (0..=100_000).map(|i| sum(model, arcs, flutes, pitch * f64::from(i) / 100_000.0)).fold(0.0, f64::max)
     }
 
     #[test]
@@ -207,7 +184,7 @@ mod tests {
             let m = model(0.25, lag, SpindleDirection::Cw);
             for arcs in &cases {
                 for k in [1, 2, 3, 4, 7] {
-                    let exact = m.peak_sum(arcs, k);
+                    let exact = m.peak_sum(arcs, k, None);
                     let scan = scanned(&m, arcs, k);
                     assert!(exact >= scan - 1e-9, "lag {lag} {arcs:?} k {k}: {exact} < {scan}");
                     // The scan's step of 0.0036° misses a peak on a jump by up to 3e-5 of it.
@@ -225,20 +202,20 @@ mod tests {
         let arcs = [arc(30.0, 120.0)];
         let flat = model(0.25, 0.0, SpindleDirection::Cw);
         let helix = model(0.25, lag, SpindleDirection::Cw);
-        assert_eq!(helix.tooth(&arcs, 120.0 + 1e-6), 0.0);
-        assert!(helix.tooth(&arcs, 120.0 - 1e-3) > 0.0);
-        assert!(helix.tooth(&arcs, 30.0 - lag + 1e-3) > 0.0);
-        assert_eq!(helix.tooth(&arcs, 30.0 - lag - 1e-6), 0.0);
-        assert_eq!(flat.tooth(&arcs, 30.0 - 1e-6), 0.0);
+        assert_eq!(helix.tooth(&arcs, 120.0 + 1e-6, None), 0.0);
+        assert!(helix.tooth(&arcs, 120.0 - 1e-3, None) > 0.0);
+        assert!(helix.tooth(&arcs, 30.0 - lag + 1e-3, None) > 0.0);
+        assert_eq!(helix.tooth(&arcs, 30.0 - lag - 1e-6, None), 0.0);
+        assert_eq!(flat.tooth(&arcs, 30.0 - 1e-6, None), 0.0);
         // Fully in the cut (tip from 100° down to 30°) the helical tooth is the window mean.
         let tip: f64 = 60.0;
         let mean = flat.table.between(tip.to_radians(), (tip + lag).to_radians()) / lag.to_radians();
-        assert!((helix.tooth(&arcs, tip) - mean).abs() < 1e-12);
+        assert!((helix.tooth(&arcs, tip, None) - mean).abs() < 1e-12);
         // ccw teeth trail on the other side.
         let ccw = model(0.25, lag, SpindleDirection::Ccw);
-        assert!(ccw.tooth(&arcs, 120.0 + lag - 1e-3) > 0.0);
-        assert_eq!(ccw.tooth(&arcs, 120.0 + lag + 1e-6), 0.0);
-        assert_eq!(ccw.tooth(&arcs, 30.0 - 1e-6), 0.0);
+        assert!(ccw.tooth(&arcs, 120.0 + lag - 1e-3, None) > 0.0);
+        assert_eq!(ccw.tooth(&arcs, 120.0 + lag + 1e-6, None), 0.0);
+        assert_eq!(ccw.tooth(&arcs, 30.0 - 1e-6, None), 0.0);
     }
 
     #[test]
@@ -252,11 +229,11 @@ mod tests {
                 let pitch = 360.0 / f64::from(k);
                 let n = 20_000;
                 let scan_mean: f64 =
-                    (0..n).map(|i| helix.sum(&arcs, k, pitch * (f64::from(i) + 0.5) / f64::from(n))).sum::<f64>()
+                    (0..n).map(|i| sum(&helix, &arcs, k, pitch * (f64::from(i) + 0.5) / f64::from(n))).sum::<f64>()
                         / f64::from(n);
-                let closed = f64::from(k) * flat.engaged_integral(&arcs) / std::f64::consts::TAU;
+                let closed = f64::from(k) * flat.engaged_integral(&arcs, None) / std::f64::consts::TAU;
                 assert!((scan_mean - closed).abs() < 1e-4 * closed, "lag {lag} k {k}: {scan_mean} vs {closed}");
-                assert!(helix.peak_sum(&arcs, k) <= flat.peak_sum(&arcs, k) + 1e-12);
+                assert!(helix.peak_sum(&arcs, k, None) <= flat.peak_sum(&arcs, k, None) + 1e-12);
             }
         }
     }

@@ -22,6 +22,8 @@
 //! * `feed`: chip-thinning feed plan (§11 item 3), capped by the spindle's power and torque;
 //! * `kienzle`, `force`: Kienzle's law, spindle torque and power with the helix lag (§11 items
 //!   4, 5);
+//! * `arcfeed`: the arc-feed correction of the chip thickness on curved paths (§11 item 6);
+//! * `phase`: the phase maximum of a general per-tooth load;
 //! * `limits`: the spindle's ratings and the tooth-passing frequency against the tool's natural
 //!   frequencies (§11 items 4, 9);
 //! * [`program()`]: G-code with the planned F words.
@@ -38,6 +40,7 @@
 //! [`crate::gcode::reader`]: its XY moves, lines and arcs, from the first known position on.
 
 mod answer;
+mod arcfeed;
 mod arcs;
 mod bbox_tree;
 mod dots;
@@ -49,6 +52,7 @@ mod force;
 mod kienzle;
 mod limits;
 mod outline;
+mod phase;
 pub mod program;
 pub mod request;
 mod segments;

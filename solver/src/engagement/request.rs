@@ -366,6 +366,12 @@ pub struct EngagementRequest {
     /// against (with `kienzle` or `material`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub machine: Option<String>,
+    /// Correct the chip thickness on arcs of the path for the feed at the cutting edge,
+    /// f_z·ρ/r_path with ρ the edge's distance from the arc's centre ((r_path ± R)/r_path at the
+    /// sides; engagement.md §11 item 6): thickness, mean chip, feed plan and forces (default
+    /// false: the seed's h = f_z·sin θ everywhere).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub arc_feed_correction: bool,
     /// Kienzle values of the work material: with `axial_depth` the answer gives the spindle
     /// torque and power along the path (engagement.md §11 item 4). Give this or `material`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -437,6 +443,8 @@ pub(crate) struct Job {
     pub rule: Option<BlockRule>,
     /// Kienzle's force model, with `kienzle` (or `material`) and `axial_depth`.
     pub force: Option<ForceModel>,
+    /// Apply the arc-feed correction on arcs of the path.
+    pub arc_feed: bool,
     /// The machine's spindle limits (checked only with a force model).
     pub spindle: SpindleLimits,
     /// The tool's natural frequencies, Hz, and their directions.
@@ -1070,6 +1078,7 @@ impl EngagementRequest {
             plan,
             rule,
             force,
+            arc_feed: self.arc_feed_correction,
             spindle,
             natural: natural_frequencies(tool),
             contact_dots: self.contact_dots,
