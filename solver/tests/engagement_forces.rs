@@ -98,6 +98,49 @@ fn full_slot_peak_torque_is_the_largest_tooth_sum() {
     }
 }
 
+/// The resultant of k teeth at phase β in a full slot, per k_c·a_p·f_z^a, cw: each tooth
+/// at θ on [0°, 180°] pushes with sin^a θ·[(−sin θ, cos θ) + ratio·(−cos θ, −sin θ)].
+fn slot_resultant(a: f64, ratio: f64, flutes: u32, phase: f64) -> f64 {
+    let (mut x, mut y) = (0.0, 0.0);
+    for j in 0..flutes {
+        let theta = (phase + 360.0 * f64::from(j) / f64::from(flutes)).rem_euclid(360.0);
+        if theta <= 180.0 {
+            let (s, c) = theta.to_radians().sin_cos();
+            let w = s.max(0.0).powf(a);
+            x += w * (-s - ratio * c);
+            y += w * (c - ratio * s);
+        }
+    }
+    x.hypot(y)
+}
+
+#[test]
+fn full_slot_peak_force_is_the_largest_resultant() {
+    let mc = 0.25;
+    let a = 1.0 - mc;
+    for ratio in [0.0, 0.3, 0.6] {
+        let mut body = slot(mc, &[1, 2, 3, 4, 5]);
+        body["kienzle"]["radial_ratio"] = json!(ratio);
+        let result = solve(body);
+        assert_eq!(result.forces.as_ref().unwrap().radial_ratio, ratio);
+        let unit = KC11 * AP * FZ.powf(a);
+        for flute in &result.flutes {
+            let k = flute.flute_count;
+            let scan = (0..=200_000)
+                .map(|i| slot_resultant(a, ratio, k, 360.0 / f64::from(k) * f64::from(i) / 200_000.0))
+                .fold(0.0, f64::max);
+            close_rel(&format!("ratio {ratio} k {k} peak force"), flute.peak_force_n.unwrap(), unit * scan, 1e-5);
+            if k == 1 {
+                // One tooth: |F| = F_t·√(1 + ratio²), largest at θ = 90°.
+                close_rel("k 1 closed", flute.peak_force_n.unwrap(), unit * (1.0 + ratio * ratio).sqrt(), 1e-9);
+            }
+        }
+    }
+    // Without radial_ratio the default applies.
+    let forces = solve(slot(mc, &[2])).forces.unwrap();
+    assert_eq!(forces.radial_ratio, engagement::DEFAULT_RADIAL_RATIO);
+}
+
 #[test]
 fn side_milling_quarter_diameter_is_the_integral_over_the_engaged_arc() {
     // a_e = D/4 along the top edge of the block: climb milling over [0°, 60°] travelling +X
@@ -185,6 +228,8 @@ proptest! {
             prop_assert!((a.torque_nm[0] - b.torque_nm[0]).abs() <= 1e-12 * a.torque_nm[0].max(1.0));
             prop_assert!(b.peak_torque_nm[0] <= a.peak_torque_nm[0] * (1.0 + 1e-9) + 1e-12);
             prop_assert!(b.peak_torque_nm[0] >= b.torque_nm[0] * (1.0 - 1e-9));
+            // The resultant is a window mean of the straight-flute resultant too.
+            prop_assert!(b.peak_force_n[0] <= a.peak_force_n[0] * (1.0 + 1e-6) + 1e-9);
         }
     }
 
@@ -277,7 +322,10 @@ fn material_is_resolved_by_the_caller() {
     body["material"] = json!("C45");
     let error = solve_body(body.clone(), &tool(None), &Physics::default()).unwrap_err();
     assert_eq!((error.code(), error.field()), ("E_INPUT", Some("material")));
-    let physics = Physics { material: Some(Kienzle { kc11: KC11, mc: 0.25 }), spindle: SpindleLimits::default() };
+    let physics = Physics {
+        material: Some(Kienzle { kc11: KC11, mc: 0.25, radial_ratio: None }),
+        spindle: SpindleLimits::default(),
+    };
     let named = solve_body(body, &tool(None), &physics).unwrap();
     let inline = solve(slot(0.25, &[4]));
     assert_eq!(named.flutes, inline.flutes);
@@ -289,6 +337,7 @@ fn bad_physics_inputs_name_their_field() {
         (json!({"kienzle": {"kc11": -1, "mc": 0.2}}), "kienzle.kc11"),
         (json!({"kienzle": {"kc11": 1800, "mc": 1.0}}), "kienzle.mc"),
         (json!({"kienzle": {"kc11": 1800, "mc": -0.1}}), "kienzle.mc"),
+        (json!({"kienzle": {"kc11": 1800, "mc": 0.2, "radial_ratio": -0.5}}), "kienzle.radial_ratio"),
         (json!({"material": "C45"}), "material"),
     ];
     for (extra, field) in cases {
@@ -317,7 +366,7 @@ fn without_kienzle_the_answer_has_no_force_fields() {
         Physics { material: None, spindle: SpindleLimits { spindle_power_kw: Some(0.01), spindle_torque_nm: None } };
     let result = solve_body(body, &tool(None), &physics).unwrap();
     let text = serde_json::to_string(&result).unwrap();
-    for key in ["torque_nm", "power_kw", "forces", "tooth_passing_hz", "W_SPINDLE"] {
+    for key in ["torque_nm", "power_kw", "force_n", "forces", "tooth_passing_hz", "W_SPINDLE"] {
         assert!(!text.contains(key), "{key} in an answer without kienzle");
     }
 }

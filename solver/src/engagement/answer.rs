@@ -96,6 +96,10 @@ pub struct EngagementSample {
     /// Spindle power 2πN·`torque_nm`/60, kW, per flute count (with `kienzle`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub power_kw: Vec<f64>,
+    /// Largest resultant cutting force on the tool over the tooth phase (tangential and radial
+    /// parts of every tooth in the cut, summed as vectors), N, per flute count (with `kienzle`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub peak_force_n: Vec<f64>,
     /// Material removal rate a_p·a_e·V_f at the nominal feed, mm³/min (with `axial_depth`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mrr: Option<f64>,
@@ -151,6 +155,9 @@ pub struct FluteResult {
     /// 2πN·`peak_torque_nm`/60, kW.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub peak_power_kw: Option<f64>,
+    /// Largest resultant cutting force on the tool over the tooth phase and the path, N.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_force_n: Option<f64>,
     /// Tooth-passing frequency N·k/60, Hz (with `kienzle` or `material`); `W_TOOTH_PASSING`
     /// when it lies within 5 % of a natural frequency of the tool's `stiffness`.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -222,6 +229,8 @@ pub struct ForceInfo {
     pub mc: f64,
     /// a_p, mm: the chip width of every tooth.
     pub axial_depth: f64,
+    /// F_r/F_t used.
+    pub radial_ratio: f64,
     /// Helix lag 2a_p·tan λ/D over which each tooth's cut is spread, degrees (0 without the
     /// tool's `helix_deg`).
     pub helix_lag_deg: f64,

@@ -244,16 +244,20 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
             Some(feed) => job.flute_counts.iter().map(|&k| feed.tooth_sum(arcs, k)).collect(),
             None => sums.iter().map(|sum| sum.ratio).collect(),
         };
-        let torques: Vec<SampleTorque> = job.force.as_ref().map_or_else(Vec::new, |model| {
-            let integral = model.engaged_integral(arcs, edge_feed.as_ref());
-            job.flute_counts
-                .iter()
-                .map(|&k| {
-                    let fz = job.feed_mode.feed_per_tooth(k, job.spindle_rpm);
-                    model.torque(arcs, edge_feed.as_ref(), integral, k, radius, fz)
-                })
-                .collect()
-        });
+        let (torques, forces): (Vec<SampleTorque>, Vec<f64>) =
+            job.force.as_ref().map_or_else(Default::default, |model| {
+                let integral = model.engaged_integral(arcs, edge_feed.as_ref());
+                job.flute_counts
+                    .iter()
+                    .map(|&k| {
+                        let fz = job.feed_mode.feed_per_tooth(k, job.spindle_rpm);
+                        (
+                            model.torque(arcs, edge_feed.as_ref(), integral, k, radius, fz),
+                            model.peak_force(arcs, k, fz, edge_feed.as_ref()),
+                        )
+                    })
+                    .unzip()
+            });
         statistic.push(index > 0 && !rapid && !arcs.is_empty() && !contact.plunge);
         samples.push(EngagementSample {
             s: station.s,
@@ -277,6 +281,7 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
             torque_nm: torques.iter().map(|t| t.mean).collect(),
             peak_torque_nm: torques.iter().map(|t| t.peak).collect(),
             power_kw: torques.iter().map(|t| power_kw(t.mean, job.spindle_rpm)).collect(),
+            peak_force_n: forces,
             mrr: job.axial_depth.map(|depth| depth * radial_depth * nominal_feed),
             flags,
         });
@@ -480,6 +485,7 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
         forces: job.force.as_ref().map(|model| ForceInfo {
             kc11: model.kc11,
             mc: model.mc,
+            radial_ratio: model.radial_ratio,
             axial_depth: model.axial_depth,
             helix_lag_deg: model.lag_deg,
             spindle_power_kw: job.spindle.spindle_power_kw,

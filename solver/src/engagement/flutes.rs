@@ -140,6 +140,7 @@ pub(crate) fn results(
             peak_torque_nm: forces.map(|f| f.1),
             mean_power_kw: forces.map(|f| power_kw(f.0, job.spindle_rpm)),
             peak_power_kw: forces.map(|f| power_kw(f.1, job.spindle_rpm)),
+            peak_force_n: forces.map(|f| f.2),
             tooth_passing_hz,
         });
     }
@@ -171,20 +172,21 @@ pub(crate) fn results(
 }
 
 /// Length-weighted mean of the phase-mean torque and the largest phase peak over the engaged
-/// samples, N·m, for one flute column (with a force model).
+/// samples, N·m, and the largest resultant force, N, for one flute column (with a force model).
 fn force_statistics(
     job: &Job,
     samples: &[EngagementSample],
     statistic: &[bool],
     weights: &[f64],
     column: usize,
-) -> Option<(f64, f64)> {
+) -> Option<(f64, f64, f64)> {
     job.force.as_ref()?;
     let engaged = || samples.iter().zip(statistic).filter(|(_, s)| **s).map(|(sample, _)| sample);
     let means: Vec<f64> = engaged().map(|s| s.torque_nm.get(column).copied().unwrap_or(0.0)).collect();
     let (_, _, mean, _) = statistics(&means, weights);
     let peak = engaged().filter_map(|s| s.peak_torque_nm.get(column).copied()).fold(0.0, f64::max);
-    Some((mean, peak))
+    let force = engaged().filter_map(|s| s.peak_force_n.get(column).copied()).fold(0.0, f64::max);
+    Some((mean, peak, force))
 }
 
 /// `W_SPINDLE_POWER` and `W_SPINDLE_TORQUE` for one flute column: where the phase-mean power or

@@ -31,7 +31,12 @@ pub(crate) struct ForceModel {
     /// Λ = 2a_p·tan λ/D, degrees (0 without a helix).
     pub lag_deg: f64,
     pub direction: SpindleDirection,
+    /// F_r/F_t.
+    pub radial_ratio: f64,
+    /// ∫ sin^a.
     pub table: SinPower,
+    /// ∫ sin^(a+1), for the force's components (sin^a·sin θ).
+    pub table_next: SinPower,
 }
 
 /// Torque at one sample for one flute count, N·m.
@@ -134,8 +139,103 @@ impl ForceModel {
         total / self.lag_deg.to_radians()
     }
 
-    /// max over the phase β of Σ_j tooth(β + j·360°/k).
-    pub(crate) fn peak_sum(&self, arcs: &[Arc], flutes: u32, feed: Option<&ArcFeed>) -> f64 {
+    /// ∫ over [from, to] (degrees) of w(θ)·(sin θ, cos θ) dθ with w = (c(θ)·max(0, sin θ))^a:
+    /// the pieces of one tooth's force along and across the travel.
+    fn moments(&self, from: f64, to: f64, feed: Option<&ArcFeed>) -> (f64, f64) {
+        let a = self.table.exponent();
+        // ∫ sin^a·cos = sin^(a+1)/(a+1) where sin ≥ 0; the back half carries no chip.
+        let cos_moment = |low: f64, high: f64| {
+            let mut total = 0.0;
+            let first = (low / 360.0).floor() as i64;
+            let last = (high / 360.0).floor() as i64;
+            for turn in first..=last {
+                let base = 360.0 * turn as f64;
+                let (x, y) = (low.max(base), high.min(base + 180.0));
+                if y > x {
+                    let power = |t: f64| t.to_radians().sin().max(0.0).powf(a + 1.0);
+                    total += (power(y) - power(x)) / (a + 1.0);
+                }
+            }
+            total
+        };
+        let Some(feed) = feed else {
+            return (self.table_next.between(from.to_radians(), to.to_radians()), cos_moment(from, to));
+        };
+        let pieces = ((to - from) / FACTOR_PIECE_DEG).ceil().max(1.0);
+        let width = (to - from) / pieces;
+        (0..pieces as usize).fold((0.0, 0.0), |(sin_sum, cos_sum), i| {
+            let low = from + width * i as f64;
+            let factor = feed.factor(low + 0.5 * width).powf(a);
+            (
+                sin_sum + factor * self.table_next.between(low.to_radians(), (low + width).to_radians()),
+                cos_sum + factor * cos_moment(low, low + width),
+            )
+        })
+    }
+
+    /// One tooth's force on the tool per k_c1.1·a_p·f_z^a, in the tool frame (along the right
+    /// normal r̂, along the travel t̂): the tangential part opposes the edge's motion, the radial
+    /// part pushes the tool away from the material.
+    pub(crate) fn tooth_force(&self, arcs: &[Arc], tip: f64, feed: Option<&ArcFeed>) -> (f64, f64) {
+        let a = self.table.exponent();
+        // Edge motion: cw teeth run towards smaller θ (velocity −de/dθ), ccw towards larger.
+        let turning = match self.direction {
+            SpindleDirection::Cw => 1.0,
+            SpindleDirection::Ccw => -1.0,
+        };
+        let combine = |sin_part: f64, cos_part: f64| {
+            // w·[turning·(−sin θ, cos θ) + ratio·(−cos θ, −sin θ)].
+            (-turning * sin_part - self.radial_ratio * cos_part, turning * cos_part - self.radial_ratio * sin_part)
+        };
+        if self.lag_deg <= 0.0 {
+            if !arcs.iter().any(|arc| arc.contains(tip, END_TOLERANCE)) {
+                return (0.0, 0.0);
+            }
+            let w = feed.map_or(1.0, |f| f.factor(tip).powf(a)) * self.table.integrand(tip.to_radians());
+            let (s, c) = tip.to_radians().sin_cos();
+            return combine(w * s, w * c);
+        }
+        let (low, high) = match self.direction {
+            SpindleDirection::Cw => (tip, tip + self.lag_deg),
+            SpindleDirection::Ccw => (tip - self.lag_deg, tip),
+        };
+        let (mut sin_part, mut cos_part) = (0.0, 0.0);
+        for arc in arcs {
+            let first = ((low - arc.to) / 360.0).floor() as i64;
+            let last = ((high - arc.from) / 360.0).ceil() as i64;
+            for turn in first..=last {
+                let shift = 360.0 * turn as f64;
+                let (x, y) = ((arc.from + shift).max(low), (arc.to + shift).min(high));
+                if y > x {
+                    let (s, c) = self.moments(x, y, feed);
+                    sin_part += s;
+                    cos_part += c;
+                }
+            }
+        }
+        let lag = self.lag_deg.to_radians();
+        combine(sin_part / lag, cos_part / lag)
+    }
+
+    /// Largest resultant force on the tool over the tooth phase, N.
+    pub(crate) fn peak_force(&self, arcs: &[Arc], flutes: u32, fz: f64, feed: Option<&ArcFeed>) -> f64 {
+        if arcs.is_empty() {
+            return 0.0;
+        }
+        let pitch = 360.0 / f64::from(flutes);
+        let resultant = |phase: f64| {
+            let (x, y) = (0..flutes).fold((0.0, 0.0), |(x, y), j| {
+                let (fx, fy) = self.tooth_force(arcs, phase + f64::from(j) * pitch, feed);
+                (x + fx, y + fy)
+            });
+            x.hypot(y)
+        };
+        let scale = self.kc11 * self.axial_depth * fz.powf(self.table.exponent());
+        scale * phase::peak_of(flutes, &self.ends(arcs), resultant)
+    }
+
+    /// Tooth angles where a tooth's load jumps or bends.
+    fn ends(&self, arcs: &[Arc]) -> Vec<f64> {
         let mut ends: Vec<f64> = arcs.iter().flat_map(|a| [a.from, a.to]).chain([0.0, 180.0]).collect();
         if self.lag_deg > 0.0 {
             // The top of the edge crossing the same places.
@@ -145,7 +245,12 @@ impl ForceModel {
             };
             ends.extend(ends.clone().iter().map(|e| e + shift));
         }
-        phase::peak(flutes, &ends, |tip| self.tooth(arcs, tip, feed))
+        ends
+    }
+
+    /// max over the phase β of Σ_j tooth(β + j·360°/k).
+    pub(crate) fn peak_sum(&self, arcs: &[Arc], flutes: u32, feed: Option<&ArcFeed>) -> f64 {
+        phase::peak(flutes, &self.ends(arcs), |tip| self.tooth(arcs, tip, feed))
     }
 }
 
@@ -159,7 +264,16 @@ mod tests {
     use super::*;
 
     fn model(mc: f64, lag_deg: f64, direction: SpindleDirection) -> ForceModel {
-        ForceModel { kc11: 1800.0, mc, axial_depth: 2.0, lag_deg, direction, table: SinPower::new(1.0 - mc) }
+        ForceModel {
+            kc11: 1800.0,
+            mc,
+            axial_depth: 2.0,
+            lag_deg,
+            direction,
+            radial_ratio: 0.3,
+            table: SinPower::new(1.0 - mc),
+            table_next: SinPower::new(2.0 - mc),
+        }
     }
 
     fn arc(from: f64, to: f64) -> Arc {
@@ -234,6 +348,34 @@ mod tests {
                 let closed = f64::from(k) * flat.engaged_integral(&arcs, None) / std::f64::consts::TAU;
                 assert!((scan_mean - closed).abs() < 1e-4 * closed, "lag {lag} k {k}: {scan_mean} vs {closed}");
                 assert!(helix.peak_sum(&arcs, k, None) <= flat.peak_sum(&arcs, k, None) + 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn helical_tooth_force_is_the_window_mean_of_the_straight_one() {
+        let arcs = [arc(10.0, 150.0)];
+        for direction in [SpindleDirection::Cw, SpindleDirection::Ccw] {
+            let flat = model(0.25, 0.0, direction);
+            let helix = model(0.25, 30.0, direction);
+            for tip in [-20.0, 0.0, 45.0, 100.0, 140.0, 170.0] {
+                let (low, high) = match direction {
+                    SpindleDirection::Cw => (tip, tip + 30.0),
+                    SpindleDirection::Ccw => (tip - 30.0, tip),
+                };
+                let n = 30_000;
+                let (mut x, mut y) = (0.0, 0.0);
+                for i in 0..n {
+                    let (fx, fy) =
+                        flat.tooth_force(&arcs, low + (high - low) * (f64::from(i) + 0.5) / f64::from(n), None);
+                    x += fx / f64::from(n);
+                    y += fy / f64::from(n);
+                }
+                let (hx, hy) = helix.tooth_force(&arcs, tip, None);
+                assert!(
+                    (hx - x).abs() < 1e-5 && (hy - y).abs() < 1e-5,
+                    "{direction:?} {tip}: ({hx}, {hy}) vs ({x}, {y})"
+                );
             }
         }
     }

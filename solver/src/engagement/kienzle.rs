@@ -19,7 +19,15 @@ pub struct Kienzle {
     pub kc11: f64,
     /// m_c: Kienzle's exponent (0 ≤ m_c < 1; typically 0.15–0.3).
     pub mc: f64,
+    /// F_r/F_t, the radial force of a tooth as a share of its tangential force (≥ 0; default
+    /// [`DEFAULT_RADIAL_RATIO`]); it enters only the resultant force on the tool.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radial_ratio: Option<f64>,
 }
+
+/// F_r/F_t when `radial_ratio` is not given: a middle value of the 0.2–0.5 that sharp end mills
+/// show; give the measured ratio of the tool and material where it matters.
+pub const DEFAULT_RADIAL_RATIO: f64 = 0.3;
 
 impl Kienzle {
     /// Checks the values, naming fields under `prefix` (e.g. `kienzle.`).
@@ -32,6 +40,14 @@ impl Kienzle {
             return Err(SolverError::input(
                 format!("{prefix}mc"),
                 format!("mc must be at least 0 and below 1 (got {})", self.mc),
+            ));
+        }
+        if let Some(ratio) = self.radial_ratio
+            && !(ratio.is_finite() && (0.0..=10.0).contains(&ratio))
+        {
+            return Err(SolverError::input(
+                format!("{prefix}radial_ratio"),
+                format!("radial_ratio must be in [0, 10] (got {ratio})"),
             ));
         }
         Ok(())

@@ -65,7 +65,7 @@ pub use answer::{
     GridInfo, PathEngagement, SampleFlag,
 };
 pub use arcs::{MillingMode, SpindleDirection};
-pub use kienzle::Kienzle;
+pub use kienzle::{DEFAULT_RADIAL_RATIO, Kienzle};
 pub use limits::{RESONANCE_BAND, SpindleLimits};
 pub use program::program;
 pub use request::{

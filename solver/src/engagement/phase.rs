@@ -18,7 +18,16 @@ pub(crate) fn peak(flutes: u32, ends: &[f64], load: impl Fn(f64) -> f64) -> f64 
         return 0.0;
     }
     let pitch = 360.0 / f64::from(flutes);
-    let sum = |phase: f64| (0..flutes).map(|j| load(phase + f64::from(j) * pitch)).sum::<f64>();
+    peak_of(flutes, ends, |phase: f64| (0..flutes).map(|j| load(phase + f64::from(j) * pitch)).sum::<f64>())
+}
+
+/// max over β of `sum(β)`, a function of the phase of k teeth (period 360°/k) that is smooth
+/// between the breakpoints `ends` (mod the pitch).
+pub(crate) fn peak_of(flutes: u32, ends: &[f64], sum: impl Fn(f64) -> f64) -> f64 {
+    if flutes == 0 {
+        return 0.0;
+    }
+    let pitch = 360.0 / f64::from(flutes);
     let mut breaks = vec![0.0, pitch];
     breaks.extend(ends.iter().map(|e| e.rem_euclid(pitch)));
     breaks.sort_by(f64::total_cmp);

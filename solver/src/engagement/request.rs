@@ -10,7 +10,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 use super::arcs::SpindleDirection;
 use super::bbox_tree::BBox;
 use super::force::ForceModel;
-use super::kienzle::{Kienzle, SinPower};
+use super::kienzle::{DEFAULT_RADIAL_RATIO, Kienzle, SinPower};
 use super::limits::{SpindleLimits, natural_frequencies};
 use super::outline::Outline;
 use super::segments::{Route, Shape};
@@ -1137,7 +1137,9 @@ impl EngagementRequest {
                 axial_depth,
                 lag_deg: lag.to_degrees(),
                 direction: self.spindle_direction,
+                radial_ratio: kienzle.radial_ratio.unwrap_or(DEFAULT_RADIAL_RATIO),
                 table: SinPower::new(1.0 - kienzle.mc),
+                table_next: SinPower::new(2.0 - kienzle.mc),
             }),
             physics.spindle,
         ))
