@@ -240,10 +240,6 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
         }
         let sums: Vec<_> = job.flute_counts.iter().map(|&k| tooth_sum(arcs, k)).collect();
         let edge_feed = if job.arc_feed { ArcFeed::at(route, station, radius) } else { None };
-        let ratios: Vec<f64> = match &edge_feed {
-            Some(feed) => job.flute_counts.iter().map(|&k| feed.tooth_sum(arcs, k)).collect(),
-            None => sums.iter().map(|sum| sum.ratio).collect(),
-        };
         let (torques, forces): (Vec<SampleTorque>, Vec<f64>) =
             job.force.as_ref().map_or_else(Default::default, |model| {
                 let integral = model.engaged_integral(arcs, edge_feed.as_ref());
@@ -274,8 +270,12 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
             thickness: job
                 .flute_counts
                 .iter()
-                .zip(&ratios)
-                .map(|(&k, ratio)| job.feed_mode.feed_per_tooth(k, job.spindle_rpm) * ratio)
+                .zip(&sums)
+                .map(|(&k, sum)| {
+                    // H_k/f_z: the exact sinusoid of §5.6, or with the arc-feed factor numeric.
+                    let ratio = edge_feed.as_ref().map_or(sum.ratio, |feed| feed.tooth_sum(arcs, k));
+                    job.feed_mode.feed_per_tooth(k, job.spindle_rpm) * ratio
+                })
                 .collect(),
             teeth: sums.iter().map(|sum| sum.teeth).collect(),
             torque_nm: torques.iter().map(|t| t.mean).collect(),

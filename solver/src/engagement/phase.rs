@@ -8,8 +8,9 @@
 
 /// Scan points per breakpoint interval before the refinement.
 const SCAN: usize = 4;
-/// Golden-section steps: the bracket shrinks to 0.618^40 ≈ 4e-9 of a scan step.
-const GOLDEN_STEPS: usize = 40;
+/// Golden-section steps: the bracket shrinks to 0.618^28 ≈ 1.4e-6 of a scan step, so the value
+/// misses a smooth peak by about 1e-12 of it.
+const GOLDEN_STEPS: usize = 28;
 
 /// max over β of Σ_j load(β + j·360°/k), with `ends` (degrees, any turn) the tooth angles where
 /// the load jumps or bends.
