@@ -442,3 +442,54 @@ fn arc_feed_correction_uses_the_feed_at_the_edge() {
     let switched = solve(straight);
     assert_eq!(unswitched.samples, switched.samples);
 }
+
+#[test]
+fn rounded_ends_are_flagged_as_upper_bounds() {
+    let mut ball = tool(None);
+    ball.kind = ToolKind::Ball;
+    let result = solve_body(slot(0.25, &[2]), &ball, &Physics::default()).unwrap();
+    assert!(result.warnings.iter().any(|w| w.code == "W_FORCE_MODEL"));
+    let flat = solve(slot(0.25, &[2]));
+    assert!(!flat.warnings.iter().any(|w| w.code == "W_FORCE_MODEL"));
+    // Same numbers: the end shape does not enter the model.
+    assert_eq!(result.flutes, flat.flutes);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 16, ..ProptestConfig::default() })]
+
+    /// Wherever the capped plan runs, the spindle's phase-mean power and torque at the block's
+    /// feed stay within the machine's ratings (checked on every sample of the block from its
+    /// own torque at the nominal feed, scaled by (f_block/f_nominal)^(1−m_c)).
+    #[test]
+    fn capped_plan_never_exceeds_the_spindle(
+        power in 0.05_f64..2.0,
+        torque in 0.2_f64..5.0,
+        offset in -6.0_f64..6.0,
+        corner in 15.0_f64..45.0,
+        rpm in 800.0_f64..6000.0,
+        mc in 0.1_f64..0.35,
+    ) {
+        let physics = Physics {
+            material: None,
+            spindle: SpindleLimits { spindle_power_kw: Some(power), spindle_torque_nm: Some(torque) },
+        };
+        let mut body = slot(mc, &[3]);
+        body["spindle_rpm"] = json!(rpm);
+        body["step"] = json!(0.5);
+        body["path"] = json!([[-10, offset], [corner, offset], [corner, 30]]);
+        body["feed_plan"] = json!({"target_thickness": 1.0, "max_feed": 50_000, "flute_count": 3});
+        let result = solve_body(body, &tool(None), &physics).unwrap();
+        let plan = result.feed_plan.clone().unwrap();
+        let nominal_feed = result.flutes[0].feed;
+        for block in &plan.blocks {
+            let feed = block.feed.unwrap();
+            for sample in result.samples.iter().filter(|s| s.s >= block.from_s - 1e-9 && s.s <= block.to_s + 1e-9) {
+                let scaled = sample.torque_nm[0] * (feed / nominal_feed).powf(1.0 - mc);
+                let scaled_power = TAU * rpm * scaled / 60_000.0;
+                prop_assert!(scaled <= torque * (1.0 + 1e-9), "s {}: {} N·m > {}", sample.s, scaled, torque);
+                prop_assert!(scaled_power <= power * (1.0 + 1e-9), "s {}: {} kW > {}", sample.s, scaled_power, power);
+            }
+        }
+    }
+}

@@ -420,6 +420,16 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
         }
     }
 
+    if let (Some(model), ToolKind::Ball | ToolKind::Bull) = (&job.force, tool.kind) {
+        warnings.push(Warning::new(
+            "W_FORCE_MODEL",
+            format!(
+                "the forces take every tooth as a straight edge cutting a chip {} mm wide (a_p): the rounded end of a {} tool cuts less near its tip, so torque, power and force are upper bounds",
+                model.axial_depth,
+                tool.kind.as_str()
+            ),
+        ));
+    }
     let (flute_results, recommended, flute_warnings) = flutes::results(job, &samples, &statistic, route.feed_length);
     warnings.extend(flute_warnings);
     let feed_plan = job.plan.as_ref().map(|plan| feed::plan(job, plan, route, &stations, &contacts));

@@ -31,10 +31,18 @@
 //! Choices where the spec is open (§13): `cw` rotation by default; constant f_z when
 //! `feed_per_tooth` is given, constant V_f when `feed` is; statistics over the engaged samples
 //! (m ≥ 1, not a plunge, not a rapid), the mean weighted by sample spacing; machining time over
-//! feed moves only; θ in degrees; 2-D only (no axial depth or helix in the contact model). A
+//! feed moves only; θ in degrees; the contact model is 2-D (the axial depth and the helix enter
+//! only the forces). A
 //! path that never touches the stock is not an error: the answer is all zeros with
 //! `W_NO_CONTACT` (§9). The exact engine splits the circle at its exact boundary crossings
 //! instead of stepping θ, so it has no angle step and its arc ends are exact.
+//!
+//! Cutting physics (§11 items 4–6, 9; only with `kienzle` or `material`, so answers without
+//! them are unchanged): every tooth cuts a chip a_p wide with a straight edge (ball and bull
+//! ends are not modelled: `W_FORCE_MODEL`); the spindle limits are compared with the torque
+//! averaged over the tooth phase, the load the drive carries (its rotor's inertia smooths the
+//! tooth-by-tooth peaks), while the peaks over the phase are reported for the tool; the
+//! tooth-passing frequency is compared with the fundamental only.
 //!
 //! A path may also be G-code text (`{"gcode": "..."}`), read by the shared
 //! [`crate::gcode::reader`]: its XY moves, lines and arcs, from the first known position on.
