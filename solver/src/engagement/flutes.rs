@@ -196,26 +196,23 @@ fn limit_warnings(job: &Job, samples: &[EngagementSample], statistic: &[bool], c
     if job.force.is_none() {
         return warnings;
     }
+    let series = |pick: fn(&EngagementSample) -> &[f64]| -> Vec<f64> {
+        samples.iter().map(|s| pick(s).get(column).copied().unwrap_or(0.0)).collect()
+    };
+    let power = series(|s| &s.power_kw);
+    let torque = series(|s| &s.torque_nm);
     let checks = [
-        ("W_SPINDLE_POWER", "power", "kW", job.spindle.spindle_power_kw, &|s: &EngagementSample| {
-            s.power_kw.get(column).copied()
-        }),
-        ("W_SPINDLE_TORQUE", "torque", "N·m", job.spindle.spindle_torque_nm, &|s: &EngagementSample| {
-            s.torque_nm.get(column).copied()
-        }),
-    ] as [(&'static str, &str, &str, Option<f64>, &dyn Fn(&EngagementSample) -> Option<f64>); 2];
-    for (code, what, unit, limit, value) in checks {
+        ("W_SPINDLE_POWER", "power", "kW", job.spindle.spindle_power_kw, &power),
+        ("W_SPINDLE_TORQUE", "torque", "N·m", job.spindle.spindle_torque_nm, &torque),
+    ];
+    for (code, what, unit, limit, values) in checks {
         let Some(limit) = limit else { continue };
-        let over = |i: usize| {
-            statistic.get(i).copied().unwrap_or(false)
-                && samples.get(i).and_then(value).is_some_and(|v| v > limit * (1.0 + LIMIT_SLACK))
-        };
+        let over = |i: usize| statistic.get(i).copied().unwrap_or(false) && values[i] > limit * (1.0 + LIMIT_SLACK);
         let intervals = runs(samples, over);
         if intervals.is_empty() {
             continue;
         }
-        let highest =
-            samples.iter().enumerate().filter(|(i, _)| over(*i)).filter_map(|(_, s)| value(s)).fold(0.0, f64::max);
+        let highest = (0..values.len()).filter(|&i| over(i)).map(|i| values[i]).fold(0.0, f64::max);
         warnings.push(Warning::new(
             code,
             format!(
