@@ -271,7 +271,8 @@ pub struct FeedPlanRequest {
 #[serde(deny_unknown_fields)]
 pub struct EngagementRequest {
     /// A registered tool number or an inline tool; only its radius (the apparent rotation
-    /// circle) and `flutes` enter the 2-D model.
+    /// circle) and `flutes` enter the 2-D model, and with `kienzle` its `helix_deg` (the helix
+    /// lag) and the natural frequencies of its `stiffness` (the tooth-passing check).
     pub tool: ToolRef,
     /// The plan-view material.
     pub stock: Stock,
@@ -338,8 +339,8 @@ pub struct EngagementRequest {
     /// Report `W_TINY_FZ` for flute counts whose feed per tooth falls below this, mm (optional).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_feed_per_tooth: Option<f64>,
-    /// a_p, the axial depth of cut, mm: gives the removal rate (MRR) and the cutting Z of the
-    /// G-code program (stock top − a_p).
+    /// a_p, the axial depth of cut, mm: gives the removal rate (MRR), the cutting Z of the
+    /// G-code program (stock top − a_p) and, with `kienzle`, the chip width of every tooth.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axial_depth: Option<f64>,
     /// Z of the stock top for the G-code program, mm (default 0).
