@@ -1,5 +1,6 @@
 //! Engagement throughput (issue 5): samples per second for 1 m of path at a 0.01 mm step
-//! through a 200 × 200 mm pocket, for both engines, and the dot engine's memory at 0.01 mm.
+//! through a 200 × 200 mm pocket, for both engines, and the dot engine's memory at 0.01 mm;
+//! with Kienzle torque and power (issue 16) at a 0.1 mm step, straight and helical flutes.
 //!
 //! Run: `cargo bench -p kerf-solver --bench engagement -- --warm-up-time 1 --measurement-time 5`
 
@@ -53,14 +54,23 @@ fn request(engine: &str) -> EngagementRequest {
         body["grid"] = json!(0.01);
         body["contact_dots"] = json!(false);
     }
+    if engine.starts_with("exact_kienzle") {
+        // Torque and power for the three flute counts; a 10× coarser step keeps a run short.
+        body["kienzle"] = json!({"kc11": 1800, "mc": 0.25});
+        body["axial_depth"] = json!(2);
+        body["step"] = json!(STEP * 10.0);
+    }
     serde_json::from_value(body).unwrap()
 }
 
 fn bench(c: &mut Criterion) {
-    let tool = Tool::new(ToolKind::Flat, 5.0);
     let mut group = c.benchmark_group("engagement_1m_at_0.01mm");
     group.sample_size(10);
-    for engine in ["exact", "dots"] {
+    for engine in ["exact", "dots", "exact_kienzle", "exact_kienzle_helix"] {
+        let mut tool = Tool::new(ToolKind::Flat, 5.0);
+        if engine == "exact_kienzle_helix" {
+            tool.helix_deg = Some(30.0);
+        }
         let request = request(engine);
         let answer = engagement::solve(&request, &tool).unwrap();
         let EngagementAnswer::Single(result) = &answer else { unreachable!() };

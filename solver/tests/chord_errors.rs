@@ -253,6 +253,8 @@ fn machine_values_are_defaults_the_request_overrides() {
         margin: Some(1.1),
         min_chord_error: Some(0.001),
         description: None,
+        spindle_power_kw: None,
+        spindle_torque_nm: None,
     };
     let request = parse(json!({"curve": circle(), "machine": "hsc"}));
     let answer = chord::solve(&request, Some(&machine)).unwrap();

@@ -187,6 +187,8 @@ fn machine_values_and_bad_block_times() {
         margin: Some(1.2),
         min_chord_error: Some(0.002),
         description: None,
+        spindle_power_kw: None,
+        spindle_torque_nm: None,
     };
     let tool = ball(3.0);
     // The machine's block time applies at the request's feed (deburr keeps its own feed).

@@ -96,6 +96,7 @@ fn request(
         correction: None,
         history: None,
         pass_range: None,
+        exclusion_deg: None,
     }
 }
 

@@ -39,9 +39,24 @@ pub struct MachineProfile {
     /// compensation), date (at most 200 characters).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub description: Option<String>,
+    /// Rated spindle power, kW (> 0): engagement with Kienzle values warns where the cut needs
+    /// more and its feed plan caps the feed to stay within it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spindle_power_kw: Option<f64>,
+    /// Rated spindle torque, N·m (> 0), used like `spindle_power_kw`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spindle_torque_nm: Option<f64>,
 }
 
 impl MachineProfile {
+    /// The spindle's rated power and torque, as engagement checks a cut against them.
+    pub fn spindle(&self) -> crate::engagement::SpindleLimits {
+        crate::engagement::SpindleLimits {
+            spindle_power_kw: self.spindle_power_kw,
+            spindle_torque_nm: self.spindle_torque_nm,
+        }
+    }
+
     /// Checks every value, naming the field as written in the machine's JSON.
     ///
     /// # Errors
@@ -53,6 +68,7 @@ impl MachineProfile {
         }
         positive("block_time_ms", self.block_time_ms)?;
         positive("max_feed", self.max_feed)?;
+        self.spindle().validate()?;
         if let Some(margin) = self.margin
             && positive("margin", margin)? < 1.0
         {

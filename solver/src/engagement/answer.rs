@@ -85,6 +85,21 @@ pub struct EngagementSample {
     pub thickness: Vec<f64>,
     /// n_k, the most teeth strictly inside the arcs at once, per flute count.
     pub teeth: Vec<u32>,
+    /// Spindle torque averaged over the tooth phase, N·m, per flute count in the order of
+    /// `flutes` (with `kienzle` or `material`): R·Σ k_c1.1·a_p·h^(1−m_c); the load the
+    /// machine's `spindle_torque_nm` is compared with.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub torque_nm: Vec<f64>,
+    /// Largest spindle torque over the tooth phase, N·m, per flute count (with `kienzle`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub peak_torque_nm: Vec<f64>,
+    /// Spindle power 2πN·`torque_nm`/60, kW, per flute count (with `kienzle`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub power_kw: Vec<f64>,
+    /// Largest resultant cutting force on the tool over the tooth phase (tangential and radial
+    /// parts of every tooth in the cut, summed as vectors), N, per flute count (with `kienzle`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub peak_force_n: Vec<f64>,
     /// Material removal rate a_p·a_e·V_f at the nominal feed, mm³/min (with `axial_depth`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mrr: Option<f64>,
@@ -127,6 +142,26 @@ pub struct FluteResult {
     /// Path intervals `[[s_from, s_to], ...]` (sample positions) where two or more teeth cut at
     /// once.
     pub multi_tooth_intervals: Vec<[f64; 2]>,
+    /// Spindle torque averaged over the tooth phase and the engaged samples (length-weighted),
+    /// N·m (with `kienzle` or `material`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mean_torque_nm: Option<f64>,
+    /// Largest torque over the tooth phase and the path, N·m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_torque_nm: Option<f64>,
+    /// 2πN·`mean_torque_nm`/60, kW.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mean_power_kw: Option<f64>,
+    /// 2πN·`peak_torque_nm`/60, kW.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_power_kw: Option<f64>,
+    /// Largest resultant cutting force on the tool over the tooth phase and the path, N.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_force_n: Option<f64>,
+    /// Tooth-passing frequency N·k/60, Hz (with `kienzle` or `material`); `W_TOOTH_PASSING`
+    /// when it lies within 5 % of a natural frequency of the tool's `stiffness`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tooth_passing_hz: Option<f64>,
 }
 
 /// Why a feed block has its feed.
@@ -138,6 +173,10 @@ pub enum FeedLimit {
     Thickness,
     /// The machine's maximum feed.
     Machine,
+    /// The spindle's rated power (with `kienzle` and a machine's `spindle_power_kw`).
+    Power,
+    /// The spindle's rated torque.
+    Torque,
 }
 
 /// A stretch of the path programmed with one feed.
@@ -178,6 +217,32 @@ pub struct FeedPlan {
     pub nominal_time_s: f64,
     /// Lowest and highest block feed, mm/min.
     pub feed_range: [f64; 2],
+}
+
+/// The cutting-force model of an answer (engagement.md §11 items 4, 5, 9).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct ForceInfo {
+    /// k_c1.1 used, N/mm².
+    pub kc11: f64,
+    /// m_c used.
+    pub mc: f64,
+    /// a_p, mm: the chip width of every tooth.
+    pub axial_depth: f64,
+    /// F_r/F_t used.
+    pub radial_ratio: f64,
+    /// Helix lag 2a_p·tan λ/D over which each tooth's cut is spread, degrees (0 without the
+    /// tool's `helix_deg`).
+    pub helix_lag_deg: f64,
+    /// The machine's rated power the path is checked against, kW.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spindle_power_kw: Option<f64>,
+    /// The machine's rated torque the path is checked against, N·m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spindle_torque_nm: Option<f64>,
+    /// The tool's natural frequencies the tooth-passing frequencies are checked against, Hz.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub natural_frequencies_hz: Vec<f64>,
 }
 
 /// The dot grid of the `dots` engine.
@@ -237,6 +302,10 @@ pub struct PathEngagement {
     /// plot of the seed's contact graph.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contact_dots: Option<Vec<[f64; 2]>>,
+    /// The force model and limits behind the torque and power fields (with `kienzle` or
+    /// `material`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub forces: Option<ForceInfo>,
     /// Feeds holding the target chip thickness, when asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub feed_plan: Option<FeedPlan>,

@@ -55,7 +55,13 @@ impl Capability for EngagementCapability {
         context: Resolved<Tool>,
         _run: &Run<'_>,
     ) -> Result<EngagementResponse, SolverError> {
-        let result = super::solve_with(request, &context.tool, context.machine.as_ref())?;
+        // A stored material is not resolved yet (no material library): the solver names
+        // `material` when a request gives one instead of `kienzle`.
+        let physics = super::Physics {
+            material: None,
+            spindle: context.machine.as_ref().map(MachineProfile::spindle).unwrap_or_default(),
+        };
+        let result = super::solve_in(request, &context.tool, context.machine.as_ref(), &physics)?;
         Ok(EngagementResponse {
             tool: context.tool,
             machine: context.machine,

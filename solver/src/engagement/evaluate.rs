@@ -2,10 +2,14 @@
 //! per-sample quantities and flags (engagement.md §5.4, §5.5, §5.10), the diagnostics of §9, and
 //! the per-flute results, recommendation and feed plan.
 
-use super::answer::{ArcDetail, EngagementSample, GridInfo, PathEngagement, PostData, RouteData, SampleFlag};
+use super::answer::{
+    ArcDetail, EngagementSample, ForceInfo, GridInfo, PathEngagement, PostData, RouteData, SampleFlag,
+};
+use super::arcfeed::ArcFeed;
 use super::arcs::{self, Arc};
 use super::dots::{Contacts, DotGrid};
 use super::exact::ExactEngine;
+use super::force::{SampleTorque, power_kw};
 use super::request::{CandidateJob, Engine, Job, grid_extent};
 use super::segments::{Route, Station};
 use super::stock::{Base, Region};
@@ -235,6 +239,21 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
             collisions.push(station.s);
         }
         let sums: Vec<_> = job.flute_counts.iter().map(|&k| tooth_sum(arcs, k)).collect();
+        let edge_feed = if job.arc_feed { ArcFeed::at(route, station, radius) } else { None };
+        let (torques, forces): (Vec<SampleTorque>, Vec<f64>) =
+            job.force.as_ref().map_or_else(Default::default, |model| {
+                let integral = model.engaged_integral(arcs, edge_feed.as_ref());
+                job.flute_counts
+                    .iter()
+                    .map(|&k| {
+                        let fz = job.feed_mode.feed_per_tooth(k, job.spindle_rpm);
+                        (
+                            model.torque(arcs, edge_feed.as_ref(), integral, k, radius, fz),
+                            model.peak_force(arcs, k, fz, edge_feed.as_ref()),
+                        )
+                    })
+                    .unzip()
+            });
         statistic.push(index > 0 && !rapid && !arcs.is_empty() && !contact.plunge);
         samples.push(EngagementSample {
             s: station.s,
@@ -246,14 +265,23 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
             engaged_deg: arcs::engaged_deg(arcs),
             radial_depth,
             arc_details: details,
-            mean_chip_thickness: nominal_fz * arcs::mean_thickness_ratio(arcs),
+            mean_chip_thickness: nominal_fz
+                * edge_feed.as_ref().map_or_else(|| arcs::mean_thickness_ratio(arcs), |feed| feed.mean_ratio(arcs)),
             thickness: job
                 .flute_counts
                 .iter()
                 .zip(&sums)
-                .map(|(&k, sum)| job.feed_mode.feed_per_tooth(k, job.spindle_rpm) * sum.ratio)
+                .map(|(&k, sum)| {
+                    // H_k/f_z: the exact sinusoid of §5.6, or with the arc-feed factor numeric.
+                    let ratio = edge_feed.as_ref().map_or(sum.ratio, |feed| feed.tooth_sum(arcs, k));
+                    job.feed_mode.feed_per_tooth(k, job.spindle_rpm) * ratio
+                })
                 .collect(),
             teeth: sums.iter().map(|sum| sum.teeth).collect(),
+            torque_nm: torques.iter().map(|t| t.mean).collect(),
+            peak_torque_nm: torques.iter().map(|t| t.peak).collect(),
+            power_kw: torques.iter().map(|t| power_kw(t.mean, job.spindle_rpm)).collect(),
+            peak_force_n: forces,
             mrr: job.axial_depth.map(|depth| depth * radial_depth * nominal_feed),
             flags,
         });
@@ -392,6 +420,16 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
         }
     }
 
+    if let (Some(model), ToolKind::Ball | ToolKind::Bull) = (&job.force, tool.kind) {
+        warnings.push(Warning::new(
+            "W_FORCE_MODEL",
+            format!(
+                "the forces take every tooth as a straight edge cutting a chip {} mm wide (a_p): the rounded end of a {} tool cuts less near its tip, so torque, power and force are upper bounds",
+                model.axial_depth,
+                tool.kind.as_str()
+            ),
+        ));
+    }
     let (flute_results, recommended, flute_warnings) = flutes::results(job, &samples, &statistic, route.feed_length);
     warnings.extend(flute_warnings);
     let feed_plan = job.plan.as_ref().map(|plan| feed::plan(job, plan, route, &stations, &contacts));
@@ -454,6 +492,16 @@ pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Resu
         max_engaged_at_s,
         max_radial_depth,
         contact_dots,
+        forces: job.force.as_ref().map(|model| ForceInfo {
+            kc11: model.kc11,
+            mc: model.mc,
+            radial_ratio: model.radial_ratio,
+            axial_depth: model.axial_depth,
+            helix_lag_deg: model.lag_deg,
+            spindle_power_kw: job.spindle.spindle_power_kw,
+            spindle_torque_nm: job.spindle.spindle_torque_nm,
+            natural_frequencies_hz: job.natural.iter().map(|(f, _)| *f).collect(),
+        }),
         feed_plan,
         blocks: None,
         warnings,

@@ -4,24 +4,39 @@
 //! At every sample the feed per tooth that makes the thickest chip equal to h* is
 //! f_z' = h*/max sin θ (basis `tooth`) or h*_Σ/(H_k/f_z) (basis `sum`); the feed of the stretch
 //! between two samples is the lower of its two ends, and a block keeps the lowest feed of its
-//! stretches, so the chip never exceeds the target at any sample.
+//! stretches, so the chip never exceeds the target at any sample. With a force model and the
+//! machine's spindle limits the feed is also capped where the phase-mean spindle power or
+//! torque would exceed them (engagement.md §11 item 4).
 
 use super::answer::{FeedBlock, FeedLimit, FeedPlan};
+use super::arcfeed::ArcFeed;
 use super::arcs::peak_thickness_ratio;
 use super::evaluate::Contact;
 use super::request::{FeedBasis, Job, PlanJob};
 use super::segments::{Route, Station};
 use super::teeth::tooth_sum;
 
-/// Feed needed at one sample, mm/min, and whether the machine cap set it.
-fn needed(job: &Job, plan: &PlanJob, contact: &Contact) -> (f64, bool) {
-    let ratio = match plan.basis {
-        FeedBasis::Tooth => peak_thickness_ratio(&contact.arcs),
-        FeedBasis::Sum => tooth_sum(&contact.arcs, plan.flute_count).ratio,
+/// Feed needed at one sample, mm/min, and what set it.
+fn needed(job: &Job, plan: &PlanJob, contact: &Contact, edge_feed: Option<&ArcFeed>) -> (f64, FeedLimit) {
+    let ratio = match (plan.basis, edge_feed) {
+        (FeedBasis::Tooth, None) => peak_thickness_ratio(&contact.arcs),
+        (FeedBasis::Sum, None) => tooth_sum(&contact.arcs, plan.flute_count).ratio,
+        (FeedBasis::Tooth, Some(feed)) => feed.peak_ratio(&contact.arcs),
+        (FeedBasis::Sum, Some(feed)) => feed.tooth_sum(&contact.arcs, plan.flute_count),
     };
     let per_tooth = if ratio > 1e-12 { plan.target / ratio } else { f64::INFINITY };
-    let feed = f64::from(plan.flute_count) * job.spindle_rpm * per_tooth;
-    if feed >= plan.max_feed { (plan.max_feed, true) } else { (feed, false) }
+    let to_feed = |fz: f64| f64::from(plan.flute_count) * job.spindle_rpm * fz;
+    let mut best = (to_feed(per_tooth), FeedLimit::Thickness);
+    // The spindle: the phase-mean torque grows as f_z^(1−m_c), so the feed per tooth that
+    // meets the cap is closed.
+    if let (Some(model), Some((torque, by_power))) = (&job.force, job.spindle.torque_cap(job.spindle_rpm)) {
+        let integral = model.engaged_integral(&contact.arcs, edge_feed);
+        let feed = to_feed(model.feed_for_torque(torque, integral, plan.flute_count, job.radius));
+        if feed < best.0 {
+            best = (feed, if by_power { FeedLimit::Power } else { FeedLimit::Torque });
+        }
+    }
+    if best.0 >= plan.max_feed { (plan.max_feed, FeedLimit::Machine) } else { best }
 }
 
 /// A stretch between consecutive samples.
@@ -30,8 +45,8 @@ struct Stretch {
     piece: usize,
     from_s: f64,
     to_s: f64,
-    /// Feed and cap flag; `None` on a rapid.
-    feed: Option<(f64, bool)>,
+    /// Feed and what set it; `None` on a rapid.
+    feed: Option<(f64, FeedLimit)>,
 }
 
 /// Rounds a feed down to whole mm/min (never below 1).
@@ -41,12 +56,13 @@ fn whole(feed: f64) -> f64 {
 
 /// The feed plan for one path.
 pub(crate) fn plan(job: &Job, plan: &PlanJob, route: &Route, stations: &[Station], contacts: &[Contact]) -> FeedPlan {
-    let feeds: Vec<Option<(f64, bool)>> = stations
+    let feeds: Vec<Option<(f64, FeedLimit)>> = stations
         .iter()
         .zip(contacts)
         .map(|(station, contact)| {
             let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
-            (!rapid).then(|| needed(job, plan, contact))
+            let edge_feed = if job.arc_feed { ArcFeed::at(route, station, job.radius) } else { None };
+            (!rapid).then(|| needed(job, plan, contact, edge_feed.as_ref()))
         })
         .collect();
     let mut stretches = Vec::new();
@@ -124,11 +140,7 @@ pub(crate) fn plan(job: &Job, plan: &PlanJob, route: &Route, stations: &[Station
                 from_s: block.from_s,
                 to_s: block.to_s,
                 feed,
-                limited_by: block.feed.map(
-                    |(_, capped)| {
-                        if capped { FeedLimit::Machine } else { FeedLimit::Thickness }
-                    },
-                ),
+                limited_by: block.feed.map(|(_, limit)| limit),
             }
         })
         .collect();

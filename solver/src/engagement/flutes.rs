@@ -3,6 +3,8 @@
 
 use super::answer::{EngagementSample, FluteResult};
 use super::evaluate::runs;
+use super::force::power_kw;
+use super::limits::{RESONANCE_BAND, resonance, tooth_passing_hz};
 use super::request::{FeedMode, Job, Representative};
 use crate::error::Warning;
 
@@ -99,6 +101,20 @@ pub(crate) fn results(
                 format!("k = {k}: the feed per tooth {feed_per_tooth:.6} mm is below {minimum} mm (rubbing)"),
             ));
         }
+        let forces = force_statistics(job, samples, statistic, &weights, column);
+        warnings.extend(limit_warnings(job, samples, statistic, column, k));
+        // With the force model only, so that answers without it stay as they were.
+        let tooth_passing_hz = job.force.is_some().then(|| tooth_passing_hz(job.spindle_rpm, k));
+        if let Some((natural, axis)) = tooth_passing_hz.and_then(|f| resonance(f, &job.natural)) {
+            warnings.push(Warning::new(
+                "W_TOOTH_PASSING",
+                format!(
+                    "k = {k}: the tooth-passing frequency {:.1} Hz (N·k/60) lies within {:.0} % of the tool's natural frequency {natural} Hz ({axis}): forced vibration; change the spindle speed",
+                    tooth_passing_hz.unwrap_or(0.0),
+                    RESONANCE_BAND * 100.0
+                ),
+            ));
+        }
         let max_teeth = samples
             .iter()
             .zip(statistic)
@@ -120,6 +136,12 @@ pub(crate) fn results(
             time_margin_s,
             max_teeth,
             multi_tooth_intervals,
+            mean_torque_nm: forces.map(|f| f.0),
+            peak_torque_nm: forces.map(|f| f.1),
+            mean_power_kw: forces.map(|f| power_kw(f.0, job.spindle_rpm)),
+            peak_power_kw: forces.map(|f| power_kw(f.1, job.spindle_rpm)),
+            peak_force_n: forces.map(|f| f.2),
+            tooth_passing_hz,
         });
     }
     let mut recommended: Vec<(f64, u32)> =
@@ -147,6 +169,60 @@ pub(crate) fn results(
         ));
     }
     (results, recommended.into_iter().map(|(_, k)| k).collect(), warnings)
+}
+
+/// Length-weighted mean of the phase-mean torque and the largest phase peak over the engaged
+/// samples, N·m, and the largest resultant force, N, for one flute column (with a force model).
+fn force_statistics(
+    job: &Job,
+    samples: &[EngagementSample],
+    statistic: &[bool],
+    weights: &[f64],
+    column: usize,
+) -> Option<(f64, f64, f64)> {
+    job.force.as_ref()?;
+    let engaged = || samples.iter().zip(statistic).filter(|(_, s)| **s).map(|(sample, _)| sample);
+    let means: Vec<f64> = engaged().map(|s| s.torque_nm.get(column).copied().unwrap_or(0.0)).collect();
+    let (_, _, mean, _) = statistics(&means, weights);
+    let peak = engaged().filter_map(|s| s.peak_torque_nm.get(column).copied()).fold(0.0, f64::max);
+    let force = engaged().filter_map(|s| s.peak_force_n.get(column).copied()).fold(0.0, f64::max);
+    Some((mean, peak, force))
+}
+
+/// `W_SPINDLE_POWER` and `W_SPINDLE_TORQUE` for one flute column: where the phase-mean power or
+/// torque of an engaged sample exceeds the machine's rating.
+fn limit_warnings(job: &Job, samples: &[EngagementSample], statistic: &[bool], column: usize, k: u32) -> Vec<Warning> {
+    let mut warnings = Vec::new();
+    if job.force.is_none() {
+        return warnings;
+    }
+    let series = |pick: fn(&EngagementSample) -> &[f64]| -> Vec<f64> {
+        samples.iter().map(|s| pick(s).get(column).copied().unwrap_or(0.0)).collect()
+    };
+    let power = series(|s| &s.power_kw);
+    let torque = series(|s| &s.torque_nm);
+    let checks = [
+        ("W_SPINDLE_POWER", "power", "kW", job.spindle.spindle_power_kw, &power),
+        ("W_SPINDLE_TORQUE", "torque", "N·m", job.spindle.spindle_torque_nm, &torque),
+    ];
+    for (code, what, unit, limit, values) in checks {
+        let Some(limit) = limit else { continue };
+        let over = |i: usize| statistic.get(i).copied().unwrap_or(false) && values[i] > limit * (1.0 + LIMIT_SLACK);
+        let intervals = runs(samples, over);
+        if intervals.is_empty() {
+            continue;
+        }
+        let highest = (0..values.len()).filter(|&i| over(i)).map(|i| values[i]).fold(0.0, f64::max);
+        warnings.push(Warning::new(
+            code,
+            format!(
+                "k = {k}: the spindle {what} reaches {highest:.3} {unit}, above the machine's {limit} {unit}, over {} interval(s), first at s = {:.3} (a feed_plan caps the feed there)",
+                intervals.len(),
+                intervals.first().map_or(0.0, |i| i[0])
+            ),
+        ));
+    }
+    warnings
 }
 
 #[cfg(test)]

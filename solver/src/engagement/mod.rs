@@ -19,21 +19,36 @@
 //! * `arcs`: arc merging, a_e and the per-arc quantities (§5.4, §5.5, §5.10);
 //! * `teeth`: H_k and n_k with the exact phase maximisation (§5.6);
 //! * `flutes`: representative values, time, recommendation (§5.7–§5.9);
-//! * `feed`: chip-thinning feed plan (§11 item 3);
+//! * `feed`: chip-thinning feed plan (§11 item 3), capped by the spindle's power and torque;
+//! * `kienzle`, `force`: Kienzle's law, spindle torque and power with the helix lag (§11 items
+//!   4, 5);
+//! * `arcfeed`: the arc-feed correction of the chip thickness on curved paths (§11 item 6);
+//! * `phase`: the phase maximum of a general per-tooth load;
+//! * `limits`: the spindle's ratings and the tooth-passing frequency against the tool's natural
+//!   frequencies (§11 items 4, 9);
 //! * [`program()`]: G-code with the planned F words.
 //!
 //! Choices where the spec is open (§13): `cw` rotation by default; constant f_z when
 //! `feed_per_tooth` is given, constant V_f when `feed` is; statistics over the engaged samples
 //! (m ≥ 1, not a plunge, not a rapid), the mean weighted by sample spacing; machining time over
-//! feed moves only; θ in degrees; 2-D only (no axial depth or helix in the contact model). A
+//! feed moves only; θ in degrees; the contact model is 2-D (the axial depth and the helix enter
+//! only the forces). A
 //! path that never touches the stock is not an error: the answer is all zeros with
 //! `W_NO_CONTACT` (§9). The exact engine splits the circle at its exact boundary crossings
 //! instead of stepping θ, so it has no angle step and its arc ends are exact.
+//!
+//! Cutting physics (§11 items 4–6, 9; only with `kienzle` or `material`, so answers without
+//! them are unchanged): every tooth cuts a chip a_p wide with a straight edge (ball and bull
+//! ends are not modelled: `W_FORCE_MODEL`); the spindle limits are compared with the torque
+//! averaged over the tooth phase, the load the drive carries (its rotor's inertia smooths the
+//! tooth-by-tooth peaks), while the peaks over the phase are reported for the tool; the
+//! tooth-passing frequency is compared with the fundamental only.
 //!
 //! A path may also be G-code text (`{"gcode": "..."}`), read by the shared
 //! [`crate::gcode::reader`]: its XY moves, lines and arcs, from the first known position on.
 
 mod answer;
+mod arcfeed;
 mod arcs;
 mod bbox_tree;
 mod capability;
@@ -42,7 +57,11 @@ mod evaluate;
 mod exact;
 mod feed;
 mod flutes;
+mod force;
+mod kienzle;
+mod limits;
 mod outline;
+mod phase;
 pub mod program;
 pub mod request;
 mod segments;
@@ -51,14 +70,16 @@ mod teeth;
 
 pub use crate::geometry::Direction;
 pub use answer::{
-    ArcDetail, Comparison, EngagementAnswer, EngagementSample, FeedBlock, FeedLimit, FeedPlan, FluteResult, GridInfo,
-    PathEngagement, SampleFlag,
+    ArcDetail, Comparison, EngagementAnswer, EngagementSample, FeedBlock, FeedLimit, FeedPlan, FluteResult, ForceInfo,
+    GridInfo, PathEngagement, SampleFlag,
 };
 pub use arcs::{MillingMode, SpindleDirection};
 pub use capability::{EngagementCapability, EngagementResponse};
+pub use kienzle::{DEFAULT_RADIAL_RATIO, Kienzle};
+pub use limits::{RESONANCE_BAND, SpindleLimits};
 pub use program::program;
 pub use request::{
-    Candidate, EngagementRequest, Engine, FeedBasis, FeedPlanRequest, PathInput, PathSegments, PreviousCut,
+    Candidate, EngagementRequest, Engine, FeedBasis, FeedPlanRequest, PathInput, PathSegments, Physics, PreviousCut,
     Representative, SegmentInput, Stock, StockBitmap, StockPolygon,
 };
 
@@ -119,7 +140,24 @@ pub fn solve_with(
     tool: &Tool,
     machine: Option<&MachineProfile>,
 ) -> Result<EngagementAnswer, SolverError> {
-    let job = request.validate(tool, machine)?;
+    solve_in(request, tool, machine, &Physics::default())
+}
+
+/// [`solve_with`] with what the server resolved for the cutting physics: the Kienzle values of
+/// the request's `material` and the machine's spindle limits (engagement.md §11 item 4). The
+/// limits are checked only when the request gives `kienzle` or `material`.
+///
+/// # Errors
+/// As [`solve_with`]; `E_INPUT` at `material` when the request names a material and
+/// `physics.material` is absent, at `axial_depth` when forces are asked for without it, and for
+/// bad Kienzle values or limits.
+pub fn solve_in(
+    request: &EngagementRequest,
+    tool: &Tool,
+    machine: Option<&MachineProfile>,
+    physics: &Physics,
+) -> Result<EngagementAnswer, SolverError> {
+    let job = request.validate(tool, machine, physics)?;
     let mut results = Vec::with_capacity(job.candidates.len());
     for candidate in &job.candidates {
         let mut result = evaluate::evaluate(&job, candidate, tool)?;

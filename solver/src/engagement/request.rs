@@ -9,6 +9,9 @@ use serde::{Deserialize, Deserializer, Serialize};
 
 use super::arcs::SpindleDirection;
 use super::bbox_tree::BBox;
+use super::force::ForceModel;
+use super::kienzle::{DEFAULT_RADIAL_RATIO, Kienzle, SinPower};
+use super::limits::{SpindleLimits, natural_frequencies};
 use super::outline::Outline;
 use super::segments::{Route, Shape};
 use super::stock::{Base, Bitmap, Cut, Region, decode_base64};
@@ -268,7 +271,8 @@ pub struct FeedPlanRequest {
 #[serde(deny_unknown_fields)]
 pub struct EngagementRequest {
     /// A registered tool number or an inline tool; only its radius (the apparent rotation
-    /// circle) and `flutes` enter the 2-D model.
+    /// circle) and `flutes` enter the 2-D model, and with `kienzle` its `helix_deg` (the helix
+    /// lag) and the natural frequencies of its `stiffness` (the tooth-passing check).
     pub tool: ToolRef,
     /// The plan-view material.
     pub stock: Stock,
@@ -335,8 +339,8 @@ pub struct EngagementRequest {
     /// Report `W_TINY_FZ` for flute counts whose feed per tooth falls below this, mm (optional).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_feed_per_tooth: Option<f64>,
-    /// a_p, the axial depth of cut, mm: gives the removal rate (MRR) and the cutting Z of the
-    /// G-code program (stock top − a_p).
+    /// a_p, the axial depth of cut, mm: gives the removal rate (MRR), the cutting Z of the
+    /// G-code program (stock top − a_p) and, with `kienzle`, the chip width of every tooth.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axial_depth: Option<f64>,
     /// Z of the stock top for the G-code program, mm (default 0).
@@ -359,13 +363,28 @@ pub struct EngagementRequest {
     pub block_time_ms: Option<f64>,
     /// A stored machine profile, resolved by the server: its `max_feed` fills an absent
     /// `feed_plan.max_feed` (a larger one is kept with `W_FEED_ABOVE_MACHINE_MAX`), its dialect
-    /// is the G-code default.
+    /// is the G-code default, its spindle power and torque are the limits the cut is checked
+    /// against (with `kienzle` or `material`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub machine: Option<String>,
     /// Which entry of `paths` the G-code program follows (0-based, default 0; a request with
     /// `path` has only 0). The endpoint's `?candidate=` overrides it; a job's program uses it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub candidate: Option<usize>,
+    /// Correct the chip thickness on arcs of the path for the feed at the cutting edge,
+    /// f_z·ρ/r_path with ρ the edge's distance from the arc's centre ((r_path ± R)/r_path at the
+    /// sides; engagement.md §11 item 6): thickness, mean chip, feed plan and forces (default
+    /// false: the seed's h = f_z·sin θ everywhere).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub arc_feed_correction: bool,
+    /// Kienzle values of the work material: with `axial_depth` the answer gives the spindle
+    /// torque and power along the path (engagement.md §11 item 4). Give this or `material`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kienzle: Option<Kienzle>,
+    /// A stored work material whose Kienzle values the server resolves (give this or
+    /// `kienzle`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<String>,
 }
 
 fn yes() -> bool {
@@ -427,6 +446,14 @@ pub(crate) struct Job {
     pub plan: Option<PlanJob>,
     /// The block-time rule of the program, at the nominal feed of the tool's flute count.
     pub rule: Option<BlockRule>,
+    /// Kienzle's force model, with `kienzle` (or `material`) and `axial_depth`.
+    pub force: Option<ForceModel>,
+    /// Apply the arc-feed correction on arcs of the path.
+    pub arc_feed: bool,
+    /// The machine's spindle limits (checked only with a force model).
+    pub spindle: SpindleLimits,
+    /// The tool's natural frequencies, Hz, and their directions.
+    pub natural: Vec<(f64, &'static str)>,
     pub contact_dots: bool,
     pub region: Region,
     /// Warnings of the stock and the machine, for every candidate.
@@ -794,7 +821,12 @@ fn read_stock(stock: &Stock, radius: f64, warnings: &mut Vec<Warning>) -> Result
 impl EngagementRequest {
     /// Validates the request against `tool` (already resolved from `self.tool`).
     /// Checks every field, with `machine` resolved from `self.machine`.
-    pub(crate) fn validate(&self, tool: &Tool, machine: Option<&MachineProfile>) -> Result<Job, SolverError> {
+    pub(crate) fn validate(
+        &self,
+        tool: &Tool,
+        machine: Option<&MachineProfile>,
+        physics: &Physics,
+    ) -> Result<Job, SolverError> {
         tool.validate("tool.")?;
         let radius = bounded("tool.radius", tool.radius, MAX_COORDINATE)?;
         let spindle_rpm = bounded("spindle_rpm", self.spindle_rpm, 1e6)?;
@@ -879,6 +911,7 @@ impl EngagementRequest {
         let spike_threshold = optional("spike_threshold_deg", self.spike_threshold_deg, positive)?;
         let min_feed_per_tooth = optional("min_feed_per_tooth", self.min_feed_per_tooth, positive)?;
         let axial_depth = self.axial_depth.map(|d| bounded("axial_depth", d, MAX_COORDINATE)).transpose()?;
+        let (force, spindle) = self.force_model(tool, axial_depth, physics)?;
         let stock_top_z = finite("stock_top_z", self.stock_top_z.unwrap_or(0.0))?;
         if stock_top_z.abs() > MAX_COORDINATE {
             return Err(SolverError::input("stock_top_z", format!("stock_top_z must lie within ±{MAX_COORDINATE} mm")));
@@ -1041,6 +1074,10 @@ impl EngagementRequest {
             clearance,
             plan,
             rule,
+            force,
+            arc_feed: self.arc_feed_correction,
+            spindle,
+            natural: natural_frequencies(tool),
             contact_dots: self.contact_dots,
             region,
             shared_warnings,
@@ -1048,6 +1085,72 @@ impl EngagementRequest {
             single: self.path.is_some(),
         })
     }
+}
+
+impl EngagementRequest {
+    /// Kienzle's model from `kienzle` or the resolved `material`, and the spindle limits.
+    fn force_model(
+        &self,
+        tool: &Tool,
+        axial_depth: Option<f64>,
+        physics: &Physics,
+    ) -> Result<(Option<ForceModel>, SpindleLimits), SolverError> {
+        physics.spindle.validate()?;
+        let kienzle = match (&self.kienzle, &self.material) {
+            (Some(_), Some(_)) => {
+                return Err(SolverError::input("material", "give material or kienzle, not both"));
+            }
+            (Some(values), None) => {
+                values.validate("kienzle.")?;
+                Some(*values)
+            }
+            (None, Some(name)) => {
+                let values = physics.material.ok_or_else(|| {
+                    SolverError::input(
+                        "material",
+                        format!("material {name:?} is not known here: give its Kienzle values as `kienzle` (kc11, mc)"),
+                    )
+                })?;
+                values.validate("material.")?;
+                Some(values)
+            }
+            (None, None) => None,
+        };
+        let Some(kienzle) = kienzle else {
+            return Ok((None, physics.spindle));
+        };
+        let axial_depth = axial_depth.ok_or_else(|| {
+            SolverError::input(
+                "axial_depth",
+                "axial_depth (mm) is required with kienzle or material: a_p is the chip width",
+            )
+        })?;
+        // Λ = 2·a_p·tan λ / D (engagement.md §11 item 5), radians.
+        let lag = tool.helix_deg.map_or(0.0, |helix| axial_depth * helix.to_radians().tan() / tool.radius);
+        Ok((
+            Some(ForceModel {
+                kc11: kienzle.kc11,
+                mc: kienzle.mc,
+                axial_depth,
+                lag_deg: lag.to_degrees(),
+                direction: self.spindle_direction,
+                radial_ratio: kienzle.radial_ratio.unwrap_or(DEFAULT_RADIAL_RATIO),
+                table: SinPower::new(1.0 - kienzle.mc),
+                table_next: SinPower::new(2.0 - kienzle.mc),
+            }),
+            physics.spindle,
+        ))
+    }
+}
+
+/// What the server resolves for an engagement request besides the tool and the machine: the
+/// Kienzle values of the request's `material` and the spindle limits of its machine.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Physics {
+    /// Kienzle values of the stored material the request names.
+    pub material: Option<Kienzle>,
+    /// The machine profile's spindle power and torque.
+    pub spindle: SpindleLimits,
 }
 
 /// The dot grid of a candidate: the stock's box cut to where the tool can reach, in cells of

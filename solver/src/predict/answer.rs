@@ -22,6 +22,8 @@ pub enum PassStatus {
     OutsideStock,
     /// Outside the requested `pass_range`.
     NotPredicted,
+    /// Its finished surface lies only at contact angles up to `exclusion_deg` (claim 8, §3.4).
+    SkippedSmallAngle,
 }
 
 /// Remarks on a pass's prediction (§5).
@@ -168,6 +170,9 @@ pub struct PredictSummary {
     pub no_surface: usize,
     /// Passes with status `outside_stock`.
     pub outside_stock: usize,
+    /// Passes with status `skipped_small_angle` (with `exclusion_deg`; absent when none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub skipped_small_angle: Option<usize>,
     /// Smallest e, mm.
     pub min_error: Option<f64>,
     /// Largest e, mm.

@@ -19,6 +19,7 @@
 //!   (§3.8);
 //! * [`shape`]: the shape-error table (§3.13);
 //! * [`correct`]: the node correction rule (§3.14);
+//! * `exclusion`: the low-angle pass exclusion of claim 8 (§3.4), with `exclusion_deg`;
 //! * `pipeline`: the per-pass flow of §3.1 over all passes in parallel.
 //!
 //! Choices where the spec is open (documented for users):
@@ -43,6 +44,7 @@ mod capability;
 mod capsule;
 pub mod correct;
 pub mod dynamics;
+mod exclusion;
 mod force;
 mod passes;
 mod pipeline;
@@ -304,6 +306,7 @@ fn assemble(job: &Job, rounds: &[Vec<Outcome>], total: &[Vec3], clamped: &[bool]
         no_cut: count_status(PassStatus::NoCut),
         no_surface: count_status(PassStatus::NoSurface),
         outside_stock: count_status(PassStatus::OutsideStock),
+        skipped_small_angle: job.exclusion.map(|_| count_status(PassStatus::SkippedSmallAngle)),
         min_error: values.iter().copied().reduce(f64::min),
         max_error: values.iter().copied().reduce(f64::max),
         mean_error: (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64),

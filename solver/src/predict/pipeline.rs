@@ -11,6 +11,7 @@ use rayon::prelude::*;
 
 use super::answer::{PassFlag, PassHistory, PassStatus};
 use super::dynamics::{self, Compliance};
+use super::exclusion;
 use super::force::{self, EdgeGrid, Engagement};
 use super::passes::PathModel;
 use super::render::{self, Image, Window};
@@ -134,6 +135,14 @@ pub(crate) fn run_round(
     let cancelled = AtomicBool::new(false);
     let report_every = (total_work / 200).max(1);
     let range = context.job.pass_range.clone();
+    // Claim 8: θ_max per pass from one global view, only when a threshold is given.
+    let skipped: Vec<bool> = match context.job.exclusion {
+        Some(threshold) => exclusion::max_contact_angles(context.job, path)
+            .into_iter()
+            .map(|angle| angle.is_some_and(|a| a <= threshold))
+            .collect(),
+        None => Vec::new(),
+    };
     let predicted: Vec<Option<Outcome>> = range
         .clone()
         .into_par_iter()
@@ -142,7 +151,11 @@ pub(crate) fn run_round(
                 cancelled.store(true, Ordering::Relaxed);
                 return None;
             }
-            let outcome = predict_pass(context, path, index, scratch);
+            let outcome = if skipped.get(index).copied().unwrap_or(false) {
+                Outcome::empty(PassStatus::SkippedSmallAngle)
+            } else {
+                predict_pass(context, path, index, scratch)
+            };
             let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
             if let Some(progress) = control.progress
                 && (finished.is_multiple_of(report_every) || finished == total_work)

@@ -172,6 +172,11 @@ pub struct PredictRequest {
     /// status `not_predicted`. Lets a long job run in chunks.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pass_range: Option<[usize; 2]>,
+    /// θ_x: do not predict passes whose largest contact angle on the finished surface is at most
+    /// this, degrees (0–90; claim 8, error-prediction.md §3.4, where the patent uses 30–60):
+    /// they get status `skipped_small_angle`. Absent: every pass is predicted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exclusion_deg: Option<f64>,
 }
 
 /// Where each path node came from, for writing the corrected program.
@@ -212,6 +217,8 @@ pub(crate) struct Job {
     pub(crate) history: Vec<usize>,
     pub(crate) pass_range: std::ops::Range<usize>,
     pub(crate) spindle_speeds: Vec<f64>,
+    /// θ_x, degrees.
+    pub(crate) exclusion: Option<f64>,
 }
 
 fn optional_positive(field: &str, value: Option<f64>, default: f64) -> Result<f64, SolverError> {
@@ -376,6 +383,16 @@ impl PredictRequest {
                 ));
             }
         }
+        let exclusion = match self.exclusion_deg {
+            None => None,
+            Some(angle) if angle.is_finite() && (0.0..=90.0).contains(&angle) => Some(angle),
+            Some(angle) => {
+                return Err(SolverError::input(
+                    "exclusion_deg",
+                    format!("exclusion_deg must be 0 to 90 degrees (got {angle})"),
+                ));
+            }
+        };
         let pass_range = match self.pass_range {
             None => 0..path.passes.len(),
             Some([from, to]) => {
@@ -422,6 +439,7 @@ impl PredictRequest {
             iterations,
             history,
             pass_range,
+            exclusion,
             spindle_speeds,
         })
     }

@@ -117,6 +117,7 @@ pub fn raster_request(
         correction: None,
         history: None,
         pass_range: None,
+        exclusion_deg: None,
     };
     (request, tool, moves)
 }
@@ -146,6 +147,7 @@ pub fn bare_request(tool: &Tool, stock: Stock, path: PathInput) -> PredictReques
         correction: None,
         history: None,
         pass_range: None,
+        exclusion_deg: None,
     }
 }
 

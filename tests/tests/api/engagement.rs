@@ -926,3 +926,39 @@ async fn path_given_as_gcode_text() {
     assert_eq!(problem["errors"][0]["path"], "path.gcode");
     assert!(problem["detail"].as_str().unwrap().contains("line 3"), "{problem}");
 }
+
+// ---------------------------------------------------------------- cutting physics
+
+#[tokio::test(flavor = "multi_thread")]
+async fn kienzle_torque_and_power_against_the_machines_spindle() {
+    let app = TestApp::spawn().await;
+    let machine = json!({"block_time_ms": 4, "max_feed": 12000, "spindle_power_kw": 0.05, "spindle_torque_nm": 100});
+    json_with(app.put_json("/api/v1/machines/small-spindle", &machine).await, 201).await;
+    let request = json!({
+        "tool": {"kind": "flat", "radius": 5, "flutes": 4}, "spindle_rpm": 8000, "feed_per_tooth": 0.05,
+        "flute_counts": [2, 4], "axial_depth": 2, "kienzle": {"kc11": 1800, "mc": 0.25},
+        "machine": "small-spindle",
+        "stock": {"polygon": [[0, 0], [100, 0], [100, 80], [0, 80]]},
+        "path": [[-10, 40], [110, 40]]
+    });
+    let answer = json_with(app.post_json("/api/v1/engagement", &request).await, 200).await;
+    let flutes = answer["flutes"].as_array().unwrap();
+    for entry in flutes {
+        let torque = entry["mean_torque_nm"].as_f64().expect("mean torque");
+        let power = entry["mean_power_kw"].as_f64().expect("mean power");
+        assert!(torque > 0.0);
+        // P = 2πNM/60, in kW.
+        let expected = 2.0 * std::f64::consts::PI * 8000.0 * torque / 60.0 / 1000.0;
+        assert!((power - expected).abs() <= 1e-9 * expected.max(1.0), "{power} vs {expected}");
+    }
+    let codes: Vec<&str> = answer["warnings"].as_array().unwrap().iter().map(|w| w["code"].as_str().unwrap()).collect();
+    assert!(codes.contains(&"W_SPINDLE_POWER"), "the 0.05 kW spindle is exceeded: {codes:?}");
+    // Without the machine no limit applies; a bad limit on a machine is refused at its field.
+    let mut unlimited = request.clone();
+    unlimited.as_object_mut().unwrap().remove("machine");
+    let answer = json_with(app.post_json("/api/v1/engagement", &unlimited).await, 200).await;
+    assert!(!answer["warnings"].to_string().contains("W_SPINDLE_POWER"));
+    let bad = json!({"block_time_ms": 4, "max_feed": 12000, "spindle_power_kw": -1});
+    let problem = problem(app.put_json("/api/v1/machines/bad-spindle", &bad).await, 422).await;
+    assert_eq!(problem["errors"][0]["path"], "spindle_power_kw");
+}

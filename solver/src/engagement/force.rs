@@ -1,0 +1,387 @@
+//! Spindle torque and power along the path from Kienzle's law (engagement.md §11 items 4 and 5):
+//! per tooth F_t = k_c1.1·a_p·h^(1−m_c), torque M = R·ΣF_t, power P = 2πNM/60, with the helix
+//! lag 2a_p·tan λ/D spreading each tooth's cut over that angle.
+//!
+//! At one sample the torque depends on the tooth phase β. Its mean over β is closed:
+//! M̄ = R·k_c1.1·a_p·f_z^a·(k/2π)·∫_E max(0, sin θ)^a dθ (a = 1 − m_c; the helix does not change
+//! it, it only averages the torque over a window of β). Its peak over β is found numerically:
+//! between breakpoints (a tooth, or the top of its helical edge, on an arc end or at 0°/180°)
+//! the torque is smooth, and without a helix a sum of concave terms ([`phase::peak`]). On a
+//! curved path with the arc-feed correction (§11 item 6) the chip is f_z·c(θ)·sin θ, so the
+//! terms carry c(θ)^(1−m_c).
+
+use super::arcfeed::ArcFeed;
+use super::arcs::{Arc, SpindleDirection};
+use super::kienzle::SinPower;
+use super::phase;
+
+/// Tooth on an arc end counts as inside, degrees (closed arcs, as in `teeth`).
+const END_TOLERANCE: f64 = 1e-9;
+/// Longest piece of an arc over which the arc-feed factor is taken as constant, degrees: the
+/// factor is smooth, so the error is about (1°)²/24 of its curvature, below 1e-5.
+const FACTOR_PIECE_DEG: f64 = 1.0;
+
+/// A validated force model for one request.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct ForceModel {
+    pub kc11: f64,
+    pub mc: f64,
+    /// a_p, mm.
+    pub axial_depth: f64,
+    /// Λ = 2a_p·tan λ/D, degrees (0 without a helix).
+    pub lag_deg: f64,
+    pub direction: SpindleDirection,
+    /// F_r/F_t.
+    pub radial_ratio: f64,
+    /// ∫ sin^a.
+    pub table: SinPower,
+    /// ∫ sin^(a+1), for the force's components (sin^a·sin θ).
+    pub table_next: SinPower,
+}
+
+/// Torque at one sample for one flute count, N·m.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SampleTorque {
+    /// Mean over the tooth phase.
+    pub mean: f64,
+    /// Largest over the tooth phase.
+    pub peak: f64,
+}
+
+impl ForceModel {
+    /// ∫ over [from, to] (degrees) of (c(θ)·max(0, sin θ))^a dθ, θ in radians.
+    fn between(&self, from: f64, to: f64, feed: Option<&ArcFeed>) -> f64 {
+        let Some(feed) = feed else {
+            return self.table.between(from.to_radians(), to.to_radians());
+        };
+        let pieces = ((to - from) / FACTOR_PIECE_DEG).ceil().max(1.0);
+        let width = (to - from) / pieces;
+        (0..pieces as usize)
+            .map(|i| {
+                let low = from + width * i as f64;
+                let factor = feed.factor(low + 0.5 * width).powf(self.table.exponent());
+                factor * self.table.between(low.to_radians(), (low + width).to_radians())
+            })
+            .sum()
+    }
+
+    /// ∫ over the arcs of (c(θ)·max(0, sin θ))^a dθ (θ in radians): the phase-mean term.
+    pub(crate) fn engaged_integral(&self, arcs: &[Arc], feed: Option<&ArcFeed>) -> f64 {
+        arcs.iter().map(|arc| self.between(arc.from, arc.to, feed)).sum()
+    }
+
+    /// N·m of torque per unit of the sin^a term for a feed per tooth `fz` and tool radius `radius`:
+    /// R·k_c1.1·a_p·f_z^a / 1000.
+    fn scale(&self, radius: f64, fz: f64) -> f64 {
+        radius * self.kc11 * self.axial_depth * fz.powf(self.table.exponent()) / 1000.0
+    }
+
+    /// Mean torque over the tooth phase from the engaged integral, N·m.
+    pub(crate) fn mean_torque(&self, integral: f64, flutes: u32, radius: f64, fz: f64) -> f64 {
+        self.scale(radius, fz) * f64::from(flutes) * integral / std::f64::consts::TAU
+    }
+
+    /// Feed per tooth at which the phase-mean torque equals `torque` (N·m); infinite without
+    /// engagement.
+    pub(crate) fn feed_for_torque(&self, torque: f64, integral: f64, flutes: u32, radius: f64) -> f64 {
+        let unit = self.mean_torque(integral, flutes, radius, 1.0);
+        if unit <= 0.0 { f64::INFINITY } else { (torque / unit).powf(1.0 / self.table.exponent()) }
+    }
+
+    /// Mean and peak torque over the tooth phase, N·m.
+    pub(crate) fn torque(
+        &self,
+        arcs: &[Arc],
+        feed: Option<&ArcFeed>,
+        integral: f64,
+        flutes: u32,
+        radius: f64,
+        fz: f64,
+    ) -> SampleTorque {
+        if arcs.is_empty() {
+            return SampleTorque { mean: 0.0, peak: 0.0 };
+        }
+        let mean = self.mean_torque(integral, flutes, radius, fz);
+        let peak = self.scale(radius, fz) * self.peak_sum(arcs, flutes, feed);
+        // The peak of a function is never below its mean; the numeric search may miss by 1e-12.
+        SampleTorque { mean, peak: peak.max(mean) }
+    }
+
+    /// One tooth's sin^a term with its tip at `tip` (degrees): the value on the arcs, or with a
+    /// helix the mean over the lag window behind the tip.
+    pub(crate) fn tooth(&self, arcs: &[Arc], tip: f64, feed: Option<&ArcFeed>) -> f64 {
+        if self.lag_deg <= 0.0 {
+            if !arcs.iter().any(|a| a.contains(tip, END_TOLERANCE)) {
+                return 0.0;
+            }
+            let factor = feed.map_or(1.0, |f| f.factor(tip).powf(self.table.exponent()));
+            return factor * self.table.integrand(tip.to_radians());
+        }
+        // The edge above the tip trails it: cw teeth run towards smaller θ, so the trailing
+        // edge sits at larger θ; ccw the other way.
+        let (low, high) = match self.direction {
+            SpindleDirection::Cw => (tip, tip + self.lag_deg),
+            SpindleDirection::Ccw => (tip - self.lag_deg, tip),
+        };
+        let mut total = 0.0;
+        for arc in arcs {
+            // Copies of the arc, one turn apart, that overlap the window.
+            let first = ((low - arc.to) / 360.0).floor() as i64;
+            let last = ((high - arc.from) / 360.0).ceil() as i64;
+            for turn in first..=last {
+                let shift = 360.0 * turn as f64;
+                let (a, b) = ((arc.from + shift).max(low), (arc.to + shift).min(high));
+                if b > a {
+                    total += self.between(a, b, feed);
+                }
+            }
+        }
+        total / self.lag_deg.to_radians()
+    }
+
+    /// ∫ over [from, to] (degrees) of w(θ)·(sin θ, cos θ) dθ with w = (c(θ)·max(0, sin θ))^a:
+    /// the pieces of one tooth's force along and across the travel.
+    fn moments(&self, from: f64, to: f64, feed: Option<&ArcFeed>) -> (f64, f64) {
+        let a = self.table.exponent();
+        // ∫ sin^a·cos = sin^(a+1)/(a+1) where sin ≥ 0; the back half carries no chip.
+        let cos_moment = |low: f64, high: f64| {
+            let mut total = 0.0;
+            let first = (low / 360.0).floor() as i64;
+            let last = (high / 360.0).floor() as i64;
+            for turn in first..=last {
+                let base = 360.0 * turn as f64;
+                let (x, y) = (low.max(base), high.min(base + 180.0));
+                if y > x {
+                    let power = |t: f64| t.to_radians().sin().max(0.0).powf(a + 1.0);
+                    total += (power(y) - power(x)) / (a + 1.0);
+                }
+            }
+            total
+        };
+        let Some(feed) = feed else {
+            return (self.table_next.between(from.to_radians(), to.to_radians()), cos_moment(from, to));
+        };
+        let pieces = ((to - from) / FACTOR_PIECE_DEG).ceil().max(1.0);
+        let width = (to - from) / pieces;
+        (0..pieces as usize).fold((0.0, 0.0), |(sin_sum, cos_sum), i| {
+            let low = from + width * i as f64;
+            let factor = feed.factor(low + 0.5 * width).powf(a);
+            (
+                sin_sum + factor * self.table_next.between(low.to_radians(), (low + width).to_radians()),
+                cos_sum + factor * cos_moment(low, low + width),
+            )
+        })
+    }
+
+    /// One tooth's force on the tool per k_c1.1·a_p·f_z^a, in the tool frame (along the right
+    /// normal r̂, along the travel t̂): the tangential part opposes the edge's motion, the radial
+    /// part pushes the tool away from the material.
+    pub(crate) fn tooth_force(&self, arcs: &[Arc], tip: f64, feed: Option<&ArcFeed>) -> (f64, f64) {
+        let a = self.table.exponent();
+        // Edge motion: cw teeth run towards smaller θ (velocity −de/dθ), ccw towards larger.
+        let turning = match self.direction {
+            SpindleDirection::Cw => 1.0,
+            SpindleDirection::Ccw => -1.0,
+        };
+        let combine = |sin_part: f64, cos_part: f64| {
+            // w·[turning·(−sin θ, cos θ) + ratio·(−cos θ, −sin θ)].
+            (-turning * sin_part - self.radial_ratio * cos_part, turning * cos_part - self.radial_ratio * sin_part)
+        };
+        if self.lag_deg <= 0.0 {
+            if !arcs.iter().any(|arc| arc.contains(tip, END_TOLERANCE)) {
+                return (0.0, 0.0);
+            }
+            let w = feed.map_or(1.0, |f| f.factor(tip).powf(a)) * self.table.integrand(tip.to_radians());
+            let (s, c) = tip.to_radians().sin_cos();
+            return combine(w * s, w * c);
+        }
+        let (low, high) = match self.direction {
+            SpindleDirection::Cw => (tip, tip + self.lag_deg),
+            SpindleDirection::Ccw => (tip - self.lag_deg, tip),
+        };
+        let (mut sin_part, mut cos_part) = (0.0, 0.0);
+        for arc in arcs {
+            let first = ((low - arc.to) / 360.0).floor() as i64;
+            let last = ((high - arc.from) / 360.0).ceil() as i64;
+            for turn in first..=last {
+                let shift = 360.0 * turn as f64;
+                let (x, y) = ((arc.from + shift).max(low), (arc.to + shift).min(high));
+                if y > x {
+                    let (s, c) = self.moments(x, y, feed);
+                    sin_part += s;
+                    cos_part += c;
+                }
+            }
+        }
+        let lag = self.lag_deg.to_radians();
+        combine(sin_part / lag, cos_part / lag)
+    }
+
+    /// Largest resultant force on the tool over the tooth phase, N.
+    pub(crate) fn peak_force(&self, arcs: &[Arc], flutes: u32, fz: f64, feed: Option<&ArcFeed>) -> f64 {
+        if arcs.is_empty() {
+            return 0.0;
+        }
+        let pitch = 360.0 / f64::from(flutes);
+        let resultant = |phase: f64| {
+            let (x, y) = (0..flutes).fold((0.0, 0.0), |(x, y), j| {
+                let (fx, fy) = self.tooth_force(arcs, phase + f64::from(j) * pitch, feed);
+                (x + fx, y + fy)
+            });
+            x.hypot(y)
+        };
+        let scale = self.kc11 * self.axial_depth * fz.powf(self.table.exponent());
+        scale * phase::peak_of(flutes, &self.ends(arcs), resultant)
+    }
+
+    /// Tooth angles where a tooth's load jumps or bends.
+    fn ends(&self, arcs: &[Arc]) -> Vec<f64> {
+        let mut ends: Vec<f64> = arcs.iter().flat_map(|a| [a.from, a.to]).chain([0.0, 180.0]).collect();
+        if self.lag_deg > 0.0 {
+            // The top of the edge crossing the same places.
+            let shift = match self.direction {
+                SpindleDirection::Cw => -self.lag_deg,
+                SpindleDirection::Ccw => self.lag_deg,
+            };
+            ends.extend(ends.clone().iter().map(|e| e + shift));
+        }
+        ends
+    }
+
+    /// max over the phase β of Σ_j tooth(β + j·360°/k).
+    pub(crate) fn peak_sum(&self, arcs: &[Arc], flutes: u32, feed: Option<&ArcFeed>) -> f64 {
+        phase::peak(flutes, &self.ends(arcs), |tip| self.tooth(arcs, tip, feed))
+    }
+}
+
+/// Spindle power for a torque, kW: P = 2πN·M/60.
+pub(crate) fn power_kw(torque_nm: f64, spindle_rpm: f64) -> f64 {
+    std::f64::consts::TAU * spindle_rpm * torque_nm / 60.0 / 1000.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn model(mc: f64, lag_deg: f64, direction: SpindleDirection) -> ForceModel {
+        ForceModel {
+            kc11: 1800.0,
+            mc,
+            axial_depth: 2.0,
+            lag_deg,
+            direction,
+            radial_ratio: 0.3,
+            table: SinPower::new(1.0 - mc),
+            table_next: SinPower::new(2.0 - mc),
+        }
+    }
+
+    fn arc(from: f64, to: f64) -> Arc {
+        Arc { from, to }
+    }
+
+    fn sum(model: &ForceModel, arcs: &[Arc], flutes: u32, phase: f64) -> f64 {
+        let pitch = 360.0 / f64::from(flutes);
+        (0..flutes).map(|j| model.tooth(arcs, phase + f64::from(j) * pitch, None)).sum()
+    }
+
+    /// Brute-force phase scan.
+    fn scanned(model: &ForceModel, arcs: &[Arc], flutes: u32) -> f64 {
+        let pitch = 360.0 / f64::from(flutes);
+        (0..=100_000).map(|i| sum(model, arcs, flutes, pitch * f64::from(i) / 100_000.0)).fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn peak_matches_a_fine_scan() {
+        let cases = [vec![arc(0.0, 180.0)], vec![arc(0.0, 60.0)], vec![arc(16.0, 23.0), arc(157.0, 164.0)]];
+        for lag in [0.0, 25.0] {
+            let m = model(0.25, lag, SpindleDirection::Cw);
+            for arcs in &cases {
+                for k in [1, 2, 3, 4, 7] {
+                    let exact = m.peak_sum(arcs, k, None);
+                    let scan = scanned(&m, arcs, k);
+                    assert!(exact >= scan - 1e-9, "lag {lag} {arcs:?} k {k}: {exact} < {scan}");
+                    // The scan's step of 0.0036° misses a peak on a jump by up to 3e-5 of it.
+                    assert!(exact - scan < 1e-4 * scan.max(1e-9), "lag {lag} {arcs:?} k {k}: {exact} vs {scan}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn helix_lag_delays_the_exit_by_the_lag_angle() {
+        // A cw tooth runs from 120° down to 30° on the arc: its tip cuts over [30°, 120°]; with a
+        // lag of 20° its top leaves 20° later, at tip angle 10°, and enters 20° after the tip.
+        let lag = 20.0;
+        let arcs = [arc(30.0, 120.0)];
+        let flat = model(0.25, 0.0, SpindleDirection::Cw);
+        let helix = model(0.25, lag, SpindleDirection::Cw);
+        assert_eq!(helix.tooth(&arcs, 120.0 + 1e-6, None), 0.0);
+        assert!(helix.tooth(&arcs, 120.0 - 1e-3, None) > 0.0);
+        assert!(helix.tooth(&arcs, 30.0 - lag + 1e-3, None) > 0.0);
+        assert_eq!(helix.tooth(&arcs, 30.0 - lag - 1e-6, None), 0.0);
+        assert_eq!(flat.tooth(&arcs, 30.0 - 1e-6, None), 0.0);
+        // Fully in the cut (tip from 100° down to 30°) the helical tooth is the window mean.
+        let tip: f64 = 60.0;
+        let mean = flat.table.between(tip.to_radians(), (tip + lag).to_radians()) / lag.to_radians();
+        assert!((helix.tooth(&arcs, tip, None) - mean).abs() < 1e-12);
+        // ccw teeth trail on the other side.
+        let ccw = model(0.25, lag, SpindleDirection::Ccw);
+        assert!(ccw.tooth(&arcs, 120.0 + lag - 1e-3, None) > 0.0);
+        assert_eq!(ccw.tooth(&arcs, 120.0 + lag + 1e-6, None), 0.0);
+        assert_eq!(ccw.tooth(&arcs, 30.0 - 1e-6, None), 0.0);
+    }
+
+    #[test]
+    fn helix_keeps_the_mean_and_lowers_the_peak() {
+        let arcs = [arc(0.0, 60.0)];
+        let flat = model(0.2, 0.0, SpindleDirection::Cw);
+        for lag in [10.0, 45.0, 400.0] {
+            let helix = model(0.2, lag, SpindleDirection::Cw);
+            for k in [1, 2, 4] {
+                // Mean over the phase by a fine scan equals the closed form for both.
+                let pitch = 360.0 / f64::from(k);
+                let n = 20_000;
+                let scan_mean: f64 =
+                    (0..n).map(|i| sum(&helix, &arcs, k, pitch * (f64::from(i) + 0.5) / f64::from(n))).sum::<f64>()
+                        / f64::from(n);
+                let closed = f64::from(k) * flat.engaged_integral(&arcs, None) / std::f64::consts::TAU;
+                assert!((scan_mean - closed).abs() < 1e-4 * closed, "lag {lag} k {k}: {scan_mean} vs {closed}");
+                assert!(helix.peak_sum(&arcs, k, None) <= flat.peak_sum(&arcs, k, None) + 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn helical_tooth_force_is_the_window_mean_of_the_straight_one() {
+        let arcs = [arc(10.0, 150.0)];
+        for direction in [SpindleDirection::Cw, SpindleDirection::Ccw] {
+            let flat = model(0.25, 0.0, direction);
+            let helix = model(0.25, 30.0, direction);
+            for tip in [-20.0, 0.0, 45.0, 100.0, 140.0, 170.0] {
+                let (low, high) = match direction {
+                    SpindleDirection::Cw => (tip, tip + 30.0),
+                    SpindleDirection::Ccw => (tip - 30.0, tip),
+                };
+                let n = 30_000;
+                let (mut x, mut y) = (0.0, 0.0);
+                for i in 0..n {
+                    let (fx, fy) =
+                        flat.tooth_force(&arcs, low + (high - low) * (f64::from(i) + 0.5) / f64::from(n), None);
+                    x += fx / f64::from(n);
+                    y += fy / f64::from(n);
+                }
+                let (hx, hy) = helix.tooth_force(&arcs, tip, None);
+                assert!(
+                    (hx - x).abs() < 1e-5 && (hy - y).abs() < 1e-5,
+                    "{direction:?} {tip}: ({hx}, {hy}) vs ({x}, {y})"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn power_is_two_pi_n_m_over_sixty() {
+        assert!((power_kw(10.0, 6000.0) - std::f64::consts::TAU * 100.0 * 10.0 / 1000.0).abs() < 1e-12);
+    }
+}
