@@ -3,6 +3,7 @@
 
 use axum::http::{HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
+use kerf_solver::ErrorCode;
 use kerf_solver::SolverError;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
@@ -30,7 +31,7 @@ pub struct Problem {
     /// Human-readable explanation specific to this request.
     pub detail: String,
     /// Stable machine-readable code (e.g. `E_HOLE_TOO_LARGE`, `E_JSON`, `E_NOT_FOUND`).
-    pub code: String,
+    pub code: ErrorCode,
     /// The fields at fault.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub errors: Vec<FieldProblem>,
@@ -41,7 +42,7 @@ pub struct Problem {
 pub enum AppError {
     /// 400: the body or a parameter is not of the right shape.
     #[error("{detail}")]
-    BadRequest { code: &'static str, detail: String, field: Option<String> },
+    BadRequest { code: ErrorCode, detail: String, field: Option<String> },
     /// 401: a state-changing request without the right bearer token.
     #[error("{0}")]
     Unauthorized(String),
@@ -77,7 +78,7 @@ pub enum AppError {
 
 impl AppError {
     /// A 400 naming `field`.
-    pub fn bad_request(code: &'static str, field: impl Into<String>, detail: impl Into<String>) -> Self {
+    pub fn bad_request(code: ErrorCode, field: impl Into<String>, detail: impl Into<String>) -> Self {
         Self::BadRequest { code, detail: detail.into(), field: Some(field.into()) }
     }
 
@@ -126,24 +127,22 @@ impl AppError {
     /// The problem document for this error.
     pub fn problem(&self) -> Problem {
         let (status, title) = self.status_title();
-        let (code, detail, field): (String, String, Option<String>) = match self {
-            Self::BadRequest { code, detail, field } => ((*code).to_owned(), detail.clone(), field.clone()),
-            Self::NotFound { detail, field } => ("E_NOT_FOUND".to_owned(), detail.clone(), field.clone()),
-            Self::Unprocessable(error) => {
-                (error.code().to_owned(), error.message().to_owned(), error.field().map(str::to_owned))
-            }
-            Self::Internal(_) => ("E_INTERNAL".to_owned(), "internal error; it has been logged".to_owned(), None),
+        let (code, detail, field): (ErrorCode, String, Option<String>) = match self {
+            Self::BadRequest { code, detail, field } => (*code, detail.clone(), field.clone()),
+            Self::NotFound { detail, field } => (ErrorCode::NotFound, detail.clone(), field.clone()),
+            Self::Unprocessable(error) => (error.code(), error.message().to_owned(), error.field().map(str::to_owned)),
+            Self::Internal(_) => (ErrorCode::Internal, "internal error; it has been logged".to_owned(), None),
             other => {
                 let code = match other {
-                    Self::Unauthorized(_) => "E_UNAUTHORIZED",
-                    Self::MethodNotAllowed => "E_METHOD",
-                    Self::Conflict(_) => "E_CONFLICT",
-                    Self::PayloadTooLarge { .. } => "E_TOO_LARGE",
-                    Self::UnsupportedMediaType(_) => "E_CONTENT_TYPE",
-                    Self::TooManyRequests(_) => "E_BUSY",
-                    _ => "E_TIMEOUT",
+                    Self::Unauthorized(_) => ErrorCode::Unauthorized,
+                    Self::MethodNotAllowed => ErrorCode::Method,
+                    Self::Conflict(_) => ErrorCode::Conflict,
+                    Self::PayloadTooLarge { .. } => ErrorCode::TooLarge,
+                    Self::UnsupportedMediaType(_) => ErrorCode::ContentType,
+                    Self::TooManyRequests(_) => ErrorCode::Busy,
+                    _ => ErrorCode::Timeout,
                 };
-                (code.to_owned(), other.to_string(), None)
+                (code, other.to_string(), None)
             }
         };
         let errors = field.map(|path| vec![FieldProblem { path, message: detail.clone() }]).unwrap_or_default();

@@ -8,6 +8,7 @@ use axum::extract::{FromRef, FromRequest, FromRequestParts, Request};
 use axum::http::HeaderMap;
 use axum::http::header::CONTENT_TYPE;
 use axum::http::request::Parts;
+use kerf_solver::ErrorCode;
 use serde::de::DeserializeOwned;
 
 use crate::error::AppError;
@@ -57,7 +58,7 @@ pub async fn body_bytes<S: Send + Sync>(request: Request, state: &S, limit: usiz
         BytesRejection::FailedToBufferBody(_) if rejection.status() == axum::http::StatusCode::PAYLOAD_TOO_LARGE => {
             AppError::PayloadTooLarge { limit }
         }
-        other => AppError::bad_request("E_BODY", "body", format!("could not read the body: {other}")),
+        other => AppError::bad_request(ErrorCode::Body, "body", format!("could not read the body: {other}")),
     })
 }
 
@@ -65,7 +66,7 @@ pub async fn body_bytes<S: Send + Sync>(request: Request, state: &S, limit: usiz
 pub fn parse_json<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, AppError> {
     // Every request body is an object; serde would otherwise read an array as the fields in order.
     if bytes.iter().find(|b| !b.is_ascii_whitespace()) != Some(&b'{') {
-        return Err(AppError::bad_request("E_JSON", "body", "the body must be a JSON object"));
+        return Err(AppError::bad_request(ErrorCode::Json, "body", "the body must be a JSON object"));
     }
     let mut deserializer = serde_json::Deserializer::from_slice(bytes);
     let value = serde_path_to_error::deserialize(&mut deserializer).map_err(|error| {
@@ -73,10 +74,14 @@ pub fn parse_json<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, AppError> {
         let inner = error.into_inner();
         // serde_path_to_error says "." for the root and "?" where it could not track the path.
         let field = if path == "." || path == "?" { "body".to_owned() } else { path };
-        AppError::bad_request("E_JSON", field.clone(), format!("{field}: {}", clean_serde_message(&inner.to_string())))
+        AppError::bad_request(
+            ErrorCode::Json,
+            field.clone(),
+            format!("{field}: {}", clean_serde_message(&inner.to_string())),
+        )
     })?;
     deserializer.end().map_err(|error| {
-        AppError::bad_request("E_JSON", "body", format!("trailing characters after the JSON value: {error}"))
+        AppError::bad_request(ErrorCode::Json, "body", format!("trailing characters after the JSON value: {error}"))
     })?;
     Ok(value)
 }
@@ -103,7 +108,11 @@ where
         serde_path_to_error::deserialize(deserializer).map(Self).map_err(|error| {
             let path = error.path().to_string();
             let field = if path == "." { "query".to_owned() } else { path };
-            AppError::bad_request("E_QUERY", field.clone(), format!("query parameter {field}: {}", error.into_inner()))
+            AppError::bad_request(
+                ErrorCode::Query,
+                field.clone(),
+                format!("query parameter {field}: {}", error.into_inner()),
+            )
         })
     }
 }
@@ -131,7 +140,7 @@ where
                     },
                     _ => None,
                 };
-                AppError::bad_request("E_PATH", key.unwrap_or_else(|| "path".to_owned()), rejection.body_text())
+                AppError::bad_request(ErrorCode::Path, key.unwrap_or_else(|| "path".to_owned()), rejection.body_text())
             },
         )
     }

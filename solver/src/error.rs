@@ -2,26 +2,28 @@
 
 use serde::Serialize;
 
+pub use crate::error_code::ErrorCode;
+
 /// Why a solver refused a request. `code` is stable and documented (e.g. `E_HOLE_TOO_LARGE`);
 /// `field` names the request field at fault when there is one (a dotted JSON path such as
 /// `hole.radius`), so the server can point the client at it.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{message}")]
 pub struct SolverError {
-    code: &'static str,
+    code: ErrorCode,
     field: Option<String>,
     message: String,
 }
 
 impl SolverError {
     /// An error with a code and a message, not tied to one field.
-    pub fn new(code: &'static str, message: impl Into<String>) -> Self {
+    pub fn new(code: ErrorCode, message: impl Into<String>) -> Self {
         Self { code, field: None, message: message.into() }
     }
 
     /// An `E_INPUT` error naming the field at fault.
     pub fn input(field: impl Into<String>, message: impl Into<String>) -> Self {
-        Self::new("E_INPUT", message).at(field)
+        Self::new(ErrorCode::Input, message).at(field)
     }
 
     /// The same error, tied to `field`.
@@ -32,7 +34,7 @@ impl SolverError {
     }
 
     /// The stable error code.
-    pub fn code(&self) -> &'static str {
+    pub fn code(&self) -> ErrorCode {
         self.code
     }
 

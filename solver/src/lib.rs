@@ -16,6 +16,7 @@ pub mod corners;
 pub mod deburr;
 pub mod engagement;
 pub mod error;
+mod error_code;
 pub mod gcode;
 pub mod geometry;
 pub mod path;
@@ -23,4 +24,4 @@ pub mod planar;
 pub mod predict;
 pub mod tool;
 
-pub use error::{SolverError, Warning};
+pub use error::{ErrorCode, SolverError, Warning};

@@ -25,7 +25,7 @@ fn base() -> Value {
 
 fn error(request: Value) -> (String, Option<String>, String) {
     let error = chord::solve(&parse(request), None).unwrap_err();
-    (error.code().to_owned(), error.field().map(str::to_owned), error.message().to_owned())
+    (error.code().as_str().to_owned(), error.field().map(str::to_owned), error.message().to_owned())
 }
 
 fn ok(request: Value) -> SegmentAnswer {

@@ -226,13 +226,13 @@ fn solve_feasible(mut request: Value) -> Option<SegmentAnswer> {
         let parsed: SegmentRequest = serde_json::from_value(request.clone()).unwrap();
         match chord::solve(&parsed, None) {
             Ok(answer) => return Some(answer),
-            Err(error) if error.code() == "E_INFEASIBLE_FEED_FOR_RADIUS" => {
+            Err(error) if error.code().as_str() == "E_INFEASIBLE_FEED_FOR_RADIUS" => {
                 assert!(error.message().contains("largest feasible feed"));
                 assert_eq!(error.field(), Some("feed"));
                 let feed = request["feed"].as_f64().unwrap();
                 request["feed"] = json!(feed / 4.0);
             }
-            Err(error) => panic!("{}: {}", error.code(), error.message()),
+            Err(error) => panic!("{}: {}", error.code().as_str(), error.message()),
         }
     }
     None

@@ -172,7 +172,7 @@ fn bad_block_times_name_the_field() {
     for value in [json!(0), json!(-4)] {
         let request = serde_json::from_value(square(json!({"block_time_ms": value}))).unwrap();
         let error = corners::solve(&request, &Tool::new(ToolKind::Flat, 1.0)).unwrap_err();
-        assert_eq!((error.code(), error.field()), ("E_INPUT", Some("block_time_ms")));
+        assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("block_time_ms")));
     }
 }
 

@@ -398,7 +398,7 @@ fn edge_case_notch_collapses() {
     }))
     .unwrap();
     let error = corners::solve(&request, &Tool::new(ToolKind::Flat, 2.0)).unwrap_err();
-    assert_eq!(error.code(), "E_OFFSET_COLLAPSE");
+    assert_eq!(error.code().as_str(), "E_OFFSET_COLLAPSE");
     assert_eq!(error.field(), Some("contour[4]"));
 }
 

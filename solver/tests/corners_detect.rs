@@ -86,10 +86,10 @@ fn curvature_is_undefined_on_axis_parallel_squares() {
 #[test]
 fn bad_paths_are_refused() {
     let mut bad = request(&[[0.0, 0.0], [1.0, 0.0]], DetectMode::TurnAngle, None);
-    assert_eq!(loop_path(&bad).unwrap_err().code(), "E_DEGENERATE");
+    assert_eq!(loop_path(&bad).unwrap_err().code().as_str(), "E_DEGENERATE");
     bad.path = vec![[0.0, 0.0], [1.0, f64::NAN], [1.0, 1.0]];
     let error = loop_path(&bad).unwrap_err();
-    assert_eq!((error.code(), error.field()), ("E_INPUT", Some("path[1]")));
+    assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("path[1]")));
     bad.path = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]];
     bad.tool_radius = 0.0;
     assert_eq!(loop_path(&bad).unwrap_err().field(), Some("tool_radius"));

@@ -34,7 +34,7 @@ fn refusal(body: Value) -> (String, Option<String>) {
         panic!("accepted");
     };
     assert!(!error.message().is_empty());
-    (error.code().to_owned(), error.field().map(str::to_owned))
+    (error.code().as_str().to_owned(), error.field().map(str::to_owned))
 }
 
 fn assert_refused(name: &str, body: Value, code: &str, field: &str) {
@@ -178,11 +178,11 @@ fn non_finite_numbers_name_their_field() {
     let mut request: ContourRequest = serde_json::from_value(base()).unwrap();
     request.contour[2] = [40.0, f64::NAN];
     let error = corners::solve(&request, &Tool::new(ToolKind::Flat, 1.0)).unwrap_err();
-    assert_eq!((error.code(), error.field()), ("E_INPUT", Some("contour[2]")));
+    assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("contour[2]")));
     let mut request: ContourRequest = serde_json::from_value(base()).unwrap();
     request.depths.top = f64::INFINITY;
     let error = corners::solve(&request, &Tool::new(ToolKind::Flat, 1.0)).unwrap_err();
-    assert_eq!((error.code(), error.field()), ("E_INPUT", Some("depths.top")));
+    assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("depths.top")));
 }
 
 #[test]

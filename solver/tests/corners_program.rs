@@ -65,7 +65,7 @@ fn ball_centre_reference_lifts_the_program_and_tilt_is_refused() {
     assert!(text.contains("Z1.0000"), "the layer at z = −2 is programmed at the ball centre −2 + 3");
     let tilted = corners::solve(&request(json!({"tilt_deg": 5})), &Tool::new(ToolKind::Flat, 3.0)).unwrap();
     let error = corners::program(&tilted, &post(Dialect::Fanuc, Reference::Tip)).unwrap_err();
-    assert_eq!(error.code(), "E_TILT_NEEDS_5_AXIS");
+    assert_eq!(error.code().as_str(), "E_TILT_NEEDS_5_AXIS");
 }
 
 #[test]

@@ -120,9 +120,9 @@ fn solve(setup: &Setup) -> Option<ContourAnswer> {
         Ok(answer) => Some(answer),
         Err(error) => {
             assert!(
-                matches!(error.code(), "E_OFFSET_COLLAPSE" | "E_OFFSET_SELF_INTERSECTION"),
+                matches!(error.code().as_str(), "E_OFFSET_COLLAPSE" | "E_OFFSET_SELF_INTERSECTION"),
                 "unexpected refusal {}: {}",
-                error.code(),
+                error.code().as_str(),
                 error.message()
             );
             None

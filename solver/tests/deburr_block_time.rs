@@ -210,7 +210,7 @@ fn machine_values_and_bad_block_times() {
         let mut body = request(tube(json!({"feed": 1000})));
         body.block_time_ms = Some(bad);
         let error = deburr::solve(&body, &tool).unwrap_err();
-        assert_eq!((error.code(), error.field()), ("E_INPUT", Some("block_time_ms")), "{bad}");
+        assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("block_time_ms")), "{bad}");
     }
     // The program header records the rule.
     let post = kerf_solver::gcode::Post {
@@ -248,7 +248,7 @@ proptest! {
         let result = match deburr::solve(&request(body), &ball(1.5)) {
             Ok(result) => result,
             Err(error) => {
-                prop_assert!(["E_FAR_GOUGE", "E_TOO_MANY_POINTS"].contains(&error.code()), "{}", error.message());
+                prop_assert!(["E_FAR_GOUGE", "E_TOO_MANY_POINTS"].contains(&error.code().as_str()), "{}", error.message());
                 return Ok(());
             }
         };

@@ -40,7 +40,7 @@ fn refused(request: &EngagementRequest) -> (String, Option<String>, String) {
     let Err(error) = engagement::solve(request, &tool()) else {
         panic!("should be refused");
     };
-    (error.code().to_owned(), error.field().map(str::to_owned), error.message().to_owned())
+    (error.code().as_str().to_owned(), error.field().map(str::to_owned), error.message().to_owned())
 }
 
 #[track_caller]
@@ -179,7 +179,7 @@ fn dots_work_over_the_limit_is_refused() {
         "path": [[-60, 50], [61, 50]], "engine": "dots", "grid": 0.001, "step": 0.01,
     }));
     let error = engagement::solve(&request, &Tool::new(ToolKind::Flat, 50.0)).unwrap_err();
-    assert_eq!((error.code(), error.field()), ("E_WORK_LIMIT", Some("grid")));
+    assert_eq!((error.code().as_str(), error.field()), ("E_WORK_LIMIT", Some("grid")));
     assert!(error.message().contains("5e8"), "{}", error.message());
 }
 
@@ -212,7 +212,7 @@ fn program_needs_the_cutting_depth() {
     let answer = engagement::solve(&with(json!({})), &tool()).unwrap();
     let post = Post { dialect: Dialect::Fanuc, reference: Reference::Tip, tool: ToolCall::Table(3) };
     let error = program(&answer, 0, &post).unwrap_err();
-    assert_eq!((error.code(), error.field()), ("E_INPUT", Some("axial_depth")));
+    assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("axial_depth")));
     let error = program(&answer, 1, &post).unwrap_err();
     assert_eq!(error.field(), Some("candidate"));
 }

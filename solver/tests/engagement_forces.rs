@@ -321,7 +321,7 @@ fn material_is_resolved_by_the_caller() {
     body.as_object_mut().unwrap().remove("kienzle");
     body["material"] = json!("C45");
     let error = solve_body(body.clone(), &tool(None), &Physics::default()).unwrap_err();
-    assert_eq!((error.code(), error.field()), ("E_INPUT", Some("material")));
+    assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("material")));
     let physics = Physics {
         material: Some(Kienzle { kc11: KC11, mc: 0.25, radial_ratio: None }),
         spindle: SpindleLimits::default(),

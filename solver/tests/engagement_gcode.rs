@@ -68,12 +68,12 @@ fn gcode_path_errors_name_the_line() {
     assert!(error.message().contains("line 2"), "{}", error.message());
 
     let error = solve(json!({"gcode": "G18\nG0 X0 Y20 Z0\nG2 X10 Z10 I10 K0\n"})).unwrap_err();
-    assert_eq!(error.code(), "E_PATH");
+    assert_eq!(error.code().as_str(), "E_PATH");
     assert!(error.message().contains("line 3"), "{}", error.message());
 
     let error = solve(json!({"gcode": "G0 X0 Y0", "start": [0, 0]})).unwrap_err();
     assert_eq!(error.field(), Some("path.gcode"));
 
     let error = solve(json!({"gcode": "(nothing moves)\nM30\n"})).unwrap_err();
-    assert_eq!(error.code(), "E_PATH");
+    assert_eq!(error.code().as_str(), "E_PATH");
 }

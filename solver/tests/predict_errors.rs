@@ -27,7 +27,7 @@ fn flat_case() -> (PredictRequest, Tool) {
 
 fn expect(result: Result<predict::Predict, SolverError>, code: &str, field: &str) -> SolverError {
     let error = result.expect_err("the request must be refused");
-    assert_eq!(error.code(), code, "{}", error.message());
+    assert_eq!(error.code().as_str(), code, "{}", error.message());
     assert_eq!(error.field(), Some(field), "{}", error.message());
     error
 }
@@ -238,7 +238,7 @@ fn progress_is_reported_and_cancellation_stops_the_run() {
     assert!(seen.iter().all(|f| (0.0..=1.0).contains(f)));
     let stop = AtomicBool::new(true);
     let cancelled = predict::solve_with(&request, &tool, None, &Control { progress: None, cancel: Some(&stop) });
-    assert_eq!(cancelled.unwrap_err().code(), "E_CANCELLED");
+    assert_eq!(cancelled.unwrap_err().code().as_str(), "E_CANCELLED");
 }
 
 #[test]

@@ -73,6 +73,6 @@ fn threshold_outside_zero_to_ninety_is_refused() {
     for bad in [-1.0, 90.5, f64::NAN] {
         let (request, tool) = flat_case(Some(bad));
         let error = predict::solve(&request, &tool, None).unwrap_err();
-        assert_eq!((error.code(), error.field()), ("E_INPUT", Some("exclusion_deg")));
+        assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("exclusion_deg")));
     }
 }

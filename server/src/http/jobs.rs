@@ -5,6 +5,7 @@ use axum::Json;
 use axum::extract::{FromRequest, Multipart, Request, State};
 use axum::http::{HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
+use kerf_solver::ErrorCode;
 use serde::{Deserialize, Serialize};
 use utoipa::{IntoParams, ToSchema};
 use utoipa_axum::router::OpenApiRouter;
@@ -99,7 +100,7 @@ async fn upload(state: &AppState, request: Request) -> AppResult<(String, Format
         Some("multipart/form-data") => {
             let mut multipart = Multipart::from_request(request, state)
                 .await
-                .map_err(|rejection| AppError::bad_request("E_MULTIPART", "file", rejection.body_text()))?;
+                .map_err(|rejection| AppError::bad_request(ErrorCode::Multipart, "file", rejection.body_text()))?;
             let mut found = None;
             loop {
                 let field = match multipart.next_field().await {
@@ -108,7 +109,7 @@ async fn upload(state: &AppState, request: Request) -> AppResult<(String, Format
                     Err(error) if error.status() == StatusCode::PAYLOAD_TOO_LARGE => {
                         return Err(AppError::PayloadTooLarge { limit });
                     }
-                    Err(error) => return Err(AppError::bad_request("E_MULTIPART", "file", error.body_text())),
+                    Err(error) => return Err(AppError::bad_request(ErrorCode::Multipart, "file", error.body_text())),
                 };
                 if field.name() != Some("file") {
                     continue;
@@ -119,13 +120,15 @@ async fn upload(state: &AppState, request: Request) -> AppResult<(String, Format
                     if error.status() == StatusCode::PAYLOAD_TOO_LARGE {
                         AppError::PayloadTooLarge { limit }
                     } else {
-                        AppError::bad_request("E_MULTIPART", "file", error.body_text())
+                        AppError::bad_request(ErrorCode::Multipart, "file", error.body_text())
                     }
                 })?;
                 found = Some((bytes, name, media));
                 break;
             }
-            found.ok_or_else(|| AppError::bad_request("E_MULTIPART", "file", "the form has no field named file"))?
+            found.ok_or_else(|| {
+                AppError::bad_request(ErrorCode::Multipart, "file", "the form has no field named file")
+            })?
         }
         Some("application/json" | "application/toml" | "text/toml" | "application/x-toml" | "text/x-toml") => {
             (body_bytes(request, state, limit).await?, None, media)
@@ -138,7 +141,7 @@ async fn upload(state: &AppState, request: Request) -> AppResult<(String, Format
         }
     };
     let text = String::from_utf8(bytes.to_vec())
-        .map_err(|_| AppError::bad_request("E_JOB_FILE", "file", "the job file is not UTF-8 text"))?;
+        .map_err(|_| AppError::bad_request(ErrorCode::JobFile, "file", "the job file is not UTF-8 text"))?;
     let format = Format::detect(name.as_deref(), media.as_deref(), &text);
     Ok((text, format))
 }
@@ -184,7 +187,7 @@ async fn submit(State(state): State<AppState>, request: Request) -> AppResult<Re
 async fn list(State(state): State<AppState>, AppQuery(query): AppQuery<PageQuery>) -> AppResult<Json<JobPage>> {
     let limit = query.limit.unwrap_or(50);
     if !(1..=200).contains(&limit) {
-        return Err(AppError::bad_request("E_QUERY", "limit", "limit must be 1 to 200"));
+        return Err(AppError::bad_request(ErrorCode::Query, "limit", "limit must be 1 to 200"));
     }
     let jobs = store::jobs::list(&state.db, limit + 1, query.before).await?;
     let more = jobs.len() > usize::try_from(limit).unwrap_or(usize::MAX);
@@ -238,7 +241,11 @@ async fn gcode(
     let index = match (query.operation, programs.len()) {
         (Some(index), count) if index < count => index,
         (Some(index), count) => {
-            return Err(AppError::bad_request("E_QUERY", "operation", format!("operation {index} out of 0..{count}")));
+            return Err(AppError::bad_request(
+                ErrorCode::Query,
+                "operation",
+                format!("operation {index} out of 0..{count}"),
+            ));
         }
         (None, 1) => 0,
         (None, count) => {
@@ -252,7 +259,7 @@ async fn gcode(
     match &programs[index] {
         (Some(program), _) => Ok(gcode_response(program.clone())),
         (None, problem) => Err(kerf_solver::SolverError::new(
-            "E_NO_PROGRAM",
+            ErrorCode::NoProgram,
             format!("operation {index} has no program: {}", problem.as_deref().unwrap_or("it writes no path")),
         )
         .at("operation")

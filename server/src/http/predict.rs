@@ -10,6 +10,7 @@ use axum::body::{Body, Bytes};
 use axum::extract::{DefaultBodyLimit, FromRequest, Multipart, Request, State};
 use axum::http::{HeaderMap, StatusCode, header};
 use axum::response::Response;
+use kerf_solver::ErrorCode;
 use kerf_solver::capability::OutputOptions;
 use kerf_solver::gcode::{Dialect, Reference};
 use kerf_solver::predict::{PredictAnswer, PredictCapability, PredictRequest};
@@ -62,7 +63,7 @@ fn multipart_error(part: &str, limit: usize, error: &axum::extract::multipart::M
     if error.status() == StatusCode::PAYLOAD_TOO_LARGE {
         AppError::PayloadTooLarge { limit }
     } else {
-        AppError::bad_request("E_MULTIPART", part, format!("{part}: {}", error.body_text()))
+        AppError::bad_request(ErrorCode::Multipart, part, format!("{part}: {}", error.body_text()))
     }
 }
 
@@ -89,7 +90,7 @@ async fn upload(state: &AppState, request: Request) -> AppResult<Upload> {
     }
     let mut multipart = Multipart::from_request(request, state)
         .await
-        .map_err(|rejection| AppError::bad_request("E_MULTIPART", "body", rejection.body_text()))?;
+        .map_err(|rejection| AppError::bad_request(ErrorCode::Multipart, "body", rejection.body_text()))?;
     let (mut json, mut mesh): (Option<Bytes>, Option<Bytes>) = (None, None);
     loop {
         let field = match multipart.next_field().await {
@@ -103,7 +104,7 @@ async fn upload(state: &AppState, request: Request) -> AppResult<Upload> {
             "stock" => &mut mesh,
             _ => {
                 return Err(AppError::bad_request(
-                    "E_MULTIPART",
+                    ErrorCode::Multipart,
                     if name.is_empty() { "body".to_owned() } else { name.clone() },
                     format!("unexpected form part `{name}`: send `request` (the JSON) and `stock` (the STL file)"),
                 ));
@@ -111,7 +112,7 @@ async fn upload(state: &AppState, request: Request) -> AppResult<Upload> {
         };
         if slot.is_some() {
             return Err(AppError::bad_request(
-                "E_MULTIPART",
+                ErrorCode::Multipart,
                 name.clone(),
                 format!("form part `{name}` is given twice"),
             ));
@@ -119,7 +120,7 @@ async fn upload(state: &AppState, request: Request) -> AppResult<Upload> {
         *slot = Some(field.bytes().await.map_err(|error| multipart_error(&name, limit, &error))?);
     }
     let json = json.ok_or_else(|| {
-        AppError::bad_request("E_MULTIPART", "request", "the form has no part `request` with the JSON request")
+        AppError::bad_request(ErrorCode::Multipart, "request", "the form has no part `request` with the JSON request")
     })?;
     Ok(Upload { request: parse_json(&json)?, mesh })
 }

@@ -2,6 +2,7 @@
 //! [`crate::capabilities::Operation::run`]), with progress and cancellation. Pure apart from the two callbacks, so it
 //! runs the same in the server's workers and in `kerf run`.
 
+use kerf_solver::ErrorCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, PoisonError};
 
@@ -61,7 +62,7 @@ pub fn execute(
 }
 
 fn failure(index: usize, error: AppError) -> JobFailure {
-    if matches!(&error, AppError::Unprocessable(e) if e.code() == "E_CANCELLED") {
+    if matches!(&error, AppError::Unprocessable(e) if e.code() == ErrorCode::Cancelled) {
         return JobFailure::Cancelled;
     }
     JobFailure::Refused(Box::new(error.under(&format!("operations[{index}]")).problem()))

@@ -23,6 +23,7 @@
 //! Machines work like tools: `[[machines]]` entries (each with its `name`) are used before the
 //! machines registry when an operation names a `machine`.
 
+use kerf_solver::ErrorCode;
 use kerf_solver::capability::{self, Lookup};
 use kerf_solver::chord::{MachineProfile, validate_machine_name};
 use kerf_solver::gcode::{Dialect, Reference};
@@ -119,7 +120,7 @@ fn line_column(text: &str, offset: usize) -> (usize, usize) {
 fn file_error(path: &str, line: Option<(usize, usize)>, message: &str) -> AppError {
     let field = if path.is_empty() || path == "." || path == "?" { "file".to_owned() } else { path.to_owned() };
     let place = line.map(|(l, c)| format!("line {l}, column {c}: ")).unwrap_or_default();
-    AppError::bad_request("E_JOB_FILE", field.clone(), format!("{place}{field}: {message}"))
+    AppError::bad_request(ErrorCode::JobFile, field.clone(), format!("{place}{field}: {message}"))
 }
 
 /// Deepest bracket nesting, ignoring brackets inside strings (a cheap guard before parsing).

@@ -1,6 +1,7 @@
 //! The job queue in SQLite (issue 7): jobs with status, progress, attempts and heartbeat, and
 //! their results. Workers claim the oldest queued job with one atomic UPDATE.
 
+use kerf_solver::ErrorCode;
 use serde::Serialize;
 use sqlx::SqlitePool;
 use utoipa::ToSchema;
@@ -116,19 +117,19 @@ fn stored_problem(text: &str, field: Option<String>) -> Problem {
         title: "Job failed".to_owned(),
         status: 422,
         detail: text.to_owned(),
-        code: "E_JOB_FAILED".to_owned(),
+        code: ErrorCode::JobFailed,
         errors,
     }
 }
 
 /// A problem for a job that stopped for a reason of its own (not an operation's refusal).
-fn job_problem(status: u16, title: &str, code: &str, detail: &str) -> Problem {
+fn job_problem(status: u16, title: &str, code: ErrorCode, detail: &str) -> Problem {
     Problem {
         kind: "about:blank".to_owned(),
         title: title.to_owned(),
         status,
         detail: detail.to_owned(),
-        code: code.to_owned(),
+        code,
         errors: Vec::new(),
     }
 }
@@ -201,7 +202,7 @@ pub async fn claim(db: &SqlitePool) -> AppResult<Option<(i64, JobFile)>> {
         Ok(job) => Ok(Some((id, job))),
         Err(error) => {
             let detail = format!("the stored job is unreadable: {error}");
-            fail(db, id, &job_problem(422, "Job failed", "E_JOB_FILE", &detail)).await?;
+            fail(db, id, &job_problem(422, "Job failed", ErrorCode::JobFile, &detail)).await?;
             Ok(None)
         }
     }
@@ -288,7 +289,7 @@ pub async fn cancel(db: &SqlitePool, id: i64) -> AppResult<Option<(JobStatus, bo
             now!(),
             ", error = ? WHERE id = ?"
         ))
-        .bind(problem_json(&job_problem(409, "Cancelled", "E_CANCELLED", "cancelled by request"))?)
+        .bind(problem_json(&job_problem(409, "Cancelled", ErrorCode::Cancelled, "cancelled by request"))?)
         .bind(id)
         .execute(&mut *transaction)
         .await?;
@@ -329,7 +330,7 @@ pub async fn recover(db: &SqlitePool) -> AppResult<(u64, u64)> {
     .bind(problem_json(&job_problem(
         503,
         "Job interrupted",
-        "E_INTERRUPTED",
+        ErrorCode::Interrupted,
         &format!("interrupted by a server stop on each of its {MAX_ATTEMPTS} attempts; not retried"),
     ))?)
     .bind(MAX_ATTEMPTS)

@@ -2,6 +2,7 @@
 //! 5-point Gauss–Legendre quadrature on adaptively halved panels, inverted by safeguarded
 //! Newton iteration.
 
+use crate::error::ErrorCode;
 use crate::error::SolverError;
 
 /// 5-point Gauss–Legendre nodes on [−1, 1].
@@ -85,7 +86,7 @@ impl ArcLengthTable {
         if converged || depth >= MAX_DEPTH || middle <= a || middle >= b {
             if self.u.len() + 2 > MAX_PANELS {
                 return Err(SolverError::new(
-                    "E_TOO_MANY_POINTS",
+                    ErrorCode::TooManyPoints,
                     format!("the curve needs more than {MAX_PANELS} arc-length panels; simplify it"),
                 )
                 .at(field));

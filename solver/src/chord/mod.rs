@@ -75,6 +75,7 @@ pub use request::{Curve, CurveRule, Direction, Mode, RadiusEstimate, SegmentRequ
 pub use rule::{BlockRule, ChordStatus, Infeasible, RuleSettings, block_time_from_saturation, chord_length};
 pub use stats::{BlockStats, PathBlocks, block_stats, path_blocks, short_block_warning};
 
+use crate::error::ErrorCode;
 use request::{Job, Plan};
 use segment::{Cut, CutError, Cutter, InfeasibleAt, Status};
 
@@ -203,7 +204,7 @@ fn infeasible_error(job: &Job, at: InfeasibleAt) -> SolverError {
         format!("{mantissa:.2}e{exponent}")
     };
     SolverError::new(
-        "E_INFEASIBLE_FEED_FOR_RADIUS",
+        ErrorCode::InfeasibleFeedForRadius,
         format!(
             "feed {} mm/min is too high for the radius {} mm at s = {:.3} mm: one block of {} ms at this feed \
              (margin {}) is {:.4} mm, longer than any chord of a circle of radius {} mm. The largest feasible feed \

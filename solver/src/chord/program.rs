@@ -7,6 +7,7 @@
 //! programmed point), 2-D curves at z = 0.
 
 use super::answer::SegmentAnswer;
+use crate::error::ErrorCode;
 use crate::error::SolverError;
 use crate::gcode::{self, Post, Program, SpindleDirection};
 use crate::geometry::Vec3;
@@ -30,10 +31,10 @@ pub fn program(answer: &SegmentAnswer, post: &Post) -> Result<String, SolverErro
         })
         .collect();
     let Some(first) = points.first() else {
-        return Err(SolverError::new("E_NO_PROGRAM", "the answer has no points"));
+        return Err(SolverError::new(ErrorCode::NoProgram, "the answer has no points"));
     };
     if points.len() < 2 {
-        return Err(SolverError::new("E_NO_PROGRAM", "the answer has no block"));
+        return Err(SolverError::new(ErrorCode::NoProgram, "the answer has no block"));
     }
     let mut path = Toolpath::default();
     path.rapid(Vec3::new(first.x, first.y, answer.safe_z));

@@ -1,6 +1,7 @@
 //! The segment request as clients send it (api.md, Segment) and its validation into a `Job`
 //! with the machine's defaults applied (chord.md §1.2 inputs, §4 E6 and E16).
 
+use crate::error::ErrorCode;
 pub use crate::geometry::Direction;
 use serde::{Deserialize, Serialize};
 
@@ -360,7 +361,7 @@ impl Curve {
                 let swept = sweep(start, end, *direction);
                 if swept == 0.0 {
                     return Err(SolverError::new(
-                        "E_DEGENERATE_CURVE",
+                        ErrorCode::DegenerateCurve,
                         "the arc starts and ends at the same angle: it has no length (use 0 and 360 for a full circle)",
                     )
                     .at("curve.end_deg"));
@@ -386,7 +387,7 @@ impl Curve {
                 let swept = sweep(start, end, *direction);
                 if swept == 0.0 {
                     return Err(SolverError::new(
-                        "E_DEGENERATE_CURVE",
+                        ErrorCode::DegenerateCurve,
                         "the ellipse arc starts and ends at the same angle: it has no length",
                     )
                     .at("curve.end_deg"));
@@ -449,7 +450,7 @@ impl Curve {
                 }
                 if vertices.len() < 2 {
                     return Err(SolverError::new(
-                        "E_DEGENERATE_CURVE",
+                        ErrorCode::DegenerateCurve,
                         "a polyline needs at least two distinct points",
                     )
                     .at("curve.points"));
@@ -481,7 +482,7 @@ impl Curve {
                 let nurbs = Nurbs::new(*degree, &control, knots.as_deref(), weights.as_deref(), "curve")?;
                 if control.windows(2).all(|pair| pair[0] == pair[1]) {
                     return Err(SolverError::new(
-                        "E_DEGENERATE_CURVE",
+                        ErrorCode::DegenerateCurve,
                         "all control points coincide: the curve has no length",
                     )
                     .at("curve.control_points"));

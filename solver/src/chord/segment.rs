@@ -6,6 +6,7 @@
 use super::numeric::last_fitting;
 use super::rule::{BlockRule, ChordStatus, Infeasible, chord_length};
 use super::shape::{Shape, circumradius};
+use crate::error::ErrorCode;
 use crate::error::SolverError;
 use crate::geometry::Vec3;
 
@@ -167,7 +168,7 @@ impl Cutter<'_> {
         };
         let end = last_fitting(g, lo_u, lo_dev.sqrt() - root, hi_u, hi_dev.sqrt() - root, tol).ok_or_else(|| {
             SolverError::new(
-                "E_NUMERIC_FAILURE",
+                ErrorCode::NumericFailure,
                 format!("the chord search did not converge at s = {:.6} mm (E14)", start.s),
             )
             .at("curve")
@@ -181,7 +182,7 @@ impl Cutter<'_> {
     fn push(&self, cut: &mut Cut, vertex: Vertex, span_end: f64) -> Result<(), SolverError> {
         if cut.vertices.len() > self.max_blocks {
             return Err(SolverError::new(
-                "E_TOO_MANY_BLOCKS",
+                ErrorCode::TooManyBlocks,
                 format!(
                     "the segmentation needs more than {} blocks; raise the chord error (feed, margin, \
                      min_chord_error or tolerance) or shorten the curve",
@@ -195,7 +196,7 @@ impl Cutter<'_> {
             && vertex.u != span_end
         {
             return Err(SolverError::new(
-                "E_NUMERIC_FAILURE",
+                ErrorCode::NumericFailure,
                 format!(
                     "no chord longer than {MIN_PROGRESS} mm fits at s = {:.6} mm: the chord error is too small for \
                      the curve here (E14)",
@@ -248,7 +249,7 @@ impl Cutter<'_> {
             let count = ((s_end - s_start) / window).ceil().max(1.0);
             if out.len() as f64 + count > self.max_blocks as f64 {
                 return Err(SolverError::new(
-                    "E_TOO_MANY_BLOCKS",
+                    ErrorCode::TooManyBlocks,
                     format!(
                         "windows of {window} mm cut this curve into more than {} pieces; lengthen the window",
                         self.max_blocks
@@ -439,7 +440,7 @@ mod tests {
         let spans = [shape.domain()];
         let cutter = Cutter { shape: &shape, spans: &spans, max_blocks: 10, limit_field: "compare_tolerance" };
         let error = cutter.constant(0.001, 50.0).unwrap_err();
-        assert_eq!(error.code(), "E_TOO_MANY_BLOCKS");
+        assert_eq!(error.code(), ErrorCode::TooManyBlocks);
         assert_eq!(error.field(), Some("compare_tolerance"));
     }
 
@@ -450,7 +451,7 @@ mod tests {
         let spans = [shape.domain()];
         let cutter = Cutter { shape: &shape, spans: &spans, max_blocks: 1000, limit_field: "tolerance" };
         let error = cutter.constant(0.0, f64::INFINITY).unwrap_err();
-        assert_eq!(error.code(), "E_NUMERIC_FAILURE");
+        assert_eq!(error.code(), ErrorCode::NumericFailure);
     }
 
     #[test]

@@ -9,6 +9,7 @@
 use super::arclength::ArcLengthTable;
 use super::numeric::minimise;
 use super::nurbs::Nurbs;
+use crate::error::ErrorCode;
 use crate::error::SolverError;
 use crate::geometry::{Vec3, distance_to_segment};
 
@@ -498,7 +499,7 @@ pub(crate) fn require_length(shape: &Shape, field: &str) -> Result<f64, SolverEr
     let length = shape.length();
     if length.is_nan() || length <= 1e-9 || !length.is_finite() {
         return Err(SolverError::new(
-            "E_DEGENERATE_CURVE",
+            ErrorCode::DegenerateCurve,
             format!("the curve has no length ({length:e} mm): nothing to segment"),
         )
         .at(field));

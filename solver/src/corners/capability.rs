@@ -2,6 +2,7 @@
 //! operation `contour`; and the loops added to a path made elsewhere (`POST
 //! /api/v1/contour/loops`, corners.md §3.4), which answers JSON only and is no job operation.
 
+use crate::error::ErrorCode;
 use serde::{Deserialize, Serialize};
 
 use super::detect::{self, DetectMode, MaterialSide, PathLoopAnswer, PathLoopRequest};
@@ -105,7 +106,7 @@ impl Capability for ContourCapability {
 
 /// A JSON answer over [`MAX_JSON_MOVES`] gets the advice to ask for G-code or submit a job.
 fn json_limit_advice(error: SolverError) -> SolverError {
-    if error.code() != "E_TOO_MANY_MOVES" {
+    if error.code() != ErrorCode::TooManyMoves {
         return error;
     }
     let advice = format!(

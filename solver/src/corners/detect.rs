@@ -3,6 +3,7 @@
 //! its radial-difference measure (f), and the rotation-invariant turn-angle rule recommended as
 //! the default.
 
+use crate::error::ErrorCode;
 use serde::{Deserialize, Serialize};
 
 use crate::planar::{Vec2, centroid, turn_angle};
@@ -204,7 +205,7 @@ pub fn loop_path_within(
     let radius = positive("tool_radius", request.tool_radius)?;
     if request.path.len() > contour_request::MAX_POINTS {
         return Err(SolverError::new(
-            "E_TOO_MANY_POINTS",
+            ErrorCode::TooManyPoints,
             format!("the path has {} points; the limit is {}", request.path.len(), contour_request::MAX_POINTS),
         )
         .at("path"));
@@ -222,12 +223,14 @@ pub fn loop_path_within(
     }
     let n = points.len();
     if n < 3 {
-        return Err(SolverError::new("E_DEGENERATE", "the path needs at least 3 distinct points").at("path"));
+        return Err(SolverError::new(ErrorCode::Degenerate, "the path needs at least 3 distinct points").at("path"));
     }
     if n > max_moves {
-        return Err(
-            SolverError::new("E_TOO_MANY_MOVES", format!("the path alone has more than {max_moves} moves")).at("path")
-        );
+        return Err(SolverError::new(
+            ErrorCode::TooManyMoves,
+            format!("the path alone has more than {max_moves} moves"),
+        )
+        .at("path"));
     }
     let tolerance = request.tolerance.unwrap_or(contour_request::DEFAULT_TOLERANCE);
     if finite("tolerance", tolerance)? < contour_request::MIN_TOLERANCE {
@@ -351,7 +354,7 @@ pub fn loop_path_within(
         let looped_moves = loop_moves(&shape, &p);
         if moves.len() + looped_moves.len() + (n - step) > max_moves {
             return Err(SolverError::new(
-                "E_TOO_MANY_MOVES",
+                ErrorCode::TooManyMoves,
                 format!(
                     "the looped path needs more than {max_moves} moves: use a coarser tolerance, smaller loops or fewer points"
                 ),

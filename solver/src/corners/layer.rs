@@ -3,6 +3,7 @@
 //! φ_k and material angles α_k, and a segment grid of its edges for the global checks.
 
 use super::prepare::Contour;
+use crate::error::ErrorCode;
 use crate::error::SolverError;
 use crate::planar::{SegmentGrid, Vec2, miter_point, right_normal, turn_angle};
 
@@ -74,7 +75,7 @@ impl Layer {
                 for k in 0..n {
                     if (moved[(k + 1) % n] - moved[k]).dot(&directions[k]) <= 0.0 {
                         return Err(SolverError::new(
-                            "E_OFFSET_COLLAPSE",
+                            ErrorCode::OffsetCollapse,
                             format!(
                                 "with its wall tilts the edge from contour[{}] vanishes at this layer",
                                 contour.source[prepared_edge[k]]

@@ -6,6 +6,7 @@
 //! not meet (a parallel-sided notch narrower than the tool), or fewer than three edges remain,
 //! the tool does not fit: `E_OFFSET_COLLAPSE`.
 
+use crate::error::ErrorCode;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
@@ -98,7 +99,8 @@ pub(crate) fn offset(
     let mut start: Vec<Vec2> = Vec::with_capacity(n);
     for (k, &before) in previous.iter().enumerate() {
         start.push(corner(before, k).ok_or_else(|| {
-            SolverError::new("E_DEGENERATE", format!("the contour reverses by 180° at {}", field(k))).at(field(k))
+            SolverError::new(ErrorCode::Degenerate, format!("the contour reverses by 180° at {}", field(k)))
+                .at(field(k))
         })?);
     }
     let scale = layer.lengths.iter().copied().fold(0.0, f64::max).max(1.0);
@@ -175,7 +177,7 @@ pub(crate) fn offset(
 
 fn collapse(describe_tool: &str, field: &str, length: f64, offset_length: f64) -> SolverError {
     SolverError::new(
-        "E_OFFSET_COLLAPSE",
+        ErrorCode::OffsetCollapse,
         format!(
             "{describe_tool} does not fit at the edge from {field} (length {length:.6}): its offset edge has length {offset_length:.6} and the neighbouring offsets do not meet"
         ),

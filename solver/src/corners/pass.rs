@@ -9,6 +9,7 @@ use super::loops::{self, LoopShape};
 use super::offset::{self, Offset};
 use super::relief::{self, ReliefShape};
 use super::request::{CornerChoice, Join, LoopConfig, LoopStyle, PassJob, Relief};
+use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};
 use crate::planar::{SegmentGrid, Vec2, find_self_intersection, signed_area};
 
@@ -459,7 +460,7 @@ fn check_loop_budget(layer: &Layer, offset: &Offset, input: &PassInput<'_>) -> R
         }
         if moves > super::request::MAX_MOVES {
             return Err(SolverError::new(
-                "E_TOO_MANY_MOVES",
+                ErrorCode::TooManyMoves,
                 format!(
                     "the corner loops alone need more than {} moves: use a coarser tolerance or smaller loops",
                     super::request::MAX_MOVES
@@ -480,7 +481,7 @@ fn check_offset(layer: &Layer, offset: &Offset, input: &PassInput<'_>, tool: &st
         Ok(Some((i, j))) => {
             let (first, second) = (input.edge_source[edges[i]], input.edge_source[edges[j]]);
             return Err(SolverError::new(
-                "E_OFFSET_SELF_INTERSECTION",
+                ErrorCode::OffsetSelfIntersection,
                 format!(
                     "{tool} does not fit between the edges from {} and {}: their offsets cross",
                     field(first),
@@ -491,16 +492,15 @@ fn check_offset(layer: &Layer, offset: &Offset, input: &PassInput<'_>, tool: &st
         }
         Err(_) => {
             return Err(SolverError::new(
-                "E_TOO_COMPLEX",
+                ErrorCode::TooComplex,
                 "the offset path's edges are too crowded to check in bounded time",
             )
             .at("contour"));
         }
     }
     if signed_area(&polygon) * signed_area(&layer.vertices) <= 0.0 {
-        return Err(
-            SolverError::new("E_OFFSET_COLLAPSE", format!("{tool} does not fit inside the contour")).at("contour")
-        );
+        return Err(SolverError::new(ErrorCode::OffsetCollapse, format!("{tool} does not fit inside the contour"))
+            .at("contour"));
     }
     Ok(())
 }
@@ -621,7 +621,7 @@ fn check_clearance(
             {
                 let source = input.edge_source[edge];
                 return Err(SolverError::new(
-                    "E_OFFSET_SELF_INTERSECTION",
+                    ErrorCode::OffsetSelfIntersection,
                     format!(
                         "the tool (radius {} + allowance {}) does not fit: near ({:.4}, {:.4}) the path comes within {distance:.6} of the edge from {} (a neck narrower than twice that)",
                         input.radius,

@@ -2,6 +2,7 @@
 //! simple-polygon check and the orientation (counter-clockwise, api.md Contour).
 
 use super::request::MAX_POINTS;
+use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning, finite};
 use crate::planar::{self, Vec2, find_self_intersection, signed_area, turn_angle};
 
@@ -82,7 +83,7 @@ impl Contour {
 pub(crate) fn prepare(points: &[[f64; 2]], fix_orientation: bool) -> Result<(Contour, Vec<Warning>), SolverError> {
     if points.len() > MAX_POINTS {
         return Err(SolverError::new(
-            "E_TOO_MANY_POINTS",
+            ErrorCode::TooManyPoints,
             format!("the contour has {} points; the limit is {MAX_POINTS}", points.len()),
         )
         .at("contour"));
@@ -118,7 +119,7 @@ pub(crate) fn prepare(points: &[[f64; 2]], fix_orientation: bool) -> Result<(Con
     }
     if kept.len() < 3 {
         return Err(SolverError::new(
-            "E_DEGENERATE",
+            ErrorCode::Degenerate,
             format!("the contour needs at least 3 distinct points (got {})", kept.len()),
         )
         .at("contour"));
@@ -131,7 +132,7 @@ pub(crate) fn prepare(points: &[[f64; 2]], fix_orientation: bool) -> Result<(Con
         Ok(Some((i, j))) => {
             let (first, second) = (kept[i].1, kept[j].1);
             return Err(SolverError::new(
-                "E_SELF_INTERSECTION",
+                ErrorCode::SelfIntersection,
                 format!(
                     "the contour is not a simple polygon: the edge from contour[{first}] meets the edge from contour[{second}]"
                 ),
@@ -140,7 +141,7 @@ pub(crate) fn prepare(points: &[[f64; 2]], fix_orientation: bool) -> Result<(Con
         }
         Err(_) => {
             return Err(SolverError::new(
-                "E_TOO_COMPLEX",
+                ErrorCode::TooComplex,
                 "the contour's edges are too crowded to check for self-intersection in bounded time",
             )
             .at("contour"));
@@ -150,7 +151,7 @@ pub(crate) fn prepare(points: &[[f64; 2]], fix_orientation: bool) -> Result<(Con
     removed.extend(straight);
     if kept.len() < 3 {
         return Err(SolverError::new(
-            "E_DEGENERATE",
+            ErrorCode::Degenerate,
             "the contour has fewer than 3 corners once straight points are removed",
         )
         .at("contour"));
@@ -169,7 +170,7 @@ pub(crate) fn prepare(points: &[[f64; 2]], fix_orientation: bool) -> Result<(Con
     if reversed {
         if !fix_orientation {
             return Err(SolverError::new(
-                "E_ORIENTATION",
+                ErrorCode::Orientation,
                 format!(
                     "the contour runs clockwise (signed area {area:.6} mm²); give it counter-clockwise or set fix_orientation"
                 ),
@@ -192,7 +193,7 @@ fn check_duplicates(kept: &[(Vec2, usize)]) -> Result<(), SolverError> {
         if (a.0 - b.0).norm() <= DUPLICATE_TOLERANCE {
             let (first, second) = (a.1.min(b.1), a.1.max(b.1));
             return Err(SolverError::new(
-                "E_DUPLICATE_POINT",
+                ErrorCode::DuplicatePoint,
                 format!("contour[{second}] repeats contour[{first}]: the polygon touches itself"),
             )
             .at(format!("contour[{second}]")));
@@ -213,9 +214,11 @@ fn check_area(kept: &[(Vec2, usize)]) -> Result<(), SolverError> {
     let length = axis.norm();
     let spread = kept.iter().map(|(p, _)| planar::cross(&axis, &(p - origin)).abs() / length).fold(0.0, f64::max);
     if length == 0.0 || spread <= DUPLICATE_TOLERANCE {
-        return Err(
-            SolverError::new("E_DEGENERATE", "the contour has zero area: all its points lie on one line").at("contour")
-        );
+        return Err(SolverError::new(
+            ErrorCode::Degenerate,
+            "the contour has zero area: all its points lie on one line",
+        )
+        .at("contour"));
     }
     Ok(())
 }
@@ -285,7 +288,7 @@ mod tests {
     #[test]
     fn clockwise_contours_are_refused_or_reversed() {
         let points = [[0.0, 0.0], [0.0, 10.0], [10.0, 10.0], [10.0, 0.0]];
-        assert_eq!(prepare(&points, false).unwrap_err().code(), "E_ORIENTATION");
+        assert_eq!(prepare(&points, false).unwrap_err().code(), ErrorCode::Orientation);
         let (contour, warnings) = prepare(&points, true).unwrap();
         assert!(contour.reversed);
         assert_eq!(contour.source, vec![3, 2, 1, 0]);
@@ -300,13 +303,13 @@ mod tests {
     #[test]
     fn bad_polygons_have_their_codes() {
         let code = |points: &[[f64; 2]]| prepare(points, false).unwrap_err().code();
-        assert_eq!(code(&[[0.0, 0.0], [1.0, 0.0]]), "E_DEGENERATE");
-        assert_eq!(code(&[[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]), "E_DEGENERATE");
-        assert_eq!(code(&[[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]]), "E_SELF_INTERSECTION");
+        assert_eq!(code(&[[0.0, 0.0], [1.0, 0.0]]), ErrorCode::Degenerate);
+        assert_eq!(code(&[[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]), ErrorCode::Degenerate);
+        assert_eq!(code(&[[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]]), ErrorCode::SelfIntersection);
         assert_eq!(
             code(&[[0.0, 0.0], [4.0, 0.0], [2.0, 2.0], [4.0, 4.0], [0.0, 4.0], [2.0, 2.0]]),
-            "E_DUPLICATE_POINT"
+            ErrorCode::DuplicatePoint
         );
-        assert_eq!(code(&[[0.0, 0.0], [f64::NAN, 0.0], [1.0, 1.0]]), "E_INPUT");
+        assert_eq!(code(&[[0.0, 0.0], [f64::NAN, 0.0], [1.0, 1.0]]), ErrorCode::Input);
     }
 }

@@ -3,6 +3,7 @@
 //! they clear the stock).
 
 use super::answer::{ContourAnswer, MoveKind};
+use crate::error::ErrorCode;
 use crate::error::SolverError;
 
 use crate::gcode::{self, Post, Program, Reference, SpindleDirection};
@@ -17,7 +18,7 @@ use crate::path::Toolpath;
 pub fn program(answer: &ContourAnswer, post: &Post) -> Result<String, SolverError> {
     if answer.tilted {
         return Err(SolverError::new(
-            "E_TILT_NEEDS_5_AXIS",
+            ErrorCode::TiltNeeds5Axis,
             "tilted walls need a 5-axis program with tool orientation; only the JSON answer carries the axes",
         )
         .at("tilt_deg"));

@@ -1,6 +1,7 @@
 //! The contour request as clients send it (api.md, Contour) and its validation into a `Job`
 //! (corners.md §1.4 inputs, §3.1 preparation, §5 input codes).
 
+use crate::error::ErrorCode;
 use serde::{Deserialize, Serialize};
 
 use super::element::Chording;
@@ -652,7 +653,7 @@ pub(crate) fn layer_heights(top: f64, bottom: f64, step: f64) -> Result<Vec<f64>
     let count = (depth / step - 1e-9).ceil().max(1.0);
     if count > MAX_LAYERS as f64 {
         return Err(SolverError::new(
-            "E_TOO_MANY_LAYERS",
+            ErrorCode::TooManyLayers,
             format!("{count} layers of at most {step} mm from {top} to {bottom}: the limit is {MAX_LAYERS}"),
         )
         .at("depths.step"));
@@ -675,6 +676,6 @@ mod tests {
         assert!((layers[0] + 5.0 / 3.0).abs() < 1e-12);
         assert_eq!(layers[2], -5.0);
         assert_eq!(layer_heights(1.0, 1.0, 2.0).unwrap(), vec![1.0]);
-        assert_eq!(layer_heights(0.0, -1e6, 1.0).unwrap_err().code(), "E_TOO_MANY_LAYERS");
+        assert_eq!(layer_heights(0.0, -1e6, 1.0).unwrap_err().code(), ErrorCode::TooManyLayers);
     }
 }

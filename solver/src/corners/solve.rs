@@ -15,6 +15,7 @@ use super::pass::{self, Action, GOUGE_TOLERANCE, MAX_ARC_STEPS, PassInput, PassP
 use super::prepare::list_indices;
 use super::request::{ContourRequest, CutDirection, Job, Join, LoopStyle, MAX_MOVES, Side};
 use crate::chord::MachineProfile;
+use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
 use crate::planar::{SegmentGrid, Vec2, array2, cross, miter_point};
@@ -131,7 +132,7 @@ pub fn solve_with(
     }
     if job.tilt.is_some() && job.layers.len().saturating_mul(first_layer.len()) > MAX_TILTED_VERTEX_LAYERS {
         return Err(SolverError::new(
-            "E_TOO_MANY_MOVES",
+            ErrorCode::TooManyMoves,
             format!(
                 "tilted walls plan every layer: {} layers × {} corners exceed {MAX_TILTED_VERTEX_LAYERS}",
                 job.layers.len(),
@@ -176,8 +177,9 @@ pub fn solve_with(
         ));
     }
 
-    let final_pass =
-        first_passes.last().ok_or_else(|| SolverError::new("E_INPUT", "at least one pass is needed").at("passes"))?;
+    let final_pass = first_passes
+        .last()
+        .ok_or_else(|| SolverError::new(ErrorCode::Input, "at least one pass is needed").at("passes"))?;
     let corners = corner_reports(&job, &setup, &first_layer, final_pass);
     warnings.extend(corner_warnings(&job, &first_passes, &corners));
     let passes: Vec<PassReport> = first_passes.iter().map(pass_report).collect();
@@ -251,7 +253,7 @@ pub fn solve_with(
 
 fn too_many_moves(layers: usize, per_layer: usize, total: usize, limit: usize) -> SolverError {
     SolverError::new(
-        "E_TOO_MANY_MOVES",
+        ErrorCode::TooManyMoves,
         format!(
             "{layers} layers of about {per_layer} moves make {total} moves; the limit is {limit}: use a larger depths.step, tolerance or fewer points"
         ),

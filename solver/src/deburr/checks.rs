@@ -5,6 +5,7 @@ use super::centre::{Construction, RidgeCentre};
 use super::profile::Profile;
 use super::request::{Edge, Job};
 use super::tolerance::Target;
+use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
 
@@ -18,7 +19,7 @@ pub(crate) fn ridge(job: &Job) -> Result<Vec<Warning>, SolverError> {
     let r1 = job.cylinder_radius;
     if reach >= r1 {
         return Err(SolverError::new(
-            "E_HOLE_TOO_LARGE",
+            ErrorCode::HoleTooLarge,
             format!("hole too large: |eccentricity| + half-width = {reach} must be below the cylinder radius {r1}"),
         )
         .at("hole.radius"));
@@ -28,7 +29,7 @@ pub(crate) fn ridge(job: &Job) -> Result<Vec<Warning>, SolverError> {
         && reach >= inner
     {
         return Err(SolverError::new(
-            "E_NOT_THROUGH",
+            ErrorCode::NotThrough,
             format!(
                 "the hole reaches |x| = {reach} across the tube, not below the inner radius {inner}: it does not \
                  meet the bore as a separate loop"
@@ -39,7 +40,7 @@ pub(crate) fn ridge(job: &Job) -> Result<Vec<Warning>, SolverError> {
     let ball = job.tool.radius;
     if job.width >= 2.0 * ball {
         return Err(SolverError::new(
-            "E_WIDTH_VS_BALL",
+            ErrorCode::WidthVsBall,
             format!(
                 "ball too small for Q: the band width W = {:.4} must be below the ball diameter {}",
                 job.width,
@@ -151,7 +152,7 @@ pub(crate) fn far_gouge(job: &Job, targets: &[Target], centres: &[Vec3]) -> Resu
 fn far_gouge_error(job: &Job, target: &Target, what: &str) -> SolverError {
     let segment = &job.profile.segments[target.segment];
     SolverError::new(
-        "E_FAR_GOUGE",
+        ErrorCode::FarGouge,
         format!(
             "{what} at {} s = {:.4}: ball radius {} is too large for this hole (R2 = {})",
             segment.name, target.parameter, job.tool.radius, job.profile.radius
@@ -175,7 +176,7 @@ pub(crate) fn inner_access(
     let ball = job.tool.radius;
     let approach = (ball >= profile.inscribed_radius()).then(|| {
         SolverError::new(
-            "E_NO_APPROACH",
+            ErrorCode::NoApproach,
             format!(
                 "the ball (radius {ball}) cannot pass through the hole (half-width {}), so no approach down the hole \
                  axis exists; approach from the bore end instead",
@@ -207,7 +208,7 @@ pub(crate) fn inner_access(
     }
     if tightest < 0.0 {
         let error = SolverError::new(
-            "E_NECK_COLLISION",
+            ErrorCode::NeckCollision,
             format!("the neck (radius {neck}) would cut the hole wall: it is short of room by {:.4} mm", -tightest),
         )
         .at("tool.neck_radius");

@@ -1,5 +1,6 @@
 //! The local frame of a cross hole and its map to machine coordinates (deburr.md §1.3, §1.4).
 
+use crate::error::ErrorCode;
 use nalgebra::Matrix3;
 
 use crate::error::SolverError;
@@ -36,7 +37,7 @@ impl Frame {
             let scale = origin_on_axis.norm().max(hole_point.norm()).max(1.0);
             if (given - from_point).abs() > 1e-6 * scale {
                 return Err(SolverError::new(
-                    "E_INCONSISTENT_ECC",
+                    ErrorCode::InconsistentEcc,
                     format!("eccentricity {given} disagrees with axis_point, which gives {from_point:.6}"),
                 )
                 .at("hole.eccentricity"));
@@ -93,6 +94,6 @@ mod tests {
         assert_abs_diff_eq!(moved.origin, frame.point(&Vec3::new(0.0, 7.0, 0.0)), epsilon = 1e-12);
         assert!(Frame::resolve(origin, 30.0, 15.0, Some(hole_point), Some(4.0)).is_ok());
         let error = Frame::resolve(origin, 30.0, 15.0, Some(hole_point), Some(3.0)).unwrap_err();
-        assert_eq!(error.code(), "E_INCONSISTENT_ECC");
+        assert_eq!(error.code(), ErrorCode::InconsistentEcc);
     }
 }

@@ -37,6 +37,7 @@ pub use diagnostics::{ExactConstruction, PointConstruction, construction_at, ide
 pub use program::program;
 pub use request::{CentreDistance, DeburrRequest, Direction, Edge, Hole, HoleShape, Method, Workpiece};
 
+use crate::error::ErrorCode;
 use centre::{Construction, RidgeCentre};
 use envelope::EnvelopePath;
 use swept_width::SweptWidths;
@@ -120,7 +121,7 @@ fn solve_centred(
     let single_section = |segment: usize, s: f64, ridge: &RidgeCentre| {
         construction.exact(profile, ridge).map(|(c, _, _)| c).ok_or_else(|| {
             SolverError::new(
-                "E_EXACT_NO_SOLUTION",
+                ErrorCode::ExactNoSolution,
                 format!(
                     "no band edges on the true surfaces near {} s = {s:.6}: the chamfer is too wide for the curvature here",
                     profile.segments[segment].name
@@ -374,7 +375,7 @@ fn point_checks(job: &Job, targets: &[Target], ridges: &[RidgeCentre]) -> Result
         let name = job.profile.segments[target.segment].name;
         if ridge.centre_offset <= -ball {
             return Err(SolverError::new(
-                "E_BALL_MISSES_EDGE",
+                ErrorCode::BallMissesEdge,
                 format!(
                     "at {name} s = {:.4} the wedge is so sharp (β = {:.2}°) that the ball would not reach the edge: \
                      reduce Q or use a larger ball",

@@ -9,6 +9,7 @@
 use super::answer::{Deburr, LeadMotion, LeadMove};
 use super::frame::Frame;
 use super::request::{Edge, Job};
+use crate::error::ErrorCode;
 use crate::error::SolverError;
 use crate::gcode::{self, Post, Program, Reference, SpindleDirection};
 use crate::geometry::{Vec3, array3, vec3};
@@ -27,7 +28,7 @@ pub(crate) fn safe_centre_z(job: &Job, frame: &Frame) -> Result<f64, SolverError
             Ok(frame.origin.z + face + job.clearance + job.tool.radius)
         }
         _ => Err(SolverError::new(
-            "E_NO_CLEARANCE_PLANE",
+            ErrorCode::NoClearancePlane,
             "the clearance plane is unknown for this bore_block: give workpiece.face_distance (vertical holes) or safe_z",
         )
         .at("safe_z")),
@@ -108,7 +109,7 @@ pub fn program(deburr: &Deburr, post: &Post) -> Result<String, SolverError> {
         add(step.motion, step.centre);
     }
     let safe_centre_z = deburr.summary.safe_centre_z.ok_or_else(|| {
-        SolverError::new("E_NO_CLEARANCE_PLANE", "the clearance plane is unknown; give safe_z").at("safe_z")
+        SolverError::new(ErrorCode::NoClearancePlane, "the clearance plane is unknown; give safe_z").at("safe_z")
     })?;
     let mut comments = deburr.description.clone();
     comments.push(format!(

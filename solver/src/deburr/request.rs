@@ -1,6 +1,7 @@
 //! The deburr request as clients send it (api.md, Deburr) and its validation into a [`Job`]
 //! (deburr.md §1.4 inputs, §4 `E_INPUT`/`E_NOT_THROUGH`/`E_INCONSISTENT_ECC`).
 
+use crate::error::ErrorCode;
 pub use crate::geometry::Direction;
 use serde::{Deserialize, Serialize};
 
@@ -264,7 +265,7 @@ impl DeburrRequest {
         size("tool.radius", tool.radius)?;
         if tool.kind != ToolKind::Ball {
             return Err(SolverError::new(
-                "E_TOOL_KIND",
+                ErrorCode::ToolKind,
                 format!("deburring needs a ball end mill, but the tool is {}", tool.kind.as_str()),
             )
             .at("tool"));
@@ -275,7 +276,7 @@ impl DeburrRequest {
                 let outer = size("workpiece.outer_radius", *outer_radius)?;
                 if inner >= outer {
                     return Err(SolverError::new(
-                        "E_NOT_THROUGH",
+                        ErrorCode::NotThrough,
                         format!("inner_radius {inner} must be smaller than outer_radius {outer}"),
                     )
                     .at("workpiece.inner_radius"));
@@ -361,7 +362,7 @@ impl DeburrRequest {
         let tolerance = optional_positive("tolerance", self.tolerance, DEFAULT_TOLERANCE)?;
         if tolerance < MIN_TOLERANCE {
             return Err(SolverError::new(
-                "E_TOL",
+                ErrorCode::Tol,
                 format!("tolerance {tolerance} is below the smallest reachable {MIN_TOLERANCE} mm"),
             )
             .at("tolerance"));

@@ -5,6 +5,7 @@
 //! cut by VP, come to distance D from the polyline. Measured at targets and in the middle of the
 //! intervals between them, where the moves stray furthest from the ideal centre path.
 
+use crate::error::ErrorCode;
 use std::cell::Cell;
 
 use super::centre::{Construction, RidgeCentre};
@@ -78,7 +79,7 @@ where
         }
         if refined.targets.len() + splits.len() > max_points {
             return Err(SolverError::new(
-                "E_TOO_MANY_POINTS",
+                ErrorCode::TooManyPoints,
                 format!("the chamfer width needs more than {max_points} points; raise the tolerance"),
             )
             .at("tolerance"));

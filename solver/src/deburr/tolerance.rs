@@ -8,6 +8,7 @@
 
 use super::profile::Profile;
 use crate::chord::BlockRule;
+use crate::error::ErrorCode;
 use crate::error::SolverError;
 use crate::geometry::{Vec3, distance_to_segment};
 
@@ -203,7 +204,7 @@ where
     ) -> Result<(), SolverError> {
         if self.out.targets.len() > self.max_points {
             return Err(SolverError::new(
-                "E_TOO_MANY_POINTS",
+                ErrorCode::TooManyPoints,
                 format!("the tolerance needs more than {} points; raise it", self.max_points),
             )
             .at("tolerance"));
@@ -236,7 +237,7 @@ where
         }
         if depth >= MAX_DEPTH {
             return Err(SolverError::new(
-                "E_TOL",
+                ErrorCode::Tol,
                 format!("tolerance {} not reached after {MAX_DEPTH} bisections", self.spacing.tolerance()),
             )
             .at("tolerance"));
@@ -311,7 +312,7 @@ where
             }
             if deviation > limit {
                 return Err(SolverError::new(
-                    "E_TOL",
+                    ErrorCode::Tol,
                     format!("tolerance {tolerance} not reached after {MAX_DEPTH} bisections"),
                 )
                 .at("tolerance"));
@@ -320,7 +321,7 @@ where
             limits.push(IntervalLimit { why, limit, radius: estimated_radius(chord, deviation), deviation });
             if out_targets.len() > max_points {
                 return Err(SolverError::new(
-                    "E_TOO_MANY_POINTS",
+                    ErrorCode::TooManyPoints,
                     format!("the tolerance needs more than {max_points} points; raise it"),
                 )
                 .at("tolerance"));

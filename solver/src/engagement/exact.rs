@@ -7,6 +7,7 @@
 //! the end circles). Between two consecutive crossings membership cannot change, so one test at
 //! the middle decides the whole sub-arc and the arc ends are exact, with no δθ.
 
+use crate::error::ErrorCode;
 use std::f64::consts::PI;
 
 use super::arcs::{Arc, normalise};
@@ -80,7 +81,7 @@ impl ExactEngine {
     fn check_budget(&self) -> Result<(), SolverError> {
         if self.tests > MAX_TESTS {
             return Err(SolverError::new(
-                "E_WORK_LIMIT",
+                ErrorCode::WorkLimit,
                 format!(
                     "the exact engine exceeded its limit of {MAX_TESTS} boundary tests: use a larger step or a simpler stock"
                 ),

@@ -6,6 +6,7 @@
 use super::answer::{EngagementAnswer, PathEngagement};
 use super::segments::{Route, Shape};
 use crate::chord::{BlockRule, PathBlocks, path_blocks, short_block_warning};
+use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};
 use crate::gcode::{self, Post, Program, Reference};
 use crate::geometry::Vec3;
@@ -131,7 +132,7 @@ fn cut(result: &PathEngagement, lift: f64) -> Result<Cut, SolverError> {
     let route = &data.route.0;
     let mut path = Toolpath::default();
     let Some(first) = route.pieces.first() else {
-        return Err(SolverError::new("E_PATH", "the path is empty").at("path"));
+        return Err(SolverError::new(ErrorCode::Path, "the path is empty").at("path"));
     };
     let start = first.shape.start_point();
     path.rapid(Vec3::new(start.x, start.y, safe_z));
@@ -189,7 +190,7 @@ fn cut(result: &PathEngagement, lift: f64) -> Result<Cut, SolverError> {
                 chords += count as f64;
                 if chords > super::MAX_CHORDS {
                     return Err(SolverError::new(
-                        "E_TOO_LARGE",
+                        ErrorCode::TooLarge,
                         format!(
                             "the program would need more than {:.0e} moves for its arcs; the limit is {:.0e}",
                             super::MAX_CHORDS,

@@ -1,6 +1,7 @@
 //! The engagement request as clients send it (api.md, Engagement; engagement.md §2) and its
 //! validation into a `Job` before any heavy work (§9 `E_INPUT`, `E_PATH`, and the size limits).
 
+use crate::error::ErrorCode;
 pub use crate::geometry::Direction;
 use std::fmt;
 
@@ -514,7 +515,7 @@ fn optional(
 }
 
 fn too_large(field: &str, what: &str, count: usize, limit: usize) -> SolverError {
-    SolverError::new("E_TOO_LARGE", format!("{what}: {count} exceeds the limit of {limit}")).at(field)
+    SolverError::new(ErrorCode::TooLarge, format!("{what}: {count} exceeds the limit of {limit}")).at(field)
 }
 
 /// A path's pieces, zero-length ones dropped with a warning (engagement.md §2.3).
@@ -542,19 +543,21 @@ pub(crate) fn read_path(input: &PathInput, field: &str, warnings: &mut Vec<Warni
         }
         PathInput::Segments(PathSegments { gcode: Some(text), start, segments }) => {
             if start.is_some() || segments.is_some() {
-                return Err(SolverError::new("E_PATH", "give the path as gcode or as start and segments, not both")
-                    .at(format!("{field}.gcode")));
+                return Err(SolverError::new(
+                    ErrorCode::Path,
+                    "give the path as gcode or as start and segments, not both",
+                )
+                .at(format!("{field}.gcode")));
             }
             read_gcode_path(text, &format!("{field}.gcode"), &mut shapes, &mut dropped)?;
         }
         PathInput::Segments(program) => {
             let start = program.start.ok_or_else(|| {
-                SolverError::new("E_PATH", "the path needs a start point [x, y]").at(format!("{field}.start"))
+                SolverError::new(ErrorCode::Path, "the path needs a start point [x, y]").at(format!("{field}.start"))
             })?;
-            let segments = program
-                .segments
-                .as_ref()
-                .ok_or_else(|| SolverError::new("E_PATH", "the path needs segments").at(format!("{field}.segments")))?;
+            let segments = program.segments.as_ref().ok_or_else(|| {
+                SolverError::new(ErrorCode::Path, "the path needs segments").at(format!("{field}.segments"))
+            })?;
             if segments.len() > MAX_SEGMENTS {
                 return Err(too_large(&format!("{field}.segments"), "path segments", segments.len(), MAX_SEGMENTS));
             }
@@ -587,9 +590,11 @@ pub(crate) fn read_path(input: &PathInput, field: &str, warnings: &mut Vec<Warni
         }
     }
     if shapes.is_empty() {
-        return Err(
-            SolverError::new("E_PATH", "the path is empty: it needs at least one move of non-zero length").at(field)
-        );
+        return Err(SolverError::new(
+            ErrorCode::Path,
+            "the path is empty: it needs at least one move of non-zero length",
+        )
+        .at(field));
     }
     if let Some(first) = dropped.first() {
         warnings.push(Warning::new(
@@ -612,11 +617,11 @@ fn arc_shape(
 ) -> Result<Shape, SolverError> {
     let (r0, r1) = ((from - centre).norm(), (to - centre).norm());
     if r0 <= 1e-9 {
-        return Err(SolverError::new("E_PATH", "the arc centre coincides with its start point").at(field));
+        return Err(SolverError::new(ErrorCode::Path, "the arc centre coincides with its start point").at(field));
     }
     if (r0 - r1).abs() > 1e-6 * r0.max(r1) {
         return Err(SolverError::new(
-            "E_PATH",
+            ErrorCode::Path,
             format!("the arc centre is {r0:.6} mm from the start point but {r1:.6} mm from the end point"),
         )
         .at(field));
@@ -657,7 +662,7 @@ fn read_gcode_path(
             MoveKind::Arc { centre, clockwise, extra_turns } => {
                 if step.modal.plane != Plane::Xy {
                     return Err(SolverError::new(
-                        "E_PATH",
+                        ErrorCode::Path,
                         format!("line {}: arcs must be in the XY plane (G17) for an engagement path", step.line),
                     )
                     .at(field));
@@ -688,7 +693,7 @@ fn read_ring(field: &str, points: &[[f64; 2]]) -> Result<Vec<P2>, SolverError> {
     }
     if ring.len() < 3 {
         return Err(SolverError::new(
-            "E_STOCK",
+            ErrorCode::Stock,
             format!("a stock ring needs at least 3 distinct points (got {})", ring.len()),
         )
         .at(field));
@@ -718,18 +723,18 @@ fn read_stock(stock: &Stock, radius: f64, warnings: &mut Vec<Warning>) -> Result
         let cells = u64::from(bitmap.width) * u64::from(bitmap.height);
         if cells > MAX_GRID_DOTS {
             return Err(SolverError::new(
-                "E_GRID_MEMORY",
+                ErrorCode::GridMemory,
                 format!("the bitmap has {cells} cells; the limit is {MAX_GRID_DOTS}"),
             )
             .at("stock.bitmap"));
         }
         let bytes = decode_base64(&bitmap.data).ok_or_else(|| {
-            SolverError::new("E_STOCK", "stock.bitmap.data is not valid base64").at("stock.bitmap.data")
+            SolverError::new(ErrorCode::Stock, "stock.bitmap.data is not valid base64").at("stock.bitmap.data")
         })?;
         let needed = cells.div_ceil(8);
         if bytes.len() as u64 != needed {
             return Err(SolverError::new(
-                "E_STOCK",
+                ErrorCode::Stock,
                 format!(
                     "stock.bitmap.data holds {} bytes; {} × {} cells need {needed}",
                     bytes.len(),
@@ -764,7 +769,7 @@ fn read_stock(stock: &Stock, radius: f64, warnings: &mut Vec<Warning>) -> Result
         }
         if let Some(polygons) = &stock.polygons {
             if polygons.is_empty() {
-                return Err(SolverError::new("E_STOCK", "stock.polygons is empty").at("stock.polygons"));
+                return Err(SolverError::new(ErrorCode::Stock, "stock.polygons is empty").at("stock.polygons"));
             }
             for (index, polygon) in polygons.iter().enumerate() {
                 add(format!("stock.polygons[{index}].outer"), &polygon.outer)?;
@@ -776,7 +781,7 @@ fn read_stock(stock: &Stock, radius: f64, warnings: &mut Vec<Warning>) -> Result
         let outline = Outline::new(rings, radius);
         let crossing = outline.first_crossing().map_err(|_| {
             SolverError::new(
-                "E_TOO_LARGE",
+                ErrorCode::TooLarge,
                 "the stock outline crowds too many edges into the same place to check it for crossings",
             )
             .at("stock")
@@ -795,12 +800,12 @@ fn read_stock(stock: &Stock, radius: f64, warnings: &mut Vec<Warning>) -> Result
                     name(ring_b)
                 )
             };
-            return Err(SolverError::new("E_STOCK", message).at(format!("{}[{vertex_a}]", name(ring_a))));
+            return Err(SolverError::new(ErrorCode::Stock, message).at(format!("{}[{vertex_a}]", name(ring_a))));
         }
         // After the crossing test, so a bow tie is reported as crossing, not as flat.
         for (ring, field) in outline.rings().iter().zip(&fields) {
             if signed_area(ring).abs() <= 1e-12 {
-                return Err(SolverError::new("E_STOCK", "the stock ring has zero area").at(field.clone()));
+                return Err(SolverError::new(ErrorCode::Stock, "the stock ring has zero area").at(field.clone()));
             }
         }
         Base::Polygons(outline)
@@ -973,7 +978,7 @@ impl EngagementRequest {
             (Some(path), None) => vec![(None, path, "path".to_owned())],
             (None, Some(paths)) => {
                 if paths.is_empty() {
-                    return Err(SolverError::new("E_PATH", "paths is empty").at("paths"));
+                    return Err(SolverError::new(ErrorCode::Path, "paths is empty").at("paths"));
                 }
                 if paths.len() > MAX_CANDIDATES {
                     return Err(too_large("paths", "candidate paths", paths.len(), MAX_CANDIDATES));
@@ -984,7 +989,7 @@ impl EngagementRequest {
                 return Err(SolverError::input("paths", "give path or paths, not both"));
             }
             (None, None) => {
-                return Err(SolverError::new("E_PATH", "the request needs a path").at("path"));
+                return Err(SolverError::new(ErrorCode::Path, "the request needs a path").at("path"));
             }
         };
         let mut candidates = Vec::with_capacity(inputs.len());
@@ -995,7 +1000,7 @@ impl EngagementRequest {
             total_samples += route.station_count(step);
             if total_samples > MAX_SAMPLES as f64 {
                 return Err(SolverError::new(
-                    "E_TOO_MANY_SAMPLES",
+                    ErrorCode::TooManySamples,
                     format!(
                         "the path(s) would need about {total_samples:.0} samples at step {step} mm; the limit is {MAX_SAMPLES}: use a larger step"
                     ),
@@ -1010,7 +1015,7 @@ impl EngagementRequest {
                 region.cuts.iter().flat_map(|cut| cut.shapes.iter()).map(|shape| shape.chord_count(g / 100.0)).sum();
             if chords > MAX_CHORDS {
                 return Err(SolverError::new(
-                    "E_WORK_LIMIT",
+                    ErrorCode::WorkLimit,
                     format!(
                         "the earlier cuts' arcs need {chords:.2e} chords at grid {g} mm; the limit is {MAX_CHORDS:.0e}: use a larger grid or engine \"exact\""
                     ),
@@ -1027,7 +1032,7 @@ impl EngagementRequest {
             }
             if rows > MAX_DOT_ROWS {
                 return Err(SolverError::new(
-                    "E_WORK_LIMIT",
+                    ErrorCode::WorkLimit,
                     format!(
                         "the dots engine would scan about {rows:.2e} grid rows (samples × rows across the tool); the limit is {MAX_DOT_ROWS:.0e}: use a larger grid or step, or engine \"exact\""
                     ),
@@ -1040,7 +1045,7 @@ impl EngagementRequest {
             let work = total_samples * 8.0 * radius / bitmap.cell;
             if work > super::MAX_BITMAP_CROSSINGS {
                 return Err(SolverError::new(
-                    "E_TOO_MANY_SAMPLES",
+                    ErrorCode::TooManySamples,
                     format!(
                         "a bitmap with cell {} mm seen by a tool of radius {radius} mm needs about {work:.2e} edge tests over the samples; the limit is {:.0e}: use a larger step, a coarser bitmap or engine \"dots\"",
                         bitmap.cell,
@@ -1182,7 +1187,7 @@ fn check_grid(route: &Route, stock_box: BBox, anchor: P2, radius: f64, grid: f64
         let dots = (width as f64) * (height as f64);
         if dots > MAX_GRID_DOTS as f64 {
             return Err(SolverError::new(
-                "E_GRID_MEMORY",
+                ErrorCode::GridMemory,
                 format!(
                     "the dot grid would need {dots:.3e} dots ({width} × {height} at grid {grid} mm, {:.0} MB); the limit is {MAX_GRID_DOTS} dots ({} MB): use a larger grid",
                     dots / 8.0 / 1e6,

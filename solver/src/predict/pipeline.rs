@@ -3,6 +3,7 @@
 //! (§3.6–3.7), deflection (§3.8), finished surface and generation point by sampling (§6.6) or by
 //! the depth buffer with view correction (§3.9–3.11), and the errors (§3.12).
 
+use crate::error::ErrorCode;
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -182,7 +183,7 @@ pub(crate) fn run_round(
 
 /// The cancellation error.
 pub(crate) fn cancelled() -> SolverError {
-    SolverError::new("E_CANCELLED", "the prediction was cancelled")
+    SolverError::new(ErrorCode::Cancelled, "the prediction was cancelled")
 }
 
 /// The full pipeline for one pass.

@@ -2,6 +2,7 @@
 //! a `Job`: tool, stock, tool path (points or G-code read into ball-centre passes), cutting
 //! conditions and method settings, with every limit checked before any heavy work.
 
+use crate::error::ErrorCode;
 pub use crate::gcode::SpindleDirection;
 use serde::{Deserialize, Serialize};
 
@@ -240,14 +241,14 @@ impl PredictRequest {
         tool.validate("tool.")?;
         if tool.kind != ToolKind::Ball {
             return Err(SolverError::new(
-                "E_TOOL_KIND",
+                ErrorCode::ToolKind,
                 format!("error prediction needs a ball end mill, not a {} tool", tool.kind.as_str()),
             )
             .at("tool.kind"));
         }
         let Some(shape_error) = tool.shape_error.clone() else {
             return Err(SolverError::new(
-                "E_NO_SHAPE_ERROR",
+                ErrorCode::NoShapeError,
                 "the tool has no shape-error table: add shape_error (a list of {\"angle_deg\", \"error\"}) to the tool",
             )
             .at("tool.shape_error"));
@@ -260,7 +261,7 @@ impl PredictRequest {
             if bytes > MAX_DEPTH_BUFFER_BYTES {
                 let limit = ((MAX_DEPTH_BUFFER_BYTES / DEPTH_BUFFER_BYTES_PER_PIXEL) as f64).sqrt() as u64;
                 return Err(SolverError::new(
-                    "E_RESOLUTION_LIMIT",
+                    ErrorCode::ResolutionLimit,
                     format!(
                         "resolution {resolution} needs a depth buffer of up to {} MiB per worker; the limit is {} MiB (resolution at most {limit})",
                         bytes >> 20,
@@ -363,13 +364,12 @@ impl PredictRequest {
             }
         }
         if builder.pass_count() == 0 {
-            return Err(
-                SolverError::new("E_NO_PASSES", "the tool path has no feed moves from a known position").at("path")
-            );
+            return Err(SolverError::new(ErrorCode::NoPasses, "the tool path has no feed moves from a known position")
+                .at("path"));
         }
         if builder.pass_count() > MAX_PASSES {
             return Err(SolverError::new(
-                "E_TOO_MANY_PASSES",
+                ErrorCode::TooManyPasses,
                 format!("the tool path has {} passes; the limit is {MAX_PASSES}", builder.pass_count()),
             )
             .at("path"));
@@ -410,7 +410,7 @@ impl PredictRequest {
         spindle_speeds.dedup();
         if spindle_speeds.len() > MAX_SPINDLE_SPEEDS {
             return Err(SolverError::new(
-                "E_TOO_MANY_SPINDLE_SPEEDS",
+                ErrorCode::TooManySpindleSpeeds,
                 format!("the program uses {} spindle speeds; the limit is {MAX_SPINDLE_SPEEDS}", spindle_speeds.len()),
             )
             .at("path"));
@@ -473,7 +473,7 @@ fn build_from_program(
                 && first != this
             {
                 return Err(SolverError::new(
-                    "E_GCODE_UNSUPPORTED",
+                    ErrorCode::GcodeUnsupported,
                     format!(
                         "line {line}: the program changes from tool {first} to tool {this}; predict one tool at a time"
                     ),
@@ -485,7 +485,7 @@ fn build_from_program(
         let (Some(from), Some(to)) = (read_move.from_xyz(), read_move.to_xyz()) else {
             if cutting && read_move.to_xyz().is_none() {
                 return Err(SolverError::new(
-                    "E_GCODE_POSITION",
+                    ErrorCode::GcodePosition,
                     format!(
                         "line {line}: a feed move to a position the program has not fully set (give X, Y and Z first)"
                     ),
@@ -507,7 +507,7 @@ fn build_from_program(
         let source = if cutting {
             let feed = read_move.modal.feed.or(defaults.feed).ok_or_else(|| {
                 SolverError::new(
-                    "E_NO_FEED",
+                    ErrorCode::NoFeed,
                     format!("line {line}: feed move without a feed rate (F) and no default feed in the request"),
                 )
                 .at(field)
@@ -519,7 +519,7 @@ fn build_from_program(
                 .or(defaults.spindle_rpm)
                 .ok_or_else(|| {
                     SolverError::new(
-                        "E_NO_SPINDLE",
+                        ErrorCode::NoSpindle,
                         format!("line {line}: feed move without a spindle speed (S) and no default spindle_rpm in the request"),
                     )
                     .at(field)
@@ -543,7 +543,7 @@ fn build_from_program(
         let chords = points.len();
         if builder.pass_count() + chords > MAX_PASSES {
             return Err(SolverError::new(
-                "E_TOO_MANY_PASSES",
+                ErrorCode::TooManyPasses,
                 format!("line {line}: the tool path has more than {MAX_PASSES} passes, the limit"),
             )
             .at(field));

@@ -2,6 +2,7 @@
 //! closedness check, and point membership by the parity of a vertical ray, with an xy bin grid so
 //! each query only looks at nearby triangles.
 
+use crate::error::ErrorCode;
 use std::collections::HashMap;
 
 use crate::error::SolverError;
@@ -37,7 +38,7 @@ struct Triangle {
     hi: Vec3,
 }
 
-fn mesh_error(code: &'static str, message: impl Into<String>) -> SolverError {
+fn mesh_error(code: ErrorCode, message: impl Into<String>) -> SolverError {
     SolverError::new(code, message).at("stock")
 }
 
@@ -51,13 +52,13 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<Vec<[Vec3; 3]>, SolverError> {
     }
     let text = std::str::from_utf8(bytes).map_err(|_| {
         mesh_error(
-            "E_MESH_FORMAT",
+            ErrorCode::MeshFormat,
             "the stock file is neither binary STL (size does not match its triangle count) nor ASCII STL",
         )
     })?;
     if !text.trim_start().starts_with("solid") {
         return Err(mesh_error(
-            "E_MESH_FORMAT",
+            ErrorCode::MeshFormat,
             "the stock file is neither binary STL (size does not match its triangle count) nor ASCII STL (no 'solid' header)",
         ));
     }
@@ -67,7 +68,7 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<Vec<[Vec3; 3]>, SolverError> {
 fn parse_binary(bytes: &[u8], count: usize) -> Result<Vec<[Vec3; 3]>, SolverError> {
     if count > MAX_TRIANGLES {
         return Err(mesh_error(
-            "E_MESH_TOO_LARGE",
+            ErrorCode::MeshTooLarge,
             format!("the stock mesh has {count} triangles; the limit is {MAX_TRIANGLES}"),
         ));
     }
@@ -80,7 +81,7 @@ fn parse_binary(bytes: &[u8], count: usize) -> Result<Vec<[Vec3; 3]>, SolverErro
         let triangle = [vertex(0), vertex(1), vertex(2)];
         if triangle.iter().any(|v| !v.iter().all(|c| c.is_finite())) {
             return Err(mesh_error(
-                "E_MESH_FORMAT",
+                ErrorCode::MeshFormat,
                 format!("triangle {} has a coordinate that is not finite", triangles.len()),
             ));
         }
@@ -102,7 +103,7 @@ fn parse_ascii(text: &str) -> Result<Vec<[Vec3; 3]>, SolverError> {
                         tokens.next().and_then(|t| t.parse::<f64>().ok()).filter(|v| v.is_finite()).ok_or_else(
                             || {
                                 mesh_error(
-                                    "E_MESH_FORMAT",
+                                    ErrorCode::MeshFormat,
                                     format!("STL line {}: a vertex needs three finite numbers", index + 1),
                                 )
                             },
@@ -113,7 +114,7 @@ fn parse_ascii(text: &str) -> Result<Vec<[Vec3; 3]>, SolverError> {
             Some("endloop") => {
                 if corners.len() != 3 {
                     return Err(mesh_error(
-                        "E_MESH_FORMAT",
+                        ErrorCode::MeshFormat,
                         format!("STL line {}: a facet has {} vertices, not 3", index + 1, corners.len()),
                     ));
                 }
@@ -121,7 +122,7 @@ fn parse_ascii(text: &str) -> Result<Vec<[Vec3; 3]>, SolverError> {
                 corners.clear();
                 if triangles.len() > MAX_TRIANGLES {
                     return Err(mesh_error(
-                        "E_MESH_TOO_LARGE",
+                        ErrorCode::MeshTooLarge,
                         format!("the stock mesh has more than {MAX_TRIANGLES} triangles, the limit"),
                     ));
                 }
@@ -136,7 +137,7 @@ fn parse_ascii(text: &str) -> Result<Vec<[Vec3; 3]>, SolverError> {
 /// vertices every edge is used exactly twice, once in each direction.
 pub(crate) fn check_closed(triangles: &[[Vec3; 3]]) -> Result<(), SolverError> {
     if triangles.is_empty() {
-        return Err(mesh_error("E_MESH_EMPTY", "the stock mesh has no triangles"));
+        return Err(mesh_error(ErrorCode::MeshEmpty, "the stock mesh has no triangles"));
     }
     let mut vertex_ids: HashMap<[u64; 3], u32> = HashMap::new();
     let mut id = |v: &Vec3| -> u32 {
@@ -163,13 +164,13 @@ pub(crate) fn check_closed(triangles: &[[Vec3; 3]]) -> Result<(), SolverError> {
     let bad = edges.values().filter(|(uses, balance)| *uses > 2 || (*uses == 2 && *balance != 0)).count();
     if open > 0 {
         return Err(mesh_error(
-            "E_MESH_NOT_CLOSED",
+            ErrorCode::MeshNotClosed,
             format!("the stock mesh is not closed: {open} edges belong to only one triangle"),
         ));
     }
     if bad > 0 {
         return Err(mesh_error(
-            "E_MESH_NOT_CLOSED",
+            ErrorCode::MeshNotClosed,
             format!(
                 "the stock mesh is not a closed surface: {bad} edges are shared by more than two triangles or by two with the same orientation"
             ),
@@ -415,12 +416,15 @@ pub(crate) mod tests {
     fn open_and_broken_meshes_are_refused() {
         let mut triangles = box_triangles(Vec3::zeros(), Vec3::new(1.0, 1.0, 1.0));
         triangles.pop();
-        assert_eq!(check_closed(&triangles).unwrap_err().code(), "E_MESH_NOT_CLOSED");
+        assert_eq!(check_closed(&triangles).unwrap_err().code(), ErrorCode::MeshNotClosed);
         let mut flipped = box_triangles(Vec3::zeros(), Vec3::new(1.0, 1.0, 1.0));
         flipped[0].swap(1, 2);
-        assert_eq!(check_closed(&flipped).unwrap_err().code(), "E_MESH_NOT_CLOSED");
-        assert_eq!(check_closed(&[]).unwrap_err().code(), "E_MESH_EMPTY");
-        assert_eq!(parse(b"not an stl").unwrap_err().code(), "E_MESH_FORMAT");
-        assert_eq!(parse(b"solid x\nfacet\nouter loop\nvertex 1 2\nendloop\n").unwrap_err().code(), "E_MESH_FORMAT");
+        assert_eq!(check_closed(&flipped).unwrap_err().code(), ErrorCode::MeshNotClosed);
+        assert_eq!(check_closed(&[]).unwrap_err().code(), ErrorCode::MeshEmpty);
+        assert_eq!(parse(b"not an stl").unwrap_err().code(), ErrorCode::MeshFormat);
+        assert_eq!(
+            parse(b"solid x\nfacet\nouter loop\nvertex 1 2\nendloop\n").unwrap_err().code(),
+            ErrorCode::MeshFormat
+        );
     }
 }

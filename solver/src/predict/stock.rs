@@ -2,6 +2,7 @@
 //! (box, half-space under a plane, cylinder), a height grid, or a closed STL mesh; point
 //! membership and a conservative classification of boxes used to skip whole tiles of samples.
 
+use crate::error::ErrorCode;
 use serde::{Deserialize, Serialize};
 
 use super::stl::{self, Mesh};
@@ -220,7 +221,7 @@ impl Stock {
                 }
                 if nx.saturating_mul(ny) > MAX_GRID_NODES {
                     return Err(SolverError::new(
-                        "E_GRID_TOO_LARGE",
+                        ErrorCode::GridTooLarge,
                         format!("the height grid has {nx} × {ny} nodes; the limit is {MAX_GRID_NODES}"),
                     )
                     .at("stock.heights"));

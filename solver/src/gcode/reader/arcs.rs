@@ -4,6 +4,7 @@
 use super::lexer::syntax;
 use super::modal::Block;
 use super::{ARC_CLOSURE_MM, ARC_CLOSURE_RELATIVE, MAX_ARC_TURNS, Modal, MoveKind, Position};
+use crate::error::ErrorCode;
 use crate::error::SolverError;
 
 /// Start angle, signed sweep and radius of an arc in its plane.
@@ -55,7 +56,7 @@ pub(super) fn arc_kind(
     let (a, b, normal) = modal.plane.axes();
     let (Some(start_a), Some(start_b), Some(end_a), Some(end_b)) = (from[a], from[b], to[a], to[b]) else {
         return Err(SolverError::new(
-            "E_GCODE_POSITION",
+            ErrorCode::GcodePosition,
             format!("line {line}: arc from a position the program has not set yet"),
         )
         .at(field));
@@ -89,7 +90,7 @@ pub(super) fn arc_kind(
         let half = chord / 2.0;
         if radius.abs() < half - ARC_CLOSURE_MM.max(ARC_CLOSURE_RELATIVE * half) {
             return Err(SolverError::new(
-                "E_ARC_RADIUS",
+                ErrorCode::ArcRadius,
                 format!(
                     "line {line}: arc radius R{} is shorter than half the chord ({:.4} mm)",
                     radius_word.value,
@@ -132,7 +133,7 @@ pub(super) fn arc_kind(
     let tolerance = ARC_CLOSURE_MM.max(ARC_CLOSURE_RELATIVE * start_radius);
     if (end_radius - start_radius).abs() > tolerance {
         return Err(SolverError::new(
-            "E_ARC_NOT_CLOSED",
+            ErrorCode::ArcNotClosed,
             format!(
                 "line {line}: the arc does not close: radius {:.4} mm at the start but {:.4} mm at the end (tolerance {:.4} mm)",
                 start_radius, end_radius, tolerance

@@ -2,6 +2,7 @@
 //! sits), and the `G` code numbering and modal groups.
 
 use super::WordSpan;
+use crate::error::ErrorCode;
 use crate::error::SolverError;
 
 /// One word of a block: letter, value and where its number sits in the line.
@@ -86,11 +87,11 @@ pub(super) fn tokenize(
 }
 
 pub(super) fn syntax(field: &str, line: usize, message: impl std::fmt::Display) -> SolverError {
-    SolverError::new("E_GCODE_SYNTAX", format!("line {line}: {message}")).at(field)
+    SolverError::new(ErrorCode::GcodeSyntax, format!("line {line}: {message}")).at(field)
 }
 
 pub(super) fn unsupported(field: &str, line: usize, message: impl std::fmt::Display) -> SolverError {
-    SolverError::new("E_GCODE_UNSUPPORTED", format!("line {line}: {message}")).at(field)
+    SolverError::new(ErrorCode::GcodeUnsupported, format!("line {line}: {message}")).at(field)
 }
 
 /// A `G` code as tenths (`G90.1` is 901, `G1` is 10), so codes compare exactly.

@@ -31,6 +31,7 @@ mod rewrite;
 
 pub use rewrite::{MoveEdit, rewrite};
 
+use crate::error::ErrorCode;
 use crate::error::SolverError;
 use arcs::{ArcGeometry, arc_kind};
 use lexer::{syntax, tokenize};
@@ -303,7 +304,7 @@ pub fn read(text: &str, field: &str, options: &ReadOptions) -> Result<ReadProgra
         line_count = line_number;
         if line_number > options.max_lines {
             return Err(SolverError::new(
-                "E_TOO_MANY_LINES",
+                ErrorCode::TooManyLines,
                 format!("the program has more than {} lines, the limit", options.max_lines),
             )
             .at(field));

@@ -1,6 +1,7 @@
 //! Unit tests of the reader and the rewrite.
 
 use super::*;
+use crate::error::ErrorCode;
 
 fn read_ok(text: &str) -> ReadProgram {
     read(text, "program", &ReadOptions::default()).unwrap()
@@ -95,21 +96,21 @@ fn arcs_by_centre_and_radius_agree_and_linearise_within_tolerance() {
 #[test]
 fn bad_programs_are_refused_with_the_line_number() {
     let cases = [
-        ("G0 X0 Y0 Z0\nG1 X1 Y1 Q\n", "E_GCODE_SYNTAX", "line 2"),
-        ("G0 X0 Y0 Z0\nG1 X1 (open\n", "E_GCODE_SYNTAX", "line 2"),
-        ("G0 X0 Y0 Z0\nG1 X1 X2 F1\n", "E_GCODE_SYNTAX", "line 2"),
-        ("G0 X0 Y0 Z0\n\nG41 D1 G1 X5 F100\n", "E_GCODE_UNSUPPORTED", "line 3"),
-        ("G81 X0 Y0 Z-1 R1 F100\n", "E_GCODE_UNSUPPORTED", "line 1"),
-        ("G0 X0 Y0 Z0\nG1 A10 F100\n", "E_GCODE_UNSUPPORTED", "line 2"),
-        ("#1=5\n", "E_GCODE_UNSUPPORTED", "line 1"),
-        ("G0 X10 Y0 Z0\nG2 X0 Y10 I-10 J1 F100\n", "E_ARC_NOT_CLOSED", "line 2"),
-        ("G0 X10 Y0 Z0\nG2 X-10 Y0 R5 F100\n", "E_ARC_RADIUS", "line 2"),
-        ("G2 X0 Y10 I-10 J0 F100\n", "E_GCODE_POSITION", "line 1"),
-        ("X10\n", "E_GCODE_SYNTAX", "line 1"),
-        ("G0 G1 X1\n", "E_GCODE_SYNTAX", "line 1"),
-        ("G1 X1 F-5\n", "E_GCODE_SYNTAX", "line 1"),
-        ("G0 X1 &\n", "E_GCODE_SYNTAX", "line 1"),
-        ("M98 P100\n", "E_GCODE_UNSUPPORTED", "line 1"),
+        ("G0 X0 Y0 Z0\nG1 X1 Y1 Q\n", ErrorCode::GcodeSyntax, "line 2"),
+        ("G0 X0 Y0 Z0\nG1 X1 (open\n", ErrorCode::GcodeSyntax, "line 2"),
+        ("G0 X0 Y0 Z0\nG1 X1 X2 F1\n", ErrorCode::GcodeSyntax, "line 2"),
+        ("G0 X0 Y0 Z0\n\nG41 D1 G1 X5 F100\n", ErrorCode::GcodeUnsupported, "line 3"),
+        ("G81 X0 Y0 Z-1 R1 F100\n", ErrorCode::GcodeUnsupported, "line 1"),
+        ("G0 X0 Y0 Z0\nG1 A10 F100\n", ErrorCode::GcodeUnsupported, "line 2"),
+        ("#1=5\n", ErrorCode::GcodeUnsupported, "line 1"),
+        ("G0 X10 Y0 Z0\nG2 X0 Y10 I-10 J1 F100\n", ErrorCode::ArcNotClosed, "line 2"),
+        ("G0 X10 Y0 Z0\nG2 X-10 Y0 R5 F100\n", ErrorCode::ArcRadius, "line 2"),
+        ("G2 X0 Y10 I-10 J0 F100\n", ErrorCode::GcodePosition, "line 1"),
+        ("X10\n", ErrorCode::GcodeSyntax, "line 1"),
+        ("G0 G1 X1\n", ErrorCode::GcodeSyntax, "line 1"),
+        ("G1 X1 F-5\n", ErrorCode::GcodeSyntax, "line 1"),
+        ("G0 X1 &\n", ErrorCode::GcodeSyntax, "line 1"),
+        ("M98 P100\n", ErrorCode::GcodeUnsupported, "line 1"),
     ];
     for (text, code, line) in cases {
         let error = read_err(text);
@@ -119,7 +120,7 @@ fn bad_programs_are_refused_with_the_line_number() {
     }
     let limited =
         read("G0 X0\nG0 X1\nG0 X2\n", "program", &ReadOptions { max_lines: 2, ..ReadOptions::default() }).unwrap_err();
-    assert_eq!(limited.code(), "E_TOO_MANY_LINES");
+    assert_eq!(limited.code(), ErrorCode::TooManyLines);
 }
 
 #[test]
