@@ -65,30 +65,3 @@ impl Warning {
         Self { code, message: message.into() }
     }
 }
-
-/// Checks that `value` is a finite number, naming `field` otherwise.
-pub fn finite(field: &str, value: f64) -> Result<f64, SolverError> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(SolverError::input(field, format!("{field} must be a finite number")))
-    }
-}
-
-/// Checks that `value` is finite and strictly positive, naming `field` otherwise.
-pub fn positive(field: &str, value: f64) -> Result<f64, SolverError> {
-    if finite(field, value)? > 0.0 {
-        Ok(value)
-    } else {
-        Err(SolverError::input(field, format!("{field} must be greater than 0 (got {value})")))
-    }
-}
-
-/// Checks that `value` is finite and not negative, naming `field` otherwise.
-pub fn non_negative(field: &str, value: f64) -> Result<f64, SolverError> {
-    if finite(field, value)? >= 0.0 {
-        Ok(value)
-    } else {
-        Err(SolverError::input(field, format!("{field} must not be negative (got {value})")))
-    }
-}

@@ -23,5 +23,6 @@ pub mod path;
 pub mod planar;
 pub mod predict;
 pub mod tool;
+pub mod validate;
 
 pub use error::{ErrorCode, SolverError, Warning};

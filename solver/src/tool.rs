@@ -5,7 +5,9 @@ use std::fmt;
 use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize};
 
-use crate::error::{SolverError, finite, positive};
+use crate::error::SolverError;
+
+use crate::validate::{finite, positive};
 
 /// The cutter's end shape.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

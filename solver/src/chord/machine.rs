@@ -3,8 +3,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{SolverError, non_negative, positive};
+use crate::error::SolverError;
+
 use crate::gcode::Dialect;
+use crate::validate::{non_negative, positive};
 
 /// Longest machine name.
 pub const MAX_NAME_CHARS: usize = 64;

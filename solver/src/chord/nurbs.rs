@@ -2,8 +2,10 @@
 //! knot-vector and weight validation, points and the first two derivatives by the basis-function
 //! algorithms A2.1–A2.3 of Piegl & Tiller, *The NURBS Book*, in homogeneous coordinates.
 
-use crate::error::{SolverError, finite};
+use crate::error::SolverError;
+
 use crate::geometry::Vec3;
+use crate::validate::finite;
 
 /// Highest supported degree.
 pub const MAX_DEGREE: usize = 5;

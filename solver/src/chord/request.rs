@@ -11,9 +11,10 @@ use super::nurbs::Nurbs;
 use super::rule::{BlockRule, RuleSettings};
 use super::segment::Estimate;
 use super::shape::{Arc, Ellipse, Polyline, Shape, Spline, require_length};
-use crate::error::{SolverError, Warning, finite, positive};
+use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
 use crate::tool::ToolRef;
+use crate::validate::{finite, positive};
 
 /// Most polyline points accepted.
 pub const MAX_POLYLINE_POINTS: usize = 1_000_000;

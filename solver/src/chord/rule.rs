@@ -6,7 +6,8 @@
 //! with C_ep never asks the control for a block shorter than it can digest at feed F.
 
 use super::machine::MachineProfile;
-use crate::error::{SolverError, Warning, finite, non_negative, positive};
+use crate::error::{SolverError, Warning};
+use crate::validate::{finite, non_negative, positive};
 
 /// Milliseconds per minute: `F·T_b/MS_PER_MIN` is the distance (mm) travelled in one block time.
 pub const MS_PER_MIN: f64 = 60_000.0;

@@ -6,8 +6,9 @@
 use serde::Serialize;
 
 use super::rule::{BlockRule, MS_PER_MIN};
-use crate::error::{SolverError, Warning, positive};
+use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
+use crate::validate::positive;
 
 /// A block counts as short when it is below `F·T_b/60000` by more than this fraction (rounding
 /// of a chord that sits exactly on the surface must not count).

@@ -199,8 +199,9 @@ pub fn loop_path_within(
     use super::loops::{self, LoopShape};
     use super::pass::MAX_ARC_STEPS;
     use super::request::{self as contour_request, LoopStyle};
-    use crate::error::{SolverError, Warning, finite, positive};
+    use crate::error::{SolverError, Warning};
     use crate::planar::{Containment, SegmentGrid, point_in_polygon, segments_intersect, signed_area, vec2};
+    use crate::validate::{finite, positive};
 
     let radius = positive("tool_radius", request.tool_radius)?;
     if request.path.len() > contour_request::MAX_POINTS {

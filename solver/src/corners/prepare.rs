@@ -3,13 +3,13 @@
 
 use super::request::MAX_POINTS;
 use crate::error::ErrorCode;
-use crate::error::{SolverError, Warning, finite};
+use crate::error::{SolverError, Warning};
 use crate::planar::{self, Vec2, find_self_intersection, signed_area, turn_angle};
+use crate::validate::finite;
 
 /// Points closer than this are one point, mm (corners.md §1.4 `tol`).
 pub const DUPLICATE_TOLERANCE: f64 = 1e-6;
-/// Largest coordinate accepted, mm (1 km: keeps every derived number finite and precise).
-pub const MAX_COORDINATE: f64 = 1e6;
+pub use crate::validate::MAX_COORDINATE;
 /// Vertices turning by at most this are straight and removed, radians (corners.md §3.1).
 pub const STRAIGHT_TURN: f64 = 1e-9;
 

@@ -7,8 +7,9 @@ use serde::{Deserialize, Serialize};
 use super::element::Chording;
 use super::prepare::{self, Contour};
 use crate::chord::{BlockRule, MachineProfile, RuleSettings};
-use crate::error::{SolverError, Warning, finite, non_negative, positive};
+use crate::error::{SolverError, Warning};
 use crate::tool::{Tool, ToolKind, ToolRef};
+use crate::validate::{finite, non_negative, positive};
 
 /// Most contour points accepted (`E_TOO_MANY_POINTS`).
 pub const MAX_POINTS: usize = 200_000;

@@ -8,9 +8,10 @@ use serde::{Deserialize, Serialize};
 use super::frame::Frame;
 use super::profile::Profile;
 use crate::chord::{BlockRule, MachineProfile, RuleSettings};
-use crate::error::{SolverError, Warning, finite, non_negative, positive};
+use crate::error::{SolverError, Warning};
 use crate::geometry::vec3;
 use crate::tool::{Tool, ToolKind, ToolRef};
+use crate::validate::{self, finite, non_negative, optional_positive, positive, within};
 
 /// Default tolerance TA in mm (deburr.md §1.4, proposed value).
 pub const DEFAULT_TOLERANCE: f64 = 0.01;
@@ -231,10 +232,7 @@ pub const MIN_LENGTH: f64 = 1e-4;
 
 /// A finite value within ±[`MAX_LENGTH`].
 fn bounded(field: &str, value: f64) -> Result<f64, SolverError> {
-    if finite(field, value)?.abs() > MAX_LENGTH {
-        return Err(SolverError::input(field, format!("{field} must lie within ±{MAX_LENGTH} mm (got {value})")));
-    }
-    Ok(value)
+    within(field, value, MAX_LENGTH)
 }
 
 /// A size: finite, from [`MIN_LENGTH`] to [`MAX_LENGTH`].
@@ -247,14 +245,7 @@ fn size(field: &str, value: f64) -> Result<f64, SolverError> {
 }
 
 fn point(field: &str, p: [f64; 3]) -> Result<[f64; 3], SolverError> {
-    for (axis, value) in ["0", "1", "2"].iter().zip(p) {
-        bounded(&format!("{field}[{axis}]"), value)?;
-    }
-    Ok(p)
-}
-
-fn optional_positive(field: &str, value: Option<f64>, default: f64) -> Result<f64, SolverError> {
-    value.map_or(Ok(default), |v| positive(field, v))
+    validate::point(field, p, MAX_LENGTH)
 }
 
 impl DeburrRequest {

@@ -5,7 +5,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{SolverError, positive};
+use crate::error::SolverError;
+
+use crate::validate::positive;
 
 /// Kienzle's specific cutting force of a work material (engagement.md §11 item 4): the
 /// tangential force on one tooth is `kc11 · a_p · h^(1 − mc)` for a chip of thickness h and

@@ -4,8 +4,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{SolverError, positive};
+use crate::error::SolverError;
+
 use crate::tool::{Stiffness, Tool};
+use crate::validate::positive;
 
 /// Relative distance of the tooth-passing frequency from a natural frequency that is warned
 /// about (issue 16: "within 5 %").

@@ -21,10 +21,11 @@ use super::{
     MAX_GRID_DOTS, MAX_SAMPLES, MAX_SEGMENTS, MAX_STOCK_VERTICES, P2,
 };
 use crate::chord::{BlockRule, MachineProfile, RuleSettings};
-use crate::error::{SolverError, Warning, finite, non_negative, positive};
+use crate::error::{SolverError, Warning};
 use crate::gcode::reader::{MoveKind, Plane, ReadOptions, read as read_program};
 use crate::planar::signed_area;
 use crate::tool::{Tool, ToolRef};
+use crate::validate::{self, finite, non_negative, positive, positive_at_most};
 
 /// One move of a path given as `start` + `segments` (engagement.md §2.3).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -481,29 +482,16 @@ impl FeedMode {
     }
 }
 
-/// Largest coordinate magnitude accepted, mm (1 km: beyond any machine, and squares stay exact
-/// enough for the boundary tests).
-pub const MAX_COORDINATE: f64 = 1e6;
+pub use crate::validate::MAX_COORDINATE;
 
 fn point(field: &str, p: [f64; 2]) -> Result<P2, SolverError> {
-    for (axis, value) in [(0, p[0]), (1, p[1])] {
-        let name = format!("{field}[{axis}]");
-        if finite(&name, value)?.abs() > MAX_COORDINATE {
-            return Err(SolverError::input(
-                name,
-                format!("coordinates must lie within ±{MAX_COORDINATE} mm (got {value})"),
-            ));
-        }
-    }
-    Ok(P2::new(p[0], p[1]))
+    let [x, y] = validate::point(field, p, MAX_COORDINATE)?;
+    Ok(P2::new(x, y))
 }
 
 /// `value` must be positive and at most `limit`.
 fn bounded(field: &str, value: f64, limit: f64) -> Result<f64, SolverError> {
-    if positive(field, value)? > limit {
-        return Err(SolverError::input(field, format!("{field} must be at most {limit} (got {value})")));
-    }
-    Ok(value)
+    positive_at_most(field, value, limit)
 }
 
 fn optional(

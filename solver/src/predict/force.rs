@@ -14,8 +14,9 @@ use serde::{Deserialize, Serialize};
 
 use super::scene::{Cover, Scene, Side, TileLists};
 use super::stock::{Region, StockModel};
-use crate::error::{SolverError, finite};
+use crate::error::SolverError;
 use crate::geometry::Vec3;
+use crate::validate::finite;
 
 /// Rings per engagement tile.
 const TILE_RINGS: usize = 6;

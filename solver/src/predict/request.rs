@@ -9,11 +9,12 @@ use serde::{Deserialize, Serialize};
 use super::force::CuttingCoefficients;
 use super::passes::{PassSource, PathBuilder, PathModel};
 use super::stock::{Stock, StockModel};
-use crate::error::{SolverError, finite, positive};
+use crate::error::SolverError;
 use crate::gcode::Reference;
 use crate::gcode::reader::{self, MoveKind, ReadOptions, ReadProgram, Spindle};
 use crate::geometry::{Vec3, vec3};
 use crate::tool::{ShapeErrorPoint, Stiffness, Tool, ToolKind, ToolRef};
+use crate::validate::{finite, optional_positive, positive};
 
 /// Default pixels per side N (the patent's 512 × 512).
 pub const DEFAULT_RESOLUTION: u32 = 512;
@@ -220,10 +221,6 @@ pub(crate) struct Job {
     pub(crate) spindle_speeds: Vec<f64>,
     /// θ_x, degrees.
     pub(crate) exclusion: Option<f64>,
-}
-
-fn optional_positive(field: &str, value: Option<f64>, default: f64) -> Result<f64, SolverError> {
-    value.map_or(Ok(default), |v| positive(field, v))
 }
 
 fn range_u32(field: &str, value: Option<u32>, default: u32, lo: u32, hi: u32) -> Result<u32, SolverError> {

@@ -3,8 +3,10 @@
 //! section radii of the rotating tool, exactly (the nominal normal line intersected with the
 //! measured profile) or to first order (δ ≈ Δr(z(θ))·sin θ).
 
-use crate::error::{SolverError, finite, positive};
+use crate::error::SolverError;
+
 use crate::tool::ShapeErrorPoint;
+use crate::validate::{finite, positive};
 
 /// δ(θ) in mm at contact angle `theta_deg`, and whether the angle was outside the table.
 pub(crate) fn delta(table: &[ShapeErrorPoint], theta_deg: f64) -> (f64, bool) {

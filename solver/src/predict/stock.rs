@@ -6,8 +6,9 @@ use crate::error::ErrorCode;
 use serde::{Deserialize, Serialize};
 
 use super::stl::{self, Mesh};
-use crate::error::{SolverError, finite, positive};
+use crate::error::SolverError;
 use crate::geometry::{Vec3, vec3};
+use crate::validate::{finite, positive};
 
 /// Most nodes of a height grid.
 pub const MAX_GRID_NODES: usize = 4_000_000;

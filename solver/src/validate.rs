@@ -1,0 +1,65 @@
+//! Field-path validation shared by every capability's request: finite, positive and bounded
+//! numbers and points, each refusal an `E_INPUT` naming the field as written in the request
+//! (`hole.radius`, `stock.polygon[3][1]`).
+
+use crate::error::SolverError;
+
+/// Largest coordinate magnitude accepted anywhere, mm (1 km: beyond any machine, and squares stay
+/// exact enough for the geometric tests).
+pub const MAX_COORDINATE: f64 = 1e6;
+
+/// Checks that `value` is a finite number, naming `field` otherwise.
+pub fn finite(field: &str, value: f64) -> Result<f64, SolverError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(SolverError::input(field, format!("{field} must be a finite number")))
+    }
+}
+
+/// Checks that `value` is finite and strictly positive, naming `field` otherwise.
+pub fn positive(field: &str, value: f64) -> Result<f64, SolverError> {
+    if finite(field, value)? > 0.0 {
+        Ok(value)
+    } else {
+        Err(SolverError::input(field, format!("{field} must be greater than 0 (got {value})")))
+    }
+}
+
+/// Checks that `value` is finite and not negative, naming `field` otherwise.
+pub fn non_negative(field: &str, value: f64) -> Result<f64, SolverError> {
+    if finite(field, value)? >= 0.0 {
+        Ok(value)
+    } else {
+        Err(SolverError::input(field, format!("{field} must not be negative (got {value})")))
+    }
+}
+
+/// Checks that `value` is finite and within ±`limit`, naming `field` otherwise.
+pub fn within(field: &str, value: f64, limit: f64) -> Result<f64, SolverError> {
+    if finite(field, value)?.abs() > limit {
+        return Err(SolverError::input(field, format!("{field} must lie within ±{limit} mm (got {value})")));
+    }
+    Ok(value)
+}
+
+/// Checks that `value` is positive and at most `limit`, naming `field` otherwise.
+pub fn positive_at_most(field: &str, value: f64, limit: f64) -> Result<f64, SolverError> {
+    if positive(field, value)? > limit {
+        return Err(SolverError::input(field, format!("{field} must be at most {limit} (got {value})")));
+    }
+    Ok(value)
+}
+
+/// `value` if given (then positive), else `default`.
+pub fn optional_positive(field: &str, value: Option<f64>, default: f64) -> Result<f64, SolverError> {
+    value.map_or(Ok(default), |v| positive(field, v))
+}
+
+/// Checks every coordinate of `point` is finite and within ±`limit`, naming `field[axis]`.
+pub fn point<const N: usize>(field: &str, point: [f64; N], limit: f64) -> Result<[f64; N], SolverError> {
+    for (axis, value) in point.iter().enumerate() {
+        within(&format!("{field}[{axis}]"), *value, limit)?;
+    }
+    Ok(point)
+}
