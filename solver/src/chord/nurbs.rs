@@ -111,6 +111,14 @@ impl Nurbs {
         to.saturating_sub(from)
     }
 
+    /// The distinct knots strictly between `lo` and `hi`, increasing.
+    pub(crate) fn distinct_knots_between(&self, lo: f64, hi: f64) -> impl Iterator<Item = f64> + '_ {
+        let from = self.knots.partition_point(|&k| k <= lo);
+        let to = self.knots.partition_point(|&k| k < hi);
+        let inside = &self.knots[from..to.max(from)];
+        inside.iter().enumerate().filter(move |&(i, k)| i == 0 || inside[i - 1] != *k).map(|(_, &k)| k)
+    }
+
     /// Degree p.
     pub(crate) fn degree(&self) -> usize {
         self.degree

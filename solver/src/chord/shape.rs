@@ -184,6 +184,63 @@ fn refine_maximum(f: &impl Fn(f64) -> f64, x: [f64; 3], y: [f64; 3], tol: f64, r
     fb.max(-negative)
 }
 
+/// Sub-intervals per knot span in [`Shape::fast_deviation`].
+const SPAN_SAMPLES: usize = 4;
+/// Most knot spans one fast deviation samples; beyond, the reference sampling is used.
+const MAX_FAST_SPANS: usize = 8;
+
+/// The fast deviation of a NURBS chord (see [`Shape::fast_deviation`]); `None` when the chord
+/// crosses more than [`MAX_FAST_SPANS`] knot spans.
+fn spline_deviation(spline: &Spline, ua: f64, ub: f64, limit: f64) -> Option<f64> {
+    let (lo, hi) = (ua.min(ub), ua.max(ub));
+    let mut breaks = [0.0_f64; MAX_FAST_SPANS + 1];
+    breaks[0] = lo;
+    let mut count = 1;
+    for knot in spline.nurbs.distinct_knots_between(lo, hi) {
+        if count == MAX_FAST_SPANS {
+            return None;
+        }
+        breaks[count] = knot;
+        count += 1;
+    }
+    breaks[count] = hi;
+    let (a, b) = (spline.nurbs.point(ua), spline.nurbs.point(ub));
+    let hint = std::cell::Cell::new(0);
+    let distance = |u: f64| distance_to_segment(&spline.nurbs.point_near(u, &hint), &a, &b);
+    const CAPACITY: usize = MAX_FAST_SPANS * SPAN_SAMPLES + 1;
+    let (mut at, mut value) = ([0.0_f64; CAPACITY], [0.0_f64; CAPACITY]);
+    at[0] = lo;
+    let mut n = 1;
+    let mut best = 0;
+    for piece in breaks[..=count].windows(2) {
+        let step = (piece[1] - piece[0]) / SPAN_SAMPLES as f64;
+        for j in 1..=SPAN_SAMPLES {
+            let u = if j == SPAN_SAMPLES { piece[1] } else { piece[0] + step * j as f64 };
+            let d = if u == hi { 0.0 } else { distance(u) };
+            if d > limit {
+                return Some(d);
+            }
+            (at[n], value[n]) = (u, d);
+            if d > value[best] {
+                best = n;
+            }
+            n += 1;
+        }
+    }
+    if best == 0 || (limit.is_finite() && value[best] < REFINE_FRACTION * limit) {
+        return Some(value[best]);
+    }
+    let tol = 1e-9 * (hi - lo) + 4.0 * f64::EPSILON * lo.abs().max(hi.abs());
+    let rounding = 8.0 * f64::EPSILON * a.amax().max(b.amax());
+    Some(refine_maximum(
+        &distance,
+        [at[best - 1], at[best], at[best + 1]],
+        [value[best - 1], value[best], value[best + 1]],
+        tol,
+        rounding,
+    ))
+}
+
 /// Radius of the circle through three points, in any dimension (chord.md §2.8); infinite when
 /// they are collinear: |u×v| ≤ 1e-15·longest side², plus the rounding of coordinates of this
 /// size (points interpolated far from the origin are collinear only to that).
@@ -291,6 +348,30 @@ impl Shape {
         match self {
             Self::Ellipse(_) | Self::Spline(_) => self.sampled_deviation(ua, ub, Some(limit)),
             Self::Arc(_) | Self::Polyline(_) => self.deviation(ua, ub),
+        }
+    }
+
+    /// dev(u_a, u_b) for the fast search (chord.md §2.9a), where only values near `limit`
+    /// need to be exact: closed forms for arcs and ellipses, the farthest vertex of a
+    /// polyline, and for NURBS four sub-intervals per knot span refined around the best sample
+    /// (a smooth span bends one way over a chord cut to its curvature, so its distance from the
+    /// chord has one hump per span). Stops at the first sample above `limit`; skips the
+    /// refinement well below it (an infinite `limit` gives the refined maximum).
+    pub(crate) fn fast_deviation(&self, ua: f64, ub: f64, limit: f64) -> f64 {
+        match self {
+            Self::Arc(_) | Self::Polyline(_) => self.deviation(ua, ub),
+            Self::Ellipse(ellipse) if (ub - ua).abs() <= std::f64::consts::FRAC_PI_2 => {
+                // The affine image of a circle: the farthest point is at the mean angle, its
+                // distance (1 − cos δ)·ab/√(a² sin² t_m + b² cos² t_m) for half-angle δ.
+                let [a, b] = ellipse.semi_axes;
+                let half = 0.5 * (ub - ua).abs();
+                let middle = ellipse.angle(0.5 * (ua + ub));
+                2.0 * (0.5 * half).sin().powi(2) * a * b / (a * middle.sin()).hypot(b * middle.cos())
+            }
+            Self::Ellipse(_) => self.sampled_deviation(ua, ub, Some(limit)),
+            Self::Spline(spline) => {
+                spline_deviation(spline, ua, ub, limit).unwrap_or_else(|| self.sampled_deviation(ua, ub, Some(limit)))
+            }
         }
     }
 
