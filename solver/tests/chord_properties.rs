@@ -8,7 +8,9 @@
 //! * every command point lies on the curve, the first and last at its ends,
 //! * on circles the on-surface chord is k_f·F·T_b/60000 (chord.md §7),
 //! * the fast search (chord.md §2.9a) gives at most 0.5 % (and at most 2) blocks more than the
-//!   reference greedy of §2.9 on random NURBS of degrees 1–5 with weights, in 2-D and 3-D.
+//!   reference greedy of §2.9 on random NURBS of degrees 1–5 with weights, in 2-D and 3-D,
+//! * in mode `guarantee` (§2.9a) no block but the last (or one ending at a corner) is shorter
+//!   than margin × feed × block time, on the same random NURBS.
 
 use kerf_solver::chord::{self, SegmentAnswer, SegmentRequest};
 use proptest::prelude::*;
@@ -475,5 +477,44 @@ proptest! {
         let samples = ((answer.curve_length / (0.05 * target)).ceil() as usize).clamp(4000, 60_000);
         check(&answer, &curve, samples, None);
         prop_assert!(answer.max_deviation <= answer.chord_error + SLACK);
+    }
+
+    #[test]
+    fn guarantee_mode_keeps_every_block_but_the_last_long_enough(
+        degree in 1_usize..=5,
+        control in prop::collection::vec(prop::array::uniform3(-20.0_f64..20.0), 6..10),
+        weights in prop::collection::vec(0.3_f64..3.0, 10),
+        flat in any::<bool>(),
+        feed in 1000.0_f64..8000.0,
+        block_time_ms in 1.0_f64..4.0,
+        margin in 1.0_f64..1.2,
+        min_chord_error in prop::option::of(0.0_f64..0.002),
+    ) {
+        let control: Vec<Point> =
+            control.iter().map(|p| if flat { [p[0], p[1], 0.0] } else { *p }).collect();
+        let weights = weights[..control.len()].to_vec();
+        let request = json!({
+            "curve": {"kind": "bspline", "degree": degree, "control_points": control, "weights": weights},
+            "feed": feed, "block_time_ms": block_time_ms, "margin": margin, "mode": "guarantee",
+            "min_chord_error": min_chord_error.unwrap_or(0.0)
+        });
+        let Some(answer) = solve_feasible(request) else { return Ok(()); };
+        prop_assert_eq!(answer.stats.short_blocks, 0);
+        let curve = Spline::new(degree, control.clone(), weights);
+        let target = target_chord(&answer);
+        let samples = ((answer.curve_length / (0.05 * target)).ceil() as usize).clamp(4000, 60_000);
+        check(&answer, &curve, samples, None);
+        // Only the last block, or (degree 1) one ending at a corner of the control polygon, may
+        // be short; the smallest radius of a NURBS is sampled: allow 1e-6 of the target.
+        let points: Vec<Point> = answer.points.iter().map(|p| to_point(p)).collect();
+        let blocks = points.len() - 1;
+        for (index, pair) in points.windows(2).enumerate() {
+            let length = norm(&sub(&pair[1], &pair[0]));
+            let at_corner = degree == 1 && control.iter().any(|c| norm(&sub(c, &pair[1])) <= 1e-9);
+            prop_assert!(
+                length >= target * (1.0 - 1e-6) || index + 1 == blocks || at_corner,
+                "block {} of {}: {} < {}", index, blocks, length, target
+            );
+        }
     }
 }

@@ -54,6 +54,7 @@
 
 mod answer;
 mod arclength;
+mod guarantee;
 pub mod machine;
 mod numeric;
 mod nurbs;
@@ -122,6 +123,7 @@ fn solve_by(
         Plan::Window { length, estimate } => {
             cutter.windows(rule, job.tolerance, length, estimate).map_err(|error| cut_error(&job, error))?
         }
+        Plan::Guarantee => cutter.guarantee(rule, job.tolerance).map_err(|error| cut_error(&job, error))?,
         Plan::Max { length, estimate } => {
             let radii = cutter.tiled_radii(length, estimate, rule.target_chord())?;
             let mut worst: Option<(f64, f64, rule::ChordStatus)> = None;

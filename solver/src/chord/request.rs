@@ -125,6 +125,10 @@ pub enum Mode {
     Window,
     /// One value for the whole curve by `rule` (embodiments 3–5).
     Curve,
+    /// Each chord's error from the smallest radius of curvature along it (chord.md §2.9a,
+    /// revision 2): no block but a span's final remainder is shorter than margin × feed ×
+    /// block time.
+    Guarantee,
 }
 
 /// The whole-curve rule of `mode: curve`.
@@ -169,7 +173,7 @@ pub struct SegmentRequest {
     /// T_b: block processing time of the control, ms (default: the machine's).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub block_time_ms: Option<f64>,
-    /// `window` (default) or `curve`.
+    /// `window` (default), `curve` or `guarantee`.
     #[serde(default)]
     pub mode: Mode,
     /// Δs: window length for `mode: window` (and `rule: max`), mm (default 5 target chords).
@@ -239,6 +243,7 @@ pub(crate) enum Plan {
     Max { length: f64, estimate: Estimate },
     Extremes { min_radius: Option<f64> },
     NormalAccel { min_radius: Option<f64> },
+    Guarantee,
 }
 
 /// A validated request: the curve built, the machine's defaults applied.
@@ -517,7 +522,8 @@ fn optional_tolerance(field: &str, value: Option<f64>) -> Result<Option<f64>, So
 impl SegmentRequest {
     /// A request for `curve` at `feed` (mm/min) on a control with `block_time_ms`, everything
     /// else at its default (window mode, no margins, no bounds): the starting point for callers
-    /// in Rust, e.g. a path solver resampling its own dense points as a `polyline`.
+    /// in Rust, e.g. a path solver resampling its own dense points as a `polyline` (set `mode`
+    /// to [`Mode::Guarantee`] for no short blocks, or use [`SegmentRequest::guarantee`]).
     pub fn new(curve: Curve, feed: f64, block_time_ms: f64) -> Self {
         Self {
             curve,
@@ -542,6 +548,12 @@ impl SegmentRequest {
             spindle_rpm: None,
             safe_z: None,
         }
+    }
+
+    /// [`SegmentRequest::new`] in mode `guarantee` (chord.md §2.9a): what a path solver uses
+    /// for the curves it emits, so that no block but a final remainder starves the control.
+    pub fn guarantee(curve: Curve, feed: f64, block_time_ms: f64) -> Self {
+        Self { mode: Mode::Guarantee, ..Self::new(curve, feed, block_time_ms) }
     }
 
     /// The block-time rule of this request with `machine`'s defaults (fields are named as in
@@ -580,6 +592,20 @@ impl SegmentRequest {
                 return Err(SolverError::input("rule", "rule applies to mode \"curve\" only"));
             }
             (Mode::Window, None) => Plan::Window { length: window.unwrap_or(default_window), estimate },
+            (Mode::Guarantee, rule) => {
+                let stray = [
+                    ("rule", rule.is_some()),
+                    ("window", window.is_some()),
+                    ("radius_estimate", self.radius_estimate.is_some()),
+                ];
+                if let Some((field, _)) = stray.iter().find(|(_, given)| *given) {
+                    return Err(SolverError::input(
+                        *field,
+                        format!("{field} does not apply to mode \"guarantee\" (each chord uses its smallest radius)"),
+                    ));
+                }
+                Plan::Guarantee
+            }
             (Mode::Curve, rule) => match rule.unwrap_or_default() {
                 CurveRule::Max => Plan::Max { length: window.unwrap_or(default_window), estimate },
                 other => {

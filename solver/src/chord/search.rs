@@ -7,10 +7,13 @@
 //!   trial is the previous chord's parameter step (or the circle chord of the window radius),
 //!   corrected by that model, so a smooth curve needs two to four deviations per block;
 //!   ellipses evaluate dev in closed form, NURBS from a few samples per knot span
-//!   ([`Shape::fast_deviation`]).
+//!   ([`Shape::fast_deviation`]). Where the fast samples are not exact (NURBS, and ellipse
+//!   chords over a quarter turn) the chord found is checked once with the reference's 32
+//!   samples, and the reference search takes over if it does not fit.
 
 use std::cell::Cell;
 
+use super::reference;
 use super::segment::{CROSSING_WIDTH, EPS, Vertex};
 use super::shape::Shape;
 use crate::error::SolverError;
@@ -67,6 +70,9 @@ pub(crate) fn chord_end(
         (lo, g_lo) = (trial, value);
         if trial >= limit.u {
             last_step.set(trial - start.u);
+            if !shape.verified(start.u, limit.u, allowed) {
+                return reference::greedy_end(shape, start, chord_error, limit, step_guess);
+            }
             return Ok(limit.u);
         }
         if evaluations >= EVALUATION_CAP {
@@ -111,6 +117,11 @@ pub(crate) fn chord_end(
         }
     }
     last_step.set(lo - start.u);
+    if lo > start.u && !shape.verified(start.u, lo, allowed) {
+        // A hump between the fast samples (curvature changing fast inside the chord): the
+        // reference search decides this chord.
+        return reference::greedy_end(shape, start, chord_error, limit, step_guess);
+    }
     Ok(lo)
 }
 

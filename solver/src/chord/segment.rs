@@ -137,22 +137,25 @@ impl<'a> Cutter<'a> {
         Self { shape, numerics, last_step: Cell::new(0.0), spans, max_blocks, limit_field }
     }
 
-    /// dev of the chord between two parameters, by this cutter's numerics.
+    /// dev of the chord between two parameters as the answer reports it: the reference's
+    /// (exact for arcs, ellipse chords and polylines; 32 samples refined for NURBS).
     pub(crate) fn deviation(&self, ua: f64, ub: f64) -> f64 {
-        match self.numerics {
-            Numerics::Fast => self.shape.fast_deviation(ua, ub, f64::INFINITY),
-            Numerics::Reference => self.shape.deviation(ua, ub),
+        match (self.numerics, self.shape) {
+            (Numerics::Fast, Shape::Arc(_) | Shape::Ellipse(_) | Shape::Polyline(_)) => {
+                self.shape.fast_deviation(ua, ub, f64::INFINITY)
+            }
+            _ => self.shape.deviation(ua, ub),
         }
     }
 
-    fn vertex(&self, u: f64) -> Vertex {
+    pub(crate) fn vertex(&self, u: f64) -> Vertex {
         Vertex { u, s: self.shape.s_at(u), point: self.shape.point(u) }
     }
 
     /// The end of the longest chord from `start` whose deviation stays within `chord_error`
     /// (chord.md §2.9 `greedy_end`), up to `limit`; `step_guess` is the circle chord of the
     /// window's radius (mm). By the fast search, or by the reference numerics for the oracle.
-    fn greedy_end(
+    pub(crate) fn greedy_end(
         &self,
         start: &Vertex,
         chord_error: f64,
@@ -172,7 +175,7 @@ impl<'a> Cutter<'a> {
     }
 
     /// Appends a command point; `span_end` is the parameter where its span ends.
-    fn push(&self, cut: &mut Cut, vertex: Vertex, span_end: f64) -> Result<(), SolverError> {
+    pub(crate) fn push(&self, cut: &mut Cut, vertex: Vertex, span_end: f64) -> Result<(), SolverError> {
         if cut.vertices.len() > self.max_blocks {
             return Err(SolverError::new(
                 "E_TOO_MANY_BLOCKS",
@@ -202,7 +205,7 @@ impl<'a> Cutter<'a> {
         Ok(())
     }
 
-    fn start(&self) -> Option<Cut> {
+    pub(crate) fn start(&self) -> Option<Cut> {
         let &(first, _) = self.spans.first()?;
         Some(Cut { vertices: vec![self.vertex(first)], ..Cut::default() })
     }

@@ -375,6 +375,17 @@ impl Shape {
         }
     }
 
+    /// Whether the chord from `ua` to `ub` stays within `allowed` by the reference deviation
+    /// (32 samples, refined): the check of a chord the fast search found where
+    /// [`Shape::fast_deviation`] only samples. Exact shapes pass without evaluation.
+    pub(crate) fn verified(&self, ua: f64, ub: f64, allowed: f64) -> bool {
+        match self {
+            Self::Arc(_) | Self::Polyline(_) => true,
+            Self::Ellipse(_) if (ub - ua).abs() <= std::f64::consts::FRAC_PI_2 => true,
+            Self::Ellipse(_) | Self::Spline(_) => self.sampled_deviation(ua, ub, Some(allowed)) <= allowed,
+        }
+    }
+
     fn sampled_deviation(&self, ua: f64, ub: f64, threshold: Option<f64>) -> f64 {
         let (a, b) = (self.point(ua), self.point(ub));
         let hint = std::cell::Cell::new(0);
