@@ -138,8 +138,11 @@ impl Cutter<'_> {
             spread: 1.0,
             blocks: 1,
         };
-        if self.deviation(before.u, last.u) <= chord_error + EPS {
+        let merged_deviation = self.deviation(before.u, last.u);
+        if merged_deviation <= chord_error + EPS {
             cut.vertices.remove(n - 2);
+            cut.deviations.truncate(n - 3);
+            cut.deviations.push(Some(merged_deviation));
             cut.windows.truncate(windows - 2);
             cut.windows.push(merged);
             return Ok(());
@@ -150,6 +153,8 @@ impl Cutter<'_> {
         };
         if fits(&before, &half) && fits(&half, &last) {
             cut.vertices[n - 2] = half;
+            cut.deviations.truncate(n - 3);
+            cut.deviations.extend([None, None]);
             cut.windows.truncate(windows - 2);
             cut.windows.push(WindowRecord { s_end: half.s, ..merged });
             cut.windows.push(WindowRecord { s_start: half.s, ..merged });

@@ -270,7 +270,11 @@ fn finite_or_none(value: f64) -> Option<f64> {
 
 /// Largest deviation of the curve from the chords of a cut.
 fn max_deviation(cutter: &Cutter<'_>, cut: &Cut) -> f64 {
-    cut.vertices.windows(2).map(|pair| cutter.deviation(pair[0].u, pair[1].u)).fold(0.0, f64::max)
+    cut.vertices
+        .windows(2)
+        .zip(&cut.deviations)
+        .map(|(pair, measured)| measured.unwrap_or_else(|| cutter.deviation(pair[0].u, pair[1].u)))
+        .fold(0.0, f64::max)
 }
 
 fn answer(job: &Job, request: &SegmentRequest, cutter: &Cutter<'_>, cut: &Cut) -> Result<SegmentAnswer, SolverError> {

@@ -2,6 +2,8 @@
 //! knot-vector and weight validation, points and the first two derivatives by the basis-function
 //! algorithms A2.1–A2.3 of Piegl & Tiller, *The NURBS Book*, in homogeneous coordinates.
 
+use std::cell::Cell;
+
 use crate::error::{SolverError, finite};
 use crate::geometry::Vec3;
 
@@ -19,6 +21,9 @@ pub(crate) struct Nurbs {
     knots: Vec<f64>,
     /// Control points times their weight, and the weight: (w·x, w·y, w·z, w).
     weighted: Vec<[f64; 4]>,
+    /// The knot span found last: a chord search evaluates near it again and again, so the
+    /// binary search over all knots is skipped when it or the next span holds the parameter.
+    last_span: Cell<usize>,
 }
 
 impl Nurbs {
@@ -79,7 +84,7 @@ impl Nurbs {
             None => vec![1.0; count],
         };
         let weighted = points.iter().zip(&weights).map(|(p, &w)| [w * p.x, w * p.y, w * p.z, w]).collect();
-        Ok(Self { degree, knots, weighted })
+        Ok(Self { degree, knots, weighted, last_span: Cell::new(degree) })
     }
 
     /// Parameter range [u_p, u_n].
@@ -143,8 +148,17 @@ impl Nurbs {
             }
             return i;
         }
+        let last = self.last_span.get();
+        for guess in [last, last + 1] {
+            if guess < n && self.knots[guess] <= u && u < self.knots[guess + 1] {
+                self.last_span.set(guess);
+                return guess;
+            }
+        }
         // First index with knot > u, minus one.
-        self.knots[..=n].partition_point(|&k| k <= u) - 1
+        let span = self.knots[..=n].partition_point(|&k| k <= u) - 1;
+        self.last_span.set(span);
+        span
     }
 
     /// The curve point at `u`.

@@ -28,7 +28,8 @@ const AIM: f64 = 1.02;
 
 /// The parameter of the end of a chord from `start` whose deviation is at most `chord_error`
 /// (+1e-12 mm) and within the bracket width of the longest such chord; `limit.u` when the
-/// whole rest fits. `last_step` holds the parameter step of the previous chord (0: none) and
+/// whole rest fits, with the chord's reference deviation where it was checked (see
+/// [`Shape::checked_deviation`]). `last_step` holds the parameter step of the previous chord (0: none) and
 /// is updated; `step_guess` is the circle-chord length in mm for the first chord.
 pub(crate) fn chord_end(
     shape: &Shape,
@@ -37,13 +38,13 @@ pub(crate) fn chord_end(
     limit: &Vertex,
     step_guess: f64,
     last_step: &Cell<f64>,
-) -> Result<f64, SolverError> {
+) -> Result<(f64, Option<f64>), SolverError> {
     let allowed = chord_error + EPS;
     if let Shape::Arc(arc) = shape {
         // dev = 2r·sin²(Δs/4r) = allowed, on the whole circle (sin² grows up to Δs = 2πr).
         let half_sine = (allowed / (2.0 * arc.radius)).sqrt();
         let step = if half_sine >= 1.0 { f64::INFINITY } else { 4.0 * arc.radius * half_sine.asin() };
-        return Ok((start.u + step).min(limit.u));
+        return Ok(((start.u + step).min(limit.u), None));
     }
     let root = allowed.sqrt();
     let g = |u: f64| shape.fast_deviation(start.u, u, allowed).sqrt() - root;
@@ -70,10 +71,7 @@ pub(crate) fn chord_end(
         (lo, g_lo) = (trial, value);
         if trial >= limit.u {
             last_step.set(trial - start.u);
-            if !shape.verified(start.u, limit.u, allowed) {
-                return reference::greedy_end(shape, start, chord_error, limit, step_guess);
-            }
-            return Ok(limit.u);
+            return checked(shape, start, chord_error, limit, step_guess, limit.u);
         }
         if evaluations >= EVALUATION_CAP {
             return Err(failure(start));
@@ -117,12 +115,28 @@ pub(crate) fn chord_end(
         }
     }
     last_step.set(lo - start.u);
-    if lo > start.u && !shape.verified(start.u, lo, allowed) {
-        // A hump between the fast samples (curvature changing fast inside the chord): the
-        // reference search decides this chord.
-        return reference::greedy_end(shape, start, chord_error, limit, step_guess);
+    if lo <= start.u {
+        return Ok((lo, None));
     }
-    Ok(lo)
+    checked(shape, start, chord_error, limit, step_guess, lo)
+}
+
+/// The chord to `end` if its reference deviation fits; else a hump lay between the fast
+/// samples (curvature changing fast inside the chord) and the reference search decides.
+fn checked(
+    shape: &Shape,
+    start: &Vertex,
+    chord_error: f64,
+    limit: &Vertex,
+    step_guess: f64,
+    end: f64,
+) -> Result<(f64, Option<f64>), SolverError> {
+    match shape.checked_deviation(start.u, end) {
+        Some(deviation) if deviation > chord_error + EPS => {
+            Ok((reference::greedy_end(shape, start, chord_error, limit, step_guess)?, None))
+        }
+        deviation => Ok((end, deviation)),
+    }
 }
 
 fn failure(start: &Vertex) -> SolverError {

@@ -76,6 +76,8 @@ pub(crate) struct WindowRecord {
 #[derive(Debug, Clone, PartialEq, Default)]
 pub(crate) struct Cut {
     pub vertices: Vec<Vertex>,
+    /// Each block's deviation where the search measured it (`None`: compute it).
+    pub deviations: Vec<Option<f64>>,
     pub windows: Vec<WindowRecord>,
     /// Block indices (block i runs from vertex i to i + 1) that end at a corner or the path end.
     pub span_ends: Vec<usize>,
@@ -117,6 +119,8 @@ pub(crate) struct Cutter<'a> {
     pub numerics: Numerics,
     /// Parameter step of the last chord: the fast search's first trial for the next.
     pub last_step: Cell<f64>,
+    /// The deviation of the chord `greedy_end` returned last, where the search measured it.
+    pub last_deviation: Cell<Option<f64>>,
     /// Parameter ranges between corners, in order.
     pub spans: &'a [(f64, f64)],
     /// Most blocks before `E_TOO_MANY_BLOCKS`.
@@ -134,7 +138,15 @@ impl<'a> Cutter<'a> {
         limit_field: &'a str,
         numerics: Numerics,
     ) -> Self {
-        Self { shape, numerics, last_step: Cell::new(0.0), spans, max_blocks, limit_field }
+        Self {
+            shape,
+            numerics,
+            last_step: Cell::new(0.0),
+            last_deviation: Cell::new(None),
+            spans,
+            max_blocks,
+            limit_field,
+        }
     }
 
     /// dev of the chord between two parameters as the answer reports it: the reference's
@@ -162,16 +174,19 @@ impl<'a> Cutter<'a> {
         limit: &Vertex,
         step_guess: f64,
     ) -> Result<Vertex, SolverError> {
-        let end = match self.numerics {
+        let (end, deviation) = match self.numerics {
             Numerics::Fast => search::chord_end(self.shape, start, chord_error, limit, step_guess, &self.last_step)?,
-            Numerics::Reference => reference::greedy_end(self.shape, start, chord_error, limit, step_guess)?,
+            Numerics::Reference => (reference::greedy_end(self.shape, start, chord_error, limit, step_guess)?, None),
         };
         if end >= limit.u {
+            self.last_deviation.set(deviation);
             return Ok(*limit);
         }
         let end = self.vertex(end);
         // A remainder below a nanometre is not a block: the chord takes it.
-        Ok(if limit.s - end.s < MIN_PROGRESS { *limit } else { end })
+        let taken = limit.s - end.s < MIN_PROGRESS;
+        self.last_deviation.set(if taken { None } else { deviation });
+        Ok(if taken { *limit } else { end })
     }
 
     /// Appends a command point; `span_end` is the parameter where its span ends.
@@ -202,6 +217,7 @@ impl<'a> Cutter<'a> {
             .at("curve"));
         }
         cut.vertices.push(vertex);
+        cut.deviations.push(self.last_deviation.take());
         Ok(())
     }
 

@@ -375,14 +375,14 @@ impl Shape {
         }
     }
 
-    /// Whether the chord from `ua` to `ub` stays within `allowed` by the reference deviation
-    /// (32 samples, refined): the check of a chord the fast search found where
-    /// [`Shape::fast_deviation`] only samples. Exact shapes pass without evaluation.
-    pub(crate) fn verified(&self, ua: f64, ub: f64, allowed: f64) -> bool {
+    /// The reference deviation (32 samples, refined) of a chord the fast search found, where
+    /// [`Shape::fast_deviation`] only samples: it catches a hump between the fast samples, and
+    /// the answer reports it as the chord's deviation. `None` where the fast value is exact.
+    pub(crate) fn checked_deviation(&self, ua: f64, ub: f64) -> Option<f64> {
         match self {
-            Self::Arc(_) | Self::Polyline(_) => true,
-            Self::Ellipse(_) if (ub - ua).abs() <= std::f64::consts::FRAC_PI_2 => true,
-            Self::Ellipse(_) | Self::Spline(_) => self.sampled_deviation(ua, ub, Some(allowed)) <= allowed,
+            Self::Arc(_) | Self::Polyline(_) => None,
+            Self::Ellipse(_) if (ub - ua).abs() <= std::f64::consts::FRAC_PI_2 => None,
+            Self::Ellipse(_) | Self::Spline(_) => Some(self.sampled_deviation(ua, ub, None)),
         }
     }
 
