@@ -12,7 +12,8 @@
 //! * `shape`, `nurbs`, `arclength`: the curves (circle, arc, ellipse, polyline, NURBS) by arc
 //!   length, chord deviation, radius of curvature, corners;
 //! * `segment`: greedy chords, the window procedure with carry-over and progress rule, the
-//!   single-value run (§2.9);
+//!   single-value run (§2.9); `search`: the fast chord search (§2.9a), `reference`: the §2.9
+//!   numerics it is tested against ([`solve_reference`]); `guarantee`: mode `guarantee` (§2.9a);
 //! * [`stats`]: block figures of any polyline ([`block_stats`]); `report`: warnings (§4);
 //! * [`machine`]: controller profiles; [`mod@program`]: G-code.
 //!
@@ -33,8 +34,10 @@
 //!   `tolerance_for(r_min, tol)` (embodiment 4); [`block_stats`] reports any polyline's blocks,
 //!   shortest block, short blocks and block-limited time. To cut its own curve by the rule,
 //!   sample it densely (≤ 1/10 of [`BlockRule::target_chord`] apart), send the samples as a
-//!   [`Curve::Polyline`] through [`SegmentRequest::new`] and [`solve`], and map each answer
-//!   point back by its `s` (arc length along the samples).
+//!   [`Curve::Polyline`] (or an arc as [`Curve::Arc`]) through [`SegmentRequest::guarantee`]
+//!   (mode `guarantee`, chord.md §2.9a: no block but a final remainder shorter than margin ×
+//!   feed × block time) and [`solve`], and map each answer point back by its `s` (arc length
+//!   along the samples).
 //!
 //! # Choices where the spec is open (chord.md §8)
 //!
