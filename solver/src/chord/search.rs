@@ -49,11 +49,11 @@ pub(crate) fn chord_end(
     let root = allowed.sqrt();
     let g = |u: f64| shape.fast_deviation(start.u, u, allowed).sqrt() - root;
     let speed = shape.speed(start.u);
-    let tol = if speed > 0.0 {
-        (CROSSING_WIDTH / speed).max(f64::EPSILON * start.u.abs())
-    } else {
-        16.0 * f64::EPSILON * start.u.abs().max(limit.u.abs()).max(f64::MIN_POSITIVE)
-    };
+    // Bracket to 1e-12 mm, but never below a few units in the last place of u: a long curve
+    // on a unit parameter range has 1e-12 mm under one ulp, where rounding of the distances
+    // (1e-16 of the coordinates) is all the root finder would see.
+    let ulps = 4.0 * f64::EPSILON * start.u.abs().max(limit.u.abs()).max(f64::MIN_POSITIVE);
+    let tol = if speed > 0.0 { (CROSSING_WIDTH / speed).max(ulps) } else { 4.0 * ulps };
     let mut step = last_step.get();
     if step.is_nan() || step <= 0.0 {
         step = if speed > 0.0 && step_guess > 0.0 { step_guess / speed } else { limit.u - start.u };
@@ -86,9 +86,9 @@ pub(crate) fn chord_end(
     let mut side = 0_i8;
     let mut fit = g_lo;
     loop {
-        // Done when bracketed to 1e-12 mm, or when the chord that fits is within 1e-10 of
-        // the longest (its √dev within 1e-10 of √C_ep).
-        if hi - lo <= tol || fit >= -1e-10 * root {
+        // Done when bracketed to 1e-12 mm, or when the chord that fits is within 1e-9 of the
+        // longest (its √dev within 1e-9 of √C_ep; the distances' own rounding is near 1e-10).
+        if hi - lo <= tol || fit >= -1e-9 * root {
             break;
         }
         if evaluations >= EVALUATION_CAP {
@@ -97,6 +97,9 @@ pub(crate) fn chord_end(
         let mut x = lo - g_lo * (hi - lo) / (g_hi - g_lo);
         if !(x > lo && x < hi) {
             x = 0.5 * (lo + hi);
+            if !(x > lo && x < hi) {
+                break; // adjacent floats
+            }
         }
         let value = g(x);
         evaluations += 1;
