@@ -314,10 +314,39 @@ impl Nurbs {
         values
     }
 
-    /// Point and first two derivatives by the basis functions (A2.3). Not in power form: at a
-    /// cusp of coincident control points these differences are exactly zero, which the corner
-    /// and radius logic rely on (the power form leaves rounding there).
+    /// Point and first two derivatives with respect to u in `span`: from the power form inside
+    /// the span, by the basis functions (A2.3) at its ends: at a cusp of coincident control
+    /// points (always at a knot) those give exactly zero, which the corner and radius logic
+    /// rely on, while the power form leaves rounding there.
     fn derivatives_in(&self, span: usize, u: f64) -> [Vec3; 3] {
+        let polynomial = &self.polynomials[span - self.degree];
+        let scale = polynomial.inverse_width;
+        let t = (u - polynomial.start) * scale;
+        if !(t > 0.0 && t < 1.0) {
+            return self.derivatives_by_basis(span, u);
+        }
+        // Horner for the value and the first two derivatives in t.
+        let mut value = polynomial.coefficients[self.degree];
+        let (mut first, mut second) = ([0.0_f64; 4], [0.0_f64; 4]);
+        for coefficient in polynomial.coefficients[..self.degree].iter().rev() {
+            for axis in 0..4 {
+                second[axis] = second[axis] * t + first[axis];
+                first[axis] = first[axis] * t + value[axis];
+                value[axis] = value[axis] * t + coefficient[axis];
+            }
+        }
+        let vector = |h: &[f64; 4], factor: f64| Vec3::new(h[0], h[1], h[2]) * factor;
+        let curvature_scale = 2.0 * scale * scale;
+        let (a0, a1, a2) = (vector(&value, 1.0), vector(&first, scale), vector(&second, curvature_scale));
+        let (w0, w1, w2) = (value[3], first[3] * scale, second[3] * curvature_scale);
+        let relative = a0 / w0;
+        let first = (a1 - w1 * relative) / w0;
+        let second = (a2 - 2.0 * w1 * first - w2 * relative) / w0;
+        [polynomial.origin + relative, first, second]
+    }
+
+    /// Point and first two derivatives by the basis functions (A2.3).
+    fn derivatives_by_basis(&self, span: usize, u: f64) -> [Vec3; 3] {
         let ders = self.basis_derivatives(span, u);
         let mut homogeneous = [[0.0_f64; 4]; 3];
         for (order, row) in ders.iter().enumerate() {
@@ -561,7 +590,12 @@ mod tests {
                 let h = curve.homogeneous_by_basis(span, u, &Vec3::zeros());
                 let by_basis = Vec3::new(h[0] / h[3], h[1] / h[3], h[2] / h[3]);
                 assert_abs_diff_eq!((curve.point(u) - by_basis).norm(), 0.0, epsilon = 1e-10);
-                assert_abs_diff_eq!((curve.derivatives(u)[0] - by_basis).norm(), 0.0, epsilon = 1e-10);
+                let [p, d1, d2] = curve.derivatives(u);
+                let [q, e1, e2] = curve.derivatives_by_basis(span, u);
+                assert_abs_diff_eq!((p - by_basis).norm(), 0.0, epsilon = 1e-10);
+                assert_abs_diff_eq!((q - by_basis).norm(), 0.0, epsilon = 1e-10);
+                assert_abs_diff_eq!((d1 - e1).norm(), 0.0, epsilon = 1e-9 * (1.0 + e1.norm()));
+                assert_abs_diff_eq!((d2 - e2).norm(), 0.0, epsilon = 1e-8 * (1.0 + e2.norm()));
             }
         }
     }
