@@ -138,9 +138,11 @@ impl Nurbs {
 
     /// The distinct knots strictly between `lo` and `hi`, increasing.
     pub(crate) fn distinct_knots_between(&self, lo: f64, hi: f64) -> impl Iterator<Item = f64> + '_ {
-        let from = self.knots.partition_point(|&k| k <= lo);
-        let to = self.knots.partition_point(|&k| k < hi);
-        let inside = &self.knots[from..to.max(from)];
+        let (start, end) = self.domain();
+        // The first knot above lo follows lo's span (found from the hint, not by a search).
+        let from = if lo >= start && lo < end { self.span(lo) + 1 } else { self.knots.partition_point(|&k| k <= lo) };
+        let to = from + self.knots[from..].iter().take_while(|&&k| k < hi).count();
+        let inside = &self.knots[from..to];
         inside.iter().enumerate().filter(move |&(i, k)| i == 0 || inside[i - 1] != *k).map(|(_, &k)| k)
     }
 
@@ -288,6 +290,9 @@ impl Nurbs {
     /// curvature may jump (a degree-2 curve is only C1 there); `None` elsewhere.
     pub(crate) fn derivatives_from_left(&self, u: f64) -> Option<[Vec3; 3]> {
         let right = self.span(u);
+        if self.knots[right] != u {
+            return None; // not a knot: one-sided limits agree (this is the common case)
+        }
         let n = self.weighted.len();
         let left = self.knots[..=n].partition_point(|&k| k < u).saturating_sub(1).clamp(self.degree, n - 1);
         (left != right).then(|| self.derivatives_in(left, u))
