@@ -466,7 +466,7 @@ impl Curve {
                     length += (pair[1] - pair[0]).norm();
                     stations.push(length);
                 }
-                let shape = Shape::Polyline(Polyline { vertices, stations });
+                let shape = Shape::Polyline(Polyline { vertices, stations, last_edge: std::cell::Cell::new(0) });
                 let corners = shape.corners(corner);
                 (shape, corners, dimension)
             }

@@ -59,6 +59,9 @@ pub(crate) struct Polyline {
     pub vertices: Vec<Vec3>,
     /// Arc length at each vertex.
     pub stations: Vec<f64>,
+    /// The edge found last: the segmentation walks along the polyline, so the next lookup is
+    /// nearly always on it or the next edge (no binary search over every vertex).
+    pub last_edge: std::cell::Cell<usize>,
 }
 
 /// A NURBS curve with its arc-length table.
@@ -126,7 +129,16 @@ impl Polyline {
     /// Index of the edge holding arc length `s`.
     fn edge(&self, s: f64) -> usize {
         let last_edge = self.vertices.len().saturating_sub(2);
-        self.stations.partition_point(|&x| x <= s).saturating_sub(1).min(last_edge)
+        let hint = self.last_edge.get();
+        for k in [hint, hint + 1] {
+            if k < last_edge && self.stations[k] <= s && s < self.stations[k + 1] {
+                self.last_edge.set(k);
+                return k;
+            }
+        }
+        let k = self.stations.partition_point(|&x| x <= s).saturating_sub(1).min(last_edge);
+        self.last_edge.set(k);
+        k
     }
 
     fn point(&self, s: f64) -> Vec3 {
@@ -328,7 +340,13 @@ impl Shape {
             Self::Polyline(line) => {
                 let (a, b) = (line.point(ua), line.point(ub));
                 let (lo, hi) = (ua.min(ub), ua.max(ub));
-                let first = line.stations.partition_point(|&x| x <= lo);
+                // The first vertex strictly after lo: the end of lo's edge (from the hint).
+                let k = line.edge(lo);
+                let first = if line.stations[k] <= lo && line.stations.get(k + 1).is_some_and(|&x| x > lo) {
+                    k + 1
+                } else {
+                    line.stations.partition_point(|&x| x <= lo)
+                };
                 let mut worst = 0.0_f64;
                 for (vertex, &station) in line.vertices.iter().zip(&line.stations).skip(first) {
                     if station >= hi {
@@ -669,7 +687,7 @@ mod tests {
         let vertices = vec![Vec3::zeros(), Vec3::new(1.0, 0.2, 0.0), Vec3::new(2.0, 0.0, 0.0)];
         let first = (vertices[1] - vertices[0]).norm();
         let stations = vec![0.0, first, 2.0 * first];
-        let line = Shape::Polyline(Polyline { vertices, stations });
+        let line = Shape::Polyline(Polyline { vertices, stations, last_edge: std::cell::Cell::new(0) });
         assert_relative_eq!(line.deviation(0.0, 2.0 * first), 0.2, max_relative = 1e-15);
         assert_eq!(line.corners(10f64.to_radians()), vec![first]);
         assert!(line.corners(30f64.to_radians()).is_empty());
