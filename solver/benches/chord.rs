@@ -1,10 +1,11 @@
-//! Benchmarks for solver::chord (issue 3, "Measure and report"): segments per second for a
-//! B-spline of about 100 000 blocks (window mode, the patent's per-window rule, and the
-//! whole-curve rule), and the R50 circle of the patent's experiment as the baseline.
+//! Benchmarks for solver::chord (issues 3 and 14, "Measure and report"): blocks per second for
+//! a B-spline of about 100 000 blocks, a large ellipse and a polyline of 100 000 points, in the
+//! patent's per-window mode, the whole-curve rule and the no-short-blocks `guarantee` mode
+//! (chord.md §2.9a), with the R50 circle of the patent's experiment as the baseline.
 //!
 //! Run: `cargo bench -p kerf-solver --bench chord -- --warm-up-time 1 --measurement-time 5`.
-//! Criterion reports time per solve; the block count of each input is printed first, so
-//! segments per second = blocks / time.
+//! Criterion reports time per solve and, from the block count of each input (printed first),
+//! blocks per second (`thrpt`, in elements/s).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use kerf_solver::chord::{self, SegmentRequest};
@@ -27,27 +28,52 @@ fn spiral() -> Value {
     json!({"kind": "bspline", "degree": 3, "control_points": control})
 }
 
-fn request(curve: &Value, mode: &str) -> SegmentRequest {
+/// A full ellipse 400 × 150 mm: about 1 800 mm of curve with radii from 56 to 1 067 mm.
+fn ellipse() -> Value {
+    json!({"kind": "ellipse", "centre": [0, 0], "semi_axes": [400, 150]})
+}
+
+/// 100 000 points 0.05 mm apart on a wavy closed curve (radius 60 ± 8 mm, 7 waves): a dense
+/// polyline of about 5 m taken as the true curve.
+fn polyline() -> Value {
+    let count = 100_000;
+    let points: Vec<[f64; 2]> = (0..count)
+        .map(|k| {
+            let angle = std::f64::consts::TAU * f64::from(k) / f64::from(count) * 13.0;
+            let radius = 60.0 + 8.0 * (7.0 * angle / 13.0).sin();
+            [radius * angle.cos(), radius * angle.sin()]
+        })
+        .collect();
+    json!({"kind": "polyline", "points": points, "corner_angle_deg": 60})
+}
+
+fn request(curve: &Value, mode: &str) -> Option<SegmentRequest> {
     serde_json::from_value(json!({
         "curve": curve, "feed": 10000, "block_time_ms": 4, "margin": 1.05, "mode": mode
     }))
-    .expect("bench request")
+    .ok()
 }
 
 fn bench(c: &mut Criterion) {
-    let spline = spiral();
     let mut group = c.benchmark_group("chord");
     group.sample_size(10);
-    for mode in ["window", "curve"] {
-        let request = request(&spline, mode);
-        let blocks = chord::solve(&request, None).expect("solve").stats.blocks;
-        println!("bspline {mode}: {blocks} blocks");
-        group.throughput(Throughput::Elements(blocks as u64));
-        group.bench_function(format!("bspline_{mode}"), |b| {
-            b.iter(|| chord::solve(std::hint::black_box(&request), None))
-        });
+    let curves = [("bspline", spiral()), ("ellipse", ellipse()), ("polyline", polyline())];
+    for (name, curve) in &curves {
+        for mode in ["window", "guarantee", "curve"] {
+            // A mode the solver does not know (before guarantee existed) is skipped.
+            let Some(request) = request(curve, mode) else {
+                println!("{name} {mode}: mode not available");
+                continue;
+            };
+            let blocks = chord::solve(&request, None).expect("solve").stats.blocks;
+            println!("{name} {mode}: {blocks} blocks");
+            group.throughput(Throughput::Elements(blocks as u64));
+            group.bench_function(format!("{name}_{mode}"), |b| {
+                b.iter(|| chord::solve(std::hint::black_box(&request), None))
+            });
+        }
     }
-    let circle = request(&json!({"kind": "circle", "centre": [0, 0], "radius": 50}), "window");
+    let circle = request(&json!({"kind": "circle", "centre": [0, 0], "radius": 50}), "window").expect("circle");
     let blocks = chord::solve(&circle, None).expect("solve").stats.blocks;
     println!("circle R50: {blocks} blocks");
     group.throughput(Throughput::Elements(blocks as u64));

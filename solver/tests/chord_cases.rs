@@ -354,3 +354,83 @@ fn surface_table_in_micrometres() {
         }
     }
 }
+
+/// chord.md §2.9a (revision 2), issue 14: on the quarter ellipse at 10 000 mm/min and 4 ms the
+/// patent's window rule leaves blocks shorter than feed × block time where a window's radius
+/// is looser than the curve inside it; mode `guarantee` leaves none but the final remainder,
+/// and every chord stays within the error of the smallest radius along it.
+#[test]
+fn guarantee_mode_leaves_no_short_blocks_on_the_quarter_ellipse() {
+    let request = |mode: &str| json!({"curve": ellipse_bc(), "feed": 10000, "block_time_ms": 4, "mode": mode});
+    let window = solve(request("window"));
+    assert!(window.stats.short_blocks > 0, "the window rule should show the problem it has");
+    let guarantee = solve(request("guarantee"));
+    assert_eq!(guarantee.stats.short_blocks, 0);
+    let lengths = block_lengths(&guarantee);
+    let block = guarantee.stats.block_length;
+    for (index, length) in lengths[..lengths.len() - 1].iter().enumerate() {
+        assert!(*length >= block * (1.0 - 1e-9), "block {index}: {length} < {block}");
+    }
+    // One window per chord, with the chord error of its smallest radius: on this ellipse the
+    // radius grows from t = 0, so it is the radius at the chord's start.
+    assert_eq!(guarantee.windows.len(), guarantee.stats.blocks);
+    for window in &guarantee.windows {
+        let t = guarantee_parameter(window.s_start);
+        let radius = (100.0 * t.sin()).hypot(50.0 * t.cos()).powi(3) / 5000.0;
+        close("window radius", window.radius.unwrap(), radius, 1e-6 * radius);
+    }
+    assert!(guarantee.max_deviation <= guarantee.chord_error + 1e-12);
+    // Backwards (t from 90° down to 0) the radius shrinks along every chord: the smallest is
+    // at its end, not its start.
+    let backwards = solve(json!({
+        "curve": {"kind": "ellipse", "centre": [0, 0], "semi_axes": [100, 50], "start_deg": 90, "end_deg": 0,
+                  "direction": "cw"},
+        "feed": 10000, "block_time_ms": 4, "mode": "guarantee"
+    }));
+    assert_eq!(backwards.stats.short_blocks, 0);
+    // Only slightly more blocks than the window rule: the chords are still about one block.
+    assert!(guarantee.stats.blocks <= window.stats.blocks + window.stats.blocks / 10);
+    // On a circle every radius is the same: case A's polygon.
+    let circle = solve(json!({"curve": circle_a(), "feed": 10000, "block_time_ms": 4, "mode": "guarantee"}));
+    let case_a = solve(json!({"curve": circle_a(), "feed": 10000, "block_time_ms": 4}));
+    assert_eq!(circle.stats.blocks, 472);
+    for (a, b) in circle.points.iter().zip(&case_a.points) {
+        close("case A point", (a[0] - b[0]).hypot(a[1] - b[1]), 0.0, 1e-9);
+    }
+}
+
+/// The ellipse parameter t at arc length `s` of the quarter ellipse 100 × 50 (bisection on a
+/// fine Simpson sum; slow and simple on purpose).
+fn guarantee_parameter(s: f64) -> f64 {
+    let length = |t: f64| {
+        let n = 2000;
+        let h = t / f64::from(n);
+        let speed = |x: f64| (100.0 * x.sin()).hypot(50.0 * x.cos());
+        let mut sum = speed(0.0) + speed(t);
+        for k in 1..n {
+            sum += speed(h * f64::from(k)) * if k % 2 == 1 { 4.0 } else { 2.0 };
+        }
+        sum * h / 3.0
+    };
+    let (mut lo, mut hi) = (0.0_f64, std::f64::consts::FRAC_PI_2);
+    for _ in 0..60 {
+        let middle = 0.5 * (lo + hi);
+        if length(middle) < s {
+            lo = middle;
+        } else {
+            hi = middle;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+#[test]
+fn guarantee_mode_refuses_window_options() {
+    for (field, value) in [("window", json!(5)), ("rule", json!("max")), ("radius_estimate", json!("minimum"))] {
+        let mut request = json!({"curve": circle_a(), "feed": 10000, "block_time_ms": 4, "mode": "guarantee"});
+        request[field] = value;
+        let parsed: SegmentRequest = serde_json::from_value(request).unwrap();
+        let error = chord::solve(&parsed, None).unwrap_err();
+        assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some(field)));
+    }
+}

@@ -253,6 +253,7 @@ fn machine_values_are_defaults_the_request_overrides() {
         margin: Some(1.1),
         min_chord_error: Some(0.001),
         description: None,
+        mode: None,
         spindle_power_kw: None,
         spindle_torque_nm: None,
     };

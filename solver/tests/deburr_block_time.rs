@@ -187,6 +187,7 @@ fn machine_values_and_bad_block_times() {
         margin: Some(1.2),
         min_chord_error: Some(0.002),
         description: None,
+        mode: None,
         spindle_power_kw: None,
         spindle_torque_nm: None,
     };

@@ -39,7 +39,7 @@ const FORM = `
       <label>Machine <select name="machine" data-field="machine"></select></label>
       <label>Feed, mm/min <input name="feed" type="number" step="any" value="10000" data-field="feed"></label>
       <label>Block time, ms <input name="block_time_ms" type="number" step="any" value="4" data-field="block_time_ms"></label>
-      <label>Chord error chosen <select name="mode" data-field="mode"><option value="window">per window</option><option value="curve">whole curve</option></select></label>
+      <label>Chord error chosen <select name="mode" data-field="mode"><option value="window">per window</option><option value="curve">whole curve</option><option value="guarantee">no short blocks (guarantee)</option></select></label>
       <label data-mode="window">Window length, mm <input name="window" type="number" step="any" placeholder="5 target chords" data-field="window"></label>
       <label data-mode="curve">Rule <select name="rule" data-field="rule"><option value="extremes">smallest radius</option><option value="max">largest window value</option><option value="normal_accel">normal acceleration</option></select></label>
       <label><span>Block margin <abbr class="symbol" title="k_f in chord.md">k_f</abbr></span> <input name="margin" type="number" step="any" value="1" data-field="margin"></label>

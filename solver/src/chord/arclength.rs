@@ -3,6 +3,8 @@
 //! Newton iteration.
 
 use crate::error::ErrorCode;
+use std::cell::Cell;
+
 use crate::error::SolverError;
 
 /// 5-point Gauss–Legendre nodes on [−1, 1].
@@ -38,6 +40,9 @@ fn panel(speed: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
 pub(crate) struct ArcLengthTable {
     u: Vec<f64>,
     s: Vec<f64>,
+    /// The panel found last: the segmentation walks along the curve, so the next lookup is
+    /// nearly always in it or the next one (no binary search over the whole table).
+    last_panel: Cell<usize>,
 }
 
 impl ArcLengthTable {
@@ -54,7 +59,8 @@ impl ArcLengthTable {
         panels_per_break: usize,
         field: &str,
     ) -> Result<Self, SolverError> {
-        let mut table = Self { u: vec![breaks.first().copied().unwrap_or(0.0)], s: vec![0.0] };
+        let mut table =
+            Self { u: vec![breaks.first().copied().unwrap_or(0.0)], s: vec![0.0], last_panel: Cell::new(0) };
         for pair in breaks.windows(2) {
             let (start, end) = (pair[0], pair[1]);
             for k in 0..panels_per_break {
@@ -109,8 +115,23 @@ impl ArcLengthTable {
 
     /// Index of the panel holding parameter `u`.
     fn panel_of_u(&self, u: f64) -> usize {
-        let last_panel = self.u.len().saturating_sub(2);
-        self.u.partition_point(|&x| x <= u).saturating_sub(1).min(last_panel)
+        self.panel_of(&self.u, u)
+    }
+
+    /// Index k of the panel with `stations[k] ≤ x < stations[k + 1]` (the last panel at and
+    /// past the end, the first before the start), trying the last panel found and the next.
+    fn panel_of(&self, stations: &[f64], x: f64) -> usize {
+        let last_panel = stations.len().saturating_sub(2);
+        let hint = self.last_panel.get();
+        for k in [hint, hint + 1] {
+            if k <= last_panel && k + 1 < stations.len() && stations[k] <= x && x < stations[k + 1] {
+                self.last_panel.set(k);
+                return k;
+            }
+        }
+        let k = stations.partition_point(|&v| v <= x).saturating_sub(1).min(last_panel);
+        self.last_panel.set(k);
+        k
     }
 
     /// Arc length from the start to parameter `u`.
@@ -125,8 +146,7 @@ impl ArcLengthTable {
 
     /// Parameter at arc length `s` (clamped to the curve).
     pub(crate) fn u_at(&self, speed: &impl Fn(f64) -> f64, s: f64) -> f64 {
-        let last_panel = self.s.len().saturating_sub(2);
-        let k = self.s.partition_point(|&x| x <= s).saturating_sub(1).min(last_panel);
+        let k = self.panel_of(&self.s, s);
         let (Some(&u0), Some(&u1), Some(&s0), Some(&s1)) =
             (self.u.get(k), self.u.get(k + 1), self.s.get(k), self.s.get(k + 1))
         else {

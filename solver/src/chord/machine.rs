@@ -41,6 +41,11 @@ pub struct MachineProfile {
     /// compensation), date (at most 200 characters).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub description: Option<String>,
+    /// How segment requests on this control choose their chord error unless they say:
+    /// `window` (the patent's, default), `curve` or `guarantee` (no block shorter than the control
+    /// needs, chord.md §2.9a).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mode: Option<super::Mode>,
     /// Rated spindle power, kW (> 0): engagement with Kienzle values warns where the cut needs
     /// more and its feed plan caps the feed to stay within it.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -12,7 +12,8 @@
 //! * `shape`, `nurbs`, `arclength`: the curves (circle, arc, ellipse, polyline, NURBS) by arc
 //!   length, chord deviation, radius of curvature, corners;
 //! * `segment`: greedy chords, the window procedure with carry-over and progress rule, the
-//!   single-value run (§2.9);
+//!   single-value run (§2.9); `search`: the fast chord search (§2.9a), `reference`: the §2.9
+//!   numerics it is tested against ([`solve_reference`]); `guarantee`: mode `guarantee` (§2.9a);
 //! * [`stats`]: block figures of any polyline ([`block_stats`]); `report`: warnings (§4);
 //! * [`machine`]: controller profiles; [`mod@program`]: G-code.
 //!
@@ -33,8 +34,10 @@
 //!   `tolerance_for(r_min, tol)` (embodiment 4); [`block_stats`] reports any polyline's blocks,
 //!   shortest block, short blocks and block-limited time. To cut its own curve by the rule,
 //!   sample it densely (≤ 1/10 of [`BlockRule::target_chord`] apart), send the samples as a
-//!   [`Curve::Polyline`] through [`SegmentRequest::new`] and [`solve`], and map each answer
-//!   point back by its `s` (arc length along the samples).
+//!   [`Curve::Polyline`] (or an arc as [`Curve::Arc`]) through [`SegmentRequest::guarantee`]
+//!   (mode `guarantee`, chord.md §2.9a: no block but a final remainder shorter than margin ×
+//!   feed × block time) and [`solve`], and map each answer point back by its `s` (arc length
+//!   along the samples).
 //!
 //! # Choices where the spec is open (chord.md §8)
 //!
@@ -55,13 +58,16 @@
 mod answer;
 mod arclength;
 mod capability;
+mod guarantee;
 pub mod machine;
 mod numeric;
 mod nurbs;
 pub mod program;
+mod reference;
 mod report;
 pub mod request;
 pub mod rule;
+mod search;
 mod segment;
 mod shape;
 pub mod stats;
@@ -77,7 +83,7 @@ pub use stats::{BlockStats, PathBlocks, block_stats, path_blocks, short_block_wa
 
 use crate::error::ErrorCode;
 use request::{Job, Plan};
-use segment::{Cut, CutError, Cutter, InfeasibleAt, Status};
+use segment::{Cut, CutError, Cutter, InfeasibleAt, Numerics, Status};
 
 use crate::error::SolverError;
 use crate::geometry::Vec3;
@@ -94,14 +100,36 @@ pub const MAX_BLOCKS: usize = 1_000_000;
 /// feed), `E_TOO_MANY_BLOCKS` (over [`MAX_BLOCKS`]), `E_TOO_MANY_POINTS` (arc-length table over
 /// its limit), `E_NUMERIC_FAILURE` (E14).
 pub fn solve(request: &SegmentRequest, machine: Option<&MachineProfile>) -> Result<SegmentAnswer, SolverError> {
+    solve_by(request, machine, Numerics::Fast)
+}
+
+/// [`solve`] by the reference numerics of chord.md §2.9 (about 400 curve evaluations per
+/// block): the oracle the fast search is tested against (§2.9a), not for production.
+///
+/// # Errors
+/// As [`solve`].
+#[doc(hidden)]
+pub fn solve_reference(
+    request: &SegmentRequest,
+    machine: Option<&MachineProfile>,
+) -> Result<SegmentAnswer, SolverError> {
+    solve_by(request, machine, Numerics::Reference)
+}
+
+fn solve_by(
+    request: &SegmentRequest,
+    machine: Option<&MachineProfile>,
+    numerics: Numerics,
+) -> Result<SegmentAnswer, SolverError> {
     let job = request.validate(machine)?;
     let rule = &job.rule;
     let limit_field = if job.tolerance.is_some() { "tolerance" } else { "min_chord_error" };
-    let cutter = Cutter { shape: &job.shape, spans: &job.spans, max_blocks: MAX_BLOCKS, limit_field };
+    let cutter = Cutter::new(&job.shape, &job.spans, MAX_BLOCKS, limit_field, numerics);
     let cut = match job.plan {
         Plan::Window { length, estimate } => {
             cutter.windows(rule, job.tolerance, length, estimate).map_err(|error| cut_error(&job, error))?
         }
+        Plan::Guarantee => cutter.guarantee(rule, job.tolerance).map_err(|error| cut_error(&job, error))?,
         Plan::Max { length, estimate } => {
             let radii = cutter.tiled_radii(length, estimate, rule.target_chord())?;
             let mut worst: Option<(f64, f64, rule::ChordStatus)> = None;
@@ -134,7 +162,7 @@ pub fn solve(request: &SegmentRequest, machine: Option<&MachineProfile>) -> Resu
             single_value(&job, &cutter, chord_error, radius, status)?
         }
     };
-    answer(&job, request, &cut)
+    answer(&job, request, &cutter, &cut)
 }
 
 /// The cut of a whole-curve chord error, as one window.
@@ -247,11 +275,15 @@ fn finite_or_none(value: f64) -> Option<f64> {
 }
 
 /// Largest deviation of the curve from the chords of a cut.
-fn max_deviation(job: &Job, cut: &Cut) -> f64 {
-    cut.vertices.windows(2).map(|pair| job.shape.deviation(pair[0].u, pair[1].u)).fold(0.0, f64::max)
+fn max_deviation(cutter: &Cutter<'_>, cut: &Cut) -> f64 {
+    cut.vertices
+        .windows(2)
+        .zip(&cut.deviations)
+        .map(|(pair, measured)| measured.unwrap_or_else(|| cutter.deviation(pair[0].u, pair[1].u)))
+        .fold(0.0, f64::max)
 }
 
-fn answer(job: &Job, request: &SegmentRequest, cut: &Cut) -> Result<SegmentAnswer, SolverError> {
+fn answer(job: &Job, request: &SegmentRequest, cutter: &Cutter<'_>, cut: &Cut) -> Result<SegmentAnswer, SolverError> {
     let rule = &job.rule;
     let positions: Vec<Vec3> = cut.vertices.iter().map(|v| v.point).collect();
     let stats = stats::stats_with_ends(&positions, rule.feed, rule.block_time_ms, &cut.span_ends);
@@ -282,17 +314,12 @@ fn answer(job: &Job, request: &SegmentRequest, cut: &Cut) -> Result<SegmentAnswe
 
     let comparison = match job.compare_tolerance {
         Some(tolerance) => {
-            let cutter = Cutter {
-                shape: &job.shape,
-                spans: &job.spans,
-                max_blocks: MAX_BLOCKS,
-                limit_field: "compare_tolerance",
-            };
-            let fixed = cutter.constant(tolerance, min_radius)?;
+            let fixed_cutter = Cutter::new(&job.shape, &job.spans, MAX_BLOCKS, "compare_tolerance", cutter.numerics);
+            let fixed = fixed_cutter.constant(tolerance, min_radius)?;
             let fixed_points: Vec<Vec3> = fixed.vertices.iter().map(|v| v.point).collect();
             Some(Comparison {
                 tolerance,
-                max_deviation: max_deviation(job, &fixed),
+                max_deviation: max_deviation(&fixed_cutter, &fixed),
                 stats: stats::stats_with_ends(&fixed_points, rule.feed, rule.block_time_ms, &fixed.span_ends),
             })
         }
@@ -317,7 +344,7 @@ fn answer(job: &Job, request: &SegmentRequest, cut: &Cut) -> Result<SegmentAnswe
         windows,
         points: positions.iter().map(|p| coordinates(p, job.dimension)).collect(),
         s: cut.vertices.iter().map(|v| v.s).collect(),
-        max_deviation: max_deviation(job, cut),
+        max_deviation: max_deviation(cutter, cut),
         stats,
         curve_length: job.shape.length(),
         min_radius: finite_or_none(min_radius),

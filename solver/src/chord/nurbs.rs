@@ -2,6 +2,8 @@
 //! knot-vector and weight validation, points and the first two derivatives by the basis-function
 //! algorithms A2.1–A2.3 of Piegl & Tiller, *The NURBS Book*, in homogeneous coordinates.
 
+use std::cell::Cell;
+
 use crate::error::SolverError;
 
 use crate::geometry::Vec3;
@@ -21,6 +23,27 @@ pub(crate) struct Nurbs {
     knots: Vec<f64>,
     /// Control points times their weight, and the weight: (w·x, w·y, w·z, w).
     weighted: Vec<[f64; 4]>,
+    /// The knot span found last: a chord search evaluates near it again and again, so the
+    /// binary search over all knots is skipped when it or the next span holds the parameter.
+    last_span: Cell<usize>,
+    /// Each knot span `degree + k` as a polynomial in its local parameter (see [`SpanPolynomial`]).
+    polynomials: Vec<SpanPolynomial>,
+}
+
+/// One knot span [u_i, u_i+1) of the curve in power form: the homogeneous curve relative to
+/// the span's first point O, (w·(x − O), w), as polynomials in t = (u − u_i)/h. Evaluating it
+/// by Horner's rule costs a few multiply-adds instead of the basis-function recurrences (the
+/// chord search evaluates the curve some fifty times per block); relative coordinates keep the
+/// rounding at the span's size, not the curve's. Points only: derivatives keep the basis
+/// functions (exact zeros at cusps).
+#[derive(Debug, Clone, PartialEq)]
+struct SpanPolynomial {
+    origin: Vec3,
+    start: f64,
+    /// 1/h (0 for an empty span, never evaluated).
+    inverse_width: f64,
+    /// Coefficients of t⁰…t^p of (w·(x − O_x), w·(y − O_y), w·(z − O_z), w).
+    coefficients: [[f64; 4]; SLOTS],
 }
 
 impl Nurbs {
@@ -81,7 +104,9 @@ impl Nurbs {
             None => vec![1.0; count],
         };
         let weighted = points.iter().zip(&weights).map(|(p, &w)| [w * p.x, w * p.y, w * p.z, w]).collect();
-        Ok(Self { degree, knots, weighted })
+        let mut curve = Self { degree, knots, weighted, last_span: Cell::new(degree), polynomials: Vec::new() };
+        curve.polynomials = (degree..count).map(|span| curve.span_polynomial(span)).collect();
+        Ok(curve)
     }
 
     /// Parameter range [u_p, u_n].
@@ -113,6 +138,16 @@ impl Nurbs {
         to.saturating_sub(from)
     }
 
+    /// The distinct knots strictly between `lo` and `hi`, increasing.
+    pub(crate) fn distinct_knots_between(&self, lo: f64, hi: f64) -> impl Iterator<Item = f64> + '_ {
+        let (start, end) = self.domain();
+        // The first knot above lo follows lo's span (found from the hint, not by a search).
+        let from = if lo >= start && lo < end { self.span(lo) + 1 } else { self.knots.partition_point(|&k| k <= lo) };
+        let to = from + self.knots[from..].iter().take_while(|&&k| k < hi).count();
+        let inside = &self.knots[from..to];
+        inside.iter().enumerate().filter(move |&(i, k)| i == 0 || inside[i - 1] != *k).map(|(_, &k)| k)
+    }
+
     /// Degree p.
     pub(crate) fn degree(&self) -> usize {
         self.degree
@@ -137,8 +172,17 @@ impl Nurbs {
             }
             return i;
         }
+        let last = self.last_span.get();
+        for guess in [last, last + 1] {
+            if guess < n && self.knots[guess] <= u && u < self.knots[guess + 1] {
+                self.last_span.set(guess);
+                return guess;
+            }
+        }
         // First index with knot > u, minus one.
-        self.knots[..=n].partition_point(|&k| k <= u) - 1
+        let span = self.knots[..=n].partition_point(|&k| k <= u) - 1;
+        self.last_span.set(span);
+        span
     }
 
     /// The curve point at `u`.
@@ -167,15 +211,76 @@ impl Nurbs {
     }
 
     fn point_in(&self, span: usize, u: f64) -> Vec3 {
+        let polynomial = &self.polynomials[span - self.degree];
+        let t = (u - polynomial.start) * polynomial.inverse_width;
+        let mut sum = polynomial.coefficients[self.degree];
+        for coefficient in polynomial.coefficients[..self.degree].iter().rev() {
+            for (total, c) in sum.iter_mut().zip(coefficient) {
+                *total = *total * t + c;
+            }
+        }
+        polynomial.origin + Vec3::new(sum[0], sum[1], sum[2]) / sum[3]
+    }
+
+    /// The homogeneous curve (relative to O) at `u` in `span` by the basis functions (A2.2).
+    fn homogeneous_by_basis(&self, span: usize, u: f64, origin: &Vec3) -> [f64; 4] {
         let basis = self.basis(span, u);
         let mut sum = [0.0; 4];
         for (j, value) in basis.iter().take(self.degree + 1).enumerate() {
-            let control = &self.weighted[span - self.degree + j];
-            for (total, coordinate) in sum.iter_mut().zip(control) {
+            let [wx, wy, wz, w] = self.weighted[span - self.degree + j];
+            let relative = [wx - w * origin.x, wy - w * origin.y, wz - w * origin.z, w];
+            for (total, coordinate) in sum.iter_mut().zip(relative) {
                 *total += value * coordinate;
             }
         }
-        Vec3::new(sum[0] / sum[3], sum[1] / sum[3], sum[2] / sum[3])
+        sum
+    }
+
+    /// The power form of knot span `span`: the homogeneous curve interpolated at p + 1 equally
+    /// spaced local parameters (exact: it is a polynomial of degree p there), converted from
+    /// Newton's divided differences to monomial coefficients.
+    fn span_polynomial(&self, span: usize) -> SpanPolynomial {
+        let p = self.degree;
+        let (start, end) = (self.knots[span], self.knots[span + 1]);
+        let mut coefficients = [[0.0; 4]; SLOTS];
+        if end <= start {
+            return SpanPolynomial { origin: Vec3::zeros(), start, inverse_width: 0.0, coefficients };
+        }
+        let origin = {
+            let h = self.homogeneous_by_basis(span, start, &Vec3::zeros());
+            Vec3::new(h[0] / h[3], h[1] / h[3], h[2] / h[3])
+        };
+        let nodes: Vec<f64> = (0..=p).map(|j| j as f64 / p as f64).collect();
+        let mut table: Vec<[f64; 4]> = nodes
+            .iter()
+            .map(|&t| {
+                let u = if t >= 1.0 { end } else { start + (end - start) * t };
+                self.homogeneous_by_basis(span, u, &origin)
+            })
+            .collect();
+        // Divided differences in place: table[k] = f[t_0..t_k].
+        for level in 1..=p {
+            for k in (level..=p).rev() {
+                let width = nodes[k] - nodes[k - level];
+                let below = table[k - 1];
+                for (value, lower) in table[k].iter_mut().zip(below) {
+                    *value = (*value - lower) / width;
+                }
+            }
+        }
+        // Newton form to powers of t: c ← c·(t − t_k) + f[t_0..t_k], from the highest term.
+        for k in (0..=p).rev() {
+            for power in (1..=p).rev() {
+                let lower = coefficients[power - 1];
+                for (value, low) in coefficients[power].iter_mut().zip(lower) {
+                    *value = low - nodes[k] * *value;
+                }
+            }
+            for (value, difference) in coefficients[0].iter_mut().zip(table[k]) {
+                *value = difference - nodes[k] * *value;
+            }
+        }
+        SpanPolynomial { origin, start, inverse_width: 1.0 / (end - start), coefficients }
     }
 
     /// Point, first and second derivative with respect to u (the right-hand limits at a knot).
@@ -187,29 +292,12 @@ impl Nurbs {
     /// curvature may jump (a degree-2 curve is only C1 there); `None` elsewhere.
     pub(crate) fn derivatives_from_left(&self, u: f64) -> Option<[Vec3; 3]> {
         let right = self.span(u);
+        if self.knots[right] != u {
+            return None; // not a knot: one-sided limits agree (this is the common case)
+        }
         let n = self.weighted.len();
         let left = self.knots[..=n].partition_point(|&k| k < u).saturating_sub(1).clamp(self.degree, n - 1);
         (left != right).then(|| self.derivatives_in(left, u))
-    }
-
-    fn derivatives_in(&self, span: usize, u: f64) -> [Vec3; 3] {
-        let ders = self.basis_derivatives(span, u);
-        let mut homogeneous = [[0.0_f64; 4]; 3];
-        for (order, row) in ders.iter().enumerate() {
-            for (j, value) in row.iter().take(self.degree + 1).enumerate() {
-                let control = &self.weighted[span - self.degree + j];
-                for (total, coordinate) in homogeneous[order].iter_mut().zip(control) {
-                    *total += value * coordinate;
-                }
-            }
-        }
-        let vector = |h: &[f64; 4]| Vec3::new(h[0], h[1], h[2]);
-        let (a0, a1, a2) = (vector(&homogeneous[0]), vector(&homogeneous[1]), vector(&homogeneous[2]));
-        let (w0, w1, w2) = (homogeneous[0][3], homogeneous[1][3], homogeneous[2][3]);
-        let point = a0 / w0;
-        let first = (a1 - w1 * point) / w0;
-        let second = (a2 - 2.0 * w1 * first - w2 * point) / w0;
-        [point, first, second]
     }
 
     /// Non-zero basis functions N_{span−p..span, p}(u) (A2.2).
@@ -231,6 +319,58 @@ impl Nurbs {
             values[j] = saved;
         }
         values
+    }
+
+    /// Point and first two derivatives with respect to u in `span`: from the power form inside
+    /// the span, by the basis functions (A2.3) at its ends: at a cusp of coincident control
+    /// points (always at a knot) those give exactly zero, which the corner and radius logic
+    /// rely on, while the power form leaves rounding there.
+    fn derivatives_in(&self, span: usize, u: f64) -> [Vec3; 3] {
+        let polynomial = &self.polynomials[span - self.degree];
+        let scale = polynomial.inverse_width;
+        let t = (u - polynomial.start) * scale;
+        if !(t > 0.0 && t < 1.0) {
+            return self.derivatives_by_basis(span, u);
+        }
+        // Horner for the value and the first two derivatives in t.
+        let mut value = polynomial.coefficients[self.degree];
+        let (mut first, mut second) = ([0.0_f64; 4], [0.0_f64; 4]);
+        for coefficient in polynomial.coefficients[..self.degree].iter().rev() {
+            for axis in 0..4 {
+                second[axis] = second[axis] * t + first[axis];
+                first[axis] = first[axis] * t + value[axis];
+                value[axis] = value[axis] * t + coefficient[axis];
+            }
+        }
+        let vector = |h: &[f64; 4], factor: f64| Vec3::new(h[0], h[1], h[2]) * factor;
+        let curvature_scale = 2.0 * scale * scale;
+        let (a0, a1, a2) = (vector(&value, 1.0), vector(&first, scale), vector(&second, curvature_scale));
+        let (w0, w1, w2) = (value[3], first[3] * scale, second[3] * curvature_scale);
+        let relative = a0 / w0;
+        let first = (a1 - w1 * relative) / w0;
+        let second = (a2 - 2.0 * w1 * first - w2 * relative) / w0;
+        [polynomial.origin + relative, first, second]
+    }
+
+    /// Point and first two derivatives by the basis functions (A2.3).
+    fn derivatives_by_basis(&self, span: usize, u: f64) -> [Vec3; 3] {
+        let ders = self.basis_derivatives(span, u);
+        let mut homogeneous = [[0.0_f64; 4]; 3];
+        for (order, row) in ders.iter().enumerate() {
+            for (j, value) in row.iter().take(self.degree + 1).enumerate() {
+                let control = &self.weighted[span - self.degree + j];
+                for (total, coordinate) in homogeneous[order].iter_mut().zip(control) {
+                    *total += value * coordinate;
+                }
+            }
+        }
+        let vector = |h: &[f64; 4]| Vec3::new(h[0], h[1], h[2]);
+        let (a0, a1, a2) = (vector(&homogeneous[0]), vector(&homogeneous[1]), vector(&homogeneous[2]));
+        let (w0, w1, w2) = (homogeneous[0][3], homogeneous[1][3], homogeneous[2][3]);
+        let point = a0 / w0;
+        let first = (a1 - w1 * point) / w0;
+        let second = (a2 - 2.0 * w1 * first - w2 * point) / w0;
+        [point, first, second]
     }
 
     /// Basis functions and their first two derivatives (A2.3); rows are the derivative order.
@@ -424,6 +564,45 @@ mod tests {
                     let change = (ahead - behind) / (2.0 * step);
                     assert_abs_diff_eq!((second - change).norm(), 0.0, epsilon = 1e-5 * (1.0 + second.norm()));
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn power_form_matches_the_basis_functions() {
+        // Far from the origin, uneven knots with a double knot, weights: degrees 1–5.
+        let control: Vec<Vec3> = (0..9)
+            .map(|i| {
+                Vec3::new(5000.0 + 7.0 * f64::from(i), -3000.0 + (f64::from(i) * 1.3).sin() * 4.0, f64::from(i % 3))
+            })
+            .collect();
+        let weights = [1.0, 2.0, 0.5, 1.0, 3.0, 1.0, 0.7, 1.4, 1.0];
+        for degree in 1..=5_usize {
+            let inner = 9 - degree - 1;
+            let mut knots = vec![0.0; degree + 1];
+            for k in 1..=inner {
+                knots.push(if k == inner && inner > 1 && degree > 1 {
+                    knots[knots.len() - 1]
+                } else {
+                    (k as f64).powf(1.3)
+                });
+            }
+            let last = knots[knots.len() - 1] + 1.0;
+            knots.extend(std::iter::repeat_n(last, degree + 1));
+            let curve = Nurbs::new(degree, &control, Some(&knots), Some(&weights), "curve").unwrap();
+            let (start, end) = curve.domain();
+            for k in 0..=200 {
+                let u = start + (end - start) * f64::from(k) / 200.0;
+                let span = curve.span(u);
+                let h = curve.homogeneous_by_basis(span, u, &Vec3::zeros());
+                let by_basis = Vec3::new(h[0] / h[3], h[1] / h[3], h[2] / h[3]);
+                assert_abs_diff_eq!((curve.point(u) - by_basis).norm(), 0.0, epsilon = 1e-10);
+                let [p, d1, d2] = curve.derivatives(u);
+                let [q, e1, e2] = curve.derivatives_by_basis(span, u);
+                assert_abs_diff_eq!((p - by_basis).norm(), 0.0, epsilon = 1e-10);
+                assert_abs_diff_eq!((q - by_basis).norm(), 0.0, epsilon = 1e-10);
+                assert_abs_diff_eq!((d1 - e1).norm(), 0.0, epsilon = 1e-9 * (1.0 + e1.norm()));
+                assert_abs_diff_eq!((d2 - e2).norm(), 0.0, epsilon = 1e-8 * (1.0 + e2.norm()));
             }
         }
     }

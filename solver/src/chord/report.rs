@@ -201,6 +201,7 @@ pub(super) fn describe(
         Plan::Max { length, .. } => format!("mode curve max over {length:.3} mm windows"),
         Plan::Extremes { .. } => "mode curve extremes".to_owned(),
         Plan::NormalAccel { .. } => "mode curve normal accel".to_owned(),
+        Plan::Guarantee => "mode guarantee (each chord from its smallest radius)".to_owned(),
     };
     let mut lines = vec![
         format!(

@@ -18,8 +18,7 @@ use crate::validate::{finite, positive};
 
 /// Most polyline points accepted.
 pub const MAX_POLYLINE_POINTS: usize = 1_000_000;
-/// Largest coordinate magnitude accepted, mm.
-pub const MAX_COORDINATE: f64 = 1e6;
+pub use crate::validate::MAX_COORDINATE;
 /// Smallest accuracy tolerance accepted, mm.
 pub const MIN_TOLERANCE: f64 = 1e-6;
 /// Default corner angle for polylines and splines, degrees.
@@ -127,6 +126,10 @@ pub enum Mode {
     Window,
     /// One value for the whole curve by `rule` (embodiments 3–5).
     Curve,
+    /// Each chord's error from the smallest radius of curvature along it (chord.md §2.9a,
+    /// revision 2): no block but a span's final remainder is shorter than margin × feed ×
+    /// block time.
+    Guarantee,
 }
 
 /// The whole-curve rule of `mode: curve`.
@@ -171,9 +174,9 @@ pub struct SegmentRequest {
     /// T_b: block processing time of the control, ms (default: the machine's).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub block_time_ms: Option<f64>,
-    /// `window` (default) or `curve`.
-    #[serde(default)]
-    pub mode: Mode,
+    /// `window`, `curve` or `guarantee` (default: the machine's `mode`, else `window`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mode: Option<Mode>,
     /// Δs: window length for `mode: window` (and `rule: max`), mm (default 5 target chords).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub window: Option<f64>,
@@ -241,6 +244,7 @@ pub(crate) enum Plan {
     Max { length: f64, estimate: Estimate },
     Extremes { min_radius: Option<f64> },
     NormalAccel { min_radius: Option<f64> },
+    Guarantee,
 }
 
 /// A validated request: the curve built, the machine's defaults applied.
@@ -463,7 +467,7 @@ impl Curve {
                     length += (pair[1] - pair[0]).norm();
                     stations.push(length);
                 }
-                let shape = Shape::Polyline(Polyline { vertices, stations });
+                let shape = Shape::Polyline(Polyline { vertices, stations, last_edge: std::cell::Cell::new(0) });
                 let corners = shape.corners(corner);
                 (shape, corners, dimension)
             }
@@ -519,13 +523,14 @@ fn optional_tolerance(field: &str, value: Option<f64>) -> Result<Option<f64>, So
 impl SegmentRequest {
     /// A request for `curve` at `feed` (mm/min) on a control with `block_time_ms`, everything
     /// else at its default (window mode, no margins, no bounds): the starting point for callers
-    /// in Rust, e.g. a path solver resampling its own dense points as a `polyline`.
+    /// in Rust, e.g. a path solver resampling its own dense points as a `polyline` (set `mode`
+    /// to [`Mode::Guarantee`] for no short blocks, or use [`SegmentRequest::guarantee`]).
     pub fn new(curve: Curve, feed: f64, block_time_ms: f64) -> Self {
         Self {
             curve,
             feed: Some(feed),
             block_time_ms: Some(block_time_ms),
-            mode: Mode::Window,
+            mode: None,
             window: None,
             rule: None,
             min_radius: None,
@@ -544,6 +549,12 @@ impl SegmentRequest {
             spindle_rpm: None,
             safe_z: None,
         }
+    }
+
+    /// [`SegmentRequest::new`] in mode `guarantee` (chord.md §2.9a): what a path solver uses
+    /// for the curves it emits, so that no block but a final remainder starves the control.
+    pub fn guarantee(curve: Curve, feed: f64, block_time_ms: f64) -> Self {
+        Self { mode: Some(Mode::Guarantee), ..Self::new(curve, feed, block_time_ms) }
     }
 
     /// The block-time rule of this request with `machine`'s defaults (fields are named as in
@@ -577,11 +588,26 @@ impl SegmentRequest {
             RadiusEstimate::Minimum => Estimate::Minimum,
         };
         let min_radius = self.min_radius.map(|r| positive("min_radius", r)).transpose()?;
-        let plan = match (self.mode, self.rule) {
+        let mode = self.mode.or(machine.and_then(|m| m.mode)).unwrap_or_default();
+        let plan = match (mode, self.rule) {
             (Mode::Window, Some(_)) => {
                 return Err(SolverError::input("rule", "rule applies to mode \"curve\" only"));
             }
             (Mode::Window, None) => Plan::Window { length: window.unwrap_or(default_window), estimate },
+            (Mode::Guarantee, rule) => {
+                let stray = [
+                    ("rule", rule.is_some()),
+                    ("window", window.is_some()),
+                    ("radius_estimate", self.radius_estimate.is_some()),
+                ];
+                if let Some((field, _)) = stray.iter().find(|(_, given)| *given) {
+                    return Err(SolverError::input(
+                        *field,
+                        format!("{field} does not apply to mode \"guarantee\" (each chord uses its smallest radius)"),
+                    ));
+                }
+                Plan::Guarantee
+            }
             (Mode::Curve, rule) => match rule.unwrap_or_default() {
                 CurveRule::Max => Plan::Max { length: window.unwrap_or(default_window), estimate },
                 other => {

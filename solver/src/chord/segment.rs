@@ -3,19 +3,19 @@
 //! progress rule, and the single-value run of embodiments 3–5 and of fixed-tolerance baselines.
 //! Paths are split at corners (E11): every corner is a command point and starts fresh windows.
 
-use super::numeric::last_fitting;
+use crate::error::ErrorCode;
+use std::cell::Cell;
+
 use super::rule::{BlockRule, ChordStatus, Infeasible, chord_length};
 use super::shape::{Shape, circumradius};
-use crate::error::ErrorCode;
+use super::{reference, search};
 use crate::error::SolverError;
 use crate::geometry::Vec3;
 
 /// Slack on the chord error when testing a chord (chord.md §2.9: eps = 1e-12 mm).
-const EPS: f64 = 1e-12;
+pub(crate) const EPS: f64 = 1e-12;
 /// Width (mm of arc length) to which the crossing is bracketed.
-const CROSSING_WIDTH: f64 = 1e-12;
-/// Fixed steps before the search for the crossing starts doubling its step (long straights).
-const STEPS_BEFORE_GALLOP: usize = 32;
+pub(crate) const CROSSING_WIDTH: f64 = 1e-12;
 /// A chord shorter than this (mm) means the search made no progress (E14).
 const MIN_PROGRESS: f64 = 1e-9;
 /// Largest ratio of a window's 3-point radius to the smallest radius inside the window that is
@@ -24,6 +24,16 @@ const MIN_PROGRESS: f64 = 1e-9;
 pub(crate) const SPREAD_CAP: f64 = 1.1;
 /// Slack on window ends (chord.md §2.9: s1 + 1e-12).
 const WINDOW_SLACK: f64 = 1e-12;
+
+/// How the chord ends are found (chord.md §2.9a).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(crate) enum Numerics {
+    /// A handful of deviations per block (`search`).
+    #[default]
+    Fast,
+    /// The reference numerics of §2.9 (`reference`), the test oracle.
+    Reference,
+}
 
 /// A command point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -67,6 +77,8 @@ pub(crate) struct WindowRecord {
 #[derive(Debug, Clone, PartialEq, Default)]
 pub(crate) struct Cut {
     pub vertices: Vec<Vertex>,
+    /// Each block's deviation where the search measured it (`None`: compute it).
+    pub deviations: Vec<Option<f64>>,
     pub windows: Vec<WindowRecord>,
     /// Block indices (block i runs from vertex i to i + 1) that end at a corner or the path end.
     pub span_ends: Vec<usize>,
@@ -104,6 +116,12 @@ impl From<SolverError> for CutError {
 /// The segmentation of one curve under a block limit.
 pub(crate) struct Cutter<'a> {
     pub shape: &'a Shape,
+    /// How chord ends are searched.
+    pub numerics: Numerics,
+    /// Parameter step of the last chord: the fast search's first trial for the next.
+    pub last_step: Cell<f64>,
+    /// The deviation of the chord `greedy_end` returned last, where the search measured it.
+    pub last_deviation: Cell<Option<f64>>,
     /// Parameter ranges between corners, in order.
     pub spans: &'a [(f64, f64)],
     /// Most blocks before `E_TOO_MANY_BLOCKS`.
@@ -112,74 +130,68 @@ pub(crate) struct Cutter<'a> {
     pub limit_field: &'a str,
 }
 
-impl Cutter<'_> {
-    fn vertex(&self, u: f64) -> Vertex {
+impl<'a> Cutter<'a> {
+    /// A cutter for `spans` of `shape`, failing past `max_blocks` blocks with `limit_field`.
+    pub(crate) fn new(
+        shape: &'a Shape,
+        spans: &'a [(f64, f64)],
+        max_blocks: usize,
+        limit_field: &'a str,
+        numerics: Numerics,
+    ) -> Self {
+        Self {
+            shape,
+            numerics,
+            last_step: Cell::new(0.0),
+            last_deviation: Cell::new(None),
+            spans,
+            max_blocks,
+            limit_field,
+        }
+    }
+
+    /// dev of the chord between two parameters as the answer reports it: the reference's
+    /// (exact for arcs, ellipse chords and polylines; 32 samples refined for NURBS).
+    pub(crate) fn deviation(&self, ua: f64, ub: f64) -> f64 {
+        match (self.numerics, self.shape) {
+            (Numerics::Fast, Shape::Arc(_) | Shape::Ellipse(_) | Shape::Polyline(_)) => {
+                self.shape.fast_deviation(ua, ub, f64::INFINITY)
+            }
+            _ => self.shape.deviation(ua, ub),
+        }
+    }
+
+    pub(crate) fn vertex(&self, u: f64) -> Vertex {
         Vertex { u, s: self.shape.s_at(u), point: self.shape.point(u) }
     }
 
-    /// `greedy_end` of chord.md §2.9: the end of the longest chord from `start` whose deviation
-    /// stays within `chord_error` (the first crossing), searched in steps of `step_guess/4` of
-    /// arc length up to `limit`.
-    fn greedy_end(
+    /// The end of the longest chord from `start` whose deviation stays within `chord_error`
+    /// (chord.md §2.9 `greedy_end`), up to `limit`; `step_guess` is the circle chord of the
+    /// window's radius (mm). By the fast search, or by the reference numerics for the oracle.
+    pub(crate) fn greedy_end(
         &self,
         start: &Vertex,
         chord_error: f64,
         limit: &Vertex,
         step_guess: f64,
     ) -> Result<Vertex, SolverError> {
-        let allowed = chord_error + EPS;
-        let quarter = step_guess / 4.0;
-        if limit.s - start.s <= quarter && self.shape.deviation_against(start.u, limit.u, allowed) <= allowed {
+        let (end, deviation) = match self.numerics {
+            Numerics::Fast => search::chord_end(self.shape, start, chord_error, limit, step_guess, &self.last_step)?,
+            Numerics::Reference => (reference::greedy_end(self.shape, start, chord_error, limit, step_guess)?, None),
+        };
+        if end >= limit.u {
+            self.last_deviation.set(deviation);
             return Ok(*limit);
         }
-        // Steps of a quarter guess of arc length, taken in the parameter with the local speed.
-        let mut step = quarter.max(1e-9);
-        let (mut lo_u, mut lo_dev) = (start.u, 0.0);
-        let mut steps = 0;
-        let (hi_u, hi_dev) = loop {
-            let speed = self.shape.speed(lo_u);
-            let ahead = if speed > 0.0 { lo_u + step / speed } else { limit.u };
-            let hi_u = ahead.min(limit.u);
-            let dev = self.shape.deviation_against(start.u, hi_u, allowed);
-            if dev > allowed {
-                break (hi_u, dev);
-            }
-            if hi_u >= limit.u {
-                return Ok(*limit);
-            }
-            (lo_u, lo_dev) = (hi_u, dev);
-            steps += 1;
-            if steps >= STEPS_BEFORE_GALLOP {
-                step *= 2.0;
-            }
-        };
-        // The deviation grows about with the square of the chord: its root is nearly linear in
-        // the chord's end, which the root finder solves in a few steps.
-        let root = allowed.sqrt();
-        let g = |u: f64| self.shape.deviation(start.u, u).sqrt() - root;
-        // Bracket to 1e-12 mm of arc length, converted with the bracket's mean speed (the speed
-        // at one end may be zero: a cusp).
-        let width = self.shape.s_at(hi_u) - self.shape.s_at(lo_u);
-        let speed = width / (hi_u - lo_u);
-        let tol = if speed > 0.0 {
-            (CROSSING_WIDTH / speed).max(f64::MIN_POSITIVE)
-        } else {
-            f64::EPSILON * hi_u.abs().max(f64::MIN_POSITIVE)
-        };
-        let end = last_fitting(g, lo_u, lo_dev.sqrt() - root, hi_u, hi_dev.sqrt() - root, tol).ok_or_else(|| {
-            SolverError::new(
-                ErrorCode::NumericFailure,
-                format!("the chord search did not converge at s = {:.6} mm (E14)", start.s),
-            )
-            .at("curve")
-        })?;
         let end = self.vertex(end);
         // A remainder below a nanometre is not a block: the chord takes it.
-        Ok(if limit.s - end.s < MIN_PROGRESS { *limit } else { end })
+        let taken = limit.s - end.s < MIN_PROGRESS;
+        self.last_deviation.set(if taken { None } else { deviation });
+        Ok(if taken { *limit } else { end })
     }
 
     /// Appends a command point; `span_end` is the parameter where its span ends.
-    fn push(&self, cut: &mut Cut, vertex: Vertex, span_end: f64) -> Result<(), SolverError> {
+    pub(crate) fn push(&self, cut: &mut Cut, vertex: Vertex, span_end: f64) -> Result<(), SolverError> {
         if cut.vertices.len() > self.max_blocks {
             return Err(SolverError::new(
                 ErrorCode::TooManyBlocks,
@@ -206,10 +218,11 @@ impl Cutter<'_> {
             .at("curve"));
         }
         cut.vertices.push(vertex);
+        cut.deviations.push(self.last_deviation.take());
         Ok(())
     }
 
-    fn start(&self) -> Option<Cut> {
+    pub(crate) fn start(&self) -> Option<Cut> {
         let &(first, _) = self.spans.first()?;
         Some(Cut { vertices: vec![self.vertex(first)], ..Cut::default() })
     }
@@ -438,7 +451,7 @@ mod tests {
     fn the_block_limit_names_its_field() {
         let shape = circle(50.0);
         let spans = [shape.domain()];
-        let cutter = Cutter { shape: &shape, spans: &spans, max_blocks: 10, limit_field: "compare_tolerance" };
+        let cutter = Cutter::new(&shape, &spans, 10, "compare_tolerance", Numerics::Fast);
         let error = cutter.constant(0.001, 50.0).unwrap_err();
         assert_eq!(error.code(), ErrorCode::TooManyBlocks);
         assert_eq!(error.field(), Some("compare_tolerance"));
@@ -449,7 +462,7 @@ mod tests {
         // Chord error 0 on a 0.1 µm circle: the longest fitting chord is below 1 nm (E14).
         let shape = circle(1e-7);
         let spans = [shape.domain()];
-        let cutter = Cutter { shape: &shape, spans: &spans, max_blocks: 1000, limit_field: "tolerance" };
+        let cutter = Cutter::new(&shape, &spans, 1000, "tolerance", Numerics::Fast);
         let error = cutter.constant(0.0, f64::INFINITY).unwrap_err();
         assert_eq!(error.code(), ErrorCode::NumericFailure);
     }
@@ -458,7 +471,7 @@ mod tests {
     fn greedy_chords_on_a_circle_have_the_sagitta_length() {
         let shape = circle(50.0);
         let spans = [shape.domain()];
-        let cutter = Cutter { shape: &shape, spans: &spans, max_blocks: 1000, limit_field: "tolerance" };
+        let cutter = Cutter::new(&shape, &spans, 1000, "tolerance", Numerics::Fast);
         let cut = cutter.constant(0.01, 50.0).unwrap();
         assert_eq!(cut.vertices.len(), 159);
         let chord = (cut.vertices[1].point - cut.vertices[0].point).norm();

@@ -60,6 +60,9 @@ pub(crate) struct Polyline {
     pub vertices: Vec<Vec3>,
     /// Arc length at each vertex.
     pub stations: Vec<f64>,
+    /// The edge found last: the segmentation walks along the polyline, so the next lookup is
+    /// nearly always on it or the next edge (no binary search over every vertex).
+    pub last_edge: std::cell::Cell<usize>,
 }
 
 /// A NURBS curve with its arc-length table.
@@ -127,7 +130,16 @@ impl Polyline {
     /// Index of the edge holding arc length `s`.
     fn edge(&self, s: f64) -> usize {
         let last_edge = self.vertices.len().saturating_sub(2);
-        self.stations.partition_point(|&x| x <= s).saturating_sub(1).min(last_edge)
+        let hint = self.last_edge.get();
+        for k in [hint, hint + 1] {
+            if k < last_edge && self.stations[k] <= s && s < self.stations[k + 1] {
+                self.last_edge.set(k);
+                return k;
+            }
+        }
+        let k = self.stations.partition_point(|&x| x <= s).saturating_sub(1).min(last_edge);
+        self.last_edge.set(k);
+        k
     }
 
     fn point(&self, s: f64) -> Vec3 {
@@ -183,6 +195,63 @@ fn refine_maximum(f: &impl Fn(f64) -> f64, x: [f64; 3], y: [f64; 3], tol: f64, r
     // Slow convergence (a kink, e.g. a curvature jump at a knot): finish on the bracket.
     let (_, negative) = minimise(|u| -f(u), a, c, tol);
     fb.max(-negative)
+}
+
+/// Sub-intervals per knot span in [`Shape::fast_deviation`].
+const SPAN_SAMPLES: usize = 4;
+/// Most knot spans one fast deviation samples; beyond, the reference sampling is used.
+const MAX_FAST_SPANS: usize = 8;
+
+/// The fast deviation of a NURBS chord (see [`Shape::fast_deviation`]); `None` when the chord
+/// crosses more than [`MAX_FAST_SPANS`] knot spans.
+fn spline_deviation(spline: &Spline, ua: f64, ub: f64, limit: f64) -> Option<f64> {
+    let (lo, hi) = (ua.min(ub), ua.max(ub));
+    let mut breaks = [0.0_f64; MAX_FAST_SPANS + 1];
+    breaks[0] = lo;
+    let mut count = 1;
+    for knot in spline.nurbs.distinct_knots_between(lo, hi) {
+        if count == MAX_FAST_SPANS {
+            return None;
+        }
+        breaks[count] = knot;
+        count += 1;
+    }
+    breaks[count] = hi;
+    let (a, b) = (spline.nurbs.point(ua), spline.nurbs.point(ub));
+    let hint = std::cell::Cell::new(0);
+    let distance = |u: f64| distance_to_segment(&spline.nurbs.point_near(u, &hint), &a, &b);
+    const CAPACITY: usize = MAX_FAST_SPANS * SPAN_SAMPLES + 1;
+    let (mut at, mut value) = ([0.0_f64; CAPACITY], [0.0_f64; CAPACITY]);
+    at[0] = lo;
+    let mut n = 1;
+    let mut best = 0;
+    for piece in breaks[..=count].windows(2) {
+        let step = (piece[1] - piece[0]) / SPAN_SAMPLES as f64;
+        for j in 1..=SPAN_SAMPLES {
+            let u = if j == SPAN_SAMPLES { piece[1] } else { piece[0] + step * j as f64 };
+            let d = if u == hi { 0.0 } else { distance(u) };
+            if d > limit {
+                return Some(d);
+            }
+            (at[n], value[n]) = (u, d);
+            if d > value[best] {
+                best = n;
+            }
+            n += 1;
+        }
+    }
+    if best == 0 || (limit.is_finite() && value[best] < REFINE_FRACTION * limit) {
+        return Some(value[best]);
+    }
+    let tol = 1e-9 * (hi - lo) + 4.0 * f64::EPSILON * lo.abs().max(hi.abs());
+    let rounding = 8.0 * f64::EPSILON * a.amax().max(b.amax());
+    Some(refine_maximum(
+        &distance,
+        [at[best - 1], at[best], at[best + 1]],
+        [value[best - 1], value[best], value[best + 1]],
+        tol,
+        rounding,
+    ))
 }
 
 /// Radius of the circle through three points, in any dimension (chord.md §2.8); infinite when
@@ -272,7 +341,13 @@ impl Shape {
             Self::Polyline(line) => {
                 let (a, b) = (line.point(ua), line.point(ub));
                 let (lo, hi) = (ua.min(ub), ua.max(ub));
-                let first = line.stations.partition_point(|&x| x <= lo);
+                // The first vertex strictly after lo: the end of lo's edge (from the hint).
+                let k = line.edge(lo);
+                let first = if line.stations[k] <= lo && line.stations.get(k + 1).is_some_and(|&x| x > lo) {
+                    k + 1
+                } else {
+                    line.stations.partition_point(|&x| x <= lo)
+                };
                 let mut worst = 0.0_f64;
                 for (vertex, &station) in line.vertices.iter().zip(&line.stations).skip(first) {
                     if station >= hi {
@@ -292,6 +367,41 @@ impl Shape {
         match self {
             Self::Ellipse(_) | Self::Spline(_) => self.sampled_deviation(ua, ub, Some(limit)),
             Self::Arc(_) | Self::Polyline(_) => self.deviation(ua, ub),
+        }
+    }
+
+    /// dev(u_a, u_b) for the fast search (chord.md §2.9a), where only values near `limit`
+    /// need to be exact: closed forms for arcs and ellipses, the farthest vertex of a
+    /// polyline, and for NURBS four sub-intervals per knot span refined around the best sample
+    /// (a smooth span bends one way over a chord cut to its curvature, so its distance from the
+    /// chord has one hump per span). Stops at the first sample above `limit`; skips the
+    /// refinement well below it (an infinite `limit` gives the refined maximum).
+    pub(crate) fn fast_deviation(&self, ua: f64, ub: f64, limit: f64) -> f64 {
+        match self {
+            Self::Arc(_) | Self::Polyline(_) => self.deviation(ua, ub),
+            Self::Ellipse(ellipse) if (ub - ua).abs() <= std::f64::consts::FRAC_PI_2 => {
+                // The affine image of a circle: the farthest point is at the mean angle, its
+                // distance (1 − cos δ)·ab/√(a² sin² t_m + b² cos² t_m) for half-angle δ.
+                let [a, b] = ellipse.semi_axes;
+                let half = 0.5 * (ub - ua).abs();
+                let middle = ellipse.angle(0.5 * (ua + ub));
+                2.0 * (0.5 * half).sin().powi(2) * a * b / (a * middle.sin()).hypot(b * middle.cos())
+            }
+            Self::Ellipse(_) => self.sampled_deviation(ua, ub, Some(limit)),
+            Self::Spline(spline) => {
+                spline_deviation(spline, ua, ub, limit).unwrap_or_else(|| self.sampled_deviation(ua, ub, Some(limit)))
+            }
+        }
+    }
+
+    /// The reference deviation (32 samples, refined) of a chord the fast search found, where
+    /// [`Shape::fast_deviation`] only samples: it catches a hump between the fast samples, and
+    /// the answer reports it as the chord's deviation. `None` where the fast value is exact.
+    pub(crate) fn checked_deviation(&self, ua: f64, ub: f64) -> Option<f64> {
+        match self {
+            Self::Arc(_) | Self::Polyline(_) => None,
+            Self::Ellipse(_) if (ub - ua).abs() <= std::f64::consts::FRAC_PI_2 => None,
+            Self::Ellipse(_) | Self::Spline(_) => Some(self.sampled_deviation(ua, ub, None)),
         }
     }
 
@@ -578,7 +688,7 @@ mod tests {
         let vertices = vec![Vec3::zeros(), Vec3::new(1.0, 0.2, 0.0), Vec3::new(2.0, 0.0, 0.0)];
         let first = (vertices[1] - vertices[0]).norm();
         let stations = vec![0.0, first, 2.0 * first];
-        let line = Shape::Polyline(Polyline { vertices, stations });
+        let line = Shape::Polyline(Polyline { vertices, stations, last_edge: std::cell::Cell::new(0) });
         assert_relative_eq!(line.deviation(0.0, 2.0 * first), 0.2, max_relative = 1e-15);
         assert_eq!(line.corners(10f64.to_radians()), vec![first]);
         assert!(line.corners(30f64.to_radians()).is_empty());

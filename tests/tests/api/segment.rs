@@ -663,3 +663,25 @@ async fn jobs_page_shows_segment_results() {
     assert_eq!(result["ok"], true);
     assert_eq!(result["plots"], 6, "plan, chord error and block length per operation: {result}");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn guarantee_mode_from_the_request_or_the_machine_leaves_no_short_block() {
+    let app = TestApp::spawn().await;
+    let quarter = json!({"kind": "ellipse", "centre": [0, 0], "semi_axes": [100, 50], "end_deg": 90});
+    let window = json_with(
+        app.post_json("/api/v1/segment", &json!({"curve": quarter, "feed": 10000, "block_time_ms": 4})).await,
+        200,
+    )
+    .await;
+    assert!(window["short_blocks"].as_u64().unwrap() > 0, "the patent's windows leave short blocks");
+    let asked = json!({"curve": quarter, "feed": 10000, "block_time_ms": 4, "mode": "guarantee"});
+    let guaranteed = json_with(app.post_json("/api/v1/segment", &asked).await, 200).await;
+    assert_eq!(guaranteed["short_blocks"], 0, "guarantee mode");
+    // A machine whose mode is guarantee makes it the default of requests naming it.
+    let machine = json!({"block_time_ms": 4, "max_feed": 10000, "mode": "guarantee"});
+    json_with(app.put_json("/api/v1/machines/no-starving", &machine).await, 201).await;
+    let named = json!({"curve": quarter, "machine": "no-starving"});
+    let from_machine = json_with(app.post_json("/api/v1/segment", &named).await, 200).await;
+    assert_eq!(from_machine["short_blocks"], 0, "the machine's guarantee mode");
+    assert_eq!(from_machine["points"], guaranteed["points"]);
+}
