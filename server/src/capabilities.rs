@@ -7,10 +7,11 @@ use std::time::Instant;
 
 use kerf_solver::SolverError;
 use kerf_solver::capability::{self, Capability, Lookup, OutputOptions, Refs, Resolved, Run, ToolNeed};
-use kerf_solver::chord::{MachineProfile, SegmentCapability, SegmentRequest};
+use kerf_solver::chord::{SegmentCapability, SegmentRequest};
 use kerf_solver::corners::{ContourCapability, ContourRequest};
 use kerf_solver::deburr::{DeburrCapability, DeburrRequest};
 use kerf_solver::engagement::{EngagementCapability, EngagementRequest};
+use kerf_solver::machine::MachineProfile;
 use kerf_solver::predict::{PredictCapability, PredictRequest};
 use kerf_solver::tool::Tool;
 use serde::{Deserialize, Serialize};

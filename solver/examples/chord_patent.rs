@@ -3,8 +3,9 @@
 //! the quarter ellipse of cases B and C against fixed 0.01 and 0.001 mm. Prints the comparison
 //! figures and the head of the program. Run: `cargo run -p kerf-solver --example chord_patent`.
 
-use kerf_solver::chord::{self, BlockStats, SegmentAnswer, SegmentRequest};
+use kerf_solver::chord::{self, SegmentAnswer, SegmentRequest};
 use kerf_solver::gcode::{Dialect, ToolCall};
+use kerf_solver::machine::BlockStats;
 use serde_json::{Value, json};
 
 fn row(name: &str, stats: &BlockStats, deviation: f64) {

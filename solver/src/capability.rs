@@ -11,9 +11,9 @@ use std::sync::atomic::AtomicBool;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
-use crate::chord::MachineProfile;
 use crate::error::SolverError;
 use crate::gcode::{Dialect, Reference};
+use crate::machine::MachineProfile;
 use crate::tool::{Tool, ToolRef};
 
 /// One capability: deburr, segment, contour, engagement, predict.

@@ -19,6 +19,7 @@ pub mod error;
 mod error_code;
 pub mod gcode;
 pub mod geometry;
+pub mod machine;
 pub mod path;
 pub mod planar;
 pub mod predict;

@@ -3,8 +3,9 @@
 //! printed precision), the fixed-tolerance baselines, the edge cases E1–E5 and the surface table
 //! through [`BlockRule`], and the G-code head of case A.
 
-use kerf_solver::chord::{self, BlockRule, ChordStatus, SegmentAnswer, SegmentRequest, WindowStatus};
+use kerf_solver::chord::{self, SegmentAnswer, SegmentRequest, WindowStatus};
 use kerf_solver::gcode::{Dialect, Post, ToolCall};
+use kerf_solver::machine::{BlockRule, ChordStatus};
 use serde_json::{Value, json};
 
 const POINT_TOLERANCE: f64 = 1e-6;
@@ -300,7 +301,7 @@ fn case_derived_constants() {
     let expected = &case("A")["expected"];
     let rule = BlockRule::new(10_000.0, 4.0).unwrap();
     let cep = rule.chord_error(50.0).unwrap().0;
-    let chord = chord::chord_length(50.0, cep);
+    let chord = kerf_solver::machine::chord_length(50.0, cep);
     // The fixture's chord is the greedy one, 1e-12 mm of slack on the chord error longer.
     close("chord", chord, number(&expected["chord_length_mm"]), 1e-9);
     let angle = 2.0 * (chord / 100.0).asin();

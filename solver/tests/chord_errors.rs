@@ -2,8 +2,9 @@
 //! the curve checks), machine defaults and overrides, warnings of the edge-case table (E1, E4,
 //! E5, E8–E10, E12, E13) and the G-code program in both dialects.
 
-use kerf_solver::chord::{self, MachineProfile, SegmentAnswer, SegmentRequest, WindowStatus};
+use kerf_solver::chord::{self, SegmentAnswer, SegmentRequest, WindowStatus};
 use kerf_solver::gcode::{Dialect, Post, ToolCall};
+use kerf_solver::machine::MachineProfile;
 use serde_json::{Value, json};
 
 fn parse(request: Value) -> SegmentRequest {

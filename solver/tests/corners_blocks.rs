@@ -3,8 +3,8 @@
 //! `tolerance`; the arcs' half-length end segments join the straight moves they continue; the
 //! summary counts the blocks; what the rule cannot fix is reported.
 
-use kerf_solver::chord::BlockRule;
 use kerf_solver::corners::{self, ContourAnswer, ContourMove, MoveKind};
+use kerf_solver::machine::BlockRule;
 use kerf_solver::planar::{Vec2, vec2};
 use kerf_solver::tool::{Tool, ToolKind};
 use proptest::prelude::*;

@@ -3,9 +3,9 @@
 //! too small for the feed, a piece shorter than one block), and the deviation stays within both
 //! the tolerance and the rule's chord error; without a block time nothing changes.
 
-use kerf_solver::chord::{BlockRule, MachineProfile};
 use kerf_solver::deburr::{self, Deburr, DeburrRequest};
 use kerf_solver::gcode::Dialect;
+use kerf_solver::machine::{BlockRule, MachineProfile};
 use kerf_solver::tool::{Tool, ToolKind};
 use proptest::prelude::*;
 use serde_json::{Value, json};

@@ -6,8 +6,8 @@ use axum::Json;
 use axum::extract::State;
 use axum::http::StatusCode;
 use kerf_solver::SolverError;
-use kerf_solver::chord::{MachineProfile, validate_machine_name};
 use kerf_solver::gcode::Dialect;
+use kerf_solver::machine::{MachineProfile, validate_machine_name};
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 

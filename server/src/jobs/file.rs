@@ -25,8 +25,8 @@
 
 use kerf_solver::ErrorCode;
 use kerf_solver::capability::{self, Lookup};
-use kerf_solver::chord::{MachineProfile, validate_machine_name};
 use kerf_solver::gcode::{Dialect, Reference};
+use kerf_solver::machine::{MachineProfile, validate_machine_name};
 use kerf_solver::predict::Stock;
 use kerf_solver::tool::{Tool, ToolRef};
 use serde::{Deserialize, Serialize};

@@ -1,7 +1,7 @@
 //! The machines registry (api.md, Machines): controller profiles keyed by name.
 
-use kerf_solver::chord::MachineProfile;
 use kerf_solver::gcode::Dialect;
+use kerf_solver::machine::MachineProfile;
 use sqlx::SqlitePool;
 
 use crate::error::{AppError, AppResult};

@@ -5,7 +5,7 @@ pub mod machines;
 pub mod tools;
 
 use kerf_solver::capability::Refs;
-use kerf_solver::chord::MachineProfile;
+use kerf_solver::machine::MachineProfile;
 use kerf_solver::tool::ToolRef;
 use sqlx::SqlitePool;
 

@@ -2,8 +2,8 @@
 
 use serde::Serialize;
 
-use super::stats::BlockStats;
 use crate::error::Warning;
+use crate::machine::stats::BlockStats;
 
 /// How a window's chord error was chosen (chord.md §2.7, §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]

@@ -3,10 +3,11 @@
 
 use serde::Serialize;
 
-use super::{MachineProfile, SegmentAnswer, SegmentRequest};
+use super::{SegmentAnswer, SegmentRequest};
 use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
 use crate::error::SolverError;
 use crate::gcode::{Post, Reference, ToolCall};
+use crate::machine::MachineProfile;
 use crate::tool::Tool;
 
 /// The segment capability.

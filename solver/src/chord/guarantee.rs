@@ -11,9 +11,9 @@
 //! The smallest radius is taken over a stretch that contains the whole chord (widened and
 //! searched again when the chord runs past it).
 
-use super::rule::{BlockRule, chord_length};
 use super::segment::{Cut, CutError, Cutter, EPS, InfeasibleAt, Status, Vertex, WindowRecord, classify};
 use crate::error::ErrorCode;
+use crate::machine::rule::{BlockRule, chord_length};
 
 /// First stretch checked for the smallest radius, in previous chords (or target chords).
 const REACH: f64 = 1.25;

@@ -59,29 +59,24 @@ mod answer;
 mod arclength;
 mod capability;
 mod guarantee;
-pub mod machine;
 mod numeric;
 mod nurbs;
 pub mod program;
 mod reference;
 mod report;
 pub mod request;
-pub mod rule;
 mod search;
 mod segment;
 mod shape;
-pub mod stats;
 
 pub use answer::{Comparison, SegmentAnswer, SegmentWindow, WindowStatus};
 pub use capability::{SegmentCapability, SegmentResult};
-pub use machine::{MachineProfile, validate_machine_name};
 pub use nurbs::{MAX_CONTROL_POINTS, MAX_DEGREE};
 pub use program::program;
 pub use request::{Curve, CurveRule, Direction, Mode, RadiusEstimate, SegmentRequest};
-pub use rule::{BlockRule, ChordStatus, Infeasible, RuleSettings, block_time_from_saturation, chord_length};
-pub use stats::{BlockStats, PathBlocks, block_stats, path_blocks, short_block_warning};
 
 use crate::error::ErrorCode;
+use crate::machine::{ChordStatus, MachineProfile};
 use request::{Job, Plan};
 use segment::{Cut, CutError, Cutter, InfeasibleAt, Numerics, Status};
 
@@ -132,7 +127,7 @@ fn solve_by(
         Plan::Guarantee => cutter.guarantee(rule, job.tolerance).map_err(|error| cut_error(&job, error))?,
         Plan::Max { length, estimate } => {
             let radii = cutter.tiled_radii(length, estimate, rule.target_chord())?;
-            let mut worst: Option<(f64, f64, rule::ChordStatus)> = None;
+            let mut worst: Option<(f64, f64, ChordStatus)> = None;
             for (s, radius) in radii {
                 let (chord_error, status) = rule
                     .chord_error(radius)
@@ -142,7 +137,7 @@ fn solve_by(
                 }
             }
             let (chord_error, radius, status) =
-                worst.unwrap_or((rule.min_chord_error, f64::INFINITY, rule::ChordStatus::Surface));
+                worst.unwrap_or((rule.min_chord_error, f64::INFINITY, ChordStatus::Surface));
             single_value(&job, &cutter, chord_error, radius, status)?
         }
         Plan::Extremes { min_radius } | Plan::NormalAccel { min_radius } => {
@@ -171,7 +166,7 @@ fn single_value(
     cutter: &Cutter<'_>,
     rule_chord_error: f64,
     radius: f64,
-    surface: rule::ChordStatus,
+    surface: ChordStatus,
 ) -> Result<Cut, SolverError> {
     let (chord_error, status) = segment::classify(rule_chord_error, surface, radius, job.tolerance);
     let mut cut = cutter.constant(chord_error, radius)?;
@@ -286,7 +281,7 @@ fn max_deviation(cutter: &Cutter<'_>, cut: &Cut) -> f64 {
 fn answer(job: &Job, request: &SegmentRequest, cutter: &Cutter<'_>, cut: &Cut) -> Result<SegmentAnswer, SolverError> {
     let rule = &job.rule;
     let positions: Vec<Vec3> = cut.vertices.iter().map(|v| v.point).collect();
-    let stats = stats::stats_with_ends(&positions, rule.feed, rule.block_time_ms, &cut.span_ends);
+    let stats = crate::machine::stats::stats_with_ends(&positions, rule.feed, rule.block_time_ms, &cut.span_ends);
     let windows: Vec<SegmentWindow> = cut
         .windows
         .iter()
@@ -320,7 +315,12 @@ fn answer(job: &Job, request: &SegmentRequest, cutter: &Cutter<'_>, cut: &Cut) -
             Some(Comparison {
                 tolerance,
                 max_deviation: max_deviation(&fixed_cutter, &fixed),
-                stats: stats::stats_with_ends(&fixed_points, rule.feed, rule.block_time_ms, &fixed.span_ends),
+                stats: crate::machine::stats::stats_with_ends(
+                    &fixed_points,
+                    rule.feed,
+                    rule.block_time_ms,
+                    &fixed.span_ends,
+                ),
             })
         }
         None => None,

@@ -4,8 +4,8 @@
 use super::request::{Job, Plan, SegmentRequest};
 use super::segment::{self, Cut, Status};
 use super::shape;
-use super::stats::BlockStats;
 use crate::error::Warning;
+use crate::machine::stats::BlockStats;
 
 /// Least increment of the G-code (4 decimals), mm; a chord error below 5 of them is
 /// resolution-limited (E13).

@@ -6,13 +6,13 @@ pub use crate::geometry::Direction;
 use serde::{Deserialize, Serialize};
 
 use super::arclength::ArcLengthTable;
-use super::machine::MachineProfile;
 use super::nurbs::Nurbs;
-use super::rule::{BlockRule, RuleSettings};
 use super::segment::Estimate;
 use super::shape::{Arc, Ellipse, Polyline, Shape, Spline, require_length};
 use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
+use crate::machine::MachineProfile;
+use crate::machine::rule::{BlockRule, RuleSettings};
 use crate::tool::ToolRef;
 use crate::validate::{finite, positive};
 

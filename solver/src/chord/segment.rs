@@ -6,11 +6,11 @@
 use crate::error::ErrorCode;
 use std::cell::Cell;
 
-use super::rule::{BlockRule, ChordStatus, Infeasible, chord_length};
 use super::shape::{Shape, circumradius};
 use super::{reference, search};
 use crate::error::SolverError;
 use crate::geometry::Vec3;
+use crate::machine::rule::{BlockRule, ChordStatus, Infeasible, chord_length};
 
 /// Slack on the chord error when testing a chord (chord.md §2.9: eps = 1e-12 mm).
 pub(crate) const EPS: f64 = 1e-12;

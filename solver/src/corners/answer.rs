@@ -247,7 +247,7 @@ pub struct ContourSummary {
     pub estimated_time_s: f64,
     /// With `block_time_ms`: the blocks, the shortest, the short ones and the block-limited time.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub blocks: Option<crate::chord::PathBlocks>,
+    pub blocks: Option<crate::machine::PathBlocks>,
 }
 
 /// The answer of `POST /api/v1/contour`.

@@ -1,6 +1,6 @@
 //! What the block-time rule did to a contour's arcs (issue 3, chord.md §4 and §6), and the
 //! warnings that explain its short blocks; the figures themselves are
-//! [`crate::chord::PathBlocks`].
+//! [`crate::machine::PathBlocks`].
 
 use super::element::{Chording, Element, rule_steps_bound};
 use super::pass::PassPlan;

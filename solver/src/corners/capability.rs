@@ -9,9 +9,9 @@ use super::detect::{self, DetectMode, MaterialSide, PathLoopAnswer, PathLoopRequ
 use super::request::MAX_MOVES;
 use super::{ContourAnswer, ContourRequest, CornerLoop};
 use crate::capability::{Capability, OutputOptions, Purpose, Refs, Resolved, Run};
-use crate::chord::MachineProfile;
 use crate::error::{SolverError, Warning};
 use crate::gcode::{Post, ToolCall};
+use crate::machine::MachineProfile;
 use crate::tool::{Tool, ToolRef};
 
 /// Most moves in a JSON answer (about 35 MB of JSON). A G-code program and a job may hold up to

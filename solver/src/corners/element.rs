@@ -1,7 +1,7 @@
 //! The exact tool-centre path of a pass: straight and circular elements with their role
 //! (corners.md §1.5 `elements[]`, §3.11 `Element`), and their chording into straight moves.
 
-use crate::chord::BlockRule;
+use crate::machine::BlockRule;
 use crate::planar::{Vec2, arc_max_step, arc_steps, circumscribed_arc, circumscribed_arc_steps};
 
 /// How arcs become straight moves: within `tolerance` of the arc, or with the block-time rule

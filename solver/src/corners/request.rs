@@ -6,8 +6,8 @@ use serde::{Deserialize, Serialize};
 
 use super::element::Chording;
 use super::prepare::{self, Contour};
-use crate::chord::{BlockRule, MachineProfile, RuleSettings};
 use crate::error::{SolverError, Warning};
+use crate::machine::{BlockRule, MachineProfile, RuleSettings};
 use crate::tool::{Tool, ToolKind, ToolRef};
 use crate::validate::{finite, non_negative, positive};
 

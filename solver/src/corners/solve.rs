@@ -14,10 +14,10 @@ use super::material::{self, Material};
 use super::pass::{self, Action, GOUGE_TOLERANCE, MAX_ARC_STEPS, PassInput, PassPlan, Stock};
 use super::prepare::list_indices;
 use super::request::{ContourRequest, CutDirection, Job, Join, LoopStyle, MAX_MOVES, Side};
-use crate::chord::MachineProfile;
 use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
+use crate::machine::MachineProfile;
 use crate::planar::{SegmentGrid, Vec2, array2, cross, miter_point};
 use crate::tool::{Tool, ToolKind};
 
@@ -208,8 +208,8 @@ pub fn solve_with(
             let (finest, arc_warnings) = blocks::arc_report(&first_passes, &job.chording);
             warnings.extend(arc_warnings);
             let moves = layers.iter().flat_map(|layer| &layer.moves).map(|step| (Vec3::from(step.to), step.feed));
-            let figures = crate::chord::path_blocks(moves, rule.block_time_ms, job.feed, finest)?;
-            warnings.extend(crate::chord::short_block_warning(&figures, rule));
+            let figures = crate::machine::path_blocks(moves, rule.block_time_ms, job.feed, finest)?;
+            warnings.extend(crate::machine::short_block_warning(&figures, rule));
             Some(figures)
         }
     };

@@ -5,9 +5,9 @@ use serde::Serialize;
 
 use super::{Deburr, DeburrRequest};
 use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
-use crate::chord::MachineProfile;
 use crate::error::SolverError;
 use crate::gcode::{Post, ToolCall};
+use crate::machine::MachineProfile;
 use crate::tool::Tool;
 
 /// The deburr capability.

@@ -43,10 +43,10 @@ use envelope::EnvelopePath;
 use swept_width::SweptWidths;
 use tolerance::{IntervalLimit, Limit, Spacing, Target};
 
-use crate::chord::MachineProfile;
-use crate::chord::stats::{BlockStats, stats_with_ends};
 use crate::error::{SolverError, Warning};
 use crate::geometry::{Vec3, array3};
+use crate::machine::MachineProfile;
+use crate::machine::stats::{BlockStats, stats_with_ends};
 use crate::tool::Tool;
 
 /// Most points a deburr loop may have; a tolerance needing more is refused (`E_TOO_MANY_POINTS`).
@@ -280,7 +280,7 @@ fn solve_centred(
 }
 
 /// Block-limited time of the feed moves of a lead, starting from `start`: Σ max(L/F, T_b), s.
-fn lead_block_time(moves: &[LeadMove], start: Vec3, rule: &crate::chord::BlockRule) -> f64 {
+fn lead_block_time(moves: &[LeadMove], start: Vec3, rule: &crate::machine::BlockRule) -> f64 {
     let mut from = start;
     let mut time = 0.0;
     for step in moves {
@@ -300,7 +300,7 @@ fn block_warnings(job: &Job, stats: &BlockStats, limits: &[IntervalLimit]) -> Ve
     let Some(rule) = job.rule else { return Vec::new() };
     let mut warnings = Vec::new();
     let smallest = |why: Limit| limits.iter().filter(|l| l.why == why).map(|l| l.radius).fold(f64::INFINITY, f64::min);
-    let reach = crate::chord::BlockRule { margin: rule.margin * tolerance::BISECTION_REACH, ..rule };
+    let reach = crate::machine::BlockRule { margin: rule.margin * tolerance::BISECTION_REACH, ..rule };
     let by_tolerance = smallest(Limit::Tolerance);
     if by_tolerance.is_finite() && stats.short_blocks > 0 {
         warnings.push(Warning::new(

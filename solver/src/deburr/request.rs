@@ -7,9 +7,9 @@ use serde::{Deserialize, Serialize};
 
 use super::frame::Frame;
 use super::profile::Profile;
-use crate::chord::{BlockRule, MachineProfile, RuleSettings};
 use crate::error::{SolverError, Warning};
 use crate::geometry::vec3;
+use crate::machine::{BlockRule, MachineProfile, RuleSettings};
 use crate::tool::{Tool, ToolKind, ToolRef};
 use crate::validate::{self, finite, non_negative, optional_positive, positive, within};
 

@@ -7,10 +7,10 @@
 //! than TA ([`Spacing::Rule`]).
 
 use super::profile::Profile;
-use crate::chord::BlockRule;
 use crate::error::ErrorCode;
 use crate::error::SolverError;
 use crate::geometry::{Vec3, distance_to_segment};
+use crate::machine::BlockRule;
 
 /// How far the bisection aims beyond the rule's target chord. Halving an interval whose chord
 /// is just above what it aims at leaves two halves of just over half of it: aiming at 2.1 target

@@ -312,7 +312,7 @@ pub struct PathEngagement {
     /// With a block time (`block_time_ms` or a machine) and `axial_depth`: the blocks of this
     /// path's program, the shortest, the short ones and the block-limited time.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub blocks: Option<crate::chord::PathBlocks>,
+    pub blocks: Option<crate::machine::PathBlocks>,
     /// Everything worth knowing that did not stop the computation.
     pub warnings: Vec<Warning>,
     /// What the G-code post needs.
@@ -360,7 +360,7 @@ pub(crate) struct PostData {
     pub spindle_rpm: f64,
     pub spindle_direction: crate::gcode::SpindleDirection,
     /// The block-time rule the program's arcs are chorded by (its feed replaced by each block's).
-    pub rule: Option<crate::chord::BlockRule>,
+    pub rule: Option<crate::machine::BlockRule>,
     pub axial_depth: Option<f64>,
     pub stock_top_z: f64,
     pub clearance: f64,

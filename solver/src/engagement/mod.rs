@@ -83,8 +83,8 @@ pub use request::{
     Representative, SegmentInput, Stock, StockBitmap, StockPolygon,
 };
 
-use crate::chord::MachineProfile;
 use crate::error::SolverError;
+use crate::machine::MachineProfile;
 use crate::tool::Tool;
 
 /// A point or vector in the plane, mm.

@@ -5,11 +5,11 @@
 
 use super::answer::{EngagementAnswer, PathEngagement};
 use super::segments::{Route, Shape};
-use crate::chord::{BlockRule, PathBlocks, path_blocks, short_block_warning};
 use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};
 use crate::gcode::{self, Post, Program, Reference};
 use crate::geometry::Vec3;
+use crate::machine::{BlockRule, PathBlocks, path_blocks, short_block_warning};
 use crate::path::{Motion, Toolpath};
 
 /// Largest distance of an arc from its chords in the program, mm.

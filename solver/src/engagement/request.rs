@@ -20,9 +20,9 @@ use super::{
     DEFAULT_BURR_DISENGAGE_DEG, DEFAULT_CHIPPING_DISENGAGE_DEG, MAX_CANDIDATES, MAX_CHORDS, MAX_DOT_ROWS, MAX_FLUTES,
     MAX_GRID_DOTS, MAX_SAMPLES, MAX_SEGMENTS, MAX_STOCK_VERTICES, P2,
 };
-use crate::chord::{BlockRule, MachineProfile, RuleSettings};
 use crate::error::{SolverError, Warning};
 use crate::gcode::reader::{MoveKind, Plane, ReadOptions, read as read_program};
+use crate::machine::{BlockRule, MachineProfile, RuleSettings};
 use crate::planar::signed_area;
 use crate::tool::{Tool, ToolRef};
 use crate::validate::{self, finite, non_negative, positive, positive_at_most};

@@ -5,7 +5,7 @@ use std::f64::consts::{PI, TAU};
 
 use super::P2;
 use super::bbox_tree::{BBox, BoxTree};
-use crate::chord::{BlockRule, Infeasible};
+use crate::machine::{BlockRule, Infeasible};
 use crate::planar::point_segment_distance;
 
 /// One geometric piece of a path.

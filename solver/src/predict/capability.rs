@@ -5,9 +5,9 @@ use serde::Serialize;
 
 use super::{PathInput, Predict, PredictRequest, ProgramOptions, Stock};
 use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
-use crate::chord::MachineProfile;
 use crate::error::SolverError;
 use crate::gcode::{Reference, ToolCall};
+use crate::machine::MachineProfile;
 use crate::tool::Tool;
 
 /// The predict capability.

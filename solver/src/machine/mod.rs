@@ -1,5 +1,14 @@
 //! Controller profiles (api.md, Machines; chord.md §2.1, §6.4): the block processing time and
-//! limits of one control, stored by the server and used as defaults by any request that names it.
+//! limits of one control, stored by the server and used as defaults by any request that names it;
+//! the block-time rule that turns them into chord errors ([`rule`]) and the block statistics of a
+//! path ([`stats`]). Every path-emitting capability uses them: segment, deburr, contour,
+//! engagement.
+
+pub mod rule;
+pub mod stats;
+
+pub use rule::{BlockRule, ChordStatus, Infeasible, RuleSettings, block_time_from_saturation, chord_length};
+pub use stats::{BlockStats, PathBlocks, block_stats, path_blocks, short_block_warning};
 
 use serde::{Deserialize, Serialize};
 
@@ -45,7 +54,7 @@ pub struct MachineProfile {
     /// `window` (the patent's, default), `curve` or `guarantee` (no block shorter than the control
     /// needs, chord.md §2.9a).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub mode: Option<super::Mode>,
+    pub mode: Option<crate::chord::Mode>,
     /// Rated spindle power, kW (> 0): engagement with Kienzle values warns where the cut needs
     /// more and its feed plan caps the feed to stay within it.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -5,7 +5,7 @@
 //! of sagitta C_ep on a circle of radius r is exactly `k_f·F·T_b/60000` long, so a polyline cut
 //! with C_ep never asks the control for a block shorter than it can digest at feed F.
 
-use super::machine::MachineProfile;
+use super::MachineProfile;
 use crate::error::{SolverError, Warning};
 use crate::validate::{finite, non_negative, positive};
 
@@ -37,7 +37,7 @@ pub enum ChordStatus {
 /// from a request through the segment solver.
 ///
 /// ```
-/// use kerf_solver::chord::BlockRule;
+/// use kerf_solver::machine::BlockRule;
 /// // The patent's experiment: R50 at 10 000 mm/min on a control with a 4 ms block time.
 /// let rule = BlockRule::new(10_000.0, 4.0).unwrap();
 /// let cep = rule.chord_error(50.0).unwrap().0;

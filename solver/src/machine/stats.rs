@@ -58,7 +58,7 @@ pub struct BlockStats {
 /// `block_time_ms`; the last block is the only span end. Zero-length moves count as blocks.
 ///
 /// ```
-/// use kerf_solver::chord::block_stats;
+/// use kerf_solver::machine::block_stats;
 /// use kerf_solver::geometry::Vec3;
 /// let points = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.5, 0.0, 0.0)];
 /// let stats = block_stats(&points, 10_000.0, 4.0).unwrap();
