@@ -3,28 +3,13 @@
 //! printed precision), the fixed-tolerance baselines, the edge cases E1–E5 and the surface table
 //! through [`BlockRule`], and the G-code head of case A.
 
+use kerf_cases::{case, close, fixture, number};
 use kerf_solver::chord::{self, SegmentAnswer, SegmentRequest, WindowStatus};
 use kerf_solver::gcode::{Dialect, Post, ToolCall};
 use kerf_solver::machine::{BlockRule, ChordStatus};
 use serde_json::{Value, json};
 
 const POINT_TOLERANCE: f64 = 1e-6;
-
-fn fixture() -> Value {
-    serde_json::from_str(include_str!("fixtures/chord.json")).unwrap()
-}
-
-fn case(id: &str) -> Value {
-    fixture()["cases"].as_array().unwrap().iter().find(|c| c["id"] == id).unwrap().clone()
-}
-
-fn number(value: &Value) -> f64 {
-    value.as_f64().unwrap_or_else(|| panic!("not a number: {value}"))
-}
-
-fn close(what: &str, got: f64, expected: f64, tolerance: f64) {
-    assert!((got - expected).abs() <= tolerance, "{what}: got {got}, expected {expected} (±{tolerance})");
-}
 
 fn solve(request: Value) -> SegmentAnswer {
     let request: SegmentRequest = serde_json::from_value(request).unwrap();
@@ -62,7 +47,7 @@ fn ellipse_bc() -> Value {
 
 #[test]
 fn case_a_reproduces_the_patent_experiment() {
-    let case = case("A");
+    let case = case("chord", "A");
     let expected = &case["expected"];
     let answer = solve(json!({
         "curve": circle_a(), "feed": 10000, "block_time_ms": 4, "mode": "window",
@@ -113,7 +98,7 @@ fn case_a_in_every_curve_mode_gives_the_same_polygon() {
 
 #[test]
 fn case_a_baselines() {
-    let baselines = &case("A")["baselines"];
+    let baselines = &case("chord", "A")["baselines"];
     for (key, tolerance) in [("fixed_0.01mm", 0.01), ("fixed_0.0005mm", 0.0005)] {
         let expected = &baselines[key];
         let answer = solve(json!({
@@ -155,7 +140,7 @@ fn case_a_gcode_head() {
         &Post { reference: kerf_solver::gcode::Reference::Tip, dialect: Dialect::Fanuc, tool: ToolCall::Table(1) },
     )
     .unwrap();
-    let case = case("A");
+    let case = case("chord", "A");
     let head: Vec<&str> =
         case["gcode_head_4_decimals"].as_array().unwrap().iter().map(|v| v.as_str().unwrap()).collect();
     // The house post writes every line with its G word and Z; compare the coordinates.
@@ -182,7 +167,7 @@ fn case_a_gcode_head() {
 
 #[test]
 fn case_b_embodiment_4_on_the_quarter_ellipse() {
-    let case = case("B");
+    let case = case("chord", "B");
     let expected = &case["expected"];
     let answer = solve(json!({
         "curve": ellipse_bc(), "feed": 10000, "block_time_ms": 4, "margin": 1.1,
@@ -229,7 +214,7 @@ fn case_b_embodiment_4_on_the_quarter_ellipse() {
 #[test]
 fn case_b_and_c_baselines() {
     for (id, feed) in [("B", 10_000.0), ("C", 12_000.0)] {
-        let baselines = &case(id)["baselines"];
+        let baselines = &case("chord", id)["baselines"];
         for (key, tolerance) in [("fixed_0.01mm", 0.01), ("fixed_0.001mm", 0.001)] {
             let expected = &baselines[key];
             let answer = solve(json!({
@@ -249,7 +234,7 @@ fn case_b_and_c_baselines() {
 
 #[test]
 fn case_c_adaptive_windows() {
-    let case = case("C");
+    let case = case("chord", "C");
     let expected = &case["expected"];
     let answer = solve(json!({
         "curve": ellipse_bc(), "feed": 12000, "block_time_ms": 4, "margin": 1.05,
@@ -293,12 +278,12 @@ fn case_c_adaptive_windows() {
 #[test]
 fn case_derived_constants() {
     for (id, margin) in [("A", 1.0), ("B", 1.1)] {
-        let expected = &case(id)["expected"];
+        let expected = &case("chord", id)["expected"];
         let rule = BlockRule::new(10_000.0, 4.0).unwrap().with_margin(margin);
         close("alpha", rule.alpha(), number(&expected["alpha_min2"]), 1e-22);
         close("h", rule.half_chord(), number(&expected["half_chord_h_mm"]), 1e-15);
     }
-    let expected = &case("A")["expected"];
+    let expected = &case("chord", "A")["expected"];
     let rule = BlockRule::new(10_000.0, 4.0).unwrap();
     let cep = rule.chord_error(50.0).unwrap().0;
     let chord = kerf_solver::machine::chord_length(50.0, cep);
@@ -311,7 +296,7 @@ fn case_derived_constants() {
 
 #[test]
 fn edge_cases_e1_to_e5() {
-    for case in fixture()["edge_cases"].as_array().unwrap() {
+    for case in fixture("chord")["edge_cases"].as_array().unwrap() {
         let label = case["label"].as_str().unwrap();
         let radius = case["r_mm"].as_f64().unwrap_or(f64::INFINITY);
         let rule = BlockRule::new(number(&case["F"]), number(&case["Tb_ms"]))
@@ -345,7 +330,7 @@ fn edge_cases_e1_to_e5() {
 
 #[test]
 fn surface_table_in_micrometres() {
-    let table = &fixture()["surface_table_um_Tb4"];
+    let table = &fixture("chord")["surface_table_um_Tb4"];
     let radii: Vec<f64> = table["r_mm"].as_array().unwrap().iter().map(number).collect();
     for (feed, row) in table["rows"].as_object().unwrap() {
         let rule = BlockRule::new(feed.parse().unwrap(), 4.0).unwrap();

@@ -3,6 +3,7 @@
 //! claim-10 check, gouge and stock clearances, detection measures, and the edge-case numbers,
 //! all to 1e-6 (the fixture's rounding).
 
+use kerf_cases::{case, fixture, number};
 use std::f64::consts::PI;
 
 use kerf_solver::corners::detect::{self, DetectMode};
@@ -14,18 +15,6 @@ use kerf_solver::tool::{Tool, ToolKind};
 use serde_json::{Value, json};
 
 const TOLERANCE: f64 = 1e-6;
-
-fn fixture() -> Value {
-    serde_json::from_str(include_str!("fixtures/corners.json")).unwrap()
-}
-
-fn case(id: &str) -> Value {
-    fixture()["cases"].as_array().unwrap().iter().find(|c| c["id"] == id).unwrap().clone()
-}
-
-fn number(value: &Value) -> f64 {
-    value.as_f64().unwrap_or_else(|| panic!("not a number: {value}"))
-}
 
 fn point(value: &Value) -> Vec2 {
     Vec2::new(number(&value[0]), number(&value[1]))
@@ -238,7 +227,7 @@ fn check_detection(id: &str, pass: &PassPlan, h: f64, sigma: f64, expected: &Val
 }
 
 fn check_case(id: &str) {
-    let case = case(id);
+    let case = case("corners", id);
     let plan = plan_of(&case);
     let h = number(&case["inputs"]["division_step_h"]);
     let detection_h = number(&case["inputs"]["detection_step_h"]);
@@ -272,7 +261,7 @@ fn c1_square_island_arc_loop() {
 fn c2_quadrilateral_parallelogram_loop() {
     check_case("C2");
     // The arc variant for comparison (ρ = 0.5) at the same corner points.
-    let case = case("C2");
+    let case = case("corners", "C2");
     let plan = plan_of(&case);
     let pass = &plan.passes[0];
     for want in case["expected"]["arc_variant_for_comparison"].as_array().unwrap() {
@@ -294,7 +283,7 @@ fn c2_quadrilateral_parallelogram_loop() {
 fn c3_l_shape_three_passes() {
     check_case("C3");
     // The inside corner's fillet, reported by the full solver on the final pass.
-    let case = case("C3");
+    let case = case("corners", "C3");
     let (request, tool) = request(&case);
     let answer = corners::solve(&request, &tool).unwrap();
     let inside = answer.corners.iter().find(|c| c.index == 3).unwrap();
@@ -316,7 +305,7 @@ fn c1_and_c2_material_with_and_without_loops_under_m1() {
     for (id, blend, key) in
         [("C1", 1.5, "M1_miter_rho_b_1p5_overcut_per_corner"), ("C2", 1.0, "M1_miter_rho_b_1_overcut_per_corner")]
     {
-        let case = case(id);
+        let case = case("corners", id);
         let closed = &case["expected"]["with_without_loop"]["closed_form"];
         for style in ["none", "loop"] {
             let (mut request, tool) = request(&case);
@@ -350,7 +339,7 @@ fn c1_and_c2_material_with_and_without_loops_under_m1() {
 }
 
 fn edge_case(label_start: &str) -> Value {
-    fixture()["edge_cases"]
+    fixture("corners")["edge_cases"]
         .as_array()
         .unwrap()
         .iter()

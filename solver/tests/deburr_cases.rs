@@ -2,6 +2,7 @@
 //! band edges and wedge angles at the sample points to 1e-6, and the tolerance algorithm's point
 //! counts and parameter lists exactly (deburr.md §5.2).
 
+use kerf_cases::{number, triple};
 use kerf_solver::deburr::{self, DeburrRequest, Edge, Hole, Workpiece};
 use kerf_solver::tool::{Tool, ToolKind, ToolRef};
 use serde_json::Value;
@@ -9,18 +10,7 @@ use serde_json::Value;
 const TOLERANCE: f64 = 1e-6;
 
 fn cases() -> Vec<Value> {
-    let text = include_str!("fixtures/deburr.json");
-    let all: Value = serde_json::from_str(text).unwrap();
-    all["cases"].as_array().unwrap().clone()
-}
-
-fn number(value: &Value) -> f64 {
-    value.as_f64().unwrap_or_else(|| panic!("not a number: {value}"))
-}
-
-fn triple(value: &Value) -> [f64; 3] {
-    let items = value.as_array().unwrap();
-    [number(&items[0]), number(&items[1]), number(&items[2])]
+    kerf_cases::fixture("deburr")["cases"].as_array().unwrap().clone()
 }
 
 fn assert_close(what: &str, got: f64, expected: f64) {

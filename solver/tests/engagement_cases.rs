@@ -4,6 +4,7 @@
 //! with constant V_f); the exact engine everywhere, the dots engine where the fixture gives its
 //! settings (C1, C3).
 
+use kerf_cases::{case, close, fixture, number};
 use std::collections::BTreeSet;
 
 use kerf_solver::engagement::{
@@ -11,24 +12,6 @@ use kerf_solver::engagement::{
 };
 use kerf_solver::tool::{Tool, ToolKind};
 use serde_json::{Value, json};
-
-fn fixture() -> Value {
-    serde_json::from_str(include_str!("fixtures/engagement.json")).unwrap()
-}
-
-fn case(id_prefix: &str) -> Value {
-    fixture()["cases"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|c| c["id"].as_str().unwrap().starts_with(id_prefix))
-        .unwrap()
-        .clone()
-}
-
-fn num(value: &Value) -> f64 {
-    value.as_f64().unwrap_or_else(|| panic!("not a number: {value}"))
-}
 
 fn tool(diameter: f64) -> Tool {
     Tool::new(ToolKind::Flat, diameter / 2.0)
@@ -81,10 +64,6 @@ fn sample_at(result: &PathEngagement, s: f64) -> &EngagementSample {
     result.samples.iter().find(|sample| (sample.s - s).abs() < 1e-6).unwrap_or_else(|| panic!("no sample at s = {s}"))
 }
 
-fn close(what: &str, got: f64, expected: f64, tolerance: f64) {
-    assert!((got - expected).abs() <= tolerance, "{what}: got {got}, expected {expected} ± {tolerance}");
-}
-
 fn close_rel(what: &str, got: f64, expected: f64, relative: f64) {
     let tolerance = relative * expected.abs() + 1e-9;
     close(what, got, expected, tolerance);
@@ -119,44 +98,49 @@ struct Tolerances {
 }
 
 fn exact_tolerances() -> Tolerances {
-    let t = &fixture()["tolerances"]["exact_engine"];
-    Tolerances { angle: num(&t["angle_deg"]), ae: num(&t["ae_mm"]), h_rel: num(&t["H_rel"]) }
+    let t = &fixture("engagement")["tolerances"]["exact_engine"];
+    Tolerances { angle: number(&t["angle_deg"]), ae: number(&t["ae_mm"]), h_rel: number(&t["H_rel"]) }
 }
 
 /// Compares one fixture checkpoint with the sample at its s.
 fn check_point(label: &str, result: &PathEngagement, checkpoint: &Value, flutes: &[u32], tol: &Tolerances) {
-    let s = num(&checkpoint["s"]);
+    let s = number(&checkpoint["s"]);
     let sample = sample_at(result, s);
     let what = |field: &str| format!("{label} s={s} {field}");
     if let Some(pos) = checkpoint["pos"].as_array() {
-        close(&what("x"), sample.position[0], num(&pos[0]), 1e-3);
-        close(&what("y"), sample.position[1], num(&pos[1]), 1e-3);
+        close(&what("x"), sample.position[0], number(&pos[0]), 1e-3);
+        close(&what("y"), sample.position[1], number(&pos[1]), 1e-3);
     }
     let arcs = checkpoint["arcs"].as_array().unwrap();
     assert_eq!(sample.arcs.len(), arcs.len(), "{}: {:?}", what("arcs"), sample.arcs);
     for (got, expected) in sample.arcs.iter().zip(arcs) {
-        close(&what("arc from"), got[0], num(&expected[0]), tol.angle);
-        close(&what("arc to"), got[1], num(&expected[1]), tol.angle);
+        close(&what("arc from"), got[0], number(&expected[0]), tol.angle);
+        close(&what("arc to"), got[1], number(&expected[1]), tol.angle);
     }
-    close(&what("engaged_deg"), sample.engaged_deg, num(&checkpoint["engaged_deg"]), 2.0 * tol.angle);
-    close(&what("ae"), sample.radial_depth, num(&checkpoint["ae"]), tol.ae);
+    close(&what("engaged_deg"), sample.engaged_deg, number(&checkpoint["engaged_deg"]), 2.0 * tol.angle);
+    close(&what("ae"), sample.radial_depth, number(&checkpoint["ae"]), tol.ae);
     let details = checkpoint["arc_details"].as_array().unwrap();
     assert_eq!(sample.arc_details.len(), details.len(), "{}", what("arc_details"));
     for (got, expected) in sample.arc_details.iter().zip(details) {
-        close(&what("entry"), got.entry_deg, num(&expected["entry"]), tol.angle);
-        close(&what("exit"), got.exit_deg, num(&expected["exit"]), tol.angle);
-        close(&what("phi"), got.engage_deg, num(&expected["phi_engage"]), tol.angle);
-        close(&what("psi"), got.disengage_deg, num(&expected["psi_disengage"]), tol.angle);
+        close(&what("entry"), got.entry_deg, number(&expected["entry"]), tol.angle);
+        close(&what("exit"), got.exit_deg, number(&expected["exit"]), tol.angle);
+        close(&what("phi"), got.engage_deg, number(&expected["phi_engage"]), tol.angle);
+        close(&what("psi"), got.disengage_deg, number(&expected["psi_disengage"]), tol.angle);
         // Ratios are printed to 4 decimals; 0.05° moves sin θ by at most 0.0009.
-        close(&what("h_entry"), got.entry_thickness_ratio, num(&expected["h_entry_ratio"]), 1e-3);
-        close(&what("h_exit"), got.exit_thickness_ratio, num(&expected["h_exit_ratio"]), 1e-3);
+        close(&what("h_entry"), got.entry_thickness_ratio, number(&expected["h_entry_ratio"]), 1e-3);
+        close(&what("h_exit"), got.exit_thickness_ratio, number(&expected["h_exit_ratio"]), 1e-3);
         assert_eq!(mode_name(got.mode), expected["mode"].as_str().unwrap(), "{}", what("mode"));
     }
     let flags: BTreeSet<&str> = checkpoint["flags"].as_array().unwrap().iter().map(|f| f.as_str().unwrap()).collect();
     assert_eq!(flag_names(sample), flags, "{}", what("flags"));
     for (column, k) in flutes.iter().enumerate() {
         let key = k.to_string();
-        close_rel(&what(&format!("H k={k}")), sample.thickness[column], num(&checkpoint["H_mm_by_k"][&key]), tol.h_rel);
+        close_rel(
+            &what(&format!("H k={k}")),
+            sample.thickness[column],
+            number(&checkpoint["H_mm_by_k"][&key]),
+            tol.h_rel,
+        );
         assert_eq!(
             u64::from(sample.teeth[column]),
             checkpoint["n_max_by_k"][&key].as_u64().unwrap(),
@@ -182,8 +166,8 @@ fn check_statistics(label: &str, result: &PathEngagement, expected: &Value, max_
     for flute in &result.flutes {
         let key = flute.flute_count.to_string();
         let row = &expected[&key];
-        close_rel(&format!("{label} max k={key}"), flute.max_thickness, num(&row["max"]), max_rel);
-        close_rel(&format!("{label} mean k={key}"), flute.mean_thickness, num(&row["mean"]), mean_rel);
+        close_rel(&format!("{label} max k={key}"), flute.max_thickness, number(&row["max"]), max_rel);
+        close_rel(&format!("{label} mean k={key}"), flute.mean_thickness, number(&row["mean"]), mean_rel);
         // Sampling-dependent: only the ordering is checked (fixture "min_and_median").
         assert!(flute.min_thickness <= flute.mean_thickness && flute.mean_thickness <= flute.max_thickness);
         assert!((flute.min_thickness..=flute.max_thickness).contains(&flute.median_thickness));
@@ -202,7 +186,7 @@ fn check_intervals(label: &str, got: &[[f64; 2]], expected: &[[f64; 2]], toleran
 // ---------------------------------------------------------------- C1
 
 fn c1_request(engine: &str) -> (EngagementRequest, Value) {
-    let c = case("C1");
+    let c = case("engagement", "C1");
     let input = &c["input"];
     let sim = &input["simulation"];
     let extra = if engine == "dots" {
@@ -223,7 +207,7 @@ fn c1_exact_engine() {
     let expected = &c["expected"];
     let result = solve(&request, 10.0);
     let flutes = flute_list(&c["input"]["tool"]["flute_candidates"]);
-    close("path length", result.path_length, num(&expected["path_length"]), 1e-9);
+    close("path length", result.path_length, number(&expected["path_length"]), 1e-9);
     let tol = exact_tolerances();
     // s = 71.25 lies off the 0.1 mm grid: the checkpoints are read from a 0.05 mm run.
     let mut fine = request.clone();
@@ -235,7 +219,7 @@ fn c1_exact_engine() {
     check_statistics("C1", &result, &expected["representative_mm"], 0.002, 0.01);
     for flute in &result.flutes {
         let key = flute.flute_count.to_string();
-        close_rel(&format!("time k={key}"), flute.time_s, num(&expected["machining_time_s"][&key]), 1e-4);
+        close_rel(&format!("time k={key}"), flute.time_s, number(&expected["machining_time_s"][&key]), 1e-4);
     }
     assert_eq!(recommended_set(&result), expected_set(&expected["recommended_flutes"]));
     // Fastest first.
@@ -244,16 +228,16 @@ fn c1_exact_engine() {
         .as_array()
         .unwrap()
         .iter()
-        .map(|i| [num(&i[0]), num(&i[1])])
+        .map(|i| [number(&i[0]), number(&i[1])])
         .collect();
-    check_intervals("C1 engaged", &result.engaged_intervals, &continuum, num(&c["input"]["simulation"]["ds"]));
+    check_intervals("C1 engaged", &result.engaged_intervals, &continuum, number(&c["input"]["simulation"]["ds"]));
     // The full-slot samples carry the closed-form table of §5.6.
     let slot = sample_at(&result, 30.0);
     for (column, k) in flutes.iter().enumerate() {
         close_rel(
             &format!("slot H/fz k={k}"),
             slot.thickness[column] / 0.05,
-            num(&expected["slot_closed_form_H_over_fz"][k.to_string()]),
+            number(&expected["slot_closed_form_H_over_fz"][k.to_string()]),
             1e-6,
         );
     }
@@ -300,15 +284,15 @@ fn c1_dots_engine() {
     let (request, c) = c1_request("dots");
     let expected = &c["expected"];
     let result = solve(&request, 10.0);
-    let dots = &fixture()["tolerances"]["dot_engine"];
-    let grid = num(&c["input"]["simulation"]["dot_engine"]["grid"]);
-    let step = num(&c["input"]["simulation"]["dot_engine"]["ds"]);
+    let dots = &fixture("engagement")["tolerances"]["dot_engine"];
+    let grid = number(&c["input"]["simulation"]["dot_engine"]["grid"]);
+    let step = number(&c["input"]["simulation"]["dot_engine"]["ds"]);
     check_statistics(
         "C1 dots",
         &result,
         &expected["representative_mm"],
-        num(&dots["representative_max_rel"]),
-        num(&dots["representative_mean_rel"]),
+        number(&dots["representative_max_rel"]),
+        number(&dots["representative_mean_rel"]),
     );
     assert_eq!(recommended_set(&result), expected_set(&expected["recommended_flutes"]));
     // a_e within 2g of the continuum somewhere in [s − Δs − g, s + g] (one step of lag).
@@ -319,10 +303,10 @@ fn c1_dots_engine() {
         assert!(best <= ae_tolerance, "dots a_e at s = {}: {} (off by {best})", sample.s, sample.radial_depth);
     }
     // Steady phases: H within the dots engine's H tolerance.
-    let h_rel = num(&dots["H_rel"]);
+    let h_rel = number(&dots["H_rel"]);
     let flutes = flute_list(&c["input"]["tool"]["flute_candidates"]);
     for checkpoint in expected["checkpoints"].as_array().unwrap() {
-        let s = num(&checkpoint["s"]);
+        let s = number(&checkpoint["s"]);
         if ![30.0, 100.0].contains(&s) {
             continue;
         }
@@ -331,7 +315,7 @@ fn c1_dots_engine() {
             close_rel(
                 &format!("dots s={s} H k={k}"),
                 sample.thickness[column],
-                num(&checkpoint["H_mm_by_k"][k.to_string()]),
+                number(&checkpoint["H_mm_by_k"][k.to_string()]),
                 h_rel,
             );
         }
@@ -345,7 +329,7 @@ fn c1_dots_engine() {
 
 #[test]
 fn c2_part_a_side_milling_matrix() {
-    let c = case("C2");
+    let c = case("engagement", "C2");
     let part = &c["part_A"];
     let input = &part["input"];
     let flutes = flute_list(&input["tool"]["flute_candidates"]);
@@ -369,11 +353,11 @@ fn c2_part_a_side_milling_matrix() {
             "h_exit_ratio": row["h_exit_ratio"], "mode": row["mode"]
         }]);
         check_point(&label, &result, &checkpoint, &flutes, &tol);
-        let sample = sample_at(&result, num(&row["checkpoint_s"]));
+        let sample = sample_at(&result, number(&row["checkpoint_s"]));
         close_rel(
             &format!("{label} mean chip thickness"),
             sample.mean_chip_thickness,
-            num(&row["mean_chip_thickness_mm"]),
+            number(&row["mean_chip_thickness_mm"]),
             1e-3,
         );
     }
@@ -381,11 +365,11 @@ fn c2_part_a_side_milling_matrix() {
 
 #[test]
 fn c2_part_b_inside_corner() {
-    let c = case("C2");
+    let c = case("engagement", "C2");
     let part = &c["part_B"];
     let input = &part["input"];
     let flutes = flute_list(&input["tool"]["flute_candidates"]);
-    let step = num(&input["simulation"]["ds"]);
+    let step = number(&input["simulation"]["ds"]);
     let tol = exact_tolerances();
     for name in ["sharp", "fillet3"] {
         let expected = &part["expected"][name];
@@ -398,30 +382,30 @@ fn c2_part_b_inside_corner() {
         );
         let result = solve(&request, 10.0);
         let label = format!("C2B {name}");
-        close(&format!("{label} length"), result.path_length, num(&expected["path_length"]), 1e-4);
+        close(&format!("{label} length"), result.path_length, number(&expected["path_length"]), 1e-4);
         for checkpoint in expected["checkpoints"].as_array().unwrap() {
             check_point(&label, &result, checkpoint, &flutes, &tol);
         }
         close(
             &format!("{label} max engaged"),
             result.max_engaged_deg,
-            num(&expected["max_engaged_deg"]),
+            number(&expected["max_engaged_deg"]),
             2.0 * tol.angle,
         );
         let at = expected.get("max_engaged_at_s").or_else(|| expected.get("max_engaged_at_s_approx")).unwrap();
-        close(&format!("{label} max engaged at"), result.max_engaged_at_s, num(at), 0.1 + step);
+        close(&format!("{label} max engaged at"), result.max_engaged_at_s, number(at), 0.1 + step);
         if let Some(max_ae) = expected.get("max_ae") {
-            close(&format!("{label} max ae"), result.max_radial_depth, num(max_ae), tol.ae);
+            close(&format!("{label} max ae"), result.max_radial_depth, number(max_ae), tol.ae);
         } else {
             let at_peak = sample_at(&result, result.max_engaged_at_s).radial_depth;
-            close(&format!("{label} ae at max engagement"), at_peak, num(&expected["max_ae_at_that_s"]), tol.ae);
+            close(&format!("{label} ae at max engagement"), at_peak, number(&expected["max_ae_at_that_s"]), tol.ae);
         }
         for flute in &result.flutes {
             let key = flute.flute_count.to_string();
             close_rel(
                 &format!("{label} H max k={key}"),
                 flute.max_thickness,
-                num(&expected["H_max_mm_by_k_over_path"][&key]),
+                number(&expected["H_max_mm_by_k_over_path"][&key]),
                 tol.h_rel,
             );
         }
@@ -435,7 +419,7 @@ fn c2_part_b_inside_corner() {
 // ---------------------------------------------------------------- C3
 
 fn c3_request(cutting: &Value, limits: Value, engine: Option<(f64, f64)>) -> (EngagementRequest, Value) {
-    let c = case("C3");
+    let c = case("engagement", "C3");
     let input = &c["input"];
     let mut extra = limits;
     match engine {
@@ -452,7 +436,7 @@ fn c3_request(cutting: &Value, limits: Value, engine: Option<(f64, f64)>) -> (En
 
 #[test]
 fn c3_exact_engine_constant_fz() {
-    let c = case("C3");
+    let c = case("engagement", "C3");
     let input = &c["input"];
     let expected = &c["expected"];
     let limits = json!({"thickness_limit": input["evaluation"]["T1_mm"], "time_limit_s": input["evaluation"]["T2_s"]});
@@ -460,17 +444,17 @@ fn c3_exact_engine_constant_fz() {
     let result = solve(&request, 20.0);
     let flutes = flute_list(&input["tool"]["flute_candidates"]);
     let tol = exact_tolerances();
-    close("C3 length", result.path_length, num(&expected["path_length"]), 1e-9);
+    close("C3 length", result.path_length, number(&expected["path_length"]), 1e-9);
     for checkpoint in expected["checkpoints"].as_array().unwrap() {
         check_point("C3", &result, checkpoint, &flutes, &tol);
     }
-    let fz = num(&input["cutting"]["fz"]);
+    let fz = number(&input["cutting"]["fz"]);
     for flute in &result.flutes {
         let key = flute.flute_count.to_string();
         close_rel(
             &format!("C3 H/fz k={key}"),
             flute.max_thickness / fz,
-            num(&expected["H_over_fz_max_by_k"][&key]),
+            number(&expected["H_over_fz_max_by_k"][&key]),
             tol.h_rel,
         );
         assert_eq!(
@@ -481,7 +465,7 @@ fn c3_exact_engine_constant_fz() {
         close_rel(
             &format!("C3 time k={key}"),
             flute.time_s,
-            num(&expected["machining_time_s_constant_fz"][&key]),
+            number(&expected["machining_time_s_constant_fz"][&key]),
             1e-4,
         );
     }
@@ -491,10 +475,10 @@ fn c3_exact_engine_constant_fz() {
         .as_object()
         .unwrap()
         .values()
-        .map(|i| [num(&i[0]), num(&i[1])])
+        .map(|i| [number(&i[0]), number(&i[1])])
         .collect();
     continuum.sort_by(|a, b| a[0].total_cmp(&b[0]));
-    check_intervals("C3 engaged", &result.engaged_intervals, &continuum, num(&input["simulation"]["ds"]));
+    check_intervals("C3 engaged", &result.engaged_intervals, &continuum, number(&input["simulation"]["ds"]));
     // Simultaneous cutting: k = 4 and 8 on b, 6 on c, 5/8/10 on a.
     for k in [4_u32, 5, 6, 8, 10] {
         let flute = result.flutes.iter().find(|f| f.flute_count == k).unwrap();
@@ -504,7 +488,7 @@ fn c3_exact_engine_constant_fz() {
 
 #[test]
 fn c3_exact_engine_constant_vf() {
-    let c = case("C3");
+    let c = case("engagement", "C3");
     let input = &c["input"];
     let expected = &c["expected"]["constant_vf_variant"];
     for (variant, key) in input["evaluation_variant_constant_vf"]
@@ -519,10 +503,10 @@ fn c3_exact_engine_constant_vf() {
         for flute in &result.flutes {
             let k = flute.flute_count.to_string();
             let row = &expected["representative_mm"][&k];
-            close_rel(&format!("vf fz k={k}"), flute.feed_per_tooth, num(&row["fz"]), 1e-5);
-            close_rel(&format!("vf max k={k}"), flute.max_thickness, num(&row["max"]), 0.002);
-            close_rel(&format!("vf mean k={k}"), flute.mean_thickness, num(&row["mean"]), 0.01);
-            close_rel(&format!("vf time k={k}"), flute.time_s, num(&expected["machining_time_s_all_k"]), 1e-9);
+            close_rel(&format!("vf fz k={k}"), flute.feed_per_tooth, number(&row["fz"]), 1e-5);
+            close_rel(&format!("vf max k={k}"), flute.max_thickness, number(&row["max"]), 0.002);
+            close_rel(&format!("vf mean k={k}"), flute.mean_thickness, number(&row["mean"]), 0.01);
+            close_rel(&format!("vf time k={k}"), flute.time_s, number(&expected["machining_time_s_all_k"]), 1e-9);
         }
         assert_eq!(recommended_set(&result), expected_set(&expected[key]), "{key}");
         let no_recommendation = result.warnings.iter().find(|w| w.code == "W_NO_RECOMMENDATION");
@@ -537,29 +521,30 @@ fn c3_exact_engine_constant_vf() {
 
 #[test]
 fn c3_dots_engine() {
-    let c = case("C3");
+    let c = case("engagement", "C3");
     let input = &c["input"];
     let expected = &c["expected"];
-    let dots = &fixture()["tolerances"]["dot_engine"];
+    let dots = &fixture("engagement")["tolerances"]["dot_engine"];
     let limits = json!({"thickness_limit": input["evaluation"]["T1_mm"], "time_limit_s": input["evaluation"]["T2_s"]});
     let settings = &input["simulation"]["dot_engine"];
-    let (request, _) = c3_request(&input["cutting"], limits, Some((num(&settings["grid"]), num(&settings["ds"]))));
+    let (request, _) =
+        c3_request(&input["cutting"], limits, Some((number(&settings["grid"]), number(&settings["ds"]))));
     let result = solve(&request, 20.0);
     check_statistics(
         "C3 dots",
         &result,
         &expected["representative_mm_constant_fz"],
-        num(&dots["representative_max_rel"]),
-        num(&dots["representative_mean_rel"]),
+        number(&dots["representative_max_rel"]),
+        number(&dots["representative_mean_rel"]),
     );
     assert_eq!(recommended_set(&result), expected_set(&expected["recommended_flutes_constant_fz"]));
-    let tolerance = num(&settings["ds"]) + num(&settings["grid"]);
+    let tolerance = number(&settings["ds"]) + number(&settings["grid"]);
     let mut continuum: Vec<[f64; 2]> = expected["engaged_intervals_s_continuum"]
         .as_object()
         .unwrap()
         .values()
-        .map(|i| [num(&i[0]), num(&i[1])])
+        .map(|i| [number(&i[0]), number(&i[1])])
         .collect();
     continuum.sort_by(|a, b| a[0].total_cmp(&b[0]));
-    check_intervals("C3 dots engaged", &result.engaged_intervals, &continuum, tolerance + num(&settings["ds"]));
+    check_intervals("C3 dots engaged", &result.engaged_intervals, &continuum, tolerance + number(&settings["ds"]));
 }

@@ -1,6 +1,7 @@
 //! Reference cases A–G of `shared/cases/error-prediction.json` (copied to `tests/fixtures/`),
 //! through the public API, to the tolerances stated there.
 
+use kerf_cases::{case, close, number, triple};
 use std::f64::consts::PI;
 
 use kerf_solver::gcode::Reference;
@@ -12,35 +13,6 @@ use kerf_solver::predict::{
 };
 use kerf_solver::tool::{Mode, ShapeErrorPoint, Stiffness, Tool, ToolKind, ToolRef};
 use serde_json::Value;
-
-fn fixture() -> Value {
-    serde_json::from_str(include_str!("fixtures/error-prediction.json")).unwrap()
-}
-
-fn case(id: &str) -> Value {
-    let all = fixture();
-    all["reference_cases"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .chain(all["unit_checks"].as_array().unwrap())
-        .find(|c| c["id"].as_str().unwrap().starts_with(id))
-        .unwrap()
-        .clone()
-}
-
-fn number(v: &Value) -> f64 {
-    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
-}
-
-fn triple(v: &Value) -> [f64; 3] {
-    let a = v.as_array().unwrap();
-    [number(&a[0]), number(&a[1]), number(&a[2])]
-}
-
-fn close(what: &str, got: f64, expected: f64, tolerance: f64) {
-    assert!((got - expected).abs() <= tolerance, "{what}: got {got}, expected {expected} ± {tolerance}");
-}
 
 /// A program of separate straight passes (ball centres), linked by rapids at a safe height.
 fn program(passes: &[([f64; 3], [f64; 3])], feed: f64) -> String {
@@ -151,7 +123,7 @@ const FEED_AB: f64 = 0.1 * 6000.0 * 2.0;
 
 #[test]
 fn case_a_flat_raster_generation_at_the_tip() {
-    let case = case("A_");
+    let case = case("error-prediction", "A_");
     let expected = &case["expected"];
     let tolerances = &case["tolerances"];
     let tool = ball(5.0, linear_table(0.01, 0.01));
@@ -181,7 +153,7 @@ fn case_a_flat_raster_generation_at_the_tip() {
 
 #[test]
 fn case_b_inclined_plane_rotation_sense() {
-    let case = case("B_");
+    let case = case("error-prediction", "B_");
     let expected = &case["expected"];
     let tolerances = &case["tolerances"];
     let tool = ball(5.0, linear_table(0.005, 0.015));
@@ -265,7 +237,7 @@ fn case_c_request(beta_deg: f64, method: Method, view_correction: bool) -> (Pred
 
 #[test]
 fn case_c_convex_cylinder_below_rotated_and_sampled() {
-    let case = case("C_");
+    let case = case("error-prediction", "C_");
     let tolerances = &case["tolerances"];
     for row in case["expected_rows"].as_array().unwrap() {
         let beta = number(&row["beta"]);
@@ -311,7 +283,7 @@ fn case_c_convex_cylinder_below_rotated_and_sampled() {
 }
 
 fn case_d_request(stiffness: Stiffness) -> (PredictRequest, Tool) {
-    let case = case("B_");
+    let case = case("error-prediction", "B_");
     let mut tool = ball(5.0, linear_table(0.005, 0.015));
     tool.stiffness = Some(stiffness);
     let mut request = request(&tool, plane_stock(&case), &case_b_passes(&case), FEED_AB, None, Method::Sampling);
@@ -324,7 +296,7 @@ fn case_d_request(stiffness: Stiffness) -> (PredictRequest, Tool) {
 
 #[test]
 fn case_d_force_and_dynamic_deflection_chain() {
-    let case = case("D_");
+    let case = case("error-prediction", "D_");
     let expected = &case["expected"];
     let tolerances = &case["tolerances"];
     let mode = |m: &Value| Mode {
@@ -375,7 +347,7 @@ fn case_d_force_and_dynamic_deflection_chain() {
 
 #[test]
 fn case_e_fft_matches_time_integration() {
-    let case = case("E_");
+    let case = case("error-prediction", "E_");
     let expected = &case["expected"];
     let steps = 3600;
     let peak = 200.0;
@@ -430,7 +402,7 @@ fn case_e_fft_matches_time_integration() {
 
 #[test]
 fn case_f_node_correction_rule() {
-    let case = case("F_");
+    let case = case("error-prediction", "F_");
     let expected = &case["expected"];
     let tolerance = number(&case["tolerances"]["offset"]);
     let error = |p: &Value| PassError { error: number(&p["e"]), normal: triple(&p["n"]) };
@@ -458,7 +430,7 @@ fn case_f_node_correction_rule() {
 
 #[test]
 fn case_g_shape_error_from_sections() {
-    let case = case("G_");
+    let case = case("error-prediction", "G_");
     let radius = 5.0;
     // Dense sections of the two measured envelopes: a ball of radius R + 0.010 about the
     // nominal centre, and the nominal profile widened by a run-out of 0.005.

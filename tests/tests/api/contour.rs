@@ -3,27 +3,14 @@
 //! LinuxCNC's `rs274` with its end points equal to the JSON moves, a table of bad requests with
 //! the database unchanged, the JSON move limit, and byte-identical answers.
 
+use kerf_cases::{case, number, triple};
 use kerf_tests::{TestApp, assert_moves_match, external_program, finished, json_with, poll_job, problem, rs274_moves};
 use serde_json::{Value, json};
 
-const FIXTURE: &str = include_str!("../../../solver/tests/fixtures/corners.json");
 const TOLERANCE: f64 = 1e-6;
-
-fn fixture_case(id: &str) -> Value {
-    let fixture: Value = serde_json::from_str(FIXTURE).unwrap();
-    fixture["cases"].as_array().unwrap().iter().find(|c| c["id"] == id).unwrap().clone()
-}
-
-fn number(value: &Value) -> f64 {
-    value.as_f64().unwrap_or_else(|| panic!("not a number: {value}"))
-}
 
 fn pair(value: &Value) -> [f64; 2] {
     [number(&value[0]), number(&value[1])]
-}
-
-fn triple(value: &Value) -> [f64; 3] {
-    [number(&value[0]), number(&value[1]), number(&value[2])]
 }
 
 fn close_pair(what: &str, got: &Value, expected: &Value) {
@@ -41,7 +28,7 @@ fn close(what: &str, got: &Value, expected: f64) {
 /// tool, one layer at z = 0, conventional milling (σ = +1, the cases' convention) and the case's
 /// passes and loop style.
 pub fn reference_request(id: &str) -> Value {
-    let case = fixture_case(id);
+    let case = case("corners", id);
     let inputs = &case["inputs"];
     let mut corner_loop = json!({"max_angle_deg": 180.0 - number(&inputs["phi_min_deg"])});
     let passes: Vec<Value> = inputs["passes"]
@@ -130,7 +117,7 @@ fn answer_moves(answer: &Value, lift: f64) -> Vec<(bool, [f64; 3])> {
 async fn reference_contours_over_http() {
     let app = app_with_tools().await;
     for id in ["C1", "C2", "C3"] {
-        let case = fixture_case(id);
+        let case = case("corners", id);
         let answer = json_with(app.post_json("/api/v1/contour", &reference_request(id)).await, 200).await;
         let expected_passes = case["expected"]["passes"].as_array().unwrap();
         let final_pass = expected_passes.last().unwrap();

@@ -4,6 +4,7 @@
 //! (moves equal to the JSON positions within 1e-4, F words equal to the plan's feeds), and a
 //! table of bad requests answered with the field at fault and the database unchanged.
 
+use kerf_cases::{case, close, number};
 use std::collections::BTreeSet;
 
 use kerf_tests::{TestApp, assert_moves_match, external_program, finished, json_with, poll_job, problem, rs274_moves};
@@ -18,28 +19,6 @@ pub fn api_example() -> Value {
         "path": [[-10,20],[70,20]], "spindle_rpm": 3000, "feed_per_tooth": 0.05,
         "flute_counts": [1,2,3,4,5,6,7,8], "thickness_limit": 0.075, "time_limit_s": 20
     })
-}
-
-fn fixture() -> Value {
-    serde_json::from_str(include_str!("../../../solver/tests/fixtures/engagement.json")).expect("fixture")
-}
-
-fn case(prefix: &str) -> Value {
-    fixture()["cases"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|c| c["id"].as_str().unwrap().starts_with(prefix))
-        .unwrap()
-        .clone()
-}
-
-fn num(value: &Value) -> f64 {
-    value.as_f64().unwrap_or_else(|| panic!("not a number: {value}"))
-}
-
-fn close(what: &str, got: f64, expected: f64, tolerance: f64) {
-    assert!((got - expected).abs() <= tolerance + 1e-12, "{what}: got {got}, expected {expected} ± {tolerance}");
 }
 
 fn close_rel(what: &str, got: f64, expected: f64, relative: f64) {
@@ -81,7 +60,7 @@ fn sample_at(result: &Value, s: f64) -> &Value {
         .as_array()
         .unwrap()
         .iter()
-        .find(|sample| (num(&sample["s"]) - s).abs() < 1e-6)
+        .find(|sample| (number(&sample["s"]) - s).abs() < 1e-6)
         .unwrap_or_else(|| panic!("no sample at s = {s}"))
 }
 
@@ -95,24 +74,24 @@ fn recommended(result: &Value) -> Vec<u64> {
 
 /// One fixture checkpoint against the sample at its s (exact-engine tolerances).
 fn check_point(label: &str, result: &Value, checkpoint: &Value, flutes: &[u64]) {
-    let s = num(&checkpoint["s"]);
+    let s = number(&checkpoint["s"]);
     let sample = sample_at(result, s);
     let what = |field: &str| format!("{label} s={s} {field}");
     let arcs = checkpoint["arcs"].as_array().unwrap();
     let got = sample["arcs"].as_array().unwrap();
     assert_eq!(got.len(), arcs.len(), "{}: {got:?}", what("arcs"));
     for (g, e) in got.iter().zip(arcs) {
-        close(&what("arc from"), num(&g[0]), num(&e[0]), 0.05);
-        close(&what("arc to"), num(&g[1]), num(&e[1]), 0.05);
+        close(&what("arc from"), number(&g[0]), number(&e[0]), 0.05);
+        close(&what("arc to"), number(&g[1]), number(&e[1]), 0.05);
     }
-    close(&what("engaged_deg"), num(&sample["engaged_deg"]), num(&checkpoint["engaged_deg"]), 0.1);
-    close(&what("radial_depth"), num(&sample["radial_depth"]), num(&checkpoint["ae"]), 0.005);
+    close(&what("engaged_deg"), number(&sample["engaged_deg"]), number(&checkpoint["engaged_deg"]), 0.1);
+    close(&what("radial_depth"), number(&sample["radial_depth"]), number(&checkpoint["ae"]), 0.005);
     for (column, k) in flutes.iter().enumerate() {
         let key = k.to_string();
         close_rel(
             &what(&format!("H k={k}")),
-            num(&sample["thickness"][column]),
-            num(&checkpoint["H_mm_by_k"][&key]),
+            number(&sample["thickness"][column]),
+            number(&checkpoint["H_mm_by_k"][&key]),
             0.002,
         );
         assert_eq!(sample["teeth"][column], checkpoint["n_max_by_k"][&key], "{}", what(&format!("n k={k}")));
@@ -122,15 +101,20 @@ fn check_point(label: &str, result: &Value, checkpoint: &Value, flutes: &[u64]) 
 fn check_statistics(label: &str, result: &Value, expected: &Value, max_rel: f64, mean_rel: f64) {
     for flute in result["flutes"].as_array().unwrap() {
         let key = flute["flute_count"].to_string();
-        close_rel(&format!("{label} max k={key}"), num(&flute["max_thickness"]), num(&expected[&key]["max"]), max_rel);
+        close_rel(
+            &format!("{label} max k={key}"),
+            number(&flute["max_thickness"]),
+            number(&expected[&key]["max"]),
+            max_rel,
+        );
         close_rel(
             &format!("{label} mean k={key}"),
-            num(&flute["mean_thickness"]),
-            num(&expected[&key]["mean"]),
+            number(&flute["mean_thickness"]),
+            number(&expected[&key]["mean"]),
             mean_rel,
         );
         let (low, mean, high) =
-            (num(&flute["min_thickness"]), num(&flute["mean_thickness"]), num(&flute["max_thickness"]));
+            (number(&flute["min_thickness"]), number(&flute["mean_thickness"]), number(&flute["max_thickness"]));
         assert!(low <= mean && mean <= high, "{label} k={key}: min ≤ mean ≤ max");
     }
 }
@@ -149,7 +133,7 @@ async fn api_example_over_http() {
     assert_eq!(answer["thickness_limit"], 0.075);
     assert_eq!(answer["time_limit_s"], 20.0);
     // L = 80 mm: P_k = 60·80/(k·0.05·3000) = 32/k s; the slot's H_k/f_z is 1, 1, 1, √2, 1.618, ...
-    close("path length", num(&answer["path_length"]), 80.0, 1e-9);
+    close("path length", number(&answer["path_length"]), 80.0, 1e-9);
     // Full slot (engagement.md §5.6): H_k/f_z = 1 for k = 1, 1/sin(π/k) for even k,
     // 1/(2 sin(π/2k)) for odd k ≥ 3.
     let slot_ratio = |k: f64| {
@@ -165,9 +149,9 @@ async fn api_example_over_http() {
     for (index, flute) in answer["flutes"].as_array().unwrap().iter().enumerate() {
         let k = (index + 1) as f64;
         assert_eq!(flute["flute_count"], index + 1);
-        close("time", num(&flute["time_s"]), 32.0 / k, 1e-9);
-        close_rel("max H", num(&flute["max_thickness"]), 0.05 * slot_ratio(k), 1e-9);
-        let meets = num(&flute["max_thickness"]) <= 0.075 && num(&flute["time_s"]) <= 20.0;
+        close("time", number(&flute["time_s"]), 32.0 / k, 1e-9);
+        close_rel("max H", number(&flute["max_thickness"]), 0.05 * slot_ratio(k), 1e-9);
+        let meets = number(&flute["max_thickness"]) <= 0.075 && number(&flute["time_s"]) <= 20.0;
         assert_eq!(flute["recommended"], meets, "k = {k}");
     }
     // T1 = 0.075 keeps k ≤ 4, T2 = 20 s needs k ≥ 2: fastest first.
@@ -176,7 +160,7 @@ async fn api_example_over_http() {
     assert_eq!(slot["arcs"], json!([[0.0, 180.0]]));
     assert_eq!(slot["engaged_deg"], 180.0);
     assert_eq!(slot["radial_depth"], 10.0);
-    close("t at s = 30", num(&slot["t"]), 60.0 * 30.0 / 300.0, 1e-9);
+    close("t at s = 30", number(&slot["t"]), 60.0 * 30.0 / 300.0, 1e-9);
     assert_eq!(sample_at(&answer, 0.0)["arcs"], json!([]));
     // Determinism: byte-identical answers.
     let once = app.client.post(app.url(URL)).json(&body).send().await.unwrap().bytes().await.unwrap();
@@ -195,7 +179,7 @@ async fn api_example_over_http() {
 #[tokio::test(flavor = "multi_thread")]
 async fn c1_slot_then_side_milling() {
     let app = TestApp::spawn().await;
-    let c = case("C1");
+    let c = case("engagement", "C1");
     let input = &c["input"];
     let expected = &c["expected"];
     let flutes = flute_list(&input["tool"]["flute_candidates"]);
@@ -214,7 +198,7 @@ async fn c1_slot_then_side_milling() {
             extra_all,
         )
     };
-    let ds = num(&input["simulation"]["ds"]);
+    let ds = number(&input["simulation"]["ds"]);
     let started = std::time::Instant::now();
     let result = json_with(app.post_json(URL, &body(json!({"step": ds}))).await, 200).await;
     eprintln!(
@@ -222,11 +206,16 @@ async fn c1_slot_then_side_milling() {
         result["samples"].as_array().unwrap().len(),
         started.elapsed()
     );
-    close("path length", num(&result["path_length"]), 142.5, 1e-9);
+    close("path length", number(&result["path_length"]), 142.5, 1e-9);
     check_statistics("C1", &result, &expected["representative_mm"], 0.002, 0.01);
     for flute in result["flutes"].as_array().unwrap() {
         let key = flute["flute_count"].to_string();
-        close_rel(&format!("time k={key}"), num(&flute["time_s"]), num(&expected["machining_time_s"][&key]), 1e-4);
+        close_rel(
+            &format!("time k={key}"),
+            number(&flute["time_s"]),
+            number(&expected["machining_time_s"][&key]),
+            1e-4,
+        );
     }
     let set: BTreeSet<u64> = recommended(&result).into_iter().collect();
     assert_eq!(set, flute_list(&expected["recommended_flutes"]).into_iter().collect());
@@ -235,8 +224,8 @@ async fn c1_slot_then_side_milling() {
     let continuum = expected["engaged_intervals_s_continuum_open"].as_array().unwrap();
     assert_eq!(intervals.len(), continuum.len(), "{intervals:?}");
     for (got, want) in intervals.iter().zip(continuum) {
-        close("interval from", num(&got[0]), num(&want[0]), ds);
-        close("interval to", num(&got[1]), num(&want[1]), ds);
+        close("interval from", number(&got[0]), number(&want[0]), ds);
+        close("interval to", number(&got[1]), number(&want[1]), ds);
     }
     // Checkpoints (s = 71.25 lies off the 0.1 mm grid: read them from a 0.05 mm run).
     let fine = json_with(app.post_json(URL, &body(json!({"step": 0.05}))).await, 200).await;
@@ -267,7 +256,7 @@ async fn c1_slot_then_side_milling() {
 #[tokio::test(flavor = "multi_thread")]
 async fn c2_side_milling_and_inside_corner_side_by_side() {
     let app = TestApp::spawn().await;
-    let c = case("C2");
+    let c = case("engagement", "C2");
     // Part A: each row a straight pass at a known radial depth, checked at its checkpoint.
     let part_a = &c["part_A"];
     let input = &part_a["input"];
@@ -286,8 +275,8 @@ async fn c2_side_milling_and_inside_corner_side_by_side() {
         let checkpoint = json!({"s": row["checkpoint_s"], "arcs": row["arcs"], "engaged_deg": row["engaged_deg"],
             "ae": row["ae_measured"], "H_mm_by_k": row["H_mm_by_k"], "n_max_by_k": row["n_max_by_k"]});
         check_point(&label, &result, &checkpoint, &flutes);
-        let sample = sample_at(&result, num(&row["checkpoint_s"]));
-        close(&label, num(&sample["mean_chip_thickness"]), num(&row["mean_chip_thickness_mm"]), 1e-5);
+        let sample = sample_at(&result, number(&row["checkpoint_s"]));
+        close(&label, number(&sample["mean_chip_thickness"]), number(&row["mean_chip_thickness_mm"]), 1e-5);
         let mode = sample["arc_details"][0]["mode"].as_str().unwrap();
         let expected_mode = match row["mode"].as_str().unwrap() {
             "down" => "climb",
@@ -320,20 +309,20 @@ async fn c2_side_milling_and_inside_corner_side_by_side() {
     assert_eq!(candidates[1]["name"], "fillet 3");
     let expected = &part_b["expected"];
     let sharp = &expected["sharp"];
-    close("sharp length", num(&candidates[0]["path_length"]), num(&sharp["path_length"]), 1e-9);
-    close("sharp max Φ", num(&candidates[0]["max_engaged_deg"]), num(&sharp["max_engaged_deg"]), 0.1);
-    close("sharp max Φ at", num(&candidates[0]["max_engaged_at_s"]), num(&sharp["max_engaged_at_s"]), 1e-6);
-    close("sharp max a_e", num(&candidates[0]["max_radial_depth"]), num(&sharp["max_ae"]), 0.005);
+    close("sharp length", number(&candidates[0]["path_length"]), number(&sharp["path_length"]), 1e-9);
+    close("sharp max Φ", number(&candidates[0]["max_engaged_deg"]), number(&sharp["max_engaged_deg"]), 0.1);
+    close("sharp max Φ at", number(&candidates[0]["max_engaged_at_s"]), number(&sharp["max_engaged_at_s"]), 1e-6);
+    close("sharp max a_e", number(&candidates[0]["max_radial_depth"]), number(&sharp["max_ae"]), 0.005);
     let fillet = &expected["fillet3"];
-    close("fillet length", num(&candidates[1]["path_length"]), num(&fillet["path_length"]), 1e-3);
-    close("fillet max Φ", num(&candidates[1]["max_engaged_deg"]), num(&fillet["max_engaged_deg"]), 0.1);
+    close("fillet length", number(&candidates[1]["path_length"]), number(&fillet["path_length"]), 1e-3);
+    close("fillet max Φ", number(&candidates[1]["max_engaged_deg"]), number(&fillet["max_engaged_deg"]), 0.1);
     for (candidate, expected) in candidates.iter().zip([sharp, fillet]) {
         for flute in candidate["flutes"].as_array().unwrap() {
             let key = flute["flute_count"].to_string();
             close_rel(
                 &format!("{} H max k={key}", candidate["name"]),
-                num(&flute["max_thickness"]),
-                num(&expected["H_max_mm_by_k_over_path"][&key]),
+                number(&flute["max_thickness"]),
+                number(&expected["H_max_mm_by_k_over_path"][&key]),
                 0.002,
             );
         }
@@ -346,7 +335,7 @@ async fn c2_side_milling_and_inside_corner_side_by_side() {
 #[tokio::test(flavor = "multi_thread")]
 async fn c3_pair_blocks_and_flute_selection() {
     let app = TestApp::spawn().await;
-    let c = case("C3");
+    let c = case("engagement", "C3");
     let input = &c["input"];
     let expected = &c["expected"];
     let flutes = flute_list(&input["tool"]["flute_candidates"]);
@@ -364,15 +353,15 @@ async fn c3_pair_blocks_and_flute_selection() {
         let key = flute["flute_count"].to_string();
         close_rel(
             &format!("H/fz k={key}"),
-            num(&flute["max_thickness"]) / 0.1,
-            num(&expected["H_over_fz_max_by_k"][&key]),
+            number(&flute["max_thickness"]) / 0.1,
+            number(&expected["H_over_fz_max_by_k"][&key]),
             0.002,
         );
         assert_eq!(flute["max_teeth"], expected["n_max_by_k_over_path"][&key], "n_max k={key}");
         close_rel(
             &format!("time k={key}"),
-            num(&flute["time_s"]),
-            num(&expected["machining_time_s_constant_fz"][&key]),
+            number(&flute["time_s"]),
+            number(&expected["machining_time_s_constant_fz"][&key]),
             1e-4,
         );
     }
@@ -402,7 +391,7 @@ async fn c3_pair_blocks_and_flute_selection() {
         );
         let result = json_with(app.post_json(URL, &body).await, 200).await;
         for flute in result["flutes"].as_array().unwrap() {
-            close("constant V_f time", num(&flute["time_s"]), 24.0, 1e-9);
+            close("constant V_f time", number(&flute["time_s"]), 24.0, 1e-9);
         }
         let got: BTreeSet<u64> = recommended(&result).into_iter().collect();
         assert_eq!(got, want.into_iter().collect(), "T2 = {}", limits["T2_s"]);
@@ -447,7 +436,7 @@ async fn a_named_machine_caps_the_feed_plan_and_sets_the_dialect() {
     assert_eq!(answer["machine"]["max_feed"], 900.0);
     assert_eq!(answer["feed_plan"]["max_feed"], 900.0, "{}", answer["feed_plan"]);
     let feeds: Vec<f64> =
-        answer["feed_plan"]["blocks"].as_array().unwrap().iter().map(|block| num(&block["feed"])).collect();
+        answer["feed_plan"]["blocks"].as_array().unwrap().iter().map(|block| number(&block["feed"])).collect();
     assert!(!feeds.is_empty() && feeds.iter().all(|&feed| feed <= 900.0 + 1e-9), "{feeds:?}");
 
     body["axial_depth"] = json!(2);
@@ -504,9 +493,9 @@ async fn block_time_chords_the_program_and_reports_its_blocks() {
     assert_eq!(blocks["block_time_ms"], 4.0);
     // 2 flutes × 0.05 mm × 3000 rpm = 300 mm/min: blocks of 0.02 mm on a 4 ms control.
     let block_length = 300.0 * 4.0 / 60_000.0;
-    assert!((num(&blocks["block_length"]) - block_length).abs() < 1e-12, "{blocks}");
+    assert!((number(&blocks["block_length"]) - block_length).abs() < 1e-12, "{blocks}");
     assert_eq!(blocks["short_blocks"], 0, "{}", ruled["warnings"]);
-    assert!(num(&blocks["min_block_length"]) >= block_length * (1.0 - 1e-9), "{blocks}");
+    assert!(number(&blocks["min_block_length"]) >= block_length * (1.0 - 1e-9), "{blocks}");
     let program = program_of(body.clone()).await;
     assert_eq!(gcode_moves(&program), blocks["blocks"].as_u64().unwrap() as usize, "every feed block is a G01");
     // The R10 quarter arc (15.7 mm) in chords of one 0.02 mm block instead of 0.28 mm ones.
@@ -595,21 +584,22 @@ async fn engagement_job_errors_name_the_line_and_field() {
 fn expected_moves(result: &Value, cut_z: f64, safe_z: f64) -> Vec<(bool, [f64; 3], Option<f64>)> {
     let samples = result["samples"].as_array().unwrap();
     let position = |s: f64| {
-        let sample = samples.iter().find(|sample| (num(&sample["s"]) - s).abs() < 1e-9).expect("block end at a sample");
-        [num(&sample["position"][0]), num(&sample["position"][1])]
+        let sample =
+            samples.iter().find(|sample| (number(&sample["s"]) - s).abs() < 1e-9).expect("block end at a sample");
+        [number(&sample["position"][0]), number(&sample["position"][1])]
     };
     let start = position(0.0);
     let blocks = result["feed_plan"]["blocks"].as_array().unwrap();
     // The plunge runs no faster than the nominal feed of the tool's flutes (f_z = 0.05, N = 3000).
-    let nominal = num(&result["time_flute_count"]) * 0.05 * 3000.0;
-    let first_feed = num(&blocks[0]["feed"]);
+    let nominal = number(&result["time_flute_count"]) * 0.05 * 3000.0;
+    let first_feed = number(&blocks[0]["feed"]);
     let mut moves = vec![
         (false, [start[0], start[1], safe_z], None),
         (true, [start[0], start[1], cut_z], Some(first_feed.min(nominal))),
     ];
     for block in blocks {
-        let end = position(num(&block["to_s"]));
-        moves.push((true, [end[0], end[1], cut_z], Some(num(&block["feed"]))));
+        let end = position(number(&block["to_s"]));
+        moves.push((true, [end[0], end[1], cut_z], Some(number(&block["feed"]))));
     }
     moves
 }
@@ -655,7 +645,7 @@ async fn gcode_of_the_feed_plan_in_both_dialects() {
         for (candidate, result) in answer["candidates"].as_array().unwrap().iter().enumerate() {
             let plan = &result["feed_plan"];
             let feeds: BTreeSet<u64> =
-                plan["blocks"].as_array().unwrap().iter().map(|b| num(&b["feed"]) as u64).collect();
+                plan["blocks"].as_array().unwrap().iter().map(|b| number(&b["feed"]) as u64).collect();
             assert!(feeds.len() >= 2, "the plan changes the feed: {feeds:?}");
             assert!(feeds.contains(&1500), "capped at the max feed in the air: {feeds:?}");
             for dialect in ["fanuc", "linuxcnc"] {

@@ -3,41 +3,13 @@
 //! LinuxCNC's `rs274`, inch programs, the upload limit, the synchronous time limit, and a table
 //! of bad requests that leave the database unchanged.
 
+use kerf_cases::{case, close, number, triple};
 use std::time::{Duration, Instant};
 
 use kerf_server::state::Limits;
 use kerf_tests::{TestApp, json_with, problem, rs274_moves};
 use reqwest::multipart::{Form, Part};
 use serde_json::{Value, json};
-
-fn fixture() -> Value {
-    serde_json::from_str(include_str!("../../../solver/tests/fixtures/error-prediction.json")).unwrap()
-}
-
-fn case(id: &str) -> Value {
-    let all = fixture();
-    all["reference_cases"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .chain(all["unit_checks"].as_array().unwrap())
-        .find(|c| c["id"].as_str().unwrap().starts_with(id))
-        .unwrap()
-        .clone()
-}
-
-fn number(v: &Value) -> f64 {
-    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
-}
-
-fn triple(v: &Value) -> [f64; 3] {
-    let a = v.as_array().unwrap_or_else(|| panic!("not a point: {v}"));
-    [number(&a[0]), number(&a[1]), number(&a[2])]
-}
-
-fn close(what: &str, got: f64, expected: f64, tolerance: f64) {
-    assert!((got - expected).abs() <= tolerance, "{what}: got {got}, expected {expected} ± {tolerance}");
-}
 
 fn flags(pass: &Value) -> Vec<String> {
     pass["flags"].as_array().map(|a| a.iter().map(|f| f.as_str().unwrap().to_owned()).collect()).unwrap_or_default()
@@ -113,7 +85,7 @@ async fn predict(app: &TestApp, body: &Value) -> Value {
 #[tokio::test(flavor = "multi_thread")]
 async fn case_a_flat_raster_over_http() {
     let app = TestApp::spawn().await;
-    let case = case("A_");
+    let case = case("error-prediction", "A_");
     let (expected, tolerances) = (&case["expected"], &case["tolerances"]);
     for method in ["sampling", "depth_buffer"] {
         let mut body = centre_request(
@@ -150,7 +122,7 @@ async fn case_a_flat_raster_over_http() {
 #[tokio::test(flavor = "multi_thread")]
 async fn case_b_inclined_plane_with_a_registered_tool() {
     let app = TestApp::spawn().await;
-    let case = case("B_");
+    let case = case("error-prediction", "B_");
     let (expected, tolerances) = (&case["expected"], &case["tolerances"]);
     // The shape-error table lives in the tool table.
     app.register_tool(12, &ball(5.0, &[(0.0, 0.005), (90.0, 0.015)])).await;
@@ -232,7 +204,7 @@ fn case_c_request(beta_deg: f64, method: &str, view_correction: bool) -> (Value,
 #[tokio::test(flavor = "multi_thread")]
 async fn case_c_convex_cylinder_over_http() {
     let app = TestApp::spawn().await;
-    let case = case("C_");
+    let case = case("error-prediction", "C_");
     let tolerances = &case["tolerances"];
     for row in case["expected_rows"].as_array().unwrap() {
         let beta = number(&row["beta"]);
@@ -270,8 +242,8 @@ async fn case_c_convex_cylinder_over_http() {
 #[tokio::test(flavor = "multi_thread")]
 async fn case_d_force_and_deflection_chain_over_http() {
     let app = TestApp::spawn().await;
-    let case_b = case("B_");
-    let case_d = case("D_");
+    let case_b = case("error-prediction", "B_");
+    let case_d = case("error-prediction", "D_");
     let (expected, tolerances) = (&case_d["expected"], &case_d["tolerances"]);
     let mode = |m: &Value| json!({"stiffness": m["k"], "frequency_hz": m["fn"], "damping_ratio": m["zeta"]});
     let compliance = &case_d["inputs"]["compliance"];
@@ -1091,7 +1063,7 @@ async fn corrections_follow_the_node_rule_of_case_f() {
     }
     assert!(moved > passes.len() / 2, "most nodes move: {moved} of {}", passes.len());
     // The whole case F polyline: the rule of `polyline_corrections` as published.
-    let case = case("F_");
+    let case = case("error-prediction", "F_");
     let to_error = |p: &Value| Some(PassError { error: number(&p["e"]), normal: triple(&p["n"]) });
     let errors: Vec<Option<PassError>> =
         case["inputs"]["pass_errors"].as_array().unwrap().iter().map(to_error).collect();

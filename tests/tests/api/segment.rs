@@ -2,21 +2,9 @@
 //! curve kind, machine defaults and overrides, G-code through `rs274` for both dialects, and a
 //! table of bad requests that leave the database unchanged.
 
+use kerf_cases::{case, close, number};
 use kerf_tests::{TestApp, external_program, json_with, problem, rs274_moves};
 use serde_json::{Value, json};
-
-fn fixture_case(id: &str) -> Value {
-    let all: Value = serde_json::from_str(include_str!("../../../solver/tests/fixtures/chord.json")).unwrap();
-    all["cases"].as_array().unwrap().iter().find(|c| c["id"] == id).unwrap().clone()
-}
-
-fn number(value: &Value) -> f64 {
-    value.as_f64().unwrap_or_else(|| panic!("not a number: {value}"))
-}
-
-fn close(what: &str, got: f64, expected: f64, tolerance: f64) {
-    assert!((got - expected).abs() <= tolerance, "{what}: got {got}, expected {expected} (±{tolerance})");
-}
 
 fn points(answer: &Value) -> Vec<Vec<f64>> {
     answer["points"]
@@ -71,7 +59,7 @@ async fn segment(app: &TestApp, body: &Value) -> Value {
 #[tokio::test(flavor = "multi_thread")]
 async fn patent_experiment_case_a_over_http() {
     let app = TestApp::spawn().await;
-    let case = fixture_case("A");
+    let case = case("chord", "A");
     let expected = &case["expected"];
     let body = json!({"curve": {"kind": "circle", "centre": [0, 0], "radius": 50},
                       "feed": 10000, "block_time_ms": 4, "mode": "window", "margin": 1.0,
@@ -126,7 +114,7 @@ async fn patent_experiment_case_a_over_http() {
 async fn cases_b_and_c_over_http() {
     let app = TestApp::spawn().await;
     let ellipse = json!({"kind": "ellipse", "centre": [0, 0], "semi_axes": [100, 50], "start_deg": 0, "end_deg": 90});
-    let case_b = fixture_case("B");
+    let case_b = case("chord", "B");
     let answer = segment(
         &app,
         &json!({"curve": ellipse, "feed": 10000, "block_time_ms": 4, "margin": 1.1, "mode": "curve", "rule": "extremes"}),
@@ -138,7 +126,7 @@ async fn cases_b_and_c_over_http() {
     assert_eq!(answer["windows"].as_array().unwrap().len(), 1);
     check_ends(&answer, &case_b["expected"]);
 
-    let case_c = fixture_case("C");
+    let case_c = case("chord", "C");
     let answer = segment(
         &app,
         &json!({"curve": ellipse, "feed": 12000, "block_time_ms": 4, "margin": 1.05, "min_chord_error": 0.001,
