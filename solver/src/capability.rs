@@ -12,7 +12,7 @@ use serde::Serialize;
 use serde::de::DeserializeOwned;
 
 use crate::error::SolverError;
-use crate::gcode::{Dialect, Reference};
+use crate::gcode::{Dialect, Post, Reference, ToolCall};
 use crate::machine::MachineProfile;
 use crate::tool::{Tool, ToolRef};
 
@@ -202,6 +202,16 @@ impl OutputOptions {
     /// The dialect of the program: the one asked for, else the machine's, else Fanuc.
     pub fn dialect_for(&self, machine: Option<&MachineProfile>) -> Dialect {
         self.dialect.or(machine.map(|m| m.dialect)).unwrap_or_default()
+    }
+
+    /// The post for a program cut with `tool` on `machine`: these options' dialect (else the
+    /// machine's) and programmed point (else the tool tip).
+    pub fn post(&self, machine: Option<&MachineProfile>, tool: &Tool) -> Post {
+        Post {
+            dialect: self.dialect_for(machine),
+            reference: self.reference.unwrap_or_default(),
+            tool: ToolCall::for_tool(tool),
+        }
     }
 }
 

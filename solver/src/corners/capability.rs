@@ -10,7 +10,6 @@ use super::request::MAX_MOVES;
 use super::{ContourAnswer, ContourRequest, CornerLoop};
 use crate::capability::{Capability, OutputOptions, Purpose, Refs, Resolved, Run};
 use crate::error::{SolverError, Warning};
-use crate::gcode::{Post, ToolCall};
 use crate::machine::MachineProfile;
 use crate::tool::{Tool, ToolRef};
 
@@ -60,11 +59,7 @@ impl Capability for ContourCapability {
         answer: &ContourResult,
         output: &OutputOptions,
     ) -> Result<String, SolverError> {
-        let post = Post {
-            dialect: output.dialect_for(answer.machine.as_ref()),
-            reference: output.reference.unwrap_or_default(),
-            tool: ToolCall::for_tool(&answer.tool),
-        };
+        let post = output.post(answer.machine.as_ref(), &answer.tool);
         super::program(&answer.result, &post)
     }
 

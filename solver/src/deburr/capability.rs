@@ -6,7 +6,6 @@ use serde::Serialize;
 use super::{Deburr, DeburrRequest};
 use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
 use crate::error::SolverError;
-use crate::gcode::{Post, ToolCall};
 use crate::machine::MachineProfile;
 use crate::tool::Tool;
 
@@ -45,11 +44,7 @@ impl Capability for DeburrCapability {
     }
 
     fn program(_request: &DeburrRequest, answer: &DeburrAnswer, output: &OutputOptions) -> Result<String, SolverError> {
-        let post = Post {
-            dialect: output.dialect_for(answer.machine.as_ref()),
-            reference: output.reference.unwrap_or_default(),
-            tool: ToolCall::for_tool(&answer.tool),
-        };
+        let post = output.post(answer.machine.as_ref(), &answer.tool);
         super::program(&answer.result, &post)
     }
 

@@ -6,7 +6,6 @@ use serde::Serialize;
 use super::{EngagementAnswer, EngagementRequest, Stock};
 use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
 use crate::error::SolverError;
-use crate::gcode::{Post, ToolCall};
 use crate::machine::MachineProfile;
 use crate::tool::Tool;
 
@@ -78,11 +77,7 @@ impl Capability for EngagementCapability {
         answer: &EngagementResponse,
         output: &OutputOptions,
     ) -> Result<String, SolverError> {
-        let post = Post {
-            dialect: output.dialect_for(answer.machine.as_ref()),
-            reference: output.reference.unwrap_or_default(),
-            tool: ToolCall::for_tool(&answer.tool),
-        };
+        let post = output.post(answer.machine.as_ref(), &answer.tool);
         let candidate = output.candidate.or(request.candidate).unwrap_or(0);
         super::program(&answer.result, candidate, &post)
     }

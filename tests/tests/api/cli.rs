@@ -10,19 +10,24 @@ fn program() -> PathBuf {
     PathBuf::from(env!("CARGO_BIN_EXE_kerf-under-test"))
 }
 
+/// `kerf run EXAMPLE -o OUT` with no tool table (the examples define their tools).
+fn run_locally(example: &std::path::Path, out: &std::path::Path) -> std::process::Output {
+    Command::new(program())
+        .arg("run")
+        .arg(example)
+        .arg("-o")
+        .arg(out)
+        .arg("--database")
+        .arg(out.join("no-such.db"))
+        .output()
+        .unwrap()
+}
+
 #[test]
 fn runs_each_example_locally() {
     for example in examples() {
         let out = tempfile::tempdir().unwrap();
-        let output = Command::new(program())
-            .arg("run")
-            .arg(&example)
-            .arg("-o")
-            .arg(out.path())
-            .arg("--database")
-            .arg(out.path().join("no-such.db"))
-            .output()
-            .unwrap();
+        let output = run_locally(&example, out.path());
         assert!(output.status.success(), "{}: {}", example.display(), String::from_utf8_lossy(&output.stderr));
         let summary: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.path().join("job.json")).unwrap()).unwrap();
@@ -86,15 +91,7 @@ async fn kerf_run_and_the_service_write_the_same_programs() {
     let app = kerf_tests::TestApp::spawn().await;
     for example in examples() {
         let out = tempfile::tempdir().unwrap();
-        let output = Command::new(program())
-            .arg("run")
-            .arg(&example)
-            .arg("-o")
-            .arg(out.path())
-            .arg("--database")
-            .arg(out.path().join("no-such.db"))
-            .output()
-            .unwrap();
+        let output = run_locally(&example, out.path());
         assert!(output.status.success(), "{}: {}", example.display(), String::from_utf8_lossy(&output.stderr));
         let media =
             if example.extension().is_some_and(|e| e == "toml") { "application/toml" } else { "application/json" };
