@@ -2,6 +2,7 @@
 //! on concurrent solver work.
 
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use sqlx::SqlitePool;
@@ -65,10 +66,12 @@ impl AppState {
     }
 
     /// Runs pure solver work on the blocking pool, never on an async worker thread, under the
-    /// concurrency bound and the synchronous time limit.
+    /// concurrency bound and the synchronous time limit. `work` gets a cancel flag that is set
+    /// when the limit passes or the client goes away (this future is dropped); the solvers check
+    /// it per unit of work, so the slot is free again within milliseconds.
     pub async fn solve<T, F>(&self, work: F) -> AppResult<T>
     where
-        F: FnOnce() -> T + Send + 'static,
+        F: FnOnce(&AtomicBool) -> T + Send + 'static,
         T: Send + 'static,
     {
         let permit =
@@ -76,9 +79,11 @@ impl AppState {
                 .await
                 .map_err(|_| AppError::TooManyRequests("all solver slots are busy; retry shortly".to_owned()))?
                 .map_err(|error| AppError::Internal(error.into()))?;
+        let cancel = Arc::new(AtomicBool::new(false));
+        let _stop = CancelOnDrop(Arc::clone(&cancel));
         let task = tokio::task::spawn_blocking(move || {
             let _permit = permit;
-            work()
+            work(&cancel)
         });
         match tokio::time::timeout(self.limits.solver_time_limit, task).await {
             Ok(Ok(value)) => Ok(value),
@@ -88,5 +93,15 @@ impl AppState {
                 self.limits.solver_time_limit.as_secs()
             ))),
         }
+    }
+}
+
+/// Sets the cancel flag when dropped: on the time limit, when the client goes away, and after a
+/// normal end (when it no longer matters).
+struct CancelOnDrop(Arc<AtomicBool>);
+
+impl Drop for CancelOnDrop {
+    fn drop(&mut self) {
+        self.0.store(true, Ordering::Relaxed);
     }
 }

@@ -12,6 +12,7 @@ use serde::Serialize;
 use serde::de::DeserializeOwned;
 
 use crate::error::SolverError;
+use crate::error_code::ErrorCode;
 use crate::gcode::{Dialect, Post, Reference, ToolCall};
 use crate::machine::MachineProfile;
 use crate::tool::{Tool, ToolRef};
@@ -154,6 +155,27 @@ pub struct Control<'a> {
     pub progress: Option<&'a (dyn Fn(f64) + Sync)>,
     /// Set to stop: the run ends with `E_CANCELLED`.
     pub cancel: Option<&'a AtomicBool>,
+}
+
+impl Control<'_> {
+    /// `Err(E_CANCELLED)` once the cancel flag is set. The solvers call it once per unit of work
+    /// (a block, a centre, a layer, a sample row), so a timed-out or abandoned request frees its
+    /// solver slot within milliseconds instead of running to the end.
+    ///
+    /// # Errors
+    /// `E_CANCELLED` when cancelled.
+    pub fn check(&self) -> Result<(), SolverError> {
+        if self.cancelled() {
+            return Err(SolverError::new(ErrorCode::Cancelled, "the computation was cancelled"));
+        }
+        Ok(())
+    }
+
+    /// Whether the cancel flag is set.
+    #[must_use]
+    pub fn cancelled(&self) -> bool {
+        self.cancel.is_some_and(|flag| flag.load(std::sync::atomic::Ordering::Relaxed))
+    }
 }
 
 impl std::fmt::Debug for Control<'_> {

@@ -134,7 +134,7 @@ pub fn segments_intersect(a: &Vec2, b: &Vec2, c: &Vec2, d: &Vec2) -> bool {
 }
 
 /// Whether `p` (known to be collinear with `a`, `b`) lies within their bounding box.
-fn within_box(p: &Vec2, a: &Vec2, b: &Vec2) -> bool {
+pub(crate) fn within_box(p: &Vec2, a: &Vec2, b: &Vec2) -> bool {
     p.x >= a.x.min(b.x) && p.x <= a.x.max(b.x) && p.y >= a.y.min(b.y) && p.y <= a.y.max(b.y)
 }
 

@@ -46,9 +46,11 @@ fn slot(mc: f64, flutes: &[u32]) -> Value {
 
 fn solve_body(body: Value, tool: &Tool, physics: &Physics) -> Result<PathEngagement, kerf_solver::error::SolverError> {
     let request: EngagementRequest = serde_json::from_value(body).unwrap();
-    engagement::solve_in(&request, tool, None, physics).map(|answer| match answer {
-        EngagementAnswer::Single(result) => *result,
-        EngagementAnswer::Comparison(_) => panic!("single path expected"),
+    engagement::solve_in(&request, tool, None, physics, kerf_solver::capability::Control::default()).map(|answer| {
+        match answer {
+            EngagementAnswer::Single(result) => *result,
+            EngagementAnswer::Comparison(_) => panic!("single path expected"),
+        }
     })
 }
 

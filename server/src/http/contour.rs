@@ -6,6 +6,7 @@ use axum::Json;
 use axum::extract::State;
 use axum::http::HeaderMap;
 use axum::response::Response;
+use kerf_solver::capability::Control;
 use kerf_solver::corners::{ContourCapability, ContourRequest, ContourResult, LoopsRequest, LoopsResult};
 use serde::Deserialize;
 use utoipa::{IntoParams, ToSchema};
@@ -87,7 +88,8 @@ async fn post_loops(
 ) -> AppResult<Json<LoopsResult>> {
     let catalog = store::catalog(&state.db, [request.refs()], Catalog::default()).await?;
     let tool = capabilities::resolve_refs::<kerf_solver::tool::Tool>(request.refs(), &catalog)?.tool;
-    let answer = state.solve(move || request.solve(tool)).await??;
+    let answer =
+        state.solve(move |cancel| request.solve(tool, Control { progress: None, cancel: Some(cancel) })).await??;
     Ok(Json(answer))
 }
 

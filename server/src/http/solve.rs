@@ -1,10 +1,7 @@
 //! What every solver endpoint does after reading its request, through the capability seam:
 //! resolve the request's references in the store, solve on the blocking pool under the solver
-//! bound (cancelled when the client goes away or the time limit passes), serialise or write the
+//! bound (cancelled when the client goes away or the time limit passes: `AppState::solve`), serialise or write the
 //! program there too, and answer JSON or G-code.
-
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 use axum::body::Bytes;
 use axum::http::{HeaderValue, header};
@@ -16,17 +13,6 @@ use crate::capabilities::{self, Delivered};
 use crate::error::AppResult;
 use crate::state::AppState;
 use crate::store;
-
-/// Sets the cancel flag when dropped: a request that hits the time limit, or whose client goes
-/// away, stops its computation (where the capability checks the flag) instead of leaving it
-/// running on the blocking pool.
-struct CancelOnDrop(Arc<AtomicBool>);
-
-impl Drop for CancelOnDrop {
-    fn drop(&mut self) {
-        self.0.store(true, Ordering::Relaxed);
-    }
-}
 
 /// Answers `request` of capability `C` as `ask` says; `upload` is a file sent with it.
 ///
@@ -44,12 +30,10 @@ pub async fn answer<C: Capability>(
     if ask.gcode {
         C::check_output(&request, &ask.output)?;
     }
-    let cancel = Arc::new(AtomicBool::new(false));
-    let _stop = CancelOnDrop(Arc::clone(&cancel));
     let (delivered, seconds) = state
-        .solve(move || {
+        .solve(move |cancel| {
             let run = Run {
-                control: Control { progress: None, cancel: Some(&cancel) },
+                control: Control { progress: None, cancel: Some(cancel) },
                 upload: upload.as_deref(),
                 purpose: if ask.gcode { Purpose::Program } else { Purpose::Json },
             };

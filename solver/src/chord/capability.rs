@@ -43,12 +43,12 @@ impl Capability for SegmentCapability {
     fn solve(
         request: &SegmentRequest,
         context: Resolved<Option<Tool>>,
-        _run: &Run<'_>,
+        run: &Run<'_>,
     ) -> Result<SegmentResult, SolverError> {
         if let Some(tool) = &context.tool {
             tool.validate("tool.")?;
         }
-        let result = super::solve(request, context.machine.as_ref())?;
+        let result = super::solve_controlled(request, context.machine.as_ref(), run.control)?;
         Ok(SegmentResult { machine: context.machine, tool: context.tool, result })
     }
 

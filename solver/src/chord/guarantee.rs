@@ -35,6 +35,9 @@ impl Cutter<'_> {
     /// Mode `guarantee`: every chord's error from the smallest radius along it, with the
     /// accuracy bound `tolerance` (which may shorten chords: the user asked for it).
     pub(crate) fn guarantee(&self, rule: &BlockRule, tolerance: Option<f64>) -> Result<Cut, CutError> {
+        if let Some(largest) = self.largest_rule_chord_error(rule, tolerance) {
+            self.refuse_certain_overflow(largest)?;
+        }
         let Some(mut cut) = self.start() else {
             return Ok(Cut::default());
         };

@@ -75,6 +75,7 @@ pub use nurbs::{MAX_CONTROL_POINTS, MAX_DEGREE};
 pub use program::program;
 pub use request::{Curve, CurveRule, Direction, Mode, RadiusEstimate, SegmentRequest};
 
+use crate::capability::Control;
 use crate::error::ErrorCode;
 use crate::machine::{ChordStatus, MachineProfile};
 use request::{Job, Plan};
@@ -95,7 +96,19 @@ pub const MAX_BLOCKS: usize = 1_000_000;
 /// feed), `E_TOO_MANY_BLOCKS` (over [`MAX_BLOCKS`]), `E_TOO_MANY_POINTS` (arc-length table over
 /// its limit), `E_NUMERIC_FAILURE` (E14).
 pub fn solve(request: &SegmentRequest, machine: Option<&MachineProfile>) -> Result<SegmentAnswer, SolverError> {
-    solve_by(request, machine, Numerics::Fast)
+    solve_by(request, machine, Numerics::Fast, Control::default())
+}
+
+/// [`solve`] that stops with `E_CANCELLED` once `control`'s cancel flag is set (checked per block).
+///
+/// # Errors
+/// As [`solve`], and `E_CANCELLED`.
+pub fn solve_controlled(
+    request: &SegmentRequest,
+    machine: Option<&MachineProfile>,
+    control: Control<'_>,
+) -> Result<SegmentAnswer, SolverError> {
+    solve_by(request, machine, Numerics::Fast, control)
 }
 
 /// [`solve`] by the reference numerics of chord.md §2.9 (about 400 curve evaluations per
@@ -108,18 +121,19 @@ pub fn solve_reference(
     request: &SegmentRequest,
     machine: Option<&MachineProfile>,
 ) -> Result<SegmentAnswer, SolverError> {
-    solve_by(request, machine, Numerics::Reference)
+    solve_by(request, machine, Numerics::Reference, Control::default())
 }
 
 fn solve_by(
     request: &SegmentRequest,
     machine: Option<&MachineProfile>,
     numerics: Numerics,
+    control: Control<'_>,
 ) -> Result<SegmentAnswer, SolverError> {
     let job = request.validate(machine)?;
     let rule = &job.rule;
     let limit_field = if job.tolerance.is_some() { "tolerance" } else { "min_chord_error" };
-    let cutter = Cutter::new(&job.shape, &job.spans, MAX_BLOCKS, limit_field, numerics);
+    let cutter = Cutter::new(&job.shape, &job.spans, MAX_BLOCKS, limit_field, numerics, control);
     let cut = match job.plan {
         Plan::Window { length, estimate } => {
             cutter.windows(rule, job.tolerance, length, estimate).map_err(|error| cut_error(&job, error))?
@@ -309,7 +323,8 @@ fn answer(job: &Job, request: &SegmentRequest, cutter: &Cutter<'_>, cut: &Cut) -
 
     let comparison = match job.compare_tolerance {
         Some(tolerance) => {
-            let fixed_cutter = Cutter::new(&job.shape, &job.spans, MAX_BLOCKS, "compare_tolerance", cutter.numerics);
+            let fixed_cutter =
+                Cutter::new(&job.shape, &job.spans, MAX_BLOCKS, "compare_tolerance", cutter.numerics, cutter.control);
             let fixed = fixed_cutter.constant(tolerance, min_radius)?;
             let fixed_points: Vec<Vec3> = fixed.vertices.iter().map(|v| v.point).collect();
             Some(Comparison {

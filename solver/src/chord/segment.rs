@@ -8,6 +8,7 @@ use std::cell::Cell;
 
 use super::shape::{Shape, circumradius};
 use super::{reference, search};
+use crate::capability::Control;
 use crate::error::SolverError;
 use crate::geometry::Vec3;
 use crate::machine::rule::{BlockRule, ChordStatus, Infeasible, chord_length};
@@ -128,6 +129,8 @@ pub(crate) struct Cutter<'a> {
     pub max_blocks: usize,
     /// Field blamed when the limit is hit.
     pub limit_field: &'a str,
+    /// Checked once per block: a cancelled request stops here.
+    pub control: Control<'a>,
 }
 
 impl<'a> Cutter<'a> {
@@ -138,6 +141,7 @@ impl<'a> Cutter<'a> {
         max_blocks: usize,
         limit_field: &'a str,
         numerics: Numerics,
+        control: Control<'a>,
     ) -> Self {
         Self {
             shape,
@@ -147,7 +151,55 @@ impl<'a> Cutter<'a> {
             spans,
             max_blocks,
             limit_field,
+            control,
         }
+    }
+
+    /// Refuses at once a curve that certainly needs more than twice the block limit (issue 13:
+    /// found out only after the whole limit's worth of chords otherwise). On a curve whose radius
+    /// of curvature stays at most R_max no chord with a sagitta of at most `largest_chord_error`
+    /// is longer than the circle's, 2·√(2·R_max·e), so length ÷ that chord is a lower bound of the
+    /// block count. The factor 2 keeps estimates (window radii) from refusing a feasible curve.
+    /// Polylines and NURBS, which may be straight, are not bounded.
+    ///
+    /// # Errors
+    /// `E_TOO_MANY_BLOCKS` at the limit's field.
+    pub(crate) fn refuse_certain_overflow(&self, largest_chord_error: f64) -> Result<(), SolverError> {
+        let Some(least_blocks) = self.least_blocks(largest_chord_error) else {
+            return Ok(());
+        };
+        if least_blocks > 2.0 * self.max_blocks as f64 {
+            return Err(SolverError::new(
+                ErrorCode::TooManyBlocks,
+                format!(
+                    "the segmentation needs at least {least_blocks:.3e} blocks (the limit is {}); raise the chord \
+                     error (feed, margin, min_chord_error or tolerance) or shorten the curve",
+                    self.max_blocks
+                ),
+            )
+            .at(self.limit_field));
+        }
+        Ok(())
+    }
+
+    /// The lower bound of the block count of [`Cutter::refuse_certain_overflow`]; `None` for
+    /// polylines and NURBS, and for a chord error of 0 (no chord fits at all: the search says so,
+    /// E14, where it fails).
+    fn least_blocks(&self, largest_chord_error: f64) -> Option<f64> {
+        let (_, max_radius) = self.shape.radius_bounds()?;
+        if largest_chord_error <= 0.0 {
+            return None;
+        }
+        let longest_chord = 2.0 * (2.0 * max_radius * largest_chord_error).sqrt();
+        Some(self.shape.length() / longest_chord)
+    }
+
+    /// The largest chord error the rule can give on this curve (at its smallest radius of
+    /// curvature), within `tolerance`; `None` when unknown or infeasible there.
+    pub(crate) fn largest_rule_chord_error(&self, rule: &BlockRule, tolerance: Option<f64>) -> Option<f64> {
+        let (min_radius, _) = self.shape.radius_bounds()?;
+        let (chord_error, _) = rule.chord_error(min_radius).ok()?;
+        Some(tolerance.map_or(chord_error, |limit| chord_error.min(limit)))
     }
 
     /// dev of the chord between two parameters as the answer reports it: the reference's
@@ -192,6 +244,7 @@ impl<'a> Cutter<'a> {
 
     /// Appends a command point; `span_end` is the parameter where its span ends.
     pub(crate) fn push(&self, cut: &mut Cut, vertex: Vertex, span_end: f64) -> Result<(), SolverError> {
+        self.control.check()?;
         if cut.vertices.len() > self.max_blocks {
             return Err(SolverError::new(
                 ErrorCode::TooManyBlocks,
@@ -230,6 +283,7 @@ impl<'a> Cutter<'a> {
     /// Embodiments 3–5 and fixed tolerances: one chord error for the whole curve. `radius` is
     /// the radius it came from (for the step guess; infinite when unknown or straight).
     pub(crate) fn constant(&self, chord_error: f64, radius: f64) -> Result<Cut, SolverError> {
+        self.refuse_certain_overflow(chord_error)?;
         let Some(mut cut) = self.start() else {
             return Ok(Cut::default());
         };
@@ -301,6 +355,9 @@ impl<'a> Cutter<'a> {
         window: f64,
         estimate: Estimate,
     ) -> Result<Cut, CutError> {
+        if let Some(largest) = self.largest_rule_chord_error(rule, tolerance) {
+            self.refuse_certain_overflow(largest)?;
+        }
         let Some(mut cut) = self.start() else {
             return Ok(Cut::default());
         };
@@ -451,10 +508,32 @@ mod tests {
     fn the_block_limit_names_its_field() {
         let shape = circle(50.0);
         let spans = [shape.domain()];
-        let cutter = Cutter::new(&shape, &spans, 10, "compare_tolerance", Numerics::Fast);
+        let cutter = Cutter::new(&shape, &spans, 10, "compare_tolerance", Numerics::Fast, Control::default());
         let error = cutter.constant(0.001, 50.0).unwrap_err();
         assert_eq!(error.code(), ErrorCode::TooManyBlocks);
         assert_eq!(error.field(), Some("compare_tolerance"));
+    }
+
+    #[test]
+    fn the_least_block_count_never_exceeds_the_cut() {
+        // Ellipses from round to 20:1, partial and full sweeps, chord errors over four decades.
+        for (a, b) in [(10.0, 10.0), (50.0, 20.0), (100.0, 5.0), (3.0, 60.0)] {
+            for end_deg in [37.0, 180.0, 360.0] {
+                let request: crate::chord::SegmentRequest = serde_json::from_value(serde_json::json!({
+                    "curve": {"kind": "ellipse", "centre": [0, 0], "semi_axes": [a, b], "start_deg": 0, "end_deg": end_deg},
+                    "feed": 1000, "block_time_ms": 4
+                }))
+                .unwrap();
+                let job = request.validate(None).unwrap();
+                let cutter =
+                    Cutter::new(&job.shape, &job.spans, 1_000_000, "tolerance", Numerics::Fast, Control::default());
+                for chord_error in [1e-4, 1e-3, 1e-2, 1e-1] {
+                    let blocks = cutter.constant(chord_error, f64::INFINITY).unwrap().vertices.len() - 1;
+                    let least = cutter.least_blocks(chord_error).unwrap();
+                    assert!(least <= blocks as f64, "{a}x{b} to {end_deg}°, e {chord_error}: {least} > {blocks}");
+                }
+            }
+        }
     }
 
     #[test]
@@ -462,7 +541,7 @@ mod tests {
         // Chord error 0 on a 0.1 µm circle: the longest fitting chord is below 1 nm (E14).
         let shape = circle(1e-7);
         let spans = [shape.domain()];
-        let cutter = Cutter::new(&shape, &spans, 1000, "tolerance", Numerics::Fast);
+        let cutter = Cutter::new(&shape, &spans, 1000, "tolerance", Numerics::Fast, Control::default());
         let error = cutter.constant(0.0, f64::INFINITY).unwrap_err();
         assert_eq!(error.code(), ErrorCode::NumericFailure);
     }
@@ -471,7 +550,7 @@ mod tests {
     fn greedy_chords_on_a_circle_have_the_sagitta_length() {
         let shape = circle(50.0);
         let spans = [shape.domain()];
-        let cutter = Cutter::new(&shape, &spans, 1000, "tolerance", Numerics::Fast);
+        let cutter = Cutter::new(&shape, &spans, 1000, "tolerance", Numerics::Fast, Control::default());
         let cut = cutter.constant(0.01, 50.0).unwrap();
         assert_eq!(cut.vertices.len(), 159);
         let chord = (cut.vertices[1].point - cut.vertices[0].point).norm();

@@ -279,6 +279,21 @@ impl Shape {
         }
     }
 
+    /// The range of the radius of curvature of the whole circle or ellipse the curve lies on
+    /// (the ellipse's b²/a at the ends of its major axis, a²/b at the minor): bounds that hold
+    /// for any part of it. `None` for polylines and NURBS, which may be straight.
+    pub(crate) fn radius_bounds(&self) -> Option<(f64, f64)> {
+        match self {
+            Self::Arc(arc) => Some((arc.radius, arc.radius)),
+            Self::Ellipse(ellipse) => {
+                let [a, b] = ellipse.semi_axes;
+                let (major, minor) = (a.max(b), a.min(b));
+                Some((minor * minor / major, major * major / minor))
+            }
+            Self::Polyline(_) | Self::Spline(_) => None,
+        }
+    }
+
     /// Arc length, mm.
     pub(crate) fn length(&self) -> f64 {
         match self {

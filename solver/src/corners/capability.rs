@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::detect::{self, DetectMode, MaterialSide, PathLoopAnswer, PathLoopRequest};
 use super::request::MAX_MOVES;
 use super::{ContourAnswer, ContourRequest, CornerLoop};
-use crate::capability::{Capability, OutputOptions, Purpose, Refs, Resolved, Run};
+use crate::capability::{Capability, Control, OutputOptions, Purpose, Refs, Resolved, Run};
 use crate::error::{SolverError, Warning};
 use crate::machine::MachineProfile;
 use crate::tool::{Tool, ToolRef};
@@ -49,7 +49,7 @@ impl Capability for ContourCapability {
     /// A JSON answer holds at most [`MAX_JSON_MOVES`] moves; a program or a job up to [`MAX_MOVES`].
     fn solve(request: &ContourRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<ContourResult, SolverError> {
         let max_moves = if run.purpose == Purpose::Json { MAX_JSON_MOVES } else { MAX_MOVES };
-        let result = super::solve_with(request, &context.tool, context.machine.as_ref(), max_moves);
+        let result = super::solve_with(request, &context.tool, context.machine.as_ref(), max_moves, run.control);
         let result = if run.purpose == Purpose::Json { result.map_err(json_limit_advice)? } else { result? };
         Ok(ContourResult { tool: context.tool, machine: context.machine, result })
     }
@@ -166,8 +166,9 @@ impl LoopsRequest {
     /// Adds loops to the path with the resolved tool; at most [`MAX_JSON_MOVES`] moves.
     ///
     /// # Errors
-    /// `E_INPUT` for a bad tool or numbers, and the path errors of [`detect::loop_path_within`].
-    pub fn solve(&self, tool: Tool) -> Result<LoopsResult, SolverError> {
+    /// `E_INPUT` for a bad tool or numbers, the path errors of [`detect::loop_path_within`], and
+    /// `E_CANCELLED` once `control`'s cancel flag is set.
+    pub fn solve(&self, tool: Tool, control: Control<'_>) -> Result<LoopsResult, SolverError> {
         tool.validate("tool.")?;
         let path_request = PathLoopRequest {
             path: self.path.clone(),
@@ -178,7 +179,7 @@ impl LoopsRequest {
             corner_loop: self.corner_loop.clone(),
             tolerance: self.tolerance,
         };
-        let result = detect::loop_path_within(&path_request, MAX_JSON_MOVES)?;
+        let result = detect::loop_path_within(&path_request, MAX_JSON_MOVES, control)?;
         Ok(LoopsResult { tool, result })
     }
 }

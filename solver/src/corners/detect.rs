@@ -3,6 +3,7 @@
 //! its radial-difference measure (f), and the rotation-invariant turn-angle rule recommended as
 //! the default.
 
+use crate::capability::Control;
 use crate::error::ErrorCode;
 use serde::{Deserialize, Serialize};
 
@@ -183,7 +184,7 @@ pub struct PathLoopAnswer {
 /// `E_INPUT` for bad numbers, `E_DEGENERATE` for fewer than 3 distinct points,
 /// `E_TOO_MANY_POINTS`, `E_TOO_MANY_MOVES` (over the contour's move limit).
 pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, crate::error::SolverError> {
-    loop_path_within(request, super::request::MAX_MOVES)
+    loop_path_within(request, super::request::MAX_MOVES, Control::default())
 }
 
 /// [`loop_path`] with a smaller move budget: `E_TOO_MANY_MOVES` at `path` as soon as the looped
@@ -194,13 +195,14 @@ pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, crate::err
 pub fn loop_path_within(
     request: &PathLoopRequest,
     max_moves: usize,
+    control: Control<'_>,
 ) -> Result<PathLoopAnswer, crate::error::SolverError> {
     use super::element::ElementKind;
     use super::loops::{self, LoopShape};
     use super::pass::MAX_ARC_STEPS;
     use super::request::{self as contour_request, LoopStyle};
     use crate::error::{SolverError, Warning};
-    use crate::planar::{Containment, SegmentGrid, point_in_polygon, segments_intersect, signed_area, vec2};
+    use crate::planar::{Containment, SegmentGrid, segments_intersect, signed_area, vec2};
     use crate::validate::{finite, positive};
 
     let radius = positive("tool_radius", request.tool_radius)?;
@@ -303,6 +305,7 @@ pub fn loop_path_within(
     let mut route: Vec<Vec2> = vec![points[0]];
     let cut = super::answer::MoveKind::Cut;
     for step in 1..=n {
+        control.check()?;
         let k = step % n;
         let p = points[k];
         moves.push(PathMove { kind: cut, to: [p.x, p.y] });
@@ -318,7 +321,7 @@ pub fn loop_path_within(
         let (before, after) = ((k + n - 1) % n, k);
         let clear = |shape: &LoopShape, scratch: &mut Vec<usize>| {
             loop_moves(shape, &p).iter().all(|(a, b, _)| {
-                let outside = match point_in_polygon(b, &points) {
+                let outside = match grid.containment(b, scratch) {
                     Containment::Boundary => (b - p).norm() < 1e-12,
                     Containment::Inside => !material_inside,
                     Containment::Outside => material_inside,

@@ -14,6 +14,7 @@ use super::material::{self, Material};
 use super::pass::{self, Action, GOUGE_TOLERANCE, MAX_ARC_STEPS, PassInput, PassPlan, Stock};
 use super::prepare::list_indices;
 use super::request::{ContourRequest, CutDirection, Job, Join, LoopStyle, MAX_MOVES, Side};
+use crate::capability::Control;
 use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
@@ -103,7 +104,7 @@ pub fn solve(request: &ContourRequest, tool: &Tool) -> Result<ContourAnswer, Sol
 /// # Errors
 /// As [`solve`].
 pub fn solve_within(request: &ContourRequest, tool: &Tool, max_moves: usize) -> Result<ContourAnswer, SolverError> {
-    solve_with(request, tool, None, max_moves)
+    solve_with(request, tool, None, max_moves, Control::default())
 }
 
 /// [`solve_within`] for a request that names a machine: `machine` is the profile its
@@ -111,13 +112,15 @@ pub fn solve_within(request: &ContourRequest, tool: &Tool, max_moves: usize) -> 
 /// rule; `W_FEED_ABOVE_MACHINE_MAX` when `feed` is above its `max_feed`).
 ///
 /// # Errors
-/// As [`solve`]. `machine` is the profile the request's `machine` names, resolved by the caller
+/// As [`solve`], and `E_CANCELLED` once `control`'s cancel flag is set (checked per layer).
+/// `machine` is the profile the request's `machine` names, resolved by the caller
 /// (`capability::resolve`).
 pub fn solve_with(
     request: &ContourRequest,
     tool: &Tool,
     machine: Option<&MachineProfile>,
     max_moves: usize,
+    control: Control<'_>,
 ) -> Result<ContourAnswer, SolverError> {
     let max_moves = max_moves.min(MAX_MOVES);
     let job = request.validate(tool, machine)?;
@@ -151,6 +154,7 @@ pub fn solve_with(
     let mut shortened = false;
     let mut previous_z = job.top;
     for (index, &z) in job.layers.iter().enumerate() {
+        control.check()?;
         let tilted;
         let (layer, passes) = if index == 0 || job.tilt.is_none() {
             (&first_layer, &first_passes)

@@ -38,8 +38,8 @@ impl Capability for DeburrCapability {
         Refs { tool: Some(&request.tool), machine: request.machine.as_deref() }
     }
 
-    fn solve(request: &DeburrRequest, context: Resolved<Tool>, _run: &Run<'_>) -> Result<DeburrAnswer, SolverError> {
-        let result = super::solve_with(request, &context.tool, context.machine.as_ref())?;
+    fn solve(request: &DeburrRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<DeburrAnswer, SolverError> {
+        let result = super::solve_controlled(request, &context.tool, context.machine.as_ref(), run.control)?;
         Ok(DeburrAnswer { tool: context.tool, machine: context.machine, result })
     }
 

@@ -37,6 +37,7 @@ pub use diagnostics::{ExactConstruction, PointConstruction, construction_at, ide
 pub use program::program;
 pub use request::{CentreDistance, DeburrRequest, Direction, Edge, Hole, HoleShape, Method, Workpiece};
 
+use crate::capability::Control;
 use crate::error::ErrorCode;
 use centre::{Construction, RidgeCentre};
 use envelope::EnvelopePath;
@@ -83,7 +84,21 @@ pub fn solve_with(
     tool: &Tool,
     machine: Option<&MachineProfile>,
 ) -> Result<Deburr, SolverError> {
-    solve_centred(request, tool, machine, ExactCentres::Swept)
+    solve_centred(request, tool, machine, ExactCentres::Swept, Control::default())
+}
+
+/// [`solve_with`] that stops with `E_CANCELLED` once `control`'s cancel flag is set (checked per
+/// centre placed).
+///
+/// # Errors
+/// As [`solve_with`], and `E_CANCELLED`.
+pub fn solve_controlled(
+    request: &DeburrRequest,
+    tool: &Tool,
+    machine: Option<&MachineProfile>,
+    control: Control<'_>,
+) -> Result<Deburr, SolverError> {
+    solve_centred(request, tool, machine, ExactCentres::Swept, control)
 }
 
 /// What `method: exact` places the centres by.
@@ -104,7 +119,7 @@ enum ExactCentres {
 /// As [`solve`], and `E_EXACT_NO_SOLUTION` where a section has no band edges on the true surfaces.
 #[doc(hidden)]
 pub fn solve_single_section(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError> {
-    solve_centred(request, tool, None, ExactCentres::SingleSection)
+    solve_centred(request, tool, None, ExactCentres::SingleSection, Control::default())
 }
 
 fn solve_centred(
@@ -112,6 +127,7 @@ fn solve_centred(
     tool: &Tool,
     machine: Option<&MachineProfile>,
     exact_centres: ExactCentres,
+    control: Control<'_>,
 ) -> Result<Deburr, SolverError> {
     let job = request.validate(tool, machine)?;
     let mut warnings = checks::ridge(&job)?;
@@ -132,7 +148,9 @@ fn solve_centred(
     };
     let envelope = (job.method == Method::Exact && exact_centres == ExactCentres::Swept)
         .then(|| EnvelopePath::solve(&construction, profile));
+    control.check()?;
     let centre_at = |segment: usize, s: f64| -> Result<Vec3, SolverError> {
+        control.check()?;
         let point = profile.segments[segment].point(profile.radius, s);
         match (job.method, &envelope) {
             (Method::Tangent, _) => Ok(construction.tangent_centre(&point)),
@@ -153,6 +171,7 @@ fn solve_centred(
         swept_width::refine_for_width(&construction, profile, &mut refined, band, MAX_POINTS, centre_at)?;
     }
     let (mut targets, mut centres, max_deviation) = (refined.targets, refined.centres, refined.max_deviation);
+    control.check()?;
 
     let mut ridges: Vec<RidgeCentre> = Vec::with_capacity(targets.len());
     let mut exact_offset: Option<f64> = None;
@@ -175,6 +194,7 @@ fn solve_centred(
     warnings.extend(point_checks(&job, &targets, &ridges)?);
     let (true_width_min, true_width_max, approx) = true_widths(&construction, &job, &targets, &ridges);
     let swept = swept_width::swept_widths(&construction, profile, &targets, &centres);
+    control.check()?;
     match job.method {
         Method::Tangent => warnings.extend(approx.or_else(|| swept_approx(&job, &swept))),
         Method::Exact => warnings.extend(width_off(&job, &swept, envelope.as_ref())),

@@ -52,7 +52,7 @@ impl Capability for EngagementCapability {
     fn solve(
         request: &EngagementRequest,
         context: Resolved<Tool>,
-        _run: &Run<'_>,
+        run: &Run<'_>,
     ) -> Result<EngagementResponse, SolverError> {
         // A stored material is not resolved yet (no material library): the solver names
         // `material` when a request gives one instead of `kienzle`.
@@ -60,7 +60,7 @@ impl Capability for EngagementCapability {
             material: None,
             spindle: context.machine.as_ref().map(MachineProfile::spindle).unwrap_or_default(),
         };
-        let result = super::solve_in(request, &context.tool, context.machine.as_ref(), &physics)?;
+        let result = super::solve_in(request, &context.tool, context.machine.as_ref(), &physics, run.control)?;
         Ok(EngagementResponse {
             tool: context.tool,
             machine: context.machine,

@@ -15,6 +15,7 @@ use super::segments::{Route, Station};
 use super::stock::{Base, Region};
 use super::teeth::tooth_sum;
 use super::{MAX_CONTACT_DOTS, feed, flutes};
+use crate::capability::Control;
 use crate::error::{SolverError, Warning};
 use crate::planar::turn_angle;
 use crate::tool::{Tool, ToolKind};
@@ -48,10 +49,16 @@ fn first_cut(route: &Route, stations: &[Station], index: usize) -> bool {
     !rapid(station) && (index == 0 || stations.get(index - 1).is_some_and(rapid))
 }
 
-fn run_exact(job: &Job, route: &Route, stations: &[Station]) -> Result<Vec<Contact>, SolverError> {
+fn run_exact(
+    job: &Job,
+    route: &Route,
+    stations: &[Station],
+    control: Control<'_>,
+) -> Result<Vec<Contact>, SolverError> {
     let mut engine = ExactEngine::default();
     let mut contacts = Vec::with_capacity(stations.len());
     for (index, station) in stations.iter().enumerate() {
+        control.check()?;
         let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
         let arcs = engine.arcs(route, &job.region, job.radius, station)?;
         let mut contact = Contact::default();
@@ -75,12 +82,18 @@ fn run_exact(job: &Job, route: &Route, stations: &[Station]) -> Result<Vec<Conta
     Ok(contacts)
 }
 
-fn run_dots(job: &Job, route: &Route, stations: &[Station], cell: f64) -> (Vec<Contact>, DotsOutput) {
+fn run_dots(
+    job: &Job,
+    route: &Route,
+    stations: &[Station],
+    cell: f64,
+    control: Control<'_>,
+) -> Result<(Vec<Contact>, DotsOutput), SolverError> {
     let radius = job.radius;
     let extent =
         job.region.bbox().and_then(|stock_box| grid_extent(route, stock_box, job.region.anchor(), radius, cell));
     let Some((origin, width, height)) = extent else {
-        return (vec![Contact::default(); stations.len()], DotsOutput { grid: None, scatter: Vec::new() });
+        return Ok((vec![Contact::default(); stations.len()], DotsOutput { grid: None, scatter: Vec::new() }));
     };
     // The request check bounds width·height by MAX_GRID_DOTS.
     let mut grid = DotGrid::new(&job.region, origin, cell, width as usize, height as usize);
@@ -91,6 +104,7 @@ fn run_dots(job: &Job, route: &Route, stations: &[Station], cell: f64) -> (Vec<C
     let mut buffer = Contacts { keep_angles: job.contact_dots, ..Contacts::default() };
     let mut previous: Option<&Station> = None;
     for station in stations {
+        control.check()?;
         let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
         let mut contact = Contact::default();
         if rapid {
@@ -120,7 +134,7 @@ fn run_dots(job: &Job, route: &Route, stations: &[Station], cell: f64) -> (Vec<C
         }
         contacts.push(contact);
     }
-    (contacts, DotsOutput { grid: Some(info), scatter })
+    Ok((contacts, DotsOutput { grid: Some(info), scatter }))
 }
 
 /// "s = a–b, c–d, … (N in all)".
@@ -165,16 +179,21 @@ fn stock_description(region: &Region) -> String {
 }
 
 /// Evaluates one candidate path.
-pub(crate) fn evaluate(job: &Job, candidate: &CandidateJob, tool: &Tool) -> Result<PathEngagement, SolverError> {
+pub(crate) fn evaluate(
+    job: &Job,
+    candidate: &CandidateJob,
+    tool: &Tool,
+    control: Control<'_>,
+) -> Result<PathEngagement, SolverError> {
     let route = &candidate.route;
     let radius = job.radius;
     let stations = route.stations(job.step);
     let (contacts, dots) = match (job.engine, job.grid) {
         (Engine::Dots, Some(cell)) => {
-            let (contacts, output) = run_dots(job, route, &stations, cell);
+            let (contacts, output) = run_dots(job, route, &stations, cell, control)?;
             (contacts, Some(output))
         }
-        _ => (run_exact(job, route, &stations)?, None),
+        _ => (run_exact(job, route, &stations, control)?, None),
     };
 
     let time_flutes = job.tool_flutes;

@@ -83,6 +83,7 @@ pub use request::{
     Representative, SegmentInput, Stock, StockBitmap, StockPolygon,
 };
 
+use crate::capability::Control;
 use crate::error::SolverError;
 use crate::machine::MachineProfile;
 use crate::tool::Tool;
@@ -140,7 +141,7 @@ pub fn solve_with(
     tool: &Tool,
     machine: Option<&MachineProfile>,
 ) -> Result<EngagementAnswer, SolverError> {
-    solve_in(request, tool, machine, &Physics::default())
+    solve_in(request, tool, machine, &Physics::default(), Control::default())
 }
 
 /// [`solve_with`] with what the server resolved for the cutting physics: the Kienzle values of
@@ -150,17 +151,19 @@ pub fn solve_with(
 /// # Errors
 /// As [`solve_with`]; `E_INPUT` at `material` when the request names a material and
 /// `physics.material` is absent, at `axial_depth` when forces are asked for without it, and for
-/// bad Kienzle values or limits.
+/// bad Kienzle values or limits; `E_CANCELLED` once `control`'s cancel flag is set (checked per
+/// sample).
 pub fn solve_in(
     request: &EngagementRequest,
     tool: &Tool,
     machine: Option<&MachineProfile>,
     physics: &Physics,
+    control: Control<'_>,
 ) -> Result<EngagementAnswer, SolverError> {
     let job = request.validate(tool, machine, physics)?;
     let mut results = Vec::with_capacity(job.candidates.len());
     for candidate in &job.candidates {
-        let mut result = evaluate::evaluate(&job, candidate, tool)?;
+        let mut result = evaluate::evaluate(&job, candidate, tool, control)?;
         if let Some((blocks, warnings)) = program::blocks(&result)? {
             result.blocks = Some(blocks);
             result.warnings.extend(warnings);

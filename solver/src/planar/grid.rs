@@ -8,7 +8,7 @@
 //! length (or the caller's query radius, if larger) and doubles until the entry count stays within
 //! a budget, so long or clustered edges cannot blow up memory. Everything is deterministic.
 
-use super::{Vec2, orient, segment_segment_distance, segments_intersect};
+use super::{Containment, Vec2, orient, segment_segment_distance, segments_intersect, within_box};
 
 /// Largest cell index per axis (cells are addressed by two 31-bit numbers).
 const MAX_CELLS_PER_AXIS: f64 = 1_048_576.0;
@@ -155,6 +155,30 @@ impl SegmentGrid {
         best
     }
 
+    /// Where `point` lies relative to the closed polygon whose edges this grid indexes (as
+    /// [`super::point_in_polygon`], with the ray cast upwards): only the edges in the point's grid
+    /// column are tested, so a query costs the column's edges, not the whole polygon's.
+    /// `scratch` is reused between calls.
+    pub fn containment(&self, point: &Vec2, scratch: &mut Vec<usize>) -> Containment {
+        scratch.clear();
+        let top = Vec2::new(point.x, self.origin.y + self.cell * 2.0 * MAX_CELLS_PER_AXIS);
+        self.candidates(point, &top, 0.0, scratch);
+        let mut inside = false;
+        for &index in scratch.iter() {
+            let (a, b) = self.segments[index];
+            if orient(&a, &b, point) == 0.0 && within_box(point, &a, &b) {
+                return Containment::Boundary;
+            }
+            if (a.x > point.x) != (b.x > point.x) {
+                let y = a.y + (point.x - a.x) * (b.y - a.y) / (b.x - a.x);
+                if point.y < y {
+                    inside = !inside;
+                }
+            }
+        }
+        if inside { Containment::Inside } else { Containment::Outside }
+    }
+
     fn cell_of(&self, value: f64, origin: f64) -> u32 {
         let index = ((value - origin) / self.cell).floor();
         // Clamped into the grid; a query outside the box simply maps to its border cells, which
@@ -250,6 +274,30 @@ mod tests {
 
     fn polygon(points: &[[f64; 2]]) -> Vec<Vec2> {
         points.iter().copied().map(vec2).collect()
+    }
+
+    #[test]
+    fn containment_agrees_with_the_full_scan() {
+        use crate::planar::point_in_polygon;
+        // A star with 400 spikes and points on a fine lattice over it, some on its vertices.
+        let star: Vec<Vec2> = (0..800)
+            .map(|k| {
+                let angle = std::f64::consts::TAU * f64::from(k) / 800.0;
+                let radius = if k % 2 == 0 { 30.0 } else { 27.0 };
+                Vec2::new(radius * angle.cos(), radius * angle.sin())
+            })
+            .collect();
+        let grid = SegmentGrid::new((0..star.len()).map(|k| (star[k], star[(k + 1) % star.len()])).collect(), 0.0);
+        let mut scratch = Vec::new();
+        let mut points: Vec<Vec2> = star.iter().step_by(7).copied().collect();
+        for i in -70..=70 {
+            for j in -70..=70 {
+                points.push(Vec2::new(f64::from(i) * 0.47, f64::from(j) * 0.45));
+            }
+        }
+        for point in &points {
+            assert_eq!(grid.containment(point, &mut scratch), point_in_polygon(point, &star), "{point:?}");
+        }
     }
 
     #[test]

@@ -148,7 +148,7 @@ pub(crate) fn run_round(
         .clone()
         .into_par_iter()
         .map_init(Scratch::default, |scratch, index| {
-            if control.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+            if control.cancelled() {
                 cancelled.store(true, Ordering::Relaxed);
                 return None;
             }

@@ -57,3 +57,75 @@ async fn burst_beyond_the_solver_slots_gets_429() {
     quick["method"] = json!("tangent");
     json_with(app.post_json("/api/v1/deburr", &quick).await, 200).await;
 }
+
+/// A closed zigzag of `points` points (radii 30 and 33 alternating): every point is a protruding
+/// corner, and its edges crowd the search grid, so looping it takes long.
+fn zigzag(points: usize) -> Vec<[f64; 2]> {
+    (0..points)
+        .map(|k| {
+            let angle = std::f64::consts::TAU * k as f64 / points as f64;
+            let radius = if k % 2 == 0 { 30.0 } else { 33.0 };
+            [radius * angle.cos(), radius * angle.sin()]
+        })
+        .collect()
+}
+
+/// A circle of radius 30 through `points` points.
+fn circle(points: usize) -> Vec<[f64; 2]> {
+    (0..points)
+        .map(|k| {
+            let angle = std::f64::consts::TAU * k as f64 / points as f64;
+            [30.0 * angle.cos(), 30.0 * angle.sin()]
+        })
+        .collect()
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn timed_out_work_stops_and_frees_its_slot() {
+    // One slot, a short time limit and a queue wait far shorter than the abandoned work would take
+    // to finish: a request after two timed-out ones is served only if the work really stopped.
+    let app = TestApp::spawn_configured(|config| {
+        config.solver_slots = 1;
+        config.limits.solver_time_limit = Duration::from_millis(100);
+        config.limits.solver_queue_wait = Duration::from_secs(3);
+    })
+    .await;
+    let ball = json!({"kind": "ball", "radius": 3});
+    // Looping 199 000 crowded corners takes minutes; 400 layers of a 600-point circle over a second.
+    let slow = [
+        (
+            "/api/v1/contour/loops",
+            json!({"tool": ball, "path": zigzag(199_000), "material_side": "left", "tolerance": 1e-6}),
+        ),
+        (
+            "/api/v1/contour",
+            json!({"tool": ball, "contour": circle(600), "side": "outside",
+                   "depths": {"top": 0, "bottom": -100, "step": 0.25}, "feed": 800}),
+        ),
+    ];
+    for (path, body) in &slow {
+        for _ in 0..2 {
+            let answer = problem(app.post_json(path, body).await, 422).await;
+            assert_eq!(answer["code"], "E_TIMEOUT", "{path}: {answer}");
+        }
+        let quick = json!({"curve": {"kind": "arc", "centre": [0, 0], "radius": 10, "start_deg": 0, "end_deg": 90},
+                           "feed": 1000, "block_time_ms": 4});
+        json_with(app.post_json("/api/v1/segment", &quick).await, 200).await;
+    }
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_segmentation_far_over_the_block_limit_is_refused_before_it_starts() {
+    // About 6.5·10¹² blocks at a feed of 10⁻⁷ mm/min: refused from the curve's radii, not after
+    // a million blocks. The time limit is shorter than cutting the limit's worth of blocks takes.
+    let app = TestApp::spawn_with(Limits { solver_time_limit: Duration::from_millis(300), ..Limits::default() }).await;
+    let body = json!({"curve": {"kind": "ellipse", "centre": [0, 0], "semi_axes": [50, 20], "start_deg": 0, "end_deg": 270},
+                      "feed": 1e-7, "block_time_ms": 4});
+    for mode in ["curve", "guarantee"] {
+        let mut body = body.clone();
+        body["mode"] = json!(mode);
+        let answer = problem(app.post_json("/api/v1/segment", &body).await, 422).await;
+        assert_eq!(answer["code"], "E_TOO_MANY_BLOCKS", "{mode}: {answer}");
+        assert!(answer["detail"].as_str().unwrap().contains("at least"), "{answer}");
+    }
+}
