@@ -127,10 +127,11 @@ async fn run(args: RunArgs) -> anyhow::Result<()> {
 
 async fn serve(args: ServeArgs) -> anyhow::Result<()> {
     let config = args.config();
-    let (router, _state) = crate::app::build(&config).await?;
+    let (router, state) = crate::app::build(&config).await?;
     let listener = TcpListener::bind(args.bind).await.with_context(|| format!("binding {}", args.bind))?;
     tracing::info!(address = %listener.local_addr()?, database = %config.database.display(), "kerf listening");
-    crate::serve(listener, router, shutdown_signal()).await?;
+    crate::serve(listener, router, config.limits.clone(), shutdown_signal()).await?;
+    state.jobs.stop_all();
     tracing::info!("kerf stopped");
     Ok(())
 }

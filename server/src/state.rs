@@ -24,6 +24,13 @@ pub struct Limits {
     pub solver_time_limit: Duration,
     /// How long a request waits for a free solver slot before it gets 429.
     pub solver_queue_wait: Duration,
+    /// Longest a client may take to send a request's headers; then the connection is closed.
+    pub header_read_timeout: Duration,
+    /// Longest a request body may stall between two pieces; then the request ends with 408.
+    pub body_idle_timeout: Duration,
+    /// After a stop signal, how long open connections may finish before they are dropped (the
+    /// jobs still running are re-queued at the next start, as after a kill).
+    pub shutdown_grace: Duration,
 }
 
 impl Default for Limits {
@@ -33,6 +40,9 @@ impl Default for Limits {
             max_upload_bytes: 128 * 1024 * 1024,
             solver_time_limit: Duration::from_secs(30),
             solver_queue_wait: Duration::from_secs(5),
+            header_read_timeout: Duration::from_secs(10),
+            body_idle_timeout: Duration::from_secs(30),
+            shutdown_grace: Duration::from_secs(30),
         }
     }
 }

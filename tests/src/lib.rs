@@ -69,7 +69,7 @@ impl TestApp {
         self.base = format!("http://{}", listener.local_addr().expect("address"));
         let (stop, stopped) = oneshot::channel::<()>();
         self.stop = Some(stop);
-        self.task = Some(tokio::spawn(kerf_server::serve(listener, router, async {
+        self.task = Some(tokio::spawn(kerf_server::serve(listener, router, self.config.limits.clone(), async {
             let _ = stopped.await;
         })));
     }

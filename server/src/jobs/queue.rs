@@ -25,12 +25,23 @@ pub struct JobRunner {
     /// Wakes idle workers when a job is submitted.
     pub submitted: Notify,
     cancel_flags: Mutex<HashMap<i64, Arc<AtomicBool>>>,
+    /// Set at shutdown: workers claim nothing more.
+    stopping: AtomicBool,
 }
 
 impl JobRunner {
     /// Tells the worker running job `id`, if any, to stop.
     pub fn cancel(&self, id: i64) {
         if let Some(flag) = self.flags().get(&id) {
+            flag.store(true, Ordering::Relaxed);
+        }
+    }
+
+    /// Tells every running job to stop, at shutdown: a stopped job keeps its `running` record,
+    /// which the next start re-queues (as after a kill).
+    pub fn stop_all(&self) {
+        self.stopping.store(true, Ordering::Relaxed);
+        for flag in self.flags().values() {
             flag.store(true, Ordering::Relaxed);
         }
     }
@@ -61,7 +72,7 @@ impl JobRunner {
 }
 
 async fn work(runner: Arc<JobRunner>, db: SqlitePool, slots: Arc<Semaphore>) {
-    loop {
+    while !runner.stopping.load(Ordering::Relaxed) {
         match store::jobs::claim(&db).await {
             Ok(Some((id, job))) => run(&runner, &db, &slots, id, job).await,
             Ok(None) => {

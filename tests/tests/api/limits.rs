@@ -129,3 +129,83 @@ async fn a_segmentation_far_over_the_block_limit_is_refused_before_it_starts() {
         assert!(answer["detail"].as_str().unwrap().contains("at least"), "{answer}");
     }
 }
+
+/// Reads from `stream` until the server closes it (or 30 s pass, which fails the test).
+async fn read_until_closed(stream: &mut tokio::net::TcpStream) -> String {
+    use tokio::io::AsyncReadExt;
+    let mut received = Vec::new();
+    let closed = tokio::time::timeout(Duration::from_secs(30), async {
+        let mut buffer = [0_u8; 4096];
+        loop {
+            match stream.read(&mut buffer).await {
+                Ok(0) | Err(_) => break,
+                Ok(n) => received.extend_from_slice(&buffer[..n]),
+            }
+        }
+    })
+    .await;
+    assert!(closed.is_ok(), "the server kept the connection open; received: {}", String::from_utf8_lossy(&received));
+    String::from_utf8_lossy(&received).into_owned()
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn clients_that_stall_are_cut_off() {
+    use tokio::io::AsyncWriteExt;
+    let app = TestApp::spawn_with(Limits {
+        header_read_timeout: Duration::from_millis(500),
+        body_idle_timeout: Duration::from_millis(500),
+        ..Limits::default()
+    })
+    .await;
+    let address = app.base.trim_start_matches("http://").to_owned();
+    // Headers that never end: the connection is closed.
+    let mut stream = tokio::net::TcpStream::connect(&address).await.unwrap();
+    stream.write_all(b"GET /healthz HTTP/1.1\r\nHost: kerf\r\n").await.unwrap();
+    read_until_closed(&mut stream).await;
+    // A body that stops coming: the request ends with a client error and stores nothing.
+    let mut stream = tokio::net::TcpStream::connect(&address).await.unwrap();
+    stream
+        .write_all(b"PUT /api/v1/tools/7 HTTP/1.1\r\nHost: kerf\r\nContent-Type: application/json\r\nContent-Length: 200\r\n\r\n{\"kind\": ")
+        .await
+        .unwrap();
+    let answer = read_until_closed(&mut stream).await;
+    let status: u16 = answer.split(' ').nth(1).and_then(|s| s.parse().ok()).unwrap_or(0);
+    assert!((400..500).contains(&status), "{answer}");
+    assert!(answer.contains("application/problem+json"), "{answer}");
+    assert_eq!(app.get("/api/v1/tools/7").await.status(), 404);
+    // The service still answers.
+    assert_eq!(app.get("/healthz").await.status(), 200);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_trickling_client_does_not_keep_a_stopped_server_alive() {
+    use tokio::io::AsyncWriteExt;
+    let mut app = TestApp::spawn_with(Limits {
+        body_idle_timeout: Duration::from_secs(60),
+        shutdown_grace: Duration::from_millis(500),
+        ..Limits::default()
+    })
+    .await;
+    let address = app.base.trim_start_matches("http://").to_owned();
+    let mut stream = tokio::net::TcpStream::connect(&address).await.unwrap();
+    stream
+        .write_all(b"PUT /api/v1/tools/7 HTTP/1.1\r\nHost: kerf\r\nContent-Type: application/json\r\nContent-Length: 500\r\n\r\n{")
+        .await
+        .unwrap();
+    // One byte every 200 ms: never idle long enough for the body timeout.
+    let trickle = tokio::spawn(async move {
+        for _ in 0..400 {
+            if stream.write_all(b" ").await.is_err() {
+                break;
+            }
+            tokio::time::sleep(Duration::from_millis(200)).await;
+        }
+    });
+    tokio::time::sleep(Duration::from_millis(600)).await;
+    let stopped = tokio::time::timeout(Duration::from_secs(30), app.shutdown()).await;
+    assert!(stopped.is_ok(), "the stopped server waited for the trickling client");
+    trickle.abort();
+    // Nothing half-written: the tool was never stored.
+    app.restart().await;
+    assert_eq!(app.get("/api/v1/tools/7").await.status(), 404);
+}
