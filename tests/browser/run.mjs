@@ -127,6 +127,31 @@ const scenarios = {
     await page.click('#deburr-compute');
     await page.waitForSelector('#deburr-plot[data-refused="true"]', { timeout: 60000 });
     if (!(await page.isDisabled('#deburr-gcode'))) throw new Error('G-code button enabled without a program');
+    // The ball's way down the hole runs through its wall: drawn red, and the reason is beside the button.
+    const blocked = await page.getAttribute('#deburr-plot', 'data-collisions');
+    const reason = await page.textContent('#deburr-gcode-note');
+    if (!blocked.split(' ').includes('approach') || !/^G-code off: ./.test(reason)) throw new Error(`approach through the wall: ${blocked}, "${reason}"`);
+
+    // On the inner edge a plain ball's shank (no neck) rubs the hole wall: red dots, a warning;
+    // a lollipop with a thin neck clears it.
+    await page.fill('#deburr-form input[name="ball_diameter"]', '4');
+    await page.click('#deburr-compute');
+    await page.waitForSelector('#deburr-plot[data-refused="false"]', { timeout: 60000 });
+    const shank = await page.getAttribute('#deburr-plot', 'data-collisions');
+    const shankNote = await page.textContent('#deburr-result');
+    if (shank !== 'neck' || !/shank .* meets the wall at \d+ of \d+ path points/.test(shankNote)) throw new Error(`shank on the inner edge: "${shank}"`);
+    await page.evaluate(async () => {
+      const body = JSON.stringify({ kind: 'ball', radius: 2, neck_radius: 1, flutes: 2, name: 'lollipop' });
+      const response = await fetch('/api/v1/tools/41', { method: 'PUT', headers: { 'content-type': 'application/json' }, body });
+      if (!response.ok) throw new Error(`tool not stored: ${response.status}`);
+    });
+    await page.reload();
+    await page.waitForSelector('#deburr-form select[name="tool_choice"] option[value="41"]', { state: 'attached', timeout: 60000 });
+    await page.selectOption('#deburr-form select[name="tool_choice"]', '41');
+    await page.click('#deburr-compute');
+    await page.waitForSelector('#deburr-result:not(.stale) #deburr-plot[data-collisions=""]', { timeout: 60000 });
+    if (await page.isDisabled('#deburr-gcode')) throw new Error('G-code button off for a lollipop that clears the wall');
+    await page.selectOption('#deburr-form select[name="tool_choice"]', 'inline');
     await page.selectOption('#deburr-form select[name="edge"]', 'outer');
     await page.fill('#deburr-form input[name="ball_diameter"]', '4');
     await page.click('#deburr-compute');
@@ -382,24 +407,38 @@ const scenarios = {
     return { segments, inked, loopPixels, reliefPixels, zoomed: zoomed / fitted, objects };
   },
 
-  // The Engagement view: computes its three sample paths side by side, checks every chart is
-  // drawn, moves the cursor over a contact graph and sees the tool marked on the path, downloads
-  // the G-code of the second path, and highlights a bad flute count.
+  // The Engagement view: computes its three sample paths (one shown at a time, the others not
+  // drawn), checks every chart of the shown one is drawn, among them spindle torque and power
+  // from the form's Kienzle values, moves the cursor over a contact graph and sees the tool
+  // marked on the path, downloads the G-code of the second path, and highlights a bad flute count.
   async engagement() {
     await page.goto(`${base}/#engagement`);
-    await page.click('#engagement-compute');
+    const [request] = await Promise.all([page.waitForRequest((r) => r.url().endsWith('/api/v1/engagement')), page.click('#engagement-compute')]);
+    const sent = request.postDataJSON();
+    if (sent.kienzle?.kc11 !== 1800 || sent.kienzle?.mc !== 0.25 || sent.axial_depth !== 2) throw new Error(`no Kienzle values sent: ${JSON.stringify(sent.kienzle)}`);
     await page.waitForSelector('#engagement-result[data-state="drawn"]', { timeout: 30000 });
-    const columns = await page.$$eval('#engagement-result .candidate', (list) => list.length);
-    const states = await page.$$eval('#engagement-result canvas', (list) => list.map((c) => c.dataset.state));
-    if (states.some((s) => s !== 'drawn')) throw new Error(`charts not drawn: ${states}`);
-    const contactGraph = '#engagement-result .candidate canvas[aria-label^="Contact position"]';
+    const columns = await page.$$eval('#engagement-result [role="tabpanel"]', (list) => list.length);
+    const shown = '#engagement-result .candidate:not([hidden])';
+    await page.waitForFunction((selector) => [...document.querySelectorAll(`${selector} canvas`)].every((c) => c.dataset.state === 'drawn'), shown, { timeout: 30000 });
+    const states = await page.$$eval(`${shown} canvas`, (list) => list.map((c) => c.dataset.state));
+    const hiddenCharts = await page.$$eval('#engagement-result .candidate[hidden] canvas', (list) => list.length);
+    if (hiddenCharts !== 0) throw new Error(`${hiddenCharts} charts drawn for paths not shown`);
+    // Torque and power over the path (power on the right axis) and per flute count in the table.
+    const torqueChart = `${shown} canvas[aria-label^="Spindle torque and power"]`;
+    const torqueInked = await inkedPixels(torqueChart);
+    if (torqueInked < 2000) throw new Error(`torque chart nearly blank: ${torqueInked}`);
+    const head = await page.textContent(`${shown} table.flutes thead`);
+    if (!/torque mean \/ peak, N·m/.test(head) || !/power mean \/ peak, kW/.test(head)) throw new Error(`flute table: ${head}`);
+    const torqueCells = await page.$$eval(`${shown} table.flutes tbody tr td:nth-child(10)`, (l) => l.map((e) => e.textContent));
+    if (!torqueCells.length || !torqueCells.every((t) => /^\d+\.\d\d \/ \d+\.\d\d$/.test(t))) throw new Error(`torque cells: ${torqueCells}`);
+    const contactGraph = `${shown} canvas[aria-label^="Contact position"]`;
     const inked = await inkedPixels(contactGraph);
     if (inked < 2000) throw new Error(`contact graph nearly blank: ${inked} inked pixels`);
     const recommendation = await page.textContent('#engagement-result .recommendation');
     // A cursor on the contact graph marks the tool on the path.
     await page.locator(contactGraph).first().scrollIntoViewIfNeeded();
     const box = await (await page.$(contactGraph)).boundingBox();
-    const plan = '#engagement-result .candidate canvas.plan';
+    const plan = `${shown} canvas.plan`;
     const before = await inkedPixels(plan);
     await page.mouse.move(box.x + box.width * 0.45, box.y + box.height / 2);
     const cursor = Number(await page.getAttribute(plan, 'data-cursor'));
@@ -407,7 +446,7 @@ const scenarios = {
     const readout = await page.textContent('#engagement-result .cursor-readout');
     if (!Number.isInteger(cursor) || cursor <= 0) throw new Error(`no cursor on the path: ${cursor}`);
     if (after <= before) throw new Error(`tool circle not drawn: ${before} -> ${after} inked pixels`);
-    if (!/s = [\d.]+ mm/.test(readout)) throw new Error(`no readout: ${readout}`);
+    if (!/s = [\d.]+ mm/.test(readout) || !/torque [\d.]+ N·m, power [\d.]+ kW/.test(readout)) throw new Error(`no readout: ${readout}`);
     // The timeline slider moves the same cursor from the keyboard.
     const timeline = page.getByRole('slider', { name: /Timeline along straight/ });
     await timeline.focus();
@@ -417,10 +456,18 @@ const scenarios = {
     if (stepped !== 50) throw new Error(`timeline moved the cursor to ${stepped}`);
     // The x axis switches to time; every chart is drawn again.
     await page.selectOption('#engagement-result select[aria-label="x axis"]', 'time');
-    const redrawn = await page.$$eval('#engagement-result canvas', (list) => list.filter((c) => c.dataset.state === 'drawn').length);
+    const redrawn = await page.$$eval(`${shown} canvas`, (list) => list.filter((c) => c.dataset.state === 'drawn').length);
     if (redrawn !== states.length) throw new Error(`after switching to time: ${redrawn} of ${states.length} charts drawn`);
-    // G-code of the second path.
-    await page.selectOption('select[name="candidate"]', '1');
+    // The second path's tab draws its charts, leaves the first undrawn, and is the G-code choice.
+    await page.click('#engagement-result [role="tab"]:nth-child(2)');
+    await page.waitForFunction((selector) => {
+      const list = [...document.querySelectorAll(`${selector} canvas`)];
+      return list.length > 0 && list.every((c) => c.dataset.state === 'drawn');
+    }, shown, { timeout: 30000 });
+    const second = await page.$eval(shown, (e) => e.querySelector('h3').textContent);
+    const leftDrawn = await page.$$eval('#engagement-result .candidate[hidden] canvas', (list) => list.length);
+    if (second !== 'two bends' || leftDrawn !== 0) throw new Error(`second tab: ${second}, ${leftDrawn} charts left drawn`);
+    if (await page.inputValue('select[name="candidate"]') !== '1') throw new Error('the G-code choice did not follow the tab');
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#engagement-gcode')]);
     const { readFile } = await import('node:fs/promises');
     const program = await readFile(await download.path(), 'utf8');
@@ -432,7 +479,7 @@ const scenarios = {
     await page.waitForSelector('#engagement-messages .message.error', { timeout: 60000 });
     const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
     if (!highlighted.includes('flute_counts')) throw new Error(`field not highlighted: ${highlighted}`);
-    return { columns, charts: states.length, inked, cursor, recommendation, feeds: feeds.size, file: download.suggestedFilename() };
+    return { columns, charts: states.length, torqueInked, inked, cursor, recommendation, feeds: feeds.size, file: download.suggestedFilename() };
   },
 
   // Predict page: runs the sample raster over the dome, checks the path coloured by error (several
@@ -440,7 +487,10 @@ const scenarios = {
   // corrected program, and a G-code error with its line.
   async predict() {
     await page.goto(`${base}/#predict`);
-    await page.click('#predict-compute');
+    // The inline ball is entered by diameter (Ø6) and sent as the radius the API takes.
+    const [request] = await Promise.all([page.waitForRequest((r) => r.url().includes('/api/v1/predict')), page.click('#predict-compute')]);
+    const radius = request.postDataJSON().tool.radius;
+    if (radius !== 3) throw new Error(`Ø6 sent as radius ${radius}`);
     await page.waitForSelector('#predict-plot[data-state="drawn"]', { timeout: 30000 });
     await page.waitForSelector('#predict-histogram[data-state="drawn"]', { timeout: 5000 });
     const segments = Number(await page.getAttribute('#predict-plot', 'data-segments'));
@@ -483,6 +533,15 @@ const scenarios = {
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#predict-gcode')]);
     const program = await (await import('node:fs/promises')).readFile(await download.path(), 'utf8');
     if (!program.includes('M30') || !program.includes('O3100')) throw new Error(`corrected program: ${program.slice(0, 200)}`);
+
+    // Entered as a radius, the size is sent as it is.
+    await page.selectOption('#predict-form select[name="size_as"]', 'radius');
+    await page.fill('#predict-form input[name="ball_size"]', '2.5');
+    const [byRadius] = await Promise.all([page.waitForRequest((r) => r.url().includes('/api/v1/predict')),
+      page.waitForResponse((r) => r.url().includes('/api/v1/predict'), { timeout: 60000 }), page.click('#predict-compute')]);
+    if (byRadius.postDataJSON().tool.radius !== 2.5) throw new Error(`radius 2.5 sent as ${byRadius.postDataJSON().tool.radius}`);
+    const sizeLabel = await page.textContent('#predict-form [data-size-label]');
+    if (sizeLabel !== 'Ball radius, mm') throw new Error(`size label: ${sizeLabel}`);
 
     // A G-code error names its line and marks the program.
     await page.fill('textarea[name="program"]', 'G21 G90\nG0 X0 Y0 Z5\nG1 Z0 F500 Q1\nM30\n');
