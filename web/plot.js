@@ -553,8 +553,11 @@ export class Plot2D {
 function legendRows(g, items, left, width) {
   g.font = '13px system-ui, sans-serif';
   const placed = [];
+  // On a narrow chart the legend starts at the edge, not above the plot area.
+  if (width < 520) left = 8;
   let [x, y] = [left, 16];
-  for (const item of items.filter((i) => i.label)) {
+  for (const entry of items.filter((i) => i.label)) {
+    const item = { ...entry, label: fitText(g, entry.label, width - left - 34) };
     const size = 26 + g.measureText(item.label).width + 14;
     if (x > left && x + size > width - 8) {
       x = left;
@@ -564,6 +567,14 @@ function legendRows(g, items, left, width) {
     x += size;
   }
   return { placed, height: placed.length ? y + 8 : 4 };
+}
+
+// `text` shortened with an ellipsis to at most `room` pixels in the current font.
+function fitText(g, text, room) {
+  if (g.measureText(text).width <= room) return text;
+  let cut = text;
+  while (cut.length > 1 && g.measureText(`${cut}…`).width > room) cut = cut.slice(0, -1);
+  return `${cut}…`;
 }
 
 function drawLegendRows(g, placed) {
@@ -827,7 +838,7 @@ export function barChart(parent, label, spec, height = 230) {
     g.font = '13px system-ui, sans-serif';
     g.textAlign = 'left';
     g.textBaseline = 'bottom';
-    g.fillText(spec.title, left, legendHeight + 18);
+    g.fillText(fitText(g, spec.title, width - 16), Math.min(left, width < 520 ? 8 : left), legendHeight + 18);
     g.textAlign = 'center';
     g.fillText(spec.xLabel || '', (left + right) / 2, full - 2);
     drawLegendRows(g, placed);

@@ -1,10 +1,10 @@
 // Browser checks of the kerf page, driven by cargo test (tests/tests/api/browser.rs).
-// Usage: node run.mjs <scenario> <base-url> <screenshot.png> [job-file]
+// Usage: node run.mjs <scenario> <base-url> <screenshot.png> [job-file [second-job-file]]
 // Prints one JSON line with what it saw; exits non-zero with the reason when a check fails.
 import { readFileSync } from 'node:fs';
 import { chromium } from 'playwright-core';
 
-const [scenario, base, screenshot, jobFile] = process.argv.slice(2);
+const [scenario, base, screenshot, jobFile, secondJobFile] = process.argv.slice(2);
 const browser = await chromium.launch({
   executablePath: process.env.KERF_CHROMIUM || '/usr/bin/chromium',
   // WebGL without a GPU: SwiftShader, which Chromium needs asked for by name.
@@ -552,6 +552,63 @@ const scenarios = {
     const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
     if (!highlighted.includes('program')) throw new Error(`program not highlighted: ${highlighted}`);
     return { segments, inked, histogram, colours, worst: lines.length, programLines: program.split('\n').length };
+  },
+
+  // Job progress as the service reports it, with one job worker: a prediction long enough to
+  // watch (the example's job with a raster of 0.01 mm steps) shows a bar with the fraction it
+  // reports; jobs queued behind it show no bar at all; cancelling the prediction lets an
+  // engagement job run, whose bar has no value (engagement reports none), then the second job
+  // file's, which ends at 100 %.
+  async progress() {
+    const example = readFileSync(jobFile, 'utf8');
+    const lines = ['%', 'G21 G90 G17', 'T3 M06', 'G00 G43 H3 Z20.', 'S8000 M03', 'G00 X0 Y0 Z5.', 'G01 Z0 F1600'];
+    const k = Math.PI / 20;
+    for (let j = 0; j <= 20; j++) {
+      for (let i = 0; i <= 2000; i++) {
+        const [x, y] = [(j % 2 ? 2000 - i : i) * 0.01, j];
+        const [z, dx, dy] = [2 * Math.sin(k * x) * Math.sin(k * y), 2 * k * Math.cos(k * x) * Math.sin(k * y), 2 * k * Math.sin(k * x) * Math.cos(k * y)];
+        const l = Math.hypot(dx, dy, 1);
+        lines.push(`X${(x - 3 * dx / l).toFixed(4)} Y${(y - 3 * dy / l).toFixed(4)} Z${(z + 3 / l - 3).toFixed(4)}`);
+      }
+    }
+    lines.push('G00 Z20.', 'M30', '%');
+    const long = example.replace(/program = """[\s\S]*?"""/, `program = """\n${lines.join('\n')}\n"""`);
+    if (long === example) throw new Error('the example has no program to replace');
+    await page.goto(`${base}/#jobs`);
+    await page.setInputFiles('#job-file', { name: 'long-prediction.toml', mimeType: 'application/toml', buffer: Buffer.from(long) });
+    const running = '#job-rows tr[data-status="running"]';
+    await page.waitForSelector(`${running} td[data-progress="reported"] progress[value]`, { timeout: 120000 });
+    // Queued behind it: an engagement job (some seconds of work; engagement reports no progress
+    // of its own) and the second job file.
+    const engagement = {
+      name: 'long engagement', operations: [{
+        operation: 'engagement', tool: { kind: 'flat', radius: 5, flutes: 2 }, stock: { polygon: [[0, 0], [300, 0], [300, 40], [0, 40]] },
+        path: [[-10, 20], [310, 20]], spindle_rpm: 3000, feed_per_tooth: 0.05, flute_counts: [1, 2, 3, 4, 5, 6, 7, 8], step: 0.002,
+      }],
+    };
+    await page.setInputFiles('#job-file', { name: 'long-engagement.json', mimeType: 'application/json', buffer: Buffer.from(JSON.stringify(engagement)) });
+    await page.waitForSelector('#job-rows tr[data-status="queued"]', { timeout: 60000 });
+    await page.setInputFiles('#job-file', secondJobFile);
+    await page.waitForFunction(() => document.querySelectorAll('#job-rows tr[data-status="queued"] td[data-progress="waiting"]').length === 2, null, { timeout: 60000 });
+    const queuedBars = await page.$$eval('#job-rows tr[data-status="queued"] progress', (l) => l.length);
+    if (queuedBars !== 0) throw new Error('a queued job shows a progress bar');
+    // The bar moves with what the service reports.
+    await page.waitForFunction((row) => {
+      const bar = document.querySelector(`${row} progress`);
+      return bar && bar.value > 0 && bar.value < 1;
+    }, running, { timeout: 120000 });
+    const reported = await page.$eval(`${running} td.progress`, (e) => e.textContent.trim());
+    if (!/^\d+(\.\d)?%$/.test(reported)) throw new Error(`reported progress: ${reported}`);
+    await page.click(`${running} button:has-text("Cancel")`);
+    await page.waitForSelector('#job-rows tr[data-status="cancelled"]', { timeout: 60000 });
+    // The engagement job runs next: a bar without a value (indeterminate) and the words say so.
+    await page.waitForSelector(`${running} td[data-progress="unknown"] progress:not([value])`, { timeout: 120000 });
+    const unknown = await page.$eval(`${running} td.progress`, (e) => e.textContent.trim());
+    if (unknown !== 'engagement running (it reports no progress)') throw new Error(`unreported progress: ${unknown}`);
+    await page.waitForSelector('#job-rows tr[data-status="done"] td[data-progress="done"]', { timeout: 180000 });
+    const done = await page.$eval('#job-rows tr[data-status="done"] td.progress', (e) => ({ text: e.textContent.trim(), value: e.querySelector('progress')?.value }));
+    if (done.text !== '100%' || done.value !== 1) throw new Error(`finished job: ${JSON.stringify(done)}`);
+    return { reported, unknown };
   },
 
   // Uploads a job file on the Jobs page, waits for it to finish, opens it, and checks each

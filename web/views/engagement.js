@@ -572,7 +572,7 @@ function seriesCharts(column, result, answer, axis, onCursor) {
     const toX = (s) => (key === 's' ? s : samples[nearestIndex(samples, 's', s)].t);
     chart('Planned feed over the path', 190, {
       yLabel: 'feed F, mm/min',
-      series: [{ label: `planned feed (target chip ${plan.target_thickness} mm, ${plan.flute_count} flutes)`, colour: '#8e44ad', width: 2,
+      series: [{ label: `planned feed (chip ${plan.target_thickness} mm, ${plan.flute_count} flutes)`, colour: '#8e44ad', width: 2,
         steps: plan.blocks.filter((b) => b.feed !== undefined).map((b) => [toX(b.from_s), toX(b.to_s), b.feed]) }],
       limits: [{ value: plan.max_feed, label: `max feed ${plan.max_feed}`, colour: LIMIT }],
     });

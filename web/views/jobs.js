@@ -36,7 +36,8 @@ function progressCell(job) {
   const td = document.createElement('td');
   td.className = 'progress';
   const count = job.operations.length;
-  const percent = `${Math.round(job.progress * 100)}%`;
+  // A long job's first per cent takes a while: tenths until 10 %, so the number moves too.
+  const percent = `${(job.progress * 100).toFixed(job.progress < 0.1 ? 1 : 0)}%`;
   const bar = document.createElement('progress');
   bar.max = 1;
   if (job.status === 'queued') {
