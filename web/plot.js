@@ -1183,7 +1183,18 @@ export class Scene3D {
     const shankTall = shankLength ?? 6 * radius;
     group.add(new THREE.Mesh(upright(new THREE.CylinderGeometry(shankRadius, shankRadius, shankTall, 24), z + neckTall + shankTall / 2), steel));
     group.visible = false;
+    this.toolParts = { metal, steel, colour };
     this.toolObject = this.add('tool', group, kind === 'ball' ? 'tool (ball, neck, shank)' : 'tool', colour);
+  }
+
+  // Draws the whole tool red while it is somewhere it must not be (`hit`), else in its colours.
+  markTool(hit) {
+    if (!this.toolParts) return;
+    const { metal, steel, colour } = this.toolParts;
+    metal.color.set(hit ? '#d50000' : colour);
+    steel.color.set(hit ? '#d50000' : '#6b7780');
+    this.root.dataset.toolHit = String(Boolean(hit));
+    this.render();
   }
 
   // Puts the tool's ball centre (flat: tip) at `p`, or hides it for null.

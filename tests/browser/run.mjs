@@ -140,6 +140,13 @@ const scenarios = {
     const shank = await page.getAttribute('#deburr-plot', 'data-collisions');
     const shankNote = await page.textContent('#deburr-result');
     if (shank !== 'neck' || !/shank .* meets the wall at \d+ of \d+ path points/.test(shankNote)) throw new Error(`shank on the inner edge: "${shank}"`);
+    // Half way along the program (on the loop round the edge) the tool is red.
+    const middle = async () => page.$eval('#deburr-result input[type="range"]', (slider) => {
+      slider.value = String(Math.round(Number(slider.max) / 2));
+      slider.dispatchEvent(new Event('input'));
+    });
+    await middle();
+    if (await page.getAttribute('#deburr-plot', 'data-tool-hit') !== 'true') throw new Error('the shank in the wall is not drawn red');
     await page.evaluate(async () => {
       const body = JSON.stringify({ kind: 'ball', radius: 2, neck_radius: 1, flutes: 2, name: 'lollipop' });
       const response = await fetch('/api/v1/tools/41', { method: 'PUT', headers: { 'content-type': 'application/json' }, body });
@@ -151,6 +158,8 @@ const scenarios = {
     await page.click('#deburr-compute');
     await page.waitForSelector('#deburr-result:not(.stale) #deburr-plot[data-collisions=""]', { timeout: 60000 });
     if (await page.isDisabled('#deburr-gcode')) throw new Error('G-code button off for a lollipop that clears the wall');
+    await middle();
+    if (await page.getAttribute('#deburr-plot', 'data-tool-hit') !== 'false') throw new Error('the lollipop is drawn red');
     await page.selectOption('#deburr-form select[name="tool_choice"]', 'inline');
     await page.selectOption('#deburr-form select[name="edge"]', 'outer');
     await page.fill('#deburr-form input[name="ball_diameter"]', '4');

@@ -66,7 +66,8 @@ function along(points, step) {
 // Checks the answer's approach and retract (ball) and path (neck) against the workpiece of
 // `request`. Returns {approach: [[a, b], ...] stretches of the leads that cut the wall (machine
 // coordinates), approachLength (mm), neck: [centre, ...] where the neck or shank meets the wall,
-// checked (number of path points looked at)}, or null when the request has no usable solids.
+// checked (number of path points looked at), at(centre) → {ball, neck} for any other point}, or
+// null when the request has no usable solids.
 export function clearance(request, answer) {
   const { workpiece, hole } = request || {};
   const sizes = workpiece?.kind === 'tube' ? [workpiece.inner_radius, workpiece.outer_radius] : [workpiece?.bore_radius, workpiece?.face_distance];
@@ -127,5 +128,7 @@ export function clearance(request, answer) {
   const every = Math.max(1, Math.floor(points.length / 240));
   const looked = points.filter((_, i) => i % every === 0);
   const neckHits = looked.filter((p) => neckInWall(p.centre)).map((p) => p.centre);
-  return { approach: stretches, approachLength, neck: neckHits, checked: looked.length };
+  // For the tool at the timeline's move: whether its ball or its neck is in the wall there.
+  const at = (c) => ({ ball: ballInWall(c), neck: neckInWall(c) });
+  return { approach: stretches, approachLength, neck: neckHits, checked: looked.length, at };
 }

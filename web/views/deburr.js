@@ -190,11 +190,20 @@ export function deburrResult(container, answer, context = {}) {
   }
   scene.finish();
   scene.moveTool(points[0].centre);
+  if (found) scene.markTool(Object.values(found.at(points[0].centre)).some(Boolean));
   if (program) {
     const lift = reference === 'tip' ? tool.radius || 0 : 0;
     new Timeline(container, program, {
       label: 'Timeline',
-      onMove: (move) => scene.moveTool([move.position[0], move.position[1], move.position[2] + lift]),
+      onMove: (move) => {
+        const centre = [move.position[0], move.position[1], move.position[2] + lift];
+        scene.moveTool(centre);
+        // Red where the ball or the neck is in the wall at this move.
+        if (found) {
+          const hit = found.at(centre);
+          scene.markTool(hit.ball || hit.neck);
+        }
+      },
     });
   }
   const s = answer.summary;

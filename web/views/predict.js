@@ -368,7 +368,7 @@ export function predictResult(container, answer, { request, program } = {}) {
     ['largest correction, µm', `${microns(s.max_correction)}${s.clamped ? ` (${s.clamped} clamped)` : ''}`],
     ['no cut / no surface / outside', `${s.no_cut} / ${s.no_surface} / ${s.outside_stock}`],
     ['method', `${s.method.replace('_', ' ')}, N ${s.resolution} (${number(s.pixel_size * 1000, 1)} µm)`],
-    ['tool', `${answer.tool.number ? 'T' + answer.tool.number + ' ' : ''}ball Ø${number(2 * answer.tool.radius, 3)} mm`],
+    ['tool', `${answer.tool.number ? 'T' + answer.tool.number + ' ' : ''}ball Ø${Number((2 * answer.tool.radius).toFixed(3))} mm`],
   ].concat(answer.timings ? [['time', `${number(answer.timings.solve_ms / 1000, 2)} s (${Math.round(answer.timings.passes_per_s)} passes/s)`]] : []));
 
   const head = document.createElement('tr');
