@@ -1,7 +1,7 @@
-// kerf plot module: every plot of the page. 2-D on a plain canvas (a plan view with pan and zoom,
-// line charts along a path) and 3-D with three.js (vendored in /vendor/three, no CDN): solids
-// see-through, paths, the tool (ball, neck, shank) at a cursor, a mm grid and axes, view presets
-// and zoom to fit. Also the colour scales the plots share.
+// kerf plot module: the page's plots. 2-D on a plain canvas (plan views with pan and zoom, charts
+// along a path with a shared cursor, bar charts per category, a colour scale and a histogram) and
+// 3-D with three.js (vendored in /vendor/three, no CDN): solids see-through, paths, the tool
+// (ball, neck, shank) at a cursor, a mm grid and axes, view presets and zoom to fit.
 import * as THREE from 'three';
 import { OrbitControls } from '/vendor/three/OrbitControls.js';
 

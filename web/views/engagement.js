@@ -1,10 +1,11 @@
 // Engagement view: tool–workpiece contact along one or several candidate paths (api.md,
-// Engagement; engagement.md §3). A form for the tool, stock, paths, cutting conditions and
-// limits; per path the plan view coloured by engagement, the contact-position graph, a_e, the
-// summed chip thickness per flute count with the threshold, representative values and time per
-// k with the recommended k highlighted, and the feed plan; a cursor on any chart marks the tool
-// on the path. The result renderer is shared with the Jobs view.
-import { api } from '/api.js';
+// Engagement; engagement.md §3). A form for the tool, stock, paths, cutting conditions, limits and
+// the work material's Kienzle values; per path (one shown at a time) the plan view coloured by
+// engagement, the contact-position graph, a_e, the summed chip thickness per flute count with
+// the threshold, spindle torque and power with the machine's limits, the feed plan, and the
+// representative values and time per k with the recommended k highlighted (the charts are
+// plot.js's); a cursor on any chart marks the tool on the path. The result renderer is shared
+// with the Jobs view.
 import { PathChart, barChart } from '/plot.js';
 import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
 
