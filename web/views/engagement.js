@@ -6,6 +6,7 @@
 // representative values and time per k with the recommended k highlighted (the charts are
 // plot.js's); a cursor on any chart marks the tool on the path. The result renderer is shared
 // with the Jobs view.
+import { api } from '/api.js';
 import { PathChart, barChart } from '/plot.js';
 import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
 
