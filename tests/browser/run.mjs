@@ -371,7 +371,7 @@ const scenarios = {
 
     // The last layer, then a corner zoomed in from the table.
     await page.selectOption('#contour-result select[name="layer"]', '2');
-    await page.waitForSelector('#contour-plot[data-layer="2"][data-state="drawn"]', { timeout: 5000 });
+    await page.waitForSelector('#contour-plot[data-layer="2"][data-state="drawn"]', { timeout: 60000 });
     await page.click('#contour-result table.corners tbody tr[data-corner="3"]');
     const zoomed = Number(await page.getAttribute('#contour-plot', 'data-scale'));
     const zoomedLoop = await colouredPixels('#contour-plot', [224, 112, 0]);
@@ -501,7 +501,7 @@ const scenarios = {
     const radius = request.postDataJSON().tool.radius;
     if (radius !== 3) throw new Error(`Ø6 sent as radius ${radius}`);
     await page.waitForSelector('#predict-plot[data-state="drawn"]', { timeout: 30000 });
-    await page.waitForSelector('#predict-histogram[data-state="drawn"]', { timeout: 5000 });
+    await page.waitForSelector('#predict-histogram[data-state="drawn"]', { timeout: 60000 });
     const segments = Number(await page.getAttribute('#predict-plot', 'data-segments'));
     const inked = await inkedPixels('#predict-plot canvas');
     const histogram = await inkedPixels('#predict-histogram');
