@@ -592,7 +592,7 @@ const scenarios = {
     const engagement = {
       name: 'long engagement', operations: [{
         operation: 'engagement', tool: { kind: 'flat', radius: 5, flutes: 2 }, stock: { polygon: [[0, 0], [300, 0], [300, 40], [0, 40]] },
-        path: [[-10, 20], [310, 20]], spindle_rpm: 3000, feed_per_tooth: 0.05, flute_counts: [1, 2, 3, 4, 5, 6, 7, 8], step: 0.002,
+        path: [[-10, 20], [310, 20]], spindle_rpm: 3000, feed_per_tooth: 0.05, flute_counts: Array.from({ length: 16 }, (_, k) => k + 1), step: 0.002,
       }],
     };
     await page.setInputFiles('#job-file', { name: 'long-engagement.json', mimeType: 'application/json', buffer: Buffer.from(JSON.stringify(engagement)) });
