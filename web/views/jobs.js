@@ -25,8 +25,8 @@ function cell(text) {
 }
 
 // Operations whose solver reports its progress while it runs (the service's job runner passes it
-// on); the others only move the job's progress when they finish. Not in the API yet: see the
-// README's page section.
+// on); the others move the job's progress only when they finish. The API does not say which
+// operations report, so this mirrors the service (predict only) and must follow it.
 const REPORTS_PROGRESS = new Set(['predict']);
 
 // The progress cell: what the service reports, no more. A running operation that reports no
