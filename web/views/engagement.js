@@ -7,7 +7,7 @@
 // plot.js's); a cursor on any chart marks the tool on the path. The result renderer is shared
 // with the Jobs view.
 import { api } from '/api.js';
-import { PathChart, barChart } from '/plot.js';
+import { PathChart, ToolPlan, barChart } from '/plot.js';
 import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
@@ -233,25 +233,6 @@ function engagementColour(deg) {
   return `rgb(${c[0]},${c[1]},${c[2]})`;
 }
 
-// Sizes a canvas to its box and returns its 2-D context in CSS pixels.
-function prepare(canvas, height) {
-  const ratio = window.devicePixelRatio || 1;
-  const width = Math.max(280, canvas.clientWidth || canvas.parentElement?.clientWidth || 600);
-  canvas.style.height = `${height}px`;
-  canvas.width = Math.round(width * ratio);
-  canvas.height = Math.round(height * ratio);
-  const ctx = canvas.getContext('2d');
-  ctx.setTransform(ratio, 0, 0, ratio, 0, 0);
-  ctx.fillStyle = '#fff';
-  ctx.fillRect(0, 0, width, height);
-  return { ctx, width, height, ratio };
-}
-
-function finish(canvas, view) {
-  view.image = view.ctx.getImageData(0, 0, canvas.width, canvas.height);
-  canvas.dataset.state = 'drawn';
-}
-
 // Index of the sample nearest to `v` on the axis `key` (sorted ascending).
 function nearestIndex(samples, key, v) {
   let low = 0;
@@ -264,7 +245,7 @@ function nearestIndex(samples, key, v) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Plan view: stock, path coloured by engagement, tool circle at the cursor
+// Plan view: what plot.js's ToolPlan draws from an answer (stock, path coloured by engagement)
 
 function base64Bits(text) {
   const binary = atob(text.replace(/\s/g, ''));
@@ -308,173 +289,31 @@ function stockRings(stock) {
   return [];
 }
 
-class PlanView {
-  constructor(canvas, result, answer) {
-    this.canvas = canvas;
-    this.result = result;
-    this.stock = answer.stock;
-    this.radius = answer.tool?.radius ?? 0;
-    const low = [Infinity, Infinity];
-    const high = [-Infinity, -Infinity];
-    const include = (p) => {
-      low[0] = Math.min(low[0], p[0]); low[1] = Math.min(low[1], p[1]);
-      high[0] = Math.max(high[0], p[0]); high[1] = Math.max(high[1], p[1]);
-    };
-    stockRings(this.stock).flat().forEach(include);
-    const bitmap = this.stock?.bitmap;
-    if (bitmap) {
-      include(bitmap.origin);
-      include([bitmap.origin[0] + bitmap.width * bitmap.cell, bitmap.origin[1] + bitmap.height * bitmap.cell]);
-    }
-    for (const s of result.samples) include(s.position);
-    this.low = [low[0] - this.radius, low[1] - this.radius];
-    this.high = [high[0] + this.radius, high[1] + this.radius];
+// The plan view's drawing (plot.js's ToolPlan) from an answer: the stock's rings, its bitmap's
+// material cells, earlier cuts as swept strokes, and the path coloured by the engaged angle.
+function planSpec(result, answer) {
+  const stock = answer.stock;
+  const bitmap = stock?.bitmap;
+  let cells = null;
+  if (bitmap && bitmap.width * bitmap.height <= 4e6) {
+    const bits = base64Bits(bitmap.data);
+    cells = { origin: bitmap.origin, size: bitmap.cell, width: bitmap.width, height: bitmap.height, filled: (i, j) => {
+      const bit = j * bitmap.width + i;
+      return Boolean(bits[bit >> 3] & (0x80 >> (bit & 7)));
+    } };
   }
-
-  draw() {
-    const width = Math.max(280, this.canvas.clientWidth || 600);
-    const spanX = this.high[0] - this.low[0] || 1;
-    const spanY = this.high[1] - this.low[1] || 1;
-    const height = Math.max(180, Math.min(520, width * spanY / spanX + 20));
-    const view = prepare(this.canvas, height);
-    const { ctx } = view;
-    const pad = 10;
-    const scale = Math.min((view.width - 2 * pad) / spanX, (view.height - 2 * pad - 16) / spanY);
-    const ox = pad + ((view.width - 2 * pad) - spanX * scale) / 2;
-    const oy = view.height - pad - ((view.height - 2 * pad - 16) - spanY * scale) / 2;
-    this.map = (p) => [ox + (p[0] - this.low[0]) * scale, oy - (p[1] - this.low[1]) * scale];
-    this.scale = scale;
-    // Stock: rings under even-odd, or the bitmap's material cells.
-    ctx.fillStyle = '#d9dfe5';
-    ctx.strokeStyle = '#5b6670';
-    ctx.lineWidth = 1;
-    const rings = stockRings(this.stock);
-    if (rings.length) {
-      ctx.beginPath();
-      for (const ring of rings) {
-        ring.forEach((p, i) => { const [x, y] = this.map(p); if (i) ctx.lineTo(x, y); else ctx.moveTo(x, y); });
-        ctx.closePath();
-      }
-      ctx.fill('evenodd');
-      ctx.stroke();
-    }
-    const bitmap = this.stock?.bitmap;
-    if (bitmap && bitmap.width * bitmap.height <= 4e6) {
-      const bits = base64Bits(bitmap.data);
-      for (let j = 0; j < bitmap.height; j++) {
-        for (let i = 0; i < bitmap.width; i++) {
-          const bit = j * bitmap.width + i;
-          if (bits[bit >> 3] & (0x80 >> (bit & 7))) {
-            const [x, y] = this.map([bitmap.origin[0] + i * bitmap.cell, bitmap.origin[1] + (j + 1) * bitmap.cell]);
-            ctx.fillRect(x, y, Math.max(1, bitmap.cell * scale), Math.max(1, bitmap.cell * scale));
-          }
-        }
-      }
-    }
-    // Material already removed by earlier cuts.
-    for (const cut of this.stock?.previous_cuts || []) {
-      const points = pathPolyline(cut.path);
-      ctx.save();
-      ctx.strokeStyle = '#fff';
-      ctx.lineCap = 'round';
-      ctx.lineJoin = 'round';
-      ctx.lineWidth = Math.max(1, 2 * cut.radius * scale);
-      ctx.beginPath();
-      points.forEach((p, i) => { const [x, y] = this.map(p); if (i) ctx.lineTo(x, y); else ctx.moveTo(x, y); });
-      ctx.stroke();
-      ctx.restore();
-    }
-    // The path, each stretch coloured by the engaged angle at its end.
-    const samples = this.result.samples;
-    ctx.lineWidth = 3;
-    ctx.lineCap = 'round';
-    for (let i = 1; i < samples.length; i++) {
-      const rapid = (samples[i].flags || []).includes('rapid');
-      ctx.strokeStyle = rapid ? '#9aa5ae' : engagementColour(samples[i].engaged_deg);
-      ctx.setLineDash(rapid ? [4, 4] : []);
-      const [x0, y0] = this.map(samples[i - 1].position);
-      const [x1, y1] = this.map(samples[i].position);
-      ctx.beginPath();
-      ctx.moveTo(x0, y0);
-      ctx.lineTo(x1, y1);
-      ctx.stroke();
-    }
-    ctx.setLineDash([]);
-    if (samples.length) {
-      const [x, y] = this.map(samples[0].position);
-      ctx.fillStyle = '#1d2327';
-      ctx.beginPath();
-      ctx.arc(x, y, 4, 0, 2 * Math.PI);
-      ctx.fill();
-    }
-    // Legend of the colour scale.
-    ctx.font = '12px system-ui, sans-serif';
-    ctx.textBaseline = 'top';
-    let lx = pad;
-    for (const [deg, text] of [[0, 'no contact'], [45, '45°'], [90, '90°'], [135, '135°'], [180, '≥180° engaged']]) {
-      ctx.fillStyle = engagementColour(deg);
-      ctx.fillRect(lx, 4, 14, 10);
-      ctx.fillStyle = '#1d2327';
-      ctx.fillText(text, lx + 17, 3);
-      lx += ctx.measureText(text).width + 30;
-    }
-    this.view = view;
-    this.view.box = { top: 0, bottom: view.height };
-    finish(this.canvas, this.view);
-  }
-
-  // The tool circle at sample `index`, its engaged arcs in red and the travel direction.
-  cursor(index) {
-    const { ctx } = this.view;
-    ctx.putImageData(this.view.image, 0, 0);
-    if (index === undefined) {
-      delete this.canvas.dataset.cursor;
-      return;
-    }
-    this.canvas.dataset.cursor = String(index);
-    const sample = this.result.samples[index];
-    const [cx, cy] = this.map(sample.position);
-    const r = this.radius * this.scale;
-    const heading = sample.heading_deg * Math.PI / 180;
-    const t = [Math.cos(heading), Math.sin(heading)];
-    const right = [t[1], -t[0]];
-    // Tool angle θ → global angle γ = θ + angle of the right-hand normal; canvas y is down.
-    const rightAngle = Math.atan2(right[1], right[0]);
-    ctx.save();
-    ctx.strokeStyle = '#1d2327';
-    ctx.lineWidth = 1.5;
-    ctx.beginPath();
-    ctx.arc(cx, cy, r, 0, 2 * Math.PI);
-    ctx.stroke();
-    ctx.strokeStyle = '#d0021b';
-    ctx.lineWidth = 5;
-    for (const [from, to] of sample.arcs) {
-      ctx.beginPath();
-      ctx.arc(cx, cy, r, -(rightAngle + from * Math.PI / 180), -(rightAngle + to * Math.PI / 180), true);
-      ctx.stroke();
-    }
-    ctx.strokeStyle = '#1d2327';
-    ctx.lineWidth = 2;
-    ctx.beginPath();
-    ctx.moveTo(cx, cy);
-    ctx.lineTo(cx + t[0] * r * 1.3, cy - t[1] * r * 1.3);
-    ctx.stroke();
-    ctx.restore();
-  }
-
-  nearest(event) {
-    const rect = this.canvas.getBoundingClientRect();
-    const mx = event.clientX - rect.left;
-    const my = event.clientY - rect.top;
-    let best = 0;
-    let bestDistance = Infinity;
-    this.result.samples.forEach((s, i) => {
-      const [x, y] = this.map(s.position);
-      const d = (x - mx) ** 2 + (y - my) ** 2;
-      if (d < bestDistance) { bestDistance = d; best = i; }
-    });
-    return bestDistance < 400 ? best : undefined;
-  }
+  const samples = result.samples;
+  return {
+    rings: stockRings(stock),
+    cells,
+    removed: (stock?.previous_cuts || []).map((cut) => ({ points: pathPolyline(cut.path), width: 2 * cut.radius })),
+    path: samples.map((s, i) => {
+      const rapid = (s.flags || []).includes('rapid');
+      return { at: s.position, colour: i && rapid ? '#9aa5ae' : engagementColour(s.engaged_deg), dashed: rapid, heading: s.heading_deg, arcs: s.arcs };
+    }),
+    radius: answer.tool?.radius ?? 0,
+    legend: [[0, 'no contact'], [45, '45°'], [90, '90°'], [135, '135°'], [180, '≥180° engaged']].map(([deg, label]) => ({ label, colour: engagementColour(deg) })),
+  };
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -689,8 +528,7 @@ function renderColumn(column, result, answer, axis) {
   const info = document.createElement('p');
   info.className = 'hint cursor-readout';
   column.append(heading, verdict, summary, plan, info);
-  const planView = new PlanView(plan, result, answer);
-  planView.draw();
+  const planView = new ToolPlan(plan, planSpec(result, answer));
   let series;
   // The timeline along the samples: the same cursor from the keyboard (arrow keys step).
   const slider = document.createElement('input');
