@@ -587,12 +587,12 @@ const scenarios = {
     await page.setInputFiles('#job-file', { name: 'long-prediction.toml', mimeType: 'application/toml', buffer: Buffer.from(long) });
     const running = '#job-rows tr[data-status="running"]';
     await page.waitForSelector(`${running} td[data-progress="reported"] progress[value]`, { timeout: 120000 });
-    // Queued behind it: an engagement job (some seconds of work; engagement reports no progress
-    // of its own) and the second job file.
+    // Queued behind it: an engagement job (some seconds of work on a 2 µm dot grid, with a small
+    // answer; engagement reports no progress of its own) and the second job file.
     const engagement = {
       name: 'long engagement', operations: [{
-        operation: 'engagement', tool: { kind: 'flat', radius: 5, flutes: 2 }, stock: { polygon: [[0, 0], [300, 0], [300, 40], [0, 40]] },
-        path: [[-10, 20], [310, 20]], spindle_rpm: 3000, feed_per_tooth: 0.05, flute_counts: Array.from({ length: 16 }, (_, k) => k + 1), step: 0.002,
+        operation: 'engagement', tool: { kind: 'flat', radius: 5, flutes: 2 }, stock: { polygon: [[0, 0], [60, 0], [60, 40], [0, 40]] },
+        path: [[-10, 20], [70, 20]], spindle_rpm: 3000, feed_per_tooth: 0.05, flute_counts: [2], engine: 'dots', grid: 0.002, step: 0.25,
       }],
     };
     await page.setInputFiles('#job-file', { name: 'long-engagement.json', mimeType: 'application/json', buffer: Buffer.from(JSON.stringify(engagement)) });
