@@ -1,7 +1,7 @@
-// kerf plot module: every plot of the page. 2-D on a plain canvas (a plan view with pan and zoom,
-// line charts along a path) and 3-D with three.js (vendored in /vendor/three, no CDN): solids
-// see-through, paths, the tool (ball, neck, shank) at a cursor, a mm grid and axes, view presets
-// and zoom to fit. Also the colour scales the plots share.
+// kerf plot module: the page's plots. 2-D on a plain canvas (plan views with pan and zoom, charts
+// along a path with a shared cursor, bar charts per category, a colour scale and a histogram) and
+// 3-D with three.js (vendored in /vendor/three, no CDN): solids see-through, paths, the tool
+// (ball, neck, shank) at a cursor, a mm grid and axes, view presets and zoom to fit.
 import * as THREE from 'three';
 import { OrbitControls } from '/vendor/three/OrbitControls.js';
 
@@ -310,7 +310,7 @@ function niceStep(raw) {
 function formatTick(v) {
   const a = Math.abs(v);
   if (a === 0) return '0';
-  if (a >= 1000 || a < 0.001) return v.toExponential(1);
+  if (a >= 1e6 || a < 0.001) return v.toExponential(1);
   return String(Number(v.toPrecision(4)));
 }
 
@@ -546,6 +546,481 @@ export class Plot2D {
   }
 }
 
+// ---------------------------------------------------------------- a tool on a plan
+
+// A plan view (XY, equal scales, fitted) of a tool moving over stock: `rings` filled under the
+// even-odd rule, `cells` (a raster: {origin, size, width, height, filled(i, j)}) filled,
+// `removed` strokes ({points, width} in mm) cleared to white, the `path` ([{at, colour, dashed,
+// heading, arcs}] per point, each stretch in its end point's colour) and a colour `legend`.
+// `cursor(i)` draws the tool circle of `radius` at path point i with its engaged `arcs` (tool
+// angle: 0° right of travel, 90° ahead) in red and the travel direction; `nearest(event)` finds
+// the path point under the pointer.
+export class ToolPlan {
+  constructor(canvas, spec) {
+    this.canvas = canvas;
+    this.spec = spec;
+    const low = [Infinity, Infinity];
+    const high = [-Infinity, -Infinity];
+    const include = (p) => {
+      low[0] = Math.min(low[0], p[0]); low[1] = Math.min(low[1], p[1]);
+      high[0] = Math.max(high[0], p[0]); high[1] = Math.max(high[1], p[1]);
+    };
+    spec.rings.flat().forEach(include);
+    if (spec.cells) {
+      include(spec.cells.origin);
+      include([spec.cells.origin[0] + spec.cells.width * spec.cells.size, spec.cells.origin[1] + spec.cells.height * spec.cells.size]);
+    }
+    spec.path.forEach((p) => include(p.at));
+    this.low = [low[0] - spec.radius, low[1] - spec.radius];
+    this.high = [high[0] + spec.radius, high[1] + spec.radius];
+    this.draw();
+  }
+
+  draw() {
+    const { rings, cells, removed, path, legend } = this.spec;
+    const spanX = this.high[0] - this.low[0] || 1;
+    const spanY = this.high[1] - this.low[1] || 1;
+    const wanted = Math.max(280, this.canvas.clientWidth || 600);
+    this.canvas.style.height = `${Math.max(180, Math.min(520, wanted * spanY / spanX + 20))}px`;
+    const [g, width, height] = sizeCanvas(this.canvas);
+    const pad = 10;
+    const scale = Math.min((width - 2 * pad) / spanX, (height - 2 * pad - 16) / spanY);
+    const ox = pad + ((width - 2 * pad) - spanX * scale) / 2;
+    const oy = height - pad - ((height - 2 * pad - 16) - spanY * scale) / 2;
+    this.map = (p) => [ox + (p[0] - this.low[0]) * scale, oy - (p[1] - this.low[1]) * scale];
+    this.scale = scale;
+    // Stock: rings under even-odd, or the raster's material cells.
+    g.fillStyle = '#d9dfe5';
+    g.strokeStyle = '#5b6670';
+    g.lineWidth = 1;
+    if (rings.length) {
+      g.beginPath();
+      for (const ring of rings) {
+        ring.forEach((p, i) => { const [x, y] = this.map(p); if (i) g.lineTo(x, y); else g.moveTo(x, y); });
+        g.closePath();
+      }
+      g.fill('evenodd');
+      g.stroke();
+    }
+    if (cells) {
+      const size = Math.max(1, cells.size * scale);
+      for (let j = 0; j < cells.height; j++) {
+        for (let i = 0; i < cells.width; i++) {
+          if (!cells.filled(i, j)) continue;
+          const [x, y] = this.map([cells.origin[0] + i * cells.size, cells.origin[1] + (j + 1) * cells.size]);
+          g.fillRect(x, y, size, size);
+        }
+      }
+    }
+    // Material already removed (earlier cuts).
+    g.save();
+    g.strokeStyle = '#fff';
+    g.lineCap = 'round';
+    g.lineJoin = 'round';
+    for (const cut of removed) {
+      g.lineWidth = Math.max(1, cut.width * scale);
+      g.beginPath();
+      cut.points.forEach((p, i) => { const [x, y] = this.map(p); if (i) g.lineTo(x, y); else g.moveTo(x, y); });
+      g.stroke();
+    }
+    g.restore();
+    // The path, each stretch in its end point's colour, and its start.
+    g.lineWidth = 3;
+    g.lineCap = 'round';
+    for (let i = 1; i < path.length; i++) {
+      g.strokeStyle = path[i].colour;
+      g.setLineDash(path[i].dashed ? [4, 4] : []);
+      const [x0, y0] = this.map(path[i - 1].at);
+      const [x1, y1] = this.map(path[i].at);
+      g.beginPath();
+      g.moveTo(x0, y0);
+      g.lineTo(x1, y1);
+      g.stroke();
+    }
+    g.setLineDash([]);
+    if (path.length) {
+      const [x, y] = this.map(path[0].at);
+      g.fillStyle = '#1d2327';
+      g.beginPath();
+      g.arc(x, y, 4, 0, 2 * Math.PI);
+      g.fill();
+    }
+    // The colour legend as swatches along the top.
+    g.font = '12px system-ui, sans-serif';
+    g.textBaseline = 'top';
+    let lx = pad;
+    for (const item of legend || []) {
+      g.fillStyle = item.colour;
+      g.fillRect(lx, 4, 14, 10);
+      g.fillStyle = '#1d2327';
+      g.fillText(item.label, lx + 17, 3);
+      lx += g.measureText(item.label).width + 30;
+    }
+    this.image = g.getImageData(0, 0, this.canvas.width, this.canvas.height);
+    this.canvas.dataset.state = 'drawn';
+  }
+
+  // The tool circle at path point `index` (undefined: none), its engaged arcs in red and the
+  // travel direction.
+  cursor(index) {
+    const g = this.canvas.getContext('2d');
+    g.putImageData(this.image, 0, 0);
+    if (index === undefined) {
+      delete this.canvas.dataset.cursor;
+      return;
+    }
+    const ratio = window.devicePixelRatio || 1;
+    g.setTransform(ratio, 0, 0, ratio, 0, 0);
+    this.canvas.dataset.cursor = String(index);
+    const point = this.spec.path[index];
+    const [cx, cy] = this.map(point.at);
+    const r = this.spec.radius * this.scale;
+    const heading = point.heading * Math.PI / 180;
+    const t = [Math.cos(heading), Math.sin(heading)];
+    // Tool angle θ → global angle θ + the angle of the right-hand normal; canvas y is down.
+    const rightAngle = Math.atan2(-t[0], t[1]);
+    g.strokeStyle = '#1d2327';
+    g.lineWidth = 1.5;
+    g.beginPath();
+    g.arc(cx, cy, r, 0, 2 * Math.PI);
+    g.stroke();
+    g.strokeStyle = '#d0021b';
+    g.lineWidth = 5;
+    for (const [from, to] of point.arcs || []) {
+      g.beginPath();
+      g.arc(cx, cy, r, -(rightAngle + from * Math.PI / 180), -(rightAngle + to * Math.PI / 180), true);
+      g.stroke();
+    }
+    g.strokeStyle = '#1d2327';
+    g.lineWidth = 2;
+    g.beginPath();
+    g.moveTo(cx, cy);
+    g.lineTo(cx + t[0] * r * 1.3, cy - t[1] * r * 1.3);
+    g.stroke();
+  }
+
+  nearest(event) {
+    const box = this.canvas.getBoundingClientRect();
+    const [mx, my] = [event.clientX - box.left, event.clientY - box.top];
+    let best;
+    let bestDistance = 400;
+    this.spec.path.forEach((p, i) => {
+      const [x, y] = this.map(p.at);
+      const d = (x - mx) ** 2 + (y - my) ** 2;
+      if (d < bestDistance) { bestDistance = d; best = i; }
+    });
+    return best;
+  }
+}
+
+// ---------------------------------------------------------------- charts along a path
+
+// Legend entries laid out in rows that wrap at `width` (nothing is clipped); returns the rows as
+// [{x, y, item}] and the height they take.
+function legendRows(g, items, left, width) {
+  g.font = '13px system-ui, sans-serif';
+  const placed = [];
+  // On a narrow chart the legend starts at the edge, not above the plot area.
+  if (width < 520) left = 8;
+  let [x, y] = [left, 16];
+  for (const entry of items.filter((i) => i.label)) {
+    const item = { ...entry, label: fitText(g, entry.label, width - left - 34) };
+    const size = 26 + g.measureText(item.label).width + 14;
+    if (x > left && x + size > width - 8) {
+      x = left;
+      y += 18;
+    }
+    placed.push({ x, y, item });
+    x += size;
+  }
+  return { placed, height: placed.length ? y + 8 : 4 };
+}
+
+// `text` shortened with an ellipsis to at most `room` pixels in the current font.
+function fitText(g, text, room) {
+  if (g.measureText(text).width <= room) return text;
+  let cut = text;
+  while (cut.length > 1 && g.measureText(`${cut}…`).width > room) cut = cut.slice(0, -1);
+  return `${cut}…`;
+}
+
+function drawLegendRows(g, placed) {
+  g.font = '13px system-ui, sans-serif';
+  g.textAlign = 'left';
+  g.textBaseline = 'alphabetic';
+  for (const { x, y, item } of placed) {
+    g.strokeStyle = item.colour;
+    g.lineWidth = item.swatch === 'bar' ? 8 : 3;
+    g.setLineDash(item.dash || []);
+    g.beginPath();
+    g.moveTo(x, y - 4);
+    g.lineTo(x + 20, y - 4);
+    g.stroke();
+    g.setLineDash([]);
+    g.fillStyle = '#1d2327';
+    g.fillText(item.label, x + 26, y);
+  }
+}
+
+// Ticks of a nice step over [low, high].
+function ticks(low, high, count) {
+  const step = niceStep((high - low) / count || 1);
+  const out = [];
+  for (let v = Math.ceil(low / step - 1e-9) * step; v <= high + step * 1e-9; v += step) out.push(Number(v.toPrecision(12)));
+  return out;
+}
+
+// A chart of quantities along a path: x is the path length or the time, y one quantity, and an
+// optional second y axis on the right for a quantity proportional to the first (`y2: {label,
+// factor}`: y2 = y·factor, e.g. spindle power beside torque). A legend that wraps, dashed limit
+// lines with their labels, and a cursor: `onHover(x)` hears the x under the pointer (undefined
+// when it leaves), `cursor(x)` draws the vertical line. Redraws itself when its width changes.
+//
+// spec: {x: [x0, x1], xLabel, yLabel, y: [low, high] (optional; else from the data, from 0),
+//   series: [{label, colour, width, dash, points: [[x, y], ...]} or {…, steps: [[x0, x1, y], ...]}],
+//   limits: [{value, label, colour}], paint(g, map) for anything else (map: {x(v), y(v)}),
+//   legend: extra legend-only items [{label, colour, dash}]}
+export class PathChart {
+  constructor(parent, { label, height = 240 }) {
+    this.canvas = document.createElement('canvas');
+    this.canvas.className = 'chart';
+    this.canvas.setAttribute('aria-label', label);
+    this.canvas.style.height = `${height}px`;
+    parent.append(this.canvas);
+    this.spec = null;
+    this.at = undefined;
+    this.canvas.addEventListener('pointermove', (event) => {
+      if (!this.box || !this.hover) return;
+      const x = event.clientX - this.canvas.getBoundingClientRect().left;
+      if (x < this.box.left || x > this.box.right) return;
+      const [x0, x1] = this.spec.x;
+      this.hover(x0 + (x - this.box.left) / (this.box.right - this.box.left) * (x1 - x0));
+    });
+    this.canvas.addEventListener('pointerleave', () => this.hover?.(undefined));
+    let width = 0;
+    new ResizeObserver(() => {
+      if (!this.spec || !this.canvas.clientWidth || Math.abs(this.canvas.clientWidth - width) < 2) return;
+      width = this.canvas.clientWidth;
+      this.draw(this.spec);
+    }).observe(this.canvas);
+  }
+
+  onHover(callback) {
+    this.hover = callback;
+  }
+
+  draw(spec) {
+    this.spec = spec;
+    const canvas = this.canvas;
+    if (!canvas.clientWidth) return;
+    const [g, width, height] = sizeCanvas(canvas);
+    const series = spec.series || [];
+    const ys = series.flatMap((s) => (s.steps ? s.steps.map((b) => b[2]) : s.points.map((p) => p[1]))).filter(Number.isFinite);
+    const limits = (spec.limits || []).filter((l) => Number.isFinite(l.value));
+    let [low, high] = spec.y || [Math.min(0, ...ys), Math.max(...ys, ...limits.map((l) => l.value))];
+    if (!Number.isFinite(high) || high <= low) high = low + 1;
+    high += (high - low) * 0.06;
+    const legendItems = [...series, ...limits.filter((l) => l.label).map((l) => ({ label: l.label, colour: l.colour, dash: [6, 4] })), ...(spec.legend || [])];
+    const left = 62;
+    const right = width - (spec.y2 ? 62 : 14);
+    const { placed, height: legendHeight } = legendRows(g, legendItems, left, width);
+    const top = legendHeight + 8;
+    const bottom = height - 40;
+    const [x0, x1] = spec.x[1] > spec.x[0] ? spec.x : [spec.x[0], spec.x[0] + 1];
+    const map = {
+      x: (v) => left + (v - x0) / (x1 - x0) * (right - left),
+      y: (v) => bottom - (v - low) / (high - low) * (bottom - top),
+    };
+    this.box = { left, right, top, bottom };
+    this.map = map;
+    // Grid, ticks and axis titles.
+    g.font = '12px system-ui, sans-serif';
+    g.lineWidth = 1;
+    g.textBaseline = 'middle';
+    for (const v of ticks(low, high, 5)) {
+      g.strokeStyle = '#e3e7eb';
+      g.beginPath(); g.moveTo(left, map.y(v)); g.lineTo(right, map.y(v)); g.stroke();
+      g.fillStyle = '#5b6670';
+      g.textAlign = 'right';
+      g.fillText(formatTick(v), left - 5, map.y(v));
+    }
+    if (spec.y2) {
+      // The right axis has round numbers of its own, placed where y·factor has them.
+      g.textAlign = 'left';
+      for (const v of ticks(low * spec.y2.factor, high * spec.y2.factor, 5)) {
+        g.strokeStyle = '#5b6670';
+        g.beginPath(); g.moveTo(right, map.y(v / spec.y2.factor)); g.lineTo(right + 4, map.y(v / spec.y2.factor)); g.stroke();
+        g.fillText(formatTick(v), right + 6, map.y(v / spec.y2.factor));
+      }
+    }
+    g.textAlign = 'center';
+    g.textBaseline = 'top';
+    for (const v of ticks(x0, x1, Math.max(2, Math.floor((right - left) / 80)))) {
+      g.strokeStyle = '#e3e7eb';
+      g.beginPath(); g.moveTo(map.x(v), top); g.lineTo(map.x(v), bottom); g.stroke();
+      g.fillStyle = '#5b6670';
+      g.fillText(formatTick(v), map.x(v), bottom + 4);
+    }
+    g.strokeStyle = '#5b6670';
+    g.strokeRect(left, top, right - left, bottom - top);
+    g.fillStyle = '#1d2327';
+    g.font = '13px system-ui, sans-serif';
+    g.textBaseline = 'bottom';
+    g.fillText(spec.xLabel || '', (left + right) / 2, height - 2);
+    const vertical = (text, x) => {
+      g.save();
+      g.translate(x, (top + bottom) / 2);
+      g.rotate(-Math.PI / 2);
+      g.textBaseline = 'top';
+      g.fillText(text, 0, 0);
+      g.restore();
+    };
+    vertical(spec.yLabel || '', 2);
+    if (spec.y2) vertical(spec.y2.label, width - 18);
+    // Data, clipped to the frame.
+    g.save();
+    g.beginPath();
+    g.rect(left, top, right - left, bottom - top);
+    g.clip();
+    spec.paint?.(g, map);
+    let drawn = 0;
+    for (const s of series) {
+      g.strokeStyle = s.colour;
+      g.lineWidth = s.width || 1.5;
+      g.setLineDash(s.dash || []);
+      g.beginPath();
+      if (s.steps) {
+        for (const [from, to, y] of s.steps) {
+          if (!Number.isFinite(y)) continue;
+          g.moveTo(map.x(from), map.y(y));
+          g.lineTo(map.x(to), map.y(y));
+          drawn++;
+        }
+      } else {
+        let pen = false;
+        for (const [x, y] of s.points) {
+          if (!Number.isFinite(y)) { pen = false; continue; }
+          if (pen) g.lineTo(map.x(x), map.y(y)); else g.moveTo(map.x(x), map.y(y));
+          pen = true;
+          drawn++;
+        }
+      }
+      g.stroke();
+    }
+    g.setLineDash([6, 4]);
+    g.lineWidth = 2;
+    for (const limit of limits) {
+      g.strokeStyle = limit.colour || '#b3261e';
+      g.beginPath(); g.moveTo(left, map.y(limit.value)); g.lineTo(right, map.y(limit.value)); g.stroke();
+    }
+    g.restore();
+    drawLegendRows(g, placed);
+    this.image = g.getImageData(0, 0, canvas.width, canvas.height);
+    canvas.dataset.state = 'drawn';
+    canvas.dataset.points = String(drawn);
+    if (this.at !== undefined) this.cursor(this.at);
+  }
+
+  // A vertical line at x (undefined: none).
+  cursor(x) {
+    this.at = x;
+    if (!this.image) return;
+    const g = this.canvas.getContext('2d');
+    g.putImageData(this.image, 0, 0);
+    if (x === undefined) return;
+    const ratio = window.devicePixelRatio || 1;
+    g.setTransform(ratio, 0, 0, ratio, 0, 0);
+    g.strokeStyle = '#1d2327';
+    g.lineWidth = 1.5;
+    g.beginPath();
+    g.moveTo(this.map.x(x), this.box.top);
+    g.lineTo(this.map.x(x), this.box.bottom);
+    g.stroke();
+  }
+}
+
+// A bar chart over categories (e.g. flute counts): one bar per category with optional marks
+// (a thick line at `mean`, a thin box at `min`) and a ★ above the `best` one, and dashed limit
+// lines. spec: {title, categories: [label], bars: [{value, colour, mean, min, best}],
+// limits: [{value, label, colour}], legend: [{label, colour, swatch}]}.
+export function barChart(parent, label, spec, height = 230) {
+  const canvas = document.createElement('canvas');
+  canvas.className = 'chart';
+  canvas.setAttribute('aria-label', label);
+  canvas.style.height = `${height}px`;
+  parent.append(canvas);
+  const draw = () => {
+    if (!canvas.clientWidth) return;
+    const [g, width, full] = sizeCanvas(canvas);
+    const limits = (spec.limits || []).filter((l) => Number.isFinite(l.value));
+    const left = 62;
+    const right = width - 12;
+    const legend = [...(spec.legend || []), ...limits.filter((l) => l.label).map((l) => ({ label: l.label, colour: l.colour, dash: [6, 4] }))];
+    const { placed, height: legendHeight } = legendRows(g, legend, left, width);
+    const top = legendHeight + 22;
+    const bottom = full - 40;
+    const high = Math.max(1e-9, ...spec.bars.map((b) => b.value), ...limits.map((l) => l.value)) * 1.12;
+    const n = spec.categories.length;
+    const x = (i) => left + (i + 0.5) / n * (right - left);
+    const y = (v) => bottom - v / high * (bottom - top);
+    g.font = '12px system-ui, sans-serif';
+    g.textBaseline = 'middle';
+    g.textAlign = 'right';
+    g.lineWidth = 1;
+    for (const v of ticks(0, high, 4)) {
+      g.strokeStyle = '#e3e7eb';
+      g.beginPath(); g.moveTo(left, y(v)); g.lineTo(right, y(v)); g.stroke();
+      g.fillStyle = '#5b6670';
+      g.fillText(formatTick(v), left - 5, y(v));
+    }
+    g.strokeStyle = '#5b6670';
+    g.strokeRect(left, top, right - left, bottom - top);
+    const w = Math.max(4, (right - left) / n * 0.6);
+    g.textAlign = 'center';
+    spec.bars.forEach((bar, i) => {
+      g.fillStyle = bar.colour;
+      g.fillRect(x(i) - w / 2, y(bar.value), w, bottom - y(bar.value));
+      g.fillStyle = '#1d2327';
+      if (Number.isFinite(bar.mean)) g.fillRect(x(i) - w / 2, y(bar.mean) - 1.5, w, 3);
+      if (Number.isFinite(bar.min)) { g.strokeStyle = '#1d2327'; g.strokeRect(x(i) - w / 2, y(bar.min) - 1, w, 2); }
+      if (bar.best) {
+        g.font = 'bold 15px system-ui, sans-serif';
+        g.textBaseline = 'bottom';
+        g.fillStyle = '#1e6b31';
+        g.fillText('★', x(i), y(bar.value) - 2);
+      }
+      g.font = '12px system-ui, sans-serif';
+      g.textBaseline = 'top';
+      g.fillStyle = '#5b6670';
+      g.fillText(spec.categories[i], x(i), bottom + 4);
+    });
+    g.setLineDash([6, 4]);
+    g.lineWidth = 2;
+    for (const limit of limits) {
+      g.strokeStyle = limit.colour || '#b3261e';
+      g.beginPath(); g.moveTo(left, y(limit.value)); g.lineTo(right, y(limit.value)); g.stroke();
+    }
+    g.setLineDash([]);
+    g.fillStyle = '#1d2327';
+    g.font = '13px system-ui, sans-serif';
+    g.textAlign = 'left';
+    g.textBaseline = 'bottom';
+    g.fillText(fitText(g, spec.title, width - 16), Math.min(left, width < 520 ? 8 : left), legendHeight + 18);
+    g.textAlign = 'center';
+    g.fillText(spec.xLabel || '', (left + right) / 2, full - 2);
+    drawLegendRows(g, placed);
+    canvas.dataset.state = 'drawn';
+  };
+  let width = 0;
+  new ResizeObserver(() => {
+    if (!canvas.clientWidth || Math.abs(canvas.clientWidth - width) < 2) return;
+    width = canvas.clientWidth;
+    draw();
+  }).observe(canvas);
+  draw();
+  return canvas;
+}
+
 // ---------------------------------------------------------------- colour scales
 
 // A diverging scale centred on zero: blue below, white at zero, red above, symmetric limits
@@ -562,6 +1037,114 @@ export function diverging(value, limit) {
 
 export function css([r, g, b]) {
   return `rgb(${r}, ${g}, ${b})`;
+}
+
+// A colour scale from `low` to `high` with its ends (and zero) labelled, and an optional band
+// ±`band` as a dashed box. colour(v) gives a CSS colour, format(v) the number shown in `unit`.
+export function drawColourScale(canvas, { low, high, band, colour, format = formatTick, unit = '' }) {
+  const width = canvas.clientWidth;
+  const height = canvas.clientHeight;
+  const ratio = window.devicePixelRatio || 1;
+  canvas.width = Math.round(width * ratio);
+  canvas.height = Math.round(height * ratio);
+  const g = canvas.getContext('2d');
+  g.setTransform(ratio, 0, 0, ratio, 0, 0);
+  g.fillStyle = '#fff';
+  g.fillRect(0, 0, width, height);
+  const left = 10;
+  const right = width - 10;
+  for (let x = left; x < right; x++) {
+    g.fillStyle = colour(low + (high - low) * (x - left) / (right - left));
+    g.fillRect(x, 4, 1, 22);
+  }
+  g.fillStyle = '#1d2327';
+  g.font = '15px sans-serif';
+  g.textBaseline = 'top';
+  g.textAlign = 'left';
+  g.fillText(`${format(low)} ${unit}`, left, 30);
+  g.textAlign = 'right';
+  g.fillText(`${format(high)} ${unit}`, right, 30);
+  if (low < 0 && high > 0) {
+    const zero = left + (right - left) * (-low / (high - low));
+    g.fillRect(zero, 0, 2, 28);
+    g.textAlign = 'center';
+    g.fillText('0', zero, 30);
+  }
+  if (band > 0) {
+    // The tolerance band: a dashed box over the scale from −band to +band.
+    const at = (e) => left + (right - left) * ((Math.max(low, Math.min(high, e)) - low) / (high - low));
+    g.strokeStyle = '#1d2327';
+    g.lineWidth = 2;
+    g.setLineDash([5, 3]);
+    g.strokeRect(at(-band), 2, at(band) - at(-band), 26);
+    g.setLineDash([]);
+  }
+  canvas.dataset.state = 'drawn';
+}
+
+// A histogram of `values` over [low, high] in 30 bins, each coloured by colour(centre), with
+// dashed lines at ±`band`; format(v) and `unit` for the axis, `label` under it.
+export function drawHistogram(canvas, values, { low, high, band, colour, format = formatTick, unit = '', label = '' }) {
+  const errors = values;
+  const width = canvas.clientWidth;
+  const height = canvas.clientHeight;
+  const ratio = window.devicePixelRatio || 1;
+  canvas.width = Math.round(width * ratio);
+  canvas.height = Math.round(height * ratio);
+  const g = canvas.getContext('2d');
+  g.setTransform(ratio, 0, 0, ratio, 0, 0);
+  g.fillStyle = '#fff';
+  g.fillRect(0, 0, width, height);
+  if (!errors.length) {
+    canvas.dataset.state = 'empty';
+    return;
+  }
+  const bins = 30;
+  const span = high - low || 1e-9;
+  const counts = new Array(bins).fill(0);
+  for (const e of errors) counts[Math.min(bins - 1, Math.floor(((e - low) / span) * bins))]++;
+  const most = Math.max(...counts);
+  const [left, right, top, bottom] = [50, width - 12, 12, height - 34];
+  g.strokeStyle = '#5b6670';
+  g.beginPath();
+  g.moveTo(left, top);
+  g.lineTo(left, bottom);
+  g.lineTo(right, bottom);
+  g.stroke();
+  const w = (right - left) / bins;
+  counts.forEach((count, i) => {
+    const h = (count / most) * (bottom - top);
+    g.fillStyle = colour(low + span * (i + 0.5) / bins);
+    g.fillRect(left + i * w + 1, bottom - h, Math.max(1, w - 2), h);
+  });
+  g.fillStyle = '#1d2327';
+  g.font = '14px sans-serif';
+  g.textAlign = 'right';
+  g.textBaseline = 'middle';
+  g.fillText(String(most), left - 6, top + 4);
+  g.fillText('0', left - 6, bottom);
+  g.textBaseline = 'top';
+  g.textAlign = 'left';
+  g.fillText(`${format(low)}`, left, bottom + 6);
+  g.textAlign = 'right';
+  g.fillText(`${format(high)} ${unit}`, right, bottom + 6);
+  g.textAlign = 'center';
+  g.fillText(label, (left + right) / 2, bottom + 6);
+  if (band > 0) {
+    g.strokeStyle = '#1d2327';
+    g.setLineDash([5, 3]);
+    for (const e of [-band, band]) {
+      if (e < low || e > high) continue;
+      const x = left + (right - left) * ((e - low) / span);
+      g.beginPath();
+      g.moveTo(x, top);
+      g.lineTo(x, bottom);
+      g.stroke();
+    }
+    g.setLineDash([]);
+  }
+  canvas.dataset.state = 'drawn';
+  canvas.dataset.bins = String(counts.filter((c) => c > 0).length);
 }
 
 // ---------------------------------------------------------------- 3-D scene
@@ -733,10 +1316,10 @@ export class Scene3D {
   }
 
   // Small dots at points.
-  dots(name, points, { colour = '#0b63b6', size = 4 } = {}) {
+  dots(name, points, { colour = '#0b63b6', size = 4, legend } = {}) {
     if (!this.scene || !points.length) return null;
     const geometry = new THREE.BufferGeometry().setFromPoints(points.map(vector));
-    return this.add(name, new THREE.Points(geometry, new THREE.PointsMaterial({ color: colour, size, sizeAttenuation: false })));
+    return this.add(name, new THREE.Points(geometry, new THREE.PointsMaterial({ color: colour, size, sizeAttenuation: false })), legend, colour);
   }
 
   // The tool: a ball of `radius` (or a flat end of that radius), a neck of `neck` radius and
@@ -767,7 +1350,18 @@ export class Scene3D {
     const shankTall = shankLength ?? 6 * radius;
     group.add(new THREE.Mesh(upright(new THREE.CylinderGeometry(shankRadius, shankRadius, shankTall, 24), z + neckTall + shankTall / 2), steel));
     group.visible = false;
+    this.toolParts = { metal, steel, colour };
     this.toolObject = this.add('tool', group, kind === 'ball' ? 'tool (ball, neck, shank)' : 'tool', colour);
+  }
+
+  // Draws the whole tool red while it is somewhere it must not be (`hit`), else in its colours.
+  markTool(hit) {
+    if (!this.toolParts) return;
+    const { metal, steel, colour } = this.toolParts;
+    metal.color.set(hit ? '#d50000' : colour);
+    steel.color.set(hit ? '#d50000' : '#6b7780');
+    this.root.dataset.toolHit = String(Boolean(hit));
+    this.render();
   }
 
   // Puts the tool's ball centre (flat: tip) at `p`, or hides it for null.

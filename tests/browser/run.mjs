@@ -1,10 +1,10 @@
 // Browser checks of the kerf page, driven by cargo test (tests/tests/api/browser.rs).
-// Usage: node run.mjs <scenario> <base-url> <screenshot.png> [job-file]
+// Usage: node run.mjs <scenario> <base-url> <screenshot.png> [job-file [second-job-file]]
 // Prints one JSON line with what it saw; exits non-zero with the reason when a check fails.
 import { readFileSync } from 'node:fs';
 import { chromium } from 'playwright-core';
 
-const [scenario, base, screenshot, jobFile] = process.argv.slice(2);
+const [scenario, base, screenshot, jobFile, secondJobFile] = process.argv.slice(2);
 const browser = await chromium.launch({
   executablePath: process.env.KERF_CHROMIUM || '/usr/bin/chromium',
   // WebGL without a GPU: SwiftShader, which Chromium needs asked for by name.
@@ -127,6 +127,40 @@ const scenarios = {
     await page.click('#deburr-compute');
     await page.waitForSelector('#deburr-plot[data-refused="true"]', { timeout: 60000 });
     if (!(await page.isDisabled('#deburr-gcode'))) throw new Error('G-code button enabled without a program');
+    // The ball's way down the hole runs through its wall: drawn red, and the reason is beside the button.
+    const blocked = await page.getAttribute('#deburr-plot', 'data-collisions');
+    const reason = await page.textContent('#deburr-gcode-note');
+    if (!blocked.split(' ').includes('approach') || !/^G-code off: ./.test(reason)) throw new Error(`approach through the wall: ${blocked}, "${reason}"`);
+
+    // On the inner edge a plain ball's shank (no neck) rubs the hole wall: red dots, a warning;
+    // a lollipop with a thin neck clears it.
+    await page.fill('#deburr-form input[name="ball_diameter"]', '4');
+    await page.click('#deburr-compute');
+    await page.waitForSelector('#deburr-plot[data-refused="false"]', { timeout: 60000 });
+    const shank = await page.getAttribute('#deburr-plot', 'data-collisions');
+    const shankNote = await page.textContent('#deburr-result');
+    if (shank !== 'neck' || !/shank .* meets the wall at \d+ of \d+ path points/.test(shankNote)) throw new Error(`shank on the inner edge: "${shank}"`);
+    // Half way along the program (on the loop round the edge) the tool is red.
+    const middle = async () => page.$eval('#deburr-result input[type="range"]', (slider) => {
+      slider.value = String(Math.round(Number(slider.max) / 2));
+      slider.dispatchEvent(new Event('input'));
+    });
+    await middle();
+    if (await page.getAttribute('#deburr-plot', 'data-tool-hit') !== 'true') throw new Error('the shank in the wall is not drawn red');
+    await page.evaluate(async () => {
+      const body = JSON.stringify({ kind: 'ball', radius: 2, neck_radius: 1, flutes: 2, name: 'lollipop' });
+      const response = await fetch('/api/v1/tools/41', { method: 'PUT', headers: { 'content-type': 'application/json' }, body });
+      if (!response.ok) throw new Error(`tool not stored: ${response.status}`);
+    });
+    await page.reload();
+    await page.waitForSelector('#deburr-form select[name="tool_choice"] option[value="41"]', { state: 'attached', timeout: 60000 });
+    await page.selectOption('#deburr-form select[name="tool_choice"]', '41');
+    await page.click('#deburr-compute');
+    await page.waitForSelector('#deburr-result:not(.stale) #deburr-plot[data-collisions=""]', { timeout: 60000 });
+    if (await page.isDisabled('#deburr-gcode')) throw new Error('G-code button off for a lollipop that clears the wall');
+    await middle();
+    if (await page.getAttribute('#deburr-plot', 'data-tool-hit') !== 'false') throw new Error('the lollipop is drawn red');
+    await page.selectOption('#deburr-form select[name="tool_choice"]', 'inline');
     await page.selectOption('#deburr-form select[name="edge"]', 'outer');
     await page.fill('#deburr-form input[name="ball_diameter"]', '4');
     await page.click('#deburr-compute');
@@ -337,7 +371,7 @@ const scenarios = {
 
     // The last layer, then a corner zoomed in from the table.
     await page.selectOption('#contour-result select[name="layer"]', '2');
-    await page.waitForSelector('#contour-plot[data-layer="2"][data-state="drawn"]', { timeout: 5000 });
+    await page.waitForSelector('#contour-plot[data-layer="2"][data-state="drawn"]', { timeout: 60000 });
     await page.click('#contour-result table.corners tbody tr[data-corner="3"]');
     const zoomed = Number(await page.getAttribute('#contour-plot', 'data-scale'));
     const zoomedLoop = await colouredPixels('#contour-plot', [224, 112, 0]);
@@ -382,24 +416,38 @@ const scenarios = {
     return { segments, inked, loopPixels, reliefPixels, zoomed: zoomed / fitted, objects };
   },
 
-  // The Engagement view: computes its three sample paths side by side, checks every chart is
-  // drawn, moves the cursor over a contact graph and sees the tool marked on the path, downloads
-  // the G-code of the second path, and highlights a bad flute count.
+  // The Engagement view: computes its three sample paths (one shown at a time, the others not
+  // drawn), checks every chart of the shown one is drawn, among them spindle torque and power
+  // from the form's Kienzle values, moves the cursor over a contact graph and sees the tool
+  // marked on the path, downloads the G-code of the second path, and highlights a bad flute count.
   async engagement() {
     await page.goto(`${base}/#engagement`);
-    await page.click('#engagement-compute');
+    const [request] = await Promise.all([page.waitForRequest((r) => r.url().endsWith('/api/v1/engagement')), page.click('#engagement-compute')]);
+    const sent = request.postDataJSON();
+    if (sent.kienzle?.kc11 !== 1800 || sent.kienzle?.mc !== 0.25 || sent.axial_depth !== 2) throw new Error(`no Kienzle values sent: ${JSON.stringify(sent.kienzle)}`);
     await page.waitForSelector('#engagement-result[data-state="drawn"]', { timeout: 30000 });
-    const columns = await page.$$eval('#engagement-result .candidate', (list) => list.length);
-    const states = await page.$$eval('#engagement-result canvas', (list) => list.map((c) => c.dataset.state));
-    if (states.some((s) => s !== 'drawn')) throw new Error(`charts not drawn: ${states}`);
-    const contactGraph = '#engagement-result .candidate canvas[aria-label^="Contact position"]';
+    const columns = await page.$$eval('#engagement-result [role="tabpanel"]', (list) => list.length);
+    const shown = '#engagement-result .candidate:not([hidden])';
+    await page.waitForFunction((selector) => [...document.querySelectorAll(`${selector} canvas`)].every((c) => c.dataset.state === 'drawn'), shown, { timeout: 30000 });
+    const states = await page.$$eval(`${shown} canvas`, (list) => list.map((c) => c.dataset.state));
+    const hiddenCharts = await page.$$eval('#engagement-result .candidate[hidden] canvas', (list) => list.length);
+    if (hiddenCharts !== 0) throw new Error(`${hiddenCharts} charts drawn for paths not shown`);
+    // Torque and power over the path (power on the right axis) and per flute count in the table.
+    const torqueChart = `${shown} canvas[aria-label^="Spindle torque and power"]`;
+    const torqueInked = await inkedPixels(torqueChart);
+    if (torqueInked < 2000) throw new Error(`torque chart nearly blank: ${torqueInked}`);
+    const head = await page.textContent(`${shown} table.flutes thead`);
+    if (!/torque mean \/ peak, N·m/.test(head) || !/power mean \/ peak, kW/.test(head)) throw new Error(`flute table: ${head}`);
+    const torqueCells = await page.$$eval(`${shown} table.flutes tbody tr td:nth-child(10)`, (l) => l.map((e) => e.textContent));
+    if (!torqueCells.length || !torqueCells.every((t) => /^\d+\.\d\d \/ \d+\.\d\d$/.test(t))) throw new Error(`torque cells: ${torqueCells}`);
+    const contactGraph = `${shown} canvas[aria-label^="Contact position"]`;
     const inked = await inkedPixels(contactGraph);
     if (inked < 2000) throw new Error(`contact graph nearly blank: ${inked} inked pixels`);
     const recommendation = await page.textContent('#engagement-result .recommendation');
     // A cursor on the contact graph marks the tool on the path.
     await page.locator(contactGraph).first().scrollIntoViewIfNeeded();
     const box = await (await page.$(contactGraph)).boundingBox();
-    const plan = '#engagement-result .candidate canvas.plan';
+    const plan = `${shown} canvas.plan`;
     const before = await inkedPixels(plan);
     await page.mouse.move(box.x + box.width * 0.45, box.y + box.height / 2);
     const cursor = Number(await page.getAttribute(plan, 'data-cursor'));
@@ -407,7 +455,7 @@ const scenarios = {
     const readout = await page.textContent('#engagement-result .cursor-readout');
     if (!Number.isInteger(cursor) || cursor <= 0) throw new Error(`no cursor on the path: ${cursor}`);
     if (after <= before) throw new Error(`tool circle not drawn: ${before} -> ${after} inked pixels`);
-    if (!/s = [\d.]+ mm/.test(readout)) throw new Error(`no readout: ${readout}`);
+    if (!/s = [\d.]+ mm/.test(readout) || !/torque [\d.]+ N·m, power [\d.]+ kW/.test(readout)) throw new Error(`no readout: ${readout}`);
     // The timeline slider moves the same cursor from the keyboard.
     const timeline = page.getByRole('slider', { name: /Timeline along straight/ });
     await timeline.focus();
@@ -417,10 +465,18 @@ const scenarios = {
     if (stepped !== 50) throw new Error(`timeline moved the cursor to ${stepped}`);
     // The x axis switches to time; every chart is drawn again.
     await page.selectOption('#engagement-result select[aria-label="x axis"]', 'time');
-    const redrawn = await page.$$eval('#engagement-result canvas', (list) => list.filter((c) => c.dataset.state === 'drawn').length);
+    const redrawn = await page.$$eval(`${shown} canvas`, (list) => list.filter((c) => c.dataset.state === 'drawn').length);
     if (redrawn !== states.length) throw new Error(`after switching to time: ${redrawn} of ${states.length} charts drawn`);
-    // G-code of the second path.
-    await page.selectOption('select[name="candidate"]', '1');
+    // The second path's tab draws its charts, leaves the first undrawn, and is the G-code choice.
+    await page.click('#engagement-result [role="tab"]:nth-child(2)');
+    await page.waitForFunction((selector) => {
+      const list = [...document.querySelectorAll(`${selector} canvas`)];
+      return list.length > 0 && list.every((c) => c.dataset.state === 'drawn');
+    }, shown, { timeout: 30000 });
+    const second = await page.$eval(shown, (e) => e.querySelector('h3').textContent);
+    const leftDrawn = await page.$$eval('#engagement-result .candidate[hidden] canvas', (list) => list.length);
+    if (second !== 'two bends' || leftDrawn !== 0) throw new Error(`second tab: ${second}, ${leftDrawn} charts left drawn`);
+    if (await page.inputValue('select[name="candidate"]') !== '1') throw new Error('the G-code choice did not follow the tab');
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#engagement-gcode')]);
     const { readFile } = await import('node:fs/promises');
     const program = await readFile(await download.path(), 'utf8');
@@ -432,7 +488,7 @@ const scenarios = {
     await page.waitForSelector('#engagement-messages .message.error', { timeout: 60000 });
     const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
     if (!highlighted.includes('flute_counts')) throw new Error(`field not highlighted: ${highlighted}`);
-    return { columns, charts: states.length, inked, cursor, recommendation, feeds: feeds.size, file: download.suggestedFilename() };
+    return { columns, charts: states.length, torqueInked, inked, cursor, recommendation, feeds: feeds.size, file: download.suggestedFilename() };
   },
 
   // Predict page: runs the sample raster over the dome, checks the path coloured by error (several
@@ -440,9 +496,12 @@ const scenarios = {
   // corrected program, and a G-code error with its line.
   async predict() {
     await page.goto(`${base}/#predict`);
-    await page.click('#predict-compute');
+    // The inline ball is entered by diameter (Ø6) and sent as the radius the API takes.
+    const [request] = await Promise.all([page.waitForRequest((r) => r.url().includes('/api/v1/predict')), page.click('#predict-compute')]);
+    const radius = request.postDataJSON().tool.radius;
+    if (radius !== 3) throw new Error(`Ø6 sent as radius ${radius}`);
     await page.waitForSelector('#predict-plot[data-state="drawn"]', { timeout: 30000 });
-    await page.waitForSelector('#predict-histogram[data-state="drawn"]', { timeout: 5000 });
+    await page.waitForSelector('#predict-histogram[data-state="drawn"]', { timeout: 60000 });
     const segments = Number(await page.getAttribute('#predict-plot', 'data-segments'));
     const inked = await inkedPixels('#predict-plot canvas');
     const histogram = await inkedPixels('#predict-histogram');
@@ -484,6 +543,15 @@ const scenarios = {
     const program = await (await import('node:fs/promises')).readFile(await download.path(), 'utf8');
     if (!program.includes('M30') || !program.includes('O3100')) throw new Error(`corrected program: ${program.slice(0, 200)}`);
 
+    // Entered as a radius, the size is sent as it is.
+    await page.selectOption('#predict-form select[name="size_as"]', 'radius');
+    await page.fill('#predict-form input[name="ball_size"]', '2.5');
+    const [byRadius] = await Promise.all([page.waitForRequest((r) => r.url().includes('/api/v1/predict')),
+      page.waitForResponse((r) => r.url().includes('/api/v1/predict'), { timeout: 60000 }), page.click('#predict-compute')]);
+    if (byRadius.postDataJSON().tool.radius !== 2.5) throw new Error(`radius 2.5 sent as ${byRadius.postDataJSON().tool.radius}`);
+    const sizeLabel = await page.textContent('#predict-form [data-size-label]');
+    if (sizeLabel !== 'Ball radius, mm') throw new Error(`size label: ${sizeLabel}`);
+
     // A G-code error names its line and marks the program.
     await page.fill('textarea[name="program"]', 'G21 G90\nG0 X0 Y0 Z5\nG1 Z0 F500 Q1\nM30\n');
     await page.click('#predict-compute');
@@ -493,6 +561,63 @@ const scenarios = {
     const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
     if (!highlighted.includes('program')) throw new Error(`program not highlighted: ${highlighted}`);
     return { segments, inked, histogram, colours, worst: lines.length, programLines: program.split('\n').length };
+  },
+
+  // Job progress as the service reports it, with one job worker: a prediction long enough to
+  // watch (the example's job with a raster of 0.01 mm steps) shows a bar with the fraction it
+  // reports; jobs queued behind it show no bar at all; cancelling the prediction lets an
+  // engagement job run, whose bar has no value (engagement reports none), then the second job
+  // file's, which ends at 100 %.
+  async progress() {
+    const example = readFileSync(jobFile, 'utf8');
+    const lines = ['%', 'G21 G90 G17', 'T3 M06', 'G00 G43 H3 Z20.', 'S8000 M03', 'G00 X0 Y0 Z5.', 'G01 Z0 F1600'];
+    const k = Math.PI / 20;
+    for (let j = 0; j <= 20; j++) {
+      for (let i = 0; i <= 2000; i++) {
+        const [x, y] = [(j % 2 ? 2000 - i : i) * 0.01, j];
+        const [z, dx, dy] = [2 * Math.sin(k * x) * Math.sin(k * y), 2 * k * Math.cos(k * x) * Math.sin(k * y), 2 * k * Math.sin(k * x) * Math.cos(k * y)];
+        const l = Math.hypot(dx, dy, 1);
+        lines.push(`X${(x - 3 * dx / l).toFixed(4)} Y${(y - 3 * dy / l).toFixed(4)} Z${(z + 3 / l - 3).toFixed(4)}`);
+      }
+    }
+    lines.push('G00 Z20.', 'M30', '%');
+    const long = example.replace(/program = """[\s\S]*?"""/, `program = """\n${lines.join('\n')}\n"""`);
+    if (long === example) throw new Error('the example has no program to replace');
+    await page.goto(`${base}/#jobs`);
+    await page.setInputFiles('#job-file', { name: 'long-prediction.toml', mimeType: 'application/toml', buffer: Buffer.from(long) });
+    const running = '#job-rows tr[data-status="running"]';
+    await page.waitForSelector(`${running} td[data-progress="reported"] progress[value]`, { timeout: 120000 });
+    // Queued behind it: an engagement job (some seconds of work on a 2 µm dot grid, with a small
+    // answer; engagement reports no progress of its own) and the second job file.
+    const engagement = {
+      name: 'long engagement', operations: [{
+        operation: 'engagement', tool: { kind: 'flat', radius: 5, flutes: 2 }, stock: { polygon: [[0, 0], [60, 0], [60, 40], [0, 40]] },
+        path: [[-10, 20], [70, 20]], spindle_rpm: 3000, feed_per_tooth: 0.05, flute_counts: [2], engine: 'dots', grid: 0.002, step: 0.25,
+      }],
+    };
+    await page.setInputFiles('#job-file', { name: 'long-engagement.json', mimeType: 'application/json', buffer: Buffer.from(JSON.stringify(engagement)) });
+    await page.waitForSelector('#job-rows tr[data-status="queued"]', { timeout: 60000 });
+    await page.setInputFiles('#job-file', secondJobFile);
+    await page.waitForFunction(() => document.querySelectorAll('#job-rows tr[data-status="queued"] td[data-progress="waiting"]').length === 2, null, { timeout: 60000 });
+    const queuedBars = await page.$$eval('#job-rows tr[data-status="queued"] progress', (l) => l.length);
+    if (queuedBars !== 0) throw new Error('a queued job shows a progress bar');
+    // The bar moves with what the service reports.
+    await page.waitForFunction((row) => {
+      const bar = document.querySelector(`${row} progress`);
+      return bar && bar.value > 0 && bar.value < 1;
+    }, running, { timeout: 120000 });
+    const reported = await page.$eval(`${running} td.progress`, (e) => e.textContent.trim());
+    if (!/^\d+(\.\d)?%$/.test(reported)) throw new Error(`reported progress: ${reported}`);
+    await page.click(`${running} button:has-text("Cancel")`);
+    await page.waitForSelector('#job-rows tr[data-status="cancelled"]', { timeout: 60000 });
+    // The engagement job runs next: a bar without a value (indeterminate) and the words say so.
+    await page.waitForSelector(`${running} td[data-progress="unknown"] progress:not([value])`, { timeout: 120000 });
+    const unknown = await page.$eval(`${running} td.progress`, (e) => e.textContent.trim());
+    if (unknown !== 'engagement running (it reports no progress)') throw new Error(`unreported progress: ${unknown}`);
+    await page.waitForSelector('#job-rows tr[data-status="done"] td[data-progress="done"]', { timeout: 180000 });
+    const done = await page.$eval('#job-rows tr[data-status="done"] td.progress', (e) => ({ text: e.textContent.trim(), value: e.querySelector('progress')?.value }));
+    if (done.text !== '100%' || done.value !== 1) throw new Error(`finished job: ${JSON.stringify(done)}`);
+    return { reported, unknown };
   },
 
   // Uploads a job file on the Jobs page, waits for it to finish, opens it, and checks each

@@ -1,9 +1,11 @@
-// Deburr view: a form for one cross-hole ridge, the 3-D plot of ridge and ball-centre path,
-// the summary, warnings and the G-code download (api.md, Deburr).
+// Deburr view: a form for one cross-hole ridge, the 3-D plot of ridge and ball-centre path with
+// where the tool would meet the wall, the summary, warnings and the G-code download (api.md,
+// Deburr).
 import { api, program as programOf, sentence } from '/api.js';
 import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
 import { Scene3D, THREE } from '/plot.js';
 import { Timeline } from '/timeline.js';
+import { clearance } from '/views/deburr-clearance.js';
 
 const FORM = `
 <div class="layout">
@@ -51,7 +53,8 @@ const FORM = `
       <button class="primary" type="submit" id="deburr-compute">Compute</button>
       <select name="dialect" aria-label="G-code dialect"><option value="">machine's dialect (else Fanuc)</option><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select>
       <select name="reference" aria-label="Programmed point"><option value="tip">tip</option><option value="centre">ball centre</option></select>
-      <button class="secondary" type="button" id="deburr-gcode">G-code</button>
+      <button class="secondary" type="button" id="deburr-gcode" aria-describedby="deburr-gcode-note">G-code</button>
+      <output id="deburr-gcode-note" class="hint"></output>
     </div>
   </form>
   <section>
@@ -162,20 +165,45 @@ export function deburrResult(container, answer, context = {}) {
   if (request) addWorkpiece(scene, request);
   scene.path('ridge', points.map((p) => p.target), { colour: '#555555', legend: 'ridge (where the edges meet)' });
   scene.path('centres', [...points.map((p) => p.centre), points[0].centre], { colour: '#0b63b6', legend: 'ball-centre path' });
-  const refused = Boolean(problem);
+  // Where the ball on its way in or out, or the neck along the path, meets the wall: red.
+  const found = request ? clearance(request, answer) : null;
+  const blocked = Boolean(found?.approach.length);
+  const refused = Boolean(problem) || blocked;
   const lead = { colour: refused ? '#b3261e' : '#c77700', dashed: true };
-  scene.path('lead-in', centres(answer.lead_in), { ...lead, legend: refused ? 'approach / retract (refused, see above)' : 'approach / retract' });
+  scene.path('lead-in', [...centres(answer.lead_in), points[0].centre], { ...lead, legend: refused ? 'approach / retract (no program, see above)' : 'approach / retract' });
   if (answer.lead_out.length) scene.path('lead-out', [points[points.length - 1].centre, ...centres(answer.lead_out)], lead);
+  found?.approach.forEach((piece, i) => scene.path('approach-collision', piece, { colour: '#d50000', legend: i === 0 ? 'ball through the wall' : undefined }));
+  if (blocked) scene.dots('approach-collision', found.approach.flat(), { colour: '#d50000', size: 7 });
+  if (found?.neck.length) scene.dots('neck-collision', found.neck, { colour: '#d50000', size: 7, legend: 'neck meets the wall' });
   const tool = answer.tool || {};
   scene.tool({ radius: tool.radius || 1, neck: tool.neck_radius, shankLength: tool.stickout, colour: refused ? '#b3261e' : undefined });
   scene.root.dataset.refused = String(refused);
+  scene.root.dataset.collisions = [blocked ? 'approach' : '', found?.neck.length ? 'neck' : ''].filter(Boolean).join(' ');
+  const notes = [];
+  if (blocked) {
+    scene.root.dataset.blocked = `the ball's way in or out runs through the wall for ${number(found.approachLength, 1)} mm (red in the view)`;
+    notes.push(message('error', `No G-code: ${scene.root.dataset.blocked}.`));
+  }
+  if (found?.neck.length) {
+    const part = tool.neck_radius ? `neck (radius ${tool.neck_radius} mm)` : 'shank (as wide as the ball: no neck given)';
+    notes.push(message('warning', `The ${part} meets the wall at ${found.neck.length} of ${found.checked} path points checked (red dots).`));
+  }
   scene.finish();
   scene.moveTool(points[0].centre);
+  if (found) scene.markTool(Object.values(found.at(points[0].centre)).some(Boolean));
   if (program) {
     const lift = reference === 'tip' ? tool.radius || 0 : 0;
     new Timeline(container, program, {
       label: 'Timeline',
-      onMove: (move) => scene.moveTool([move.position[0], move.position[1], move.position[2] + lift]),
+      onMove: (move) => {
+        const centre = [move.position[0], move.position[1], move.position[2] + lift];
+        scene.moveTool(centre);
+        // Red where the ball or the neck is in the wall at this move.
+        if (found) {
+          const hit = found.at(centre);
+          scene.markTool(hit.ball || hit.neck);
+        }
+      },
     });
   }
   const s = answer.summary;
@@ -192,7 +220,7 @@ export function deburrResult(container, answer, context = {}) {
   }
   if (answer.machine) items.push(['machine', `${answer.machine.name} (${answer.machine.dialect})`]);
   showSummary(summaryBox, items);
-  warnings.replaceChildren(...warningMessages(answer.warnings));
+  warnings.replaceChildren(...notes, ...warningMessages(answer.warnings));
   return scene.root;
 }
 
@@ -211,6 +239,7 @@ export const deburrView = {
     const messages = root.querySelector('#deburr-messages');
     const result = root.querySelector('#deburr-result');
     const gcode = root.querySelector('#deburr-gcode');
+    const gcodeNote = root.querySelector('#deburr-gcode-note');
     form.addEventListener('change', () => syncVisibility(form));
     loadTools(form.elements.tool_choice, 'inline ball (size below)', (tool) => tool.kind === 'ball').then(() => syncVisibility(form));
     loadMachines(form.elements.machine);
@@ -229,9 +258,14 @@ export const deburrView = {
       } catch (refused) {
         problem = refused;
       }
-      gcode.disabled = !program;
-      gcode.title = program ? '' : `No program: ${sentence(problem?.detail || problem?.title)}`;
-      deburrResult(result, last.answer, { request: last.request, program, problem, reference }).id = 'deburr-plot';
+      const scene = deburrResult(result, last.answer, { request: last.request, program, problem, reference });
+      scene.id = 'deburr-plot';
+      // Off when the service refuses the program or the page sees the approach cut the wall;
+      // the reason is beside the button (a tooltip alone is out of reach on a touch screen).
+      const reason = problem ? sentence(problem.detail || problem.title) : scene.dataset.blocked ? sentence(scene.dataset.blocked) : '';
+      gcode.disabled = Boolean(reason);
+      gcodeNote.textContent = reason ? `G-code off: ${reason}` : '';
+      gcode.title = gcodeNote.textContent;
       // The answer says so itself when it carries W_NO_PROGRAM.
       if (problem && !last.answer.warnings.some((w) => w.code === 'W_NO_PROGRAM')) {
         messages.append(message('error', `No G-code for this path. ${sentence(problem.detail || problem.title)}`, problem.code));

@@ -1,10 +1,13 @@
 // Engagement view: tool–workpiece contact along one or several candidate paths (api.md,
-// Engagement; engagement.md §3). A form for the tool, stock, paths, cutting conditions and
-// limits; per path the plan view coloured by engagement, the contact-position graph, a_e, the
-// summed chip thickness per flute count with the threshold, representative values and time per
-// k with the recommended k highlighted, and the feed plan; a cursor on any chart marks the tool
-// on the path. The result renderer is shared with the Jobs view.
+// Engagement; engagement.md §3). A form for the tool, stock, paths, cutting conditions, limits and
+// the work material's Kienzle values; per path (one shown at a time) the plan view coloured by
+// engagement, the contact-position graph, a_e, the summed chip thickness per flute count with
+// the threshold, spindle torque and power with the machine's limits, the feed plan, and the
+// representative values and time per k with the recommended k highlighted (the charts are
+// plot.js's); a cursor on any chart marks the tool on the path. The result renderer is shared
+// with the Jobs view.
 import { api } from '/api.js';
+import { PathChart, ToolPlan, barChart } from '/plot.js';
 import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
@@ -49,8 +52,12 @@ const FORM = `
       <label><span>Step along the path, mm <abbr class="symbol" title="Δs">Δs</abbr></span> <input name="step" type="number" step="any" placeholder="D/50" data-field="step"></label>
       <label data-engine="dots"><span>Dot spacing, mm <abbr class="symbol" title="g">g</abbr></span> <input name="grid" type="number" step="any" placeholder="D/200" data-field="grid"></label>
     </fieldset>
-    <fieldset><legend>G-code and feed plan</legend>
+    <fieldset><legend>Work material (torque and power)</legend>
       <label><span>Depth of cut, mm <abbr class="symbol" title="axial depth a_p">a_p</abbr></span> <input name="axial_depth" type="number" step="any" value="2" data-field="axial_depth"></label>
+      <label><span>Specific cutting force, N/mm² <abbr class="symbol" title="Kienzle k_c1.1">k<sub>c1.1</sub></abbr></span> <input name="kc11" type="number" step="any" value="1800" placeholder="none: no torque or power" data-field="kienzle.kc11" title="e.g. about 1800 for a plain carbon steel, 700 for an aluminium alloy"></label>
+      <label><span>Kienzle exponent <abbr class="symbol" title="Kienzle m_c">m<sub>c</sub></abbr></span> <input name="mc" type="number" step="any" value="0.25" data-field="kienzle.mc" title="typically 0.15–0.3"></label>
+    </fieldset>
+    <fieldset><legend>G-code and feed plan</legend>
       <label><span>Target chip thickness, mm <abbr class="symbol" title="h*">h*</abbr></span> <input name="target_thickness" type="number" step="any" value="0.05" data-field="feed_plan.target_thickness" title="empty: no feed plan, nominal feed"></label>
       <label>Max feed, mm/min <input name="max_feed" type="number" step="any" value="2000" placeholder="machine's" data-field="feed_plan.max_feed"></label>
       <label>Machine <select name="machine" data-field="machine"></select></label>
@@ -155,6 +162,8 @@ export function engagementRequest(form) {
     axial_depth: numeric(form, 'axial_depth'),
   });
   if (body.engine === 'dots') body.grid = numeric(form, 'grid');
+  const [kc11, mc] = [numeric(form, 'kc11'), numeric(form, 'mc')];
+  if (kc11 !== undefined || mc !== undefined) body.kienzle = { kc11, mc };
   const target = numeric(form, 'target_thickness');
   if (target !== undefined) body.feed_plan = { target_thickness: target, max_feed: numeric(form, 'max_feed') };
   if (value(form, 'machine')) body.machine = value(form, 'machine');
@@ -224,116 +233,6 @@ function engagementColour(deg) {
   return `rgb(${c[0]},${c[1]},${c[2]})`;
 }
 
-function niceStep(span, count) {
-  const raw = span / Math.max(1, count);
-  const power = 10 ** Math.floor(Math.log10(raw));
-  return [1, 2, 2.5, 5, 10].map((m) => m * power).find((s) => s >= raw) || raw;
-}
-
-function formatTick(v, step) {
-  const digits = Math.max(0, Math.min(4, -Math.floor(Math.log10(step) + 1e-9)));
-  return v.toFixed(digits);
-}
-
-// Sizes a canvas to its box and returns its 2-D context in CSS pixels.
-function prepare(canvas, height) {
-  const ratio = window.devicePixelRatio || 1;
-  const width = Math.max(280, canvas.clientWidth || canvas.parentElement?.clientWidth || 600);
-  canvas.style.height = `${height}px`;
-  canvas.width = Math.round(width * ratio);
-  canvas.height = Math.round(height * ratio);
-  const ctx = canvas.getContext('2d');
-  ctx.setTransform(ratio, 0, 0, ratio, 0, 0);
-  ctx.fillStyle = '#fff';
-  ctx.fillRect(0, 0, width, height);
-  return { ctx, width, height, ratio };
-}
-
-// A chart frame: axes, grid, ticks and labels; returns x/y mapping functions.
-function frame(ctx, box, range, labels) {
-  const { left, top, right, bottom } = box;
-  const [x0, x1, y0, y1] = range;
-  const x = (v) => left + (v - x0) / (x1 - x0 || 1) * (right - left);
-  const y = (v) => bottom - (v - y0) / (y1 - y0 || 1) * (bottom - top);
-  ctx.save();
-  ctx.font = '12px system-ui, sans-serif';
-  ctx.strokeStyle = '#e3e7eb';
-  ctx.fillStyle = '#5b6670';
-  ctx.lineWidth = 1;
-  const xs = labels.xticks || niceStep(x1 - x0, 8);
-  ctx.textAlign = 'center';
-  ctx.textBaseline = 'top';
-  for (let v = Math.ceil(x0 / xs - 1e-9) * xs; v <= x1 + 1e-9; v += xs) {
-    ctx.beginPath();
-    ctx.moveTo(x(v), top);
-    ctx.lineTo(x(v), bottom);
-    ctx.stroke();
-    ctx.fillText(labels.xformat ? labels.xformat(v) : formatTick(v, xs), x(v), bottom + 3);
-  }
-  const ys = labels.yticks || niceStep(y1 - y0, 5);
-  ctx.textAlign = 'right';
-  ctx.textBaseline = 'middle';
-  for (let v = Math.ceil(y0 / ys - 1e-9) * ys; v <= y1 + 1e-9; v += ys) {
-    ctx.beginPath();
-    ctx.moveTo(left, y(v));
-    ctx.lineTo(right, y(v));
-    ctx.stroke();
-    ctx.fillText(formatTick(v, ys), left - 4, y(v));
-  }
-  ctx.strokeStyle = '#5b6670';
-  ctx.strokeRect(left, top, right - left, bottom - top);
-  ctx.fillStyle = '#1d2327';
-  ctx.font = '13px system-ui, sans-serif';
-  ctx.textAlign = 'left';
-  ctx.textBaseline = 'bottom';
-  ctx.fillText(labels.title, left, top - 4);
-  ctx.textAlign = 'right';
-  ctx.textBaseline = 'bottom';
-  if (labels.x) ctx.fillText(labels.x, right, box.height - 2);
-  ctx.restore();
-  return { x, y };
-}
-
-function dashedLine(ctx, x0, y0, x1, y1, colour, label) {
-  ctx.save();
-  ctx.strokeStyle = colour;
-  ctx.lineWidth = 2;
-  ctx.setLineDash([6, 4]);
-  ctx.beginPath();
-  ctx.moveTo(x0, y0);
-  ctx.lineTo(x1, y1);
-  ctx.stroke();
-  if (label) {
-    ctx.setLineDash([]);
-    ctx.fillStyle = colour;
-    ctx.font = '12px system-ui, sans-serif';
-    ctx.textAlign = 'right';
-    ctx.textBaseline = 'bottom';
-    ctx.fillText(label, x1 - 2, y0 - 2);
-  }
-  ctx.restore();
-}
-
-function finish(canvas, view) {
-  view.image = view.ctx.getImageData(0, 0, canvas.width, canvas.height);
-  canvas.dataset.state = 'drawn';
-}
-
-// Redraws the stored image and a vertical cursor at x.
-function cursorLine(view, xPixel) {
-  const { ctx } = view;
-  ctx.putImageData(view.image, 0, 0);
-  if (xPixel === undefined) return;
-  ctx.save();
-  ctx.strokeStyle = '#1d2327';
-  ctx.lineWidth = 1.5;
-  ctx.beginPath();
-  ctx.moveTo(xPixel, view.box.top);
-  ctx.lineTo(xPixel, view.box.bottom);
-  ctx.stroke();
-  ctx.restore();
-}
-
 // Index of the sample nearest to `v` on the axis `key` (sorted ascending).
 function nearestIndex(samples, key, v) {
   let low = 0;
@@ -346,7 +245,7 @@ function nearestIndex(samples, key, v) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Plan view: stock, path coloured by engagement, tool circle at the cursor
+// Plan view: what plot.js's ToolPlan draws from an answer (stock, path coloured by engagement)
 
 function base64Bits(text) {
   const binary = atob(text.replace(/\s/g, ''));
@@ -390,310 +289,139 @@ function stockRings(stock) {
   return [];
 }
 
-class PlanView {
-  constructor(canvas, result, answer) {
-    this.canvas = canvas;
-    this.result = result;
-    this.stock = answer.stock;
-    this.radius = answer.tool?.radius ?? 0;
-    const low = [Infinity, Infinity];
-    const high = [-Infinity, -Infinity];
-    const include = (p) => {
-      low[0] = Math.min(low[0], p[0]); low[1] = Math.min(low[1], p[1]);
-      high[0] = Math.max(high[0], p[0]); high[1] = Math.max(high[1], p[1]);
-    };
-    stockRings(this.stock).flat().forEach(include);
-    const bitmap = this.stock?.bitmap;
-    if (bitmap) {
-      include(bitmap.origin);
-      include([bitmap.origin[0] + bitmap.width * bitmap.cell, bitmap.origin[1] + bitmap.height * bitmap.cell]);
-    }
-    for (const s of result.samples) include(s.position);
-    this.low = [low[0] - this.radius, low[1] - this.radius];
-    this.high = [high[0] + this.radius, high[1] + this.radius];
+// The plan view's drawing (plot.js's ToolPlan) from an answer: the stock's rings, its bitmap's
+// material cells, earlier cuts as swept strokes, and the path coloured by the engaged angle.
+function planSpec(result, answer) {
+  const stock = answer.stock;
+  const bitmap = stock?.bitmap;
+  let cells = null;
+  if (bitmap && bitmap.width * bitmap.height <= 4e6) {
+    const bits = base64Bits(bitmap.data);
+    cells = { origin: bitmap.origin, size: bitmap.cell, width: bitmap.width, height: bitmap.height, filled: (i, j) => {
+      const bit = j * bitmap.width + i;
+      return Boolean(bits[bit >> 3] & (0x80 >> (bit & 7)));
+    } };
   }
-
-  draw() {
-    const width = Math.max(280, this.canvas.clientWidth || 600);
-    const spanX = this.high[0] - this.low[0] || 1;
-    const spanY = this.high[1] - this.low[1] || 1;
-    const height = Math.max(180, Math.min(520, width * spanY / spanX + 20));
-    const view = prepare(this.canvas, height);
-    const { ctx } = view;
-    const pad = 10;
-    const scale = Math.min((view.width - 2 * pad) / spanX, (view.height - 2 * pad - 16) / spanY);
-    const ox = pad + ((view.width - 2 * pad) - spanX * scale) / 2;
-    const oy = view.height - pad - ((view.height - 2 * pad - 16) - spanY * scale) / 2;
-    this.map = (p) => [ox + (p[0] - this.low[0]) * scale, oy - (p[1] - this.low[1]) * scale];
-    this.scale = scale;
-    // Stock: rings under even-odd, or the bitmap's material cells.
-    ctx.fillStyle = '#d9dfe5';
-    ctx.strokeStyle = '#5b6670';
-    ctx.lineWidth = 1;
-    const rings = stockRings(this.stock);
-    if (rings.length) {
-      ctx.beginPath();
-      for (const ring of rings) {
-        ring.forEach((p, i) => { const [x, y] = this.map(p); if (i) ctx.lineTo(x, y); else ctx.moveTo(x, y); });
-        ctx.closePath();
-      }
-      ctx.fill('evenodd');
-      ctx.stroke();
-    }
-    const bitmap = this.stock?.bitmap;
-    if (bitmap && bitmap.width * bitmap.height <= 4e6) {
-      const bits = base64Bits(bitmap.data);
-      for (let j = 0; j < bitmap.height; j++) {
-        for (let i = 0; i < bitmap.width; i++) {
-          const bit = j * bitmap.width + i;
-          if (bits[bit >> 3] & (0x80 >> (bit & 7))) {
-            const [x, y] = this.map([bitmap.origin[0] + i * bitmap.cell, bitmap.origin[1] + (j + 1) * bitmap.cell]);
-            ctx.fillRect(x, y, Math.max(1, bitmap.cell * scale), Math.max(1, bitmap.cell * scale));
-          }
-        }
-      }
-    }
-    // Material already removed by earlier cuts.
-    for (const cut of this.stock?.previous_cuts || []) {
-      const points = pathPolyline(cut.path);
-      ctx.save();
-      ctx.strokeStyle = '#fff';
-      ctx.lineCap = 'round';
-      ctx.lineJoin = 'round';
-      ctx.lineWidth = Math.max(1, 2 * cut.radius * scale);
-      ctx.beginPath();
-      points.forEach((p, i) => { const [x, y] = this.map(p); if (i) ctx.lineTo(x, y); else ctx.moveTo(x, y); });
-      ctx.stroke();
-      ctx.restore();
-    }
-    // The path, each stretch coloured by the engaged angle at its end.
-    const samples = this.result.samples;
-    ctx.lineWidth = 3;
-    ctx.lineCap = 'round';
-    for (let i = 1; i < samples.length; i++) {
-      const rapid = (samples[i].flags || []).includes('rapid');
-      ctx.strokeStyle = rapid ? '#9aa5ae' : engagementColour(samples[i].engaged_deg);
-      ctx.setLineDash(rapid ? [4, 4] : []);
-      const [x0, y0] = this.map(samples[i - 1].position);
-      const [x1, y1] = this.map(samples[i].position);
-      ctx.beginPath();
-      ctx.moveTo(x0, y0);
-      ctx.lineTo(x1, y1);
-      ctx.stroke();
-    }
-    ctx.setLineDash([]);
-    if (samples.length) {
-      const [x, y] = this.map(samples[0].position);
-      ctx.fillStyle = '#1d2327';
-      ctx.beginPath();
-      ctx.arc(x, y, 4, 0, 2 * Math.PI);
-      ctx.fill();
-    }
-    // Legend of the colour scale.
-    ctx.font = '12px system-ui, sans-serif';
-    ctx.textBaseline = 'top';
-    let lx = pad;
-    for (const [deg, text] of [[0, 'no contact'], [45, '45°'], [90, '90°'], [135, '135°'], [180, '≥180° engaged']]) {
-      ctx.fillStyle = engagementColour(deg);
-      ctx.fillRect(lx, 4, 14, 10);
-      ctx.fillStyle = '#1d2327';
-      ctx.fillText(text, lx + 17, 3);
-      lx += ctx.measureText(text).width + 30;
-    }
-    this.view = view;
-    this.view.box = { top: 0, bottom: view.height };
-    finish(this.canvas, this.view);
-  }
-
-  // The tool circle at sample `index`, its engaged arcs in red and the travel direction.
-  cursor(index) {
-    const { ctx } = this.view;
-    ctx.putImageData(this.view.image, 0, 0);
-    if (index === undefined) {
-      delete this.canvas.dataset.cursor;
-      return;
-    }
-    this.canvas.dataset.cursor = String(index);
-    const sample = this.result.samples[index];
-    const [cx, cy] = this.map(sample.position);
-    const r = this.radius * this.scale;
-    const heading = sample.heading_deg * Math.PI / 180;
-    const t = [Math.cos(heading), Math.sin(heading)];
-    const right = [t[1], -t[0]];
-    // Tool angle θ → global angle γ = θ + angle of the right-hand normal; canvas y is down.
-    const rightAngle = Math.atan2(right[1], right[0]);
-    ctx.save();
-    ctx.strokeStyle = '#1d2327';
-    ctx.lineWidth = 1.5;
-    ctx.beginPath();
-    ctx.arc(cx, cy, r, 0, 2 * Math.PI);
-    ctx.stroke();
-    ctx.strokeStyle = '#d0021b';
-    ctx.lineWidth = 5;
-    for (const [from, to] of sample.arcs) {
-      ctx.beginPath();
-      ctx.arc(cx, cy, r, -(rightAngle + from * Math.PI / 180), -(rightAngle + to * Math.PI / 180), true);
-      ctx.stroke();
-    }
-    ctx.strokeStyle = '#1d2327';
-    ctx.lineWidth = 2;
-    ctx.beginPath();
-    ctx.moveTo(cx, cy);
-    ctx.lineTo(cx + t[0] * r * 1.3, cy - t[1] * r * 1.3);
-    ctx.stroke();
-    ctx.restore();
-  }
-
-  nearest(event) {
-    const rect = this.canvas.getBoundingClientRect();
-    const mx = event.clientX - rect.left;
-    const my = event.clientY - rect.top;
-    let best = 0;
-    let bestDistance = Infinity;
-    this.result.samples.forEach((s, i) => {
-      const [x, y] = this.map(s.position);
-      const d = (x - mx) ** 2 + (y - my) ** 2;
-      if (d < bestDistance) { bestDistance = d; best = i; }
-    });
-    return bestDistance < 400 ? best : undefined;
-  }
+  const samples = result.samples;
+  return {
+    rings: stockRings(stock),
+    cells,
+    removed: (stock?.previous_cuts || []).map((cut) => ({ points: pathPolyline(cut.path), width: 2 * cut.radius })),
+    path: samples.map((s, i) => {
+      const rapid = (s.flags || []).includes('rapid');
+      return { at: s.position, colour: i && rapid ? '#9aa5ae' : engagementColour(s.engaged_deg), dashed: rapid, heading: s.heading_deg, arcs: s.arcs };
+    }),
+    radius: answer.tool?.radius ?? 0,
+    legend: [[0, 'no contact'], [45, '45°'], [90, '90°'], [135, '135°'], [180, '≥180° engaged']].map(([deg, label]) => ({ label, colour: engagementColour(deg) })),
+  };
 }
 
 // ---------------------------------------------------------------------------------------------
-// Charts over the path (x = s or t), sharing a cursor
+// Charts over the path (x = s or t), sharing a cursor; drawn by plot.js
+
+// The sample (and its flute values) per flute count as [x, value] points.
+function perFlute(samples, key, field, k) {
+  return samples.map((s) => [s[key], s[field]?.[k]]);
+}
+
+function fluteLabel(flute) {
+  return `${flute.flute_count} flute${flute.flute_count === 1 ? '' : 's'}${flute.recommended ? ' ✓' : ''}`;
+}
 
 function seriesCharts(column, result, answer, axis, onCursor) {
   const samples = result.samples;
   const key = axis === 'time' ? 't' : 's';
   const last = samples[samples.length - 1] || { s: 0, t: 0 };
-  const xRange = [0, Math.max(1e-9, last[key])];
+  const x = [0, Math.max(1e-9, last[key])];
   const xLabel = axis === 'time' ? `time, s (${result.time_flute_count} flutes)` : 'path length s, mm';
   const charts = [];
-  const box = (width, height) => ({ left: 54, right: width - 10, top: 20, bottom: height - 34, height });
-
-  const make = (label, height, draw) => {
-    const canvas = document.createElement('canvas');
-    canvas.className = 'chart';
-    canvas.setAttribute('aria-label', label);
-    column.append(canvas);
-    const view = prepare(canvas, height);
-    view.box = box(view.width, view.height);
-    draw(view);
-    finish(canvas, view);
-    const chart = { canvas, view, map: view.map };
-    canvas.addEventListener('pointermove', (event) => {
-      const rect = canvas.getBoundingClientRect();
-      const px = event.clientX - rect.left;
-      if (px < view.box.left || px > view.box.right || !samples.length) return;
-      const v = xRange[0] + (px - view.box.left) / (view.box.right - view.box.left) * (xRange[1] - xRange[0]);
-      onCursor(nearestIndex(samples, key, v));
-    });
-    canvas.addEventListener('pointerleave', () => onCursor(undefined));
-    charts.push(chart);
-    return chart;
+  const chart = (label, height, spec) => {
+    const made = new PathChart(column, { label, height });
+    made.onHover((v) => onCursor(v === undefined || !samples.length ? undefined : nearestIndex(samples, key, v)));
+    made.draw({ x, xLabel, ...spec });
+    charts.push(made);
+    return made;
   };
+  const lines = (field) => result.flutes.map((flute, k) => ({
+    label: fluteLabel(flute), colour: kColour(k), width: flute.recommended ? 2.2 : 1.1, points: perFlute(samples, key, field, k),
+  }));
 
   // Contact-position graph (engagement.md §3.1, 410): engaged arcs at every sample.
   const back = samples.some((s) => s.arcs.some(([from]) => from < -1e-9));
   const thetaRange = back ? [-180, 180] : [0, 180];
-  make('Contact position over the path', 300, (view) => {
-    const { ctx } = view;
-    const map = frame(ctx, view.box, [...xRange, ...thetaRange],
-      { title: 'contact θ, ° (90 ahead, 0 right, 180 left)', x: xLabel, yticks: back ? 45 : 30 });
-    view.map = map;
-    ctx.fillStyle = '#0b3d91';
-    // Each sample's arcs span from its x to the next sample's, on whole pixels (no moiré).
-    samples.forEach((sample, i) => {
-      const next = samples[i + 1];
-      const x0 = Math.floor(map.x(sample[key]));
-      const w = Math.max(1, (next ? Math.floor(map.x(next[key])) : x0 + 1) - x0);
-      for (const [from, to] of sample.arcs) {
-        const pieces = to > 180 ? [[from, 180], [-180, to - 360]] : [[from, to]];
-        for (const [a, b] of pieces) {
-          const lo = Math.max(thetaRange[0], a);
-          const hi = Math.min(thetaRange[1], b);
-          if (hi < lo) continue;
-          ctx.fillRect(x0, Math.floor(map.y(hi)), w, Math.max(1, Math.ceil(map.y(lo) - map.y(hi))));
+  chart('Contact position over the path', 280, {
+    yLabel: 'contact angle θ, °', y: thetaRange, series: [],
+    legend: [{ label: 'engaged arc (θ: 90° ahead, 0° right, 180° left of travel)', colour: '#0b3d91' }]
+      .concat(result.contact_dots ? [{ label: 'removed dots', colour: 'rgb(230, 120, 0)' }] : []),
+    paint(g, map) {
+      g.fillStyle = '#0b3d91';
+      // Each sample's arcs span from its x to the next sample's, on whole pixels (no moiré).
+      samples.forEach((sample, i) => {
+        const next = samples[i + 1];
+        const x0 = Math.floor(map.x(sample[key]));
+        const w = Math.max(1, (next ? Math.floor(map.x(next[key])) : x0 + 1) - x0);
+        for (const [from, to] of sample.arcs) {
+          const pieces = to > 180 ? [[from, 180], [-180, to - 360]] : [[from, to]];
+          for (const [a, b] of pieces) {
+            const lo = Math.max(thetaRange[0], a);
+            const hi = Math.min(thetaRange[1], b);
+            if (hi < lo) continue;
+            g.fillRect(x0, Math.floor(map.y(hi)), w, Math.max(1, Math.ceil(map.y(lo) - map.y(hi))));
+          }
         }
+      });
+      if (result.contact_dots && key === 's') {
+        // The dots engine's removed dots (the seed's scatter).
+        g.fillStyle = 'rgba(230, 120, 0, 0.35)';
+        for (const [s, theta] of result.contact_dots) g.fillRect(Math.floor(map.x(s)), Math.floor(map.y(theta)), 1, 1);
       }
-    });
-    if (result.contact_dots && key === 's') {
-      // The dots engine's removed dots (the seed's scatter).
-      ctx.fillStyle = 'rgba(230, 120, 0, 0.35)';
-      for (const [s, theta] of result.contact_dots) ctx.fillRect(Math.floor(map.x(s)), Math.floor(map.y(theta)), 1, 1);
-    }
+    },
   });
 
   // Radial depth of cut (420).
-  const aeMax = samples.reduce((m, s) => Math.max(m, s.radial_depth), 1e-6);
-  make('Radial depth of cut over the path', 150, (view) => {
-    const { ctx } = view;
-    const map = frame(ctx, view.box, [...xRange, 0, aeMax * 1.08], { title: 'radial depth a_e, mm', x: xLabel });
-    view.map = map;
-    ctx.strokeStyle = '#2e8b57';
-    ctx.lineWidth = 1.5;
-    ctx.beginPath();
-    samples.forEach((s, i) => { if (i) ctx.lineTo(map.x(s[key]), map.y(s.radial_depth)); else ctx.moveTo(map.x(s[key]), map.y(s.radial_depth)); });
-    ctx.stroke();
+  chart('Radial depth of cut over the path', 170, {
+    yLabel: 'a_e, mm',
+    series: [{ label: 'radial depth of cut a_e', colour: '#2e8b57', points: samples.map((s) => [s[key], s.radial_depth]) }],
   });
 
-  // Summed chip thickness per flute count (430) with T1.
+  // Summed chip thickness per flute count (430) with the limit.
   const limit = answer.thickness_limit;
-  const hMax = Math.max(1e-6, limit || 0, ...result.flutes.map((f) => f.max_thickness));
-  make('Summed chip thickness per flute count over the path', 240, (view) => {
-    const { ctx } = view;
-    const map = frame(ctx, view.box, [...xRange, 0, hMax * 1.1], { title: 'summed chip thickness H_k, mm', x: xLabel });
-    view.map = map;
-    result.flutes.forEach((flute, k) => {
-      ctx.strokeStyle = kColour(k);
-      ctx.lineWidth = flute.recommended ? 2.2 : 1;
-      ctx.beginPath();
-      samples.forEach((s, i) => {
-        const h = s.thickness[k];
-        if (i) ctx.lineTo(map.x(s[key]), map.y(h)); else ctx.moveTo(map.x(s[key]), map.y(h));
-      });
-      ctx.stroke();
-    });
-    if (limit !== undefined) dashedLine(ctx, view.box.left, map.y(limit), view.box.right, map.y(limit), LIMIT, `T1 = ${limit} mm`);
-    ctx.font = '12px system-ui, sans-serif';
-    ctx.textBaseline = 'top';
-    let lx = view.box.left + 4;
-    result.flutes.forEach((flute, k) => {
-      ctx.fillStyle = kColour(k);
-      const text = `k=${flute.flute_count}${flute.recommended ? '✓' : ''}`;
-      ctx.fillText(text, lx, view.box.top + 3);
-      lx += ctx.measureText(text).width + 8;
-    });
+  chart('Summed chip thickness per flute count over the path', 240, {
+    yLabel: 'chip thickness H, mm', series: lines('thickness'),
+    limits: [{ value: limit, label: `limit ${limit} mm`, colour: LIMIT }],
   });
+
+  // Spindle torque and power per flute count (with Kienzle values): power is torque times
+  // 2πN/60, so one curve per flute count reads on both axes, with the machine's limits.
+  const torqueAt = samples.find((s) => s.torque_nm?.some((m) => m > 0));
+  if (torqueAt) {
+    const k = torqueAt.torque_nm.findIndex((m) => m > 0);
+    const factor = torqueAt.power_kw[k] / torqueAt.torque_nm[k];
+    const forces = result.forces || {};
+    chart('Spindle torque and power per flute count over the path', 260, {
+      yLabel: 'spindle torque, N·m', y2: { label: 'spindle power, kW', factor }, series: lines('torque_nm'),
+      limits: [
+        { value: forces.spindle_torque_nm, label: `machine torque ${forces.spindle_torque_nm} N·m`, colour: LIMIT },
+        { value: forces.spindle_power_kw / factor, label: `machine power ${forces.spindle_power_kw} kW`, colour: '#8a5a00' },
+      ],
+    });
+  }
 
   // The feed plan's F words along the path.
   const plan = result.feed_plan;
   if (plan && plan.blocks.length) {
-    const fMax = Math.max(1, plan.max_feed, ...plan.blocks.map((b) => b.feed || 0));
-    make('Planned feed over the path', 150, (view) => {
-      const { ctx } = view;
-      const map = frame(ctx, view.box, [...xRange, 0, fMax * 1.1],
-        { title: `planned feed F, mm/min (h* ${plan.target_thickness}, k ${plan.flute_count})`, x: xLabel });
-      view.map = map;
-      const toX = (s) => (key === 's' ? map.x(s) : map.x(samples[nearestIndex(samples, 's', s)].t));
-      ctx.strokeStyle = '#8e44ad';
-      ctx.lineWidth = 2;
-      for (const block of plan.blocks) {
-        if (block.feed === undefined) continue;
-        ctx.beginPath();
-        ctx.moveTo(toX(block.from_s), map.y(block.feed));
-        ctx.lineTo(toX(block.to_s), map.y(block.feed));
-        ctx.stroke();
-      }
-      dashedLine(ctx, view.box.left, map.y(plan.max_feed), view.box.right, map.y(plan.max_feed), LIMIT, `max feed ${plan.max_feed}`);
+    const toX = (s) => (key === 's' ? s : samples[nearestIndex(samples, 's', s)].t);
+    chart('Planned feed over the path', 190, {
+      yLabel: 'feed F, mm/min',
+      series: [{ label: `planned feed (chip ${plan.target_thickness} mm, ${plan.flute_count} flutes)`, colour: '#8e44ad', width: 2,
+        steps: plan.blocks.filter((b) => b.feed !== undefined).map((b) => [toX(b.from_s), toX(b.to_s), b.feed]) }],
+      limits: [{ value: plan.max_feed, label: `max feed ${plan.max_feed}`, colour: LIMIT }],
     });
   }
   return {
     charts,
     cursor(index) {
-      for (const chart of charts) {
-        cursorLine(chart.view, index === undefined ? undefined : chart.view.map.x(samples[index][key]));
-      }
+      for (const made of charts) made.cursor(index === undefined ? undefined : samples[index][key]);
     },
   };
 }
@@ -707,57 +435,19 @@ function fluteCharts(column, result, answer) {
   const row = document.createElement('div');
   row.className = 'chart-row';
   column.append(row);
-  const bars = (label, title, values, limit, limitLabel, draw) => {
-    const canvas = document.createElement('canvas');
-    canvas.className = 'chart';
-    canvas.setAttribute('aria-label', label);
-    row.append(canvas);
-    const view = prepare(canvas, 230);
-    view.box = { left: 54, right: view.width - 10, top: 20, bottom: view.height - 34, height: view.height };
-    const top = Math.max(1e-6, limit || 0, ...values) * 1.12;
-    const n = flutes.length;
-    const map = frame(view.ctx, view.box, [-0.5, n - 0.5, 0, top], {
-      title, x: 'flute count k', xticks: 1, xformat: (v) => (v >= 0 && v < n ? String(flutes[Math.round(v)].flute_count) : ''),
-    });
-    draw(view.ctx, map, (i) => map.x(i));
-    if (limit !== undefined) dashedLine(view.ctx, view.box.left, map.y(limit), view.box.right, map.y(limit), LIMIT, limitLabel);
-    finish(canvas, view);
-  };
   const colour = (f) => (f.recommended ? RECOMMENDED : REJECTED);
-  const markBest = (ctx, x, y, f) => {
-    if (f.flute_count !== best) return;
-    ctx.save();
-    ctx.fillStyle = RECOMMENDED;
-    ctx.font = 'bold 15px system-ui, sans-serif';
-    ctx.textAlign = 'center';
-    ctx.textBaseline = 'bottom';
-    ctx.fillText('★', x, y - 2);
-    ctx.restore();
-  };
-  bars('Chip thickness per flute count', 'H_k per k, mm: max bar, mean ▬, min ▭',
-    flutes.map((f) => f.max_thickness), answer.thickness_limit, answer.thickness_limit !== undefined ? `T1 = ${answer.thickness_limit}` : '',
-    (ctx, map, xc) => {
-      const w = Math.max(6, (map.x(1) - map.x(0)) * 0.6);
-      flutes.forEach((f, i) => {
-        ctx.fillStyle = colour(f);
-        ctx.fillRect(xc(i) - w / 2, map.y(f.max_thickness), w, map.y(0) - map.y(f.max_thickness));
-        ctx.fillStyle = '#1d2327';
-        ctx.fillRect(xc(i) - w / 2, map.y(f.mean_thickness) - 1.5, w, 3);
-        ctx.strokeStyle = '#1d2327';
-        ctx.strokeRect(xc(i) - w / 2, map.y(f.min_thickness) - 1, w, 2);
-        markBest(ctx, xc(i), map.y(f.max_thickness), f);
-      });
-    });
-  bars('Machining time per flute count', 'machining time P_k, s',
-    flutes.map((f) => f.time_s), answer.time_limit_s, answer.time_limit_s !== undefined ? `T2 = ${answer.time_limit_s} s` : '',
-    (ctx, map, xc) => {
-      const w = Math.max(6, (map.x(1) - map.x(0)) * 0.6);
-      flutes.forEach((f, i) => {
-        ctx.fillStyle = colour(f);
-        ctx.fillRect(xc(i) - w / 2, map.y(f.time_s), w, map.y(0) - map.y(f.time_s));
-        markBest(ctx, xc(i), map.y(f.time_s), f);
-      });
-    });
+  const legend = [{ label: 'meets the limits', colour: RECOMMENDED, swatch: 'bar' }, { label: 'does not', colour: REJECTED, swatch: 'bar' }];
+  const categories = flutes.map((f) => String(f.flute_count));
+  barChart(row, 'Chip thickness per flute count', {
+    title: 'chip thickness H, mm: largest (bar), mean ▬, least ▭', xLabel: 'flute count', categories, legend,
+    bars: flutes.map((f) => ({ value: f.max_thickness, mean: f.mean_thickness, min: f.min_thickness, colour: colour(f), best: f.flute_count === best })),
+    limits: [{ value: answer.thickness_limit, label: `limit ${answer.thickness_limit} mm`, colour: LIMIT }],
+  });
+  barChart(row, 'Machining time per flute count', {
+    title: 'machining time, s', xLabel: 'flute count', categories, legend,
+    bars: flutes.map((f) => ({ value: f.time_s, colour: colour(f), best: f.flute_count === best })),
+    limits: [{ value: answer.time_limit_s, label: `limit ${answer.time_limit_s} s`, colour: LIMIT }],
+  });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -766,15 +456,21 @@ function fluteCharts(column, result, answer) {
 function fluteTable(result) {
   const table = document.createElement('table');
   table.className = 'flutes';
-  table.innerHTML = '<thead><tr><th>k</th><th>f_z, mm</th><th>V_f, mm/min</th><th>max H, mm</th><th>mean H</th><th>min H</th><th>median H</th><th>time, s</th><th>teeth at once</th><th>recommended</th></tr></thead>';
+  // With Kienzle values the flute counts also carry torque, power and the tooth-passing frequency.
+  const physics = result.flutes.some((f) => f.mean_torque_nm !== undefined && f.mean_torque_nm !== null);
+  const head = ['flutes', 'feed per tooth, mm', 'feed, mm/min', 'largest H, mm', 'mean H', 'least H', 'median H', 'time, s', 'teeth at once']
+    .concat(physics ? ['torque mean / peak, N·m', 'power mean / peak, kW', 'tooth passing, Hz'] : [], ['recommended']);
+  table.innerHTML = `<thead><tr>${head.map((h) => `<th>${h}</th>`).join('')}</tr></thead>`;
   const body = document.createElement('tbody');
   for (const f of result.flutes) {
     const tr = document.createElement('tr');
     if (f.recommended) tr.className = 'recommended';
     if (f.flute_count === result.recommended[0]) tr.classList.add('best');
+    const loads = physics ? [`${number(f.mean_torque_nm, 2)} / ${number(f.peak_torque_nm, 2)}`,
+      `${number(f.mean_power_kw, 3)} / ${number(f.peak_power_kw, 3)}`, number(f.tooth_passing_hz, 1)] : [];
     for (const text of [f.flute_count, number(f.feed_per_tooth, 4), number(f.feed, 0), number(f.max_thickness, 5),
       number(f.mean_thickness, 5), number(f.min_thickness, 5), number(f.median_thickness, 5), number(f.time_s, 2),
-      f.max_teeth, f.recommended ? (f.flute_count === result.recommended[0] ? '★ yes (fastest)' : 'yes') : 'no']) {
+      f.max_teeth, ...loads, f.recommended ? (f.flute_count === result.recommended[0] ? '★ yes (fastest)' : 'yes') : 'no']) {
       const td = document.createElement('td');
       td.textContent = String(text);
       tr.append(td);
@@ -788,8 +484,12 @@ function fluteTable(result) {
 function readout(sample, result) {
   if (!sample) return 'Move over a chart or the path to place the tool.';
   const arcs = sample.arcs.map(([a, b]) => `[${a.toFixed(1)}°, ${b.toFixed(1)}°]`).join(' ') || 'none';
-  const h = result.flutes.map((f, k) => `k${f.flute_count} ${sample.thickness[k].toFixed(4)}`).join(', ');
-  return `s = ${sample.s.toFixed(3)} mm, t = ${sample.t.toFixed(2)} s, at (${sample.position[0].toFixed(3)}, ${sample.position[1].toFixed(3)}): arcs ${arcs}, Φ = ${sample.engaged_deg.toFixed(1)}°, a_e = ${sample.radial_depth.toFixed(3)} mm; H: ${h}`;
+  const h = result.flutes.map((f, k) => `${f.flute_count} flutes ${sample.thickness[k].toFixed(4)}`).join(', ');
+  // Torque and power at the tool's own flute count (the one the time axis is for).
+  const own = result.flutes.findIndex((f) => f.flute_count === result.time_flute_count);
+  const load = sample.torque_nm?.length && own >= 0
+    ? `; torque ${sample.torque_nm[own].toFixed(2)} N·m, power ${sample.power_kw[own].toFixed(3)} kW (${result.time_flute_count} flutes)` : '';
+  return `s = ${sample.s.toFixed(3)} mm, t = ${sample.t.toFixed(2)} s, at (${sample.position[0].toFixed(3)}, ${sample.position[1].toFixed(3)}): arcs ${arcs}, engaged ${sample.engaged_deg.toFixed(1)}°, a_e = ${sample.radial_depth.toFixed(3)} mm; chip thickness H: ${h}${load}`;
 }
 
 function renderColumn(column, result, answer, axis) {
@@ -806,7 +506,7 @@ function renderColumn(column, result, answer, axis) {
   const items = [
     ['path length, mm', number(result.path_length, 2)],
     ['feed length, mm', number(result.feed_length, 2)],
-    ['max engaged Φ, °', `${number(result.max_engaged_deg, 1)} at s ${number(result.max_engaged_at_s, 2)}`],
+    ['largest engaged angle, °', `${number(result.max_engaged_deg, 1)} at s ${number(result.max_engaged_at_s, 2)}`],
     ['max radial depth, mm', number(result.max_radial_depth, 3)],
     ['engine, step', `${result.engine}, ${result.step} mm`],
     ['samples', result.samples.length],
@@ -828,8 +528,7 @@ function renderColumn(column, result, answer, axis) {
   const info = document.createElement('p');
   info.className = 'hint cursor-readout';
   column.append(heading, verdict, summary, plan, info);
-  const planView = new PlanView(plan, result, answer);
-  planView.draw();
+  const planView = new ToolPlan(plan, planSpec(result, answer));
   let series;
   // The timeline along the samples: the same cursor from the keyboard (arrow keys step).
   const slider = document.createElement('input');
@@ -872,8 +571,6 @@ function renderColumn(column, result, answer, axis) {
   column.cursor = setCursor;
 }
 
-// Shows an engagement answer in `container`: one column per candidate path, side by side.
-// Used by the form and by job results.
 // Shows an engagement answer in `container`: one candidate path at a time, chosen with tabs that
 // name each path's best flute count; the charts take the width of the result column.
 // `onSelect(index)` hears which candidate is shown (the form's G-code choice follows it).
@@ -922,6 +619,7 @@ export function engagementResult(container, answer, { onSelect } = {}) {
     shown = index;
     cells.forEach((cell, i) => {
       cell.hidden = i !== index;
+      if (i !== index) cell.replaceChildren();
       tabs.children[i].setAttribute('aria-selected', String(i === index));
       tabs.children[i].tabIndex = i === index ? 0 : -1;
     });
@@ -929,9 +627,9 @@ export function engagementResult(container, answer, { onSelect } = {}) {
     renderColumn(cells[index], candidates[index], answer, axis.value);
     onSelect?.(index);
   };
-  const render = () => candidates.forEach((result, i) => renderColumn(cells[i], result, answer, axis.value));
-  axis.addEventListener('change', render);
-  render();
+  // Only the candidate shown is drawn (select draws it), so a comparison of many paths is
+  // as light as one.
+  axis.addEventListener('change', () => select(shown));
   select(shown);
   // Charts follow the width of the result column (a window resized, columns stacked).
   let width = columns.clientWidth;

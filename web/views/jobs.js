@@ -24,15 +24,56 @@ function cell(text) {
   return td;
 }
 
+// Operations whose solver reports its progress while it runs (the service's job runner passes it
+// on); the others move the job's progress only when they finish. The API does not say which
+// operations report, so this mirrors the service (predict only) and must follow it.
+const REPORTS_PROGRESS = new Set(['predict']);
+
+// The progress cell: what the service reports, no more. A running operation that reports no
+// progress of its own gets an indeterminate bar (no value) and says which operation is running;
+// a queued job has no bar.
+function progressCell(job) {
+  const td = document.createElement('td');
+  td.className = 'progress';
+  const count = job.operations.length;
+  // A long job's first per cent takes a while: tenths until 10 %, so the number moves too.
+  const percent = `${(job.progress * 100).toFixed(job.progress < 0.1 ? 1 : 0)}%`;
+  const bar = document.createElement('progress');
+  bar.max = 1;
+  if (job.status === 'queued') {
+    td.dataset.progress = 'waiting';
+    td.append('waiting');
+    return td;
+  }
+  if (job.status === 'running') {
+    const index = Math.min(count - 1, Math.floor(job.progress * count + 1e-9));
+    const operation = job.operations[index];
+    const of = count > 1 ? `operation ${index + 1} of ${count}, ` : '';
+    if (REPORTS_PROGRESS.has(operation)) {
+      bar.value = job.progress;
+      td.dataset.progress = 'reported';
+      td.append(bar, ` ${percent}`);
+      bar.setAttribute('aria-label', `${of}${operation}: ${percent}`);
+    } else {
+      // No value: the browser shows "busy", not a number the service never gave.
+      td.dataset.progress = 'unknown';
+      const note = `${of}${operation} running (it reports no progress)`;
+      bar.setAttribute('aria-label', note);
+      td.append(bar, ` ${note}`);
+    }
+    return td;
+  }
+  bar.value = job.status === 'done' ? 1 : job.progress;
+  td.dataset.progress = job.status;
+  td.append(bar, ` ${job.status === 'done' ? '100%' : percent}`);
+  return td;
+}
+
 function row(job, root) {
   const tr = document.createElement('tr');
   tr.dataset.job = String(job.id);
   tr.dataset.status = job.status;
-  const bar = document.createElement('progress');
-  bar.max = 1;
-  bar.value = job.progress;
-  const progress = document.createElement('td');
-  progress.append(bar, ` ${Math.round(job.progress * 100)}%`);
+  const progress = progressCell(job);
   const status = cell(job.status);
   status.className = `status ${job.status}`;
   if (job.error) status.title = job.error;

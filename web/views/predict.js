@@ -4,8 +4,8 @@
 // scale, a histogram of the errors, the worst passes with their NC lines, warnings, and the
 // corrected program. `predictResult` also shows prediction jobs.
 import { api } from '/api.js';
-import { clearProblem, computed, computing, download, keepForm, loadTools, markComputed, message, number, numeric, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
-import { Scene3D, THREE, css, diverging } from '/plot.js';
+import { clearProblem, computed, computing, download, half, keepForm, loadTools, markComputed, message, number, numeric, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
+import { Scene3D, THREE, css, diverging, drawColourScale, drawHistogram } from '/plot.js';
 import { Timeline } from '/timeline.js';
 
 // The sample: a raster finishing program over a gentle dome (20 × 20 mm, 2 mm high) with an R3
@@ -71,7 +71,8 @@ const FORM = `
     <fieldset><legend>Tool (ball end mill)</legend>
       <label>Tool <select name="tool_choice" data-field="tool"></select></label>
       <div data-inline-tool>
-        <label>Ball radius, mm <input name="radius" type="number" step="any" value="3" data-field="tool.radius"></label>
+        <label>Size entered as <select name="size_as"><option value="diameter">diameter Ø</option><option value="radius">radius</option></select></label>
+        <label><span data-size-label>Ball diameter Ø, mm</span> <input name="ball_size" type="number" step="any" value="6" data-field="tool.radius"></label>
         <label>Flutes <input name="flutes" type="number" value="2" data-field="tool.flutes"></label>
         <label>Helix angle, ° <input name="helix" type="number" step="any" value="30" data-field="tool.helix_deg"></label>
         <label class="stacked"><span>Shape error: contact angle in ° (0 = tip, 90 = equator) and error in mm, one pair a line <abbr class="symbol" title="δ(θ)">δ(θ)</abbr></span><textarea name="shape_error" rows="4" data-field="tool.shape_error" title="one row per contact angle: angle in degrees (0 = tip, 90 = equator), error in mm">0 0.004
@@ -137,12 +138,18 @@ function rows(text) {
   return text.split('\n').map((l) => l.trim()).filter((l) => l !== '').map((l) => l.split(/[\s,;]+/).map(Number));
 }
 
+// The inline ball's radius, as the API takes it, from the size entered as a diameter or a radius.
+function ballRadius(form) {
+  const size = numeric(form, 'ball_size');
+  return value(form, 'size_as') === 'diameter' ? half(size) : size;
+}
+
 // The request body from the form (field names as api.md) and, for an STL stock, the file.
 export function predictRequest(form) {
   const choice = value(form, 'tool_choice');
   let tool = Number(choice);
   if (choice === 'inline') {
-    tool = { kind: 'ball', radius: numeric(form, 'radius'), flutes: numeric(form, 'flutes') ?? 2, helix_deg: numeric(form, 'helix') };
+    tool = { kind: 'ball', radius: ballRadius(form), flutes: numeric(form, 'flutes') ?? 2, helix_deg: numeric(form, 'helix') };
     tool.shape_error = rows(value(form, 'shape_error')).map(([angle, error]) => ({ angle_deg: angle, error }));
     const kind = value(form, 'stiffness_kind');
     const k = numeric(form, 'k');
@@ -199,6 +206,7 @@ function syncVisibility(form) {
   const kind = value(form, 'stock_kind');
   form.querySelectorAll('[data-stock]').forEach((e) => { e.hidden = e.dataset.stock !== kind; });
   form.querySelector('[data-inline-tool]').hidden = value(form, 'tool_choice') !== 'inline';
+  form.querySelector('[data-size-label]').textContent = value(form, 'size_as') === 'diameter' ? 'Ball diameter Ø, mm' : 'Ball radius, mm';
   const stiffness = value(form, 'stiffness_kind');
   form.querySelectorAll('[data-stiffness]').forEach((e) => { e.hidden = !e.dataset.stiffness.split(' ').includes(stiffness); });
 }
@@ -274,110 +282,6 @@ function runs(passes) {
   return out;
 }
 
-function drawScale(canvas, limit, band) {
-  const [low, high] = [-limit, limit];
-  const width = canvas.clientWidth;
-  const height = canvas.clientHeight;
-  const ratio = window.devicePixelRatio || 1;
-  canvas.width = Math.round(width * ratio);
-  canvas.height = Math.round(height * ratio);
-  const g = canvas.getContext('2d');
-  g.setTransform(ratio, 0, 0, ratio, 0, 0);
-  g.fillStyle = '#fff';
-  g.fillRect(0, 0, width, height);
-  const left = 10;
-  const right = width - 10;
-  for (let x = left; x < right; x++) {
-    g.fillStyle = colourOf(low + (high - low) * (x - left) / (right - left), limit);
-    g.fillRect(x, 4, 1, 22);
-  }
-  g.fillStyle = '#1d2327';
-  g.font = '15px sans-serif';
-  g.textBaseline = 'top';
-  g.textAlign = 'left';
-  g.fillText(`${microns(low)} µm`, left, 30);
-  g.textAlign = 'right';
-  g.fillText(`${microns(high)} µm`, right, 30);
-  if (low < 0 && high > 0) {
-    const zero = left + (right - left) * (-low / (high - low));
-    g.fillRect(zero, 0, 2, 28);
-    g.textAlign = 'center';
-    g.fillText('0', zero, 30);
-  }
-  if (band > 0) {
-    // The tolerance band: a dashed box over the scale from −band to +band.
-    const at = (e) => left + (right - left) * ((Math.max(low, Math.min(high, e)) - low) / (high - low));
-    g.strokeStyle = '#1d2327';
-    g.lineWidth = 2;
-    g.setLineDash([5, 3]);
-    g.strokeRect(at(-band), 2, at(band) - at(-band), 26);
-    g.setLineDash([]);
-  }
-  canvas.dataset.state = 'drawn';
-}
-
-function drawHistogram(canvas, errors, low, high, limit, band) {
-  const width = canvas.clientWidth;
-  const height = canvas.clientHeight;
-  const ratio = window.devicePixelRatio || 1;
-  canvas.width = Math.round(width * ratio);
-  canvas.height = Math.round(height * ratio);
-  const g = canvas.getContext('2d');
-  g.setTransform(ratio, 0, 0, ratio, 0, 0);
-  g.fillStyle = '#fff';
-  g.fillRect(0, 0, width, height);
-  if (!errors.length) {
-    canvas.dataset.state = 'empty';
-    return;
-  }
-  const bins = 30;
-  const span = high - low || 1e-9;
-  const counts = new Array(bins).fill(0);
-  for (const e of errors) counts[Math.min(bins - 1, Math.floor(((e - low) / span) * bins))]++;
-  const most = Math.max(...counts);
-  const [left, right, top, bottom] = [50, width - 12, 12, height - 34];
-  g.strokeStyle = '#5b6670';
-  g.beginPath();
-  g.moveTo(left, top);
-  g.lineTo(left, bottom);
-  g.lineTo(right, bottom);
-  g.stroke();
-  const w = (right - left) / bins;
-  counts.forEach((count, i) => {
-    const h = (count / most) * (bottom - top);
-    g.fillStyle = colourOf(low + span * (i + 0.5) / bins, limit);
-    g.fillRect(left + i * w + 1, bottom - h, Math.max(1, w - 2), h);
-  });
-  g.fillStyle = '#1d2327';
-  g.font = '14px sans-serif';
-  g.textAlign = 'right';
-  g.textBaseline = 'middle';
-  g.fillText(String(most), left - 6, top + 4);
-  g.fillText('0', left - 6, bottom);
-  g.textBaseline = 'top';
-  g.textAlign = 'left';
-  g.fillText(`${microns(low)}`, left, bottom + 6);
-  g.textAlign = 'right';
-  g.fillText(`${microns(high)} µm`, right, bottom + 6);
-  g.textAlign = 'center';
-  g.fillText('passes per error', (left + right) / 2, bottom + 6);
-  if (band > 0) {
-    g.strokeStyle = '#1d2327';
-    g.setLineDash([5, 3]);
-    for (const e of [-band, band]) {
-      if (e < low || e > high) continue;
-      const x = left + (right - left) * ((e - low) / span);
-      g.beginPath();
-      g.moveTo(x, top);
-      g.lineTo(x, bottom);
-      g.stroke();
-    }
-    g.setLineDash([]);
-  }
-  canvas.dataset.state = 'drawn';
-  canvas.dataset.bins = String(counts.filter((c) => c > 0).length);
-}
-
 // Shows a prediction in `container`: path coloured by error with its scale, histogram, summary,
 // worst passes and warnings. `context`: the `request` adds the stock, the `program` the timeline
 // (a worst pass goes to its line). Used by the form and by job results.
@@ -445,8 +349,9 @@ export function predictResult(container, answer, { request, program } = {}) {
   const end = (pass) => pass.corrected.map((c, k) => c - pass.correction[k]);
   const redraw = () => {
     const band = Number(bandInput.value) / 1000;
-    drawScale(scale, limit, band);
-    drawHistogram(histogram, errors, low, high, limit, band);
+    const colour = (e) => colourOf(e, limit);
+    drawColourScale(scale, { low: -limit, high: limit, band, colour, format: microns, unit: 'µm' });
+    drawHistogram(histogram, errors, { low, high, band, colour, format: microns, unit: 'µm', label: 'passes per error' });
     const outside = band > 0 ? errors.filter((e) => Math.abs(e) > band).length : null;
     bandCount.textContent = outside === null ? '' : `${outside} of ${errors.length} passes outside ±${bandInput.value} µm.`;
   };
@@ -463,7 +368,7 @@ export function predictResult(container, answer, { request, program } = {}) {
     ['largest correction, µm', `${microns(s.max_correction)}${s.clamped ? ` (${s.clamped} clamped)` : ''}`],
     ['no cut / no surface / outside', `${s.no_cut} / ${s.no_surface} / ${s.outside_stock}`],
     ['method', `${s.method.replace('_', ' ')}, N ${s.resolution} (${number(s.pixel_size * 1000, 1)} µm)`],
-    ['tool', `${answer.tool.number ? 'T' + answer.tool.number + ' ' : ''}ball R${answer.tool.radius}`],
+    ['tool', `${answer.tool.number ? 'T' + answer.tool.number + ' ' : ''}ball Ø${Number((2 * answer.tool.radius).toFixed(3))} mm`],
   ].concat(answer.timings ? [['time', `${number(answer.timings.solve_ms / 1000, 2)} s (${Math.round(answer.timings.passes_per_s)} passes/s)`]] : []));
 
   const head = document.createElement('tr');
@@ -558,7 +463,7 @@ export const predictView = {
       const { body } = predictRequest(form);
       const slot = value(form, 'save_number');
       try {
-        await api('PUT', `/api/v1/tools/${encodeURIComponent(slot)}`, { ...body.tool, name: `R${body.tool.radius} ball, shape error` });
+        await api('PUT', `/api/v1/tools/${encodeURIComponent(slot)}`, { ...body.tool, name: `Ø${2 * body.tool.radius} ball, shape error` });
         messages.replaceChildren(message('ok', `tool ${slot} saved with its shape-error table`));
         await loadTools(form.elements.tool_choice, 'inline ball (below)', isBall, predictToolLabel);
       } catch (problem) {
