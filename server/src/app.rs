@@ -52,6 +52,7 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
         .split_for_parts();
     let mut document = document;
     crate::openapi::describe_responses(&mut document);
+    crate::openapi::describe_security(&mut document);
     (routes, document)
 }
 

@@ -12,6 +12,7 @@ use utoipa::OpenApi;
                        application/problem+json (RFC 9457) with a stable `code` and the fields at fault in `errors`.",
         license(name = "MIT OR Apache-2.0")
     ),
+    components(schemas(crate::http::output::Format, crate::http::contour::JsonOnly)),
     tags(
         (name = "service", description = "Health"),
         (name = "tools", description = "The tool table, keyed by tool number"),
@@ -47,6 +48,32 @@ pub fn describe_responses(document: &mut utoipa::openapi::OpenApi) {
                     reason.clone_into(&mut response.description);
                 }
             }
+        }
+    }
+}
+
+/// Documents the optional API token: a bearer scheme, every operation open without it or with it
+/// (the server asks for it only when `--api-token` is set), and a 401 on every `/api/v1` operation
+/// (with a token set, changes and solver calls need it; with `--private`, reads too).
+pub fn describe_security(document: &mut utoipa::openapi::OpenApi) {
+    use utoipa::openapi::security::{Http, HttpAuthScheme, SecurityRequirement, SecurityScheme};
+    use utoipa::openapi::{Content, Ref, RefOr, ResponseBuilder};
+    let components = document.components.get_or_insert_with(Default::default);
+    components.add_security_scheme("bearer", SecurityScheme::Http(Http::new(HttpAuthScheme::Bearer)));
+    document.security =
+        Some(vec![SecurityRequirement::default(), SecurityRequirement::new("bearer", Vec::<String>::new())]);
+    let unauthorised = ResponseBuilder::new()
+        .description("Missing or wrong API token (only when the service has one)")
+        .content("application/problem+json", Content::new(Some(RefOr::Ref(Ref::from_schema_name("Problem")))))
+        .build();
+    for (path, item) in &mut document.paths.paths {
+        if !path.starts_with("/api/v1/") {
+            continue;
+        }
+        let operations =
+            [&mut item.get, &mut item.put, &mut item.post, &mut item.delete, &mut item.patch, &mut item.head];
+        for operation in operations.into_iter().flatten() {
+            operation.responses.responses.entry("401".to_owned()).or_insert_with(|| RefOr::T(unauthorised.clone()));
         }
     }
 }

@@ -71,3 +71,38 @@ fn every_response_has_a_description() {
         }
     }
 }
+
+/// Every `$ref` names a schema the document defines.
+#[test]
+fn every_reference_is_defined() {
+    let (_, document) = kerf_server::app::api();
+    let json = serde_json::to_value(&document).unwrap();
+    let defined = json["components"]["schemas"].as_object().unwrap();
+    let text = json.to_string();
+    for piece in text.split("\"#/components/schemas/").skip(1) {
+        let name = &piece[..piece.find('"').unwrap()];
+        assert!(defined.contains_key(name), "#/components/schemas/{name} is referenced but not defined");
+    }
+}
+
+/// Routes that answer JSON or a program document both media types on their 200, and every API
+/// operation its 401 (the token) with the bearer scheme.
+#[test]
+fn answers_and_the_token_are_documented() {
+    let (_, document) = kerf_server::app::api();
+    let json = serde_json::to_value(&document).unwrap();
+    assert_eq!(json["components"]["securitySchemes"]["bearer"]["scheme"], "bearer");
+    for path in ["/api/v1/deburr", "/api/v1/segment", "/api/v1/contour", "/api/v1/engagement", "/api/v1/predict"] {
+        let content = &json["paths"][path]["post"]["responses"]["200"]["content"];
+        assert!(content["application/json"].is_object() && content["text/x-gcode"].is_object(), "{path}: {content}");
+        assert!(json["paths"][path]["post"]["responses"]["429"].is_object(), "{path} has no 429");
+    }
+    for (path, item) in json["paths"].as_object().unwrap() {
+        if !path.starts_with("/api/v1/") {
+            continue;
+        }
+        for (method, operation) in item.as_object().unwrap() {
+            assert!(operation["responses"]["401"].is_object(), "{method} {path} has no 401");
+        }
+    }
+}

@@ -32,12 +32,14 @@ use crate::store;
     params(OutputQuery),
     request_body = ContourRequest,
     responses(
-        (status = 200, description = "The path as JSON", body = ContourResult),
-        (status = 200, description = "The program (`?format=gcode`)", body = String, content_type = "text/x-gcode"),
+        (status = 200, description = "The path as JSON, or the program (`?format=gcode`)", content(
+            (ContourResult = "application/json"),
+            (String = "text/x-gcode"))),
         (status = 400, body = Problem, content_type = "application/problem+json"),
         (status = 404, description = "Unknown tool number or machine", body = Problem, content_type = "application/problem+json"),
         (status = 413, body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
+        (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json"),
         (status = 422, description = "Impossible contour or over a limit (codes in corners.md §5; `E_TOO_MANY_MOVES` for answers over the move limit); `E_TIMEOUT` over the synchronous time limit: submit a job", body = Problem, content_type = "application/problem+json")))]
 async fn post_contour(
     State(state): State<AppState>,
@@ -80,6 +82,7 @@ pub struct LoopsQuery {
         (status = 404, description = "Unknown tool number", body = Problem, content_type = "application/problem+json"),
         (status = 413, body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
+        (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json"),
         (status = 422, description = "Bad numbers, a degenerate path, or over a limit; `E_TIMEOUT` over the synchronous time limit", body = Problem, content_type = "application/problem+json")))]
 async fn post_loops(
     State(state): State<AppState>,

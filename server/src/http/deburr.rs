@@ -22,12 +22,14 @@ use crate::state::AppState;
     params(OutputQuery),
     request_body = DeburrRequest,
     responses(
-        (status = 200, description = "The path as JSON", body = DeburrAnswer),
-        (status = 200, description = "The program (`?format=gcode`)", body = String, content_type = "text/x-gcode"),
+        (status = 200, description = "The path as JSON, or the program (`?format=gcode`)", content(
+            (DeburrAnswer = "application/json"),
+            (String = "text/x-gcode"))),
         (status = 400, body = Problem, content_type = "application/problem+json"),
         (status = 404, description = "Unknown tool number or machine", body = Problem, content_type = "application/problem+json"),
         (status = 413, body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
+        (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json"),
         (status = 422, description = "Impossible geometry (codes in deburr.md §4); `E_TIMEOUT` over the synchronous time limit: submit a job", body = Problem, content_type = "application/problem+json")))]
 async fn post_deburr(
     State(state): State<AppState>,

@@ -50,8 +50,9 @@ pub struct EngagementQuery {
     params(EngagementQuery),
     request_body = EngagementRequest,
     responses(
-        (status = 200, description = "The engagement analysis as JSON", body = EngagementResponse),
-        (status = 200, description = "The program of one path (`?format=gcode`)", body = String, content_type = "text/x-gcode"),
+        (status = 200, description = "The engagement analysis as JSON, or the program of one path (`?format=gcode`)", content(
+            (EngagementResponse = "application/json"),
+            (String = "text/x-gcode"))),
         (status = 400, body = Problem, content_type = "application/problem+json"),
         (status = 404, description = "Unknown tool number or machine", body = Problem, content_type = "application/problem+json"),
         (status = 413, body = Problem, content_type = "application/problem+json"),

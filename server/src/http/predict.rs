@@ -139,8 +139,9 @@ async fn upload(state: &AppState, request: Request) -> AppResult<Upload> {
             (PredictRequest = "application/json"),
             (PredictForm = "multipart/form-data"))),
     responses(
-        (status = 200, description = "The prediction as JSON", body = PredictAnswer),
-        (status = 200, description = "The corrected program (`?format=gcode`)", body = String, content_type = "text/x-gcode"),
+        (status = 200, description = "The prediction as JSON, or the corrected program (`?format=gcode`)", content(
+            (PredictAnswer = "application/json"),
+            (String = "text/x-gcode"))),
         (status = 400, description = "Not the right shape (JSON or form)", body = Problem, content_type = "application/problem+json"),
         (status = 404, description = "Unknown tool number", body = Problem, content_type = "application/problem+json"),
         (status = 413, description = "Body over the upload limit", body = Problem, content_type = "application/problem+json"),

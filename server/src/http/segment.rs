@@ -23,12 +23,14 @@ use crate::state::AppState;
     params(OutputQuery),
     request_body = SegmentRequest,
     responses(
-        (status = 200, description = "The blocks as JSON", body = SegmentResult),
-        (status = 200, description = "The program (`?format=gcode`)", body = String, content_type = "text/x-gcode"),
+        (status = 200, description = "The blocks as JSON, or the program (`?format=gcode`)", content(
+            (SegmentResult = "application/json"),
+            (String = "text/x-gcode"))),
         (status = 400, body = Problem, content_type = "application/problem+json"),
         (status = 404, description = "Unknown machine or tool number", body = Problem, content_type = "application/problem+json"),
         (status = 413, body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
+        (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json"),
         (status = 422, description = "Impossible request: `E_INPUT`, `E_DEGENERATE_CURVE`, `E_INFEASIBLE_FEED_FOR_RADIUS` (the message gives the largest feasible feed), `E_TOO_MANY_BLOCKS`, `E_TOO_MANY_POINTS`, `E_NUMERIC_FAILURE`; `E_TIMEOUT` over the synchronous time limit: submit a job", body = Problem, content_type = "application/problem+json")))]
 async fn post_segment(
     State(state): State<AppState>,
