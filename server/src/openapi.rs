@@ -27,14 +27,31 @@ use utoipa::OpenApi;
 )]
 pub struct ApiDoc;
 
-/// Gives every response without a description its status's reason phrase: OpenAPI requires a
-/// description on every response, and utoipa leaves out the empty ones.
+/// Gives every response without a description its status's reason phrase (OpenAPI requires a
+/// description on every response, and utoipa leaves out the empty ones), and documents the 400
+/// of every operation with parameters.
 pub fn describe_responses(document: &mut utoipa::openapi::OpenApi) {
     use utoipa::openapi::RefOr;
     for item in document.paths.paths.values_mut() {
         let operations =
             [&mut item.get, &mut item.put, &mut item.post, &mut item.delete, &mut item.patch, &mut item.head];
         for operation in operations.into_iter().flatten() {
+            // The path and query extractors answer 400 for a parameter that does not parse.
+            if operation.parameters.as_ref().is_some_and(|parameters| !parameters.is_empty()) {
+                operation.responses.responses.entry("400".to_owned()).or_insert_with(|| {
+                    RefOr::T(
+                        utoipa::openapi::ResponseBuilder::new()
+                            .description("A path or query parameter that does not parse")
+                            .content(
+                                "application/problem+json",
+                                utoipa::openapi::Content::new(Some(RefOr::Ref(
+                                    utoipa::openapi::Ref::from_schema_name("Problem"),
+                                ))),
+                            )
+                            .build(),
+                    )
+                });
+            }
             for (status, response) in &mut operation.responses.responses {
                 if let RefOr::T(response) = response
                     && response.description.is_empty()

@@ -202,7 +202,7 @@ async fn record(state: &AppState, id: i64) -> AppResult<JobRecord> {
 
 /// A job: status, progress and, when done, its results.
 #[utoipa::path(get, path = "/api/v1/jobs/{id}", tag = "jobs",
-    params(("id" = i64, Path, description = "Job id")),
+    params(("id" = i64, Path, description = "Job id", minimum = 1)),
     responses((status = 200, body = JobView), (status = 404, body = Problem, content_type = "application/problem+json")))]
 async fn show(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobId>) -> AppResult<Json<JobView>> {
     let job = record(&state, id).await?;
@@ -222,7 +222,7 @@ async fn show(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobI
 
 /// A finished job's G-code program (one per operation).
 #[utoipa::path(get, path = "/api/v1/jobs/{id}/gcode", tag = "jobs",
-    params(("id" = i64, Path, description = "Job id"), ProgramQuery),
+    params(("id" = i64, Path, description = "Job id", minimum = 1), ProgramQuery),
     responses(
         (status = 200, body = String, content_type = "text/x-gcode"),
         (status = 404, body = Problem, content_type = "application/problem+json"),
@@ -269,7 +269,7 @@ async fn gcode(
 
 /// Cancels a queued or running job.
 #[utoipa::path(delete, path = "/api/v1/jobs/{id}", tag = "jobs",
-    params(("id" = i64, Path, description = "Job id")),
+    params(("id" = i64, Path, description = "Job id", minimum = 1)),
     responses(
         (status = 200, description = "Cancelled", body = JobView),
         (status = 404, body = Problem, content_type = "application/problem+json"),

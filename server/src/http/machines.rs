@@ -40,7 +40,7 @@ async fn list_machines(State(state): State<AppState>) -> AppResult<Json<Vec<Mach
 
 /// One machine.
 #[utoipa::path(get, path = "/api/v1/machines/{name}", tag = "machines",
-    params(("name" = String, Path, description = "Machine name: 1–64 letters, digits, `-`, `_`, `.`, not starting with `.`")),
+    params(("name" = String, Path, description = "Machine name: 1–64 letters, digits, `-`, `_`, `.`, not starting with `.`", pattern = r"^[A-Za-z0-9_-][A-Za-z0-9_.-]{0,63}$")),
     responses(
         (status = 200, body = MachineProfile),
         (status = 404, body = Problem, content_type = "application/problem+json"),
@@ -55,7 +55,7 @@ async fn get_machine(
 
 /// Registers or replaces a machine: 201 when new, 200 when replaced.
 #[utoipa::path(put, path = "/api/v1/machines/{name}", tag = "machines",
-    params(("name" = String, Path, description = "Machine name: 1–64 letters, digits, `-`, `_`, `.`, not starting with `.`")),
+    params(("name" = String, Path, description = "Machine name: 1–64 letters, digits, `-`, `_`, `.`, not starting with `.`", pattern = r"^[A-Za-z0-9_-][A-Za-z0-9_.-]{0,63}$")),
     request_body = MachineProfile,
     responses(
         (status = 201, description = "Created", body = MachineProfile),
@@ -82,7 +82,7 @@ async fn put_machine(
 
 /// Removes a machine. Jobs already submitted keep the profile they were resolved with.
 #[utoipa::path(delete, path = "/api/v1/machines/{name}", tag = "machines",
-    params(("name" = String, Path, description = "Machine name")),
+    params(("name" = String, Path, description = "Machine name: 1–64 letters, digits, `-`, `_`, `.`, not starting with `.`", pattern = r"^[A-Za-z0-9_-][A-Za-z0-9_.-]{0,63}$")),
     responses(
         (status = 204, description = "Deleted"),
         (status = 404, body = Problem, content_type = "application/problem+json"),

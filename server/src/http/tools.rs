@@ -35,7 +35,7 @@ async fn list_tools(State(state): State<AppState>) -> AppResult<Json<Vec<Tool>>>
 
 /// One tool.
 #[utoipa::path(get, path = "/api/v1/tools/{number}", tag = "tools",
-    params(("number" = u32, Path, description = "Tool number, 1–9999")),
+    params(("number" = u32, Path, description = "Tool number, 1–9999", minimum = 1, maximum = 9999)),
     responses(
         (status = 200, body = Tool),
         (status = 400, body = Problem, content_type = "application/problem+json"),
@@ -51,7 +51,7 @@ async fn get_tool(State(state): State<AppState>, AppPath(number): AppPath<ToolNu
 
 /// Registers or replaces a tool: 201 when new, 200 when replaced.
 #[utoipa::path(put, path = "/api/v1/tools/{number}", tag = "tools",
-    params(("number" = u32, Path, description = "Tool number, 1–9999")),
+    params(("number" = u32, Path, description = "Tool number, 1–9999", minimum = 1, maximum = 9999)),
     request_body = Tool,
     responses(
         (status = 201, description = "Created", body = Tool),
@@ -78,10 +78,12 @@ async fn put_tool(
 
 /// Removes a tool.
 #[utoipa::path(delete, path = "/api/v1/tools/{number}", tag = "tools",
-    params(("number" = u32, Path, description = "Tool number, 1–9999")),
+    params(("number" = u32, Path, description = "Tool number, 1–9999", minimum = 1, maximum = 9999)),
     responses(
         (status = 204, description = "Deleted"),
-        (status = 404, body = Problem, content_type = "application/problem+json")))]
+        (status = 400, description = "The number is not a number", body = Problem, content_type = "application/problem+json"),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "The number is outside 1–9999", body = Problem, content_type = "application/problem+json")))]
 async fn delete_tool(State(state): State<AppState>, AppPath(number): AppPath<ToolNumber>) -> AppResult<StatusCode> {
     let number = checked_number(number)?;
     if store::tools::delete(&state.db, number).await? {

@@ -17,6 +17,7 @@ mod machines;
 mod openapi;
 mod predict;
 mod request_fuzz;
+mod schemathesis;
 mod segment;
 mod tools;
 mod web;
