@@ -213,10 +213,8 @@ impl Tool {
         if !(1..=32).contains(&self.flutes) {
             return Err(SolverError::input(field("flutes"), format!("flutes must be 1 to 32 (got {})", self.flutes)));
         }
-        if let Some(name) = &self.name
-            && name.chars().count() > MAX_NAME_CHARS
-        {
-            return Err(SolverError::input(field("name"), format!("name must be at most {MAX_NAME_CHARS} characters")));
+        if let Some(name) = &self.name {
+            crate::validate::text(&field("name"), name, MAX_NAME_CHARS)?;
         }
         if let Some(helix) = self.helix_deg
             && !(0.0..90.0).contains(&finite(&field("helix_deg"), helix)?)

@@ -63,3 +63,22 @@ pub fn point<const N: usize>(field: &str, point: [f64; N], limit: f64) -> Result
     }
     Ok(point)
 }
+
+/// A name or description of at most `max_chars` characters without control characters (NUL, CR,
+/// LF, tab…): such text goes into G-code comments and headers, where a line break would start a
+/// new block.
+///
+/// # Errors
+/// `E_INPUT` at `field` for a control character or text over `max_chars`.
+pub fn text<'a>(field: &str, value: &'a str, max_chars: usize) -> Result<&'a str, SolverError> {
+    if value.chars().count() > max_chars {
+        return Err(SolverError::input(field, format!("{field} must be at most {max_chars} characters")));
+    }
+    if let Some(control) = value.chars().find(|c| c.is_control()) {
+        return Err(SolverError::input(
+            field,
+            format!("{field} must not contain control characters (found U+{:04X})", u32::from(control)),
+        ));
+    }
+    Ok(value)
+}

@@ -230,9 +230,15 @@ pub fn parse(text: &str, format: Format) -> AppResult<JobFile> {
     Ok(job)
 }
 
+/// Longest job name.
+const MAX_JOB_NAME_CHARS: usize = 200;
+
 fn check(job: &JobFile) -> AppResult<()> {
     if job.operations.is_empty() || job.operations.len() > MAX_OPERATIONS {
         return Err(file_error("operations", None, &format!("a job needs 1 to {MAX_OPERATIONS} operations")));
+    }
+    if let Some(name) = &job.name {
+        kerf_solver::validate::text("name", name, MAX_JOB_NAME_CHARS)?;
     }
     for (index, tool) in job.tools.iter().enumerate() {
         let field = format!("tools[{index}]");

@@ -98,13 +98,8 @@ impl MachineProfile {
         if let Some(min_chord_error) = self.min_chord_error {
             non_negative("min_chord_error", min_chord_error)?;
         }
-        if let Some(description) = &self.description
-            && description.chars().count() > MAX_DESCRIPTION_CHARS
-        {
-            return Err(SolverError::input(
-                "description",
-                format!("description must be at most {MAX_DESCRIPTION_CHARS} characters"),
-            ));
+        if let Some(description) = &self.description {
+            crate::validate::text("description", description, MAX_DESCRIPTION_CHARS)?;
         }
         Ok(())
     }

@@ -253,3 +253,40 @@ async fn oversized_body_is_413() {
     assert_eq!(answer["code"], "E_TOO_LARGE");
     assert_eq!(json_with(app.get("/api/v1/tools").await, 200).await, json!([]));
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn names_that_would_break_a_program_line_are_refused() {
+    // Names and descriptions end up in G-code comments and headers: a line break would start a
+    // block of its own there (M30, a move...). Nothing is stored.
+    let app = TestApp::spawn().await;
+    for name in ["T1\nM30", "cut\r", "nul\u{0}", "tab\there"] {
+        let answer =
+            problem(app.put_json("/api/v1/tools/4", &json!({"kind": "ball", "radius": 3, "name": name})).await, 422)
+                .await;
+        assert_eq!(answer["errors"][0]["path"], "name", "{name:?}: {answer}");
+        let answer = problem(
+            app.put_json("/api/v1/machines/mill", &json!({"block_time_ms": 4, "max_feed": 10000, "description": name}))
+                .await,
+            422,
+        )
+        .await;
+        assert_eq!(answer["errors"][0]["path"], "description", "{name:?}: {answer}");
+        let job = json!({"name": name, "operations": [{"operation": "segment",
+            "curve": {"kind": "arc", "centre": [0, 0], "radius": 10, "start_deg": 0, "end_deg": 90},
+            "feed": 1000, "block_time_ms": 4}]});
+        let answer = problem(app.post_json("/api/v1/jobs", &job).await, 422).await;
+        assert_eq!(answer["errors"][0]["path"], "name", "{name:?}: {answer}");
+    }
+    assert_eq!(app.get("/api/v1/tools/4").await.status(), 404);
+    assert_eq!(app.get("/api/v1/machines/mill").await.status(), 404);
+    let jobs: Value = app.get("/api/v1/jobs").await.json().await.unwrap();
+    assert_eq!(jobs["jobs"].as_array().map(Vec::len), Some(0), "{jobs}");
+    // Ordinary text, accents included, is kept.
+    let tool = json_with(
+        app.put_json("/api/v1/tools/4", &json!({"kind": "ball", "radius": 3, "name": "Kugelfräser Ø6 (Schlichten)"}))
+            .await,
+        201,
+    )
+    .await;
+    assert_eq!(tool["name"], "Kugelfräser Ø6 (Schlichten)");
+}
