@@ -28,6 +28,9 @@ pub struct Limits {
     pub header_read_timeout: Duration,
     /// Longest a request body may stall between two pieces; then the request ends with 408.
     pub body_idle_timeout: Duration,
+    /// Bytes of solver answers (JSON or G-code) held at once while their clients read them; an
+    /// answer that does not fit gets 429, so slow readers of large answers cannot exhaust memory.
+    pub answer_budget_bytes: usize,
     /// After a stop signal, how long open connections may finish before they are dropped (the
     /// jobs still running are re-queued at the next start, as after a kill).
     pub shutdown_grace: Duration,
@@ -40,6 +43,7 @@ impl Default for Limits {
             max_upload_bytes: 128 * 1024 * 1024,
             solver_time_limit: Duration::from_secs(30),
             solver_queue_wait: Duration::from_secs(5),
+            answer_budget_bytes: 512 * 1024 * 1024,
             header_read_timeout: Duration::from_secs(10),
             body_idle_timeout: Duration::from_secs(30),
             shutdown_grace: Duration::from_secs(30),
@@ -61,12 +65,17 @@ pub struct AppState {
     pub jobs: Arc<JobRunner>,
     /// The optional API token.
     pub auth: Auth,
+    /// [`Limits::answer_budget_bytes`] in KiB permits.
+    pub answer_budget: Arc<Semaphore>,
 }
 
 impl AppState {
     /// State over `db` with `limits`, allowing `solver_slots` solver calls at once, guarded by `auth`.
     pub fn new(db: SqlitePool, limits: Limits, solver_slots: usize, auth: Auth) -> Self {
         Self {
+            answer_budget: Arc::new(Semaphore::new(
+                limits.answer_budget_bytes.div_ceil(1024).clamp(1, Semaphore::MAX_PERMITS),
+            )),
             db,
             limits,
             solver_slots: Arc::new(Semaphore::new(solver_slots.max(1))),
@@ -113,5 +122,39 @@ struct CancelOnDrop(Arc<AtomicBool>);
 impl Drop for CancelOnDrop {
     fn drop(&mut self) {
         self.0.store(true, Ordering::Relaxed);
+    }
+}
+
+impl AppState {
+    /// `bytes` as a response body that holds its share of the answer budget until the connection
+    /// has taken the last piece (the body is handed out in 64 KiB pieces as the client reads).
+    ///
+    /// # Errors
+    /// 429 when the answers being read already hold the budget.
+    pub fn budgeted_body(&self, bytes: axum::body::Bytes) -> AppResult<axum::body::Body> {
+        const PIECE: usize = 64 * 1024;
+        // An answer larger than the whole budget takes all of it (alone), rather than never.
+        let budget_kib = self.limits.answer_budget_bytes.div_ceil(1024).clamp(1, Semaphore::MAX_PERMITS);
+        let kib = u32::try_from(bytes.len().div_ceil(1024).clamp(1, budget_kib)).unwrap_or(u32::MAX);
+        let permit = Arc::clone(&self.answer_budget).try_acquire_many_owned(kib).map_err(|_| {
+            AppError::TooManyRequests(
+                "large answers being read hold the memory budget; retry shortly or submit a job".to_owned(),
+            )
+        })?;
+        let mut rest = bytes;
+        let mut held = Some(permit);
+        let pieces = std::iter::from_fn(move || {
+            if rest.is_empty() {
+                return None;
+            }
+            let piece = rest.split_to(rest.len().min(PIECE));
+            if rest.is_empty() {
+                // The last piece is out of our hands: its share goes back now.
+                held.take();
+            }
+            Some(Ok::<_, std::convert::Infallible>(piece))
+        });
+        let stream = futures_util::stream::iter(pieces);
+        Ok(axum::body::Body::from_stream(stream))
     }
 }

@@ -8,7 +8,7 @@ use axum::http::{HeaderValue, header};
 use axum::response::{IntoResponse, Response};
 use kerf_solver::capability::{Capability, Control, Purpose, Run};
 
-use super::output::{Ask, gcode_response};
+use super::output::Ask;
 use crate::capabilities::{self, Delivered};
 use crate::error::AppResult;
 use crate::state::AppState;
@@ -40,14 +40,14 @@ pub async fn answer<C: Capability>(
             capabilities::solve::<C>(&request, resolved, &run, ask.gcode.then_some(&ask.output), ask.timings)
         })
         .await??;
-    let mut response = match delivered {
-        Delivered::Program(program) => gcode_response(program),
-        Delivered::Json(bytes) => {
-            let mut response = bytes.into_response();
-            response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("application/json"));
-            response
-        }
+    let (bytes, media_type) = match delivered {
+        Delivered::Program(program) => (Bytes::from(program), "text/x-gcode; charset=utf-8"),
+        Delivered::Json(bytes) => (Bytes::from(bytes), "application/json"),
     };
+    let length = bytes.len();
+    let mut response = state.budgeted_body(bytes)?.into_response();
+    response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static(media_type));
+    response.headers_mut().insert(header::CONTENT_LENGTH, HeaderValue::from(length));
     if let Ok(value) = HeaderValue::from_str(&format!("solve;dur={:.1}", seconds * 1e3)) {
         response.headers_mut().insert("server-timing", value);
     }

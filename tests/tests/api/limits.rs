@@ -209,3 +209,27 @@ async fn a_trickling_client_does_not_keep_a_stopped_server_alive() {
     app.restart().await;
     assert_eq!(app.get("/api/v1/tools/7").await.status(), 404);
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn slow_readers_of_large_answers_hold_a_bounded_budget() {
+    // A 2 MiB budget and a 19 MB answer that its client does not read: the next answer gets 429
+    // with Retry-After until the first one has been read.
+    let app = TestApp::spawn_with(Limits { answer_budget_bytes: 2 * 1024 * 1024, ..Limits::default() }).await;
+    let large = json!({"tool": {"kind": "ball", "radius": 3}, "contour": circle(600), "side": "outside",
+                       "depths": {"top": 0, "bottom": -100, "step": 0.25}, "feed": 800});
+    let unread = app.post_json("/api/v1/contour", &large).await;
+    assert_eq!(unread.status(), 200);
+    let length: usize = unread.headers()["content-length"].to_str().unwrap().parse().unwrap();
+    assert!(length > 10_000_000, "{length}");
+    let quick = json!({"curve": {"kind": "arc", "centre": [0, 0], "radius": 10, "start_deg": 0, "end_deg": 90},
+                       "feed": 1000, "block_time_ms": 4});
+    let refused = app.post_json("/api/v1/segment", &quick).await;
+    assert!(refused.headers().contains_key("retry-after"), "{:?}", refused.headers());
+    let answer = problem(refused, 429).await;
+    assert_eq!(answer["code"], "E_BUSY", "{answer}");
+    // Reading the large answer gives the budget back; it arrives whole.
+    let body = unread.bytes().await.unwrap();
+    assert_eq!(body.len(), length);
+    serde_json::from_slice::<serde_json::Value>(&body).unwrap();
+    json_with(app.post_json("/api/v1/segment", &quick).await, 200).await;
+}
