@@ -28,8 +28,9 @@ pub struct Limits {
     pub header_read_timeout: Duration,
     /// Longest a request body may stall between two pieces; then the request ends with 408.
     pub body_idle_timeout: Duration,
-    /// Bytes of solver answers (JSON or G-code) held at once while their clients read them; an
-    /// answer that does not fit gets 429, so slow readers of large answers cannot exhaust memory.
+    /// Bytes of solver answers (JSON or G-code) held at once while their clients read them, and of
+    /// predict uploads being received; what does not fit gets 429, so slow readers of large
+    /// answers or many large uploads cannot exhaust memory.
     pub answer_budget_bytes: usize,
     /// After a stop signal, how long open connections may finish before they are dropped (the
     /// jobs still running are re-queued at the next start, as after a kill).
@@ -126,6 +127,23 @@ impl Drop for CancelOnDrop {
 }
 
 impl AppState {
+    /// A share of the memory budget ([`Limits::answer_budget_bytes`]) for `bytes` held in memory
+    /// on behalf of one request (an answer being read, an upload being received), released when
+    /// the permit drops. Something larger than the whole budget takes all of it, alone.
+    ///
+    /// # Errors
+    /// 429 when the budget is held by other requests.
+    pub fn reserve_memory(&self, bytes: usize) -> AppResult<tokio::sync::OwnedSemaphorePermit> {
+        let budget_kib = self.limits.answer_budget_bytes.div_ceil(1024).clamp(1, Semaphore::MAX_PERMITS);
+        let kib = u32::try_from(bytes.div_ceil(1024).clamp(1, budget_kib)).unwrap_or(u32::MAX);
+        Arc::clone(&self.answer_budget).try_acquire_many_owned(kib).map_err(|_| {
+            AppError::TooManyRequests(
+                "large answers and uploads in progress hold the memory budget; retry shortly or submit a job"
+                    .to_owned(),
+            )
+        })
+    }
+
     /// `bytes` as a response body that holds its share of the answer budget until the connection
     /// has taken the last piece (the body is handed out in 64 KiB pieces as the client reads).
     ///
@@ -133,14 +151,7 @@ impl AppState {
     /// 429 when the answers being read already hold the budget.
     pub fn budgeted_body(&self, bytes: axum::body::Bytes) -> AppResult<axum::body::Body> {
         const PIECE: usize = 64 * 1024;
-        // An answer larger than the whole budget takes all of it (alone), rather than never.
-        let budget_kib = self.limits.answer_budget_bytes.div_ceil(1024).clamp(1, Semaphore::MAX_PERMITS);
-        let kib = u32::try_from(bytes.len().div_ceil(1024).clamp(1, budget_kib)).unwrap_or(u32::MAX);
-        let permit = Arc::clone(&self.answer_budget).try_acquire_many_owned(kib).map_err(|_| {
-            AppError::TooManyRequests(
-                "large answers being read hold the memory budget; retry shortly or submit a job".to_owned(),
-            )
-        })?;
+        let permit = self.reserve_memory(bytes.len())?;
         let mut rest = bytes;
         let mut held = Some(permit);
         let pieces = std::iter::from_fn(move || {

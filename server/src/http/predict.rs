@@ -159,7 +159,16 @@ async fn post_predict(
         output: OutputOptions { dialect: query.dialect, reference: query.reference, candidate: None },
         timings: query.timings.unwrap_or(false),
     };
+    // While it arrives, possibly slowly, the upload holds its share of the memory budget (its
+    // declared length, else the whole upload limit); once read, the solver slots bound it.
+    let declared = request
+        .headers()
+        .get(header::CONTENT_LENGTH)
+        .and_then(|v| v.to_str().ok())
+        .and_then(|v| v.parse::<usize>().ok());
+    let upload_share = state.reserve_memory(declared.unwrap_or(state.limits.max_upload_bytes))?;
     let Upload { request, mesh } = upload(&state, request).await?;
+    drop(upload_share);
     super::solve::answer::<PredictCapability>(&state, request, mesh, ask).await
 }
 

@@ -233,3 +233,59 @@ async fn slow_readers_of_large_answers_hold_a_bounded_budget() {
     serde_json::from_slice::<serde_json::Value>(&body).unwrap();
     json_with(app.post_json("/api/v1/segment", &quick).await, 200).await;
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn slow_uploads_hold_a_bounded_budget() {
+    use tokio::io::AsyncWriteExt;
+    // An upload that declares 3 MiB and arrives slowly holds the 2 MiB budget while it arrives: a
+    // second upload gets 429 with Retry-After instead of piling up in memory.
+    let app = TestApp::spawn_with(Limits { answer_budget_bytes: 2 * 1024 * 1024, ..Limits::default() }).await;
+    let address = app.base.trim_start_matches("http://").to_owned();
+    let mut slow = tokio::net::TcpStream::connect(&address).await.unwrap();
+    slow.write_all(
+        b"POST /api/v1/predict HTTP/1.1\r\nHost: kerf\r\nContent-Type: multipart/form-data; boundary=XX\r\n\
+          Content-Length: 3145728\r\n\r\n--XX\r\nContent-Disposition: form-data; name=\"stock\"\r\n\r\nsolid",
+    )
+    .await
+    .unwrap();
+    // The first upload is read by then: its share is taken before the body is read.
+    let mut refused = None;
+    for _ in 0..100 {
+        let response = app
+            .client
+            .post(app.url("/api/v1/predict"))
+            .header("content-type", "application/json")
+            .body("{}")
+            .send()
+            .await
+            .unwrap();
+        if response.status() == 429 {
+            refused = Some(response);
+            break;
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    let refused = refused.expect("a second upload is refused while the first holds the budget");
+    assert!(refused.headers().contains_key("retry-after"));
+    assert_eq!(problem(refused, 429).await["code"], "E_BUSY");
+    // When the slow client goes away, its share comes back.
+    drop(slow);
+    let mut answered = 429;
+    for _ in 0..100 {
+        answered = app
+            .client
+            .post(app.url("/api/v1/predict"))
+            .header("content-type", "application/json")
+            .body("{}")
+            .send()
+            .await
+            .unwrap()
+            .status()
+            .as_u16();
+        if answered != 429 {
+            break;
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    assert_eq!(answered, 400, "an empty predict request is a bad request once the budget is free");
+}
