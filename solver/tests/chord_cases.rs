@@ -137,7 +137,12 @@ fn case_a_gcode_head() {
     let answer = solve(json!({"curve": circle_a(), "feed": 10000, "block_time_ms": 4}));
     let program = chord::program(
         &answer,
-        &Post { reference: kerf_solver::gcode::Reference::Tip, dialect: Dialect::Fanuc, tool: ToolCall::Table(1) },
+        &Post {
+            reference: kerf_solver::gcode::Reference::Tip,
+            dialect: Dialect::Fanuc,
+            tool: ToolCall::Table(1),
+            arcs: kerf_solver::gcode::Arcs::Chords,
+        },
     )
     .unwrap();
     let case = case("chord", "A");

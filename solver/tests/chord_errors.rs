@@ -247,6 +247,7 @@ fn too_many_windows_are_refused_before_the_work() {
 #[test]
 fn machine_values_are_defaults_the_request_overrides() {
     let machine = MachineProfile {
+        arcs: None,
         name: None,
         block_time_ms: 4.0,
         max_feed: 10_000.0,
@@ -381,7 +382,12 @@ fn programs_in_both_dialects() {
     }));
     let fanuc = chord::program(
         &answer,
-        &Post { reference: kerf_solver::gcode::Reference::Tip, dialect: Dialect::Fanuc, tool: ToolCall::Table(3) },
+        &Post {
+            reference: kerf_solver::gcode::Reference::Tip,
+            dialect: Dialect::Fanuc,
+            tool: ToolCall::Table(3),
+            arcs: kerf_solver::gcode::Arcs::Chords,
+        },
     )
     .unwrap();
     assert!(fanuc.starts_with("%\nO1001 (KERF SEGMENT)\n"));
@@ -398,6 +404,7 @@ fn programs_in_both_dialects() {
             reference: kerf_solver::gcode::Reference::Tip,
             dialect: Dialect::Linuxcnc,
             tool: ToolCall::Manual("as set up".to_owned()),
+            arcs: kerf_solver::gcode::Arcs::Chords,
         },
     )
     .unwrap();

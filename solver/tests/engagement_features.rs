@@ -280,7 +280,12 @@ fn program_carries_the_planned_feeds() {
     let answer = engagement::solve(&request(body), &tool()).unwrap();
     let result = &answer.candidates()[0];
     let plan = result.feed_plan.as_ref().unwrap();
-    let post = Post { dialect: Dialect::Linuxcnc, reference: Reference::Tip, tool: ToolCall::Table(4) };
+    let post = Post {
+        dialect: Dialect::Linuxcnc,
+        reference: Reference::Tip,
+        tool: ToolCall::Table(4),
+        arcs: kerf_solver::gcode::Arcs::Chords,
+    };
     let text = program(&answer, 0, &post).unwrap();
     assert!(text.contains("T4 M06") && text.contains("S4000 M03") && text.ends_with("M30\n"));
     // Cutting at Z = 10 − 3, clearance at 15.

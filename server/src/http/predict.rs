@@ -155,7 +155,7 @@ async fn post_predict(
 ) -> AppResult<Response> {
     let ask = Ask {
         gcode: wants_gcode(&headers, query.format),
-        output: OutputOptions { dialect: query.dialect, reference: query.reference, candidate: None },
+        output: OutputOptions { dialect: query.dialect, reference: query.reference, ..OutputOptions::default() },
         timings: query.timings.unwrap_or(false),
     };
     let Upload { request, mesh } = upload(&state, request).await?;

@@ -62,7 +62,12 @@ impl Capability for SegmentCapability {
             Some(tool) => ToolCall::for_tool(tool),
             None => ToolCall::Manual("none named in the request".to_owned()),
         };
-        let post = Post { dialect: output.dialect_for(answer.machine.as_ref()), reference: Reference::Tip, tool };
+        let post = Post {
+            dialect: output.dialect_for(answer.machine.as_ref()),
+            reference: Reference::Tip,
+            tool,
+            arcs: output.arcs_for(answer.machine.as_ref()),
+        };
         super::program(&answer.result, &post)
     }
 

@@ -359,5 +359,9 @@ fn answer(job: &Job, request: &SegmentRequest, cutter: &Cutter<'_>, cut: &Cut) -
         description,
         spindle_rpm: job.spindle_rpm,
         safe_z,
+        circle: match &job.shape {
+            shape::Shape::Arc(arc) => Some(arc.clone()),
+            _ => None,
+        },
     })
 }

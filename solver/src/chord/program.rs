@@ -1,5 +1,6 @@
 //! The G-code program of a segment answer (chord.md §6.1): G01 blocks through the command points
-//! with the F word, written by the house post.
+//! with the F word, written by the house post; with `arcs = g2g3` a circle or arc is written as
+//! G02/G03 blocks of at most half a turn ending at the last command point (issue 15).
 //!
 //! The path: rapid to the clearance plane above the first point, feed down to it, the G01
 //! blocks, and (by the post) back up to the clearance plane. A segment program has no tool of its
@@ -9,7 +10,7 @@
 use super::answer::SegmentAnswer;
 use crate::error::ErrorCode;
 use crate::error::SolverError;
-use crate::gcode::{self, Post, Program, SpindleDirection};
+use crate::gcode::{self, Arcs, Post, Program, SpindleDirection};
 use crate::geometry::Vec3;
 use crate::path::Toolpath;
 
@@ -39,8 +40,16 @@ pub fn program(answer: &SegmentAnswer, post: &Post) -> Result<String, SolverErro
     let mut path = Toolpath::default();
     path.rapid(Vec3::new(first.x, first.y, answer.safe_z));
     path.linear(*first, answer.feed);
-    for point in &points[1..] {
-        path.linear(*point, answer.feed);
+    match (&answer.circle, post.arcs) {
+        (Some(arc), Arcs::G2g3) => {
+            let end = points[points.len() - 1];
+            path.arc_sweep(*first, end, arc.centre, arc.sense * arc.sweep, answer.feed);
+        }
+        _ => {
+            for point in &points[1..] {
+                path.linear(*point, answer.feed);
+            }
+        }
     }
     Ok(gcode::write(&Program {
         dialect: post.dialect,

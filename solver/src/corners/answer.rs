@@ -47,6 +47,24 @@ pub struct ContourLayer {
     pub z: f64,
     /// The moves in order.
     pub moves: Vec<ContourMove>,
+    /// The arcs among the moves, for a program that writes them as G02/G03.
+    #[serde(skip)]
+    pub(crate) arcs: Vec<ArcSpan>,
+}
+
+/// The chord moves `first..=last` of a layer run one arc of the tool-centre path from `start` to
+/// `end` about `centre` (sweep in radians, counter-clockwise positive), all in the layer plane.
+/// Under the block-time rule the move before `first` may have been lengthened to the first
+/// circumscribed vertex (and the arc's last chord joined to the move after it): the exact
+/// `start` and `end` lie on those straight moves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ArcSpan {
+    pub first: usize,
+    pub last: usize,
+    pub start: [f64; 2],
+    pub end: [f64; 2],
+    pub centre: [f64; 2],
+    pub sweep: f64,
 }
 
 /// Whether the material protrudes at a corner.

@@ -4,8 +4,8 @@
 //! warnings.
 
 use super::answer::{
-    ContourAnswer, ContourCorner, ContourLayer, ContourMove, ContourSummary, Convexity, CornerAction, LoopReport,
-    MaterialReport, MoveKind, PassReport, ReliefReport,
+    ArcSpan, ContourAnswer, ContourCorner, ContourLayer, ContourMove, ContourSummary, Convexity, CornerAction,
+    LoopReport, MaterialReport, MoveKind, PassReport, ReliefReport,
 };
 use super::blocks;
 use super::element::{Chording, Element, ElementKind};
@@ -166,8 +166,9 @@ pub fn solve_with(
             shortened = true;
         }
         lead_used = lead_used.min(lead);
-        let moves = layer_moves(&job, layer, passes, lead_point.map(|(point, _)| point), index == 0, previous_z, z);
-        layers.push(ContourLayer { z, moves });
+        let (moves, arcs) =
+            layer_moves(&job, layer, passes, lead_point.map(|(point, _)| point), index == 0, previous_z, z);
+        layers.push(ContourLayer { z, moves, arcs });
         previous_z = z;
     }
     if shortened {
@@ -415,15 +416,16 @@ fn layer_moves(
     first: bool,
     previous_z: f64,
     z: f64,
-) -> Vec<ContourMove> {
+) -> (Vec<ContourMove>, Vec<ArcSpan>) {
     let start_axis = axis(job, layer, 0).map(|a| Box::new([a.x, a.y, a.z]));
     let at = |p: &Vec2, height: f64| [p.x, p.y, height];
     let mut moves = Vec::new();
     let step =
         |kind: MoveKind, to: [f64; 3], feed: Option<f64>| ContourMove { kind, to, feed, axis: start_axis.clone() };
     let Some(first_start) = passes.first().map(|p| p.start) else {
-        return Vec::new();
+        return (Vec::new(), Vec::new());
     };
+    let mut arcs = Vec::new();
     let entry = lead_point.unwrap_or(first_start);
     let approach = (previous_z + APPROACH_GAP.min(job.safe_z - previous_z)).max(z);
     if first {
@@ -473,6 +475,18 @@ fn layer_moves(
                     last -= 1;
                 }
             }
+            if let Element::Arc { start, end, centre, sweep, .. } = element
+                && last > first
+            {
+                arcs.push(ArcSpan {
+                    first: moves.len(),
+                    last: moves.len() + last - first - 1,
+                    start: [start.x, start.y],
+                    end: [end.x, end.y],
+                    centre: [centre.x, centre.y],
+                    sweep: *sweep,
+                });
+            }
             for (index, point) in points.iter().enumerate().take(last).skip(first) {
                 let axis = from_axis.zip(to_axis).map(|(a, b)| {
                     let s = (index as f64 + 1.0) / count;
@@ -494,7 +508,7 @@ fn layer_moves(
         }
     }
     moves.push(ContourMove { kind: MoveKind::Rapid, to: at(&here, job.safe_z), feed: None, axis: start_axis });
-    moves
+    (moves, arcs)
 }
 
 fn corner_action(action: Action) -> CornerAction {

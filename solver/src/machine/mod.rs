@@ -62,6 +62,10 @@ pub struct MachineProfile {
     /// Rated spindle torque, N·m (> 0), used like `spindle_power_kw`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spindle_torque_nm: Option<f64>,
+    /// How programs for this control write circular moves unless the request says (`?arcs=`,
+    /// `[output] arcs`): `g2g3` or `chords` (default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arcs: Option<crate::gcode::Arcs>,
 }
 
 impl MachineProfile {
