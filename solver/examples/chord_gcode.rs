@@ -20,6 +20,7 @@ fn main() {
                 dialect,
                 tool: ToolCall::Table(1),
                 arcs: kerf_solver::gcode::Arcs::Chords,
+                plunge_feed: None,
             },
         )
         .expect("program");

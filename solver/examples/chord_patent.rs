@@ -85,6 +85,7 @@ fn main() {
         dialect: Dialect::Fanuc,
         tool: ToolCall::Table(1),
         arcs: kerf_solver::gcode::Arcs::Chords,
+        plunge_feed: None,
     };
     let program = chord::program(&answer, &post).expect("program");
     for line in program.lines().take(18) {

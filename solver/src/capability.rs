@@ -219,6 +219,7 @@ impl OutputOptions {
             reference: self.reference.unwrap_or_default(),
             tool: ToolCall::for_tool(tool),
             arcs: self.arcs_for(machine),
+            plunge_feed: tool.plunge_feed.or(machine.and_then(|m| m.plunge_feed)),
         }
     }
 }

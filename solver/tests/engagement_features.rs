@@ -285,6 +285,7 @@ fn program_carries_the_planned_feeds() {
         reference: Reference::Tip,
         tool: ToolCall::Table(4),
         arcs: kerf_solver::gcode::Arcs::Chords,
+        plunge_feed: None,
     };
     let text = program(&answer, 0, &post).unwrap();
     assert!(text.contains("T4 M06") && text.contains("S4000 M03") && text.ends_with("M30\n"));
@@ -298,9 +299,10 @@ fn program_carries_the_planned_feeds() {
         .collect();
     let planned: std::collections::BTreeSet<u64> = plan.blocks.iter().map(|b| b.feed.unwrap() as u64).collect();
     assert!(feeds.len() >= 2, "{feeds:?}");
-    // The descent into the cut runs at the nominal feed (2 flutes × 0.05 × 4000 = 400) at most.
+    // The descent into the cut runs at half the nominal feed (2 flutes × 0.05 × 4000 = 400) at
+    // most: the plunge without a plunge feed.
     for feed in &feeds {
-        assert!(planned.contains(&(*feed as u64)) || *feed == 400.0, "F{feed} not in the plan {planned:?}");
+        assert!(planned.contains(&(*feed as u64)) || *feed == 200.0, "F{feed} not in the plan {planned:?}");
     }
     // The arc's chord points lie on the arc, within the chord tolerance.
     let mut on_arc = 0;

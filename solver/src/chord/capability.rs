@@ -67,6 +67,11 @@ impl Capability for SegmentCapability {
             reference: Reference::Tip,
             tool,
             arcs: output.arcs_for(answer.machine.as_ref()),
+            plunge_feed: answer
+                .tool
+                .as_ref()
+                .and_then(|tool| tool.plunge_feed)
+                .or(answer.machine.as_ref().and_then(|m| m.plunge_feed)),
         };
         super::program(&answer.result, &post)
     }

@@ -61,6 +61,7 @@ pub fn program(answer: &SegmentAnswer, post: &Post) -> Result<String, SolverErro
         spindle_direction: SpindleDirection::Cw,
         safe_z: answer.safe_z,
         blend_tolerance: answer.chord_error.max(1e-4),
+        plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
         path: &path,
     }))
 }

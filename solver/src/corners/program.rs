@@ -69,6 +69,7 @@ pub fn program(answer: &ContourAnswer, post: &Post) -> Result<String, SolverErro
         spindle_direction: SpindleDirection::Cw,
         safe_z: answer.summary.safe_z + lift,
         blend_tolerance: answer.summary.tolerance,
+        plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
         path: &path,
     }))
 }

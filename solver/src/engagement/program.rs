@@ -100,6 +100,7 @@ pub fn program(answer: &EngagementAnswer, candidate: usize, post: &Post) -> Resu
         spindle_direction: data.spindle_direction,
         safe_z,
         blend_tolerance: CHORD_TOLERANCE * 5.0,
+        plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
         path: &path,
     }))
 }

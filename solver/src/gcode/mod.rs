@@ -107,12 +107,25 @@ pub struct Post {
     pub tool: ToolCall,
     /// Circular moves as G02/G03 or as chords.
     pub arcs: Arcs,
+    /// Feed of plunges, mm/min (the tool's, else the machine's); `None`: a fraction
+    /// [`DEFAULT_PLUNGE_FRACTION`] of the cutting feed.
+    pub plunge_feed: Option<f64>,
+}
+
+/// A plunge runs at this fraction of the cutting feed when neither tool nor machine gives a
+/// `plunge_feed` (issue 15: never a plunge at the cutting feed).
+pub const DEFAULT_PLUNGE_FRACTION: f64 = 0.5;
+
+/// The feed of a plunge after cutting at `feed`: `plunge_feed` when slower, else
+/// [`DEFAULT_PLUNGE_FRACTION`] of `feed`.
+pub fn plunge_feed(feed: f64, plunge_feed: Option<f64>) -> f64 {
+    plunge_feed.map_or(feed * DEFAULT_PLUNGE_FRACTION, |plunge| plunge.min(feed))
 }
 
 impl Post {
     /// A post writing arcs as chords (the default of every option but the tool).
     pub fn new(dialect: Dialect, reference: Reference, tool: ToolCall) -> Self {
-        Self { dialect, reference, tool, arcs: Arcs::Chords }
+        Self { dialect, reference, tool, arcs: Arcs::Chords, plunge_feed: None }
     }
 }
 
@@ -137,8 +150,19 @@ pub struct Program<'a> {
     pub safe_z: f64,
     /// Path blending tolerance for LinuxCNC's `G64 P`, mm.
     pub blend_tolerance: f64,
+    /// Plunges (straight feed moves straight down: X and Y unchanged, Z lower) run at
+    /// [`plunge_feed`] of their feed with this value; `None`: at their own feed (the capability
+    /// made sure they run in air).
+    pub plunges: Option<Plunges>,
     /// The moves; the first should start from the clearance plane.
     pub path: &'a Toolpath,
+}
+
+/// How a program slows its plunges.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plunges {
+    /// The tool's or machine's plunge feed, mm/min.
+    pub feed: Option<f64>,
 }
 
 /// Spindle rotation seen from the spindle, looking down the tool at the workpiece.
@@ -233,7 +257,10 @@ pub fn write(program: &Program<'_>) -> String {
             }
             Motion::Linear { feed } | Motion::Arc { feed, .. } => {
                 let _ = write!(out, "G01 X{x} Y{y} Z{z}");
-                feed
+                match (program.plunges, position) {
+                    (Some(plunges), Some(from)) if is_plunge(from, step.to) => plunge_feed(feed, plunges.feed),
+                    _ => feed,
+                }
             }
         };
         if current_feed == Some(feed) {
@@ -251,6 +278,11 @@ pub fn write(program: &Program<'_>) -> String {
         out.push_str("%\n");
     }
     out
+}
+
+/// Whether the straight move from `from` to `to` goes straight down the tool axis.
+fn is_plunge(from: Vec3, to: Vec3) -> bool {
+    to.z < from.z - 1e-9 && (to.x - from.x).abs() <= 1e-9 && (to.y - from.y).abs() <= 1e-9
 }
 
 /// Feed word value: whole mm/min where exact, else one decimal.
@@ -293,6 +325,7 @@ mod tests {
             spindle_direction: SpindleDirection::Cw,
             safe_z: 50.0,
             blend_tolerance: 0.01,
+            plunges: None,
             path: &path,
         };
         let fanuc = write(&program);
@@ -326,6 +359,7 @@ mod tests {
             spindle_direction: SpindleDirection::Cw,
             safe_z: 5.0,
             blend_tolerance: 0.01,
+            plunges: None,
             path: &path,
         };
         let text = write(&program);

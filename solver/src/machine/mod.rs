@@ -66,6 +66,10 @@ pub struct MachineProfile {
     /// `[output] arcs`): `g2g3` or `chords` (default).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub arcs: Option<crate::gcode::Arcs>,
+    /// Feed of plunges (straight moves down the tool axis), mm/min (> 0), for tools without
+    /// their own `plunge_feed`; default half the cutting feed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plunge_feed: Option<f64>,
 }
 
 impl MachineProfile {
@@ -98,6 +102,9 @@ impl MachineProfile {
                     "margin must be at least 1 (got {margin}): below 1 blocks get shorter than the control can process"
                 ),
             ));
+        }
+        if let Some(plunge_feed) = self.plunge_feed {
+            positive("plunge_feed", plunge_feed)?;
         }
         if let Some(min_chord_error) = self.min_chord_error {
             non_negative("min_chord_error", min_chord_error)?;

@@ -463,6 +463,8 @@ pub fn corrected_program(
                 spindle_direction: request.spindle_direction.unwrap_or_default(),
                 safe_z,
                 blend_tolerance: 0.001,
+                // The points are the caller's path, written as given.
+                plunges: None,
                 path: &path,
             }))
         }

@@ -9,6 +9,7 @@ mod contour;
 mod deburr;
 mod deburr_machine;
 mod engagement;
+mod entries;
 mod gcode;
 mod job_fuzz;
 mod jobs;
