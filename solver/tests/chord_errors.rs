@@ -249,6 +249,9 @@ fn machine_values_are_defaults_the_request_overrides() {
     let machine = MachineProfile {
         arcs: None,
         plunge_feed: None,
+        max_accel: None,
+        rapid_feed: None,
+        tool_change_s: None,
         name: None,
         block_time_ms: 4.0,
         max_feed: 10_000.0,

@@ -182,6 +182,9 @@ fn machine_values_and_bad_block_times() {
     let machine = MachineProfile {
         arcs: None,
         plunge_feed: None,
+        max_accel: None,
+        rapid_feed: None,
+        tool_change_s: None,
         name: Some("hsc".to_owned()),
         block_time_ms: 4.0,
         max_feed: 2000.0,

@@ -28,6 +28,11 @@ pub struct SegmentResult {
     /// Windows, command points, block figures, the comparison and warnings.
     #[serde(flatten)]
     pub result: SegmentAnswer,
+    /// With a machine that has `max_accel`: the time the control would take for the program
+    /// (the plunge at the plunge feed, the blocks with a trapezoidal feed profile and the block
+    /// time, the retract at `rapid_feed`, one tool change when a tool is named) and its parts.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cycle_time: Option<crate::machine::cycle::CycleTime>,
 }
 
 impl Capability for SegmentCapability {
@@ -49,7 +54,11 @@ impl Capability for SegmentCapability {
             tool.validate("tool.")?;
         }
         let result = super::solve(request, context.machine.as_ref())?;
-        Ok(SegmentResult { machine: context.machine, tool: context.tool, result })
+        let cycle_time = context.machine.as_ref().and_then(|machine| {
+            let plunge = context.tool.as_ref().and_then(|t| t.plunge_feed).or(machine.plunge_feed);
+            super::cycle_time(&result, machine, plunge, context.tool.is_some())
+        });
+        Ok(SegmentResult { machine: context.machine, tool: context.tool, result, cycle_time })
     }
 
     /// The curve is the programmed point: `reference` does not apply.

@@ -266,6 +266,12 @@ pub struct ContourSummary {
     /// With `block_time_ms`: the blocks, the shortest, the short ones and the block-limited time.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub blocks: Option<crate::machine::PathBlocks>,
+    /// With a machine that has `max_accel`: the time the control would take for the program
+    /// (trapezoidal feed profile, stops at sharp corners, plunges at the plunge feed, rapids at
+    /// `rapid_feed`, one tool change) and its parts: cutting, air (loops, leads and links), rapid,
+    /// tool change.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cycle_time: Option<crate::machine::cycle::CycleTime>,
 }
 
 /// The answer of `POST /api/v1/contour`.

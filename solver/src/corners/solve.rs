@@ -232,6 +232,7 @@ pub fn solve_with(
         tolerance: job.tolerance,
         estimated_time_s: time_min * 60.0,
         blocks,
+        cycle_time: machine.and_then(|m| contour_cycle_time(&layers, m, job.tool.plunge_feed)),
     };
     let description = describe(&job, &summary);
     let centre_height = match job.tool.kind {
@@ -509,6 +510,35 @@ fn layer_moves(
     }
     moves.push(ContourMove { kind: MoveKind::Rapid, to: at(&here, job.safe_z), feed: None, axis: start_axis });
     (moves, arcs)
+}
+
+/// The cycle time of the program of `layers` on `machine` (None without its `max_accel`):
+/// cuts in the material, loops and links in the air, plunges at the plunge feed as the program
+/// writes them.
+fn contour_cycle_time(
+    layers: &[ContourLayer],
+    machine: &MachineProfile,
+    tool_plunge_feed: Option<f64>,
+) -> Option<crate::machine::cycle::CycleTime> {
+    use crate::machine::cycle::{Step, cycle_time};
+    let dynamics = machine.dynamics()?;
+    let plunge = tool_plunge_feed.or(machine.plunge_feed);
+    let first = layers.first()?.moves.first()?;
+    let mut here = Vec3::from(first.to);
+    let mut steps = Vec::new();
+    for step in layers.iter().flat_map(|layer| &layer.moves) {
+        let to = Vec3::from(step.to);
+        steps.push(match (step.kind, step.feed) {
+            (MoveKind::Rapid, _) | (_, None) => Step::Rapid(to),
+            (kind, Some(feed)) => {
+                let down = to.z < here.z && (to.x - here.x).abs() <= 1e-9 && (to.y - here.y).abs() <= 1e-9;
+                let feed = if down { crate::gcode::plunge_feed(feed, plunge) } else { feed };
+                Step::Feed { to, feed, air: kind != MoveKind::Cut }
+            }
+        });
+        here = to;
+    }
+    Some(cycle_time(Vec3::from(first.to), &steps, &dynamics, 1))
 }
 
 fn corner_action(action: Action) -> CornerAction {

@@ -87,3 +87,56 @@ async fn plunges_run_at_the_plunge_feed() {
     let stored = json_with(app.get("/api/v1/tools/3").await, 200).await;
     assert_eq!(stored["plunge_feed"], 150.0);
 }
+
+/// Rest to rest over `length` mm at cruise `speed` mm/s with acceleration `accel` mm/s².
+fn rest_to_rest(length: f64, speed: f64, accel: f64) -> f64 {
+    if length >= speed * speed / accel { length / speed + speed / accel } else { 2.0 * (length / accel).sqrt() }
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn cycle_time_with_acceleration_rapids_and_tool_change() {
+    let app = TestApp::spawn().await;
+    app.register_tool(3, &json!({"kind": "flat", "radius": 3})).await;
+    let machine = json!({"block_time_ms": 1, "max_feed": 12000, "max_accel": 500, "rapid_feed": 30000,
+                         "tool_change_s": 4});
+    assert_eq!(app.put_json("/api/v1/machines/accel", &machine).await.status(), 201);
+    // A straight line of 100 mm at 6000 mm/min (100 mm/s): 1 s cruising plus v/a = 0.2 s; the
+    // plunge of 5 mm at half the feed and the 5 mm retract are triangles of 2·√(5/500) s.
+    let body = json!({"curve": {"kind": "polyline", "points": [[0, 0], [50, 0], [100, 0]]}, "feed": 6000,
+                      "machine": "accel", "tool": 3});
+    let answer = json_with(app.post_json("/api/v1/segment", &body).await, 200).await;
+    let time = &answer["cycle_time"];
+    let number = |v: &Value| v.as_f64().unwrap();
+    let close = |label: &str, got: f64, want: f64| assert!((got - want).abs() < 1e-9, "{label}: {got} vs {want}");
+    close("cutting", number(&time["cutting_s"]), rest_to_rest(100.0, 100.0, 500.0));
+    close("air", number(&time["air_s"]), rest_to_rest(5.0, 50.0, 500.0));
+    close("rapid", number(&time["rapid_s"]), rest_to_rest(5.0, 500.0, 500.0));
+    close("tool change", number(&time["tool_change_s"]), 4.0);
+    let parts: f64 = ["cutting_s", "air_s", "rapid_s", "tool_change_s"].iter().map(|k| number(&time[k])).sum();
+    close("total", number(&time["total_s"]), parts);
+    // Without max_accel there is no cycle time.
+    let plain = json!({"curve": {"kind": "polyline", "points": [[0, 0], [100, 0]]}, "feed": 6000, "block_time_ms": 1});
+    let answer = json_with(app.post_json("/api/v1/segment", &plain).await, 200).await;
+    assert!(answer.get("cycle_time").is_none());
+
+    // A square island: the tool stops at the corners, so the control takes longer than length
+    // over feed; loops and leads are air.
+    let contour = json!({"tool": 3, "contour": [[0, 0], [40, 0], [40, 40], [0, 40]], "side": "outside",
+                         "depths": {"top": 0, "bottom": -2, "step": 2}, "feed": 3000, "machine": "accel"});
+    let answer = json_with(app.post_json("/api/v1/contour", &contour).await, 200).await;
+    let summary = &answer["summary"];
+    let time = &summary["cycle_time"];
+    assert!(number(&time["cutting_s"]) > 0.0 && number(&time["air_s"]) > 0.0 && number(&time["rapid_s"]) > 0.0);
+    let feed_time = number(&summary["estimated_time_s"]);
+    assert!(number(&time["cutting_s"]) + number(&time["air_s"]) > feed_time, "{summary}");
+    let parts: f64 = ["cutting_s", "air_s", "rapid_s", "tool_change_s"].iter().map(|k| number(&time[k])).sum();
+    close("contour total", number(&time["total_s"]), parts);
+
+    // Bad values name their fields.
+    for (field, value) in [("max_accel", json!(0)), ("rapid_feed", json!(-1)), ("tool_change_s", json!(-2))] {
+        let mut bad = machine.clone();
+        bad[field] = value;
+        let body = problem(app.put_json("/api/v1/machines/bad", &bad).await, 422).await;
+        assert_eq!(body["errors"][0]["path"], field, "{body}");
+    }
+}
