@@ -321,7 +321,8 @@ fn program_carries_the_planned_feeds() {
     }
     assert!(on_arc > 10);
     assert!(text.contains("X40.0000 Y30.0000"));
-    // The nominal program (no plan) uses one feed: 2 flutes × 0.05 × 4000.
+    // The nominal program (no plan) uses one feed, 2 flutes × 0.05 × 4000, after the plunge at
+    // half of it.
     let body = json!({
         "tool": 1, "spindle_rpm": 4000, "feed_per_tooth": 0.05, "step": 0.5,
         "stock": {"polygon": [[0, -20], [60, -20], [60, 20], [0, 20]]},
@@ -330,6 +331,6 @@ fn program_carries_the_planned_feeds() {
     let answer = engagement::solve(&request(body), &tool()).unwrap();
     let text = program(&answer, 0, &post).unwrap();
     let feed_words = text.lines().filter(|l| l.starts_with("G01") && l.contains(" F")).count();
-    assert_eq!(feed_words, 1, "{text}");
-    assert!(text.contains("F400"));
+    assert_eq!(feed_words, 2, "{text}");
+    assert!(text.contains(" F200\n") && text.contains(" F400\n"), "{text}");
 }

@@ -24,8 +24,11 @@ pub struct MoveEdit {
 /// Everything else stays byte for byte: line count, block numbers, comments, modal words and the
 /// coordinates of unchanged moves. A changed coordinate is written in the line's units with at
 /// least 4 decimals (more if the line had more); a changed axis the line did not program is
-/// inserted after the block's last word. Incremental (`G91`) blocks get new increments so every
-/// later end point stays where it was. `program` must be the result of [`read`] on `text`.
+/// inserted after the block's last word. Incremental (`G91`) feed blocks get new increments so
+/// every later end point stays where it was. Rapids without an edit are never rewritten (issue
+/// 15): after a moved cut they start, and in the axes they do not program end, where that cut
+/// ended; the next feed move is written to its own end point from there. `program` must be the
+/// result of [`read`] on `text`.
 ///
 /// # Errors
 /// `E_INPUT` for an edit that names no move, or a non-finite coordinate.
