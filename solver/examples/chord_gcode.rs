@@ -15,7 +15,13 @@ fn main() {
     for dialect in [Dialect::Fanuc, Dialect::Linuxcnc] {
         let program = chord::program(
             &answer,
-            &Post { reference: kerf_solver::gcode::Reference::Tip, dialect, tool: ToolCall::Table(1) },
+            &Post {
+                reference: kerf_solver::gcode::Reference::Tip,
+                dialect,
+                tool: ToolCall::Table(1),
+                arcs: kerf_solver::gcode::Arcs::Chords,
+                plunge_feed: None,
+            },
         )
         .expect("program");
         match files.next() {

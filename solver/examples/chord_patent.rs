@@ -84,6 +84,8 @@ fn main() {
         reference: kerf_solver::gcode::Reference::Tip,
         dialect: Dialect::Fanuc,
         tool: ToolCall::Table(1),
+        arcs: kerf_solver::gcode::Arcs::Chords,
+        plunge_feed: None,
     };
     let program = chord::program(&answer, &post).expect("program");
     for line in program.lines().take(18) {

@@ -13,7 +13,7 @@ use serde::de::DeserializeOwned;
 
 use crate::error::SolverError;
 use crate::error_code::ErrorCode;
-use crate::gcode::{Dialect, Post, Reference, ToolCall};
+use crate::gcode::{Arcs, Dialect, Post, Reference, ToolCall};
 use crate::machine::MachineProfile;
 use crate::tool::{Tool, ToolRef};
 
@@ -218,6 +218,8 @@ pub struct OutputOptions {
     pub reference: Option<Reference>,
     /// Which candidate path to program (engagement `paths`); `None`: the request's choice, else 0.
     pub candidate: Option<usize>,
+    /// Circular moves as G02/G03 or chords; `None`: the machine's `arcs`, else chords.
+    pub arcs: Option<Arcs>,
 }
 
 impl OutputOptions {
@@ -226,13 +228,20 @@ impl OutputOptions {
         self.dialect.or(machine.map(|m| m.dialect)).unwrap_or_default()
     }
 
-    /// The post for a program cut with `tool` on `machine`: these options' dialect (else the
-    /// machine's) and programmed point (else the tool tip).
+    /// How arcs are written: as asked, else the machine's default, else chords.
+    pub fn arcs_for(&self, machine: Option<&MachineProfile>) -> Arcs {
+        self.arcs.or(machine.and_then(|m| m.arcs)).unwrap_or_default()
+    }
+
+    /// The post for a program cut with `tool` on `machine`: these options' dialect and arcs
+    /// (else the machine's) and programmed point (else the tool tip).
     pub fn post(&self, machine: Option<&MachineProfile>, tool: &Tool) -> Post {
         Post {
             dialect: self.dialect_for(machine),
             reference: self.reference.unwrap_or_default(),
             tool: ToolCall::for_tool(tool),
+            arcs: self.arcs_for(machine),
+            plunge_feed: tool.plunge_feed.or(machine.and_then(|m| m.plunge_feed)),
         }
     }
 }
@@ -247,6 +256,8 @@ pub fn program<C: Capability>(
     answer: &C::Answer,
     output: &OutputOptions,
 ) -> Result<String, SolverError> {
-    let output = OutputOptions { dialect: Some(output.dialect_for(C::machine(answer))), ..*output };
+    let machine = C::machine(answer);
+    let output =
+        OutputOptions { dialect: Some(output.dialect_for(machine)), arcs: Some(output.arcs_for(machine)), ..*output };
     C::program(request, answer, &output)
 }

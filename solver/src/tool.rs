@@ -62,6 +62,10 @@ pub struct Tool {
     /// Length from the holder face to the tip in mm (> 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stickout: Option<f64>,
+    /// Feed of straight moves down the tool axis (plunges), mm/min (> 0): programs never plunge
+    /// faster (issue 15). Default: the machine's `plunge_feed`, else half the cutting feed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plunge_feed: Option<f64>,
     /// Neck radius in mm of a lollipop or back-deburring cutter (0 < neck_radius < radius): the
     /// radius of the shank just above the cutting head. Without it the shank is taken to be as
     /// wide as the cutter.
@@ -174,6 +178,7 @@ impl Tool {
             name: None,
             helix_deg: None,
             stickout: None,
+            plunge_feed: None,
             neck_radius: None,
             shape_error: None,
             stiffness: None,
@@ -223,6 +228,9 @@ impl Tool {
         }
         if let Some(stickout) = self.stickout {
             positive(&field("stickout"), stickout)?;
+        }
+        if let Some(plunge_feed) = self.plunge_feed {
+            positive(&field("plunge_feed"), plunge_feed)?;
         }
         if let Some(neck) = self.neck_radius {
             positive(&field("neck_radius"), neck)?;
@@ -340,6 +348,9 @@ pub const TOOL_NUMBERS: std::ops::RangeInclusive<u32> = 1..=9999;
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(untagged)]
+// A request holds one of these: boxing the inline tool would save nothing worth the indirection
+// at every use.
+#[allow(clippy::large_enum_variant)]
 pub enum ToolRef {
     /// A registered tool number (1–9999).
     Number(u32),

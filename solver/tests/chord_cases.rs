@@ -137,7 +137,13 @@ fn case_a_gcode_head() {
     let answer = solve(json!({"curve": circle_a(), "feed": 10000, "block_time_ms": 4}));
     let program = chord::program(
         &answer,
-        &Post { reference: kerf_solver::gcode::Reference::Tip, dialect: Dialect::Fanuc, tool: ToolCall::Table(1) },
+        &Post {
+            reference: kerf_solver::gcode::Reference::Tip,
+            dialect: Dialect::Fanuc,
+            tool: ToolCall::Table(1),
+            arcs: kerf_solver::gcode::Arcs::Chords,
+            plunge_feed: None,
+        },
     )
     .unwrap();
     let case = case("chord", "A");
@@ -146,9 +152,11 @@ fn case_a_gcode_head() {
     // The house post writes every line with its G word and Z; compare the coordinates.
     let lines: Vec<&str> = program.lines().collect();
     let start = lines.iter().position(|l| l.starts_with("G00 X50.0000 Y0.0000")).expect("rapid above the start");
-    assert!(lines[start + 1].starts_with("G01 X50.0000 Y0.0000 Z0.0000 F10000"));
-    assert!(head[2].starts_with("G01 X49.9956 Y0.6667"));
-    assert!(lines[start + 2].starts_with("G01 X49.9956 Y0.6667 Z0.0000"));
+    // The plunge to the start runs at half the feed (no plunge feed given); the first chord
+    // carries the feed, as in the reference head.
+    assert!(lines[start + 1].starts_with("G01 X50.0000 Y0.0000 Z0.0000 F5000"));
+    assert_eq!(head[2], "G01 X49.9956 Y0.6667 F10000");
+    assert_eq!(lines[start + 2], "G01 X49.9956 Y0.6667 Z0.0000 F10000");
     for (line, want) in lines[start + 3..].iter().zip(&head[3..]) {
         assert!(line.starts_with(&format!("G01 {want}")), "{line} vs {want}");
     }
@@ -161,7 +169,7 @@ fn case_a_gcode_head() {
             })
         })
         .count();
-    assert_eq!(feed_words, 1);
+    assert_eq!(feed_words, 2);
     assert_eq!(lines.iter().filter(|l| l.starts_with("G01")).count(), 473);
 }
 

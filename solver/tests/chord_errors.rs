@@ -247,6 +247,11 @@ fn too_many_windows_are_refused_before_the_work() {
 #[test]
 fn machine_values_are_defaults_the_request_overrides() {
     let machine = MachineProfile {
+        arcs: None,
+        plunge_feed: None,
+        max_accel: None,
+        rapid_feed: None,
+        tool_change_s: None,
         name: None,
         block_time_ms: 4.0,
         max_feed: 10_000.0,
@@ -381,14 +386,32 @@ fn programs_in_both_dialects() {
     }));
     let fanuc = chord::program(
         &answer,
-        &Post { reference: kerf_solver::gcode::Reference::Tip, dialect: Dialect::Fanuc, tool: ToolCall::Table(3) },
+        &Post {
+            reference: kerf_solver::gcode::Reference::Tip,
+            dialect: Dialect::Fanuc,
+            tool: ToolCall::Table(3),
+            arcs: kerf_solver::gcode::Arcs::Chords,
+            plunge_feed: None,
+        },
     )
     .unwrap();
     assert!(fanuc.starts_with("%\nO1001 (KERF SEGMENT)\n"));
-    // Clearance 5 mm above the highest point (the start, z = -1).
+    // Clearance 5 mm above the highest point (the start, z = -1); the plunge at half the feed.
     assert!(fanuc.contains(
-        "T3 M06\nG00 G43 H3 Z4.0000\nS8000 M03\nG00 X20.0000 Y0.0000 Z4.0000\nG01 X20.0000 Y0.0000 Z-1.0000 F2000\n"
+        "T3 M06\nG00 G43 H3 Z4.0000\nS8000 M03\nG00 X20.0000 Y0.0000 Z4.0000\nG01 X20.0000 Y0.0000 Z-1.0000 F1000\n"
     ));
+    let slow = chord::program(
+        &answer,
+        &Post {
+            reference: kerf_solver::gcode::Reference::Tip,
+            dialect: Dialect::Fanuc,
+            tool: ToolCall::Table(3),
+            arcs: kerf_solver::gcode::Arcs::Chords,
+            plunge_feed: Some(120.0),
+        },
+    )
+    .unwrap();
+    assert!(slow.contains("G01 X20.0000 Y0.0000 Z-1.0000 F120\nG01 "), "the plunge feed given");
     assert!(fanuc.ends_with("M05\nG00 Z4.0000\nM30\n%\n"));
     let g01 = fanuc.lines().filter(|l| l.starts_with("G01")).count();
     assert_eq!(g01, answer.stats.blocks + 1);
@@ -398,6 +421,8 @@ fn programs_in_both_dialects() {
             reference: kerf_solver::gcode::Reference::Tip,
             dialect: Dialect::Linuxcnc,
             tool: ToolCall::Manual("as set up".to_owned()),
+            arcs: kerf_solver::gcode::Arcs::Chords,
+            plunge_feed: None,
         },
     )
     .unwrap();

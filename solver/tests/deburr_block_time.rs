@@ -180,6 +180,11 @@ fn a_radius_too_small_for_the_feed_is_reported() {
 #[test]
 fn machine_values_and_bad_block_times() {
     let machine = MachineProfile {
+        arcs: None,
+        plunge_feed: None,
+        max_accel: None,
+        rapid_feed: None,
+        tool_change_s: None,
         name: Some("hsc".to_owned()),
         block_time_ms: 4.0,
         max_feed: 2000.0,
@@ -218,6 +223,8 @@ fn machine_values_and_bad_block_times() {
         dialect: Dialect::Fanuc,
         reference: kerf_solver::gcode::Reference::Tip,
         tool: kerf_solver::gcode::ToolCall::Table(7),
+        arcs: kerf_solver::gcode::Arcs::Chords,
+        plunge_feed: None,
     };
     let program = deburr::program(&result, &post).unwrap();
     assert!(program.contains("(BLOCK TIME 4 MS MARGIN 1.2:"), "{program}");

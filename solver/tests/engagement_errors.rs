@@ -210,7 +210,13 @@ fn a_path_that_never_touches_the_stock_gives_zeros_and_a_warning() {
 #[test]
 fn program_needs_the_cutting_depth() {
     let answer = engagement::solve(&with(json!({})), &tool()).unwrap();
-    let post = Post { dialect: Dialect::Fanuc, reference: Reference::Tip, tool: ToolCall::Table(3) };
+    let post = Post {
+        dialect: Dialect::Fanuc,
+        reference: Reference::Tip,
+        tool: ToolCall::Table(3),
+        arcs: kerf_solver::gcode::Arcs::Chords,
+        plunge_feed: None,
+    };
     let error = program(&answer, 0, &post).unwrap_err();
     assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("axial_depth")));
     let error = program(&answer, 1, &post).unwrap_err();

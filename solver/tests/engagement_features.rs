@@ -280,7 +280,13 @@ fn program_carries_the_planned_feeds() {
     let answer = engagement::solve(&request(body), &tool()).unwrap();
     let result = &answer.candidates()[0];
     let plan = result.feed_plan.as_ref().unwrap();
-    let post = Post { dialect: Dialect::Linuxcnc, reference: Reference::Tip, tool: ToolCall::Table(4) };
+    let post = Post {
+        dialect: Dialect::Linuxcnc,
+        reference: Reference::Tip,
+        tool: ToolCall::Table(4),
+        arcs: kerf_solver::gcode::Arcs::Chords,
+        plunge_feed: None,
+    };
     let text = program(&answer, 0, &post).unwrap();
     assert!(text.contains("T4 M06") && text.contains("S4000 M03") && text.ends_with("M30\n"));
     // Cutting at Z = 10 − 3, clearance at 15.
@@ -293,9 +299,10 @@ fn program_carries_the_planned_feeds() {
         .collect();
     let planned: std::collections::BTreeSet<u64> = plan.blocks.iter().map(|b| b.feed.unwrap() as u64).collect();
     assert!(feeds.len() >= 2, "{feeds:?}");
-    // The descent into the cut runs at the nominal feed (2 flutes × 0.05 × 4000 = 400) at most.
+    // The descent into the cut runs at half the nominal feed (2 flutes × 0.05 × 4000 = 400) at
+    // most: the plunge without a plunge feed.
     for feed in &feeds {
-        assert!(planned.contains(&(*feed as u64)) || *feed == 400.0, "F{feed} not in the plan {planned:?}");
+        assert!(planned.contains(&(*feed as u64)) || *feed == 200.0, "F{feed} not in the plan {planned:?}");
     }
     // The arc's chord points lie on the arc, within the chord tolerance.
     let mut on_arc = 0;
@@ -314,7 +321,8 @@ fn program_carries_the_planned_feeds() {
     }
     assert!(on_arc > 10);
     assert!(text.contains("X40.0000 Y30.0000"));
-    // The nominal program (no plan) uses one feed: 2 flutes × 0.05 × 4000.
+    // The nominal program (no plan) uses one feed, 2 flutes × 0.05 × 4000, after the plunge at
+    // half of it.
     let body = json!({
         "tool": 1, "spindle_rpm": 4000, "feed_per_tooth": 0.05, "step": 0.5,
         "stock": {"polygon": [[0, -20], [60, -20], [60, 20], [0, 20]]},
@@ -323,6 +331,6 @@ fn program_carries_the_planned_feeds() {
     let answer = engagement::solve(&request(body), &tool()).unwrap();
     let text = program(&answer, 0, &post).unwrap();
     let feed_words = text.lines().filter(|l| l.starts_with("G01") && l.contains(" F")).count();
-    assert_eq!(feed_words, 1, "{text}");
-    assert!(text.contains("F400"));
+    assert_eq!(feed_words, 2, "{text}");
+    assert!(text.contains(" F200\n") && text.contains(" F400\n"), "{text}");
 }

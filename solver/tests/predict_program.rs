@@ -71,6 +71,11 @@ fn gcode_comes_back_with_only_coordinates_changed() {
         }
     }
     assert!(changed >= 3);
+    // Rapids stay byte for byte (issue 15): only cutting moves change.
+    for (old, new) in PROGRAM.lines().zip(corrected.lines()).filter(|(old, _)| old.contains(" G0 ")) {
+        assert_eq!(old, new);
+    }
+    assert_eq!(PROGRAM.lines().filter(|l| l.contains(" G0 ")).count(), 2);
     // Every pass ends where the answer says, to the written precision.
     let read = reader::read(&corrected, "program", &ReadOptions::default()).unwrap();
     let feed_moves: Vec<_> = read.moves.iter().filter(|m| !matches!(m.kind, reader::MoveKind::Rapid)).collect();
@@ -136,6 +141,11 @@ fn points_become_a_complete_program() {
     let answer = predict::solve(&request, &tool, None).unwrap();
     let text = predict::corrected_program(&request, &answer, &options()).unwrap();
     assert!(text.starts_with("%\nO1000"));
+    // The corrections move cutting points only: the rapids are those over the programmed points
+    // (first and last at Y 0 and 0.8, the clearance 5 mm over z = 0), byte for byte.
+    assert!(answer.summary.max_correction > 0.0);
+    let rapids: Vec<&str> = text.lines().filter(|l| l.starts_with("G00 X")).collect();
+    assert_eq!(rapids, ["G00 X-8.0000 Y0.0000 Z5.0000", "G00 X-8.0000 Y0.8000 Z5.0000"], "{text}");
     assert!(text.contains("S8000 M03"));
     assert!(text.contains("G01 X"));
     assert!(text.ends_with("M30\n%\n"));

@@ -34,6 +34,10 @@ pub struct EngagementQuery {
     /// G-code only: which entry of `paths` to program (0-based; default the request's
     /// `candidate`, else 0); a request with `path` has only candidate 0.
     pub candidate: Option<usize>,
+    /// Arc segments of the path: `g2g3` (G02/G03 with I/J, end points those of the chords) or
+    /// `chords` (G01 within 0.001 mm, or by the block-time rule); default the machine's `arcs`,
+    /// else `chords`.
+    pub arcs: Option<kerf_solver::gcode::Arcs>,
 }
 
 /// Analyses the tool–workpiece engagement along a tool path and recommends flute counts.
@@ -70,7 +74,12 @@ async fn post_engagement(
 ) -> AppResult<Response> {
     let ask = Ask {
         gcode: wants_gcode(&headers, query.format),
-        output: OutputOptions { dialect: query.dialect, reference: query.reference, candidate: query.candidate },
+        output: OutputOptions {
+            dialect: query.dialect,
+            reference: query.reference,
+            candidate: query.candidate,
+            arcs: query.arcs,
+        },
         timings: false,
     };
     super::solve::answer::<EngagementCapability>(&state, request, None, ask).await

@@ -1,11 +1,11 @@
 //! Output negotiation shared by every path-producing endpoint (api.md, Conventions: G-code):
 //! JSON by default; G-code with `Accept: text/x-gcode` or `?format=gcode`, in `?dialect=`
-//! (`fanuc` default, or the machine's) with `?reference=tip|centre`.
+//! (`fanuc` default, or the machine's) with `?reference=tip|centre` and `?arcs=g2g3|chords`.
 
 use axum::http::{HeaderMap, HeaderValue, header};
 use axum::response::{IntoResponse, Response};
 use kerf_solver::capability::OutputOptions;
-use kerf_solver::gcode::{Dialect, Reference};
+use kerf_solver::gcode::{Arcs, Dialect, Reference};
 use serde::Deserialize;
 use utoipa::{IntoParams, ToSchema};
 
@@ -33,6 +33,10 @@ pub struct OutputQuery {
     pub dialect: Option<Dialect>,
     /// Programmed point: `tip` (default; length offset to the tool tip) or `centre`.
     pub reference: Option<Reference>,
+    /// Circular moves: `g2g3` (G02/G03 with I/J in the XY plane, end points those of the chords)
+    /// or `chords` (G01 within the tolerance); default the named machine's `arcs`, else `chords`.
+    /// Ellipses, NURBS and polylines stay chords.
+    pub arcs: Option<Arcs>,
 }
 
 /// What the client asked for: JSON, or the program with its output options.
@@ -51,7 +55,12 @@ impl Ask {
     pub fn negotiate(headers: &HeaderMap, query: &OutputQuery) -> Self {
         Self {
             gcode: wants_gcode(headers, query.format),
-            output: OutputOptions { dialect: query.dialect, reference: query.reference, candidate: None },
+            output: OutputOptions {
+                dialect: query.dialect,
+                reference: query.reference,
+                candidate: None,
+                arcs: query.arcs,
+            },
             timings: false,
         }
     }

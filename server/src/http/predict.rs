@@ -156,7 +156,7 @@ async fn post_predict(
 ) -> AppResult<Response> {
     let ask = Ask {
         gcode: wants_gcode(&headers, query.format),
-        output: OutputOptions { dialect: query.dialect, reference: query.reference, candidate: None },
+        output: OutputOptions { dialect: query.dialect, reference: query.reference, ..OutputOptions::default() },
         timings: query.timings.unwrap_or(false),
     };
     // While it arrives, possibly slowly, the upload holds its share of the memory budget (its

@@ -25,7 +25,7 @@
 
 use kerf_solver::ErrorCode;
 use kerf_solver::capability::{self, Lookup};
-use kerf_solver::gcode::{Dialect, Reference};
+use kerf_solver::gcode::{Arcs, Dialect, Reference};
 use kerf_solver::machine::{MachineProfile, validate_machine_name};
 use kerf_solver::predict::Stock;
 use kerf_solver::tool::{Tool, ToolRef};
@@ -77,12 +77,16 @@ pub struct OutputOptions {
     /// `tip` or `centre`; default `tip` (a predict operation's G-code path keeps its own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference: Option<Reference>,
+    /// `g2g3` (circular moves as G02/G03) or `chords`; default each operation's machine's
+    /// `arcs`, else `chords`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arcs: Option<Arcs>,
 }
 
 impl OutputOptions {
     /// The options every operation's program is written with.
     pub fn for_programs(&self) -> capability::OutputOptions {
-        capability::OutputOptions { dialect: self.dialect, reference: self.reference, candidate: None }
+        capability::OutputOptions { dialect: self.dialect, reference: self.reference, candidate: None, arcs: self.arcs }
     }
 }
 

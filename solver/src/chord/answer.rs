@@ -106,4 +106,8 @@ pub struct SegmentAnswer {
     /// Clearance plane for the program.
     #[serde(skip)]
     pub(crate) safe_z: f64,
+    /// The circle or arc the curve is, for a program that writes it as G02/G03 (`None` for
+    /// ellipses, polylines and NURBS: they stay chords).
+    #[serde(skip)]
+    pub(crate) circle: Option<super::shape::Arc>,
 }

@@ -28,6 +28,11 @@ pub struct SegmentResult {
     /// Windows, command points, block figures, the comparison and warnings.
     #[serde(flatten)]
     pub result: SegmentAnswer,
+    /// With a machine that has `max_accel`: the time the control would take for the program
+    /// (the plunge at the plunge feed, the blocks with a trapezoidal feed profile and the block
+    /// time, the retract at `rapid_feed`, one tool change when a tool is named) and its parts.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cycle_time: Option<crate::machine::cycle::CycleTime>,
 }
 
 impl Capability for SegmentCapability {
@@ -49,7 +54,11 @@ impl Capability for SegmentCapability {
             tool.validate("tool.")?;
         }
         let result = super::solve_controlled(request, context.machine.as_ref(), run.control)?;
-        Ok(SegmentResult { machine: context.machine, tool: context.tool, result })
+        let cycle_time = context.machine.as_ref().and_then(|machine| {
+            let plunge = context.tool.as_ref().and_then(|t| t.plunge_feed).or(machine.plunge_feed);
+            super::cycle_time(&result, machine, plunge, context.tool.is_some())
+        });
+        Ok(SegmentResult { machine: context.machine, tool: context.tool, result, cycle_time })
     }
 
     /// The curve is the programmed point: `reference` does not apply.
@@ -62,7 +71,17 @@ impl Capability for SegmentCapability {
             Some(tool) => ToolCall::for_tool(tool),
             None => ToolCall::Manual("none named in the request".to_owned()),
         };
-        let post = Post { dialect: output.dialect_for(answer.machine.as_ref()), reference: Reference::Tip, tool };
+        let post = Post {
+            dialect: output.dialect_for(answer.machine.as_ref()),
+            reference: Reference::Tip,
+            tool,
+            arcs: output.arcs_for(answer.machine.as_ref()),
+            plunge_feed: answer
+                .tool
+                .as_ref()
+                .and_then(|tool| tool.plunge_feed)
+                .or(answer.machine.as_ref().and_then(|m| m.plunge_feed)),
+        };
         super::program(&answer.result, &post)
     }
 

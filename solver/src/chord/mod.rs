@@ -72,6 +72,7 @@ mod shape;
 pub use answer::{Comparison, SegmentAnswer, SegmentWindow, WindowStatus};
 pub use capability::{SegmentCapability, SegmentResult};
 pub use nurbs::{MAX_CONTROL_POINTS, MAX_DEGREE};
+pub(crate) use program::cycle_time;
 pub use program::program;
 pub use request::{Curve, CurveRule, Direction, Mode, RadiusEstimate, SegmentRequest};
 
@@ -374,5 +375,9 @@ fn answer(job: &Job, request: &SegmentRequest, cutter: &Cutter<'_>, cut: &Cut) -
         description,
         spindle_rpm: job.spindle_rpm,
         safe_z,
+        circle: match &job.shape {
+            shape::Shape::Arc(arc) => Some(arc.clone()),
+            _ => None,
+        },
     })
 }

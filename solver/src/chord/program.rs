@@ -1,5 +1,6 @@
 //! The G-code program of a segment answer (chord.md §6.1): G01 blocks through the command points
-//! with the F word, written by the house post.
+//! with the F word, written by the house post; with `arcs = g2g3` a circle or arc is written as
+//! G02/G03 blocks of at most half a turn ending at the last command point (issue 15).
 //!
 //! The path: rapid to the clearance plane above the first point, feed down to it, the G01
 //! blocks, and (by the post) back up to the clearance plane. A segment program has no tool of its
@@ -9,9 +10,36 @@
 use super::answer::SegmentAnswer;
 use crate::error::ErrorCode;
 use crate::error::SolverError;
-use crate::gcode::{self, Post, Program, SpindleDirection};
+use crate::gcode::{self, Arcs, Post, Program, SpindleDirection};
 use crate::geometry::Vec3;
+use crate::machine::MachineProfile;
+use crate::machine::cycle::{CycleTime, Step, cycle_time as cycle_time_of};
 use crate::path::Toolpath;
+
+/// The cycle time of the chord program on `machine` (None without its `max_accel`): from the
+/// clearance plane above the first point, the plunge (air) at the plunge feed, every block
+/// (cutting), the retract; one tool change when `tool_change`.
+pub(crate) fn cycle_time(
+    answer: &SegmentAnswer,
+    machine: &MachineProfile,
+    plunge_feed: Option<f64>,
+    tool_change: bool,
+) -> Option<CycleTime> {
+    let dynamics = machine.dynamics()?;
+    let points: Vec<Vec3> = answer.points.iter().map(|p| point(p)).collect();
+    let first = *points.first()?;
+    let above = Vec3::new(first.x, first.y, answer.safe_z);
+    let mut steps = vec![Step::Feed { to: first, feed: gcode::plunge_feed(answer.feed, plunge_feed), air: true }];
+    steps.extend(points[1..].iter().map(|&to| Step::Feed { to, feed: answer.feed, air: false }));
+    let last = points[points.len() - 1];
+    steps.push(Step::Rapid(Vec3::new(last.x, last.y, answer.safe_z)));
+    Some(cycle_time_of(above, &steps, &dynamics, usize::from(tool_change)))
+}
+
+/// A command point as a 3-D point (2-D curves at z = 0).
+fn point(p: &[f64]) -> Vec3 {
+    Vec3::new(p.first().copied().unwrap_or(0.0), p.get(1).copied().unwrap_or(0.0), p.get(2).copied().unwrap_or(0.0))
+}
 
 /// The complete program for a segment answer. `post.reference` does not apply: the curve is
 /// the programmed point.
@@ -19,17 +47,7 @@ use crate::path::Toolpath;
 /// # Errors
 /// `E_NO_PROGRAM` when the answer has no block (it always has one when `solve` succeeded).
 pub fn program(answer: &SegmentAnswer, post: &Post) -> Result<String, SolverError> {
-    let points: Vec<Vec3> = answer
-        .points
-        .iter()
-        .map(|p| {
-            Vec3::new(
-                p.first().copied().unwrap_or(0.0),
-                p.get(1).copied().unwrap_or(0.0),
-                p.get(2).copied().unwrap_or(0.0),
-            )
-        })
-        .collect();
+    let points: Vec<Vec3> = answer.points.iter().map(|p| point(p)).collect();
     let Some(first) = points.first() else {
         return Err(SolverError::new(ErrorCode::NoProgram, "the answer has no points"));
     };
@@ -39,8 +57,16 @@ pub fn program(answer: &SegmentAnswer, post: &Post) -> Result<String, SolverErro
     let mut path = Toolpath::default();
     path.rapid(Vec3::new(first.x, first.y, answer.safe_z));
     path.linear(*first, answer.feed);
-    for point in &points[1..] {
-        path.linear(*point, answer.feed);
+    match (&answer.circle, post.arcs) {
+        (Some(arc), Arcs::G2g3) => {
+            let end = points[points.len() - 1];
+            path.arc_sweep(*first, end, arc.centre, arc.sense * arc.sweep, answer.feed);
+        }
+        _ => {
+            for point in &points[1..] {
+                path.linear(*point, answer.feed);
+            }
+        }
     }
     Ok(gcode::write(&Program {
         dialect: post.dialect,
@@ -52,6 +78,7 @@ pub fn program(answer: &SegmentAnswer, post: &Post) -> Result<String, SolverErro
         spindle_direction: SpindleDirection::Cw,
         safe_z: answer.safe_z,
         blend_tolerance: answer.chord_error.max(1e-4),
+        plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
         path: &path,
     }))
 }

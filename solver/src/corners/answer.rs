@@ -47,6 +47,24 @@ pub struct ContourLayer {
     pub z: f64,
     /// The moves in order.
     pub moves: Vec<ContourMove>,
+    /// The arcs among the moves, for a program that writes them as G02/G03.
+    #[serde(skip)]
+    pub(crate) arcs: Vec<ArcSpan>,
+}
+
+/// The chord moves `first..=last` of a layer run one arc of the tool-centre path from `start` to
+/// `end` about `centre` (sweep in radians, counter-clockwise positive), all in the layer plane.
+/// Under the block-time rule the move before `first` may have been lengthened to the first
+/// circumscribed vertex (and the arc's last chord joined to the move after it): the exact
+/// `start` and `end` lie on those straight moves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ArcSpan {
+    pub first: usize,
+    pub last: usize,
+    pub start: [f64; 2],
+    pub end: [f64; 2],
+    pub centre: [f64; 2],
+    pub sweep: f64,
 }
 
 /// Whether the material protrudes at a corner.
@@ -248,6 +266,12 @@ pub struct ContourSummary {
     /// With `block_time_ms`: the blocks, the shortest, the short ones and the block-limited time.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub blocks: Option<crate::machine::PathBlocks>,
+    /// With a machine that has `max_accel`: the time the control would take for the program
+    /// (trapezoidal feed profile, stops at sharp corners, plunges at the plunge feed, rapids at
+    /// `rapid_feed`, one tool change) and its parts: cutting, air (loops, leads and links), rapid,
+    /// tool change.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cycle_time: Option<crate::machine::cycle::CycleTime>,
 }
 
 /// The answer of `POST /api/v1/contour`.

@@ -1,12 +1,13 @@
 //! The G-code program of a solved contour (api.md G-code conventions): every layer's moves in
 //! order, rapids as G00, cuts, loops and links as G01 at their feeds (loops at `loop_feed` where
-//! they clear the stock).
+//! they clear the stock). With `arcs = g2g3` the chords of each arc (loops, round joins) become
+//! G02/G03 blocks from the arc's exact start to its exact end (issue 15).
 
 use super::answer::{ContourAnswer, MoveKind};
 use crate::error::ErrorCode;
 use crate::error::SolverError;
 
-use crate::gcode::{self, Post, Program, Reference, SpindleDirection};
+use crate::gcode::{self, Arcs, Post, Program, Reference, SpindleDirection};
 use crate::geometry::Vec3;
 use crate::path::Toolpath;
 
@@ -30,12 +31,30 @@ pub fn program(answer: &ContourAnswer, post: &Post) -> Result<String, SolverErro
     let offset = Vec3::new(0.0, 0.0, lift);
     let mut path = Toolpath::default();
     for layer in &answer.layers {
-        for step in &layer.moves {
+        let mut spans = layer.arcs.iter().filter(|_| post.arcs == Arcs::G2g3).peekable();
+        let mut index = 0;
+        while let Some(step) = layer.moves.get(index) {
+            if let Some(span) = spans.next_if(|span| span.first == index)
+                && let Some(feed) = step.feed
+            {
+                let height = layer.z + lift;
+                let start = Vec3::new(span.start[0], span.start[1], height);
+                // The move before was lengthened to the first chord vertex under the block-time
+                // rule: it ends at the arc's start again, on the same line.
+                if let Some(previous) = path.moves.last_mut() {
+                    previous.to = start;
+                }
+                let end = Vec3::new(span.end[0], span.end[1], height);
+                path.arc_sweep(start, end, Vec3::new(span.centre[0], span.centre[1], height), span.sweep, feed);
+                index = span.last + 1;
+                continue;
+            }
             let to = Vec3::from(step.to) + offset;
             match (step.kind, step.feed) {
                 (MoveKind::Rapid, _) | (_, None) => path.rapid(to),
                 (_, Some(feed)) => path.linear(to, feed),
             }
+            index += 1;
         }
     }
     let mut comments = answer.description.clone();
@@ -50,6 +69,7 @@ pub fn program(answer: &ContourAnswer, post: &Post) -> Result<String, SolverErro
         spindle_direction: SpindleDirection::Cw,
         safe_z: answer.summary.safe_z + lift,
         blend_tolerance: answer.summary.tolerance,
+        plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
         path: &path,
     }))
 }

@@ -4,8 +4,8 @@
 //! warnings.
 
 use super::answer::{
-    ContourAnswer, ContourCorner, ContourLayer, ContourMove, ContourSummary, Convexity, CornerAction, LoopReport,
-    MaterialReport, MoveKind, PassReport, ReliefReport,
+    ArcSpan, ContourAnswer, ContourCorner, ContourLayer, ContourMove, ContourSummary, Convexity, CornerAction,
+    LoopReport, MaterialReport, MoveKind, PassReport, ReliefReport,
 };
 use super::blocks;
 use super::element::{Chording, Element, ElementKind};
@@ -170,8 +170,9 @@ pub fn solve_with(
             shortened = true;
         }
         lead_used = lead_used.min(lead);
-        let moves = layer_moves(&job, layer, passes, lead_point.map(|(point, _)| point), index == 0, previous_z, z);
-        layers.push(ContourLayer { z, moves });
+        let (moves, arcs) =
+            layer_moves(&job, layer, passes, lead_point.map(|(point, _)| point), index == 0, previous_z, z);
+        layers.push(ContourLayer { z, moves, arcs });
         previous_z = z;
     }
     if shortened {
@@ -235,6 +236,7 @@ pub fn solve_with(
         tolerance: job.tolerance,
         estimated_time_s: time_min * 60.0,
         blocks,
+        cycle_time: machine.and_then(|m| contour_cycle_time(&layers, m, job.tool.plunge_feed)),
     };
     let description = describe(&job, &summary);
     let centre_height = match job.tool.kind {
@@ -419,15 +421,16 @@ fn layer_moves(
     first: bool,
     previous_z: f64,
     z: f64,
-) -> Vec<ContourMove> {
+) -> (Vec<ContourMove>, Vec<ArcSpan>) {
     let start_axis = axis(job, layer, 0).map(|a| Box::new([a.x, a.y, a.z]));
     let at = |p: &Vec2, height: f64| [p.x, p.y, height];
     let mut moves = Vec::new();
     let step =
         |kind: MoveKind, to: [f64; 3], feed: Option<f64>| ContourMove { kind, to, feed, axis: start_axis.clone() };
     let Some(first_start) = passes.first().map(|p| p.start) else {
-        return Vec::new();
+        return (Vec::new(), Vec::new());
     };
+    let mut arcs = Vec::new();
     let entry = lead_point.unwrap_or(first_start);
     let approach = (previous_z + APPROACH_GAP.min(job.safe_z - previous_z)).max(z);
     if first {
@@ -477,6 +480,18 @@ fn layer_moves(
                     last -= 1;
                 }
             }
+            if let Element::Arc { start, end, centre, sweep, .. } = element
+                && last > first
+            {
+                arcs.push(ArcSpan {
+                    first: moves.len(),
+                    last: moves.len() + last - first - 1,
+                    start: [start.x, start.y],
+                    end: [end.x, end.y],
+                    centre: [centre.x, centre.y],
+                    sweep: *sweep,
+                });
+            }
             for (index, point) in points.iter().enumerate().take(last).skip(first) {
                 let axis = from_axis.zip(to_axis).map(|(a, b)| {
                     let s = (index as f64 + 1.0) / count;
@@ -498,7 +513,36 @@ fn layer_moves(
         }
     }
     moves.push(ContourMove { kind: MoveKind::Rapid, to: at(&here, job.safe_z), feed: None, axis: start_axis });
-    moves
+    (moves, arcs)
+}
+
+/// The cycle time of the program of `layers` on `machine` (None without its `max_accel`):
+/// cuts in the material, loops and links in the air, plunges at the plunge feed as the program
+/// writes them.
+fn contour_cycle_time(
+    layers: &[ContourLayer],
+    machine: &MachineProfile,
+    tool_plunge_feed: Option<f64>,
+) -> Option<crate::machine::cycle::CycleTime> {
+    use crate::machine::cycle::{Step, cycle_time};
+    let dynamics = machine.dynamics()?;
+    let plunge = tool_plunge_feed.or(machine.plunge_feed);
+    let first = layers.first()?.moves.first()?;
+    let mut here = Vec3::from(first.to);
+    let mut steps = Vec::new();
+    for step in layers.iter().flat_map(|layer| &layer.moves) {
+        let to = Vec3::from(step.to);
+        steps.push(match (step.kind, step.feed) {
+            (MoveKind::Rapid, _) | (_, None) => Step::Rapid(to),
+            (kind, Some(feed)) => {
+                let down = to.z < here.z && (to.x - here.x).abs() <= 1e-9 && (to.y - here.y).abs() <= 1e-9;
+                let feed = if down { crate::gcode::plunge_feed(feed, plunge) } else { feed };
+                Step::Feed { to, feed, air: kind != MoveKind::Cut }
+            }
+        });
+        here = to;
+    }
+    Some(cycle_time(Vec3::from(first.to), &steps, &dynamics, 1))
 }
 
 fn corner_action(action: Action) -> CornerAction {

@@ -131,6 +131,8 @@ pub fn program(deburr: &Deburr, post: &Post) -> Result<String, SolverError> {
         spindle_direction: SpindleDirection::Cw,
         safe_z: safe_centre_z + offset.z,
         blend_tolerance: deburr.summary.tolerance,
+        // Every move down runs in air: to the lead point beside the edge, or down the hole.
+        plunges: None,
         path: &path,
     }))
 }

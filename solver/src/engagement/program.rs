@@ -1,16 +1,18 @@
 //! The G-code program of one evaluated path (engagement.md §3.2 adoption, §11 items 3 and 12):
 //! the path at the cutting depth with the feed plan's F words (or the nominal feed), rapids
 //! lifted to the clearance plane, arcs as chords (with a block time, by the block-time rule of
-//! chord.md); and the block figures of that program for the answer.
+//! chord.md) or as G02/G03 (`arcs = g2g3`, issue 15); and the block figures of the chord program
+//! for the answer.
 
 use super::answer::{EngagementAnswer, PathEngagement};
 use super::segments::{Route, Shape};
 use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};
+use crate::gcode::Arcs;
 use crate::gcode::{self, Post, Program, Reference};
 use crate::geometry::Vec3;
 use crate::machine::{BlockRule, PathBlocks, path_blocks, short_block_warning};
-use crate::path::{Motion, Toolpath};
+use crate::path::Toolpath;
 
 /// Largest distance of an arc from its chords in the program, mm.
 pub const CHORD_TOLERANCE: f64 = 0.001;
@@ -70,7 +72,7 @@ pub fn program(answer: &EngagementAnswer, candidate: usize, post: &Post) -> Resu
         Reference::Tip => 0.0,
         Reference::Centre => data.centre_height,
     };
-    let Cut { path, cut_z, safe_z, .. } = cut(result, lift)?;
+    let Cut { path, cut_z, safe_z, .. } = cut(result, lift, post.arcs)?;
     let mut comments = data.description.clone();
     comments.push(format!("cut Z {:.4}, clearance Z {:.4}, control point {}", cut_z, safe_z, post.reference.as_str()));
     if let Some(plan) = &result.feed_plan {
@@ -98,6 +100,7 @@ pub fn program(answer: &EngagementAnswer, candidate: usize, post: &Post) -> Resu
         spindle_direction: data.spindle_direction,
         safe_z,
         blend_tolerance: CHORD_TOLERANCE * 5.0,
+        plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
         path: &path,
     }))
 }
@@ -118,8 +121,9 @@ struct Cut {
 /// The tool path of `result` with the control point `lift` above the tip: the cut at
 /// `stock_top_z − axial_depth`, rapids at the clearance plane, arcs as chords within
 /// [`CHORD_TOLERANCE`], or with a block time at the block-time rule's chord error for the arc's
-/// radius and feed (chords of one block), never coarser than that.
-fn cut(result: &PathEngagement, lift: f64) -> Result<Cut, SolverError> {
+/// radius and feed (chords of one block), never coarser than that; with [`Arcs::G2g3`] each arc
+/// portion is one circular move to the chords' last point.
+fn cut(result: &PathEngagement, lift: f64, arcs: Arcs) -> Result<Cut, SolverError> {
     let data = &result.post;
     let depth = data.axial_depth.ok_or_else(|| {
         SolverError::input(
@@ -163,6 +167,16 @@ fn cut(result: &PathEngagement, lift: f64) -> Result<Cut, SolverError> {
                     raised = false;
                 }
                 let portion = piece.shape.portion(from, to);
+                if let (Arcs::G2g3, Shape::Arc { centre, sweep, .. }) = (arcs, portion) {
+                    // The chords' last point, computed as they compute it.
+                    if let Some(end) = portion.flatten_into(1).last().copied() {
+                        let start = portion.point(0.0);
+                        let (start, end3) = (Vec3::new(start.x, start.y, cut_z), Vec3::new(end.x, end.y, cut_z));
+                        path.arc_sweep(start, end3, Vec3::new(centre.x, centre.y, cut_z), sweep, feed);
+                        at = end;
+                    }
+                    continue;
+                }
                 let count = match (portion, &data.rule) {
                     (Shape::Arc { radius, .. }, Some(rule)) => {
                         let rule = BlockRule { feed, ..*rule };
@@ -219,11 +233,8 @@ pub(crate) fn blocks(result: &PathEngagement) -> Result<Option<(PathBlocks, Vec<
     let (Some(rule), Some(_)) = (&result.post.rule, result.post.axial_depth) else {
         return Ok(None);
     };
-    let cut = cut(result, 0.0)?;
-    let moves = cut.path.moves.iter().map(|step| match step.motion {
-        Motion::Rapid => (step.to, None),
-        Motion::Linear { feed } => (step.to, Some(feed)),
-    });
+    let cut = cut(result, 0.0, Arcs::Chords)?;
+    let moves = cut.path.moves.iter().map(|step| (step.to, step.motion.feed()));
     let figures = path_blocks(moves, rule.block_time_ms, rule.feed, cut.finest_arc_tolerance)?;
     let mut warnings = Vec::new();
     let (count, radius, feed_limit) = cut.infeasible;

@@ -13,6 +13,7 @@ use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
+use crate::geometry::Vec3;
 use crate::path::{Motion, Toolpath};
 
 /// The control the program is written for.
@@ -25,6 +26,32 @@ pub enum Dialect {
     Fanuc,
     /// LinuxCNC (rs274ngc): adds `G64 P` blending tolerance.
     Linuxcnc,
+}
+
+/// How circular moves are written (issue 15): as the control's own circular interpolation or as
+/// straight chords.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Arcs {
+    /// G01 chords within the capability's tolerance (and the block-time rule with a block time):
+    /// what every control runs.
+    #[default]
+    Chords,
+    /// G02/G03 in the XY plane (G17) with the centre as I/J relative to the start (both
+    /// dialects: incremental I/J is Fanuc's and LinuxCNC's default); the end point is the chord
+    /// version's last point. Curves that are not circular (ellipses, NURBS, polylines) stay chords.
+    G2g3,
+}
+
+impl Arcs {
+    /// The name used in comments and JSON.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Chords => "chords",
+            Self::G2g3 => "g2g3",
+        }
+    }
 }
 
 /// Which point of the tool the program coordinates describe.
@@ -78,6 +105,28 @@ pub struct Post {
     pub reference: Reference,
     /// Tool selection.
     pub tool: ToolCall,
+    /// Circular moves as G02/G03 or as chords.
+    pub arcs: Arcs,
+    /// Feed of plunges, mm/min (the tool's, else the machine's); `None`: a fraction
+    /// [`DEFAULT_PLUNGE_FRACTION`] of the cutting feed.
+    pub plunge_feed: Option<f64>,
+}
+
+/// A plunge runs at this fraction of the cutting feed when neither tool nor machine gives a
+/// `plunge_feed` (issue 15: never a plunge at the cutting feed).
+pub const DEFAULT_PLUNGE_FRACTION: f64 = 0.5;
+
+/// The feed of a plunge after cutting at `feed`: `plunge_feed` when slower, else
+/// [`DEFAULT_PLUNGE_FRACTION`] of `feed`.
+pub fn plunge_feed(feed: f64, plunge_feed: Option<f64>) -> f64 {
+    plunge_feed.map_or(feed * DEFAULT_PLUNGE_FRACTION, |plunge| plunge.min(feed))
+}
+
+impl Post {
+    /// A post writing arcs as chords (the default of every option but the tool).
+    pub fn new(dialect: Dialect, reference: Reference, tool: ToolCall) -> Self {
+        Self { dialect, reference, tool, arcs: Arcs::Chords, plunge_feed: None }
+    }
 }
 
 /// Everything the post needs besides the path.
@@ -101,8 +150,19 @@ pub struct Program<'a> {
     pub safe_z: f64,
     /// Path blending tolerance for LinuxCNC's `G64 P`, mm.
     pub blend_tolerance: f64,
+    /// Plunges (straight feed moves straight down: X and Y unchanged, Z lower) run at
+    /// [`plunge_feed`] of their feed with this value; `None`: at their own feed (the capability
+    /// made sure they run in air).
+    pub plunges: Option<Plunges>,
     /// The moves; the first should start from the clearance plane.
     pub path: &'a Toolpath,
+}
+
+/// How a program slows its plunges.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plunges {
+    /// The tool's or machine's plunge feed, mm/min.
+    pub feed: Option<f64>,
 }
 
 /// Spindle rotation seen from the spindle, looking down the tool at the workpiece.
@@ -173,21 +233,43 @@ pub fn write(program: &Program<'_>) -> String {
     }
     let _ = writeln!(out, "S{} {}", program.spindle_rpm.round(), program.spindle_direction.m_code());
     let mut current_feed: Option<f64> = None;
+    let mut position: Option<Vec3> = None;
     for step in &program.path.moves {
         let (x, y, z) = (mm(step.to.x), mm(step.to.y), mm(step.to.z));
-        match step.motion {
+        let feed = match step.motion {
             Motion::Rapid => {
                 let _ = writeln!(out, "G00 X{x} Y{y} Z{z}");
+                position = Some(step.to);
+                continue;
             }
-            Motion::Linear { feed } => {
-                if current_feed == Some(feed) {
-                    let _ = writeln!(out, "G01 X{x} Y{y} Z{z}");
-                } else {
-                    let _ = writeln!(out, "G01 X{x} Y{y} Z{z} F{}", feed_word(feed));
-                    current_feed = Some(feed);
+            // An arc needs its start; a path never starts with one (the post writes a straight
+            // move there rather than a wrong centre). An arc whose printed end is its printed
+            // start would be a full circle on one control and nothing on another: written as the
+            // straight move it is meant to be (producers split full circles).
+            Motion::Arc { feed, centre, clockwise }
+                if position.is_some_and(|start| mm(start.x) != x || mm(start.y) != y) =>
+            {
+                let start = position.unwrap_or_default();
+                let word = if clockwise { "G02" } else { "G03" };
+                let (i, j) = (mm(centre.x - start.x), mm(centre.y - start.y));
+                let _ = write!(out, "{word} X{x} Y{y} Z{z} I{i} J{j}");
+                feed
+            }
+            Motion::Linear { feed } | Motion::Arc { feed, .. } => {
+                let _ = write!(out, "G01 X{x} Y{y} Z{z}");
+                match (program.plunges, position) {
+                    (Some(plunges), Some(from)) if is_plunge(from, step.to) => plunge_feed(feed, plunges.feed),
+                    _ => feed,
                 }
             }
+        };
+        if current_feed == Some(feed) {
+            out.push('\n');
+        } else {
+            let _ = writeln!(out, " F{}", feed_word(feed));
+            current_feed = Some(feed);
         }
+        position = Some(step.to);
     }
     out.push_str("M05\n");
     let _ = writeln!(out, "G00 Z{}", mm(program.safe_z));
@@ -198,6 +280,11 @@ pub fn write(program: &Program<'_>) -> String {
     out
 }
 
+/// Whether the straight move from `from` to `to` goes straight down the tool axis.
+fn is_plunge(from: Vec3, to: Vec3) -> bool {
+    to.z < from.z - 1e-9 && (to.x - from.x).abs() <= 1e-9 && (to.y - from.y).abs() <= 1e-9
+}
+
 /// Feed word value: whole mm/min where exact, else one decimal.
 fn feed_word(feed: f64) -> String {
     if feed.fract() == 0.0 { format!("{feed:.0}") } else { format!("{feed:.1}") }
@@ -206,7 +293,6 @@ fn feed_word(feed: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::Vec3;
 
     #[test]
     fn mm_never_prints_negative_zero() {
@@ -239,6 +325,7 @@ mod tests {
             spindle_direction: SpindleDirection::Cw,
             safe_z: 50.0,
             blend_tolerance: 0.01,
+            plunges: None,
             path: &path,
         };
         let fanuc = write(&program);
@@ -250,5 +337,40 @@ mod tests {
         assert!(linuxcnc.starts_with("(KERF TEST)\n"));
         assert!(linuxcnc.contains("G64 P0.0100\n"));
         assert!(!linuxcnc.contains('%'));
+    }
+
+    #[test]
+    fn arcs_are_written_with_i_j_from_their_start() {
+        let mut path = Toolpath::default();
+        path.rapid(Vec3::new(10.0, 0.0, 5.0));
+        path.linear(Vec3::new(10.0, 0.0, -1.0), 100.0);
+        // A full turn counter-clockwise: two half turns, the last ending exactly at the end.
+        let centre = Vec3::new(0.0, 0.0, -1.0);
+        path.arc_sweep(Vec3::new(10.0, 0.0, -1.0), Vec3::new(10.0, 0.0, -1.0), centre, std::f64::consts::TAU, 400.0);
+        // A degenerate arc (end = start) is a straight move, never a full circle.
+        path.arc(Vec3::new(10.0, 0.0, -1.0), centre, true, 400.0);
+        let program = Program {
+            dialect: Dialect::Linuxcnc,
+            number: 1000,
+            title: "arcs",
+            comments: Vec::new(),
+            tool: ToolCall::Table(1),
+            spindle_rpm: 1000.0,
+            spindle_direction: SpindleDirection::Cw,
+            safe_z: 5.0,
+            blend_tolerance: 0.01,
+            plunges: None,
+            path: &path,
+        };
+        let text = write(&program);
+        assert!(
+            text.contains(
+                "G01 X10.0000 Y0.0000 Z-1.0000 F100\n\
+                 G03 X-10.0000 Y0.0000 Z-1.0000 I-10.0000 J0.0000 F400\n\
+                 G03 X10.0000 Y0.0000 Z-1.0000 I10.0000 J0.0000\n\
+                 G01 X10.0000 Y0.0000 Z-1.0000\n"
+            ),
+            "{text}"
+        );
     }
 }

@@ -4,6 +4,7 @@
 //! path ([`stats`]). Every path-emitting capability uses them: segment, deburr, contour,
 //! engagement.
 
+pub mod cycle;
 pub mod rule;
 pub mod stats;
 
@@ -62,9 +63,37 @@ pub struct MachineProfile {
     /// Rated spindle torque, N·m (> 0), used like `spindle_power_kw`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spindle_torque_nm: Option<f64>,
+    /// How programs for this control write circular moves unless the request says (`?arcs=`,
+    /// `[output] arcs`): `g2g3` or `chords` (default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arcs: Option<crate::gcode::Arcs>,
+    /// Feed of plunges (straight moves down the tool axis), mm/min (> 0), for tools without
+    /// their own `plunge_feed`; default half the cutting feed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plunge_feed: Option<f64>,
+    /// Largest path acceleration, mm/s² (> 0): with it, answers add a `cycle_time` with a
+    /// trapezoidal feed profile (issue 15).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_accel: Option<f64>,
+    /// Rapid traverse feed, mm/min (> 0; default `max_feed`), for `cycle_time`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rapid_feed: Option<f64>,
+    /// Time of one tool change, s (≥ 0; default 0), for `cycle_time`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tool_change_s: Option<f64>,
 }
 
 impl MachineProfile {
+    /// What [`cycle::cycle_time`] needs, when the profile has an acceleration.
+    pub fn dynamics(&self) -> Option<cycle::Dynamics> {
+        Some(cycle::Dynamics {
+            max_accel: self.max_accel?,
+            rapid_feed: self.rapid_feed.unwrap_or(self.max_feed),
+            block_time_s: self.block_time_ms / 1000.0,
+            tool_change_s: self.tool_change_s.unwrap_or(0.0),
+        })
+    }
+
     /// The spindle's rated power and torque, as engagement checks a cut against them.
     pub fn spindle(&self) -> crate::engagement::SpindleLimits {
         crate::engagement::SpindleLimits {
@@ -94,6 +123,18 @@ impl MachineProfile {
                     "margin must be at least 1 (got {margin}): below 1 blocks get shorter than the control can process"
                 ),
             ));
+        }
+        if let Some(plunge_feed) = self.plunge_feed {
+            positive("plunge_feed", plunge_feed)?;
+        }
+        if let Some(max_accel) = self.max_accel {
+            positive("max_accel", max_accel)?;
+        }
+        if let Some(rapid_feed) = self.rapid_feed {
+            positive("rapid_feed", rapid_feed)?;
+        }
+        if let Some(tool_change_s) = self.tool_change_s {
+            non_negative("tool_change_s", tool_change_s)?;
         }
         if let Some(min_chord_error) = self.min_chord_error {
             non_negative("min_chord_error", min_chord_error)?;

@@ -411,7 +411,11 @@ pub fn corrected_program(
                 }
                 let moved = (node..=last).any(|n| corrections.offsets[n] != Vec3::zeros())
                     || (node > 0 && corrections.offsets[node - 1] != Vec3::zeros());
-                if moved && let Some(to) = read_move.to_xyz() {
+                // Rapids are never rewritten (issue 15): only cutting moves change.
+                if moved
+                    && read_move.kind != MoveKind::Rapid
+                    && let Some(to) = read_move.to_xyz()
+                {
                     let new_to = vec3(to) + corrections.offsets[last];
                     let centre = match read_move.kind {
                         MoveKind::Arc { centre, .. } if node > 0 => {
@@ -437,14 +441,16 @@ pub fn corrected_program(
             let feed = request.feed.ok_or_else(|| SolverError::input("feed", "feed is needed"))?;
             let spindle_rpm =
                 request.spindle_rpm.ok_or_else(|| SolverError::input("spindle_rpm", "spindle_rpm is needed"))?;
-            let safe_z = corrected.iter().map(|p| p.z).fold(f64::NEG_INFINITY, f64::max) + CLEARANCE;
+            // The rapids are those of the uncorrected path (issue 15: a correction changes only
+            // the cutting moves): the clearance plane over the programmed points, above the
+            // programmed first and last point.
+            let safe_z = points.iter().map(|p| p[2]).fold(f64::NEG_INFINITY, f64::max) + CLEARANCE;
             let mut path = Toolpath::default();
-            let first = corrected[0];
+            let (first, last) = (vec3(points[0]), vec3(points[points.len() - 1]));
             path.rapid(Vec3::new(first.x, first.y, safe_z));
             for p in &corrected {
                 path.linear(*p, feed);
             }
-            let last = corrected[corrected.len() - 1];
             path.rapid(Vec3::new(last.x, last.y, safe_z));
             Ok(gcode::write(&Program {
                 dialect: options.dialect,
@@ -463,6 +469,8 @@ pub fn corrected_program(
                 spindle_direction: request.spindle_direction.unwrap_or_default(),
                 safe_z,
                 blend_tolerance: 0.001,
+                // The points are the caller's path, written as given.
+                plunges: None,
                 path: &path,
             }))
         }

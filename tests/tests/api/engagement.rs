@@ -590,12 +590,13 @@ fn expected_moves(result: &Value, cut_z: f64, safe_z: f64) -> Vec<(bool, [f64; 3
     };
     let start = position(0.0);
     let blocks = result["feed_plan"]["blocks"].as_array().unwrap();
-    // The plunge runs no faster than the nominal feed of the tool's flutes (f_z = 0.05, N = 3000).
+    // The plunge runs no faster than the nominal feed of the tool's flutes (f_z = 0.05, N = 3000),
+    // halved (no plunge feed given).
     let nominal = number(&result["time_flute_count"]) * 0.05 * 3000.0;
     let first_feed = number(&blocks[0]["feed"]);
     let mut moves = vec![
         (false, [start[0], start[1], safe_z], None),
-        (true, [start[0], start[1], cut_z], Some(first_feed.min(nominal))),
+        (true, [start[0], start[1], cut_z], Some(first_feed.min(nominal) * 0.5)),
     ];
     for block in blocks {
         let end = position(number(&block["to_s"]));
@@ -687,7 +688,8 @@ async fn gcode_of_the_feed_plan_in_both_dialects() {
         }
     }
 
-    // Without a feed plan every cutting move runs at the nominal feed of the tool's flutes.
+    // Without a feed plan every cutting move runs at the nominal feed of the tool's flutes, the
+    // plunge (the first feed move) at half of it.
     let mut nominal = api_example();
     nominal["axial_depth"] = json!(2);
     let program = app
@@ -700,7 +702,9 @@ async fn gcode_of_the_feed_plan_in_both_dialects() {
         .text()
         .await
         .unwrap();
-    assert!(program_feeds(&program).iter().flatten().all(|f| (*f - 300.0).abs() <= 0.05), "{program}");
+    let feeds: Vec<f64> = program_feeds(&program).into_iter().flatten().collect();
+    assert!((feeds[0] - 150.0).abs() <= 0.05, "{program}");
+    assert!(feeds[1..].iter().all(|f| (*f - 300.0).abs() <= 0.05), "{program}");
     if let Some(moves) = rs274_moves(&program, app.directory(), "engagement_nominal") {
         assert!(moves.iter().any(|m| m.0 && (m.1[0] - 70.0).abs() < 1e-9 && (m.1[2] + 2.0).abs() < 1e-9));
     }

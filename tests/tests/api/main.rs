@@ -1,5 +1,6 @@
 //! Loopback tests: the real service on 127.0.0.1:0 with a temporary SQLite file, over HTTP.
 
+mod arcs;
 mod auth;
 mod bad_requests;
 mod browser;
@@ -8,6 +9,7 @@ mod contour;
 mod deburr;
 mod deburr_machine;
 mod engagement;
+mod entries;
 mod gcode;
 mod job_fuzz;
 mod jobs;

@@ -357,11 +357,14 @@ async fn programs_pass_rs274_and_match_json() {
             for (index, (got, want)) in feeds.iter().zip(&expected).enumerate() {
                 assert!(distance(got, want) <= 1e-4 * 3f64.sqrt(), "{label}: point {index} {got:?} vs {want:?}");
             }
-            let first_feed = program.lines().find(|l| l.starts_with("G01")).unwrap();
+            // The plunge to the start at half the feed (no plunge feed given), then the feed.
+            let mut g01 = program.lines().filter(|l| l.starts_with("G01"));
             let feed = answer["feed"].as_f64().unwrap();
-            assert!(first_feed.ends_with(&format!("F{feed:.0}")), "{label}: F word on the first block: {first_feed}");
+            let (plunge, first_block) = (g01.next().unwrap(), g01.next().unwrap());
+            assert!(plunge.ends_with(&format!("F{:.0}", feed * 0.5)), "{label}: F word of the plunge: {plunge}");
+            assert!(first_block.ends_with(&format!("F{feed:.0}")), "{label}: F word on the first block: {first_block}");
             let f_words = program.lines().filter(|l| l.starts_with("G01") && l.contains(" F")).count();
-            assert_eq!(f_words, 1, "{label}: modal feed");
+            assert_eq!(f_words, 2, "{label}: modal feed");
             if name == "ellipse_c" {
                 assert!(program.contains("M00"), "an inline tool without a number stops for a manual change");
             } else {

@@ -24,8 +24,11 @@ pub struct MoveEdit {
 /// Everything else stays byte for byte: line count, block numbers, comments, modal words and the
 /// coordinates of unchanged moves. A changed coordinate is written in the line's units with at
 /// least 4 decimals (more if the line had more); a changed axis the line did not program is
-/// inserted after the block's last word. Incremental (`G91`) blocks get new increments so every
-/// later end point stays where it was. `program` must be the result of [`read`] on `text`.
+/// inserted after the block's last word. Incremental (`G91`) feed blocks get new increments so
+/// every later end point stays where it was. Rapids without an edit are never rewritten (issue
+/// 15): after a moved cut they start, and in the axes they do not program end, where that cut
+/// ended; the next feed move is written to its own end point from there. `program` must be the
+/// result of [`read`] on `text`.
 ///
 /// # Errors
 /// `E_INPUT` for an edit that names no move, or a non-finite coordinate.
@@ -33,6 +36,7 @@ pub fn rewrite(text: &str, program: &ReadProgram, edits: &[MoveEdit], field: &st
     let count = program.moves.len();
     let mut new_to: Vec<Position> = program.moves.iter().map(|m| m.to).collect();
     let mut centres: Vec<Option<[f64; 3]>> = vec![None; count];
+    let mut edited = vec![false; count];
     for edit in edits {
         if edit.index >= count {
             return Err(SolverError::input(field, format!("edit names move {} of {count}", edit.index)));
@@ -42,6 +46,7 @@ pub fn rewrite(text: &str, program: &ReadProgram, edits: &[MoveEdit], field: &st
         }
         new_to[edit.index] = edit.to.map(Some);
         centres[edit.index] = edit.centre;
+        edited[edit.index] = true;
     }
     // Where each move of the rewritten program really ends (written values are rounded), so
     // incremental words and modal axes follow the control, not the exact edits.
@@ -52,6 +57,21 @@ pub fn rewrite(text: &str, program: &ReadProgram, edits: &[MoveEdit], field: &st
         let start = if continuous { actual[index - 1] } else { read_move.from };
         if start == read_move.from && new_to[index] == read_move.to && centres[index].is_none() {
             actual.push(read_move.to);
+            continue;
+        }
+        // A rapid nobody edited stays as written, byte for byte (issue 15): after a moved cut
+        // it starts elsewhere, so the axes it does not program (absolute) or all of them
+        // (incremental) end shifted with its start; the next cutting move is rewritten to its
+        // own end point from there.
+        if read_move.kind == MoveKind::Rapid && !edited[index] {
+            let shifted = std::array::from_fn(|axis| match read_move.modal.distance {
+                Distance::Absolute if read_move.words.axes[axis].is_some() => read_move.to[axis],
+                _ => match (start[axis], read_move.from[axis], read_move.to[axis]) {
+                    (Some(now), Some(before), Some(end)) => Some(now + (end - before)),
+                    (_, _, end) => end,
+                },
+            });
+            actual.push(shifted);
             continue;
         }
         let scale = read_move.modal.units.scale();

@@ -1,0 +1,142 @@
+//! Entries (issue 15, item 3): no program plunges at the cutting feed. Every straight feed move
+//! down the tool axis of a segment, contour or engagement program runs at the tool's
+//! `plunge_feed`, else the machine's, else half the cutting feed; the programs still pass `rs274`.
+
+use kerf_tests::{TestApp, json_with, problem, rs274_moves};
+use serde_json::{Value, json};
+
+/// Every plunge of `program` (G01 with X and Y unchanged and Z lower) with its modal feed, and
+/// the largest feed of any other G01.
+fn plunges(program: &str) -> (Vec<f64>, f64) {
+    let (mut at, mut feed) = ([f64::NAN; 3], f64::NAN);
+    let (mut found, mut cutting) = (Vec::new(), 0.0_f64);
+    for line in program.lines().filter(|l| l.starts_with("G0")) {
+        let word = |axis: char| line.split_whitespace().find_map(|w| w.strip_prefix(axis)?.parse::<f64>().ok());
+        if let Some(f) = word('F') {
+            feed = f;
+        }
+        let to = [word('X').unwrap_or(at[0]), word('Y').unwrap_or(at[1]), word('Z').unwrap_or(at[2])];
+        if line.starts_with("G01") {
+            if to[0] == at[0] && to[1] == at[1] && to[2] < at[2] {
+                found.push(feed);
+            } else {
+                cutting = cutting.max(feed);
+            }
+        }
+        at = to;
+    }
+    (found, cutting)
+}
+
+async fn gcode(app: &TestApp, path: &str, body: &Value) -> String {
+    let response = app.client.post(app.url(&format!("{path}?format=gcode&dialect=linuxcnc"))).json(body).send().await;
+    let response = response.unwrap();
+    assert_eq!(response.status(), 200, "{path}");
+    response.text().await.unwrap()
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn plunges_run_at_the_plunge_feed() {
+    let app = TestApp::spawn().await;
+    app.register_tool(3, &json!({"kind": "flat", "radius": 3, "plunge_feed": 150})).await;
+    app.register_tool(4, &json!({"kind": "flat", "radius": 3})).await;
+    let machine = json!({"block_time_ms": 4, "max_feed": 12000, "plunge_feed": 90});
+    assert_eq!(app.put_json("/api/v1/machines/plunger", &machine).await.status(), 201);
+    let segment = json!({"curve": {"kind": "circle", "centre": [0, 0, -2], "radius": 20}, "feed": 2000,
+                         "block_time_ms": 4, "tool": 3});
+    let contour = json!({"tool": 3, "contour": [[0, 0], [80, 0], [80, 60], [0, 60]], "side": "outside",
+                         "depths": {"top": 0, "bottom": -4, "step": 2}, "feed": 800});
+    let engagement = json!({"tool": 3, "stock": {"polygon": [[0, 0], [60, 0], [60, 40], [0, 40]]},
+                            "path": [[10, 20], [70, 20]], "spindle_rpm": 3000, "feed": 600, "axial_depth": 2});
+    for (name, path, body) in [
+        ("segment", "/api/v1/segment", &segment),
+        ("contour", "/api/v1/contour", &contour),
+        ("engagement", "/api/v1/engagement", &engagement),
+    ] {
+        // The tool's plunge feed; without it the machine's; without both half the cutting feed.
+        let mut on_machine = body.clone();
+        on_machine["tool"] = json!(4);
+        on_machine["machine"] = json!("plunger");
+        let mut plain = body.clone();
+        plain["tool"] = json!(4);
+        for (variant, request, limit) in
+            [("tool", body.clone(), Some(150.0)), ("machine", on_machine, Some(90.0)), ("half", plain, None)]
+        {
+            let program = gcode(&app, path, &request).await;
+            let (found, cutting) = plunges(&program);
+            assert!(!found.is_empty(), "{name} {variant}: the program plunges\n{program}");
+            let limit = limit.unwrap_or(cutting * 0.5);
+            for feed in found {
+                assert!(feed <= limit + 1e-9, "{name} {variant}: plunge at F{feed} over {limit}\n{program}");
+                assert!(feed < cutting, "{name} {variant}: plunge at the cutting feed F{cutting}");
+            }
+            rs274_moves(&program, app.directory(), &format!("plunge_{name}_{variant}"));
+        }
+    }
+    // A bad plunge feed names its field.
+    let body =
+        problem(app.put_json("/api/v1/tools/5", &json!({"kind": "flat", "radius": 3, "plunge_feed": 0})).await, 422)
+            .await;
+    assert_eq!(body["errors"][0]["path"], "plunge_feed", "{body}");
+    let body = problem(
+        app.put_json("/api/v1/machines/bad", &json!({"block_time_ms": 4, "max_feed": 1, "plunge_feed": -5})).await,
+        422,
+    )
+    .await;
+    assert_eq!(body["errors"][0]["path"], "plunge_feed", "{body}");
+    let stored = json_with(app.get("/api/v1/tools/3").await, 200).await;
+    assert_eq!(stored["plunge_feed"], 150.0);
+}
+
+/// Rest to rest over `length` mm at cruise `speed` mm/s with acceleration `accel` mm/s².
+fn rest_to_rest(length: f64, speed: f64, accel: f64) -> f64 {
+    if length >= speed * speed / accel { length / speed + speed / accel } else { 2.0 * (length / accel).sqrt() }
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn cycle_time_with_acceleration_rapids_and_tool_change() {
+    let app = TestApp::spawn().await;
+    app.register_tool(3, &json!({"kind": "flat", "radius": 3})).await;
+    let machine = json!({"block_time_ms": 1, "max_feed": 12000, "max_accel": 500, "rapid_feed": 30000,
+                         "tool_change_s": 4});
+    assert_eq!(app.put_json("/api/v1/machines/accel", &machine).await.status(), 201);
+    // A straight line of 100 mm at 6000 mm/min (100 mm/s): 1 s cruising plus v/a = 0.2 s; the
+    // plunge of 5 mm at half the feed and the 5 mm retract are triangles of 2·√(5/500) s.
+    let body = json!({"curve": {"kind": "polyline", "points": [[0, 0], [50, 0], [100, 0]]}, "feed": 6000,
+                      "machine": "accel", "tool": 3});
+    let answer = json_with(app.post_json("/api/v1/segment", &body).await, 200).await;
+    let time = &answer["cycle_time"];
+    let number = |v: &Value| v.as_f64().unwrap();
+    let close = |label: &str, got: f64, want: f64| assert!((got - want).abs() < 1e-9, "{label}: {got} vs {want}");
+    close("cutting", number(&time["cutting_s"]), rest_to_rest(100.0, 100.0, 500.0));
+    close("air", number(&time["air_s"]), rest_to_rest(5.0, 50.0, 500.0));
+    close("rapid", number(&time["rapid_s"]), rest_to_rest(5.0, 500.0, 500.0));
+    close("tool change", number(&time["tool_change_s"]), 4.0);
+    let parts: f64 = ["cutting_s", "air_s", "rapid_s", "tool_change_s"].iter().map(|k| number(&time[k])).sum();
+    close("total", number(&time["total_s"]), parts);
+    // Without max_accel there is no cycle time.
+    let plain = json!({"curve": {"kind": "polyline", "points": [[0, 0], [100, 0]]}, "feed": 6000, "block_time_ms": 1});
+    let answer = json_with(app.post_json("/api/v1/segment", &plain).await, 200).await;
+    assert!(answer.get("cycle_time").is_none());
+
+    // A square island: the tool stops at the corners, so the control takes longer than length
+    // over feed; loops and leads are air.
+    let contour = json!({"tool": 3, "contour": [[0, 0], [40, 0], [40, 40], [0, 40]], "side": "outside",
+                         "depths": {"top": 0, "bottom": -2, "step": 2}, "feed": 3000, "machine": "accel"});
+    let answer = json_with(app.post_json("/api/v1/contour", &contour).await, 200).await;
+    let summary = &answer["summary"];
+    let time = &summary["cycle_time"];
+    assert!(number(&time["cutting_s"]) > 0.0 && number(&time["air_s"]) > 0.0 && number(&time["rapid_s"]) > 0.0);
+    let feed_time = number(&summary["estimated_time_s"]);
+    assert!(number(&time["cutting_s"]) + number(&time["air_s"]) > feed_time, "{summary}");
+    let parts: f64 = ["cutting_s", "air_s", "rapid_s", "tool_change_s"].iter().map(|k| number(&time[k])).sum();
+    close("contour total", number(&time["total_s"]), parts);
+
+    // Bad values name their fields.
+    for (field, value) in [("max_accel", json!(0)), ("rapid_feed", json!(-1)), ("tool_change_s", json!(-2))] {
+        let mut bad = machine.clone();
+        bad[field] = value;
+        let body = problem(app.put_json("/api/v1/machines/bad", &bad).await, 422).await;
+        assert_eq!(body["errors"][0]["path"], field, "{body}");
+    }
+}
