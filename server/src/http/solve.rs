@@ -56,6 +56,7 @@ pub async fn answer<C: Capability>(
             capabilities::solve::<C>(&request, resolved, &run, ask.gcode.then_some(&ask.output), ask.timings)
         })
         .await??;
+    crate::metrics::observe_solver(C::NAME, seconds);
     let mut response = match delivered {
         Delivered::Program(program) => gcode_response(program),
         Delivered::Json(bytes) => {

@@ -54,7 +54,9 @@ pub fn execute(
             upload: None,
             purpose: Purpose::Job,
         };
+        let started = std::time::Instant::now();
         let stored = operation.run(job, &run, &output).map_err(|error| failure(index, error))?;
+        crate::metrics::observe_solver(operation.name(), started.elapsed().as_secs_f64());
         outputs.push(stored);
         progress((index + 1) as f64 / count as f64);
     }

@@ -1,12 +1,24 @@
-//! The job queue in SQLite (issue 7): jobs with status, progress, attempts and heartbeat, and
-//! their results. Workers claim the oldest queued job with one atomic UPDATE.
+//! The job queue (issue 7; issue 12): jobs with status, progress, attempts and heartbeat, and
+//! their results.
+//!
+//! In SQLite one process owns the queue: its workers claim the oldest queued job with one atomic
+//! UPDATE, and at start every job left `running` is queued again ([`recover`]). In PostgreSQL any
+//! number of processes share it: a worker claims in a short transaction with
+//! `SELECT … FOR UPDATE SKIP LOCKED` (concurrent claimers skip each other's rows instead of
+//! waiting), writes its name and a lease on the job, and pushes the lease forward with each
+//! heartbeat; a running job whose lease expired (its worker died, `kill -9`) is claimed again
+//! like a queued one. Submissions and cancellations `NOTIFY` the workers (`kerf_jobs`,
+//! `kerf_cancel`); every write of a running job checks that the job is still the writer's.
 
 use kerf_solver::ErrorCode;
 use serde::Serialize;
-use sqlx::SqlitePool;
+use std::time::Duration;
+
 use utoipa::ToSchema;
 
+use super::on;
 use crate::capabilities::Stored;
+use crate::db::Db;
 use crate::error::{AppError, AppResult, FieldProblem, Problem};
 use crate::jobs::file::JobFile;
 
@@ -20,17 +32,42 @@ macro_rules! now {
     };
 }
 
-/// The columns of a [`JobRow`].
+/// The columns of a [`JobRow`] in SQLite.
 macro_rules! columns {
     () => {
         "id, name, status, progress, operations, attempts, error, error_field, submitted_at, started_at, finished_at"
     };
 }
 
+/// A PostgreSQL timestamp column as SQLite stores them (`2026-01-02T03:04:05.678Z`).
+macro_rules! pg_time {
+    ($column:literal) => {
+        concat!("to_char(", $column, " AT TIME ZONE 'UTC', 'YYYY-MM-DD\"T\"HH24:MI:SS.MS\"Z\"') AS ", $column)
+    };
+}
+
+/// The columns of a [`JobRow`] in PostgreSQL.
+macro_rules! pg_columns {
+    () => {
+        concat!(
+            "id, name, status, progress, operations, attempts, error, error_field, ",
+            pg_time!("submitted_at"),
+            ", ",
+            pg_time!("started_at"),
+            ", ",
+            pg_time!("finished_at")
+        )
+    };
+}
+
+/// The channel a submission notifies (payload: the job id).
+pub const SUBMITTED_CHANNEL: &str = "kerf_jobs";
+/// The channel a cancellation notifies (payload: the job id).
+pub const CANCEL_CHANNEL: &str = "kerf_cancel";
+
 /// Where a job is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema, sqlx::Type)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
 #[serde(rename_all = "snake_case")]
-#[sqlx(rename_all = "snake_case")]
 pub enum JobStatus {
     /// Waiting for a worker.
     Queued,
@@ -42,6 +79,20 @@ pub enum JobStatus {
     Failed,
     /// Cancelled by `DELETE`.
     Cancelled,
+}
+
+impl JobStatus {
+    /// The status stored as `text` (the `status` column's CHECK allows no other).
+    fn parse(text: &str) -> AppResult<Self> {
+        Ok(match text {
+            "queued" => Self::Queued,
+            "running" => Self::Running,
+            "done" => Self::Done,
+            "failed" => Self::Failed,
+            "cancelled" => Self::Cancelled,
+            other => return Err(AppError::Internal(anyhow::anyhow!("unknown stored job status {other:?}"))),
+        })
+    }
 }
 
 /// A job as listed and shown.
@@ -76,10 +127,10 @@ pub struct JobRecord {
 struct JobRow {
     id: i64,
     name: Option<String>,
-    status: JobStatus,
+    status: String,
     progress: f64,
-    #[sqlx(json)]
-    operations: Vec<String>,
+    /// JSON array of names.
+    operations: String,
     attempts: i64,
     error: Option<String>,
     error_field: Option<String>,
@@ -88,21 +139,25 @@ struct JobRow {
     finished_at: Option<String>,
 }
 
-impl From<JobRow> for JobRecord {
-    fn from(row: JobRow) -> Self {
+impl TryFrom<JobRow> for JobRecord {
+    type Error = AppError;
+
+    fn try_from(row: JobRow) -> AppResult<Self> {
         let error = row.error.map(|text| stored_problem(&text, row.error_field));
-        Self {
+        let operations = serde_json::from_str(&row.operations)
+            .map_err(|error| AppError::Internal(anyhow::anyhow!("stored operations are unreadable: {error}")))?;
+        Ok(Self {
             id: row.id,
             name: row.name,
-            status: row.status,
+            status: JobStatus::parse(&row.status)?,
             progress: row.progress,
-            operations: row.operations,
+            operations,
             attempts: row.attempts,
             error,
             submitted_at: row.submitted_at,
             started_at: row.started_at,
             finished_at: row.finished_at,
-        }
+        })
     }
 }
 
@@ -138,194 +193,292 @@ fn problem_json(problem: &Problem) -> AppResult<String> {
     serde_json::to_string(problem).map_err(|e| AppError::Internal(e.into()))
 }
 
-/// Stores a new queued job; returns its id.
-pub async fn insert(db: &SqlitePool, job: &JobFile, hash: &str) -> AppResult<i64> {
+/// Who claims jobs: the worker's name, written on the job it runs, and how long its lease lasts
+/// without a heartbeat (PostgreSQL; SQLite has one process and no leases).
+#[derive(Debug, Clone)]
+pub struct Claimant {
+    /// Unique among the processes sharing the database (host, process id, start time).
+    pub worker: String,
+    /// How long a claimed job stays this worker's without a heartbeat.
+    pub lease: Duration,
+}
+
+/// A job a worker claimed.
+#[derive(Debug)]
+pub struct Claimed {
+    /// Job id.
+    pub id: i64,
+    /// The resolved job.
+    pub job: JobFile,
+    /// Which attempt this is (1 for the first).
+    pub attempt: i64,
+}
+
+/// Stores a new queued job and wakes the workers; returns its id.
+pub async fn insert(db: &Db, job: &JobFile, hash: &str) -> AppResult<i64> {
     let json = serde_json::to_string(job).map_err(|e| AppError::Internal(e.into()))?;
     let operations: Vec<&str> = job.operations.iter().map(|o| o.name()).collect();
     let operations = serde_json::to_string(&operations).map_err(|e| AppError::Internal(e.into()))?;
-    let (id,): (i64,) = sqlx::query_as(
-        "INSERT INTO jobs (name, status, content_hash, job_json, operations) VALUES (?, 'queued', ?, ?, ?) RETURNING id",
-    )
-    .bind(&job.name)
-    .bind(hash)
-    .bind(json)
-    .bind(operations)
-    .fetch_one(db)
-    .await?;
-    Ok(id)
+    const INSERT: &str = "INSERT INTO jobs (name, status, content_hash, job_json, operations)
+         VALUES ($1, 'queued', $2, $3, $4) RETURNING id";
+    match db {
+        Db::Sqlite(pool) => {
+            let (id,): (i64,) =
+                sqlx::query_as(INSERT).bind(&job.name).bind(hash).bind(json).bind(operations).fetch_one(pool).await?;
+            Ok(id)
+        }
+        Db::Postgres(pool) => {
+            // The notification is delivered at commit, when the job is there to claim.
+            let mut transaction = pool.begin().await?;
+            let (id,): (i64,) = sqlx::query_as(INSERT)
+                .bind(&job.name)
+                .bind(hash)
+                .bind(json)
+                .bind(operations)
+                .fetch_one(&mut *transaction)
+                .await?;
+            sqlx::query("SELECT pg_notify($1, $2)")
+                .bind(SUBMITTED_CHANNEL)
+                .bind(id.to_string())
+                .execute(&mut *transaction)
+                .await?;
+            transaction.commit().await?;
+            Ok(id)
+        }
+    }
 }
 
 /// A finished job with the same content, if any.
-pub async fn find_done(db: &SqlitePool, hash: &str) -> AppResult<Option<i64>> {
-    let row: Option<(i64,)> =
-        sqlx::query_as("SELECT id FROM jobs WHERE content_hash = ? AND status = 'done' ORDER BY id LIMIT 1")
-            .bind(hash)
-            .fetch_optional(db)
-            .await?;
+pub async fn find_done(db: &Db, hash: &str) -> AppResult<Option<i64>> {
+    let row: Option<(i64,)> = on!(db, query_as,
+        both: "SELECT id FROM jobs WHERE content_hash = $1 AND status = 'done' ORDER BY id LIMIT 1",
+        [hash], fetch_optional)?;
     Ok(row.map(|(id,)| id))
 }
 
 /// One job.
-pub async fn get(db: &SqlitePool, id: i64) -> AppResult<Option<JobRecord>> {
-    let row: Option<JobRow> =
-        sqlx::query_as(concat!("SELECT ", columns!(), " FROM jobs WHERE id = ?")).bind(id).fetch_optional(db).await?;
-    Ok(row.map(JobRecord::from))
+pub async fn get(db: &Db, id: i64) -> AppResult<Option<JobRecord>> {
+    let row: Option<JobRow> = on!(db, query_as,
+        sqlite: concat!("SELECT ", columns!(), " FROM jobs WHERE id = $1"),
+        postgres: concat!("SELECT ", pg_columns!(), " FROM jobs WHERE id = $1"),
+        [id], fetch_optional)?;
+    row.map(JobRecord::try_from).transpose()
 }
 
 /// Up to `limit` jobs with ids below `before`, newest first.
-pub async fn list(db: &SqlitePool, limit: i64, before: Option<i64>) -> AppResult<Vec<JobRecord>> {
-    let rows: Vec<JobRow> =
-        sqlx::query_as(concat!("SELECT ", columns!(), " FROM jobs WHERE id < ? ORDER BY id DESC LIMIT ?"))
-            .bind(before.unwrap_or(i64::MAX))
-            .bind(limit)
-            .fetch_all(db)
-            .await?;
-    Ok(rows.into_iter().map(JobRecord::from).collect())
+pub async fn list(db: &Db, limit: i64, before: Option<i64>) -> AppResult<Vec<JobRecord>> {
+    let rows: Vec<JobRow> = on!(db, query_as,
+        sqlite: concat!("SELECT ", columns!(), " FROM jobs WHERE id < $1 ORDER BY id DESC LIMIT $2"),
+        postgres: concat!("SELECT ", pg_columns!(), " FROM jobs WHERE id < $1 ORDER BY id DESC LIMIT $2"),
+        [before.unwrap_or(i64::MAX), limit], fetch_all)?;
+    rows.into_iter().map(JobRecord::try_from).collect()
 }
 
-/// Claims the oldest queued job for a worker: marks it running and returns it.
-pub async fn claim(db: &SqlitePool) -> AppResult<Option<(i64, JobFile)>> {
-    let row: Option<(i64, String)> = sqlx::query_as(concat!(
-        "UPDATE jobs SET status = 'running', attempts = attempts + 1, progress = 0, started_at = ",
-        now!(),
-        ",
-                heartbeat_at = ",
-        now!(),
-        "
-         WHERE id = (SELECT id FROM jobs WHERE status = 'queued' ORDER BY id LIMIT 1)
-         RETURNING id, job_json"
-    ))
-    .fetch_optional(db)
-    .await?;
-    let Some((id, json)) = row else { return Ok(None) };
+/// Claims the oldest job to run for `claimant`: marks it running (PostgreSQL: with the
+/// claimant's name and lease) and returns it. In PostgreSQL a running job whose lease expired
+/// is claimed again, or failed with `E_INTERRUPTED` once it has used its attempts.
+pub async fn claim(db: &Db, claimant: &Claimant) -> AppResult<Option<Claimed>> {
+    let row: Option<(i64, String, i64)> = match db {
+        Db::Sqlite(pool) => {
+            sqlx::query_as(concat!(
+                "UPDATE jobs SET status = 'running', attempts = attempts + 1, progress = 0, started_at = ",
+                now!(),
+                ", heartbeat_at = ",
+                now!(),
+                " WHERE id = (SELECT id FROM jobs WHERE status = 'queued' ORDER BY id LIMIT 1)
+                 RETURNING id, job_json, attempts"
+            ))
+            .fetch_optional(pool)
+            .await?
+        }
+        Db::Postgres(pool) => {
+            let mut transaction = pool.begin().await?;
+            sqlx::query(
+                "UPDATE jobs SET status = 'failed', finished_at = now(), lease_expires_at = NULL, error = $1
+                 WHERE id IN (SELECT id FROM jobs
+                              WHERE status = 'running' AND lease_expires_at < now() AND attempts >= $2
+                              FOR UPDATE SKIP LOCKED)",
+            )
+            .bind(problem_json(&job_problem(
+                503,
+                "Job interrupted",
+                ErrorCode::Interrupted,
+                &format!("its worker stopped (lease expired) on each of its {MAX_ATTEMPTS} attempts; not retried"),
+            ))?)
+            .bind(MAX_ATTEMPTS)
+            .execute(&mut *transaction)
+            .await?;
+            let row = sqlx::query_as(
+                "WITH next AS (
+                     SELECT id FROM jobs
+                     WHERE status = 'queued' OR (status = 'running' AND lease_expires_at < now())
+                     ORDER BY id LIMIT 1
+                     FOR UPDATE SKIP LOCKED)
+                 UPDATE jobs SET status = 'running', attempts = attempts + 1, progress = 0, started_at = now(),
+                     heartbeat_at = now(), worker = $1, lease_expires_at = now() + make_interval(secs => $2)
+                 FROM next WHERE jobs.id = next.id
+                 RETURNING jobs.id, jobs.job_json, jobs.attempts",
+            )
+            .bind(&claimant.worker)
+            .bind(claimant.lease.as_secs_f64())
+            .fetch_optional(&mut *transaction)
+            .await?;
+            transaction.commit().await?;
+            row
+        }
+    };
+    let Some((id, json, attempt)) = row else { return Ok(None) };
     match serde_json::from_str(&json) {
-        Ok(job) => Ok(Some((id, job))),
+        Ok(job) => Ok(Some(Claimed { id, job, attempt })),
         Err(error) => {
             let detail = format!("the stored job is unreadable: {error}");
-            fail(db, id, &job_problem(422, "Job failed", ErrorCode::JobFile, &detail)).await?;
+            fail(db, id, claimant, &job_problem(422, "Job failed", ErrorCode::JobFile, &detail)).await?;
             Ok(None)
         }
     }
 }
 
-/// Records progress and the heartbeat of a running job.
-pub async fn heartbeat(db: &SqlitePool, id: i64, progress: f64) -> AppResult<()> {
-    sqlx::query(concat!(
-        "UPDATE jobs SET progress = ?, heartbeat_at = ",
-        now!(),
-        " WHERE id = ? AND status = 'running'"
-    ))
-    .bind(progress.clamp(0.0, 1.0))
-    .bind(id)
-    .execute(db)
-    .await?;
-    Ok(())
+/// Records progress and the heartbeat of a running job (PostgreSQL: and extends the lease).
+/// Returns false when the job is no longer the claimant's to run: cancelled, or (PostgreSQL)
+/// claimed by another worker after this one's lease expired. The worker then stops it.
+pub async fn heartbeat(db: &Db, id: i64, claimant: &Claimant, progress: f64) -> AppResult<bool> {
+    let progress = progress.clamp(0.0, 1.0);
+    let updated = on!(db, query,
+        sqlite: concat!("UPDATE jobs SET progress = $1, heartbeat_at = ", now!(), " WHERE id = $2 AND status = 'running'"),
+        postgres: "UPDATE jobs SET progress = $1, heartbeat_at = now(), lease_expires_at = now() + make_interval(secs => $4)
+                   WHERE id = $2 AND status = 'running' AND worker = $3",
+        [progress, id, &claimant.worker, claimant.lease.as_secs_f64()], execute)?;
+    Ok(updated > 0)
 }
 
-/// Stores the results and marks the job done, in one transaction, unless it was cancelled
-/// meanwhile. Returns whether it was stored.
-pub async fn finish(db: &SqlitePool, id: i64, outputs: &[Stored]) -> AppResult<bool> {
-    let mut transaction = db.begin().await?;
-    let updated = sqlx::query(concat!(
-        "UPDATE jobs SET status = 'done', progress = 1, finished_at = ",
-        now!(),
-        " WHERE id = ? AND status = 'running'"
-    ))
-    .bind(id)
-    .execute(&mut *transaction)
-    .await?;
-    if updated.rows_affected() == 0 {
-        transaction.rollback().await?;
-        return Ok(false);
+/// Stores the results and marks the job done, in one transaction, unless it was cancelled (or,
+/// in PostgreSQL, is no longer the claimant's) meanwhile. Returns whether it was stored.
+pub async fn finish(db: &Db, id: i64, claimant: &Claimant, outputs: &[Stored]) -> AppResult<bool> {
+    macro_rules! finish_in {
+        ($pool:expr, $update:expr) => {{
+            let mut transaction = $pool.begin().await?;
+            let updated = sqlx::query($update).bind(id).bind(&claimant.worker).execute(&mut *transaction).await?;
+            if updated.rows_affected() == 0 {
+                transaction.rollback().await?;
+                return Ok(false);
+            }
+            for (position, output) in outputs.iter().enumerate() {
+                sqlx::query(
+                    "INSERT INTO job_results (job_id, position, operation, result_json, gcode, gcode_problem)
+                     VALUES ($1, $2, $3, $4, $5, $6)",
+                )
+                .bind(id)
+                .bind(i64::try_from(position).unwrap_or(i64::MAX))
+                .bind(&output.operation)
+                .bind(output.result.get())
+                .bind(&output.gcode)
+                .bind(&output.gcode_problem)
+                .execute(&mut *transaction)
+                .await?;
+            }
+            transaction.commit().await?;
+        }};
     }
-    for (position, output) in outputs.iter().enumerate() {
-        let result = output.result.get();
-        sqlx::query(
-            "INSERT INTO job_results (job_id, position, operation, result_json, gcode, gcode_problem)
-             VALUES (?, ?, ?, ?, ?, ?)",
-        )
-        .bind(id)
-        .bind(i64::try_from(position).unwrap_or(i64::MAX))
-        .bind(&output.operation)
-        .bind(result)
-        .bind(&output.gcode)
-        .bind(&output.gcode_problem)
-        .execute(&mut *transaction)
-        .await?;
+    match db {
+        Db::Sqlite(pool) => finish_in!(
+            pool,
+            concat!(
+                "UPDATE jobs SET status = 'done', progress = 1, finished_at = ",
+                now!(),
+                " WHERE id = $1 AND status = 'running'"
+            )
+        ),
+        Db::Postgres(pool) => finish_in!(
+            pool,
+            "UPDATE jobs SET status = 'done', progress = 1, finished_at = now(), lease_expires_at = NULL
+             WHERE id = $1 AND status = 'running' AND worker = $2"
+        ),
     }
-    transaction.commit().await?;
     Ok(true)
 }
 
-/// Marks a running job failed with the problem.
-pub async fn fail(db: &SqlitePool, id: i64, problem: &Problem) -> AppResult<()> {
+/// Marks a running job failed with the problem (PostgreSQL: only while it is the claimant's).
+pub async fn fail(db: &Db, id: i64, claimant: &Claimant, problem: &Problem) -> AppResult<()> {
     let json = problem_json(problem)?;
     let field = problem.errors.first().map(|error| error.path.clone());
-    sqlx::query(concat!(
-        "UPDATE jobs SET status = 'failed', error = ?, error_field = ?, finished_at = ",
-        now!(),
-        "
-         WHERE id = ? AND status = 'running'"
-    ))
-    .bind(json)
-    .bind(field)
-    .bind(id)
-    .execute(db)
-    .await?;
+    on!(db, query,
+        sqlite: concat!(
+            "UPDATE jobs SET status = 'failed', error = $1, error_field = $2, finished_at = ",
+            now!(),
+            " WHERE id = $3 AND status = 'running'"
+        ),
+        postgres: "UPDATE jobs SET status = 'failed', error = $1, error_field = $2, finished_at = now(),
+                   lease_expires_at = NULL WHERE id = $3 AND status = 'running' AND worker = $4",
+        [json, field, id, &claimant.worker], execute)?;
     Ok(())
 }
 
 /// Cancels a queued or running job. `Ok(None)` if there is no such job; otherwise the status
-/// the job had, and whether this call cancelled it.
-pub async fn cancel(db: &SqlitePool, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
-    let mut transaction = db.begin().await?;
-    let row: Option<(JobStatus,)> =
-        sqlx::query_as("SELECT status FROM jobs WHERE id = ?").bind(id).fetch_optional(&mut *transaction).await?;
-    let Some((status,)) = row else { return Ok(None) };
-    let cancellable = matches!(status, JobStatus::Queued | JobStatus::Running);
-    if cancellable {
-        sqlx::query(concat!(
-            "UPDATE jobs SET status = 'cancelled', finished_at = ",
-            now!(),
-            ", error = ? WHERE id = ?"
-        ))
-        .bind(problem_json(&job_problem(409, "Cancelled", ErrorCode::Cancelled, "cancelled by request"))?)
-        .bind(id)
-        .execute(&mut *transaction)
-        .await?;
+/// the job had, and whether this call cancelled it. In PostgreSQL the workers are notified, so
+/// the one running it stops at once (its heartbeat would find out within a second anyway).
+pub async fn cancel(db: &Db, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
+    let error = problem_json(&job_problem(409, "Cancelled", ErrorCode::Cancelled, "cancelled by request"))?;
+    macro_rules! cancel_in {
+        ($pool:expr, $select:expr, $update:expr, $notify:expr) => {{
+            let mut transaction = $pool.begin().await?;
+            let row: Option<(String,)> = sqlx::query_as($select).bind(id).fetch_optional(&mut *transaction).await?;
+            let Some((status,)) = row else { return Ok(None) };
+            let status = JobStatus::parse(&status)?;
+            let cancellable = matches!(status, JobStatus::Queued | JobStatus::Running);
+            if cancellable {
+                sqlx::query($update).bind(error).bind(id).execute(&mut *transaction).await?;
+                if let Some(notify) = $notify {
+                    sqlx::query(notify).bind(CANCEL_CHANNEL).bind(id.to_string()).execute(&mut *transaction).await?;
+                }
+            }
+            transaction.commit().await?;
+            Ok(Some((status, cancellable)))
+        }};
     }
-    transaction.commit().await?;
-    Ok(Some((status, cancellable)))
+    match db {
+        Db::Sqlite(pool) => cancel_in!(
+            pool,
+            "SELECT status FROM jobs WHERE id = $1",
+            concat!("UPDATE jobs SET status = 'cancelled', finished_at = ", now!(), ", error = $1 WHERE id = $2"),
+            None::<&'static str>
+        ),
+        Db::Postgres(pool) => cancel_in!(
+            pool,
+            "SELECT status FROM jobs WHERE id = $1 FOR UPDATE",
+            "UPDATE jobs SET status = 'cancelled', finished_at = now(), lease_expires_at = NULL, error = $1
+             WHERE id = $2",
+            Some("SELECT pg_notify($1, $2)")
+        ),
+    }
 }
 
 /// A finished job's results, in operation order: operation, result JSON, whether a program
 /// exists and why not.
-pub async fn results(db: &SqlitePool, id: i64) -> AppResult<Vec<(String, String, bool, Option<String>)>> {
-    Ok(sqlx::query_as(
-        "SELECT operation, result_json, gcode IS NOT NULL, gcode_problem FROM job_results WHERE job_id = ?
-         ORDER BY position",
-    )
-    .bind(id)
-    .fetch_all(db)
-    .await?)
+pub async fn results(db: &Db, id: i64) -> AppResult<Vec<(String, String, bool, Option<String>)>> {
+    Ok(on!(db, query_as,
+        both: "SELECT operation, result_json, gcode IS NOT NULL, gcode_problem FROM job_results WHERE job_id = $1
+               ORDER BY position",
+        [id], fetch_all)?)
 }
 
 /// The programs of a finished job, in operation order (`None` where none could be written).
-pub async fn programs(db: &SqlitePool, id: i64) -> AppResult<Vec<(Option<String>, Option<String>)>> {
-    Ok(sqlx::query_as("SELECT gcode, gcode_problem FROM job_results WHERE job_id = ? ORDER BY position")
-        .bind(id)
-        .fetch_all(db)
-        .await?)
+pub async fn programs(db: &Db, id: i64) -> AppResult<Vec<(Option<String>, Option<String>)>> {
+    Ok(on!(db, query_as,
+        both: "SELECT gcode, gcode_problem FROM job_results WHERE job_id = $1 ORDER BY position",
+        [id], fetch_all)?)
 }
 
-/// At start-up no job can be running: each one a stopped server left `running` is queued again,
-/// or failed with the reason once it has used its attempts. Returns (re-queued, failed).
-pub async fn recover(db: &SqlitePool) -> AppResult<(u64, u64)> {
+/// At start-up of an SQLite service no job can be running: each one a stopped server left
+/// `running` is queued again, or failed with the reason once it has used its attempts. Returns
+/// (re-queued, failed). In PostgreSQL other processes may be running jobs right now: nothing is
+/// touched, expired leases are claimed again instead ([`claim`]).
+pub async fn recover(db: &Db) -> AppResult<(u64, u64)> {
+    let Db::Sqlite(pool) = db else { return Ok((0, 0)) };
     let failed = sqlx::query(concat!(
         "UPDATE jobs SET status = 'failed', finished_at = ",
         now!(),
-        ", error = ?
-         WHERE status = 'running' AND attempts >= ?"
+        ", error = $1
+         WHERE status = 'running' AND attempts >= $2"
     ))
     .bind(problem_json(&job_problem(
         503,
@@ -334,12 +487,34 @@ pub async fn recover(db: &SqlitePool) -> AppResult<(u64, u64)> {
         &format!("interrupted by a server stop on each of its {MAX_ATTEMPTS} attempts; not retried"),
     ))?)
     .bind(MAX_ATTEMPTS)
-    .execute(db)
+    .execute(pool)
     .await?
     .rows_affected();
     let requeued = sqlx::query("UPDATE jobs SET status = 'queued', progress = 0 WHERE status = 'running'")
-        .execute(db)
+        .execute(pool)
         .await?
         .rows_affected();
     Ok((requeued, failed))
+}
+
+/// Hands the jobs `claimant` is running back to the queue (PostgreSQL, on a graceful stop of its
+/// process), so another worker takes them at once instead of after the lease; the attempt does
+/// not count. Returns how many. SQLite's [`recover`] does this at the next start.
+pub async fn release(db: &Db, claimant: &Claimant) -> AppResult<u64> {
+    let Db::Postgres(pool) = db else { return Ok(0) };
+    let mut transaction = pool.begin().await?;
+    let released = sqlx::query(
+        "UPDATE jobs SET status = 'queued', progress = 0, worker = NULL, lease_expires_at = NULL,
+             attempts = GREATEST(attempts - 1, 0)
+         WHERE status = 'running' AND worker = $1",
+    )
+    .bind(&claimant.worker)
+    .execute(&mut *transaction)
+    .await?
+    .rows_affected();
+    if released > 0 {
+        sqlx::query("SELECT pg_notify($1, '')").bind(SUBMITTED_CHANNEL).execute(&mut *transaction).await?;
+    }
+    transaction.commit().await?;
+    Ok(released)
 }
