@@ -137,11 +137,16 @@ impl PgServer {
     pub fn directory(&self) -> &Path {
         self.directory.path()
     }
+
+    /// Stops the server at once (as a crash would); dropping it stops it too.
+    pub fn stop(&self) {
+        let data = self.data();
+        let _ = self.command("pg_ctl").args(["-D", &data, "-m", "immediate", "-w", "stop"]).output();
+    }
 }
 
 impl Drop for PgServer {
     fn drop(&mut self) {
-        let data = self.data();
-        let _ = self.command("pg_ctl").args(["-D", &data, "-m", "immediate", "-w", "stop"]).output();
+        self.stop();
     }
 }
