@@ -121,6 +121,10 @@ const STATES: [&str; 5] = ["queued", "running", "done", "failed", "cancelled"];
 
 /// `GET /metrics`: every metric in the OpenMetrics text format (which Prometheus reads).
 pub async fn metrics(State(db): State<Db>) -> Response {
+    // The gauge is the process's, the counts are this database's: one scrape at a time, so two
+    // services in one process (the tests) each answer their own.
+    static SCRAPE: tokio::sync::Mutex<()> = tokio::sync::Mutex::const_new(());
+    let _scrape = SCRAPE.lock().await;
     match tokio::time::timeout(Duration::from_secs(2), store::job_counts(&db)).await {
         Ok(Ok(counts)) => {
             for state in STATES {

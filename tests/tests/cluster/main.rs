@@ -4,7 +4,9 @@
 //! SQLite run of the same files. Two API nodes on one database see each other's tools, machines
 //! and jobs, and a cancel through one reaches the job running on the other within two seconds.
 //! Each test skips, printing why, when PostgreSQL is not installed (fails under
-//! `KERF_REQUIRE_EXTERNAL=1`).
+//! `KERF_REQUIRE_EXTERNAL=1`). The deployment files are checked against the same binary (`deploy`).
+
+mod deploy;
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
