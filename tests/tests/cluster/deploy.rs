@@ -44,7 +44,7 @@ fn parses(label: &str, arguments: &[String], environment: &BTreeMap<String, Stri
         }
     }
     match Cli::try_parse_from(&line) {
-        Ok(cli) => cli.command.unwrap_or_else(|| Command::Serve(cli.serve)),
+        Ok(cli) => cli.command.unwrap_or(Command::Serve(cli.serve)),
         Err(error) => panic!("{label}: `{}` is refused:\n{error}", line.join(" ")),
     }
 }
