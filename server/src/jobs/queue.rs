@@ -18,11 +18,11 @@ use sqlx::PgPool;
 use sqlx::postgres::PgListener;
 use tokio::sync::{Notify, Semaphore};
 
-use super::execute::{JobFailure, execute};
+use super::execute::{JobFailure, execute, execute_operation};
 use crate::db::Db;
 use crate::error::AppError;
 use crate::store;
-use crate::store::jobs::{CANCEL_CHANNEL, Claimant, Claimed, SUBMITTED_CHANNEL};
+use crate::store::jobs::{CANCEL_CHANNEL, Claimant, Claimed, SUBMITTED_CHANNEL, Work};
 
 /// How often a running job's progress and heartbeat are written.
 const HEARTBEAT: Duration = Duration::from_millis(250);
@@ -36,7 +36,7 @@ pub const DEFAULT_LEASE: Duration = Duration::from_secs(15);
 pub struct JobRunner {
     /// Wakes idle workers when a job is submitted.
     pub submitted: Notify,
-    cancel_flags: Mutex<HashMap<i64, Arc<AtomicBool>>>,
+    cancel_flags: Mutex<HashMap<Work, Arc<AtomicBool>>>,
     claimant: Claimant,
 }
 
@@ -73,14 +73,16 @@ impl JobRunner {
         &self.claimant.worker
     }
 
-    /// Tells the worker running job `id` in this process, if any, to stop.
+    /// Tells the workers running job `id` (or chunks of it) in this process, if any, to stop.
     pub fn cancel(&self, id: i64) {
-        if let Some(flag) = self.flags().get(&id) {
-            flag.store(true, Ordering::Relaxed);
+        for (work, flag) in self.flags().iter() {
+            if work.id == id {
+                flag.store(true, Ordering::Relaxed);
+            }
         }
     }
 
-    fn flags(&self) -> std::sync::MutexGuard<'_, HashMap<i64, Arc<AtomicBool>>> {
+    fn flags(&self) -> std::sync::MutexGuard<'_, HashMap<Work, Arc<AtomicBool>>> {
         self.cancel_flags.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 
@@ -178,17 +180,22 @@ async fn work(runner: Arc<JobRunner>, db: Db, slots: Arc<Semaphore>) {
     }
 }
 
-async fn run(runner: &JobRunner, db: &Db, slots: &Arc<Semaphore>, Claimed { id, job, attempt }: Claimed) {
+async fn run(runner: &JobRunner, db: &Db, slots: &Arc<Semaphore>, Claimed { work, job, attempt }: Claimed) {
     let claimant = &runner.claimant;
-    tracing::info!(id, attempt, worker = %claimant.worker, "job claimed");
+    let id = work.id;
+    tracing::info!(id, chunk = ?work.chunk, attempt, worker = %claimant.worker, "claimed");
     let cancelled = Arc::new(AtomicBool::new(false));
-    runner.flags().insert(id, Arc::clone(&cancelled));
+    runner.flags().insert(work, Arc::clone(&cancelled));
     let progress = Arc::new(AtomicU64::new(0));
     let Ok(permit) = Arc::clone(slots).acquire_owned().await else { return };
     let (task_progress, task_cancelled) = (Arc::clone(&progress), Arc::clone(&cancelled));
     let mut task = tokio::task::spawn_blocking(move || {
         let _permit = permit;
-        execute(&job, &|fraction| task_progress.store(fraction.to_bits(), Ordering::Relaxed), &task_cancelled)
+        let report = |fraction: f64| task_progress.store(fraction.to_bits(), Ordering::Relaxed);
+        match work.chunk {
+            None => execute(&job, &report, &task_cancelled),
+            Some(index) => execute_operation(&job, index, &report, &task_cancelled).map(|stored| vec![stored]),
+        }
     });
     let mut ticker = tokio::time::interval(HEARTBEAT);
     let outcome = loop {
@@ -196,7 +203,7 @@ async fn run(runner: &JobRunner, db: &Db, slots: &Arc<Semaphore>, Claimed { id, 
             outcome = &mut task => break outcome,
             _ = ticker.tick() => {
                 let fraction = f64::from_bits(progress.load(Ordering::Relaxed));
-                match store::jobs::heartbeat(db, id, claimant, fraction).await {
+                match store::jobs::heartbeat(db, work, claimant, fraction).await {
                     Ok(true) => {}
                     // Cancelled, or no longer ours: stop computing.
                     Ok(false) => cancelled.store(true, Ordering::Relaxed),
@@ -205,18 +212,36 @@ async fn run(runner: &JobRunner, db: &Db, slots: &Arc<Semaphore>, Claimed { id, 
             }
         }
     };
-    runner.flags().remove(&id);
+    runner.flags().remove(&work);
     let stored = match outcome {
-        Ok(Ok(outputs)) => store::jobs::finish(db, id, claimant, &outputs).await.map(|_| ()),
+        Ok(Ok(outputs)) => finish(db, work, claimant, &outputs).await,
         Ok(Err(JobFailure::Cancelled)) => Ok(()),
-        Ok(Err(JobFailure::Refused(problem))) => store::jobs::fail(db, id, claimant, &problem).await,
+        Ok(Err(JobFailure::Refused(problem))) => store::jobs::fail(db, work, claimant, &problem).await,
         Err(join_error) => {
             tracing::error!(id, %join_error, "job task failed");
             let internal = AppError::Internal(anyhow::anyhow!("the job's task failed"));
-            store::jobs::fail(db, id, claimant, &internal.problem()).await
+            store::jobs::fail(db, work, claimant, &internal.problem()).await
         }
     };
     if let Err(error) = stored {
         tracing::error!(id, %error, "storing the job outcome failed");
+    }
+}
+
+/// Stores finished work, once more after a failure (two finishers of one job's chunks can meet
+/// in a deadlock that PostgreSQL breaks by failing one of them). Work that cannot be stored is not
+/// lost: its chunk's lease expires and another worker runs it again.
+async fn finish(
+    db: &Db,
+    work: Work,
+    claimant: &Claimant,
+    outputs: &[crate::capabilities::Stored],
+) -> crate::error::AppResult<()> {
+    match store::jobs::finish(db, work, claimant, outputs).await {
+        Ok(_) => Ok(()),
+        Err(error) => {
+            tracing::warn!(id = work.id, %error, "storing the result failed; once more");
+            store::jobs::finish(db, work, claimant, outputs).await.map(|_| ())
+        }
     }
 }

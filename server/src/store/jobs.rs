@@ -3,12 +3,14 @@
 //!
 //! In SQLite one process owns the queue: its workers claim the oldest queued job with one atomic
 //! UPDATE, and at start every job left `running` is queued again ([`recover`]). In PostgreSQL any
-//! number of processes share it: a worker claims in a short transaction with
+//! number of processes share it, and a job is split into chunks (one per operation) that
+//! different workers run at once: a worker claims a chunk in a short transaction with
 //! `SELECT … FOR UPDATE SKIP LOCKED` (concurrent claimers skip each other's rows instead of
-//! waiting), writes its name and a lease on the job, and pushes the lease forward with each
-//! heartbeat; a running job whose lease expired (its worker died, `kill -9`) is claimed again
-//! like a queued one. Submissions and cancellations `NOTIFY` the workers (`kerf_jobs`,
-//! `kerf_cancel`); every write of a running job checks that the job is still the writer's.
+//! waiting), writes its name and a lease on the chunk, and pushes the lease forward with each
+//! heartbeat; a running chunk whose lease expired (its worker died, `kill -9`) is claimed again
+//! like a queued one. Each chunk stores its operation's result; the last one marks the job done.
+//! Submissions and cancellations `NOTIFY` the workers (`kerf_jobs`, `kerf_cancel`); every write
+//! of a running chunk checks that it is still the writer's and its job still running.
 
 use kerf_solver::ErrorCode;
 use serde::Serialize;
@@ -193,31 +195,48 @@ fn problem_json(problem: &Problem) -> AppResult<String> {
     serde_json::to_string(problem).map_err(|e| AppError::Internal(e.into()))
 }
 
-/// Who claims jobs: the worker's name, written on the job it runs, and how long its lease lasts
+/// Who claims work: the worker's name, written on the chunk it runs, and how long its lease lasts
 /// without a heartbeat (PostgreSQL; SQLite has one process and no leases).
 #[derive(Debug, Clone)]
 pub struct Claimant {
     /// Unique among the processes sharing the database (host, process id, start time).
     pub worker: String,
-    /// How long a claimed job stays this worker's without a heartbeat.
+    /// How long a claimed chunk stays this worker's without a heartbeat.
     pub lease: Duration,
 }
 
-/// A job a worker claimed.
-#[derive(Debug)]
-pub struct Claimed {
+/// What a worker runs: a whole job (SQLite), or one chunk of it (PostgreSQL: operation `chunk`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Work {
     /// Job id.
     pub id: i64,
+    /// The operation this chunk is, or `None` for the whole job.
+    pub chunk: Option<usize>,
+}
+
+impl Work {
+    fn position(self) -> i64 {
+        self.chunk.map_or(0, |chunk| i64::try_from(chunk).unwrap_or(i64::MAX))
+    }
+}
+
+/// Work a worker claimed.
+#[derive(Debug)]
+pub struct Claimed {
+    /// The job, and the chunk of it.
+    pub work: Work,
     /// The resolved job.
     pub job: JobFile,
     /// Which attempt this is (1 for the first).
     pub attempt: i64,
 }
 
-/// Stores a new queued job and wakes the workers; returns its id.
+/// Stores a new queued job (PostgreSQL: with one chunk per operation) and wakes the workers;
+/// returns its id.
 pub async fn insert(db: &Db, job: &JobFile, hash: &str) -> AppResult<i64> {
     let json = serde_json::to_string(job).map_err(|e| AppError::Internal(e.into()))?;
     let operations: Vec<&str> = job.operations.iter().map(|o| o.name()).collect();
+    let count = i64::try_from(operations.len()).unwrap_or(i64::MAX);
     let operations = serde_json::to_string(&operations).map_err(|e| AppError::Internal(e.into()))?;
     const INSERT: &str = "INSERT INTO jobs (name, status, content_hash, job_json, operations)
          VALUES ($1, 'queued', $2, $3, $4) RETURNING id";
@@ -228,7 +247,7 @@ pub async fn insert(db: &Db, job: &JobFile, hash: &str) -> AppResult<i64> {
             Ok(id)
         }
         Db::Postgres(pool) => {
-            // The notification is delivered at commit, when the job is there to claim.
+            // The notification is delivered at commit, when the chunks are there to claim.
             let mut transaction = pool.begin().await?;
             let (id,): (i64,) = sqlx::query_as(INSERT)
                 .bind(&job.name)
@@ -237,6 +256,13 @@ pub async fn insert(db: &Db, job: &JobFile, hash: &str) -> AppResult<i64> {
                 .bind(operations)
                 .fetch_one(&mut *transaction)
                 .await?;
+            sqlx::query(
+                "INSERT INTO job_chunks (job_id, position, status) SELECT $1, generate_series(0, $2 - 1), 'queued'",
+            )
+            .bind(id)
+            .bind(count)
+            .execute(&mut *transaction)
+            .await?;
             sqlx::query("SELECT pg_notify($1, $2)")
                 .bind(SUBMITTED_CHANNEL)
                 .bind(id.to_string())
@@ -274,13 +300,14 @@ pub async fn list(db: &Db, limit: i64, before: Option<i64>) -> AppResult<Vec<Job
     rows.into_iter().map(JobRecord::try_from).collect()
 }
 
-/// Claims the oldest job to run for `claimant`: marks it running (PostgreSQL: with the
-/// claimant's name and lease) and returns it. In PostgreSQL a running job whose lease expired
-/// is claimed again, or failed with `E_INTERRUPTED` once it has used its attempts.
+/// Claims the next work for `claimant`. SQLite: the oldest queued job, marked running.
+/// PostgreSQL: the first queued chunk of the oldest job still to run (or a running chunk whose
+/// lease expired), marked running with the claimant's name and lease; its job is marked running
+/// too. A chunk whose lease expired after its last attempt fails its job with `E_INTERRUPTED`.
 pub async fn claim(db: &Db, claimant: &Claimant) -> AppResult<Option<Claimed>> {
-    let row: Option<(i64, String, i64)> = match db {
+    let (work, json, attempt) = match db {
         Db::Sqlite(pool) => {
-            sqlx::query_as(concat!(
+            let row: Option<(i64, String, i64)> = sqlx::query_as(concat!(
                 "UPDATE jobs SET status = 'running', attempts = attempts + 1, progress = 0, started_at = ",
                 now!(),
                 ", heartbeat_at = ",
@@ -289,116 +316,235 @@ pub async fn claim(db: &Db, claimant: &Claimant) -> AppResult<Option<Claimed>> {
                  RETURNING id, job_json, attempts"
             ))
             .fetch_optional(pool)
-            .await?
+            .await?;
+            let Some((id, json, attempt)) = row else { return Ok(None) };
+            (Work { id, chunk: None }, json, attempt)
         }
         Db::Postgres(pool) => {
-            let mut transaction = pool.begin().await?;
-            sqlx::query(
-                "UPDATE jobs SET status = 'failed', finished_at = now(), lease_expires_at = NULL, error = $1
-                 WHERE id IN (SELECT id FROM jobs
-                              WHERE status = 'running' AND lease_expires_at < now() AND attempts >= $2
-                              FOR UPDATE SKIP LOCKED)",
-            )
-            .bind(problem_json(&job_problem(
-                503,
-                "Job interrupted",
-                ErrorCode::Interrupted,
-                &format!("its worker stopped (lease expired) on each of its {MAX_ATTEMPTS} attempts; not retried"),
-            ))?)
-            .bind(MAX_ATTEMPTS)
-            .execute(&mut *transaction)
-            .await?;
-            let row = sqlx::query_as(
-                "WITH next AS (
-                     SELECT id FROM jobs
-                     WHERE status = 'queued' OR (status = 'running' AND lease_expires_at < now())
-                     ORDER BY id LIMIT 1
-                     FOR UPDATE SKIP LOCKED)
-                 UPDATE jobs SET status = 'running', attempts = attempts + 1, progress = 0, started_at = now(),
-                     heartbeat_at = now(), worker = $1, lease_expires_at = now() + make_interval(secs => $2)
-                 FROM next WHERE jobs.id = next.id
-                 RETURNING jobs.id, jobs.job_json, jobs.attempts",
-            )
-            .bind(&claimant.worker)
-            .bind(claimant.lease.as_secs_f64())
-            .fetch_optional(&mut *transaction)
-            .await?;
-            transaction.commit().await?;
-            row
+            // A chunk of a job cancelled in the meantime is skipped: try the next one.
+            let mut found = None;
+            for _ in 0..8 {
+                match claim_chunk(pool, claimant).await? {
+                    Chunk::None => return Ok(None),
+                    Chunk::Gone => {}
+                    Chunk::Claimed(work, json, attempt) => {
+                        found = Some((work, json, attempt));
+                        break;
+                    }
+                }
+            }
+            let Some(found) = found else { return Ok(None) };
+            found
         }
     };
-    let Some((id, json, attempt)) = row else { return Ok(None) };
     match serde_json::from_str(&json) {
-        Ok(job) => Ok(Some(Claimed { id, job, attempt })),
+        Ok(job) => Ok(Some(Claimed { work, job, attempt })),
         Err(error) => {
             let detail = format!("the stored job is unreadable: {error}");
-            fail(db, id, claimant, &job_problem(422, "Job failed", ErrorCode::JobFile, &detail)).await?;
+            fail(db, work, claimant, &job_problem(422, "Job failed", ErrorCode::JobFile, &detail)).await?;
             Ok(None)
         }
     }
 }
 
-/// Records progress and the heartbeat of a running job (PostgreSQL: and extends the lease).
-/// Returns false when the job is no longer the claimant's to run: cancelled, or (PostgreSQL)
-/// claimed by another worker after this one's lease expired. The worker then stops it.
-pub async fn heartbeat(db: &Db, id: i64, claimant: &Claimant, progress: f64) -> AppResult<bool> {
-    let progress = progress.clamp(0.0, 1.0);
-    let updated = on!(db, query,
-        sqlite: concat!("UPDATE jobs SET progress = $1, heartbeat_at = ", now!(), " WHERE id = $2 AND status = 'running'"),
-        postgres: "UPDATE jobs SET progress = $1, heartbeat_at = now(), lease_expires_at = now() + make_interval(secs => $4)
-                   WHERE id = $2 AND status = 'running' AND worker = $3",
-        [progress, id, &claimant.worker, claimant.lease.as_secs_f64()], execute)?;
-    Ok(updated > 0)
+/// The outcome of one claim transaction.
+enum Chunk {
+    /// Nothing to run.
+    None,
+    /// A chunk of a job that is no longer to run (cancelled or failed meanwhile).
+    Gone,
+    /// The chunk, its job's JSON and the chunk's attempt.
+    Claimed(Work, String, i64),
 }
 
-/// Stores the results and marks the job done, in one transaction, unless it was cancelled (or,
-/// in PostgreSQL, is no longer the claimant's) meanwhile. Returns whether it was stored.
-pub async fn finish(db: &Db, id: i64, claimant: &Claimant, outputs: &[Stored]) -> AppResult<bool> {
-    macro_rules! finish_in {
-        ($pool:expr, $update:expr) => {{
-            let mut transaction = $pool.begin().await?;
-            let updated = sqlx::query($update).bind(id).bind(&claimant.worker).execute(&mut *transaction).await?;
+async fn claim_chunk(pool: &sqlx::PgPool, claimant: &Claimant) -> AppResult<Chunk> {
+    let mut transaction = pool.begin().await?;
+    sqlx::query(
+        "WITH dead AS (
+             UPDATE job_chunks SET status = 'failed', lease_expires_at = NULL
+             WHERE (job_id, position) IN (
+                 SELECT job_id, position FROM job_chunks
+                 WHERE status = 'running' AND lease_expires_at < now() AND attempts >= $2
+                 FOR UPDATE SKIP LOCKED)
+             RETURNING job_id)
+         UPDATE jobs SET status = 'failed', finished_at = now(), error = $1
+         WHERE id IN (SELECT job_id FROM dead) AND status IN ('queued', 'running')",
+    )
+    .bind(problem_json(&job_problem(
+        503,
+        "Job interrupted",
+        ErrorCode::Interrupted,
+        &format!("its worker stopped (lease expired) on each of its {MAX_ATTEMPTS} attempts; not retried"),
+    ))?)
+    .bind(MAX_ATTEMPTS)
+    .execute(&mut *transaction)
+    .await?;
+    let chunk: Option<(i64, i64, i64)> = sqlx::query_as(
+        "WITH next AS (
+             SELECT c.job_id, c.position FROM job_chunks c JOIN jobs j ON j.id = c.job_id
+             WHERE j.status IN ('queued', 'running')
+               AND (c.status = 'queued' OR (c.status = 'running' AND c.lease_expires_at < now()))
+             ORDER BY c.job_id, c.position LIMIT 1
+             FOR UPDATE OF c SKIP LOCKED)
+         UPDATE job_chunks c SET status = 'running', attempts = c.attempts + 1, progress = 0, worker = $1,
+             lease_expires_at = now() + make_interval(secs => $2)
+         FROM next WHERE c.job_id = next.job_id AND c.position = next.position
+         RETURNING c.job_id, c.position, c.attempts",
+    )
+    .bind(&claimant.worker)
+    .bind(claimant.lease.as_secs_f64())
+    .fetch_optional(&mut *transaction)
+    .await?;
+    let Some((id, position, attempt)) = chunk else {
+        transaction.commit().await?;
+        return Ok(Chunk::None);
+    };
+    let job: Option<(String,)> = sqlx::query_as(
+        "UPDATE jobs SET status = 'running', started_at = COALESCE(started_at, now()), heartbeat_at = now(),
+             attempts = GREATEST(attempts, $2)
+         WHERE id = $1 AND status IN ('queued', 'running')
+         RETURNING job_json",
+    )
+    .bind(id)
+    .bind(attempt)
+    .fetch_optional(&mut *transaction)
+    .await?;
+    let Some((json,)) = job else {
+        // Cancelled between the two statements: leave the chunk to nobody.
+        transaction.rollback().await?;
+        return Ok(Chunk::Gone);
+    };
+    transaction.commit().await?;
+    let chunk = usize::try_from(position).map_err(|e| AppError::Internal(e.into()))?;
+    Ok(Chunk::Claimed(Work { id, chunk: Some(chunk) }, json, attempt))
+}
+
+/// Records progress and the heartbeat of running work (PostgreSQL: of the chunk, extending its
+/// lease; the job's progress is the mean of its chunks'). Returns false when the work is no
+/// longer the claimant's to run: its job was cancelled or failed, or (PostgreSQL) the chunk was
+/// claimed by another worker after this one's lease expired. The worker then stops it.
+pub async fn heartbeat(db: &Db, work: Work, claimant: &Claimant, progress: f64) -> AppResult<bool> {
+    let progress = progress.clamp(0.0, 1.0);
+    match db {
+        Db::Sqlite(pool) => {
+            let updated = sqlx::query(concat!(
+                "UPDATE jobs SET progress = $1, heartbeat_at = ",
+                now!(),
+                " WHERE id = $2 AND status = 'running'"
+            ))
+            .bind(progress)
+            .bind(work.id)
+            .execute(pool)
+            .await?;
+            Ok(updated.rows_affected() > 0)
+        }
+        Db::Postgres(pool) => {
+            let updated = sqlx::query(
+                "UPDATE job_chunks SET progress = $1, lease_expires_at = now() + make_interval(secs => $4)
+                 WHERE job_id = $2 AND position = $5 AND worker = $3 AND status = 'running'
+                   AND EXISTS (SELECT 1 FROM jobs WHERE id = $2 AND status = 'running')",
+            )
+            .bind(progress)
+            .bind(work.id)
+            .bind(&claimant.worker)
+            .bind(claimant.lease.as_secs_f64())
+            .bind(work.position())
+            .execute(pool)
+            .await?;
             if updated.rows_affected() == 0 {
-                transaction.rollback().await?;
                 return Ok(false);
             }
-            for (position, output) in outputs.iter().enumerate() {
+            sqlx::query(
+                "UPDATE jobs SET heartbeat_at = now(),
+                     progress = (SELECT LEAST(1, GREATEST(0, avg(progress))) FROM job_chunks WHERE job_id = $1)
+                 WHERE id = $1 AND status = 'running'",
+            )
+            .bind(work.id)
+            .execute(pool)
+            .await?;
+            Ok(true)
+        }
+    }
+}
+
+/// Stores the results and marks the work done, in one transaction, unless its job was
+/// cancelled (or, in PostgreSQL, the chunk is no longer the claimant's) meanwhile; in PostgreSQL
+/// the job is done with its last chunk. Returns whether it was stored.
+pub async fn finish(db: &Db, work: Work, claimant: &Claimant, outputs: &[Stored]) -> AppResult<bool> {
+    macro_rules! results_in {
+        ($transaction:expr, $first:expr) => {
+            for (offset, output) in outputs.iter().enumerate() {
                 sqlx::query(
                     "INSERT INTO job_results (job_id, position, operation, result_json, gcode, gcode_problem)
                      VALUES ($1, $2, $3, $4, $5, $6)",
                 )
-                .bind(id)
-                .bind(i64::try_from(position).unwrap_or(i64::MAX))
+                .bind(work.id)
+                .bind($first + i64::try_from(offset).unwrap_or(i64::MAX))
                 .bind(&output.operation)
                 .bind(output.result.get())
                 .bind(&output.gcode)
                 .bind(&output.gcode_problem)
-                .execute(&mut *transaction)
+                .execute(&mut *$transaction)
                 .await?;
             }
-            transaction.commit().await?;
-        }};
+        };
     }
     match db {
-        Db::Sqlite(pool) => finish_in!(
-            pool,
-            concat!(
+        Db::Sqlite(pool) => {
+            let mut transaction = pool.begin().await?;
+            let updated = sqlx::query(concat!(
                 "UPDATE jobs SET status = 'done', progress = 1, finished_at = ",
                 now!(),
                 " WHERE id = $1 AND status = 'running'"
+            ))
+            .bind(work.id)
+            .execute(&mut *transaction)
+            .await?;
+            if updated.rows_affected() == 0 {
+                transaction.rollback().await?;
+                return Ok(false);
+            }
+            results_in!(transaction, 0);
+            transaction.commit().await?;
+        }
+        Db::Postgres(pool) => {
+            let mut transaction = pool.begin().await?;
+            // The job's row first: finishers of one job's chunks take turns, so the last one
+            // sees every other chunk done.
+            let job: Option<(String,)> = sqlx::query_as("SELECT status FROM jobs WHERE id = $1 FOR UPDATE")
+                .bind(work.id)
+                .fetch_optional(&mut *transaction)
+                .await?;
+            let updated = sqlx::query(
+                "UPDATE job_chunks SET status = 'done', progress = 1, lease_expires_at = NULL
+                 WHERE job_id = $1 AND position = $2 AND worker = $3 AND status = 'running'",
             )
-        ),
-        Db::Postgres(pool) => finish_in!(
-            pool,
-            "UPDATE jobs SET status = 'done', progress = 1, finished_at = now(), lease_expires_at = NULL
-             WHERE id = $1 AND status = 'running' AND worker = $2"
-        ),
+            .bind(work.id)
+            .bind(work.position())
+            .bind(&claimant.worker)
+            .execute(&mut *transaction)
+            .await?;
+            if job.is_none_or(|(status,)| status != "running") || updated.rows_affected() == 0 {
+                transaction.rollback().await?;
+                return Ok(false);
+            }
+            results_in!(transaction, work.position());
+            sqlx::query(
+                "UPDATE jobs SET status = 'done', progress = 1, finished_at = now()
+                 WHERE id = $1 AND NOT EXISTS (SELECT 1 FROM job_chunks WHERE job_id = $1 AND status <> 'done')",
+            )
+            .bind(work.id)
+            .execute(&mut *transaction)
+            .await?;
+            transaction.commit().await?;
+        }
     }
     Ok(true)
 }
 
-/// Marks a running job failed with the problem (PostgreSQL: only while it is the claimant's).
-pub async fn fail(db: &Db, id: i64, claimant: &Claimant, problem: &Problem) -> AppResult<()> {
+/// Marks running work's job failed with the problem (PostgreSQL: only while the chunk is the
+/// claimant's; the job's other chunks stop at their next heartbeat).
+pub async fn fail(db: &Db, work: Work, claimant: &Claimant, problem: &Problem) -> AppResult<()> {
     let json = problem_json(problem)?;
     let field = problem.errors.first().map(|error| error.path.clone());
     on!(db, query,
@@ -407,9 +553,13 @@ pub async fn fail(db: &Db, id: i64, claimant: &Claimant, problem: &Problem) -> A
             now!(),
             " WHERE id = $3 AND status = 'running'"
         ),
-        postgres: "UPDATE jobs SET status = 'failed', error = $1, error_field = $2, finished_at = now(),
-                   lease_expires_at = NULL WHERE id = $3 AND status = 'running' AND worker = $4",
-        [json, field, id, &claimant.worker], execute)?;
+        postgres: "WITH chunk AS (
+                       UPDATE job_chunks SET status = 'failed', lease_expires_at = NULL
+                       WHERE job_id = $3 AND position = $5 AND worker = $4 AND status = 'running'
+                       RETURNING job_id)
+                   UPDATE jobs SET status = 'failed', error = $1, error_field = $2, finished_at = now()
+                   WHERE id IN (SELECT job_id FROM chunk) AND status = 'running'",
+        [json, field, work.id, &claimant.worker, work.position()], execute)?;
     Ok(())
 }
 
@@ -445,8 +595,7 @@ pub async fn cancel(db: &Db, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
         Db::Postgres(pool) => cancel_in!(
             pool,
             "SELECT status FROM jobs WHERE id = $1 FOR UPDATE",
-            "UPDATE jobs SET status = 'cancelled', finished_at = now(), lease_expires_at = NULL, error = $1
-             WHERE id = $2",
+            "UPDATE jobs SET status = 'cancelled', finished_at = now(), error = $1 WHERE id = $2",
             Some("SELECT pg_notify($1, $2)")
         ),
     }
@@ -497,14 +646,14 @@ pub async fn recover(db: &Db) -> AppResult<(u64, u64)> {
     Ok((requeued, failed))
 }
 
-/// Hands the jobs `claimant` is running back to the queue (PostgreSQL, on a graceful stop of its
-/// process), so another worker takes them at once instead of after the lease; the attempt does
-/// not count. Returns how many. SQLite's [`recover`] does this at the next start.
+/// Hands the chunks `claimant` is running back to the queue (PostgreSQL, on a graceful stop of
+/// its process), so another worker takes them at once instead of after the lease; the attempt
+/// does not count. Returns how many. SQLite's [`recover`] does this at the next start.
 pub async fn release(db: &Db, claimant: &Claimant) -> AppResult<u64> {
     let Db::Postgres(pool) = db else { return Ok(0) };
     let mut transaction = pool.begin().await?;
     let released = sqlx::query(
-        "UPDATE jobs SET status = 'queued', progress = 0, worker = NULL, lease_expires_at = NULL,
+        "UPDATE job_chunks SET status = 'queued', progress = 0, worker = NULL, lease_expires_at = NULL,
              attempts = GREATEST(attempts - 1, 0)
          WHERE status = 'running' AND worker = $1",
     )

@@ -152,16 +152,19 @@ async fn outputs(client: &Client, base: &str, id: i64) -> Vec<(String, String)> 
     outputs
 }
 
-/// The worker process a running job is claimed by, from the `worker` column (host:pid:start).
-async fn worker_pid(postgres: &PgServer, id: i64) -> Option<u32> {
+/// The worker processes running chunks of job `id` now, from the chunks' `worker` column
+/// (host:pid:start).
+async fn running_workers(postgres: &PgServer, id: i64) -> Vec<u32> {
     let pool = sqlx::PgPool::connect(&postgres.url()).await.unwrap();
-    let row: Option<(Option<String>,)> = sqlx::query_as("SELECT worker FROM jobs WHERE id = $1 AND status = 'running'")
-        .bind(id)
-        .fetch_optional(&pool)
-        .await
-        .unwrap();
+    let rows: Vec<(String,)> = sqlx::query_as(
+        "SELECT DISTINCT worker FROM job_chunks WHERE job_id = $1 AND status = 'running' AND worker IS NOT NULL",
+    )
+    .bind(id)
+    .fetch_all(&pool)
+    .await
+    .unwrap();
     pool.close().await;
-    row?.0?.split(':').nth(1)?.parse().ok()
+    rows.iter().filter_map(|(worker,)| worker.split(':').nth(1)?.parse().ok()).collect()
 }
 
 /// A result without the time it took (prediction results in jobs carry their `timings`).
@@ -202,15 +205,22 @@ async fn workers_share_the_queue_and_survive_a_kill() {
         ids.push(submit(&client, &api.base, job).await);
     }
 
-    // Kill the worker that runs the long job once it is well into it.
+    // The long job's chunks (one per operation) run on both workers at once; kill one of them
+    // once the job is well under way.
     let long = ids[0];
-    let running = poll_job(&client, &api.base, long, 60, |j| {
-        j["status"] == "running" && j["progress"].as_f64().is_some_and(|p| p > 0.1)
-    })
-    .await;
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let pids = loop {
+        let pids = running_workers(&postgres, long).await;
+        if pids.len() == 2 || Instant::now() > deadline {
+            break pids;
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    };
+    assert_eq!(pids.len(), 2, "both workers run chunks of the long job at once: {pids:?}");
+    tokio::time::sleep(Duration::from_millis(500)).await;
+    let running = json_with(client.get(format!("{}/api/v1/jobs/{long}", api.base)).send().await.unwrap(), 200).await;
     assert_eq!(running["status"], "running", "{running}");
-    let pid = worker_pid(&postgres, long).await.expect("the running job names its worker");
-    let index = workers.iter().position(|w| w.as_ref().is_some_and(|w| w.id() == pid)).expect("one of ours");
+    let index = workers.iter().position(|w| w.as_ref().is_some_and(|w| w.id() == pids[0])).expect("one of ours");
     workers[index].take().unwrap().kill();
 
     let started = Instant::now();
@@ -220,7 +230,7 @@ async fn workers_share_the_queue_and_survive_a_kill() {
         assert_eq!(done["progress"], 1.0);
     }
     let long_done = json_with(client.get(format!("{}/api/v1/jobs/{long}", api.base)).send().await.unwrap(), 200).await;
-    assert_eq!(long_done["attempts"], 2, "re-claimed once after the kill: {long_done}");
+    assert_eq!(long_done["attempts"], 2, "the killed chunk was claimed again once: {long_done}");
     eprintln!("all {} jobs done {:.1} s after the kill", ids.len(), started.elapsed().as_secs_f64());
 
     // Nothing is left running or queued.
