@@ -8,7 +8,7 @@
 //! | `kerf_http_request_duration_seconds` | histogram | `route` |
 //! | `kerf_solver_seconds` | histogram | `capability` (synchronous requests and job operations) |
 //! | `kerf_jobs` | gauge, read from the database at each scrape | `state` |
-//! | `kerf_job_chunks_claimed_total` | counter (claims by this process; a job is one chunk) | |
+//! | `kerf_job_chunks_claimed_total` | counter (chunks, or whole SQLite jobs, this process claimed) | |
 
 use std::sync::LazyLock;
 use std::time::{Duration, Instant};
