@@ -2,7 +2,7 @@
 //! rejection (unknown path, wrong method, panics), body limit and request tracing.
 
 use std::any::Any;
-use std::path::PathBuf;
+use std::time::Duration;
 
 use axum::Router;
 use axum::body::Body;
@@ -17,22 +17,25 @@ use utoipa_axum::router::OpenApiRouter;
 use utoipa_swagger_ui::SwaggerUi;
 
 use crate::auth::{Auth, require_token};
+use crate::db::Database;
 use crate::error::AppError;
 use crate::openapi::ApiDoc;
 use crate::state::{AppState, Limits};
-use crate::{db, http, web};
+use crate::{db, http, metrics, web};
 
 /// How to run the service.
 #[derive(Debug, Clone)]
 pub struct Config {
-    /// SQLite file (created with the schema if missing).
-    pub database: PathBuf,
+    /// The store: an SQLite file (created with the schema if missing) or a PostgreSQL URL.
+    pub database: Database,
     /// Request limits.
     pub limits: Limits,
     /// Solver calls allowed at once (synchronous requests and jobs together).
     pub solver_slots: usize,
-    /// Job workers.
+    /// Job workers in this process (0: an API node that runs no jobs).
     pub job_workers: usize,
+    /// How long a claimed job stays a worker's without a heartbeat (PostgreSQL).
+    pub job_lease: Duration,
     /// The optional API token.
     pub auth: Auth,
 }
@@ -63,11 +66,13 @@ pub fn router(state: AppState) -> Router {
     api_routes
         .merge(SwaggerUi::new("/docs").url("/api/v1/openapi.json", document))
         .merge(web::router())
+        .merge(metrics::routes())
         .fallback(|| async { AppError::not_found("no such resource") })
         .method_not_allowed_fallback(|| async { AppError::MethodNotAllowed })
         .layer(axum::middleware::from_fn_with_state(state.clone(), require_token))
         .layer(DefaultBodyLimit::max(max_body))
         .layer(RequestBodyTimeoutLayer::new(state.limits.body_idle_timeout))
+        .layer(axum::middleware::from_fn(metrics::track))
         .layer(TraceLayer::new_for_http())
         .layer(CatchPanicLayer::custom(panic_response))
         .with_state(state)
@@ -88,7 +93,7 @@ fn panic_response(cause: Box<dyn Any + Send + 'static>) -> Response<Body> {
 /// When the database cannot be opened or migrated.
 pub async fn build(config: &Config) -> anyhow::Result<(Router, AppState)> {
     let pool = db::open(&config.database).await?;
-    let state = AppState::new(pool, config.limits.clone(), config.solver_slots, config.auth.clone());
+    let state = AppState::new(pool, config.limits.clone(), config.solver_slots, config.auth.clone(), config.job_lease);
     state.jobs.start(&state.db, &state.solver_slots, config.job_workers).await?;
     Ok((router(state.clone()), state))
 }

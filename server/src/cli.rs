@@ -1,8 +1,9 @@
 //! The `kerf` program: command line and environment configuration, `serve` (until SIGINT or
-//! SIGTERM) and `run`.
+//! SIGTERM), `worker` (claims and runs jobs from PostgreSQL, no API) and `run`.
 
 use std::net::SocketAddr;
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::Context;
@@ -12,6 +13,8 @@ use tracing_subscriber::EnvFilter;
 
 use crate::app::Config;
 use crate::auth::Auth;
+use crate::db::{self, Database};
+use crate::jobs::queue::{DEFAULT_LEASE, JobRunner};
 use crate::state::Limits;
 
 /// kerf: CAM web service (tool-centre paths as JSON or G-code).
@@ -31,6 +34,8 @@ pub struct Cli {
 pub enum Command {
     /// Run the HTTP service (the default).
     Serve(ServeArgs),
+    /// Claim and run jobs from a PostgreSQL database shared with `kerf serve` nodes (no API).
+    Worker(WorkerArgs),
     /// Run a job file locally, without the service, and write its results as files.
     Run(RunArgs),
 }
@@ -44,9 +49,27 @@ pub struct RunArgs {
     #[arg(short, long, default_value = "kerf-out")]
     pub out: PathBuf,
     /// Tool table and machines registry to resolve the tool numbers and machine names the job file
-    /// does not define (read only; used if it exists).
+    /// does not define (read only; an SQLite file is used if it exists, or a `postgres://` URL).
     #[arg(long, env = "KERF_DATABASE", default_value = "kerf.db")]
-    pub database: PathBuf,
+    pub database: Database,
+}
+
+/// Options of `kerf worker`.
+#[derive(Debug, Clone, Args)]
+pub struct WorkerArgs {
+    /// The PostgreSQL database the API nodes use (`postgres://user:password@host:port/name`).
+    #[arg(long, env = "KERF_DATABASE")]
+    pub database: Database,
+    /// Jobs this process runs at once (default: the number of CPU cores).
+    #[arg(long, env = "KERF_JOB_WORKERS")]
+    pub job_workers: Option<usize>,
+    /// Seconds a claimed job stays this worker's without a heartbeat; after that (the process
+    /// died) another worker claims it again.
+    #[arg(long, env = "KERF_JOB_LEASE_S", default_value_t = DEFAULT_LEASE.as_secs_f64())]
+    pub job_lease_s: f64,
+    /// Address for `/metrics`, `/readyz` and `/healthz` of this worker (none when absent).
+    #[arg(long, env = "KERF_METRICS_BIND")]
+    pub metrics_bind: Option<SocketAddr>,
 }
 
 /// Options of the service.
@@ -55,9 +78,10 @@ pub struct ServeArgs {
     /// Address to listen on.
     #[arg(long, env = "KERF_BIND", default_value = "127.0.0.1:8080")]
     pub bind: SocketAddr,
-    /// SQLite database file, created with the schema if missing.
+    /// The database: an SQLite file (a path or `sqlite://PATH`, created with the schema if
+    /// missing) or PostgreSQL (`postgres://user:password@host:port/name`, migrated at start).
     #[arg(long, env = "KERF_DATABASE", default_value = "kerf.db")]
-    pub database: PathBuf,
+    pub database: Database,
     /// Largest accepted request body, bytes.
     #[arg(long, env = "KERF_MAX_BODY_BYTES", default_value_t = Limits::default().max_body_bytes)]
     pub max_body_bytes: usize,
@@ -70,9 +94,13 @@ pub struct ServeArgs {
     /// Solver calls allowed at once (default: the number of CPU cores).
     #[arg(long, env = "KERF_SOLVER_SLOTS")]
     pub solver_slots: Option<usize>,
-    /// Job workers (default: the number of CPU cores).
+    /// Job workers in this process (default: the number of CPU cores); 0 runs no jobs here
+    /// (an API node in front of `kerf worker` processes on PostgreSQL).
     #[arg(long, env = "KERF_JOB_WORKERS")]
     pub job_workers: Option<usize>,
+    /// Seconds a job claimed by this process stays its own without a heartbeat (PostgreSQL).
+    #[arg(long, env = "KERF_JOB_LEASE_S", default_value_t = DEFAULT_LEASE.as_secs_f64())]
+    pub job_lease_s: f64,
     /// API token: when set, requests that change state need `Authorization: Bearer <token>`.
     #[arg(long, env = "KERF_API_TOKEN", hide_env_values = true)]
     pub api_token: Option<String>,
@@ -95,6 +123,7 @@ impl ServeArgs {
             },
             solver_slots: self.solver_slots.unwrap_or(cores),
             job_workers: self.job_workers.unwrap_or(cores),
+            job_lease: lease(self.job_lease_s),
             auth: Auth { token: self.api_token.clone().filter(|t| !t.is_empty()), private: self.private },
         }
     }
@@ -112,6 +141,7 @@ pub fn main() -> anyhow::Result<()> {
     let runtime = tokio::runtime::Runtime::new().context("starting the async runtime")?;
     match cli.command {
         Some(Command::Serve(args)) => runtime.block_on(serve(args)),
+        Some(Command::Worker(args)) => runtime.block_on(worker(args)),
         Some(Command::Run(args)) => runtime.block_on(run(args)),
         None => runtime.block_on(serve(cli.serve)),
     }
@@ -125,14 +155,45 @@ async fn run(args: RunArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// A lease of `seconds` (at least 1 s).
+fn lease(seconds: f64) -> Duration {
+    if seconds.is_finite() && seconds >= 1.0 { Duration::from_secs_f64(seconds) } else { Duration::from_secs(1) }
+}
+
 async fn serve(args: ServeArgs) -> anyhow::Result<()> {
     let config = args.config();
     let (router, state) = crate::app::build(&config).await?;
     let listener = TcpListener::bind(args.bind).await.with_context(|| format!("binding {}", args.bind))?;
-    tracing::info!(address = %listener.local_addr()?, database = %config.database.display(), "kerf listening");
+    tracing::info!(address = %listener.local_addr()?, database = %config.database, "kerf listening");
     crate::serve(listener, router, config.limits.clone(), shutdown_signal()).await?;
-    state.jobs.stop_all();
+    state.jobs.release(&state.db).await;
     tracing::info!("kerf stopped");
+    Ok(())
+}
+
+async fn worker(args: WorkerArgs) -> anyhow::Result<()> {
+    if !matches!(args.database, Database::Postgres(_)) {
+        anyhow::bail!(
+            "kerf worker needs a PostgreSQL database (--database postgres://...); with SQLite, kerf serve runs the jobs"
+        );
+    }
+    let cores = std::thread::available_parallelism().map_or(2, std::num::NonZero::get);
+    let workers = args.job_workers.unwrap_or(cores).max(1);
+    let db = db::open(&args.database).await?;
+    let runner = Arc::new(JobRunner::new(lease(args.job_lease_s)));
+    runner.start(&db, &Arc::new(tokio::sync::Semaphore::new(workers)), workers).await?;
+    if let Some(bind) = args.metrics_bind {
+        let listener = TcpListener::bind(bind).await.with_context(|| format!("binding {bind}"))?;
+        tracing::info!(address = %listener.local_addr()?, "worker metrics listening");
+        let router = crate::metrics::worker_router(db.clone());
+        tokio::spawn(async move {
+            crate::serve(listener, router, crate::state::Limits::default(), std::future::pending()).await
+        });
+    }
+    tracing::info!(database = %args.database, worker = runner.worker(), workers, "kerf worker running");
+    shutdown_signal().await;
+    runner.release(&db).await;
+    tracing::info!("kerf worker stopped");
     Ok(())
 }
 

@@ -1,19 +1,154 @@
-//! SQLite: opening the database file (created if missing, WAL, foreign keys, busy timeout) and
-//! applying the migrations in `migrations/`.
+//! The two stores behind one handle: an embedded SQLite file (the default: created if missing,
+//! WAL, foreign keys, busy timeout) or a PostgreSQL server shared by any number of API nodes and
+//! worker processes. Each has its own migrations (`migrations/sqlite/`, `migrations/postgres/`),
+//! applied at start; `store/` holds the SQL of both.
 
-use std::path::Path;
+use std::fmt;
+use std::path::{Path, PathBuf};
 use std::str::FromStr;
 use std::time::Duration;
 
 use anyhow::Context;
-use sqlx::SqlitePool;
+use sqlx::postgres::{PgConnectOptions, PgPoolOptions};
 use sqlx::sqlite::{SqliteConnectOptions, SqliteJournalMode, SqlitePoolOptions, SqliteSynchronous};
+use sqlx::{PgPool, SqlitePool};
 
-/// Opens (creating if needed) the database at `path` and migrates it to the current schema.
+/// Where the data lives, as `--database` names it: a file path or `sqlite://PATH` (SQLite), or
+/// `postgres://…` / `postgresql://…` (PostgreSQL).
+#[derive(Clone, PartialEq, Eq)]
+pub enum Database {
+    /// An SQLite file.
+    Sqlite(PathBuf),
+    /// A PostgreSQL connection URL.
+    Postgres(String),
+}
+
+impl Database {
+    /// Reads a `--database` value. Never fails: anything that is not a PostgreSQL URL is a path.
+    pub fn parse(text: &str) -> Self {
+        if text.starts_with("postgres://") || text.starts_with("postgresql://") {
+            return Self::Postgres(text.to_owned());
+        }
+        let path = text.strip_prefix("sqlite://").or_else(|| text.strip_prefix("sqlite:")).unwrap_or(text);
+        Self::Sqlite(PathBuf::from(path))
+    }
+
+    /// The SQLite file, if this is one.
+    pub fn sqlite_path(&self) -> Option<&Path> {
+        match self {
+            Self::Sqlite(path) => Some(path),
+            Self::Postgres(_) => None,
+        }
+    }
+}
+
+impl FromStr for Database {
+    type Err = std::convert::Infallible;
+
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        Ok(Self::parse(text))
+    }
+}
+
+impl From<PathBuf> for Database {
+    fn from(path: PathBuf) -> Self {
+        Self::Sqlite(path)
+    }
+}
+
+/// Shown in logs: the file, or the URL without its password.
+impl fmt::Display for Database {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Sqlite(path) => write!(f, "{}", path.display()),
+            Self::Postgres(url) => match url.split_once('@') {
+                Some((credentials, rest)) => match credentials.rsplit_once(':') {
+                    Some((user, _password)) if !user.ends_with('/') => write!(f, "{user}:***@{rest}"),
+                    _ => write!(f, "{url}"),
+                },
+                None => write!(f, "{url}"),
+            },
+        }
+    }
+}
+
+impl fmt::Debug for Database {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Database({self})")
+    }
+}
+
+/// An open store: a pool of either kind. Cheap to clone.
+#[derive(Debug, Clone)]
+pub enum Db {
+    /// The embedded SQLite file.
+    Sqlite(SqlitePool),
+    /// A PostgreSQL server.
+    Postgres(PgPool),
+}
+
+impl Db {
+    /// Whether this is PostgreSQL (shared by several processes: leases, LISTEN/NOTIFY).
+    pub fn is_postgres(&self) -> bool {
+        matches!(self, Self::Postgres(_))
+    }
+
+    /// `sqlite` or `postgres`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Sqlite(_) => "sqlite",
+            Self::Postgres(_) => "postgres",
+        }
+    }
+
+    /// One round trip to the database.
+    ///
+    /// # Errors
+    /// When the database does not answer.
+    pub async fn ping(&self) -> Result<(), sqlx::Error> {
+        match self {
+            Self::Sqlite(pool) => sqlx::query("SELECT 1").execute(pool).await.map(|_| ()),
+            Self::Postgres(pool) => sqlx::query("SELECT 1").execute(pool).await.map(|_| ()),
+        }
+    }
+}
+
+/// Opens (creating an SQLite file if needed) the database and migrates it to the current schema.
+/// Several processes may start on one PostgreSQL database at once: sqlx takes an advisory lock
+/// while it migrates.
 ///
 /// # Errors
-/// When the file cannot be opened or a migration fails.
-pub async fn open(path: &Path) -> anyhow::Result<SqlitePool> {
+/// When the database cannot be opened or reached, or a migration fails.
+pub async fn open(database: &Database) -> anyhow::Result<Db> {
+    match database {
+        Database::Sqlite(path) => open_sqlite(path).await.map(Db::Sqlite),
+        Database::Postgres(url) => {
+            let pool = connect_postgres(url, 16).await.with_context(|| format!("connecting to {database}"))?;
+            sqlx::migrate!("../migrations/postgres").run(&pool).await.context("applying migrations")?;
+            Ok(Db::Postgres(pool))
+        }
+    }
+}
+
+/// Opens an existing database to read the tool table and machines registry (`kerf run`):
+/// `None` when it is an SQLite file that does not exist. Nothing is created or migrated.
+///
+/// # Errors
+/// When the database cannot be opened.
+pub async fn open_read_only(database: &Database) -> anyhow::Result<Option<Db>> {
+    match database {
+        Database::Sqlite(path) if !path.exists() => Ok(None),
+        Database::Sqlite(path) => {
+            let options = SqliteConnectOptions::from_str("sqlite:")?.filename(path).read_only(true);
+            Ok(Some(Db::Sqlite(SqlitePoolOptions::new().max_connections(1).connect_with(options).await?)))
+        }
+        Database::Postgres(url) => {
+            Ok(Some(Db::Postgres(connect_postgres(url, 2).await.with_context(|| format!("connecting to {database}"))?)))
+        }
+    }
+}
+
+async fn open_sqlite(path: &Path) -> anyhow::Result<SqlitePool> {
     let options = SqliteConnectOptions::from_str("sqlite:")?
         .filename(path)
         .create_if_missing(true)
@@ -27,6 +162,31 @@ pub async fn open(path: &Path) -> anyhow::Result<SqlitePool> {
         .connect_with(options)
         .await
         .with_context(|| format!("opening database {}", path.display()))?;
-    sqlx::migrate!("../migrations").run(&pool).await.context("applying migrations")?;
+    sqlx::migrate!("../migrations/sqlite").run(&pool).await.context("applying migrations")?;
     Ok(pool)
+}
+
+async fn connect_postgres(url: &str, connections: u32) -> anyhow::Result<PgPool> {
+    let options = PgConnectOptions::from_str(url)?.application_name("kerf");
+    Ok(PgPoolOptions::new()
+        .max_connections(connections)
+        .acquire_timeout(Duration::from_secs(10))
+        .connect_with(options)
+        .await?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn database_values() {
+        assert_eq!(Database::parse("kerf.db"), Database::Sqlite("kerf.db".into()));
+        assert_eq!(Database::parse("sqlite:///var/lib/kerf.db"), Database::Sqlite("/var/lib/kerf.db".into()));
+        assert_eq!(Database::parse("sqlite:kerf.db"), Database::Sqlite("kerf.db".into()));
+        let url = "postgres://kerf:s3cret@db:5432/kerf";
+        assert_eq!(Database::parse(url), Database::Postgres(url.to_owned()));
+        assert_eq!(Database::parse(url).to_string(), "postgres://kerf:***@db:5432/kerf");
+        assert_eq!(Database::parse("postgresql://db/kerf").to_string(), "postgresql://db/kerf");
+    }
 }

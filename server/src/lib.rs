@@ -1,4 +1,4 @@
-//! kerf's HTTP service: axum routes per resource over SQLite (sqlx), problem+json errors, the
+//! kerf's HTTP service: axum routes per resource over SQLite or PostgreSQL (sqlx), problem+json errors, the
 //! OpenAPI document with interactive docs, and the embedded web page. Geometry lives in
 //! `kerf_solver`; handlers validate, resolve stored references and hand the work to the solver
 //! on the blocking pool.
@@ -12,6 +12,7 @@ pub mod error;
 pub mod extract;
 pub mod http;
 pub mod jobs;
+pub mod metrics;
 pub mod openapi;
 pub mod state;
 pub mod store;

@@ -5,10 +5,10 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use sqlx::SqlitePool;
 use tokio::sync::Semaphore;
 
 use crate::auth::Auth;
+use crate::db::Db;
 use crate::error::{AppError, AppResult};
 use crate::jobs::queue::JobRunner;
 
@@ -52,11 +52,18 @@ impl Default for Limits {
     }
 }
 
+/// The store, for handlers that need nothing else (`/metrics`, `/readyz`).
+impl axum::extract::FromRef<AppState> for Db {
+    fn from_ref(state: &AppState) -> Self {
+        state.db.clone()
+    }
+}
+
 /// Everything a handler needs; cheap to clone.
 #[derive(Debug, Clone)]
 pub struct AppState {
-    /// The SQLite pool.
-    pub db: SqlitePool,
+    /// The store (SQLite or PostgreSQL).
+    pub db: Db,
     /// Request limits.
     pub limits: Limits,
     /// Permits for solver work running at once (bounds CPU and memory under a burst); shared
@@ -71,8 +78,9 @@ pub struct AppState {
 }
 
 impl AppState {
-    /// State over `db` with `limits`, allowing `solver_slots` solver calls at once, guarded by `auth`.
-    pub fn new(db: SqlitePool, limits: Limits, solver_slots: usize, auth: Auth) -> Self {
+    /// State over `db` with `limits`, allowing `solver_slots` solver calls at once, guarded by
+    /// `auth`, with job leases of `lease` (PostgreSQL).
+    pub fn new(db: Db, limits: Limits, solver_slots: usize, auth: Auth, lease: Duration) -> Self {
         Self {
             answer_budget: Arc::new(Semaphore::new(
                 limits.answer_budget_bytes.div_ceil(1024).clamp(1, Semaphore::MAX_PERMITS),
@@ -80,7 +88,7 @@ impl AppState {
             db,
             limits,
             solver_slots: Arc::new(Semaphore::new(solver_slots.max(1))),
-            jobs: Arc::new(JobRunner::default()),
+            jobs: Arc::new(JobRunner::new(lease)),
             auth,
         }
     }

@@ -1,10 +1,15 @@
-//! Test harness: starts the real service on `127.0.0.1:0` with a temporary SQLite file and talks
-//! HTTP to it, and helpers for the external checks (LinuxCNC's `rs274`, headless Chromium).
+//! Test harness: starts the real service on `127.0.0.1:0` with a temporary SQLite file (or a
+//! throw-away PostgreSQL server, [`postgres`]) and talks HTTP to it, and helpers for the external
+//! checks (LinuxCNC's `rs274`, headless Chromium, PostgreSQL).
+
+pub mod postgres;
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Duration;
 
 use kerf_server::app::Config;
+use kerf_server::db::Database;
 use kerf_server::state::Limits;
 use reqwest::{Client, Response};
 use serde_json::Value;
@@ -12,16 +17,50 @@ use tokio::net::TcpListener;
 use tokio::sync::oneshot;
 use tokio::task::JoinHandle;
 
-/// A running service with its own database in a temporary directory.
+pub use postgres::PgServer;
+
+/// Which store a test runs the service on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Store {
+    /// A temporary SQLite file (the default).
+    Sqlite,
+    /// A throw-away PostgreSQL server of the test's own.
+    Postgres,
+}
+
+/// Runs each `async fn NAME(store: Store)` test body on both stores: a module `NAME` with the
+/// tests `sqlite` and `postgres` (which skips, printing why, when PostgreSQL is not installed).
+#[macro_export]
+macro_rules! on_both_stores {
+    ($($test:ident),+ $(,)?) => {
+        $(
+            mod $test {
+                #[tokio::test(flavor = "multi_thread")]
+                async fn sqlite() {
+                    super::$test($crate::Store::Sqlite).await;
+                }
+
+                #[tokio::test(flavor = "multi_thread")]
+                async fn postgres() {
+                    super::$test($crate::Store::Postgres).await;
+                }
+            }
+        )+
+    };
+}
+
+/// A running service with its own database in a temporary directory or PostgreSQL server.
 pub struct TestApp {
     /// `http://127.0.0.1:PORT`.
     pub base: String,
     /// HTTP client.
     pub client: Client,
-    /// The database file.
+    /// The SQLite database file (unused on PostgreSQL).
     pub database: PathBuf,
     /// The configuration it was started with.
     pub config: Config,
+    /// The PostgreSQL server it uses, if any (kept running while the app is).
+    pub postgres: Option<Arc<PgServer>>,
     directory: tempfile::TempDir,
     stop: Option<oneshot::Sender<()>>,
     task: Option<JoinHandle<std::io::Result<()>>>,
@@ -40,13 +79,36 @@ impl TestApp {
 
     /// Starts a service with the default configuration changed by `adjust`.
     pub async fn spawn_configured(adjust: impl FnOnce(&mut Config)) -> Self {
+        Self::spawn_at(None, adjust).await
+    }
+
+    /// Starts a service on `store` with the default configuration changed by `adjust`; `None`
+    /// (the test skips, having printed why) when the store is PostgreSQL and it is not installed.
+    pub async fn spawn_on(store: Store, adjust: impl FnOnce(&mut Config)) -> Option<Self> {
+        let postgres = match store {
+            Store::Sqlite => None,
+            Store::Postgres => Some(Arc::new(PgServer::start()?)),
+        };
+        Some(Self::spawn_at(postgres, adjust).await)
+    }
+
+    /// Starts a second API node on this one's database (PostgreSQL: the same server).
+    pub async fn spawn_beside(&self, adjust: impl FnOnce(&mut Config)) -> Self {
+        let mut config = self.config.clone();
+        adjust(&mut config);
+        let postgres = self.postgres.clone();
+        Self::spawn_at(postgres, |c| *c = config).await
+    }
+
+    async fn spawn_at(postgres: Option<Arc<PgServer>>, adjust: impl FnOnce(&mut Config)) -> Self {
         let directory = tempfile::tempdir().expect("temporary directory");
         let database = directory.path().join("kerf.db");
         let mut config = Config {
-            database: database.clone(),
+            database: postgres.as_ref().map_or_else(|| Database::Sqlite(database.clone()), |pg| pg.database()),
             limits: Limits::default(),
             solver_slots: 2,
             job_workers: 2,
+            job_lease: Duration::from_secs(15),
             auth: kerf_server::auth::Auth::default(),
         };
         adjust(&mut config);
@@ -55,6 +117,7 @@ impl TestApp {
             client: Client::builder().timeout(Duration::from_secs(60)).build().expect("client"),
             database,
             config,
+            postgres,
             directory,
             stop: None,
             task: None,
@@ -175,27 +238,50 @@ pub struct ServerProcess {
 impl ServerProcess {
     /// Starts `program serve` on `database` at a free loopback port and waits until it answers.
     pub async fn start(program: &Path, database: &Path) -> Self {
-        let port = std::net::TcpListener::bind("127.0.0.1:0").and_then(|l| l.local_addr()).expect("free port").port();
+        Self::start_with(program, &["serve", "--database", &database.to_string_lossy()]).await
+    }
+
+    /// Starts `program` with `arguments` and `--bind` (`serve`) or `--metrics-bind` (`worker`)
+    /// at a free loopback port, and waits until it answers `/healthz` there.
+    pub async fn start_with(program: &Path, arguments: &[&str]) -> Self {
+        let port = free_port();
+        let bind = if arguments.first() == Some(&"worker") { "--metrics-bind" } else { "--bind" };
         let child = std::process::Command::new(program)
-            .arg("serve")
-            .arg("--bind")
+            .args(arguments)
+            .arg(bind)
             .arg(format!("127.0.0.1:{port}"))
-            .arg("--database")
-            .arg(database)
-            .env("RUST_LOG", "warn")
+            .env("RUST_LOG", std::env::var("KERF_TEST_LOG").unwrap_or_else(|_| "warn".to_owned()))
             .stdout(std::process::Stdio::null())
-            .stderr(std::process::Stdio::null())
+            .stderr(if std::env::var_os("KERF_TEST_LOG").is_some() {
+                std::process::Stdio::inherit()
+            } else {
+                std::process::Stdio::null()
+            })
             .spawn()
             .expect("server starts");
-        let server = Self { base: format!("http://127.0.0.1:{port}"), child };
+        let mut server = Self { base: format!("http://127.0.0.1:{port}"), child };
         let client = Client::new();
-        for _ in 0..200 {
+        for _ in 0..400 {
             if client.get(format!("{}/healthz", server.base)).send().await.is_ok_and(|r| r.status().is_success()) {
                 return server;
+            }
+            if let Ok(Some(status)) = server.child.try_wait() {
+                panic!("{} {arguments:?} exited with {status} before answering", program.display());
             }
             tokio::time::sleep(Duration::from_millis(50)).await;
         }
         panic!("the server did not come up on port {port}");
+    }
+
+    /// The process id (to send it signals).
+    pub fn id(&self) -> u32 {
+        self.child.id()
+    }
+
+    /// Asks the process to stop (SIGTERM) and waits for it.
+    pub fn terminate(mut self) {
+        let _ = std::process::Command::new("kill").arg("-TERM").arg(self.child.id().to_string()).status();
+        let _ = self.child.wait();
     }
 
     /// Kills the process at once (SIGKILL), as a power cut or `kill -9` would.
@@ -210,6 +296,11 @@ impl Drop for ServerProcess {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
+}
+
+/// A loopback port free right now.
+pub fn free_port() -> u16 {
+    std::net::TcpListener::bind("127.0.0.1:0").and_then(|l| l.local_addr()).expect("free port").port()
 }
 
 /// Polls job `id` at `base` until `done(job)` or `seconds` pass; returns the last state.

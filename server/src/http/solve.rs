@@ -40,6 +40,7 @@ pub async fn answer<C: Capability>(
             capabilities::solve::<C>(&request, resolved, &run, ask.gcode.then_some(&ask.output), ask.timings)
         })
         .await??;
+    crate::metrics::observe_solver(C::NAME, seconds);
     let (bytes, media_type) = match delivered {
         Delivered::Program(program) => (Bytes::from(program), "text/x-gcode; charset=utf-8"),
         Delivered::Json(bytes) => (Bytes::from(bytes), "application/json"),

@@ -33,32 +33,52 @@ pub fn execute(
     cancelled: &AtomicBool,
 ) -> Result<Vec<Stored>, JobFailure> {
     let count = job.operations.len();
-    let output = job.output.for_programs();
     let mut outputs = Vec::with_capacity(count);
-    for (index, operation) in job.operations.iter().enumerate() {
-        if cancelled.load(Ordering::Relaxed) {
-            return Err(JobFailure::Cancelled);
-        }
-        // Solvers report from their worker threads, not always in order: pass on increases
-        // only, scaled into this operation's share of the job.
-        let reached = Mutex::new(0.0_f64);
-        let within = |fraction: f64| {
-            let mut reached = reached.lock().unwrap_or_else(PoisonError::into_inner);
-            if fraction > *reached {
-                *reached = fraction;
-                progress((index as f64 + fraction) / count as f64);
-            }
-        };
-        let run = Run {
-            control: Control { progress: Some(&within), cancel: Some(cancelled) },
-            upload: None,
-            purpose: Purpose::Job,
-        };
-        let stored = operation.run(job, &run, &output).map_err(|error| failure(index, error))?;
-        outputs.push(stored);
+    for index in 0..count {
+        let within = |fraction: f64| progress((index as f64 + fraction) / count as f64);
+        outputs.push(execute_operation(job, index, &within, cancelled)?);
         progress((index + 1) as f64 / count as f64);
     }
     Ok(outputs)
+}
+
+/// Runs operation `index` of `job` alone (a chunk of the job: what one worker claims on
+/// PostgreSQL), exactly as [`execute`] runs it among the others. `progress` receives the
+/// fraction of this operation done (0–1), increasing only.
+///
+/// # Errors
+/// The operation's refusal (its fields under `operations[index]`), or the cancellation.
+pub fn execute_operation(
+    job: &JobFile,
+    index: usize,
+    progress: &(dyn Fn(f64) + Sync),
+    cancelled: &AtomicBool,
+) -> Result<Stored, JobFailure> {
+    let Some(operation) = job.operations.get(index) else {
+        let error = AppError::Internal(anyhow::anyhow!("the job has no operation {index}"));
+        return Err(JobFailure::Refused(Box::new(error.problem())));
+    };
+    if cancelled.load(Ordering::Relaxed) {
+        return Err(JobFailure::Cancelled);
+    }
+    // Solvers report from their worker threads, not always in order: pass on increases only.
+    let reached = Mutex::new(0.0_f64);
+    let within = |fraction: f64| {
+        let mut reached = reached.lock().unwrap_or_else(PoisonError::into_inner);
+        if fraction > *reached {
+            *reached = fraction;
+            progress(fraction);
+        }
+    };
+    let run = Run {
+        control: Control { progress: Some(&within), cancel: Some(cancelled) },
+        upload: None,
+        purpose: Purpose::Job,
+    };
+    let started = std::time::Instant::now();
+    let stored = operation.run(job, &run, &job.output.for_programs()).map_err(|error| failure(index, error))?;
+    crate::metrics::observe_solver(operation.name(), started.elapsed().as_secs_f64());
+    Ok(stored)
 }
 
 fn failure(index: usize, error: AppError) -> JobFailure {

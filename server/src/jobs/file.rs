@@ -31,10 +31,10 @@ use kerf_solver::predict::Stock;
 use kerf_solver::tool::{Tool, ToolRef};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
-use sqlx::SqlitePool;
 use utoipa::ToSchema;
 
 use crate::capabilities::{Catalog, Operation, machine_in, tool_in};
+use crate::db::Db;
 use crate::error::{AppError, AppResult};
 use crate::store;
 
@@ -296,7 +296,7 @@ impl JobFile {
     ///
     /// # Errors
     /// 404 naming `operations[i].tool` or `operations[i].machine` for an unknown reference.
-    pub async fn resolve(mut self, db: Option<&SqlitePool>) -> AppResult<Self> {
+    pub async fn resolve(mut self, db: Option<&Db>) -> AppResult<Self> {
         let given = Catalog { tools: std::mem::take(&mut self.tools), machines: std::mem::take(&mut self.machines) };
         let found = match db {
             Some(db) => store::catalog(db, self.operations.iter().map(Operation::refs), given).await?,

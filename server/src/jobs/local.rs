@@ -3,15 +3,13 @@
 
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
-use std::str::FromStr;
 use std::sync::atomic::AtomicBool;
 
 use anyhow::{Context, bail};
-use sqlx::SqlitePool;
-use sqlx::sqlite::{SqliteConnectOptions, SqlitePoolOptions};
 
 use super::execute::{JobFailure, execute};
 use super::file::{self, Format};
+use crate::db::{self, Database};
 use crate::error::AppError;
 
 /// What `kerf run` wrote.
@@ -26,11 +24,6 @@ fn describe(error: &AppError) -> String {
     format!("{} ({})", problem.detail, problem.code)
 }
 
-async fn open_tools(database: &Path) -> anyhow::Result<SqlitePool> {
-    let options = SqliteConnectOptions::from_str("sqlite:")?.filename(database).read_only(true);
-    Ok(SqlitePoolOptions::new().max_connections(1).connect_with(options).await?)
-}
-
 /// Runs the job file at `path`, resolving tool numbers (and machine names) against `database`
 /// when it exists, and writes `job.json`, one `NN-operation.json` per operation and its
 /// `NN-operation.nc` program into `out`.
@@ -38,13 +31,13 @@ async fn open_tools(database: &Path) -> anyhow::Result<SqlitePool> {
 /// # Errors
 /// When the file cannot be read or parsed, a tool is unknown, an operation is refused, or the
 /// outputs cannot be written; the message names the line and field where known.
-pub async fn run(path: &Path, out: &Path, database: Option<&Path>) -> anyhow::Result<RunReport> {
+pub async fn run(path: &Path, out: &Path, database: Option<&Database>) -> anyhow::Result<RunReport> {
     let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let format = Format::detect(path.file_name().and_then(|n| n.to_str()), None, &text);
     let job = file::parse(&text, format).map_err(|e| anyhow::anyhow!("{}: {}", path.display(), describe(&e)))?;
     let pool = match database {
-        Some(database) if database.exists() => Some(open_tools(database).await?),
-        _ => None,
+        Some(database) => db::open_read_only(database).await?,
+        None => None,
     };
     let job = job.resolve(pool.as_ref()).await.map_err(|e| anyhow::anyhow!("{}: {}", path.display(), describe(&e)))?;
 

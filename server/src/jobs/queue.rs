@@ -1,80 +1,174 @@
-//! The job workers: a bounded pool of tasks that claim queued jobs from SQLite, run them on the
+//! The job workers: a bounded pool of tasks that claim jobs from the store, run them on the
 //! blocking pool under the shared solver bound, record progress and heartbeat, and store the
 //! results; plus cancellation of running jobs and recovery after a stop.
+//!
+//! The same workers run inside `kerf serve` (SQLite or PostgreSQL) and in `kerf worker`
+//! processes (PostgreSQL). With PostgreSQL a listener wakes idle workers on `NOTIFY kerf_jobs`
+//! and stops a cancelled job on `NOTIFY kerf_cancel`, whichever process cancelled it; polling
+//! every [`IDLE_POLL`] is only the fallback (a lost notification, a lease that expired). A
+//! heartbeat that finds the job no longer the worker's (cancelled, or re-claimed after its lease
+//! expired) stops it too.
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use sqlx::SqlitePool;
+use sqlx::PgPool;
+use sqlx::postgres::PgListener;
 use tokio::sync::{Notify, Semaphore};
 
-use super::execute::{JobFailure, execute};
+use super::execute::{JobFailure, execute, execute_operation};
+use crate::db::Db;
 use crate::error::AppError;
 use crate::store;
+use crate::store::jobs::{CANCEL_CHANNEL, Claimant, Claimed, SUBMITTED_CHANNEL, Work};
 
 /// How often a running job's progress and heartbeat are written.
 const HEARTBEAT: Duration = Duration::from_millis(250);
 /// How often idle workers look for work without being woken.
-const IDLE_POLL: Duration = Duration::from_secs(2);
+pub const IDLE_POLL: Duration = Duration::from_secs(2);
+/// How long a claimed job stays a worker's without a heartbeat (PostgreSQL), by default.
+pub const DEFAULT_LEASE: Duration = Duration::from_secs(15);
 
-/// Coordination between the HTTP handlers and the workers.
-#[derive(Debug, Default)]
+/// Coordination between the HTTP handlers, the listener and the workers of one process.
+#[derive(Debug)]
 pub struct JobRunner {
     /// Wakes idle workers when a job is submitted.
     pub submitted: Notify,
-    cancel_flags: Mutex<HashMap<i64, Arc<AtomicBool>>>,
-    /// Set at shutdown: workers claim nothing more.
-    stopping: AtomicBool,
+    cancel_flags: Mutex<HashMap<Work, Arc<AtomicBool>>>,
+    claimant: Claimant,
+}
+
+impl Default for JobRunner {
+    fn default() -> Self {
+        Self::new(DEFAULT_LEASE)
+    }
+}
+
+/// A name for this process among all that share the database: host, process id and start time.
+fn worker_name() -> String {
+    let host = std::env::var("HOSTNAME")
+        .ok()
+        .or_else(|| std::fs::read_to_string("/etc/hostname").ok())
+        .map(|h| h.trim().to_owned())
+        .filter(|h| !h.is_empty())
+        .unwrap_or_else(|| "kerf".to_owned());
+    let started = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
+    format!("{host}:{}:{}", std::process::id(), started.as_millis())
 }
 
 impl JobRunner {
-    /// Tells the worker running job `id`, if any, to stop.
+    /// A runner whose claims hold for `lease` without a heartbeat.
+    pub fn new(lease: Duration) -> Self {
+        Self {
+            submitted: Notify::new(),
+            cancel_flags: Mutex::default(),
+            claimant: Claimant { worker: worker_name(), lease: lease.max(Duration::from_secs(1)) },
+        }
+    }
+
+    /// The name this process's workers write on the jobs they run.
+    pub fn worker(&self) -> &str {
+        &self.claimant.worker
+    }
+
+    /// Tells the workers running job `id` (or chunks of it) in this process, if any, to stop.
     pub fn cancel(&self, id: i64) {
-        if let Some(flag) = self.flags().get(&id) {
-            flag.store(true, Ordering::Relaxed);
+        for (work, flag) in self.flags().iter() {
+            if work.id == id {
+                flag.store(true, Ordering::Relaxed);
+            }
         }
     }
 
-    /// Tells every running job to stop, at shutdown: a stopped job keeps its `running` record,
-    /// which the next start re-queues (as after a kill).
-    pub fn stop_all(&self) {
-        self.stopping.store(true, Ordering::Relaxed);
-        for flag in self.flags().values() {
-            flag.store(true, Ordering::Relaxed);
-        }
-    }
-
-    fn flags(&self) -> std::sync::MutexGuard<'_, HashMap<i64, Arc<AtomicBool>>> {
+    fn flags(&self) -> std::sync::MutexGuard<'_, HashMap<Work, Arc<AtomicBool>>> {
         self.cancel_flags.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 
-    /// Re-queues or fails the jobs a stopped server left running, then starts `workers` workers.
+    /// Hands the jobs this process is running back to the queue (PostgreSQL; on a graceful stop).
+    pub async fn release(&self, db: &Db) {
+        for flag in self.flags().values() {
+            flag.store(true, Ordering::Relaxed);
+        }
+        match store::jobs::release(db, &self.claimant).await {
+            Ok(0) => {}
+            Ok(released) => tracing::info!(released, "running jobs handed back to the queue"),
+            Err(error) => tracing::warn!(%error, "handing running jobs back failed; their leases will expire"),
+        }
+    }
+
+    /// Re-queues or fails the jobs a stopped server left running (SQLite), then starts `workers`
+    /// workers, and with PostgreSQL the listener that wakes them. `workers` may be 0: an API node
+    /// that runs no jobs itself.
     ///
     /// # Errors
     /// When the recovery update fails.
-    pub async fn start(
-        self: &Arc<Self>,
-        db: &SqlitePool,
-        slots: &Arc<Semaphore>,
-        workers: usize,
-    ) -> anyhow::Result<()> {
+    pub async fn start(self: &Arc<Self>, db: &Db, slots: &Arc<Semaphore>, workers: usize) -> anyhow::Result<()> {
         let (requeued, failed) = store::jobs::recover(db).await.map_err(|e| anyhow::anyhow!("{e}"))?;
         if requeued + failed > 0 {
             tracing::warn!(requeued, failed, "jobs interrupted by the last stop");
         }
-        for _ in 0..workers.max(1) {
+        if workers == 0 {
+            if !db.is_postgres() {
+                tracing::warn!("no job workers: submitted jobs wait until a server with workers starts");
+            }
+            return Ok(());
+        }
+        if let Db::Postgres(pool) = db {
+            tokio::spawn(listen(Arc::clone(self), pool.clone()));
+        }
+        for _ in 0..workers {
             tokio::spawn(work(Arc::clone(self), db.clone(), Arc::clone(slots)));
         }
+        tracing::info!(workers, worker = %self.claimant.worker, "job workers started");
         Ok(())
     }
 }
 
-async fn work(runner: Arc<JobRunner>, db: SqlitePool, slots: Arc<Semaphore>) {
-    while !runner.stopping.load(Ordering::Relaxed) {
-        match store::jobs::claim(&db).await {
-            Ok(Some((id, job))) => run(&runner, &db, &slots, id, job).await,
+/// Wakes idle workers on `kerf_jobs` and stops cancelled jobs on `kerf_cancel`; reconnects
+/// after a lost connection (the workers poll meanwhile).
+async fn listen(runner: Arc<JobRunner>, pool: PgPool) {
+    loop {
+        let mut listener = match PgListener::connect_with(&pool).await {
+            Ok(listener) => listener,
+            Err(error) => {
+                tracing::warn!(%error, "LISTEN connection failed; polling until it is back");
+                tokio::time::sleep(IDLE_POLL).await;
+                continue;
+            }
+        };
+        if let Err(error) = listener.listen_all([SUBMITTED_CHANNEL, CANCEL_CHANNEL]).await {
+            tracing::warn!(%error, "LISTEN failed; polling until it works");
+            tokio::time::sleep(IDLE_POLL).await;
+            continue;
+        }
+        loop {
+            match listener.recv().await {
+                Ok(notification) if notification.channel() == CANCEL_CHANNEL => {
+                    if let Ok(id) = notification.payload().parse() {
+                        runner.cancel(id);
+                    }
+                }
+                Ok(_) => runner.submitted.notify_one(),
+                Err(error) => {
+                    tracing::warn!(%error, "LISTEN connection lost; reconnecting");
+                    // Anything submitted meanwhile is found by the next claim.
+                    runner.submitted.notify_waiters();
+                    break;
+                }
+            }
+        }
+    }
+}
+
+async fn work(runner: Arc<JobRunner>, db: Db, slots: Arc<Semaphore>) {
+    loop {
+        match store::jobs::claim(&db, &runner.claimant).await {
+            Ok(Some(claimed)) => {
+                crate::metrics::chunk_claimed();
+                run(&runner, &db, &slots, claimed).await;
+            }
             Ok(None) => {
                 let _ = tokio::time::timeout(IDLE_POLL, runner.submitted.notified()).await;
             }
@@ -86,15 +180,22 @@ async fn work(runner: Arc<JobRunner>, db: SqlitePool, slots: Arc<Semaphore>) {
     }
 }
 
-async fn run(runner: &JobRunner, db: &SqlitePool, slots: &Arc<Semaphore>, id: i64, job: super::file::JobFile) {
+async fn run(runner: &JobRunner, db: &Db, slots: &Arc<Semaphore>, Claimed { work, job, attempt }: Claimed) {
+    let claimant = &runner.claimant;
+    let id = work.id;
+    tracing::info!(id, chunk = ?work.chunk, attempt, worker = %claimant.worker, "claimed");
     let cancelled = Arc::new(AtomicBool::new(false));
-    runner.flags().insert(id, Arc::clone(&cancelled));
+    runner.flags().insert(work, Arc::clone(&cancelled));
     let progress = Arc::new(AtomicU64::new(0));
     let Ok(permit) = Arc::clone(slots).acquire_owned().await else { return };
     let (task_progress, task_cancelled) = (Arc::clone(&progress), Arc::clone(&cancelled));
     let mut task = tokio::task::spawn_blocking(move || {
         let _permit = permit;
-        execute(&job, &|fraction| task_progress.store(fraction.to_bits(), Ordering::Relaxed), &task_cancelled)
+        let report = |fraction: f64| task_progress.store(fraction.to_bits(), Ordering::Relaxed);
+        match work.chunk {
+            None => execute(&job, &report, &task_cancelled),
+            Some(index) => execute_operation(&job, index, &report, &task_cancelled).map(|stored| vec![stored]),
+        }
     });
     let mut ticker = tokio::time::interval(HEARTBEAT);
     let outcome = loop {
@@ -102,24 +203,45 @@ async fn run(runner: &JobRunner, db: &SqlitePool, slots: &Arc<Semaphore>, id: i6
             outcome = &mut task => break outcome,
             _ = ticker.tick() => {
                 let fraction = f64::from_bits(progress.load(Ordering::Relaxed));
-                if let Err(error) = store::jobs::heartbeat(db, id, fraction).await {
-                    tracing::warn!(id, %error, "recording progress failed");
+                match store::jobs::heartbeat(db, work, claimant, fraction).await {
+                    Ok(true) => {}
+                    // Cancelled, or no longer ours: stop computing.
+                    Ok(false) => cancelled.store(true, Ordering::Relaxed),
+                    Err(error) => tracing::warn!(id, %error, "recording progress failed"),
                 }
             }
         }
     };
-    runner.flags().remove(&id);
+    runner.flags().remove(&work);
     let stored = match outcome {
-        Ok(Ok(outputs)) => store::jobs::finish(db, id, &outputs).await.map(|_| ()),
+        Ok(Ok(outputs)) => finish(db, work, claimant, &outputs).await,
         Ok(Err(JobFailure::Cancelled)) => Ok(()),
-        Ok(Err(JobFailure::Refused(problem))) => store::jobs::fail(db, id, &problem).await,
+        Ok(Err(JobFailure::Refused(problem))) => store::jobs::fail(db, work, claimant, &problem).await,
         Err(join_error) => {
             tracing::error!(id, %join_error, "job task failed");
             let internal = AppError::Internal(anyhow::anyhow!("the job's task failed"));
-            store::jobs::fail(db, id, &internal.problem()).await
+            store::jobs::fail(db, work, claimant, &internal.problem()).await
         }
     };
     if let Err(error) = stored {
         tracing::error!(id, %error, "storing the job outcome failed");
+    }
+}
+
+/// Stores finished work, once more after a failure (two finishers of one job's chunks can meet
+/// in a deadlock that PostgreSQL breaks by failing one of them). Work that cannot be stored is not
+/// lost: its chunk's lease expires and another worker runs it again.
+async fn finish(
+    db: &Db,
+    work: Work,
+    claimant: &Claimant,
+    outputs: &[crate::capabilities::Stored],
+) -> crate::error::AppResult<()> {
+    match store::jobs::finish(db, work, claimant, outputs).await {
+        Ok(_) => Ok(()),
+        Err(error) => {
+            tracing::warn!(id = work.id, %error, "storing the result failed; once more");
+            store::jobs::finish(db, work, claimant, outputs).await.map(|_| ())
+        }
     }
 }

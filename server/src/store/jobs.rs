@@ -1,12 +1,26 @@
-//! The job queue in SQLite (issue 7): jobs with status, progress, attempts and heartbeat, and
-//! their results. Workers claim the oldest queued job with one atomic UPDATE.
+//! The job queue (issue 7; issue 12): jobs with status, progress, attempts and heartbeat, and
+//! their results.
+//!
+//! In SQLite one process owns the queue: its workers claim the oldest queued job with one atomic
+//! UPDATE, and at start every job left `running` is queued again ([`recover`]). In PostgreSQL any
+//! number of processes share it, and a job is split into chunks (one per operation) that
+//! different workers run at once: a worker claims a chunk in a short transaction with
+//! `SELECT … FOR UPDATE SKIP LOCKED` (concurrent claimers skip each other's rows instead of
+//! waiting), writes its name and a lease on the chunk, and pushes the lease forward with each
+//! heartbeat; a running chunk whose lease expired (its worker died, `kill -9`) is claimed again
+//! like a queued one. Each chunk stores its operation's result; the last one marks the job done.
+//! Submissions and cancellations `NOTIFY` the workers (`kerf_jobs`, `kerf_cancel`); every write
+//! of a running chunk checks that it is still the writer's and its job still running.
 
 use kerf_solver::ErrorCode;
 use serde::Serialize;
-use sqlx::SqlitePool;
+use std::time::Duration;
+
 use utoipa::ToSchema;
 
+use super::on;
 use crate::capabilities::Stored;
+use crate::db::Db;
 use crate::error::{AppError, AppResult, FieldProblem, Problem};
 use crate::jobs::file::JobFile;
 
@@ -20,17 +34,42 @@ macro_rules! now {
     };
 }
 
-/// The columns of a [`JobRow`].
+/// The columns of a [`JobRow`] in SQLite.
 macro_rules! columns {
     () => {
         "id, name, status, progress, operations, attempts, error, error_field, submitted_at, started_at, finished_at"
     };
 }
 
+/// A PostgreSQL timestamp column as SQLite stores them (`2026-01-02T03:04:05.678Z`).
+macro_rules! pg_time {
+    ($column:literal) => {
+        concat!("to_char(", $column, " AT TIME ZONE 'UTC', 'YYYY-MM-DD\"T\"HH24:MI:SS.MS\"Z\"') AS ", $column)
+    };
+}
+
+/// The columns of a [`JobRow`] in PostgreSQL.
+macro_rules! pg_columns {
+    () => {
+        concat!(
+            "id, name, status, progress, operations, attempts, error, error_field, ",
+            pg_time!("submitted_at"),
+            ", ",
+            pg_time!("started_at"),
+            ", ",
+            pg_time!("finished_at")
+        )
+    };
+}
+
+/// The channel a submission notifies (payload: the job id).
+pub const SUBMITTED_CHANNEL: &str = "kerf_jobs";
+/// The channel a cancellation notifies (payload: the job id).
+pub const CANCEL_CHANNEL: &str = "kerf_cancel";
+
 /// Where a job is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema, sqlx::Type)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
 #[serde(rename_all = "snake_case")]
-#[sqlx(rename_all = "snake_case")]
 pub enum JobStatus {
     /// Waiting for a worker.
     Queued,
@@ -42,6 +81,20 @@ pub enum JobStatus {
     Failed,
     /// Cancelled by `DELETE`.
     Cancelled,
+}
+
+impl JobStatus {
+    /// The status stored as `text` (the `status` column's CHECK allows no other).
+    fn parse(text: &str) -> AppResult<Self> {
+        Ok(match text {
+            "queued" => Self::Queued,
+            "running" => Self::Running,
+            "done" => Self::Done,
+            "failed" => Self::Failed,
+            "cancelled" => Self::Cancelled,
+            other => return Err(AppError::Internal(anyhow::anyhow!("unknown stored job status {other:?}"))),
+        })
+    }
 }
 
 /// A job as listed and shown.
@@ -76,10 +129,10 @@ pub struct JobRecord {
 struct JobRow {
     id: i64,
     name: Option<String>,
-    status: JobStatus,
+    status: String,
     progress: f64,
-    #[sqlx(json)]
-    operations: Vec<String>,
+    /// JSON array of names.
+    operations: String,
     attempts: i64,
     error: Option<String>,
     error_field: Option<String>,
@@ -88,21 +141,25 @@ struct JobRow {
     finished_at: Option<String>,
 }
 
-impl From<JobRow> for JobRecord {
-    fn from(row: JobRow) -> Self {
+impl TryFrom<JobRow> for JobRecord {
+    type Error = AppError;
+
+    fn try_from(row: JobRow) -> AppResult<Self> {
         let error = row.error.map(|text| stored_problem(&text, row.error_field));
-        Self {
+        let operations = serde_json::from_str(&row.operations)
+            .map_err(|error| AppError::Internal(anyhow::anyhow!("stored operations are unreadable: {error}")))?;
+        Ok(Self {
             id: row.id,
             name: row.name,
-            status: row.status,
+            status: JobStatus::parse(&row.status)?,
             progress: row.progress,
-            operations: row.operations,
+            operations,
             attempts: row.attempts,
             error,
             submitted_at: row.submitted_at,
             started_at: row.started_at,
             finished_at: row.finished_at,
-        }
+        })
     }
 }
 
@@ -138,194 +195,439 @@ fn problem_json(problem: &Problem) -> AppResult<String> {
     serde_json::to_string(problem).map_err(|e| AppError::Internal(e.into()))
 }
 
-/// Stores a new queued job; returns its id.
-pub async fn insert(db: &SqlitePool, job: &JobFile, hash: &str) -> AppResult<i64> {
+/// Who claims work: the worker's name, written on the chunk it runs, and how long its lease lasts
+/// without a heartbeat (PostgreSQL; SQLite has one process and no leases).
+#[derive(Debug, Clone)]
+pub struct Claimant {
+    /// Unique among the processes sharing the database (host, process id, start time).
+    pub worker: String,
+    /// How long a claimed chunk stays this worker's without a heartbeat.
+    pub lease: Duration,
+}
+
+/// What a worker runs: a whole job (SQLite), or one chunk of it (PostgreSQL: operation `chunk`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Work {
+    /// Job id.
+    pub id: i64,
+    /// The operation this chunk is, or `None` for the whole job.
+    pub chunk: Option<usize>,
+}
+
+impl Work {
+    fn position(self) -> i64 {
+        self.chunk.map_or(0, |chunk| i64::try_from(chunk).unwrap_or(i64::MAX))
+    }
+}
+
+/// Work a worker claimed.
+#[derive(Debug)]
+pub struct Claimed {
+    /// The job, and the chunk of it.
+    pub work: Work,
+    /// The resolved job.
+    pub job: JobFile,
+    /// Which attempt this is (1 for the first).
+    pub attempt: i64,
+}
+
+/// Stores a new queued job (PostgreSQL: with one chunk per operation) and wakes the workers;
+/// returns its id.
+pub async fn insert(db: &Db, job: &JobFile, hash: &str) -> AppResult<i64> {
     let json = serde_json::to_string(job).map_err(|e| AppError::Internal(e.into()))?;
     let operations: Vec<&str> = job.operations.iter().map(|o| o.name()).collect();
+    let count = i64::try_from(operations.len()).unwrap_or(i64::MAX);
     let operations = serde_json::to_string(&operations).map_err(|e| AppError::Internal(e.into()))?;
-    let (id,): (i64,) = sqlx::query_as(
-        "INSERT INTO jobs (name, status, content_hash, job_json, operations) VALUES (?, 'queued', ?, ?, ?) RETURNING id",
-    )
-    .bind(&job.name)
-    .bind(hash)
-    .bind(json)
-    .bind(operations)
-    .fetch_one(db)
-    .await?;
-    Ok(id)
+    const INSERT: &str = "INSERT INTO jobs (name, status, content_hash, job_json, operations)
+         VALUES ($1, 'queued', $2, $3, $4) RETURNING id";
+    match db {
+        Db::Sqlite(pool) => {
+            let (id,): (i64,) =
+                sqlx::query_as(INSERT).bind(&job.name).bind(hash).bind(json).bind(operations).fetch_one(pool).await?;
+            Ok(id)
+        }
+        Db::Postgres(pool) => {
+            // The notification is delivered at commit, when the chunks are there to claim.
+            let mut transaction = pool.begin().await?;
+            let (id,): (i64,) = sqlx::query_as(INSERT)
+                .bind(&job.name)
+                .bind(hash)
+                .bind(json)
+                .bind(operations)
+                .fetch_one(&mut *transaction)
+                .await?;
+            sqlx::query(
+                "INSERT INTO job_chunks (job_id, position, status) SELECT $1, generate_series(0, $2 - 1), 'queued'",
+            )
+            .bind(id)
+            .bind(count)
+            .execute(&mut *transaction)
+            .await?;
+            sqlx::query("SELECT pg_notify($1, $2)")
+                .bind(SUBMITTED_CHANNEL)
+                .bind(id.to_string())
+                .execute(&mut *transaction)
+                .await?;
+            transaction.commit().await?;
+            Ok(id)
+        }
+    }
 }
 
 /// A finished job with the same content, if any.
-pub async fn find_done(db: &SqlitePool, hash: &str) -> AppResult<Option<i64>> {
-    let row: Option<(i64,)> =
-        sqlx::query_as("SELECT id FROM jobs WHERE content_hash = ? AND status = 'done' ORDER BY id LIMIT 1")
-            .bind(hash)
-            .fetch_optional(db)
-            .await?;
+pub async fn find_done(db: &Db, hash: &str) -> AppResult<Option<i64>> {
+    let row: Option<(i64,)> = on!(db, query_as,
+        both: "SELECT id FROM jobs WHERE content_hash = $1 AND status = 'done' ORDER BY id LIMIT 1",
+        [hash], fetch_optional)?;
     Ok(row.map(|(id,)| id))
 }
 
 /// One job.
-pub async fn get(db: &SqlitePool, id: i64) -> AppResult<Option<JobRecord>> {
-    let row: Option<JobRow> =
-        sqlx::query_as(concat!("SELECT ", columns!(), " FROM jobs WHERE id = ?")).bind(id).fetch_optional(db).await?;
-    Ok(row.map(JobRecord::from))
+pub async fn get(db: &Db, id: i64) -> AppResult<Option<JobRecord>> {
+    let row: Option<JobRow> = on!(db, query_as,
+        sqlite: concat!("SELECT ", columns!(), " FROM jobs WHERE id = $1"),
+        postgres: concat!("SELECT ", pg_columns!(), " FROM jobs WHERE id = $1"),
+        [id], fetch_optional)?;
+    row.map(JobRecord::try_from).transpose()
 }
 
 /// Up to `limit` jobs with ids below `before`, newest first.
-pub async fn list(db: &SqlitePool, limit: i64, before: Option<i64>) -> AppResult<Vec<JobRecord>> {
-    let rows: Vec<JobRow> =
-        sqlx::query_as(concat!("SELECT ", columns!(), " FROM jobs WHERE id < ? ORDER BY id DESC LIMIT ?"))
-            .bind(before.unwrap_or(i64::MAX))
-            .bind(limit)
-            .fetch_all(db)
-            .await?;
-    Ok(rows.into_iter().map(JobRecord::from).collect())
+pub async fn list(db: &Db, limit: i64, before: Option<i64>) -> AppResult<Vec<JobRecord>> {
+    let rows: Vec<JobRow> = on!(db, query_as,
+        sqlite: concat!("SELECT ", columns!(), " FROM jobs WHERE id < $1 ORDER BY id DESC LIMIT $2"),
+        postgres: concat!("SELECT ", pg_columns!(), " FROM jobs WHERE id < $1 ORDER BY id DESC LIMIT $2"),
+        [before.unwrap_or(i64::MAX), limit], fetch_all)?;
+    rows.into_iter().map(JobRecord::try_from).collect()
 }
 
-/// Claims the oldest queued job for a worker: marks it running and returns it.
-pub async fn claim(db: &SqlitePool) -> AppResult<Option<(i64, JobFile)>> {
-    let row: Option<(i64, String)> = sqlx::query_as(concat!(
-        "UPDATE jobs SET status = 'running', attempts = attempts + 1, progress = 0, started_at = ",
-        now!(),
-        ",
-                heartbeat_at = ",
-        now!(),
-        "
-         WHERE id = (SELECT id FROM jobs WHERE status = 'queued' ORDER BY id LIMIT 1)
-         RETURNING id, job_json"
-    ))
-    .fetch_optional(db)
-    .await?;
-    let Some((id, json)) = row else { return Ok(None) };
+/// Claims the next work for `claimant`. SQLite: the oldest queued job, marked running.
+/// PostgreSQL: the first queued chunk of the oldest job still to run (or a running chunk whose
+/// lease expired), marked running with the claimant's name and lease; its job is marked running
+/// too. A chunk whose lease expired after its last attempt fails its job with `E_INTERRUPTED`.
+pub async fn claim(db: &Db, claimant: &Claimant) -> AppResult<Option<Claimed>> {
+    let (work, json, attempt) = match db {
+        Db::Sqlite(pool) => {
+            let row: Option<(i64, String, i64)> = sqlx::query_as(concat!(
+                "UPDATE jobs SET status = 'running', attempts = attempts + 1, progress = 0, started_at = ",
+                now!(),
+                ", heartbeat_at = ",
+                now!(),
+                " WHERE id = (SELECT id FROM jobs WHERE status = 'queued' ORDER BY id LIMIT 1)
+                 RETURNING id, job_json, attempts"
+            ))
+            .fetch_optional(pool)
+            .await?;
+            let Some((id, json, attempt)) = row else { return Ok(None) };
+            (Work { id, chunk: None }, json, attempt)
+        }
+        Db::Postgres(pool) => {
+            // A chunk of a job cancelled in the meantime is skipped: try the next one.
+            let mut found = None;
+            for _ in 0..8 {
+                match claim_chunk(pool, claimant).await? {
+                    Chunk::None => return Ok(None),
+                    Chunk::Gone => {}
+                    Chunk::Claimed(work, json, attempt) => {
+                        found = Some((work, json, attempt));
+                        break;
+                    }
+                }
+            }
+            let Some(found) = found else { return Ok(None) };
+            found
+        }
+    };
     match serde_json::from_str(&json) {
-        Ok(job) => Ok(Some((id, job))),
+        Ok(job) => Ok(Some(Claimed { work, job, attempt })),
         Err(error) => {
             let detail = format!("the stored job is unreadable: {error}");
-            fail(db, id, &job_problem(422, "Job failed", ErrorCode::JobFile, &detail)).await?;
+            fail(db, work, claimant, &job_problem(422, "Job failed", ErrorCode::JobFile, &detail)).await?;
             Ok(None)
         }
     }
 }
 
-/// Records progress and the heartbeat of a running job.
-pub async fn heartbeat(db: &SqlitePool, id: i64, progress: f64) -> AppResult<()> {
-    sqlx::query(concat!(
-        "UPDATE jobs SET progress = ?, heartbeat_at = ",
-        now!(),
-        " WHERE id = ? AND status = 'running'"
-    ))
-    .bind(progress.clamp(0.0, 1.0))
-    .bind(id)
-    .execute(db)
-    .await?;
-    Ok(())
+/// The outcome of one claim transaction.
+enum Chunk {
+    /// Nothing to run.
+    None,
+    /// A chunk of a job that is no longer to run (cancelled or failed meanwhile).
+    Gone,
+    /// The chunk, its job's JSON and the chunk's attempt.
+    Claimed(Work, String, i64),
 }
 
-/// Stores the results and marks the job done, in one transaction, unless it was cancelled
-/// meanwhile. Returns whether it was stored.
-pub async fn finish(db: &SqlitePool, id: i64, outputs: &[Stored]) -> AppResult<bool> {
-    let mut transaction = db.begin().await?;
-    let updated = sqlx::query(concat!(
-        "UPDATE jobs SET status = 'done', progress = 1, finished_at = ",
-        now!(),
-        " WHERE id = ? AND status = 'running'"
-    ))
-    .bind(id)
+async fn claim_chunk(pool: &sqlx::PgPool, claimant: &Claimant) -> AppResult<Chunk> {
+    let mut transaction = pool.begin().await?;
+    sqlx::query(
+        "WITH dead AS (
+             UPDATE job_chunks SET status = 'failed', lease_expires_at = NULL
+             WHERE (job_id, position) IN (
+                 SELECT job_id, position FROM job_chunks
+                 WHERE status = 'running' AND lease_expires_at < now() AND attempts >= $2
+                 FOR UPDATE SKIP LOCKED)
+             RETURNING job_id)
+         UPDATE jobs SET status = 'failed', finished_at = now(), error = $1
+         WHERE id IN (SELECT job_id FROM dead) AND status IN ('queued', 'running')",
+    )
+    .bind(problem_json(&job_problem(
+        503,
+        "Job interrupted",
+        ErrorCode::Interrupted,
+        &format!("its worker stopped (lease expired) on each of its {MAX_ATTEMPTS} attempts; not retried"),
+    ))?)
+    .bind(MAX_ATTEMPTS)
     .execute(&mut *transaction)
     .await?;
-    if updated.rows_affected() == 0 {
+    let chunk: Option<(i64, i64, i64)> = sqlx::query_as(
+        "WITH next AS (
+             SELECT c.job_id, c.position FROM job_chunks c JOIN jobs j ON j.id = c.job_id
+             WHERE j.status IN ('queued', 'running')
+               AND (c.status = 'queued' OR (c.status = 'running' AND c.lease_expires_at < now()))
+             ORDER BY c.job_id, c.position LIMIT 1
+             FOR UPDATE OF c SKIP LOCKED)
+         UPDATE job_chunks c SET status = 'running', attempts = c.attempts + 1, progress = 0, worker = $1,
+             lease_expires_at = now() + make_interval(secs => $2)
+         FROM next WHERE c.job_id = next.job_id AND c.position = next.position
+         RETURNING c.job_id, c.position, c.attempts",
+    )
+    .bind(&claimant.worker)
+    .bind(claimant.lease.as_secs_f64())
+    .fetch_optional(&mut *transaction)
+    .await?;
+    let Some((id, position, attempt)) = chunk else {
+        transaction.commit().await?;
+        return Ok(Chunk::None);
+    };
+    let job: Option<(String,)> = sqlx::query_as(
+        "UPDATE jobs SET status = 'running', started_at = COALESCE(started_at, now()), heartbeat_at = now(),
+             attempts = GREATEST(attempts, $2)
+         WHERE id = $1 AND status IN ('queued', 'running')
+         RETURNING job_json",
+    )
+    .bind(id)
+    .bind(attempt)
+    .fetch_optional(&mut *transaction)
+    .await?;
+    let Some((json,)) = job else {
+        // Cancelled between the two statements: leave the chunk to nobody.
         transaction.rollback().await?;
-        return Ok(false);
-    }
-    for (position, output) in outputs.iter().enumerate() {
-        let result = output.result.get();
-        sqlx::query(
-            "INSERT INTO job_results (job_id, position, operation, result_json, gcode, gcode_problem)
-             VALUES (?, ?, ?, ?, ?, ?)",
-        )
-        .bind(id)
-        .bind(i64::try_from(position).unwrap_or(i64::MAX))
-        .bind(&output.operation)
-        .bind(result)
-        .bind(&output.gcode)
-        .bind(&output.gcode_problem)
-        .execute(&mut *transaction)
-        .await?;
-    }
+        return Ok(Chunk::Gone);
+    };
     transaction.commit().await?;
+    let chunk = usize::try_from(position).map_err(|e| AppError::Internal(e.into()))?;
+    Ok(Chunk::Claimed(Work { id, chunk: Some(chunk) }, json, attempt))
+}
+
+/// Records progress and the heartbeat of running work (PostgreSQL: of the chunk, extending its
+/// lease; the job's progress is the mean of its chunks'). Returns false when the work is no
+/// longer the claimant's to run: its job was cancelled or failed, or (PostgreSQL) the chunk was
+/// claimed by another worker after this one's lease expired. The worker then stops it.
+pub async fn heartbeat(db: &Db, work: Work, claimant: &Claimant, progress: f64) -> AppResult<bool> {
+    let progress = progress.clamp(0.0, 1.0);
+    match db {
+        Db::Sqlite(pool) => {
+            let updated = sqlx::query(concat!(
+                "UPDATE jobs SET progress = $1, heartbeat_at = ",
+                now!(),
+                " WHERE id = $2 AND status = 'running'"
+            ))
+            .bind(progress)
+            .bind(work.id)
+            .execute(pool)
+            .await?;
+            Ok(updated.rows_affected() > 0)
+        }
+        Db::Postgres(pool) => {
+            let updated = sqlx::query(
+                "UPDATE job_chunks SET progress = $1, lease_expires_at = now() + make_interval(secs => $4)
+                 WHERE job_id = $2 AND position = $5 AND worker = $3 AND status = 'running'
+                   AND EXISTS (SELECT 1 FROM jobs WHERE id = $2 AND status = 'running')",
+            )
+            .bind(progress)
+            .bind(work.id)
+            .bind(&claimant.worker)
+            .bind(claimant.lease.as_secs_f64())
+            .bind(work.position())
+            .execute(pool)
+            .await?;
+            if updated.rows_affected() == 0 {
+                return Ok(false);
+            }
+            sqlx::query(
+                "UPDATE jobs SET heartbeat_at = now(),
+                     progress = (SELECT LEAST(1, GREATEST(0, avg(progress))) FROM job_chunks WHERE job_id = $1)
+                 WHERE id = $1 AND status = 'running'",
+            )
+            .bind(work.id)
+            .execute(pool)
+            .await?;
+            Ok(true)
+        }
+    }
+}
+
+/// Stores the results and marks the work done, in one transaction, unless its job was
+/// cancelled (or, in PostgreSQL, the chunk is no longer the claimant's) meanwhile; in PostgreSQL
+/// the job is done with its last chunk. Returns whether it was stored.
+pub async fn finish(db: &Db, work: Work, claimant: &Claimant, outputs: &[Stored]) -> AppResult<bool> {
+    macro_rules! results_in {
+        ($transaction:expr, $first:expr) => {
+            for (offset, output) in outputs.iter().enumerate() {
+                sqlx::query(
+                    "INSERT INTO job_results (job_id, position, operation, result_json, gcode, gcode_problem)
+                     VALUES ($1, $2, $3, $4, $5, $6)",
+                )
+                .bind(work.id)
+                .bind($first + i64::try_from(offset).unwrap_or(i64::MAX))
+                .bind(&output.operation)
+                .bind(output.result.get())
+                .bind(&output.gcode)
+                .bind(&output.gcode_problem)
+                .execute(&mut *$transaction)
+                .await?;
+            }
+        };
+    }
+    match db {
+        Db::Sqlite(pool) => {
+            let mut transaction = pool.begin().await?;
+            let updated = sqlx::query(concat!(
+                "UPDATE jobs SET status = 'done', progress = 1, finished_at = ",
+                now!(),
+                " WHERE id = $1 AND status = 'running'"
+            ))
+            .bind(work.id)
+            .execute(&mut *transaction)
+            .await?;
+            if updated.rows_affected() == 0 {
+                transaction.rollback().await?;
+                return Ok(false);
+            }
+            results_in!(transaction, 0);
+            transaction.commit().await?;
+        }
+        Db::Postgres(pool) => {
+            let mut transaction = pool.begin().await?;
+            // The job's row first: finishers of one job's chunks take turns, so the last one
+            // sees every other chunk done.
+            let job: Option<(String,)> = sqlx::query_as("SELECT status FROM jobs WHERE id = $1 FOR UPDATE")
+                .bind(work.id)
+                .fetch_optional(&mut *transaction)
+                .await?;
+            let updated = sqlx::query(
+                "UPDATE job_chunks SET status = 'done', progress = 1, lease_expires_at = NULL
+                 WHERE job_id = $1 AND position = $2 AND worker = $3 AND status = 'running'",
+            )
+            .bind(work.id)
+            .bind(work.position())
+            .bind(&claimant.worker)
+            .execute(&mut *transaction)
+            .await?;
+            if job.is_none_or(|(status,)| status != "running") || updated.rows_affected() == 0 {
+                transaction.rollback().await?;
+                return Ok(false);
+            }
+            results_in!(transaction, work.position());
+            sqlx::query(
+                "UPDATE jobs SET status = 'done', progress = 1, finished_at = now()
+                 WHERE id = $1 AND NOT EXISTS (SELECT 1 FROM job_chunks WHERE job_id = $1 AND status <> 'done')",
+            )
+            .bind(work.id)
+            .execute(&mut *transaction)
+            .await?;
+            transaction.commit().await?;
+        }
+    }
     Ok(true)
 }
 
-/// Marks a running job failed with the problem.
-pub async fn fail(db: &SqlitePool, id: i64, problem: &Problem) -> AppResult<()> {
+/// Marks running work's job failed with the problem (PostgreSQL: only while the chunk is the
+/// claimant's; the job's other chunks stop at their next heartbeat).
+pub async fn fail(db: &Db, work: Work, claimant: &Claimant, problem: &Problem) -> AppResult<()> {
     let json = problem_json(problem)?;
     let field = problem.errors.first().map(|error| error.path.clone());
-    sqlx::query(concat!(
-        "UPDATE jobs SET status = 'failed', error = ?, error_field = ?, finished_at = ",
-        now!(),
-        "
-         WHERE id = ? AND status = 'running'"
-    ))
-    .bind(json)
-    .bind(field)
-    .bind(id)
-    .execute(db)
-    .await?;
+    on!(db, query,
+        sqlite: concat!(
+            "UPDATE jobs SET status = 'failed', error = $1, error_field = $2, finished_at = ",
+            now!(),
+            " WHERE id = $3 AND status = 'running'"
+        ),
+        postgres: "WITH chunk AS (
+                       UPDATE job_chunks SET status = 'failed', lease_expires_at = NULL
+                       WHERE job_id = $3 AND position = $5 AND worker = $4 AND status = 'running'
+                       RETURNING job_id)
+                   UPDATE jobs SET status = 'failed', error = $1, error_field = $2, finished_at = now()
+                   WHERE id IN (SELECT job_id FROM chunk) AND status = 'running'",
+        [json, field, work.id, &claimant.worker, work.position()], execute)?;
     Ok(())
 }
 
 /// Cancels a queued or running job. `Ok(None)` if there is no such job; otherwise the status
-/// the job had, and whether this call cancelled it.
-pub async fn cancel(db: &SqlitePool, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
-    let mut transaction = db.begin().await?;
-    let row: Option<(JobStatus,)> =
-        sqlx::query_as("SELECT status FROM jobs WHERE id = ?").bind(id).fetch_optional(&mut *transaction).await?;
-    let Some((status,)) = row else { return Ok(None) };
-    let cancellable = matches!(status, JobStatus::Queued | JobStatus::Running);
-    if cancellable {
-        sqlx::query(concat!(
-            "UPDATE jobs SET status = 'cancelled', finished_at = ",
-            now!(),
-            ", error = ? WHERE id = ?"
-        ))
-        .bind(problem_json(&job_problem(409, "Cancelled", ErrorCode::Cancelled, "cancelled by request"))?)
-        .bind(id)
-        .execute(&mut *transaction)
-        .await?;
+/// the job had, and whether this call cancelled it. In PostgreSQL the workers are notified, so
+/// the one running it stops at once (its heartbeat would find out within a second anyway).
+pub async fn cancel(db: &Db, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
+    let error = problem_json(&job_problem(409, "Cancelled", ErrorCode::Cancelled, "cancelled by request"))?;
+    macro_rules! cancel_in {
+        ($pool:expr, $select:expr, $update:expr, $notify:expr) => {{
+            let mut transaction = $pool.begin().await?;
+            let row: Option<(String,)> = sqlx::query_as($select).bind(id).fetch_optional(&mut *transaction).await?;
+            let Some((status,)) = row else { return Ok(None) };
+            let status = JobStatus::parse(&status)?;
+            let cancellable = matches!(status, JobStatus::Queued | JobStatus::Running);
+            if cancellable {
+                sqlx::query($update).bind(error).bind(id).execute(&mut *transaction).await?;
+                if let Some(notify) = $notify {
+                    sqlx::query(notify).bind(CANCEL_CHANNEL).bind(id.to_string()).execute(&mut *transaction).await?;
+                }
+            }
+            transaction.commit().await?;
+            Ok(Some((status, cancellable)))
+        }};
     }
-    transaction.commit().await?;
-    Ok(Some((status, cancellable)))
+    match db {
+        Db::Sqlite(pool) => cancel_in!(
+            pool,
+            "SELECT status FROM jobs WHERE id = $1",
+            concat!("UPDATE jobs SET status = 'cancelled', finished_at = ", now!(), ", error = $1 WHERE id = $2"),
+            None::<&'static str>
+        ),
+        Db::Postgres(pool) => cancel_in!(
+            pool,
+            "SELECT status FROM jobs WHERE id = $1 FOR UPDATE",
+            "UPDATE jobs SET status = 'cancelled', finished_at = now(), error = $1 WHERE id = $2",
+            Some("SELECT pg_notify($1, $2)")
+        ),
+    }
 }
 
 /// A finished job's results, in operation order: operation, result JSON, whether a program
 /// exists and why not.
-pub async fn results(db: &SqlitePool, id: i64) -> AppResult<Vec<(String, String, bool, Option<String>)>> {
-    Ok(sqlx::query_as(
-        "SELECT operation, result_json, gcode IS NOT NULL, gcode_problem FROM job_results WHERE job_id = ?
-         ORDER BY position",
-    )
-    .bind(id)
-    .fetch_all(db)
-    .await?)
+pub async fn results(db: &Db, id: i64) -> AppResult<Vec<(String, String, bool, Option<String>)>> {
+    Ok(on!(db, query_as,
+        both: "SELECT operation, result_json, gcode IS NOT NULL, gcode_problem FROM job_results WHERE job_id = $1
+               ORDER BY position",
+        [id], fetch_all)?)
 }
 
 /// The programs of a finished job, in operation order (`None` where none could be written).
-pub async fn programs(db: &SqlitePool, id: i64) -> AppResult<Vec<(Option<String>, Option<String>)>> {
-    Ok(sqlx::query_as("SELECT gcode, gcode_problem FROM job_results WHERE job_id = ? ORDER BY position")
-        .bind(id)
-        .fetch_all(db)
-        .await?)
+pub async fn programs(db: &Db, id: i64) -> AppResult<Vec<(Option<String>, Option<String>)>> {
+    Ok(on!(db, query_as,
+        both: "SELECT gcode, gcode_problem FROM job_results WHERE job_id = $1 ORDER BY position",
+        [id], fetch_all)?)
 }
 
-/// At start-up no job can be running: each one a stopped server left `running` is queued again,
-/// or failed with the reason once it has used its attempts. Returns (re-queued, failed).
-pub async fn recover(db: &SqlitePool) -> AppResult<(u64, u64)> {
+/// At start-up of an SQLite service no job can be running: each one a stopped server left
+/// `running` is queued again, or failed with the reason once it has used its attempts. Returns
+/// (re-queued, failed). In PostgreSQL other processes may be running jobs right now: nothing is
+/// touched, expired leases are claimed again instead ([`claim`]).
+pub async fn recover(db: &Db) -> AppResult<(u64, u64)> {
+    let Db::Sqlite(pool) = db else { return Ok((0, 0)) };
     let failed = sqlx::query(concat!(
         "UPDATE jobs SET status = 'failed', finished_at = ",
         now!(),
-        ", error = ?
-         WHERE status = 'running' AND attempts >= ?"
+        ", error = $1
+         WHERE status = 'running' AND attempts >= $2"
     ))
     .bind(problem_json(&job_problem(
         503,
@@ -334,12 +636,34 @@ pub async fn recover(db: &SqlitePool) -> AppResult<(u64, u64)> {
         &format!("interrupted by a server stop on each of its {MAX_ATTEMPTS} attempts; not retried"),
     ))?)
     .bind(MAX_ATTEMPTS)
-    .execute(db)
+    .execute(pool)
     .await?
     .rows_affected();
     let requeued = sqlx::query("UPDATE jobs SET status = 'queued', progress = 0 WHERE status = 'running'")
-        .execute(db)
+        .execute(pool)
         .await?
         .rows_affected();
     Ok((requeued, failed))
+}
+
+/// Hands the chunks `claimant` is running back to the queue (PostgreSQL, on a graceful stop of
+/// its process), so another worker takes them at once instead of after the lease; the attempt
+/// does not count. Returns how many. SQLite's [`recover`] does this at the next start.
+pub async fn release(db: &Db, claimant: &Claimant) -> AppResult<u64> {
+    let Db::Postgres(pool) = db else { return Ok(0) };
+    let mut transaction = pool.begin().await?;
+    let released = sqlx::query(
+        "UPDATE job_chunks SET status = 'queued', progress = 0, worker = NULL, lease_expires_at = NULL,
+             attempts = GREATEST(attempts - 1, 0)
+         WHERE status = 'running' AND worker = $1",
+    )
+    .bind(&claimant.worker)
+    .execute(&mut *transaction)
+    .await?
+    .rows_affected();
+    if released > 0 {
+        sqlx::query("SELECT pg_notify($1, '')").bind(SUBMITTED_CHANNEL).execute(&mut *transaction).await?;
+    }
+    transaction.commit().await?;
+    Ok(released)
 }

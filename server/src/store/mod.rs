@@ -1,4 +1,7 @@
-//! Repositories: the only place with SQL. Handlers call these functions.
+//! Repositories: the only place with SQL. Handlers call these functions with the [`Db`] they
+//! hold; each function runs its statement on whichever store that is. Where SQLite and
+//! PostgreSQL accept the same text (`$1` placeholders work in both) it is written once; where
+//! they differ (timestamps, upserts, the queue's leases) each store has its own static SQL.
 
 pub mod jobs;
 pub mod machines;
@@ -7,15 +10,44 @@ pub mod tools;
 use kerf_solver::capability::Refs;
 use kerf_solver::machine::MachineProfile;
 use kerf_solver::tool::ToolRef;
-use sqlx::SqlitePool;
 
 use crate::capabilities::Catalog;
+use crate::db::Db;
 use crate::error::AppResult;
+
+/// Runs one statement on the store `$db` is: `sqlx::$make` (`query` or `query_as`) over the
+/// SQL for that store (`both:` one text, or `sqlite:` and `postgres:` each their own), with the
+/// arguments bound in order, finished by `$run` (`fetch_one`, ..., or `execute`: the rows affected). Evaluates to the
+/// `Result` of `$run`. Both stores take the same arguments; SQLite leaves those its text does not
+/// name unused (the worker and lease of the queue's statements: it has one process, no leases).
+macro_rules! on {
+    // `execute` answers the number of rows affected, the same type for both stores.
+    ($db:expr, query, sqlite: $sqlite:expr, postgres: $postgres:expr, [$($bind:expr),* $(,)?], execute) => {
+        match $db {
+            $crate::db::Db::Sqlite(pool) => {
+                sqlx::query($sqlite)$(.bind($bind))*.execute(pool).await.map(|done| done.rows_affected())
+            }
+            $crate::db::Db::Postgres(pool) => {
+                sqlx::query($postgres)$(.bind($bind))*.execute(pool).await.map(|done| done.rows_affected())
+            }
+        }
+    };
+    ($db:expr, $make:ident, both: $sql:expr, [$($bind:expr),* $(,)?], $run:ident) => {
+        on!($db, $make, sqlite: $sql, postgres: $sql, [$($bind),*], $run)
+    };
+    ($db:expr, $make:ident, sqlite: $sqlite:expr, postgres: $postgres:expr, [$($bind:expr),* $(,)?], $run:ident) => {
+        match $db {
+            $crate::db::Db::Sqlite(pool) => sqlx::$make($sqlite)$(.bind($bind))*.$run(pool).await,
+            $crate::db::Db::Postgres(pool) => sqlx::$make($postgres)$(.bind($bind))*.$run(pool).await,
+        }
+    };
+}
+pub(crate) use on;
 
 /// `catalog` completed with the tools and machines `refs` name that it lacks, from the tool table
 /// and the machines registry (those that exist; resolution reports the others).
 pub async fn catalog<'a>(
-    db: &SqlitePool,
+    db: &Db,
     refs: impl IntoIterator<Item = Refs<'a>>,
     mut catalog: Catalog,
 ) -> AppResult<Catalog> {
@@ -34,4 +66,9 @@ pub async fn catalog<'a>(
         }
     }
     Ok(catalog)
+}
+
+/// Counts of jobs by status (for the `kerf_jobs` gauge).
+pub async fn job_counts(db: &Db) -> AppResult<Vec<(String, i64)>> {
+    Ok(on!(db, query_as, both: "SELECT status, COUNT(*) FROM jobs GROUP BY status", [], fetch_all)?)
 }

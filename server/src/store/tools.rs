@@ -1,8 +1,9 @@
 //! The tool table (api.md, Tools).
 
 use kerf_solver::tool::{Tool, ToolRef};
-use sqlx::SqlitePool;
 
+use super::on;
+use crate::db::Db;
 use crate::error::{AppError, AppResult};
 
 fn decode(json: &str) -> AppResult<Tool> {
@@ -11,47 +12,45 @@ fn decode(json: &str) -> AppResult<Tool> {
 }
 
 /// The tool with `number`, if registered.
-pub async fn get(db: &SqlitePool, number: u32) -> AppResult<Option<Tool>> {
+pub async fn get(db: &Db, number: u32) -> AppResult<Option<Tool>> {
     let row: Option<(String,)> =
-        sqlx::query_as("SELECT tool_json FROM tools WHERE number = ?").bind(number).fetch_optional(db).await?;
+        on!(db, query_as, both: "SELECT tool_json FROM tools WHERE number = $1", [i64::from(number)], fetch_optional)?;
     row.map(|(json,)| decode(&json)).transpose()
 }
 
 /// All tools ordered by number.
-pub async fn list(db: &SqlitePool) -> AppResult<Vec<Tool>> {
-    let rows: Vec<(String,)> = sqlx::query_as("SELECT tool_json FROM tools ORDER BY number").fetch_all(db).await?;
+pub async fn list(db: &Db) -> AppResult<Vec<Tool>> {
+    let rows: Vec<(String,)> = on!(db, query_as, both: "SELECT tool_json FROM tools ORDER BY number", [], fetch_all)?;
     rows.iter().map(|(json,)| decode(json)).collect()
 }
 
 /// Stores `tool` (whose `number` is set) and says whether it was new.
-pub async fn put(db: &SqlitePool, tool: &Tool) -> AppResult<bool> {
+pub async fn put(db: &Db, tool: &Tool) -> AppResult<bool> {
     let number = tool.number.ok_or_else(|| AppError::Internal(anyhow::anyhow!("tool without number")))?;
     let json = serde_json::to_string(tool).map_err(|error| AppError::Internal(error.into()))?;
-    let (revision,): (i64,) = sqlx::query_as(
-        "INSERT INTO tools (number, kind, radius, name, tool_json) VALUES (?, ?, ?, ?, ?)
+    let (revision,): (i64,) = on!(db, query_as,
+        sqlite: "INSERT INTO tools (number, kind, radius, name, tool_json) VALUES ($1, $2, $3, $4, $5)
          ON CONFLICT (number) DO UPDATE SET kind = excluded.kind, radius = excluded.radius, name = excluded.name,
              tool_json = excluded.tool_json, revision = revision + 1,
              updated_at = strftime('%Y-%m-%dT%H:%M:%fZ', 'now')
          RETURNING revision",
-    )
-    .bind(number)
-    .bind(tool.kind.as_str())
-    .bind(tool.radius)
-    .bind(&tool.name)
-    .bind(json)
-    .fetch_one(db)
-    .await?;
+        postgres: "INSERT INTO tools (number, kind, radius, name, tool_json) VALUES ($1, $2, $3, $4, $5)
+         ON CONFLICT (number) DO UPDATE SET kind = excluded.kind, radius = excluded.radius, name = excluded.name,
+             tool_json = excluded.tool_json, revision = tools.revision + 1, updated_at = now()
+         RETURNING revision",
+        [i64::from(number), tool.kind.as_str(), tool.radius, &tool.name, &json],
+        fetch_one)?;
     Ok(revision == 1)
 }
 
 /// Deletes the tool; false if there was none.
-pub async fn delete(db: &SqlitePool, number: u32) -> AppResult<bool> {
-    let result = sqlx::query("DELETE FROM tools WHERE number = ?").bind(number).execute(db).await?;
-    Ok(result.rows_affected() > 0)
+pub async fn delete(db: &Db, number: u32) -> AppResult<bool> {
+    let result = on!(db, query, both: "DELETE FROM tools WHERE number = $1", [i64::from(number)], execute)?;
+    Ok(result > 0)
 }
 
 /// The tool a solver request names: looked up by number (404 if unknown) or given inline.
-pub async fn resolve(db: &SqlitePool, tool: &ToolRef) -> AppResult<Tool> {
+pub async fn resolve(db: &Db, tool: &ToolRef) -> AppResult<Tool> {
     match tool {
         ToolRef::Inline(tool) => Ok(tool.clone()),
         ToolRef::Number(number) => get(db, *number)

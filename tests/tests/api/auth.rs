@@ -1,16 +1,15 @@
 //! The optional API token: writes need it, reads stay open unless private.
 
 use kerf_server::auth::Auth;
-use kerf_tests::{TestApp, json_with, problem};
+use kerf_tests::{Store, TestApp, json_with, problem};
 use serde_json::json;
 
-async fn app(private: bool) -> TestApp {
-    TestApp::spawn_configured(|config| config.auth = Auth { token: Some("shop-floor-7".to_owned()), private }).await
+async fn app(store: Store, private: bool) -> Option<TestApp> {
+    TestApp::spawn_on(store, |config| config.auth = Auth { token: Some("shop-floor-7".to_owned()), private }).await
 }
 
-#[tokio::test(flavor = "multi_thread")]
-async fn token_guards_writes() {
-    let app = app(false).await;
+async fn token_guards_writes(store: Store) {
+    let Some(app) = app(store, false).await else { return };
     let tool = json!({"kind": "ball", "radius": 3});
     let answer = problem(app.put_json("/api/v1/tools/7", &tool).await, 401).await;
     assert_eq!(answer["code"], "E_UNAUTHORIZED");
@@ -34,9 +33,8 @@ async fn token_guards_writes() {
     assert_eq!(json_with(app.get("/api/v1/tools").await, 200).await.as_array().unwrap().len(), 1, "not deleted");
 }
 
-#[tokio::test(flavor = "multi_thread")]
-async fn private_mode_guards_reads() {
-    let app = app(true).await;
+async fn private_mode_guards_reads(store: Store) {
+    let Some(app) = app(store, true).await else { return };
     problem(app.get("/api/v1/tools").await, 401).await;
     problem(app.get("/api/v1/jobs").await, 401).await;
     let response = app.client.get(app.url("/api/v1/tools")).bearer_auth("shop-floor-7").send().await.unwrap();
@@ -45,3 +43,5 @@ async fn private_mode_guards_reads() {
     assert_eq!(app.get("/").await.status(), 200);
     assert_eq!(app.get("/api/v1/openapi.json").await.status(), 200);
 }
+
+kerf_tests::on_both_stores!(token_guards_writes, private_mode_guards_reads);

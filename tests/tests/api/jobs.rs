@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use kerf_server::state::Limits;
-use kerf_tests::{ServerProcess, TestApp, finished, json_with, poll_job, problem};
+use kerf_tests::{ServerProcess, Store, TestApp, finished, json_with, poll_job, problem};
 use reqwest::multipart::{Form, Part};
 use serde_json::{Value, json};
 
@@ -48,9 +48,8 @@ pub fn long_job(operations: usize) -> Value {
     json!({"name": "long", "operations": vec![operation; operations]})
 }
 
-#[tokio::test(flavor = "multi_thread")]
-async fn example_jobs_run_to_the_end() {
-    let app = TestApp::spawn().await;
+async fn example_jobs_run_to_the_end(store: Store) {
+    let Some(app) = TestApp::spawn_on(store, |_| {}).await else { return };
     for path in examples() {
         let operations = if path.extension().is_some_and(|e| e == "toml") {
             toml::from_str::<Value>(&std::fs::read_to_string(&path).unwrap()).unwrap()["operations"]
@@ -94,9 +93,8 @@ async fn example_jobs_run_to_the_end() {
     }
 }
 
-#[tokio::test(flavor = "multi_thread")]
-async fn raw_uploads_run_and_refusals_name_the_field() {
-    let app = TestApp::spawn().await;
+async fn raw_uploads_run_and_refusals_name_the_field(store: Store) {
+    let Some(app) = TestApp::spawn_on(store, |_| {}).await else { return };
     for path in examples() {
         // A changed name makes a different job, so it runs instead of being reused.
         let text = std::fs::read_to_string(&path).unwrap().replacen("name = \"", "name = \"raw ", 1).replacen(
@@ -129,9 +127,9 @@ async fn raw_uploads_run_and_refusals_name_the_field() {
     assert_eq!(error["errors"][0]["path"], format!("operations[0].{}", direct["errors"][0]["path"].as_str().unwrap()));
 }
 
-#[tokio::test(flavor = "multi_thread")]
-async fn bad_uploads() {
-    let app = TestApp::spawn_with(Limits { max_body_bytes: 64 * 1024, ..Limits::default() }).await;
+async fn bad_uploads(store: Store) {
+    let limits = Limits { max_body_bytes: 64 * 1024, ..Limits::default() };
+    let Some(app) = TestApp::spawn_on(store, |config| config.limits = limits).await else { return };
     app.register_tool(7, &json!({"kind": "ball", "radius": 3})).await;
     let good = "name = \"x\"\n[[operations]]\noperation = \"deburr\"\ntool = 7\nedge = \"outer\"\ncut_amount = 0.2\nworkpiece = { kind = \"tube\", origin = [0, 0, 0], inner_radius = 15, outer_radius = 25 }\nhole = { shape = \"round\", radius = 5 }\n";
     // (what, body, media type, status, field at fault, start of the detail)
@@ -220,9 +218,8 @@ async fn bad_uploads() {
     problem(app.get("/api/v1/jobs?limit=0").await, 400).await;
 }
 
-#[tokio::test(flavor = "multi_thread")]
-async fn cancel_paging_and_conflicts() {
-    let app = TestApp::spawn().await;
+async fn cancel_paging_and_conflicts(store: Store) {
+    let Some(app) = TestApp::spawn_on(store, |_| {}).await else { return };
     // Two long jobs on two workers, then a third waits in the queue.
     let mut ids = Vec::new();
     for n in 0..3 {
@@ -326,9 +323,8 @@ fn raw_results(job_text: &str) -> Vec<String> {
     results.iter().map(|result| result["result"].get().to_owned()).collect()
 }
 
-#[tokio::test(flavor = "multi_thread")]
-async fn jobs_answer_as_the_endpoints_do() {
-    let app = TestApp::spawn().await;
+async fn jobs_answer_as_the_endpoints_do(store: Store) {
+    let Some(app) = TestApp::spawn_on(store, |_| {}).await else { return };
     let machine = json!({"block_time_ms": 4, "max_feed": 12000, "dialect": "linuxcnc"});
     json_with(app.put_json("/api/v1/machines/lcnc", &machine).await, 201).await;
     let deburr = json!({
@@ -384,3 +380,11 @@ async fn jobs_answer_as_the_endpoints_do() {
     assert!(engagement_program.contains("Y40.0000"), "the second candidate's path: {engagement_program}");
     assert!(!engagement_program.contains("Y20.0000"), "not the first candidate's path");
 }
+
+kerf_tests::on_both_stores!(
+    example_jobs_run_to_the_end,
+    raw_uploads_run_and_refusals_name_the_field,
+    bad_uploads,
+    cancel_paging_and_conflicts,
+    jobs_answer_as_the_endpoints_do
+);

@@ -1,12 +1,11 @@
 //! The machines registry: create, replace, read, list, delete, bad names and values, and
 //! survival across a restart.
 
-use kerf_tests::{TestApp, json_with, problem};
+use kerf_tests::{Store, TestApp, json_with, problem};
 use serde_json::json;
 
-#[tokio::test(flavor = "multi_thread")]
-async fn machine_crud_and_restart() {
-    let mut app = TestApp::spawn().await;
+async fn machine_crud_and_restart(store: Store) {
+    let Some(mut app) = TestApp::spawn_on(store, |_| {}).await else { return };
     assert_eq!(json_with(app.get("/api/v1/machines").await, 200).await, json!([]));
 
     let hsc = json!({"block_time_ms": 4, "max_feed": 12000, "dialect": "linuxcnc", "margin": 1.1,
@@ -51,9 +50,8 @@ async fn machine_crud_and_restart() {
     app.shutdown().await;
 }
 
-#[tokio::test(flavor = "multi_thread")]
-async fn bad_machines_are_refused_and_nothing_is_stored() {
-    let app = TestApp::spawn().await;
+async fn bad_machines_are_refused_and_nothing_is_stored(store: Store) {
+    let Some(app) = TestApp::spawn_on(store, |_| {}).await else { return };
     let good = json!({"block_time_ms": 4, "max_feed": 10000});
     let long_name = format!("/api/v1/machines/{}", "m".repeat(65));
     let long_text = "x".repeat(201);
@@ -161,3 +159,5 @@ async fn bad_machines_are_refused_and_nothing_is_stored() {
     assert!(mismatches.is_empty(), "{}", mismatches.join("\n"));
     assert_eq!(json_with(app.get("/api/v1/machines").await, 200).await, json!([]), "database unchanged");
 }
+
+kerf_tests::on_both_stores!(machine_crud_and_restart, bad_machines_are_refused_and_nothing_is_stored);

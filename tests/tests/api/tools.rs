@@ -1,11 +1,10 @@
 //! The tool table: create, replace, read, list, delete, and survival across a restart.
 
-use kerf_tests::{TestApp, json_with, problem};
+use kerf_tests::{Store, TestApp, json_with, problem};
 use serde_json::json;
 
-#[tokio::test(flavor = "multi_thread")]
-async fn tool_crud_and_restart() {
-    let mut app = TestApp::spawn().await;
+async fn tool_crud_and_restart(store: Store) {
+    let Some(mut app) = TestApp::spawn_on(store, |_| {}).await else { return };
     assert_eq!(json_with(app.get("/healthz").await, 200).await["status"], "ok");
     assert_eq!(json_with(app.get("/api/v1/tools").await, 200).await, json!([]));
 
@@ -40,3 +39,5 @@ async fn tool_crud_and_restart() {
     problem(app.delete("/api/v1/tools/12").await, 404).await;
     app.shutdown().await;
 }
+
+kerf_tests::on_both_stores!(tool_crud_and_restart);

@@ -1,0 +1,335 @@
+//! Past one machine (issue 12), on a throw-away PostgreSQL server and real processes on loopback:
+//! one `kerf serve --job-workers 0` and two `kerf worker`s share the queue; one worker is killed
+//! with SIGKILL in the middle of a job; every job ends done with the results of a one-process
+//! SQLite run of the same files. Two API nodes on one database see each other's tools, machines
+//! and jobs, and a cancel through one reaches the job running on the other within two seconds.
+//! Each test skips, printing why, when PostgreSQL is not installed (fails under
+//! `KERF_REQUIRE_EXTERNAL=1`). The deployment files are checked against the same binary (`deploy`).
+
+mod deploy;
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use kerf_tests::{PgServer, ServerProcess, Store, TestApp, finished, json_with, poll_job};
+use reqwest::Client;
+use serde_json::{Value, json};
+
+fn program() -> PathBuf {
+    PathBuf::from(env!("CARGO_BIN_EXE_kerf-under-test"))
+}
+
+/// The example job files, as JSON values.
+fn examples() -> Vec<Value> {
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(folder)
+        .expect("examples folder")
+        .map(|entry| entry.expect("entry").path())
+        .filter(|path| path.extension().is_some_and(|e| e == "json" || e == "toml"))
+        .collect();
+    files.sort();
+    files
+        .iter()
+        .map(|path| {
+            let text = std::fs::read_to_string(path).unwrap();
+            if path.extension().is_some_and(|e| e == "toml") {
+                toml::from_str(&text).unwrap()
+            } else {
+                serde_json::from_str(&text).unwrap()
+            }
+        })
+        .collect()
+}
+
+/// A job whose operations take a while: exact-width deburring at a tiny tolerance.
+fn long_job(name: &str, operations: usize) -> Value {
+    let operation = json!({
+        "operation": "deburr", "tool": {"kind": "ball", "radius": 3, "number": 7},
+        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
+        "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5,
+        "tolerance": 2e-6, "method": "exact"
+    });
+    json!({"name": name, "operations": vec![operation; operations]})
+}
+
+/// A prediction job: a ball end mill finishing a double-wave surface by a zig-zag raster
+/// (`tests/load/predict-job.py` at a smaller size), `size` mm square, `pick` mm between lines,
+/// sampling at `resolution`.
+fn predict_job(size: f64, pick: f64, resolution: u32) -> Value {
+    let radius = 5.0;
+    let surface = |x: f64, y: f64| {
+        let (amplitude, k) = (25.0, std::f64::consts::PI / 160.0);
+        let z = amplitude * (k * x).sin() * (k * y).sin();
+        let dx = amplitude * k * (k * x).cos() * (k * y).sin();
+        let dy = amplitude * k * (k * x).sin() * (k * y).cos();
+        let length = (dx * dx + dy * dy + 1.0).sqrt();
+        (z, [-dx / length, -dy / length, 1.0 / length])
+    };
+    let lines = (size / pick).round() as usize + 1;
+    let mut program = vec!["%".to_owned(), "O1000 (RASTER)".to_owned(), "G21 G90 G17".to_owned(), "T1 M06".to_owned()];
+    program.push("S6000 M03".to_owned());
+    for line in 0..lines {
+        for k in 0..lines {
+            let i = if line % 2 == 0 { k } else { lines - 1 - k };
+            let (x, y) = (i as f64 * pick, line as f64 * pick);
+            let (z, n) = surface(x, y);
+            let tip = [x + radius * n[0], y + radius * n[1], z + radius * n[2] - radius];
+            if line == 0 && k == 0 {
+                program.push(format!("G0 X{:.4} Y{:.4} Z60.0", tip[0], tip[1]));
+                program.push(format!("G1 Z{:.4} F1200", tip[2]));
+            } else {
+                program.push(format!("X{:.4} Y{:.4} Z{:.4}", tip[0], tip[1], tip[2]));
+            }
+        }
+    }
+    program.extend(["G0 Z60.0", "M05", "M30", "%"].map(str::to_owned));
+    let (margin, spacing) = (2.0 * radius, 0.5);
+    let count = ((size + 2.0 * margin) / spacing).round() as usize + 1;
+    let heights: Vec<Vec<f64>> = (0..count)
+        .map(|j| {
+            (0..count)
+                .map(|i| {
+                    let (z, n) = surface(-margin + i as f64 * spacing, -margin + j as f64 * spacing);
+                    ((z + 0.2 / n[2]) * 1e6).round() / 1e6
+                })
+                .collect()
+        })
+        .collect();
+    let mode = json!({"stiffness": 5000, "frequency_hz": 1370, "damping_ratio": 0.05});
+    let shape_error: Vec<Value> = (0..10)
+        .map(|k| json!({"angle_deg": 10 * k, "error": 0.003 + 0.004 * f64::from(10 * k).to_radians().sin()}))
+        .collect();
+    let tool = json!({"number": 1, "kind": "ball", "radius": radius, "shape_error": shape_error,
+        "stiffness": {"kind": "modal", "x": [mode], "y": [mode]}});
+    json!({
+        "name": format!("raster {size} mm, {} passes, N = {resolution}", lines * lines),
+        "tools": [tool],
+        "operations": [{"operation": "predict", "tool": 1,
+            "stock": {"kind": "grid", "origin": [-margin, -margin], "spacing": spacing, "heights": heights, "bottom": -100.0},
+            "path": {"kind": "gcode", "program": program.join("\n") + "\n"},
+            "cutting": {"ktc": 2000, "krc": 800, "kac": 300}, "method": "sampling", "resolution": resolution}]
+    })
+}
+
+/// The mixed jobs: the examples, renamed so no two are identical (identical jobs are reused).
+fn mixed_jobs(count: usize) -> Vec<Value> {
+    let examples = examples();
+    (0..count)
+        .map(|n| {
+            let mut job = examples[n % examples.len()].clone();
+            job["name"] = json!(format!("mixed {n}"));
+            job
+        })
+        .collect()
+}
+
+async fn submit(client: &Client, base: &str, job: &Value) -> i64 {
+    let response = client.post(format!("{base}/api/v1/jobs")).json(job).send().await.unwrap();
+    json_with(response, 202).await["id"].as_i64().unwrap()
+}
+
+/// A finished job's results and programs, as served (the raw text of each `result`, and each
+/// operation's G-code).
+async fn outputs(client: &Client, base: &str, id: i64) -> Vec<(String, String)> {
+    use std::collections::BTreeMap;
+
+    use serde_json::value::RawValue;
+    let text = client.get(format!("{base}/api/v1/jobs/{id}")).send().await.unwrap().text().await.unwrap();
+    let job: BTreeMap<String, Box<RawValue>> = serde_json::from_str(&text).unwrap();
+    let results: Vec<BTreeMap<String, Box<RawValue>>> = serde_json::from_str(job["results"].get()).unwrap();
+    let mut outputs = Vec::new();
+    for (index, result) in results.iter().enumerate() {
+        let gcode = client
+            .get(format!("{base}/api/v1/jobs/{id}/gcode?operation={index}"))
+            .send()
+            .await
+            .unwrap()
+            .text()
+            .await
+            .unwrap();
+        outputs.push((result["result"].get().to_owned(), gcode));
+    }
+    outputs
+}
+
+/// The worker processes running chunks of job `id` now, from the chunks' `worker` column
+/// (host:pid:start).
+async fn running_workers(postgres: &PgServer, id: i64) -> Vec<u32> {
+    let pool = sqlx::PgPool::connect(&postgres.url()).await.unwrap();
+    let rows: Vec<(String,)> = sqlx::query_as(
+        "SELECT DISTINCT worker FROM job_chunks WHERE job_id = $1 AND status = 'running' AND worker IS NOT NULL",
+    )
+    .bind(id)
+    .fetch_all(&pool)
+    .await
+    .unwrap();
+    pool.close().await;
+    rows.iter().filter_map(|(worker,)| worker.split(':').nth(1)?.parse().ok()).collect()
+}
+
+/// A result without the time it took (prediction results in jobs carry their `timings`).
+fn without_timings(result: &str) -> Value {
+    let mut value: Value = serde_json::from_str(result).unwrap();
+    if let Some(object) = value.as_object_mut() {
+        object.remove("timings");
+    }
+    value
+}
+
+async fn metric(client: &Client, base: &str, name: &str) -> Option<f64> {
+    let text = client.get(format!("{base}/metrics")).send().await.unwrap().text().await.unwrap();
+    text.lines().find(|line| line.starts_with(name)).and_then(|line| line.rsplit(' ').next()?.parse().ok())
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn workers_share_the_queue_and_survive_a_kill() {
+    let Some(postgres) = PgServer::start() else { return };
+    let url = postgres.url();
+    let client = Client::builder().timeout(Duration::from_secs(60)).build().unwrap();
+    let api = ServerProcess::start_with(&program(), &["serve", "--database", &url, "--job-workers", "0"]).await;
+    let worker_arguments = ["worker", "--database", &url, "--job-workers", "1", "--job-lease-s", "3"];
+    let mut workers = Vec::new();
+    for _ in 0..2 {
+        workers.push(Some(ServerProcess::start_with(&program(), &worker_arguments).await));
+    }
+    assert_eq!(
+        json_with(client.get(format!("{}/readyz", api.base)).send().await.unwrap(), 200).await["status"],
+        "ready"
+    );
+
+    // The long job first, so a worker takes it at once; then the rest.
+    let mut jobs = vec![long_job("long, killed", 8), predict_job(20.0, 0.5, 96)];
+    jobs.extend(mixed_jobs(20));
+    let mut ids = Vec::new();
+    for job in &jobs {
+        ids.push(submit(&client, &api.base, job).await);
+    }
+
+    // The long job's chunks (one per operation) run on both workers at once; kill one of them
+    // once the job is well under way.
+    let long = ids[0];
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let pids = loop {
+        let pids = running_workers(&postgres, long).await;
+        if pids.len() == 2 || Instant::now() > deadline {
+            break pids;
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    };
+    assert_eq!(pids.len(), 2, "both workers run chunks of the long job at once: {pids:?}");
+    tokio::time::sleep(Duration::from_millis(500)).await;
+    let running = json_with(client.get(format!("{}/api/v1/jobs/{long}", api.base)).send().await.unwrap(), 200).await;
+    assert_eq!(running["status"], "running", "{running}");
+    let index = workers.iter().position(|w| w.as_ref().is_some_and(|w| w.id() == pids[0])).expect("one of ours");
+    workers[index].take().unwrap().kill();
+
+    let started = Instant::now();
+    for (&id, job) in ids.iter().zip(&jobs) {
+        let done = poll_job(&client, &api.base, id, 300, finished).await;
+        assert_eq!(done["status"], "done", "{}: {done}", job["name"]);
+        assert_eq!(done["progress"], 1.0);
+    }
+    let long_done = json_with(client.get(format!("{}/api/v1/jobs/{long}", api.base)).send().await.unwrap(), 200).await;
+    assert_eq!(long_done["attempts"], 2, "the killed chunk was claimed again once: {long_done}");
+    eprintln!("all {} jobs done {:.1} s after the kill", ids.len(), started.elapsed().as_secs_f64());
+
+    // Nothing is left running or queued.
+    let page = json_with(client.get(format!("{}/api/v1/jobs?limit=200", api.base)).send().await.unwrap(), 200).await;
+    assert!(page["jobs"].as_array().unwrap().iter().all(|j| j["status"] == "done"), "{page}");
+
+    // The surviving worker's metrics: it claimed jobs, and its database answers.
+    let survivor = workers.iter().flatten().next().unwrap();
+    let claimed = metric(&client, &survivor.base, "kerf_job_chunks_claimed_total").await.unwrap();
+    assert!(claimed >= 1.0, "claims counted: {claimed}");
+    assert_eq!(client.get(format!("{}/readyz", survivor.base)).send().await.unwrap().status(), 200);
+    let done = metric(&client, &api.base, "kerf_jobs{state=\"done\"}").await.unwrap();
+    assert_eq!(done, jobs.len() as f64);
+
+    // The same files through one SQLite process give the same results and programs, byte for byte.
+    let local = TestApp::spawn_on(Store::Sqlite, |_| {}).await.unwrap();
+    let mut local_ids = Vec::new();
+    for job in &jobs {
+        local_ids.push(submit(&local.client, &local.base, job).await);
+    }
+    for ((&id, &local_id), job) in ids.iter().zip(&local_ids).zip(&jobs) {
+        let local_done = poll_job(&local.client, &local.base, local_id, 300, finished).await;
+        assert_eq!(local_done["status"], "done", "{local_done}");
+        let shared = outputs(&client, &api.base, id).await;
+        let alone = outputs(&local.client, &local.base, local_id).await;
+        assert_eq!(shared.len(), alone.len(), "{}", job["name"]);
+        for (index, (a, b)) in shared.iter().zip(&alone).enumerate() {
+            assert!(
+                without_timings(&a.0) == without_timings(&b.0),
+                "{}: operation {index}'s result differs from the one-process run",
+                job["name"]
+            );
+            assert!(a.1 == b.1, "{}: operation {index}'s program differs from the one-process run", job["name"]);
+        }
+    }
+    for worker in workers.into_iter().flatten() {
+        worker.terminate();
+    }
+    api.terminate();
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn two_api_nodes_share_the_registry_and_cancel_reaches_the_other() {
+    let Some(first) = TestApp::spawn_on(Store::Postgres, |config| config.job_workers = 1).await else { return };
+    // The second node runs no jobs: whatever runs, runs on the first.
+    let second = first.spawn_beside(|config| config.job_workers = 0).await;
+
+    let tool = json!({"kind": "ball", "radius": 3, "name": "shared"});
+    json_with(first.put_json("/api/v1/tools/7", &tool).await, 201).await;
+    assert_eq!(json_with(second.get("/api/v1/tools/7").await, 200).await["name"], "shared");
+    let machine = json!({"block_time_ms": 4, "max_feed": 12000, "dialect": "linuxcnc"});
+    json_with(second.put_json("/api/v1/machines/lcnc", &machine).await, 201).await;
+    assert_eq!(json_with(first.get("/api/v1/machines").await, 200).await.as_array().unwrap().len(), 1);
+    // A replace through one is a replace for the other (200, not 201).
+    json_with(second.put_json("/api/v1/tools/7", &json!({"kind": "ball", "radius": 2})).await, 200).await;
+    assert_eq!(json_with(first.get("/api/v1/tools/7").await, 200).await["radius"], 2.0);
+
+    // A long job submitted through the second node runs on the first node's worker; a short one
+    // waits behind it. Cancelled through the second node, the long one stops on the first at
+    // once (NOTIFY), and the short one runs.
+    let long = submit(&second.client, &second.base, &long_job("long, cancelled", 40)).await;
+    let running = poll_job(&second.client, &second.base, long, 60, |j| j["status"] == "running").await;
+    assert_eq!(running["status"], "running");
+    let mut short = mixed_jobs(1).remove(0);
+    short["name"] = json!("behind the long one");
+    let short = submit(&second.client, &second.base, &short).await;
+    tokio::time::sleep(Duration::from_millis(500)).await;
+    assert_eq!(json_with(second.get(&format!("/api/v1/jobs/{short}")).await, 200).await["status"], "queued");
+    let cancelled_at = Instant::now();
+    json_with(second.delete(&format!("/api/v1/jobs/{long}")).await, 200).await;
+    let after = poll_job(&first.client, &first.base, short, 30, |j| j["status"] != "queued").await;
+    let reached = cancelled_at.elapsed();
+    assert_ne!(after["status"], "queued", "{after}");
+    assert!(reached < Duration::from_secs(2), "the cancel reached the other node's worker in {reached:?}");
+    eprintln!("cancel reached the other node's worker in {:.0} ms", reached.as_secs_f64() * 1e3);
+    let short_done = poll_job(&first.client, &first.base, short, 60, finished).await;
+    assert_eq!(short_done["status"], "done", "{short_done}");
+    assert_eq!(json_with(first.get(&format!("/api/v1/jobs/{long}")).await, 200).await["status"], "cancelled");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn readiness_follows_the_database() {
+    let Some(app) = TestApp::spawn_on(Store::Postgres, |_| {}).await else { return };
+    assert_eq!(json_with(app.get("/readyz").await, 200).await["database"], "postgres");
+    app.postgres.as_ref().unwrap().stop();
+    let answer = app.get("/readyz").await;
+    assert_eq!(answer.status(), 503);
+    assert_eq!(answer.headers()["content-type"], "application/problem+json");
+    // The process itself is up: its page still answers.
+    assert_eq!(app.get("/").await.status(), 200);
+    drop(app);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_worker_needs_postgres() {
+    let folder = tempfile::tempdir().unwrap();
+    let database = folder.path().join("kerf.db");
+    let output = std::process::Command::new(program()).args(["worker", "--database"]).arg(&database).output().unwrap();
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("PostgreSQL"), "{stderr}");
+}
