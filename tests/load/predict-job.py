@@ -11,7 +11,9 @@ Usage:
     cargo build --release -p kerf-server
     ./target/release/kerf serve --bind 127.0.0.1:18087 --database /tmp/bench.db &
     tests/load/predict-job.py /tmp/predict-job.json http://127.0.0.1:18087 $!
-(RAYON_NUM_THREADS=1 in the server's environment gives the one-core figure.)
+(RAYON_NUM_THREADS=1 in the server's environment gives the one-core figure; KERF_PREDICT_PICK sets the
+pick and step, mm, e.g. 0.29963 for the seed's job size; tests/load/predict-cluster.sh runs the job
+through SQLite and through PostgreSQL with one and two worker processes.)
 """
 import json
 import math
@@ -21,6 +23,8 @@ import time
 import urllib.request
 
 SIZE, PICK, STEP, RADIUS = 160.0, 0.5, 0.5, 5.0
+# The seed's job size (286 463 passes) is about PICK = STEP = 160 / 534: 535 x 535 = 286 225 passes.
+PICK = STEP = float(os.environ.get("KERF_PREDICT_PICK", PICK))
 
 
 def surface(x, y):
