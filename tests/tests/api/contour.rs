@@ -295,7 +295,7 @@ async fn answers_are_byte_identical() {
 }
 
 /// A circle of `points` vertices with radius 30: no corner turns enough for a loop.
-fn circle(points: usize) -> Vec<[f64; 2]> {
+pub(crate) fn circle(points: usize) -> Vec<[f64; 2]> {
     (0..points)
         .map(|k| {
             let angle = std::f64::consts::TAU * k as f64 / points as f64;

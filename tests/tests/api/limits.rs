@@ -6,6 +6,8 @@ use std::time::Duration;
 
 use kerf_server::state::Limits;
 use kerf_tests::{TestApp, json_with, problem};
+
+use crate::contour::circle;
 use serde_json::json;
 
 /// A deburr request that takes a few hundred milliseconds: exact width at a tiny tolerance.
@@ -70,16 +72,6 @@ fn zigzag(points: usize) -> Vec<[f64; 2]> {
         .collect()
 }
 
-/// A circle of radius 30 through `points` points.
-fn circle(points: usize) -> Vec<[f64; 2]> {
-    (0..points)
-        .map(|k| {
-            let angle = std::f64::consts::TAU * k as f64 / points as f64;
-            [30.0 * angle.cos(), 30.0 * angle.sin()]
-        })
-        .collect()
-}
-
 #[tokio::test(flavor = "multi_thread")]
 async fn timed_out_work_stops_and_frees_its_slot() {
     // One slot, a short time limit and a queue wait far shorter than the abandoned work would take
@@ -130,6 +122,14 @@ async fn a_segmentation_far_over_the_block_limit_is_refused_before_it_starts() {
     }
 }
 
+/// A raw connection to `app` that has sent `bytes` (a request head, perhaps part of a body).
+async fn raw_request(app: &TestApp, bytes: &[u8]) -> tokio::net::TcpStream {
+    use tokio::io::AsyncWriteExt;
+    let mut stream = tokio::net::TcpStream::connect(app.base.trim_start_matches("http://")).await.unwrap();
+    stream.write_all(bytes).await.unwrap();
+    stream
+}
+
 /// Reads from `stream` until the server closes it (or 30 s pass, which fails the test).
 async fn read_until_closed(stream: &mut tokio::net::TcpStream) -> String {
     use tokio::io::AsyncReadExt;
@@ -150,24 +150,21 @@ async fn read_until_closed(stream: &mut tokio::net::TcpStream) -> String {
 
 #[tokio::test(flavor = "multi_thread")]
 async fn clients_that_stall_are_cut_off() {
-    use tokio::io::AsyncWriteExt;
     let app = TestApp::spawn_with(Limits {
         header_read_timeout: Duration::from_millis(500),
         body_idle_timeout: Duration::from_millis(500),
         ..Limits::default()
     })
     .await;
-    let address = app.base.trim_start_matches("http://").to_owned();
     // Headers that never end: the connection is closed.
-    let mut stream = tokio::net::TcpStream::connect(&address).await.unwrap();
-    stream.write_all(b"GET /healthz HTTP/1.1\r\nHost: kerf\r\n").await.unwrap();
+    let mut stream = raw_request(&app, b"GET /healthz HTTP/1.1\r\nHost: kerf\r\n").await;
     read_until_closed(&mut stream).await;
     // A body that stops coming: the request ends with a client error and stores nothing.
-    let mut stream = tokio::net::TcpStream::connect(&address).await.unwrap();
-    stream
-        .write_all(b"PUT /api/v1/tools/7 HTTP/1.1\r\nHost: kerf\r\nContent-Type: application/json\r\nContent-Length: 200\r\n\r\n{\"kind\": ")
-        .await
-        .unwrap();
+    let mut stream = raw_request(
+        &app,
+        b"PUT /api/v1/tools/7 HTTP/1.1\r\nHost: kerf\r\nContent-Type: application/json\r\nContent-Length: 200\r\n\r\n{\"kind\": ",
+    )
+    .await;
     let answer = read_until_closed(&mut stream).await;
     let status: u16 = answer.split(' ').nth(1).and_then(|s| s.parse().ok()).unwrap_or(0);
     assert!((400..500).contains(&status), "{answer}");
@@ -186,12 +183,11 @@ async fn a_trickling_client_does_not_keep_a_stopped_server_alive() {
         ..Limits::default()
     })
     .await;
-    let address = app.base.trim_start_matches("http://").to_owned();
-    let mut stream = tokio::net::TcpStream::connect(&address).await.unwrap();
-    stream
-        .write_all(b"PUT /api/v1/tools/7 HTTP/1.1\r\nHost: kerf\r\nContent-Type: application/json\r\nContent-Length: 500\r\n\r\n{")
-        .await
-        .unwrap();
+    let mut stream = raw_request(
+        &app,
+        b"PUT /api/v1/tools/7 HTTP/1.1\r\nHost: kerf\r\nContent-Type: application/json\r\nContent-Length: 500\r\n\r\n{",
+    )
+    .await;
     // One byte every 200 ms: never idle long enough for the body timeout.
     let trickle = tokio::spawn(async move {
         for _ in 0..400 {
@@ -236,18 +232,15 @@ async fn slow_readers_of_large_answers_hold_a_bounded_budget() {
 
 #[tokio::test(flavor = "multi_thread")]
 async fn slow_uploads_hold_a_bounded_budget() {
-    use tokio::io::AsyncWriteExt;
     // An upload that declares 3 MiB and arrives slowly holds the 2 MiB budget while it arrives: a
     // second upload gets 429 with Retry-After instead of piling up in memory.
     let app = TestApp::spawn_with(Limits { answer_budget_bytes: 2 * 1024 * 1024, ..Limits::default() }).await;
-    let address = app.base.trim_start_matches("http://").to_owned();
-    let mut slow = tokio::net::TcpStream::connect(&address).await.unwrap();
-    slow.write_all(
+    let slow = raw_request(
+        &app,
         b"POST /api/v1/predict HTTP/1.1\r\nHost: kerf\r\nContent-Type: multipart/form-data; boundary=XX\r\n\
           Content-Length: 3145728\r\n\r\n--XX\r\nContent-Disposition: form-data; name=\"stock\"\r\n\r\nsolid",
     )
-    .await
-    .unwrap();
+    .await;
     // The first upload is read by then: its share is taken before the body is read.
     let mut refused = None;
     for _ in 0..100 {
