@@ -400,10 +400,16 @@ const scenarios = {
     await page.click('#contour-compute');
     const local = await page.textContent('#contour-messages');
     if (!/line 2/i.test(local)) throw new Error(`local check: ${local}`);
-    // Every layer in 3-D, and the timeline moves the tool there too.
+    // Every layer in 3-D, and the timeline moves the tool there too. The program comes slowly
+    // (as on a busy machine): the old plot stays dimmed until the new one replaces it.
+    const slowProgram = async (route) => { await new Promise((r) => setTimeout(r, 1500)); await route.continue(); };
+    await page.route('**/api/v1/contour?format=gcode*', slowProgram);
+    await page.$eval('#contour-plot', (plot) => { plot.dataset.old = 'yes'; });
     await page.fill('#contour-form input[name="points"], #contour-form textarea[name="points"]', '0, 10\n40, 10\n40, 0\n80, 25\n40, 50\n40, 40\n0, 40');
     await page.click('#contour-compute');
     await page.waitForSelector('#contour-result:not(.stale) #contour-plot[data-state="drawn"]', { timeout: 60000 });
+    await page.unroute('**/api/v1/contour?format=gcode*', slowProgram);
+    if (await page.$('#contour-plot[data-old]')) throw new Error('the old plot was undimmed before the new one came');
     await page.selectOption('#contour-result select[aria-label="View"]', '3d');
     await page.waitForSelector('#contour-plot-3d[data-state="drawn"]', { timeout: 60000 });
     const objects = (await page.getAttribute('#contour-plot-3d', 'data-objects')).split(' ');

@@ -407,17 +407,20 @@ export const contourView = {
       computing(messages, result);
       try {
         const answer = await api('POST', '/api/v1/contour', body);
-        computed(messages, result);
-        markComputed(form);
-        clearProblem(form);
         let program = null;
+        let refusal = null;
         try {
           program = await programOf('/api/v1/contour', body, gcodeQuery(form));
         } catch (refused) {
-          messages.append(message('error', `No G-code for this path. ${sentence(refused.detail || refused.title)}`, refused.code));
+          refusal = refused;
         }
         root.querySelector('#contour-gcode').disabled = !program;
         contourResult(result, answer, { program }).id = 'contour-plot';
+        // Undimmed only now: until the new plot is in place the old one is still the stale one.
+        computed(messages, result);
+        markComputed(form);
+        clearProblem(form);
+        if (refusal) messages.append(message('error', `No G-code for this path. ${sentence(refusal.detail || refusal.title)}`, refusal.code));
       } catch (problem) {
         showProblem(messages, form, problem);
         markContour(form, messages, problem);

@@ -268,22 +268,29 @@ export const deburrView = {
       gcode.title = gcodeNote.textContent;
       // The answer says so itself when it carries W_NO_PROGRAM.
       if (problem && !last.answer.warnings.some((w) => w.code === 'W_NO_PROGRAM')) {
-        messages.append(message('error', `No G-code for this path. ${sentence(problem.detail || problem.title)}`, problem.code));
+        return message('error', `No G-code for this path. ${sentence(problem.detail || problem.title)}`, problem.code);
       }
+      return null;
     };
-    form.elements.dialect.addEventListener('change', draw);
-    form.elements.reference.addEventListener('change', draw);
+    const redraw = async () => {
+      const refusal = await draw();
+      if (refusal) messages.append(refusal);
+    };
+    form.elements.dialect.addEventListener('change', redraw);
+    form.elements.reference.addEventListener('change', redraw);
     form.addEventListener('submit', async (event) => {
       event.preventDefault();
       computing(messages, result);
       const request = deburrRequest(form);
       try {
         const answer = await api('POST', '/api/v1/deburr', request);
+        last = { request, answer };
+        const refusal = await draw();
+        // Undimmed only now: until the new scene is in place the old one is still the stale one.
         clearProblem(form);
         computed(messages, result);
         markComputed(form);
-        last = { request, answer };
-        await draw();
+        if (refusal) messages.append(refusal);
       } catch (problem) {
         showProblem(messages, form, problem);
       }

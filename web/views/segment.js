@@ -355,20 +355,23 @@ export const segmentView = {
       computing(messages, result);
       try {
         const answer = await api('POST', '/api/v1/segment', body);
-        computed(messages, result);
-        markComputed(form);
-        clearProblem(form);
         let program = null;
+        let refusal = null;
         try {
           program = await programOf('/api/v1/segment', body, segmentQuery(form));
         } catch (refused) {
-          messages.append(message('error', `No G-code for these blocks. ${sentence(refused.detail || refused.title)}`, refused.code));
+          refusal = refused;
         }
         root.querySelector('#segment-gcode').disabled = !program;
         segmentResult(result, answer, { request: body, machine: form.elements.machine.machines?.get(body.machine), program }).id = 'segment-plot';
         const charts = result.querySelectorAll('canvas.chart');
         charts[0].id = 'segment-chart';
         charts[1].id = 'segment-lengths';
+        // Undimmed only now: until the new plot is in place the old one is still the stale one.
+        computed(messages, result);
+        markComputed(form);
+        clearProblem(form);
+        if (refusal) messages.append(message('error', `No G-code for these blocks. ${sentence(refusal.detail || refusal.title)}`, refusal.code));
       } catch (problem) {
         showProblem(messages, form, problem);
       }
