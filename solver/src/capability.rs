@@ -176,6 +176,34 @@ impl Control<'_> {
     pub fn cancelled(&self) -> bool {
         self.cancel.is_some_and(|flag| flag.load(std::sync::atomic::Ordering::Relaxed))
     }
+
+    /// Reports `done` of `total` units of work (a layer, a block, a sample) finished, only every
+    /// `total / 200` units so a per-sample call stays cheap.
+    pub fn report(&self, done: usize, total: usize) {
+        let Some(progress) = self.progress else { return };
+        if total == 0 {
+            return;
+        }
+        let every = (total / 200).max(1);
+        if done.is_multiple_of(every) || done >= total {
+            progress((done as f64 / total as f64).min(1.0));
+        }
+    }
+
+    /// Reports the fraction done where the work is not counted in units (along a curve).
+    pub fn report_fraction(&self, fraction: f64) {
+        if let Some(progress) = self.progress {
+            progress(fraction.clamp(0.0, 1.0));
+        }
+    }
+
+    /// Runs `work` as part `index` of `count` equal parts of this run: its progress 0–1 is
+    /// reported as `(index + fraction) / count` (the candidates of a comparison, say).
+    pub fn part<T>(&self, index: usize, count: usize, work: impl FnOnce(Control<'_>) -> T) -> T {
+        let Some(progress) = self.progress else { return work(*self) };
+        let scaled = move |fraction: f64| progress((index as f64 + fraction) / count.max(1) as f64);
+        work(Control { progress: Some(&scaled), cancel: self.cancel })
+    }
 }
 
 impl std::fmt::Debug for Control<'_> {

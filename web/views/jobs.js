@@ -24,14 +24,8 @@ function cell(text) {
   return td;
 }
 
-// Operations whose solver reports its progress while it runs (the service's job runner passes it
-// on); the others move the job's progress only when they finish. The API does not say which
-// operations report, so this mirrors the service (predict only) and must follow it.
-const REPORTS_PROGRESS = new Set(['predict']);
-
-// The progress cell: what the service reports, no more. A running operation that reports no
-// progress of its own gets an indeterminate bar (no value) and says which operation is running;
-// a queued job has no bar.
+// The progress cell: what the service reports, no more. Every operation reports its progress
+// while it runs (a layer, a block, a sample, a pass at a time); a queued job has no bar.
 function progressCell(job) {
   const td = document.createElement('td');
   td.className = 'progress';
@@ -47,20 +41,11 @@ function progressCell(job) {
   }
   if (job.status === 'running') {
     const index = Math.min(count - 1, Math.floor(job.progress * count + 1e-9));
-    const operation = job.operations[index];
     const of = count > 1 ? `operation ${index + 1} of ${count}, ` : '';
-    if (REPORTS_PROGRESS.has(operation)) {
-      bar.value = job.progress;
-      td.dataset.progress = 'reported';
-      td.append(bar, ` ${percent}`);
-      bar.setAttribute('aria-label', `${of}${operation}: ${percent}`);
-    } else {
-      // No value: the browser shows "busy", not a number the service never gave.
-      td.dataset.progress = 'unknown';
-      const note = `${of}${operation} running (it reports no progress)`;
-      bar.setAttribute('aria-label', note);
-      td.append(bar, ` ${note}`);
-    }
+    bar.value = job.progress;
+    td.dataset.progress = 'reported';
+    td.append(bar, ` ${percent}`);
+    bar.setAttribute('aria-label', `${of}${job.operations[index]}: ${percent}`);
     return td;
   }
   bar.value = job.status === 'done' ? 1 : job.progress;

@@ -270,6 +270,9 @@ impl<'a> Cutter<'a> {
             )
             .at("curve"));
         }
+        if cut.vertices.len().is_multiple_of(256) {
+            self.control.report_fraction(vertex.s / self.shape.length());
+        }
         cut.vertices.push(vertex);
         cut.deviations.push(self.last_deviation.take());
         Ok(())

@@ -306,6 +306,7 @@ pub fn loop_path_within(
     let cut = super::answer::MoveKind::Cut;
     for step in 1..=n {
         control.check()?;
+        control.report(step, n);
         let k = step % n;
         let p = points[k];
         moves.push(PathMove { kind: cut, to: [p.x, p.y] });

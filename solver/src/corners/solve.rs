@@ -155,6 +155,7 @@ pub fn solve_with(
     let mut previous_z = job.top;
     for (index, &z) in job.layers.iter().enumerate() {
         control.check()?;
+        control.report(index, job.layers.len());
         let tilted;
         let (layer, passes) = if index == 0 || job.tilt.is_none() {
             (&first_layer, &first_passes)

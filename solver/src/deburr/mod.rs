@@ -149,6 +149,8 @@ fn solve_centred(
     let envelope = (job.method == Method::Exact && exact_centres == ExactCentres::Swept)
         .then(|| EnvelopePath::solve(&construction, profile));
     control.check()?;
+    // Progress by stage: the centres' count is known only once they are placed.
+    control.report_fraction(0.2);
     let centre_at = |segment: usize, s: f64| -> Result<Vec3, SolverError> {
         control.check()?;
         let point = profile.segments[segment].point(profile.radius, s);
@@ -161,6 +163,7 @@ fn solve_centred(
 
     let spacing = Spacing::new(job.tolerance, job.rule, request::MIN_TOLERANCE);
     let mut bisected = tolerance::targets(profile, &spacing, MAX_POINTS, centre_at)?;
+    control.report_fraction(0.4);
     // The loop ends where it starts: the closing target (end of the last segment) is the start
     // point, which evaluates differently only by rounding (sin 2π ≠ 0).
     let last = bisected.centres.len() - 1;
@@ -172,6 +175,7 @@ fn solve_centred(
     }
     let (mut targets, mut centres, max_deviation) = (refined.targets, refined.centres, refined.max_deviation);
     control.check()?;
+    control.report_fraction(0.7);
 
     let mut ridges: Vec<RidgeCentre> = Vec::with_capacity(targets.len());
     let mut exact_offset: Option<f64> = None;

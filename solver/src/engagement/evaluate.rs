@@ -59,6 +59,7 @@ fn run_exact(
     let mut contacts = Vec::with_capacity(stations.len());
     for (index, station) in stations.iter().enumerate() {
         control.check()?;
+        control.report(index, stations.len());
         let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
         let arcs = engine.arcs(route, &job.region, job.radius, station)?;
         let mut contact = Contact::default();
@@ -103,8 +104,9 @@ fn run_dots(
     let mut scatter = Vec::new();
     let mut buffer = Contacts { keep_angles: job.contact_dots, ..Contacts::default() };
     let mut previous: Option<&Station> = None;
-    for station in stations {
+    for (index, station) in stations.iter().enumerate() {
         control.check()?;
+        control.report(index, stations.len());
         let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
         let mut contact = Contact::default();
         if rapid {

@@ -162,8 +162,9 @@ pub fn solve_in(
 ) -> Result<EngagementAnswer, SolverError> {
     let job = request.validate(tool, machine, physics)?;
     let mut results = Vec::with_capacity(job.candidates.len());
-    for candidate in &job.candidates {
-        let mut result = evaluate::evaluate(&job, candidate, tool, control)?;
+    for (index, candidate) in job.candidates.iter().enumerate() {
+        let mut result =
+            control.part(index, job.candidates.len(), |part| evaluate::evaluate(&job, candidate, tool, part))?;
         if let Some((blocks, warnings)) = program::blocks(&result)? {
             result.blocks = Some(blocks);
             result.warnings.extend(warnings);
