@@ -15,6 +15,16 @@ const FORM = `
       <label>Min chord error, mm <input name="min_chord_error" type="number" step="any" placeholder="0" data-field="min_chord_error"></label>
       <label>Description <input name="description" type="text" placeholder="control, mode, date" data-field="description"></label>
     </fieldset>
+    <fieldset><legend>Programs, motion and spindle (optional)</legend>
+      <label>Chord error rule <select name="mode" data-field="mode"><option value="">default (window)</option><option value="window">window</option><option value="curve">curve</option><option value="guarantee">guarantee: no short block</option></select></label>
+      <label>Circular moves <select name="arcs" data-field="arcs"><option value="">default (chords)</option><option value="chords">chords (G01)</option><option value="g2g3">G02/G03</option></select></label>
+      <label>Plunge feed, mm/min <input name="plunge_feed" type="number" step="any" placeholder="half the cutting feed" data-field="plunge_feed"></label>
+      <label>Acceleration, mm/s² <input name="max_accel" type="number" step="any" placeholder="none: no cycle time" data-field="max_accel"></label>
+      <label>Rapid feed, mm/min <input name="rapid_feed" type="number" step="any" placeholder="max feed" data-field="rapid_feed"></label>
+      <label>Tool change, s <input name="tool_change_s" type="number" step="any" placeholder="0" data-field="tool_change_s"></label>
+      <label>Spindle power, kW <input name="spindle_power_kw" type="number" step="any" data-field="spindle_power_kw"></label>
+      <label>Spindle torque, N·m <input name="spindle_torque_nm" type="number" step="any" data-field="spindle_torque_nm"></label>
+    </fieldset>
     <fieldset><legend>Block time from a saturation test</legend>
       <label>Test block, mm <input name="test_block" type="number" step="any" value="0.1"></label>
       <label>Saturated speed, mm/min <input name="saturated" type="number" step="any" value="1500"></label>
@@ -30,10 +40,30 @@ const FORM = `
   </section>
 </div>`;
 
+// The profile's fields the form edits; text and choices, the rest numbers (empty: not sent).
+const TEXT_FIELDS = ['dialect', 'description', 'mode', 'arcs'];
+const NUMBER_FIELDS = ['block_time_ms', 'max_feed', 'margin', 'min_chord_error', 'plunge_feed', 'max_accel', 'rapid_feed', 'tool_change_s', 'spindle_power_kw', 'spindle_torque_nm'];
+
+// The machine last opened with Edit: saving keeps the fields of it the form does not show, so
+// editing on the page never drops what was registered through the API.
+let editing = null;
+
 function fill(form, machine) {
-  for (const name of ['name', 'block_time_ms', 'max_feed', 'dialect', 'margin', 'min_chord_error', 'description']) {
-    form.elements[name].value = machine[name] ?? '';
+  editing = machine;
+  form.elements.name.value = machine.name ?? '';
+  for (const name of [...TEXT_FIELDS, ...NUMBER_FIELDS]) form.elements[name].value = machine[name] ?? '';
+}
+
+// The body of the PUT: the edited machine's other fields, then every field of the form.
+function machineBody(form) {
+  const body = { ...(editing ?? {}) };
+  delete body.name;
+  for (const name of TEXT_FIELDS) body[name] = form.elements[name].value.trim() || undefined;
+  for (const name of NUMBER_FIELDS) {
+    const text = form.elements[name].value.trim();
+    body[name] = text === '' ? undefined : Number(text);
   }
+  return body;
 }
 
 async function refresh(root) {
@@ -60,8 +90,7 @@ async function refresh(root) {
         try {
           await api('DELETE', `/api/v1/machines/${encodeURIComponent(machine.name)}`);
           messages.replaceChildren(message('ok', `Machine ${machine.name} deleted.`));
-          root.addEventListener('kerf:show', () => refresh(root));
-    refresh(root);
+          refresh(root);
         } catch (problem) {
           showProblem(messages, null, problem);
         }
@@ -81,6 +110,7 @@ export const machinesView = {
     const form = root.querySelector('#machine-form');
     const messages = root.querySelector('#machine-messages');
     refresh(root);
+    root.addEventListener('kerf:show', () => refresh(root));
     root.querySelector('#machine-saturation').addEventListener('click', () => {
       const length = Number(form.elements.test_block.value);
       const speed = Number(form.elements.saturated.value);
@@ -88,18 +118,9 @@ export const machinesView = {
     });
     form.addEventListener('submit', async (event) => {
       event.preventDefault();
-      const optional = (name) => (form.elements[name].value.trim() === '' ? undefined : Number(form.elements[name].value));
       const name = form.elements.name.value.trim();
-      const machine = {
-        block_time_ms: Number(form.elements.block_time_ms.value),
-        max_feed: Number(form.elements.max_feed.value),
-        dialect: form.elements.dialect.value,
-        margin: optional('margin'),
-        min_chord_error: optional('min_chord_error'),
-        description: form.elements.description.value.trim() || undefined,
-      };
       try {
-        await api('PUT', `/api/v1/machines/${encodeURIComponent(name || ' ')}`, machine);
+        await api('PUT', `/api/v1/machines/${encodeURIComponent(name || ' ')}`, machineBody(form));
         clearProblem(form);
         messages.replaceChildren(message('ok', `Machine ${name} saved.`));
         refresh(root);
