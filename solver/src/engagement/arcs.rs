@@ -28,13 +28,29 @@ impl Arc {
     /// Whether `angle` (any turn) lies on the arc, ends widened by `tolerance` (negative
     /// `tolerance` tests the interior).
     pub(crate) fn contains(&self, angle: f64, tolerance: f64) -> bool {
-        let offset = (angle - self.from).rem_euclid(360.0);
+        let offset = modulo(angle - self.from, 360.0);
         if tolerance >= 0.0 {
             offset <= self.span() + tolerance || offset >= 360.0 - tolerance
         } else {
             offset > -tolerance && offset < self.span() + tolerance
         }
     }
+}
+
+/// `angle` modulo `period`, in [0, `period`): `rem_euclid` without its `fmod` call for the few
+/// turns the engine's angles span (a tooth, an arc end), where it was a tenth of the run time.
+pub(crate) fn modulo(angle: f64, period: f64) -> f64 {
+    if !(angle.abs() <= 4.0 * period) {
+        return angle.rem_euclid(period);
+    }
+    let mut wrapped = angle;
+    while wrapped < 0.0 {
+        wrapped += period;
+    }
+    while wrapped >= period {
+        wrapped -= period;
+    }
+    wrapped
 }
 
 /// Wraps an angle into [−180°, 180°).
@@ -48,54 +64,55 @@ pub(crate) fn wrap_deg(angle: f64) -> f64 {
 
 /// Sorted, merged arcs: touching arcs (also across ±180°) join, a closed circle becomes
 /// [−180°, 180°], ends just behind 0°/180° snap onto them, and arcs shorter than 0.01° go.
-pub(crate) fn normalise(arcs: &[Arc]) -> Vec<Arc> {
-    let mut pieces: Vec<Arc> = arcs
-        .iter()
-        .filter(|a| a.to.is_finite() && a.from.is_finite() && a.to > a.from)
-        .map(|a| {
-            let from = wrap_deg(a.from);
-            let to = if from == a.from { a.to } else { from + a.span() };
-            Arc { from, to: to.min(from + 360.0) }
-        })
-        .collect();
-    pieces.sort_by(|a, b| a.from.total_cmp(&b.from));
-    let mut merged: Vec<Arc> = Vec::with_capacity(pieces.len());
-    for arc in pieces {
-        match merged.last_mut() {
-            Some(last) if arc.from <= last.to + TOUCH_DEG => last.to = last.to.max(arc.to),
-            _ => merged.push(arc),
+/// Works in the given buffer (once per sample: no allocation of its own).
+pub(crate) fn normalise(mut arcs: Vec<Arc>) -> Vec<Arc> {
+    arcs.retain(|a| a.to.is_finite() && a.from.is_finite() && a.to > a.from);
+    for arc in &mut arcs {
+        let from = wrap_deg(arc.from);
+        let to = if from == arc.from { arc.to } else { from + arc.span() };
+        *arc = Arc { from, to: to.min(from + 360.0) };
+    }
+    arcs.sort_by(|a, b| a.from.total_cmp(&b.from));
+    let mut merged = 0;
+    for index in 0..arcs.len() {
+        let arc = arcs[index];
+        if merged > 0 && arc.from <= arcs[merged - 1].to + TOUCH_DEG {
+            arcs[merged - 1].to = arcs[merged - 1].to.max(arc.to);
+        } else {
+            arcs[merged] = arc;
+            merged += 1;
         }
     }
+    arcs.truncate(merged);
     // Close over ±180°: the last arc may reach round to the first ones.
-    while merged.len() > 1 {
-        let (Some(first), Some(last)) = (merged.first().copied(), merged.last().copied()) else {
+    while arcs.len() > 1 {
+        let (Some(first), Some(last)) = (arcs.first().copied(), arcs.last().copied()) else {
             break;
         };
         if last.to + TOUCH_DEG >= first.from + 360.0 {
-            merged.remove(0);
-            if let Some(end) = merged.last_mut() {
+            arcs.remove(0);
+            if let Some(end) = arcs.last_mut() {
                 end.to = end.to.max(first.to + 360.0);
             }
         } else {
             break;
         }
     }
-    let mut result = Vec::with_capacity(merged.len());
-    for mut arc in merged {
-        if arc.span() >= 360.0 - TOUCH_DEG {
-            return vec![Arc { from: -180.0, to: 180.0 }];
-        }
+    if arcs.iter().any(|arc| arc.span() >= 360.0 - TOUCH_DEG) {
+        arcs.clear();
+        arcs.push(Arc { from: -180.0, to: 180.0 });
+        return arcs;
+    }
+    for arc in &mut arcs {
         if (-SNAP_DEG..0.0).contains(&arc.from) {
             arc.from = 0.0;
         }
         if arc.to > 180.0 && arc.to <= 180.0 + SNAP_DEG {
             arc.to = 180.0;
         }
-        if arc.span() >= SNAP_DEG {
-            result.push(arc);
-        }
     }
-    result
+    arcs.retain(|arc| arc.span() >= SNAP_DEG);
+    arcs
 }
 
 /// Φ, the total engaged angle, degrees.
@@ -244,11 +261,11 @@ mod tests {
 
     #[test]
     fn merging_wraps_and_snaps() {
-        let merged = normalise(&[arc(170.0, 180.0), arc(-180.0, -170.0), arc(10.0, 20.0)]);
+        let merged = normalise(vec![arc(170.0, 180.0), arc(-180.0, -170.0), arc(10.0, 20.0)]);
         assert_eq!(merged, vec![arc(10.0, 20.0), arc(170.0, 190.0)]);
-        assert_eq!(normalise(&[arc(-0.005, 60.0), arc(100.0, 180.004)]), vec![arc(0.0, 60.0), arc(100.0, 180.0)]);
-        assert_eq!(normalise(&[arc(5.0, 5.004)]), vec![]);
-        assert_eq!(normalise(&[arc(-180.0, 0.0), arc(0.0, 180.0)]), vec![arc(-180.0, 180.0)]);
+        assert_eq!(normalise(vec![arc(-0.005, 60.0), arc(100.0, 180.004)]), vec![arc(0.0, 60.0), arc(100.0, 180.0)]);
+        assert_eq!(normalise(vec![arc(5.0, 5.004)]), vec![]);
+        assert_eq!(normalise(vec![arc(-180.0, 0.0), arc(0.0, 180.0)]), vec![arc(-180.0, 180.0)]);
     }
 
     #[test]

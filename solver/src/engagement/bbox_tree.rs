@@ -127,8 +127,14 @@ impl BoxTree {
         if self.nodes.is_empty() {
             return;
         }
-        let mut stack = vec![0_usize];
-        while let Some(index) = stack.pop() {
+        // A median split halves the items at each level, so the tree is under 64 levels deep and
+        // this depth-first stack (at most one waiting node per level) never fills: no allocation
+        // per query, which runs several times per engagement sample.
+        let mut stack = [0_usize; 128];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let index = stack[top];
             let node = &self.nodes[index];
             if !node.bbox.overlaps(region) {
                 continue;
@@ -140,8 +146,9 @@ impl BoxTree {
                     }
                 }
             } else {
-                stack.push(node.second);
-                stack.push(node.first);
+                stack[top] = node.second;
+                stack[top + 1] = node.first;
+                top += 2;
             }
         }
     }

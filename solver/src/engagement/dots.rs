@@ -470,7 +470,7 @@ impl Contacts {
                 close(start, end, &mut arcs);
             }
         }
-        normalise(&arcs)
+        normalise(arcs)
     }
 
     /// Empties the buffers for the next sample.
@@ -556,7 +556,7 @@ mod tests {
             let clusters = sorted_clusters(&contacts.front, gap);
             splits += clusters.len() - 1;
             let expected: Vec<Arc> = normalise(
-                &clusters
+                clusters
                     .iter()
                     .map(|(low, high)| {
                         let low = (low - 0.5 * cell).max(-radius);

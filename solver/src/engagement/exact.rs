@@ -24,6 +24,7 @@ pub(crate) const MAX_TESTS: u64 = 4_000_000_000;
 #[derive(Debug, Default)]
 pub(crate) struct ExactEngine {
     pieces: Vec<Shape>,
+    earlier: Vec<usize>,
     angles: Vec<f64>,
     tests: u64,
 }
@@ -40,7 +41,7 @@ impl ExactEngine {
         let centre = station.centre;
         let forward = station.tangent;
         let right = right_normal(&forward);
-        route.swept_before(station, 2.0 * radius, &mut self.pieces);
+        route.swept_before(station, 2.0 * radius, &mut self.pieces, &mut self.earlier);
         self.angles.clear();
         for piece in &self.pieces {
             piece.crossings(radius, centre, radius, &mut self.angles);
@@ -74,7 +75,7 @@ impl ExactEngine {
             }
         }
         self.check_budget()?;
-        Ok(normalise(&arcs))
+        Ok(normalise(arcs))
     }
 
     /// Refuses once the work limit is spent.

@@ -361,22 +361,22 @@ impl Route {
 
     /// The cutting pieces that can come within `reach` of `centre` before the tool is at
     /// `station` (the current piece truncated there), most recent first.
-    pub(crate) fn swept_before(&self, station: &Station, reach: f64, out: &mut Vec<Shape>) {
+    pub(crate) fn swept_before(&self, station: &Station, reach: f64, out: &mut Vec<Shape>, earlier: &mut Vec<usize>) {
         out.clear();
+        earlier.clear();
         if let Some(current) = self.pieces.get(station.piece)
             && !current.rapid
             && station.local > 0.0
         {
             out.push(current.shape.truncated(station.local));
         }
-        let mut earlier = Vec::new();
         self.tree.query(&BBox::around(station.centre, reach), &mut |index| {
             if index < station.piece {
                 earlier.push(index);
             }
         });
         earlier.sort_unstable_by(|a, b| b.cmp(a));
-        for index in earlier {
+        for &index in earlier.iter() {
             if let Some(piece) = self.pieces.get(index)
                 && !piece.rapid
                 && piece.shape.distance(station.centre) < reach

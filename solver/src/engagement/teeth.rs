@@ -5,7 +5,7 @@
 //! the clamp max(0, sin θ) switches); between those breakpoints the sum is f_z·|C|·sin(β + arg C),
 //! so its maximum lies at a breakpoint or at β* = 90° − arg C.
 
-use super::arcs::Arc;
+use super::arcs::{Arc, modulo};
 
 /// Tolerance on arc ends, degrees (closed arcs: a tooth on an end counts, §9).
 const END_TOLERANCE: f64 = 1e-9;
@@ -23,38 +23,70 @@ fn on_arcs(arcs: &[Arc], angle: f64, tolerance: f64) -> bool {
     arcs.iter().any(|arc| arc.contains(angle, tolerance))
 }
 
-fn clamped_sin(angle_deg: f64) -> f64 {
-    angle_deg.to_radians().sin().max(0.0)
-}
+/// Breakpoints of one sample fit on the stack (4 + 2 per arc); more arcs take the heap.
+const STACK_BREAKS: usize = 32;
 
 /// H_k/f_z,k and n_k for `flutes` teeth on `arcs` (§5.6, exact maximisation).
+///
+/// Runs once per flute count and sample, so it allocates nothing for the usual few arcs and
+/// takes the tooth directions by rotation instead of a sine and cosine per tooth.
 pub(crate) fn tooth_sum(arcs: &[Arc], flutes: u32) -> ToothSum {
     if arcs.is_empty() || flutes == 0 {
         return ToothSum { ratio: 0.0, teeth: 0 };
     }
     let pitch = 360.0 / f64::from(flutes);
-    let mut breaks = vec![0.0, pitch];
-    for arc in arcs {
-        for end in [arc.from, arc.to] {
-            breaks.push(end.rem_euclid(pitch));
+    let needed = 4 + 2 * arcs.len();
+    let mut stack = [0.0_f64; STACK_BREAKS];
+    let mut heap = Vec::new();
+    let breaks: &mut [f64] = if needed <= STACK_BREAKS {
+        &mut stack[..needed]
+    } else {
+        heap.resize(needed, 0.0);
+        &mut heap
+    };
+    breaks[..4].copy_from_slice(&[0.0, pitch, 0.0, modulo(180.0, pitch)]);
+    for (index, arc) in arcs.iter().enumerate() {
+        breaks[4 + 2 * index] = modulo(arc.from, pitch);
+        breaks[5 + 2 * index] = modulo(arc.to, pitch);
+    }
+    breaks.sort_unstable_by(f64::total_cmp);
+    let mut kept = 1;
+    for index in 1..breaks.len() {
+        if (breaks[index] - breaks[kept - 1]).abs() > 1e-12 {
+            breaks[kept] = breaks[index];
+            kept += 1;
         }
     }
-    breaks.push(0.0_f64.rem_euclid(pitch));
-    breaks.push(180.0_f64.rem_euclid(pitch));
-    breaks.sort_by(f64::total_cmp);
-    breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-12);
+    let breaks = &breaks[..kept];
 
     let tooth = |phase: f64, j: u32| phase + f64::from(j) * pitch;
+    let (pitch_sin, pitch_cos) = pitch.to_radians().sin_cos();
+    // Σ sin θ_j over the teeth `counts`, the sines by rotation from tooth 0 at `phase`.
+    let sine_sum = |phase: f64, counts: &dyn Fn(u32) -> bool| {
+        let (mut sin, mut cos) = phase.to_radians().sin_cos();
+        let mut sum = 0.0;
+        for j in 0..flutes {
+            if counts(j) {
+                sum += sin.max(0.0);
+            }
+            (sin, cos) = (sin * pitch_cos + cos * pitch_sin, cos * pitch_cos - sin * pitch_sin);
+        }
+        sum
+    };
     let mut best = 0.0_f64;
     let mut teeth = 0_u32;
-    for &phase in &breaks {
-        let sum: f64 = (0..flutes)
-            .map(|j| tooth(phase, j))
-            .filter(|&angle| on_arcs(arcs, angle, END_TOLERANCE))
-            .map(clamped_sin)
-            .sum();
-        best = best.max(sum);
+    for &phase in breaks {
+        best = best.max(sine_sum(phase, &|j| on_arcs(arcs, tooth(phase, j), END_TOLERANCE)));
     }
+    // Teeth cutting throughout an interval: on an arc and in the front half (0° < θ < 180°; the
+    // interval's middle is never on 0° or 180°, which are breaks).
+    let active = |middle: f64, j: u32| {
+        let angle = tooth(middle, j);
+        on_arcs(arcs, angle, 0.0) && {
+            let turn = modulo(angle, 360.0);
+            turn > 0.0 && turn < 180.0
+        }
+    };
     for pair in breaks.windows(2) {
         let (low, high) = (pair[0], pair[1]);
         if high - low <= 1e-12 {
@@ -63,27 +95,26 @@ pub(crate) fn tooth_sum(arcs: &[Arc], flutes: u32) -> ToothSum {
         let middle = 0.5 * (low + high);
         let inside = (0..flutes).filter(|&j| on_arcs(arcs, tooth(middle, j), -END_TOLERANCE)).count();
         teeth = teeth.max(u32::try_from(inside).unwrap_or(u32::MAX));
-        // Teeth cutting throughout this interval: on an arc and in the front half.
-        let active: Vec<u32> = (0..flutes)
-            .filter(|&j| {
-                let angle = tooth(middle, j);
-                on_arcs(arcs, angle, 0.0) && angle.to_radians().sin() > 0.0
-            })
-            .collect();
+        // C = Σ e^{i·j·pitch} over the active teeth, the directions by rotation from tooth 0.
         let (mut cx, mut cy) = (0.0, 0.0);
-        for &j in &active {
-            let angle = (f64::from(j) * pitch).to_radians();
-            cx += angle.cos();
-            cy += angle.sin();
+        let (mut direction_cos, mut direction_sin) = (1.0, 0.0);
+        for j in 0..flutes {
+            if active(middle, j) {
+                cx += direction_cos;
+                cy += direction_sin;
+            }
+            (direction_cos, direction_sin) = (
+                direction_cos * pitch_cos - direction_sin * pitch_sin,
+                direction_sin * pitch_cos + direction_cos * pitch_sin,
+            );
         }
         if cx.hypot(cy) <= 1e-12 {
             continue;
         }
         let peak = 90.0 - cy.atan2(cx).to_degrees();
-        let phase = low + (peak - low).rem_euclid(360.0);
+        let phase = low + modulo(peak - low, 360.0);
         if phase < high {
-            let sum: f64 = active.iter().map(|&j| tooth(phase, j).to_radians().sin()).sum();
-            best = best.max(sum);
+            best = best.max(sine_sum(phase, &|j| active(middle, j)));
         }
     }
     ToothSum { ratio: best, teeth }
@@ -95,6 +126,10 @@ mod tests {
 
     fn arc(from: f64, to: f64) -> Arc {
         Arc { from, to }
+    }
+
+    fn clamped_sin(angle_deg: f64) -> f64 {
+        angle_deg.to_radians().sin().max(0.0)
     }
 
     /// Brute-force phase scan, for comparison.
