@@ -40,7 +40,8 @@ impl Arc {
 /// `angle` modulo `period`, in [0, `period`): `rem_euclid` without its `fmod` call for the few
 /// turns the engine's angles span (a tooth, an arc end), where it was a tenth of the run time.
 pub(crate) fn modulo(angle: f64, period: f64) -> f64 {
-    if !(angle.abs() <= 4.0 * period) {
+    // Far turns and NaN take the exact library path.
+    if angle.is_nan() || angle.abs() > 4.0 * period {
         return angle.rem_euclid(period);
     }
     let mut wrapped = angle;
