@@ -1,7 +1,7 @@
 // kerf form helpers shared by the views: reading fields, the tool and machine choices (machine
 // values as placeholders, only overrides sent), errors at the field, warnings as sentences, the
 // per-view state kept in local storage, summaries and downloads.
-import { machines, plainFieldMessage, plainTitle, sentence, technical, tools } from '/api.js';
+import { api, machines, plainFieldMessage, plainTitle, program, sentence, technical, tools } from '/api.js';
 
 // ---------------------------------------------------------------- reading fields
 
@@ -52,6 +52,26 @@ export function computing(messages, result) {
 export function computed(messages, result, text = 'Computed.') {
   messages.replaceChildren(message('ok', text));
   result?.classList.remove('stale');
+}
+
+// POSTs `body` to `path` for the answer, then asks for its program (`query`: the G-code options).
+// A refused program does not refuse the answer: `refusal` says why there is none.
+export async function answerAndProgram(path, body, query) {
+  const answer = await api('POST', path, body);
+  try {
+    return { answer, program: await program(path, body, query), refusal: null };
+  } catch (refusal) {
+    return { answer, program: null, refusal };
+  }
+}
+
+// After the new result is drawn (only then: until it replaces the old one, the old one is the
+// stale one): success, the form marked computed, and why there is no program if refused.
+export function showComputed(form, messages, result, refusal, what) {
+  computed(messages, result);
+  markComputed(form);
+  clearProblem(form);
+  if (refusal) messages.append(message('error', `No G-code for ${what}. ${sentence(refusal.detail || refusal.title)}`, refusal.code));
 }
 
 // Fills a summary box with [name, value] pairs, each a line with the value in bold.

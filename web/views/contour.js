@@ -3,10 +3,10 @@
 // selector; loops, reliefs, links and corners in their own colours; wheel to zoom, drag to pan,
 // double-click to fit), the corner table with the material left or over-cut, the summary, the
 // warnings and the G-code download. `contourResult` also renders job results.
-import { api, program as programOf, sentence } from '/api.js';
+import { api } from '/api.js';
 import { Timeline } from '/timeline.js';
 import { Plot2D, Scene3D, THREE } from '/plot.js';
-import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
+import { answerAndProgram, clearProblem, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, programName, showComputed, showProblem, showSummary, value, warningMessages } from '/form.js';
 
 // An arrow-shaped island: five protruding corners (a 64° tip among them) and two inside corners.
 const SAMPLE = `# x, y in mm, counter-clockwise; one point a line
@@ -406,21 +406,10 @@ export const contourView = {
       if (!body) return;
       computing(messages, result);
       try {
-        const answer = await api('POST', '/api/v1/contour', body);
-        let program = null;
-        let refusal = null;
-        try {
-          program = await programOf('/api/v1/contour', body, gcodeQuery(form));
-        } catch (refused) {
-          refusal = refused;
-        }
+        const { answer, program, refusal } = await answerAndProgram('/api/v1/contour', body, gcodeQuery(form));
         root.querySelector('#contour-gcode').disabled = !program;
         contourResult(result, answer, { program }).id = 'contour-plot';
-        // Undimmed only now: until the new plot is in place the old one is still the stale one.
-        computed(messages, result);
-        markComputed(form);
-        clearProblem(form);
-        if (refusal) messages.append(message('error', `No G-code for this path. ${sentence(refusal.detail || refusal.title)}`, refusal.code));
+        showComputed(form, messages, result, refusal, 'this path');
       } catch (problem) {
         showProblem(messages, form, problem);
         markContour(form, messages, problem);

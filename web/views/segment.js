@@ -1,9 +1,9 @@
 // Segment view: cut a curve into G01 blocks by the control's block time (api.md, Segment;
 // chord.md). A form for the curve and the rule, the curve with its blocks, the chord error and the
 // block length along the curve, the rule side by side with a fixed tolerance, G-code download.
-import { api, program as programOf, sentence } from '/api.js';
+import { api } from '/api.js';
 import { Timeline } from '/timeline.js';
-import { clearProblem, computed, computing, download, keepForm, loadMachines, machineFields, machineNote, markComputed, message, number, numeric, showProblem, showSummary, value, warningMessages } from '/form.js';
+import { answerAndProgram, clearProblem, computing, download, keepForm, loadMachines, machineFields, machineNote, message, number, numeric, showComputed, showProblem, showSummary, value, warningMessages } from '/form.js';
 import { PlanPlot, drawChart } from '/plot.js';
 
 const FORM = `
@@ -354,24 +354,13 @@ export const segmentView = {
       if (!body) return;
       computing(messages, result);
       try {
-        const answer = await api('POST', '/api/v1/segment', body);
-        let program = null;
-        let refusal = null;
-        try {
-          program = await programOf('/api/v1/segment', body, segmentQuery(form));
-        } catch (refused) {
-          refusal = refused;
-        }
+        const { answer, program, refusal } = await answerAndProgram('/api/v1/segment', body, segmentQuery(form));
         root.querySelector('#segment-gcode').disabled = !program;
         segmentResult(result, answer, { request: body, machine: form.elements.machine.machines?.get(body.machine), program }).id = 'segment-plot';
         const charts = result.querySelectorAll('canvas.chart');
         charts[0].id = 'segment-chart';
         charts[1].id = 'segment-lengths';
-        // Undimmed only now: until the new plot is in place the old one is still the stale one.
-        computed(messages, result);
-        markComputed(form);
-        clearProblem(form);
-        if (refusal) messages.append(message('error', `No G-code for these blocks. ${sentence(refusal.detail || refusal.title)}`, refusal.code));
+        showComputed(form, messages, result, refusal, 'these blocks');
       } catch (problem) {
         showProblem(messages, form, problem);
       }
