@@ -3,8 +3,9 @@
 //! surfaces. Everything here is in the local frame (§1.3): A1 is the y_L axis, the hole axis runs
 //! along z_L through (f, 0).
 
+use super::job::Job;
 use super::profile::{Profile, ProfilePoint};
-use super::request::{Edge, Job};
+use super::request::Edge;
 use crate::geometry::{Vec3, root_near};
 
 /// The per-job constants of the construction.

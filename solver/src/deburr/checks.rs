@@ -2,8 +2,9 @@
 //! the ridge exists, the far-side gouge, tool access for inner edges and chamfer overlap.
 
 use super::centre::{Construction, RidgeCentre};
+use super::job::Job;
 use super::profile::Profile;
-use super::request::{Edge, Job};
+use super::request::Edge;
 use super::tolerance::Target;
 use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};

@@ -25,6 +25,7 @@ mod checks;
 mod diagnostics;
 mod envelope;
 mod frame;
+mod job;
 mod profile;
 pub mod program;
 pub mod request;
@@ -441,7 +442,7 @@ fn point_checks(job: &Job, targets: &[Target], ridges: &[RidgeCentre]) -> Result
     Ok(warnings)
 }
 
-use request::Job;
+use job::Job;
 
 /// Range of the chamfer width really cut by one ball section in VP at the emitted centres, and
 /// W_APPROX if the worst is more than 5 % off W (§2.9, §4).

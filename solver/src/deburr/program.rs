@@ -8,7 +8,8 @@
 
 use super::answer::{Deburr, LeadMotion, LeadMove};
 use super::frame::Frame;
-use super::request::{Edge, Job};
+use super::job::Job;
+use super::request::Edge;
 use crate::error::ErrorCode;
 use crate::error::SolverError;
 use crate::gcode::{self, Post, Program, Reference, SpindleDirection};

@@ -3,7 +3,8 @@
 
 use serde::Serialize;
 
-use super::request::{Method, NodeSource};
+use super::job::NodeSource;
+use super::request::Method;
 use crate::error::Warning;
 use crate::geometry::Vec3;
 

@@ -10,8 +10,8 @@
 //! pixel).
 
 use super::capsule::Capsule;
+use super::job::Job;
 use super::passes::{PathModel, Stamps};
-use super::request::Job;
 use crate::geometry::Vec3;
 
 /// Most pixels of the global view: the pixel grows past R/32 on a large footprint to stay

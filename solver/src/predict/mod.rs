@@ -46,6 +46,7 @@ pub mod correct;
 pub mod dynamics;
 mod exclusion;
 mod force;
+mod job;
 mod passes;
 mod pipeline;
 mod render;
@@ -67,9 +68,9 @@ pub use stock::Stock;
 
 use answer::Corrections;
 use correct::PassError;
+use job::Job;
 use passes::PathModel;
 use pipeline::{Context, Outcome};
-use request::Job;
 
 use crate::error::{SolverError, Warning};
 use crate::gcode::reader::{self, MoveEdit, MoveKind, ReadOptions};

@@ -1,0 +1,215 @@
+//! A deburr request validated into the model the solver works on, a [`Job`] (deburr.md §1.4
+//! inputs, §4 `E_INPUT`/`E_NOT_THROUGH`/`E_INCONSISTENT_ECC`).
+
+use super::frame::Frame;
+use super::profile::Profile;
+use crate::error::{ErrorCode, SolverError, Warning};
+use crate::geometry::vec3;
+use crate::machine::{BlockRule, MachineProfile, RuleSettings};
+use crate::tool::{Tool, ToolKind};
+use crate::validate::{self, finite, non_negative, optional_positive, positive, within};
+
+use super::request::{
+    CentreDistance, DEFAULT_CLEARANCE, DEFAULT_FEED, DEFAULT_LEAD_DISTANCE, DEFAULT_SPINDLE_RPM, DEFAULT_TOLERANCE,
+    DeburrRequest, Direction, Edge, HoleShape, MIN_TOLERANCE, Method, Workpiece,
+};
+
+/// A validated deburr job: every number finite and in range, the frame and profile built.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Job {
+    pub frame: Frame,
+    pub profile: Profile,
+    pub edge: Edge,
+    /// R1.
+    pub cylinder_radius: f64,
+    /// RN and RT when the workpiece is a tube.
+    pub tube_radii: Option<(f64, f64)>,
+    /// Distance from A1 to the part's top along the hole axis (RT, or the block face), if known.
+    pub top_distance: Option<f64>,
+    pub width: f64,
+    pub cut_amount: f64,
+    pub tolerance: f64,
+    pub method: Method,
+    pub direction: Direction,
+    pub tool: Tool,
+    pub feed: f64,
+    pub spindle_rpm: f64,
+    pub clearance: f64,
+    pub lead_distance: f64,
+    pub safe_z: Option<f64>,
+    /// The block-time rule at `feed`, when a block time is known (request or machine).
+    pub rule: Option<BlockRule>,
+    /// Warnings from resolving the rule (`W_FEED_ABOVE_MACHINE_MAX`).
+    pub rule_warnings: Vec<Warning>,
+}
+
+/// Largest length or coordinate accepted, mm (100 m: beyond any part, and far enough from the
+/// float range that squares and the bisection stay exact).
+pub const MAX_LENGTH: f64 = 1e5;
+/// Smallest radius, cut amount or width accepted, mm (0.1 µm: below any tool or feature).
+pub const MIN_LENGTH: f64 = 1e-4;
+
+/// A finite value within ±[`MAX_LENGTH`].
+fn bounded(field: &str, value: f64) -> Result<f64, SolverError> {
+    within(field, value, MAX_LENGTH)
+}
+
+/// A size: finite, from [`MIN_LENGTH`] to [`MAX_LENGTH`].
+fn size(field: &str, value: f64) -> Result<f64, SolverError> {
+    let value = bounded(field, positive(field, value)?)?;
+    if value < MIN_LENGTH {
+        return Err(SolverError::input(field, format!("{field} must be at least {MIN_LENGTH} mm (got {value})")));
+    }
+    Ok(value)
+}
+
+fn point(field: &str, p: [f64; 3]) -> Result<[f64; 3], SolverError> {
+    validate::point(field, p, MAX_LENGTH)
+}
+
+impl DeburrRequest {
+    /// Validates the request against `tool` (already resolved from `self.tool`) and `machine`
+    /// (resolved from `self.machine`).
+    pub(crate) fn validate(&self, tool: &Tool, machine: Option<&MachineProfile>) -> Result<Job, SolverError> {
+        tool.validate("tool.")?;
+        size("tool.radius", tool.radius)?;
+        if tool.kind != ToolKind::Ball {
+            return Err(SolverError::new(
+                ErrorCode::ToolKind,
+                format!("deburring needs a ball end mill, but the tool is {}", tool.kind.as_str()),
+            )
+            .at("tool"));
+        }
+        let (origin, arrangement, cylinder_radius, tube_radii, top_distance) = match &self.workpiece {
+            Workpiece::Tube { origin, arrangement_angle_deg, inner_radius, outer_radius } => {
+                let inner = size("workpiece.inner_radius", *inner_radius)?;
+                let outer = size("workpiece.outer_radius", *outer_radius)?;
+                if inner >= outer {
+                    return Err(SolverError::new(
+                        ErrorCode::NotThrough,
+                        format!("inner_radius {inner} must be smaller than outer_radius {outer}"),
+                    )
+                    .at("workpiece.inner_radius"));
+                }
+                let r1 = if self.edge == Edge::Inner { inner } else { outer };
+                (origin, arrangement_angle_deg, r1, Some((inner, outer)), Some(outer))
+            }
+            Workpiece::BoreBlock { origin, arrangement_angle_deg, bore_radius, face_distance } => {
+                let bore = size("workpiece.bore_radius", *bore_radius)?;
+                if self.edge != Edge::Inner {
+                    return Err(SolverError::input("edge", "a bore_block has only an inner edge (edge: \"inner\")"));
+                }
+                if let Some(face) = face_distance {
+                    size("workpiece.face_distance", *face)?;
+                    if *face <= bore {
+                        return Err(SolverError::input(
+                            "workpiece.face_distance",
+                            format!("face_distance {face} must exceed bore_radius {bore}"),
+                        ));
+                    }
+                }
+                (origin, arrangement_angle_deg, bore, None, *face_distance)
+            }
+        };
+        let origin = vec3(point("workpiece.origin", *origin)?);
+        let arrangement = finite("workpiece.arrangement_angle_deg", *arrangement)?;
+
+        let hole = &self.hole;
+        let radius = size("hole.radius", hole.radius)?;
+        let penetration = finite("hole.penetration_angle_deg", hole.penetration_angle_deg)?;
+        let start = finite("start_deg", self.start_deg)?;
+        if start != 0.0 && hole.shape != HoleShape::Round {
+            return Err(SolverError::input("start_deg", "start_deg applies only to round holes"));
+        }
+        let eccentricity = hole.eccentricity.map(|f| bounded("hole.eccentricity", f)).transpose()?;
+        let axis_point = hole.axis_point.map(|p| point("hole.axis_point", p)).transpose()?.map(vec3);
+        let (frame, eccentricity) = Frame::resolve(origin, arrangement, penetration, axis_point, eccentricity)?;
+
+        let profile = match (hole.shape, hole.centre_distance) {
+            (HoleShape::Round, None) => Profile::round(radius, eccentricity, start.to_radians()),
+            (HoleShape::Slot, Some(CentreDistance::Along(length))) => {
+                let length = bounded("hole.centre_distance", non_negative("hole.centre_distance", length)?)?;
+                Profile::rounded_rect(radius, eccentricity, 0.0, length / 2.0, true)
+            }
+            (HoleShape::RoundedRect, Some(CentreDistance::AcrossAlong([across, along]))) => {
+                let across = bounded("hole.centre_distance[0]", non_negative("hole.centre_distance[0]", across)?)?;
+                let along = bounded("hole.centre_distance[1]", non_negative("hole.centre_distance[1]", along)?)?;
+                Profile::rounded_rect(radius, eccentricity, across / 2.0, along / 2.0, false)
+            }
+            (HoleShape::Round, Some(_)) => {
+                return Err(SolverError::input("hole.centre_distance", "a round hole has no centre_distance"));
+            }
+            (HoleShape::Slot, _) => {
+                return Err(SolverError::input(
+                    "hole.centre_distance",
+                    "a slot needs centre_distance: the distance L_s between its end circles along A1",
+                ));
+            }
+            (HoleShape::RoundedRect, _) => {
+                return Err(SolverError::input(
+                    "hole.centre_distance",
+                    "a rounded_rect needs centre_distance: [across, along] between its corner circles",
+                ));
+            }
+        };
+
+        let (width, cut_amount) = match (self.cut_amount, self.width) {
+            (Some(q), None) => {
+                let q = size("cut_amount", q)?;
+                (q * std::f64::consts::SQRT_2, q)
+            }
+            (None, Some(w)) => {
+                let w = size("width", w)?;
+                (w, w / std::f64::consts::SQRT_2)
+            }
+            (Some(_), Some(_)) => {
+                return Err(SolverError::input("width", "give cut_amount or width, not both"));
+            }
+            (None, None) => {
+                return Err(SolverError::input("cut_amount", "cut_amount (Q) or width (W) is required"));
+            }
+        };
+        let tolerance = optional_positive("tolerance", self.tolerance, DEFAULT_TOLERANCE)?;
+        if tolerance < MIN_TOLERANCE {
+            return Err(SolverError::new(
+                ErrorCode::Tol,
+                format!("tolerance {tolerance} is below the smallest reachable {MIN_TOLERANCE} mm"),
+            )
+            .at("tolerance"));
+        }
+        let safe_z = self.safe_z.map(|z| bounded("safe_z", z)).transpose()?;
+        let feed = optional_positive("feed", self.feed, DEFAULT_FEED)?;
+        let (rule, rule_warnings) = if self.block_time_ms.is_some() || machine.is_some() {
+            let settings =
+                RuleSettings { feed: Some(feed), block_time_ms: self.block_time_ms, ..RuleSettings::default() };
+            let (rule, warnings) = BlockRule::resolve(&settings, machine)?;
+            (Some(rule), warnings)
+        } else {
+            (None, Vec::new())
+        };
+        Ok(Job {
+            frame,
+            profile,
+            edge: self.edge,
+            cylinder_radius,
+            tube_radii,
+            top_distance,
+            width,
+            cut_amount,
+            tolerance,
+            method: self.method,
+            direction: self.direction,
+            tool: tool.clone(),
+            feed,
+            spindle_rpm: optional_positive("spindle_rpm", self.spindle_rpm, DEFAULT_SPINDLE_RPM)?,
+            clearance: bounded("clearance", optional_positive("clearance", self.clearance, DEFAULT_CLEARANCE)?)?,
+            lead_distance: bounded(
+                "lead_distance",
+                optional_positive("lead_distance", self.lead_distance, DEFAULT_LEAD_DISTANCE)?,
+            )?,
+            safe_z,
+            rule,
+            rule_warnings,
+        })
+    }
+}
