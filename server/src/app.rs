@@ -19,6 +19,7 @@ use utoipa_swagger_ui::SwaggerUi;
 use crate::auth::{Auth, require_token};
 use crate::db::Database;
 use crate::error::AppError;
+use crate::jobs::storage::JobStorage;
 use crate::openapi::ApiDoc;
 use crate::state::{AppState, Limits};
 use crate::{db, http, metrics, web};
@@ -38,6 +39,8 @@ pub struct Config {
     pub job_lease: Duration,
     /// The optional API token.
     pub auth: Auth,
+    /// The job store's quota, per-job cap and retention.
+    pub job_storage: JobStorage,
 }
 
 /// The OpenAPI document and the API routes.
@@ -93,7 +96,21 @@ fn panic_response(cause: Box<dyn Any + Send + 'static>) -> Response<Body> {
 /// When the database cannot be opened or migrated.
 pub async fn build(config: &Config) -> anyhow::Result<(Router, AppState)> {
     let pool = db::open(&config.database).await?;
-    let state = AppState::new(pool, config.limits.clone(), config.solver_slots, config.auth.clone(), config.job_lease);
+    let state = AppState::new(
+        pool,
+        config.limits.clone(),
+        config.solver_slots,
+        config.auth.clone(),
+        config.job_lease,
+        config.job_storage,
+    );
+    if !crate::store::jobs::incremental_vacuum(&state.db).await? {
+        tracing::warn!(
+            database = %config.database,
+            "this SQLite file was made before incremental vacuum: the space of pruned jobs is reused but the file \
+             does not shrink; stop the service and run `kerf jobs prune` once to convert it"
+        );
+    }
     state.jobs.start(&state.db, &state.solver_slots, config.job_workers).await?;
     Ok((router(state.clone()), state))
 }

@@ -282,3 +282,34 @@ async fn slow_uploads_hold_a_bounded_budget() {
     }
     assert_eq!(answered, 400, "an empty predict request is a bad request once the budget is free");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn slow_readers_of_large_job_programs_hold_a_bounded_budget() {
+    // A 1 MiB budget and a job whose program is some 20 MB: while one client does not read it, the
+    // next download of a large job output gets 429 with Retry-After instead of another copy in memory.
+    let app = TestApp::spawn_with(Limits { answer_budget_bytes: 1024 * 1024, ..Limits::default() }).await;
+    let job = json!({"name": "deep contour", "operations": [{"operation": "contour",
+        "tool": {"kind": "ball", "radius": 3}, "contour": circle(600), "side": "outside",
+        "depths": {"top": 0, "bottom": -250, "step": 0.25}, "feed": 800}]});
+    let id = json_with(app.post_json("/api/v1/jobs", &job).await, 202).await["id"].as_i64().unwrap();
+    let done = kerf_tests::poll_job(&app.client, &app.base, id, 300, kerf_tests::finished).await;
+    assert_eq!(done["status"], "done", "{done}");
+    let program = format!("/api/v1/jobs/{id}/gcode");
+    let unread = app.get(&program).await;
+    assert_eq!(unread.status(), 200);
+    let length: usize = unread.headers()["content-length"].to_str().unwrap().parse().unwrap();
+    assert!(length > 15_000_000, "{length}");
+    for path in [program.clone(), format!("/api/v1/jobs/{id}")] {
+        let refused = app.get(&path).await;
+        assert!(refused.headers().contains_key("retry-after"), "{path}: {:?}", refused.headers());
+        assert_eq!(problem(refused, 429).await["code"], "E_BUSY", "{path}");
+    }
+    // Reading it gives the budget back; it arrives whole.
+    let first = unread.text().await.unwrap();
+    assert_eq!(first.len(), length);
+    assert!(first.trim_end().ends_with('%') && first.contains("M30"), "a whole program");
+    let again = app.get(&program).await;
+    assert_eq!(again.status(), 200);
+    assert_eq!(again.text().await.unwrap(), first);
+    json_with(app.get(&format!("/api/v1/jobs/{id}")).await, 200).await;
+}
