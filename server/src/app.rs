@@ -66,8 +66,11 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
 pub fn router(state: AppState) -> Router {
     let max_body = state.limits.max_body_bytes;
     let (api_routes, document) = api();
+    // The docs' own handler answers an unknown file with an empty 404: make it a problem.
+    let docs = Router::from(SwaggerUi::new("/docs").url("/api/v1/openapi.json", document))
+        .layer(axum::middleware::map_response(empty_not_found_as_problem));
     api_routes
-        .merge(SwaggerUi::new("/docs").url("/api/v1/openapi.json", document))
+        .merge(docs)
         .merge(web::router())
         .merge(metrics::routes())
         .fallback(|| async { AppError::not_found("no such resource") })
@@ -79,6 +82,15 @@ pub fn router(state: AppState) -> Router {
         .layer(TraceLayer::new_for_http())
         .layer(CatchPanicLayer::custom(panic_response))
         .with_state(state)
+}
+
+async fn empty_not_found_as_problem(response: Response<Body>) -> Response<Body> {
+    if response.status() == axum::http::StatusCode::NOT_FOUND
+        && !response.headers().contains_key(axum::http::header::CONTENT_TYPE)
+    {
+        return AppError::not_found("no such page of the API docs").into_response();
+    }
+    response
 }
 
 fn panic_response(cause: Box<dyn Any + Send + 'static>) -> Response<Body> {

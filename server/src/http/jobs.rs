@@ -12,7 +12,7 @@ use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
 use crate::error::{AppError, AppResult, Problem};
-use crate::extract::{AppPath, AppQuery, body_bytes, media_type};
+use crate::extract::{AppPath, AppQuery, body_bytes, media_type, refuse_declared_over};
 use crate::jobs::file::{self, Format, JobFile};
 use crate::state::{AppState, PIECE, held_body, pieces_of};
 use crate::store;
@@ -94,6 +94,7 @@ struct JobId {
 /// Reads the uploaded job file's text and its format.
 async fn upload(state: &AppState, request: Request) -> AppResult<(String, Format)> {
     let limit = state.limits.max_body_bytes;
+    refuse_declared_over(request.headers(), limit)?;
     let media = media_type(request.headers());
     let (bytes, name, media) = match media.as_deref() {
         Some("multipart/form-data") => {

@@ -313,3 +313,49 @@ async fn slow_readers_of_large_job_programs_hold_a_bounded_budget() {
     assert_eq!(again.text().await.unwrap(), first);
     json_with(app.get(&format!("/api/v1/jobs/{id}")).await, 200).await;
 }
+
+/// Reads from `stream` until the end of a response head (or 10 s pass, which fails the test).
+async fn read_head(stream: &mut tokio::net::TcpStream) -> String {
+    use tokio::io::AsyncReadExt;
+    let mut received = Vec::new();
+    let read = tokio::time::timeout(Duration::from_secs(10), async {
+        let mut buffer = [0_u8; 4096];
+        while !received.windows(4).any(|w| w == b"\r\n\r\n") {
+            match stream.read(&mut buffer).await {
+                Ok(0) | Err(_) => break,
+                Ok(n) => received.extend_from_slice(&buffer[..n]),
+            }
+        }
+    })
+    .await;
+    assert!(read.is_ok(), "no answer; received: {}", String::from_utf8_lossy(&received));
+    String::from_utf8_lossy(&received).into_owned()
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_body_declared_over_the_limit_gets_413_before_100_continue() {
+    let app = TestApp::spawn_with(Limits { max_body_bytes: 1024, ..Limits::default() }).await;
+    for (route, media_type) in [
+        ("PUT /api/v1/tools/7", "application/json"),
+        ("POST /api/v1/jobs", "application/toml"),
+        ("POST /api/v1/jobs", "multipart/form-data; boundary=XX"),
+        ("POST /api/v1/predict", "application/json"),
+    ] {
+        let head = format!(
+            "{route} HTTP/1.1\r\nHost: kerf\r\nContent-Type: {media_type}\r\nContent-Length: 999999999999\r\n\
+             Expect: 100-continue\r\n\r\n"
+        );
+        let mut stream = raw_request(&app, head.as_bytes()).await;
+        let answer = read_head(&mut stream).await;
+        assert!(answer.starts_with("HTTP/1.1 413"), "{route} ({media_type}): {answer}");
+        assert!(answer.contains("application/problem+json"), "{answer}");
+    }
+    // Within the limit the client is told to go on.
+    let mut stream = raw_request(
+        &app,
+        b"PUT /api/v1/tools/7 HTTP/1.1\r\nHost: kerf\r\nContent-Type: application/json\r\nContent-Length: 30\r\n\
+          Expect: 100-continue\r\n\r\n",
+    )
+    .await;
+    assert!(read_head(&mut stream).await.starts_with("HTTP/1.1 100"));
+}
