@@ -241,7 +241,12 @@ async fn prune(args: PruneArgs) -> anyhow::Result<()> {
         println!("another process is pruning this database right now; nothing removed");
         return Ok(());
     };
-    let ids: Vec<String> = pruned.ids.iter().map(i64::to_string).collect();
+    // The ids, up to a screenful.
+    const LISTED: usize = 50;
+    let mut ids: Vec<String> = pruned.ids.iter().take(LISTED).map(i64::to_string).collect();
+    if pruned.ids.len() > LISTED {
+        ids.push(format!("… {} more", pruned.ids.len() - LISTED));
+    }
     println!(
         "removed {} finished job(s) older than {} day(s){}: {} of job files and results",
         pruned.ids.len(),

@@ -263,3 +263,38 @@ async fn the_sqlite_file_stays_bounded_and_shrinks_after_pruning() {
     assert!(output.contains(&format!("removed {stored} finished job(s)")), "{output}");
     assert!(pruned * 4 < full, "the file gave the pruned jobs' space back: {full} → {pruned} bytes");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn results_stored_before_compression_are_still_served() {
+    // A row as the schema before migration 0004 stored it: plain text, no compressed columns.
+    let app = TestApp::spawn_configured(|config| config.job_workers = 0).await;
+    let db = db::open(&app.config.database).await.unwrap();
+    let Db::Sqlite(pool) = &db else { unreachable!("an SQLite test app") };
+    let job = serde_json::to_string(&quick_job("old")).unwrap();
+    let (id,): (i64,) = sqlx::query_as(
+        "INSERT INTO jobs (name, status, content_hash, job_json, operations, finished_at)
+         VALUES ('old', 'done', 'h', $1, '[\"deburr\"]', '2020-01-01T00:00:00.000Z') RETURNING id",
+    )
+    .bind(&job)
+    .fetch_one(pool)
+    .await
+    .unwrap();
+    sqlx::query(
+        "INSERT INTO job_results (job_id, position, operation, result_json, gcode) VALUES ($1, 0, 'deburr', $2, $3)",
+    )
+    .bind(id)
+    .bind(r#"{"points": [[1.5, 2.5, 3.5]]}"#)
+    .bind("%\nO1000\nG00 X1.5000\nM30\n%\n")
+    .execute(pool)
+    .await
+    .unwrap();
+    let shown = json_with(app.get(&format!("/api/v1/jobs/{id}")).await, 200).await;
+    assert_eq!(shown["results"][0]["result"], json!({"points": [[1.5, 2.5, 3.5]]}), "{shown}");
+    assert_eq!(shown["results"][0]["gcode"], true);
+    let program = app.get(&format!("/api/v1/jobs/{id}/gcode")).await;
+    assert_eq!(program.status(), 200);
+    assert_eq!(program.text().await.unwrap(), "%\nO1000\nG00 X1.5000\nM30\n%\n");
+    // And it is pruned like any other finished job.
+    let output = prune_command(&app, &["--older-than-days", "30"]);
+    assert!(output.contains(&format!("removed 1 finished job(s) older than 30 day(s) (ids {id})")), "{output}");
+}
