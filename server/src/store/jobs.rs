@@ -701,6 +701,22 @@ pub async fn fail(db: &Db, work: Work, claimant: &Claimant, problem: &Problem) -
                    UPDATE jobs SET status = 'failed', error = $1, error_field = $2, finished_at = now()
                    WHERE id IN (SELECT job_id FROM chunk) AND status = 'running'",
         [json, field, work.id, &claimant.worker, work.position()], execute)?;
+    drop_partial_results(db, work.id).await
+}
+
+/// Removes what chunks of a job that then failed or was cancelled stored (PostgreSQL: other
+/// chunks may have finished first), so a job that will never be done takes no more than its job
+/// file. No-op for a job still to run or done.
+async fn drop_partial_results(db: &Db, id: i64) -> AppResult<()> {
+    on!(db, query,
+        both: "DELETE FROM job_results WHERE job_id = $1
+               AND EXISTS (SELECT 1 FROM jobs WHERE id = $1 AND status IN ('failed', 'cancelled'))",
+        [id], execute)?;
+    on!(db, query,
+        sqlite: "UPDATE jobs SET stored_bytes = length(CAST(job_json AS BLOB))
+                 WHERE id = $1 AND status IN ('failed', 'cancelled')",
+        postgres: "UPDATE jobs SET stored_bytes = octet_length(job_json) WHERE id = $1 AND status IN ('failed', 'cancelled')",
+        [id], execute)?;
     Ok(())
 }
 
@@ -708,6 +724,14 @@ pub async fn fail(db: &Db, work: Work, claimant: &Claimant, problem: &Problem) -
 /// the job had, and whether this call cancelled it. In PostgreSQL the workers are notified, so
 /// the one running it stops at once (its heartbeat would find out within a second anyway).
 pub async fn cancel(db: &Db, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
+    let cancelled = cancel_job(db, id).await?;
+    if matches!(cancelled, Some((_, true))) {
+        drop_partial_results(db, id).await?;
+    }
+    Ok(cancelled)
+}
+
+async fn cancel_job(db: &Db, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
     let error = problem_json(&job_problem(409, "Cancelled", ErrorCode::Cancelled, "cancelled by request"))?;
     macro_rules! cancel_in {
         ($pool:expr, $select:expr, $update:expr, $notify:expr) => {{

@@ -119,6 +119,15 @@ async fn a_job_over_the_per_job_cap_fails_naming_its_operation(store: Store) {
     assert_eq!(job["error"]["code"], "E_RESULT_TOO_LARGE", "{job}");
     assert_eq!(job["error"]["errors"][0]["path"], "operations[1]", "{job}");
     assert!(job["error"]["detail"].as_str().unwrap().contains("--job-result-max-mb"), "{job}");
+    // Nothing of it stays stored, not even the result of the operation that fitted (on
+    // PostgreSQL its chunk may have finished first).
+    let db = db::open(&app.config.database).await.unwrap();
+    let rows: (i64,) = match &db {
+        Db::Sqlite(pool) => sqlx::query_as("SELECT COUNT(*) FROM job_results").fetch_one(pool).await.unwrap(),
+        Db::Postgres(pool) => sqlx::query_as("SELECT COUNT(*) FROM job_results").fetch_one(pool).await.unwrap(),
+    };
+    assert_eq!(rows.0, 0, "results of a failed job");
+    assert!(usage(&db).await.1 < 4096, "the failed job takes only its job file");
 }
 
 /// `kerf jobs prune ARGUMENTS` on `app`'s store; its standard output.
