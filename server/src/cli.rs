@@ -57,8 +57,9 @@ pub enum JobsCommand {
 /// Options of `kerf jobs prune`.
 #[derive(Debug, Clone, Args)]
 pub struct PruneArgs {
-    /// Remove the jobs that finished more than this many days ago (0: every finished job).
-    #[arg(long, env = "KERF_JOB_RETENTION_DAYS", default_value_t = 30.0)]
+    /// Remove the jobs that finished more than this many days ago (0: every finished job). Not
+    /// read from `KERF_JOB_RETENTION_DAYS`, where 0 means the opposite (keep forever).
+    #[arg(long, default_value_t = 30.0)]
     pub older_than_days: f64,
     /// The database (an SQLite file or a `postgres://` URL).
     #[arg(long, env = "KERF_DATABASE", default_value = "kerf.db")]
