@@ -19,6 +19,7 @@ use utoipa_swagger_ui::SwaggerUi;
 use crate::auth::{Auth, require_token};
 use crate::db::Database;
 use crate::error::AppError;
+use crate::jobs::storage::JobStorage;
 use crate::openapi::ApiDoc;
 use crate::state::{AppState, Limits};
 use crate::{db, http, metrics, web};
@@ -38,6 +39,8 @@ pub struct Config {
     pub job_lease: Duration,
     /// The optional API token.
     pub auth: Auth,
+    /// The job store's quota, per-job cap and retention.
+    pub job_storage: JobStorage,
 }
 
 /// The OpenAPI document and the API routes.
@@ -63,8 +66,11 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
 pub fn router(state: AppState) -> Router {
     let max_body = state.limits.max_body_bytes;
     let (api_routes, document) = api();
+    // The docs' own handler answers an unknown file with an empty 404: make it a problem.
+    let docs = Router::from(SwaggerUi::new("/docs").url("/api/v1/openapi.json", document))
+        .layer(axum::middleware::map_response(empty_not_found_as_problem));
     api_routes
-        .merge(SwaggerUi::new("/docs").url("/api/v1/openapi.json", document))
+        .merge(docs)
         .merge(web::router())
         .merge(metrics::routes())
         .fallback(|| async { AppError::not_found("no such resource") })
@@ -76,6 +82,15 @@ pub fn router(state: AppState) -> Router {
         .layer(TraceLayer::new_for_http())
         .layer(CatchPanicLayer::custom(panic_response))
         .with_state(state)
+}
+
+async fn empty_not_found_as_problem(response: Response<Body>) -> Response<Body> {
+    if response.status() == axum::http::StatusCode::NOT_FOUND
+        && !response.headers().contains_key(axum::http::header::CONTENT_TYPE)
+    {
+        return AppError::not_found("no such page of the API docs").into_response();
+    }
+    response
 }
 
 fn panic_response(cause: Box<dyn Any + Send + 'static>) -> Response<Body> {
@@ -93,7 +108,21 @@ fn panic_response(cause: Box<dyn Any + Send + 'static>) -> Response<Body> {
 /// When the database cannot be opened or migrated.
 pub async fn build(config: &Config) -> anyhow::Result<(Router, AppState)> {
     let pool = db::open(&config.database).await?;
-    let state = AppState::new(pool, config.limits.clone(), config.solver_slots, config.auth.clone(), config.job_lease);
+    let state = AppState::new(
+        pool,
+        config.limits.clone(),
+        config.solver_slots,
+        config.auth.clone(),
+        config.job_lease,
+        config.job_storage,
+    );
+    if !crate::store::jobs::incremental_vacuum(&state.db).await? {
+        tracing::warn!(
+            database = %config.database,
+            "this SQLite file was made before incremental vacuum: the space of pruned jobs is reused but the file \
+             does not shrink; stop the service and run `kerf jobs prune` once to convert it"
+        );
+    }
     state.jobs.start(&state.db, &state.solver_slots, config.job_workers).await?;
     Ok((router(state.clone()), state))
 }

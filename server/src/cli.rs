@@ -1,5 +1,5 @@
 //! The `kerf` program: command line and environment configuration, `serve` (until SIGINT or
-//! SIGTERM), `worker` (claims and runs jobs from PostgreSQL, no API) and `run`.
+//! SIGTERM), `worker` (claims and runs jobs from PostgreSQL, no API), `run` and `jobs prune`.
 
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -15,6 +15,7 @@ use crate::app::Config;
 use crate::auth::Auth;
 use crate::db::{self, Database};
 use crate::jobs::queue::{DEFAULT_LEASE, JobRunner};
+use crate::jobs::storage::{self, JobStorage, MIB, mib};
 use crate::state::Limits;
 
 /// kerf: CAM web service (tool-centre paths as JSON or G-code).
@@ -38,6 +39,59 @@ pub enum Command {
     Worker(WorkerArgs),
     /// Run a job file locally, without the service, and write its results as files.
     Run(RunArgs),
+    /// Manage the stored jobs.
+    #[command(subcommand)]
+    Jobs(JobsCommand),
+}
+
+/// `kerf jobs` subcommands.
+#[derive(Debug, Subcommand)]
+pub enum JobsCommand {
+    /// Remove finished jobs (done, failed, cancelled) older than a number of days, with their
+    /// results; queued and running jobs stay. Prints what it removed. On an SQLite file made
+    /// before incremental vacuum it also converts the file (one full VACUUM: stop the service
+    /// first), after which the file shrinks as jobs are pruned.
+    Prune(PruneArgs),
+}
+
+/// Options of `kerf jobs prune`.
+#[derive(Debug, Clone, Args)]
+pub struct PruneArgs {
+    /// Remove the jobs that finished more than this many days ago (0: every finished job). Not
+    /// read from `KERF_JOB_RETENTION_DAYS`, where 0 means the opposite (keep forever).
+    #[arg(long, default_value_t = 30.0)]
+    pub older_than_days: f64,
+    /// The database (an SQLite file or a `postgres://` URL).
+    #[arg(long, env = "KERF_DATABASE", default_value = "kerf.db")]
+    pub database: Database,
+}
+
+/// The job store's bounds, shared by `serve` and `worker`.
+#[derive(Debug, Clone, Args)]
+pub struct JobStorageArgs {
+    /// MiB all stored jobs may take together (job files and compressed results); a submission
+    /// beyond it gets 429 `E_JOB_STORE_FULL`. 0: no quota.
+    #[arg(long, env = "KERF_JOB_STORE_QUOTA_MB", default_value_t = JobStorage::default().quota() / MIB)]
+    pub job_store_quota_mb: u64,
+    /// MiB one job's stored results may take (compressed); a job over it fails with
+    /// `E_RESULT_TOO_LARGE` naming the operation.
+    #[arg(long, env = "KERF_JOB_RESULT_MAX_MB", default_value_t = JobStorage::default().job_max_bytes / MIB)]
+    pub job_result_max_mb: u64,
+    /// Days a finished job is kept before it is pruned (0: forever).
+    #[arg(long, env = "KERF_JOB_RETENTION_DAYS", default_value_t = 30.0)]
+    pub job_retention_days: f64,
+}
+
+impl JobStorageArgs {
+    /// The bounds these options describe.
+    pub fn storage(&self) -> JobStorage {
+        JobStorage {
+            quota_bytes: (self.job_store_quota_mb > 0).then(|| self.job_store_quota_mb.saturating_mul(MIB)),
+            job_max_bytes: self.job_result_max_mb.max(1).saturating_mul(MIB),
+            retention: storage::days(self.job_retention_days),
+            ..JobStorage::default()
+        }
+    }
 }
 
 /// Options of `kerf run`.
@@ -70,6 +124,9 @@ pub struct WorkerArgs {
     /// Address for `/metrics`, `/readyz` and `/healthz` of this worker (none when absent).
     #[arg(long, env = "KERF_METRICS_BIND")]
     pub metrics_bind: Option<SocketAddr>,
+    /// The job store's bounds.
+    #[command(flatten)]
+    pub storage: JobStorageArgs,
 }
 
 /// Options of the service.
@@ -107,6 +164,9 @@ pub struct ServeArgs {
     /// With a token, reads of the API need it too.
     #[arg(long, env = "KERF_PRIVATE")]
     pub private: bool,
+    /// The job store's bounds.
+    #[command(flatten)]
+    pub storage: JobStorageArgs,
 }
 
 impl ServeArgs {
@@ -125,6 +185,7 @@ impl ServeArgs {
             job_workers: self.job_workers.unwrap_or(cores),
             job_lease: lease(self.job_lease_s),
             auth: Auth { token: self.api_token.clone().filter(|t| !t.is_empty()), private: self.private },
+            job_storage: self.storage.storage(),
         }
     }
 }
@@ -143,6 +204,7 @@ pub fn main() -> anyhow::Result<()> {
         Some(Command::Serve(args)) => runtime.block_on(serve(args)),
         Some(Command::Worker(args)) => runtime.block_on(worker(args)),
         Some(Command::Run(args)) => runtime.block_on(run(args)),
+        Some(Command::Jobs(JobsCommand::Prune(args))) => runtime.block_on(prune(args)),
         None => runtime.block_on(serve(cli.serve)),
     }
 }
@@ -151,6 +213,57 @@ async fn run(args: RunArgs) -> anyhow::Result<()> {
     let report = crate::jobs::local::run(&args.job_file, &args.out, Some(&args.database)).await?;
     for file in report.files {
         println!("{}", file.display());
+    }
+    Ok(())
+}
+
+/// `kerf jobs prune`: removes the finished jobs older than the given days and says what it removed.
+async fn prune(args: PruneArgs) -> anyhow::Result<()> {
+    if !(args.older_than_days.is_finite() && args.older_than_days >= 0.0) {
+        anyhow::bail!("--older-than-days must be a number of days, 0 or more (got {})", args.older_than_days);
+    }
+    let file_size = |database: &Database| {
+        database.sqlite_path().map(|path| {
+            ["", "-wal"]
+                .iter()
+                .filter_map(|suffix| std::fs::metadata(format!("{}{suffix}", path.display())).ok())
+                .map(|metadata| metadata.len())
+                .sum::<u64>()
+        })
+    };
+    if args.database.sqlite_path().is_some_and(|path| !path.exists()) {
+        anyhow::bail!("no database at {}", args.database);
+    }
+    let before = file_size(&args.database);
+    let db = db::open(&args.database).await?;
+    let older_than = Duration::from_secs_f64(args.older_than_days * 86_400.0);
+    let pruned = crate::store::jobs::prune(&db, older_than).await?;
+    let Some(pruned) = pruned else {
+        println!("another process is pruning this database right now; nothing removed");
+        return Ok(());
+    };
+    // The ids, up to a screenful.
+    const LISTED: usize = 50;
+    let mut ids: Vec<String> = pruned.ids.iter().take(LISTED).map(i64::to_string).collect();
+    if pruned.ids.len() > LISTED {
+        ids.push(format!("… {} more", pruned.ids.len() - LISTED));
+    }
+    println!(
+        "removed {} finished job(s) older than {} day(s){}: {} of job files and results",
+        pruned.ids.len(),
+        args.older_than_days,
+        if ids.is_empty() { String::new() } else { format!(" (ids {})", ids.join(", ")) },
+        mib(pruned.bytes.unsigned_abs())
+    );
+    if !crate::store::jobs::incremental_vacuum(&db).await? {
+        println!("converting the SQLite file to incremental vacuum (one full VACUUM)");
+        crate::store::jobs::convert_to_incremental_vacuum(&db).await?;
+    }
+    let (jobs, bytes) = crate::store::jobs::usage(&db).await?;
+    println!("the store holds {jobs} job(s), {}", mib(bytes.unsigned_abs()));
+    db.close().await;
+    if let (Some(before), Some(after)) = (before, file_size(&args.database)) {
+        println!("database file: {} before, {} after", mib(before), mib(after));
     }
     Ok(())
 }
@@ -180,7 +293,7 @@ async fn worker(args: WorkerArgs) -> anyhow::Result<()> {
     let cores = std::thread::available_parallelism().map_or(2, std::num::NonZero::get);
     let workers = args.job_workers.unwrap_or(cores).max(1);
     let db = db::open(&args.database).await?;
-    let runner = Arc::new(JobRunner::new(lease(args.job_lease_s)));
+    let runner = Arc::new(JobRunner::new(lease(args.job_lease_s), args.storage.storage()));
     runner.start(&db, &Arc::new(tokio::sync::Semaphore::new(workers)), workers).await?;
     if let Some(bind) = args.metrics_bind {
         let listener = TcpListener::bind(bind).await.with_context(|| format!("binding {bind}"))?;

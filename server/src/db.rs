@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 use sqlx::postgres::{PgConnectOptions, PgPoolOptions};
-use sqlx::sqlite::{SqliteConnectOptions, SqliteJournalMode, SqlitePoolOptions, SqliteSynchronous};
+use sqlx::sqlite::{SqliteAutoVacuum, SqliteConnectOptions, SqliteJournalMode, SqlitePoolOptions, SqliteSynchronous};
 use sqlx::{PgPool, SqlitePool};
 
 /// Where the data lives, as `--database` names it: a file path or `sqlite://PATH` (SQLite), or
@@ -101,6 +101,14 @@ impl Db {
         }
     }
 
+    /// Closes the pool (an SQLite file's write-ahead log is checkpointed and removed).
+    pub async fn close(&self) {
+        match self {
+            Self::Sqlite(pool) => pool.close().await,
+            Self::Postgres(pool) => pool.close().await,
+        }
+    }
+
     /// One round trip to the database.
     ///
     /// # Errors
@@ -152,7 +160,14 @@ async fn open_sqlite(path: &Path) -> anyhow::Result<SqlitePool> {
     let options = SqliteConnectOptions::from_str("sqlite:")?
         .filename(path)
         .create_if_missing(true)
+        // A new file gives pages freed by pruned jobs back to the file system (`PRAGMA
+        // incremental_vacuum` after each prune); on a file created before, this is a no-op until
+        // `kerf jobs prune` converts it.
+        .auto_vacuum(SqliteAutoVacuum::Incremental)
         .journal_mode(SqliteJournalMode::Wal)
+        // The write-ahead log is cut back to 64 MiB after each checkpoint instead of keeping the
+        // size of the largest transaction (a job's results) for good.
+        .pragma("journal_size_limit", "67108864")
         .synchronous(SqliteSynchronous::Normal)
         .foreign_keys(true)
         // Concurrent writers wait for the lock instead of failing with "database is locked".

@@ -67,6 +67,11 @@ pub enum AppError {
     /// 429: the service is saturated; try again.
     #[error("{0}")]
     TooManyRequests(String),
+    /// 429 `E_JOB_STORE_FULL`: the job store is at its quota; finished jobs must be pruned (or
+    /// the quota raised) before another job fits. No `Retry-After`: waiting alone does not help
+    /// until the retention prunes.
+    #[error("{0}")]
+    JobStoreFull(String),
     /// 422 `E_TIMEOUT`: the synchronous time limit was hit; submit a job instead. Not a 5xx:
     /// the request is well-formed but too long for a synchronous answer (api.md: a 5xx is a bug).
     #[error("{0}")]
@@ -119,6 +124,7 @@ impl AppError {
             Self::UnsupportedMediaType(_) => (StatusCode::UNSUPPORTED_MEDIA_TYPE, "Unsupported media type"),
             Self::Unprocessable(_) => (StatusCode::UNPROCESSABLE_ENTITY, "Unprocessable request"),
             Self::TooManyRequests(_) => (StatusCode::TOO_MANY_REQUESTS, "Too many requests"),
+            Self::JobStoreFull(_) => (StatusCode::TOO_MANY_REQUESTS, "Job store full"),
             Self::Timeout(_) => (StatusCode::UNPROCESSABLE_ENTITY, "Over the synchronous time limit"),
             Self::Internal(_) => (StatusCode::INTERNAL_SERVER_ERROR, "Internal error"),
         }
@@ -140,6 +146,7 @@ impl AppError {
                     Self::PayloadTooLarge { .. } => ErrorCode::TooLarge,
                     Self::UnsupportedMediaType(_) => ErrorCode::ContentType,
                     Self::TooManyRequests(_) => ErrorCode::Busy,
+                    Self::JobStoreFull(_) => ErrorCode::JobStoreFull,
                     _ => ErrorCode::Timeout,
                 };
                 (code, other.to_string(), None)

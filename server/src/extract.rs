@@ -6,7 +6,7 @@ use axum::extract::path::ErrorKind;
 use axum::extract::rejection::{BytesRejection, PathRejection};
 use axum::extract::{FromRef, FromRequest, FromRequestParts, Request};
 use axum::http::HeaderMap;
-use axum::http::header::CONTENT_TYPE;
+use axum::http::header::{CONTENT_LENGTH, CONTENT_TYPE};
 use axum::http::request::Parts;
 use kerf_solver::ErrorCode;
 use serde::de::DeserializeOwned;
@@ -52,8 +52,24 @@ pub fn media_type(headers: &HeaderMap) -> Option<String> {
     (!essence.is_empty()).then_some(essence)
 }
 
-/// Reads the whole body, mapping the body-limit rejection to 413.
+/// 413 at once when the request declares a body longer than `limit` (`Content-Length`), before
+/// anything reads it: a client that sent `Expect: 100-continue` then gets the 413 instead of
+/// `100 Continue` (hyper sends that only when the body is first read) and never sends the body.
+///
+/// # Errors
+/// 413 when the declared length is over the limit.
+pub fn refuse_declared_over(headers: &HeaderMap, limit: usize) -> Result<(), AppError> {
+    let declared = headers.get(CONTENT_LENGTH).and_then(|v| v.to_str().ok()).and_then(|v| v.trim().parse::<u64>().ok());
+    match declared {
+        Some(length) if length > u64::try_from(limit).unwrap_or(u64::MAX) => Err(AppError::PayloadTooLarge { limit }),
+        _ => Ok(()),
+    }
+}
+
+/// Reads the whole body, mapping the body-limit rejection to 413 (at once when the declared length
+/// is over the limit: [`refuse_declared_over`]).
 pub async fn body_bytes<S: Send + Sync>(request: Request, state: &S, limit: usize) -> Result<Bytes, AppError> {
+    refuse_declared_over(request.headers(), limit)?;
     Bytes::from_request(request, state).await.map_err(|rejection| match rejection {
         BytesRejection::FailedToBufferBody(_) if rejection.status() == axum::http::StatusCode::PAYLOAD_TOO_LARGE => {
             AppError::PayloadTooLarge { limit }

@@ -8,6 +8,7 @@
 //! | `kerf_http_request_duration_seconds` | histogram | `route` |
 //! | `kerf_solver_seconds` | histogram | `capability` (synchronous requests and job operations) |
 //! | `kerf_jobs` | gauge, read from the database at each scrape | `state` |
+//! | `kerf_job_store_bytes` | gauge, read at each scrape: what the stored jobs take (job files, compressed results), the quota's measure | |
 //! | `kerf_job_chunks_claimed_total` | counter (chunks, or whole SQLite jobs, this process claimed) | |
 
 use std::sync::LazyLock;
@@ -72,6 +73,7 @@ struct Metrics {
     request_seconds: Family<RouteLabels, Histogram, Buckets>,
     solver_seconds: Family<CapabilityLabels, Histogram, Buckets>,
     jobs: Family<StateLabels, Gauge>,
+    store_bytes: Gauge,
     chunks_claimed: Counter,
 }
 
@@ -87,9 +89,15 @@ static METRICS: LazyLock<Metrics> = LazyLock::new(|| {
     registry.register("kerf_solver_seconds", "Time one solver call took, by capability", solver_seconds.clone());
     let jobs = Family::<StateLabels, Gauge>::default();
     registry.register("kerf_jobs", "Jobs in the database, by state", jobs.clone());
+    let store_bytes = Gauge::default();
+    registry.register(
+        "kerf_job_store_bytes",
+        "Bytes the stored jobs take (job files and compressed results; what the quota bounds)",
+        store_bytes.clone(),
+    );
     let chunks_claimed = Counter::default();
     registry.register("kerf_job_chunks_claimed", "Job chunks this process claimed", chunks_claimed.clone());
-    Metrics { registry, requests, request_seconds, solver_seconds, jobs, chunks_claimed }
+    Metrics { registry, requests, request_seconds, solver_seconds, jobs, store_bytes, chunks_claimed }
 });
 
 /// Records one solver call of `capability` that took `seconds`.
@@ -135,6 +143,13 @@ pub async fn metrics(State(db): State<Db>) -> Response {
         // The other metrics are still worth a scrape; the gauge keeps its last values.
         Ok(Err(error)) => tracing::warn!(%error, "counting jobs for /metrics failed"),
         Err(_) => tracing::warn!("counting jobs for /metrics timed out"),
+    }
+    match tokio::time::timeout(Duration::from_secs(2), store::jobs::usage(&db)).await {
+        Ok(Ok((_, bytes))) => {
+            METRICS.store_bytes.set(bytes);
+        }
+        Ok(Err(error)) => tracing::warn!(%error, "measuring the job store for /metrics failed"),
+        Err(_) => tracing::warn!("measuring the job store for /metrics timed out"),
     }
     let mut text = String::new();
     if let Err(error) = prometheus_client::encoding::text::encode(&mut text, &METRICS.registry) {

@@ -11,6 +11,7 @@ use crate::auth::Auth;
 use crate::db::Db;
 use crate::error::{AppError, AppResult};
 use crate::jobs::queue::JobRunner;
+use crate::jobs::storage::JobStorage;
 
 /// Limits that protect the service from large or slow requests.
 #[derive(Debug, Clone)]
@@ -79,8 +80,8 @@ pub struct AppState {
 
 impl AppState {
     /// State over `db` with `limits`, allowing `solver_slots` solver calls at once, guarded by
-    /// `auth`, with job leases of `lease` (PostgreSQL).
-    pub fn new(db: Db, limits: Limits, solver_slots: usize, auth: Auth, lease: Duration) -> Self {
+    /// `auth`, with job leases of `lease` (PostgreSQL) and the job store bounded by `storage`.
+    pub fn new(db: Db, limits: Limits, solver_slots: usize, auth: Auth, lease: Duration, storage: JobStorage) -> Self {
         Self {
             answer_budget: Arc::new(Semaphore::new(
                 limits.answer_budget_bytes.div_ceil(1024).clamp(1, Semaphore::MAX_PERMITS),
@@ -88,7 +89,7 @@ impl AppState {
             db,
             limits,
             solver_slots: Arc::new(Semaphore::new(solver_slots.max(1))),
-            jobs: Arc::new(JobRunner::new(lease)),
+            jobs: Arc::new(JobRunner::new(lease, storage)),
             auth,
         }
     }
@@ -158,22 +159,34 @@ impl AppState {
     /// # Errors
     /// 429 when the answers being read already hold the budget.
     pub fn budgeted_body(&self, bytes: axum::body::Bytes) -> AppResult<axum::body::Body> {
-        const PIECE: usize = 64 * 1024;
         let permit = self.reserve_memory(bytes.len())?;
-        let mut rest = bytes;
-        let mut held = Some(permit);
-        let pieces = std::iter::from_fn(move || {
-            if rest.is_empty() {
-                return None;
-            }
-            let piece = rest.split_to(rest.len().min(PIECE));
-            if rest.is_empty() {
-                // The last piece is out of our hands: its share goes back now.
-                held.take();
-            }
-            Some(Ok::<_, std::convert::Infallible>(piece))
-        });
-        let stream = futures_util::stream::iter(pieces);
-        Ok(axum::body::Body::from_stream(stream))
+        Ok(held_body(permit, pieces_of(bytes)))
     }
+}
+
+/// Bytes of a body handed to the connection at a time.
+pub const PIECE: usize = 64 * 1024;
+
+/// `bytes` in pieces of at most [`PIECE`] bytes.
+pub fn pieces_of(mut bytes: axum::body::Bytes) -> impl Iterator<Item = std::io::Result<axum::body::Bytes>> + Send {
+    std::iter::from_fn(move || (!bytes.is_empty()).then(|| Ok(bytes.split_to(bytes.len().min(PIECE)))))
+}
+
+/// A response body of `pieces`, taken one at a time as the client reads, that holds `permit` (a
+/// share of the memory budget) until the last piece is out of its hands or the client went away.
+pub fn held_body(
+    permit: tokio::sync::OwnedSemaphorePermit,
+    pieces: impl Iterator<Item = std::io::Result<axum::body::Bytes>> + Send + 'static,
+) -> axum::body::Body {
+    let mut pieces = pieces.peekable();
+    let mut held = Some(permit);
+    let pieces = std::iter::from_fn(move || {
+        let piece = pieces.next();
+        if pieces.peek().is_none() {
+            // The last piece is out of our hands: its share goes back now.
+            held.take();
+        }
+        piece
+    });
+    axum::body::Body::from_stream(futures_util::stream::iter(pieces))
 }

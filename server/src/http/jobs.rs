@@ -11,11 +11,10 @@ use utoipa::{IntoParams, ToSchema};
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
-use super::output::gcode_response;
 use crate::error::{AppError, AppResult, Problem};
-use crate::extract::{AppPath, AppQuery, body_bytes, media_type};
+use crate::extract::{AppPath, AppQuery, body_bytes, media_type, refuse_declared_over};
 use crate::jobs::file::{self, Format, JobFile};
-use crate::state::AppState;
+use crate::state::{AppState, PIECE, held_body, pieces_of};
 use crate::store;
 use crate::store::jobs::{JobRecord, JobStatus};
 
@@ -95,6 +94,7 @@ struct JobId {
 /// Reads the uploaded job file's text and its format.
 async fn upload(state: &AppState, request: Request) -> AppResult<(String, Format)> {
     let limit = state.limits.max_body_bytes;
+    refuse_declared_over(request.headers(), limit)?;
     let media = media_type(request.headers());
     let (bytes, name, media) = match media.as_deref() {
         Some("multipart/form-data") => {
@@ -168,7 +168,8 @@ fn located(id: i64, status: StatusCode, body: &Submitted) -> Response {
         (status = 404, description = "Unknown tool number", body = Problem, content_type = "application/problem+json"),
         (status = 413, body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
-        (status = 422, body = Problem, content_type = "application/problem+json")))]
+        (status = 422, body = Problem, content_type = "application/problem+json"),
+        (status = 429, description = "`E_JOB_STORE_FULL`: the job store is at its quota (prune finished jobs or raise the quota); nothing was stored", body = Problem, content_type = "application/problem+json")))]
 async fn submit(State(state): State<AppState>, request: Request) -> AppResult<Response> {
     let (text, format) = upload(&state, request).await?;
     let job = file::parse(&text, format)?.resolve(Some(&state.db)).await?;
@@ -176,7 +177,7 @@ async fn submit(State(state): State<AppState>, request: Request) -> AppResult<Re
     if let Some(id) = store::jobs::find_done(&state.db, &hash).await? {
         return Ok(located(id, StatusCode::OK, &Submitted { id, status: JobStatus::Done, reused: true }));
     }
-    let id = store::jobs::insert(&state.db, &job, &hash).await?;
+    let id = store::jobs::insert(&state.db, &job, &hash, state.jobs.storage.quota()).await?;
     state.jobs.submitted.notify_one();
     Ok(located(id, StatusCode::ACCEPTED, &Submitted { id, status: JobStatus::Queued, reused: false }))
 }
@@ -201,33 +202,59 @@ async fn record(state: &AppState, id: i64) -> AppResult<JobRecord> {
 }
 
 /// A job: status, progress and, when done, its results.
+///
+/// The results of a done job are held in memory twice (decompressed, then the answer) while the
+/// client reads them: that share of the memory budget is taken before they are read from the
+/// store (429 when other answers hold it).
 #[utoipa::path(get, path = "/api/v1/jobs/{id}", tag = "jobs",
     params(("id" = i64, Path, description = "Job id", minimum = 1)),
-    responses((status = 200, body = JobView), (status = 404, body = Problem, content_type = "application/problem+json")))]
-async fn show(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobId>) -> AppResult<Json<JobView>> {
+    responses(
+        (status = 200, body = JobView),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 429, description = "Large answers being read hold the memory budget; retry", body = Problem, content_type = "application/problem+json")))]
+async fn show(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobId>) -> AppResult<Response> {
     let job = record(&state, id).await?;
-    let results = if job.status == JobStatus::Done {
-        let rows = store::jobs::results(&state.db, id).await?;
+    if job.status != JobStatus::Done {
+        return Ok(Json(JobView { job, results: None }).into_response());
+    }
+    let length = usize::try_from(store::jobs::results_length(&state.db, id).await?).unwrap_or(usize::MAX);
+    let permit = state.reserve_memory(length.saturating_mul(2))?;
+    let rows = store::jobs::results(&state.db, id).await?;
+    let body = tokio::task::spawn_blocking(move || {
         let mut results = Vec::with_capacity(rows.len());
-        for (operation, json, gcode, gcode_problem) in rows {
-            let result = serde_json::value::RawValue::from_string(json).map_err(|e| AppError::Internal(e.into()))?;
-            results.push(JobResult { operation, result, gcode, gcode_problem });
+        for row in rows {
+            let result = serde_json::value::RawValue::from_string(row.result.into_string()?)
+                .map_err(|e| AppError::Internal(e.into()))?;
+            results.push(JobResult {
+                operation: row.operation,
+                result,
+                gcode: row.gcode,
+                gcode_problem: row.gcode_problem,
+            });
         }
-        Some(results)
-    } else {
-        None
-    };
-    Ok(Json(JobView { job, results }))
+        serde_json::to_vec(&JobView { job, results: Some(results) }).map_err(|e| AppError::Internal(e.into()))
+    })
+    .await
+    .map_err(|e| AppError::Internal(e.into()))??;
+    let length = body.len();
+    let mut response = held_body(permit, pieces_of(body.into())).into_response();
+    response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("application/json"));
+    response.headers_mut().insert(header::CONTENT_LENGTH, HeaderValue::from(length));
+    Ok(response)
 }
 
 /// A finished job's G-code program (one per operation).
+///
+/// It is decompressed as the client reads it, never whole in memory; the compressed program holds
+/// its share of the memory budget until sent (429 when other answers hold it).
 #[utoipa::path(get, path = "/api/v1/jobs/{id}/gcode", tag = "jobs",
     params(("id" = i64, Path, description = "Job id", minimum = 1), ProgramQuery),
     responses(
         (status = 200, body = String, content_type = "text/x-gcode"),
         (status = 404, body = Problem, content_type = "application/problem+json"),
         (status = 409, description = "Not finished", body = Problem, content_type = "application/problem+json"),
-        (status = 422, description = "No program for that operation, or several to choose from", body = Problem, content_type = "application/problem+json")))]
+        (status = 422, description = "No program for that operation, or several to choose from", body = Problem, content_type = "application/problem+json"),
+        (status = 429, description = "Large answers being read hold the memory budget; retry", body = Problem, content_type = "application/problem+json")))]
 async fn gcode(
     State(state): State<AppState>,
     AppPath(JobId { id }): AppPath<JobId>,
@@ -256,15 +283,22 @@ async fn gcode(
             .into());
         }
     };
-    match &programs[index] {
-        (Some(program), _) => Ok(gcode_response(program.clone())),
-        (None, problem) => Err(kerf_solver::SolverError::new(
+    let (has_program, problem) = &programs[index];
+    let program = if *has_program { store::jobs::program(&state.db, id, index).await? } else { None };
+    let Some(program) = program else {
+        return Err(kerf_solver::SolverError::new(
             ErrorCode::NoProgram,
             format!("operation {index} has no program: {}", problem.as_deref().unwrap_or("it writes no path")),
         )
         .at("operation")
-        .into()),
-    }
+        .into());
+    };
+    let permit = state.reserve_memory(program.held() + PIECE)?;
+    let length = program.length();
+    let mut response = held_body(permit, program.pieces()).into_response();
+    response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("text/x-gcode; charset=utf-8"));
+    response.headers_mut().insert(header::CONTENT_LENGTH, HeaderValue::from(length));
+    Ok(response)
 }
 
 /// Cancels a queued or running job.

@@ -2,8 +2,7 @@
 //! JSON by default; G-code with `Accept: text/x-gcode` or `?format=gcode`, in `?dialect=`
 //! (`fanuc` default, or the machine's) with `?reference=tip|centre` and `?arcs=g2g3|chords`.
 
-use axum::http::{HeaderMap, HeaderValue, header};
-use axum::response::{IntoResponse, Response};
+use axum::http::{HeaderMap, header};
 use kerf_solver::capability::OutputOptions;
 use kerf_solver::gcode::{Arcs, Dialect, Reference};
 use serde::Deserialize;
@@ -78,11 +77,4 @@ pub fn wants_gcode(headers: &HeaderMap, format: Option<Format>) -> bool {
         Some(format) => format == Format::Gcode,
         None => accepts_gcode,
     }
-}
-
-/// A G-code program as the answer.
-pub fn gcode_response(program: String) -> Response {
-    let mut response = program.into_response();
-    response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("text/x-gcode; charset=utf-8"));
-    response
 }

@@ -21,7 +21,7 @@ use utoipa_axum::routes;
 
 use super::output::{Ask, Format, wants_gcode};
 use crate::error::{AppError, AppResult, Problem};
-use crate::extract::{AppQuery, body_bytes, is_json, media_type, parse_json};
+use crate::extract::{AppQuery, body_bytes, is_json, media_type, parse_json, refuse_declared_over};
 use crate::state::AppState;
 
 /// Query parameters of `POST /api/v1/predict`: the output negotiation of every path-producing
@@ -70,11 +70,7 @@ fn multipart_error(part: &str, limit: usize, error: &axum::extract::multipart::M
 /// Reads the body under the upload limit: JSON, or the multipart form.
 async fn upload(state: &AppState, request: Request) -> AppResult<Upload> {
     let limit = state.limits.max_upload_bytes;
-    let declared =
-        request.headers().get(header::CONTENT_LENGTH).and_then(|v| v.to_str().ok()).and_then(|v| v.parse::<u64>().ok());
-    if declared.is_some_and(|length| length > limit as u64) {
-        return Err(AppError::PayloadTooLarge { limit });
-    }
+    refuse_declared_over(request.headers(), limit)?;
     // The route's default limit is off (see `router`); this one applies instead.
     let request = request.map(|body| Body::new(http_body_util::Limited::new(body, limit)));
     if is_json(request.headers()) {

@@ -127,31 +127,59 @@ fn file_error(path: &str, line: Option<(usize, usize)>, message: &str) -> AppErr
     AppError::bad_request(ErrorCode::JobFile, field.clone(), format!("{place}{field}: {message}"))
 }
 
-/// Deepest bracket nesting, ignoring brackets inside strings (a cheap guard before parsing).
+/// Deepest bracket nesting, ignoring brackets inside strings (TOML's four kinds: basic and literal,
+/// single-line and multi-line; JSON's are the basic kind) and inside TOML comments: a cheap guard
+/// before parsing.
 fn nesting(text: &str) -> usize {
-    let (mut depth, mut deepest, mut quote, mut escaped) = (0_usize, 0_usize, None::<char>, false);
-    for c in text.chars() {
-        if let Some(q) = quote {
-            if escaped {
-                escaped = false;
-            } else if c == '\\' && q == '"' {
-                escaped = true;
-            } else if c == q {
-                quote = None;
+    let (mut depth, mut deepest) = (0_usize, 0_usize);
+    let mut rest = text;
+    while let Some(c) = rest.chars().next() {
+        let after = &rest[c.len_utf8()..];
+        rest = match c {
+            '#' => after.find('\n').map_or("", |end| &after[end..]),
+            '"' | '\'' => {
+                let triple = if c == '"' { "\"\"\"" } else { "\'\'\'" };
+                if rest.starts_with(triple) {
+                    string_end(&rest[3..], triple, c == '"')
+                } else {
+                    string_end(after, &rest[..1], c == '"')
+                }
             }
-            continue;
-        }
-        match c {
-            '"' | '\'' => quote = Some(c),
             '[' | '{' => {
                 depth += 1;
                 deepest = deepest.max(depth);
+                after
             }
-            ']' | '}' => depth = depth.saturating_sub(1),
-            _ => {}
-        }
+            ']' | '}' => {
+                depth = depth.saturating_sub(1);
+                after
+            }
+            _ => after,
+        };
     }
     deepest
+}
+
+/// What follows the string whose text starts `text` and ends with `quote` (a backslash escapes
+/// the next character in basic strings). An unterminated string runs to the end.
+fn string_end<'a>(text: &'a str, quote: &str, escapes: bool) -> &'a str {
+    let mut index = 0;
+    while index < text.len() {
+        let rest = &text[index..];
+        if escapes && rest.starts_with('\\') {
+            index += 1 + rest[1..].chars().next().map_or(0, char::len_utf8);
+        } else if rest.starts_with(quote) {
+            // A multi-line string may end in up to two more quotes that belong to its text.
+            let mut end = index + quote.len();
+            while quote.len() == 3 && text[end..].starts_with(&quote[..1]) && end < index + 5 {
+                end += 1;
+            }
+            return &text[end..];
+        } else {
+            index += rest.chars().next().map_or(1, char::len_utf8);
+        }
+    }
+    ""
 }
 
 /// TOML has `nan` and `inf`, which no request accepts and JSON (the stored job) cannot hold:
@@ -436,5 +464,25 @@ hole = { shape = "round", radius = 5 }
         assert_eq!(Format::detect(None, Some("application/json"), "x = 1"), Format::Json);
         assert_eq!(Format::detect(None, None, "  {\"a\": 1}"), Format::Json);
         assert_eq!(Format::detect(None, None, "a = 1"), Format::Toml);
+    }
+
+    #[test]
+    fn nesting_counts_brackets_outside_comments_and_strings() {
+        assert_eq!(nesting("a = [[1], [2]]\n[[operations]]\nb = { c = [3] }"), 2);
+        let brackets = "[".repeat(100);
+        // A comment, basic, literal and multi-line strings full of brackets do not count.
+        let quiet = format!(
+            "# {brackets}\nname = \"{brackets}\\\" {brackets}\" # {brackets}\nx = '{brackets}'\n\
+             y = \"\"\"\n{brackets}\"\"\"\"\nz = '''{brackets}\n'''\n[[operations]]\nw = [1] # ]]]]\n"
+        );
+        assert_eq!(nesting(&quiet), 2, "{quiet}");
+        // The same brackets outside them do.
+        assert_eq!(nesting(&format!("a = {brackets}")), 100);
+        // A job file with brackets in a comment and its name is read.
+        let job = format!(
+            "# {brackets}\n{}",
+            TOML_JOB.replace("name = \"tube\"", &format!("name = \"tube {}\"", "[".repeat(40)))
+        );
+        assert_eq!(parse(&job, Format::Toml).unwrap().operations.len(), 1);
     }
 }

@@ -5,3 +5,4 @@ pub mod execute;
 pub mod file;
 pub mod local;
 pub mod queue;
+pub mod storage;

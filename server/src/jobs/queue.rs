@@ -19,10 +19,12 @@ use sqlx::postgres::PgListener;
 use tokio::sync::{Notify, Semaphore};
 
 use super::execute::{JobFailure, execute, execute_operation};
+use super::storage::JobStorage;
 use crate::db::Db;
 use crate::error::AppError;
 use crate::store;
-use crate::store::jobs::{CANCEL_CHANNEL, Claimant, Claimed, SUBMITTED_CHANNEL, Work};
+use crate::store::jobs::{CANCEL_CHANNEL, Claimant, Claimed, Finished, SUBMITTED_CHANNEL, Work};
+use crate::store::packed::Packed;
 
 /// How often a running job's progress and heartbeat are written.
 const HEARTBEAT: Duration = Duration::from_millis(250);
@@ -38,11 +40,13 @@ pub struct JobRunner {
     pub submitted: Notify,
     cancel_flags: Mutex<HashMap<Work, Arc<AtomicBool>>>,
     claimant: Claimant,
+    /// The bounds of the job store: submissions and finished work are checked against them.
+    pub storage: JobStorage,
 }
 
 impl Default for JobRunner {
     fn default() -> Self {
-        Self::new(DEFAULT_LEASE)
+        Self::new(DEFAULT_LEASE, JobStorage::default())
     }
 }
 
@@ -59,12 +63,14 @@ fn worker_name() -> String {
 }
 
 impl JobRunner {
-    /// A runner whose claims hold for `lease` without a heartbeat.
-    pub fn new(lease: Duration) -> Self {
+    /// A runner whose claims hold for `lease` without a heartbeat, storing results within
+    /// `storage`.
+    pub fn new(lease: Duration, storage: JobStorage) -> Self {
         Self {
             submitted: Notify::new(),
             cancel_flags: Mutex::default(),
             claimant: Claimant { worker: worker_name(), lease: lease.max(Duration::from_secs(1)) },
+            storage,
         }
     }
 
@@ -109,6 +115,7 @@ impl JobRunner {
         if requeued + failed > 0 {
             tracing::warn!(requeued, failed, "jobs interrupted by the last stop");
         }
+        super::storage::start_pruner(db.clone(), self.storage);
         if workers == 0 {
             if !db.is_postgres() {
                 tracing::warn!("no job workers: submitted jobs wait until a server with workers starts");
@@ -192,10 +199,12 @@ async fn run(runner: &JobRunner, db: &Db, slots: &Arc<Semaphore>, Claimed { work
     let mut task = tokio::task::spawn_blocking(move || {
         let _permit = permit;
         let report = |fraction: f64| task_progress.store(fraction.to_bits(), Ordering::Relaxed);
-        match work.chunk {
+        let outputs = match work.chunk {
             None => execute(&job, &report, &task_cancelled),
             Some(index) => execute_operation(&job, index, &report, &task_cancelled).map(|stored| vec![stored]),
-        }
+        }?;
+        // Compressed here, on the blocking thread and in the solver slot, not on the async threads.
+        Ok::<_, JobFailure>(outputs.iter().map(Packed::new).collect::<Vec<_>>())
     });
     let mut ticker = tokio::time::interval(HEARTBEAT);
     let outcome = loop {
@@ -214,7 +223,13 @@ async fn run(runner: &JobRunner, db: &Db, slots: &Arc<Semaphore>, Claimed { work
     };
     runner.flags().remove(&work);
     let stored = match outcome {
-        Ok(Ok(outputs)) => finish(db, work, claimant, &outputs).await,
+        Ok(Ok(outputs)) => match finish(db, work, claimant, &outputs, &runner.storage).await {
+            Ok(Finished::Refused(problem)) => {
+                tracing::warn!(id, code = %problem.code.as_str(), "{}", problem.detail);
+                store::jobs::fail(db, work, claimant, &problem).await
+            }
+            other => other.map(drop),
+        },
         Ok(Err(JobFailure::Cancelled)) => Ok(()),
         Ok(Err(JobFailure::Refused(problem))) => store::jobs::fail(db, work, claimant, &problem).await,
         Err(join_error) => {
@@ -235,13 +250,14 @@ async fn finish(
     db: &Db,
     work: Work,
     claimant: &Claimant,
-    outputs: &[crate::capabilities::Stored],
-) -> crate::error::AppResult<()> {
-    match store::jobs::finish(db, work, claimant, outputs).await {
-        Ok(_) => Ok(()),
+    outputs: &[Packed],
+    storage: &JobStorage,
+) -> crate::error::AppResult<Finished> {
+    match store::jobs::finish(db, work, claimant, outputs, storage).await {
+        Ok(finished) => Ok(finished),
         Err(error) => {
             tracing::warn!(id = work.id, %error, "storing the result failed; once more");
-            store::jobs::finish(db, work, claimant, outputs).await.map(|_| ())
+            store::jobs::finish(db, work, claimant, outputs, storage).await
         }
     }
 }

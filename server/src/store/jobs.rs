@@ -19,10 +19,11 @@ use std::time::Duration;
 use utoipa::ToSchema;
 
 use super::on;
-use crate::capabilities::Stored;
+use super::packed::{Packed, StoredText};
 use crate::db::Db;
 use crate::error::{AppError, AppResult, FieldProblem, Problem};
 use crate::jobs::file::JobFile;
+use crate::jobs::storage::{JobStorage, mib};
 
 /// Attempts a job gets: one retry after a server stop interrupted it.
 pub const MAX_ATTEMPTS: i64 = 2;
@@ -66,6 +67,12 @@ macro_rules! pg_columns {
 pub const SUBMITTED_CHANNEL: &str = "kerf_jobs";
 /// The channel a cancellation notifies (payload: the job id).
 pub const CANCEL_CHANNEL: &str = "kerf_cancel";
+
+/// PostgreSQL advisory lock held while a process checks the quota and adds to the store (so two
+/// processes cannot both fit into the last free bytes).
+const QUOTA_LOCK: i64 = 0x6b65_7266_0001;
+/// PostgreSQL advisory lock of the process pruning old jobs (the others skip their turn).
+const PRUNE_LOCK: i64 = 0x6b65_7266_0002;
 
 /// Where a job is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
@@ -231,31 +238,70 @@ pub struct Claimed {
     pub attempt: i64,
 }
 
+/// Bytes as the stores count them.
+fn bytes(count: usize) -> i64 {
+    i64::try_from(count).unwrap_or(i64::MAX)
+}
+
+/// The 429 `E_JOB_STORE_FULL` of a submission that does not fit.
+async fn store_full(db: &Db, needed: i64, quota: i64) -> AppResult<AppError> {
+    let (_, used) = usage(db).await?;
+    Ok(AppError::JobStoreFull(format!(
+        "the job store holds {} of its {} quota, no room for this job ({}); prune finished jobs (kerf jobs \
+         prune, or wait for the retention) or raise --job-store-quota-mb",
+        mib(used.unsigned_abs()),
+        mib(quota.unsigned_abs()),
+        mib(needed.unsigned_abs())
+    )))
+}
+
 /// Stores a new queued job (PostgreSQL: with one chunk per operation) and wakes the workers;
-/// returns its id.
-pub async fn insert(db: &Db, job: &JobFile, hash: &str) -> AppResult<i64> {
+/// returns its id. A job that would take the store past `quota` bytes is refused (429
+/// `E_JOB_STORE_FULL`) and nothing of it is written: the check and the insert are one statement
+/// (SQLite) or one transaction under the quota lock (PostgreSQL).
+pub async fn insert(db: &Db, job: &JobFile, hash: &str, quota: u64) -> AppResult<i64> {
     let json = serde_json::to_string(job).map_err(|e| AppError::Internal(e.into()))?;
     let operations: Vec<&str> = job.operations.iter().map(|o| o.name()).collect();
     let count = i64::try_from(operations.len()).unwrap_or(i64::MAX);
     let operations = serde_json::to_string(&operations).map_err(|e| AppError::Internal(e.into()))?;
-    const INSERT: &str = "INSERT INTO jobs (name, status, content_hash, job_json, operations)
-         VALUES ($1, 'queued', $2, $3, $4) RETURNING id";
+    let (size, quota) = (bytes(json.len()), i64::try_from(quota).unwrap_or(i64::MAX));
+    const INSERT: &str = "INSERT INTO jobs (name, status, content_hash, job_json, operations, stored_bytes)
+         SELECT $1, 'queued', $2, $3, $4, CAST($5 AS BIGINT)
+         WHERE (SELECT COALESCE(SUM(stored_bytes), 0) FROM jobs) + CAST($5 AS BIGINT) <= CAST($6 AS BIGINT)
+         RETURNING id";
     match db {
         Db::Sqlite(pool) => {
-            let (id,): (i64,) =
-                sqlx::query_as(INSERT).bind(&job.name).bind(hash).bind(json).bind(operations).fetch_one(pool).await?;
-            Ok(id)
-        }
-        Db::Postgres(pool) => {
-            // The notification is delivered at commit, when the chunks are there to claim.
-            let mut transaction = pool.begin().await?;
-            let (id,): (i64,) = sqlx::query_as(INSERT)
+            let row: Option<(i64,)> = sqlx::query_as(INSERT)
                 .bind(&job.name)
                 .bind(hash)
                 .bind(json)
                 .bind(operations)
-                .fetch_one(&mut *transaction)
+                .bind(size)
+                .bind(quota)
+                .fetch_optional(pool)
                 .await?;
+            match row {
+                Some((id,)) => Ok(id),
+                None => Err(store_full(db, size, quota).await?),
+            }
+        }
+        Db::Postgres(pool) => {
+            // The notification is delivered at commit, when the chunks are there to claim.
+            let mut transaction = pool.begin().await?;
+            sqlx::query("SELECT pg_advisory_xact_lock($1)").bind(QUOTA_LOCK).execute(&mut *transaction).await?;
+            let row: Option<(i64,)> = sqlx::query_as(INSERT)
+                .bind(&job.name)
+                .bind(hash)
+                .bind(json)
+                .bind(operations)
+                .bind(size)
+                .bind(quota)
+                .fetch_optional(&mut *transaction)
+                .await?;
+            let Some((id,)) = row else {
+                transaction.rollback().await?;
+                return Err(store_full(db, size, quota).await?);
+            };
             sqlx::query(
                 "INSERT INTO job_chunks (job_id, position, status) SELECT $1, generate_series(0, $2 - 1), 'queued'",
             )
@@ -467,42 +513,124 @@ pub async fn heartbeat(db: &Db, work: Work, claimant: &Claimant, progress: f64) 
     }
 }
 
+/// What became of finished work.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Finished {
+    /// Its results are stored.
+    Stored,
+    /// Its job was cancelled (or, in PostgreSQL, the chunk is no longer the claimant's) meanwhile.
+    Gone,
+    /// Its results do not fit (over the per-job cap or the quota): nothing was stored, and the
+    /// job is to fail with this problem.
+    Refused(Problem),
+}
+
+/// Whether `outputs` (operations from `first` on) fit: the job already takes `job_bytes`, the
+/// store `total_bytes`. The problem to fail the job with when they do not.
+fn check_fit(
+    job_bytes: i64,
+    total_bytes: i64,
+    outputs: &[Packed],
+    first: i64,
+    storage: &JobStorage,
+) -> Option<Problem> {
+    let added: i64 = outputs.iter().map(|output| bytes(output.stored_bytes())).sum();
+    let cap = i64::try_from(storage.job_max_bytes).unwrap_or(i64::MAX);
+    let mut running = job_bytes;
+    for (offset, output) in outputs.iter().enumerate() {
+        running = running.saturating_add(bytes(output.stored_bytes()));
+        if running > cap {
+            let index = first + bytes(offset);
+            let detail = format!(
+                "operations[{index}] ({}) brings the job's stored results to {} (compressed), over the limit of {} \
+                 per job (--job-result-max-mb); split the job or make the operation smaller",
+                output.operation,
+                mib(running.unsigned_abs()),
+                mib(storage.job_max_bytes)
+            );
+            return Some(Problem {
+                errors: vec![FieldProblem { path: format!("operations[{index}]"), message: detail.clone() }],
+                ..job_problem(422, "Result too large", ErrorCode::ResultTooLarge, &detail)
+            });
+        }
+    }
+    let quota = storage.quota();
+    (total_bytes.saturating_add(added).unsigned_abs() > quota).then(|| {
+        job_problem(
+            429,
+            "Job store full",
+            ErrorCode::JobStoreFull,
+            &format!(
+                "its results ({} compressed) do not fit: the job store holds {} of its {} quota; prune finished \
+                 jobs (kerf jobs prune, or wait for the retention) or raise --job-store-quota-mb, then submit it again",
+                mib(added.unsigned_abs()),
+                mib(total_bytes.unsigned_abs()),
+                mib(quota)
+            ),
+        )
+    })
+}
+
 /// Stores the results and marks the work done, in one transaction, unless its job was
-/// cancelled (or, in PostgreSQL, the chunk is no longer the claimant's) meanwhile; in PostgreSQL
-/// the job is done with its last chunk. Returns whether it was stored.
-pub async fn finish(db: &Db, work: Work, claimant: &Claimant, outputs: &[Stored]) -> AppResult<bool> {
+/// cancelled (or, in PostgreSQL, the chunk is no longer the claimant's) meanwhile, or the results
+/// do not fit in `storage` (then nothing is written). In PostgreSQL the job is done with its last
+/// chunk.
+pub async fn finish(
+    db: &Db,
+    work: Work,
+    claimant: &Claimant,
+    outputs: &[Packed],
+    storage: &JobStorage,
+) -> AppResult<Finished> {
+    let added: i64 = outputs.iter().map(|output| bytes(output.stored_bytes())).sum();
     macro_rules! results_in {
         ($transaction:expr, $first:expr) => {
             for (offset, output) in outputs.iter().enumerate() {
                 sqlx::query(
-                    "INSERT INTO job_results (job_id, position, operation, result_json, gcode, gcode_problem)
-                     VALUES ($1, $2, $3, $4, $5, $6)",
+                    "INSERT INTO job_results (job_id, position, operation, result_json, result_gz, result_bytes,
+                         gcode_gz, gcode_bytes, gcode_problem)
+                     VALUES ($1, $2, $3, '', $4, $5, $6, $7, $8)",
                 )
                 .bind(work.id)
                 .bind($first + i64::try_from(offset).unwrap_or(i64::MAX))
                 .bind(&output.operation)
-                .bind(output.result.get())
-                .bind(&output.gcode)
+                .bind(&output.result_gz)
+                .bind(bytes(output.result_bytes))
+                .bind(&output.gcode_gz)
+                .bind(bytes(output.gcode_bytes))
                 .bind(&output.gcode_problem)
                 .execute(&mut *$transaction)
                 .await?;
             }
+            sqlx::query("UPDATE jobs SET stored_bytes = stored_bytes + $1 WHERE id = $2")
+                .bind(added)
+                .bind(work.id)
+                .execute(&mut *$transaction)
+                .await?;
         };
     }
     match db {
         Db::Sqlite(pool) => {
+            // The first statement writes, so the transaction holds the file's write lock from
+            // there on: the quota check and the results it admits are one step.
             let mut transaction = pool.begin().await?;
-            let updated = sqlx::query(concat!(
+            let job: Option<(i64,)> = sqlx::query_as(concat!(
                 "UPDATE jobs SET status = 'done', progress = 1, finished_at = ",
                 now!(),
-                " WHERE id = $1 AND status = 'running'"
+                " WHERE id = $1 AND status = 'running' RETURNING stored_bytes"
             ))
             .bind(work.id)
-            .execute(&mut *transaction)
+            .fetch_optional(&mut *transaction)
             .await?;
-            if updated.rows_affected() == 0 {
+            let Some((job_bytes,)) = job else {
                 transaction.rollback().await?;
-                return Ok(false);
+                return Ok(Finished::Gone);
+            };
+            let (total,): (i64,) =
+                sqlx::query_as("SELECT COALESCE(SUM(stored_bytes), 0) FROM jobs").fetch_one(&mut *transaction).await?;
+            if let Some(problem) = check_fit(job_bytes, total, outputs, 0, storage) {
+                transaction.rollback().await?;
+                return Ok(Finished::Refused(problem));
             }
             results_in!(transaction, 0);
             transaction.commit().await?;
@@ -511,10 +639,11 @@ pub async fn finish(db: &Db, work: Work, claimant: &Claimant, outputs: &[Stored]
             let mut transaction = pool.begin().await?;
             // The job's row first: finishers of one job's chunks take turns, so the last one
             // sees every other chunk done.
-            let job: Option<(String,)> = sqlx::query_as("SELECT status FROM jobs WHERE id = $1 FOR UPDATE")
-                .bind(work.id)
-                .fetch_optional(&mut *transaction)
-                .await?;
+            let job: Option<(String, i64)> =
+                sqlx::query_as("SELECT status, stored_bytes FROM jobs WHERE id = $1 FOR UPDATE")
+                    .bind(work.id)
+                    .fetch_optional(&mut *transaction)
+                    .await?;
             let updated = sqlx::query(
                 "UPDATE job_chunks SET status = 'done', progress = 1, lease_expires_at = NULL
                  WHERE job_id = $1 AND position = $2 AND worker = $3 AND status = 'running'",
@@ -524,9 +653,21 @@ pub async fn finish(db: &Db, work: Work, claimant: &Claimant, outputs: &[Stored]
             .bind(&claimant.worker)
             .execute(&mut *transaction)
             .await?;
-            if job.is_none_or(|(status,)| status != "running") || updated.rows_affected() == 0 {
+            let Some((_, job_bytes)) = job.filter(|(status, _)| status == "running") else {
                 transaction.rollback().await?;
-                return Ok(false);
+                return Ok(Finished::Gone);
+            };
+            if updated.rows_affected() == 0 {
+                transaction.rollback().await?;
+                return Ok(Finished::Gone);
+            }
+            sqlx::query("SELECT pg_advisory_xact_lock($1)").bind(QUOTA_LOCK).execute(&mut *transaction).await?;
+            let (total,): (i64,) = sqlx::query_as("SELECT COALESCE(SUM(stored_bytes), 0)::BIGINT FROM jobs")
+                .fetch_one(&mut *transaction)
+                .await?;
+            if let Some(problem) = check_fit(job_bytes, total, outputs, work.position(), storage) {
+                transaction.rollback().await?;
+                return Ok(Finished::Refused(problem));
             }
             results_in!(transaction, work.position());
             sqlx::query(
@@ -539,7 +680,7 @@ pub async fn finish(db: &Db, work: Work, claimant: &Claimant, outputs: &[Stored]
             transaction.commit().await?;
         }
     }
-    Ok(true)
+    Ok(Finished::Stored)
 }
 
 /// Marks running work's job failed with the problem (PostgreSQL: only while the chunk is the
@@ -560,6 +701,22 @@ pub async fn fail(db: &Db, work: Work, claimant: &Claimant, problem: &Problem) -
                    UPDATE jobs SET status = 'failed', error = $1, error_field = $2, finished_at = now()
                    WHERE id IN (SELECT job_id FROM chunk) AND status = 'running'",
         [json, field, work.id, &claimant.worker, work.position()], execute)?;
+    drop_partial_results(db, work.id).await
+}
+
+/// Removes what chunks of a job that then failed or was cancelled stored (PostgreSQL: other
+/// chunks may have finished first), so a job that will never be done takes no more than its job
+/// file. No-op for a job still to run or done.
+async fn drop_partial_results(db: &Db, id: i64) -> AppResult<()> {
+    on!(db, query,
+        both: "DELETE FROM job_results WHERE job_id = $1
+               AND EXISTS (SELECT 1 FROM jobs WHERE id = $1 AND status IN ('failed', 'cancelled'))",
+        [id], execute)?;
+    on!(db, query,
+        sqlite: "UPDATE jobs SET stored_bytes = length(CAST(job_json AS BLOB))
+                 WHERE id = $1 AND status IN ('failed', 'cancelled')",
+        postgres: "UPDATE jobs SET stored_bytes = octet_length(job_json) WHERE id = $1 AND status IN ('failed', 'cancelled')",
+        [id], execute)?;
     Ok(())
 }
 
@@ -567,6 +724,14 @@ pub async fn fail(db: &Db, work: Work, claimant: &Claimant, problem: &Problem) -
 /// the job had, and whether this call cancelled it. In PostgreSQL the workers are notified, so
 /// the one running it stops at once (its heartbeat would find out within a second anyway).
 pub async fn cancel(db: &Db, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
+    let cancelled = cancel_job(db, id).await?;
+    if matches!(cancelled, Some((_, true))) {
+        drop_partial_results(db, id).await?;
+    }
+    Ok(cancelled)
+}
+
+async fn cancel_job(db: &Db, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
     let error = problem_json(&job_problem(409, "Cancelled", ErrorCode::Cancelled, "cancelled by request"))?;
     macro_rules! cancel_in {
         ($pool:expr, $select:expr, $update:expr, $notify:expr) => {{
@@ -601,20 +766,149 @@ pub async fn cancel(db: &Db, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
     }
 }
 
-/// A finished job's results, in operation order: operation, result JSON, whether a program
-/// exists and why not.
-pub async fn results(db: &Db, id: i64) -> AppResult<Vec<(String, String, bool, Option<String>)>> {
+/// One operation's stored result.
+#[derive(Debug)]
+pub struct ResultRow {
+    /// The operation's name.
+    pub operation: String,
+    /// Its result JSON.
+    pub result: StoredText,
+    /// Whether a program exists.
+    pub gcode: bool,
+    /// Why no program could be written, if so.
+    pub gcode_problem: Option<String>,
+}
+
+/// A finished job's results, in operation order.
+pub async fn results(db: &Db, id: i64) -> AppResult<Vec<ResultRow>> {
+    type Row = (String, Option<String>, Option<Vec<u8>>, i64, bool, Option<String>);
+    let rows: Vec<Row> = on!(db, query_as,
+        both: "SELECT operation, result_json, result_gz, result_bytes, gcode IS NOT NULL OR gcode_gz IS NOT NULL,
+                   gcode_problem
+               FROM job_results WHERE job_id = $1 ORDER BY position",
+        [id], fetch_all)?;
+    Ok(rows
+        .into_iter()
+        .map(|(operation, json, compressed, length, gcode, gcode_problem)| ResultRow {
+            operation,
+            result: StoredText::from_columns(json, compressed, length).unwrap_or(StoredText::Plain(String::new())),
+            gcode,
+            gcode_problem,
+        })
+        .collect())
+}
+
+/// The bytes a finished job's results take uncompressed (what showing them holds in memory).
+pub async fn results_length(db: &Db, id: i64) -> AppResult<i64> {
+    let (length,): (i64,) = on!(db, query_as,
+        sqlite: "SELECT COALESCE(SUM(result_bytes), 0) FROM job_results WHERE job_id = $1",
+        postgres: "SELECT COALESCE(SUM(result_bytes), 0)::BIGINT FROM job_results WHERE job_id = $1",
+        [id], fetch_one)?;
+    Ok(length)
+}
+
+/// For each operation of a finished job, in order: whether it has a program, and why not.
+pub async fn programs(db: &Db, id: i64) -> AppResult<Vec<(bool, Option<String>)>> {
     Ok(on!(db, query_as,
-        both: "SELECT operation, result_json, gcode IS NOT NULL, gcode_problem FROM job_results WHERE job_id = $1
+        both: "SELECT gcode IS NOT NULL OR gcode_gz IS NOT NULL, gcode_problem FROM job_results WHERE job_id = $1
                ORDER BY position",
         [id], fetch_all)?)
 }
 
-/// The programs of a finished job, in operation order (`None` where none could be written).
-pub async fn programs(db: &Db, id: i64) -> AppResult<Vec<(Option<String>, Option<String>)>> {
+/// The program of operation `position` of a finished job, if it has one.
+pub async fn program(db: &Db, id: i64, position: usize) -> AppResult<Option<StoredText>> {
+    let row: Option<(Option<String>, Option<Vec<u8>>, i64)> = on!(db, query_as,
+        both: "SELECT gcode, gcode_gz, gcode_bytes FROM job_results WHERE job_id = $1 AND position = $2",
+        [id, bytes(position)], fetch_optional)?;
+    Ok(row.and_then(|(text, compressed, length)| StoredText::from_columns(text, compressed, length)))
+}
+
+/// Jobs stored and the bytes they take (job files and compressed results).
+pub async fn usage(db: &Db) -> AppResult<(i64, i64)> {
     Ok(on!(db, query_as,
-        both: "SELECT gcode, gcode_problem FROM job_results WHERE job_id = $1 ORDER BY position",
-        [id], fetch_all)?)
+        sqlite: "SELECT COUNT(*), COALESCE(SUM(stored_bytes), 0) FROM jobs",
+        postgres: "SELECT COUNT(*), COALESCE(SUM(stored_bytes), 0)::BIGINT FROM jobs",
+        [], fetch_one)?)
+}
+
+/// Finished jobs removed by [`prune`].
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Pruned {
+    /// Their ids, ascending.
+    pub ids: Vec<i64>,
+    /// The bytes they took.
+    pub bytes: i64,
+}
+
+/// Removes the finished jobs (done, failed, cancelled) that finished more than `older_than` ago,
+/// with their results; queued and running jobs are never touched. SQLite then gives the freed
+/// pages back to the file system (incremental vacuum, where the file has it) and truncates the
+/// write-ahead log. `None` in PostgreSQL when another process is pruning right now.
+pub async fn prune(db: &Db, older_than: Duration) -> AppResult<Option<Pruned>> {
+    let mut rows: Vec<(i64, i64)> = match db {
+        Db::Sqlite(pool) => {
+            let rows = sqlx::query_as(
+                "DELETE FROM jobs WHERE status IN ('done', 'failed', 'cancelled')
+                     AND finished_at < strftime('%Y-%m-%dT%H:%M:%fZ', 'now', $1)
+                 RETURNING id, stored_bytes",
+            )
+            .bind(format!("-{:.3} seconds", older_than.as_secs_f64()))
+            .fetch_all(pool)
+            .await?;
+            if !rows.is_empty() {
+                sqlx::query("PRAGMA incremental_vacuum").execute(pool).await?;
+                sqlx::query("PRAGMA wal_checkpoint(TRUNCATE)").execute(pool).await?;
+            }
+            rows
+        }
+        Db::Postgres(pool) => {
+            let mut transaction = pool.begin().await?;
+            let (ours,): (bool,) = sqlx::query_as("SELECT pg_try_advisory_xact_lock($1)")
+                .bind(PRUNE_LOCK)
+                .fetch_one(&mut *transaction)
+                .await?;
+            if !ours {
+                return Ok(None);
+            }
+            let rows = sqlx::query_as(
+                "DELETE FROM jobs WHERE status IN ('done', 'failed', 'cancelled')
+                     AND finished_at < now() - make_interval(secs => $1)
+                 RETURNING id, stored_bytes",
+            )
+            .bind(older_than.as_secs_f64())
+            .fetch_all(&mut *transaction)
+            .await?;
+            transaction.commit().await?;
+            rows
+        }
+    };
+    rows.sort_unstable();
+    Ok(Some(Pruned {
+        bytes: rows.iter().map(|(_, bytes)| bytes).sum(),
+        ids: rows.into_iter().map(|(id, _)| id).collect(),
+    }))
+}
+
+/// How an SQLite file gives freed space back: `true` when it has incremental vacuum (files
+/// created since migration 0004), `false` for older files (freed pages are reused, the file does
+/// not shrink until [`convert_to_incremental_vacuum`]). Always `true` in PostgreSQL.
+pub async fn incremental_vacuum(db: &Db) -> AppResult<bool> {
+    let Db::Sqlite(pool) = db else { return Ok(true) };
+    let (mode,): (i64,) = sqlx::query_as("PRAGMA auto_vacuum").fetch_one(pool).await?;
+    Ok(mode == 2)
+}
+
+/// Rewrites an SQLite file with incremental vacuum (one full `VACUUM`: it needs the file's size
+/// again in free disk space and no other process using the file), giving all free pages back.
+/// Nothing to do in PostgreSQL.
+pub async fn convert_to_incremental_vacuum(db: &Db) -> AppResult<()> {
+    let Db::Sqlite(pool) = db else { return Ok(()) };
+    // The mode and the VACUUM that applies it must run on one connection.
+    let mut connection = pool.acquire().await?;
+    sqlx::query("PRAGMA auto_vacuum = INCREMENTAL").execute(&mut *connection).await?;
+    sqlx::query("VACUUM").execute(&mut *connection).await?;
+    sqlx::query("PRAGMA wal_checkpoint(TRUNCATE)").execute(&mut *connection).await?;
+    Ok(())
 }
 
 /// At start-up of an SQLite service no job can be running: each one a stopped server left

@@ -282,3 +282,80 @@ async fn slow_uploads_hold_a_bounded_budget() {
     }
     assert_eq!(answered, 400, "an empty predict request is a bad request once the budget is free");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn slow_readers_of_large_job_programs_hold_a_bounded_budget() {
+    // A 1 MiB budget and a job whose program is some 20 MB: while one client does not read it, the
+    // next download of a large job output gets 429 with Retry-After instead of another copy in memory.
+    let app = TestApp::spawn_with(Limits { answer_budget_bytes: 1024 * 1024, ..Limits::default() }).await;
+    let job = json!({"name": "deep contour", "operations": [{"operation": "contour",
+        "tool": {"kind": "ball", "radius": 3}, "contour": circle(600), "side": "outside",
+        "depths": {"top": 0, "bottom": -250, "step": 0.25}, "feed": 800}]});
+    let id = json_with(app.post_json("/api/v1/jobs", &job).await, 202).await["id"].as_i64().unwrap();
+    let done = kerf_tests::poll_job(&app.client, &app.base, id, 300, kerf_tests::finished).await;
+    assert_eq!(done["status"], "done", "{done}");
+    let program = format!("/api/v1/jobs/{id}/gcode");
+    let unread = app.get(&program).await;
+    assert_eq!(unread.status(), 200);
+    let length: usize = unread.headers()["content-length"].to_str().unwrap().parse().unwrap();
+    assert!(length > 15_000_000, "{length}");
+    for path in [program.clone(), format!("/api/v1/jobs/{id}")] {
+        let refused = app.get(&path).await;
+        assert!(refused.headers().contains_key("retry-after"), "{path}: {:?}", refused.headers());
+        assert_eq!(problem(refused, 429).await["code"], "E_BUSY", "{path}");
+    }
+    // Reading it gives the budget back; it arrives whole.
+    let first = unread.text().await.unwrap();
+    assert_eq!(first.len(), length);
+    assert!(first.trim_end().ends_with('%') && first.contains("M30"), "a whole program");
+    let again = app.get(&program).await;
+    assert_eq!(again.status(), 200);
+    assert_eq!(again.text().await.unwrap(), first);
+    json_with(app.get(&format!("/api/v1/jobs/{id}")).await, 200).await;
+}
+
+/// Reads from `stream` until the end of a response head (or 10 s pass, which fails the test).
+async fn read_head(stream: &mut tokio::net::TcpStream) -> String {
+    use tokio::io::AsyncReadExt;
+    let mut received = Vec::new();
+    let read = tokio::time::timeout(Duration::from_secs(10), async {
+        let mut buffer = [0_u8; 4096];
+        while !received.windows(4).any(|w| w == b"\r\n\r\n") {
+            match stream.read(&mut buffer).await {
+                Ok(0) | Err(_) => break,
+                Ok(n) => received.extend_from_slice(&buffer[..n]),
+            }
+        }
+    })
+    .await;
+    assert!(read.is_ok(), "no answer; received: {}", String::from_utf8_lossy(&received));
+    String::from_utf8_lossy(&received).into_owned()
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_body_declared_over_the_limit_gets_413_before_100_continue() {
+    let app = TestApp::spawn_with(Limits { max_body_bytes: 1024, ..Limits::default() }).await;
+    for (route, media_type) in [
+        ("PUT /api/v1/tools/7", "application/json"),
+        ("POST /api/v1/jobs", "application/toml"),
+        ("POST /api/v1/jobs", "multipart/form-data; boundary=XX"),
+        ("POST /api/v1/predict", "application/json"),
+    ] {
+        let head = format!(
+            "{route} HTTP/1.1\r\nHost: kerf\r\nContent-Type: {media_type}\r\nContent-Length: 999999999999\r\n\
+             Expect: 100-continue\r\n\r\n"
+        );
+        let mut stream = raw_request(&app, head.as_bytes()).await;
+        let answer = read_head(&mut stream).await;
+        assert!(answer.starts_with("HTTP/1.1 413"), "{route} ({media_type}): {answer}");
+        assert!(answer.contains("application/problem+json"), "{answer}");
+    }
+    // Within the limit the client is told to go on.
+    let mut stream = raw_request(
+        &app,
+        b"PUT /api/v1/tools/7 HTTP/1.1\r\nHost: kerf\r\nContent-Type: application/json\r\nContent-Length: 30\r\n\
+          Expect: 100-continue\r\n\r\n",
+    )
+    .await;
+    assert!(read_head(&mut stream).await.starts_with("HTTP/1.1 100"));
+}

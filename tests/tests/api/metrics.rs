@@ -41,6 +41,7 @@ async fn metrics_and_readiness(store: Store) {
     assert!(solves.is_some_and(|n| n >= 2.0), "the request and the job's operation: {text}");
     assert!(sample(&text, r#"kerf_jobs{state="done"}"#).is_some_and(|n| n >= 1.0), "{text}");
     assert_eq!(sample(&text, r#"kerf_jobs{state="running"}"#), Some(0.0), "{text}");
+    assert!(sample(&text, "kerf_job_store_bytes").is_some_and(|n| n > 100.0), "the stored job: {text}");
     assert!(sample(&text, "kerf_job_chunks_claimed_total").is_some_and(|n| n >= 1.0), "{text}");
     // Unknown paths are one label, not one per path.
     app.get("/no/such/path/12345").await;

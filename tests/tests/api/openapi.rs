@@ -27,4 +27,7 @@ async fn document_covers_every_route_and_docs_are_served() {
     let initializer = app.get("/docs/swagger-initializer.js").await;
     assert_eq!(initializer.status(), 200);
     assert!(initializer.text().await.unwrap().contains("/api/v1/openapi.json"));
+    // A file the docs do not have is a problem document like every other 404.
+    let missing = kerf_tests::problem(app.get("/docs/no-such-file.js").await, 404).await;
+    assert_eq!(missing["code"], "E_NOT_FOUND");
 }
