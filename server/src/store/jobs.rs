@@ -734,8 +734,8 @@ pub async fn cancel(db: &Db, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
 async fn cancel_job(db: &Db, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
     let error = problem_json(&job_problem(409, "Cancelled", ErrorCode::Cancelled, "cancelled by request"))?;
     macro_rules! cancel_in {
-        ($pool:expr, $select:expr, $update:expr, $notify:expr) => {{
-            let mut transaction = $pool.begin().await?;
+        ($begin:expr, $select:expr, $update:expr, $notify:expr) => {{
+            let mut transaction = $begin.await?;
             let row: Option<(String,)> = sqlx::query_as($select).bind(id).fetch_optional(&mut *transaction).await?;
             let Some((status,)) = row else { return Ok(None) };
             let status = JobStatus::parse(&status)?;
@@ -751,14 +751,17 @@ async fn cancel_job(db: &Db, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
         }};
     }
     match db {
+        // IMMEDIATE: the write lock from the start. A deferred transaction that reads and then
+        // writes fails at once with SQLITE_BUSY when a worker wrote in between (the busy timeout
+        // does not apply to a stale read snapshot): a 500 under load.
         Db::Sqlite(pool) => cancel_in!(
-            pool,
+            pool.begin_with("BEGIN IMMEDIATE"),
             "SELECT status FROM jobs WHERE id = $1",
             concat!("UPDATE jobs SET status = 'cancelled', finished_at = ", now!(), ", error = $1 WHERE id = $2"),
             None::<&'static str>
         ),
         Db::Postgres(pool) => cancel_in!(
-            pool,
+            pool.begin(),
             "SELECT status FROM jobs WHERE id = $1 FOR UPDATE",
             "UPDATE jobs SET status = 'cancelled', finished_at = now(), error = $1 WHERE id = $2",
             Some("SELECT pg_notify($1, $2)")

@@ -76,23 +76,26 @@ fn zigzag(points: usize) -> Vec<[f64; 2]> {
 async fn timed_out_work_stops_and_frees_its_slot() {
     // One slot, a short time limit and a queue wait far shorter than the abandoned work would take
     // to finish: a request after two timed-out ones is served only if the work really stopped.
+    // The wait is generous (10 s) so that a loaded machine, slow to reach the work's first check,
+    // does not fail it; the work would take minutes.
     let app = TestApp::spawn_configured(|config| {
         config.solver_slots = 1;
         config.limits.solver_time_limit = Duration::from_millis(100);
-        config.limits.solver_queue_wait = Duration::from_secs(3);
+        config.limits.solver_queue_wait = Duration::from_secs(10);
     })
     .await;
     let ball = json!({"kind": "ball", "radius": 3});
-    // Looping 199 000 crowded corners takes minutes; 400 layers of a 600-point circle over a second.
+    // Looping 199 000 crowded corners takes minutes; the program of 4000 layers of a 600-point
+    // circle (2.4 million moves, over the JSON answer's limit) tens of seconds.
     let slow = [
         (
             "/api/v1/contour/loops",
             json!({"tool": ball, "path": zigzag(199_000), "material_side": "left", "tolerance": 1e-6}),
         ),
         (
-            "/api/v1/contour",
+            "/api/v1/contour?format=gcode",
             json!({"tool": ball, "contour": circle(600), "side": "outside",
-                   "depths": {"top": 0, "bottom": -100, "step": 0.25}, "feed": 800}),
+                   "depths": {"top": 0, "bottom": -100, "step": 0.025}, "feed": 800}),
         ),
     ];
     for (path, body) in &slow {

@@ -451,20 +451,21 @@ async fn upload_limit_is_the_routes_own() {
 
 #[tokio::test(flavor = "multi_thread")]
 async fn over_the_time_limit_is_422_and_frees_the_slot() {
+    // One slot, and a request waits at most 1 s for it: far less than the abandoned prediction
+    // (seconds of work) would hold it if it ran on. Each request after a timed-out one is served
+    // (422, then 200), not refused 429, only if the abandoned work really stopped.
     let app = TestApp::spawn_configured(|config| {
         config.solver_slots = 1;
         config.limits.solver_time_limit = Duration::from_millis(300);
+        config.limits.solver_queue_wait = Duration::from_secs(1);
     })
     .await;
-    let mut long = raster_request(finishing_tool(), 40, 81);
-    long["resolution"] = json!(1024);
-    let answer = problem(app.post_json("/api/v1/predict", &long).await, 422).await;
-    assert_eq!(answer["code"], "E_TIMEOUT");
-    assert!(answer["detail"].as_str().unwrap().contains("/api/v1/jobs"), "{answer}");
-    // The abandoned prediction stops: the only solver slot is free again at once.
-    let started = Instant::now();
+    for _ in 0..2 {
+        let answer = problem(app.post_json("/api/v1/predict", &long_request()).await, 422).await;
+        assert_eq!(answer["code"], "E_TIMEOUT");
+        assert!(answer["detail"].as_str().unwrap().contains("/api/v1/jobs"), "{answer}");
+    }
     predict(&app, &raster_request(finishing_tool(), 2, 3)).await;
-    assert!(started.elapsed() < Duration::from_secs(5), "slot freed after {:?}", started.elapsed());
 }
 
 #[tokio::test(flavor = "multi_thread")]
@@ -993,9 +994,10 @@ async fn long_prediction_job_reports_progress_and_cancels_promptly() {
     }
     assert!(seen.len() >= 3, "progress reported while running: {seen:?}");
     // Cancelled at once, and the only worker and solver slot are free again promptly.
+    // The quick job can only run once the one worker lets go of the long prediction, which
+    // would otherwise run for far longer than the quick job is waited for.
     let cancelled = json_with(app.delete(&format!("/api/v1/jobs/{id}")).await, 200).await;
     assert_eq!(cancelled["status"], "cancelled");
-    let stopped = Instant::now();
     let quick = json_with(
         app.post_json("/api/v1/jobs", &predict_job("quick", &raster_request(finishing_tool(), 2, 3))).await,
         202,
@@ -1004,7 +1006,6 @@ async fn long_prediction_job_reports_progress_and_cancels_promptly() {
     let job =
         kerf_tests::poll_job(&app.client, &app.base, quick["id"].as_i64().unwrap(), 30, kerf_tests::finished).await;
     assert_eq!(job["status"], "done", "{job}");
-    assert!(stopped.elapsed() < Duration::from_secs(5), "the cancelled job let go after {:?}", stopped.elapsed());
     let job = json_with(app.get(&format!("/api/v1/jobs/{id}")).await, 200).await;
     assert_eq!(job["status"], "cancelled", "cancelled, not failed: {job}");
 }
@@ -1019,7 +1020,6 @@ fn a_cancelled_prediction_is_a_cancelled_job_not_a_failure() {
     let job = file::parse(&predict_job("long", &long_request()).to_string(), Format::Json).unwrap();
     let cancel = AtomicBool::new(false);
     let reports = std::sync::Mutex::new(Vec::new());
-    let started = Instant::now();
     let outcome = std::thread::scope(|scope| {
         scope.spawn(|| {
             std::thread::sleep(Duration::from_millis(500));
@@ -1028,9 +1028,10 @@ fn a_cancelled_prediction_is_a_cancelled_job_not_a_failure() {
         execute(&job, &|fraction| reports.lock().unwrap().push(fraction), &cancel)
     });
     assert_eq!(outcome.unwrap_err(), JobFailure::Cancelled);
-    assert!(started.elapsed() < Duration::from_secs(5), "stopped after {:?}", started.elapsed());
     let reports = reports.into_inner().unwrap();
     assert!(!reports.is_empty() && reports.iter().all(|f| *f > 0.0 && *f < 1.0), "{reports:?}");
+    // Stopped where it was cancelled, half a second in, not near the end of the prediction.
+    assert!(reports.last().is_some_and(|f| *f < 0.5), "ran on after the cancel: {reports:?}");
     assert!(reports.windows(2).all(|w| w[0] < w[1]), "increasing: {reports:?}");
 }
 
