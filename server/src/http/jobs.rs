@@ -1,5 +1,6 @@
 //! Jobs over HTTP (api.md, Jobs): submit a job file (multipart field `file`, or the raw body as
-//! JSON or TOML), follow it, fetch its results and G-code, cancel it, list jobs with paging.
+//! JSON or TOML), follow it, fetch its results and G-code (each operation's, or the one program
+//! of the whole job, or every output as a zip archive), cancel it, list jobs with paging.
 
 use axum::Json;
 use axum::extract::{FromRequest, Multipart, Request, State};
@@ -15,6 +16,7 @@ use super::output::gcode_response;
 use crate::error::{AppError, AppResult, Problem};
 use crate::extract::{AppPath, AppQuery, body_bytes, media_type};
 use crate::jobs::file::{self, Format, JobFile};
+use crate::jobs::program::{self, OperationOutput};
 use crate::state::AppState;
 use crate::store;
 use crate::store::jobs::{JobRecord, JobStatus};
@@ -267,6 +269,72 @@ async fn gcode(
     }
 }
 
+/// A finished job's stored file and every operation's stored outputs: 404 for an unknown job,
+/// 409 for one not done.
+async fn finished(state: &AppState, id: i64) -> AppResult<(JobFile, Vec<store::outputs::OperationRow>)> {
+    let job = record(state, id).await?;
+    if job.status != JobStatus::Done {
+        return Err(AppError::Conflict(format!("job {id} is {:?}, not done", job.status).to_lowercase()));
+    }
+    let json = store::outputs::job_file(&state.db, id)
+        .await?
+        .ok_or_else(|| AppError::not_found(format!("job {id} does not exist")))?;
+    let file: JobFile = serde_json::from_str(&json).map_err(|error| AppError::Internal(error.into()))?;
+    Ok((file, store::outputs::outputs(&state.db, id).await?))
+}
+
+fn operation_outputs(rows: &[store::outputs::OperationRow]) -> Vec<OperationOutput<'_>> {
+    rows.iter()
+        .map(|(operation, result, gcode, gcode_problem)| OperationOutput {
+            operation,
+            result,
+            gcode: gcode.as_deref(),
+            gcode_problem: gcode_problem.as_deref(),
+        })
+        .collect()
+}
+
+/// A finished job's one program: every operation in order with its tool change, spindle and
+/// coolant, one program number (`[output] program_number`, else `2000 + (id − 1) mod 6000`), a
+/// header listing operations, tools and estimated times. Operations without a program are named
+/// in the header as not included.
+#[utoipa::path(get, path = "/api/v1/jobs/{id}/program", tag = "jobs",
+    params(("id" = i64, Path, description = "Job id", minimum = 1)),
+    responses(
+        (status = 200, body = String, content_type = "text/x-gcode"),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 409, description = "Not finished", body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "No operation has a program (`E_NO_PROGRAM`)", body = Problem, content_type = "application/problem+json")))]
+async fn job_program(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobId>) -> AppResult<Response> {
+    let (file, rows) = finished(&state, id).await?;
+    let number = program::program_number(&file, Some(id));
+    let text = program::job_program(&file, number, &operation_outputs(&rows))?;
+    Ok(gcode_response(text))
+}
+
+/// Every output of a finished job as a zip archive (stored, uncompressed): `job.json`, each
+/// operation's answer `NN-operation.json` and program `NN-operation.nc`, and the job's one
+/// program `program.nc` (the files `kerf run -o DIR` writes).
+#[utoipa::path(get, path = "/api/v1/jobs/{id}/outputs.zip", tag = "jobs",
+    params(("id" = i64, Path, description = "Job id", minimum = 1)),
+    responses(
+        (status = 200, body = Vec<u8>, content_type = "application/zip"),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 409, description = "Not finished", body = Problem, content_type = "application/problem+json")))]
+async fn outputs_zip(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobId>) -> AppResult<Response> {
+    let (file, rows) = finished(&state, id).await?;
+    let number = program::program_number(&file, Some(id));
+    let files = program::files(&file, number, &operation_outputs(&rows));
+    let archive = crate::zip::stored(&files).map_err(|message| AppError::Internal(anyhow::anyhow!(message)))?;
+    let mut response = archive.into_response();
+    let headers = response.headers_mut();
+    headers.insert(header::CONTENT_TYPE, HeaderValue::from_static("application/zip"));
+    if let Ok(disposition) = HeaderValue::from_str(&format!("attachment; filename=\"kerf-job-{id}.zip\"")) {
+        headers.insert(header::CONTENT_DISPOSITION, disposition);
+    }
+    Ok(response)
+}
+
 /// Cancels a queued or running job.
 #[utoipa::path(delete, path = "/api/v1/jobs/{id}", tag = "jobs",
     params(("id" = i64, Path, description = "Job id", minimum = 1)),
@@ -289,5 +357,10 @@ async fn cancel(State(state): State<AppState>, AppPath(JobId { id }): AppPath<Jo
 
 /// Routes of this module.
 pub fn router() -> OpenApiRouter<AppState> {
-    OpenApiRouter::new().routes(routes!(submit, list)).routes(routes!(show, cancel)).routes(routes!(gcode))
+    OpenApiRouter::new()
+        .routes(routes!(submit, list))
+        .routes(routes!(show, cancel))
+        .routes(routes!(gcode))
+        .routes(routes!(job_program))
+        .routes(routes!(outputs_zip))
 }

@@ -4,4 +4,5 @@
 pub mod execute;
 pub mod file;
 pub mod local;
+pub mod program;
 pub mod queue;

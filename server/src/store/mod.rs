@@ -5,6 +5,7 @@
 
 pub mod jobs;
 pub mod machines;
+pub mod outputs;
 pub mod tools;
 
 use kerf_solver::capability::Refs;

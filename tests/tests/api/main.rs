@@ -12,6 +12,7 @@ mod engagement;
 mod entries;
 mod gcode;
 mod job_fuzz;
+mod job_program;
 mod jobs;
 mod limits;
 mod load;
