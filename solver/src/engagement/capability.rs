@@ -54,6 +54,9 @@ impl Capability for EngagementCapability {
         context: Resolved<Tool>,
         run: &Run<'_>,
     ) -> Result<EngagementResponse, SolverError> {
+        if let Some(feed) = request.plunge_feed {
+            crate::validate::positive("plunge_feed", feed)?;
+        }
         // A stored material is not resolved yet (no material library): the solver names
         // `material` when a request gives one instead of `kienzle`.
         let physics = super::Physics {
@@ -77,7 +80,8 @@ impl Capability for EngagementCapability {
         answer: &EngagementResponse,
         output: &OutputOptions,
     ) -> Result<String, SolverError> {
-        let post = output.post(answer.machine.as_ref(), &answer.tool);
+        let mut post = output.post(answer.machine.as_ref(), &answer.tool);
+        post.plunge_feed = request.plunge_feed.or(post.plunge_feed);
         let candidate = output.candidate.or(request.candidate).unwrap_or(0);
         super::program(&answer.result, candidate, &post)
     }
