@@ -6,7 +6,9 @@ use serde::Serialize;
 use super::{Deburr, DeburrRequest};
 use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
 use crate::error::SolverError;
+use crate::geometry::Vec3;
 use crate::machine::MachineProfile;
+use crate::machine::cycle::{CycleTime, Dynamics, Step};
 use crate::tool::Tool;
 
 /// The deburr capability.
@@ -23,6 +25,11 @@ pub struct DeburrAnswer {
     /// error) spaced the points, its dialect is the G-code default.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub machine: Option<MachineProfile>,
+    /// With a machine that has `max_accel`: the time the control would take for the program
+    /// (trapezoidal feed profile, stops at sharp vertices, rapids at `rapid_feed`, one tool
+    /// change) and its parts: cutting (the loop), air (the leads), rapid, tool change (issue 15).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cycle_time: Option<CycleTime>,
     /// The loop of centres, leads, summary and warnings.
     #[serde(flatten)]
     pub result: Deburr,
@@ -40,7 +47,8 @@ impl Capability for DeburrCapability {
 
     fn solve(request: &DeburrRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<DeburrAnswer, SolverError> {
         let result = super::solve_controlled(request, &context.tool, context.machine.as_ref(), run.control)?;
-        Ok(DeburrAnswer { tool: context.tool, machine: context.machine, result })
+        let cycle_time = context.machine.as_ref().and_then(MachineProfile::dynamics).map(|d| cycle_time(&result, &d));
+        Ok(DeburrAnswer { tool: context.tool, machine: context.machine, cycle_time, result })
     }
 
     fn program(_request: &DeburrRequest, answer: &DeburrAnswer, output: &OutputOptions) -> Result<String, SolverError> {
@@ -51,4 +59,23 @@ impl Capability for DeburrCapability {
     fn machine(answer: &DeburrAnswer) -> Option<&MachineProfile> {
         answer.machine.as_ref()
     }
+}
+
+/// The cycle time of the deburring program: the leads' feed moves in the air, the loop cutting
+/// at the deburring feed (the program's moves down run in air at that feed too), one tool change.
+fn cycle_time(result: &Deburr, dynamics: &Dynamics) -> CycleTime {
+    use super::LeadMotion;
+    let feed = result.summary.feed;
+    let lead = |step: &super::LeadMove| {
+        let to = Vec3::from(step.centre);
+        match step.motion {
+            LeadMotion::Rapid => Step::Rapid(to),
+            LeadMotion::Feed => Step::Feed { to, feed, air: true },
+        }
+    };
+    let mut steps: Vec<Step> = result.lead_in.iter().map(lead).collect();
+    steps.extend(result.points.iter().skip(1).map(|p| Step::Feed { to: Vec3::from(p.centre), feed, air: false }));
+    steps.extend(result.lead_out.iter().map(lead));
+    let start = result.lead_in.first().map_or_else(Vec3::zeros, |step| Vec3::from(step.centre));
+    crate::machine::cycle::cycle_time(start, &steps, dynamics, 1)
 }

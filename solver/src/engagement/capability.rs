@@ -34,6 +34,12 @@ pub struct EngagementResponse {
     /// T2 as given, s.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_limit_s: Option<f64>,
+    /// With a machine that has `max_accel` and an `axial_depth` (a program): the time the control
+    /// would take for the program of the request's `candidate` path (trapezoidal feed profile,
+    /// stops at sharp corners, the plunge at the plunge feed, rapids at `rapid_feed`, one tool
+    /// change) and its parts (issue 15).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cycle_time: Option<crate::machine::cycle::CycleTime>,
     /// Samples, flute counts and recommendation (or `candidates`, one such result per path).
     #[serde(flatten)]
     pub result: EngagementAnswer,
@@ -64,7 +70,15 @@ impl Capability for EngagementCapability {
             spindle: context.machine.as_ref().map(MachineProfile::spindle).unwrap_or_default(),
         };
         let result = super::solve_in(request, &context.tool, context.machine.as_ref(), &physics, run.control)?;
+        let cycle_time = context.machine.as_ref().and_then(MachineProfile::dynamics).and_then(|dynamics| {
+            let plunge = request
+                .plunge_feed
+                .or(context.tool.plunge_feed)
+                .or(context.machine.as_ref().and_then(|m| m.plunge_feed));
+            super::program::cycle_time(&result, request.candidate.unwrap_or(0), &dynamics, plunge)
+        });
         Ok(EngagementResponse {
+            cycle_time,
             tool: context.tool,
             machine: context.machine,
             stock: request.stock.clone(),

@@ -238,3 +238,52 @@ async fn a_request_plunge_feed_wins_and_bad_entries_name_their_field() {
     let body = problem(app.put_json("/api/v1/tools/9", &ball).await, 422).await;
     assert_eq!(body["errors"][0]["path"], "centre_cutting", "{body}");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn deburr_and_engagement_have_a_cycle_time_too() {
+    let app = TestApp::spawn().await;
+    app.register_tool(3, &json!({"kind": "flat", "radius": 3})).await;
+    app.register_tool(7, &json!({"kind": "ball", "radius": 3})).await;
+    let machine = json!({"block_time_ms": 1, "max_feed": 12000, "max_accel": 500, "rapid_feed": 30000,
+                         "tool_change_s": 4});
+    assert_eq!(app.put_json("/api/v1/machines/accel", &machine).await.status(), 201);
+    let number = |v: &Value| v.as_f64().unwrap();
+    let close = |label: &str, got: f64, want: f64| assert!((got - want).abs() < 1e-9, "{label}: {got} vs {want}");
+    let parts =
+        |time: &Value| ["cutting_s", "air_s", "rapid_s", "tool_change_s"].iter().map(|k| number(&time[*k])).sum();
+
+    // Engagement: one straight cut of 80 mm at 600 mm/min (10 mm/s) from rest to rest, the
+    // plunge in the air at half the feed.
+    let engagement = json!({"tool": 3, "stock": {"polygon": [[0, 0], [60, 0], [60, 40], [0, 40]]},
+                            "path": [[-10, 20], [70, 20]], "spindle_rpm": 3000, "feed": 600, "axial_depth": 2,
+                            "machine": "accel"});
+    let answer = json_with(app.post_json("/api/v1/engagement", &engagement).await, 200).await;
+    let time = &answer["cycle_time"];
+    close("engagement cutting", number(&time["cutting_s"]), rest_to_rest(80.0, 10.0, 500.0));
+    assert!(number(&time["air_s"]) > 0.0 && number(&time["rapid_s"]) > 0.0, "{time}");
+    close("engagement tool change", number(&time["tool_change_s"]), 4.0);
+    close("engagement total", number(&time["total_s"]), parts(time));
+    let mut plain = engagement.clone();
+    plain.as_object_mut().unwrap().remove("machine");
+    assert!(json_with(app.post_json("/api/v1/engagement", &plain).await, 200).await.get("cycle_time").is_none());
+
+    // Deburr: the loop cuts, the leads are air; with accelerations and stops the control takes at
+    // least the feed time of the loop.
+    let deburr = json!({"tool": 7, "machine": "accel", "edge": "outer", "cut_amount": 0.3, "feed": 400,
+        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 15, "outer_radius": 25},
+        "hole": {"shape": "round", "radius": 6}});
+    let answer = json_with(app.post_json("/api/v1/deburr", &deburr).await, 200).await;
+    let time = &answer["cycle_time"];
+    let points = answer["points"].as_array().unwrap();
+    let loop_length: f64 = points
+        .windows(2)
+        .map(|pair| {
+            let (a, b) = (&pair[0]["centre"], &pair[1]["centre"]);
+            (0..3).map(|k| (number(&b[k]) - number(&a[k])).powi(2)).sum::<f64>().sqrt()
+        })
+        .sum();
+    let cutting = number(&time["cutting_s"]);
+    assert!(cutting >= loop_length / (400.0 / 60.0) - 1e-9 && cutting < 2.0 * loop_length / (400.0 / 60.0), "{time}");
+    assert!(number(&time["air_s"]) > 0.0 && number(&time["rapid_s"]) > 0.0, "{time}");
+    close("deburr total", number(&time["total_s"]), parts(time));
+}
