@@ -313,7 +313,9 @@ pub fn write(job: &Job<'_>, operations: &[Operation<'_>]) -> Result<String, Solv
                 "{} {}: not in this program: {}",
                 index + 1,
                 operation.name,
-                operation.problem.unwrap_or("its program is its own file, operation output")
+                operation
+                    .problem
+                    .unwrap_or("its program keeps the layout of the program it corrects: run its own file")
             ),
         };
         let _ = writeln!(out, "{}", comment(&line));
