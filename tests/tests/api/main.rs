@@ -7,6 +7,7 @@ mod browser;
 mod cli;
 mod contour;
 mod deburr;
+mod deburr_holes;
 mod deburr_machine;
 mod engagement;
 mod entries;
