@@ -17,6 +17,7 @@ pub mod openapi;
 pub mod state;
 pub mod store;
 pub mod web;
+pub mod zip;
 
 use std::future::Future;
 

@@ -66,6 +66,11 @@ pub struct Tool {
     /// faster (issue 15). Default: the machine's `plunge_feed`, else half the cutting feed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub plunge_feed: Option<f64>,
+    /// Whether the end cuts at its centre, so the tool may plunge straight down into material
+    /// (issue 15). Default true; `false` (flat and bull tools with a centre hole or inserts)
+    /// makes contour layers enter on a ramp. A ball always cuts at its centre.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub centre_cutting: Option<bool>,
     /// Neck radius in mm of a lollipop or back-deburring cutter (0 < neck_radius < radius): the
     /// radius of the shank just above the cutting head. Without it the shank is taken to be as
     /// wide as the cutter.
@@ -179,10 +184,16 @@ impl Tool {
             helix_deg: None,
             stickout: None,
             plunge_feed: None,
+            centre_cutting: None,
             neck_radius: None,
             shape_error: None,
             stiffness: None,
         }
+    }
+
+    /// Whether the tool may plunge straight down into material.
+    pub fn cuts_at_centre(&self) -> bool {
+        self.centre_cutting.unwrap_or(true)
     }
 
     /// Checks every field; `prefix` is prepended to field names in errors (e.g. `tool.`).
@@ -231,6 +242,9 @@ impl Tool {
         }
         if let Some(plunge_feed) = self.plunge_feed {
             positive(&field("plunge_feed"), plunge_feed)?;
+        }
+        if self.kind == ToolKind::Ball && self.centre_cutting == Some(false) {
+            return Err(SolverError::input(field("centre_cutting"), "a ball end mill always cuts at its centre"));
         }
         if let Some(neck) = self.neck_radius {
             positive(&field("neck_radius"), neck)?;

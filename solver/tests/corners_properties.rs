@@ -7,6 +7,9 @@
 //!   outgoing moves collinear, along one of the corner's faces, a different face each time);
 //! * every pass and every layer is closed;
 //! * the same request gives byte-identical answers;
+//! * a tool that does not cut at its centre enters every layer on a ramp: no feed move goes down
+//!   steeper than the ramp angle or faster than the plunge feed, and the ramp keeps the tool
+//!   radius from the contour (issue 15);
 //!
 //! each with and without the block-time rule (`block_time_ms`).
 //!
@@ -60,6 +63,10 @@ struct Setup {
     max_angle_deg: f64,
     /// With the block-time rule (arcs chorded by it, their end segments merged).
     block_time: Option<f64>,
+    /// Whether the flat tool cuts at its centre (else its layers enter on ramps).
+    centre_cutting: bool,
+    /// Ramp angle, degrees.
+    ramp_angle_deg: f64,
 }
 
 fn setup() -> impl Strategy<Value = Setup> {
@@ -73,18 +80,34 @@ fn setup() -> impl Strategy<Value = Setup> {
         any::<bool>(),
         100.0f64..179.0,
         prop::option::of(0.5f64..8.0),
+        (any::<bool>(), 0.5f64..45.0),
     )
-        .prop_map(|(contour, radius, outside, climb, style, two_passes, round, max_angle_deg, block_time)| Setup {
-            contour,
-            radius,
-            outside,
-            climb,
-            style,
-            two_passes,
-            round,
-            max_angle_deg,
-            block_time,
-        })
+        .prop_map(
+            |(
+                contour,
+                radius,
+                outside,
+                climb,
+                style,
+                two_passes,
+                round,
+                max_angle_deg,
+                block_time,
+                (centre_cutting, ramp_angle_deg),
+            )| Setup {
+                contour,
+                radius,
+                outside,
+                climb,
+                style,
+                two_passes,
+                round,
+                max_angle_deg,
+                block_time,
+                centre_cutting,
+                ramp_angle_deg,
+            },
+        )
 }
 
 fn request(setup: &Setup) -> ContourRequest {
@@ -106,7 +129,8 @@ fn request(setup: &Setup) -> ContourRequest {
         "passes": passes,
         "feed": 600,
         "loop_feed": 2000,
-        "tolerance": 0.005
+        "tolerance": 0.005,
+        "ramp_angle_deg": setup.ramp_angle_deg
     });
     if let Some(block_time) = setup.block_time {
         body["block_time_ms"] = json!(block_time);
@@ -115,7 +139,7 @@ fn request(setup: &Setup) -> ContourRequest {
 }
 
 fn solve(setup: &Setup) -> Option<ContourAnswer> {
-    let tool = Tool::new(ToolKind::Flat, setup.radius);
+    let tool = Tool { centre_cutting: Some(setup.centre_cutting), ..Tool::new(ToolKind::Flat, setup.radius) };
     match corners::solve(&request(setup), &tool) {
         Ok(answer) => Some(answer),
         Err(error) => {
@@ -241,5 +265,36 @@ proptest! {
         }
         let again = solve(&setup).unwrap();
         prop_assert_eq!(serde_json::to_string(&answer).unwrap(), serde_json::to_string(&again).unwrap());
+    }
+
+    #[test]
+    fn layers_of_a_tool_that_does_not_cut_at_its_centre_enter_on_ramps(setup in setup()) {
+        let setup = Setup { centre_cutting: false, ..setup };
+        let Some(answer) = solve(&setup) else { return Ok(()); };
+        let slope = setup.ramp_angle_deg.to_radians().tan();
+        let plunge_feed = 600.0 * kerf_solver::gcode::DEFAULT_PLUNGE_FRACTION;
+        let polygon: Vec<Vec2> = setup.contour.iter().copied().map(vec2).collect();
+        let mut ramps = 0;
+        for layer in &answer.layers {
+            for pair in layer.moves.windows(2) {
+                let (from, to) = (pair[0].to, pair[1].to);
+                let Some(feed) = pair[1].feed else { continue };
+                if pair[1].kind == MoveKind::Rapid || to[2] >= from[2] {
+                    continue;
+                }
+                let run = (xy(to) - xy(from)).norm();
+                let drop = from[2] - to[2];
+                prop_assert!(run > 0.0, "a plunge straight down at {to:?}");
+                prop_assert!(drop <= run * slope * (1.0 + 1e-9) + 1e-12, "{drop} down over {run} at {to:?}");
+                prop_assert!(feed <= plunge_feed, "ramp at F{feed}");
+                for k in 0..polygon.len() {
+                    let distance =
+                        segment_segment_distance(&xy(from), &xy(to), &polygon[k], &polygon[(k + 1) % polygon.len()]);
+                    prop_assert!(distance >= setup.radius - GOUGE, "ramp {from:?}→{to:?} within {distance} of edge {k}");
+                }
+                ramps += 1;
+            }
+        }
+        prop_assert!(ramps >= answer.layers.len(), "every layer enters on a ramp");
     }
 }

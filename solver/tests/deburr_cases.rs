@@ -60,7 +60,9 @@ fn request(case: &Value) -> (DeburrRequest, Tool) {
     let request = DeburrRequest {
         tool: ToolRef::Inline(tool.clone()),
         workpiece,
-        hole,
+        hole: Some(hole),
+        holes: None,
+        pattern: None,
         edge,
         cut_amount: Some(number(&inputs["Q"])),
         width: None,

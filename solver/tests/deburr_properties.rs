@@ -70,14 +70,16 @@ fn case() -> impl Strategy<Value = Case> {
             let request = DeburrRequest {
                 tool: ToolRef::Inline(tool.clone()),
                 workpiece,
-                hole: Hole {
+                hole: Some(Hole {
                     shape,
                     radius,
                     centre_distance,
                     eccentricity: Some(eccentricity),
                     penetration_angle_deg: penetration,
                     axis_point: None,
-                },
+                }),
+                holes: None,
+                pattern: None,
                 edge: if inner { Edge::Inner } else { Edge::Outer },
                 cut_amount: None,
                 width: Some(width),
@@ -212,7 +214,9 @@ proptest! {
         let request = DeburrRequest {
             tool: ToolRef::Inline(tool.clone()),
             workpiece,
-            hole: Hole { shape, radius: values[7], centre_distance, eccentricity: Some(values[8]), penetration_angle_deg: values[9], axis_point: None },
+            hole: Some(Hole { shape, radius: values[7], centre_distance, eccentricity: Some(values[8]), penetration_angle_deg: values[9], axis_point: None }),
+            holes: None,
+            pattern: None,
             edge: if pick < 3 { Edge::Inner } else { Edge::Outer },
             cut_amount: Some(values[10]),
             width: None,

@@ -143,6 +143,23 @@ async function openJob(id, root) {
     const title = document.createElement('h2');
     title.textContent = `Job #${job.id}${job.name ? ': ' + job.name : ''}`;
     box.append(title);
+    // The whole job as one program: every operation with its tool change (issue 15).
+    if (job.results.some((result) => result.gcode)) {
+      const whole = document.createElement('div');
+      whole.className = 'actions';
+      const program = document.createElement('button');
+      program.className = 'secondary';
+      program.textContent = 'Program (all operations)';
+      program.addEventListener('click', async () => {
+        try {
+          download(`job-${job.id}.nc`, await api('GET', `/api/v1/jobs/${job.id}/program`, undefined, 'text/x-gcode'));
+        } catch (problem) {
+          showProblem(root.querySelector('#job-messages'), null, problem);
+        }
+      });
+      whole.append(program);
+      box.append(whole);
+    }
     const shown = [];
     job.results.forEach((result, index) => {
       const section = document.createElement('section');

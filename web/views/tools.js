@@ -80,7 +80,9 @@ function edit(form, tool) {
   const stiffness = tool.stiffness;
   form.elements.stiffness.value = stiffness?.kind === 'static' && stiffness.x === stiffness.y ? stiffness.x : '';
   form.querySelector('[data-kept-stiffness]').hidden = !stiffness || form.elements.stiffness.value !== '';
-  form.kept = stiffness && form.elements.stiffness.value === '' ? { stiffness } : {};
+  // Data the form does not show stays as stored: the plunge feed and whether it cuts at its centre.
+  form.kept = { plunge_feed: tool.plunge_feed, centre_cutting: tool.centre_cutting };
+  if (stiffness && form.elements.stiffness.value === '') form.kept.stiffness = stiffness;
   syncForm(form);
   form.elements.size.focus();
 }

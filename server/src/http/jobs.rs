@@ -1,5 +1,6 @@
 //! Jobs over HTTP (api.md, Jobs): submit a job file (multipart field `file`, or the raw body as
-//! JSON or TOML), follow it, fetch its results and G-code, cancel it, list jobs with paging.
+//! JSON or TOML), follow it, fetch its results and G-code (each operation's, or the one program
+//! of the whole job, or every output as a zip archive), cancel it, list jobs with paging.
 
 use axum::Json;
 use axum::extract::{FromRequest, Multipart, Request, State};
@@ -14,6 +15,7 @@ use utoipa_axum::routes;
 use crate::error::{AppError, AppResult, Problem};
 use crate::extract::{AppPath, AppQuery, body_bytes, media_type, refuse_declared_over};
 use crate::jobs::file::{self, Format, JobFile};
+use crate::jobs::program::{self, OperationOutput};
 use crate::state::{AppState, PIECE, held_body, pieces_of};
 use crate::store;
 use crate::store::jobs::{JobRecord, JobStatus};
@@ -301,6 +303,85 @@ async fn gcode(
     Ok(response)
 }
 
+/// A finished job's stored file and every operation's stored outputs: 404 for an unknown job,
+/// 409 for one not done, 429 while the memory budget cannot hold them and what is built of them
+/// (the program or the archive, about as large again), which the permit reserves.
+async fn finished(
+    state: &AppState,
+    id: i64,
+) -> AppResult<(JobFile, Vec<store::outputs::OperationRow>, tokio::sync::OwnedSemaphorePermit)> {
+    let job = record(state, id).await?;
+    if job.status != JobStatus::Done {
+        return Err(AppError::Conflict(format!("job {id} is {:?}, not done", job.status).to_lowercase()));
+    }
+    let permit = state.reserve_memory(store::outputs::length(&state.db, id).await?.saturating_mul(2))?;
+    let json = store::outputs::job_file(&state.db, id)
+        .await?
+        .ok_or_else(|| AppError::not_found(format!("job {id} does not exist")))?;
+    let file: JobFile = serde_json::from_str(&json).map_err(|error| AppError::Internal(error.into()))?;
+    Ok((file, store::outputs::outputs(&state.db, id).await?, permit))
+}
+
+fn operation_outputs(rows: &[store::outputs::OperationRow]) -> Vec<OperationOutput<'_>> {
+    rows.iter()
+        .map(|(operation, result, gcode, gcode_problem)| OperationOutput {
+            operation,
+            result,
+            gcode: gcode.as_deref(),
+            gcode_problem: gcode_problem.as_deref(),
+        })
+        .collect()
+}
+
+/// A finished job's one program: every operation in order with its tool change, spindle and
+/// coolant, one program number (`[output] program_number`, else `2000 + (id − 1) mod 6000`), a
+/// header listing operations, tools and estimated times. Operations without a program are named
+/// in the header as not included.
+#[utoipa::path(get, path = "/api/v1/jobs/{id}/program", tag = "jobs",
+    params(("id" = i64, Path, description = "Job id", minimum = 1)),
+    responses(
+        (status = 200, body = String, content_type = "text/x-gcode"),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 409, description = "Not finished", body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "No operation has a program (`E_NO_PROGRAM`)", body = Problem, content_type = "application/problem+json")))]
+async fn job_program(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobId>) -> AppResult<Response> {
+    let (file, rows, permit) = finished(&state, id).await?;
+    let number = program::program_number(&file, Some(id));
+    let text = program::job_program(&file, number, &operation_outputs(&rows))?;
+    drop(rows);
+    let length = text.len();
+    let mut response = held_body(permit, pieces_of(text.into())).into_response();
+    response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("text/x-gcode; charset=utf-8"));
+    response.headers_mut().insert(header::CONTENT_LENGTH, HeaderValue::from(length));
+    Ok(response)
+}
+
+/// Every output of a finished job as a zip archive (stored, uncompressed): `job.json`, each
+/// operation's answer `NN-operation.json` and program `NN-operation.nc`, and the job's one
+/// program `program.nc` (the files `kerf run -o DIR` writes).
+#[utoipa::path(get, path = "/api/v1/jobs/{id}/outputs.zip", tag = "jobs",
+    params(("id" = i64, Path, description = "Job id", minimum = 1)),
+    responses(
+        (status = 200, body = Vec<u8>, content_type = "application/zip"),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 409, description = "Not finished", body = Problem, content_type = "application/problem+json")))]
+async fn outputs_zip(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobId>) -> AppResult<Response> {
+    let (file, rows, permit) = finished(&state, id).await?;
+    let number = program::program_number(&file, Some(id));
+    let files = program::files(&file, number, &operation_outputs(&rows));
+    let archive = crate::zip::stored(&files).map_err(|message| AppError::Internal(anyhow::anyhow!(message)))?;
+    drop((files, rows));
+    let length = archive.len();
+    let mut response = held_body(permit, pieces_of(archive.into())).into_response();
+    let headers = response.headers_mut();
+    headers.insert(header::CONTENT_TYPE, HeaderValue::from_static("application/zip"));
+    headers.insert(header::CONTENT_LENGTH, HeaderValue::from(length));
+    if let Ok(disposition) = HeaderValue::from_str(&format!("attachment; filename=\"kerf-job-{id}.zip\"")) {
+        headers.insert(header::CONTENT_DISPOSITION, disposition);
+    }
+    Ok(response)
+}
+
 /// Cancels a queued or running job.
 #[utoipa::path(delete, path = "/api/v1/jobs/{id}", tag = "jobs",
     params(("id" = i64, Path, description = "Job id", minimum = 1)),
@@ -323,5 +404,10 @@ async fn cancel(State(state): State<AppState>, AppPath(JobId { id }): AppPath<Jo
 
 /// Routes of this module.
 pub fn router() -> OpenApiRouter<AppState> {
-    OpenApiRouter::new().routes(routes!(submit, list)).routes(routes!(show, cancel)).routes(routes!(gcode))
+    OpenApiRouter::new()
+        .routes(routes!(submit, list))
+        .routes(routes!(show, cancel))
+        .routes(routes!(gcode))
+        .routes(routes!(job_program))
+        .routes(routes!(outputs_zip))
 }

@@ -25,6 +25,7 @@
 
 use kerf_solver::ErrorCode;
 use kerf_solver::capability::{self, Lookup};
+use kerf_solver::gcode::job::Coolant;
 use kerf_solver::gcode::{Arcs, Dialect, Reference};
 use kerf_solver::machine::{MachineProfile, validate_machine_name};
 use kerf_solver::predict::Stock;
@@ -81,6 +82,15 @@ pub struct OutputOptions {
     /// `arcs`, else `chords`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub arcs: Option<Arcs>,
+    /// Number of the job's one program (`GET /api/v1/jobs/{id}/program`): 1–7999; default
+    /// `2000 + (id − 1) mod 6000` (`kerf run`: 2000).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(minimum = 1, maximum = 7999)]
+    pub program_number: Option<u32>,
+    /// Coolant of every operation in the job's one program: `off` (default), `flood` (M08) or
+    /// `mist` (M07); M09 after each operation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coolant: Option<Coolant>,
 }
 
 impl OutputOptions {
@@ -281,6 +291,9 @@ fn check(job: &JobFile) -> AppResult<()> {
         if job.tools[..index].iter().any(|t| t.number == Some(number)) {
             return Err(file_error(&format!("{field}.number"), None, &format!("tool {number} is defined twice")));
         }
+    }
+    if let Some(number) = job.output.program_number {
+        kerf_solver::gcode::job::check_number("output.program_number", number)?;
     }
     for (index, operation) in job.operations.iter().enumerate() {
         if let Operation::Predict(request) = operation

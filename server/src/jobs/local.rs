@@ -9,6 +9,7 @@ use anyhow::{Context, bail};
 
 use super::execute::{JobFailure, execute};
 use super::file::{self, Format};
+use super::program::{self, OperationOutput};
 use crate::db::{self, Database};
 use crate::error::AppError;
 
@@ -26,7 +27,8 @@ fn describe(error: &AppError) -> String {
 
 /// Runs the job file at `path`, resolving tool numbers (and machine names) against `database`
 /// when it exists, and writes `job.json`, one `NN-operation.json` per operation and its
-/// `NN-operation.nc` program into `out`.
+/// `NN-operation.nc` program, and the job's one program `program.nc` into `out` (the files of
+/// `GET /api/v1/jobs/{id}/outputs.zip`).
 ///
 /// # Errors
 /// When the file cannot be read or parsed, a tool is unknown, an operation is refused, or the
@@ -66,25 +68,25 @@ pub async fn run(path: &Path, out: &Path, database: Option<&Database>) -> anyhow
 
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let mut files = Vec::new();
-    let mut write = |name: String, contents: &str| -> anyhow::Result<()> {
+    let mut write = |name: String, contents: &[u8]| -> anyhow::Result<()> {
         let target = out.join(name);
         std::fs::write(&target, contents).with_context(|| format!("writing {}", target.display()))?;
         files.push(target);
         Ok(())
     };
-    let summary = serde_json::json!({
-        "name": job.name,
-        "operations": outputs.iter().map(|o| serde_json::json!({
-            "operation": o.operation, "gcode": o.gcode.is_some(), "gcode_problem": o.gcode_problem
-        })).collect::<Vec<_>>(),
-    });
-    write("job.json".to_owned(), &serde_json::to_string_pretty(&summary)?)?;
-    for (index, output) in outputs.iter().enumerate() {
-        // The answer exactly as the endpoint gives it.
-        write(format!("{index:02}-{}.json", output.operation), output.result.get())?;
-        if let Some(program) = &output.gcode {
-            write(format!("{index:02}-{}.nc", output.operation), program)?;
-        }
+    let rows: Vec<OperationOutput<'_>> = outputs
+        .iter()
+        .map(|output| OperationOutput {
+            operation: &output.operation,
+            result: output.result.get(),
+            gcode: output.gcode.as_deref(),
+            gcode_problem: output.gcode_problem.as_deref(),
+        })
+        .collect();
+    // No job id here: the program number is the file's, else the first job number.
+    let number = program::program_number(&job, None);
+    for (name, contents) in program::files(&job, number, &rows) {
+        write(name, &contents)?;
     }
     Ok(RunReport { files })
 }

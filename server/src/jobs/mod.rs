@@ -4,5 +4,6 @@
 pub mod execute;
 pub mod file;
 pub mod local;
+pub mod program;
 pub mod queue;
 pub mod storage;

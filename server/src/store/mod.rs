@@ -6,6 +6,7 @@
 pub mod jobs;
 pub mod machines;
 pub mod packed;
+pub mod outputs;
 pub mod tools;
 
 use kerf_solver::capability::Refs;

@@ -53,9 +53,13 @@ impl Capability for SegmentCapability {
         if let Some(tool) = &context.tool {
             tool.validate("tool.")?;
         }
+        if let Some(feed) = request.plunge_feed {
+            crate::validate::positive("plunge_feed", feed)?;
+        }
         let result = super::solve_controlled(request, context.machine.as_ref(), run.control)?;
         let cycle_time = context.machine.as_ref().and_then(|machine| {
-            let plunge = context.tool.as_ref().and_then(|t| t.plunge_feed).or(machine.plunge_feed);
+            let plunge =
+                request.plunge_feed.or(context.tool.as_ref().and_then(|t| t.plunge_feed)).or(machine.plunge_feed);
             super::cycle_time(&result, machine, plunge, context.tool.is_some())
         });
         Ok(SegmentResult { machine: context.machine, tool: context.tool, result, cycle_time })
@@ -63,7 +67,7 @@ impl Capability for SegmentCapability {
 
     /// The curve is the programmed point: `reference` does not apply.
     fn program(
-        _request: &SegmentRequest,
+        request: &SegmentRequest,
         answer: &SegmentResult,
         output: &OutputOptions,
     ) -> Result<String, SolverError> {
@@ -76,10 +80,9 @@ impl Capability for SegmentCapability {
             reference: Reference::Tip,
             tool,
             arcs: output.arcs_for(answer.machine.as_ref()),
-            plunge_feed: answer
-                .tool
-                .as_ref()
-                .and_then(|tool| tool.plunge_feed)
+            plunge_feed: request
+                .plunge_feed
+                .or(answer.tool.as_ref().and_then(|tool| tool.plunge_feed))
                 .or(answer.machine.as_ref().and_then(|m| m.plunge_feed)),
         };
         super::program(&answer.result, &post)

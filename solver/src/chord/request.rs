@@ -232,6 +232,11 @@ pub struct SegmentRequest {
     /// Spindle speed for the G-code program, rpm (default 6000).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spindle_rpm: Option<f64>,
+    /// Feed of plunges (straight moves down the tool axis) in the program, mm/min (issue 15;
+    /// default the tool's `plunge_feed`, else the machine's, else half the cutting feed; never
+    /// faster than the cutting feed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plunge_feed: Option<f64>,
     /// Z of the clearance plane for the G-code program, mm (default 5 above the curve's highest point).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub safe_z: Option<f64>,
@@ -547,6 +552,7 @@ impl SegmentRequest {
             machine: None,
             tool: None,
             spindle_rpm: None,
+            plunge_feed: None,
             safe_z: None,
         }
     }

@@ -55,11 +55,12 @@ impl Capability for ContourCapability {
     }
 
     fn program(
-        _request: &ContourRequest,
+        request: &ContourRequest,
         answer: &ContourResult,
         output: &OutputOptions,
     ) -> Result<String, SolverError> {
-        let post = output.post(answer.machine.as_ref(), &answer.tool);
+        let mut post = output.post(answer.machine.as_ref(), &answer.tool);
+        post.plunge_feed = request.plunge_feed.or(post.plunge_feed);
         super::program(&answer.result, &post)
     }
 

@@ -28,6 +28,9 @@ pub const DEFAULT_TOLERANCE: f64 = 0.01;
 pub const MIN_TOLERANCE: f64 = 1e-6;
 /// Default spindle speed, rpm.
 pub const DEFAULT_SPINDLE_RPM: f64 = 6000.0;
+/// Steepest descent of a ramp entry unless the request says, degrees: within what flat end mills
+/// that do not cut at the centre are usually ramped at (2–5°).
+pub const DEFAULT_RAMP_ANGLE_DEG: f64 = 3.0;
 /// Default largest material angle that still gets a loop (corners.md §1.4 `alpha_max`), degrees.
 pub const DEFAULT_MAX_ANGLE_DEG: f64 = 170.0;
 /// Largest wall tilt accepted, degrees.
@@ -338,6 +341,14 @@ pub struct ContourRequest {
     /// Spindle speed, rpm (default 6000).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spindle_rpm: Option<f64>,
+    /// Feed of plunges and ramp entries, mm/min (issue 15; default the tool's `plunge_feed`, else
+    /// the machine's, else half of `feed`; never faster than `feed`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plunge_feed: Option<f64>,
+    /// Steepest descent of a ramp entry, degrees (0 < angle ≤ 45, default 3). Layers enter on a
+    /// ramp when the tool does not cut at its centre (`centre_cutting: false`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ramp_angle_deg: Option<f64>,
     /// Radial stock on the wall before the first pass (left by roughing), mm. With it the first
     /// pass's loops may run at `loop_feed` where they clear that stock.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -405,6 +416,11 @@ pub(crate) struct Job {
     /// How arcs become chords: `tolerance`, or the block-time rule within it.
     pub chording: Chording,
     pub spindle_rpm: f64,
+    /// Feed of plunges and ramps: the request's, else the tool's, else the machine's (`None`:
+    /// half the cutting feed).
+    pub plunge_feed: Option<f64>,
+    /// Ramp angle of layer entries, radians, when the tool does not cut at its centre.
+    pub ramp: Option<f64>,
     pub stock_allowance: Option<f64>,
     /// Tilt per prepared edge, radians; `None` when every wall is vertical.
     pub tilt: Option<Vec<f64>>,
@@ -462,6 +478,20 @@ impl ContourRequest {
         };
         let chording = Chording { tolerance, rules };
         let spindle_rpm = positive("spindle_rpm", self.spindle_rpm.unwrap_or(DEFAULT_SPINDLE_RPM))?;
+        let plunge_feed = self
+            .plunge_feed
+            .map(|f| positive("plunge_feed", f))
+            .transpose()?
+            .or(tool.plunge_feed)
+            .or(machine.and_then(|m| m.plunge_feed));
+        let ramp_angle = finite("ramp_angle_deg", self.ramp_angle_deg.unwrap_or(DEFAULT_RAMP_ANGLE_DEG))?;
+        if !(ramp_angle > 0.0 && ramp_angle <= 45.0) {
+            return Err(SolverError::input(
+                "ramp_angle_deg",
+                format!("ramp_angle_deg must be above 0 and at most 45 (got {ramp_angle})"),
+            ));
+        }
+        let ramp = (!tool.cuts_at_centre()).then(|| ramp_angle.to_radians());
         let clearance = non_negative("clearance", self.clearance.unwrap_or(DEFAULT_CLEARANCE))?;
         let safe_z = match self.safe_z {
             Some(z) => {
@@ -534,6 +564,8 @@ impl ContourRequest {
             tolerance,
             chording,
             spindle_rpm,
+            plunge_feed,
+            ramp,
             stock_allowance,
             tilt,
             blend_radius,

@@ -237,7 +237,7 @@ pub fn solve_with(
         tolerance: job.tolerance,
         estimated_time_s: time_min * 60.0,
         blocks,
-        cycle_time: machine.and_then(|m| contour_cycle_time(&layers, m, job.tool.plunge_feed)),
+        cycle_time: machine.and_then(|m| contour_cycle_time(&layers, m, job.plunge_feed)),
     };
     let description = describe(&job, &summary);
     let centre_height = match job.tool.kind {
@@ -440,7 +440,10 @@ fn layer_moves(
     if approach < job.safe_z {
         moves.push(step(MoveKind::Rapid, at(&entry, approach), None));
     }
-    moves.push(step(MoveKind::Link, at(&entry, z), Some(job.feed)));
+    let towards = if entry == first_start { first_chord_end(job, &passes[0]) } else { Some(first_start) };
+    for (to, feed) in entry_moves(job, entry, towards, approach.min(job.safe_z), z) {
+        moves.push(step(MoveKind::Link, to, Some(feed)));
+    }
     let mut here = entry;
     let loop_feed = job.loop_feed.unwrap_or(job.feed);
     for pass in passes {
@@ -453,7 +456,10 @@ fn layer_moves(
                 if approach < job.safe_z {
                     moves.push(step(MoveKind::Rapid, at(&pass.start, approach), None));
                 }
-                moves.push(step(MoveKind::Link, at(&pass.start, z), Some(job.feed)));
+                let towards = first_chord_end(job, pass);
+                for (to, feed) in entry_moves(job, pass.start, towards, approach.min(job.safe_z), z) {
+                    moves.push(step(MoveKind::Link, to, Some(feed)));
+                }
             }
         }
         let merge = job.chording.rules.is_some();
@@ -515,6 +521,51 @@ fn layer_moves(
     }
     moves.push(ContourMove { kind: MoveKind::Rapid, to: at(&here, job.safe_z), feed: None, axis: start_axis });
     (moves, arcs)
+}
+
+/// Longest leg of a ramp entry, in tool radii: long enough for a shallow angle, short enough to
+/// stay near the entry point.
+const MAX_RAMP_RADII: f64 = 4.0;
+
+/// Most legs of one ramp entry.
+const MAX_RAMP_LEGS: usize = 10_000;
+
+/// The end of the first chord of `pass`: the direction a ramp entry at its start runs along.
+fn first_chord_end(job: &Job, pass: &PassPlan) -> Option<Vec2> {
+    let element = pass.elements.first()?;
+    element.chords(&job.chording, MAX_ARC_STEPS).first().copied()
+}
+
+/// The feed moves (end, feed) from `point` at `from_z` down to `point` at `z` (issue 15): one
+/// plunge when the tool cuts at its centre (at the cutting feed in the answer; the post writes it
+/// at the plunge feed); otherwise a ramp at the plunge feed that runs from `point` towards
+/// `towards` and back, legs of at most [`MAX_RAMP_RADII`] tool radii, each descending the same
+/// height at no more than the ramp angle, ending at `point` at `z`. Without a direction (no lead
+/// and a zero-length first move) the tool plunges.
+fn entry_moves(job: &Job, point: Vec2, towards: Option<Vec2>, from_z: f64, z: f64) -> Vec<([f64; 3], f64)> {
+    let bottom = vec![([point.x, point.y, z], job.feed)];
+    let drop = from_z - z;
+    let Some(angle) = job.ramp else { return bottom };
+    let Some((direction, length)) = towards
+        .map(|t| t - point)
+        .and_then(|d| d.try_normalize(1e-9).map(|u| (u, d.norm().min(MAX_RAMP_RADII * job.radius))))
+    else {
+        return bottom;
+    };
+    if drop <= 0.0 || length <= 1e-6 {
+        return bottom;
+    }
+    let feed = crate::gcode::plunge_feed(job.feed, job.plunge_feed);
+    let legs = (drop / (length * angle.tan())).ceil() as usize;
+    let legs = (legs + legs % 2).clamp(2, MAX_RAMP_LEGS);
+    let far = point + direction * length;
+    (1..=legs)
+        .map(|leg| {
+            let at = if leg % 2 == 1 { far } else { point };
+            let height = if leg == legs { z } else { from_z - drop * leg as f64 / legs as f64 };
+            ([at.x, at.y, height], feed)
+        })
+        .collect()
 }
 
 /// The cycle time of the program of `layers` on `machine` (None without its `max_accel`):

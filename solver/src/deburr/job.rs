@@ -114,7 +114,7 @@ impl DeburrRequest {
         let origin = vec3(point("workpiece.origin", *origin)?);
         let arrangement = finite("workpiece.arrangement_angle_deg", *arrangement)?;
 
-        let hole = &self.hole;
+        let hole = self.hole.as_ref().ok_or_else(|| SolverError::input("hole", "give hole (or holes)"))?;
         let radius = size("hole.radius", hole.radius)?;
         let penetration = finite("hole.penetration_angle_deg", hole.penetration_angle_deg)?;
         let start = finite("start_deg", self.start_deg)?;

@@ -36,7 +36,10 @@ pub use answer::{Deburr, DeburrPoint, DeburrSummary, LeadMotion, LeadMove};
 pub use capability::{DeburrAnswer, DeburrCapability};
 pub use diagnostics::{ExactConstruction, PointConstruction, construction_at, ideal_centres};
 pub use program::program;
-pub use request::{CentreDistance, DeburrRequest, Direction, Edge, Hole, HoleShape, Method, Workpiece};
+pub use request::{
+    CentreDistance, DeburrRequest, Direction, Edge, Hole, HolePattern, HoleShape, MAX_HOLES, Method, PlacedHole,
+    Placement, Workpiece,
+};
 
 use crate::capability::Control;
 use crate::error::ErrorCode;
@@ -567,7 +570,7 @@ fn describe(request: &DeburrRequest, job: &Job, summary: &DeburrSummary) -> Vec<
             format!("bore block R {bore_radius} arrangement {arrangement_angle_deg} deg")
         }
     };
-    let hole = &request.hole;
+    let Some(hole) = &request.hole else { return Vec::new() };
     let shape = match hole.shape {
         HoleShape::Round => "round",
         HoleShape::Slot => "slot",

@@ -87,32 +87,69 @@ pub(crate) fn leads(
 
 /// The complete program for a solved deburr job.
 pub fn program(deburr: &Deburr, post: &Post) -> Result<String, SolverError> {
-    if let Some(blocker) = &deburr.program_blocker {
+    program_for_holes(&[deburr], post)
+}
+
+/// One program for several holes deburred with one tool (issue 15): each hole's approach, loop
+/// and way out in order, the tool lifted to the highest clearance plane of them between holes
+/// and moved across there. The header is the first hole's with the number of holes.
+///
+/// # Errors
+/// The first hole's reason when one has no program (`program_blocker`); `E_NO_PROGRAM` without
+/// holes.
+pub fn program_for_holes(holes: &[&Deburr], post: &Post) -> Result<String, SolverError> {
+    let Some(deburr) = holes.first() else {
+        return Err(SolverError::new(ErrorCode::NoProgram, "no hole to deburr"));
+    };
+    if let Some(blocker) = holes.iter().find_map(|hole| hole.program_blocker.as_ref()) {
         return Err(blocker.clone());
     }
     let offset = match post.reference {
         Reference::Tip => -deburr.ball_radius * Vec3::z(),
         Reference::Centre => Vec3::zeros(),
     };
-    let feed = deburr.summary.feed;
+    let mut safe_centre_z = f64::NEG_INFINITY;
+    for hole in holes {
+        let z = hole.summary.safe_centre_z.ok_or_else(|| {
+            SolverError::new(ErrorCode::NoClearancePlane, "the clearance plane is unknown; give safe_z").at("safe_z")
+        })?;
+        safe_centre_z = safe_centre_z.max(z);
+    }
     let mut path = Toolpath::default();
-    let mut add = |motion: LeadMotion, centre: [f64; 3]| match motion {
-        LeadMotion::Rapid => path.rapid(vec3(centre) + offset),
-        LeadMotion::Feed => path.linear(vec3(centre) + offset, feed),
-    };
-    for step in &deburr.lead_in {
-        add(step.motion, step.centre);
+    for (index, hole) in holes.iter().enumerate() {
+        let feed = hole.summary.feed;
+        if index > 0
+            && let (Some(last), Some(next)) = (path.moves.last().map(|m| m.to), hole.lead_in.first())
+        {
+            // Up to the highest clearance plane, across, and on to this hole's own approach.
+            let next = vec3(next.centre) + offset;
+            let up = Vec3::new(last.x, last.y, safe_centre_z + offset.z);
+            let across = Vec3::new(next.x, next.y, up.z);
+            if up != last {
+                path.rapid(up);
+            }
+            if across != up && across != next {
+                path.rapid(across);
+            }
+        }
+        let mut add = |motion: LeadMotion, centre: [f64; 3]| match motion {
+            LeadMotion::Rapid => path.rapid(vec3(centre) + offset),
+            LeadMotion::Feed => path.linear(vec3(centre) + offset, feed),
+        };
+        for step in &hole.lead_in {
+            add(step.motion, step.centre);
+        }
+        for point in hole.points.iter().skip(1) {
+            add(LeadMotion::Feed, point.centre);
+        }
+        for step in &hole.lead_out {
+            add(step.motion, step.centre);
+        }
     }
-    for point in deburr.points.iter().skip(1) {
-        add(LeadMotion::Feed, point.centre);
-    }
-    for step in &deburr.lead_out {
-        add(step.motion, step.centre);
-    }
-    let safe_centre_z = deburr.summary.safe_centre_z.ok_or_else(|| {
-        SolverError::new(ErrorCode::NoClearancePlane, "the clearance plane is unknown; give safe_z").at("safe_z")
-    })?;
     let mut comments = deburr.description.clone();
+    if holes.len() > 1 {
+        comments.push(format!("{} holes in one program: the first is described above", holes.len()));
+    }
     comments.push(format!(
         "control point: {}{}",
         post.reference.as_str(),

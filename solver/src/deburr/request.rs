@@ -4,7 +4,9 @@
 pub use crate::geometry::Direction;
 use serde::{Deserialize, Serialize};
 
+use crate::error::SolverError;
 use crate::tool::ToolRef;
+use crate::validate::finite;
 
 /// Default tolerance TA in mm (deburr.md §1.4, proposed value).
 pub const DEFAULT_TOLERANCE: f64 = 0.01;
@@ -102,6 +104,174 @@ pub struct Hole {
     pub axis_point: Option<[f64; 3]>,
 }
 
+/// One hole of `holes`: a [`Hole`] and where it lies on the workpiece.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct PlacedHole {
+    /// `round`, `slot` or `rounded_rect`.
+    pub shape: HoleShape,
+    /// R2, mm.
+    pub radius: f64,
+    /// As in [`Hole`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub centre_distance: Option<CentreDistance>,
+    /// As in [`Hole`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eccentricity: Option<f64>,
+    /// θ_P: where around the cylinder axis the hole lies (from +Z), degrees.
+    #[serde(default)]
+    pub penetration_angle_deg: f64,
+    /// θ_A of this hole, overriding the workpiece's, degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arrangement_angle_deg: Option<f64>,
+    /// Position along the cylinder axis from `workpiece.origin`, mm (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axial_position: Option<f64>,
+}
+
+/// Copies of `hole`: at each of `around_deg` (penetration angles about the cylinder axis; default
+/// the hole's own) and at `count` stations `pitch` apart along the axis from the origin (default
+/// one station).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct HolePattern {
+    /// Penetration angles θ_P of the copies around the cylinder, degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub around_deg: Option<Vec<f64>>,
+    /// Distance between stations along the cylinder axis, mm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pitch: Option<f64>,
+    /// Stations along the axis (1–100, default 1; more than one needs `pitch`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub count: Option<usize>,
+}
+
+/// Most holes one request deburrs.
+pub const MAX_HOLES: usize = 100;
+
+/// One hole of a several-hole request, as a single-hole request.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Placement {
+    /// Where its fields are in the request: `holes[i]`, or `hole` for a pattern's copies.
+    pub field: String,
+    /// Its penetration angle, arrangement angle and axial position, as placed.
+    pub penetration_angle_deg: f64,
+    /// θ_A, degrees.
+    pub arrangement_angle_deg: f64,
+    /// Along the cylinder axis from `workpiece.origin`, mm.
+    pub axial_position: f64,
+    /// The single-hole request.
+    pub request: DeburrRequest,
+}
+
+impl DeburrRequest {
+    /// Whether the request names more than one hole (`holes` or `pattern`).
+    pub fn is_several(&self) -> bool {
+        self.holes.is_some() || self.pattern.is_some()
+    }
+
+    /// Every hole as a single-hole request, in the order the program visits them.
+    ///
+    /// # Errors
+    /// `E_INPUT` naming `hole`, `holes` or `pattern` when the combination or a placement is wrong.
+    pub fn placements(&self) -> Result<Vec<Placement>, SolverError> {
+        let (origin, arrangement) = match &self.workpiece {
+            Workpiece::Tube { origin, arrangement_angle_deg, .. }
+            | Workpiece::BoreBlock { origin, arrangement_angle_deg, .. } => (*origin, *arrangement_angle_deg),
+        };
+        let placed: Vec<(String, Hole, Option<f64>, f64)> = match (&self.hole, &self.holes, &self.pattern) {
+            (Some(_), Some(_), _) => return Err(SolverError::input("holes", "give hole or holes, not both")),
+            (_, Some(_), Some(_)) => {
+                return Err(SolverError::input("pattern", "a pattern copies hole: give it with hole, not holes"));
+            }
+            (None, None, _) => return Err(SolverError::input("hole", "give hole (or holes)")),
+            (Some(hole), None, None) => vec![("hole".to_owned(), hole.clone(), None, 0.0)],
+            (None, Some(holes), None) => {
+                if holes.is_empty() || holes.len() > MAX_HOLES {
+                    return Err(SolverError::input("holes", format!("give 1 to {MAX_HOLES} holes")));
+                }
+                holes
+                    .iter()
+                    .enumerate()
+                    .map(|(index, placed)| {
+                        let field = format!("holes[{index}]");
+                        let axial = finite(&format!("{field}.axial_position"), placed.axial_position.unwrap_or(0.0))?;
+                        let hole = Hole {
+                            shape: placed.shape,
+                            radius: placed.radius,
+                            centre_distance: placed.centre_distance,
+                            eccentricity: placed.eccentricity,
+                            penetration_angle_deg: placed.penetration_angle_deg,
+                            axis_point: None,
+                        };
+                        Ok((field, hole, placed.arrangement_angle_deg, axial))
+                    })
+                    .collect::<Result<_, SolverError>>()?
+            }
+            (Some(hole), None, Some(pattern)) => {
+                let angles = pattern.around_deg.clone().unwrap_or_else(|| vec![hole.penetration_angle_deg]);
+                let count = pattern.count.unwrap_or(1);
+                if angles.is_empty() || count == 0 || angles.len() * count > MAX_HOLES {
+                    return Err(SolverError::input(
+                        "pattern",
+                        format!("a pattern makes 1 to {MAX_HOLES} holes (around_deg × count)"),
+                    ));
+                }
+                let pitch = match (pattern.pitch, count) {
+                    (Some(pitch), _) => finite("pattern.pitch", pitch)?,
+                    (None, 1) => 0.0,
+                    (None, _) => return Err(SolverError::input("pattern.pitch", "count above 1 needs pitch")),
+                };
+                if hole.axis_point.is_some() {
+                    return Err(SolverError::input("hole.axis_point", "a pattern places its holes: no axis_point"));
+                }
+                let mut placed = Vec::with_capacity(angles.len() * count);
+                for station in 0..count {
+                    for (index, angle) in angles.iter().enumerate() {
+                        let angle = finite(&format!("pattern.around_deg[{index}]"), *angle)?;
+                        let copy = Hole { penetration_angle_deg: angle, ..hole.clone() };
+                        placed.push(("hole".to_owned(), copy, None, pitch * station as f64));
+                    }
+                }
+                placed
+            }
+        };
+        placed
+            .into_iter()
+            .map(|(field, hole, own_arrangement, axial)| {
+                let arrangement = own_arrangement.unwrap_or(arrangement);
+                let theta = finite(&format!("{field}.arrangement_angle_deg"), arrangement)?.to_radians();
+                // A1 points along +Y turned by θ_A about Z (deburr.md §1.3).
+                let along = [-theta.sin(), theta.cos(), 0.0];
+                let moved = [origin[0] + axial * along[0], origin[1] + axial * along[1], origin[2]];
+                let workpiece = match &self.workpiece {
+                    Workpiece::Tube { inner_radius, outer_radius, .. } => Workpiece::Tube {
+                        origin: moved,
+                        arrangement_angle_deg: arrangement,
+                        inner_radius: *inner_radius,
+                        outer_radius: *outer_radius,
+                    },
+                    Workpiece::BoreBlock { bore_radius, face_distance, .. } => Workpiece::BoreBlock {
+                        origin: moved,
+                        arrangement_angle_deg: arrangement,
+                        bore_radius: *bore_radius,
+                        face_distance: *face_distance,
+                    },
+                };
+                Ok(Placement {
+                    field,
+                    penetration_angle_deg: hole.penetration_angle_deg,
+                    arrangement_angle_deg: arrangement,
+                    axial_position: axial,
+                    request: DeburrRequest { workpiece, hole: Some(hole), holes: None, pattern: None, ..self.clone() },
+                })
+            })
+            .collect()
+    }
+}
+
 /// Which ridge is deburred.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
@@ -137,8 +307,17 @@ pub struct DeburrRequest {
     pub tool: ToolRef,
     /// The tube or bored block.
     pub workpiece: Workpiece,
-    /// The through hole.
-    pub hole: Hole,
+    /// The through hole (or give `holes`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hole: Option<Hole>,
+    /// Several holes deburred by one program (issue 15), instead of `hole`: each with its own
+    /// shape and, optionally, its own `arrangement_angle_deg` and `axial_position` along the
+    /// cylinder axis from `workpiece.origin`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub holes: Option<Vec<PlacedHole>>,
+    /// Copies of `hole` around the cylinder and along its axis (issue 15).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pattern: Option<HolePattern>,
     /// Which ridge.
     pub edge: Edge,
     /// Q, the amount of cutting (W = √2·Q), mm. Give this or `width`.

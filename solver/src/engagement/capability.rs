@@ -34,6 +34,12 @@ pub struct EngagementResponse {
     /// T2 as given, s.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_limit_s: Option<f64>,
+    /// With a machine that has `max_accel` and an `axial_depth` (a program): the time the control
+    /// would take for the program of the request's `candidate` path (trapezoidal feed profile,
+    /// stops at sharp corners, the plunge at the plunge feed, rapids at `rapid_feed`, one tool
+    /// change) and its parts (issue 15).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cycle_time: Option<crate::machine::cycle::CycleTime>,
     /// Samples, flute counts and recommendation (or `candidates`, one such result per path).
     #[serde(flatten)]
     pub result: EngagementAnswer,
@@ -54,6 +60,9 @@ impl Capability for EngagementCapability {
         context: Resolved<Tool>,
         run: &Run<'_>,
     ) -> Result<EngagementResponse, SolverError> {
+        if let Some(feed) = request.plunge_feed {
+            crate::validate::positive("plunge_feed", feed)?;
+        }
         // A stored material is not resolved yet (no material library): the solver names
         // `material` when a request gives one instead of `kienzle`.
         let physics = super::Physics {
@@ -61,7 +70,15 @@ impl Capability for EngagementCapability {
             spindle: context.machine.as_ref().map(MachineProfile::spindle).unwrap_or_default(),
         };
         let result = super::solve_in(request, &context.tool, context.machine.as_ref(), &physics, run.control)?;
+        let cycle_time = context.machine.as_ref().and_then(MachineProfile::dynamics).and_then(|dynamics| {
+            let plunge = request
+                .plunge_feed
+                .or(context.tool.plunge_feed)
+                .or(context.machine.as_ref().and_then(|m| m.plunge_feed));
+            super::program::cycle_time(&result, request.candidate.unwrap_or(0), &dynamics, plunge)
+        });
         Ok(EngagementResponse {
+            cycle_time,
             tool: context.tool,
             machine: context.machine,
             stock: request.stock.clone(),
@@ -77,7 +94,8 @@ impl Capability for EngagementCapability {
         answer: &EngagementResponse,
         output: &OutputOptions,
     ) -> Result<String, SolverError> {
-        let post = output.post(answer.machine.as_ref(), &answer.tool);
+        let mut post = output.post(answer.machine.as_ref(), &answer.tool);
+        post.plunge_feed = request.plunge_feed.or(post.plunge_feed);
         let candidate = output.candidate.or(request.candidate).unwrap_or(0);
         super::program(&answer.result, candidate, &post)
     }

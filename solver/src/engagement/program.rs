@@ -105,6 +105,24 @@ pub fn program(answer: &EngagementAnswer, candidate: usize, post: &Post) -> Resu
     }))
 }
 
+/// The cycle time of candidate `candidate`'s chord program on a machine with `dynamics` (issue
+/// 15, item 4): one tool change, plunges in the air at the plunge feed, the final retract. `None` when the answer
+/// has no program (no `axial_depth`, no such candidate).
+pub(crate) fn cycle_time(
+    answer: &EngagementAnswer,
+    candidate: usize,
+    dynamics: &crate::machine::cycle::Dynamics,
+    plunge_feed: Option<f64>,
+) -> Option<crate::machine::cycle::CycleTime> {
+    let candidates = answer.candidates();
+    let result = candidates.get(candidate)?;
+    let Cut { mut path, safe_z, .. } = cut(result, 0.0, Arcs::Chords).ok()?;
+    // The post's retract to the clearance plane after the spindle stops.
+    let last = path.moves.last()?.to;
+    path.rapid(Vec3::new(last.x, last.y, safe_z));
+    crate::machine::cycle::path_cycle_time(&path, dynamics, plunge_feed, 1)
+}
+
 /// The moves of a program and what the block-time rule did to its arcs.
 struct Cut {
     path: Toolpath,

@@ -287,6 +287,11 @@ pub struct EngagementRequest {
     pub paths: Option<Vec<Candidate>>,
     /// Spindle speed N, rpm.
     pub spindle_rpm: f64,
+    /// Feed of plunges (straight moves down the tool axis) in the program, mm/min (issue 15;
+    /// default the tool's `plunge_feed`, else the machine's, else half the cutting feed; never
+    /// faster than the cutting feed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plunge_feed: Option<f64>,
     /// Feed per tooth f_z, mm/tooth, kept for every flute count (constant f_z: V_f = k·f_z·N).
     /// Give this or `feed`.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -7,6 +7,7 @@
 //! post wraps the program in `%` with an `O` number; the LinuxCNC post adds `G64 P` (path blending
 //! held within the path tolerance). Both are accepted by LinuxCNC's `rs274` interpreter.
 
+pub mod job;
 pub mod reader;
 
 use std::fmt::Write as _;

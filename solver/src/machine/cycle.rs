@@ -137,6 +137,41 @@ pub fn cycle_time(start: Vec3, steps: &[Step], dynamics: &Dynamics, tool_changes
     time
 }
 
+/// The cycle time of a program's tool path (chords, not arcs: an arc counts as its chord) from
+/// its first point: rapids at the rapid feed, straight moves down the tool axis in the air at
+/// `plunge_feed` of their feed ([`crate::gcode::plunge_feed`], as the post writes them), every
+/// other feed move cutting. `None` for an empty path.
+pub fn path_cycle_time(
+    path: &crate::path::Toolpath,
+    dynamics: &Dynamics,
+    plunge_feed: Option<f64>,
+    tool_changes: usize,
+) -> Option<CycleTime> {
+    use crate::path::Motion;
+    let start = path.moves.first()?.to;
+    let mut here = start;
+    let steps: Vec<Step> = path
+        .moves
+        .iter()
+        .map(|step| {
+            let to = step.to;
+            let from = std::mem::replace(&mut here, to);
+            match step.motion {
+                Motion::Rapid => Step::Rapid(to),
+                Motion::Linear { feed } | Motion::Arc { feed, .. } => {
+                    let down = to.z < from.z && (to.x - from.x).abs() <= 1e-9 && (to.y - from.y).abs() <= 1e-9;
+                    if down {
+                        Step::Feed { to, feed: crate::gcode::plunge_feed(feed, plunge_feed), air: true }
+                    } else {
+                        Step::Feed { to, feed, air: false }
+                    }
+                }
+            }
+        })
+        .collect();
+    Some(cycle_time(start, &steps, dynamics, tool_changes))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -140,3 +140,150 @@ async fn cycle_time_with_acceleration_rapids_and_tool_change() {
         assert_eq!(body["errors"][0]["path"], field, "{body}");
     }
 }
+
+/// Every G01 that goes down in `program`: (from, to, modal feed).
+fn descents(program: &str) -> Vec<([f64; 3], [f64; 3], f64)> {
+    let (mut at, mut feed) = ([f64::NAN; 3], f64::NAN);
+    let mut found = Vec::new();
+    for line in program.lines().filter(|l| l.starts_with("G0")) {
+        let word = |axis: char| line.split_whitespace().find_map(|w| w.strip_prefix(axis)?.parse::<f64>().ok());
+        if let Some(f) = word('F') {
+            feed = f;
+        }
+        let to = [word('X').unwrap_or(at[0]), word('Y').unwrap_or(at[1]), word('Z').unwrap_or(at[2])];
+        if line.starts_with("G01") && to[2] < at[2] {
+            found.push((at, to, feed));
+        }
+        at = to;
+    }
+    found
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn tools_that_do_not_cut_at_the_centre_ramp_into_contour_layers() {
+    let app = TestApp::spawn().await;
+    app.register_tool(6, &json!({"kind": "flat", "radius": 4, "centre_cutting": false, "plunge_feed": 200})).await;
+    assert_eq!(json_with(app.get("/api/v1/tools/6").await, 200).await["centre_cutting"], false);
+    // A pocket (the lead point lies in the material) and an island, two layers each.
+    for side in ["inside", "outside"] {
+        for (ramp_angle, plunge_feed) in [(None, None), (Some(5.0), Some(120.0))] {
+            let mut body = json!({"tool": 6, "contour": [[0, 0], [80, 0], [80, 60], [0, 60]], "side": side,
+                                  "depths": {"top": 0, "bottom": -6, "step": 3}, "feed": 900});
+            if let Some(angle) = ramp_angle {
+                body["ramp_angle_deg"] = json!(angle);
+            }
+            if let Some(feed) = plunge_feed {
+                body["plunge_feed"] = json!(feed);
+            }
+            let (angle, limit) = (ramp_angle.unwrap_or(3.0_f64), plunge_feed.unwrap_or(200.0));
+            for dialect in ["fanuc", "linuxcnc"] {
+                let url = format!("/api/v1/contour?format=gcode&dialect={dialect}");
+                let response = app.client.post(app.url(&url)).json(&body).send().await.unwrap();
+                assert_eq!(response.status(), 200);
+                let program = response.text().await.unwrap();
+                let label = format!("{side} {dialect} {ramp_angle:?}");
+                let below_top: Vec<_> = descents(&program).into_iter().filter(|(_, to, _)| to[2] < 0.0).collect();
+                assert!(below_top.len() >= 4, "{label}: each layer ramps down in legs\n{program}");
+                for (from, to, feed) in below_top {
+                    let run = (to[0] - from[0]).hypot(to[1] - from[1]);
+                    assert!(run > 0.0, "{label}: straight down into the material at {to:?}");
+                    // 4 decimals in the program: the slope within their rounding.
+                    assert!((from[2] - to[2]) <= run * angle.to_radians().tan() + 2e-4, "{label}: {from:?} → {to:?}");
+                    assert!(feed <= limit, "{label}: down at F{feed}, above the plunge feed F{limit}");
+                }
+                rs274_moves(&program, app.directory(), &format!("ramp_{side}_{dialect}"));
+            }
+        }
+    }
+    // A centre-cutting tool of the same size plunges (at its plunge feed, straight down).
+    app.register_tool(5, &json!({"kind": "flat", "radius": 4, "plunge_feed": 200})).await;
+    let body = json!({"tool": 5, "contour": [[0, 0], [80, 0], [80, 60], [0, 60]], "side": "inside",
+                      "depths": {"top": 0, "bottom": -6, "step": 3}, "feed": 900});
+    let response = app.client.post(app.url("/api/v1/contour?format=gcode")).json(&body).send().await.unwrap();
+    let program = response.text().await.unwrap();
+    assert!(descents(&program).iter().any(|(from, to, feed)| from[0] == to[0] && from[1] == to[1] && *feed == 200.0));
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_request_plunge_feed_wins_and_bad_entries_name_their_field() {
+    let app = TestApp::spawn().await;
+    app.register_tool(3, &json!({"kind": "flat", "radius": 3, "plunge_feed": 150})).await;
+    let segment = json!({"curve": {"kind": "circle", "centre": [0, 0, -2], "radius": 20}, "feed": 2000,
+                         "block_time_ms": 4, "tool": 3, "plunge_feed": 70});
+    let engagement = json!({"tool": 3, "stock": {"polygon": [[0, 0], [60, 0], [60, 40], [0, 40]]},
+                            "path": [[10, 20], [70, 20]], "spindle_rpm": 3000, "feed": 600, "axial_depth": 2,
+                            "plunge_feed": 70});
+    let contour = json!({"tool": 3, "contour": [[0, 0], [80, 0], [80, 60], [0, 60]], "side": "outside",
+                         "depths": {"top": 0, "bottom": -4, "step": 2}, "feed": 800, "plunge_feed": 70});
+    for (path, body) in
+        [("/api/v1/segment", &segment), ("/api/v1/engagement", &engagement), ("/api/v1/contour", &contour)]
+    {
+        let program = gcode(&app, path, body).await;
+        let (found, _) = plunges(&program);
+        assert!(!found.is_empty() && found.iter().all(|feed| *feed == 70.0), "{path}: {found:?}");
+        for (field, value) in [("plunge_feed", json!(0)), ("plunge_feed", json!(-3))] {
+            let mut bad = body.clone();
+            bad[field] = value;
+            let body = problem(app.post_json(path, &bad).await, 422).await;
+            assert_eq!(body["errors"][0]["path"], field, "{path}: {body}");
+        }
+    }
+    for angle in [0.0, 60.0] {
+        let mut bad = contour.clone();
+        bad["ramp_angle_deg"] = json!(angle);
+        let body = problem(app.post_json("/api/v1/contour", &bad).await, 422).await;
+        assert_eq!(body["errors"][0]["path"], "ramp_angle_deg", "{body}");
+    }
+    let ball = json!({"kind": "ball", "radius": 3, "centre_cutting": false});
+    let body = problem(app.put_json("/api/v1/tools/9", &ball).await, 422).await;
+    assert_eq!(body["errors"][0]["path"], "centre_cutting", "{body}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn deburr_and_engagement_have_a_cycle_time_too() {
+    let app = TestApp::spawn().await;
+    app.register_tool(3, &json!({"kind": "flat", "radius": 3})).await;
+    app.register_tool(7, &json!({"kind": "ball", "radius": 3})).await;
+    let machine = json!({"block_time_ms": 1, "max_feed": 12000, "max_accel": 500, "rapid_feed": 30000,
+                         "tool_change_s": 4});
+    assert_eq!(app.put_json("/api/v1/machines/accel", &machine).await.status(), 201);
+    let number = |v: &Value| v.as_f64().unwrap();
+    let close = |label: &str, got: f64, want: f64| assert!((got - want).abs() < 1e-9, "{label}: {got} vs {want}");
+    let parts =
+        |time: &Value| ["cutting_s", "air_s", "rapid_s", "tool_change_s"].iter().map(|k| number(&time[*k])).sum();
+
+    // Engagement: one straight cut of 80 mm at 600 mm/min (10 mm/s) from rest to rest, the
+    // plunge in the air at half the feed.
+    let engagement = json!({"tool": 3, "stock": {"polygon": [[0, 0], [60, 0], [60, 40], [0, 40]]},
+                            "path": [[-10, 20], [70, 20]], "spindle_rpm": 3000, "feed": 600, "axial_depth": 2,
+                            "machine": "accel"});
+    let answer = json_with(app.post_json("/api/v1/engagement", &engagement).await, 200).await;
+    let time = &answer["cycle_time"];
+    close("engagement cutting", number(&time["cutting_s"]), rest_to_rest(80.0, 10.0, 500.0));
+    assert!(number(&time["air_s"]) > 0.0 && number(&time["rapid_s"]) > 0.0, "{time}");
+    close("engagement tool change", number(&time["tool_change_s"]), 4.0);
+    close("engagement total", number(&time["total_s"]), parts(time));
+    let mut plain = engagement.clone();
+    plain.as_object_mut().unwrap().remove("machine");
+    assert!(json_with(app.post_json("/api/v1/engagement", &plain).await, 200).await.get("cycle_time").is_none());
+
+    // Deburr: the loop cuts, the leads are air; with accelerations and stops the control takes at
+    // least the feed time of the loop.
+    let deburr = json!({"tool": 7, "machine": "accel", "edge": "outer", "cut_amount": 0.3, "feed": 400,
+        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 15, "outer_radius": 25},
+        "hole": {"shape": "round", "radius": 6}});
+    let answer = json_with(app.post_json("/api/v1/deburr", &deburr).await, 200).await;
+    let time = &answer["cycle_time"];
+    let points = answer["points"].as_array().unwrap();
+    let loop_length: f64 = points
+        .windows(2)
+        .map(|pair| {
+            let (a, b) = (&pair[0]["centre"], &pair[1]["centre"]);
+            (0..3).map(|k| (number(&b[k]) - number(&a[k])).powi(2)).sum::<f64>().sqrt()
+        })
+        .sum();
+    let cutting = number(&time["cutting_s"]);
+    assert!(cutting >= loop_length / (400.0 / 60.0) - 1e-9 && cutting < 2.0 * loop_length / (400.0 / 60.0), "{time}");
+    assert!(number(&time["air_s"]) > 0.0 && number(&time["rapid_s"]) > 0.0, "{time}");
+    close("deburr total", number(&time["total_s"]), parts(time));
+}

@@ -1,0 +1,458 @@
+//! One program per job (issue 15, item 1; README "One program per job"): the programs of a job's
+//! operations, each written by [`super::write`], joined into one program a control runs from start
+//! to end: one program number, one header listing the operations with their tools and estimated
+//! times, each operation with its tool change, spindle and coolant, a retract to the job's
+//! clearance height between operations, and one program end.
+//!
+//! The operations' programs are kept as text (a job stores them as its endpoints write them), so
+//! [`Section::parse`] reads back exactly the layout [`super::write`] produces; a program of any
+//! other layout (predict's corrected copy of a caller's own program) is not a section and is
+//! listed in the header as not included.
+
+use std::fmt::Write as _;
+
+use serde::{Deserialize, Serialize};
+
+use super::{Dialect, comment, mm};
+use crate::error::SolverError;
+
+/// The safety line every program of [`super::write`] starts its blocks with.
+const SAFETY_LINE: &str = "G21 G17 G90 G40 G49 G80 G94";
+
+/// Lowest and highest program number a job may ask for: Fanuc's `O1`–`O7999` (8000–9999 hold
+/// the machine builder's protected programs and macros).
+pub const PROGRAM_NUMBERS: std::ops::RangeInclusive<u32> = 1..=7999;
+
+/// Job programs numbered from the job id use `O2000`–`O7999`, clear of the `O1000` and `O1001`
+/// of the single-operation programs.
+const FIRST_JOB_NUMBER: u32 = 2000;
+
+/// The default program number of job `id`: `2000 + (id − 1) mod 6000`, so the last 6000 jobs of
+/// a service never share one and none equals a single-operation program's.
+pub fn number_for_job(id: i64) -> u32 {
+    let span = i64::from(*PROGRAM_NUMBERS.end() - FIRST_JOB_NUMBER + 1);
+    FIRST_JOB_NUMBER + u32::try_from((id - 1).rem_euclid(span)).unwrap_or(0)
+}
+
+/// Checks a program number asked for in a job file.
+///
+/// # Errors
+/// `E_INPUT` at `field` outside [`PROGRAM_NUMBERS`].
+pub fn check_number(field: &str, number: u32) -> Result<(), SolverError> {
+    if PROGRAM_NUMBERS.contains(&number) {
+        Ok(())
+    } else {
+        Err(SolverError::input(
+            field,
+            format!(
+                "program number {number} is outside {}–{} (8000–9999 are the control's protected programs)",
+                PROGRAM_NUMBERS.start(),
+                PROGRAM_NUMBERS.end()
+            ),
+        ))
+    }
+}
+
+/// Coolant for every operation of a job program.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Coolant {
+    /// No coolant code (the operator's choice at the machine).
+    #[default]
+    Off,
+    /// `M08` after the spindle starts, `M09` after it stops.
+    Flood,
+    /// `M07` after the spindle starts, `M09` after it stops.
+    Mist,
+}
+
+impl Coolant {
+    fn on_code(self) -> Option<&'static str> {
+        match self {
+            Self::Off => None,
+            Self::Flood => Some("M08"),
+            Self::Mist => Some("M07"),
+        }
+    }
+}
+
+/// One operation of a job as the job program needs it.
+#[derive(Debug, Clone, Copy)]
+pub struct Operation<'a> {
+    /// The capability's name (`deburr`, ...).
+    pub name: &'a str,
+    /// Its program, if one was written.
+    pub program: Option<&'a str>,
+    /// Why none was written, if so.
+    pub problem: Option<&'a str>,
+    /// The tool in words (`ball R3.0000`), if the operation has one.
+    pub tool: Option<&'a str>,
+    /// Rapid feed of its machine, mm/min (for the time estimate; rapids untimed without it).
+    pub rapid_feed: Option<f64>,
+    /// Time of a tool change on its machine, s.
+    pub tool_change_s: Option<f64>,
+}
+
+/// What the job program is called and how it is written.
+#[derive(Debug, Clone)]
+pub struct Job<'a> {
+    /// Dialect of the job program.
+    pub dialect: Dialect,
+    /// Program number (`O` word for Fanuc; named in the title comment for LinuxCNC).
+    pub number: u32,
+    /// Title, e.g. `kerf job 42 tube`.
+    pub title: &'a str,
+    /// Coolant of every operation.
+    pub coolant: Coolant,
+}
+
+/// One operation's program, read back into its parts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Section<'a> {
+    /// The program's title comment (`(KERF DEBURR)`).
+    pub title: &'a str,
+    /// Its header comment lines.
+    pub comments: Vec<&'a str>,
+    /// LinuxCNC's `G64 P…` line, if written.
+    pub blend: Option<&'a str>,
+    /// The tool number of `T n M06`; `None` for a manual change (`M00`).
+    pub tool_number: Option<u32>,
+    /// The tool-change lines up to the length offset, without the clearance move.
+    pub tool_change: Vec<&'a str>,
+    /// Z of the operation's clearance plane.
+    pub safe_z: f64,
+    /// The spindle line (`S6000 M03`).
+    pub spindle: &'a str,
+    /// The moves, up to the spindle stop.
+    pub moves: Vec<&'a str>,
+}
+
+impl<'a> Section<'a> {
+    /// Reads a program written by [`super::write`]; `None` for any other layout.
+    pub fn parse(text: &'a str) -> Option<Self> {
+        let mut lines = text.lines().filter(|line| *line != "%").peekable();
+        let first = lines.next()?;
+        let title = match first.strip_prefix('O') {
+            Some(rest) => rest.split_once(' ')?.1,
+            None => first,
+        };
+        title.starts_with('(').then_some(())?;
+        let mut comments = Vec::new();
+        while let Some(line) = lines.next_if(|line| line.starts_with('(')) {
+            comments.push(line);
+        }
+        (lines.next()? == SAFETY_LINE).then_some(())?;
+        let blend = lines.next_if(|line| line.starts_with("G64 "));
+        let mut tool_change = Vec::new();
+        let (tool_number, clearance) = if let Some(call) = lines.next_if(|line| line.starts_with('T')) {
+            let number: u32 = call.strip_prefix('T')?.strip_suffix(" M06")?.parse().ok()?;
+            tool_change.push(call);
+            let offset = lines.next()?;
+            let z = offset.strip_prefix(&format!("G00 G43 H{number} Z"))?;
+            (Some(number), z)
+        } else {
+            while let Some(line) = lines.next_if(|line| line.starts_with('(')) {
+                tool_change.push(line);
+            }
+            (lines.next()? == "M00").then_some(())?;
+            tool_change.push("M00");
+            (None, lines.next()?.strip_prefix("G00 Z")?)
+        };
+        let safe_z: f64 = clearance.parse().ok()?;
+        let spindle = lines.next()?;
+        (spindle.starts_with('S') && (spindle.ends_with(" M03") || spindle.ends_with(" M04"))).then_some(())?;
+        let rest: Vec<&str> = lines.collect();
+        let tail = ["M05", &format!("G00 Z{clearance}"), "M30"];
+        let body = rest.len().checked_sub(tail.len())?;
+        (rest[body..] == tail).then_some(())?;
+        let moves = rest[..body].to_vec();
+        moves.iter().all(|line| is_move(line)).then_some(())?;
+        Some(Self { title, comments, blend, tool_number, tool_change, safe_z, spindle, moves })
+    }
+
+    /// The feed time of the moves (every feed move at its feed) and their rapid length, s and mm.
+    fn feed_time_and_rapids(&self) -> (f64, f64) {
+        let (mut feed_s, mut rapid_mm) = (0.0, 0.0);
+        let mut at: Option<[f64; 3]> = None;
+        let mut feed = 0.0;
+        for line in &self.moves {
+            let words = Words::of(line);
+            if let Some(f) = words.f {
+                feed = f;
+            }
+            let to = [words.x.unwrap_or(0.0), words.y.unwrap_or(0.0), words.z.unwrap_or(0.0)];
+            let Some(from) = at.replace(to) else { continue };
+            let straight = ((to[0] - from[0]).powi(2) + (to[1] - from[1]).powi(2) + (to[2] - from[2]).powi(2)).sqrt();
+            let length = match (words.code, words.i, words.j) {
+                ("G02" | "G03", Some(i), Some(j)) => {
+                    arc_length(from, to, [from[0] + i, from[1] + j], words.code == "G02")
+                }
+                _ => straight,
+            };
+            if words.code == "G00" {
+                rapid_mm += length;
+            } else if feed > 0.0 {
+                feed_s += length / feed * 60.0;
+            }
+        }
+        (feed_s, rapid_mm)
+    }
+}
+
+/// Whether a line is one of the motion blocks [`super::write`] writes.
+fn is_move(line: &str) -> bool {
+    ["G00 X", "G01 X", "G02 X", "G03 X"].iter().any(|start| line.starts_with(start))
+}
+
+/// The words of one motion block.
+struct Words<'a> {
+    code: &'a str,
+    x: Option<f64>,
+    y: Option<f64>,
+    z: Option<f64>,
+    i: Option<f64>,
+    j: Option<f64>,
+    f: Option<f64>,
+}
+
+impl<'a> Words<'a> {
+    fn of(line: &'a str) -> Self {
+        let mut words = line.split(' ');
+        let code = words.next().unwrap_or("");
+        let mut read = Self { code, x: None, y: None, z: None, i: None, j: None, f: None };
+        for word in words {
+            let value = word.get(1..).and_then(|v| v.parse().ok());
+            match word.as_bytes().first() {
+                Some(b'X') => read.x = value,
+                Some(b'Y') => read.y = value,
+                Some(b'Z') => read.z = value,
+                Some(b'I') => read.i = value,
+                Some(b'J') => read.j = value,
+                Some(b'F') => read.f = value,
+                _ => {}
+            }
+        }
+        read
+    }
+}
+
+/// Length of a helical arc in XY about `centre` from `from` to `to` (at most a full turn).
+fn arc_length(from: [f64; 3], to: [f64; 3], centre: [f64; 2], clockwise: bool) -> f64 {
+    let radius = (from[0] - centre[0]).hypot(from[1] - centre[1]);
+    let start = (from[1] - centre[1]).atan2(from[0] - centre[0]);
+    let end = (to[1] - centre[1]).atan2(to[0] - centre[0]);
+    let mut sweep = if clockwise { start - end } else { end - start };
+    if sweep <= 0.0 {
+        sweep += std::f64::consts::TAU;
+    }
+    (radius * sweep).hypot(to[2] - from[2])
+}
+
+/// The estimated time of one operation, s: feed moves at their feed, rapids at the machine's
+/// rapid feed, one tool change at the machine's tool-change time.
+fn estimated_time_s(section: &Section<'_>, operation: &Operation<'_>) -> f64 {
+    let (feed_s, rapid_mm) = section.feed_time_and_rapids();
+    let rapid_s = operation.rapid_feed.filter(|f| *f > 0.0).map_or(0.0, |f| rapid_mm / f * 60.0);
+    let change_s = if section.tool_number.is_some() { operation.tool_change_s.unwrap_or(0.0) } else { 0.0 };
+    feed_s + rapid_s + change_s
+}
+
+/// The one program of a job: every operation that has a program of [`super::write`]'s layout, in
+/// order. Operations without one are named in the header as not included.
+///
+/// # Errors
+/// `E_NO_PROGRAM` when no operation has a program.
+pub fn write(job: &Job<'_>, operations: &[Operation<'_>]) -> Result<String, SolverError> {
+    let sections: Vec<Option<Section<'_>>> =
+        operations.iter().map(|operation| operation.program.and_then(Section::parse)).collect();
+    if sections.iter().all(Option::is_none) {
+        return Err(SolverError::new(
+            crate::error::ErrorCode::NoProgram,
+            "no operation of this job has a program to join",
+        ));
+    }
+    let clearance = sections.iter().flatten().map(|s| s.safe_z).fold(f64::NEG_INFINITY, f64::max);
+    let fanuc = job.dialect == Dialect::Fanuc;
+    let mut out = String::new();
+    out.push_str("%\n");
+    if fanuc {
+        let _ = writeln!(out, "O{:04} {}", job.number, comment(job.title));
+    } else {
+        // LinuxCNC reads an O word as a subroutine label: the number is in the title instead.
+        let _ = writeln!(out, "{}", comment(&format!("O{:04} {}", job.number, job.title)));
+    }
+    let included = sections.iter().flatten().count();
+    let mut tools: Vec<u32> = sections.iter().flatten().filter_map(|s| s.tool_number).collect();
+    tools.sort_unstable();
+    tools.dedup();
+    let tools: Vec<String> = tools.iter().map(|n| format!("T{n}")).collect();
+    let times: Vec<Option<f64>> = sections
+        .iter()
+        .zip(operations)
+        .map(|(section, operation)| section.as_ref().map(|s| estimated_time_s(s, operation)))
+        .collect();
+    let total: f64 = times.iter().flatten().sum();
+    let _ = writeln!(
+        out,
+        "{}",
+        comment(&format!(
+            "{} operations, {included} in this program, tools {}, estimated {total:.1} s",
+            operations.len(),
+            if tools.is_empty() { "manual".to_owned() } else { tools.join(" ") }
+        ))
+    );
+    for (index, (operation, time)) in operations.iter().zip(&times).enumerate() {
+        let tool = operation.tool.unwrap_or("no tool");
+        let line = match (time, &sections[index]) {
+            (Some(time), Some(section)) => {
+                let call = section.tool_number.map_or_else(|| "manual tool change".to_owned(), |n| format!("T{n}"));
+                format!("{} {}: {call} {tool}, {time:.1} s", index + 1, operation.name)
+            }
+            _ => format!(
+                "{} {}: not in this program: {}",
+                index + 1,
+                operation.name,
+                operation
+                    .problem
+                    .unwrap_or("its program keeps the layout of the program it corrects: run its own file")
+            ),
+        };
+        let _ = writeln!(out, "{}", comment(&line));
+    }
+    let _ = writeln!(out, "{}", comment(&format!("clearance between operations Z{}", mm(clearance))));
+    let _ = writeln!(out, "{SAFETY_LINE}");
+    for (index, (section, operation)) in sections.iter().zip(operations).enumerate() {
+        let Some(section) = section else { continue };
+        let _ = writeln!(out, "{}", comment(&format!("operation {} {}", index + 1, operation.name)));
+        let _ = writeln!(out, "{}", section.title);
+        for line in &section.comments {
+            let _ = writeln!(out, "{line}");
+        }
+        if !fanuc && let Some(blend) = section.blend {
+            let _ = writeln!(out, "{blend}");
+        }
+        for line in &section.tool_change {
+            let _ = writeln!(out, "{line}");
+        }
+        match section.tool_number {
+            Some(number) => {
+                let _ = writeln!(out, "G00 G43 H{number} Z{}", mm(clearance));
+            }
+            None => {
+                let _ = writeln!(out, "G00 Z{}", mm(clearance));
+            }
+        }
+        let _ = writeln!(out, "{}", section.spindle);
+        if let Some(code) = job.coolant.on_code() {
+            let _ = writeln!(out, "{code}");
+        }
+        // Across to the first point at the clearance height, then down as the operation goes.
+        if let Some(first) = section.moves.first() {
+            let words = Words::of(first);
+            if let (Some(x), Some(y)) = (words.x, words.y) {
+                let across = format!("G00 X{} Y{} Z{}", mm(x), mm(y), mm(clearance));
+                if across != *first {
+                    let _ = writeln!(out, "{across}");
+                }
+            }
+        }
+        for line in &section.moves {
+            let _ = writeln!(out, "{line}");
+        }
+        out.push_str("M05\n");
+        if job.coolant.on_code().is_some() {
+            out.push_str("M09\n");
+        }
+        let _ = writeln!(out, "G00 Z{}", mm(clearance));
+    }
+    out.push_str("M30\n%\n");
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gcode::{Program, SpindleDirection, ToolCall};
+    use crate::geometry::Vec3;
+    use crate::path::Toolpath;
+
+    fn program(dialect: Dialect, tool: ToolCall, safe_z: f64) -> String {
+        let mut path = Toolpath::default();
+        path.rapid(Vec3::new(1.0, 2.0, safe_z));
+        path.linear(Vec3::new(1.0, 2.0, -1.0), 300.0);
+        path.linear(Vec3::new(61.0, 2.0, -1.0), 600.0);
+        path.rapid(Vec3::new(61.0, 2.0, safe_z));
+        super::super::write(&Program {
+            dialect,
+            number: 1000,
+            title: "kerf test",
+            comments: vec!["a comment".to_owned()],
+            tool,
+            spindle_rpm: 6000.0,
+            spindle_direction: SpindleDirection::Cw,
+            safe_z,
+            blend_tolerance: 0.01,
+            plunges: Some(super::super::Plunges { feed: None }),
+            path: &path,
+        })
+    }
+
+    #[test]
+    fn sections_read_back_what_write_writes() {
+        for dialect in [Dialect::Fanuc, Dialect::Linuxcnc] {
+            let text = program(dialect, ToolCall::Table(7), 30.0);
+            let section = Section::parse(&text).expect("a section");
+            assert_eq!(section.title, "(KERF TEST)");
+            assert_eq!(section.tool_number, Some(7));
+            assert_eq!(section.safe_z, 30.0);
+            assert_eq!(section.moves.len(), 4);
+            assert_eq!(section.blend.is_some(), dialect == Dialect::Linuxcnc);
+            // 2 mm... the plunge: 31 mm at 150 mm/min, then 60 mm at 600 mm/min.
+            let (feed_s, rapid_mm) = section.feed_time_and_rapids();
+            assert!((feed_s - (31.0 / 150.0 + 60.0 / 600.0) * 60.0).abs() < 1e-9, "{feed_s}");
+            assert!((rapid_mm - 31.0).abs() < 1e-9);
+            let manual = program(dialect, ToolCall::Manual("ball R3".to_owned()), 30.0);
+            assert_eq!(Section::parse(&manual).expect("a manual section").tool_number, None);
+        }
+        assert!(Section::parse("G0 X1\nM30\n").is_none());
+    }
+
+    #[test]
+    fn a_job_program_has_one_number_one_end_and_a_change_per_operation() {
+        let first = program(Dialect::Fanuc, ToolCall::Table(7), 30.0);
+        let second = program(Dialect::Fanuc, ToolCall::Table(3), 5.0);
+        let operation = |text| Operation {
+            name: "deburr",
+            program: Some(text),
+            problem: None,
+            tool: Some("ball R3"),
+            rapid_feed: None,
+            tool_change_s: None,
+        };
+        let missing = Operation { program: None, problem: Some("no path"), ..operation("") };
+        let job = Job { dialect: Dialect::Fanuc, number: 2042, title: "kerf job 42", coolant: Coolant::Flood };
+        let text = write(&job, &[operation(&first), missing, operation(&second)]).unwrap();
+        assert!(text.starts_with("%\nO2042 (KERF JOB 42)\n"), "{text}");
+        assert_eq!(text.lines().filter(|l| l.starts_with('O')).count(), 1);
+        assert_eq!(text.matches("M06").count(), 2);
+        assert_eq!(text.matches("M30").count(), 1);
+        assert_eq!(text.matches("M08").count(), 2);
+        assert!(text.contains("(2 DEBURR: NOT IN THIS PROGRAM: NO PATH)"), "{text}");
+        // The second operation comes down from the highest clearance plane of the job.
+        assert!(text.contains("T3 M06\nG00 G43 H3 Z30.0000\nS6000 M03\nM08\nG00 X1.0000 Y2.0000 Z30.0000\n"), "{text}");
+        assert!(text.ends_with("M05\nM09\nG00 Z30.0000\nM30\n%\n"));
+        let none = write(&job, &[missing]).unwrap_err();
+        assert_eq!(none.code(), crate::error::ErrorCode::NoProgram);
+    }
+
+    #[test]
+    fn default_numbers_stay_in_the_job_range() {
+        assert_eq!(number_for_job(1), 2000);
+        assert_eq!(number_for_job(6000), 7999);
+        assert_eq!(number_for_job(6001), 2000);
+        assert!(check_number("output.program_number", 9000).is_err());
+        assert!(check_number("output.program_number", 0).is_err());
+        assert!(check_number("output.program_number", 1234).is_ok());
+    }
+}
