@@ -75,7 +75,7 @@ pub use answer::{
 };
 pub use arcs::{MillingMode, SpindleDirection};
 pub use capability::{EngagementCapability, EngagementResponse};
-pub use kienzle::{DEFAULT_RADIAL_RATIO, Kienzle};
+pub use kienzle::{DEFAULT_RADIAL_RATIO, Kienzle, MAX_KC11};
 pub use limits::{RESONANCE_BAND, SpindleLimits};
 pub use program::program;
 pub use request::{

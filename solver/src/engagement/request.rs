@@ -383,8 +383,9 @@ pub struct EngagementRequest {
     /// torque and power along the path (engagement.md §11 item 4). Give this or `material`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kienzle: Option<Kienzle>,
-    /// A stored work material whose Kienzle values the server resolves (give this or
-    /// `kienzle`).
+    /// The name of a work material in the materials library (`/api/v1/materials/{name}`, or a
+    /// job file's `materials`): its Kienzle values, as `kienzle` would give them (give this or
+    /// `kienzle`; 404 naming `material` when unknown).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
 }

@@ -16,6 +16,7 @@ mod jobs;
 mod limits;
 mod load;
 mod machines;
+mod materials;
 mod metrics;
 mod openapi;
 mod predict;
