@@ -1,8 +1,8 @@
 // Engagement view: tool–workpiece contact along one or several candidate paths (api.md,
 // Engagement; engagement.md §3). A form for the tool, stock, paths, cutting conditions, limits and
-// the work material (from the library, or typed Kienzle values); per path (one shown at a time) the plan view coloured by
-// engagement, the contact-position graph, a_e, the summed chip thickness per flute count with
-// the threshold, spindle torque and power with the machine's limits, the feed plan, and the
+// the work material (from the library, or typed Kienzle values); per path (one shown at a time)
+// the plan view coloured by engagement, the contact-position graph, a_e, the summed chip
+// thickness per flute count with the threshold, spindle torque and power with the machine's limits, the feed plan, and the
 // representative values and time per k with the recommended k highlighted (the charts are
 // plot.js's); a cursor on any chart marks the tool on the path. The result renderer is shared
 // with the Jobs view.
