@@ -205,6 +205,65 @@ fn helix_lag_is_two_ap_tan_helix_over_d() {
     assert_eq!(straight.helix_lag_deg, 0.0);
 }
 
+/// The same slot as two candidate paths, the second with its own a_p.
+fn slot_pair(request_depth: Option<f64>, own_depth: Value) -> Value {
+    let mut body = slot(0.25, &[2, 4]);
+    let path = body.as_object_mut().unwrap().remove("path").unwrap();
+    body["paths"] =
+        json!([{"name": "request's a_p", "path": path}, {"name": "own a_p", "path": path, "axial_depth": own_depth}]);
+    match request_depth {
+        Some(depth) => body["axial_depth"] = json!(depth),
+        None => drop(body.as_object_mut().unwrap().remove("axial_depth")),
+    }
+    body
+}
+
+fn solve_pair(body: Value, tool: &Tool) -> Result<Vec<PathEngagement>, kerf_solver::error::SolverError> {
+    let request: EngagementRequest = serde_json::from_value(body).unwrap();
+    engagement::solve_in(&request, tool, None, &Physics::default(), kerf_solver::capability::Control::default()).map(
+        |answer| match answer {
+            EngagementAnswer::Comparison(comparison) => comparison.candidates,
+            EngagementAnswer::Single(_) => panic!("candidates expected"),
+        },
+    )
+}
+
+#[test]
+fn a_path_with_its_own_axial_depth() {
+    // Torque is linear in the chip width a_p (no helix): twice the depth, twice the torque and
+    // removal rate; the helix lag 2a_p·tan λ/D doubles too.
+    let helix: f64 = 30.0;
+    for (tool, lag_per_mm) in [(tool(None), 0.0), (tool(Some(helix)), (helix.to_radians().tan() / RADIUS).to_degrees())]
+    {
+        let pair = solve_pair(slot_pair(Some(AP), json!(2.0 * AP)), &tool).unwrap();
+        let (shallow, deep) = (&pair[0], &pair[1]);
+        let (a, b) = (shallow.forces.as_ref().unwrap(), deep.forces.as_ref().unwrap());
+        assert_eq!((a.axial_depth, b.axial_depth), (AP, 2.0 * AP));
+        assert!(
+            (a.helix_lag_deg - AP * lag_per_mm).abs() < 1e-12
+                && (b.helix_lag_deg - 2.0 * AP * lag_per_mm).abs() < 1e-12
+        );
+        for (x, y) in shallow.flutes.iter().zip(&deep.flutes) {
+            let (once, twice) = (x.mean_torque_nm.unwrap(), y.mean_torque_nm.unwrap());
+            close_rel("mean torque at 2·a_p", twice, 2.0 * once, 1e-12);
+            close_rel("power at 2·a_p", y.mean_power_kw.unwrap(), 2.0 * x.mean_power_kw.unwrap(), 1e-12);
+        }
+        close_rel("removal rate at 2·a_p", deep.max_mrr.unwrap(), 2.0 * shallow.max_mrr.unwrap(), 1e-12);
+    }
+    // Every path may bring its own a_p instead of the request; a path with none then has none.
+    let own = solve_pair(slot_pair(None, json!(3.0)), &tool(None));
+    let error = own.unwrap_err();
+    assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("axial_depth")));
+    let mut both_own = slot_pair(None, json!(3.0));
+    both_own["paths"][0]["axial_depth"] = json!(1.5);
+    let pair = solve_pair(both_own, &tool(None)).unwrap();
+    assert_eq!(pair.iter().map(|c| c.forces.as_ref().unwrap().axial_depth).collect::<Vec<_>>(), [1.5, 3.0]);
+    for bad in [json!(-1.0), json!(0.0), json!(1e9)] {
+        let error = solve_pair(slot_pair(Some(AP), bad.clone()), &tool(None)).unwrap_err();
+        assert_eq!(error.field(), Some("paths[1].axial_depth"), "{bad}");
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
 

@@ -260,7 +260,7 @@ pub(crate) fn evaluate(
         let sums: Vec<_> = job.flute_counts.iter().map(|&k| tooth_sum(arcs, k)).collect();
         let edge_feed = if job.arc_feed { ArcFeed::at(route, station, radius) } else { None };
         let (torques, forces): (Vec<SampleTorque>, Vec<f64>) =
-            job.force.as_ref().map_or_else(Default::default, |model| {
+            candidate.force.as_ref().map_or_else(Default::default, |model| {
                 let integral = model.engaged_integral(arcs, edge_feed.as_ref());
                 job.flute_counts
                     .iter()
@@ -301,7 +301,7 @@ pub(crate) fn evaluate(
             peak_torque_nm: torques.iter().map(|t| t.peak).collect(),
             power_kw: torques.iter().map(|t| power_kw(t.mean, job.spindle_rpm)).collect(),
             peak_force_n: forces,
-            mrr: job.axial_depth.map(|depth| depth * radial_depth * nominal_feed),
+            mrr: candidate.axial_depth.map(|depth| depth * radial_depth * nominal_feed),
             flags,
         });
     }
@@ -439,7 +439,7 @@ pub(crate) fn evaluate(
         }
     }
 
-    if let (Some(model), ToolKind::Ball | ToolKind::Bull) = (&job.force, tool.kind) {
+    if let (Some(model), ToolKind::Ball | ToolKind::Bull) = (&candidate.force, tool.kind) {
         warnings.push(Warning::new(
             "W_FORCE_MODEL",
             format!(
@@ -449,9 +449,11 @@ pub(crate) fn evaluate(
             ),
         ));
     }
-    let (flute_results, recommended, flute_warnings) = flutes::results(job, &samples, &statistic, route.feed_length);
+    let (flute_results, recommended, flute_warnings) =
+        flutes::results(job, candidate.force.as_ref(), &samples, &statistic, route.feed_length);
     warnings.extend(flute_warnings);
-    let feed_plan = job.plan.as_ref().map(|plan| feed::plan(job, plan, route, &stations, &contacts));
+    let feed_plan =
+        job.plan.as_ref().map(|plan| feed::plan(job, candidate.force.as_ref(), plan, route, &stations, &contacts));
 
     let (max_engaged_deg, max_engaged_at_s) = samples
         .iter()
@@ -496,7 +498,7 @@ pub(crate) fn evaluate(
     ];
     Ok(PathEngagement {
         name: candidate.name.clone(),
-        max_mrr: job.axial_depth.map(|depth| depth * max_radial_depth * nominal_feed),
+        max_mrr: candidate.axial_depth.map(|depth| depth * max_radial_depth * nominal_feed),
         samples,
         flutes: flute_results,
         recommended,
@@ -511,7 +513,7 @@ pub(crate) fn evaluate(
         max_engaged_at_s,
         max_radial_depth,
         contact_dots,
-        forces: job.force.as_ref().map(|model| ForceInfo {
+        forces: candidate.force.as_ref().map(|model| ForceInfo {
             kc11: model.kc11,
             mc: model.mc,
             radial_ratio: model.radial_ratio,
@@ -530,7 +532,7 @@ pub(crate) fn evaluate(
             spindle_rpm: job.spindle_rpm,
             spindle_direction: job.direction,
             rule: job.rule,
-            axial_depth: job.axial_depth,
+            axial_depth: candidate.axial_depth,
             stock_top_z: job.stock_top_z,
             clearance: job.clearance,
             tool_radius: tool.radius,

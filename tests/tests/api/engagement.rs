@@ -956,3 +956,38 @@ async fn kienzle_torque_and_power_against_the_machines_spindle() {
     let problem = problem(app.put_json("/api/v1/machines/bad-spindle", &bad).await, 422).await;
     assert_eq!(problem["errors"][0]["path"], "spindle_power_kw");
 }
+
+/// Candidate paths at different depths: each answer and program uses its own a_p.
+#[tokio::test(flavor = "multi_thread")]
+async fn each_candidate_path_may_give_its_own_axial_depth() {
+    let app = TestApp::spawn().await;
+    let request = json!({
+        "tool": {"kind": "flat", "radius": 5, "flutes": 4}, "spindle_rpm": 8000, "feed_per_tooth": 0.05,
+        "flute_counts": [4], "axial_depth": 2, "kienzle": {"kc11": 1800, "mc": 0.25},
+        "stock": {"polygon": [[0, 0], [100, 0], [100, 80], [0, 80]]},
+        "paths": [
+            {"name": "full depth in one pass", "path": [[-10, 40], [110, 40]], "axial_depth": 6},
+            {"name": "the request's depth", "path": [[-10, 40], [110, 40]]}
+        ]
+    });
+    let answer = json_with(app.post_json(URL, &request).await, 200).await;
+    let candidates = answer["candidates"].as_array().unwrap();
+    let torque = |c: &Value| c["flutes"][0]["mean_torque_nm"].as_f64().unwrap();
+    assert_eq!(candidates[0]["forces"]["axial_depth"], 6.0);
+    assert_eq!(candidates[1]["forces"]["axial_depth"], 2.0);
+    close_rel(
+        "three times the depth, three times the torque",
+        torque(&candidates[0]),
+        3.0 * torque(&candidates[1]),
+        1e-12,
+    );
+    for (candidate, z) in [(0, "Z-6.0000"), (1, "Z-2.0000")] {
+        let url = app.url(&format!("{URL}?format=gcode&candidate={candidate}"));
+        let program = app.client.post(url).json(&request).send().await.unwrap().text().await.unwrap();
+        assert!(program.contains(z), "candidate {candidate} cuts at {z}: {program}");
+    }
+    let mut bad = request.clone();
+    bad["paths"][0]["axial_depth"] = json!(-6);
+    let problem = problem(app.post_json(URL, &bad).await, 422).await;
+    assert_eq!(problem["errors"][0]["path"], "paths[0].axial_depth");
+}
