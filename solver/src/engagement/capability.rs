@@ -64,7 +64,7 @@ impl Capability for EngagementCapability {
     ) -> Result<EngagementResponse, SolverError> {
         let physics = super::Physics {
             material: context.material.as_ref().map(Material::kienzle),
-            spindle: context.machine.as_ref().map(MachineProfile::spindle).unwrap_or_default(),
+            spindle: context.machine.as_ref().map(|m| m.spindle_at(request.spindle_rpm)).unwrap_or_default(),
         };
         let result = super::solve_in(request, &context.tool, context.machine.as_ref(), &physics, run.control)?;
         Ok(EngagementResponse {

@@ -991,3 +991,47 @@ async fn each_candidate_path_may_give_its_own_axial_depth() {
     let problem = problem(app.post_json(URL, &bad).await, 422).await;
     assert_eq!(problem["errors"][0]["path"], "paths[0].axial_depth");
 }
+
+/// A machine's power curve: at a low spindle speed the power it gives there, not its rating,
+/// limits the cut, and the capped feed plan brings the path's power under it.
+#[tokio::test(flavor = "multi_thread")]
+async fn the_power_curve_limits_the_cut_at_its_speed() {
+    let app = TestApp::spawn().await;
+    // 0.5 kW at standstill rising to 8 kW at 4000 rpm: 1.4375 kW available at 500 rpm.
+    let machine = json!({"block_time_ms": 4, "max_feed": 20000, "spindle_power_kw": 8,
+                         "spindle_power_curve": [[0, 0.5], [4000, 8.0], [12000, 8.0]]});
+    json_with(app.put_json("/api/v1/machines/s1-curve", &machine).await, 201).await;
+    let request = json!({
+        "tool": {"kind": "flat", "radius": 8, "flutes": 4}, "spindle_rpm": 500, "feed_per_tooth": 0.3,
+        "flute_counts": [4], "axial_depth": 10, "material": "42CrMo4", "machine": "s1-curve",
+        "stock": {"polygon": [[0, 0], [100, 0], [100, 80], [0, 80]]},
+        "path": [[-10, 40], [110, 40]],
+        "feed_plan": {"target_thickness": 1.0, "max_feed": 20000, "flute_count": 4}
+    });
+    let answer = json_with(app.post_json(URL, &request).await, 200).await;
+    let available = 0.5 + 7.5 * 500.0 / 4000.0;
+    close_rel("power available at 500 rpm", answer["forces"]["spindle_power_kw"].as_f64().unwrap(), available, 1e-12);
+    let power = answer["flutes"][0]["mean_power_kw"].as_f64().unwrap();
+    assert!(power > available && power < 8.0, "over the curve, under the rating: {power} kW");
+    assert!(answer["warnings"].to_string().contains("W_SPINDLE_POWER"), "{}", answer["warnings"]);
+    let blocks = answer["feed_plan"]["blocks"].as_array().unwrap();
+    let cutting: Vec<&Value> = blocks.iter().filter(|b| b["limited_by"] == "power").collect();
+    assert!(!cutting.is_empty(), "{blocks:?}");
+    // The slowest power-limited feed, run as a constant feed, stays under the curve's power.
+    let feed = cutting.iter().map(|b| b["feed"].as_f64().unwrap()).fold(f64::INFINITY, f64::min);
+    let mut capped = request.clone();
+    let body = capped.as_object_mut().unwrap();
+    body.remove("feed_per_tooth");
+    body.remove("feed_plan");
+    body.insert("feed".to_owned(), json!(feed));
+    let answer = json_with(app.post_json(URL, &capped).await, 200).await;
+    // The highest phase-mean power of any sample (the path's mean is lower: entry and exit).
+    let samples = answer["samples"].as_array().unwrap();
+    let power = samples.iter().filter_map(|s| s["power_kw"][0].as_f64()).fold(0.0, f64::max);
+    assert!(power <= available && power > 0.99 * available, "capped: {power} kW of {available}");
+    assert!(!answer["warnings"].to_string().contains("W_SPINDLE_POWER"));
+
+    let bad = json!({"block_time_ms": 4, "max_feed": 12000, "spindle_power_curve": [[0, 1], [5000, 4], [4000, 5]]});
+    let problem = problem(app.put_json("/api/v1/machines/bad-curve", &bad).await, 422).await;
+    assert_eq!(problem["errors"][0]["path"], "spindle_power_curve[2][0]");
+}
