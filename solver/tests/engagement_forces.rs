@@ -504,16 +504,66 @@ fn arc_feed_correction_uses_the_feed_at_the_edge() {
     assert_eq!(unswitched.samples, switched.samples);
 }
 
+/// ∫₀^a_p r(z)·sin^(−m_c)κ(z) dz for a corner radius r_c (R ball), directly in z after
+/// z = a_p·u² (the integrand has a z^(−m_c/2) singularity at the tip): independent of the
+/// solver's κ substitution and tables.
+fn torque_width(radius: f64, corner: f64, depth: f64, mc: f64) -> f64 {
+    let n = 400_000;
+    (0..n)
+        .map(|i| {
+            let u = (f64::from(i) + 0.5) / f64::from(n);
+            let z = depth * u * u;
+            let (r, sin_kappa) = if z < corner {
+                let s = (corner * corner - (corner - z) * (corner - z)).sqrt() / corner;
+                (radius - corner + corner * s, s)
+            } else {
+                (radius, 1.0)
+            };
+            r * sin_kappa.powf(-mc) * 2.0 * depth * u / f64::from(n)
+        })
+        .sum()
+}
+
 #[test]
-fn rounded_ends_are_flagged_as_upper_bounds() {
+fn ball_and_bull_ends_integrate_chip_and_lever_arm_over_the_height() {
     let mut ball = tool(None);
     ball.kind = ToolKind::Ball;
-    let result = solve_body(slot(0.25, &[2]), &ball, &Physics::default()).unwrap();
-    assert!(result.warnings.iter().any(|w| w.code == "W_FORCE_MODEL"));
+    let mut bull = tool(None);
+    bull.kind = ToolKind::Bull;
+    bull.corner_radius = Some(2.0);
+    for mc in [0.0, 0.25] {
+        let a = 1.0 - mc;
+        let integral = sin_power_integral(a, 0.0, PI);
+        for (label, end, corner, depth) in
+            [("ball a_p = R", &ball, RADIUS, RADIUS), ("ball a_p < R", &ball, RADIUS, 2.0), ("bull", &bull, 2.0, 4.0)]
+        {
+            let mut body = slot(mc, &[2, 4]);
+            body["axial_depth"] = json!(depth);
+            let result = solve_body(body, end, &Physics::default()).unwrap();
+            assert!(result.warnings.iter().any(|w| w.code == "W_FORCE_MODEL"), "{label}: still an upper bound");
+            let width = torque_width(RADIUS, corner, depth, mc);
+            for flute in &result.flutes {
+                let k = f64::from(flute.flute_count);
+                let expected = k * KC11 * width * FZ.powf(a) * integral / TAU / 1000.0;
+                close_rel(&format!("{label} mc {mc} k {k}"), flute.mean_torque_nm.unwrap(), expected, 1e-4);
+            }
+        }
+    }
+    // m_c = 0: the spindle's work per turn is k_c·k·f_z times the slot's cross-section A, so
+    // M = k·k_c·f_z·A/(2π): a half disc πR²/2 for the ball at a_p = R, 2R·a_p less the two
+    // corners' (1 − π/4)·r_c² for the bull.
+    let check = |end: &Tool, depth: f64, area: f64| {
+        let mut body = slot(0.0, &[4]);
+        body["axial_depth"] = json!(depth);
+        let result = solve_body(body, end, &Physics::default()).unwrap();
+        let expected = 4.0 * KC11 * FZ * area / TAU / 1000.0;
+        close_rel(&format!("{:?} cross-section", end.kind), result.flutes[0].mean_torque_nm.unwrap(), expected, 1e-6);
+    };
+    check(&ball, RADIUS, PI * RADIUS * RADIUS / 2.0);
+    check(&bull, 4.0, 2.0 * RADIUS * 4.0 - 2.0 * (1.0 - PI / 4.0) * 4.0);
+    // A flat end has no warning and R·a_p.
     let flat = solve(slot(0.25, &[2]));
     assert!(!flat.warnings.iter().any(|w| w.code == "W_FORCE_MODEL"));
-    // Same numbers: the end shape does not enter the model.
-    assert_eq!(result.flutes, flat.flutes);
 }
 
 proptest! {

@@ -267,7 +267,7 @@ pub(crate) fn evaluate(
                     .map(|&k| {
                         let fz = job.feed_mode.feed_per_tooth(k, job.spindle_rpm);
                         (
-                            model.torque(arcs, edge_feed.as_ref(), integral, k, radius, fz),
+                            model.torque(arcs, edge_feed.as_ref(), integral, k, fz),
                             model.peak_force(arcs, k, fz, edge_feed.as_ref()),
                         )
                     })
@@ -443,9 +443,9 @@ pub(crate) fn evaluate(
         warnings.push(Warning::new(
             "W_FORCE_MODEL",
             format!(
-                "the forces take every tooth as a straight edge cutting a chip {} mm wide (a_p): the rounded end of a {} tool cuts less near its tip, so torque, power and force are upper bounds",
-                model.axial_depth,
-                tool.kind.as_str()
+                "the {} end's chips (h = f_z·sin θ·sin κ) and lever arms are integrated over a_p = {} mm, but with the engaged arcs of the full radius at every height: where the end's circle is smaller than the radius at a height (a cut shallower than the corner radius, a wall beside it), torque, power and force are upper bounds",
+                tool.kind.as_str(),
+                model.axial_depth
             ),
         ));
     }

@@ -38,7 +38,7 @@ fn needed(
     // meets the cap is closed.
     if let (Some(model), Some((torque, by_power))) = (force, job.spindle.torque_cap(job.spindle_rpm)) {
         let integral = model.engaged_integral(&contact.arcs, edge_feed);
-        let feed = to_feed(model.feed_for_torque(torque, integral, plan.flute_count, job.radius));
+        let feed = to_feed(model.feed_for_torque(torque, integral, plan.flute_count));
         if feed < best.0 {
             best = (feed, if by_power { FeedLimit::Power } else { FeedLimit::Torque });
         }

@@ -24,7 +24,7 @@ use crate::error::{SolverError, Warning};
 use crate::gcode::reader::{MoveKind, Plane, ReadOptions, read as read_program};
 use crate::machine::{BlockRule, MachineProfile, RuleSettings};
 use crate::planar::signed_area;
-use crate::tool::{Tool, ToolRef};
+use crate::tool::{Tool, ToolKind, ToolRef};
 use crate::validate::{self, finite, non_negative, positive, positive_at_most};
 
 /// One move of a path given as `start` + `segments` (engagement.md §2.3).
@@ -1148,15 +1148,25 @@ fn force_model(
     })?;
     // Λ = 2·a_p·tan λ / D (engagement.md §11 item 5), radians.
     let lag = tool.helix_deg.map_or(0.0, |helix| axial_depth * helix.to_radians().tan() / tool.radius);
+    let (table, table_next) = (SinPower::new(1.0 - kienzle.mc), SinPower::new(2.0 - kienzle.mc));
+    let corner_radius = match tool.kind {
+        ToolKind::Flat => 0.0,
+        ToolKind::Ball => tool.radius,
+        ToolKind::Bull => tool.corner_radius.unwrap_or(0.0).min(tool.radius),
+    };
+    let (force_width, torque_width) =
+        ForceModel::end_widths(&table, &table_next, tool.radius, corner_radius, axial_depth);
     Ok(ForceModel {
         kc11: kienzle.kc11,
         mc: kienzle.mc,
         axial_depth,
+        force_width,
+        torque_width,
         lag_deg: lag.to_degrees(),
         direction,
         radial_ratio: kienzle.radial_ratio.unwrap_or(DEFAULT_RADIAL_RATIO),
-        table: SinPower::new(1.0 - kienzle.mc),
-        table_next: SinPower::new(2.0 - kienzle.mc),
+        table,
+        table_next,
     })
 }
 
