@@ -54,6 +54,15 @@ export async function machines() {
   }
 }
 
+// The materials library by name.
+export async function materials() {
+  try {
+    return new Map((await api('GET', '/api/v1/materials')).map((m) => [m.name, m]));
+  } catch (problem) {
+    return new Map();
+  }
+}
+
 // The registered tools by number.
 export async function tools() {
   try {

@@ -1,7 +1,7 @@
 // kerf form helpers shared by the views: reading fields, the tool and machine choices (machine
 // values as placeholders, only overrides sent), errors at the field, warnings as sentences, the
 // per-view state kept in local storage, summaries and downloads.
-import { api, machines, plainFieldMessage, plainTitle, program, sentence, technical, tools } from '/api.js';
+import { api, machines, materials, plainFieldMessage, plainTitle, program, sentence, technical, tools } from '/api.js';
 
 // ---------------------------------------------------------------- reading fields
 
@@ -255,6 +255,24 @@ export function loadMachines(select, noneLabel = 'none') {
     select.machines = table;
     restoreChoice(select, chosen);
     select.dispatchEvent(new Event('kerf:machines'));
+  };
+  if (!select.options.length) select.append(new Option(noneLabel, ''));
+  onShow(select, fill);
+  return track(select.form, fill());
+}
+
+// Fills a material <select> with "values below" and the library's materials, keeping the
+// choice; `select.materials` holds the library for placeholders.
+export function loadMaterials(select, noneLabel) {
+  const fill = async () => {
+    const chosen = select.value;
+    const table = await materials();
+    select.replaceChildren(new Option(noneLabel, ''));
+    for (const material of table.values()) {
+      select.append(new Option(`${material.name}: kc1.1 ${material.kc11} N/mm², mc ${material.mc}`, material.name));
+    }
+    select.materials = table;
+    restoreChoice(select, chosen);
   };
   if (!select.options.length) select.append(new Option(noneLabel, ''));
   onShow(select, fill);

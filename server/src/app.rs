@@ -54,6 +54,7 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
         .merge(http::predict::router())
         .merge(http::jobs::router())
         .merge(http::machines::router())
+        .merge(http::materials::router())
         .merge(http::segment::router())
         .split_for_parts();
     let mut document = document;

@@ -12,6 +12,7 @@ use kerf_solver::corners::{ContourCapability, ContourRequest};
 use kerf_solver::deburr::{DeburrCapability, DeburrRequest};
 use kerf_solver::engagement::{EngagementCapability, EngagementRequest};
 use kerf_solver::machine::MachineProfile;
+use kerf_solver::material::Material;
 use kerf_solver::predict::{PredictCapability, PredictRequest};
 use kerf_solver::tool::Tool;
 use serde::{Deserialize, Serialize};
@@ -50,7 +51,7 @@ macro_rules! registry {
                 }
             }
 
-            /// The tool and machine the operation refers to.
+            /// The tool, machine and material the operation refers to.
             pub fn refs(&self) -> Refs<'_> {
                 match self {
                     $(Self::$variant(request) => <$capability as Capability>::refs(request),)+
@@ -60,7 +61,7 @@ macro_rules! registry {
             /// Checks that the operation's references resolve against `lookup`.
             ///
             /// # Errors
-            /// The 404 naming the field of an unknown tool or machine.
+            /// The 404 naming the field of an unknown tool, machine or material.
             pub fn check_refs(&self, lookup: &impl Lookup) -> Result<(), AppError> {
                 match self {
                     $(Self::$variant(request) => resolve::<$capability>(request, lookup).map(drop),)+
@@ -154,14 +155,16 @@ impl<'de> Deserialize<'de> for OperationName {
     }
 }
 
-/// Tools and machines found for a set of references: what a request or a job refers to, fetched
-/// from the store or given in a job file. Resolution looks things up here only.
+/// Tools, machines and materials found for a set of references: what a request or a job refers
+/// to, fetched from the store or given in a job file. Resolution looks things up here only.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Catalog {
     /// Tools, each with its number.
     pub tools: Vec<Tool>,
     /// Machines, each with its name.
     pub machines: Vec<MachineProfile>,
+    /// Work materials, each with its name.
+    pub materials: Vec<Material>,
 }
 
 impl Lookup for Catalog {
@@ -171,6 +174,10 @@ impl Lookup for Catalog {
 
     fn machine(&self, name: &str) -> Option<MachineProfile> {
         machine_in(&self.machines, name)
+    }
+
+    fn material(&self, name: &str) -> Option<Material> {
+        material_in(&self.materials, name)
     }
 }
 
@@ -184,10 +191,15 @@ pub fn machine_in(machines: &[MachineProfile], name: &str) -> Option<MachineProf
     machines.iter().find(|machine| machine.name.as_deref() == Some(name)).cloned()
 }
 
+/// The material called `name` in `materials`.
+pub fn material_in(materials: &[Material], name: &str) -> Option<Material> {
+    materials.iter().find(|material| material.name.as_deref() == Some(name)).cloned()
+}
+
 /// The one resolution step, for capability `C`: its request's references from `lookup`.
 ///
 /// # Errors
-/// 404 naming `tool` or `machine` when a reference is unknown.
+/// 404 naming `tool`, `machine` or `material` when a reference is unknown.
 pub fn resolve<C: Capability>(request: &C::Request, lookup: &impl Lookup) -> Result<Resolved<C::Tool>, AppError> {
     resolve_refs(C::refs(request), lookup)
 }

@@ -3,7 +3,8 @@
 //! run` and the job workers. A capability declares its name, its request and answer types, the
 //! tool and machine it refers to, how it solves a resolved request and how it writes its program.
 //!
-//! The server resolves references (a tool number, a machine name) once, with [`resolve`], into a
+//! The server resolves references (a tool number, a machine name, a material name) once, with
+//! [`resolve`], into a
 //! [`Resolved`] context; the solver never sees an unresolved reference.
 
 use std::sync::atomic::AtomicBool;
@@ -15,6 +16,7 @@ use crate::error::SolverError;
 use crate::error_code::ErrorCode;
 use crate::gcode::{Arcs, Dialect, Post, Reference, ToolCall};
 use crate::machine::MachineProfile;
+use crate::material::Material;
 use crate::tool::{Tool, ToolRef};
 
 /// One capability: deburr, segment, contour, engagement, predict.
@@ -29,7 +31,7 @@ pub trait Capability {
     /// when the request may name none.
     type Tool: ToolNeed;
 
-    /// The tool and machine the request refers to.
+    /// The tool, machine and material the request refers to.
     fn refs(request: &Self::Request) -> Refs<'_>;
 
     /// Checks the output options before any work, so a program that cannot be written is refused
@@ -74,15 +76,19 @@ pub struct Refs<'a> {
     pub tool: Option<&'a ToolRef>,
     /// The name of a registered machine.
     pub machine: Option<&'a str>,
+    /// The name of a work material in the materials library.
+    pub material: Option<&'a str>,
 }
 
-/// Where resolution finds what a request refers to: the tool table and machines registry (the
-/// server's store), or a job's own tools and machines.
+/// Where resolution finds what a request refers to: the tool table, machines registry and
+/// materials library (the server's store), or a job's own tools, machines and materials.
 pub trait Lookup {
     /// The tool with `number`, if any.
     fn tool(&self, number: u32) -> Option<Tool>;
     /// The machine called `name`, if any.
     fn machine(&self, name: &str) -> Option<MachineProfile>;
+    /// The material called `name`, if any.
+    fn material(&self, name: &str) -> Option<Material>;
 }
 
 /// A request's references, resolved.
@@ -92,6 +98,8 @@ pub struct Resolved<T> {
     pub tool: T,
     /// The machine the request names, if any.
     pub machine: Option<MachineProfile>,
+    /// The work material the request names, if any.
+    pub material: Option<Material>,
 }
 
 /// How a capability's tool need is met by what resolution found.
@@ -115,17 +123,17 @@ impl ToolNeed for Option<Tool> {
 /// Why a reference could not be resolved: the field and what is missing.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Unresolved {
-    /// The request field that refers to it (`tool`, `machine`).
+    /// The request field that refers to it (`tool`, `machine`, `material`).
     pub field: &'static str,
     /// What is missing.
     pub message: String,
 }
 
-/// The one resolution step: the tool and machine `refs` names, from `lookup`. Inline tools are
-/// taken as given (the capability validates them).
+/// The one resolution step: the tool, machine and material `refs` names, from `lookup`. Inline
+/// tools are taken as given (the capability validates them).
 ///
 /// # Errors
-/// [`Unresolved`] naming the field of an unknown tool number or machine name.
+/// [`Unresolved`] naming the field of an unknown tool number, machine name or material name.
 pub fn resolve<T: ToolNeed>(refs: Refs<'_>, lookup: &impl Lookup) -> Result<Resolved<T>, Unresolved> {
     let found =
         match refs.tool {
@@ -145,7 +153,14 @@ pub fn resolve<T: ToolNeed>(refs: Refs<'_>, lookup: &impl Lookup) -> Result<Reso
             message: format!("machine {name:?} is not registered (GET /api/v1/machines)"),
         })?),
     };
-    Ok(Resolved { tool, machine })
+    let material = match refs.material {
+        None => None,
+        Some(name) => Some(lookup.material(name).ok_or_else(|| Unresolved {
+            field: "material",
+            message: format!("material {name:?} is not in the materials library (GET /api/v1/materials)"),
+        })?),
+    };
+    Ok(Resolved { tool, machine, material })
 }
 
 /// Progress reporting and cancellation for long runs.

@@ -6,7 +6,8 @@
 //!
 //! Modules: [`geometry`] (vectors and small numeric helpers), [`tool`] (the cutter),
 //! [`path`] (typed moves), [`gcode`] (posts for the supported dialects), [`capability`] (the seam
-//! every way in dispatches through), and one module per capability: [`deburr`], [`chord`],
+//! every way in dispatches through), [`material`] (work materials' Kienzle values), and one
+//! module per capability: [`deburr`], [`chord`],
 //! [`corners`], [`engagement`], [`predict`].
 #![deny(missing_docs)]
 
@@ -20,6 +21,7 @@ mod error_code;
 pub mod gcode;
 pub mod geometry;
 pub mod machine;
+pub mod material;
 pub mod path;
 pub mod planar;
 pub mod predict;

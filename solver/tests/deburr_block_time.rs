@@ -195,6 +195,7 @@ fn machine_values_and_bad_block_times() {
         mode: None,
         spindle_power_kw: None,
         spindle_torque_nm: None,
+        spindle_power_curve: None,
     };
     let tool = ball(3.0);
     // The machine's block time applies at the request's feed (deburr keeps its own feed).

@@ -205,6 +205,65 @@ fn helix_lag_is_two_ap_tan_helix_over_d() {
     assert_eq!(straight.helix_lag_deg, 0.0);
 }
 
+/// The same slot as two candidate paths, the second with its own a_p.
+fn slot_pair(request_depth: Option<f64>, own_depth: Value) -> Value {
+    let mut body = slot(0.25, &[2, 4]);
+    let path = body.as_object_mut().unwrap().remove("path").unwrap();
+    body["paths"] =
+        json!([{"name": "request's a_p", "path": path}, {"name": "own a_p", "path": path, "axial_depth": own_depth}]);
+    match request_depth {
+        Some(depth) => body["axial_depth"] = json!(depth),
+        None => drop(body.as_object_mut().unwrap().remove("axial_depth")),
+    }
+    body
+}
+
+fn solve_pair(body: Value, tool: &Tool) -> Result<Vec<PathEngagement>, kerf_solver::error::SolverError> {
+    let request: EngagementRequest = serde_json::from_value(body).unwrap();
+    engagement::solve_in(&request, tool, None, &Physics::default(), kerf_solver::capability::Control::default()).map(
+        |answer| match answer {
+            EngagementAnswer::Comparison(comparison) => comparison.candidates,
+            EngagementAnswer::Single(_) => panic!("candidates expected"),
+        },
+    )
+}
+
+#[test]
+fn a_path_with_its_own_axial_depth() {
+    // Torque is linear in the chip width a_p (no helix): twice the depth, twice the torque and
+    // removal rate; the helix lag 2a_p·tan λ/D doubles too.
+    let helix: f64 = 30.0;
+    for (tool, lag_per_mm) in [(tool(None), 0.0), (tool(Some(helix)), (helix.to_radians().tan() / RADIUS).to_degrees())]
+    {
+        let pair = solve_pair(slot_pair(Some(AP), json!(2.0 * AP)), &tool).unwrap();
+        let (shallow, deep) = (&pair[0], &pair[1]);
+        let (a, b) = (shallow.forces.as_ref().unwrap(), deep.forces.as_ref().unwrap());
+        assert_eq!((a.axial_depth, b.axial_depth), (AP, 2.0 * AP));
+        assert!(
+            (a.helix_lag_deg - AP * lag_per_mm).abs() < 1e-12
+                && (b.helix_lag_deg - 2.0 * AP * lag_per_mm).abs() < 1e-12
+        );
+        for (x, y) in shallow.flutes.iter().zip(&deep.flutes) {
+            let (once, twice) = (x.mean_torque_nm.unwrap(), y.mean_torque_nm.unwrap());
+            close_rel("mean torque at 2·a_p", twice, 2.0 * once, 1e-12);
+            close_rel("power at 2·a_p", y.mean_power_kw.unwrap(), 2.0 * x.mean_power_kw.unwrap(), 1e-12);
+        }
+        close_rel("removal rate at 2·a_p", deep.max_mrr.unwrap(), 2.0 * shallow.max_mrr.unwrap(), 1e-12);
+    }
+    // Every path may bring its own a_p instead of the request; a path with none then has none.
+    let own = solve_pair(slot_pair(None, json!(3.0)), &tool(None));
+    let error = own.unwrap_err();
+    assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("axial_depth")));
+    let mut both_own = slot_pair(None, json!(3.0));
+    both_own["paths"][0]["axial_depth"] = json!(1.5);
+    let pair = solve_pair(both_own, &tool(None)).unwrap();
+    assert_eq!(pair.iter().map(|c| c.forces.as_ref().unwrap().axial_depth).collect::<Vec<_>>(), [1.5, 3.0]);
+    for bad in [json!(-1.0), json!(0.0), json!(1e9)] {
+        let error = solve_pair(slot_pair(Some(AP), bad.clone()), &tool(None)).unwrap_err();
+        assert_eq!(error.field(), Some("paths[1].axial_depth"), "{bad}");
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
 
@@ -445,16 +504,66 @@ fn arc_feed_correction_uses_the_feed_at_the_edge() {
     assert_eq!(unswitched.samples, switched.samples);
 }
 
+/// ∫₀^a_p r(z)·sin^(−m_c)κ(z) dz for a corner radius r_c (R ball), directly in z after
+/// z = a_p·u² (the integrand has a z^(−m_c/2) singularity at the tip): independent of the
+/// solver's κ substitution and tables.
+fn torque_width(radius: f64, corner: f64, depth: f64, mc: f64) -> f64 {
+    let n = 400_000;
+    (0..n)
+        .map(|i| {
+            let u = (f64::from(i) + 0.5) / f64::from(n);
+            let z = depth * u * u;
+            let (r, sin_kappa) = if z < corner {
+                let s = (corner * corner - (corner - z) * (corner - z)).sqrt() / corner;
+                (radius - corner + corner * s, s)
+            } else {
+                (radius, 1.0)
+            };
+            r * sin_kappa.powf(-mc) * 2.0 * depth * u / f64::from(n)
+        })
+        .sum()
+}
+
 #[test]
-fn rounded_ends_are_flagged_as_upper_bounds() {
+fn ball_and_bull_ends_integrate_chip_and_lever_arm_over_the_height() {
     let mut ball = tool(None);
     ball.kind = ToolKind::Ball;
-    let result = solve_body(slot(0.25, &[2]), &ball, &Physics::default()).unwrap();
-    assert!(result.warnings.iter().any(|w| w.code == "W_FORCE_MODEL"));
+    let mut bull = tool(None);
+    bull.kind = ToolKind::Bull;
+    bull.corner_radius = Some(2.0);
+    for mc in [0.0, 0.25] {
+        let a = 1.0 - mc;
+        let integral = sin_power_integral(a, 0.0, PI);
+        for (label, end, corner, depth) in
+            [("ball a_p = R", &ball, RADIUS, RADIUS), ("ball a_p < R", &ball, RADIUS, 2.0), ("bull", &bull, 2.0, 4.0)]
+        {
+            let mut body = slot(mc, &[2, 4]);
+            body["axial_depth"] = json!(depth);
+            let result = solve_body(body, end, &Physics::default()).unwrap();
+            assert!(result.warnings.iter().any(|w| w.code == "W_FORCE_MODEL"), "{label}: still an upper bound");
+            let width = torque_width(RADIUS, corner, depth, mc);
+            for flute in &result.flutes {
+                let k = f64::from(flute.flute_count);
+                let expected = k * KC11 * width * FZ.powf(a) * integral / TAU / 1000.0;
+                close_rel(&format!("{label} mc {mc} k {k}"), flute.mean_torque_nm.unwrap(), expected, 1e-4);
+            }
+        }
+    }
+    // m_c = 0: the spindle's work per turn is k_c·k·f_z times the slot's cross-section A, so
+    // M = k·k_c·f_z·A/(2π): a half disc πR²/2 for the ball at a_p = R, 2R·a_p less the two
+    // corners' (1 − π/4)·r_c² for the bull.
+    let check = |end: &Tool, depth: f64, area: f64| {
+        let mut body = slot(0.0, &[4]);
+        body["axial_depth"] = json!(depth);
+        let result = solve_body(body, end, &Physics::default()).unwrap();
+        let expected = 4.0 * KC11 * FZ * area / TAU / 1000.0;
+        close_rel(&format!("{:?} cross-section", end.kind), result.flutes[0].mean_torque_nm.unwrap(), expected, 1e-6);
+    };
+    check(&ball, RADIUS, PI * RADIUS * RADIUS / 2.0);
+    check(&bull, 4.0, 2.0 * RADIUS * 4.0 - 2.0 * (1.0 - PI / 4.0) * 4.0);
+    // A flat end has no warning and R·a_p.
     let flat = solve(slot(0.25, &[2]));
     assert!(!flat.warnings.iter().any(|w| w.code == "W_FORCE_MODEL"));
-    // Same numbers: the end shape does not enter the model.
-    assert_eq!(result.flutes, flat.flutes);
 }
 
 proptest! {

@@ -9,6 +9,7 @@ use kerf_solver::corners::ContourCapability;
 use kerf_solver::deburr::DeburrCapability;
 use kerf_solver::engagement::EngagementCapability;
 use kerf_solver::machine::MachineProfile;
+use kerf_solver::material::Material;
 use kerf_solver::tool::Tool;
 use serde_json::{Value, json};
 
@@ -20,6 +21,9 @@ impl Lookup for Inline {
         None
     }
     fn machine(&self, _name: &str) -> Option<MachineProfile> {
+        None
+    }
+    fn material(&self, _name: &str) -> Option<Material> {
         None
     }
 }

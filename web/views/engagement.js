@@ -1,14 +1,14 @@
 // Engagement view: tool–workpiece contact along one or several candidate paths (api.md,
 // Engagement; engagement.md §3). A form for the tool, stock, paths, cutting conditions, limits and
-// the work material's Kienzle values; per path (one shown at a time) the plan view coloured by
-// engagement, the contact-position graph, a_e, the summed chip thickness per flute count with
-// the threshold, spindle torque and power with the machine's limits, the feed plan, and the
+// the work material (from the library, or typed Kienzle values); per path (one shown at a time)
+// the plan view coloured by engagement, the contact-position graph, a_e, the summed chip
+// thickness per flute count with the threshold, spindle torque and power with the machine's limits, the feed plan, and the
 // representative values and time per k with the recommended k highlighted (the charts are
 // plot.js's); a cursor on any chart marks the tool on the path. The result renderer is shared
 // with the Jobs view.
 import { api } from '/api.js';
 import { PathChart, ToolPlan, barChart } from '/plot.js';
-import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
+import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
   { name: 'straight', text: '-10 20\n70 20' },
@@ -54,6 +54,7 @@ const FORM = `
     </fieldset>
     <fieldset><legend>Work material (torque and power)</legend>
       <label><span>Depth of cut, mm <abbr class="symbol" title="axial depth a_p">a_p</abbr></span> <input name="axial_depth" type="number" step="any" value="2" data-field="axial_depth"></label>
+      <label>Material <select name="material" data-field="material" title="a material of the library (GET /api/v1/materials), or the values below"></select></label>
       <label><span>Specific cutting force, N/mm² <abbr class="symbol" title="Kienzle k_c1.1">k<sub>c1.1</sub></abbr></span> <input name="kc11" type="number" step="any" value="1800" placeholder="none: no torque or power" data-field="kienzle.kc11" title="e.g. about 1800 for a plain carbon steel, 700 for an aluminium alloy"></label>
       <label><span>Kienzle exponent <abbr class="symbol" title="Kienzle m_c">m<sub>c</sub></abbr></span> <input name="mc" type="number" step="any" value="0.25" data-field="kienzle.mc" title="typically 0.15–0.3"></label>
     </fieldset>
@@ -163,7 +164,8 @@ export function engagementRequest(form) {
   });
   if (body.engine === 'dots') body.grid = numeric(form, 'grid');
   const [kc11, mc] = [numeric(form, 'kc11'), numeric(form, 'mc')];
-  if (kc11 !== undefined || mc !== undefined) body.kienzle = { kc11, mc };
+  if (value(form, 'material')) body.material = value(form, 'material');
+  else if (kc11 !== undefined || mc !== undefined) body.kienzle = { kc11, mc };
   const target = numeric(form, 'target_thickness');
   if (target !== undefined) body.feed_plan = { target_thickness: target, max_feed: numeric(form, 'max_feed') };
   if (value(form, 'machine')) body.machine = value(form, 'machine');
@@ -657,6 +659,23 @@ export const engagementView = {
     loadTools(form.elements.tool_choice, 'inline flat end mill (size below)', () => true, (tool) => `${toolLabel(tool)} z${tool.flutes}`).then(() => syncVisibility(form));
     loadMachines(form.elements.machine);
     machineFields(form, { max_feed: 'max_feed' });
+    loadMaterials(form.elements.material, 'the values below');
+    // A stored material replaces the typed values: the fields show its values, greyed, and get
+    // the typed ones back when "the values below" is chosen again.
+    const showMaterial = () => {
+      const material = form.elements.material.materials?.get(value(form, 'material'));
+      for (const name of ['kc11', 'mc']) {
+        const input = form.elements[name];
+        if (material) {
+          if (!input.disabled) input.dataset.typed = input.value;
+          input.value = material[name];
+        } else if (input.disabled) {
+          input.value = input.dataset.typed ?? input.defaultValue;
+        }
+        input.disabled = Boolean(material);
+      }
+    };
+    form.elements.material.addEventListener('change', showMaterial);
     syncVisibility(form);
     const fail = (problem) => {
       showProblem(messages, form, problem);

@@ -6,6 +6,7 @@ pub mod engagement;
 pub mod health;
 pub mod jobs;
 pub mod machines;
+pub mod materials;
 pub mod output;
 pub mod predict;
 pub mod segment;

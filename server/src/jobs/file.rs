@@ -20,21 +20,23 @@
 //! hole = { shape = "round", radius = 5 }
 //! ```
 //!
-//! Machines work like tools: `[[machines]]` entries (each with its `name`) are used before the
-//! machines registry when an operation names a `machine`.
+//! Machines and materials work like tools: `[[machines]]` and `[[materials]]` entries (each with
+//! its `name`) are used before the machines registry and the materials library when an operation
+//! names a `machine` or a `material`.
 
 use kerf_solver::ErrorCode;
 use kerf_solver::capability::{self, Lookup};
 use kerf_solver::gcode::job::Coolant;
 use kerf_solver::gcode::{Arcs, Dialect, Reference};
 use kerf_solver::machine::{MachineProfile, validate_machine_name};
+use kerf_solver::material::{Material, validate_material_name};
 use kerf_solver::predict::Stock;
 use kerf_solver::tool::{Tool, ToolRef};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use utoipa::ToSchema;
 
-use crate::capabilities::{Catalog, Operation, machine_in, tool_in};
+use crate::capabilities::{Catalog, Operation, machine_in, material_in, tool_in};
 use crate::db::Db;
 use crate::error::{AppError, AppResult};
 use crate::store;
@@ -61,6 +63,11 @@ pub struct JobFile {
     /// its operations name, from the file or the registry.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub machines: Vec<MachineProfile>,
+    /// Work materials (Kienzle values, each with its `name`) the operations may name; they take
+    /// precedence over the materials library. Once submitted, the job holds exactly the
+    /// materials its operations name, from the file or the library.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub materials: Vec<Material>,
     /// How the G-code of every operation is written.
     #[serde(default)]
     pub output: OutputOptions,
@@ -307,7 +314,28 @@ fn check(job: &JobFile) -> AppResult<()> {
             ));
         }
     }
-    check_machines(&job.machines)
+    check_machines(&job.machines)?;
+    check_materials(&job.materials)
+}
+
+/// Every material of a job file has a valid name, once, and valid values (422 like a PUT).
+fn check_materials(materials: &[Material]) -> AppResult<()> {
+    for (index, material) in materials.iter().enumerate() {
+        let field = format!("materials[{index}]");
+        let Some(name) = &material.name else {
+            return Err(file_error(&format!("{field}.name"), None, "materials in a job file need their name"));
+        };
+        let prefixed = |error: kerf_solver::SolverError| {
+            let at = error.field().map_or_else(|| field.clone(), |inner| format!("{field}.{inner}"));
+            error.at(at)
+        };
+        validate_material_name(name).map_err(prefixed)?;
+        material.validate().map_err(prefixed)?;
+        if materials[..index].iter().any(|m| m.name == material.name) {
+            return Err(file_error(&format!("{field}.name"), None, &format!("material {name:?} is defined twice")));
+        }
+    }
+    Ok(())
 }
 
 /// Every machine of a job file has a valid name, once, and valid values (422 like a PUT).
@@ -331,14 +359,20 @@ fn check_machines(machines: &[MachineProfile]) -> AppResult<()> {
 }
 
 impl JobFile {
-    /// The job with exactly the tools and machines its operations name, each from the file, else
-    /// the tool table and machines registry of `db` (when given), so it runs anywhere without the
-    /// database. Every reference is resolved here once, with the capability's own resolution.
+    /// The job with exactly the tools, machines and materials its operations name, each from the
+    /// file, else the tool table, machines registry and materials library of `db` (when given),
+    /// so it runs anywhere without the database. Every reference is resolved here once, with the
+    /// capability's own resolution.
     ///
     /// # Errors
-    /// 404 naming `operations[i].tool` or `operations[i].machine` for an unknown reference.
+    /// 404 naming `operations[i].tool`, `operations[i].machine` or `operations[i].material` for
+    /// an unknown reference.
     pub async fn resolve(mut self, db: Option<&Db>) -> AppResult<Self> {
-        let given = Catalog { tools: std::mem::take(&mut self.tools), machines: std::mem::take(&mut self.machines) };
+        let given = Catalog {
+            tools: std::mem::take(&mut self.tools),
+            machines: std::mem::take(&mut self.machines),
+            materials: std::mem::take(&mut self.materials),
+        };
         let found = match db {
             Some(db) => store::catalog(db, self.operations.iter().map(Operation::refs), given).await?,
             None => given,
@@ -355,11 +389,17 @@ impl JobFile {
             })
             .collect();
         let names: Vec<&str> = refs.iter().filter_map(|r| r.machine).collect();
+        let material_names: Vec<&str> = refs.iter().filter_map(|r| r.material).collect();
         let tools = found.tools.into_iter().filter(|t| t.number.is_some_and(|n| numbers.contains(&n))).collect();
         let machines =
             found.machines.into_iter().filter(|m| m.name.as_deref().is_some_and(|n| names.contains(&n))).collect();
         self.tools = tools;
         self.machines = machines;
+        self.materials = found
+            .materials
+            .into_iter()
+            .filter(|m| m.name.as_deref().is_some_and(|n| material_names.contains(&n)))
+            .collect();
         Ok(self)
     }
 
@@ -370,7 +410,8 @@ impl JobFile {
     }
 }
 
-/// A resolved job is its own lookup: its operations find their tools and machines in it.
+/// A resolved job is its own lookup: its operations find their tools, machines and materials in
+/// it.
 impl Lookup for JobFile {
     fn tool(&self, number: u32) -> Option<Tool> {
         tool_in(&self.tools, number)
@@ -378,6 +419,10 @@ impl Lookup for JobFile {
 
     fn machine(&self, name: &str) -> Option<MachineProfile> {
         machine_in(&self.machines, name)
+    }
+
+    fn material(&self, name: &str) -> Option<Material> {
+        material_in(&self.materials, name)
     }
 }
 

@@ -5,8 +5,9 @@
 
 pub mod jobs;
 pub mod machines;
-pub mod packed;
+pub mod materials;
 pub mod outputs;
+pub mod packed;
 pub mod tools;
 
 use kerf_solver::capability::Refs;
@@ -46,8 +47,9 @@ macro_rules! on {
 }
 pub(crate) use on;
 
-/// `catalog` completed with the tools and machines `refs` name that it lacks, from the tool table
-/// and the machines registry (those that exist; resolution reports the others).
+/// `catalog` completed with the tools, machines and materials `refs` name that it lacks, from the
+/// tool table, the machines registry and the materials library (those that exist; resolution
+/// reports the others).
 pub async fn catalog<'a>(
     db: &Db,
     refs: impl IntoIterator<Item = Refs<'a>>,
@@ -65,6 +67,12 @@ pub async fn catalog<'a>(
             && let Some(machine) = machines::get(db, name).await?
         {
             catalog.machines.push(MachineProfile { name: Some(name.to_owned()), ..machine });
+        }
+        if let Some(name) = refs.material
+            && !catalog.materials.iter().any(|material| material.name.as_deref() == Some(name))
+            && let Some(material) = materials::get(db, name).await?
+        {
+            catalog.materials.push(material);
         }
     }
     Ok(catalog)

@@ -42,7 +42,7 @@ impl Capability for SegmentCapability {
     type Tool = Option<Tool>;
 
     fn refs(request: &SegmentRequest) -> Refs<'_> {
-        Refs { tool: request.tool.as_ref(), machine: request.machine.as_deref() }
+        Refs { tool: request.tool.as_ref(), machine: request.machine.as_deref(), material: None }
     }
 
     fn solve(

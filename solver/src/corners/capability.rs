@@ -43,7 +43,7 @@ impl Capability for ContourCapability {
     type Tool = Tool;
 
     fn refs(request: &ContourRequest) -> Refs<'_> {
-        Refs { tool: Some(&request.tool), machine: request.machine.as_deref() }
+        Refs { tool: Some(&request.tool), machine: request.machine.as_deref(), material: None }
     }
 
     /// A JSON answer holds at most [`MAX_JSON_MOVES`] moves; a program or a job up to [`MAX_MOVES`].
@@ -161,7 +161,7 @@ pub struct LoopsResult {
 impl LoopsRequest {
     /// The tool it refers to.
     pub fn refs(&self) -> Refs<'_> {
-        Refs { tool: Some(&self.tool), machine: None }
+        Refs { tool: Some(&self.tool), machine: None, material: None }
     }
 
     /// Adds loops to the path with the resolved tool; at most [`MAX_JSON_MOVES`] moves.

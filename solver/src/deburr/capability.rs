@@ -63,7 +63,7 @@ impl Capability for DeburrCapability {
     type Tool = Tool;
 
     fn refs(request: &DeburrRequest) -> Refs<'_> {
-        Refs { tool: Some(&request.tool), machine: request.machine.as_deref() }
+        Refs { tool: Some(&request.tool), machine: request.machine.as_deref(), material: None }
     }
 
     fn solve(request: &DeburrRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<DeburrAnswer, SolverError> {

@@ -173,7 +173,7 @@ pub enum FeedLimit {
     Thickness,
     /// The machine's maximum feed.
     Machine,
-    /// The spindle's rated power (with `kienzle` and a machine's `spindle_power_kw`).
+    /// The spindle's power (with `kienzle` and a machine's `spindle_power_kw` or power curve).
     Power,
     /// The spindle's rated torque.
     Torque,

@@ -7,6 +7,7 @@ use super::{EngagementAnswer, EngagementRequest, Stock};
 use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
 use crate::error::SolverError;
 use crate::machine::MachineProfile;
+use crate::material::Material;
 use crate::tool::Tool;
 
 /// The engagement capability.
@@ -26,6 +27,10 @@ pub struct EngagementResponse {
     /// `feed_plan.max_feed` is given, its dialect is the G-code default.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub machine: Option<MachineProfile>,
+    /// The work material the request named, as stored in the materials library: the Kienzle
+    /// values the forces were computed with.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub material: Option<Material>,
     /// The stock, as given.
     pub stock: Stock,
     /// T1 as given, mm.
@@ -52,7 +57,10 @@ impl Capability for EngagementCapability {
     type Tool = Tool;
 
     fn refs(request: &EngagementRequest) -> Refs<'_> {
-        Refs { tool: Some(&request.tool), machine: request.machine.as_deref() }
+        // A request giving both `material` and `kienzle` is refused by the solver (422 at
+        // `material`), whether or not the material exists, so the name is looked up only alone.
+        let material = if request.kienzle.is_none() { request.material.as_deref() } else { None };
+        Refs { tool: Some(&request.tool), machine: request.machine.as_deref(), material }
     }
 
     fn solve(
@@ -63,11 +71,9 @@ impl Capability for EngagementCapability {
         if let Some(feed) = request.plunge_feed {
             crate::validate::positive("plunge_feed", feed)?;
         }
-        // A stored material is not resolved yet (no material library): the solver names
-        // `material` when a request gives one instead of `kienzle`.
         let physics = super::Physics {
-            material: None,
-            spindle: context.machine.as_ref().map(MachineProfile::spindle).unwrap_or_default(),
+            material: context.material.as_ref().map(Material::kienzle),
+            spindle: context.machine.as_ref().map(|m| m.spindle_at(request.spindle_rpm)).unwrap_or_default(),
         };
         let result = super::solve_in(request, &context.tool, context.machine.as_ref(), &physics, run.control)?;
         let cycle_time = context.machine.as_ref().and_then(MachineProfile::dynamics).and_then(|dynamics| {
@@ -81,6 +87,7 @@ impl Capability for EngagementCapability {
             cycle_time,
             tool: context.tool,
             machine: context.machine,
+            material: context.material,
             stock: request.stock.clone(),
             thickness_limit: request.thickness_limit,
             time_limit_s: request.time_limit_s,

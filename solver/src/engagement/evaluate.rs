@@ -262,14 +262,14 @@ pub(crate) fn evaluate(
         let sums: Vec<_> = job.flute_counts.iter().map(|&k| tooth_sum(arcs, k)).collect();
         let edge_feed = if job.arc_feed { ArcFeed::at(route, station, radius) } else { None };
         let (torques, forces): (Vec<SampleTorque>, Vec<f64>) =
-            job.force.as_ref().map_or_else(Default::default, |model| {
+            candidate.force.as_ref().map_or_else(Default::default, |model| {
                 let integral = model.engaged_integral(arcs, edge_feed.as_ref());
                 job.flute_counts
                     .iter()
                     .map(|&k| {
                         let fz = job.feed_mode.feed_per_tooth(k, job.spindle_rpm);
                         (
-                            model.torque(arcs, edge_feed.as_ref(), integral, k, radius, fz),
+                            model.torque(arcs, edge_feed.as_ref(), integral, k, fz),
                             model.peak_force(arcs, k, fz, edge_feed.as_ref()),
                         )
                     })
@@ -303,7 +303,7 @@ pub(crate) fn evaluate(
             peak_torque_nm: torques.iter().map(|t| t.peak).collect(),
             power_kw: torques.iter().map(|t| power_kw(t.mean, job.spindle_rpm)).collect(),
             peak_force_n: forces,
-            mrr: job.axial_depth.map(|depth| depth * radial_depth * nominal_feed),
+            mrr: candidate.axial_depth.map(|depth| depth * radial_depth * nominal_feed),
             flags,
         });
     }
@@ -441,19 +441,21 @@ pub(crate) fn evaluate(
         }
     }
 
-    if let (Some(model), ToolKind::Ball | ToolKind::Bull) = (&job.force, tool.kind) {
+    if let (Some(model), ToolKind::Ball | ToolKind::Bull) = (&candidate.force, tool.kind) {
         warnings.push(Warning::new(
             "W_FORCE_MODEL",
             format!(
-                "the forces take every tooth as a straight edge cutting a chip {} mm wide (a_p): the rounded end of a {} tool cuts less near its tip, so torque, power and force are upper bounds",
-                model.axial_depth,
-                tool.kind.as_str()
+                "the {} end's chips (h = f_z·sin θ·sin κ) and lever arms are integrated over a_p = {} mm, but with the engaged arcs of the full radius at every height: where the end's circle is smaller than the radius at a height (a cut shallower than the corner radius, a wall beside it), torque, power and force are upper bounds",
+                tool.kind.as_str(),
+                model.axial_depth
             ),
         ));
     }
-    let (flute_results, recommended, flute_warnings) = flutes::results(job, &samples, &statistic, route.feed_length);
+    let (flute_results, recommended, flute_warnings) =
+        flutes::results(job, candidate.force.as_ref(), &samples, &statistic, route.feed_length);
     warnings.extend(flute_warnings);
-    let feed_plan = job.plan.as_ref().map(|plan| feed::plan(job, plan, route, &stations, &contacts));
+    let feed_plan =
+        job.plan.as_ref().map(|plan| feed::plan(job, candidate.force.as_ref(), plan, route, &stations, &contacts));
 
     let (max_engaged_deg, max_engaged_at_s) = samples
         .iter()
@@ -498,7 +500,7 @@ pub(crate) fn evaluate(
     ];
     Ok(PathEngagement {
         name: candidate.name.clone(),
-        max_mrr: job.axial_depth.map(|depth| depth * max_radial_depth * nominal_feed),
+        max_mrr: candidate.axial_depth.map(|depth| depth * max_radial_depth * nominal_feed),
         samples,
         flutes: flute_results,
         recommended,
@@ -513,7 +515,7 @@ pub(crate) fn evaluate(
         max_engaged_at_s,
         max_radial_depth,
         contact_dots,
-        forces: job.force.as_ref().map(|model| ForceInfo {
+        forces: candidate.force.as_ref().map(|model| ForceInfo {
             kc11: model.kc11,
             mc: model.mc,
             radial_ratio: model.radial_ratio,
@@ -532,7 +534,7 @@ pub(crate) fn evaluate(
             spindle_rpm: job.spindle_rpm,
             spindle_direction: job.direction,
             rule: job.rule,
-            axial_depth: job.axial_depth,
+            axial_depth: candidate.axial_depth,
             stock_top_z: job.stock_top_z,
             clearance: job.clearance,
             tool_radius: tool.radius,

@@ -12,12 +12,19 @@ use super::answer::{FeedBlock, FeedLimit, FeedPlan};
 use super::arcfeed::ArcFeed;
 use super::arcs::peak_thickness_ratio;
 use super::evaluate::Contact;
+use super::force::ForceModel;
 use super::request::{FeedBasis, Job, PlanJob};
 use super::segments::{Route, Station};
 use super::teeth::tooth_sum;
 
 /// Feed needed at one sample, mm/min, and what set it.
-fn needed(job: &Job, plan: &PlanJob, contact: &Contact, edge_feed: Option<&ArcFeed>) -> (f64, FeedLimit) {
+fn needed(
+    job: &Job,
+    force: Option<&ForceModel>,
+    plan: &PlanJob,
+    contact: &Contact,
+    edge_feed: Option<&ArcFeed>,
+) -> (f64, FeedLimit) {
     let ratio = match (plan.basis, edge_feed) {
         (FeedBasis::Tooth, None) => peak_thickness_ratio(&contact.arcs),
         (FeedBasis::Sum, None) => tooth_sum(&contact.arcs, plan.flute_count).ratio,
@@ -29,9 +36,9 @@ fn needed(job: &Job, plan: &PlanJob, contact: &Contact, edge_feed: Option<&ArcFe
     let mut best = (to_feed(per_tooth), FeedLimit::Thickness);
     // The spindle: the phase-mean torque grows as f_z^(1−m_c), so the feed per tooth that
     // meets the cap is closed.
-    if let (Some(model), Some((torque, by_power))) = (&job.force, job.spindle.torque_cap(job.spindle_rpm)) {
+    if let (Some(model), Some((torque, by_power))) = (force, job.spindle.torque_cap(job.spindle_rpm)) {
         let integral = model.engaged_integral(&contact.arcs, edge_feed);
-        let feed = to_feed(model.feed_for_torque(torque, integral, plan.flute_count, job.radius));
+        let feed = to_feed(model.feed_for_torque(torque, integral, plan.flute_count));
         if feed < best.0 {
             best = (feed, if by_power { FeedLimit::Power } else { FeedLimit::Torque });
         }
@@ -55,14 +62,21 @@ fn whole(feed: f64) -> f64 {
 }
 
 /// The feed plan for one path.
-pub(crate) fn plan(job: &Job, plan: &PlanJob, route: &Route, stations: &[Station], contacts: &[Contact]) -> FeedPlan {
+pub(crate) fn plan(
+    job: &Job,
+    force: Option<&ForceModel>,
+    plan: &PlanJob,
+    route: &Route,
+    stations: &[Station],
+    contacts: &[Contact],
+) -> FeedPlan {
     let feeds: Vec<Option<(f64, FeedLimit)>> = stations
         .iter()
         .zip(contacts)
         .map(|(station, contact)| {
             let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
             let edge_feed = if job.arc_feed { ArcFeed::at(route, station, job.radius) } else { None };
-            (!rapid).then(|| needed(job, plan, contact, edge_feed.as_ref()))
+            (!rapid).then(|| needed(job, force, plan, contact, edge_feed.as_ref()))
         })
         .collect();
     let mut stretches = Vec::new();

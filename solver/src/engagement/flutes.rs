@@ -3,7 +3,7 @@
 
 use super::answer::{EngagementSample, FluteResult};
 use super::evaluate::runs;
-use super::force::power_kw;
+use super::force::{ForceModel, power_kw};
 use super::limits::{RESONANCE_BAND, resonance, tooth_passing_hz};
 use super::request::{FeedMode, Job, Representative};
 use crate::error::Warning;
@@ -35,6 +35,7 @@ fn statistics(values: &[f64], weights: &[f64]) -> (f64, f64, f64, f64) {
 /// (`W_MULTI_TOOTH`, `W_TINY_FZ`, `W_NO_RECOMMENDATION`, `W_THRESHOLD_MISSING`).
 pub(crate) fn results(
     job: &Job,
+    force: Option<&ForceModel>,
     samples: &[EngagementSample],
     statistic: &[bool],
     feed_length: f64,
@@ -101,10 +102,10 @@ pub(crate) fn results(
                 format!("k = {k}: the feed per tooth {feed_per_tooth:.6} mm is below {minimum} mm (rubbing)"),
             ));
         }
-        let forces = force_statistics(job, samples, statistic, &weights, column);
-        warnings.extend(limit_warnings(job, samples, statistic, column, k));
+        let forces = force_statistics(force, samples, statistic, &weights, column);
+        warnings.extend(limit_warnings(job, force, samples, statistic, column, k));
         // With the force model only, so that answers without it stay as they were.
-        let tooth_passing_hz = job.force.is_some().then(|| tooth_passing_hz(job.spindle_rpm, k));
+        let tooth_passing_hz = force.is_some().then(|| tooth_passing_hz(job.spindle_rpm, k));
         if let Some((natural, axis)) = tooth_passing_hz.and_then(|f| resonance(f, &job.natural)) {
             warnings.push(Warning::new(
                 "W_TOOTH_PASSING",
@@ -174,13 +175,13 @@ pub(crate) fn results(
 /// Length-weighted mean of the phase-mean torque and the largest phase peak over the engaged
 /// samples, N·m, and the largest resultant force, N, for one flute column (with a force model).
 fn force_statistics(
-    job: &Job,
+    force: Option<&ForceModel>,
     samples: &[EngagementSample],
     statistic: &[bool],
     weights: &[f64],
     column: usize,
 ) -> Option<(f64, f64, f64)> {
-    job.force.as_ref()?;
+    force?;
     let engaged = || samples.iter().zip(statistic).filter(|(_, s)| **s).map(|(sample, _)| sample);
     let means: Vec<f64> = engaged().map(|s| s.torque_nm.get(column).copied().unwrap_or(0.0)).collect();
     let (_, _, mean, _) = statistics(&means, weights);
@@ -191,9 +192,16 @@ fn force_statistics(
 
 /// `W_SPINDLE_POWER` and `W_SPINDLE_TORQUE` for one flute column: where the phase-mean power or
 /// torque of an engaged sample exceeds the machine's rating.
-fn limit_warnings(job: &Job, samples: &[EngagementSample], statistic: &[bool], column: usize, k: u32) -> Vec<Warning> {
+fn limit_warnings(
+    job: &Job,
+    force: Option<&ForceModel>,
+    samples: &[EngagementSample],
+    statistic: &[bool],
+    column: usize,
+    k: u32,
+) -> Vec<Warning> {
     let mut warnings = Vec::new();
-    if job.force.is_none() {
+    if force.is_none() {
         return warnings;
     }
     let series = |pick: fn(&EngagementSample) -> &[f64]| -> Vec<f64> {

@@ -9,6 +9,13 @@
 //! the torque is smooth, and without a helix a sum of concave terms ([`phase::peak`]). On a
 //! curved path with the arc-feed correction (§11 item 6) the chip is f_z·c(θ)·sin θ, so the
 //! terms carry c(θ)^(1−m_c).
+//!
+//! Ball and bull-nose ends (§11 item 5): on the rounded end the edge at height z meets the
+//! material at the angle κ from the tool axis, so its chip is h = f_z·sin θ·sin κ, its width
+//! dz/sin κ and its lever arm r(z). A tooth's tangential force and torque are then the flat
+//! model's with a_p replaced by [`ForceModel::force_width`] = ∫ sin^(−m_c)κ dz and R·a_p by
+//! [`ForceModel::torque_width`] = ∫ r(z)·sin^(−m_c)κ dz, integrated in κ along the corner arc
+//! (z = r_c(1 − cos κ)) with the same sin^a tables; a flat end gives a_p and R·a_p.
 
 use super::arcfeed::ArcFeed;
 use super::arcs::{Arc, SpindleDirection};
@@ -28,6 +35,11 @@ pub(crate) struct ForceModel {
     pub mc: f64,
     /// a_p, mm.
     pub axial_depth: f64,
+    /// ∫₀^a_p sin^(−m_c)κ dz, mm: the chip width a tooth's force scales with (a_p for a flat end).
+    pub force_width: f64,
+    /// ∫₀^a_p r(z)·sin^(−m_c)κ dz, mm²: the width times lever arm its torque scales with (R·a_p
+    /// for a flat end).
+    pub torque_width: f64,
     /// Λ = 2a_p·tan λ/D, degrees (0 without a helix).
     pub lag_deg: f64,
     pub direction: SpindleDirection,
@@ -70,21 +82,45 @@ impl ForceModel {
         arcs.iter().map(|arc| self.between(arc.from, arc.to, feed)).sum()
     }
 
-    /// N·m of torque per unit of the sin^a term for a feed per tooth `fz` and tool radius `radius`:
-    /// R·k_c1.1·a_p·f_z^a / 1000.
-    fn scale(&self, radius: f64, fz: f64) -> f64 {
-        radius * self.kc11 * self.axial_depth * fz.powf(self.table.exponent()) / 1000.0
+    /// N·m of torque per unit of the sin^a term for a feed per tooth `fz`:
+    /// k_c1.1·∫r(z)·sin^(−m_c)κ dz·f_z^a / 1000 (R·k_c1.1·a_p·f_z^a / 1000 for a flat end).
+    fn scale(&self, fz: f64) -> f64 {
+        self.torque_width * self.kc11 * fz.powf(self.table.exponent()) / 1000.0
+    }
+
+    /// The chip widths of a tool with corner radius `corner_radius` (0 flat, R ball) and radius
+    /// `radius` cut `axial_depth` deep: (force width, torque width), see the module's notes.
+    pub(crate) fn end_widths(
+        table: &SinPower,
+        table_next: &SinPower,
+        radius: f64,
+        corner_radius: f64,
+        axial_depth: f64,
+    ) -> (f64, f64) {
+        let on_corner = axial_depth.min(corner_radius);
+        let straight = axial_depth - on_corner;
+        if on_corner <= 0.0 {
+            return (straight, radius * straight);
+        }
+        // z = r_c(1 − cos κ), dz = r_c·sin κ dκ, r = R − r_c + r_c·sin κ:
+        // ∫ sin^(−m_c)κ dz = r_c·∫ sin^a κ dκ, ∫ r·sin^(−m_c)κ dz = (R − r_c)·r_c·∫ sin^a + r_c²·∫ sin^(a+1).
+        let top = (1.0 - on_corner / corner_radius).clamp(-1.0, 1.0).acos();
+        let (power, next) = (table.between(0.0, top), table_next.between(0.0, top));
+        let force_width = corner_radius * power + straight;
+        let torque_width =
+            (radius - corner_radius) * corner_radius * power + corner_radius * corner_radius * next + radius * straight;
+        (force_width, torque_width)
     }
 
     /// Mean torque over the tooth phase from the engaged integral, N·m.
-    pub(crate) fn mean_torque(&self, integral: f64, flutes: u32, radius: f64, fz: f64) -> f64 {
-        self.scale(radius, fz) * f64::from(flutes) * integral / std::f64::consts::TAU
+    pub(crate) fn mean_torque(&self, integral: f64, flutes: u32, fz: f64) -> f64 {
+        self.scale(fz) * f64::from(flutes) * integral / std::f64::consts::TAU
     }
 
     /// Feed per tooth at which the phase-mean torque equals `torque` (N·m); infinite without
     /// engagement.
-    pub(crate) fn feed_for_torque(&self, torque: f64, integral: f64, flutes: u32, radius: f64) -> f64 {
-        let unit = self.mean_torque(integral, flutes, radius, 1.0);
+    pub(crate) fn feed_for_torque(&self, torque: f64, integral: f64, flutes: u32) -> f64 {
+        let unit = self.mean_torque(integral, flutes, 1.0);
         if unit <= 0.0 { f64::INFINITY } else { (torque / unit).powf(1.0 / self.table.exponent()) }
     }
 
@@ -95,14 +131,13 @@ impl ForceModel {
         feed: Option<&ArcFeed>,
         integral: f64,
         flutes: u32,
-        radius: f64,
         fz: f64,
     ) -> SampleTorque {
         if arcs.is_empty() {
             return SampleTorque { mean: 0.0, peak: 0.0 };
         }
-        let mean = self.mean_torque(integral, flutes, radius, fz);
-        let peak = self.scale(radius, fz) * self.peak_sum(arcs, flutes, feed);
+        let mean = self.mean_torque(integral, flutes, fz);
+        let peak = self.scale(fz) * self.peak_sum(arcs, flutes, feed);
         // The peak of a function is never below its mean; the numeric search may miss by 1e-12.
         SampleTorque { mean, peak: peak.max(mean) }
     }
@@ -230,7 +265,7 @@ impl ForceModel {
             });
             x.hypot(y)
         };
-        let scale = self.kc11 * self.axial_depth * fz.powf(self.table.exponent());
+        let scale = self.kc11 * self.force_width * fz.powf(self.table.exponent());
         scale * phase::peak_of(flutes, &self.ends(arcs), resultant)
     }
 
@@ -268,6 +303,8 @@ mod tests {
             kc11: 1800.0,
             mc,
             axial_depth: 2.0,
+            force_width: 2.0,
+            torque_width: 10.0,
             lag_deg,
             direction,
             radial_ratio: 0.3,

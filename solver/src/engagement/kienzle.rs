@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::SolverError;
 
-use crate::validate::positive;
+use crate::validate::positive_at_most;
 
 /// Kienzle's specific cutting force of a work material (engagement.md §11 item 4): the
 /// tangential force on one tooth is `kc11 · a_p · h^(1 − mc)` for a chip of thickness h and
@@ -16,8 +16,8 @@ use crate::validate::positive;
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(deny_unknown_fields)]
 pub struct Kienzle {
-    /// k_c1.1: specific cutting force at h = 1 mm and b = 1 mm, N/mm² (> 0; e.g. about 1800 for
-    /// a plain carbon steel, 700 for an aluminium alloy).
+    /// k_c1.1: specific cutting force at h = 1 mm and b = 1 mm, N/mm² (0 < k_c1.1 ≤ 20 000; e.g.
+    /// about 2200 for a plain carbon steel, 700 for an aluminium alloy).
     pub kc11: f64,
     /// m_c: Kienzle's exponent (0 ≤ m_c < 1; typically 0.15–0.3).
     pub mc: f64,
@@ -31,13 +31,17 @@ pub struct Kienzle {
 /// show; give the measured ratio of the tool and material where it matters.
 pub const DEFAULT_RADIAL_RATIO: f64 = 0.3;
 
+/// Largest k_c1.1 accepted, N/mm²: hardened steels reach about 5000; a larger value is a unit
+/// mistake (N/m², or MPa at another chip size).
+pub const MAX_KC11: f64 = 20_000.0;
+
 impl Kienzle {
     /// Checks the values, naming fields under `prefix` (e.g. `kienzle.`).
     ///
     /// # Errors
-    /// `E_INPUT` when `kc11` is not positive and finite or `mc` is outside [0, 1).
+    /// `E_INPUT` when `kc11` is not in (0, [`MAX_KC11`]] or `mc` is outside [0, 1).
     pub fn validate(&self, prefix: &str) -> Result<(), SolverError> {
-        positive(&format!("{prefix}kc11"), self.kc11)?;
+        positive_at_most(&format!("{prefix}kc11"), self.kc11, MAX_KC11)?;
         if !(self.mc.is_finite() && (0.0..1.0).contains(&self.mc)) {
             return Err(SolverError::input(
                 format!("{prefix}mc"),

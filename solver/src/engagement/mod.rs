@@ -38,8 +38,10 @@
 //! instead of stepping θ, so it has no angle step and its arc ends are exact.
 //!
 //! Cutting physics (§11 items 4–6, 9; only with `kienzle` or `material`, so answers without
-//! them are unchanged): every tooth cuts a chip a_p wide with a straight edge (ball and bull
-//! ends are not modelled: `W_FORCE_MODEL`); the spindle limits are compared with the torque
+//! them are unchanged): every tooth cuts a chip a_p wide with a straight edge, or on a ball or
+//! bull end a chip f_z·sin θ·sin κ thin and dz/sin κ wide at the lever arm r(z), integrated over
+//! the height (the engaged arcs stay the full radius's at every height: `W_FORCE_MODEL` says the
+//! figures are upper bounds there); the spindle limits are compared with the torque
 //! averaged over the tooth phase, the load the drive carries (its rotor's inertia smooths the
 //! tooth-by-tooth peaks), while the peaks over the phase are reported for the tool; the
 //! tooth-passing frequency is compared with the fundamental only.
@@ -75,7 +77,7 @@ pub use answer::{
 };
 pub use arcs::{MillingMode, SpindleDirection};
 pub use capability::{EngagementCapability, EngagementResponse};
-pub use kienzle::{DEFAULT_RADIAL_RATIO, Kienzle};
+pub use kienzle::{DEFAULT_RADIAL_RATIO, Kienzle, MAX_KC11};
 pub use limits::{RESONANCE_BAND, SpindleLimits};
 pub use program::program;
 pub use request::{

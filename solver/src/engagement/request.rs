@@ -24,7 +24,7 @@ use crate::error::{SolverError, Warning};
 use crate::gcode::reader::{MoveKind, Plane, ReadOptions, read as read_program};
 use crate::machine::{BlockRule, MachineProfile, RuleSettings};
 use crate::planar::signed_area;
-use crate::tool::{Tool, ToolRef};
+use crate::tool::{Tool, ToolKind, ToolRef};
 use crate::validate::{self, finite, non_negative, positive, positive_at_most};
 
 /// One move of a path given as `start` + `segments` (engagement.md §2.3).
@@ -125,6 +125,10 @@ pub struct Candidate {
     pub name: Option<String>,
     /// The tool-centre path.
     pub path: PathInput,
+    /// a_p of this path, mm: replaces the request's `axial_depth` for it (removal rate, forces,
+    /// the program's cutting Z), so paths at different depths compare side by side.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axial_depth: Option<f64>,
 }
 
 /// One region of a polygon stock.
@@ -347,7 +351,8 @@ pub struct EngagementRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_feed_per_tooth: Option<f64>,
     /// a_p, the axial depth of cut, mm: gives the removal rate (MRR), the cutting Z of the
-    /// G-code program (stock top − a_p) and, with `kienzle`, the chip width of every tooth.
+    /// G-code program (stock top − a_p) and, with `kienzle`, the chip width of every tooth
+    /// (an entry of `paths` may give its own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axial_depth: Option<f64>,
     /// Z of the stock top for the G-code program, mm (default 0).
@@ -388,8 +393,9 @@ pub struct EngagementRequest {
     /// torque and power along the path (engagement.md §11 item 4). Give this or `material`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kienzle: Option<Kienzle>,
-    /// A stored work material whose Kienzle values the server resolves (give this or
-    /// `kienzle`).
+    /// The name of a work material in the materials library (`/api/v1/materials/{name}`, or a
+    /// job file's `materials`): its Kienzle values, as `kienzle` would give them (give this or
+    /// `kienzle`; 404 naming `material` when unknown).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
 }
@@ -424,6 +430,10 @@ pub(crate) struct CandidateJob {
     pub name: Option<String>,
     pub route: Route,
     pub warnings: Vec<Warning>,
+    /// a_p of this path: its own, else the request's.
+    pub axial_depth: Option<f64>,
+    /// Kienzle's force model at this path's a_p, with `kienzle` (or `material`).
+    pub force: Option<ForceModel>,
 }
 
 /// A validated request: every number finite and in range, the geometry built.
@@ -447,14 +457,11 @@ pub(crate) struct Job {
     pub radial_depth_max: Option<f64>,
     pub spike_threshold: Option<f64>,
     pub min_feed_per_tooth: Option<f64>,
-    pub axial_depth: Option<f64>,
     pub stock_top_z: f64,
     pub clearance: f64,
     pub plan: Option<PlanJob>,
     /// The block-time rule of the program, at the nominal feed of the tool's flute count.
     pub rule: Option<BlockRule>,
-    /// Kienzle's force model, with `kienzle` (or `material`) and `axial_depth`.
-    pub force: Option<ForceModel>,
     /// Apply the arc-feed correction on arcs of the path.
     pub arc_feed: bool,
     /// The machine's spindle limits (checked only with a force model).
@@ -909,7 +916,7 @@ impl EngagementRequest {
         let spike_threshold = optional("spike_threshold_deg", self.spike_threshold_deg, positive)?;
         let min_feed_per_tooth = optional("min_feed_per_tooth", self.min_feed_per_tooth, positive)?;
         let axial_depth = self.axial_depth.map(|d| bounded("axial_depth", d, MAX_COORDINATE)).transpose()?;
-        let (force, spindle) = self.force_model(tool, axial_depth, physics)?;
+        let (kienzle, spindle) = self.kienzle(physics)?;
         let stock_top_z = finite("stock_top_z", self.stock_top_z.unwrap_or(0.0))?;
         if stock_top_z.abs() > MAX_COORDINATE {
             return Err(SolverError::input("stock_top_z", format!("stock_top_z must lie within ±{MAX_COORDINATE} mm")));
@@ -967,8 +974,10 @@ impl EngagementRequest {
         };
         let (region, _) = read_stock(&self.stock, radius, &mut shared_warnings)?;
 
-        let inputs: Vec<(Option<String>, &PathInput, String)> = match (&self.path, &self.paths) {
-            (Some(path), None) => vec![(None, path, "path".to_owned())],
+        // (name, path, its field, its own a_p and that field)
+        type Input<'a> = (Option<String>, &'a PathInput, String, Option<f64>, String);
+        let inputs: Vec<Input<'_>> = match (&self.path, &self.paths) {
+            (Some(path), None) => vec![(None, path, "path".to_owned(), None, String::new())],
             (None, Some(paths)) => {
                 if paths.is_empty() {
                     return Err(SolverError::new(ErrorCode::Path, "paths is empty").at("paths"));
@@ -976,7 +985,19 @@ impl EngagementRequest {
                 if paths.len() > MAX_CANDIDATES {
                     return Err(too_large("paths", "candidate paths", paths.len(), MAX_CANDIDATES));
                 }
-                paths.iter().enumerate().map(|(i, c)| (c.name.clone(), &c.path, format!("paths[{i}].path"))).collect()
+                paths
+                    .iter()
+                    .enumerate()
+                    .map(|(i, c)| {
+                        (
+                            c.name.clone(),
+                            &c.path,
+                            format!("paths[{i}].path"),
+                            c.axial_depth,
+                            format!("paths[{i}].axial_depth"),
+                        )
+                    })
+                    .collect()
             }
             (Some(_), Some(_)) => {
                 return Err(SolverError::input("paths", "give path or paths, not both"));
@@ -987,7 +1008,10 @@ impl EngagementRequest {
         };
         let mut candidates = Vec::with_capacity(inputs.len());
         let mut total_samples = 0.0;
-        for (name, input, field) in inputs {
+        for (name, input, field, own_depth, depth_field) in inputs {
+            let own_depth = own_depth.map(|d| bounded(&depth_field, d, MAX_COORDINATE)).transpose()?;
+            let depth = own_depth.or(axial_depth);
+            let force = kienzle.map(|values| force_model(&values, tool, depth, self.spindle_direction)).transpose()?;
             let mut warnings = Vec::new();
             let route = read_path(input, &field, &mut warnings)?;
             total_samples += route.station_count(step);
@@ -1000,7 +1024,7 @@ impl EngagementRequest {
                 )
                 .at("step"));
             }
-            candidates.push(CandidateJob { name, route, warnings });
+            candidates.push(CandidateJob { name, route, warnings, axial_depth: depth, force });
         }
         if let Some(g) = grid {
             // The dots engine rasterises earlier cuts' arcs as chords within g/100.
@@ -1067,12 +1091,10 @@ impl EngagementRequest {
             radial_depth_max,
             spike_threshold,
             min_feed_per_tooth,
-            axial_depth,
             stock_top_z,
             clearance,
             plan,
             rule,
-            force,
             arc_feed: self.arc_feed_correction,
             spindle,
             natural: natural_frequencies(tool),
@@ -1086,13 +1108,8 @@ impl EngagementRequest {
 }
 
 impl EngagementRequest {
-    /// Kienzle's model from `kienzle` or the resolved `material`, and the spindle limits.
-    fn force_model(
-        &self,
-        tool: &Tool,
-        axial_depth: Option<f64>,
-        physics: &Physics,
-    ) -> Result<(Option<ForceModel>, SpindleLimits), SolverError> {
+    /// The Kienzle values from `kienzle` or the resolved `material`, and the spindle limits.
+    fn kienzle(&self, physics: &Physics) -> Result<(Option<Kienzle>, SpindleLimits), SolverError> {
         physics.spindle.validate()?;
         let kienzle = match (&self.kienzle, &self.material) {
             (Some(_), Some(_)) => {
@@ -1114,31 +1131,48 @@ impl EngagementRequest {
             }
             (None, None) => None,
         };
-        let Some(kienzle) = kienzle else {
-            return Ok((None, physics.spindle));
-        };
-        let axial_depth = axial_depth.ok_or_else(|| {
-            SolverError::input(
-                "axial_depth",
-                "axial_depth (mm) is required with kienzle or material: a_p is the chip width",
-            )
-        })?;
-        // Λ = 2·a_p·tan λ / D (engagement.md §11 item 5), radians.
-        let lag = tool.helix_deg.map_or(0.0, |helix| axial_depth * helix.to_radians().tan() / tool.radius);
-        Ok((
-            Some(ForceModel {
-                kc11: kienzle.kc11,
-                mc: kienzle.mc,
-                axial_depth,
-                lag_deg: lag.to_degrees(),
-                direction: self.spindle_direction,
-                radial_ratio: kienzle.radial_ratio.unwrap_or(DEFAULT_RADIAL_RATIO),
-                table: SinPower::new(1.0 - kienzle.mc),
-                table_next: SinPower::new(2.0 - kienzle.mc),
-            }),
-            physics.spindle,
-        ))
+        Ok((kienzle, physics.spindle))
     }
+}
+
+/// Kienzle's force model for a path cut `axial_depth` deep.
+///
+/// # Errors
+/// `E_INPUT` at `axial_depth` without a depth: a_p is the chip width.
+fn force_model(
+    kienzle: &Kienzle,
+    tool: &Tool,
+    axial_depth: Option<f64>,
+    direction: SpindleDirection,
+) -> Result<ForceModel, SolverError> {
+    let axial_depth = axial_depth.ok_or_else(|| {
+        SolverError::input(
+            "axial_depth",
+            "axial_depth (mm) is required with kienzle or material (or paths[i].axial_depth for every path): a_p is the chip width",
+        )
+    })?;
+    // Λ = 2·a_p·tan λ / D (engagement.md §11 item 5), radians.
+    let lag = tool.helix_deg.map_or(0.0, |helix| axial_depth * helix.to_radians().tan() / tool.radius);
+    let (table, table_next) = (SinPower::new(1.0 - kienzle.mc), SinPower::new(2.0 - kienzle.mc));
+    let corner_radius = match tool.kind {
+        ToolKind::Flat => 0.0,
+        ToolKind::Ball => tool.radius,
+        ToolKind::Bull => tool.corner_radius.unwrap_or(0.0).min(tool.radius),
+    };
+    let (force_width, torque_width) =
+        ForceModel::end_widths(&table, &table_next, tool.radius, corner_radius, axial_depth);
+    Ok(ForceModel {
+        kc11: kienzle.kc11,
+        mc: kienzle.mc,
+        axial_depth,
+        force_width,
+        torque_width,
+        lag_deg: lag.to_degrees(),
+        direction,
+        radial_ratio: kienzle.radial_ratio.unwrap_or(DEFAULT_RADIAL_RATIO),
+        table,
+        table_next,
+    })
 }
 
 /// What the server resolves for an engagement request besides the tool and the machine: the

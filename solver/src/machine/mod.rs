@@ -63,6 +63,13 @@ pub struct MachineProfile {
     /// Rated spindle torque, N·m (> 0), used like `spindle_power_kw`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spindle_torque_nm: Option<f64>,
+    /// The spindle's power curve (S1, continuous duty): `[[rpm, kW], ...]`, 2–64 points, speeds
+    /// rising from 0 or more, powers above 0. The power available at a request's spindle speed
+    /// is interpolated linearly between the points and held beyond the ends; with
+    /// `spindle_power_kw` too the lower of the two applies. The curve below a drive's base speed
+    /// is how a constant-torque range is written (power rising with speed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spindle_power_curve: Option<Vec<[f64; 2]>>,
     /// How programs for this control write circular moves unless the request says (`?arcs=`,
     /// `[output] arcs`): `g2g3` or `chords` (default).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -102,6 +109,22 @@ impl MachineProfile {
         }
     }
 
+    /// The spindle's limits at `spindle_rpm`: the rated power, lowered to the power curve's
+    /// value at that speed when the profile has a curve (a speed that is not a positive finite
+    /// number, which the request's validation refuses, gets the rated values).
+    pub fn spindle_at(&self, spindle_rpm: f64) -> crate::engagement::SpindleLimits {
+        let rated = self.spindle();
+        let Some(curve) = self.spindle_power_curve.as_deref().filter(|c| !c.is_empty()) else { return rated };
+        if !(spindle_rpm.is_finite() && spindle_rpm > 0.0) {
+            return rated;
+        }
+        let on_curve = power_on_curve(curve, spindle_rpm);
+        crate::engagement::SpindleLimits {
+            spindle_power_kw: Some(rated.spindle_power_kw.map_or(on_curve, |power| power.min(on_curve))),
+            ..rated
+        }
+    }
+
     /// Checks every value, naming the field as written in the machine's JSON.
     ///
     /// # Errors
@@ -114,6 +137,9 @@ impl MachineProfile {
         positive("block_time_ms", self.block_time_ms)?;
         positive("max_feed", self.max_feed)?;
         self.spindle().validate()?;
+        if let Some(curve) = &self.spindle_power_curve {
+            validate_power_curve(curve)?;
+        }
         if let Some(margin) = self.margin
             && positive("margin", margin)? < 1.0
         {
@@ -146,6 +172,45 @@ impl MachineProfile {
     }
 }
 
+/// Most points of a spindle power curve.
+pub const MAX_CURVE_POINTS: usize = 64;
+
+/// Checks a power curve: 2–64 points, speeds finite, at least 0 and rising, powers positive.
+fn validate_power_curve(curve: &[[f64; 2]]) -> Result<(), SolverError> {
+    if !(2..=MAX_CURVE_POINTS).contains(&curve.len()) {
+        return Err(SolverError::input(
+            "spindle_power_curve",
+            format!("a power curve has 2 to {MAX_CURVE_POINTS} points [rpm, kW] (got {})", curve.len()),
+        ));
+    }
+    for (index, [rpm, power]) in curve.iter().enumerate() {
+        let speed_field = format!("spindle_power_curve[{index}][0]");
+        non_negative(&speed_field, *rpm)?;
+        positive(&format!("spindle_power_curve[{index}][1]"), *power)?;
+        if index > 0 && *rpm <= curve[index - 1][0] {
+            return Err(SolverError::input(
+                speed_field,
+                format!("the speeds of a power curve must rise (got {rpm} rpm after {} rpm)", curve[index - 1][0]),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The power of `curve` at `spindle_rpm`, kW: linear between points, held beyond the ends.
+fn power_on_curve(curve: &[[f64; 2]], spindle_rpm: f64) -> f64 {
+    let (first, last) = (curve[0], curve[curve.len() - 1]);
+    if spindle_rpm <= first[0] {
+        return first[1];
+    }
+    if spindle_rpm >= last[0] {
+        return last[1];
+    }
+    let upper = curve.partition_point(|point| point[0] <= spindle_rpm);
+    let ([n0, p0], [n1, p1]) = (curve[upper - 1], curve[upper]);
+    p0 + (p1 - p0) * (spindle_rpm - n0) / (n1 - n0)
+}
+
 /// Checks a machine name for the registry path `/api/v1/machines/{name}`: 1–64 characters of
 /// letters, digits, `-`, `_` and `.`, not starting with `.`.
 ///
@@ -167,6 +232,35 @@ pub fn validate_machine_name(name: &str) -> Result<(), SolverError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn power_curve_interpolates_and_holds_its_ends() {
+        let json = r#"{"block_time_ms": 4, "max_feed": 12000, "spindle_torque_nm": 50,
+                       "spindle_power_curve": [[0, 0.5], [1000, 5], [8000, 5], [12000, 3]]}"#;
+        let machine: MachineProfile = serde_json::from_str(json).unwrap();
+        machine.validate().unwrap();
+        let power = |rpm: f64| machine.spindle_at(rpm).spindle_power_kw.unwrap();
+        assert!((power(500.0) - 2.75).abs() < 1e-12);
+        assert!((power(1000.0) - 5.0).abs() < 1e-12);
+        assert!((power(10_000.0) - 4.0).abs() < 1e-12);
+        assert!((power(20_000.0) - 3.0).abs() < 1e-12, "held beyond the last point");
+        assert_eq!(machine.spindle_at(500.0).spindle_torque_nm, Some(50.0));
+        // A rated power below the curve wins where it is lower.
+        let rated = MachineProfile { spindle_power_kw: Some(4.0), ..machine.clone() };
+        assert!((rated.spindle_at(500.0).spindle_power_kw.unwrap() - 2.75).abs() < 1e-12);
+        assert_eq!(rated.spindle_at(5000.0).spindle_power_kw, Some(4.0));
+        assert_eq!(rated.spindle_at(f64::NAN).spindle_power_kw, Some(4.0));
+
+        let field = |curve: Vec<[f64; 2]>| {
+            let bad = MachineProfile { spindle_power_curve: Some(curve), ..machine.clone() };
+            bad.validate().unwrap_err().field().map(str::to_owned)
+        };
+        assert_eq!(field(vec![[0.0, 1.0]]).as_deref(), Some("spindle_power_curve"));
+        assert_eq!(field(vec![[0.0, 1.0]; 65]).as_deref(), Some("spindle_power_curve"));
+        assert_eq!(field(vec![[0.0, 1.0], [0.0, 2.0]]).as_deref(), Some("spindle_power_curve[1][0]"));
+        assert_eq!(field(vec![[-1.0, 1.0], [10.0, 2.0]]).as_deref(), Some("spindle_power_curve[0][0]"));
+        assert_eq!(field(vec![[0.0, 1.0], [10.0, 0.0]]).as_deref(), Some("spindle_power_curve[1][1]"));
+    }
 
     #[test]
     fn profiles_round_trip_and_validate() {

@@ -48,7 +48,7 @@ impl Capability for PredictCapability {
     type Tool = Tool;
 
     fn refs(request: &PredictRequest) -> Refs<'_> {
-        Refs { tool: Some(&request.tool), machine: None }
+        Refs { tool: Some(&request.tool), machine: None, material: None }
     }
 
     fn check_output(request: &PredictRequest, output: &OutputOptions) -> Result<(), SolverError> {

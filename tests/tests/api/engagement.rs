@@ -956,3 +956,82 @@ async fn kienzle_torque_and_power_against_the_machines_spindle() {
     let problem = problem(app.put_json("/api/v1/machines/bad-spindle", &bad).await, 422).await;
     assert_eq!(problem["errors"][0]["path"], "spindle_power_kw");
 }
+
+/// Candidate paths at different depths: each answer and program uses its own a_p.
+#[tokio::test(flavor = "multi_thread")]
+async fn each_candidate_path_may_give_its_own_axial_depth() {
+    let app = TestApp::spawn().await;
+    let request = json!({
+        "tool": {"kind": "flat", "radius": 5, "flutes": 4}, "spindle_rpm": 8000, "feed_per_tooth": 0.05,
+        "flute_counts": [4], "axial_depth": 2, "kienzle": {"kc11": 1800, "mc": 0.25},
+        "stock": {"polygon": [[0, 0], [100, 0], [100, 80], [0, 80]]},
+        "paths": [
+            {"name": "full depth in one pass", "path": [[-10, 40], [110, 40]], "axial_depth": 6},
+            {"name": "the request's depth", "path": [[-10, 40], [110, 40]]}
+        ]
+    });
+    let answer = json_with(app.post_json(URL, &request).await, 200).await;
+    let candidates = answer["candidates"].as_array().unwrap();
+    let torque = |c: &Value| c["flutes"][0]["mean_torque_nm"].as_f64().unwrap();
+    assert_eq!(candidates[0]["forces"]["axial_depth"], 6.0);
+    assert_eq!(candidates[1]["forces"]["axial_depth"], 2.0);
+    close_rel(
+        "three times the depth, three times the torque",
+        torque(&candidates[0]),
+        3.0 * torque(&candidates[1]),
+        1e-12,
+    );
+    for (candidate, z) in [(0, "Z-6.0000"), (1, "Z-2.0000")] {
+        let url = app.url(&format!("{URL}?format=gcode&candidate={candidate}"));
+        let program = app.client.post(url).json(&request).send().await.unwrap().text().await.unwrap();
+        assert!(program.contains(z), "candidate {candidate} cuts at {z}: {program}");
+    }
+    let mut bad = request.clone();
+    bad["paths"][0]["axial_depth"] = json!(-6);
+    let problem = problem(app.post_json(URL, &bad).await, 422).await;
+    assert_eq!(problem["errors"][0]["path"], "paths[0].axial_depth");
+}
+
+/// A machine's power curve: at a low spindle speed the power it gives there, not its rating,
+/// limits the cut, and the capped feed plan brings the path's power under it.
+#[tokio::test(flavor = "multi_thread")]
+async fn the_power_curve_limits_the_cut_at_its_speed() {
+    let app = TestApp::spawn().await;
+    // 0.5 kW at standstill rising to 8 kW at 4000 rpm: 1.4375 kW available at 500 rpm.
+    let machine = json!({"block_time_ms": 4, "max_feed": 20000, "spindle_power_kw": 8,
+                         "spindle_power_curve": [[0, 0.5], [4000, 8.0], [12000, 8.0]]});
+    json_with(app.put_json("/api/v1/machines/s1-curve", &machine).await, 201).await;
+    let request = json!({
+        "tool": {"kind": "flat", "radius": 8, "flutes": 4}, "spindle_rpm": 500, "feed_per_tooth": 0.3,
+        "flute_counts": [4], "axial_depth": 10, "material": "42CrMo4", "machine": "s1-curve",
+        "stock": {"polygon": [[0, 0], [100, 0], [100, 80], [0, 80]]},
+        "path": [[-10, 40], [110, 40]],
+        "feed_plan": {"target_thickness": 1.0, "max_feed": 20000, "flute_count": 4}
+    });
+    let answer = json_with(app.post_json(URL, &request).await, 200).await;
+    let available = 0.5 + 7.5 * 500.0 / 4000.0;
+    close_rel("power available at 500 rpm", answer["forces"]["spindle_power_kw"].as_f64().unwrap(), available, 1e-12);
+    let power = answer["flutes"][0]["mean_power_kw"].as_f64().unwrap();
+    assert!(power > available && power < 8.0, "over the curve, under the rating: {power} kW");
+    assert!(answer["warnings"].to_string().contains("W_SPINDLE_POWER"), "{}", answer["warnings"]);
+    let blocks = answer["feed_plan"]["blocks"].as_array().unwrap();
+    let cutting: Vec<&Value> = blocks.iter().filter(|b| b["limited_by"] == "power").collect();
+    assert!(!cutting.is_empty(), "{blocks:?}");
+    // The slowest power-limited feed, run as a constant feed, stays under the curve's power.
+    let feed = cutting.iter().map(|b| b["feed"].as_f64().unwrap()).fold(f64::INFINITY, f64::min);
+    let mut capped = request.clone();
+    let body = capped.as_object_mut().unwrap();
+    body.remove("feed_per_tooth");
+    body.remove("feed_plan");
+    body.insert("feed".to_owned(), json!(feed));
+    let answer = json_with(app.post_json(URL, &capped).await, 200).await;
+    // The highest phase-mean power of any sample (the path's mean is lower: entry and exit).
+    let samples = answer["samples"].as_array().unwrap();
+    let power = samples.iter().filter_map(|s| s["power_kw"][0].as_f64()).fold(0.0, f64::max);
+    assert!(power <= available && power > 0.99 * available, "capped: {power} kW of {available}");
+    assert!(!answer["warnings"].to_string().contains("W_SPINDLE_POWER"));
+
+    let bad = json!({"block_time_ms": 4, "max_feed": 12000, "spindle_power_curve": [[0, 1], [5000, 4], [4000, 5]]});
+    let problem = problem(app.put_json("/api/v1/machines/bad-curve", &bad).await, 422).await;
+    assert_eq!(problem["errors"][0]["path"], "spindle_power_curve[2][0]");
+}

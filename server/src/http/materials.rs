@@ -1,0 +1,98 @@
+//! The materials library over HTTP (issue 16): `PUT/GET/DELETE /api/v1/materials/{name}`, list.
+//! A material holds Kienzle's k_c1.1 and m_c (engagement.md §11 item 4); an engagement request
+//! that names it cuts it with these values.
+
+use axum::Json;
+use axum::extract::State;
+use axum::http::StatusCode;
+use kerf_solver::SolverError;
+use kerf_solver::material::{Material, validate_material_name};
+use utoipa_axum::router::OpenApiRouter;
+use utoipa_axum::routes;
+
+use crate::error::{AppError, AppResult, Problem};
+use crate::extract::{AppJson, AppPath};
+use crate::state::AppState;
+use crate::store;
+
+/// The `{name}` path parameter.
+#[derive(Debug, serde::Deserialize)]
+struct MaterialName {
+    name: String,
+}
+
+fn checked_name(MaterialName { name }: MaterialName) -> AppResult<String> {
+    validate_material_name(&name)?;
+    Ok(name)
+}
+
+fn unknown(name: &str) -> AppError {
+    AppError::not_found(format!("material {name:?} is not in the materials library"))
+}
+
+/// All materials of the library, ordered by name (the seeded ones included).
+#[utoipa::path(get, path = "/api/v1/materials", tag = "materials",
+    responses((status = 200, body = Vec<Material>)))]
+async fn list_materials(State(state): State<AppState>) -> AppResult<Json<Vec<Material>>> {
+    Ok(Json(store::materials::list(&state.db).await?))
+}
+
+/// One material.
+#[utoipa::path(get, path = "/api/v1/materials/{name}", tag = "materials",
+    params(("name" = String, Path, description = "Material name: 1–64 letters, digits, `-`, `_`, `.`, not starting with `.`", pattern = r"^[A-Za-z0-9_-][A-Za-z0-9_.-]{0,63}$")),
+    responses(
+        (status = 200, body = Material),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "Bad name", body = Problem, content_type = "application/problem+json")))]
+async fn get_material(
+    State(state): State<AppState>,
+    AppPath(name): AppPath<MaterialName>,
+) -> AppResult<Json<Material>> {
+    let name = checked_name(name)?;
+    store::materials::get(&state.db, &name).await?.map(Json).ok_or_else(|| unknown(&name))
+}
+
+/// Stores or replaces a material: 201 when new, 200 when replaced (the record is replaced whole).
+#[utoipa::path(put, path = "/api/v1/materials/{name}", tag = "materials",
+    params(("name" = String, Path, description = "Material name: 1–64 letters, digits, `-`, `_`, `.`, not starting with `.`", pattern = r"^[A-Za-z0-9_-][A-Za-z0-9_.-]{0,63}$")),
+    request_body = Material,
+    responses(
+        (status = 201, description = "Created", body = Material),
+        (status = 200, description = "Replaced", body = Material),
+        (status = 400, body = Problem, content_type = "application/problem+json"),
+        (status = 413, body = Problem, content_type = "application/problem+json"),
+        (status = 415, body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "Bad name or value", body = Problem, content_type = "application/problem+json")))]
+async fn put_material(
+    State(state): State<AppState>,
+    AppPath(name): AppPath<MaterialName>,
+    AppJson(mut material): AppJson<Material>,
+) -> AppResult<(StatusCode, Json<Material>)> {
+    let name = checked_name(name)?;
+    if material.name.as_ref().is_some_and(|given| *given != name) {
+        return Err(SolverError::input("name", format!("body name differs from the path's {name:?}")).into());
+    }
+    material.name = Some(name);
+    material.validate()?;
+    let created = store::materials::put(&state.db, &material).await?;
+    let status = if created { StatusCode::CREATED } else { StatusCode::OK };
+    Ok((status, Json(material)))
+}
+
+/// Removes a material (a seeded one too: it does not come back). Jobs already submitted keep the
+/// values they were resolved with.
+#[utoipa::path(delete, path = "/api/v1/materials/{name}", tag = "materials",
+    params(("name" = String, Path, description = "Material name: 1–64 letters, digits, `-`, `_`, `.`, not starting with `.`", pattern = r"^[A-Za-z0-9_-][A-Za-z0-9_.-]{0,63}$")),
+    responses(
+        (status = 204, description = "Deleted"),
+        (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = "Bad name", body = Problem, content_type = "application/problem+json")))]
+async fn delete_material(State(state): State<AppState>, AppPath(name): AppPath<MaterialName>) -> AppResult<StatusCode> {
+    let name = checked_name(name)?;
+    if store::materials::delete(&state.db, &name).await? { Ok(StatusCode::NO_CONTENT) } else { Err(unknown(&name)) }
+}
+
+/// Routes of this module.
+pub fn router() -> OpenApiRouter<AppState> {
+    OpenApiRouter::new().routes(routes!(list_materials)).routes(routes!(get_material, put_material, delete_material))
+}
