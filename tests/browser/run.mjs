@@ -354,6 +354,7 @@ const scenarios = {
     for (const [key, expected] of Object.entries({ ...full, margin: 1.2 })) {
       if (edited[key] !== expected) throw new Error(`editing on the page changed ${key}: ${JSON.stringify(edited)}`);
     }
+    await page.evaluate(async (url) => { await fetch(url, { method: 'DELETE' }); }, `${base}/api/v1/machines/api-full`);
 
     // Delete it again.
     await page.click('#tabs a[data-view="machines"]');

@@ -59,6 +59,7 @@ mod answer;
 mod arclength;
 mod capability;
 mod guarantee;
+mod job;
 mod numeric;
 mod nurbs;
 pub mod program;
@@ -79,7 +80,7 @@ pub use request::{Curve, CurveRule, Direction, Mode, RadiusEstimate, SegmentRequ
 use crate::capability::Control;
 use crate::error::ErrorCode;
 use crate::machine::{ChordStatus, MachineProfile};
-use request::{Job, Plan};
+use job::{Job, Plan};
 use segment::{Cut, CutError, Cutter, InfeasibleAt, Numerics, Status};
 
 use crate::error::SolverError;

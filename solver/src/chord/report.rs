@@ -1,7 +1,8 @@
 //! Warnings and program header of a segment answer (chord.md §4: E1, E4, E5, E8–E10, E12, E13;
 //! §6.1 comment block).
 
-use super::request::{Job, Plan, SegmentRequest};
+use super::job::{Job, Plan};
+use super::request::SegmentRequest;
 use super::segment::{self, Cut, Status};
 use super::shape;
 use crate::error::Warning;

@@ -7,7 +7,8 @@
 use std::f64::consts::TAU;
 
 use super::element::{Element, ElementKind};
-use super::request::{LoopConfig, LoopStyle};
+use super::job::LoopConfig;
+use super::request::LoopStyle;
 use crate::planar::{Vec2, right_normal};
 
 /// A loop at one corner.

@@ -59,6 +59,7 @@ mod capability;
 pub mod detect;
 pub mod division;
 mod element;
+mod job;
 mod layer;
 pub mod loops;
 pub mod material;

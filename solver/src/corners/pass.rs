@@ -4,11 +4,12 @@
 //! S round to S.
 
 use super::element::{Chording, Element, ElementKind};
+use super::job::{CornerChoice, LoopConfig, PassJob};
 use super::layer::{Class, Layer};
 use super::loops::{self, LoopShape};
 use super::offset::{self, Offset};
 use super::relief::{self, ReliefShape};
-use super::request::{CornerChoice, Join, LoopConfig, LoopStyle, PassJob, Relief};
+use super::request::{Join, LoopStyle, Relief};
 use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};
 use crate::planar::{SegmentGrid, Vec2, find_self_intersection, signed_area};

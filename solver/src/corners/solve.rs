@@ -9,11 +9,12 @@ use super::answer::{
 };
 use super::blocks;
 use super::element::{Chording, Element, ElementKind};
+use super::job::Job;
 use super::layer::Layer;
 use super::material::{self, Material};
 use super::pass::{self, Action, GOUGE_TOLERANCE, MAX_ARC_STEPS, PassInput, PassPlan, Stock};
 use super::prepare::list_indices;
-use super::request::{ContourRequest, CutDirection, Job, Join, LoopStyle, MAX_MOVES, Side};
+use super::request::{ContourRequest, CutDirection, Join, LoopStyle, MAX_MOVES, Side};
 use crate::capability::Control;
 use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};

@@ -13,7 +13,8 @@ use super::arcfeed::ArcFeed;
 use super::arcs::peak_thickness_ratio;
 use super::evaluate::Contact;
 use super::force::ForceModel;
-use super::request::{FeedBasis, Job, PlanJob};
+use super::job::{Job, PlanJob};
+use super::request::FeedBasis;
 use super::segments::{Route, Station};
 use super::teeth::tooth_sum;
 

@@ -4,8 +4,9 @@
 use super::answer::{EngagementSample, FluteResult};
 use super::evaluate::runs;
 use super::force::{ForceModel, power_kw};
+use super::job::{FeedMode, Job};
 use super::limits::{RESONANCE_BAND, resonance, tooth_passing_hz};
-use super::request::{FeedMode, Job, Representative};
+use super::request::Representative;
 use crate::error::Warning;
 
 /// Relative slack of the limit comparisons, so a value equal to its limit passes.

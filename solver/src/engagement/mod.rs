@@ -60,11 +60,13 @@ mod exact;
 mod feed;
 mod flutes;
 mod force;
+mod job;
 mod kienzle;
 mod limits;
 mod outline;
 mod phase;
 pub mod program;
+pub use job::Physics;
 pub mod request;
 mod segments;
 mod stock;
@@ -81,7 +83,7 @@ pub use kienzle::{DEFAULT_RADIAL_RATIO, Kienzle, MAX_KC11};
 pub use limits::{RESONANCE_BAND, SpindleLimits};
 pub use program::program;
 pub use request::{
-    Candidate, EngagementRequest, Engine, FeedBasis, FeedPlanRequest, PathInput, PathSegments, Physics, PreviousCut,
+    Candidate, EngagementRequest, Engine, FeedBasis, FeedPlanRequest, PathInput, PathSegments, PreviousCut,
     Representative, SegmentInput, Stock, StockBitmap, StockPolygon,
 };
 
