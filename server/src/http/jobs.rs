@@ -203,6 +203,29 @@ async fn record(state: &AppState, id: i64) -> AppResult<JobRecord> {
     store::jobs::get(&state.db, id).await?.ok_or_else(|| AppError::not_found(format!("job {id} does not exist")))
 }
 
+/// The record of a finished job: 404 for an unknown one, 409 for one not done.
+async fn done_record(state: &AppState, id: i64) -> AppResult<JobRecord> {
+    let job = record(state, id).await?;
+    if job.status != JobStatus::Done {
+        return Err(AppError::Conflict(format!("job {id} is {:?}, not done", job.status).to_lowercase()));
+    }
+    Ok(job)
+}
+
+/// A download of `length` bytes of `media_type` handed out in `pieces`, holding `permit` (its
+/// share of the memory budget) until sent.
+fn held_download(
+    permit: tokio::sync::OwnedSemaphorePermit,
+    pieces: impl Iterator<Item = std::io::Result<axum::body::Bytes>> + Send + 'static,
+    length: usize,
+    media_type: &'static str,
+) -> Response {
+    let mut response = held_body(permit, pieces).into_response();
+    response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static(media_type));
+    response.headers_mut().insert(header::CONTENT_LENGTH, HeaderValue::from(length));
+    response
+}
+
 /// A job: status, progress and, when done, its results.
 ///
 /// The results of a done job are held in memory twice (decompressed, then the answer) while the
@@ -239,10 +262,7 @@ async fn show(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobI
     .await
     .map_err(|e| AppError::Internal(e.into()))??;
     let length = body.len();
-    let mut response = held_body(permit, pieces_of(body.into())).into_response();
-    response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("application/json"));
-    response.headers_mut().insert(header::CONTENT_LENGTH, HeaderValue::from(length));
-    Ok(response)
+    Ok(held_download(permit, pieces_of(body.into()), length, "application/json"))
 }
 
 /// A finished job's G-code program (one per operation).
@@ -262,10 +282,7 @@ async fn gcode(
     AppPath(JobId { id }): AppPath<JobId>,
     AppQuery(query): AppQuery<ProgramQuery>,
 ) -> AppResult<Response> {
-    let job = record(&state, id).await?;
-    if job.status != JobStatus::Done {
-        return Err(AppError::Conflict(format!("job {id} is {:?}, not done", job.status).to_lowercase()));
-    }
+    done_record(&state, id).await?;
     let programs = store::jobs::programs(&state.db, id).await?;
     let index = match (query.operation, programs.len()) {
         (Some(index), count) if index < count => index,
@@ -297,10 +314,7 @@ async fn gcode(
     };
     let permit = state.reserve_memory(program.held() + PIECE)?;
     let length = program.length();
-    let mut response = held_body(permit, program.pieces()).into_response();
-    response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("text/x-gcode; charset=utf-8"));
-    response.headers_mut().insert(header::CONTENT_LENGTH, HeaderValue::from(length));
-    Ok(response)
+    Ok(held_download(permit, program.pieces(), length, "text/x-gcode; charset=utf-8"))
 }
 
 /// A finished job's stored file and every operation's stored outputs: 404 for an unknown job,
@@ -310,10 +324,7 @@ async fn finished(
     state: &AppState,
     id: i64,
 ) -> AppResult<(JobFile, Vec<store::outputs::OperationRow>, tokio::sync::OwnedSemaphorePermit)> {
-    let job = record(state, id).await?;
-    if job.status != JobStatus::Done {
-        return Err(AppError::Conflict(format!("job {id} is {:?}, not done", job.status).to_lowercase()));
-    }
+    done_record(state, id).await?;
     let permit = state.reserve_memory(store::outputs::length(&state.db, id).await?.saturating_mul(2))?;
     let json = store::outputs::job_file(&state.db, id)
         .await?
@@ -343,17 +354,15 @@ fn operation_outputs(rows: &[store::outputs::OperationRow]) -> Vec<OperationOutp
         (status = 200, body = String, content_type = "text/x-gcode"),
         (status = 404, body = Problem, content_type = "application/problem+json"),
         (status = 409, description = "Not finished", body = Problem, content_type = "application/problem+json"),
-        (status = 422, description = "No operation has a program (`E_NO_PROGRAM`)", body = Problem, content_type = "application/problem+json")))]
+        (status = 422, description = "No operation has a program (`E_NO_PROGRAM`)", body = Problem, content_type = "application/problem+json"),
+        (status = 429, description = "Large answers being read hold the memory budget; retry", body = Problem, content_type = "application/problem+json")))]
 async fn job_program(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobId>) -> AppResult<Response> {
     let (file, rows, permit) = finished(&state, id).await?;
     let number = program::program_number(&file, Some(id));
     let text = program::job_program(&file, number, &operation_outputs(&rows))?;
     drop(rows);
     let length = text.len();
-    let mut response = held_body(permit, pieces_of(text.into())).into_response();
-    response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("text/x-gcode; charset=utf-8"));
-    response.headers_mut().insert(header::CONTENT_LENGTH, HeaderValue::from(length));
-    Ok(response)
+    Ok(held_download(permit, pieces_of(text.into()), length, "text/x-gcode; charset=utf-8"))
 }
 
 /// Every output of a finished job as a zip archive (stored, uncompressed): `job.json`, each
@@ -364,7 +373,8 @@ async fn job_program(State(state): State<AppState>, AppPath(JobId { id }): AppPa
     responses(
         (status = 200, body = Vec<u8>, content_type = "application/zip"),
         (status = 404, body = Problem, content_type = "application/problem+json"),
-        (status = 409, description = "Not finished", body = Problem, content_type = "application/problem+json")))]
+        (status = 409, description = "Not finished", body = Problem, content_type = "application/problem+json"),
+        (status = 429, description = "Large answers being read hold the memory budget; retry", body = Problem, content_type = "application/problem+json")))]
 async fn outputs_zip(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobId>) -> AppResult<Response> {
     let (file, rows, permit) = finished(&state, id).await?;
     let number = program::program_number(&file, Some(id));
@@ -372,12 +382,9 @@ async fn outputs_zip(State(state): State<AppState>, AppPath(JobId { id }): AppPa
     let archive = crate::zip::stored(&files).map_err(|message| AppError::Internal(anyhow::anyhow!(message)))?;
     drop((files, rows));
     let length = archive.len();
-    let mut response = held_body(permit, pieces_of(archive.into())).into_response();
-    let headers = response.headers_mut();
-    headers.insert(header::CONTENT_TYPE, HeaderValue::from_static("application/zip"));
-    headers.insert(header::CONTENT_LENGTH, HeaderValue::from(length));
+    let mut response = held_download(permit, pieces_of(archive.into()), length, "application/zip");
     if let Ok(disposition) = HeaderValue::from_str(&format!("attachment; filename=\"kerf-job-{id}.zip\"")) {
-        headers.insert(header::CONTENT_DISPOSITION, disposition);
+        response.headers_mut().insert(header::CONTENT_DISPOSITION, disposition);
     }
     Ok(response)
 }
