@@ -248,6 +248,16 @@ const scenarios = {
     if (stored.radius !== 4 || stored.neck_radius !== 2.5) throw new Error(`tool by diameter: ${JSON.stringify(stored)}`);
     await page.click('#tool-rows tr[data-tool="12"] button:has-text("Edit")');
     if (await page.inputValue('#tool-form input[name="size"]') !== '8') throw new Error('edit did not fill the form');
+    // A flat end mill that does not cut at its centre, with its own plunge feed.
+    await page.selectOption('#tool-form select[name="kind"]', 'flat');
+    await page.fill('#tool-form input[name="plunge_feed"]', '250');
+    await page.selectOption('#tool-form select[name="centre_cutting"]', 'false');
+    await page.click('#tool-save');
+    await page.waitForSelector('#tool-rows tr[data-tool="12"] td:text-is("flat")', { timeout: 60000 });
+    const flat = await page.evaluate(async () => (await (await fetch('/api/v1/tools/12')).json()));
+    if (flat.plunge_feed !== 250 || flat.centre_cutting !== false) throw new Error(`entries of the tool: ${JSON.stringify(flat)}`);
+    await page.click('#tool-rows tr[data-tool="12"] button:has-text("Edit")');
+    if (await page.inputValue('#tool-form select[name="centre_cutting"]') !== 'false') throw new Error('edit did not fill centre cutting');
     await page.click('#tool-rows tr[data-tool="12"] button:has-text("Delete")');
     if (!(await page.$('#tool-rows tr[data-tool="12"]'))) throw new Error('deleted without asking');
     await page.click('#tool-rows tr[data-tool="12"] button:has-text("Yes, delete")');

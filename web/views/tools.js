@@ -20,6 +20,8 @@ const FORM = `
       <label>Neck radius, mm <input name="neck_radius" type="number" step="any" placeholder="none (shank as big as the head)" data-field="neck_radius"></label>
       <label>Stickout, mm <input name="stickout" type="number" step="any" placeholder="none" data-field="stickout"></label>
       <label>Helix angle, ° <input name="helix_deg" type="number" step="any" placeholder="none" data-field="helix_deg"></label>
+      <label>Plunge feed, mm/min <input name="plunge_feed" type="number" step="any" placeholder="the machine's, else half the cutting feed" data-field="plunge_feed"></label>
+      <label data-kinds="flat bull">Cuts at its centre <select name="centre_cutting" data-field="centre_cutting"><option value="">yes (default)</option><option value="false">no: enter layers on a ramp</option></select></label>
       <label class="stacked">Shape error: angle in °, error in mm, one pair a line <textarea name="shape_error" rows="4" spellcheck="false" placeholder="0 0.004&#10;45 0.006&#10;90 0.009" data-field="shape_error"></textarea></label>
       <label>Stiffness (static, X = Y), N/mm <input name="stiffness" type="number" step="any" placeholder="none" data-field="stiffness"></label>
       <p class="hint" data-kept-stiffness hidden>This tool has a measured (modal) stiffness; it is kept unless you enter a static one.</p>
@@ -36,6 +38,7 @@ const FORM = `
 function syncForm(form) {
   form.querySelector('[data-size-label]').textContent = value(form, 'size_as') === 'diameter' ? 'Diameter Ø, mm' : 'Radius, mm';
   form.querySelectorAll('[data-kind]').forEach((e) => { e.hidden = e.dataset.kind !== value(form, 'kind'); });
+  form.querySelectorAll('[data-kinds]').forEach((e) => { e.hidden = !e.dataset.kinds.split(' ').includes(value(form, 'kind')); });
 }
 
 // "angle error" lines into the API's table.
@@ -61,6 +64,9 @@ function toolFrom(form, keep = {}) {
     neck_radius: numeric(form, 'neck_radius'),
     stickout: numeric(form, 'stickout'),
     helix_deg: numeric(form, 'helix_deg'),
+    plunge_feed: numeric(form, 'plunge_feed'),
+    // A ball always cuts at its centre (the service refuses `false` on one).
+    centre_cutting: value(form, 'kind') !== 'ball' && value(form, 'centre_cutting') === 'false' ? false : undefined,
     flutes: numeric(form, 'flutes'),
     name: value(form, 'name').trim() || undefined,
     shape_error: shapeError(value(form, 'shape_error')),
@@ -75,13 +81,14 @@ function edit(form, tool) {
   form.elements.kind.value = tool.kind;
   form.elements.size_as.value = 'diameter';
   form.elements.size.value = String(2 * tool.radius);
-  for (const name of ['corner_radius', 'neck_radius', 'stickout', 'helix_deg', 'flutes', 'name']) form.elements[name].value = tool[name] ?? '';
+  for (const name of ['corner_radius', 'neck_radius', 'stickout', 'helix_deg', 'plunge_feed', 'flutes', 'name']) form.elements[name].value = tool[name] ?? '';
+  form.elements.centre_cutting.value = tool.centre_cutting === false ? 'false' : '';
   form.elements.shape_error.value = (tool.shape_error || []).map((p) => `${p.angle_deg} ${p.error}`).join('\n');
   const stiffness = tool.stiffness;
   form.elements.stiffness.value = stiffness?.kind === 'static' && stiffness.x === stiffness.y ? stiffness.x : '';
   form.querySelector('[data-kept-stiffness]').hidden = !stiffness || form.elements.stiffness.value !== '';
-  // Data the form does not show stays as stored: the plunge feed and whether it cuts at its centre.
-  form.kept = { plunge_feed: tool.plunge_feed, centre_cutting: tool.centre_cutting };
+  // Data the form does not show stays as stored (a measured stiffness).
+  form.kept = {};
   if (stiffness && form.elements.stiffness.value === '') form.kept.stiffness = stiffness;
   syncForm(form);
   form.elements.size.focus();
