@@ -152,16 +152,6 @@ impl AppState {
             )
         })
     }
-
-    /// `bytes` as a response body that holds its share of the answer budget until the connection
-    /// has taken the last piece (the body is handed out in 64 KiB pieces as the client reads).
-    ///
-    /// # Errors
-    /// 429 when the answers being read already hold the budget.
-    pub fn budgeted_body(&self, bytes: axum::body::Bytes) -> AppResult<axum::body::Body> {
-        let permit = self.reserve_memory(bytes.len())?;
-        Ok(held_body(permit, pieces_of(bytes)))
-    }
 }
 
 /// Bytes of a body handed to the connection at a time.
@@ -189,4 +179,18 @@ pub fn held_body(
         piece
     });
     axum::body::Body::from_stream(futures_util::stream::iter(pieces))
+}
+
+/// A download of `length` bytes of `media_type` handed out in `pieces`, holding `permit` (its
+/// share of the memory budget) until sent.
+pub fn held_download(
+    permit: tokio::sync::OwnedSemaphorePermit,
+    pieces: impl Iterator<Item = std::io::Result<axum::body::Bytes>> + Send + 'static,
+    length: usize,
+    media_type: &'static str,
+) -> axum::response::Response {
+    let mut response = axum::response::IntoResponse::into_response(held_body(permit, pieces));
+    response.headers_mut().insert(axum::http::header::CONTENT_TYPE, axum::http::HeaderValue::from_static(media_type));
+    response.headers_mut().insert(axum::http::header::CONTENT_LENGTH, axum::http::HeaderValue::from(length));
+    response
 }

@@ -16,7 +16,7 @@ use crate::error::{AppError, AppResult, Problem};
 use crate::extract::{AppPath, AppQuery, body_bytes, media_type, refuse_declared_over};
 use crate::jobs::file::{self, Format, JobFile};
 use crate::jobs::program::{self, OperationOutput};
-use crate::state::{AppState, PIECE, held_body, pieces_of};
+use crate::state::{AppState, PIECE, held_download, pieces_of};
 use crate::store;
 use crate::store::jobs::{JobRecord, JobStatus};
 
@@ -210,20 +210,6 @@ async fn done_record(state: &AppState, id: i64) -> AppResult<JobRecord> {
         return Err(AppError::Conflict(format!("job {id} is {:?}, not done", job.status).to_lowercase()));
     }
     Ok(job)
-}
-
-/// A download of `length` bytes of `media_type` handed out in `pieces`, holding `permit` (its
-/// share of the memory budget) until sent.
-fn held_download(
-    permit: tokio::sync::OwnedSemaphorePermit,
-    pieces: impl Iterator<Item = std::io::Result<axum::body::Bytes>> + Send + 'static,
-    length: usize,
-    media_type: &'static str,
-) -> Response {
-    let mut response = held_body(permit, pieces).into_response();
-    response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static(media_type));
-    response.headers_mut().insert(header::CONTENT_LENGTH, HeaderValue::from(length));
-    response
 }
 
 /// A job: status, progress and, when done, its results.

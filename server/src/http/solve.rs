@@ -5,13 +5,13 @@
 
 use axum::body::Bytes;
 use axum::http::{HeaderValue, header};
-use axum::response::{IntoResponse, Response};
+use axum::response::Response;
 use kerf_solver::capability::{Capability, Control, Purpose, Run};
 
 use super::output::Ask;
 use crate::capabilities::{self, Delivered};
 use crate::error::AppResult;
-use crate::state::AppState;
+use crate::state::{AppState, held_download, pieces_of};
 use crate::store;
 
 /// Answers `request` of capability `C` as `ask` says; `upload` is a file sent with it.
@@ -46,9 +46,7 @@ pub async fn answer<C: Capability>(
         Delivered::Json(bytes) => (Bytes::from(bytes), "application/json"),
     };
     let length = bytes.len();
-    let mut response = state.budgeted_body(bytes)?.into_response();
-    response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static(media_type));
-    response.headers_mut().insert(header::CONTENT_LENGTH, HeaderValue::from(length));
+    let mut response = held_download(state.reserve_memory(length)?, pieces_of(bytes), length, media_type);
     if let Ok(value) = HeaderValue::from_str(&format!("solve;dur={:.1}", seconds * 1e3)) {
         response.headers_mut().insert("server-timing", value);
     }

@@ -133,13 +133,14 @@ async fn raw_request(app: &TestApp, bytes: &[u8]) -> tokio::net::TcpStream {
     stream
 }
 
-/// Reads from `stream` until the server closes it (or 30 s pass, which fails the test).
-async fn read_until_closed(stream: &mut tokio::net::TcpStream) -> String {
+/// Reads from `stream` until `done` says what was received is enough or the server closes it;
+/// with whether that happened before `seconds` passed.
+async fn read_until(stream: &mut tokio::net::TcpStream, seconds: u64, done: fn(&[u8]) -> bool) -> (String, bool) {
     use tokio::io::AsyncReadExt;
     let mut received = Vec::new();
-    let closed = tokio::time::timeout(Duration::from_secs(30), async {
+    let finished = tokio::time::timeout(Duration::from_secs(seconds), async {
         let mut buffer = [0_u8; 4096];
-        loop {
+        while !done(&received) {
             match stream.read(&mut buffer).await {
                 Ok(0) | Err(_) => break,
                 Ok(n) => received.extend_from_slice(&buffer[..n]),
@@ -147,8 +148,14 @@ async fn read_until_closed(stream: &mut tokio::net::TcpStream) -> String {
         }
     })
     .await;
-    assert!(closed.is_ok(), "the server kept the connection open; received: {}", String::from_utf8_lossy(&received));
-    String::from_utf8_lossy(&received).into_owned()
+    (String::from_utf8_lossy(&received).into_owned(), finished.is_ok())
+}
+
+/// Reads from `stream` until the server closes it (or 30 s pass, which fails the test).
+async fn read_until_closed(stream: &mut tokio::net::TcpStream) -> String {
+    let (received, closed) = read_until(stream, 30, |_| false).await;
+    assert!(closed, "the server kept the connection open; received: {received}");
+    received
 }
 
 #[tokio::test(flavor = "multi_thread")]
@@ -319,20 +326,9 @@ async fn slow_readers_of_large_job_programs_hold_a_bounded_budget() {
 
 /// Reads from `stream` until the end of a response head (or 10 s pass, which fails the test).
 async fn read_head(stream: &mut tokio::net::TcpStream) -> String {
-    use tokio::io::AsyncReadExt;
-    let mut received = Vec::new();
-    let read = tokio::time::timeout(Duration::from_secs(10), async {
-        let mut buffer = [0_u8; 4096];
-        while !received.windows(4).any(|w| w == b"\r\n\r\n") {
-            match stream.read(&mut buffer).await {
-                Ok(0) | Err(_) => break,
-                Ok(n) => received.extend_from_slice(&buffer[..n]),
-            }
-        }
-    })
-    .await;
-    assert!(read.is_ok(), "no answer; received: {}", String::from_utf8_lossy(&received));
-    String::from_utf8_lossy(&received).into_owned()
+    let (received, read) = read_until(stream, 10, |received| received.windows(4).any(|w| w == b"\r\n\r\n")).await;
+    assert!(read, "no answer; received: {received}");
+    received
 }
 
 #[tokio::test(flavor = "multi_thread")]
