@@ -7,13 +7,8 @@ use std::time::Instant;
 
 use kerf_solver::SolverError;
 use kerf_solver::capability::{self, Capability, Lookup, OutputOptions, Refs, Resolved, Run, ToolNeed};
-use kerf_solver::chord::{SegmentCapability, SegmentRequest};
-use kerf_solver::corners::{ContourCapability, ContourRequest};
-use kerf_solver::deburr::{DeburrCapability, DeburrRequest};
-use kerf_solver::engagement::{EngagementCapability, EngagementRequest};
 use kerf_solver::machine::MachineProfile;
 use kerf_solver::material::Material;
-use kerf_solver::predict::{PredictCapability, PredictRequest};
 use kerf_solver::tool::Tool;
 use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
@@ -21,12 +16,39 @@ use utoipa::ToSchema;
 
 use crate::error::AppError;
 
-/// The registry: one line per capability: the variant of [`Operation`], the capability type, its
-/// request type (named so the OpenAPI document shows the concrete schema; the compiler checks that
-/// it is the capability's) and the operation's description in the OpenAPI document.
+/// The registry: the one list of capabilities, one entry each. It hands the list to `$callback`
+/// (a macro in scope where it is called): [`registry!`] here builds the job [`Operation`] from it,
+/// `http::endpoints` the HTTP endpoints. An entry names the variant of [`Operation`]; the solver
+/// module with the capability, request and answer types (named so the OpenAPI document shows the
+/// concrete schemas; the compiler checks that they are the capability's); the endpoint's body,
+/// `json(Query)` with the query parameters it takes (a type of `http::output`) or `upload` for a
+/// capability with its own handler in `http/<module>.rs`; and the operation's description.
+macro_rules! with_registry {
+    ($callback:ident) => {
+        $callback! {
+            Deburr => deburr::{DeburrCapability, DeburrRequest, DeburrAnswer}, json(OutputQuery),
+                "`POST /api/v1/deburr`.";
+            Segment => chord::{SegmentCapability, SegmentRequest, SegmentResult}, json(OutputQuery),
+                "`POST /api/v1/segment`.";
+            Contour => corners::{ContourCapability, ContourRequest, ContourResult}, json(OutputQuery),
+                "`POST /api/v1/contour`.";
+            Engagement => engagement::{EngagementCapability, EngagementRequest, EngagementResponse}, json(CandidateQuery),
+                "`POST /api/v1/engagement`; the job's program is that of the request's `candidate` path (default the first).";
+            Predict => predict::{PredictCapability, PredictRequest, PredictAnswer}, upload,
+                "`POST /api/v1/predict` (a job file cannot carry an STL file: no `mesh` stock).";
+        }
+    };
+}
+pub(crate) use with_registry;
+
+/// Builds the job [`Operation`] and its dispatch from the registry's entries.
 macro_rules! registry {
-    ($($variant:ident => $capability:ty, $request:ty, $doc:literal);+ $(;)?) => {
-        $(const _: fn(<$capability as Capability>::Request) -> $request = |request| request;)+
+    ($($variant:ident => $module:ident::{$capability:ident, $request:ident, $answer:ident}, $body:ident $(($query:ident))?, $doc:literal;)+) => {
+        $(
+            use kerf_solver::$module::{$capability, $request};
+            const _: fn(<$capability as Capability>::Request) -> $request = |request| request;
+            const _: fn(<$capability as Capability>::Answer) -> kerf_solver::$module::$answer = |answer| answer;
+        )+
 
         /// One job operation: `operation` names the capability, the other fields are its
         /// endpoint's request.
@@ -92,15 +114,7 @@ macro_rules! registry {
     };
 }
 
-registry! {
-    Deburr => DeburrCapability, DeburrRequest, "`POST /api/v1/deburr`.";
-    Segment => SegmentCapability, SegmentRequest, "`POST /api/v1/segment`.";
-    Contour => ContourCapability, ContourRequest, "`POST /api/v1/contour`.";
-    Engagement => EngagementCapability, EngagementRequest,
-        "`POST /api/v1/engagement`; the job's program is that of the request's `candidate` path (default the first).";
-    Predict => PredictCapability, PredictRequest,
-        "`POST /api/v1/predict` (a job file cannot carry an STL file: no `mesh` stock).";
-}
+with_registry!(registry);
 
 // Hand-written instead of serde's internally tagged enum, which buffers the table and so loses
 // the field path and line of errors inside it. When `operation` is the first key (as in every

@@ -23,6 +23,8 @@ use crate::tool::{Tool, ToolRef};
 pub trait Capability {
     /// Its name: the endpoint (`/api/v1/{NAME}`), the job `operation` and the page's view id.
     const NAME: &'static str;
+    /// How its endpoint is documented; the server generates the endpoint from the registry.
+    const ENDPOINT: Endpoint;
     /// The request, as its endpoint takes it and as a job operation holds it.
     type Request: Serialize + DeserializeOwned + Clone + Send + Sync + 'static;
     /// The answer, as its endpoint returns it as JSON and as a job stores it.
@@ -67,6 +69,21 @@ pub trait Capability {
 
     /// Records how long the solve took, for capabilities whose answer reports it.
     fn record_time(_answer: &mut Self::Answer, _seconds: f64) {}
+}
+
+/// The documentation of a capability's endpoint `POST /api/v1/{NAME}` in the OpenAPI document.
+/// It lives with the capability because the capability knows what it answers and refuses; the
+/// server's handler is generated and only forwards these texts.
+#[derive(Debug, Clone, Copy)]
+pub struct Endpoint {
+    /// The one-line summary.
+    pub summary: &'static str,
+    /// What the endpoint returns, in a paragraph or two.
+    pub description: &'static str,
+    /// What a 404 means here (which references the request can make).
+    pub not_found: &'static str,
+    /// What a 422 means here: the capability's refusal codes.
+    pub refused: &'static str,
 }
 
 /// The references a request makes, to be resolved before it is solved.

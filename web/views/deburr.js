@@ -305,3 +305,6 @@ export const deburrView = {
     keepForm(id, form);
   },
 };
+
+// This capability's view in the page's list (`web/views.js` loads it by the capability's name).
+export const view = { title: 'Deburr', mount: deburrView.mount, result: deburrResult };

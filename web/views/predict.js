@@ -473,3 +473,6 @@ export const predictView = {
     keepForm(id, form);
   },
 };
+
+// This capability's view in the page's list (`web/views.js` loads it by the capability's name).
+export const view = { title: 'Predict', mount: predictView.mount, result: predictResult };

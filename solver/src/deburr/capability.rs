@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use super::{Deburr, DeburrRequest};
-use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
+use crate::capability::{Capability, Endpoint, OutputOptions, Refs, Resolved, Run};
 use crate::error::SolverError;
 use crate::geometry::Vec3;
 use crate::machine::MachineProfile;
@@ -58,6 +58,17 @@ pub struct HoleAnswer {
 
 impl Capability for DeburrCapability {
     const NAME: &'static str = "deburr";
+    const ENDPOINT: Endpoint = Endpoint {
+        summary: "Deburrs one ridge of a cross hole with a ball end mill.",
+        description: "Returns the closed loop of ball centres in machining order (JSON), or with `Accept: \
+            text/x-gcode` / `?format=gcode` a complete program (dialect from `?dialect=`, else the \
+            named machine's, else Fanuc). With `block_time_ms` or a `machine` the points follow the \
+            block-time rule at `feed` (never coarser than `tolerance`) and the summary reports the \
+            blocks.",
+        not_found: "Unknown tool number or machine",
+        refused: "Impossible geometry (codes in deburr.md §4); `E_TIMEOUT` over the synchronous time \
+            limit: submit a job",
+    };
     type Request = DeburrRequest;
     type Answer = DeburrAnswer;
     type Tool = Tool;

@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use super::{EngagementAnswer, EngagementRequest, Stock};
-use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
+use crate::capability::{Capability, Endpoint, OutputOptions, Refs, Resolved, Run};
 use crate::error::SolverError;
 use crate::machine::MachineProfile;
 use crate::material::Material;
@@ -52,6 +52,21 @@ pub struct EngagementResponse {
 
 impl Capability for EngagementCapability {
     const NAME: &'static str = "engagement";
+    const ENDPOINT: Endpoint = Endpoint {
+        summary: "Analyses the tool–workpiece engagement along a tool path and recommends flute counts.",
+        description: "Moves the tool's cutting circle along the path over the stock and returns, per sample, \
+            the engaged arcs (tool angle: 90° ahead, 0° right, 180° left of travel), the radial \
+            depth and the summed chip thickness of every candidate flute count; per flute count the \
+            representative thicknesses, the machining time and whether it meets `thickness_limit` \
+            and `time_limit_s`. `paths` compares several candidate paths side by side. With `Accept: \
+            text/x-gcode` or `?format=gcode` (and `axial_depth`) it returns the program of one path \
+            (`?candidate=`) at the feeds of `feed_plan` (chip-thinning compensation) or at the \
+            nominal feed. A `machine` supplies `feed_plan.max_feed` and the dialect.",
+        not_found: "Unknown tool number or machine",
+        refused: "Impossible or over a limit: `E_INPUT`, `E_PATH`, `E_STOCK`, `E_TOO_LARGE`, \
+            `E_TOO_MANY_SAMPLES`, `E_GRID_MEMORY`, `E_WORK_LIMIT` (engagement.md §9); `E_TIMEOUT` \
+            over the synchronous time limit: submit a job",
+    };
     type Request = EngagementRequest;
     type Answer = EngagementResponse;
     type Tool = Tool;

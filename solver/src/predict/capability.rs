@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use super::{PathInput, Predict, PredictRequest, ProgramOptions, Stock};
-use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
+use crate::capability::{Capability, Endpoint, OutputOptions, Refs, Resolved, Run};
 use crate::error::SolverError;
 use crate::gcode::{Reference, ToolCall};
 use crate::machine::MachineProfile;
@@ -43,6 +43,19 @@ pub struct PredictAnswer {
 
 impl Capability for PredictCapability {
     const NAME: &'static str = "predict";
+    const ENDPOINT: Endpoint = Endpoint {
+        summary: "Predicts the machining error of a ball-end-mill finishing path and corrects the path.",
+        description: "Returns one record per pass (error along the surface normal, contact angle, generation \
+            point, normal, flags, corrected end point), a summary with the worst passes and warnings \
+            (JSON), or with `Accept: text/x-gcode` / `?format=gcode` the corrected program. The body \
+            is JSON, or a form with the JSON in part `request` and the STL stock in part `stock`. \
+            Long paths exceed the synchronous time limit (422 `E_TIMEOUT`): submit them as a job \
+            (`operation = \"predict\"`).",
+        not_found: "Unknown tool number",
+        refused: "Impossible or over a limit: tool kind, no shape-error table, G-code errors with the \
+            line, open mesh, resolution over the memory limit; `E_TIMEOUT` over the synchronous time \
+            limit: submit a job",
+    };
     type Request = PredictRequest;
     type Answer = PredictAnswer;
     type Tool = Tool;
