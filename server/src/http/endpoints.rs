@@ -6,8 +6,6 @@
 
 use utoipa_axum::router::OpenApiRouter;
 
-#[allow(unused_imports, reason = "the registry names the query types its entries use")]
-use super::output::{CandidateQuery, OutputQuery};
 use crate::capabilities::with_registry;
 use crate::state::AppState;
 
