@@ -69,6 +69,7 @@ fn request(
         history: None,
         pass_range: None,
         exclusion_deg: None,
+        exclusion_shape_error: None,
     }
 }
 

@@ -58,6 +58,8 @@ pub(crate) struct Job {
     pub(crate) spindle_speeds: Vec<f64>,
     /// θ_x, degrees.
     pub(crate) exclusion: Option<f64>,
+    /// e_S for the excluded passes.
+    pub(crate) exclusion_shape_error: bool,
 }
 
 fn range_u32(field: &str, value: Option<u32>, default: u32, lo: u32, hi: u32) -> Result<u32, SolverError> {
@@ -227,6 +229,13 @@ impl PredictRequest {
                 ));
             }
         };
+        let exclusion_shape_error = self.exclusion_shape_error.unwrap_or(false);
+        if exclusion_shape_error && exclusion.is_none() {
+            return Err(SolverError::input(
+                "exclusion_shape_error",
+                "exclusion_shape_error applies to passes excluded by exclusion_deg: give exclusion_deg too",
+            ));
+        }
         let pass_range = match self.pass_range {
             None => 0..path.passes.len(),
             Some([from, to]) => {
@@ -274,6 +283,7 @@ impl PredictRequest {
             history,
             pass_range,
             exclusion,
+            exclusion_shape_error,
             spindle_speeds,
         })
     }

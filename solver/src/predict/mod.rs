@@ -225,7 +225,10 @@ fn node_corrections(path: &PathModel, outcomes: &[Outcome], limit: f64) -> (Vec<
         let error = segment.pass.and_then(|p| {
             let o = &outcomes[p];
             match (o.status, o.error, o.normal) {
-                (PassStatus::Ok, Some(error), Some(n)) => Some(PassError { error, normal: array3(&n) }),
+                // Excluded passes with e_S (`exclusion_shape_error`) are corrected for it too.
+                (PassStatus::Ok | PassStatus::SkippedSmallAngle, Some(error), Some(n)) => {
+                    Some(PassError { error, normal: array3(&n) })
+                }
                 _ => None,
             }
         });

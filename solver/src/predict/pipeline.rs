@@ -154,7 +154,11 @@ pub(crate) fn run_round(
                 return None;
             }
             let outcome = if skipped.get(index).copied().unwrap_or(false) {
-                Outcome::empty(PassStatus::SkippedSmallAngle)
+                if context.job.exclusion_shape_error {
+                    shape_error_only(context, path, index, scratch)
+                } else {
+                    Outcome::empty(PassStatus::SkippedSmallAngle)
+                }
             } else {
                 predict_pass(context, path, index, scratch)
             };
@@ -187,8 +191,34 @@ pub(crate) fn cancelled() -> SolverError {
     SolverError::new(ErrorCode::Cancelled, "the prediction was cancelled")
 }
 
+/// A pass excluded by claim 8 with `exclusion_shape_error` (§3.4, E15): the same prediction
+/// position, finished surface and generation point as a full prediction, and e_S = −δ(θ_c), but
+/// neither force nor deflection (the reason for the exclusion): e_D stays null and e = e_S. The
+/// status stays `skipped_small_angle`.
+fn shape_error_only(context: &Context<'_>, path: &PathModel, index: usize, scratch: &mut Scratch) -> Outcome {
+    let mut outcome = predict_pass_with(context, path, index, scratch, false);
+    if outcome.status == PassStatus::Ok {
+        outcome.status = PassStatus::SkippedSmallAngle;
+    } else {
+        outcome = Outcome::empty(PassStatus::SkippedSmallAngle);
+    }
+    outcome
+}
+
 /// The full pipeline for one pass.
 pub(crate) fn predict_pass(context: &Context<'_>, path: &PathModel, index: usize, scratch: &mut Scratch) -> Outcome {
+    predict_pass_with(context, path, index, scratch, true)
+}
+
+/// The pipeline for one pass, with the force and deflection steps (S3, S4, S10) only when
+/// `deflection` is set.
+fn predict_pass_with(
+    context: &Context<'_>,
+    path: &PathModel,
+    index: usize,
+    scratch: &mut Scratch,
+    deflection: bool,
+) -> Outcome {
     let job = context.job;
     let radius = job.radius;
     let pass = path.passes[index];
@@ -213,7 +243,7 @@ pub(crate) fn predict_pass(context: &Context<'_>, path: &PathModel, index: usize
     let Some(grid) = context.grids[sign_slot(source.rotation_sign)].as_ref() else {
         return Outcome::empty(PassStatus::NoCut);
     };
-    let coefficients = if job.deflection.is_none() { job.cutting.as_ref() } else { None };
+    let coefficients = if job.deflection.is_none() && deflection { job.cutting.as_ref() } else { None };
     let mut pieces = Vec::new();
     // Stations: the middle first, then alternately ahead and behind (§3.3).
     let step = tooth_feed.max(length / 16.0);
@@ -320,6 +350,16 @@ pub(crate) fn predict_pass(context: &Context<'_>, path: &PathModel, index: usize
         outcome.flags.push(PassFlag::Extrapolated);
     }
     let error_shape = -delta;
+    if !deflection {
+        outcome.error_shape = Some(error_shape);
+        outcome.error = Some(error_shape);
+        outcome.contact_angle = Some(contact_angle);
+        outcome.azimuth = azimuth;
+        outcome.rotation_angle = rotation_angle;
+        outcome.point = Some(point);
+        outcome.normal = Some(normal);
+        return outcome;
+    }
     let force_history = &engagement.force;
     let mut history_deflection: Option<Vec<[f64; 2]>> = None;
     let deflection: Option<[f64; 2]> = if let Some(prescribed) = &job.deflection {

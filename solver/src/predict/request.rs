@@ -172,4 +172,10 @@ pub struct PredictRequest {
     /// they get status `skipped_small_angle`. Absent: every pass is predicted.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub exclusion_deg: Option<f64>,
+    /// With `exclusion_deg`: still find the generation point of the excluded passes and report
+    /// their shape-error term e_S (and e = e_S, e_D null; the path is corrected for it), without
+    /// the force and deflection (§3.4, E15). Default false: excluded passes are skipped (the
+    /// patent's default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exclusion_shape_error: Option<bool>,
 }

@@ -118,6 +118,7 @@ pub fn raster_request(
         history: None,
         pass_range: None,
         exclusion_deg: None,
+        exclusion_shape_error: None,
     };
     (request, tool, moves)
 }
@@ -148,6 +149,7 @@ pub fn bare_request(tool: &Tool, stock: Stock, path: PathInput) -> PredictReques
         history: None,
         pass_range: None,
         exclusion_deg: None,
+        exclusion_shape_error: None,
     }
 }
 
