@@ -70,6 +70,8 @@ fn request(
         pass_range: None,
         exclusion_deg: None,
         exclusion_shape_error: None,
+        merge_similar_passes: None,
+        merge_tolerance: None,
     }
 }
 

@@ -15,6 +15,7 @@ use super::dynamics::{self, Compliance};
 use super::exclusion;
 use super::force::{self, EdgeGrid, Engagement};
 use super::job::Job;
+use super::merge;
 use super::passes::PathModel;
 use super::render::{self, Image, Window};
 use super::request::Method;
@@ -50,6 +51,9 @@ pub(crate) struct Outcome {
     pub(crate) finished_count: usize,
     pub(crate) view: Option<Vec3>,
     pub(crate) history: Option<PassHistory>,
+    /// Merged: the simulated pass whose result this is, and the bound on the difference.
+    pub(crate) merged_with: Option<usize>,
+    pub(crate) merge_bound: Option<f64>,
 }
 
 impl Outcome {
@@ -72,6 +76,8 @@ impl Outcome {
             finished_count: 0,
             view: None,
             history: None,
+            merged_with: None,
+            merge_bound: None,
         }
     }
 }
@@ -136,6 +142,13 @@ pub(crate) fn run_round(
 ) -> Option<Vec<Outcome>> {
     let cancelled = AtomicBool::new(false);
     let report_every = (total_work / 200).max(1);
+    let report = |finished: usize| {
+        if let Some(progress) = control.progress
+            && (finished.is_multiple_of(report_every) || finished == total_work)
+        {
+            progress(finished as f64 / total_work as f64);
+        }
+    };
     let range = context.job.pass_range.clone();
     // Claim 8: θ_max per pass from one global view, only when a threshold is given.
     let skipped: Vec<bool> = match context.job.exclusion {
@@ -145,45 +158,97 @@ pub(crate) fn run_round(
             .collect(),
         None => Vec::new(),
     };
-    let predicted: Vec<Option<Outcome>> = range
-        .clone()
+    let is_skipped = |index: usize| skipped.get(index).copied().unwrap_or(false);
+    let simulate = |indices: &[usize]| -> Option<Vec<Outcome>> {
+        let outcomes: Vec<Option<Outcome>> = indices
+            .par_iter()
+            .map_init(Scratch::default, |scratch, &index| {
+                if control.cancelled() {
+                    cancelled.store(true, Ordering::Relaxed);
+                    return None;
+                }
+                let outcome = if is_skipped(index) {
+                    if context.job.exclusion_shape_error {
+                        shape_error_only(context, path, index, scratch)
+                    } else {
+                        Outcome::empty(PassStatus::SkippedSmallAngle)
+                    }
+                } else {
+                    predict_pass(context, path, index, scratch)
+                };
+                report(done.fetch_add(1, Ordering::Relaxed) + 1);
+                Some(outcome)
+            })
+            .collect();
+        if cancelled.load(Ordering::Relaxed) { None } else { outcomes.into_iter().collect() }
+    };
+    let indices: Vec<usize> = range.clone().collect();
+    let predicted: Vec<Outcome> = match context.job.merge_tolerance {
+        None => simulate(&indices)?,
+        Some(tolerance) => {
+            let links = merge_links(context, path, &range, &is_skipped, &cancelled, control)?;
+            let (outcomes, merged) =
+                merge::run(path, &indices, &links, tolerance, merge::Resolution::new(context.job), |batch| {
+                    simulate(batch)
+                })?;
+            report(done.fetch_add(merged, Ordering::Relaxed) + merged);
+            outcomes
+        }
+    };
+    let mut predicted = predicted.into_iter();
+    (0..path.passes.len())
+        .map(
+            |index| {
+                if range.contains(&index) { predicted.next() } else { Some(Outcome::empty(PassStatus::NotPredicted)) }
+            },
+        )
+        .collect()
+}
+
+/// `links[k]`: whether pass `range.start + k + 1` is similar to the pass before it (merging,
+/// [`merge::similar`]); excluded passes and passes with a history are never linked.
+fn merge_links(
+    context: &Context<'_>,
+    path: &PathModel,
+    range: &std::ops::Range<usize>,
+    is_skipped: &(impl Fn(usize) -> bool + Sync),
+    cancelled: &AtomicBool,
+    control: &Control<'_>,
+) -> Option<Vec<bool>> {
+    const CHUNK: usize = 256;
+    let job = context.job;
+    let tolerance = job.merge_tolerance.unwrap_or(0.0);
+    let free = |index: usize| !is_skipped(index) && !job.history.contains(&index);
+    let pairs = range.len().saturating_sub(1);
+    let chunks: Vec<Vec<bool>> = (0..pairs.div_ceil(CHUNK))
         .into_par_iter()
-        .map_init(Scratch::default, |scratch, index| {
+        .map_init(Scratch::default, |scratch, chunk| {
             if control.cancelled() {
                 cancelled.store(true, Ordering::Relaxed);
-                return None;
+                return Vec::new();
             }
-            let outcome = if skipped.get(index).copied().unwrap_or(false) {
-                if context.job.exclusion_shape_error {
-                    shape_error_only(context, path, index, scratch)
-                } else {
-                    Outcome::empty(PassStatus::SkippedSmallAngle)
-                }
-            } else {
-                predict_pass(context, path, index, scratch)
-            };
-            let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
-            if let Some(progress) = control.progress
-                && (finished.is_multiple_of(report_every) || finished == total_work)
-            {
-                progress(finished as f64 / total_work as f64);
-            }
-            Some(outcome)
+            let first = range.start + chunk * CHUNK;
+            let last = (first + CHUNK).min(range.start + pairs);
+            let mut previous = merge::Neighbourhood::default();
+            let mut previous_ok = free(first) && merge::neighbourhood(job, path, first, scratch, &mut previous);
+            let mut current = merge::Neighbourhood::default();
+            (first..last)
+                .map(|a| {
+                    let current_ok = free(a + 1) && merge::neighbourhood(job, path, a + 1, scratch, &mut current);
+                    let linked = previous_ok
+                        && current_ok
+                        && merge::similar(path, a, &previous, &current, job.radius, tolerance);
+                    std::mem::swap(&mut previous, &mut current);
+                    previous_ok = current_ok;
+                    linked
+                })
+                .collect()
         })
         .collect();
     if cancelled.load(Ordering::Relaxed) {
         return None;
     }
-    let mut predicted = predicted.into_iter();
-    (0..path.passes.len())
-        .map(|index| {
-            if range.contains(&index) {
-                predicted.next().flatten()
-            } else {
-                Some(Outcome::empty(PassStatus::NotPredicted))
-            }
-        })
-        .collect()
+    Some(chunks.concat())
 }
 
 /// The cancellation error.

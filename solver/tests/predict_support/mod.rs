@@ -119,6 +119,8 @@ pub fn raster_request(
         pass_range: None,
         exclusion_deg: None,
         exclusion_shape_error: None,
+        merge_similar_passes: None,
+        merge_tolerance: None,
     };
     (request, tool, moves)
 }
@@ -150,6 +152,8 @@ pub fn bare_request(tool: &Tool, stock: Stock, path: PathInput) -> PredictReques
         pass_range: None,
         exclusion_deg: None,
         exclusion_shape_error: None,
+        merge_similar_passes: None,
+        merge_tolerance: None,
     }
 }
 
