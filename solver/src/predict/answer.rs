@@ -135,7 +135,8 @@ pub struct PredictedPass {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub merged_with: Option<usize>,
     /// The error of the merge, mm: how much `error` can differ from simulating this pass (the
-    /// spread of the errors of the simulated passes on either side).
+    /// spread of the errors of the simulated passes on either side plus the resolution of one
+    /// prediction).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub merge_bound: Option<f64>,
 }

@@ -48,15 +48,18 @@ pub(crate) struct Neighbourhood {
     conditions: [f64; 3],
 }
 
-/// The stock's top over (x, y) and its bottom, for the stocks that are height fields.
-fn top(stock: &StockModel, x: f64, y: f64) -> Option<Option<f64>> {
+/// The stock's top over (x, y) for the stocks that are height fields (`NaN` outside the
+/// footprint); `None` for the others.
+fn top(stock: &StockModel, x: f64, y: f64) -> Option<f64> {
+    let inside = |lo: [f64; 2], hi: [f64; 2]| x > lo[0] && x < hi[0] && y > lo[1] && y < hi[1];
     match stock {
-        StockModel::Box { lo, hi } => Some((x > lo.x && x < hi.x && y > lo.y && y < hi.y).then_some(hi.z)),
-        StockModel::Plane { point, normal, lo, hi } => Some(
-            (x > lo[0] && x < hi[0] && y > lo[1] && y < hi[1])
-                .then(|| point.z - ((x - point.x) * normal.x + (y - point.y) * normal.y) / normal.z),
-        ),
-        StockModel::Grid(grid) => Some(grid.top_at(x, y)),
+        StockModel::Box { lo, hi } => Some(if inside([lo.x, lo.y], [hi.x, hi.y]) { hi.z } else { f64::NAN }),
+        StockModel::Plane { point, normal, lo, hi } => Some(if inside(*lo, *hi) {
+            point.z - ((x - point.x) * normal.x + (y - point.y) * normal.y) / normal.z
+        } else {
+            f64::NAN
+        }),
+        StockModel::Grid(grid) => Some(grid.top_at(x, y).unwrap_or(f64::NAN)),
         StockModel::Cylinder { .. } | StockModel::Mesh(_) => None,
     }
 }
@@ -113,7 +116,7 @@ pub(crate) fn neighbourhood(
             let Some(height) = top(&job.stock, centre.x + offset(i), centre.y + offset(j)) else {
                 return false;
             };
-            out.tops.push(height.map_or(f64::NAN, |h| h - centre.z));
+            out.tops.push(height - centre.z);
         }
     }
     // A bottom more than 2R below the centre is out of the ball's reach.
@@ -204,7 +207,7 @@ pub(crate) fn run(
     let mut runs: Vec<(usize, usize)> = Vec::new();
     let mut first = 0;
     for k in 0..count {
-        if k + 1 == count || !links[k] {
+        if links.get(k).is_none_or(|linked| !linked) {
             runs.push((first, k));
             first = k + 1;
         }
