@@ -738,6 +738,46 @@ fn bad_cases() -> Vec<Case> {
         ("resolution out of range", with(&["resolution"], json!(100_000)), "", 422, "resolution", "E_INPUT", ""),
         ("box upside down", with(&["stock", "max"], json!([20, 20, -20])), "", 422, "stock.max", "E_INPUT", ""),
         (
+            "merge tolerance zero",
+            {
+                let mut body = with(&["merge_similar_passes"], json!(true));
+                body["merge_tolerance"] = json!(0);
+                body
+            },
+            "",
+            422,
+            "merge_tolerance",
+            "E_INPUT",
+            "above 0",
+        ),
+        (
+            "merge tolerance without merging",
+            with(&["merge_tolerance"], json!(0.001)),
+            "",
+            422,
+            "merge_tolerance",
+            "E_INPUT",
+            "merge_similar_passes",
+        ),
+        (
+            "merge switch not a bool",
+            with(&["merge_similar_passes"], json!("yes")),
+            "",
+            400,
+            "merge_similar_passes",
+            "E_JSON",
+            "",
+        ),
+        (
+            "shape error for excluded passes without a threshold",
+            with(&["exclusion_shape_error"], json!(true)),
+            "",
+            422,
+            "exclusion_shape_error",
+            "E_INPUT",
+            "exclusion_deg",
+        ),
+        (
             "mesh stock without its file",
             with(&["stock"], json!({"kind": "mesh"})),
             "",
