@@ -12,7 +12,7 @@ fn steps() -> impl Strategy<Value = Vec<(f64, f64, f64, f64, u8)>> {
 proptest! {
     #[test]
     fn bounded_by_the_feeds_and_by_stopping_everywhere(moves in steps(), accel in 50.0..5000.0_f64) {
-        let dynamics = Dynamics { max_accel: accel, rapid_feed: 20_000.0, block_time_s: 0.0, tool_change_s: 3.0 };
+        let dynamics = Dynamics { max_accel: accel, max_jerk: None, rapid_feed: 20_000.0, block_time_s: 0.0, tool_change_s: 3.0 };
         let path: Vec<Step> = moves
             .iter()
             .map(|&(x, y, z, feed, kind)| {
