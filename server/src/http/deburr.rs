@@ -12,12 +12,15 @@ use crate::error::{AppResult, Problem};
 use crate::extract::{AppJson, AppQuery};
 use crate::state::AppState;
 
-/// Deburrs one ridge of a cross hole with a ball end mill.
+/// Deburrs one ridge of a cross hole with a ball end mill, or several holes and both ridges.
 ///
 /// Returns the closed loop of ball centres in machining order (JSON), or with
 /// `Accept: text/x-gcode` / `?format=gcode` a complete program (dialect from `?dialect=`, else
 /// the named machine's, else Fanuc). With `block_time_ms` or a `machine` the points follow the
 /// block-time rule at `feed` (never coarser than `tolerance`) and the summary reports the blocks.
+/// With `holes`, a `pattern` or `edge: both` one program visits every loop (one per hole and
+/// edge, listed in `holes`) in a short order (`visiting_order`), changing to `inner_tool` once for
+/// the inside ridges and stopping (`M00`) to turn the tube for holes that point down.
 #[utoipa::path(post, path = "/api/v1/deburr", tag = "deburr",
     params(OutputQuery),
     request_body = DeburrRequest,
@@ -26,7 +29,7 @@ use crate::state::AppState;
             (DeburrAnswer = "application/json"),
             (String = "text/x-gcode"))),
         (status = 400, body = Problem, content_type = "application/problem+json"),
-        (status = 404, description = "Unknown tool number or machine", body = Problem, content_type = "application/problem+json"),
+        (status = 404, description = "Unknown tool number (`tool`, `inner_tool`) or machine", body = Problem, content_type = "application/problem+json"),
         (status = 413, body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
         (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json"),

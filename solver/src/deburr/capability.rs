@@ -40,7 +40,8 @@ pub struct DeburrAnswer {
     /// program visits them (the fields beside it are those of the first).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub holes: Option<Vec<HoleAnswer>>,
-    /// With `holes`: the order the program visits the loops in and the travel it saves.
+    /// With `holes`, `pattern` or `edge: both`: the order the program visits the loops in and the
+    /// travel it saves.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub visiting_order: Option<VisitingOrder>,
     /// The loop of centres, leads, summary and warnings.
