@@ -490,6 +490,57 @@ mod tests {
     }
 
     #[test]
+    fn stops_inside_an_operation_are_kept_and_counted() {
+        let mut path = Toolpath::default();
+        path.rapid(Vec3::new(1.0, 2.0, 30.0));
+        path.linear(Vec3::new(1.0, 2.0, 20.0), 300.0);
+        path.rapid(Vec3::new(1.0, 2.0, 30.0));
+        path.rapid(Vec3::new(5.0, 2.0, 30.0));
+        path.linear(Vec3::new(5.0, 2.0, 20.0), 300.0);
+        let program = Program {
+            dialect: Dialect::Fanuc,
+            number: 1000,
+            title: "kerf deburr",
+            comments: Vec::new(),
+            tool: ToolCall::Table(7),
+            spindle_rpm: 6000.0,
+            spindle_direction: SpindleDirection::Cw,
+            safe_z: 30.0,
+            blend_tolerance: 0.01,
+            plunges: None,
+            path: &path,
+        };
+        let stop = crate::gcode::ProgramStop {
+            before: 3,
+            notice: Some("turn the tube".to_owned()),
+            tool: Some(ToolCall::Table(8)),
+            spindle_rpm: 5000.0,
+        };
+        let text = crate::gcode::write_changing(&program, &[stop]);
+        assert!(
+            text.contains("G00 X1.0000 Y2.0000 Z30.0000\nM05\nG00 Z30.0000\n(TURN THE TUBE)\nM00\nT8 M06\nG00 G43 H8 Z30.0000\nS5000 M03\nG00 X5.0000"),
+            "{text}"
+        );
+        let section = Section::parse(&text).expect("a section with a stop");
+        assert_eq!((section.tool_number, section.changes.clone()), (Some(7), vec![Some(8)]));
+        // 10 mm down at 300 mm/min twice, the rapids up and across, two tool changes.
+        let operation = Operation {
+            name: "deburr",
+            program: Some(&text),
+            problem: None,
+            tool: Some("ball R3"),
+            rapid_feed: Some(6000.0),
+            tool_change_s: Some(5.0),
+        };
+        let time = estimated_time_s(&section, &operation);
+        assert!((time - (2.0 * 10.0 / 300.0 * 60.0 + 14.0 / 6000.0 * 60.0 + 10.0)).abs() < 1e-9, "{time}");
+        let job = Job { dialect: Dialect::Fanuc, number: 2001, title: "kerf job", coolant: Coolant::Off };
+        let joined = write(&job, &[operation]).unwrap();
+        assert!(joined.contains("TOOLS T7 T8,") && joined.contains("(1 DEBURR: T7 THEN T8 BALL R3"), "{joined}");
+        assert_eq!(joined.matches("M06").count(), 2);
+    }
+
+    #[test]
     fn default_numbers_stay_in_the_job_range() {
         assert_eq!(number_for_job(1), 2000);
         assert_eq!(number_for_job(6000), 7999);
