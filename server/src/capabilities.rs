@@ -80,6 +80,14 @@ macro_rules! registry {
                 }
             }
 
+            /// Every reference of the operation, for a lookup to fetch: its [`Self::refs`], then
+            /// one per further tool (deburr's `inner_tool`).
+            pub fn all_refs(&self) -> Vec<Refs<'_>> {
+                match self {
+                    $(Self::$variant(request) => capability::all_refs::<$capability>(request),)+
+                }
+            }
+
             /// Checks that the operation's references resolve against `lookup`.
             ///
             /// # Errors
@@ -213,9 +221,11 @@ pub fn material_in(materials: &[Material], name: &str) -> Option<Material> {
 /// The one resolution step, for capability `C`: its request's references from `lookup`.
 ///
 /// # Errors
-/// 404 naming `tool`, `machine` or `material` when a reference is unknown.
+/// 404 naming `tool`, `machine`, `material` or another tool's field (`inner_tool`) when a
+/// reference is unknown.
 pub fn resolve<C: Capability>(request: &C::Request, lookup: &impl Lookup) -> Result<Resolved<C::Tool>, AppError> {
-    resolve_refs(C::refs(request), lookup)
+    capability::resolve_request::<C>(request, lookup)
+        .map_err(|unresolved| AppError::unknown(unresolved.field, unresolved.message))
 }
 
 /// [`resolve`] for references outside a capability (the contour loops endpoint).

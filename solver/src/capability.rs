@@ -36,6 +36,12 @@ pub trait Capability {
     /// The tool, machine and material the request refers to.
     fn refs(request: &Self::Request) -> Refs<'_>;
 
+    /// Tools the request names besides `refs().tool` (deburr's `inner_tool`), each with its
+    /// field; resolved like `tool` into [`Resolved::other_tools`], in this order. Default none.
+    fn other_tools(_request: &Self::Request) -> Vec<OtherTool<'_>> {
+        Vec::new()
+    }
+
     /// Checks the output options before any work, so a program that cannot be written is refused
     /// at once instead of after the computation.
     ///
@@ -97,6 +103,23 @@ pub struct Refs<'a> {
     pub material: Option<&'a str>,
 }
 
+/// A tool a request names besides `tool` (deburr's `inner_tool`): the request field that holds
+/// it and the reference. An unknown number is reported at `field`, as `tool` is.
+#[derive(Debug, Clone, Copy)]
+pub struct OtherTool<'a> {
+    /// The request field (`inner_tool`).
+    pub field: &'static str,
+    /// A number in the tool table or the tool itself.
+    pub tool: &'a ToolRef,
+}
+
+impl<'a> OtherTool<'a> {
+    /// This tool's reference alone, for a lookup that fetches what [`Refs`] name.
+    pub fn refs(self) -> Refs<'a> {
+        Refs { tool: Some(self.tool), ..Refs::default() }
+    }
+}
+
 /// Where resolution finds what a request refers to: the tool table, machines registry and
 /// materials library (the server's store), or a job's own tools, machines and materials.
 pub trait Lookup {
@@ -117,6 +140,8 @@ pub struct Resolved<T> {
     pub machine: Option<MachineProfile>,
     /// The work material the request names, if any.
     pub material: Option<Material>,
+    /// The tools of [`Capability::other_tools`], in its order (empty for most capabilities).
+    pub other_tools: Vec<Tool>,
 }
 
 /// How a capability's tool need is met by what resolution found.
@@ -177,7 +202,44 @@ pub fn resolve<T: ToolNeed>(refs: Refs<'_>, lookup: &impl Lookup) -> Result<Reso
             message: format!("material {name:?} is not in the materials library (GET /api/v1/materials)"),
         })?),
     };
-    Ok(Resolved { tool, machine, material })
+    Ok(Resolved { tool, machine, material, other_tools: Vec::new() })
+}
+
+/// The tools `others` name, from `lookup` (inline tools as given), in order.
+///
+/// # Errors
+/// [`Unresolved`] at the other tool's field for an unknown tool number.
+pub fn resolve_other_tools(others: &[OtherTool<'_>], lookup: &impl Lookup) -> Result<Vec<Tool>, Unresolved> {
+    others
+        .iter()
+        .map(|other| match other.tool {
+            ToolRef::Inline(tool) => Ok(tool.clone()),
+            ToolRef::Number(number) => lookup.tool(*number).ok_or_else(|| Unresolved {
+                field: other.field,
+                message: format!("tool {number} ({}) is not in the tool table", other.field),
+            }),
+        })
+        .collect()
+}
+
+/// The one resolution step of capability `C`'s request: [`resolve`] of its [`Capability::refs`]
+/// and its [`Capability::other_tools`].
+///
+/// # Errors
+/// As [`resolve`] and [`resolve_other_tools`].
+pub fn resolve_request<C: Capability>(
+    request: &C::Request,
+    lookup: &impl Lookup,
+) -> Result<Resolved<C::Tool>, Unresolved> {
+    let mut resolved = resolve(C::refs(request), lookup)?;
+    resolved.other_tools = resolve_other_tools(&C::other_tools(request), lookup)?;
+    Ok(resolved)
+}
+
+/// Every reference of capability `C`'s request, for a lookup to fetch: its [`Capability::refs`],
+/// then one per other tool.
+pub fn all_refs<C: Capability>(request: &C::Request) -> Vec<Refs<'_>> {
+    std::iter::once(C::refs(request)).chain(C::other_tools(request).into_iter().map(OtherTool::refs)).collect()
 }
 
 /// Progress reporting and cancellation for long runs.
