@@ -464,8 +464,14 @@ async fn over_the_time_limit_is_422_and_frees_the_slot() {
         let answer = problem(app.post_json("/api/v1/predict", &long_request()).await, 422).await;
         assert_eq!(answer["code"], "E_TIMEOUT");
         assert!(answer["detail"].as_str().unwrap().contains("/api/v1/jobs"), "{answer}");
+        assert!(answer["detail"].as_str().unwrap().contains("limit of 0.3 s"), "{answer}");
     }
-    predict(&app, &raster_request(finishing_tool(), 2, 3)).await;
+    // The small request gets the slot: answered, or itself timed out on a loaded machine (300 ms
+    // of a debug build), but never refused 429 for a slot the abandoned work still holds.
+    let response = app.post_json("/api/v1/predict", &raster_request(finishing_tool(), 2, 3)).await;
+    let status = response.status().as_u16();
+    let body = response.text().await.unwrap();
+    assert!(status == 200 || (status == 422 && body.contains("E_TIMEOUT")), "{status}: {body}");
 }
 
 #[tokio::test(flavor = "multi_thread")]
