@@ -8,7 +8,7 @@
 -- [units_from, units_to) of it) or 'finish'. `work` is the estimated core-seconds, `weight` the
 -- chunk's share of its operation (an operation's chunks weigh 1 together; the job's progress is
 -- the weighted sum of its chunks' progress over its operations). A done part keeps its output,
--- gzip-compressed JSON, with its uncompressed length and solve time, until the finish step has
+-- gzip-compressed CBOR, with its uncompressed length and solve time, until the finish step has
 -- merged it (counted in `jobs.stored_bytes` meanwhile).
 ALTER TABLE job_chunks ADD COLUMN operation BIGINT;
 UPDATE job_chunks SET operation = position;

@@ -89,12 +89,12 @@ macro_rules! registry {
                 }
             }
 
-            /// Solves part `part` of the operation as a job does; its output as JSON, for the
+            /// Solves part `part` of the operation as a job does; its output, serialised for the
             /// finish step.
             ///
             /// # Errors
             /// The problem of the refusal (cancellation is `E_CANCELLED`).
-            pub fn run_part(&self, lookup: &impl Lookup, part: &Part, run: &Run<'_>) -> Result<PartJson, AppError> {
+            pub fn run_part(&self, lookup: &impl Lookup, part: &Part, run: &Run<'_>) -> Result<PartBytes, AppError> {
                 match self {
                     $(Self::$variant(request) => part_output::<$capability>(request, lookup, part, run),)+
                 }
@@ -323,25 +323,26 @@ fn split<C: Capability>(request: &C::Request, lookup: &impl Lookup, sizing: &Siz
     C::split(request, &resolved, sizing)
 }
 
-/// A part's output, as JSON, and how long its solve took.
+/// A part's output, serialised (CBOR: every number exactly as computed, non-finite ones too), and
+/// how long its solve took.
 #[derive(Debug)]
-pub struct PartJson {
+pub struct PartBytes {
     /// The output.
-    pub json: Vec<u8>,
+    pub bytes: Vec<u8>,
     /// Seconds.
     pub seconds: f64,
 }
 
-/// Where a part's output goes: JSON bytes (the job layer compresses and stores them).
+/// Where a part's output goes: CBOR bytes (the job layer compresses and stores them).
 #[derive(Debug, Default)]
-struct JsonSink(Vec<u8>);
+struct CborSink(Vec<u8>);
 
-impl PartSink for JsonSink {
+impl PartSink for CborSink {
     fn put<T: Serialize>(&mut self, value: &T) -> Result<(), SolverError> {
-        self.0 = serde_json::to_vec(value).map_err(|error| {
+        self.0.clear();
+        ciborium::into_writer(value, &mut self.0).map_err(|error| {
             SolverError::new(kerf_solver::ErrorCode::Internal, format!("a part's output cannot be written: {error}"))
-        })?;
-        Ok(())
+        })
     }
 }
 
@@ -350,12 +351,12 @@ fn part_output<C: Capability>(
     lookup: &impl Lookup,
     part: &Part,
     run: &Run<'_>,
-) -> Result<PartJson, AppError> {
+) -> Result<PartBytes, AppError> {
     let resolved = resolve::<C>(request, lookup)?;
     let started = Instant::now();
-    let mut sink = JsonSink::default();
+    let mut sink = CborSink::default();
     C::solve_part(request, resolved, part, run, &mut sink)?;
-    Ok(PartJson { json: sink.0, seconds: started.elapsed().as_secs_f64() })
+    Ok(PartBytes { bytes: sink.0, seconds: started.elapsed().as_secs_f64() })
 }
 
 fn finish_output<C: Capability>(

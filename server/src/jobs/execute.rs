@@ -10,7 +10,7 @@ use kerf_solver::capability::{Control, Part, Purpose, Run, Split};
 
 use super::file::JobFile;
 use super::parts::{StoredParts, sizing};
-use crate::capabilities::{Operation, PartJson, Stored};
+use crate::capabilities::{Operation, PartBytes, Stored};
 use crate::error::{AppError, Problem};
 
 /// Why a job did not finish.
@@ -76,7 +76,7 @@ pub fn execute_part(
     part: &Part,
     progress: &(dyn Fn(f64) + Sync),
     cancelled: &AtomicBool,
-) -> Result<PartJson, JobFailure> {
+) -> Result<PartBytes, JobFailure> {
     within(job, index, progress, cancelled, |operation, run| operation.run_part(job, part, run))
 }
 

@@ -35,7 +35,7 @@ pub fn sizing() -> Sizing {
     Sizing { part_seconds, max_parts: MAX_PARTS }
 }
 
-/// The stored outputs of an operation's parts (gzip-compressed JSON, in order), each
+/// The stored outputs of an operation's parts (gzip-compressed CBOR, in order), each
 /// decompressed only when the finish step reads it.
 #[derive(Debug)]
 pub struct StoredParts {
@@ -60,10 +60,10 @@ impl PartSource for StoredParts {
         let unreadable = |error: &dyn std::fmt::Display| {
             SolverError::new(ErrorCode::Internal, format!("a part's output is unreadable: {error}"))
         };
-        let mut json = Vec::new();
-        if let Err(error) = GzDecoder::new(compressed.as_slice()).read_to_end(&mut json) {
+        let mut bytes = Vec::new();
+        if let Err(error) = GzDecoder::new(compressed.as_slice()).read_to_end(&mut bytes) {
             return Some(Err(unreadable(&error)));
         }
-        Some(serde_json::from_slice(&json).map_err(|error| unreadable(&error)))
+        Some(ciborium::from_reader(bytes.as_slice()).map_err(|error| unreadable(&error)))
     }
 }

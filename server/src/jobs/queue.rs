@@ -238,8 +238,8 @@ async fn run(runner: &JobRunner, db: &Db, slots: &Arc<Semaphore>, Claimed { work
                 let output = execute_part(&job, operation, &part, &report, &task_cancelled)?;
                 Output::Part(PartOutput {
                     operation: job.operations[operation].name().to_owned(),
-                    gz: gzip(&output.json),
-                    bytes: output.json.len(),
+                    gz: gzip(&output.bytes),
+                    bytes: output.bytes.len(),
                     seconds: output.seconds,
                 })
             }

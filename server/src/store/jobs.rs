@@ -883,7 +883,7 @@ async fn finishing(
 pub struct PartOutput {
     /// The operation's name.
     pub operation: String,
-    /// The output, gzip-compressed JSON.
+    /// The output, gzip-compressed CBOR.
     pub gz: Vec<u8>,
     /// Its uncompressed length, bytes.
     pub bytes: usize,
