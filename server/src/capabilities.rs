@@ -6,7 +6,9 @@
 use std::time::Instant;
 
 use kerf_solver::SolverError;
-use kerf_solver::capability::{self, Capability, Lookup, OutputOptions, Refs, Resolved, Run, ToolNeed};
+use kerf_solver::capability::{
+    self, Capability, Lookup, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing, Split, ToolNeed,
+};
 use kerf_solver::machine::MachineProfile;
 use kerf_solver::material::Material;
 use kerf_solver::tool::Tool;
@@ -106,6 +108,46 @@ macro_rules! registry {
             pub fn run(&self, lookup: &impl Lookup, run: &Run<'_>, output: &OutputOptions) -> Result<Stored, AppError> {
                 match self {
                     $(Self::$variant(request) => store_output::<$capability>(request, lookup, run, output),)+
+                }
+            }
+
+            /// How the operation divides into parts that different workers solve at once
+            /// ([`Capability::split`]), resolved against `lookup`; `None`: it is solved whole.
+            pub fn split(&self, lookup: &impl Lookup, sizing: &Sizing) -> Option<Split> {
+                match self {
+                    $(Self::$variant(request) => split::<$capability>(request, lookup, sizing),)+
+                }
+            }
+
+            /// Solves part `part` of the operation as a job does; its output, serialised for the
+            /// finish step.
+            ///
+            /// # Errors
+            /// The problem of the refusal (cancellation is `E_CANCELLED`).
+            pub fn run_part(&self, lookup: &impl Lookup, part: &Part, run: &Run<'_>) -> Result<PartBytes, AppError> {
+                match self {
+                    $(Self::$variant(request) => part_output::<$capability>(request, lookup, part, run),)+
+                }
+            }
+
+            /// The finish step of a split operation: merges its parts' outputs (`parts`, in
+            /// order) into what [`Operation::run`] stores for the whole operation. `seconds` is
+            /// what the parts' solves took, for the answers that report their time.
+            ///
+            /// # Errors
+            /// The problem of the refusal (cancellation is `E_CANCELLED`).
+            pub fn finish(
+                &self,
+                lookup: &impl Lookup,
+                parts: &mut impl PartSource,
+                run: &Run<'_>,
+                output: &OutputOptions,
+                seconds: f64,
+            ) -> Result<Stored, AppError> {
+                match self {
+                    $(Self::$variant(request) => {
+                        finish_output::<$capability>(request, lookup, parts, run, output, seconds)
+                    })+
                 }
             }
 
@@ -297,6 +339,72 @@ fn store_output<C: Capability>(
     let started = Instant::now();
     let mut answer = C::solve(request, resolved, run)?;
     C::record_time(&mut answer, started.elapsed().as_secs_f64());
+    stored::<C>(request, answer, output)
+}
+
+fn split<C: Capability>(request: &C::Request, lookup: &impl Lookup, sizing: &Sizing) -> Option<Split> {
+    let resolved = resolve::<C>(request, lookup).ok()?;
+    C::split(request, &resolved, sizing)
+}
+
+/// A part's output, serialised (CBOR: every number exactly as computed, non-finite ones too), and
+/// how long its solve took.
+#[derive(Debug)]
+pub struct PartBytes {
+    /// The output.
+    pub bytes: Vec<u8>,
+    /// Seconds.
+    pub seconds: f64,
+}
+
+/// Where a part's output goes: CBOR bytes (the job layer compresses and stores them).
+#[derive(Debug, Default)]
+struct CborSink(Vec<u8>);
+
+impl PartSink for CborSink {
+    fn put<T: Serialize>(&mut self, value: &T) -> Result<(), SolverError> {
+        self.0.clear();
+        ciborium::into_writer(value, &mut self.0).map_err(|error| {
+            SolverError::new(kerf_solver::ErrorCode::Internal, format!("a part's output cannot be written: {error}"))
+        })
+    }
+}
+
+fn part_output<C: Capability>(
+    request: &C::Request,
+    lookup: &impl Lookup,
+    part: &Part,
+    run: &Run<'_>,
+) -> Result<PartBytes, AppError> {
+    let resolved = resolve::<C>(request, lookup)?;
+    let started = Instant::now();
+    let mut sink = CborSink::default();
+    C::solve_part(request, resolved, part, run, &mut sink)?;
+    Ok(PartBytes { bytes: sink.0, seconds: started.elapsed().as_secs_f64() })
+}
+
+fn finish_output<C: Capability>(
+    request: &C::Request,
+    lookup: &impl Lookup,
+    parts: &mut impl PartSource,
+    run: &Run<'_>,
+    output: &OutputOptions,
+    seconds: f64,
+) -> Result<Stored, AppError> {
+    let resolved = resolve::<C>(request, lookup)?;
+    let started = Instant::now();
+    let mut answer = C::finish(request, resolved, parts, run)?;
+    C::record_time(&mut answer, seconds + started.elapsed().as_secs_f64());
+    stored::<C>(request, answer, output)
+}
+
+/// A job's stored output of `answer`: its program written with `output`, the answer trimmed for
+/// storage.
+fn stored<C: Capability>(
+    request: &C::Request,
+    mut answer: C::Answer,
+    output: &OutputOptions,
+) -> Result<Stored, AppError> {
     let program = capability::program::<C>(request, &answer, output);
     C::for_storage(&mut answer);
     let result = serde_json::value::to_raw_value(&answer).map_err(|error| AppError::Internal(error.into()))?;

@@ -75,6 +75,133 @@ pub trait Capability {
 
     /// Records how long the solve took, for capabilities whose answer reports it.
     fn record_time(_answer: &mut Self::Answer, _seconds: f64) {}
+
+    /// Splits the request's work into parts that different workers may solve at once (issue 12,
+    /// a job split into chunks): ranges of its units of work (prediction passes, candidate
+    /// paths) sized after `sizing`, each solved by [`Capability::solve_part`], then merged by
+    /// [`Capability::finish`] into the answer [`Capability::solve`] gives. `None` (the default):
+    /// the request is solved whole, as when it is refused (solving it whole reports why) or too
+    /// small to be worth splitting.
+    fn split(_request: &Self::Request, _context: &Resolved<Self::Tool>, _sizing: &Sizing) -> Option<Split> {
+        None
+    }
+
+    /// Solves part `part` of a request [`Capability::split`] split, handing what the finish step
+    /// needs to `sink` (the caller stores it, in any serde format, until the finish step).
+    ///
+    /// # Errors
+    /// The capability's refusals, as [`Capability::solve`]; `E_INTERNAL` for a capability that
+    /// does not split.
+    fn solve_part(
+        _request: &Self::Request,
+        _context: Resolved<Self::Tool>,
+        _part: &Part,
+        _run: &Run<'_>,
+        _sink: &mut impl PartSink,
+    ) -> Result<(), SolverError> {
+        Err(not_split(Self::NAME))
+    }
+
+    /// The finish step of a split request: reads the parts' outputs from `parts`, in the order
+    /// [`Capability::split`] gave the parts, and gives the answer [`Capability::solve`] would
+    /// give for the whole request, equal field for field (its program then byte for byte).
+    ///
+    /// # Errors
+    /// As [`Capability::solve`]; `E_INTERNAL` when the parts do not belong to the request.
+    fn finish(
+        _request: &Self::Request,
+        _context: Resolved<Self::Tool>,
+        _parts: &mut impl PartSource,
+        _run: &Run<'_>,
+    ) -> Result<Self::Answer, SolverError> {
+        Err(not_split(Self::NAME))
+    }
+}
+
+/// How large the parts of a split request should be (see [`Capability::split`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sizing {
+    /// The work one part should hold, in seconds of one core of the reference machine (the
+    /// capabilities' cost models are measured on it; README, "More than one machine").
+    pub part_seconds: f64,
+    /// The most parts one request is split into.
+    pub max_parts: usize,
+}
+
+/// A request split into parts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Split {
+    /// The parts, in order: their units together are the request's, each once.
+    pub parts: Vec<Part>,
+    /// The estimated work of the finish step, core-seconds.
+    pub finish_seconds: f64,
+}
+
+impl Split {
+    /// `units` cut into parts of about `sizing.part_seconds` each, given the work of one unit and
+    /// the fixed work every part repeats (reading the request); `None` when one part would do.
+    /// Parts are at least `10 × setup_seconds` long, so the repeated setup stays under a tenth.
+    #[must_use]
+    pub fn even(
+        units: std::ops::Range<usize>,
+        unit_seconds: f64,
+        setup_seconds: f64,
+        finish_seconds: f64,
+        sizing: &Sizing,
+    ) -> Option<Self> {
+        let count = units.len();
+        let total = count as f64 * unit_seconds;
+        let per_part = sizing.part_seconds.max(10.0 * setup_seconds);
+        if !(total.is_finite() && per_part > 0.0) {
+            return None;
+        }
+        let parts = ((total / per_part).round() as usize).clamp(1, sizing.max_parts.max(1)).min(count);
+        if parts < 2 {
+            return None;
+        }
+        let parts = (0..parts)
+            .map(|k| {
+                let from = units.start + count * k / parts;
+                let to = units.start + count * (k + 1) / parts;
+                Part { units: from..to, seconds: (to - from) as f64 * unit_seconds + setup_seconds }
+            })
+            .collect();
+        Some(Self { parts, finish_seconds })
+    }
+}
+
+/// One part of a split request: a range of its units of work.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Part {
+    /// The units, `[start, end)` (passes, candidate paths).
+    pub units: std::ops::Range<usize>,
+    /// The estimated work, core-seconds.
+    pub seconds: f64,
+}
+
+/// Where a part's output goes ([`Capability::solve_part`]).
+pub trait PartSink {
+    /// Stores `value` as the part's output.
+    ///
+    /// # Errors
+    /// `E_INTERNAL` when it cannot be written.
+    fn put<T: Serialize>(&mut self, value: &T) -> Result<(), SolverError>;
+}
+
+/// The stored outputs of a split request's parts, in order ([`Capability::finish`]).
+pub trait PartSource {
+    /// How many parts there are.
+    fn count(&self) -> usize;
+
+    /// The next part's output, read as `T`; `None` after the last.
+    ///
+    /// # Errors
+    /// `E_INTERNAL` when it cannot be read as `T`.
+    fn next_part<T: DeserializeOwned>(&mut self) -> Option<Result<T, SolverError>>;
+}
+
+fn not_split(name: &str) -> SolverError {
+    SolverError::new(ErrorCode::Internal, format!("{name} requests are not split into parts"))
 }
 
 /// The documentation of a capability's endpoint `POST /api/v1/{NAME}` in the OpenAPI document.

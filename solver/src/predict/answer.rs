@@ -1,7 +1,7 @@
 //! What a prediction request answers (api.md, Error prediction): one record per pass in path
 //! order, statistics, warnings, and (not serialised) what the corrected program needs.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::job::NodeSource;
 use super::request::Method;
@@ -9,7 +9,7 @@ use crate::error::Warning;
 use crate::geometry::Vec3;
 
 /// What happened at a pass (§5).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum PassStatus {
@@ -28,7 +28,7 @@ pub enum PassStatus {
 }
 
 /// Remarks on a pass's prediction (§5).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum PassFlag {
@@ -60,7 +60,7 @@ pub enum PassFlag {
 }
 
 /// Force and deflection over one revolution (§1.3 O2).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct PassHistory {
     /// Rotation step, degrees (ψ_m = m·step).
