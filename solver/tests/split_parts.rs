@@ -35,7 +35,7 @@ impl PartSource for Texts {
 }
 
 fn context(tool: &Tool) -> Resolved<Tool> {
-    Resolved { tool: tool.clone(), machine: None, material: None }
+    Resolved { tool: tool.clone(), machine: None, material: None, other_tools: Vec::new() }
 }
 
 /// Splits into parts of `part_seconds`, solves them apart and finishes: the answer's JSON and
