@@ -25,7 +25,8 @@ pub struct PredictCapability;
 #[derive(Debug, Clone, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct Timings {
-    /// Wall time of the prediction and correction, ms.
+    /// Wall time of the prediction and correction, ms (a job split into parts on several
+    /// workers: the parts' times added up, and the finish step's).
     pub solve_ms: f64,
     /// Passes predicted (those in `pass_range`, every round).
     pub passes: usize,
