@@ -6,6 +6,8 @@
 mod support;
 
 use kerf_solver::capability::{self, Capability, OutputOptions, PartSink, PartSource, Resolved, Run, Sizing, Split};
+use kerf_solver::engagement::{EngagementCapability, EngagementRequest};
+use kerf_solver::machine::MachineProfile;
 use kerf_solver::predict::{CorrectionOptions, Method, PredictCapability, PredictRequest};
 use kerf_solver::tool::Tool;
 use serde::Serialize;
@@ -98,6 +100,66 @@ fn what_is_not_split() {
     assert!(split_and_finish(&request, &tool, 1e-3).is_none());
 }
 
+/// Three candidate paths through a 60 × 40 mm block, cut by a 4-flute Ø10 end mill at 2 mm a_p
+/// with Kienzle forces, on a machine with a block time and accelerations (blocks, cycle time).
+fn engagement_request(step: f64) -> (EngagementRequest, Tool, MachineProfile) {
+    let request = serde_json::from_value(serde_json::json!({
+        "tool": 1, "machine": "mill",
+        "stock": {"polygon": [[0, 0], [60, 0], [60, 40], [0, 40]]},
+        "paths": [
+            {"name": "straight", "path": [[-10, 20], [70, 20]]},
+            {"name": "zig-zag", "path": [[-10, 5], [70, 5], [70, 15], [-10, 15], [-10, 25], [70, 25]]},
+            {"name": "deeper", "path": [[-10, 30], [35, 20], [70, 35]], "axial_depth": 3},
+        ],
+        "spindle_rpm": 8000, "feed_per_tooth": 0.05, "flute_counts": [2, 3, 4],
+        "thickness_limit": 0.08, "step": step, "kienzle": {"kc11": 1800, "mc": 0.25}, "axial_depth": 2,
+        "candidate": 1,
+    }))
+    .unwrap();
+    let mut tool = Tool::new(kerf_solver::tool::ToolKind::Flat, 5.0);
+    tool.flutes = 4;
+    let machine = serde_json::from_value(serde_json::json!({
+        "name": "mill", "block_time_ms": 4, "max_feed": 12000, "max_accel": 2000, "dialect": "linuxcnc"
+    }))
+    .unwrap();
+    (request, tool, machine)
+}
+
+#[test]
+fn engagement_candidates_split_into_parts_are_the_whole_comparison() {
+    let (request, tool, machine) = engagement_request(0.05);
+    let context =
+        || Resolved { tool: tool.clone(), machine: Some(machine.clone()), material: None, other_tools: Vec::new() };
+    let whole = EngagementCapability::solve(&request, context(), &Run::default()).unwrap();
+    let output = OutputOptions::default();
+    let whole_program = capability::program::<EngagementCapability>(&request, &whole, &output).unwrap();
+    assert!(whole.cycle_time.is_some() && whole.result.candidates().iter().all(|c| c.blocks.is_some()));
+    let Split { parts, .. } =
+        EngagementCapability::split(&request, &context(), &Sizing { part_seconds: 1e-4, max_parts: 16 })
+            .expect("three candidates split");
+    assert_eq!(parts.len(), 3);
+    let mut texts = Texts::default();
+    for part in &parts {
+        EngagementCapability::solve_part(&request, context(), part, &Run::default(), &mut texts).unwrap();
+    }
+    let merged = EngagementCapability::finish(&request, context(), &mut texts, &Run::default()).unwrap();
+    assert!(serde_json::to_string(&merged).unwrap() == serde_json::to_string(&whole).unwrap());
+    for candidate in 0..3 {
+        let output = OutputOptions { candidate: Some(candidate), ..output };
+        assert!(
+            capability::program::<EngagementCapability>(&request, &merged, &output).unwrap()
+                == capability::program::<EngagementCapability>(&request, &whole, &output).unwrap(),
+            "candidate {candidate}'s program"
+        );
+    }
+    assert!(
+        capability::program::<EngagementCapability>(&request, &merged, &OutputOptions::default()).unwrap()
+            == whole_program
+    );
+    // One path, or parts that one would hold, stay whole.
+    assert!(EngagementCapability::split(&request, &context(), &Sizing { part_seconds: 1e6, max_parts: 16 }).is_none());
+}
+
 /// Process CPU time (user + system) in seconds, from /proc (0 where unavailable).
 fn cpu_seconds() -> f64 {
     let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else { return 0.0 };
@@ -126,15 +188,20 @@ fn cost_model() {
         eprintln!("{label}: {cpu:.3} s CPU ({wall:.3} s wall), {:.3e} core-s per unit of {count}", cpu / count as f64);
         cpu
     };
-    for (method, resolution, cutting) in [
-        (Method::Sampling, 256, true),
-        (Method::Sampling, 256, false),
-        (Method::Sampling, 128, true),
-        (Method::Sampling, 512, true),
-        (Method::DepthBuffer, 256, true),
-        (Method::DepthBuffer, 128, true),
+    // The seed's job is the same raster at a 0.29963 mm pick and step (286 225 passes): three
+    // times the passes around each one.
+    for (method, resolution, cutting, pick) in [
+        (Method::Sampling, 256, true, 0.5),
+        (Method::Sampling, 256, false, 0.5),
+        (Method::Sampling, 128, true, 0.5),
+        (Method::Sampling, 512, true, 0.5),
+        (Method::DepthBuffer, 256, true, 0.5),
+        (Method::DepthBuffer, 128, true, 0.5),
+        (Method::Sampling, 256, true, 0.29963),
+        (Method::Sampling, 256, true, 1.0),
+        (Method::DepthBuffer, 256, true, 0.29963),
     ] {
-        let (mut request, tool, moves) = support::raster_request(160.0, 0.5, 0.5, method, resolution);
+        let (mut request, tool, moves) = support::raster_request(160.0, pick, pick, method, resolution);
         if !cutting {
             request.cutting = None;
         }
@@ -142,8 +209,26 @@ fn cost_model() {
         request.pass_range = Some([middle, middle]);
         let setup = measure(&format!("setup, {moves} passes"), &request, &tool, moves);
         request.pass_range = Some([middle, middle + slice]);
-        let total = measure(&format!("{method:?} N = {resolution}, force {cutting}"), &request, &tool, slice);
+        let total =
+            measure(&format!("{method:?} N = {resolution}, force {cutting}, pick {pick}"), &request, &tool, slice);
         eprintln!("  per pass without the setup: {:.3e} core-s", (total - setup) / slice as f64);
+    }
+    // Engagement: core-seconds per sample of the exact engine, per flute count.
+    for counts in [vec![2], vec![2, 3, 4]] {
+        let (mut request, tool, machine) = engagement_request(0.005);
+        request.flute_counts = Some(counts.clone());
+        let context = Resolved { tool: tool.clone(), machine: Some(machine), material: None, other_tools: Vec::new() };
+        let (started, cpu) = (std::time::Instant::now(), cpu_seconds());
+        let answer = pool.install(|| EngagementCapability::solve(&request, context, &Run::default()).unwrap());
+        let cpu = cpu_seconds() - cpu;
+        let samples: usize = answer.result.candidates().iter().map(|c| c.samples.len()).sum();
+        eprintln!(
+            "engagement, exact, {} flute counts: {samples} samples, {cpu:.3} s CPU ({:.3} s wall), {:.3e} core-s per \
+             sample and flute count",
+            counts.len(),
+            started.elapsed().as_secs_f64(),
+            cpu / (samples * counts.len()) as f64
+        );
     }
     // The finish step: the whole path's passes merged (all `not_predicted` but one slice, which
     // costs the same to merge), corrected and written as a program.

@@ -128,9 +128,11 @@ def measure(label, kerf, database, workers, body, postgres=None):
         result = job["results"][0]["result"]
         passes, solve = result["summary"]["passes"], result["timings"]["solve_ms"] / 1000
         print(f"{label:34} {passes} passes: upload to done {wall:7.1f} s ({passes / wall:6.0f} passes/s), "
-              f"solve {solve:7.1f} s, outside the solver {wall - solve:5.1f} s, kerf CPU {cpu:7.1f} s, "
-              f"load {load_before} -> {load()}", flush=True)
-        if postgres:
+              f"kerf CPU {cpu:7.1f} s ({cpu / passes * 1e3:.2f} ms per pass), load {load_before} -> {load()}",
+              flush=True)
+        if not postgres:
+            print(f"{'':34} solve {solve:.1f} s, outside the solver {wall - solve:.1f} s", flush=True)
+        else:
             # Parts: their count, solve time (summed over workers) and the finish step's time.
             rows = postgres.query("SELECT kind, COUNT(*), SUM(solve_seconds), SUM(work), MAX(attempts) "
                                   "FROM job_chunks GROUP BY kind ORDER BY kind")
@@ -143,7 +145,7 @@ def measure(label, kerf, database, workers, body, postgres=None):
                           f"(estimated {float(work):.1f} core-s)", flush=True)
             print(f"{'':34} finish step (merge, correct, write the answer and program): "
                   f"{solve - parts_seconds:.1f} s", flush=True)
-        return wall
+        return wall, cpu
     finally:
         for p in processes:
             p.terminate()
@@ -159,13 +161,16 @@ def main():
     try:
         body = json.dumps(job).encode()
         print(f"job file {len(body) / 1e6:.1f} MB", flush=True)
-        measure("SQLite, one process", kerf, os.path.join(folder, "kerf.db"), 0, body)
+        alone = measure("SQLite, one process", kerf, os.path.join(folder, "kerf.db"), 0, body)
         for workers in (1, 2):
             postgres = Postgres()
             try:
-                measure(f"PostgreSQL, {workers} worker process(es)", kerf, postgres.url, workers, body, postgres)
+                shared = measure(f"PostgreSQL, {workers} worker process(es)", kerf, postgres.url, workers, body,
+                                 postgres)
             finally:
                 postgres.stop()
+            print(f"{'':34} against one SQLite process: wall {shared[0] - alone[0]:+.1f} s, "
+                  f"CPU {shared[1] - alone[1]:+.1f} s ({(shared[1] / alone[1] - 1) * 100:+.1f} %)", flush=True)
     finally:
         shutil.rmtree(folder, ignore_errors=True)
 

@@ -27,7 +27,8 @@ pub struct PredictCapability;
 #[derive(Debug, Clone, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct Timings {
-    /// Wall time of the prediction and correction, ms.
+    /// Wall time of the prediction and correction, ms (a job split into parts on several
+    /// workers: the parts' times added up, and the finish step's).
     pub solve_ms: f64,
     /// Passes predicted (those in `pass_range`, every round).
     pub passes: usize,
@@ -248,30 +249,40 @@ struct Cost {
     finish_seconds: f64,
 }
 
-/// A pass by surface sampling: a constant (the swept volumes around the pass, the prediction
-/// stations, the force model) and a part growing with the samples, N², here at N = 256.
-/// Measured: 0.83, 0.855 and 0.96 ms per pass at N = 128, 256 and 512 (the seed's raster).
-const SAMPLING_PASS_SECONDS: [f64; 2] = [0.82e-3, 0.035e-3];
-/// A pass by the depth buffer, the same way: 1.08 and 2.0 ms at N = 128 and 256, the pixels
-/// dominate.
-const DEPTH_BUFFER_PASS_SECONDS: [f64; 2] = [0.77e-3, 1.23e-3];
-/// Reading the request, per pass of the path: 0.16 s for the 103 041 passes of the raster.
+/// A pass's core-seconds by method: `[fixed, per neighbouring pass, at N = 256]`. A pass costs a
+/// constant (its stations, the force model), a share for every pass within 2R of it (the swept
+/// volumes gathered and tested around it) and a share growing with the samples or pixels, N².
+/// Measured on the raster of `tests/predict_support` (Ø10 ball, one thread, CPU time; passes per
+/// mm² d at picks of 1, 0.5 and 0.3 mm: 1.0, 4.0 and 11.2): sampling at N = 256 took 0.50, 0.81 and
+/// 1.53 ms per pass, and 0.86 and 0.97 ms at N = 128 and 512 (d = 4.0).
+const SAMPLING_PASS_SECONDS: [f64; 3] = [0.36e-3, 0.33e-6, 0.035e-3];
+/// The depth buffer: 1.98 and 3.43 ms at N = 256 (d = 4.0, 11.2), 1.03 ms at N = 128 (d = 4.0).
+const DEPTH_BUFFER_PASS_SECONDS: [f64; 3] = [0.0, 0.64e-6, 1.26e-3];
+/// Reading the request, per pass of the path: 0.16 s for the 103 041 passes of the raster, 0.46 s
+/// for 286 225.
 const SETUP_PASS_SECONDS: f64 = 1.6e-6;
-/// The finish step, per pass of the path: 7 µs merging and writing (0.72 s for 103 041
+/// The finish step, per pass of the path: 7 µs merging and writing (0.71 s for 103 041
 /// passes), and compressing the answer's 730 bytes per pass for the store.
 const FINISH_PASS_SECONDS: f64 = 30e-6;
 
-/// The cost model of a prediction (the force model's share, under 2 % at N_t = 360, N_θ = 90,
-/// is in the constant).
+/// The cost model of a prediction. The passes around one are estimated from the passes per mm²
+/// of the path's extent in XY (a raster's density; the force model's share, under 2 % at
+/// N_t = 360, N_θ = 90, is in the constant).
 fn cost(job: &super::job::Job) -> Cost {
     let pixels = (f64::from(job.resolution) / 256.0).powi(2);
-    let [fixed, per_pixels] = match job.method {
+    let [fixed, per_neighbour, per_pixels] = match job.method {
         Method::Sampling => SAMPLING_PASS_SECONDS,
         Method::DepthBuffer => DEPTH_BUFFER_PASS_SECONDS,
     };
     let passes = job.path.passes.len() as f64;
+    let reach = std::f64::consts::PI * (2.0 * job.radius).powi(2);
+    let (lo, hi) = job.path.nodes.iter().fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), node| {
+        ([lo[0].min(node.x), lo[1].min(node.y)], [hi[0].max(node.x), hi[1].max(node.y)])
+    });
+    let area = ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(reach);
+    let neighbours = (passes * reach / area).min(passes);
     Cost {
-        pass_seconds: fixed + per_pixels * pixels,
+        pass_seconds: fixed + per_neighbour * neighbours + per_pixels * pixels,
         setup_seconds: SETUP_PASS_SECONDS * passes,
         finish_seconds: FINISH_PASS_SECONDS * passes,
     }

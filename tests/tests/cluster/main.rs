@@ -332,6 +332,29 @@ fn large_prediction() -> Value {
     job
 }
 
+/// An engagement comparison of three candidate paths through a 60 × 40 mm block, fine enough
+/// (0.003 mm steps, 140 000 samples) to be split into parts of [`PART_SECONDS`]; on a machine with a
+/// block time and accelerations (blocks, cycle time), programming the second candidate.
+fn engagement_comparison() -> Value {
+    json!({
+        "name": "engagement, three candidates",
+        "tools": [{"number": 2, "kind": "flat", "radius": 5, "flutes": 4}],
+        "machines": [{"name": "mill", "block_time_ms": 4, "max_feed": 12000, "max_accel": 2000, "dialect": "linuxcnc"}],
+        "output": {"program_number": 4343},
+        "operations": [{
+            "operation": "engagement", "tool": 2, "machine": "mill",
+            "stock": {"polygon": [[0, 0], [60, 0], [60, 40], [0, 40]]},
+            "paths": [
+                {"name": "straight", "path": [[-10, 20], [70, 20]]},
+                {"name": "zig-zag", "path": [[-10, 5], [70, 5], [70, 15], [-10, 15], [-10, 25], [70, 25]]},
+                {"name": "deeper", "path": [[-10, 30], [35, 20], [70, 35]], "axial_depth": 3}
+            ],
+            "spindle_rpm": 8000, "feed_per_tooth": 0.05, "flute_counts": [2, 3, 4], "thickness_limit": 0.08,
+            "step": 0.003, "kienzle": {"kc11": 1800, "mc": 0.25}, "axial_depth": 2, "candidate": 1
+        }]
+    })
+}
+
 /// Workers that split work into parts of this many core-seconds (`KERF_JOB_PART_S`; the default
 /// 8 would leave this test's prediction whole).
 const PART_SECONDS: &str = "1";
@@ -352,6 +375,8 @@ async fn a_prediction_splits_across_workers_and_survives_a_kill() {
     let pool = connect(&postgres).await;
     let job = large_prediction();
     let id = submit(&client, &api.base, &job).await;
+    let engagement = engagement_comparison();
+    let engagement_id = submit(&client, &api.base, &engagement).await;
 
     // The one operation is split, and both workers run parts of it at once.
     let deadline = Instant::now() + Duration::from_secs(300);
@@ -423,30 +448,45 @@ async fn a_prediction_splits_across_workers_and_survives_a_kill() {
     assert_eq!(left, 0, "every chunk done, and the parts' outputs dropped once merged");
     assert_eq!(stored, expected, "the job takes its file and its result");
 
-    // One SQLite process runs the same file whole: the same result (but for the time it took) and
-    // programs, byte for byte.
+    // The engagement comparison was split into parts too, and is done.
+    let engagement_done = poll_job(&client, &api.base, engagement_id, 900, finished).await;
+    assert_eq!(engagement_done["status"], "done", "{}", engagement_done["error"]);
+    let (engagement_parts,): (i64,) =
+        sqlx::query_as("SELECT COUNT(*) FROM job_chunks WHERE job_id = $1 AND kind = 'part' AND status = 'done'")
+            .bind(engagement_id)
+            .fetch_one(&pool)
+            .await
+            .unwrap();
+    assert!(engagement_parts >= 2, "the engagement candidates are split: {engagement_parts} parts");
+
+    // One SQLite process runs the same files whole: the same results (but for the time a
+    // prediction took) and programs, byte for byte.
     let local = TestApp::spawn_on(Store::Sqlite, |_| {}).await.unwrap();
-    let local_id = submit(&local.client, &local.base, &job).await;
-    let local_done = poll_job(&local.client, &local.base, local_id, 900, finished).await;
-    assert_eq!(local_done["status"], "done", "{}", local_done["error"]);
-    let shared = outputs(&client, &api.base, id).await;
-    let alone = outputs(&local.client, &local.base, local_id).await;
-    assert_eq!(shared.len(), 1);
-    assert!(shared[0].0.contains("\"timings\":{"), "the merged result reports its time");
-    assert!(
-        strip_timings(&shared[0].0) == strip_timings(&alone[0].0),
-        "the merged result differs from the one-process run"
-    );
-    assert!(shared[0].1 == alone[0].1, "the merged program differs from the one-process run");
     let job_program = |base: &str, id: i64| {
         let client = client.clone();
         let url = format!("{base}/api/v1/jobs/{id}/program");
         async move { client.get(url).send().await.unwrap().text().await.unwrap() }
     };
-    assert!(
-        job_program(&api.base, id).await == job_program(&local.base, local_id).await,
-        "the job's one program differs from the one-process run"
-    );
+    for (shared_id, file) in [(id, &job), (engagement_id, &engagement)] {
+        let local_id = submit(&local.client, &local.base, file).await;
+        let local_done = poll_job(&local.client, &local.base, local_id, 900, finished).await;
+        assert_eq!(local_done["status"], "done", "{}", local_done["error"]);
+        let shared = outputs(&client, &api.base, shared_id).await;
+        let alone = outputs(&local.client, &local.base, local_id).await;
+        let name = &file["name"];
+        assert_eq!(shared.len(), 1);
+        assert!(
+            strip_timings(&shared[0].0) == strip_timings(&alone[0].0),
+            "{name}: the merged result differs from the one-process run"
+        );
+        assert!(shared[0].1 == alone[0].1, "{name}: the merged program differs from the one-process run");
+        assert!(
+            job_program(&api.base, shared_id).await == job_program(&local.base, local_id).await,
+            "{name}: the job's one program differs from the one-process run"
+        );
+    }
+    let shared = outputs(&client, &api.base, id).await;
+    assert!(shared[0].0.contains("\"timings\":{"), "the merged prediction reports its time");
     pool.close().await;
     for worker in workers.into_iter().flatten() {
         worker.terminate();
