@@ -11,6 +11,7 @@ run (the machine may be shared).
 Usage (release build, PostgreSQL from Debian's package; as root it runs as the postgres user):
     cargo build --release -p kerf-server
     KERF_PREDICT_PICK=0.29963 tests/load/predict-cluster.py target/release/kerf   # the seed's size
+    tests/load/predict-cluster.py target/release/kerf sqlite 2   # only these runs
 Without KERF_PREDICT_PICK the job is predict-job.py's 103 041-pass raster.
 """
 import glob
@@ -155,22 +156,27 @@ def measure(label, kerf, database, workers, body, postgres=None):
 
 def main():
     kerf = os.path.abspath(sys.argv[1] if len(sys.argv) > 1 else "target/release/kerf")
+    # Which runs: any of sqlite, 1 and 2 (PostgreSQL with that many workers); all by default.
+    runs = sys.argv[2:] or ["sqlite", "1", "2"]
     job = load_job()
     print(f"job: {job['name']}", flush=True)
     folder = tempfile.mkdtemp(prefix="kerf-measure-")
     try:
         body = json.dumps(job).encode()
         print(f"job file {len(body) / 1e6:.1f} MB", flush=True)
-        alone = measure("SQLite, one process", kerf, os.path.join(folder, "kerf.db"), 0, body)
-        for workers in (1, 2):
+        alone = None
+        if "sqlite" in runs:
+            alone = measure("SQLite, one process", kerf, os.path.join(folder, "kerf.db"), 0, body)
+        for workers in [int(run) for run in runs if run != "sqlite"]:
             postgres = Postgres()
             try:
                 shared = measure(f"PostgreSQL, {workers} worker process(es)", kerf, postgres.url, workers, body,
                                  postgres)
             finally:
                 postgres.stop()
-            print(f"{'':34} against one SQLite process: wall {shared[0] - alone[0]:+.1f} s, "
-                  f"CPU {shared[1] - alone[1]:+.1f} s ({(shared[1] / alone[1] - 1) * 100:+.1f} %)", flush=True)
+            if alone:
+                print(f"{'':34} against one SQLite process: wall {shared[0] - alone[0]:+.1f} s, "
+                      f"CPU {shared[1] - alone[1]:+.1f} s ({(shared[1] / alone[1] - 1) * 100:+.1f} %)", flush=True)
     finally:
         shutil.rmtree(folder, ignore_errors=True)
 

@@ -11,8 +11,9 @@ use kerf_solver::capability::{PartSource, Sizing};
 use kerf_solver::{ErrorCode, SolverError};
 use serde::de::DeserializeOwned;
 
-/// Core-seconds of work per part, by default: a part takes a few seconds on a worker (4 s on a
-/// 2-core worker running one chunk at a time, 8 s running two).
+/// Core-seconds of work per part, by default: a part takes a few seconds on a worker (about 5 s
+/// on a 2-core worker running one chunk at a time, 10 s running two: README, "More than one
+/// machine").
 pub const PART_SECONDS: f64 = 8.0;
 /// Most parts one operation is split into.
 pub const MAX_PARTS: usize = 1000;
