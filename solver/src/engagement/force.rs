@@ -188,7 +188,33 @@ impl ForceModel {
     /// One tooth's sin^a term with its tip at `tip` (degrees): the value on the arcs, or with a
     /// helix the mean over the lag window behind the tip.
     pub(crate) fn tooth(&self, arcs: &[Arc], tip: f64, feed: Option<&ArcFeed>) -> f64 {
-        self.tooth_in(arcs, tip, feed, (0.0, self.lag_deg))
+        if self.lag_deg <= 0.0 {
+            if !arcs.iter().any(|a| a.contains(tip, END_TOLERANCE)) {
+                return 0.0;
+            }
+            let factor = feed.map_or(1.0, |f| f.factor(tip).powf(self.table.exponent()));
+            return factor * self.table.integrand(tip.to_radians());
+        }
+        // The edge above the tip trails it: cw teeth run towards smaller θ, so the trailing
+        // edge sits at larger θ; ccw the other way.
+        let (low, high) = match self.direction {
+            SpindleDirection::Cw => (tip, tip + self.lag_deg),
+            SpindleDirection::Ccw => (tip - self.lag_deg, tip),
+        };
+        let mut total = 0.0;
+        for arc in arcs {
+            // Copies of the arc, one turn apart, that overlap the window.
+            let first = ((low - arc.to) / 360.0).floor() as i64;
+            let last = ((high - arc.from) / 360.0).ceil() as i64;
+            for turn in first..=last {
+                let shift = 360.0 * turn as f64;
+                let (a, b) = ((arc.from + shift).max(low), (arc.to + shift).min(high));
+                if b > a {
+                    total += self.between(a, b, feed);
+                }
+            }
+        }
+        total / self.lag_deg.to_radians()
     }
 
     /// The largest and smallest max(0, sin θ)^a over θ in [`from`, `to`] (degrees): sin^a
@@ -247,8 +273,9 @@ impl ForceModel {
         }
     }
 
-    /// [`Self::tooth`] for the part of the edge whose lag runs over `lag`: the mean over that
-    /// window, or the value at its one angle when it has no width.
+    /// [`Self::tooth`] for the part of the edge whose lag runs over `lag` (a section of a
+    /// rounded end; the flat end keeps its own copy, the hot path of the bench): the mean over
+    /// that window, or the value at its one angle when it has no width.
     fn tooth_in(&self, arcs: &[Arc], tip: f64, feed: Option<&ArcFeed>, lag: (f64, f64)) -> f64 {
         let width = lag.1 - lag.0;
         if width <= 0.0 {
@@ -314,7 +341,44 @@ impl ForceModel {
     /// normal r̂, along the travel t̂): the tangential part opposes the edge's motion, the radial
     /// part pushes the tool away from the material.
     pub(crate) fn tooth_force(&self, arcs: &[Arc], tip: f64, feed: Option<&ArcFeed>) -> (f64, f64) {
-        self.tooth_force_in(arcs, tip, feed, (0.0, self.lag_deg))
+        let a = self.table.exponent();
+        // Edge motion: cw teeth run towards smaller θ (velocity −de/dθ), ccw towards larger.
+        let turning = match self.direction {
+            SpindleDirection::Cw => 1.0,
+            SpindleDirection::Ccw => -1.0,
+        };
+        let combine = |sin_part: f64, cos_part: f64| {
+            // w·[turning·(−sin θ, cos θ) + ratio·(−cos θ, −sin θ)].
+            (-turning * sin_part - self.radial_ratio * cos_part, turning * cos_part - self.radial_ratio * sin_part)
+        };
+        if self.lag_deg <= 0.0 {
+            if !arcs.iter().any(|arc| arc.contains(tip, END_TOLERANCE)) {
+                return (0.0, 0.0);
+            }
+            let w = feed.map_or(1.0, |f| f.factor(tip).powf(a)) * self.table.integrand(tip.to_radians());
+            let (s, c) = tip.to_radians().sin_cos();
+            return combine(w * s, w * c);
+        }
+        let (low, high) = match self.direction {
+            SpindleDirection::Cw => (tip, tip + self.lag_deg),
+            SpindleDirection::Ccw => (tip - self.lag_deg, tip),
+        };
+        let (mut sin_part, mut cos_part) = (0.0, 0.0);
+        for arc in arcs {
+            let first = ((low - arc.to) / 360.0).floor() as i64;
+            let last = ((high - arc.from) / 360.0).ceil() as i64;
+            for turn in first..=last {
+                let shift = 360.0 * turn as f64;
+                let (x, y) = ((arc.from + shift).max(low), (arc.to + shift).min(high));
+                if y > x {
+                    let (s, c) = self.moments(x, y, feed);
+                    sin_part += s;
+                    cos_part += c;
+                }
+            }
+        }
+        let lag = self.lag_deg.to_radians();
+        combine(sin_part / lag, cos_part / lag)
     }
 
     /// [`Self::tooth_force`] for the part of the edge whose lag runs over `lag` (see
