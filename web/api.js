@@ -13,9 +13,8 @@ function askForToken() {
   box.querySelector('input').focus();
 }
 
-// Calls the API; resolves to the parsed JSON (or text for G-code); rejects with the problem document.
-// A FormData body is sent as multipart/form-data.
-export async function api(method, path, body, accept = 'application/json') {
+// Sends one request with the token; resolves to the response, rejects when there is no answer.
+async function send(method, path, body, accept) {
   const options = { method, headers: { accept } };
   if (token()) options.headers.authorization = `Bearer ${token()}`;
   if (body instanceof FormData) {
@@ -31,13 +30,34 @@ export async function api(method, path, body, accept = 'application/json') {
     throw { status: 0, title: 'No connection', detail: 'The kerf service did not answer. Is it running?' };
   }
   if (response.status === 401) askForToken();
-  if (response.status === 204) return null;
+  return response;
+}
+
+// The problem document of a failed response (or one made of its text).
+async function failure(response) {
   const type = response.headers.get('content-type') || '';
   const payload = type.includes('json') ? await response.json() : await response.text();
-  if (!response.ok) {
-    throw typeof payload === 'object' ? payload : { status: response.status, detail: String(payload) };
-  }
-  return payload;
+  return typeof payload === 'object' ? payload : { status: response.status, detail: String(payload) };
+}
+
+// Calls the API; resolves to the parsed JSON, the text of a text answer (G-code) or a Blob of any
+// other (a zip); rejects with the problem document. A FormData body is sent as multipart/form-data.
+export async function api(method, path, body, accept = 'application/json') {
+  const response = await send(method, path, body, accept);
+  if (response.status === 204) return null;
+  if (!response.ok) throw await failure(response);
+  const type = response.headers.get('content-type') || '';
+  if (type.includes('json')) return response.json();
+  if (type === '' || type.startsWith('text/')) return response.text();
+  return response.blob();
+}
+
+// Fetches a binary answer (a job's outputs.zip) as a Blob, its bytes untouched; rejects with the
+// problem document like api().
+export async function binary(path, accept = 'application/zip') {
+  const response = await send('GET', path, undefined, accept);
+  if (!response.ok) throw await failure(response);
+  return response.blob();
 }
 
 // Fetches a program: the same request with `?format=gcode…` and the G-code media type.

@@ -1,22 +1,25 @@
-// kerf's list of views, in tab order: the one place that names them. Each entry gives the route
-// id (`#/deburr`), the tab title, the form view's `mount(root, id)` and, for a capability, how its
-// answer is shown (`result(container, answer)`, also used for job results). Later generated from
-// the server's capability registry.
-import { contourResult, contourView } from '/views/contour.js';
-import { deburrResult, deburrView } from '/views/deburr.js';
-import { engagementResult, engagementView } from '/views/engagement.js';
+// kerf's list of views, in tab order. The capability views come from the server's capability
+// registry (`/capabilities.js`, generated): for each name, `/views/{name}.js` exports `view` with
+// its tab title, the form view's `mount(root, id)` and how its answer is shown (`result(container,
+// answer)`, also used for job results). The other views are listed here.
+import { CAPABILITIES } from '/capabilities.js';
 import { jobsView } from '/views/jobs.js';
 import { machinesView } from '/views/machines.js';
-import { predictResult, predictView } from '/views/predict.js';
-import { segmentResult, segmentView } from '/views/segment.js';
 import { toolsView } from '/views/tools.js';
 
+// A capability whose view does not load is left out (and reported) instead of breaking the page.
+const capabilityViews = (await Promise.all(CAPABILITIES.map(async (id) => {
+  try {
+    const { view } = await import(`/views/${id}.js`);
+    return { id, ...view };
+  } catch (error) {
+    console.error(`the view of capability ${id} did not load`, error);
+    return null;
+  }
+}))).filter(Boolean);
+
 export const VIEWS = [
-  { id: 'deburr', title: 'Deburr', mount: deburrView.mount, result: deburrResult },
-  { id: 'segment', title: 'Segment', mount: segmentView.mount, result: segmentResult },
-  { id: 'contour', title: 'Contour', mount: contourView.mount, result: contourResult },
-  { id: 'engagement', title: 'Engagement', mount: engagementView.mount, result: engagementResult },
-  { id: 'predict', title: 'Predict', mount: predictView.mount, result: predictResult },
+  ...capabilityViews,
   { id: 'jobs', title: 'Jobs', mount: jobsView.mount },
   { id: 'tools', title: 'Tools', mount: toolsView.mount },
   { id: 'machines', title: 'Machines', mount: machinesView.mount },

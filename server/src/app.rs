@@ -48,14 +48,11 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
     let (routes, document) = OpenApiRouter::with_openapi(ApiDoc::openapi())
         .merge(http::health::router())
         .merge(http::tools::router())
-        .merge(http::deburr::router())
+        .merge(http::endpoints::router())
         .merge(http::contour::router())
-        .merge(http::engagement::router())
-        .merge(http::predict::router())
         .merge(http::jobs::router())
         .merge(http::machines::router())
         .merge(http::materials::router())
-        .merge(http::segment::router())
         .split_for_parts();
     let mut document = document;
     crate::openapi::describe_responses(&mut document);

@@ -6,14 +6,11 @@
 use std::time::Instant;
 
 use kerf_solver::SolverError;
-use kerf_solver::capability::{self, Capability, Lookup, OutputOptions, Refs, Resolved, Run, ToolNeed};
-use kerf_solver::chord::{SegmentCapability, SegmentRequest};
-use kerf_solver::corners::{ContourCapability, ContourRequest};
-use kerf_solver::deburr::{DeburrCapability, DeburrRequest};
-use kerf_solver::engagement::{EngagementCapability, EngagementRequest};
+use kerf_solver::capability::{
+    self, Capability, Lookup, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing, Split, ToolNeed,
+};
 use kerf_solver::machine::MachineProfile;
 use kerf_solver::material::Material;
-use kerf_solver::predict::{PredictCapability, PredictRequest};
 use kerf_solver::tool::Tool;
 use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
@@ -21,12 +18,39 @@ use utoipa::ToSchema;
 
 use crate::error::AppError;
 
-/// The registry: one line per capability: the variant of [`Operation`], the capability type, its
-/// request type (named so the OpenAPI document shows the concrete schema; the compiler checks that
-/// it is the capability's) and the operation's description in the OpenAPI document.
+/// The registry: the one list of capabilities, one entry each. It hands the list to `$callback`
+/// (a macro in scope where it is called): [`registry!`] here builds the job [`Operation`] from it,
+/// `http::endpoints` the HTTP endpoints. An entry names the variant of [`Operation`]; the solver
+/// module with the capability, request and answer types (named so the OpenAPI document shows the
+/// concrete schemas; the compiler checks that they are the capability's); the endpoint's body,
+/// `json(Query)` with the query parameters it takes (a type of `http::output`) or `upload` for a
+/// capability with its own handler in `http/<module>.rs`; and the operation's description.
+macro_rules! with_registry {
+    ($callback:ident) => {
+        $callback! {
+            Deburr => deburr::{DeburrCapability, DeburrRequest, DeburrAnswer}, json(OutputQuery),
+                "`POST /api/v1/deburr`.";
+            Segment => chord::{SegmentCapability, SegmentRequest, SegmentResult}, json(OutputQuery),
+                "`POST /api/v1/segment`.";
+            Contour => corners::{ContourCapability, ContourRequest, ContourResult}, json(OutputQuery),
+                "`POST /api/v1/contour`.";
+            Engagement => engagement::{EngagementCapability, EngagementRequest, EngagementResponse}, json(CandidateQuery),
+                "`POST /api/v1/engagement`; the job's program is that of the request's `candidate` path (default the first).";
+            Predict => predict::{PredictCapability, PredictRequest, PredictAnswer}, upload,
+                "`POST /api/v1/predict` (a job file cannot carry an STL file: no `mesh` stock).";
+        }
+    };
+}
+pub(crate) use with_registry;
+
+/// Builds the job [`Operation`] and its dispatch from the registry's entries.
 macro_rules! registry {
-    ($($variant:ident => $capability:ty, $request:ty, $doc:literal);+ $(;)?) => {
-        $(const _: fn(<$capability as Capability>::Request) -> $request = |request| request;)+
+    ($($variant:ident => $module:ident::{$capability:ident, $request:ident, $answer:ident}, $body:ident $(($query:ident))?, $doc:literal;)+) => {
+        $(
+            use kerf_solver::$module::{$capability, $request};
+            const _: fn(<$capability as Capability>::Request) -> $request = |request| request;
+            const _: fn(<$capability as Capability>::Answer) -> kerf_solver::$module::$answer = |answer| answer;
+        )+
 
         /// One job operation: `operation` names the capability, the other fields are its
         /// endpoint's request.
@@ -58,6 +82,14 @@ macro_rules! registry {
                 }
             }
 
+            /// Every reference of the operation, for a lookup to fetch: its [`Self::refs`], then
+            /// one per further tool (deburr's `inner_tool`).
+            pub fn all_refs(&self) -> Vec<Refs<'_>> {
+                match self {
+                    $(Self::$variant(request) => capability::all_refs::<$capability>(request),)+
+                }
+            }
+
             /// Checks that the operation's references resolve against `lookup`.
             ///
             /// # Errors
@@ -79,6 +111,46 @@ macro_rules! registry {
                 }
             }
 
+            /// How the operation divides into parts that different workers solve at once
+            /// ([`Capability::split`]), resolved against `lookup`; `None`: it is solved whole.
+            pub fn split(&self, lookup: &impl Lookup, sizing: &Sizing) -> Option<Split> {
+                match self {
+                    $(Self::$variant(request) => split::<$capability>(request, lookup, sizing),)+
+                }
+            }
+
+            /// Solves part `part` of the operation as a job does; its output, serialised for the
+            /// finish step.
+            ///
+            /// # Errors
+            /// The problem of the refusal (cancellation is `E_CANCELLED`).
+            pub fn run_part(&self, lookup: &impl Lookup, part: &Part, run: &Run<'_>) -> Result<PartBytes, AppError> {
+                match self {
+                    $(Self::$variant(request) => part_output::<$capability>(request, lookup, part, run),)+
+                }
+            }
+
+            /// The finish step of a split operation: merges its parts' outputs (`parts`, in
+            /// order) into what [`Operation::run`] stores for the whole operation. `seconds` is
+            /// what the parts' solves took, for the answers that report their time.
+            ///
+            /// # Errors
+            /// The problem of the refusal (cancellation is `E_CANCELLED`).
+            pub fn finish(
+                &self,
+                lookup: &impl Lookup,
+                parts: &mut impl PartSource,
+                run: &Run<'_>,
+                output: &OutputOptions,
+                seconds: f64,
+            ) -> Result<Stored, AppError> {
+                match self {
+                    $(Self::$variant(request) => {
+                        finish_output::<$capability>(request, lookup, parts, run, output, seconds)
+                    })+
+                }
+            }
+
             /// Reads the request of the capability called `name` from `fields`.
             fn read<'de, D: serde::Deserializer<'de>>(name: &str, fields: D) -> Result<Self, D::Error> {
                 $(
@@ -92,15 +164,7 @@ macro_rules! registry {
     };
 }
 
-registry! {
-    Deburr => DeburrCapability, DeburrRequest, "`POST /api/v1/deburr`.";
-    Segment => SegmentCapability, SegmentRequest, "`POST /api/v1/segment`.";
-    Contour => ContourCapability, ContourRequest, "`POST /api/v1/contour`.";
-    Engagement => EngagementCapability, EngagementRequest,
-        "`POST /api/v1/engagement`; the job's program is that of the request's `candidate` path (default the first).";
-    Predict => PredictCapability, PredictRequest,
-        "`POST /api/v1/predict` (a job file cannot carry an STL file: no `mesh` stock).";
-}
+with_registry!(registry);
 
 // Hand-written instead of serde's internally tagged enum, which buffers the table and so loses
 // the field path and line of errors inside it. When `operation` is the first key (as in every
@@ -199,9 +263,11 @@ pub fn material_in(materials: &[Material], name: &str) -> Option<Material> {
 /// The one resolution step, for capability `C`: its request's references from `lookup`.
 ///
 /// # Errors
-/// 404 naming `tool`, `machine` or `material` when a reference is unknown.
+/// 404 naming `tool`, `machine`, `material` or another tool's field (`inner_tool`) when a
+/// reference is unknown.
 pub fn resolve<C: Capability>(request: &C::Request, lookup: &impl Lookup) -> Result<Resolved<C::Tool>, AppError> {
-    resolve_refs(C::refs(request), lookup)
+    capability::resolve_request::<C>(request, lookup)
+        .map_err(|unresolved| AppError::unknown(unresolved.field, unresolved.message))
 }
 
 /// [`resolve`] for references outside a capability (the contour loops endpoint).
@@ -273,6 +339,72 @@ fn store_output<C: Capability>(
     let started = Instant::now();
     let mut answer = C::solve(request, resolved, run)?;
     C::record_time(&mut answer, started.elapsed().as_secs_f64());
+    stored::<C>(request, answer, output)
+}
+
+fn split<C: Capability>(request: &C::Request, lookup: &impl Lookup, sizing: &Sizing) -> Option<Split> {
+    let resolved = resolve::<C>(request, lookup).ok()?;
+    C::split(request, &resolved, sizing)
+}
+
+/// A part's output, serialised (CBOR: every number exactly as computed, non-finite ones too), and
+/// how long its solve took.
+#[derive(Debug)]
+pub struct PartBytes {
+    /// The output.
+    pub bytes: Vec<u8>,
+    /// Seconds.
+    pub seconds: f64,
+}
+
+/// Where a part's output goes: CBOR bytes (the job layer compresses and stores them).
+#[derive(Debug, Default)]
+struct CborSink(Vec<u8>);
+
+impl PartSink for CborSink {
+    fn put<T: Serialize>(&mut self, value: &T) -> Result<(), SolverError> {
+        self.0.clear();
+        ciborium::into_writer(value, &mut self.0).map_err(|error| {
+            SolverError::new(kerf_solver::ErrorCode::Internal, format!("a part's output cannot be written: {error}"))
+        })
+    }
+}
+
+fn part_output<C: Capability>(
+    request: &C::Request,
+    lookup: &impl Lookup,
+    part: &Part,
+    run: &Run<'_>,
+) -> Result<PartBytes, AppError> {
+    let resolved = resolve::<C>(request, lookup)?;
+    let started = Instant::now();
+    let mut sink = CborSink::default();
+    C::solve_part(request, resolved, part, run, &mut sink)?;
+    Ok(PartBytes { bytes: sink.0, seconds: started.elapsed().as_secs_f64() })
+}
+
+fn finish_output<C: Capability>(
+    request: &C::Request,
+    lookup: &impl Lookup,
+    parts: &mut impl PartSource,
+    run: &Run<'_>,
+    output: &OutputOptions,
+    seconds: f64,
+) -> Result<Stored, AppError> {
+    let resolved = resolve::<C>(request, lookup)?;
+    let started = Instant::now();
+    let mut answer = C::finish(request, resolved, parts, run)?;
+    C::record_time(&mut answer, seconds + started.elapsed().as_secs_f64());
+    stored::<C>(request, answer, output)
+}
+
+/// A job's stored output of `answer`: its program written with `output`, the answer trimmed for
+/// storage.
+fn stored<C: Capability>(
+    request: &C::Request,
+    mut answer: C::Answer,
+    output: &OutputOptions,
+) -> Result<Stored, AppError> {
     let program = capability::program::<C>(request, &answer, output);
     C::for_storage(&mut answer);
     let result = serde_json::value::to_raw_value(&answer).map_err(|error| AppError::Internal(error.into()))?;

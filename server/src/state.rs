@@ -119,7 +119,7 @@ impl AppState {
             Ok(Err(join_error)) => Err(AppError::Internal(anyhow::anyhow!("solver task failed: {join_error}"))),
             Err(_) => Err(AppError::Timeout(format!(
                 "the computation takes longer than the synchronous limit of {} s; submit it as a job (POST /api/v1/jobs)",
-                self.limits.solver_time_limit.as_secs()
+                self.limits.solver_time_limit.as_secs_f64()
             ))),
         }
     }

@@ -1,6 +1,7 @@
 //! The web page (`web/`), compiled into the binary so a shop-floor PC needs only the executable.
 //! Every file of `web/` is served at its own path (listed at build time by `build.rs`), and
-//! nothing outside `web/` can be reached. Each file has a
+//! nothing outside `web/` can be reached, plus `/capabilities.js`, generated from the capability
+//! registry. Each file has a
 //! strong ETag (a hash of its bytes): the browser revalidates and gets 304 while the binary is the
 //! same; answers are gzip-compressed when the browser accepts it.
 
@@ -9,9 +10,11 @@ use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
 use axum::response::IntoResponse;
 use axum::routing::get;
 use sha2::{Digest, Sha256};
+use std::sync::LazyLock;
 use tower_http::compression::CompressionLayer;
 
 /// One served file.
+#[derive(Clone, Copy)]
 struct Asset {
     path: &'static str,
     media_type: &'static str,
@@ -20,6 +23,13 @@ struct Asset {
 
 /// Every file of `web/` (`index.html` at `/`), listed by `build.rs`.
 const ASSETS: &[Asset] = include!(concat!(env!("OUT_DIR"), "/web_assets.rs"));
+
+/// `/capabilities.js`: the capability registry's names, in registry order, from which the page
+/// builds its capability views (`web/views.js` loads `/views/{name}.js` for each).
+static CAPABILITIES_MODULE: LazyLock<String> = LazyLock::new(|| {
+    let names = serde_json::to_string(crate::capabilities::NAMES).unwrap_or_else(|_| "[]".to_owned());
+    format!("// Generated from the server's capability registry.\nexport const CAPABILITIES = {names};\n")
+});
 
 /// The strong ETag of `body`: a quoted hash of its bytes.
 fn etag(body: &[u8]) -> HeaderValue {
@@ -37,7 +47,12 @@ fn not_modified(headers: &HeaderMap, tag: &HeaderValue) -> bool {
 
 /// Routes for the page's files.
 pub fn router<S: Clone + Send + Sync + 'static>() -> Router<S> {
-    let routes = ASSETS.iter().fold(Router::new(), |router, asset| {
+    let generated = Asset {
+        path: "/capabilities.js",
+        media_type: "text/javascript; charset=utf-8",
+        body: CAPABILITIES_MODULE.as_bytes(),
+    };
+    let routes = ASSETS.iter().copied().chain([generated]).fold(Router::new(), |router, asset| {
         let tag = etag(asset.body);
         router.route(
             asset.path,

@@ -10,6 +10,12 @@
 //! program still sweeps the stock): ms per pass = sample time / 1000. Before each group the bench
 //! prints one measured slice with wall and process CPU time (the machine is shared, so CPU time
 //! per pass is the per-core figure), and once the whole program on all threads.
+//!
+//! Environment: `KERF_BENCH_SLICES=n` measures the slice n times per group (old and new builds
+//! run alternately give ranges on a shared machine); `KERF_BENCH_ONLY=name` keeps the groups whose
+//! name contains it; `KERF_BENCH_WHOLE=0` skips the whole-program run (4 min on 2 cores);
+//! `KERF_BENCH_DUMP=dir` writes each group's slice answer to `dir/<group>.json` (to compare the
+//! answers of two builds field by field).
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -52,6 +58,8 @@ fn report(label: &str, passes: usize, wall: f64, cpu: f64) {
 }
 
 fn bench(c: &mut Criterion) {
+    let slices: usize = std::env::var("KERF_BENCH_SLICES").ok().and_then(|v| v.parse().ok()).unwrap_or(1);
+    let only = std::env::var("KERF_BENCH_ONLY").unwrap_or_default();
     let mut group = c.benchmark_group("predict");
     group.sample_size(10);
     for (method, resolution, name) in [
@@ -59,6 +67,9 @@ fn bench(c: &mut Criterion) {
         (Method::DepthBuffer, 256, "depth_buffer_N256"),
         (Method::Sampling, 512, "sampling_N512"),
     ] {
+        if !name.contains(only.as_str()) {
+            continue;
+        }
         let (mut request, tool, moves) = support::raster_request(160.0, 0.5, 0.5, method, resolution);
         let middle = moves / 2;
         for threads in [1, 2] {
@@ -70,18 +81,27 @@ fn bench(c: &mut Criterion) {
             pool.install(|| predict::solve(&request, &tool, None).unwrap());
             let (setup_wall, setup_cpu) = (started.elapsed().as_secs_f64(), cpu_seconds() - cpu);
             request.pass_range = Some([middle, middle + SLICE]);
-            let (started, cpu) = (Instant::now(), cpu_seconds());
-            let answer = pool.install(|| predict::solve(&request, &tool, None).unwrap());
-            let (wall, cpu) = (started.elapsed().as_secs_f64(), cpu_seconds() - cpu);
-            assert_eq!(answer.summary.predicted + answer.summary.no_cut + answer.summary.no_surface, SLICE);
             eprintln!("{label}: setup {setup_wall:.3} s wall, {setup_cpu:.2} s CPU for {moves} passes");
-            report(&label, SLICE, wall - setup_wall, cpu - setup_cpu);
+            for _ in 0..slices {
+                let (started, cpu) = (Instant::now(), cpu_seconds());
+                let answer = pool.install(|| predict::solve(&request, &tool, None).unwrap());
+                let (wall, cpu) = (started.elapsed().as_secs_f64(), cpu_seconds() - cpu);
+                assert_eq!(answer.summary.predicted + answer.summary.no_cut + answer.summary.no_surface, SLICE);
+                report(&label, SLICE, wall - setup_wall, cpu - setup_cpu);
+                if let Ok(dir) = std::env::var("KERF_BENCH_DUMP") {
+                    let text = serde_json::to_string_pretty(&answer).unwrap();
+                    std::fs::write(format!("{dir}/{label}.json"), text).unwrap();
+                }
+            }
             group.bench_function(format!("{label}_{SLICE}_of_{moves}_passes"), |b| {
                 b.iter(|| pool.install(|| black_box(predict::solve(&request, &tool, None).unwrap())));
             });
         }
     }
     group.finish();
+    if std::env::var("KERF_BENCH_WHOLE").is_ok_and(|v| v == "0") {
+        return;
+    }
     // The whole program once, on all threads.
     let (mut request, tool, moves) = support::raster_request(160.0, 0.5, 0.5, Method::Sampling, 256);
     request.pass_range = None;

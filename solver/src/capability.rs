@@ -23,6 +23,8 @@ use crate::tool::{Tool, ToolRef};
 pub trait Capability {
     /// Its name: the endpoint (`/api/v1/{NAME}`), the job `operation` and the page's view id.
     const NAME: &'static str;
+    /// How its endpoint is documented; the server generates the endpoint from the registry.
+    const ENDPOINT: Endpoint;
     /// The request, as its endpoint takes it and as a job operation holds it.
     type Request: Serialize + DeserializeOwned + Clone + Send + Sync + 'static;
     /// The answer, as its endpoint returns it as JSON and as a job stores it.
@@ -33,6 +35,12 @@ pub trait Capability {
 
     /// The tool, machine and material the request refers to.
     fn refs(request: &Self::Request) -> Refs<'_>;
+
+    /// Tools the request names besides `refs().tool` (deburr's `inner_tool`), each with its
+    /// field; resolved like `tool` into [`Resolved::other_tools`], in this order. Default none.
+    fn other_tools(_request: &Self::Request) -> Vec<OtherTool<'_>> {
+        Vec::new()
+    }
 
     /// Checks the output options before any work, so a program that cannot be written is refused
     /// at once instead of after the computation.
@@ -67,6 +75,148 @@ pub trait Capability {
 
     /// Records how long the solve took, for capabilities whose answer reports it.
     fn record_time(_answer: &mut Self::Answer, _seconds: f64) {}
+
+    /// Splits the request's work into parts that different workers may solve at once (issue 12,
+    /// a job split into chunks): ranges of its units of work (prediction passes, candidate
+    /// paths) sized after `sizing`, each solved by [`Capability::solve_part`], then merged by
+    /// [`Capability::finish`] into the answer [`Capability::solve`] gives. `None` (the default):
+    /// the request is solved whole, as when it is refused (solving it whole reports why) or too
+    /// small to be worth splitting.
+    fn split(_request: &Self::Request, _context: &Resolved<Self::Tool>, _sizing: &Sizing) -> Option<Split> {
+        None
+    }
+
+    /// Solves part `part` of a request [`Capability::split`] split, handing what the finish step
+    /// needs to `sink` (the caller stores it, in any serde format, until the finish step).
+    ///
+    /// # Errors
+    /// The capability's refusals, as [`Capability::solve`]; `E_INTERNAL` for a capability that
+    /// does not split.
+    fn solve_part(
+        _request: &Self::Request,
+        _context: Resolved<Self::Tool>,
+        _part: &Part,
+        _run: &Run<'_>,
+        _sink: &mut impl PartSink,
+    ) -> Result<(), SolverError> {
+        Err(not_split(Self::NAME))
+    }
+
+    /// The finish step of a split request: reads the parts' outputs from `parts`, in the order
+    /// [`Capability::split`] gave the parts, and gives the answer [`Capability::solve`] would
+    /// give for the whole request, equal field for field (its program then byte for byte).
+    ///
+    /// # Errors
+    /// As [`Capability::solve`]; `E_INTERNAL` when the parts do not belong to the request.
+    fn finish(
+        _request: &Self::Request,
+        _context: Resolved<Self::Tool>,
+        _parts: &mut impl PartSource,
+        _run: &Run<'_>,
+    ) -> Result<Self::Answer, SolverError> {
+        Err(not_split(Self::NAME))
+    }
+}
+
+/// How large the parts of a split request should be (see [`Capability::split`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sizing {
+    /// The work one part should hold, in seconds of one core of the reference machine (the
+    /// capabilities' cost models are measured on it; README, "More than one machine").
+    pub part_seconds: f64,
+    /// The most parts one request is split into.
+    pub max_parts: usize,
+}
+
+/// A request split into parts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Split {
+    /// The parts, in order: their units together are the request's, each once.
+    pub parts: Vec<Part>,
+    /// The estimated work of the finish step, core-seconds.
+    pub finish_seconds: f64,
+}
+
+impl Split {
+    /// `units` cut into parts of about `sizing.part_seconds` each, given the work of one unit and
+    /// the fixed work every part repeats (reading the request); `None` when one part would do.
+    /// Parts are at least `10 × setup_seconds` long, so the repeated setup stays under a tenth.
+    #[must_use]
+    pub fn even(
+        units: std::ops::Range<usize>,
+        unit_seconds: f64,
+        setup_seconds: f64,
+        finish_seconds: f64,
+        sizing: &Sizing,
+    ) -> Option<Self> {
+        let count = units.len();
+        let total = count as f64 * unit_seconds;
+        let per_part = sizing.part_seconds.max(10.0 * setup_seconds);
+        if !(total.is_finite() && per_part > 0.0) {
+            return None;
+        }
+        let parts = ((total / per_part).round() as usize).clamp(1, sizing.max_parts.max(1)).min(count);
+        if parts < 2 {
+            return None;
+        }
+        let parts = (0..parts)
+            .map(|k| {
+                let from = units.start + count * k / parts;
+                let to = units.start + count * (k + 1) / parts;
+                Part { units: from..to, seconds: (to - from) as f64 * unit_seconds + setup_seconds }
+            })
+            .collect();
+        Some(Self { parts, finish_seconds })
+    }
+}
+
+/// One part of a split request: a range of its units of work.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Part {
+    /// The units, `[start, end)` (passes, candidate paths).
+    pub units: std::ops::Range<usize>,
+    /// The estimated work, core-seconds.
+    pub seconds: f64,
+}
+
+/// Where a part's output goes ([`Capability::solve_part`]).
+pub trait PartSink {
+    /// Stores `value` as the part's output.
+    ///
+    /// # Errors
+    /// `E_INTERNAL` when it cannot be written.
+    fn put<T: Serialize>(&mut self, value: &T) -> Result<(), SolverError>;
+}
+
+/// The stored outputs of a split request's parts, in order ([`Capability::finish`]).
+pub trait PartSource {
+    /// How many parts there are.
+    fn count(&self) -> usize;
+
+    /// The next part's output, read as `T`; `None` after the last.
+    ///
+    /// # Errors
+    /// `E_INTERNAL` when it cannot be read as `T`.
+    fn next_part<T: DeserializeOwned>(&mut self) -> Option<Result<T, SolverError>>;
+}
+
+fn not_split(name: &str) -> SolverError {
+    SolverError::new(ErrorCode::Internal, format!("{name} requests are not split into parts"))
+}
+
+/// The documentation of a capability's endpoint `POST /api/v1/{NAME}` in the OpenAPI document.
+/// It lives with the capability because the capability knows what it answers and refuses; the
+/// server's handler is generated and only forwards these texts.
+#[derive(Debug, Clone, Copy)]
+pub struct Endpoint {
+    /// The one-line summary.
+    pub summary: &'static str,
+    /// What the endpoint returns, in a paragraph or two.
+    pub description: &'static str,
+    /// What a 404 means here (which references the request can make).
+    pub not_found: &'static str,
+    /// What a 422 means here: the capability's refusal codes.
+    pub refused: &'static str,
 }
 
 /// The references a request makes, to be resolved before it is solved.
@@ -78,6 +228,23 @@ pub struct Refs<'a> {
     pub machine: Option<&'a str>,
     /// The name of a work material in the materials library.
     pub material: Option<&'a str>,
+}
+
+/// A tool a request names besides `tool` (deburr's `inner_tool`): the request field that holds
+/// it and the reference. An unknown number is reported at `field`, as `tool` is.
+#[derive(Debug, Clone, Copy)]
+pub struct OtherTool<'a> {
+    /// The request field (`inner_tool`).
+    pub field: &'static str,
+    /// A number in the tool table or the tool itself.
+    pub tool: &'a ToolRef,
+}
+
+impl<'a> OtherTool<'a> {
+    /// This tool's reference alone, for a lookup that fetches what [`Refs`] name.
+    pub fn refs(self) -> Refs<'a> {
+        Refs { tool: Some(self.tool), ..Refs::default() }
+    }
 }
 
 /// Where resolution finds what a request refers to: the tool table, machines registry and
@@ -100,6 +267,8 @@ pub struct Resolved<T> {
     pub machine: Option<MachineProfile>,
     /// The work material the request names, if any.
     pub material: Option<Material>,
+    /// The tools of [`Capability::other_tools`], in its order (empty for most capabilities).
+    pub other_tools: Vec<Tool>,
 }
 
 /// How a capability's tool need is met by what resolution found.
@@ -160,7 +329,44 @@ pub fn resolve<T: ToolNeed>(refs: Refs<'_>, lookup: &impl Lookup) -> Result<Reso
             message: format!("material {name:?} is not in the materials library (GET /api/v1/materials)"),
         })?),
     };
-    Ok(Resolved { tool, machine, material })
+    Ok(Resolved { tool, machine, material, other_tools: Vec::new() })
+}
+
+/// The tools `others` name, from `lookup` (inline tools as given), in order.
+///
+/// # Errors
+/// [`Unresolved`] at the other tool's field for an unknown tool number.
+pub fn resolve_other_tools(others: &[OtherTool<'_>], lookup: &impl Lookup) -> Result<Vec<Tool>, Unresolved> {
+    others
+        .iter()
+        .map(|other| match other.tool {
+            ToolRef::Inline(tool) => Ok(tool.clone()),
+            ToolRef::Number(number) => lookup.tool(*number).ok_or_else(|| Unresolved {
+                field: other.field,
+                message: format!("tool {number} ({}) is not in the tool table", other.field),
+            }),
+        })
+        .collect()
+}
+
+/// The one resolution step of capability `C`'s request: [`resolve`] of its [`Capability::refs`]
+/// and its [`Capability::other_tools`].
+///
+/// # Errors
+/// As [`resolve`] and [`resolve_other_tools`].
+pub fn resolve_request<C: Capability>(
+    request: &C::Request,
+    lookup: &impl Lookup,
+) -> Result<Resolved<C::Tool>, Unresolved> {
+    let mut resolved = resolve(C::refs(request), lookup)?;
+    resolved.other_tools = resolve_other_tools(&C::other_tools(request), lookup)?;
+    Ok(resolved)
+}
+
+/// Every reference of capability `C`'s request, for a lookup to fetch: its [`Capability::refs`],
+/// then one per other tool.
+pub fn all_refs<C: Capability>(request: &C::Request) -> Vec<Refs<'_>> {
+    std::iter::once(C::refs(request)).chain(C::other_tools(request).into_iter().map(OtherTool::refs)).collect()
 }
 
 /// Progress reporting and cancellation for long runs.

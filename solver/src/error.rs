@@ -1,6 +1,6 @@
 //! Solver failures and warnings, each with a stable code (deburr.md §4 and the other specs' edge-case tables).
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 pub use crate::error_code::ErrorCode;
 
@@ -57,6 +57,33 @@ pub struct Warning {
     pub code: &'static str,
     /// What happened and where.
     pub message: String,
+}
+
+/// A warning read back (the parts of a split request). Its code is kept once per distinct code
+/// for the life of the process: the codes are a small fixed set.
+impl<'de> Deserialize<'de> for Warning {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        struct Read {
+            code: String,
+            message: String,
+        }
+        static CODES: std::sync::Mutex<Vec<&'static str>> = std::sync::Mutex::new(Vec::new());
+        let Read { code, message } = Read::deserialize(deserializer)?;
+        let mut codes = CODES.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let code = match codes.iter().find(|known| **known == code) {
+            Some(known) => known,
+            None if codes.len() >= 1000 => {
+                return Err(serde::de::Error::custom("more distinct warning codes than kerf has"));
+            }
+            None => {
+                let known: &'static str = Box::leak(code.into_boxed_str());
+                codes.push(known);
+                known
+            }
+        };
+        Ok(Self { code, message })
+    }
 }
 
 impl Warning {

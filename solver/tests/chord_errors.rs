@@ -250,6 +250,7 @@ fn machine_values_are_defaults_the_request_overrides() {
         arcs: None,
         plunge_feed: None,
         max_accel: None,
+        max_jerk: None,
         rapid_feed: None,
         tool_change_s: None,
         name: None,

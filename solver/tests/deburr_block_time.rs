@@ -183,6 +183,7 @@ fn machine_values_and_bad_block_times() {
         arcs: None,
         plunge_feed: None,
         max_accel: None,
+        max_jerk: None,
         rapid_feed: None,
         tool_change_s: None,
         name: Some("hsc".to_owned()),

@@ -31,7 +31,7 @@ fn request(case: &Value) -> (DeburrRequest, Tool) {
     let arrangement = number(&inputs["arrangement_deg"]);
     let edge = if inputs["side"] == "outer" { Edge::Outer } else { Edge::Inner };
     let workpiece = match edge {
-        Edge::Outer => {
+        Edge::Outer | Edge::Both => {
             Workpiece::Tube { origin, arrangement_angle_deg: arrangement, inner_radius: r1 * 0.75, outer_radius: r1 }
         }
         Edge::Inner => Workpiece::BoreBlock {
@@ -64,6 +64,7 @@ fn request(case: &Value) -> (DeburrRequest, Tool) {
         holes: None,
         pattern: None,
         edge,
+        inner_tool: None,
         cut_amount: Some(number(&inputs["Q"])),
         width: None,
         tolerance: Some(number(&inputs["TA"])),

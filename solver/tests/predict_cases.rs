@@ -69,6 +69,9 @@ fn request(
         history: None,
         pass_range: None,
         exclusion_deg: None,
+        exclusion_shape_error: None,
+        merge_similar_passes: None,
+        merge_tolerance: None,
     }
 }
 

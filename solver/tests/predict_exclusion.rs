@@ -76,3 +76,68 @@ fn threshold_outside_zero_to_ninety_is_refused() {
         assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("exclusion_deg")));
     }
 }
+
+/// With `exclusion_shape_error` an excluded pass keeps its status but gets e_S from the same
+/// generation point as a full prediction; here (no force model) e = e_S for every pass, so the
+/// excluded passes carry exactly the plain prediction's numbers, and the path is corrected the
+/// same way.
+#[test]
+fn excluded_passes_get_their_shape_error_when_asked() {
+    let (plain, _) = line_statuses(None);
+    let (mut request, tool) = flat_case(Some(15.0));
+    request.exclusion_shape_error = Some(true);
+    let answer = predict::solve(&request, &tool, None).unwrap();
+    assert_eq!(answer.summary.skipped_small_angle, Some(3));
+    for index in [1, 3, 5] {
+        let (p, e) = (&plain.passes[index], &answer.passes[index]);
+        assert_eq!(e.status, PassStatus::SkippedSmallAngle);
+        assert_eq!(p.status, PassStatus::Ok);
+        assert!(e.error_shape.is_some());
+        assert_eq!(e.error_shape, p.error_shape, "pass {index}");
+        assert_eq!(e.error, e.error_shape);
+        assert_eq!(e.error_deflection, None);
+        assert_eq!(e.contact_angle_deg, p.contact_angle_deg);
+        assert_eq!(e.normal, p.normal);
+        assert_eq!(e.generation_point, p.generation_point);
+        assert_eq!(e.correction, p.correction);
+    }
+    // Without the switch the same passes carry nothing and the path is not moved there.
+    let (skipped, _) = line_statuses(Some(15.0));
+    for index in [1, 3, 5] {
+        assert_eq!(skipped.passes[index].error_shape, None);
+        assert_eq!(skipped.passes[index].correction, [0.0; 3]);
+    }
+}
+
+/// With a force model the excluded pass's e_S equals the full prediction's e_S, and e_D is left
+/// out (not computed) rather than zero.
+#[test]
+fn excluded_shape_error_matches_the_full_prediction_with_force() {
+    let tool = finishing_tool(3.0);
+    let (mut request, _) = flat_case(Some(15.0));
+    request.cutting =
+        Some(predict::CuttingCoefficients { ktc: 2000.0, krc: 800.0, kac: 300.0, kte: 0.0, kre: 0.0, kae: 0.0 });
+    let mut full = request.clone();
+    full.exclusion_deg = None;
+    let full = predict::solve(&full, &tool, None).unwrap();
+    request.exclusion_shape_error = Some(true);
+    let excluded = predict::solve(&request, &tool, None).unwrap();
+    for index in [1, 3, 5] {
+        let (f, e) = (&full.passes[index], &excluded.passes[index]);
+        assert!(f.error_deflection.is_some());
+        assert_eq!(e.error_shape, f.error_shape, "pass {index}");
+        assert_eq!(e.contact_angle_deg, f.contact_angle_deg);
+        assert_eq!((e.error_deflection, e.error, e.deflection), (None, e.error_shape, None));
+    }
+}
+
+#[test]
+fn shape_error_switch_without_threshold_is_refused() {
+    let (mut request, tool) = flat_case(None);
+    request.exclusion_shape_error = Some(true);
+    let error = predict::solve(&request, &tool, None).unwrap_err();
+    assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("exclusion_shape_error")));
+    // Off without a threshold is the default and accepted.
+    request.exclusion_shape_error = Some(false);
+    assert!(predict::solve(&request, &tool, None).is_ok());
+}

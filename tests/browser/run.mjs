@@ -167,6 +167,24 @@ const scenarios = {
     await page.waitForSelector('#deburr-plot[data-refused="false"]', { timeout: 60000 });
     if (await page.isDisabled('#deburr-gcode')) throw new Error('G-code button still off');
 
+    // Both edges in one request, the bore edge with the lollipop: both loops drawn, the summary
+    // counts them and the one tool change, and the program changes tools once.
+    await page.selectOption('#deburr-form select[name="edge"]', 'both');
+    await page.selectOption('#deburr-form select[name="inner_tool_choice"]', '41');
+    await page.click('#deburr-compute');
+    await page.waitForFunction(() => /loops \(holes × edges\)\s*2/.test(document.querySelector('#deburr-result:not(.stale) .summary')?.textContent ?? ''), null, { timeout: 60000 });
+    const bothObjects = (await page.getAttribute('#deburr-plot', 'data-objects')).split(' ');
+    const bothSummary = await page.textContent('#deburr-result .summary');
+    if (!bothObjects.includes('centres-1')) throw new Error(`the bore loop is not drawn: ${bothObjects}`);
+    if (!/tool changes\s*1/.test(bothSummary)) throw new Error(`no tool change in the summary: ${bothSummary}`);
+    const bothProgram = await page.evaluate(async () => (await fetch('/api/v1/deburr?format=gcode', {
+      method: 'POST', headers: { 'content-type': 'application/json' },
+      body: JSON.stringify({ tool: { kind: 'ball', radius: 2 }, inner_tool: 41, edge: 'both', cut_amount: 0.2,
+        workpiece: { kind: 'tube', origin: [0, 0, 0], inner_radius: 15, outer_radius: 25 }, hole: { shape: 'round', radius: 5 } }),
+    })).text());
+    if ((bothProgram.match(/M06/g) || []).length !== 1 || !/M00/.test(bothProgram)) throw new Error(`both edges program: ${bothProgram.slice(0, 400)}`);
+    await page.selectOption('#deburr-form select[name="edge"]', 'outer');
+
     // A bad value: its message under the field, aria-invalid, aria-describedby naming the message,
     // focus on the field, the last result still there but dimmed.
     await page.fill('input[name="hole_radius"]', '-1');
@@ -734,6 +752,36 @@ const scenarios = {
     if (inked < 500) throw new Error(`job plot nearly blank: ${inked} inked pixels`);
     if (!downloads.includes('G-code') || !downloads.includes('JSON')) throw new Error(`downloads: ${downloads}`);
     return { plots, inked, seconds };
+  },
+
+  // Uploads a job file, opens the finished job and clicks "All outputs (zip)": the download is
+  // the service's outputs.zip byte for byte (a zip: PK\x03\x04), and its central directory
+  // names the expected entries.
+  async jobzip() {
+    await page.goto(`${base}/#jobs`);
+    await page.setInputFiles('#job-file', jobFile);
+    await page.waitForSelector('#job-rows tr[data-status="done"]', { timeout: 120000 });
+    await page.click('#job-rows tr[data-status="done"] button');
+    await page.waitForSelector('#job-zip', { timeout: 60000 });
+    const [download] = await Promise.all([page.waitForEvent('download', { timeout: 60000 }), page.click('#job-zip')]);
+    const bytes = readFileSync(await download.path());
+    if (!bytes.subarray(0, 4).equals(Buffer.from([0x50, 0x4b, 0x03, 0x04]))) {
+      throw new Error(`not a zip: ${bytes.subarray(0, 8).toString('hex')}`);
+    }
+    // The end of central directory record, then each central directory entry's name.
+    const end = bytes.lastIndexOf(Buffer.from([0x50, 0x4b, 0x05, 0x06]));
+    if (end < 0) throw new Error('no end of central directory');
+    const count = bytes.readUInt16LE(end + 10);
+    let at = bytes.readUInt32LE(end + 16);
+    const entries = [];
+    for (let i = 0; i < count; i++) {
+      if (bytes.readUInt32LE(at) !== 0x02014b50) throw new Error(`bad central directory entry ${i}`);
+      const [nameLength, extra, comment] = [bytes.readUInt16LE(at + 28), bytes.readUInt16LE(at + 30), bytes.readUInt16LE(at + 32)];
+      entries.push(bytes.subarray(at + 46, at + 46 + nameLength).toString('utf8'));
+      at += 46 + nameLength + extra + comment;
+    }
+    const id = await page.$eval('#job-rows tr[data-status="done"]', (row) => row.dataset.job);
+    return { id: Number(id), file: download.suggestedFilename(), size: bytes.length, entries: entries.sort() };
   },
 };
 

@@ -2,7 +2,11 @@
 """One prediction job through one SQLite process and through PostgreSQL with one and with two
 `kerf worker` processes behind a `kerf serve --job-workers 0` (issue 12): wall time from upload
 to done, the solver's own time, passes per second, CPU time of the kerf processes, and so the
-overhead of claiming, heartbeats and storing against the one-process run.
+overhead of claiming, heartbeats, splitting into parts and merging them against the one-process
+run. On PostgreSQL the prediction is split into parts (`KERF_JOB_PART_S` core-seconds each,
+default 8) that the workers run at once, and a finish step merges them; the script prints the
+parts, their solve time and the finish step's. The machine's load average is printed with each
+run (the machine may be shared).
 
 Usage (release build, PostgreSQL from Debian's package; as root it runs as the postgres user):
     cargo build --release -p kerf-server
@@ -75,12 +79,23 @@ class Postgres:
             command = ["runuser", "-u", "postgres", "--", *command]
         subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
 
+    def query(self, sql):
+        command = [os.path.join(self.bin, "psql"), "-h", self.folder, "-p", str(self.port), "-U", "postgres",
+                   "-At", "-F", " ", "-c", sql, "postgres"]
+        if self.root:
+            command = ["runuser", "-u", "postgres", "--", *command]
+        return subprocess.run(command, check=True, capture_output=True, text=True).stdout.strip()
+
     def stop(self):
         self.run("pg_ctl", "-D", os.path.join(self.folder, "data"), "-m", "fast", "-w", "stop")
         shutil.rmtree(self.folder, ignore_errors=True)
 
 
-def measure(label, kerf, database, workers, body):
+def load():
+    return open("/proc/loadavg").read().split()[0]
+
+
+def measure(label, kerf, database, workers, body, postgres=None):
     port = free_port()
     base = f"http://127.0.0.1:{port}"
     env = dict(os.environ, RUST_LOG="warn")
@@ -96,6 +111,7 @@ def measure(label, kerf, database, workers, body):
         wait_up(base)
         time.sleep(1)
         cpu = {p.pid: cpu_seconds(p.pid) for p in processes}
+        load_before = load()
         started = time.time()
         request = urllib.request.Request(base + "/api/v1/jobs", data=body,
                                          headers={"content-type": "application/json"})
@@ -112,8 +128,24 @@ def measure(label, kerf, database, workers, body):
         result = job["results"][0]["result"]
         passes, solve = result["summary"]["passes"], result["timings"]["solve_ms"] / 1000
         print(f"{label:34} {passes} passes: upload to done {wall:7.1f} s ({passes / wall:6.0f} passes/s), "
-              f"solve {solve:7.1f} s, outside the solver {wall - solve:5.1f} s, kerf CPU {cpu:7.1f} s", flush=True)
-        return wall
+              f"kerf CPU {cpu:7.1f} s ({cpu / passes * 1e3:.2f} ms per pass), load {load_before} -> {load()}",
+              flush=True)
+        if not postgres:
+            print(f"{'':34} solve {solve:.1f} s, outside the solver {wall - solve:.1f} s", flush=True)
+        else:
+            # Parts: their count, solve time (summed over workers) and the finish step's time.
+            rows = postgres.query("SELECT kind, COUNT(*), SUM(solve_seconds), SUM(work), MAX(attempts) "
+                                  "FROM job_chunks GROUP BY kind ORDER BY kind")
+            parts_seconds = 0.0
+            for row in rows.splitlines():
+                kind, count, seconds, work, attempts = row.split()
+                if kind == "part":
+                    parts_seconds = float(seconds)
+                    print(f"{'':34} {count} parts: solve {parts_seconds:.1f} s summed over the workers "
+                          f"(estimated {float(work):.1f} core-s)", flush=True)
+            print(f"{'':34} finish step (merge, correct, write the answer and program): "
+                  f"{solve - parts_seconds:.1f} s", flush=True)
+        return wall, cpu
     finally:
         for p in processes:
             p.terminate()
@@ -129,13 +161,16 @@ def main():
     try:
         body = json.dumps(job).encode()
         print(f"job file {len(body) / 1e6:.1f} MB", flush=True)
-        measure("SQLite, one process", kerf, os.path.join(folder, "kerf.db"), 0, body)
+        alone = measure("SQLite, one process", kerf, os.path.join(folder, "kerf.db"), 0, body)
         for workers in (1, 2):
             postgres = Postgres()
             try:
-                measure(f"PostgreSQL, {workers} worker process(es)", kerf, postgres.url, workers, body)
+                shared = measure(f"PostgreSQL, {workers} worker process(es)", kerf, postgres.url, workers, body,
+                                 postgres)
             finally:
                 postgres.stop()
+            print(f"{'':34} against one SQLite process: wall {shared[0] - alone[0]:+.1f} s, "
+                  f"CPU {shared[1] - alone[1]:+.1f} s ({(shared[1] / alone[1] - 1) * 100:+.1f} %)", flush=True)
     finally:
         shutil.rmtree(folder, ignore_errors=True)
 

@@ -245,10 +245,16 @@ impl ServerProcess {
     /// Starts `program` with `arguments` and `--bind` (`serve`) or `--metrics-bind` (`worker`)
     /// at a free loopback port, and waits until it answers `/healthz` there.
     pub async fn start_with(program: &Path, arguments: &[&str]) -> Self {
+        Self::start_with_env(program, arguments, &[]).await
+    }
+
+    /// [`ServerProcess::start_with`] with these environment variables set.
+    pub async fn start_with_env(program: &Path, arguments: &[&str], environment: &[(&str, &str)]) -> Self {
         let port = free_port();
         let bind = if arguments.first() == Some(&"worker") { "--metrics-bind" } else { "--bind" };
         let child = std::process::Command::new(program)
             .args(arguments)
+            .envs(environment.iter().copied())
             .arg(bind)
             .arg(format!("127.0.0.1:{port}"))
             .env("RUST_LOG", std::env::var("KERF_TEST_LOG").unwrap_or_else(|_| "warn".to_owned()))

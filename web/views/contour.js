@@ -429,3 +429,6 @@ export const contourView = {
     keepForm(id, form);
   },
 };
+
+// This capability's view in the page's list (`web/views.js` loads it by the capability's name).
+export const view = { title: 'Contour', mount: contourView.mount, result: contourResult };

@@ -39,7 +39,8 @@ const FORM = `
       <label><span>Hole tilt from +Z, ° <abbr class="symbol" title="penetration angle θ_P">θP</abbr></span> <input name="penetration" type="number" step="any" value="0" data-field="hole.penetration_angle_deg"></label>
     </fieldset>
     <fieldset><legend>Cut</legend>
-      <label>Which edge <select name="edge" data-field="edge"><option value="outer">outer (tube outside)</option><option value="inner">inner (bore)</option></select></label>
+      <label>Which edge <select name="edge" data-field="edge"><option value="outer">outer (tube outside)</option><option value="inner">inner (bore)</option><option value="both">both (one program)</option></select></label>
+      <label data-edge="both">Tool for the bore edge <select name="inner_tool_choice" data-field="inner_tool"></select></label>
       <label><span>Chamfer size, mm <abbr class="symbol" title="cut amount Q; width W = √2·Q">Q</abbr></span> <input name="cut_amount" type="number" step="any" value="0.2" data-field="cut_amount"></label>
       <label><span>Path tolerance, mm <abbr class="symbol" title="TA">TA</abbr></span> <input name="tolerance" type="number" step="any" value="0.01" data-field="tolerance"></label>
       <label>Method <select name="method" data-field="method"><option value="tangent">tangent construction</option><option value="exact">exact chamfer width</option></select></label>
@@ -76,9 +77,12 @@ export function deburrRequest(form) {
   const hole = { shape, radius: numeric(form, 'hole_radius'), eccentricity: numeric(form, 'eccentricity') ?? 0, penetration_angle_deg: numeric(form, 'penetration') ?? 0 };
   if (shape === 'slot') hole.centre_distance = numeric(form, 'slot_length');
   if (shape === 'rounded_rect') hole.centre_distance = [numeric(form, 'rect_across'), numeric(form, 'rect_along')];
+  const edge = value(form, 'edge');
+  const innerChoice = value(form, 'inner_tool_choice');
   return {
     tool, workpiece, hole,
-    edge: value(form, 'edge'),
+    edge,
+    inner_tool: edge === 'both' && innerChoice && innerChoice !== 'inline' ? Number(innerChoice) : undefined,
     cut_amount: numeric(form, 'cut_amount'),
     tolerance: numeric(form, 'tolerance'),
     method: value(form, 'method'),
@@ -97,6 +101,7 @@ function syncVisibility(form) {
   form.querySelectorAll('[data-shape]').forEach((e) => { e.hidden = e.dataset.shape !== shape; });
   form.querySelector('[data-inline-tool]').hidden = value(form, 'tool_choice') !== 'inline';
   if (kind === 'bore_block') form.elements.edge.value = 'inner';
+  form.querySelectorAll('[data-edge]').forEach((e) => { e.hidden = e.dataset.edge !== value(form, 'edge'); });
 }
 
 
@@ -165,6 +170,11 @@ export function deburrResult(container, answer, context = {}) {
   if (request) addWorkpiece(scene, request);
   scene.path('ridge', points.map((p) => p.target), { colour: '#555555', legend: 'ridge (where the edges meet)' });
   scene.path('centres', [...points.map((p) => p.centre), points[0].centre], { colour: '#0b63b6', legend: 'ball-centre path' });
+  // Several loops (holes, both edges): every other loop too, in the order the program visits them.
+  (answer.holes ?? []).slice(1).forEach((loop, i) => {
+    scene.path(`ridge-${i + 1}`, loop.points.map((p) => p.target), { colour: '#555555' });
+    scene.path(`centres-${i + 1}`, loop.points.map((p) => p.centre), { colour: loop.edge === 'inner' ? '#6a1b9a' : '#0b63b6', legend: i === 0 && loop.edge === 'inner' ? 'bore-edge centre path' : undefined });
+  });
   // Where the ball on its way in or out, or the neck along the path, meets the wall: red.
   const found = request ? clearance(request, answer) : null;
   const blocked = Boolean(found?.approach.length);
@@ -219,6 +229,16 @@ export function deburrResult(container, answer, context = {}) {
     items.push(['blocks (short)', `${s.blocks} (${s.short_blocks})`], ['block length, mm', number(s.block_length, 4)]);
   }
   if (answer.machine) items.push(['machine', `${answer.machine.name} (${answer.machine.dialect})`]);
+  if (answer.holes) {
+    const order = answer.visiting_order;
+    items.push(['loops (holes × edges)', answer.holes.length]);
+    if (order) {
+      items.push(['travel between loops, mm', `${number(order.travel, 1)} (request order ${number(order.request_order_travel, 1)})`]);
+      if (order.tool_changes) items.push(['tool changes', order.tool_changes]);
+      if (order.turns) items.push(['tube turns (M00)', order.turns]);
+    }
+  }
+  if (answer.cycle_time) items.push(['cycle time, s', number(answer.cycle_time.total_s, 1)]);
   showSummary(summaryBox, items);
   warnings.replaceChildren(...notes, ...warningMessages(answer.warnings));
   return scene.root;
@@ -242,6 +262,7 @@ export const deburrView = {
     const gcodeNote = root.querySelector('#deburr-gcode-note');
     form.addEventListener('change', () => syncVisibility(form));
     loadTools(form.elements.tool_choice, 'inline ball (size below)', (tool) => tool.kind === 'ball').then(() => syncVisibility(form));
+    loadTools(form.elements.inner_tool_choice, 'the same tool', (tool) => tool.kind === 'ball');
     loadMachines(form.elements.machine);
     machineFields(form, { block_time_ms: 'block_time_ms' });
     syncVisibility(form);
@@ -305,3 +326,6 @@ export const deburrView = {
     keepForm(id, form);
   },
 };
+
+// This capability's view in the page's list (`web/views.js` loads it by the capability's name).
+export const view = { title: 'Deburr', mount: deburrView.mount, result: deburrResult };

@@ -734,3 +734,6 @@ export const engagementView = {
     });
   },
 };
+
+// This capability's view in the page's list (`web/views.js` loads it by the capability's name).
+export const view = { title: 'Engagement', mount: engagementView.mount, result: engagementResult };

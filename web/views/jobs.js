@@ -1,6 +1,6 @@
 // Jobs workbench: drop or pick a job file, watch it queue and run, browse past jobs, open a
 // result with the view of its operation, download G-code and JSON (api.md, Jobs).
-import { api, sentence } from '/api.js';
+import { api, binary, sentence } from '/api.js';
 import { download, message, showProblem } from '/form.js';
 import { resultView } from '/views.js';
 
@@ -143,10 +143,24 @@ async function openJob(id, root) {
     const title = document.createElement('h2');
     title.textContent = `Job #${job.id}${job.name ? ': ' + job.name : ''}`;
     box.append(title);
-    // The whole job as one program: every operation with its tool change (issue 15).
+    // The whole job as one program: every operation with its tool change (issue 15), and every
+    // output in one zip (job.json, each answer and program, the job's program).
+    const whole = document.createElement('div');
+    whole.className = 'actions';
+    const zip = document.createElement('button');
+    zip.className = 'secondary';
+    zip.id = 'job-zip';
+    zip.textContent = 'All outputs (zip)';
+    zip.addEventListener('click', async () => {
+      try {
+        download(`job-${job.id}.zip`, await binary(`/api/v1/jobs/${job.id}/outputs.zip`), 'application/zip');
+      } catch (problem) {
+        showProblem(root.querySelector('#job-messages'), null, problem);
+      }
+    });
+    whole.append(zip);
+    box.append(whole);
     if (job.results.some((result) => result.gcode)) {
-      const whole = document.createElement('div');
-      whole.className = 'actions';
       const program = document.createElement('button');
       program.className = 'secondary';
       program.textContent = 'Program (all operations)';
@@ -157,8 +171,7 @@ async function openJob(id, root) {
           showProblem(root.querySelector('#job-messages'), null, problem);
         }
       });
-      whole.append(program);
-      box.append(whole);
+      whole.prepend(program);
     }
     const shown = [];
     job.results.forEach((result, index) => {

@@ -20,6 +20,7 @@ const FORM = `
       <label>Circular moves <select name="arcs" data-field="arcs"><option value="">default (chords)</option><option value="chords">chords (G01)</option><option value="g2g3">G02/G03</option></select></label>
       <label>Plunge feed, mm/min <input name="plunge_feed" type="number" step="any" placeholder="half the cutting feed" data-field="plunge_feed"></label>
       <label>Acceleration, mm/s² <input name="max_accel" type="number" step="any" placeholder="none: no cycle time" data-field="max_accel"></label>
+      <label>Jerk, mm/s³ <input name="max_jerk" type="number" step="any" placeholder="none: trapezoids" data-field="max_jerk"></label>
       <label>Rapid feed, mm/min <input name="rapid_feed" type="number" step="any" placeholder="max feed" data-field="rapid_feed"></label>
       <label>Tool change, s <input name="tool_change_s" type="number" step="any" placeholder="0" data-field="tool_change_s"></label>
       <label>Spindle power, kW <input name="spindle_power_kw" type="number" step="any" data-field="spindle_power_kw"></label>
@@ -42,7 +43,7 @@ const FORM = `
 
 // The profile's fields the form edits; text and choices, the rest numbers (empty: not sent).
 const TEXT_FIELDS = ['dialect', 'description', 'mode', 'arcs'];
-const NUMBER_FIELDS = ['block_time_ms', 'max_feed', 'margin', 'min_chord_error', 'plunge_feed', 'max_accel', 'rapid_feed', 'tool_change_s', 'spindle_power_kw', 'spindle_torque_nm'];
+const NUMBER_FIELDS = ['block_time_ms', 'max_feed', 'margin', 'min_chord_error', 'plunge_feed', 'max_accel', 'max_jerk', 'rapid_feed', 'tool_change_s', 'spindle_power_kw', 'spindle_torque_nm'];
 
 // The machine last opened with Edit: saving keeps the fields of it the form does not show, so
 // editing on the page never drops what was registered through the API.

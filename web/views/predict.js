@@ -369,7 +369,8 @@ export function predictResult(container, answer, { request, program } = {}) {
     ['no cut / no surface / outside', `${s.no_cut} / ${s.no_surface} / ${s.outside_stock}`],
     ['method', `${s.method.replace('_', ' ')}, N ${s.resolution} (${number(s.pixel_size * 1000, 1)} µm)`],
     ['tool', `${answer.tool.number ? 'T' + answer.tool.number + ' ' : ''}ball Ø${Number((2 * answer.tool.radius).toFixed(3))} mm`],
-  ].concat(answer.timings ? [['time', `${number(answer.timings.solve_ms / 1000, 2)} s (${Math.round(answer.timings.passes_per_s)} passes/s)`]] : []));
+  ].concat(s.merge ? [['merged passes', `${s.merge.merged} (${s.merge.simulated} simulated), error of the merge ≤ ${microns(s.merge.max_bound)} µm`]] : [])
+    .concat(answer.timings ? [['time', `${number(answer.timings.solve_ms / 1000, 2)} s (${Math.round(answer.timings.passes_per_s)} passes/s)`]] : []));
 
   const head = document.createElement('tr');
   for (const title of ['#', 'pass', 'NC line', 'error, µm', 'contact angle, °', 'flags']) {
@@ -473,3 +474,6 @@ export const predictView = {
     keepForm(id, form);
   },
 };
+
+// This capability's view in the page's list (`web/views.js` loads it by the capability's name).
+export const view = { title: 'Predict', mount: predictView.mount, result: predictResult };

@@ -380,3 +380,6 @@ export const segmentView = {
     keepForm(id, form);
   },
 };
+
+// This capability's view in the page's list (`web/views.js` loads it by the capability's name).
+export const view = { title: 'Segment', mount: segmentView.mount, result: segmentResult };

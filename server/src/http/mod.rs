@@ -1,14 +1,13 @@
-//! HTTP routes, one module per resource, each with a `router()`.
+//! HTTP routes, one module per resource, each with a `router()`; the solver endpoints are generated
+//! from the capability registry in `endpoints`.
 
 pub mod contour;
-pub mod deburr;
-pub mod engagement;
+pub mod endpoints;
 pub mod health;
 pub mod jobs;
 pub mod machines;
 pub mod materials;
 pub mod output;
 pub mod predict;
-pub mod segment;
 pub mod solve;
 pub mod tools;

@@ -38,6 +38,56 @@ pub struct OutputQuery {
     pub arcs: Option<Arcs>,
 }
 
+/// Query parameters of an endpoint whose answer holds several candidate paths (engagement): the
+/// output negotiation of [`OutputQuery`] plus which candidate to program.
+#[derive(Debug, Clone, Default, Deserialize, IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+pub struct CandidateQuery {
+    /// `json` (default) or `gcode`; `Accept: text/x-gcode` also selects G-code.
+    pub format: Option<Format>,
+    /// G-code dialect: `fanuc` or `linuxcnc` (default: the named machine's, else `fanuc`).
+    pub dialect: Option<Dialect>,
+    /// Programmed point: `tip` (default; length offset to the tool tip) or `centre` (the centre
+    /// of the tool's end rounding: the ball centre, the bull-nose corner centre, the tip for a
+    /// flat end mill).
+    pub reference: Option<Reference>,
+    /// G-code only: which entry of `paths` to program (0-based; default the request's
+    /// `candidate`, else 0); a request with `path` has only candidate 0.
+    pub candidate: Option<usize>,
+    /// Arc segments of the path: `g2g3` (G02/G03 with I/J, end points those of the chords) or
+    /// `chords` (G01 within 0.001 mm, or by the block-time rule); default the machine's `arcs`,
+    /// else `chords`.
+    pub arcs: Option<Arcs>,
+}
+
+/// A query that says what the client asks for (with the `Accept` header).
+pub trait Negotiate {
+    /// What the client asked for; an explicit `format` wins over `Accept`.
+    fn ask(&self, headers: &HeaderMap) -> Ask;
+}
+
+impl Negotiate for OutputQuery {
+    fn ask(&self, headers: &HeaderMap) -> Ask {
+        Ask::negotiate(headers, self)
+    }
+}
+
+impl Negotiate for CandidateQuery {
+    fn ask(&self, headers: &HeaderMap) -> Ask {
+        Ask {
+            gcode: wants_gcode(headers, self.format),
+            output: OutputOptions {
+                dialect: self.dialect,
+                reference: self.reference,
+                candidate: self.candidate,
+                arcs: self.arcs,
+            },
+            timings: false,
+        }
+    }
+}
+
 /// What the client asked for: JSON, or the program with its output options.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Ask {

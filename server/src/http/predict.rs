@@ -11,7 +11,7 @@ use axum::extract::{DefaultBodyLimit, FromRequest, Multipart, Request, State};
 use axum::http::{HeaderMap, StatusCode, header};
 use axum::response::Response;
 use kerf_solver::ErrorCode;
-use kerf_solver::capability::OutputOptions;
+use kerf_solver::capability::{Capability, OutputOptions};
 use kerf_solver::gcode::{Dialect, Reference};
 use kerf_solver::predict::{PredictAnswer, PredictCapability, PredictRequest};
 use serde::Deserialize;
@@ -121,14 +121,11 @@ async fn upload(state: &AppState, request: Request) -> AppResult<Upload> {
     Ok(Upload { request: parse_json(&json)?, mesh })
 }
 
-/// Predicts the machining error of a ball-end-mill finishing path and corrects the path.
-///
-/// Returns one record per pass (error along the surface normal, contact angle, generation point,
-/// normal, flags, corrected end point), a summary with the worst passes and warnings (JSON), or
-/// with `Accept: text/x-gcode` / `?format=gcode` the corrected program. The body is JSON, or a
-/// form with the JSON in part `request` and the STL stock in part `stock`. Long paths exceed the
-/// synchronous time limit (422 `E_TIMEOUT`): submit them as a job (`operation = "predict"`).
+/// The predict capability's endpoint, with its upload (documented with the capability's
+/// [`Endpoint`](kerf_solver::capability::Endpoint) texts like the generated ones).
 #[utoipa::path(post, path = "/api/v1/predict", tag = "predict",
+    summary = <PredictCapability as Capability>::ENDPOINT.summary,
+    description = <PredictCapability as Capability>::ENDPOINT.description,
     params(PredictQuery),
     request_body(description = "The request as JSON, or a form with it in part `request` and the STL stock in part `stock`.",
         content(
@@ -139,10 +136,10 @@ async fn upload(state: &AppState, request: Request) -> AppResult<Upload> {
             (PredictAnswer = "application/json"),
             (String = "text/x-gcode"))),
         (status = 400, description = "Not the right shape (JSON or form)", body = Problem, content_type = "application/problem+json"),
-        (status = 404, description = "Unknown tool number", body = Problem, content_type = "application/problem+json"),
+        (status = 404, description = <PredictCapability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
         (status = 413, description = "Body over the upload limit", body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
-        (status = 422, description = "Impossible or over a limit: tool kind, no shape-error table, G-code errors with the line, open mesh, resolution over the memory limit; `E_TIMEOUT` over the synchronous time limit: submit a job", body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = <PredictCapability as Capability>::ENDPOINT.refused, body = Problem, content_type = "application/problem+json"),
         (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json")))]
 async fn post_predict(
     State(state): State<AppState>,

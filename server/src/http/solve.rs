@@ -6,7 +6,7 @@
 use axum::body::Bytes;
 use axum::http::{HeaderValue, header};
 use axum::response::Response;
-use kerf_solver::capability::{Capability, Control, Purpose, Run};
+use kerf_solver::capability::{self, Capability, Control, Purpose, Run};
 
 use super::output::Ask;
 use crate::capabilities::{self, Delivered};
@@ -25,7 +25,8 @@ pub async fn answer<C: Capability>(
     upload: Option<Bytes>,
     ask: Ask,
 ) -> AppResult<Response> {
-    let catalog = store::catalog(&state.db, [C::refs(&request)], capabilities::Catalog::default()).await?;
+    let catalog =
+        store::catalog(&state.db, capability::all_refs::<C>(&request), capabilities::Catalog::default()).await?;
     let resolved = capabilities::resolve::<C>(&request, &catalog)?;
     if ask.gcode {
         C::check_output(&request, &ask.output)?;

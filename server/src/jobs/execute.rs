@@ -6,10 +6,11 @@ use kerf_solver::ErrorCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, PoisonError};
 
-use kerf_solver::capability::{Control, Purpose, Run};
+use kerf_solver::capability::{Control, Part, Purpose, Run, Split};
 
 use super::file::JobFile;
-use crate::capabilities::Stored;
+use super::parts::{StoredParts, sizing};
+use crate::capabilities::{Operation, PartBytes, Stored};
 use crate::error::{AppError, Problem};
 
 /// Why a job did not finish.
@@ -54,6 +55,61 @@ pub fn execute_operation(
     progress: &(dyn Fn(f64) + Sync),
     cancelled: &AtomicBool,
 ) -> Result<Stored, JobFailure> {
+    within(job, index, progress, cancelled, |operation, run| operation.run(job, run, &job.output.for_programs()))
+}
+
+/// How operation `index` of `job` divides into parts for different workers ([`sizing`]), or
+/// `None` to solve it whole. CPU work (the capability reads the request): call it on a blocking
+/// thread.
+pub fn plan(job: &JobFile, index: usize) -> Option<Split> {
+    job.operations.get(index)?.split(job, &sizing())
+}
+
+/// Solves part `part` of operation `index` (a chunk of an operation split by [`plan`]); its
+/// output, for the finish step. `progress` as for [`execute_operation`], of this part.
+///
+/// # Errors
+/// As [`execute_operation`].
+pub fn execute_part(
+    job: &JobFile,
+    index: usize,
+    part: &Part,
+    progress: &(dyn Fn(f64) + Sync),
+    cancelled: &AtomicBool,
+) -> Result<PartBytes, JobFailure> {
+    within(job, index, progress, cancelled, |operation, run| operation.run_part(job, part, run))
+}
+
+/// The finish step of operation `index`, split by [`plan`]: merges its parts' outputs (in order)
+/// into the operation's result and program, equal byte for byte to what [`execute_operation`]
+/// stores (apart from the time an answer reports it took: `seconds`, the parts' solve time, plus
+/// the finish step's).
+///
+/// # Errors
+/// As [`execute_operation`].
+pub fn execute_finish(
+    job: &JobFile,
+    index: usize,
+    parts: Vec<Vec<u8>>,
+    seconds: f64,
+    progress: &(dyn Fn(f64) + Sync),
+    cancelled: &AtomicBool,
+) -> Result<Stored, JobFailure> {
+    let mut parts = StoredParts::new(parts);
+    within(job, index, progress, cancelled, |operation, run| {
+        operation.finish(job, &mut parts, run, &job.output.for_programs(), seconds)
+    })
+}
+
+/// Runs `work` on operation `index` of `job` as a job runs it: with progress (passed on when it
+/// increases) and cancellation, its time recorded, its refusal under `operations[index]`.
+fn within<T>(
+    job: &JobFile,
+    index: usize,
+    progress: &(dyn Fn(f64) + Sync),
+    cancelled: &AtomicBool,
+    work: impl FnOnce(&Operation, &Run<'_>) -> Result<T, AppError>,
+) -> Result<T, JobFailure> {
     let Some(operation) = job.operations.get(index) else {
         let error = AppError::Internal(anyhow::anyhow!("the job has no operation {index}"));
         return Err(JobFailure::Refused(Box::new(error.problem())));
@@ -76,9 +132,9 @@ pub fn execute_operation(
         purpose: Purpose::Job,
     };
     let started = std::time::Instant::now();
-    let stored = operation.run(job, &run, &job.output.for_programs()).map_err(|error| failure(index, error))?;
+    let output = work(operation, &run).map_err(|error| failure(index, error))?;
     crate::metrics::observe_solver(operation.name(), started.elapsed().as_secs_f64());
-    Ok(stored)
+    Ok(output)
 }
 
 fn failure(index: usize, error: AppError) -> JobFailure {

@@ -25,7 +25,7 @@
 //! names a `machine` or a `material`.
 
 use kerf_solver::ErrorCode;
-use kerf_solver::capability::{self, Lookup};
+use kerf_solver::capability::{self, Lookup, Refs};
 use kerf_solver::gcode::job::Coolant;
 use kerf_solver::gcode::{Arcs, Dialect, Reference};
 use kerf_solver::machine::{MachineProfile, validate_machine_name};
@@ -373,14 +373,15 @@ impl JobFile {
             machines: std::mem::take(&mut self.machines),
             materials: std::mem::take(&mut self.materials),
         };
+        let all_refs: Vec<Refs<'_>> = self.operations.iter().flat_map(|operation| operation.all_refs()).collect();
         let found = match db {
-            Some(db) => store::catalog(db, self.operations.iter().map(Operation::refs), given).await?,
+            Some(db) => store::catalog(db, all_refs, given).await?,
             None => given,
         };
         for (index, operation) in self.operations.iter().enumerate() {
             operation.check_refs(&found).map_err(|error| error.under(&format!("operations[{index}]")))?;
         }
-        let refs: Vec<_> = self.operations.iter().map(Operation::refs).collect();
+        let refs: Vec<_> = self.operations.iter().flat_map(|operation| operation.all_refs()).collect();
         let numbers: Vec<u32> = refs
             .iter()
             .filter_map(|r| match r.tool {

@@ -4,6 +4,7 @@
 pub mod execute;
 pub mod file;
 pub mod local;
+pub mod parts;
 pub mod program;
 pub mod queue;
 pub mod storage;

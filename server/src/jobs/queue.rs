@@ -18,13 +18,14 @@ use sqlx::PgPool;
 use sqlx::postgres::PgListener;
 use tokio::sync::{Notify, Semaphore};
 
-use super::execute::{JobFailure, execute, execute_operation};
+use super::execute::{JobFailure, execute, execute_finish, execute_operation, execute_part, plan};
+use super::file::JobFile;
 use super::storage::JobStorage;
 use crate::db::Db;
-use crate::error::AppError;
+use crate::error::{AppError, AppResult};
 use crate::store;
-use crate::store::jobs::{CANCEL_CHANNEL, Claimant, Claimed, Finished, SUBMITTED_CHANNEL, Work};
-use crate::store::packed::Packed;
+use crate::store::jobs::{CANCEL_CHANNEL, Claimant, Claimed, Finished, PartOutput, SUBMITTED_CHANNEL, Task, Work};
+use crate::store::packed::{Packed, gzip};
 
 /// How often a running job's progress and heartbeat are written.
 const HEARTBEAT: Duration = Duration::from_millis(250);
@@ -187,43 +188,72 @@ async fn work(runner: Arc<JobRunner>, db: Db, slots: Arc<Semaphore>) {
     }
 }
 
-async fn run(runner: &JobRunner, db: &Db, slots: &Arc<Semaphore>, Claimed { work, job, attempt }: Claimed) {
+/// What a chunk computed: an operation's (or a whole job's) results, or a part's output.
+enum Output {
+    Results(Vec<Packed>),
+    Part(PartOutput),
+}
+
+async fn run(runner: &JobRunner, db: &Db, slots: &Arc<Semaphore>, Claimed { work, task, job, attempt }: Claimed) {
     let claimant = &runner.claimant;
     let id = work.id;
-    tracing::info!(id, chunk = ?work.chunk, attempt, worker = %claimant.worker, "claimed");
+    tracing::info!(id, chunk = ?work.chunk, ?task, attempt, worker = %claimant.worker, "claimed");
     let cancelled = Arc::new(AtomicBool::new(false));
     runner.flags().insert(work, Arc::clone(&cancelled));
     let progress = Arc::new(AtomicU64::new(0));
+    let beat = Beat { db, work, claimant, progress: &progress, cancelled: &cancelled };
     let Ok(permit) = Arc::clone(slots).acquire_owned().await else { return };
-    let (task_progress, task_cancelled) = (Arc::clone(&progress), Arc::clone(&cancelled));
-    let mut task = tokio::task::spawn_blocking(move || {
+    let job = Arc::new(job);
+    let Some(task) = divide(&beat, &job, task).await else {
+        runner.flags().remove(&work);
+        return;
+    };
+    let parts = match &task {
+        Task::Finish { operation } => match store::jobs::part_outputs(db, id, *operation).await {
+            Ok(parts) => parts,
+            Err(error) => {
+                tracing::error!(id, %error, "reading the parts' outputs failed");
+                runner.flags().remove(&work);
+                if let Err(error) = store::jobs::fail(db, work, claimant, &error.problem()).await {
+                    tracing::error!(id, %error, "storing the job outcome failed");
+                }
+                return;
+            }
+        },
+        _ => Vec::new(),
+    };
+    let (task_progress, task_cancelled, computed) = (Arc::clone(&progress), Arc::clone(&cancelled), task.clone());
+    let computing = tokio::task::spawn_blocking(move || {
         let _permit = permit;
         let report = |fraction: f64| task_progress.store(fraction.to_bits(), Ordering::Relaxed);
-        let outputs = match work.chunk {
-            None => execute(&job, &report, &task_cancelled),
-            Some(index) => execute_operation(&job, index, &report, &task_cancelled).map(|stored| vec![stored]),
-        }?;
-        // Compressed here, on the blocking thread and in the solver slot, not on the async threads.
-        Ok::<_, JobFailure>(outputs.iter().map(Packed::new).collect::<Vec<_>>())
-    });
-    let mut ticker = tokio::time::interval(HEARTBEAT);
-    let outcome = loop {
-        tokio::select! {
-            outcome = &mut task => break outcome,
-            _ = ticker.tick() => {
-                let fraction = f64::from_bits(progress.load(Ordering::Relaxed));
-                match store::jobs::heartbeat(db, work, claimant, fraction).await {
-                    Ok(true) => {}
-                    // Cancelled, or no longer ours: stop computing.
-                    Ok(false) => cancelled.store(true, Ordering::Relaxed),
-                    Err(error) => tracing::warn!(id, %error, "recording progress failed"),
-                }
+        let packed = |outputs: Vec<crate::capabilities::Stored>| {
+            // Compressed here, on the blocking thread and in the solver slot, not on the async
+            // threads.
+            Output::Results(outputs.iter().map(Packed::new).collect())
+        };
+        Ok::<_, JobFailure>(match computed {
+            Task::Job => packed(execute(&job, &report, &task_cancelled)?),
+            Task::Operation(index) => packed(vec![execute_operation(&job, index, &report, &task_cancelled)?]),
+            Task::Part { operation, part } => {
+                let output = execute_part(&job, operation, &part, &report, &task_cancelled)?;
+                Output::Part(PartOutput {
+                    operation: job.operations[operation].name().to_owned(),
+                    gz: gzip(&output.bytes),
+                    bytes: output.bytes.len(),
+                    seconds: output.seconds,
+                })
             }
-        }
-    };
+            Task::Finish { operation } => {
+                let seconds = parts.iter().map(|(_, seconds)| seconds).sum();
+                let parts = parts.into_iter().map(|(output, _)| output).collect();
+                packed(vec![execute_finish(&job, operation, parts, seconds, &report, &task_cancelled)?])
+            }
+        })
+    });
+    let outcome = beat.during(computing).await;
     runner.flags().remove(&work);
     let stored = match outcome {
-        Ok(Ok(outputs)) => match finish(db, work, claimant, &outputs, &runner.storage).await {
+        Ok(Ok(output)) => match finish(db, work, &task, claimant, &output, &runner.storage).await {
             Ok(Finished::Refused(problem)) => {
                 tracing::warn!(id, code = %problem.code.as_str(), "{}", problem.detail);
                 store::jobs::fail(db, work, claimant, &problem).await
@@ -243,21 +273,95 @@ async fn run(runner: &JobRunner, db: &Db, slots: &Arc<Semaphore>, Claimed { work
     }
 }
 
+/// The heartbeat of one claimed chunk.
+struct Beat<'a> {
+    db: &'a Db,
+    work: Work,
+    claimant: &'a Claimant,
+    progress: &'a AtomicU64,
+    cancelled: &'a AtomicBool,
+}
+
+impl Beat<'_> {
+    /// Awaits `task`, writing the chunk's progress and heartbeat every [`HEARTBEAT`] meanwhile; a
+    /// heartbeat that finds the chunk no longer ours (cancelled, or claimed again after our lease
+    /// expired) sets the cancel flag, which stops the computation.
+    async fn during<T>(&self, mut task: tokio::task::JoinHandle<T>) -> Result<T, tokio::task::JoinError> {
+        let mut ticker = tokio::time::interval(HEARTBEAT);
+        loop {
+            tokio::select! {
+                outcome = &mut task => return outcome,
+                _ = ticker.tick() => {
+                    let fraction = f64::from_bits(self.progress.load(Ordering::Relaxed));
+                    match store::jobs::heartbeat(self.db, self.work, self.claimant, fraction).await {
+                        Ok(true) => {}
+                        // Cancelled, or no longer ours: stop computing.
+                        Ok(false) => self.cancelled.store(true, Ordering::Relaxed),
+                        Err(error) => tracing::warn!(id = self.work.id, %error, "recording progress failed"),
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A whole operation's chunk (PostgreSQL) whose work divides is split first ([`plan`],
+/// [`store::jobs::split`]): the chunk becomes the first part, which this worker then solves,
+/// while other workers claim the other parts. Other tasks run as claimed. `None` when the chunk
+/// is no longer ours.
+async fn divide(beat: &Beat<'_>, job: &Arc<JobFile>, task: Task) -> Option<Task> {
+    let Task::Operation(index) = task else { return Some(task) };
+    if !beat.db.is_postgres() {
+        return Some(task);
+    }
+    let planned = {
+        let job = Arc::clone(job);
+        beat.during(tokio::task::spawn_blocking(move || plan(&job, index))).await
+    };
+    let split = match planned {
+        Ok(Some(split)) if !beat.cancelled.load(Ordering::Relaxed) => split,
+        Ok(_) => return Some(task),
+        Err(error) => {
+            tracing::error!(id = beat.work.id, %error, "splitting the operation failed; solving it whole");
+            return Some(task);
+        }
+    };
+    match store::jobs::split(beat.db, beat.work, beat.claimant, &split).await {
+        Ok(true) => {
+            tracing::info!(id = beat.work.id, operation = index, parts = split.parts.len(), "split");
+            let part = split.parts.into_iter().next()?;
+            Some(Task::Part { operation: index, part })
+        }
+        Ok(false) => None,
+        Err(error) => {
+            tracing::warn!(id = beat.work.id, %error, "storing the split failed; solving the operation whole");
+            Some(task)
+        }
+    }
+}
+
 /// Stores finished work, once more after a failure (two finishers of one job's chunks can meet
 /// in a deadlock that PostgreSQL breaks by failing one of them). Work that cannot be stored is not
 /// lost: its chunk's lease expires and another worker runs it again.
 async fn finish(
     db: &Db,
     work: Work,
+    task: &Task,
     claimant: &Claimant,
-    outputs: &[Packed],
+    output: &Output,
     storage: &JobStorage,
-) -> crate::error::AppResult<Finished> {
-    match store::jobs::finish(db, work, claimant, outputs, storage).await {
+) -> AppResult<Finished> {
+    let once = || async {
+        match output {
+            Output::Part(part) => store::jobs::finish_part(db, work, task.operation(), claimant, part, storage).await,
+            Output::Results(outputs) => store::jobs::finish(db, work, task, claimant, outputs, storage).await,
+        }
+    };
+    match once().await {
         Ok(finished) => Ok(finished),
         Err(error) => {
             tracing::warn!(id = work.id, %error, "storing the result failed; once more");
-            store::jobs::finish(db, work, claimant, outputs, storage).await
+            once().await
         }
     }
 }

@@ -3,16 +3,19 @@
 //!
 //! In SQLite one process owns the queue: its workers claim the oldest queued job with one atomic
 //! UPDATE, and at start every job left `running` is queued again ([`recover`]). In PostgreSQL any
-//! number of processes share it, and a job is split into chunks (one per operation) that
-//! different workers run at once: a worker claims a chunk in a short transaction with
-//! `SELECT … FOR UPDATE SKIP LOCKED` (concurrent claimers skip each other's rows instead of
-//! waiting), writes its name and a lease on the chunk, and pushes the lease forward with each
-//! heartbeat; a running chunk whose lease expired (its worker died, `kill -9`) is claimed again
-//! like a queued one. Each chunk stores its operation's result; the last one marks the job done.
+//! number of processes share it, and a job is split into chunks (one per operation, and an
+//! operation whose work divides into parts and a finish step: [`split`]) that different workers
+//! run at once: a worker claims a chunk in a short transaction with `SELECT … FOR UPDATE SKIP
+//! LOCKED` (concurrent claimers skip each other's rows instead of waiting), writes its name and a
+//! lease on the chunk, and pushes the lease forward with each heartbeat; a running chunk whose
+//! lease expired (its worker died, `kill -9`) is claimed again like a queued one. A part stores its
+//! output on its chunk; a whole operation or a finish step stores the operation's result; the last
+//! chunk marks the job done.
 //! Submissions and cancellations `NOTIFY` the workers (`kerf_jobs`, `kerf_cancel`); every write
 //! of a running chunk checks that it is still the writer's and its job still running.
 
 use kerf_solver::ErrorCode;
+use kerf_solver::capability::{Part, Split};
 use serde::Serialize;
 use std::time::Duration;
 
@@ -212,12 +215,12 @@ pub struct Claimant {
     pub lease: Duration,
 }
 
-/// What a worker runs: a whole job (SQLite), or one chunk of it (PostgreSQL: operation `chunk`).
+/// What a worker runs: a whole job (SQLite), or one chunk of it (PostgreSQL: chunk `chunk`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Work {
     /// Job id.
     pub id: i64,
-    /// The operation this chunk is, or `None` for the whole job.
+    /// The chunk's number within its job (`job_chunks.position`), or `None` for the whole job.
     pub chunk: Option<usize>,
 }
 
@@ -227,16 +230,56 @@ impl Work {
     }
 }
 
+/// What a claimed piece of work computes.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Task {
+    /// Every operation of the job, in order (SQLite).
+    Job,
+    /// Operation `i`, whole: the worker may first split it ([`split`]).
+    Operation(usize),
+    /// One part of an operation that was split.
+    Part {
+        /// The operation's index.
+        operation: usize,
+        /// The part.
+        part: Part,
+    },
+    /// The finish step of an operation that was split: merges its parts' outputs.
+    Finish {
+        /// The operation's index.
+        operation: usize,
+    },
+}
+
+impl Task {
+    /// The operation a chunk belongs to (0 for a whole job: its results start there).
+    pub fn operation(&self) -> usize {
+        match self {
+            Self::Job => 0,
+            Self::Operation(operation) | Self::Part { operation, .. } | Self::Finish { operation } => *operation,
+        }
+    }
+}
+
 /// Work a worker claimed.
 #[derive(Debug)]
 pub struct Claimed {
     /// The job, and the chunk of it.
     pub work: Work,
+    /// What the chunk computes.
+    pub task: Task,
     /// The resolved job.
     pub job: JobFile,
     /// Which attempt this is (1 for the first).
     pub attempt: i64,
 }
+
+/// Sets job `$1`'s progress to the weighted sum of its chunks' (an operation's chunks weigh 1
+/// together, so this is the mean over operations of each one's share done).
+const JOB_PROGRESS: &str = "UPDATE jobs SET heartbeat_at = now(), progress = (
+         SELECT LEAST(1, GREATEST(0, COALESCE(SUM(weight * progress) / NULLIF(SUM(weight), 0), 0)))
+         FROM job_chunks WHERE job_id = $1)
+     WHERE id = $1 AND status = 'running'";
 
 /// Bytes as the stores count them.
 fn bytes(count: usize) -> i64 {
@@ -255,7 +298,8 @@ async fn store_full(db: &Db, needed: i64, quota: i64) -> AppResult<AppError> {
     )))
 }
 
-/// Stores a new queued job (PostgreSQL: with one chunk per operation) and wakes the workers;
+/// Stores a new queued job (PostgreSQL: with one chunk per operation, which the worker that
+/// claims it may split) and wakes the workers;
 /// returns its id. A job that would take the store past `quota` bytes is refused (429
 /// `E_JOB_STORE_FULL`) and nothing of it is written: the check and the insert are one statement
 /// (SQLite) or one transaction under the quota lock (PostgreSQL).
@@ -303,7 +347,8 @@ pub async fn insert(db: &Db, job: &JobFile, hash: &str, quota: u64) -> AppResult
                 return Err(store_full(db, size, quota).await?);
             };
             sqlx::query(
-                "INSERT INTO job_chunks (job_id, position, status) SELECT $1, generate_series(0, $2 - 1), 'queued'",
+                "INSERT INTO job_chunks (job_id, position, operation, status)
+                 SELECT $1, n, n, 'queued' FROM generate_series(0, $2 - 1) AS n",
             )
             .bind(id)
             .bind(count)
@@ -348,10 +393,11 @@ pub async fn list(db: &Db, limit: i64, before: Option<i64>) -> AppResult<Vec<Job
 
 /// Claims the next work for `claimant`. SQLite: the oldest queued job, marked running.
 /// PostgreSQL: the first queued chunk of the oldest job still to run (or a running chunk whose
-/// lease expired), marked running with the claimant's name and lease; its job is marked running
-/// too. A chunk whose lease expired after its last attempt fails its job with `E_INTERRUPTED`.
+/// lease expired; a finish step only once its operation's parts are all done), marked running
+/// with the claimant's name and lease; its job is marked running too. A chunk whose lease
+/// expired after its last attempt fails its job with `E_INTERRUPTED`.
 pub async fn claim(db: &Db, claimant: &Claimant) -> AppResult<Option<Claimed>> {
-    let (work, json, attempt) = match db {
+    let (work, task, json, attempt) = match db {
         Db::Sqlite(pool) => {
             let row: Option<(i64, String, i64)> = sqlx::query_as(concat!(
                 "UPDATE jobs SET status = 'running', attempts = attempts + 1, progress = 0, started_at = ",
@@ -364,7 +410,7 @@ pub async fn claim(db: &Db, claimant: &Claimant) -> AppResult<Option<Claimed>> {
             .fetch_optional(pool)
             .await?;
             let Some((id, json, attempt)) = row else { return Ok(None) };
-            (Work { id, chunk: None }, json, attempt)
+            (Work { id, chunk: None }, Task::Job, json, attempt)
         }
         Db::Postgres(pool) => {
             // A chunk of a job cancelled in the meantime is skipped: try the next one.
@@ -373,8 +419,8 @@ pub async fn claim(db: &Db, claimant: &Claimant) -> AppResult<Option<Claimed>> {
                 match claim_chunk(pool, claimant).await? {
                     Chunk::None => return Ok(None),
                     Chunk::Gone => {}
-                    Chunk::Claimed(work, json, attempt) => {
-                        found = Some((work, json, attempt));
+                    Chunk::Claimed(work, task, json, attempt) => {
+                        found = Some((work, task, json, attempt));
                         break;
                     }
                 }
@@ -384,7 +430,7 @@ pub async fn claim(db: &Db, claimant: &Claimant) -> AppResult<Option<Claimed>> {
         }
     };
     match serde_json::from_str(&json) {
-        Ok(job) => Ok(Some(Claimed { work, job, attempt })),
+        Ok(job) => Ok(Some(Claimed { work, task, job, attempt })),
         Err(error) => {
             let detail = format!("the stored job is unreadable: {error}");
             fail(db, work, claimant, &job_problem(422, "Job failed", ErrorCode::JobFile, &detail)).await?;
@@ -399,9 +445,12 @@ enum Chunk {
     None,
     /// A chunk of a job that is no longer to run (cancelled or failed meanwhile).
     Gone,
-    /// The chunk, its job's JSON and the chunk's attempt.
-    Claimed(Work, String, i64),
+    /// The chunk, what it computes, its job's JSON and the chunk's attempt.
+    Claimed(Work, Task, String, i64),
 }
+
+/// A claimed chunk's row: job, position, attempts, kind, operation, units.
+type ChunkRow = (i64, i64, i64, String, i64, Option<i64>, Option<i64>, f64);
 
 async fn claim_chunk(pool: &sqlx::PgPool, claimant: &Claimant) -> AppResult<Chunk> {
     let mut transaction = pool.begin().await?;
@@ -425,25 +474,37 @@ async fn claim_chunk(pool: &sqlx::PgPool, claimant: &Claimant) -> AppResult<Chun
     .bind(MAX_ATTEMPTS)
     .execute(&mut *transaction)
     .await?;
-    let chunk: Option<(i64, i64, i64)> = sqlx::query_as(
+    let chunk: Option<ChunkRow> = sqlx::query_as(
         "WITH next AS (
              SELECT c.job_id, c.position FROM job_chunks c JOIN jobs j ON j.id = c.job_id
              WHERE j.status IN ('queued', 'running')
                AND (c.status = 'queued' OR (c.status = 'running' AND c.lease_expires_at < now()))
-             ORDER BY c.job_id, c.position LIMIT 1
+               AND (c.kind <> 'finish' OR NOT EXISTS (
+                   SELECT 1 FROM job_chunks p
+                   WHERE p.job_id = c.job_id AND p.operation = c.operation AND p.kind = 'part' AND p.status <> 'done'))
+             ORDER BY c.job_id, c.operation, c.position LIMIT 1
              FOR UPDATE OF c SKIP LOCKED)
          UPDATE job_chunks c SET status = 'running', attempts = c.attempts + 1, progress = 0, worker = $1,
              lease_expires_at = now() + make_interval(secs => $2)
          FROM next WHERE c.job_id = next.job_id AND c.position = next.position
-         RETURNING c.job_id, c.position, c.attempts",
+         RETURNING c.job_id, c.position, c.attempts, c.kind, c.operation, c.units_from, c.units_to, c.work",
     )
     .bind(&claimant.worker)
     .bind(claimant.lease.as_secs_f64())
     .fetch_optional(&mut *transaction)
     .await?;
-    let Some((id, position, attempt)) = chunk else {
+    let Some((id, position, attempt, kind, operation, from, to, work)) = chunk else {
         transaction.commit().await?;
         return Ok(Chunk::None);
+    };
+    let index = |value: i64| usize::try_from(value).map_err(|e| AppError::Internal(e.into()));
+    let operation = index(operation)?;
+    let task = match (kind.as_str(), from, to) {
+        ("part", Some(from), Some(to)) => {
+            Task::Part { operation, part: Part { units: index(from)?..index(to)?, seconds: work } }
+        }
+        ("finish", _, _) => Task::Finish { operation },
+        _ => Task::Operation(operation),
     };
     let job: Option<(String,)> = sqlx::query_as(
         "UPDATE jobs SET status = 'running', started_at = COALESCE(started_at, now()), heartbeat_at = now(),
@@ -460,13 +521,124 @@ async fn claim_chunk(pool: &sqlx::PgPool, claimant: &Claimant) -> AppResult<Chun
         transaction.rollback().await?;
         return Ok(Chunk::Gone);
     };
+    // A chunk claimed again starts over: the job's progress loses what it had done.
+    sqlx::query(JOB_PROGRESS).bind(id).execute(&mut *transaction).await?;
     transaction.commit().await?;
-    let chunk = usize::try_from(position).map_err(|e| AppError::Internal(e.into()))?;
-    Ok(Chunk::Claimed(Work { id, chunk: Some(chunk) }, json, attempt))
+    Ok(Chunk::Claimed(Work { id, chunk: Some(index(position)?) }, task, json, attempt))
+}
+
+/// Splits the operation chunk `work` that `claimant` runs into `split`'s parts (PostgreSQL): the
+/// chunk becomes the first part, which the claimant goes on to solve, and the other parts and
+/// the operation's finish step are queued (the finish step is claimable once every part is done;
+/// [`claim`]); each chunk weighs its share of the estimated work. Returns false when the chunk is
+/// no longer the claimant's or its job no longer runs (nothing is written), and always in SQLite,
+/// where one process runs the whole job.
+pub async fn split(db: &Db, work: Work, claimant: &Claimant, split: &Split) -> AppResult<bool> {
+    let Db::Postgres(pool) = db else { return Ok(false) };
+    let Some((first, rest)) = split.parts.split_first() else { return Ok(false) };
+    let total = split.parts.iter().map(|part| part.seconds).sum::<f64>() + split.finish_seconds;
+    let weight = |seconds: f64| {
+        if total > 0.0 && total.is_finite() { seconds / total } else { 1.0 / (split.parts.len() + 1) as f64 }
+    };
+    let unit = |value: usize| i64::try_from(value).unwrap_or(i64::MAX);
+    let mut transaction = pool.begin().await?;
+    // The job's row first: splitters of one job take turns numbering the new chunks.
+    let job: Option<(String,)> = sqlx::query_as("SELECT status FROM jobs WHERE id = $1 FOR UPDATE")
+        .bind(work.id)
+        .fetch_optional(&mut *transaction)
+        .await?;
+    if job.is_none_or(|(status,)| status != "running") {
+        transaction.rollback().await?;
+        return Ok(false);
+    }
+    let updated = sqlx::query(
+        "UPDATE job_chunks SET kind = 'part', units_from = $4, units_to = $5, work = $6, weight = $7
+         WHERE job_id = $1 AND position = $2 AND worker = $3 AND status = 'running' AND kind = 'whole'
+         RETURNING operation",
+    )
+    .bind(work.id)
+    .bind(work.position())
+    .bind(&claimant.worker)
+    .bind(unit(first.units.start))
+    .bind(unit(first.units.end))
+    .bind(first.seconds)
+    .bind(weight(first.seconds))
+    .fetch_optional(&mut *transaction)
+    .await?;
+    let Some(row) = updated else {
+        transaction.rollback().await?;
+        return Ok(false);
+    };
+    let operation: i64 = sqlx::Row::try_get(&row, 0)?;
+    let (next,): (i64,) =
+        sqlx::query_as("SELECT COALESCE(MAX(position), -1)::BIGINT + 1 FROM job_chunks WHERE job_id = $1")
+            .bind(work.id)
+            .fetch_one(&mut *transaction)
+            .await?;
+    let froms: Vec<i64> = rest.iter().map(|part| unit(part.units.start)).collect();
+    let tos: Vec<i64> = rest.iter().map(|part| unit(part.units.end)).collect();
+    let seconds: Vec<f64> = rest.iter().map(|part| part.seconds).collect();
+    let weights: Vec<f64> = rest.iter().map(|part| weight(part.seconds)).collect();
+    sqlx::query(
+        "INSERT INTO job_chunks (job_id, position, operation, status, kind, units_from, units_to, work, weight)
+         SELECT $1, $2 + k - 1, $3, 'queued', 'part', f, t, w, s
+         FROM UNNEST($4::BIGINT[], $5::BIGINT[], $6::DOUBLE PRECISION[], $7::DOUBLE PRECISION[])
+             WITH ORDINALITY AS u(f, t, w, s, k)",
+    )
+    .bind(work.id)
+    .bind(next)
+    .bind(operation)
+    .bind(&froms)
+    .bind(&tos)
+    .bind(&seconds)
+    .bind(&weights)
+    .execute(&mut *transaction)
+    .await?;
+    sqlx::query(
+        "INSERT INTO job_chunks (job_id, position, operation, status, kind, work, weight)
+         VALUES ($1, $2, $3, 'queued', 'finish', $4, $5)",
+    )
+    .bind(work.id)
+    .bind(next + unit(rest.len()))
+    .bind(operation)
+    .bind(split.finish_seconds)
+    .bind(weight(split.finish_seconds))
+    .execute(&mut *transaction)
+    .await?;
+    sqlx::query(JOB_PROGRESS).bind(work.id).execute(&mut *transaction).await?;
+    sqlx::query("SELECT pg_notify($1, $2)")
+        .bind(SUBMITTED_CHANNEL)
+        .bind(work.id.to_string())
+        .execute(&mut *transaction)
+        .await?;
+    transaction.commit().await?;
+    Ok(true)
+}
+
+/// The outputs of operation `operation`'s parts, in unit order: each gzip-compressed, with the
+/// seconds its solve took (PostgreSQL; a finish step reads them).
+pub async fn part_outputs(db: &Db, id: i64, operation: usize) -> AppResult<Vec<(Vec<u8>, f64)>> {
+    let Db::Postgres(pool) = db else { return Ok(Vec::new()) };
+    let rows: Vec<(Option<Vec<u8>>, f64)> = sqlx::query_as(
+        "SELECT output_gz, solve_seconds FROM job_chunks WHERE job_id = $1 AND operation = $2 AND kind = 'part'
+         ORDER BY units_from",
+    )
+    .bind(id)
+    .bind(i64::try_from(operation).unwrap_or(i64::MAX))
+    .fetch_all(pool)
+    .await?;
+    rows.into_iter()
+        .map(|(output, seconds)| {
+            output.map(|output| (output, seconds)).ok_or_else(|| {
+                AppError::Internal(anyhow::anyhow!("operations[{operation}]: a part's output is missing"))
+            })
+        })
+        .collect()
 }
 
 /// Records progress and the heartbeat of running work (PostgreSQL: of the chunk, extending its
-/// lease; the job's progress is the mean of its chunks'). Returns false when the work is no
+/// lease; the job's progress is the weighted sum of its chunks', written in the same transaction
+/// so the two always agree). Returns false when the work is no
 /// longer the claimant's to run: its job was cancelled or failed, or (PostgreSQL) the chunk was
 /// claimed by another worker after this one's lease expired. The worker then stops it.
 pub async fn heartbeat(db: &Db, work: Work, claimant: &Claimant, progress: f64) -> AppResult<bool> {
@@ -485,6 +657,7 @@ pub async fn heartbeat(db: &Db, work: Work, claimant: &Claimant, progress: f64) 
             Ok(updated.rows_affected() > 0)
         }
         Db::Postgres(pool) => {
+            let mut transaction = pool.begin().await?;
             let updated = sqlx::query(
                 "UPDATE job_chunks SET progress = $1, lease_expires_at = now() + make_interval(secs => $4)
                  WHERE job_id = $2 AND position = $5 AND worker = $3 AND status = 'running'
@@ -495,19 +668,14 @@ pub async fn heartbeat(db: &Db, work: Work, claimant: &Claimant, progress: f64) 
             .bind(&claimant.worker)
             .bind(claimant.lease.as_secs_f64())
             .bind(work.position())
-            .execute(pool)
+            .execute(&mut *transaction)
             .await?;
             if updated.rows_affected() == 0 {
+                transaction.rollback().await?;
                 return Ok(false);
             }
-            sqlx::query(
-                "UPDATE jobs SET heartbeat_at = now(),
-                     progress = (SELECT LEAST(1, GREATEST(0, avg(progress))) FROM job_chunks WHERE job_id = $1)
-                 WHERE id = $1 AND status = 'running'",
-            )
-            .bind(work.id)
-            .execute(pool)
-            .await?;
+            sqlx::query(JOB_PROGRESS).bind(work.id).execute(&mut *transaction).await?;
+            transaction.commit().await?;
             Ok(true)
         }
     }
@@ -525,26 +693,26 @@ pub enum Finished {
     Refused(Problem),
 }
 
-/// Whether `outputs` (operations from `first` on) fit: the job already takes `job_bytes`, the
-/// store `total_bytes`. The problem to fail the job with when they do not.
+/// Whether `outputs` (operations from `first` on: each one's name and compressed bytes) fit: the
+/// job already takes `job_bytes`, the store `total_bytes`. The problem to fail the job with when
+/// they do not.
 fn check_fit(
     job_bytes: i64,
     total_bytes: i64,
-    outputs: &[Packed],
+    outputs: &[(&str, i64)],
     first: i64,
     storage: &JobStorage,
 ) -> Option<Problem> {
-    let added: i64 = outputs.iter().map(|output| bytes(output.stored_bytes())).sum();
+    let added: i64 = outputs.iter().map(|(_, size)| size).sum();
     let cap = i64::try_from(storage.job_max_bytes).unwrap_or(i64::MAX);
     let mut running = job_bytes;
-    for (offset, output) in outputs.iter().enumerate() {
-        running = running.saturating_add(bytes(output.stored_bytes()));
+    for (offset, (operation, size)) in outputs.iter().enumerate() {
+        running = running.saturating_add(*size);
         if running > cap {
             let index = first + bytes(offset);
             let detail = format!(
-                "operations[{index}] ({}) brings the job's stored results to {} (compressed), over the limit of {} \
-                 per job (--job-result-max-mb); split the job or make the operation smaller",
-                output.operation,
+                "operations[{index}] ({operation}) brings the job's stored results to {} (compressed), over the limit \
+                 of {} per job (--job-result-max-mb); split the job or make the operation smaller",
                 mib(running.unsigned_abs()),
                 mib(storage.job_max_bytes)
             );
@@ -573,18 +741,23 @@ fn check_fit(
 
 /// Stores the results and marks the work done, in one transaction, unless its job was
 /// cancelled (or, in PostgreSQL, the chunk is no longer the claimant's) meanwhile, or the results
-/// do not fit in `storage` (then nothing is written). In PostgreSQL the job is done with its last
-/// chunk.
+/// do not fit in `storage` (then nothing is written). In PostgreSQL `task` is a whole operation or
+/// a finish step (its result is the operation's; the parts' outputs it merged are dropped), and
+/// the job is done with its last chunk.
 pub async fn finish(
     db: &Db,
     work: Work,
+    task: &Task,
     claimant: &Claimant,
     outputs: &[Packed],
     storage: &JobStorage,
 ) -> AppResult<Finished> {
-    let added: i64 = outputs.iter().map(|output| bytes(output.stored_bytes())).sum();
+    let sizes: Vec<(&str, i64)> =
+        outputs.iter().map(|output| (output.operation.as_str(), bytes(output.stored_bytes()))).collect();
+    let added: i64 = sizes.iter().map(|(_, size)| size).sum();
+    let first = bytes(task.operation());
     macro_rules! results_in {
-        ($transaction:expr, $first:expr) => {
+        ($transaction:expr, $delta:expr) => {
             for (offset, output) in outputs.iter().enumerate() {
                 sqlx::query(
                     "INSERT INTO job_results (job_id, position, operation, result_json, result_gz, result_bytes,
@@ -592,7 +765,7 @@ pub async fn finish(
                      VALUES ($1, $2, $3, '', $4, $5, $6, $7, $8)",
                 )
                 .bind(work.id)
-                .bind($first + i64::try_from(offset).unwrap_or(i64::MAX))
+                .bind(first + i64::try_from(offset).unwrap_or(i64::MAX))
                 .bind(&output.operation)
                 .bind(&output.result_gz)
                 .bind(bytes(output.result_bytes))
@@ -603,7 +776,7 @@ pub async fn finish(
                 .await?;
             }
             sqlx::query("UPDATE jobs SET stored_bytes = stored_bytes + $1 WHERE id = $2")
-                .bind(added)
+                .bind($delta)
                 .bind(work.id)
                 .execute(&mut *$transaction)
                 .await?;
@@ -628,48 +801,46 @@ pub async fn finish(
             };
             let (total,): (i64,) =
                 sqlx::query_as("SELECT COALESCE(SUM(stored_bytes), 0) FROM jobs").fetch_one(&mut *transaction).await?;
-            if let Some(problem) = check_fit(job_bytes, total, outputs, 0, storage) {
+            if let Some(problem) = check_fit(job_bytes, total, &sizes, first, storage) {
                 transaction.rollback().await?;
                 return Ok(Finished::Refused(problem));
             }
-            results_in!(transaction, 0);
+            results_in!(transaction, added);
             transaction.commit().await?;
         }
         Db::Postgres(pool) => {
             let mut transaction = pool.begin().await?;
             // The job's row first: finishers of one job's chunks take turns, so the last one
             // sees every other chunk done.
-            let job: Option<(String, i64)> =
-                sqlx::query_as("SELECT status, stored_bytes FROM jobs WHERE id = $1 FOR UPDATE")
-                    .bind(work.id)
-                    .fetch_optional(&mut *transaction)
-                    .await?;
-            let updated = sqlx::query(
-                "UPDATE job_chunks SET status = 'done', progress = 1, lease_expires_at = NULL
-                 WHERE job_id = $1 AND position = $2 AND worker = $3 AND status = 'running'",
-            )
-            .bind(work.id)
-            .bind(work.position())
-            .bind(&claimant.worker)
-            .execute(&mut *transaction)
-            .await?;
-            let Some((_, job_bytes)) = job.filter(|(status, _)| status == "running") else {
+            let Some(job_bytes) = finishing(&mut transaction, work, claimant).await? else {
                 transaction.rollback().await?;
                 return Ok(Finished::Gone);
             };
-            if updated.rows_affected() == 0 {
-                transaction.rollback().await?;
-                return Ok(Finished::Gone);
-            }
+            // A finish step's parts are merged into its result: their outputs go.
+            let (parts,): (i64,) = sqlx::query_as(
+                "SELECT COALESCE(SUM(octet_length(output_gz)), 0)::BIGINT FROM job_chunks
+                 WHERE job_id = $1 AND operation = $2 AND kind = 'part'",
+            )
+            .bind(work.id)
+            .bind(first)
+            .fetch_one(&mut *transaction)
+            .await?;
             sqlx::query("SELECT pg_advisory_xact_lock($1)").bind(QUOTA_LOCK).execute(&mut *transaction).await?;
             let (total,): (i64,) = sqlx::query_as("SELECT COALESCE(SUM(stored_bytes), 0)::BIGINT FROM jobs")
                 .fetch_one(&mut *transaction)
                 .await?;
-            if let Some(problem) = check_fit(job_bytes, total, outputs, work.position(), storage) {
+            if let Some(problem) = check_fit(job_bytes - parts, total - parts, &sizes, first, storage) {
                 transaction.rollback().await?;
                 return Ok(Finished::Refused(problem));
             }
-            results_in!(transaction, work.position());
+            results_in!(transaction, added - parts);
+            sqlx::query(
+                "UPDATE job_chunks SET output_gz = NULL WHERE job_id = $1 AND operation = $2 AND kind = 'part'",
+            )
+            .bind(work.id)
+            .bind(first)
+            .execute(&mut *transaction)
+            .await?;
             sqlx::query(
                 "UPDATE jobs SET status = 'done', progress = 1, finished_at = now()
                  WHERE id = $1 AND NOT EXISTS (SELECT 1 FROM job_chunks WHERE job_id = $1 AND status <> 'done')",
@@ -677,9 +848,110 @@ pub async fn finish(
             .bind(work.id)
             .execute(&mut *transaction)
             .await?;
+            sqlx::query(JOB_PROGRESS).bind(work.id).execute(&mut *transaction).await?;
             transaction.commit().await?;
         }
     }
+    Ok(Finished::Stored)
+}
+
+/// Locks the job of running chunk `work` and marks the chunk done, if it is still the claimant's
+/// and its job still runs; the job's stored bytes then.
+async fn finishing(
+    transaction: &mut sqlx::Transaction<'_, sqlx::Postgres>,
+    work: Work,
+    claimant: &Claimant,
+) -> AppResult<Option<i64>> {
+    let job: Option<(String, i64)> = sqlx::query_as("SELECT status, stored_bytes FROM jobs WHERE id = $1 FOR UPDATE")
+        .bind(work.id)
+        .fetch_optional(&mut **transaction)
+        .await?;
+    let updated = sqlx::query(
+        "UPDATE job_chunks SET status = 'done', progress = 1, lease_expires_at = NULL
+         WHERE job_id = $1 AND position = $2 AND worker = $3 AND status = 'running'",
+    )
+    .bind(work.id)
+    .bind(work.position())
+    .bind(&claimant.worker)
+    .execute(&mut **transaction)
+    .await?;
+    Ok(job.filter(|(status, _)| status == "running" && updated.rows_affected() > 0).map(|(_, stored)| stored))
+}
+
+/// A part's output, compressed for storage until its finish step.
+#[derive(Debug, Clone)]
+pub struct PartOutput {
+    /// The operation's name.
+    pub operation: String,
+    /// The output, gzip-compressed CBOR.
+    pub gz: Vec<u8>,
+    /// Its uncompressed length, bytes.
+    pub bytes: usize,
+    /// The seconds its solve took.
+    pub seconds: f64,
+}
+
+/// Stores a part's output on its chunk and marks the chunk done, in one transaction, unless its
+/// job was cancelled or the chunk is no longer the claimant's meanwhile, or the output does not fit
+/// in `storage` (the job's stored bytes count it until the finish step drops it). Wakes the
+/// workers when it was the operation's last part: its finish step is claimable (PostgreSQL).
+pub async fn finish_part(
+    db: &Db,
+    work: Work,
+    operation: usize,
+    claimant: &Claimant,
+    output: &PartOutput,
+    storage: &JobStorage,
+) -> AppResult<Finished> {
+    let Db::Postgres(pool) = db else {
+        return Err(AppError::Internal(anyhow::anyhow!("parts are stored in PostgreSQL only")));
+    };
+    let size = bytes(output.gz.len());
+    let operation = bytes(operation);
+    let mut transaction = pool.begin().await?;
+    let Some(job_bytes) = finishing(&mut transaction, work, claimant).await? else {
+        transaction.rollback().await?;
+        return Ok(Finished::Gone);
+    };
+    sqlx::query("SELECT pg_advisory_xact_lock($1)").bind(QUOTA_LOCK).execute(&mut *transaction).await?;
+    let (total,): (i64,) =
+        sqlx::query_as("SELECT COALESCE(SUM(stored_bytes), 0)::BIGINT FROM jobs").fetch_one(&mut *transaction).await?;
+    if let Some(problem) = check_fit(job_bytes, total, &[(output.operation.as_str(), size)], operation, storage) {
+        transaction.rollback().await?;
+        return Ok(Finished::Refused(problem));
+    }
+    sqlx::query(
+        "UPDATE job_chunks SET output_gz = $3, output_bytes = $4, solve_seconds = $5
+         WHERE job_id = $1 AND position = $2",
+    )
+    .bind(work.id)
+    .bind(work.position())
+    .bind(&output.gz)
+    .bind(bytes(output.bytes))
+    .bind(output.seconds)
+    .execute(&mut *transaction)
+    .await?;
+    sqlx::query("UPDATE jobs SET stored_bytes = stored_bytes + $1 WHERE id = $2")
+        .bind(size)
+        .bind(work.id)
+        .execute(&mut *transaction)
+        .await?;
+    sqlx::query(JOB_PROGRESS).bind(work.id).execute(&mut *transaction).await?;
+    let (left,): (i64,) = sqlx::query_as(
+        "SELECT COUNT(*) FROM job_chunks WHERE job_id = $1 AND operation = $2 AND kind = 'part' AND status <> 'done'",
+    )
+    .bind(work.id)
+    .bind(operation)
+    .fetch_one(&mut *transaction)
+    .await?;
+    if left == 0 {
+        sqlx::query("SELECT pg_notify($1, $2)")
+            .bind(SUBMITTED_CHANNEL)
+            .bind(work.id.to_string())
+            .execute(&mut *transaction)
+            .await?;
+    }
+    transaction.commit().await?;
     Ok(Finished::Stored)
 }
 
@@ -717,6 +989,15 @@ async fn drop_partial_results(db: &Db, id: i64) -> AppResult<()> {
                  WHERE id = $1 AND status IN ('failed', 'cancelled')",
         postgres: "UPDATE jobs SET stored_bytes = octet_length(job_json) WHERE id = $1 AND status IN ('failed', 'cancelled')",
         [id], execute)?;
+    if let Db::Postgres(pool) = db {
+        sqlx::query(
+            "UPDATE job_chunks SET output_gz = NULL WHERE job_id = $1 AND output_gz IS NOT NULL
+             AND EXISTS (SELECT 1 FROM jobs WHERE id = $1 AND status IN ('failed', 'cancelled'))",
+        )
+        .bind(id)
+        .execute(pool)
+        .await?;
+    }
     Ok(())
 }
 
@@ -949,15 +1230,19 @@ pub async fn recover(db: &Db) -> AppResult<(u64, u64)> {
 pub async fn release(db: &Db, claimant: &Claimant) -> AppResult<u64> {
     let Db::Postgres(pool) = db else { return Ok(0) };
     let mut transaction = pool.begin().await?;
-    let released = sqlx::query(
+    let jobs: Vec<(i64,)> = sqlx::query_as(
         "UPDATE job_chunks SET status = 'queued', progress = 0, worker = NULL, lease_expires_at = NULL,
              attempts = GREATEST(attempts - 1, 0)
-         WHERE status = 'running' AND worker = $1",
+         WHERE status = 'running' AND worker = $1
+         RETURNING job_id",
     )
     .bind(&claimant.worker)
-    .execute(&mut *transaction)
-    .await?
-    .rows_affected();
+    .fetch_all(&mut *transaction)
+    .await?;
+    let released = jobs.len() as u64;
+    for (id,) in jobs {
+        sqlx::query(JOB_PROGRESS).bind(id).execute(&mut *transaction).await?;
+    }
     if released > 0 {
         sqlx::query("SELECT pg_notify($1, '')").bind(SUBMITTED_CHANNEL).execute(&mut *transaction).await?;
     }

@@ -51,7 +51,7 @@ impl Packed {
 }
 
 /// `bytes` gzip-compressed at the default level.
-fn gzip(bytes: &[u8]) -> Vec<u8> {
+pub(crate) fn gzip(bytes: &[u8]) -> Vec<u8> {
     let mut encoder = GzEncoder::new(Vec::with_capacity(bytes.len() / 8 + 64), Compression::default());
     // Writing to a Vec cannot fail.
     let _ = encoder.write_all(bytes);

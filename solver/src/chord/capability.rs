@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use super::{SegmentAnswer, SegmentRequest};
-use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
+use crate::capability::{Capability, Endpoint, OutputOptions, Refs, Resolved, Run};
 use crate::error::SolverError;
 use crate::gcode::{Post, Reference, ToolCall};
 use crate::machine::MachineProfile;
@@ -37,6 +37,17 @@ pub struct SegmentResult {
 
 impl Capability for SegmentCapability {
     const NAME: &'static str = "segment";
+    const ENDPOINT: Endpoint = Endpoint {
+        summary: "Cuts a curve into G01 blocks by the block-time rule.",
+        description: "Returns the command points with the chord error per window and the block figures (JSON), \
+            or with `Accept: text/x-gcode` / `?format=gcode` a complete program of G01 blocks with \
+            the F word (dialect from `?dialect=`, else the named machine's, else Fanuc; `reference` \
+            does not apply: the curve is the programmed point).",
+        not_found: "Unknown machine or tool number",
+        refused: "Impossible request: `E_INPUT`, `E_DEGENERATE_CURVE`, `E_INFEASIBLE_FEED_FOR_RADIUS` (the \
+            message gives the largest feasible feed), `E_TOO_MANY_BLOCKS`, `E_TOO_MANY_POINTS`, \
+            `E_NUMERIC_FAILURE`; `E_TIMEOUT` over the synchronous time limit: submit a job",
+    };
     type Request = SegmentRequest;
     type Answer = SegmentResult;
     type Tool = Option<Tool>;

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::detect::{self, DetectMode, MaterialSide, PathLoopAnswer, PathLoopRequest};
 use super::request::MAX_MOVES;
 use super::{ContourAnswer, ContourRequest, CornerLoop};
-use crate::capability::{Capability, Control, OutputOptions, Purpose, Refs, Resolved, Run};
+use crate::capability::{Capability, Control, Endpoint, OutputOptions, Purpose, Refs, Resolved, Run};
 use crate::error::{SolverError, Warning};
 use crate::machine::MachineProfile;
 use crate::tool::{Tool, ToolRef};
@@ -38,6 +38,18 @@ pub struct ContourResult {
 
 impl Capability for ContourCapability {
     const NAME: &'static str = "contour";
+    const ENDPOINT: Endpoint = Endpoint {
+        summary: "Layered contour milling: the tool-centre path of every layer with corner loops at \
+            protruding corners and optional relief at inside corners.",
+        description: "Returns the layers' moves, the corners with their actions and the material left or cut \
+            (JSON, at most 500 000 moves), or with `Accept: text/x-gcode` / `?format=gcode` a \
+            complete program (up to the solver's limit of 6 000 000 moves; dialect from `?dialect=`, \
+            else the named machine's, else Fanuc). With `block_time_ms` or a `machine` the arcs are \
+            chorded by the block-time rule and the summary reports the blocks.",
+        not_found: "Unknown tool number or machine",
+        refused: "Impossible contour or over a limit (codes in corners.md §5; `E_TOO_MANY_MOVES` for \
+            answers over the move limit); `E_TIMEOUT` over the synchronous time limit: submit a job",
+    };
     type Request = ContourRequest;
     type Answer = ContourResult;
     type Tool = Tool;

@@ -3,9 +3,11 @@
 
 use serde::Serialize;
 
-use super::{Deburr, DeburrRequest};
-use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
+use super::program::Leg;
+use super::{Deburr, DeburrRequest, Edge};
+use crate::capability::{Capability, Endpoint, OtherTool, OutputOptions, Refs, Resolved, Run};
 use crate::error::SolverError;
+use crate::gcode::{Reference, ToolCall};
 use crate::geometry::Vec3;
 use crate::machine::MachineProfile;
 use crate::machine::cycle::{CycleTime, Dynamics, Step};
@@ -21,43 +23,107 @@ pub struct DeburrCapability;
 pub struct DeburrAnswer {
     /// The tool, as resolved from the table or given inline.
     pub tool: Tool,
+    /// With `edge: both` and `inner_tool`: the tool of the inside ridges, as resolved.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inner_tool: Option<Tool>,
     /// The machine the request named, as registered: its block time (and margin, minimum chord
     /// error) spaced the points, its dialect is the G-code default.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub machine: Option<MachineProfile>,
     /// With a machine that has `max_accel`: the time the control would take for the program
-    /// (trapezoidal feed profile, stops at sharp vertices, rapids at `rapid_feed`, one tool
-    /// change) and its parts: cutting (the loop), air (the leads), rapid, tool change (issue 15).
+    /// (feed profile limited by acceleration, and jerk with `max_jerk`; stops at sharp vertices,
+    /// rapids at `rapid_feed`, a tool change per tool) and its parts: cutting (the loops), air
+    /// (the leads), rapid, tool change (issue 15).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cycle_time: Option<CycleTime>,
-    /// With `holes` or `pattern`: every hole in the order the program visits them (the fields
-    /// beside it are those of the first).
+    /// With `holes`, `pattern` or `edge: both`: every loop (one per hole and edge) in the order the
+    /// program visits them (the fields beside it are those of the first).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub holes: Option<Vec<HoleAnswer>>,
+    /// With `holes`, `pattern` or `edge: both`: the order the program visits the loops in and the
+    /// travel it saves.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub visiting_order: Option<VisitingOrder>,
     /// The loop of centres, leads, summary and warnings.
     #[serde(flatten)]
     pub result: Deburr,
 }
 
-/// One hole of a several-hole answer.
+/// One loop of a several-loop answer: a hole at one edge.
 #[derive(Debug, Clone, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct HoleAnswer {
-    /// Where its fields are in the request: `holes[i]`, or `hole` for a pattern's copies.
+    /// Where its fields are in the request: `holes[i]`, or `hole` for a pattern's copies and a
+    /// single hole.
     pub field: String,
+    /// Its place among the request's holes: `i` of `holes[i]`, the copy of a pattern (station by
+    /// station, every angle at each), 0 for a single hole.
+    pub index: usize,
+    /// The request field naming the tool that cuts it: `tool`, or `inner_tool`.
+    pub tool_field: &'static str,
+    /// The hole points down (θ_P more than 90° from +Z): a vertical tool reaches it only with the
+    /// tube turned 180° about its axis, so its loop is given as turned (the program stops with
+    /// `M00` for the operator to turn the tube before it).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub turned: bool,
     /// Its penetration angle θ_P, degrees.
     pub penetration_angle_deg: f64,
     /// Its arrangement angle θ_A, degrees.
     pub arrangement_angle_deg: f64,
     /// Its position along the cylinder axis from `workpiece.origin`, mm.
     pub axial_position: f64,
-    /// Its loop of centres, leads, summary and warnings.
+    /// Its loop of centres, leads, summary and warnings; `edge` says which ridge.
     #[serde(flatten)]
     pub result: Deburr,
 }
 
+/// The order a several-loop program visits its loops in (issue 15): loops of one tool together
+/// (the tool of `tool` first, then `inner_tool` when it is another), within a tool the holes
+/// pointing up before the turned ones (after them for the second tool, so the tube is turned at
+/// most twice), each group in a short order (nearest neighbour from its first loop in request
+/// order, then 2-opt) over the travel between loops as the program makes it: up to the clearance
+/// plane, across, down to the next approach.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct VisitingOrder {
+    /// The loops in visiting order.
+    pub loops: Vec<VisitStop>,
+    /// The travel between loops in this order, mm (programmed tip).
+    pub travel: f64,
+    /// The travel in request order (hole by hole, outer before inner, grouped by tool), mm.
+    pub request_order_travel: f64,
+    /// Tool changes inside the program (0, or 1 with an `inner_tool` other than `tool`).
+    pub tool_changes: usize,
+    /// Stops for the operator to turn the tube (holes pointing down), 0 to 2.
+    pub turns: usize,
+}
+
+/// One loop of a visiting order: which hole, which edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct VisitStop {
+    /// The hole's `index` (its place among the request's holes).
+    pub index: usize,
+    /// The ridge: `outer` or `inner`.
+    pub edge: Edge,
+}
+
 impl Capability for DeburrCapability {
     const NAME: &'static str = "deburr";
+    const ENDPOINT: Endpoint = Endpoint {
+        summary: "Deburrs one ridge of a cross hole with a ball end mill, or several holes and both ridges.",
+        description: "Returns the closed loop of ball centres in machining order (JSON), or with `Accept: \
+            text/x-gcode` / `?format=gcode` a complete program (dialect from `?dialect=`, else the \
+            named machine's, else Fanuc). With `block_time_ms` or a `machine` the points follow the \
+            block-time rule at `feed` (never coarser than `tolerance`) and the summary reports the \
+            blocks. With `holes`, a `pattern` or `edge: both` one program visits every loop (one per \
+            hole and edge, listed in `holes`) in a short order (`visiting_order`), changing to \
+            `inner_tool` once for the inside ridges and stopping (`M00`) to turn the tube for holes \
+            that point down.",
+        not_found: "Unknown tool number (`tool`, `inner_tool`) or machine",
+        refused: "Impossible geometry (codes in deburr.md §4); `E_TIMEOUT` over the synchronous time \
+            limit: submit a job",
+    };
     type Request = DeburrRequest;
     type Answer = DeburrAnswer;
     type Tool = Tool;
@@ -66,46 +132,121 @@ impl Capability for DeburrCapability {
         Refs { tool: Some(&request.tool), machine: request.machine.as_deref(), material: None }
     }
 
+    fn other_tools(request: &DeburrRequest) -> Vec<OtherTool<'_>> {
+        request.inner_tool.iter().map(|tool| OtherTool { field: "inner_tool", tool }).collect()
+    }
+
     fn solve(request: &DeburrRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<DeburrAnswer, SolverError> {
         if !request.is_several() {
             let result = super::solve_controlled(request, &context.tool, context.machine.as_ref(), run.control)?;
-            let cycle_time =
-                context.machine.as_ref().and_then(MachineProfile::dynamics).map(|d| cycle_time(&[&result], &d));
-            return Ok(DeburrAnswer { tool: context.tool, machine: context.machine, cycle_time, holes: None, result });
+            let cycle_time = context
+                .machine
+                .as_ref()
+                .and_then(MachineProfile::dynamics)
+                .map(|d| cycle_time(&[Leg { deburr: &result, tool: 0, turned: false }], &d));
+            return Ok(DeburrAnswer {
+                tool: context.tool,
+                inner_tool: None,
+                machine: context.machine,
+                cycle_time,
+                holes: None,
+                visiting_order: None,
+                result,
+            });
         }
-        let mut holes = Vec::new();
+        let inner_tool = request.inner_tool.as_ref().and(context.other_tools.first().cloned());
+        let mut loops = Vec::new();
         for placement in request.placements()? {
             run.control.check()?;
-            let result =
-                super::solve_controlled(&placement.request, &context.tool, context.machine.as_ref(), run.control)
-                    .map_err(|error| match error.field() {
-                        // A hole's own field: named where the request has it.
-                        Some(field) if placement.field != "hole" && field.starts_with("hole.") => {
-                            let inner = field.trim_start_matches("hole.").to_owned();
-                            error.at(format!("{}.{inner}", placement.field))
-                        }
-                        _ => error,
-                    })?;
-            holes.push(HoleAnswer {
+            let tool = match &inner_tool {
+                Some(inner) if placement.tool_field == "inner_tool" => inner,
+                _ => &context.tool,
+            };
+            let result = super::solve_controlled(&placement.request, tool, context.machine.as_ref(), run.control)
+                .map_err(|error| match error.field() {
+                    // A hole's own field: named where the request has it.
+                    Some(field) if placement.field != "hole" && field.starts_with("hole.") => {
+                        let inner = field.trim_start_matches("hole.").to_owned();
+                        error.at(format!("{}.{inner}", placement.field))
+                    }
+                    // The inside ridge's tool: named as the request names it.
+                    Some(field) if placement.tool_field == "inner_tool" && field.starts_with("tool") => {
+                        let rest = field.trim_start_matches("tool").to_owned();
+                        error.at(format!("inner_tool{rest}"))
+                    }
+                    _ => error,
+                })?;
+            loops.push(HoleAnswer {
                 field: placement.field,
+                index: placement.index,
+                tool_field: placement.tool_field,
+                turned: placement.turned,
                 penetration_angle_deg: placement.penetration_angle_deg,
                 arrangement_angle_deg: placement.arrangement_angle_deg,
                 axial_position: placement.axial_position,
                 result,
             });
         }
-        let results: Vec<&Deburr> = holes.iter().map(|hole| &hole.result).collect();
-        let cycle_time = context.machine.as_ref().and_then(MachineProfile::dynamics).map(|d| cycle_time(&results, &d));
+        let another = inner_tool.as_ref().filter(|inner| **inner != context.tool).cloned();
+        let tool = |hole: &HoleAnswer| usize::from(another.is_some() && hole.tool_field == "inner_tool");
+        // The groups in program order: the first tool up then turned, the second turned then up.
+        let rank = |hole: &HoleAnswer| 2 * tool(hole) + usize::from(hole.turned != (tool(hole) == 1));
+        // Request order, grouped (stable: each group keeps its request order).
+        let request_order: Vec<usize> = {
+            let mut indices: Vec<usize> = (0..loops.len()).collect();
+            indices.sort_by_key(|&i| rank(&loops[i]));
+            indices
+        };
+        let results: Vec<&Deburr> = loops.iter().map(|hole| &hole.result).collect();
+        let safe_z = super::program::safe_z(&results, Reference::Tip).ok();
+        let cost =
+            |from: &Deburr, to: &Deburr| safe_z.map_or(0.0, |z| super::program::travel(from, to, z, Reference::Tip));
+        let mut order = Vec::with_capacity(loops.len());
+        for group in 0..4 {
+            let indices: Vec<usize> = request_order.iter().copied().filter(|&i| rank(&loops[i]) == group).collect();
+            let matrix: Vec<Vec<f64>> = indices
+                .iter()
+                .map(|&a| indices.iter().map(|&b| cost(&loops[a].result, &loops[b].result)).collect())
+                .collect();
+            order.extend(super::order::short_order(&matrix).into_iter().map(|at| indices[at]));
+        }
+        let travel_of = |sequence: &[usize]| -> f64 {
+            sequence.windows(2).map(|pair| cost(&loops[pair[0]].result, &loops[pair[1]].result)).sum()
+        };
+        let changes = |pick: &dyn Fn(&HoleAnswer) -> usize| {
+            order.windows(2).filter(|pair| pick(&loops[pair[0]]) != pick(&loops[pair[1]])).count()
+        };
+        let visiting_order = VisitingOrder {
+            loops: order.iter().map(|&i| VisitStop { index: loops[i].index, edge: loops[i].result.edge }).collect(),
+            travel: travel_of(&order),
+            request_order_travel: travel_of(&request_order),
+            tool_changes: changes(&tool),
+            turns: changes(&|hole: &HoleAnswer| usize::from(hole.turned))
+                + usize::from(order.first().is_some_and(|&i| loops[i].turned)),
+        };
+        let mut slots: Vec<Option<HoleAnswer>> = loops.into_iter().map(Some).collect();
+        let holes: Vec<HoleAnswer> = order.iter().filter_map(|&i| slots[i].take()).collect();
+        let legs: Vec<Leg<'_>> =
+            holes.iter().map(|hole| Leg { deburr: &hole.result, tool: tool(hole), turned: hole.turned }).collect();
+        let cycle_time = context.machine.as_ref().and_then(MachineProfile::dynamics).map(|d| cycle_time(&legs, &d));
         let result = holes[0].result.clone();
-        Ok(DeburrAnswer { tool: context.tool, machine: context.machine, cycle_time, holes: Some(holes), result })
+        Ok(DeburrAnswer {
+            tool: context.tool,
+            inner_tool,
+            machine: context.machine,
+            cycle_time,
+            holes: Some(holes),
+            visiting_order: Some(visiting_order),
+            result,
+        })
     }
 
     fn program(_request: &DeburrRequest, answer: &DeburrAnswer, output: &OutputOptions) -> Result<String, SolverError> {
         let post = output.post(answer.machine.as_ref(), &answer.tool);
         match &answer.holes {
             Some(holes) => {
-                let results: Vec<&Deburr> = holes.iter().map(|hole| &hole.result).collect();
-                super::program::program_for_holes(&results, &post)
+                let (legs, tools) = legs(answer, holes);
+                super::program::program_for_loops(&legs, &tools, &post)
             }
             None => super::program(&answer.result, &post),
         }
@@ -116,27 +257,41 @@ impl Capability for DeburrCapability {
     }
 }
 
-/// The cycle time of the deburring program: the leads' feed moves in the air, each loop cutting
-/// at the deburring feed (the program's moves down run in air at that feed too), one tool change.
-/// Between holes the path goes straight from one way out to the next approach (the program lifts
-/// to the highest clearance plane first: the same length when the planes agree).
-fn cycle_time(holes: &[&Deburr], dynamics: &Dynamics) -> CycleTime {
-    use super::LeadMotion;
-    let mut steps = Vec::new();
-    for hole in holes {
-        let feed = hole.summary.feed;
-        let lead = |step: &super::LeadMove| {
-            let to = Vec3::from(step.centre);
-            match step.motion {
-                LeadMotion::Rapid => Step::Rapid(to),
-                LeadMotion::Feed => Step::Feed { to, feed, air: true },
-            }
-        };
-        steps.extend(hole.lead_in.iter().map(lead));
-        steps.extend(hole.points.iter().skip(1).map(|p| Step::Feed { to: Vec3::from(p.centre), feed, air: false }));
-        steps.extend(hole.lead_out.iter().map(lead));
-    }
-    let start =
-        holes.first().and_then(|hole| hole.lead_in.first()).map_or_else(Vec3::zeros, |step| Vec3::from(step.centre));
-    crate::machine::cycle::cycle_time(start, &steps, dynamics, 1)
+/// The loops of a several-loop answer as the program visits them, and the tool call of each
+/// tool: `tool`, then `inner_tool` when it is another tool.
+fn legs<'a>(answer: &'a DeburrAnswer, holes: &'a [HoleAnswer]) -> (Vec<Leg<'a>>, Vec<ToolCall>) {
+    let another = answer.inner_tool.as_ref().filter(|inner| **inner != answer.tool);
+    let legs = holes
+        .iter()
+        .map(|hole| Leg {
+            deburr: &hole.result,
+            tool: usize::from(another.is_some() && hole.tool_field == "inner_tool"),
+            turned: hole.turned,
+        })
+        .collect();
+    let tools = std::iter::once(&answer.tool).chain(another).map(ToolCall::for_tool).collect();
+    (legs, tools)
+}
+
+/// The cycle time of the deburring program: the moves the program makes (each loop's approach,
+/// loop and way out, the travel between loops over the clearance plane), the loops cutting at
+/// the deburring feed and every other move in the air (the program's moves down run in air at
+/// that feed too), one tool change per tool (the operator's turns of the tube are not timed).
+fn cycle_time(legs: &[Leg<'_>], dynamics: &Dynamics) -> CycleTime {
+    use crate::path::Motion;
+    let visit = super::program::visit(legs, Reference::Tip);
+    let steps: Vec<Step> = visit
+        .path
+        .moves
+        .iter()
+        .zip(&visit.air)
+        .map(|(step, air)| match step.motion {
+            Motion::Rapid => Step::Rapid(step.to),
+            Motion::Linear { feed } | Motion::Arc { feed, .. } => Step::Feed { to: step.to, feed, air: *air },
+        })
+        .collect();
+    let start = visit.path.moves.first().map_or_else(Vec3::zeros, |step| step.to);
+    let mut tools: Vec<usize> = legs.iter().map(|leg| leg.tool).collect();
+    tools.dedup();
+    crate::machine::cycle::cycle_time(start, &steps, dynamics, tools.len())
 }

@@ -80,6 +80,10 @@ impl DeburrRequest {
             )
             .at("tool"));
         }
+        if self.edge == Edge::Both {
+            // The capability splits `both` into one request per ridge (`placements`).
+            return Err(SolverError::input("edge", "one ridge at a time here: edge \"outer\" or \"inner\""));
+        }
         let (origin, arrangement, cylinder_radius, tube_radii, top_distance) = match &self.workpiece {
             Workpiece::Tube { origin, arrangement_angle_deg, inner_radius, outer_radius } => {
                 let inner = size("workpiece.inner_radius", *inner_radius)?;

@@ -26,6 +26,7 @@ mod diagnostics;
 mod envelope;
 mod frame;
 mod job;
+mod order;
 mod profile;
 pub mod program;
 pub mod request;
@@ -33,7 +34,7 @@ mod swept_width;
 mod tolerance;
 
 pub use answer::{Deburr, DeburrPoint, DeburrSummary, LeadMotion, LeadMove};
-pub use capability::{DeburrAnswer, DeburrCapability};
+pub use capability::{DeburrAnswer, DeburrCapability, HoleAnswer, VisitStop, VisitingOrder};
 pub use diagnostics::{ExactConstruction, PointConstruction, construction_at, ideal_centres};
 pub use program::program;
 pub use request::{
@@ -561,6 +562,7 @@ fn describe(request: &DeburrRequest, job: &Job, summary: &DeburrSummary) -> Vec<
     let edge = match job.edge {
         Edge::Outer => "outer",
         Edge::Inner => "inner",
+        Edge::Both => "both",
     };
     let part = match &request.workpiece {
         Workpiece::Tube { inner_radius, outer_radius, arrangement_angle_deg, .. } => {

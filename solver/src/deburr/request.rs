@@ -151,32 +151,65 @@ pub struct HolePattern {
 /// Most holes one request deburrs.
 pub const MAX_HOLES: usize = 100;
 
-/// One hole of a several-hole request, as a single-hole request.
+/// One loop of a several-loop request (several holes, or both edges), as a single-hole,
+/// single-edge request.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Placement {
-    /// Where its fields are in the request: `holes[i]`, or `hole` for a pattern's copies.
+    /// Where its fields are in the request: `holes[i]`, or `hole` for a pattern's copies and a
+    /// single hole.
     pub field: String,
+    /// Its place in the request's holes: `i` of `holes[i]`, the copy of a pattern (station by
+    /// station, every angle at each), 0 for a single hole.
+    pub index: usize,
+    /// The request field naming its tool: `tool`, or `inner_tool` for an inside ridge when given.
+    pub tool_field: &'static str,
+    /// Whether the tube is turned 180° about its axis for it: a hole of a tube whose axis points
+    /// downward (θ_P more than 90° from +Z) cannot be reached by a vertical tool from above, so
+    /// `request` places it turned up (θ_P − 180°).
+    pub turned: bool,
     /// Its penetration angle, arrangement angle and axial position, as placed.
     pub penetration_angle_deg: f64,
     /// θ_A, degrees.
     pub arrangement_angle_deg: f64,
     /// Along the cylinder axis from `workpiece.origin`, mm.
     pub axial_position: f64,
-    /// The single-hole request.
+    /// The single-hole request (its `edge` is `outer` or `inner`).
     pub request: DeburrRequest,
 }
 
 impl DeburrRequest {
-    /// Whether the request names more than one hole (`holes` or `pattern`).
+    /// Whether the request deburrs more than one loop (`holes`, `pattern` or `edge: both`).
     pub fn is_several(&self) -> bool {
-        self.holes.is_some() || self.pattern.is_some()
+        self.holes.is_some() || self.pattern.is_some() || self.edge == Edge::Both
     }
 
-    /// Every hole as a single-hole request, in the order the program visits them.
+    /// The edges each hole is deburred at, in order: the outer ridge before the inner.
+    fn edges(&self) -> Result<Vec<Edge>, SolverError> {
+        if self.inner_tool.is_some() && self.edge != Edge::Both {
+            return Err(SolverError::input(
+                "inner_tool",
+                "inner_tool is the tool of the inside ridge when both edges are deburred: give it with edge \"both\"",
+            ));
+        }
+        match (self.edge, &self.workpiece) {
+            (Edge::Both, Workpiece::BoreBlock { .. }) => Err(SolverError::input(
+                "edge",
+                "a bore_block has only an inner edge (edge: \"inner\"), so not \"both\"",
+            )),
+            (Edge::Both, Workpiece::Tube { .. }) => Ok(vec![Edge::Outer, Edge::Inner]),
+            (edge, _) => Ok(vec![edge]),
+        }
+    }
+
+    /// Every loop as a single-hole, single-edge request, hole by hole in request order (each
+    /// hole's outer ridge, then its inner one, with `edge: both`); a tube's hole that points
+    /// downward is placed as the tube turned half a turn about its axis shows it (`turned`).
     ///
     /// # Errors
-    /// `E_INPUT` naming `hole`, `holes` or `pattern` when the combination or a placement is wrong.
+    /// `E_INPUT` naming `hole`, `holes`, `pattern`, `edge` or `inner_tool` when the combination or a
+    /// placement is wrong.
     pub fn placements(&self) -> Result<Vec<Placement>, SolverError> {
+        let edges = self.edges()?;
         let (origin, arrangement) = match &self.workpiece {
             Workpiece::Tube { origin, arrangement_angle_deg, .. }
             | Workpiece::BoreBlock { origin, arrangement_angle_deg, .. } => (*origin, *arrangement_angle_deg),
@@ -238,37 +271,59 @@ impl DeburrRequest {
                 placed
             }
         };
-        placed
-            .into_iter()
-            .map(|(field, hole, own_arrangement, axial)| {
-                let arrangement = own_arrangement.unwrap_or(arrangement);
-                let theta = finite(&format!("{field}.arrangement_angle_deg"), arrangement)?.to_radians();
-                // A1 points along +Y turned by θ_A about Z (deburr.md §1.3).
-                let along = [-theta.sin(), theta.cos(), 0.0];
-                let moved = [origin[0] + axial * along[0], origin[1] + axial * along[1], origin[2]];
-                let workpiece = match &self.workpiece {
-                    Workpiece::Tube { inner_radius, outer_radius, .. } => Workpiece::Tube {
-                        origin: moved,
-                        arrangement_angle_deg: arrangement,
-                        inner_radius: *inner_radius,
-                        outer_radius: *outer_radius,
-                    },
-                    Workpiece::BoreBlock { bore_radius, face_distance, .. } => Workpiece::BoreBlock {
-                        origin: moved,
-                        arrangement_angle_deg: arrangement,
-                        bore_radius: *bore_radius,
-                        face_distance: *face_distance,
-                    },
-                };
-                Ok(Placement {
-                    field,
+        let mut placements = Vec::with_capacity(placed.len() * edges.len());
+        for (index, (field, hole, own_arrangement, axial)) in placed.into_iter().enumerate() {
+            let arrangement = own_arrangement.unwrap_or(arrangement);
+            let theta = finite(&format!("{field}.arrangement_angle_deg"), arrangement)?.to_radians();
+            // A1 points along +Y turned by θ_A about Z (deburr.md §1.3).
+            let along = [-theta.sin(), theta.cos(), 0.0];
+            let moved = [origin[0] + axial * along[0], origin[1] + axial * along[1], origin[2]];
+            let workpiece = match &self.workpiece {
+                Workpiece::Tube { inner_radius, outer_radius, .. } => Workpiece::Tube {
+                    origin: moved,
+                    arrangement_angle_deg: arrangement,
+                    inner_radius: *inner_radius,
+                    outer_radius: *outer_radius,
+                },
+                Workpiece::BoreBlock { bore_radius, face_distance, .. } => Workpiece::BoreBlock {
+                    origin: moved,
+                    arrangement_angle_deg: arrangement,
+                    bore_radius: *bore_radius,
+                    face_distance: *face_distance,
+                },
+            };
+            // A hole pointing down is deburred with the tube turned half a turn about its axis.
+            let turned = matches!(self.workpiece, Workpiece::Tube { .. })
+                && finite(&format!("{field}.penetration_angle_deg"), hole.penetration_angle_deg)?.to_radians().cos()
+                    < -1e-9;
+            let programmed = if turned {
+                Hole { penetration_angle_deg: hole.penetration_angle_deg - 180.0, ..hole.clone() }
+            } else {
+                hole.clone()
+            };
+            for edge in &edges {
+                let tool_field = if *edge == Edge::Inner && self.inner_tool.is_some() { "inner_tool" } else { "tool" };
+                placements.push(Placement {
+                    field: field.clone(),
+                    index,
+                    tool_field,
+                    turned,
                     penetration_angle_deg: hole.penetration_angle_deg,
                     arrangement_angle_deg: arrangement,
                     axial_position: axial,
-                    request: DeburrRequest { workpiece, hole: Some(hole), holes: None, pattern: None, ..self.clone() },
-                })
-            })
-            .collect()
+                    request: DeburrRequest {
+                        workpiece: workpiece.clone(),
+                        hole: Some(programmed.clone()),
+                        holes: None,
+                        pattern: None,
+                        edge: *edge,
+                        inner_tool: None,
+                        ..self.clone()
+                    },
+                });
+            }
+        }
+        Ok(placements)
     }
 }
 
@@ -281,6 +336,9 @@ pub enum Edge {
     Outer,
     /// Hole wall × inner surface (bore) (RLN).
     Inner,
+    /// Both ridges of a tube's holes in one program (a request's choice; each loop of the
+    /// answer is `outer` or `inner`).
+    Both,
 }
 
 /// How the band edges are placed.
@@ -318,8 +376,13 @@ pub struct DeburrRequest {
     /// Copies of `hole` around the cylinder and along its axis (issue 15).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pattern: Option<HolePattern>,
-    /// Which ridge.
+    /// Which ridge: `outer`, `inner` or `both` (a tube's; every hole's outer loop and inner
+    /// loop, each an entry of the answer's `holes`).
     pub edge: Edge,
+    /// With `edge: both`: the tool of the inside ridges, a registered tool number or an inline
+    /// ball tool (default `tool`). The program changes tools once between them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inner_tool: Option<ToolRef>,
     /// Q, the amount of cutting (W = √2·Q), mm. Give this or `width`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cut_amount: Option<f64>,

@@ -1,7 +1,7 @@
 //! What an engagement request answers (api.md, Engagement: `samples`, `flutes`, `recommended`;
 //! engagement.md §3.1 outputs and the [X] extras).
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::arcs::MillingMode;
 use super::request::{Engine, FeedBasis};
@@ -9,7 +9,7 @@ use super::segments::Route;
 use crate::error::Warning;
 
 /// One engaged arc with its entry and exit (engagement.md §5.4).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct ArcDetail {
     /// θ_in: where a tooth enters the material, degrees.
@@ -29,7 +29,7 @@ pub struct ArcDetail {
 }
 
 /// Marks on one sample.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum SampleFlag {
@@ -53,7 +53,7 @@ pub enum SampleFlag {
 }
 
 /// The state at one sample of the path (api.md: `s`, `t`, `arcs`, `engaged_deg`, `radial_depth`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct EngagementSample {
     /// Path length from the start, mm.
@@ -75,7 +75,7 @@ pub struct EngagementSample {
     /// a_e: radial depth of cut, the measure of the arcs' lateral projection, mm.
     pub radial_depth: f64,
     /// Entry, exit and mode of each arc, in the order of `arcs`.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub arc_details: Vec<ArcDetail>,
     /// Mean undeformed chip thickness over the engaged angles at the feed per tooth of
     /// `time_flute_count` teeth, mm (side milling: f_z·(a_e/R)/φ).
@@ -88,29 +88,29 @@ pub struct EngagementSample {
     /// Spindle torque averaged over the tooth phase, N·m, per flute count in the order of
     /// `flutes` (with `kienzle` or `material`): R·Σ k_c1.1·a_p·h^(1−m_c); the load the
     /// machine's `spindle_torque_nm` is compared with.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub torque_nm: Vec<f64>,
     /// Largest spindle torque over the tooth phase, N·m, per flute count (with `kienzle`).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub peak_torque_nm: Vec<f64>,
     /// Spindle power 2πN·`torque_nm`/60, kW, per flute count (with `kienzle`).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub power_kw: Vec<f64>,
     /// Largest resultant cutting force on the tool over the tooth phase (tangential and radial
     /// parts of every tooth in the cut, summed as vectors), N, per flute count (with `kienzle`).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub peak_force_n: Vec<f64>,
     /// Material removal rate a_p·a_e·V_f at the nominal feed, mm³/min (with `axial_depth`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mrr: Option<f64>,
     /// Risk and state marks.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub flags: Vec<SampleFlag>,
 }
 
 /// Results for one flute count (api.md: `max_thickness`, `mean_thickness`, `min_thickness`,
 /// `time_s`, `recommended`; engagement.md §5.7–§5.9).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct FluteResult {
     /// k.
@@ -165,7 +165,7 @@ pub struct FluteResult {
 }
 
 /// Why a feed block has its feed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum FeedLimit {
@@ -180,7 +180,7 @@ pub enum FeedLimit {
 }
 
 /// A stretch of the path programmed with one feed.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct FeedBlock {
     /// Path segment the block lies on.
@@ -198,7 +198,7 @@ pub struct FeedBlock {
 }
 
 /// Feeds that hold the target chip thickness (chip-thinning compensation, §11 item 3).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct FeedPlan {
     /// Teeth of the cutter the feeds are for.
@@ -220,7 +220,7 @@ pub struct FeedPlan {
 }
 
 /// The cutting-force model of an answer (engagement.md §11 items 4, 5, 9).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct ForceInfo {
     /// k_c1.1 used, N/mm².
@@ -247,12 +247,12 @@ pub struct ForceInfo {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub spindle_torque_nm: Option<f64>,
     /// The tool's natural frequencies the tooth-passing frequencies are checked against, Hz.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub natural_frequencies_hz: Vec<f64>,
 }
 
 /// The dot grid of the `dots` engine.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct GridInfo {
     /// g, mm.
@@ -268,7 +268,7 @@ pub struct GridInfo {
 }
 
 /// The answer for one path.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct PathEngagement {
     /// Candidate name, when given.
@@ -321,7 +321,7 @@ pub struct PathEngagement {
     pub blocks: Option<crate::machine::PathBlocks>,
     /// Everything worth knowing that did not stop the computation.
     pub warnings: Vec<Warning>,
-    /// What the G-code post needs.
+    /// What the G-code post needs (read back empty: a split request's finish step fills it in).
     #[serde(skip)]
     pub(crate) post: PostData,
 }
@@ -381,6 +381,31 @@ pub(crate) struct PostData {
 /// The route, comparable so the answer can derive `PartialEq`.
 #[derive(Debug, Clone)]
 pub(crate) struct RouteData(pub Route);
+
+impl Default for PostData {
+    /// Nothing to post: what an answer read back holds until its post data is rebuilt.
+    fn default() -> Self {
+        Self {
+            route: RouteData(Route {
+                pieces: Vec::new(),
+                tree: super::bbox_tree::BoxTree::default(),
+                length: 0.0,
+                feed_length: 0.0,
+            }),
+            nominal_feed: 0.0,
+            spindle_rpm: 0.0,
+            spindle_direction: crate::gcode::SpindleDirection::default(),
+            rule: None,
+            axial_depth: None,
+            cut_z: None,
+            stock_top_z: 0.0,
+            clearance: 0.0,
+            tool_radius: 0.0,
+            centre_height: 0.0,
+            description: Vec::new(),
+        }
+    }
+}
 
 impl PartialEq for RouteData {
     fn eq(&self, other: &Self) -> bool {

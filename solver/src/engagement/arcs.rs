@@ -2,7 +2,7 @@
 //! the numeric rules of §9, radial depth (§5.5), and the per-arc quantities of §5.4 and §5.10.
 
 pub use crate::gcode::SpindleDirection;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Two arc ends closer than this (degrees) touch.
 const TOUCH_DEG: f64 = 1e-9;
@@ -194,7 +194,7 @@ pub(crate) fn mean_thickness_ratio(arcs: &[Arc]) -> f64 {
 }
 
 /// How a tooth passes through one engaged arc (§5.4, an extension of the spec).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum MillingMode {

@@ -1,11 +1,17 @@
 //! Engagement analysis as a capability (the seam of engineering.md): `POST /api/v1/engagement`,
 //! job operation `engagement`.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+use super::answer::{Comparison, PathEngagement, PostData, RouteData};
+use super::job::Job;
+use super::request::Engine;
 use super::{EngagementAnswer, EngagementRequest, Stock};
-use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
-use crate::error::SolverError;
+use crate::capability::{
+    Capability, Endpoint, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing, Split,
+};
+use crate::error::{ErrorCode, SolverError};
+use crate::gcode::SpindleDirection;
 use crate::machine::MachineProfile;
 use crate::material::Material;
 use crate::tool::Tool;
@@ -52,6 +58,21 @@ pub struct EngagementResponse {
 
 impl Capability for EngagementCapability {
     const NAME: &'static str = "engagement";
+    const ENDPOINT: Endpoint = Endpoint {
+        summary: "Analyses the tool–workpiece engagement along a tool path and recommends flute counts.",
+        description: "Moves the tool's cutting circle along the path over the stock and returns, per sample, \
+            the engaged arcs (tool angle: 90° ahead, 0° right, 180° left of travel), the radial \
+            depth and the summed chip thickness of every candidate flute count; per flute count the \
+            representative thicknesses, the machining time and whether it meets `thickness_limit` \
+            and `time_limit_s`. `paths` compares several candidate paths side by side. With `Accept: \
+            text/x-gcode` or `?format=gcode` (and `axial_depth`) it returns the program of one path \
+            (`?candidate=`) at the feeds of `feed_plan` (chip-thinning compensation) or at the \
+            nominal feed. A `machine` supplies `feed_plan.max_feed` and the dialect.",
+        not_found: "Unknown tool number or machine",
+        refused: "Impossible or over a limit: `E_INPUT`, `E_PATH`, `E_STOCK`, `E_TOO_LARGE`, \
+            `E_TOO_MANY_SAMPLES`, `E_GRID_MEMORY`, `E_WORK_LIMIT` (engagement.md §9); `E_TIMEOUT` \
+            over the synchronous time limit: submit a job",
+    };
     type Request = EngagementRequest;
     type Answer = EngagementResponse;
     type Tool = Tool;
@@ -68,31 +89,103 @@ impl Capability for EngagementCapability {
         context: Resolved<Tool>,
         run: &Run<'_>,
     ) -> Result<EngagementResponse, SolverError> {
-        if let Some(feed) = request.plunge_feed {
-            crate::validate::positive("plunge_feed", feed)?;
+        check_plunge_feed(request)?;
+        let result = super::solve_in(
+            request,
+            &context.tool,
+            context.machine.as_ref(),
+            &physics(request, &context),
+            run.control,
+        )?;
+        Ok(respond(request, context, result))
+    }
+
+    /// The candidate paths of a request with `paths`, in runs of about `sizing.part_seconds`
+    /// (see `cost`); a request with one `path`, or a refused one, is solved whole.
+    fn split(request: &EngagementRequest, context: &Resolved<Tool>, sizing: &Sizing) -> Option<Split> {
+        if request.paths.as_ref().is_none_or(|paths| paths.len() < 2) || check_plunge_feed(request).is_err() {
+            return None;
         }
-        let physics = super::Physics {
-            material: context.material.as_ref().map(Material::kienzle),
-            spindle: context.machine.as_ref().map(|m| m.spindle_at(request.spindle_rpm)).unwrap_or_default(),
-        };
-        let result = super::solve_in(request, &context.tool, context.machine.as_ref(), &physics, run.control)?;
-        let cycle_time = context.machine.as_ref().and_then(MachineProfile::dynamics).and_then(|dynamics| {
-            let plunge = request
-                .plunge_feed
-                .or(context.tool.plunge_feed)
-                .or(context.machine.as_ref().and_then(|m| m.plunge_feed));
-            super::program::cycle_time(&result, request.candidate.unwrap_or(0), &dynamics, plunge)
-        });
-        Ok(EngagementResponse {
-            cycle_time,
-            tool: context.tool,
-            machine: context.machine,
-            material: context.material,
-            stock: request.stock.clone(),
-            thickness_limit: request.thickness_limit,
-            time_limit_s: request.time_limit_s,
-            result,
-        })
+        let job = request.validate(&context.tool, context.machine.as_ref(), &physics(request, context)).ok()?;
+        if job.single {
+            return None;
+        }
+        let costs: Vec<f64> = job.candidates.iter().map(|candidate| cost(&job, &candidate.route)).collect();
+        let total: f64 = costs.iter().sum();
+        let count = ((total / sizing.part_seconds).round() as usize).clamp(1, sizing.max_parts.max(1)).min(costs.len());
+        if count < 2 {
+            return None;
+        }
+        // Consecutive candidates, `count` parts: a new one once the running cost passes the next
+        // share, or when each candidate left must make a part of its own.
+        let share = total / count as f64;
+        let mut parts = Vec::with_capacity(count);
+        let (mut start, mut sum) = (0, 0.0);
+        for (index, seconds) in costs.iter().enumerate() {
+            sum += seconds;
+            let parts_after = count.saturating_sub(parts.len() + 1);
+            let candidates_after = costs.len() - index - 1;
+            if candidates_after == 0
+                || candidates_after == parts_after
+                || (parts_after > 0 && sum >= share * (parts.len() + 1) as f64)
+            {
+                let seconds = costs[start..=index].iter().sum();
+                parts.push(Part { units: start..index + 1, seconds });
+                start = index + 1;
+            }
+        }
+        (parts.len() >= 2).then_some(Split { parts, finish_seconds: FINISH_SECONDS })
+    }
+
+    /// Evaluates the candidate paths of `part` as [`super::solve_in`] does each one, and hands on
+    /// their results with what their programs need beyond the route.
+    fn solve_part(
+        request: &EngagementRequest,
+        context: Resolved<Tool>,
+        part: &Part,
+        run: &Run<'_>,
+        sink: &mut impl PartSink,
+    ) -> Result<(), SolverError> {
+        check_plunge_feed(request)?;
+        let job = request.validate(&context.tool, context.machine.as_ref(), &physics(request, &context))?;
+        let candidates = job.candidates.get(part.units.clone()).ok_or_else(|| mismatch("the part's candidates"))?;
+        let mut results = Vec::with_capacity(candidates.len());
+        for (index, candidate) in candidates.iter().enumerate() {
+            let mut result = run.control.part(index, candidates.len(), |part| {
+                super::evaluate::evaluate(&job, candidate, &context.tool, part)
+            })?;
+            if let Some((blocks, warnings)) = super::program::blocks(&result)? {
+                result.blocks = Some(blocks);
+                result.warnings.extend(warnings);
+            }
+            let post = PartPost::from(&result.post);
+            results.push(PartCandidate { result, post });
+        }
+        sink.put(&results)
+    }
+
+    /// The candidates' results in order, their post data rebuilt, answered as `solve` answers.
+    fn finish(
+        request: &EngagementRequest,
+        context: Resolved<Tool>,
+        parts: &mut impl PartSource,
+        run: &Run<'_>,
+    ) -> Result<EngagementResponse, SolverError> {
+        check_plunge_feed(request)?;
+        let job = request.validate(&context.tool, context.machine.as_ref(), &physics(request, &context))?;
+        let mut candidates = Vec::with_capacity(job.candidates.len());
+        while let Some(part) = parts.next_part::<Vec<PartCandidate>>() {
+            for PartCandidate { mut result, post } in part? {
+                let route = &job.candidates.get(candidates.len()).ok_or_else(|| mismatch("more candidates"))?.route;
+                result.post = post.into_post(route, &job);
+                candidates.push(result);
+            }
+            run.control.check()?;
+        }
+        if job.single || candidates.len() != job.candidates.len() {
+            return Err(mismatch("fewer candidates"));
+        }
+        Ok(respond(request, context, EngagementAnswer::Comparison(Comparison { candidates })))
     }
 
     /// The program of one path: `output.candidate`, else the request's `candidate`, else 0.
@@ -109,5 +202,130 @@ impl Capability for EngagementCapability {
 
     fn machine(answer: &EngagementResponse) -> Option<&MachineProfile> {
         answer.machine.as_ref()
+    }
+}
+
+/// A plunge feed, when given, must be positive.
+fn check_plunge_feed(request: &EngagementRequest) -> Result<(), SolverError> {
+    if let Some(feed) = request.plunge_feed {
+        crate::validate::positive("plunge_feed", feed)?;
+    }
+    Ok(())
+}
+
+/// The cutting physics the server resolved: the material's Kienzle values and the machine's
+/// spindle at the request's speed.
+fn physics(request: &EngagementRequest, context: &Resolved<Tool>) -> super::Physics {
+    super::Physics {
+        material: context.material.as_ref().map(Material::kienzle),
+        spindle: context.machine.as_ref().map(|m| m.spindle_at(request.spindle_rpm)).unwrap_or_default(),
+    }
+}
+
+/// The answer to `request` around the solver's `result`: the tool, machine, material and stock
+/// it was judged with, and the cycle time of the programmed candidate.
+fn respond(request: &EngagementRequest, context: Resolved<Tool>, result: EngagementAnswer) -> EngagementResponse {
+    let cycle_time = context.machine.as_ref().and_then(MachineProfile::dynamics).and_then(|dynamics| {
+        let plunge =
+            request.plunge_feed.or(context.tool.plunge_feed).or(context.machine.as_ref().and_then(|m| m.plunge_feed));
+        super::program::cycle_time(&result, request.candidate.unwrap_or(0), &dynamics, plunge)
+    });
+    EngagementResponse {
+        cycle_time,
+        tool: context.tool,
+        machine: context.machine,
+        material: context.material,
+        stock: request.stock.clone(),
+        thickness_limit: request.thickness_limit,
+        time_limit_s: request.time_limit_s,
+        result,
+    }
+}
+
+fn mismatch(what: &str) -> SolverError {
+    SolverError::new(ErrorCode::Internal, format!("the parts do not belong to this engagement request: {what}"))
+}
+
+/// Core-seconds per sample, per flute count evaluated (`cost_model` in `solver/tests/split_parts.rs`,
+/// the exact engine with Kienzle forces, one thread: 4.5 µs per sample with one flute count, 19 µs
+/// with three).
+const EXACT_SAMPLE_SECONDS: f64 = 6.0e-6;
+/// Core-seconds per grid row the dots engine scans (the work limit's measure: 5·10⁸ rows, about
+/// 25 s).
+const DOT_ROW_SECONDS: f64 = 5.0e-8;
+/// Core-seconds of the finish step: reading the parts back and answering.
+const FINISH_SECONDS: f64 = 0.1;
+
+/// The estimated core-seconds of one candidate path: its samples, and with the dots engine the
+/// grid rows each scans.
+fn cost(job: &Job, route: &super::segments::Route) -> f64 {
+    let samples = route.station_count(job.step);
+    let contact = match (job.engine, job.grid) {
+        (Engine::Dots, Some(cell)) => samples * (2.0 * job.radius / cell) * DOT_ROW_SECONDS,
+        _ => 0.0,
+    };
+    contact + samples * EXACT_SAMPLE_SECONDS * job.flute_counts.len().max(1) as f64
+}
+
+/// One candidate's result as a part hands it on.
+#[derive(Debug, Serialize, Deserialize)]
+struct PartCandidate {
+    result: PathEngagement,
+    post: PartPost,
+}
+
+/// What a candidate's program needs beyond its route and the request's settings (which the
+/// finish step reads from the request again).
+#[derive(Debug, Serialize, Deserialize)]
+struct PartPost {
+    nominal_feed: f64,
+    spindle_rpm: f64,
+    spindle_direction: SpindleDirection,
+    axial_depth: Option<f64>,
+    /// The tip's Z when a_p came from it (parts stored before it carry none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    cut_z: Option<f64>,
+    stock_top_z: f64,
+    clearance: f64,
+    tool_radius: f64,
+    centre_height: f64,
+    description: Vec<String>,
+}
+
+impl From<&PostData> for PartPost {
+    fn from(post: &PostData) -> Self {
+        Self {
+            nominal_feed: post.nominal_feed,
+            spindle_rpm: post.spindle_rpm,
+            spindle_direction: post.spindle_direction,
+            axial_depth: post.axial_depth,
+            cut_z: post.cut_z,
+            stock_top_z: post.stock_top_z,
+            clearance: post.clearance,
+            tool_radius: post.tool_radius,
+            centre_height: post.centre_height,
+            description: post.description.clone(),
+        }
+    }
+}
+
+impl PartPost {
+    /// The post data `evaluate` built: these figures, the candidate's route and the request's
+    /// block rule.
+    fn into_post(self, route: &super::segments::Route, job: &Job) -> PostData {
+        PostData {
+            route: RouteData(route.clone()),
+            nominal_feed: self.nominal_feed,
+            spindle_rpm: self.spindle_rpm,
+            spindle_direction: self.spindle_direction,
+            rule: job.rule,
+            axial_depth: self.axial_depth,
+            cut_z: self.cut_z,
+            stock_top_z: self.stock_top_z,
+            clearance: self.clearance,
+            tool_radius: self.tool_radius,
+            centre_height: self.centre_height,
+            description: self.description,
+        }
     }
 }

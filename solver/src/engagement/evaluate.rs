@@ -15,7 +15,7 @@ use super::job::{CandidateJob, Job, grid_extent};
 use super::request::Engine;
 use super::segments::{Route, Station};
 use super::stock::{Base, Region};
-use super::teeth::tooth_sum;
+use super::teeth::ToothSums;
 use super::{MAX_CONTACT_DOTS, feed, flutes};
 use crate::capability::Control;
 use crate::error::{SolverError, Warning};
@@ -225,6 +225,7 @@ pub(crate) fn evaluate(
     let mut plunges = Vec::new();
     let mut back = Vec::new();
     let mut collisions = Vec::new();
+    let mut tooth_sums = ToothSums::default();
     for (index, (station, contact)) in stations.iter().zip(&contacts).enumerate() {
         let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
         let arcs = &contact.arcs;
@@ -276,7 +277,7 @@ pub(crate) fn evaluate(
             flags.push(SampleFlag::Collision);
             collisions.push(station.s);
         }
-        let sums: Vec<_> = job.flute_counts.iter().map(|&k| tooth_sum(arcs, k)).collect();
+        let sums = tooth_sums.of(arcs, &job.flute_counts);
         let edge_feed = if job.arc_feed { ArcFeed::at(route, station, radius) } else { None };
         let (torques, forces): (Vec<SampleTorque>, Vec<f64>) =
             candidate.force.as_ref().map_or_else(Default::default, |model| {
@@ -309,7 +310,7 @@ pub(crate) fn evaluate(
             thickness: job
                 .flute_counts
                 .iter()
-                .zip(&sums)
+                .zip(sums)
                 .map(|(&k, sum)| {
                     // H_k/f_z: the exact sinusoid of §5.6, or with the arc-feed factor numeric.
                     let ratio = edge_feed.as_ref().map_or(sum.ratio, |feed| feed.tooth_sum(arcs, k));

@@ -120,6 +120,38 @@ pub(crate) fn tooth_sum(arcs: &[Arc], flutes: u32) -> ToothSum {
     ToothSum { ratio: best, teeth }
 }
 
+/// The tooth sums of the previous sample, reused when a sample's arcs are the same to the bit:
+/// along a straight cut at constant engagement consecutive samples have the same arcs, and
+/// [`tooth_sum`] is a pure function of them, so reusing it changes nothing.
+#[derive(Debug, Default)]
+pub(crate) struct ToothSums {
+    arcs: Vec<Arc>,
+    flute_counts: Vec<u32>,
+    sums: Vec<ToothSum>,
+}
+
+impl ToothSums {
+    /// [`tooth_sum`] of `arcs` for each of `flute_counts`.
+    pub(crate) fn of(&mut self, arcs: &[Arc], flute_counts: &[u32]) -> &[ToothSum] {
+        let same = self.flute_counts == flute_counts
+            && self.arcs.len() == arcs.len()
+            && self
+                .arcs
+                .iter()
+                .zip(arcs)
+                .all(|(old, new)| old.from.to_bits() == new.from.to_bits() && old.to.to_bits() == new.to.to_bits());
+        if !same {
+            self.arcs.clear();
+            self.arcs.extend_from_slice(arcs);
+            self.flute_counts.clear();
+            self.flute_counts.extend_from_slice(flute_counts);
+            self.sums.clear();
+            self.sums.extend(flute_counts.iter().map(|&k| tooth_sum(arcs, k)));
+        }
+        &self.sums
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -181,6 +213,25 @@ mod tests {
                 let scan = sampled(arcs, k, 200_000);
                 assert!(exact >= scan - 1e-12, "{arcs:?} k = {k}: {exact} < {scan}");
                 assert!(exact - scan < 1e-3, "{arcs:?} k = {k}: {exact} vs {scan}");
+            }
+        }
+    }
+
+    #[test]
+    fn reused_sums_equal_fresh_ones() {
+        let mut memo = ToothSums::default();
+        let samples = [
+            vec![arc(0.0, 60.0)],
+            vec![arc(0.0, 60.0)],
+            vec![arc(0.0, 60.000_000_000_000_01)],
+            vec![arc(0.0, 60.0), arc(100.0, 130.0)],
+            vec![],
+            vec![arc(0.0, 60.0)],
+        ];
+        for counts in [vec![2, 3, 4], vec![5], vec![2, 3, 4], vec![5, 6, 7]] {
+            for arcs in &samples {
+                let fresh: Vec<ToothSum> = counts.iter().map(|&k| tooth_sum(arcs, k)).collect();
+                assert_eq!(memo.of(arcs, &counts), fresh.as_slice(), "{arcs:?} {counts:?}");
             }
         }
     }

@@ -124,8 +124,11 @@ pub struct Section<'a> {
     pub safe_z: f64,
     /// The spindle line (`S6000 M03`).
     pub spindle: &'a str,
-    /// The moves, up to the spindle stop.
+    /// The moves, up to the spindle stop, with the tool changes between them (written by
+    /// [`super::write_changing`]).
     pub moves: Vec<&'a str>,
+    /// The tools the moves change to, in order (`None`: a manual change).
+    pub changes: Vec<Option<u32>>,
 }
 
 impl<'a> Section<'a> {
@@ -167,8 +170,16 @@ impl<'a> Section<'a> {
         let body = rest.len().checked_sub(tail.len())?;
         (rest[body..] == tail).then_some(())?;
         let moves = rest[..body].to_vec();
-        moves.iter().all(|line| is_move(line)).then_some(())?;
-        Some(Self { title, comments, blend, tool_number, tool_change, safe_z, spindle, moves })
+        moves.iter().all(|line| is_move(line) || is_change(line)).then_some(())?;
+        let mut changes = Vec::new();
+        for line in &moves {
+            if let Some(call) = line.strip_prefix('T') {
+                changes.push(Some(call.strip_suffix(" M06")?.parse().ok()?));
+            } else if line.starts_with("(TOOL NOT IN THE TOOL TABLE") {
+                changes.push(None);
+            }
+        }
+        Some(Self { title, comments, blend, tool_number, tool_change, safe_z, spindle, moves, changes })
     }
 
     /// The feed time of the moves (every feed move at its feed) and their rapid length, s and mm.
@@ -177,6 +188,15 @@ impl<'a> Section<'a> {
         let mut at: Option<[f64; 3]> = None;
         let mut feed = 0.0;
         for line in &self.moves {
+            if !is_move(line) {
+                // A tool change: the tool goes up (or comes down to the offset) where it is.
+                if line.starts_with("G00 ")
+                    && let (Some(z), Some(here)) = (Words::of(line).z, at.as_mut())
+                {
+                    here[2] = z;
+                }
+                continue;
+            }
             let words = Words::of(line);
             if let Some(f) = words.f {
                 feed = f;
@@ -203,6 +223,20 @@ impl<'a> Section<'a> {
 /// Whether a line is one of the motion blocks [`super::write`] writes.
 fn is_move(line: &str) -> bool {
     ["G00 X", "G01 X", "G02 X", "G03 X"].iter().any(|start| line.starts_with(start))
+}
+
+/// Whether a line is one of those [`super::write_changing`] writes for a stop between moves:
+/// spindle stop, the lift, the operator's notice and `M00`, the tool call with its length offset
+/// (or the manual change with its comments) and the spindle start.
+fn is_change(line: &str) -> bool {
+    let number = |text: &str| !text.is_empty() && text.bytes().all(|b| b.is_ascii_digit());
+    line == "M05"
+        || line == "M00"
+        || (line.starts_with('(') && line.ends_with(')'))
+        || line.starts_with("G00 Z")
+        || line.starts_with("G00 G43 H")
+        || line.strip_prefix('T').and_then(|rest| rest.strip_suffix(" M06")).is_some_and(number)
+        || (line.starts_with('S') && (line.ends_with(" M03") || line.ends_with(" M04")))
 }
 
 /// The words of one motion block.
@@ -254,7 +288,8 @@ fn arc_length(from: [f64; 3], to: [f64; 3], centre: [f64; 2], clockwise: bool) -
 fn estimated_time_s(section: &Section<'_>, operation: &Operation<'_>) -> f64 {
     let (feed_s, rapid_mm) = section.feed_time_and_rapids();
     let rapid_s = operation.rapid_feed.filter(|f| *f > 0.0).map_or(0.0, |f| rapid_mm / f * 60.0);
-    let change_s = if section.tool_number.is_some() { operation.tool_change_s.unwrap_or(0.0) } else { 0.0 };
+    let changes = usize::from(section.tool_number.is_some()) + section.changes.iter().flatten().count();
+    let change_s = operation.tool_change_s.unwrap_or(0.0) * changes as f64;
     feed_s + rapid_s + change_s
 }
 
@@ -283,7 +318,11 @@ pub fn write(job: &Job<'_>, operations: &[Operation<'_>]) -> Result<String, Solv
         let _ = writeln!(out, "{}", comment(&format!("O{:04} {}", job.number, job.title)));
     }
     let included = sections.iter().flatten().count();
-    let mut tools: Vec<u32> = sections.iter().flatten().filter_map(|s| s.tool_number).collect();
+    let mut tools: Vec<u32> = sections
+        .iter()
+        .flatten()
+        .flat_map(|s| s.tool_number.into_iter().chain(s.changes.iter().flatten().copied()))
+        .collect();
     tools.sort_unstable();
     tools.dedup();
     let tools: Vec<String> = tools.iter().map(|n| format!("T{n}")).collect();
@@ -306,7 +345,11 @@ pub fn write(job: &Job<'_>, operations: &[Operation<'_>]) -> Result<String, Solv
         let tool = operation.tool.unwrap_or("no tool");
         let line = match (time, &sections[index]) {
             (Some(time), Some(section)) => {
-                let call = section.tool_number.map_or_else(|| "manual tool change".to_owned(), |n| format!("T{n}"));
+                let call = std::iter::once(section.tool_number)
+                    .chain(section.changes.iter().copied())
+                    .map(|number| number.map_or_else(|| "manual tool change".to_owned(), |n| format!("T{n}")))
+                    .collect::<Vec<_>>()
+                    .join(" then ");
                 format!("{} {}: {call} {tool}, {time:.1} s", index + 1, operation.name)
             }
             _ => format!(
@@ -444,6 +487,57 @@ mod tests {
         assert!(text.ends_with("M05\nM09\nG00 Z30.0000\nM30\n%\n"));
         let none = write(&job, &[missing]).unwrap_err();
         assert_eq!(none.code(), crate::error::ErrorCode::NoProgram);
+    }
+
+    #[test]
+    fn stops_inside_an_operation_are_kept_and_counted() {
+        let mut path = Toolpath::default();
+        path.rapid(Vec3::new(1.0, 2.0, 30.0));
+        path.linear(Vec3::new(1.0, 2.0, 20.0), 300.0);
+        path.rapid(Vec3::new(1.0, 2.0, 30.0));
+        path.rapid(Vec3::new(5.0, 2.0, 30.0));
+        path.linear(Vec3::new(5.0, 2.0, 20.0), 300.0);
+        let program = Program {
+            dialect: Dialect::Fanuc,
+            number: 1000,
+            title: "kerf deburr",
+            comments: Vec::new(),
+            tool: ToolCall::Table(7),
+            spindle_rpm: 6000.0,
+            spindle_direction: SpindleDirection::Cw,
+            safe_z: 30.0,
+            blend_tolerance: 0.01,
+            plunges: None,
+            path: &path,
+        };
+        let stop = crate::gcode::ProgramStop {
+            before: 3,
+            notice: Some("turn the tube".to_owned()),
+            tool: Some(ToolCall::Table(8)),
+            spindle_rpm: 5000.0,
+        };
+        let text = crate::gcode::write_changing(&program, &[stop]);
+        assert!(
+            text.contains("G00 X1.0000 Y2.0000 Z30.0000\nM05\nG00 Z30.0000\n(TURN THE TUBE)\nM00\nT8 M06\nG00 G43 H8 Z30.0000\nS5000 M03\nG00 X5.0000"),
+            "{text}"
+        );
+        let section = Section::parse(&text).expect("a section with a stop");
+        assert_eq!((section.tool_number, section.changes.clone()), (Some(7), vec![Some(8)]));
+        // 10 mm down at 300 mm/min twice, the rapids up and across, two tool changes.
+        let operation = Operation {
+            name: "deburr",
+            program: Some(&text),
+            problem: None,
+            tool: Some("ball R3"),
+            rapid_feed: Some(6000.0),
+            tool_change_s: Some(5.0),
+        };
+        let time = estimated_time_s(&section, &operation);
+        assert!((time - (2.0 * 10.0 / 300.0 * 60.0 + 14.0 / 6000.0 * 60.0 + 10.0)).abs() < 1e-9, "{time}");
+        let job = Job { dialect: Dialect::Fanuc, number: 2001, title: "kerf job", coolant: Coolant::Off };
+        let joined = write(&job, &[operation]).unwrap();
+        assert!(joined.contains("TOOLS T7 T8,") && joined.contains("(1 DEBURR: T7 THEN T8 BALL R3"), "{joined}");
+        assert_eq!(joined.matches("M06").count(), 2);
     }
 
     #[test]

@@ -203,8 +203,48 @@ pub fn comment(text: &str) -> String {
     format!("({})", cleaned.trim())
 }
 
+/// A stop in the middle of a program (issue 15: a deburr of both edges whose inside needs another
+/// tool, or of holes on both sides of a tube): before move `before` of the path the spindle
+/// stops and the tool goes up to the clearance plane; the program stops for the operator with a
+/// notice (`M00`) if there is one, changes the tool with its length offset if there is one, and
+/// starts the spindle again.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProgramStop {
+    /// The index of the move the stop comes before.
+    pub before: usize,
+    /// What the operator does at an `M00` (turn the part), if anything.
+    pub notice: Option<String>,
+    /// The new tool, if it changes.
+    pub tool: Option<ToolCall>,
+    /// The spindle speed after it, rpm (the direction stays the program's).
+    pub spindle_rpm: f64,
+}
+
+/// Writes the tool call of `tool` with its length offset at `safe_z`.
+fn write_tool_call(out: &mut String, tool: &ToolCall, safe_z: f64) {
+    match tool {
+        ToolCall::Table(number) => {
+            let _ = writeln!(out, "T{number} M06");
+            let _ = writeln!(out, "G00 G43 H{number} Z{}", mm(safe_z));
+        }
+        ToolCall::Manual(description) => {
+            let _ = writeln!(out, "{}", comment(&format!("TOOL NOT IN THE TOOL TABLE: {description}")));
+            let _ = writeln!(out, "{}", comment("LOAD IT, ACTIVATE ITS LENGTH OFFSET, THEN CYCLE START"));
+            out.push_str("M00\n");
+            let _ = writeln!(out, "G00 Z{}", mm(safe_z));
+        }
+    }
+}
+
 /// Writes the whole program.
 pub fn write(program: &Program<'_>) -> String {
+    write_changing(program, &[])
+}
+
+/// Writes the whole program with stops in it (`stops` in the order of their moves); each is
+/// `M05`, `G00 Z` to the clearance plane, the notice as a comment with `M00`, the tool call as at
+/// the start, and the spindle line. Without stops, [`write`].
+pub fn write_changing(program: &Program<'_>, stops: &[ProgramStop]) -> String {
     let mut out = String::with_capacity(64 + program.path.moves.len() * 40);
     let fanuc = program.dialect == Dialect::Fanuc;
     if fanuc {
@@ -220,22 +260,29 @@ pub fn write(program: &Program<'_>) -> String {
     if !fanuc {
         let _ = writeln!(out, "G64 P{}", mm(program.blend_tolerance));
     }
-    match &program.tool {
-        ToolCall::Table(number) => {
-            let _ = writeln!(out, "T{number} M06");
-            let _ = writeln!(out, "G00 G43 H{number} Z{}", mm(program.safe_z));
-        }
-        ToolCall::Manual(description) => {
-            let _ = writeln!(out, "{}", comment(&format!("TOOL NOT IN THE TOOL TABLE: {description}")));
-            let _ = writeln!(out, "{}", comment("LOAD IT, ACTIVATE ITS LENGTH OFFSET, THEN CYCLE START"));
-            out.push_str("M00\n");
-            let _ = writeln!(out, "G00 Z{}", mm(program.safe_z));
-        }
-    }
+    write_tool_call(&mut out, &program.tool, program.safe_z);
     let _ = writeln!(out, "S{} {}", program.spindle_rpm.round(), program.spindle_direction.m_code());
     let mut current_feed: Option<f64> = None;
     let mut position: Option<Vec3> = None;
-    for step in &program.path.moves {
+    let mut stops = stops.iter().peekable();
+    for (index, step) in program.path.moves.iter().enumerate() {
+        while let Some(stop) = stops.next_if(|stop| stop.before <= index) {
+            out.push_str("M05\n");
+            let _ = writeln!(out, "G00 Z{}", mm(program.safe_z));
+            if let Some(notice) = &stop.notice {
+                let _ = writeln!(out, "{}", comment(notice));
+                out.push_str("M00\n");
+            }
+            if let Some(tool) = &stop.tool {
+                write_tool_call(&mut out, tool, program.safe_z);
+            }
+            let _ = writeln!(out, "S{} {}", stop.spindle_rpm.round(), program.spindle_direction.m_code());
+            if let Some(at) = &mut position {
+                at.z = program.safe_z;
+            }
+            // The first feed move after the change states its feed again.
+            current_feed = None;
+        }
         let (x, y, z) = (mm(step.to.x), mm(step.to.y), mm(step.to.z));
         let feed = match step.motion {
             Motion::Rapid => {

@@ -16,7 +16,10 @@ use serde::{Deserialize, Serialize};
 use crate::error::SolverError;
 
 use crate::gcode::Dialect;
-use crate::validate::{non_negative, positive};
+use crate::validate::{non_negative, positive, positive_at_most};
+
+/// Largest `max_jerk`, mm/s³ (10⁶ m/s³: far beyond any machine axis; more is a unit mistake).
+pub const MAX_JERK: f64 = 1e9;
 
 /// Longest machine name.
 pub const MAX_NAME_CHARS: usize = 64;
@@ -82,6 +85,10 @@ pub struct MachineProfile {
     /// trapezoidal feed profile (issue 15).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_accel: Option<f64>,
+    /// Largest path jerk, mm/s³ (> 0, at most 10⁹): with `max_accel`, `cycle_time` changes speed
+    /// in jerk-limited S-curves instead of trapezoids (issue 15).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_jerk: Option<f64>,
     /// Rapid traverse feed, mm/min (> 0; default `max_feed`), for `cycle_time`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rapid_feed: Option<f64>,
@@ -95,6 +102,7 @@ impl MachineProfile {
     pub fn dynamics(&self) -> Option<cycle::Dynamics> {
         Some(cycle::Dynamics {
             max_accel: self.max_accel?,
+            max_jerk: self.max_jerk,
             rapid_feed: self.rapid_feed.unwrap_or(self.max_feed),
             block_time_s: self.block_time_ms / 1000.0,
             tool_change_s: self.tool_change_s.unwrap_or(0.0),
@@ -155,6 +163,9 @@ impl MachineProfile {
         }
         if let Some(max_accel) = self.max_accel {
             positive("max_accel", max_accel)?;
+        }
+        if let Some(max_jerk) = self.max_jerk {
+            positive_at_most("max_jerk", max_jerk, MAX_JERK)?;
         }
         if let Some(rapid_feed) = self.rapid_feed {
             positive("rapid_feed", rapid_feed)?;
@@ -274,6 +285,11 @@ mod tests {
         assert_eq!(bad.validate().unwrap_err().field(), Some("margin"));
         let bad = MachineProfile { block_time_ms: 0.0, ..machine.clone() };
         assert_eq!(bad.validate().unwrap_err().field(), Some("block_time_ms"));
+        for jerk in [0.0, -1.0, f64::NAN, 2e9] {
+            let bad = MachineProfile { max_jerk: Some(jerk), ..machine.clone() };
+            assert_eq!(bad.validate().unwrap_err().field(), Some("max_jerk"), "{jerk}");
+        }
+        MachineProfile { max_jerk: Some(5e4), ..machine.clone() }.validate().unwrap();
         let bad = MachineProfile { name: Some("a b".to_owned()), ..machine };
         assert_eq!(bad.validate().unwrap_err().field(), Some("name"));
         assert!(serde_json::from_str::<MachineProfile>(r#"{"block_time_ms": 4, "max_feed": 1, "x": 1}"#).is_err());

@@ -3,7 +3,7 @@
 //! time: how many blocks, the shortest, how many starve the control, and a cycle time that
 //! accounts for the block limit; and the same over a whole path of feed moves and rapids.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::rule::{BlockRule, MS_PER_MIN};
 use crate::error::{SolverError, Warning};
@@ -133,7 +133,7 @@ pub(crate) fn stats_with_ends(points: &[Vec3], feed: f64, block_time_ms: f64, sp
 ///
 /// A *span* is a run of feed moves between two rapids; its last block ends where the control
 /// stops anyway (a retract follows), so a short one there is counted apart.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct PathBlocks {
     /// Block processing time T_b of the control, ms.

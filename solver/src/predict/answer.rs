@@ -1,7 +1,7 @@
 //! What a prediction request answers (api.md, Error prediction): one record per pass in path
 //! order, statistics, warnings, and (not serialised) what the corrected program needs.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::job::NodeSource;
 use super::request::Method;
@@ -9,7 +9,7 @@ use crate::error::Warning;
 use crate::geometry::Vec3;
 
 /// What happened at a pass (§5).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum PassStatus {
@@ -28,7 +28,7 @@ pub enum PassStatus {
 }
 
 /// Remarks on a pass's prediction (§5).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum PassFlag {
@@ -60,7 +60,7 @@ pub enum PassFlag {
 }
 
 /// Force and deflection over one revolution (§1.3 O2).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct PassHistory {
     /// Rotation step, degrees (ψ_m = m·step).
@@ -130,6 +130,15 @@ pub struct PredictedPass {
     /// Force and deflection over one revolution, when asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub history: Option<PassHistory>,
+    /// With `merge_similar_passes`: the simulated pass whose result this pass carries (absent for
+    /// simulated passes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub merged_with: Option<usize>,
+    /// The error of the merge, mm: how much `error` can differ from simulating this pass (the
+    /// spread of the errors of the simulated passes on either side plus the resolution of one
+    /// prediction).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub merge_bound: Option<f64>,
 }
 
 /// One worst pass.
@@ -200,6 +209,23 @@ pub struct PredictSummary {
     pub samples_per_revolution: usize,
     /// N_θ used.
     pub edge_elements: usize,
+    /// Merging of similar passes, with `merge_similar_passes`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub merge: Option<MergeSummary>,
+}
+
+/// How many passes were simulated and merged (`merge_similar_passes`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct MergeSummary {
+    /// The tolerance used, mm.
+    pub tolerance: f64,
+    /// Passes simulated (in `pass_range`, first round).
+    pub simulated: usize,
+    /// Passes that carry a simulated pass's result.
+    pub merged: usize,
+    /// Largest `merge_bound`, mm.
+    pub max_bound: f64,
 }
 
 /// The answer of `POST /api/v1/predict`.

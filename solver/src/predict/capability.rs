@@ -1,12 +1,20 @@
 //! Error prediction as a capability (the seam of engineering.md): `POST /api/v1/predict`, job
 //! operation `predict`. The STL file of a `mesh` stock comes as the run's upload.
 
-use serde::Serialize;
+use std::sync::atomic::AtomicUsize;
 
-use super::{PathInput, Predict, PredictRequest, ProgramOptions, Stock};
-use crate::capability::{Capability, OutputOptions, Refs, Resolved, Run};
-use crate::error::SolverError;
+use serde::{Deserialize, Serialize};
+
+use super::answer::{PassFlag, PassHistory, PassStatus};
+use super::pipeline::{self, Context, Outcome};
+use super::request::Method;
+use super::{PathInput, Predict, PredictRequest, ProgramOptions, Stock, correct};
+use crate::capability::{
+    Capability, Endpoint, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing, Split,
+};
+use crate::error::{ErrorCode, SolverError};
 use crate::gcode::{Reference, ToolCall};
+use crate::geometry::{Vec3, array3, vec3};
 use crate::machine::MachineProfile;
 use crate::tool::Tool;
 
@@ -19,7 +27,8 @@ pub struct PredictCapability;
 #[derive(Debug, Clone, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct Timings {
-    /// Wall time of the prediction and correction, ms.
+    /// Wall time of the prediction and correction, ms (a job split into parts on several
+    /// workers: the parts' times added up, and the finish step's).
     pub solve_ms: f64,
     /// Passes predicted (those in `pass_range`, every round).
     pub passes: usize,
@@ -43,6 +52,19 @@ pub struct PredictAnswer {
 
 impl Capability for PredictCapability {
     const NAME: &'static str = "predict";
+    const ENDPOINT: Endpoint = Endpoint {
+        summary: "Predicts the machining error of a ball-end-mill finishing path and corrects the path.",
+        description: "Returns one record per pass (error along the surface normal, contact angle, generation \
+            point, normal, flags, corrected end point), a summary with the worst passes and warnings \
+            (JSON), or with `Accept: text/x-gcode` / `?format=gcode` the corrected program. The body \
+            is JSON, or a form with the JSON in part `request` and the STL stock in part `stock`. \
+            Long paths exceed the synchronous time limit (422 `E_TIMEOUT`): submit them as a job \
+            (`operation = \"predict\"`).",
+        not_found: "Unknown tool number",
+        refused: "Impossible or over a limit: tool kind, no shape-error table, G-code errors with the \
+            line, open mesh, resolution over the memory limit; `E_TIMEOUT` over the synchronous time \
+            limit: submit a job",
+    };
     type Request = PredictRequest;
     type Answer = PredictAnswer;
     type Tool = Tool;
@@ -57,23 +79,101 @@ impl Capability for PredictCapability {
 
     /// A `mesh` stock needs the uploaded STL file, and an upload needs a `mesh` stock.
     fn solve(request: &PredictRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<PredictAnswer, SolverError> {
-        match (&request.stock, run.upload) {
-            (Stock::Mesh {}, None) => {
-                return Err(SolverError::input(
-                    "stock",
-                    "a mesh stock needs its STL file: send multipart/form-data with the JSON in part `request` \
-                     and the STL file in part `stock`",
-                ));
-            }
-            (stock, Some(_)) if !matches!(stock, Stock::Mesh {}) => {
-                return Err(SolverError::input(
-                    "stock.kind",
-                    "an STL file was uploaded but stock.kind is not \"mesh\"",
-                ));
-            }
-            _ => {}
-        }
+        check_upload(request, run)?;
         let result = super::solve_with(request, &context.tool, run.upload, &run.control)?;
+        Ok(PredictAnswer { tool: context.tool, result, timings: None })
+    }
+
+    /// Pass ranges of about `sizing.part_seconds` each (see `cost`). Not split: a refused
+    /// request, a mesh stock (a job cannot carry one), `iterations` ≥ 2, whose second round
+    /// predicts the path corrected by the first round's errors of every pass, so no part could
+    /// start it before all of the first round is done, and `merge_similar_passes`, whose runs of
+    /// similar passes would be cut at the part boundaries (the merged answer would differ from
+    /// one process's).
+    fn split(request: &PredictRequest, context: &Resolved<Tool>, sizing: &Sizing) -> Option<Split> {
+        if matches!(request.stock, Stock::Mesh {}) {
+            return None;
+        }
+        let job = request.validate(&context.tool, None).ok()?;
+        if job.iterations != 1 || job.merge_tolerance.is_some() {
+            return None;
+        }
+        let cost = cost(&job);
+        Split::even(job.pass_range.clone(), cost.pass_seconds, cost.setup_seconds, cost.finish_seconds, sizing)
+    }
+
+    /// Predicts the passes of `part` (the whole path still sweeps the stock, as with
+    /// `pass_range`) and hands on their raw outcomes, in full precision.
+    fn solve_part(
+        request: &PredictRequest,
+        context: Resolved<Tool>,
+        part: &Part,
+        run: &Run<'_>,
+        sink: &mut impl PartSink,
+    ) -> Result<(), SolverError> {
+        check_upload(request, run)?;
+        let mut ranged = request.clone();
+        ranged.pass_range = Some([part.units.start, part.units.end]);
+        let job = ranged.validate(&context.tool, run.upload)?;
+        let outcomes = pipeline::run_round(
+            &Context::new(&job),
+            &job.path,
+            &run.control,
+            &AtomicUsize::new(0),
+            job.pass_range.len().max(1),
+        )
+        .ok_or_else(pipeline::cancelled)?;
+        let passes = outcomes[job.pass_range.clone()].iter().map(PartPass::from).collect();
+        sink.put(&PartPasses { from: job.pass_range.start, passes })
+    }
+
+    /// Merges the parts' passes and finishes as [`super::solve_with`] finishes its one round:
+    /// the node corrections from every pass's error, clamped, the per-pass records and summary,
+    /// the warnings.
+    fn finish(
+        request: &PredictRequest,
+        context: Resolved<Tool>,
+        parts: &mut impl PartSource,
+        run: &Run<'_>,
+    ) -> Result<PredictAnswer, SolverError> {
+        check_upload(request, run)?;
+        let job = request.validate(&context.tool, run.upload)?;
+        let count = job.path.passes.len();
+        let mut outcomes: Vec<Option<Outcome>> = vec![None; count];
+        let mut read = 0;
+        while let Some(part) = parts.next_part::<PartPasses>() {
+            let part = part?;
+            for (offset, pass) in part.passes.into_iter().enumerate() {
+                let index = part.from + offset;
+                match outcomes.get_mut(index) {
+                    Some(slot @ None) if job.pass_range.contains(&index) => *slot = Some(pass.into()),
+                    _ => return Err(mismatch(format!("pass {index} is outside the request or in two parts"))),
+                }
+            }
+            read += 1;
+            run.control.report(read, parts.count());
+            run.control.check()?;
+        }
+        let outcomes = outcomes
+            .into_iter()
+            .enumerate()
+            .map(|(index, outcome)| match outcome {
+                Some(outcome) => Ok(outcome),
+                None if !job.pass_range.contains(&index) => Ok(PartPass::not_predicted().into()),
+                None => Err(mismatch(format!("no part predicted pass {index}"))),
+            })
+            .collect::<Result<Vec<Outcome>, SolverError>>()?;
+        // solve_with's round 0, the only one of a split request.
+        let node_count = job.path.nodes.len();
+        let (step, _, ambiguous) = super::node_corrections(&job.path, &outcomes, f64::INFINITY);
+        let mut total = vec![Vec3::zeros(); node_count];
+        let mut clamped = vec![false; node_count];
+        for node in 0..node_count {
+            total[node] += step[node];
+            clamped[node] = correct::clamp(&mut total[node], job.max_correction);
+        }
+        let mut result = super::assemble(&job, &[outcomes], &total, &clamped, &ambiguous);
+        result.warnings.extend(super::rapid_collisions(&job));
         Ok(PredictAnswer { tool: context.tool, result, timings: None })
     }
 
@@ -114,6 +214,205 @@ impl Capability for PredictCapability {
             passes,
             passes_per_s: if seconds > 0.0 { (passes as f64 / seconds).round() } else { 0.0 },
         });
+    }
+}
+
+/// A `mesh` stock needs the uploaded STL file, and an upload needs a `mesh` stock.
+fn check_upload(request: &PredictRequest, run: &Run<'_>) -> Result<(), SolverError> {
+    match (&request.stock, run.upload) {
+        (Stock::Mesh {}, None) => Err(SolverError::input(
+            "stock",
+            "a mesh stock needs its STL file: send multipart/form-data with the JSON in part `request` and the STL \
+             file in part `stock`",
+        )),
+        (stock, Some(_)) if !matches!(stock, Stock::Mesh {}) => {
+            Err(SolverError::input("stock.kind", "an STL file was uploaded but stock.kind is not \"mesh\""))
+        }
+        _ => Ok(()),
+    }
+}
+
+fn mismatch(detail: String) -> SolverError {
+    SolverError::new(ErrorCode::Internal, format!("the parts do not belong to this prediction: {detail}"))
+}
+
+/// What a prediction costs, in core-seconds of the reference machine (README, "More than one
+/// machine": measured by `cost_model` in `solver/tests/split_parts.rs`, one thread, CPU time).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Cost {
+    /// Per predicted pass.
+    pass_seconds: f64,
+    /// What every part repeats: reading the request (the G-code, the stock, the path model).
+    setup_seconds: f64,
+    /// The finish step: merging the parts, correcting, writing the answer and the program, and
+    /// compressing them for the store.
+    finish_seconds: f64,
+}
+
+/// A pass's core-seconds by method: `[fixed, per neighbouring pass, at N = 256]`. A pass costs a
+/// constant (its stations, the force model), a share for every pass within 2R of it (the swept
+/// volumes gathered and tested around it) and a share growing with the samples or pixels, N².
+/// Measured on the raster of `tests/predict_support` (Ø10 ball, one thread, CPU time; passes per
+/// mm² d at picks of 1, 0.5 and 0.3 mm: 1.0, 4.0 and 11.2): sampling at N = 256 took 0.50, 0.81 and
+/// 1.53 ms per pass, and 0.86 and 0.97 ms at N = 128 and 512 (d = 4.0).
+const SAMPLING_PASS_SECONDS: [f64; 3] = [0.36e-3, 0.33e-6, 0.035e-3];
+/// The depth buffer: 1.98 and 3.43 ms at N = 256 (d = 4.0, 11.2), 1.03 ms at N = 128 (d = 4.0).
+const DEPTH_BUFFER_PASS_SECONDS: [f64; 3] = [0.0, 0.64e-6, 1.26e-3];
+/// Reading the request, per pass of the path: 0.16 s for the 103 041 passes of the raster, 0.46 s
+/// for 286 225.
+const SETUP_PASS_SECONDS: f64 = 1.6e-6;
+/// The finish step, per pass of the path: 7 µs merging and writing (0.71 s for 103 041
+/// passes), and compressing the answer's 730 bytes per pass for the store.
+const FINISH_PASS_SECONDS: f64 = 30e-6;
+
+/// The cost model of a prediction. The passes around one are estimated from the passes per mm²
+/// of the path's extent in XY (a raster's density; the force model's share, under 2 % at
+/// N_t = 360, N_θ = 90, is in the constant).
+fn cost(job: &super::job::Job) -> Cost {
+    let pixels = (f64::from(job.resolution) / 256.0).powi(2);
+    let [fixed, per_neighbour, per_pixels] = match job.method {
+        Method::Sampling => SAMPLING_PASS_SECONDS,
+        Method::DepthBuffer => DEPTH_BUFFER_PASS_SECONDS,
+    };
+    let passes = job.path.passes.len() as f64;
+    let reach = std::f64::consts::PI * (2.0 * job.radius).powi(2);
+    let (lo, hi) = job.path.nodes.iter().fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), node| {
+        ([lo[0].min(node.x), lo[1].min(node.y)], [hi[0].max(node.x), hi[1].max(node.y)])
+    });
+    let area = ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(reach);
+    let neighbours = (passes * reach / area).min(passes);
+    Cost {
+        pass_seconds: fixed + per_neighbour * neighbours + per_pixels * pixels,
+        setup_seconds: SETUP_PASS_SECONDS * passes,
+        finish_seconds: FINISH_PASS_SECONDS * passes,
+    }
+}
+
+/// A part's output: the raw outcome of passes `from`, `from + 1`, ….
+#[derive(Debug, Serialize, Deserialize)]
+struct PartPasses {
+    from: usize,
+    passes: Vec<PartPass>,
+}
+
+/// One pass's [`Outcome`] as stored between a part and the finish step (vectors as arrays, angles
+/// in radians: every number exactly as computed).
+#[derive(Debug, Serialize, Deserialize)]
+struct PartPass {
+    status: PassStatus,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    flags: Vec<PassFlag>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    position: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    centre: Option<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    error: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    error_deflection: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    error_shape: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    contact_angle: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    azimuth: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    rotation_angle: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    point: Option<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    normal: Option<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    deflection: Option<[f64; 2]>,
+    #[serde(default)]
+    cut_count: usize,
+    #[serde(default)]
+    finished_count: usize,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    view: Option<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    history: Option<PassHistory>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    merged_with: Option<usize>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    merge_bound: Option<f64>,
+}
+
+impl PartPass {
+    fn not_predicted() -> Self {
+        Self {
+            status: PassStatus::NotPredicted,
+            flags: Vec::new(),
+            position: None,
+            centre: None,
+            error: None,
+            error_deflection: None,
+            error_shape: None,
+            contact_angle: None,
+            azimuth: None,
+            rotation_angle: None,
+            point: None,
+            normal: None,
+            deflection: None,
+            cut_count: 0,
+            finished_count: 0,
+            view: None,
+            history: None,
+            merged_with: None,
+            merge_bound: None,
+        }
+    }
+}
+
+impl From<&Outcome> for PartPass {
+    fn from(o: &Outcome) -> Self {
+        Self {
+            status: o.status,
+            flags: o.flags.clone(),
+            position: o.position,
+            centre: o.centre.as_ref().map(array3),
+            error: o.error,
+            error_deflection: o.error_deflection,
+            error_shape: o.error_shape,
+            contact_angle: o.contact_angle,
+            azimuth: o.azimuth,
+            rotation_angle: o.rotation_angle,
+            point: o.point.as_ref().map(array3),
+            normal: o.normal.as_ref().map(array3),
+            deflection: o.deflection,
+            cut_count: o.cut_count,
+            finished_count: o.finished_count,
+            view: o.view.as_ref().map(array3),
+            history: o.history.clone(),
+            merged_with: o.merged_with,
+            merge_bound: o.merge_bound,
+        }
+    }
+}
+
+impl From<PartPass> for Outcome {
+    fn from(p: PartPass) -> Self {
+        Self {
+            status: p.status,
+            flags: p.flags,
+            position: p.position,
+            centre: p.centre.map(vec3),
+            error: p.error,
+            error_deflection: p.error_deflection,
+            error_shape: p.error_shape,
+            contact_angle: p.contact_angle,
+            azimuth: p.azimuth,
+            rotation_angle: p.rotation_angle,
+            point: p.point.map(vec3),
+            normal: p.normal.map(vec3),
+            deflection: p.deflection,
+            cut_count: p.cut_count,
+            finished_count: p.finished_count,
+            view: p.view.map(vec3),
+            history: p.history,
+            merged_with: p.merged_with,
+            merge_bound: p.merge_bound,
+        }
     }
 }
 

@@ -54,12 +54,26 @@ impl Capsule {
     /// radius `r2`, if the ray meets it.
     #[inline]
     pub(crate) fn entry_z(&self, x: f64, y: f64, r2: f64) -> Option<f64> {
+        self.entry_z_up_to(x, y, r2, f64::INFINITY)
+    }
+
+    /// [`Self::entry_z`], or `None` early when the capsule's lowest point over (x, y) is
+    /// certainly at or above `top`: every point of the capsule over (x, y) is within R of an
+    /// axis point c with c.z ≥ min_z and an xy distance ≥ d (the distance to the axis's
+    /// projection), so its z ≥ min_z − √(R² − d²).
+    #[inline]
+    pub(crate) fn entry_z_up_to(&self, x: f64, y: f64, r2: f64, top: f64) -> Option<f64> {
         // Beyond R of the axis in xy the ray misses everything.
         let (abx, aby) = self.ab_xy;
         let (apx, apy) = (x - self.a.x, y - self.a.y);
         let t = ((apx * abx + apy * aby) * self.inverse_xy).clamp(0.0, 1.0);
         let (dx, dy) = (apx - t * abx, apy - t * aby);
-        if dx * dx + dy * dy > r2 {
+        let d2 = dx * dx + dy * dy;
+        if d2 > r2 {
+            return None;
+        }
+        let rise = self.min_z - top;
+        if rise > 0.0 && rise * rise >= r2 - d2 {
             return None;
         }
         if self.denom > 0.0 {
@@ -86,6 +100,14 @@ impl Capsule {
             }
         }
         best.is_finite().then_some(best)
+    }
+
+    /// Squared distance from `p` to the axis segment.
+    #[inline]
+    pub(crate) fn distance_squared(&self, p: &Vec3) -> f64 {
+        let ap = p - self.a;
+        let t = ap.dot(&self.axis).clamp(0.0, self.length);
+        (ap - t * self.axis).norm_squared()
     }
 
     /// Whether the ray through `q` (along +z) has entered the capsule by the time it reaches `q`

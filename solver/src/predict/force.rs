@@ -205,6 +205,7 @@ pub(crate) fn engage(
     let mut group_pool = TileLists::default();
     let mut current_group = None;
     let mut lists = TileLists::default();
+    let mut hide_hint = 0usize;
     for (tile, region, lo, hi) in kept {
         let key = group_of(tile);
         if current_group != Some(key) {
@@ -213,6 +214,11 @@ pub(crate) fn engage(
             current_group = Some(key);
         }
         scene.candidates(&lo, &hi, false, Some(&group_pool), &mut lists);
+        // A tile that one T1 capsule hides whole engages nothing (the same answer as testing each
+        // element, without the stock and capsule tests).
+        if scene.hides_box(&lo, &hi, &lists.before, &mut hide_hint) {
+            continue;
+        }
         let mut hint = 0usize;
         for k in tile.rings.0..tile.rings.1 {
             let (sin_t, cos_t) = grid.ring_angle[k];

@@ -13,9 +13,10 @@ use crate::tool::{ShapeErrorPoint, Stiffness, Tool, ToolKind};
 use crate::validate::{finite, optional_positive, positive};
 
 use super::request::{
-    DEFAULT_ARC_TOLERANCE, DEFAULT_EDGE_ELEMENTS, DEFAULT_MAX_CORRECTION, DEFAULT_RESOLUTION, DEFAULT_STEPS,
-    DEFAULT_VIEW_CORRECTION_DEG, DEPTH_BUFFER_BYTES_PER_PIXEL, MAX_DEPTH_BUFFER_BYTES, MAX_HISTORIES, MAX_PASSES,
-    MAX_SAMPLING_RESOLUTION, MAX_SPINDLE_SPEEDS, Method, PathInput, PredictRequest, PrescribedDeflection,
+    DEFAULT_ARC_TOLERANCE, DEFAULT_EDGE_ELEMENTS, DEFAULT_MAX_CORRECTION, DEFAULT_MERGE_TOLERANCE, DEFAULT_RESOLUTION,
+    DEFAULT_STEPS, DEFAULT_VIEW_CORRECTION_DEG, DEPTH_BUFFER_BYTES_PER_PIXEL, MAX_DEPTH_BUFFER_BYTES, MAX_HISTORIES,
+    MAX_MERGE_TOLERANCE, MAX_PASSES, MAX_SAMPLING_RESOLUTION, MAX_SPINDLE_SPEEDS, Method, PathInput, PredictRequest,
+    PrescribedDeflection,
 };
 
 /// Where each path node came from, for writing the corrected program.
@@ -58,6 +59,10 @@ pub(crate) struct Job {
     pub(crate) spindle_speeds: Vec<f64>,
     /// θ_x, degrees.
     pub(crate) exclusion: Option<f64>,
+    /// e_S for the excluded passes.
+    pub(crate) exclusion_shape_error: bool,
+    /// Merging of similar passes and its tolerance, mm.
+    pub(crate) merge_tolerance: Option<f64>,
 }
 
 fn range_u32(field: &str, value: Option<u32>, default: u32, lo: u32, hi: u32) -> Result<u32, SolverError> {
@@ -227,6 +232,29 @@ impl PredictRequest {
                 ));
             }
         };
+        let exclusion_shape_error = self.exclusion_shape_error.unwrap_or(false);
+        if exclusion_shape_error && exclusion.is_none() {
+            return Err(SolverError::input(
+                "exclusion_shape_error",
+                "exclusion_shape_error applies to passes excluded by exclusion_deg: give exclusion_deg too",
+            ));
+        }
+        let merge_tolerance = match (self.merge_similar_passes.unwrap_or(false), self.merge_tolerance) {
+            (_, Some(t)) if !(t.is_finite() && t > 0.0 && t <= MAX_MERGE_TOLERANCE) => {
+                return Err(SolverError::input(
+                    "merge_tolerance",
+                    format!("merge_tolerance must be above 0 and at most {MAX_MERGE_TOLERANCE} mm (got {t})"),
+                ));
+            }
+            (false, Some(_)) => {
+                return Err(SolverError::input(
+                    "merge_tolerance",
+                    "merge_tolerance applies with merge_similar_passes: true",
+                ));
+            }
+            (true, t) => Some(t.unwrap_or(DEFAULT_MERGE_TOLERANCE)),
+            (false, None) => None,
+        };
         let pass_range = match self.pass_range {
             None => 0..path.passes.len(),
             Some([from, to]) => {
@@ -274,6 +302,8 @@ impl PredictRequest {
             history,
             pass_range,
             exclusion,
+            exclusion_shape_error,
+            merge_tolerance,
             spindle_speeds,
         })
     }

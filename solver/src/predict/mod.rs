@@ -19,7 +19,9 @@
 //!   (§3.8);
 //! * [`shape`]: the shape-error table (§3.13);
 //! * [`correct`]: the node correction rule (§3.14);
-//! * `exclusion`: the low-angle pass exclusion of claim 8 (§3.4), with `exclusion_deg`;
+//! * `exclusion`: the low-angle pass exclusion of claim 8 (§3.4), with `exclusion_deg` (and e_S
+//!   for the excluded passes with `exclusion_shape_error`);
+//! * `merge`: merging near-identical consecutive passes (§3.2), with `merge_similar_passes`;
 //! * `pipeline`: the per-pass flow of §3.1 over all passes in parallel.
 //!
 //! Choices where the spec is open (documented for users):
@@ -47,6 +49,7 @@ pub mod dynamics;
 mod exclusion;
 mod force;
 mod job;
+mod merge;
 mod passes;
 mod pipeline;
 mod render;
@@ -60,7 +63,9 @@ pub mod stock;
 use std::sync::atomic::AtomicUsize;
 
 pub use crate::capability::Control;
-pub use answer::{PassFlag, PassHistory, PassStatus, Predict, PredictSummary, PredictedPass, RoundSummary, WorstPass};
+pub use answer::{
+    MergeSummary, PassFlag, PassHistory, PassStatus, Predict, PredictSummary, PredictedPass, RoundSummary, WorstPass,
+};
 pub use capability::{PredictAnswer, PredictCapability, Timings};
 pub use force::CuttingCoefficients;
 pub use request::{CorrectionOptions, Method, PathInput, PredictRequest, PrescribedDeflection, SpindleDirection};
@@ -225,7 +230,10 @@ fn node_corrections(path: &PathModel, outcomes: &[Outcome], limit: f64) -> (Vec<
         let error = segment.pass.and_then(|p| {
             let o = &outcomes[p];
             match (o.status, o.error, o.normal) {
-                (PassStatus::Ok, Some(error), Some(n)) => Some(PassError { error, normal: array3(&n) }),
+                // Excluded passes with e_S (`exclusion_shape_error`) are corrected for it too.
+                (PassStatus::Ok | PassStatus::SkippedSmallAngle, Some(error), Some(n)) => {
+                    Some(PassError { error, normal: array3(&n) })
+                }
                 _ => None,
             }
         });
@@ -285,6 +293,8 @@ fn assemble(job: &Job, rounds: &[Vec<Outcome>], total: &[Vec3], clamped: &[bool]
             correction: array3(&correction),
             corrected: array3(&(path.nodes[end_node] + correction + job.reference_offset)),
             history: outcome.history.clone(),
+            merged_with: outcome.merged_with,
+            merge_bound: outcome.merge_bound,
         });
     }
     let errors: Vec<(usize, f64)> = passes.iter().filter_map(|p| p.error.map(|e| (p.index, e))).collect();
@@ -321,6 +331,15 @@ fn assemble(job: &Job, rounds: &[Vec<Outcome>], total: &[Vec3], clamped: &[bool]
         pixel_size: 2.0 * job.radius / f64::from(job.resolution),
         samples_per_revolution: job.steps,
         edge_elements: job.edge_elements,
+        merge: job.merge_tolerance.map(|tolerance| {
+            let merged: Vec<f64> = first.iter().filter_map(|o| o.merge_bound).collect();
+            MergeSummary {
+                tolerance,
+                simulated: first.iter().filter(|o| o.status != PassStatus::NotPredicted).count() - merged.len(),
+                merged: merged.len(),
+                max_bound: merged.iter().copied().fold(0.0, f64::max),
+            }
+        }),
     };
     Predict {
         passes,

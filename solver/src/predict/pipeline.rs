@@ -15,6 +15,7 @@ use super::dynamics::{self, Compliance};
 use super::exclusion;
 use super::force::{self, EdgeGrid, Engagement};
 use super::job::Job;
+use super::merge;
 use super::passes::PathModel;
 use super::render::{self, Image, Window};
 use super::request::Method;
@@ -50,6 +51,9 @@ pub(crate) struct Outcome {
     pub(crate) finished_count: usize,
     pub(crate) view: Option<Vec3>,
     pub(crate) history: Option<PassHistory>,
+    /// Merged: the simulated pass whose result this is, and the bound on the difference.
+    pub(crate) merged_with: Option<usize>,
+    pub(crate) merge_bound: Option<f64>,
 }
 
 impl Outcome {
@@ -72,6 +76,8 @@ impl Outcome {
             finished_count: 0,
             view: None,
             history: None,
+            merged_with: None,
+            merge_bound: None,
         }
     }
 }
@@ -136,6 +142,13 @@ pub(crate) fn run_round(
 ) -> Option<Vec<Outcome>> {
     let cancelled = AtomicBool::new(false);
     let report_every = (total_work / 200).max(1);
+    let report = |finished: usize| {
+        if let Some(progress) = control.progress
+            && (finished.is_multiple_of(report_every) || finished == total_work)
+        {
+            progress(finished as f64 / total_work as f64);
+        }
+    };
     let range = context.job.pass_range.clone();
     // Claim 8: θ_max per pass from one global view, only when a threshold is given.
     let skipped: Vec<bool> = match context.job.exclusion {
@@ -145,41 +158,97 @@ pub(crate) fn run_round(
             .collect(),
         None => Vec::new(),
     };
-    let predicted: Vec<Option<Outcome>> = range
-        .clone()
+    let is_skipped = |index: usize| skipped.get(index).copied().unwrap_or(false);
+    let simulate = |indices: &[usize]| -> Option<Vec<Outcome>> {
+        let outcomes: Vec<Option<Outcome>> = indices
+            .par_iter()
+            .map_init(Scratch::default, |scratch, &index| {
+                if control.cancelled() {
+                    cancelled.store(true, Ordering::Relaxed);
+                    return None;
+                }
+                let outcome = if is_skipped(index) {
+                    if context.job.exclusion_shape_error {
+                        shape_error_only(context, path, index, scratch)
+                    } else {
+                        Outcome::empty(PassStatus::SkippedSmallAngle)
+                    }
+                } else {
+                    predict_pass(context, path, index, scratch)
+                };
+                report(done.fetch_add(1, Ordering::Relaxed) + 1);
+                Some(outcome)
+            })
+            .collect();
+        if cancelled.load(Ordering::Relaxed) { None } else { outcomes.into_iter().collect() }
+    };
+    let indices: Vec<usize> = range.clone().collect();
+    let predicted: Vec<Outcome> = match context.job.merge_tolerance {
+        None => simulate(&indices)?,
+        Some(tolerance) => {
+            let links = merge_links(context, path, &range, &is_skipped, &cancelled, control)?;
+            let (outcomes, merged) =
+                merge::run(path, &indices, &links, tolerance, merge::Resolution::new(context.job), |batch| {
+                    simulate(batch)
+                })?;
+            report(done.fetch_add(merged, Ordering::Relaxed) + merged);
+            outcomes
+        }
+    };
+    let mut predicted = predicted.into_iter();
+    (0..path.passes.len())
+        .map(
+            |index| {
+                if range.contains(&index) { predicted.next() } else { Some(Outcome::empty(PassStatus::NotPredicted)) }
+            },
+        )
+        .collect()
+}
+
+/// `links[k]`: whether pass `range.start + k + 1` is similar to the pass before it (merging,
+/// [`merge::similar`]); excluded passes and passes with a history are never linked.
+fn merge_links(
+    context: &Context<'_>,
+    path: &PathModel,
+    range: &std::ops::Range<usize>,
+    is_skipped: &(impl Fn(usize) -> bool + Sync),
+    cancelled: &AtomicBool,
+    control: &Control<'_>,
+) -> Option<Vec<bool>> {
+    const CHUNK: usize = 256;
+    let job = context.job;
+    let tolerance = job.merge_tolerance.unwrap_or(0.0);
+    let free = |index: usize| !is_skipped(index) && !job.history.contains(&index);
+    let pairs = range.len().saturating_sub(1);
+    let chunks: Vec<Vec<bool>> = (0..pairs.div_ceil(CHUNK))
         .into_par_iter()
-        .map_init(Scratch::default, |scratch, index| {
+        .map_init(Scratch::default, |scratch, chunk| {
             if control.cancelled() {
                 cancelled.store(true, Ordering::Relaxed);
-                return None;
+                return Vec::new();
             }
-            let outcome = if skipped.get(index).copied().unwrap_or(false) {
-                Outcome::empty(PassStatus::SkippedSmallAngle)
-            } else {
-                predict_pass(context, path, index, scratch)
-            };
-            let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
-            if let Some(progress) = control.progress
-                && (finished.is_multiple_of(report_every) || finished == total_work)
-            {
-                progress(finished as f64 / total_work as f64);
-            }
-            Some(outcome)
+            let first = range.start + chunk * CHUNK;
+            let last = (first + CHUNK).min(range.start + pairs);
+            let mut previous = merge::Neighbourhood::default();
+            let mut previous_ok = free(first) && merge::neighbourhood(job, path, first, scratch, &mut previous);
+            let mut current = merge::Neighbourhood::default();
+            (first..last)
+                .map(|a| {
+                    let current_ok = free(a + 1) && merge::neighbourhood(job, path, a + 1, scratch, &mut current);
+                    let linked = previous_ok
+                        && current_ok
+                        && merge::similar(path, a, &previous, &current, job.radius, tolerance);
+                    std::mem::swap(&mut previous, &mut current);
+                    previous_ok = current_ok;
+                    linked
+                })
+                .collect()
         })
         .collect();
     if cancelled.load(Ordering::Relaxed) {
         return None;
     }
-    let mut predicted = predicted.into_iter();
-    (0..path.passes.len())
-        .map(|index| {
-            if range.contains(&index) {
-                predicted.next().flatten()
-            } else {
-                Some(Outcome::empty(PassStatus::NotPredicted))
-            }
-        })
-        .collect()
+    Some(chunks.concat())
 }
 
 /// The cancellation error.
@@ -187,8 +256,34 @@ pub(crate) fn cancelled() -> SolverError {
     SolverError::new(ErrorCode::Cancelled, "the prediction was cancelled")
 }
 
+/// A pass excluded by claim 8 with `exclusion_shape_error` (§3.4, E15): the same prediction
+/// position, finished surface and generation point as a full prediction, and e_S = −δ(θ_c), but
+/// neither force nor deflection (the reason for the exclusion): e_D stays null and e = e_S. The
+/// status stays `skipped_small_angle`.
+fn shape_error_only(context: &Context<'_>, path: &PathModel, index: usize, scratch: &mut Scratch) -> Outcome {
+    let mut outcome = predict_pass_with(context, path, index, scratch, false);
+    if outcome.status == PassStatus::Ok {
+        outcome.status = PassStatus::SkippedSmallAngle;
+    } else {
+        outcome = Outcome::empty(PassStatus::SkippedSmallAngle);
+    }
+    outcome
+}
+
 /// The full pipeline for one pass.
 pub(crate) fn predict_pass(context: &Context<'_>, path: &PathModel, index: usize, scratch: &mut Scratch) -> Outcome {
+    predict_pass_with(context, path, index, scratch, true)
+}
+
+/// The pipeline for one pass, with the force and deflection steps (S3, S4, S10) only when
+/// `deflection` is set.
+fn predict_pass_with(
+    context: &Context<'_>,
+    path: &PathModel,
+    index: usize,
+    scratch: &mut Scratch,
+    deflection: bool,
+) -> Outcome {
     let job = context.job;
     let radius = job.radius;
     let pass = path.passes[index];
@@ -213,7 +308,7 @@ pub(crate) fn predict_pass(context: &Context<'_>, path: &PathModel, index: usize
     let Some(grid) = context.grids[sign_slot(source.rotation_sign)].as_ref() else {
         return Outcome::empty(PassStatus::NoCut);
     };
-    let coefficients = if job.deflection.is_none() { job.cutting.as_ref() } else { None };
+    let coefficients = if job.deflection.is_none() && deflection { job.cutting.as_ref() } else { None };
     let mut pieces = Vec::new();
     // Stations: the middle first, then alternately ahead and behind (§3.3).
     let step = tooth_feed.max(length / 16.0);
@@ -320,6 +415,16 @@ pub(crate) fn predict_pass(context: &Context<'_>, path: &PathModel, index: usize
         outcome.flags.push(PassFlag::Extrapolated);
     }
     let error_shape = -delta;
+    if !deflection {
+        outcome.error_shape = Some(error_shape);
+        outcome.error = Some(error_shape);
+        outcome.contact_angle = Some(contact_angle);
+        outcome.azimuth = azimuth;
+        outcome.rotation_angle = rotation_angle;
+        outcome.point = Some(point);
+        outcome.normal = Some(normal);
+        return outcome;
+    }
     let force_history = &engagement.force;
     let mut history_deflection: Option<Vec<[f64; 2]>> = None;
     let deflection: Option<[f64; 2]> = if let Some(prescribed) = &job.deflection {

@@ -121,10 +121,15 @@ pub(crate) fn render(scene: &Scene, stock: &StockModel, window: &Window) -> Imag
         scene.candidates(&union_lo, &union_hi, true, None, &mut pool);
     }
     let mut lists = TileLists::default();
+    let mut hide_hint = 0usize;
     for (i0, i1, j0, j1, region, lo, hi) in kept {
         {
             scene.candidates(&lo, &hi, true, Some(&pool), &mut lists);
             lists.region = Some(region);
+            // A tile that one T1 capsule hides whole has no cut or finished pixel.
+            if scene.hides_box(&lo, &hi, &lists.before, &mut hide_hint) {
+                continue;
+            }
             let mut hints = [0usize; 2];
             for j in j0..j1 {
                 let y = coordinate(j, window.centre[1]);

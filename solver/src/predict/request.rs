@@ -31,6 +31,10 @@ pub const DEFAULT_MAX_CORRECTION: f64 = 0.1;
 pub const MAX_PASSES: usize = 2_000_000;
 /// Most passes whose force and deflection history a request may ask for.
 pub const MAX_HISTORIES: usize = 100;
+/// Default tolerance of `merge_similar_passes`, mm.
+pub const DEFAULT_MERGE_TOLERANCE: f64 = 0.001;
+/// Largest `merge_tolerance`, mm.
+pub const MAX_MERGE_TOLERANCE: f64 = 0.1;
 /// Most distinct spindle speeds in one program.
 pub const MAX_SPINDLE_SPEEDS: usize = 1000;
 
@@ -172,4 +176,20 @@ pub struct PredictRequest {
     /// they get status `skipped_small_angle`. Absent: every pass is predicted.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub exclusion_deg: Option<f64>,
+    /// With `exclusion_deg`: still find the generation point of the excluded passes and report
+    /// their shape-error term e_S (and e = e_S, e_D null; the path is corrected for it), without
+    /// the force and deflection (§3.4, E15). Default false: excluded passes are skipped (the
+    /// patent's default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exclusion_shape_error: Option<bool>,
+    /// Simulate only some of a run of near-identical consecutive passes (same feed, speed,
+    /// length, direction and neighbourhood within `merge_tolerance`) and give the others the
+    /// nearest simulated result with its `merge_bound` (§3.2; box, plane and grid stocks).
+    /// Default false: every pass is simulated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub merge_similar_passes: Option<bool>,
+    /// Tolerance of the merge, mm (default 0.001, at most 0.1): how far the geometry of merged
+    /// passes may differ, and how far the errors of the simulated passes around them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub merge_tolerance: Option<f64>,
 }

@@ -204,6 +204,7 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
             scene.candidates(&union_lo, &union_hi, true, None, &mut pool);
         }
         let mut tile_lists: Vec<TileLists> = Vec::with_capacity(tile_count);
+        let mut hide_hint = 0usize;
         for (tile, entry) in boxes.into_iter().enumerate() {
             let Some(TileBox { lo, hi, region, members }) = entry else {
                 tile_lists.push(TileLists::default());
@@ -212,6 +213,16 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
             let mut lists = TileLists::default();
             scene.candidates(&lo, &hi, true, Some(&pool), &mut lists);
             lists.region = Some(region);
+            // A tile that one T1 capsule hides whole has no cut or finished sample: every sample
+            // would test CutBefore (or Air outside the stock), which the rest treats alike.
+            if scene.hides_box(&lo, &hi, &lists.before, &mut hide_hint) {
+                for &(r, i) in &members {
+                    tile_of[r][i] = tile;
+                    row_states[r][i] = SampleState::CutBefore;
+                }
+                tile_lists.push(lists);
+                continue;
+            }
             let mut hints = [0usize; 2];
             for &(r, i) in &members {
                 tile_of[r][i] = tile;

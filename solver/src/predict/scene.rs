@@ -212,7 +212,9 @@ impl Scene {
             if capsule.min_z - self.radius > q.z + self.eps {
                 continue;
             }
-            if let Some(entry) = capsule.entry_z(q.x, q.y, self.r2) {
+            // Capsules whose lowest point over q lies more than 2ε above it are skipped before the
+            // square root (neither hidden nor a tie, so the same answer).
+            if let Some(entry) = capsule.entry_z_up_to(q.x, q.y, self.r2, q.z + 2.0 * self.eps) {
                 if entry < q.z - self.eps {
                     *hint = position;
                     return Cover::Hidden;
@@ -223,6 +225,30 @@ impl Scene {
             }
         }
         state
+    }
+
+    /// Whether one listed T1 capsule hides every point of the frame box `[lo, hi]`: the box lies
+    /// in the capsule shrunk by 2ε (its centre within R − 2ε − half its diagonal of the axis). Then
+    /// every point q of the box has q − 2ε·ẑ inside the capsule, so the ray enters it more than ε
+    /// before q and [`Self::cover`] would answer `Hidden` for each (the capsule passes the
+    /// conservative box filter, so it is in the list). `hint` is the list position that hid the
+    /// previous box (tried first).
+    pub(crate) fn hides_box(&self, lo: &Vec3, hi: &Vec3, list: &[u32], hint: &mut usize) -> bool {
+        let centre = 0.5 * (lo + hi);
+        let limit = self.radius - 0.5 * (hi - lo).norm() - 2.0 * self.eps;
+        if limit <= 0.0 {
+            return false;
+        }
+        let limit2 = limit * limit;
+        let start = (*hint).min(list.len());
+        let (tail, head) = list.split_at(start);
+        for (position, &index) in head.iter().enumerate().map(|(k, i)| (k + start, i)).chain(tail.iter().enumerate()) {
+            if self.before[index as usize].distance_squared(&centre) <= limit2 {
+                *hint = position;
+                return true;
+            }
+        }
+        false
     }
 
     /// In the stock, given the tile's region.

@@ -128,6 +128,16 @@ impl HeightGrid {
         )
     }
 
+    /// [`Self::top`] for the other modules.
+    pub(crate) fn top_at(&self, x: f64, y: f64) -> Option<f64> {
+        self.top(x, y)
+    }
+
+    /// Bottom of the material.
+    pub(crate) fn bottom(&self) -> f64 {
+        self.bottom
+    }
+
     /// Bilinear top height at (x, y), `None` outside the footprint.
     fn top(&self, x: f64, y: f64) -> Option<f64> {
         let u = (x - self.origin[0]) / self.spacing;

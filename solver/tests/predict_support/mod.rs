@@ -118,6 +118,9 @@ pub fn raster_request(
         history: None,
         pass_range: None,
         exclusion_deg: None,
+        exclusion_shape_error: None,
+        merge_similar_passes: None,
+        merge_tolerance: None,
     };
     (request, tool, moves)
 }
@@ -148,6 +151,9 @@ pub fn bare_request(tool: &Tool, stock: Stock, path: PathInput) -> PredictReques
         history: None,
         pass_range: None,
         exclusion_deg: None,
+        exclusion_shape_error: None,
+        merge_similar_passes: None,
+        merge_tolerance: None,
     }
 }
 

@@ -159,3 +159,30 @@ async fn jobs_page_shows_a_prediction_job() {
     assert_eq!(result["ok"], true);
     assert_eq!(result["plots"], 3, "path, colour scale and histogram: {result}");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn jobs_page_downloads_every_output_as_a_zip() {
+    let app = TestApp::spawn().await;
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/shop-job.toml");
+    let Some(result) = run_scenario(&app, "jobzip", &[example.to_str().unwrap()]) else { return };
+    assert_eq!(result["ok"], true);
+    let id = result["id"].as_i64().unwrap();
+    assert_eq!(result["file"], format!("job-{id}.zip"));
+    let entries: Vec<&str> = result["entries"].as_array().unwrap().iter().map(|e| e.as_str().unwrap()).collect();
+    assert_eq!(
+        entries,
+        [
+            "00-deburr.json",
+            "00-deburr.nc",
+            "01-contour.json",
+            "01-contour.nc",
+            "02-segment.json",
+            "02-segment.nc",
+            "job.json",
+            "program.nc"
+        ]
+    );
+    // The page saved the service's bytes unchanged.
+    let served = app.get(&format!("/api/v1/jobs/{id}/outputs.zip")).await.bytes().await.unwrap();
+    assert_eq!(result["size"].as_u64().unwrap(), served.len() as u64);
+}

@@ -133,12 +133,67 @@ async fn cycle_time_with_acceleration_rapids_and_tool_change() {
     close("contour total", number(&time["total_s"]), parts);
 
     // Bad values name their fields.
-    for (field, value) in [("max_accel", json!(0)), ("rapid_feed", json!(-1)), ("tool_change_s", json!(-2))] {
+    for (field, value) in [
+        ("max_accel", json!(0)),
+        ("rapid_feed", json!(-1)),
+        ("tool_change_s", json!(-2)),
+        ("max_jerk", json!(0)),
+        ("max_jerk", json!(-5)),
+        ("max_jerk", json!(2e9)),
+    ] {
         let mut bad = machine.clone();
         bad[field] = value;
         let body = problem(app.put_json("/api/v1/machines/bad", &bad).await, 422).await;
         assert_eq!(body["errors"][0]["path"], field, "{body}");
     }
+}
+
+/// Rest to rest over `length` mm at cruise `v` mm/s with acceleration `a` mm/s² and jerk `j`
+/// mm/s³ (the S-curve: v/a + a/j to reach v while a is reached, else 2√(v/j)).
+fn s_curve_rest_to_rest(length: f64, v: f64, a: f64, j: f64) -> f64 {
+    let to_cruise = if v >= a * a / j { v / a + a / j } else { 2.0 * (v / j).sqrt() };
+    if length >= v * to_cruise {
+        return length / v + to_cruise;
+    }
+    if length >= 2.0 * a * a * a / (j * j) {
+        let k = a * a / j;
+        let peak = 0.5 * (-k + (k * k + 4.0 * a * length).sqrt());
+        2.0 * (peak / a + a / j)
+    } else {
+        4.0 * (length / (2.0 * j)).cbrt()
+    }
+}
+
+/// A machine with `max_jerk`: the straight cut takes the S-curve's closed form, longer than the
+/// trapezoid's, and the answer says which jerk it used; `edge: both` with an inner tool counts
+/// two tool changes.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_jerk_limit_takes_the_s_curve() {
+    let app = TestApp::spawn().await;
+    app.register_tool(3, &json!({"kind": "flat", "radius": 3})).await;
+    let machine = json!({"block_time_ms": 1, "max_feed": 12000, "max_accel": 500, "max_jerk": 5000,
+                         "rapid_feed": 30000, "tool_change_s": 4});
+    assert_eq!(app.put_json("/api/v1/machines/jerk", &machine).await.status(), 201);
+    let stored = json_with(app.get("/api/v1/machines/jerk").await, 200).await;
+    assert_eq!(stored["max_jerk"], 5000.0);
+    let body = json!({"curve": {"kind": "polyline", "points": [[0, 0], [50, 0], [100, 0]]}, "feed": 6000,
+                      "machine": "jerk", "tool": 3});
+    let answer = json_with(app.post_json("/api/v1/segment", &body).await, 200).await;
+    let time = &answer["cycle_time"];
+    let cutting = time["cutting_s"].as_f64().unwrap();
+    let expected = s_curve_rest_to_rest(100.0, 100.0, 500.0, 5000.0);
+    assert!((cutting - expected).abs() < 1e-9, "{cutting} vs {expected}");
+    assert!(cutting > rest_to_rest(100.0, 100.0, 500.0));
+    assert_eq!(time["max_jerk"], 5000.0);
+    assert!(answer["machine"]["max_jerk"] == 5000.0, "{}", answer["machine"]);
+
+    app.register_tool(7, &json!({"kind": "ball", "radius": 3})).await;
+    app.register_tool(8, &json!({"kind": "ball", "radius": 2})).await;
+    let deburr = json!({"tool": 7, "inner_tool": 8, "edge": "both", "machine": "jerk", "cut_amount": 0.3,
+        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 15, "outer_radius": 25},
+        "hole": {"shape": "round", "radius": 5}});
+    let answer = json_with(app.post_json("/api/v1/deburr", &deburr).await, 200).await;
+    assert_eq!(answer["cycle_time"]["tool_change_s"], 8.0, "{}", answer["cycle_time"]);
 }
 
 /// Every G01 that goes down in `program`: (from, to, modal feed).

@@ -1,8 +1,11 @@
 //! Past one machine (issue 12), on a throw-away PostgreSQL server and real processes on loopback:
 //! one `kerf serve --job-workers 0` and two `kerf worker`s share the queue; one worker is killed
 //! with SIGKILL in the middle of a job; every job ends done with the results of a one-process
-//! SQLite run of the same files. Two API nodes on one database see each other's tools, machines
-//! and jobs, and a cancel through one reaches the job running on the other within two seconds.
+//! SQLite run of the same files. A large prediction is split into parts that both workers run at
+//! once, one killed in the middle of a part, and its merged result and program are a one-process
+//! run's byte for byte; a refused part fails its job with its problem. Two API nodes on one
+//! database see each other's tools, machines and jobs, and a cancel through one reaches the job
+//! running on the other within two seconds.
 //! Each test skips, printing why, when PostgreSQL is not installed (fails under
 //! `KERF_REQUIRE_EXTERNAL=1`). The deployment files are checked against the same binary (`deploy`).
 
@@ -271,6 +274,268 @@ async fn workers_share_the_queue_and_survive_a_kill() {
     for worker in workers.into_iter().flatten() {
         worker.terminate();
     }
+    api.terminate();
+}
+
+/// A result's text without the time it took (`"timings": {...}`, the last member of a prediction
+/// answer; flat), so the rest can be compared byte for byte.
+fn strip_timings(result: &str) -> String {
+    match result.find(",\"timings\":{") {
+        Some(start) => {
+            let end = result[start..].find('}').map_or(result.len(), |end| start + end + 1);
+            format!("{}{}", &result[..start], &result[end..])
+        }
+        None => result.to_owned(),
+    }
+}
+
+async fn connect(postgres: &PgServer) -> sqlx::PgPool {
+    sqlx::PgPool::connect(&postgres.url()).await.unwrap()
+}
+
+/// Chunks of job `id` running on the worker process `pid` now: (position, kind).
+async fn chunks_of(pool: &sqlx::PgPool, id: i64, pid: u32) -> Vec<(i64, String)> {
+    sqlx::query_as(
+        "SELECT position, kind FROM job_chunks
+         WHERE job_id = $1 AND status = 'running' AND split_part(worker, ':', 2) = $2",
+    )
+    .bind(id)
+    .bind(pid.to_string())
+    .fetch_all(pool)
+    .await
+    .unwrap()
+}
+
+/// The job's progress and the weighted sum of its chunks' progress, read in one snapshot, and
+/// the chunks' weights together.
+async fn progress_and_sum(pool: &sqlx::PgPool, id: i64) -> (f64, f64, f64) {
+    sqlx::query_as(
+        "SELECT j.progress, COALESCE(SUM(c.weight * c.progress) / NULLIF(SUM(c.weight), 0), 0), SUM(c.weight)
+         FROM jobs j JOIN job_chunks c ON c.job_id = j.id WHERE j.id = $1 GROUP BY j.progress",
+    )
+    .bind(id)
+    .fetch_one(pool)
+    .await
+    .unwrap()
+}
+
+fn signal(pid: u32, name: &str) {
+    let status = std::process::Command::new("kill").arg(format!("-{name}")).arg(pid.to_string()).status().unwrap();
+    assert!(status.success(), "kill -{name} {pid}");
+}
+
+/// The prediction job of the split tests: 10 201 passes (a 30 mm raster at 0.3 mm) sampled at
+/// N = 96, with a fixed program number so the job's one program does not depend on its id.
+fn large_prediction() -> Value {
+    let mut job = predict_job(30.0, 0.3, 96);
+    job["output"] = json!({"program_number": 4242});
+    job
+}
+
+/// An engagement comparison of three candidate paths through a 60 × 40 mm block, fine enough
+/// (0.003 mm steps, 140 000 samples) to be split into parts of [`PART_SECONDS`]; on a machine with a
+/// block time and accelerations (blocks, cycle time), programming the second candidate.
+fn engagement_comparison() -> Value {
+    json!({
+        "name": "engagement, three candidates",
+        "tools": [{"number": 2, "kind": "flat", "radius": 5, "flutes": 4}],
+        "machines": [{"name": "mill", "block_time_ms": 4, "max_feed": 12000, "max_accel": 2000, "dialect": "linuxcnc"}],
+        "output": {"program_number": 4343},
+        "operations": [{
+            "operation": "engagement", "tool": 2, "machine": "mill",
+            "stock": {"polygon": [[0, 0], [60, 0], [60, 40], [0, 40]]},
+            "paths": [
+                {"name": "straight", "path": [[-10, 20], [70, 20]]},
+                {"name": "zig-zag", "path": [[-10, 5], [70, 5], [70, 15], [-10, 15], [-10, 25], [70, 25]]},
+                {"name": "deeper", "path": [[-10, 30], [35, 20], [70, 35]], "axial_depth": 3}
+            ],
+            "spindle_rpm": 8000, "feed_per_tooth": 0.05, "flute_counts": [2, 3, 4], "thickness_limit": 0.08,
+            "step": 0.003, "kienzle": {"kc11": 1800, "mc": 0.25}, "axial_depth": 2, "candidate": 1
+        }]
+    })
+}
+
+/// Workers that split work into parts of this many core-seconds (`KERF_JOB_PART_S`; the default
+/// 8 would leave this test's prediction whole).
+const PART_SECONDS: &str = "1";
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_prediction_splits_across_workers_and_survives_a_kill() {
+    let Some(postgres) = PgServer::start() else { return };
+    let url = postgres.url();
+    let client = Client::builder().timeout(Duration::from_secs(60)).build().unwrap();
+    let api = ServerProcess::start_with(&program(), &["serve", "--database", &url, "--job-workers", "0"]).await;
+    let worker_arguments = ["worker", "--database", &url, "--job-workers", "1", "--job-lease-s", "3"];
+    let mut workers = Vec::new();
+    for _ in 0..2 {
+        let worker =
+            ServerProcess::start_with_env(&program(), &worker_arguments, &[("KERF_JOB_PART_S", PART_SECONDS)]).await;
+        workers.push(Some(worker));
+    }
+    let pool = connect(&postgres).await;
+    let job = large_prediction();
+    let id = submit(&client, &api.base, &job).await;
+    let engagement = engagement_comparison();
+    let engagement_id = submit(&client, &api.base, &engagement).await;
+
+    // The one operation is split, and both workers run parts of it at once.
+    let deadline = Instant::now() + Duration::from_secs(300);
+    let pids = loop {
+        let pids = running_workers(&postgres, id).await;
+        if pids.len() == 2 || Instant::now() > deadline {
+            break pids;
+        }
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    };
+    assert_eq!(pids.len(), 2, "both workers run parts of the one prediction at once: {pids:?}");
+    let (parts,): (i64,) =
+        sqlx::query_as("SELECT COUNT(*) FROM job_chunks WHERE job_id = $1 AND kind = 'part' AND operation = 0")
+            .bind(id)
+            .fetch_one(&pool)
+            .await
+            .unwrap();
+    assert!(parts >= 3, "the prediction is split into parts: {parts}");
+
+    // The job's progress is the sum of its chunks' (weighted by their work; one operation's
+    // weights make 1), in every snapshot.
+    for _ in 0..10 {
+        let (progress, sum, weights) = progress_and_sum(&pool, id).await;
+        assert!((progress - sum).abs() < 1e-9, "job progress {progress}, chunks' sum {sum}");
+        assert!((weights - 1.0).abs() < 1e-9, "one operation's chunks weigh {weights}");
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+
+    // Kill one worker in the middle of a part: stopped first (SIGSTOP), so the part it runs is
+    // surely unfinished when it is killed (SIGKILL); if it had none running, let it go on and
+    // look again.
+    let (victim, killed) = loop {
+        assert!(Instant::now() < deadline, "no worker ran a part to kill");
+        let pid = running_workers(&postgres, id).await.first().copied();
+        let Some(pid) = pid else {
+            tokio::time::sleep(Duration::from_millis(20)).await;
+            continue;
+        };
+        signal(pid, "STOP");
+        match chunks_of(&pool, id, pid).await.as_slice() {
+            [(position, kind), ..] if kind == "part" => break (pid, *position),
+            _ => signal(pid, "CONT"),
+        }
+    };
+    let index = workers.iter().position(|w| w.as_ref().is_some_and(|w| w.id() == victim)).expect("one of ours");
+    workers[index].take().unwrap().kill();
+
+    let done = poll_job(&client, &api.base, id, 900, finished).await;
+    assert_eq!(done["status"], "done", "{}", done["error"]);
+    assert_eq!(done["progress"], 1.0);
+    let (attempts,): (i64,) = sqlx::query_as("SELECT attempts FROM job_chunks WHERE job_id = $1 AND position = $2")
+        .bind(id)
+        .bind(killed)
+        .fetch_one(&pool)
+        .await
+        .unwrap();
+    assert_eq!(attempts, 2, "the killed part was claimed again");
+    let (left, stored, expected): (i64, i64, i64) = sqlx::query_as(
+        "SELECT (SELECT COUNT(*) FROM job_chunks WHERE job_id = $1 AND (output_gz IS NOT NULL OR status <> 'done')),
+                stored_bytes,
+                octet_length(job_json) + (SELECT SUM(octet_length(result_gz) + COALESCE(octet_length(gcode_gz), 0))
+                                          FROM job_results WHERE job_id = $1)
+         FROM jobs WHERE id = $1",
+    )
+    .bind(id)
+    .fetch_one(&pool)
+    .await
+    .unwrap();
+    assert_eq!(left, 0, "every chunk done, and the parts' outputs dropped once merged");
+    assert_eq!(stored, expected, "the job takes its file and its result");
+
+    // The engagement comparison was split into parts too, and is done.
+    let engagement_done = poll_job(&client, &api.base, engagement_id, 900, finished).await;
+    assert_eq!(engagement_done["status"], "done", "{}", engagement_done["error"]);
+    let (engagement_parts,): (i64,) =
+        sqlx::query_as("SELECT COUNT(*) FROM job_chunks WHERE job_id = $1 AND kind = 'part' AND status = 'done'")
+            .bind(engagement_id)
+            .fetch_one(&pool)
+            .await
+            .unwrap();
+    assert!(engagement_parts >= 2, "the engagement candidates are split: {engagement_parts} parts");
+
+    // One SQLite process runs the same files whole: the same results (but for the time a
+    // prediction took) and programs, byte for byte.
+    let local = TestApp::spawn_on(Store::Sqlite, |_| {}).await.unwrap();
+    let job_program = |base: &str, id: i64| {
+        let client = client.clone();
+        let url = format!("{base}/api/v1/jobs/{id}/program");
+        async move { client.get(url).send().await.unwrap().text().await.unwrap() }
+    };
+    for (shared_id, file) in [(id, &job), (engagement_id, &engagement)] {
+        let local_id = submit(&local.client, &local.base, file).await;
+        let local_done = poll_job(&local.client, &local.base, local_id, 900, finished).await;
+        assert_eq!(local_done["status"], "done", "{}", local_done["error"]);
+        let shared = outputs(&client, &api.base, shared_id).await;
+        let alone = outputs(&local.client, &local.base, local_id).await;
+        let name = &file["name"];
+        assert_eq!(shared.len(), 1);
+        assert!(
+            strip_timings(&shared[0].0) == strip_timings(&alone[0].0),
+            "{name}: the merged result differs from the one-process run"
+        );
+        assert!(shared[0].1 == alone[0].1, "{name}: the merged program differs from the one-process run");
+        assert!(
+            job_program(&api.base, shared_id).await == job_program(&local.base, local_id).await,
+            "{name}: the job's one program differs from the one-process run"
+        );
+    }
+    let shared = outputs(&client, &api.base, id).await;
+    assert!(shared[0].0.contains("\"timings\":{"), "the merged prediction reports its time");
+    pool.close().await;
+    for worker in workers.into_iter().flatten() {
+        worker.terminate();
+    }
+    api.terminate();
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_refused_part_fails_its_job_with_its_problem() {
+    let Some(postgres) = PgServer::start() else { return };
+    let url = postgres.url();
+    let client = Client::builder().timeout(Duration::from_secs(60)).build().unwrap();
+    let api = ServerProcess::start_with(&program(), &["serve", "--database", &url, "--job-workers", "0"]).await;
+    // Results of at most 1 MiB per job: the parts' outputs together are more.
+    let worker = ServerProcess::start_with_env(
+        &program(),
+        &["worker", "--database", &url, "--job-workers", "1", "--job-result-max-mb", "1"],
+        &[("KERF_JOB_PART_S", PART_SECONDS)],
+    )
+    .await;
+    let pool = connect(&postgres).await;
+    let id = submit(&client, &api.base, &large_prediction()).await;
+    let failed = poll_job(&client, &api.base, id, 900, finished).await;
+    assert_eq!(failed["status"], "failed", "{failed}");
+    let error = &failed["error"];
+    assert_eq!(error["code"], "E_RESULT_TOO_LARGE", "{error}");
+    assert_eq!(error["status"], 422);
+    assert_eq!(error["errors"][0]["path"], "operations[0]", "{error}");
+    // The chunk refused was one of the operation's parts (or its finish step), and nothing the
+    // others stored is left.
+    let (kind,): (String,) = sqlx::query_as("SELECT kind FROM job_chunks WHERE job_id = $1 AND status = 'failed'")
+        .bind(id)
+        .fetch_one(&pool)
+        .await
+        .unwrap();
+    assert!(kind == "part" || kind == "finish", "the refused chunk is a {kind}");
+    eprintln!("the refused chunk: a {kind}");
+    let (outputs, stored, file): (i64, i64, i64) = sqlx::query_as(
+        "SELECT (SELECT COUNT(*) FROM job_chunks WHERE job_id = $1 AND output_gz IS NOT NULL), stored_bytes,
+                octet_length(job_json)::BIGINT
+         FROM jobs WHERE id = $1",
+    )
+    .bind(id)
+    .fetch_one(&pool)
+    .await
+    .unwrap();
+    assert_eq!((outputs, stored), (0, file), "a failed job keeps only its file");
+    pool.close().await;
+    worker.terminate();
     api.terminate();
 }
 

@@ -1,0 +1,84 @@
+//! The solver endpoints `POST /api/v1/{name}` (api.md), generated from the capability registry
+//! (`capabilities::with_registry!`): one small `#[utoipa::path]` handler per capability with a
+//! JSON body, documented with the capability's own [`Endpoint`](kerf_solver::capability::Endpoint)
+//! texts, so the OpenAPI document names each capability's concrete request and answer. A
+//! capability with an upload (`upload` in the registry) keeps its handler in `http/<module>.rs`.
+
+use utoipa_axum::router::OpenApiRouter;
+
+use crate::capabilities::with_registry;
+use crate::state::AppState;
+
+/// One capability's endpoint: a handler module for a JSON body, nothing for an upload.
+macro_rules! endpoint {
+    ($variant:ident, $module:ident, $capability:ident, $request:ident, $answer:ident, json($query:ident)) => {
+        #[allow(non_snake_case, reason = "named after the registry's variant")]
+        mod $variant {
+            use axum::extract::State;
+            use axum::http::HeaderMap;
+            use axum::response::Response;
+            use kerf_solver::capability::Capability;
+            use kerf_solver::$module::{$answer, $capability, $request};
+
+            use super::super::output::Negotiate;
+            #[allow(unused_imports, reason = "one of them is this endpoint's query")]
+            use super::super::output::{CandidateQuery, OutputQuery};
+            use crate::error::{AppResult, Problem};
+            use crate::extract::{AppJson, AppQuery};
+            use crate::state::AppState;
+
+            #[utoipa::path(post,
+                context_path = "/api/v1/",
+                path = <$capability as Capability>::NAME,
+                operation_id = format!("post_{}", <$capability as Capability>::NAME),
+                tag = <$capability as Capability>::NAME,
+                summary = <$capability as Capability>::ENDPOINT.summary,
+                description = <$capability as Capability>::ENDPOINT.description,
+                params($query),
+                request_body = $request,
+                responses(
+                    (status = 200, description = "The answer as JSON, or the program (`?format=gcode`)", content(
+                        ($answer = "application/json"),
+                        (String = "text/x-gcode"))),
+                    (status = 400, body = Problem, content_type = "application/problem+json"),
+                    (status = 404, description = <$capability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
+                    (status = 413, body = Problem, content_type = "application/problem+json"),
+                    (status = 415, body = Problem, content_type = "application/problem+json"),
+                    (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json"),
+                    (status = 422, description = <$capability as Capability>::ENDPOINT.refused, body = Problem, content_type = "application/problem+json")))]
+            pub async fn post(
+                State(state): State<AppState>,
+                headers: HeaderMap,
+                AppQuery(query): AppQuery<$query>,
+                AppJson(request): AppJson<$request>,
+            ) -> AppResult<Response> {
+                super::super::solve::answer::<$capability>(&state, request, None, query.ask(&headers)).await
+            }
+        }
+    };
+    ($variant:ident, $module:ident, $capability:ident, $request:ident, $answer:ident, upload) => {};
+}
+
+/// The routes of one capability's endpoint.
+macro_rules! route {
+    ($variant:ident, $module:ident, json) => {
+        OpenApiRouter::new().routes(utoipa_axum::routes!($variant::post))
+    };
+    ($variant:ident, $module:ident, upload) => {
+        super::$module::router()
+    };
+}
+
+/// Every capability's endpoint module and [`router`].
+macro_rules! endpoints {
+    ($($variant:ident => $module:ident::{$capability:ident, $request:ident, $answer:ident}, $body:ident $(($query:ident))?, $doc:literal;)+) => {
+        $(endpoint!($variant, $module, $capability, $request, $answer, $body $(($query))?);)+
+
+        /// The routes of every capability's endpoint, in registry order.
+        pub fn router() -> OpenApiRouter<AppState> {
+            OpenApiRouter::new()$(.merge(route!($variant, $module, $body)))+
+        }
+    };
+}
+
+with_registry!(endpoints);
