@@ -1,5 +1,6 @@
 //! The `kerf` program: command line and environment configuration, `serve` (until SIGINT or
-//! SIGTERM), `worker` (claims and runs jobs from PostgreSQL, no API), `run` and `jobs prune`.
+//! SIGTERM), `worker` (claims and runs jobs from PostgreSQL, no API), `run`, `migrate` and `jobs
+//! prune`.
 
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -39,6 +40,9 @@ pub enum Command {
     Worker(WorkerArgs),
     /// Run a job file locally, without the service, and write its results as files.
     Run(RunArgs),
+    /// Bring an existing database to this version's schema and stop (what `serve` and `worker`
+    /// do at start; `run` only reads a database as it is).
+    Migrate(MigrateArgs),
     /// Manage the stored jobs.
     #[command(subcommand)]
     Jobs(JobsCommand),
@@ -102,8 +106,18 @@ pub struct RunArgs {
     /// Folder for the results (created if missing).
     #[arg(short, long, default_value = "kerf-out")]
     pub out: PathBuf,
-    /// Tool table and machines registry to resolve the tool numbers and machine names the job file
-    /// does not define (read only; an SQLite file is used if it exists, or a `postgres://` URL).
+    /// Tool table, machines registry and materials library to resolve the tool numbers, machine
+    /// and material names the job file does not define (read as it is, never migrated: `kerf
+    /// migrate` upgrades an older one; an SQLite file is used if it exists, or a `postgres://`
+    /// URL).
+    #[arg(long, env = "KERF_DATABASE", default_value = "kerf.db")]
+    pub database: Database,
+}
+
+/// Options of `kerf migrate`.
+#[derive(Debug, Clone, Args)]
+pub struct MigrateArgs {
+    /// The database (an SQLite file, which must exist, or a `postgres://` URL).
     #[arg(long, env = "KERF_DATABASE", default_value = "kerf.db")]
     pub database: Database,
 }
@@ -204,6 +218,7 @@ pub fn main() -> anyhow::Result<()> {
         Some(Command::Serve(args)) => runtime.block_on(serve(args)),
         Some(Command::Worker(args)) => runtime.block_on(worker(args)),
         Some(Command::Run(args)) => runtime.block_on(run(args)),
+        Some(Command::Migrate(args)) => runtime.block_on(migrate(args)),
         Some(Command::Jobs(JobsCommand::Prune(args))) => runtime.block_on(prune(args)),
         None => runtime.block_on(serve(cli.serve)),
     }
@@ -214,6 +229,17 @@ async fn run(args: RunArgs) -> anyhow::Result<()> {
     for file in report.files {
         println!("{}", file.display());
     }
+    Ok(())
+}
+
+/// `kerf migrate`: applies the migrations an existing database lacks.
+async fn migrate(args: MigrateArgs) -> anyhow::Result<()> {
+    if args.database.sqlite_path().is_some_and(|path| !path.exists()) {
+        anyhow::bail!("no database at {} (kerf serve creates a new one)", args.database);
+    }
+    let db = db::open(&args.database).await?;
+    db.close().await;
+    println!("{}: at this version's schema", args.database);
     Ok(())
 }
 

@@ -1,8 +1,10 @@
 //! Engagement throughput (issue 5): samples per second for 1 m of path at a 0.01 mm step
 //! through a 200 × 200 mm pocket, for both engines, and the dot engine's memory at 0.01 mm;
-//! with Kienzle torque and power (issue 16) at a 0.1 mm step, straight and helical flutes.
+//! with Kienzle torque and power (issue 16) at a 0.1 mm step, straight and helical flutes, and
+//! for a ball end whose 16 height bands each take their own section's engagement.
 //!
 //! Run: `cargo bench -p kerf-solver --bench engagement -- --warm-up-time 1 --measurement-time 5`
+//! (`KERF_BENCH_ONLY=ball` for the configurations whose name contains `ball`)
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use kerf_solver::engagement::{self, EngagementAnswer, EngagementRequest};
@@ -66,9 +68,22 @@ fn request(engine: &str) -> EngagementRequest {
 fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("engagement_1m_at_0.01mm");
     group.sample_size(10);
-    for engine in ["exact", "dots", "exact_kienzle", "exact_kienzle_helix"] {
-        let mut tool = Tool::new(ToolKind::Flat, 5.0);
-        if engine == "exact_kienzle_helix" {
+    // `KERF_BENCH_ONLY=name` runs the configurations whose name contains it (`name$`: that one
+    // only), skipping the others' set-up too (each solves its request once to count samples).
+    let filter = std::env::var("KERF_BENCH_ONLY").ok();
+    for engine in
+        ["exact", "dots", "exact_kienzle", "exact_kienzle_helix", "exact_kienzle_ball", "exact_kienzle_ball_helix"]
+    {
+        let wanted = filter.as_deref().is_none_or(|f| match f.strip_suffix('$') {
+            Some(exact) => engine == exact,
+            None => engine.contains(f),
+        });
+        if !wanted {
+            continue;
+        }
+        let kind = if engine.contains("ball") { ToolKind::Ball } else { ToolKind::Flat };
+        let mut tool = Tool::new(kind, 5.0);
+        if engine.ends_with("helix") {
             tool.helix_deg = Some(30.0);
         }
         let request = request(engine);

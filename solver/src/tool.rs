@@ -62,6 +62,10 @@ pub struct Tool {
     /// Length from the holder face to the tip in mm (> 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stickout: Option<f64>,
+    /// Length of the cutting edge from the tip in mm (> 0): the deepest axial depth of cut the
+    /// tool takes (an engagement path whose a_p exceeds it is refused).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flute_length: Option<f64>,
     /// Feed of straight moves down the tool axis (plunges), mm/min (> 0): programs never plunge
     /// faster (issue 15). Default: the machine's `plunge_feed`, else half the cutting feed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -183,6 +187,7 @@ impl Tool {
             name: None,
             helix_deg: None,
             stickout: None,
+            flute_length: None,
             plunge_feed: None,
             centre_cutting: None,
             neck_radius: None,
@@ -239,6 +244,9 @@ impl Tool {
         }
         if let Some(stickout) = self.stickout {
             positive(&field("stickout"), stickout)?;
+        }
+        if let Some(flute_length) = self.flute_length {
+            positive(&field("flute_length"), flute_length)?;
         }
         if let Some(plunge_feed) = self.plunge_feed {
             positive(&field("plunge_feed"), plunge_feed)?;

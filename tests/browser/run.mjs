@@ -675,6 +675,67 @@ const scenarios = {
     return { reported, moving };
   },
 
+  // Chooses a material of the library on the engagement form: the k_c1.1 and m_c fields show
+  // its values, greyed; the request names the material instead of sending values; and the
+  // torque and power per flute count in the table are the API's answer for that material, equal
+  // to the answer with its values typed in and unlike the answer for the form's example values.
+  async engagementMaterial() {
+    await page.goto(`${base}/#engagement`);
+    const select = '#engagement-form select[name="material"]';
+    await page.waitForSelector(`${select} option[value="C45"]`, { state: 'attached', timeout: 60000 });
+    const stored = await page.evaluate(async (url) => (await fetch(url)).json(), `${base}/api/v1/materials/C45`);
+    await page.selectOption(select, 'C45');
+    const fields = await page.$$eval('#engagement-form input[name="kc11"], #engagement-form input[name="mc"]',
+      (list) => list.map((e) => ({ value: Number(e.value), disabled: e.disabled })));
+    if (fields[0].value !== stored.kc11 || fields[1].value !== stored.mc || !fields.every((f) => f.disabled)) {
+      throw new Error(`the form does not show C45's values: ${JSON.stringify(fields)} vs ${stored.kc11}, ${stored.mc}`);
+    }
+    const [request] = await Promise.all([
+      page.waitForRequest((r) => r.url().endsWith('/api/v1/engagement') && r.method() === 'POST'),
+      page.click('#engagement-compute'),
+    ]);
+    const sent = request.postDataJSON();
+    if (sent.material !== 'C45' || sent.kienzle !== undefined) throw new Error(`sent ${JSON.stringify({ material: sent.material, kienzle: sent.kienzle })}`);
+    await page.waitForSelector('#engagement-result[data-state="drawn"]', { timeout: 30000 });
+    const shown = '#engagement-result .candidate:not([hidden])';
+    const head = await page.$$eval(`${shown} table.flutes thead th`, (l) => l.map((e) => e.textContent));
+    const [torqueColumn, powerColumn] = [head.indexOf('torque mean / peak, N·m'), head.indexOf('power mean / peak, kW')];
+    if (torqueColumn < 0 || powerColumn < 0) throw new Error(`flute table without torque and power: ${head}`);
+    const rows = await page.$$eval(`${shown} table.flutes tbody tr`, (list) => list.map((r) => [...r.children].map((td) => td.textContent)));
+    // The same request straight to the API: by name, with C45's values typed, with the example's.
+    const answers = await page.evaluate(async ([url, body, values]) => {
+      const post = async (b) => {
+        const response = await fetch(url, { method: 'POST', headers: { 'content-type': 'application/json' }, body: JSON.stringify(b) });
+        if (!response.ok) throw new Error(`API ${response.status}: ${await response.text()}`);
+        const answer = await response.json();
+        return answer.candidates ? answer.candidates[0] : answer;
+      };
+      const { material, ...rest } = body;
+      return {
+        named: await post(body),
+        typed: await post({ ...rest, kienzle: values }),
+        example: await post({ ...rest, kienzle: { kc11: 1800, mc: 0.25 } }),
+      };
+    }, [`${base}/api/v1/engagement`, sent, { kc11: stored.kc11, mc: stored.mc }]);
+    const { named, typed, example } = answers;
+    if (named.forces?.kc11 !== stored.kc11 || named.forces?.mc !== stored.mc) throw new Error(`API forces: ${JSON.stringify(named.forces)}`);
+    if (rows.length !== named.flutes.length || !rows.length) throw new Error(`${rows.length} rows for ${named.flutes.length} flute counts`);
+    named.flutes.forEach((f, i) => {
+      const torque = `${f.mean_torque_nm.toFixed(2)} / ${f.peak_torque_nm.toFixed(2)}`;
+      const power = `${f.mean_power_kw.toFixed(3)} / ${f.peak_power_kw.toFixed(3)}`;
+      if (rows[i][0] !== String(f.flute_count) || rows[i][torqueColumn] !== torque || rows[i][powerColumn] !== power) {
+        throw new Error(`row ${i}: page ${rows[i][0]} flutes ${rows[i][torqueColumn]} N·m, ${rows[i][powerColumn]} kW; API ${f.flute_count} flutes ${torque} N·m, ${power} kW`);
+      }
+      if (f.mean_torque_nm !== typed.flutes[i].mean_torque_nm || f.peak_power_kw !== typed.flutes[i].peak_power_kw) {
+        throw new Error(`C45 by name and by its values differ: ${f.mean_torque_nm} vs ${typed.flutes[i].mean_torque_nm}`);
+      }
+      if (!(f.mean_torque_nm > 0) || Math.abs(f.mean_torque_nm - example.flutes[i].mean_torque_nm) < 1e-3 * f.mean_torque_nm) {
+        throw new Error(`C45's torque ${f.mean_torque_nm} is the example values' ${example.flutes[i].mean_torque_nm}`);
+      }
+    });
+    return { rows: rows.length, torque: rows[0][torqueColumn], power: rows[0][powerColumn] };
+  },
+
   // Uploads a job file on the Jobs page, waits for it to finish, opens it, and checks each
   // operation's plot.
   async jobs() {

@@ -78,6 +78,17 @@ pub async fn catalog<'a>(
     Ok(catalog)
 }
 
+/// Whether the database's schema has `table`: a database an older kerf left may lack a library
+/// (`machines` came with migration 0003, `materials` with 0006) until it is migrated.
+pub async fn has_table(db: &Db, table: &str) -> AppResult<bool> {
+    let (count,): (i64,) = on!(db, query_as,
+        sqlite: "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name = $1",
+        postgres: "SELECT COUNT(*) FROM information_schema.tables WHERE table_schema = current_schema() AND table_name = $1",
+        [table],
+        fetch_one)?;
+    Ok(count > 0)
+}
+
 /// Counts of jobs by status (for the `kerf_jobs` gauge).
 pub async fn job_counts(db: &Db) -> AppResult<Vec<(String, i64)>> {
     Ok(on!(db, query_as, both: "SELECT status, COUNT(*) FROM jobs GROUP BY status", [], fetch_all)?)

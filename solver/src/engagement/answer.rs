@@ -234,6 +234,12 @@ pub struct ForceInfo {
     /// Helix lag 2a_p·tan λ/D over which each tooth's cut is spread, degrees (0 without the
     /// tool's `helix_deg`).
     pub helix_lag_deg: f64,
+    /// Ball and bull-nose ends with engine `exact`: the most sections of the end (heights whose
+    /// engaged arcs were found at their own radius, refined where the engagement changes with
+    /// height, and the straight flank above the corner) summed at one sample (engagement.md §11
+    /// item 5).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub height_sections: Option<usize>,
     /// The machine's rated power the path is checked against, kW.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub spindle_power_kw: Option<f64>,
@@ -362,6 +368,8 @@ pub(crate) struct PostData {
     /// The block-time rule the program's arcs are chorded by (its feed replaced by each block's).
     pub rule: Option<crate::machine::BlockRule>,
     pub axial_depth: Option<f64>,
+    /// The tip's Z when a_p came from it (the program cuts there instead of top − a_p).
+    pub cut_z: Option<f64>,
     pub stock_top_z: f64,
     pub clearance: f64,
     pub tool_radius: f64,
@@ -389,6 +397,7 @@ impl Default for PostData {
             spindle_direction: crate::gcode::SpindleDirection::default(),
             rule: None,
             axial_depth: None,
+            cut_z: None,
             stock_top_z: 0.0,
             clearance: 0.0,
             tool_radius: 0.0,

@@ -31,10 +31,27 @@ impl ArcFeed {
         }
     }
 
+    /// The factor of a tool `ratio` = R/r_path times the path's radius, turning left (`side`
+    /// +1) or right (−1).
+    #[cfg(test)]
+    pub(crate) fn new(ratio: f64, side: f64) -> Self {
+        Self { ratio, side }
+    }
+
     /// c(θ) = ρ(θ)/r_path = √(1 + q² ± 2q·cos θ), q = R/r_path, θ in degrees.
     pub(crate) fn factor(&self, theta: f64) -> f64 {
         let q = self.ratio;
         (1.0 + q * q + 2.0 * self.side * q * theta.to_radians().cos()).max(0.0).sqrt()
+    }
+
+    /// The largest c(θ) anywhere on the circle: (r_path + R)/r_path.
+    pub(crate) fn largest_factor(&self) -> f64 {
+        1.0 + self.ratio
+    }
+
+    /// The smallest c(θ) anywhere on the circle: |r_path − R|/r_path.
+    pub(crate) fn smallest_factor(&self) -> f64 {
+        (1.0 - self.ratio).abs()
     }
 
     /// c(θ)·max(0, sin θ) on the arcs, 0 off them.

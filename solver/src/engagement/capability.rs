@@ -282,6 +282,9 @@ struct PartPost {
     spindle_rpm: f64,
     spindle_direction: SpindleDirection,
     axial_depth: Option<f64>,
+    /// The tip's Z when a_p came from it (parts stored before it carry none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    cut_z: Option<f64>,
     stock_top_z: f64,
     clearance: f64,
     tool_radius: f64,
@@ -296,6 +299,7 @@ impl From<&PostData> for PartPost {
             spindle_rpm: post.spindle_rpm,
             spindle_direction: post.spindle_direction,
             axial_depth: post.axial_depth,
+            cut_z: post.cut_z,
             stock_top_z: post.stock_top_z,
             clearance: post.clearance,
             tool_radius: post.tool_radius,
@@ -316,6 +320,7 @@ impl PartPost {
             spindle_direction: self.spindle_direction,
             rule: job.rule,
             axial_depth: self.axial_depth,
+            cut_z: self.cut_z,
             stock_top_z: self.stock_top_z,
             clearance: self.clearance,
             tool_radius: self.tool_radius,

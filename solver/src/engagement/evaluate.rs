@@ -10,6 +10,7 @@ use super::arcs::{self, Arc};
 use super::dots::{Contacts, DotGrid};
 use super::exact::ExactEngine;
 use super::force::{SampleTorque, power_kw};
+use super::heights::{Bands, MAX_SECTIONS};
 use super::job::{CandidateJob, Job, grid_extent};
 use super::request::Engine;
 use super::segments::{Route, Station};
@@ -34,6 +35,9 @@ pub(crate) struct Contact {
     pub arcs: Vec<Arc>,
     pub plunge: bool,
     pub collision: bool,
+    /// With a rounded end's force model and the exact engine: what the end's sections engage,
+    /// each height its own arcs.
+    pub slices: Option<Bands>,
 }
 
 /// The dots engine's extras.
@@ -52,11 +56,16 @@ fn first_cut(route: &Route, stations: &[Station], index: usize) -> bool {
 
 fn run_exact(
     job: &Job,
-    route: &Route,
+    candidate: &CandidateJob,
     stations: &[Station],
     control: Control<'_>,
 ) -> Result<Vec<Contact>, SolverError> {
+    let route = &candidate.route;
     let mut engine = ExactEngine::default();
+    // The height bands of a rounded end, each with its own section's radius (engagement.md §11
+    // item 5); their own engine, whose work limit grows with their number.
+    let rounded = candidate.force.as_ref().filter(|model| model.rounded());
+    let mut section_engine = ExactEngine::with_limit(super::exact::MAX_TESTS.saturating_mul(MAX_SECTIONS as u64));
     let mut contacts = Vec::with_capacity(stations.len());
     for (index, station) in stations.iter().enumerate() {
         control.check()?;
@@ -76,6 +85,13 @@ fn run_exact(
                     ..*station
                 };
                 contact.plunge = !engine.arcs(route, &job.region, job.radius, &start)?.is_empty();
+            }
+            if let Some(model) = rounded {
+                contact.slices = model.bands(
+                    &arcs,
+                    |radius| section_engine.arcs(route, &job.region, radius, station),
+                    |radius| if job.arc_feed { ArcFeed::at(route, station, radius) } else { None },
+                )?;
             }
             contact.arcs = arcs;
         }
@@ -196,7 +212,7 @@ pub(crate) fn evaluate(
             let (contacts, output) = run_dots(job, route, &stations, cell, control)?;
             (contacts, Some(output))
         }
-        _ => (run_exact(job, route, &stations, control)?, None),
+        _ => (run_exact(job, candidate, &stations, control)?, None),
     };
 
     let time_flutes = job.tool_flutes;
@@ -265,14 +281,15 @@ pub(crate) fn evaluate(
         let edge_feed = if job.arc_feed { ArcFeed::at(route, station, radius) } else { None };
         let (torques, forces): (Vec<SampleTorque>, Vec<f64>) =
             candidate.force.as_ref().map_or_else(Default::default, |model| {
-                let integral = model.engaged_integral(arcs, edge_feed.as_ref());
+                let slices = contact.slices.as_ref();
+                let integral = model.integral(arcs, edge_feed.as_ref(), slices);
                 job.flute_counts
                     .iter()
                     .map(|&k| {
                         let fz = job.feed_mode.feed_per_tooth(k, job.spindle_rpm);
                         (
-                            model.torque(arcs, edge_feed.as_ref(), integral, k, fz),
-                            model.peak_force(arcs, k, fz, edge_feed.as_ref()),
+                            model.torque(arcs, edge_feed.as_ref(), slices, integral, k, fz),
+                            model.peak_force(arcs, k, fz, edge_feed.as_ref(), slices),
                         )
                     })
                     .unzip()
@@ -443,11 +460,13 @@ pub(crate) fn evaluate(
         }
     }
 
-    if let (Some(model), ToolKind::Ball | ToolKind::Bull) = (&candidate.force, tool.kind) {
+    if let (Some(model), Engine::Dots) = (&candidate.force, job.engine)
+        && model.rounded()
+    {
         warnings.push(Warning::new(
             "W_FORCE_MODEL",
             format!(
-                "the {} end's chips (h = f_z·sin θ·sin κ) and lever arms are integrated over a_p = {} mm, but with the engaged arcs of the full radius at every height: where the end's circle is smaller than the radius at a height (a cut shallower than the corner radius, a wall beside it), torque, power and force are upper bounds",
+                "the {} end's chips (h = f_z·sin θ·sin κ) and lever arms are integrated over a_p = {} mm, but engine \"dots\" gives only the full radius's engaged arcs, taken at every height: where the end's smaller sections meet other material (a wall beside the tool, a cut shallower than the corner radius, scallops of an earlier pass, a slot's exit), torque, power and force are off; engine \"exact\" takes each height's own arcs",
                 tool.kind.as_str(),
                 model.axial_depth
             ),
@@ -523,6 +542,7 @@ pub(crate) fn evaluate(
             radial_ratio: model.radial_ratio,
             axial_depth: model.axial_depth,
             helix_lag_deg: model.lag_deg,
+            height_sections: contacts.iter().filter_map(|c| c.slices.as_ref()).map(|b| b.sections.len()).max(),
             spindle_power_kw: job.spindle.spindle_power_kw,
             spindle_torque_nm: job.spindle.spindle_torque_nm,
             natural_frequencies_hz: job.natural.iter().map(|(f, _)| *f).collect(),
@@ -537,6 +557,7 @@ pub(crate) fn evaluate(
             spindle_direction: job.direction,
             rule: job.rule,
             axial_depth: candidate.axial_depth,
+            cut_z: candidate.cut_z,
             stock_top_z: job.stock_top_z,
             clearance: job.clearance,
             tool_radius: tool.radius,

@@ -27,9 +27,17 @@ pub(crate) struct ExactEngine {
     earlier: Vec<usize>,
     angles: Vec<f64>,
     tests: u64,
+    /// Tests allowed before the engine gives up; at least [`MAX_TESTS`].
+    limit: u64,
 }
 
 impl ExactEngine {
+    /// An engine allowed `limit` tests (at least [`MAX_TESTS`]): one that evaluates several
+    /// circles per sample (the height bands of a rounded end).
+    pub(crate) fn with_limit(limit: u64) -> Self {
+        Self { limit, ..Self::default() }
+    }
+
     /// The engaged arcs at `station` (§5.3.1) for a tool of `radius`.
     pub(crate) fn arcs(
         &mut self,
@@ -80,11 +88,12 @@ impl ExactEngine {
 
     /// Refuses once the work limit is spent.
     fn check_budget(&self) -> Result<(), SolverError> {
-        if self.tests > MAX_TESTS {
+        let limit = self.limit.max(MAX_TESTS);
+        if self.tests > limit {
             return Err(SolverError::new(
                 ErrorCode::WorkLimit,
                 format!(
-                    "the exact engine exceeded its limit of {MAX_TESTS} boundary tests: use a larger step or a simpler stock"
+                    "the exact engine exceeded its limit of {limit} boundary tests: use a larger step or a simpler stock"
                 ),
             )
             .at("step"));

@@ -38,7 +38,7 @@ fn needed(
     // The spindle: the phase-mean torque grows as f_z^(1−m_c), so the feed per tooth that
     // meets the cap is closed.
     if let (Some(model), Some((torque, by_power))) = (force, job.spindle.torque_cap(job.spindle_rpm)) {
-        let integral = model.engaged_integral(&contact.arcs, edge_feed);
+        let integral = model.integral(&contact.arcs, edge_feed, contact.slices.as_ref());
         let feed = to_feed(model.feed_for_torque(torque, integral, plan.flute_count));
         if feed < best.0 {
             best = (feed, if by_power { FeedLimit::Power } else { FeedLimit::Torque });

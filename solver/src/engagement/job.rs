@@ -6,6 +6,7 @@ use crate::error::ErrorCode;
 use super::arcs::SpindleDirection;
 use super::bbox_tree::BBox;
 use super::force::ForceModel;
+use super::heights::{CORNER_BANDS, Loads};
 use super::kienzle::{DEFAULT_RADIAL_RATIO, Kienzle, SinPower};
 use super::limits::{SpindleLimits, natural_frequencies};
 use super::outline::Outline;
@@ -51,8 +52,10 @@ pub(crate) struct CandidateJob {
     pub name: Option<String>,
     pub route: Route,
     pub warnings: Vec<Warning>,
-    /// a_p of this path: its own, else the request's.
+    /// a_p of this path: its own, else the request's, else from its Z under the stock top.
     pub axial_depth: Option<f64>,
+    /// The Z of the tool tip when a_p came from it (the program cuts there).
+    pub cut_z: Option<f64>,
     /// Kienzle's force model at this path's a_p, with `kienzle` (or `material`).
     pub force: Option<ForceModel>,
 }
@@ -141,6 +144,17 @@ fn too_large(field: &str, what: &str, count: usize, limit: usize) -> SolverError
 
 /// A path's pieces, zero-length ones dropped with a warning (engagement.md §2.3).
 pub(crate) fn read_path(input: &PathInput, field: &str, warnings: &mut Vec<Warning>) -> Result<Route, SolverError> {
+    read_path_levels(input, field, warnings, &mut Vec::new())
+}
+
+/// [`read_path`], adding to `levels` the Z (mm) and line of both ends of every XY feed move of
+/// a G-code path whose Z is known.
+fn read_path_levels(
+    input: &PathInput,
+    field: &str,
+    warnings: &mut Vec<Warning>,
+    levels: &mut Vec<(f64, usize)>,
+) -> Result<Route, SolverError> {
     let mut shapes: Vec<(Shape, bool, usize)> = Vec::new();
     let mut dropped = Vec::new();
     match input {
@@ -170,7 +184,7 @@ pub(crate) fn read_path(input: &PathInput, field: &str, warnings: &mut Vec<Warni
                 )
                 .at(format!("{field}.gcode")));
             }
-            read_gcode_path(text, &format!("{field}.gcode"), &mut shapes, &mut dropped)?;
+            read_gcode_path(text, &format!("{field}.gcode"), &mut shapes, &mut dropped, levels)?;
         }
         PathInput::Segments(program) => {
             let start = program.start.ok_or_else(|| {
@@ -269,6 +283,7 @@ fn read_gcode_path(
     field: &str,
     shapes: &mut Vec<(Shape, bool, usize)>,
     dropped: &mut Vec<String>,
+    levels: &mut Vec<(f64, usize)>,
 ) -> Result<(), SolverError> {
     let program = read_program(text, field, &ReadOptions { max_lines: MAX_SEGMENTS, ..ReadOptions::default() })?;
     for step in &program.moves {
@@ -294,6 +309,9 @@ fn read_gcode_path(
         if shape.length() <= 1e-9 {
             dropped.push(here);
         } else {
+            if !rapid {
+                levels.extend([step.from[2], step.to[2]].into_iter().flatten().map(|z| (z, step.line)));
+            }
             shapes.push((shape, rapid, step.line));
         }
     }
@@ -538,10 +556,15 @@ impl EngagementRequest {
         let min_feed_per_tooth = optional("min_feed_per_tooth", self.min_feed_per_tooth, positive)?;
         let axial_depth = self.axial_depth.map(|d| bounded("axial_depth", d, MAX_COORDINATE)).transpose()?;
         let (kienzle, spindle) = self.kienzle(physics)?;
-        let stock_top_z = finite("stock_top_z", self.stock_top_z.unwrap_or(0.0))?;
-        if stock_top_z.abs() > MAX_COORDINATE {
-            return Err(SolverError::input("stock_top_z", format!("stock_top_z must lie within ±{MAX_COORDINATE} mm")));
-        }
+        // A Z in the plane of the coordinates.
+        let z_value = |field: &str, z: f64| -> Result<f64, SolverError> {
+            let z = finite(field, z)?;
+            if z.abs() > MAX_COORDINATE {
+                return Err(SolverError::input(field, format!("{field} must lie within ±{MAX_COORDINATE} mm")));
+            }
+            Ok(z)
+        };
+        let stock_top_z = z_value("stock_top_z", self.stock_top_z.unwrap_or(0.0))?;
         let clearance = bounded("clearance", self.clearance.unwrap_or(5.0), MAX_COORDINATE)?;
         // Warnings of the whole request, repeated in every candidate's answer.
         let mut shared_warnings = Vec::new();
@@ -595,10 +618,13 @@ impl EngagementRequest {
         };
         let (region, _) = read_stock(&self.stock, radius, &mut shared_warnings)?;
 
-        // (name, path, its field, its own a_p and that field)
-        type Input<'a> = (Option<String>, &'a PathInput, String, Option<f64>, String);
+        let cut_z = self.cut_z.map(|z| z_value("cut_z", z)).transpose()?;
+        // Where a G-code path's own Z counts: only with an explicit stock top.
+        let top_given = self.stock_top_z.is_some();
+        // (name, path, its field, the field prefix of its own a_p and cut_z, those values)
+        type Input<'a> = (Option<String>, &'a PathInput, String, String, Option<f64>, Option<f64>);
         let inputs: Vec<Input<'_>> = match (&self.path, &self.paths) {
-            (Some(path), None) => vec![(None, path, "path".to_owned(), None, String::new())],
+            (Some(path), None) => vec![(None, path, "path".to_owned(), String::new(), None, None)],
             (None, Some(paths)) => {
                 if paths.is_empty() {
                     return Err(SolverError::new(ErrorCode::Path, "paths is empty").at("paths"));
@@ -614,8 +640,9 @@ impl EngagementRequest {
                             c.name.clone(),
                             &c.path,
                             format!("paths[{i}].path"),
+                            format!("paths[{i}]."),
                             c.axial_depth,
-                            format!("paths[{i}].axial_depth"),
+                            c.cut_z,
                         )
                     })
                     .collect()
@@ -629,12 +656,32 @@ impl EngagementRequest {
         };
         let mut candidates = Vec::with_capacity(inputs.len());
         let mut total_samples = 0.0;
-        for (name, input, field, own_depth, depth_field) in inputs {
-            let own_depth = own_depth.map(|d| bounded(&depth_field, d, MAX_COORDINATE)).transpose()?;
-            let depth = own_depth.or(axial_depth);
-            let force = kienzle.map(|values| force_model(&values, tool, depth, self.spindle_direction)).transpose()?;
+        let mut section_radii = 0.0_f64;
+        for (name, input, field, prefix, own_depth, own_cut_z) in inputs {
+            let own_depth =
+                own_depth.map(|d| bounded(&format!("{prefix}axial_depth"), d, MAX_COORDINATE)).transpose()?;
+            let own_cut_z = own_cut_z.map(|z| z_value(&format!("{prefix}cut_z"), z)).transpose()?;
             let mut warnings = Vec::new();
-            let route = read_path(input, &field, &mut warnings)?;
+            let mut levels = Vec::new();
+            let route = read_path_levels(input, &field, &mut warnings, &mut levels)?;
+            let explicit = own_depth
+                .map(|d| (d, format!("{prefix}axial_depth")))
+                .or_else(|| axial_depth.map(|d| (d, "axial_depth".to_owned())));
+            let level = if own_cut_z.is_some() || cut_z.is_some() || !top_given {
+                None
+            } else {
+                program_level(&levels, &format!("{field}.gcode"), explicit.is_none(), &mut warnings)
+            };
+            let height = own_cut_z
+                .map(|z| (z, format!("{prefix}cut_z")))
+                .or_else(|| cut_z.map(|z| (z, "cut_z".to_owned())))
+                .or(level);
+            let (depth, path_z) = path_depth(explicit, height, stock_top_z, tool, &mut warnings)?;
+            let force = kienzle.map(|values| force_model(&values, tool, depth, self.spindle_direction)).transpose()?;
+            if force.as_ref().is_some_and(ForceModel::rounded) {
+                // The sections of a rounded end: about one circle per band edge.
+                section_radii = (CORNER_BANDS + 1) as f64 * radius;
+            }
             total_samples += route.station_count(step);
             if total_samples > MAX_SAMPLES as f64 {
                 return Err(SolverError::new(
@@ -645,7 +692,7 @@ impl EngagementRequest {
                 )
                 .at("step"));
             }
-            candidates.push(CandidateJob { name, route, warnings, axial_depth: depth, force });
+            candidates.push(CandidateJob { name, route, warnings, axial_depth: depth, cut_z: path_z, force });
         }
         if let Some(g) = grid {
             // The dots engine rasterises earlier cuts' arcs as chords within g/100.
@@ -679,8 +726,9 @@ impl EngagementRequest {
             }
         }
         if let (Engine::Exact, Base::Bitmap(bitmap)) = (self.engine, &region.base) {
-            // Every sample intersects the circle with about 8R/cell cell edges.
-            let work = total_samples * 8.0 * radius / bitmap.cell;
+            // Every sample intersects the circle with about 8R/cell cell edges, and the height
+            // sections of a rounded end their own circles.
+            let work = total_samples * 8.0 * (radius + section_radii) / bitmap.cell;
             if work > super::MAX_BITMAP_CROSSINGS {
                 return Err(SolverError::new(
                     ErrorCode::TooManySamples,
@@ -769,11 +817,12 @@ fn force_model(
     let axial_depth = axial_depth.ok_or_else(|| {
         SolverError::input(
             "axial_depth",
-            "axial_depth (mm) is required with kienzle or material (or paths[i].axial_depth for every path): a_p is the chip width",
+            "axial_depth (mm) is required with kienzle or material (or paths[i].axial_depth for every path), or the path's Z under the stock top (cut_z, with stock_top_z, default 0): a_p is the chip width",
         )
     })?;
     // Λ = 2·a_p·tan λ / D (engagement.md §11 item 5), radians.
-    let lag = tool.helix_deg.map_or(0.0, |helix| axial_depth * helix.to_radians().tan() / tool.radius);
+    let helix_tan = tool.helix_deg.map_or(0.0, |helix| helix.to_radians().tan());
+    let lag = axial_depth * helix_tan / tool.radius;
     let (table, table_next) = (SinPower::new(1.0 - kienzle.mc), SinPower::new(2.0 - kienzle.mc));
     let corner_radius = match tool.kind {
         ToolKind::Flat => 0.0,
@@ -789,11 +838,97 @@ fn force_model(
         force_width,
         torque_width,
         lag_deg: lag.to_degrees(),
+        radius: tool.radius,
+        corner_radius,
+        helix_tan,
+        loads: (corner_radius > 0.0 && axial_depth > 0.0).then(|| Box::new(Loads::new(1.0 - kienzle.mc))),
         direction,
         radial_ratio: kienzle.radial_ratio.unwrap_or(DEFAULT_RADIAL_RATIO),
         table,
         table_next,
     })
+}
+
+/// The one Z level of a G-code path's XY feed moves, with its field, for a_p from the stock
+/// height (only when no explicit a_p wins: `wanted`); several levels give `W_AXIAL_DEPTH` and
+/// none.
+fn program_level(
+    levels: &[(f64, usize)],
+    field: &str,
+    wanted: bool,
+    warnings: &mut Vec<Warning>,
+) -> Option<(f64, String)> {
+    let (&(first, line), rest) = levels.split_first()?;
+    let other = rest.iter().find(|(z, _)| (z - first).abs() > 1e-6);
+    match other {
+        None => Some((first, format!("{field} (Z of its feed moves, line {line})"))),
+        Some((z, other_line)) => {
+            if wanted {
+                warnings.push(Warning::new(
+                    "W_AXIAL_DEPTH",
+                    format!(
+                        "the program's XY feed moves run at several Z levels (Z {first} at line {line}, Z {z} at line {other_line}): no a_p from the stock height; the 2-D model takes one level per path, so give axial_depth or cut_z, or each level as its own entry of paths"
+                    ),
+                ));
+            }
+            None
+        }
+    }
+}
+
+/// a_p of one path and the Z it runs at when a_p came from it: the explicit axial depth
+/// (`explicit`, with its field) wins; else `top` − the path's Z (`height`, with its field),
+/// 0 at or above the top. Both warn where they disagree; an a_p beyond the tool's flute length
+/// is refused at the field that set it.
+fn path_depth(
+    explicit: Option<(f64, String)>,
+    height: Option<(f64, String)>,
+    top: f64,
+    tool: &Tool,
+    warnings: &mut Vec<Warning>,
+) -> Result<(Option<f64>, Option<f64>), SolverError> {
+    let reach = |depth: f64, field: &str, how: &str| -> Result<(), SolverError> {
+        match tool.flute_length {
+            Some(length) if depth > length => Err(SolverError::input(
+                field,
+                format!(
+                    "{how} a_p = {depth} mm, more than the tool's flute_length {length} mm: the shank would cut (check the path's Z and the stock top)"
+                ),
+            )),
+            _ => Ok(()),
+        }
+    };
+    if let Some((depth, field)) = explicit {
+        if let Some((z, z_field)) = &height
+            && ((top - z).max(0.0) - depth).abs() > 1e-9
+        {
+            warnings.push(Warning::new(
+                "W_AXIAL_DEPTH",
+                format!(
+                    "{field} = {depth} mm is used; the path's Z {z} ({z_field}) under the stock top {top} would give a_p = {} mm",
+                    (top - z).max(0.0)
+                ),
+            ));
+        }
+        reach(depth, &field, &format!("{field} gives"))?;
+        return Ok((Some(depth), None));
+    }
+    let Some((z, field)) = height else {
+        return Ok((None, None));
+    };
+    let depth = top - z;
+    if depth <= 0.0 {
+        warnings.push(Warning::new(
+            "W_AXIAL_DEPTH",
+            format!(
+                "the tool tip runs at Z {z} ({field}), at or above the stock top {top}: a_p = 0, the path cuts no chip (torque, power and removal rate are 0)"
+            ),
+        ));
+        return Ok((Some(0.0), Some(z)));
+    }
+    let field_name = field.split(' ').next().unwrap_or(&field).to_owned();
+    reach(depth, &field_name, &format!("the stock top {top} less the path's Z {z} ({field}) gives"))?;
+    Ok((Some(depth), Some(z)))
 }
 
 /// What the server resolves for an engagement request besides the tool and the machine: the

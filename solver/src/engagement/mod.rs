@@ -21,7 +21,7 @@
 //! * `flutes`: representative values, time, recommendation (§5.7–§5.9);
 //! * `feed`: chip-thinning feed plan (§11 item 3), capped by the spindle's power and torque;
 //! * `kienzle`, `force`: Kienzle's law, spindle torque and power with the helix lag (§11 items
-//!   4, 5);
+//!   4, 5); `heights`: a ball or bull end's engagement by height;
 //! * `arcfeed`: the arc-feed correction of the chip thickness on curved paths (§11 item 6);
 //! * `phase`: the phase maximum of a general per-tooth load;
 //! * `limits`: the spindle's ratings and the tooth-passing frequency against the tool's natural
@@ -31,8 +31,8 @@
 //! Choices where the spec is open (§13): `cw` rotation by default; constant f_z when
 //! `feed_per_tooth` is given, constant V_f when `feed` is; statistics over the engaged samples
 //! (m ≥ 1, not a plunge, not a rapid), the mean weighted by sample spacing; machining time over
-//! feed moves only; θ in degrees; the contact model is 2-D (the axial depth and the helix enter
-//! only the forces). A
+//! feed moves only; θ in degrees; the contact graph is 2-D, the full radius's (the axial depth,
+//! the helix and a rounded end's smaller sections enter only the forces). A
 //! path that never touches the stock is not an error: the answer is all zeros with
 //! `W_NO_CONTACT` (§9). The exact engine splits the circle at its exact boundary crossings
 //! instead of stepping θ, so it has no angle step and its arc ends are exact.
@@ -40,8 +40,10 @@
 //! Cutting physics (§11 items 4–6, 9; only with `kienzle` or `material`, so answers without
 //! them are unchanged): every tooth cuts a chip a_p wide with a straight edge, or on a ball or
 //! bull end a chip f_z·sin θ·sin κ thin and dz/sin κ wide at the lever arm r(z), integrated over
-//! the height (the engaged arcs stay the full radius's at every height: `W_FORCE_MODEL` says the
-//! figures are upper bounds there); the spindle limits are compared with the torque
+//! the height in bands, each with the engaged arcs of its own section (radius r(z)) against the
+//! stock its height has left (engine `exact`; engine `dots` takes the full radius's arcs at
+//! every height, with `W_FORCE_MODEL`); a_p is `axial_depth`, or `stock_top_z` less the path's
+//! Z (`cut_z`, a G-code path's own); the spindle limits are compared with the torque
 //! averaged over the tooth phase, the load the drive carries (its rotor's inertia smooths the
 //! tooth-by-tooth peaks), while the peaks over the phase are reported for the tool; the
 //! tooth-passing frequency is compared with the fundamental only.
@@ -60,6 +62,7 @@ mod exact;
 mod feed;
 mod flutes;
 mod force;
+mod heights;
 mod job;
 mod kienzle;
 mod limits;

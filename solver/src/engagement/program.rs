@@ -146,10 +146,11 @@ fn cut(result: &PathEngagement, lift: f64, arcs: Arcs) -> Result<Cut, SolverErro
     let depth = data.axial_depth.ok_or_else(|| {
         SolverError::input(
             "axial_depth",
-            "the G-code program needs axial_depth: it cuts at Z = stock_top_z − axial_depth",
+            "the G-code program needs axial_depth (it cuts at Z = stock_top_z − axial_depth) or the path's Z (cut_z)",
         )
     })?;
-    let cut_z = data.stock_top_z - depth + lift;
+    // At the path's own Z when a_p came from it (also above the top, where a_p is 0).
+    let cut_z = data.cut_z.unwrap_or(data.stock_top_z - depth) + lift;
     let safe_z = data.stock_top_z + data.clearance + lift;
     let route = &data.route.0;
     let mut path = Toolpath::default();

@@ -113,6 +113,10 @@ pub struct Candidate {
     /// the program's cutting Z), so paths at different depths compare side by side.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axial_depth: Option<f64>,
+    /// Z of the tool tip along this path, mm: replaces the request's `cut_z` for it (a_p =
+    /// `stock_top_z` − cut_z where no `axial_depth` is given).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cut_z: Option<f64>,
 }
 
 /// One region of a polygon stock.
@@ -336,12 +340,23 @@ pub struct EngagementRequest {
     pub min_feed_per_tooth: Option<f64>,
     /// a_p, the axial depth of cut, mm: gives the removal rate (MRR), the cutting Z of the
     /// G-code program (stock top − a_p) and, with `kienzle`, the chip width of every tooth
-    /// (an entry of `paths` may give its own).
+    /// (an entry of `paths` may give its own). Without it a_p comes from the heights:
+    /// `stock_top_z` − `cut_z` (see `cut_z`); given, it wins over them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axial_depth: Option<f64>,
-    /// Z of the stock top for the G-code program, mm (default 0).
+    /// Z of the stock's top face, mm (default 0): the plan-view stock is material from its
+    /// outline up to this height. The G-code program's clearance is above it, and a path whose
+    /// tip runs at Z = `cut_z` (or a G-code path's Z, with `stock_top_z` given) cuts a_p =
+    /// `stock_top_z` − Z.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stock_top_z: Option<f64>,
+    /// Z of the tool tip along the path, mm (an entry of `paths` may give its own): without
+    /// `axial_depth` the path cuts a_p = `stock_top_z` − cut_z, 0 when it runs at or above the
+    /// top (`W_AXIAL_DEPTH`); an a_p beyond the tool's `flute_length` is refused. A G-code path
+    /// gives its own Z when its XY feed moves share one level and `stock_top_z` is given (a
+    /// program's Z0 is not always the stock top).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cut_z: Option<f64>,
     /// Height of the clearance plane above the stock top, mm (default 5).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub clearance: Option<f64>,

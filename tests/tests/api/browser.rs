@@ -1,5 +1,6 @@
 //! The page in real headless Chromium (Debian's `chromium`, driven by playwright-core from
-//! `tests/browser/`): it loads, submits the sample job with its button, and plots; the workbench
+//! `tests/browser/`): it loads, submits the sample job with its button, and plots (the engagement
+//! view also with a material of the library, checked against the API); the workbench
 //! keeps state, honours machines, reports errors at the field and never scrolls sideways; jobs
 //! show the progress the service reports and no more. Every scenario also fails on a console
 //! error or a request that leaves 127.0.0.1.
@@ -105,6 +106,15 @@ async fn engagement_page_compares_the_sample_paths() {
     assert_eq!(result["charts"], 8, "the charts of the path shown, no more: {result}");
     assert!(result["recommendation"].as_str().unwrap().contains("Recommended flute counts"), "{result}");
     assert_eq!(result["file"], "engagement-1-fanuc.nc");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn engagement_page_computes_with_a_library_material() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "engagementMaterial", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["rows"].as_u64().unwrap() >= 1, "{result}");
+    eprintln!("C45 on the page: {} N·m, {} kW", result["torque"], result["power"]);
 }
 
 #[tokio::test(flavor = "multi_thread")]

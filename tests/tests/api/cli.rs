@@ -124,3 +124,90 @@ async fn kerf_run_and_the_service_write_the_same_programs() {
         }
     }
 }
+
+/// A database left by an older kerf: its migrations applied up to `version` only (0004: before
+/// the materials library of 0006; 0002: before the machines registry of 0003).
+async fn old_database(path: &std::path::Path, version: i64) {
+    let options = sqlx::sqlite::SqliteConnectOptions::new().filename(path).create_if_missing(true);
+    let pool = sqlx::sqlite::SqlitePoolOptions::new().max_connections(1).connect_with(options).await.unwrap();
+    sqlx::migrate!("../migrations/sqlite").run_to(version, &pool).await.unwrap();
+    pool.close().await;
+}
+
+/// An engagement job (a slot, with forces) whose operation names `material` and, if given,
+/// `machine`; `materials` is the job file's own `[[materials]]` table (TOML).
+fn material_job(folder: &std::path::Path, material: &str, machine: Option<&str>, materials: &str) -> PathBuf {
+    let file = folder.join("job.toml");
+    let machine = machine.map(|m| format!("machine = \"{m}\"\n")).unwrap_or_default();
+    std::fs::write(
+        &file,
+        format!(
+            "{materials}\n[[operations]]\noperation = \"engagement\"\ntool = {{ kind = \"flat\", radius = 5, flutes = 4 }}\n\
+             spindle_rpm = 3000\nfeed_per_tooth = 0.05\naxial_depth = 2\nmaterial = \"{material}\"\n{machine}\
+             path = [[-10, 0], [45, 0]]\nstock = {{ polygon = [[0, -20], [50, -20], [50, 20], [0, 20]] }}\n"
+        ),
+    )
+    .unwrap();
+    file
+}
+
+fn run_against(file: &std::path::Path, database: &std::path::Path, out: &std::path::Path) -> std::process::Output {
+    Command::new(program()).arg("run").arg(file).arg("-o").arg(out).arg("--database").arg(database).output().unwrap()
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_database_from_before_the_materials_library_is_named_not_an_internal_error() {
+    let folder = tempfile::tempdir().unwrap();
+    let database = folder.path().join("old.db");
+    old_database(&database, 4).await;
+    let before = std::fs::read(&database).unwrap();
+
+    // A library material: the database has no library to look it up in. Before the fix this
+    // was "internal error; it has been logged (E_INTERNAL)".
+    let file = material_job(folder.path(), "C45", None, "");
+    let output = run_against(&file, &database, &folder.path().join("out"));
+    assert!(!output.status.success());
+    let message = String::from_utf8_lossy(&output.stderr);
+    assert!(!message.contains("E_INTERNAL") && !message.contains("internal error"), "{message}");
+    assert!(message.contains("operations[0].material"), "names the field: {message}");
+    assert!(message.contains("predates the materials library"), "says why: {message}");
+    assert!(message.contains("kerf migrate"), "says how to upgrade: {message}");
+    assert!(!folder.path().join("out").exists(), "nothing written for a failed job");
+    assert_eq!(std::fs::read(&database).unwrap(), before, "kerf run leaves the database as it was");
+
+    // A material the job file defines needs no library: the old database is fine.
+    let file = material_job(folder.path(), "mine", None, "[[materials]]\nname = \"mine\"\nkc11 = 1500\nmc = 0.2\n");
+    let output = run_against(&file, &database, &folder.path().join("out"));
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let result: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(folder.path().join("out/00-engagement.json")).unwrap()).unwrap();
+    assert_eq!(result["forces"]["kc11"], 1500.0);
+
+    // `kerf migrate` upgrades it, after which the library material resolves.
+    let migrated = Command::new(program()).arg("migrate").arg("--database").arg(&database).output().unwrap();
+    assert!(migrated.status.success(), "{}", String::from_utf8_lossy(&migrated.stderr));
+    let file = material_job(folder.path(), "C45", None, "");
+    let output = run_against(&file, &database, &folder.path().join("out-c45"));
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let result: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(folder.path().join("out-c45/00-engagement.json")).unwrap())
+            .unwrap();
+    assert_eq!(result["forces"]["kc11"], 2220.0, "C45 from the seeded library");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_database_from_before_the_machines_registry_is_named_too() {
+    let folder = tempfile::tempdir().unwrap();
+    let database = folder.path().join("older.db");
+    old_database(&database, 2).await;
+    let file =
+        material_job(folder.path(), "mine", Some("mill"), "[[materials]]\nname = \"mine\"\nkc11 = 1500\nmc = 0.2\n");
+    let output = run_against(&file, &database, &folder.path().join("out"));
+    assert!(!output.status.success());
+    let message = String::from_utf8_lossy(&output.stderr);
+    assert!(!message.contains("E_INTERNAL"), "{message}");
+    assert!(
+        message.contains("operations[0].machine") && message.contains("predates the machines registry"),
+        "{message}"
+    );
+}

@@ -118,7 +118,9 @@ fn compose_mirrors_the_tested_topology() {
                 assert!(worker.metrics_bind.is_some(), "{name}: workers expose their metrics");
                 workers += 1;
             }
-            Command::Run(_) | Command::Jobs(_) => panic!("{name}: kerf {arguments:?} is not a service"),
+            Command::Run(_) | Command::Migrate(_) | Command::Jobs(_) => {
+                panic!("{name}: kerf {arguments:?} is not a service")
+            }
         }
     }
     assert_eq!((api_nodes, workers), (2, 1), "two API nodes and a (scaled) worker service");
@@ -168,7 +170,9 @@ fn kubernetes_example_mirrors_the_tested_topology() {
                     assert!(options.metrics_bind.is_some(), "{name}: workers expose their metrics");
                     worker = true;
                 }
-                Command::Run(_) | Command::Jobs(_) => panic!("{name}: kerf {arguments:?} is not a service"),
+                Command::Run(_) | Command::Migrate(_) | Command::Jobs(_) => {
+                    panic!("{name}: kerf {arguments:?} is not a service")
+                }
             }
         }
     }
