@@ -260,12 +260,16 @@ const scenarios = {
     await page.fill('#tool-form input[name="number"]', '12');
     await page.fill('#tool-form input[name="size"]', '8');
     await page.fill('#tool-form input[name="neck_radius"]', '2.5');
+    await page.fill('#tool-form input[name="flute_length"]', '20');
     await page.click('#tool-save');
     await page.waitForSelector('#tool-rows tr[data-tool="12"]', { timeout: 60000 });
     const stored = await page.evaluate(async () => (await (await fetch('/api/v1/tools/12')).json()));
-    if (stored.radius !== 4 || stored.neck_radius !== 2.5) throw new Error(`tool by diameter: ${JSON.stringify(stored)}`);
+    if (stored.radius !== 4 || stored.neck_radius !== 2.5 || stored.flute_length !== 20) throw new Error(`tool by diameter: ${JSON.stringify(stored)}`);
+    const extras = await page.textContent('#tool-rows tr[data-tool="12"]');
+    if (!extras.includes('flutes 20 long')) throw new Error(`flute length not listed: ${extras}`);
     await page.click('#tool-rows tr[data-tool="12"] button:has-text("Edit")');
     if (await page.inputValue('#tool-form input[name="size"]') !== '8') throw new Error('edit did not fill the form');
+    if (await page.inputValue('#tool-form input[name="flute_length"]') !== '20') throw new Error('edit did not fill the flute length');
     // A flat end mill that does not cut at its centre, with its own plunge feed.
     await page.selectOption('#tool-form select[name="kind"]', 'flat');
     await page.fill('#tool-form input[name="plunge_feed"]', '250');
@@ -733,6 +737,19 @@ const scenarios = {
         throw new Error(`C45's torque ${f.mean_torque_nm} is the example values' ${example.flutes[i].mean_torque_nm}`);
       }
     });
+    // Depth of cut from the heights: no a_p typed, stock top at Z 5 and the tip at Z 2 cut 3 mm.
+    await page.fill('#engagement-form input[name="axial_depth"]', '');
+    await page.fill('#engagement-form input[name="stock_top_z"]', '5');
+    await page.fill('#engagement-form input[name="cut_z"]', '2');
+    const [fromHeights] = await Promise.all([
+      page.waitForRequest((r) => r.url().endsWith('/api/v1/engagement') && r.method() === 'POST'),
+      page.click('#engagement-compute'),
+    ]);
+    const heights = fromHeights.postDataJSON();
+    if (heights.axial_depth !== undefined || heights.stock_top_z !== 5 || heights.cut_z !== 2) {
+      throw new Error(`heights sent as ${JSON.stringify({ axial_depth: heights.axial_depth, stock_top_z: heights.stock_top_z, cut_z: heights.cut_z })}`);
+    }
+    await page.waitForFunction(() => /depth of cut a_p, mm\s*3\.000/.test(document.querySelector('#engagement-result .candidate:not([hidden]) .summary')?.textContent ?? ''), null, { timeout: 30000 });
     return { rows: rows.length, torque: rows[0][torqueColumn], power: rows[0][powerColumn] };
   },
 

@@ -53,7 +53,9 @@ const FORM = `
       <label data-engine="dots"><span>Dot spacing, mm <abbr class="symbol" title="g">g</abbr></span> <input name="grid" type="number" step="any" placeholder="D/200" data-field="grid"></label>
     </fieldset>
     <fieldset><legend>Work material (torque and power)</legend>
-      <label><span>Depth of cut, mm <abbr class="symbol" title="axial depth a_p">a_p</abbr></span> <input name="axial_depth" type="number" step="any" value="2" data-field="axial_depth"></label>
+      <label><span>Depth of cut, mm <abbr class="symbol" title="axial depth a_p">a_p</abbr></span> <input name="axial_depth" type="number" step="any" value="2" placeholder="stock top − cut Z" data-field="axial_depth" title="empty: a_p = stock top Z − cut Z (or a G-code path's Z)"></label>
+      <label>Stock top Z, mm <input name="stock_top_z" type="number" step="any" placeholder="0" data-field="stock_top_z"></label>
+      <label><span>Cut Z (tool tip), mm</span> <input name="cut_z" type="number" step="any" placeholder="none" data-field="cut_z" title="the tip's Z while cutting; a_p = stock top − cut Z where no depth of cut is given"></label>
       <label>Material <select name="material" data-field="material" title="a material of the library (GET /api/v1/materials), or the values below"></select></label>
       <label><span>Specific cutting force, N/mm² <abbr class="symbol" title="Kienzle k_c1.1">k<sub>c1.1</sub></abbr></span> <input name="kc11" type="number" step="any" value="1800" placeholder="none: no torque or power" data-field="kienzle.kc11" title="e.g. about 1800 for a plain carbon steel, 700 for an aluminium alloy"></label>
       <label><span>Kienzle exponent <abbr class="symbol" title="Kienzle m_c">m<sub>c</sub></abbr></span> <input name="mc" type="number" step="any" value="0.25" data-field="kienzle.mc" title="typically 0.15–0.3"></label>
@@ -161,6 +163,8 @@ export function engagementRequest(form) {
     engine: value(form, 'engine'),
     step: numeric(form, 'step'),
     axial_depth: numeric(form, 'axial_depth'),
+    stock_top_z: numeric(form, 'stock_top_z'),
+    cut_z: numeric(form, 'cut_z'),
   });
   if (body.engine === 'dots') body.grid = numeric(form, 'grid');
   const [kc11, mc] = [numeric(form, 'kc11'), numeric(form, 'mc')];
@@ -522,6 +526,7 @@ function renderColumn(column, result, answer, axis) {
     const b = result.blocks;
     items.push(['program blocks (short)', `${b.blocks} (${b.short_blocks})`], ['block-limited time, s', number(b.estimated_time_s, 2)]);
   }
+  if (result.forces) items.push(['depth of cut a_p, mm', number(result.forces.axial_depth, 3)]);
   if (result.max_mrr !== undefined) items.push(['max MRR, mm³/min', number(result.max_mrr, 0)]);
   showSummary(summary, items);
   const plan = document.createElement('canvas');

@@ -1,6 +1,6 @@
 // Tool table view: list, register or replace, edit and delete (with a confirmation) the tools
 // (api.md, Tools). Sizes by diameter or radius; the optional data later capabilities need:
-// neck, stickout, helix, shape-error table and a static stiffness.
+// neck, stickout, flute length, helix, shape-error table and a static stiffness.
 import { api } from '/api.js';
 import { clearProblem, confirmButton, message, numeric, showProblem, value } from '/form.js';
 
@@ -19,6 +19,7 @@ const FORM = `
     <fieldset><legend>Optional data</legend>
       <label>Neck radius, mm <input name="neck_radius" type="number" step="any" placeholder="none (shank as big as the head)" data-field="neck_radius"></label>
       <label>Stickout, mm <input name="stickout" type="number" step="any" placeholder="none" data-field="stickout"></label>
+      <label>Flute length, mm <input name="flute_length" type="number" step="any" placeholder="none (not checked)" data-field="flute_length" title="the longest depth of cut the flutes reach; a deeper a_p is refused"></label>
       <label>Helix angle, ° <input name="helix_deg" type="number" step="any" placeholder="none" data-field="helix_deg"></label>
       <label>Plunge feed, mm/min <input name="plunge_feed" type="number" step="any" placeholder="the machine's, else half the cutting feed" data-field="plunge_feed"></label>
       <label data-kinds="flat bull">Cuts at its centre <select name="centre_cutting" data-field="centre_cutting"><option value="">yes (default)</option><option value="false">no: enter layers on a ramp</option></select></label>
@@ -64,6 +65,7 @@ function toolFrom(form, keep = {}) {
     neck_radius: numeric(form, 'neck_radius'),
     stickout: numeric(form, 'stickout'),
     helix_deg: numeric(form, 'helix_deg'),
+    flute_length: numeric(form, 'flute_length'),
     plunge_feed: numeric(form, 'plunge_feed'),
     // A ball always cuts at its centre (the service refuses `false` on one).
     centre_cutting: value(form, 'kind') !== 'ball' && value(form, 'centre_cutting') === 'false' ? false : undefined,
@@ -81,7 +83,7 @@ function edit(form, tool) {
   form.elements.kind.value = tool.kind;
   form.elements.size_as.value = 'diameter';
   form.elements.size.value = String(2 * tool.radius);
-  for (const name of ['corner_radius', 'neck_radius', 'stickout', 'helix_deg', 'plunge_feed', 'flutes', 'name']) form.elements[name].value = tool[name] ?? '';
+  for (const name of ['corner_radius', 'neck_radius', 'stickout', 'flute_length', 'helix_deg', 'plunge_feed', 'flutes', 'name']) form.elements[name].value = tool[name] ?? '';
   form.elements.centre_cutting.value = tool.centre_cutting === false ? 'false' : '';
   form.elements.shape_error.value = (tool.shape_error || []).map((p) => `${p.angle_deg} ${p.error}`).join('\n');
   const stiffness = tool.stiffness;
@@ -95,7 +97,7 @@ function edit(form, tool) {
 }
 
 function extras(tool) {
-  return [tool.stickout && `stickout ${tool.stickout}`, tool.helix_deg && `helix ${tool.helix_deg}°`,
+  return [tool.stickout && `stickout ${tool.stickout}`, tool.flute_length && `flutes ${tool.flute_length} long`, tool.helix_deg && `helix ${tool.helix_deg}°`,
     tool.shape_error && `shape error (${tool.shape_error.length})`, tool.stiffness && `stiffness (${tool.stiffness.kind})`]
     .filter(Boolean).join(', ');
 }
