@@ -162,6 +162,10 @@ pub struct ServeArgs {
     /// Longest synchronous solver call, seconds, before the client is told to submit a job.
     #[arg(long, env = "KERF_SOLVER_TIME_LIMIT_S", default_value_t = Limits::default().solver_time_limit.as_secs())]
     pub solver_time_limit_s: u64,
+    /// MiB of solver answers kept to answer the same question (request, stored tool, machine
+    /// and material values, output options) again without solving; 0 keeps none.
+    #[arg(long, env = "KERF_ANSWER_CACHE_MB", default_value_t = u64::try_from(Limits::default().answer_cache_bytes).unwrap_or(u64::MAX) / MIB)]
+    pub answer_cache_mb: u64,
     /// Solver calls allowed at once (default: the number of CPU cores).
     #[arg(long, env = "KERF_SOLVER_SLOTS")]
     pub solver_slots: Option<usize>,
@@ -193,6 +197,7 @@ impl ServeArgs {
                 max_body_bytes: self.max_body_bytes,
                 max_upload_bytes: self.max_upload_bytes,
                 solver_time_limit: Duration::from_secs(self.solver_time_limit_s.max(1)),
+                answer_cache_bytes: usize::try_from(self.answer_cache_mb.saturating_mul(MIB)).unwrap_or(usize::MAX),
                 ..Limits::default()
             },
             solver_slots: self.solver_slots.unwrap_or(cores),

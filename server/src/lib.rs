@@ -3,6 +3,7 @@
 //! `kerf_solver`; handlers validate, resolve stored references and hand the work to the solver
 //! on the blocking pool.
 
+pub mod answer_cache;
 pub mod app;
 pub mod auth;
 pub mod capabilities;

@@ -10,6 +10,7 @@
 //! | `kerf_jobs` | gauge, read from the database at each scrape | `state` |
 //! | `kerf_job_store_bytes` | gauge, read at each scrape: what the stored jobs take (job files, compressed results), the quota's measure | |
 //! | `kerf_job_chunks_claimed_total` | counter (chunks, or whole SQLite jobs, this process claimed) | |
+//! | `kerf_answer_cache_lookups_total` | counter (solver requests looked up in the answer cache) | `result` (`hit`, `miss`) |
 
 use std::sync::LazyLock;
 use std::time::{Duration, Instant};
@@ -49,6 +50,11 @@ struct CapabilityLabels {
 }
 
 #[derive(Clone, Debug, Hash, PartialEq, Eq, EncodeLabelSet)]
+struct LookupLabels {
+    result: &'static str,
+}
+
+#[derive(Clone, Debug, Hash, PartialEq, Eq, EncodeLabelSet)]
 struct StateLabels {
     state: &'static str,
 }
@@ -75,6 +81,7 @@ struct Metrics {
     jobs: Family<StateLabels, Gauge>,
     store_bytes: Gauge,
     chunks_claimed: Counter,
+    cache_lookups: Family<LookupLabels, Counter>,
 }
 
 static METRICS: LazyLock<Metrics> = LazyLock::new(|| {
@@ -97,12 +104,23 @@ static METRICS: LazyLock<Metrics> = LazyLock::new(|| {
     );
     let chunks_claimed = Counter::default();
     registry.register("kerf_job_chunks_claimed", "Job chunks this process claimed", chunks_claimed.clone());
-    Metrics { registry, requests, request_seconds, solver_seconds, jobs, store_bytes, chunks_claimed }
+    let cache_lookups = Family::<LookupLabels, Counter>::default();
+    registry.register(
+        "kerf_answer_cache_lookups",
+        "Solver requests looked up in the answer cache, by result",
+        cache_lookups.clone(),
+    );
+    Metrics { registry, requests, request_seconds, solver_seconds, jobs, store_bytes, chunks_claimed, cache_lookups }
 });
 
 /// Records one solver call of `capability` that took `seconds`.
 pub fn observe_solver(capability: &str, seconds: f64) {
     METRICS.solver_seconds.get_or_create(&CapabilityLabels { capability: capability.to_owned() }).observe(seconds);
+}
+
+/// Counts one answer-cache lookup, a hit or a miss.
+pub fn answer_cache_lookup(hit: bool) {
+    METRICS.cache_lookups.get_or_create(&LookupLabels { result: if hit { "hit" } else { "miss" } }).inc();
 }
 
 /// Counts one claimed job chunk.

@@ -7,6 +7,7 @@ use std::time::Duration;
 
 use tokio::sync::Semaphore;
 
+use crate::answer_cache::AnswerCache;
 use crate::auth::Auth;
 use crate::db::Db;
 use crate::error::{AppError, AppResult};
@@ -33,6 +34,9 @@ pub struct Limits {
     /// predict uploads being received; what does not fit gets 429, so slow readers of large
     /// answers or many large uploads cannot exhaust memory.
     pub answer_budget_bytes: usize,
+    /// Bytes of solver answers kept to answer the same question again without solving
+    /// ([`crate::answer_cache`]); 0 keeps none.
+    pub answer_cache_bytes: usize,
     /// After a stop signal, how long open connections may finish before they are dropped (the
     /// jobs still running are re-queued at the next start, as after a kill).
     pub shutdown_grace: Duration,
@@ -46,6 +50,7 @@ impl Default for Limits {
             solver_time_limit: Duration::from_secs(30),
             solver_queue_wait: Duration::from_secs(5),
             answer_budget_bytes: 512 * 1024 * 1024,
+            answer_cache_bytes: 64 * 1024 * 1024,
             header_read_timeout: Duration::from_secs(10),
             body_idle_timeout: Duration::from_secs(30),
             shutdown_grace: Duration::from_secs(30),
@@ -76,6 +81,8 @@ pub struct AppState {
     pub auth: Auth,
     /// [`Limits::answer_budget_bytes`] in KiB permits.
     pub answer_budget: Arc<Semaphore>,
+    /// Answers kept for questions asked again.
+    pub answers: Arc<AnswerCache>,
 }
 
 impl AppState {
@@ -86,6 +93,7 @@ impl AppState {
             answer_budget: Arc::new(Semaphore::new(
                 limits.answer_budget_bytes.div_ceil(1024).clamp(1, Semaphore::MAX_PERMITS),
             )),
+            answers: Arc::new(AnswerCache::new(limits.answer_cache_bytes)),
             db,
             limits,
             solver_slots: Arc::new(Semaphore::new(solver_slots.max(1))),

@@ -1,7 +1,8 @@
 //! What every solver endpoint does after reading its request, through the capability seam:
 //! resolve the request's references in the store, solve on the blocking pool under the solver
 //! bound (cancelled when the client goes away or the time limit passes: `AppState::solve`), serialise or write the
-//! program there too, and answer JSON or G-code.
+//! program there too, and answer JSON or G-code. A question asked before is answered from the
+//! answer cache ([`crate::answer_cache`]).
 
 use axum::body::Bytes;
 use axum::http::{HeaderValue, header};
@@ -9,7 +10,8 @@ use axum::response::Response;
 use kerf_solver::capability::{self, Capability, Control, Purpose, Run};
 
 use super::output::Ask;
-use crate::capabilities::{self, Delivered};
+use crate::answer_cache::{AnswerCache, CachedAnswer, Question};
+use crate::capabilities::{self, Catalog, Delivered};
 use crate::error::AppResult;
 use crate::state::{AppState, held_download, pieces_of};
 use crate::store;
@@ -31,6 +33,17 @@ pub async fn answer<C: Capability>(
     if ask.gcode {
         C::check_output(&request, &ask.output)?;
     }
+    // An upload is not part of the question's key, and timings differ from run to run.
+    let question = (state.answers.enabled() && upload.is_none() && !ask.timings)
+        .then(|| question::<C>(&request, &catalog, &ask))
+        .flatten();
+    if let Some(question) = &question {
+        let cached = state.answers.get(question);
+        crate::metrics::answer_cache_lookup(cached.is_some());
+        if let Some(CachedAnswer { bytes, media_type }) = cached {
+            return respond(state, bytes, media_type, HeaderValue::from_static("cache;desc=\"answer cache\""));
+        }
+    }
     let (delivered, seconds) = state
         .solve(move |cancel| {
             let run = Run {
@@ -46,11 +59,29 @@ pub async fn answer<C: Capability>(
         Delivered::Program(program) => (Bytes::from(program), "text/x-gcode; charset=utf-8"),
         Delivered::Json(bytes) => (Bytes::from(bytes), "application/json"),
     };
+    if let Some(question) = question {
+        state.answers.put(question, CachedAnswer { bytes: bytes.clone(), media_type });
+    }
+    let timing = HeaderValue::from_str(&format!("solve;dur={:.1}", seconds * 1e3))
+        .unwrap_or_else(|_| HeaderValue::from_static("solve"));
+    respond(state, bytes, media_type, timing)
+}
+
+/// The answer cache's key: the capability, the request, the stored values it resolved to and
+/// what the client asked for (format and program options). `None` when something does not
+/// serialise (then the request is solved, not cached).
+fn question<C: Capability>(request: &C::Request, catalog: &Catalog, ask: &Ask) -> Option<Question> {
+    let request = serde_json::to_vec(request).ok()?;
+    let found = serde_json::to_vec(&(&catalog.tools, &catalog.machines, &catalog.materials)).ok()?;
+    let asked = format!("{ask:?}");
+    Some(AnswerCache::question(&[C::NAME.as_bytes(), &request, &found, asked.as_bytes()]))
+}
+
+/// The answer's bytes as a response held against the memory budget.
+fn respond(state: &AppState, bytes: Bytes, media_type: &'static str, timing: HeaderValue) -> AppResult<Response> {
     let length = bytes.len();
     let mut response = held_download(state.reserve_memory(length)?, pieces_of(bytes), length, media_type);
-    if let Ok(value) = HeaderValue::from_str(&format!("solve;dur={:.1}", seconds * 1e3)) {
-        response.headers_mut().insert("server-timing", value);
-    }
+    response.headers_mut().insert("server-timing", timing);
     response.headers_mut().insert(header::VARY, HeaderValue::from_static("accept"));
     Ok(response)
 }

@@ -1,5 +1,6 @@
 //! Loopback tests: the real service on 127.0.0.1:0 with a temporary SQLite file, over HTTP.
 
+mod answer_cache;
 mod arcs;
 mod auth;
 mod bad_requests;
