@@ -70,6 +70,17 @@ fn point(field: &str, coordinates: &[f64]) -> Result<Vec3, SolverError> {
 /// Points of one list, all with the dimension of the first.
 fn points(field: &str, list: &[Vec<f64>]) -> Result<(Vec<Vec3>, usize), SolverError> {
     let dimension = list.first().map_or(2, Vec::len);
+    // Field names are formatted only when a point is refused: a 100 000-point polyline would
+    // otherwise spend longer naming its points than segmenting them.
+    let valid = |coordinates: &Vec<f64>| {
+        coordinates.len() == dimension
+            && (2..=3).contains(&dimension)
+            && coordinates.iter().all(|value| value.is_finite() && value.abs() <= MAX_COORDINATE)
+    };
+    if list.iter().all(valid) {
+        let point = |c: &Vec<f64>| Vec3::new(c[0], c[1], c.get(2).copied().unwrap_or(0.0));
+        return Ok((list.iter().map(point).collect(), dimension));
+    }
     let mut out = Vec::with_capacity(list.len());
     for (index, coordinates) in list.iter().enumerate() {
         let path = format!("{field}[{index}]");

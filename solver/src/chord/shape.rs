@@ -127,23 +127,50 @@ impl Spline {
 }
 
 impl Polyline {
-    /// Index of the edge holding arc length `s`.
+    /// Index of the edge holding arc length `s`: the last station at or before `s` (the last
+    /// edge beyond the end). Gallops from the previous answer and bisects inside the bracket
+    /// found, so nearby lookups (a chord's ends, a radius's three points) cost a few steps
+    /// instead of a search of the whole list.
     fn edge(&self, s: f64) -> usize {
+        let stations = &self.stations;
         let last_edge = self.vertices.len().saturating_sub(2);
-        let hint = self.last_edge.get();
-        for k in [hint, hint + 1] {
-            if k < last_edge && self.stations[k] <= s && s < self.stations[k + 1] {
-                self.last_edge.set(k);
-                return k;
+        let hint = self.last_edge.get().min(stations.len().saturating_sub(1));
+        // Invariant: stations[..below] <= s and stations[above..] > s.
+        let (mut below, mut above) = (0, stations.len());
+        let mut step = 1;
+        if stations.get(hint).is_some_and(|&x| x <= s) {
+            below = hint;
+            while below + step < stations.len() {
+                if stations[below + step] > s {
+                    above = below + step;
+                    break;
+                }
+                below += step;
+                step *= 2;
+            }
+        } else {
+            above = hint;
+            while above >= step {
+                if stations[above - step] <= s {
+                    below = above - step;
+                    break;
+                }
+                above -= step;
+                step *= 2;
             }
         }
-        let k = self.stations.partition_point(|&x| x <= s).saturating_sub(1).min(last_edge);
+        let at_or_before = below + stations[below..above].partition_point(|&x| x <= s);
+        let k = at_or_before.saturating_sub(1).min(last_edge);
         self.last_edge.set(k);
         k
     }
 
     fn point(&self, s: f64) -> Vec3 {
-        let k = self.edge(s);
+        self.point_on(self.edge(s), s)
+    }
+
+    /// The point at arc length `s` on edge `k` (the edge holding `s`).
+    fn point_on(&self, k: usize, s: f64) -> Vec3 {
         let (Some(a), Some(b), Some(&s0), Some(&s1)) =
             (self.vertices.get(k), self.vertices.get(k + 1), self.stations.get(k), self.stations.get(k + 1))
         else {
@@ -354,10 +381,18 @@ impl Shape {
                 2.0 * arc.radius * quarter.sin().powi(2)
             }
             Self::Polyline(line) => {
-                let (a, b) = (line.point(ua), line.point(ub));
                 let (lo, hi) = (ua.min(ub), ua.max(ub));
-                // The first vertex strictly after lo: the end of lo's edge (from the hint).
+                // lo's edge from the hint (the search keeps a chord's start and moves its end);
+                // hi's edge forward from it over the chord's few vertices, so that the end's
+                // lookup neither searches the whole list nor moves the hint away from the start.
                 let k = line.edge(lo);
+                let mut k_hi = k;
+                while k_hi + 2 < line.vertices.len() && line.stations[k_hi + 1] <= hi {
+                    k_hi += 1;
+                }
+                let (k_a, k_b) = if ua <= ub { (k, k_hi) } else { (k_hi, k) };
+                let (a, b) = (line.point_on(k_a, ua), line.point_on(k_b, ub));
+                // The first vertex strictly after lo: the end of lo's edge.
                 let first = if line.stations[k] <= lo && line.stations.get(k + 1).is_some_and(|&x| x > lo) {
                     k + 1
                 } else {
@@ -707,5 +742,55 @@ mod tests {
         assert_relative_eq!(line.deviation(0.0, 2.0 * first), 0.2, max_relative = 1e-15);
         assert_eq!(line.corners(10f64.to_radians()), vec![first]);
         assert!(line.corners(30f64.to_radians()).is_empty());
+    }
+
+    /// The galloping edge lookup finds what a search of the whole list finds, and the
+    /// deviation's own edge walk gives, bit for bit, what looking up both ends afresh and
+    /// scanning every vertex gives: on a wavy line with repeated vertices, for chords in both
+    /// directions, starting anywhere, with the hint left anywhere.
+    #[test]
+    fn polyline_deviation_walk_equals_a_fresh_lookup() {
+        let mut vertices: Vec<Vec3> = (0..400)
+            .map(|k| {
+                let t = f64::from(k) * 0.05;
+                Vec3::new(t, (3.0 * t).sin() * 0.3, 0.0)
+            })
+            .collect();
+        vertices.insert(100, vertices[100]); // a zero-length edge
+        let mut stations = vec![0.0];
+        for pair in vertices.windows(2) {
+            stations.push(stations.last().unwrap() + (pair[1] - pair[0]).norm());
+        }
+        let total = *stations.last().unwrap();
+        let line =
+            Polyline { vertices: vertices.clone(), stations: stations.clone(), last_edge: std::cell::Cell::new(0) };
+        let shape = Shape::Polyline(line);
+        let Shape::Polyline(line) = &shape else { unreachable!() };
+        let fresh_point = |s: f64| {
+            let k = stations.partition_point(|&x| x <= s).saturating_sub(1).min(vertices.len() - 2);
+            line.point_on(k, s)
+        };
+        let mut seed = 12_345_u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..2000 {
+            let s = (next() - 0.01) * total * 1.02;
+            line.last_edge.set((next() * 402.0) as usize);
+            let whole = stations.partition_point(|&x| x <= s).saturating_sub(1).min(vertices.len() - 2);
+            assert_eq!(line.edge(s), whole, "{s}");
+            let ua = next() * total * 1.01;
+            let ub = (ua + (next() - 0.3) * 3.0).clamp(0.0, total * 1.01);
+            line.last_edge.set((next() * 400.0) as usize);
+            let (a, b) = (fresh_point(ua), fresh_point(ub));
+            let (lo, hi) = (ua.min(ub), ua.max(ub));
+            let expected = vertices
+                .iter()
+                .zip(&stations)
+                .filter(|&(_, &station)| station > lo && station < hi)
+                .fold(0.0_f64, |worst, (vertex, _)| worst.max(distance_to_segment(vertex, &a, &b)));
+            assert_eq!(shape.deviation(ua, ub).to_bits(), expected.to_bits(), "{ua} {ub}");
+        }
     }
 }
