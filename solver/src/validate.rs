@@ -59,7 +59,11 @@ pub fn optional_positive(field: &str, value: Option<f64>, default: f64) -> Resul
 /// Checks every coordinate of `point` is finite and within ±`limit`, naming `field[axis]`.
 pub fn point<const N: usize>(field: &str, point: [f64; N], limit: f64) -> Result<[f64; N], SolverError> {
     for (axis, value) in point.iter().enumerate() {
-        within(&format!("{field}[{axis}]"), *value, limit)?;
+        // The name is formatted only for a refusal: long point lists are checked by the
+        // thousand.
+        if !(value.is_finite() && value.abs() <= limit) {
+            within(&format!("{field}[{axis}]"), *value, limit)?;
+        }
     }
     Ok(point)
 }
