@@ -59,30 +59,43 @@ pub struct Warning {
     pub message: String,
 }
 
-/// A warning read back (the parts of a split request). Its code is kept once per distinct code
-/// for the life of the process: the codes are a small fixed set.
+/// A warning read back (the parts of a split request).
 impl<'de> Deserialize<'de> for Warning {
     fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
         #[derive(Deserialize)]
         struct Read {
-            code: String,
+            #[serde(deserialize_with = "interned")]
+            code: Name,
             message: String,
         }
-        static CODES: std::sync::Mutex<Vec<&'static str>> = std::sync::Mutex::new(Vec::new());
         let Read { code, message } = Read::deserialize(deserializer)?;
-        let mut codes = CODES.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-        let code = match codes.iter().find(|known| **known == code) {
-            Some(known) => known,
-            None if codes.len() >= 1000 => {
-                return Err(serde::de::Error::custom("more distinct warning codes than kerf has"));
-            }
-            None => {
-                let known: &'static str = Box::leak(code.into_boxed_str());
-                codes.push(known);
-                known
-            }
-        };
         Ok(Self { code, message })
+    }
+}
+
+/// A name from a small fixed set (a warning's code, a deburr point's segment). Spelled as an
+/// alias so that serde's derive, which borrows a field typed `&str` from the input, reads it with
+/// [`interned`] instead.
+pub(crate) type Name = &'static str;
+
+/// A [`Name`] read back (a warning's code, a deburr point's segment: the parts of a split
+/// request). Each distinct text is kept once for the life of the process: they are names from a
+/// small fixed set.
+///
+/// # Errors
+/// When the text is not a string, or past 1000 distinct texts.
+pub(crate) fn interned<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<&'static str, D::Error> {
+    static KNOWN: std::sync::Mutex<Vec<&'static str>> = std::sync::Mutex::new(Vec::new());
+    let text = String::deserialize(deserializer)?;
+    let mut known = KNOWN.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    match known.iter().find(|name| **name == text) {
+        Some(name) => Ok(name),
+        None if known.len() >= 1000 => Err(serde::de::Error::custom("more distinct names than kerf has")),
+        None => {
+            let name: &'static str = Box::leak(text.into_boxed_str());
+            known.push(name);
+            Ok(name)
+        }
     }
 }
 

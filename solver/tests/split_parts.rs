@@ -2,43 +2,22 @@
 //! apart, passing their outputs through JSON as the job store does, and finishing gives the
 //! answer and program of solving the request whole, byte for byte.
 
+#[path = "split_support/mod.rs"]
+mod split_support;
 #[path = "predict_support/mod.rs"]
 mod support;
 
-use kerf_solver::capability::{self, Capability, OutputOptions, PartSink, PartSource, Resolved, Run, Sizing, Split};
-use kerf_solver::engagement::{EngagementCapability, EngagementRequest};
-use kerf_solver::machine::MachineProfile;
+use kerf_solver::capability::{self, Capability, OutputOptions, Part, Purpose, Resolved, Run, Sizing, Split};
+use kerf_solver::corners::ContourCapability;
+use kerf_solver::deburr::DeburrCapability;
+use kerf_solver::engagement::EngagementCapability;
 use kerf_solver::predict::{CorrectionOptions, Method, PredictCapability, PredictRequest};
 use kerf_solver::tool::Tool;
-use serde::Serialize;
-use serde::de::DeserializeOwned;
-
-/// Parts' outputs as JSON text, as the job store keeps them.
-#[derive(Default)]
-struct Texts(Vec<String>, usize);
-
-impl PartSink for Texts {
-    fn put<T: Serialize>(&mut self, value: &T) -> Result<(), kerf_solver::SolverError> {
-        self.0.push(serde_json::to_string(value).unwrap());
-        Ok(())
-    }
-}
-
-impl PartSource for Texts {
-    fn count(&self) -> usize {
-        self.0.len()
-    }
-
-    fn next_part<T: DeserializeOwned>(&mut self) -> Option<Result<T, kerf_solver::SolverError>> {
-        let text = self.0.get(self.1)?;
-        self.1 += 1;
-        Some(Ok(serde_json::from_str(text).unwrap()))
-    }
-}
-
-fn context(tool: &Tool) -> Resolved<Tool> {
-    Resolved { tool: tool.clone(), machine: None, material: None, other_tools: Vec::new() }
-}
+use proptest::prelude::*;
+use serde_json::json;
+use split_support::{
+    Texts, context, contour_context, contour_request, deburr_context, deburr_request, engagement_request,
+};
 
 /// Splits into parts of `part_seconds`, solves them apart and finishes: the answer's JSON and
 /// program, and how many parts there were.
@@ -100,31 +79,6 @@ fn what_is_not_split() {
     assert!(split_and_finish(&request, &tool, 1e-3).is_none());
 }
 
-/// Three candidate paths through a 60 × 40 mm block, cut by a 4-flute Ø10 end mill at 2 mm a_p
-/// with Kienzle forces, on a machine with a block time and accelerations (blocks, cycle time).
-fn engagement_request(step: f64) -> (EngagementRequest, Tool, MachineProfile) {
-    let request = serde_json::from_value(serde_json::json!({
-        "tool": 1, "machine": "mill",
-        "stock": {"polygon": [[0, 0], [60, 0], [60, 40], [0, 40]]},
-        "paths": [
-            {"name": "straight", "path": [[-10, 20], [70, 20]]},
-            {"name": "zig-zag", "path": [[-10, 5], [70, 5], [70, 15], [-10, 15], [-10, 25], [70, 25]]},
-            {"name": "deeper", "path": [[-10, 30], [35, 20], [70, 35]], "axial_depth": 3},
-        ],
-        "spindle_rpm": 8000, "feed_per_tooth": 0.05, "flute_counts": [2, 3, 4],
-        "thickness_limit": 0.08, "step": step, "kienzle": {"kc11": 1800, "mc": 0.25}, "axial_depth": 2,
-        "candidate": 1,
-    }))
-    .unwrap();
-    let mut tool = Tool::new(kerf_solver::tool::ToolKind::Flat, 5.0);
-    tool.flutes = 4;
-    let machine = serde_json::from_value(serde_json::json!({
-        "name": "mill", "block_time_ms": 4, "max_feed": 12000, "max_accel": 2000, "dialect": "linuxcnc"
-    }))
-    .unwrap();
-    (request, tool, machine)
-}
-
 #[test]
 fn engagement_candidates_split_into_parts_are_the_whole_comparison() {
     let (request, tool, machine) = engagement_request(0.05);
@@ -160,98 +114,181 @@ fn engagement_candidates_split_into_parts_are_the_whole_comparison() {
     assert!(EngagementCapability::split(&request, &context(), &Sizing { part_seconds: 1e6, max_parts: 16 }).is_none());
 }
 
-/// Process CPU time (user + system) in seconds, from /proc (0 where unavailable).
-fn cpu_seconds() -> f64 {
-    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else { return 0.0 };
-    let Some(rest) = stat.rsplit(')').next() else { return 0.0 };
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |i: usize| fields.get(i).and_then(|f| f.parse::<f64>().ok()).unwrap_or(0.0);
-    (ticks(11) + ticks(12)) / 100.0
+/// A job's run: what a worker solves with.
+fn job_run() -> Run<'static> {
+    Run { purpose: Purpose::Job, ..Run::default() }
 }
 
-/// The measurements behind predict's cost model (`solver/src/predict/capability.rs`, README "More
-/// than one machine"): core-seconds of the setup every part repeats (per pass of the path), of a
-/// predicted pass by method, N and with or without the force model, and of the finish step (per
-/// pass), on one thread of the seed's 103 041-pass raster. CPU time, so a shared machine's load
-/// matters less than to wall time.
-///
-/// `cargo test --release -p kerf-solver --test split_parts -- --ignored --nocapture cost_model`
-#[test]
-#[ignore = "a measurement, minutes long: run it in release builds"]
-fn cost_model() {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-    let slice = 2000;
-    let measure = |label: &str, request: &PredictRequest, tool: &Tool, count: usize| {
-        let (started, cpu) = (std::time::Instant::now(), cpu_seconds());
-        pool.install(|| PredictCapability::solve(request, context(tool), &Run::default()).unwrap());
-        let (wall, cpu) = (started.elapsed().as_secs_f64(), cpu_seconds() - cpu);
-        eprintln!("{label}: {cpu:.3} s CPU ({wall:.3} s wall), {:.3e} core-s per unit of {count}", cpu / count as f64);
-        cpu
-    };
-    // The seed's job is the same raster at a 0.29963 mm pick and step (286 225 passes): three
-    // times the passes around each one.
-    for (method, resolution, cutting, pick) in [
-        (Method::Sampling, 256, true, 0.5),
-        (Method::Sampling, 256, false, 0.5),
-        (Method::Sampling, 128, true, 0.5),
-        (Method::Sampling, 512, true, 0.5),
-        (Method::DepthBuffer, 256, true, 0.5),
-        (Method::DepthBuffer, 128, true, 0.5),
-        (Method::Sampling, 256, true, 0.29963),
-        (Method::Sampling, 256, true, 1.0),
-        (Method::DepthBuffer, 256, true, 0.29963),
-    ] {
-        let (mut request, tool, moves) = support::raster_request(160.0, pick, pick, method, resolution);
-        if !cutting {
-            request.cutting = None;
-        }
-        let middle = moves / 2;
-        request.pass_range = Some([middle, middle]);
-        let setup = measure(&format!("setup, {moves} passes"), &request, &tool, moves);
-        request.pass_range = Some([middle, middle + slice]);
-        let total =
-            measure(&format!("{method:?} N = {resolution}, force {cutting}, pick {pick}"), &request, &tool, slice);
-        eprintln!("  per pass without the setup: {:.3e} core-s", (total - setup) / slice as f64);
-    }
-    // Engagement: core-seconds per sample of the exact engine, per flute count.
-    for counts in [vec![2], vec![2, 3, 4]] {
-        let (mut request, tool, machine) = engagement_request(0.005);
-        request.flute_counts = Some(counts.clone());
-        let context = Resolved { tool: tool.clone(), machine: Some(machine), material: None, other_tools: Vec::new() };
-        let (started, cpu) = (std::time::Instant::now(), cpu_seconds());
-        let answer = pool.install(|| EngagementCapability::solve(&request, context, &Run::default()).unwrap());
-        let cpu = cpu_seconds() - cpu;
-        let samples: usize = answer.result.candidates().iter().map(|c| c.samples.len()).sum();
-        eprintln!(
-            "engagement, exact, {} flute counts: {samples} samples, {cpu:.3} s CPU ({:.3} s wall), {:.3e} core-s per \
-             sample and flute count",
-            counts.len(),
-            started.elapsed().as_secs_f64(),
-            cpu / (samples * counts.len()) as f64
-        );
-    }
-    // The finish step: the whole path's passes merged (all `not_predicted` but one slice, which
-    // costs the same to merge), corrected and written as a program.
-    let (request, tool, moves) = support::raster_request(160.0, 0.5, 0.5, Method::Sampling, 64);
-    let parts = PredictCapability::split(&request, &context(&tool), &Sizing { part_seconds: 1e9, max_parts: 2 })
-        .map_or(0, |split| split.parts.len());
-    eprintln!("(sizing at one part: {parts} parts)");
+/// The program of `answer`, or why there is none (a tilted wall's contour has none: only its
+/// JSON answer carries the axes).
+fn program_of<C: Capability>(request: &C::Request, answer: &C::Answer) -> String {
+    capability::program::<C>(request, answer, &OutputOptions::default()).unwrap_or_else(|error| format!("{error:?}"))
+}
+
+/// The answer's JSON and program of solving `request` whole, as one process runs a job.
+fn whole_of<C: Capability>(request: &C::Request, context: &Resolved<C::Tool>) -> (String, String)
+where
+    Resolved<C::Tool>: Clone,
+{
+    let answer = C::solve(request, context.clone(), &job_run()).unwrap();
+    (serde_json::to_string(&answer).unwrap(), program_of::<C>(request, &answer))
+}
+
+/// The answer's JSON and program of solving `parts` of `request` apart (their outputs through
+/// JSON, as the job store passes them on through CBOR) and finishing.
+fn parts_of<C: Capability>(request: &C::Request, context: &Resolved<C::Tool>, parts: &[Part]) -> (String, String)
+where
+    Resolved<C::Tool>: Clone,
+{
     let mut texts = Texts::default();
-    let part = kerf_solver::capability::Part { units: 0..moves, seconds: 0.0 };
-    pool.install(|| PredictCapability::solve_part(&request, context(&tool), &part, &Run::default(), &mut texts))
-        .unwrap();
-    let (started, cpu) = (std::time::Instant::now(), cpu_seconds());
-    let answer = pool.install(|| {
-        let answer = PredictCapability::finish(&request, context(&tool), &mut texts, &Run::default()).unwrap();
-        let program = capability::program::<PredictCapability>(&request, &answer, &OutputOptions::default()).unwrap();
-        (serde_json::to_vec(&answer).unwrap().len(), program.len())
-    });
-    let cpu = cpu_seconds() - cpu;
-    eprintln!(
-        "finish, {moves} passes: {cpu:.3} s CPU ({:.3} s wall), {:.3e} core-s per pass; answer {} MB, program {} MB",
-        started.elapsed().as_secs_f64(),
-        cpu / moves as f64,
-        answer.0 / 1_000_000,
-        answer.1 / 1_000_000
+    for part in parts {
+        C::solve_part(request, context.clone(), part, &job_run(), &mut texts).unwrap();
+    }
+    let answer = C::finish(request, context.clone(), &mut texts, &job_run()).unwrap();
+    (serde_json::to_string(&answer).unwrap(), program_of::<C>(request, &answer))
+}
+
+/// Splits at `part_seconds` and asserts the merged answer and program are the whole ones; the
+/// number of parts.
+fn assert_split_is_whole<C: Capability>(
+    label: &str,
+    request: &C::Request,
+    context: &Resolved<C::Tool>,
+    part_seconds: f64,
+) -> usize
+where
+    Resolved<C::Tool>: Clone,
+{
+    let Split { parts, finish_seconds } = C::split(request, context, &Sizing { part_seconds, max_parts: 1000 })
+        .unwrap_or_else(|| panic!("{label}: splits at {part_seconds} core-s"));
+    assert!(parts.len() >= 2 && finish_seconds > 0.0, "{label}: {} parts", parts.len());
+    assert!(parts.windows(2).all(|pair| pair[0].units.end == pair[1].units.start), "{label}: consecutive parts");
+    let (json, program) = whole_of::<C>(request, context);
+    let (split_json, split_program) = parts_of::<C>(request, context, &parts);
+    assert!(split_json == json, "{label}: the merged answer differs from the whole one ({} parts)", parts.len());
+    assert!(split_program == program, "{label}: the merged program differs from the whole one");
+    parts.len()
+}
+
+/// `units` cut at the sorted, distinct `cuts` (each within it) into consecutive parts.
+fn cut(units: usize, cuts: &[usize]) -> Vec<Part> {
+    let mut bounds: Vec<usize> = cuts.iter().map(|c| c % units.max(1)).filter(|&c| c > 0).collect();
+    bounds.sort_unstable();
+    bounds.dedup();
+    bounds.insert(0, 0);
+    bounds.push(units);
+    bounds.windows(2).map(|pair| Part { units: pair[0]..pair[1], seconds: 1.0 }).collect()
+}
+
+#[test]
+fn contour_layers_split_into_parts_are_the_whole_contour() {
+    let cases = [
+        // Layers repeat the first one's plan: only many split, into parts ten times the plan.
+        ("arrow", contour_request(1, json!({"depths": {"top": 0, "bottom": -9, "step": 0.02}})), false),
+        ("tilted walls", contour_request(9, json!({"tilt_deg": 3})), false),
+        ("ramped, on a machine", contour_request(10, json!({"machine": "mill", "ramp_angle_deg": 3})), true),
+        (
+            "lead shortened",
+            contour_request(
+                1,
+                json!({"side": "inside", "lead": 100, "depths": {"top": 0, "bottom": -6, "step": 0.02}}),
+            ),
+            false,
+        ),
+    ];
+    for (label, request, machine) in cases {
+        let context = contour_context(machine);
+        for part_seconds in [1e-6, 1e-3] {
+            assert_split_is_whole::<ContourCapability>(label, &request, &context, part_seconds);
+        }
+        let answer = ContourCapability::solve(&request, context.clone(), &job_run()).unwrap();
+        let shortened = answer.result.warnings.iter().any(|w| w.code == "W_LEAD_SHORTENED");
+        assert_eq!(shortened, label == "lead shortened", "{label}");
+        assert!(ContourCapability::split(&request, &context, &Sizing { part_seconds: 1e6, max_parts: 1000 }).is_none());
+    }
+    // A refused contour is solved whole, which reports why.
+    let refused = contour_request(5, json!({"feed": -1}));
+    assert!(
+        ContourCapability::split(&refused, &contour_context(false), &Sizing { part_seconds: 1e-9, max_parts: 9 })
+            .is_none()
     );
+}
+
+#[test]
+fn deburr_loops_split_into_parts_are_the_whole_deburring() {
+    // Holes up, down (turned, M00) and sideways, out of order along the tube.
+    let holes = [(5.0, 0.0, 0.0), (4.0, 180.0, 40.0), (5.0, 90.0, 80.0), (3.0, 170.0, 10.0), (4.0, 10.0, 120.0)];
+    let cases = [
+        ("outer edges", deburr_request(&holes, "outer", json!({})), deburr_context(None, false)),
+        (
+            "both edges, an inner tool, a machine",
+            deburr_request(&holes, "both", json!({"inner_tool": 8, "machine": "mill"})),
+            deburr_context(Some(2.0), true),
+        ),
+        ("exact method", deburr_request(&holes[..3], "inner", json!({"method": "exact"})), deburr_context(None, false)),
+    ];
+    for (label, request, context) in cases {
+        for part_seconds in [1e-9, 1e-3] {
+            assert_split_is_whole::<DeburrCapability>(label, &request, &context, part_seconds);
+        }
+        assert!(DeburrCapability::split(&request, &context, &Sizing { part_seconds: 1e6, max_parts: 1000 }).is_none());
+    }
+    // A pattern's copies split too; one hole does not.
+    let mut pattern = deburr_request(
+        &[],
+        "outer",
+        json!({"hole": {"shape": "slot", "radius": 3, "centre_distance": 6}, "pattern": {"around_deg": [0, 120, 240], "pitch": 30, "count": 2}}),
+    );
+    pattern.holes = None;
+    assert_split_is_whole::<DeburrCapability>("pattern", &pattern, &deburr_context(None, false), 1e-9);
+    let mut one = pattern.clone();
+    one.pattern = None;
+    assert!(
+        DeburrCapability::split(&one, &deburr_context(None, false), &Sizing { part_seconds: 1e-9, max_parts: 9 })
+            .is_none()
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 12, ..ProptestConfig::default() })]
+
+    /// Any number of layers cut anywhere into parts merges into the whole contour.
+    #[test]
+    fn contour_parts_cut_anywhere_are_the_whole(
+        layers in 1usize..14,
+        cuts in proptest::collection::vec(0usize..100, 0..6),
+        tilted in any::<bool>(),
+        machine in any::<bool>(),
+    ) {
+        let extra = if tilted { json!({"tilt_deg": 2}) } else if machine { json!({"machine": "mill"}) } else { json!({}) };
+        let request = contour_request(layers, extra);
+        let context = contour_context(machine && !tilted);
+        let parts = cut(layers, &cuts);
+        let (json, program) = whole_of::<ContourCapability>(&request, &context);
+        let (split_json, split_program) = parts_of::<ContourCapability>(&request, &context, &parts);
+        prop_assert!(split_json == json, "{} parts of {layers} layers", parts.len());
+        prop_assert!(split_program == program);
+    }
+
+    /// Any list of holes cut anywhere into parts merges into the whole deburring, visiting
+    /// order, turns and tool change included.
+    #[test]
+    fn deburr_parts_cut_anywhere_are_the_whole(
+        holes in proptest::collection::vec((3.0f64..6.0, prop_oneof![Just(0.0), Just(90.0), Just(180.0), -60.0f64..60.0], 0.0f64..200.0), 1..7),
+        cuts in proptest::collection::vec(0usize..100, 0..6),
+        both in any::<bool>(),
+    ) {
+        let (edge, extra, inner) = if both { ("both", json!({"inner_tool": 8}), Some(2.0)) } else { ("outer", json!({}), None) };
+        // Holes far enough apart along the tube not to meet.
+        let holes: Vec<(f64, f64, f64)> =
+            holes.iter().enumerate().map(|(i, &(r, a, along))| (r, a, (along / 20.0).floor() * 20.0 + 200.0 * i as f64)).collect();
+        let request = deburr_request(&holes, edge, extra);
+        let context = deburr_context(inner, false);
+        let loops = holes.len() * if both { 2 } else { 1 };
+        let parts = cut(loops, &cuts);
+        let (json, program) = whole_of::<DeburrCapability>(&request, &context);
+        let (split_json, split_program) = parts_of::<DeburrCapability>(&request, &context, &parts);
+        prop_assert!(split_json == json, "{} parts of {loops} loops", parts.len());
+        prop_assert!(split_program == program);
+    }
 }

@@ -1,14 +1,14 @@
 //! What a contour request answers (api.md, Contour: `layers`, `corners`, `warnings`, plus the
 //! per-pass figures and a summary).
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::request::{CutDirection, Join, LoopStyle, Relief, Side};
 use crate::error::Warning;
 use crate::tool::ToolKind;
 
 /// What a move does.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum MoveKind {
@@ -23,7 +23,7 @@ pub enum MoveKind {
 }
 
 /// One move of the tool tip (the programmed point with the length offset to the tip).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct ContourMove {
     /// `cut`, `loop`, `link` or `rapid`.
@@ -57,7 +57,7 @@ pub struct ContourLayer {
 /// Under the block-time rule the move before `first` may have been lengthened to the first
 /// circumscribed vertex (and the arc's last chord joined to the move after it): the exact
 /// `start` and `end` lie on those straight moves.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub(crate) struct ArcSpan {
     pub first: usize,
     pub last: usize,

@@ -8,7 +8,10 @@ use serde::{Deserialize, Serialize};
 use super::detect::{self, DetectMode, MaterialSide, PathLoopAnswer, PathLoopRequest};
 use super::request::MAX_MOVES;
 use super::{ContourAnswer, ContourRequest, CornerLoop};
-use crate::capability::{Capability, Control, Endpoint, OutputOptions, Purpose, Refs, Resolved, Run};
+use crate::capability::{
+    Capability, Control, Endpoint, OutputOptions, Part, PartSink, PartSource, Purpose, Refs, Resolved, Run, Sizing,
+    Split,
+};
 use crate::error::{SolverError, Warning};
 use crate::machine::MachineProfile;
 use crate::tool::{Tool, ToolRef};
@@ -63,6 +66,34 @@ impl Capability for ContourCapability {
         let max_moves = if run.purpose == Purpose::Json { MAX_JSON_MOVES } else { MAX_MOVES };
         let result = super::solve_with(request, &context.tool, context.machine.as_ref(), max_moves, run.control);
         let result = if run.purpose == Purpose::Json { result.map_err(json_limit_advice)? } else { result? };
+        Ok(ContourResult { tool: context.tool, machine: context.machine, result })
+    }
+
+    /// Ranges of layers of about `sizing.part_seconds` each (`parts`): a job's contour only,
+    /// which may hold up to [`MAX_MOVES`] moves.
+    fn split(request: &ContourRequest, context: &Resolved<Tool>, sizing: &Sizing) -> Option<Split> {
+        super::parts::split(request, &context.tool, context.machine.as_ref(), sizing)
+    }
+
+    /// The moves of the layers of `part`.
+    fn solve_part(
+        request: &ContourRequest,
+        context: Resolved<Tool>,
+        part: &Part,
+        run: &Run<'_>,
+        sink: &mut impl PartSink,
+    ) -> Result<(), SolverError> {
+        super::parts::solve_part(request, &context.tool, context.machine.as_ref(), part, run.control, sink)
+    }
+
+    /// Every layer's moves, answered as `solve` answers a job.
+    fn finish(
+        request: &ContourRequest,
+        context: Resolved<Tool>,
+        parts: &mut impl PartSource,
+        run: &Run<'_>,
+    ) -> Result<ContourResult, SolverError> {
+        let result = super::parts::finish(request, &context.tool, context.machine.as_ref(), parts, run.control)?;
         Ok(ContourResult { tool: context.tool, machine: context.machine, result })
     }
 

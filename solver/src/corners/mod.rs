@@ -24,7 +24,8 @@
 //! * [`detect`]: corner detection on an existing CL point list (§3.4, claims 8–9), and loops
 //!   added to such a path ([`detect::loop_path`]);
 //! * [`program`](mod@program): G-code;
-//! * `blocks`: with `block_time_ms`, the block figures of the answer (issue 3).
+//! * `blocks`: with `block_time_ms`, the block figures of the answer (issue 3);
+//! * `parts`: a job's layers split into ranges that several workers make at once (issue 12).
 //!
 //! Choices where the spec is open (see also the module docs):
 //! * `direction` `climb` (default) puts the material on the right of travel (σ = −1);
@@ -64,6 +65,7 @@ mod layer;
 pub mod loops;
 pub mod material;
 mod offset;
+mod parts;
 mod pass;
 mod prepare;
 pub mod program;

@@ -123,140 +123,221 @@ pub fn solve_with(
     max_moves: usize,
     control: Control<'_>,
 ) -> Result<ContourAnswer, SolverError> {
-    let max_moves = max_moves.min(MAX_MOVES);
-    let job = request.validate(tool, machine)?;
-    let setup = Setup::new(&job);
-    let first_z = job.layers.first().copied().unwrap_or(job.bottom);
-    let first_layer = build_layer(&job, &setup, first_z)?;
-    let first_passes = plan_passes(&job, &setup, &first_layer)?;
-    let per_layer = layer_move_count(&first_passes, &job.chording);
-    let total = per_layer.saturating_mul(job.layers.len());
-    if total > max_moves {
-        return Err(too_many_moves(job.layers.len(), per_layer, total, max_moves));
-    }
-    if job.tilt.is_some() && job.layers.len().saturating_mul(first_layer.len()) > MAX_TILTED_VERTEX_LAYERS {
-        return Err(SolverError::new(
-            ErrorCode::TooManyMoves,
-            format!(
-                "tilted walls plan every layer: {} layers × {} corners exceed {MAX_TILTED_VERTEX_LAYERS}",
-                job.layers.len(),
-                first_layer.len()
-            ),
-        )
-        .at("depths.step"));
-    }
+    let prepared = Prepared::new(request, tool, machine, max_moves)?;
+    let layers = prepared.layers(0..prepared.job.layers.len(), control)?;
+    prepared.answer(machine, max_moves, layers)
+}
 
-    let mut warnings = job.warnings.clone();
-    for pass in &first_passes {
-        warnings.extend(pass.warnings.iter().cloned());
-    }
-    let mut layers = Vec::with_capacity(job.layers.len());
-    let mut lead_used = job.lead;
-    let mut shortened = false;
-    let mut previous_z = job.top;
-    for (index, &z) in job.layers.iter().enumerate() {
-        control.check()?;
-        control.report(index, job.layers.len());
-        let tilted;
-        let (layer, passes) = if index == 0 || job.tilt.is_none() {
-            (&first_layer, &first_passes)
-        } else {
-            let layer = build_layer(&job, &setup, z)?;
-            let passes = plan_passes(&job, &setup, &layer)?;
-            tilted = (layer, passes);
-            (&tilted.0, &tilted.1)
-        };
-        let lead_point = lead_point(&job, layer, passes);
-        let lead = lead_point.map_or(0.0, |(_, lead)| lead);
-        if lead < job.lead {
-            shortened = true;
+/// What every layer of a contour is made from: the validated job, how it travels the contour,
+/// and the first layer with its passes (every layer's, unless the walls are tilted). Solving
+/// whole or in layer ranges (a job split into parts) makes it the same way.
+pub(crate) struct Prepared {
+    pub(crate) job: Job,
+    setup: Setup,
+    first_layer: Layer,
+    first_passes: Vec<PassPlan>,
+}
+
+/// One layer's moves and the lead its passes start from (0 without a lead point).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub(crate) struct LayerMoves {
+    pub(crate) z: f64,
+    pub(crate) moves: Vec<ContourMove>,
+    pub(crate) arcs: Vec<ArcSpan>,
+    pub(crate) lead: f64,
+}
+
+impl Prepared {
+    /// Validates the request and plans the first layer; refuses a contour over `max_moves` (at
+    /// most [`MAX_MOVES`]) before any other layer is made.
+    ///
+    /// # Errors
+    /// As [`solve`].
+    pub(crate) fn new(
+        request: &ContourRequest,
+        tool: &Tool,
+        machine: Option<&MachineProfile>,
+        max_moves: usize,
+    ) -> Result<Self, SolverError> {
+        let max_moves = max_moves.min(MAX_MOVES);
+        let job = request.validate(tool, machine)?;
+        let setup = Setup::new(&job);
+        let first_z = job.layers.first().copied().unwrap_or(job.bottom);
+        let first_layer = build_layer(&job, &setup, first_z)?;
+        let first_passes = plan_passes(&job, &setup, &first_layer)?;
+        let per_layer = layer_move_count(&first_passes, &job.chording);
+        let total = per_layer.saturating_mul(job.layers.len());
+        if total > max_moves {
+            return Err(too_many_moves(job.layers.len(), per_layer, total, max_moves));
         }
-        lead_used = lead_used.min(lead);
-        let (moves, arcs) =
-            layer_moves(&job, layer, passes, lead_point.map(|(point, _)| point), index == 0, previous_z, z);
-        layers.push(ContourLayer { z, moves, arcs });
-        previous_z = z;
-    }
-    if shortened {
-        warnings.push(Warning::new(
-            "W_LEAD_SHORTENED",
-            format!("the lead of {} mm would gouge the contour; {lead_used:.4} mm is used", job.lead),
-        ));
+        if job.tilt.is_some() && job.layers.len().saturating_mul(first_layer.len()) > MAX_TILTED_VERTEX_LAYERS {
+            return Err(SolverError::new(
+                ErrorCode::TooManyMoves,
+                format!(
+                    "tilted walls plan every layer: {} layers × {} corners exceed {MAX_TILTED_VERTEX_LAYERS}",
+                    job.layers.len(),
+                    first_layer.len()
+                ),
+            )
+            .at("depths.step"));
+        }
+        Ok(Self { job, setup, first_layer, first_passes })
     }
 
-    let final_pass = first_passes
-        .last()
-        .ok_or_else(|| SolverError::new(ErrorCode::Input, "at least one pass is needed").at("passes"))?;
-    let corners = corner_reports(&job, &setup, &first_layer, final_pass);
-    warnings.extend(corner_warnings(&job, &first_passes, &corners));
-    let passes: Vec<PassReport> = first_passes.iter().map(pass_report).collect();
+    /// The vertices of one layer's contour.
+    pub(crate) fn corners(&self) -> usize {
+        self.first_layer.len()
+    }
 
-    let mut feed_length = 0.0;
-    let mut time_min = 0.0;
-    let mut moves = 0;
-    for layer in &layers {
-        let mut from: Option<[f64; 3]> = None;
-        for step in &layer.moves {
-            if let (Some(a), Some(feed)) = (from, step.feed) {
-                let length = Vec3::from(step.to).metric_distance(&Vec3::from(a));
-                feed_length += length;
-                time_min += length / feed;
+    /// The moves of one layer (of the first; a tilted wall's layers have about as many).
+    pub(crate) fn moves_per_layer(&self) -> usize {
+        layer_move_count(&self.first_passes, &self.job.chording)
+    }
+
+    /// The moves of the layers `range` (indices into the job's layers), in order.
+    ///
+    /// # Errors
+    /// Tilted walls: the tool-fit codes of a layer's plan; `E_CANCELLED` once `control`'s cancel
+    /// flag is set (checked per layer).
+    pub(crate) fn layers(
+        &self,
+        range: std::ops::Range<usize>,
+        control: Control<'_>,
+    ) -> Result<Vec<LayerMoves>, SolverError> {
+        let job = &self.job;
+        let mut layers = Vec::with_capacity(range.len());
+        let (from, count) = (range.start, range.len());
+        for index in range {
+            let z = job.layers[index];
+            control.check()?;
+            control.report(index - from, count);
+            let tilted;
+            let (layer, passes) = if index == 0 || job.tilt.is_none() {
+                (&self.first_layer, &self.first_passes)
+            } else {
+                let layer = build_layer(job, &self.setup, z)?;
+                let passes = plan_passes(job, &self.setup, &layer)?;
+                tilted = (layer, passes);
+                (&tilted.0, &tilted.1)
+            };
+            let lead_point = lead_point(job, layer, passes);
+            let lead = lead_point.map_or(0.0, |(_, lead)| lead);
+            let previous_z = if index == 0 { job.top } else { job.layers[index - 1] };
+            let (moves, arcs) =
+                layer_moves(job, layer, passes, lead_point.map(|(point, _)| point), index == 0, previous_z, z);
+            layers.push(LayerMoves { z, moves, arcs, lead });
+        }
+        Ok(layers)
+    }
+
+    /// The answer from every layer's moves, in order: corners, passes, summary, warnings.
+    ///
+    /// # Errors
+    /// `E_TOO_MANY_MOVES` over `max_moves`; `E_INPUT` without a pass.
+    pub(crate) fn answer(
+        &self,
+        machine: Option<&MachineProfile>,
+        max_moves: usize,
+        made: Vec<LayerMoves>,
+    ) -> Result<ContourAnswer, SolverError> {
+        let max_moves = max_moves.min(MAX_MOVES);
+        let Self { job, setup, first_layer, first_passes } = self;
+        let job: &Job = job;
+        let mut warnings = job.warnings.clone();
+        for pass in first_passes {
+            warnings.extend(pass.warnings.iter().cloned());
+        }
+        let mut lead_used = job.lead;
+        let mut shortened = false;
+        let mut layers = Vec::with_capacity(made.len());
+        for LayerMoves { z, moves, arcs, lead } in made {
+            if lead < job.lead {
+                shortened = true;
             }
-            from = Some(step.to);
+            lead_used = lead_used.min(lead);
+            layers.push(ContourLayer { z, moves, arcs });
         }
-        moves += layer.moves.len();
-    }
-    if moves > max_moves {
-        return Err(too_many_moves(layers.len(), moves / layers.len().max(1), moves, max_moves));
-    }
-    let blocks = match &job.chording.rules {
-        None => None,
-        Some((rule, _)) => {
-            let (finest, arc_warnings) = blocks::arc_report(&first_passes, &job.chording);
-            warnings.extend(arc_warnings);
-            let moves = layers.iter().flat_map(|layer| &layer.moves).map(|step| (Vec3::from(step.to), step.feed));
-            let figures = crate::machine::path_blocks(moves, rule.block_time_ms, job.feed, finest)?;
-            warnings.extend(crate::machine::short_block_warning(&figures, rule));
-            Some(figures)
+        if shortened {
+            warnings.push(Warning::new(
+                "W_LEAD_SHORTENED",
+                format!("the lead of {} mm would gouge the contour; {lead_used:.4} mm is used", job.lead),
+            ));
         }
-    };
-    let loop_feed = job.loop_feed.unwrap_or(job.feed);
-    let summary = ContourSummary {
-        side: job.side,
-        direction: job.direction,
-        tool_radius: job.radius,
-        corners: first_layer.len(),
-        layers: layers.len(),
-        passes: job.passes.len(),
-        moves,
-        feed_length,
-        feed: job.feed,
-        loop_feed,
-        spindle_rpm: job.spindle_rpm,
-        safe_z: job.safe_z,
-        lead: lead_used,
-        tolerance: job.tolerance,
-        estimated_time_s: time_min * 60.0,
-        blocks,
-        cycle_time: machine.and_then(|m| contour_cycle_time(&layers, m, job.plunge_feed)),
-    };
-    let description = describe(&job, &summary);
-    let centre_height = match job.tool.kind {
-        ToolKind::Flat => 0.0,
-        ToolKind::Ball => job.radius,
-        ToolKind::Bull => job.tool.corner_radius.unwrap_or(0.0),
-    };
-    Ok(ContourAnswer {
-        layers,
-        corners,
-        passes,
-        summary,
-        warnings,
-        tool_kind: job.tool.kind,
-        centre_height,
-        description,
-        tilted: job.tilt.is_some(),
-    })
+
+        let final_pass = first_passes
+            .last()
+            .ok_or_else(|| SolverError::new(ErrorCode::Input, "at least one pass is needed").at("passes"))?;
+        let corners = corner_reports(job, setup, first_layer, final_pass);
+        warnings.extend(corner_warnings(job, first_passes, &corners));
+        let passes: Vec<PassReport> = first_passes.iter().map(pass_report).collect();
+
+        let mut feed_length = 0.0;
+        let mut time_min = 0.0;
+        let mut moves = 0;
+        for layer in &layers {
+            let mut from: Option<[f64; 3]> = None;
+            for step in &layer.moves {
+                if let (Some(a), Some(feed)) = (from, step.feed) {
+                    let length = Vec3::from(step.to).metric_distance(&Vec3::from(a));
+                    feed_length += length;
+                    time_min += length / feed;
+                }
+                from = Some(step.to);
+            }
+            moves += layer.moves.len();
+        }
+        if moves > max_moves {
+            return Err(too_many_moves(layers.len(), moves / layers.len().max(1), moves, max_moves));
+        }
+        let blocks = match &job.chording.rules {
+            None => None,
+            Some((rule, _)) => {
+                let (finest, arc_warnings) = blocks::arc_report(first_passes, &job.chording);
+                warnings.extend(arc_warnings);
+                let moves = layers.iter().flat_map(|layer| &layer.moves).map(|step| (Vec3::from(step.to), step.feed));
+                let figures = crate::machine::path_blocks(moves, rule.block_time_ms, job.feed, finest)?;
+                warnings.extend(crate::machine::short_block_warning(&figures, rule));
+                Some(figures)
+            }
+        };
+        let loop_feed = job.loop_feed.unwrap_or(job.feed);
+        let summary = ContourSummary {
+            side: job.side,
+            direction: job.direction,
+            tool_radius: job.radius,
+            corners: first_layer.len(),
+            layers: layers.len(),
+            passes: job.passes.len(),
+            moves,
+            feed_length,
+            feed: job.feed,
+            loop_feed,
+            spindle_rpm: job.spindle_rpm,
+            safe_z: job.safe_z,
+            lead: lead_used,
+            tolerance: job.tolerance,
+            estimated_time_s: time_min * 60.0,
+            blocks,
+            cycle_time: machine.and_then(|m| contour_cycle_time(&layers, m, job.plunge_feed)),
+        };
+        let description = describe(job, &summary);
+        let centre_height = match job.tool.kind {
+            ToolKind::Flat => 0.0,
+            ToolKind::Ball => job.radius,
+            ToolKind::Bull => job.tool.corner_radius.unwrap_or(0.0),
+        };
+        Ok(ContourAnswer {
+            layers,
+            corners,
+            passes,
+            summary,
+            warnings,
+            tool_kind: job.tool.kind,
+            centre_height,
+            description,
+            tilted: job.tilt.is_some(),
+        })
+    }
 }
 
 fn too_many_moves(layers: usize, per_layer: usize, total: usize, limit: usize) -> SolverError {

@@ -1,12 +1,12 @@
 //! What a deburr request answers (api.md, Deburr: answer 200).
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::request::{Edge, Method};
 use crate::error::{SolverError, Warning};
 
 /// One machining target with its ball centre, in machining order.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct DeburrPoint {
     /// Ridge point P, machine coordinates.
@@ -19,7 +19,9 @@ pub struct DeburrPoint {
     pub wedge_angle_deg: f64,
     /// Profile segment (`arc`; slot `line_y+x`, `arc_cs2`, `line_y-x`, `arc_cs1`; rounded
     /// rectangle `line_y+x`, `arc_q1`, `line_x+y`, `arc_q2`, `line_y-x`, `arc_q3`, `line_x-y`, `arc_q4`).
-    pub segment: &'static str,
+    #[serde(deserialize_with = "crate::error::interned")]
+    #[cfg_attr(feature = "schema", schema(value_type = String))]
+    pub segment: crate::error::Name,
     /// Parameter s ∈ [0, 1] along the segment.
     pub parameter: f64,
     /// φ on the segment's circle, degrees (arcs only).
@@ -31,7 +33,7 @@ pub struct DeburrPoint {
 }
 
 /// A move of the approach or the way out.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct LeadMove {
     /// `rapid` (G00) or `feed` (G01).
@@ -43,7 +45,7 @@ pub struct LeadMove {
 }
 
 /// Rapid or feed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum LeadMotion {
@@ -54,7 +56,7 @@ pub enum LeadMotion {
 }
 
 /// Figures a CAM engineer checks before running the job.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct DeburrSummary {
     /// Distinct points of the closed loop (`points` has one more: the closing point).
@@ -121,7 +123,7 @@ pub struct DeburrSummary {
 }
 
 /// The answer: the closed loop of centres, the approach and way out, a summary and warnings.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct Deburr {
     /// The deburred ridge, echoed: choosing the wrong one gouges.

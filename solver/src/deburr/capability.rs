@@ -4,8 +4,11 @@
 use serde::Serialize;
 
 use super::program::Leg;
+use super::request::Placement;
 use super::{Deburr, DeburrRequest, Edge};
-use crate::capability::{Capability, Endpoint, OtherTool, OutputOptions, Refs, Resolved, Run};
+use crate::capability::{
+    Capability, Endpoint, OtherTool, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing, Split,
+};
 use crate::error::SolverError;
 use crate::gcode::{Reference, ToolCall};
 use crate::geometry::Vec3;
@@ -154,91 +157,39 @@ impl Capability for DeburrCapability {
                 result,
             });
         }
-        let inner_tool = request.inner_tool.as_ref().and(context.other_tools.first().cloned());
+        let inner_tool = inner_tool(request, &context);
         let mut loops = Vec::new();
         for placement in request.placements()? {
             run.control.check()?;
-            let tool = match &inner_tool {
-                Some(inner) if placement.tool_field == "inner_tool" => inner,
-                _ => &context.tool,
-            };
-            let result = super::solve_controlled(&placement.request, tool, context.machine.as_ref(), run.control)
-                .map_err(|error| match error.field() {
-                    // A hole's own field: named where the request has it.
-                    Some(field) if placement.field != "hole" && field.starts_with("hole.") => {
-                        let inner = field.trim_start_matches("hole.").to_owned();
-                        error.at(format!("{}.{inner}", placement.field))
-                    }
-                    // The inside ridge's tool: named as the request names it.
-                    Some(field) if placement.tool_field == "inner_tool" && field.starts_with("tool") => {
-                        let rest = field.trim_start_matches("tool").to_owned();
-                        error.at(format!("inner_tool{rest}"))
-                    }
-                    _ => error,
-                })?;
-            loops.push(HoleAnswer {
-                field: placement.field,
-                index: placement.index,
-                tool_field: placement.tool_field,
-                turned: placement.turned,
-                penetration_angle_deg: placement.penetration_angle_deg,
-                arrangement_angle_deg: placement.arrangement_angle_deg,
-                axial_position: placement.axial_position,
-                result,
-            });
+            let result = solve_loop(&placement, &context, inner_tool.as_ref(), run)?;
+            loops.push(hole_answer(placement, result));
         }
-        let another = inner_tool.as_ref().filter(|inner| **inner != context.tool).cloned();
-        let tool = |hole: &HoleAnswer| usize::from(another.is_some() && hole.tool_field == "inner_tool");
-        // The groups in program order: the first tool up then turned, the second turned then up.
-        let rank = |hole: &HoleAnswer| 2 * tool(hole) + usize::from(hole.turned != (tool(hole) == 1));
-        // Request order, grouped (stable: each group keeps its request order).
-        let request_order: Vec<usize> = {
-            let mut indices: Vec<usize> = (0..loops.len()).collect();
-            indices.sort_by_key(|&i| rank(&loops[i]));
-            indices
-        };
-        let results: Vec<&Deburr> = loops.iter().map(|hole| &hole.result).collect();
-        let safe_z = super::program::safe_z(&results, Reference::Tip).ok();
-        let cost =
-            |from: &Deburr, to: &Deburr| safe_z.map_or(0.0, |z| super::program::travel(from, to, z, Reference::Tip));
-        let mut order = Vec::with_capacity(loops.len());
-        for group in 0..4 {
-            let indices: Vec<usize> = request_order.iter().copied().filter(|&i| rank(&loops[i]) == group).collect();
-            let matrix: Vec<Vec<f64>> = indices
-                .iter()
-                .map(|&a| indices.iter().map(|&b| cost(&loops[a].result, &loops[b].result)).collect())
-                .collect();
-            order.extend(super::order::short_order(&matrix).into_iter().map(|at| indices[at]));
-        }
-        let travel_of = |sequence: &[usize]| -> f64 {
-            sequence.windows(2).map(|pair| cost(&loops[pair[0]].result, &loops[pair[1]].result)).sum()
-        };
-        let changes = |pick: &dyn Fn(&HoleAnswer) -> usize| {
-            order.windows(2).filter(|pair| pick(&loops[pair[0]]) != pick(&loops[pair[1]])).count()
-        };
-        let visiting_order = VisitingOrder {
-            loops: order.iter().map(|&i| VisitStop { index: loops[i].index, edge: loops[i].result.edge }).collect(),
-            travel: travel_of(&order),
-            request_order_travel: travel_of(&request_order),
-            tool_changes: changes(&tool),
-            turns: changes(&|hole: &HoleAnswer| usize::from(hole.turned))
-                + usize::from(order.first().is_some_and(|&i| loops[i].turned)),
-        };
-        let mut slots: Vec<Option<HoleAnswer>> = loops.into_iter().map(Some).collect();
-        let holes: Vec<HoleAnswer> = order.iter().filter_map(|&i| slots[i].take()).collect();
-        let legs: Vec<Leg<'_>> =
-            holes.iter().map(|hole| Leg { deburr: &hole.result, tool: tool(hole), turned: hole.turned }).collect();
-        let cycle_time = context.machine.as_ref().and_then(MachineProfile::dynamics).map(|d| cycle_time(&legs, &d));
-        let result = holes[0].result.clone();
-        Ok(DeburrAnswer {
-            tool: context.tool,
-            inner_tool,
-            machine: context.machine,
-            cycle_time,
-            holes: Some(holes),
-            visiting_order: Some(visiting_order),
-            result,
-        })
+        Ok(arrange(context, inner_tool, loops))
+    }
+    /// A several-loop request's loops in ranges of about `sizing.part_seconds` (`parts`).
+    fn split(request: &DeburrRequest, _context: &Resolved<Tool>, sizing: &Sizing) -> Option<Split> {
+        super::parts::split(request, sizing)
+    }
+
+    /// The loops of `part`.
+    fn solve_part(
+        request: &DeburrRequest,
+        context: Resolved<Tool>,
+        part: &Part,
+        run: &Run<'_>,
+        sink: &mut impl PartSink,
+    ) -> Result<(), SolverError> {
+        super::parts::solve_part(request, &context, part, run, sink)
+    }
+
+    /// Every loop, grouped and ordered as `solve` orders them.
+    fn finish(
+        request: &DeburrRequest,
+        context: Resolved<Tool>,
+        parts: &mut impl PartSource,
+        run: &Run<'_>,
+    ) -> Result<DeburrAnswer, SolverError> {
+        super::parts::finish(request, context, parts, run)
     }
 
     fn program(_request: &DeburrRequest, answer: &DeburrAnswer, output: &OutputOptions) -> Result<String, SolverError> {
@@ -254,6 +205,110 @@ impl Capability for DeburrCapability {
 
     fn machine(answer: &DeburrAnswer) -> Option<&MachineProfile> {
         answer.machine.as_ref()
+    }
+}
+
+/// The tool of the inside ridges: `inner_tool` as resolved, when the request gives one.
+pub(super) fn inner_tool(request: &DeburrRequest, context: &Resolved<Tool>) -> Option<Tool> {
+    request.inner_tool.as_ref().and(context.other_tools.first().cloned())
+}
+
+/// One loop of a several-loop request: its hole at its edge with its tool, errors named where
+/// the request has the fields.
+pub(super) fn solve_loop(
+    placement: &Placement,
+    context: &Resolved<Tool>,
+    inner_tool: Option<&Tool>,
+    run: &Run<'_>,
+) -> Result<Deburr, SolverError> {
+    let tool = match inner_tool {
+        Some(inner) if placement.tool_field == "inner_tool" => inner,
+        _ => &context.tool,
+    };
+    super::solve_controlled(&placement.request, tool, context.machine.as_ref(), run.control).map_err(|error| {
+        match error.field() {
+            // A hole's own field: named where the request has it.
+            Some(field) if placement.field != "hole" && field.starts_with("hole.") => {
+                let inner = field.trim_start_matches("hole.").to_owned();
+                error.at(format!("{}.{inner}", placement.field))
+            }
+            // The inside ridge's tool: named as the request names it.
+            Some(field) if placement.tool_field == "inner_tool" && field.starts_with("tool") => {
+                let rest = field.trim_start_matches("tool").to_owned();
+                error.at(format!("inner_tool{rest}"))
+            }
+            _ => error,
+        }
+    })
+}
+
+/// A loop of a several-loop answer: its placement and its result.
+pub(super) fn hole_answer(placement: Placement, result: Deburr) -> HoleAnswer {
+    HoleAnswer {
+        field: placement.field,
+        index: placement.index,
+        tool_field: placement.tool_field,
+        turned: placement.turned,
+        penetration_angle_deg: placement.penetration_angle_deg,
+        arrangement_angle_deg: placement.arrangement_angle_deg,
+        axial_position: placement.axial_position,
+        result,
+    }
+}
+
+/// The answer of a several-loop request from its loops in request order: the loops grouped by
+/// tool and turn, each group in a short visiting order (`order`), the program's cycle time.
+pub(super) fn arrange(context: Resolved<Tool>, inner_tool: Option<Tool>, loops: Vec<HoleAnswer>) -> DeburrAnswer {
+    let another = inner_tool.as_ref().filter(|inner| **inner != context.tool).cloned();
+    let tool = |hole: &HoleAnswer| usize::from(another.is_some() && hole.tool_field == "inner_tool");
+    // The groups in program order: the first tool up then turned, the second turned then up.
+    let rank = |hole: &HoleAnswer| 2 * tool(hole) + usize::from(hole.turned != (tool(hole) == 1));
+    // Request order, grouped (stable: each group keeps its request order).
+    let request_order: Vec<usize> = {
+        let mut indices: Vec<usize> = (0..loops.len()).collect();
+        indices.sort_by_key(|&i| rank(&loops[i]));
+        indices
+    };
+    let results: Vec<&Deburr> = loops.iter().map(|hole| &hole.result).collect();
+    let safe_z = super::program::safe_z(&results, Reference::Tip).ok();
+    let cost = |from: &Deburr, to: &Deburr| safe_z.map_or(0.0, |z| super::program::travel(from, to, z, Reference::Tip));
+    let mut order = Vec::with_capacity(loops.len());
+    for group in 0..4 {
+        let indices: Vec<usize> = request_order.iter().copied().filter(|&i| rank(&loops[i]) == group).collect();
+        let matrix: Vec<Vec<f64>> = indices
+            .iter()
+            .map(|&a| indices.iter().map(|&b| cost(&loops[a].result, &loops[b].result)).collect())
+            .collect();
+        order.extend(super::order::short_order(&matrix).into_iter().map(|at| indices[at]));
+    }
+    let travel_of = |sequence: &[usize]| -> f64 {
+        sequence.windows(2).map(|pair| cost(&loops[pair[0]].result, &loops[pair[1]].result)).sum()
+    };
+    let changes = |pick: &dyn Fn(&HoleAnswer) -> usize| {
+        order.windows(2).filter(|pair| pick(&loops[pair[0]]) != pick(&loops[pair[1]])).count()
+    };
+    let visiting_order = VisitingOrder {
+        loops: order.iter().map(|&i| VisitStop { index: loops[i].index, edge: loops[i].result.edge }).collect(),
+        travel: travel_of(&order),
+        request_order_travel: travel_of(&request_order),
+        tool_changes: changes(&tool),
+        turns: changes(&|hole: &HoleAnswer| usize::from(hole.turned))
+            + usize::from(order.first().is_some_and(|&i| loops[i].turned)),
+    };
+    let mut slots: Vec<Option<HoleAnswer>> = loops.into_iter().map(Some).collect();
+    let holes: Vec<HoleAnswer> = order.iter().filter_map(|&i| slots[i].take()).collect();
+    let legs: Vec<Leg<'_>> =
+        holes.iter().map(|hole| Leg { deburr: &hole.result, tool: tool(hole), turned: hole.turned }).collect();
+    let cycle_time = context.machine.as_ref().and_then(MachineProfile::dynamics).map(|d| cycle_time(&legs, &d));
+    let result = holes[0].result.clone();
+    DeburrAnswer {
+        tool: context.tool,
+        inner_tool,
+        machine: context.machine,
+        cycle_time,
+        holes: Some(holes),
+        visiting_order: Some(visiting_order),
+        result,
     }
 }
 

@@ -16,7 +16,9 @@
 //! * `tolerance`: the target points from TA (§3), or with a block time from the block-time rule
 //!   per interval, never coarser than TA (issue 3, chord.md);
 //! * `checks`: validity limits and warnings (§4);
-//! * [`program`]: lead moves and G-code (§6.3).
+//! * [`program`]: lead moves and G-code (§6.3);
+//! * `parts`: a several-loop job's loops split into ranges that several workers solve at once
+//!   (issue 12).
 
 mod answer;
 mod capability;
@@ -27,6 +29,7 @@ mod envelope;
 mod frame;
 mod job;
 mod order;
+mod parts;
 mod profile;
 pub mod program;
 pub mod request;

@@ -246,7 +246,7 @@ fn mismatch(what: &str) -> SolverError {
     SolverError::new(ErrorCode::Internal, format!("the parts do not belong to this engagement request: {what}"))
 }
 
-/// Core-seconds per sample, per flute count evaluated (`cost_model` in `solver/tests/split_parts.rs`,
+/// Core-seconds per sample, per flute count evaluated (`tests/load/cost_model.rs`, section `engagement`,
 /// the exact engine with Kienzle forces, one thread: 4.5 µs per sample with one flute count, 19 µs
 /// with three).
 const EXACT_SAMPLE_SECONDS: f64 = 6.0e-6;

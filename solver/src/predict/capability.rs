@@ -237,7 +237,7 @@ fn mismatch(detail: String) -> SolverError {
 }
 
 /// What a prediction costs, in core-seconds of the reference machine (README, "More than one
-/// machine": measured by `cost_model` in `solver/tests/split_parts.rs`, one thread, CPU time).
+/// machine": measured by `tests/load/cost_model.rs`, section `predict`, one thread, CPU time).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Cost {
     /// Per predicted pass.

@@ -3,7 +3,8 @@
 //! with SIGKILL in the middle of a job; every job ends done with the results of a one-process
 //! SQLite run of the same files. A large prediction is split into parts that both workers run at
 //! once, one killed in the middle of a part, and its merged result and program are a one-process
-//! run's byte for byte; a refused part fails its job with its problem. Two API nodes on one
+//! run's byte for byte, as are those of an engagement comparison, a contour and a deburring split
+//! into parts; a refused part fails its job with its problem. Two API nodes on one
 //! database see each other's tools, machines and jobs, and a cancel through one reaches the job
 //! running on the other within two seconds.
 //! Each test skips, printing why, when PostgreSQL is not installed (fails under
@@ -355,9 +356,56 @@ fn engagement_comparison() -> Value {
     })
 }
 
+/// A contour of many layers: a star of 100 corners (radius 100 mm, every other corner 3 mm in), two
+/// passes with arc loops, 120 layers (240 000 moves, about 0.6 core-s by the cost model) to be
+/// split into parts of [`PART_SECONDS`]; on a machine with a block time and accelerations.
+fn contour_layers() -> Value {
+    let star: Vec<[f64; 2]> = (0..100)
+        .map(|k| {
+            let angle = std::f64::consts::TAU * f64::from(k) / 100.0;
+            let radius = if k % 2 == 0 { 100.0 } else { 97.0 };
+            [radius * angle.cos(), radius * angle.sin()]
+        })
+        .collect();
+    json!({
+        "name": "contour, a star of 120 layers",
+        "tools": [{"number": 3, "kind": "flat", "radius": 3}],
+        "machines": [{"name": "mill", "block_time_ms": 2, "max_feed": 12000, "max_accel": 2000}],
+        "output": {"program_number": 4444},
+        "operations": [{
+            "operation": "contour", "tool": 3, "machine": "mill", "contour": star, "side": "outside",
+            "depths": {"top": 0, "bottom": -12, "step": 0.1}, "corner_loop": {"style": "arc"},
+            "feed": 800, "loop_feed": 2000, "stock_allowance": 0.5, "spindle_rpm": 8000,
+            "passes": [{"allowance": 0.3, "join": "round"}, {"allowance": 0}]
+        }]
+    })
+}
+
+/// A deburring of 40 holes along a tube, both edges (80 loops, the inside ridges with another
+/// tool), holes pointing up, sideways and down (turned: `M00`), exact width at a fine tolerance
+/// (about 0.6 core-s by the cost model) to be split into parts of [`PART_SECONDS`].
+fn deburr_holes() -> Value {
+    let holes: Vec<Value> = (0..40)
+        .map(|i| {
+            let angle = [0.0, 180.0, 90.0, 170.0][i % 4];
+            json!({"shape": "round", "radius": 5, "penetration_angle_deg": angle, "axial_position": 20 * ((i * 7) % 40)})
+        })
+        .collect();
+    json!({
+        "name": "deburr, 40 holes, both edges",
+        "tools": [{"number": 7, "kind": "ball", "radius": 3}, {"number": 8, "kind": "ball", "radius": 2}],
+        "output": {"program_number": 4545},
+        "operations": [{
+            "operation": "deburr", "tool": 7, "inner_tool": 8, "edge": "both", "cut_amount": 0.3,
+            "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 15, "outer_radius": 25},
+            "holes": holes, "method": "exact", "tolerance": 1e-4
+        }]
+    })
+}
+
 /// Workers that split work into parts of this many core-seconds (`KERF_JOB_PART_S`; the default
-/// 8 would leave this test's prediction whole).
-const PART_SECONDS: &str = "1";
+/// 8 would leave this test's operations whole).
+const PART_SECONDS: &str = "0.25";
 
 #[tokio::test(flavor = "multi_thread")]
 async fn a_prediction_splits_across_workers_and_survives_a_kill() {
@@ -377,6 +425,10 @@ async fn a_prediction_splits_across_workers_and_survives_a_kill() {
     let id = submit(&client, &api.base, &job).await;
     let engagement = engagement_comparison();
     let engagement_id = submit(&client, &api.base, &engagement).await;
+    let contour = contour_layers();
+    let contour_id = submit(&client, &api.base, &contour).await;
+    let deburr = deburr_holes();
+    let deburr_id = submit(&client, &api.base, &deburr).await;
 
     // The one operation is split, and both workers run parts of it at once.
     let deadline = Instant::now() + Duration::from_secs(300);
@@ -448,16 +500,23 @@ async fn a_prediction_splits_across_workers_and_survives_a_kill() {
     assert_eq!(left, 0, "every chunk done, and the parts' outputs dropped once merged");
     assert_eq!(stored, expected, "the job takes its file and its result");
 
-    // The engagement comparison was split into parts too, and is done.
-    let engagement_done = poll_job(&client, &api.base, engagement_id, 900, finished).await;
-    assert_eq!(engagement_done["status"], "done", "{}", engagement_done["error"]);
-    let (engagement_parts,): (i64,) =
-        sqlx::query_as("SELECT COUNT(*) FROM job_chunks WHERE job_id = $1 AND kind = 'part' AND status = 'done'")
-            .bind(engagement_id)
-            .fetch_one(&pool)
-            .await
-            .unwrap();
-    assert!(engagement_parts >= 2, "the engagement candidates are split: {engagement_parts} parts");
+    // The engagement comparison, the contour's layers and the deburring's loops were split into
+    // parts too, and are done.
+    for (other, what) in
+        [(engagement_id, "engagement candidates"), (contour_id, "contour layers"), (deburr_id, "deburr loops")]
+    {
+        let other_done = poll_job(&client, &api.base, other, 900, finished).await;
+        assert_eq!(other_done["status"], "done", "{what}: {}", other_done["error"]);
+        assert_eq!(other_done["progress"], 1.0, "{what}");
+        let (parts,): (i64,) =
+            sqlx::query_as("SELECT COUNT(*) FROM job_chunks WHERE job_id = $1 AND kind = 'part' AND status = 'done'")
+                .bind(other)
+                .fetch_one(&pool)
+                .await
+                .unwrap();
+        assert!(parts >= 2, "the {what} are split: {parts} parts");
+        eprintln!("{what}: {parts} parts");
+    }
 
     // One SQLite process runs the same files whole: the same results (but for the time a
     // prediction took) and programs, byte for byte.
@@ -467,7 +526,7 @@ async fn a_prediction_splits_across_workers_and_survives_a_kill() {
         let url = format!("{base}/api/v1/jobs/{id}/program");
         async move { client.get(url).send().await.unwrap().text().await.unwrap() }
     };
-    for (shared_id, file) in [(id, &job), (engagement_id, &engagement)] {
+    for (shared_id, file) in [(id, &job), (engagement_id, &engagement), (contour_id, &contour), (deburr_id, &deburr)] {
         let local_id = submit(&local.client, &local.base, file).await;
         let local_done = poll_job(&local.client, &local.base, local_id, 900, finished).await;
         assert_eq!(local_done["status"], "done", "{}", local_done["error"]);
