@@ -5,7 +5,7 @@
 
 use nalgebra::Matrix3;
 
-use super::capsule::Capsule;
+use super::capsule::{BoxProbe, Capsule};
 use super::passes::{PathModel, Stamps};
 use super::stock::{Region, StockModel};
 use crate::geometry::Vec3;
@@ -107,6 +107,15 @@ pub(crate) struct Scene {
     pub(crate) after: Vec<Capsule>,
 }
 
+/// The capsules sorted by lowest axis point, ties in path order: the box filter and the point
+/// test stop at the first capsule too high to matter. Which capsule hides a point never depends on
+/// the order, only how soon a scan finds it. (Sorting keys, not the 128-byte capsules.)
+fn by_lowest_point(capsules: Vec<Capsule>) -> Vec<Capsule> {
+    let mut keys: Vec<(f64, u32)> = capsules.iter().enumerate().map(|(i, c)| (c.min_z, i as u32)).collect();
+    keys.sort_unstable_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+    keys.into_iter().map(|(_, i)| capsules[i as usize]).collect()
+}
+
 /// Whether a ray has entered a swept volume by the time it reaches a point.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub(crate) enum Cover {
@@ -137,7 +146,15 @@ impl Scene {
                 Side::After => after.push(capsule),
             }
         }
-        Self { radius, r2: radius * radius, eps: 1e-9 * radius, centre, rotation, before, after }
+        Self {
+            radius,
+            r2: radius * radius,
+            eps: 1e-9 * radius,
+            centre,
+            rotation,
+            before: by_lowest_point(before),
+            after: by_lowest_point(after),
+        }
     }
 
     /// World point of a frame point.
@@ -153,7 +170,8 @@ impl Scene {
 
     /// Fills `lists` with the capsules that may hide a point of the frame box `[lo, hi]`, taken
     /// from `pool` (or from all capsules); `want_after` skips T2 when only K is needed. The
-    /// region is left to the caller.
+    /// region is left to the caller. The capsules are sorted by `min_z` and pools list them in
+    /// index order, so the scan stops at the first capsule above the box (all later ones are).
     pub(crate) fn candidates(
         &self,
         lo: &Vec3,
@@ -164,14 +182,29 @@ impl Scene {
     ) {
         lists.before.clear();
         lists.after.clear();
-        let tie = self.eps;
+        let probe = BoxProbe::new(lo, hi);
+        let (r, tie) = (self.radius, self.eps);
         let pick = |capsules: &[Capsule], from: Option<&[u32]>, out: &mut Vec<u32>| match from {
-            Some(indices) => out.extend(
-                indices.iter().copied().filter(|&i| capsules[i as usize].may_cover_box(lo, hi, self.radius, tie)),
-            ),
-            None => out.extend(
-                (0..capsules.len() as u32).filter(|&i| capsules[i as usize].may_cover_box(lo, hi, self.radius, tie)),
-            ),
+            Some(indices) => {
+                debug_assert!(indices.is_sorted());
+                for &i in indices {
+                    let capsule = &capsules[i as usize];
+                    if capsule.above(&probe, r, tie) {
+                        break;
+                    }
+                    if capsule.may_cover(&probe, r, tie) {
+                        out.push(i);
+                    }
+                }
+            }
+            None => {
+                let end = capsules.partition_point(|c| !c.above(&probe, r, tie));
+                for (i, capsule) in capsules[..end].iter().enumerate() {
+                    if capsule.may_cover(&probe, r, tie) {
+                        out.push(i as u32);
+                    }
+                }
+            }
         };
         pick(&self.before, pool.map(|p| p.before.as_slice()), &mut lists.before);
         if want_after {
@@ -197,30 +230,34 @@ impl Scene {
         (world_lo, world_hi)
     }
 
-    /// How the frame point `q` is covered by the listed capsules of one side; `hint` is the
-    /// list position that covered the previous point (tried first).
+    /// How the frame point `q` is covered by the listed capsules of one side (`list` in index
+    /// order); `hint` is the list position that covered the previous point (tried first).
     pub(crate) fn cover(&self, q: &Vec3, side: Side, list: &[u32], hint: &mut usize) -> Cover {
+        debug_assert!(list.is_sorted());
         let capsules = match side {
             Side::Before => &self.before,
             Side::After => &self.after,
         };
         let mut state = Cover::Open;
         let start = (*hint).min(list.len());
-        let (tail, head) = list.split_at(start);
-        for (position, &index) in head.iter().enumerate().map(|(k, i)| (k + start, i)).chain(tail.iter().enumerate()) {
-            let capsule = &capsules[index as usize];
-            if capsule.min_z - self.radius > q.z + self.eps {
-                continue;
-            }
-            // Capsules whose lowest point over q lies more than 2ε above it are skipped before the
-            // square root (neither hidden nor a tie, so the same answer).
-            if let Some(entry) = capsule.entry_z_up_to(q.x, q.y, self.r2, q.z + 2.0 * self.eps) {
-                if entry < q.z - self.eps {
-                    *hint = position;
-                    return Cover::Hidden;
+        // From the hint to the end, then the start of the list; each part is sorted by `min_z`,
+        // so its scan stops at the first capsule too high to reach q.
+        for (offset, part) in [(start, &list[start..]), (0, &list[..start])] {
+            for (k, &index) in part.iter().enumerate() {
+                let capsule = &capsules[index as usize];
+                if capsule.min_z - self.radius > q.z + self.eps {
+                    break;
                 }
-                if entry <= q.z + self.eps {
-                    state = Cover::Tie;
+                // Capsules whose lowest point over q lies more than 2ε above it are skipped before
+                // the square root (neither hidden nor a tie, so the same answer).
+                if let Some(entry) = capsule.entry_z_up_to(q.x, q.y, self.r2, q.z + 2.0 * self.eps) {
+                    if entry < q.z - self.eps {
+                        *hint = offset + k;
+                        return Cover::Hidden;
+                    }
+                    if entry <= q.z + self.eps {
+                        state = Cover::Tie;
+                    }
                 }
             }
         }
