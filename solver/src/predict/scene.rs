@@ -340,3 +340,99 @@ impl Scene {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+
+    /// Random pieces near the origin on both sides (some repeated heights, some vertical or
+    /// degenerate).
+    fn pieces() -> impl Strategy<Value = Vec<Piece>> {
+        let point = || (-12.0..12.0_f64, -12.0..12.0_f64, prop_oneof![-8.0..8.0_f64, Just(-1.0)]);
+        prop::collection::vec((point(), point(), any::<bool>(), 0..4u8), 0..60).prop_map(|raw| {
+            raw.into_iter()
+                .map(|((ax, ay, az), (bx, by, bz), before, kind)| {
+                    let a = Vec3::new(ax, ay, az);
+                    let b = match kind {
+                        0 => a,
+                        1 => Vec3::new(ax, ay, bz),
+                        _ => Vec3::new(bx, by, bz),
+                    };
+                    Piece { a, b, side: if before { Side::Before } else { Side::After } }
+                })
+                .collect()
+        })
+    }
+
+    fn frame_box() -> impl Strategy<Value = (Vec3, Vec3)> {
+        (-8.0..8.0_f64, -8.0..8.0_f64, -8.0..4.0_f64, 0.0..3.0_f64, 0.0..3.0_f64, 0.0..2.0_f64)
+            .prop_map(|(x, y, z, w, h, d)| (Vec3::new(x, y, z), Vec3::new(x + w, y + h, z + d)))
+    }
+
+    /// The filter over every capsule, without the early stop.
+    fn brute(capsules: &[Capsule], from: &[u32], lo: &Vec3, hi: &Vec3, r: f64, tie: f64) -> Vec<u32> {
+        from.iter().copied().filter(|&i| capsules[i as usize].may_cover_box(lo, hi, r, tie)).collect()
+    }
+
+    /// The point test over every listed capsule, without the early stop.
+    fn brute_cover(scene: &Scene, q: &Vec3, capsules: &[Capsule], list: &[u32]) -> Cover {
+        let mut state = Cover::Open;
+        for &i in list {
+            if let Some(entry) = capsules[i as usize].entry_z(q.x, q.y, scene.r2) {
+                if entry < q.z - scene.eps {
+                    return Cover::Hidden;
+                }
+                if entry <= q.z + scene.eps {
+                    state = Cover::Tie;
+                }
+            }
+        }
+        state
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 256, .. ProptestConfig::default() })]
+
+        /// The sorted capsules with the early stop give exactly the candidates of the full scan,
+        /// from all capsules and from a pool, and the same point test answers.
+        #[test]
+        fn candidates_match_brute_force(pieces in pieces(), outer in frame_box(), inner in frame_box(), hint in 0..40usize) {
+            let scene = Scene::new(&pieces, Vec3::new(1.0, -2.0, 0.5), Matrix3::identity(), 5.0);
+            prop_assert!(scene.before.is_sorted_by(|p, q| p.min_z <= q.min_z));
+            prop_assert!(scene.after.is_sorted_by(|p, q| p.min_z <= q.min_z));
+            let (r, tie) = (scene.radius, scene.eps);
+            let all_before: Vec<u32> = (0..scene.before.len() as u32).collect();
+            let all_after: Vec<u32> = (0..scene.after.len() as u32).collect();
+            // A pool for a box holding both boxes, then the inner box from it.
+            let (pool_lo, pool_hi) = (outer.0.inf(&inner.0), outer.1.sup(&inner.1));
+            let mut pool = TileLists::default();
+            scene.candidates(&pool_lo, &pool_hi, true, None, &mut pool);
+            prop_assert_eq!(&pool.before, &brute(&scene.before, &all_before, &pool_lo, &pool_hi, r, tie));
+            prop_assert_eq!(&pool.after, &brute(&scene.after, &all_after, &pool_lo, &pool_hi, r, tie));
+            let mut lists = TileLists::default();
+            scene.candidates(&inner.0, &inner.1, true, Some(&pool), &mut lists);
+            prop_assert_eq!(&lists.before, &brute(&scene.before, &pool.before, &inner.0, &inner.1, r, tie));
+            prop_assert_eq!(&lists.after, &brute(&scene.after, &pool.after, &inner.0, &inner.1, r, tie));
+            // Point tests at the inner box's corners and centre, from any starting hint.
+            for k in 0..9 {
+                let q = if k == 8 {
+                    0.5 * (inner.0 + inner.1)
+                } else {
+                    Vec3::new(
+                        if k & 1 == 0 { inner.0.x } else { inner.1.x },
+                        if k & 2 == 0 { inner.0.y } else { inner.1.y },
+                        if k & 4 == 0 { inner.0.z } else { inner.1.z },
+                    )
+                };
+                for (side, capsules, list) in
+                    [(Side::Before, &scene.before, &all_before), (Side::After, &scene.after, &all_after)]
+                {
+                    let mut h = hint;
+                    prop_assert_eq!(scene.cover(&q, side, list, &mut h), brute_cover(&scene, &q, capsules, list));
+                }
+            }
+        }
+    }
+}
