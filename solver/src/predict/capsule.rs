@@ -122,20 +122,31 @@ impl Capsule {
 
     /// Conservative test: can the capsule cover any point of the box `[lo, hi]` (bounding circle
     /// of its xy rectangle and its top)?
-    #[inline]
+    #[cfg(test)]
     pub(crate) fn may_cover_box(&self, lo: &Vec3, hi: &Vec3, r: f64, tie: f64) -> bool {
-        let rise = self.min_z - hi.z - tie;
+        self.may_cover(&BoxProbe::new(lo, hi), r, tie)
+    }
+
+    /// Whether the capsule's axis lies more than R (+ `tie`) above the top of the probed box, so
+    /// that it covers no point of it. Monotone in `min_z`: over capsules sorted by `min_z`, once
+    /// one is above, all later ones are.
+    #[inline]
+    pub(crate) fn above(&self, probe: &BoxProbe, r: f64, tie: f64) -> bool {
+        self.min_z - probe.top - tie > r
+    }
+
+    /// [`Self::may_cover_box`] with the box's centre and half-diagonal computed once per box.
+    #[inline]
+    pub(crate) fn may_cover(&self, probe: &BoxProbe, r: f64, tie: f64) -> bool {
+        let rise = self.min_z - probe.top - tie;
         if rise > r {
             return false;
         }
-        let (cx, cy) = (0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y));
-        let (width, height) = (hi.x - lo.x, hi.y - lo.y);
-        let half_diagonal = 0.5 * (width * width + height * height).sqrt();
         let (abx, aby) = self.ab_xy;
-        let (apx, apy) = (cx - self.a.x, cy - self.a.y);
+        let (apx, apy) = (probe.cx - self.a.x, probe.cy - self.a.y);
         let t = ((apx * abx + apy * aby) * self.inverse_xy).clamp(0.0, 1.0);
         let (dx, dy) = (apx - t * abx, apy - t * aby);
-        let distance = ((dx * dx + dy * dy).sqrt() - half_diagonal).max(0.0);
+        let distance = ((dx * dx + dy * dy).sqrt() - probe.half_diagonal).max(0.0);
         if distance >= r {
             return false;
         }
@@ -147,6 +158,28 @@ impl Capsule {
     #[cfg(test)]
     pub(crate) fn distance_xy(&self, x: f64, y: f64) -> f64 {
         distance_2d(x, y, &self.a, &self.b)
+    }
+}
+
+/// What the box filter needs of a box: its xy centre, the half-diagonal of its xy rectangle and
+/// its top.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BoxProbe {
+    cx: f64,
+    cy: f64,
+    half_diagonal: f64,
+    top: f64,
+}
+
+impl BoxProbe {
+    pub(crate) fn new(lo: &Vec3, hi: &Vec3) -> Self {
+        let (width, height) = (hi.x - lo.x, hi.y - lo.y);
+        Self {
+            cx: 0.5 * (lo.x + hi.x),
+            cy: 0.5 * (lo.y + hi.y),
+            half_diagonal: 0.5 * (width * width + height * height).sqrt(),
+            top: hi.z,
+        }
     }
 }
 

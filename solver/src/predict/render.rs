@@ -14,6 +14,8 @@ use crate::geometry::Vec3;
 
 /// Pixels per tile side.
 const TILE: usize = 16;
+/// Tiles per group side (groups share a candidate pool).
+const GROUP: usize = 4;
 
 /// The window: square of side `window` in the image plane of the scene's frame, centred at
 /// `centre` (image-plane coordinates relative to the ball centre), N × N pixels.
@@ -120,11 +122,30 @@ pub(crate) fn render(scene: &Scene, stock: &StockModel, window: &Window) -> Imag
     if !kept.is_empty() {
         scene.candidates(&union_lo, &union_hi, true, None, &mut pool);
     }
+    // A middle level: GROUP × GROUP neighbouring tiles share a narrower pool (the tiles keep
+    // their row-major order, which the sums and the region tie-break depend on).
+    let groups = tiles.div_ceil(GROUP);
+    let group_of = |i0: usize, j0: usize| (j0 / TILE / GROUP) * groups + i0 / TILE / GROUP;
+    let mut group_boxes: Vec<Option<(Vec3, Vec3)>> = vec![None; groups * groups];
+    for &(i0, _, j0, _, _, lo, hi) in &kept {
+        let entry = group_boxes[group_of(i0, j0)].get_or_insert((lo, hi));
+        *entry = (entry.0.inf(&lo), entry.1.sup(&hi));
+    }
+    let group_pools: Vec<TileLists> = group_boxes
+        .iter()
+        .map(|entry| {
+            let mut lists = TileLists::default();
+            if let Some((lo, hi)) = entry {
+                scene.candidates(lo, hi, true, Some(&pool), &mut lists);
+            }
+            lists
+        })
+        .collect();
     let mut lists = TileLists::default();
     let mut hide_hint = 0usize;
     for (i0, i1, j0, j1, region, lo, hi) in kept {
         {
-            scene.candidates(&lo, &hi, true, Some(&pool), &mut lists);
+            scene.candidates(&lo, &hi, true, Some(&group_pools[group_of(i0, j0)]), &mut lists);
             lists.region = Some(region);
             // A tile that one T1 capsule hides whole has no cut or finished pixel.
             if scene.hides_box(&lo, &hi, &lists.before, &mut hide_hint) {

@@ -5,7 +5,7 @@
 
 use nalgebra::Matrix3;
 
-use super::capsule::Capsule;
+use super::capsule::{BoxProbe, Capsule};
 use super::passes::{PathModel, Stamps};
 use super::stock::{Region, StockModel};
 use crate::geometry::Vec3;
@@ -107,6 +107,15 @@ pub(crate) struct Scene {
     pub(crate) after: Vec<Capsule>,
 }
 
+/// The capsules sorted by lowest axis point, ties in path order: the box filter and the point
+/// test stop at the first capsule too high to matter. Which capsule hides a point never depends on
+/// the order, only how soon a scan finds it. (Sorting keys, not the 128-byte capsules.)
+fn by_lowest_point(capsules: Vec<Capsule>) -> Vec<Capsule> {
+    let mut keys: Vec<(f64, u32)> = capsules.iter().enumerate().map(|(i, c)| (c.min_z, i as u32)).collect();
+    keys.sort_unstable_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+    keys.into_iter().map(|(_, i)| capsules[i as usize]).collect()
+}
+
 /// Whether a ray has entered a swept volume by the time it reaches a point.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub(crate) enum Cover {
@@ -137,7 +146,15 @@ impl Scene {
                 Side::After => after.push(capsule),
             }
         }
-        Self { radius, r2: radius * radius, eps: 1e-9 * radius, centre, rotation, before, after }
+        Self {
+            radius,
+            r2: radius * radius,
+            eps: 1e-9 * radius,
+            centre,
+            rotation,
+            before: by_lowest_point(before),
+            after: by_lowest_point(after),
+        }
     }
 
     /// World point of a frame point.
@@ -153,7 +170,8 @@ impl Scene {
 
     /// Fills `lists` with the capsules that may hide a point of the frame box `[lo, hi]`, taken
     /// from `pool` (or from all capsules); `want_after` skips T2 when only K is needed. The
-    /// region is left to the caller.
+    /// region is left to the caller. The capsules are sorted by `min_z` and pools list them in
+    /// index order, so the scan stops at the first capsule above the box (all later ones are).
     pub(crate) fn candidates(
         &self,
         lo: &Vec3,
@@ -164,14 +182,29 @@ impl Scene {
     ) {
         lists.before.clear();
         lists.after.clear();
-        let tie = self.eps;
+        let probe = BoxProbe::new(lo, hi);
+        let (r, tie) = (self.radius, self.eps);
         let pick = |capsules: &[Capsule], from: Option<&[u32]>, out: &mut Vec<u32>| match from {
-            Some(indices) => out.extend(
-                indices.iter().copied().filter(|&i| capsules[i as usize].may_cover_box(lo, hi, self.radius, tie)),
-            ),
-            None => out.extend(
-                (0..capsules.len() as u32).filter(|&i| capsules[i as usize].may_cover_box(lo, hi, self.radius, tie)),
-            ),
+            Some(indices) => {
+                debug_assert!(indices.is_sorted());
+                for &i in indices {
+                    let capsule = &capsules[i as usize];
+                    if capsule.above(&probe, r, tie) {
+                        break;
+                    }
+                    if capsule.may_cover(&probe, r, tie) {
+                        out.push(i);
+                    }
+                }
+            }
+            None => {
+                let end = capsules.partition_point(|c| !c.above(&probe, r, tie));
+                for (i, capsule) in capsules[..end].iter().enumerate() {
+                    if capsule.may_cover(&probe, r, tie) {
+                        out.push(i as u32);
+                    }
+                }
+            }
         };
         pick(&self.before, pool.map(|p| p.before.as_slice()), &mut lists.before);
         if want_after {
@@ -197,30 +230,34 @@ impl Scene {
         (world_lo, world_hi)
     }
 
-    /// How the frame point `q` is covered by the listed capsules of one side; `hint` is the
-    /// list position that covered the previous point (tried first).
+    /// How the frame point `q` is covered by the listed capsules of one side (`list` in index
+    /// order); `hint` is the list position that covered the previous point (tried first).
     pub(crate) fn cover(&self, q: &Vec3, side: Side, list: &[u32], hint: &mut usize) -> Cover {
+        debug_assert!(list.is_sorted());
         let capsules = match side {
             Side::Before => &self.before,
             Side::After => &self.after,
         };
         let mut state = Cover::Open;
         let start = (*hint).min(list.len());
-        let (tail, head) = list.split_at(start);
-        for (position, &index) in head.iter().enumerate().map(|(k, i)| (k + start, i)).chain(tail.iter().enumerate()) {
-            let capsule = &capsules[index as usize];
-            if capsule.min_z - self.radius > q.z + self.eps {
-                continue;
-            }
-            // Capsules whose lowest point over q lies more than 2ε above it are skipped before the
-            // square root (neither hidden nor a tie, so the same answer).
-            if let Some(entry) = capsule.entry_z_up_to(q.x, q.y, self.r2, q.z + 2.0 * self.eps) {
-                if entry < q.z - self.eps {
-                    *hint = position;
-                    return Cover::Hidden;
+        // From the hint to the end, then the start of the list; each part is sorted by `min_z`,
+        // so its scan stops at the first capsule too high to reach q.
+        for (offset, part) in [(start, &list[start..]), (0, &list[..start])] {
+            for (k, &index) in part.iter().enumerate() {
+                let capsule = &capsules[index as usize];
+                if capsule.min_z - self.radius > q.z + self.eps {
+                    break;
                 }
-                if entry <= q.z + self.eps {
-                    state = Cover::Tie;
+                // Capsules whose lowest point over q lies more than 2ε above it are skipped before
+                // the square root (neither hidden nor a tie, so the same answer).
+                if let Some(entry) = capsule.entry_z_up_to(q.x, q.y, self.r2, q.z + 2.0 * self.eps) {
+                    if entry < q.z - self.eps {
+                        *hint = offset + k;
+                        return Cover::Hidden;
+                    }
+                    if entry <= q.z + self.eps {
+                        state = Cover::Tie;
+                    }
                 }
             }
         }
@@ -300,6 +337,102 @@ impl Scene {
         PointTest {
             state: if after == Cover::Open { SampleState::Finished } else { SampleState::CutAfter },
             cut: before == Cover::Open,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+
+    /// Random pieces near the origin on both sides (some repeated heights, some vertical or
+    /// degenerate).
+    fn pieces() -> impl Strategy<Value = Vec<Piece>> {
+        let point = || (-12.0..12.0_f64, -12.0..12.0_f64, prop_oneof![-8.0..8.0_f64, Just(-1.0)]);
+        prop::collection::vec((point(), point(), any::<bool>(), 0..4u8), 0..60).prop_map(|raw| {
+            raw.into_iter()
+                .map(|((ax, ay, az), (bx, by, bz), before, kind)| {
+                    let a = Vec3::new(ax, ay, az);
+                    let b = match kind {
+                        0 => a,
+                        1 => Vec3::new(ax, ay, bz),
+                        _ => Vec3::new(bx, by, bz),
+                    };
+                    Piece { a, b, side: if before { Side::Before } else { Side::After } }
+                })
+                .collect()
+        })
+    }
+
+    fn frame_box() -> impl Strategy<Value = (Vec3, Vec3)> {
+        (-8.0..8.0_f64, -8.0..8.0_f64, -8.0..4.0_f64, 0.0..3.0_f64, 0.0..3.0_f64, 0.0..2.0_f64)
+            .prop_map(|(x, y, z, w, h, d)| (Vec3::new(x, y, z), Vec3::new(x + w, y + h, z + d)))
+    }
+
+    /// The filter over every capsule, without the early stop.
+    fn brute(capsules: &[Capsule], from: &[u32], lo: &Vec3, hi: &Vec3, r: f64, tie: f64) -> Vec<u32> {
+        from.iter().copied().filter(|&i| capsules[i as usize].may_cover_box(lo, hi, r, tie)).collect()
+    }
+
+    /// The point test over every listed capsule, without the early stop.
+    fn brute_cover(scene: &Scene, q: &Vec3, capsules: &[Capsule], list: &[u32]) -> Cover {
+        let mut state = Cover::Open;
+        for &i in list {
+            if let Some(entry) = capsules[i as usize].entry_z(q.x, q.y, scene.r2) {
+                if entry < q.z - scene.eps {
+                    return Cover::Hidden;
+                }
+                if entry <= q.z + scene.eps {
+                    state = Cover::Tie;
+                }
+            }
+        }
+        state
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 256, .. ProptestConfig::default() })]
+
+        /// The sorted capsules with the early stop give exactly the candidates of the full scan,
+        /// from all capsules and from a pool, and the same point test answers.
+        #[test]
+        fn candidates_match_brute_force(pieces in pieces(), outer in frame_box(), inner in frame_box(), hint in 0..40usize) {
+            let scene = Scene::new(&pieces, Vec3::new(1.0, -2.0, 0.5), Matrix3::identity(), 5.0);
+            prop_assert!(scene.before.is_sorted_by(|p, q| p.min_z <= q.min_z));
+            prop_assert!(scene.after.is_sorted_by(|p, q| p.min_z <= q.min_z));
+            let (r, tie) = (scene.radius, scene.eps);
+            let all_before: Vec<u32> = (0..scene.before.len() as u32).collect();
+            let all_after: Vec<u32> = (0..scene.after.len() as u32).collect();
+            // A pool for a box holding both boxes, then the inner box from it.
+            let (pool_lo, pool_hi) = (outer.0.inf(&inner.0), outer.1.sup(&inner.1));
+            let mut pool = TileLists::default();
+            scene.candidates(&pool_lo, &pool_hi, true, None, &mut pool);
+            prop_assert_eq!(&pool.before, &brute(&scene.before, &all_before, &pool_lo, &pool_hi, r, tie));
+            prop_assert_eq!(&pool.after, &brute(&scene.after, &all_after, &pool_lo, &pool_hi, r, tie));
+            let mut lists = TileLists::default();
+            scene.candidates(&inner.0, &inner.1, true, Some(&pool), &mut lists);
+            prop_assert_eq!(&lists.before, &brute(&scene.before, &pool.before, &inner.0, &inner.1, r, tie));
+            prop_assert_eq!(&lists.after, &brute(&scene.after, &pool.after, &inner.0, &inner.1, r, tie));
+            // Point tests at the inner box's corners and centre, from any starting hint.
+            for k in 0..9 {
+                let q = if k == 8 {
+                    0.5 * (inner.0 + inner.1)
+                } else {
+                    Vec3::new(
+                        if k & 1 == 0 { inner.0.x } else { inner.1.x },
+                        if k & 2 == 0 { inner.0.y } else { inner.1.y },
+                        if k & 4 == 0 { inner.0.z } else { inner.1.z },
+                    )
+                };
+                for (side, capsules, list) in
+                    [(Side::Before, &scene.before, &all_before), (Side::After, &scene.after, &all_after)]
+                {
+                    let mut h = hint;
+                    prop_assert_eq!(scene.cover(&q, side, list, &mut h), brute_cover(&scene, &q, capsules, list));
+                }
+            }
         }
     }
 }

@@ -146,8 +146,9 @@ impl HeightGrid {
         if !(0.0..=max_u).contains(&u) || !(0.0..=max_v).contains(&v) {
             return None;
         }
-        let i = (u.floor() as usize).min(self.nx - 2);
-        let j = (v.floor() as usize).min(self.ny - 2);
+        // u, v ≥ 0 here, so truncation is the floor (without a libm call on baseline x86-64).
+        let i = (u as usize).min(self.nx - 2);
+        let j = (v as usize).min(self.ny - 2);
         let (fu, fv) = (u - i as f64, v - j as f64);
         let h = |di: usize, dj: usize| self.heights[(j + dj) * self.nx + i + di];
         Some((1.0 - fv) * ((1.0 - fu) * h(0, 0) + fu * h(1, 0)) + fv * ((1.0 - fu) * h(0, 1) + fu * h(1, 1)))
