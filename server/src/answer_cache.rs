@@ -109,10 +109,10 @@ mod tests {
         cache.put(a, answer(100));
         cache.put(b, answer(100));
         assert!(cache.get(&a).is_some()); // a is now the most recent
-        for i in 0..6 {
+        for i in 0..7 {
             cache.put([10 + i; 32], answer(100));
         }
-        // 800 bytes hold eight answers: b, the least recently used, went first.
+        // 800 bytes hold eight answers; the ninth pushed out b, the least recently used.
         assert!(cache.get(&b).is_none());
         assert!(cache.get(&a).is_some());
         cache.put(c, answer(101)); // over an eighth of the budget: not kept
