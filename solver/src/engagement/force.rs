@@ -341,70 +341,45 @@ impl ForceModel {
     /// normal r̂, along the travel t̂): the tangential part opposes the edge's motion, the radial
     /// part pushes the tool away from the material.
     pub(crate) fn tooth_force(&self, arcs: &[Arc], tip: f64, feed: Option<&ArcFeed>) -> (f64, f64) {
-        let a = self.table.exponent();
-        // Edge motion: cw teeth run towards smaller θ (velocity −de/dθ), ccw towards larger.
-        let turning = match self.direction {
-            SpindleDirection::Cw => 1.0,
-            SpindleDirection::Ccw => -1.0,
-        };
-        let combine = |sin_part: f64, cos_part: f64| {
-            // w·[turning·(−sin θ, cos θ) + ratio·(−cos θ, −sin θ)].
-            (-turning * sin_part - self.radial_ratio * cos_part, turning * cos_part - self.radial_ratio * sin_part)
-        };
         if self.lag_deg <= 0.0 {
-            if !arcs.iter().any(|arc| arc.contains(tip, END_TOLERANCE)) {
-                return (0.0, 0.0);
-            }
-            let w = feed.map_or(1.0, |f| f.factor(tip).powf(a)) * self.table.integrand(tip.to_radians());
-            let (s, c) = tip.to_radians().sin_cos();
-            return combine(w * s, w * c);
+            return self.edge_point_force(arcs, tip, feed);
         }
         let (low, high) = match self.direction {
             SpindleDirection::Cw => (tip, tip + self.lag_deg),
             SpindleDirection::Ccw => (tip - self.lag_deg, tip),
         };
-        let (mut sin_part, mut cos_part) = (0.0, 0.0);
-        for arc in arcs {
-            let first = ((low - arc.to) / 360.0).floor() as i64;
-            let last = ((high - arc.from) / 360.0).ceil() as i64;
-            for turn in first..=last {
-                let shift = 360.0 * turn as f64;
-                let (x, y) = ((arc.from + shift).max(low), (arc.to + shift).min(high));
-                if y > x {
-                    let (s, c) = self.moments(x, y, feed);
-                    sin_part += s;
-                    cos_part += c;
-                }
-            }
-        }
+        let (sin_part, cos_part) = self.window_moments(arcs, low, high, feed);
         let lag = self.lag_deg.to_radians();
-        combine(sin_part / lag, cos_part / lag)
+        self.tool_frame(sin_part / lag, cos_part / lag)
     }
 
     /// [`Self::tooth_force`] for the part of the edge whose lag runs over `lag` (see
     /// [`Self::tooth_in`]).
     fn tooth_force_in(&self, arcs: &[Arc], tip: f64, feed: Option<&ArcFeed>, lag: (f64, f64)) -> (f64, f64) {
-        let a = self.table.exponent();
-        // Edge motion: cw teeth run towards smaller θ (velocity −de/dθ), ccw towards larger.
-        let turning = match self.direction {
-            SpindleDirection::Cw => 1.0,
-            SpindleDirection::Ccw => -1.0,
-        };
-        let combine = |sin_part: f64, cos_part: f64| {
-            // w·[turning·(−sin θ, cos θ) + ratio·(−cos θ, −sin θ)].
-            (-turning * sin_part - self.radial_ratio * cos_part, turning * cos_part - self.radial_ratio * sin_part)
-        };
         let width = lag.1 - lag.0;
         if width <= 0.0 {
-            let at = self.window(tip, (lag.0, lag.0)).0;
-            if !arcs.iter().any(|arc| arc.contains(at, END_TOLERANCE)) {
-                return (0.0, 0.0);
-            }
-            let w = feed.map_or(1.0, |f| f.factor(at).powf(a)) * self.table.integrand(at.to_radians());
-            let (s, c) = at.to_radians().sin_cos();
-            return combine(w * s, w * c);
+            return self.edge_point_force(arcs, self.window(tip, (lag.0, lag.0)).0, feed);
         }
         let (low, high) = self.window(tip, lag);
+        let (sin_part, cos_part) = self.window_moments(arcs, low, high, feed);
+        let width = width.to_radians();
+        self.tool_frame(sin_part / width, cos_part / width)
+    }
+
+    /// The force of an edge without helix lag whose one point is at `at`: zero outside the arcs.
+    fn edge_point_force(&self, arcs: &[Arc], at: f64, feed: Option<&ArcFeed>) -> (f64, f64) {
+        if !arcs.iter().any(|arc| arc.contains(at, END_TOLERANCE)) {
+            return (0.0, 0.0);
+        }
+        let a = self.table.exponent();
+        let w = feed.map_or(1.0, |f| f.factor(at).powf(a)) * self.table.integrand(at.to_radians());
+        let (s, c) = at.to_radians().sin_cos();
+        self.tool_frame(w * s, w * c)
+    }
+
+    /// The sine and cosine moments of the engaged arcs (every turn of them) inside the edge's
+    /// window [low, high], degrees.
+    fn window_moments(&self, arcs: &[Arc], low: f64, high: f64, feed: Option<&ArcFeed>) -> (f64, f64) {
         let (mut sin_part, mut cos_part) = (0.0, 0.0);
         for arc in arcs {
             let first = ((low - arc.to) / 360.0).floor() as i64;
@@ -419,8 +394,18 @@ impl ForceModel {
                 }
             }
         }
-        let width = width.to_radians();
-        combine(sin_part / width, cos_part / width)
+        (sin_part, cos_part)
+    }
+
+    /// Moments w·sin θ and w·cos θ into the tool frame: w·[turning·(−sin θ, cos θ) +
+    /// ratio·(−cos θ, −sin θ)], where cw teeth run towards smaller θ (velocity −de/dθ), ccw
+    /// towards larger.
+    fn tool_frame(&self, sin_part: f64, cos_part: f64) -> (f64, f64) {
+        let turning = match self.direction {
+            SpindleDirection::Cw => 1.0,
+            SpindleDirection::Ccw => -1.0,
+        };
+        (-turning * sin_part - self.radial_ratio * cos_part, turning * cos_part - self.radial_ratio * sin_part)
     }
 
     /// Largest resultant force on the tool over the tooth phase, N; with a rounded end's

@@ -28,31 +28,41 @@ pub(crate) fn peak_of(flutes: u32, ends: &[f64], sum: impl Fn(f64) -> f64) -> f6
     if flutes == 0 {
         return 0.0;
     }
+    let breaks = breakpoints(flutes, ends);
+    let mut best = breaks.iter().map(|&b| sum(b)).fold(0.0, f64::max);
+    for pair in breaks.windows(2) {
+        if pair[1] - pair[0] > 1e-9 {
+            best = best.max(piece_peak(&sum, pair[0], pair[1]));
+        }
+    }
+    best
+}
+
+/// The breakpoints of one pitch: its ends and every `ends` angle reduced into it, sorted, those
+/// within 1e-12° of each other merged.
+fn breakpoints(flutes: u32, ends: &[f64]) -> Vec<f64> {
     let pitch = 360.0 / f64::from(flutes);
     let mut breaks = vec![0.0, pitch];
     breaks.extend(ends.iter().map(|e| e.rem_euclid(pitch)));
     breaks.sort_by(f64::total_cmp);
     breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-12);
-    let mut best = breaks.iter().map(|&b| sum(b)).fold(0.0, f64::max);
-    for pair in breaks.windows(2) {
-        let (low, high) = (pair[0], pair[1]);
-        if high - low <= 1e-9 {
-            continue;
-        }
-        let step = (high - low) / SCAN as f64;
-        // Interior scan points; the ends are breakpoints, already evaluated.
-        let Some((centre, value)) = (1..SCAN)
-            .map(|i| {
-                let phase = low + step * i as f64;
-                (phase, sum(phase))
-            })
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-        else {
-            continue;
-        };
-        best = best.max(value).max(golden(&sum, centre - step, centre + step));
-    }
-    best
+    breaks
+}
+
+/// The largest value of `sum` inside the piece (low, high): the best of [`SCAN`] − 1 interior
+/// points, refined by golden section around it (the ends are breakpoints, evaluated apart).
+fn piece_peak(sum: &impl Fn(f64) -> f64, low: f64, high: f64) -> f64 {
+    let step = (high - low) / SCAN as f64;
+    let Some((centre, value)) = (1..SCAN)
+        .map(|i| {
+            let phase = low + step * i as f64;
+            (phase, sum(phase))
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+    else {
+        return 0.0;
+    };
+    value.max(golden(sum, centre - step, centre + step))
 }
 
 /// [`peak_of`] for sums with many breakpoints (the height bands of a rounded end): `bound(low,
@@ -68,11 +78,7 @@ pub(crate) fn peak_bounded(
     if flutes == 0 {
         return 0.0;
     }
-    let pitch = 360.0 / f64::from(flutes);
-    let mut breaks = vec![0.0, pitch];
-    breaks.extend(ends.iter().map(|e| e.rem_euclid(pitch)));
-    breaks.sort_by(f64::total_cmp);
-    breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-12);
+    let breaks = breakpoints(flutes, ends);
     let mut best = breaks.iter().map(|&b| sum(b)).fold(0.0, f64::max);
     let mut pieces: Vec<(f64, f64, f64)> = breaks
         .windows(2)
@@ -84,17 +90,7 @@ pub(crate) fn peak_bounded(
         if limit <= best {
             break;
         }
-        let step = (high - low) / SCAN as f64;
-        let Some((centre, value)) = (1..SCAN)
-            .map(|i| {
-                let phase = low + step * i as f64;
-                (phase, sum(phase))
-            })
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-        else {
-            continue;
-        };
-        best = best.max(value).max(golden(&sum, centre - step, centre + step));
+        best = best.max(piece_peak(&sum, low, high));
     }
     best
 }
