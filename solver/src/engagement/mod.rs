@@ -74,6 +74,7 @@ pub mod request;
 mod segments;
 mod stock;
 mod teeth;
+mod wire;
 
 pub use crate::geometry::Direction;
 pub use answer::{
