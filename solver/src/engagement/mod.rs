@@ -72,6 +72,7 @@ pub mod program;
 pub use job::Physics;
 pub mod request;
 mod segments;
+mod series;
 mod stock;
 mod teeth;
 mod wire;
