@@ -61,7 +61,8 @@ impl ExactEngine {
             *angle = wrap_rad(*angle - right_angle);
         }
         self.angles.extend([-PI, -PI / 2.0, 0.0, PI / 2.0]);
-        self.angles.sort_by(f64::total_cmp);
+        // Unstable is enough: angles equal under the total order are the same bits.
+        self.angles.sort_unstable_by(f64::total_cmp);
         self.angles.dedup_by(|a, b| (*a - *b).abs() <= 1e-13);
         self.tests += (self.angles.len() * (self.pieces.len() + 1)) as u64;
         self.check_budget()?;
