@@ -210,6 +210,8 @@ pub(crate) fn evaluate(
     let mut back = Vec::new();
     let mut collisions = Vec::new();
     let mut tooth_sums = ToothSums::default();
+    // The last tangent's bits and heading: along a line every sample has the same tangent.
+    let mut last_heading: Option<([u64; 2], f64)> = None;
     for (index, (station, contact)) in stations.iter().zip(&contacts).enumerate() {
         let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
         let arcs = &contact.arcs;
@@ -262,6 +264,15 @@ pub(crate) fn evaluate(
             collisions.push(station.s);
         }
         let sums = tooth_sums.of(arcs, &job.flute_counts);
+        let bits = [station.tangent.x.to_bits(), station.tangent.y.to_bits()];
+        let heading_deg = match last_heading {
+            Some((last, heading)) if last == bits => heading,
+            _ => {
+                let heading = station.tangent.y.atan2(station.tangent.x).to_degrees();
+                last_heading = Some((bits, heading));
+                heading
+            }
+        };
         let edge_feed = if job.arc_feed { ArcFeed::at(route, station, radius) } else { None };
         let (torques, forces): (Vec<SampleTorque>, Vec<f64>) =
             candidate.force.as_ref().map_or_else(Default::default, |model| {
@@ -283,7 +294,7 @@ pub(crate) fn evaluate(
             s: station.s,
             t: 60.0 * station.feed_s / nominal_feed,
             position: [station.centre.x, station.centre.y],
-            heading_deg: station.tangent.y.atan2(station.tangent.x).to_degrees(),
+            heading_deg,
             segment: route.pieces.get(station.piece).map_or(0, |p| p.source),
             arcs: arcs.iter().map(|a| [a.from, a.to]).collect(),
             engaged_deg: arcs::engaged_deg(arcs),
