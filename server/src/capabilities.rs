@@ -309,7 +309,7 @@ pub fn solve<C: Capability>(
     if timings {
         C::record_time(&mut answer, seconds);
     }
-    let bytes = serde_json::to_vec(&answer).map_err(|error| AppError::Internal(error.into()))?;
+    let bytes = C::to_json(answer).map_err(|error| AppError::Internal(error.into()))?;
     Ok((Delivered::Json(bytes), seconds))
 }
 

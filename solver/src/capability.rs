@@ -76,6 +76,15 @@ pub trait Capability {
     /// Records how long the solve took, for capabilities whose answer reports it.
     fn record_time(_answer: &mut Self::Answer, _seconds: f64) {}
 
+    /// The answer as its endpoint's JSON: `serde_json::to_vec`, or the same bytes written faster
+    /// (engagement, whose samples are most of a large answer).
+    ///
+    /// # Errors
+    /// When the answer cannot be serialised.
+    fn to_json(answer: Self::Answer) -> serde_json::Result<Vec<u8>> {
+        serde_json::to_vec(&answer)
+    }
+
     /// Splits the request's work into parts that different workers may solve at once (issue 12,
     /// a job split into chunks): ranges of its units of work (prediction passes, candidate
     /// paths) sized after `sizing`, each solved by [`Capability::solve_part`], then merged by

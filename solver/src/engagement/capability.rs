@@ -203,6 +203,10 @@ impl Capability for EngagementCapability {
     fn machine(answer: &EngagementResponse) -> Option<&MachineProfile> {
         answer.machine.as_ref()
     }
+
+    fn to_json(answer: EngagementResponse) -> serde_json::Result<Vec<u8>> {
+        super::wire::to_json(answer)
+    }
 }
 
 /// A plunge feed, when given, must be positive.

@@ -14,6 +14,7 @@ use super::heights::{Bands, MAX_SECTIONS};
 use super::job::{CandidateJob, Job, grid_extent};
 use super::request::Engine;
 use super::segments::{Route, Station};
+use super::series::{self, Series};
 use super::stock::{Base, Region};
 use super::teeth::ToothSums;
 use super::{MAX_CONTACT_DOTS, feed, flutes};
@@ -167,24 +168,6 @@ fn list_intervals(intervals: &[[f64; 2]]) -> String {
     if more > 0 { format!("s = {} and {more} more", shown.join(", ")) } else { format!("s = {}", shown.join(", ")) }
 }
 
-/// Runs of consecutive samples where `test` holds, as [s_first, s_last].
-pub(crate) fn runs(samples: &[EngagementSample], test: impl Fn(usize) -> bool) -> Vec<[f64; 2]> {
-    let mut intervals: Vec<[f64; 2]> = Vec::new();
-    let mut open = false;
-    for (index, sample) in samples.iter().enumerate() {
-        if test(index) {
-            match intervals.last_mut() {
-                Some(last) if open => last[1] = sample.s,
-                _ => intervals.push([sample.s, sample.s]),
-            }
-            open = true;
-        } else {
-            open = false;
-        }
-    }
-    intervals
-}
-
 fn stock_description(region: &Region) -> String {
     match &region.base {
         Base::Polygons(outline) => {
@@ -219,6 +202,7 @@ pub(crate) fn evaluate(
     let nominal_feed = job.feed_mode.feed(time_flutes, job.spindle_rpm);
     let nominal_fz = job.feed_mode.feed_per_tooth(time_flutes, job.spindle_rpm);
     let mut samples = Vec::with_capacity(stations.len());
+    let mut series = Series::with_capacity(stations.len(), job.flute_counts.len());
     let mut statistic = Vec::with_capacity(stations.len());
     let mut warnings = job.shared_warnings.clone();
     warnings.extend(candidate.warnings.iter().cloned());
@@ -226,6 +210,8 @@ pub(crate) fn evaluate(
     let mut back = Vec::new();
     let mut collisions = Vec::new();
     let mut tooth_sums = ToothSums::default();
+    // The last tangent's bits and heading: along a line every sample has the same tangent.
+    let mut last_heading: Option<([u64; 2], f64)> = None;
     for (index, (station, contact)) in stations.iter().zip(&contacts).enumerate() {
         let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
         let arcs = &contact.arcs;
@@ -278,6 +264,15 @@ pub(crate) fn evaluate(
             collisions.push(station.s);
         }
         let sums = tooth_sums.of(arcs, &job.flute_counts);
+        let bits = [station.tangent.x.to_bits(), station.tangent.y.to_bits()];
+        let heading_deg = match last_heading {
+            Some((last, heading)) if last == bits => heading,
+            _ => {
+                let heading = station.tangent.y.atan2(station.tangent.x).to_degrees();
+                last_heading = Some((bits, heading));
+                heading
+            }
+        };
         let edge_feed = if job.arc_feed { ArcFeed::at(route, station, radius) } else { None };
         let (torques, forces): (Vec<SampleTorque>, Vec<f64>) =
             candidate.force.as_ref().map_or_else(Default::default, |model| {
@@ -299,7 +294,7 @@ pub(crate) fn evaluate(
             s: station.s,
             t: 60.0 * station.feed_s / nominal_feed,
             position: [station.centre.x, station.centre.y],
-            heading_deg: station.tangent.y.atan2(station.tangent.x).to_degrees(),
+            heading_deg,
             segment: route.pieces.get(station.piece).map_or(0, |p| p.source),
             arcs: arcs.iter().map(|a| [a.from, a.to]).collect(),
             engaged_deg: arcs::engaged_deg(arcs),
@@ -325,11 +320,13 @@ pub(crate) fn evaluate(
             mrr: candidate.axial_depth.map(|depth| depth * radial_depth * nominal_feed),
             flags,
         });
+        if let Some(sample) = samples.last() {
+            series.push(sample);
+        }
     }
 
     // Diagnostics (engagement.md §9).
-    let engaged_intervals =
-        runs(&samples, |i| !samples[i].arcs.is_empty() && !samples[i].flags.contains(&SampleFlag::Rapid));
+    let engaged_intervals = series.runs(|i| series.arc_count[i] > 0 && !series.marked(i, series::RAPID));
     if !statistic.iter().any(|s| *s) {
         warnings.push(Warning::new(
             "W_NO_CONTACT",
@@ -350,7 +347,7 @@ pub(crate) fn evaluate(
         ));
     }
     if !back.is_empty() {
-        let intervals = runs(&samples, |i| samples[i].flags.contains(&SampleFlag::BackContact));
+        let intervals = series.runs(|i| series.marked(i, series::BACK_CONTACT));
         warnings.push(Warning::new(
             "W_PLUNGE",
             format!(
@@ -360,7 +357,7 @@ pub(crate) fn evaluate(
         ));
     }
     if !collisions.is_empty() {
-        let intervals = runs(&samples, |i| samples[i].flags.contains(&SampleFlag::Collision));
+        let intervals = series.runs(|i| series.marked(i, series::COLLISION));
         warnings.push(Warning::new(
             "W_RAPID_COLLISION",
             format!(
@@ -369,14 +366,14 @@ pub(crate) fn evaluate(
             ),
         ));
     }
-    let immersion = runs(&samples, |i| samples[i].engaged_deg >= FULL_IMMERSION_DEG);
+    let immersion = series.runs(|i| series.engaged_deg[i] >= FULL_IMMERSION_DEG);
     if !immersion.is_empty() {
         warnings.push(Warning::new(
             "W_FULL_IMMERSION",
             format!("full immersion (slotting, Φ ≥ {FULL_IMMERSION_DEG}°) at {}", list_intervals(&immersion)),
         ));
     }
-    let multi_arc = runs(&samples, |i| samples[i].arcs.len() >= 2);
+    let multi_arc = series.runs(|i| series.arc_count[i] >= 2);
     if !multi_arc.is_empty() {
         warnings.push(Warning::new(
             "W_MULTI_ARC",
@@ -384,9 +381,9 @@ pub(crate) fn evaluate(
         ));
     }
     if let Some(threshold) = job.spike_threshold {
-        let spikes = runs(&samples, |i| {
+        let spikes = series.runs(|i| {
             i > 0 && statistic[i] && statistic[i - 1] && {
-                let jump = (samples[i].engaged_deg - samples[i - 1].engaged_deg).abs();
+                let jump = (series.engaged_deg[i] - series.engaged_deg[i - 1]).abs();
                 jump > threshold
             }
         });
@@ -473,19 +470,18 @@ pub(crate) fn evaluate(
         ));
     }
     let (flute_results, recommended, flute_warnings) =
-        flutes::results(job, candidate.force.as_ref(), &samples, &statistic, route.feed_length);
+        flutes::results(job, candidate.force.as_ref(), &samples, &series, &statistic, route.feed_length);
     warnings.extend(flute_warnings);
     let feed_plan =
         job.plan.as_ref().map(|plan| feed::plan(job, candidate.force.as_ref(), plan, route, &stations, &contacts));
 
-    let (max_engaged_deg, max_engaged_at_s) = samples
-        .iter()
+    let (max_engaged_deg, max_engaged_at_s) = (series.engaged_deg.iter().zip(&series.s))
         .zip(&statistic)
         .filter(|(_, s)| **s)
-        .map(|(sample, _)| (sample.engaged_deg, sample.s))
+        .map(|((&phi, &s), _)| (phi, s))
         .fold((0.0, 0.0), |best, (phi, s)| if phi > best.0 { (phi, s) } else { best });
     let max_radial_depth =
-        samples.iter().zip(&statistic).filter(|(_, s)| **s).map(|(sample, _)| sample.radial_depth).fold(0.0, f64::max);
+        series.radial_depth.iter().zip(&statistic).filter(|(_, s)| **s).map(|(&depth, _)| depth).fold(0.0, f64::max);
     let (contact_dots, grid) = match dots {
         Some(output) => {
             let mut scatter = output.scatter;

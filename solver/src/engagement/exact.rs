@@ -29,6 +29,9 @@ pub(crate) struct ExactEngine {
     tests: u64,
     /// Tests allowed before the engine gives up; at least [`MAX_TESTS`].
     limit: u64,
+    /// The last normal's bits and its polar angle: along a line every sample has the same
+    /// normal, and the angle is a pure function of it.
+    last_angle: Option<([u64; 2], f64)>,
 }
 
 impl ExactEngine {
@@ -56,12 +59,21 @@ impl ExactEngine {
         }
         region.crossings(centre, radius, &mut self.angles);
         // Global polar angle γ ↦ tool angle θ = γ − angle of the right-hand normal (§4.1).
-        let right_angle = right.y.atan2(right.x);
+        let bits = [right.x.to_bits(), right.y.to_bits()];
+        let right_angle = match self.last_angle {
+            Some((last, angle)) if last == bits => angle,
+            _ => {
+                let angle = right.y.atan2(right.x);
+                self.last_angle = Some((bits, angle));
+                angle
+            }
+        };
         for angle in &mut self.angles {
             *angle = wrap_rad(*angle - right_angle);
         }
         self.angles.extend([-PI, -PI / 2.0, 0.0, PI / 2.0]);
-        self.angles.sort_by(f64::total_cmp);
+        // Unstable is enough: angles equal under the total order are the same bits.
+        self.angles.sort_unstable_by(f64::total_cmp);
         self.angles.dedup_by(|a, b| (*a - *b).abs() <= 1e-13);
         self.tests += (self.angles.len() * (self.pieces.len() + 1)) as u64;
         self.check_budget()?;

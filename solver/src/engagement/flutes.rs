@@ -2,11 +2,11 @@
 //! multi-tooth intervals, and the recommendation under the two limits (§5.9).
 
 use super::answer::{EngagementSample, FluteResult};
-use super::evaluate::runs;
 use super::force::{ForceModel, power_kw};
 use super::job::{FeedMode, Job};
 use super::limits::{RESONANCE_BAND, resonance, tooth_passing_hz};
 use super::request::Representative;
+use super::series::Series;
 use crate::error::Warning;
 
 /// Relative slack of the limit comparisons, so a value equal to its limit passes.
@@ -25,10 +25,12 @@ fn statistics(values: &[f64], weights: &[f64]) -> (f64, f64, f64, f64) {
     } else {
         values.iter().sum::<f64>() / values.len() as f64
     };
-    let mut sorted = values.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    let middle = sorted.len() / 2;
-    let median = if sorted.len() % 2 == 1 { sorted[middle] } else { 0.5 * (sorted[middle - 1] + sorted[middle]) };
+    // The middle element(s) of the sorted values, found without sorting them all.
+    let mut values = values.to_vec();
+    let middle = values.len() / 2;
+    let odd = values.len() % 2 == 1;
+    let (below, &mut at, _) = values.select_nth_unstable_by(middle, f64::total_cmp);
+    let median = if odd { at } else { 0.5 * (below.iter().copied().max_by(f64::total_cmp).unwrap_or(at) + at) };
     (max, min, mean.clamp(min, max), median)
 }
 
@@ -38,25 +40,23 @@ pub(crate) fn results(
     job: &Job,
     force: Option<&ForceModel>,
     samples: &[EngagementSample],
+    series: &Series,
     statistic: &[bool],
     feed_length: f64,
 ) -> (Vec<FluteResult>, Vec<u32>, Vec<Warning>) {
     let mut warnings = Vec::new();
-    let weights: Vec<f64> = samples
+    let positions = &series.s;
+    let weights: Vec<f64> = positions
         .iter()
         .enumerate()
         .filter(|(i, _)| statistic.get(*i).copied().unwrap_or(false))
-        .map(|(i, sample)| sample.s - samples.get(i.wrapping_sub(1)).map_or(sample.s, |p| p.s))
+        .map(|(i, &s)| s - positions.get(i.wrapping_sub(1)).map_or(s, |&p| p))
         .collect();
     let mut results = Vec::with_capacity(job.flute_counts.len());
     let mut failures = Vec::new();
     for (column, &k) in job.flute_counts.iter().enumerate() {
-        let values: Vec<f64> = samples
-            .iter()
-            .zip(statistic)
-            .filter(|(_, s)| **s)
-            .map(|(sample, _)| sample.thickness.get(column).copied().unwrap_or(0.0))
-            .collect();
+        let (thickness, teeth) = (&series.thickness[column], &series.teeth[column]);
+        let values: Vec<f64> = thickness.iter().zip(statistic).filter(|(_, s)| **s).map(|(&h, _)| h).collect();
         let (max, min, mean, median) = statistics(&values, &weights);
         let feed_per_tooth = job.feed_mode.feed_per_tooth(k, job.spindle_rpm);
         let feed = job.feed_mode.feed(k, job.spindle_rpm);
@@ -81,10 +81,8 @@ pub(crate) fn results(
         if !reasons.is_empty() {
             failures.push(format!("k = {k}: {}", reasons.join(", ")));
         }
-        let multi_tooth_intervals = runs(samples, |i| {
-            statistic.get(i).copied().unwrap_or(false)
-                && samples.get(i).and_then(|s| s.teeth.get(column)).is_some_and(|n| *n >= 2)
-        });
+        let multi_tooth_intervals =
+            series.runs(|i| statistic.get(i).copied().unwrap_or(false) && teeth.get(i).is_some_and(|n| *n >= 2));
         if !multi_tooth_intervals.is_empty() {
             warnings.push(Warning::new(
                 "W_MULTI_TOOTH",
@@ -104,7 +102,7 @@ pub(crate) fn results(
             ));
         }
         let forces = force_statistics(force, samples, statistic, &weights, column);
-        warnings.extend(limit_warnings(job, force, samples, statistic, column, k));
+        warnings.extend(limit_warnings(job, force, samples, series, statistic, column, k));
         // With the force model only, so that answers without it stay as they were.
         let tooth_passing_hz = force.is_some().then(|| tooth_passing_hz(job.spindle_rpm, k));
         if let Some((natural, axis)) = tooth_passing_hz.and_then(|f| resonance(f, &job.natural)) {
@@ -117,13 +115,7 @@ pub(crate) fn results(
                 ),
             ));
         }
-        let max_teeth = samples
-            .iter()
-            .zip(statistic)
-            .filter(|(_, s)| **s)
-            .filter_map(|(sample, _)| sample.teeth.get(column).copied())
-            .max()
-            .unwrap_or(0);
+        let max_teeth = teeth.iter().zip(statistic).filter(|(_, s)| **s).map(|(&n, _)| n).max().unwrap_or(0);
         results.push(FluteResult {
             flute_count: k,
             feed_per_tooth,
@@ -197,6 +189,7 @@ fn limit_warnings(
     job: &Job,
     force: Option<&ForceModel>,
     samples: &[EngagementSample],
+    series: &Series,
     statistic: &[bool],
     column: usize,
     k: u32,
@@ -205,11 +198,11 @@ fn limit_warnings(
     if force.is_none() {
         return warnings;
     }
-    let series = |pick: fn(&EngagementSample) -> &[f64]| -> Vec<f64> {
+    let column_of = |pick: fn(&EngagementSample) -> &[f64]| -> Vec<f64> {
         samples.iter().map(|s| pick(s).get(column).copied().unwrap_or(0.0)).collect()
     };
-    let power = series(|s| &s.power_kw);
-    let torque = series(|s| &s.torque_nm);
+    let power = column_of(|s| &s.power_kw);
+    let torque = column_of(|s| &s.torque_nm);
     let checks = [
         ("W_SPINDLE_POWER", "power", "kW", job.spindle.spindle_power_kw, &power),
         ("W_SPINDLE_TORQUE", "torque", "N·m", job.spindle.spindle_torque_nm, &torque),
@@ -217,7 +210,7 @@ fn limit_warnings(
     for (code, what, unit, limit, values) in checks {
         let Some(limit) = limit else { continue };
         let over = |i: usize| statistic.get(i).copied().unwrap_or(false) && values[i] > limit * (1.0 + LIMIT_SLACK);
-        let intervals = runs(samples, over);
+        let intervals = series.runs(over);
         if intervals.is_empty() {
             continue;
         }

@@ -72,8 +72,10 @@ pub mod program;
 pub use job::Physics;
 pub mod request;
 mod segments;
+mod series;
 mod stock;
 mod teeth;
+mod wire;
 
 pub use crate::geometry::Direction;
 pub use answer::{
