@@ -189,11 +189,7 @@ impl ForceModel {
     /// helix the mean over the lag window behind the tip.
     pub(crate) fn tooth(&self, arcs: &[Arc], tip: f64, feed: Option<&ArcFeed>) -> f64 {
         if self.lag_deg <= 0.0 {
-            if !arcs.iter().any(|a| a.contains(tip, END_TOLERANCE)) {
-                return 0.0;
-            }
-            let factor = feed.map_or(1.0, |f| f.factor(tip).powf(self.table.exponent()));
-            return factor * self.table.integrand(tip.to_radians());
+            return self.edge_point(arcs, tip, feed).unwrap_or(0.0);
         }
         // The edge above the tip trails it: cw teeth run towards smaller θ, so the trailing
         // edge sits at larger θ; ccw the other way.
@@ -202,18 +198,7 @@ impl ForceModel {
             SpindleDirection::Ccw => (tip - self.lag_deg, tip),
         };
         let mut total = 0.0;
-        for arc in arcs {
-            // Copies of the arc, one turn apart, that overlap the window.
-            let first = ((low - arc.to) / 360.0).floor() as i64;
-            let last = ((high - arc.from) / 360.0).ceil() as i64;
-            for turn in first..=last {
-                let shift = 360.0 * turn as f64;
-                let (a, b) = ((arc.from + shift).max(low), (arc.to + shift).min(high));
-                if b > a {
-                    total += self.between(a, b, feed);
-                }
-            }
-        }
+        in_window(arcs, low, high, |a, b| total += self.between(a, b, feed));
         total / self.lag_deg.to_radians()
     }
 
@@ -279,27 +264,11 @@ impl ForceModel {
     fn tooth_in(&self, arcs: &[Arc], tip: f64, feed: Option<&ArcFeed>, lag: (f64, f64)) -> f64 {
         let width = lag.1 - lag.0;
         if width <= 0.0 {
-            let at = self.window(tip, (lag.0, lag.0)).0;
-            if !arcs.iter().any(|a| a.contains(at, END_TOLERANCE)) {
-                return 0.0;
-            }
-            let factor = feed.map_or(1.0, |f| f.factor(at).powf(self.table.exponent()));
-            return factor * self.table.integrand(at.to_radians());
+            return self.edge_point(arcs, self.window(tip, (lag.0, lag.0)).0, feed).unwrap_or(0.0);
         }
         let (low, high) = self.window(tip, lag);
         let mut total = 0.0;
-        for arc in arcs {
-            // Copies of the arc, one turn apart, that overlap the window.
-            let first = ((low - arc.to) / 360.0).floor() as i64;
-            let last = ((high - arc.from) / 360.0).ceil() as i64;
-            for turn in first..=last {
-                let shift = 360.0 * turn as f64;
-                let (a, b) = ((arc.from + shift).max(low), (arc.to + shift).min(high));
-                if b > a {
-                    total += self.between(a, b, feed);
-                }
-            }
-        }
+        in_window(arcs, low, high, |a, b| total += self.between(a, b, feed));
         total / width.to_radians()
     }
 
@@ -366,13 +335,18 @@ impl ForceModel {
         self.tool_frame(sin_part / width, cos_part / width)
     }
 
+    /// The sin^a term of an edge without helix lag whose one point is at `at`; `None` outside
+    /// the arcs.
+    fn edge_point(&self, arcs: &[Arc], at: f64, feed: Option<&ArcFeed>) -> Option<f64> {
+        arcs.iter().any(|arc| arc.contains(at, END_TOLERANCE)).then(|| {
+            let factor = feed.map_or(1.0, |f| f.factor(at).powf(self.table.exponent()));
+            factor * self.table.integrand(at.to_radians())
+        })
+    }
+
     /// The force of an edge without helix lag whose one point is at `at`: zero outside the arcs.
     fn edge_point_force(&self, arcs: &[Arc], at: f64, feed: Option<&ArcFeed>) -> (f64, f64) {
-        if !arcs.iter().any(|arc| arc.contains(at, END_TOLERANCE)) {
-            return (0.0, 0.0);
-        }
-        let a = self.table.exponent();
-        let w = feed.map_or(1.0, |f| f.factor(at).powf(a)) * self.table.integrand(at.to_radians());
+        let Some(w) = self.edge_point(arcs, at, feed) else { return (0.0, 0.0) };
         let (s, c) = at.to_radians().sin_cos();
         self.tool_frame(w * s, w * c)
     }
@@ -381,19 +355,11 @@ impl ForceModel {
     /// window [low, high], degrees.
     fn window_moments(&self, arcs: &[Arc], low: f64, high: f64, feed: Option<&ArcFeed>) -> (f64, f64) {
         let (mut sin_part, mut cos_part) = (0.0, 0.0);
-        for arc in arcs {
-            let first = ((low - arc.to) / 360.0).floor() as i64;
-            let last = ((high - arc.from) / 360.0).ceil() as i64;
-            for turn in first..=last {
-                let shift = 360.0 * turn as f64;
-                let (x, y) = ((arc.from + shift).max(low), (arc.to + shift).min(high));
-                if y > x {
-                    let (s, c) = self.moments(x, y, feed);
-                    sin_part += s;
-                    cos_part += c;
-                }
-            }
-        }
+        in_window(arcs, low, high, |x, y| {
+            let (s, c) = self.moments(x, y, feed);
+            sin_part += s;
+            cos_part += c;
+        });
         (sin_part, cos_part)
     }
 
@@ -653,6 +619,23 @@ impl ForceModel {
             largest - smallest
         };
         (largest, change)
+    }
+}
+
+/// Calls `piece(from, to)` for every part of the arcs, each turn of them, inside the window
+/// [low, high], degrees.
+fn in_window(arcs: &[Arc], low: f64, high: f64, mut piece: impl FnMut(f64, f64)) {
+    for arc in arcs {
+        // Copies of the arc, one turn apart, that overlap the window.
+        let first = ((low - arc.to) / 360.0).floor() as i64;
+        let last = ((high - arc.from) / 360.0).ceil() as i64;
+        for turn in first..=last {
+            let shift = 360.0 * turn as f64;
+            let (from, to) = ((arc.from + shift).max(low), (arc.to + shift).min(high));
+            if to > from {
+                piece(from, to);
+            }
+        }
     }
 }
 
