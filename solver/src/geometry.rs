@@ -40,6 +40,21 @@ pub fn array3(v: &Vec3) -> [f64; 3] {
     [v.x, v.y, v.z]
 }
 
+/// Serde for an optional vector as `[x, y, z]` (nalgebra is built without serde): every
+/// coordinate exactly, for values kept between a job's parts.
+pub(crate) mod optional_vec3 {
+    use super::{Vec3, array3, vec3};
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub(crate) fn serialize<S: Serializer>(value: &Option<Vec3>, serializer: S) -> Result<S::Ok, S::Error> {
+        value.as_ref().map(array3).serialize(serializer)
+    }
+
+    pub(crate) fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Option<Vec3>, D::Error> {
+        Ok(Option::<[f64; 3]>::deserialize(deserializer)?.map(vec3))
+    }
+}
+
 /// Right-handed rotation about +Z by `angle` radians.
 pub fn rotation_z(angle: f64) -> Matrix3<f64> {
     let (s, c) = angle.sin_cos();

@@ -354,11 +354,7 @@ pub async fn insert(db: &Db, job: &JobFile, hash: &str, quota: u64) -> AppResult
             .bind(count)
             .execute(&mut *transaction)
             .await?;
-            sqlx::query("SELECT pg_notify($1, $2)")
-                .bind(SUBMITTED_CHANNEL)
-                .bind(id.to_string())
-                .execute(&mut *transaction)
-                .await?;
+            wake_workers(&mut transaction, id).await?;
             transaction.commit().await?;
             Ok(id)
         }
@@ -606,13 +602,19 @@ pub async fn split(db: &Db, work: Work, claimant: &Claimant, split: &Split) -> A
     .execute(&mut *transaction)
     .await?;
     sqlx::query(JOB_PROGRESS).bind(work.id).execute(&mut *transaction).await?;
-    sqlx::query("SELECT pg_notify($1, $2)")
-        .bind(SUBMITTED_CHANNEL)
-        .bind(work.id.to_string())
-        .execute(&mut *transaction)
-        .await?;
+    wake_workers(&mut transaction, work.id).await?;
     transaction.commit().await?;
     Ok(true)
+}
+
+/// Wakes idle workers (`LISTEN/NOTIFY`) when `transaction` commits: job `id` has work to claim.
+async fn wake_workers(transaction: &mut sqlx::Transaction<'_, sqlx::Postgres>, id: i64) -> AppResult<()> {
+    sqlx::query("SELECT pg_notify($1, $2)")
+        .bind(SUBMITTED_CHANNEL)
+        .bind(id.to_string())
+        .execute(&mut **transaction)
+        .await?;
+    Ok(())
 }
 
 /// The outputs of operation `operation`'s parts, in unit order: each gzip-compressed, with the
@@ -945,11 +947,7 @@ pub async fn finish_part(
     .fetch_one(&mut *transaction)
     .await?;
     if left == 0 {
-        sqlx::query("SELECT pg_notify($1, $2)")
-            .bind(SUBMITTED_CHANNEL)
-            .bind(work.id.to_string())
-            .execute(&mut *transaction)
-            .await?;
+        wake_workers(&mut transaction, work.id).await?;
     }
     transaction.commit().await?;
     Ok(Finished::Stored)

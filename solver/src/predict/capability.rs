@@ -5,7 +5,7 @@ use std::sync::atomic::AtomicUsize;
 
 use serde::{Deserialize, Serialize};
 
-use super::answer::{PassFlag, PassHistory, PassStatus};
+use super::answer::PassStatus;
 use super::pipeline::{self, Context, Outcome};
 use super::request::Method;
 use super::{PathInput, Predict, PredictRequest, ProgramOptions, Stock, correct};
@@ -14,7 +14,7 @@ use crate::capability::{
 };
 use crate::error::{ErrorCode, SolverError};
 use crate::gcode::{Reference, ToolCall};
-use crate::geometry::{Vec3, array3, vec3};
+use crate::geometry::Vec3;
 use crate::machine::MachineProfile;
 use crate::tool::Tool;
 
@@ -115,7 +115,7 @@ impl Capability for PredictCapability {
         let mut ranged = request.clone();
         ranged.pass_range = Some([part.units.start, part.units.end]);
         let job = ranged.validate(&context.tool, run.upload)?;
-        let outcomes = pipeline::run_round(
+        let mut outcomes = pipeline::run_round(
             &Context::new(&job),
             &job.path,
             &run.control,
@@ -123,7 +123,7 @@ impl Capability for PredictCapability {
             job.pass_range.len().max(1),
         )
         .ok_or_else(pipeline::cancelled)?;
-        let passes = outcomes[job.pass_range.clone()].iter().map(PartPass::from).collect();
+        let passes = outcomes.drain(job.pass_range.clone()).collect();
         sink.put(&PartPasses { from: job.pass_range.start, passes })
     }
 
@@ -146,7 +146,7 @@ impl Capability for PredictCapability {
             for (offset, pass) in part.passes.into_iter().enumerate() {
                 let index = part.from + offset;
                 match outcomes.get_mut(index) {
-                    Some(slot @ None) if job.pass_range.contains(&index) => *slot = Some(pass.into()),
+                    Some(slot @ None) if job.pass_range.contains(&index) => *slot = Some(pass),
                     _ => return Err(mismatch(format!("pass {index} is outside the request or in two parts"))),
                 }
             }
@@ -159,7 +159,7 @@ impl Capability for PredictCapability {
             .enumerate()
             .map(|(index, outcome)| match outcome {
                 Some(outcome) => Ok(outcome),
-                None if !job.pass_range.contains(&index) => Ok(PartPass::not_predicted().into()),
+                None if !job.pass_range.contains(&index) => Ok(Outcome::empty(PassStatus::NotPredicted)),
                 None => Err(mismatch(format!("no part predicted pass {index}"))),
             })
             .collect::<Result<Vec<Outcome>, SolverError>>()?;
@@ -292,128 +292,7 @@ fn cost(job: &super::job::Job) -> Cost {
 #[derive(Debug, Serialize, Deserialize)]
 struct PartPasses {
     from: usize,
-    passes: Vec<PartPass>,
-}
-
-/// One pass's [`Outcome`] as stored between a part and the finish step (vectors as arrays, angles
-/// in radians: every number exactly as computed).
-#[derive(Debug, Serialize, Deserialize)]
-struct PartPass {
-    status: PassStatus,
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    flags: Vec<PassFlag>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    position: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    centre: Option<[f64; 3]>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    error: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    error_deflection: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    error_shape: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    contact_angle: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    azimuth: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    rotation_angle: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    point: Option<[f64; 3]>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    normal: Option<[f64; 3]>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    deflection: Option<[f64; 2]>,
-    #[serde(default)]
-    cut_count: usize,
-    #[serde(default)]
-    finished_count: usize,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    view: Option<[f64; 3]>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    history: Option<PassHistory>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    merged_with: Option<usize>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    merge_bound: Option<f64>,
-}
-
-impl PartPass {
-    fn not_predicted() -> Self {
-        Self {
-            status: PassStatus::NotPredicted,
-            flags: Vec::new(),
-            position: None,
-            centre: None,
-            error: None,
-            error_deflection: None,
-            error_shape: None,
-            contact_angle: None,
-            azimuth: None,
-            rotation_angle: None,
-            point: None,
-            normal: None,
-            deflection: None,
-            cut_count: 0,
-            finished_count: 0,
-            view: None,
-            history: None,
-            merged_with: None,
-            merge_bound: None,
-        }
-    }
-}
-
-impl From<&Outcome> for PartPass {
-    fn from(o: &Outcome) -> Self {
-        Self {
-            status: o.status,
-            flags: o.flags.clone(),
-            position: o.position,
-            centre: o.centre.as_ref().map(array3),
-            error: o.error,
-            error_deflection: o.error_deflection,
-            error_shape: o.error_shape,
-            contact_angle: o.contact_angle,
-            azimuth: o.azimuth,
-            rotation_angle: o.rotation_angle,
-            point: o.point.as_ref().map(array3),
-            normal: o.normal.as_ref().map(array3),
-            deflection: o.deflection,
-            cut_count: o.cut_count,
-            finished_count: o.finished_count,
-            view: o.view.as_ref().map(array3),
-            history: o.history.clone(),
-            merged_with: o.merged_with,
-            merge_bound: o.merge_bound,
-        }
-    }
-}
-
-impl From<PartPass> for Outcome {
-    fn from(p: PartPass) -> Self {
-        Self {
-            status: p.status,
-            flags: p.flags,
-            position: p.position,
-            centre: p.centre.map(vec3),
-            error: p.error,
-            error_deflection: p.error_deflection,
-            error_shape: p.error_shape,
-            contact_angle: p.contact_angle,
-            azimuth: p.azimuth,
-            rotation_angle: p.rotation_angle,
-            point: p.point.map(vec3),
-            normal: p.normal.map(vec3),
-            deflection: p.deflection,
-            cut_count: p.cut_count,
-            finished_count: p.finished_count,
-            view: p.view.map(vec3),
-            history: p.history,
-            merged_with: p.merged_with,
-            merge_bound: p.merge_bound,
-        }
-    }
+    passes: Vec<Outcome>,
 }
 
 /// A G-code path is written back with its own programmed point: another one is refused.

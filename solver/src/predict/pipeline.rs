@@ -9,6 +9,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use nalgebra::Matrix3;
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 use super::answer::{PassFlag, PassHistory, PassStatus};
 use super::dynamics::{self, Compliance};
@@ -24,40 +25,59 @@ use super::scene::{self, Scene, Scratch};
 use super::shape;
 use crate::capability::Control;
 use crate::error::SolverError;
-use crate::geometry::Vec3;
+use crate::geometry::{Vec3, optional_vec3};
 
 /// Most prediction positions tried along one pass (§3.3).
 const MAX_STATIONS: usize = 17;
 /// Fewest finished pixels before the view is corrected (§5 E5).
 const MIN_FINISHED_PIXELS: usize = 4;
 
-/// What one pass gives.
-#[derive(Debug, Clone, PartialEq)]
+/// What one pass gives; serialised (vectors as arrays, angles in radians, every number exactly
+/// as computed) between a split prediction's parts and its finish step.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub(crate) struct Outcome {
     pub(crate) status: PassStatus,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub(crate) flags: Vec<PassFlag>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) position: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "optional_vec3")]
     pub(crate) centre: Option<Vec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) error: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) error_deflection: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) error_shape: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) contact_angle: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) azimuth: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) rotation_angle: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "optional_vec3")]
     pub(crate) point: Option<Vec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "optional_vec3")]
     pub(crate) normal: Option<Vec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) deflection: Option<[f64; 2]>,
+    #[serde(default)]
     pub(crate) cut_count: usize,
+    #[serde(default)]
     pub(crate) finished_count: usize,
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "optional_vec3")]
     pub(crate) view: Option<Vec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) history: Option<PassHistory>,
     /// Merged: the simulated pass whose result this is, and the bound on the difference.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) merged_with: Option<usize>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) merge_bound: Option<f64>,
 }
 
 impl Outcome {
-    fn empty(status: PassStatus) -> Self {
+    pub(crate) fn empty(status: PassStatus) -> Self {
         Self {
             status,
             flags: Vec::new(),
