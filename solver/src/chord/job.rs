@@ -284,9 +284,9 @@ impl Curve {
                     .at("curve.control_points"));
                 }
                 let breaks: Vec<f64> = nurbs.breaks().iter().map(|(knot, _)| *knot).collect();
-                let speed = |u: f64| nurbs.derivatives(u)[1].norm();
+                let speed = |u: f64| nurbs.speed(u);
                 let table = ArcLengthTable::build(&speed, &breaks, 4, "curve.control_points")?;
-                let shape = Shape::Spline(Spline { nurbs, table });
+                let shape = Shape::Spline(Spline::new(nurbs, table));
                 let corners = shape.corners(corner);
                 (shape, corners, dimension)
             }

@@ -9,7 +9,7 @@
 //!
 //! * [`rule`]: C_ep for a radius (Eqs. 1–15, margins, the lower clamp): the building block for
 //!   every path solver ([`BlockRule::tolerance_for`]);
-//! * `shape`, `nurbs`, `arclength`: the curves (circle, arc, ellipse, polyline, NURBS) by arc
+//! * `shape`, `nurbs`, `cubic`, `arclength`, `radius`: the curves (circle, arc, ellipse, polyline, NURBS) by arc
 //!   length, chord deviation, radius of curvature, corners;
 //! * `segment`: greedy chords, the window procedure with carry-over and progress rule, the
 //!   single-value run (§2.9); `search`: the fast chord search (§2.9a), `reference`: the §2.9
@@ -58,11 +58,13 @@
 mod answer;
 mod arclength;
 mod capability;
+mod cubic;
 mod guarantee;
 mod job;
 mod numeric;
 mod nurbs;
 pub mod program;
+mod radius;
 mod reference;
 mod report;
 pub mod request;

@@ -28,6 +28,19 @@ pub(crate) struct Nurbs {
     last_span: Cell<usize>,
     /// Each knot span `degree + k` as a polynomial in its local parameter (see [`SpanPolynomial`]).
     polynomials: Vec<SpanPolynomial>,
+    /// The one weight of every control point when all are equal: the curve is a polynomial
+    /// (a plain B-spline) on each span, not a ratio of two.
+    common_weight: Option<f64>,
+}
+
+/// A stretch [lo, hi] inside one knot span of a polynomial curve of degree ≤ 3, in the span's
+/// power form: P(t) = origin + Σ coefficients[k]·t^k with t = (u − u_i)/h.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct CubicPiece {
+    pub coefficients: [Vec3; 4],
+    /// Local parameters of lo and hi.
+    pub t_lo: f64,
+    pub t_hi: f64,
 }
 
 /// One knot span [u_i, u_i+1) of the curve in power form: the homogeneous curve relative to
@@ -103,8 +116,10 @@ impl Nurbs {
             }
             None => vec![1.0; count],
         };
+        let common_weight = weights.iter().all(|&w| w == weights[0]).then_some(weights[0]);
         let weighted = points.iter().zip(&weights).map(|(p, &w)| [w * p.x, w * p.y, w * p.z, w]).collect();
-        let mut curve = Self { degree, knots, weighted, last_span: Cell::new(degree), polynomials: Vec::new() };
+        let mut curve =
+            Self { degree, knots, weighted, last_span: Cell::new(degree), polynomials: Vec::new(), common_weight };
         curve.polynomials = (degree..count).map(|span| curve.span_polynomial(span)).collect();
         Ok(curve)
     }
@@ -131,13 +146,6 @@ impl Nurbs {
         out
     }
 
-    /// How many knots (with repetition) lie strictly between `lo` and `hi`.
-    pub(crate) fn knots_inside(&self, lo: f64, hi: f64) -> usize {
-        let from = self.knots.partition_point(|&k| k <= lo);
-        let to = self.knots.partition_point(|&k| k < hi);
-        to.saturating_sub(from)
-    }
-
     /// The distinct knots strictly between `lo` and `hi`, increasing.
     pub(crate) fn distinct_knots_between(&self, lo: f64, hi: f64) -> impl Iterator<Item = f64> + '_ {
         let (start, end) = self.domain();
@@ -153,8 +161,19 @@ impl Nurbs {
         self.degree
     }
 
+    /// The knot spans' indices for [`Nurbs::span`] and [`Nurbs::derivatives_in`]: p to n − 1
+    /// (some may be empty).
+    pub(crate) fn spans(&self) -> std::ops::Range<usize> {
+        self.degree..self.weighted.len()
+    }
+
+    /// The parameter range [u_i, u_i+1] of knot span `span`.
+    pub(crate) fn span_range(&self, span: usize) -> (f64, f64) {
+        (self.knots[span], self.knots[span + 1])
+    }
+
     /// Knot span index i with u_i ≤ u < u_{i+1} (A2.1), the last non-empty span at the end.
-    fn span(&self, u: f64) -> usize {
+    pub(crate) fn span(&self, u: f64) -> usize {
         let n = self.weighted.len();
         let (start, end) = self.domain();
         if u >= end {
@@ -208,6 +227,26 @@ impl Nurbs {
         };
         hint.set(span);
         self.point_in(span, u)
+    }
+
+    /// [lo, hi] as a [`CubicPiece`] when it lies inside one knot span (its end may be the span's
+    /// closing knot) of a polynomial curve of degree ≤ 3; `None` otherwise.
+    pub(crate) fn cubic_piece(&self, lo: f64, hi: f64) -> Option<CubicPiece> {
+        let weight = self.common_weight?;
+        if self.degree > 3 || lo >= hi || lo.is_nan() || hi.is_nan() {
+            return None;
+        }
+        let span = self.span(lo);
+        let polynomial = &self.polynomials[span - self.degree];
+        if hi > self.knots[span + 1] {
+            return None;
+        }
+        let mut coefficients = [Vec3::zeros(); 4];
+        for (vector, h) in coefficients.iter_mut().zip(&polynomial.coefficients[..=self.degree]) {
+            *vector = Vec3::new(h[0], h[1], h[2]) / weight;
+        }
+        let local = |u: f64| (u - polynomial.start) * polynomial.inverse_width;
+        Some(CubicPiece { coefficients, t_lo: local(lo), t_hi: local(hi) })
     }
 
     fn point_in(&self, span: usize, u: f64) -> Vec3 {
@@ -325,7 +364,7 @@ impl Nurbs {
     /// the span, by the basis functions (A2.3) at its ends: at a cusp of coincident control
     /// points (always at a knot) those give exactly zero, which the corner and radius logic
     /// rely on, while the power form leaves rounding there.
-    fn derivatives_in(&self, span: usize, u: f64) -> [Vec3; 3] {
+    pub(crate) fn derivatives_in(&self, span: usize, u: f64) -> [Vec3; 3] {
         let polynomial = &self.polynomials[span - self.degree];
         let scale = polynomial.inverse_width;
         let t = (u - polynomial.start) * scale;
@@ -350,6 +389,30 @@ impl Nurbs {
         let first = (a1 - w1 * relative) / w0;
         let second = (a2 - 2.0 * w1 * first - w2 * relative) / w0;
         [polynomial.origin + relative, first, second]
+    }
+
+    /// |dC/du| (the right-hand limit at a knot): the arc-length integrand, from the power form
+    /// without the second derivative [`Nurbs::derivatives_in`] also carries.
+    pub(crate) fn speed(&self, u: f64) -> f64 {
+        let span = self.span(u);
+        let polynomial = &self.polynomials[span - self.degree];
+        let scale = polynomial.inverse_width;
+        let t = (u - polynomial.start) * scale;
+        if !(t > 0.0 && t < 1.0) {
+            return self.derivatives_by_basis(span, u)[1].norm();
+        }
+        let mut value = polynomial.coefficients[self.degree];
+        let mut first = [0.0_f64; 4];
+        for coefficient in polynomial.coefficients[..self.degree].iter().rev() {
+            for axis in 0..4 {
+                first[axis] = first[axis] * t + value[axis];
+                value[axis] = value[axis] * t + coefficient[axis];
+            }
+        }
+        // (a/w)' = (a' − w'·a/w)/w, in u: d/du = scale·d/dt.
+        let relative = Vec3::new(value[0], value[1], value[2]) / value[3];
+        let first_t = Vec3::new(first[0], first[1], first[2]) - first[3] * relative;
+        (first_t * (scale / value[3])).norm()
     }
 
     /// Point and first two derivatives by the basis functions (A2.3).
@@ -560,6 +623,9 @@ mod tests {
                 let [_, first, second] = curve.derivatives(u);
                 let difference = (curve.point(u + step) - curve.point(u - step)) / (2.0 * step);
                 assert_abs_diff_eq!((first - difference).norm(), 0.0, epsilon = 1e-6 * (1.0 + first.norm()));
+                // The speed without the second derivative agrees with the full evaluation.
+                assert_abs_diff_eq!(curve.speed(u), first.norm(), epsilon = 1e-12 * first.norm());
+                assert_abs_diff_eq!(curve.speed(0.4), curve.derivatives(0.4)[1].norm(), epsilon = 1e-12);
                 if degree >= 3 {
                     let [_, ahead, _] = curve.derivatives(u + step);
                     let [_, behind, _] = curve.derivatives(u - step);

@@ -6,10 +6,12 @@
 //!   nearly linear in u because the deviation grows with the square of the chord. The first
 //!   trial is the previous chord's parameter step (or the circle chord of the window radius),
 //!   corrected by that model, so a smooth curve needs two to four deviations per block;
-//!   ellipses evaluate dev in closed form, NURBS from a few samples per knot span
-//!   ([`Shape::fast_deviation`]). Where the fast samples are not exact (NURBS, and ellipse
-//!   chords over a quarter turn) the chord found is checked once with the reference's 32
-//!   samples, and the reference search takes over if it does not fit.
+//!   ellipses evaluate dev in closed form, chords inside one span of a plain B-spline of
+//!   degree ≤ 3 exactly from its power form (`cubic`), other NURBS from a few samples per knot
+//!   span ([`Shape::fast_deviation`]). Where the fast value is not exact (those samples, and
+//!   ellipse chords over a quarter turn) the chord found is checked once with the reference's
+//!   32 samples, and the reference search takes over if it does not fit; an exact value is the
+//!   chord's reported deviation as it is.
 
 use crate::error::ErrorCode;
 use std::cell::Cell;
@@ -53,7 +55,12 @@ pub(crate) fn chord_end(
     // refines its maximum a little differently, and must not reject a chord for that alone.
     let aim = if matches!(shape, Shape::Spline(_)) { allowed * (1.0 - AIM_INSIDE) } else { allowed };
     let root = aim.sqrt();
-    let g = |u: f64| shape.fast_deviation(start.u, u, aim).sqrt() - root;
+    // g and, where the fast deviation is exact, the deviation itself (the chord then needs no
+    // check: the answer reports that value).
+    let g = |u: f64| {
+        let (deviation, exact) = shape.fast_deviation(start.u, u, aim);
+        (deviation.sqrt() - root, exact.then_some(deviation))
+    };
     let speed = shape.speed(start.u);
     // Bracket to 1e-12 mm, but never below a few units in the last place of u: a long curve
     // on a unit parameter range has 1e-12 mm under one ulp, where rounding of the distances
@@ -66,18 +73,18 @@ pub(crate) fn chord_end(
     }
     let mut evaluations = 0;
     // Bracket: lo fits (g ≤ 0), hi does not.
-    let (mut lo, mut g_lo) = (start.u, -root);
+    let (mut lo, mut g_lo, mut known_at_lo) = (start.u, -root, None);
     let mut trial = (start.u + step).min(limit.u);
     let (mut hi, mut g_hi) = loop {
-        let value = g(trial);
+        let (value, known) = g(trial);
         evaluations += 1;
         if value > 0.0 {
             break (trial, value);
         }
-        (lo, g_lo) = (trial, value);
+        (lo, g_lo, known_at_lo) = (trial, value, known);
         if trial >= limit.u {
             last_step.set(trial - start.u);
-            return checked(shape, start, chord_error, limit, step_guess, limit.u);
+            return checked(shape, start, chord_error, limit, step_guess, (limit.u, known));
         }
         if evaluations >= EVALUATION_CAP {
             return Err(failure(start));
@@ -101,13 +108,21 @@ pub(crate) fn chord_end(
             return Err(failure(start));
         }
         let mut x = lo - g_lo * (hi - lo) / (g_hi - g_lo);
+        // A secant step that rounds onto an end of the bracket puts the root within rounding
+        // of it: try half the bracket width inside, which ends the search when it fits (else
+        // Illinois would only halve the far side's value, one bisection per step).
+        if x >= hi {
+            x = hi - 0.5 * tol;
+        } else if x <= lo {
+            x = lo + 0.5 * tol;
+        }
         if !(x > lo && x < hi) {
             x = 0.5 * (lo + hi);
             if !(x > lo && x < hi) {
                 break; // adjacent floats
             }
         }
-        let value = g(x);
+        let (value, known) = g(x);
         evaluations += 1;
         if value > 0.0 {
             (hi, g_hi) = (x, value);
@@ -116,7 +131,7 @@ pub(crate) fn chord_end(
             }
             side = 1;
         } else {
-            (lo, g_lo, fit) = (x, value, value);
+            (lo, g_lo, fit, known_at_lo) = (x, value, value, known);
             if side == -1 {
                 g_hi *= 0.5;
             }
@@ -127,19 +142,23 @@ pub(crate) fn chord_end(
     if lo <= start.u {
         return Ok((lo, None));
     }
-    checked(shape, start, chord_error, limit, step_guess, lo)
+    checked(shape, start, chord_error, limit, step_guess, (lo, known_at_lo))
 }
 
 /// The chord to `end` if its reference deviation fits; else a hump lay between the fast
-/// samples (curvature changing fast inside the chord) and the reference search decides.
+/// samples (curvature changing fast inside the chord) and the reference search decides. A chord
+/// whose fast deviation was exact (`known`) is taken with it.
 fn checked(
     shape: &Shape,
     start: &Vertex,
     chord_error: f64,
     limit: &Vertex,
     step_guess: f64,
-    end: f64,
+    (end, known): (f64, Option<f64>),
 ) -> Result<(f64, Option<f64>), SolverError> {
+    if known.is_some() {
+        return Ok((end, known));
+    }
     match shape.checked_deviation(start.u, end) {
         Some(deviation) if deviation > chord_error + EPS => {
             Ok((reference::greedy_end(shape, start, chord_error, limit, step_guess)?, None))

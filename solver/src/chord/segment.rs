@@ -203,11 +203,15 @@ impl<'a> Cutter<'a> {
     }
 
     /// dev of the chord between two parameters as the answer reports it: the reference's
-    /// (exact for arcs, ellipse chords and polylines; 32 samples refined for NURBS).
+    /// (exact for arcs, ellipse chords, polylines and chords inside a cubic B-spline span; 32
+    /// samples refined for other NURBS).
     pub(crate) fn deviation(&self, ua: f64, ub: f64) -> f64 {
         match (self.numerics, self.shape) {
             (Numerics::Fast, Shape::Arc(_) | Shape::Ellipse(_) | Shape::Polyline(_)) => {
-                self.shape.fast_deviation(ua, ub, f64::INFINITY)
+                self.shape.fast_deviation(ua, ub, f64::INFINITY).0
+            }
+            (Numerics::Fast, Shape::Spline(_)) => {
+                self.shape.checked_deviation(ua, ub).unwrap_or_else(|| self.shape.deviation(ua, ub))
             }
             _ => self.shape.deviation(ua, ub),
         }

@@ -7,8 +7,10 @@
 //! arc-length inversion out of the inner loops.
 
 use super::arclength::ArcLengthTable;
+use super::cubic;
 use super::numeric::minimise;
 use super::nurbs::Nurbs;
+use super::radius::SpanMinima;
 use crate::error::ErrorCode;
 use crate::error::SolverError;
 use crate::geometry::{Vec3, distance_to_segment};
@@ -23,9 +25,6 @@ const REFINE_FRACTION: f64 = 0.9;
 
 /// Most parabolic steps when refining a deviation.
 const PARABOLIC_STEPS: usize = 6;
-
-/// Curvature samples per window or knot span when looking for the smallest radius.
-const RADIUS_SAMPLES: usize = 16;
 
 /// Most radius samples on one stretch.
 const MAX_RADIUS_SAMPLES: usize = 4096;
@@ -65,11 +64,12 @@ pub(crate) struct Polyline {
     pub last_edge: std::cell::Cell<usize>,
 }
 
-/// A NURBS curve with its arc-length table.
+/// A NURBS curve with its arc-length table and its spans' smallest radii.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Spline {
     pub nurbs: Nurbs,
     pub table: ArcLengthTable,
+    pub radius_minima: SpanMinima,
 }
 
 /// One of the supported curves.
@@ -111,18 +111,19 @@ impl Ellipse {
 }
 
 impl Spline {
-    fn speed(&self, u: f64) -> f64 {
-        self.nurbs.derivatives(u)[1].norm()
+    pub(crate) fn new(nurbs: Nurbs, table: ArcLengthTable) -> Self {
+        let radius_minima = SpanMinima::new(&nurbs);
+        Self { nurbs, table, radius_minima }
     }
 
-    /// Radius of curvature |C'|³/|C'×C''|; at a knot the smaller of both one-sided values.
-    fn radius(&self, u: f64) -> f64 {
-        let of = |[_, first, second]: [Vec3; 3]| {
-            let bend = first.cross(&second).norm();
-            if bend == 0.0 { f64::INFINITY } else { first.norm().powi(3) / bend }
-        };
-        let right = of(self.nurbs.derivatives(u));
-        self.nurbs.derivatives_from_left(u).map_or(right, |left| right.min(of(left)))
+    fn speed(&self, u: f64) -> f64 {
+        self.nurbs.speed(u)
+    }
+
+    /// The exact deviation of a chord inside one knot span of a plain B-spline of degree ≤ 3
+    /// ([`cubic::deviation`]); `None` elsewhere.
+    fn exact_deviation(&self, ua: f64, ub: f64) -> Option<f64> {
+        self.nurbs.cubic_piece(ua.min(ub), ua.max(ub)).as_ref().and_then(cubic::deviation)
     }
 }
 
@@ -422,36 +423,48 @@ impl Shape {
 
     /// dev(u_a, u_b) for the fast search (chord.md §2.9a), where only values near `limit`
     /// need to be exact: closed forms for arcs and ellipses, the farthest vertex of a
-    /// polyline, and for NURBS four sub-intervals per knot span refined around the best sample
-    /// (a smooth span bends one way over a chord cut to its curvature, so its distance from the
-    /// chord has one hump per span). Stops at the first sample above `limit`; skips the
-    /// refinement well below it (an infinite `limit` gives the refined maximum).
-    pub(crate) fn fast_deviation(&self, ua: f64, ub: f64, limit: f64) -> f64 {
+    /// polyline, the exact value inside one span of a plain B-spline of degree ≤ 3, and for other
+    /// NURBS four sub-intervals per knot span refined around the best sample (a smooth span
+    /// bends one way over a chord cut to its curvature, so its distance from the chord has one
+    /// hump per span). Stops at the first sample above `limit`; skips the
+    /// refinement well below it (an infinite `limit` gives the refined maximum). The flag says
+    /// whether the value is exact (a closed form, a polyline's vertices, a cubic span), so that
+    /// the chord needs no check.
+    pub(crate) fn fast_deviation(&self, ua: f64, ub: f64, limit: f64) -> (f64, bool) {
         match self {
-            Self::Arc(_) | Self::Polyline(_) => self.deviation(ua, ub),
+            Self::Arc(_) | Self::Polyline(_) => (self.deviation(ua, ub), true),
             Self::Ellipse(ellipse) if (ub - ua).abs() <= std::f64::consts::FRAC_PI_2 => {
                 // The affine image of a circle: the farthest point is at the mean angle, its
                 // distance (1 − cos δ)·ab/√(a² sin² t_m + b² cos² t_m) for half-angle δ.
                 let [a, b] = ellipse.semi_axes;
                 let half = 0.5 * (ub - ua).abs();
                 let middle = ellipse.angle(0.5 * (ua + ub));
-                2.0 * (0.5 * half).sin().powi(2) * a * b / (a * middle.sin()).hypot(b * middle.cos())
+                (2.0 * (0.5 * half).sin().powi(2) * a * b / (a * middle.sin()).hypot(b * middle.cos()), true)
             }
-            Self::Ellipse(_) => self.sampled_deviation(ua, ub, Some(limit)),
-            Self::Spline(spline) => {
-                spline_deviation(spline, ua, ub, limit).unwrap_or_else(|| self.sampled_deviation(ua, ub, Some(limit)))
-            }
+            Self::Ellipse(_) => (self.sampled_deviation(ua, ub, Some(limit)), false),
+            Self::Spline(spline) => match spline.exact_deviation(ua, ub) {
+                Some(exact) => (exact, true),
+                None => {
+                    let sampled = spline_deviation(spline, ua, ub, limit)
+                        .unwrap_or_else(|| self.sampled_deviation(ua, ub, Some(limit)));
+                    (sampled, false)
+                }
+            },
         }
     }
 
     /// The reference deviation (32 samples, refined) of a chord the fast search found, where
     /// [`Shape::fast_deviation`] only samples: it catches a hump between the fast samples, and
-    /// the answer reports it as the chord's deviation. `None` where the fast value is exact.
+    /// the answer reports it as the chord's deviation. The exact value of a cubic span's chord;
+    /// `None` where the fast value is exact and cheap.
     pub(crate) fn checked_deviation(&self, ua: f64, ub: f64) -> Option<f64> {
         match self {
             Self::Arc(_) | Self::Polyline(_) => None,
             Self::Ellipse(_) if (ub - ua).abs() <= std::f64::consts::FRAC_PI_2 => None,
-            Self::Ellipse(_) | Self::Spline(_) => Some(self.sampled_deviation(ua, ub, None)),
+            Self::Ellipse(_) => Some(self.sampled_deviation(ua, ub, None)),
+            Self::Spline(spline) => {
+                Some(spline.exact_deviation(ua, ub).unwrap_or_else(|| self.sampled_deviation(ua, ub, None)))
+            }
         }
     }
 
@@ -545,29 +558,7 @@ impl Shape {
                 }
                 best
             }
-            Self::Spline(spline) => {
-                let breaks = spline.nurbs.knots_inside(lo, hi);
-                let count = (RADIUS_SAMPLES * (breaks + 1)).min(MAX_RADIUS_SAMPLES);
-                let step = (hi - lo) / count as f64;
-                let mut best = (f64::INFINITY, lo);
-                let mut best_index = 0;
-                for j in 0..=count {
-                    let u = lo + step * j as f64;
-                    let radius = spline.radius(u);
-                    if radius < best.0 {
-                        (best, best_index) = ((radius, u), j);
-                    }
-                }
-                if best.0.is_finite() && hi > lo {
-                    let from = lo + step * best_index.saturating_sub(1) as f64;
-                    let to = (lo + step * (best_index + 1) as f64).min(hi);
-                    let (u, radius) = minimise(|u| spline.radius(u), from, to, 1e-9 * (hi - lo));
-                    if radius < best.0 {
-                        best = (radius, u);
-                    }
-                }
-                best
-            }
+            Self::Spline(spline) => spline.radius_minima.smallest(&spline.nurbs, lo, hi),
         }
     }
 

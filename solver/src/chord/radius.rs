@@ -1,0 +1,156 @@
+//! The smallest radius of curvature of a NURBS on a stretch (chord.md §2.8 E10 window guard,
+//! §2.9a `guarantee`, `radius_estimate: minimum`): every knot span's interior local minima are
+//! found once, the first time a stretch reaches the span, so a window's smallest radius is the
+//! least of its ends, its interior knots and the minima recorded inside it: a handful of radius
+//! evaluations per window instead of a fresh sampling of each (issue 14).
+
+use std::cell::OnceCell;
+
+use super::numeric::minimise;
+use super::nurbs::Nurbs;
+use crate::geometry::Vec3;
+
+/// Radius samples per knot span before the local minima among them are refined. The radius of a
+/// span of degree ≤ 5 is a ratio of low-degree polynomials with few turns; the per-window
+/// sampling this replaces took 16 per window and knot span.
+const SPAN_SAMPLES: usize = 32;
+
+/// Where the radius is probed next to an end, as a fraction of a sample step: far enough for
+/// its change to stand above rounding, near enough to see a dip hugging a knot.
+const INWARD_PROBE: f64 = 1e-6;
+
+/// Pieces a stretch is sampled in on top of its span's minima, ends and knots.
+const STRETCH_PIECES: usize = 8;
+
+/// Radius of curvature |C'|³/|C'×C''| from a point and its first two derivatives (infinite
+/// where straight).
+pub(crate) fn radius_of([_, first, second]: [Vec3; 3]) -> f64 {
+    let bend = first.cross(&second).norm();
+    if bend == 0.0 { f64::INFINITY } else { first.norm().powi(3) / bend }
+}
+
+/// Radius of curvature at `u`; at a knot the smaller of both one-sided values (the curvature
+/// of a degree-2 curve may jump there).
+pub(crate) fn radius_at(nurbs: &Nurbs, u: f64) -> f64 {
+    let right = radius_of(nurbs.derivatives(u));
+    nurbs.derivatives_from_left(u).map_or(right, |left| right.min(radius_of(left)))
+}
+
+/// (u, radius of curvature there).
+type RadiusAt = (f64, f64);
+
+/// The interior local minima of the radius of curvature of each knot span, found on demand.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct SpanMinima {
+    /// Per knot span (index − degree): (u, radius) of each interior local minimum, increasing u.
+    spans: Vec<OnceCell<Box<[RadiusAt]>>>,
+}
+
+impl SpanMinima {
+    pub(crate) fn new(nurbs: &Nurbs) -> Self {
+        Self { spans: nurbs.spans().map(|_| OnceCell::new()).collect() }
+    }
+
+    /// The smallest radius of curvature on [lo, hi] (lo ≤ hi) and where it is: the least of the
+    /// ends, the interior knots (both one-sided values), the spans' interior minima inside, and
+    /// [`STRETCH_PIECES`] − 1 samples of the stretch itself, the lowest of which is refined when
+    /// it is the least of all (a dip between two of the span's samples, on a span much longer
+    /// than the stretch), as is an end that is the least where the radius falls going inward.
+    pub(crate) fn smallest(&self, nurbs: &Nurbs, lo: f64, hi: f64) -> (f64, f64) {
+        let mut best = (radius_at(nurbs, lo), lo);
+        let mut consider = |radius: f64, u: f64| {
+            if radius < best.0 {
+                best = (radius, u);
+            }
+        };
+        if hi <= lo || hi.is_nan() {
+            return best;
+        }
+        consider(radius_at(nurbs, hi), hi);
+        for knot in nurbs.distinct_knots_between(lo, hi) {
+            consider(radius_at(nurbs, knot), knot);
+        }
+        let first = nurbs.span(lo);
+        let last = nurbs.span(hi).max(first);
+        for span in first..=last {
+            for &(u, radius) in self.of_span(nurbs, span) {
+                if u > lo && u < hi {
+                    consider(radius, u);
+                }
+            }
+        }
+        let step = (hi - lo) / STRETCH_PIECES as f64;
+        let mut lowest = (f64::INFINITY, lo);
+        for j in 1..STRETCH_PIECES {
+            let u = lo + step * j as f64;
+            let radius = radius_at(nurbs, u);
+            if radius < lowest.0 {
+                lowest = (radius, u);
+            }
+        }
+        // The bracket to refine: around the lowest sample when it is the least of all, or next
+        // to an end that is the least where the radius still falls going inward.
+        let bracket = if lowest.0 < best.0 {
+            best = lowest;
+            Some((lowest.1 - step, lowest.1 + step))
+        } else if best.1 == lo && radius_at(nurbs, lo + INWARD_PROBE * step) < best.0 {
+            Some((lo, lo + step))
+        } else if best.1 == hi && radius_at(nurbs, hi - INWARD_PROBE * step) < best.0 {
+            Some((hi - step, hi))
+        } else {
+            None
+        };
+        if let Some((from, to)) = bracket {
+            let (u, refined) = minimise(|u| radius_at(nurbs, u), from, to, 1e-9 * (hi - lo));
+            if refined < best.0 {
+                best = (refined, u);
+            }
+        }
+        best
+    }
+
+    fn of_span(&self, nurbs: &Nurbs, span: usize) -> &[RadiusAt] {
+        let first = nurbs.spans().start;
+        self.spans.get(span - first).map_or(&[], |cell| cell.get_or_init(|| span_minima(nurbs, span)))
+    }
+}
+
+/// The interior local minima of the radius on knot span `span`: [`SPAN_SAMPLES`] samples of the
+/// span's own polynomial (one-sided at its ends), each sample lower than its neighbours refined
+/// by Brent's method between them. A minimum against a span end is the end's value, which
+/// [`SpanMinima::smallest`] takes from the knot itself.
+fn span_minima(nurbs: &Nurbs, span: usize) -> Box<[RadiusAt]> {
+    let (start, end) = nurbs.span_range(span);
+    if end <= start {
+        return Box::new([]);
+    }
+    let radius = |u: f64| radius_of(nurbs.derivatives_in(span, u));
+    let step = (end - start) / SPAN_SAMPLES as f64;
+    let at = |j: usize| if j == SPAN_SAMPLES { end } else { start + step * j as f64 };
+    let samples: Vec<f64> = (0..=SPAN_SAMPLES).map(|j| radius(at(j))).collect();
+    let tol = 1e-9 * (end - start);
+    let mut minima = Vec::new();
+    for j in 0..=SPAN_SAMPLES {
+        let here = samples[j];
+        let below_left = j == 0 || here < samples[j - 1];
+        let below_right = j == SPAN_SAMPLES || here <= samples[j + 1];
+        if !here.is_finite() || !below_left || !below_right {
+            continue;
+        }
+        let (from, to) = if j == 0 || j == SPAN_SAMPLES {
+            // The lowest sample at a span end: the end's value is the knot's, unless the radius
+            // falls going inward (a dip next to the knot, where the curvature may jump).
+            let (inward, neighbour) = if j == 0 { (1.0, at(1)) } else { (-1.0, at(SPAN_SAMPLES - 1)) };
+            let falls_inward = radius(at(j) + inward * INWARD_PROBE * step) < here;
+            if !falls_inward {
+                continue;
+            }
+            (at(j).min(neighbour), at(j).max(neighbour))
+        } else {
+            (at(j - 1), at(j + 1))
+        };
+        let (u, refined) = minimise(radius, from, to, tol);
+        minima.push(if refined < here && u > start && u < end { (u, refined) } else { (at(j), here) });
+    }
+    minima.into_boxed_slice()
+}
