@@ -30,10 +30,15 @@ const FULL_IMMERSION_DEG: f64 = 179.9;
 /// Intervals or positions listed in one warning before "and N more".
 const LISTED: usize = 6;
 
+/// Arcs shared between consecutive contacts that found the same ones.
+pub(crate) type SharedArcs = std::sync::Arc<[Arc]>;
+
 /// What an engine found at one station.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Contact {
-    pub arcs: Vec<Arc>,
+    /// Shared with the previous contact when equal to the bit (most samples along a straight
+    /// cut): one allocation per change of engagement instead of one per sample.
+    pub arcs: SharedArcs,
     pub plunge: bool,
     pub collision: bool,
     /// With a rounded end's force model and the exact engine: what the end's sections engage,
@@ -65,14 +70,7 @@ struct ArcValues {
 impl ArcValues {
     /// The values for `arcs`, recomputed only when they differ from the last call's.
     fn of(&mut self, arcs: &[Arc], job: &Job, radius: f64) -> &Self {
-        let same = self.arcs.as_deref().is_some_and(|last| {
-            last.len() == arcs.len()
-                && last
-                    .iter()
-                    .zip(arcs)
-                    .all(|(old, new)| old.from.to_bits() == new.from.to_bits() && old.to.to_bits() == new.to.to_bits())
-        });
-        if same {
+        if self.arcs.as_deref().is_some_and(|last| same_arcs(last, arcs)) {
             return self;
         }
         let last = self.arcs.get_or_insert_with(Vec::new);
@@ -110,6 +108,23 @@ struct DotsOutput {
     scatter: Vec<[f64; 2]>,
 }
 
+/// Whether two arc lists are the same to the bit.
+fn same_arcs(first: &[Arc], second: &[Arc]) -> bool {
+    first.len() == second.len()
+        && first
+            .iter()
+            .zip(second)
+            .all(|(a, b)| a.from.to_bits() == b.from.to_bits() && a.to.to_bits() == b.to.to_bits())
+}
+
+/// `arcs` as a contact's, shared with `previous`'s when they are the same.
+fn share_arcs(previous: Option<&Contact>, arcs: &[Arc]) -> SharedArcs {
+    match previous {
+        Some(previous) if same_arcs(&previous.arcs, arcs) => SharedArcs::clone(&previous.arcs),
+        _ => SharedArcs::from(arcs),
+    }
+}
+
 fn first_cut(route: &Route, stations: &[Station], index: usize) -> bool {
     let Some(station) = stations.get(index) else {
         return false;
@@ -135,7 +150,7 @@ fn run_exact(
         control.check()?;
         control.report(index, stations.len());
         let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
-        let arcs = engine.arcs(route, &job.region, job.radius, station)?;
+        let arcs = share_arcs(contacts.last(), engine.arcs_in_place(route, &job.region, job.radius, station)?);
         let mut contact = Contact::default();
         if rapid {
             contact.collision = !arcs.is_empty();
@@ -148,7 +163,7 @@ fn run_exact(
                     centre: route.pieces.get(station.piece).map_or(station.centre, |p| p.shape.start_point()),
                     ..*station
                 };
-                contact.plunge = !engine.arcs(route, &job.region, job.radius, &start)?.is_empty();
+                contact.plunge = !engine.arcs_in_place(route, &job.region, job.radius, &start)?.is_empty();
             }
             if let Some(model) = rounded {
                 contact.slices = model.bands(
@@ -212,7 +227,7 @@ fn run_dots(
                     }
                 }
             }
-            contact.arcs = buffer.arcs(radius, cell, step);
+            contact.arcs = share_arcs(contacts.last(), &buffer.arcs(radius, cell, step));
             previous = Some(station);
         }
         contacts.push(contact);
@@ -278,7 +293,7 @@ pub(crate) fn evaluate(
     let mut last_heading: Option<([u64; 2], f64)> = None;
     for (index, (station, contact)) in stations.iter().zip(&contacts).enumerate() {
         let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
-        let arcs = &contact.arcs;
+        let arcs: &[Arc] = &contact.arcs;
         let values = arc_values.of(arcs, job, radius);
         let radial_depth = values.radial_depth;
         let mut flags = Vec::new();

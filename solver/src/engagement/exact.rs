@@ -37,6 +37,8 @@ pub(crate) struct ExactEngine {
     /// same tool angles to the bit, so the middles repeat and their cosine and sine (a fifth of
     /// the engine's time) are pure functions of them.
     middles: Vec<(u64, f64, f64)>,
+    /// The arcs of the last [`Self::arcs_in_place`] call (a buffer kept between samples).
+    found: Vec<Arc>,
 }
 
 impl ExactEngine {
@@ -54,6 +56,19 @@ impl ExactEngine {
         radius: f64,
         station: &Station,
     ) -> Result<Vec<Arc>, SolverError> {
+        Ok(self.arcs_in_place(route, region, radius, station)?.to_vec())
+    }
+
+    /// [`Self::arcs`] in the engine's own buffer, valid until the next call: the sample loop
+    /// keeps a copy only when the arcs differ from the previous sample's, so most samples
+    /// allocate nothing here.
+    pub(crate) fn arcs_in_place(
+        &mut self,
+        route: &Route,
+        region: &Region,
+        radius: f64,
+        station: &Station,
+    ) -> Result<&[Arc], SolverError> {
         let centre = station.centre;
         let forward = station.tangent;
         let right = right_normal(&forward);
@@ -83,7 +98,8 @@ impl ExactEngine {
         self.tests += (self.angles.len() * (self.pieces.len() + 1)) as u64;
         self.check_budget()?;
         let limit = radius * (1.0 - REACH_TOLERANCE);
-        let mut arcs = Vec::new();
+        let mut arcs = std::mem::take(&mut self.found);
+        arcs.clear();
         let count = self.angles.len();
         for index in 0..count {
             let low = self.angles[index];
@@ -100,8 +116,9 @@ impl ExactEngine {
                 arcs.push(Arc { from: low.to_degrees(), to: high.to_degrees() });
             }
         }
+        self.found = normalise(arcs);
         self.check_budget()?;
-        Ok(normalise(arcs))
+        Ok(&self.found)
     }
 
     /// cos and sin of the middle of sub-arc `index`, reused from the last sample when that
