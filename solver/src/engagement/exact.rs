@@ -11,7 +11,7 @@ use crate::error::ErrorCode;
 use std::f64::consts::PI;
 
 use super::arcs::{Arc, normalise};
-use super::segments::{Route, Shape, Station};
+use super::segments::{NearPieces, Route, Shape, Station};
 use super::stock::{REACH_TOLERANCE, Region};
 use crate::error::SolverError;
 use crate::planar::right_normal;
@@ -24,7 +24,7 @@ pub(crate) const MAX_TESTS: u64 = 4_000_000_000;
 #[derive(Debug, Default)]
 pub(crate) struct ExactEngine {
     pieces: Vec<Shape>,
-    earlier: Vec<usize>,
+    near: NearPieces,
     angles: Vec<f64>,
     tests: u64,
     /// Tests allowed before the engine gives up; at least [`MAX_TESTS`].
@@ -72,7 +72,7 @@ impl ExactEngine {
         let centre = station.centre;
         let forward = station.tangent;
         let right = right_normal(&forward);
-        route.swept_before(station, 2.0 * radius, &mut self.pieces, &mut self.earlier);
+        route.swept_before(station, 2.0 * radius, &mut self.pieces, &mut self.near);
         self.angles.clear();
         for piece in &self.pieces {
             piece.crossings(radius, centre, radius, &mut self.angles);
