@@ -12,7 +12,7 @@ use std::f64::consts::PI;
 
 use super::arcs::{Arc, normalise};
 use super::segments::{NearPieces, Route, Shape, Station};
-use super::stock::{REACH_TOLERANCE, Region};
+use super::stock::{NearEdges, REACH_TOLERANCE, Region};
 use crate::error::SolverError;
 use crate::planar::right_normal;
 
@@ -25,6 +25,7 @@ pub(crate) const MAX_TESTS: u64 = 4_000_000_000;
 pub(crate) struct ExactEngine {
     pieces: Vec<Shape>,
     near: NearPieces,
+    near_edges: NearEdges,
     angles: Vec<f64>,
     tests: u64,
     /// Tests allowed before the engine gives up; at least [`MAX_TESTS`].
@@ -77,7 +78,7 @@ impl ExactEngine {
         for piece in &self.pieces {
             piece.crossings(radius, centre, radius, &mut self.angles);
         }
-        region.crossings(centre, radius, &mut self.angles);
+        region.crossings(centre, radius, &mut self.angles, &mut self.near_edges);
         // Global polar angle γ ↦ tool angle θ = γ − angle of the right-hand normal (§4.1).
         let bits = [right.x.to_bits(), right.y.to_bits()];
         let right_angle = match self.last_angle {
