@@ -161,6 +161,45 @@ impl ExactEngine {
 
 /// Wraps radians into [−π, π).
 fn wrap_rad(angle: f64) -> f64 {
-    let wrapped = (angle + PI).rem_euclid(2.0 * PI) - PI;
+    let wrapped = euclid_turn(angle + PI) - PI;
     if wrapped >= PI { -PI } else { wrapped }
+}
+
+/// `shifted.rem_euclid(2π)` to the bit, without its `fmod` call for the engine's angles
+/// (a polar angle less the normal's, shifted by π: within [−π, 3π]), where the call was over 1 %
+/// of the run time. On [2π, 4π) fmod's exact result is shifted − 2π, which that subtraction
+/// gives exactly (Sterbenz); on (−2π, 0) rem_euclid adds 2π to shifted itself, as done here.
+fn euclid_turn(shifted: f64) -> f64 {
+    let turn = 2.0 * PI;
+    if (0.0..turn).contains(&shifted) {
+        shifted
+    } else if (turn..2.0 * turn).contains(&shifted) {
+        shifted - turn
+    } else if shifted > -turn && shifted < 0.0 {
+        // −2π itself goes to rem_euclid: fmod gives −0 there, which it keeps.
+        shifted + turn
+    } else {
+        shifted.rem_euclid(turn)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn euclid_turn_is_rem_euclid_to_the_bit() {
+        let turn = 2.0 * PI;
+        let mut values = vec![0.0, -0.0, turn, 2.0 * turn, -turn, PI, 3.0 * PI, -PI, 1e-300, -1e-300, 7.0 * PI];
+        values.extend([turn, 2.0 * turn, -turn].iter().flat_map(|&v| [v.next_up(), v.next_down()]));
+        // A deterministic spread over the engine's range and beyond.
+        let mut x = 0.123_456_789_f64;
+        for _ in 0..100_000 {
+            x = (x * 3.987_654_321 + 0.314_159).fract();
+            values.push(-3.0 * PI + 9.0 * PI * x);
+        }
+        for value in values {
+            assert_eq!(euclid_turn(value).to_bits(), value.rem_euclid(turn).to_bits(), "{value:e}");
+        }
+    }
 }
