@@ -10,9 +10,10 @@
 use crate::error::ErrorCode;
 use std::f64::consts::PI;
 
+use super::P2;
 use super::arcs::{Arc, normalise};
 use super::segments::{NearPieces, Route, Shape, Station};
-use super::stock::{NearEdges, REACH_TOLERANCE, Region};
+use super::stock::{NearEdges, OutlineSide, REACH_TOLERANCE, Region};
 use crate::error::SolverError;
 use crate::planar::right_normal;
 
@@ -26,6 +27,11 @@ pub(crate) struct ExactEngine {
     pieces: Vec<Shape>,
     near: NearPieces,
     near_edges: NearEdges,
+    /// The last circle clear of the outline: its centre, radius and whether it lies in the
+    /// outline. A clear circle whose disc overlaps that one's lies in the same face of the
+    /// outline (the two discs together are connected and hold no edge), so it has the same
+    /// answer without the ray query.
+    last_clear: Option<(P2, f64, bool)>,
     angles: Vec<f64>,
     tests: u64,
     /// Tests allowed before the engine gives up; at least [`MAX_TESTS`].
@@ -78,7 +84,7 @@ impl ExactEngine {
         for piece in &self.pieces {
             piece.crossings(radius, centre, radius, &mut self.angles);
         }
-        region.crossings(centre, radius, &mut self.angles, &mut self.near_edges);
+        let outline_side = region.crossings(centre, radius, &mut self.angles, &mut self.near_edges);
         // Global polar angle γ ↦ tool angle θ = γ − angle of the right-hand normal (§4.1).
         let bits = [right.x.to_bits(), right.y.to_bits()];
         let right_angle = match self.last_angle {
@@ -101,6 +107,9 @@ impl ExactEngine {
         let limit = radius * (1.0 - REACH_TOLERANCE);
         let mut arcs = std::mem::take(&mut self.found);
         arcs.clear();
+        // Clear of the outline: one containment test at the centre answers for every sub-arc
+        // (the outline's ray query is the costly part of a test), taken at the first need.
+        let mut centre_in_outline: Option<bool> = None;
         let count = self.angles.len();
         for index in 0..count {
             let low = self.angles[index];
@@ -111,8 +120,23 @@ impl ExactEngine {
             let middle = 0.5 * (low + high);
             let (cos, sin) = self.middle_cos_sin(index, middle);
             let q = centre + radius * (cos * right + sin * forward);
-            let engaged =
-                self.pieces.iter().all(|piece| piece.distance(q) >= limit) && region.contains(q, &mut self.tests);
+            let engaged = self.pieces.iter().all(|piece| piece.distance(q) >= limit)
+                && match outline_side {
+                    OutlineSide::Clear => {
+                        *centre_in_outline.get_or_insert_with(|| match self.last_clear {
+                            Some((last, last_radius, inside)) if (centre - last).norm() < radius.min(last_radius) => {
+                                self.last_clear = Some((centre, radius, inside));
+                                inside
+                            }
+                            _ => {
+                                let inside = region.in_outline(centre, &mut self.tests);
+                                self.last_clear = Some((centre, radius, inside));
+                                inside
+                            }
+                        }) && region.kept_by_cuts(q, &mut self.tests)
+                    }
+                    OutlineSide::Near => region.contains(q, &mut self.tests),
+                };
             if engaged {
                 arcs.push(Arc { from: low.to_degrees(), to: high.to_degrees() });
             }

@@ -13,6 +13,21 @@ pub(crate) const BOUNDARY_TOLERANCE: f64 = 1e-9;
 /// Relative tolerance of "at least R from the swept path" (§5.3.3: R·(1 − 1e-9)).
 pub(crate) const REACH_TOLERANCE: f64 = 1e-9;
 
+/// How far beyond the tool circle, mm, a polygon outline must keep its edges for
+/// [`Region::crossings`] to call the circle clear of it: a thousand times the boundary band, so
+/// that rounding in the containment test cannot tell points of the disc apart.
+pub(crate) const CLEAR_MARGIN: f64 = 1e-6;
+
+/// Where a tool circle lies against a polygon outline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum OutlineSide {
+    /// An edge may come near the circle (or the stock is a bitmap): test every point.
+    Near,
+    /// No edge within [`CLEAR_MARGIN`] of the disc: every point of it is in the outline or
+    /// every point is out.
+    Clear,
+}
+
 /// How far, as a share of the lookup reach, the tool may move before [`Region::crossings`]
 /// asks the outline's grid again.
 const NEAR_EDGES_MARGIN: f64 = 0.25;
@@ -170,11 +185,21 @@ impl Region {
     /// Whether `q` is material at the start of the operation (outline, less earlier cuts);
     /// adds the edges and pieces examined to `work`.
     pub(crate) fn contains(&self, q: P2, work: &mut u64) -> bool {
-        let in_outline = match &self.base {
+        self.in_outline(q, work) && self.kept_by_cuts(q, work)
+    }
+
+    /// Whether `q` lies in the initial outline (earlier cuts not applied); adds the edges
+    /// examined to `work`.
+    pub(crate) fn in_outline(&self, q: P2, work: &mut u64) -> bool {
+        match &self.base {
             Base::Polygons(outline) => outline.contains(q, BOUNDARY_TOLERANCE, work),
             Base::Bitmap(bitmap) => bitmap.contains(q),
-        };
-        in_outline && self.cuts.iter().all(|cut| cut.keeps(q, work))
+        }
+    }
+
+    /// Whether no earlier cut has removed `q`; adds the pieces examined to `work`.
+    pub(crate) fn kept_by_cuts(&self, q: P2, work: &mut u64) -> bool {
+        self.cuts.iter().all(|cut| cut.keeps(q, work))
     }
 
     /// Where the dot grid is anchored: the bitmap's origin, else the coordinate origin.
@@ -204,7 +229,13 @@ impl Region {
     /// Adds the polar angles about `c` where circle (`c`, `radius`) crosses the outline or the
     /// boundary of an earlier cut; `near` keeps the outline's edge lookup for the next samples
     /// (see [`NearEdges`]).
-    pub(crate) fn crossings(&self, c: P2, radius: f64, out: &mut Vec<f64>, near: &mut NearEdges) {
+    ///
+    /// Returns [`OutlineSide::Clear`] when a polygon outline has no edge within
+    /// [`CLEAR_MARGIN`] beyond the circle: then the whole disc lies in one face of the outline,
+    /// farther than the boundary band from every edge, so the even-odd test gives every point
+    /// of it the same answer and one test at `c` stands for all of them.
+    pub(crate) fn crossings(&self, c: P2, radius: f64, out: &mut Vec<f64>, near: &mut NearEdges) -> OutlineSide {
+        let mut side = OutlineSide::Near;
         match &self.base {
             Base::Polygons(outline) => {
                 let reach = radius * (1.0 + 1e-9);
@@ -215,7 +246,7 @@ impl Region {
                 if !still_valid {
                     let edges = &mut near.edges;
                     edges.clear();
-                    outline.edges_near(c, reach + margin, |from, to| edges.push((from, to)));
+                    outline.edges_near(c, reach + CLEAR_MARGIN + margin, |from, to| edges.push((from, to)));
                     near.taken = Some((c, reach));
                 }
                 // The box test `edges_near` itself makes at `reach`: the edges intersected are
@@ -224,14 +255,19 @@ impl Region {
                 // where nothing changes, which the arcs' merge undoes). Repeated edges add the
                 // same angles, which the engine merges.
                 let (low, high) = (c.add_scalar(-reach), c.add_scalar(reach));
+                let (clear_low, clear_high) = (low.add_scalar(-CLEAR_MARGIN), high.add_scalar(CLEAR_MARGIN));
+                let mut clear = true;
                 for &(from, to) in &near.edges {
-                    if from.x.max(to.x) >= low.x
-                        && from.x.min(to.x) <= high.x
-                        && from.y.max(to.y) >= low.y
-                        && from.y.min(to.y) <= high.y
-                    {
+                    let (min, max) = (from.inf(&to), from.sup(&to));
+                    if max.x >= clear_low.x && min.x <= clear_high.x && max.y >= clear_low.y && min.y <= clear_high.y {
+                        clear = false;
+                    }
+                    if max.x >= low.x && min.x <= high.x && max.y >= low.y && min.y <= high.y {
                         circle_segment(c, radius, from, to, out);
                     }
+                }
+                if clear {
+                    side = OutlineSide::Clear;
                 }
             }
             Base::Bitmap(bitmap) => bitmap.crossings(c, radius, out),
@@ -244,6 +280,7 @@ impl Region {
                 shape.crossings(cut.radius, c, radius, out);
             }
         }
+        side
     }
 }
 
