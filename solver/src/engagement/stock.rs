@@ -324,6 +324,41 @@ mod tests {
     }
 
     #[test]
+    fn a_clear_circle_is_all_in_or_all_out() {
+        // A square with a square hole: circles inside the material, in the hole, outside and
+        // across edges.
+        let square =
+            |low: f64, high: f64| vec![P2::new(low, low), P2::new(high, low), P2::new(high, high), P2::new(low, high)];
+        let radius = 1.5;
+        let region = Region {
+            base: Base::Polygons(Outline::new(vec![square(0.0, 20.0), square(8.0, 12.0)], radius)),
+            cuts: Vec::new(),
+        };
+        let mut near = NearEdges::default();
+        let (mut clear, mut crossing) = (0, 0);
+        for step in 0..600 {
+            // A walk with small steps (the kept edge list is reused) and jumps.
+            let t = f64::from(step);
+            let centre = P2::new(10.0 + 13.0 * (0.013 * t).sin(), 10.0 + 13.0 * (0.021 * t + 0.4).cos());
+            let mut angles = Vec::new();
+            let side = region.crossings(centre, radius, &mut angles, &mut near);
+            let inside = region.in_outline(centre, &mut 0);
+            let agree = (0..64).all(|k| {
+                let angle = f64::from(k) * std::f64::consts::TAU / 64.0;
+                region.in_outline(centre + radius * P2::new(angle.cos(), angle.sin()), &mut 0) == inside
+            });
+            if side == OutlineSide::Clear {
+                clear += 1;
+                assert!(angles.is_empty() && agree, "{centre:?}");
+            } else if !agree {
+                crossing += 1;
+                assert!(!angles.is_empty(), "{centre:?}");
+            }
+        }
+        assert!(clear > 100 && crossing > 100, "{clear} clear, {crossing} crossing");
+    }
+
+    #[test]
     fn bitmap_cells_and_crossings() {
         // 4 × 2 raster, material in columns 1 and 2 of row 0 only: 0110 0000.
         let bitmap = Bitmap { origin: P2::new(0.0, 0.0), cell: 1.0, width: 4, height: 2, bytes: vec![0b0110_0000] };
