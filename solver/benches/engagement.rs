@@ -5,9 +5,15 @@
 //!
 //! Run: `cargo bench -p kerf-solver --bench engagement -- --warm-up-time 1 --measurement-time 5`
 //! (`KERF_BENCH_ONLY=ball` for the configurations whose name contains `ball`)
+//!
+//! For measuring CPU time on a shared machine (`perf stat -e task-clock`), and for checking
+//! that a change leaves the answer alone: `KERF_BENCH_SOLVES=n` solves each chosen
+//! configuration n more times instead of benchmarking it, and `KERF_BENCH_DUMP=dir` writes each
+//! chosen configuration's answer JSON (the capability's own writer) to `dir/<name>.json`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use kerf_solver::engagement::{self, EngagementAnswer, EngagementRequest};
+use kerf_solver::capability::{Capability, Resolved, Run};
+use kerf_solver::engagement::{self, EngagementAnswer, EngagementCapability, EngagementRequest};
 use kerf_solver::tool::{Tool, ToolKind};
 use serde_json::json;
 
@@ -101,6 +107,18 @@ fn bench(c: &mut Criterion) {
             );
         }
         eprintln!("{engine}: {samples} samples, path {:.1} mm", result.path_length);
+        if let Ok(dir) = std::env::var("KERF_BENCH_DUMP") {
+            let context = Resolved { tool: tool.clone(), machine: None, material: None, other_tools: Vec::new() };
+            let answer = EngagementCapability::solve(&request, context, &Run::default()).unwrap();
+            let bytes = EngagementCapability::to_json(answer).unwrap();
+            std::fs::write(format!("{dir}/{engine}.json"), bytes).unwrap();
+        }
+        if let Some(solves) = std::env::var("KERF_BENCH_SOLVES").ok().and_then(|n| n.parse::<usize>().ok()) {
+            for _ in 0..solves {
+                drop(std::hint::black_box(engagement::solve(&request, &tool).unwrap()));
+            }
+            continue;
+        }
         group.throughput(Throughput::Elements(samples));
         group.bench_function(engine, |b| {
             b.iter(|| engagement::solve(&request, &tool).unwrap());

@@ -285,6 +285,23 @@ pub(crate) struct Route {
     pub feed_length: f64,
 }
 
+/// How far, as a share of the reach, the tool may move before [`Route::swept_before`] asks the
+/// tree again.
+const NEAR_MARGIN: f64 = 0.25;
+
+/// The earlier pieces whose boxes overlap the square of half-side (1 + [`NEAR_MARGIN`])·reach
+/// around where they were looked up, most recent first. While the tool stays on the same piece
+/// within NEAR_MARGIN·reach of that point (in x and in y), every piece whose box overlaps its
+/// own square of half-side reach is in the list, so the tree (about 4 % of the exact bench's
+/// time when asked at every sample) is asked once per quarter reach of travel; the exact
+/// distance test that follows decides as before.
+#[derive(Debug, Default)]
+pub(crate) struct NearPieces {
+    /// Centre, current piece and reach of the lookup (`None`: nothing looked up yet).
+    taken: Option<(P2, usize, f64)>,
+    earlier: Vec<usize>,
+}
+
 /// Where the tool is at one sample (engagement.md §5.2: stored as piece and local offset).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Station {
@@ -361,22 +378,36 @@ impl Route {
 
     /// The cutting pieces that can come within `reach` of `centre` before the tool is at
     /// `station` (the current piece truncated there), most recent first.
-    pub(crate) fn swept_before(&self, station: &Station, reach: f64, out: &mut Vec<Shape>, earlier: &mut Vec<usize>) {
+    ///
+    /// The tree query behind it is kept in `near` for the following samples (see
+    /// [`NearPieces`]); the pieces given are the same either way.
+    pub(crate) fn swept_before(&self, station: &Station, reach: f64, out: &mut Vec<Shape>, near: &mut NearPieces) {
         out.clear();
-        earlier.clear();
         if let Some(current) = self.pieces.get(station.piece)
             && !current.rapid
             && station.local > 0.0
         {
             out.push(current.shape.truncated(station.local));
         }
-        self.tree.query(&BBox::around(station.centre, reach), &mut |index| {
-            if index < station.piece {
-                earlier.push(index);
-            }
+        let margin = NEAR_MARGIN * reach;
+        let still_valid = near.taken.is_some_and(|(centre, piece, taken_reach)| {
+            piece == station.piece
+                && taken_reach == reach
+                && (station.centre.x - centre.x).abs() <= margin
+                && (station.centre.y - centre.y).abs() <= margin
         });
-        earlier.sort_unstable_by(|a, b| b.cmp(a));
-        for &index in earlier.iter() {
+        if !still_valid {
+            let earlier = &mut near.earlier;
+            earlier.clear();
+            self.tree.query(&BBox::around(station.centre, reach + margin), &mut |index| {
+                if index < station.piece {
+                    earlier.push(index);
+                }
+            });
+            earlier.sort_unstable_by(|a, b| b.cmp(a));
+            near.taken = Some((station.centre, station.piece, reach));
+        }
+        for &index in &near.earlier {
             if let Some(piece) = self.pieces.get(index)
                 && !piece.rapid
                 && piece.shape.distance(station.centre) < reach
