@@ -57,6 +57,9 @@ struct SpanPolynomial {
     inverse_width: f64,
     /// Coefficients of t⁰…t^p of (w·(x − O_x), w·(y − O_y), w·(z − O_z), w).
     coefficients: [[f64; 4]; SLOTS],
+    /// For a plain B-spline (one common weight): coefficients of t⁰…t^(2p−2) of |dP/dt|², so the
+    /// arc-length integrand is one square root of a polynomial; empty (all zero) otherwise.
+    speed_squared: [f64; 2 * MAX_DEGREE - 1],
 }
 
 impl Nurbs {
@@ -283,7 +286,13 @@ impl Nurbs {
         let (start, end) = (self.knots[span], self.knots[span + 1]);
         let mut coefficients = [[0.0; 4]; SLOTS];
         if end <= start {
-            return SpanPolynomial { origin: Vec3::zeros(), start, inverse_width: 0.0, coefficients };
+            return SpanPolynomial {
+                origin: Vec3::zeros(),
+                start,
+                inverse_width: 0.0,
+                coefficients,
+                speed_squared: [0.0; 2 * MAX_DEGREE - 1],
+            };
         }
         let origin = {
             let h = self.homogeneous_by_basis(span, start, &Vec3::zeros());
@@ -319,7 +328,18 @@ impl Nurbs {
                 *value = difference - nodes[k] * *value;
             }
         }
-        SpanPolynomial { origin, start, inverse_width: 1.0 / (end - start), coefficients }
+        let mut speed_squared = [0.0; 2 * MAX_DEGREE - 1];
+        if let Some(weight) = self.common_weight {
+            // dP/dt = Σ k·a_k·t^(k−1); its square by convolution of the coefficient vectors.
+            let derivative =
+                |k: usize| Vec3::new(coefficients[k][0], coefficients[k][1], coefficients[k][2]) * (k as f64 / weight);
+            for i in 1..=p {
+                for j in 1..=p {
+                    speed_squared[i + j - 2] += derivative(i).dot(&derivative(j));
+                }
+            }
+        }
+        SpanPolynomial { origin, start, inverse_width: 1.0 / (end - start), coefficients, speed_squared }
     }
 
     /// Point, first and second derivative with respect to u (the right-hand limits at a knot).
@@ -391,8 +411,9 @@ impl Nurbs {
         [polynomial.origin + relative, first, second]
     }
 
-    /// |dC/du| (the right-hand limit at a knot): the arc-length integrand, from the power form
-    /// without the second derivative [`Nurbs::derivatives_in`] also carries.
+    /// |dC/du| (the right-hand limit at a knot): the arc-length integrand, from the span's
+    /// squared-speed polynomial on a plain B-spline, else from the power form without the
+    /// second derivative [`Nurbs::derivatives_in`] also carries.
     pub(crate) fn speed(&self, u: f64) -> f64 {
         let span = self.span(u);
         let polynomial = &self.polynomials[span - self.degree];
@@ -400,6 +421,10 @@ impl Nurbs {
         let t = (u - polynomial.start) * scale;
         if !(t > 0.0 && t < 1.0) {
             return self.derivatives_by_basis(span, u)[1].norm();
+        }
+        if self.common_weight.is_some() {
+            let squared = polynomial.speed_squared[..=2 * self.degree - 2].iter().rev().fold(0.0, |sum, c| sum * t + c);
+            return squared.max(0.0).sqrt() * scale;
         }
         let mut value = polynomial.coefficients[self.degree];
         let mut first = [0.0_f64; 4];
@@ -625,7 +650,10 @@ mod tests {
                 assert_abs_diff_eq!((first - difference).norm(), 0.0, epsilon = 1e-6 * (1.0 + first.norm()));
                 // The speed without the second derivative agrees with the full evaluation.
                 assert_abs_diff_eq!(curve.speed(u), first.norm(), epsilon = 1e-12 * first.norm());
-                assert_abs_diff_eq!(curve.speed(0.4), curve.derivatives(0.4)[1].norm(), epsilon = 1e-12);
+                // On a plain B-spline the speed comes from the squared-speed polynomial.
+                let plain = Nurbs::new(degree, &control, None, None, "curve").unwrap();
+                let plain_first = plain.derivatives(u)[1].norm();
+                assert_abs_diff_eq!(plain.speed(u), plain_first, epsilon = 1e-12 * plain_first);
                 if degree >= 3 {
                     let [_, ahead, _] = curve.derivatives(u + step);
                     let [_, behind, _] = curve.derivatives(u - step);
