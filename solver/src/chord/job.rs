@@ -10,7 +10,7 @@ use super::request::{
     MAX_POLYLINE_POINTS, MIN_TOLERANCE, Mode, RadiusEstimate, SegmentRequest,
 };
 use super::segment::Estimate;
-use super::shape::{Arc, Ellipse, Polyline, Shape, Spline, require_length};
+use super::shape::{Arc, Ellipse, Polyline, Shape, Spline, ellipse_speed, require_length};
 use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
 use crate::machine::MachineProfile;
@@ -190,10 +190,7 @@ impl Curve {
                 }
                 let start = start.to_radians();
                 let sense = direction.sign();
-                let speed = |u: f64| {
-                    let t = start + sense * u;
-                    (a * t.sin()).hypot(b * t.cos())
-                };
+                let speed = |u: f64| ellipse_speed([a, b], start + sense * u);
                 // Panel breaks at the quarter points, where the speed has its extremes.
                 let quarter = std::f64::consts::FRAC_PI_2;
                 let mut breaks = vec![0.0];

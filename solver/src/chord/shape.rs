@@ -81,6 +81,14 @@ pub(crate) enum Shape {
     Spline(Spline),
 }
 
+/// |dP/dt| of an ellipse with semi-axes a, b at angle t: √(a² sin² t + b² cos² t). Not by
+/// `hypot`, whose guard against overflow cost a quarter of an ellipse's segmentation: the
+/// semi-axes are at most `MAX_COORDINATE` (1e6 mm), far from it.
+pub(crate) fn ellipse_speed([a, b]: [f64; 2], t: f64) -> f64 {
+    let (sin, cos) = t.sin_cos();
+    ((a * sin).powi(2) + (b * cos).powi(2)).sqrt()
+}
+
 impl Ellipse {
     fn angle(&self, u: f64) -> f64 {
         self.start + self.sense * u
@@ -98,15 +106,13 @@ impl Ellipse {
 
     /// |dP/du|.
     fn speed(&self, u: f64) -> f64 {
-        let t = self.angle(u);
-        let [a, b] = self.semi_axes;
-        (a * t.sin()).hypot(b * t.cos())
+        ellipse_speed(self.semi_axes, self.angle(u))
     }
 
     /// Radius of curvature at t: (a² sin² t + b² cos² t)^{3/2} / (a·b).
     fn radius(&self, t: f64) -> f64 {
         let [a, b] = self.semi_axes;
-        (a * t.sin()).hypot(b * t.cos()).powi(3) / (a * b)
+        ellipse_speed(self.semi_axes, t).powi(3) / (a * b)
     }
 }
 
@@ -439,7 +445,7 @@ impl Shape {
                 let [a, b] = ellipse.semi_axes;
                 let half = 0.5 * (ub - ua).abs();
                 let middle = ellipse.angle(0.5 * (ua + ub));
-                (2.0 * (0.5 * half).sin().powi(2) * a * b / (a * middle.sin()).hypot(b * middle.cos()), true)
+                (2.0 * (0.5 * half).sin().powi(2) * a * b / ellipse_speed(ellipse.semi_axes, middle), true)
             }
             Self::Ellipse(_) => (self.sampled_deviation(ua, ub, Some(limit)), false),
             Self::Spline(spline) => match spline.exact_deviation(ua, ub) {
