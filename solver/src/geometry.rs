@@ -69,13 +69,19 @@ pub fn rotation_y(angle: f64) -> Matrix3<f64> {
 
 /// Distance from `p` to the closed segment `[a, b]` (a degenerate segment is a point).
 pub fn distance_to_segment(p: &Vec3, a: &Vec3, b: &Vec3) -> f64 {
+    distance_squared_to_segment(p, a, b).sqrt()
+}
+
+/// The square of [`distance_to_segment`]: the farthest of many points needs one square root,
+/// not one per point (the square root is monotone, so the result is the same to the bit).
+pub fn distance_squared_to_segment(p: &Vec3, a: &Vec3, b: &Vec3) -> f64 {
     let ab = b - a;
     let length_squared = ab.norm_squared();
     if length_squared == 0.0 {
-        return (p - a).norm();
+        return (p - a).norm_squared();
     }
     let t = ((p - a).dot(&ab) / length_squared).clamp(0.0, 1.0);
-    (p - (a + t * ab)).norm()
+    (p - (a + t * ab)).norm_squared()
 }
 
 /// Finds a root of `f` near `start`: steps outwards in both directions (first `step`, growing by
