@@ -11,14 +11,23 @@ use kerf_solver::deburr::{self, DeburrRequest};
 use kerf_solver::tool::{Tool, ToolKind};
 
 fn request(tolerance: f64, method: &str) -> DeburrRequest {
+    request_with_cut(0.5, tolerance, method)
+}
+
+fn request_with_cut(cut_amount: f64, tolerance: f64, method: &str) -> DeburrRequest {
     serde_json::from_value(serde_json::json!({
         "tool": {"kind": "ball", "radius": 3},
         "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
         "hole": {"shape": "round", "radius": 10},
-        "edge": "outer", "cut_amount": 0.5, "tolerance": tolerance, "method": method
+        "edge": "outer", "cut_amount": cut_amount, "tolerance": tolerance, "method": method
     }))
     .expect("valid request")
 }
+
+/// The request of tests/load/deburr-distinct.lua (issue 14 item 5): case 1 with a cut amount
+/// around 0.3 (one of the values that script sends), tolerance 0.01, the default (tangent) method.
+const DISTINCT_LOAD_NAME: &str = "typical_distinct_load_cut0.300123_tangent";
+const DISTINCT_LOAD_CUT: f64 = 0.300123;
 
 /// Which solver entry a bench runs.
 #[derive(Clone, Copy)]
@@ -34,13 +43,18 @@ fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("deburr");
     for (name, tolerance, method, entry) in [
         ("typical_case1_tangent", 0.01, "tangent", Entry::Solve),
+        (DISTINCT_LOAD_NAME, 0.01, "tangent", Entry::Solve),
         ("typical_case1_exact", 0.01, "exact", Entry::Solve),
         ("typical_case1_exact_single_section", 0.01, "exact", Entry::SingleSection),
         ("10k_points_tangent", 1e-6, "tangent", Entry::Solve),
         ("10k_points_exact", 1e-6, "exact", Entry::Solve),
         ("10k_points_exact_single_section", 1e-6, "exact", Entry::SingleSection),
     ] {
-        let job = request(tolerance, method);
+        let job = if name == DISTINCT_LOAD_NAME {
+            request_with_cut(DISTINCT_LOAD_CUT, tolerance, method)
+        } else {
+            request(tolerance, method)
+        };
         let run = move |job: &DeburrRequest| match entry {
             Entry::Solve => deburr::solve(job, tool),
             Entry::SingleSection => deburr::solve_single_section(job, tool),
