@@ -118,11 +118,6 @@ impl Construction {
         (q.x * q.x + q.z * q.z).sqrt() - self.cylinder_radius
     }
 
-    fn cylinder_gradient(q: &Vec3) -> Vec3 {
-        let r = (q.x * q.x + q.z * q.z).sqrt();
-        Vec3::new(q.x / r, 0.0, q.z / r)
-    }
-
     /// Where the circle of radius `radius` around `centre` in VP meets the cylinder surface
     /// (`on_wall` false) or the hole wall (`on_wall` true), nearest to direction `near`.
     pub(super) fn circle_meets_surface(
@@ -149,16 +144,18 @@ impl Construction {
         let mut turned = 0.0_f64;
         for _ in 0..12 {
             let q = centre + radius * (cos * b1 + sin * b2);
-            let value = surface(q);
+            // The value and its gradient from one evaluation (the wall's distance and the
+            // cylinder's radius are computed once per step, not again for the slope).
+            let (value, gradient) = if on_wall {
+                let (distance, (gx, gy)) = profile.signed_distance(q.x, q.y);
+                (distance, Vec3::new(gx, gy, 0.0))
+            } else {
+                let r = (q.x * q.x + q.z * q.z).sqrt();
+                (r - self.cylinder_radius, Vec3::new(q.x / r, 0.0, q.z / r))
+            };
             if value.abs() < 1e-14 {
                 return Some(q);
             }
-            let gradient = if on_wall {
-                let (_, (gx, gy)) = profile.signed_distance(q.x, q.y);
-                Vec3::new(gx, gy, 0.0)
-            } else {
-                Self::cylinder_gradient(&q)
-            };
             let slope = gradient.dot(&(radius * (cos * b2 - sin * b1)));
             if slope.abs() < 1e-12 {
                 break;

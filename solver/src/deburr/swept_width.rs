@@ -12,7 +12,7 @@ use super::centre::{Construction, RidgeCentre};
 use super::profile::Profile;
 use super::tolerance::{IntervalLimit, Refined, Target, interval_deviation};
 use crate::error::SolverError;
-use crate::geometry::{Vec3, distance_to_segment, root_near};
+use crate::geometry::{Vec3, distance_squared_to_segment, root_near};
 
 /// Most intervals of a loop at which the swept width is measured (at its end target and its
 /// middle); denser loops are measured at intervals spread evenly.
@@ -123,24 +123,39 @@ impl Polyline<'_> {
     /// Only the local part of the loop counts: a far part within reach is E_FAR_GOUGE's business.
     fn distance(&self, point: &Vec3, hint: &Cell<usize>) -> f64 {
         let count = self.centres.len() - 1;
-        let vertex = |k: usize| &self.centres[k % count];
-        let squared = |k: usize| (vertex(k) - point).norm_squared();
+        // Indices wrap by a comparison, not `%`: this runs for every evaluation of the swept
+        // width's root searches, and an integer division per vertex showed in the profile.
+        let next = |k: usize| if k + 1 == count { 0 } else { k + 1 };
+        let previous = |k: usize| if k == 0 { count - 1 } else { k - 1 };
+        let squared = |k: usize| (self.centres[k] - point).norm_squared();
         let mut index = hint.get() % count;
-        while squared(index + 1) < squared(index) {
-            index = (index + 1) % count;
+        let mut here = squared(index);
+        loop {
+            let ahead = squared(next(index));
+            if ahead >= here {
+                break;
+            }
+            (index, here) = (next(index), ahead);
         }
-        while squared(index + count - 1) < squared(index) {
-            index = (index + count - 1) % count;
+        loop {
+            let behind = squared(previous(index));
+            if behind >= here {
+                break;
+            }
+            (index, here) = (previous(index), behind);
         }
         hint.set(index);
         // Two moves either side of the nearest vertex: a long straight move next to short ones
-        // can hold the nearest point while its far end is not the nearest vertex.
-        (0..4)
-            .map(|k| {
-                let from = index + 2 * count + k - 2;
-                distance_to_segment(point, vertex(from), vertex(from + 1))
-            })
-            .fold(f64::INFINITY, f64::min)
+        // can hold the nearest point while its far end is not the nearest vertex. The nearest by
+        // squared distance, then one square root: the root is monotone, so the same bits.
+        let mut from = previous(previous(index));
+        let mut nearest = f64::INFINITY;
+        for _ in 0..4 {
+            let to = next(from);
+            nearest = nearest.min(distance_squared_to_segment(point, &self.centres[from], &self.centres[to]));
+            from = to;
+        }
+        nearest.sqrt()
     }
 }
 
@@ -175,15 +190,27 @@ fn width_from(
         edges.iter_mut().zip(legs.iter_mut()).zip([(tangent_g1 - target, false), (tangent_g2 - target, true)])
     {
         let hint = Cell::new(hint);
+        // The leg last evaluated and its point: the secant search ends on an evaluation at the
+        // leg it returns, so the band edge there is the point already found, not a new
+        // intersection solve (the same computation, so the same bits).
+        let last: Cell<Option<(f64, Option<Vec3>)>> = Cell::new(None);
         // The point of the true section curve at `leg` from P, and how far outside the cut it is.
         let on_curve = |leg: f64| construction.circle_meets_surface(profile, plane, &target, leg, &near, on_wall);
-        let outside = |leg: f64| on_curve(leg).map_or(f64::NAN, |q| polyline.distance(&q, &hint) - ball);
+        let outside = |leg: f64| {
+            let point = on_curve(leg);
+            last.set(Some((leg, point)));
+            point.map_or(f64::NAN, |q| polyline.distance(&q, &hint) - ball)
+        };
         let tangent_leg = near.norm();
         let start = known.unwrap_or(tangent_leg);
         let leg = secant_root(&outside, start)
             .or_else(|| root_near(outside, tangent_leg, 0.05 * tangent_leg, 0.95 * tangent_leg, 1e-14 * tangent_leg));
         *known = leg;
-        *edge = on_curve(leg?)?;
+        let leg = leg?;
+        *edge = match last.get() {
+            Some((evaluated, point)) if evaluated.to_bits() == leg.to_bits() => point?,
+            _ => on_curve(leg)?,
+        };
     }
     Some((edges[0] - edges[1]).norm())
 }
