@@ -42,6 +42,26 @@ pub(crate) struct RidgeCentre {
     pub centre_offset: f64,
 }
 
+/// The direction in VP from which [`Construction::circle_meets_surface`] starts: `near`'s
+/// components along the plane's basis and the unit vector (cos, sin) they point along.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct CircleStart {
+    along_b1: f64,
+    along_b2: f64,
+    cos: f64,
+    sin: f64,
+}
+
+impl CircleStart {
+    /// The start towards `near` in `plane`.
+    pub(super) fn new(plane: (Vec3, Vec3), near: &Vec3) -> Self {
+        let (b1, b2) = plane;
+        let (along_b1, along_b2) = (near.dot(&b1), near.dot(&b2));
+        let length = (along_b1 * along_b1 + along_b2 * along_b2).sqrt();
+        Self { along_b1, along_b2, cos: along_b1 / length, sin: along_b2 / length }
+    }
+}
+
 impl RidgeCentre {
     /// Wedge angle β = π − acos(m1·m2), radians.
     pub fn wedge_angle(&self) -> f64 {
@@ -129,6 +149,20 @@ impl Construction {
         near: &Vec3,
         on_wall: bool,
     ) -> Option<Vec3> {
+        self.circle_meets_surface_from(profile, plane, centre, radius, &CircleStart::new(plane, near), on_wall)
+    }
+
+    /// [`Self::circle_meets_surface`] from a start direction computed once: root searches over
+    /// the radius keep `near` and the plane, so they need not normalise it again per radius.
+    pub(super) fn circle_meets_surface_from(
+        &self,
+        profile: &Profile,
+        plane: (Vec3, Vec3),
+        centre: &Vec3,
+        radius: f64,
+        start: &CircleStart,
+        on_wall: bool,
+    ) -> Option<Vec3> {
         let (b1, b2) = plane;
         let at = |angle: f64| centre + radius * (angle.cos() * b1 + angle.sin() * b2);
         let surface = |q: Vec3| {
@@ -138,9 +172,7 @@ impl Construction {
         // vector (cos, sin) by each step instead of calling the trigonometric functions, which
         // would cost more than the rest of the construction; the bracketing search below is the
         // fallback for strongly curved cases.
-        let (along_b1, along_b2) = (near.dot(&b1), near.dot(&b2));
-        let length = (along_b1 * along_b1 + along_b2 * along_b2).sqrt();
-        let (mut cos, mut sin) = (along_b1 / length, along_b2 / length);
+        let (mut cos, mut sin) = (start.cos, start.sin);
         let mut turned = 0.0_f64;
         for _ in 0..12 {
             let q = centre + radius * (cos * b1 + sin * b2);
@@ -174,8 +206,8 @@ impl Construction {
             };
             (cos, sin) = (cos * step_cos - sin * step_sin, sin * step_cos + cos * step_sin);
         }
-        let start = along_b2.atan2(along_b1);
-        let angle = root_near(|a| surface(at(a)), start, 1e-3, 1.2, 1e-15)?;
+        let start_angle = start.along_b2.atan2(start.along_b1);
+        let angle = root_near(|a| surface(at(a)), start_angle, 1e-3, 1.2, 1e-15)?;
         Some(at(angle))
     }
 
@@ -199,9 +231,11 @@ impl Construction {
         let plane = ridge.plane_basis();
         let p = ridge.target;
         let (tangent_g1, tangent_g2) = ridge.band_edges(self.half_width);
+        let (start_g1, start_g2) =
+            (CircleStart::new(plane, &(tangent_g1 - p)), CircleStart::new(plane, &(tangent_g2 - p)));
         let edges = |leg: f64| -> Option<(Vec3, Vec3)> {
-            let g1 = self.circle_meets_surface(profile, plane, &p, leg, &(tangent_g1 - p), false)?;
-            let g2 = self.circle_meets_surface(profile, plane, &p, leg, &(tangent_g2 - p), true)?;
+            let g1 = self.circle_meets_surface_from(profile, plane, &p, leg, &start_g1, false)?;
+            let g2 = self.circle_meets_surface_from(profile, plane, &p, leg, &start_g2, true)?;
             Some((g1, g2))
         };
         let width_error = |leg: f64| edges(leg).map_or(f64::NAN, |(g1, g2)| (g1 - g2).norm() - 2.0 * self.half_width);

@@ -8,7 +8,7 @@
 use crate::error::ErrorCode;
 use std::cell::Cell;
 
-use super::centre::{Construction, RidgeCentre};
+use super::centre::{CircleStart, Construction, RidgeCentre};
 use super::profile::Profile;
 use super::tolerance::{IntervalLimit, Refined, Target, interval_deviation};
 use crate::error::SolverError;
@@ -195,15 +195,16 @@ fn width_from(
         // intersection solve (the same computation, so the same bits).
         let last: Cell<Option<(f64, Option<Vec3>)>> = Cell::new(None);
         // The point of the true section curve at `leg` from P, and how far outside the cut it is.
-        let on_curve = |leg: f64| construction.circle_meets_surface(profile, plane, &target, leg, &near, on_wall);
+        let start = CircleStart::new(plane, &near);
+        let on_curve = |leg: f64| construction.circle_meets_surface_from(profile, plane, &target, leg, &start, on_wall);
         let outside = |leg: f64| {
             let point = on_curve(leg);
             last.set(Some((leg, point)));
             point.map_or(f64::NAN, |q| polyline.distance(&q, &hint) - ball)
         };
         let tangent_leg = near.norm();
-        let start = known.unwrap_or(tangent_leg);
-        let leg = secant_root(&outside, start)
+        let first_leg = known.unwrap_or(tangent_leg);
+        let leg = secant_root(&outside, first_leg)
             .or_else(|| root_near(outside, tangent_leg, 0.05 * tangent_leg, 0.95 * tangent_leg, 1e-14 * tangent_leg));
         *known = leg;
         let leg = leg?;
