@@ -12,7 +12,7 @@ use super::centre::{CircleStart, Construction, RidgeCentre};
 use super::profile::Profile;
 use super::tolerance::{IntervalLimit, Refined, Target, interval_deviation};
 use crate::error::SolverError;
-use crate::geometry::{Vec3, distance_squared_to_segment, root_near};
+use crate::geometry::{Vec3, root_near};
 
 /// Most intervals of a loop at which the swept width is measured (at its end target and its
 /// middle); denser loops are measured at intervals spread evenly.
@@ -58,7 +58,7 @@ where
         };
         let mut splits = Vec::new();
         {
-            let polyline = Polyline { centres: &refined.centres };
+            let polyline = Polyline::new(&refined.centres);
             for index in 0..refined.targets.len() - 1 {
                 if refined.limits[index].deviation * SAG_TO_WIDTH <= band {
                     continue;
@@ -116,9 +116,44 @@ pub(crate) struct SweptWidths {
 /// The closed centre polyline (local frame; the last centre repeats the first).
 struct Polyline<'a> {
     centres: &'a [Vec3],
+    /// Move k, from centre k to centre k + 1, with its vector and squared length computed once:
+    /// every evaluation of the swept width's root searches measures four moves.
+    moves: Vec<Move>,
 }
 
-impl Polyline<'_> {
+/// One straight move of the polyline.
+struct Move {
+    from: Vec3,
+    /// to − from.
+    along: Vec3,
+    /// |to − from|².
+    length_squared: f64,
+}
+
+impl Move {
+    /// `geometry::distance_squared_to_segment(point, from, to)` with the move's vector and
+    /// squared length computed once: the same operations in the same order, so the same bits.
+    fn distance_squared(&self, point: &Vec3) -> f64 {
+        if self.length_squared == 0.0 {
+            return (point - self.from).norm_squared();
+        }
+        let t = ((point - self.from).dot(&self.along) / self.length_squared).clamp(0.0, 1.0);
+        (point - (self.from + t * self.along)).norm_squared()
+    }
+}
+
+impl<'a> Polyline<'a> {
+    fn new(centres: &'a [Vec3]) -> Self {
+        let moves = centres
+            .windows(2)
+            .map(|pair| {
+                let along = pair[1] - pair[0];
+                Move { from: pair[0], along, length_squared: along.norm_squared() }
+            })
+            .collect();
+        Self { centres, moves }
+    }
+
     /// Distance from `point` to the polyline near vertex `hint`, which moves to the nearest vertex.
     /// Only the local part of the loop counts: a far part within reach is E_FAR_GOUGE's business.
     fn distance(&self, point: &Vec3, hint: &Cell<usize>) -> f64 {
@@ -151,9 +186,8 @@ impl Polyline<'_> {
         let mut from = previous(previous(index));
         let mut nearest = f64::INFINITY;
         for _ in 0..4 {
-            let to = next(from);
-            nearest = nearest.min(distance_squared_to_segment(point, &self.centres[from], &self.centres[to]));
-            from = to;
+            nearest = nearest.min(self.moves[from].distance_squared(point));
+            from = next(from);
         }
         nearest.sqrt()
     }
@@ -246,7 +280,7 @@ pub(crate) fn swept_widths(
     targets: &[Target],
     centres: &[Vec3],
 ) -> SweptWidths {
-    let polyline = Polyline { centres };
+    let polyline = Polyline::new(centres);
     let width = 2.0 * construction.half_width;
     let intervals = targets.len() - 1;
     let stride = intervals.div_ceil(MAX_MEASURED_INTERVALS).max(1);
