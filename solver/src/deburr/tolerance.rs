@@ -9,7 +9,7 @@
 use super::profile::Profile;
 use crate::error::ErrorCode;
 use crate::error::SolverError;
-use crate::geometry::{Vec3, distance_to_segment};
+use crate::geometry::{Vec3, distance_squared_to_segment, distance_to_segment};
 use crate::machine::BlockRule;
 
 /// How far the bisection aims beyond the rule's target chord. Halving an interval whose chord
@@ -227,7 +227,9 @@ where
         inner: &[Vec3; 7],
         depth: u32,
     ) -> Result<(), SolverError> {
-        let deviation = inner.iter().map(|p| distance_to_segment(p, start, end)).fold(0.0, f64::max);
+        // The farthest sub-sample by squared distance, then one square root (monotone: the same
+        // bits as the largest of seven distances).
+        let deviation = inner.iter().map(|p| distance_squared_to_segment(p, start, end)).fold(0.0, f64::max).sqrt();
         let limit = match self.spacing {
             Spacing::Fixed(tolerance) => tolerance,
             Spacing::Rule(_) => self.spacing.limit((end - start).norm(), deviation).0,
