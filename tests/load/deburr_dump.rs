@@ -1,8 +1,8 @@
 //! Writes the answer JSON and G-code of a few deburr requests (the typical request of
-//! tests/load/deburr-distinct.lua and its neighbours) to the directory named by
-//! `KERF_DEBURR_DUMP`, so that two builds can be compared byte for byte with `cmp` after a change
-//! meant to leave the answers alone. Ignored by default; run with
-//! `KERF_DEBURR_DUMP=/tmp/dump cargo test -p kerf-solver --test deburr_identity_dump -- --ignored`.
+//! tests/load/deburr-distinct.lua and its neighbours) to the directory
+//! given as its argument, so that two builds can be compared byte for byte with `cmp` after a
+//! change meant to leave the answers alone:
+//! `cargo run --release -p kerf-solver --example deburr_dump -- /tmp/dump`.
 
 use kerf_solver::deburr::{self, DeburrRequest};
 use kerf_solver::gcode::{Arcs, Dialect, Post, Reference, ToolCall};
@@ -17,10 +17,8 @@ fn request(hole: serde_json::Value, edge: &str, cut_amount: f64, method: &str) -
     .expect("valid request")
 }
 
-#[test]
-#[ignore = "writes files for a byte comparison of two builds"]
-fn dump_answers_and_programs() {
-    let Ok(directory) = std::env::var("KERF_DEBURR_DUMP") else { return };
+fn main() {
+    let directory = std::env::args().nth(1).expect("usage: deburr_dump DIRECTORY");
     std::fs::create_dir_all(&directory).unwrap();
     let round = serde_json::json!({"shape": "round", "radius": 10});
     let slot = serde_json::json!({"shape": "slot", "radius": 6, "centre_distance": 12});
