@@ -6,6 +6,13 @@
 //! Run: `cargo bench -p kerf-solver --bench chord -- --warm-up-time 1 --measurement-time 5`.
 //! Criterion reports time per solve and, from the block count of each input (printed first),
 //! blocks per second (`thrpt`, in elements/s).
+//!
+//! On a shared machine, and to check that a change leaves the answers alone (as the engagement
+//! bench): `KERF_BENCH_ONLY=name` keeps the configurations whose name (`bspline_window`,
+//! `circle_r50`, ...) contains it (`name$`: that one only); `KERF_BENCH_SOLVES=n` solves each
+//! kept configuration n more times instead of benchmarking it (CPU time under `perf stat -e
+//! task-clock`, instructions under callgrind); `KERF_BENCH_DUMP=dir` writes each kept
+//! configuration's answer JSON to `dir/<name>.json` (to `cmp` two builds).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use kerf_solver::chord::{self, SegmentRequest};
@@ -54,30 +61,59 @@ fn request(curve: &Value, mode: &str) -> Option<SegmentRequest> {
     .ok()
 }
 
+/// Whether `KERF_BENCH_ONLY` keeps the configuration `name`.
+fn wanted(name: &str) -> bool {
+    std::env::var("KERF_BENCH_ONLY").ok().is_none_or(|filter| match filter.strip_suffix('$') {
+        Some(exact) => name == exact,
+        None => name.contains(&filter),
+    })
+}
+
+/// Solves `request` once to print its block count, writes its answer for `KERF_BENCH_DUMP`,
+/// and solves it `KERF_BENCH_SOLVES` times or benchmarks it.
+fn run(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    request: &SegmentRequest,
+) {
+    let answer = chord::solve(request, None).expect("solve");
+    let blocks = answer.stats.blocks;
+    println!("{name}: {blocks} blocks");
+    if let Ok(dir) = std::env::var("KERF_BENCH_DUMP") {
+        std::fs::write(format!("{dir}/{name}.json"), serde_json::to_vec(&answer).expect("json")).expect("dump");
+    }
+    if let Some(solves) = std::env::var("KERF_BENCH_SOLVES").ok().and_then(|n| n.parse::<usize>().ok()) {
+        for _ in 0..solves {
+            drop(std::hint::black_box(chord::solve(std::hint::black_box(request), None)));
+        }
+        return;
+    }
+    group.throughput(Throughput::Elements(blocks as u64));
+    group.bench_function(name, |b| b.iter(|| chord::solve(std::hint::black_box(request), None)));
+}
+
 fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("chord");
     group.sample_size(10);
     let curves = [("bspline", spiral()), ("ellipse", ellipse()), ("polyline", polyline())];
     for (name, curve) in &curves {
         for mode in ["window", "guarantee", "curve"] {
+            let name = format!("{name}_{mode}");
+            if !wanted(&name) {
+                continue;
+            }
             // A mode the solver does not know (before guarantee existed) is skipped.
             let Some(request) = request(curve, mode) else {
-                println!("{name} {mode}: mode not available");
+                println!("{name}: mode not available");
                 continue;
             };
-            let blocks = chord::solve(&request, None).expect("solve").stats.blocks;
-            println!("{name} {mode}: {blocks} blocks");
-            group.throughput(Throughput::Elements(blocks as u64));
-            group.bench_function(format!("{name}_{mode}"), |b| {
-                b.iter(|| chord::solve(std::hint::black_box(&request), None))
-            });
+            run(&mut group, &name, &request);
         }
     }
-    let circle = request(&json!({"kind": "circle", "centre": [0, 0], "radius": 50}), "window").expect("circle");
-    let blocks = chord::solve(&circle, None).expect("solve").stats.blocks;
-    println!("circle R50: {blocks} blocks");
-    group.throughput(Throughput::Elements(blocks as u64));
-    group.bench_function("circle_r50", |b| b.iter(|| chord::solve(std::hint::black_box(&circle), None)));
+    if wanted("circle_r50") {
+        let circle = request(&json!({"kind": "circle", "centre": [0, 0], "radius": 50}), "window").expect("circle");
+        run(&mut group, "circle_r50", &circle);
+    }
     group.finish();
 }
 

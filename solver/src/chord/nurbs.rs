@@ -178,6 +178,12 @@ impl Nurbs {
     /// Knot span index i with u_i ≤ u < u_{i+1} (A2.1), the last non-empty span at the end.
     pub(crate) fn span(&self, u: f64) -> usize {
         let n = self.weighted.len();
+        // The span found last holds u nearly always (the search evaluates near it again and
+        // again): one bracket test before the ends' cases and the binary search.
+        let last = self.last_span.get();
+        if last < n && self.knots[last] <= u && u < self.knots[last + 1] {
+            return last;
+        }
         let (start, end) = self.domain();
         if u >= end {
             // Last span with a non-zero length.
@@ -194,12 +200,9 @@ impl Nurbs {
             }
             return i;
         }
-        let last = self.last_span.get();
-        for guess in [last, last + 1] {
-            if guess < n && self.knots[guess] <= u && u < self.knots[guess + 1] {
-                self.last_span.set(guess);
-                return guess;
-            }
+        if last + 1 < n && self.knots[last + 1] <= u && u < self.knots[last + 2] {
+            self.last_span.set(last + 1);
+            return last + 1;
         }
         // First index with knot > u, minus one.
         let span = self.knots[..=n].partition_point(|&k| k <= u) - 1;
@@ -423,7 +426,9 @@ impl Nurbs {
             return self.derivatives_by_basis(span, u)[1].norm();
         }
         if self.common_weight.is_some() {
-            let squared = polynomial.speed_squared[..=2 * self.degree - 2].iter().rev().fold(0.0, |sum, c| sum * t + c);
+            // Every coefficient, the ones above degree 2p − 2 being zero: a loop of fixed length
+            // the compiler unrolls (leading zeros leave Horner's sum exactly as it was).
+            let squared = polynomial.speed_squared.iter().rev().fold(0.0, |sum, c| sum * t + c);
             return squared.max(0.0).sqrt() * scale;
         }
         let mut value = polynomial.coefficients[self.degree];
