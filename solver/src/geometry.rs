@@ -75,13 +75,36 @@ pub fn distance_to_segment(p: &Vec3, a: &Vec3, b: &Vec3) -> f64 {
 /// The square of [`distance_to_segment`]: the farthest of many points needs one square root,
 /// not one per point (the square root is monotone, so the result is the same to the bit).
 pub fn distance_squared_to_segment(p: &Vec3, a: &Vec3, b: &Vec3) -> f64 {
-    let ab = b - a;
-    let length_squared = ab.norm_squared();
-    if length_squared == 0.0 {
-        return (p - a).norm_squared();
+    Segment::new(*a, *b).distance_squared(p)
+}
+
+/// A closed segment with its vector and squared length computed once, for measuring many points
+/// against it (a polyline's moves, a chord against the vertices it spans).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Segment {
+    /// Start.
+    pub from: Vec3,
+    /// End − start.
+    pub along: Vec3,
+    /// |end − start|².
+    pub length_squared: f64,
+}
+
+impl Segment {
+    /// The segment from `from` to `to`.
+    pub fn new(from: Vec3, to: Vec3) -> Self {
+        let along = to - from;
+        Self { from, along, length_squared: along.norm_squared() }
     }
-    let t = ((p - a).dot(&ab) / length_squared).clamp(0.0, 1.0);
-    (p - (a + t * ab)).norm_squared()
+
+    /// [`distance_squared_to_segment`] of `point` (a degenerate segment is a point).
+    pub fn distance_squared(&self, point: &Vec3) -> f64 {
+        if self.length_squared == 0.0 {
+            return (point - self.from).norm_squared();
+        }
+        let t = ((point - self.from).dot(&self.along) / self.length_squared).clamp(0.0, 1.0);
+        (point - (self.from + t * self.along)).norm_squared()
+    }
 }
 
 /// Finds a root of `f` near `start`: steps outwards in both directions (first `step`, growing by

@@ -13,7 +13,7 @@ use super::nurbs::Nurbs;
 use super::radius::SpanMinima;
 use crate::error::ErrorCode;
 use crate::error::SolverError;
-use crate::geometry::{Vec3, distance_squared_to_segment, distance_to_segment};
+use crate::geometry::{Segment, Vec3, distance_to_segment};
 
 /// Sub-intervals sampled before the deviation is refined (chord.md §2.9).
 const DEVIATION_SAMPLES: usize = 32;
@@ -405,14 +405,16 @@ impl Shape {
                 } else {
                     line.stations.partition_point(|&x| x <= lo)
                 };
-                let mut worst_squared = 0.0_f64;
-                for (vertex, &station) in line.vertices.iter().zip(&line.stations).skip(first) {
-                    if station >= hi {
-                        break;
-                    }
-                    worst_squared = worst_squared.max(distance_squared_to_segment(vertex, &a, &b));
+                // The vertices strictly inside, then their distances in a plain loop over them
+                // against the chord's vector computed once (the search measures a chord's dozen
+                // vertices several times per block).
+                let mut end = first;
+                while end < line.stations.len() && line.stations[end] < hi {
+                    end += 1;
                 }
-                worst_squared.sqrt()
+                let chord = Segment::new(a, b);
+                let inside = line.vertices.get(first..end).unwrap_or_default();
+                inside.iter().map(|vertex| chord.distance_squared(vertex)).fold(0.0_f64, f64::max).sqrt()
             }
             Self::Ellipse(_) | Self::Spline(_) => self.sampled_deviation(ua, ub, None),
         }

@@ -12,7 +12,7 @@ use super::centre::{CircleStart, Construction, RidgeCentre};
 use super::profile::Profile;
 use super::tolerance::{IntervalLimit, Refined, Target, interval_deviation};
 use crate::error::SolverError;
-use crate::geometry::{Vec3, root_near};
+use crate::geometry::{Segment, Vec3, root_near};
 
 /// Most intervals of a loop at which the swept width is measured (at its end target and its
 /// middle); denser loops are measured at intervals spread evenly.
@@ -118,39 +118,12 @@ struct Polyline<'a> {
     centres: &'a [Vec3],
     /// Move k, from centre k to centre k + 1, with its vector and squared length computed once:
     /// every evaluation of the swept width's root searches measures four moves.
-    moves: Vec<Move>,
-}
-
-/// One straight move of the polyline.
-struct Move {
-    from: Vec3,
-    /// to − from.
-    along: Vec3,
-    /// |to − from|².
-    length_squared: f64,
-}
-
-impl Move {
-    /// `geometry::distance_squared_to_segment(point, from, to)` with the move's vector and
-    /// squared length computed once: the same operations in the same order, so the same bits.
-    fn distance_squared(&self, point: &Vec3) -> f64 {
-        if self.length_squared == 0.0 {
-            return (point - self.from).norm_squared();
-        }
-        let t = ((point - self.from).dot(&self.along) / self.length_squared).clamp(0.0, 1.0);
-        (point - (self.from + t * self.along)).norm_squared()
-    }
+    moves: Vec<Segment>,
 }
 
 impl<'a> Polyline<'a> {
     fn new(centres: &'a [Vec3]) -> Self {
-        let moves = centres
-            .windows(2)
-            .map(|pair| {
-                let along = pair[1] - pair[0];
-                Move { from: pair[0], along, length_squared: along.norm_squared() }
-            })
-            .collect();
+        let moves = centres.windows(2).map(|pair| Segment::new(pair[0], pair[1])).collect();
         Self { centres, moves }
     }
 
