@@ -10,7 +10,8 @@
 //! * [`rule`]: C_ep for a radius (Eqs. 1–15, margins, the lower clamp): the building block for
 //!   every path solver ([`BlockRule::tolerance_for`]);
 //! * `shape`, `nurbs`, `cubic`, `arclength`, `radius`: the curves (circle, arc, ellipse, polyline, NURBS) by arc
-//!   length, chord deviation, radius of curvature, corners;
+//!   length, chord deviation, radius of curvature, corners; `polynomial`: real roots of low-degree
+//!   polynomials (the exact radius turns of plain cubic spans);
 //! * `segment`: greedy chords, the window procedure with carry-over and progress rule, the
 //!   single-value run (§2.9); `search`: the fast chord search (§2.9a), `reference`: the §2.9
 //!   numerics it is tested against ([`solve_reference`]); `guarantee`: mode `guarantee` (§2.9a);
@@ -63,6 +64,7 @@ mod guarantee;
 mod job;
 mod numeric;
 mod nurbs;
+mod polynomial;
 pub mod program;
 mod radius;
 mod reference;

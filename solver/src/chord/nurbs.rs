@@ -238,21 +238,35 @@ impl Nurbs {
     /// [lo, hi] as a [`CubicPiece`] when it lies inside one knot span (its end may be the span's
     /// closing knot) of a polynomial curve of degree ≤ 3; `None` otherwise.
     pub(crate) fn cubic_piece(&self, lo: f64, hi: f64) -> Option<CubicPiece> {
-        let weight = self.common_weight?;
-        if self.degree > 3 || lo >= hi || lo.is_nan() || hi.is_nan() {
+        if !self.is_plain_cubic() || lo >= hi || lo.is_nan() || hi.is_nan() {
             return None;
         }
         let span = self.span(lo);
-        let polynomial = &self.polynomials[span - self.degree];
         if hi > self.knots[span + 1] {
             return None;
         }
+        let coefficients = self.plain_span_form(span)?;
+        let polynomial = &self.polynomials[span - self.degree];
+        let local = |u: f64| (u - polynomial.start) * polynomial.inverse_width;
+        Some(CubicPiece { coefficients, t_lo: local(lo), t_hi: local(hi) })
+    }
+
+    /// Whether every span is a polynomial of degree ≤ 3 (a plain B-spline: one common weight),
+    /// whose radius of curvature turns where a polynomial has its roots (`radius`).
+    pub(crate) fn is_plain_cubic(&self) -> bool {
+        self.common_weight.is_some() && self.degree <= 3
+    }
+
+    /// The power-form coefficients a₀…a₃ of knot span `span` of a plain cubic curve, in the
+    /// span's own parameter t ∈ [0, 1] and relative to its first point; `None` for other curves.
+    pub(crate) fn plain_span_form(&self, span: usize) -> Option<[Vec3; 4]> {
+        let weight = self.common_weight.filter(|_| self.degree <= 3)?;
+        let polynomial = &self.polynomials[span - self.degree];
         let mut coefficients = [Vec3::zeros(); 4];
         for (vector, h) in coefficients.iter_mut().zip(&polynomial.coefficients[..=self.degree]) {
             *vector = Vec3::new(h[0], h[1], h[2]) / weight;
         }
-        let local = |u: f64| (u - polynomial.start) * polynomial.inverse_width;
-        Some(CubicPiece { coefficients, t_lo: local(lo), t_hi: local(hi) })
+        Some(coefficients)
     }
 
     fn point_in(&self, span: usize, u: f64) -> Vec3 {

@@ -4,11 +4,16 @@
 //! least of its ends, its interior knots, the minima recorded inside it and eight samples of the
 //! window itself: about ten radius evaluations per window instead of a fresh sampling of 16 per
 //! window and knot span refined by Brent's method (issue 14).
+//!
+//! On a plain B-spline of degree ≤ 3 the turns of each span's radius are found exactly, as the
+//! roots of a polynomial (`polynomial`), and a stretch's smallest radius is the least of its
+//! ends, its knots and the turns inside it, with no samples at all.
 
 use std::cell::OnceCell;
 
 use super::numeric::minimise;
 use super::nurbs::Nurbs;
+use super::polynomial::Polynomial;
 use crate::geometry::Vec3;
 
 /// Radius samples per knot span before the local minima among them are refined. The radius of a
@@ -43,13 +48,16 @@ type RadiusAt = (f64, f64);
 /// The interior local minima of the radius of curvature of each knot span, found on demand.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub(crate) struct SpanMinima {
-    /// Per knot span (index − degree): (u, radius) of each interior local minimum, increasing u.
+    /// Per knot span (index − degree): (u, radius) of each interior local minimum, increasing u
+    /// (every interior turn of the radius where `exact`).
     spans: Vec<OnceCell<Box<[RadiusAt]>>>,
+    /// The turns are exact (a plain cubic curve): a stretch needs no samples of its own.
+    exact: bool,
 }
 
 impl SpanMinima {
     pub(crate) fn new(nurbs: &Nurbs) -> Self {
-        Self { spans: nurbs.spans().map(|_| OnceCell::new()).collect() }
+        Self { spans: nurbs.spans().map(|_| OnceCell::new()).collect(), exact: nurbs.is_plain_cubic() }
     }
 
     /// The smallest radius of curvature on [lo, hi] (lo ≤ hi) and where it is: the least of the
@@ -79,6 +87,11 @@ impl SpanMinima {
                     consider(radius, u);
                 }
             }
+        }
+        if self.exact {
+            // The radius is smooth inside each span, so its least value on the stretch is at an
+            // end, a knot or a turn: all considered.
+            return best;
         }
         let step = (hi - lo) / STRETCH_PIECES as f64;
         let mut lowest = (f64::INFINITY, lo);
@@ -112,8 +125,49 @@ impl SpanMinima {
 
     fn of_span(&self, nurbs: &Nurbs, span: usize) -> &[RadiusAt] {
         let first = nurbs.spans().start;
-        self.spans.get(span - first).map_or(&[], |cell| cell.get_or_init(|| span_minima(nurbs, span)))
+        let exact = self.exact;
+        self.spans.get(span - first).map_or(&[], |cell| {
+            cell.get_or_init(|| if exact { span_turns(nurbs, span) } else { span_minima(nurbs, span) })
+        })
     }
+}
+
+/// Every interior turn of the radius on knot span `span` of a plain cubic curve: with P′ and P″
+/// in the span's parameter t, S = |P′|² and C = |P′ × P″|², the radius is (S³/C)^½, whose
+/// derivative vanishes where 3·S′·C − S·C′ does (degree ≤ 7; the parameter's scale changes no
+/// root). Maxima come along with the minima; the caller takes the least.
+fn span_turns(nurbs: &Nurbs, span: usize) -> Box<[RadiusAt]> {
+    let (start, end) = nurbs.span_range(span);
+    let Some([_, a1, a2, a3]) = nurbs.plain_span_form(span).filter(|_| end > start) else {
+        return Box::new([]);
+    };
+    // P′ = a₁ + 2a₂t + 3a₃t² and P″ = 2a₂ + 6a₃t, per axis.
+    let first = |k: usize| Polynomial::new(&[a1[k], 2.0 * a2[k], 3.0 * a3[k]]);
+    let second = |k: usize| Polynomial::new(&[2.0 * a2[k], 6.0 * a3[k]]);
+    let (p1, p2) = ([first(0), first(1), first(2)], [second(0), second(1), second(2)]);
+    let cross = |i: usize, j: usize| p1[i].times(&p2[j]).plus_scaled(-1.0, &p1[j].times(&p2[i]));
+    let bend = [cross(1, 2), cross(2, 0), cross(0, 1)];
+    let sum_of_squares = |parts: &[Polynomial; 3]| {
+        parts.iter().fold(Polynomial::new(&[0.0]), |sum, part| sum.plus_scaled(1.0, &part.times(part)))
+    };
+    let (speed_squared, bend_squared) = (sum_of_squares(&p1), sum_of_squares(&bend));
+    let turning = speed_squared
+        .derivative()
+        .times(&bend_squared)
+        .scaled(3.0)
+        .plus_scaled(-1.0, &speed_squared.times(&bend_squared.derivative()));
+    let width = end - start;
+    turning
+        .roots_in(0.0, 1.0)
+        .as_slice()
+        .iter()
+        .filter(|&&t| t > 0.0 && t < 1.0)
+        .map(|&t| {
+            let u = start + width * t;
+            (u, radius_of(nurbs.derivatives_in(span, u)))
+        })
+        .filter(|&(u, _)| u > start && u < end)
+        .collect()
 }
 
 /// The interior local minima of the radius on knot span `span`: [`SPAN_SAMPLES`] samples of the
@@ -159,6 +213,44 @@ fn span_minima(nurbs: &Nurbs, span: usize) -> Box<[RadiusAt]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn plain_cubic_turns_are_exact() {
+        // A spiral with a z wave, as in the chord bench: stretches of a fifth of a span to three
+        // spans, each checked against dense samples refined around the least.
+        let mut control = Vec::new();
+        let mut angle: f64 = 0.0;
+        while control.len() < 40 {
+            let radius = 50.0 + 12.0 * angle / std::f64::consts::TAU;
+            control.push(Vec3::new(radius * angle.cos(), radius * angle.sin(), 0.5 * (3.0 * angle).sin()));
+            angle += 10.0 / radius;
+        }
+        for degree in [2, 3] {
+            let nurbs = Nurbs::new(degree, &control, None, None, "curve").unwrap();
+            let minima = SpanMinima::new(&nurbs);
+            let (start, end) = nurbs.domain();
+            let span = (end - start) / (control.len() - degree) as f64;
+            for k in 0..60 {
+                let lo = start + (end - start) * f64::from(k) / 61.0;
+                for width in [0.2, 1.0, 3.0] {
+                    let hi = (lo + width * span).min(end);
+                    let (radius, _) = minima.smallest(&nurbs, lo, hi);
+                    let step = (hi - lo) / 2000.0;
+                    let (best_u, _) = (0..=2000)
+                        .map(|j| lo + step * f64::from(j))
+                        .map(|u| (u, radius_at(&nurbs, u)))
+                        .fold((lo, f64::INFINITY), |best, (u, r)| if r < best.1 { (u, r) } else { best });
+                    let (_, refined) =
+                        minimise(|u| radius_at(&nurbs, u), (best_u - step).max(lo), (best_u + step).min(hi), 1e-14);
+                    let dense = refined.min(radius_at(&nurbs, best_u));
+                    assert!(
+                        radius <= dense * (1.0 + 1e-12) && radius >= dense * (1.0 - 1e-9),
+                        "degree {degree} [{lo}, {hi}]: {radius} vs {dense}"
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn the_smallest_radius_matches_dense_sampling() {

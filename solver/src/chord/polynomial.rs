@@ -1,0 +1,235 @@
+//! Polynomials of low degree and their real roots on an interval, for the exact extrema of a plain
+//! B-spline span (chord.md §2.9a: "curvature bounds ... of a NURBS span" and exact chord
+//! deviations): the roots of the derivative split the interval into pieces where the polynomial
+//! is monotone, and each piece whose ends differ in sign holds one root, found by Newton steps
+//! kept inside the bracket (bisection where a step leaves it). No sampling, so no root between
+//! samples is missed.
+
+/// Highest degree handled (the radius of curvature of a cubic span leads to degree 7).
+pub(crate) const MAX_DEGREE: usize = 8;
+
+/// Most Newton or bisection steps for one root (bisection alone narrows the bracket to 2⁻¹⁰⁰).
+const ROOT_STEPS: usize = 100;
+/// A root is found when a Newton step moves it less than this fraction of its bracket: its
+/// function's extrema sit at such roots, and a function is flat at its extremum, so the value
+/// there is then exact to about the square of it.
+const ROOT_WIDTH: f64 = 1e-12;
+
+/// Σ c_k·x^k, lowest power first, of degree at most [`MAX_DEGREE`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Polynomial {
+    coefficients: [f64; MAX_DEGREE + 1],
+    /// Index of the highest non-zero coefficient (0 for a constant, also for zero).
+    degree: usize,
+}
+
+/// Real roots in increasing order, at most [`MAX_DEGREE`] of them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Roots {
+    values: [f64; MAX_DEGREE],
+    count: usize,
+}
+
+impl Roots {
+    fn push(&mut self, x: f64) {
+        // A root at a piece's shared end is found from both sides: keep it once.
+        if self.count > 0 && self.values[self.count - 1] == x {
+            return;
+        }
+        if self.count < MAX_DEGREE {
+            self.values[self.count] = x;
+            self.count += 1;
+        }
+    }
+
+    pub(crate) fn as_slice(&self) -> &[f64] {
+        &self.values[..self.count]
+    }
+}
+
+impl Polynomial {
+    /// The polynomial with these coefficients (lowest power first; at most `MAX_DEGREE + 1`,
+    /// the rest ignored).
+    pub(crate) fn new(coefficients: &[f64]) -> Self {
+        let mut all = [0.0; MAX_DEGREE + 1];
+        for (slot, &c) in all.iter_mut().zip(coefficients) {
+            *slot = c;
+        }
+        let degree = all.iter().rposition(|&c| c != 0.0).unwrap_or(0);
+        Self { coefficients: all, degree }
+    }
+
+    /// p · q (degrees adding up to at most [`MAX_DEGREE`]; higher terms are dropped).
+    pub(crate) fn times(&self, other: &Self) -> Self {
+        let mut product = [0.0; MAX_DEGREE + 1];
+        for (i, &a) in self.coefficients[..=self.degree].iter().enumerate() {
+            for (j, &b) in other.coefficients[..=other.degree].iter().enumerate() {
+                if i + j <= MAX_DEGREE {
+                    product[i + j] += a * b;
+                }
+            }
+        }
+        Self::new(&product)
+    }
+
+    /// factor · p.
+    pub(crate) fn scaled(&self, factor: f64) -> Self {
+        Self::new(&self.coefficients.map(|c| factor * c))
+    }
+
+    /// p + factor · q.
+    pub(crate) fn plus_scaled(&self, factor: f64, other: &Self) -> Self {
+        let mut sum = self.coefficients;
+        for (total, &c) in sum.iter_mut().zip(&other.coefficients) {
+            *total += factor * c;
+        }
+        Self::new(&sum)
+    }
+
+    pub(crate) fn value(&self, x: f64) -> f64 {
+        self.coefficients[..=self.degree].iter().rev().fold(0.0, |sum, &c| sum * x + c)
+    }
+
+    pub(crate) fn derivative(&self) -> Self {
+        let mut derivative = [0.0; MAX_DEGREE + 1];
+        for k in 1..=self.degree {
+            derivative[k - 1] = k as f64 * self.coefficients[k];
+        }
+        Self::new(&derivative)
+    }
+
+    /// The real roots in [lo, hi] (a root of even multiplicity, where the sign does not change,
+    /// may be missed; callers take the extrema of a function at roots of its derivative and at
+    /// the interval's ends, where such a double root is a flat turn, not an extremum). None for
+    /// the zero polynomial.
+    pub(crate) fn roots_in(&self, lo: f64, hi: f64) -> Roots {
+        let mut roots = Roots { values: [0.0; MAX_DEGREE], count: 0 };
+        if lo.is_nan() || hi.is_nan() || lo > hi || self.degree == 0 {
+            return roots;
+        }
+        if self.degree == 1 {
+            let root = -self.coefficients[0] / self.coefficients[1];
+            if root >= lo && root <= hi {
+                roots.push(root);
+            }
+            return roots;
+        }
+        if self.degree == 2 {
+            let [c, b, a] = [self.coefficients[0], self.coefficients[1], self.coefficients[2]];
+            let discriminant = b * b - 4.0 * a * c;
+            if discriminant >= 0.0 {
+                // The form without cancellation: q = −(b + sign(b)·√D)/2, roots q/a and c/q.
+                let q = -0.5 * (b + b.signum() * discriminant.sqrt());
+                let (first, second) = (q / a, if q == 0.0 { q / a } else { c / q });
+                for root in [first.min(second), first.max(second)] {
+                    if root >= lo && root <= hi {
+                        roots.push(root);
+                    }
+                }
+            }
+            return roots;
+        }
+        let slope = self.derivative();
+        let turns = slope.roots_in(lo, hi);
+        let mut left = lo;
+        let mut value_left = self.value(lo);
+        for &right in turns.as_slice().iter().chain(std::iter::once(&hi)) {
+            let value_right = self.value(right);
+            if value_left == 0.0 {
+                roots.push(left);
+            } else if value_left.signum() != value_right.signum() && value_right != 0.0 {
+                roots.push(self.root_between(&slope, left, right, value_left));
+            }
+            (left, value_left) = (right, value_right);
+        }
+        if value_left == 0.0 {
+            roots.push(left);
+        }
+        roots
+    }
+
+    /// The root of the polynomial, monotone on [left, right] with a sign change there.
+    fn root_between(&self, slope: &Self, left: f64, right: f64, value_left: f64) -> f64 {
+        let rising = value_left < 0.0;
+        let (mut lo, mut hi) = (left, right);
+        let mut x = 0.5 * (lo + hi);
+        for _ in 0..ROOT_STEPS {
+            let value = self.value(x);
+            if value == 0.0 {
+                return x;
+            }
+            if (value < 0.0) == rising {
+                lo = x;
+            } else {
+                hi = x;
+            }
+            let step = value / slope.value(x);
+            let newton = x - step;
+            if step.abs() <= ROOT_WIDTH * (right - left) {
+                return if newton > lo && newton < hi { newton } else { x };
+            }
+            let next = if newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
+            if next == x || !(next > lo && next < hi) {
+                return x;
+            }
+            x = next;
+        }
+        x
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The polynomial with these roots (leading coefficient `scale`).
+    fn with_roots(roots: &[f64], scale: f64) -> Polynomial {
+        roots.iter().fold(Polynomial::new(&[scale]), |p, &r| p.times(&Polynomial::new(&[-r, 1.0])))
+    }
+
+    #[test]
+    fn finds_every_simple_root_in_the_interval() {
+        let cases: [&[f64]; 5] = [
+            &[0.3],
+            &[0.1, 0.7],
+            &[-2.0, 0.25, 0.5, 0.75, 3.0],
+            &[0.01, 0.011, 0.5, 0.98, 0.99],
+            &[0.05, 0.15, 0.3, 0.45, 0.6, 0.75, 0.9],
+        ];
+        for roots in cases {
+            for scale in [1e-6, 1.0, 1e6] {
+                let found = with_roots(roots, scale).roots_in(0.0, 1.0);
+                let inside: Vec<f64> = roots.iter().copied().filter(|r| (0.0..=1.0).contains(r)).collect();
+                assert_eq!(found.as_slice().len(), inside.len(), "{roots:?} × {scale}: {:?}", found.as_slice());
+                for (got, want) in found.as_slice().iter().zip(&inside) {
+                    assert!((got - want).abs() < 1e-12, "{roots:?} × {scale}: {got} vs {want}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn roots_at_the_ends_count_once() {
+        let found = with_roots(&[0.0, 0.5, 1.0], 2.0).roots_in(0.0, 1.0);
+        assert_eq!(found.as_slice(), &[0.0, 0.5, 1.0]);
+    }
+
+    #[test]
+    fn constants_and_lines() {
+        assert!(Polynomial::new(&[0.0]).roots_in(0.0, 1.0).as_slice().is_empty());
+        assert!(Polynomial::new(&[2.0, 0.0, 0.0]).roots_in(0.0, 1.0).as_slice().is_empty());
+        assert_eq!(Polynomial::new(&[-1.0, 4.0]).roots_in(0.0, 1.0).as_slice(), &[0.25]);
+        assert!(Polynomial::new(&[-1.0, 4.0]).roots_in(0.5, 1.0).as_slice().is_empty());
+    }
+
+    #[test]
+    fn algebra_matches_evaluation() {
+        let p = Polynomial::new(&[1.0, -2.0, 0.5]);
+        let q = Polynomial::new(&[0.25, 3.0]);
+        for x in [-1.5, 0.0, 0.3, 2.0] {
+            assert!((p.times(&q).value(x) - p.value(x) * q.value(x)).abs() < 1e-12);
+            assert!((p.plus_scaled(-2.0, &q).value(x) - (p.value(x) - 2.0 * q.value(x))).abs() < 1e-12);
+            assert!((p.derivative().value(x) - (-2.0 + x)).abs() < 1e-12);
+        }
+    }
+}
