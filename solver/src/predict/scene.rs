@@ -60,8 +60,7 @@ pub(crate) fn gather(path: &PathModel, query: &Query, scratch: &mut Scratch, out
     let centre = &centre;
     out.clear();
     scratch.indices.clear();
-    path.near(centre, reach, &mut scratch.stamps, &mut scratch.indices);
-    scratch.indices.sort_unstable();
+    path.near_in_order(centre, reach, &mut scratch.stamps, &mut scratch.indices);
     out.reserve(scratch.indices.len());
     for &index in &scratch.indices {
         let segment = &path.segments[index as usize];
