@@ -351,10 +351,23 @@ pub(crate) struct PointTest {
 
 impl Scene {
     pub(crate) fn test(&self, stock: &StockModel, lists: &TileLists, q: &Vec3, hints: &mut [usize; 2]) -> PointTest {
+        match lists.region {
+            Some(region) => self.test_in(stock, region, lists, q, hints),
+            None => PointTest { state: SampleState::Air, cut: false },
+        }
+    }
+
+    /// [`Self::test`] for a point whose place relative to the stock is `region` (a part of the
+    /// tile's box).
+    pub(crate) fn test_in(
+        &self,
+        stock: &StockModel,
+        region: Region,
+        lists: &TileLists,
+        q: &Vec3,
+        hints: &mut [usize; 2],
+    ) -> PointTest {
         let air = PointTest { state: SampleState::Air, cut: false };
-        let Some(region) = lists.region else {
-            return air;
-        };
         if !self.in_stock(stock, region, q) {
             return air;
         }

@@ -161,10 +161,14 @@ impl HeightGrid {
     /// per-block extremes otherwise.
     fn range(&self, lo: [f64; 2], hi: [f64; 2]) -> (f64, f64) {
         let index = |v: f64, origin: f64, count: usize| ((v - origin) / self.spacing).clamp(0.0, (count - 1) as f64);
-        let i0 = index(lo[0], self.origin[0], self.nx).floor() as usize;
-        let i1 = index(hi[0], self.origin[0], self.nx).ceil() as usize;
-        let j0 = index(lo[1], self.origin[1], self.ny).floor() as usize;
-        let j1 = index(hi[1], self.origin[1], self.ny).ceil() as usize;
+        // The indices are ≥ 0, so truncation is the floor and one more where it cut a fraction is
+        // the ceiling (without libm calls on baseline x86-64).
+        let floor = |u: f64| u as usize;
+        let ceil = |u: f64| (u as usize) + usize::from((u as usize as f64) < u);
+        let i0 = floor(index(lo[0], self.origin[0], self.nx));
+        let i1 = ceil(index(hi[0], self.origin[0], self.nx));
+        let j0 = floor(index(lo[1], self.origin[1], self.ny));
+        let j1 = ceil(index(hi[1], self.origin[1], self.ny));
         let (mut low, mut high) = (f64::INFINITY, f64::NEG_INFINITY);
         if (i1 - i0 + 1) * (j1 - j0 + 1) <= MAX_RANGE_NODES {
             for j in j0..=j1 {
