@@ -15,7 +15,8 @@
 //! run alternately give ranges on a shared machine); `KERF_BENCH_ONLY=name` keeps the groups whose
 //! name contains it; `KERF_BENCH_WHOLE=0` skips the whole-program run (4 min on 2 cores);
 //! `KERF_BENCH_DUMP=dir` writes each group's slice answer to `dir/<group>.json` (to compare the
-//! answers of two builds field by field).
+//! answers of two builds field by field); `KERF_BENCH_THREADS=n` measures on n threads only (1
+//! for instruction counts under callgrind, whose toggles are global across threads).
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -60,6 +61,10 @@ fn report(label: &str, passes: usize, wall: f64, cpu: f64) {
 fn bench(c: &mut Criterion) {
     let slices: usize = std::env::var("KERF_BENCH_SLICES").ok().and_then(|v| v.parse().ok()).unwrap_or(1);
     let only = std::env::var("KERF_BENCH_ONLY").unwrap_or_default();
+    let thread_counts: Vec<usize> = match std::env::var("KERF_BENCH_THREADS").ok().and_then(|v| v.parse().ok()) {
+        Some(threads) => vec![threads],
+        None => vec![1, 2],
+    };
     let mut group = c.benchmark_group("predict");
     group.sample_size(10);
     for (method, resolution, name) in [
@@ -72,7 +77,7 @@ fn bench(c: &mut Criterion) {
         }
         let (mut request, tool, moves) = support::raster_request(160.0, 0.5, 0.5, method, resolution);
         let middle = moves / 2;
-        for threads in [1, 2] {
+        for &threads in &thread_counts {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             let label = format!("{name}_{threads}_threads");
             // Setup alone (reading 103 041 lines, the grids), then the slice.

@@ -8,6 +8,8 @@
 //! (ball and shank) over (x, y), so the same test serves the depth buffer and the point test of
 //! the surface-sampling method (§6.6, 3-axis with a vertical shank).
 
+use nalgebra::Matrix3;
+
 use crate::geometry::Vec3;
 
 /// A capsule of radius R about the segment AB, in view-frame coordinates.
@@ -48,6 +50,11 @@ impl Capsule {
             inverse_denom: if denom > 0.0 { 1.0 / denom } else { 0.0 },
             min_z: a.z.min(b.z),
         }
+    }
+
+    /// This capsule in another frame (`rotation` applied to both ends).
+    pub(crate) fn in_frame(&self, rotation: &Matrix3<f64>) -> Self {
+        Self::new(rotation * self.a, rotation * self.b)
     }
 
     /// The smallest z at which the ray along +z through (x, y) is inside the capsule of squared

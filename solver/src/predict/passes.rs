@@ -161,14 +161,33 @@ impl PathModel {
     }
 
     /// Appends to `out` the indices of segments whose xy bounding box meets the square of half
-    /// side `reach` about `centre`, each once; `stamps` is per-thread scratch.
+    /// side `reach` about `centre`, each once, in the grid's order; `stamps` is per-thread scratch.
     pub(crate) fn near(&self, centre: &Vec3, reach: f64, stamps: &mut Stamps, out: &mut Vec<u32>) {
-        stamps.next(self.segments.len());
+        stamps.reserve(self.segments.len());
+        let first = out.len();
         self.grid.visit(centre.x - reach, centre.y - reach, centre.x + reach, centre.y + reach, |index| {
-            if stamps.first_visit(index) {
+            if stamps.mark(index) {
                 out.push(index);
             }
         });
+        for &index in &out[first..] {
+            stamps.unmark(index);
+        }
+    }
+
+    /// [`Self::near`] in increasing index order (path order), read off the marks instead of
+    /// sorting.
+    pub(crate) fn near_in_order(&self, centre: &Vec3, reach: f64, stamps: &mut Stamps, out: &mut Vec<u32>) {
+        stamps.reserve(self.segments.len());
+        let (mut lowest, mut highest) = (u32::MAX, 0);
+        self.grid.visit(centre.x - reach, centre.y - reach, centre.x + reach, centre.y + reach, |index| {
+            stamps.mark(index);
+            lowest = lowest.min(index);
+            highest = highest.max(index);
+        });
+        if lowest <= highest {
+            stamps.drain(lowest, highest, out);
+        }
     }
 
     /// The same path with its nodes moved (same segments and passes).
@@ -185,32 +204,42 @@ impl PathModel {
     }
 }
 
-/// Per-thread "seen" marks for deduplicating grid hits.
+/// Per-thread marks of the segments one neighbour query has visited (one bit each, all clear
+/// between queries), for visiting each segment once.
 #[derive(Debug, Default)]
 pub(crate) struct Stamps {
-    marks: Vec<u32>,
-    generation: u32,
+    bits: Vec<u64>,
 }
 
 impl Stamps {
-    fn next(&mut self, count: usize) {
-        if self.marks.len() < count {
-            self.marks.resize(count, 0);
-        }
-        self.generation = self.generation.wrapping_add(1);
-        if self.generation == 0 {
-            self.marks.fill(0);
-            self.generation = 1;
+    fn reserve(&mut self, count: usize) {
+        let words = count.div_ceil(64);
+        if self.bits.len() < words {
+            self.bits.resize(words, 0);
         }
     }
 
-    fn first_visit(&mut self, index: u32) -> bool {
-        let mark = &mut self.marks[index as usize];
-        if *mark == self.generation {
-            false
-        } else {
-            *mark = self.generation;
-            true
+    /// Marks `index`; whether it was unmarked.
+    fn mark(&mut self, index: u32) -> bool {
+        let (word, bit) = (index as usize / 64, 1u64 << (index % 64));
+        let unmarked = self.bits[word] & bit == 0;
+        self.bits[word] |= bit;
+        unmarked
+    }
+
+    fn unmark(&mut self, index: u32) {
+        self.bits[index as usize / 64] &= !(1u64 << (index % 64));
+    }
+
+    /// Appends the marked indices in `lowest..=highest` (all of them) in increasing order and
+    /// clears their marks.
+    fn drain(&mut self, lowest: u32, highest: u32, out: &mut Vec<u32>) {
+        for word in lowest as usize / 64..=highest as usize / 64 {
+            let mut bits = std::mem::take(&mut self.bits[word]);
+            while bits != 0 {
+                out.push((word * 64) as u32 + bits.trailing_zeros());
+                bits &= bits - 1;
+            }
         }
     }
 }
@@ -328,6 +357,9 @@ mod tests {
             sorted.sort_unstable();
             sorted.dedup();
             assert_eq!(sorted.len(), found.len());
+            let mut in_order = Vec::new();
+            path.near_in_order(&probe, 1.2, &mut stamps, &mut in_order);
+            assert_eq!(in_order, sorted);
             for (index, _) in path.segments.iter().enumerate() {
                 let (a, b) = path.ends(index);
                 let overlaps = a.x.min(b.x) <= probe.x + 1.2

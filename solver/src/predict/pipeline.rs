@@ -398,7 +398,7 @@ fn predict_pass_with(
         }
         Method::DepthBuffer => {
             let image =
-                depth_buffer(context, path, &pieces, &centre, &feed_direction, sigma, gap, &mut outcome, scratch);
+                depth_buffer(context, path, &below, &centre, &feed_direction, sigma, gap, &mut outcome, scratch);
             if no_engagement && !image.retraced {
                 return Outcome::empty(PassStatus::NoCut);
             }
@@ -536,11 +536,12 @@ fn view_frame(view: &Vec3, feed_direction: &Vec3) -> Matrix3<f64> {
 }
 
 /// The depth-buffer method: from below, then the rotated and zoomed views when needed (§3.10).
+/// `scene` is the engagement's, in the machine frame.
 #[allow(clippy::too_many_arguments)]
 fn depth_buffer(
     context: &Context<'_>,
     path: &PathModel,
-    pieces: &[scene::Piece],
+    scene: &Scene,
     centre: &Vec3,
     feed_direction: &Vec3,
     sigma: f64,
@@ -552,7 +553,7 @@ fn depth_buffer(
     let radius = job.radius;
     let pixels = job.resolution as usize;
     let up = Vec3::z();
-    let below_scene = Scene::new(pieces, *centre, view_frame(&up, feed_direction), radius);
+    let below_scene = scene.in_frame(view_frame(&up, feed_direction));
     let full = Window { centre: [0.0, 0.0], side: 2.0 * radius, pixels, area_weighted: false };
     let below = render::render(&below_scene, &job.stock, &full);
     outcome.cut_count = below.cut_pixels;

@@ -9,13 +9,15 @@
 use std::collections::HashMap;
 
 use super::scene::{SampleState, Scene, TileLists};
-use super::stock::StockModel;
+use super::stock::{Region, StockModel};
 use crate::geometry::Vec3;
 
 /// Pixels per tile side.
 const TILE: usize = 16;
 /// Tiles per group side (groups share a candidate pool).
 const GROUP: usize = 4;
+/// Pixels per side of the blocks a tile crossed by the stock's surface is placed by.
+const BLOCK: usize = 8;
 
 /// The window: square of side `window` in the image plane of the scene's frame, centred at
 /// `centre` (image-plane coordinates relative to the ball centre), N × N pixels.
@@ -87,30 +89,37 @@ pub(crate) fn render(scene: &Scene, stock: &StockModel, window: &Window) -> Imag
     // Tiles on M's disc, below the ball centre and meeting the stock; then the capsules near
     // all of them.
     let tiles = n.div_ceil(TILE);
-    let mut kept: Vec<(usize, usize, usize, usize, super::stock::Region, Vec3, Vec3)> = Vec::new();
+    // The frame box of M over the pixels i0..i1 × j0..j1, if any of them is on its disc.
+    let pixel_box = |(i0, i1): (usize, usize), (j0, j1): (usize, usize)| -> Option<(Vec3, Vec3)> {
+        let (x_lo, x_hi) = (coordinate(i0, window.centre[0]), coordinate(i1 - 1, window.centre[0]));
+        let (y_lo, y_hi) = (coordinate(j0, window.centre[1]), coordinate(j1 - 1, window.centre[1]));
+        let nearest_x = 0.0_f64.clamp(x_lo, x_hi);
+        let nearest_y = 0.0_f64.clamp(y_lo, y_hi);
+        let rho_min = nearest_x.hypot(nearest_y);
+        if rho_min > radius {
+            return None;
+        }
+        let rho_max = (x_lo.abs().max(x_hi.abs())).hypot(y_lo.abs().max(y_hi.abs())).min(radius);
+        let lo = Vec3::new(x_lo, y_lo, -(r2 - rho_min * rho_min).max(0.0).sqrt()) - Vec3::repeat(scene.eps);
+        let hi = Vec3::new(x_hi, y_hi, -(r2 - rho_max * rho_max).max(0.0).sqrt()) + Vec3::repeat(scene.eps);
+        Some((lo, hi))
+    };
+    let mut kept: Vec<(usize, usize, usize, usize, Region, Vec3, Vec3)> = Vec::new();
     let mut union_lo = Vec3::repeat(f64::INFINITY);
     let mut union_hi = Vec3::repeat(f64::NEG_INFINITY);
     for tile_j in 0..tiles {
         for tile_i in 0..tiles {
             let (i0, i1) = (tile_i * TILE, ((tile_i + 1) * TILE).min(n));
             let (j0, j1) = (tile_j * TILE, ((tile_j + 1) * TILE).min(n));
-            let (x_lo, x_hi) = (coordinate(i0, window.centre[0]), coordinate(i1 - 1, window.centre[0]));
-            let (y_lo, y_hi) = (coordinate(j0, window.centre[1]), coordinate(j1 - 1, window.centre[1]));
-            let nearest_x = 0.0_f64.clamp(x_lo, x_hi);
-            let nearest_y = 0.0_f64.clamp(y_lo, y_hi);
-            let rho_min = nearest_x.hypot(nearest_y);
-            if rho_min > radius {
+            let Some((lo, hi)) = pixel_box((i0, i1), (j0, j1)) else {
                 continue;
-            }
-            let rho_max = (x_lo.abs().max(x_hi.abs())).hypot(y_lo.abs().max(y_hi.abs())).min(radius);
-            let lo = Vec3::new(x_lo, y_lo, -(r2 - rho_min * rho_min).max(0.0).sqrt()) - Vec3::repeat(scene.eps);
-            let hi = Vec3::new(x_hi, y_hi, -(r2 - rho_max * rho_max).max(0.0).sqrt()) + Vec3::repeat(scene.eps);
+            };
             let (world_lo, _) = scene.world_box(&lo, &hi);
             if world_lo.z > scene.centre.z {
                 continue;
             }
             let region = scene.region(stock, &lo, &hi);
-            if region == super::stock::Region::Outside {
+            if region == Region::Outside {
                 continue;
             }
             union_lo = union_lo.inf(&lo);
@@ -151,10 +160,34 @@ pub(crate) fn render(scene: &Scene, stock: &StockModel, window: &Window) -> Imag
             if scene.hides_box(&lo, &hi, &lists.before, &mut hide_hint) {
                 continue;
             }
+            // A tile that meets the stock's surface: its blocks are placed one by one, so that
+            // only the pixels of blocks the surface crosses pay for the point-in-stock test.
+            let mut block_regions = [[region; TILE / BLOCK]; TILE / BLOCK];
+            if region == Region::Mixed {
+                for (b_j, regions) in block_regions.iter_mut().enumerate() {
+                    for (b_i, block_region) in regions.iter_mut().enumerate() {
+                        let (bi0, bj0) = (i0 + b_i * BLOCK, j0 + b_j * BLOCK);
+                        let columns = (bi0, (bi0 + BLOCK).min(i1));
+                        let rows = (bj0, (bj0 + BLOCK).min(j1));
+                        *block_region = if columns.0 < columns.1
+                            && rows.0 < rows.1
+                            && let Some((lo, hi)) = pixel_box(columns, rows)
+                        {
+                            scene.region(stock, &lo, &hi)
+                        } else {
+                            Region::Outside
+                        };
+                    }
+                }
+            }
             let mut hints = [0usize; 2];
             for j in j0..j1 {
                 let y = coordinate(j, window.centre[1]);
                 for i in i0..i1 {
+                    let block_region = block_regions[(j - j0) / BLOCK][(i - i0) / BLOCK];
+                    if block_region == Region::Outside {
+                        continue;
+                    }
                     let x = coordinate(i, window.centre[0]);
                     let rho2 = x * x + y * y;
                     if rho2 > r2 {
@@ -167,7 +200,7 @@ pub(crate) fn render(scene: &Scene, stock: &StockModel, window: &Window) -> Imag
                     if offset.z > 0.0 {
                         continue;
                     }
-                    let test = scene.test(stock, &lists, &q, &mut hints);
+                    let test = scene.test_in(stock, block_region, &lists, &q, &mut hints);
                     if test.cut {
                         image.cut_pixels += 1;
                         image.cut_inward -= offset / radius;

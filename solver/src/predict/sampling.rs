@@ -67,12 +67,13 @@ struct Run {
     end: f64,
 }
 
-/// A tile of samples: its box (frame), place relative to the stock, and (row, sample) members.
+/// A tile of samples: its box (frame), place relative to the stock, and its members (the range
+/// of samples on each row of the block).
 struct TileBox {
     lo: Vec3,
     hi: Vec3,
     region: Region,
-    members: Vec<(usize, usize)>,
+    members: [(usize, usize); ROW_BLOCK],
 }
 
 /// One row of the band.
@@ -84,6 +85,13 @@ struct Row {
     step: f64,
     count: usize,
     full_circle: bool,
+}
+
+impl Row {
+    /// α of sample `i`, at the middle of its step.
+    fn alpha(&self, i: usize) -> f64 {
+        self.alpha_lo + (i as f64 + 0.5) * self.step
+    }
 }
 
 /// Samples the band around the ball centre of `scene` (whose frame must be the machine frame).
@@ -145,14 +153,8 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
     let mut cut_samples = 0;
     let mut finished_samples = 0;
     let mut retraced = false;
-    let mut states: Vec<SampleState> = Vec::new();
-    let mut block_points: Vec<Vec<Vec3>> = Vec::new();
     for block_start in (0..rows.len()).step_by(ROW_BLOCK) {
         let block = &rows[block_start..(block_start + ROW_BLOCK).min(rows.len())];
-        block_points.clear();
-        for row in block {
-            block_points.push((0..row.count).map(|i| point(row, row.alpha_lo + (i as f64 + 0.5) * row.step)).collect());
-        }
         // Tiles: the same α window across the block's rows.
         let alpha_min = block.iter().map(|r| r.alpha_lo).fold(f64::INFINITY, f64::min);
         let alpha_max = block.iter().map(|r| r.alpha_lo + r.step * r.count as f64).fold(f64::NEG_INFINITY, f64::max);
@@ -165,6 +167,9 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
         let mut row_states: Vec<Vec<SampleState>> = block.iter().map(|r| vec![SampleState::Air; r.count]).collect();
         let mut tile_of: Vec<Vec<usize>> = block.iter().map(|r| vec![0; r.count]).collect();
         // Tile boxes and their place relative to the stock, then the capsules near all of them.
+        // A box needs only each row's first and last sample: the samples between lie on the arc
+        // joining them, within its sagitta of their chord. The samples themselves are computed
+        // only in the tiles that are tested.
         let mut boxes: Vec<Option<TileBox>> = Vec::with_capacity(tile_count);
         let mut union_lo = Vec3::repeat(f64::INFINITY);
         let mut union_hi = Vec3::repeat(f64::NEG_INFINITY);
@@ -172,23 +177,27 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
             let (t_lo, t_hi) = (alpha_min + tile as f64 * tile_width, alpha_min + (tile + 1) as f64 * tile_width);
             let mut lo = Vec3::repeat(f64::INFINITY);
             let mut hi = Vec3::repeat(f64::NEG_INFINITY);
-            let mut members: Vec<(usize, usize)> = Vec::new();
+            let mut members = [(0, 0); ROW_BLOCK];
             for (r, row) in block.iter().enumerate() {
                 if row.count == 0 {
                     continue;
                 }
                 let first = (((t_lo - row.alpha_lo) / row.step).ceil().max(0.0)) as usize;
                 let last = (((t_hi - row.alpha_lo) / row.step).ceil().max(0.0) as usize).min(row.count);
-                for (i, p) in block_points[r].iter().enumerate().take(last).skip(first) {
-                    lo = lo.inf(p);
-                    hi = hi.sup(p);
-                    members.push((r, i));
+                if first >= last {
+                    continue;
                 }
+                members[r] = (first, last);
+                let (alpha_first, alpha_last) = (row.alpha(first), row.alpha(last - 1));
+                let sagitta = Vec3::repeat(row.rho * (1.0 - (0.5 * (alpha_last - alpha_first)).cos()));
+                let (p, q) = (point(row, alpha_first), point(row, alpha_last));
+                lo = lo.inf(&(p.inf(&q) - sagitta));
+                hi = hi.sup(&(p.sup(&q) + sagitta));
             }
             // Bisection points lie within one step of a sample.
             let margin = Vec3::repeat(band.spacing * 1.01 + scene.eps);
             let (lo, hi) = (lo - margin, hi + margin);
-            if members.is_empty() || lo.z > 0.0 {
+            if members.iter().all(|(first, last)| first == last) || lo.z > 0.0 {
                 boxes.push(None);
                 continue;
             }
@@ -217,34 +226,32 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
             lists.region = Some(region);
             // A tile that one T1 capsule hides whole has no cut or finished sample: every sample
             // would test CutBefore (or Air outside the stock), which the rest treats alike.
-            if scene.hides_box(&lo, &hi, &lists.before, &mut hide_hint) {
-                for &(r, i) in &members {
-                    tile_of[r][i] = tile;
-                    row_states[r][i] = SampleState::CutBefore;
-                }
-                tile_lists.push(lists);
-                continue;
-            }
+            let hidden = scene.hides_box(&lo, &hi, &lists.before, &mut hide_hint);
             let mut hints = [0usize; 2];
-            for &(r, i) in &members {
-                tile_of[r][i] = tile;
-                let test = scene.test(stock, &lists, &block_points[r][i], &mut hints);
-                row_states[r][i] = test.state;
-                if test.cut {
-                    cut_samples += 1;
-                }
-                if test.state == SampleState::Finished {
-                    finished_samples += 1;
-                    if !test.cut {
-                        retraced = true;
+            for (r, (row, &(first, last))) in block.iter().zip(&members).enumerate() {
+                for i in first..last {
+                    tile_of[r][i] = tile;
+                    if hidden {
+                        row_states[r][i] = SampleState::CutBefore;
+                        continue;
+                    }
+                    let test = scene.test(stock, &lists, &point(row, row.alpha(i)), &mut hints);
+                    row_states[r][i] = test.state;
+                    if test.cut {
+                        cut_samples += 1;
+                    }
+                    if test.state == SampleState::Finished {
+                        finished_samples += 1;
+                        if !test.cut {
+                            retraced = true;
+                        }
                     }
                 }
             }
             tile_lists.push(lists);
         }
         for (r, row) in block.iter().enumerate() {
-            states.clear();
-            states.extend_from_slice(&row_states[r]);
+            let states = &row_states[r];
             let row_index = block_start + r;
             let mut i = 0;
             while i < row.count {
@@ -257,11 +264,10 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
                     i += 1;
                 }
                 let last = i - 1;
-                let alpha_at = |k: usize| row.alpha_lo + (k as f64 + 0.5) * row.step;
                 let refine = |inside: usize, outside_alpha: f64| -> f64 {
                     let lists = &tile_lists[tile_of[r][inside]];
                     let mut hints = [0usize; 2];
-                    let (mut good, mut bad) = (alpha_at(inside), outside_alpha);
+                    let (mut good, mut bad) = (row.alpha(inside), outside_alpha);
                     for _ in 0..BISECTIONS {
                         let mid = 0.5 * (good + bad);
                         let q = point(row, mid);
@@ -273,11 +279,11 @@ pub(crate) fn sample(scene: &Scene, stock: &StockModel, band: &Band) -> Surface 
                     }
                     0.5 * (good + bad)
                 };
-                let start = if first == 0 { row.alpha_lo } else { refine(first, alpha_at(first - 1)) };
+                let start = if first == 0 { row.alpha_lo } else { refine(first, row.alpha(first - 1)) };
                 let end = if last + 1 == row.count {
                     row.alpha_lo + row.step * row.count as f64
                 } else {
-                    refine(last, alpha_at(last + 1))
+                    refine(last, row.alpha(last + 1))
                 };
                 runs.push(Run { row: row_index, start, end });
             }

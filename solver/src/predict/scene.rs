@@ -60,8 +60,8 @@ pub(crate) fn gather(path: &PathModel, query: &Query, scratch: &mut Scratch, out
     let centre = &centre;
     out.clear();
     scratch.indices.clear();
-    path.near(centre, reach, &mut scratch.stamps, &mut scratch.indices);
-    scratch.indices.sort_unstable();
+    path.near_in_order(centre, reach, &mut scratch.stamps, &mut scratch.indices);
+    out.reserve(scratch.indices.len());
     for &index in &scratch.indices {
         let segment = &path.segments[index as usize];
         let (a, b) = path.ends(index as usize);
@@ -109,11 +109,22 @@ pub(crate) struct Scene {
 
 /// The capsules sorted by lowest axis point, ties in path order: the box filter and the point
 /// test stop at the first capsule too high to matter. Which capsule hides a point never depends on
-/// the order, only how soon a scan finds it. (Sorting keys, not the 128-byte capsules.)
+/// the order, only how soon a scan finds it. (Sorting integer keys, not the 128-byte capsules.)
 fn by_lowest_point(capsules: Vec<Capsule>) -> Vec<Capsule> {
-    let mut keys: Vec<(f64, u32)> = capsules.iter().enumerate().map(|(i, c)| (c.min_z, i as u32)).collect();
-    keys.sort_unstable_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+    if capsules.is_sorted_by(|p, q| p.min_z <= q.min_z) {
+        return capsules;
+    }
+    let mut keys: Vec<(u64, u32)> =
+        capsules.iter().enumerate().map(|(i, c)| (total_order_key(c.min_z), i as u32)).collect();
+    keys.sort_unstable();
     keys.into_iter().map(|(_, i)| capsules[i as usize]).collect()
+}
+
+/// An unsigned integer in the order of [`f64::total_cmp`] (integer keys sort faster than a float
+/// comparator).
+fn total_order_key(value: f64) -> u64 {
+    let bits = value.to_bits();
+    if bits >> 63 == 1 { !bits } else { bits | 1 << 63 }
 }
 
 /// Whether a ray has entered a swept volume by the time it reaches a point.
@@ -137,8 +148,9 @@ pub(crate) struct TileLists {
 
 impl Scene {
     pub(crate) fn new(pieces: &[Piece], centre: Vec3, rotation: Matrix3<f64>, radius: f64) -> Self {
-        let mut before = Vec::new();
-        let mut after = Vec::new();
+        let before_count = pieces.iter().filter(|p| p.side == Side::Before).count();
+        let mut before = Vec::with_capacity(before_count);
+        let mut after = Vec::with_capacity(pieces.len() - before_count);
         for piece in pieces {
             let capsule = Capsule::new(rotation * (piece.a - centre), rotation * (piece.b - centre));
             match piece.side {
@@ -154,6 +166,23 @@ impl Scene {
             rotation,
             before: by_lowest_point(before),
             after: by_lowest_point(after),
+        }
+    }
+
+    /// The same capsules seen in the view frame `rotation`, for a scene in the machine frame (the
+    /// capsules as [`Self::new`] would build them from the same pieces). A turn about the vertical
+    /// keeps every height, so the capsules keep their order and need no new sort.
+    pub(crate) fn in_frame(&self, rotation: Matrix3<f64>) -> Self {
+        debug_assert_eq!(self.rotation, Matrix3::identity());
+        let turn = |capsules: &[Capsule]| by_lowest_point(capsules.iter().map(|c| c.in_frame(&rotation)).collect());
+        Self {
+            radius: self.radius,
+            r2: self.r2,
+            eps: self.eps,
+            centre: self.centre,
+            rotation,
+            before: turn(&self.before),
+            after: turn(&self.after),
         }
     }
 
@@ -322,10 +351,23 @@ pub(crate) struct PointTest {
 
 impl Scene {
     pub(crate) fn test(&self, stock: &StockModel, lists: &TileLists, q: &Vec3, hints: &mut [usize; 2]) -> PointTest {
+        match lists.region {
+            Some(region) => self.test_in(stock, region, lists, q, hints),
+            None => PointTest { state: SampleState::Air, cut: false },
+        }
+    }
+
+    /// [`Self::test`] for a point whose place relative to the stock is `region` (a part of the
+    /// tile's box).
+    pub(crate) fn test_in(
+        &self,
+        stock: &StockModel,
+        region: Region,
+        lists: &TileLists,
+        q: &Vec3,
+        hints: &mut [usize; 2],
+    ) -> PointTest {
         let air = PointTest { state: SampleState::Air, cut: false };
-        let Some(region) = lists.region else {
-            return air;
-        };
         if !self.in_stock(stock, region, q) {
             return air;
         }

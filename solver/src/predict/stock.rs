@@ -14,6 +14,8 @@ use crate::validate::{finite, positive};
 pub const MAX_GRID_NODES: usize = 4_000_000;
 /// Side of the min/max blocks of a height grid, in nodes.
 const BLOCK: usize = 8;
+/// Most nodes a box classification reads one by one (more: the blocks' extremes).
+const MAX_RANGE_NODES: usize = 25;
 
 /// The stock as the client describes it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -154,22 +156,39 @@ impl HeightGrid {
         Some((1.0 - fv) * ((1.0 - fu) * h(0, 0) + fu * h(1, 0)) + fv * ((1.0 - fu) * h(0, 1) + fu * h(1, 1)))
     }
 
-    /// Lowest and highest node heights that bound the surface over the rectangle.
+    /// Lowest and highest node heights that bound the surface over the rectangle: the nodes of
+    /// the cells it meets when they are few (a tile of samples or pixels spans a handful), the
+    /// per-block extremes otherwise.
     fn range(&self, lo: [f64; 2], hi: [f64; 2]) -> (f64, f64) {
         let index = |v: f64, origin: f64, count: usize| ((v - origin) / self.spacing).clamp(0.0, (count - 1) as f64);
-        let i0 = index(lo[0], self.origin[0], self.nx).floor() as usize;
-        let i1 = index(hi[0], self.origin[0], self.nx).ceil() as usize;
-        let j0 = index(lo[1], self.origin[1], self.ny).floor() as usize;
-        let j1 = index(hi[1], self.origin[1], self.ny).ceil() as usize;
+        // The indices are ≥ 0, so truncation is the floor and one more where it cut a fraction is
+        // the ceiling (without libm calls on baseline x86-64).
+        let floor = |u: f64| u as usize;
+        let ceil = |u: f64| (u as usize) + usize::from((u as usize as f64) < u);
+        let i0 = floor(index(lo[0], self.origin[0], self.nx));
+        let i1 = ceil(index(hi[0], self.origin[0], self.nx));
+        let j0 = floor(index(lo[1], self.origin[1], self.ny));
+        let j1 = ceil(index(hi[1], self.origin[1], self.ny));
         let (mut low, mut high) = (f64::INFINITY, f64::NEG_INFINITY);
-        for bj in j0 / BLOCK..=j1 / BLOCK {
-            for bi in i0 / BLOCK..=i1 / BLOCK {
-                let b = bj * self.blocks_x + bi;
-                low = low.min(self.block_min[b]);
-                high = high.max(self.block_max[b]);
+        if (i1 - i0 + 1) * (j1 - j0 + 1) <= MAX_RANGE_NODES {
+            for j in j0..=j1 {
+                for &h in &self.heights[j * self.nx + i0..=j * self.nx + i1] {
+                    low = low.min(h);
+                    high = high.max(h);
+                }
+            }
+        } else {
+            for bj in j0 / BLOCK..=j1 / BLOCK {
+                for bi in i0 / BLOCK..=i1 / BLOCK {
+                    let b = bj * self.blocks_x + bi;
+                    low = low.min(self.block_min[b]);
+                    high = high.max(self.block_max[b]);
+                }
             }
         }
-        (low, high)
+        // The bilinear value can round a few units in the last place beyond its nodes.
+        let slack = 8.0 * f64::EPSILON * low.abs().max(high.abs());
+        (low - slack, high + slack)
     }
 }
 
