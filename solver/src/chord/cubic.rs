@@ -58,6 +58,8 @@ fn largest_hump(w: f64, alpha: f64, beta: f64, gamma: f64) -> f64 {
     let g =
         |x: f64| ((-6.0 * gamma * x - 10.0 * beta) * x + (2.0 * gamma * w * w - 4.0 * alpha)) * x + 2.0 * beta * w * w;
     let slope = |x: f64| (-18.0 * gamma * x - 20.0 * beta) * x + (2.0 * gamma * w * w - 4.0 * alpha);
+    // −w, the turns of g inside (at most two, put in order by hand: a sort call cost more than
+    // the rest of this function on the chord bench), w.
     let mut breaks = [-w, w, w, w];
     let mut count = 1;
     for turn in quadratic_roots(-18.0 * gamma, -20.0 * beta, 2.0 * gamma * w * w - 4.0 * alpha) {
@@ -66,9 +68,11 @@ fn largest_hump(w: f64, alpha: f64, beta: f64, gamma: f64) -> f64 {
             count += 1;
         }
     }
+    if count == 3 && breaks[1] > breaks[2] {
+        breaks.swap(1, 2);
+    }
     breaks[count] = w;
-    let breaks = &mut breaks[..=count];
-    breaks.sort_by(f64::total_cmp);
+    let breaks = &breaks[..=count];
     let mut best = 0.0_f64;
     for pair in breaks.windows(2) {
         let (left, right) = (pair[0], pair[1]);

@@ -60,6 +60,9 @@ struct SpanPolynomial {
     /// For a plain B-spline (one common weight): coefficients of t⁰…t^(2p−2) of |dP/dt|², so the
     /// arc-length integrand is one square root of a polynomial; empty (all zero) otherwise.
     speed_squared: [f64; 2 * MAX_DEGREE - 1],
+    /// For a plain B-spline: the coefficients of P − O itself (the homogeneous ones divided by
+    /// the common weight once, not at every chord the search measures); zero otherwise.
+    plain: [Vec3; SLOTS],
 }
 
 impl Nurbs {
@@ -260,13 +263,11 @@ impl Nurbs {
     /// The power-form coefficients a₀…a₃ of knot span `span` of a plain cubic curve, in the
     /// span's own parameter t ∈ [0, 1] and relative to its first point; `None` for other curves.
     pub(crate) fn plain_span_form(&self, span: usize) -> Option<[Vec3; 4]> {
-        let weight = self.common_weight.filter(|_| self.degree <= 3)?;
-        let polynomial = &self.polynomials[span - self.degree];
-        let mut coefficients = [Vec3::zeros(); 4];
-        for (vector, h) in coefficients.iter_mut().zip(&polynomial.coefficients[..=self.degree]) {
-            *vector = Vec3::new(h[0], h[1], h[2]) / weight;
+        if !self.is_plain_cubic() {
+            return None;
         }
-        Some(coefficients)
+        let [a0, a1, a2, a3, ..] = self.polynomials[span - self.degree].plain;
+        Some([a0, a1, a2, a3])
     }
 
     fn point_in(&self, span: usize, u: f64) -> Vec3 {
@@ -309,6 +310,7 @@ impl Nurbs {
                 inverse_width: 0.0,
                 coefficients,
                 speed_squared: [0.0; 2 * MAX_DEGREE - 1],
+                plain: [Vec3::zeros(); SLOTS],
             };
         }
         let origin = {
@@ -356,7 +358,13 @@ impl Nurbs {
                 }
             }
         }
-        SpanPolynomial { origin, start, inverse_width: 1.0 / (end - start), coefficients, speed_squared }
+        let mut plain = [Vec3::zeros(); SLOTS];
+        if let Some(weight) = self.common_weight {
+            for (vector, h) in plain.iter_mut().zip(&coefficients) {
+                *vector = Vec3::new(h[0], h[1], h[2]) / weight;
+            }
+        }
+        SpanPolynomial { origin, start, inverse_width: 1.0 / (end - start), coefficients, speed_squared, plain }
     }
 
     /// Point, first and second derivative with respect to u (the right-hand limits at a knot).
