@@ -49,6 +49,105 @@ pub(crate) fn deviation(piece: &CubicPiece) -> Option<f64> {
     Some(largest_hump(half, q0.dot(&q0), q0.dot(&q1), q1.dot(&q1)))
 }
 
+/// The largest distance from the segment `a`–`b` of a chord that crosses one knot: `first` runs
+/// from `a` to the knot, `second` from the knot to `b`, each in its own span's power form.
+/// `None` where a point might project beyond the segment's ends, or where a piece's distance might
+/// have more than one hump (the caller samples instead).
+///
+/// Each piece is measured from the chord end it touches: expanded about that end, P − end =
+/// x·(c₁ + c₂x + c₃x²) with x ≥ 0 running into the piece, so its squared distance from the
+/// chord's line is h(x) = x²·|V(x)|², V = (c₁ + c₂x + c₃x²) × d, and h′ = 2x·q(x) with the quartic
+/// q = |V|² + x·V·V′. The signs of q's Bernstein coefficients on the piece bound its roots
+/// (variation diminishing): none, h grows to the knot; one, h peaks at q's one root there.
+pub(crate) fn deviation_across_knot(first: &CubicPiece, second: &CubicPiece, a: &Vec3, b: &Vec3) -> Option<f64> {
+    let chord = b - a;
+    let length = chord.norm();
+    if !(length > 0.0 && length.is_finite()) {
+        return None;
+    }
+    let direction = chord / length;
+    // About t_a going forward; about t_b going backward (x = t_b − t flips the even powers).
+    let [_, a1, a2, a3] = first.coefficients;
+    let t = first.t_lo;
+    let from_start = [a1 + t * (2.0 * a2 + 3.0 * a3 * t), a2 + 3.0 * a3 * t, a3];
+    let [_, b1, b2, b3] = second.coefficients;
+    let t = second.t_hi;
+    let from_end = [b1 + t * (2.0 * b2 + 3.0 * b3 * t), -(b2 + 3.0 * b3 * t), b3];
+    let near_start = largest_from_end(from_start, &direction, first.t_hi - first.t_lo)?;
+    let near_end = largest_from_end(from_end, &direction, second.t_hi - second.t_lo)?;
+    Some(near_start.max(near_end).sqrt())
+}
+
+/// max over x ∈ [0, extent] of h(x) = x²·|(c₁ + c₂x + c₃x²) × d|² (see [`deviation_across_knot`]);
+/// `None` when the piece does not move steadily away from its end along d (its projection on the
+/// chord could leave the segment) or when q may have more than one root.
+fn largest_from_end([c1, c2, c3]: [Vec3; 3], direction: &Vec3, extent: f64) -> Option<f64> {
+    if extent.is_nan() {
+        return None;
+    }
+    if extent <= 0.0 {
+        return Some(0.0);
+    }
+    // The projection x·(c₁ + c₂x + c₃x²)·d must grow with x: its slope is a quadratic ≥ 0.
+    let slope = [c1.dot(direction), 2.0 * c2.dot(direction), 3.0 * c3.dot(direction)];
+    if !non_negative_quadratic(slope, extent) {
+        return None;
+    }
+    let [v0, v1, v2] = [c1.cross(direction), c2.cross(direction), c3.cross(direction)];
+    let h = |x: f64| {
+        let v = v0 + x * (v1 + x * v2);
+        x * x * v.norm_squared()
+    };
+    // q = |V|² + x·V·V′, lowest power first, then scaled to the piece (x = extent·s).
+    let q =
+        [v0.dot(&v0), 3.0 * v0.dot(&v1), 2.0 * v1.dot(&v1) + 4.0 * v0.dot(&v2), 5.0 * v1.dot(&v2), 3.0 * v2.dot(&v2)];
+    let mut scale = 1.0;
+    let scaled = q.map(|coefficient| {
+        let value = coefficient * scale;
+        scale *= extent;
+        value
+    });
+    let [s0, s1, s2, s3, s4] = scaled;
+    let bernstein =
+        [s0, s0 + s1 / 4.0, s0 + s1 / 2.0 + s2 / 6.0, s0 + 0.75 * s1 + 0.5 * s2 + 0.25 * s3, s0 + s1 + s2 + s3 + s4];
+    let mut changes = 0;
+    let mut previous = 0.0_f64;
+    for value in bernstein {
+        if value != 0.0 {
+            if previous != 0.0 && value.signum() != previous.signum() {
+                changes += 1;
+            }
+            previous = value;
+        }
+    }
+    let q_at = |x: f64| q[0] + x * (q[1] + x * (q[2] + x * (q[3] + x * q[4])));
+    let q_slope = |x: f64| q[1] + x * (2.0 * q[2] + x * (3.0 * q[3] + x * 4.0 * q[4]));
+    match changes {
+        0 => Some(h(extent)),
+        1 if q[0] > 0.0 && q_at(extent) < 0.0 => {
+            let peak = root(&q_at, &q_slope, 0.0, extent, q[0]);
+            Some(h(peak).max(h(extent)))
+        }
+        1 => Some(h(extent)),
+        _ => None,
+    }
+}
+
+/// Whether p₀ + p₁x + p₂x² ≥ 0 on [0, extent].
+fn non_negative_quadratic([p0, p1, p2]: [f64; 3], extent: f64) -> bool {
+    let value = |x: f64| p0 + x * (p1 + x * p2);
+    if value(0.0) < 0.0 || value(extent) < 0.0 {
+        return false;
+    }
+    if p2 > 0.0 {
+        let vertex = -p1 / (2.0 * p2);
+        if vertex > 0.0 && vertex < extent && value(vertex) < 0.0 {
+            return false;
+        }
+    }
+    true
+}
+
 /// max over |x| ≤ w of f(x) = (w² − x²)·√(α + 2βx + γx²): f vanishes at ±w, so the maximum is
 /// at a root of the derivative's factor g(x) = −6γx³ − 10βx² + (2γw² − 4α)x + 2βw² (from
 /// (f²)' = (w² − x²)·g(x)). g(−w) ≥ 0 ≥ g(w); g is split at its own turning points into pieces
@@ -140,6 +239,7 @@ fn root(g: &impl Fn(f64) -> f64, slope: &impl Fn(f64) -> f64, left: f64, right: 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::chord::nurbs::{CubicStretch, Nurbs};
 
     /// The distance from the chord by brute force: many samples of the piece.
     fn sampled(piece: &CubicPiece) -> f64 {
@@ -195,6 +295,47 @@ mod tests {
         // and the search fell back to the bracket's middle, far from the root.
         let hump = largest_hump(0.03871972443956874, 0.36262487493168816, 5.024123675499595, 69.60862437104088);
         assert!((hump - 0.000_960_557_651_682_66).abs() < 1e-15, "{hump}");
+    }
+
+    #[test]
+    fn chords_across_a_knot_match_dense_sampling() {
+        // Plain B-splines of degree 2 and 3 through a wavy 3-D control polygon, chords of a tenth
+        // to nine tenths of a span starting anywhere; those crossing one knot are measured.
+        let control: Vec<Vec3> = (0..12)
+            .map(|k| {
+                let k = f64::from(k);
+                Vec3::new(10.0 * k, 6.0 * (0.9 * k).sin(), 2.0 * (0.5 * k).cos())
+            })
+            .collect();
+        for degree in [2, 3] {
+            let curve = Nurbs::new(degree, &control, None, None, "curve").unwrap();
+            let (start, end) = curve.domain();
+            let span = (end - start) / (control.len() - degree) as f64;
+            let mut measured = 0;
+            for k in 0..200 {
+                let lo = start + (end - start) * f64::from(k) / 200.0;
+                for width in [0.1, 0.4, 0.9] {
+                    let hi = (lo + width * span).min(end);
+                    let Some(CubicStretch::AcrossKnot(first, second)) = curve.cubic_stretch(lo, hi) else {
+                        continue;
+                    };
+                    let (a, b) = (curve.point(lo), curve.point(hi));
+                    let Some(exact) = deviation_across_knot(&first, &second, &a, &b) else { continue };
+                    let dense = (0..=20_000)
+                        .map(|j| {
+                            let u = lo + (hi - lo) * f64::from(j) / 20_000.0;
+                            crate::geometry::distance_to_segment(&curve.point(u), &a, &b)
+                        })
+                        .fold(0.0, f64::max);
+                    assert!(
+                        exact >= dense - 1e-12 && exact <= dense * (1.0 + 1e-6) + 1e-12,
+                        "degree {degree}, [{lo}, {hi}]: {exact} vs {dense}"
+                    );
+                    measured += 1;
+                }
+            }
+            assert!(measured > 100, "degree {degree}: only {measured} chords measured");
+        }
     }
 
     #[test]

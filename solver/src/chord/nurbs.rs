@@ -43,6 +43,15 @@ pub(crate) struct CubicPiece {
     pub t_hi: f64,
 }
 
+/// A chord's stretch of a plain cubic curve by the knot spans it lies in (see
+/// [`Nurbs::cubic_stretch`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum CubicStretch {
+    Inside(CubicPiece),
+    /// From the chord's start to the knot, and from the knot to its end.
+    AcrossKnot(CubicPiece, CubicPiece),
+}
+
 /// One knot span [u_i, u_i+1) of the curve in power form: the homogeneous curve relative to
 /// the span's first point O, (w·(x − O), w), as polynomials in t = (u − u_i)/h. Evaluating it
 /// by Horner's rule costs a few multiply-adds instead of the basis-function recurrences (the
@@ -238,20 +247,35 @@ impl Nurbs {
         self.point_in(span, u)
     }
 
-    /// [lo, hi] as a [`CubicPiece`] when it lies inside one knot span (its end may be the span's
-    /// closing knot) of a polynomial curve of degree ≤ 3; `None` otherwise.
-    pub(crate) fn cubic_piece(&self, lo: f64, hi: f64) -> Option<CubicPiece> {
+    /// [lo, hi] of a polynomial curve of degree ≤ 3 as the stretches of the knot spans it lies
+    /// in: one (its end may be the span's closing knot), or two when it crosses one knot; `None`
+    /// for other curves and for stretches over more knots.
+    pub(crate) fn cubic_stretch(&self, lo: f64, hi: f64) -> Option<CubicStretch> {
         if !self.is_plain_cubic() || lo >= hi || lo.is_nan() || hi.is_nan() {
             return None;
         }
         let span = self.span(lo);
-        if hi > self.knots[span + 1] {
+        let knot = self.knots[span + 1];
+        if hi <= knot {
+            return Some(CubicStretch::Inside(self.piece_in(span, lo, hi)));
+        }
+        // The next non-empty span (a repeated knot leaves empty ones between).
+        let mut next = span + 1;
+        while next < self.weighted.len() && self.knots[next + 1] <= knot {
+            next += 1;
+        }
+        if next >= self.weighted.len() || hi > self.knots[next + 1] {
             return None;
         }
-        let coefficients = self.plain_span_form(span)?;
+        Some(CubicStretch::AcrossKnot(self.piece_in(span, lo, knot), self.piece_in(next, knot, hi)))
+    }
+
+    /// [lo, hi] inside knot span `span` of a plain cubic curve as a [`CubicPiece`].
+    fn piece_in(&self, span: usize, lo: f64, hi: f64) -> CubicPiece {
+        let [a0, a1, a2, a3, ..] = self.polynomials[span - self.degree].plain;
         let polynomial = &self.polynomials[span - self.degree];
         let local = |u: f64| (u - polynomial.start) * polynomial.inverse_width;
-        Some(CubicPiece { coefficients, t_lo: local(lo), t_hi: local(hi) })
+        CubicPiece { coefficients: [a0, a1, a2, a3], t_lo: local(lo), t_hi: local(hi) }
     }
 
     /// Whether every span is a polynomial of degree ≤ 3 (a plain B-spline: one common weight),

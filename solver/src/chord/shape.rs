@@ -9,7 +9,7 @@
 use super::arclength::ArcLengthTable;
 use super::cubic;
 use super::numeric::minimise;
-use super::nurbs::Nurbs;
+use super::nurbs::{CubicStretch, Nurbs};
 use super::radius::SpanMinima;
 use crate::error::ErrorCode;
 use crate::error::SolverError;
@@ -126,10 +126,17 @@ impl Spline {
         self.nurbs.speed(u)
     }
 
-    /// The exact deviation of a chord inside one knot span of a plain B-spline of degree ≤ 3
-    /// ([`cubic::deviation`]); `None` elsewhere.
+    /// The exact deviation of a chord of a plain B-spline of degree ≤ 3 inside one knot span
+    /// ([`cubic::deviation`]) or across one knot ([`cubic::deviation_across_knot`]); `None`
+    /// elsewhere.
     fn exact_deviation(&self, ua: f64, ub: f64) -> Option<f64> {
-        self.nurbs.cubic_piece(ua.min(ub), ua.max(ub)).as_ref().and_then(cubic::deviation)
+        let (lo, hi) = (ua.min(ub), ua.max(ub));
+        match self.nurbs.cubic_stretch(lo, hi)? {
+            CubicStretch::Inside(piece) => cubic::deviation(&piece),
+            CubicStretch::AcrossKnot(first, second) => {
+                cubic::deviation_across_knot(&first, &second, &self.nurbs.point(lo), &self.nurbs.point(hi))
+            }
+        }
     }
 }
 
