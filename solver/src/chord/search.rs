@@ -6,9 +6,9 @@
 //!   nearly linear in u because the deviation grows with the square of the chord. The first
 //!   trial is the previous chord's parameter step (or the circle chord of the window radius),
 //!   corrected by that model, so a smooth curve needs two to four deviations per block;
-//!   ellipses evaluate dev in closed form, chords inside one span of a plain B-spline of
-//!   degree ≤ 3 exactly from its power form (`cubic`), other NURBS from a few samples per knot
-//!   span ([`Shape::fast_deviation`]). Where the fast value is not exact (those samples, and
+//!   ellipses evaluate dev in closed form, chords of a plain B-spline of degree ≤ 3 inside one
+//!   span or across one knot exactly from the spans' power forms (`cubic`), other NURBS from a
+//!   few samples per knot span ([`Shape::fast_deviation`]). Where the fast value is not exact (those samples, and
 //!   ellipse chords over a quarter turn) the chord found is checked once with the reference's
 //!   32 samples, and the reference search takes over if it does not fit; an exact value is the
 //!   chord's reported deviation as it is.

@@ -438,12 +438,13 @@ impl Shape {
 
     /// dev(u_a, u_b) for the fast search (chord.md §2.9a), where only values near `limit`
     /// need to be exact: closed forms for arcs and ellipses, the farthest vertex of a
-    /// polyline, the exact value inside one span of a plain B-spline of degree ≤ 3, and for other
+    /// polyline, the exact value inside one span or across one knot of a plain B-spline of degree
+    /// ≤ 3, and for other
     /// NURBS four sub-intervals per knot span refined around the best sample (a smooth span
     /// bends one way over a chord cut to its curvature, so its distance from the chord has one
     /// hump per span). Stops at the first sample above `limit`; skips the
     /// refinement well below it (an infinite `limit` gives the refined maximum). The flag says
-    /// whether the value is exact (a closed form, a polyline's vertices, a cubic span), so that
+    /// whether the value is exact (a closed form, a polyline's vertices, cubic spans), so that
     /// the chord needs no check.
     pub(crate) fn fast_deviation(&self, ua: f64, ub: f64, limit: f64) -> (f64, bool) {
         match self {
