@@ -64,6 +64,7 @@ mod guarantee;
 mod job;
 mod numeric;
 mod nurbs;
+mod polyline;
 mod polynomial;
 pub mod program;
 mod radius;

@@ -16,9 +16,9 @@
 use crate::error::ErrorCode;
 use std::cell::Cell;
 
-use super::reference;
 use super::segment::{CROSSING_WIDTH, EPS, Vertex};
 use super::shape::Shape;
+use super::{polyline, reference};
 use crate::error::SolverError;
 
 /// Most deviation evaluations of one search (chord.md E14 caps iterations at 200).
@@ -50,6 +50,14 @@ pub(crate) fn chord_end(
         let half_sine = (allowed / (2.0 * arc.radius)).sqrt();
         let step = if half_sine >= 1.0 { f64::INFINITY } else { 4.0 * arc.radius * half_sine.asin() };
         return Ok(((start.u + step).min(limit.u), None));
+    }
+    if let Shape::Polyline(line) = shape {
+        let step = last_step.get();
+        let predicted = if step > 0.0 { step } else { step_guess };
+        if let Some((end, deviation)) = polyline::chord_end(line, start, allowed, limit, predicted) {
+            last_step.set(end - start.u);
+            return Ok((end, Some(deviation)));
+        }
     }
     // On NURBS aim a hair (1e-8) inside the bound: the reference check of the chord found
     // refines its maximum a little differently, and must not reject a chord for that alone.

@@ -145,7 +145,7 @@ impl Polyline {
     /// edge beyond the end). Gallops from the previous answer and bisects inside the bracket
     /// found, so nearby lookups (a chord's ends, a radius's three points) cost a few steps
     /// instead of a search of the whole list.
-    fn edge(&self, s: f64) -> usize {
+    pub(crate) fn edge(&self, s: f64) -> usize {
         let stations = &self.stations;
         let last_edge = self.vertices.len().saturating_sub(2);
         let hint = self.last_edge.get().min(stations.len().saturating_sub(1));
@@ -181,6 +181,38 @@ impl Polyline {
 
     fn point(&self, s: f64) -> Vec3 {
         self.point_on(self.edge(s), s)
+    }
+
+    /// The farthest vertex strictly between arc lengths `ua` and `ub` from the chord joining
+    /// their points (chord.md §2.9: a polyline's deviation is exact).
+    pub(crate) fn deviation(&self, ua: f64, ub: f64) -> f64 {
+        let (lo, hi) = (ua.min(ub), ua.max(ub));
+        // lo's edge from the hint (the search keeps a chord's start and moves its end);
+        // hi's edge forward from it over the chord's few vertices, so that the end's
+        // lookup neither searches the whole list nor moves the hint away from the start.
+        let k = self.edge(lo);
+        let mut k_hi = k;
+        while k_hi + 2 < self.vertices.len() && self.stations[k_hi + 1] <= hi {
+            k_hi += 1;
+        }
+        let (k_a, k_b) = if ua <= ub { (k, k_hi) } else { (k_hi, k) };
+        let (a, b) = (self.point_on(k_a, ua), self.point_on(k_b, ub));
+        // The first vertex strictly after lo: the end of lo's edge.
+        let first = if self.stations[k] <= lo && self.stations.get(k + 1).is_some_and(|&x| x > lo) {
+            k + 1
+        } else {
+            self.stations.partition_point(|&x| x <= lo)
+        };
+        // The vertices strictly inside, then their distances in a plain loop over them
+        // against the chord's vector computed once (the search measures a chord's dozen
+        // vertices several times per block).
+        let mut end = first;
+        while end < self.stations.len() && self.stations[end] < hi {
+            end += 1;
+        }
+        let chord = Segment::new(a, b);
+        let inside = self.vertices.get(first..end).unwrap_or_default();
+        inside.iter().map(|vertex| chord.distance_squared(vertex)).fold(0.0_f64, f64::max).sqrt()
     }
 
     /// The point at arc length `s` on edge `k` (the edge holding `s`).
@@ -394,35 +426,7 @@ impl Shape {
                 let quarter = (ub - ua).abs() / (4.0 * arc.radius);
                 2.0 * arc.radius * quarter.sin().powi(2)
             }
-            Self::Polyline(line) => {
-                let (lo, hi) = (ua.min(ub), ua.max(ub));
-                // lo's edge from the hint (the search keeps a chord's start and moves its end);
-                // hi's edge forward from it over the chord's few vertices, so that the end's
-                // lookup neither searches the whole list nor moves the hint away from the start.
-                let k = line.edge(lo);
-                let mut k_hi = k;
-                while k_hi + 2 < line.vertices.len() && line.stations[k_hi + 1] <= hi {
-                    k_hi += 1;
-                }
-                let (k_a, k_b) = if ua <= ub { (k, k_hi) } else { (k_hi, k) };
-                let (a, b) = (line.point_on(k_a, ua), line.point_on(k_b, ub));
-                // The first vertex strictly after lo: the end of lo's edge.
-                let first = if line.stations[k] <= lo && line.stations.get(k + 1).is_some_and(|&x| x > lo) {
-                    k + 1
-                } else {
-                    line.stations.partition_point(|&x| x <= lo)
-                };
-                // The vertices strictly inside, then their distances in a plain loop over them
-                // against the chord's vector computed once (the search measures a chord's dozen
-                // vertices several times per block).
-                let mut end = first;
-                while end < line.stations.len() && line.stations[end] < hi {
-                    end += 1;
-                }
-                let chord = Segment::new(a, b);
-                let inside = line.vertices.get(first..end).unwrap_or_default();
-                inside.iter().map(|vertex| chord.distance_squared(vertex)).fold(0.0_f64, f64::max).sqrt()
-            }
+            Self::Polyline(line) => line.deviation(ua, ub),
             Self::Ellipse(_) | Self::Spline(_) => self.sampled_deviation(ua, ub, None),
         }
     }
