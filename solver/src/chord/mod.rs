@@ -13,7 +13,7 @@
 //!   length, chord deviation, radius of curvature, corners; `polynomial`: real roots of low-degree
 //!   polynomials (the exact radius turns of plain cubic spans);
 //! * `segment`: greedy chords, the window procedure with carry-over and progress rule, the
-//!   single-value run (§2.9); `search`: the fast chord search (§2.9a), `reference`: the §2.9
+//!   single-value run (§2.9); `search`: the fast chord search (§2.9a; `polyline` for polylines), `reference`: the §2.9
 //!   numerics it is tested against ([`solve_reference`]); `guarantee`: mode `guarantee` (§2.9a);
 //! * [`stats`]: block figures of any polyline ([`block_stats`]); `report`: warnings (§4);
 //! * [`machine`]: controller profiles; [`mod@program`]: G-code.

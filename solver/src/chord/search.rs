@@ -2,6 +2,7 @@
 //! of §2.9 up to its 1e-12 mm bracket, from a handful of deviation evaluations per block.
 //!
 //! * circular arcs: the chord end in closed form from the sagitta, dev = 2r·sin²(Δs/4r);
+//! * polylines: placed on an edge where the first spanned vertex reaches C_ep (`polyline`);
 //! * everything else: a bracketed secant (Illinois) on g(u) = √dev(u_a, u) − √C_ep, which is
 //!   nearly linear in u because the deviation grows with the square of the chord. The first
 //!   trial is the previous chord's parameter step (or the circle chord of the window radius),
