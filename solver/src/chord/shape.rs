@@ -569,9 +569,20 @@ impl Shape {
                 let count = (((hi - lo) / (0.25 * scale)).ceil() as usize).clamp(1, MAX_RADIUS_SAMPLES);
                 let step = (hi - lo - scale) / count as f64;
                 let mut best = (f64::INFINITY, lo + half);
+                // The three points move forward along the polyline with the samples: each keeps
+                // its edge and steps on from it, instead of a lookup per point.
+                let first_edge = line.edge(lo);
+                let mut edges = [first_edge; 3];
+                let mut point_at = |which: usize, s: f64| {
+                    let edge = &mut edges[which];
+                    while *edge + 2 < line.vertices.len() && line.stations[*edge + 1] <= s {
+                        *edge += 1;
+                    }
+                    line.point_on(*edge, s)
+                };
                 for j in 0..=count {
                     let s = lo + half + step * j as f64;
-                    let radius = circumradius(&line.point(s - half), &line.point(s), &line.point(s + half));
+                    let radius = circumradius(&point_at(0, s - half), &point_at(1, s), &point_at(2, s + half));
                     if radius < best.0 {
                         best = (radius, s);
                     }
