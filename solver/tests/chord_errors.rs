@@ -445,3 +445,32 @@ fn cusps_of_coincident_control_points_are_corners() {
     assert!(cusp.is_some(), "the cusp is a command point");
     assert_eq!(answer.stats.short_blocks, 0);
 }
+
+#[test]
+fn slight_kinks_of_a_degree_one_nurbs_end_chords_exactly() {
+    // A rational polyline whose kinks turn by less than the corner angle, straight between, with
+    // no lower bound on the chord error: the straight pieces give a chord error of 0, so a chord
+    // can only end at a kink. The search used to stop a rounding's width short of one and fail
+    // there (E14); found by the property tests.
+    let control = json!([
+        [0.0, 0.0],
+        [-1.1704469260882564, 9.543362084870154],
+        [11.375169350133055, -1.274923222184214],
+        [19.553489805329008, -14.496098002475502],
+        [7.497014611099476, -0.7475753822931459],
+        [-5.7316412841657405, 7.611826625788984]
+    ]);
+    let weights = json!([0.3, 0.3, 2.9013787588892597, 2.2104877404508745, 0.4671387817575172, 0.9563530493516416]);
+    for mode in ["window", "curve", "guarantee"] {
+        let answer = ok(json!({
+            "curve": {"kind": "bspline", "degree": 1, "control_points": control, "weights": weights},
+            "feed": 1000, "block_time_ms": 1, "mode": mode, "min_chord_error": 0
+        }));
+        assert_eq!(answer.points.len(), 6, "{mode}: one block per straight piece");
+        for (point, expected) in answer.points.iter().zip(control.as_array().unwrap()) {
+            for axis in 0..2 {
+                assert!((point[axis] - expected[axis].as_f64().unwrap()).abs() < 1e-9, "{mode}: {point:?}");
+            }
+        }
+    }
+}

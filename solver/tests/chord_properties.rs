@@ -139,13 +139,32 @@ impl Dense {
         Self { t, points, s }
     }
 
-    /// Index of the sample nearest to `point` among those within 1 mm of arc length of `s_hint`.
-    fn locate(&self, point: &Point, s_hint: f64) -> usize {
+    /// The samples within 1 mm of arc length of `s_hint` about as near `point` as the nearest
+    /// (within two sample spacings), the nearest of each run of neighbours: where the curve comes
+    /// back near itself (a hairpin) one on each branch, of which the caller keeps the one the
+    /// point is on.
+    fn candidates(&self, point: &Point, s_hint: f64) -> Vec<usize> {
         let lo = self.s.partition_point(|&s| s < s_hint - 1.0);
         let hi = self.s.partition_point(|&s| s <= s_hint + 1.0).min(self.s.len());
-        (lo..hi)
-            .min_by(|&a, &b| norm(&sub(&self.points[a], point)).total_cmp(&norm(&sub(&self.points[b], point))))
-            .unwrap()
+        let distance = |index: usize| norm(&sub(&self.points[index], point));
+        let nearest = (lo..hi).min_by(|&a, &b| distance(a).total_cmp(&distance(b))).unwrap();
+        let last = self.s.len() - 1;
+        let spacing = self.s[(nearest + 1).min(last)] - self.s[nearest.saturating_sub(1)];
+        // The nearest sample of each run of neighbouring ones: one per branch.
+        let mut runs: Vec<usize> = Vec::new();
+        let mut previous: Option<usize> = None;
+        for index in (lo..hi).filter(|&index| distance(index) <= distance(nearest) + spacing) {
+            match runs.last_mut() {
+                Some(best) if previous == Some(index - 1) => {
+                    if distance(index) < distance(*best) {
+                        *best = index;
+                    }
+                }
+                _ => runs.push(index),
+            }
+            previous = Some(index);
+        }
+        runs
     }
 }
 
@@ -191,7 +210,14 @@ fn check(answer: &SegmentAnswer, curve: &dyn Reference, samples: usize, min_bloc
     let indices: Vec<usize> = points
         .iter()
         .zip(&answer.s)
-        .map(|(p, &s)| dense.locate(p, s * dense.s.last().unwrap() / answer.curve_length))
+        .map(|(p, &s)| {
+            let candidates = dense.candidates(p, s * dense.s.last().unwrap() / answer.curve_length);
+            if let [only] = candidates[..] {
+                return only;
+            }
+            let on_curve = |index: usize| distance_to_curve(curve, &dense, index, p);
+            candidates.into_iter().map(|index| (on_curve(index), index)).min_by(|a, b| a.0.total_cmp(&b.0)).unwrap().1
+        })
         .collect();
     for (point, &index) in points.iter().zip(&indices) {
         let distance = distance_to_curve(curve, &dense, index, point);

@@ -161,6 +161,22 @@ impl Nurbs {
         out
     }
 
+    /// The first knot in (lo, hi] where the curve is only C⁰ (multiplicity ≥ degree, so its
+    /// tangent may turn there), if any.
+    pub(crate) fn first_kink_in(&self, lo: f64, hi: f64) -> Option<f64> {
+        let end = self.domain().1;
+        let mut i = self.knots.partition_point(|&k| k <= lo);
+        while i < self.knots.len() && self.knots[i] <= hi && self.knots[i] < end {
+            let knot = self.knots[i];
+            let repeats = self.knots[i..].iter().take_while(|&&k| k == knot).count();
+            if repeats >= self.degree {
+                return Some(knot);
+            }
+            i += repeats;
+        }
+        None
+    }
+
     /// The distinct knots strictly between `lo` and `hi`, increasing.
     pub(crate) fn distinct_knots_between(&self, lo: f64, hi: f64) -> impl Iterator<Item = f64> + '_ {
         let (start, end) = self.domain();

@@ -147,6 +147,17 @@ pub(crate) fn chord_end(
             side = -1;
         }
     }
+    // Bracketed to its width without the deviation settling at C_ep: a jump in it, as at a
+    // kink the curve turns at. A chord to the kink that fits ends there exactly.
+    if fit < -1e-9 * root
+        && let Some(kink) = shape.kink_between(lo, hi)
+        && kink > lo
+    {
+        let (value, known) = g(kink);
+        if value <= 0.0 {
+            (lo, known_at_lo) = (kink, known);
+        }
+    }
     last_step.set(lo - start.u);
     if lo <= start.u {
         return Ok((lo, None));

@@ -270,6 +270,10 @@ fn refine_maximum(f: &impl Fn(f64) -> f64, x: [f64; 3], y: [f64; 3], tol: f64, r
     fb.max(-negative)
 }
 
+/// Most steps bracketing, and then bisecting, the tip of a hairpin at a chord end
+/// (`end_overshoot`).
+const OVERSHOOT_STEPS: usize = 64;
+
 /// Sub-intervals per knot span in [`Shape::fast_deviation`].
 const SPAN_SAMPLES: usize = 4;
 /// Most knot spans one fast deviation samples; beyond, the reference sampling is used.
@@ -313,18 +317,79 @@ fn spline_deviation(spline: &Spline, ua: f64, ub: f64, limit: f64) -> Option<f64
             n += 1;
         }
     }
+    let overshoot = end_overshoot(spline, ua, ub, at[1] - at[0], &distance);
     if best == 0 || (limit.is_finite() && value[best] < REFINE_FRACTION * limit) {
-        return Some(value[best]);
+        return Some(value[best].max(overshoot));
     }
     let tol = 1e-9 * (hi - lo) + 4.0 * f64::EPSILON * lo.abs().max(hi.abs());
     let rounding = 8.0 * f64::EPSILON * a.amax().max(b.amax());
-    Some(refine_maximum(
+    let refined = refine_maximum(
         &distance,
         [at[best - 1], at[best], at[best + 1]],
         [value[best - 1], value[best], value[best + 1]],
         tol,
         rounding,
-    ))
+    );
+    Some(refined.max(overshoot))
+}
+
+/// The largest distance from the chord `a`–`b` near an end where the curve runs back along the
+/// chord (it went past that end and turned: a hairpin between two samples, which the property
+/// tests found on a rational curve, a 0.009 mm overshoot the samples saw as a few micrometres).
+/// The tip is where the curve turns along the chord: bracketed by steps back from the end
+/// (from `width`, doubling) to where the curve still heads for the end, then bisected; the
+/// distance is refined between the tip's mirror and the end. 0 where the curve leaves `a` and
+/// reaches `b` heading along the chord.
+fn end_overshoot(spline: &Spline, ua: f64, ub: f64, width: f64, distance: &impl Fn(f64) -> f64) -> f64 {
+    let (a, b) = (spline.nurbs.point(ua), spline.nurbs.point(ub));
+    let chord = b - a;
+    let travel = (ub - ua).signum();
+    let tol = 1e-9 * (ub - ua).abs() + 4.0 * f64::EPSILON * ua.abs().max(ub.abs());
+    // The curve's motion along the chord, travelling from ua to ub.
+    let heading = |u: f64| (spline.nurbs.derivatives(u)[1] * travel).dot(&chord);
+    let mut largest = 0.0_f64;
+    for (end, inward) in [(ua, travel), (ub, -travel)] {
+        // Leaving a it must head for b, and arriving at b it must come from a's side: moving
+        // back along the chord at either end, it is beyond that end on one side of its tip.
+        let away = |u: f64| heading(u) < 0.0;
+        if !away(end) {
+            continue;
+        }
+        let reach = (ub - ua).abs();
+        let (mut inner, mut outer, mut step) = (end, end, width.abs().min(reach));
+        let mut bracketed = false;
+        for _ in 0..OVERSHOOT_STEPS {
+            outer = end + inward * step;
+            if !away(outer) {
+                bracketed = true;
+                break;
+            }
+            inner = outer;
+            if step >= reach {
+                break;
+            }
+            step = (2.0 * step).min(reach);
+        }
+        if !bracketed {
+            continue; // runs back all the way: the samples see it
+        }
+        for _ in 0..OVERSHOOT_STEPS {
+            let middle = 0.5 * (inner + outer);
+            if (outer - inner).abs() <= tol || middle == inner || middle == outer {
+                break;
+            }
+            if away(middle) {
+                inner = middle;
+            } else {
+                outer = middle;
+            }
+        }
+        let tip = 0.5 * (inner + outer);
+        let mirror = tip + (tip - end);
+        let (_, negative) = minimise(|u| -distance(u), end.min(mirror), end.max(mirror), tol);
+        largest = largest.max(-negative).max(distance(tip));
+    }
+    largest
 }
 
 /// Radius of the circle through three points, in any dimension (chord.md §2.8); infinite when
@@ -364,6 +429,21 @@ impl Shape {
                 Some((minor * minor / major, major * major / minor))
             }
             Self::Polyline(_) | Self::Spline(_) => None,
+        }
+    }
+
+    /// The first point in (u_a, u_b] where the curve may turn without bending (a polyline's
+    /// vertex, a NURBS knot where it is only C⁰), if any: a chord that fits up to it and no
+    /// further must end there exactly, or the next chord starts a rounding's width short of it
+    /// and cannot get past (with a chord error of 0 on straight pieces).
+    pub(crate) fn kink_between(&self, ua: f64, ub: f64) -> Option<f64> {
+        match self {
+            Self::Arc(_) | Self::Ellipse(_) => None,
+            Self::Polyline(line) => {
+                let next = line.edge(ua) + 1;
+                line.stations.get(next).copied().filter(|&s| s > ua && s <= ub)
+            }
+            Self::Spline(spline) => spline.nurbs.first_kink_in(ua, ub),
         }
     }
 
@@ -510,21 +590,26 @@ impl Shape {
                 best_index = j;
             }
         }
+        let overshoot = match self {
+            Self::Spline(spline) => end_overshoot(spline, ua, ub, step, &distance),
+            _ => 0.0,
+        };
         let best = samples[best_index];
         if best_index == 0 || threshold.is_some_and(|limit| best < REFINE_FRACTION * limit) {
-            return best;
+            return best.max(overshoot);
         }
         let at = |j: usize| ua + step * j as f64;
         let tol = 1e-9 * (ub - ua).abs() + 4.0 * f64::EPSILON * ua.abs().max(ub.abs());
         // Distances are computed from coordinates of this size: their rounding is the floor.
         let rounding = 8.0 * f64::EPSILON * a.amax().max(b.amax());
-        refine_maximum(
+        let refined = refine_maximum(
             &distance,
             [at(best_index - 1), at(best_index), at(best_index + 1)],
             [samples[best_index - 1], best, samples[best_index + 1]],
             tol,
             rounding,
-        )
+        );
+        refined.max(overshoot)
     }
 
     /// The smallest radius of curvature on [u_a, u_b] (mm; infinite where straight), and where it
@@ -701,6 +786,53 @@ pub(crate) fn require_length(shape: &Shape, field: &str) -> Result<f64, SolverEr
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    #[test]
+    fn a_hairpin_beyond_the_chord_end_counts() {
+        // A rational quadratic that runs 0.009 mm past a chord's end and turns back between two
+        // of the 32 samples (found by the property tests): the deviation is the tip's distance
+        // from that end, not the few micrometres the samples alone see.
+        let control: Vec<Vec3> = [
+            [6.3178282535315535, 0.0],
+            [-5.278122233799347, -11.483615078424297],
+            [3.9571577762024446, -7.539654064436308],
+            [0.0, 7.151824819702683],
+            [-14.628399769836593, 13.930560152940036],
+            [-14.207321980790294, -9.675831506395363],
+            [16.021925858200994, 11.955354107956543],
+            [1.7083640345294515, 1.7133571694329857],
+        ]
+        .iter()
+        .map(|p| Vec3::new(p[0], p[1], 0.0))
+        .collect();
+        let weights = [
+            2.4877905030426497,
+            0.8473523686460599,
+            2.3344922658374028,
+            0.3,
+            2.1120301725436215,
+            1.9240425844729563,
+            0.3,
+            0.3,
+        ];
+        let nurbs = Nurbs::new(2, &control, None, Some(&weights), "curve").unwrap();
+        let breaks: Vec<f64> = nurbs.breaks().iter().map(|(knot, _)| *knot).collect();
+        let table = ArcLengthTable::build(&|u| nurbs.speed(u), &breaks, 4, "curve").unwrap();
+        let shape = Shape::Spline(Spline::new(nurbs.clone(), table));
+        let (ua, ub) = (0.833_099_343_911_542_7, 0.971_634_124_853_778_8);
+        let (a, b) = (nurbs.point(ua), nurbs.point(ub));
+        let dense = (0..=200_000)
+            .map(|j| distance_to_segment(&nurbs.point(ua + (ub - ua) * f64::from(j) / 200_000.0), &a, &b))
+            .fold(0.0, f64::max);
+        assert!(dense > 0.008, "{dense}");
+        for (what, deviation) in [
+            ("reference", shape.deviation(ua, ub)),
+            ("checked", shape.checked_deviation(ua, ub).unwrap()),
+            ("fast", shape.fast_deviation(ua, ub, f64::INFINITY).0),
+        ] {
+            assert!(deviation >= dense * (1.0 - 1e-6), "{what}: {deviation} below {dense}");
+        }
+    }
 
     fn ellipse() -> Shape {
         let (a, b) = (100.0_f64, 50.0_f64);
