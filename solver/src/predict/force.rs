@@ -229,7 +229,8 @@ pub(crate) fn engage(
                     continue;
                 }
                 let q = radius * e_r;
-                if !scene.in_stock(stock, region, &q)
+                if (region == Region::Mixed && scene.hidden_at_hint(&q, &lists.before, hint))
+                    || !scene.in_stock(stock, region, &q)
                     || scene.cover(&q, Side::Before, &lists.before, &mut hint) != Cover::Open
                 {
                     continue;

@@ -260,7 +260,10 @@ impl Scene {
     }
 
     /// How the frame point `q` is covered by the listed capsules of one side (`list` in index
-    /// order); `hint` is the list position that covered the previous point (tried first).
+    /// order); `hint` is the list position that covered the previous point (tried first). Kept
+    /// out of line: one tight loop for every caller (inlined into the pixel and sample loops it
+    /// cost more instructions).
+    #[inline(never)]
     pub(crate) fn cover(&self, q: &Vec3, side: Side, list: &[u32], hint: &mut usize) -> Cover {
         debug_assert!(list.is_sorted());
         let capsules = match side {
@@ -273,24 +276,45 @@ impl Scene {
         // so its scan stops at the first capsule too high to reach q.
         for (offset, part) in [(start, &list[start..]), (0, &list[..start])] {
             for (k, &index) in part.iter().enumerate() {
-                let capsule = &capsules[index as usize];
-                if capsule.min_z - self.radius > q.z + self.eps {
-                    break;
-                }
-                // Capsules whose lowest point over q lies more than 2ε above it are skipped before
-                // the square root (neither hidden nor a tie, so the same answer).
-                if let Some(entry) = capsule.entry_z_up_to(q.x, q.y, self.r2, q.z + 2.0 * self.eps) {
-                    if entry < q.z - self.eps {
+                match self.capsule_cover(&capsules[index as usize], q) {
+                    None => break,
+                    Some(Cover::Hidden) => {
                         *hint = offset + k;
                         return Cover::Hidden;
                     }
-                    if entry <= q.z + self.eps {
-                        state = Cover::Tie;
-                    }
+                    Some(Cover::Tie) => state = Cover::Tie,
+                    Some(Cover::Open) => {}
                 }
             }
         }
         state
+    }
+
+    /// How one capsule covers the frame point `q`; `None` when its axis lies too high to reach q
+    /// (so does every later capsule of a list sorted by `min_z`). Always inlined: it is the
+    /// inner loop of every point test.
+    #[inline(always)]
+    fn capsule_cover(&self, capsule: &Capsule, q: &Vec3) -> Option<Cover> {
+        if capsule.min_z - self.radius > q.z + self.eps {
+            return None;
+        }
+        // Capsules whose lowest point over q lies more than 2ε above it are skipped before the
+        // square root (neither hidden nor a tie, so the same answer).
+        Some(match capsule.entry_z_up_to(q.x, q.y, self.r2, q.z + 2.0 * self.eps) {
+            Some(entry) if entry < q.z - self.eps => Cover::Hidden,
+            Some(entry) if entry <= q.z + self.eps => Cover::Tie,
+            _ => Cover::Open,
+        })
+    }
+
+    /// Whether the T1 capsule at position `hint` of `list` hides `q`: the first test of
+    /// [`Self::cover`] on its own. Neighbouring points are nearly always hidden by the same
+    /// capsule, so where the tile meets the stock's surface callers ask this before the costlier
+    /// point-in-stock test (a point it hides is cut before or not in the stock, which every
+    /// caller treats alike).
+    #[inline]
+    pub(crate) fn hidden_at_hint(&self, q: &Vec3, list: &[u32], hint: usize) -> bool {
+        list.get(hint).is_some_and(|&index| self.capsule_cover(&self.before[index as usize], q) == Some(Cover::Hidden))
     }
 
     /// Whether one listed T1 capsule hides every point of the frame box `[lo, hi]`: the box lies
@@ -332,7 +356,8 @@ impl Scene {
 pub(crate) enum SampleState {
     /// Not in the stock (or not on the lower hemisphere).
     Air,
-    /// In the stock but hidden by T1: cut before.
+    /// Hidden by T1: cut before (or not in the stock: a point T1 hides needs no stock test, and
+    /// every caller treats both alike).
     CutBefore,
     /// In the cutting region K, hidden by T2: cut again later.
     CutAfter,
@@ -358,7 +383,8 @@ impl Scene {
     }
 
     /// [`Self::test`] for a point whose place relative to the stock is `region` (a part of the
-    /// tile's box).
+    /// tile's box). Always inlined into the callers' pixel and sample loops.
+    #[inline(always)]
     pub(crate) fn test_in(
         &self,
         stock: &StockModel,
@@ -367,13 +393,16 @@ impl Scene {
         q: &Vec3,
         hints: &mut [usize; 2],
     ) -> PointTest {
-        let air = PointTest { state: SampleState::Air, cut: false };
+        let cut_before = PointTest { state: SampleState::CutBefore, cut: false };
+        if region == Region::Mixed && self.hidden_at_hint(q, &lists.before, hints[0]) {
+            return cut_before;
+        }
         if !self.in_stock(stock, region, q) {
-            return air;
+            return PointTest { state: SampleState::Air, cut: false };
         }
         let before = self.cover(q, Side::Before, &lists.before, &mut hints[0]);
         if before == Cover::Hidden {
-            return PointTest { state: SampleState::CutBefore, cut: false };
+            return cut_before;
         }
         let after = self.cover(q, Side::After, &lists.after, &mut hints[1]);
         PointTest {
