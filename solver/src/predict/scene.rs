@@ -50,17 +50,31 @@ pub(crate) struct Query {
     /// Keep every piece within `reach` in 3-D (tilted views) instead of those that can hide
     /// the lower hemisphere from below.
     pub(crate) any_view: bool,
+    pub(crate) order: PieceOrder,
+}
+
+/// The order of the gathered pieces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum PieceOrder {
+    /// Path order (neighbourhoods compared pass by pass).
+    Path,
+    /// By their segments' lowest points, ties in path order: a scene seen from below keeps its
+    /// capsules in this order, so only the pieces clipped at the gap can be out of place.
+    Height,
 }
 
 /// Collects the motion near the ball minus the gap (σ − gap, σ + gap), as pieces that can hide
 /// part of the lower hemisphere seen from below (xy within 2R, lowest point below the ball
 /// centre), or for tilted views every piece within `reach` in 3-D.
 pub(crate) fn gather(path: &PathModel, query: &Query, scratch: &mut Scratch, out: &mut Vec<Piece>) {
-    let Query { centre, sigma, gap, radius, reach, any_view } = *query;
+    let Query { centre, sigma, gap, radius, reach, any_view, order } = *query;
     let centre = &centre;
     out.clear();
     scratch.indices.clear();
-    path.near_in_order(centre, reach, &mut scratch.stamps, &mut scratch.indices);
+    match order {
+        PieceOrder::Path => path.near_in_order(centre, reach, &mut scratch.stamps, &mut scratch.indices),
+        PieceOrder::Height => path.near_by_height(centre, reach, &mut scratch.stamps, &mut scratch.indices),
+    }
     out.reserve(scratch.indices.len());
     for &index in &scratch.indices {
         let segment = &path.segments[index as usize];
@@ -107,16 +121,18 @@ pub(crate) struct Scene {
     pub(crate) after: Vec<Capsule>,
 }
 
-/// The capsules sorted by lowest axis point, ties in path order: the box filter and the point
-/// test stop at the first capsule too high to matter. Which capsule hides a point never depends on
-/// the order, only how soon a scan finds it. (Sorting integer keys, not the 128-byte capsules.)
+/// The capsules sorted by lowest axis point: the box filter and the point test stop at the first
+/// capsule too high to matter. Which capsule hides a point never depends on the order, only how
+/// soon a scan finds it. Pieces gathered in [`PieceOrder::Height`] come sorted but for the few
+/// clipped at the gap, which the run-adaptive stable sort merges in about linear time. (Sorting
+/// integer keys, not the 128-byte capsules.)
 fn by_lowest_point(capsules: Vec<Capsule>) -> Vec<Capsule> {
     if capsules.is_sorted_by(|p, q| p.min_z <= q.min_z) {
         return capsules;
     }
     let mut keys: Vec<(u64, u32)> =
         capsules.iter().enumerate().map(|(i, c)| (total_order_key(c.min_z), i as u32)).collect();
-    keys.sort_unstable();
+    keys.sort();
     keys.into_iter().map(|(_, i)| capsules[i as usize]).collect()
 }
 
