@@ -257,22 +257,31 @@ impl Scene {
         }
     }
 
-    /// World bounding box of a frame box.
+    /// World bounding box of a frame box. Rounding is monotone, so [`Self::world`] reaches each
+    /// world coordinate's extremes over the box at the corner taking, per frame axis, the low or
+    /// the high end as that axis's back-rotation coefficient is ≥ 0 or not (the same bits as
+    /// trying all 8 corners): 2 corners for the machine frame, at most 6 for any other.
     pub(crate) fn world_box(&self, lo: &Vec3, hi: &Vec3) -> (Vec3, Vec3) {
         let back = self.rotation.transpose();
-        let mut world_lo = Vec3::repeat(f64::INFINITY);
-        let mut world_hi = Vec3::repeat(f64::NEG_INFINITY);
-        for corner in 0..8 {
-            let c = Vec3::new(
-                if corner & 1 == 0 { lo.x } else { hi.x },
-                if corner & 2 == 0 { lo.y } else { hi.y },
-                if corner & 4 == 0 { lo.z } else { hi.z },
-            );
-            let w = self.centre + back * c;
-            world_lo = world_lo.inf(&w);
-            world_hi = world_hi.sup(&w);
-        }
-        (world_lo, world_hi)
+        let corner = |row: usize, low: bool| {
+            let pick = |column: usize| if (back[(row, column)] >= 0.0) == low { lo[column] } else { hi[column] };
+            Vec3::new(pick(0), pick(1), pick(2))
+        };
+        let extreme = |low: bool| {
+            let mut extreme = Vec3::zeros();
+            let mut last: Option<(Vec3, Vec3)> = None;
+            for row in 0..3 {
+                let c = corner(row, low);
+                let w = match last {
+                    Some((previous, w)) if previous == c => w,
+                    _ => self.world(&c),
+                };
+                extreme[row] = w[row];
+                last = Some((c, w));
+            }
+            extreme
+        };
+        (extreme(true), extreme(false))
     }
 
     /// How the frame point `q` is covered by the listed capsules of one side (`list` in index
@@ -481,6 +490,35 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig { cases: 256, .. ProptestConfig::default() })]
+
+        /// The world box from the extreme corners is the box of all 8 corners, bit for bit, for
+        /// the machine frame, turns about the vertical and tilted frames.
+        #[test]
+        fn world_box_matches_all_corners(
+            turn in -4.0..4.0_f64,
+            tilt in prop_oneof![Just(0.0), -1.5..1.5_f64],
+            machine in any::<bool>(),
+            (lo, hi) in frame_box(),
+        ) {
+            let rotation = if machine {
+                Matrix3::identity()
+            } else {
+                *nalgebra::Rotation3::from_euler_angles(tilt, 0.0, turn).matrix()
+            };
+            let scene = Scene::new(&[], Vec3::new(3.25, -1.5, 0.75), rotation, 5.0);
+            let mut world_lo = Vec3::repeat(f64::INFINITY);
+            let mut world_hi = Vec3::repeat(f64::NEG_INFINITY);
+            for corner in 0..8 {
+                let c = Vec3::new(
+                    if corner & 1 == 0 { lo.x } else { hi.x },
+                    if corner & 2 == 0 { lo.y } else { hi.y },
+                    if corner & 4 == 0 { lo.z } else { hi.z },
+                );
+                world_lo = world_lo.inf(&scene.world(&c));
+                world_hi = world_hi.sup(&scene.world(&c));
+            }
+            prop_assert_eq!(scene.world_box(&lo, &hi), (world_lo, world_hi));
+        }
 
         /// The sorted capsules with the early stop give exactly the candidates of the full scan,
         /// from all capsules and from a pool, and the same point test answers.
