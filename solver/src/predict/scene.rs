@@ -343,22 +343,35 @@ impl Scene {
     }
 
     /// Whether one listed T1 capsule hides every point of the frame box `[lo, hi]`: the box lies
-    /// in the capsule shrunk by 2ε (its centre within R − 2ε − half its diagonal of the axis). Then
-    /// every point q of the box has q − 2ε·ẑ inside the capsule, so the ray enters it more than ε
-    /// before q and [`Self::cover`] would answer `Hidden` for each (the capsule passes the
-    /// conservative box filter, so it is in the list). `hint` is the list position that hid the
-    /// previous box (tried first).
+    /// in the capsule shrunk by 2ε. A capsule is convex, so that holds when the box's 8 corners
+    /// lie within R − 2ε of the axis (checked after two cheaper tests of the box's centre: within
+    /// R − 2ε is needed, within R − 2ε − half the diagonal is enough). Then every point q of the
+    /// box has q − 2ε·ẑ inside the capsule, so the ray enters it more than ε before q and
+    /// [`Self::cover`] would answer `Hidden` for each (the capsule passes the conservative box
+    /// filter, so it is in the list). `hint` is the list position that hid the previous box
+    /// (tried first).
     pub(crate) fn hides_box(&self, lo: &Vec3, hi: &Vec3, list: &[u32], hint: &mut usize) -> bool {
         let centre = 0.5 * (lo + hi);
-        let limit = self.radius - 0.5 * (hi - lo).norm() - 2.0 * self.eps;
-        if limit <= 0.0 {
-            return false;
-        }
-        let limit2 = limit * limit;
+        let inner = self.radius - 2.0 * self.eps;
+        let inner2 = inner * inner;
+        let sure = (inner - 0.5 * (hi - lo).norm()).max(0.0);
+        let sure2 = sure * sure;
+        let corners = [0, 1, 2, 3, 4, 5, 6, 7].map(|corner: usize| {
+            Vec3::new(
+                if corner & 1 == 0 { lo.x } else { hi.x },
+                if corner & 2 == 0 { lo.y } else { hi.y },
+                if corner & 4 == 0 { lo.z } else { hi.z },
+            )
+        });
         let start = (*hint).min(list.len());
         let (tail, head) = list.split_at(start);
         for (position, &index) in head.iter().enumerate().map(|(k, i)| (k + start, i)).chain(tail.iter().enumerate()) {
-            if self.before[index as usize].distance_squared(&centre) <= limit2 {
+            let capsule = &self.before[index as usize];
+            let to_centre = capsule.distance_squared(&centre);
+            if to_centre > inner2 {
+                continue;
+            }
+            if (sure > 0.0 && to_centre <= sure2) || corners.iter().all(|c| capsule.distance_squared(c) <= inner2) {
                 *hint = position;
                 return true;
             }
@@ -518,6 +531,36 @@ mod tests {
                 world_hi = world_hi.sup(&scene.world(&c));
             }
             prop_assert_eq!(scene.world_box(&lo, &hi), (world_lo, world_hi));
+        }
+
+        /// Every point of a box that one T1 capsule hides whole is hidden by the point test.
+        #[test]
+        fn hidden_boxes_hide_their_points(
+            pieces in pieces(),
+            (lo, size) in frame_box(),
+            shrink in 0.05..1.0_f64,
+            inside in (0.0..1.0_f64, 0.0..1.0_f64, 0.0..1.0_f64),
+        ) {
+            let scene = Scene::new(&pieces, Vec3::new(1.0, -2.0, 0.5), Matrix3::identity(), 5.0);
+            let hi = lo + shrink * (size - lo);
+            let mut lists = TileLists::default();
+            scene.candidates(&lo, &hi, false, None, &mut lists);
+            let mut hint = 0;
+            if scene.hides_box(&lo, &hi, &lists.before, &mut hint) {
+                let all: Vec<u32> = (0..scene.before.len() as u32).collect();
+                for k in 0..9 {
+                    let q = if k == 8 {
+                        lo + (hi - lo).component_mul(&Vec3::new(inside.0, inside.1, inside.2))
+                    } else {
+                        Vec3::new(
+                            if k & 1 == 0 { lo.x } else { hi.x },
+                            if k & 2 == 0 { lo.y } else { hi.y },
+                            if k & 4 == 0 { lo.z } else { hi.z },
+                        )
+                    };
+                    prop_assert_eq!(brute_cover(&scene, &q, &scene.before, &all), Cover::Hidden);
+                }
+            }
         }
 
         /// The sorted capsules with the early stop give exactly the candidates of the full scan,
