@@ -71,6 +71,8 @@ struct Tile {
     steps: (usize, usize),
     lo: Vec3,
     hi: Vec3,
+    /// Index of its group in [`EdgeGrid::group_boxes`].
+    group: usize,
 }
 
 /// The edge discretisation for one spindle sense.
@@ -86,6 +88,9 @@ pub(crate) struct EdgeGrid {
     /// Per ring and step: (cos φ, sin φ).
     azimuth: Vec<(f64, f64)>,
     tiles: Vec<Tile>,
+    /// Per group of GROUP_RINGS × GROUP_STEPS tiles, the box of its unit vectors: a group whose
+    /// box misses the stock spares its tiles the classification.
+    group_boxes: Vec<(Vec3, Vec3)>,
 }
 
 impl EdgeGrid {
@@ -110,7 +115,11 @@ impl EdgeGrid {
                 azimuth.push((c, s));
             }
         }
-        let mut grid = Self { rings, steps, flutes, sign, ring_angle, azimuth, tiles: Vec::new() };
+        let mut grid =
+            Self { rings, steps, flutes, sign, ring_angle, azimuth, tiles: Vec::new(), group_boxes: Vec::new() };
+        let group_columns = steps.div_ceil(GROUP_STEPS * TILE_STEPS);
+        let group_count = rings.div_ceil(GROUP_RINGS * TILE_RINGS) * group_columns;
+        grid.group_boxes = vec![(Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)); group_count];
         for k0 in (0..rings).step_by(TILE_RINGS) {
             for i0 in (0..steps).step_by(TILE_STEPS) {
                 let rings = (k0, (k0 + TILE_RINGS).min(grid.rings));
@@ -124,7 +133,10 @@ impl EdgeGrid {
                         hi = hi.sup(&u);
                     }
                 }
-                grid.tiles.push(Tile { rings, steps, lo, hi });
+                let group = k0 / (GROUP_RINGS * TILE_RINGS) * group_columns + i0 / (GROUP_STEPS * TILE_STEPS);
+                let group_box = &mut grid.group_boxes[group];
+                *group_box = (group_box.0.inf(&lo), group_box.1.sup(&hi));
+                grid.tiles.push(Tile { rings, steps, lo, hi, group });
             }
         }
         grid
@@ -171,10 +183,19 @@ pub(crate) fn engage(
     let mut kept: Vec<(&Tile, Region, Vec3, Vec3)> = Vec::new();
     let mut union_lo = Vec3::repeat(f64::INFINITY);
     let mut union_hi = Vec3::repeat(f64::NEG_INFINITY);
+    let mut group_outside: Vec<Option<bool>> = vec![None; grid.group_boxes.len()];
     for tile in &grid.tiles {
         // Upper bound of ê_r·û over the tile.
         let front: f64 = (0..3).map(|c| (u[c] * tile.lo[c]).max(u[c] * tile.hi[c])).sum();
         if front <= 0.0 {
+            continue;
+        }
+        let outside = *group_outside[tile.group].get_or_insert_with(|| {
+            let (lo, hi) = grid.group_boxes[tile.group];
+            let (lo, hi) = (radius * lo - Vec3::repeat(scene.eps), radius * hi + Vec3::repeat(scene.eps));
+            scene.region(stock, &lo, &hi) == Region::Outside
+        });
+        if outside {
             continue;
         }
         let lo = radius * tile.lo - Vec3::repeat(scene.eps);
@@ -229,7 +250,8 @@ pub(crate) fn engage(
                     continue;
                 }
                 let q = radius * e_r;
-                if !scene.in_stock(stock, region, &q)
+                if (region == Region::Mixed && scene.hidden_at_hint(&q, &lists.before, hint))
+                    || !scene.in_stock(stock, region, &q)
                     || scene.cover(&q, Side::Before, &lists.before, &mut hint) != Cover::Open
                 {
                     continue;

@@ -103,6 +103,7 @@ pub(crate) fn neighbourhood(
             radius,
             reach: 2.0 * radius,
             any_view: false,
+            order: scene::PieceOrder::Path,
         },
         scratch,
         &mut pieces,

@@ -175,6 +175,7 @@ fn rapid_collisions(job: &Job) -> Option<Warning> {
                 radius,
                 reach: 0.5 * segment.length + 2.0 * radius,
                 any_view: true,
+                order: scene::PieceOrder::Height,
             },
             &mut scratch,
             &mut pieces,

@@ -51,6 +51,10 @@ pub(crate) struct PathModel {
     pub(crate) segments: Vec<Segment>,
     pub(crate) passes: Vec<Pass>,
     grid: SegmentGrid,
+    /// The segments ranked by their lowest end's z (ties in path order): `by_height[k]` is the
+    /// segment of rank k, `height_rank[i]` the rank of segment i.
+    by_height: Vec<u32>,
+    height_rank: Vec<u32>,
 }
 
 /// Builds a path from runs of connected nodes; within a run, consecutive nodes are joined by a
@@ -123,12 +127,23 @@ impl PathBuilder {
 
     /// Finishes the path; `cell` is the preferred grid cell size (the ball radius).
     pub(crate) fn build(self, cell: f64) -> PathModel {
-        let grid = SegmentGrid::new(&self.nodes, &self.segments, cell);
-        PathModel { nodes: self.nodes, segments: self.segments, passes: self.passes, grid }
+        PathModel::new(self.nodes, self.segments, self.passes, cell)
     }
 }
 
 impl PathModel {
+    fn new(nodes: Vec<Vec3>, segments: Vec<Segment>, passes: Vec<Pass>, cell: f64) -> Self {
+        let grid = SegmentGrid::new(&nodes, &segments, cell);
+        let lowest = |s: &Segment| nodes[s.start_node].z.min(nodes[s.end_node].z);
+        let mut by_height: Vec<u32> = (0..segments.len() as u32).collect();
+        by_height.sort_by(|&i, &j| lowest(&segments[i as usize]).total_cmp(&lowest(&segments[j as usize])));
+        let mut height_rank = vec![0; segments.len()];
+        for (rank, &index) in by_height.iter().enumerate() {
+            height_rank[index as usize] = rank as u32;
+        }
+        Self { nodes, segments, passes, grid, by_height, height_rank }
+    }
+
     pub(crate) fn ends(&self, segment: usize) -> (Vec3, Vec3) {
         let s = &self.segments[segment];
         (self.nodes[s.start_node], self.nodes[s.end_node])
@@ -190,6 +205,27 @@ impl PathModel {
         }
     }
 
+    /// [`Self::near`] ordered by the segments' lowest points (ties in path order), read off the
+    /// marks of their height ranks instead of sorting: the order the scenes keep their capsules
+    /// in (§6.2), so that a scene built from pieces in this order needs no sort.
+    pub(crate) fn near_by_height(&self, centre: &Vec3, reach: f64, stamps: &mut Stamps, out: &mut Vec<u32>) {
+        stamps.reserve(self.segments.len());
+        let (mut lowest, mut highest) = (u32::MAX, 0);
+        self.grid.visit(centre.x - reach, centre.y - reach, centre.x + reach, centre.y + reach, |index| {
+            let rank = self.height_rank[index as usize];
+            stamps.mark(rank);
+            lowest = lowest.min(rank);
+            highest = highest.max(rank);
+        });
+        let first = out.len();
+        if lowest <= highest {
+            stamps.drain(lowest, highest, out);
+        }
+        for entry in &mut out[first..] {
+            *entry = self.by_height[*entry as usize];
+        }
+    }
+
     /// The same path with its nodes moved (same segments and passes).
     pub(crate) fn with_nodes(&self, nodes: Vec<Vec3>, cell: f64) -> Self {
         let mut segments = self.segments.clone();
@@ -199,8 +235,7 @@ impl PathModel {
             s.length = (nodes[s.end_node] - nodes[s.start_node]).norm();
             sigma += s.length;
         }
-        let grid = SegmentGrid::new(&nodes, &segments, cell);
-        Self { nodes, segments, passes: self.passes.clone(), grid }
+        Self::new(nodes, segments, self.passes.clone(), cell)
     }
 }
 
@@ -346,7 +381,7 @@ mod tests {
         for i in 1..200 {
             let x = f64::from(i % 20) * 0.5;
             let y = f64::from(i / 20) * 0.5;
-            builder.to(Vec3::new(x, y, 0.0), Some(source()));
+            builder.to(Vec3::new(x, y, f64::from(i % 7) * 0.1), Some(source()));
         }
         let path = builder.build(1.0);
         let mut stamps = Stamps::default();
@@ -360,6 +395,15 @@ mod tests {
             let mut in_order = Vec::new();
             path.near_in_order(&probe, 1.2, &mut stamps, &mut in_order);
             assert_eq!(in_order, sorted);
+            let mut by_height = Vec::new();
+            path.near_by_height(&probe, 1.2, &mut stamps, &mut by_height);
+            let lowest = |i: u32| {
+                let (a, b) = path.ends(i as usize);
+                a.z.min(b.z)
+            };
+            let mut expected = sorted.clone();
+            expected.sort_by(|&i, &j| lowest(i).total_cmp(&lowest(j)).then(i.cmp(&j)));
+            assert_eq!(by_height, expected);
             for (index, _) in path.segments.iter().enumerate() {
                 let (a, b) = path.ends(index);
                 let overlaps = a.x.min(b.x) <= probe.x + 1.2

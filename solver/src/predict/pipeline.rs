@@ -21,7 +21,7 @@ use super::passes::PathModel;
 use super::render::{self, Image, Window};
 use super::request::Method;
 use super::sampling::{self, Band};
-use super::scene::{self, Scene, Scratch};
+use super::scene::{self, PieceOrder, Scene, Scratch};
 use super::shape;
 use crate::capability::Control;
 use crate::error::SolverError;
@@ -347,7 +347,15 @@ fn predict_pass_with(
         let sigma = segment.sigma + s;
         scene::gather(
             path,
-            &scene::Query { centre, sigma, gap, radius, reach: 2.0 * radius, any_view: false },
+            &scene::Query {
+                centre,
+                sigma,
+                gap,
+                radius,
+                reach: 2.0 * radius,
+                any_view: false,
+                order: PieceOrder::Height,
+            },
             scratch,
             &mut pieces,
         );
@@ -582,7 +590,15 @@ fn depth_buffer(
     let mut wide = Vec::new();
     scene::gather(
         path,
-        &scene::Query { centre: *centre, sigma, gap, radius, reach: 5.0 * radius, any_view: true },
+        &scene::Query {
+            centre: *centre,
+            sigma,
+            gap,
+            radius,
+            reach: 5.0 * radius,
+            any_view: true,
+            order: PieceOrder::Path,
+        },
         scratch,
         &mut wide,
     );

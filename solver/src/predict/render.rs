@@ -160,23 +160,25 @@ pub(crate) fn render(scene: &Scene, stock: &StockModel, window: &Window) -> Imag
             if scene.hides_box(&lo, &hi, &lists.before, &mut hide_hint) {
                 continue;
             }
-            // A tile that meets the stock's surface: its blocks are placed one by one, so that
-            // only the pixels of blocks the surface crosses pay for the point-in-stock test.
-            let mut block_regions = [[region; TILE / BLOCK]; TILE / BLOCK];
-            if region == Region::Mixed {
-                for (b_j, regions) in block_regions.iter_mut().enumerate() {
-                    for (b_i, block_region) in regions.iter_mut().enumerate() {
-                        let (bi0, bj0) = (i0 + b_i * BLOCK, j0 + b_j * BLOCK);
-                        let columns = (bi0, (bi0 + BLOCK).min(i1));
-                        let rows = (bj0, (bj0 + BLOCK).min(j1));
-                        *block_region = if columns.0 < columns.1
-                            && rows.0 < rows.1
-                            && let Some((lo, hi)) = pixel_box(columns, rows)
-                        {
-                            scene.region(stock, &lo, &hi)
-                        } else {
-                            Region::Outside
-                        };
+            // The tile's blocks one by one: those one T1 capsule hides whole are skipped (their
+            // pixels would all be cut before), and where the stock's surface crosses the tile
+            // only the pixels of blocks it crosses pay for the point-in-stock test. `None`: no
+            // pixel of the block needs a test.
+            let mut block_regions = [[None; TILE / BLOCK]; TILE / BLOCK];
+            for (b_j, regions) in block_regions.iter_mut().enumerate() {
+                for (b_i, block_region) in regions.iter_mut().enumerate() {
+                    let (bi0, bj0) = (i0 + b_i * BLOCK, j0 + b_j * BLOCK);
+                    let columns = (bi0, (bi0 + BLOCK).min(i1));
+                    let rows = (bj0, (bj0 + BLOCK).min(j1));
+                    if columns.0 >= columns.1 || rows.0 >= rows.1 {
+                        continue;
+                    }
+                    let Some((lo, hi)) = pixel_box(columns, rows) else {
+                        continue;
+                    };
+                    let placed = if region == Region::Mixed { scene.region(stock, &lo, &hi) } else { region };
+                    if placed != Region::Outside && !scene.hides_box(&lo, &hi, &lists.before, &mut hide_hint) {
+                        *block_region = Some(placed);
                     }
                 }
             }
@@ -184,10 +186,9 @@ pub(crate) fn render(scene: &Scene, stock: &StockModel, window: &Window) -> Imag
             for j in j0..j1 {
                 let y = coordinate(j, window.centre[1]);
                 for i in i0..i1 {
-                    let block_region = block_regions[(j - j0) / BLOCK][(i - i0) / BLOCK];
-                    if block_region == Region::Outside {
+                    let Some(block_region) = block_regions[(j - j0) / BLOCK][(i - i0) / BLOCK] else {
                         continue;
-                    }
+                    };
                     let x = coordinate(i, window.centre[0]);
                     let rho2 = x * x + y * y;
                     if rho2 > r2 {

@@ -50,17 +50,31 @@ pub(crate) struct Query {
     /// Keep every piece within `reach` in 3-D (tilted views) instead of those that can hide
     /// the lower hemisphere from below.
     pub(crate) any_view: bool,
+    pub(crate) order: PieceOrder,
+}
+
+/// The order of the gathered pieces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum PieceOrder {
+    /// Path order (neighbourhoods compared pass by pass).
+    Path,
+    /// By their segments' lowest points, ties in path order: a scene seen from below keeps its
+    /// capsules in this order, so only the pieces clipped at the gap can be out of place.
+    Height,
 }
 
 /// Collects the motion near the ball minus the gap (σ − gap, σ + gap), as pieces that can hide
 /// part of the lower hemisphere seen from below (xy within 2R, lowest point below the ball
 /// centre), or for tilted views every piece within `reach` in 3-D.
 pub(crate) fn gather(path: &PathModel, query: &Query, scratch: &mut Scratch, out: &mut Vec<Piece>) {
-    let Query { centre, sigma, gap, radius, reach, any_view } = *query;
+    let Query { centre, sigma, gap, radius, reach, any_view, order } = *query;
     let centre = &centre;
     out.clear();
     scratch.indices.clear();
-    path.near_in_order(centre, reach, &mut scratch.stamps, &mut scratch.indices);
+    match order {
+        PieceOrder::Path => path.near_in_order(centre, reach, &mut scratch.stamps, &mut scratch.indices),
+        PieceOrder::Height => path.near_by_height(centre, reach, &mut scratch.stamps, &mut scratch.indices),
+    }
     out.reserve(scratch.indices.len());
     for &index in &scratch.indices {
         let segment = &path.segments[index as usize];
@@ -107,16 +121,18 @@ pub(crate) struct Scene {
     pub(crate) after: Vec<Capsule>,
 }
 
-/// The capsules sorted by lowest axis point, ties in path order: the box filter and the point
-/// test stop at the first capsule too high to matter. Which capsule hides a point never depends on
-/// the order, only how soon a scan finds it. (Sorting integer keys, not the 128-byte capsules.)
+/// The capsules sorted by lowest axis point: the box filter and the point test stop at the first
+/// capsule too high to matter. Which capsule hides a point never depends on the order, only how
+/// soon a scan finds it. Pieces gathered in [`PieceOrder::Height`] come sorted but for the few
+/// clipped at the gap, which the run-adaptive stable sort merges in about linear time. (Sorting
+/// integer keys, not the 128-byte capsules.)
 fn by_lowest_point(capsules: Vec<Capsule>) -> Vec<Capsule> {
     if capsules.is_sorted_by(|p, q| p.min_z <= q.min_z) {
         return capsules;
     }
     let mut keys: Vec<(u64, u32)> =
         capsules.iter().enumerate().map(|(i, c)| (total_order_key(c.min_z), i as u32)).collect();
-    keys.sort_unstable();
+    keys.sort();
     keys.into_iter().map(|(_, i)| capsules[i as usize]).collect()
 }
 
@@ -241,26 +257,38 @@ impl Scene {
         }
     }
 
-    /// World bounding box of a frame box.
+    /// World bounding box of a frame box. Rounding is monotone, so [`Self::world`] reaches each
+    /// world coordinate's extremes over the box at the corner taking, per frame axis, the low or
+    /// the high end as that axis's back-rotation coefficient is ≥ 0 or not (the same bits as
+    /// trying all 8 corners): 2 corners for the machine frame, at most 6 for any other.
     pub(crate) fn world_box(&self, lo: &Vec3, hi: &Vec3) -> (Vec3, Vec3) {
         let back = self.rotation.transpose();
-        let mut world_lo = Vec3::repeat(f64::INFINITY);
-        let mut world_hi = Vec3::repeat(f64::NEG_INFINITY);
-        for corner in 0..8 {
-            let c = Vec3::new(
-                if corner & 1 == 0 { lo.x } else { hi.x },
-                if corner & 2 == 0 { lo.y } else { hi.y },
-                if corner & 4 == 0 { lo.z } else { hi.z },
-            );
-            let w = self.centre + back * c;
-            world_lo = world_lo.inf(&w);
-            world_hi = world_hi.sup(&w);
-        }
-        (world_lo, world_hi)
+        let corner = |row: usize, low: bool| {
+            let pick = |column: usize| if (back[(row, column)] >= 0.0) == low { lo[column] } else { hi[column] };
+            Vec3::new(pick(0), pick(1), pick(2))
+        };
+        let extreme = |low: bool| {
+            let mut extreme = Vec3::zeros();
+            let mut last: Option<(Vec3, Vec3)> = None;
+            for row in 0..3 {
+                let c = corner(row, low);
+                let w = match last {
+                    Some((previous, w)) if previous == c => w,
+                    _ => self.world(&c),
+                };
+                extreme[row] = w[row];
+                last = Some((c, w));
+            }
+            extreme
+        };
+        (extreme(true), extreme(false))
     }
 
     /// How the frame point `q` is covered by the listed capsules of one side (`list` in index
-    /// order); `hint` is the list position that covered the previous point (tried first).
+    /// order); `hint` is the list position that covered the previous point (tried first). Kept
+    /// out of line: one tight loop for every caller (inlined into the pixel and sample loops it
+    /// cost more instructions).
+    #[inline(never)]
     pub(crate) fn cover(&self, q: &Vec3, side: Side, list: &[u32], hint: &mut usize) -> Cover {
         debug_assert!(list.is_sorted());
         let capsules = match side {
@@ -273,43 +301,77 @@ impl Scene {
         // so its scan stops at the first capsule too high to reach q.
         for (offset, part) in [(start, &list[start..]), (0, &list[..start])] {
             for (k, &index) in part.iter().enumerate() {
-                let capsule = &capsules[index as usize];
-                if capsule.min_z - self.radius > q.z + self.eps {
-                    break;
-                }
-                // Capsules whose lowest point over q lies more than 2ε above it are skipped before
-                // the square root (neither hidden nor a tie, so the same answer).
-                if let Some(entry) = capsule.entry_z_up_to(q.x, q.y, self.r2, q.z + 2.0 * self.eps) {
-                    if entry < q.z - self.eps {
+                match self.capsule_cover(&capsules[index as usize], q) {
+                    None => break,
+                    Some(Cover::Hidden) => {
                         *hint = offset + k;
                         return Cover::Hidden;
                     }
-                    if entry <= q.z + self.eps {
-                        state = Cover::Tie;
-                    }
+                    Some(Cover::Tie) => state = Cover::Tie,
+                    Some(Cover::Open) => {}
                 }
             }
         }
         state
     }
 
+    /// How one capsule covers the frame point `q`; `None` when its axis lies too high to reach q
+    /// (so does every later capsule of a list sorted by `min_z`). Always inlined: it is the
+    /// inner loop of every point test.
+    #[inline(always)]
+    fn capsule_cover(&self, capsule: &Capsule, q: &Vec3) -> Option<Cover> {
+        if capsule.min_z - self.radius > q.z + self.eps {
+            return None;
+        }
+        // Capsules whose lowest point over q lies more than 2ε above it are skipped before the
+        // square root (neither hidden nor a tie, so the same answer).
+        Some(match capsule.entry_z_up_to(q.x, q.y, self.r2, q.z + 2.0 * self.eps) {
+            Some(entry) if entry < q.z - self.eps => Cover::Hidden,
+            Some(entry) if entry <= q.z + self.eps => Cover::Tie,
+            _ => Cover::Open,
+        })
+    }
+
+    /// Whether the T1 capsule at position `hint` of `list` hides `q`: the first test of
+    /// [`Self::cover`] on its own. Neighbouring points are nearly always hidden by the same
+    /// capsule, so where the tile meets the stock's surface callers ask this before the costlier
+    /// point-in-stock test (a point it hides is cut before or not in the stock, which every
+    /// caller treats alike).
+    #[inline]
+    pub(crate) fn hidden_at_hint(&self, q: &Vec3, list: &[u32], hint: usize) -> bool {
+        list.get(hint).is_some_and(|&index| self.capsule_cover(&self.before[index as usize], q) == Some(Cover::Hidden))
+    }
+
     /// Whether one listed T1 capsule hides every point of the frame box `[lo, hi]`: the box lies
-    /// in the capsule shrunk by 2ε (its centre within R − 2ε − half its diagonal of the axis). Then
-    /// every point q of the box has q − 2ε·ẑ inside the capsule, so the ray enters it more than ε
-    /// before q and [`Self::cover`] would answer `Hidden` for each (the capsule passes the
-    /// conservative box filter, so it is in the list). `hint` is the list position that hid the
-    /// previous box (tried first).
+    /// in the capsule shrunk by 2ε. A capsule is convex, so that holds when the box's 8 corners
+    /// lie within R − 2ε of the axis (checked after two cheaper tests of the box's centre: within
+    /// R − 2ε is needed, within R − 2ε − half the diagonal is enough). Then every point q of the
+    /// box has q − 2ε·ẑ inside the capsule, so the ray enters it more than ε before q and
+    /// [`Self::cover`] would answer `Hidden` for each (the capsule passes the conservative box
+    /// filter, so it is in the list). `hint` is the list position that hid the previous box
+    /// (tried first).
     pub(crate) fn hides_box(&self, lo: &Vec3, hi: &Vec3, list: &[u32], hint: &mut usize) -> bool {
         let centre = 0.5 * (lo + hi);
-        let limit = self.radius - 0.5 * (hi - lo).norm() - 2.0 * self.eps;
-        if limit <= 0.0 {
-            return false;
-        }
-        let limit2 = limit * limit;
+        let inner = self.radius - 2.0 * self.eps;
+        let inner2 = inner * inner;
+        let sure = (inner - 0.5 * (hi - lo).norm()).max(0.0);
+        let sure2 = sure * sure;
+        let corners = [0, 1, 2, 3, 4, 5, 6, 7].map(|corner: usize| {
+            Vec3::new(
+                if corner & 1 == 0 { lo.x } else { hi.x },
+                if corner & 2 == 0 { lo.y } else { hi.y },
+                if corner & 4 == 0 { lo.z } else { hi.z },
+            )
+        });
         let start = (*hint).min(list.len());
         let (tail, head) = list.split_at(start);
         for (position, &index) in head.iter().enumerate().map(|(k, i)| (k + start, i)).chain(tail.iter().enumerate()) {
-            if self.before[index as usize].distance_squared(&centre) <= limit2 {
+            let capsule = &self.before[index as usize];
+            let to_centre = capsule.distance_squared(&centre);
+            if to_centre > inner2 {
+                continue;
+            }
+            if (sure > 0.0 && to_centre <= sure2) || corners.iter().all(|c| capsule.distance_squared(c) <= inner2) {
                 *hint = position;
                 return true;
             }
@@ -332,7 +394,8 @@ impl Scene {
 pub(crate) enum SampleState {
     /// Not in the stock (or not on the lower hemisphere).
     Air,
-    /// In the stock but hidden by T1: cut before.
+    /// Hidden by T1: cut before (or not in the stock: a point T1 hides needs no stock test, and
+    /// every caller treats both alike).
     CutBefore,
     /// In the cutting region K, hidden by T2: cut again later.
     CutAfter,
@@ -358,7 +421,8 @@ impl Scene {
     }
 
     /// [`Self::test`] for a point whose place relative to the stock is `region` (a part of the
-    /// tile's box).
+    /// tile's box). Always inlined into the callers' pixel and sample loops.
+    #[inline(always)]
     pub(crate) fn test_in(
         &self,
         stock: &StockModel,
@@ -367,13 +431,16 @@ impl Scene {
         q: &Vec3,
         hints: &mut [usize; 2],
     ) -> PointTest {
-        let air = PointTest { state: SampleState::Air, cut: false };
+        let cut_before = PointTest { state: SampleState::CutBefore, cut: false };
+        if region == Region::Mixed && self.hidden_at_hint(q, &lists.before, hints[0]) {
+            return cut_before;
+        }
         if !self.in_stock(stock, region, q) {
-            return air;
+            return PointTest { state: SampleState::Air, cut: false };
         }
         let before = self.cover(q, Side::Before, &lists.before, &mut hints[0]);
         if before == Cover::Hidden {
-            return PointTest { state: SampleState::CutBefore, cut: false };
+            return cut_before;
         }
         let after = self.cover(q, Side::After, &lists.after, &mut hints[1]);
         PointTest {
@@ -436,6 +503,65 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig { cases: 256, .. ProptestConfig::default() })]
+
+        /// The world box from the extreme corners is the box of all 8 corners, bit for bit, for
+        /// the machine frame, turns about the vertical and tilted frames.
+        #[test]
+        fn world_box_matches_all_corners(
+            turn in -4.0..4.0_f64,
+            tilt in prop_oneof![Just(0.0), -1.5..1.5_f64],
+            machine in any::<bool>(),
+            (lo, hi) in frame_box(),
+        ) {
+            let rotation = if machine {
+                Matrix3::identity()
+            } else {
+                *nalgebra::Rotation3::from_euler_angles(tilt, 0.0, turn).matrix()
+            };
+            let scene = Scene::new(&[], Vec3::new(3.25, -1.5, 0.75), rotation, 5.0);
+            let mut world_lo = Vec3::repeat(f64::INFINITY);
+            let mut world_hi = Vec3::repeat(f64::NEG_INFINITY);
+            for corner in 0..8 {
+                let c = Vec3::new(
+                    if corner & 1 == 0 { lo.x } else { hi.x },
+                    if corner & 2 == 0 { lo.y } else { hi.y },
+                    if corner & 4 == 0 { lo.z } else { hi.z },
+                );
+                world_lo = world_lo.inf(&scene.world(&c));
+                world_hi = world_hi.sup(&scene.world(&c));
+            }
+            prop_assert_eq!(scene.world_box(&lo, &hi), (world_lo, world_hi));
+        }
+
+        /// Every point of a box that one T1 capsule hides whole is hidden by the point test.
+        #[test]
+        fn hidden_boxes_hide_their_points(
+            pieces in pieces(),
+            (lo, size) in frame_box(),
+            shrink in 0.05..1.0_f64,
+            inside in (0.0..1.0_f64, 0.0..1.0_f64, 0.0..1.0_f64),
+        ) {
+            let scene = Scene::new(&pieces, Vec3::new(1.0, -2.0, 0.5), Matrix3::identity(), 5.0);
+            let hi = lo + shrink * (size - lo);
+            let mut lists = TileLists::default();
+            scene.candidates(&lo, &hi, false, None, &mut lists);
+            let mut hint = 0;
+            if scene.hides_box(&lo, &hi, &lists.before, &mut hint) {
+                let all: Vec<u32> = (0..scene.before.len() as u32).collect();
+                for k in 0..9 {
+                    let q = if k == 8 {
+                        lo + (hi - lo).component_mul(&Vec3::new(inside.0, inside.1, inside.2))
+                    } else {
+                        Vec3::new(
+                            if k & 1 == 0 { lo.x } else { hi.x },
+                            if k & 2 == 0 { lo.y } else { hi.y },
+                            if k & 4 == 0 { lo.z } else { hi.z },
+                        )
+                    };
+                    prop_assert_eq!(brute_cover(&scene, &q, &scene.before, &all), Cover::Hidden);
+                }
+            }
+        }
 
         /// The sorted capsules with the early stop give exactly the candidates of the full scan,
         /// from all capsules and from a pool, and the same point test answers.
