@@ -209,7 +209,7 @@ impl Curve {
                 let shape = Shape::Ellipse(Ellipse {
                     centre: c,
                     semi_axes: [a, b],
-                    rotation: angle("curve.rotation_deg", *rotation_deg)?.to_radians(),
+                    rotation_sin_cos: angle("curve.rotation_deg", *rotation_deg)?.to_radians().sin_cos(),
                     start,
                     sense,
                     sweep: swept,

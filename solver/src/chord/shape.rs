@@ -46,7 +46,8 @@ pub(crate) struct Arc {
 pub(crate) struct Ellipse {
     pub centre: Vec3,
     pub semi_axes: [f64; 2],
-    pub rotation: f64,
+    /// sin and cos of the rotation ψ (computed once: every point needs them).
+    pub rotation_sin_cos: (f64, f64),
     pub start: f64,
     pub sense: f64,
     pub sweep: f64,
@@ -100,7 +101,7 @@ impl Ellipse {
 
     fn point(&self, u: f64) -> Vec3 {
         let (x, y) = self.local(self.angle(u));
-        let (sin, cos) = self.rotation.sin_cos();
+        let (sin, cos) = self.rotation_sin_cos;
         self.centre + Vec3::new(cos * x - sin * y, sin * x + cos * y, 0.0)
     }
 
@@ -841,7 +842,7 @@ mod tests {
         Shape::Ellipse(Ellipse {
             centre: Vec3::zeros(),
             semi_axes: [a, b],
-            rotation: 0.0,
+            rotation_sin_cos: (0.0, 1.0),
             start: 0.0,
             sense: 1.0,
             sweep: std::f64::consts::FRAC_PI_2,
