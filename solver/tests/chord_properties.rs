@@ -500,9 +500,13 @@ proptest! {
             Err(error) => panic!("{}: {}", error.code().as_str(), error.message()),
         };
         let (fast, oracle) = (answer.stats.blocks, reference.stats.blocks);
-        // chord.md §2.9a item 3; a count of a few hundred blocks may differ by one where the
-        // two numerics round a window's last chord differently.
-        let allowed = (0.005 * oracle as f64).floor().clamp(1.0, 2.0) as usize;
+        // chord.md §2.9a item 3, read as 0.5 % with at least one block of slack (the issue's "the
+        // block count within 0.5 %"). Not capped at 2: in window mode a chord ending within 1e-8
+        // mm of its window's end goes to one window or the next by rounding, and every later
+        // window shifts, so a count of thousands drifts by a few blocks between any two numerics
+        // (a rational curve of 6 610 blocks: 3 more, the first difference a chord 1e-8 mm from a
+        // window end, found by this test; 0.05 %).
+        let allowed = (0.005 * oracle as f64).floor().max(1.0) as usize;
         prop_assert!(fast <= oracle + allowed, "{} blocks, the reference greedy {}", fast, oracle);
         let curve = Spline::new(degree, control, weights);
         let target = target_chord(&answer);
