@@ -10,11 +10,9 @@
 //! square is a polynomial of degree 6: its interior maxima are roots of a cubic, found exactly.
 
 use super::nurbs::CubicPiece;
+use super::polynomial::{bracketed_root, quadratic_roots};
 use crate::geometry::Vec3;
 
-/// Most Newton or bisection steps for a root of the cubic (bisection alone halves the bracket
-/// to 2⁻⁶⁰ of the chord).
-const ROOT_STEPS: usize = 60;
 /// A root is found when a Newton step moves it less than this fraction of its bracket: f is
 /// flat at its maximum, so the value is then exact to about the square of it, 1e-20.
 const ROOT_WIDTH: f64 = 1e-10;
@@ -125,7 +123,7 @@ fn largest_from_end([c1, c2, c3]: [Vec3; 3], direction: &Vec3, extent: f64) -> O
     match changes {
         0 => Some(h(extent)),
         1 if q[0] > 0.0 && q_at(extent) < 0.0 => {
-            let peak = root(&q_at, &q_slope, 0.0, extent, q[0]);
+            let peak = bracketed_root(&q_at, &q_slope, 0.0, extent, q[0], ROOT_WIDTH);
             Some(h(peak).max(h(extent)))
         }
         1 => Some(h(extent)),
@@ -180,60 +178,9 @@ fn largest_hump(w: f64, alpha: f64, beta: f64, gamma: f64) -> f64 {
         if g_left.signum() * g_right.signum() > 0.0 {
             continue;
         }
-        best = best.max(hump(root(&g, &slope, left, right, g_left)));
+        best = best.max(hump(bracketed_root(&g, &slope, left, right, g_left, ROOT_WIDTH)));
     }
     best
-}
-
-/// The real roots of a·x² + b·x + c (none, one or two, in no order); a linear equation when
-/// a = 0.
-fn quadratic_roots(a: f64, b: f64, c: f64) -> impl Iterator<Item = f64> {
-    let mut roots = [f64::NAN; 2];
-    if a == 0.0 {
-        if b != 0.0 {
-            roots[0] = -c / b;
-        }
-    } else {
-        let discriminant = b * b - 4.0 * a * c;
-        if discriminant >= 0.0 {
-            // The form without cancellation: q = −(b + sign(b)·√D)/2, roots q/a and c/q.
-            let q = -0.5 * (b + b.signum() * discriminant.sqrt());
-            roots[0] = q / a;
-            if q != 0.0 {
-                roots[1] = c / q;
-            }
-        }
-    }
-    roots.into_iter().filter(|x| x.is_finite())
-}
-
-/// The root of a function monotone on [left, right] whose ends' values differ in sign (or one
-/// is zero): Newton steps kept inside the bracket, bisection where a step leaves it.
-fn root(g: &impl Fn(f64) -> f64, slope: &impl Fn(f64) -> f64, left: f64, right: f64, g_left: f64) -> f64 {
-    let rising = g_left < 0.0;
-    let (mut lo, mut hi) = (left, right);
-    let mut x = 0.5 * (lo + hi);
-    for _ in 0..ROOT_STEPS {
-        let value = g(x);
-        if value == 0.0 {
-            return x;
-        }
-        if (value < 0.0) == rising {
-            lo = x;
-        } else {
-            hi = x;
-        }
-        let step = value / slope(x);
-        if step.abs() <= ROOT_WIDTH * (right - left) {
-            return x; // converged: a smaller step could round onto a bracket end
-        }
-        let newton = x - step;
-        x = if newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
-        if hi - lo <= ROOT_WIDTH * (right - left) {
-            return x;
-        }
-    }
-    x
 }
 
 #[cfg(test)]
