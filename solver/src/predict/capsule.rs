@@ -92,6 +92,14 @@ impl Capsule {
             let c = apx * apx + apy * apy - along * along - r2;
             let disc = half_b * half_b - self.denom * c;
             if disc >= 0.0 {
+                // The capsule lies inside the infinite cylinder, so when the ray enters that at or
+                // above `top` (t ≥ top − a.z) it enters the capsule no lower: the common case for
+                // the neighbouring pass's capsules over an open point, decided without the square
+                // root or the end spheres. t ≥ top − a.z ⟺ w = −half_b − denom·(top − a.z) ≥ √disc.
+                let w = -half_b - self.denom * (top - self.a.z);
+                if w >= 0.0 && w * w >= disc {
+                    return None;
+                }
                 let t = (-half_b - disc.sqrt()) * self.inverse_denom;
                 let foot = along + t * self.axis.z;
                 if (0.0..=self.length).contains(&foot) {
@@ -245,6 +253,39 @@ mod tests {
                             // Grazing rays may differ by the brute-force step.
                             let d = capsule.distance_xy(x, y);
                             assert!((d - r).abs() < 1e-3, "{e:?} vs {f:?} at distance {d}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The early exits of `entry_z_up_to` (the lowest-point bound and the cylinder's entry) give
+    /// up only where the entry is at or above `top`, and otherwise the entry itself.
+    #[test]
+    fn entry_up_to_agrees_with_entry() {
+        let r = 2.0;
+        let segments = [
+            (Vec3::new(0.0, 0.0, 0.0), Vec3::new(5.0, 1.0, 2.0)),
+            (Vec3::new(1.0, 1.0, 1.0), Vec3::new(1.0, 1.0, 4.0)),
+            (Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 0.0)),
+            (Vec3::new(-1.0, 2.0, 3.0), Vec3::new(3.0, -2.0, 3.0)),
+            (Vec3::new(0.5, -0.5, 1.0), Vec3::new(1.0, 0.0, 0.8)),
+        ];
+        for (a, b) in segments {
+            let capsule = Capsule::new(a, b);
+            for i in 0..25 {
+                for j in 0..25 {
+                    let x = -3.0 + 0.41 * f64::from(i);
+                    let y = -4.0 + 0.43 * f64::from(j);
+                    let entry = capsule.entry_z(x, y, r * r);
+                    for k in 0..40 {
+                        let top = -3.0 + 0.2 * f64::from(k);
+                        match (capsule.entry_z_up_to(x, y, r * r, top), entry) {
+                            (Some(e), Some(f)) => assert_eq!(e, f),
+                            (None, Some(f)) => assert!(f >= top, "{f} < {top} at ({x}, {y})"),
+                            (None, None) => {}
+                            (Some(e), None) => panic!("{e} without an entry at ({x}, {y})"),
                         }
                     }
                 }
