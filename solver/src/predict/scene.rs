@@ -324,12 +324,23 @@ impl Scene {
             return None;
         }
         // Capsules whose lowest point over q lies more than 2ε above it are skipped before the
-        // square root (neither hidden nor a tie, so the same answer).
-        Some(match capsule.entry_z_up_to(q.x, q.y, self.r2, q.z + 2.0 * self.eps) {
+        // square root (neither hidden nor a tie, so the same answer): most by the bound of their
+        // infinite cylinder, the rest by the bounds in `entry_z_up_to`.
+        let top = q.z + 2.0 * self.eps;
+        if capsule.cylinder_at_or_above(q.x, q.y, self.r2, top) {
+            return Some(Cover::Open);
+        }
+        Some(self.cover_by_entry(capsule.entry_z_up_to(q.x, q.y, self.r2, top), q))
+    }
+
+    /// How a ray that enters a capsule at `entry` (if at all) covers `q`.
+    #[inline(always)]
+    fn cover_by_entry(&self, entry: Option<f64>, q: &Vec3) -> Cover {
+        match entry {
             Some(entry) if entry < q.z - self.eps => Cover::Hidden,
             Some(entry) if entry <= q.z + self.eps => Cover::Tie,
             _ => Cover::Open,
-        })
+        }
     }
 
     /// Whether the T1 capsule at position `hint` of `list` hides `q`: the first test of
@@ -339,7 +350,12 @@ impl Scene {
     /// caller treats alike).
     #[inline]
     pub(crate) fn hidden_at_hint(&self, q: &Vec3, list: &[u32], hint: usize) -> bool {
-        list.get(hint).is_some_and(|&index| self.capsule_cover(&self.before[index as usize], q) == Some(Cover::Hidden))
+        // Without the cylinder's bound of the scan: the capsule that hid the previous point
+        // nearly always hides this one too.
+        list.get(hint).is_some_and(|&index| {
+            let entry = self.before[index as usize].entry_z_up_to(q.x, q.y, self.r2, q.z + 2.0 * self.eps);
+            self.cover_by_entry(entry, q) == Cover::Hidden
+        })
     }
 
     /// Whether one listed T1 capsule hides every point of the frame box `[lo, hi]`: the box lies
