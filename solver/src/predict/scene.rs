@@ -167,8 +167,12 @@ impl Scene {
         let before_count = pieces.iter().filter(|p| p.side == Side::Before).count();
         let mut before = Vec::with_capacity(before_count);
         let mut after = Vec::with_capacity(pieces.len() - before_count);
+        // The machine frame (the common case) needs no product: 1·x + 0·y + 0·z is x (up to the
+        // sign of a zero).
+        let machine = rotation == Matrix3::identity();
+        let to_frame = |p: &Vec3| if machine { p - centre } else { rotation * (p - centre) };
         for piece in pieces {
-            let capsule = Capsule::new(rotation * (piece.a - centre), rotation * (piece.b - centre));
+            let capsule = Capsule::new(to_frame(&piece.a), to_frame(&piece.b));
             match piece.side {
                 Side::Before => before.push(capsule),
                 Side::After => after.push(capsule),
