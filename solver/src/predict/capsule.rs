@@ -27,6 +27,10 @@ pub(crate) struct Capsule {
     /// along the view).
     denom: f64,
     inverse_denom: f64,
+    /// Unit xy direction of the axis and its rise per unit of xy length (zeros for a segment along
+    /// the view), for [`Self::cylinder_at_or_above`].
+    unit_xy: (f64, f64),
+    slope: f64,
     /// Lowest z of the axis segment.
     pub(crate) min_z: f64,
 }
@@ -39,6 +43,7 @@ impl Capsule {
         let denom = 1.0 - axis.z * axis.z;
         let denom = if length > 0.0 && denom > 1e-12 { denom } else { 0.0 };
         let length_xy2 = ab.x * ab.x + ab.y * ab.y;
+        let inverse_cos_tilt = if denom > 0.0 { 1.0 / denom.sqrt() } else { 0.0 };
         Self {
             a,
             b,
@@ -48,6 +53,8 @@ impl Capsule {
             inverse_xy: if length_xy2 > 0.0 { 1.0 / length_xy2 } else { 0.0 },
             denom,
             inverse_denom: if denom > 0.0 { 1.0 / denom } else { 0.0 },
+            unit_xy: (axis.x * inverse_cos_tilt, axis.y * inverse_cos_tilt),
+            slope: axis.z * inverse_cos_tilt,
             min_z: a.z.min(b.z),
         }
     }
@@ -108,6 +115,24 @@ impl Capsule {
             }
         }
         best.is_finite().then_some(best)
+    }
+
+    /// Whether the ray along +z through (x, y) enters the infinite cylinder about the axis (of
+    /// squared radius `r2`) at or above `top`, or misses it: then it enters the capsule, which
+    /// lies inside, no lower. The cylinder is entered at the axis's height over the foot of
+    /// (x, y) on its line less √(r2 − n²)/cos φ (n the xy distance to the line, φ the axis's
+    /// tilt, cos² φ = denom), compared squared: no square root. Never true for a segment along
+    /// the view (unit_xy and slope zero, so the squared term is 0). Always inlined: it settles
+    /// most capsules of the point test's inner loop (the neighbouring pass's capsules over an
+    /// open point), before [`Self::entry_z_up_to`].
+    #[inline(always)]
+    pub(crate) fn cylinder_at_or_above(&self, x: f64, y: f64, r2: f64, top: f64) -> bool {
+        let (apx, apy) = (x - self.a.x, y - self.a.y);
+        let (ux, uy) = self.unit_xy;
+        let (along, across) = (apx * ux + apy * uy, apy * ux - apx * uy);
+        let depth2 = r2 - across * across;
+        let rise = self.a.z + along * self.slope - top;
+        depth2 < 0.0 || (rise >= 0.0 && rise * rise * self.denom >= depth2)
     }
 
     /// Squared distance from `p` to the axis segment.
@@ -250,6 +275,45 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The early exits of `entry_z_up_to` (the lowest-point bound) and the cylinder's bound give
+    /// up only where the entry is at or above `top`; otherwise `entry_z_up_to` is the entry.
+    #[test]
+    fn early_exits_agree_with_entry() {
+        let r = 2.0;
+        let mut cylinder_decided = 0;
+        let segments = [
+            (Vec3::new(0.0, 0.0, 0.0), Vec3::new(5.0, 1.0, 2.0)),
+            (Vec3::new(1.0, 1.0, 1.0), Vec3::new(1.0, 1.0, 4.0)),
+            (Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 0.0)),
+            (Vec3::new(-1.0, 2.0, 3.0), Vec3::new(3.0, -2.0, 3.0)),
+            (Vec3::new(0.5, -0.5, 1.0), Vec3::new(1.0, 0.0, 0.8)),
+        ];
+        for (a, b) in segments {
+            let capsule = Capsule::new(a, b);
+            for i in 0..25 {
+                for j in 0..25 {
+                    let x = -3.0 + 0.41 * f64::from(i);
+                    let y = -4.0 + 0.43 * f64::from(j);
+                    let entry = capsule.entry_z(x, y, r * r);
+                    for k in 0..40 {
+                        let top = -3.0 + 0.2 * f64::from(k);
+                        if capsule.cylinder_at_or_above(x, y, r * r, top) {
+                            cylinder_decided += 1;
+                            assert!(entry.is_none_or(|f| f >= top), "{entry:?} < {top} at ({x}, {y})");
+                        }
+                        match (capsule.entry_z_up_to(x, y, r * r, top), entry) {
+                            (Some(e), Some(f)) => assert_eq!(e, f),
+                            (None, Some(f)) => assert!(f >= top, "{f} < {top} at ({x}, {y})"),
+                            (None, None) => {}
+                            (Some(e), None) => panic!("{e} without an entry at ({x}, {y})"),
+                        }
+                    }
+                }
+            }
+        }
+        assert!(cylinder_decided > 1000, "{cylinder_decided}");
     }
 
     #[test]

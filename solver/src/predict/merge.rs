@@ -104,6 +104,7 @@ pub(crate) fn neighbourhood(
             reach: 2.0 * radius,
             any_view: false,
             order: scene::PieceOrder::Path,
+            stock_top: f64::INFINITY,
         },
         scratch,
         &mut pieces,

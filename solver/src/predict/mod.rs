@@ -176,6 +176,7 @@ fn rapid_collisions(job: &Job) -> Option<Warning> {
                 reach: 0.5 * segment.length + 2.0 * radius,
                 any_view: true,
                 order: scene::PieceOrder::Height,
+                stock_top: f64::INFINITY,
             },
             &mut scratch,
             &mut pieces,

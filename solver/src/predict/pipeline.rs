@@ -355,6 +355,9 @@ fn predict_pass_with(
                 reach: 2.0 * radius,
                 any_view: false,
                 order: PieceOrder::Height,
+                stock_top: job
+                    .stock
+                    .highest_top([centre.x - radius, centre.y - radius], [centre.x + radius, centre.y + radius]),
             },
             scratch,
             &mut pieces,
@@ -598,6 +601,7 @@ fn depth_buffer(
             reach: 5.0 * radius,
             any_view: true,
             order: PieceOrder::Path,
+            stock_top: f64::INFINITY,
         },
         scratch,
         &mut wide,

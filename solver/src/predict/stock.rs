@@ -1,6 +1,7 @@
 //! The stock W before the analysed operation (error-prediction.md §1.2 I1, §3.5): analytic solids
 //! (box, half-space under a plane, cylinder), a height grid, or a closed STL mesh; point
-//! membership and a conservative classification of boxes used to skip whole tiles of samples.
+//! membership, a conservative classification of boxes used to skip whole tiles of samples, and a
+//! bound of the top under the ball that narrows the motion a scene gathers.
 
 use crate::error::ErrorCode;
 use serde::{Deserialize, Serialize};
@@ -16,6 +17,9 @@ pub const MAX_GRID_NODES: usize = 4_000_000;
 const BLOCK: usize = 8;
 /// Most nodes a box classification reads one by one (more: the blocks' extremes).
 const MAX_RANGE_NODES: usize = 25;
+/// Most nodes [`StockModel::highest_top`] reads one by one: a ball's footprint at the usual grid
+/// spacings (blocks reach up to 8 nodes beyond it, a far looser bound on a slope).
+const MAX_TOP_NODES: usize = 4096;
 
 /// The stock as the client describes it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -162,7 +166,7 @@ impl HeightGrid {
     /// Lowest and highest node heights that bound the surface over the rectangle: the nodes of
     /// the cells it meets when they are few (a tile of samples or pixels spans a handful), the
     /// per-block extremes otherwise.
-    fn range(&self, lo: [f64; 2], hi: [f64; 2]) -> (f64, f64) {
+    fn range(&self, lo: [f64; 2], hi: [f64; 2], max_nodes: usize) -> (f64, f64) {
         let index = |v: f64, origin: f64, count: usize| ((v - origin) / self.spacing).clamp(0.0, (count - 1) as f64);
         // The indices are ≥ 0 (and < 2³²), so truncation is the floor and one more where it cut a
         // fraction is the ceiling (without libm calls on baseline x86-64).
@@ -173,7 +177,7 @@ impl HeightGrid {
         let j0 = floor(index(lo[1], self.origin[1], self.ny));
         let j1 = ceil(index(hi[1], self.origin[1], self.ny));
         let (mut low, mut high) = (f64::INFINITY, f64::NEG_INFINITY);
-        if (i1 - i0 + 1) * (j1 - j0 + 1) <= MAX_RANGE_NODES {
+        if (i1 - i0 + 1) * (j1 - j0 + 1) <= max_nodes {
             for j in j0..=j1 {
                 for &h in &self.heights[j * self.nx + i0..=j * self.nx + i1] {
                     low = low.min(h);
@@ -367,7 +371,7 @@ impl StockModel {
                 if hi.x < a[0] || lo.x > b[0] || hi.y < a[1] || lo.y > b[1] || hi.z <= grid.bottom {
                     return Region::Outside;
                 }
-                let (low, high) = grid.range([lo.x, lo.y], [hi.x, hi.y]);
+                let (low, high) = grid.range([lo.x, lo.y], [hi.x, hi.y], MAX_RANGE_NODES);
                 let footprint_inside = lo.x > a[0] && hi.x < b[0] && lo.y > a[1] && hi.y < b[1];
                 if lo.z >= high - margin {
                     Region::Outside
@@ -386,6 +390,16 @@ impl StockModel {
                     Region::Outside
                 }
             }
+        }
+    }
+
+    /// An upper bound of the z of the material over the xy rectangle `[lo, hi]` (∞ where no
+    /// cheap one is known: the solids other than a box or a height grid).
+    pub(crate) fn highest_top(&self, lo: [f64; 2], hi: [f64; 2]) -> f64 {
+        match self {
+            Self::Box { hi: top, .. } => top.z,
+            Self::Grid(grid) => grid.range(lo, hi, MAX_TOP_NODES).1,
+            Self::Plane { .. } | Self::Cylinder { .. } | Self::Mesh(_) => f64::INFINITY,
         }
     }
 
