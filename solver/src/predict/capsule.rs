@@ -246,31 +246,38 @@ mod tests {
         None
     }
 
-    #[test]
-    fn capsule_entry_matches_brute_force() {
-        let r = 2.0;
-        let segments = [
+    /// Axis segments for the entry tests: tilted, vertical, a point, level, and a short one
+    /// sloping down.
+    fn test_segments() -> [(Vec3, Vec3); 5] {
+        [
             (Vec3::new(0.0, 0.0, 0.0), Vec3::new(5.0, 1.0, 2.0)),
             (Vec3::new(1.0, 1.0, 1.0), Vec3::new(1.0, 1.0, 4.0)),
             (Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 0.0)),
             (Vec3::new(-1.0, 2.0, 3.0), Vec3::new(3.0, -2.0, 3.0)),
-        ];
-        for (a, b) in segments {
+            (Vec3::new(0.5, -0.5, 1.0), Vec3::new(1.0, 0.0, 0.8)),
+        ]
+    }
+
+    /// A 25 × 25 grid of ray positions (x, y) around the segments.
+    fn probe_grid() -> impl Iterator<Item = (f64, f64)> {
+        (0..25).flat_map(|i| (0..25).map(move |j| (-3.0 + 0.41 * f64::from(i), -4.0 + 0.43 * f64::from(j))))
+    }
+
+    #[test]
+    fn capsule_entry_matches_brute_force() {
+        let r = 2.0;
+        for &(a, b) in &test_segments()[..4] {
             let capsule = Capsule::new(a, b);
-            for i in 0..25 {
-                for j in 0..25 {
-                    let x = -3.0 + 0.41 * f64::from(i);
-                    let y = -4.0 + 0.43 * f64::from(j);
-                    let exact = capsule.entry_z(x, y, r * r);
-                    let brute = brute_entry(&a, &b, x, y, r);
-                    match (exact, brute) {
-                        (Some(e), Some(f)) => assert!((e - f).abs() < 2e-4, "{e} vs {f}"),
-                        (None, None) => {}
-                        (e, f) => {
-                            // Grazing rays may differ by the brute-force step.
-                            let d = capsule.distance_xy(x, y);
-                            assert!((d - r).abs() < 1e-3, "{e:?} vs {f:?} at distance {d}");
-                        }
+            for (x, y) in probe_grid() {
+                let exact = capsule.entry_z(x, y, r * r);
+                let brute = brute_entry(&a, &b, x, y, r);
+                match (exact, brute) {
+                    (Some(e), Some(f)) => assert!((e - f).abs() < 2e-4, "{e} vs {f}"),
+                    (None, None) => {}
+                    (e, f) => {
+                        // Grazing rays may differ by the brute-force step.
+                        let d = capsule.distance_xy(x, y);
+                        assert!((d - r).abs() < 1e-3, "{e:?} vs {f:?} at distance {d}");
                     }
                 }
             }
@@ -283,32 +290,21 @@ mod tests {
     fn early_exits_agree_with_entry() {
         let r = 2.0;
         let mut cylinder_decided = 0;
-        let segments = [
-            (Vec3::new(0.0, 0.0, 0.0), Vec3::new(5.0, 1.0, 2.0)),
-            (Vec3::new(1.0, 1.0, 1.0), Vec3::new(1.0, 1.0, 4.0)),
-            (Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 0.0)),
-            (Vec3::new(-1.0, 2.0, 3.0), Vec3::new(3.0, -2.0, 3.0)),
-            (Vec3::new(0.5, -0.5, 1.0), Vec3::new(1.0, 0.0, 0.8)),
-        ];
-        for (a, b) in segments {
+        for (a, b) in test_segments() {
             let capsule = Capsule::new(a, b);
-            for i in 0..25 {
-                for j in 0..25 {
-                    let x = -3.0 + 0.41 * f64::from(i);
-                    let y = -4.0 + 0.43 * f64::from(j);
-                    let entry = capsule.entry_z(x, y, r * r);
-                    for k in 0..40 {
-                        let top = -3.0 + 0.2 * f64::from(k);
-                        if capsule.cylinder_at_or_above(x, y, r * r, top) {
-                            cylinder_decided += 1;
-                            assert!(entry.is_none_or(|f| f >= top), "{entry:?} < {top} at ({x}, {y})");
-                        }
-                        match (capsule.entry_z_up_to(x, y, r * r, top), entry) {
-                            (Some(e), Some(f)) => assert_eq!(e, f),
-                            (None, Some(f)) => assert!(f >= top, "{f} < {top} at ({x}, {y})"),
-                            (None, None) => {}
-                            (Some(e), None) => panic!("{e} without an entry at ({x}, {y})"),
-                        }
+            for (x, y) in probe_grid() {
+                let entry = capsule.entry_z(x, y, r * r);
+                for k in 0..40 {
+                    let top = -3.0 + 0.2 * f64::from(k);
+                    if capsule.cylinder_at_or_above(x, y, r * r, top) {
+                        cylinder_decided += 1;
+                        assert!(entry.is_none_or(|f| f >= top), "{entry:?} < {top} at ({x}, {y})");
+                    }
+                    match (capsule.entry_z_up_to(x, y, r * r, top), entry) {
+                        (Some(e), Some(f)) => assert_eq!(e, f),
+                        (None, Some(f)) => assert!(f >= top, "{f} < {top} at ({x}, {y})"),
+                        (None, None) => {}
+                        (Some(e), None) => panic!("{e} without an entry at ({x}, {y})"),
                     }
                 }
             }
