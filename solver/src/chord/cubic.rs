@@ -21,30 +21,81 @@ const ROOT_WIDTH: f64 = 1e-10;
 /// `None` where a point of the piece might project beyond the segment's ends (then its distance
 /// from the segment is not its distance from the line: the caller samples instead).
 pub(crate) fn deviation(piece: &CubicPiece) -> Option<f64> {
-    let [_, _, a2, a3] = piece.coefficients;
-    let point = |t: f64| {
-        let [c0, c1, c2, c3] = piece.coefficients;
+    Some(Chord::of(piece)?.deviation)
+}
+
+/// [`deviation`] with its rate of change as the chord's end `t_hi` moves along the curve, per unit
+/// of the piece's parameter: the chord search steps to the chord error by Newton with it.
+///
+/// The farthest point P* stays the farthest to first order (it is an interior maximum), so the
+/// rate is that of the distance of the fixed P* from the line A–B as B moves with P′(t_hi):
+/// with u = B − A, n = P* − A and m = n × u, D = |m|/|u| and
+/// dD = m·(n × P′)/(|m|·|u|) − |m|·(u·P′)/|u|³. `None` as for [`deviation`], and where the
+/// piece is straight (D = 0: the rate has no direction).
+pub(crate) fn deviation_with_rate(piece: &CubicPiece) -> Option<(f64, f64)> {
+    let chord = Chord::of(piece)?;
+    let [_, a1, a2, a3] = piece.coefficients;
+    let t_hi = piece.t_hi;
+    let velocity = a1 + t_hi * (2.0 * a2 + 3.0 * a3 * t_hi);
+    let peak_from_start = piece.point(chord.peak) - piece.point(piece.t_lo);
+    let rate = rate_of_distance(&peak_from_start, &(chord.end - chord.start), &velocity)?;
+    Some((chord.deviation, rate))
+}
+
+/// The rate of the distance of a fixed point from the line A–B as B moves with `velocity`, with
+/// `from_start` = point − A and `along` = B − A (see [`deviation_with_rate`]); `None` for a point
+/// on the line.
+fn rate_of_distance(from_start: &Vec3, along: &Vec3, velocity: &Vec3) -> Option<f64> {
+    let m = from_start.cross(along);
+    let (m_norm, length) = (m.norm(), along.norm());
+    if !(m_norm > 0.0 && length > 0.0) {
+        return None;
+    }
+    let rate = m.dot(&from_start.cross(velocity)) / (m_norm * length) - m_norm * along.dot(velocity) / length.powi(3);
+    rate.is_finite().then_some(rate)
+}
+
+impl CubicPiece {
+    fn point(&self, t: f64) -> Vec3 {
+        let [c0, c1, c2, c3] = self.coefficients;
         c0 + t * (c1 + t * (c2 + t * c3))
-    };
-    let (t_a, t_b) = (piece.t_lo, piece.t_hi);
-    let chord = point(t_b) - point(t_a);
-    let length = chord.norm();
-    if !(length > 0.0 && length.is_finite()) {
-        return None;
     }
-    let direction = chord / length;
-    let q_of = |t: f64| a2 + a3 * (t_a + t_b + t);
-    let width = t_b - t_a;
-    // The projection of P(t) on the chord is L·τ − width²·τ(1 − τ)·(Q·d) with τ = (t − t_a)/width:
-    // inside [0, L] for every τ when width²·max|Q·d| ≤ L (Q·d is affine: largest at an end).
-    let along = q_of(t_a).dot(&direction).abs().max(q_of(t_b).dot(&direction).abs());
-    if width * width * along > length {
-        return None;
+}
+
+/// A chord of a piece measured exactly: its ends, its deviation and where the curve is farthest.
+struct Chord {
+    start: Vec3,
+    end: Vec3,
+    deviation: f64,
+    /// Local parameter of the farthest point.
+    peak: f64,
+}
+
+impl Chord {
+    fn of(piece: &CubicPiece) -> Option<Self> {
+        let [_, _, a2, a3] = piece.coefficients;
+        let (t_a, t_b) = (piece.t_lo, piece.t_hi);
+        let (start, end) = (piece.point(t_a), piece.point(t_b));
+        let chord = end - start;
+        let length = chord.norm();
+        if !(length > 0.0 && length.is_finite()) {
+            return None;
+        }
+        let direction = chord / length;
+        let q_of = |t: f64| a2 + a3 * (t_a + t_b + t);
+        let width = t_b - t_a;
+        // The projection of P(t) on the chord is L·τ − width²·τ(1 − τ)·(Q·d) with τ = (t − t_a)/width:
+        // inside [0, L] for every τ when width²·max|Q·d| ≤ L (Q·d is affine: largest at an end).
+        let along = q_of(t_a).dot(&direction).abs().max(q_of(t_b).dot(&direction).abs());
+        if width * width * along > length {
+            return None;
+        }
+        let half = 0.5 * width;
+        let q0: Vec3 = q_of(t_a + half).cross(&direction);
+        let q1: Vec3 = a3.cross(&direction);
+        let (deviation, x) = largest_hump(half, q0.dot(&q0), q0.dot(&q1), q1.dot(&q1));
+        Some(Self { start, end, deviation, peak: t_a + half + x })
     }
-    let half = 0.5 * width;
-    let q0: Vec3 = q_of(t_a + half).cross(&direction);
-    let q1: Vec3 = a3.cross(&direction);
-    Some(largest_hump(half, q0.dot(&q0), q0.dot(&q1), q1.dot(&q1)))
 }
 
 /// The largest distance from the segment `a`–`b` of a chord that crosses one knot: `first` runs
@@ -58,33 +109,55 @@ pub(crate) fn deviation(piece: &CubicPiece) -> Option<f64> {
 /// q = |V|² + x·V·V′. The signs of q's Bernstein coefficients on the piece bound its roots
 /// (variation diminishing): none, h grows to the knot; one, h peaks at q's one root there.
 pub(crate) fn deviation_across_knot(first: &CubicPiece, second: &CubicPiece, a: &Vec3, b: &Vec3) -> Option<f64> {
+    Some(across_knot(first, second, a, b)?.0)
+}
+
+/// [`deviation_across_knot`] with its rate as the chord's end moves along `second`, per unit of
+/// `second`'s parameter (as [`deviation_with_rate`]).
+pub(crate) fn deviation_across_knot_with_rate(
+    first: &CubicPiece,
+    second: &CubicPiece,
+    a: &Vec3,
+    b: &Vec3,
+) -> Option<(f64, f64)> {
+    let (deviation, peak_from_start, velocity) = across_knot(first, second, a, b)?;
+    Some((deviation, rate_of_distance(&peak_from_start, &(b - a), &velocity)?))
+}
+
+/// The deviation of [`deviation_across_knot`], the farthest point less `a`, and the curve's
+/// velocity at `b` in `second`'s parameter.
+fn across_knot(first: &CubicPiece, second: &CubicPiece, a: &Vec3, b: &Vec3) -> Option<(f64, Vec3, Vec3)> {
     let chord = b - a;
     let length = chord.norm();
     if !(length > 0.0 && length.is_finite()) {
         return None;
     }
     let direction = chord / length;
-    // About t_a going forward; about t_b going backward (x = t_b − t flips the even powers).
+    // About t_a going forward; about t_b going backward (x = t_b − t flips the even powers, and
+    // P − b = −x·(c₁ + c₂x + c₃x²)).
     let [_, a1, a2, a3] = first.coefficients;
     let t = first.t_lo;
     let from_start = [a1 + t * (2.0 * a2 + 3.0 * a3 * t), a2 + 3.0 * a3 * t, a3];
     let [_, b1, b2, b3] = second.coefficients;
     let t = second.t_hi;
     let from_end = [b1 + t * (2.0 * b2 + 3.0 * b3 * t), -(b2 + 3.0 * b3 * t), b3];
-    let near_start = largest_from_end(from_start, &direction, first.t_hi - first.t_lo)?;
-    let near_end = largest_from_end(from_end, &direction, second.t_hi - second.t_lo)?;
-    Some(near_start.max(near_end).sqrt())
+    let (near_start, x_start) = largest_from_end(from_start, &direction, first.t_hi - first.t_lo)?;
+    let (near_end, x_end) = largest_from_end(from_end, &direction, second.t_hi - second.t_lo)?;
+    let offset = |[c1, c2, c3]: [Vec3; 3], x: f64| x * (c1 + x * (c2 + x * c3));
+    let peak_from_start =
+        if near_start >= near_end { offset(from_start, x_start) } else { chord - offset(from_end, x_end) };
+    Some((near_start.max(near_end).sqrt(), peak_from_start, from_end[0]))
 }
 
-/// max over x ∈ [0, extent] of h(x) = x²·|(c₁ + c₂x + c₃x²) × d|² (see [`deviation_across_knot`]);
-/// `None` when the piece does not move steadily away from its end along d (its projection on the
+/// max over x ∈ [0, extent] of h(x) = x²·|(c₁ + c₂x + c₃x²) × d|² (see [`deviation_across_knot`])
+/// and the x where it is; `None` when the piece does not move steadily away from its end along d (its projection on the
 /// chord could leave the segment) or when q may have more than one root.
-fn largest_from_end([c1, c2, c3]: [Vec3; 3], direction: &Vec3, extent: f64) -> Option<f64> {
+fn largest_from_end([c1, c2, c3]: [Vec3; 3], direction: &Vec3, extent: f64) -> Option<(f64, f64)> {
     if extent.is_nan() {
         return None;
     }
     if extent <= 0.0 {
-        return Some(0.0);
+        return Some((0.0, 0.0));
     }
     // The projection x·(c₁ + c₂x + c₃x²)·d must grow with x: its slope is a quadratic ≥ 0.
     let slope = [c1.dot(direction), 2.0 * c2.dot(direction), 3.0 * c3.dot(direction)];
@@ -120,13 +193,15 @@ fn largest_from_end([c1, c2, c3]: [Vec3; 3], direction: &Vec3, extent: f64) -> O
     }
     let q_at = |x: f64| q[0] + x * (q[1] + x * (q[2] + x * (q[3] + x * q[4])));
     let q_slope = |x: f64| q[1] + x * (2.0 * q[2] + x * (3.0 * q[3] + x * 4.0 * q[4]));
+    let at_extent = (h(extent), extent);
     match changes {
-        0 => Some(h(extent)),
+        0 => Some(at_extent),
         1 if q[0] > 0.0 && q_at(extent) < 0.0 => {
             let peak = bracketed_root(&q_at, &q_slope, 0.0, extent, q[0], ROOT_WIDTH);
-            Some(h(peak).max(h(extent)))
+            let at_peak = (h(peak), peak);
+            Some(if at_peak.0 > at_extent.0 { at_peak } else { at_extent })
         }
-        1 => Some(h(extent)),
+        1 => Some(at_extent),
         _ => None,
     }
 }
@@ -150,7 +225,7 @@ fn non_negative_quadratic([p0, p1, p2]: [f64; 3], extent: f64) -> bool {
 /// at a root of the derivative's factor g(x) = −6γx³ − 10βx² + (2γw² − 4α)x + 2βw² (from
 /// (f²)' = (w² − x²)·g(x)). g(−w) ≥ 0 ≥ g(w); g is split at its own turning points into pieces
 /// where it is monotone, and each sign change is a root.
-fn largest_hump(w: f64, alpha: f64, beta: f64, gamma: f64) -> f64 {
+fn largest_hump(w: f64, alpha: f64, beta: f64, gamma: f64) -> (f64, f64) {
     let hump = |x: f64| (w * w - x * x) * (alpha + x * (2.0 * beta + gamma * x)).max(0.0).sqrt();
     let g =
         |x: f64| ((-6.0 * gamma * x - 10.0 * beta) * x + (2.0 * gamma * w * w - 4.0 * alpha)) * x + 2.0 * beta * w * w;
@@ -170,15 +245,22 @@ fn largest_hump(w: f64, alpha: f64, beta: f64, gamma: f64) -> f64 {
     }
     breaks[count] = w;
     let breaks = &breaks[..=count];
-    let mut best = 0.0_f64;
+    let mut best = (0.0_f64, 0.0_f64);
+    let mut keep = |x: f64| {
+        let value = hump(x);
+        if value > best.0 {
+            best = (value, x);
+        }
+    };
     for pair in breaks.windows(2) {
         let (left, right) = (pair[0], pair[1]);
-        best = best.max(hump(left)).max(hump(right));
+        keep(left);
+        keep(right);
         let (g_left, g_right) = (g(left), g(right));
         if g_left.signum() * g_right.signum() > 0.0 {
             continue;
         }
-        best = best.max(hump(bracketed_root(&g, &slope, left, right, g_left, ROOT_WIDTH)));
+        keep(bracketed_root(&g, &slope, left, right, g_left, ROOT_WIDTH));
     }
     best
 }
@@ -190,15 +272,11 @@ mod tests {
 
     /// The distance from the chord by brute force: many samples of the piece.
     fn sampled(piece: &CubicPiece) -> f64 {
-        let point = |t: f64| {
-            let [c0, c1, c2, c3] = piece.coefficients;
-            c0 + t * (c1 + t * (c2 + t * c3))
-        };
-        let (a, b) = (point(piece.t_lo), point(piece.t_hi));
+        let (a, b) = (piece.point(piece.t_lo), piece.point(piece.t_hi));
         (0..=100_000)
             .map(|k| {
                 let t = piece.t_lo + (piece.t_hi - piece.t_lo) * f64::from(k) / 100_000.0;
-                crate::geometry::distance_to_segment(&point(t), &a, &b)
+                crate::geometry::distance_to_segment(&piece.point(t), &a, &b)
             })
             .fold(0.0, f64::max)
     }
@@ -237,10 +315,37 @@ mod tests {
     }
 
     #[test]
+    fn the_rate_matches_a_difference_of_deviations() {
+        // A bend, a 3-D twist, an S whose farthest point is off the middle.
+        let cases = [
+            ([Vec3::zeros(), Vec3::x(), Vec3::new(0.0, 0.3, 0.0), Vec3::zeros()], 0.1, 0.4),
+            ([Vec3::zeros(), Vec3::new(1.0, 0.2, 0.0), Vec3::new(0.0, 0.7, 0.1), Vec3::new(0.05, -0.3, 0.4)], 0.1, 0.6),
+            ([Vec3::zeros(), Vec3::x(), Vec3::new(0.0, 0.2, 0.0), Vec3::new(0.0, 0.5, 0.0)], 0.0, 0.5),
+        ];
+        for (coefficients, t_lo, t_hi) in cases {
+            let piece = CubicPiece { coefficients, t_lo, t_hi };
+            let (value, rate) = deviation_with_rate(&piece).expect("bends inside");
+            assert!((value - deviation(&piece).unwrap()).abs() < 1e-15);
+            let step = 1e-6;
+            let moved = |t_hi: f64| deviation(&CubicPiece { t_hi, ..piece }).unwrap();
+            let difference = (moved(t_hi + step) - moved(t_hi - step)) / (2.0 * step);
+            assert!((rate - difference).abs() <= 1e-6 * difference.abs(), "{rate} vs {difference}");
+        }
+    }
+
+    #[test]
+    fn a_straight_piece_has_no_rate() {
+        let piece =
+            CubicPiece { coefficients: [Vec3::zeros(), Vec3::x(), Vec3::x(), Vec3::zeros()], t_lo: 0.0, t_hi: 1.0 };
+        assert_eq!(deviation(&piece), Some(0.0));
+        assert_eq!(deviation_with_rate(&piece), None);
+    }
+
+    #[test]
     fn a_root_found_to_rounding_is_kept() {
         // Found by the chord property tests: the last Newton step rounded onto the bracket's end,
         // and the search fell back to the bracket's middle, far from the root.
-        let hump = largest_hump(0.03871972443956874, 0.36262487493168816, 5.024123675499595, 69.60862437104088);
+        let (hump, _) = largest_hump(0.03871972443956874, 0.36262487493168816, 5.024123675499595, 69.60862437104088);
         assert!((hump - 0.000_960_557_651_682_66).abs() < 1e-15, "{hump}");
     }
 
@@ -263,7 +368,7 @@ mod tests {
                 let lo = start + (end - start) * f64::from(k) / 200.0;
                 for width in [0.1, 0.4, 0.9] {
                     let hi = (lo + width * span).min(end);
-                    let Some(CubicStretch::AcrossKnot(first, second)) = curve.cubic_stretch(lo, hi) else {
+                    let Some((CubicStretch::AcrossKnot(first, second), _)) = curve.cubic_stretch(lo, hi) else {
                         continue;
                     };
                     let (a, b) = (curve.point(lo), curve.point(hi));

@@ -266,14 +266,16 @@ impl Nurbs {
     /// [lo, hi] of a polynomial curve of degree ≤ 3 as the stretches of the knot spans it lies
     /// in: one (its end may be the span's closing knot), or two when it crosses one knot; `None`
     /// for other curves and for stretches over more knots.
-    pub(crate) fn cubic_stretch(&self, lo: f64, hi: f64) -> Option<CubicStretch> {
+    /// With the stretch, dt/du of the span holding `hi` (the rate of a chord end moving there).
+    pub(crate) fn cubic_stretch(&self, lo: f64, hi: f64) -> Option<(CubicStretch, f64)> {
         if !self.is_plain_cubic() || lo >= hi || lo.is_nan() || hi.is_nan() {
             return None;
         }
+        let per_u = |span: usize| self.polynomials[span - self.degree].inverse_width;
         let span = self.span(lo);
         let knot = self.knots[span + 1];
         if hi <= knot {
-            return Some(CubicStretch::Inside(self.piece_in(span, lo, hi)));
+            return Some((CubicStretch::Inside(self.piece_in(span, lo, hi)), per_u(span)));
         }
         // The next non-empty span (a repeated knot leaves empty ones between).
         let mut next = span + 1;
@@ -283,7 +285,7 @@ impl Nurbs {
         if next >= self.weighted.len() || hi > self.knots[next + 1] {
             return None;
         }
-        Some(CubicStretch::AcrossKnot(self.piece_in(span, lo, knot), self.piece_in(next, knot, hi)))
+        Some((CubicStretch::AcrossKnot(self.piece_in(span, lo, knot), self.piece_in(next, knot, hi)), per_u(next)))
     }
 
     /// [lo, hi] inside knot span `span` of a plain cubic curve as a [`CubicPiece`].

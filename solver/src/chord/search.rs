@@ -3,6 +3,10 @@
 //!
 //! * circular arcs: the chord end in closed form from the sagitta, dev = 2r·sin²(Δs/4r);
 //! * polylines: placed on an edge where the first spanned vertex reaches C_ep (`polyline`);
+//! * plain B-splines of degree ≤ 3, a chord inside one knot span or across one knot: Newton
+//!   steps on √dev from the previous chord's step, with the deviation's rate from the envelope
+//!   theorem (`cubic`): two deviations per block nearly always, one to step and one to confirm;
+//!   the bracketed secant below takes over where Newton does not settle;
 //! * everything else: a bracketed secant (Illinois) on g(u) = √dev(u_a, u) − √C_ep, which is
 //!   nearly linear in u because the deviation grows with the square of the chord. The first
 //!   trial is the previous chord's parameter step (or the circle chord of the window radius),
@@ -18,7 +22,7 @@ use crate::error::ErrorCode;
 use std::cell::Cell;
 
 use super::segment::{CROSSING_WIDTH, EPS, Vertex};
-use super::shape::Shape;
+use super::shape::{Shape, Spline};
 use super::{polyline, reference};
 use crate::error::SolverError;
 
@@ -28,6 +32,11 @@ const EVALUATION_CAP: usize = 200;
 const AIM_INSIDE: f64 = 1e-8;
 /// Largest growth of the trial step per expansion (the model may be far off on a straight).
 const MAX_GROWTH: f64 = 4.0;
+/// Most Newton steps of [`newton_end`] before the bracketed search takes over.
+const NEWTON_STEPS: usize = 4;
+/// Newton's chord end is aimed this fraction of the chord inside the root, the middle of the
+/// stop's band (√dev within 1e-9 of √C_ep, below it): its own error is second order, far less.
+const NEWTON_INSIDE: f64 = 5e-10;
 /// The model's step is aimed this much past (expanding) or short of (shrinking) the root, so
 /// the next trial brackets it.
 const AIM: f64 = 1.02;
@@ -79,6 +88,16 @@ pub(crate) fn chord_end(
     let mut step = last_step.get();
     if step.is_nan() || step <= 0.0 {
         step = if speed > 0.0 && step_guess > 0.0 { step_guess / speed } else { limit.u - start.u };
+    }
+    if let Shape::Spline(spline) = shape {
+        match newton_end(spline, start, limit.u, root, start.u + step) {
+            Ok((end, deviation)) => {
+                last_step.set(end - start.u);
+                return Ok((end, Some(deviation)));
+            }
+            Err(Some(estimate)) => step = estimate - start.u,
+            Err(None) => {}
+        }
     }
     let mut evaluations = 0;
     // Bracket: lo fits (g ≤ 0), hi does not.
@@ -163,6 +182,44 @@ pub(crate) fn chord_end(
         return Ok((lo, None));
     }
     checked(shape, start, chord_error, limit, step_guess, (lo, known_at_lo))
+}
+
+/// Newton steps on g(u) = √dev(u) − `root` from `trial`, while the chord stays inside one knot
+/// span of a plain cubic B-spline, where its deviation and the deviation's rate are exact
+/// ([`Spline::deviation_with_rate`]): from the previous chord's step two deviations nearly
+/// always (one to step, one to confirm), against three or four for the bracketed search. The
+/// chord end and its deviation once g is within the bracketed search's stop (−1e-9·root ≤ g ≤ 0);
+/// else `Err` with the last estimate inside the limit, if any, for the bracketed search to start
+/// from (a chord across a knot, to the limit, on a piece where g does not rise).
+fn newton_end(
+    spline: &Spline,
+    start: &Vertex,
+    limit: f64,
+    root: f64,
+    mut trial: f64,
+) -> Result<(f64, f64), Option<f64>> {
+    let mut estimate = None;
+    for _ in 0..NEWTON_STEPS {
+        if !(trial > start.u && trial < limit) {
+            return Err(estimate);
+        }
+        estimate = Some(trial);
+        let Some((deviation, rate)) = spline.deviation_with_rate(start.u, trial) else {
+            return Err(estimate);
+        };
+        let value = deviation.sqrt() - root;
+        if value <= 0.0 && value >= -1e-9 * root {
+            return Ok((trial, deviation));
+        }
+        // g′ = dev′/(2√dev).
+        let slope = rate / (2.0 * deviation.sqrt());
+        if !(slope > 0.0 && slope.is_finite()) {
+            return Err(estimate);
+        }
+        let next = trial - value / slope;
+        trial = start.u + (next - start.u) * (1.0 - NEWTON_INSIDE);
+    }
+    Err(estimate)
 }
 
 /// The chord to `end` if its reference deviation fits; else a hump lay between the fast

@@ -130,9 +130,22 @@ impl Spline {
     /// The exact deviation of a chord of a plain B-spline of degree ≤ 3 inside one knot span
     /// ([`cubic::deviation`]) or across one knot ([`cubic::deviation_across_knot`]); `None`
     /// elsewhere.
+    /// [`Spline::exact_deviation`] of a chord from `ua` to `ub > ua`, with its rate of change per
+    /// unit of u as `ub` moves ([`cubic::deviation_with_rate`]); `None` where that is `None`.
+    pub(crate) fn deviation_with_rate(&self, ua: f64, ub: f64) -> Option<(f64, f64)> {
+        let (stretch, per_u) = self.nurbs.cubic_stretch(ua, ub)?;
+        let (deviation, rate) = match stretch {
+            CubicStretch::Inside(piece) => cubic::deviation_with_rate(&piece)?,
+            CubicStretch::AcrossKnot(first, second) => {
+                cubic::deviation_across_knot_with_rate(&first, &second, &self.nurbs.point(ua), &self.nurbs.point(ub))?
+            }
+        };
+        Some((deviation, rate * per_u))
+    }
+
     fn exact_deviation(&self, ua: f64, ub: f64) -> Option<f64> {
         let (lo, hi) = (ua.min(ub), ua.max(ub));
-        match self.nurbs.cubic_stretch(lo, hi)? {
+        match self.nurbs.cubic_stretch(lo, hi)?.0 {
             CubicStretch::Inside(piece) => cubic::deviation(&piece),
             CubicStretch::AcrossKnot(first, second) => {
                 cubic::deviation_across_knot(&first, &second, &self.nurbs.point(lo), &self.nurbs.point(hi))
@@ -833,6 +846,46 @@ mod tests {
         ] {
             assert!(deviation >= dense * (1.0 - 1e-6), "{what}: {deviation} below {dense}");
         }
+    }
+
+    #[test]
+    fn the_deviation_rate_matches_a_difference_inside_a_span_and_across_a_knot() {
+        // A plain cubic B-spline through a wavy 3-D polygon; chords from a third to eight tenths of
+        // a span, the end moved a little either way (staying on its side of a knot).
+        let control: Vec<Vec3> = (0..12)
+            .map(|k| {
+                let k = f64::from(k);
+                Vec3::new(10.0 * k, 6.0 * (0.9 * k).sin(), 2.0 * (0.5 * k).cos())
+            })
+            .collect();
+        let nurbs = Nurbs::new(3, &control, None, None, "curve").unwrap();
+        let breaks: Vec<f64> = nurbs.breaks().iter().map(|(knot, _)| *knot).collect();
+        let table = ArcLengthTable::build(&|u| nurbs.speed(u), &breaks, 4, "curve").unwrap();
+        let spline = Spline::new(nurbs, table);
+        let span = 1.0 / 9.0;
+        let (mut inside, mut across) = (0, 0);
+        for k in 0..100 {
+            let lo = 0.9 * f64::from(k) / 100.0;
+            for width in [0.3, 0.8] {
+                let hi = lo + width * span;
+                let Some((deviation, rate)) = spline.deviation_with_rate(lo, hi) else { continue };
+                let step = 1e-7;
+                let knot = breaks.iter().any(|&knot| knot > lo && knot < hi);
+                if breaks.iter().any(|&knot| (knot - hi).abs() < 2.0 * step) {
+                    continue;
+                }
+                let moved = |end: f64| spline.exact_deviation(lo, end).unwrap();
+                let difference = (moved(hi + step) - moved(hi - step)) / (2.0 * step);
+                assert_eq!(deviation, moved(hi));
+                assert!((rate - difference).abs() <= 1e-5 * difference.abs(), "[{lo}, {hi}]: {rate} vs {difference}");
+                if knot {
+                    across += 1;
+                } else {
+                    inside += 1;
+                }
+            }
+        }
+        assert!(inside > 50 && across > 50, "{inside} inside, {across} across a knot");
     }
 
     fn ellipse() -> Shape {
