@@ -2,8 +2,9 @@
 //! B-spline span (chord.md §2.9a: "curvature bounds ... of a NURBS span" and exact chord
 //! deviations): the roots of the derivative split the interval into pieces where the polynomial
 //! is monotone, and each piece whose ends differ in sign holds one root, found by Newton steps
-//! kept inside the bracket (bisection where a step leaves it). No sampling, so no root between
-//! samples is missed.
+//! kept inside the bracket (bisection where a step leaves it); first, the signs of the Bernstein
+//! coefficients on the interval settle the common cases of no root and of one. No sampling, so
+//! no root between samples is missed.
 
 /// Highest degree handled (the radius of curvature of a cubic span leads to degree 7).
 pub(crate) const MAX_DEGREE: usize = 8;
@@ -59,33 +60,6 @@ impl Polynomial {
         Self { coefficients: all, degree }
     }
 
-    /// p · q (degrees adding up to at most [`MAX_DEGREE`]; higher terms are dropped).
-    pub(crate) fn times(&self, other: &Self) -> Self {
-        let mut product = [0.0; MAX_DEGREE + 1];
-        for (i, &a) in self.coefficients[..=self.degree].iter().enumerate() {
-            for (j, &b) in other.coefficients[..=other.degree].iter().enumerate() {
-                if i + j <= MAX_DEGREE {
-                    product[i + j] += a * b;
-                }
-            }
-        }
-        Self::new(&product)
-    }
-
-    /// factor · p.
-    pub(crate) fn scaled(&self, factor: f64) -> Self {
-        Self::new(&self.coefficients.map(|c| factor * c))
-    }
-
-    /// p + factor · q.
-    pub(crate) fn plus_scaled(&self, factor: f64, other: &Self) -> Self {
-        let mut sum = self.coefficients;
-        for (total, &c) in sum.iter_mut().zip(&other.coefficients) {
-            *total += factor * c;
-        }
-        Self::new(&sum)
-    }
-
     pub(crate) fn value(&self, x: f64) -> f64 {
         self.coefficients[..=self.degree].iter().rev().fold(0.0, |sum, &c| sum * x + c)
     }
@@ -129,6 +103,16 @@ impl Polynomial {
             return roots;
         }
         let slope = self.derivative();
+        // Most spans' turning polynomials have no root or one on the interval, which the signs
+        // of their Bernstein coefficients show without finding the derivative's roots.
+        match self.bernstein_sign_changes(lo, hi) {
+            Some(0) => return roots,
+            Some(1) => {
+                roots.push(self.root_between(&slope, lo, hi, self.value(lo)));
+                return roots;
+            }
+            _ => {}
+        }
         let turns = slope.roots_in(lo, hi);
         let mut left = lo;
         let mut value_left = self.value(lo);
@@ -145,6 +129,47 @@ impl Polynomial {
             roots.push(left);
         }
         roots
+    }
+
+    /// The sign changes of the polynomial's Bernstein coefficients on [lo, hi], which bound its
+    /// roots there and share their parity (variation diminishing: none, no root; one, exactly
+    /// one); `None` when a coefficient is within rounding of zero, where the count may be off.
+    fn bernstein_sign_changes(&self, lo: f64, hi: f64) -> Option<usize> {
+        let n = self.degree;
+        // Every quantity below is a sum of terms no larger than Σ|a_k|·r^k (r the interval's
+        // reach from 0), so it is exact to about n²·ε of that: a coefficient within 1e-12 of it
+        // may have the wrong sign.
+        let reach = lo.abs() + (hi - lo);
+        let magnitude = self.coefficients[..=n].iter().rev().fold(0.0, |sum, c| sum * reach + c.abs());
+        // p(lo + w·s) by Taylor shifts (repeated synthetic division), then scaled by w^k.
+        let mut shifted = self.coefficients;
+        for k in 0..n {
+            for j in (k..n).rev() {
+                shifted[j] += lo * shifted[j + 1];
+            }
+        }
+        let width = hi - lo;
+        let mut power = 1.0;
+        for c in &mut shifted[..=n] {
+            *c *= power;
+            power *= width;
+        }
+        // b_i = Σ_{j ≤ i} C(i, j)/C(n, j)·c_j.
+        let mut bernstein = [0.0; MAX_DEGREE + 1];
+        for (i, value) in bernstein.iter_mut().enumerate().take(n + 1) {
+            let mut sum = 0.0;
+            let mut ratio = 1.0; // C(i, j)/C(n, j), from j = 0
+            for (j, &c) in shifted[..=i].iter().enumerate() {
+                sum += ratio * c;
+                ratio *= (i - j) as f64 / (n - j) as f64;
+            }
+            *value = sum;
+        }
+        let margin = 1e-12 * magnitude;
+        if !(margin.is_finite() && margin > 0.0) || bernstein[..=n].iter().any(|b| b.abs() <= margin) {
+            return None;
+        }
+        Some(bernstein[..=n].windows(2).filter(|pair| pair[0].signum() != pair[1].signum()).count())
     }
 
     /// The root of the polynomial on [left, right], where its sign changes once.
@@ -218,9 +243,44 @@ pub(crate) fn bracketed_root(
 mod tests {
     use super::*;
 
+    impl Polynomial {
+        /// p · q (degrees adding up to at most [`MAX_DEGREE`]; higher terms are dropped).
+        fn times(&self, other: &Self) -> Self {
+            let mut product = [0.0; MAX_DEGREE + 1];
+            for (i, &a) in self.coefficients[..=self.degree].iter().enumerate() {
+                for (j, &b) in other.coefficients[..=other.degree].iter().enumerate() {
+                    if i + j <= MAX_DEGREE {
+                        product[i + j] += a * b;
+                    }
+                }
+            }
+            Self::new(&product)
+        }
+    }
+
     /// The polynomial with these roots (leading coefficient `scale`).
     fn with_roots(roots: &[f64], scale: f64) -> Polynomial {
         roots.iter().fold(Polynomial::new(&[scale]), |p, &r| p.times(&Polynomial::new(&[-r, 1.0])))
+    }
+
+    #[test]
+    fn bernstein_signs_count_the_roots_they_can() {
+        // No root, one root, three roots (the signs may only bound them), a root at an end.
+        let none = with_roots(&[2.0, 3.0, -1.0, 1.5, -0.5], 2.0);
+        assert_eq!(none.bernstein_sign_changes(0.0, 1.0), Some(0));
+        let one = with_roots(&[0.3, 2.0, 3.0, -1.0], -1.0);
+        assert_eq!(one.bernstein_sign_changes(0.0, 1.0), Some(1));
+        assert_eq!(one.roots_in(0.0, 1.0).as_slice().len(), 1);
+        assert!((one.roots_in(0.0, 1.0).as_slice()[0] - 0.3).abs() < 1e-14);
+        let three = with_roots(&[0.2, 0.5, 0.7, 4.0], 1.0);
+        assert!(three.bernstein_sign_changes(0.0, 1.0).is_some_and(|changes| changes >= 3));
+        assert_eq!(three.roots_in(0.0, 1.0).as_slice().len(), 3);
+        let at_end = with_roots(&[0.0, 2.0, 3.0], 1.0);
+        assert_eq!(at_end.bernstein_sign_changes(0.0, 1.0), None);
+        // Shifted away from 0: the same polynomial moved by 10, on [10, 11].
+        let moved = with_roots(&[10.3, 12.0, 13.0, 9.0], -1.0);
+        assert_eq!(moved.bernstein_sign_changes(10.0, 11.0), Some(1));
+        assert!((moved.roots_in(10.0, 11.0).as_slice()[0] - 10.3).abs() < 1e-12);
     }
 
     #[test]
@@ -267,7 +327,6 @@ mod tests {
         let q = Polynomial::new(&[0.25, 3.0]);
         for x in [-1.5, 0.0, 0.3, 2.0] {
             assert!((p.times(&q).value(x) - p.value(x) * q.value(x)).abs() < 1e-12);
-            assert!((p.plus_scaled(-2.0, &q).value(x) - (p.value(x) - 2.0 * q.value(x))).abs() < 1e-12);
             assert!((p.derivative().value(x) - (-2.0 + x)).abs() < 1e-12);
         }
     }

@@ -141,21 +141,19 @@ fn span_turns(nurbs: &Nurbs, span: usize) -> Box<[RadiusAt]> {
     let Some([_, a1, a2, a3]) = nurbs.plain_span_form(span).filter(|_| end > start) else {
         return Box::new([]);
     };
-    // P′ = a₁ + 2a₂t + 3a₃t² and P″ = 2a₂ + 6a₃t, per axis.
-    let first = |k: usize| Polynomial::new(&[a1[k], 2.0 * a2[k], 3.0 * a3[k]]);
-    let second = |k: usize| Polynomial::new(&[2.0 * a2[k], 6.0 * a3[k]]);
-    let (p1, p2) = ([first(0), first(1), first(2)], [second(0), second(1), second(2)]);
-    let cross = |i: usize, j: usize| p1[i].times(&p2[j]).plus_scaled(-1.0, &p1[j].times(&p2[i]));
-    let bend = [cross(1, 2), cross(2, 0), cross(0, 1)];
-    let sum_of_squares = |parts: &[Polynomial; 3]| {
-        parts.iter().fold(Polynomial::new(&[0.0]), |sum, part| sum.plus_scaled(1.0, &part.times(part)))
-    };
-    let (speed_squared, bend_squared) = (sum_of_squares(&p1), sum_of_squares(&bend));
-    let turning = speed_squared
-        .derivative()
-        .times(&bend_squared)
-        .scaled(3.0)
-        .plus_scaled(-1.0, &speed_squared.times(&bend_squared.derivative()));
+    // P′ = a₁ + 2a₂t + 3a₃t² and P′ × P″ = 2(a₁ × a₂) + 6(a₁ × a₃)t + 6(a₂ × a₃)t² (the
+    // parallel terms cancel), so S and C are quartics: built directly, not by general products.
+    let speed_squared = squared_norm([a1, 2.0 * a2, 3.0 * a3]);
+    let bend_squared = squared_norm([2.0 * a1.cross(&a2), 6.0 * a1.cross(&a3), 6.0 * a2.cross(&a3)]);
+    let derivative = |p: &[f64; 5]| [p[1], 2.0 * p[2], 3.0 * p[3], 4.0 * p[4]];
+    let (speed_slope, bend_slope) = (derivative(&speed_squared), derivative(&bend_squared));
+    let mut coefficients = [0.0; 8];
+    for (i, (&ds, &dc)) in speed_slope.iter().zip(&bend_slope).enumerate() {
+        for (j, (&c, &s)) in bend_squared.iter().zip(&speed_squared).enumerate() {
+            coefficients[i + j] += 3.0 * ds * c - s * dc;
+        }
+    }
+    let turning = Polynomial::new(&coefficients);
     let width = end - start;
     turning
         .roots_in(0.0, 1.0)
@@ -168,6 +166,11 @@ fn span_turns(nurbs: &Nurbs, span: usize) -> Box<[RadiusAt]> {
         })
         .filter(|&(u, _)| u > start && u < end)
         .collect()
+}
+
+/// |q₀ + q₁t + q₂t²|², lowest power first.
+fn squared_norm([q0, q1, q2]: [Vec3; 3]) -> [f64; 5] {
+    [q0.dot(&q0), 2.0 * q0.dot(&q1), q1.dot(&q1) + 2.0 * q0.dot(&q2), 2.0 * q1.dot(&q2), q2.dot(&q2)]
 }
 
 /// The interior local minima of the radius on knot span `span`: [`SPAN_SAMPLES`] samples of the
