@@ -204,14 +204,27 @@ impl Nurbs {
     }
 
     /// Knot span index i with u_i ≤ u < u_{i+1} (A2.1), the last non-empty span at the end.
+    #[inline]
     pub(crate) fn span(&self, u: f64) -> usize {
-        let n = self.weighted.len();
         // The span found last holds u nearly always (the search evaluates near it again and
-        // again): one bracket test before the ends' cases and the binary search.
+        // again): one bracket test, inlined into the callers (a million and a half of them per
+        // solve on the chord bench), before the ends' cases and the search.
         let last = self.last_span.get();
-        if last < n && self.knots[last] <= u && u < self.knots[last + 1] {
+        if let (Some(&lo), Some(&hi)) = (self.knots.get(last), self.knots.get(last + 1))
+            && lo <= u
+            && u < hi
+            && last < self.weighted.len()
+        {
             return last;
         }
+        self.span_searched(u)
+    }
+
+    /// [`Nurbs::span`] past the last span's bracket test.
+    #[cold]
+    fn span_searched(&self, u: f64) -> usize {
+        let n = self.weighted.len();
+        let last = self.last_span.get();
         let (start, end) = self.domain();
         if u >= end {
             // Last span with a non-zero length.
