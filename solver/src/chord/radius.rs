@@ -51,13 +51,20 @@ pub(crate) struct SpanMinima {
     /// Per knot span (index − degree): (u, radius) of each interior local minimum, increasing u
     /// (every interior turn of the radius where `exact`).
     spans: Vec<OnceCell<Box<[RadiusAt]>>>,
+    /// Per knot span: the radius at its first knot (the smaller one-sided value), by the basis
+    /// functions, found once (each knot lies in a few windows or chords' stretches).
+    knot_radii: Vec<OnceCell<f64>>,
     /// The turns are exact (a plain cubic curve): a stretch needs no samples of its own.
     exact: bool,
 }
 
 impl SpanMinima {
     pub(crate) fn new(nurbs: &Nurbs) -> Self {
-        Self { spans: nurbs.spans().map(|_| OnceCell::new()).collect(), exact: nurbs.is_plain_cubic() }
+        Self {
+            spans: nurbs.spans().map(|_| OnceCell::new()).collect(),
+            knot_radii: nurbs.spans().map(|_| OnceCell::new()).collect(),
+            exact: nurbs.is_plain_cubic(),
+        }
     }
 
     /// The smallest radius of curvature on [lo, hi] (lo ≤ hi) and where it is: the least of the
@@ -76,11 +83,15 @@ impl SpanMinima {
             return best;
         }
         consider(radius_at(nurbs, hi), hi);
-        for knot in nurbs.distinct_knots_between(lo, hi) {
-            consider(radius_at(nurbs, knot), knot);
-        }
         let first = nurbs.span(lo);
         let last = nurbs.span(hi).max(first);
+        // The distinct knots strictly inside: each the first knot of a non-empty span after lo's.
+        for span in first + 1..=last {
+            let (knot, next) = nurbs.span_range(span);
+            if next > knot && knot > lo && knot < hi {
+                consider(self.knot_radius(nurbs, span), knot);
+            }
+        }
         for span in first..=last {
             for &(u, radius) in self.of_span(nurbs, span) {
                 if u > lo && u < hi {
@@ -121,6 +132,15 @@ impl SpanMinima {
             }
         }
         best
+    }
+
+    /// [`radius_at`] the first knot of span `span`, remembered.
+    fn knot_radius(&self, nurbs: &Nurbs, span: usize) -> f64 {
+        let knot = nurbs.span_range(span).0;
+        let first = nurbs.spans().start;
+        self.knot_radii
+            .get(span - first)
+            .map_or_else(|| radius_at(nurbs, knot), |cell| *cell.get_or_init(|| radius_at(nurbs, knot)))
     }
 
     fn of_span(&self, nurbs: &Nurbs, span: usize) -> &[RadiusAt] {
