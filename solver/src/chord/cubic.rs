@@ -30,28 +30,29 @@ pub(crate) fn deviation(piece: &CubicPiece) -> Option<f64> {
 /// The farthest point P* stays the farthest to first order (it is an interior maximum), so the
 /// rate is that of the distance of the fixed P* from the line A–B as B moves with P′(t_hi):
 /// with u = B − A, n = P* − A and m = n × u, D = |m|/|u| and
-/// dD = m·(n × P′)/(|m|·|u|) − |m|·(u·P′)/|u|³. `None` as for [`deviation`], and where the
-/// piece is straight (D = 0: the rate has no direction).
+/// dD = m·(n × P′)/(|m|·|u|) − |m|·(u·P′)/|u|³ = m·(n × P′)/(D·|u|²) − D·(u·P′)/|u|².
+/// `None` as for [`deviation`], and where the piece is straight (D = 0: the rate has no
+/// direction).
 pub(crate) fn deviation_with_rate(piece: &CubicPiece) -> Option<(f64, f64)> {
     let chord = Chord::of(piece)?;
     let [_, a1, a2, a3] = piece.coefficients;
     let t_hi = piece.t_hi;
     let velocity = a1 + t_hi * (2.0 * a2 + 3.0 * a3 * t_hi);
-    let peak_from_start = piece.point(chord.peak) - piece.point(piece.t_lo);
-    let rate = rate_of_distance(&peak_from_start, &(chord.end - chord.start), &velocity)?;
+    let peak_from_start = piece.point(chord.peak) - chord.start;
+    let rate = rate_of_distance(chord.deviation, &peak_from_start, &(chord.end - chord.start), &velocity)?;
     Some((chord.deviation, rate))
 }
 
-/// The rate of the distance of a fixed point from the line A–B as B moves with `velocity`, with
-/// `from_start` = point − A and `along` = B − A (see [`deviation_with_rate`]); `None` for a point
-/// on the line.
-fn rate_of_distance(from_start: &Vec3, along: &Vec3, velocity: &Vec3) -> Option<f64> {
-    let m = from_start.cross(along);
-    let (m_norm, length) = (m.norm(), along.norm());
-    if !(m_norm > 0.0 && length > 0.0) {
+/// The rate of `distance`, that of a fixed point from the line A–B, as B moves with `velocity`,
+/// with `from_start` = point − A and `along` = B − A (see [`deviation_with_rate`]); `None` for a
+/// point on the line.
+fn rate_of_distance(distance: f64, from_start: &Vec3, along: &Vec3, velocity: &Vec3) -> Option<f64> {
+    let length_squared = along.norm_squared();
+    if !(distance > 0.0 && length_squared > 0.0) {
         return None;
     }
-    let rate = m.dot(&from_start.cross(velocity)) / (m_norm * length) - m_norm * along.dot(velocity) / length.powi(3);
+    let m = from_start.cross(along);
+    let rate = (m.dot(&from_start.cross(velocity)) / distance - distance * along.dot(velocity)) / length_squared;
     rate.is_finite().then_some(rate)
 }
 
@@ -121,7 +122,7 @@ pub(crate) fn deviation_across_knot_with_rate(
     b: &Vec3,
 ) -> Option<(f64, f64)> {
     let (deviation, peak_from_start, velocity) = across_knot(first, second, a, b)?;
-    Some((deviation, rate_of_distance(&peak_from_start, &(b - a), &velocity)?))
+    Some((deviation, rate_of_distance(deviation, &peak_from_start, &(b - a), &velocity)?))
 }
 
 /// The deviation of [`deviation_across_knot`], the farthest point less `a`, and the curve's
@@ -230,6 +231,13 @@ fn largest_hump(w: f64, alpha: f64, beta: f64, gamma: f64) -> (f64, f64) {
     let g =
         |x: f64| ((-6.0 * gamma * x - 10.0 * beta) * x + (2.0 * gamma * w * w - 4.0 * alpha)) * x + 2.0 * beta * w * w;
     let slope = |x: f64| (-18.0 * gamma * x - 20.0 * beta) * x + (2.0 * gamma * w * w - 4.0 * alpha);
+    // Nearly always g falls over all of [−w, w] (its slope stays below 20|β|w + 2γw² − 4α there,
+    // γ ≥ 0): its one root there is the peak, found from the middle as below, without the
+    // turns of g or its values at the ends.
+    if 20.0 * beta.abs() * w + 2.0 * gamma * w * w < 4.0 * alpha {
+        let peak = bracketed_root(&g, &slope, -w, w, 1.0, ROOT_WIDTH);
+        return (hump(peak), peak);
+    }
     // −w, the turns of g inside (at most two, put in order by hand: a sort call cost more than
     // the rest of this function on the chord bench), w.
     let mut breaks = [-w, w, w, w];
