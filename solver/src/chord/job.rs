@@ -106,6 +106,13 @@ fn radius(field: &str, value: f64) -> Result<f64, SolverError> {
 /// radians exceeds a micro-radian, and a quarter-turn search could no longer advance.
 const MAX_ANGLE_DEG: f64 = 1e6;
 
+/// Gauss–Legendre panels a NURBS's arc-length table starts each knot span with (each is then
+/// halved until its halves agree with it, [`ArcLengthTable::build`]): a span's speed is one
+/// smooth function, so one panel is enough to start from, and the halving finds where it is
+/// not (4 panels cost a quarter of the chord bench's B-spline solve for the same lengths to
+/// 1e-15).
+pub(crate) const NURBS_PANELS_PER_SPAN: usize = 1;
+
 /// A finite angle in degrees within ±[`MAX_ANGLE_DEG`].
 fn angle(field: &str, value: f64) -> Result<f64, SolverError> {
     if finite(field, value)?.abs() > MAX_ANGLE_DEG {
@@ -282,7 +289,7 @@ impl Curve {
                 }
                 let breaks: Vec<f64> = nurbs.breaks().iter().map(|(knot, _)| *knot).collect();
                 let speed = |u: f64| nurbs.speed(u);
-                let table = ArcLengthTable::build(&speed, &breaks, 4, "curve.control_points")?;
+                let table = ArcLengthTable::build(&speed, &breaks, NURBS_PANELS_PER_SPAN, "curve.control_points")?;
                 let shape = Shape::Spline(Spline::new(nurbs, table));
                 let corners = shape.corners(corner);
                 (shape, corners, dimension)

@@ -849,6 +849,37 @@ mod tests {
     }
 
     #[test]
+    fn one_panel_per_knot_span_gives_the_arc_length_of_sixty_four() {
+        // Rational curves of degree 2 to 5 with weights from 0.05 to 20, one with a near-cusp
+        // (two control points 1e-4 apart): the table the chord job builds against a fine one.
+        for degree in 2..=5 {
+            let control: Vec<Vec3> = (0..14)
+                .map(|k| {
+                    let k = f64::from(k);
+                    let nudge = if k == 7.0 { 1e-4 } else { 0.0 };
+                    Vec3::new(10.0 * (k - 1.0).max(0.0) + nudge, 8.0 * (1.3 * k).sin(), 3.0 * (0.7 * k).cos())
+                })
+                .collect();
+            let weights: Vec<f64> = (0..14).map(|k| [0.05, 1.0, 20.0, 0.7, 3.0][k % 5]).collect();
+            let nurbs = Nurbs::new(degree, &control, None, Some(&weights), "curve").unwrap();
+            let breaks: Vec<f64> = nurbs.breaks().iter().map(|(knot, _)| *knot).collect();
+            let speed = |u: f64| nurbs.speed(u);
+            let coarse =
+                ArcLengthTable::build(&speed, &breaks, super::super::job::NURBS_PANELS_PER_SPAN, "curve").unwrap();
+            let fine = ArcLengthTable::build(&speed, &breaks, 64, "curve").unwrap();
+            assert_relative_eq!(coarse.length(), fine.length(), max_relative = 1e-13);
+            for k in 0..=1000 {
+                let u = f64::from(k) / 1000.0;
+                let (a, b) = (coarse.s_at(&speed, u), fine.s_at(&speed, u));
+                assert!((a - b).abs() <= 1e-13 * fine.length(), "degree {degree}, u = {u}: {a} vs {b}");
+                let s = fine.length() * f64::from(k) / 1000.0;
+                let (a, b) = (coarse.u_at(&speed, s), fine.u_at(&speed, s));
+                assert!((a - b).abs() <= 1e-12, "degree {degree}, s = {s}: {a} vs {b}");
+            }
+        }
+    }
+
+    #[test]
     fn the_deviation_rate_matches_a_difference_inside_a_span_and_across_a_knot() {
         // A plain cubic B-spline through a wavy 3-D polygon; chords from a third to eight tenths of
         // a span, the end moved a little either way (staying on its side of a knot).
