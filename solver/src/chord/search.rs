@@ -79,15 +79,13 @@ pub(crate) fn chord_end(
         let (deviation, exact) = shape.fast_deviation(start.u, u, aim);
         (deviation.sqrt() - root, exact.then_some(deviation))
     };
-    let speed = shape.speed(start.u);
-    // Bracket to 1e-12 mm, but never below a few units in the last place of u: a long curve
-    // on a unit parameter range has 1e-12 mm under one ulp, where rounding of the distances
-    // (1e-16 of the coordinates) is all the root finder would see.
-    let ulps = 4.0 * f64::EPSILON * start.u.abs().max(limit.u.abs()).max(f64::MIN_POSITIVE);
-    let tol = if speed > 0.0 { (CROSSING_WIDTH / speed).max(ulps) } else { 4.0 * ulps };
+    // The speed at the start only where the previous chord's step does not give the first
+    // trial, or the bracket's width is needed (not by Newton).
+    let start_speed = std::cell::OnceCell::new();
+    let speed = || *start_speed.get_or_init(|| shape.speed(start.u));
     let mut step = last_step.get();
     if step.is_nan() || step <= 0.0 {
-        step = if speed > 0.0 && step_guess > 0.0 { step_guess / speed } else { limit.u - start.u };
+        step = if speed() > 0.0 && step_guess > 0.0 { step_guess / speed() } else { limit.u - start.u };
     }
     if let Shape::Spline(spline) = shape {
         match newton_end(spline, start, limit.u, root, start.u + step) {
@@ -99,6 +97,12 @@ pub(crate) fn chord_end(
             Err(None) => {}
         }
     }
+    let speed = speed();
+    // Bracket to 1e-12 mm, but never below a few units in the last place of u: a long curve
+    // on a unit parameter range has 1e-12 mm under one ulp, where rounding of the distances
+    // (1e-16 of the coordinates) is all the root finder would see.
+    let ulps = 4.0 * f64::EPSILON * start.u.abs().max(limit.u.abs()).max(f64::MIN_POSITIVE);
+    let tol = if speed > 0.0 { (CROSSING_WIDTH / speed).max(ulps) } else { 4.0 * ulps };
     let mut evaluations = 0;
     // Bracket: lo fits (g ≤ 0), hi does not.
     let (mut lo, mut g_lo, mut known_at_lo) = (start.u, -root, None);
