@@ -3,10 +3,11 @@
 //!
 //! * circular arcs: the chord end in closed form from the sagitta, dev = 2r·sin²(Δs/4r);
 //! * polylines: placed on an edge where the first spanned vertex reaches C_ep (`polyline`);
-//! * plain B-splines of degree ≤ 3, a chord inside one knot span or across one knot: Newton
-//!   steps on √dev from the previous chord's step, with the deviation's rate from the envelope
-//!   theorem (`cubic`): two deviations per block nearly always, one to step and one to confirm;
-//!   the bracketed secant below takes over where Newton does not settle;
+//! * plain B-splines of degree ≤ 3 (a chord inside one knot span or across one knot) and
+//!   ellipses (a chord of up to a quarter turn): Newton steps on √dev from the previous chord's
+//!   step, with the deviation's rate in closed form (for the B-spline from the envelope theorem,
+//!   `cubic`): two deviations per block nearly always, one to step and one to confirm; the
+//!   bracketed secant below takes over where Newton does not settle;
 //! * everything else: a bracketed secant (Illinois) on g(u) = √dev(u_a, u) − √C_ep, which is
 //!   nearly linear in u because the deviation grows with the square of the chord. The first
 //!   trial is the previous chord's parameter step (or the circle chord of the window radius),
@@ -22,7 +23,7 @@ use crate::error::ErrorCode;
 use std::cell::Cell;
 
 use super::segment::{CROSSING_WIDTH, EPS, Vertex};
-use super::shape::{Shape, Spline};
+use super::shape::Shape;
 use super::{polyline, reference};
 use crate::error::SolverError;
 
@@ -87,15 +88,13 @@ pub(crate) fn chord_end(
     if step.is_nan() || step <= 0.0 {
         step = if speed() > 0.0 && step_guess > 0.0 { step_guess / speed() } else { limit.u - start.u };
     }
-    if let Shape::Spline(spline) = shape {
-        match newton_end(spline, start, limit.u, root, start.u + step) {
-            Ok((end, deviation)) => {
-                last_step.set(end - start.u);
-                return Ok((end, Some(deviation)));
-            }
-            Err(Some(estimate)) => step = estimate - start.u,
-            Err(None) => {}
+    match newton_end(shape, start, limit.u, root, start.u + step) {
+        Ok((end, deviation)) => {
+            last_step.set(end - start.u);
+            return Ok((end, Some(deviation)));
         }
+        Err(Some(estimate)) => step = estimate - start.u,
+        Err(None) => {}
     }
     let speed = speed();
     // Bracket to 1e-12 mm, but never below a few units in the last place of u: a long curve
@@ -188,27 +187,21 @@ pub(crate) fn chord_end(
     checked(shape, start, chord_error, limit, step_guess, (lo, known_at_lo))
 }
 
-/// Newton steps on g(u) = √dev(u) − `root` from `trial`, while the chord stays inside one knot
-/// span of a plain cubic B-spline, where its deviation and the deviation's rate are exact
-/// ([`Spline::deviation_with_rate`]): from the previous chord's step two deviations nearly
-/// always (one to step, one to confirm), against three or four for the bracketed search. The
-/// chord end and its deviation once g is within the bracketed search's stop (−1e-9·root ≤ g ≤ 0);
-/// else `Err` with the last estimate inside the limit, if any, for the bracketed search to start
-/// from (a chord across a knot, to the limit, on a piece where g does not rise).
-fn newton_end(
-    spline: &Spline,
-    start: &Vertex,
-    limit: f64,
-    root: f64,
-    mut trial: f64,
-) -> Result<(f64, f64), Option<f64>> {
+/// Newton steps on g(u) = √dev(u) − `root` from `trial`, while the chord's deviation and the
+/// deviation's rate are exact ([`Shape::deviation_with_rate`]): from the previous chord's step
+/// two deviations nearly always (one to step, one to confirm), against three or four for the
+/// bracketed search. The chord end and its deviation once g is within the bracketed search's
+/// stop (−1e-9·root ≤ g ≤ 0); else `Err` with the last estimate inside the limit, if any, for
+/// the bracketed search to start from (a chord over more than one knot or a quarter turn, to the
+/// limit, on a piece where g does not rise, other curves).
+fn newton_end(shape: &Shape, start: &Vertex, limit: f64, root: f64, mut trial: f64) -> Result<(f64, f64), Option<f64>> {
     let mut estimate = None;
     for _ in 0..NEWTON_STEPS {
         if !(trial > start.u && trial < limit) {
             return Err(estimate);
         }
         estimate = Some(trial);
-        let Some((deviation, rate)) = spline.deviation_with_rate(start.u, trial) else {
+        let Some((deviation, rate)) = shape.deviation_with_rate(start.u, trial) else {
             return Err(estimate);
         };
         let value = deviation.sqrt() - root;

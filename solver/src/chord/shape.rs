@@ -110,6 +110,23 @@ impl Ellipse {
         ellipse_speed(self.semi_axes, self.angle(u))
     }
 
+    /// The deviation of the chord from `ua` to `ub` (at most a quarter turn apart), as in
+    /// [`Shape::fast_deviation`], with its rate per unit of u as `ub` moves: with the half angle
+    /// δ = (ub − ua)/2 and the mean angle t_m, dev = 2·sin²(δ/2)·ab/v(t_m) for
+    /// v = (a² sin² t + b² cos² t)^½, and dv/dt = (a² − b²)·sin t·cos t/v.
+    fn deviation_with_rate(&self, ua: f64, ub: f64) -> (f64, f64) {
+        let [a, b] = self.semi_axes;
+        let half = 0.5 * (ub - ua);
+        let (sin, cos) = self.angle(0.5 * (ua + ub)).sin_cos();
+        let speed = ((a * sin).powi(2) + (b * cos).powi(2)).sqrt();
+        let bulge = 2.0 * (0.5 * half).sin().powi(2);
+        let deviation = bulge * a * b / speed;
+        // d/dub: the half angle and the mean angle (through the sense of the parameter) move by ½.
+        let speed_rate = (a * a - b * b) * sin * cos / speed * 0.5 * self.sense;
+        let rate = 0.5 * half.sin() * a * b / speed - deviation * speed_rate / speed;
+        (deviation, rate)
+    }
+
     /// Radius of curvature at t: (a² sin² t + b² cos² t)^{3/2} / (a·b).
     fn radius(&self, t: f64) -> f64 {
         let [a, b] = self.semi_axes;
@@ -567,6 +584,20 @@ impl Shape {
         }
     }
 
+    /// The exact deviation of the chord from `ua` to `ub > ua` with its rate per unit of u as
+    /// `ub` moves, where both have closed forms: chords of a plain cubic B-spline inside one span
+    /// or across one knot ([`Spline::deviation_with_rate`]) and ellipse chords of up to a quarter
+    /// turn; `None` elsewhere (the chord search then brackets).
+    pub(crate) fn deviation_with_rate(&self, ua: f64, ub: f64) -> Option<(f64, f64)> {
+        match self {
+            Self::Spline(spline) => spline.deviation_with_rate(ua, ub),
+            Self::Ellipse(ellipse) if ub > ua && ub - ua <= std::f64::consts::FRAC_PI_2 => {
+                Some(ellipse.deviation_with_rate(ua, ub))
+            }
+            _ => None,
+        }
+    }
+
     /// The reference deviation (32 samples, refined) of a chord the fast search found, where
     /// [`Shape::fast_deviation`] only samples: it catches a hump between the fast samples, and
     /// the answer reports it as the chord's deviation. The exact value of a cubic span's chord;
@@ -932,6 +963,25 @@ mod tests {
             sweep: std::f64::consts::FRAC_PI_2,
             table,
         })
+    }
+
+    #[test]
+    fn the_ellipse_deviation_rate_matches_a_difference_both_ways_round() {
+        for sense in [1.0, -1.0] {
+            let Shape::Ellipse(mut ellipse) = ellipse() else { unreachable!() };
+            (ellipse.sense, ellipse.start) = (sense, 0.4);
+            let shape = Shape::Ellipse(ellipse);
+            for (ua, ub) in [(0.0, 0.01), (0.3, 0.35), (0.7, 1.5), (1.0, 1.0 + std::f64::consts::FRAC_PI_2)] {
+                let (deviation, rate) = shape.deviation_with_rate(ua, ub).expect("a quarter turn or less");
+                assert_relative_eq!(deviation, shape.fast_deviation(ua, ub, f64::INFINITY).0, max_relative = 1e-15);
+                assert_relative_eq!(deviation, shape.deviation(ua, ub), max_relative = 1e-9);
+                let step = 1e-7;
+                let moved = |end: f64| shape.fast_deviation(ua, end, f64::INFINITY).0;
+                let difference = (moved(ub + step) - moved(ub - step)) / (2.0 * step);
+                assert_relative_eq!(rate, difference, max_relative = 1e-6);
+            }
+            assert_eq!(shape.deviation_with_rate(0.0, 1.6), None, "past a quarter turn");
+        }
     }
 
     #[test]
