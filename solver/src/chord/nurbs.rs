@@ -309,6 +309,27 @@ impl Nurbs {
         CubicPiece { coefficients: [a0, a1, a2, a3], t_lo: local(lo), t_hi: local(hi) }
     }
 
+    /// The radius of curvature at `u` strictly inside a knot span of a plain cubic curve, from the
+    /// span's power form: |P′|³/|P′ × P″| in the span's own parameter (the scale cancels), without
+    /// the homogeneous division of [`Nurbs::derivatives_in`]; `None` at a knot (whose one-sided
+    /// values may differ) and on other curves. The smallest radius of a stretch evaluates this at
+    /// every chord's ends in mode `guarantee`.
+    pub(crate) fn plain_radius_inside(&self, u: f64) -> Option<f64> {
+        if !self.is_plain_cubic() {
+            return None;
+        }
+        let polynomial = &self.polynomials[self.span(u) - self.degree];
+        let t = (u - polynomial.start) * polynomial.inverse_width;
+        if !(t > 0.0 && t < 1.0) {
+            return None;
+        }
+        let [_, a1, a2, a3, ..] = polynomial.plain;
+        let first = a1 + t * (2.0 * a2 + 3.0 * a3 * t);
+        let second = 2.0 * a2 + 6.0 * a3 * t;
+        let bend = first.cross(&second).norm();
+        Some(if bend == 0.0 { f64::INFINITY } else { first.norm().powi(3) / bend })
+    }
+
     /// Whether every span is a polynomial of degree ≤ 3 (a plain B-spline: one common weight),
     /// whose radius of curvature turns where a polynomial has its roots (`radius`).
     pub(crate) fn is_plain_cubic(&self) -> bool {
@@ -783,6 +804,46 @@ mod tests {
                 assert_abs_diff_eq!((d2 - e2).norm(), 0.0, epsilon = 1e-8 * (1.0 + e2.norm()));
             }
         }
+    }
+
+    #[test]
+    fn the_plain_radius_matches_the_homogeneous_one() {
+        // Uneven knots, far from the origin, degrees 1-3; rational curves and knots have none.
+        let control: Vec<Vec3> = (0..9)
+            .map(|k| {
+                let k = f64::from(k);
+                Vec3::new(1000.0 + 7.0 * k, -500.0 + 4.0 * (1.1 * k).sin(), 2.0 * (0.6 * k).cos())
+            })
+            .collect();
+        for degree in 1..=3 {
+            let inner = control.len() - degree - 1;
+            let mut knots = vec![0.0; degree + 1];
+            knots.extend((1..=inner).map(|k| (f64::from(k as u32) / (inner + 1) as f64).powf(1.3)));
+            knots.extend(vec![1.0; degree + 1]);
+            let curve = Nurbs::new(degree, &control, Some(&knots), None, "curve").unwrap();
+            for k in 1..500 {
+                let u = f64::from(k) / 500.0;
+                let Some(plain) = curve.plain_radius_inside(u) else {
+                    assert!(knots.contains(&u), "degree {degree}: no plain radius at {u}");
+                    continue;
+                };
+                let [_, first, second] = curve.derivatives(u);
+                let bend = first.cross(&second).norm();
+                let homogeneous = if bend == 0.0 { f64::INFINITY } else { first.norm().powi(3) / bend };
+                if degree == 1 {
+                    assert_eq!(plain, f64::INFINITY);
+                } else {
+                    assert!(
+                        (plain - homogeneous).abs() <= 1e-9 * homogeneous,
+                        "degree {degree}, u = {u}: {plain} vs {homogeneous}"
+                    );
+                }
+            }
+            assert_eq!(curve.plain_radius_inside(knots[degree + 1]), None, "at a knot");
+        }
+        let weights = vec![1.0, 2.0, 1.0, 1.0, 0.5, 1.0, 1.0, 3.0, 1.0];
+        let rational = Nurbs::new(3, &control, None, Some(&weights), "curve").unwrap();
+        assert_eq!(rational.plain_radius_inside(0.3), None);
     }
 
     #[test]
