@@ -4,7 +4,7 @@
 //! through [`BlockRule`], and the G-code head of case A.
 
 use kerf_cases::{case, close, fixture, number};
-use kerf_solver::chord::{self, SegmentAnswer, SegmentRequest, WindowStatus};
+use kerf_solver::chord::{self, CommandPoint, SegmentAnswer, SegmentRequest, WindowStatus};
 use kerf_solver::gcode::{Dialect, Post, ToolCall};
 use kerf_solver::machine::{BlockRule, ChordStatus};
 use serde_json::{Value, json};
@@ -16,7 +16,7 @@ fn solve(request: Value) -> SegmentAnswer {
     chord::solve(&request, None).unwrap()
 }
 
-fn check_points(what: &str, got: &[Vec<f64>], expected: &Value) {
+fn check_points(what: &str, got: &[CommandPoint], expected: &Value) {
     let expected = expected.as_array().unwrap();
     assert_eq!(got.len(), expected.len(), "{what}: count");
     for (index, (point, want)) in got.iter().zip(expected).enumerate() {

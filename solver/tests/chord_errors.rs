@@ -2,7 +2,7 @@
 //! the curve checks), machine defaults and overrides, warnings of the edge-case table (E1, E4,
 //! E5, E8–E10, E12, E13) and the G-code program in both dialects.
 
-use kerf_solver::chord::{self, SegmentAnswer, SegmentRequest, WindowStatus};
+use kerf_solver::chord::{self, CommandPoint, SegmentAnswer, SegmentRequest, WindowStatus};
 use kerf_solver::gcode::{Dialect, Post, ToolCall};
 use kerf_solver::machine::MachineProfile;
 use serde_json::{Value, json};
@@ -31,6 +31,11 @@ fn error(request: Value) -> (String, Option<String>, String) {
 
 fn ok(request: Value) -> SegmentAnswer {
     chord::solve(&parse(request), None).unwrap()
+}
+
+/// The command points as their coordinate lists, `[x, y]` or `[x, y, z]`.
+fn coordinates(answer: &SegmentAnswer) -> Vec<&[f64]> {
+    answer.points.iter().map(CommandPoint::as_slice).collect()
 }
 
 fn codes(answer: &SegmentAnswer) -> Vec<&'static str> {
@@ -306,7 +311,7 @@ fn straight_lines_are_one_block() {
     assert_eq!(answer.stats.blocks, 1);
     assert_eq!(answer.windows.iter().map(|w| w.status).collect::<Vec<_>>()[0], WindowStatus::Straight);
     assert!(codes(&answer).contains(&"I_STRAIGHT"));
-    assert_eq!(answer.points, vec![vec![0.0, 0.0, 0.0], vec![30.0, 0.0, 0.0]]);
+    assert_eq!(coordinates(&answer), [[0.0, 0.0, 0.0], [30.0, 0.0, 0.0]]);
     // E12: a curve shorter than one block time.
     let short = json!({"kind": "polyline", "points": [[0, 0], [0.5, 0]]});
     let answer = ok(with(base(), "curve", short));
@@ -325,7 +330,7 @@ fn corners_split_the_path_and_are_always_points() {
         points.push([20.0, 0.2 * f64::from(k)]);
     }
     let answer = ok(with(base(), "curve", json!({"kind": "polyline", "points": points})));
-    assert_eq!(answer.points, vec![vec![0.0, 0.0], vec![20.0, 0.0], vec![20.0, 20.0]]);
+    assert_eq!(coordinates(&answer), [[0.0, 0.0], [20.0, 0.0], [20.0, 20.0]]);
     // A spline with a double knot (degree 2: C0) turning 90° is split there too.
     let spline = json!({"kind": "bspline", "degree": 2,
         "control_points": [[0, 0], [10, 0], [20, 0], [20, 10], [20, 20]],

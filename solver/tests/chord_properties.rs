@@ -13,7 +13,7 @@
 //! * in mode `guarantee` (§2.9a) no block but the last (or one ending at a corner) is shorter
 //!   than margin × feed × block time, on the same random NURBS.
 
-use kerf_solver::chord::{self, SegmentAnswer, SegmentRequest};
+use kerf_solver::chord::{self, CommandPoint, SegmentAnswer, SegmentRequest};
 use proptest::prelude::*;
 use serde_json::{Value, json};
 
@@ -34,7 +34,8 @@ fn norm(a: &Point) -> f64 {
     dot(a, a).sqrt()
 }
 
-fn to_point(p: &[f64]) -> Point {
+fn to_point(p: &CommandPoint) -> Point {
+    let p = p.as_slice();
     [p[0], p[1], p.get(2).copied().unwrap_or(0.0)]
 }
 
@@ -203,7 +204,7 @@ fn block_chord_errors(answer: &SegmentAnswer) -> Vec<f64> {
 /// span (so may be a short remainder).
 fn check(answer: &SegmentAnswer, curve: &dyn Reference, samples: usize, min_block: Option<f64>) {
     let dense = Dense::new(curve, samples);
-    let points: Vec<Point> = answer.points.iter().map(|p| to_point(p)).collect();
+    let points: Vec<Point> = answer.points.iter().map(to_point).collect();
     let first = points.first().unwrap();
     let last = points.last().unwrap();
     assert!(norm(&sub(first, &curve.at(0.0))) <= 1e-9, "first point off the start");
@@ -438,10 +439,10 @@ proptest! {
             "feed": feed, "block_time_ms": block_time_ms, "margin": margin, "radius_estimate": "minimum"
         });
         let Some(answer) = solve_feasible(request) else { return Ok(()); };
-        prop_assert_eq!(answer.points[0].len(), 3);
+        prop_assert_eq!(answer.points[0].dimension(), 3);
         prop_assert!(answer.warnings.iter().all(|w| w.code != "W_SPARSE_POLYLINE"));
         let allowed = block_chord_errors(&answer);
-        let points: Vec<Point> = answer.points.iter().map(|p| to_point(p)).collect();
+        let points: Vec<Point> = answer.points.iter().map(to_point).collect();
         let mut stations = vec![0.0];
         for pair in vertices.windows(2) {
             stations.push(stations.last().unwrap() + norm(&sub(&pair[1], &pair[0])));
@@ -557,7 +558,7 @@ proptest! {
         check(&answer, &curve, samples, None);
         // Only the last block, or (degree 1) one ending at a corner of the control polygon, may
         // be short; the smallest radius of a NURBS is sampled: allow 1e-6 of the target.
-        let points: Vec<Point> = answer.points.iter().map(|p| to_point(p)).collect();
+        let points: Vec<Point> = answer.points.iter().map(to_point).collect();
         let blocks = points.len() - 1;
         for (index, pair) in points.windows(2).enumerate() {
             let length = norm(&sub(&pair[1], &pair[0]));

@@ -1,9 +1,67 @@
 //! What a segment request answers (api.md, Segment; chord.md §1.3 outputs and §6 reports).
 
-use serde::Serialize;
+use std::ops::Index;
+
+use serde::{Serialize, Serializer};
 
 use crate::error::Warning;
+use crate::geometry::Vec3;
 use crate::machine::stats::BlockStats;
+
+/// A command point, `[x, y]` or `[x, y, z]` like the curve, and written to JSON as that array.
+///
+/// The coordinates are held inline: a long curve has about 100 000 points, and a `Vec<f64>` each
+/// would cost as many small allocations (and frees) per solve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CommandPoint {
+    /// x, y, z; the coordinates past `dimension` are 0 (so `to_vec3` puts a 2-D point at z = 0
+    /// and the derived equality compares only the point's own coordinates).
+    coordinates: [f64; 3],
+    /// How many coordinates the point has: 2 or 3, the curve's.
+    dimension: usize,
+}
+
+impl CommandPoint {
+    /// The first `dimension` coordinates of `point` (at most 3).
+    pub(crate) fn new(point: &Vec3, dimension: usize) -> Self {
+        let dimension = dimension.min(3);
+        let mut coordinates = [0.0; 3];
+        coordinates[..dimension].copy_from_slice(&[point.x, point.y, point.z][..dimension]);
+        Self { coordinates, dimension }
+    }
+
+    /// The coordinates, `[x, y]` or `[x, y, z]`.
+    pub fn as_slice(&self) -> &[f64] {
+        &self.coordinates[..self.dimension]
+    }
+
+    /// How many coordinates the point has: 2 or 3, like the curve.
+    pub fn dimension(&self) -> usize {
+        self.dimension
+    }
+
+    /// The point in space (a 2-D curve's at z = 0).
+    pub fn to_vec3(&self) -> Vec3 {
+        let [x, y, z] = self.coordinates;
+        Vec3::new(x, y, z)
+    }
+}
+
+/// `point[axis]`: x, y or (3-D only) z.
+impl Index<usize> for CommandPoint {
+    type Output = f64;
+
+    fn index(&self, axis: usize) -> &f64 {
+        &self.as_slice()[axis]
+    }
+}
+
+/// As the array of its coordinates, the JSON a `Vec<f64>` had.
+impl Serialize for CommandPoint {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_seq(self.as_slice())
+    }
+}
 
 /// How a window's chord error was chosen (chord.md §2.7, §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -67,7 +125,9 @@ pub struct SegmentAnswer {
     pub windows: Vec<SegmentWindow>,
     /// The command points in order, `[x, y]` or `[x, y, z]` like the curve; the first is the curve
     /// start, the last its end. Consecutive points are one G01 block.
-    pub points: Vec<Vec<f64>>,
+    // Documented as the arrays of numbers it is written as.
+    #[cfg_attr(feature = "schema", schema(value_type = Vec<Vec<f64>>))]
+    pub points: Vec<CommandPoint>,
     /// Arc length of each point along the curve, mm.
     pub s: Vec<f64>,
     /// Block figures at the feed and block time.

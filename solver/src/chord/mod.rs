@@ -75,7 +75,7 @@ mod search;
 mod segment;
 mod shape;
 
-pub use answer::{Comparison, SegmentAnswer, SegmentWindow, WindowStatus};
+pub use answer::{CommandPoint, Comparison, SegmentAnswer, SegmentWindow, WindowStatus};
 pub use capability::{SegmentCapability, SegmentResult};
 pub use nurbs::{MAX_CONTROL_POINTS, MAX_DEGREE};
 pub(crate) use program::cycle_time;
@@ -281,11 +281,6 @@ fn status_of(status: Status) -> WindowStatus {
     }
 }
 
-fn coordinates(point: &Vec3, dimension: usize) -> Vec<f64> {
-    let all = [point.x, point.y, point.z];
-    all[..dimension.min(3)].to_vec()
-}
-
 fn finite_or_none(value: f64) -> Option<f64> {
     value.is_finite().then_some(value)
 }
@@ -364,7 +359,7 @@ fn answer(job: &Job, request: &SegmentRequest, cutter: &Cutter<'_>, cut: &Cut) -
         chord_error,
         min_window_chord_error: if min_window_chord_error.is_finite() { min_window_chord_error } else { 0.0 },
         windows,
-        points: positions.iter().map(|p| coordinates(p, job.dimension)).collect(),
+        points: positions.iter().map(|p| CommandPoint::new(p, job.dimension)).collect(),
         s: cut.vertices.iter().map(|v| v.s).collect(),
         max_deviation: max_deviation(cutter, cut),
         stats,

@@ -7,7 +7,7 @@
 //! own: the caller says how the program selects one. Coordinates are those of the curve (the
 //! programmed point), 2-D curves at z = 0.
 
-use super::answer::SegmentAnswer;
+use super::answer::{CommandPoint, SegmentAnswer};
 use crate::error::ErrorCode;
 use crate::error::SolverError;
 use crate::gcode::{self, Arcs, Post, Program, SpindleDirection};
@@ -26,7 +26,7 @@ pub(crate) fn cycle_time(
     tool_change: bool,
 ) -> Option<CycleTime> {
     let dynamics = machine.dynamics()?;
-    let points: Vec<Vec3> = answer.points.iter().map(|p| point(p)).collect();
+    let points: Vec<Vec3> = answer.points.iter().map(CommandPoint::to_vec3).collect();
     let first = *points.first()?;
     let above = Vec3::new(first.x, first.y, answer.safe_z);
     let mut steps = vec![Step::Feed { to: first, feed: gcode::plunge_feed(answer.feed, plunge_feed), air: true }];
@@ -36,18 +36,13 @@ pub(crate) fn cycle_time(
     Some(cycle_time_of(above, &steps, &dynamics, usize::from(tool_change)))
 }
 
-/// A command point as a 3-D point (2-D curves at z = 0).
-fn point(p: &[f64]) -> Vec3 {
-    Vec3::new(p.first().copied().unwrap_or(0.0), p.get(1).copied().unwrap_or(0.0), p.get(2).copied().unwrap_or(0.0))
-}
-
 /// The complete program for a segment answer. `post.reference` does not apply: the curve is
 /// the programmed point.
 ///
 /// # Errors
 /// `E_NO_PROGRAM` when the answer has no block (it always has one when `solve` succeeded).
 pub fn program(answer: &SegmentAnswer, post: &Post) -> Result<String, SolverError> {
-    let points: Vec<Vec3> = answer.points.iter().map(|p| point(p)).collect();
+    let points: Vec<Vec3> = answer.points.iter().map(CommandPoint::to_vec3).collect();
     let Some(first) = points.first() else {
         return Err(SolverError::new(ErrorCode::NoProgram, "the answer has no points"));
     };

@@ -76,14 +76,25 @@ pub fn block_stats(points: &[Vec3], feed: f64, block_time_ms: f64) -> Result<Blo
 }
 
 /// [`block_stats`] with the span ends given as block indices (block i joins points i and i + 1).
+///
+/// One pass over the blocks, without a list of their lengths or of the angles between them (a
+/// segment answer of a long curve has about 100 000 blocks).
 pub(crate) fn stats_with_ends(points: &[Vec3], feed: f64, block_time_ms: f64, span_ends: &[usize]) -> BlockStats {
     let block_length = feed * block_time_ms / MS_PER_MIN;
     let short_below = block_length * (1.0 - SHORT_SLACK);
-    let lengths: Vec<f64> = points.windows(2).map(|pair| (pair[1] - pair[0]).norm()).collect();
     let (mut inner_min, mut all_min, mut max) = (f64::INFINITY, f64::INFINITY, 0.0_f64);
     let (mut short_blocks, mut short_end_blocks) = (0, 0);
     let mut estimated_time_s = 0.0;
-    for (index, &length) in lengths.iter().enumerate() {
+    // The sums start at -0.0 as `Iterator::sum` of f64 does (they were such sums): the same bits
+    // even with no blocks, whose path length is -0.0.
+    let mut path_length = -0.0;
+    let (mut max_angle, mut angle_sum, mut angles) = (0.0_f64, -0.0, 0_usize);
+    let mut last_length = 0.0;
+    // The previous block's vector and length: the direction change is taken where it ends.
+    let mut previous: Option<(Vec3, f64)> = None;
+    for (index, pair) in points.windows(2).enumerate() {
+        let step = pair[1] - pair[0];
+        let length = step.norm();
         let span_end = span_ends.binary_search(&index).is_ok();
         all_min = all_min.min(length);
         max = max.max(length);
@@ -94,6 +105,18 @@ pub(crate) fn stats_with_ends(points: &[Vec3], feed: f64, block_time_ms: f64, sp
             short_blocks += usize::from(length < short_below);
         }
         estimated_time_s += (length / feed * 60.0).max(block_time_ms / 1000.0);
+        path_length += length;
+        if let Some((before, before_length)) = previous {
+            let norms = before_length * length;
+            if norms > 0.0 {
+                let angle = (before.dot(&step) / norms).clamp(-1.0, 1.0).acos().to_degrees();
+                max_angle = max_angle.max(angle);
+                angle_sum += angle;
+                angles += 1;
+            }
+        }
+        previous = Some((step, length));
+        last_length = length;
     }
     let min_block_length = if inner_min.is_finite() {
         inner_min
@@ -102,29 +125,20 @@ pub(crate) fn stats_with_ends(points: &[Vec3], feed: f64, block_time_ms: f64, sp
     } else {
         0.0
     };
-    let path_length: f64 = lengths.iter().sum();
-    let angles: Vec<f64> = points
-        .windows(3)
-        .filter_map(|three| {
-            let (a, b) = (three[1] - three[0], three[2] - three[1]);
-            let norms = a.norm() * b.norm();
-            (norms > 0.0).then(|| (a.dot(&b) / norms).clamp(-1.0, 1.0).acos().to_degrees())
-        })
-        .collect();
     BlockStats {
-        blocks: lengths.len(),
+        blocks: points.len().saturating_sub(1),
         block_length,
         min_block_length,
         max_block_length: max,
-        last_block_length: lengths.last().copied().unwrap_or(0.0),
+        last_block_length: last_length,
         short_blocks,
         short_end_blocks,
         min_block_ratio: min_block_length / block_length,
         path_length,
         estimated_time_s,
         path_time_s: path_length / feed * 60.0,
-        max_vertex_angle_deg: angles.iter().copied().fold(0.0, f64::max),
-        mean_vertex_angle_deg: if angles.is_empty() { 0.0 } else { angles.iter().sum::<f64>() / angles.len() as f64 },
+        max_vertex_angle_deg: max_angle,
+        mean_vertex_angle_deg: if angles == 0 { 0.0 } else { angle_sum / angles as f64 },
     }
 }
 
