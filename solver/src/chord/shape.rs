@@ -144,9 +144,6 @@ impl Spline {
         self.nurbs.speed(u)
     }
 
-    /// The exact deviation of a chord of a plain B-spline of degree ≤ 3 inside one knot span
-    /// ([`cubic::deviation`]) or across one knot ([`cubic::deviation_across_knot`]); `None`
-    /// elsewhere.
     /// [`Spline::exact_deviation`] of a chord from `ua` to `ub > ua`, with its rate of change per
     /// unit of u as `ub` moves ([`cubic::deviation_with_rate`]); `None` where that is `None`.
     pub(crate) fn deviation_with_rate(&self, ua: f64, ub: f64) -> Option<(f64, f64)> {
@@ -160,6 +157,9 @@ impl Spline {
         Some((deviation, rate * per_u))
     }
 
+    /// The exact deviation of a chord of a plain B-spline of degree ≤ 3 inside one knot span
+    /// ([`cubic::deviation`]) or across one knot ([`cubic::deviation_across_knot`]); `None`
+    /// elsewhere.
     fn exact_deviation(&self, ua: f64, ub: f64) -> Option<f64> {
         let (lo, hi) = (ua.min(ub), ua.max(ub));
         match self.nurbs.cubic_stretch(lo, hi)?.0 {
