@@ -26,13 +26,31 @@ const MAX_DEPTH: u32 = 16;
 pub(crate) const MAX_PANELS: usize = 2_000_000;
 
 /// ∫ speed over [a, b] by one 5-point Gauss–Legendre panel.
-fn panel(speed: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+pub(crate) fn gauss_panel(speed: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
     let (centre, half) = (0.5 * (a + b), 0.5 * (b - a));
     let mut sum = 0.0;
     for (node, weight) in NODES.iter().zip(WEIGHTS) {
         sum += weight * speed(centre + half * node);
     }
     sum * half
+}
+
+/// The integrand of an arc-length table, |dC/du|, and its integral over one panel: a curve of
+/// polynomial pieces finds the piece once per panel, not once per node (the chord search takes
+/// an arc length at every command point and window end; issue 14).
+pub(crate) trait Speed {
+    fn speed(&self, u: f64) -> f64;
+
+    /// ∫ speed over [a, b] by one 5-point Gauss–Legendre panel.
+    fn panel(&self, a: f64, b: f64) -> f64 {
+        gauss_panel(|u| self.speed(u), a, b)
+    }
+}
+
+impl<F: Fn(f64) -> f64> Speed for F {
+    fn speed(&self, u: f64) -> f64 {
+        self(u)
+    }
 }
 
 /// Panel boundaries `u[k]` with the arc length `s[k]` from the start to each.
@@ -54,7 +72,7 @@ impl ArcLengthTable {
     /// # Errors
     /// `E_TOO_MANY_POINTS` (at `field`) past [`MAX_PANELS`].
     pub(crate) fn build(
-        speed: &impl Fn(f64) -> f64,
+        speed: &impl Speed,
         breaks: &[f64],
         panels_per_break: usize,
         field: &str,
@@ -70,7 +88,7 @@ impl ArcLengthTable {
                 } else {
                     start + (end - start) * (k + 1) as f64 / panels_per_break as f64
                 };
-                let whole = panel(speed, a, b);
+                let whole = speed.panel(a, b);
                 table.refine(speed, a, b, whole, 0, field)?;
             }
         }
@@ -79,7 +97,7 @@ impl ArcLengthTable {
 
     fn refine(
         &mut self,
-        speed: &impl Fn(f64) -> f64,
+        speed: &impl Speed,
         a: f64,
         b: f64,
         whole: f64,
@@ -87,7 +105,7 @@ impl ArcLengthTable {
         field: &str,
     ) -> Result<(), SolverError> {
         let middle = 0.5 * (a + b);
-        let (left, right) = (panel(speed, a, middle), panel(speed, middle, b));
+        let (left, right) = (speed.panel(a, middle), speed.panel(middle, b));
         let converged = (left + right - whole).abs() <= 1e-14 + 1e-13 * whole.abs();
         if converged || depth >= MAX_DEPTH || middle <= a || middle >= b {
             if self.u.len() + 2 > MAX_PANELS {
@@ -135,17 +153,17 @@ impl ArcLengthTable {
     }
 
     /// Arc length from the start to parameter `u`.
-    pub(crate) fn s_at(&self, speed: &impl Fn(f64) -> f64, u: f64) -> f64 {
+    pub(crate) fn s_at(&self, speed: &impl Speed, u: f64) -> f64 {
         let k = self.panel_of_u(u);
         match (self.u.get(k), self.s.get(k)) {
-            (Some(&u0), Some(&s0)) if u > u0 => s0 + panel(speed, u0, u),
+            (Some(&u0), Some(&s0)) if u > u0 => s0 + speed.panel(u0, u),
             (_, Some(&s0)) => s0,
             _ => 0.0,
         }
     }
 
     /// Parameter at arc length `s` (clamped to the curve).
-    pub(crate) fn u_at(&self, speed: &impl Fn(f64) -> f64, s: f64) -> f64 {
+    pub(crate) fn u_at(&self, speed: &impl Speed, s: f64) -> f64 {
         let k = self.panel_of(&self.s, s);
         let (Some(&u0), Some(&u1), Some(&s0), Some(&s1)) =
             (self.u.get(k), self.u.get(k + 1), self.s.get(k), self.s.get(k + 1))
@@ -163,7 +181,7 @@ impl ArcLengthTable {
         let (mut lo, mut hi) = (u0, u1);
         let mut u = u0 + (u1 - u0) * target / (s1 - s0);
         for _ in 0..super::numeric::ITERATION_CAP {
-            let residual = panel(speed, u0, u) - target;
+            let residual = speed.panel(u0, u) - target;
             if residual > 0.0 {
                 hi = u;
             } else {
@@ -172,7 +190,7 @@ impl ArcLengthTable {
             if residual.abs() <= 1e-15 * (1.0 + s.abs()) || hi - lo <= f64::EPSILON * u.abs() {
                 return u;
             }
-            let slope = speed(u);
+            let slope = speed.speed(u);
             let newton = u - residual / slope;
             u = if slope > 0.0 && newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
         }

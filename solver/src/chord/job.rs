@@ -288,8 +288,7 @@ impl Curve {
                     .at("curve.control_points"));
                 }
                 let breaks: Vec<f64> = nurbs.breaks().iter().map(|(knot, _)| *knot).collect();
-                let speed = |u: f64| nurbs.speed(u);
-                let table = ArcLengthTable::build(&speed, &breaks, NURBS_PANELS_PER_SPAN, "curve.control_points")?;
+                let table = ArcLengthTable::build(&nurbs, &breaks, NURBS_PANELS_PER_SPAN, "curve.control_points")?;
                 let shape = Shape::Spline(Spline::new(nurbs, table));
                 let corners = shape.corners(corner);
                 (shape, corners, dimension)

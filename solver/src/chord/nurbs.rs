@@ -6,6 +6,7 @@ use std::cell::Cell;
 
 use crate::error::SolverError;
 
+use super::arclength::{Speed, gauss_panel};
 use crate::geometry::Vec3;
 use crate::validate::finite;
 
@@ -72,6 +73,40 @@ struct SpanPolynomial {
     /// For a plain B-spline: the coefficients of P − O itself (the homogeneous ones divided by
     /// the common weight once, not at every chord the search measures); zero otherwise.
     plain: [Vec3; SLOTS],
+}
+
+impl SpanPolynomial {
+    /// |dC/du| at local parameter t of a plain B-spline's span, from its squared-speed polynomial.
+    fn plain_speed(&self, t: f64) -> f64 {
+        // Every coefficient, the ones above degree 2p − 2 being zero: a loop of fixed length the
+        // compiler unrolls (leading zeros leave Horner's sum exactly as it was).
+        let squared = self.speed_squared.iter().rev().fold(0.0, |sum, c| sum * t + c);
+        squared.max(0.0).sqrt() * self.inverse_width
+    }
+}
+
+impl Speed for Nurbs {
+    fn speed(&self, u: f64) -> f64 {
+        Nurbs::speed(self, u)
+    }
+
+    /// On a plain B-spline the span is found once for the five nodes, which lie inside one span
+    /// when the panel does (the table's panels end at knots); each node's value is the one
+    /// [`Nurbs::speed`] gives, bit for bit.
+    fn panel(&self, a: f64, b: f64) -> f64 {
+        if self.common_weight.is_none() {
+            return gauss_panel(|u| Nurbs::speed(self, u), a, b);
+        }
+        let polynomial = &self.polynomials[self.span(0.5 * (a + b)) - self.degree];
+        gauss_panel(
+            |u| {
+                let t = (u - polynomial.start) * polynomial.inverse_width;
+                if t > 0.0 && t < 1.0 { polynomial.plain_speed(t) } else { Nurbs::speed(self, u) }
+            },
+            a,
+            b,
+        )
+    }
 }
 
 impl Nurbs {
@@ -524,10 +559,7 @@ impl Nurbs {
             return self.derivatives_by_basis(span, u)[1].norm();
         }
         if self.common_weight.is_some() {
-            // Every coefficient, the ones above degree 2p − 2 being zero: a loop of fixed length
-            // the compiler unrolls (leading zeros leave Horner's sum exactly as it was).
-            let squared = polynomial.speed_squared.iter().rev().fold(0.0, |sum, c| sum * t + c);
-            return squared.max(0.0).sqrt() * scale;
+            return polynomial.plain_speed(t);
         }
         let mut value = polynomial.coefficients[self.degree];
         let mut first = [0.0_f64; 4];

@@ -514,7 +514,7 @@ impl Shape {
         match self {
             Self::Arc(_) | Self::Polyline(_) => u,
             Self::Ellipse(ellipse) => ellipse.table.s_at(&|x| ellipse.speed(x), u),
-            Self::Spline(spline) => spline.table.s_at(&|x| spline.speed(x), u),
+            Self::Spline(spline) => spline.table.s_at(&spline.nurbs, u),
         }
     }
 
@@ -523,7 +523,7 @@ impl Shape {
         match self {
             Self::Arc(_) | Self::Polyline(_) => s.clamp(0.0, self.domain().1),
             Self::Ellipse(ellipse) => ellipse.table.u_at(&|x| ellipse.speed(x), s),
-            Self::Spline(spline) => spline.table.u_at(&|x| spline.speed(x), s),
+            Self::Spline(spline) => spline.table.u_at(&spline.nurbs, s),
         }
     }
 
@@ -881,9 +881,10 @@ mod tests {
 
     #[test]
     fn one_panel_per_knot_span_gives_the_arc_length_of_sixty_four() {
-        // Rational curves of degree 2 to 5 with weights from 0.05 to 20, one with a near-cusp
-        // (two control points 1e-4 apart): the table the chord job builds against a fine one.
-        for degree in 2..=5 {
+        // Rational curves of degree 2 to 5 with weights from 0.05 to 20, and plain ones, with a
+        // near-cusp (two control points 1e-4 apart): the table the chord job builds against a
+        // fine one.
+        for (degree, rational) in (2..=5).flat_map(|degree| [(degree, true), (degree, false)]) {
             let control: Vec<Vec3> = (0..14)
                 .map(|k| {
                     let k = f64::from(k);
@@ -891,20 +892,23 @@ mod tests {
                     Vec3::new(10.0 * (k - 1.0).max(0.0) + nudge, 8.0 * (1.3 * k).sin(), 3.0 * (0.7 * k).cos())
                 })
                 .collect();
-            let weights: Vec<f64> = (0..14).map(|k| [0.05, 1.0, 20.0, 0.7, 3.0][k % 5]).collect();
+            let weights: Vec<f64> =
+                (0..14).map(|k| if rational { [0.05, 1.0, 20.0, 0.7, 3.0][k % 5] } else { 1.0 }).collect();
             let nurbs = Nurbs::new(degree, &control, None, Some(&weights), "curve").unwrap();
             let breaks: Vec<f64> = nurbs.breaks().iter().map(|(knot, _)| *knot).collect();
+            // The coarse table as the job builds it (the span found once per panel), the fine one
+            // node by node through the plain closure.
             let speed = |u: f64| nurbs.speed(u);
             let coarse =
-                ArcLengthTable::build(&speed, &breaks, super::super::job::NURBS_PANELS_PER_SPAN, "curve").unwrap();
+                ArcLengthTable::build(&nurbs, &breaks, super::super::job::NURBS_PANELS_PER_SPAN, "curve").unwrap();
             let fine = ArcLengthTable::build(&speed, &breaks, 64, "curve").unwrap();
             assert_relative_eq!(coarse.length(), fine.length(), max_relative = 1e-13);
             for k in 0..=1000 {
                 let u = f64::from(k) / 1000.0;
-                let (a, b) = (coarse.s_at(&speed, u), fine.s_at(&speed, u));
+                let (a, b) = (coarse.s_at(&nurbs, u), fine.s_at(&speed, u));
                 assert!((a - b).abs() <= 1e-13 * fine.length(), "degree {degree}, u = {u}: {a} vs {b}");
                 let s = fine.length() * f64::from(k) / 1000.0;
-                let (a, b) = (coarse.u_at(&speed, s), fine.u_at(&speed, s));
+                let (a, b) = (coarse.u_at(&nurbs, s), fine.u_at(&speed, s));
                 assert!((a - b).abs() <= 1e-12, "degree {degree}, s = {s}: {a} vs {b}");
             }
         }
