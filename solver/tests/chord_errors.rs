@@ -479,3 +479,30 @@ fn slight_kinks_of_a_degree_one_nurbs_end_chords_exactly() {
         }
     }
 }
+
+#[test]
+fn a_sparse_polyline_is_warned_about_unless_its_long_edges_meet_at_corners() {
+    // A circle of radius 50 through points 5 mm apart: far sparser than a quarter of the 0.7 mm
+    // chord the rule aims at.
+    let sparse: Vec<[f64; 2]> = (0..=62)
+        .map(|k| {
+            let angle = f64::from(k) * 0.1;
+            [50.0 * angle.cos(), 50.0 * angle.sin()]
+        })
+        .collect();
+    let request = json!({"curve": {"kind": "polyline", "points": sparse}, "feed": 10000, "block_time_ms": 4});
+    assert!(codes(&ok(request)).contains(&"W_SPARSE_POLYLINE"));
+    // The same density on a polyline whose only bends are corners (a square): nothing to warn of.
+    let square = json!([[0, 0], [40, 0], [40, 40], [0, 40], [0, 0]]);
+    let request = json!({"curve": {"kind": "polyline", "points": square}, "feed": 10000, "block_time_ms": 4});
+    assert!(!codes(&ok(request)).contains(&"W_SPARSE_POLYLINE"));
+    // Dense points, 0.05 mm apart on the same circle: none.
+    let dense: Vec<[f64; 2]> = (0..=6000)
+        .map(|k| {
+            let angle = f64::from(k) * 0.001;
+            [50.0 * angle.cos(), 50.0 * angle.sin()]
+        })
+        .collect();
+    let request = json!({"curve": {"kind": "polyline", "points": dense}, "feed": 10000, "block_time_ms": 4});
+    assert!(!codes(&ok(request)).contains(&"W_SPARSE_POLYLINE"));
+}
