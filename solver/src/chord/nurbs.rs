@@ -365,6 +365,63 @@ impl Nurbs {
         Some(if bend == 0.0 { f64::INFINITY } else { first.norm().powi(3) / bend })
     }
 
+    /// The radius of curvature at interior knot `u` of a plain cubic curve, the smaller of its
+    /// one-sided values, from the power forms of the spans on either side (at the left one's
+    /// t = 1 and the right one's t = 0); `None` off a knot, on other curves, and where the curve
+    /// nearly stops there: the basis functions give the exact zero of a cusp, the power forms only
+    /// a rounding of it (radius_at then takes them; a curve has one knot per span, and their
+    /// radii by the basis functions cost a twentieth of the chord bench's B-spline solve).
+    pub(crate) fn plain_radius_at_knot(&self, u: f64) -> Option<f64> {
+        if !self.is_plain_cubic() {
+            return None;
+        }
+        let right = self.span(u);
+        if self.knots[right] != u {
+            return None;
+        }
+        let n = self.weighted.len();
+        let left = self.knots[..=n].partition_point(|&k| k < u).saturating_sub(1).clamp(self.degree, n - 1);
+        let radius = |span: usize, t: f64| {
+            let [first, second] = self.plain_derivatives_moving(span, t)?;
+            let bend = first.cross(&second).norm();
+            Some(if bend == 0.0 { f64::INFINITY } else { first.norm().powi(3) / bend })
+        };
+        let from_right = radius(right, 0.0)?;
+        if left == right {
+            return Some(from_right);
+        }
+        Some(from_right.min(radius(left, 1.0)?))
+    }
+
+    /// |dC/du| just after knot `u` of a plain cubic curve from the power form of the span it
+    /// starts; `None` as for [`Nurbs::plain_radius_at_knot`] (off a knot, other curves, a near
+    /// stop).
+    pub(crate) fn plain_speed_at_knot(&self, u: f64) -> Option<f64> {
+        if !self.is_plain_cubic() {
+            return None;
+        }
+        let span = self.span(u);
+        if self.knots[span] != u {
+            return None;
+        }
+        let [first, _] = self.plain_derivatives_moving(span, 0.0)?;
+        Some(first.norm() * self.polynomials[span - self.degree].inverse_width)
+    }
+
+    /// P′ and P″ in the parameter of non-empty span `span` of a plain cubic curve at its local t,
+    /// when |P′| stands clear of the power form's rounding (above 1e-6 of its coefficients'
+    /// size); `None` for an empty span and a near stop.
+    fn plain_derivatives_moving(&self, span: usize, t: f64) -> Option<[Vec3; 2]> {
+        let polynomial = &self.polynomials[span - self.degree];
+        if polynomial.inverse_width == 0.0 {
+            return None;
+        }
+        let [_, a1, a2, a3, ..] = polynomial.plain;
+        let first = a1 + t * (2.0 * a2 + 3.0 * a3 * t);
+        let size = a1.norm() + 2.0 * a2.norm() + 3.0 * a3.norm();
+        (first.norm() > 1e-6 * size).then(|| [first, 2.0 * a2 + 6.0 * a3 * t])
+    }
+
     /// Whether every span is a polynomial of degree ≤ 3 (a plain B-spline: one common weight),
     /// whose radius of curvature turns where a polynomial has its roots (`radius`).
     pub(crate) fn is_plain_cubic(&self) -> bool {
@@ -872,7 +929,39 @@ mod tests {
                 }
             }
             assert_eq!(curve.plain_radius_inside(knots[degree + 1]), None, "at a knot");
+            // At the interior knots: both one-sided radii and the speed after the knot, as the
+            // basis functions give them.
+            for &knot in &knots[degree + 1..knots.len() - degree - 1] {
+                let radius = |[_, first, second]: [Vec3; 3]| {
+                    let bend = first.cross(&second).norm();
+                    if bend == 0.0 { f64::INFINITY } else { first.norm().powi(3) / bend }
+                };
+                let right = curve.derivatives(knot);
+                let by_basis =
+                    curve.derivatives_from_left(knot).map_or(radius(right), |left| radius(left).min(radius(right)));
+                let plain = curve.plain_radius_at_knot(knot).expect("the curve moves at its knots");
+                if degree == 1 {
+                    assert_eq!(plain, f64::INFINITY);
+                } else {
+                    assert!(
+                        (plain - by_basis).abs() <= 1e-9 * by_basis,
+                        "degree {degree}, knot {knot}: {plain} vs {by_basis}"
+                    );
+                }
+                let speed = curve.plain_speed_at_knot(knot).unwrap();
+                assert!((speed - curve.speed(knot)).abs() <= 1e-12 * speed, "degree {degree}, knot {knot}");
+            }
         }
+        // A cusp: three coincident control points of a cubic stop the curve at a knot, where only
+        // the basis functions are exact.
+        let mut cusp = control.clone();
+        (cusp[4], cusp[5]) = (cusp[3], cusp[3]);
+        let curve = Nurbs::new(3, &cusp, None, None, "curve").unwrap();
+        let slowest = (1..6).map(|k| f64::from(k) / 6.0).min_by(|a, b| curve.speed(*a).total_cmp(&curve.speed(*b)));
+        let knot = slowest.unwrap();
+        assert!(curve.speed(knot) < 1e-12, "the curve stops at a knot: {}", curve.speed(knot));
+        assert_eq!(curve.plain_radius_at_knot(knot), None);
+        assert_eq!(curve.plain_speed_at_knot(knot), None);
         let weights = vec![1.0, 2.0, 1.0, 1.0, 0.5, 1.0, 1.0, 3.0, 1.0];
         let rational = Nurbs::new(3, &control, None, Some(&weights), "curve").unwrap();
         assert_eq!(rational.plain_radius_inside(0.3), None);

@@ -38,7 +38,7 @@ pub(crate) fn radius_of([_, first, second]: [Vec3; 3]) -> f64 {
 /// Radius of curvature at `u`; at a knot the smaller of both one-sided values (the curvature
 /// of a degree-2 curve may jump there).
 pub(crate) fn radius_at(nurbs: &Nurbs, u: f64) -> f64 {
-    if let Some(radius) = nurbs.plain_radius_inside(u) {
+    if let Some(radius) = nurbs.plain_radius_inside(u).or_else(|| nurbs.plain_radius_at_knot(u)) {
         return radius;
     }
     let right = radius_of(nurbs.derivatives(u));

@@ -786,7 +786,8 @@ impl Shape {
                     let (before, (knot, multiplicity), after) = (window[0].0, window[1], window[2].0);
                     // A tangent may break where the curve is only C0 (multiplicity ≥ degree) or
                     // where it stops (a cusp from `degree` coincident control points).
-                    let stops = spline.speed(knot) <= 1e-9 * mean_speed;
+                    let speed = spline.nurbs.plain_speed_at_knot(knot).unwrap_or_else(|| spline.speed(knot));
+                    let stops = speed <= 1e-9 * mean_speed;
                     if multiplicity < degree && !stops {
                         continue;
                     }
