@@ -923,7 +923,7 @@ mod tests {
                     assert_eq!(plain, f64::INFINITY);
                 } else {
                     assert!(
-                        (plain - homogeneous).abs() <= 1e-9 * homogeneous,
+                        (plain - homogeneous).abs() <= 1e-11 * homogeneous,
                         "degree {degree}, u = {u}: {plain} vs {homogeneous}"
                     );
                 }
@@ -944,7 +944,7 @@ mod tests {
                     assert_eq!(plain, f64::INFINITY);
                 } else {
                     assert!(
-                        (plain - by_basis).abs() <= 1e-9 * by_basis,
+                        (plain - by_basis).abs() <= 1e-11 * by_basis,
                         "degree {degree}, knot {knot}: {plain} vs {by_basis}"
                     );
                 }
