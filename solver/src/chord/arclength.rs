@@ -8,10 +8,10 @@ use std::cell::Cell;
 use crate::error::SolverError;
 
 /// 5-point Gauss–Legendre nodes on [−1, 1].
-const NODES: [f64; 5] =
+pub(crate) const NODES: [f64; 5] =
     [-0.906_179_845_938_664, -0.538_469_310_105_683_1, 0.0, 0.538_469_310_105_683_1, 0.906_179_845_938_664];
 /// Their weights.
-const WEIGHTS: [f64; 5] = [
+pub(crate) const WEIGHTS: [f64; 5] = [
     0.236_926_885_056_189_1,
     0.478_628_670_499_366_5,
     0.568_888_888_888_888_9,
