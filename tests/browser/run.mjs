@@ -381,7 +381,8 @@ const scenarios = {
     if (await page.inputValue('#machine-form input[name="spindle_power_kw"]') !== '5.5') throw new Error('Edit did not fill the spindle power');
     await page.fill('#machine-form input[name="margin"]', '1.2');
     await page.click('#machine-save');
-    await page.waitForSelector('#machine-messages .message.ok', { timeout: 60000 });
+    // The message of hsc-page's save is still there: wait for the one naming this machine.
+    await page.waitForFunction(() => /Machine api-full saved/.test(document.querySelector('#machine-messages .message.ok')?.textContent ?? ''), null, { timeout: 60000 });
     const edited = await page.evaluate(async (url) => (await fetch(url)).json(), `${base}/api/v1/machines/api-full`);
     for (const [key, expected] of Object.entries({ ...full, margin: 1.2 })) {
       if (edited[key] !== expected) throw new Error(`editing on the page changed ${key}: ${JSON.stringify(edited)}`);
