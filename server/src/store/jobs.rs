@@ -281,6 +281,17 @@ const JOB_PROGRESS: &str = "UPDATE jobs SET heartbeat_at = now(), progress = (
          FROM job_chunks WHERE job_id = $1)
      WHERE id = $1 AND status = 'running'";
 
+/// Sets job `id`'s progress from its chunks' ([`JOB_PROGRESS`]) after locking the job's row in a
+/// statement of its own. Under READ COMMITTED a statement reads in the snapshot it started with:
+/// in one statement two workers' heartbeats could each sum the chunks before the other's commit,
+/// and the later write would leave the job behind its chunks (seen once by the cluster test). A
+/// transaction that waited for the lock reads the chunks afresh, the other's commit included.
+async fn set_job_progress(transaction: &mut sqlx::Transaction<'_, sqlx::Postgres>, id: i64) -> AppResult<()> {
+    sqlx::query("SELECT id FROM jobs WHERE id = $1 FOR UPDATE").bind(id).execute(&mut **transaction).await?;
+    sqlx::query(JOB_PROGRESS).bind(id).execute(&mut **transaction).await?;
+    Ok(())
+}
+
 /// Bytes as the stores count them.
 fn bytes(count: usize) -> i64 {
     i64::try_from(count).unwrap_or(i64::MAX)
@@ -518,7 +529,7 @@ async fn claim_chunk(pool: &sqlx::PgPool, claimant: &Claimant) -> AppResult<Chun
         return Ok(Chunk::Gone);
     };
     // A chunk claimed again starts over: the job's progress loses what it had done.
-    sqlx::query(JOB_PROGRESS).bind(id).execute(&mut *transaction).await?;
+    set_job_progress(&mut transaction, id).await?;
     transaction.commit().await?;
     Ok(Chunk::Claimed(Work { id, chunk: Some(index(position)?) }, task, json, attempt))
 }
@@ -601,7 +612,7 @@ pub async fn split(db: &Db, work: Work, claimant: &Claimant, split: &Split) -> A
     .bind(weight(split.finish_seconds))
     .execute(&mut *transaction)
     .await?;
-    sqlx::query(JOB_PROGRESS).bind(work.id).execute(&mut *transaction).await?;
+    set_job_progress(&mut transaction, work.id).await?;
     wake_workers(&mut transaction, work.id).await?;
     transaction.commit().await?;
     Ok(true)
@@ -676,7 +687,7 @@ pub async fn heartbeat(db: &Db, work: Work, claimant: &Claimant, progress: f64) 
                 transaction.rollback().await?;
                 return Ok(false);
             }
-            sqlx::query(JOB_PROGRESS).bind(work.id).execute(&mut *transaction).await?;
+            set_job_progress(&mut transaction, work.id).await?;
             transaction.commit().await?;
             Ok(true)
         }
@@ -850,7 +861,7 @@ pub async fn finish(
             .bind(work.id)
             .execute(&mut *transaction)
             .await?;
-            sqlx::query(JOB_PROGRESS).bind(work.id).execute(&mut *transaction).await?;
+            set_job_progress(&mut transaction, work.id).await?;
             transaction.commit().await?;
         }
     }
@@ -938,7 +949,7 @@ pub async fn finish_part(
         .bind(work.id)
         .execute(&mut *transaction)
         .await?;
-    sqlx::query(JOB_PROGRESS).bind(work.id).execute(&mut *transaction).await?;
+    set_job_progress(&mut transaction, work.id).await?;
     let (left,): (i64,) = sqlx::query_as(
         "SELECT COUNT(*) FROM job_chunks WHERE job_id = $1 AND operation = $2 AND kind = 'part' AND status <> 'done'",
     )
@@ -1274,7 +1285,7 @@ pub async fn release(db: &Db, claimant: &Claimant) -> AppResult<u64> {
     .await?;
     let released = jobs.len() as u64;
     for (id,) in jobs {
-        sqlx::query(JOB_PROGRESS).bind(id).execute(&mut *transaction).await?;
+        set_job_progress(&mut transaction, id).await?;
     }
     if released > 0 {
         sqlx::query("SELECT pg_notify($1, '')").bind(SUBMITTED_CHANNEL).execute(&mut *transaction).await?;

@@ -553,6 +553,57 @@ async fn a_prediction_splits_across_workers_and_survives_a_kill() {
     api.terminate();
 }
 
+/// Two workers' heartbeats at once keep the job's progress at its chunks' sum: the second one
+/// waits for the first's lock on the job and must add up the chunks after the first commits (it
+/// used to sum them from the snapshot it took before waiting, and left the job behind; the
+/// prediction test above saw that once). The first heartbeat is held open by hand between its
+/// chunk's update and its commit, so the interleaving is certain.
+#[tokio::test(flavor = "multi_thread")]
+async fn heartbeats_at_once_keep_the_job_at_its_chunks_sum() {
+    use kerf_server::jobs::file::{self, Format};
+    use kerf_server::store::jobs::{self as store, Claimant};
+    let Some(postgres) = PgServer::start() else { return };
+    let db = kerf_server::db::open(&postgres.database()).await.unwrap();
+    let deburr = json!({"operation": "deburr", "tool": {"kind": "ball", "radius": 3},
+        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
+        "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5});
+    let job = json!({"name": "two chunks", "operations": [deburr, deburr]});
+    let id = store::insert(&db, &file::parse(&job.to_string(), Format::Json).unwrap(), "two chunks", u64::MAX)
+        .await
+        .unwrap();
+    let claimant = |worker: &str| Claimant { worker: worker.into(), lease: Duration::from_secs(60) };
+    let (first, second) = (claimant("first"), claimant("second"));
+    let first_work = store::claim(&db, &first).await.unwrap().expect("a chunk for the first worker").work;
+    let second_work = store::claim(&db, &second).await.unwrap().expect("a chunk for the second worker").work;
+    assert_eq!((first_work.id, second_work.id), (id, id));
+    assert_ne!(first_work.chunk, second_work.chunk);
+
+    // The first heartbeat: its chunk at 0.5 and the job's row locked, not committed yet.
+    let pool = connect(&postgres).await;
+    let mut held = pool.begin().await.unwrap();
+    let position = i64::try_from(first_work.chunk.unwrap()).unwrap();
+    sqlx::query("UPDATE job_chunks SET progress = 0.5 WHERE job_id = $1 AND position = $2")
+        .bind(id)
+        .bind(position)
+        .execute(&mut *held)
+        .await
+        .unwrap();
+    sqlx::query("SELECT id FROM jobs WHERE id = $1 FOR UPDATE").bind(id).execute(&mut *held).await.unwrap();
+
+    let second_beat = tokio::spawn({
+        let db = db.clone();
+        async move { store::heartbeat(&db, second_work, &second, 0.25).await }
+    });
+    tokio::time::sleep(Duration::from_millis(500)).await;
+    assert!(!second_beat.is_finished(), "the second heartbeat waits for the first's lock on the job");
+    held.commit().await.unwrap();
+    assert!(second_beat.await.unwrap().unwrap(), "the second heartbeat keeps its chunk");
+
+    let (progress, sum, _) = progress_and_sum(&pool, id).await;
+    assert!((sum - 0.375).abs() < 1e-9, "the chunks at 0.5 and 0.25 weigh alike: {sum}");
+    assert!((progress - sum).abs() < 1e-9, "job progress {progress}, chunks' sum {sum}");
+}
+
 #[tokio::test(flavor = "multi_thread")]
 async fn a_refused_part_fails_its_job_with_its_problem() {
     let Some(postgres) = PgServer::start() else { return };
