@@ -7,6 +7,7 @@ use std::cell::Cell;
 use crate::error::SolverError;
 
 use super::arclength::{Speed, gauss_panel};
+use super::radius::radius_from;
 use crate::geometry::Vec3;
 use crate::validate::finite;
 
@@ -361,8 +362,7 @@ impl Nurbs {
         let [_, a1, a2, a3, ..] = polynomial.plain;
         let first = a1 + t * (2.0 * a2 + 3.0 * a3 * t);
         let second = 2.0 * a2 + 6.0 * a3 * t;
-        let bend = first.cross(&second).norm();
-        Some(if bend == 0.0 { f64::INFINITY } else { first.norm().powi(3) / bend })
+        Some(radius_from(&first, &second))
     }
 
     /// The radius of curvature at interior knot `u` of a plain cubic curve, the smaller of its
@@ -383,8 +383,7 @@ impl Nurbs {
         let left = self.knots[..=n].partition_point(|&k| k < u).saturating_sub(1).clamp(self.degree, n - 1);
         let radius = |span: usize, t: f64| {
             let [first, second] = self.plain_derivatives_moving(span, t)?;
-            let bend = first.cross(&second).norm();
-            Some(if bend == 0.0 { f64::INFINITY } else { first.norm().powi(3) / bend })
+            Some(radius_from(&first, &second))
         };
         let from_right = radius(right, 0.0)?;
         if left == right {
@@ -806,6 +805,7 @@ fn validate_knots(knots: &[f64], degree: usize, count: usize, field: &str) -> Re
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::chord::radius::radius_of;
     use approx::assert_abs_diff_eq;
 
     fn points(list: &[[f64; 2]]) -> Vec<Vec3> {
@@ -916,9 +916,7 @@ mod tests {
                     assert!(knots.contains(&u), "degree {degree}: no plain radius at {u}");
                     continue;
                 };
-                let [_, first, second] = curve.derivatives(u);
-                let bend = first.cross(&second).norm();
-                let homogeneous = if bend == 0.0 { f64::INFINITY } else { first.norm().powi(3) / bend };
+                let homogeneous = radius_of(curve.derivatives(u));
                 if degree == 1 {
                     assert_eq!(plain, f64::INFINITY);
                 } else {
@@ -932,13 +930,10 @@ mod tests {
             // At the interior knots: both one-sided radii and the speed after the knot, as the
             // basis functions give them.
             for &knot in &knots[degree + 1..knots.len() - degree - 1] {
-                let radius = |[_, first, second]: [Vec3; 3]| {
-                    let bend = first.cross(&second).norm();
-                    if bend == 0.0 { f64::INFINITY } else { first.norm().powi(3) / bend }
-                };
                 let right = curve.derivatives(knot);
-                let by_basis =
-                    curve.derivatives_from_left(knot).map_or(radius(right), |left| radius(left).min(radius(right)));
+                let by_basis = curve
+                    .derivatives_from_left(knot)
+                    .map_or(radius_of(right), |left| radius_of(left).min(radius_of(right)));
                 let plain = curve.plain_radius_at_knot(knot).expect("the curve moves at its knots");
                 if degree == 1 {
                     assert_eq!(plain, f64::INFINITY);

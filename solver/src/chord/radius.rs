@@ -31,7 +31,13 @@ const STRETCH_PIECES: usize = 8;
 /// Radius of curvature |C'|³/|C'×C''| from a point and its first two derivatives (infinite
 /// where straight).
 pub(crate) fn radius_of([_, first, second]: [Vec3; 3]) -> f64 {
-    let bend = first.cross(&second).norm();
+    radius_from(&first, &second)
+}
+
+/// Radius of curvature |C'|³/|C'×C''| from the first two derivatives in any parameter (the
+/// scale cancels; infinite where straight).
+pub(crate) fn radius_from(first: &Vec3, second: &Vec3) -> f64 {
+    let bend = first.cross(second).norm();
     if bend == 0.0 { f64::INFINITY } else { first.norm().powi(3) / bend }
 }
 
