@@ -40,6 +40,16 @@
 //!   feed × block time) and [`solve`], and map each answer point back by its `s` (arc length
 //!   along the samples).
 //!
+//! [`rule`]: crate::machine::rule
+//! [`stats`]: crate::machine::stats
+//! [`machine`]: crate::machine
+//! [`block_stats`]: crate::machine::block_stats
+//! [`BlockRule::resolve`]: crate::machine::BlockRule::resolve
+//! [`BlockRule::target_chord`]: crate::machine::BlockRule::target_chord
+//! [`BlockRule::tolerance_for`]: crate::machine::BlockRule::tolerance_for
+//! [`validate_machine_name`]: crate::machine::validate_machine_name
+//! [`Post`]: crate::gcode::Post
+//!
 //! # Choices where the spec is open (chord.md §8)
 //!
 //! The window radius is the 3-point circumradius by default (the patent), held within 1.1 times

@@ -1,5 +1,5 @@
 //! The contour request as clients send it (api.md, Contour): the wire types and their defaults.
-//! [`super::job`] validates it into the model the solver works on.
+//! `job` validates it into the model the solver works on.
 
 use serde::{Deserialize, Serialize};
 

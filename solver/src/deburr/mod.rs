@@ -16,7 +16,7 @@
 //! * `tolerance`: the target points from TA (§3), or with a block time from the block-time rule
 //!   per interval, never coarser than TA (issue 3, chord.md);
 //! * `checks`: validity limits and warnings (§4);
-//! * [`program`]: lead moves and G-code (§6.3);
+//! * [`mod@program`]: lead moves and G-code (§6.3);
 //! * `parts`: a several-loop job's loops split into ranges that several workers solve at once
 //!   (issue 12).
 

@@ -1,5 +1,5 @@
 //! The deburr request as clients send it (api.md, Deburr): the wire types and their defaults.
-//! [`super::job`] validates it into the model the solver works on.
+//! `job` validates it into the model the solver works on.
 
 pub use crate::geometry::Direction;
 use serde::{Deserialize, Serialize};

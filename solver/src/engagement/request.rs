@@ -1,5 +1,5 @@
 //! The engagement request as clients send it (api.md, Engagement; engagement.md §2): the wire
-//! types and their defaults. [`super::job`] validates it into the model the solver works on.
+//! types and their defaults. `job` validates it into the model the solver works on.
 
 pub use crate::geometry::Direction;
 use std::fmt;

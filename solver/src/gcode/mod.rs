@@ -243,7 +243,7 @@ pub fn write(program: &Program<'_>) -> String {
 
 /// Writes the whole program with stops in it (`stops` in the order of their moves); each is
 /// `M05`, `G00 Z` to the clearance plane, the notice as a comment with `M00`, the tool call as at
-/// the start, and the spindle line. Without stops, [`write`].
+/// the start, and the spindle line. Without stops, [`fn@write`].
 pub fn write_changing(program: &Program<'_>, stops: &[ProgramStop]) -> String {
     let mut out = String::with_capacity(64 + program.path.moves.len() * 40);
     let fanuc = program.dialect == Dialect::Fanuc;

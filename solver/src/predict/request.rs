@@ -1,5 +1,5 @@
 //! The prediction request as clients send it (api.md, Error prediction): the wire types, their
-//! defaults and limits. [`super::job`] validates it into the model the solver works on.
+//! defaults and limits. `job` validates it into the model the solver works on.
 
 pub use crate::gcode::SpindleDirection;
 use serde::{Deserialize, Serialize};

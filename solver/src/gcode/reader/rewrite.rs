@@ -28,7 +28,7 @@ pub struct MoveEdit {
 /// every later end point stays where it was. Rapids without an edit are never rewritten (issue
 /// 15): after a moved cut they start, and in the axes they do not program end, where that cut
 /// ended; the next feed move is written to its own end point from there. `program` must be the
-/// result of [`read`] on `text`.
+/// result of [`super::read`] on `text`.
 ///
 /// # Errors
 /// `E_INPUT` for an edit that names no move, or a non-finite coordinate.
