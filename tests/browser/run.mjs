@@ -763,6 +763,8 @@ const scenarios = {
     await page.waitForSelector('#job-rows tr[data-status="done"]', { timeout: 60000 });
     const seconds = (Date.now() - started) / 1000;
     await page.click('#job-rows tr[data-status="done"] button');
+    // Every operation's plots, not only the first one's (each waits for its own program).
+    await page.waitForSelector('#job-result[data-state="shown"]', { timeout: 60000 });
     await page.waitForSelector('#job-result [data-state="drawn"]', { timeout: 60000 });
     const plots = await page.$$eval('#job-result canvas', (list) => list.length);
     const inked = await inkedPixels('#job-result canvas');

@@ -140,6 +140,7 @@ async function openJob(id, root) {
   try {
     const job = await api('GET', `/api/v1/jobs/${id}`);
     box.replaceChildren();
+    delete box.dataset.state;
     const title = document.createElement('h2');
     title.textContent = `Job #${job.id}${job.name ? ': ' + job.name : ''}`;
     box.append(title);
@@ -211,6 +212,8 @@ async function openJob(id, root) {
       })());
     });
     await Promise.all(shown);
+    // Each operation is shown once its program has come: only now is every plot on the page.
+    box.dataset.state = 'shown';
     box.scrollIntoView({ behavior: 'smooth', block: 'start' });
   } catch (problem) {
     showProblem(root.querySelector('#job-messages'), null, problem);
