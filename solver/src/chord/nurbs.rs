@@ -365,6 +365,15 @@ impl Nurbs {
         Some(radius_from(&first, &second))
     }
 
+    /// The span starting at knot `u` of a plain cubic curve; `None` off a knot and on other curves.
+    fn plain_cubic_span_from_knot(&self, u: f64) -> Option<usize> {
+        if !self.is_plain_cubic() {
+            return None;
+        }
+        let span = self.span(u);
+        (self.knots[span] == u).then_some(span)
+    }
+
     /// The radius of curvature at interior knot `u` of a plain cubic curve, the smaller of its
     /// one-sided values, from the power forms of the spans on either side (at the left one's
     /// t = 1 and the right one's t = 0); `None` off a knot, on other curves, and where the curve
@@ -372,13 +381,7 @@ impl Nurbs {
     /// a rounding of it (radius_at then takes them; a curve has one knot per span, and their
     /// radii by the basis functions cost a twentieth of the chord bench's B-spline solve).
     pub(crate) fn plain_radius_at_knot(&self, u: f64) -> Option<f64> {
-        if !self.is_plain_cubic() {
-            return None;
-        }
-        let right = self.span(u);
-        if self.knots[right] != u {
-            return None;
-        }
+        let right = self.plain_cubic_span_from_knot(u)?;
         let n = self.weighted.len();
         let left = self.knots[..=n].partition_point(|&k| k < u).saturating_sub(1).clamp(self.degree, n - 1);
         let radius = |span: usize, t: f64| {
@@ -396,13 +399,7 @@ impl Nurbs {
     /// starts; `None` as for [`Nurbs::plain_radius_at_knot`] (off a knot, other curves, a near
     /// stop).
     pub(crate) fn plain_speed_at_knot(&self, u: f64) -> Option<f64> {
-        if !self.is_plain_cubic() {
-            return None;
-        }
-        let span = self.span(u);
-        if self.knots[span] != u {
-            return None;
-        }
+        let span = self.plain_cubic_span_from_knot(u)?;
         let [first, _] = self.plain_derivatives_moving(span, 0.0)?;
         Some(first.norm() * self.polynomials[span - self.degree].inverse_width)
     }
