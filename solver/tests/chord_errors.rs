@@ -484,12 +484,10 @@ fn slight_kinks_of_a_degree_one_nurbs_end_chords_exactly() {
 fn a_sparse_polyline_is_warned_about_unless_its_long_edges_meet_at_corners() {
     // A circle of radius 50 through points 5 mm apart: far sparser than a quarter of the 0.7 mm
     // chord the rule aims at.
-    let sparse: Vec<[f64; 2]> = (0..=62)
-        .map(|k| {
-            let angle = f64::from(k) * 0.1;
-            [50.0 * angle.cos(), 50.0 * angle.sin()]
-        })
-        .collect();
+    let on_circle = |step: f64, count: u32| -> Vec<[f64; 2]> {
+        (0..=count).map(|k| f64::from(k) * step).map(|angle| [50.0 * angle.cos(), 50.0 * angle.sin()]).collect()
+    };
+    let sparse = on_circle(0.1, 62);
     let request = json!({"curve": {"kind": "polyline", "points": sparse}, "feed": 10000, "block_time_ms": 4});
     assert!(codes(&ok(request)).contains(&"W_SPARSE_POLYLINE"));
     // The same density on a polyline whose only bends are corners (a square): nothing to warn of.
@@ -497,12 +495,7 @@ fn a_sparse_polyline_is_warned_about_unless_its_long_edges_meet_at_corners() {
     let request = json!({"curve": {"kind": "polyline", "points": square}, "feed": 10000, "block_time_ms": 4});
     assert!(!codes(&ok(request)).contains(&"W_SPARSE_POLYLINE"));
     // Dense points, 0.05 mm apart on the same circle: none.
-    let dense: Vec<[f64; 2]> = (0..=6000)
-        .map(|k| {
-            let angle = f64::from(k) * 0.001;
-            [50.0 * angle.cos(), 50.0 * angle.sin()]
-        })
-        .collect();
+    let dense = on_circle(0.001, 6000);
     let request = json!({"curve": {"kind": "polyline", "points": dense}, "feed": 10000, "block_time_ms": 4});
     assert!(!codes(&ok(request)).contains(&"W_SPARSE_POLYLINE"));
 }

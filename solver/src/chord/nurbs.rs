@@ -902,6 +902,14 @@ mod tests {
             })
             .collect();
         for degree in 1..=3 {
+            // Straight (degree 1): infinite; else within 1e-11 of the basis functions' value.
+            let same_radius = |plain: f64, reference: f64, at: &str| {
+                if degree == 1 {
+                    assert_eq!(plain, f64::INFINITY, "{at}");
+                } else {
+                    assert!((plain - reference).abs() <= 1e-11 * reference, "{at}: {plain} vs {reference}");
+                }
+            };
             let inner = control.len() - degree - 1;
             let mut knots = vec![0.0; degree + 1];
             knots.extend((1..=inner).map(|k| (f64::from(k as u32) / (inner + 1) as f64).powf(1.3)));
@@ -913,15 +921,7 @@ mod tests {
                     assert!(knots.contains(&u), "degree {degree}: no plain radius at {u}");
                     continue;
                 };
-                let homogeneous = radius_of(curve.derivatives(u));
-                if degree == 1 {
-                    assert_eq!(plain, f64::INFINITY);
-                } else {
-                    assert!(
-                        (plain - homogeneous).abs() <= 1e-11 * homogeneous,
-                        "degree {degree}, u = {u}: {plain} vs {homogeneous}"
-                    );
-                }
+                same_radius(plain, radius_of(curve.derivatives(u)), &format!("degree {degree}, u = {u}"));
             }
             assert_eq!(curve.plain_radius_inside(knots[degree + 1]), None, "at a knot");
             // At the interior knots: both one-sided radii and the speed after the knot, as the
@@ -932,14 +932,7 @@ mod tests {
                     .derivatives_from_left(knot)
                     .map_or(radius_of(right), |left| radius_of(left).min(radius_of(right)));
                 let plain = curve.plain_radius_at_knot(knot).expect("the curve moves at its knots");
-                if degree == 1 {
-                    assert_eq!(plain, f64::INFINITY);
-                } else {
-                    assert!(
-                        (plain - by_basis).abs() <= 1e-11 * by_basis,
-                        "degree {degree}, knot {knot}: {plain} vs {by_basis}"
-                    );
-                }
+                same_radius(plain, by_basis, &format!("degree {degree}, knot {knot}"));
                 let speed = curve.plain_speed_at_knot(knot).unwrap();
                 assert!((speed - curve.speed(knot)).abs() <= 1e-12 * speed, "degree {degree}, knot {knot}");
             }
