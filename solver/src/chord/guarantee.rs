@@ -38,10 +38,11 @@ impl Cutter<'_> {
         if let Some(largest) = self.largest_rule_chord_error(rule, tolerance) {
             self.refuse_certain_overflow(largest)?;
         }
-        let Some(mut cut) = self.start() else {
+        let target = rule.target_chord();
+        let Some(mut cut) = self.start(target) else {
             return Ok(Cut::default());
         };
-        let target = rule.target_chord();
+        cut.windows.reserve(self.expected_blocks(target));
         for &(u_start, u_end) in self.spans {
             let limit = self.vertex(u_end);
             let mut from = self.vertex(u_start);

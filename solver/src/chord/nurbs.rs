@@ -71,6 +71,8 @@ struct SpanPolynomial {
     /// For a plain B-spline (one common weight): coefficients of t⁰…t^(2p−2) of |dP/dt|², so the
     /// arc-length integrand is one square root of a polynomial; empty (all zero) otherwise.
     speed_squared: [f64; 2 * MAX_DEGREE - 1],
+    /// 2p − 1, the coefficients of `speed_squared` that may be non-zero.
+    speed_terms: usize,
     /// For a plain B-spline: the coefficients of P − O itself (the homogeneous ones divided by
     /// the common weight once, not at every chord the search measures); zero otherwise.
     plain: [Vec3; SLOTS],
@@ -79,9 +81,12 @@ struct SpanPolynomial {
 impl SpanPolynomial {
     /// |dC/du| at local parameter t of a plain B-spline's span, from its squared-speed polynomial.
     fn plain_speed(&self, t: f64) -> f64 {
-        // Every coefficient, the ones above degree 2p − 2 being zero: a loop of fixed length the
-        // compiler unrolls (leading zeros leave Horner's sum exactly as it was).
-        let squared = self.speed_squared.iter().rev().fold(0.0, |sum, c| sum * t + c);
+        // Loops of fixed length the compiler unrolls: the cubic's five coefficients (nearly every
+        // curve sent), else all of them, the ones above degree 2p − 2 being zero (leading zeros
+        // leave Horner's sum exactly as it was, so both give the same bits).
+        let horner = |coefficients: &[f64]| coefficients.iter().rev().fold(0.0, |sum, c| sum * t + c);
+        let squared =
+            if self.speed_terms == 5 { horner(&self.speed_squared[..5]) } else { horner(&self.speed_squared) };
         squared.max(0.0).sqrt() * self.inverse_width
     }
 }
@@ -474,6 +479,7 @@ impl Nurbs {
                 inverse_width: 0.0,
                 coefficients,
                 speed_squared: [0.0; 2 * MAX_DEGREE - 1],
+                speed_terms: 2 * p - 1,
                 plain: [Vec3::zeros(); SLOTS],
             };
         }
@@ -528,7 +534,15 @@ impl Nurbs {
                 *vector = Vec3::new(h[0], h[1], h[2]) / weight;
             }
         }
-        SpanPolynomial { origin, start, inverse_width: 1.0 / (end - start), coefficients, speed_squared, plain }
+        SpanPolynomial {
+            origin,
+            start,
+            inverse_width: 1.0 / (end - start),
+            coefficients,
+            speed_squared,
+            speed_terms: 2 * p - 1,
+            plain,
+        }
     }
 
     /// Point, first and second derivative with respect to u (the right-hand limits at a knot).
