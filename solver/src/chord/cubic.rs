@@ -24,36 +24,52 @@ pub(crate) fn deviation(piece: &CubicPiece) -> Option<f64> {
     Some(Chord::of(piece)?.deviation)
 }
 
-/// [`deviation`] with its rate of change as the chord's end `t_hi` moves along the curve, per unit
-/// of the piece's parameter: the chord search steps to the chord error by Newton with it.
+/// [`deviation`] with what its rate of change needs as the chord's end `t_hi` moves along the
+/// curve, per unit of the piece's parameter: the chord search steps to the chord error by Newton
+/// with it.
 ///
 /// The farthest point P* stays the farthest to first order (it is an interior maximum), so the
 /// rate is that of the distance of the fixed P* from the line A–B as B moves with P′(t_hi):
 /// with u = B − A, n = P* − A and m = n × u, D = |m|/|u| and
 /// dD = m·(n × P′)/(|m|·|u|) − |m|·(u·P′)/|u|³ = m·(n × P′)/(D·|u|²) − D·(u·P′)/|u|².
-/// `None` as for [`deviation`], and where the piece is straight (D = 0: the rate has no
-/// direction).
-pub(crate) fn deviation_with_rate(piece: &CubicPiece) -> Option<(f64, f64)> {
+/// `None` as for [`deviation`]; the rate itself is `None` where the piece is straight (D = 0:
+/// the rate has no direction).
+pub(crate) fn deviation_with_rate(piece: &CubicPiece) -> Option<(f64, RateInputs)> {
     let chord = Chord::of(piece)?;
     let [_, a1, a2, a3] = piece.coefficients;
     let t_hi = piece.t_hi;
     let velocity = a1 + t_hi * (2.0 * a2 + 3.0 * a3 * t_hi);
-    let peak_from_start = piece.point(chord.peak) - chord.start;
-    let rate = rate_of_distance(chord.deviation, &peak_from_start, &(chord.end - chord.start), &velocity)?;
-    Some((chord.deviation, rate))
+    let from_start = piece.point(chord.peak) - chord.start;
+    let inputs = RateInputs { distance: chord.deviation, from_start, along: chord.end - chord.start, velocity };
+    Some((chord.deviation, inputs))
 }
 
-/// The rate of `distance`, that of a fixed point from the line A–B, as B moves with `velocity`,
-/// with `from_start` = point − A and `along` = B − A (see [`deviation_with_rate`]); `None` for a
-/// point on the line.
-fn rate_of_distance(distance: f64, from_start: &Vec3, along: &Vec3, velocity: &Vec3) -> Option<f64> {
-    let length_squared = along.norm_squared();
-    if !(distance > 0.0 && length_squared > 0.0) {
-        return None;
+/// What the rate of a chord's deviation needs (see [`deviation_with_rate`]): the distance of the
+/// farthest point from the chord's line, that point less the chord's start A, the chord B − A and
+/// the curve's velocity at B. Kept rather than worked out, because the search's last trial, the
+/// one that confirms the chord, needs the deviation alone.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct RateInputs {
+    distance: f64,
+    from_start: Vec3,
+    along: Vec3,
+    velocity: Vec3,
+}
+
+impl RateInputs {
+    /// The rate of the distance as B moves with the velocity; `None` for a point on the line.
+    pub(crate) fn rate(&self) -> Option<f64> {
+        let length_squared = self.along.norm_squared();
+        let distance = self.distance;
+        if !(distance > 0.0 && length_squared > 0.0) {
+            return None;
+        }
+        let m = self.from_start.cross(&self.along);
+        let rate = (m.dot(&self.from_start.cross(&self.velocity)) / distance
+            - distance * self.along.dot(&self.velocity))
+            / length_squared;
+        rate.is_finite().then_some(rate)
     }
-    let m = from_start.cross(along);
-    let rate = (m.dot(&from_start.cross(velocity)) / distance - distance * along.dot(velocity)) / length_squared;
-    rate.is_finite().then_some(rate)
 }
 
 impl CubicPiece {
@@ -113,16 +129,16 @@ pub(crate) fn deviation_across_knot(first: &CubicPiece, second: &CubicPiece, a: 
     Some(across_knot(first, second, a, b)?.0)
 }
 
-/// [`deviation_across_knot`] with its rate as the chord's end moves along `second`, per unit of
-/// `second`'s parameter (as [`deviation_with_rate`]).
+/// [`deviation_across_knot`] with what its rate needs as the chord's end moves along `second`,
+/// per unit of `second`'s parameter (as [`deviation_with_rate`]).
 pub(crate) fn deviation_across_knot_with_rate(
     first: &CubicPiece,
     second: &CubicPiece,
     a: &Vec3,
     b: &Vec3,
-) -> Option<(f64, f64)> {
-    let (deviation, peak_from_start, velocity) = across_knot(first, second, a, b)?;
-    Some((deviation, rate_of_distance(deviation, &peak_from_start, &(b - a), &velocity)?))
+) -> Option<(f64, RateInputs)> {
+    let (distance, from_start, velocity) = across_knot(first, second, a, b)?;
+    Some((distance, RateInputs { distance, from_start, along: b - a, velocity }))
 }
 
 /// The deviation of [`deviation_across_knot`], the farthest point less `a`, and the curve's
@@ -332,7 +348,8 @@ mod tests {
         ];
         for (coefficients, t_lo, t_hi) in cases {
             let piece = CubicPiece { coefficients, t_lo, t_hi };
-            let (value, rate) = deviation_with_rate(&piece).expect("bends inside");
+            let (value, inputs) = deviation_with_rate(&piece).expect("bends inside");
+            let rate = inputs.rate().expect("a rate");
             assert!((value - deviation(&piece).unwrap()).abs() < 1e-15);
             let step = 1e-6;
             let moved = |t_hi: f64| deviation(&CubicPiece { t_hi, ..piece }).unwrap();
@@ -346,7 +363,7 @@ mod tests {
         let piece =
             CubicPiece { coefficients: [Vec3::zeros(), Vec3::x(), Vec3::x(), Vec3::zeros()], t_lo: 0.0, t_hi: 1.0 };
         assert_eq!(deviation(&piece), Some(0.0));
-        assert_eq!(deviation_with_rate(&piece), None);
+        assert_eq!(deviation_with_rate(&piece).and_then(|(_, inputs)| inputs.rate()), None);
     }
 
     #[test]

@@ -208,6 +208,9 @@ fn newton_end(shape: &Shape, start: &Vertex, limit: f64, root: f64, mut trial: f
         if value <= 0.0 && value >= -1e-9 * root {
             return Ok((trial, deviation));
         }
+        let Some(rate) = rate.per_u() else {
+            return Err(estimate);
+        };
         // g′ = dev′/(2√dev).
         let slope = rate / (2.0 * deviation.sqrt());
         if !(slope > 0.0 && slope.is_finite()) {

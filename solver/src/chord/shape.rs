@@ -158,6 +158,27 @@ impl Speed for Ellipse {
     }
 }
 
+/// The rate of a chord's deviation per unit of u as its end moves ([`Shape::deviation_with_rate`]),
+/// worked out when asked: the chord search's last trial, which confirms the chord, needs the
+/// deviation alone.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum DeviationRate {
+    /// In closed form (an ellipse chord).
+    Known(f64),
+    /// A plain cubic B-spline's chord: the rate per unit of the span's parameter, times `per_u`.
+    Spline { inputs: cubic::RateInputs, per_u: f64 },
+}
+
+impl DeviationRate {
+    /// The rate per unit of u; `None` where the chord is straight (the rate has no direction).
+    pub(crate) fn per_u(&self) -> Option<f64> {
+        match self {
+            Self::Known(rate) => Some(*rate),
+            Self::Spline { inputs, per_u } => Some(inputs.rate()? * per_u),
+        }
+    }
+}
+
 impl Spline {
     pub(crate) fn new(nurbs: Nurbs, table: ArcLengthTable) -> Self {
         let radius_minima = SpanMinima::new(&nurbs);
@@ -170,15 +191,15 @@ impl Spline {
 
     /// [`Spline::exact_deviation`] of a chord from `ua` to `ub > ua`, with its rate of change per
     /// unit of u as `ub` moves ([`cubic::deviation_with_rate`]); `None` where that is `None`.
-    pub(crate) fn deviation_with_rate(&self, ua: f64, ub: f64) -> Option<(f64, f64)> {
+    pub(crate) fn deviation_with_rate(&self, ua: f64, ub: f64) -> Option<(f64, DeviationRate)> {
         let (stretch, per_u) = self.nurbs.cubic_stretch(ua, ub)?;
-        let (deviation, rate) = match stretch {
+        let (deviation, inputs) = match stretch {
             CubicStretch::Inside(piece) => cubic::deviation_with_rate(&piece)?,
             CubicStretch::AcrossKnot(first, second) => {
                 cubic::deviation_across_knot_with_rate(&first, &second, &self.nurbs.point(ua), &self.nurbs.point(ub))?
             }
         };
-        Some((deviation, rate * per_u))
+        Some((deviation, DeviationRate::Spline { inputs, per_u }))
     }
 
     /// The exact deviation of a chord of a plain B-spline of degree ≤ 3 inside one knot span
@@ -612,11 +633,12 @@ impl Shape {
     /// `ub` moves, where both have closed forms: chords of a plain cubic B-spline inside one span
     /// or across one knot ([`Spline::deviation_with_rate`]) and ellipse chords of up to a quarter
     /// turn; `None` elsewhere (the chord search then brackets).
-    pub(crate) fn deviation_with_rate(&self, ua: f64, ub: f64) -> Option<(f64, f64)> {
+    pub(crate) fn deviation_with_rate(&self, ua: f64, ub: f64) -> Option<(f64, DeviationRate)> {
         match self {
             Self::Spline(spline) => spline.deviation_with_rate(ua, ub),
             Self::Ellipse(ellipse) if ub > ua && ub - ua <= std::f64::consts::FRAC_PI_2 => {
-                Some(ellipse.deviation_with_rate(ua, ub))
+                let (deviation, rate) = ellipse.deviation_with_rate(ua, ub);
+                Some((deviation, DeviationRate::Known(rate)))
             }
             _ => None,
         }
@@ -960,6 +982,7 @@ mod tests {
             for width in [0.3, 0.8] {
                 let hi = lo + width * span;
                 let Some((deviation, rate)) = spline.deviation_with_rate(lo, hi) else { continue };
+                let Some(rate) = rate.per_u() else { continue };
                 let step = 1e-7;
                 let knot = breaks.iter().any(|&knot| knot > lo && knot < hi);
                 if breaks.iter().any(|&knot| (knot - hi).abs() < 2.0 * step) {
@@ -1002,6 +1025,7 @@ mod tests {
             let shape = Shape::Ellipse(ellipse);
             for (ua, ub) in [(0.0, 0.01), (0.3, 0.35), (0.7, 1.5), (1.0, 1.0 + std::f64::consts::FRAC_PI_2)] {
                 let (deviation, rate) = shape.deviation_with_rate(ua, ub).expect("a quarter turn or less");
+                let rate = rate.per_u().expect("a rate");
                 assert_relative_eq!(deviation, shape.fast_deviation(ua, ub, f64::INFINITY).0, max_relative = 1e-15);
                 assert_relative_eq!(deviation, shape.deviation(ua, ub), max_relative = 1e-9);
                 let step = 1e-7;
