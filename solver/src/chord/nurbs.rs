@@ -487,14 +487,14 @@ impl Nurbs {
             let h = self.homogeneous_by_basis(span, start, &Vec3::zeros());
             Vec3::new(h[0] / h[3], h[1] / h[3], h[2] / h[3])
         };
-        let nodes: Vec<f64> = (0..=p).map(|j| j as f64 / p as f64).collect();
-        let mut table: Vec<[f64; 4]> = nodes
-            .iter()
-            .map(|&t| {
-                let u = if t >= 1.0 { end } else { start + (end - start) * t };
-                self.homogeneous_by_basis(span, u, &origin)
-            })
-            .collect();
+        // Fixed arrays, not vectors: a curve of 7 000 spans built two allocations per span.
+        let mut nodes = [0.0; SLOTS];
+        let mut table = [[0.0; 4]; SLOTS];
+        for j in 0..=p {
+            let t = j as f64 / p as f64;
+            let u = if t >= 1.0 { end } else { start + (end - start) * t };
+            (nodes[j], table[j]) = (t, self.homogeneous_by_basis(span, u, &origin));
+        }
         // Divided differences in place: table[k] = f[t_0..t_k].
         for level in 1..=p {
             for k in (level..=p).rev() {
