@@ -286,6 +286,11 @@ impl Nurbs {
             self.last_span.set(last + 1);
             return last + 1;
         }
+        // The span before: a chord that starts before the knot the last lookup crossed.
+        if last > self.degree && last <= n && self.knots[last - 1] <= u && u < self.knots[last] {
+            self.last_span.set(last - 1);
+            return last - 1;
+        }
         // First index with knot > u, minus one.
         let span = self.knots[..=n].partition_point(|&k| k <= u) - 1;
         self.last_span.set(span);
