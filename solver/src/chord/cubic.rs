@@ -20,7 +20,7 @@ const ROOT_WIDTH: f64 = 1e-10;
 /// The largest distance of the curve over the piece from the segment joining its ends, or
 /// `None` where a point of the piece might project beyond the segment's ends (then its distance
 /// from the segment is not its distance from the line: the caller samples instead).
-pub(crate) fn deviation(piece: &CubicPiece) -> Option<f64> {
+pub(crate) fn deviation(piece: &CubicPiece<'_>) -> Option<f64> {
     Some(Chord::of(piece)?.deviation)
 }
 
@@ -34,9 +34,9 @@ pub(crate) fn deviation(piece: &CubicPiece) -> Option<f64> {
 /// dD = m·(n × P′)/(|m|·|u|) − |m|·(u·P′)/|u|³ = m·(n × P′)/(D·|u|²) − D·(u·P′)/|u|².
 /// `None` as for [`deviation`]; the rate itself is `None` where the piece is straight (D = 0:
 /// the rate has no direction).
-pub(crate) fn deviation_with_rate(piece: &CubicPiece) -> Option<(f64, RateInputs)> {
+pub(crate) fn deviation_with_rate(piece: &CubicPiece<'_>) -> Option<(f64, RateInputs)> {
     let chord = Chord::of(piece)?;
-    let [_, a1, a2, a3] = piece.coefficients;
+    let [_, a1, a2, a3] = *piece.coefficients;
     let t_hi = piece.t_hi;
     let velocity = a1 + t_hi * (2.0 * a2 + 3.0 * a3 * t_hi);
     let from_start = piece.point(chord.peak) - chord.start;
@@ -72,9 +72,9 @@ impl RateInputs {
     }
 }
 
-impl CubicPiece {
+impl CubicPiece<'_> {
     fn point(&self, t: f64) -> Vec3 {
-        let [c0, c1, c2, c3] = self.coefficients;
+        let [c0, c1, c2, c3] = *self.coefficients;
         c0 + t * (c1 + t * (c2 + t * c3))
     }
 }
@@ -89,8 +89,8 @@ struct Chord {
 }
 
 impl Chord {
-    fn of(piece: &CubicPiece) -> Option<Self> {
-        let [_, _, a2, a3] = piece.coefficients;
+    fn of(piece: &CubicPiece<'_>) -> Option<Self> {
+        let [_, _, a2, a3] = *piece.coefficients;
         let (t_a, t_b) = (piece.t_lo, piece.t_hi);
         let (start, end) = (piece.point(t_a), piece.point(t_b));
         let chord = end - start;
@@ -125,15 +125,20 @@ impl Chord {
 /// chord's line is h(x) = x²·|V(x)|², V = (c₁ + c₂x + c₃x²) × d, and h′ = 2x·q(x) with the quartic
 /// q = |V|² + x·V·V′. The signs of q's Bernstein coefficients on the piece bound its roots
 /// (variation diminishing): none, h grows to the knot; one, h peaks at q's one root there.
-pub(crate) fn deviation_across_knot(first: &CubicPiece, second: &CubicPiece, a: &Vec3, b: &Vec3) -> Option<f64> {
+pub(crate) fn deviation_across_knot(
+    first: &CubicPiece<'_>,
+    second: &CubicPiece<'_>,
+    a: &Vec3,
+    b: &Vec3,
+) -> Option<f64> {
     Some(across_knot(first, second, a, b)?.0)
 }
 
 /// [`deviation_across_knot`] with what its rate needs as the chord's end moves along `second`,
 /// per unit of `second`'s parameter (as [`deviation_with_rate`]).
 pub(crate) fn deviation_across_knot_with_rate(
-    first: &CubicPiece,
-    second: &CubicPiece,
+    first: &CubicPiece<'_>,
+    second: &CubicPiece<'_>,
     a: &Vec3,
     b: &Vec3,
 ) -> Option<(f64, RateInputs)> {
@@ -143,7 +148,7 @@ pub(crate) fn deviation_across_knot_with_rate(
 
 /// The deviation of [`deviation_across_knot`], the farthest point less `a`, and the curve's
 /// velocity at `b` in `second`'s parameter.
-fn across_knot(first: &CubicPiece, second: &CubicPiece, a: &Vec3, b: &Vec3) -> Option<(f64, Vec3, Vec3)> {
+fn across_knot(first: &CubicPiece<'_>, second: &CubicPiece<'_>, a: &Vec3, b: &Vec3) -> Option<(f64, Vec3, Vec3)> {
     let chord = b - a;
     let length = chord.norm();
     if !(length > 0.0 && length.is_finite()) {
@@ -152,10 +157,10 @@ fn across_knot(first: &CubicPiece, second: &CubicPiece, a: &Vec3, b: &Vec3) -> O
     let direction = chord / length;
     // About t_a going forward; about t_b going backward (x = t_b − t flips the even powers, and
     // P − b = −x·(c₁ + c₂x + c₃x²)).
-    let [_, a1, a2, a3] = first.coefficients;
+    let [_, a1, a2, a3] = *first.coefficients;
     let t = first.t_lo;
     let from_start = [a1 + t * (2.0 * a2 + 3.0 * a3 * t), a2 + 3.0 * a3 * t, a3];
-    let [_, b1, b2, b3] = second.coefficients;
+    let [_, b1, b2, b3] = *second.coefficients;
     let t = second.t_hi;
     let from_end = [b1 + t * (2.0 * b2 + 3.0 * b3 * t), -(b2 + 3.0 * b3 * t), b3];
     let (near_start, x_start) = largest_from_end(from_start, &direction, first.t_hi - first.t_lo)?;
@@ -295,7 +300,7 @@ mod tests {
     use crate::chord::nurbs::{CubicStretch, Nurbs};
 
     /// The distance from the chord by brute force: many samples of the piece.
-    fn sampled(piece: &CubicPiece) -> f64 {
+    fn sampled(piece: &CubicPiece<'_>) -> f64 {
         let (a, b) = (piece.point(piece.t_lo), piece.point(piece.t_hi));
         (0..=100_000)
             .map(|k| {
@@ -309,7 +314,7 @@ mod tests {
     fn a_parabola_peaks_at_the_middle() {
         // y = t² from −1 to 1: the chord y = 1, deviation 1 at t = 0.
         let piece =
-            CubicPiece { coefficients: [Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::zeros()], t_lo: -1.0, t_hi: 1.0 };
+            CubicPiece { coefficients: &[Vec3::zeros(), Vec3::x(), Vec3::y(), Vec3::zeros()], t_lo: -1.0, t_hi: 1.0 };
         assert!((deviation(&piece).unwrap() - 1.0).abs() < 1e-15);
     }
 
@@ -331,7 +336,7 @@ mod tests {
             ),
         ];
         for (coefficients, t_lo, t_hi) in cases {
-            let piece = CubicPiece { coefficients, t_lo, t_hi };
+            let piece = CubicPiece { coefficients: &coefficients, t_lo, t_hi };
             let exact = deviation(&piece).expect("projection inside");
             let dense = sampled(&piece);
             assert!(exact >= dense - 1e-15 && exact <= dense * (1.0 + 1e-8) + 1e-15, "{exact} vs {dense}");
@@ -347,7 +352,7 @@ mod tests {
             ([Vec3::zeros(), Vec3::x(), Vec3::new(0.0, 0.2, 0.0), Vec3::new(0.0, 0.5, 0.0)], 0.0, 0.5),
         ];
         for (coefficients, t_lo, t_hi) in cases {
-            let piece = CubicPiece { coefficients, t_lo, t_hi };
+            let piece = CubicPiece { coefficients: &coefficients, t_lo, t_hi };
             let (value, inputs) = deviation_with_rate(&piece).expect("bends inside");
             let rate = inputs.rate().expect("a rate");
             assert!((value - deviation(&piece).unwrap()).abs() < 1e-15);
@@ -361,7 +366,7 @@ mod tests {
     #[test]
     fn a_straight_piece_has_no_rate() {
         let piece =
-            CubicPiece { coefficients: [Vec3::zeros(), Vec3::x(), Vec3::x(), Vec3::zeros()], t_lo: 0.0, t_hi: 1.0 };
+            CubicPiece { coefficients: &[Vec3::zeros(), Vec3::x(), Vec3::x(), Vec3::zeros()], t_lo: 0.0, t_hi: 1.0 };
         assert_eq!(deviation(&piece), Some(0.0));
         assert_eq!(deviation_with_rate(&piece).and_then(|(_, inputs)| inputs.rate()), None);
     }
@@ -419,7 +424,7 @@ mod tests {
     fn a_piece_bending_back_past_its_ends_is_left_to_sampling() {
         // A hairpin: points project beyond the chord's ends.
         let piece = CubicPiece {
-            coefficients: [Vec3::zeros(), Vec3::x(), Vec3::new(0.0, 5.0, 0.0), Vec3::new(-3.0, 0.0, 0.0)],
+            coefficients: &[Vec3::zeros(), Vec3::x(), Vec3::new(0.0, 5.0, 0.0), Vec3::new(-3.0, 0.0, 0.0)],
             t_lo: 0.0,
             t_hi: 1.0,
         };

@@ -36,10 +36,11 @@ pub(crate) struct Nurbs {
 }
 
 /// A stretch [lo, hi] inside one knot span of a polynomial curve of degree ≤ 3, in the span's
-/// power form: P(t) = origin + Σ coefficients[k]·t^k with t = (u − u_i)/h.
+/// power form: P(t) = origin + Σ coefficients[k]·t^k with t = (u − u_i)/h. Borrows the span's
+/// coefficients (the chord search builds one or two pieces for every deviation it measures).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct CubicPiece {
-    pub coefficients: [Vec3; 4],
+pub(crate) struct CubicPiece<'a> {
+    pub coefficients: &'a [Vec3; 4],
     /// Local parameters of lo and hi.
     pub t_lo: f64,
     pub t_hi: f64,
@@ -48,10 +49,10 @@ pub(crate) struct CubicPiece {
 /// A chord's stretch of a plain cubic curve by the knot spans it lies in (see
 /// [`Nurbs::cubic_stretch`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum CubicStretch {
-    Inside(CubicPiece),
+pub(crate) enum CubicStretch<'a> {
+    Inside(CubicPiece<'a>),
     /// From the chord's start to the knot, and from the knot to its end.
-    AcrossKnot(CubicPiece, CubicPiece),
+    AcrossKnot(CubicPiece<'a>, CubicPiece<'a>),
 }
 
 /// One knot span [u_i, u_i+1) of the curve in power form: the homogeneous curve relative to
@@ -326,7 +327,7 @@ impl Nurbs {
     /// in: one (its end may be the span's closing knot), or two when it crosses one knot; `None`
     /// for other curves and for stretches over more knots.
     /// With the stretch, dt/du of the span holding `hi` (the rate of a chord end moving there).
-    pub(crate) fn cubic_stretch(&self, lo: f64, hi: f64) -> Option<(CubicStretch, f64)> {
+    pub(crate) fn cubic_stretch(&self, lo: f64, hi: f64) -> Option<(CubicStretch<'_>, f64)> {
         if !self.is_plain_cubic() || lo >= hi || lo.is_nan() || hi.is_nan() {
             return None;
         }
@@ -334,7 +335,7 @@ impl Nurbs {
         let span = self.span(lo);
         let knot = self.knots[span + 1];
         if hi <= knot {
-            return Some((CubicStretch::Inside(self.piece_in(span, lo, hi)), per_u(span)));
+            return Some((CubicStretch::Inside(self.piece_in(span, lo, hi)?), per_u(span)));
         }
         // The next non-empty span (a repeated knot leaves empty ones between).
         let mut next = span + 1;
@@ -344,15 +345,15 @@ impl Nurbs {
         if next >= self.weighted.len() || hi > self.knots[next + 1] {
             return None;
         }
-        Some((CubicStretch::AcrossKnot(self.piece_in(span, lo, knot), self.piece_in(next, knot, hi)), per_u(next)))
+        Some((CubicStretch::AcrossKnot(self.piece_in(span, lo, knot)?, self.piece_in(next, knot, hi)?), per_u(next)))
     }
 
     /// [lo, hi] inside knot span `span` of a plain cubic curve as a [`CubicPiece`].
-    fn piece_in(&self, span: usize, lo: f64, hi: f64) -> CubicPiece {
-        let [a0, a1, a2, a3, ..] = self.polynomials[span - self.degree].plain;
+    fn piece_in(&self, span: usize, lo: f64, hi: f64) -> Option<CubicPiece<'_>> {
         let polynomial = &self.polynomials[span - self.degree];
+        let coefficients = polynomial.plain.first_chunk()?;
         let local = |u: f64| (u - polynomial.start) * polynomial.inverse_width;
-        CubicPiece { coefficients: [a0, a1, a2, a3], t_lo: local(lo), t_hi: local(hi) }
+        Some(CubicPiece { coefficients, t_lo: local(lo), t_hi: local(hi) })
     }
 
     /// The radius of curvature at `u` strictly inside a knot span of a plain cubic curve, from the
