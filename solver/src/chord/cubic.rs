@@ -34,29 +34,35 @@ pub(crate) fn deviation(piece: &CubicPiece<'_>) -> Option<f64> {
 /// dD = m·(n × P′)/(|m|·|u|) − |m|·(u·P′)/|u|³ = m·(n × P′)/(D·|u|²) − D·(u·P′)/|u|².
 /// `None` as for [`deviation`]; the rate itself is `None` where the piece is straight (D = 0:
 /// the rate has no direction).
-pub(crate) fn deviation_with_rate(piece: &CubicPiece<'_>) -> Option<(f64, RateInputs)> {
+pub(crate) fn deviation_with_rate<'a>(piece: &CubicPiece<'a>) -> Option<(f64, RateInputs<'a>)> {
     let chord = Chord::of(piece)?;
-    let [_, a1, a2, a3] = *piece.coefficients;
-    let t_hi = piece.t_hi;
-    let velocity = a1 + t_hi * (2.0 * a2 + 3.0 * a3 * t_hi);
-    let from_start = piece.point(chord.peak) - chord.start;
-    let inputs = RateInputs { distance: chord.deviation, from_start, along: chord.end - chord.start, velocity };
+    let along = chord.end - chord.start;
+    let inputs =
+        RateInputs { distance: chord.deviation, along, farthest: Farthest::OnPiece(*piece, chord.peak, chord.start) };
     Some((chord.deviation, inputs))
 }
 
 /// What the rate of a chord's deviation needs (see [`deviation_with_rate`]): the distance of the
-/// farthest point from the chord's line, that point less the chord's start A, the chord B − A and
-/// the curve's velocity at B. Kept rather than worked out, because the search's last trial, the
-/// one that confirms the chord, needs the deviation alone.
+/// farthest point from the chord's line, the chord B − A, and where the farthest point and the
+/// curve's velocity at B come from. Kept rather than worked out, because the search's last trial,
+/// the one that confirms the chord, needs the deviation alone.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct RateInputs {
+pub(crate) struct RateInputs<'a> {
     distance: f64,
-    from_start: Vec3,
     along: Vec3,
-    velocity: Vec3,
+    farthest: Farthest<'a>,
 }
 
-impl RateInputs {
+/// The farthest point less the chord's start, and the velocity at the chord's end.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Farthest<'a> {
+    /// A chord inside one piece: the piece, the farthest point's parameter, the chord's start.
+    OnPiece(CubicPiece<'a>, f64, Vec3),
+    /// Found across a knot: the farthest point less the start, and the velocity.
+    Known(Vec3, Vec3),
+}
+
+impl RateInputs<'_> {
     /// The rate of the distance as B moves with the velocity; `None` for a point on the line.
     pub(crate) fn rate(&self) -> Option<f64> {
         let length_squared = self.along.norm_squared();
@@ -64,10 +70,17 @@ impl RateInputs {
         if !(distance > 0.0 && length_squared > 0.0) {
             return None;
         }
-        let m = self.from_start.cross(&self.along);
-        let rate = (m.dot(&self.from_start.cross(&self.velocity)) / distance
-            - distance * self.along.dot(&self.velocity))
-            / length_squared;
+        let (from_start, velocity) = match self.farthest {
+            Farthest::OnPiece(piece, peak, start) => {
+                let [_, a1, a2, a3] = *piece.coefficients;
+                let t_hi = piece.t_hi;
+                (piece.point(peak) - start, a1 + t_hi * (2.0 * a2 + 3.0 * a3 * t_hi))
+            }
+            Farthest::Known(from_start, velocity) => (from_start, velocity),
+        };
+        let m = from_start.cross(&self.along);
+        let rate =
+            (m.dot(&from_start.cross(&velocity)) / distance - distance * self.along.dot(&velocity)) / length_squared;
         rate.is_finite().then_some(rate)
     }
 }
@@ -141,9 +154,9 @@ pub(crate) fn deviation_across_knot_with_rate(
     second: &CubicPiece<'_>,
     a: &Vec3,
     b: &Vec3,
-) -> Option<(f64, RateInputs)> {
+) -> Option<(f64, RateInputs<'static>)> {
     let (distance, from_start, velocity) = across_knot(first, second, a, b)?;
-    Some((distance, RateInputs { distance, from_start, along: b - a, velocity }))
+    Some((distance, RateInputs { distance, along: b - a, farthest: Farthest::Known(from_start, velocity) }))
 }
 
 /// The deviation of [`deviation_across_knot`], the farthest point less `a`, and the curve's

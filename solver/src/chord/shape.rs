@@ -162,14 +162,14 @@ impl Speed for Ellipse {
 /// worked out when asked: the chord search's last trial, which confirms the chord, needs the
 /// deviation alone.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum DeviationRate {
+pub(crate) enum DeviationRate<'a> {
     /// In closed form (an ellipse chord).
     Known(f64),
     /// A plain cubic B-spline's chord: the rate per unit of the span's parameter, times `per_u`.
-    Spline { inputs: cubic::RateInputs, per_u: f64 },
+    Spline { inputs: cubic::RateInputs<'a>, per_u: f64 },
 }
 
-impl DeviationRate {
+impl DeviationRate<'_> {
     /// The rate per unit of u; `None` where the chord is straight (the rate has no direction).
     pub(crate) fn per_u(&self) -> Option<f64> {
         match self {
@@ -191,7 +191,7 @@ impl Spline {
 
     /// [`Spline::exact_deviation`] of a chord from `ua` to `ub > ua`, with its rate of change per
     /// unit of u as `ub` moves ([`cubic::deviation_with_rate`]); `None` where that is `None`.
-    pub(crate) fn deviation_with_rate(&self, ua: f64, ub: f64) -> Option<(f64, DeviationRate)> {
+    pub(crate) fn deviation_with_rate(&self, ua: f64, ub: f64) -> Option<(f64, DeviationRate<'_>)> {
         let (stretch, per_u) = self.nurbs.cubic_stretch(ua, ub)?;
         let (deviation, inputs) = match stretch {
             CubicStretch::Inside(piece) => cubic::deviation_with_rate(&piece)?,
@@ -633,7 +633,7 @@ impl Shape {
     /// `ub` moves, where both have closed forms: chords of a plain cubic B-spline inside one span
     /// or across one knot ([`Spline::deviation_with_rate`]) and ellipse chords of up to a quarter
     /// turn; `None` elsewhere (the chord search then brackets).
-    pub(crate) fn deviation_with_rate(&self, ua: f64, ub: f64) -> Option<(f64, DeviationRate)> {
+    pub(crate) fn deviation_with_rate(&self, ua: f64, ub: f64) -> Option<(f64, DeviationRate<'_>)> {
         match self {
             Self::Spline(spline) => spline.deviation_with_rate(ua, ub),
             Self::Ellipse(ellipse) if ub > ua && ub - ua <= std::f64::consts::FRAC_PI_2 => {
