@@ -2,6 +2,8 @@
 //! engagement.md §3.1 outputs and the [X] extras).
 
 use serde::{Deserialize, Serialize};
+use smallvec::SmallVec;
+use std::sync::Arc;
 
 use super::arcs::MillingMode;
 use super::request::{Engine, FeedBasis};
@@ -52,6 +54,23 @@ pub enum SampleFlag {
     Collision,
 }
 
+/// A sample's engaged arcs: inline up to two (nearly every sample), on the heap beyond.
+pub type SampleArcs = SmallVec<[[f64; 2]; 2]>;
+
+/// One value per flute count of the request (`flutes`): inline up to four, on the heap beyond.
+pub type PerFluteCount<T> = SmallVec<[T; 4]>;
+
+/// The entry and exit of a sample's arcs, in the order of its arcs: shared by the samples whose
+/// arcs are the same (nearly every sample along a straight cut), not copied into each.
+pub type SampleArcDetails = Arc<[ArcDetail]>;
+
+fn no_details(details: &SampleArcDetails) -> bool {
+    details.is_empty()
+}
+
+/// A sample's risk and state marks (inline up to four).
+pub type SampleFlags = SmallVec<[SampleFlag; 4]>;
+
 /// The state at one sample of the path (api.md: `s`, `t`, `arcs`, `engaged_deg`, `radial_depth`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
@@ -69,22 +88,26 @@ pub struct EngagementSample {
     pub segment: usize,
     /// Engaged arcs `[[from_deg, to_deg], ...]`, tool angle of engagement.md §4.1 (90° ahead,
     /// 0° right, 180° left of travel); from in [−180, 180), to in (from, from + 360], sorted.
-    pub arcs: Vec<[f64; 2]>,
+    #[cfg_attr(feature = "schema", schema(value_type = Vec<[f64; 2]>))]
+    pub arcs: SampleArcs,
     /// Φ: total engaged angle, degrees.
     pub engaged_deg: f64,
     /// a_e: radial depth of cut, the measure of the arcs' lateral projection, mm.
     pub radial_depth: f64,
     /// Entry, exit and mode of each arc, in the order of `arcs`.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub arc_details: Vec<ArcDetail>,
+    #[serde(default, skip_serializing_if = "no_details")]
+    #[cfg_attr(feature = "schema", schema(value_type = Vec<ArcDetail>))]
+    pub arc_details: SampleArcDetails,
     /// Mean undeformed chip thickness over the engaged angles at the feed per tooth of
     /// `time_flute_count` teeth, mm (side milling: f_z·(a_e/R)/φ).
     pub mean_chip_thickness: f64,
     /// H_k, the largest summed chip thickness over the tooth phase, per flute count in the
     /// order of `flutes`, mm.
-    pub thickness: Vec<f64>,
+    #[cfg_attr(feature = "schema", schema(value_type = Vec<f64>))]
+    pub thickness: PerFluteCount<f64>,
     /// n_k, the most teeth strictly inside the arcs at once, per flute count.
-    pub teeth: Vec<u32>,
+    #[cfg_attr(feature = "schema", schema(value_type = Vec<u32>))]
+    pub teeth: PerFluteCount<u32>,
     /// Spindle torque averaged over the tooth phase, N·m, per flute count in the order of
     /// `flutes` (with `kienzle` or `material`): R·Σ k_c1.1·a_p·h^(1−m_c); the load the
     /// machine's `spindle_torque_nm` is compared with.
@@ -104,8 +127,9 @@ pub struct EngagementSample {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mrr: Option<f64>,
     /// Risk and state marks.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub flags: Vec<SampleFlag>,
+    #[serde(default, skip_serializing_if = "SmallVec::is_empty")]
+    #[cfg_attr(feature = "schema", schema(value_type = Vec<SampleFlag>))]
+    pub flags: SampleFlags,
 }
 
 /// Results for one flute count (api.md: `max_thickness`, `mean_thickness`, `min_thickness`,

@@ -3,7 +3,8 @@
 //! the per-flute results, recommendation and feed plan.
 
 use super::answer::{
-    ArcDetail, EngagementSample, ForceInfo, GridInfo, PathEngagement, PostData, RouteData, SampleFlag,
+    ArcDetail, EngagementSample, ForceInfo, GridInfo, PathEngagement, PostData, RouteData, SampleArcDetails,
+    SampleFlag, SampleFlags,
 };
 use super::arcfeed::ArcFeed;
 use super::arcs::{self, Arc};
@@ -57,7 +58,7 @@ struct ArcValues {
     arcs: Option<Vec<Arc>>,
     radial_depth: f64,
     engaged_deg: f64,
-    details: Vec<ArcDetail>,
+    details: SampleArcDetails,
     /// Some arc disengages at or beyond ψ_B (§5.10).
     burr: bool,
     /// Some arc disengages at or below ψ_C.
@@ -79,22 +80,24 @@ impl ArcValues {
         self.radial_depth = arcs::radial_depth(arcs, radius);
         self.engaged_deg = arcs::engaged_deg(arcs);
         self.mean_thickness_ratio = arcs::mean_thickness_ratio(arcs);
-        self.details.clear();
         let (mut burr, mut chipping) = (false, false);
-        for arc in arcs {
-            let ends = arcs::arc_ends(arc, job.direction);
-            burr |= ends.disengage >= job.burr_disengage;
-            chipping |= ends.disengage <= job.chipping_disengage;
-            self.details.push(ArcDetail {
-                entry_deg: ends.entry,
-                exit_deg: ends.exit,
-                engage_deg: ends.engage,
-                disengage_deg: ends.disengage,
-                entry_thickness_ratio: ends.entry_ratio,
-                exit_thickness_ratio: ends.exit_ratio,
-                mode: ends.mode,
-            });
-        }
+        self.details = arcs
+            .iter()
+            .map(|arc| {
+                let ends = arcs::arc_ends(arc, job.direction);
+                burr |= ends.disengage >= job.burr_disengage;
+                chipping |= ends.disengage <= job.chipping_disengage;
+                ArcDetail {
+                    entry_deg: ends.entry,
+                    exit_deg: ends.exit,
+                    engage_deg: ends.engage,
+                    disengage_deg: ends.disengage,
+                    entry_thickness_ratio: ends.entry_ratio,
+                    exit_thickness_ratio: ends.exit_ratio,
+                    mode: ends.mode,
+                }
+            })
+            .collect();
         self.burr = burr;
         self.chipping = chipping;
         self.behind = arcs.iter().any(|a| a.from < -BACK_TOLERANCE_DEG || a.to > 180.0 + BACK_TOLERANCE_DEG);
@@ -296,7 +299,7 @@ pub(crate) fn evaluate(
         let arcs: &[Arc] = &contact.arcs;
         let values = arc_values.of(arcs, job, radius);
         let radial_depth = values.radial_depth;
-        let mut flags = Vec::new();
+        let mut flags = SampleFlags::new();
         if values.burr {
             flags.push(SampleFlag::BurrRisk);
         }

@@ -213,6 +213,8 @@ fn flag_name(flag: SampleFlag) -> &'static [u8] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::engagement::answer::{SampleArcDetails, SampleArcs, SampleFlags};
+    use smallvec::smallvec;
 
     fn sample(index: usize) -> EngagementSample {
         let odd = index % 2 == 1;
@@ -231,20 +233,20 @@ mod tests {
             position: [-0.0, 1e21],
             heading_deg: -180.0,
             segment: index * 1_000_003,
-            arcs: if odd { vec![[-90.0, 12.5], [100.0, f64::INFINITY]] } else { Vec::new() },
+            arcs: if odd { smallvec![[-90.0, 12.5], [100.0, f64::INFINITY]] } else { SampleArcs::new() },
             engaged_deg: 123_456_789.125,
             radial_depth: 5e-7,
-            arc_details: if odd { vec![detail.clone(), detail] } else { Vec::new() },
+            arc_details: if odd { vec![detail.clone(), detail].into() } else { SampleArcDetails::default() },
             mean_chip_thickness: 0.049_999_999_999_999_996,
-            thickness: vec![0.05, 1e16, 2.5e-5],
-            teeth: vec![0, 3, u32::MAX],
+            thickness: smallvec![0.05, 1e16, 2.5e-5],
+            teeth: smallvec![0, 3, u32::MAX],
             torque_nm: if odd { vec![1.5, 2.25] } else { Vec::new() },
             peak_torque_nm: if odd { vec![f64::NEG_INFINITY] } else { Vec::new() },
             power_kw: if odd { vec![7.0] } else { Vec::new() },
             peak_force_n: if odd { vec![123.456] } else { Vec::new() },
             mrr: odd.then_some(4321.0),
             flags: if odd {
-                vec![
+                smallvec![
                     SampleFlag::BurrRisk,
                     SampleFlag::ChippingRisk,
                     SampleFlag::Plunge,
@@ -255,7 +257,7 @@ mod tests {
                     SampleFlag::Collision,
                 ]
             } else {
-                Vec::new()
+                SampleFlags::new()
             },
         }
     }
