@@ -111,20 +111,18 @@ impl Ellipse {
     }
 
     /// The deviation of the chord from `ua` to `ub` (at most a quarter turn apart), as in
-    /// [`Shape::fast_deviation`], with its rate per unit of u as `ub` moves: with the half angle
-    /// δ = (ub − ua)/2 and the mean angle t_m, dev = 2·sin²(δ/2)·ab/v(t_m) for
-    /// v = (a² sin² t + b² cos² t)^½, and dv/dt = (a² − b²)·sin t·cos t/v.
-    fn deviation_with_rate(&self, ua: f64, ub: f64) -> (f64, f64) {
+    /// [`Shape::fast_deviation`], with its rate per unit of u as `ub` moves (worked out when
+    /// asked, [`EllipseChord::rate`]): with the half angle δ = (ub − ua)/2 and the mean angle t_m,
+    /// dev = 2·sin²(δ/2)·ab/v(t_m) for v = (a² sin² t + b² cos² t)^½, and
+    /// dv/dt = (a² − b²)·sin t·cos t/v.
+    fn deviation_with_rate(&self, ua: f64, ub: f64) -> (f64, DeviationRate<'_>) {
         let [a, b] = self.semi_axes;
         let half = 0.5 * (ub - ua);
         let (sin, cos) = self.angle(0.5 * (ua + ub)).sin_cos();
         let speed = ((a * sin).powi(2) + (b * cos).powi(2)).sqrt();
         let bulge = 2.0 * (0.5 * half).sin().powi(2);
         let deviation = bulge * a * b / speed;
-        // d/dub: the half angle and the mean angle (through the sense of the parameter) move by ½.
-        let speed_rate = (a * a - b * b) * sin * cos / speed * 0.5 * self.sense;
-        let rate = 0.5 * half.sin() * a * b / speed - deviation * speed_rate / speed;
-        (deviation, rate)
+        (deviation, DeviationRate::Ellipse(EllipseChord { ellipse: self, half, sin, cos, speed, deviation }))
     }
 
     /// Radius of curvature at t: (a² sin² t + b² cos² t)^{3/2} / (a·b).
@@ -163,8 +161,8 @@ impl Speed for Ellipse {
 /// deviation alone.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum DeviationRate<'a> {
-    /// In closed form (an ellipse chord).
-    Known(f64),
+    /// An ellipse chord of up to a quarter turn, in closed form.
+    Ellipse(EllipseChord<'a>),
     /// A plain cubic B-spline's chord: the rate per unit of the span's parameter, times `per_u`.
     Spline { inputs: cubic::RateInputs<'a>, per_u: f64 },
 }
@@ -173,9 +171,31 @@ impl DeviationRate<'_> {
     /// The rate per unit of u; `None` where the chord is straight (the rate has no direction).
     pub(crate) fn per_u(&self) -> Option<f64> {
         match self {
-            Self::Known(rate) => Some(*rate),
+            Self::Ellipse(chord) => Some(chord.rate()),
             Self::Spline { inputs, per_u } => Some(inputs.rate()? * per_u),
         }
+    }
+}
+
+/// An ellipse chord as [`Ellipse::deviation_with_rate`] measured it: its half angle, the sine and
+/// cosine of its mean angle, the speed there and its deviation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct EllipseChord<'a> {
+    ellipse: &'a Ellipse,
+    half: f64,
+    sin: f64,
+    cos: f64,
+    speed: f64,
+    deviation: f64,
+}
+
+impl EllipseChord<'_> {
+    /// d dev/d ub: the half angle and the mean angle (through the sense of the parameter) move by ½.
+    fn rate(&self) -> f64 {
+        let Self { ellipse, half, sin, cos, speed, deviation } = *self;
+        let [a, b] = ellipse.semi_axes;
+        let speed_rate = (a * a - b * b) * sin * cos / speed * 0.5 * ellipse.sense;
+        0.5 * half.sin() * a * b / speed - deviation * speed_rate / speed
     }
 }
 
@@ -637,8 +657,7 @@ impl Shape {
         match self {
             Self::Spline(spline) => spline.deviation_with_rate(ua, ub),
             Self::Ellipse(ellipse) if ub > ua && ub - ua <= std::f64::consts::FRAC_PI_2 => {
-                let (deviation, rate) = ellipse.deviation_with_rate(ua, ub);
-                Some((deviation, DeviationRate::Known(rate)))
+                Some(ellipse.deviation_with_rate(ua, ub))
             }
             _ => None,
         }
