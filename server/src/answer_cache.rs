@@ -1,4 +1,4 @@
-//! The answer cache of the solver endpoints (issue 14, item 5): a solver answer is a pure
+//! The answer cache of the solver endpoints: a solver answer is a pure
 //! function of the request, the stored values its references resolved to (tools, machine,
 //! material) and the output options, so the same question asked again is answered with the bytes
 //! of the first answer, without a solver slot. Safe by construction: those values are part of the

@@ -1,4 +1,4 @@
-//! Optional bearer token (issue 7): when `KERF_API_TOKEN` is set, every request that changes
+//! Optional bearer token: when `KERF_API_TOKEN` is set, every request that changes
 //! state needs `Authorization: Bearer <token>`; with `--private` reads of the API need it too.
 //! The health check, the page's files and the API documentation stay open: they hold no data.
 

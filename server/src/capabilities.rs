@@ -30,11 +30,11 @@ macro_rules! with_registry {
         $callback! {
             Deburr => deburr::{DeburrCapability, DeburrRequest, DeburrAnswer}, json(OutputQuery),
                 "`POST /api/v1/deburr`.";
-            Segment => chord::{SegmentCapability, SegmentRequest, SegmentResult}, json(OutputQuery),
+            Segment => segment::{SegmentCapability, SegmentRequest, SegmentAnswer}, json(OutputQuery),
                 "`POST /api/v1/segment`.";
-            Contour => corners::{ContourCapability, ContourRequest, ContourResult}, json(OutputQuery),
+            Contour => contour::{ContourCapability, ContourRequest, ContourAnswer}, json(OutputQuery),
                 "`POST /api/v1/contour`.";
-            Engagement => engagement::{EngagementCapability, EngagementRequest, EngagementResponse}, json(CandidateQuery),
+            Engagement => engagement::{EngagementCapability, EngagementRequest, EngagementAnswer}, json(CandidateQuery),
                 "`POST /api/v1/engagement`; the job's program is that of the request's `candidate` path (default the first).";
             Predict => predict::{PredictCapability, PredictRequest, PredictAnswer}, upload,
                 "`POST /api/v1/predict` (a job file cannot carry an STL file: no `mesh` stock).";

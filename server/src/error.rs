@@ -1,5 +1,5 @@
 //! `AppError`: every failure the HTTP layer can answer, rendered as RFC 9457
-//! `application/problem+json` (api.md, Errors). 5xx causes are logged, never sent to the client.
+//! `application/problem+json` (docs/spec/api.md, Errors). 5xx causes are logged, never sent to the client.
 
 use axum::http::{HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
@@ -73,7 +73,7 @@ pub enum AppError {
     #[error("{0}")]
     JobStoreFull(String),
     /// 422 `E_TIMEOUT`: the synchronous time limit was hit; submit a job instead. Not a 5xx:
-    /// the request is well-formed but too long for a synchronous answer (api.md: a 5xx is a bug).
+    /// the request is well-formed but too long for a synchronous answer (docs/spec/api.md: a 5xx is a bug).
     #[error("{0}")]
     Timeout(String),
     /// 500: a bug or an infrastructure failure. The cause is logged, not sent.

@@ -1,4 +1,4 @@
-//! Metrics and readiness (issue 12): `GET /metrics` in the Prometheus/OpenMetrics text format,
+//! Metrics and readiness: `GET /metrics` in the Prometheus/OpenMetrics text format,
 //! written by the `prometheus-client` crate, and `GET /readyz`, ready only while the database
 //! answers. The API serves both on its own port; a `kerf worker` on `--metrics-bind`.
 //!

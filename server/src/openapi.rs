@@ -16,15 +16,15 @@ use utoipa::OpenApi;
     tags(
         (name = "service", description = "Health"),
         (name = "tools", description = "The tool table, keyed by tool number"),
-        (name = "deburr", description = "Cross-hole deburring with a ball end mill (deburr.md)"),
-        (name = "machines", description = "Controller profiles (block processing time, feed limit, dialect), keyed by name (chord.md)"),
+        (name = "deburr", description = "Cross-hole deburring with a ball end mill (docs/spec/deburr.md)"),
+        (name = "machines", description = "Controller profiles (block processing time, feed limit, dialect), keyed by name (docs/spec/segment.md)"),
         (name = "materials", description = "Work materials with their Kienzle values (k_c1.1, m_c), keyed by name; \
-                                             engagement requests name them for torque and power (engagement.md §11)"),
-        (name = "segment", description = "Line-segment approximation with the chord error from the block processing time (chord.md)"),
-        (name = "contour", description = "Layered contour milling with corner loops and inside-corner relief (corners.md)"),
+                                             engagement requests name them for torque and power (docs/spec/engagement.md §11)"),
+        (name = "segment", description = "Line-segment approximation with the chord error from the block processing time (docs/spec/segment.md)"),
+        (name = "contour", description = "Layered contour milling with corner loops and inside-corner relief (docs/spec/contour.md)"),
         (name = "engagement", description = "Tool–workpiece engagement along a path, chip thickness per flute count and \
-                                              the recommended flute counts (engagement.md)"),
-        (name = "predict", description = "Machining-error prediction and path correction for ball-end-mill finishing (error-prediction.md)")
+                                              the recommended flute counts (docs/spec/engagement.md)"),
+        (name = "predict", description = "Machining-error prediction and path correction for ball-end-mill finishing (docs/spec/predict.md)")
     )
 )]
 pub struct ApiDoc;

@@ -1,5 +1,5 @@
 //! Deburr throughput: ball centres per second for a ~10 000-point job (single core) and a typical
-//! 92-point job (reference case 1), for the seed's tangent method, the exact method (issue 19:
+//! 92-point job (reference case 1), for the patent's tangent method, the exact method (issue 19:
 //! centres whose swept chamfer is W wide) and, for comparison, the exact method before issue 19
 //! (each centre from its own ball section, `solve_single_section`). The cost per centre is one
 //! over the throughput; the ratio exact / single-section is the price of the swept solve.
@@ -24,7 +24,7 @@ fn request_with_cut(cut_amount: f64, tolerance: f64, method: &str) -> DeburrRequ
     .expect("valid request")
 }
 
-/// The request of tests/load/deburr-distinct.lua (issue 14 item 5): case 1 with a cut amount
+/// The request of tests/load/deburr-distinct.lua: case 1 with a cut amount
 /// around 0.3 (one of the values that script sends), tolerance 0.01, the default (tangent) method.
 const DISTINCT_LOAD_NAME: &str = "typical_distinct_load_cut0.300123_tangent";
 const DISTINCT_LOAD_CUT: f64 = 0.300123;

@@ -1,6 +1,6 @@
-//! Engagement throughput (issue 5): samples per second for 1 m of path at a 0.01 mm step
+//! Engagement throughput: samples per second for 1 m of path at a 0.01 mm step
 //! through a 200 × 200 mm pocket, for both engines, and the dot engine's memory at 0.01 mm;
-//! with Kienzle torque and power (issue 16) at a 0.1 mm step, straight and helical flutes, and
+//! with Kienzle torque and power at a 0.1 mm step, straight and helical flutes, and
 //! for a ball end whose 16 height bands each take their own section's engagement.
 //!
 //! Run: `cargo bench -p kerf-solver --bench engagement -- --warm-up-time 1 --measurement-time 5`
@@ -13,7 +13,7 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use kerf_solver::capability::{Capability, Resolved, Run};
-use kerf_solver::engagement::{self, EngagementAnswer, EngagementCapability, EngagementRequest};
+use kerf_solver::engagement::{self, EngagementCapability, EngagementRequest, EngagementSolution};
 use kerf_solver::tool::{Tool, ToolKind};
 use serde_json::json;
 
@@ -94,7 +94,7 @@ fn bench(c: &mut Criterion) {
         }
         let request = request(engine);
         let answer = engagement::solve(&request, &tool).unwrap();
-        let EngagementAnswer::Single(result) = &answer else { unreachable!() };
+        let EngagementSolution::Single(result) = &answer else { unreachable!() };
         let samples = result.samples.len() as u64;
         if let Some(grid) = &result.grid {
             let full = (POCKET / 0.01) * (POCKET / 0.01);

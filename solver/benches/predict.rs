@@ -1,10 +1,10 @@
 //! Benchmarks for solver::predict: passes per second per core and on both cores for a realistic
-//! finishing program, as a ratio against the seed's 0.070 s per pass (patent Fig. 21).
+//! finishing program, as a ratio against the patent's 0.070 s per pass (patent Fig. 21).
 //!
 //! The program (tests/predict_support): a ball end mill Ø10 finishing a double-wave surface
 //! (slopes up to 26°) by a zig-zag raster, pick 0.5 mm, 0.5 mm segments, 103 041 feed passes,
 //! f_t = 0.1 mm at 6000 rpm, force model with modal stiffness; stock = surface + 0.2 mm as a
-//! height grid. Resolution N = 256 gives the seed's pixel size 0.039 mm; N = 512 is twice as fine.
+//! height grid. Resolution N = 256 gives the patent's pixel size 0.039 mm; N = 512 is twice as fine.
 //!
 //! Each criterion sample predicts a slice of 1000 passes in the middle of the program (the whole
 //! program still sweeps the stock): ms per pass = sample time / 1000. Before each group the bench
@@ -24,10 +24,10 @@ use std::time::Instant;
 use criterion::{Criterion, criterion_group, criterion_main};
 use kerf_solver::predict::{self, Method};
 
-#[path = "../tests/predict_support/mod.rs"]
+#[path = "../tests/predict/support.rs"]
 mod support;
 
-/// The seed's time per pass (patent Fig. 21, GPU, 2009).
+/// The patent's time per pass (patent Fig. 21, GPU, 2009).
 const SEED_SECONDS_PER_PASS: f64 = 0.070;
 /// Passes per criterion sample.
 const SLICE: usize = 1000;
@@ -49,7 +49,7 @@ fn report(label: &str, passes: usize, wall: f64, cpu: f64) {
     let per_pass = wall / passes as f64;
     let cpu_per_pass = cpu / passes as f64;
     eprintln!(
-        "{label}: {passes} passes, wall {:.3} ms/pass ({:.0} passes/s, {:.0}× the seed), CPU {:.3} ms/pass per core ({:.0}× the seed per core)",
+        "{label}: {passes} passes, wall {:.3} ms/pass ({:.0} passes/s, {:.0}× the patent), CPU {:.3} ms/pass per core ({:.0}× the patent per core)",
         per_pass * 1e3,
         1.0 / per_pass,
         SEED_SECONDS_PER_PASS / per_pass,

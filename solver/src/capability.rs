@@ -85,8 +85,8 @@ pub trait Capability {
         serde_json::to_vec(&answer)
     }
 
-    /// Splits the request's work into parts that different workers may solve at once (issue 12,
-    /// a job split into chunks): ranges of its units of work (prediction passes, candidate
+    /// Splits the request's work into parts that different workers may solve at once (a job
+    /// split into chunks): ranges of its units of work (prediction passes, candidate
     /// paths) sized after `sizing`, each solved by [`Capability::solve_part`], then merged by
     /// [`Capability::finish`] into the answer [`Capability::solve`] gives. `None` (the default):
     /// the request is solved whole, as when it is refused (solving it whole reports why) or too

@@ -1,4 +1,4 @@
-//! Solver failures and warnings, each with a stable code (deburr.md §4 and the other specs' edge-case tables).
+//! Solver failures and warnings, each with a stable code (docs/spec/deburr.md §4 and the other specs' edge-case tables).
 
 use serde::{Deserialize, Serialize};
 

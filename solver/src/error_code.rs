@@ -1,4 +1,4 @@
-//! The stable error codes of kerf's answers (api.md, Errors; each spec's edge-case table): one
+//! The stable error codes of kerf's answers (docs/spec/api.md, Errors; each spec's edge-case table): one
 //! type, so no code is compared as a string and the OpenAPI document lists them all.
 
 use serde::{Deserialize, Serialize};

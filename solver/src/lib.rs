@@ -7,13 +7,12 @@
 //! Modules: [`geometry`] (vectors and small numeric helpers), [`tool`] (the cutter),
 //! [`path`] (typed moves), [`gcode`] (posts for the supported dialects), [`capability`] (the seam
 //! every way in dispatches through), [`material`] (work materials' Kienzle values), and one
-//! module per capability: [`deburr`], [`chord`],
-//! [`corners`], [`engagement`], [`predict`].
+//! module per capability: [`deburr`], [`segment`],
+//! [`contour`], [`engagement`], [`predict`].
 #![deny(missing_docs)]
 
 pub mod capability;
-pub mod chord;
-pub mod corners;
+pub mod contour;
 pub mod deburr;
 pub mod engagement;
 pub mod error;
@@ -25,6 +24,7 @@ pub mod material;
 pub mod path;
 pub mod planar;
 pub mod predict;
+pub mod segment;
 pub mod tool;
 pub mod validate;
 

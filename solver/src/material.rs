@@ -1,4 +1,4 @@
-//! Work materials (issue 16; engagement.md §11 item 4): the Kienzle values of a named material, as
+//! Work materials (docs/spec/engagement.md §11 item 4): the Kienzle values of a named material, as
 //! the materials library stores them (`/api/v1/materials/{name}`) and as an engagement request
 //! names them with `material`. The server resolves the name; the solver only sees the values.
 

@@ -190,7 +190,7 @@ pub fn line_intersection(p: &Vec2, dp: &Vec2, q: &Vec2, dq: &Vec2) -> Option<Vec
 }
 
 /// The corner point of two offset lines through `vertex`: line 1 with unit normal `n1` shifted by
-/// `o1` along it, line 2 with `n2` and `o2` (corners.md O2 for equal offsets, O3 otherwise). `None`
+/// `o1` along it, line 2 with `n2` and `o2` (docs/spec/contour.md O2 for equal offsets, O3 otherwise). `None`
 /// for a reversal (n1 = −n2), or for parallel lines with different offsets.
 pub fn miter_point(vertex: &Vec2, n1: &Vec2, o1: f64, n2: &Vec2, o2: f64) -> Option<Vec2> {
     if o1 == o2 {
@@ -279,7 +279,7 @@ mod tests {
         let v = Vec2::new(20.0, 0.0);
         let p = miter_point(&v, &Vec2::new(0.0, -1.0), 1.0, &Vec2::new(1.0, 0.0), 1.0).unwrap();
         assert_abs_diff_eq!(p, Vec2::new(21.0, -1.0), epsilon = 1e-15);
-        // O3 with different offsets (corners.md §3.9.2 example, as a right-hand corner).
+        // O3 with different offsets (docs/spec/contour.md §3.9.2 example, as a right-hand corner).
         let v = Vec2::new(20.0, 20.0);
         let p = miter_point(&v, &Vec2::new(1.0, 0.0), 1.015427, &Vec2::new(0.0, 1.0), 1.154701).unwrap();
         assert_abs_diff_eq!(p, Vec2::new(21.015427, 21.154701), epsilon = 1e-12);

@@ -1,4 +1,4 @@
-//! The cutter: kind, radius and the optional data later capabilities need (api.md, Tools).
+//! The cutter: kind, radius and the optional data later capabilities need (docs/spec/api.md, Tools).
 
 use std::fmt;
 
@@ -67,11 +67,11 @@ pub struct Tool {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub flute_length: Option<f64>,
     /// Feed of straight moves down the tool axis (plunges), mm/min (> 0): programs never plunge
-    /// faster (issue 15). Default: the machine's `plunge_feed`, else half the cutting feed.
+    /// faster. Default: the machine's `plunge_feed`, else half the cutting feed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub plunge_feed: Option<f64>,
-    /// Whether the end cuts at its centre, so the tool may plunge straight down into material
-    /// (issue 15). Default true; `false` (flat and bull tools with a centre hole or inserts)
+    /// Whether the end cuts at its centre, so the tool may plunge straight down into material.
+    /// Default true; `false` (flat and bull tools with a centre hole or inserts)
     /// makes contour layers enter on a ramp. A ball always cuts at its centre.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub centre_cutting: Option<bool>,
@@ -80,13 +80,13 @@ pub struct Tool {
     /// wide as the cutter.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub neck_radius: Option<f64>,
-    /// Shape-error table δ(θ) of the rotating cutting edge (error-prediction.md §3.13): the
+    /// Shape-error table δ(θ) of the rotating cutting edge (docs/spec/predict.md §3.13): the
     /// outward deviation of the edge envelope from the nominal ball along its normal, in mm, at
     /// contact angles θ from 0° (tip) to 90° (equator), angles strictly increasing. Linear
     /// interpolation between rows.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shape_error: Option<Vec<ShapeErrorPoint>>,
-    /// Tool-tip stiffness in X and Y (error-prediction.md §3.8): static, modal or a measured
+    /// Tool-tip stiffness in X and Y (docs/spec/predict.md §3.8): static, modal or a measured
     /// frequency-response table.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stiffness: Option<Stiffness>,
@@ -363,7 +363,7 @@ impl Stiffness {
     }
 }
 
-/// Smallest and largest tool numbers (api.md, Tools).
+/// Smallest and largest tool numbers (docs/spec/api.md, Tools).
 pub const TOOL_NUMBERS: std::ops::RangeInclusive<u32> = 1..=9999;
 
 /// How a solver request names its tool: a number in the tool table, or the tool itself.

@@ -1,4 +1,4 @@
-//! Cycle time invariants (issue 15, item 4) on random paths: never shorter than every move at
+//! Cycle time invariants on random paths: never shorter than every move at
 //! its feed, never longer than stopping at every vertex, and the parts add up.
 
 use kerf_solver::geometry::Vec3;

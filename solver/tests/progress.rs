@@ -1,15 +1,15 @@
-//! Every capability reports its progress while it runs (issue 17, "job progress that moves"):
+//! Every capability reports its progress while it runs:
 //! through the seam's `Control`, a job's bar moves within one operation, not only 0 → 100 %.
 
 use std::sync::Mutex;
 
 use kerf_solver::capability::{Capability, Control, Lookup, Resolved, Run, resolve};
-use kerf_solver::chord::SegmentCapability;
-use kerf_solver::corners::ContourCapability;
+use kerf_solver::contour::ContourCapability;
 use kerf_solver::deburr::DeburrCapability;
 use kerf_solver::engagement::EngagementCapability;
 use kerf_solver::machine::MachineProfile;
 use kerf_solver::material::Material;
+use kerf_solver::segment::SegmentCapability;
 use kerf_solver::tool::Tool;
 use serde_json::{Value, json};
 

@@ -1,14 +1,12 @@
-//! Requests split into parts (issue 12: a job's chunks on different workers): solving the parts
+//! Requests split into parts (a job's chunks on different workers): solving the parts
 //! apart, passing their outputs through JSON as the job store does, and finishing gives the
 //! answer and program of solving the request whole, byte for byte.
 
-#[path = "split_support/mod.rs"]
-mod split_support;
-#[path = "predict_support/mod.rs"]
-mod support;
+use crate::predict::support;
+use crate::split_support;
 
 use kerf_solver::capability::{self, Capability, OutputOptions, Part, Purpose, Resolved, Run, Sizing, Split};
-use kerf_solver::corners::ContourCapability;
+use kerf_solver::contour::ContourCapability;
 use kerf_solver::deburr::DeburrCapability;
 use kerf_solver::engagement::EngagementCapability;
 use kerf_solver::predict::{CorrectionOptions, Method, PredictCapability, PredictRequest};

@@ -1,4 +1,4 @@
-//! The measurements behind the capabilities' cost models (issue 12: how a job's operation is cut
+//! The measurements behind the capabilities' cost models (how a job's operation is cut
 //! into parts; README "More than one machine"): core-seconds on one thread (CPU time, so a shared
 //! machine's load matters less than to wall time) of the work a split request's parts and finish
 //! step do. A measurement, not a test; run one section or all:
@@ -12,13 +12,13 @@
 //! sampling, N = 256, 4 passes per mm²), so figures measured in a debug build can be scaled to a
 //! release build's: the contour and deburr constants were measured that way.
 
-#[path = "../../solver/tests/split_support/mod.rs"]
+#[path = "../../solver/tests/split_support.rs"]
 mod split_support;
-#[path = "../../solver/tests/predict_support/mod.rs"]
+#[path = "../../solver/tests/predict/support.rs"]
 mod support;
 
 use kerf_solver::capability::{self, Capability, OutputOptions, Part, Purpose, Resolved, Run, Sizing};
-use kerf_solver::corners::ContourCapability;
+use kerf_solver::contour::ContourCapability;
 use kerf_solver::deburr::DeburrCapability;
 use kerf_solver::engagement::EngagementCapability;
 use kerf_solver::predict::{Method, PredictCapability, PredictRequest};
@@ -88,10 +88,10 @@ fn ratio(pool: &rayon::ThreadPool) {
 
 /// Predict's cost model (`solver/src/predict/capability.rs`): the setup every part repeats (per
 /// pass of the path), a predicted pass by method, N and with or without the force model, and the
-/// finish step (per pass), on one thread of the seed's 103 041-pass raster.
+/// finish step (per pass), on one thread of the patent's 103 041-pass raster.
 fn predict(pool: &rayon::ThreadPool) {
     let slice = 2000;
-    // The seed's job is the same raster at a 0.29963 mm pick and step (286 225 passes): three
+    // The patent's job is the same raster at a 0.29963 mm pick and step (286 225 passes): three
     // times the passes around each one.
     for (method, resolution, cutting, pick) in [
         (Method::Sampling, 256, true, 0.5),
@@ -183,7 +183,7 @@ where
     (parts, finish, answer)
 }
 
-/// Contour (`solver/src/corners/parts.rs`): a star of `corners` corners (radius `corners` mm,
+/// Contour (`solver/src/contour/parts.rs`): a star of `corners` corners (radius `corners` mm,
 /// every other corner 3 mm in), two passes; untilted the
 /// layers repeat the first layer's plan (per move), tilted every layer is planned (per corner and
 /// pass).

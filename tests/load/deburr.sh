@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Load figure for issue 2: typical deburr requests over loopback with wrk (Debian package `wrk`).
+# Load figure: typical deburr requests over loopback with wrk (Debian package `wrk`).
 # Starts the release binary on a temporary database, registers tool 7, then runs
 # wrk with 64 connections on 2 threads. Usage: tests/load/deburr.sh [seconds] [distinct]
 # Without `distinct` every request is the same (answered from the answer cache after the first);

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Engagement over HTTP (issue 14 item 3): samples per second of server CPU for the engagement
+"""Engagement over HTTP: samples per second of server CPU for the engagement
 bench's request (1 m of zig-zag clearing path at a 0.01 mm step, exact engine, flat Ø10 tool),
 answered as JSON.
 

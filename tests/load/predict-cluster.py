@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """One prediction job through one SQLite process and through PostgreSQL with one and with two
-`kerf worker` processes behind a `kerf serve --job-workers 0` (issue 12): wall time from upload
+`kerf worker` processes behind a `kerf serve --job-workers 0`: wall time from upload
 to done, the solver's own time, passes per second, CPU time of the kerf processes, and so the
 overhead of claiming, heartbeats, splitting into parts and merging them against the one-process
 run. On PostgreSQL the prediction is split into parts (`KERF_JOB_PART_S` core-seconds each,
@@ -10,7 +10,7 @@ run (the machine may be shared).
 
 Usage (release build, PostgreSQL from Debian's package; as root it runs as the postgres user):
     cargo build --release -p kerf-server
-    KERF_PREDICT_PICK=0.29963 tests/load/predict-cluster.py target/release/kerf   # the seed's size
+    KERF_PREDICT_PICK=0.29963 tests/load/predict-cluster.py target/release/kerf   # the patent's size
     tests/load/predict-cluster.py target/release/kerf sqlite 2   # only these runs
 Without KERF_PREDICT_PICK the job is predict-job.py's 103 041-pass raster.
 """

@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
-"""Passes per second of a prediction job over HTTP (issue 6), the whole path of a realistic program.
+"""Passes per second of a prediction job over HTTP, the whole path of a realistic program.
 
 Writes the job of solver/benches/predict.rs as a job file: a Ø10 ball end mill finishing a
 double-wave surface (160 x 160 mm, slopes up to 26°) by a zig-zag raster, pick 0.5 mm, 0.5 mm
 segments, 103 041 feed passes, modal stiffness and the force model, stock = surface + 0.2 mm as a
-height grid, surface sampling at N = 256 (the seed's pixel size 0.039 mm). With a base URL it
+height grid, surface sampling at N = 256 (the patent's pixel size 0.039 mm). With a base URL it
 submits the job, follows its progress and prints the job's timings and the server's CPU time.
 
 Usage:
@@ -12,7 +12,7 @@ Usage:
     ./target/release/kerf serve --bind 127.0.0.1:18087 --database /tmp/bench.db &
     tests/load/predict-job.py /tmp/predict-job.json http://127.0.0.1:18087 $!
 (RAYON_NUM_THREADS=1 in the server's environment gives the one-core figure; KERF_PREDICT_PICK sets the
-pick and step, mm, e.g. 0.29963 for the seed's job size; tests/load/predict-cluster.sh runs the job
+pick and step, mm, e.g. 0.29963 for the patent's job size; tests/load/predict-cluster.sh runs the job
 through SQLite and through PostgreSQL with one and two worker processes.)
 """
 import json
@@ -23,7 +23,7 @@ import time
 import urllib.request
 
 SIZE, PICK, STEP, RADIUS = 160.0, 0.5, 0.5, 5.0
-# The seed's job size (286 463 passes) is about PICK = STEP = 160 / 534: 535 x 535 = 286 225 passes.
+# The patent's job size (286 463 passes) is about PICK = STEP = 160 / 534: 535 x 535 = 286 225 passes.
 PICK = STEP = float(os.environ.get("KERF_PREDICT_PICK", PICK))
 
 
@@ -93,9 +93,9 @@ def measure(path, base, pid):
     result = json.load(urllib.request.urlopen(f"{base}/api/v1/jobs/{submitted['id']}"))["results"][0]["result"]
     timings, passes = result["timings"], result["summary"]["passes"]
     print(f"job: {passes} passes, {wall:.1f} s from upload to done; solve {timings['solve_ms'] / 1000:.1f} s = "
-          f"{timings['passes_per_s']:.0f} passes/s ({0.070 * timings['passes_per_s']:.0f}x the seed's 0.070 s/pass); "
+          f"{timings['passes_per_s']:.0f} passes/s ({0.070 * timings['passes_per_s']:.0f}x the patent's 0.070 s/pass); "
           f"server CPU {cpu:.1f} s = {cpu / passes * 1000:.3f} ms/pass per core "
-          f"({0.070 / (cpu / passes):.0f}x the seed per core)")
+          f"({0.070 / (cpu / passes):.0f}x the patent per core)")
 
 
 if __name__ == "__main__":

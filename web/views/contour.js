@@ -1,4 +1,4 @@
-// Contour view: layered contour milling with corner loops and inside-corner relief (api.md,
+// Contour view: layered contour milling with corner loops and inside-corner relief (docs/spec/api.md,
 // Contour). A form, a 2-D plot of the contour and the tool-centre path of one layer (layer
 // selector; loops, reliefs, links and corners in their own colours; wheel to zoom, drag to pan,
 // double-click to fit), the corner table with the material left or over-cut, the summary, the
@@ -89,7 +89,7 @@ export function parsePoints(text) {
   return { points };
 }
 
-// The request body from the form (field names as api.md); throws {error, line} for bad points.
+// The request body from the form (field names as docs/spec/api.md); throws {error, line} for bad points.
 export function contourRequest(form) {
   const parsed = parsePoints(value(form, 'points'));
   if (parsed.error) throw parsed;

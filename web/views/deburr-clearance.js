@@ -1,6 +1,6 @@
 // Deburr clearance on the page: where the ball on its way in or out, or the neck above it along
 // the path, runs into the tube or the bored block, so the 3-D view can draw it red and the G-code
-// button say why it is off. The workpiece is the one the view draws (deburr.md §1.3: local y
+// button say why it is off. The workpiece is the one the view draws (docs/spec/deburr.md §1.3: local y
 // along the cylinder axis A1, z along the hole axis A2, the hole through the wall on the +z side).
 // The service's own checks (E_NO_APPROACH, E_NECK_COLLISION) still decide whether it writes a
 // program; this shows where, and catches an approach the page can see is wrong.

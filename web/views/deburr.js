@@ -1,5 +1,5 @@
 // Deburr view: a form for one cross-hole ridge, the 3-D plot of ridge and ball-centre path with
-// where the tool would meet the wall, the summary, warnings and the G-code download (api.md,
+// where the tool would meet the wall, the summary, warnings and the G-code download (docs/spec/api.md,
 // Deburr).
 import { api, program as programOf, sentence } from '/api.js';
 import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
@@ -64,7 +64,7 @@ const FORM = `
   </section>
 </div>`;
 
-// The request body from the form (field names as api.md).
+// The request body from the form (field names as docs/spec/api.md).
 export function deburrRequest(form) {
   const choice = value(form, 'tool_choice');
   const tool = choice === 'inline' ? { kind: 'ball', radius: half(numeric(form, 'ball_diameter')) } : Number(choice);
@@ -105,7 +105,7 @@ function syncVisibility(form) {
 }
 
 
-// The solids of the request in machine coordinates (deburr.md §1.3: local y along the cylinder
+// The solids of the request in machine coordinates (docs/spec/deburr.md §1.3: local y along the cylinder
 // axis A1, z along the hole axis A2, g = O + R_z(θ_A)·R_y(θ_P)·l): the tube or bored block and the
 // hole's wall, drawn see-through.
 function addWorkpiece(scene, request) {

@@ -1,5 +1,5 @@
-// Engagement view: tool–workpiece contact along one or several candidate paths (api.md,
-// Engagement; engagement.md §3). A form for the tool, stock, paths, cutting conditions, limits and
+// Engagement view: tool–workpiece contact along one or several candidate paths (docs/spec/api.md,
+// Engagement; docs/spec/engagement.md §3). A form for the tool, stock, paths, cutting conditions, limits and
 // the work material (from the library, or typed Kienzle values); per path (one shown at a time)
 // the plan view coloured by engagement, the contact-position graph, a_e, the summed chip
 // thickness per flute count with the threshold, spindle torque and power with the machine's limits, the feed plan, and the
@@ -43,8 +43,8 @@ const FORM = `
       <label>Spindle rotation <select name="spindle_direction" data-field="spindle_direction"><option value="cw">cw (M03)</option><option value="ccw">ccw (M04)</option></select></label>
     </fieldset>
     <fieldset><legend>Limits</legend>
-      <label><span>Chip thickness limit, mm <abbr class="symbol" title="T1 in engagement.md">T1</abbr></span> <input name="thickness_limit" type="number" step="any" value="0.075" data-field="thickness_limit"></label>
-      <label><span>Machining time limit, s <abbr class="symbol" title="T2 in engagement.md">T2</abbr></span> <input name="time_limit_s" type="number" step="any" value="20" data-field="time_limit_s"></label>
+      <label><span>Chip thickness limit, mm <abbr class="symbol" title="T1 in docs/spec/engagement.md">T1</abbr></span> <input name="thickness_limit" type="number" step="any" value="0.075" data-field="thickness_limit"></label>
+      <label><span>Machining time limit, s <abbr class="symbol" title="T2 in docs/spec/engagement.md">T2</abbr></span> <input name="time_limit_s" type="number" step="any" value="20" data-field="time_limit_s"></label>
       <label>Chip thickness judged by <select name="representative" data-field="representative"><option value="max">largest</option><option value="mean">mean</option><option value="median">median</option></select></label>
     </fieldset>
     <fieldset><legend>Simulation</legend>
@@ -134,7 +134,7 @@ function pathBoxes(form) {
   return [...form.querySelectorAll('.engagement-path')];
 }
 
-// The request body from the form (field names as api.md).
+// The request body from the form (field names as docs/spec/api.md).
 export function engagementRequest(form) {
   const choice = value(form, 'tool_choice');
   const tool = choice === 'inline'
@@ -352,7 +352,7 @@ function seriesCharts(column, result, answer, axis, onCursor) {
     label: fluteLabel(flute), colour: kColour(k), width: flute.recommended ? 2.2 : 1.1, points: perFlute(samples, key, field, k),
   }));
 
-  // Contact-position graph (engagement.md §3.1, 410): engaged arcs at every sample.
+  // Contact-position graph (docs/spec/engagement.md §3.1, 410): engaged arcs at every sample.
   const back = samples.some((s) => s.arcs.some(([from]) => from < -1e-9));
   const thetaRange = back ? [-180, 180] : [0, 180];
   chart('Contact position over the path', 280, {
@@ -377,7 +377,7 @@ function seriesCharts(column, result, answer, axis, onCursor) {
         }
       });
       if (result.contact_dots && key === 's') {
-        // The dots engine's removed dots (the seed's scatter).
+        // The dots engine's removed dots (the patent's scatter).
         g.fillStyle = 'rgba(230, 120, 0, 0.35)';
         for (const [s, theta] of result.contact_dots) g.fillRect(Math.floor(map.x(s)), Math.floor(map.y(theta)), 1, 1);
       }

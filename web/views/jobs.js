@@ -1,5 +1,5 @@
 // Jobs workbench: drop or pick a job file, watch it queue and run, browse past jobs, open a
-// result with the view of its operation, download G-code and JSON (api.md, Jobs).
+// result with the view of its operation, download G-code and JSON (docs/spec/api.md, Jobs).
 import { api, binary, sentence } from '/api.js';
 import { download, message, showProblem } from '/form.js';
 import { resultView } from '/views.js';
@@ -144,7 +144,7 @@ async function openJob(id, root) {
     const title = document.createElement('h2');
     title.textContent = `Job #${job.id}${job.name ? ': ' + job.name : ''}`;
     box.append(title);
-    // The whole job as one program: every operation with its tool change (issue 15), and every
+    // The whole job as one program: every operation with its tool change, and every
     // output in one zip (job.json, each answer and program, the job's program).
     const whole = document.createElement('div');
     whole.className = 'actions';

@@ -1,5 +1,5 @@
-// Machines view: the controller profiles (api.md, Machines): list, register or replace, delete,
-// and the block time from a saturation test (chord.md §2.1, Eq. 1).
+// Machines view: the controller profiles (docs/spec/api.md, Machines): list, register or replace, delete,
+// and the block time from a saturation test (docs/spec/segment.md §2.1, Eq. 1).
 import { api } from '/api.js';
 import { clearProblem, confirmButton, message, showProblem } from '/form.js';
 
@@ -11,7 +11,7 @@ const FORM = `
       <label>Block time, ms <input name="block_time_ms" type="number" step="any" value="4" data-field="block_time_ms"></label>
       <label>Max feed, mm/min <input name="max_feed" type="number" step="any" value="10000" data-field="max_feed"></label>
       <label>Dialect <select name="dialect" data-field="dialect"><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select></label>
-      <label><span>Block margin <abbr class="symbol" title="k_f in chord.md">k_f</abbr></span> <input name="margin" type="number" step="any" placeholder="1" data-field="margin"></label>
+      <label><span>Block margin <abbr class="symbol" title="k_f in docs/spec/segment.md">k_f</abbr></span> <input name="margin" type="number" step="any" placeholder="1" data-field="margin"></label>
       <label>Min chord error, mm <input name="min_chord_error" type="number" step="any" placeholder="0" data-field="min_chord_error"></label>
       <label>Description <input name="description" type="text" placeholder="control, mode, date" data-field="description"></label>
     </fieldset>

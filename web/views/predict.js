@@ -1,5 +1,5 @@
 // Predict view: machining-error prediction and path correction for ball-end-mill finishing
-// (api.md, Error prediction). A form (tool with its shape-error table and stiffness, stock, the
+// (docs/spec/api.md, Error prediction). A form (tool with its shape-error table and stiffness, stock, the
 // G-code program, cutting conditions, method), the path coloured by predicted error with a colour
 // scale, a histogram of the errors, the worst passes with their NC lines, warnings, and the
 // corrected program. `predictResult` also shows prediction jobs.
@@ -144,7 +144,7 @@ function ballRadius(form) {
   return value(form, 'size_as') === 'diameter' ? half(size) : size;
 }
 
-// The request body from the form (field names as api.md) and, for an STL stock, the file.
+// The request body from the form (field names as docs/spec/api.md) and, for an STL stock, the file.
 export function predictRequest(form) {
   const choice = value(form, 'tool_choice');
   let tool = Number(choice);

@@ -1,5 +1,5 @@
-// Segment view: cut a curve into G01 blocks by the control's block time (api.md, Segment;
-// chord.md). A form for the curve and the rule, the curve with its blocks, the chord error and the
+// Segment view: cut a curve into G01 blocks by the control's block time (docs/spec/api.md, Segment;
+// docs/spec/segment.md). A form for the curve and the rule, the curve with its blocks, the chord error and the
 // block length along the curve, the rule side by side with a fixed tolerance, G-code download.
 import { api } from '/api.js';
 import { Timeline } from '/timeline.js';
@@ -42,7 +42,7 @@ const FORM = `
       <label>Chord error chosen <select name="mode" data-field="mode"><option value="window">per window</option><option value="curve">whole curve</option><option value="guarantee">no short blocks (guarantee)</option></select></label>
       <label data-mode="window">Window length, mm <input name="window" type="number" step="any" placeholder="5 target chords" data-field="window"></label>
       <label data-mode="curve">Rule <select name="rule" data-field="rule"><option value="extremes">smallest radius</option><option value="max">largest window value</option><option value="normal_accel">normal acceleration</option></select></label>
-      <label><span>Block margin <abbr class="symbol" title="k_f in chord.md">k_f</abbr></span> <input name="margin" type="number" step="any" value="1" data-field="margin"></label>
+      <label><span>Block margin <abbr class="symbol" title="k_f in docs/spec/segment.md">k_f</abbr></span> <input name="margin" type="number" step="any" value="1" data-field="margin"></label>
       <label>Smallest chord error, mm <input name="min_chord_error" type="number" step="any" value="0" data-field="min_chord_error"></label>
       <label>Tolerance, mm <input name="tolerance" type="number" step="any" placeholder="none" data-field="tolerance"></label>
       <label>Compare with a fixed tolerance, mm <input name="compare_tolerance" type="number" step="any" value="0.01" data-field="compare_tolerance"></label>
@@ -83,7 +83,7 @@ function dropUndefined(object) {
   return Object.fromEntries(Object.entries(object).filter(([, v]) => v !== undefined && v !== ''));
 }
 
-// The request body from the form (field names as api.md).
+// The request body from the form (field names as docs/spec/api.md).
 export function segmentRequest(form) {
   const kind = value(form, 'kind');
   const centre = [numeric(form, 'cx') ?? 0, numeric(form, 'cy') ?? 0];

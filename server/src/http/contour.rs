@@ -1,11 +1,11 @@
-//! `POST /api/v1/contour/loops` (api.md, Contour): corner loops added to a closed tool-centre path
-//! made elsewhere (corners.md §3.4, claims 8–10), as JSON. `POST /api/v1/contour` is the contour
+//! `POST /api/v1/contour/loops` (docs/spec/api.md, Contour): corner loops added to a closed tool-centre path
+//! made elsewhere (docs/spec/contour.md §3.4, claims 8–10), as JSON. `POST /api/v1/contour` is the contour
 //! capability's endpoint, generated in `endpoints`.
 
 use axum::Json;
 use axum::extract::State;
 use kerf_solver::capability::Control;
-use kerf_solver::corners::{LoopsRequest, LoopsResult};
+use kerf_solver::contour::{LoopsAnswer, LoopsRequest};
 use serde::Deserialize;
 use utoipa::{IntoParams, ToSchema};
 use utoipa_axum::router::OpenApiRouter;
@@ -44,7 +44,7 @@ pub struct LoopsQuery {
     params(LoopsQuery),
     request_body = LoopsRequest,
     responses(
-        (status = 200, description = "The looped path", body = LoopsResult),
+        (status = 200, description = "The looped path", body = LoopsAnswer),
         (status = 400, body = Problem, content_type = "application/problem+json"),
         (status = 404, description = "Unknown tool number", body = Problem, content_type = "application/problem+json"),
         (status = 413, body = Problem, content_type = "application/problem+json"),
@@ -55,7 +55,7 @@ async fn post_loops(
     State(state): State<AppState>,
     AppQuery(_query): AppQuery<LoopsQuery>,
     AppJson(request): AppJson<LoopsRequest>,
-) -> AppResult<Json<LoopsResult>> {
+) -> AppResult<Json<LoopsAnswer>> {
     let catalog = store::catalog(&state.db, [request.refs()], Catalog::default()).await?;
     let tool = capabilities::resolve_refs::<kerf_solver::tool::Tool>(request.refs(), &catalog)?.tool;
     let answer =

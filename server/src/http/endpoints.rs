@@ -1,4 +1,4 @@
-//! The solver endpoints `POST /api/v1/{name}` (api.md), generated from the capability registry
+//! The solver endpoints `POST /api/v1/{name}` (docs/spec/api.md), generated from the capability registry
 //! (`capabilities::with_registry!`): one small `#[utoipa::path]` handler per capability with a
 //! JSON body, documented with the capability's own [`Endpoint`](kerf_solver::capability::Endpoint)
 //! texts, so the OpenAPI document names each capability's concrete request and answer. A

@@ -1,4 +1,4 @@
-//! Jobs over HTTP (api.md, Jobs): submit a job file (multipart field `file`, or the raw body as
+//! Jobs over HTTP (docs/spec/api.md, Jobs): submit a job file (multipart field `file`, or the raw body as
 //! JSON or TOML), follow it, fetch its results and G-code (each operation's, or the one program
 //! of the whole job, or every output as a zip archive), cancel it, list jobs with paging.
 

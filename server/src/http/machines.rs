@@ -1,4 +1,4 @@
-//! The machines registry over HTTP (api.md, Machines): `PUT/GET/DELETE /api/v1/machines/{name}`,
+//! The machines registry over HTTP (docs/spec/api.md, Machines): `PUT/GET/DELETE /api/v1/machines/{name}`,
 //! list. A machine is a controller profile (block processing time, feed limit, dialect, margins);
 //! a solver request that names it takes its values as defaults.
 

@@ -1,5 +1,5 @@
-//! The materials library over HTTP (issue 16): `PUT/GET/DELETE /api/v1/materials/{name}`, list.
-//! A material holds Kienzle's k_c1.1 and m_c (engagement.md §11 item 4); an engagement request
+//! The materials library over HTTP: `PUT/GET/DELETE /api/v1/materials/{name}`, list.
+//! A material holds Kienzle's k_c1.1 and m_c (docs/spec/engagement.md §11 item 4); an engagement request
 //! that names it cuts it with these values.
 
 use axum::Json;

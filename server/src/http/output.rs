@@ -1,4 +1,4 @@
-//! Output negotiation shared by every path-producing endpoint (api.md, Conventions: G-code):
+//! Output negotiation shared by every path-producing endpoint (docs/spec/api.md, Conventions: G-code):
 //! JSON by default; G-code with `Accept: text/x-gcode` or `?format=gcode`, in `?dialect=`
 //! (`fanuc` default, or the machine's) with `?reference=tip|centre` and `?arcs=g2g3|chords`.
 

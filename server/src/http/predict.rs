@@ -1,4 +1,4 @@
-//! `POST /api/v1/predict` (api.md, Error prediction): machining-error prediction and path
+//! `POST /api/v1/predict` (docs/spec/api.md, Error prediction): machining-error prediction and path
 //! correction for ball-end-mill finishing, as JSON or as the corrected G-code program.
 //!
 //! The request is JSON, or `multipart/form-data` with the JSON in part `request` and the stock's

@@ -1,4 +1,4 @@
-//! The tool table over HTTP (api.md, Tools): `PUT/GET/DELETE /api/v1/tools/{number}`, list.
+//! The tool table over HTTP (docs/spec/api.md, Tools): `PUT/GET/DELETE /api/v1/tools/{number}`, list.
 
 use axum::Json;
 use axum::extract::State;

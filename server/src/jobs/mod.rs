@@ -1,4 +1,4 @@
-//! Jobs (issue 7; api.md, Jobs): job files naming one or more operations, their resolution into
+//! Jobs (docs/spec/api.md, Jobs): job files naming one or more operations, their resolution into
 //! self-contained jobs, the pure execution of a job, and the persistent queue with its workers.
 
 pub mod execute;

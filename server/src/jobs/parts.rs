@@ -1,4 +1,4 @@
-//! Operations split into parts (issue 12, PostgreSQL): how large a part should be, and the
+//! Operations split into parts (PostgreSQL): how large a part should be, and the
 //! parts' outputs as a finish step reads them back. The capabilities decide how their work
 //! divides and how parts merge (`Capability::split`, `solve_part`, `finish`); the queue
 //! (`store::jobs::split`, `claim`) runs the parts on any workers and the finish step after the

@@ -1,4 +1,4 @@
-//! A job's outputs as files (issue 15, item 1): the one program that runs every operation
+//! A job's outputs as files: the one program that runs every operation
 //! (`kerf_solver::gcode::job`), and the set of files `kerf run -o DIR` writes and
 //! `GET /api/v1/jobs/{id}/outputs.zip` holds: `job.json`, `NN-operation.json`,
 //! `NN-operation.nc` and `program.nc`.

@@ -1,4 +1,4 @@
-//! Bounds on the job store (issue 13): the total quota, the per-job cap, retention, and the pruner
+//! Bounds on the job store: the total quota, the per-job cap, retention, and the pruner
 //! task that removes finished jobs past their retention (in `kerf serve`, and in `kerf worker` on
 //! PostgreSQL: one process at a time prunes, the others skip).
 

@@ -1,4 +1,4 @@
-//! The job queue (issue 7; issue 12): jobs with status, progress, attempts and heartbeat, and
+//! The job queue: jobs with status, progress, attempts and heartbeat, and
 //! their results.
 //!
 //! In SQLite one process owns the queue: its workers claim the oldest queued job with one atomic

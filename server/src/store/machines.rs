@@ -1,4 +1,4 @@
-//! The machines registry (api.md, Machines): controller profiles keyed by name.
+//! The machines registry (docs/spec/api.md, Machines): controller profiles keyed by name.
 
 use super::on;
 use crate::db::Db;

@@ -1,4 +1,4 @@
-//! The materials library (issue 16): work materials with their Kienzle values, keyed by name,
+//! The materials library: work materials with their Kienzle values, keyed by name,
 //! seeded by migration 0006 with published values.
 
 use kerf_solver::material::{IsoGroup, Material};

@@ -1,4 +1,4 @@
-//! What a finished job's one program and its outputs archive are made of (issue 15, item 1): the
+//! What a finished job's one program and its outputs archive are made of: the
 //! stored job file and every operation's stored answer and program.
 
 use crate::db::Db;

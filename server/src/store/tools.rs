@@ -1,4 +1,4 @@
-//! The tool table (api.md, Tools).
+//! The tool table (docs/spec/api.md, Tools).
 
 use kerf_solver::tool::{Tool, ToolRef};
 

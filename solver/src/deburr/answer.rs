@@ -1,4 +1,4 @@
-//! What a deburr request answers (api.md, Deburr: answer 200).
+//! What a deburr request answers (docs/spec/api.md, Deburr: answer 200).
 
 use serde::{Deserialize, Serialize};
 
@@ -74,7 +74,7 @@ pub struct DeburrSummary {
     pub width: f64,
     /// Smallest and largest chamfer width cut by one ball section: where the ball at each emitted
     /// centre, cut by the ridge's normal plane, meets the true surfaces (at up to 1024 points,
-    /// spread evenly, on denser loops), mm. The seed's single-section figure; the swept figures
+    /// spread evenly, on denser loops), mm. The patent's single-section figure; the swept figures
     /// below are what the moves really cut.
     pub true_width_min: f64,
     /// See `true_width_min`.
@@ -90,7 +90,7 @@ pub struct DeburrSummary {
     pub wedge_angle_min_deg: f64,
     /// Largest wedge angle β, degrees.
     pub wedge_angle_max_deg: f64,
-    /// `exact` only: the largest distance between the seed's tangent-line centre and the exact
+    /// `exact` only: the largest distance between the patent's tangent-line centre and the exact
     /// centre of the same target, mm.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_exact_offset: Option<f64>,
@@ -102,7 +102,7 @@ pub struct DeburrSummary {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub safe_centre_z: Option<f64>,
     /// Time of the feed moves (loop and leads) at `feed`, s; with a block time the block-limited
-    /// time Σ max(Lᵢ/F, T_b) (chord.md §6.3).
+    /// time Σ max(Lᵢ/F, T_b) (docs/spec/segment.md §6.3).
     pub estimated_time_s: f64,
     /// With a block time (the request's or the machine's): the block processing time, ms.
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -36,7 +36,7 @@ pub struct DeburrAnswer {
     /// With a machine that has `max_accel`: the time the control would take for the program
     /// (feed profile limited by acceleration, and jerk with `max_jerk`; stops at sharp vertices,
     /// rapids at `rapid_feed`, a tool change per tool) and its parts: cutting (the loops), air
-    /// (the leads), rapid, tool change (issue 15).
+    /// (the leads), rapid, tool change.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cycle_time: Option<CycleTime>,
     /// With `holes`, `pattern` or `edge: both`: every loop (one per hole and edge) in the order the
@@ -80,7 +80,7 @@ pub struct HoleAnswer {
     pub result: Deburr,
 }
 
-/// The order a several-loop program visits its loops in (issue 15): loops of one tool together
+/// The order a several-loop program visits its loops in: loops of one tool together
 /// (the tool of `tool` first, then `inner_tool` when it is another), within a tool the holes
 /// pointing up before the turned ones (after them for the second tool, so the tube is turned at
 /// most twice), each group in a short order (nearest neighbour from its first loop in request
@@ -124,7 +124,7 @@ impl Capability for DeburrCapability {
             `inner_tool` once for the inside ridges and stopping (`M00`) to turn the tube for holes \
             that point down.",
         not_found: "Unknown tool number (`tool`, `inner_tool`) or machine",
-        refused: "Impossible geometry (codes in deburr.md §4); `E_TIMEOUT` over the synchronous time \
+        refused: "Impossible geometry (codes in docs/spec/deburr.md §4); `E_TIMEOUT` over the synchronous time \
             limit: submit a job",
     };
     type Request = DeburrRequest;

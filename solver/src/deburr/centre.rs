@@ -1,4 +1,4 @@
-//! The ball centre for one ridge point: the seed's tangent-line construction (deburr.md §2.7,
+//! The ball centre for one ridge point: the patent's tangent-line construction (docs/spec/deburr.md §2.7,
 //! the unified normal form) and kerf's exact variant, which puts the band edges on the true
 //! surfaces. Everything here is in the local frame (§1.3): A1 is the y_L axis, the hole axis runs
 //! along z_L through (f, 0).
@@ -23,7 +23,7 @@ pub(crate) struct Construction {
     pub centre_to_chord: f64,
 }
 
-/// The construction at one ridge point (deburr.md §2.5, §2.7), local frame.
+/// The construction at one ridge point (docs/spec/deburr.md §2.5, §2.7), local frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct RidgeCentre {
     /// Ridge point P.
@@ -98,7 +98,7 @@ impl Construction {
         }
     }
 
-    /// The seed's construction at profile point `point` (deburr.md §2.7). The caller has checked
+    /// The patent's construction at profile point `point` (docs/spec/deburr.md §2.7). The caller has checked
     /// |x| < R1.
     #[inline]
     pub fn tangent(&self, point: &ProfilePoint) -> RidgeCentre {
@@ -213,7 +213,7 @@ impl Construction {
 
     /// The chamfer width the tangent-line centre really cuts: the distance between the points
     /// where the ball's section circle in VP meets the true cylinder surface and hole wall
-    /// (deburr.md §2.9, W_APPROX). `None` if a circle misses a surface.
+    /// (docs/spec/deburr.md §2.9, W_APPROX). `None` if a circle misses a surface.
     pub fn true_width(&self, profile: &Profile, ridge: &RidgeCentre) -> Option<f64> {
         let (g1, g2) = ridge.band_edges(self.half_width);
         let plane = ridge.plane_basis();
@@ -314,7 +314,7 @@ mod tests {
             assert_abs_diff_eq!((centre - g2).norm(), 3.0, epsilon = 1e-10);
             let tangent = ridge.cylinder_normal.cross(&ridge.wall_normal).normalize();
             assert_abs_diff_eq!((centre - ridge.target).dot(&tangent), 0.0, epsilon = 1e-10);
-            // The seed's approximation is off by well under a per cent of W here (§2.9).
+            // The patent's approximation is off by well under a per cent of W here (§2.9).
             let true_width = construction.true_width(&profile, &ridge).unwrap();
             assert!((true_width / (2.0 * construction.half_width) - 1.0).abs() < 0.01);
         }

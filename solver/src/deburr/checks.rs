@@ -1,4 +1,4 @@
-//! Validity limits and warnings of deburr.md §4 that look at the geometry as a whole: whether
+//! Validity limits and warnings of docs/spec/deburr.md §4 that look at the geometry as a whole: whether
 //! the ridge exists, the far-side gouge, tool access for inner edges and chamfer overlap.
 
 use super::centre::{Construction, RidgeCentre};
@@ -108,7 +108,7 @@ impl RidgeSamples {
     }
 }
 
-/// E_FAR_GOUGE (deburr.md §4): for every centre, the ridge samples inside the ball must form
+/// E_FAR_GOUGE (docs/spec/deburr.md §4): for every centre, the ridge samples inside the ball must form
 /// one run around its own target and must not be the whole ridge. The ridge samples set the
 /// check's resolution, so a loop with many more points than samples is checked at two centres
 /// per sample spacing (every centre otherwise).

@@ -1,4 +1,4 @@
-//! The whole construction at one ridge point (deburr.md §1.5 diagnostics: u, β, L, CL, G1, G2),
+//! The whole construction at one ridge point (docs/spec/deburr.md §1.5 diagnostics: u, β, L, CL, G1, G2),
 //! for inspection and for the tests that check the geometry identities of §2.9.
 
 use serde::Serialize;
@@ -43,7 +43,7 @@ pub struct PointConstruction {
 
 /// The single-section exact construction: band edges on the true surfaces, in VP, and the centre
 /// whose own ball section meets them W apart. `method: exact` aims its swept chamfer at these
-/// band edges; its centres are not this one's but those of [`ideal_centres`] (issue 19).
+/// band edges; its centres are not this one's but those of [`ideal_centres`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct ExactConstruction {
@@ -113,8 +113,8 @@ pub fn construction_at(
 }
 
 /// The ideal centre path of the request's method at `places` (segment name and parameter),
-/// machine coordinates: the seed's closed form for `tangent`; for `exact` the path whose swept
-/// chamfer meets the true surfaces W apart (issue 19), solved once for all places. The emitted
+/// machine coordinates: the patent's closed form for `tangent`; for `exact` the path whose swept
+/// chamfer meets the true surfaces W apart, solved once for all places. The emitted
 /// centres are points of it, and the tolerance bounds the moves' distance from it.
 ///
 /// # Errors

@@ -1,4 +1,4 @@
-//! kerf's `exact` centre path (issue 19; deburr.md §2.9, the swept-sphere characteristic circle):
+//! kerf's `exact` centre path (docs/spec/deburr.md §2.9, the swept-sphere characteristic circle):
 //! centres whose swept envelope, not one ball section, meets the true surfaces W apart.
 //!
 //! The ball moving along the centre path cuts the envelope of its positions; its characteristic
@@ -16,7 +16,7 @@
 //! moved by Newton steps until both distances are D.
 //!
 //! The edge curves are sampled at nodes spread along the ridge and interpolated (cubic Hermite);
-//! the centres are solved at the nodes, and between them the centre is the seed's closed-form
+//! the centres are solved at the nodes, and between them the centre is the patent's closed-form
 //! centre plus the interpolated correction, which is smooth and small.
 
 use super::centre::Construction;
@@ -36,7 +36,7 @@ const MAX_NODES: usize = 16_384;
 pub(crate) struct EnvelopePath {
     /// Per segment: its first node and node count (its end is the next segment's first node).
     segments: Vec<(usize, usize)>,
-    /// Per node: the exact centre minus the seed's tangent-line centre.
+    /// Per node: the exact centre minus the patent's tangent-line centre.
     corrections: Vec<Vec3>,
     /// Per node: the target band edges G1 and G2, samples of the edge curves.
     edges: [Vec<Vec3>; 2],
@@ -166,7 +166,7 @@ impl EnvelopePath {
         best
     }
 
-    /// The exact centre at parameter `s` of segment `segment`: the seed's centre plus the
+    /// The exact centre at parameter `s` of segment `segment`: the patent's centre plus the
     /// interpolated correction.
     pub fn centre(&self, construction: &Construction, profile: &Profile, segment: usize, s: f64) -> Vec3 {
         let point = profile.segments[segment].point(profile.radius, s);
@@ -324,7 +324,7 @@ mod tests {
 
     #[test]
     fn centres_touch_both_edge_curves() {
-        // Tube R10, hole r8 (issue 19, geometry 3).
+        // Tube R10, hole r8 (geometry 3).
         let construction = construction(10.0, 3.0, 0.5 * std::f64::consts::SQRT_2);
         let profile = Profile::round(8.0, 0.0, 0.0);
         let path = EnvelopePath::solve(&construction, &profile);
@@ -353,7 +353,7 @@ mod tests {
 
     #[test]
     fn a_too_tight_ridge_is_bridged_not_overcut() {
-        // Tube R10, hole r8 off centre by 0.3, ball 4, Q 1 (issue 19, geometry 4): near φ = 0 the
+        // Tube R10, hole r8 off centre by 0.3, ball 4, Q 1 (geometry 4): near φ = 0 the
         // edge curves bend more tightly than the ball can follow.
         let construction = construction(10.0, 4.0, std::f64::consts::SQRT_2);
         let profile = Profile::round(8.0, 0.3, 0.0);

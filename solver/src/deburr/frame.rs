@@ -1,4 +1,4 @@
-//! The local frame of a cross hole and its map to machine coordinates (deburr.md §1.3, §1.4).
+//! The local frame of a cross hole and its map to machine coordinates (docs/spec/deburr.md §1.3, §1.4).
 
 use crate::error::ErrorCode;
 use nalgebra::Matrix3;

@@ -1,4 +1,4 @@
-//! A deburr request validated into the model the solver works on, a [`Job`] (deburr.md §1.4
+//! A deburr request validated into the model the solver works on, a [`Job`] (docs/spec/deburr.md §1.4
 //! inputs, §4 `E_INPUT`/`E_NOT_THROUGH`/`E_INCONSISTENT_ECC`).
 
 use super::frame::Frame;

@@ -1,4 +1,4 @@
-//! Cross-hole deburring with a ball end mill (spec: deburr.md; seed 000).
+//! Cross-hole deburring with a ball end mill (spec: docs/spec/deburr.md; patent 000).
 //!
 //! A through hole meets the outer or inner cylindrical surface of a tube (or the bore of a block)
 //! in a closed ridge. For points on that ridge this module computes the ball centre that cuts a
@@ -10,15 +10,13 @@
 //! * `frame`: local frame and its map to the machine (§1.3);
 //! * `profile`: hole cross-sections (§2.8);
 //! * `centre`: the ball-centre construction (§2.5, §2.7) and the single-section exact variant;
-//! * `envelope`: the `exact` centre path, whose swept envelope meets the true surfaces W apart
-//!   (issue 19);
-//! * `swept_width`: the chamfer width the emitted moves really cut (issue 19);
+//! * `envelope`: the `exact` centre path, whose swept envelope meets the true surfaces W apart;
+//! * `swept_width`: the chamfer width the emitted moves really cut;
 //! * `tolerance`: the target points from TA (§3), or with a block time from the block-time rule
-//!   per interval, never coarser than TA (issue 3, chord.md);
+//!   per interval, never coarser than TA (docs/spec/segment.md);
 //! * `checks`: validity limits and warnings (§4);
 //! * [`mod@program`]: lead moves and G-code (§6.3);
-//! * `parts`: a several-loop job's loops split into ranges that several workers solve at once
-//!   (issue 12).
+//! * `parts`: a several-loop job's loops split into ranges that several workers solve at once.
 
 mod answer;
 mod capability;
@@ -69,13 +67,13 @@ const APPROX_LIMIT: f64 = 0.05;
 
 /// Smallest band of the swept chamfer width around W that `method: exact` promises, mm: the
 /// band is ±max(this, TA), since the straight moves stray from the ideal centre path by up to
-/// TA and the swept chamfer with them (`W_WIDTH_OFF`, issue 19).
+/// TA and the swept chamfer with them (`W_WIDTH_OFF`).
 pub const WIDTH_TOLERANCE: f64 = 0.005;
 
 /// Solves a deburr request with its resolved tool (a request that names no machine).
 ///
 /// # Errors
-/// Every failure of deburr.md §4 with its code, and `E_INPUT` naming the field for bad numbers.
+/// Every failure of docs/spec/deburr.md §4 with its code, and `E_INPUT` naming the field for bad numbers.
 pub fn solve(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError> {
     solve_with(request, tool, None)
 }
@@ -112,7 +110,7 @@ pub fn solve_controlled(
 /// What `method: exact` places the centres by.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum ExactCentres {
-    /// The swept envelope meets the true surfaces W apart (issue 19).
+    /// The swept envelope meets the true surfaces W apart.
     Swept,
     /// One ball section in VP meets them W apart: the exact method before issue 19, kept for
     /// the bench's cost comparison.
@@ -192,7 +190,7 @@ fn solve_centred(
         let mut ridge = construction.tangent(&point);
         if job.method == Method::Exact {
             exact_offset = Some(exact_offset.unwrap_or(0.0).max((centre - ridge.centre).norm()));
-            // CL of the exact centre: its distance from P, signed as for the seed (positive when
+            // CL of the exact centre: its distance from P, signed as for the patent (positive when
             // C is on the air side).
             let from_target = ridge.target - centre;
             ridge.centre_offset = from_target.norm().copysign(from_target.dot(&ridge.bisector));
@@ -325,7 +323,7 @@ fn lead_block_time(moves: &[LeadMove], start: Vec3, rule: &crate::machine::Block
     time
 }
 
-/// Warnings about blocks shorter than feed × block time, with why they are (issue 3): the
+/// Warnings about blocks shorter than feed × block time, with why they are: the
 /// tolerance forbids longer chords, the radius is too small for the feed, or a piece of the
 /// profile is shorter than one block.
 fn block_warnings(job: &Job, stats: &BlockStats, limits: &[IntervalLimit]) -> Vec<Warning> {
@@ -519,7 +517,7 @@ fn swept_approx(job: &Job, swept: &SweptWidths) -> Option<Warning> {
     })
 }
 
-/// W_WIDTH_OFF (issue 19): the exact method's swept chamfer leaves W ± max(0.005 mm, TA) (the
+/// W_WIDTH_OFF: the exact method's swept chamfer leaves W ± max(0.005 mm, TA) (the
 /// moves stray from the ideal centre path by up to TA), with the worst place, and why when the
 /// coupled solve found no placement that gives W there.
 fn width_off(job: &Job, swept: &SweptWidths, envelope: Option<&EnvelopePath>) -> Option<Warning> {

@@ -1,4 +1,4 @@
-//! A short order to visit several loops (issue 15, item 5): nearest neighbour from the first
+//! A short order to visit several loops: nearest neighbour from the first
 //! loop, then 2-opt (reversing a stretch of the order while that shortens it), over a travel
 //! cost that need not be symmetric. The same is run from the given order too and the shorter
 //! of the two kept, so the result is never longer than the given order. Deterministic: ties go

@@ -1,4 +1,4 @@
-//! The hole's cross-section seen from +z_L, as segments in machining order (deburr.md §2.8), and
+//! The hole's cross-section seen from +z_L, as segments in machining order (docs/spec/deburr.md §2.8), and
 //! its signed distance (used for the true-surface band edges and the access checks).
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -23,7 +23,7 @@ pub(crate) enum Piece {
     Line { start: (f64, f64), end: (f64, f64), normal: (f64, f64) },
 }
 
-/// A named piece of the profile (names as in deburr.md §2.8, lower case).
+/// A named piece of the profile (names as in docs/spec/deburr.md §2.8, lower case).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Segment {
     pub name: &'static str,
@@ -55,7 +55,7 @@ impl Segment {
         }
     }
 
-    /// Number of equal parameter intervals the tolerance bisection starts from (deburr.md §3):
+    /// Number of equal parameter intervals the tolerance bisection starts from (docs/spec/deburr.md §3):
     /// ⌈sweep/90°⌉ for arcs, 1 for lines.
     pub fn initial_intervals(&self) -> u32 {
         match self.piece {

@@ -1,5 +1,5 @@
 //! Lead-in, lead-out and the G-code program of a deburr job (issue: "complete and safe to run";
-//! deburr.md §6.3, §7).
+//! docs/spec/deburr.md §6.3, §7).
 //!
 //! Outer edge: rapid above the lead point A0 = C0 − δ·u0 (δ back along the bisector, in air), feed
 //! down to A0 and on to C0, run the loop, back to A0 and up. Inner edge: rapid above the hole
@@ -91,7 +91,7 @@ pub fn program(deburr: &Deburr, post: &Post) -> Result<String, SolverError> {
     program_for_holes(&[deburr], post)
 }
 
-/// One program for several holes deburred with one tool (issue 15): [`program_for_loops`] with
+/// One program for several holes deburred with one tool: [`program_for_loops`] with
 /// one tool, the tube never turned.
 ///
 /// # Errors
@@ -228,7 +228,7 @@ pub(crate) fn visit(legs: &[Leg<'_>], reference: Reference) -> Visit {
     Visit { path, air, stops, safe_z }
 }
 
-/// One program for several loops (issue 15): holes, and with `edge: both` each hole's outer and
+/// One program for several loops: holes, and with `edge: both` each hole's outer and
 /// inner ridge: each loop's approach, loop and way out in the order given, the tool lifted to
 /// the highest clearance plane of them between loops and moved across there. `tools[leg.tool]`
 /// cuts a leg; where the tool changes the program changes it (`T M06`, `G43 H`, spindle), and

@@ -1,4 +1,4 @@
-//! The deburr request as clients send it (api.md, Deburr): the wire types and their defaults.
+//! The deburr request as clients send it (docs/spec/api.md, Deburr): the wire types and their defaults.
 //! `job` validates it into the model the solver works on.
 
 pub use crate::geometry::Direction;
@@ -8,7 +8,7 @@ use crate::error::SolverError;
 use crate::tool::ToolRef;
 use crate::validate::finite;
 
-/// Default tolerance TA in mm (deburr.md §1.4, proposed value).
+/// Default tolerance TA in mm (docs/spec/deburr.md §1.4, proposed value).
 pub const DEFAULT_TOLERANCE: f64 = 0.01;
 /// Default feed in mm/min for the deburring loop.
 pub const DEFAULT_FEED: f64 = 300.0;
@@ -18,7 +18,7 @@ pub const DEFAULT_SPINDLE_RPM: f64 = 6000.0;
 pub const DEFAULT_CLEARANCE: f64 = 5.0;
 /// Default lead distance in mm: how far the outer-edge approach starts back along the bisector.
 pub const DEFAULT_LEAD_DISTANCE: f64 = 1.0;
-/// Smallest tolerance accepted (deburr.md §4, `E_TOL`).
+/// Smallest tolerance accepted (docs/spec/deburr.md §4, `E_TOL`).
 pub const MIN_TOLERANCE: f64 = 1e-6;
 
 /// The part carrying the cylindrical surface.
@@ -30,7 +30,7 @@ pub enum Workpiece {
     Tube {
         /// A point on the tube axis A1 at the hole station, machine/work coordinates.
         origin: [f64; 3],
-        /// θ_A: angle of A1 from +Y in the XY plane, counter-clockwise seen from +Z (deburr.md §1.3).
+        /// θ_A: angle of A1 from +Y in the XY plane, counter-clockwise seen from +Z (docs/spec/deburr.md §1.3).
         #[serde(default)]
         arrangement_angle_deg: f64,
         /// RN, mm.
@@ -54,7 +54,7 @@ pub enum Workpiece {
     },
 }
 
-/// Cross-section of the through hole seen along its axis (deburr.md §1.2).
+/// Cross-section of the through hole seen along its axis (docs/spec/deburr.md §1.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
@@ -80,7 +80,7 @@ pub enum CentreDistance {
     AcrossAlong([f64; 2]),
 }
 
-/// The through hole and where its axis A2 lies relative to A1 (deburr.md §1.2–1.4).
+/// The through hole and where its axis A2 lies relative to A1 (docs/spec/deburr.md §1.2–1.4).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(deny_unknown_fields)]
@@ -95,10 +95,10 @@ pub struct Hole {
     /// f: signed distance of A2 from A1 along x_L, mm (default 0, or from `axis_point`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub eccentricity: Option<f64>,
-    /// θ_P: angle of A2 from +Z, a rotation about A1 (deburr.md §1.3).
+    /// θ_P: angle of A2 from +Z, a rotation about A1 (docs/spec/deburr.md §1.3).
     #[serde(default)]
     pub penetration_angle_deg: f64,
-    /// Any point on the hole axis A2 (the seed's "third position"): its station along A1 moves
+    /// Any point on the hole axis A2 (the patent's "third position"): its station along A1 moves
     /// the origin there, and it fixes f (which must agree if also given).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axis_point: Option<[f64; 3]>,
@@ -275,7 +275,7 @@ impl DeburrRequest {
         for (index, (field, hole, own_arrangement, axial)) in placed.into_iter().enumerate() {
             let arrangement = own_arrangement.unwrap_or(arrangement);
             let theta = finite(&format!("{field}.arrangement_angle_deg"), arrangement)?.to_radians();
-            // A1 points along +Y turned by θ_A about Z (deburr.md §1.3).
+            // A1 points along +Y turned by θ_A about Z (docs/spec/deburr.md §1.3).
             let along = [-theta.sin(), theta.cos(), 0.0];
             let moved = [origin[0] + axial * along[0], origin[1] + axial * along[1], origin[2]];
             let workpiece = match &self.workpiece {
@@ -348,7 +348,7 @@ pub enum Edge {
 #[cfg_attr(feature = "schema", schema(as = DeburrMethod))]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
-    /// The seed's closed form: band edges on the tangent lines at P (deburr.md §2.5).
+    /// The patent's closed form: band edges on the tangent lines at P (docs/spec/deburr.md §2.5).
     #[default]
     Tangent,
     /// Band edges on the true surfaces, and the chamfer the ball sweeps along the moves is W wide
@@ -368,12 +368,12 @@ pub struct DeburrRequest {
     /// The through hole (or give `holes`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub hole: Option<Hole>,
-    /// Several holes deburred by one program (issue 15), instead of `hole`: each with its own
+    /// Several holes deburred by one program, instead of `hole`: each with its own
     /// shape and, optionally, its own `arrangement_angle_deg` and `axial_position` along the
     /// cylinder axis from `workpiece.origin`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub holes: Option<Vec<PlacedHole>>,
-    /// Copies of `hole` around the cylinder and along its axis (issue 15).
+    /// Copies of `hole` around the cylinder and along its axis.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pattern: Option<HolePattern>,
     /// Which ridge: `outer`, `inner` or `both` (a tube's; every hole's outer loop and inner
@@ -392,7 +392,7 @@ pub struct DeburrRequest {
     /// TA: largest distance of the centre polyline from the ideal centre path, mm (default 0.01).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tolerance: Option<f64>,
-    /// `tangent` (default, the seed) or `exact`.
+    /// `tangent` (default, the patent) or `exact`.
     #[serde(default)]
     pub method: Method,
     /// φ_0: where a round hole's loop starts, degrees from +x_L (round holes only).
@@ -423,7 +423,7 @@ pub struct DeburrRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub machine: Option<String>,
     /// T_b: the control's block processing time, ms (default: the machine's). With it the points
-    /// are spaced by the block-time rule (chord.md): per interval the chord error that keeps its
+    /// are spaced by the block-time rule (docs/spec/segment.md): per interval the chord error that keeps its
     /// block at least `feed` × `block_time_ms` long on the local radius of the centre path, never
     /// coarser than `tolerance`; the summary then reports the blocks.
     #[serde(default, skip_serializing_if = "Option::is_none")]

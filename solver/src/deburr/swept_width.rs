@@ -1,4 +1,4 @@
-//! The chamfer width the emitted moves really cut (issue 19; deburr.md §2.9, measured "on the
+//! The chamfer width the emitted moves really cut (docs/spec/deburr.md §2.9, measured "on the
 //! swept-sphere characteristic circle"): the ball swept along the straight moves between the
 //! centres removes everything within D of the centre polyline, so in the ridge's normal plane VP
 //! at a ridge point the band edges are where the true cylinder surface and the true hole wall,
@@ -27,7 +27,7 @@ const MAX_WIDTH_ROUNDS: usize = 4;
 /// edges. Intervals whose sag times this stays inside the band are not measured.
 const SAG_TO_WIDTH: f64 = 4.0;
 
-/// The TA placement measured on the swept result (issue 19): a straight move cuts the corner of
+/// The TA placement measured on the swept result: a straight move cuts the corner of
 /// the ideal centre path by up to TA, which narrows the swept chamfer between targets. Intervals
 /// whose middle is swept more than `band` off W while their end targets are not are halved
 /// (at most [`MAX_WIDTH_ROUNDS`] times), so the moves keep W ± band wherever the ideal path does.

@@ -1,8 +1,8 @@
-//! Target points from the tolerance TA: the adaptive bisection of deburr.md §3, exactly as
+//! Target points from the tolerance TA: the adaptive bisection of docs/spec/deburr.md §3, exactly as
 //! specified (K = 8 sub-samples, depth ≤ 20, strict `>`, left first), so point counts match the
 //! reference cases.
 //!
-//! With a block time (issue 3, chord.md) the same bisection runs with a tolerance per interval:
+//! With a block time (docs/spec/segment.md) the same bisection runs with a tolerance per interval:
 //! the block-time rule's chord error at the interval's own radius of curvature, never coarser
 //! than TA ([`Spacing::Rule`]).
 
@@ -21,9 +21,9 @@ pub(crate) const BISECTION_REACH: f64 = 2.1;
 /// How the bisection decides that an interval is fine enough.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum Spacing {
-    /// The fixed tolerance TA (deburr.md §3).
+    /// The fixed tolerance TA (docs/spec/deburr.md §3).
     Fixed(f64),
-    /// The block-time rule (issue 3): per interval the rule's chord error at the interval's radius.
+    /// The block-time rule: per interval the rule's chord error at the interval's radius.
     Rule(RuleSpacing),
 }
 

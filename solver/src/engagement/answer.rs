@@ -1,5 +1,5 @@
-//! What an engagement request answers (api.md, Engagement: `samples`, `flutes`, `recommended`;
-//! engagement.md §3.1 outputs and the [X] extras).
+//! What an engagement request answers (docs/spec/api.md, Engagement: `samples`, `flutes`, `recommended`;
+//! docs/spec/engagement.md §3.1 outputs and the [X] extras).
 
 use serde::{Deserialize, Serialize};
 use smallvec::SmallVec;
@@ -10,7 +10,7 @@ use super::request::{Engine, FeedBasis};
 use super::segments::Route;
 use crate::error::Warning;
 
-/// One engaged arc with its entry and exit (engagement.md §5.4).
+/// One engaged arc with its entry and exit (docs/spec/engagement.md §5.4).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct ArcDetail {
@@ -71,7 +71,7 @@ fn no_details(details: &SampleArcDetails) -> bool {
 /// A sample's risk and state marks (inline up to four).
 pub type SampleFlags = SmallVec<[SampleFlag; 4]>;
 
-/// The state at one sample of the path (api.md: `s`, `t`, `arcs`, `engaged_deg`, `radial_depth`).
+/// The state at one sample of the path (docs/spec/api.md: `s`, `t`, `arcs`, `engaged_deg`, `radial_depth`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct EngagementSample {
@@ -86,7 +86,7 @@ pub struct EngagementSample {
     /// Index of the path segment (for a point list, the segment from point `segment`; for a
     /// G-code path, the program line of the move).
     pub segment: usize,
-    /// Engaged arcs `[[from_deg, to_deg], ...]`, tool angle of engagement.md §4.1 (90° ahead,
+    /// Engaged arcs `[[from_deg, to_deg], ...]`, tool angle of docs/spec/engagement.md §4.1 (90° ahead,
     /// 0° right, 180° left of travel); from in [−180, 180), to in (from, from + 360], sorted.
     #[cfg_attr(feature = "schema", schema(value_type = Vec<[f64; 2]>))]
     pub arcs: SampleArcs,
@@ -132,8 +132,8 @@ pub struct EngagementSample {
     pub flags: SampleFlags,
 }
 
-/// Results for one flute count (api.md: `max_thickness`, `mean_thickness`, `min_thickness`,
-/// `time_s`, `recommended`; engagement.md §5.7–§5.9).
+/// Results for one flute count (docs/spec/api.md: `max_thickness`, `mean_thickness`, `min_thickness`,
+/// `time_s`, `recommended`; docs/spec/engagement.md §5.7–§5.9).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct FluteResult {
@@ -243,7 +243,7 @@ pub struct FeedPlan {
     pub feed_range: [f64; 2],
 }
 
-/// The cutting-force model of an answer (engagement.md §11 items 4, 5, 9).
+/// The cutting-force model of an answer (docs/spec/engagement.md §11 items 4, 5, 9).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct ForceInfo {
@@ -260,7 +260,7 @@ pub struct ForceInfo {
     pub helix_lag_deg: f64,
     /// Ball and bull-nose ends with engine `exact`: the most sections of the end (heights whose
     /// engaged arcs were found at their own radius, refined where the engagement changes with
-    /// height, and the straight flank above the corner) summed at one sample (engagement.md §11
+    /// height, and the straight flank above the corner) summed at one sample (docs/spec/engagement.md §11
     /// item 5).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub height_sections: Option<usize>,
@@ -329,7 +329,7 @@ pub struct PathEngagement {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_mrr: Option<f64>,
     /// `dots` engine: removed dots as `[s, θ_deg]` (one per sample and 1° bin) for the scatter
-    /// plot of the seed's contact graph.
+    /// plot of the patent's contact graph.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contact_dots: Option<Vec<[f64; 2]>>,
     /// The force model and limits behind the torque and power fields (with `kienzle` or
@@ -365,14 +365,14 @@ pub struct Comparison {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(untagged)]
-pub enum EngagementAnswer {
+pub enum EngagementSolution {
     /// The request gave `path`.
     Single(Box<PathEngagement>),
     /// The request gave `paths`.
     Comparison(Comparison),
 }
 
-impl EngagementAnswer {
+impl EngagementSolution {
     /// The results in request order (one for `path`).
     pub fn candidates(&self) -> &[PathEngagement] {
         match self {

@@ -1,4 +1,4 @@
-//! Arc-feed correction of the chip thickness (engagement.md §11 item 6): on a curved path the
+//! Arc-feed correction of the chip thickness (docs/spec/engagement.md §11 item 6): on a curved path the
 //! cutting edge meets the material at a distance ρ(θ) from the path's centre, not r_path, so
 //! it advances f_z·ρ/r_path per tooth there: (r_path + R)/r_path on the outside of the turn,
 //! (r_path − R)/r_path on the inside, and the chip is h = f_z·c(θ)·sin θ with c = ρ/r_path.

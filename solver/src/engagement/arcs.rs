@@ -1,4 +1,4 @@
-//! Engaged arcs on the tool circle in the angle convention of engagement.md §4.1: merging and
+//! Engaged arcs on the tool circle in the angle convention of docs/spec/engagement.md §4.1: merging and
 //! the numeric rules of §9, radial depth (§5.5), and the per-arc quantities of §5.4 and §5.10.
 
 pub use crate::gcode::SpindleDirection;

@@ -1,5 +1,5 @@
 //! A static bounding-box tree: which path pieces (of the path and of earlier cuts) can reach a
-//! query box (the pruning of engagement.md §5.3.3, for long paths).
+//! query box (the pruning of docs/spec/engagement.md §5.3.3, for long paths).
 //!
 //! The stock outline's edges use `planar::SegmentGrid` instead (see `outline`); the path keeps
 //! this tree because its pieces are arcs as well as lines, and the grid indexes straight

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use super::answer::{Comparison, PathEngagement, PostData, RouteData};
 use super::job::Job;
 use super::request::Engine;
-use super::{EngagementAnswer, EngagementRequest, Stock};
+use super::{EngagementRequest, EngagementSolution, Stock};
 use crate::capability::{
     Capability, Endpoint, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing, Split,
 };
@@ -26,7 +26,7 @@ pub struct EngagementCapability;
 /// with `paths`).
 #[derive(Debug, Clone, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
-pub struct EngagementResponse {
+pub struct EngagementAnswer {
     /// The tool, as resolved from the table or given inline.
     pub tool: Tool,
     /// The machine the request named, as registered: its `max_feed` caps the feed plan unless
@@ -48,12 +48,12 @@ pub struct EngagementResponse {
     /// With a machine that has `max_accel` and an `axial_depth` (a program): the time the control
     /// would take for the program of the request's `candidate` path (trapezoidal feed profile,
     /// stops at sharp corners, the plunge at the plunge feed, rapids at `rapid_feed`, one tool
-    /// change) and its parts (issue 15).
+    /// change) and its parts.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cycle_time: Option<crate::machine::cycle::CycleTime>,
     /// Samples, flute counts and recommendation (or `candidates`, one such result per path).
     #[serde(flatten)]
-    pub result: EngagementAnswer,
+    pub result: EngagementSolution,
 }
 
 impl Capability for EngagementCapability {
@@ -70,11 +70,11 @@ impl Capability for EngagementCapability {
             nominal feed. A `machine` supplies `feed_plan.max_feed` and the dialect.",
         not_found: "Unknown tool number or machine",
         refused: "Impossible or over a limit: `E_INPUT`, `E_PATH`, `E_STOCK`, `E_TOO_LARGE`, \
-            `E_TOO_MANY_SAMPLES`, `E_GRID_MEMORY`, `E_WORK_LIMIT` (engagement.md §9); `E_TIMEOUT` \
+            `E_TOO_MANY_SAMPLES`, `E_GRID_MEMORY`, `E_WORK_LIMIT` (docs/spec/engagement.md §9); `E_TIMEOUT` \
             over the synchronous time limit: submit a job",
     };
     type Request = EngagementRequest;
-    type Answer = EngagementResponse;
+    type Answer = EngagementAnswer;
     type Tool = Tool;
 
     fn refs(request: &EngagementRequest) -> Refs<'_> {
@@ -88,7 +88,7 @@ impl Capability for EngagementCapability {
         request: &EngagementRequest,
         context: Resolved<Tool>,
         run: &Run<'_>,
-    ) -> Result<EngagementResponse, SolverError> {
+    ) -> Result<EngagementAnswer, SolverError> {
         check_plunge_feed(request)?;
         let result = super::solve_in(
             request,
@@ -170,7 +170,7 @@ impl Capability for EngagementCapability {
         context: Resolved<Tool>,
         parts: &mut impl PartSource,
         run: &Run<'_>,
-    ) -> Result<EngagementResponse, SolverError> {
+    ) -> Result<EngagementAnswer, SolverError> {
         check_plunge_feed(request)?;
         let job = request.validate(&context.tool, context.machine.as_ref(), &physics(request, &context))?;
         let mut candidates = Vec::with_capacity(job.candidates.len());
@@ -185,13 +185,13 @@ impl Capability for EngagementCapability {
         if job.single || candidates.len() != job.candidates.len() {
             return Err(mismatch("fewer candidates"));
         }
-        Ok(respond(request, context, EngagementAnswer::Comparison(Comparison { candidates })))
+        Ok(respond(request, context, EngagementSolution::Comparison(Comparison { candidates })))
     }
 
     /// The program of one path: `output.candidate`, else the request's `candidate`, else 0.
     fn program(
         request: &EngagementRequest,
-        answer: &EngagementResponse,
+        answer: &EngagementAnswer,
         output: &OutputOptions,
     ) -> Result<String, SolverError> {
         let mut post = output.post(answer.machine.as_ref(), &answer.tool);
@@ -200,11 +200,11 @@ impl Capability for EngagementCapability {
         super::program(&answer.result, candidate, &post)
     }
 
-    fn machine(answer: &EngagementResponse) -> Option<&MachineProfile> {
+    fn machine(answer: &EngagementAnswer) -> Option<&MachineProfile> {
         answer.machine.as_ref()
     }
 
-    fn to_json(answer: EngagementResponse) -> serde_json::Result<Vec<u8>> {
+    fn to_json(answer: EngagementAnswer) -> serde_json::Result<Vec<u8>> {
         super::wire::to_json(answer)
     }
 }
@@ -228,13 +228,13 @@ fn physics(request: &EngagementRequest, context: &Resolved<Tool>) -> super::Phys
 
 /// The answer to `request` around the solver's `result`: the tool, machine, material and stock
 /// it was judged with, and the cycle time of the programmed candidate.
-fn respond(request: &EngagementRequest, context: Resolved<Tool>, result: EngagementAnswer) -> EngagementResponse {
+fn respond(request: &EngagementRequest, context: Resolved<Tool>, result: EngagementSolution) -> EngagementAnswer {
     let cycle_time = context.machine.as_ref().and_then(MachineProfile::dynamics).and_then(|dynamics| {
         let plunge =
             request.plunge_feed.or(context.tool.plunge_feed).or(context.machine.as_ref().and_then(|m| m.plunge_feed));
         super::program::cycle_time(&result, request.candidate.unwrap_or(0), &dynamics, plunge)
     });
-    EngagementResponse {
+    EngagementAnswer {
         cycle_time,
         tool: context.tool,
         machine: context.machine,

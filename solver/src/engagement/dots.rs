@@ -1,4 +1,4 @@
-//! Engine A, dot removal (engagement.md §5.3.2, the seed's method): the stock as a grid of dots,
+//! Engine A, dot removal (docs/spec/engagement.md §5.3.2, the patent's method): the stock as a grid of dots,
 //! each sample removing the dots inside the tool circle and reporting their contact angles; the
 //! arcs are rebuilt from the removed dots' lateral offsets.
 //!

@@ -1,5 +1,5 @@
 //! One candidate path end to end: contact at every sample from the chosen engine, the
-//! per-sample quantities and flags (engagement.md §5.4, §5.5, §5.10), the diagnostics of §9, and
+//! per-sample quantities and flags (docs/spec/engagement.md §5.4, §5.5, §5.10), the diagnostics of §9, and
 //! the per-flute results, recommendation and feed plan.
 
 use super::answer::{
@@ -144,7 +144,7 @@ fn run_exact(
 ) -> Result<Vec<Contact>, SolverError> {
     let route = &candidate.route;
     let mut engine = ExactEngine::default();
-    // The height bands of a rounded end, each with its own section's radius (engagement.md §11
+    // The height bands of a rounded end, each with its own section's radius (docs/spec/engagement.md §11
     // item 5); their own engine, whose work limit grows with their number.
     let rounded = candidate.force.as_ref().filter(|model| model.rounded());
     let mut section_engine = ExactEngine::with_limit(super::exact::MAX_TESTS.saturating_mul(MAX_SECTIONS as u64));
@@ -391,7 +391,7 @@ pub(crate) fn evaluate(
         }
     }
 
-    // Diagnostics (engagement.md §9).
+    // Diagnostics (docs/spec/engagement.md §9).
     let engaged_intervals = series.runs(|i| series.arc_count[i] > 0 && !series.marked(i, series::RAPID));
     if !statistic.iter().any(|s| *s) {
         warnings.push(Warning::new(

@@ -1,4 +1,4 @@
-//! Engine B, the exact boundary test (engagement.md §5.3.3): at each sample, the part of the
+//! Engine B, the exact boundary test (docs/spec/engagement.md §5.3.3): at each sample, the part of the
 //! tool circle that lies in the stock and at least R from the path travelled so far.
 //!
 //! Instead of stepping θ on a grid and bisecting, the circle is split where it crosses any

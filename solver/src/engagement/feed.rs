@@ -1,12 +1,12 @@
 //! The feed that holds a target chip thickness along the path (chip-thinning compensation,
-//! engagement.md §11 item 3), capped by the machine's feed, as blocks of one feed each.
+//! docs/spec/engagement.md §11 item 3), capped by the machine's feed, as blocks of one feed each.
 //!
 //! At every sample the feed per tooth that makes the thickest chip equal to h* is
 //! f_z' = h*/max sin θ (basis `tooth`) or h*_Σ/(H_k/f_z) (basis `sum`); the feed of the stretch
 //! between two samples is the lower of its two ends, and a block keeps the lowest feed of its
 //! stretches, so the chip never exceeds the target at any sample. With a force model and the
 //! machine's spindle limits the feed is also capped where the phase-mean spindle power or
-//! torque would exceed them (engagement.md §11 item 4).
+//! torque would exceed them (docs/spec/engagement.md §11 item 4).
 
 use super::answer::{FeedBlock, FeedLimit, FeedPlan};
 use super::arcfeed::ArcFeed;

@@ -1,4 +1,4 @@
-//! Per flute count: representative values of H_k (engagement.md §5.7), machining time (§5.8),
+//! Per flute count: representative values of H_k (docs/spec/engagement.md §5.7), machining time (§5.8),
 //! multi-tooth intervals, and the recommendation under the two limits (§5.9).
 
 use super::answer::{EngagementSample, FluteResult};

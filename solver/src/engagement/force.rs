@@ -1,4 +1,4 @@
-//! Spindle torque and power along the path from Kienzle's law (engagement.md §11 items 4 and 5):
+//! Spindle torque and power along the path from Kienzle's law (docs/spec/engagement.md §11 items 4 and 5):
 //! per tooth F_t = k_c1.1·a_p·h^(1−m_c), torque M = R·ΣF_t, power P = 2πNM/60, with the helix
 //! lag 2a_p·tan λ/D spreading each tooth's cut over that angle.
 //!

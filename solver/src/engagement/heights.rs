@@ -1,4 +1,4 @@
-//! The engagement of a ball or bull-nose end by height (engagement.md §11 item 5): the end's
+//! The engagement of a ball or bull-nose end by height (docs/spec/engagement.md §11 item 5): the end's
 //! section at height z above the tip is a circle of radius r(z), which meets the stock that the
 //! sections of the same height have left along the path so far, so each height has its own
 //! engaged arcs. The exact engine finds them for any radius.

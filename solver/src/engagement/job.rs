@@ -1,4 +1,4 @@
-//! An engagement request validated into a [`Job`] before any heavy work (engagement.md §9
+//! An engagement request validated into a [`Job`] before any heavy work (docs/spec/engagement.md §9
 //! `E_INPUT`, `E_PATH`, and the size limits): paths read into routes, the stock into a region.
 
 use crate::error::ErrorCode;
@@ -26,7 +26,7 @@ use crate::planar::signed_area;
 use crate::tool::{Tool, ToolKind};
 use crate::validate::{self, finite, non_negative, positive, positive_at_most};
 
-/// How the flute counts share the feed (engagement.md §2.5).
+/// How the flute counts share the feed (docs/spec/engagement.md §2.5).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum FeedMode {
     /// Constant f_z (mm/tooth).
@@ -142,7 +142,7 @@ fn too_large(field: &str, what: &str, count: usize, limit: usize) -> SolverError
     SolverError::new(ErrorCode::TooLarge, format!("{what}: {count} exceeds the limit of {limit}")).at(field)
 }
 
-/// A path's pieces, zero-length ones dropped with a warning (engagement.md §2.3).
+/// A path's pieces, zero-length ones dropped with a warning (docs/spec/engagement.md §2.3).
 pub(crate) fn read_path(input: &PathInput, field: &str, warnings: &mut Vec<Warning>) -> Result<Route, SolverError> {
     read_path_levels(input, field, warnings, &mut Vec::new())
 }
@@ -820,7 +820,7 @@ fn force_model(
             "axial_depth (mm) is required with kienzle or material (or paths[i].axial_depth for every path), or the path's Z under the stock top (cut_z, with stock_top_z, default 0): a_p is the chip width",
         )
     })?;
-    // Λ = 2·a_p·tan λ / D (engagement.md §11 item 5), radians.
+    // Λ = 2·a_p·tan λ / D (docs/spec/engagement.md §11 item 5), radians.
     let helix_tan = tool.helix_deg.map_or(0.0, |helix| helix.to_radians().tan());
     let lag = axial_depth * helix_tan / tool.radius;
     let (table, table_next) = (SinPower::new(1.0 - kienzle.mc), SinPower::new(2.0 - kienzle.mc));
@@ -942,7 +942,7 @@ pub struct Physics {
 }
 
 /// The dot grid of a candidate: the stock's box cut to where the tool can reach, in cells of
-/// `grid`; refused past [`MAX_GRID_DOTS`] (engagement.md §9 `W_GRID_MEMORY`: refuse).
+/// `grid`; refused past [`MAX_GRID_DOTS`] (docs/spec/engagement.md §9 `W_GRID_MEMORY`: refuse).
 /// Dots sit at `anchor` + (i + ½, j + ½)·`grid` (the bitmap's origin, so its cells and the dots
 /// line up).
 pub(crate) fn grid_extent(

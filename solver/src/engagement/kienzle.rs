@@ -1,5 +1,5 @@
 //! Kienzle's cutting-force law and the integral of its chip-thickness term over the tool circle
-//! (engagement.md §11 item 4): F_t = k_c1.1·b·h^(1−m_c) with h = f_z·sin θ, so every force,
+//! (docs/spec/engagement.md §11 item 4): F_t = k_c1.1·b·h^(1−m_c) with h = f_z·sin θ, so every force,
 //! torque and power of a tooth is a multiple of max(0, sin θ)^(1−m_c) and every mean over the
 //! tooth phase a multiple of its integral over the engaged arcs.
 
@@ -9,7 +9,7 @@ use crate::error::SolverError;
 
 use crate::validate::positive_at_most;
 
-/// Kienzle's specific cutting force of a work material (engagement.md §11 item 4): the
+/// Kienzle's specific cutting force of a work material (docs/spec/engagement.md §11 item 4): the
 /// tangential force on one tooth is `kc11 · a_p · h^(1 − mc)` for a chip of thickness h and
 /// width a_p (mm).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

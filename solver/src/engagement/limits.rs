@@ -1,4 +1,4 @@
-//! What the machine and the tool allow (engagement.md §11 items 4 and 9): the spindle's power
+//! What the machine and the tool allow (docs/spec/engagement.md §11 items 4 and 9): the spindle's power
 //! and torque against the cut's torque, and the tooth-passing frequency N·k/60 against the
 //! tool's natural frequencies.
 
@@ -10,10 +10,10 @@ use crate::tool::{Stiffness, Tool};
 use crate::validate::positive;
 
 /// Relative distance of the tooth-passing frequency from a natural frequency that is warned
-/// about (issue 16: "within 5 %").
+/// about ("within 5 %").
 pub const RESONANCE_BAND: f64 = 0.05;
 
-/// The spindle's ratings, from the machine profile (engagement.md §11 item 4). The cut is
+/// The spindle's ratings, from the machine profile (docs/spec/engagement.md §11 item 4). The cut is
 /// compared through its torque averaged over the tooth phase: that is the load the spindle
 /// drive carries, its rotor's inertia smoothing the tooth-by-tooth peaks.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]

@@ -1,5 +1,5 @@
-//! Tool–workpiece engagement over time and flute-count recommendation (spec: engagement.md;
-//! seed 003).
+//! Tool–workpiece engagement over time and flute-count recommendation (spec: docs/spec/engagement.md;
+//! patent 003).
 //!
 //! The tool's cutting circle moves along a 2-D tool-centre path over a plan-view stock. At each
 //! sample the solver finds the engaged arcs (angles of the circle touching material not yet
@@ -7,7 +7,7 @@
 //! and derives the radial depth, entry/exit angles, milling mode and burr/chipping flags, the
 //! summed chip thickness of k teeth maximised exactly over the tooth phase, the representative
 //! values and machining time per flute count, and the flute counts that meet a thickness and a
-//! time limit. Beyond the seed it returns the feed that holds a target chip thickness (per block
+//! time limit. Beyond the patent it returns the feed that holds a target chip thickness (per block
 //! and as G-code), the removal rate over time, and compares several candidate paths at once.
 //!
 //! * [`request`]: the request and its validation (§2, §9);
@@ -15,7 +15,7 @@
 //! * `stock`, `outline`, `bbox_tree`: the material W₀ and the indexes over it and the path (the
 //!   plane geometry itself is [`crate::planar`]'s);
 //! * `exact`: engine B, the exact boundary test (§5.3.3, default);
-//! * `dots`: engine A, the seed's dot removal (§5.3.2);
+//! * `dots`: engine A, the patent's dot removal (§5.3.2);
 //! * `arcs`: arc merging, a_e and the per-arc quantities (§5.4, §5.5, §5.10);
 //! * `teeth`: H_k and n_k with the exact phase maximisation (§5.6);
 //! * `flutes`: representative values, time, recommendation (§5.7–§5.9);
@@ -79,11 +79,11 @@ mod wire;
 
 pub use crate::geometry::Direction;
 pub use answer::{
-    ArcDetail, Comparison, EngagementAnswer, EngagementSample, FeedBlock, FeedLimit, FeedPlan, FluteResult, ForceInfo,
-    GridInfo, PathEngagement, SampleFlag,
+    ArcDetail, Comparison, EngagementSample, EngagementSolution, FeedBlock, FeedLimit, FeedPlan, FluteResult,
+    ForceInfo, GridInfo, PathEngagement, SampleFlag,
 };
 pub use arcs::{MillingMode, SpindleDirection};
-pub use capability::{EngagementCapability, EngagementResponse};
+pub use capability::{EngagementAnswer, EngagementCapability};
 pub use kienzle::{DEFAULT_RADIAL_RATIO, Kienzle, MAX_KC11};
 pub use limits::{RESONANCE_BAND, SpindleLimits};
 pub use program::program;
@@ -134,7 +134,7 @@ pub const DEFAULT_CHIPPING_DISENGAGE_DEG: f64 = 20.0;
 /// `E_INPUT` naming the field for bad numbers; `E_PATH` (empty path, arc centre not equidistant),
 /// `E_STOCK` (crossing or degenerate rings, bad bitmap), `E_TOO_LARGE`, `E_TOO_MANY_SAMPLES`,
 /// `E_GRID_MEMORY` (limits, with the limit in the message), `E_WORK_LIMIT`.
-pub fn solve(request: &EngagementRequest, tool: &Tool) -> Result<EngagementAnswer, SolverError> {
+pub fn solve(request: &EngagementRequest, tool: &Tool) -> Result<EngagementSolution, SolverError> {
     solve_with(request, tool, None)
 }
 
@@ -149,12 +149,12 @@ pub fn solve_with(
     request: &EngagementRequest,
     tool: &Tool,
     machine: Option<&MachineProfile>,
-) -> Result<EngagementAnswer, SolverError> {
+) -> Result<EngagementSolution, SolverError> {
     solve_in(request, tool, machine, &Physics::default(), Control::default())
 }
 
 /// [`solve_with`] with what the server resolved for the cutting physics: the Kienzle values of
-/// the request's `material` and the machine's spindle limits (engagement.md §11 item 4). The
+/// the request's `material` and the machine's spindle limits (docs/spec/engagement.md §11 item 4). The
 /// limits are checked only when the request gives `kienzle` or `material`.
 ///
 /// # Errors
@@ -168,7 +168,7 @@ pub fn solve_in(
     machine: Option<&MachineProfile>,
     physics: &Physics,
     control: Control<'_>,
-) -> Result<EngagementAnswer, SolverError> {
+) -> Result<EngagementSolution, SolverError> {
     let job = request.validate(tool, machine, physics)?;
     let mut results = Vec::with_capacity(job.candidates.len());
     for (index, candidate) in job.candidates.iter().enumerate() {
@@ -183,7 +183,7 @@ pub fn solve_in(
     if job.single
         && let Some(result) = results.pop()
     {
-        return Ok(EngagementAnswer::Single(Box::new(result)));
+        return Ok(EngagementSolution::Single(Box::new(result)));
     }
-    Ok(EngagementAnswer::Comparison(Comparison { candidates: results }))
+    Ok(EngagementSolution::Comparison(Comparison { candidates: results }))
 }

@@ -1,5 +1,5 @@
 //! The outline of a polygon stock: several rings read together under the even-odd rule with an
-//! inclusive boundary band (engagement.md §2.2, §5.3.2), indexed for the exact engine's queries
+//! inclusive boundary band (docs/spec/engagement.md §2.2, §5.3.2), indexed for the exact engine's queries
 //! and checked for crossings.
 //!
 //! The plane geometry is [`crate::planar`]'s: orientation and signed area, segment intersection,

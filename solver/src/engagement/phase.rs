@@ -1,5 +1,5 @@
 //! The largest sum over k evenly spaced teeth of a per-tooth load, over the tooth phase
-//! (engagement.md §5.6 generalised to loads that are not f_z·sin θ: Kienzle's h^(1−m_c), the
+//! (docs/spec/engagement.md §5.6 generalised to loads that are not f_z·sin θ: Kienzle's h^(1−m_c), the
 //! helix window, the arc-feed factor; §11 items 4–6).
 //!
 //! Between breakpoints (a tooth on a place where the load jumps or bends) the sum is smooth; a

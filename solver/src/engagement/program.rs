@@ -1,10 +1,10 @@
-//! The G-code program of one evaluated path (engagement.md §3.2 adoption, §11 items 3 and 12):
+//! The G-code program of one evaluated path (docs/spec/engagement.md §3.2 adoption, §11 items 3 and 12):
 //! the path at the cutting depth with the feed plan's F words (or the nominal feed), rapids
 //! lifted to the clearance plane, arcs as chords (with a block time, by the block-time rule of
-//! chord.md) or as G02/G03 (`arcs = g2g3`, issue 15); and the block figures of the chord program
+//! docs/spec/segment.md) or as G02/G03 (`arcs = g2g3`); and the block figures of the chord program
 //! for the answer.
 
-use super::answer::{EngagementAnswer, PathEngagement};
+use super::answer::{EngagementSolution, PathEngagement};
 use super::segments::{Route, Shape};
 use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};
@@ -62,7 +62,7 @@ fn runs(result: &PathEngagement) -> Vec<Run> {
 /// # Errors
 /// `E_INPUT` at `candidate` for an index out of range, and at `axial_depth` when the request
 /// gave no axial depth (the cutting Z is `stock_top_z − axial_depth`).
-pub fn program(answer: &EngagementAnswer, candidate: usize, post: &Post) -> Result<String, SolverError> {
+pub fn program(answer: &EngagementSolution, candidate: usize, post: &Post) -> Result<String, SolverError> {
     let candidates = answer.candidates();
     let result = candidates.get(candidate).ok_or_else(|| {
         SolverError::input("candidate", format!("candidate {candidate} does not exist ({} path(s))", candidates.len()))
@@ -109,7 +109,7 @@ pub fn program(answer: &EngagementAnswer, candidate: usize, post: &Post) -> Resu
 /// 15, item 4): one tool change, plunges in the air at the plunge feed, the final retract. `None` when the answer
 /// has no program (no `axial_depth`, no such candidate).
 pub(crate) fn cycle_time(
-    answer: &EngagementAnswer,
+    answer: &EngagementSolution,
     candidate: usize,
     dynamics: &crate::machine::cycle::Dynamics,
     plunge_feed: Option<f64>,
@@ -132,7 +132,7 @@ struct Cut {
     finest_arc_tolerance: Option<f64>,
     /// Arcs too tight for one block at their feed: count, smallest radius, largest feasible feed.
     infeasible: (usize, f64, f64),
-    /// Arcs whose [`CHORD_TOLERANCE`] needs chords shorter than a block (chord.md E4).
+    /// Arcs whose [`CHORD_TOLERANCE`] needs chords shorter than a block (docs/spec/segment.md E4).
     overridden_arcs: usize,
 }
 
@@ -243,7 +243,7 @@ fn cut(result: &PathEngagement, lift: f64, arcs: Arcs) -> Result<Cut, SolverErro
 }
 
 /// With a block time and an axial depth: the block figures of the program's feed moves and the
-/// warnings that explain short ones (arcs too tight for one block at their feed, chord.md E3;
+/// warnings that explain short ones (arcs too tight for one block at their feed, docs/spec/segment.md E3;
 /// short straight moves, E9).
 ///
 /// # Errors

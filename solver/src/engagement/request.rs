@@ -1,4 +1,4 @@
-//! The engagement request as clients send it (api.md, Engagement; engagement.md §2): the wire
+//! The engagement request as clients send it (docs/spec/api.md, Engagement; docs/spec/engagement.md §2): the wire
 //! types and their defaults. `job` validates it into the model the solver works on.
 
 pub use crate::geometry::Direction;
@@ -11,7 +11,7 @@ use super::arcs::SpindleDirection;
 use super::kienzle::Kienzle;
 use crate::tool::ToolRef;
 
-/// One move of a path given as `start` + `segments` (engagement.md §2.3).
+/// One move of a path given as `start` + `segments` (docs/spec/engagement.md §2.3).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
@@ -21,7 +21,7 @@ pub enum SegmentInput {
         /// End point [x, y], mm.
         to: [f64; 2],
         /// A positioning move (G0): it does not cut and is not timed; touching material is
-        /// reported as a collision (engagement.md §5.8).
+        /// reported as a collision (docs/spec/engagement.md §5.8).
         #[serde(default, skip_serializing_if = "std::ops::Not::not")]
         rapid: bool,
     },
@@ -59,7 +59,7 @@ pub struct PathSegments {
 }
 
 /// A tool-centre path in the plane of the stock: a list of points joined by feed moves
-/// (`[[x, y], ...]`, as in api.md), or `{"start": [x, y], "segments": [...]}` with lines, arcs
+/// (`[[x, y], ...]`, as in docs/spec/api.md), or `{"start": [x, y], "segments": [...]}` with lines, arcs
 /// and rapids.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
@@ -134,7 +134,7 @@ pub struct StockPolygon {
     pub holes: Vec<Vec<[f64; 2]>>,
 }
 
-/// A raster stock (engagement.md §2.2): cell (i, j) covers [x0 + i·cell, x0 + (i+1)·cell) ×
+/// A raster stock (docs/spec/engagement.md §2.2): cell (i, j) covers [x0 + i·cell, x0 + (i+1)·cell) ×
 /// [y0 + j·cell, ...).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
@@ -173,7 +173,7 @@ pub struct PreviousCut {
 #[cfg_attr(feature = "schema", schema(as = EngagementStock))]
 #[serde(deny_unknown_fields)]
 pub struct Stock {
-    /// One outline [[x, y], ...] (api.md form).
+    /// One outline [[x, y], ...] (docs/spec/api.md form).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polygon: Option<Vec<[f64; 2]>>,
     /// Holes of `polygon`.
@@ -190,7 +190,7 @@ pub struct Stock {
     pub previous_cuts: Vec<PreviousCut>,
 }
 
-/// Contact engine (engagement.md §5.3).
+/// Contact engine (docs/spec/engagement.md §5.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
@@ -199,17 +199,17 @@ pub enum Engine {
     /// with arc ends computed exactly (default; for numbers).
     #[default]
     Exact,
-    /// Engine A, the seed's method: a grid of workpiece dots removed by the moving circle; also
+    /// Engine A, the patent's method: a grid of workpiece dots removed by the moving circle; also
     /// returns the contact dots for the scatter plot.
     Dots,
 }
 
-/// Statistic of H_k compared with `thickness_limit` (engagement.md §5.7).
+/// Statistic of H_k compared with `thickness_limit` (docs/spec/engagement.md §5.7).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum Representative {
-    /// Largest summed chip thickness (default; the seed's).
+    /// Largest summed chip thickness (default; the patent's).
     #[default]
     Max,
     /// Length-weighted mean over the engaged samples.
@@ -218,7 +218,7 @@ pub enum Representative {
     Median,
 }
 
-/// What the chip-thinning compensation holds at the target (engagement.md §11 item 3).
+/// What the chip-thinning compensation holds at the target (docs/spec/engagement.md §11 item 3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
@@ -230,7 +230,7 @@ pub enum FeedBasis {
     Sum,
 }
 
-/// Ask for the feed that holds a target chip thickness along the path (engagement.md §11 item 3).
+/// Ask for the feed that holds a target chip thickness along the path (docs/spec/engagement.md §11 item 3).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(deny_unknown_fields)]
@@ -259,7 +259,7 @@ pub struct FeedPlanRequest {
 
 /// `POST /api/v1/engagement`: tool/workpiece contact along one path (`path`) or several
 /// candidate paths compared side by side (`paths`), chip thickness per flute count, machining
-/// time and the recommended flute counts (engagement.md).
+/// time and the recommended flute counts (docs/spec/engagement.md).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(deny_unknown_fields)]
@@ -279,8 +279,8 @@ pub struct EngagementRequest {
     pub paths: Option<Vec<Candidate>>,
     /// Spindle speed N, rpm.
     pub spindle_rpm: f64,
-    /// Feed of plunges (straight moves down the tool axis) in the program, mm/min (issue 15;
-    /// default the tool's `plunge_feed`, else the machine's, else half the cutting feed; never
+    /// Feed of plunges (straight moves down the tool axis) in the program, mm/min
+    /// (default the tool's `plunge_feed`, else the machine's, else half the cutting feed; never
     /// faster than the cutting feed).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub plunge_feed: Option<f64>,
@@ -366,7 +366,7 @@ pub struct EngagementRequest {
     /// `dots` engine: return the contact dots for the scatter plot (default true).
     #[serde(default = "yes")]
     pub contact_dots: bool,
-    /// Block processing time of the control, ms (chord.md; default: the machine's). With it the
+    /// Block processing time of the control, ms (docs/spec/segment.md; default: the machine's). With it the
     /// G-code program chords arcs at the block-time rule's chord error for their radius and
     /// feed (chords of one block; never coarser than 0.001 mm), and with `axial_depth` the
     /// answer reports the program's `blocks`.
@@ -384,12 +384,12 @@ pub struct EngagementRequest {
     pub candidate: Option<usize>,
     /// Correct the chip thickness on arcs of the path for the feed at the cutting edge,
     /// f_z·ρ/r_path with ρ the edge's distance from the arc's centre ((r_path ± R)/r_path at the
-    /// sides; engagement.md §11 item 6): thickness, mean chip, feed plan and forces (default
-    /// false: the seed's h = f_z·sin θ everywhere).
+    /// sides; docs/spec/engagement.md §11 item 6): thickness, mean chip, feed plan and forces (default
+    /// false: the patent's h = f_z·sin θ everywhere).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub arc_feed_correction: bool,
     /// Kienzle values of the work material: with `axial_depth` the answer gives the spindle
-    /// torque and power along the path (engagement.md §11 item 4). Give this or `material`.
+    /// torque and power along the path (docs/spec/engagement.md §11 item 4). Give this or `material`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kienzle: Option<Kienzle>,
     /// The name of a work material in the materials library (`/api/v1/materials/{name}`, or a

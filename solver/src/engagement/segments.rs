@@ -1,5 +1,5 @@
 //! The tool-centre path as lines and arcs (G1/G2/G3): lengths, points, tangents, distances, the
-//! boundary crossings the exact engine needs, and the sampling of engagement.md §5.2.
+//! boundary crossings the exact engine needs, and the sampling of docs/spec/engagement.md §5.2.
 
 use std::f64::consts::{PI, TAU};
 
@@ -96,7 +96,7 @@ impl Shape {
         offset <= sweep.abs() || sweep.abs() >= TAU
     }
 
-    /// Euclidean distance from `q` to the piece (engagement.md §5.3.3, distance helpers).
+    /// Euclidean distance from `q` to the piece (docs/spec/engagement.md §5.3.3, distance helpers).
     pub(crate) fn distance(&self, q: P2) -> f64 {
         match *self {
             Self::Line { from, to } => point_segment_distance(&q, &from, &to),
@@ -194,7 +194,7 @@ impl Shape {
     /// second value says so). A line is one chord.
     ///
     /// # Errors
-    /// [`Infeasible`] when the arc cannot hold one block at the rule's feed (chord.md E3).
+    /// [`Infeasible`] when the arc cannot hold one block at the rule's feed (docs/spec/segment.md E3).
     pub(crate) fn rule_chords(&self, rule: &BlockRule, tolerance: f64) -> Result<(usize, bool), Infeasible> {
         let Self::Arc { radius, sweep, .. } = *self else { return Ok((1, false)) };
         let (chord_error, _) = rule.chord_error(radius)?;
@@ -263,7 +263,7 @@ pub(crate) struct Piece {
     pub start_s: f64,
     /// Feed length (rapids excluded) before the piece.
     pub start_feed: f64,
-    /// Positioning move: does not cut, not timed (engagement.md §5.8).
+    /// Positioning move: does not cut, not timed (docs/spec/engagement.md §5.8).
     pub rapid: bool,
     /// Index of the segment in the request (for a point list: the segment from point i).
     pub source: usize,
@@ -302,7 +302,7 @@ pub(crate) struct NearPieces {
     earlier: Vec<usize>,
 }
 
-/// Where the tool is at one sample (engagement.md §5.2: stored as piece and local offset).
+/// Where the tool is at one sample (docs/spec/engagement.md §5.2: stored as piece and local offset).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Station {
     pub piece: usize,

@@ -1,8 +1,7 @@
 //! A compact copy of the per-sample values the passes after the sample loop read (the
 //! diagnostics' runs of §9, the flute statistics of §5.7), taken while each sample is built:
 //! those passes then scan short contiguous arrays instead of the large per-sample records and
-//! the small vectors they point to, which at 100 000 samples is most of their cost (issue 14
-//! item 3).
+//! the small vectors they point to, which at 100 000 samples is most of their cost.
 
 use super::answer::{EngagementSample, SampleFlag};
 

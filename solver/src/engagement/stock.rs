@@ -1,4 +1,4 @@
-//! The initial material W₀ (engagement.md §2.2): polygons with holes (even-odd, boundary
+//! The initial material W₀ (docs/spec/engagement.md §2.2): polygons with holes (even-odd, boundary
 //! inclusive), a bit-packed bitmap, and material already removed by earlier cuts (§5.3.3, prior
 //! operations); membership and the circle crossings the exact engine splits at.
 
@@ -7,7 +7,7 @@ use super::bbox_tree::{BBox, BoxTree};
 use super::outline::Outline;
 use super::segments::{Shape, circle_segment};
 
-/// Boundary tolerance of the stock outline, mm (engagement.md §5.3.2: ±1e-9).
+/// Boundary tolerance of the stock outline, mm (docs/spec/engagement.md §5.3.2: ±1e-9).
 pub(crate) const BOUNDARY_TOLERANCE: f64 = 1e-9;
 
 /// Relative tolerance of "at least R from the swept path" (§5.3.3: R·(1 − 1e-9)).

@@ -1,5 +1,5 @@
 //! Summed chip thickness of k evenly spaced teeth, maximised exactly over the tooth phase, and
-//! the number of teeth in the cut (engagement.md §5.6).
+//! the number of teeth in the cut (docs/spec/engagement.md §5.6).
 //!
 //! The active set of teeth changes only where a tooth sits on an arc end (or at 0°/180°, where
 //! the clamp max(0, sin θ) switches); between those breakpoints the sum is f_z·|C|·sin(β + arg C),
@@ -181,7 +181,7 @@ mod tests {
 
     #[test]
     fn full_slot_closed_forms() {
-        // engagement.md §5.6 table, k = 1…10.
+        // docs/spec/engagement.md §5.6 table, k = 1…10.
         let expected = [1.0, 1.0, 1.0, std::f64::consts::SQRT_2, 1.618034, 2.0, 2.246980, 2.613126, 2.879385, 3.236068];
         for (k, value) in (1..=10).zip(expected) {
             let sum = tooth_sum(&[arc(0.0, 180.0)], k);

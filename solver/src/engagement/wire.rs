@@ -1,5 +1,5 @@
-//! The engagement answer as JSON, byte for byte what `serde_json::to_vec` writes, but cheaper
-//! (issue 14 item 3): the samples, nearly all of the 40 MB of a 1 m path at 0.01 mm, are written
+//! The engagement answer as JSON, byte for byte what `serde_json::to_vec` writes, but cheaper:
+//! the samples, nearly all of the 40 MB of a 1 m path at 0.01 mm, are written
 //! by hand straight into one pre-sized buffer; the rest of the answer, a few kilobytes, still
 //! goes through serde.
 //!
@@ -7,9 +7,9 @@
 //! doubling; here the keys are constants and the numbers use the formatters `serde_json` uses
 //! (`zmij` for floats, `itoa` for integers), so the text is identical.
 
-use super::answer::{ArcDetail, EngagementAnswer, EngagementSample, PathEngagement, SampleFlag};
+use super::answer::{ArcDetail, EngagementSample, EngagementSolution, PathEngagement, SampleFlag};
 use super::arcs::MillingMode;
-use super::capability::EngagementResponse;
+use super::capability::EngagementAnswer;
 
 /// What `serde_json` writes for a candidate whose samples were taken out.
 const EMPTY_SAMPLES: &[u8] = b"\"samples\":[]";
@@ -23,7 +23,7 @@ const ITEM_BYTES: usize = 48;
 ///
 /// # Errors
 /// When serde cannot write the answer's other fields.
-pub fn to_json(mut answer: EngagementResponse) -> serde_json::Result<Vec<u8>> {
+pub fn to_json(mut answer: EngagementAnswer) -> serde_json::Result<Vec<u8>> {
     let mut taken: Vec<Vec<EngagementSample>> =
         candidates_mut(&mut answer.result).map(|c| std::mem::take(&mut c.samples)).collect();
     let rest = serde_json::to_vec(&answer)?;
@@ -51,10 +51,10 @@ pub fn to_json(mut answer: EngagementResponse) -> serde_json::Result<Vec<u8>> {
     Ok(out)
 }
 
-fn candidates_mut(answer: &mut EngagementAnswer) -> impl Iterator<Item = &mut PathEngagement> {
+fn candidates_mut(answer: &mut EngagementSolution) -> impl Iterator<Item = &mut PathEngagement> {
     let slice: &mut [PathEngagement] = match answer {
-        EngagementAnswer::Single(result) => std::slice::from_mut(result.as_mut()),
-        EngagementAnswer::Comparison(comparison) => &mut comparison.candidates,
+        EngagementSolution::Single(result) => std::slice::from_mut(result.as_mut()),
+        EngagementSolution::Comparison(comparison) => &mut comparison.candidates,
     };
     slice.iter_mut()
 }

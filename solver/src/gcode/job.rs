@@ -1,4 +1,4 @@
-//! One program per job (issue 15, item 1; README "One program per job"): the programs of a job's
+//! One program per job (README "One program per job"): the programs of a job's
 //! operations, each written by [`super::write`], joined into one program a control runs from start
 //! to end: one program number, one header listing the operations with their tools and estimated
 //! times, each operation with its tool change, spindle and coolant, a retract to the job's

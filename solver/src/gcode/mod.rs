@@ -1,5 +1,5 @@
 //! G-code posts: turns a [`Toolpath`] into a complete program for a Fanuc-style control or
-//! LinuxCNC (api.md, G-code conventions; README "G-code conventions").
+//! LinuxCNC (docs/spec/api.md, G-code conventions; README "G-code conventions").
 //!
 //! Both dialects print every coordinate with 4 decimals in mm (never `-0.0000`), absolute mode,
 //! feed per minute, and start with a safety line, the tool change with its length offset and the
@@ -29,7 +29,7 @@ pub enum Dialect {
     Linuxcnc,
 }
 
-/// How circular moves are written (issue 15): as the control's own circular interpolation or as
+/// How circular moves are written: as the control's own circular interpolation or as
 /// straight chords.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
@@ -114,7 +114,7 @@ pub struct Post {
 }
 
 /// A plunge runs at this fraction of the cutting feed when neither tool nor machine gives a
-/// `plunge_feed` (issue 15: never a plunge at the cutting feed).
+/// `plunge_feed` (never a plunge at the cutting feed).
 pub const DEFAULT_PLUNGE_FRACTION: f64 = 0.5;
 
 /// The feed of a plunge after cutting at `feed`: `plunge_feed` when slower, else
@@ -203,7 +203,7 @@ pub fn comment(text: &str) -> String {
     format!("({})", cleaned.trim())
 }
 
-/// A stop in the middle of a program (issue 15: a deburr of both edges whose inside needs another
+/// A stop in the middle of a program (a deburr of both edges whose inside needs another
 /// tool, or of holes on both sides of a tube): before move `before` of the path the spindle
 /// stops and the tool goes up to the clearance plane; the program stops for the operator with a
 /// notice (`M00`) if there is one, changes the tool with its length offset if there is one, and

@@ -1,4 +1,4 @@
-//! The cycle time a control would take (issue 15, item 4): every move runs a trapezoidal feed
+//! The cycle time a control would take: every move runs a trapezoidal feed
 //! profile limited by its feed and the machine's acceleration, stopping at sharp vertices and
 //! where rapids begin and end; a block never takes less than the block time; rapids run at the
 //! rapid feed; a tool change adds its time. The breakdown separates cutting, air (feed moves the

@@ -1,4 +1,4 @@
-//! Controller profiles (api.md, Machines; chord.md §2.1, §6.4): the block processing time and
+//! Controller profiles (docs/spec/api.md, Machines; docs/spec/segment.md §2.1, §6.4): the block processing time and
 //! limits of one control, stored by the server and used as defaults by any request that names it;
 //! the block-time rule that turns them into chord errors ([`rule`]) and the block statistics of a
 //! path ([`stats`]). Every path-emitting capability uses them: segment, deburr, contour,
@@ -37,7 +37,7 @@ pub struct MachineProfile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
     /// T_b: time the control needs to read and prepare one block, ms (> 0). Measure it with a
-    /// run of short blocks: T_b = block length / saturated speed × 60000 (chord.md §2.1, Eq. 1).
+    /// run of short blocks: T_b = block length / saturated speed × 60000 (docs/spec/segment.md §2.1, Eq. 1).
     pub block_time_ms: f64,
     /// Highest programmable cutting feed, mm/min (> 0); the feed of a request that gives none.
     pub max_feed: f64,
@@ -56,9 +56,9 @@ pub struct MachineProfile {
     pub description: Option<String>,
     /// How segment requests on this control choose their chord error unless they say:
     /// `window` (the patent's, default), `curve` or `guarantee` (no block shorter than the control
-    /// needs, chord.md §2.9a).
+    /// needs, docs/spec/segment.md §2.9a).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub mode: Option<crate::chord::Mode>,
+    pub mode: Option<crate::segment::Mode>,
     /// Rated spindle power, kW (> 0): engagement with Kienzle values warns where the cut needs
     /// more and its feed plan caps the feed to stay within it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -82,11 +82,11 @@ pub struct MachineProfile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub plunge_feed: Option<f64>,
     /// Largest path acceleration, mm/s² (> 0): with it, answers add a `cycle_time` with a
-    /// trapezoidal feed profile (issue 15).
+    /// trapezoidal feed profile.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_accel: Option<f64>,
     /// Largest path jerk, mm/s³ (> 0, at most 10⁹): with `max_accel`, `cycle_time` changes speed
-    /// in jerk-limited S-curves instead of trapezoids (issue 15).
+    /// in jerk-limited S-curves instead of trapezoids.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_jerk: Option<f64>,
     /// Rapid traverse feed, mm/min (> 0; default `max_feed`), for `cycle_time`.

@@ -1,5 +1,5 @@
 //! The block-time rule: the target chord error C_ep from the local radius, the feed and the
-//! controller's block processing time (chord.md §2.1–§2.7, Eqs. 1–15, embodiments 1–6).
+//! controller's block processing time (docs/spec/segment.md §2.1–§2.7, Eqs. 1–15, embodiments 1–6).
 //!
 //! This is the building block every path-emitting solver uses to pick its point spacing: a chord
 //! of sagitta C_ep on a circle of radius r is exactly `k_f·F·T_b/60000` long, so a polyline cut
@@ -12,7 +12,7 @@ use crate::validate::{finite, non_negative, positive};
 /// Milliseconds per minute: `F·T_b/MS_PER_MIN` is the distance (mm) travelled in one block time.
 pub const MS_PER_MIN: f64 = 60_000.0;
 
-/// Why a radius cannot be served at the rule's feed (chord.md §4, E3): no chord as long as one
+/// Why a radius cannot be served at the rule's feed (docs/spec/segment.md §4, E3): no chord as long as one
 /// block time at the feed fits in a circle of this radius.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Infeasible {
@@ -23,7 +23,7 @@ pub struct Infeasible {
     pub feed_limit: f64,
 }
 
-/// How a chord error came about (chord.md §2.7).
+/// How a chord error came about (docs/spec/segment.md §2.7).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ChordStatus {
     /// On (or, with margins, just above) the chord-error surface.
@@ -52,7 +52,7 @@ pub struct BlockRule {
     pub block_time_ms: f64,
     /// k_f: margin factor on the feed (Eq. 5), ≥ 1 unless unsafe margins are allowed.
     pub margin: f64,
-    /// k_ce: factor on the computed chord error, ≥ 1 (chord.md §2.4).
+    /// k_ce: factor on the computed chord error, ≥ 1 (docs/spec/segment.md §2.4).
     pub chord_error_factor: f64,
     /// k_r: factor on the radius, in (0, 1] (a factor above 1 is the unsafe side, §8 Q4).
     pub radius_factor: f64,
@@ -163,7 +163,7 @@ impl BlockRule {
         Self { min_chord_error, ..self }
     }
 
-    /// Checks every factor (chord.md §4, E6), naming the request field at fault: the margins
+    /// Checks every factor (docs/spec/segment.md §4, E6), naming the request field at fault: the margins
     /// must be finite and positive; factors on the safe side only (`margin`, `chord_error_factor`,
     /// `block_time_factor` ≥ 1, `radius_factor` ≤ 1) unless `allow_unsafe` is set, in which case a
     /// `W_UNSAFE_MARGIN` warning is returned for each one below the surface.
@@ -217,7 +217,7 @@ impl BlockRule {
     }
 
     /// F·T_b/60000: the distance travelled in one block time at the feed, mm, without margins. A
-    /// block shorter than this starves the control (chord.md §1.1, E8/E9).
+    /// block shorter than this starves the control (docs/spec/segment.md §1.1, E8/E9).
     pub fn block_length(&self) -> f64 {
         self.feed * self.block_time_ms / MS_PER_MIN
     }
@@ -228,7 +228,7 @@ impl BlockRule {
     }
 
     /// The target chord error C_ep for a local radius of curvature `radius` (mm; `f64::INFINITY`
-    /// for a straight piece), chord.md §2.7: the smaller root of Eq. 5 in the cancellation-free
+    /// for a straight piece), docs/spec/segment.md §2.7: the smaller root of Eq. 5 in the cancellation-free
     /// form `h²/(r + √(r² − h²))`, times k_ce, then raised to C_emin.
     ///
     /// # Errors
@@ -258,7 +258,7 @@ impl BlockRule {
     /// The chord tolerance a path solver should cut with at a point of local radius `radius`:
     /// the rule's C_ep, but never coarser than the accuracy bound `tolerance` (mm) when one is
     /// given. This is "pick the point spacing by the block-time rule, never coarser than the
-    /// tolerance" of issue 3 in one call.
+    /// tolerance" in one call.
     ///
     /// # Errors
     /// [`Infeasible`] as for [`BlockRule::chord_error`].
@@ -302,7 +302,7 @@ impl BlockRule {
     }
 }
 
-/// Chord length on a circle of `radius` with sagitta `chord_error`: `2√(2rC − C²)` (chord.md §2.2),
+/// Chord length on a circle of `radius` with sagitta `chord_error`: `2√(2rC − C²)` (docs/spec/segment.md §2.2),
 /// or the diameter when the sagitta reaches the radius. Infinite for a straight piece.
 pub fn chord_length(radius: f64, chord_error: f64) -> f64 {
     if radius == f64::INFINITY {

@@ -1,4 +1,4 @@
-//! Block statistics of any polyline at a feed and block time (chord.md §6.2–§6.3, E8, E9): the
+//! Block statistics of any polyline at a feed and block time (docs/spec/segment.md §6.2–§6.3, E8, E9): the
 //! figures a CAM engineer checks before sending a program to a control with a block processing
 //! time: how many blocks, the shortest, how many starve the control, and a cycle time that
 //! accounts for the block limit; and the same over a whole path of feed moves and rapids.
@@ -17,7 +17,7 @@ const SHORT_SLACK: f64 = 1e-9;
 /// Block figures of a polyline run at one feed on a control with a block processing time.
 ///
 /// A *span end* is a block that ends where the control stops or nearly stops anyway: the end of
-/// the path, or a corner the path was split at (chord.md E8, E11). Greedy chords leave a shorter
+/// the path, or a corner the path was split at (docs/spec/segment.md E8, E11). Greedy chords leave a shorter
 /// remainder there; it is counted apart from the other blocks.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
@@ -43,7 +43,7 @@ pub struct BlockStats {
     pub min_block_ratio: f64,
     /// Length of the polyline, mm.
     pub path_length: f64,
-    /// Block-limited time Σ max(Lᵢ/F, T_b), s (chord.md §6.3). Does not model acceleration or
+    /// Block-limited time Σ max(Lᵢ/F, T_b), s (docs/spec/segment.md §6.3). Does not model acceleration or
     /// deceleration at vertices, so it flatters coarse polygons.
     pub estimated_time_s: f64,
     /// Path length over feed, s: the time if blocks were free.
@@ -267,7 +267,7 @@ pub fn path_blocks(
     })
 }
 
-/// `W_BLOCK_TIME_VIOLATION` (chord.md E9) when inner blocks of `blocks` are short.
+/// `W_BLOCK_TIME_VIOLATION` (docs/spec/segment.md E9) when inner blocks of `blocks` are short.
 pub fn short_block_warning(blocks: &PathBlocks, rule: &BlockRule) -> Option<Warning> {
     (blocks.short_blocks > 0).then(|| {
         Warning::new(

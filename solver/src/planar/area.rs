@@ -1,6 +1,6 @@
 //! Areas of regions bounded by lines and circles: half-plane clipping of convex polygons, the
 //! exact area of a disk ∩ polygon, and of a capsule (a disk swept along a segment) ∩ a convex
-//! polygon. Used for the material left and over-cut at corners (corners.md §3.10) and for the
+//! polygon. Used for the material left and over-cut at corners (docs/spec/contour.md §3.10) and for the
 //! engagement solver's tool/stock overlaps.
 
 use super::{Vec2, cross, signed_area};

@@ -1,4 +1,4 @@
-//! What a prediction request answers (api.md, Error prediction): one record per pass in path
+//! What a prediction request answers (docs/spec/api.md, Error prediction): one record per pass in path
 //! order, statistics, warnings, and (not serialised) what the corrected program needs.
 
 use serde::{Deserialize, Serialize};

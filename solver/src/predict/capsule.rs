@@ -1,5 +1,5 @@
 //! Swept volume of a ball end mill on one straight segment (a capsule) and where a ray along the
-//! view direction first enters it: the closed forms of error-prediction.md §3.5 and §6.3.
+//! view direction first enters it: the closed forms of docs/spec/predict.md §3.5 and §6.3.
 //!
 //! Everything here works in a view frame whose +z is the view direction v̂ (from the material
 //! toward the tool): a ray through a point (x, y) travels along +z, and the capsule's "entry

@@ -1,4 +1,4 @@
-//! Tool-path correction (error-prediction.md §3.14, claim 9): every node moves against the
+//! Tool-path correction (docs/spec/predict.md §3.14, claim 9): every node moves against the
 //! predicted errors of the passes on both sides of it, in the direction of E′_i + E′_j and by the
 //! amount that best cancels both passes' normal errors (projection least squares); a clamp limits
 //! the move (§5 E20). Arcs are refitted through their corrected chord points.

@@ -1,4 +1,4 @@
-//! Tool-tip deflection over one revolution from the cutting force (error-prediction.md §3.8, S4):
+//! Tool-tip deflection over one revolution from the cutting force (docs/spec/predict.md §3.8, S4):
 //! steady-state forced response D_m = G(mΩ)·F_m per spindle harmonic, with G static, modal or a
 //! measured compliance table; the FFT route for whole histories, and a precomputed periodic
 //! impulse response so one prediction needs D only at the generation instant (O(N_t)).

@@ -1,4 +1,4 @@
-//! Exclusion of low-angle passes before prediction (error-prediction.md §3.4, claim 8): where
+//! Exclusion of low-angle passes before prediction (docs/spec/predict.md §3.4, claim 8): where
 //! the tool axis is nearly along the surface normal deflection hardly matters, so passes whose
 //! finished surface lies only at small contact angles are not predicted.
 //!

@@ -1,5 +1,5 @@
 //! Engagement of the cutting edge and the mechanistic cutting force over one revolution
-//! (error-prediction.md §3.7, S3).
+//! (docs/spec/predict.md §3.7, S3).
 //!
 //! The edge is discretised into N_θ elements (θ_k = (k + ½)Δθ) and the revolution into N_t
 //! rotation steps. Flute j at contact angle θ sits at azimuth
@@ -26,7 +26,7 @@ const TILE_STEPS: usize = 12;
 const GROUP_RINGS: usize = 2;
 const GROUP_STEPS: usize = 3;
 
-/// Specific cutting forces of the tool/material pair (error-prediction.md §1.2 I5, §3.7).
+/// Specific cutting forces of the tool/material pair (docs/spec/predict.md §1.2 I5, §3.7).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(deny_unknown_fields)]

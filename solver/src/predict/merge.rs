@@ -1,5 +1,5 @@
-//! Merging near-identical consecutive passes (error-prediction.md §3.2, "successive lines ... may
-//! be merged", §0051; issue 16 item 5): long finishing programs repeat the same cut pass after
+//! Merging near-identical consecutive passes (docs/spec/predict.md §3.2, "successive lines ... may
+//! be merged", §0051): long finishing programs repeat the same cut pass after
 //! pass, so only some of them are simulated and the others carry the result of the nearest
 //! simulated one, with a bound on how much that can differ from simulating them.
 //!

@@ -1,5 +1,5 @@
 //! Machining-error prediction and path correction for ball-end-mill finishing (spec:
-//! error-prediction.md; seed 002, JP2010-237843 A).
+//! docs/spec/predict.md; patent 002, JP2010-237843 A).
 //!
 //! For every pass of a finishing path this module finds where on the ball the surviving surface
 //! is generated (the generation point C, contact angle θ_c, azimuth φ_c and the rotation angle ψ_c
@@ -433,7 +433,7 @@ pub fn corrected_program(
                 }
                 let moved = (node..=last).any(|n| corrections.offsets[n] != Vec3::zeros())
                     || (node > 0 && corrections.offsets[node - 1] != Vec3::zeros());
-                // Rapids are never rewritten (issue 15): only cutting moves change.
+                // Rapids are never rewritten: only cutting moves change.
                 if moved
                     && read_move.kind != MoveKind::Rapid
                     && let Some(to) = read_move.to_xyz()
@@ -463,7 +463,7 @@ pub fn corrected_program(
             let feed = request.feed.ok_or_else(|| SolverError::input("feed", "feed is needed"))?;
             let spindle_rpm =
                 request.spindle_rpm.ok_or_else(|| SolverError::input("spindle_rpm", "spindle_rpm is needed"))?;
-            // The rapids are those of the uncorrected path (issue 15: a correction changes only
+            // The rapids are those of the uncorrected path (a correction changes only
             // the cutting moves): the clearance plane over the programmed points, above the
             // programmed first and last point.
             let safe_z = points.iter().map(|p| p[2]).fold(f64::NEG_INFINITY, f64::max) + CLEARANCE;

@@ -1,4 +1,4 @@
-//! The tool path as ball-centre segments in program order (error-prediction.md §3.2): passes
+//! The tool path as ball-centre segments in program order (docs/spec/predict.md §3.2): passes
 //! (one feed line or arc chord each, with its NC line), the global arclength that splits the
 //! motion into T1 (before) and T2 (after), and an xy grid of segments for the neighbour queries of
 //! §6.1 (`sweep`).

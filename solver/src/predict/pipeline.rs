@@ -1,4 +1,4 @@
-//! The per-pass prediction of error-prediction.md §3.1 (S1–S11) and its run over all passes in
+//! The per-pass prediction of docs/spec/predict.md §3.1 (S1–S11) and its run over all passes in
 //! parallel (rayon, results in pass order): prediction position (§3.3), cutting region and force
 //! (§3.6–3.7), deflection (§3.8), finished surface and generation point by sampling (§6.6) or by
 //! the depth buffer with view correction (§3.9–3.11), and the errors (§3.12).

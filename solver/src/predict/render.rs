@@ -1,4 +1,4 @@
-//! The software depth buffer (error-prediction.md §3.5, §3.6, §3.9–3.11, §6.2): an orthographic
+//! The software depth buffer (docs/spec/predict.md §3.5, §3.6, §3.9–3.11, §6.2): an orthographic
 //! N × N view of the lower hemisphere M, the swept volumes and the stock along v̂, evaluated
 //! analytically per pixel. From below (v̂ = +Z) or from a rotated or zoomed view (§3.10).
 //!

@@ -1,4 +1,4 @@
-//! The prediction request as clients send it (api.md, Error prediction): the wire types, their
+//! The prediction request as clients send it (docs/spec/api.md, Error prediction): the wire types, their
 //! defaults and limits. `job` validates it into the model the solver works on.
 
 pub use crate::gcode::SpindleDirection;
@@ -98,7 +98,7 @@ pub struct CorrectionOptions {
 }
 
 /// `POST /api/v1/predict`: predict the machining error of a ball-end-mill finishing path from
-/// the tool's shape error and deflection, and correct the path (error-prediction.md).
+/// the tool's shape error and deflection, and correct the path (docs/spec/predict.md).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(deny_unknown_fields)]
@@ -172,7 +172,7 @@ pub struct PredictRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pass_range: Option<[usize; 2]>,
     /// θ_x: do not predict passes whose largest contact angle on the finished surface is at most
-    /// this, degrees (0–90; claim 8, error-prediction.md §3.4, where the patent uses 30–60):
+    /// this, degrees (0–90; claim 8, docs/spec/predict.md §3.4, where the patent uses 30–60):
     /// they get status `skipped_small_angle`. Absent: every pass is predicted.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub exclusion_deg: Option<f64>,

@@ -1,4 +1,4 @@
-//! The resolution-free surface-sampling method (error-prediction.md §6.6): a point q of M
+//! The resolution-free surface-sampling method (docs/spec/predict.md §6.6): a point q of M
 //! survives iff it is in W and hidden by neither T1 nor T2; the generation point is the
 //! area-weighted mean of the surviving surface, projected radially onto M.
 //!

@@ -1,4 +1,4 @@
-//! What one prediction position sees (error-prediction.md §3.5, §6.1–6.2): the nearby swept
+//! What one prediction position sees (docs/spec/predict.md §3.5, §6.1–6.2): the nearby swept
 //! volumes split into T1 (motion before s₀ − n_g·f_t) and T2 (after s₀ + n_g·f_t) as capsules in
 //! a view frame, per-tile candidate lists, and the point test every method shares: is a point of
 //! M in the stock, and is it behind a swept volume along the view direction?

@@ -1,4 +1,4 @@
-//! The tool's shape-error table δ(θ) and its conversions (error-prediction.md §3.13, S11):
+//! The tool's shape-error table δ(θ) and its conversions (docs/spec/predict.md §3.13, S11):
 //! linear interpolation in θ, clamped and flagged outside the table (§5 E14), and δ from measured
 //! section radii of the rotating tool, exactly (the nominal normal line intersected with the
 //! measured profile) or to first order (δ ≈ Δr(z(θ))·sin θ).

@@ -1,4 +1,4 @@
-//! STL stock meshes (error-prediction.md §1.2 I1): parsing ASCII and binary STL from bytes, the
+//! STL stock meshes (docs/spec/predict.md §1.2 I1): parsing ASCII and binary STL from bytes, the
 //! closedness check, and point membership by the parity of a vertical ray, with an xy bin grid so
 //! each query only looks at nearby triangles.
 

@@ -1,4 +1,4 @@
-//! The stock W before the analysed operation (error-prediction.md §1.2 I1, §3.5): analytic solids
+//! The stock W before the analysed operation (docs/spec/predict.md §1.2 I1, §3.5): analytic solids
 //! (box, half-space under a plane, cylinder), a height grid, or a closed STL mesh; point
 //! membership, a conservative classification of boxes used to skip whole tiles of samples, and a
 //! bound of the top under the ball that narrows the motion a scene gathers.

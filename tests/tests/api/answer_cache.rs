@@ -1,4 +1,4 @@
-//! The answer cache (issue 14, item 5): a question asked again is answered from the cache with
+//! The answer cache: a question asked again is answered from the cache with
 //! the same bytes; a changed tool, machine, format or program option is a new question; a
 //! zero budget keeps nothing. (Requests with `?timings=true` or an upload are never looked up:
 //! `server/src/http/solve.rs`.)

@@ -1,4 +1,4 @@
-//! Arcs as G02/G03 (issue 15, item 2): segment circles and arcs, contour loops and round joins,
+//! Arcs as G02/G03: segment circles and arcs, contour loops and round joins,
 //! engagement arc segments, written with `?arcs=g2g3` (or a machine's `arcs`, or a job's
 //! `[output] arcs`), through LinuxCNC's `rs274` in both dialects: every `ARC_FEED` ends where the
 //! chord program's run of `STRAIGHT_FEED`s ends, and everything else is the same move.

@@ -1,5 +1,5 @@
 //! Bad input answered with the right 4xx problem+json naming the field, and the database left
-//! unchanged (api.md, Errors).
+//! unchanged (docs/spec/api.md, Errors).
 
 use kerf_server::state::Limits;
 use kerf_tests::{TestApp, json_with, problem};

@@ -1,5 +1,5 @@
 //! `POST /api/v1/contour` and `POST /api/v1/contour/loops` over HTTP: the three reference
-//! contours of corners.md (C1–C3) to the fixture's 1e-6, G-code of both dialects through
+//! contours of docs/spec/contour.md (C1–C3) to the fixture's 1e-6, G-code of both dialects through
 //! LinuxCNC's `rs274` with its end points equal to the JSON moves, a table of bad requests with
 //! the database unchanged, the JSON move limit, and byte-identical answers.
 
@@ -28,7 +28,7 @@ fn close(what: &str, got: &Value, expected: f64) {
 /// tool, one layer at z = 0, conventional milling (σ = +1, the cases' convention) and the case's
 /// passes and loop style.
 pub fn reference_request(id: &str) -> Value {
-    let case = case("corners", id);
+    let case = case("contour", id);
     let inputs = &case["inputs"];
     let mut corner_loop = json!({"max_angle_deg": 180.0 - number(&inputs["phi_min_deg"])});
     let passes: Vec<Value> = inputs["passes"]
@@ -117,7 +117,7 @@ fn answer_moves(answer: &Value, lift: f64) -> Vec<(bool, [f64; 3])> {
 async fn reference_contours_over_http() {
     let app = app_with_tools().await;
     for id in ["C1", "C2", "C3"] {
-        let case = case("corners", id);
+        let case = case("contour", id);
         let answer = json_with(app.post_json("/api/v1/contour", &reference_request(id)).await, 200).await;
         let expected_passes = case["expected"]["passes"].as_array().unwrap();
         let final_pass = expected_passes.last().unwrap();

@@ -106,7 +106,7 @@ async fn reference_case_1_over_http() {
     assert_eq!(forward_points[1]["centre"], backward_points[backward_points.len() - 2]["centre"]);
 
     // The exact method sweeps a chamfer W wide on the true surfaces (within max(0.005 mm, TA))
-    // and says how far the seed is off.
+    // and says how far the patent is off.
     let mut exact = body.clone();
     exact["method"] = json!("exact");
     let exact_answer = json_with(app.post_json("/api/v1/deburr", &exact).await, 200).await;

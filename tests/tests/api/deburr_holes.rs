@@ -1,4 +1,4 @@
-//! Several holes in one deburr request (issue 15, item 5): `holes` or a `pattern` of `hole`
+//! Several holes in one deburr request: `holes` or a `pattern` of `hole`
 //! gives one program visiting every hole in a short order, lifting to the clearance plane between
 //! them, and an answer with one entry per hole and edge; `edge: both` deburrs both ridges, with a
 //! tool change to `inner_tool`; holes pointing down are deburred with the tube turned.

@@ -1,4 +1,4 @@
-//! Deburring with the block-time rule over HTTP (issue 3): a stored machine (or a request's
+//! Deburring with the block-time rule over HTTP: a stored machine (or a request's
 //! `block_time_ms`) spaces the points so no block is shorter than feed × block time, the summary
 //! reports the blocks, the machine's dialect is the G-code default, and jobs resolve the machine.
 

@@ -1,5 +1,5 @@
-//! `POST /api/v1/engagement` over HTTP: the api.md example, the reference cases C1–C3 of
-//! `shared/cases/engagement.json` to their tolerances (C2 part B as two candidate paths side by
+//! `POST /api/v1/engagement` over HTTP: the docs/spec/api.md example, the reference cases C1–C3 of
+//! `solver/tests/fixtures/engagement.json` to their tolerances (C2 part B as two candidate paths side by
 //! side), the dots engine, G-code of the feed plan in both dialects through LinuxCNC's `rs274`
 //! (moves equal to the JSON positions within 1e-4, F words equal to the plan's feeds), and a
 //! table of bad requests answered with the field at fault and the database unchanged.
@@ -12,7 +12,7 @@ use serde_json::{Value, json};
 
 const URL: &str = "/api/v1/engagement";
 
-/// The api.md example.
+/// The docs/spec/api.md example.
 pub fn api_example() -> Value {
     json!({
         "tool": {"kind": "flat", "radius": 5}, "stock": {"polygon": [[0,0],[60,0],[60,40],[0,40]]},
@@ -134,7 +134,7 @@ async fn api_example_over_http() {
     assert_eq!(answer["time_limit_s"], 20.0);
     // L = 80 mm: P_k = 60·80/(k·0.05·3000) = 32/k s; the slot's H_k/f_z is 1, 1, 1, √2, 1.618, ...
     close("path length", number(&answer["path_length"]), 80.0, 1e-9);
-    // Full slot (engagement.md §5.6): H_k/f_z = 1 for k = 1, 1/sin(π/k) for even k,
+    // Full slot (docs/spec/engagement.md §5.6): H_k/f_z = 1 for k = 1, 1/sin(π/k) for even k,
     // 1/(2 sin(π/2k)) for odd k ≥ 3.
     let slot_ratio = |k: f64| {
         let pi = std::f64::consts::PI;
@@ -233,7 +233,7 @@ async fn c1_slot_then_side_milling() {
         check_point("C1", &fine, checkpoint, &flutes);
     }
 
-    // The dots engine over HTTP, at the fixture's grid and step: the seed's contact dots and
+    // The dots engine over HTTP, at the fixture's grid and step: the patent's contact dots and
     // the representative values within its tolerances.
     let dots_settings = &input["simulation"]["dot_engine"];
     let dots = json_with(
@@ -401,7 +401,7 @@ async fn c3_pair_blocks_and_flute_selection() {
     }
 }
 
-/// A path that never touches the stock is not an error (engagement.md §9 `W_NO_CONTACT`): all
+/// A path that never touches the stock is not an error (docs/spec/engagement.md §9 `W_NO_CONTACT`): all
 /// series zero, T1 trivially met, and the answer says so.
 #[tokio::test(flavor = "multi_thread")]
 async fn a_path_that_never_touches_the_stock_is_a_warning() {

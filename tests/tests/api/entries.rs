@@ -1,4 +1,4 @@
-//! Entries (issue 15, item 3): no program plunges at the cutting feed. Every straight feed move
+//! Entries: no program plunges at the cutting feed. Every straight feed move
 //! down the tool axis of a segment, contour or engagement program runs at the tool's
 //! `plunge_feed`, else the machine's, else half the cutting feed; the programs still pass `rs274`.
 

@@ -1,4 +1,4 @@
-//! One program per job (issue 15, item 1): `GET /api/v1/jobs/{id}/program` joins every
+//! One program per job: `GET /api/v1/jobs/{id}/program` joins every
 //! operation's program into one with one program number, a tool change per operation and one
 //! end; `outputs.zip` holds every output; `kerf run` writes the same program; both dialects pass
 //! `rs274`; bad requests get their problem.

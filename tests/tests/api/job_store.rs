@@ -1,4 +1,4 @@
-//! The job store stays bounded (issue 13): a quota that refuses what does not fit and writes
+//! The job store stays bounded: a quota that refuses what does not fit and writes
 //! nothing of it, retention that prunes finished jobs on its own, `kerf jobs prune` on a real
 //! database, and an SQLite file that stays small and shrinks again after pruning.
 

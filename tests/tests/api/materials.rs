@@ -1,4 +1,4 @@
-//! The materials library (issue 16): the seeded materials, create, replace, read, list, delete,
+//! The materials library: the seeded materials, create, replace, read, list, delete,
 //! bad names and values, survival across a restart; engagement requests and jobs that name a
 //! material, on both stores.
 

@@ -1,4 +1,4 @@
-//! `POST /api/v1/predict` over HTTP: reference cases A–D of `shared/cases/error-prediction.json`
+//! `POST /api/v1/predict` over HTTP: reference cases A–D of `solver/tests/fixtures/predict.json`
 //! to their tolerances, the mesh stock as a multipart upload, the corrected program through
 //! LinuxCNC's `rs274`, inch programs, the upload limit, the synchronous time limit, and a table
 //! of bad requests that leave the database unchanged.
@@ -85,7 +85,7 @@ async fn predict(app: &TestApp, body: &Value) -> Value {
 #[tokio::test(flavor = "multi_thread")]
 async fn case_a_flat_raster_over_http() {
     let app = TestApp::spawn().await;
-    let case = case("error-prediction", "A_");
+    let case = case("predict", "A_");
     let (expected, tolerances) = (&case["expected"], &case["tolerances"]);
     for method in ["sampling", "depth_buffer"] {
         let mut body = centre_request(
@@ -122,7 +122,7 @@ async fn case_a_flat_raster_over_http() {
 #[tokio::test(flavor = "multi_thread")]
 async fn case_b_inclined_plane_with_a_registered_tool() {
     let app = TestApp::spawn().await;
-    let case = case("error-prediction", "B_");
+    let case = case("predict", "B_");
     let (expected, tolerances) = (&case["expected"], &case["tolerances"]);
     // The shape-error table lives in the tool table.
     app.register_tool(12, &ball(5.0, &[(0.0, 0.005), (90.0, 0.015)])).await;
@@ -204,7 +204,7 @@ fn case_c_request(beta_deg: f64, method: &str, view_correction: bool) -> (Value,
 #[tokio::test(flavor = "multi_thread")]
 async fn case_c_convex_cylinder_over_http() {
     let app = TestApp::spawn().await;
-    let case = case("error-prediction", "C_");
+    let case = case("predict", "C_");
     let tolerances = &case["tolerances"];
     for row in case["expected_rows"].as_array().unwrap() {
         let beta = number(&row["beta"]);
@@ -242,8 +242,8 @@ async fn case_c_convex_cylinder_over_http() {
 #[tokio::test(flavor = "multi_thread")]
 async fn case_d_force_and_deflection_chain_over_http() {
     let app = TestApp::spawn().await;
-    let case_b = case("error-prediction", "B_");
-    let case_d = case("error-prediction", "D_");
+    let case_b = case("predict", "B_");
+    let case_d = case("predict", "D_");
     let (expected, tolerances) = (&case_d["expected"], &case_d["tolerances"]);
     let mode = |m: &Value| json!({"stiffness": m["k"], "frequency_hz": m["fn"], "damping_ratio": m["zeta"]});
     let compliance = &case_d["inputs"]["compliance"];
@@ -1110,7 +1110,7 @@ async fn corrections_follow_the_node_rule_of_case_f() {
     }
     assert!(moved > passes.len() / 2, "most nodes move: {moved} of {}", passes.len());
     // The whole case F polyline: the rule of `polyline_corrections` as published.
-    let case = case("error-prediction", "F_");
+    let case = case("predict", "F_");
     let to_error = |p: &Value| Some(PassError { error: number(&p["e"]), normal: triple(&p["n"]) });
     let errors: Vec<Option<PassError>> =
         case["inputs"]["pass_errors"].as_array().unwrap().iter().map(to_error).collect();

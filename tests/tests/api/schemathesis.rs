@@ -1,6 +1,6 @@
 //! The server against its own OpenAPI document, checked from outside by schemathesis (PyPI):
 //! thousands of generated requests on every route, failing on any 5xx, a status the document does
-//! not list, a wrong content type, or an answer that breaks its schema. The seed is fixed so a
+//! not list, a wrong content type, or an answer that breaks its schema. The patent is fixed so a
 //! failure reproduces; one worker, because hypothesis's lambda-source cache is not thread-safe
 //! (a run with two workers once died of it). `.ci/run` installs schemathesis in a venv.
 

@@ -59,7 +59,7 @@ async fn segment(app: &TestApp, body: &Value) -> Value {
 #[tokio::test(flavor = "multi_thread")]
 async fn patent_experiment_case_a_over_http() {
     let app = TestApp::spawn().await;
-    let case = case("chord", "A");
+    let case = case("segment", "A");
     let expected = &case["expected"];
     let body = json!({"curve": {"kind": "circle", "centre": [0, 0], "radius": 50},
                       "feed": 10000, "block_time_ms": 4, "mode": "window", "margin": 1.0,
@@ -114,7 +114,7 @@ async fn patent_experiment_case_a_over_http() {
 async fn cases_b_and_c_over_http() {
     let app = TestApp::spawn().await;
     let ellipse = json!({"kind": "ellipse", "centre": [0, 0], "semi_axes": [100, 50], "start_deg": 0, "end_deg": 90});
-    let case_b = case("chord", "B");
+    let case_b = case("segment", "B");
     let answer = segment(
         &app,
         &json!({"curve": ellipse, "feed": 10000, "block_time_ms": 4, "margin": 1.1, "mode": "curve", "rule": "extremes"}),
@@ -126,7 +126,7 @@ async fn cases_b_and_c_over_http() {
     assert_eq!(answer["windows"].as_array().unwrap().len(), 1);
     check_ends(&answer, &case_b["expected"]);
 
-    let case_c = case("chord", "C");
+    let case_c = case("segment", "C");
     let answer = segment(
         &app,
         &json!({"curve": ellipse, "feed": 12000, "block_time_ms": 4, "margin": 1.05, "min_chord_error": 0.001,

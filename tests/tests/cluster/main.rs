@@ -1,4 +1,4 @@
-//! Past one machine (issue 12), on a throw-away PostgreSQL server and real processes on loopback:
+//! Past one machine, on a throw-away PostgreSQL server and real processes on loopback:
 //! one `kerf serve --job-workers 0` and two `kerf worker`s share the queue; one worker is killed
 //! with SIGKILL in the middle of a job; every job ends done with the results of a one-process
 //! SQLite run of the same files. A large prediction is split into parts that both workers run at

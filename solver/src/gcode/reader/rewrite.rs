@@ -59,7 +59,7 @@ pub fn rewrite(text: &str, program: &ReadProgram, edits: &[MoveEdit], field: &st
             actual.push(read_move.to);
             continue;
         }
-        // A rapid nobody edited stays as written, byte for byte (issue 15): after a moved cut
+        // A rapid nobody edited stays as written, byte for byte: after a moved cut
         // it starts elsewhere, so the axes it does not program (absolute) or all of them
         // (incremental) end shifted with its start; the next cutting move is rewritten to its
         // own end point from there.

@@ -1,0 +1,229 @@
+//! Contour milling as a capability (the seam of engineering.md): `POST /api/v1/contour`, job
+//! operation `contour`; and the loops added to a path made elsewhere (`POST
+//! /api/v1/contour/loops`, docs/spec/contour.md §3.4), which answers JSON only and is no job operation.
+
+use crate::error::ErrorCode;
+use serde::{Deserialize, Serialize};
+
+use super::detect::{self, DetectMode, MaterialSide, PathLoopAnswer, PathLoopRequest};
+use super::request::MAX_MOVES;
+use super::{ContourRequest, ContourSolution, CornerLoop};
+use crate::capability::{
+    Capability, Control, Endpoint, OutputOptions, Part, PartSink, PartSource, Purpose, Refs, Resolved, Run, Sizing,
+    Split,
+};
+use crate::error::{SolverError, Warning};
+use crate::machine::MachineProfile;
+use crate::tool::{Tool, ToolRef};
+
+/// Most moves in a JSON answer (about 35 MB of JSON). A G-code program and a job may hold up to
+/// the solver's own limit, [`MAX_MOVES`].
+pub const MAX_JSON_MOVES: usize = 500_000;
+
+/// The contour capability.
+#[derive(Debug, Clone, Copy)]
+pub struct ContourCapability;
+
+/// The contour answer: the tool used and the solver's result.
+#[derive(Debug, Clone, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct ContourAnswer {
+    /// The tool, as resolved from the table or given inline.
+    pub tool: Tool,
+    /// The machine the request named, as registered: its block time (and margin, minimum chord
+    /// error) chorded the arcs, its dialect is the G-code default.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub machine: Option<MachineProfile>,
+    /// Layers with their moves, corners, passes, summary and warnings.
+    #[serde(flatten)]
+    pub result: ContourSolution,
+}
+
+impl Capability for ContourCapability {
+    const NAME: &'static str = "contour";
+    const ENDPOINT: Endpoint = Endpoint {
+        summary: "Layered contour milling: the tool-centre path of every layer with corner loops at \
+            protruding corners and optional relief at inside corners.",
+        description: "Returns the layers' moves, the corners with their actions and the material left or cut \
+            (JSON, at most 500 000 moves), or with `Accept: text/x-gcode` / `?format=gcode` a \
+            complete program (up to the solver's limit of 6 000 000 moves; dialect from `?dialect=`, \
+            else the named machine's, else Fanuc). With `block_time_ms` or a `machine` the arcs are \
+            chorded by the block-time rule and the summary reports the blocks.",
+        not_found: "Unknown tool number or machine",
+        refused: "Impossible contour or over a limit (codes in docs/spec/contour.md §5; `E_TOO_MANY_MOVES` for \
+            answers over the move limit); `E_TIMEOUT` over the synchronous time limit: submit a job",
+    };
+    type Request = ContourRequest;
+    type Answer = ContourAnswer;
+    type Tool = Tool;
+
+    fn refs(request: &ContourRequest) -> Refs<'_> {
+        Refs { tool: Some(&request.tool), machine: request.machine.as_deref(), material: None }
+    }
+
+    /// A JSON answer holds at most [`MAX_JSON_MOVES`] moves; a program or a job up to [`MAX_MOVES`].
+    fn solve(request: &ContourRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<ContourAnswer, SolverError> {
+        let max_moves = if run.purpose == Purpose::Json { MAX_JSON_MOVES } else { MAX_MOVES };
+        let result = super::solve_with(request, &context.tool, context.machine.as_ref(), max_moves, run.control);
+        let result = if run.purpose == Purpose::Json { result.map_err(json_limit_advice)? } else { result? };
+        Ok(ContourAnswer { tool: context.tool, machine: context.machine, result })
+    }
+
+    /// Ranges of layers of about `sizing.part_seconds` each (`parts`): a job's contour only,
+    /// which may hold up to [`MAX_MOVES`] moves.
+    fn split(request: &ContourRequest, context: &Resolved<Tool>, sizing: &Sizing) -> Option<Split> {
+        super::parts::split(request, &context.tool, context.machine.as_ref(), sizing)
+    }
+
+    /// The moves of the layers of `part`.
+    fn solve_part(
+        request: &ContourRequest,
+        context: Resolved<Tool>,
+        part: &Part,
+        run: &Run<'_>,
+        sink: &mut impl PartSink,
+    ) -> Result<(), SolverError> {
+        super::parts::solve_part(request, &context.tool, context.machine.as_ref(), part, run.control, sink)
+    }
+
+    /// Every layer's moves, answered as `solve` answers a job.
+    fn finish(
+        request: &ContourRequest,
+        context: Resolved<Tool>,
+        parts: &mut impl PartSource,
+        run: &Run<'_>,
+    ) -> Result<ContourAnswer, SolverError> {
+        let result = super::parts::finish(request, &context.tool, context.machine.as_ref(), parts, run.control)?;
+        Ok(ContourAnswer { tool: context.tool, machine: context.machine, result })
+    }
+
+    fn program(
+        request: &ContourRequest,
+        answer: &ContourAnswer,
+        output: &OutputOptions,
+    ) -> Result<String, SolverError> {
+        let mut post = output.post(answer.machine.as_ref(), &answer.tool);
+        post.plunge_feed = request.plunge_feed.or(post.plunge_feed);
+        super::program(&answer.result, &post)
+    }
+
+    fn machine(answer: &ContourAnswer) -> Option<&MachineProfile> {
+        answer.machine.as_ref()
+    }
+
+    /// Keeps a stored result within [`MAX_JSON_MOVES`]: from the first layer that would pass the
+    /// limit on, layers keep their `z` but lose their moves, and `W_MOVES_NOT_STORED` says so
+    /// (the program, written before, has every move).
+    fn for_storage(answer: &mut ContourAnswer) {
+        let total = answer.result.summary.moves;
+        if total <= MAX_JSON_MOVES {
+            return;
+        }
+        let mut kept = 0;
+        let mut first_dropped = None;
+        for (index, layer) in answer.result.layers.iter_mut().enumerate() {
+            if first_dropped.is_some() || kept + layer.moves.len() > MAX_JSON_MOVES {
+                first_dropped.get_or_insert(index);
+                layer.moves = Vec::new();
+            } else {
+                kept += layer.moves.len();
+            }
+        }
+        if let Some(first) = first_dropped {
+            let layers = answer.result.layers.len();
+            answer.result.warnings.push(Warning::new(
+                "W_MOVES_NOT_STORED",
+                format!(
+                    "the answer has {total} moves, more than the {MAX_JSON_MOVES} a stored JSON result holds: layers \
+                     {first} to {} are listed without their moves; the G-code program has every move",
+                    layers - 1
+                ),
+            ));
+        }
+    }
+}
+
+/// A JSON answer over [`MAX_JSON_MOVES`] gets the advice to ask for G-code or submit a job.
+fn json_limit_advice(error: SolverError) -> SolverError {
+    if error.code() != ErrorCode::TooManyMoves {
+        return error;
+    }
+    let advice = format!(
+        "{} (a JSON answer holds at most {MAX_JSON_MOVES} moves; ask for G-code with Accept: text/x-gcode or \
+         ?format=gcode, or submit a job (POST /api/v1/jobs), which allow up to {MAX_MOVES} moves)",
+        error.message(),
+    );
+    let field = error.field().map(str::to_owned);
+    let advised = SolverError::new(error.code(), advice);
+    match field {
+        Some(field) => advised.at(field),
+        None => advised,
+    }
+}
+
+/// `POST /api/v1/contour/loops`: a closed tool-centre path made elsewhere, whose corners get
+/// loops (docs/spec/contour.md §3.4, claims 8–10).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct LoopsRequest {
+    /// A registered tool number or an inline tool; its `radius` sizes the loops.
+    pub tool: ToolRef,
+    /// The closed path `[[x, y], ...]` of the tool centre in travel order (the last point need
+    /// not repeat the first; at most 200 000 points).
+    pub path: Vec<[f64; 2]>,
+    /// `left` (default) or `right` of travel: where the material lies.
+    #[serde(default)]
+    pub material_side: MaterialSide,
+    /// `turn_angle` (default), `patent_curvature` (claim 8) or `patent_delta_l` (claim 9).
+    #[serde(default)]
+    pub detect: DetectMode,
+    /// Threshold of the mode: ψ_min in degrees for `turn_angle` (default 10), κ_th in 1/mm for
+    /// `patent_curvature` (default 1/tool radius), λ_th for `patent_delta_l` (default sin 5°).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub threshold: Option<f64>,
+    /// Loop style and sizing, as for contours.
+    #[serde(default)]
+    pub corner_loop: CornerLoop,
+    /// Chord tolerance of loop arcs, mm (default 0.01).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
+}
+
+/// The looped path: the tool used and the solver's result.
+#[derive(Debug, Clone, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct LoopsAnswer {
+    /// The tool, as resolved from the table or given inline.
+    pub tool: Tool,
+    /// Detection measures per point, the looped path and the claim-10 check.
+    #[serde(flatten)]
+    pub result: PathLoopAnswer,
+}
+
+impl LoopsRequest {
+    /// The tool it refers to.
+    pub fn refs(&self) -> Refs<'_> {
+        Refs { tool: Some(&self.tool), machine: None, material: None }
+    }
+
+    /// Adds loops to the path with the resolved tool; at most [`MAX_JSON_MOVES`] moves.
+    ///
+    /// # Errors
+    /// `E_INPUT` for a bad tool or numbers, the path errors of [`detect::loop_path_within`], and
+    /// `E_CANCELLED` once `control`'s cancel flag is set.
+    pub fn solve(&self, tool: Tool, control: Control<'_>) -> Result<LoopsAnswer, SolverError> {
+        tool.validate("tool.")?;
+        let path_request = PathLoopRequest {
+            path: self.path.clone(),
+            material_side: self.material_side,
+            detect: self.detect,
+            threshold: self.threshold,
+            tool_radius: tool.radius,
+            corner_loop: self.corner_loop.clone(),
+            tolerance: self.tolerance,
+        };
+        let result = detect::loop_path_within(&path_request, MAX_JSON_MOVES, control)?;
+        Ok(LoopsAnswer { tool, result })
+    }
+}
