@@ -146,7 +146,7 @@ fn bench(c: &mut Criterion) {
     );
     drop(answer);
 
-    let mut group = c.benchmark_group("corners");
+    let mut group = c.benchmark_group("contour");
     group.sample_size(10);
     group.throughput(Throughput::Elements((VERTICES * LAYERS) as u64));
     group.bench_function("solve_100k_vertices_50_layers", |b| {

@@ -93,7 +93,7 @@ fn run(
 }
 
 fn bench(c: &mut Criterion) {
-    let mut group = c.benchmark_group("chord");
+    let mut group = c.benchmark_group("segment");
     group.sample_size(10);
     let curves = [("bspline", spiral()), ("ellipse", ellipse()), ("polyline", polyline())];
     for (name, curve) in &curves {
