@@ -5,7 +5,8 @@
 // warnings and the G-code download. `contourResult` also renders job results.
 import { api } from '/api.js';
 import { Timeline } from '/timeline.js';
-import { Plot2D, Scene3D, THREE } from '/plot.js';
+import { ContourPlan } from '/plot/plan.js';
+import { Scene3D, THREE } from '/plot/scene3d.js';
 import { answerAndProgram, clearProblem, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, programName, showComputed, showProblem, showSummary, value, warningMessages } from '/form.js';
 
 // An arrow-shaped island: five protruding corners (a 64° tip among them) and two inside corners.
@@ -247,7 +248,7 @@ export function contourResult(container, answer, { program } = {}) {
   summary.className = 'summary';
   container.append(bar, canvas, hint, note, warnings, summary);
 
-  const plot = new Plot2D(canvas);
+  const plot = new ContourPlan(canvas);
   const contour = answer.corners.map((c) => c.vertex);
   const legend = [['contour', COLOUR.contour], ['cut', COLOUR.cut], ['loop', COLOUR.loop], ['relief', COLOUR.relief],
     ['link', COLOUR.link, [6, 4]], ['rapid', COLOUR.rapid, [3, 4]]];

@@ -3,7 +3,7 @@
 // Deburr).
 import { api, program as programOf, sentence } from '/api.js';
 import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
-import { Scene3D, THREE } from '/plot.js';
+import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
 import { clearance } from '/views/deburr-clearance.js';
 

@@ -4,10 +4,11 @@
 // the plan view coloured by engagement, the contact-position graph, a_e, the summed chip
 // thickness per flute count with the threshold, spindle torque and power with the machine's limits, the feed plan, and the
 // representative values and time per k with the recommended k highlighted (the charts are
-// plot.js's); a cursor on any chart marks the tool on the path. The result renderer is shared
+// plot/charts.js's); a cursor on any chart marks the tool on the path. The result renderer is shared
 // with the Jobs view.
 import { api } from '/api.js';
-import { PathChart, ToolPlan, barChart } from '/plot.js';
+import { PathChart, barChart } from '/plot/charts.js';
+import { ToolPlan } from '/plot/tool-plan.js';
 import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
@@ -251,7 +252,7 @@ function nearestIndex(samples, key, v) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Plan view: what plot.js's ToolPlan draws from an answer (stock, path coloured by engagement)
+// Plan view: what plot/tool-plan.js's ToolPlan draws from an answer (stock, path coloured by engagement)
 
 function base64Bits(text) {
   const binary = atob(text.replace(/\s/g, ''));
@@ -295,7 +296,7 @@ function stockRings(stock) {
   return [];
 }
 
-// The plan view's drawing (plot.js's ToolPlan) from an answer: the stock's rings, its bitmap's
+// The plan view's drawing (plot/tool-plan.js's ToolPlan) from an answer: the stock's rings, its bitmap's
 // material cells, earlier cuts as swept strokes, and the path coloured by the engaged angle.
 function planSpec(result, answer) {
   const stock = answer.stock;
@@ -323,7 +324,7 @@ function planSpec(result, answer) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Charts over the path (x = s or t), sharing a cursor; drawn by plot.js
+// Charts over the path (x = s or t), sharing a cursor; drawn by plot/charts.js
 
 // The sample (and its flute values) per flute count as [x, value] points.
 function perFlute(samples, key, field, k) {

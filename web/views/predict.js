@@ -5,7 +5,8 @@
 // corrected program. `predictResult` also shows prediction jobs.
 import { api } from '/api.js';
 import { clearProblem, computed, computing, download, half, keepForm, loadTools, markComputed, message, number, numeric, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
-import { Scene3D, THREE, css, diverging, drawColourScale, drawHistogram } from '/plot.js';
+import { css, diverging, drawColourScale, drawHistogram } from '/plot/colour.js';
+import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
 
 // The sample: a raster finishing program over a gentle dome (20 × 20 mm, 2 mm high) with an R3

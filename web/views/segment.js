@@ -4,7 +4,8 @@
 import { api } from '/api.js';
 import { Timeline } from '/timeline.js';
 import { answerAndProgram, clearProblem, computing, download, keepForm, loadMachines, machineFields, machineNote, message, number, numeric, showComputed, showProblem, showSummary, value, warningMessages } from '/form.js';
-import { PlanPlot, drawChart } from '/plot.js';
+import { drawChart } from '/plot/charts.js';
+import { CurvePlan } from '/plot/plan.js';
 
 const FORM = `
 <div class="layout">
@@ -275,7 +276,7 @@ export function segmentResult(container, answer, { request, machine, program } =
   if (request?.curve) series.push({ label: 'target curve', points: curvePoints(request.curve), colour: '#9aa5ae', width: 1 });
   series.push({ label: `${answer.blocks} blocks`, points, colour: '#0b63b6', width: 2, marks: points.length > 4000 ? 0 : 4, count: true });
   if (short.length) series.push({ label: `shorter than one block time: ${short.length} (${answer.short_end_blocks} of them remainders at ends)`, points, segments: short, colour: '#b3261e', width: 3.5 });
-  const planPlot = new PlanPlot(plan);
+  const planPlot = new CurvePlan(plan);
   planPlot.setSeries(series);
   if (program) {
     // The timeline walks the program block by block: feed, block length and time per block.
