@@ -9,7 +9,7 @@
 import { api } from '/api.js';
 import { PathChart, barChart } from '/plot/charts.js';
 import { ToolPlan } from '/plot/tool-plan.js';
-import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
+import { clearProblem, download, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, machineFields, message, number, numeric, programName, showProblem, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
   { name: 'straight', text: '-10 20\n70 20' },
@@ -683,9 +683,6 @@ export const engagementView = {
     };
     form.elements.material.addEventListener('change', showMaterial);
     syncVisibility(form);
-    const fail = (problem) => {
-      showProblem(messages, form, problem);
-    };
     const fillCandidates = () => {
       const select = form.elements.candidate;
       const previous = select.value;
@@ -694,22 +691,18 @@ export const engagementView = {
     };
     fillCandidates();
     form.addEventListener('input', fillCandidates);
-    form.addEventListener('submit', async (event) => {
-      event.preventDefault();
-      clearProblem(form);
-      fillCandidates();
-      try {
-        const body = engagementRequest(form);
-        computing(messages, result);
-        const answer = await api('POST', '/api/v1/engagement', body);
-        computed(messages, result);
-        markComputed(form);
-        clearProblem(form);
+    submitFlow(form, {
+      messages,
+      result,
+      read: () => {
+        fillCandidates();
+        return engagementRequest(form);
+      },
+      ask: (body) => api('POST', '/api/v1/engagement', body),
+      show: (answer) => {
         engagementResult(result, answer, { onSelect: (i) => { form.elements.candidate.value = String(i); } });
         result.dataset.state = 'drawn';
-      } catch (problem) {
-        fail(problem);
-      }
+      },
     });
     root.querySelector('#engagement-gcode').addEventListener('click', async () => {
       clearProblem(form);
@@ -719,7 +712,7 @@ export const engagementView = {
         download(programName(`engagement-${candidate}`, form), program);
         messages.replaceChildren();
       } catch (problem) {
-        fail(problem);
+        showProblem(messages, form, problem);
       }
     });
     keepForm(id, form, {
