@@ -1,4 +1,5 @@
-// kerf form helpers shared by the views: reading fields, the tool and machine choices (machine
+// kerf form helpers shared by the views: the submit flow (read the form, ask the service, show the
+// answer or mark the problem at its fields), reading fields, the tool and machine choices (machine
 // values as placeholders, only overrides sent), errors at the field, warnings as sentences, the
 // per-view state kept in local storage, summaries and downloads.
 import { api, machines, materials, plainFieldMessage, plainTitle, program, sentence, technical, tools } from '/api.js';

@@ -92,12 +92,13 @@ class InputError {
   }
 }
 
-// "x y" per line (or "x, y"), or JSON. Returns the JSON value or a list of points.
 // Whether a path box holds a G-code program (words like G1, X10) rather than "x y" lines.
 function isGcode(text) {
   return /^\s*%|(^|\s)[GXYNO]\s*[-+]?\d/im.test(text) && !/^\s*[[{]/.test(text);
 }
 
+// "x y" per line (or "x, y"), or JSON. Returns the JSON value or a list of points; throws an
+// InputError at `field` for a line it cannot read.
 function parsePoints(text, field) {
   const trimmed = text.trim();
   if (trimmed.startsWith('[') || trimmed.startsWith('{')) {

@@ -1,5 +1,5 @@
 // Tool table view: list, register or replace, edit and delete (with a confirmation) the tools
-// (docs/spec/api.md, Tools). Sizes by diameter or radius; the optional data later capabilities need:
+// (docs/spec/api.md, Tools). Sizes by diameter or radius; the optional data other views need:
 // neck, stickout, flute length, helix, shape-error table and a static stiffness.
 import { api } from '/api.js';
 import { clearProblem, confirmButton, message, numeric, showProblem, submitFlow, value } from '/form.js';
