@@ -44,13 +44,13 @@ export function warningMessages(warnings = []) {
 }
 
 // Shows "computing…" and dims the last result until the answer comes.
-export function computing(messages, result) {
+function computing(messages, result) {
   messages.replaceChildren(message('info', 'Computing…'));
   result?.classList.add('stale');
 }
 
 // Shows success in green and undims the result.
-export function computed(messages, result, text = 'Computed.') {
+function computed(messages, result, text = 'Computed.') {
   messages.replaceChildren(message('ok', text));
   result?.classList.remove('stale');
 }
@@ -469,7 +469,7 @@ export function keepForm(view, form, { onReset, more } = {}) {
 }
 
 // Tells keepForm that the form's request gave a result.
-export function markComputed(form) {
+function markComputed(form) {
   form.dispatchEvent(new Event('kerf:computed'));
 }
 
