@@ -4,7 +4,8 @@ import { VIEWS } from '/views.js';
 
 const mounted = new Map();
 
-// The view a location hash names: `#/deburr`, also the older `#deburr`; else the first.
+// The view a location hash names: `#/deburr`, or `#deburr` (a link typed or kept without the
+// slash still opens its view); else the first.
 function routed() {
   const id = location.hash.replace(/^#\/?/, '');
   return VIEWS.find((v) => v.id === id) || VIEWS[0];

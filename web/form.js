@@ -1,4 +1,5 @@
-// kerf form helpers shared by the views: reading fields, the tool and machine choices (machine
+// kerf form helpers shared by the views: the submit flow (read the form, ask the service, show the
+// answer or mark the problem at its fields), reading fields, the tool and machine choices (machine
 // values as placeholders, only overrides sent), errors at the field, warnings as sentences, the
 // per-view state kept in local storage, summaries and downloads.
 import { api, machines, materials, plainFieldMessage, plainTitle, program, sentence, technical, tools } from '/api.js';
@@ -43,13 +44,13 @@ export function warningMessages(warnings = []) {
 }
 
 // Shows "computing…" and dims the last result until the answer comes.
-export function computing(messages, result) {
+function computing(messages, result) {
   messages.replaceChildren(message('info', 'Computing…'));
   result?.classList.add('stale');
 }
 
 // Shows success in green and undims the result.
-export function computed(messages, result, text = 'Computed.') {
+function computed(messages, result, text = 'Computed.') {
   messages.replaceChildren(message('ok', text));
   result?.classList.remove('stale');
 }
@@ -65,13 +66,50 @@ export async function answerAndProgram(path, body, query) {
   }
 }
 
-// After the new result is drawn (only then: until it replaces the old one, the old one is the
-// stale one): success, the form marked computed, and why there is no program if refused.
-export function showComputed(form, messages, result, refusal, what) {
-  computed(messages, result);
-  markComputed(form);
-  clearProblem(form);
-  if (refusal) messages.append(message('error', `No G-code for ${what}. ${sentence(refusal.detail || refusal.title)}`, refusal.code));
+// The flow of a form that asks the service, the same in every view. On submit the marks of an
+// earlier problem go and `read()` builds the request from the form (throwing a problem document
+// for input the page can already tell is wrong). `ask(request)` then asks the service while
+// "Computing…" shows and the last result dims (`quiet`: no such notice, for a form that only
+// saves); `show(answer, request)` draws the new result and may return a message to add, e.g. why
+// there is no program. Only after the new result is drawn (until it replaces the old one, the old
+// one is the stale one): success in green (`done`: a text, or a function of the answer, the
+// request and the seconds the service took), the result undimmed, the form marked computed. A
+// problem from any step is shown at its fields, then handed to `failed(problem)` for what the view
+// adds to it.
+export function submitFlow(form, { messages, result, read = () => null, ask, show = () => null, done = 'Computed.', failed, quiet = false }) {
+  const fail = (problem) => {
+    showProblem(messages, form, problem);
+    failed?.(problem);
+  };
+  form.addEventListener('submit', async (event) => {
+    event.preventDefault();
+    clearProblem(form);
+    let request;
+    try {
+      request = read();
+    } catch (problem) {
+      fail(problem);
+      return;
+    }
+    if (!quiet) computing(messages, result);
+    try {
+      const started = performance.now();
+      const answer = await ask(request);
+      const seconds = (performance.now() - started) / 1000;
+      const note = await show(answer, request);
+      clearProblem(form);
+      computed(messages, result, typeof done === 'function' ? done(answer, request, seconds) : done);
+      markComputed(form);
+      if (note) messages.append(note);
+    } catch (problem) {
+      fail(problem);
+    }
+  });
+}
+
+// Why a computed answer has no program, as a message for `submitFlow`'s `show` to return.
+export function refusalMessage(refusal, what) {
+  return refusal ? message('error', `No G-code for ${what}. ${sentence(refusal.detail || refusal.title)}`, refusal.code) : null;
 }
 
 // Fills a summary box with [name, value] pairs, each a line with the value in bold.
@@ -431,7 +469,7 @@ export function keepForm(view, form, { onReset, more } = {}) {
 }
 
 // Tells keepForm that the form's request gave a result.
-export function markComputed(form) {
+function markComputed(form) {
   form.dispatchEvent(new Event('kerf:computed'));
 }
 

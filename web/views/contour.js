@@ -5,8 +5,9 @@
 // warnings and the G-code download. `contourResult` also renders job results.
 import { api } from '/api.js';
 import { Timeline } from '/timeline.js';
-import { Plot2D, Scene3D, THREE } from '/plot.js';
-import { answerAndProgram, clearProblem, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, programName, showComputed, showProblem, showSummary, value, warningMessages } from '/form.js';
+import { ContourPlan } from '/plot/plan.js';
+import { Scene3D, THREE } from '/plot/scene3d.js';
+import { answerAndProgram, clearProblem, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, programName, refusalMessage, showProblem, showSummary, submitFlow, value, warningMessages } from '/form.js';
 
 // An arrow-shaped island: five protruding corners (a 64° tip among them) and two inside corners.
 const SAMPLE = `# x, y in mm, counter-clockwise; one point a line
@@ -247,7 +248,7 @@ export function contourResult(container, answer, { program } = {}) {
   summary.className = 'summary';
   container.append(bar, canvas, hint, note, warnings, summary);
 
-  const plot = new Plot2D(canvas);
+  const plot = new ContourPlan(canvas);
   const contour = answer.corners.map((c) => c.vertex);
   const legend = [['contour', COLOUR.contour], ['cut', COLOUR.cut], ['loop', COLOUR.loop], ['relief', COLOUR.relief],
     ['link', COLOUR.link, [6, 4]], ['rapid', COLOUR.rapid, [3, 4]]];
@@ -391,35 +392,30 @@ export const contourView = {
     loadMachines(form.elements.machine);
     machineFields(form, { block_time_ms: 'block_time_ms' });
     sync();
+    // The request, or a problem at the points box for a line that is not "x, y".
     const request = () => {
-      clearProblem(form);
       try {
         return contourRequest(form);
       } catch (bad) {
-        showProblem(messages, form, { status: 400, title: 'Bad input', errors: [{ path: 'contour', message: bad.error }] });
-        return null;
+        throw { status: 400, title: 'Bad input', errors: [{ path: 'contour', message: bad.error }] };
       }
     };
-    form.addEventListener('submit', async (event) => {
-      event.preventDefault();
-      const body = request();
-      if (!body) return;
-      computing(messages, result);
-      try {
-        const { answer, program, refusal } = await answerAndProgram('/api/v1/contour', body, gcodeQuery(form));
+    submitFlow(form, {
+      messages,
+      result,
+      read: request,
+      ask: (body) => answerAndProgram('/api/v1/contour', body, gcodeQuery(form)),
+      show: ({ answer, program, refusal }) => {
         root.querySelector('#contour-gcode').disabled = !program;
         contourResult(result, answer, { program }).id = 'contour-plot';
-        showComputed(form, messages, result, refusal, 'this path');
-      } catch (problem) {
-        showProblem(messages, form, problem);
-        markContour(form, messages, problem);
-      }
+        return refusalMessage(refusal, 'this path');
+      },
+      failed: (problem) => markContour(form, messages, problem),
     });
     root.querySelector('#contour-gcode').addEventListener('click', async () => {
-      const body = request();
-      if (!body) return;
+      clearProblem(form);
       try {
-        const program = await api('POST', `/api/v1/contour${gcodeQuery(form)}`, body, 'text/x-gcode');
+        const program = await api('POST', `/api/v1/contour${gcodeQuery(form)}`, request(), 'text/x-gcode');
         download(programName('contour', form), program);
       } catch (problem) {
         showProblem(messages, form, problem);

@@ -4,7 +4,7 @@
 // along the cylinder axis A1, z along the hole axis A2, the hole through the wall on the +z side).
 // The service's own checks (E_NO_APPROACH, E_NECK_COLLISION) still decide whether it writes a
 // program; this shows where, and catches an approach the page can see is wrong.
-import { THREE } from '/plot.js';
+import { THREE } from '/plot/scene3d.js';
 
 // Directions on a sphere (a Fibonacci lattice): enough to find a ball inside a wall that is
 // thicker than the spacing of the points at the ball's surface.

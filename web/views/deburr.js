@@ -2,8 +2,8 @@
 // where the tool would meet the wall, the summary, warnings and the G-code download (docs/spec/api.md,
 // Deburr).
 import { api, program as programOf, sentence } from '/api.js';
-import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, value, warningMessages } from '/form.js';
-import { Scene3D, THREE } from '/plot.js';
+import { download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, programName, showProblem, showSummary, submitFlow, value, warningMessages } from '/form.js';
+import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
 import { clearance } from '/views/deburr-clearance.js';
 
@@ -299,22 +299,15 @@ export const deburrView = {
     };
     form.elements.dialect.addEventListener('change', redraw);
     form.elements.reference.addEventListener('change', redraw);
-    form.addEventListener('submit', async (event) => {
-      event.preventDefault();
-      computing(messages, result);
-      const request = deburrRequest(form);
-      try {
-        const answer = await api('POST', '/api/v1/deburr', request);
+    submitFlow(form, {
+      messages,
+      result,
+      read: () => deburrRequest(form),
+      ask: (request) => api('POST', '/api/v1/deburr', request),
+      show: (answer, request) => {
         last = { request, answer };
-        const refusal = await draw();
-        // Undimmed only now: until the new scene is in place the old one is still the stale one.
-        clearProblem(form);
-        computed(messages, result);
-        markComputed(form);
-        if (refusal) messages.append(refusal);
-      } catch (problem) {
-        showProblem(messages, form, problem);
-      }
+        return draw();
+      },
     });
     gcode.addEventListener('click', async () => {
       try {

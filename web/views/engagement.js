@@ -4,11 +4,12 @@
 // the plan view coloured by engagement, the contact-position graph, a_e, the summed chip
 // thickness per flute count with the threshold, spindle torque and power with the machine's limits, the feed plan, and the
 // representative values and time per k with the recommended k highlighted (the charts are
-// plot.js's); a cursor on any chart marks the tool on the path. The result renderer is shared
+// plot/charts.js's); a cursor on any chart marks the tool on the path. The result renderer is shared
 // with the Jobs view.
 import { api } from '/api.js';
-import { PathChart, ToolPlan, barChart } from '/plot.js';
-import { clearProblem, computed, computing, download, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, machineFields, markComputed, message, number, numeric, programName, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
+import { PathChart, barChart } from '/plot/charts.js';
+import { ToolPlan } from '/plot/tool-plan.js';
+import { clearProblem, download, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, machineFields, message, number, numeric, programName, showProblem, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
   { name: 'straight', text: '-10 20\n70 20' },
@@ -91,12 +92,13 @@ class InputError {
   }
 }
 
-// "x y" per line (or "x, y"), or JSON. Returns the JSON value or a list of points.
 // Whether a path box holds a G-code program (words like G1, X10) rather than "x y" lines.
 function isGcode(text) {
   return /^\s*%|(^|\s)[GXYNO]\s*[-+]?\d/im.test(text) && !/^\s*[[{]/.test(text);
 }
 
+// "x y" per line (or "x, y"), or JSON. Returns the JSON value or a list of points; throws an
+// InputError at `field` for a line it cannot read.
 function parsePoints(text, field) {
   const trimmed = text.trim();
   if (trimmed.startsWith('[') || trimmed.startsWith('{')) {
@@ -251,7 +253,7 @@ function nearestIndex(samples, key, v) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Plan view: what plot.js's ToolPlan draws from an answer (stock, path coloured by engagement)
+// Plan view: what plot/tool-plan.js's ToolPlan draws from an answer (stock, path coloured by engagement)
 
 function base64Bits(text) {
   const binary = atob(text.replace(/\s/g, ''));
@@ -295,7 +297,7 @@ function stockRings(stock) {
   return [];
 }
 
-// The plan view's drawing (plot.js's ToolPlan) from an answer: the stock's rings, its bitmap's
+// The plan view's drawing (plot/tool-plan.js's ToolPlan) from an answer: the stock's rings, its bitmap's
 // material cells, earlier cuts as swept strokes, and the path coloured by the engaged angle.
 function planSpec(result, answer) {
   const stock = answer.stock;
@@ -323,7 +325,7 @@ function planSpec(result, answer) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Charts over the path (x = s or t), sharing a cursor; drawn by plot.js
+// Charts over the path (x = s or t), sharing a cursor; drawn by plot/charts.js
 
 // The sample (and its flute values) per flute count as [x, value] points.
 function perFlute(samples, key, field, k) {
@@ -682,9 +684,6 @@ export const engagementView = {
     };
     form.elements.material.addEventListener('change', showMaterial);
     syncVisibility(form);
-    const fail = (problem) => {
-      showProblem(messages, form, problem);
-    };
     const fillCandidates = () => {
       const select = form.elements.candidate;
       const previous = select.value;
@@ -693,22 +692,18 @@ export const engagementView = {
     };
     fillCandidates();
     form.addEventListener('input', fillCandidates);
-    form.addEventListener('submit', async (event) => {
-      event.preventDefault();
-      clearProblem(form);
-      fillCandidates();
-      try {
-        const body = engagementRequest(form);
-        computing(messages, result);
-        const answer = await api('POST', '/api/v1/engagement', body);
-        computed(messages, result);
-        markComputed(form);
-        clearProblem(form);
+    submitFlow(form, {
+      messages,
+      result,
+      read: () => {
+        fillCandidates();
+        return engagementRequest(form);
+      },
+      ask: (body) => api('POST', '/api/v1/engagement', body),
+      show: (answer) => {
         engagementResult(result, answer, { onSelect: (i) => { form.elements.candidate.value = String(i); } });
         result.dataset.state = 'drawn';
-      } catch (problem) {
-        fail(problem);
-      }
+      },
     });
     root.querySelector('#engagement-gcode').addEventListener('click', async () => {
       clearProblem(form);
@@ -718,7 +713,7 @@ export const engagementView = {
         download(programName(`engagement-${candidate}`, form), program);
         messages.replaceChildren();
       } catch (problem) {
-        fail(problem);
+        showProblem(messages, form, problem);
       }
     });
     keepForm(id, form, {

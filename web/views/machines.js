@@ -1,7 +1,7 @@
 // Machines view: the controller profiles (docs/spec/api.md, Machines): list, register or replace, delete,
 // and the block time from a saturation test (docs/spec/segment.md §2.1, Eq. 1).
 import { api } from '/api.js';
-import { clearProblem, confirmButton, message, showProblem } from '/form.js';
+import { confirmButton, message, showProblem, submitFlow } from '/form.js';
 
 const FORM = `
 <div class="layout">
@@ -117,17 +117,13 @@ export const machinesView = {
       const speed = Number(form.elements.saturated.value);
       if (length > 0 && speed > 0) form.elements.block_time_ms.value = String(Number((length / speed * 60000).toPrecision(6)));
     });
-    form.addEventListener('submit', async (event) => {
-      event.preventDefault();
-      const name = form.elements.name.value.trim();
-      try {
-        await api('PUT', `/api/v1/machines/${encodeURIComponent(name || ' ')}`, machineBody(form));
-        clearProblem(form);
-        messages.replaceChildren(message('ok', `Machine ${name} saved.`));
-        refresh(root);
-      } catch (problem) {
-        showProblem(messages, form, problem);
-      }
+    submitFlow(form, {
+      messages,
+      quiet: true,
+      read: () => ({ name: form.elements.name.value.trim(), machine: machineBody(form) }),
+      ask: ({ name, machine }) => api('PUT', `/api/v1/machines/${encodeURIComponent(name || ' ')}`, machine),
+      show: () => { refresh(root); },
+      done: (answer, { name }) => `Machine ${name} saved.`,
     });
   },
 };

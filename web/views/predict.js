@@ -4,8 +4,9 @@
 // scale, a histogram of the errors, the worst passes with their NC lines, warnings, and the
 // corrected program. `predictResult` also shows prediction jobs.
 import { api } from '/api.js';
-import { clearProblem, computed, computing, download, half, keepForm, loadTools, markComputed, message, number, numeric, showProblem, showSummary, toolLabel, value, warningMessages } from '/form.js';
-import { Scene3D, THREE, css, diverging, drawColourScale, drawHistogram } from '/plot.js';
+import { clearProblem, download, half, keepForm, loadTools, message, number, numeric, showProblem, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
+import { css, diverging, drawColourScale, drawHistogram } from '/plot/colour.js';
+import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
 
 // The sample: a raster finishing program over a gentle dome (20 × 20 mm, 2 mm high) with an R3
@@ -432,23 +433,17 @@ export const predictView = {
       showProblem(messages, form, problem);
       markProblem(form, problem);
     };
-    form.addEventListener('submit', async (event) => {
-      event.preventDefault();
-      clear();
-      computing(messages, result);
-      const started = performance.now();
-      try {
-        const answer = await api('POST', '/api/v1/predict?timings=true', payload(predictRequest(form)));
-        const seconds = (performance.now() - started) / 1000;
-        computed(messages, result, `${answer.summary.passes} passes predicted in ${seconds.toFixed(2)} s.`);
-        markComputed(form);
-        clearProblem(form);
-        const sent = predictRequest(form).body;
-        predictResult(result, answer, { request: sent, program: sent.path.program }).id = 'predict-plot';
+    submitFlow(form, {
+      messages,
+      result,
+      read: () => predictRequest(form),
+      ask: (request) => api('POST', '/api/v1/predict?timings=true', payload(request)),
+      show: (answer, { body }) => {
+        predictResult(result, answer, { request: body, program: body.path.program }).id = 'predict-plot';
         result.querySelector('canvas.histogram').id = 'predict-histogram';
-      } catch (problem) {
-        fail(problem);
-      }
+      },
+      done: (answer, request, seconds) => `${answer.summary.passes} passes predicted in ${seconds.toFixed(2)} s.`,
+      failed: (problem) => markProblem(form, problem),
     });
     root.querySelector('#predict-gcode').addEventListener('click', async () => {
       clear();

@@ -3,8 +3,9 @@
 // block length along the curve, the rule side by side with a fixed tolerance, G-code download.
 import { api } from '/api.js';
 import { Timeline } from '/timeline.js';
-import { answerAndProgram, clearProblem, computing, download, keepForm, loadMachines, machineFields, machineNote, message, number, numeric, showComputed, showProblem, showSummary, value, warningMessages } from '/form.js';
-import { PlanPlot, drawChart } from '/plot.js';
+import { answerAndProgram, clearProblem, download, keepForm, loadMachines, machineFields, machineNote, message, number, numeric, refusalMessage, showProblem, showSummary, submitFlow, value, warningMessages } from '/form.js';
+import { drawChart } from '/plot/charts.js';
+import { CurvePlan } from '/plot/plan.js';
 
 const FORM = `
 <div class="layout">
@@ -275,7 +276,7 @@ export function segmentResult(container, answer, { request, machine, program } =
   if (request?.curve) series.push({ label: 'target curve', points: curvePoints(request.curve), colour: '#9aa5ae', width: 1 });
   series.push({ label: `${answer.blocks} blocks`, points, colour: '#0b63b6', width: 2, marks: points.length > 4000 ? 0 : 4, count: true });
   if (short.length) series.push({ label: `shorter than one block time: ${short.length} (${answer.short_end_blocks} of them remainders at ends)`, points, segments: short, colour: '#b3261e', width: 3.5 });
-  const planPlot = new PlanPlot(plan);
+  const planPlot = new CurvePlan(plan);
   planPlot.setSeries(series);
   if (program) {
     // The timeline walks the program block by block: feed, block length and time per block.
@@ -339,38 +340,34 @@ export const segmentView = {
     syncVisibility(form);
     loadMachines(form.elements.machine, 'none (values below)');
     machineFields(form, { feed: 'max_feed', block_time_ms: 'block_time_ms', margin: 'margin', min_chord_error: 'min_chord_error' });
+    // The request, or a problem at the points box for a line that is not a point.
     const request = () => {
-      clearProblem(form);
       try {
         return segmentRequest(form);
       } catch (error) {
-        showProblem(messages, form, { status: 400, title: 'Bad input', detail: String(error.message || error), errors: [{ path: 'curve.points' }] });
-        return null;
+        throw { status: 400, title: 'Bad input', detail: String(error.message || error), errors: [{ path: 'curve.points' }] };
       }
     };
-    form.addEventListener('submit', async (event) => {
-      event.preventDefault();
-      const body = request();
-      if (!body) return;
-      computing(messages, result);
-      try {
-        const { answer, program, refusal } = await answerAndProgram('/api/v1/segment', body, segmentQuery(form));
+    submitFlow(form, {
+      messages,
+      result,
+      read: request,
+      ask: (body) => answerAndProgram('/api/v1/segment', body, segmentQuery(form)),
+      show: ({ answer, program, refusal }, body) => {
         root.querySelector('#segment-gcode').disabled = !program;
         segmentResult(result, answer, { request: body, machine: form.elements.machine.machines?.get(body.machine), program }).id = 'segment-plot';
         const charts = result.querySelectorAll('canvas.chart');
         charts[0].id = 'segment-chart';
         charts[1].id = 'segment-lengths';
-        showComputed(form, messages, result, refusal, 'these blocks');
-      } catch (problem) {
-        showProblem(messages, form, problem);
-      }
+        return refusalMessage(refusal, 'these blocks');
+      },
     });
     root.querySelector('#segment-gcode').addEventListener('click', async () => {
-      const body = request();
-      if (!body) return;
-      const dialect = value(form, 'dialect');
-      const query = segmentQuery(form);
+      clearProblem(form);
       try {
+        const body = request();
+        const dialect = value(form, 'dialect');
+        const query = segmentQuery(form);
         const program = await api('POST', `/api/v1/segment${query}`, body, 'text/x-gcode');
         download(`segment-${dialect || body.machine || 'fanuc'}.nc`, program);
       } catch (problem) {

@@ -1,8 +1,8 @@
 // Tool table view: list, register or replace, edit and delete (with a confirmation) the tools
-// (docs/spec/api.md, Tools). Sizes by diameter or radius; the optional data later capabilities need:
+// (docs/spec/api.md, Tools). Sizes by diameter or radius; the optional data other views need:
 // neck, stickout, flute length, helix, shape-error table and a static stiffness.
 import { api } from '/api.js';
-import { clearProblem, confirmButton, message, numeric, showProblem, value } from '/form.js';
+import { clearProblem, confirmButton, message, numeric, showProblem, submitFlow, value } from '/form.js';
 
 const FORM = `
 <div class="layout">
@@ -150,17 +150,13 @@ export const toolsView = {
     syncForm(form);
     root.addEventListener('kerf:show', () => refresh(root));
     refresh(root);
-    form.addEventListener('submit', async (event) => {
-      event.preventDefault();
-      const number = value(form, 'number');
-      try {
-        await api('PUT', `/api/v1/tools/${encodeURIComponent(number)}`, toolFrom(form, form.kept));
-        clearProblem(form);
-        messages.replaceChildren(message('ok', `Tool T${number} saved.`));
-        refresh(root);
-      } catch (problem) {
-        showProblem(messages, form, problem);
-      }
+    submitFlow(form, {
+      messages,
+      quiet: true,
+      read: () => ({ number: value(form, 'number'), tool: toolFrom(form, form.kept) }),
+      ask: ({ number, tool }) => api('PUT', `/api/v1/tools/${encodeURIComponent(number)}`, tool),
+      show: () => { refresh(root); },
+      done: (answer, { number }) => `Tool T${number} saved.`,
     });
   },
 };
