@@ -75,6 +75,16 @@ pub struct JobFile {
     pub operations: Vec<Operation>,
 }
 
+impl store::jobs::Submission for JobFile {
+    fn job_name(&self) -> Option<&str> {
+        self.name.as_deref()
+    }
+
+    fn operation_names(&self) -> Vec<&str> {
+        self.operations.iter().map(Operation::name).collect()
+    }
+}
+
 /// G-code options of a job.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
@@ -375,7 +385,7 @@ impl JobFile {
         };
         let all_refs: Vec<Refs<'_>> = self.operations.iter().flat_map(|operation| operation.all_refs()).collect();
         let found = match db {
-            Some(db) => store::catalog(db, all_refs, given).await?,
+            Some(db) => crate::capabilities::catalog(db, all_refs, given).await?,
             None => given,
         };
         for (index, operation) in self.operations.iter().enumerate() {
