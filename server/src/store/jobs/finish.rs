@@ -79,107 +79,155 @@ pub async fn finish(
     outputs: &[Packed],
     storage: &JobStorage,
 ) -> AppResult<Finished> {
-    let sizes: Vec<(&str, i64)> =
-        outputs.iter().map(|output| (output.operation.as_str(), bytes(output.stored_bytes()))).collect();
-    let added: i64 = sizes.iter().map(|(_, size)| size).sum();
-    let first = bytes(task.operation());
-    macro_rules! results_in {
-        ($transaction:expr, $delta:expr) => {
-            for (offset, output) in outputs.iter().enumerate() {
-                sqlx::query(
-                    "INSERT INTO job_results (job_id, position, operation, result_json, result_gz, result_bytes,
-                         gcode_gz, gcode_bytes, gcode_problem)
-                     VALUES ($1, $2, $3, '', $4, $5, $6, $7, $8)",
-                )
-                .bind(work.id)
-                .bind(first + i64::try_from(offset).unwrap_or(i64::MAX))
-                .bind(&output.operation)
-                .bind(&output.result_gz)
-                .bind(bytes(output.result_bytes))
-                .bind(&output.gcode_gz)
-                .bind(bytes(output.gcode_bytes))
-                .bind(&output.gcode_problem)
-                .execute(&mut *$transaction)
-                .await?;
-            }
-            sqlx::query("UPDATE jobs SET stored_bytes = stored_bytes + $1 WHERE id = $2")
-                .bind($delta)
-                .bind(work.id)
-                .execute(&mut *$transaction)
-                .await?;
-        };
-    }
+    let results = Results::new(work, task, outputs);
     match db {
-        Db::Sqlite(pool) => {
-            // The first statement writes, so the transaction holds the file's write lock from
-            // there on: the quota check and the results it admits are one step.
-            let mut transaction = pool.begin().await?;
-            let job: Option<(i64,)> = sqlx::query_as(concat!(
-                "UPDATE jobs SET status = 'done', progress = 1, finished_at = ",
-                now!(),
-                " WHERE id = $1 AND status = 'running' RETURNING stored_bytes"
-            ))
-            .bind(work.id)
-            .fetch_optional(&mut *transaction)
-            .await?;
-            let Some((job_bytes,)) = job else {
-                transaction.rollback().await?;
-                return Ok(Finished::Gone);
-            };
-            let (total,): (i64,) =
-                sqlx::query_as("SELECT COALESCE(SUM(stored_bytes), 0) FROM jobs").fetch_one(&mut *transaction).await?;
-            if let Some(problem) = check_fit(job_bytes, total, &sizes, first, storage) {
-                transaction.rollback().await?;
-                return Ok(Finished::Refused(problem));
-            }
-            results_in!(transaction, added);
-            transaction.commit().await?;
-        }
-        Db::Postgres(pool) => {
-            let mut transaction = pool.begin().await?;
-            // The job's row first: finishers of one job's chunks take turns, so the last one
-            // sees every other chunk done.
-            let Some(job_bytes) = finishing(&mut transaction, work, claimant).await? else {
-                transaction.rollback().await?;
-                return Ok(Finished::Gone);
-            };
-            // A finish step's parts are merged into its result: their outputs go.
-            let (parts,): (i64,) = sqlx::query_as(
-                "SELECT COALESCE(SUM(octet_length(output_gz)), 0)::BIGINT FROM job_chunks
-                 WHERE job_id = $1 AND operation = $2 AND kind = 'part'",
-            )
-            .bind(work.id)
-            .bind(first)
-            .fetch_one(&mut *transaction)
-            .await?;
-            sqlx::query("SELECT pg_advisory_xact_lock($1)").bind(QUOTA_LOCK).execute(&mut *transaction).await?;
-            let (total,): (i64,) = sqlx::query_as("SELECT COALESCE(SUM(stored_bytes), 0)::BIGINT FROM jobs")
-                .fetch_one(&mut *transaction)
-                .await?;
-            if let Some(problem) = check_fit(job_bytes - parts, total - parts, &sizes, first, storage) {
-                transaction.rollback().await?;
-                return Ok(Finished::Refused(problem));
-            }
-            results_in!(transaction, added - parts);
-            sqlx::query(
-                "UPDATE job_chunks SET output_gz = NULL WHERE job_id = $1 AND operation = $2 AND kind = 'part'",
-            )
-            .bind(work.id)
-            .bind(first)
-            .execute(&mut *transaction)
-            .await?;
-            sqlx::query(
-                "UPDATE jobs SET status = 'done', progress = 1, finished_at = now()
-                 WHERE id = $1 AND NOT EXISTS (SELECT 1 FROM job_chunks WHERE job_id = $1 AND status <> 'done')",
-            )
-            .bind(work.id)
-            .execute(&mut *transaction)
-            .await?;
-            set_job_progress(&mut transaction, work.id).await?;
-            transaction.commit().await?;
-        }
+        Db::Sqlite(pool) => finish_sqlite(pool, &results, storage).await,
+        Db::Postgres(pool) => finish_postgres(pool, claimant, &results, storage).await,
     }
+}
+
+/// The results finished work brings: operations from `first` on, with each one's name and
+/// compressed size, and their sum.
+struct Results<'a> {
+    work: Work,
+    first: i64,
+    outputs: &'a [Packed],
+    sizes: Vec<(&'a str, i64)>,
+    added: i64,
+}
+
+impl<'a> Results<'a> {
+    fn new(work: Work, task: &Task, outputs: &'a [Packed]) -> Self {
+        let sizes: Vec<(&str, i64)> =
+            outputs.iter().map(|output| (output.operation.as_str(), bytes(output.stored_bytes()))).collect();
+        let added = sizes.iter().map(|(_, size)| size).sum();
+        Self { work, first: bytes(task.operation()), outputs, sizes, added }
+    }
+}
+
+/// Inserts `$results`' rows into `job_results` and adds `$delta` to their job's stored bytes, in
+/// `$transaction`. The statements are the same in both stores; a macro because their
+/// transactions are different types.
+macro_rules! insert_results {
+    ($transaction:expr, $results:expr, $delta:expr) => {
+        for (offset, output) in $results.outputs.iter().enumerate() {
+            sqlx::query(
+                "INSERT INTO job_results (job_id, position, operation, result_json, result_gz, result_bytes,
+                     gcode_gz, gcode_bytes, gcode_problem)
+                 VALUES ($1, $2, $3, '', $4, $5, $6, $7, $8)",
+            )
+            .bind($results.work.id)
+            .bind($results.first + i64::try_from(offset).unwrap_or(i64::MAX))
+            .bind(&output.operation)
+            .bind(&output.result_gz)
+            .bind(bytes(output.result_bytes))
+            .bind(&output.gcode_gz)
+            .bind(bytes(output.gcode_bytes))
+            .bind(&output.gcode_problem)
+            .execute(&mut *$transaction)
+            .await?;
+        }
+        sqlx::query("UPDATE jobs SET stored_bytes = stored_bytes + $1 WHERE id = $2")
+            .bind($delta)
+            .bind($results.work.id)
+            .execute(&mut *$transaction)
+            .await?;
+    };
+}
+
+/// [`finish`] in SQLite: the whole job is done at once.
+async fn finish_sqlite(pool: &sqlx::SqlitePool, results: &Results<'_>, storage: &JobStorage) -> AppResult<Finished> {
+    // The first statement writes, so the transaction holds the file's write lock from there on:
+    // the quota check and the results it admits are one step.
+    let mut transaction = pool.begin().await?;
+    let job: Option<(i64,)> = sqlx::query_as(concat!(
+        "UPDATE jobs SET status = 'done', progress = 1, finished_at = ",
+        now!(),
+        " WHERE id = $1 AND status = 'running' RETURNING stored_bytes"
+    ))
+    .bind(results.work.id)
+    .fetch_optional(&mut *transaction)
+    .await?;
+    let Some((job_bytes,)) = job else {
+        transaction.rollback().await?;
+        return Ok(Finished::Gone);
+    };
+    let (total,): (i64,) =
+        sqlx::query_as("SELECT COALESCE(SUM(stored_bytes), 0) FROM jobs").fetch_one(&mut *transaction).await?;
+    if let Some(problem) = check_fit(job_bytes, total, &results.sizes, results.first, storage) {
+        transaction.rollback().await?;
+        return Ok(Finished::Refused(problem));
+    }
+    insert_results!(transaction, results, results.added);
+    transaction.commit().await?;
     Ok(Finished::Stored)
+}
+
+/// [`finish`] in PostgreSQL: one chunk is done, the job with its last one.
+async fn finish_postgres(
+    pool: &sqlx::PgPool,
+    claimant: &Claimant,
+    results: &Results<'_>,
+    storage: &JobStorage,
+) -> AppResult<Finished> {
+    let Results { work, first, .. } = *results;
+    let mut transaction = pool.begin().await?;
+    // The job's row first: finishers of one job's chunks take turns, so the last one sees every
+    // other chunk done.
+    let Some(job_bytes) = finishing(&mut transaction, work, claimant).await? else {
+        transaction.rollback().await?;
+        return Ok(Finished::Gone);
+    };
+    // A finish step's parts are merged into its result: their outputs go.
+    let parts = parts_bytes(&mut transaction, work.id, first).await?;
+    let total = locked_total(&mut transaction).await?;
+    if let Some(problem) = check_fit(job_bytes - parts, total - parts, &results.sizes, first, storage) {
+        transaction.rollback().await?;
+        return Ok(Finished::Refused(problem));
+    }
+    insert_results!(transaction, results, results.added - parts);
+    sqlx::query("UPDATE job_chunks SET output_gz = NULL WHERE job_id = $1 AND operation = $2 AND kind = 'part'")
+        .bind(work.id)
+        .bind(first)
+        .execute(&mut *transaction)
+        .await?;
+    sqlx::query(
+        "UPDATE jobs SET status = 'done', progress = 1, finished_at = now()
+         WHERE id = $1 AND NOT EXISTS (SELECT 1 FROM job_chunks WHERE job_id = $1 AND status <> 'done')",
+    )
+    .bind(work.id)
+    .execute(&mut *transaction)
+    .await?;
+    set_job_progress(&mut transaction, work.id).await?;
+    transaction.commit().await?;
+    Ok(Finished::Stored)
+}
+
+/// The bytes the stored outputs of operation `operation`'s parts take (0 for an operation that
+/// was not split).
+async fn parts_bytes(
+    transaction: &mut sqlx::Transaction<'_, sqlx::Postgres>,
+    id: i64,
+    operation: i64,
+) -> AppResult<i64> {
+    let (parts,): (i64,) = sqlx::query_as(
+        "SELECT COALESCE(SUM(octet_length(output_gz)), 0)::BIGINT FROM job_chunks
+         WHERE job_id = $1 AND operation = $2 AND kind = 'part'",
+    )
+    .bind(id)
+    .bind(operation)
+    .fetch_one(&mut **transaction)
+    .await?;
+    Ok(parts)
+}
+
+/// The bytes all jobs take, read under the quota lock (PostgreSQL), which `transaction` then
+/// holds until it ends: no other process adds to the store between this check and its writes.
+async fn locked_total(transaction: &mut sqlx::Transaction<'_, sqlx::Postgres>) -> AppResult<i64> {
+    sqlx::query("SELECT pg_advisory_xact_lock($1)").bind(QUOTA_LOCK).execute(&mut **transaction).await?;
+    let (total,): (i64,) =
+        sqlx::query_as("SELECT COALESCE(SUM(stored_bytes), 0)::BIGINT FROM jobs").fetch_one(&mut **transaction).await?;
+    Ok(total)
 }
 
 /// Locks the job of running chunk `work` and marks the chunk done, if it is still the claimant's
@@ -240,9 +288,7 @@ pub async fn finish_part(
         transaction.rollback().await?;
         return Ok(Finished::Gone);
     };
-    sqlx::query("SELECT pg_advisory_xact_lock($1)").bind(QUOTA_LOCK).execute(&mut *transaction).await?;
-    let (total,): (i64,) =
-        sqlx::query_as("SELECT COALESCE(SUM(stored_bytes), 0)::BIGINT FROM jobs").fetch_one(&mut *transaction).await?;
+    let total = locked_total(&mut transaction).await?;
     if let Some(problem) = check_fit(job_bytes, total, &[(output.operation.as_str(), size)], operation, storage) {
         transaction.rollback().await?;
         return Ok(Finished::Refused(problem));
