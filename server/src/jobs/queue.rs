@@ -193,8 +193,9 @@ async fn work(runner: Arc<JobRunner>, db: Db, slots: Arc<Semaphore>) {
 /// Claims the next work for `claimant` ([`store::jobs::claim`]) with its job file read. A job
 /// whose stored file cannot be read is failed with `E_JOB_FILE`, and there is nothing to run.
 async fn claim(db: &Db, claimant: &Claimant) -> AppResult<Option<(Claimed, JobFile)>> {
-    let Some(claimed) = store::jobs::claim(db, claimant).await? else { return Ok(None) };
-    match serde_json::from_str(&claimed.job_json) {
+    let Some(mut claimed) = store::jobs::claim(db, claimant).await? else { return Ok(None) };
+    // Taken out, so a long run does not hold the file's text besides the file.
+    match serde_json::from_str(&std::mem::take(&mut claimed.job_json)) {
         Ok(job) => Ok(Some((claimed, job))),
         Err(error) => {
             let problem = Problem {
