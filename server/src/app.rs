@@ -19,9 +19,9 @@ use utoipa_swagger_ui::SwaggerUi;
 use crate::auth::{Auth, require_token};
 use crate::db::Database;
 use crate::error::AppError;
-use crate::jobs::storage::JobStorage;
 use crate::openapi::ApiDoc;
 use crate::state::{AppState, Limits};
+use crate::store::jobs::JobStorage;
 use crate::{db, http, metrics, web};
 
 /// How to run the service.
@@ -73,7 +73,7 @@ pub fn router(state: AppState) -> Router {
         .merge(metrics::routes())
         .fallback(|| async { AppError::not_found("no such resource") })
         .method_not_allowed_fallback(|| async { AppError::MethodNotAllowed })
-        .layer(axum::middleware::from_fn_with_state(state.clone(), require_token))
+        .layer(axum::middleware::from_fn_with_state(state.auth.clone(), require_token))
         .layer(DefaultBodyLimit::max(max_body))
         .layer(RequestBodyTimeoutLayer::new(state.limits.body_idle_timeout))
         .layer(axum::middleware::from_fn(metrics::track))

@@ -8,7 +8,6 @@ use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
 
 use crate::error::AppError;
-use crate::state::AppState;
 
 /// Who may call the API.
 #[derive(Debug, Clone, Default)]
@@ -42,9 +41,9 @@ impl Auth {
     }
 }
 
-/// Middleware: refuses requests that need the token and lack it with 401.
-pub async fn require_token(State(state): State<AppState>, request: Request, next: Next) -> Response {
-    let auth = &state.auth;
+/// Middleware: refuses requests that need the token and lack it with 401. It takes only the
+/// [`Auth`] (not the whole application state), so this module needs nothing above it.
+pub async fn require_token(State(auth): State<Auth>, request: Request, next: Next) -> Response {
     if auth.needs_token(request.method(), request.uri().path()) && !auth.accepts(&request) {
         return AppError::Unauthorized(
             "this request needs the API token: send Authorization: Bearer <token>".to_owned(),

@@ -11,12 +11,14 @@ use kerf_solver::capability::{
 };
 use kerf_solver::machine::MachineProfile;
 use kerf_solver::material::Material;
-use kerf_solver::tool::Tool;
+use kerf_solver::tool::{Tool, ToolRef};
 use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
 use utoipa::ToSchema;
 
-use crate::error::AppError;
+use crate::db::Db;
+use crate::error::{AppError, AppResult};
+use crate::store;
 
 /// The registry: the one list of capabilities, one entry each. It hands the list to `$callback`
 /// (a macro in scope where it is called): [`registry!`] here builds the job [`Operation`] from it,
@@ -243,6 +245,37 @@ impl Lookup for Catalog {
     fn material(&self, name: &str) -> Option<Material> {
         material_in(&self.materials, name)
     }
+}
+
+/// `catalog` completed with the tools, machines and materials `refs` name that it lacks, from the
+/// tool table, the machines registry and the materials library (those that exist; resolution
+/// reports the others).
+pub async fn catalog<'a>(
+    db: &Db,
+    refs: impl IntoIterator<Item = Refs<'a>>,
+    mut catalog: Catalog,
+) -> AppResult<Catalog> {
+    for refs in refs {
+        if let Some(ToolRef::Number(number)) = refs.tool
+            && !catalog.tools.iter().any(|tool| tool.number == Some(*number))
+            && let Some(tool) = store::tools::get(db, *number).await?
+        {
+            catalog.tools.push(tool);
+        }
+        if let Some(name) = refs.machine
+            && !catalog.machines.iter().any(|machine| machine.name.as_deref() == Some(name))
+            && let Some(machine) = store::machines::get(db, name).await?
+        {
+            catalog.machines.push(MachineProfile { name: Some(name.to_owned()), ..machine });
+        }
+        if let Some(name) = refs.material
+            && !catalog.materials.iter().any(|material| material.name.as_deref() == Some(name))
+            && let Some(material) = store::materials::get(db, name).await?
+        {
+            catalog.materials.push(material);
+        }
+    }
+    Ok(catalog)
 }
 
 /// The tool numbered `number` in `tools`.

@@ -16,8 +16,8 @@ use crate::app::Config;
 use crate::auth::Auth;
 use crate::db::{self, Database};
 use crate::jobs::queue::{DEFAULT_LEASE, JobRunner};
-use crate::jobs::storage::{self, JobStorage, MIB, mib};
 use crate::state::Limits;
+use crate::store::jobs::{self as storage, JobStorage, MIB, mib};
 
 /// kerf: CAM web service (tool-centre paths as JSON or G-code).
 #[derive(Debug, Parser)]

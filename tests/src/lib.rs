@@ -110,7 +110,7 @@ impl TestApp {
             job_workers: 2,
             job_lease: Duration::from_secs(15),
             auth: kerf_server::auth::Auth::default(),
-            job_storage: kerf_server::jobs::storage::JobStorage::default(),
+            job_storage: kerf_server::store::jobs::JobStorage::default(),
         };
         adjust(&mut config);
         let mut app = Self {

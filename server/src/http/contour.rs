@@ -15,7 +15,6 @@ use crate::capabilities::{self, Catalog};
 use crate::error::{AppResult, Problem};
 use crate::extract::{AppJson, AppQuery};
 use crate::state::AppState;
-use crate::store;
 
 /// The only answer format of the loops endpoint.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema)]
@@ -56,7 +55,7 @@ async fn post_loops(
     AppQuery(_query): AppQuery<LoopsQuery>,
     AppJson(request): AppJson<LoopsRequest>,
 ) -> AppResult<Json<LoopsAnswer>> {
-    let catalog = store::catalog(&state.db, [request.refs()], Catalog::default()).await?;
+    let catalog = capabilities::catalog(&state.db, [request.refs()], Catalog::default()).await?;
     let tool = capabilities::resolve_refs::<kerf_solver::tool::Tool>(request.refs(), &catalog)?.tool;
     let answer =
         state.solve(move |cancel| request.solve(tool, Control { progress: None, cancel: Some(cancel) })).await??;

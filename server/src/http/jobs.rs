@@ -14,11 +14,13 @@ use utoipa_axum::routes;
 
 use crate::error::{AppError, AppResult, Problem};
 use crate::extract::{AppPath, AppQuery, body_bytes, media_type, refuse_declared_over};
+use crate::http::stream::{held_download, pieces_of};
 use crate::jobs::file::{self, Format, JobFile};
 use crate::jobs::program::{self, OperationOutput};
-use crate::state::{AppState, PIECE, held_download, pieces_of};
+use crate::state::AppState;
 use crate::store;
 use crate::store::jobs::{JobRecord, JobStatus};
+use crate::store::packed::PIECE;
 
 /// The answer to a submission.
 #[derive(Debug, Serialize, ToSchema)]

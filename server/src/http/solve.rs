@@ -13,8 +13,8 @@ use super::output::Ask;
 use crate::answer_cache::{AnswerCache, CachedAnswer, Question};
 use crate::capabilities::{self, Catalog, Delivered};
 use crate::error::AppResult;
-use crate::state::{AppState, held_download, pieces_of};
-use crate::store;
+use crate::http::stream::{held_download, pieces_of};
+use crate::state::AppState;
 
 /// Answers `request` of capability `C` as `ask` says; `upload` is a file sent with it.
 ///
@@ -28,7 +28,7 @@ pub async fn answer<C: Capability>(
     ask: Ask,
 ) -> AppResult<Response> {
     let catalog =
-        store::catalog(&state.db, capability::all_refs::<C>(&request), capabilities::Catalog::default()).await?;
+        capabilities::catalog(&state.db, capability::all_refs::<C>(&request), capabilities::Catalog::default()).await?;
     let resolved = capabilities::resolve::<C>(&request, &catalog)?;
     if ask.gcode {
         C::check_output(&request, &ask.output)?;

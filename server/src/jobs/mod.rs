@@ -6,5 +6,5 @@ pub mod file;
 pub mod local;
 pub mod parts;
 pub mod program;
+pub mod pruner;
 pub mod queue;
-pub mod storage;

@@ -14,17 +14,19 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
+use kerf_solver::ErrorCode;
 use sqlx::PgPool;
 use sqlx::postgres::PgListener;
 use tokio::sync::{Notify, Semaphore};
 
 use super::execute::{JobFailure, execute, execute_finish, execute_operation, execute_part, plan};
 use super::file::JobFile;
-use super::storage::JobStorage;
 use crate::db::Db;
-use crate::error::{AppError, AppResult};
+use crate::error::{AppError, AppResult, Problem};
 use crate::store;
-use crate::store::jobs::{CANCEL_CHANNEL, Claimant, Claimed, Finished, PartOutput, SUBMITTED_CHANNEL, Task, Work};
+use crate::store::jobs::{
+    CANCEL_CHANNEL, Claimant, Claimed, Finished, JobStorage, PartOutput, SUBMITTED_CHANNEL, Task, Work,
+};
 use crate::store::packed::{Packed, gzip};
 
 /// How often a running job's progress and heartbeat are written.
@@ -116,7 +118,7 @@ impl JobRunner {
         if requeued + failed > 0 {
             tracing::warn!(requeued, failed, "jobs interrupted by the last stop");
         }
-        super::storage::start_pruner(db.clone(), self.storage);
+        super::pruner::start_pruner(db.clone(), self.storage);
         if workers == 0 {
             if !db.is_postgres() {
                 tracing::warn!("no job workers: submitted jobs wait until a server with workers starts");
@@ -172,10 +174,10 @@ async fn listen(runner: Arc<JobRunner>, pool: PgPool) {
 
 async fn work(runner: Arc<JobRunner>, db: Db, slots: Arc<Semaphore>) {
     loop {
-        match store::jobs::claim(&db, &runner.claimant).await {
-            Ok(Some(claimed)) => {
+        match claim(&db, &runner.claimant).await {
+            Ok(Some((claimed, job))) => {
                 crate::metrics::chunk_claimed();
-                run(&runner, &db, &slots, claimed).await;
+                run(&runner, &db, &slots, claimed, job).await;
             }
             Ok(None) => {
                 let _ = tokio::time::timeout(IDLE_POLL, runner.submitted.notified()).await;
@@ -188,13 +190,41 @@ async fn work(runner: Arc<JobRunner>, db: Db, slots: Arc<Semaphore>) {
     }
 }
 
+/// Claims the next work for `claimant` ([`store::jobs::claim`]) with its job file read. A job
+/// whose stored file cannot be read is failed with `E_JOB_FILE`, and there is nothing to run.
+async fn claim(db: &Db, claimant: &Claimant) -> AppResult<Option<(Claimed, JobFile)>> {
+    let Some(mut claimed) = store::jobs::claim(db, claimant).await? else { return Ok(None) };
+    // Taken out, so a long run does not hold the file's text besides the file.
+    match serde_json::from_str(&std::mem::take(&mut claimed.job_json)) {
+        Ok(job) => Ok(Some((claimed, job))),
+        Err(error) => {
+            let problem = Problem {
+                kind: "about:blank".to_owned(),
+                title: "Job failed".to_owned(),
+                status: 422,
+                detail: format!("the stored job is unreadable: {error}"),
+                code: ErrorCode::JobFile,
+                errors: Vec::new(),
+            };
+            store::jobs::fail(db, claimed.work, claimant, &problem).await?;
+            Ok(None)
+        }
+    }
+}
+
 /// What a chunk computed: an operation's (or a whole job's) results, or a part's output.
 enum Output {
     Results(Vec<Packed>),
     Part(PartOutput),
 }
 
-async fn run(runner: &JobRunner, db: &Db, slots: &Arc<Semaphore>, Claimed { work, task, job, attempt }: Claimed) {
+async fn run(
+    runner: &JobRunner,
+    db: &Db,
+    slots: &Arc<Semaphore>,
+    Claimed { work, task, attempt, .. }: Claimed,
+    job: JobFile,
+) {
     let claimant = &runner.claimant;
     let id = work.id;
     tracing::info!(id, chunk = ?work.chunk, ?task, attempt, worker = %claimant.worker, "claimed");
@@ -229,7 +259,19 @@ async fn run(runner: &JobRunner, db: &Db, slots: &Arc<Semaphore>, Claimed { work
         let packed = |outputs: Vec<crate::capabilities::Stored>| {
             // Compressed here, on the blocking thread and in the solver slot, not on the async
             // threads.
-            Output::Results(outputs.iter().map(Packed::new).collect())
+            Output::Results(
+                outputs
+                    .iter()
+                    .map(|stored| {
+                        Packed::new(
+                            &stored.operation,
+                            stored.result.get(),
+                            stored.gcode.as_deref(),
+                            stored.gcode_problem.as_deref(),
+                        )
+                    })
+                    .collect(),
+            )
         };
         Ok::<_, JobFailure>(match computed {
             Task::Job => packed(execute(&job, &report, &task_cancelled)?),

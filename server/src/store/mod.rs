@@ -10,11 +10,6 @@ pub mod outputs;
 pub mod packed;
 pub mod tools;
 
-use kerf_solver::capability::Refs;
-use kerf_solver::machine::MachineProfile;
-use kerf_solver::tool::ToolRef;
-
-use crate::capabilities::Catalog;
 use crate::db::Db;
 use crate::error::AppResult;
 
@@ -46,37 +41,6 @@ macro_rules! on {
     };
 }
 pub(crate) use on;
-
-/// `catalog` completed with the tools, machines and materials `refs` name that it lacks, from the
-/// tool table, the machines registry and the materials library (those that exist; resolution
-/// reports the others).
-pub async fn catalog<'a>(
-    db: &Db,
-    refs: impl IntoIterator<Item = Refs<'a>>,
-    mut catalog: Catalog,
-) -> AppResult<Catalog> {
-    for refs in refs {
-        if let Some(ToolRef::Number(number)) = refs.tool
-            && !catalog.tools.iter().any(|tool| tool.number == Some(*number))
-            && let Some(tool) = tools::get(db, *number).await?
-        {
-            catalog.tools.push(tool);
-        }
-        if let Some(name) = refs.machine
-            && !catalog.machines.iter().any(|machine| machine.name.as_deref() == Some(name))
-            && let Some(machine) = machines::get(db, name).await?
-        {
-            catalog.machines.push(MachineProfile { name: Some(name.to_owned()), ..machine });
-        }
-        if let Some(name) = refs.material
-            && !catalog.materials.iter().any(|material| material.name.as_deref() == Some(name))
-            && let Some(material) = materials::get(db, name).await?
-        {
-            catalog.materials.push(material);
-        }
-    }
-    Ok(catalog)
-}
 
 /// Whether the database's schema has `table`: a database an older kerf left may lack a library
 /// (`machines` came with migration 0003, `materials` with 0006) until it is migrated.

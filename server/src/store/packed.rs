@@ -9,9 +9,11 @@ use flate2::Compression;
 use flate2::read::GzDecoder;
 use flate2::write::GzEncoder;
 
-use crate::capabilities::Stored;
 use crate::error::{AppError, AppResult};
-use crate::state::PIECE;
+
+/// Bytes of a body handed to the connection at a time; a stored text is read back in pieces of
+/// this size ([`StoredText::pieces`]), so the two match.
+pub const PIECE: usize = 64 * 1024;
 
 /// One operation's output, compressed for storage.
 #[derive(Debug, Clone)]
@@ -31,16 +33,16 @@ pub struct Packed {
 }
 
 impl Packed {
-    /// `stored` compressed (CPU work: call it on a blocking thread).
-    pub fn new(stored: &Stored) -> Self {
-        let result = stored.result.get();
+    /// Operation `operation`'s `result` JSON and `gcode` program (or the `gcode_problem` why it
+    /// has none) compressed (CPU work: call it on a blocking thread).
+    pub fn new(operation: &str, result: &str, gcode: Option<&str>, gcode_problem: Option<&str>) -> Self {
         Self {
-            operation: stored.operation.clone(),
+            operation: operation.to_owned(),
             result_gz: gzip(result.as_bytes()),
             result_bytes: result.len(),
-            gcode_gz: stored.gcode.as_deref().map(|program| gzip(program.as_bytes())),
-            gcode_bytes: stored.gcode.as_ref().map_or(0, String::len),
-            gcode_problem: stored.gcode_problem.clone(),
+            gcode_gz: gcode.map(|program| gzip(program.as_bytes())),
+            gcode_bytes: gcode.map_or(0, str::len),
+            gcode_problem: gcode_problem.map(str::to_owned),
         }
     }
 

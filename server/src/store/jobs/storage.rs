@@ -1,11 +1,10 @@
-//! Bounds on the job store: the total quota, the per-job cap, retention, and the pruner
-//! task that removes finished jobs past their retention (in `kerf serve`, and in `kerf worker` on
-//! PostgreSQL: one process at a time prunes, the others skip).
+//! Bounds on the job store (the total quota, the per-job cap, retention) and what it holds now.
 
 use std::time::Duration;
 
 use crate::db::Db;
-use crate::store;
+use crate::error::AppResult;
+use crate::store::on;
 
 /// One mebibyte.
 pub const MIB: u64 = 1024 * 1024;
@@ -51,24 +50,10 @@ pub fn mib(bytes: u64) -> String {
     format!("{:.1} MiB", bytes as f64 / MIB as f64)
 }
 
-/// Starts the pruner: every `storage.prune_every` (and at once) it removes the finished jobs older
-/// than the retention. Does nothing when jobs are kept forever.
-pub fn start_pruner(db: Db, storage: JobStorage) {
-    let Some(retention) = storage.retention else { return };
-    tokio::spawn(async move {
-        let mut ticker = tokio::time::interval(storage.prune_every.max(Duration::from_millis(10)));
-        loop {
-            ticker.tick().await;
-            match store::jobs::prune(&db, retention).await {
-                Ok(Some(pruned)) if !pruned.ids.is_empty() => tracing::info!(
-                    jobs = pruned.ids.len(),
-                    bytes = pruned.bytes,
-                    retention_days = retention.as_secs_f64() / 86_400.0,
-                    "pruned finished jobs past their retention"
-                ),
-                Ok(_) => {}
-                Err(error) => tracing::warn!(%error, "pruning old jobs failed; trying again later"),
-            }
-        }
-    });
+/// Jobs stored and the bytes they take (job files and compressed results).
+pub async fn usage(db: &Db) -> AppResult<(i64, i64)> {
+    Ok(on!(db, query_as,
+        sqlite: "SELECT COUNT(*), COALESCE(SUM(stored_bytes), 0) FROM jobs",
+        postgres: "SELECT COUNT(*), COALESCE(SUM(stored_bytes), 0)::BIGINT FROM jobs",
+        [], fetch_one)?)
 }
