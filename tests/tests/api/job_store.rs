@@ -11,8 +11,8 @@ use kerf_server::store;
 use kerf_tests::{Store, TestApp, finished, json_with, poll_job, problem};
 use serde_json::{Value, json};
 
-use crate::contour::circle;
 use crate::jobs::long_job;
+use kerf_cases::contour::circle;
 
 fn program() -> PathBuf {
     PathBuf::from(env!("CARGO_BIN_EXE_kerf-under-test"))
@@ -28,9 +28,7 @@ fn segment_job(name: &str) -> Value {
 
 /// A quick deburr job.
 fn quick_job(name: &str) -> Value {
-    json!({"name": name, "operations": [{"operation": "deburr", "tool": {"kind": "ball", "radius": 3},
-        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
-        "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5}]})
+    json!({"name": name, "operations": [kerf_cases::operation("deburr", kerf_cases::deburr::case_1())]})
 }
 
 async fn submit(app: &TestApp, job: &Value) -> reqwest::Response {

@@ -39,12 +39,7 @@ async fn upload_raw(app: &TestApp, body: String, media_type: &str) -> reqwest::R
 
 /// A job whose operations take a while: exact-width deburring at a tiny tolerance.
 pub fn long_job(operations: usize) -> Value {
-    let operation = json!({
-        "operation": "deburr", "tool": {"kind": "ball", "radius": 3, "number": 7},
-        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
-        "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5,
-        "tolerance": 2e-6, "method": "exact"
-    });
+    let operation = kerf_cases::operation("deburr", kerf_cases::deburr::long_request());
     json!({"name": "long", "operations": vec![operation; operations]})
 }
 
@@ -241,9 +236,7 @@ async fn cancel_paging_and_conflicts(store: Store) {
     assert_eq!(cancelled["status"], "cancelled");
     // The worker lets go: a small job submitted now runs (on PostgreSQL behind the other long
     // job's remaining chunks, which the freed worker takes first).
-    let small = json!({"name": "small", "operations": [{"operation": "deburr", "tool": {"kind": "ball", "radius": 3},
-        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
-        "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5}]});
+    let small = json!({"name": "small", "operations": [kerf_cases::operation("deburr", kerf_cases::deburr::case_1())]});
     let small_id =
         json_with(upload_raw(&app, small.to_string(), "application/json").await, 202).await["id"].as_i64().unwrap();
     let small_job = poll_job(&app.client, &app.base, small_id, 30, finished).await;
