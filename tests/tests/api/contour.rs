@@ -243,9 +243,7 @@ async fn json_answers_are_limited_and_gcode_goes_further() {
     let detail = refused["detail"].as_str().unwrap();
     assert!(detail.contains("500000") && detail.contains("G-code") && detail.contains("job"), "{detail}");
 
-    let response = app.client.post(app.url("/api/v1/contour?format=gcode")).json(&body).send().await.unwrap();
-    assert_eq!(response.status(), 200);
-    let program = response.text().await.unwrap();
+    let program = app.post_text("/api/v1/contour?format=gcode", &body, 200).await;
     let blocks = program.lines().filter(|l| l.starts_with("G01") || l.starts_with("G00")).count();
     assert!(blocks > 500_000, "{blocks} blocks");
     assert!(program.ends_with("M30\n%\n"));
@@ -723,9 +721,7 @@ async fn a_named_machine_gives_the_block_time_and_dialect() {
     let overridden = json_with(app.post_json("/api/v1/contour", &body).await, 200).await;
     assert_eq!(overridden["summary"]["blocks"]["block_time_ms"], 10.0);
 
-    let response = app.client.post(app.url("/api/v1/contour?format=gcode")).json(&body).send().await.unwrap();
-    assert_eq!(response.status(), 200);
-    let program = response.text().await.unwrap();
+    let program = app.post_text("/api/v1/contour?format=gcode", &body, 200).await;
     assert!(!program.starts_with('%') && program.contains("G64"), "linuxcnc from the machine:\n{program}");
 
     let mut operation = body.clone();

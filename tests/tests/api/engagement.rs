@@ -416,9 +416,7 @@ async fn a_named_machine_caps_the_feed_plan_and_sets_the_dialect() {
     assert!(!feeds.is_empty() && feeds.iter().all(|&feed| feed <= 900.0 + 1e-9), "{feeds:?}");
 
     body["axial_depth"] = json!(2);
-    let response = app.client.post(app.url(&format!("{URL}?format=gcode"))).json(&body).send().await.unwrap();
-    assert_eq!(response.status(), 200);
-    let program = response.text().await.unwrap();
+    let program = app.post_text(&format!("{URL}?format=gcode"), &body, 200).await;
     assert!(!program.starts_with('%') && program.contains("G64"), "linuxcnc from the machine:\n{program}");
 
     body["feed_plan"]["max_feed"] = json!(5000);
@@ -435,9 +433,7 @@ async fn the_program_turns_the_spindle_as_analysed() {
     body["axial_depth"] = json!(2);
     for (direction, code, other) in [("cw", "S3000 M03", "M04"), ("ccw", "S3000 M04", "M03")] {
         body["spindle_direction"] = json!(direction);
-        let response = app.client.post(app.url(&format!("{URL}?format=gcode"))).json(&body).send().await.unwrap();
-        assert_eq!(response.status(), 200);
-        let program = response.text().await.unwrap();
+        let program = app.post_text(&format!("{URL}?format=gcode"), &body, 200).await;
         assert!(program.contains(code) && !program.contains(other), "{direction}:\n{program}");
     }
 }

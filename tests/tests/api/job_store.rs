@@ -298,9 +298,8 @@ async fn results_stored_before_compression_are_still_served() {
     let shown = json_with(app.get(&format!("/api/v1/jobs/{id}")).await, 200).await;
     assert_eq!(shown["results"][0]["result"], json!({"points": [[1.5, 2.5, 3.5]]}), "{shown}");
     assert_eq!(shown["results"][0]["gcode"], true);
-    let program = app.get(&format!("/api/v1/jobs/{id}/gcode")).await;
-    assert_eq!(program.status(), 200);
-    assert_eq!(program.text().await.unwrap(), "%\nO1000\nG00 X1.5000\nM30\n%\n");
+    let program = app.get_text(&format!("/api/v1/jobs/{id}/gcode"), 200).await;
+    assert_eq!(program, "%\nO1000\nG00 X1.5000\nM30\n%\n");
     // And it is pruned like any other finished job.
     let output = prune_command(&app, &["--older-than-days", "30"]);
     assert!(output.contains(&format!("removed 1 finished job(s) older than 30 day(s) (ids {id})")), "{output}");

@@ -72,9 +72,8 @@ async fn example_jobs_run_to_the_end(store: Store) {
             assert!(result["operation"].is_string());
             assert!(result["result"].as_object().is_some_and(|o| !o.is_empty()), "{result}");
             assert_eq!(result["gcode"], true, "{result}");
-            let program = app.get(&format!("/api/v1/jobs/{id}/gcode?operation={index}")).await;
-            assert_eq!(program.status(), 200);
-            assert!(program.text().await.unwrap().contains("M30"));
+            let program = app.get_text(&format!("/api/v1/jobs/{id}/gcode?operation={index}"), 200).await;
+            assert!(program.contains("M30"));
         }
         if operations > 1 {
             let answer = problem(app.get(&format!("/api/v1/jobs/{id}/gcode")).await, 422).await;
@@ -348,9 +347,7 @@ async fn jobs_answer_as_the_endpoints_do(store: Store) {
     let stored = raw_results(&job_text);
 
     for (index, (name, request)) in [("deburr", &deburr), ("engagement", &engagement)].into_iter().enumerate() {
-        let answer = app.post_json(&format!("/api/v1/{name}"), request).await;
-        assert_eq!(answer.status(), 200);
-        let answer = answer.text().await.unwrap();
+        let answer = app.post_text(&format!("/api/v1/{name}"), request, 200).await;
         assert_eq!(stored[index], answer, "{name}: the stored result is the endpoint's answer byte for byte");
         let direct = app
             .client

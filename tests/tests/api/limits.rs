@@ -313,9 +313,7 @@ async fn slow_readers_of_large_job_programs_hold_a_bounded_budget() {
     let first = unread.text().await.unwrap();
     assert_eq!(first.len(), length);
     assert!(first.trim_end().ends_with('%') && first.contains("M30"), "a whole program");
-    let again = app.get(&program).await;
-    assert_eq!(again.status(), 200);
-    assert_eq!(again.text().await.unwrap(), first);
+    assert_eq!(app.get_text(&program, 200).await, first);
     json_with(app.get(&format!("/api/v1/jobs/{id}")).await, 200).await;
 }
 
