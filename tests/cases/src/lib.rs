@@ -32,7 +32,7 @@ pub fn operation(name: &str, request: Value) -> Value {
     with(serde_json::json!({"operation": name}), request)
 }
 
-/// The fixture `name` (`deburr`, `chord`, `corners`, `engagement`, `error-prediction`).
+/// The fixture `name` (`deburr`, `segment`, `contour`, `engagement`, `predict`).
 ///
 /// # Panics
 /// When the file is missing or not JSON: a broken fixture is a broken test.
