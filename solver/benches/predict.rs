@@ -1,7 +1,7 @@
 //! Benchmarks for solver::predict: passes per second per core and on both cores for a realistic
 //! finishing program, as a ratio against the patent's 0.070 s per pass (patent Fig. 21).
 //!
-//! The program (tests/predict_support): a ball end mill Ø10 finishing a double-wave surface
+//! The program (kerf_cases::predict): a ball end mill Ø10 finishing a double-wave surface
 //! (slopes up to 26°) by a zig-zag raster, pick 0.5 mm, 0.5 mm segments, 103 041 feed passes,
 //! f_t = 0.1 mm at 6000 rpm, force model with modal stiffness; stock = surface + 0.2 mm as a
 //! height grid. Resolution N = 256 gives the patent's pixel size 0.039 mm; N = 512 is twice as fine.
@@ -24,8 +24,7 @@ use std::time::Instant;
 use criterion::{Criterion, criterion_group, criterion_main};
 use kerf_solver::predict::{self, Method};
 
-#[path = "../tests/predict/support.rs"]
-mod support;
+use kerf_cases::predict as support;
 
 /// The patent's time per pass (patent Fig. 21, GPU, 2009).
 const SEED_SECONDS_PER_PASS: f64 = 0.070;

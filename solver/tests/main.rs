@@ -10,4 +10,3 @@ mod predict;
 mod progress;
 mod segment;
 mod split_parts;
-mod split_support;

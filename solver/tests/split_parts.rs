@@ -2,9 +2,10 @@
 //! apart, passing their outputs through JSON as the job store does, and finishing gives the
 //! answer and program of solving the request whole, byte for byte.
 
-use crate::predict::support;
-use crate::split_support;
-
+use kerf_cases::predict;
+use kerf_cases::split::{
+    Texts, context, contour_context, contour_request, deburr_context, deburr_request, engagement_request,
+};
 use kerf_solver::capability::{self, Capability, OutputOptions, Part, Purpose, Resolved, Run, Sizing, Split};
 use kerf_solver::contour::ContourCapability;
 use kerf_solver::deburr::DeburrCapability;
@@ -13,9 +14,6 @@ use kerf_solver::predict::{CorrectionOptions, Method, PredictCapability, Predict
 use kerf_solver::tool::Tool;
 use proptest::prelude::*;
 use serde_json::json;
-use split_support::{
-    Texts, context, contour_context, contour_request, deburr_context, deburr_request, engagement_request,
-};
 
 /// Splits into parts of `part_seconds`, solves them apart and finishes: the answer's JSON and
 /// program, and how many parts there were.
@@ -41,7 +39,7 @@ fn whole(request: &PredictRequest, tool: &Tool) -> (String, String) {
 fn a_prediction_split_into_parts_is_the_whole_prediction() {
     // 21 × 21 passes over a 10 mm square: every part boundary falls inside a raster line, where
     // the corrections need the errors on both sides.
-    let (request, tool, moves) = support::raster_request(10.0, 0.5, 0.5, Method::Sampling, 48);
+    let (request, tool, moves) = predict::raster_request(10.0, 0.5, 0.5, Method::Sampling, 48);
     let (json, program) = whole(&request, &tool);
     for part_seconds in [1e-3, 0.02, 0.05] {
         let (split_json, split_program, parts) =
@@ -54,7 +52,7 @@ fn a_prediction_split_into_parts_is_the_whole_prediction() {
 
 #[test]
 fn a_range_of_passes_splits_within_it() {
-    let (mut request, tool, _) = support::raster_request(10.0, 0.5, 0.5, Method::DepthBuffer, 32);
+    let (mut request, tool, _) = predict::raster_request(10.0, 0.5, 0.5, Method::DepthBuffer, 32);
     request.pass_range = Some([100, 300]);
     request.exclusion_deg = Some(5.0);
     let (json, program) = whole(&request, &tool);
@@ -65,7 +63,7 @@ fn a_range_of_passes_splits_within_it() {
 
 #[test]
 fn what_is_not_split() {
-    let (mut request, tool, _) = support::raster_request(10.0, 0.5, 0.5, Method::Sampling, 48);
+    let (mut request, tool, _) = predict::raster_request(10.0, 0.5, 0.5, Method::Sampling, 48);
     // Large parts: one would do.
     assert!(split_and_finish(&request, &tool, 1e6).is_none());
     // A second round predicts the path the first corrected: not split.

@@ -12,11 +12,10 @@
 //! sampling, N = 256, 4 passes per mm²), so figures measured in a debug build can be scaled to a
 //! release build's: the contour and deburr constants were measured that way.
 
-#[path = "../../solver/tests/split_support.rs"]
-mod split_support;
-#[path = "../../solver/tests/predict/support.rs"]
-mod support;
-
+use kerf_cases::predict as support;
+use kerf_cases::split::{
+    Texts, context, contour_context, contour_request, deburr_context, deburr_request, engagement_request,
+};
 use kerf_solver::capability::{self, Capability, OutputOptions, Part, Purpose, Resolved, Run, Sizing};
 use kerf_solver::contour::ContourCapability;
 use kerf_solver::deburr::DeburrCapability;
@@ -24,9 +23,6 @@ use kerf_solver::engagement::EngagementCapability;
 use kerf_solver::predict::{Method, PredictCapability, PredictRequest};
 use kerf_solver::tool::Tool;
 use serde_json::json;
-use split_support::{
-    Texts, context, contour_context, contour_request, deburr_context, deburr_request, engagement_request,
-};
 
 /// Process CPU time (user + system) in seconds, from /proc (0 where unavailable).
 fn cpu_seconds() -> f64 {

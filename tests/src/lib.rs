@@ -179,6 +179,16 @@ impl TestApp {
         self.client.put(self.url(path)).json(body).send().await.expect("request")
     }
 
+    /// GET a text answer (G-code, HTML, a script), asserting its status first.
+    pub async fn get_text(&self, path: &str, status: u16) -> String {
+        text_with(path, self.get(path).await, status).await
+    }
+
+    /// POST a JSON value for a text answer (`?format=gcode`), asserting its status first.
+    pub async fn post_text(&self, path: &str, body: &Value, status: u16) -> String {
+        text_with(path, self.post_json(path, body).await, status).await
+    }
+
     /// DELETE.
     pub async fn delete(&self, path: &str) -> Response {
         self.client.delete(self.url(path)).send().await.expect("request")
@@ -189,6 +199,15 @@ impl TestApp {
         let response = self.put_json(&format!("/api/v1/tools/{number}"), tool).await;
         assert!(response.status().is_success(), "registering tool {number}: {}", response.status());
     }
+}
+
+/// Reads the body of the answer to `path` as text, asserting the status first: the path and the
+/// body are in the message when it differs.
+async fn text_with(path: &str, response: Response, status: u16) -> String {
+    let actual = response.status().as_u16();
+    let text = response.text().await.expect("body");
+    assert_eq!(actual, status, "{path}: unexpected status; body: {text}");
+    text
 }
 
 /// Reads the body as JSON, asserting the status first.

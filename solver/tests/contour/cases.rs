@@ -29,54 +29,10 @@ fn close_point(what: &str, got: Vec2, expected: &Value) {
     assert!((got - expected).norm() <= TOLERANCE * 1.5, "{what}: got {got:?}, expected {expected:?}");
 }
 
-/// The API request for a case: an inline flat tool, one layer at z = 0, conventional milling
-/// (σ = +1, the cases' convention), the loop style of the case's loop passes.
+/// The API request for a case ([`kerf_cases::contour::reference_request`]) and its flat tool.
 fn request(case: &Value) -> (ContourRequest, Tool) {
-    let inputs = &case["inputs"];
-    let radius = number(&inputs["tool_radius"]);
-    let mut corner_loop = json!({"max_angle_deg": 180.0 - number(&inputs["phi_min_deg"])});
-    let passes: Vec<Value> = inputs["passes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|pass| match pass["join"].as_str().unwrap() {
-            "loop_arc" => {
-                corner_loop["style"] = json!("arc");
-                corner_loop["radius"] = pass["rho"].clone();
-                json!({"allowance": pass["delta"], "loop": true})
-            }
-            "loop_par" => {
-                corner_loop["style"] = json!("parallelogram");
-                corner_loop["leg"] = pass["L"].clone();
-                json!({"allowance": pass["delta"], "loop": true})
-            }
-            "round" => json!({"allowance": pass["delta"], "loop": false, "join": "round"}),
-            other => panic!("unknown join {other}"),
-        })
-        .collect();
-    // The fixture rounds its inputs to 1e-6; where the spec gives a vertex exactly (C2's
-    // (18 + √3, 1 + 6√3)), use the exact value so derived angles match to 1e-6 degrees too.
-    let exact = [18.0 + 3f64.sqrt(), 1.0 + 6.0 * 3f64.sqrt()];
-    let contour: Vec<[f64; 2]> = inputs["contour"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|p| {
-            let p = [number(&p[0]), number(&p[1])];
-            if (p[0] - exact[0]).abs() < 1e-6 && (p[1] - exact[1]).abs() < 1e-6 { exact } else { p }
-        })
-        .collect();
-    let body = json!({
-        "tool": {"kind": "flat", "radius": radius},
-        "contour": contour,
-        "side": "outside",
-        "direction": "conventional",
-        "depths": {"top": 1.0, "bottom": 0.0, "step": 1.0},
-        "corner_loop": corner_loop,
-        "passes": passes,
-        "feed": 800,
-    });
-    (serde_json::from_value(body).unwrap(), Tool::new(ToolKind::Flat, radius))
+    let radius = number(&case["inputs"]["tool_radius"]);
+    (serde_json::from_value(kerf_cases::contour::reference_request(case)).unwrap(), Tool::new(ToolKind::Flat, radius))
 }
 
 fn plan_of(case: &Value) -> Plan {

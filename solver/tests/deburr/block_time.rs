@@ -67,11 +67,7 @@ fn smallest_radius(result: &Deburr) -> f64 {
 
 #[test]
 fn without_a_block_time_nothing_changes() {
-    let body = json!({
-        "tool": {"kind": "ball", "radius": 3},
-        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
-        "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5, "tolerance": 0.01
-    });
+    let body = kerf_cases::with(kerf_cases::deburr::case_1(), json!({"tolerance": 0.01}));
     let plain = deburr::solve(&request(body.clone()), &ball(3.0)).unwrap();
     assert_eq!(plain.summary.count, 92, "reference case 1");
     assert_eq!(deburr::solve_with(&request(body), &ball(3.0), None).unwrap(), plain);

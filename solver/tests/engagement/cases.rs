@@ -17,36 +17,11 @@ fn tool(diameter: f64) -> Tool {
     Tool::new(ToolKind::Flat, diameter / 2.0)
 }
 
-/// Builds the API request from a fixture input block (stock and path pass through unchanged).
+/// The API request for a fixture input block ([`kerf_cases::engagement::fixture_request`]; the
+/// tool is passed to the solver apart).
 fn request(stock: &Value, path: &Value, cutting: &Value, flutes: &Value, extra: Value) -> EngagementRequest {
-    let polygons: Vec<Value> = stock["polygons"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|p| {
-            let mut p = p.clone();
-            if p["holes"].as_array().is_some_and(Vec::is_empty) {
-                p.as_object_mut().unwrap().remove("holes");
-            }
-            p
-        })
-        .collect();
-    let mut body = json!({
-        "tool": {"kind": "flat", "radius": 1.0},
-        "stock": {"polygons": polygons},
-        "path": path,
-        "spindle_rpm": cutting["spindle_rpm"],
-        "flute_counts": flutes,
-    });
-    if cutting["feed_mode"] == "constant_vf" {
-        body["feed"] = cutting["vf_mm_per_min"].clone();
-    } else {
-        body["feed_per_tooth"] = cutting["fz"].clone();
-    }
-    for (key, value) in extra.as_object().unwrap() {
-        body[key] = value.clone();
-    }
-    serde_json::from_value(body).unwrap()
+    let body = kerf_cases::engagement::fixture_request(stock, path, cutting, flutes, 1.0);
+    serde_json::from_value(kerf_cases::with(body, extra)).unwrap()
 }
 
 fn single(answer: EngagementSolution) -> PathEngagement {

@@ -1,15 +1,13 @@
 //! Bad inputs get a clear error naming the field (and the line for G-code), never a panic; long
 //! runs report progress and can be cancelled; other stock forms give the same answers.
 
-use super::support;
-
 use std::sync::Mutex;
 use std::sync::atomic::AtomicBool;
 
+use kerf_cases::predict::{bare_request, finishing_tool, inclined_case};
 use kerf_solver::SolverError;
 use kerf_solver::predict::{self, Control, Method, PassStatus, PathInput, PredictRequest, Stock};
 use kerf_solver::tool::{Tool, ToolKind};
-use support::{bare_request, finishing_tool, inclined_case};
 
 fn flat_case() -> (PredictRequest, Tool) {
     // Four raster passes over a flat block, ball R = 3, from a small program.

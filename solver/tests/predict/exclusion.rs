@@ -5,11 +5,9 @@
 //! the stock top (θ_max = asin(√(3² − 2.9²)/3) = 14.8°); the pixel of the global view (R/32)
 //! blurs each by at most one pixel.
 
-use super::support;
-
+use kerf_cases::predict::{bare_request, finishing_tool};
 use kerf_solver::predict::{self, PassStatus, PathInput, PredictRequest, Stock};
 use kerf_solver::tool::Tool;
-use support::{bare_request, finishing_tool};
 
 fn flat_case(exclusion: Option<f64>) -> (PredictRequest, Tool) {
     let tool = finishing_tool(3.0);

@@ -3,11 +3,9 @@
 //! than the reference tolerance; the depth buffer and the surface sampling agree within 0.2° up
 //! to 85°; the answer does not depend on the thread count.
 
-use super::support;
-
+use kerf_cases::predict::{PATENT, inclined_case, inclined_case_with};
 use kerf_solver::predict::{self, Method, PredictedPass};
 use proptest::prelude::*;
-use support::{PATENT, inclined_case, inclined_case_with};
 
 fn middle(request: &kerf_solver::predict::PredictRequest, tool: &kerf_solver::tool::Tool) -> PredictedPass {
     let answer = predict::solve(request, tool, None).unwrap();
@@ -49,7 +47,7 @@ proptest! {
     #[test]
     fn doubling_the_resolution_moves_the_contact_angle_little(slope in 5.0f64..85.0, uphill in 0.0f64..360.0) {
         for (conditions, method, tolerance) in [
-            (support::FINE, Method::Sampling, 0.02),
+            (kerf_cases::predict::FINE, Method::Sampling, 0.02),
             (PATENT, Method::DepthBuffer, 0.15),
         ] {
             let (mut request, tool) = inclined_case_with(conditions, slope, uphill, 0.0, [0.0; 3], method);

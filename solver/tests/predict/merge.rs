@@ -3,12 +3,10 @@
 //! merged pass's error differs from simulating it by at most its reported `merge_bound`, the
 //! simulated passes are unchanged, and a long uniform program simulates far fewer passes.
 
-use super::support;
-
+use kerf_cases::predict::{bare_request, finishing_tool};
 use kerf_solver::predict::{self, CuttingCoefficients, PathInput, Predict, PredictRequest, Stock};
 use kerf_solver::tool::Tool;
 use proptest::prelude::*;
-use support::{bare_request, finishing_tool};
 
 /// A zig-zag raster of ball centres: `lines` lines of `steps` segments of `step` mm along the
 /// plane's level direction, `pick` apart up the slope; coordinates rounded to `decimals` as a

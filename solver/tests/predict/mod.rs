@@ -7,4 +7,3 @@ mod invariance;
 mod merge;
 mod program;
 mod properties;
-pub mod support;

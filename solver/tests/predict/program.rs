@@ -2,8 +2,7 @@
 //! comments and modal words and only coordinates changed (arcs still close); a path of points
 //! becomes a complete program; iterations and the clamp behave (docs/spec/predict.md §3.14, §8).
 
-use super::support;
-
+use kerf_cases::predict::{bare_request, finishing_tool};
 use kerf_solver::gcode::reader::{self, ReadOptions};
 use kerf_solver::gcode::{Dialect, Reference, SpindleDirection, ToolCall};
 use kerf_solver::predict::{
@@ -11,7 +10,6 @@ use kerf_solver::predict::{
     Stock,
 };
 use kerf_solver::tool::Tool;
-use support::{bare_request, finishing_tool};
 
 const PROGRAM: &str = "%\nO0002 (CORRECT ME)\nN10 G21 G90 G17 G94\nN20 T1 M06\nN30 S8000 M03\n\
 N40 G0 X-8 Y-0.8 Z20\nN50 G1 Z0 F1600 ; plunge outside the block\nN60 X28\nN70 Y-0.4\nN80 X-8\n\

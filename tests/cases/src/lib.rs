@@ -1,10 +1,38 @@
-//! Test support, shared by the solver's case tests and the loopback tests: the reference cases of
-//! `../shared/cases` (copied to `solver/tests/fixtures/`) and the few helpers every test reads
-//! them with, so no test file keeps its own copy.
+//! Test support, shared by the solver's tests, the loopback tests, the benches and the cost
+//! model: the reference cases of `../shared/cases` (copied to `solver/tests/fixtures/`), the few
+//! helpers every test reads them with, and the requests the tests build, one builder per request
+//! shape (a module per capability), so no test file keeps its own copy.
+//!
+//! The JSON builders return the body as the API takes it; a solver test parses the same body
+//! into the request type (`serde_json::from_value`), so both kinds of test solve the same request.
 
 use serde_json::Value;
 
-/// The fixture `name` (`deburr`, `chord`, `corners`, `engagement`, `error-prediction`).
+pub mod contour;
+pub mod deburr;
+pub mod engagement;
+pub mod predict;
+pub mod split;
+
+/// `body` with the top-level fields of `extra` set (added or replaced).
+///
+/// # Panics
+/// When `extra` is not an object.
+#[must_use]
+pub fn with(mut body: Value, extra: Value) -> Value {
+    for (key, value) in extra.as_object().expect("extra fields are an object") {
+        body[key] = value.clone();
+    }
+    body
+}
+
+/// `request` as operation `name` of a job file (`{"operation": name, ...request}`).
+#[must_use]
+pub fn operation(name: &str, request: Value) -> Value {
+    with(serde_json::json!({"operation": name}), request)
+}
+
+/// The fixture `name` (`deburr`, `segment`, `contour`, `engagement`, `predict`).
 ///
 /// # Panics
 /// When the file is missing or not JSON: a broken fixture is a broken test.

@@ -8,8 +8,7 @@ use reqwest::Response;
 use serde_json::{Value, json};
 
 fn deburr() -> Value {
-    json!({"tool": 7, "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
-        "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5, "tolerance": 0.01})
+    kerf_cases::with(kerf_cases::deburr::case_1(), json!({"tool": 7, "tolerance": 0.01}))
 }
 
 /// Whether the answer came from the cache (its `Server-Timing` says so), and its bytes.

@@ -14,10 +14,7 @@ fn same_point(a: &[f64; 3], b: &[f64; 3]) -> bool {
 
 /// The program of `body` at `path` with the extra query `query`.
 async fn program(app: &TestApp, path: &str, query: &str, body: &Value) -> String {
-    let url = app.url(&format!("{path}?format=gcode&{query}"));
-    let response = app.client.post(url).json(body).send().await.unwrap();
-    assert_eq!(response.status(), 200, "{path}?{query}");
-    response.text().await.unwrap()
+    app.post_text(&format!("{path}?format=gcode&{query}"), body, 200).await
 }
 
 /// Asserts that the arc program's moves are the chord program's with each run of chords replaced

@@ -5,7 +5,9 @@ use kerf_server::state::Limits;
 use kerf_tests::{TestApp, json_with, problem};
 use serde_json::{Value, json};
 
-use crate::deburr::{app_with_tools, request};
+use kerf_cases::deburr::request;
+
+use crate::deburr::app_with_tools;
 
 /// A valid deburr request to start each bad case from.
 fn valid() -> Value {

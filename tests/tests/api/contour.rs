@@ -3,6 +3,7 @@
 //! LinuxCNC's `rs274` with its end points equal to the JSON moves, a table of bad requests with
 //! the database unchanged, the JSON move limit, and byte-identical answers.
 
+use kerf_cases::contour::{circle, pocket_request, reference};
 use kerf_cases::{case, number, triple};
 use kerf_tests::{TestApp, assert_moves_match, external_program, finished, json_with, poll_job, problem, rs274_moves};
 use serde_json::{Value, json};
@@ -22,72 +23,6 @@ fn close_pair(what: &str, got: &Value, expected: &Value) {
 fn close(what: &str, got: &Value, expected: f64) {
     let got = number(got);
     assert!((got - expected).abs() <= TOLERANCE, "{what}: got {got}, expected {expected}");
-}
-
-/// The API request of a reference case (as the solver's case tests build it): an inline flat
-/// tool, one layer at z = 0, conventional milling (σ = +1, the cases' convention) and the case's
-/// passes and loop style.
-pub fn reference_request(id: &str) -> Value {
-    let case = case("contour", id);
-    let inputs = &case["inputs"];
-    let mut corner_loop = json!({"max_angle_deg": 180.0 - number(&inputs["phi_min_deg"])});
-    let passes: Vec<Value> = inputs["passes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|pass| match pass["join"].as_str().unwrap() {
-            "loop_arc" => {
-                corner_loop["style"] = json!("arc");
-                corner_loop["radius"] = pass["rho"].clone();
-                json!({"allowance": pass["delta"], "loop": true})
-            }
-            "loop_par" => {
-                corner_loop["style"] = json!("parallelogram");
-                corner_loop["leg"] = pass["L"].clone();
-                json!({"allowance": pass["delta"], "loop": true})
-            }
-            "round" => json!({"allowance": pass["delta"], "loop": false, "join": "round"}),
-            other => panic!("unknown join {other}"),
-        })
-        .collect();
-    // C2's vertex (18 + √3, 1 + 6√3) exactly, as the spec gives it (the fixture rounds to 1e-6).
-    let exact = [18.0 + 3f64.sqrt(), 1.0 + 6.0 * 3f64.sqrt()];
-    let contour: Vec<[f64; 2]> = inputs["contour"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|p| {
-            let p = pair(p);
-            if (p[0] - exact[0]).abs() < 1e-6 && (p[1] - exact[1]).abs() < 1e-6 { exact } else { p }
-        })
-        .collect();
-    json!({
-        "tool": {"kind": "flat", "radius": inputs["tool_radius"]},
-        "contour": contour,
-        "side": "outside",
-        "direction": "conventional",
-        "depths": {"top": 1.0, "bottom": 0.0, "step": 1.0},
-        "corner_loop": corner_loop,
-        "passes": passes,
-        "feed": 800,
-    })
-}
-
-/// A pocket whose top wall has a wedge of material reaching into it (a 53° tip at (40, 40)):
-/// three layers, a loop at the tip, dogbone relief in the inside corners, tool 3 (flat R3).
-pub fn pocket_request() -> Value {
-    json!({
-        "tool": 3,
-        "contour": [[0, 0], [80, 0], [80, 60], [50, 60], [40, 40], [30, 60], [0, 60]],
-        "side": "inside",
-        "depths": {"top": 0, "bottom": -6, "step": 2},
-        "corner_loop": {"style": "arc"},
-        "inside_corner_relief": "dogbone",
-        "feed": 800,
-        "loop_feed": 1500,
-        "stock_allowance": 0.5,
-        "passes": [{"allowance": 0.3, "join": "round"}, {"allowance": 0}]
-    })
 }
 
 pub async fn app_with_tools() -> TestApp {
@@ -118,7 +53,7 @@ async fn reference_contours_over_http() {
     let app = app_with_tools().await;
     for id in ["C1", "C2", "C3"] {
         let case = case("contour", id);
-        let answer = json_with(app.post_json("/api/v1/contour", &reference_request(id)).await, 200).await;
+        let answer = json_with(app.post_json("/api/v1/contour", &reference(id)).await, 200).await;
         let expected_passes = case["expected"]["passes"].as_array().unwrap();
         let final_pass = expected_passes.last().unwrap();
         assert_eq!(answer["tool"]["kind"], "flat");
@@ -235,7 +170,7 @@ async fn gcode_of_both_dialects_matches_the_json_moves() {
         return;
     }
     let app = app_with_tools().await;
-    let mut ball = reference_request("C3");
+    let mut ball = reference("C3");
     ball["tool"] = json!(4);
     ball["depths"] = json!({"top": 0, "bottom": -3, "step": 1.5});
     let mut blocks = pocket_request();
@@ -244,7 +179,7 @@ async fn gcode_of_both_dialects_matches_the_json_moves() {
         ("pocket", pocket_request(), 0.0),
         ("pocket_block_time", blocks, 0.0),
         ("c3_ball", ball, 2.0),
-        ("c2_inline", reference_request("C2"), 0.0),
+        ("c2_inline", reference("C2"), 0.0),
     ];
     for (name, body, centre_height) in jobs {
         let answer = json_with(app.post_json("/api/v1/contour", &body).await, 200).await;
@@ -281,7 +216,7 @@ async fn answers_are_byte_identical() {
     let app = app_with_tools().await;
     let mut blocks = pocket_request();
     blocks["block_time_ms"] = json!(4);
-    for body in [pocket_request(), reference_request("C2"), blocks] {
+    for body in [pocket_request(), reference("C2"), blocks] {
         let mut answers = Vec::new();
         for accept in ["application/json", "application/json", "text/x-gcode", "text/x-gcode"] {
             let response =
@@ -292,16 +227,6 @@ async fn answers_are_byte_identical() {
         assert_eq!(answers[0], answers[1], "JSON");
         assert_eq!(answers[2], answers[3], "G-code");
     }
-}
-
-/// A circle of `points` vertices with radius 30: no corner turns enough for a loop.
-pub(crate) fn circle(points: usize) -> Vec<[f64; 2]> {
-    (0..points)
-        .map(|k| {
-            let angle = std::f64::consts::TAU * k as f64 / points as f64;
-            [30.0 * angle.cos(), 30.0 * angle.sin()]
-        })
-        .collect()
 }
 
 #[tokio::test(flavor = "multi_thread")]
@@ -318,9 +243,7 @@ async fn json_answers_are_limited_and_gcode_goes_further() {
     let detail = refused["detail"].as_str().unwrap();
     assert!(detail.contains("500000") && detail.contains("G-code") && detail.contains("job"), "{detail}");
 
-    let response = app.client.post(app.url("/api/v1/contour?format=gcode")).json(&body).send().await.unwrap();
-    assert_eq!(response.status(), 200);
-    let program = response.text().await.unwrap();
+    let program = app.post_text("/api/v1/contour?format=gcode", &body, 200).await;
     let blocks = program.lines().filter(|l| l.starts_with("G01") || l.starts_with("G00")).count();
     assert!(blocks > 500_000, "{blocks} blocks");
     assert!(program.ends_with("M30\n%\n"));
@@ -652,7 +575,7 @@ async fn loops_on_an_existing_path_repeat_the_contour_loops() {
     let app = app_with_tools().await;
     // C1's final pass: the square's offset by r = 1, travelled counter-clockwise from S (the
     // middle of edge 0), material on the left.
-    let contour = json_with(app.post_json("/api/v1/contour", &reference_request("C1")).await, 200).await;
+    let contour = json_with(app.post_json("/api/v1/contour", &reference("C1")).await, 200).await;
     let body = json!({
         "tool": {"kind": "flat", "radius": 1},
         "path": [[10, -1], [21, -1], [21, 21], [-1, 21], [-1, -1]],
@@ -733,9 +656,9 @@ async fn jobs_store_what_fits_and_refusals_name_the_field() {
 #[tokio::test(flavor = "multi_thread")]
 async fn block_time_rule_chooses_the_arc_chords_and_reports_the_blocks() {
     let app = app_with_tools().await;
-    let plain = json_with(app.post_json("/api/v1/contour", &reference_request("C1")).await, 200).await;
+    let plain = json_with(app.post_json("/api/v1/contour", &reference("C1")).await, 200).await;
     assert!(plain["summary"].get("blocks").is_none(), "no block figures without a block time");
-    let mut body = reference_request("C1");
+    let mut body = reference("C1");
     body["block_time_ms"] = json!(4);
     let ruled = json_with(app.post_json("/api/v1/contour", &body).await, 200).await;
     let blocks = &ruled["summary"]["blocks"];
@@ -776,7 +699,7 @@ async fn block_time_rule_chooses_the_arc_chords_and_reports_the_blocks() {
 #[tokio::test(flavor = "multi_thread")]
 async fn a_named_machine_gives_the_block_time_and_dialect() {
     let app = app_with_tools().await;
-    let mut body = reference_request("C1");
+    let mut body = reference("C1");
     body["machine"] = json!("mill-4ms");
     let unknown = problem(app.post_json("/api/v1/contour", &body).await, 404).await;
     assert_eq!(unknown["errors"][0]["path"], "machine");
@@ -789,7 +712,7 @@ async fn a_named_machine_gives_the_block_time_and_dialect() {
     let codes: Vec<&str> =
         from_machine["warnings"].as_array().unwrap().iter().map(|w| w["code"].as_str().unwrap()).collect();
     assert!(codes.contains(&"W_FEED_ABOVE_MACHINE_MAX"), "feed 800 over the machine's 600: {codes:?}");
-    let mut explicit = reference_request("C1");
+    let mut explicit = reference("C1");
     explicit["block_time_ms"] = json!(4);
     let explicit = json_with(app.post_json("/api/v1/contour", &explicit).await, 200).await;
     assert_eq!(from_machine["layers"], explicit["layers"], "the machine's block time chords as the request's");
@@ -798,9 +721,7 @@ async fn a_named_machine_gives_the_block_time_and_dialect() {
     let overridden = json_with(app.post_json("/api/v1/contour", &body).await, 200).await;
     assert_eq!(overridden["summary"]["blocks"]["block_time_ms"], 10.0);
 
-    let response = app.client.post(app.url("/api/v1/contour?format=gcode")).json(&body).send().await.unwrap();
-    assert_eq!(response.status(), 200);
-    let program = response.text().await.unwrap();
+    let program = app.post_text("/api/v1/contour?format=gcode", &body, 200).await;
     assert!(!program.starts_with('%') && program.contains("G64"), "linuxcnc from the machine:\n{program}");
 
     let mut operation = body.clone();

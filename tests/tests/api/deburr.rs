@@ -1,20 +1,10 @@
 //! `POST /api/v1/deburr` over HTTP: every hole shape on both edges, the reference case 1 numbers,
 //! determinism and the exact method.
 
+use kerf_cases::deburr::{case_1, request};
+use kerf_cases::with;
 use kerf_tests::{TestApp, json_with};
 use serde_json::{Value, json};
-
-/// A valid request for `hole` on `edge` of a tube with tool 7.
-pub fn request(hole: Value, edge: &str) -> Value {
-    json!({
-        "tool": 7,
-        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 30, "outer_radius": 50},
-        "hole": hole,
-        "edge": edge,
-        "cut_amount": 0.3,
-        "tolerance": 0.01
-    })
-}
 
 pub async fn app_with_tools() -> TestApp {
     let app = TestApp::spawn().await;
@@ -80,12 +70,7 @@ async fn every_hole_shape_on_both_edges() {
 #[tokio::test(flavor = "multi_thread")]
 async fn reference_case_1_over_http() {
     let app = app_with_tools().await;
-    let body = json!({
-        "tool": {"kind": "ball", "radius": 3},
-        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
-        "hole": {"shape": "round", "radius": 10},
-        "edge": "outer", "cut_amount": 0.5, "tolerance": 0.01
-    });
+    let body = with(case_1(), json!({"tolerance": 0.01}));
     let answer = json_with(app.post_json("/api/v1/deburr", &body).await, 200).await;
     assert_eq!(answer["summary"]["count"], 92);
     let first = point3(&answer["points"][0]["centre"]);

@@ -128,9 +128,7 @@ async fn a_four_hole_pattern_is_one_program_with_four_closed_loops() {
 
     for dialect in ["fanuc", "linuxcnc"] {
         let url = format!("/api/v1/deburr?format=gcode&dialect={dialect}");
-        let response = app.client.post(app.url(&url)).json(&four_along()).send().await.unwrap();
-        assert_eq!(response.status(), 200);
-        let program = response.text().await.unwrap();
+        let program = app.post_text(&url, &four_along(), 200).await;
         assert_eq!(program.matches("M06").count(), 1, "one tool for every hole");
         let Some(moves) = rs274_moves(&program, app.directory(), &format!("holes_{dialect}")) else { return };
         assert_eq!(feed_runs(&moves), 4, "{dialect}: four loops");
@@ -209,9 +207,7 @@ async fn four_holes_around_the_tube_are_four_loops_clear_of_the_wall() {
         [0.0, 90.0, 180.0, 270.0].map(|angle_deg| RadialHole { radius: 5.0, angle_deg, along: 0.0 }).to_vec();
     for dialect in ["fanuc", "linuxcnc"] {
         let url = format!("/api/v1/deburr?format=gcode&dialect={dialect}");
-        let response = app.client.post(app.url(&url)).json(&request).send().await.unwrap();
-        assert_eq!(response.status(), 200);
-        let program = response.text().await.unwrap();
+        let program = app.post_text(&url, &request, 200).await;
         assert_eq!(program.matches("M06").count(), 1, "{dialect}: one tool");
         assert_eq!(program.lines().filter(|l| *l == "M00").count(), 1, "{dialect}: one stop to turn the tube");
         assert!(program.contains("(TURN THE TUBE 180 DEG ABOUT ITS AXIS"), "{program}");
@@ -264,9 +260,7 @@ async fn both_edges_change_to_the_inner_tool_once() {
         .collect();
     for dialect in ["fanuc", "linuxcnc"] {
         let url = format!("/api/v1/deburr?format=gcode&dialect={dialect}");
-        let response = app.client.post(app.url(&url)).json(&both_edges()).send().await.unwrap();
-        assert_eq!(response.status(), 200);
-        let program = response.text().await.unwrap();
+        let program = app.post_text(&url, &both_edges(), 200).await;
         let changes: Vec<&str> = program.lines().filter(|l| l.contains("M06")).collect();
         assert_eq!(changes, ["T7 M06", "T8 M06"], "{dialect}: one change per tool");
         assert_eq!(program.matches("G43 H8 ").count(), 1, "{dialect}");

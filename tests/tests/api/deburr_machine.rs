@@ -5,16 +5,9 @@
 use kerf_tests::{TestApp, external_program, finished, json_with, poll_job, problem, rs274_moves};
 use serde_json::{Value, json};
 
+/// The tube request of [`kerf_cases::deburr::tube_request`] with `extra` fields.
 fn request(extra: Value) -> Value {
-    let mut body = json!({
-        "tool": 7,
-        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 15, "outer_radius": 25},
-        "hole": {"shape": "round", "radius": 8}, "edge": "outer", "cut_amount": 0.3, "tolerance": 0.01
-    });
-    for (key, value) in extra.as_object().unwrap() {
-        body[key] = value.clone();
-    }
-    body
+    kerf_cases::with(kerf_cases::deburr::tube_request(), extra)
 }
 
 fn centre(point: &Value) -> [f64; 3] {

@@ -25,34 +25,10 @@ fn close_rel(what: &str, got: f64, expected: f64, relative: f64) {
     close(what, got, expected, relative * expected.abs() + 1e-9);
 }
 
-/// The request body for a fixture input block (its stock polygons and path pass unchanged).
+/// The request body for a fixture input block ([`kerf_cases::engagement::fixture_request`]) with
+/// a tool of `diameter` and `extra` fields.
 fn fixture_request(stock: &Value, path: &Value, cutting: &Value, flutes: &Value, diameter: f64, extra: Value) -> Value {
-    let polygons: Vec<Value> = stock["polygons"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|p| {
-            let mut p = p.clone();
-            if p["holes"].as_array().is_some_and(Vec::is_empty) {
-                p.as_object_mut().unwrap().remove("holes");
-            }
-            p
-        })
-        .collect();
-    let mut body = json!({
-        "tool": {"kind": "flat", "radius": diameter / 2.0},
-        "stock": {"polygons": polygons}, "path": path,
-        "spindle_rpm": cutting["spindle_rpm"], "flute_counts": flutes,
-    });
-    if cutting["feed_mode"] == "constant_vf" {
-        body["feed"] = cutting["vf_mm_per_min"].clone();
-    } else {
-        body["feed_per_tooth"] = cutting["fz"].clone();
-    }
-    for (key, value) in extra.as_object().unwrap() {
-        body[key] = value.clone();
-    }
-    body
+    kerf_cases::with(kerf_cases::engagement::fixture_request(stock, path, cutting, flutes, diameter / 2.0), extra)
 }
 
 fn sample_at(result: &Value, s: f64) -> &Value {
@@ -440,9 +416,7 @@ async fn a_named_machine_caps_the_feed_plan_and_sets_the_dialect() {
     assert!(!feeds.is_empty() && feeds.iter().all(|&feed| feed <= 900.0 + 1e-9), "{feeds:?}");
 
     body["axial_depth"] = json!(2);
-    let response = app.client.post(app.url(&format!("{URL}?format=gcode"))).json(&body).send().await.unwrap();
-    assert_eq!(response.status(), 200);
-    let program = response.text().await.unwrap();
+    let program = app.post_text(&format!("{URL}?format=gcode"), &body, 200).await;
     assert!(!program.starts_with('%') && program.contains("G64"), "linuxcnc from the machine:\n{program}");
 
     body["feed_plan"]["max_feed"] = json!(5000);
@@ -459,9 +433,7 @@ async fn the_program_turns_the_spindle_as_analysed() {
     body["axial_depth"] = json!(2);
     for (direction, code, other) in [("cw", "S3000 M03", "M04"), ("ccw", "S3000 M04", "M03")] {
         body["spindle_direction"] = json!(direction);
-        let response = app.client.post(app.url(&format!("{URL}?format=gcode"))).json(&body).send().await.unwrap();
-        assert_eq!(response.status(), 200);
-        let program = response.text().await.unwrap();
+        let program = app.post_text(&format!("{URL}?format=gcode"), &body, 200).await;
         assert!(program.contains(code) && !program.contains(other), "{direction}:\n{program}");
     }
 }

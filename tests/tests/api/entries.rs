@@ -29,10 +29,7 @@ fn plunges(program: &str) -> (Vec<f64>, f64) {
 }
 
 async fn gcode(app: &TestApp, path: &str, body: &Value) -> String {
-    let response = app.client.post(app.url(&format!("{path}?format=gcode&dialect=linuxcnc"))).json(body).send().await;
-    let response = response.unwrap();
-    assert_eq!(response.status(), 200, "{path}");
-    response.text().await.unwrap()
+    app.post_text(&format!("{path}?format=gcode&dialect=linuxcnc"), body, 200).await
 }
 
 #[tokio::test(flavor = "multi_thread")]
@@ -233,9 +230,7 @@ async fn tools_that_do_not_cut_at_the_centre_ramp_into_contour_layers() {
             let (angle, limit) = (ramp_angle.unwrap_or(3.0_f64), plunge_feed.unwrap_or(200.0));
             for dialect in ["fanuc", "linuxcnc"] {
                 let url = format!("/api/v1/contour?format=gcode&dialect={dialect}");
-                let response = app.client.post(app.url(&url)).json(&body).send().await.unwrap();
-                assert_eq!(response.status(), 200);
-                let program = response.text().await.unwrap();
+                let program = app.post_text(&url, &body, 200).await;
                 let label = format!("{side} {dialect} {ramp_angle:?}");
                 let below_top: Vec<_> = descents(&program).into_iter().filter(|(_, to, _)| to[2] < 0.0).collect();
                 assert!(below_top.len() >= 4, "{label}: each layer ramps down in legs\n{program}");

@@ -11,8 +11,8 @@ use kerf_server::store;
 use kerf_tests::{Store, TestApp, finished, json_with, poll_job, problem};
 use serde_json::{Value, json};
 
-use crate::contour::circle;
 use crate::jobs::long_job;
+use kerf_cases::contour::circle;
 
 fn program() -> PathBuf {
     PathBuf::from(env!("CARGO_BIN_EXE_kerf-under-test"))
@@ -28,9 +28,7 @@ fn segment_job(name: &str) -> Value {
 
 /// A quick deburr job.
 fn quick_job(name: &str) -> Value {
-    json!({"name": name, "operations": [{"operation": "deburr", "tool": {"kind": "ball", "radius": 3},
-        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
-        "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5}]})
+    json!({"name": name, "operations": [kerf_cases::operation("deburr", kerf_cases::deburr::case_1())]})
 }
 
 async fn submit(app: &TestApp, job: &Value) -> reqwest::Response {
@@ -300,9 +298,8 @@ async fn results_stored_before_compression_are_still_served() {
     let shown = json_with(app.get(&format!("/api/v1/jobs/{id}")).await, 200).await;
     assert_eq!(shown["results"][0]["result"], json!({"points": [[1.5, 2.5, 3.5]]}), "{shown}");
     assert_eq!(shown["results"][0]["gcode"], true);
-    let program = app.get(&format!("/api/v1/jobs/{id}/gcode")).await;
-    assert_eq!(program.status(), 200);
-    assert_eq!(program.text().await.unwrap(), "%\nO1000\nG00 X1.5000\nM30\n%\n");
+    let program = app.get_text(&format!("/api/v1/jobs/{id}/gcode"), 200).await;
+    assert_eq!(program, "%\nO1000\nG00 X1.5000\nM30\n%\n");
     // And it is pruned like any other finished job.
     let output = prune_command(&app, &["--older-than-days", "30"]);
     assert!(output.contains(&format!("removed 1 finished job(s) older than 30 day(s) (ids {id})")), "{output}");

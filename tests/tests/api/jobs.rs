@@ -39,12 +39,7 @@ async fn upload_raw(app: &TestApp, body: String, media_type: &str) -> reqwest::R
 
 /// A job whose operations take a while: exact-width deburring at a tiny tolerance.
 pub fn long_job(operations: usize) -> Value {
-    let operation = json!({
-        "operation": "deburr", "tool": {"kind": "ball", "radius": 3, "number": 7},
-        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
-        "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5,
-        "tolerance": 2e-6, "method": "exact"
-    });
+    let operation = kerf_cases::operation("deburr", kerf_cases::deburr::long_request());
     json!({"name": "long", "operations": vec![operation; operations]})
 }
 
@@ -77,9 +72,8 @@ async fn example_jobs_run_to_the_end(store: Store) {
             assert!(result["operation"].is_string());
             assert!(result["result"].as_object().is_some_and(|o| !o.is_empty()), "{result}");
             assert_eq!(result["gcode"], true, "{result}");
-            let program = app.get(&format!("/api/v1/jobs/{id}/gcode?operation={index}")).await;
-            assert_eq!(program.status(), 200);
-            assert!(program.text().await.unwrap().contains("M30"));
+            let program = app.get_text(&format!("/api/v1/jobs/{id}/gcode?operation={index}"), 200).await;
+            assert!(program.contains("M30"));
         }
         if operations > 1 {
             let answer = problem(app.get(&format!("/api/v1/jobs/{id}/gcode")).await, 422).await;
@@ -241,9 +235,7 @@ async fn cancel_paging_and_conflicts(store: Store) {
     assert_eq!(cancelled["status"], "cancelled");
     // The worker lets go: a small job submitted now runs (on PostgreSQL behind the other long
     // job's remaining chunks, which the freed worker takes first).
-    let small = json!({"name": "small", "operations": [{"operation": "deburr", "tool": {"kind": "ball", "radius": 3},
-        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
-        "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5}]});
+    let small = json!({"name": "small", "operations": [kerf_cases::operation("deburr", kerf_cases::deburr::case_1())]});
     let small_id =
         json_with(upload_raw(&app, small.to_string(), "application/json").await, 202).await["id"].as_i64().unwrap();
     let small_job = poll_job(&app.client, &app.base, small_id, 30, finished).await;
@@ -355,9 +347,7 @@ async fn jobs_answer_as_the_endpoints_do(store: Store) {
     let stored = raw_results(&job_text);
 
     for (index, (name, request)) in [("deburr", &deburr), ("engagement", &engagement)].into_iter().enumerate() {
-        let answer = app.post_json(&format!("/api/v1/{name}"), request).await;
-        assert_eq!(answer.status(), 200);
-        let answer = answer.text().await.unwrap();
+        let answer = app.post_text(&format!("/api/v1/{name}"), request, 200).await;
         assert_eq!(stored[index], answer, "{name}: the stored result is the endpoint's answer byte for byte");
         let direct = app
             .client

@@ -7,15 +7,12 @@ use std::time::Duration;
 use kerf_server::state::Limits;
 use kerf_tests::{TestApp, json_with, problem};
 
-use crate::contour::circle;
+use kerf_cases::contour::circle;
 use serde_json::json;
 
 /// A deburr request that takes a few hundred milliseconds: exact width at a tiny tolerance.
 fn slow_request() -> serde_json::Value {
-    json!({"tool": {"kind": "ball", "radius": 3},
-           "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
-           "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5,
-           "tolerance": 1e-6, "method": "exact"})
+    kerf_cases::with(kerf_cases::deburr::case_1(), json!({"tolerance": 1e-6, "method": "exact"}))
 }
 
 #[tokio::test(flavor = "multi_thread")]
@@ -25,9 +22,7 @@ async fn slow_synchronous_call_is_told_to_submit_a_job() {
     assert_eq!(answer["code"], "E_TIMEOUT");
     assert!(answer["detail"].as_str().unwrap().contains("/api/v1/jobs"), "{answer}");
     // The same work as a job runs to the end.
-    let job = json!({"operations": [{"operation": "deburr", "tool": {"kind": "ball", "radius": 3},
-        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
-        "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5, "tolerance": 1e-6, "method": "exact"}]});
+    let job = json!({"operations": [kerf_cases::operation("deburr", slow_request())]});
     let id = json_with(app.post_json("/api/v1/jobs", &job).await, 202).await["id"].as_i64().unwrap();
     let done = kerf_tests::poll_job(&app.client, &app.base, id, 60, kerf_tests::finished).await;
     assert_eq!(done["status"], "done");
@@ -318,9 +313,7 @@ async fn slow_readers_of_large_job_programs_hold_a_bounded_budget() {
     let first = unread.text().await.unwrap();
     assert_eq!(first.len(), length);
     assert!(first.trim_end().ends_with('%') && first.contains("M30"), "a whole program");
-    let again = app.get(&program).await;
-    assert_eq!(again.status(), 200);
-    assert_eq!(again.text().await.unwrap(), first);
+    assert_eq!(app.get_text(&program, 200).await, first);
     json_with(app.get(&format!("/api/v1/jobs/{id}")).await, 200).await;
 }
 

@@ -13,8 +13,7 @@ const CLIENTS: usize = 64;
 const REQUESTS: usize = 2_000;
 
 fn deburr_body(tool: u32) -> Value {
-    json!({"tool": tool, "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
-           "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5})
+    kerf_cases::with(kerf_cases::deburr::case_1(), json!({"tool": tool}))
 }
 
 /// What one client did: latencies, statuses, final state of its own tools, accepted jobs.

@@ -20,13 +20,10 @@ async fn document_covers_every_route_and_docs_are_served() {
     ] {
         assert!(paths.contains_key(path), "{path} documented");
     }
-    let docs = app.get("/docs/").await;
-    assert_eq!(docs.status(), 200);
-    let html = docs.text().await.unwrap();
+    let html = app.get_text("/docs/", 200).await;
     assert!(html.contains("swagger"), "swagger UI page");
-    let initializer = app.get("/docs/swagger-initializer.js").await;
-    assert_eq!(initializer.status(), 200);
-    assert!(initializer.text().await.unwrap().contains("/api/v1/openapi.json"));
+    let initializer = app.get_text("/docs/swagger-initializer.js", 200).await;
+    assert!(initializer.contains("/api/v1/openapi.json"));
     // A file the docs do not have is a problem document like every other 404.
     let missing = kerf_tests::problem(app.get("/docs/no-such-file.js").await, 404).await;
     assert_eq!(missing["code"], "E_NOT_FOUND");

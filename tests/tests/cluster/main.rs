@@ -47,12 +47,7 @@ fn examples() -> Vec<Value> {
 
 /// A job whose operations take a while: exact-width deburring at a tiny tolerance.
 fn long_job(name: &str, operations: usize) -> Value {
-    let operation = json!({
-        "operation": "deburr", "tool": {"kind": "ball", "radius": 3, "number": 7},
-        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
-        "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5,
-        "tolerance": 2e-6, "method": "exact"
-    });
+    let operation = kerf_cases::operation("deburr", kerf_cases::deburr::long_request());
     json!({"name": name, "operations": vec![operation; operations]})
 }
 
@@ -564,9 +559,7 @@ async fn heartbeats_at_once_keep_the_job_at_its_chunks_sum() {
     use kerf_server::store::jobs::{self as store, Claimant};
     let Some(postgres) = PgServer::start() else { return };
     let db = kerf_server::db::open(&postgres.database()).await.unwrap();
-    let deburr = json!({"operation": "deburr", "tool": {"kind": "ball", "radius": 3},
-        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
-        "hole": {"shape": "round", "radius": 10}, "edge": "outer", "cut_amount": 0.5});
+    let deburr = kerf_cases::operation("deburr", kerf_cases::deburr::case_1());
     let job = json!({"name": "two chunks", "operations": [deburr, deburr]});
     let id = store::insert(&db, &file::parse(&job.to_string(), Format::Json).unwrap(), "two chunks", u64::MAX)
         .await

@@ -1,8 +1,7 @@
 //! Requests for the split tests and the cost-model measurement (`tests/load/cost_model.rs`):
-//! engagement candidates, a contour of some layers, a tube's holes; and parts' outputs kept as
-//! JSON text, as the job store keeps them (CBOR there).
-
-#![allow(dead_code)]
+//! engagement candidates, a contour of some layers, a tube's holes, typed with the context the
+//! server would resolve; and parts' outputs kept as JSON text, as the job store keeps them (CBOR
+//! there).
 
 use kerf_solver::capability::{PartSink, PartSource, Resolved};
 use kerf_solver::contour::ContourRequest;
@@ -37,6 +36,7 @@ impl PartSource for Texts {
     }
 }
 
+/// The context of `tool` alone: no machine, material or other tools.
 pub fn context(tool: &Tool) -> Resolved<Tool> {
     Resolved { tool: tool.clone(), machine: None, material: None, other_tools: Vec::new() }
 }
@@ -66,25 +66,15 @@ pub fn engagement_request(step: f64) -> (EngagementRequest, Tool, MachineProfile
     (request, tool, machine)
 }
 
+/// A flat end mill of `radius`.
 pub fn flat(radius: f64) -> Tool {
     Tool::new(kerf_solver::tool::ToolKind::Flat, radius)
 }
 
-/// The arrow island of `examples/contour-arrow.toml`, `layers` layers deep, with `extra` fields.
+/// The arrow island of `examples/contour-arrow.toml` ([`crate::contour::arrow_request`]),
+/// `layers` layers deep, with `extra` fields.
 pub fn contour_request(layers: usize, extra: serde_json::Value) -> ContourRequest {
-    let mut request = json!({
-        "tool": 3,
-        "contour": [[0, 10], [40, 10], [40, 0], [80, 25], [40, 50], [40, 40], [0, 40]],
-        "side": "outside",
-        "depths": {"top": 0, "bottom": -(layers as f64), "step": 1},
-        "corner_loop": {"style": "arc"}, "inside_corner_relief": "dogbone",
-        "feed": 800, "loop_feed": 2000, "stock_allowance": 0.5, "spindle_rpm": 8000,
-        "passes": [{"allowance": 0.3, "join": "round"}, {"allowance": 0}],
-    });
-    for (key, value) in extra.as_object().unwrap() {
-        request[key] = value.clone();
-    }
-    serde_json::from_value(request).unwrap()
+    serde_json::from_value(crate::with(crate::contour::arrow_request(layers), extra)).unwrap()
 }
 
 pub fn contour_context(machine: bool) -> Resolved<Tool> {
@@ -97,27 +87,15 @@ pub fn contour_context(machine: bool) -> Resolved<Tool> {
     Resolved { tool: flat(3.0), machine, material: None, other_tools: Vec::new() }
 }
 
+/// A ball end mill of `radius`.
 pub fn ball(radius: f64) -> Tool {
     Tool::new(kerf_solver::tool::ToolKind::Ball, radius)
 }
 
-/// A tube's holes (radius, penetration angle, axial position) deburred at `edge`.
+/// A tube's holes (radius, penetration angle, axial position) deburred at `edge`
+/// ([`crate::deburr::holes_request`]), with `extra` fields.
 pub fn deburr_request(holes: &[(f64, f64, f64)], edge: &str, extra: serde_json::Value) -> DeburrRequest {
-    let holes: Vec<_> = holes
-        .iter()
-        .map(|&(radius, angle, along)| {
-            json!({"shape": "round", "radius": radius, "penetration_angle_deg": angle, "axial_position": along})
-        })
-        .collect();
-    let mut request = json!({
-        "tool": 7, "edge": edge, "cut_amount": 0.3,
-        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 15, "outer_radius": 25},
-        "holes": holes,
-    });
-    for (key, value) in extra.as_object().unwrap() {
-        request[key] = value.clone();
-    }
-    serde_json::from_value(request).unwrap()
+    serde_json::from_value(crate::with(crate::deburr::holes_request(holes, edge), extra)).unwrap()
 }
 
 pub fn deburr_context(inner: Option<f64>, machine: bool) -> Resolved<Tool> {

@@ -1,7 +1,6 @@
-//! Test helper: a realistic finishing program (ball end mill, zig-zag raster over a curved
-//! surface) with its stock, for the invariance tests and the bench.
-
-#![allow(dead_code)]
+//! Prediction requests, typed: a realistic finishing program (ball end mill, zig-zag raster over
+//! a curved surface) with its stock, for the invariance and split tests, the bench and the cost
+//! model; a request with every option at its default; contour passes on an inclined plane.
 
 use kerf_solver::gcode::Reference;
 use kerf_solver::predict::{CuttingCoefficients, Method, PathInput, PredictRequest, Stock};
