@@ -247,22 +247,7 @@ impl Prepared {
         for pass in first_passes {
             warnings.extend(pass.warnings.iter().cloned());
         }
-        let mut lead_used = job.lead;
-        let mut shortened = false;
-        let mut layers = Vec::with_capacity(made.len());
-        for LayerMoves { z, moves, arcs, lead } in made {
-            if lead < job.lead {
-                shortened = true;
-            }
-            lead_used = lead_used.min(lead);
-            layers.push(ContourLayer { z, moves, arcs });
-        }
-        if shortened {
-            warnings.push(Warning::new(
-                "W_LEAD_SHORTENED",
-                format!("the lead of {} mm would gouge the contour; {lead_used:.4} mm is used", job.lead),
-            ));
-        }
+        let (layers, lead_used) = answer_layers(job, made, &mut warnings);
 
         let final_pass = first_passes
             .last()
@@ -271,35 +256,11 @@ impl Prepared {
         warnings.extend(corner_warnings(job, first_passes, &corners));
         let passes: Vec<PassReport> = first_passes.iter().map(pass_report).collect();
 
-        let mut feed_length = 0.0;
-        let mut time_min = 0.0;
-        let mut moves = 0;
-        for layer in &layers {
-            let mut from: Option<[f64; 3]> = None;
-            for step in &layer.moves {
-                if let (Some(a), Some(feed)) = (from, step.feed) {
-                    let length = Vec3::from(step.to).metric_distance(&Vec3::from(a));
-                    feed_length += length;
-                    time_min += length / feed;
-                }
-                from = Some(step.to);
-            }
-            moves += layer.moves.len();
-        }
+        let (feed_length, time_min, moves) = feed_travel(&layers);
         if moves > max_moves {
             return Err(too_many_moves(layers.len(), moves / layers.len().max(1), moves, max_moves));
         }
-        let blocks = match &job.chording.rules {
-            None => None,
-            Some((rule, _)) => {
-                let (finest, arc_warnings) = blocks::arc_report(first_passes, &job.chording);
-                warnings.extend(arc_warnings);
-                let moves = layers.iter().flat_map(|layer| &layer.moves).map(|step| (Vec3::from(step.to), step.feed));
-                let figures = crate::machine::path_blocks(moves, rule.block_time_ms, job.feed, finest)?;
-                warnings.extend(crate::machine::short_block_warning(&figures, rule));
-                Some(figures)
-            }
-        };
+        let blocks = block_figures(job, first_passes, &layers, &mut warnings)?;
         let loop_feed = job.loop_feed.unwrap_or(job.feed);
         let summary = ContourSummary {
             side: job.side,
@@ -321,11 +282,7 @@ impl Prepared {
             cycle_time: machine.and_then(|m| contour_cycle_time(&layers, m, job.plunge_feed)),
         };
         let description = describe(job, &summary);
-        let centre_height = match job.tool.kind {
-            ToolKind::Flat => 0.0,
-            ToolKind::Ball => job.radius,
-            ToolKind::Bull => job.tool.corner_radius.unwrap_or(0.0),
-        };
+        let centre_height = centre_height(job);
         Ok(ContourSolution {
             layers,
             corners,
@@ -337,6 +294,78 @@ impl Prepared {
             description,
             tilted: job.tilt.is_some(),
         })
+    }
+}
+
+/// The answer's layers from the moves made, the shortest lead any layer used, and a warning when
+/// a lead had to be shortened.
+fn answer_layers(job: &Job, made: Vec<LayerMoves>, warnings: &mut Vec<Warning>) -> (Vec<ContourLayer>, f64) {
+    let mut lead_used = job.lead;
+    let mut shortened = false;
+    let mut layers = Vec::with_capacity(made.len());
+    for LayerMoves { z, moves, arcs, lead } in made {
+        if lead < job.lead {
+            shortened = true;
+        }
+        lead_used = lead_used.min(lead);
+        layers.push(ContourLayer { z, moves, arcs });
+    }
+    if shortened {
+        warnings.push(Warning::new(
+            "W_LEAD_SHORTENED",
+            format!("the lead of {} mm would gouge the contour; {lead_used:.4} mm is used", job.lead),
+        ));
+    }
+    (layers, lead_used)
+}
+
+/// Length (mm) and time (min) of the feed moves, and the count of all moves.
+fn feed_travel(layers: &[ContourLayer]) -> (f64, f64, usize) {
+    let mut feed_length = 0.0;
+    let mut time_min = 0.0;
+    let mut moves = 0;
+    for layer in layers {
+        let mut from: Option<[f64; 3]> = None;
+        for step in &layer.moves {
+            if let (Some(a), Some(feed)) = (from, step.feed) {
+                let length = Vec3::from(step.to).metric_distance(&Vec3::from(a));
+                feed_length += length;
+                time_min += length / feed;
+            }
+            from = Some(step.to);
+        }
+        moves += layer.moves.len();
+    }
+    (feed_length, time_min, moves)
+}
+
+/// Under the block-time rule, the block figures of every move and the warnings on arcs and
+/// short blocks; `None` without the rule.
+fn block_figures(
+    job: &Job,
+    first_passes: &[PassPlan],
+    layers: &[ContourLayer],
+    warnings: &mut Vec<Warning>,
+) -> Result<Option<crate::machine::PathBlocks>, SolverError> {
+    Ok(match &job.chording.rules {
+        None => None,
+        Some((rule, _)) => {
+            let (finest, arc_warnings) = blocks::arc_report(first_passes, &job.chording);
+            warnings.extend(arc_warnings);
+            let moves = layers.iter().flat_map(|layer| &layer.moves).map(|step| (Vec3::from(step.to), step.feed));
+            let figures = crate::machine::path_blocks(moves, rule.block_time_ms, job.feed, finest)?;
+            warnings.extend(crate::machine::short_block_warning(&figures, rule));
+            Some(figures)
+        }
+    })
+}
+
+/// Height of the tool's centre above its tip: the G-code reference point of ball and bull tools.
+fn centre_height(job: &Job) -> f64 {
+    match job.tool.kind {
+        ToolKind::Flat => 0.0,
+        ToolKind::Ball => job.radius,
+        ToolKind::Bull => job.tool.corner_radius.unwrap_or(0.0),
     }
 }
 
@@ -506,44 +535,82 @@ fn layer_moves(
     z: f64,
 ) -> (Vec<ContourMove>, Vec<ArcSpan>) {
     let start_axis = axis(job, layer, 0).map(|a| Box::new([a.x, a.y, a.z]));
-    let at = |p: &Vec2, height: f64| [p.x, p.y, height];
-    let mut moves = Vec::new();
-    let step =
-        |kind: MoveKind, to: [f64; 3], feed: Option<f64>| ContourMove { kind, to, feed, axis: start_axis.clone() };
     let Some(first_start) = passes.first().map(|p| p.start) else {
         return (Vec::new(), Vec::new());
     };
-    let mut arcs = Vec::new();
+    let mut out = LayerWriter { moves: Vec::new(), arcs: Vec::new(), start_axis, z };
     let entry = lead_point.unwrap_or(first_start);
     let approach = (previous_z + APPROACH_GAP.min(job.safe_z - previous_z)).max(z);
     if first {
-        moves.push(step(MoveKind::Rapid, at(&entry, job.safe_z), None));
+        out.push(MoveKind::Rapid, at(&entry, job.safe_z), None);
     }
     if approach < job.safe_z {
-        moves.push(step(MoveKind::Rapid, at(&entry, approach), None));
+        out.push(MoveKind::Rapid, at(&entry, approach), None);
     }
     let towards = if entry == first_start { first_chord_end(job, &passes[0]) } else { Some(first_start) };
     for (to, feed) in entry_moves(job, entry, towards, approach.min(job.safe_z), z) {
-        moves.push(step(MoveKind::Link, to, Some(feed)));
+        out.push(MoveKind::Link, to, Some(feed));
     }
     let mut here = entry;
     let loop_feed = job.loop_feed.unwrap_or(job.feed);
     for pass in passes {
         if here != pass.start {
-            if lead_point.is_some() || clears(layer, &here, &pass.start, pass.offset) {
-                moves.push(step(MoveKind::Link, at(&pass.start, z), Some(job.feed)));
-            } else {
-                moves.push(step(MoveKind::Rapid, at(&here, job.safe_z), None));
-                moves.push(step(MoveKind::Rapid, at(&pass.start, job.safe_z), None));
-                if approach < job.safe_z {
-                    moves.push(step(MoveKind::Rapid, at(&pass.start, approach), None));
-                }
-                let towards = first_chord_end(job, pass);
-                for (to, feed) in entry_moves(job, pass.start, towards, approach.min(job.safe_z), z) {
-                    moves.push(step(MoveKind::Link, to, Some(feed)));
-                }
+            out.link(job, layer, here, pass, lead_point.is_some(), approach);
+        }
+        out.pass(job, layer, pass, loop_feed);
+        here = pass.start;
+        if let Some(lead) = lead_point {
+            out.push(MoveKind::Link, at(&lead, z), Some(job.feed));
+            here = lead;
+        }
+    }
+    out.push(MoveKind::Rapid, at(&here, job.safe_z), None);
+    (out.moves, out.arcs)
+}
+
+/// The point `p` at `height`.
+fn at(p: &Vec2, height: f64) -> [f64; 3] {
+    [p.x, p.y, height]
+}
+
+/// One layer's moves and arc spans as they are written at height `z`.
+struct LayerWriter {
+    moves: Vec<ContourMove>,
+    arcs: Vec<ArcSpan>,
+    /// The tool axis at the start edge (tilted walls), given to every move but the cuts.
+    start_axis: Option<Box<[f64; 3]>>,
+    z: f64,
+}
+
+impl LayerWriter {
+    /// Appends a move with the start edge's tool axis.
+    fn push(&mut self, kind: MoveKind, to: [f64; 3], feed: Option<f64>) {
+        self.moves.push(ContourMove { kind, to, feed, axis: self.start_axis.clone() });
+    }
+
+    /// From `here` to the start of `pass`: straight at the layer's height where that clears the
+    /// contour (always from a lead point), else up, over and down again with an entry.
+    fn link(&mut self, job: &Job, layer: &Layer, here: Vec2, pass: &PassPlan, from_lead: bool, approach: f64) {
+        let z = self.z;
+        if from_lead || clears(layer, &here, &pass.start, pass.offset) {
+            self.push(MoveKind::Link, at(&pass.start, z), Some(job.feed));
+        } else {
+            self.push(MoveKind::Rapid, at(&here, job.safe_z), None);
+            self.push(MoveKind::Rapid, at(&pass.start, job.safe_z), None);
+            if approach < job.safe_z {
+                self.push(MoveKind::Rapid, at(&pass.start, approach), None);
+            }
+            let towards = first_chord_end(job, pass);
+            for (to, feed) in entry_moves(job, pass.start, towards, approach.min(job.safe_z), z) {
+                self.push(MoveKind::Link, to, Some(feed));
             }
         }
+    }
+
+    /// The elements of `pass` as chords, loops at `loop_feed` where they clear the stock, each
+    /// move with its tool axis blended along the element, and the arcs' spans.
+    fn pass(&mut self, job: &Job, layer: &Layer, pass: &PassPlan, loop_feed: f64) {
+        let z = self.z;
         let merge = job.chording.rules.is_some();
         for (position, (element, meta)) in pass.elements.iter().zip(&pass.meta).enumerate() {
             let kind = if element.kind() == ElementKind::Loop { MoveKind::Loop } else { MoveKind::Cut };
@@ -558,7 +625,7 @@ fn layer_moves(
             if merge && matches!(element, Element::Arc { .. }) && points.len() > 1 {
                 let before = position.checked_sub(1).and_then(|k| pass.elements.get(k));
                 if before.is_some_and(|line| continues(line, &element.start(), &points[0]))
-                    && let Some(previous) = moves.last_mut()
+                    && let Some(previous) = self.moves.last_mut()
                     && previous.to == at(&element.start(), z)
                 {
                     previous.to = at(&points[0], z);
@@ -572,9 +639,9 @@ fn layer_moves(
             if let Element::Arc { start, end, centre, sweep, .. } = element
                 && last > first
             {
-                arcs.push(ArcSpan {
-                    first: moves.len(),
-                    last: moves.len() + last - first - 1,
+                self.arcs.push(ArcSpan {
+                    first: self.moves.len(),
+                    last: self.moves.len() + last - first - 1,
                     start: [start.x, start.y],
                     end: [end.x, end.y],
                     centre: [centre.x, centre.y],
@@ -587,22 +654,10 @@ fn layer_moves(
                     let mixed = (a * (1.0 - s) + b * s).try_normalize(0.0).unwrap_or(b);
                     Box::new([mixed.x, mixed.y, mixed.z])
                 });
-                moves.push(ContourMove { kind, to: at(point, z), feed: Some(feed), axis });
+                self.moves.push(ContourMove { kind, to: at(point, z), feed: Some(feed), axis });
             }
         }
-        here = pass.start;
-        if let Some(lead) = lead_point {
-            moves.push(ContourMove {
-                kind: MoveKind::Link,
-                to: at(&lead, z),
-                feed: Some(job.feed),
-                axis: start_axis.clone(),
-            });
-            here = lead;
-        }
     }
-    moves.push(ContourMove { kind: MoveKind::Rapid, to: at(&here, job.safe_z), feed: None, axis: start_axis });
-    (moves, arcs)
 }
 
 /// Longest leg of a ramp entry, in tool radii: long enough for a shallow angle, short enough to
@@ -769,6 +824,15 @@ fn corner_reports(job: &Job, setup: &Setup, layer: &Layer, final_pass: &PassPlan
 /// cutting feed, and passes whose allowance does not protect the tip (E1).
 fn corner_warnings(job: &Job, passes: &[PassPlan], corners: &[ContourCorner]) -> Vec<Warning> {
     let mut warnings = Vec::new();
+    shape_warnings(job, passes, corners, &mut warnings);
+    loop_feed_warnings(job, passes, &mut warnings);
+    allowance_warnings(job, passes, &mut warnings);
+    warnings
+}
+
+/// Corners whose shape needs saying: acute tips, convex corners too flat to loop, inside
+/// corners left with a fillet.
+fn shape_warnings(job: &Job, passes: &[PassPlan], corners: &[ContourCorner], warnings: &mut Vec<Warning>) {
     let acute: Vec<usize> = corners
         .iter()
         .filter(|c| c.convexity == Convexity::Convex && c.angle_deg < ACUTE_TIP_DEG)
@@ -820,6 +884,10 @@ fn corner_warnings(job: &Job, passes: &[PassPlan], corners: &[ContourCorner]) ->
             ),
         ));
     }
+}
+
+/// Loops that run at the cutting feed although a faster loop feed is given, and why.
+fn loop_feed_warnings(job: &Job, passes: &[PassPlan], warnings: &mut Vec<Warning>) {
     if job.loop_feed.is_some_and(|f| f != job.feed) {
         for pass in passes {
             let slow: Vec<usize> =
@@ -842,6 +910,11 @@ fn corner_warnings(job: &Job, passes: &[PassPlan], corners: &[ContourCorner]) ->
             }
         }
     }
+}
+
+/// Passes before the last whose allowance does not protect the final tips under the control
+/// model (E1): miters against the blend radius, round joins against the servo lag.
+fn allowance_warnings(job: &Job, passes: &[PassPlan], warnings: &mut Vec<Warning>) {
     let lag_product = job.servo_time_constant_s.map(|t| (job.feed / 60.0 * t).powi(2));
     for pass in passes.iter().take(passes.len().saturating_sub(1)) {
         let mut needed: f64 = 0.0;
@@ -872,7 +945,6 @@ fn corner_warnings(job: &Job, passes: &[PassPlan], corners: &[ContourCorner]) ->
             ));
         }
     }
-    warnings
 }
 
 fn pass_report(pass: &PassPlan) -> PassReport {
