@@ -1,8 +1,8 @@
-//! One program per job (README "One program per job"): the programs of a job's
-//! operations, each written by [`super::write`], joined into one program a control runs from start
-//! to end: one program number, one header listing the operations with their tools and estimated
-//! times, each operation with its tool change, spindle and coolant, a retract to the job's
-//! clearance height between operations, and one program end.
+//! One program per job (docs/spec/api.md Jobs; README "One program per job"): the programs of a
+//! job's operations, each written by [`super::write`], joined into one program a control runs from
+//! start to end: one program number, one header listing the operations with their tools and
+//! estimated times, each operation with its tool change, spindle and coolant, a retract to the
+//! job's clearance height between operations, and one program end.
 //!
 //! The operations' programs are kept as text (a job stores them as its endpoints write them), so
 //! [`Section::parse`] reads back exactly the layout [`super::write`] produces; a program of any

@@ -1,5 +1,6 @@
-//! Arcs of the G-code reader: start angle, sweep and radius in the plane, and the centre and
-//! turns of a `G2`/`G3` block checked for closure.
+//! Arcs of the G-code reader (docs/spec/predict.md §8, engagement.md §11: `G2`/`G3` import): start
+//! angle, sweep and radius in the plane, and the centre and turns of a `G2`/`G3` block checked for
+//! closure.
 
 use super::lexer::syntax;
 use super::modal::Block;

@@ -1,5 +1,6 @@
 //! Reading G-code programs into typed moves with their source line numbers and modal state, and
-//! rewriting a program with new coordinates while keeping everything else byte for byte.
+//! rewriting a program with new coordinates while keeping everything else byte for byte
+//! (docs/spec/predict.md §8 corrected G-code; docs/spec/engagement.md §11 G-code import).
 //!
 //! The reader understands the RS274/Fanuc subset that CAM posts emit for 3-axis milling: `G0`
 //! `G1` `G2` `G3` (arcs by `I J K` or `R`, helical arcs, LinuxCNC's `P` turns), `G17` `G18` `G19`,

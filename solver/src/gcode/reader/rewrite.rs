@@ -1,5 +1,6 @@
-//! Rewriting a program with new end points (and arc centres) while keeping everything else byte
-//! for byte.
+//! Rewriting a program with new end points (and arc centres) while keeping everything else byte for
+//! byte (docs/spec/predict.md §8 corrected G-code: same format, line numbers, comments and modal
+//! state; only coordinates change).
 
 use std::fmt::Write as _;
 
