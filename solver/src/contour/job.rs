@@ -84,9 +84,9 @@ pub(crate) struct Job {
 
 impl ContourRequest {
     /// Checks every field and prepares the contour, with `machine` resolved from `self.machine`.
-    /// The sections are checked in a fixed order (feeds, depths, chording, spindle and entry,
-    /// heights, passes, loops, contour, corners, controller): a request with several faults is
-    /// refused for the first.
+    /// The sections are checked in a fixed order (tool, feeds, depths, chording, spindle and
+    /// entry, heights, stock and passes, loops, contour and start edge, corners, tilt,
+    /// controller): a request with several faults is refused for the first.
     pub(crate) fn validate(&self, tool: &Tool, machine: Option<&MachineProfile>) -> Result<Job, SolverError> {
         tool.validate("tool.")?;
         let radius = tool.radius;
