@@ -158,7 +158,7 @@ fn rewrite_move(
     {
         arc_words(read_move, from, to, wanted_centre.unwrap_or(centre), clockwise, &mut changes, &mut inserts);
     }
-    let edit = (!changes.is_empty() || !inserts.is_empty()).then(|| LineEdit {
+    let edit = (!changes.is_empty() || !inserts.is_empty()).then_some(LineEdit {
         line: read_move.line,
         changes,
         inserts,
