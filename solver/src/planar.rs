@@ -1,7 +1,7 @@
-//! Plane (2-D) geometry shared by the contour and engagement solvers: vectors, orientation and
-//! area, point-in-polygon, segment intersection and distance, line offsets and miter points, a
-//! uniform-grid segment index with a simple-polygon check, convex clipping with exact disk areas,
-//! and arc chording.
+//! Plane (2-D) geometry shared by the contour and engagement solvers (docs/spec/contour.md §3.3,
+//! §3.10; docs/spec/engagement.md): vectors, orientation and area, point-in-polygon, segment
+//! intersection and distance, line offsets and miter points, a uniform-grid segment index with a
+//! simple-polygon check, convex clipping with exact disk areas, and arc chording.
 //!
 //! Conventions: points and vectors are [`Vec2`] in mm; angles in radians; a polygon is a slice of
 //! its vertices without the closing repeat; positive signed area means counter-clockwise. The

@@ -3,11 +3,17 @@
 //! its radial-difference measure (f), and the rotation-invariant turn-angle rule recommended as
 //! the default.
 
-use crate::capability::Control;
-use crate::error::ErrorCode;
 use serde::{Deserialize, Serialize};
 
-use crate::planar::{Vec2, centroid, turn_angle};
+use super::element::ElementKind;
+use super::job::LoopConfig;
+use super::loops::{self, LoopShape};
+use super::pass::MAX_ARC_STEPS;
+use super::request::{self as contour_request, LoopStyle};
+use crate::capability::Control;
+use crate::error::{ErrorCode, SolverError, Warning};
+use crate::planar::{Containment, SegmentGrid, Vec2, centroid, segments_intersect, signed_area, turn_angle, vec2};
+use crate::validate::{finite, positive};
 
 /// How corners are found on a point list.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -183,7 +189,7 @@ pub struct PathLoopAnswer {
 /// # Errors
 /// `E_INPUT` for bad numbers, `E_DEGENERATE` for fewer than 3 distinct points,
 /// `E_TOO_MANY_POINTS`, `E_TOO_MANY_MOVES` (over the contour's move limit).
-pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, crate::error::SolverError> {
+pub fn loop_path(request: &PathLoopRequest) -> Result<PathLoopAnswer, SolverError> {
     loop_path_within(request, super::request::MAX_MOVES, Control::default())
 }
 
@@ -196,16 +202,100 @@ pub fn loop_path_within(
     request: &PathLoopRequest,
     max_moves: usize,
     control: Control<'_>,
-) -> Result<PathLoopAnswer, crate::error::SolverError> {
-    use super::element::ElementKind;
-    use super::loops::{self, LoopShape};
-    use super::pass::MAX_ARC_STEPS;
-    use super::request::{self as contour_request, LoopStyle};
-    use crate::error::{SolverError, Warning};
-    use crate::planar::{Containment, SegmentGrid, segments_intersect, signed_area, vec2};
-    use crate::validate::{finite, positive};
-
+) -> Result<PathLoopAnswer, SolverError> {
     let radius = positive("tool_radius", request.tool_radius)?;
+    let points = path_points(request, max_moves)?;
+    let n = points.len();
+    let tolerance = request.tolerance.unwrap_or(contour_request::DEFAULT_TOLERANCE);
+    if finite("tolerance", tolerance)? < contour_request::MIN_TOLERANCE {
+        return Err(SolverError::input("tolerance", "tolerance is below the smallest accepted"));
+    }
+    let sigma = match request.material_side {
+        MaterialSide::Left => 1.0,
+        MaterialSide::Right => -1.0,
+    };
+    let threshold = detect_threshold(request, radius)?;
+    // The loop sizing of contours, with the request's detection deciding where.
+    let config = request.corner_loop.config(radius)?;
+
+    let (centre, measures) = measures(&points);
+    let mut warnings = Vec::new();
+    let corner = detect_corners(request, &measures, sigma, threshold, &config, &mut warnings);
+
+    let material_inside = (signed_area(&points) > 0.0) == (sigma > 0.0);
+    let grid = SegmentGrid::new((0..n).map(|k| (points[k], points[(k + 1) % n])).collect(), 0.0);
+    let looper = Looper { points: &points, grid, material_inside, tolerance, sigma };
+    let mut scratch = Vec::new();
+    let mut looped = vec![false; n];
+    let mut skipped = 0;
+    let mut moves: Vec<PathMove> = Vec::with_capacity(n + 1);
+    let mut visits: Vec<usize> = Vec::new();
+    let mut route: Vec<Vec2> = vec![points[0]];
+    let cut = super::answer::MoveKind::Cut;
+    for step in 1..=n {
+        control.check()?;
+        control.report(step, n);
+        let k = step % n;
+        let p = points[k];
+        moves.push(PathMove { kind: cut, to: [p.x, p.y] });
+        route.push(p);
+        if !corner[k] || config.style == LoopStyle::None {
+            continue;
+        }
+        let d1 = (p - points[(k + n - 1) % n]).normalize();
+        let d2 = (points[(k + 1) % n] - p).normalize();
+        let Some((shape, _)) = loops::sized(&config, &p, &d1, &d2, sigma) else {
+            continue;
+        };
+        let Some(shape) = looper.fitted(shape, k, &d1, &d2, &mut scratch) else {
+            skipped += 1;
+            continue;
+        };
+        looped[k] = true;
+        visits.push(route.len() - 1);
+        let looped_moves = chorded_loop(&shape, &p, tolerance);
+        if moves.len() + looped_moves.len() + (n - step) > max_moves {
+            return Err(SolverError::new(
+                ErrorCode::TooManyMoves,
+                format!(
+                    "the looped path needs more than {max_moves} moves: use a coarser tolerance, smaller loops or fewer points"
+                ),
+            )
+            .at("path"));
+        }
+        for (_, to, kind) in looped_moves {
+            let kind = if kind == ElementKind::Loop { super::answer::MoveKind::Loop } else { cut };
+            moves.push(PathMove { kind, to: [to.x, to.y] });
+            route.push(to);
+        }
+        visits.push(route.len() - 1);
+    }
+    if skipped > 0 {
+        warnings.push(Warning::new(
+            "W_LOOP_SKIPPED_GOUGE",
+            format!("{skipped} corners got no loop: every variant would cross the path or enter the material"),
+        ));
+    }
+    let (max_abs_cross, min_dot) = corner_visit_turns(&visits, &route);
+    let points = measures
+        .iter()
+        .zip(corner.iter().zip(&looped))
+        .map(|(m, (&corner, &looped))| DetectedPoint {
+            turn_deg: m.turn.to_degrees(),
+            curvature: m.curvature,
+            protrudes: m.protrudes,
+            delta_l: m.delta_l,
+            delta_l_per_step: m.delta_l_per_step,
+            corner,
+            looped,
+        })
+        .collect();
+    Ok(PathLoopAnswer { centre: [centre.x, centre.y], points, moves, max_abs_cross, min_dot, warnings })
+}
+
+/// The request's path as points: finite, repeated points dropped (also a last point repeating
+/// the first), at least 3 and at most `max_moves` of them.
+fn path_points(request: &PathLoopRequest, max_moves: usize) -> Result<Vec<Vec2>, SolverError> {
     if request.path.len() > contour_request::MAX_POINTS {
         return Err(SolverError::new(
             ErrorCode::TooManyPoints,
@@ -235,33 +325,38 @@ pub fn loop_path_within(
         )
         .at("path"));
     }
-    let tolerance = request.tolerance.unwrap_or(contour_request::DEFAULT_TOLERANCE);
-    if finite("tolerance", tolerance)? < contour_request::MIN_TOLERANCE {
-        return Err(SolverError::input("tolerance", "tolerance is below the smallest accepted"));
-    }
-    let sigma = match request.material_side {
-        MaterialSide::Left => 1.0,
-        MaterialSide::Right => -1.0,
-    };
+    Ok(points)
+}
+
+/// The detection threshold in the units [`is_corner`] takes (radians for the turn angle), the
+/// mode's default when the request gives none.
+fn detect_threshold(request: &PathLoopRequest, radius: f64) -> Result<f64, SolverError> {
     let threshold = match (request.detect, request.threshold) {
         (_, Some(value)) => positive("threshold", value)?,
         (DetectMode::TurnAngle, None) => 10.0,
         (DetectMode::PatentCurvature, None) => 1.0 / radius,
         (DetectMode::PatentDeltaL, None) => 5f64.to_radians().sin(),
     };
-    let threshold = if request.detect == DetectMode::TurnAngle {
+    if request.detect == DetectMode::TurnAngle {
         if threshold >= 180.0 {
             return Err(SolverError::input("threshold", "a turn threshold must lie below 180°"));
         }
-        threshold.to_radians()
+        Ok(threshold.to_radians())
     } else {
-        threshold
-    };
-    // The loop sizing of contours, with the request's detection deciding where.
-    let config = request.corner_loop.config(radius)?;
+        Ok(threshold)
+    }
+}
 
-    let (centre, measures) = measures(&points);
-    let mut warnings = Vec::new();
+/// Per point: whether the request's mode calls it a corner turning towards the air; warns where
+/// the patent's rules are undefined or miss turns the loop sizing would take.
+fn detect_corners(
+    request: &PathLoopRequest,
+    measures: &[PointMeasures],
+    sigma: f64,
+    threshold: f64,
+    config: &LoopConfig,
+    warnings: &mut Vec<Warning>,
+) -> Vec<bool> {
     let undefined = measures.iter().filter(|m| m.curvature.is_none()).count();
     if request.detect == DetectMode::PatentCurvature && undefined > 0 {
         warnings.push(Warning::new(
@@ -283,104 +378,84 @@ pub fn loop_path_within(
             ));
         }
     }
+    corner
+}
 
-    let material_inside = (signed_area(&points) > 0.0) == (sigma > 0.0);
-    let grid = SegmentGrid::new((0..n).map(|k| (points[k], points[(k + 1) % n])).collect(), 0.0);
-    let mut scratch = Vec::new();
-    let loop_moves = |shape: &LoopShape, p: &Vec2| -> Vec<(Vec2, Vec2, ElementKind)> {
-        let mut from = *p;
-        let mut moves = Vec::new();
-        for element in shape.elements(p) {
-            for to in element.chord(tolerance, MAX_ARC_STEPS) {
-                moves.push((from, to, element.kind()));
-                from = to;
-            }
+/// A loop's moves from `p` round to `p`: its arcs chorded from outside within `tolerance`, each
+/// move with its element's kind.
+fn chorded_loop(shape: &LoopShape, p: &Vec2, tolerance: f64) -> Vec<(Vec2, Vec2, ElementKind)> {
+    let mut from = *p;
+    let mut moves = Vec::new();
+    for element in shape.elements(p) {
+        for to in element.chord(tolerance, MAX_ARC_STEPS) {
+            moves.push((from, to, element.kind()));
+            from = to;
         }
-        moves
-    };
-    let mut looped = vec![false; n];
-    let mut skipped = 0;
-    let mut moves: Vec<PathMove> = Vec::with_capacity(n + 1);
-    let mut visits: Vec<usize> = Vec::new();
-    let mut route: Vec<Vec2> = vec![points[0]];
-    let cut = super::answer::MoveKind::Cut;
-    for step in 1..=n {
-        control.check()?;
-        control.report(step, n);
-        let k = step % n;
-        let p = points[k];
-        moves.push(PathMove { kind: cut, to: [p.x, p.y] });
-        route.push(p);
-        if !corner[k] || config.style == LoopStyle::None {
-            continue;
-        }
-        let d1 = (p - points[(k + n - 1) % n]).normalize();
-        let d2 = (points[(k + 1) % n] - p).normalize();
-        let Some((shape, _)) = loops::sized(&config, &p, &d1, &d2, sigma) else {
-            continue;
-        };
-        let (before, after) = ((k + n - 1) % n, k);
-        let clear = |shape: &LoopShape, scratch: &mut Vec<usize>| {
-            loop_moves(shape, &p).iter().all(|(a, b, _)| {
-                let outside = match grid.containment(b, scratch) {
-                    Containment::Boundary => (b - p).norm() < 1e-12,
-                    Containment::Inside => !material_inside,
-                    Containment::Outside => material_inside,
-                };
-                scratch.clear();
-                grid.candidates(a, b, 0.0, scratch);
-                outside
-                    && scratch.iter().all(|&e| {
-                        e == before || e == after || !segments_intersect(a, b, &points[e], &points[(e + 1) % n])
-                    })
-            })
-        };
+    }
+    moves
+}
+
+/// The given path and what a loop on it must clear: the path itself and its material side.
+struct Looper<'a> {
+    points: &'a [Vec2],
+    grid: SegmentGrid,
+    /// Whether the material lies inside the closed path.
+    material_inside: bool,
+    tolerance: f64,
+    sigma: f64,
+}
+
+impl Looper<'_> {
+    /// The loop at point `k` that clears the path: `shape` as sized, else up to four halvings,
+    /// then a triangle of the last leg; `None` when none of them clears.
+    fn fitted(&self, shape: LoopShape, k: usize, d1: &Vec2, d2: &Vec2, scratch: &mut Vec<usize>) -> Option<LoopShape> {
+        let p = self.points[k];
         let mut candidate = Some(shape);
         let mut attempt = shape;
         for round in 0..6 {
-            if clear(&attempt, &mut scratch) {
+            if self.clears(&attempt, k, scratch) {
                 break;
             }
             attempt = if round < 4 {
-                attempt.scaled(&p, &d1, &d2, sigma, 0.5)
+                attempt.scaled(&p, d1, d2, self.sigma, 0.5)
             } else {
-                LoopShape::triangle(&p, &d1, &d2, attempt.leg)
+                LoopShape::triangle(&p, d1, d2, attempt.leg)
             };
             if round == 5 {
                 candidate = None;
             }
         }
-        let Some(shape) = candidate.map(|_| attempt) else {
-            skipped += 1;
-            continue;
-        };
-        looped[k] = true;
-        visits.push(route.len() - 1);
-        let looped_moves = loop_moves(&shape, &p);
-        if moves.len() + looped_moves.len() + (n - step) > max_moves {
-            return Err(SolverError::new(
-                ErrorCode::TooManyMoves,
-                format!(
-                    "the looped path needs more than {max_moves} moves: use a coarser tolerance, smaller loops or fewer points"
-                ),
-            )
-            .at("path"));
-        }
-        for (_, to, kind) in looped_moves {
-            let kind = if kind == ElementKind::Loop { super::answer::MoveKind::Loop } else { cut };
-            moves.push(PathMove { kind, to: [to.x, to.y] });
-            route.push(to);
-        }
-        visits.push(route.len() - 1);
+        candidate.map(|_| attempt)
     }
-    if skipped > 0 {
-        warnings.push(Warning::new(
-            "W_LOOP_SKIPPED_GOUGE",
-            format!("{skipped} corners got no loop: every variant would cross the path or enter the material"),
-        ));
+
+    /// Whether every move of the loop at point `k` ends off the material side and crosses no
+    /// edge of the path but the two meeting at `k`.
+    fn clears(&self, shape: &LoopShape, k: usize, scratch: &mut Vec<usize>) -> bool {
+        let (points, grid, material_inside) = (self.points, &self.grid, self.material_inside);
+        let n = points.len();
+        let p = points[k];
+        let (before, after) = ((k + n - 1) % n, k);
+        chorded_loop(shape, &p, self.tolerance).iter().all(|(a, b, _)| {
+            let outside = match grid.containment(b, scratch) {
+                Containment::Boundary => (b - p).norm() < 1e-12,
+                Containment::Inside => !material_inside,
+                Containment::Outside => material_inside,
+            };
+            scratch.clear();
+            grid.candidates(a, b, 0.0, scratch);
+            outside
+                && scratch
+                    .iter()
+                    .all(|&e| e == before || e == after || !segments_intersect(a, b, &points[e], &points[(e + 1) % n]))
+        })
     }
+}
+
+/// Claim 10 at the corner visits (route indices): the largest |cross| and the smallest dot
+/// product of the unit moves into and out of each.
+fn corner_visit_turns(visits: &[usize], route: &[Vec2]) -> (f64, f64) {
     let (mut max_abs_cross, mut min_dot) = (0.0_f64, 1.0_f64);
-    for &i in &visits {
+    for &i in visits {
         let (Some(back), Some(here), Some(ahead)) =
             (i.checked_sub(1).and_then(|j| route.get(j)), route.get(i), route.get(i + 1))
         else {
@@ -392,18 +467,5 @@ pub fn loop_path_within(
         max_abs_cross = max_abs_cross.max(crate::planar::cross(&u, &v).abs());
         min_dot = min_dot.min(u.dot(&v));
     }
-    let points = measures
-        .iter()
-        .zip(corner.iter().zip(&looped))
-        .map(|(m, (&corner, &looped))| DetectedPoint {
-            turn_deg: m.turn.to_degrees(),
-            curvature: m.curvature,
-            protrudes: m.protrudes,
-            delta_l: m.delta_l,
-            delta_l_per_step: m.delta_l_per_step,
-            corner,
-            looped,
-        })
-        .collect();
-    Ok(PathLoopAnswer { centre: [centre.x, centre.y], points, moves, max_abs_cross, min_dot, warnings })
+    (max_abs_cross, min_dot)
 }

@@ -84,113 +84,26 @@ pub(crate) struct Job {
 
 impl ContourRequest {
     /// Checks every field and prepares the contour, with `machine` resolved from `self.machine`.
+    /// The sections are checked in a fixed order (tool, feeds, depths, chording, spindle and
+    /// entry, heights, stock and passes, loops, contour and start edge, corners, tilt,
+    /// controller): a request with several faults is refused for the first.
     pub(crate) fn validate(&self, tool: &Tool, machine: Option<&MachineProfile>) -> Result<Job, SolverError> {
         tool.validate("tool.")?;
         let radius = tool.radius;
         let feed = positive("feed", self.feed)?;
         let loop_feed = self.loop_feed.map(|f| positive("loop_feed", f)).transpose()?;
-        let depths = &self.depths;
-        let top = finite("depths.top", depths.top)?;
-        let bottom = finite("depths.bottom", depths.bottom)?;
-        let step = positive("depths.step", depths.step)?;
-        for (field, value) in [("depths.top", top), ("depths.bottom", bottom)] {
-            if value.abs() > super::prepare::MAX_COORDINATE {
-                return Err(SolverError::input(
-                    field,
-                    format!("{field} must lie within ±{} mm", super::prepare::MAX_COORDINATE),
-                ));
-            }
-        }
-        if radius > super::prepare::MAX_COORDINATE {
-            return Err(SolverError::input("tool.radius", "the tool radius is implausibly large"));
-        }
-        if bottom > top {
-            return Err(SolverError::input(
-                "depths.bottom",
-                format!("depths.bottom {bottom} lies above depths.top {top}"),
-            ));
-        }
-        let layers = layer_heights(top, bottom, step)?;
-        let tolerance = self.tolerance.unwrap_or(DEFAULT_TOLERANCE);
-        if finite("tolerance", tolerance)? < MIN_TOLERANCE {
-            return Err(SolverError::input(
-                "tolerance",
-                format!("tolerance must be at least {MIN_TOLERANCE} mm (got {tolerance})"),
-            ));
-        }
-        let mut rule_warnings = Vec::new();
-        let rules = if self.block_time_ms.is_some() || machine.is_some() {
-            let settings =
-                RuleSettings { feed: Some(feed), block_time_ms: self.block_time_ms, ..RuleSettings::default() };
-            let (rule, warnings) = BlockRule::resolve(&settings, machine)?;
-            rule_warnings = warnings;
-            let loops = BlockRule { feed: feed.max(loop_feed.unwrap_or(feed)), ..rule };
-            Some((rule, loops))
-        } else {
-            None
-        };
-        let chording = Chording { tolerance, rules };
-        let spindle_rpm = positive("spindle_rpm", self.spindle_rpm.unwrap_or(DEFAULT_SPINDLE_RPM))?;
-        let plunge_feed = self
-            .plunge_feed
-            .map(|f| positive("plunge_feed", f))
-            .transpose()?
-            .or(tool.plunge_feed)
-            .or(machine.and_then(|m| m.plunge_feed));
-        let ramp_angle = finite("ramp_angle_deg", self.ramp_angle_deg.unwrap_or(DEFAULT_RAMP_ANGLE_DEG))?;
-        if !(ramp_angle > 0.0 && ramp_angle <= 45.0) {
-            return Err(SolverError::input(
-                "ramp_angle_deg",
-                format!("ramp_angle_deg must be above 0 and at most 45 (got {ramp_angle})"),
-            ));
-        }
-        let ramp = (!tool.cuts_at_centre()).then(|| ramp_angle.to_radians());
-        let clearance = non_negative("clearance", self.clearance.unwrap_or(DEFAULT_CLEARANCE))?;
-        let safe_z = match self.safe_z {
-            Some(z) => {
-                if finite("safe_z", z)? <= top {
-                    return Err(SolverError::input("safe_z", format!("safe_z {z} must lie above depths.top {top}")));
-                }
-                z
-            }
-            None => top + clearance.max(1e-3),
-        };
-        let lead = non_negative("lead", self.lead.unwrap_or(radius))?;
-        let stock_allowance = self.stock_allowance.map(|s| non_negative("stock_allowance", s)).transpose()?;
-        let passes = self.pass_jobs()?;
-        if let (Some(stock), Some(first)) = (stock_allowance, passes.first())
-            && stock < first.allowance
-        {
-            return Err(SolverError::input(
-                "stock_allowance",
-                format!("stock_allowance {stock} is smaller than the first pass's allowance {}", first.allowance),
-            ));
-        }
+        let (top, bottom, layers) = self.layer_depths(radius)?;
+        let (tolerance, chording, rule_warnings) = self.chording(feed, loop_feed, machine)?;
+        let (spindle_rpm, plunge_feed, ramp) = self.spindle_and_entry(tool, machine)?;
+        let (safe_z, lead) = self.heights(top, radius)?;
+        let (stock_allowance, passes) = self.stock_and_passes()?;
         let loop_config = self.corner_loop.config(radius)?;
         let (contour, mut warnings) = prepare::prepare(&self.contour, self.fix_orientation)?;
         warnings.extend(rule_warnings);
-        let start_edge = match self.start_edge {
-            None => contour.edge_containing(0),
-            Some(k) if k < self.contour.len() => contour.edge_containing(k),
-            Some(k) => {
-                return Err(SolverError::input(
-                    "start_edge",
-                    format!("start_edge {k} is not an index of contour (0 to {})", self.contour.len() - 1),
-                ));
-            }
-        };
+        let start_edge = self.prepared_start_edge(&contour)?;
         let choices = self.corner_choices(&contour)?;
         let tilt = self.tilt(&contour)?;
-        let (blend_radius, servo_time_constant_s) = match &self.controller {
-            None => (None, None),
-            Some(model) => (
-                model.blend_radius.map(|b| non_negative("controller.blend_radius", b)).transpose()?,
-                model
-                    .servo_time_constant_ms
-                    .map(|t| non_negative("controller.servo_time_constant_ms", t).map(|t| t / 1000.0))
-                    .transpose()?,
-            ),
-        };
+        let (blend_radius, servo_time_constant_s) = self.controller_model()?;
         if tilt.is_some() && tool.kind != ToolKind::Flat {
             warnings.push(Warning::new(
                 "W_TILT_TOOL_KIND",
@@ -224,6 +137,144 @@ impl ContourRequest {
             blend_radius,
             servo_time_constant_s,
             warnings,
+        })
+    }
+
+    /// `depths`: top, bottom and the layer heights from top down (the tool radius is checked for
+    /// size here too, as it bounds the coordinates like the depths).
+    fn layer_depths(&self, radius: f64) -> Result<(f64, f64, Vec<f64>), SolverError> {
+        let depths = &self.depths;
+        let top = finite("depths.top", depths.top)?;
+        let bottom = finite("depths.bottom", depths.bottom)?;
+        let step = positive("depths.step", depths.step)?;
+        for (field, value) in [("depths.top", top), ("depths.bottom", bottom)] {
+            if value.abs() > super::prepare::MAX_COORDINATE {
+                return Err(SolverError::input(
+                    field,
+                    format!("{field} must lie within ±{} mm", super::prepare::MAX_COORDINATE),
+                ));
+            }
+        }
+        if radius > super::prepare::MAX_COORDINATE {
+            return Err(SolverError::input("tool.radius", "the tool radius is implausibly large"));
+        }
+        if bottom > top {
+            return Err(SolverError::input(
+                "depths.bottom",
+                format!("depths.bottom {bottom} lies above depths.top {top}"),
+            ));
+        }
+        Ok((top, bottom, layer_heights(top, bottom, step)?))
+    }
+
+    /// `tolerance`, and with `block_time_ms` or a machine the block-time rules of cutting and
+    /// loop arcs (loops at the larger of the two feeds), with the rule's warnings.
+    fn chording(
+        &self,
+        feed: f64,
+        loop_feed: Option<f64>,
+        machine: Option<&MachineProfile>,
+    ) -> Result<(f64, Chording, Vec<Warning>), SolverError> {
+        let tolerance = self.tolerance.unwrap_or(DEFAULT_TOLERANCE);
+        if finite("tolerance", tolerance)? < MIN_TOLERANCE {
+            return Err(SolverError::input(
+                "tolerance",
+                format!("tolerance must be at least {MIN_TOLERANCE} mm (got {tolerance})"),
+            ));
+        }
+        let mut rule_warnings = Vec::new();
+        let rules = if self.block_time_ms.is_some() || machine.is_some() {
+            let settings =
+                RuleSettings { feed: Some(feed), block_time_ms: self.block_time_ms, ..RuleSettings::default() };
+            let (rule, warnings) = BlockRule::resolve(&settings, machine)?;
+            rule_warnings = warnings;
+            let loops = BlockRule { feed: feed.max(loop_feed.unwrap_or(feed)), ..rule };
+            Some((rule, loops))
+        } else {
+            None
+        };
+        Ok((tolerance, Chording { tolerance, rules }, rule_warnings))
+    }
+
+    /// `spindle_rpm`, the plunge feed (the request's, else the tool's, else the machine's) and
+    /// the ramp angle in radians for a tool that does not cut at its centre.
+    fn spindle_and_entry(
+        &self,
+        tool: &Tool,
+        machine: Option<&MachineProfile>,
+    ) -> Result<(f64, Option<f64>, Option<f64>), SolverError> {
+        let spindle_rpm = positive("spindle_rpm", self.spindle_rpm.unwrap_or(DEFAULT_SPINDLE_RPM))?;
+        let plunge_feed = self
+            .plunge_feed
+            .map(|f| positive("plunge_feed", f))
+            .transpose()?
+            .or(tool.plunge_feed)
+            .or(machine.and_then(|m| m.plunge_feed));
+        let ramp_angle = finite("ramp_angle_deg", self.ramp_angle_deg.unwrap_or(DEFAULT_RAMP_ANGLE_DEG))?;
+        if !(ramp_angle > 0.0 && ramp_angle <= 45.0) {
+            return Err(SolverError::input(
+                "ramp_angle_deg",
+                format!("ramp_angle_deg must be above 0 and at most 45 (got {ramp_angle})"),
+            ));
+        }
+        let ramp = (!tool.cuts_at_centre()).then(|| ramp_angle.to_radians());
+        Ok((spindle_rpm, plunge_feed, ramp))
+    }
+
+    /// The clearance plane (`safe_z`, else `clearance` above the top) and the `lead` length.
+    fn heights(&self, top: f64, radius: f64) -> Result<(f64, f64), SolverError> {
+        let clearance = non_negative("clearance", self.clearance.unwrap_or(DEFAULT_CLEARANCE))?;
+        let safe_z = match self.safe_z {
+            Some(z) => {
+                if finite("safe_z", z)? <= top {
+                    return Err(SolverError::input("safe_z", format!("safe_z {z} must lie above depths.top {top}")));
+                }
+                z
+            }
+            None => top + clearance.max(1e-3),
+        };
+        let lead = non_negative("lead", self.lead.unwrap_or(radius))?;
+        Ok((safe_z, lead))
+    }
+
+    /// `stock_allowance` and the passes; the stock must be at least the first pass's allowance.
+    fn stock_and_passes(&self) -> Result<(Option<f64>, Vec<PassJob>), SolverError> {
+        let stock_allowance = self.stock_allowance.map(|s| non_negative("stock_allowance", s)).transpose()?;
+        let passes = self.pass_jobs()?;
+        if let (Some(stock), Some(first)) = (stock_allowance, passes.first())
+            && stock < first.allowance
+        {
+            return Err(SolverError::input(
+                "stock_allowance",
+                format!("stock_allowance {stock} is smaller than the first pass's allowance {}", first.allowance),
+            ));
+        }
+        Ok((stock_allowance, passes))
+    }
+
+    /// The prepared edge holding `start_edge` (default: the edge from the first point).
+    fn prepared_start_edge(&self, contour: &Contour) -> Result<usize, SolverError> {
+        match self.start_edge {
+            None => Ok(contour.edge_containing(0)),
+            Some(k) if k < self.contour.len() => Ok(contour.edge_containing(k)),
+            Some(k) => Err(SolverError::input(
+                "start_edge",
+                format!("start_edge {k} is not an index of contour (0 to {})", self.contour.len() - 1),
+            )),
+        }
+    }
+
+    /// The `controller` model: blend radius, mm, and servo time constant, s.
+    fn controller_model(&self) -> Result<(Option<f64>, Option<f64>), SolverError> {
+        Ok(match &self.controller {
+            None => (None, None),
+            Some(model) => (
+                model.blend_radius.map(|b| non_negative("controller.blend_radius", b)).transpose()?,
+                model
+                    .servo_time_constant_ms
+                    .map(|t| non_negative("controller.servo_time_constant_ms", t).map(|t| t / 1000.0))
+                    .transpose()?,
+            ),
         })
     }
 

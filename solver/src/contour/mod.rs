@@ -19,6 +19,9 @@
 //! * `relief`: dogbone and T-bone reliefs (beyond the patent);
 //! * [`material`]: material left and over-cut, control models M1/M2 (§3.10);
 //! * `solve`: layers, passes, links at the clearance plane, the answer (§3.8, §3.9.1);
+//! * `moves`: one layer's moves: lead point, entry, the passes' chords, links and retract
+//!   (§3.9.1);
+//! * `report`: the answer's corner, pass and warning reports and the description (§3.8, §3.10);
 //! * [`division`]: division coordinates, the one-number encoding and the claim-10 check (§3.6,
 //!   §3.7);
 //! * [`detect`]: corner detection on an existing CL point list (§3.4, claims 8–9), and loops
@@ -64,12 +67,14 @@ mod job;
 mod layer;
 pub mod loops;
 pub mod material;
+mod moves;
 mod offset;
 mod parts;
 mod pass;
 mod prepare;
 pub mod program;
 mod relief;
+mod report;
 pub mod request;
 mod solve;
 

@@ -72,37 +72,80 @@ pub(crate) fn offset(
     describe_tool: &str,
 ) -> Result<Offset, SolverError> {
     let n = layer.len();
-    let field = |edge: usize| format!("contour[{}]", edge_source[edge]);
-    let mut previous: Vec<usize> = (0..n).map(|k| layer.previous(k)).collect();
-    let mut next: Vec<usize> = (0..n).map(|k| layer.next(k)).collect();
-    let corner = |before: usize, after: usize| {
-        if layer.next(before) == after {
-            // Adjacent edges meet at their common vertex: O2/O3.
-            return miter_point(
-                &layer.vertices[after],
-                &layer.air_normal(before),
-                offsets[before],
-                &layer.air_normal(after),
-                offsets[after],
-            );
-        }
-        // Edges with removed edges between them: intersect their offset lines.
-        let on_before = layer.vertices[before] + offsets[before] * layer.air_normal(before);
-        let on_after = layer.vertices[after] + offsets[after] * layer.air_normal(after);
-        let (t1, t2) = (layer.directions[before], layer.directions[after]);
-        if crate::planar::cross(&t1, &t2).abs() <= 1e-12 {
-            return None;
-        }
-        line_intersection(&on_before, &t1, &on_after, &t2)
-    };
+    let previous: Vec<usize> = (0..n).map(|k| layer.previous(k)).collect();
+    let next: Vec<usize> = (0..n).map(|k| layer.next(k)).collect();
     // start[e]: the CL point where edge e begins (intersection with its active predecessor).
     let mut start: Vec<Vec2> = Vec::with_capacity(n);
     for (k, &before) in previous.iter().enumerate() {
-        start.push(corner(before, k).ok_or_else(|| {
-            SolverError::new(ErrorCode::Degenerate, format!("the contour reverses by 180° at {}", field(k)))
-                .at(field(k))
+        start.push(offset_corner(layer, offsets, before, k).ok_or_else(|| {
+            let field = edge_field(edge_source, k);
+            SolverError::new(ErrorCode::Degenerate, format!("the contour reverses by 180° at {field}")).at(field)
         })?);
     }
+    let links = Links { previous, next, start };
+    let survivors = drop_short_edges(layer, offsets, edge_source, describe_tool, links)?;
+    let Some(anchor) = (0..n).find(|&k| survivors.active[k]) else {
+        return Err(collapse(describe_tool, &edge_field(edge_source, 0), layer.lengths[0], 0.0));
+    };
+    Ok(chains(layer, &survivors.start, survivors.active, anchor))
+}
+
+/// The request field of traversal edge `edge`.
+fn edge_field(edge_source: &[usize], edge: usize) -> String {
+    format!("contour[{}]", edge_source[edge])
+}
+
+/// Where the offset lines of edges `before` and `after` meet; `None` for parallel lines of
+/// edges that are not neighbours.
+fn offset_corner(layer: &Layer, offsets: &[f64], before: usize, after: usize) -> Option<Vec2> {
+    if layer.next(before) == after {
+        // Adjacent edges meet at their common vertex: O2/O3.
+        return miter_point(
+            &layer.vertices[after],
+            &layer.air_normal(before),
+            offsets[before],
+            &layer.air_normal(after),
+            offsets[after],
+        );
+    }
+    // Edges with removed edges between them: intersect their offset lines.
+    let on_before = layer.vertices[before] + offsets[before] * layer.air_normal(before);
+    let on_after = layer.vertices[after] + offsets[after] * layer.air_normal(after);
+    let (t1, t2) = (layer.directions[before], layer.directions[after]);
+    if crate::planar::cross(&t1, &t2).abs() <= 1e-12 {
+        return None;
+    }
+    line_intersection(&on_before, &t1, &on_after, &t2)
+}
+
+/// The offset edges as a doubly linked list: each surviving edge's neighbours and the CL point
+/// where it begins.
+struct Links {
+    previous: Vec<usize>,
+    next: Vec<usize>,
+    start: Vec<Vec2>,
+}
+
+/// Which edges survive and where the surviving ones begin.
+struct Survivors {
+    active: Vec<bool>,
+    start: Vec<Vec2>,
+}
+
+/// Edge events (O4): removes offset edges of no length, shortest first, joining their
+/// neighbours' offset lines, until every edge left has a length.
+///
+/// # Errors
+/// `E_OFFSET_COLLAPSE` when three edges or fewer would be left, or the neighbours do not meet.
+fn drop_short_edges(
+    layer: &Layer,
+    offsets: &[f64],
+    edge_source: &[usize],
+    describe_tool: &str,
+    links: Links,
+) -> Result<Survivors, SolverError> {
+    let n = layer.len();
+    let Links { mut previous, mut next, mut start } = links;
     let scale = layer.lengths.iter().copied().fold(0.0, f64::max).max(1.0);
     let limit = 1e-12 * scale;
     let length =
@@ -123,11 +166,11 @@ pub(crate) fn offset(
             continue;
         }
         if remaining <= 3 {
-            return Err(collapse(describe_tool, &field(edge), layer.lengths[edge], event.length));
+            return Err(collapse(describe_tool, &edge_field(edge_source, edge), layer.lengths[edge], event.length));
         }
         let (before, after) = (previous[edge], next[edge]);
-        let Some(point) = corner(before, after) else {
-            return Err(collapse(describe_tool, &field(edge), layer.lengths[edge], event.length));
+        let Some(point) = offset_corner(layer, offsets, before, after) else {
+            return Err(collapse(describe_tool, &edge_field(edge_source, edge), layer.lengths[edge], event.length));
         };
         active[edge] = false;
         remaining -= 1;
@@ -142,12 +185,16 @@ pub(crate) fn offset(
             }
         }
     }
-    // Each vertex takes the CL point of the first surviving edge at or after it.
+    Ok(Survivors { active, start })
+}
+
+/// Each vertex takes the CL point of the first surviving edge at or after it; the vertices
+/// sharing one CL point form a chain, recorded by its first vertex. `anchor` is a surviving
+/// edge.
+fn chains(layer: &Layer, start: &[Vec2], active: Vec<bool>, anchor: usize) -> Offset {
+    let n = layer.len();
     let mut cl = vec![Vec2::zeros(); n];
     let mut chain_start = vec![0; n];
-    let Some(anchor) = (0..n).find(|&k| active[k]) else {
-        return Err(collapse(describe_tool, &field(0), layer.lengths[0], 0.0));
-    };
     for step in 0..n {
         let edge = (anchor + step) % n;
         if !active[edge] {
@@ -172,7 +219,7 @@ pub(crate) fn offset(
             member = layer.next(member);
         }
     }
-    Ok(Offset { cl, active, chain_start })
+    Offset { cl, active, chain_start }
 }
 
 fn collapse(describe_tool: &str, field: &str, length: f64, offset_length: f64) -> SolverError {

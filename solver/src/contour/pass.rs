@@ -1,7 +1,9 @@
 //! One pass around one layer's contour (docs/spec/contour.md §3.3 offset, §3.5 loops with the global gouge
 //! check and its fallbacks, §3.5.7 stock contact, §3.11 `plan_pass`): the miter CL polygon and
-//! its validity (O4, O5, global clearance), the action at every corner, and the element list from
-//! S round to S.
+//! its validity (O4, O5, global clearance; the checks are in `clearance`), the action at every
+//! corner, and the element list from S round to S.
+
+mod clearance;
 
 use super::element::{Chording, Element, ElementKind};
 use super::job::{CornerChoice, LoopConfig, PassJob};
@@ -10,9 +12,9 @@ use super::loops::{self, LoopShape};
 use super::offset::{self, Offset};
 use super::relief::{self, ReliefShape};
 use super::request::{Join, LoopStyle, Relief};
-use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};
-use crate::planar::{SegmentGrid, Vec2, find_self_intersection, signed_area};
+use crate::planar::{SegmentGrid, Vec2};
+use clearance::{check_clearance, check_loop_budget, check_offset, gouge_fallbacks, stock_clearance};
 
 /// Clearance below which a move gouges, mm.
 pub const GOUGE_TOLERANCE: f64 = 1e-9;
@@ -206,26 +208,71 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
     let cl = offset.cl.clone();
 
     check_loop_budget(layer, &offset, input)?;
-    let mut warnings = Vec::new();
     // S lies on edge 0, or on the first edge the tool follows.
     let first_edge = (0..n).find(|&k| offset.active[k]).unwrap_or(0);
     let start = start_point(layer, &cl, offsets, first_edge);
-    let mut path = Path::default();
+    let mut walk = Walk {
+        path: Path::default(),
+        current: start,
+        skipped: Vec::new(),
+        fallbacks: Vec::new(),
+        reliefs_skipped: Vec::new(),
+        scratch: Vec::new(),
+    };
     let mut corners: Vec<Option<CornerPlan>> = vec![None; n];
-    let mut current = start;
-    let mut skipped: Vec<usize> = Vec::new();
-    let mut fallbacks: Vec<String> = Vec::new();
-    let mut reliefs_skipped: Vec<usize> = Vec::new();
-    let mut scratch = Vec::new();
     for step in 1..=n {
         let k = (first_edge + step) % n;
+        corners[k] = Some(walk.corner(layer, input, &offset, clear, k));
+    }
+    walk.path.push(cut(walk.current, start), first_edge, first_edge, false);
+    check_clearance(layer, &walk.path.elements, clear, input, &mut walk.scratch)?;
+
+    let warnings = pass_warnings(input, &offset, &walk, &tool);
+    let corners: Vec<CornerPlan> = corners.into_iter().flatten().collect();
+    let gouge_min_clearance = corners.iter().filter_map(|c| c.clearance).reduce(f64::min);
+    let stock_min_clearance = corners.iter().filter_map(|c| c.stock_clearance).reduce(f64::min);
+    Ok(PassPlan {
+        index: input.index,
+        allowance: input.pass.allowance,
+        offset: clear,
+        edge_offsets: offsets.clone(),
+        loops: input.pass.loops,
+        join: input.pass.join,
+        start,
+        start_edge: first_edge,
+        cl,
+        unreached_edges: (0..n).filter(|&k| !offset.active[k]).collect(),
+        elements: walk.path.elements,
+        meta: walk.path.meta,
+        corners,
+        gouge_min_clearance,
+        stock_min_clearance,
+        warnings,
+    })
+}
+
+/// The walk from S round the contour as one pass is planned: the path so far, where the tool
+/// stands, and the corners whose loop or relief had to be left out (for the warnings).
+struct Walk {
+    path: Path,
+    current: Vec2,
+    /// Request indices of convex corners whose loop gouged even after the fallbacks.
+    skipped: Vec<usize>,
+    /// Why a loop was resized or restyled to clear the contour, per corner.
+    fallbacks: Vec<String>,
+    /// Request indices of inside corners whose relief would gouge another face.
+    reliefs_skipped: Vec<usize>,
+    scratch: Vec<usize>,
+}
+
+impl Walk {
+    /// Plans the corner at traversal vertex `k` and appends its moves (the cut up to it and the
+    /// loop, join or relief there).
+    fn corner(&mut self, layer: &Layer, input: &PassInput<'_>, offset: &Offset, clear: f64, k: usize) -> CornerPlan {
         let vertex = layer.vertices[k];
-        let (d1, d2) = layer.corner_directions(k);
         let turn = layer.turn(k);
         let class = layer.class(k);
-        let p = cl[k];
-        let choice = input.choices[k];
-        let (o1, o2) = (offsets[layer.previous(k)], offsets[k]);
+        let p = offset.cl[k];
         let mut plan = CornerPlan {
             k,
             source: input.source[k],
@@ -242,139 +289,155 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
             stock_clearance: None,
             loop_feed: false,
         };
-        let big_enough = turn.abs() >= input.loop_config.min_turn;
         let incoming = layer.previous(k);
         if offset.merged(layer, k) {
             plan.action = Action::Unreached;
             if offset.chain_start[k] == k {
-                path.push(cut(current, p), incoming, incoming, false);
-                current = p;
+                self.path.push(cut(self.current, p), incoming, incoming, false);
+                self.current = p;
             }
-            corners[k] = Some(plan);
-            continue;
+            return plan;
         }
         match class {
-            Class::Convex => {
-                let wanted = input.pass.loops
-                    && input.loop_config.style != LoopStyle::None
-                    && choice.loops.unwrap_or(big_enough);
-                let found = if wanted {
-                    loops::sized(input.loop_config, &p, &d1, &d2, layer.sigma).and_then(|(shape, fallback)| {
-                        let chosen = gouge_fallbacks(layer, &shape, &p, &d1, &d2, &vertex, clear, input, &mut scratch);
-                        match &chosen {
-                            Ok(_) => {
-                                if let Some(reason) = fallback {
-                                    fallbacks.push(format!("{}: {reason}", field(input.source[k])));
-                                }
-                            }
-                            Err(_) => skipped.push(input.source[k]),
-                        }
-                        chosen.ok()
-                    })
-                } else {
-                    None
-                };
-                if let Some((shape, clearance)) = found {
-                    plan.action = match shape.style {
-                        LoopStyle::Triangle => Action::LoopTriangle,
-                        LoopStyle::Parallelogram => Action::LoopParallelogram,
-                        LoopStyle::Arc | LoopStyle::None => Action::LoopArc,
-                    };
-                    plan.clearance = Some(clearance);
-                    if let Some(stock) = input.stock {
-                        let stock_clearance = stock_clearance(stock, &shape, &p, &vertex, input, &mut scratch);
-                        plan.stock_clearance = Some(stock_clearance);
-                        plan.loop_feed = stock_clearance >= -GOUGE_TOLERANCE;
-                    }
-                    path.push(cut(current, p), incoming, incoming, false);
-                    for element in shape.elements(&p) {
-                        let (from, to) = match element.kind() {
-                            ElementKind::Exit => (incoming, incoming),
-                            ElementKind::Entry => (k, k),
-                            _ => (incoming, k),
-                        };
-                        let fast = element.kind() == ElementKind::Loop && plan.loop_feed;
-                        path.push(element, from, to, fast);
-                    }
-                    plan.loop_shape = Some(shape);
-                    current = p;
-                } else if input.pass.join == Join::Round && o1 == o2 {
-                    plan.action = Action::Round;
-                    let e1 = vertex + o1 * layer.air_normal(layer.previous(k));
-                    let e2 = vertex + o2 * layer.air_normal(k);
-                    path.push(cut(current, e1), incoming, incoming, false);
-                    path.push(
-                        Element::Arc {
-                            start: e1,
-                            end: e2,
-                            centre: vertex,
-                            radius: o1,
-                            sweep: turn,
-                            kind: ElementKind::Cut,
-                        },
-                        incoming,
-                        k,
-                        false,
-                    );
-                    current = e2;
-                } else {
-                    plan.action = Action::Miter;
-                    path.push(cut(current, p), incoming, incoming, false);
-                    current = p;
-                }
-            }
-            Class::Reflex => {
-                path.push(cut(current, p), incoming, incoming, false);
-                current = p;
-                let style = if big_enough { choice.relief } else { Relief::None };
-                if style != Relief::None {
-                    let shape = relief::shape(layer, k, &p, o1.min(o2), style, choice.tbone_edge, input.request_order);
-                    let moves = [(p, shape.target), (shape.target, p)];
-                    let (previous_edge, next_edge) = (layer.previous(k), k);
-                    let gouges = moves.iter().any(|(a, b)| {
-                        layer
-                            .grid
-                            .nearest(a, b, clear - GOUGE_TOLERANCE, &mut scratch, |e| {
-                                e == previous_edge || e == next_edge
-                            })
-                            .is_some()
-                    });
-                    if gouges {
-                        reliefs_skipped.push(input.source[k]);
-                    } else {
-                        plan.action = if style == Relief::Dogbone { Action::Dogbone } else { Action::Tbone };
-                        for (a, b) in moves {
-                            path.push(
-                                Element::Line { start: a, end: b, kind: ElementKind::Relief },
-                                incoming,
-                                incoming,
-                                false,
-                            );
-                        }
-                        plan.relief = Some(shape);
-                    }
-                }
-            }
+            Class::Convex => self.convex(layer, input, clear, &mut plan),
+            Class::Reflex => self.reflex(layer, input, clear, &mut plan),
         }
-        corners[k] = Some(plan);
+        plan
     }
-    path.push(cut(current, start), first_edge, first_edge, false);
-    check_clearance(layer, &path.elements, clear, input, &mut scratch)?;
 
-    if !skipped.is_empty() {
+    /// A protruding corner: a loop when wanted and one clears the contour, else the pass's join
+    /// (round when both faces have the same offset, else miter).
+    fn convex(&mut self, layer: &Layer, input: &PassInput<'_>, clear: f64, plan: &mut CornerPlan) {
+        let (k, vertex, turn, p) = (plan.k, plan.vertex, plan.turn, plan.cl_point);
+        let (d1, d2) = layer.corner_directions(k);
+        let choice = input.choices[k];
+        let offsets = &input.edge_offsets;
+        let (o1, o2) = (offsets[layer.previous(k)], offsets[k]);
+        let big_enough = turn.abs() >= input.loop_config.min_turn;
+        let incoming = layer.previous(k);
+        let wanted =
+            input.pass.loops && input.loop_config.style != LoopStyle::None && choice.loops.unwrap_or(big_enough);
+        let found = if wanted {
+            loops::sized(input.loop_config, &p, &d1, &d2, layer.sigma).and_then(|(shape, fallback)| {
+                let chosen = gouge_fallbacks(layer, &shape, &p, &d1, &d2, &vertex, clear, input, &mut self.scratch);
+                match &chosen {
+                    Ok(_) => {
+                        if let Some(reason) = fallback {
+                            self.fallbacks.push(format!("{}: {reason}", field(input.source[k])));
+                        }
+                    }
+                    Err(_) => self.skipped.push(input.source[k]),
+                }
+                chosen.ok()
+            })
+        } else {
+            None
+        };
+        if let Some((shape, clearance)) = found {
+            plan.action = match shape.style {
+                LoopStyle::Triangle => Action::LoopTriangle,
+                LoopStyle::Parallelogram => Action::LoopParallelogram,
+                LoopStyle::Arc | LoopStyle::None => Action::LoopArc,
+            };
+            plan.clearance = Some(clearance);
+            if let Some(stock) = input.stock {
+                let stock_clearance = stock_clearance(stock, &shape, &p, &vertex, input, &mut self.scratch);
+                plan.stock_clearance = Some(stock_clearance);
+                plan.loop_feed = stock_clearance >= -GOUGE_TOLERANCE;
+            }
+            self.path.push(cut(self.current, p), incoming, incoming, false);
+            for element in shape.elements(&p) {
+                let (from, to) = match element.kind() {
+                    ElementKind::Exit => (incoming, incoming),
+                    ElementKind::Entry => (k, k),
+                    _ => (incoming, k),
+                };
+                let fast = element.kind() == ElementKind::Loop && plan.loop_feed;
+                self.path.push(element, from, to, fast);
+            }
+            plan.loop_shape = Some(shape);
+            self.current = p;
+        } else if input.pass.join == Join::Round && o1 == o2 {
+            plan.action = Action::Round;
+            let e1 = vertex + o1 * layer.air_normal(layer.previous(k));
+            let e2 = vertex + o2 * layer.air_normal(k);
+            self.path.push(cut(self.current, e1), incoming, incoming, false);
+            self.path.push(
+                Element::Arc { start: e1, end: e2, centre: vertex, radius: o1, sweep: turn, kind: ElementKind::Cut },
+                incoming,
+                k,
+                false,
+            );
+            self.current = e2;
+        } else {
+            plan.action = Action::Miter;
+            self.path.push(cut(self.current, p), incoming, incoming, false);
+            self.current = p;
+        }
+    }
+
+    /// An inside corner: the cut into it, then the dogbone or T-bone relief if one is asked for
+    /// and it gouges neither other face.
+    fn reflex(&mut self, layer: &Layer, input: &PassInput<'_>, clear: f64, plan: &mut CornerPlan) {
+        let (k, turn, p) = (plan.k, plan.turn, plan.cl_point);
+        let choice = input.choices[k];
+        let offsets = &input.edge_offsets;
+        let (o1, o2) = (offsets[layer.previous(k)], offsets[k]);
+        let big_enough = turn.abs() >= input.loop_config.min_turn;
+        let incoming = layer.previous(k);
+        self.path.push(cut(self.current, p), incoming, incoming, false);
+        self.current = p;
+        let style = if big_enough { choice.relief } else { Relief::None };
+        if style == Relief::None {
+            return;
+        }
+        let shape = relief::shape(layer, k, &p, o1.min(o2), style, choice.tbone_edge, input.request_order);
+        let moves = [(p, shape.target), (shape.target, p)];
+        let (previous_edge, next_edge) = (layer.previous(k), k);
+        let scratch = &mut self.scratch;
+        let gouges = moves.iter().any(|(a, b)| {
+            layer
+                .grid
+                .nearest(a, b, clear - GOUGE_TOLERANCE, scratch, |e| e == previous_edge || e == next_edge)
+                .is_some()
+        });
+        if gouges {
+            self.reliefs_skipped.push(input.source[k]);
+        } else {
+            plan.action = if style == Relief::Dogbone { Action::Dogbone } else { Action::Tbone };
+            for (a, b) in moves {
+                self.path.push(
+                    Element::Line { start: a, end: b, kind: ElementKind::Relief },
+                    incoming,
+                    incoming,
+                    false,
+                );
+            }
+            plan.relief = Some(shape);
+        }
+    }
+}
+
+/// The pass's warnings: loops left out or resized, edges the tool cannot follow, reliefs left
+/// out.
+fn pass_warnings(input: &PassInput<'_>, offset: &Offset, walk: &Walk, tool: &str) -> Vec<Warning> {
+    let n = offset.active.len();
+    let mut warnings = Vec::new();
+    if !walk.skipped.is_empty() {
         warnings.push(Warning::new(
             "W_LOOP_SKIPPED_GOUGE",
             format!(
                 "pass {}: {} loops would come closer than r + δ to the contour even after the fallbacks and were replaced by the {} join: {}",
                 input.index + 1,
-                skipped.len(),
+                walk.skipped.len(),
                 join_name(input.pass.join),
-                list(&skipped)
+                list(&walk.skipped)
             ),
         ));
     }
-    if !fallbacks.is_empty() {
-        warnings.push(Warning::new("W_LOOP_FALLBACK", format!("pass {}: {}", input.index + 1, first_few(&fallbacks))));
+    if !walk.fallbacks.is_empty() {
+        warnings
+            .push(Warning::new("W_LOOP_FALLBACK", format!("pass {}: {}", input.index + 1, first_few(&walk.fallbacks))));
     }
     if !offset.active.iter().all(|a| *a) {
         let unreached: Vec<usize> = (0..n).filter(|&k| !offset.active[k]).map(|k| input.edge_source[k]).collect();
@@ -388,33 +451,13 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
             ),
         ));
     }
-    if !reliefs_skipped.is_empty() {
+    if !walk.reliefs_skipped.is_empty() {
         warnings.push(Warning::new(
             "W_RELIEF_SKIPPED",
-            format!("pass {}: the relief would gouge another face at {}", input.index + 1, list(&reliefs_skipped)),
+            format!("pass {}: the relief would gouge another face at {}", input.index + 1, list(&walk.reliefs_skipped)),
         ));
     }
-    let corners: Vec<CornerPlan> = corners.into_iter().flatten().collect();
-    let gouge_min_clearance = corners.iter().filter_map(|c| c.clearance).reduce(f64::min);
-    let stock_min_clearance = corners.iter().filter_map(|c| c.stock_clearance).reduce(f64::min);
-    Ok(PassPlan {
-        index: input.index,
-        allowance: input.pass.allowance,
-        offset: clear,
-        edge_offsets: offsets.clone(),
-        loops: input.pass.loops,
-        join: input.pass.join,
-        start,
-        start_edge: first_edge,
-        cl,
-        unreached_edges: (0..n).filter(|&k| !offset.active[k]).collect(),
-        elements: path.elements,
-        meta: path.meta,
-        corners,
-        gouge_min_clearance,
-        stock_min_clearance,
-        warnings,
-    })
+    warnings
 }
 
 fn join_name(join: Join) -> &'static str {
@@ -440,72 +483,6 @@ fn cut(start: Vec2, end: Vec2) -> Element {
     Element::Line { start, end, kind: ElementKind::Cut }
 }
 
-/// Refuses before building any loop when the loops alone would need more moves than an answer
-/// may hold (huge loop radii with a fine chord tolerance on many corners).
-fn check_loop_budget(layer: &Layer, offset: &Offset, input: &PassInput<'_>) -> Result<(), SolverError> {
-    if !input.pass.loops || input.loop_config.style == LoopStyle::None {
-        return Ok(());
-    }
-    let mut moves = 0usize;
-    for k in 0..layer.len() {
-        if offset.merged(layer, k) || layer.class(k) != Class::Convex {
-            continue;
-        }
-        let (d1, d2) = layer.corner_directions(k);
-        if let Some((shape, _)) = loops::sized(input.loop_config, &offset.cl[k], &d1, &d2, layer.sigma) {
-            moves += shape
-                .elements(&offset.cl[k])
-                .iter()
-                .map(|e| e.chords_count(&input.chording, MAX_ARC_STEPS))
-                .sum::<usize>();
-        }
-        if moves > super::request::MAX_MOVES {
-            return Err(SolverError::new(
-                ErrorCode::TooManyMoves,
-                format!(
-                    "the corner loops alone need more than {} moves: use a coarser tolerance or smaller loops",
-                    super::request::MAX_MOVES
-                ),
-            )
-            .at("tolerance"));
-        }
-    }
-    Ok(())
-}
-
-/// O5 (the CL polygon is simple) and its orientation; O4 is the edge events of `offset`.
-fn check_offset(layer: &Layer, offset: &Offset, input: &PassInput<'_>, tool: &str) -> Result<(), SolverError> {
-    let edges: Vec<usize> = (0..layer.len()).filter(|&k| offset.active[k]).collect();
-    let polygon = offset.polygon(layer);
-    match find_self_intersection(&polygon) {
-        Ok(None) => {}
-        Ok(Some((i, j))) => {
-            let (first, second) = (input.edge_source[edges[i]], input.edge_source[edges[j]]);
-            return Err(SolverError::new(
-                ErrorCode::OffsetSelfIntersection,
-                format!(
-                    "{tool} does not fit between the edges from {} and {}: their offsets cross",
-                    field(first),
-                    field(second)
-                ),
-            )
-            .at(field(second)));
-        }
-        Err(_) => {
-            return Err(SolverError::new(
-                ErrorCode::TooComplex,
-                "the offset path's edges are too crowded to check in bounded time",
-            )
-            .at("contour"));
-        }
-    }
-    if signed_area(&polygon) * signed_area(&layer.vertices) <= 0.0 {
-        return Err(SolverError::new(ErrorCode::OffsetCollapse, format!("{tool} does not fit inside the contour"))
-            .at("contour"));
-    }
-    Ok(())
-}
-
 /// S: the offset foot of the middle of edge `edge`, or the middle of the offset edge if that
 /// foot falls outside it.
 fn start_point(layer: &Layer, cl: &[Vec2], offsets: &[f64], edge: usize) -> Vec2 {
@@ -516,126 +493,4 @@ fn start_point(layer: &Layer, cl: &[Vec2], offsets: &[f64], edge: usize) -> Vec2
     let along = (foot - cl[edge]).dot(&t);
     let length = (cl[after] - cl[edge]).dot(&t);
     if along > 0.0 && along < length { foot } else { 0.5 * (cl[edge] + cl[after]) }
-}
-
-/// The loop, or a smaller or simpler one, that clears the contour by r + δ (§3.5.5): halve the
-/// size up to 4 times, then the triangle with the smallest legs. Returns the shape and its
-/// clearance, or the first clearance when every variant gouges.
-#[allow(clippy::too_many_arguments)]
-fn gouge_fallbacks(
-    layer: &Layer,
-    shape: &LoopShape,
-    p: &Vec2,
-    d1: &Vec2,
-    d2: &Vec2,
-    vertex: &Vec2,
-    clear: f64,
-    input: &PassInput<'_>,
-    scratch: &mut Vec<usize>,
-) -> Result<(LoopShape, f64), f64> {
-    let mut first = None;
-    let mut candidate = *shape;
-    for attempt in 0..6 {
-        if attempt == 5 {
-            candidate = LoopShape::triangle(p, d1, d2, candidate.leg);
-        }
-        let clearance = loop_clearance(layer, &candidate, p, vertex, clear, &input.chording, scratch);
-        if clearance >= -GOUGE_TOLERANCE {
-            return Ok((candidate, clearance));
-        }
-        first.get_or_insert(clearance);
-        if attempt < 4 {
-            candidate = candidate.scaled(p, d1, d2, layer.sigma, 0.5);
-        }
-    }
-    Err(first.unwrap_or(f64::NEG_INFINITY))
-}
-
-/// The straight moves of a loop (exit, chorded loop, entry) from P.
-fn loop_moves(shape: &LoopShape, p: &Vec2, chording: &Chording) -> Vec<(Vec2, Vec2)> {
-    let mut moves = Vec::new();
-    let mut from = *p;
-    for element in shape.elements(p) {
-        for to in element.chords(chording, MAX_ARC_STEPS) {
-            moves.push((from, to));
-            from = to;
-        }
-    }
-    moves
-}
-
-/// min over the loop's moves of their distance to the contour, minus `clear`. The search radius
-/// |PV| + `clear` is enough: P is on the loop and V on the contour.
-fn loop_clearance(
-    layer: &Layer,
-    shape: &LoopShape,
-    p: &Vec2,
-    vertex: &Vec2,
-    clear: f64,
-    chording: &Chording,
-    scratch: &mut Vec<usize>,
-) -> f64 {
-    let radius = (p - vertex).norm().max(clear) + 1e-6;
-    loop_moves(shape, p, chording)
-        .iter()
-        .filter_map(|(a, b)| layer.grid.nearest(a, b, radius, scratch, |_| false))
-        .map(|(distance, _)| distance)
-        .fold(radius, f64::min)
-        - clear
-}
-
-/// Smallest clearance of the loop's moves to the stock before this pass, minus r.
-fn stock_clearance(
-    stock: &Stock,
-    shape: &LoopShape,
-    p: &Vec2,
-    vertex: &Vec2,
-    input: &PassInput<'_>,
-    scratch: &mut Vec<usize>,
-) -> f64 {
-    let radius = (p - vertex).norm() + input.radius + 1.0;
-    let moves = loop_moves(shape, p, &input.chording);
-    let mut best = f64::INFINITY;
-    for (grid, inset) in &stock.parts {
-        for (a, b) in &moves {
-            if let Some((distance, _)) = grid.nearest(a, b, radius, scratch, |_| false) {
-                best = best.min(distance - inset);
-            }
-        }
-    }
-    best.min(radius) - input.radius
-}
-
-/// The global check of the cut moves: no point closer than r + δ to the contour (§3.3, the CL
-/// polygon keeps its distance from every contour).
-fn check_clearance(
-    layer: &Layer,
-    elements: &[Element],
-    clear: f64,
-    input: &PassInput<'_>,
-    scratch: &mut Vec<usize>,
-) -> Result<(), SolverError> {
-    for element in elements.iter().filter(|e| e.kind() == ElementKind::Cut) {
-        let mut from = element.start();
-        for to in element.chords(&input.chording, MAX_ARC_STEPS) {
-            if let Some((distance, edge)) = layer.grid.nearest(&from, &to, clear - GOUGE_TOLERANCE, scratch, |_| false)
-            {
-                let source = input.edge_source[edge];
-                return Err(SolverError::new(
-                    ErrorCode::OffsetSelfIntersection,
-                    format!(
-                        "the tool (radius {} + allowance {}) does not fit: near ({:.4}, {:.4}) the path comes within {distance:.6} of the edge from {} (a neck narrower than twice that)",
-                        input.radius,
-                        input.pass.allowance,
-                        to.x,
-                        to.y,
-                        field(source)
-                    ),
-                )
-                .at(field(source)));
-            }
-            from = to;
-        }
-    }
-    Ok(())
 }

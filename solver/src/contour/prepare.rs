@@ -81,42 +81,9 @@ impl Contour {
 /// `E_SELF_INTERSECTION`, `E_ORIENTATION` (clockwise and not `fix_orientation`),
 /// `E_TOO_MANY_POINTS`, `E_TOO_COMPLEX`, `E_INPUT` for non-finite coordinates.
 pub(crate) fn prepare(points: &[[f64; 2]], fix_orientation: bool) -> Result<(Contour, Vec<Warning>), SolverError> {
-    if points.len() > MAX_POINTS {
-        return Err(SolverError::new(
-            ErrorCode::TooManyPoints,
-            format!("the contour has {} points; the limit is {MAX_POINTS}", points.len()),
-        )
-        .at("contour"));
-    }
-    for (index, point) in points.iter().enumerate() {
-        let field = format!("contour[{index}]");
-        if finite(&field, point[0])?.abs() > MAX_COORDINATE || finite(&field, point[1])?.abs() > MAX_COORDINATE {
-            return Err(SolverError::input(field, format!("coordinates must lie within ±{MAX_COORDINATE} mm")));
-        }
-    }
+    check_points(points)?;
     let mut warnings = Vec::new();
-    let mut kept: Vec<(Vec2, usize)> = Vec::with_capacity(points.len());
-    let mut removed: Vec<usize> = Vec::new();
-    let closing = points.len() > 1
-        && points
-            .first()
-            .zip(points.last())
-            .is_some_and(|(first, last)| (planar::vec2(*first) - planar::vec2(*last)).norm() <= DUPLICATE_TOLERANCE);
-    let used = if closing { points.len() - 1 } else { points.len() };
-    for (index, point) in points.iter().take(used).enumerate() {
-        let p = planar::vec2(*point);
-        match kept.last() {
-            Some((last, _)) if (p - last).norm() <= DUPLICATE_TOLERANCE => removed.push(index),
-            _ => kept.push((p, index)),
-        }
-    }
-    while kept.len() > 1
-        && kept.first().zip(kept.last()).is_some_and(|(first, last)| (first.0 - last.0).norm() <= DUPLICATE_TOLERANCE)
-    {
-        if let Some((_, index)) = kept.pop() {
-            removed.push(index);
-        }
-    }
+    let (kept, mut removed, used) = distinct_points(points);
     if kept.len() < 3 {
         return Err(SolverError::new(
             ErrorCode::Degenerate,
@@ -126,27 +93,7 @@ pub(crate) fn prepare(points: &[[f64; 2]], fix_orientation: bool) -> Result<(Con
     }
     check_duplicates(&kept)?;
     check_area(&kept)?;
-    let polygon: Vec<Vec2> = kept.iter().map(|(p, _)| *p).collect();
-    match find_self_intersection(&polygon) {
-        Ok(None) => {}
-        Ok(Some((i, j))) => {
-            let (first, second) = (kept[i].1, kept[j].1);
-            return Err(SolverError::new(
-                ErrorCode::SelfIntersection,
-                format!(
-                    "the contour is not a simple polygon: the edge from contour[{first}] meets the edge from contour[{second}]"
-                ),
-            )
-            .at(format!("contour[{second}]")));
-        }
-        Err(_) => {
-            return Err(SolverError::new(
-                ErrorCode::TooComplex,
-                "the contour's edges are too crowded to check for self-intersection in bounded time",
-            )
-            .at("contour"));
-        }
-    }
+    check_simple(&kept)?;
     let (kept, straight) = remove_straight(kept);
     removed.extend(straight);
     if kept.len() < 3 {
@@ -182,6 +129,81 @@ pub(crate) fn prepare(points: &[[f64; 2]], fix_orientation: bool) -> Result<(Con
         warnings.push(Warning::new("W_CONTOUR_REVERSED", "the contour ran clockwise and was reversed"));
     }
     Ok((Contour { points, source, reversed, request_len: used }, warnings))
+}
+
+/// `E_TOO_MANY_POINTS` over the limit; `E_INPUT` for a coordinate that is not finite or out of
+/// bounds.
+fn check_points(points: &[[f64; 2]]) -> Result<(), SolverError> {
+    if points.len() > MAX_POINTS {
+        return Err(SolverError::new(
+            ErrorCode::TooManyPoints,
+            format!("the contour has {} points; the limit is {MAX_POINTS}", points.len()),
+        )
+        .at("contour"));
+    }
+    for (index, point) in points.iter().enumerate() {
+        let field = format!("contour[{index}]");
+        if finite(&field, point[0])?.abs() > MAX_COORDINATE || finite(&field, point[1])?.abs() > MAX_COORDINATE {
+            return Err(SolverError::input(field, format!("coordinates must lie within ±{MAX_COORDINATE} mm")));
+        }
+    }
+    Ok(())
+}
+
+/// The points without a closing repeat of the first and without repeated consecutive points
+/// (also round the end), each with its request index; the indices removed; and how many request
+/// points the contour uses (all but a closing repeat).
+fn distinct_points(points: &[[f64; 2]]) -> (Vec<(Vec2, usize)>, Vec<usize>, usize) {
+    let mut kept: Vec<(Vec2, usize)> = Vec::with_capacity(points.len());
+    let mut removed: Vec<usize> = Vec::new();
+    let closing = points.len() > 1
+        && points
+            .first()
+            .zip(points.last())
+            .is_some_and(|(first, last)| (planar::vec2(*first) - planar::vec2(*last)).norm() <= DUPLICATE_TOLERANCE);
+    let used = if closing { points.len() - 1 } else { points.len() };
+    for (index, point) in points.iter().take(used).enumerate() {
+        let p = planar::vec2(*point);
+        match kept.last() {
+            Some((last, _)) if (p - last).norm() <= DUPLICATE_TOLERANCE => removed.push(index),
+            _ => kept.push((p, index)),
+        }
+    }
+    while kept.len() > 1
+        && kept.first().zip(kept.last()).is_some_and(|(first, last)| (first.0 - last.0).norm() <= DUPLICATE_TOLERANCE)
+    {
+        if let Some((_, index)) = kept.pop() {
+            removed.push(index);
+        }
+    }
+    (kept, removed, used)
+}
+
+/// `E_SELF_INTERSECTION` when two edges meet; `E_TOO_COMPLEX` when the check cannot finish in
+/// bounded time.
+fn check_simple(kept: &[(Vec2, usize)]) -> Result<(), SolverError> {
+    let polygon: Vec<Vec2> = kept.iter().map(|(p, _)| *p).collect();
+    match find_self_intersection(&polygon) {
+        Ok(None) => {}
+        Ok(Some((i, j))) => {
+            let (first, second) = (kept[i].1, kept[j].1);
+            return Err(SolverError::new(
+                ErrorCode::SelfIntersection,
+                format!(
+                    "the contour is not a simple polygon: the edge from contour[{first}] meets the edge from contour[{second}]"
+                ),
+            )
+            .at(format!("contour[{second}]")));
+        }
+        Err(_) => {
+            return Err(SolverError::new(
+                ErrorCode::TooComplex,
+                "the contour's edges are too crowded to check for self-intersection in bounded time",
+            )
+            .at("contour"));
+        }
+    }
+    Ok(())
 }
 
 /// `E_DUPLICATE_POINT` when two non-consecutive points coincide (the polygon touches itself).

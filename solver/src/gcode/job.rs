@@ -1,8 +1,8 @@
-//! One program per job (README "One program per job"): the programs of a job's
-//! operations, each written by [`super::write`], joined into one program a control runs from start
-//! to end: one program number, one header listing the operations with their tools and estimated
-//! times, each operation with its tool change, spindle and coolant, a retract to the job's
-//! clearance height between operations, and one program end.
+//! One program per job (docs/spec/api.md Jobs; README "One program per job"): the programs of a
+//! job's operations, each written by [`super::write`], joined into one program a control runs from
+//! start to end: one program number, one header listing the operations with their tools and
+//! estimated times, each operation with its tool change, spindle and coolant, a retract to the
+//! job's clearance height between operations, and one program end.
 //!
 //! The operations' programs are kept as text (a job stores them as its endpoints write them), so
 //! [`Section::parse`] reads back exactly the layout [`super::write`] produces; a program of any
@@ -308,10 +308,27 @@ pub fn write(job: &Job<'_>, operations: &[Operation<'_>]) -> Result<String, Solv
         ));
     }
     let clearance = sections.iter().flatten().map(|s| s.safe_z).fold(f64::NEG_INFINITY, f64::max);
-    let fanuc = job.dialect == Dialect::Fanuc;
     let mut out = String::new();
+    write_header(&mut out, job, operations, &sections, clearance);
+    for (index, (section, operation)) in sections.iter().zip(operations).enumerate() {
+        let Some(section) = section else { continue };
+        write_section(&mut out, job, index, operation, section, clearance);
+    }
+    out.push_str("M30\n%\n");
+    Ok(out)
+}
+
+/// The job program's head: number and title, the operations with their tools and times (or why
+/// they are left out), the clearance height and the safety line.
+fn write_header(
+    out: &mut String,
+    job: &Job<'_>,
+    operations: &[Operation<'_>],
+    sections: &[Option<Section<'_>>],
+    clearance: f64,
+) {
     out.push_str("%\n");
-    if fanuc {
+    if job.dialect == Dialect::Fanuc {
         let _ = writeln!(out, "O{:04} {}", job.number, comment(job.title));
     } else {
         // LinuxCNC reads an O word as a subroutine label: the number is in the title instead.
@@ -365,52 +382,62 @@ pub fn write(job: &Job<'_>, operations: &[Operation<'_>]) -> Result<String, Solv
     }
     let _ = writeln!(out, "{}", comment(&format!("clearance between operations Z{}", mm(clearance))));
     let _ = writeln!(out, "{SAFETY_LINE}");
-    for (index, (section, operation)) in sections.iter().zip(operations).enumerate() {
-        let Some(section) = section else { continue };
-        let _ = writeln!(out, "{}", comment(&format!("operation {} {}", index + 1, operation.name)));
-        let _ = writeln!(out, "{}", section.title);
-        for line in &section.comments {
-            let _ = writeln!(out, "{line}");
-        }
-        if !fanuc && let Some(blend) = section.blend {
-            let _ = writeln!(out, "{blend}");
-        }
-        for line in &section.tool_change {
-            let _ = writeln!(out, "{line}");
-        }
-        match section.tool_number {
-            Some(number) => {
-                let _ = writeln!(out, "G00 G43 H{number} Z{}", mm(clearance));
-            }
-            None => {
-                let _ = writeln!(out, "G00 Z{}", mm(clearance));
-            }
-        }
-        let _ = writeln!(out, "{}", section.spindle);
-        if let Some(code) = job.coolant.on_code() {
-            let _ = writeln!(out, "{code}");
-        }
-        // Across to the first point at the clearance height, then down as the operation goes.
-        if let Some(first) = section.moves.first() {
-            let words = Words::of(first);
-            if let (Some(x), Some(y)) = (words.x, words.y) {
-                let across = format!("G00 X{} Y{} Z{}", mm(x), mm(y), mm(clearance));
-                if across != *first {
-                    let _ = writeln!(out, "{across}");
-                }
-            }
-        }
-        for line in &section.moves {
-            let _ = writeln!(out, "{line}");
-        }
-        out.push_str("M05\n");
-        if job.coolant.on_code().is_some() {
-            out.push_str("M09\n");
-        }
-        let _ = writeln!(out, "G00 Z{}", mm(clearance));
+}
+
+/// One operation (number `index` from 0) in the job program: its head and tool change, the
+/// spindle and coolant on, across at the common clearance height to its first point, its moves,
+/// and everything off and up again.
+fn write_section(
+    out: &mut String,
+    job: &Job<'_>,
+    index: usize,
+    operation: &Operation<'_>,
+    section: &Section<'_>,
+    clearance: f64,
+) {
+    let _ = writeln!(out, "{}", comment(&format!("operation {} {}", index + 1, operation.name)));
+    let _ = writeln!(out, "{}", section.title);
+    for line in &section.comments {
+        let _ = writeln!(out, "{line}");
     }
-    out.push_str("M30\n%\n");
-    Ok(out)
+    if job.dialect != Dialect::Fanuc
+        && let Some(blend) = section.blend
+    {
+        let _ = writeln!(out, "{blend}");
+    }
+    for line in &section.tool_change {
+        let _ = writeln!(out, "{line}");
+    }
+    match section.tool_number {
+        Some(number) => {
+            let _ = writeln!(out, "G00 G43 H{number} Z{}", mm(clearance));
+        }
+        None => {
+            let _ = writeln!(out, "G00 Z{}", mm(clearance));
+        }
+    }
+    let _ = writeln!(out, "{}", section.spindle);
+    if let Some(code) = job.coolant.on_code() {
+        let _ = writeln!(out, "{code}");
+    }
+    // Across to the first point at the clearance height, then down as the operation goes.
+    if let Some(first) = section.moves.first() {
+        let words = Words::of(first);
+        if let (Some(x), Some(y)) = (words.x, words.y) {
+            let across = format!("G00 X{} Y{} Z{}", mm(x), mm(y), mm(clearance));
+            if across != *first {
+                let _ = writeln!(out, "{across}");
+            }
+        }
+    }
+    for line in &section.moves {
+        let _ = writeln!(out, "{line}");
+    }
+    out.push_str("M05\n");
+    if job.coolant.on_code().is_some() {
+        out.push_str("M09\n");
+    }
+    let _ = writeln!(out, "G00 Z{}", mm(clearance));
 }
 
 #[cfg(test)]

@@ -1,4 +1,4 @@
-//! Chording of circular arcs from outside: the polyline's segments are tangent to the arc, so no
+//! Chording of circular arcs from outside (docs/spec/contour.md §3.5.1 loop arcs): the polyline's segments are tangent to the arc, so no
 //! point of it comes closer to the centre than the radius (a tool-centre arc chorded this way
 //! never cuts deeper than the arc itself), and its first and last segments continue the arc's end
 //! tangents exactly (collinear with straight moves that join the arc tangentially).

@@ -1,6 +1,6 @@
-//! A sparse uniform grid over line segments for near-neighbour and intersection queries, and the
-//! simple-polygon check built on it (no `O(n²)` pair loop: each edge is tested only against the
-//! edges sharing its grid cells).
+//! A sparse uniform grid (docs/spec/contour.md §3.1 simplicity, §3.5.5 gouge check) over line
+//! segments for near-neighbour and intersection queries, and the simple-polygon check built on it
+//! (no `O(n²)` pair loop: each edge is tested only against the edges sharing its grid cells).
 //!
 //! The grid stores `(cell, segment)` entries sorted by cell, column-major, so that every column's
 //! cells form one contiguous run found by binary search: memory is proportional to the number of

@@ -1,5 +1,5 @@
-//! Segmentation as a capability (the seam of engineering.md): `POST /api/v1/segment`, job
-//! operation `segment`.
+//! Segmentation as a capability (docs/spec/segment.md, docs/spec/api.md Segment; the seam of
+//! engineering.md): `POST /api/v1/segment`, job operation `segment`.
 
 use serde::Serialize;
 

@@ -141,157 +141,27 @@ fn corner_angle(value: Option<f64>) -> Result<f64, SolverError> {
     Ok(degrees.to_radians())
 }
 
+/// What building a curve gives: its shape, the parameters of its corners and its dimension
+/// (2 or 3).
+type Built = (Shape, Vec<f64>, usize);
+
 impl Curve {
     /// Builds the curve, its corner list and its dimension.
     pub(crate) fn build(&self) -> Result<(Shape, Vec<f64>, usize, Vec<Warning>), SolverError> {
         let mut warnings = Vec::new();
         let (shape, corners, dimension) = match self {
-            Self::Circle { centre, radius: r, start_deg, direction } => {
-                let c = point("curve.centre", centre)?;
-                let shape = Shape::Arc(Arc {
-                    centre: c,
-                    radius: radius("curve.radius", *r)?,
-                    start: angle("curve.start_deg", *start_deg)?.to_radians(),
-                    sense: direction.sign(),
-                    sweep: std::f64::consts::TAU,
-                });
-                (shape, Vec::new(), centre.len())
+            Self::Circle { centre, radius, start_deg, direction } => {
+                build_circle(centre, *radius, *start_deg, *direction)?
             }
-            Self::Arc { centre, radius: r, start_deg, end_deg, direction } => {
-                let c = point("curve.centre", centre)?;
-                let start = angle("curve.start_deg", *start_deg)?;
-                let end = angle("curve.end_deg", *end_deg)?;
-                let swept = sweep(start, end, *direction);
-                if swept == 0.0 {
-                    return Err(SolverError::new(
-                        ErrorCode::DegenerateCurve,
-                        "the arc starts and ends at the same angle: it has no length (use 0 and 360 for a full circle)",
-                    )
-                    .at("curve.end_deg"));
-                }
-                let shape = Shape::Arc(Arc {
-                    centre: c,
-                    radius: radius("curve.radius", *r)?,
-                    start: start.to_radians(),
-                    sense: direction.sign(),
-                    sweep: swept,
-                });
-                (shape, Vec::new(), centre.len())
+            Self::Arc { centre, radius, start_deg, end_deg, direction } => {
+                build_arc(centre, *radius, *start_deg, *end_deg, *direction)?
             }
             Self::Ellipse { centre, semi_axes, start_deg, end_deg, rotation_deg, direction } => {
-                let c = point("curve.centre", centre)?;
-                let a = radius("curve.semi_axes[0]", semi_axes[0])?;
-                let b = radius("curve.semi_axes[1]", semi_axes[1])?;
-                let start = angle("curve.start_deg", *start_deg)?;
-                let end = match end_deg {
-                    Some(end) => angle("curve.end_deg", *end)?,
-                    None => start + 360.0,
-                };
-                let swept = sweep(start, end, *direction);
-                if swept == 0.0 {
-                    return Err(SolverError::new(
-                        ErrorCode::DegenerateCurve,
-                        "the ellipse arc starts and ends at the same angle: it has no length",
-                    )
-                    .at("curve.end_deg"));
-                }
-                let start = start.to_radians();
-                let sense = direction.sign();
-                let speed = |u: f64| ellipse_speed([a, b], start + sense * u);
-                // Panel breaks at the quarter points, where the speed has its extremes.
-                let quarter = std::f64::consts::FRAC_PI_2;
-                let mut breaks = vec![0.0];
-                let first = if sense > 0.0 { (start / quarter).floor() + 1.0 } else { (start / quarter).ceil() - 1.0 };
-                let mut k = first;
-                loop {
-                    let u = (k * quarter - start) * sense;
-                    if u >= swept - 1e-12 {
-                        break;
-                    }
-                    breaks.push(u);
-                    k += sense;
-                }
-                breaks.push(swept);
-                let table = ArcLengthTable::build(&speed, &breaks, 16, "curve")?;
-                let shape = Shape::Ellipse(Ellipse {
-                    centre: c,
-                    semi_axes: [a, b],
-                    rotation_sin_cos: angle("curve.rotation_deg", *rotation_deg)?.to_radians().sin_cos(),
-                    start,
-                    sense,
-                    sweep: swept,
-                    table,
-                });
-                (shape, Vec::new(), centre.len())
+                build_ellipse(centre, *semi_axes, *start_deg, *end_deg, *rotation_deg, *direction)?
             }
-            Self::Polyline { points: list, corner_angle_deg } => {
-                if list.len() > MAX_POLYLINE_POINTS {
-                    return Err(SolverError::input(
-                        "curve.points",
-                        format!("at most {MAX_POLYLINE_POINTS} points are accepted (got {})", list.len()),
-                    ));
-                }
-                let corner = corner_angle(*corner_angle_deg)?;
-                let (all, dimension) = points("curve.points", list)?;
-                let mut vertices: Vec<Vec3> = Vec::with_capacity(all.len());
-                let mut dropped = 0;
-                for p in all {
-                    if vertices.last() == Some(&p) {
-                        dropped += 1;
-                    } else {
-                        vertices.push(p);
-                    }
-                }
-                if dropped > 0 {
-                    warnings.push(Warning::new(
-                        "W_DUPLICATE_POINTS",
-                        format!("{dropped} repeated consecutive points were dropped"),
-                    ));
-                }
-                if vertices.len() < 2 {
-                    return Err(SolverError::new(
-                        ErrorCode::DegenerateCurve,
-                        "a polyline needs at least two distinct points",
-                    )
-                    .at("curve.points"));
-                }
-                let mut stations = Vec::with_capacity(vertices.len());
-                let mut length = 0.0;
-                stations.push(0.0);
-                for pair in vertices.windows(2) {
-                    length += (pair[1] - pair[0]).norm();
-                    stations.push(length);
-                }
-                let shape = Shape::Polyline(Polyline { vertices, stations, last_edge: std::cell::Cell::new(0) });
-                let corners = shape.corners(corner);
-                (shape, corners, dimension)
-            }
+            Self::Polyline { points, corner_angle_deg } => build_polyline(points, *corner_angle_deg, &mut warnings)?,
             Self::Bspline { degree, control_points, knots, weights, corner_angle_deg } => {
-                let corner = corner_angle(*corner_angle_deg)?;
-                if control_points.len() > super::nurbs::MAX_CONTROL_POINTS {
-                    return Err(SolverError::input(
-                        "curve.control_points",
-                        format!(
-                            "at most {} control points are accepted (got {})",
-                            super::nurbs::MAX_CONTROL_POINTS,
-                            control_points.len()
-                        ),
-                    ));
-                }
-                let (control, dimension) = points("curve.control_points", control_points)?;
-                let nurbs = Nurbs::new(*degree, &control, knots.as_deref(), weights.as_deref(), "curve")?;
-                if control.windows(2).all(|pair| pair[0] == pair[1]) {
-                    return Err(SolverError::new(
-                        ErrorCode::DegenerateCurve,
-                        "all control points coincide: the curve has no length",
-                    )
-                    .at("curve.control_points"));
-                }
-                let breaks: Vec<f64> = nurbs.breaks().iter().map(|(knot, _)| *knot).collect();
-                let table = ArcLengthTable::build(&nurbs, &breaks, NURBS_PANELS_PER_SPAN, "curve.control_points")?;
-                let shape = Shape::Spline(Spline::new(nurbs, table));
-                let corners = shape.corners(corner);
-                (shape, corners, dimension)
+                build_bspline(*degree, control_points, knots.as_deref(), weights.as_deref(), *corner_angle_deg)?
             }
         };
         let field = match self {
@@ -302,6 +172,175 @@ impl Curve {
         require_length(&shape, field)?;
         Ok((shape, corners, dimension, warnings))
     }
+}
+
+/// A full circle from `start_deg`.
+fn build_circle(centre: &[f64], r: f64, start_deg: f64, direction: Direction) -> Result<Built, SolverError> {
+    let c = point("curve.centre", centre)?;
+    let shape = Shape::Arc(Arc {
+        centre: c,
+        radius: radius("curve.radius", r)?,
+        start: angle("curve.start_deg", start_deg)?.to_radians(),
+        sense: direction.sign(),
+        sweep: std::f64::consts::TAU,
+    });
+    Ok((shape, Vec::new(), centre.len()))
+}
+
+/// A circular arc from `start_deg` to `end_deg`; refused when it has no sweep.
+fn build_arc(centre: &[f64], r: f64, start_deg: f64, end_deg: f64, direction: Direction) -> Result<Built, SolverError> {
+    let c = point("curve.centre", centre)?;
+    let start = angle("curve.start_deg", start_deg)?;
+    let end = angle("curve.end_deg", end_deg)?;
+    let swept = sweep(start, end, direction);
+    if swept == 0.0 {
+        return Err(SolverError::new(
+            ErrorCode::DegenerateCurve,
+            "the arc starts and ends at the same angle: it has no length (use 0 and 360 for a full circle)",
+        )
+        .at("curve.end_deg"));
+    }
+    let shape = Shape::Arc(Arc {
+        centre: c,
+        radius: radius("curve.radius", r)?,
+        start: start.to_radians(),
+        sense: direction.sign(),
+        sweep: swept,
+    });
+    Ok((shape, Vec::new(), centre.len()))
+}
+
+/// An elliptic arc with its arc-length table, panels broken at the quarter points.
+fn build_ellipse(
+    centre: &[f64],
+    semi_axes: [f64; 2],
+    start_deg: f64,
+    end_deg: Option<f64>,
+    rotation_deg: f64,
+    direction: Direction,
+) -> Result<Built, SolverError> {
+    let c = point("curve.centre", centre)?;
+    let a = radius("curve.semi_axes[0]", semi_axes[0])?;
+    let b = radius("curve.semi_axes[1]", semi_axes[1])?;
+    let start = angle("curve.start_deg", start_deg)?;
+    let end = match end_deg {
+        Some(end) => angle("curve.end_deg", end)?,
+        None => start + 360.0,
+    };
+    let swept = sweep(start, end, direction);
+    if swept == 0.0 {
+        return Err(SolverError::new(
+            ErrorCode::DegenerateCurve,
+            "the ellipse arc starts and ends at the same angle: it has no length",
+        )
+        .at("curve.end_deg"));
+    }
+    let start = start.to_radians();
+    let sense = direction.sign();
+    let speed = |u: f64| ellipse_speed([a, b], start + sense * u);
+    // Panel breaks at the quarter points, where the speed has its extremes.
+    let quarter = std::f64::consts::FRAC_PI_2;
+    let mut breaks = vec![0.0];
+    let first = if sense > 0.0 { (start / quarter).floor() + 1.0 } else { (start / quarter).ceil() - 1.0 };
+    let mut k = first;
+    loop {
+        let u = (k * quarter - start) * sense;
+        if u >= swept - 1e-12 {
+            break;
+        }
+        breaks.push(u);
+        k += sense;
+    }
+    breaks.push(swept);
+    let table = ArcLengthTable::build(&speed, &breaks, 16, "curve")?;
+    let shape = Shape::Ellipse(Ellipse {
+        centre: c,
+        semi_axes: [a, b],
+        rotation_sin_cos: angle("curve.rotation_deg", rotation_deg)?.to_radians().sin_cos(),
+        start,
+        sense,
+        sweep: swept,
+        table,
+    });
+    Ok((shape, Vec::new(), centre.len()))
+}
+
+/// A polyline without repeated consecutive points (warned), its stations and corners.
+fn build_polyline(
+    list: &[Vec<f64>],
+    corner_angle_deg: Option<f64>,
+    warnings: &mut Vec<Warning>,
+) -> Result<Built, SolverError> {
+    if list.len() > MAX_POLYLINE_POINTS {
+        return Err(SolverError::input(
+            "curve.points",
+            format!("at most {MAX_POLYLINE_POINTS} points are accepted (got {})", list.len()),
+        ));
+    }
+    let corner = corner_angle(corner_angle_deg)?;
+    let (all, dimension) = points("curve.points", list)?;
+    let mut vertices: Vec<Vec3> = Vec::with_capacity(all.len());
+    let mut dropped = 0;
+    for p in all {
+        if vertices.last() == Some(&p) {
+            dropped += 1;
+        } else {
+            vertices.push(p);
+        }
+    }
+    if dropped > 0 {
+        warnings
+            .push(Warning::new("W_DUPLICATE_POINTS", format!("{dropped} repeated consecutive points were dropped")));
+    }
+    if vertices.len() < 2 {
+        return Err(SolverError::new(ErrorCode::DegenerateCurve, "a polyline needs at least two distinct points")
+            .at("curve.points"));
+    }
+    let mut stations = Vec::with_capacity(vertices.len());
+    let mut length = 0.0;
+    stations.push(0.0);
+    for pair in vertices.windows(2) {
+        length += (pair[1] - pair[0]).norm();
+        stations.push(length);
+    }
+    let shape = Shape::Polyline(Polyline { vertices, stations, last_edge: std::cell::Cell::new(0) });
+    let corners = shape.corners(corner);
+    Ok((shape, corners, dimension))
+}
+
+/// A B-spline or NURBS curve with its arc-length table and the corners at its knots.
+fn build_bspline(
+    degree: usize,
+    control_points: &[Vec<f64>],
+    knots: Option<&[f64]>,
+    weights: Option<&[f64]>,
+    corner_angle_deg: Option<f64>,
+) -> Result<Built, SolverError> {
+    let corner = corner_angle(corner_angle_deg)?;
+    if control_points.len() > super::nurbs::MAX_CONTROL_POINTS {
+        return Err(SolverError::input(
+            "curve.control_points",
+            format!(
+                "at most {} control points are accepted (got {})",
+                super::nurbs::MAX_CONTROL_POINTS,
+                control_points.len()
+            ),
+        ));
+    }
+    let (control, dimension) = points("curve.control_points", control_points)?;
+    let nurbs = Nurbs::new(degree, &control, knots, weights, "curve")?;
+    if control.windows(2).all(|pair| pair[0] == pair[1]) {
+        return Err(SolverError::new(
+            ErrorCode::DegenerateCurve,
+            "all control points coincide: the curve has no length",
+        )
+        .at("curve.control_points"));
+    }
+    let breaks: Vec<f64> = nurbs.breaks().iter().map(|(knot, _)| *knot).collect();
+    let table = ArcLengthTable::build(&nurbs, &breaks, NURBS_PANELS_PER_SPAN, "curve.control_points")?;
+    let shape = Shape::Spline(Spline::new(nurbs, table));
+    let corners = shape.corners(corner);
+    Ok((shape, corners, dimension))
 }
 
 fn optional_tolerance(field: &str, value: Option<f64>) -> Result<Option<f64>, SolverError> {

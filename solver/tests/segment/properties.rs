@@ -505,7 +505,7 @@ proptest! {
             Err(error) => panic!("{}: {}", error.code().as_str(), error.message()),
         };
         let (fast, oracle) = (answer.stats.blocks, reference.stats.blocks);
-        // docs/spec/segment.md §2.9a item 3, read as 0.5 % with at least one block of slack (the issue's "the
+        // docs/spec/segment.md §2.9a item 3, read as 0.5 % with at least one block of slack (the requirement "the
         // block count within 0.5 %"). Not capped at 2: in window mode a chord ending within 1e-8
         // mm of its window's end goes to one window or the next by rounding, and every later
         // window shifts, so a count of thousands drifts by a few blocks between any two numerics

@@ -1,5 +1,6 @@
-//! Arcs of the G-code reader: start angle, sweep and radius in the plane, and the centre and
-//! turns of a `G2`/`G3` block checked for closure.
+//! Arcs of the G-code reader (docs/spec/predict.md §8, engagement.md §11: `G2`/`G3` import): start
+//! angle, sweep and radius in the plane, and the centre and turns of a `G2`/`G3` block checked for
+//! closure.
 
 use super::lexer::syntax;
 use super::modal::Block;
@@ -61,8 +62,27 @@ pub(super) fn arc_kind(
         )
         .at(field));
     };
-    let scale = modal.units.scale();
-    let extra_turns = match block.turns {
+    let extra_turns = arc_turns(block, line, field)?;
+    let (start, end) = ([start_a, start_b], [end_a, end_b]);
+    let (centre_a, centre_b) = if let Some(radius_word) = block.radius {
+        if block.offsets.iter().any(Option::is_some) {
+            return Err(syntax(field, line, "an arc takes either R or I/J/K, not both"));
+        }
+        radius_centre(radius_word.value, modal.units.scale(), start, end, clockwise, line, field)?
+    } else {
+        offset_centre(block, modal, start, line, field)?
+    };
+    check_closure([centre_a, centre_b], start, end, line, field)?;
+    let mut centre = [0.0; 3];
+    centre[a] = centre_a;
+    centre[b] = centre_b;
+    centre[normal] = from[normal].unwrap_or(0.0);
+    Ok(MoveKind::Arc { centre, clockwise, extra_turns })
+}
+
+/// Full turns beyond the first partial one: LinuxCNC's `P` word minus 1 (0 without it).
+fn arc_turns(block: &Block, line: usize, field: &str) -> Result<u32, SolverError> {
+    Ok(match block.turns {
         None => 0,
         Some(word) => {
             let turns = word.value;
@@ -75,56 +95,86 @@ pub(super) fn arc_kind(
             }
             turns as u32 - 1
         }
-    };
+    })
+}
+
+/// The in-plane centre of an `R` arc from `start` to `end` (mm): `r_word` in the line's units
+/// (`scale` mm each), negative for the long arc.
+fn radius_centre(
+    r_word: f64,
+    scale: f64,
+    start: [f64; 2],
+    end: [f64; 2],
+    clockwise: bool,
+    line: usize,
+    field: &str,
+) -> Result<(f64, f64), SolverError> {
+    let ([start_a, start_b], [end_a, end_b]) = (start, end);
+    let radius = r_word * scale;
+    let (dx, dy) = (end_a - start_a, end_b - start_b);
+    let chord = dx.hypot(dy);
+    if chord < 1e-9 {
+        return Err(syntax(field, line, "a full circle cannot be given with R: use I/J/K"));
+    }
+    let half = chord / 2.0;
+    if radius.abs() < half - ARC_CLOSURE_MM.max(ARC_CLOSURE_RELATIVE * half) {
+        return Err(SolverError::new(
+            ErrorCode::ArcRadius,
+            format!("line {line}: arc radius R{} is shorter than half the chord ({:.4} mm)", r_word, half / scale),
+        )
+        .at(field));
+    }
+    let rise = (radius * radius - half * half).max(0.0).sqrt();
+    // The centre lies left of the chord for a short counter-clockwise arc or a long
+    // clockwise one (negative R asks for the long arc).
+    let left = (radius >= 0.0) != clockwise;
+    let side = if left { 1.0 } else { -1.0 };
+    let (mid_a, mid_b) = ((start_a + end_a) / 2.0, (start_b + end_b) / 2.0);
+    Ok((mid_a - side * rise * dy / chord, mid_b + side * rise * dx / chord))
+}
+
+/// The in-plane centre of an `I J K` arc starting at `start` (mm): offsets from the start, or
+/// absolute under `G90.1`; a missing word leaves that coordinate at the start's.
+fn offset_centre(
+    block: &Block,
+    modal: &Modal,
+    start: [f64; 2],
+    line: usize,
+    field: &str,
+) -> Result<(f64, f64), SolverError> {
+    let (a, b, normal) = modal.plane.axes();
+    let [start_a, start_b] = start;
+    let scale = modal.units.scale();
     let offset_letters = ['I', 'J', 'K'];
-    let (centre_a, centre_b) = if let Some(radius_word) = block.radius {
-        if block.offsets.iter().any(Option::is_some) {
-            return Err(syntax(field, line, "an arc takes either R or I/J/K, not both"));
-        }
-        let radius = radius_word.value * scale;
-        let (dx, dy) = (end_a - start_a, end_b - start_b);
-        let chord = dx.hypot(dy);
-        if chord < 1e-9 {
-            return Err(syntax(field, line, "a full circle cannot be given with R: use I/J/K"));
-        }
-        let half = chord / 2.0;
-        if radius.abs() < half - ARC_CLOSURE_MM.max(ARC_CLOSURE_RELATIVE * half) {
-            return Err(SolverError::new(
-                ErrorCode::ArcRadius,
-                format!(
-                    "line {line}: arc radius R{} is shorter than half the chord ({:.4} mm)",
-                    radius_word.value,
-                    half / scale
-                ),
-            )
-            .at(field));
-        }
-        let rise = (radius * radius - half * half).max(0.0).sqrt();
-        // The centre lies left of the chord for a short counter-clockwise arc or a long
-        // clockwise one (negative R asks for the long arc).
-        let left = (radius >= 0.0) != clockwise;
-        let side = if left { 1.0 } else { -1.0 };
-        let (mid_a, mid_b) = ((start_a + end_a) / 2.0, (start_b + end_b) / 2.0);
-        (mid_a - side * rise * dy / chord, mid_b + side * rise * dx / chord)
+    let offset = |axis: usize| block.offsets[axis].map(|w| w.value * scale);
+    let (oa, ob) = (offset(a), offset(b));
+    if block.offsets[normal].is_some() {
+        return Err(syntax(
+            field,
+            line,
+            format!("{} is not an arc-centre word in the selected plane", offset_letters[normal]),
+        ));
+    }
+    if oa.is_none() && ob.is_none() {
+        return Err(syntax(field, line, "an arc needs R or centre words I/J/K"));
+    }
+    Ok(if modal.absolute_arc_centre {
+        (oa.unwrap_or(start_a), ob.unwrap_or(start_b))
     } else {
-        let offset = |axis: usize| block.offsets[axis].map(|w| w.value * scale);
-        let (oa, ob) = (offset(a), offset(b));
-        if block.offsets[normal].is_some() {
-            return Err(syntax(
-                field,
-                line,
-                format!("{} is not an arc-centre word in the selected plane", offset_letters[normal]),
-            ));
-        }
-        if oa.is_none() && ob.is_none() {
-            return Err(syntax(field, line, "an arc needs R or centre words I/J/K"));
-        }
-        if modal.absolute_arc_centre {
-            (oa.unwrap_or(start_a), ob.unwrap_or(start_b))
-        } else {
-            (start_a + oa.unwrap_or(0.0), start_b + ob.unwrap_or(0.0))
-        }
-    };
+        (start_a + oa.unwrap_or(0.0), start_b + ob.unwrap_or(0.0))
+    })
+}
+
+/// Refuses an arc whose centre is its start, or whose end is off its circle by more than the
+/// closure tolerance.
+fn check_closure(
+    centre: [f64; 2],
+    start: [f64; 2],
+    end: [f64; 2],
+    line: usize,
+    field: &str,
+) -> Result<(), SolverError> {
+    let ([centre_a, centre_b], [start_a, start_b], [end_a, end_b]) = (centre, start, end);
     let start_radius = (start_a - centre_a).hypot(start_b - centre_b);
     let end_radius = (end_a - centre_a).hypot(end_b - centre_b);
     if start_radius < 1e-9 {
@@ -141,9 +191,5 @@ pub(super) fn arc_kind(
         )
         .at(field));
     }
-    let mut centre = [0.0; 3];
-    centre[a] = centre_a;
-    centre[b] = centre_b;
-    centre[normal] = from[normal].unwrap_or(0.0);
-    Ok(MoveKind::Arc { centre, clockwise, extra_turns })
+    Ok(())
 }

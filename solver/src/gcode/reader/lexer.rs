@@ -1,4 +1,4 @@
-//! The lexer of the G-code reader: a line split into words (letter, value, where the number
+//! The lexer of the G-code reader (docs/spec/predict.md §8, engagement.md §11): a line split into words (letter, value, where the number
 //! sits), and the `G` code numbering and modal groups.
 
 use super::WordSpan;

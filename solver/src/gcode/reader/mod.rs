@@ -1,5 +1,6 @@
 //! Reading G-code programs into typed moves with their source line numbers and modal state, and
-//! rewriting a program with new coordinates while keeping everything else byte for byte.
+//! rewriting a program with new coordinates while keeping everything else byte for byte
+//! (docs/spec/predict.md §8 corrected G-code; docs/spec/engagement.md §11 G-code import).
 //!
 //! The reader understands the RS274/Fanuc subset that CAM posts emit for 3-axis milling: `G0`
 //! `G1` `G2` `G3` (arcs by `I J K` or `R`, helical arcs, LinuxCNC's `P` turns), `G17` `G18` `G19`,
@@ -35,7 +36,7 @@ use crate::error::ErrorCode;
 use crate::error::SolverError;
 use arcs::{ArcGeometry, arc_kind};
 use lexer::{syntax, tokenize};
-use modal::parse_block;
+use modal::{Block, parse_block};
 
 /// Millimetres per inch.
 pub const MM_PER_INCH: f64 = 25.4;
@@ -290,12 +291,14 @@ pub struct ReadProgram {
 /// `E_GCODE_POSITION` (an arc from a position the program never set) and `E_TOO_MANY_LINES`,
 /// each with the line number in the message.
 pub fn read(text: &str, field: &str, options: &ReadOptions) -> Result<ReadProgram, SolverError> {
-    let mut modal = Modal::default();
-    let mut motion: Option<u32> = None;
-    let mut feed_per_rev = false;
-    let mut feed_word: Option<f64> = None;
-    let mut position: Position = options.start;
-    let mut moves = Vec::new();
+    let mut reader = Reader {
+        modal: Modal::default(),
+        motion: None,
+        feed_per_rev: false,
+        feed_word: None,
+        position: options.start,
+        moves: Vec::new(),
+    };
     let mut words = Vec::new();
     let mut line_count = 0;
     let mut ended = false;
@@ -312,20 +315,9 @@ pub fn read(text: &str, field: &str, options: &ReadOptions) -> Result<ReadProgra
         if ended {
             continue;
         }
-        let line = raw.strip_suffix('\r').unwrap_or(raw);
-        let trimmed = line.trim_start();
-        if trimmed.starts_with('%') {
+        let Some((code, offset)) = block_code(raw, options.block_delete) else {
             continue;
-        }
-        let mut code = line;
-        let mut offset = 0;
-        if let Some(rest) = trimmed.strip_prefix('/') {
-            if options.block_delete {
-                continue;
-            }
-            offset = line.len() - rest.len();
-            code = rest;
-        }
+        };
         words.clear();
         let code_end = tokenize(code, line_number, field, &mut words)? + offset;
         for word in &mut words {
@@ -336,7 +328,52 @@ pub fn read(text: &str, field: &str, options: &ReadOptions) -> Result<ReadProgra
             continue;
         }
         let block = parse_block(&words, line_number, field)?;
-        // Modal changes take effect before the block's motion (RS274 order of execution).
+        reader.set_modes(&block);
+        reader.execute(&block, line_number, code_end, field)?;
+        if block.end {
+            ended = true;
+        }
+    }
+    Ok(ReadProgram { moves: reader.moves, line_count, modal: reader.modal })
+}
+
+/// The part of a source line the control executes and its byte offset in the line: `None` for
+/// `%` lines and, with block delete on, for blocks starting with `/`.
+fn block_code(raw: &str, block_delete: bool) -> Option<(&str, usize)> {
+    let line = raw.strip_suffix('\r').unwrap_or(raw);
+    let trimmed = line.trim_start();
+    if trimmed.starts_with('%') {
+        return None;
+    }
+    let mut code = line;
+    let mut offset = 0;
+    if let Some(rest) = trimmed.strip_prefix('/') {
+        if block_delete {
+            return None;
+        }
+        offset = line.len() - rest.len();
+        code = rest;
+    }
+    Some((code, offset))
+}
+
+/// The control's state as the program runs: modal state, motion mode, feed words and where the
+/// tool is, and the moves so far.
+struct Reader {
+    modal: Modal,
+    motion: Option<u32>,
+    feed_per_rev: bool,
+    /// The last `F` word, in mm (per minute, or per revolution under `G95`).
+    feed_word: Option<f64>,
+    position: Position,
+    moves: Vec<ReadMove>,
+}
+
+impl Reader {
+    /// The block's modal changes, which take effect before its motion (RS274 order of
+    /// execution).
+    fn set_modes(&mut self, block: &Block) {
+        let modal = &mut self.modal;
         if let Some(units) = block.units {
             modal.units = units;
         }
@@ -350,21 +387,21 @@ pub fn read(text: &str, field: &str, options: &ReadOptions) -> Result<ReadProgra
             modal.absolute_arc_centre = absolute;
         }
         if let Some(per_rev) = block.feed_per_rev {
-            feed_per_rev = per_rev;
+            self.feed_per_rev = per_rev;
         }
         if let Some(rpm) = block.spindle_rpm {
             modal.spindle_rpm = Some(rpm);
         }
         if let Some(feed) = block.feed {
-            feed_word = Some(feed * modal.units.scale());
+            self.feed_word = Some(feed * modal.units.scale());
         }
-        modal.feed = if feed_per_rev {
-            match (feed_word, modal.spindle_rpm) {
+        modal.feed = if self.feed_per_rev {
+            match (self.feed_word, modal.spindle_rpm) {
                 (Some(per_rev), Some(rpm)) => Some(per_rev * rpm),
                 _ => None,
             }
         } else {
-            feed_word
+            self.feed_word
         };
         if let Some(tool) = block.tool {
             modal.tool = Some(tool);
@@ -373,79 +410,98 @@ pub fn read(text: &str, field: &str, options: &ReadOptions) -> Result<ReadProgra
             modal.spindle = spindle;
         }
         if block.tool_change {
-            position = [None; 3];
+            self.position = [None; 3];
         }
         if let Some(code) = block.motion {
-            motion = Some(code);
+            self.motion = Some(code);
         }
+    }
+
+    /// The block's motion: a move in the current motion mode, or a home return or machine-
+    /// coordinate move that leaves axes unknown.
+    fn execute(&mut self, block: &Block, line_number: usize, code_end: usize, field: &str) -> Result<(), SolverError> {
         let has_axes = block.axes.iter().any(Option::is_some);
-        let scale = modal.units.scale();
-        let target = |position: &Position| -> Position {
-            let mut to = *position;
-            for axis in 0..3 {
-                if let Some(word) = block.axes[axis] {
-                    let value = word.value * scale;
-                    to[axis] = match modal.distance {
-                        Distance::Absolute => Some(value),
-                        Distance::Incremental => position[axis].map(|p| p + value),
-                    };
-                }
-            }
-            to
-        };
         match block.non_modal {
             Some(40 | 100) => {}
             Some(280 | 300) => {
                 // Through the intermediate point (if any) to the reference point: unknown here.
-                position = [None; 3];
+                self.position = [None; 3];
             }
             Some(530) => {
                 // Machine coordinates: the end is unknown in work coordinates.
-                for (axis, word) in position.iter_mut().zip(&block.axes) {
+                for (axis, word) in self.position.iter_mut().zip(&block.axes) {
                     if word.is_some() {
                         *axis = None;
                     }
                 }
             }
             Some(_) | None if has_axes || matches!(block.motion, Some(20 | 30)) => {
-                let Some(code) = motion else {
-                    return Err(syntax(field, line_number, "axis words without a motion mode (G0, G1, G2 or G3)"));
-                };
-                if code == 800 {
-                    return Err(syntax(field, line_number, "axis words while the motion mode is cancelled (G80)"));
-                }
-                let to = target(&position);
-                let kind = match code {
-                    0 => MoveKind::Rapid,
-                    10 => MoveKind::Linear,
-                    _ => arc_kind(&block, &modal, &position, &to, code == 20, line_number, field)?,
-                };
-                // Missing axis words go right after the block's last axis word.
-                let insert_at = block.axes.iter().flatten().map(|w| w.span.end).max().unwrap_or(code_end);
-                let words = MoveWords {
-                    axes: block.axes.map(|w| w.map(|w| w.span)),
-                    offsets: block.offsets.map(|w| w.map(|w| w.span)),
-                    radius: block.radius.map(|w| w.span),
-                    insert_at,
-                };
-                moves.push(ReadMove {
-                    line: line_number,
-                    block_number: block.block_number,
-                    kind,
-                    from: position,
-                    to,
-                    modal,
-                    words,
-                });
-                position = to;
+                self.motion_move(block, line_number, code_end, field)?;
             }
             Some(_) | None => {}
         }
-        if block.end {
-            ended = true;
+        Ok(())
+    }
+
+    /// A move in the current motion mode to the block's axis words.
+    fn motion_move(
+        &mut self,
+        block: &Block,
+        line_number: usize,
+        code_end: usize,
+        field: &str,
+    ) -> Result<(), SolverError> {
+        let modal = self.modal;
+        let position = self.position;
+        let Some(code) = self.motion else {
+            return Err(syntax(field, line_number, "axis words without a motion mode (G0, G1, G2 or G3)"));
+        };
+        if code == 800 {
+            return Err(syntax(field, line_number, "axis words while the motion mode is cancelled (G80)"));
+        }
+        let to = target(block, &modal, &position);
+        let kind = match code {
+            0 => MoveKind::Rapid,
+            10 => MoveKind::Linear,
+            _ => arc_kind(block, &modal, &position, &to, code == 20, line_number, field)?,
+        };
+        // Missing axis words go right after the block's last axis word.
+        let insert_at = block.axes.iter().flatten().map(|w| w.span.end).max().unwrap_or(code_end);
+        let words = MoveWords {
+            axes: block.axes.map(|w| w.map(|w| w.span)),
+            offsets: block.offsets.map(|w| w.map(|w| w.span)),
+            radius: block.radius.map(|w| w.span),
+            insert_at,
+        };
+        self.moves.push(ReadMove {
+            line: line_number,
+            block_number: block.block_number,
+            kind,
+            from: position,
+            to,
+            modal,
+            words,
+        });
+        self.position = to;
+        Ok(())
+    }
+}
+
+/// Where the block's axis words take the tool from `position`, in mm: absolute words set their
+/// axis, incremental ones add to it (an unknown axis stays unknown).
+fn target(block: &Block, modal: &Modal, position: &Position) -> Position {
+    let scale = modal.units.scale();
+    let mut to = *position;
+    for axis in 0..3 {
+        if let Some(word) = block.axes[axis] {
+            let value = word.value * scale;
+            to[axis] = match modal.distance {
+                Distance::Absolute => Some(value),
+                Distance::Incremental => position[axis].map(|p| p + value),
+            };
         }
     }
-    Ok(ReadProgram { moves, line_count, modal })
+    to
 }
 
 #[cfg(test)]

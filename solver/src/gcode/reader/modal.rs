@@ -1,5 +1,6 @@
-//! One block's words turned into what the block asks for (motion, plane, units, distance mode,
-//! feed, spindle, tool), with two codes of one modal group refused.
+//! The G-code reader's blocks (docs/spec/predict.md §8, engagement.md §11): one block's words
+//! turned into what the block asks for (motion, plane, units, distance mode, feed, spindle, tool),
+//! with two codes of one modal group refused.
 
 use super::lexer::{Word, g_group, g_tenths, syntax, unsupported};
 use super::{Distance, Plane, Spindle, Units};

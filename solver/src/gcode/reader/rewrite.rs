@@ -1,5 +1,6 @@
-//! Rewriting a program with new end points (and arc centres) while keeping everything else byte
-//! for byte.
+//! Rewriting a program with new end points (and arc centres) while keeping everything else byte for
+//! byte (docs/spec/predict.md §8 corrected G-code: same format, line numbers, comments and modal
+//! state; only coordinates change).
 
 use std::fmt::Write as _;
 
@@ -25,29 +26,17 @@ pub struct MoveEdit {
 /// coordinates of unchanged moves. A changed coordinate is written in the line's units with at
 /// least 4 decimals (more if the line had more); a changed axis the line did not program is
 /// inserted after the block's last word. Incremental (`G91`) feed blocks get new increments so
-/// every later end point stays where it was. Rapids without an edit are never rewritten (issue
-/// 15): after a moved cut they start, and in the axes they do not program end, where that cut
-/// ended; the next feed move is written to its own end point from there. `program` must be the
+/// every later end point stays where it was. Rapids without an edit are never rewritten, so the
+/// program's air moves stay as its post wrote them: after a moved cut they start, and in the axes
+/// they do not program end, where that cut ended; the next feed move is written to its own end
+/// point from there. `program` must be the
 /// result of [`super::read`] on `text`.
 ///
 /// # Errors
 /// `E_INPUT` for an edit that names no move, or a non-finite coordinate.
 pub fn rewrite(text: &str, program: &ReadProgram, edits: &[MoveEdit], field: &str) -> Result<String, SolverError> {
     let count = program.moves.len();
-    let mut new_to: Vec<Position> = program.moves.iter().map(|m| m.to).collect();
-    let mut centres: Vec<Option<[f64; 3]>> = vec![None; count];
-    let mut edited = vec![false; count];
-    for edit in edits {
-        if edit.index >= count {
-            return Err(SolverError::input(field, format!("edit names move {} of {count}", edit.index)));
-        }
-        if edit.to.iter().chain(edit.centre.iter().flatten()).any(|v| !v.is_finite()) {
-            return Err(SolverError::input(field, "an edited coordinate is not finite"));
-        }
-        new_to[edit.index] = edit.to.map(Some);
-        centres[edit.index] = edit.centre;
-        edited[edit.index] = true;
-    }
+    let targets = Targets::of(program, edits, field)?;
     // Where each move of the rewritten program really ends (written values are rounded), so
     // incremental words and modal axes follow the control, not the exact edits.
     let mut actual: Vec<Position> = Vec::with_capacity(count);
@@ -55,7 +44,7 @@ pub fn rewrite(text: &str, program: &ReadProgram, edits: &[MoveEdit], field: &st
     for (index, read_move) in program.moves.iter().enumerate() {
         let continuous = index > 0 && program.moves[index - 1].to == read_move.from;
         let start = if continuous { actual[index - 1] } else { read_move.from };
-        if start == read_move.from && new_to[index] == read_move.to && centres[index].is_none() {
+        if start == read_move.from && targets.to[index] == read_move.to && targets.centres[index].is_none() {
             actual.push(read_move.to);
             continue;
         }
@@ -63,70 +52,123 @@ pub fn rewrite(text: &str, program: &ReadProgram, edits: &[MoveEdit], field: &st
         // it starts elsewhere, so the axes it does not program (absolute) or all of them
         // (incremental) end shifted with its start; the next cutting move is rewritten to its
         // own end point from there.
-        if read_move.kind == MoveKind::Rapid && !edited[index] {
-            let shifted = std::array::from_fn(|axis| match read_move.modal.distance {
-                Distance::Absolute if read_move.words.axes[axis].is_some() => read_move.to[axis],
-                _ => match (start[axis], read_move.from[axis], read_move.to[axis]) {
-                    (Some(now), Some(before), Some(end)) => Some(now + (end - before)),
-                    (_, _, end) => end,
-                },
-            });
-            actual.push(shifted);
+        if read_move.kind == MoveKind::Rapid && !targets.edited[index] {
+            actual.push(shifted_rapid(read_move, &start));
             continue;
         }
-        let scale = read_move.modal.units.scale();
-        let mut end_actual = read_move.to;
-        let mut changes: Vec<(WordSpan, String)> = Vec::new();
-        let mut inserts: Vec<String> = Vec::new();
-        let letters = ['X', 'Y', 'Z'];
-        for axis in 0..3 {
-            let (Some(end), Some(old_end)) = (new_to[index][axis], read_move.to[axis]) else {
-                continue;
-            };
-            let span = read_move.words.axes[axis];
-            let decimals = span.map_or(4, |s| s.decimals.max(4));
-            // The value to write, what the line means now (kept), and where the axis lands if
-            // written.
-            let (value, kept_value, base) = match read_move.modal.distance {
-                Distance::Absolute => match (span, start[axis]) {
-                    // A word the line does not have leaves the axis where the move starts.
-                    (None, Some(from)) => (end / scale, from / scale, 0.0),
-                    (None, None) => continue,
-                    (Some(_), _) => (end / scale, old_end / scale, 0.0),
-                },
-                Distance::Incremental => {
-                    let (Some(from), Some(old_from)) = (start[axis], read_move.from[axis]) else {
-                        continue;
-                    };
-                    ((end - from) / scale, (old_end - old_from) / scale, from)
-                }
-            };
-            let written = number(value, decimals);
-            if written == number(kept_value, decimals) {
-                end_actual[axis] = Some(base + kept_value * scale);
-                continue;
-            }
-            end_actual[axis] = Some(base + written.parse::<f64>().unwrap_or(value) * scale);
-            match span {
-                Some(span) => changes.push((span, written)),
-                None => inserts.push(format!("{}{written}", letters[axis])),
-            }
-        }
-        if let MoveKind::Arc { centre, clockwise, .. } = read_move.kind
-            && let (Some(from), Some(to)) = (known(&start), known(&end_actual))
-        {
-            arc_words(read_move, from, to, centres[index].unwrap_or(centre), clockwise, &mut changes, &mut inserts);
-        }
+        let (end_actual, edit) = rewrite_move(read_move, &start, &targets.to[index], targets.centres[index]);
         actual.push(end_actual);
-        if !changes.is_empty() || !inserts.is_empty() {
-            replacements.push(LineEdit {
-                line: read_move.line,
-                changes,
-                inserts,
-                insert_at: read_move.words.insert_at,
-            });
+        replacements.extend(edit);
+    }
+    Ok(apply(text, &replacements))
+}
+
+/// Per move of the program: its wanted end, wanted arc centre and whether an edit names it.
+struct Targets {
+    to: Vec<Position>,
+    centres: Vec<Option<[f64; 3]>>,
+    edited: Vec<bool>,
+}
+
+impl Targets {
+    /// The edits laid over the program's own end points.
+    ///
+    /// # Errors
+    /// `E_INPUT` for an edit that names no move, or a non-finite coordinate.
+    fn of(program: &ReadProgram, edits: &[MoveEdit], field: &str) -> Result<Self, SolverError> {
+        let count = program.moves.len();
+        let mut new_to: Vec<Position> = program.moves.iter().map(|m| m.to).collect();
+        let mut centres: Vec<Option<[f64; 3]>> = vec![None; count];
+        let mut edited = vec![false; count];
+        for edit in edits {
+            if edit.index >= count {
+                return Err(SolverError::input(field, format!("edit names move {} of {count}", edit.index)));
+            }
+            if edit.to.iter().chain(edit.centre.iter().flatten()).any(|v| !v.is_finite()) {
+                return Err(SolverError::input(field, "an edited coordinate is not finite"));
+            }
+            new_to[edit.index] = edit.to.map(Some);
+            centres[edit.index] = edit.centre;
+            edited[edit.index] = true;
+        }
+        Ok(Self { to: new_to, centres, edited })
+    }
+}
+
+/// Where an unedited rapid ends when it starts at `start`: the axes it programs absolutely stay,
+/// the others move with its start.
+fn shifted_rapid(read_move: &ReadMove, start: &Position) -> Position {
+    std::array::from_fn(|axis| match read_move.modal.distance {
+        Distance::Absolute if read_move.words.axes[axis].is_some() => read_move.to[axis],
+        _ => match (start[axis], read_move.from[axis], read_move.to[axis]) {
+            (Some(now), Some(before), Some(end)) => Some(now + (end - before)),
+            (_, _, end) => end,
+        },
+    })
+}
+
+/// The words of one move from `start` to `new_to` (and for arcs its centre words): where the
+/// move really ends as written, and the line's changes if any.
+fn rewrite_move(
+    read_move: &ReadMove,
+    start: &Position,
+    new_to: &Position,
+    wanted_centre: Option<[f64; 3]>,
+) -> (Position, Option<LineEdit>) {
+    let scale = read_move.modal.units.scale();
+    let mut end_actual = read_move.to;
+    let mut changes: Vec<(WordSpan, String)> = Vec::new();
+    let mut inserts: Vec<String> = Vec::new();
+    let letters = ['X', 'Y', 'Z'];
+    for axis in 0..3 {
+        let (Some(end), Some(old_end)) = (new_to[axis], read_move.to[axis]) else {
+            continue;
+        };
+        let span = read_move.words.axes[axis];
+        let decimals = span.map_or(4, |s| s.decimals.max(4));
+        // The value to write, what the line means now (kept), and where the axis lands if
+        // written.
+        let (value, kept_value, base) = match read_move.modal.distance {
+            Distance::Absolute => match (span, start[axis]) {
+                // A word the line does not have leaves the axis where the move starts.
+                (None, Some(from)) => (end / scale, from / scale, 0.0),
+                (None, None) => continue,
+                (Some(_), _) => (end / scale, old_end / scale, 0.0),
+            },
+            Distance::Incremental => {
+                let (Some(from), Some(old_from)) = (start[axis], read_move.from[axis]) else {
+                    continue;
+                };
+                ((end - from) / scale, (old_end - old_from) / scale, from)
+            }
+        };
+        let written = number(value, decimals);
+        if written == number(kept_value, decimals) {
+            end_actual[axis] = Some(base + kept_value * scale);
+            continue;
+        }
+        end_actual[axis] = Some(base + written.parse::<f64>().unwrap_or(value) * scale);
+        match span {
+            Some(span) => changes.push((span, written)),
+            None => inserts.push(format!("{}{written}", letters[axis])),
         }
     }
+    if let MoveKind::Arc { centre, clockwise, .. } = read_move.kind
+        && let (Some(from), Some(to)) = (known(start), known(&end_actual))
+    {
+        arc_words(read_move, from, to, wanted_centre.unwrap_or(centre), clockwise, &mut changes, &mut inserts);
+    }
+    let edit = (!changes.is_empty() || !inserts.is_empty()).then_some(LineEdit {
+        line: read_move.line,
+        changes,
+        inserts,
+        insert_at: read_move.words.insert_at,
+    });
+    (end_actual, edit)
+}
+
+/// `text` with the line edits (in line order) applied; other lines byte for byte.
+fn apply(text: &str, replacements: &[LineEdit]) -> String {
     let mut out = String::with_capacity(text.len() + replacements.len() * 8);
     let mut pending = replacements.iter().peekable();
     for (index, raw) in text.split('\n').enumerate() {
@@ -168,7 +210,7 @@ pub fn rewrite(text: &str, program: &ReadProgram, edits: &[MoveEdit], field: &st
         }
         out.push_str(&raw[cursor..]);
     }
-    Ok(out)
+    out
 }
 
 /// The text changes of one rewritten line.

@@ -1,4 +1,4 @@
-//! Unit tests of the reader and the rewrite.
+//! Unit tests of the reader and the rewrite (docs/spec/predict.md §8 corrected G-code).
 
 use super::*;
 use crate::error::ErrorCode;
