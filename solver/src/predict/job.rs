@@ -6,7 +6,7 @@ use super::force::CuttingCoefficients;
 use super::passes::{PassSource, PathBuilder, PathModel};
 use super::stock::StockModel;
 use crate::error::{ErrorCode, SolverError};
-use crate::gcode::reader::{self, MoveKind, ReadOptions, ReadProgram, Spindle};
+use crate::gcode::reader::{self, MoveKind, ReadMove, ReadOptions, ReadProgram, Spindle};
 use crate::gcode::{Reference, SpindleDirection};
 use crate::geometry::{Vec3, vec3};
 use crate::tool::{ShapeErrorPoint, Stiffness, Tool, ToolKind};
@@ -404,18 +404,7 @@ fn build_from_program(
         let line = read_move.line;
         let cutting = !matches!(read_move.kind, MoveKind::Rapid);
         if cutting {
-            if let (Some(first), Some(this)) = (tool_number, read_move.modal.tool)
-                && first != this
-            {
-                return Err(SolverError::new(
-                    ErrorCode::GcodeUnsupported,
-                    format!(
-                        "line {line}: the program changes from tool {first} to tool {this}; predict one tool at a time"
-                    ),
-                )
-                .at(field));
-            }
-            tool_number = tool_number.or(read_move.modal.tool);
+            tool_number = one_tool(tool_number, read_move)?;
         }
         let (Some(from), Some(to)) = (read_move.from_xyz(), read_move.to_xyz()) else {
             if cutting && read_move.to_xyz().is_none() {
@@ -439,41 +428,7 @@ fn build_from_program(
             builder.start(centre_of(vec3(from)));
             node_sources.push(NodeSource { item: index, chord: 0, chords: 0 });
         }
-        let source = if cutting {
-            let feed = read_move.modal.feed.or(defaults.feed).ok_or_else(|| {
-                SolverError::new(
-                    ErrorCode::NoFeed,
-                    format!("line {line}: feed move without a feed rate (F) and no default feed in the request"),
-                )
-                .at(field)
-            })?;
-            let spindle_rpm = read_move
-                .modal
-                .spindle_rpm
-                .filter(|s| *s > 0.0)
-                .or(defaults.spindle_rpm)
-                .ok_or_else(|| {
-                    SolverError::new(
-                        ErrorCode::NoSpindle,
-                        format!("line {line}: feed move without a spindle speed (S) and no default spindle_rpm in the request"),
-                    )
-                    .at(field)
-                })?;
-            let rotation_sign = match read_move.modal.spindle {
-                Spindle::Clockwise => -1.0,
-                Spindle::CounterClockwise => 1.0,
-                Spindle::Off => defaults.sign,
-            };
-            Some(PassSource {
-                line: Some(line),
-                block_number: read_move.block_number,
-                feed,
-                spindle_rpm,
-                rotation_sign,
-            })
-        } else {
-            None
-        };
+        let source = if cutting { Some(pass_source(read_move, defaults)?) } else { None };
         let points = read_move.points(arc_tolerance).unwrap_or_else(|| vec![to]);
         let chords = points.len();
         if builder.pass_count() + chords > MAX_PASSES {
@@ -495,4 +450,46 @@ fn build_from_program(
         current = Some(to);
     }
     Ok(())
+}
+
+/// The tool of the program's cutting moves so far, given `read_move` (a cutting move): one tool
+/// per prediction, since the shape error and stiffness are one tool's.
+fn one_tool(tool_number: Option<u32>, read_move: &ReadMove) -> Result<Option<u32>, SolverError> {
+    let line = read_move.line;
+    if let (Some(first), Some(this)) = (tool_number, read_move.modal.tool)
+        && first != this
+    {
+        return Err(SolverError::new(
+            ErrorCode::GcodeUnsupported,
+            format!("line {line}: the program changes from tool {first} to tool {this}; predict one tool at a time"),
+        )
+        .at("path.program"));
+    }
+    Ok(tool_number.or(read_move.modal.tool))
+}
+
+/// The cutting conditions of a feed move: its modal feed, spindle speed and direction, or the
+/// request's defaults where the program sets none.
+fn pass_source(read_move: &ReadMove, defaults: &Defaults) -> Result<PassSource, SolverError> {
+    let (line, field) = (read_move.line, "path.program");
+    let feed = read_move.modal.feed.or(defaults.feed).ok_or_else(|| {
+        SolverError::new(
+            ErrorCode::NoFeed,
+            format!("line {line}: feed move without a feed rate (F) and no default feed in the request"),
+        )
+        .at(field)
+    })?;
+    let spindle_rpm = read_move.modal.spindle_rpm.filter(|s| *s > 0.0).or(defaults.spindle_rpm).ok_or_else(|| {
+        SolverError::new(
+            ErrorCode::NoSpindle,
+            format!("line {line}: feed move without a spindle speed (S) and no default spindle_rpm in the request"),
+        )
+        .at(field)
+    })?;
+    let rotation_sign = match read_move.modal.spindle {
+        Spindle::Clockwise => -1.0,
+        Spindle::CounterClockwise => 1.0,
+        Spindle::Off => defaults.sign,
+    };
+    Ok(PassSource { line: Some(line), block_number: read_move.block_number, feed, spindle_rpm, rotation_sign })
 }
