@@ -63,6 +63,7 @@ fn size(field: &str, value: f64) -> Result<f64, SolverError> {
     Ok(value)
 }
 
+/// A point with every coordinate finite and within ±[`MAX_LENGTH`].
 fn point(field: &str, p: [f64; 3]) -> Result<[f64; 3], SolverError> {
     validate::point(field, p, MAX_LENGTH)
 }

@@ -179,6 +179,7 @@ impl From<PartLoop> for Deburr {
     }
 }
 
+/// `E_INTERNAL`: the parts handed to the finish step are not this request's.
 fn mismatch(detail: String) -> SolverError {
     SolverError::new(ErrorCode::Internal, format!("the parts do not belong to this deburring: {detail}"))
 }

@@ -36,6 +36,7 @@ pub(crate) fn safe_centre_z(job: &Job, frame: &Frame) -> Result<f64, SolverError
     }
 }
 
+/// A lead move to ball centre `centre`, with its tip.
 fn lead(motion: LeadMotion, centre: Vec3, ball_radius: f64) -> LeadMove {
     LeadMove { motion, centre: array3(&centre), tip: array3(&(centre - ball_radius * Vec3::z())) }
 }

@@ -49,6 +49,7 @@ pub struct CuttingCoefficients {
 }
 
 impl CuttingCoefficients {
+    /// Checks that every coefficient is finite, naming it under `field`.
     pub(crate) fn validate(&self, field: &str) -> Result<(), SolverError> {
         for (name, value) in [
             ("ktc", self.ktc),

@@ -65,6 +65,7 @@ pub(crate) struct Job {
     pub(crate) merge_tolerance: Option<f64>,
 }
 
+/// `value` (or `default`) within `lo..=hi`, else `E_INPUT` naming `field`.
 fn range_u32(field: &str, value: Option<u32>, default: u32, lo: u32, hi: u32) -> Result<u32, SolverError> {
     let v = value.unwrap_or(default);
     if (lo..=hi).contains(&v) {

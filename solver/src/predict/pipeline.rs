@@ -77,6 +77,7 @@ pub(crate) struct Outcome {
 }
 
 impl Outcome {
+    /// A pass with `status` and nothing predicted.
     pub(crate) fn empty(status: PassStatus) -> Self {
         Self {
             status,
@@ -115,11 +116,14 @@ struct SpindleKernels {
     outside: bool,
 }
 
+/// The slot of a spindle direction in per-direction tables: 0 clockwise (−1), 1 counter-clockwise (+1).
 fn sign_slot(sign: f64) -> usize {
     usize::from(sign > 0.0)
 }
 
 impl<'a> Context<'a> {
+    /// What every pass of `job` shares: an edge grid per spindle direction used and, with a
+    /// force model and stiffness, the deflection kernels per spindle speed.
     pub(crate) fn new(job: &'a Job) -> Self {
         let helix = job.helix.tan();
         let mut grids = [None, None];
