@@ -1,8 +1,6 @@
 //! Deburr throughput: ball centres per second for a ~10 000-point job (single core) and a typical
-//! 92-point job (reference case 1), for the patent's tangent method, the exact method (issue 19:
-//! centres whose swept chamfer is W wide) and, for comparison, the exact method before issue 19
-//! (each centre from its own ball section, `solve_single_section`). The cost per centre is one
-//! over the throughput; the ratio exact / single-section is the price of the swept solve.
+//! 92-point job (reference case 1), for the patent's tangent method and the exact method (centres
+//! whose swept chamfer is W wide). The cost per centre is one over the throughput.
 //!
 //! `cargo bench -p kerf-solver --bench deburr`
 
@@ -29,36 +27,22 @@ fn request_with_cut(cut_amount: f64, tolerance: f64, method: &str) -> DeburrRequ
 const DISTINCT_LOAD_NAME: &str = "typical_distinct_load_cut0.300123_tangent";
 const DISTINCT_LOAD_CUT: f64 = 0.300123;
 
-/// Which solver entry a bench runs.
-#[derive(Clone, Copy)]
-enum Entry {
-    /// `deburr::solve` (tangent, or exact with the swept solve).
-    Solve,
-    /// The exact method before issue 19.
-    SingleSection,
-}
-
 fn bench(c: &mut Criterion) {
     let tool = &Tool::new(ToolKind::Ball, 3.0);
     let mut group = c.benchmark_group("deburr");
-    for (name, tolerance, method, entry) in [
-        ("typical_case1_tangent", 0.01, "tangent", Entry::Solve),
-        (DISTINCT_LOAD_NAME, 0.01, "tangent", Entry::Solve),
-        ("typical_case1_exact", 0.01, "exact", Entry::Solve),
-        ("typical_case1_exact_single_section", 0.01, "exact", Entry::SingleSection),
-        ("10k_points_tangent", 1e-6, "tangent", Entry::Solve),
-        ("10k_points_exact", 1e-6, "exact", Entry::Solve),
-        ("10k_points_exact_single_section", 1e-6, "exact", Entry::SingleSection),
+    for (name, tolerance, method) in [
+        ("typical_case1_tangent", 0.01, "tangent"),
+        (DISTINCT_LOAD_NAME, 0.01, "tangent"),
+        ("typical_case1_exact", 0.01, "exact"),
+        ("10k_points_tangent", 1e-6, "tangent"),
+        ("10k_points_exact", 1e-6, "exact"),
     ] {
         let job = if name == DISTINCT_LOAD_NAME {
             request_with_cut(DISTINCT_LOAD_CUT, tolerance, method)
         } else {
             request(tolerance, method)
         };
-        let run = move |job: &DeburrRequest| match entry {
-            Entry::Solve => deburr::solve(job, tool),
-            Entry::SingleSection => deburr::solve_single_section(job, tool),
-        };
+        let run = |job: &DeburrRequest| deburr::solve(job, tool);
         let count = run(&job).expect("solves").summary.count;
         eprintln!("{name}: {count} points");
         group.throughput(Throughput::Elements(count as u64));

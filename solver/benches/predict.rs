@@ -27,7 +27,7 @@ use kerf_solver::predict::{self, Method};
 use kerf_cases::predict as support;
 
 /// The patent's time per pass (patent Fig. 21, GPU, 2009).
-const SEED_SECONDS_PER_PASS: f64 = 0.070;
+const PATENT_SECONDS_PER_PASS: f64 = 0.070;
 /// Passes per criterion sample.
 const SLICE: usize = 1000;
 
@@ -51,9 +51,9 @@ fn report(label: &str, passes: usize, wall: f64, cpu: f64) {
         "{label}: {passes} passes, wall {:.3} ms/pass ({:.0} passes/s, {:.0}× the patent), CPU {:.3} ms/pass per core ({:.0}× the patent per core)",
         per_pass * 1e3,
         1.0 / per_pass,
-        SEED_SECONDS_PER_PASS / per_pass,
+        PATENT_SECONDS_PER_PASS / per_pass,
         cpu_per_pass * 1e3,
-        SEED_SECONDS_PER_PASS / cpu_per_pass,
+        PATENT_SECONDS_PER_PASS / cpu_per_pass,
     );
 }
 

@@ -63,27 +63,74 @@ fn size(field: &str, value: f64) -> Result<f64, SolverError> {
     Ok(value)
 }
 
+/// A point with every coordinate finite and within ±[`MAX_LENGTH`].
 fn point(field: &str, p: [f64; 3]) -> Result<[f64; 3], SolverError> {
     validate::point(field, p, MAX_LENGTH)
+}
+
+/// The workpiece section, checked: the placement of A1 and the radii.
+struct Part {
+    origin: crate::geometry::Vec3,
+    arrangement: f64,
+    /// R1: the radius of the cylinder the ridge lies on.
+    cylinder_radius: f64,
+    tube_radii: Option<(f64, f64)>,
+    top_distance: Option<f64>,
+}
+
+/// The cutting and program settings, checked.
+struct Conditions {
+    safe_z: Option<f64>,
+    feed: f64,
+    rule: Option<BlockRule>,
+    rule_warnings: Vec<Warning>,
+    spindle_rpm: f64,
+    clearance: f64,
+    lead_distance: f64,
 }
 
 impl DeburrRequest {
     /// Validates the request against `tool` (already resolved from `self.tool`) and `machine`
     /// (resolved from `self.machine`).
+    ///
+    /// The sections are checked in a fixed order (tool, edge, workpiece, hole, chamfer,
+    /// conditions), so a request with several faults is always refused for the same one.
     pub(crate) fn validate(&self, tool: &Tool, machine: Option<&MachineProfile>) -> Result<Job, SolverError> {
-        tool.validate("tool.")?;
-        size("tool.radius", tool.radius)?;
-        if tool.kind != ToolKind::Ball {
-            return Err(SolverError::new(
-                ErrorCode::ToolKind,
-                format!("deburring needs a ball end mill, but the tool is {}", tool.kind.as_str()),
-            )
-            .at("tool"));
-        }
+        check_tool(tool)?;
         if self.edge == Edge::Both {
             // The capability splits `both` into one request per ridge (`placements`).
             return Err(SolverError::input("edge", "one ridge at a time here: edge \"outer\" or \"inner\""));
         }
+        let part = self.part()?;
+        let (frame, profile) = self.hole_model(&part)?;
+        let (width, cut_amount, tolerance) = self.chamfer()?;
+        let conditions = self.conditions(machine)?;
+        Ok(Job {
+            frame,
+            profile,
+            edge: self.edge,
+            cylinder_radius: part.cylinder_radius,
+            tube_radii: part.tube_radii,
+            top_distance: part.top_distance,
+            width,
+            cut_amount,
+            tolerance,
+            method: self.method,
+            direction: self.direction,
+            tool: tool.clone(),
+            feed: conditions.feed,
+            spindle_rpm: conditions.spindle_rpm,
+            clearance: conditions.clearance,
+            lead_distance: conditions.lead_distance,
+            safe_z: conditions.safe_z,
+            rule: conditions.rule,
+            rule_warnings: conditions.rule_warnings,
+        })
+    }
+
+    /// The workpiece: a tube (whose edge picks R1 from its radii) or a bore block (inner edge
+    /// only, its face beyond the bore), and the placement of A1.
+    fn part(&self) -> Result<Part, SolverError> {
         let (origin, arrangement, cylinder_radius, tube_radii, top_distance) = match &self.workpiece {
             Workpiece::Tube { origin, arrangement_angle_deg, inner_radius, outer_radius } => {
                 let inner = size("workpiece.inner_radius", *inner_radius)?;
@@ -117,7 +164,11 @@ impl DeburrRequest {
         };
         let origin = vec3(point("workpiece.origin", *origin)?);
         let arrangement = finite("workpiece.arrangement_angle_deg", *arrangement)?;
+        Ok(Part { origin, arrangement, cylinder_radius, tube_radii, top_distance })
+    }
 
+    /// The hole: its frame on the part (§1.3) and its cross-section (§2.8).
+    fn hole_model(&self, part: &Part) -> Result<(Frame, Profile), SolverError> {
         let hole = self.hole.as_ref().ok_or_else(|| SolverError::input("hole", "give hole (or holes)"))?;
         let radius = size("hole.radius", hole.radius)?;
         let penetration = finite("hole.penetration_angle_deg", hole.penetration_angle_deg)?;
@@ -127,7 +178,8 @@ impl DeburrRequest {
         }
         let eccentricity = hole.eccentricity.map(|f| bounded("hole.eccentricity", f)).transpose()?;
         let axis_point = hole.axis_point.map(|p| point("hole.axis_point", p)).transpose()?.map(vec3);
-        let (frame, eccentricity) = Frame::resolve(origin, arrangement, penetration, axis_point, eccentricity)?;
+        let (frame, eccentricity) =
+            Frame::resolve(part.origin, part.arrangement, penetration, axis_point, eccentricity)?;
 
         let profile = match (hole.shape, hole.centre_distance) {
             (HoleShape::Round, None) => Profile::round(radius, eccentricity, start.to_radians()),
@@ -156,7 +208,11 @@ impl DeburrRequest {
                 ));
             }
         };
+        Ok((frame, profile))
+    }
 
+    /// The chamfer: W and Q (one given, the other W = √2·Q) and the tolerance TA.
+    fn chamfer(&self) -> Result<(f64, f64, f64), SolverError> {
         let (width, cut_amount) = match (self.cut_amount, self.width) {
             (Some(q), None) => {
                 let q = size("cut_amount", q)?;
@@ -181,6 +237,12 @@ impl DeburrRequest {
             )
             .at("tolerance"));
         }
+        Ok((width, cut_amount, tolerance))
+    }
+
+    /// Feed, speed, the block-time rule (from the request or the machine) and the program's
+    /// heights and distances.
+    fn conditions(&self, machine: Option<&MachineProfile>) -> Result<Conditions, SolverError> {
         let safe_z = self.safe_z.map(|z| bounded("safe_z", z)).transpose()?;
         let feed = optional_positive("feed", self.feed, DEFAULT_FEED)?;
         let (rule, rule_warnings) = if self.block_time_ms.is_some() || machine.is_some() {
@@ -191,29 +253,31 @@ impl DeburrRequest {
         } else {
             (None, Vec::new())
         };
-        Ok(Job {
-            frame,
-            profile,
-            edge: self.edge,
-            cylinder_radius,
-            tube_radii,
-            top_distance,
-            width,
-            cut_amount,
-            tolerance,
-            method: self.method,
-            direction: self.direction,
-            tool: tool.clone(),
+        Ok(Conditions {
+            safe_z,
             feed,
+            rule,
+            rule_warnings,
             spindle_rpm: optional_positive("spindle_rpm", self.spindle_rpm, DEFAULT_SPINDLE_RPM)?,
             clearance: bounded("clearance", optional_positive("clearance", self.clearance, DEFAULT_CLEARANCE)?)?,
             lead_distance: bounded(
                 "lead_distance",
                 optional_positive("lead_distance", self.lead_distance, DEFAULT_LEAD_DISTANCE)?,
             )?,
-            safe_z,
-            rule,
-            rule_warnings,
         })
     }
+}
+
+/// The tool: a valid ball end mill of a usable radius.
+fn check_tool(tool: &Tool) -> Result<(), SolverError> {
+    tool.validate("tool.")?;
+    size("tool.radius", tool.radius)?;
+    if tool.kind != ToolKind::Ball {
+        return Err(SolverError::new(
+            ErrorCode::ToolKind,
+            format!("deburring needs a ball end mill, but the tool is {}", tool.kind.as_str()),
+        )
+        .at("tool"));
+    }
+    Ok(())
 }

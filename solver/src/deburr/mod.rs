@@ -9,7 +9,8 @@
 //! * [`request`]: the request and its validation (§1.4);
 //! * `frame`: local frame and its map to the machine (§1.3);
 //! * `profile`: hole cross-sections (§2.8);
-//! * `centre`: the ball-centre construction (§2.5, §2.7) and the single-section exact variant;
+//! * `centre`: the ball-centre construction (§2.5, §2.7) and the single-section exact one (the
+//!   `exact` path's start and the diagnostics);
 //! * `envelope`: the `exact` centre path, whose swept envelope meets the true surfaces W apart;
 //! * `swept_width`: the chamfer width the emitted moves really cut;
 //! * `tolerance`: the target points from TA (§3), or with a block time from the block-time rule
@@ -90,7 +91,7 @@ pub fn solve_with(
     tool: &Tool,
     machine: Option<&MachineProfile>,
 ) -> Result<Deburr, SolverError> {
-    solve_centred(request, tool, machine, ExactCentres::Swept, Control::default())
+    solve_centred(request, tool, machine, Control::default())
 }
 
 /// [`solve_with`] that stops with `E_CANCELLED` once `control`'s cancel flag is set (checked per
@@ -104,69 +105,170 @@ pub fn solve_controlled(
     machine: Option<&MachineProfile>,
     control: Control<'_>,
 ) -> Result<Deburr, SolverError> {
-    solve_centred(request, tool, machine, ExactCentres::Swept, control)
+    solve_centred(request, tool, machine, control)
 }
 
-/// What `method: exact` places the centres by.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum ExactCentres {
-    /// The swept envelope meets the true surfaces W apart.
-    Swept,
-    /// One ball section in VP meets them W apart: the exact method before issue 19, kept for
-    /// the bench's cost comparison.
-    SingleSection,
-}
-
-/// [`solve`] with `method: exact` placing each centre by its own ball section in VP only (the
-/// method before issue 19, whose swept chamfer is wider than W on tightly curved ridges). For
-/// the bench's cost comparison, not for machining.
-///
-/// # Errors
-/// As [`solve`], and `E_EXACT_NO_SOLUTION` where a section has no band edges on the true surfaces.
-#[doc(hidden)]
-pub fn solve_single_section(request: &DeburrRequest, tool: &Tool) -> Result<Deburr, SolverError> {
-    solve_centred(request, tool, None, ExactCentres::SingleSection, Control::default())
-}
-
+/// Places, checks and describes the centres of one deburr loop, reporting progress by stage
+/// (the centres' count is known only once they are placed).
 fn solve_centred(
     request: &DeburrRequest,
     tool: &Tool,
     machine: Option<&MachineProfile>,
-    exact_centres: ExactCentres,
     control: Control<'_>,
 ) -> Result<Deburr, SolverError> {
     let job = request.validate(tool, machine)?;
     let mut warnings = checks::ridge(&job)?;
-    let ball = job.tool.radius;
     let construction = Construction::for_job(&job);
-    let profile = &job.profile;
-    let single_section = |segment: usize, s: f64, ridge: &RidgeCentre| {
-        construction.exact(profile, ridge).map(|(c, _, _)| c).ok_or_else(|| {
-            SolverError::new(
-                ErrorCode::ExactNoSolution,
-                format!(
-                    "no band edges on the true surfaces near {} s = {s:.6}: the chamfer is too wide for the curvature here",
-                    profile.segments[segment].name
-                ),
-            )
-            .at("method")
-        })
-    };
-    let envelope = (job.method == Method::Exact && exact_centres == ExactCentres::Swept)
-        .then(|| EnvelopePath::solve(&construction, profile));
+    let envelope = (job.method == Method::Exact).then(|| EnvelopePath::solve(&construction, &job.profile));
     control.check()?;
-    // Progress by stage: the centres' count is known only once they are placed.
     control.report_fraction(0.2);
+    let mut refined = place_centres(&job, &construction, envelope.as_ref(), control)?;
+    control.check()?;
+    control.report_fraction(0.7);
+
+    let (mut ridges, exact_offset) = ridges_at(&job, &construction, &refined.targets, &refined.centres);
+    warnings.extend(point_checks(&job, &refined.targets, &ridges)?);
+    let (true_width_min, true_width_max, approx) = true_widths(&construction, &job, &refined.targets, &ridges);
+    let swept = swept_width::swept_widths(&construction, &job.profile, &refined.targets, &refined.centres);
+    control.check()?;
+    match job.method {
+        Method::Tangent => warnings.extend(approx.or_else(|| swept_approx(&job, &swept))),
+        Method::Exact => warnings.extend(width_off(&job, &swept, envelope.as_ref())),
+    }
+    checks::far_gouge(&job, &refined.targets, &refined.centres)?;
+    let shank_direction = job.frame.local_vector(&Vec3::z());
+    let (access_warnings, mut program_blocker) = checks::inner_access(&job, &ridges, &shank_direction);
+    warnings.extend(access_warnings);
+    warnings.extend(checks::overlap(&job, &construction, &ridges));
+    warnings.extend(checks::outer_shank(&job, &ridges));
+
+    if job.direction == Direction::Cw {
+        refined.targets.reverse();
+        ridges.reverse();
+        refined.centres.reverse();
+    }
+    let (targets, centres) = (&refined.targets, &refined.centres);
+    let points = machine_points(&job, targets, &ridges, centres);
+    let path_length: f64 = centres.windows(2).map(|pair| (pair[1] - pair[0]).norm()).sum();
+
+    let ends =
+        leads_and_time(&job, centres, &ridges, &refined.limits, path_length, &mut program_blocker, &mut warnings);
+    let wedge = ridges.iter().map(|r| r.wedge_angle().to_degrees());
+    let summary = DeburrSummary {
+        count: targets.len() - 1,
+        path_length,
+        max_deviation: refined.max_deviation,
+        tolerance: job.tolerance,
+        cut_amount: job.cut_amount,
+        width: job.width,
+        true_width_min,
+        true_width_max,
+        swept_width_min: swept.min,
+        swept_width_max: swept.max,
+        wedge_angle_min_deg: wedge.clone().fold(f64::INFINITY, f64::min),
+        wedge_angle_max_deg: wedge.fold(f64::NEG_INFINITY, f64::max),
+        max_exact_offset: exact_offset,
+        feed: job.feed,
+        spindle_rpm: job.spindle_rpm,
+        safe_centre_z: ends.safe_centre_z,
+        estimated_time_s: ends.estimated_time_s,
+        block_time_ms: job.rule.map(|rule| rule.block_time_ms),
+        block_length: job.rule.map(|rule| rule.block_length()),
+        blocks: ends.blocks.as_ref().map(|stats| stats.blocks),
+        min_block_length: ends.blocks.as_ref().map(|stats| stats.min_block_length),
+        short_blocks: ends.blocks.as_ref().map(|stats| stats.short_blocks),
+    };
+    let description = describe(request, &job, &summary);
+    Ok(Deburr {
+        edge: job.edge,
+        method: job.method,
+        points,
+        lead_in: ends.lead_in,
+        lead_out: ends.lead_out,
+        summary,
+        warnings,
+        program_blocker,
+        description,
+        ball_radius: job.tool.radius,
+    })
+}
+
+/// The way in and out of a loop and what the whole program takes.
+struct Ends {
+    lead_in: Vec<LeadMove>,
+    lead_out: Vec<LeadMove>,
+    /// The height the leads start and end at; `None` when no program can be written.
+    safe_centre_z: Option<f64>,
+    /// The loop and its leads at the feed, or block-limited with a block time, s.
+    estimated_time_s: f64,
+    /// The loop's blocks, with a block time.
+    blocks: Option<BlockStats>,
+}
+
+/// The leads (§6.3), `W_NO_PROGRAM` when no program can be written (the first blocker kept),
+/// and the time of the loop and its leads, with the block warnings under a block-time rule.
+fn leads_and_time(
+    job: &Job,
+    centres: &[Vec3],
+    ridges: &[RidgeCentre],
+    limits: &[IntervalLimit],
+    path_length: f64,
+    program_blocker: &mut Option<SolverError>,
+    warnings: &mut Vec<Warning>,
+) -> Ends {
+    let frame = &job.frame;
+    let safe_centre_z = program::safe_centre_z(job, frame);
+    let (lead_in, lead_out) = match &safe_centre_z {
+        Ok(z) => program::leads(job, frame.point(&centres[0]), frame.vector(&ridges[0].bisector), *z),
+        Err(_) => (Vec::new(), Vec::new()),
+    };
+    if program_blocker.is_none() {
+        *program_blocker = safe_centre_z.as_ref().err().cloned();
+    }
+    if let Some(blocker) = program_blocker {
+        warnings.push(Warning::new("W_NO_PROGRAM", format!("no G-code can be written: {}", blocker.message())));
+    }
+    let lead_feed_length: f64 = lead_feed_length(&lead_in, frame.point(&centres[0]))
+        + lead_feed_length(&lead_out, frame.point(&centres[centres.len() - 1]));
+    let blocks = job.rule.map(|rule| {
+        // The loop continues into the way out: no block of it ends a span.
+        let stats = stats_with_ends(centres, rule.feed, rule.block_time_ms, &[]);
+        warnings.extend(job.rule_warnings.iter().cloned());
+        warnings.extend(block_warnings(job, &stats, limits));
+        let lead_time = lead_block_time(&lead_in, frame.point(&centres[0]), &rule)
+            + lead_block_time(&lead_out, frame.point(&centres[centres.len() - 1]), &rule);
+        (stats, lead_time)
+    });
+    let estimated_time_s = match &blocks {
+        Some((stats, lead_time)) => stats.estimated_time_s + lead_time,
+        None => (path_length + lead_feed_length) / job.feed * 60.0,
+    };
+    Ends {
+        lead_in,
+        lead_out,
+        safe_centre_z: safe_centre_z.ok(),
+        estimated_time_s,
+        blocks: blocks.map(|(stats, _)| stats),
+    }
+}
+
+/// The target points and their centres (§3): bisection by TA (or the block-time rule), the
+/// dense refinement, and for `method: exact` more points where the swept chamfer leaves its band.
+/// The centres come from the `exact` path when there is one, else from the tangent method.
+fn place_centres(
+    job: &Job,
+    construction: &Construction,
+    envelope: Option<&EnvelopePath>,
+    control: Control<'_>,
+) -> Result<tolerance::Refined, SolverError> {
+    let profile = &job.profile;
     let centre_at = |segment: usize, s: f64| -> Result<Vec3, SolverError> {
         control.check()?;
-        let point = profile.segments[segment].point(profile.radius, s);
-        match (job.method, &envelope) {
-            (Method::Tangent, _) => Ok(construction.tangent_centre(&point)),
-            (Method::Exact, Some(path)) => Ok(path.centre(&construction, profile, segment, s)),
-            (Method::Exact, None) => single_section(segment, s, &construction.tangent(&point)),
+        match envelope {
+            Some(path) => Ok(path.centre(construction, profile, segment, s)),
+            None => Ok(construction.tangent_centre(&profile.segments[segment].point(profile.radius, s))),
         }
     };
-
     let spacing = Spacing::new(job.tolerance, job.rule, request::MIN_TOLERANCE);
     let mut bisected = tolerance::targets(profile, &spacing, MAX_POINTS, centre_at)?;
     control.report_fraction(0.4);
@@ -177,15 +279,24 @@ fn solve_centred(
     let mut refined = tolerance::refine(&bisected, &spacing, MAX_POINTS, centre_at)?;
     if envelope.is_some() {
         let band = WIDTH_TOLERANCE.max(job.tolerance);
-        swept_width::refine_for_width(&construction, profile, &mut refined, band, MAX_POINTS, centre_at)?;
+        swept_width::refine_for_width(construction, profile, &mut refined, band, MAX_POINTS, centre_at)?;
     }
-    let (mut targets, mut centres, max_deviation) = (refined.targets, refined.centres, refined.max_deviation);
-    control.check()?;
-    control.report_fraction(0.7);
+    Ok(refined)
+}
 
+/// The ridge construction at each target, its centre replaced by the placed one for `method:
+/// exact` (with CL measured to it), and the largest distance of an exact centre from the
+/// tangent-line one. The last ridge is the first: the loop closes.
+fn ridges_at(
+    job: &Job,
+    construction: &Construction,
+    targets: &[Target],
+    centres: &[Vec3],
+) -> (Vec<RidgeCentre>, Option<f64>) {
+    let profile = &job.profile;
     let mut ridges: Vec<RidgeCentre> = Vec::with_capacity(targets.len());
     let mut exact_offset: Option<f64> = None;
-    for (target, centre) in targets.iter().zip(&centres) {
+    for (target, centre) in targets.iter().zip(centres) {
         let point = profile.segments[target.segment].point(profile.radius, target.parameter);
         let mut ridge = construction.tangent(&point);
         if job.method == Method::Exact {
@@ -200,33 +311,18 @@ fn solve_centred(
     }
     let last = ridges.len() - 1;
     ridges[last] = ridges[0];
+    (ridges, exact_offset)
+}
 
-    warnings.extend(point_checks(&job, &targets, &ridges)?);
-    let (true_width_min, true_width_max, approx) = true_widths(&construction, &job, &targets, &ridges);
-    let swept = swept_width::swept_widths(&construction, profile, &targets, &centres);
-    control.check()?;
-    match job.method {
-        Method::Tangent => warnings.extend(approx.or_else(|| swept_approx(&job, &swept))),
-        Method::Exact => warnings.extend(width_off(&job, &swept, envelope.as_ref())),
-    }
-    checks::far_gouge(&job, &targets, &centres)?;
-    let shank_direction = job.frame.local_vector(&Vec3::z());
-    let (access_warnings, mut program_blocker) = checks::inner_access(&job, &ridges, &shank_direction);
-    warnings.extend(access_warnings);
-    warnings.extend(checks::overlap(&job, &construction, &ridges));
-    warnings.extend(checks::outer_shank(&job, &ridges));
-
-    if job.direction == Direction::Cw {
-        targets.reverse();
-        ridges.reverse();
-        centres.reverse();
-    }
-    let frame = &job.frame;
-    let down = ball * Vec3::z();
-    let points: Vec<DeburrPoint> = targets
+/// The answer's points in machine coordinates: target, centre and tip, with the construction's
+/// figures at each.
+fn machine_points(job: &Job, targets: &[Target], ridges: &[RidgeCentre], centres: &[Vec3]) -> Vec<DeburrPoint> {
+    let (frame, profile) = (&job.frame, &job.profile);
+    let down = job.tool.radius * Vec3::z();
+    targets
         .iter()
-        .zip(&ridges)
-        .zip(&centres)
+        .zip(ridges)
+        .zip(centres)
         .map(|((target, ridge), centre)| {
             let machine_centre = frame.point(centre);
             let point = profile.segments[target.segment].point(profile.radius, target.parameter);
@@ -241,72 +337,7 @@ fn solve_centred(
                 centre_offset: ridge.centre_offset,
             }
         })
-        .collect();
-    let path_length: f64 = centres.windows(2).map(|pair| (pair[1] - pair[0]).norm()).sum();
-
-    let safe_centre_z = program::safe_centre_z(&job, frame);
-    let (lead_in, lead_out) = match &safe_centre_z {
-        Ok(z) => program::leads(&job, frame.point(&centres[0]), frame.vector(&ridges[0].bisector), *z),
-        Err(_) => (Vec::new(), Vec::new()),
-    };
-    if program_blocker.is_none() {
-        program_blocker = safe_centre_z.as_ref().err().cloned();
-    }
-    if let Some(blocker) = &program_blocker {
-        warnings.push(Warning::new("W_NO_PROGRAM", format!("no G-code can be written: {}", blocker.message())));
-    }
-    let lead_feed_length: f64 = lead_feed_length(&lead_in, frame.point(&centres[0]))
-        + lead_feed_length(&lead_out, frame.point(&centres[centres.len() - 1]));
-    let blocks = job.rule.map(|rule| {
-        // The loop continues into the way out: no block of it ends a span.
-        let stats = stats_with_ends(&centres, rule.feed, rule.block_time_ms, &[]);
-        warnings.extend(job.rule_warnings.iter().cloned());
-        warnings.extend(block_warnings(&job, &stats, &refined.limits));
-        let lead_time = lead_block_time(&lead_in, frame.point(&centres[0]), &rule)
-            + lead_block_time(&lead_out, frame.point(&centres[centres.len() - 1]), &rule);
-        (stats, lead_time)
-    });
-    let wedge = ridges.iter().map(|r| r.wedge_angle().to_degrees());
-    let summary = DeburrSummary {
-        count: targets.len() - 1,
-        path_length,
-        max_deviation,
-        tolerance: job.tolerance,
-        cut_amount: job.cut_amount,
-        width: job.width,
-        true_width_min,
-        true_width_max,
-        swept_width_min: swept.min,
-        swept_width_max: swept.max,
-        wedge_angle_min_deg: wedge.clone().fold(f64::INFINITY, f64::min),
-        wedge_angle_max_deg: wedge.fold(f64::NEG_INFINITY, f64::max),
-        max_exact_offset: exact_offset,
-        feed: job.feed,
-        spindle_rpm: job.spindle_rpm,
-        safe_centre_z: safe_centre_z.ok(),
-        estimated_time_s: match &blocks {
-            Some((stats, lead_time)) => stats.estimated_time_s + lead_time,
-            None => (path_length + lead_feed_length) / job.feed * 60.0,
-        },
-        block_time_ms: job.rule.map(|rule| rule.block_time_ms),
-        block_length: job.rule.map(|rule| rule.block_length()),
-        blocks: blocks.as_ref().map(|(stats, _)| stats.blocks),
-        min_block_length: blocks.as_ref().map(|(stats, _)| stats.min_block_length),
-        short_blocks: blocks.as_ref().map(|(stats, _)| stats.short_blocks),
-    };
-    let description = describe(request, &job, &summary);
-    Ok(Deburr {
-        edge: job.edge,
-        method: job.method,
-        points,
-        lead_in,
-        lead_out,
-        summary,
-        warnings,
-        program_blocker,
-        description,
-        ball_radius: ball,
-    })
+        .collect()
 }
 
 /// Block-limited time of the feed moves of a lead, starting from `start`: Σ max(L/F, T_b), s.

@@ -99,10 +99,10 @@ mod tests {
     #[test]
     fn never_longer_than_the_given_order_and_every_stop_once() {
         // Points on a pseudo-random walk (a fixed linear congruential sequence).
-        let mut seed: u64 = 12_345;
+        let mut state: u64 = 12_345;
         let mut next = || {
-            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 33) as f64 / f64::from(1u32 << 31) * 100.0
+            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            (state >> 33) as f64 / f64::from(1u32 << 31) * 100.0
         };
         for count in [1, 2, 3, 5, 12, 40] {
             let points: Vec<[f64; 2]> = (0..count).map(|_| [next(), next()]).collect();

@@ -1,5 +1,5 @@
-//! A several-loop deburr job split into ranges of its loops (docs/spec/deburr.md §6.3 and issue
-//! 15's visiting order): every part solves the loops of its range, one per hole and edge in
+//! A several-loop deburr job split into ranges of its loops (docs/spec/deburr.md §6.3, §7: several
+//! holes visited in a short order): every part solves the loops of its range, one per hole and edge in
 //! request order, and hands them on; the finish step places the holes again (cheap: no loop is
 //! solved) and makes what depends on every loop, as one solve does: the grouping by tool and
 //! turn, the visiting order (nearest neighbour and 2-opt over all loops of a group), the `M00`
@@ -179,6 +179,7 @@ impl From<PartLoop> for Deburr {
     }
 }
 
+/// `E_INTERNAL`: the parts handed to the finish step are not this request's.
 fn mismatch(detail: String) -> SolverError {
     SolverError::new(ErrorCode::Internal, format!("the parts do not belong to this deburring: {detail}"))
 }

@@ -1,5 +1,5 @@
-//! Lead-in, lead-out and the G-code program of a deburr job (issue: "complete and safe to run";
-//! docs/spec/deburr.md §6.3, §7).
+//! Lead-in, lead-out and the G-code program of a deburr job (docs/spec/deburr.md §6.3, §7): a
+//! program complete and safe to run as it is.
 //!
 //! Outer edge: rapid above the lead point A0 = C0 − δ·u0 (δ back along the bisector, in air), feed
 //! down to A0 and on to C0, run the loop, back to A0 and up. Inner edge: rapid above the hole
@@ -36,6 +36,7 @@ pub(crate) fn safe_centre_z(job: &Job, frame: &Frame) -> Result<f64, SolverError
     }
 }
 
+/// A lead move to ball centre `centre`, with its tip.
 fn lead(motion: LeadMotion, centre: Vec3, ball_radius: f64) -> LeadMove {
     LeadMove { motion, centre: array3(&centre), tip: array3(&(centre - ball_radius * Vec3::z())) }
 }

@@ -214,84 +214,12 @@ impl DeburrRequest {
             Workpiece::Tube { origin, arrangement_angle_deg, .. }
             | Workpiece::BoreBlock { origin, arrangement_angle_deg, .. } => (*origin, *arrangement_angle_deg),
         };
-        let placed: Vec<(String, Hole, Option<f64>, f64)> = match (&self.hole, &self.holes, &self.pattern) {
-            (Some(_), Some(_), _) => return Err(SolverError::input("holes", "give hole or holes, not both")),
-            (_, Some(_), Some(_)) => {
-                return Err(SolverError::input("pattern", "a pattern copies hole: give it with hole, not holes"));
-            }
-            (None, None, _) => return Err(SolverError::input("hole", "give hole (or holes)")),
-            (Some(hole), None, None) => vec![("hole".to_owned(), hole.clone(), None, 0.0)],
-            (None, Some(holes), None) => {
-                if holes.is_empty() || holes.len() > MAX_HOLES {
-                    return Err(SolverError::input("holes", format!("give 1 to {MAX_HOLES} holes")));
-                }
-                holes
-                    .iter()
-                    .enumerate()
-                    .map(|(index, placed)| {
-                        let field = format!("holes[{index}]");
-                        let axial = finite(&format!("{field}.axial_position"), placed.axial_position.unwrap_or(0.0))?;
-                        let hole = Hole {
-                            shape: placed.shape,
-                            radius: placed.radius,
-                            centre_distance: placed.centre_distance,
-                            eccentricity: placed.eccentricity,
-                            penetration_angle_deg: placed.penetration_angle_deg,
-                            axis_point: None,
-                        };
-                        Ok((field, hole, placed.arrangement_angle_deg, axial))
-                    })
-                    .collect::<Result<_, SolverError>>()?
-            }
-            (Some(hole), None, Some(pattern)) => {
-                let angles = pattern.around_deg.clone().unwrap_or_else(|| vec![hole.penetration_angle_deg]);
-                let count = pattern.count.unwrap_or(1);
-                if angles.is_empty() || count == 0 || angles.len() * count > MAX_HOLES {
-                    return Err(SolverError::input(
-                        "pattern",
-                        format!("a pattern makes 1 to {MAX_HOLES} holes (around_deg × count)"),
-                    ));
-                }
-                let pitch = match (pattern.pitch, count) {
-                    (Some(pitch), _) => finite("pattern.pitch", pitch)?,
-                    (None, 1) => 0.0,
-                    (None, _) => return Err(SolverError::input("pattern.pitch", "count above 1 needs pitch")),
-                };
-                if hole.axis_point.is_some() {
-                    return Err(SolverError::input("hole.axis_point", "a pattern places its holes: no axis_point"));
-                }
-                let mut placed = Vec::with_capacity(angles.len() * count);
-                for station in 0..count {
-                    for (index, angle) in angles.iter().enumerate() {
-                        let angle = finite(&format!("pattern.around_deg[{index}]"), *angle)?;
-                        let copy = Hole { penetration_angle_deg: angle, ..hole.clone() };
-                        placed.push(("hole".to_owned(), copy, None, pitch * station as f64));
-                    }
-                }
-                placed
-            }
-        };
+        let placed = self.holes_to_place()?;
         let mut placements = Vec::with_capacity(placed.len() * edges.len());
         for (index, (field, hole, own_arrangement, axial)) in placed.into_iter().enumerate() {
             let arrangement = own_arrangement.unwrap_or(arrangement);
             let theta = finite(&format!("{field}.arrangement_angle_deg"), arrangement)?.to_radians();
-            // A1 points along +Y turned by θ_A about Z (docs/spec/deburr.md §1.3).
-            let along = [-theta.sin(), theta.cos(), 0.0];
-            let moved = [origin[0] + axial * along[0], origin[1] + axial * along[1], origin[2]];
-            let workpiece = match &self.workpiece {
-                Workpiece::Tube { inner_radius, outer_radius, .. } => Workpiece::Tube {
-                    origin: moved,
-                    arrangement_angle_deg: arrangement,
-                    inner_radius: *inner_radius,
-                    outer_radius: *outer_radius,
-                },
-                Workpiece::BoreBlock { bore_radius, face_distance, .. } => Workpiece::BoreBlock {
-                    origin: moved,
-                    arrangement_angle_deg: arrangement,
-                    bore_radius: *bore_radius,
-                    face_distance: *face_distance,
-                },
-            };
+            let workpiece = self.moved_workpiece(origin, theta, arrangement, axial);
             // A hole pointing down is deburred with the tube turned half a turn about its axis.
             let turned = matches!(self.workpiece, Workpiece::Tube { .. })
                 && finite(&format!("{field}.penetration_angle_deg"), hole.penetration_angle_deg)?.to_radians().cos()
@@ -325,6 +253,101 @@ impl DeburrRequest {
         }
         Ok(placements)
     }
+
+    /// The holes to deburr, each with the field it came from, its own arrangement angle (if it
+    /// has one) and its axial position along A1: the one `hole`, the listed `holes`, or the
+    /// copies a `pattern` makes of `hole`.
+    fn holes_to_place(&self) -> Result<Vec<ToPlace>, SolverError> {
+        match (&self.hole, &self.holes, &self.pattern) {
+            (Some(_), Some(_), _) => Err(SolverError::input("holes", "give hole or holes, not both")),
+            (_, Some(_), Some(_)) => {
+                Err(SolverError::input("pattern", "a pattern copies hole: give it with hole, not holes"))
+            }
+            (None, None, _) => Err(SolverError::input("hole", "give hole (or holes)")),
+            (Some(hole), None, None) => Ok(vec![("hole".to_owned(), hole.clone(), None, 0.0)]),
+            (None, Some(holes), None) => listed_holes(holes),
+            (Some(hole), None, Some(pattern)) => pattern_holes(hole, pattern),
+        }
+    }
+
+    /// The workpiece moved `axial` along A1 (A1 turned by `theta`, radians, about Z) and turned to
+    /// `arrangement`, degrees.
+    fn moved_workpiece(&self, origin: [f64; 3], theta: f64, arrangement: f64, axial: f64) -> Workpiece {
+        // A1 points along +Y turned by θ_A about Z (docs/spec/deburr.md §1.3).
+        let along = [-theta.sin(), theta.cos(), 0.0];
+        let moved = [origin[0] + axial * along[0], origin[1] + axial * along[1], origin[2]];
+        match &self.workpiece {
+            Workpiece::Tube { inner_radius, outer_radius, .. } => Workpiece::Tube {
+                origin: moved,
+                arrangement_angle_deg: arrangement,
+                inner_radius: *inner_radius,
+                outer_radius: *outer_radius,
+            },
+            Workpiece::BoreBlock { bore_radius, face_distance, .. } => Workpiece::BoreBlock {
+                origin: moved,
+                arrangement_angle_deg: arrangement,
+                bore_radius: *bore_radius,
+                face_distance: *face_distance,
+            },
+        }
+    }
+}
+
+/// A hole to deburr: the field it came from, the hole, its own arrangement angle (if it has one)
+/// and its axial position along A1, mm.
+type ToPlace = (String, Hole, Option<f64>, f64);
+
+/// The listed `holes`, each with its own placement.
+fn listed_holes(holes: &[PlacedHole]) -> Result<Vec<ToPlace>, SolverError> {
+    if holes.is_empty() || holes.len() > MAX_HOLES {
+        return Err(SolverError::input("holes", format!("give 1 to {MAX_HOLES} holes")));
+    }
+    holes
+        .iter()
+        .enumerate()
+        .map(|(index, placed)| {
+            let field = format!("holes[{index}]");
+            let axial = finite(&format!("{field}.axial_position"), placed.axial_position.unwrap_or(0.0))?;
+            let hole = Hole {
+                shape: placed.shape,
+                radius: placed.radius,
+                centre_distance: placed.centre_distance,
+                eccentricity: placed.eccentricity,
+                penetration_angle_deg: placed.penetration_angle_deg,
+                axis_point: None,
+            };
+            Ok((field, hole, placed.arrangement_angle_deg, axial))
+        })
+        .collect::<Result<_, SolverError>>()
+}
+
+/// The copies a `pattern` makes of `hole`: every angle around A1 at every station along it.
+fn pattern_holes(hole: &Hole, pattern: &HolePattern) -> Result<Vec<ToPlace>, SolverError> {
+    let angles = pattern.around_deg.clone().unwrap_or_else(|| vec![hole.penetration_angle_deg]);
+    let count = pattern.count.unwrap_or(1);
+    if angles.is_empty() || count == 0 || angles.len() * count > MAX_HOLES {
+        return Err(SolverError::input(
+            "pattern",
+            format!("a pattern makes 1 to {MAX_HOLES} holes (around_deg × count)"),
+        ));
+    }
+    let pitch = match (pattern.pitch, count) {
+        (Some(pitch), _) => finite("pattern.pitch", pitch)?,
+        (None, 1) => 0.0,
+        (None, _) => return Err(SolverError::input("pattern.pitch", "count above 1 needs pitch")),
+    };
+    if hole.axis_point.is_some() {
+        return Err(SolverError::input("hole.axis_point", "a pattern places its holes: no axis_point"));
+    }
+    let mut placed = Vec::with_capacity(angles.len() * count);
+    for station in 0..count {
+        for (index, angle) in angles.iter().enumerate() {
+            let angle = finite(&format!("pattern.around_deg[{index}]"), *angle)?;
+            let copy = Hole { penetration_angle_deg: angle, ..hole.clone() };
+            placed.push(("hole".to_owned(), copy, None, pitch * station as f64));
+        }
+    }
+    Ok(placed)
 }
 
 /// Which ridge is deburred.

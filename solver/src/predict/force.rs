@@ -49,6 +49,7 @@ pub struct CuttingCoefficients {
 }
 
 impl CuttingCoefficients {
+    /// Checks that every coefficient is finite, naming it under `field`.
     pub(crate) fn validate(&self, field: &str) -> Result<(), SolverError> {
         for (name, value) in [
             ("ktc", self.ktc),
@@ -176,45 +177,24 @@ pub(crate) fn engage(
         force: if coefficients.is_some() { vec![[0.0; 3]; grid.steps] } else { Vec::new() },
     };
     let d_theta = std::f64::consts::FRAC_PI_2 / grid.rings as f64;
-    let width = radius * d_theta;
-    let flute_shift = grid.steps / grid.flutes;
-    let u = feed_direction;
+    let engager = Engager {
+        grid,
+        scene,
+        stock,
+        u: feed_direction,
+        tooth_feed,
+        coefficients,
+        width: radius * d_theta,
+        flute_shift: grid.steps / grid.flutes,
+    };
     // Tiles on the front of the ball that meet the stock, then the capsules near all of them.
-    let mut kept: Vec<(&Tile, Region, Vec3, Vec3)> = Vec::new();
-    let mut union_lo = Vec3::repeat(f64::INFINITY);
-    let mut union_hi = Vec3::repeat(f64::NEG_INFINITY);
-    let mut group_outside: Vec<Option<bool>> = vec![None; grid.group_boxes.len()];
-    for tile in &grid.tiles {
-        // Upper bound of ê_r·û over the tile.
-        let front: f64 = (0..3).map(|c| (u[c] * tile.lo[c]).max(u[c] * tile.hi[c])).sum();
-        if front <= 0.0 {
-            continue;
-        }
-        let outside = *group_outside[tile.group].get_or_insert_with(|| {
-            let (lo, hi) = grid.group_boxes[tile.group];
-            let (lo, hi) = (radius * lo - Vec3::repeat(scene.eps), radius * hi + Vec3::repeat(scene.eps));
-            scene.region(stock, &lo, &hi) == Region::Outside
-        });
-        if outside {
-            continue;
-        }
-        let lo = radius * tile.lo - Vec3::repeat(scene.eps);
-        let hi = radius * tile.hi + Vec3::repeat(scene.eps);
-        let region = scene.region(stock, &lo, &hi);
-        if region == Region::Outside {
-            continue;
-        }
-        union_lo = union_lo.inf(&lo);
-        union_hi = union_hi.sup(&hi);
-        kept.push((tile, region, lo, hi));
-    }
+    let (mut kept, union_lo, union_hi) = engager.kept_tiles();
     if kept.is_empty() {
         return engagement;
     }
     let mut pool = TileLists::default();
     scene.candidates(&union_lo, &union_hi, false, None, &mut pool);
     // A middle level: groups of neighbouring tiles share a narrower pool.
-    let group_of = |tile: &Tile| (tile.rings.0 / (GROUP_RINGS * TILE_RINGS), tile.steps.0 / (GROUP_STEPS * TILE_STEPS));
     let mut groups: std::collections::BTreeMap<(usize, usize), (Vec3, Vec3)> = std::collections::BTreeMap::new();
     for (tile, _, lo, hi) in &kept {
         let entry =
@@ -240,6 +220,77 @@ pub(crate) fn engage(
         if scene.hides_box(&lo, &hi, &lists.before, &mut hide_hint) {
             continue;
         }
+        engager.engage_tile(tile, region, &lists, &mut engagement);
+    }
+    engagement
+}
+
+/// The group of neighbouring tiles `tile` belongs to (groups share a candidate pool).
+fn group_of(tile: &Tile) -> (usize, usize) {
+    (tile.rings.0 / (GROUP_RINGS * TILE_RINGS), tile.steps.0 / (GROUP_STEPS * TILE_STEPS))
+}
+
+/// A tile kept for testing: its place relative to the stock and its box (machine frame,
+/// relative to the ball centre).
+type KeptTile<'a> = (&'a Tile, Region, Vec3, Vec3);
+
+/// What one engagement tests the cutting edge against, and the force model's constants.
+struct Engager<'a> {
+    grid: &'a EdgeGrid,
+    scene: &'a Scene,
+    stock: &'a StockModel,
+    /// Feed direction û.
+    u: &'a Vec3,
+    tooth_feed: f64,
+    coefficients: Option<&'a CuttingCoefficients>,
+    /// Edge element width R·Δθ, mm.
+    width: f64,
+    /// ψ steps between neighbouring flutes.
+    flute_shift: usize,
+}
+
+impl<'a> Engager<'a> {
+    /// The tiles on the front of the ball (ê_r·û > 0 somewhere) that meet the stock, in grid
+    /// order, and the box around all of them.
+    fn kept_tiles(&self) -> (Vec<KeptTile<'a>>, Vec3, Vec3) {
+        let (grid, scene, stock, u) = (self.grid, self.scene, self.stock, self.u);
+        let radius = scene.radius;
+        let mut kept: Vec<KeptTile<'a>> = Vec::new();
+        let mut union_lo = Vec3::repeat(f64::INFINITY);
+        let mut union_hi = Vec3::repeat(f64::NEG_INFINITY);
+        let mut group_outside: Vec<Option<bool>> = vec![None; grid.group_boxes.len()];
+        for tile in &grid.tiles {
+            // Upper bound of ê_r·û over the tile.
+            let front: f64 = (0..3).map(|c| (u[c] * tile.lo[c]).max(u[c] * tile.hi[c])).sum();
+            if front <= 0.0 {
+                continue;
+            }
+            let outside = *group_outside[tile.group].get_or_insert_with(|| {
+                let (lo, hi) = grid.group_boxes[tile.group];
+                let (lo, hi) = (radius * lo - Vec3::repeat(scene.eps), radius * hi + Vec3::repeat(scene.eps));
+                scene.region(stock, &lo, &hi) == Region::Outside
+            });
+            if outside {
+                continue;
+            }
+            let lo = radius * tile.lo - Vec3::repeat(scene.eps);
+            let hi = radius * tile.hi + Vec3::repeat(scene.eps);
+            let region = scene.region(stock, &lo, &hi);
+            if region == Region::Outside {
+                continue;
+            }
+            union_lo = union_lo.inf(&lo);
+            union_hi = union_hi.sup(&hi);
+            kept.push((tile, region, lo, hi));
+        }
+        (kept, union_lo, union_hi)
+    }
+
+    /// Tests the front elements of one tile against W and T1 (`lists`), counting the engaged
+    /// ones and, with coefficients, adding their forces to each flute's ψ steps.
+    fn engage_tile(&self, tile: &Tile, region: Region, lists: &TileLists, engagement: &mut Engagement) {
+        let (grid, scene, stock, u) = (self.grid, self.scene, self.stock, self.u);
+        let (radius, tooth_feed, width, flute_shift) = (scene.radius, self.tooth_feed, self.width, self.flute_shift);
         let mut hint = 0usize;
         for k in tile.rings.0..tile.rings.1 {
             let (sin_t, cos_t) = grid.ring_angle[k];
@@ -257,7 +308,7 @@ pub(crate) fn engage(
                     continue;
                 }
                 engagement.cut_elements += 1;
-                let Some(cutting) = coefficients else {
+                let Some(cutting) = self.coefficients else {
                     continue;
                 };
                 let h = tooth_feed * along;
@@ -281,5 +332,4 @@ pub(crate) fn engage(
             }
         }
     }
-    engagement
 }

@@ -77,6 +77,7 @@ pub(crate) struct Outcome {
 }
 
 impl Outcome {
+    /// A pass with `status` and nothing predicted.
     pub(crate) fn empty(status: PassStatus) -> Self {
         Self {
             status,
@@ -115,11 +116,14 @@ struct SpindleKernels {
     outside: bool,
 }
 
+/// The slot of a spindle direction in per-direction tables: 0 clockwise (−1), 1 counter-clockwise (+1).
 fn sign_slot(sign: f64) -> usize {
     usize::from(sign > 0.0)
 }
 
 impl<'a> Context<'a> {
+    /// What every pass of `job` shares: an edge grid per spindle direction used and, with a
+    /// force model and stiffness, the deflection kernels per spindle speed.
     pub(crate) fn new(job: &'a Job) -> Self {
         let helix = job.helix.tan();
         let mut grids = [None, None];
@@ -295,6 +299,28 @@ pub(crate) fn predict_pass(context: &Context<'_>, path: &PathModel, index: usize
     predict_pass_with(context, path, index, scratch, true)
 }
 
+/// One pass's geometry and conditions, as the pipeline's steps use them.
+struct PassSetup {
+    /// The pass's path segment, and the path's arclength at its start.
+    segment: usize,
+    sigma: f64,
+    start: Vec3,
+    length: f64,
+    feed_direction: Vec3,
+    tooth_feed: f64,
+    /// g = n_g · f_t: T1 ends and T2 starts this far from the prediction position, mm.
+    gap: f64,
+}
+
+/// A prediction position on a pass: its arclength from the pass start, the ball centre, the
+/// scene there (machine frame) and the tool's engagement.
+struct Station {
+    s: f64,
+    centre: Vec3,
+    below: Scene,
+    engagement: Engagement,
+}
+
 /// The pipeline for one pass, with the force and deflection steps (S3, S4, S10) only when
 /// `deflection` is set.
 fn predict_pass_with(
@@ -329,8 +355,118 @@ fn predict_pass_with(
         return Outcome::empty(PassStatus::NoCut);
     };
     let coefficients = if job.deflection.is_none() && deflection { job.cutting.as_ref() } else { None };
+    let setup =
+        PassSetup { segment: pass.segment, sigma: segment.sigma, start, length, feed_direction, tooth_feed, gap };
+    let Some((station, no_engagement)) = engaged_station(context, path, &setup, grid, coefficients, scratch) else {
+        return Outcome::empty(PassStatus::NoCut);
+    };
+    let mut outcome = Outcome::empty(PassStatus::Ok);
+    outcome.position = Some(station.s);
+    outcome.centre = Some(station.centre);
+    let centre = station.centre;
+
+    // The finished surface and the generation point.
+    let Some((point, tip)) = finished_surface(context, path, &setup, &station, no_engagement, &mut outcome, scratch)
+    else {
+        return Outcome::empty(PassStatus::NoCut);
+    };
+    let Some(point) = point else {
+        outcome.status = PassStatus::NoSurface;
+        return outcome;
+    };
+
+    // Angles and normal (§3.11), errors (§3.12).
+    let contact = contact(job, tip, point, centre, source.rotation_sign, &mut outcome.flags);
+    outcome.error_shape = Some(contact.error_shape);
+    outcome.contact_angle = Some(contact.contact_angle);
+    outcome.azimuth = contact.azimuth;
+    outcome.rotation_angle = contact.rotation_angle;
+    outcome.point = Some(contact.point);
+    outcome.normal = Some(contact.normal);
+    if !deflection {
+        outcome.error = Some(contact.error_shape);
+        return outcome;
+    }
+    let force_history = &station.engagement.force;
+    let (deflection, history_deflection) = deflection_at_contact(
+        context,
+        index,
+        source.spindle_rpm,
+        coefficients,
+        force_history,
+        contact.rotation_angle,
+        &mut outcome,
+    );
+    let normal = contact.normal;
+    let error_deflection =
+        deflection.map(|d| if contact.azimuth.is_none() { 0.0 } else { d[0] * normal.x + d[1] * normal.y });
+    outcome.error_deflection = error_deflection;
+    outcome.error = Some(contact.error_shape + error_deflection.unwrap_or(0.0));
+    outcome.deflection = deflection;
+    if job.history.contains(&index) && !force_history.is_empty() {
+        outcome.history = Some(PassHistory {
+            step_deg: 360.0 / force_history.len() as f64,
+            force: force_history.clone(),
+            deflection: history_deflection.unwrap_or_default(),
+        });
+    }
+    outcome
+}
+
+/// Where the finished surface is generated and what the shape error makes of it there.
+struct Contact {
+    /// Generation point C (world).
+    point: Vec3,
+    /// θ_c, radians.
+    contact_angle: f64,
+    /// φ_c, radians; `None` at the tip.
+    azimuth: Option<f64>,
+    /// n̂ at C, out of the material.
+    normal: Vec3,
+    /// ψ_c, radians; `None` at the tip.
+    rotation_angle: Option<f64>,
+    /// e_S = −δ(θ_c), mm.
+    error_shape: f64,
+}
+
+/// The contact angles and normal at the generation point (§3.11) and the shape error there
+/// (§3.12), flagging `AtTip` and an extrapolated shape-error table.
+fn contact(job: &Job, tip: bool, point: Vec3, centre: Vec3, sign: f64, flags: &mut Vec<PassFlag>) -> Contact {
+    let radius = job.radius;
+    let (point, contact_angle, azimuth, normal) = if tip {
+        flags.push(PassFlag::AtTip);
+        (centre - radius * Vec3::z(), 0.0, None, Vec3::z())
+    } else {
+        let offset = point - centre;
+        let theta = (-offset.z / radius).clamp(-1.0, 1.0).acos();
+        (point, theta, Some(offset.y.atan2(offset.x)), -offset / radius)
+    };
+    let rotation_angle = azimuth.map(|phi| {
+        (sign * (phi - job.flute_zero) + (1.0 - contact_angle.cos()) * job.helix.tan())
+            .rem_euclid(std::f64::consts::TAU)
+    });
+    let (delta, extrapolated) = shape::delta(&job.shape_error, contact_angle.to_degrees());
+    if extrapolated {
+        flags.push(PassFlag::Extrapolated);
+    }
+    Contact { point, contact_angle, azimuth, normal, rotation_angle, error_shape: -delta }
+}
+
+/// The prediction position (§3.3): the middle of the pass first, then alternately ahead and
+/// behind, up to [`MAX_STATIONS`], the first where the tool cuts; else the middle, flagged
+/// `true` (no engagement: a retraced pass may still finish the surface there).
+fn engaged_station(
+    context: &Context<'_>,
+    path: &PathModel,
+    setup: &PassSetup,
+    grid: &EdgeGrid,
+    coefficients: Option<&force::CuttingCoefficients>,
+    scratch: &mut Scratch,
+) -> Option<(Station, bool)> {
+    let job = context.job;
+    let radius = job.radius;
+    let PassSetup { length, tooth_feed, gap, start, feed_direction, .. } = *setup;
     let mut pieces = Vec::new();
-    // Stations: the middle first, then alternately ahead and behind (§3.3).
     let step = tooth_feed.max(length / 16.0);
     let mut stations = vec![0.5 * length];
     for m in 1..MAX_STATIONS {
@@ -340,11 +476,10 @@ fn predict_pass_with(
             stations.push(s);
         }
     }
-    let mut chosen: Option<(f64, Vec3, Scene, Engagement)> = None;
-    let mut retraced: Option<(f64, Vec3, Scene, Engagement)> = None;
+    let mut retraced: Option<Station> = None;
     for (try_index, &s) in stations.iter().enumerate() {
         let centre = start + s * feed_direction;
-        let sigma = segment.sigma + s;
+        let sigma = setup.sigma + s;
         scene::gather(
             path,
             &scene::Query {
@@ -365,38 +500,43 @@ fn predict_pass_with(
         let below = Scene::new(&pieces, centre, Matrix3::identity(), radius);
         let engagement = force::engage(grid, &below, &job.stock, &feed_direction, tooth_feed, coefficients);
         if engagement.cut_elements > 0 {
-            chosen = Some((s, centre, below, engagement));
-            break;
+            return Some((Station { s, centre, below, engagement }, false));
         }
         if try_index == 0 {
-            retraced = Some((s, centre, below, engagement));
+            retraced = Some(Station { s, centre, below, engagement });
         }
     }
-    let mut outcome = Outcome::empty(PassStatus::Ok);
-    let found = match chosen {
-        Some(c) => Some((c, false)),
-        None => retraced.map(|r| (r, true)),
-    };
-    let Some(((s, centre, below, engagement), no_engagement)) = found else {
-        return Outcome::empty(PassStatus::NoCut);
-    };
-    outcome.position = Some(s);
-    outcome.centre = Some(centre);
-    let sigma = segment.sigma + s;
+    retraced.map(|station| (station, true))
+}
 
-    // The finished surface and the generation point.
-    let pixel = 2.0 * radius / f64::from(job.resolution);
-    let (point, tip) = match job.method {
+/// The finished surface at `station` by the request's method, with its counts and flags in
+/// `outcome`: the generation point (if any surface is finished) and whether it is at the tip.
+/// `None` when nothing is cut there after all (no engagement and nothing retraced).
+fn finished_surface(
+    context: &Context<'_>,
+    path: &PathModel,
+    setup: &PassSetup,
+    station: &Station,
+    no_engagement: bool,
+    outcome: &mut Outcome,
+    scratch: &mut Scratch,
+) -> Option<(Option<Vec3>, bool)> {
+    let job = context.job;
+    let Station { s, centre, ref below, .. } = *station;
+    let (feed_direction, gap) = (setup.feed_direction, setup.gap);
+    let sigma = setup.sigma + s;
+    let pixel = 2.0 * job.radius / f64::from(job.resolution);
+    Some(match job.method {
         Method::Sampling => {
-            let band = band(path, pass.segment, &centre, &feed_direction, sigma, gap, pixel);
-            let surface = sampling::sample(&below, &job.stock, &band);
+            let band = band(path, setup.segment, &centre, &feed_direction, sigma, gap, pixel);
+            let surface = sampling::sample(below, &job.stock, &band);
             outcome.cut_count = surface.cut_samples;
             outcome.finished_count = surface.finished_samples;
             if surface.regions > 1 {
                 outcome.flags.push(PassFlag::SeveralRegions);
             }
             if no_engagement && !surface.retraced {
-                return Outcome::empty(PassStatus::NoCut);
+                return None;
             }
             if surface.retraced {
                 outcome.flags.push(PassFlag::Retraced);
@@ -408,10 +548,9 @@ fn predict_pass_with(
             (surface.point, tip)
         }
         Method::DepthBuffer => {
-            let image =
-                depth_buffer(context, path, &below, &centre, &feed_direction, sigma, gap, &mut outcome, scratch);
+            let image = depth_buffer(context, path, below, &centre, &feed_direction, sigma, gap, outcome, scratch);
             if no_engagement && !image.retraced {
-                return Outcome::empty(PassStatus::NoCut);
+                return None;
             }
             if image.retraced {
                 outcome.flags.push(PassFlag::Retraced);
@@ -421,46 +560,26 @@ fn predict_pass_with(
                 && image.centroid_offset < 0.5 * image.pixel;
             (image.point, tip)
         }
-    };
-    let Some(point) = point else {
-        outcome.status = PassStatus::NoSurface;
-        return outcome;
-    };
+    })
+}
 
-    // Angles and normal (§3.11), errors (§3.12).
-    let (point, contact_angle, azimuth, normal) = if tip {
-        outcome.flags.push(PassFlag::AtTip);
-        (centre - radius * Vec3::z(), 0.0, None, Vec3::z())
-    } else {
-        let offset = point - centre;
-        let theta = (-offset.z / radius).clamp(-1.0, 1.0).acos();
-        (point, theta, Some(offset.y.atan2(offset.x)), -offset / radius)
-    };
-    let sign = source.rotation_sign;
-    let rotation_angle = azimuth.map(|phi| {
-        (sign * (phi - job.flute_zero) + (1.0 - contact_angle.cos()) * job.helix.tan())
-            .rem_euclid(std::f64::consts::TAU)
-    });
-    let (delta, extrapolated) = shape::delta(&job.shape_error, contact_angle.to_degrees());
-    if extrapolated {
-        outcome.flags.push(PassFlag::Extrapolated);
-    }
-    let error_shape = -delta;
-    if !deflection {
-        outcome.error_shape = Some(error_shape);
-        outcome.error = Some(error_shape);
-        outcome.contact_angle = Some(contact_angle);
-        outcome.azimuth = azimuth;
-        outcome.rotation_angle = rotation_angle;
-        outcome.point = Some(point);
-        outcome.normal = Some(normal);
-        return outcome;
-    }
-    let force_history = &engagement.force;
+/// The deflection D at the contact's rotation angle (§3.8): prescribed, or from the force
+/// history through the spindle speed's kernels, with D over the whole revolution for the passes
+/// whose history is asked for; `None` (flagged) without a deflection model.
+fn deflection_at_contact(
+    context: &Context<'_>,
+    index: usize,
+    spindle_rpm: f64,
+    coefficients: Option<&force::CuttingCoefficients>,
+    force_history: &[[f64; 3]],
+    rotation_angle: Option<f64>,
+    outcome: &mut Outcome,
+) -> (Option<[f64; 2]>, Option<Vec<[f64; 2]>>) {
+    let job = context.job;
     let mut history_deflection: Option<Vec<[f64; 2]>> = None;
     let deflection: Option<[f64; 2]> = if let Some(prescribed) = &job.deflection {
         rotation_angle.map_or(Some([0.0, 0.0]), |psi| Some(prescribed_at(prescribed, psi)))
-    } else if let (Some(_), Some(spindle)) = (coefficients, context.kernels.get(&source.spindle_rpm.to_bits())) {
+    } else if let (Some(_), Some(spindle)) = (coefficients, context.kernels.get(&spindle_rpm.to_bits())) {
         if spindle.outside {
             outcome.flags.push(PassFlag::OutsideFrfBand);
         }
@@ -476,24 +595,7 @@ fn predict_pass_with(
         outcome.flags.push(PassFlag::NoDeflection);
         None
     };
-    let error_deflection = deflection.map(|d| if azimuth.is_none() { 0.0 } else { d[0] * normal.x + d[1] * normal.y });
-    outcome.error_shape = Some(error_shape);
-    outcome.error_deflection = error_deflection;
-    outcome.error = Some(error_shape + error_deflection.unwrap_or(0.0));
-    outcome.contact_angle = Some(contact_angle);
-    outcome.azimuth = azimuth;
-    outcome.rotation_angle = rotation_angle;
-    outcome.point = Some(point);
-    outcome.normal = Some(normal);
-    outcome.deflection = deflection;
-    if job.history.contains(&index) && !force_history.is_empty() {
-        outcome.history = Some(PassHistory {
-            step_deg: 360.0 / force_history.len() as f64,
-            force: force_history.clone(),
-            deflection: history_deflection.unwrap_or_default(),
-        });
-    }
-    outcome
+    (deflection, history_deflection)
 }
 
 /// D(ψ) of a prescribed history, periodic, linear between samples.

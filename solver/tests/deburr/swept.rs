@@ -228,7 +228,7 @@ fn worst_error(widths: &[(f64, f64)], width: f64) -> (f64, f64, f64) {
 }
 
 /// Four geometries: tight and loose ridges, centred and off-centre holes.
-fn issue_geometries() -> [(&'static str, Geometry); 4] {
+fn tight_and_loose_geometries() -> [(&'static str, Geometry); 4] {
     let base = Geometry {
         outer: true,
         inner_radius: 20.0,
@@ -300,8 +300,8 @@ fn check_exact(name: &str, geometry: &Geometry, answer: &Deburr, widths: &[(f64,
 }
 
 #[test]
-fn exact_swept_width_is_w_on_the_issue_geometries() {
-    for (index, (name, geometry)) in issue_geometries().into_iter().enumerate() {
+fn exact_swept_width_is_w_on_tight_and_loose_ridges() {
+    for (index, (name, geometry)) in tight_and_loose_geometries().into_iter().enumerate() {
         let (request, tool) = geometry.request(Method::Exact, TOLERANCE);
         let answer = deburr::solve(&request, &tool).unwrap_or_else(|e| panic!("{name}: {}", e.message()));
         let widths = swept_widths(&geometry, &answer, 720);
@@ -333,7 +333,7 @@ fn exact_swept_width_is_w_on_the_issue_geometries() {
 
 #[test]
 fn tangent_swept_width_is_reported() {
-    for (name, geometry) in issue_geometries() {
+    for (name, geometry) in tight_and_loose_geometries() {
         let (request, tool) = geometry.request(Method::Tangent, TOLERANCE);
         let answer = deburr::solve(&request, &tool).unwrap_or_else(|e| panic!("{name}: {}", e.message()));
         let widths = swept_widths(&geometry, &answer, 720);
