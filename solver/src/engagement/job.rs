@@ -7,8 +7,8 @@ use super::arcs::SpindleDirection;
 use super::bbox_tree::BBox;
 use super::force::ForceModel;
 use super::heights::{CORNER_BANDS, Loads};
-use super::kienzle::{DEFAULT_RADIAL_RATIO, Kienzle, SinPower};
-use super::limits::{SpindleLimits, natural_frequencies};
+use super::kienzle::SinPower;
+use super::limits::natural_frequencies;
 use super::outline::Outline;
 use super::request::{
     Direction, EngagementRequest, Engine, FeedBasis, PathInput, PathSegments, Representative, SegmentInput, Stock,
@@ -21,7 +21,8 @@ use super::{
 };
 use crate::error::{SolverError, Warning};
 use crate::gcode::reader::{MoveKind, Plane, ReadOptions, read as read_program};
-use crate::machine::{BlockRule, MachineProfile, RuleSettings};
+use crate::machine::{BlockRule, MachineProfile, RuleSettings, SpindleLimits};
+use crate::material::{DEFAULT_RADIAL_RATIO, Kienzle};
 use crate::planar::signed_area;
 use crate::tool::{Tool, ToolKind};
 use crate::validate::{self, finite, non_negative, positive, positive_at_most};
