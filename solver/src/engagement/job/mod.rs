@@ -137,6 +137,15 @@ fn too_large(field: &str, what: &str, count: usize, limit: usize) -> SolverError
     SolverError::new(ErrorCode::TooLarge, format!("{what}: {count} exceeds the limit of {limit}")).at(field)
 }
 
+/// A Z in the plane of the coordinates.
+fn z_value(field: &str, z: f64) -> Result<f64, SolverError> {
+    let z = validate::finite(field, z)?;
+    if z.abs() > MAX_COORDINATE {
+        return Err(SolverError::input(field, format!("{field} must lie within ±{MAX_COORDINATE} mm")));
+    }
+    Ok(z)
+}
+
 /// What the server resolves for an engagement request besides the tool and the machine: the
 /// Kienzle values of the request's `material` and the spindle limits of its machine.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
