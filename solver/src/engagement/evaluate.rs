@@ -1,6 +1,7 @@
 //! One candidate path end to end (docs/spec/engagement.md §5): contact at every sample from the
 //! chosen engine, the per-sample quantities and flags (§5.4, §5.5, §5.10), the diagnostics of §9
-//! (`diagnostics`), and the per-flute results, recommendation and feed plan.
+//! (`diagnostics`), and the per-flute results, recommendation and feed plan. The engines' contact
+//! at each sample is `contact`'s.
 
 use super::answer::{
     ArcDetail, EngagementSample, ForceInfo, GridInfo, PathEngagement, PostData, RouteData, SampleArcDetails,
@@ -8,13 +9,11 @@ use super::answer::{
 };
 use super::arcfeed::ArcFeed;
 use super::arcs::{self, Arc};
-use super::dots::{Contacts, DotGrid};
-use super::exact::ExactEngine;
+use super::contact::{Contact, DotsOutput, run_dots, run_exact, same_arcs};
 use super::force::{SampleTorque, power_kw};
-use super::heights::{Bands, MAX_SECTIONS};
-use super::job::{CandidateJob, Job, grid_extent};
+use super::job::{CandidateJob, Job};
 use super::request::Engine;
-use super::segments::{Route, Station};
+use super::segments::Station;
 use super::series::{self, Series};
 use super::stock::{Base, Region};
 use super::teeth::ToothSums;
@@ -25,22 +24,6 @@ use crate::tool::{Tool, ToolKind};
 
 /// Engagement on the back half deeper than this (degrees) marks `back_contact` (§9 W_PLUNGE).
 const BACK_TOLERANCE_DEG: f64 = 1.0;
-
-/// Arcs shared between consecutive contacts that found the same ones.
-pub(crate) type SharedArcs = std::sync::Arc<[Arc]>;
-
-/// What an engine found at one station.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct Contact {
-    /// Shared with the previous contact when equal to the bit (most samples along a straight
-    /// cut): one allocation per change of engagement instead of one per sample.
-    pub arcs: SharedArcs,
-    pub plunge: bool,
-    pub collision: bool,
-    /// With a rounded end's force model and the exact engine: what the end's sections engage,
-    /// each height its own arcs.
-    pub slices: Option<Bands>,
-}
 
 /// What a sample's arcs alone decide: a_e, Φ, the arc ends and their flags, the mean chip
 /// thickness ratio without the arc-feed factor. Kept for the previous sample and reused while
@@ -98,139 +81,6 @@ impl ArcValues {
         self.behind = arcs.iter().any(|a| a.from < -BACK_TOLERANCE_DEG || a.to > 180.0 + BACK_TOLERANCE_DEG);
         self
     }
-}
-
-/// The dots engine's extras.
-struct DotsOutput {
-    grid: Option<GridInfo>,
-    scatter: Vec<[f64; 2]>,
-}
-
-/// Whether two arc lists are the same to the bit.
-fn same_arcs(first: &[Arc], second: &[Arc]) -> bool {
-    first.len() == second.len()
-        && first
-            .iter()
-            .zip(second)
-            .all(|(a, b)| a.from.to_bits() == b.from.to_bits() && a.to.to_bits() == b.to.to_bits())
-}
-
-/// `arcs` as a contact's, shared with `previous`'s when they are the same.
-fn share_arcs(previous: Option<&Contact>, arcs: &[Arc]) -> SharedArcs {
-    match previous {
-        Some(previous) if same_arcs(&previous.arcs, arcs) => SharedArcs::clone(&previous.arcs),
-        _ => SharedArcs::from(arcs),
-    }
-}
-
-fn first_cut(route: &Route, stations: &[Station], index: usize) -> bool {
-    let Some(station) = stations.get(index) else {
-        return false;
-    };
-    let rapid = |s: &Station| route.pieces.get(s.piece).is_some_and(|p| p.rapid);
-    !rapid(station) && (index == 0 || stations.get(index - 1).is_some_and(rapid))
-}
-
-fn run_exact(
-    job: &Job,
-    candidate: &CandidateJob,
-    stations: &[Station],
-    control: Control<'_>,
-) -> Result<Vec<Contact>, SolverError> {
-    let route = &candidate.route;
-    let mut engine = ExactEngine::default();
-    // The height bands of a rounded end, each with its own section's radius (docs/spec/engagement.md §11
-    // item 5); their own engine, whose work limit grows with their number.
-    let rounded = candidate.force.as_ref().filter(|model| model.rounded());
-    let mut section_engine = ExactEngine::with_limit(super::exact::MAX_TESTS.saturating_mul(MAX_SECTIONS as u64));
-    let mut contacts = Vec::with_capacity(stations.len());
-    for (index, station) in stations.iter().enumerate() {
-        control.check()?;
-        control.report(index, stations.len());
-        let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
-        let arcs = share_arcs(contacts.last(), engine.arcs_in_place(route, &job.region, job.radius, station)?);
-        let mut contact = Contact::default();
-        if rapid {
-            contact.collision = !arcs.is_empty();
-        } else {
-            if first_cut(route, stations, index) {
-                // Contact where the cut begins (the piece's start): the tool enters in material.
-                let start = Station {
-                    local: 0.0,
-                    s: station.s - station.local,
-                    centre: route.pieces.get(station.piece).map_or(station.centre, |p| p.shape.start_point()),
-                    ..*station
-                };
-                contact.plunge = !engine.arcs_in_place(route, &job.region, job.radius, &start)?.is_empty();
-            }
-            if let Some(model) = rounded {
-                contact.slices = model.bands(
-                    &arcs,
-                    |radius| section_engine.arcs(route, &job.region, radius, station),
-                    |radius| if job.arc_feed { ArcFeed::at(route, station, radius) } else { None },
-                )?;
-            }
-            contact.arcs = arcs;
-        }
-        contacts.push(contact);
-    }
-    Ok(contacts)
-}
-
-fn run_dots(
-    job: &Job,
-    route: &Route,
-    stations: &[Station],
-    cell: f64,
-    control: Control<'_>,
-) -> Result<(Vec<Contact>, DotsOutput), SolverError> {
-    let radius = job.radius;
-    let extent =
-        job.region.bbox().and_then(|stock_box| grid_extent(route, stock_box, job.region.anchor(), radius, cell));
-    let Some((origin, width, height)) = extent else {
-        return Ok((vec![Contact::default(); stations.len()], DotsOutput { grid: None, scatter: Vec::new() }));
-    };
-    // The request check bounds width·height by MAX_GRID_DOTS.
-    let mut grid = DotGrid::new(&job.region, origin, cell, width as usize, height as usize);
-    let (width, height) = grid.size();
-    let info = GridInfo { cell, origin: [grid.origin().x, grid.origin().y], width, height, bytes: grid.bytes() };
-    let mut contacts = Vec::with_capacity(stations.len());
-    let mut scatter = Vec::new();
-    let mut buffer = Contacts { keep_angles: job.contact_dots, ..Contacts::default() };
-    let mut previous: Option<&Station> = None;
-    for (index, station) in stations.iter().enumerate() {
-        control.check()?;
-        control.report(index, stations.len());
-        let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
-        let mut contact = Contact::default();
-        if rapid {
-            contact.collision = grid.any_inside(station.centre, radius);
-            previous = None;
-        } else {
-            let step = previous.map_or(job.step, |p| station.s - p.s);
-            buffer.clear();
-            grid.remove(station.centre, previous.map(|p| p.centre), radius, &mut |dot| {
-                buffer.record(dot, station, radius, step, cell)
-            });
-            contact.plunge = previous.is_none() && buffer.touched();
-            if job.contact_dots {
-                let mut bins = [0_u64; 6];
-                for angle in &buffer.angles {
-                    let bin = (angle.floor() + 180.0).clamp(0.0, 359.0) as usize;
-                    bins[bin / 64] |= 1 << (bin % 64);
-                }
-                for bin in 0..360 {
-                    if bins[bin / 64] & (1 << (bin % 64)) != 0 {
-                        scatter.push([station.s, bin as f64 - 180.0 + 0.5]);
-                    }
-                }
-            }
-            contact.arcs = share_arcs(contacts.last(), &buffer.arcs(radius, cell, step));
-            previous = Some(station);
-        }
-        contacts.push(contact);
-    }
-    Ok((contacts, DotsOutput { grid: Some(info), scatter }))
 }
 
 /// The samples of one path and what the passes after the sample loop read of them.

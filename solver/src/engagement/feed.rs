@@ -11,7 +11,7 @@
 use super::answer::{FeedBlock, FeedLimit, FeedPlan};
 use super::arcfeed::ArcFeed;
 use super::arcs::peak_thickness_ratio;
-use super::evaluate::Contact;
+use super::contact::Contact;
 use super::force::ForceModel;
 use super::job::{Job, PlanJob};
 use super::request::FeedBasis;

@@ -18,6 +18,7 @@
 //! * `dots`: engine A, the patent's dot removal (§5.3.2);
 //! * `arcs`: arc merging, a_e and the per-arc quantities (§5.4, §5.5, §5.10);
 //! * `teeth`: H_k and n_k with the exact phase maximisation (§5.6);
+//! * `contact`: each sample's contact from the chosen engine;
 //! * `evaluate`, `diagnostics`: one path end to end, and its warnings (§5, §9);
 //! * `flutes`: representative values, time, recommendation (§5.7–§5.9);
 //! * `feed`: chip-thinning feed plan (§11 item 3), capped by the spindle's power and torque;
@@ -59,6 +60,7 @@ mod arcfeed;
 mod arcs;
 mod bbox_tree;
 mod capability;
+mod contact;
 mod diagnostics;
 mod dots;
 mod evaluate;
