@@ -1,4 +1,4 @@
-//! The capability seam (engineering.md, "The capability seam"): one trait that every capability
+//! The capability seam (engineering.md, "The capability seam"; docs/spec/api.md): one trait that every capability
 //! implements and every way in dispatches through: the HTTP handlers, the job executor, `kerf
 //! run` and the job workers. A capability declares its name, its request and answer types, the
 //! tool and machine it refers to, how it solves a resolved request and how it writes its program.

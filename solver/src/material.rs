@@ -1,11 +1,64 @@
-//! Work materials (docs/spec/engagement.md §11 item 4): the Kienzle values of a named material, as
-//! the materials library stores them (`/api/v1/materials/{name}`) and as an engagement request
-//! names them with `material`. The server resolves the name; the solver only sees the values.
+//! Work materials (docs/spec/engagement.md §11 item 4): Kienzle's cutting-force values
+//! ([`Kienzle`], as an engagement request gives them inline with `kienzle`) and the named
+//! materials that hold them, as the materials library stores them (`/api/v1/materials/{name}`)
+//! and as an engagement request names them with `material`. The server resolves the name; the
+//! solver only sees the values.
 
 use serde::{Deserialize, Serialize};
 
-use crate::engagement::Kienzle;
 use crate::error::SolverError;
+use crate::validate::positive_at_most;
+
+/// Kienzle's specific cutting force of a work material (docs/spec/engagement.md §11 item 4): the
+/// tangential force on one tooth is `kc11 · a_p · h^(1 − mc)` for a chip of thickness h and
+/// width a_p (mm).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct Kienzle {
+    /// k_c1.1: specific cutting force at h = 1 mm and b = 1 mm, N/mm² (0 < k_c1.1 ≤ 20 000; e.g.
+    /// about 2200 for a plain carbon steel, 700 for an aluminium alloy).
+    pub kc11: f64,
+    /// m_c: Kienzle's exponent (0 ≤ m_c < 1; typically 0.15–0.3).
+    pub mc: f64,
+    /// F_r/F_t, the radial force of a tooth as a share of its tangential force (≥ 0; default
+    /// [`DEFAULT_RADIAL_RATIO`]); it enters only the resultant force on the tool.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radial_ratio: Option<f64>,
+}
+
+/// F_r/F_t when `radial_ratio` is not given: a middle value of the 0.2–0.5 that sharp end mills
+/// show; give the measured ratio of the tool and material where it matters.
+pub const DEFAULT_RADIAL_RATIO: f64 = 0.3;
+
+/// Largest k_c1.1 accepted, N/mm²: hardened steels reach about 5000; a larger value is a unit
+/// mistake (N/m², or MPa at another chip size).
+pub const MAX_KC11: f64 = 20_000.0;
+
+impl Kienzle {
+    /// Checks the values, naming fields under `prefix` (e.g. `kienzle.`).
+    ///
+    /// # Errors
+    /// `E_INPUT` when `kc11` is not in (0, [`MAX_KC11`]] or `mc` is outside [0, 1).
+    pub fn validate(&self, prefix: &str) -> Result<(), SolverError> {
+        positive_at_most(&format!("{prefix}kc11"), self.kc11, MAX_KC11)?;
+        if !(self.mc.is_finite() && (0.0..1.0).contains(&self.mc)) {
+            return Err(SolverError::input(
+                format!("{prefix}mc"),
+                format!("mc must be at least 0 and below 1 (got {})", self.mc),
+            ));
+        }
+        if let Some(ratio) = self.radial_ratio
+            && !(ratio.is_finite() && (0.0..=10.0).contains(&ratio))
+        {
+            return Err(SolverError::input(
+                format!("{prefix}radial_ratio"),
+                format!("radial_ratio must be in [0, 10] (got {ratio})"),
+            ));
+        }
+        Ok(())
+    }
+}
 
 /// Longest material name (the same rule as machine names).
 pub const MAX_NAME_CHARS: usize = 64;

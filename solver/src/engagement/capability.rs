@@ -1,5 +1,5 @@
-//! Engagement analysis as a capability (the seam of engineering.md): `POST /api/v1/engagement`,
-//! job operation `engagement`.
+//! Engagement analysis as a capability (the seam of engineering.md; docs/spec/api.md, Engagement;
+//! docs/spec/engagement.md §3): `POST /api/v1/engagement`, job operation `engagement`.
 
 use serde::{Deserialize, Serialize};
 

@@ -1,6 +1,7 @@
-//! One candidate path end to end: contact at every sample from the chosen engine, the
-//! per-sample quantities and flags (docs/spec/engagement.md §5.4, §5.5, §5.10), the diagnostics of §9, and
-//! the per-flute results, recommendation and feed plan.
+//! One candidate path end to end (docs/spec/engagement.md §5): contact at every sample from the
+//! chosen engine, the per-sample quantities and flags (§5.4, §5.5, §5.10), the diagnostics of §9
+//! (`diagnostics`), and the per-flute results, recommendation and feed plan. The engines' contact
+//! at each sample is `contact`'s.
 
 use super::answer::{
     ArcDetail, EngagementSample, ForceInfo, GridInfo, PathEngagement, PostData, RouteData, SampleArcDetails,
@@ -8,44 +9,21 @@ use super::answer::{
 };
 use super::arcfeed::ArcFeed;
 use super::arcs::{self, Arc};
-use super::dots::{Contacts, DotGrid};
-use super::exact::ExactEngine;
+use super::contact::{Contact, DotsOutput, run_dots, run_exact, same_arcs};
 use super::force::{SampleTorque, power_kw};
-use super::heights::{Bands, MAX_SECTIONS};
-use super::job::{CandidateJob, Job, grid_extent};
+use super::job::{CandidateJob, Job};
 use super::request::Engine;
-use super::segments::{Route, Station};
+use super::segments::Station;
 use super::series::{self, Series};
 use super::stock::{Base, Region};
 use super::teeth::ToothSums;
-use super::{MAX_CONTACT_DOTS, feed, flutes};
+use super::{MAX_CONTACT_DOTS, diagnostics, feed, flutes};
 use crate::capability::Control;
 use crate::error::{SolverError, Warning};
-use crate::planar::turn_angle;
 use crate::tool::{Tool, ToolKind};
 
 /// Engagement on the back half deeper than this (degrees) marks `back_contact` (§9 W_PLUNGE).
 const BACK_TOLERANCE_DEG: f64 = 1.0;
-/// Φ at or above this is full immersion (§9 W_FULL_IMMERSION).
-const FULL_IMMERSION_DEG: f64 = 179.9;
-/// Intervals or positions listed in one warning before "and N more".
-const LISTED: usize = 6;
-
-/// Arcs shared between consecutive contacts that found the same ones.
-pub(crate) type SharedArcs = std::sync::Arc<[Arc]>;
-
-/// What an engine found at one station.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct Contact {
-    /// Shared with the previous contact when equal to the bit (most samples along a straight
-    /// cut): one allocation per change of engagement instead of one per sample.
-    pub arcs: SharedArcs,
-    pub plunge: bool,
-    pub collision: bool,
-    /// With a rounded end's force model and the exact engine: what the end's sections engage,
-    /// each height its own arcs.
-    pub slices: Option<Bands>,
-}
 
 /// What a sample's arcs alone decide: a_e, Φ, the arc ends and their flags, the mean chip
 /// thickness ratio without the arc-feed factor. Kept for the previous sample and reused while
@@ -105,163 +83,22 @@ impl ArcValues {
     }
 }
 
-/// The dots engine's extras.
-struct DotsOutput {
-    grid: Option<GridInfo>,
-    scatter: Vec<[f64; 2]>,
+/// The samples of one path and what the passes after the sample loop read of them.
+pub(super) struct Sampled {
+    pub samples: Vec<EngagementSample>,
+    pub series: Series,
+    /// Whether each sample enters the statistics: engaged, not the first, not a plunge, not a rapid.
+    pub statistic: Vec<bool>,
+    /// Where the tool starts cutting already in material, as [s, s] intervals.
+    pub plunges: Vec<[f64; 2]>,
+    /// Where the back half of the tool engages.
+    pub back: Vec<f64>,
+    /// Where a rapid passes through material.
+    pub collisions: Vec<f64>,
 }
 
-/// Whether two arc lists are the same to the bit.
-fn same_arcs(first: &[Arc], second: &[Arc]) -> bool {
-    first.len() == second.len()
-        && first
-            .iter()
-            .zip(second)
-            .all(|(a, b)| a.from.to_bits() == b.from.to_bits() && a.to.to_bits() == b.to.to_bits())
-}
-
-/// `arcs` as a contact's, shared with `previous`'s when they are the same.
-fn share_arcs(previous: Option<&Contact>, arcs: &[Arc]) -> SharedArcs {
-    match previous {
-        Some(previous) if same_arcs(&previous.arcs, arcs) => SharedArcs::clone(&previous.arcs),
-        _ => SharedArcs::from(arcs),
-    }
-}
-
-fn first_cut(route: &Route, stations: &[Station], index: usize) -> bool {
-    let Some(station) = stations.get(index) else {
-        return false;
-    };
-    let rapid = |s: &Station| route.pieces.get(s.piece).is_some_and(|p| p.rapid);
-    !rapid(station) && (index == 0 || stations.get(index - 1).is_some_and(rapid))
-}
-
-fn run_exact(
-    job: &Job,
-    candidate: &CandidateJob,
-    stations: &[Station],
-    control: Control<'_>,
-) -> Result<Vec<Contact>, SolverError> {
-    let route = &candidate.route;
-    let mut engine = ExactEngine::default();
-    // The height bands of a rounded end, each with its own section's radius (docs/spec/engagement.md §11
-    // item 5); their own engine, whose work limit grows with their number.
-    let rounded = candidate.force.as_ref().filter(|model| model.rounded());
-    let mut section_engine = ExactEngine::with_limit(super::exact::MAX_TESTS.saturating_mul(MAX_SECTIONS as u64));
-    let mut contacts = Vec::with_capacity(stations.len());
-    for (index, station) in stations.iter().enumerate() {
-        control.check()?;
-        control.report(index, stations.len());
-        let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
-        let arcs = share_arcs(contacts.last(), engine.arcs_in_place(route, &job.region, job.radius, station)?);
-        let mut contact = Contact::default();
-        if rapid {
-            contact.collision = !arcs.is_empty();
-        } else {
-            if first_cut(route, stations, index) {
-                // Contact where the cut begins (the piece's start): the tool enters in material.
-                let start = Station {
-                    local: 0.0,
-                    s: station.s - station.local,
-                    centre: route.pieces.get(station.piece).map_or(station.centre, |p| p.shape.start_point()),
-                    ..*station
-                };
-                contact.plunge = !engine.arcs_in_place(route, &job.region, job.radius, &start)?.is_empty();
-            }
-            if let Some(model) = rounded {
-                contact.slices = model.bands(
-                    &arcs,
-                    |radius| section_engine.arcs(route, &job.region, radius, station),
-                    |radius| if job.arc_feed { ArcFeed::at(route, station, radius) } else { None },
-                )?;
-            }
-            contact.arcs = arcs;
-        }
-        contacts.push(contact);
-    }
-    Ok(contacts)
-}
-
-fn run_dots(
-    job: &Job,
-    route: &Route,
-    stations: &[Station],
-    cell: f64,
-    control: Control<'_>,
-) -> Result<(Vec<Contact>, DotsOutput), SolverError> {
-    let radius = job.radius;
-    let extent =
-        job.region.bbox().and_then(|stock_box| grid_extent(route, stock_box, job.region.anchor(), radius, cell));
-    let Some((origin, width, height)) = extent else {
-        return Ok((vec![Contact::default(); stations.len()], DotsOutput { grid: None, scatter: Vec::new() }));
-    };
-    // The request check bounds width·height by MAX_GRID_DOTS.
-    let mut grid = DotGrid::new(&job.region, origin, cell, width as usize, height as usize);
-    let (width, height) = grid.size();
-    let info = GridInfo { cell, origin: [grid.origin().x, grid.origin().y], width, height, bytes: grid.bytes() };
-    let mut contacts = Vec::with_capacity(stations.len());
-    let mut scatter = Vec::new();
-    let mut buffer = Contacts { keep_angles: job.contact_dots, ..Contacts::default() };
-    let mut previous: Option<&Station> = None;
-    for (index, station) in stations.iter().enumerate() {
-        control.check()?;
-        control.report(index, stations.len());
-        let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
-        let mut contact = Contact::default();
-        if rapid {
-            contact.collision = grid.any_inside(station.centre, radius);
-            previous = None;
-        } else {
-            let step = previous.map_or(job.step, |p| station.s - p.s);
-            buffer.clear();
-            grid.remove(station.centre, previous.map(|p| p.centre), radius, &mut |dot| {
-                buffer.record(dot, station, radius, step, cell)
-            });
-            contact.plunge = previous.is_none() && buffer.touched();
-            if job.contact_dots {
-                let mut bins = [0_u64; 6];
-                for angle in &buffer.angles {
-                    let bin = (angle.floor() + 180.0).clamp(0.0, 359.0) as usize;
-                    bins[bin / 64] |= 1 << (bin % 64);
-                }
-                for bin in 0..360 {
-                    if bins[bin / 64] & (1 << (bin % 64)) != 0 {
-                        scatter.push([station.s, bin as f64 - 180.0 + 0.5]);
-                    }
-                }
-            }
-            contact.arcs = share_arcs(contacts.last(), &buffer.arcs(radius, cell, step));
-            previous = Some(station);
-        }
-        contacts.push(contact);
-    }
-    Ok((contacts, DotsOutput { grid: Some(info), scatter }))
-}
-
-/// "s = a–b, c–d, … (N in all)".
-fn list_intervals(intervals: &[[f64; 2]]) -> String {
-    let shown: Vec<String> = intervals
-        .iter()
-        .take(LISTED)
-        .map(|[a, b]| if (b - a).abs() < 1e-9 { format!("{a:.3}") } else { format!("{a:.3}–{b:.3}") })
-        .collect();
-    let more = intervals.len().saturating_sub(LISTED);
-    if more > 0 { format!("s = {} and {more} more", shown.join(", ")) } else { format!("s = {}", shown.join(", ")) }
-}
-
-fn stock_description(region: &Region) -> String {
-    match &region.base {
-        Base::Polygons(outline) => {
-            let rings = outline.rings();
-            format!("stock: polygon rings {}, vertices {}", rings.len(), rings.iter().map(Vec::len).sum::<usize>())
-        }
-        Base::Bitmap(bitmap) => {
-            format!("stock: bitmap {} x {} cells of {} mm", bitmap.width, bitmap.height, bitmap.cell)
-        }
-    }
-}
-
-/// Evaluates one candidate path.
+/// Evaluates one candidate path: the engine's contacts, the samples, the diagnostics, the
+/// per-flute results and feed plan, in that order.
 pub(crate) fn evaluate(
     job: &Job,
     candidate: &CandidateJob,
@@ -269,7 +106,6 @@ pub(crate) fn evaluate(
     control: Control<'_>,
 ) -> Result<PathEngagement, SolverError> {
     let route = &candidate.route;
-    let radius = job.radius;
     let stations = route.stations(job.step);
     let (contacts, dots) = match (job.engine, job.grid) {
         (Engine::Dots, Some(cell)) => {
@@ -281,54 +117,91 @@ pub(crate) fn evaluate(
 
     let time_flutes = job.tool_flutes;
     let nominal_feed = job.feed_mode.feed(time_flutes, job.spindle_rpm);
-    let nominal_fz = job.feed_mode.feed_per_tooth(time_flutes, job.spindle_rpm);
+    let mut warnings = job.shared_warnings.clone();
+    warnings.extend(candidate.warnings.iter().cloned());
+    let sampled = sample_all(job, candidate, &stations, &contacts, nominal_feed);
+    let Sampled { samples, series, statistic, .. } = &sampled;
+
+    let engaged_intervals = series.runs(|i| series.arc_count[i] > 0 && !series.marked(i, series::RAPID));
+    diagnostics::sampling(&mut warnings, job, &sampled, &engaged_intervals);
+    diagnostics::vertices(&mut warnings, route);
+    diagnostics::dots(&mut warnings, job);
+    diagnostics::force_model(&mut warnings, job, candidate, tool);
+    let (flute_results, recommended, flute_warnings) =
+        flutes::results(job, candidate.force.as_ref(), samples, series, statistic, route.feed_length);
+    warnings.extend(flute_warnings);
+    let feed_plan =
+        job.plan.as_ref().map(|plan| feed::plan(job, candidate.force.as_ref(), plan, route, &stations, &contacts));
+
+    let (max_engaged_deg, max_engaged_at_s) = (series.engaged_deg.iter().zip(&series.s))
+        .zip(statistic)
+        .filter(|(_, s)| **s)
+        .map(|((&phi, &s), _)| (phi, s))
+        .fold((0.0, 0.0), |best, (phi, s)| if phi > best.0 { (phi, s) } else { best });
+    let max_radial_depth =
+        series.radial_depth.iter().zip(statistic).filter(|(_, s)| **s).map(|(&depth, _)| depth).fold(0.0, f64::max);
+    let (contact_dots, grid) = contact_dots(job, dots, &mut warnings);
+    Ok(PathEngagement {
+        name: candidate.name.clone(),
+        max_mrr: candidate.axial_depth.map(|depth| depth * max_radial_depth * nominal_feed),
+        samples: sampled.samples,
+        flutes: flute_results,
+        recommended,
+        path_length: route.length,
+        feed_length: route.feed_length,
+        time_flute_count: time_flutes,
+        engine: job.engine,
+        step: job.step,
+        grid,
+        engaged_intervals,
+        max_engaged_deg,
+        max_engaged_at_s,
+        max_radial_depth,
+        contact_dots,
+        forces: candidate.force.as_ref().map(|model| ForceInfo {
+            kc11: model.kc11,
+            mc: model.mc,
+            radial_ratio: model.radial_ratio,
+            axial_depth: model.axial_depth,
+            helix_lag_deg: model.lag_deg,
+            height_sections: contacts.iter().filter_map(|c| c.slices.as_ref()).map(|b| b.sections.len()).max(),
+            spindle_power_kw: job.spindle.spindle_power_kw,
+            spindle_torque_nm: job.spindle.spindle_torque_nm,
+            natural_frequencies_hz: job.natural.iter().map(|(f, _)| *f).collect(),
+        }),
+        feed_plan,
+        blocks: None,
+        warnings,
+        post: post_data(job, candidate, tool, nominal_feed),
+    })
+}
+
+/// Every sample of the path from the engine's contacts: arcs, a_e, Φ, flags, the tooth sums of
+/// every flute count, and with a force model the torque, power and peak force.
+fn sample_all(
+    job: &Job,
+    candidate: &CandidateJob,
+    stations: &[Station],
+    contacts: &[Contact],
+    nominal_feed: f64,
+) -> Sampled {
+    let route = &candidate.route;
+    let radius = job.radius;
+    let nominal_fz = job.feed_mode.feed_per_tooth(job.tool_flutes, job.spindle_rpm);
     let mut samples = Vec::with_capacity(stations.len());
     let mut series = Series::with_capacity(stations.len(), job.flute_counts.len());
     let mut statistic = Vec::with_capacity(stations.len());
-    let mut warnings = job.shared_warnings.clone();
-    warnings.extend(candidate.warnings.iter().cloned());
-    let mut plunges = Vec::new();
-    let mut back = Vec::new();
-    let mut collisions = Vec::new();
+    let mut marks = Marks::default();
     let mut tooth_sums = ToothSums::default();
     let mut arc_values = ArcValues::default();
     // The last tangent's bits and heading: along a line every sample has the same tangent.
     let mut last_heading: Option<([u64; 2], f64)> = None;
-    for (index, (station, contact)) in stations.iter().zip(&contacts).enumerate() {
+    for (index, (station, contact)) in stations.iter().zip(contacts).enumerate() {
         let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
         let arcs: &[Arc] = &contact.arcs;
         let values = arc_values.of(arcs, job, radius);
         let radial_depth = values.radial_depth;
-        let mut flags = SampleFlags::new();
-        if values.burr {
-            flags.push(SampleFlag::BurrRisk);
-        }
-        if values.chipping {
-            flags.push(SampleFlag::ChippingRisk);
-        }
-        if contact.plunge {
-            flags.push(SampleFlag::Plunge);
-            plunges.push([station.s, station.s]);
-        }
-        if values.behind && !contact.plunge && index > 0 {
-            flags.push(SampleFlag::BackContact);
-            back.push(station.s);
-        }
-        if !arcs.is_empty() {
-            if job.radial_depth_max.is_some_and(|high| radial_depth > high) {
-                flags.push(SampleFlag::VibrationRisk);
-            }
-            if job.radial_depth_min.is_some_and(|low| radial_depth < low) {
-                flags.push(SampleFlag::RubbingRisk);
-            }
-        }
-        if rapid {
-            flags.push(SampleFlag::Rapid);
-        }
-        if contact.collision {
-            flags.push(SampleFlag::Collision);
-            collisions.push(station.s);
-        }
+        let flags = marks.flags(job, values, contact, station, index > 0, rapid);
         let sums = tooth_sums.of(arcs, &job.flute_counts);
         let bits = [station.tangent.x.to_bits(), station.tangent.y.to_bits()];
         let heading_deg = match last_heading {
@@ -340,21 +213,7 @@ pub(crate) fn evaluate(
             }
         };
         let edge_feed = if job.arc_feed { ArcFeed::at(route, station, radius) } else { None };
-        let (torques, forces): (Vec<SampleTorque>, Vec<f64>) =
-            candidate.force.as_ref().map_or_else(Default::default, |model| {
-                let slices = contact.slices.as_ref();
-                let integral = model.integral(arcs, edge_feed.as_ref(), slices);
-                job.flute_counts
-                    .iter()
-                    .map(|&k| {
-                        let fz = job.feed_mode.feed_per_tooth(k, job.spindle_rpm);
-                        (
-                            model.torque(arcs, edge_feed.as_ref(), slices, integral, k, fz),
-                            model.peak_force(arcs, k, fz, edge_feed.as_ref(), slices),
-                        )
-                    })
-                    .unzip()
-            });
+        let (torques, forces) = sample_forces(job, candidate, contact, edge_feed.as_ref());
         statistic.push(index > 0 && !rapid && !arcs.is_empty() && !contact.plunge);
         samples.push(EngagementSample {
             s: station.s,
@@ -390,182 +249,117 @@ pub(crate) fn evaluate(
             series.push(sample);
         }
     }
+    let Marks { plunges, back, collisions } = marks;
+    Sampled { samples, series, statistic, plunges, back, collisions }
+}
 
-    // Diagnostics (docs/spec/engagement.md §9).
-    let engaged_intervals = series.runs(|i| series.arc_count[i] > 0 && !series.marked(i, series::RAPID));
-    if !statistic.iter().any(|s| *s) {
-        warnings.push(Warning::new(
-            "W_NO_CONTACT",
-            if engaged_intervals.is_empty() {
-                "no engagement: the tool never touches the stock along this path (check the stock and path coordinates); all series are zero"
-            } else {
-                "no engagement to evaluate: the tool touches the stock only where it plunges; the statistics are zero"
-            },
-        ));
-    }
-    if !plunges.is_empty() {
-        warnings.push(Warning::new(
-            "W_PLUNGE",
-            format!(
-                "the tool is already in material where it starts cutting at {}: a plunge (those samples are left out of the statistics)",
-                list_intervals(&plunges)
-            ),
-        ));
-    }
-    if !back.is_empty() {
-        let intervals = series.runs(|i| series.marked(i, series::BACK_CONTACT));
-        warnings.push(Warning::new(
-            "W_PLUNGE",
-            format!(
-                "engagement on the back half of the tool (ramp, reversal into stock) at {}",
-                list_intervals(&intervals)
-            ),
-        ));
-    }
-    if !collisions.is_empty() {
-        let intervals = series.runs(|i| series.marked(i, series::COLLISION));
-        warnings.push(Warning::new(
-            "W_RAPID_COLLISION",
-            format!(
-                "a rapid passes through material at {}: at cutting depth this is a collision (the G-code program retracts to the clearance plane for rapids)",
-                list_intervals(&intervals)
-            ),
-        ));
-    }
-    let immersion = series.runs(|i| series.engaged_deg[i] >= FULL_IMMERSION_DEG);
-    if !immersion.is_empty() {
-        warnings.push(Warning::new(
-            "W_FULL_IMMERSION",
-            format!("full immersion (slotting, Φ ≥ {FULL_IMMERSION_DEG}°) at {}", list_intervals(&immersion)),
-        ));
-    }
-    let multi_arc = series.runs(|i| series.arc_count[i] >= 2);
-    if !multi_arc.is_empty() {
-        warnings.push(Warning::new(
-            "W_MULTI_ARC",
-            format!("two or more separate contact zones at {}", list_intervals(&multi_arc)),
-        ));
-    }
-    if let Some(threshold) = job.spike_threshold {
-        let spikes = series.runs(|i| {
-            i > 0 && statistic[i] && statistic[i - 1] && {
-                let jump = (series.engaged_deg[i] - series.engaged_deg[i - 1]).abs();
-                jump > threshold
+/// Where the flags that the diagnostics list by position were raised.
+#[derive(Default)]
+struct Marks {
+    plunges: Vec<[f64; 2]>,
+    back: Vec<f64>,
+    collisions: Vec<f64>,
+}
+
+impl Marks {
+    /// The flags of one sample (§5.10, §9), noting the positions of plunges, back contact and
+    /// collisions; `after_first`: not the path's first sample.
+    fn flags(
+        &mut self,
+        job: &Job,
+        values: &ArcValues,
+        contact: &Contact,
+        station: &Station,
+        after_first: bool,
+        rapid: bool,
+    ) -> SampleFlags {
+        let radial_depth = values.radial_depth;
+        let mut flags = SampleFlags::new();
+        if values.burr {
+            flags.push(SampleFlag::BurrRisk);
+        }
+        if values.chipping {
+            flags.push(SampleFlag::ChippingRisk);
+        }
+        if contact.plunge {
+            flags.push(SampleFlag::Plunge);
+            self.plunges.push([station.s, station.s]);
+        }
+        if values.behind && !contact.plunge && after_first {
+            flags.push(SampleFlag::BackContact);
+            self.back.push(station.s);
+        }
+        if !contact.arcs.is_empty() {
+            if job.radial_depth_max.is_some_and(|high| radial_depth > high) {
+                flags.push(SampleFlag::VibrationRisk);
             }
-        });
-        if !spikes.is_empty() {
-            warnings.push(Warning::new(
-                "W_ENGAGEMENT_SPIKE",
-                format!(
-                    "the engaged angle jumps by more than {threshold}° between samples at {} (inside corners: consider a fillet, a feed reduction or trochoidal clearing)",
-                    list_intervals(&spikes)
-                ),
-            ));
-        }
-    }
-    let vertices: Vec<String> = route
-        .pieces
-        .windows(2)
-        .filter_map(|pair| {
-            let out = pair[0].shape.tangent(pair[0].shape.length());
-            let into = pair[1].shape.tangent(0.0);
-            let turn = turn_angle(&out, &into).to_degrees();
-            (turn.abs() > 1.0).then(|| format!("s = {:.3} ({turn:+.1}°)", pair[0].end_s()))
-        })
-        .collect();
-    if !vertices.is_empty() {
-        let more = vertices.len().saturating_sub(LISTED);
-        warnings.push(Warning::new(
-            "W_VERTEX",
-            format!(
-                "{} path vertices turn by more than 1°, each evaluated in the incoming direction: {}{}",
-                vertices.len(),
-                vertices.iter().take(LISTED).cloned().collect::<Vec<_>>().join(", "),
-                if more > 0 { format!(" and {more} more") } else { String::new() }
-            ),
-        ));
-    }
-    if let (Engine::Dots, Some(cell)) = (job.engine, job.grid) {
-        let step = job.step;
-        let mut notes = Vec::new();
-        if step < 4.0 * cell {
-            notes.push(format!("step {step} mm is below 4 × grid ({} mm): sampling gaps", 4.0 * cell));
-        }
-        if radius / cell < 50.0 {
-            notes.push(format!(
-                "R/grid = {:.1} is below 50: angles near 0°/180° resolve only to about {:.1}°",
-                radius / cell,
-                (1.0 - 2.0 * cell / radius).clamp(-1.0, 1.0).acos().to_degrees()
-            ));
-        }
-        if step > radius / 10.0 {
-            notes.push(format!("step {step} mm is above R/10 ({} mm): coarse in time", radius / 10.0));
-        }
-        if !notes.is_empty() {
-            warnings.push(Warning::new(
-                "W_RESOLUTION",
-                format!("dots engine at grid {cell} mm, step {step} mm: {}", notes.join("; ")),
-            ));
-        }
-        if let Base::Polygons(outline) = &job.region.base {
-            let short = outline
-                .rings()
-                .iter()
-                .flat_map(|ring| ring.iter().zip(ring.iter().cycle().skip(1)))
-                .filter(|(a, b)| (*b - *a).norm() < 2.0 * cell)
-                .count();
-            if short > 0 {
-                warnings.push(Warning::new(
-                    "W_THIN_FEATURE",
-                    format!("{short} stock edge(s) are shorter than 2 × grid ({} mm): features that small blur or vanish in the dots", 2.0 * cell),
-                ));
+            if job.radial_depth_min.is_some_and(|low| radial_depth < low) {
+                flags.push(SampleFlag::RubbingRisk);
             }
         }
+        if rapid {
+            flags.push(SampleFlag::Rapid);
+        }
+        if contact.collision {
+            flags.push(SampleFlag::Collision);
+            self.collisions.push(station.s);
+        }
+        flags
     }
+}
 
-    if let (Some(model), Engine::Dots) = (&candidate.force, job.engine)
-        && model.rounded()
-    {
+/// With a force model, the torque (phase mean and peak) and the peak force of every flute count
+/// at one sample; nothing without.
+fn sample_forces(
+    job: &Job,
+    candidate: &CandidateJob,
+    contact: &Contact,
+    edge_feed: Option<&ArcFeed>,
+) -> (Vec<SampleTorque>, Vec<f64>) {
+    let arcs: &[Arc] = &contact.arcs;
+    candidate.force.as_ref().map_or_else(Default::default, |model| {
+        let slices = contact.slices.as_ref();
+        let integral = model.integral(arcs, edge_feed, slices);
+        job.flute_counts
+            .iter()
+            .map(|&k| {
+                let fz = job.feed_mode.feed_per_tooth(k, job.spindle_rpm);
+                (
+                    model.torque(arcs, edge_feed, slices, integral, k, fz),
+                    model.peak_force(arcs, k, fz, edge_feed, slices),
+                )
+            })
+            .unzip()
+    })
+}
+
+/// The dots engine's contact dots for the scatter plot, decimated past [`MAX_CONTACT_DOTS`] with
+/// `W_CONTACT_DOTS_DECIMATED` (when the request wants them), and its grid.
+fn contact_dots(
+    job: &Job,
+    dots: Option<DotsOutput>,
+    warnings: &mut Vec<Warning>,
+) -> (Option<Vec<[f64; 2]>>, Option<GridInfo>) {
+    let Some(output) = dots else { return (None, None) };
+    let mut scatter = output.scatter;
+    if scatter.len() > MAX_CONTACT_DOTS {
+        let stride = scatter.len().div_ceil(MAX_CONTACT_DOTS);
         warnings.push(Warning::new(
-            "W_FORCE_MODEL",
+            "W_CONTACT_DOTS_DECIMATED",
             format!(
-                "the {} end's chips (h = f_z·sin θ·sin κ) and lever arms are integrated over a_p = {} mm, but engine \"dots\" gives only the full radius's engaged arcs, taken at every height: where the end's smaller sections meet other material (a wall beside the tool, a cut shallower than the corner radius, scallops of an earlier pass, a slot's exit), torque, power and force are off; engine \"exact\" takes each height's own arcs",
-                tool.kind.as_str(),
-                model.axial_depth
+                "{} contact dots exceed the limit of {MAX_CONTACT_DOTS}: every {stride}th is returned",
+                scatter.len()
             ),
         ));
+        scatter = scatter.into_iter().step_by(stride).collect();
     }
-    let (flute_results, recommended, flute_warnings) =
-        flutes::results(job, candidate.force.as_ref(), &samples, &series, &statistic, route.feed_length);
-    warnings.extend(flute_warnings);
-    let feed_plan =
-        job.plan.as_ref().map(|plan| feed::plan(job, candidate.force.as_ref(), plan, route, &stations, &contacts));
+    (job.contact_dots.then_some(scatter), output.grid)
+}
 
-    let (max_engaged_deg, max_engaged_at_s) = (series.engaged_deg.iter().zip(&series.s))
-        .zip(&statistic)
-        .filter(|(_, s)| **s)
-        .map(|((&phi, &s), _)| (phi, s))
-        .fold((0.0, 0.0), |best, (phi, s)| if phi > best.0 { (phi, s) } else { best });
-    let max_radial_depth =
-        series.radial_depth.iter().zip(&statistic).filter(|(_, s)| **s).map(|(&depth, _)| depth).fold(0.0, f64::max);
-    let (contact_dots, grid) = match dots {
-        Some(output) => {
-            let mut scatter = output.scatter;
-            if scatter.len() > MAX_CONTACT_DOTS {
-                let stride = scatter.len().div_ceil(MAX_CONTACT_DOTS);
-                warnings.push(Warning::new(
-                    "W_CONTACT_DOTS_DECIMATED",
-                    format!(
-                        "{} contact dots exceed the limit of {MAX_CONTACT_DOTS}: every {stride}th is returned",
-                        scatter.len()
-                    ),
-                ));
-                scatter = scatter.into_iter().step_by(stride).collect();
-            }
-            (job.contact_dots.then_some(scatter), output.grid)
-        }
-        None => (None, None),
-    };
+/// What the G-code program of the path needs besides the samples (docs/spec/engagement.md §3.2,
+/// §11 item 12): the route, feeds, heights and the program's description lines.
+fn post_data(job: &Job, candidate: &CandidateJob, tool: &Tool, nominal_feed: f64) -> PostData {
+    let route = &candidate.route;
     let centre_height = match tool.kind {
         ToolKind::Ball => tool.radius,
         ToolKind::Bull => tool.corner_radius.unwrap_or(0.0),
@@ -581,50 +375,30 @@ pub(crate) fn evaluate(
         stock_description(&job.region),
         format!("tool R {} mm, {} flutes, S {} rpm", tool.radius, tool.flutes, job.spindle_rpm),
     ];
-    Ok(PathEngagement {
-        name: candidate.name.clone(),
-        max_mrr: candidate.axial_depth.map(|depth| depth * max_radial_depth * nominal_feed),
-        samples,
-        flutes: flute_results,
-        recommended,
-        path_length: route.length,
-        feed_length: route.feed_length,
-        time_flute_count: time_flutes,
-        engine: job.engine,
-        step: job.step,
-        grid,
-        engaged_intervals,
-        max_engaged_deg,
-        max_engaged_at_s,
-        max_radial_depth,
-        contact_dots,
-        forces: candidate.force.as_ref().map(|model| ForceInfo {
-            kc11: model.kc11,
-            mc: model.mc,
-            radial_ratio: model.radial_ratio,
-            axial_depth: model.axial_depth,
-            helix_lag_deg: model.lag_deg,
-            height_sections: contacts.iter().filter_map(|c| c.slices.as_ref()).map(|b| b.sections.len()).max(),
-            spindle_power_kw: job.spindle.spindle_power_kw,
-            spindle_torque_nm: job.spindle.spindle_torque_nm,
-            natural_frequencies_hz: job.natural.iter().map(|(f, _)| *f).collect(),
-        }),
-        feed_plan,
-        blocks: None,
-        warnings,
-        post: PostData {
-            route: RouteData(route.clone()),
-            nominal_feed,
-            spindle_rpm: job.spindle_rpm,
-            spindle_direction: job.direction,
-            rule: job.rule,
-            axial_depth: candidate.axial_depth,
-            cut_z: candidate.cut_z,
-            stock_top_z: job.stock_top_z,
-            clearance: job.clearance,
-            tool_radius: tool.radius,
-            centre_height,
-            description,
-        },
-    })
+    PostData {
+        route: RouteData(route.clone()),
+        nominal_feed,
+        spindle_rpm: job.spindle_rpm,
+        spindle_direction: job.direction,
+        rule: job.rule,
+        axial_depth: candidate.axial_depth,
+        cut_z: candidate.cut_z,
+        stock_top_z: job.stock_top_z,
+        clearance: job.clearance,
+        tool_radius: tool.radius,
+        centre_height,
+        description,
+    }
+}
+
+fn stock_description(region: &Region) -> String {
+    match &region.base {
+        Base::Polygons(outline) => {
+            let rings = outline.rings();
+            format!("stock: polygon rings {}, vertices {}", rings.len(), rings.iter().map(Vec::len).sum::<usize>())
+        }
+        Base::Bitmap(bitmap) => {
+            format!("stock: bitmap {} x {} cells of {} mm", bitmap.width, bitmap.height, bitmap.cell)
+        }
+    }
 }

@@ -11,7 +11,7 @@
 use super::answer::{FeedBlock, FeedLimit, FeedPlan};
 use super::arcfeed::ArcFeed;
 use super::arcs::peak_thickness_ratio;
-use super::evaluate::Contact;
+use super::contact::Contact;
 use super::force::ForceModel;
 use super::job::{Job, PlanJob};
 use super::request::FeedBasis;
@@ -62,7 +62,9 @@ fn whole(feed: f64) -> f64 {
     feed.floor().max(1.0)
 }
 
-/// The feed plan for one path.
+/// The feed plan for one path: the stretches between samples at the feed each needs, grouped
+/// into blocks within the tolerance band, short blocks merged, feeds rounded down to whole
+/// mm/min.
 pub(crate) fn plan(
     job: &Job,
     force: Option<&ForceModel>,
@@ -71,75 +73,8 @@ pub(crate) fn plan(
     stations: &[Station],
     contacts: &[Contact],
 ) -> FeedPlan {
-    let feeds: Vec<Option<(f64, FeedLimit)>> = stations
-        .iter()
-        .zip(contacts)
-        .map(|(station, contact)| {
-            let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
-            let edge_feed = if job.arc_feed { ArcFeed::at(route, station, job.radius) } else { None };
-            (!rapid).then(|| needed(job, force, plan, contact, edge_feed.as_ref()))
-        })
-        .collect();
-    let mut stretches = Vec::new();
-    for index in 1..stations.len() {
-        let (before, here) = (&stations[index - 1], &stations[index]);
-        if here.s - before.s <= 0.0 {
-            continue;
-        }
-        let feed = match (feeds[index - 1], feeds[index]) {
-            (_, None) => None,
-            (None, Some(f)) => Some(f),
-            (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
-        };
-        stretches.push(Stretch { piece: here.piece, from_s: before.s, to_s: here.s, feed });
-    }
-
-    // Group stretches of one piece whose feeds lie within the tolerance band.
-    let mut blocks: Vec<(Stretch, f64)> = Vec::new();
-    for stretch in stretches {
-        if let Some((block, highest)) = blocks.last_mut()
-            && block.piece == stretch.piece
-        {
-            match (block.feed, stretch.feed) {
-                (None, None) => {
-                    block.to_s = stretch.to_s;
-                    continue;
-                }
-                (Some(low), Some(feed)) => {
-                    let new_low = if feed.0 < low.0 { feed } else { low };
-                    let new_high = highest.max(feed.0);
-                    if new_high <= new_low.0 * (1.0 + plan.tolerance) {
-                        block.feed = Some(new_low);
-                        block.to_s = stretch.to_s;
-                        *highest = new_high;
-                        continue;
-                    }
-                }
-                _ => {}
-            }
-        }
-        let high = stretch.feed.map_or(0.0, |f| f.0);
-        blocks.push((stretch, high));
-    }
-
-    // Merge blocks shorter than the minimum into their neighbour, at the lower feed.
-    let mut merged: Vec<Stretch> = Vec::with_capacity(blocks.len());
-    for (block, _) in blocks {
-        if let Some(last) = merged.last_mut()
-            && last.piece == block.piece
-            && last.feed.is_some() == block.feed.is_some()
-            && (last.to_s - last.from_s < plan.min_block_length || block.to_s - block.from_s < plan.min_block_length)
-        {
-            last.to_s = block.to_s;
-            last.feed = match (last.feed, block.feed) {
-                (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
-                _ => None,
-            };
-            continue;
-        }
-        merged.push(block);
-    }
-
+    let stretches = stretches(job, force, plan, route, stations, contacts);
+    let merged = merge_short(group(stretches, plan.tolerance), plan.min_block_length);
     let mut time_s = 0.0;
     let mut range = [f64::INFINITY, 0.0_f64];
     let blocks: Vec<FeedBlock> = merged
@@ -172,4 +107,95 @@ pub(crate) fn plan(
         nominal_time_s: 60.0 * route.feed_length / job.feed_mode.feed(plan.flute_count, job.spindle_rpm),
         feed_range: range,
     }
+}
+
+/// The stretches between consecutive samples, each at the lower of the feeds its two ends need
+/// (none on a rapid).
+fn stretches(
+    job: &Job,
+    force: Option<&ForceModel>,
+    plan: &PlanJob,
+    route: &Route,
+    stations: &[Station],
+    contacts: &[Contact],
+) -> Vec<Stretch> {
+    let feeds: Vec<Option<(f64, FeedLimit)>> = stations
+        .iter()
+        .zip(contacts)
+        .map(|(station, contact)| {
+            let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
+            let edge_feed = if job.arc_feed { ArcFeed::at(route, station, job.radius) } else { None };
+            (!rapid).then(|| needed(job, force, plan, contact, edge_feed.as_ref()))
+        })
+        .collect();
+    let mut stretches = Vec::new();
+    for index in 1..stations.len() {
+        let (before, here) = (&stations[index - 1], &stations[index]);
+        if here.s - before.s <= 0.0 {
+            continue;
+        }
+        let feed = match (feeds[index - 1], feeds[index]) {
+            (_, None) => None,
+            (None, Some(f)) => Some(f),
+            (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
+        };
+        stretches.push(Stretch { piece: here.piece, from_s: before.s, to_s: here.s, feed });
+    }
+    stretches
+}
+
+/// Stretches of one piece whose feeds lie within `tolerance` of the lowest grouped into one block
+/// at that lowest feed; each block with the highest feed it took in.
+fn group(stretches: Vec<Stretch>, tolerance: f64) -> Vec<(Stretch, f64)> {
+    // Group stretches of one piece whose feeds lie within the tolerance band.
+    let mut blocks: Vec<(Stretch, f64)> = Vec::new();
+    for stretch in stretches {
+        if let Some((block, highest)) = blocks.last_mut()
+            && block.piece == stretch.piece
+        {
+            match (block.feed, stretch.feed) {
+                (None, None) => {
+                    block.to_s = stretch.to_s;
+                    continue;
+                }
+                (Some(low), Some(feed)) => {
+                    let new_low = if feed.0 < low.0 { feed } else { low };
+                    let new_high = highest.max(feed.0);
+                    if new_high <= new_low.0 * (1.0 + tolerance) {
+                        block.feed = Some(new_low);
+                        block.to_s = stretch.to_s;
+                        *highest = new_high;
+                        continue;
+                    }
+                }
+                _ => {}
+            }
+        }
+        let high = stretch.feed.map_or(0.0, |f| f.0);
+        blocks.push((stretch, high));
+    }
+    blocks
+}
+
+/// Blocks shorter than `min_block_length` merged into their neighbour on the same piece, at the
+/// lower feed.
+fn merge_short(blocks: Vec<(Stretch, f64)>, min_block_length: f64) -> Vec<Stretch> {
+    // Merge blocks shorter than the minimum into their neighbour, at the lower feed.
+    let mut merged: Vec<Stretch> = Vec::with_capacity(blocks.len());
+    for (block, _) in blocks {
+        if let Some(last) = merged.last_mut()
+            && last.piece == block.piece
+            && last.feed.is_some() == block.feed.is_some()
+            && (last.to_s - last.from_s < min_block_length || block.to_s - block.from_s < min_block_length)
+        {
+            last.to_s = block.to_s;
+            last.feed = match (last.feed, block.feed) {
+                (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
+                _ => None,
+            };
+            continue;
+        }
+        merged.push(block);
+    }
+    merged
 }

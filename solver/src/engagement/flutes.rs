@@ -66,21 +66,8 @@ pub(crate) fn results(
             Representative::Mean => mean,
             Representative::Median => median,
         };
-        let thickness_margin = job.thickness_limit.map(|limit| limit - representative);
-        let time_margin_s = job.time_limit.map(|limit| limit - time_s);
-        let thickness_ok = job.thickness_limit.is_none_or(|limit| representative <= limit * (1.0 + LIMIT_SLACK));
-        let time_ok = job.time_limit.is_none_or(|limit| time_s <= limit * (1.0 + LIMIT_SLACK));
-        let recommended = (job.thickness_limit.is_some() || job.time_limit.is_some()) && thickness_ok && time_ok;
-        let mut reasons = Vec::new();
-        if let (false, Some(limit)) = (thickness_ok, job.thickness_limit) {
-            reasons.push(format!("thickness {representative:.6} mm > {limit} mm"));
-        }
-        if let (false, Some(limit)) = (time_ok, job.time_limit) {
-            reasons.push(format!("time {time_s:.4} s > {limit} s"));
-        }
-        if !reasons.is_empty() {
-            failures.push(format!("k = {k}: {}", reasons.join(", ")));
-        }
+        let verdict = verdict(job, k, representative, time_s);
+        failures.extend(verdict.failure);
         let multi_tooth_intervals =
             series.runs(|i| statistic.get(i).copied().unwrap_or(false) && teeth.get(i).is_some_and(|n| *n >= 2));
         if !multi_tooth_intervals.is_empty() {
@@ -103,18 +90,7 @@ pub(crate) fn results(
         }
         let forces = force_statistics(force, samples, statistic, &weights, column);
         warnings.extend(limit_warnings(job, force, samples, series, statistic, column, k));
-        // With the force model only, so that answers without it stay as they were.
-        let tooth_passing_hz = force.is_some().then(|| tooth_passing_hz(job.spindle_rpm, k));
-        if let Some((natural, axis)) = tooth_passing_hz.and_then(|f| resonance(f, &job.natural)) {
-            warnings.push(Warning::new(
-                "W_TOOTH_PASSING",
-                format!(
-                    "k = {k}: the tooth-passing frequency {:.1} Hz (N·k/60) lies within {:.0} % of the tool's natural frequency {natural} Hz ({axis}): forced vibration; change the spindle speed",
-                    tooth_passing_hz.unwrap_or(0.0),
-                    RESONANCE_BAND * 100.0
-                ),
-            ));
-        }
+        let tooth_passing_hz = tooth_passing(job, force, k, &mut warnings);
         let max_teeth = teeth.iter().zip(statistic).filter(|(_, s)| **s).map(|(&n, _)| n).max().unwrap_or(0);
         results.push(FluteResult {
             flute_count: k,
@@ -125,9 +101,9 @@ pub(crate) fn results(
             min_thickness: min,
             median_thickness: median,
             time_s,
-            recommended,
-            thickness_margin,
-            time_margin_s,
+            recommended: verdict.recommended,
+            thickness_margin: verdict.thickness_margin,
+            time_margin_s: verdict.time_margin_s,
             max_teeth,
             multi_tooth_intervals,
             mean_torque_nm: forces.map(|f| f.0),
@@ -138,6 +114,57 @@ pub(crate) fn results(
             tooth_passing_hz,
         });
     }
+    let recommended = recommendation(job, &results, &failures, &mut warnings);
+    (results, recommended, warnings)
+}
+
+/// Whether flute count `k` meets the limits (§5.9) with its representative thickness and its
+/// time: the margins, the verdict, and why it fails.
+struct Verdict {
+    thickness_margin: Option<f64>,
+    time_margin_s: Option<f64>,
+    recommended: bool,
+    /// "k = …: thickness … > …, time … > …" when a limit is missed.
+    failure: Option<String>,
+}
+
+fn verdict(job: &Job, k: u32, representative: f64, time_s: f64) -> Verdict {
+    let thickness_margin = job.thickness_limit.map(|limit| limit - representative);
+    let time_margin_s = job.time_limit.map(|limit| limit - time_s);
+    let thickness_ok = job.thickness_limit.is_none_or(|limit| representative <= limit * (1.0 + LIMIT_SLACK));
+    let time_ok = job.time_limit.is_none_or(|limit| time_s <= limit * (1.0 + LIMIT_SLACK));
+    let recommended = (job.thickness_limit.is_some() || job.time_limit.is_some()) && thickness_ok && time_ok;
+    let mut reasons = Vec::new();
+    if let (false, Some(limit)) = (thickness_ok, job.thickness_limit) {
+        reasons.push(format!("thickness {representative:.6} mm > {limit} mm"));
+    }
+    if let (false, Some(limit)) = (time_ok, job.time_limit) {
+        reasons.push(format!("time {time_s:.4} s > {limit} s"));
+    }
+    let failure = (!reasons.is_empty()).then(|| format!("k = {k}: {}", reasons.join(", ")));
+    Verdict { thickness_margin, time_margin_s, recommended, failure }
+}
+
+/// The tooth-passing frequency of `k` flutes, with the force model only (so that answers
+/// without it stay as they were), and `W_TOOTH_PASSING` near a natural frequency of the tool.
+fn tooth_passing(job: &Job, force: Option<&ForceModel>, k: u32, warnings: &mut Vec<Warning>) -> Option<f64> {
+    let tooth_passing_hz = force.is_some().then(|| tooth_passing_hz(job.spindle_rpm, k));
+    if let Some((natural, axis)) = tooth_passing_hz.and_then(|f| resonance(f, &job.natural)) {
+        warnings.push(Warning::new(
+            "W_TOOTH_PASSING",
+            format!(
+                "k = {k}: the tooth-passing frequency {:.1} Hz (N·k/60) lies within {:.0} % of the tool's natural frequency {natural} Hz ({axis}): forced vibration; change the spindle speed",
+                tooth_passing_hz.unwrap_or(0.0),
+                RESONANCE_BAND * 100.0
+            ),
+        ));
+    }
+    tooth_passing_hz
+}
+
+/// The recommended flute counts, fastest first (§5.9), with `W_THRESHOLD_MISSING` for a limit
+/// not given and `W_NO_RECOMMENDATION` (listing `failures`) when none meets them.
+fn recommendation(job: &Job, results: &[FluteResult], failures: &[String], warnings: &mut Vec<Warning>) -> Vec<u32> {
     let mut recommended: Vec<(f64, u32)> =
         results.iter().filter(|r| r.recommended).map(|r| (r.time_s, r.flute_count)).collect();
     recommended.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
@@ -162,7 +189,7 @@ pub(crate) fn results(
             format!("no flute count satisfies the limits: {}", failures.join("; ")),
         ));
     }
-    (results, recommended.into_iter().map(|(_, k)| k).collect(), warnings)
+    recommended.into_iter().map(|(_, k)| k).collect()
 }
 
 /// Length-weighted mean of the phase-mean torque and the largest phase peak over the engaged

@@ -244,43 +244,10 @@ impl ForceModel {
             edges.push(edge(top * index as f64 / CORNER_BANDS as f64)?);
         }
         for _ in 0..MAX_HALVINGS {
-            // Each band's share of the torque width, and the trapezoid's error over it from the
-            // curvature of f(z) = ∫ sin^a over the arcs at z: share·h²·|f''|/12 where f is smooth,
-            // f'' from the divided differences at its edges; taken 6 times larger, since at a
-            // kink (where a wall comes into reach: f = 0 below, √ above) the rule misses up to
-            // share·h²·|f''|/2.
-            let band = |pair: &[Edge]| (pair[1].widths.1 - pair[0].widths.1) / self.torque_width;
-            let total: f64 = edges.windows(2).map(|pair| band(pair) * 0.5 * (pair[0].measure + pair[1].measure)).sum();
-            let limit = TOLERANCE * total.max(1e-9);
-            let bent: Vec<f64> = edges
-                .windows(3)
-                .map(|three| {
-                    let slope = |a: &Edge, b: &Edge| (b.measure - a.measure) / (b.z - a.z);
-                    2.0 * (slope(&three[1], &three[2]) - slope(&three[0], &three[1])).abs() / (three[2].z - three[0].z)
-                })
-                .collect();
-            // At edge i (1 ≤ i ≤ len − 2) the curvature is bent[i − 1]; the outer edges take
-            // their neighbour's.
-            let curvature = |index: usize| bent[index.clamp(1, bent.len()) - 1];
-            let mut split: Vec<(f64, usize)> = edges
-                .windows(2)
-                .enumerate()
-                .map(|(index, pair)| {
-                    let height = pair[1].z - pair[0].z;
-                    let bend = curvature(index).max(curvature(index + 1));
-                    (band(pair) * height * height * bend / 2.0, index)
-                })
-                .filter(|(error, _)| *error > limit)
-                .collect();
-            let room = MAX_SECTIONS.saturating_sub(edges.len());
-            if split.is_empty() || room == 0 {
+            let halve = self.to_halve(&edges);
+            if halve.is_empty() {
                 break;
             }
-            // The largest changes first, as many as there is room for.
-            split.sort_by(|a, b| b.0.total_cmp(&a.0));
-            split.truncate(room);
-            let mut halve: Vec<usize> = split.into_iter().map(|(_, index)| index).collect();
-            halve.sort_unstable();
             let mut middles = Vec::with_capacity(halve.len());
             for &index in &halve {
                 middles.push(edge(0.5 * (edges[index].z + edges[index + 1].z))?);
@@ -295,6 +262,57 @@ impl ForceModel {
             }
             edges = refined;
         }
+        Ok(Some(Bands::new(self.sections(edges, full, feed))))
+    }
+
+    /// The bands among `edges` to halve (their lower edges' indices, rising): those whose
+    /// trapezoid error exceeds the tolerance, the largest first as far as [`MAX_SECTIONS`]
+    /// leaves room; none when all are within it.
+    fn to_halve(&self, edges: &[Edge]) -> Vec<usize> {
+        // Each band's share of the torque width, and the trapezoid's error over it from the
+        // curvature of f(z) = ∫ sin^a over the arcs at z: share·h²·|f''|/12 where f is smooth,
+        // f'' from the divided differences at its edges; taken 6 times larger, since at a
+        // kink (where a wall comes into reach: f = 0 below, √ above) the rule misses up to
+        // share·h²·|f''|/2.
+        let band = |pair: &[Edge]| (pair[1].widths.1 - pair[0].widths.1) / self.torque_width;
+        let total: f64 = edges.windows(2).map(|pair| band(pair) * 0.5 * (pair[0].measure + pair[1].measure)).sum();
+        let limit = TOLERANCE * total.max(1e-9);
+        let bent: Vec<f64> = edges
+            .windows(3)
+            .map(|three| {
+                let slope = |a: &Edge, b: &Edge| (b.measure - a.measure) / (b.z - a.z);
+                2.0 * (slope(&three[1], &three[2]) - slope(&three[0], &three[1])).abs() / (three[2].z - three[0].z)
+            })
+            .collect();
+        // At edge i (1 ≤ i ≤ len − 2) the curvature is bent[i − 1]; the outer edges take
+        // their neighbour's.
+        let curvature = |index: usize| bent[index.clamp(1, bent.len()) - 1];
+        let mut split: Vec<(f64, usize)> = edges
+            .windows(2)
+            .enumerate()
+            .map(|(index, pair)| {
+                let height = pair[1].z - pair[0].z;
+                let bend = curvature(index).max(curvature(index + 1));
+                (band(pair) * height * height * bend / 2.0, index)
+            })
+            .filter(|(error, _)| *error > limit)
+            .collect();
+        let room = MAX_SECTIONS.saturating_sub(edges.len());
+        if split.is_empty() || room == 0 {
+            return Vec::new();
+        }
+        // The largest changes first, as many as there is room for.
+        split.sort_by(|a, b| b.0.total_cmp(&a.0));
+        split.truncate(room);
+        let mut halve: Vec<usize> = split.into_iter().map(|(_, index)| index).collect();
+        halve.sort_unstable();
+        halve
+    }
+
+    /// The sections of the end from its refined edges: each edge with half of each neighbouring
+    /// band's widths (the trapezoid rule), and above the corner the straight flank at the full
+    /// radius's arcs.
+    fn sections(&self, mut edges: Vec<Edge>, full: &[Arc], feed: impl Fn(f64) -> Option<ArcFeed>) -> Vec<Section> {
         let (force_width, torque_width) = (self.force_width, self.torque_width);
         let mut sections = Vec::with_capacity(edges.len() + 1);
         for index in 0..edges.len() {
@@ -327,61 +345,6 @@ impl ForceModel {
                 feed: feed(self.radius),
             });
         }
-        Ok(Some(Bands::new(sections)))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn tabulated_loads_are_the_power_of_the_sine() {
-        for exponent in [0.6, 0.75, 1.0] {
-            let loads = Loads::new(exponent);
-            for step in 0..=36_000 {
-                let theta = -180.0 + 0.0137 * f64::from(step);
-                let exact = theta.to_radians().sin().max(0.0).powf(exponent);
-                assert!((loads.power(theta) - exact).abs() <= 3e-7 * exact, "{exponent} {theta}");
-            }
-        }
-    }
-
-    #[test]
-    fn stacked_shares_follow_the_closed_arcs() {
-        let sections = [
-            Section {
-                torque_share: 0.25,
-                force_share: 0.5,
-                arcs: vec![Arc { from: 0.0, to: 180.0 }],
-                ..Section::default()
-            },
-            Section {
-                torque_share: 0.75,
-                force_share: 0.5,
-                arcs: vec![Arc { from: 90.0, to: 200.0 }],
-                ..Section::default()
-            },
-        ];
-        let stack = Stack::new(&sections);
-        assert_eq!(stack.weight(-10.0), (0.0, 0.0));
-        assert_eq!(stack.weight(0.0), (0.25, 0.5));
-        assert_eq!(stack.weight(45.0), (0.25, 0.5));
-        assert_eq!(stack.weight(90.0), (1.0, 1.0));
-        assert_eq!(stack.weight(180.0), (1.0, 1.0));
-        // 190° is −170°: only the second arc, across ±180°.
-        assert_eq!(stack.weight(190.0), (0.75, 0.5));
-        assert_eq!(stack.weight(-165.0), (0.75, 0.5));
-        assert_eq!(stack.weight(-150.0), (0.0, 0.0));
-        // Every angle the sections' own test accepts, and no other.
-        for step in 0..3600 {
-            let theta = -180.0 + f64::from(step) * 0.1;
-            let expected = sections
-                .iter()
-                .filter(|s| s.arcs.iter().any(|a| a.contains(theta, END_TOLERANCE)))
-                .fold((0.0, 0.0), |(t, f), s| (t + s.torque_share, f + s.force_share));
-            let got = stack.weight(theta);
-            assert!((got.0 - expected.0).abs() < 1e-12 && (got.1 - expected.1).abs() < 1e-12, "{theta}: {got:?}");
-        }
+        sections
     }
 }

@@ -1,64 +1,8 @@
-//! Kienzle's cutting-force law and the integral of its chip-thickness term over the tool circle
-//! (docs/spec/engagement.md §11 item 4): F_t = k_c1.1·b·h^(1−m_c) with h = f_z·sin θ, so every force,
-//! torque and power of a tooth is a multiple of max(0, sin θ)^(1−m_c) and every mean over the
-//! tooth phase a multiple of its integral over the engaged arcs.
-
-use serde::{Deserialize, Serialize};
-
-use crate::error::SolverError;
-
-use crate::validate::positive_at_most;
-
-/// Kienzle's specific cutting force of a work material (docs/spec/engagement.md §11 item 4): the
-/// tangential force on one tooth is `kc11 · a_p · h^(1 − mc)` for a chip of thickness h and
-/// width a_p (mm).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
-#[serde(deny_unknown_fields)]
-pub struct Kienzle {
-    /// k_c1.1: specific cutting force at h = 1 mm and b = 1 mm, N/mm² (0 < k_c1.1 ≤ 20 000; e.g.
-    /// about 2200 for a plain carbon steel, 700 for an aluminium alloy).
-    pub kc11: f64,
-    /// m_c: Kienzle's exponent (0 ≤ m_c < 1; typically 0.15–0.3).
-    pub mc: f64,
-    /// F_r/F_t, the radial force of a tooth as a share of its tangential force (≥ 0; default
-    /// [`DEFAULT_RADIAL_RATIO`]); it enters only the resultant force on the tool.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub radial_ratio: Option<f64>,
-}
-
-/// F_r/F_t when `radial_ratio` is not given: a middle value of the 0.2–0.5 that sharp end mills
-/// show; give the measured ratio of the tool and material where it matters.
-pub const DEFAULT_RADIAL_RATIO: f64 = 0.3;
-
-/// Largest k_c1.1 accepted, N/mm²: hardened steels reach about 5000; a larger value is a unit
-/// mistake (N/m², or MPa at another chip size).
-pub const MAX_KC11: f64 = 20_000.0;
-
-impl Kienzle {
-    /// Checks the values, naming fields under `prefix` (e.g. `kienzle.`).
-    ///
-    /// # Errors
-    /// `E_INPUT` when `kc11` is not in (0, [`MAX_KC11`]] or `mc` is outside [0, 1).
-    pub fn validate(&self, prefix: &str) -> Result<(), SolverError> {
-        positive_at_most(&format!("{prefix}kc11"), self.kc11, MAX_KC11)?;
-        if !(self.mc.is_finite() && (0.0..1.0).contains(&self.mc)) {
-            return Err(SolverError::input(
-                format!("{prefix}mc"),
-                format!("mc must be at least 0 and below 1 (got {})", self.mc),
-            ));
-        }
-        if let Some(ratio) = self.radial_ratio
-            && !(ratio.is_finite() && (0.0..=10.0).contains(&ratio))
-        {
-            return Err(SolverError::input(
-                format!("{prefix}radial_ratio"),
-                format!("radial_ratio must be in [0, 10] (got {ratio})"),
-            ));
-        }
-        Ok(())
-    }
-}
+//! The integral of Kienzle's chip-thickness term over the tool circle (docs/spec/engagement.md §11
+//! item 4): F_t = k_c1.1·b·h^(1−m_c) with h = f_z·sin θ, so every force, torque and power of a
+//! tooth is a multiple of max(0, sin θ)^(1−m_c) and every mean over the tooth phase a multiple of
+//! its integral over the engaged arcs. The law's values themselves, [`crate::material::Kienzle`],
+//! belong to the work material.
 
 /// Cells of the table over [0, π/2]: the interpolation error is below 1e-10 of the integral.
 const CELLS: usize = 2048;

@@ -1,66 +1,12 @@
-//! What the machine and the tool allow (docs/spec/engagement.md §11 items 4 and 9): the spindle's power
-//! and torque against the cut's torque, and the tooth-passing frequency N·k/60 against the
-//! tool's natural frequencies.
-
-use serde::{Deserialize, Serialize};
-
-use crate::error::SolverError;
+//! What the tool allows (docs/spec/engagement.md §11 item 9): the tooth-passing frequency N·k/60
+//! against the tool's natural frequencies. The spindle's power and torque limits (§11 item 4) are
+//! the machine's, [`crate::machine::SpindleLimits`].
 
 use crate::tool::{Stiffness, Tool};
-use crate::validate::positive;
 
 /// Relative distance of the tooth-passing frequency from a natural frequency that is warned
 /// about ("within 5 %").
 pub const RESONANCE_BAND: f64 = 0.05;
-
-/// The spindle's ratings, from the machine profile (docs/spec/engagement.md §11 item 4). The cut is
-/// compared through its torque averaged over the tooth phase: that is the load the spindle
-/// drive carries, its rotor's inertia smoothing the tooth-by-tooth peaks.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
-#[serde(deny_unknown_fields)]
-pub struct SpindleLimits {
-    /// Rated spindle power, kW (> 0).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub spindle_power_kw: Option<f64>,
-    /// Rated spindle torque, N·m (> 0).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub spindle_torque_nm: Option<f64>,
-}
-
-impl SpindleLimits {
-    /// Checks both values, naming the fields as in a machine profile.
-    ///
-    /// # Errors
-    /// `E_INPUT` for a value that is not positive and finite.
-    pub fn validate(&self) -> Result<(), SolverError> {
-        if let Some(power) = self.spindle_power_kw {
-            positive("spindle_power_kw", power)?;
-        }
-        if let Some(torque) = self.spindle_torque_nm {
-            positive("spindle_torque_nm", torque)?;
-        }
-        Ok(())
-    }
-
-    /// Whether either limit is given.
-    pub fn any(&self) -> bool {
-        self.spindle_power_kw.is_some() || self.spindle_torque_nm.is_some()
-    }
-
-    /// The largest phase-mean torque both limits allow at `spindle_rpm`, N·m, and whether power
-    /// (rather than torque) sets it.
-    pub(crate) fn torque_cap(&self, spindle_rpm: f64) -> Option<(f64, bool)> {
-        // P = 2πN·M/60 ⇒ M = 60·P/(2πN), P in W.
-        let from_power = self.spindle_power_kw.map(|p| 60.0 * p * 1000.0 / (std::f64::consts::TAU * spindle_rpm));
-        match (from_power, self.spindle_torque_nm) {
-            (Some(p), Some(t)) => Some(if p <= t { (p, true) } else { (t, false) }),
-            (Some(p), None) => Some((p, true)),
-            (None, Some(t)) => Some((t, false)),
-            (None, None) => None,
-        }
-    }
-}
 
 /// The tool's natural frequencies, Hz, with the direction they belong to: every mode of a modal
 /// stiffness; for a measured table the frequency of its largest compliance; none for a static
@@ -96,6 +42,7 @@ pub(crate) fn resonance(passing_hz: f64, natural: &[(f64, &'static str)]) -> Opt
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::machine::SpindleLimits;
 
     #[test]
     fn power_and_torque_caps() {

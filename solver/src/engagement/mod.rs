@@ -18,14 +18,18 @@
 //! * `dots`: engine A, the patent's dot removal (§5.3.2);
 //! * `arcs`: arc merging, a_e and the per-arc quantities (§5.4, §5.5, §5.10);
 //! * `teeth`: H_k and n_k with the exact phase maximisation (§5.6);
+//! * `contact`: each sample's contact from the chosen engine;
+//! * `evaluate`, `diagnostics`: one path end to end, and its warnings (§5, §9);
 //! * `flutes`: representative values, time, recommendation (§5.7–§5.9);
 //! * `feed`: chip-thinning feed plan (§11 item 3), capped by the spindle's power and torque;
-//! * `kienzle`, `force`: Kienzle's law, spindle torque and power with the helix lag (§11 items
-//!   4, 5); `heights`: a ball or bull end's engagement by height;
+//! * `kienzle`, `force`: Kienzle's law (its values are the work material's,
+//!   [`crate::material::Kienzle`]), spindle torque and power with the helix lag (§11 items 4, 5);
+//!   `heights`: a ball or bull end's engagement by height;
 //! * `arcfeed`: the arc-feed correction of the chip thickness on curved paths (§11 item 6);
 //! * `phase`: the phase maximum of a general per-tooth load;
-//! * `limits`: the spindle's ratings and the tooth-passing frequency against the tool's natural
-//!   frequencies (§11 items 4, 9);
+//! * `limits`: the tooth-passing frequency against the tool's natural frequencies (§11 item 9);
+//!   the spindle's ratings it checks the torque against are the machine's
+//!   ([`crate::machine::SpindleLimits`], §11 item 4);
 //! * [`program()`]: G-code with the planned F words.
 //!
 //! Choices where the spec is open (§13): `cw` rotation by default; constant f_z when
@@ -56,6 +60,8 @@ mod arcfeed;
 mod arcs;
 mod bbox_tree;
 mod capability;
+mod contact;
+mod diagnostics;
 mod dots;
 mod evaluate;
 mod exact;
@@ -84,8 +90,7 @@ pub use answer::{
 };
 pub use arcs::{MillingMode, SpindleDirection};
 pub use capability::{EngagementAnswer, EngagementCapability};
-pub use kienzle::{DEFAULT_RADIAL_RATIO, Kienzle, MAX_KC11};
-pub use limits::{RESONANCE_BAND, SpindleLimits};
+pub use limits::RESONANCE_BAND;
 pub use program::program;
 pub use request::{
     Candidate, EngagementRequest, Engine, FeedBasis, FeedPlanRequest, PathInput, PathSegments, PreviousCut,

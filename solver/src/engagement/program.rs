@@ -105,9 +105,10 @@ pub fn program(answer: &EngagementSolution, candidate: usize, post: &Post) -> Re
     }))
 }
 
-/// The cycle time of candidate `candidate`'s chord program on a machine with `dynamics` (issue
-/// 15, item 4): one tool change, plunges in the air at the plunge feed, the final retract. `None` when the answer
-/// has no program (no `axial_depth`, no such candidate).
+/// The cycle time of candidate `candidate`'s chord program on a machine with `dynamics`
+/// (docs/spec/engagement.md §11 item 7): one tool change, plunges in the air at the plunge feed,
+/// the final retract, so the time is the program's as the control runs it. `None` when the
+/// answer has no program (no `axial_depth`, no such candidate).
 pub(crate) fn cycle_time(
     answer: &EngagementSolution,
     candidate: usize,

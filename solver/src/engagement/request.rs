@@ -8,7 +8,7 @@ use serde::de::{self, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize};
 
 use super::arcs::SpindleDirection;
-use super::kienzle::Kienzle;
+use crate::material::Kienzle;
 use crate::tool::ToolRef;
 
 /// One move of a path given as `start` + `segments` (docs/spec/engagement.md §2.3).

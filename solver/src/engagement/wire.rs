@@ -1,4 +1,5 @@
-//! The engagement answer as JSON, byte for byte what `serde_json::to_vec` writes, but cheaper:
+//! The engagement answer as JSON (docs/spec/engagement.md §3), byte for byte what
+//! `serde_json::to_vec` writes, but cheaper:
 //! the samples, nearly all of the 40 MB of a 1 m path at 0.01 mm, are written
 //! by hand straight into one pre-sized buffer; the rest of the answer, a few kilobytes, still
 //! goes through serde.

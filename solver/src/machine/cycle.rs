@@ -1,4 +1,5 @@
-//! The cycle time a control would take: every move runs a trapezoidal feed
+//! The cycle time a control would take (docs/spec/api.md, Machines; docs/spec/engagement.md §11
+//! item 7): every move runs a trapezoidal feed
 //! profile limited by its feed and the machine's acceleration, stopping at sharp vertices and
 //! where rapids begin and end; a block never takes less than the block time; rapids run at the
 //! rapid feed; a tool change adds its time. The breakdown separates cutting, air (feed moves the

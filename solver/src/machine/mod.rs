@@ -1,14 +1,16 @@
 //! Controller profiles (docs/spec/api.md, Machines; docs/spec/segment.md §2.1, §6.4): the block processing time and
 //! limits of one control, stored by the server and used as defaults by any request that names it;
 //! the block-time rule that turns them into chord errors ([`rule`]) and the block statistics of a
-//! path ([`stats`]). Every path-emitting capability uses them: segment, deburr, contour,
-//! engagement.
+//! path ([`stats`]); the spindle's ratings ([`SpindleLimits`], docs/spec/engagement.md §11 item 4).
+//! Every path-emitting capability uses them: segment, deburr, contour, engagement.
 
 pub mod cycle;
 pub mod rule;
+mod spindle;
 pub mod stats;
 
-pub use rule::{BlockRule, ChordStatus, Infeasible, RuleSettings, block_time_from_saturation, chord_length};
+pub use rule::{BlockRule, ChordStatus, Infeasible, Mode, RuleSettings, block_time_from_saturation, chord_length};
+pub use spindle::SpindleLimits;
 pub use stats::{BlockStats, PathBlocks, block_stats, path_blocks, short_block_warning};
 
 use serde::{Deserialize, Serialize};
@@ -58,7 +60,7 @@ pub struct MachineProfile {
     /// `window` (the patent's, default), `curve` or `guarantee` (no block shorter than the control
     /// needs, docs/spec/segment.md §2.9a).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub mode: Option<crate::segment::Mode>,
+    pub mode: Option<Mode>,
     /// Rated spindle power, kW (> 0): engagement with Kienzle values warns where the cut needs
     /// more and its feed plan caps the feed to stay within it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -110,24 +112,21 @@ impl MachineProfile {
     }
 
     /// The spindle's rated power and torque, as engagement checks a cut against them.
-    pub fn spindle(&self) -> crate::engagement::SpindleLimits {
-        crate::engagement::SpindleLimits {
-            spindle_power_kw: self.spindle_power_kw,
-            spindle_torque_nm: self.spindle_torque_nm,
-        }
+    pub fn spindle(&self) -> SpindleLimits {
+        SpindleLimits { spindle_power_kw: self.spindle_power_kw, spindle_torque_nm: self.spindle_torque_nm }
     }
 
     /// The spindle's limits at `spindle_rpm`: the rated power, lowered to the power curve's
     /// value at that speed when the profile has a curve (a speed that is not a positive finite
     /// number, which the request's validation refuses, gets the rated values).
-    pub fn spindle_at(&self, spindle_rpm: f64) -> crate::engagement::SpindleLimits {
+    pub fn spindle_at(&self, spindle_rpm: f64) -> SpindleLimits {
         let rated = self.spindle();
         let Some(curve) = self.spindle_power_curve.as_deref().filter(|c| !c.is_empty()) else { return rated };
         if !(spindle_rpm.is_finite() && spindle_rpm > 0.0) {
             return rated;
         }
         let on_curve = power_on_curve(curve, spindle_rpm);
-        crate::engagement::SpindleLimits {
+        SpindleLimits {
             spindle_power_kw: Some(rated.spindle_power_kw.map_or(on_curve, |power| power.min(on_curve))),
             ..rated
         }

@@ -5,9 +5,29 @@
 //! of sagitta C_ep on a circle of radius r is exactly `k_f·F·T_b/60000` long, so a polyline cut
 //! with C_ep never asks the control for a block shorter than it can digest at feed F.
 
+use serde::{Deserialize, Serialize};
+
 use super::MachineProfile;
 use crate::error::{SolverError, Warning};
 use crate::validate::{finite, non_negative, positive};
+
+/// Where the chord error comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+// Named apart from the tool's vibration mode in the OpenAPI document.
+#[cfg_attr(feature = "schema", schema(as = SegmentMode))]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    /// Per curvature window of length `window` (embodiments 1, 2 and 6; Fig. 7).
+    #[default]
+    Window,
+    /// One value for the whole curve by `rule` (embodiments 3–5).
+    Curve,
+    /// Each chord's error from the smallest radius of curvature along it (docs/spec/segment.md §2.9a,
+    /// revision 2): no block but a span's final remainder is shorter than margin × feed ×
+    /// block time.
+    Guarantee,
+}
 
 /// Milliseconds per minute: `F·T_b/MS_PER_MIN` is the distance (mm) travelled in one block time.
 pub const MS_PER_MIN: f64 = 60_000.0;

@@ -8,13 +8,13 @@ use super::cut::Estimate;
 use super::nurbs::Nurbs;
 use super::request::{
     Curve, CurveRule, DEFAULT_CORNER_ANGLE_DEG, DEFAULT_SPINDLE_RPM, DEFAULT_WINDOW_CHORDS, Direction, MAX_COORDINATE,
-    MAX_POLYLINE_POINTS, MIN_TOLERANCE, Mode, RadiusEstimate, SegmentRequest,
+    MAX_POLYLINE_POINTS, MIN_TOLERANCE, RadiusEstimate, SegmentRequest,
 };
 use super::shape::{Arc, Ellipse, Polyline, Shape, Spline, ellipse_speed, require_length};
 use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
-use crate::machine::MachineProfile;
 use crate::machine::rule::{BlockRule, RuleSettings};
+use crate::machine::{MachineProfile, Mode};
 use crate::validate::{finite, positive};
 
 /// Where the chord error comes from, resolved.

@@ -90,7 +90,7 @@ pub use capability::{SegmentAnswer, SegmentCapability};
 pub use nurbs::{MAX_CONTROL_POINTS, MAX_DEGREE};
 pub(crate) use program::cycle_time;
 pub use program::program;
-pub use request::{Curve, CurveRule, Direction, Mode, RadiusEstimate, SegmentRequest};
+pub use request::{Curve, CurveRule, Direction, RadiusEstimate, SegmentRequest};
 
 use crate::capability::Control;
 use crate::error::ErrorCode;

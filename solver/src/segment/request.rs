@@ -4,6 +4,7 @@
 pub use crate::geometry::Direction;
 use serde::{Deserialize, Serialize};
 
+use crate::machine::Mode;
 use crate::tool::ToolRef;
 
 /// Most polyline points accepted.
@@ -102,24 +103,6 @@ pub enum Curve {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         corner_angle_deg: Option<f64>,
     },
-}
-
-/// Where the chord error comes from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
-// Named apart from the tool's vibration mode in the OpenAPI document.
-#[cfg_attr(feature = "schema", schema(as = SegmentMode))]
-#[serde(rename_all = "snake_case")]
-pub enum Mode {
-    /// Per curvature window of length `window` (embodiments 1, 2 and 6; Fig. 7).
-    #[default]
-    Window,
-    /// One value for the whole curve by `rule` (embodiments 3–5).
-    Curve,
-    /// Each chord's error from the smallest radius of curvature along it (docs/spec/segment.md §2.9a,
-    /// revision 2): no block but a span's final remainder is shorter than margin × feed ×
-    /// block time.
-    Guarantee,
 }
 
 /// The whole-curve rule of `mode: curve`.

@@ -6,9 +6,9 @@
 
 use std::f64::consts::{PI, TAU};
 
-use kerf_solver::engagement::{
-    self, EngagementRequest, EngagementSolution, FeedLimit, Kienzle, PathEngagement, Physics, SpindleLimits,
-};
+use kerf_solver::engagement::{self, EngagementRequest, EngagementSolution, FeedLimit, PathEngagement, Physics};
+use kerf_solver::machine::SpindleLimits;
+use kerf_solver::material::{self, Kienzle};
 use kerf_solver::tool::{Mode, Stiffness, Tool, ToolKind};
 use proptest::prelude::*;
 use serde_json::{Value, json};
@@ -140,7 +140,7 @@ fn full_slot_peak_force_is_the_largest_resultant() {
     }
     // Without radial_ratio the default applies.
     let forces = solve(slot(mc, &[2])).forces.unwrap();
-    assert_eq!(forces.radial_ratio, engagement::DEFAULT_RADIAL_RATIO);
+    assert_eq!(forces.radial_ratio, material::DEFAULT_RADIAL_RATIO);
 }
 
 #[test]

@@ -9,11 +9,10 @@
 
 use std::f64::consts::{PI, TAU};
 
-use kerf_solver::engagement::{
-    self, EngagementRequest, EngagementSample, EngagementSolution, PathEngagement, Physics, SpindleLimits,
-};
+use kerf_solver::engagement::{self, EngagementRequest, EngagementSample, EngagementSolution, PathEngagement, Physics};
 use kerf_solver::error::SolverError;
 use kerf_solver::gcode::{Dialect, Post, Reference, ToolCall};
+use kerf_solver::machine::SpindleLimits;
 use kerf_solver::tool::{Tool, ToolKind};
 use proptest::prelude::*;
 use serde_json::{Value, json};
