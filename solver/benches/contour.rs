@@ -86,7 +86,7 @@ fn fixture_request(case: &Value, loops: bool, controller: Option<ControllerModel
     (request, Tool::new(ToolKind::Flat, radius))
 }
 
-/// The with/without-loops material table of the issue, printed once: per corner of the final
+/// The with/without-loops material table, printed once: per corner of the final
 /// pass, material left / over-cut (mm²) with loops, and without loops as miter or round joins,
 /// ideal and under M1 (blend radius ρ_b: 1.5 mm for C1 as in docs/spec/contour.md §3.10, 1 mm for C2 as in
 /// its case, 3 mm for C3) and M2 (servo T = 31.62 ms at 600 mm/min: Δ = 0.05 mm on a 1 mm arc).

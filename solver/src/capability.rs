@@ -131,7 +131,7 @@ pub trait Capability {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sizing {
     /// The work one part should hold, in seconds of one core of the reference machine (the
-    /// capabilities' cost models are measured on it; README, "More than one machine").
+    /// capabilities' cost models are measured on it; docs/guide/performance.md, "Split cost models").
     pub part_seconds: f64,
     /// The most parts one request is split into.
     pub max_parts: usize,

@@ -1,5 +1,5 @@
 //! The measurements behind the capabilities' cost models (how a job's operation is cut
-//! into parts; README "More than one machine"): core-seconds on one thread (CPU time, so a shared
+//! into parts; docs/guide/performance.md, "Split cost models"): core-seconds on one thread (CPU time, so a shared
 //! machine's load matters less than to wall time) of the work a split request's parts and finish
 //! step do. A measurement, not a test; run one section or all:
 //!
@@ -8,7 +8,7 @@
 //! cargo run -p kerf-solver --example cost_model -- ratio contour deburr   # debug build
 //! ```
 //!
-//! `ratio` times one predict case whose release figure the README gives (0.81 ms per pass,
+//! `ratio` times one predict case whose release figure docs/guide/performance.md gives (0.81 ms per pass,
 //! sampling, N = 256, 4 passes per mm²), so figures measured in a debug build can be scaled to a
 //! release build's: the contour and deburr constants were measured that way.
 
@@ -67,7 +67,7 @@ fn predict_seconds(pool: &rayon::ThreadPool, request: &PredictRequest, tool: &To
 }
 
 /// The debug/release ratio: predict's sampling pass at N = 256, pick 0.5 mm, whose release
-/// figure is 0.81 ms (README), on a smaller raster (the passes around each one are as many).
+/// figure is 0.81 ms (docs/guide/performance.md), on a smaller raster (the passes around each one are as many).
 fn ratio(pool: &rayon::ThreadPool) {
     let (mut request, tool, moves) = support::raster_request(40.0, 0.5, 0.5, Method::Sampling, 256);
     let (middle, slice) = (moves / 2, 200);

@@ -12,8 +12,7 @@ use kerf_solver::{ErrorCode, SolverError};
 use serde::de::DeserializeOwned;
 
 /// Core-seconds of work per part, by default: a part takes a few seconds on a worker (about 5 s
-/// on a 2-core worker running one chunk at a time, 10 s running two: README, "More than one
-/// machine").
+/// on a 2-core worker running one chunk at a time, 10 s running two: docs/guide/performance.md, "Split cost models").
 pub const PART_SECONDS: f64 = 8.0;
 /// Most parts one operation is split into.
 pub const MAX_PARTS: usize = 1000;
@@ -23,7 +22,7 @@ pub const PART_SECONDS_VARIABLE: &str = "KERF_JOB_PART_S";
 
 /// How large parts are: about [`PART_SECONDS`] core-seconds of the reference machine each (or
 /// `KERF_JOB_PART_S`), at most [`MAX_PARTS`] per operation. The capabilities' cost models
-/// (README, "More than one machine") turn a request into core-seconds.
+/// (docs/guide/performance.md, "Split cost models") turn a request into core-seconds.
 pub fn sizing() -> Sizing {
     static PART: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
     let part_seconds = *PART.get_or_init(|| {

@@ -16,7 +16,7 @@ use crate::tool::Tool;
 
 /// Core-seconds to plan one corner of one pass of a layer (offsets, corner actions, gouge and
 /// stock checks): measured 2.5·10⁻⁵ and 2.8·10⁻⁵ on stars of 100 and 400 corners, two passes,
-/// tilted walls (every layer planned), less the layers' moves (README "More than one machine",
+/// tilted walls (every layer planned), less the layers' moves (docs/guide/performance.md, "Split cost models",
 /// `tests/load/cost_model.rs`).
 const PLAN_SECONDS: f64 = 2.7e-5;
 /// Core-seconds to make one move of a layer from its plan (chording, leads, links): measured

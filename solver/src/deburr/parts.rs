@@ -16,7 +16,7 @@ use crate::tool::Tool;
 
 /// Core-seconds of one loop besides its points (validation, profile, leads, checks) and per
 /// point, by method: fitted to loops of 32, 64 and 164 points (tangent 0.33, 0.83 and 2.0 ms;
-/// exact 1.2, 2.0 and 3.0 ms; README "More than one machine", `tests/load/cost_model.rs`).
+/// exact 1.2, 2.0 and 3.0 ms; docs/guide/performance.md, "Split cost models", `tests/load/cost_model.rs`).
 const TANGENT_LOOP_SECONDS: f64 = 5.0e-5;
 /// See [`TANGENT_LOOP_SECONDS`].
 const EXACT_LOOP_SECONDS: f64 = 7.0e-4;

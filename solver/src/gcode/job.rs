@@ -1,4 +1,4 @@
-//! One program per job (docs/spec/api.md Jobs; README "One program per job"): the programs of a
+//! One program per job (docs/spec/api.md Jobs; docs/guide/jobs.md): the programs of a
 //! job's operations, each written by [`super::write`], joined into one program a control runs from
 //! start to end: one program number, one header listing the operations with their tools and
 //! estimated times, each operation with its tool change, spindle and coolant, a retract to the

@@ -1,5 +1,5 @@
 //! G-code posts: turns a [`Toolpath`] into a complete program for a Fanuc-style control or
-//! LinuxCNC (docs/spec/api.md, G-code conventions; README "G-code conventions").
+//! LinuxCNC (docs/spec/api.md, G-code conventions; docs/guide/gcode.md).
 //!
 //! Both dialects print every coordinate with 4 decimals in mm (never `-0.0000`), absolute mode,
 //! feed per minute, and start with a safety line, the tool change with its length offset and the

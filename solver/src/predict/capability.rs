@@ -236,8 +236,7 @@ fn mismatch(detail: String) -> SolverError {
     SolverError::new(ErrorCode::Internal, format!("the parts do not belong to this prediction: {detail}"))
 }
 
-/// What a prediction costs, in core-seconds of the reference machine (README, "More than one
-/// machine": measured by `tests/load/cost_model.rs`, section `predict`, one thread, CPU time).
+/// What a prediction costs, in core-seconds of the reference machine (docs/guide/performance.md, "Split cost models": measured by `tests/load/cost_model.rs`, section `predict`, one thread, CPU time).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Cost {
     /// Per predicted pass.

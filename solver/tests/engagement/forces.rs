@@ -74,7 +74,7 @@ fn full_slot_mean_torque_is_the_closed_form() {
             // N·mm → N·m.
             let expected = k * KC11 * AP * FZ.powf(a) * RADIUS * integral / TAU / 1000.0;
             close_rel(&format!("mc {mc} k {k} mean torque"), flute.mean_torque_nm.unwrap(), expected, 0.005);
-            // Far tighter than the 0.5 %: the table is exact to about 1e-9.
+            // Far tighter than the 0.5 % a machinist needs: the table is exact to about 1e-9.
             close_rel(&format!("mc {mc} k {k} mean torque, tight"), flute.mean_torque_nm.unwrap(), expected, 1e-6);
         }
         if mc == 0.0 {

@@ -1,5 +1,5 @@
-//! Ball and bull-nose ends with the engagement of every height (docs/spec/engagement.md §11 item 5; issue
-//! 16, item 3): each height band of the end takes the engaged arcs of its own section (radius
+//! Ball and bull-nose ends with the engagement of every height (docs/spec/engagement.md §11 item 5):
+//! each height band of the end takes the engaged arcs of its own section (radius
 //! r(z)) against the stock its height has left, and the forces are summed over the bands. A flat
 //! end is unchanged; a full slot deeper than the ball matches an independent quadrature over z;
 //! beside a wall the ball's small sections near the tip do not reach it, so the torque falls
