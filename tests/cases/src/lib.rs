@@ -1,5 +1,5 @@
 //! Test support, shared by the solver's tests, the loopback tests, the benches and the cost
-//! model: the reference cases of `../shared/cases` (copied to `solver/tests/fixtures/`), the few
+//! model: the reference cases of the specs (`solver/tests/fixtures/`, one file per capability), the few
 //! helpers every test reads them with, and the requests the tests build, one builder per request
 //! shape (a module per capability), so no test file keeps its own copy.
 //!
