@@ -348,3 +348,58 @@ impl ForceModel {
         sections
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tabulated_loads_are_the_power_of_the_sine() {
+        for exponent in [0.6, 0.75, 1.0] {
+            let loads = Loads::new(exponent);
+            for step in 0..=36_000 {
+                let theta = -180.0 + 0.0137 * f64::from(step);
+                let exact = theta.to_radians().sin().max(0.0).powf(exponent);
+                assert!((loads.power(theta) - exact).abs() <= 3e-7 * exact, "{exponent} {theta}");
+            }
+        }
+    }
+
+    #[test]
+    fn stacked_shares_follow_the_closed_arcs() {
+        let sections = [
+            Section {
+                torque_share: 0.25,
+                force_share: 0.5,
+                arcs: vec![Arc { from: 0.0, to: 180.0 }],
+                ..Section::default()
+            },
+            Section {
+                torque_share: 0.75,
+                force_share: 0.5,
+                arcs: vec![Arc { from: 90.0, to: 200.0 }],
+                ..Section::default()
+            },
+        ];
+        let stack = Stack::new(&sections);
+        assert_eq!(stack.weight(-10.0), (0.0, 0.0));
+        assert_eq!(stack.weight(0.0), (0.25, 0.5));
+        assert_eq!(stack.weight(45.0), (0.25, 0.5));
+        assert_eq!(stack.weight(90.0), (1.0, 1.0));
+        assert_eq!(stack.weight(180.0), (1.0, 1.0));
+        // 190° is −170°: only the second arc, across ±180°.
+        assert_eq!(stack.weight(190.0), (0.75, 0.5));
+        assert_eq!(stack.weight(-165.0), (0.75, 0.5));
+        assert_eq!(stack.weight(-150.0), (0.0, 0.0));
+        // Every angle the sections' own test accepts, and no other.
+        for step in 0..3600 {
+            let theta = -180.0 + f64::from(step) * 0.1;
+            let expected = sections
+                .iter()
+                .filter(|s| s.arcs.iter().any(|a| a.contains(theta, END_TOLERANCE)))
+                .fold((0.0, 0.0), |(t, f), s| (t + s.torque_share, f + s.force_share));
+            let got = stack.weight(theta);
+            assert!((got.0 - expected.0).abs() < 1e-12 && (got.1 - expected.1).abs() < 1e-12, "{theta}: {got:?}");
+        }
+    }
+}
