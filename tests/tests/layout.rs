@@ -1,4 +1,4 @@
-//! The module layout ARCHITECTURE.md promises, checked on the sources: inside each crate the
+//! The module layout docs/architecture.md promises, checked on the sources: inside each crate the
 //! top-level modules depend on each other without a circle, and the job layer never reaches into
 //! the HTTP layer. A `crate::name` path anywhere in a module's files (outside its `#[cfg(test)]`
 //! part) counts as a dependency on `name`.
