@@ -61,6 +61,27 @@ async function colouredPixels(selector, colour) {
   }, [colour, PIXELS]);
 }
 
+// Every file the page downloads, by name: a refused download must add none.
+const downloads = [];
+page.on('download', (file) => downloads.push(file.suggestedFilename()));
+
+// Clicks a download button: the file's name and text.
+async function downloaded(selector) {
+  const [file] = await Promise.all([page.waitForEvent('download', { timeout: 60000 }), page.click(selector)]);
+  return { name: file.suggestedFilename(), text: readFileSync(await file.path(), 'utf8') };
+}
+
+// Clicks a download button on a form the service (or the page) refuses: the error shown in
+// `messages` (emptied first, so the error is this click's), and no file.
+async function refusedDownload(selector, messages) {
+  const before = downloads.length;
+  await page.$eval(messages, (box) => box.replaceChildren());
+  await page.click(selector);
+  await page.waitForSelector(`${messages} .message.error`, { timeout: 60000 });
+  if (downloads.length !== before) throw new Error(`${selector} downloaded ${downloads.slice(before)} for a refused form`);
+  return page.textContent(`${messages} .message.error`);
+}
+
 const scenarios = {
   // Loads the page, submits the sample deburr job with the button, waits for the 3-D scene: the
   // tube, the hole and the tool are in it; the timeline moves the tool and marks the G-code line
@@ -166,6 +187,13 @@ const scenarios = {
     await page.click('#deburr-compute');
     await page.waitForSelector('#deburr-plot[data-refused="false"]', { timeout: 60000 });
     if (await page.isDisabled('#deburr-gcode')) throw new Error('G-code button still off');
+    // The G-code download: named after the dialect (none chosen, no machine: Fanuc), a Fanuc
+    // program from its first lines to M30.
+    const deburrProgram = await downloaded('#deburr-gcode');
+    const deburrLines = deburrProgram.text.split('\n').slice(0, 2).join(' | ');
+    if (deburrProgram.name !== 'deburr-fanuc.nc' || deburrLines !== '% | O1000 (KERF DEBURR)' || !/^M30$/m.test(deburrProgram.text)) {
+      throw new Error(`deburr download ${deburrProgram.name}: ${deburrProgram.text.slice(0, 300)}`);
+    }
 
     // Both edges in one request, the bore edge with the lollipop: both loops drawn, the summary
     // counts them and the one tool change, and the program changes tools once.
@@ -199,7 +227,11 @@ const scenarios = {
     if (bad.name !== 'hole_radius' || !bad.note || !bad.below || !bad.focused) throw new Error(`field error: ${JSON.stringify(bad)}`);
     const kept = await page.$$eval('#deburr-result.stale #deburr-plot', (l) => l.length);
     if (kept !== 1) throw new Error('the last good result was not kept dimmed');
-    return { segments, inked, objects, firstPlot, note: bad.note };
+    // The G-code button with the bad value: the service's refusal at the field, no file.
+    const deburrRefused = await refusedDownload('#deburr-gcode', '#deburr-messages');
+    const refusedMarks = await page.$$eval('#deburr-form [aria-invalid="true"]', (l) => l.map((e) => e.name));
+    if (!/marked field/.test(deburrRefused) || refusedMarks.join() !== 'hole_radius') throw new Error(`deburr download refused: "${deburrRefused}", ${refusedMarks}`);
+    return { segments, inked, objects, firstPlot, note: bad.note, program: deburrLines };
   },
 
   // The workbench: routes with Back, state kept across a view switch and a reload, a machine's
@@ -342,6 +374,7 @@ const scenarios = {
       }, reject);
     });
     if (!program.includes('G01 X49.9956 Y0.6667 Z0.0000') || !program.includes('M30')) throw new Error(`program: ${program.slice(0, 400)}`);
+    if (file.suggestedFilename() !== 'segment-fanuc.nc') throw new Error(`segment download named ${file.suggestedFilename()}`);
 
     // A bad value is reported with the field highlighted.
     await page.fill('input[name="feed"]', '-1');
@@ -368,6 +401,9 @@ const scenarios = {
     const withMachine = await page.textContent('#segment-result .summary');
     if (!/hsc-page/.test(withMachine) || !/12000 mm\/min/.test(withMachine)) throw new Error(`machine not used: ${withMachine}`);
     const machineBlocks = Number(await page.getAttribute('#segment-plot', 'data-segments'));
+    // With the machine chosen and no dialect, the program is in the machine's and named after it.
+    const machineProgram = await downloaded('#segment-gcode');
+    if (machineProgram.name !== 'segment-hsc-page.nc' || !machineProgram.text.includes('M30')) throw new Error(`segment download with a machine ${machineProgram.name}: ${machineProgram.text.slice(0, 300)}`);
 
     // A machine registered through the API with motion and spindle values, edited on the page
     // (its margin), keeps every value it had.
@@ -434,6 +470,7 @@ const scenarios = {
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#contour-gcode')]);
     const program = readFileSync(await download.path(), 'utf8');
     if (!program.includes('G64 P') || !program.trim().endsWith('M30')) throw new Error(`program: ${program.slice(0, 200)}`);
+    if (download.suggestedFilename() !== 'contour-linuxcnc.nc') throw new Error(`contour download named ${download.suggestedFilename()}`);
 
     // A bad step is reported on its field; a crossing contour on the points box; a line that is
     // not "x, y" before anything is sent.
@@ -452,6 +489,9 @@ const scenarios = {
     await page.click('#contour-compute');
     const local = await page.textContent('#contour-messages');
     if (!/line 2/i.test(local)) throw new Error(`local check: ${local}`);
+    const contourRefused = await refusedDownload('#contour-gcode', '#contour-messages');
+    const contourMarks = await page.$$eval('#contour-form .invalid', (l) => l.map((e) => e.name));
+    if (!/line 2/i.test(contourRefused) || !contourMarks.includes('points')) throw new Error(`contour download refused: "${contourRefused}", ${contourMarks}`);
     // Every layer in 3-D, and the timeline moves the tool there too. The program comes slowly
     // (as on a busy machine): the old plot stays dimmed until the new one replaces it.
     const slowProgram = async (route) => { await new Promise((r) => setTimeout(r, 1500)); await route.continue(); };
@@ -541,11 +581,20 @@ const scenarios = {
     const feeds = new Set([...program.matchAll(/ F(\d+(?:\.\d)?)/g)].map((m) => m[1]));
     if (!program.includes('M30') || feeds.size < 2) throw new Error(`program without its feed plan: ${program.slice(0, 400)}`);
     // A flute count out of range is refused with the field highlighted.
+    const fluteCounts = await page.inputValue('input[name="flute_counts"]');
     await page.fill('input[name="flute_counts"]', '2, 40');
     await page.click('#engagement-compute');
     await page.waitForSelector('#engagement-messages .message.error', { timeout: 60000 });
     const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
     if (!highlighted.includes('flute_counts')) throw new Error(`field not highlighted: ${highlighted}`);
+    const engagementRefused = await refusedDownload('#engagement-gcode', '#engagement-messages');
+    const refusedMarks = await page.$$eval('#engagement-form .invalid', (list) => list.map((e) => e.name));
+    if (!refusedMarks.includes('flute_counts')) throw new Error(`download refused without the field marked: "${engagementRefused}", ${refusedMarks}`);
+    await page.fill('input[name="flute_counts"]', fluteCounts);
+    const again = await downloaded('#engagement-gcode');
+    const left = await page.$$eval('#engagement-messages > *', (list) => list.length);
+    const marksLeft = await page.$$eval('#engagement-form .invalid', (list) => list.length);
+    if (again.name !== 'engagement-1-fanuc.nc' || !again.text.includes('M30') || left || marksLeft) throw new Error(`download after the fix: ${again.name}, ${left} messages, ${marksLeft} marks left`);
     return { columns, charts: states.length, torqueInked, inked, cursor, recommendation, feeds: feeds.size, file: download.suggestedFilename() };
   },
 
@@ -600,6 +649,7 @@ const scenarios = {
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#predict-gcode')]);
     const program = await (await import('node:fs/promises')).readFile(await download.path(), 'utf8');
     if (!program.includes('M30') || !program.includes('O3100')) throw new Error(`corrected program: ${program.slice(0, 200)}`);
+    if (download.suggestedFilename() !== 'corrected.nc') throw new Error(`corrected program named ${download.suggestedFilename()}`);
 
     // Entered as a radius, the size is sent as it is.
     await page.selectOption('#predict-form select[name="size_as"]', 'radius');
@@ -618,6 +668,11 @@ const scenarios = {
     if (!/line 3/i.test(error)) throw new Error(`error without its line: ${error}`);
     const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
     if (!highlighted.includes('program')) throw new Error(`program not highlighted: ${highlighted}`);
+    // The same program refused by "Corrected program": its line named and selected in the program.
+    await page.$eval('textarea[name="program"]', (area) => area.setSelectionRange(0, 0));
+    const predictRefused = await refusedDownload('#predict-gcode', '#predict-messages');
+    const selected = await page.$eval('textarea[name="program"]', (area) => area.value.slice(area.selectionStart, area.selectionEnd));
+    if (!/line 3/i.test(predictRefused) || selected !== 'G1 Z0 F500 Q1') throw new Error(`corrected program refused: "${predictRefused}", selected "${selected}"`);
     return { segments, inked, histogram, colours, worst: lines.length, programLines: program.split('\n').length };
   },
 
