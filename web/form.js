@@ -1,7 +1,8 @@
 // kerf form helpers shared by the views: the submit flow (read the form, ask the service, show the
-// answer or mark the problem at its fields), reading fields, the tool and machine choices (machine
-// values as placeholders, only overrides sent), errors at the field, warnings as sentences, the
-// per-view state kept in local storage, summaries and downloads.
+// answer or mark the problem at its fields), the G-code download flow (the same, ending in a file),
+// reading fields, the tool and machine choices (machine values as placeholders, only overrides
+// sent), errors at the field, warnings as sentences, the per-view state kept in local storage,
+// summaries and downloads.
 import { api, machines, materials, plainFieldMessage, plainTitle, program, sentence, technical, tools } from '/api.js';
 
 // ---------------------------------------------------------------- reading fields
@@ -103,6 +104,30 @@ export function submitFlow(form, { messages, result, read = () => null, ask, sho
       if (note) messages.append(note);
     } catch (problem) {
       fail(problem);
+    }
+  });
+}
+
+// The G-code download behind a view's `button`, the same in every view. On click the marks of an
+// earlier problem go (`keepMarks`: they stay until the next problem replaces them), `read()`
+// builds the request from the form (throwing a problem document for input the page can already
+// tell is wrong) and the program is asked of `path` with `query` (`?format=gcode…`). `query` and
+// `name` may be functions of the form's state at the click, taken before the program is asked, so
+// the file is named after the dialect it was asked in. The program downloads as `name`, then
+// `done()` runs; a problem from any step is shown at its fields in `messages`, then handed to
+// `failed(problem)` for what the view adds to it.
+export function downloadFlow(button, form, { messages, read, path, query, name, done, failed, keepMarks = false }) {
+  const now = (option) => (typeof option === 'function' ? option() : option);
+  button.addEventListener('click', async () => {
+    if (!keepMarks) clearProblem(form);
+    try {
+      const body = read();
+      const fileName = now(name);
+      download(fileName, await program(path, body, now(query)));
+      done?.();
+    } catch (problem) {
+      showProblem(messages, form, problem);
+      failed?.(problem);
     }
   });
 }

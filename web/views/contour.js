@@ -3,11 +3,10 @@
 // selector; loops, reliefs, links and corners in their own colours; wheel to zoom, drag to pan,
 // double-click to fit), the corner table with the material left or over-cut, the summary, the
 // warnings and the G-code download. `contourResult` also renders job results.
-import { api } from '/api.js';
 import { Timeline } from '/timeline.js';
 import { ContourPlan } from '/plot/plan.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
-import { answerAndProgram, clearProblem, download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, programName, refusalMessage, showProblem, showSummary, submitFlow, value, warningMessages } from '/form.js';
+import { answerAndProgram, downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, programName, refusalMessage, showSummary, submitFlow, value, warningMessages } from '/form.js';
 
 // An arrow-shaped island: five protruding corners (a 64° tip among them) and two inside corners.
 const SAMPLE = `# x, y in mm, counter-clockwise; one point a line
@@ -412,15 +411,13 @@ export const contourView = {
       },
       failed: (problem) => markContour(form, messages, problem),
     });
-    root.querySelector('#contour-gcode').addEventListener('click', async () => {
-      clearProblem(form);
-      try {
-        const program = await api('POST', `/api/v1/contour${gcodeQuery(form)}`, request(), 'text/x-gcode');
-        download(programName('contour', form), program);
-      } catch (problem) {
-        showProblem(messages, form, problem);
-        markContour(form, messages, problem);
-      }
+    downloadFlow(root.querySelector('#contour-gcode'), form, {
+      messages,
+      read: request,
+      path: '/api/v1/contour',
+      query: () => gcodeQuery(form),
+      name: () => programName('contour', form),
+      failed: (problem) => markContour(form, messages, problem),
     });
     keepForm(id, form);
   },

@@ -2,7 +2,7 @@
 // where the tool would meet the wall, the summary, warnings and the G-code download (docs/spec/api.md,
 // Deburr).
 import { api, program as programOf, sentence } from '/api.js';
-import { download, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, programName, showProblem, showSummary, submitFlow, value, warningMessages } from '/form.js';
+import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, programName, showSummary, submitFlow, value, warningMessages } from '/form.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
 import { clearance } from '/views/deburr-clearance.js';
@@ -309,12 +309,14 @@ export const deburrView = {
         return draw();
       },
     });
-    gcode.addEventListener('click', async () => {
-      try {
-        download(programName('deburr', form), await programOf('/api/v1/deburr', deburrRequest(form), gcodeQuery(form)));
-      } catch (problem) {
-        showProblem(messages, form, problem);
-      }
+    // The marks of an earlier problem stay on a download, as they always have here.
+    downloadFlow(gcode, form, {
+      messages,
+      read: () => deburrRequest(form),
+      path: '/api/v1/deburr',
+      query: () => gcodeQuery(form),
+      name: () => programName('deburr', form),
+      keepMarks: true,
     });
     keepForm(id, form);
   },

@@ -9,7 +9,7 @@
 import { api } from '/api.js';
 import { PathChart, barChart } from '/plot/charts.js';
 import { ToolPlan } from '/plot/tool-plan.js';
-import { clearProblem, download, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, machineFields, message, number, numeric, programName, showProblem, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
+import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, machineFields, message, number, numeric, programName, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
   { name: 'straight', text: '-10 20\n70 20' },
@@ -705,16 +705,15 @@ export const engagementView = {
         result.dataset.state = 'drawn';
       },
     });
-    root.querySelector('#engagement-gcode').addEventListener('click', async () => {
-      clearProblem(form);
-      const candidate = value(form, 'candidate') || '0';
-      try {
-        const program = await api('POST', `/api/v1/engagement${gcodeQuery(form)}&candidate=${candidate}`, engagementRequest(form), 'text/x-gcode');
-        download(programName(`engagement-${candidate}`, form), program);
-        messages.replaceChildren();
-      } catch (problem) {
-        showProblem(messages, form, problem);
-      }
+    // The program of the candidate chosen for G-code (the tab shown, or the select).
+    const candidate = () => value(form, 'candidate') || '0';
+    downloadFlow(root.querySelector('#engagement-gcode'), form, {
+      messages,
+      read: () => engagementRequest(form),
+      path: '/api/v1/engagement',
+      query: () => `${gcodeQuery(form)}&candidate=${candidate()}`,
+      name: () => programName(`engagement-${candidate()}`, form),
+      done: () => messages.replaceChildren(),
     });
     keepForm(id, form, {
       more: {

@@ -4,7 +4,7 @@
 // scale, a histogram of the errors, the worst passes with their NC lines, warnings, and the
 // corrected program. `predictResult` also shows prediction jobs.
 import { api } from '/api.js';
-import { clearProblem, download, half, keepForm, loadTools, message, number, numeric, showProblem, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
+import { clearProblem, downloadFlow, half, keepForm, loadTools, message, number, numeric, showProblem, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
 import { css, diverging, drawColourScale, drawHistogram } from '/plot/colour.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
@@ -445,14 +445,13 @@ export const predictView = {
       done: (answer, request, seconds) => `${answer.summary.passes} passes predicted in ${seconds.toFixed(2)} s.`,
       failed: (problem) => markProblem(form, problem),
     });
-    root.querySelector('#predict-gcode').addEventListener('click', async () => {
-      clear();
-      try {
-        const program = await api('POST', '/api/v1/predict?format=gcode', payload(predictRequest(form)), 'text/x-gcode');
-        download('corrected.nc', program);
-      } catch (problem) {
-        fail(problem);
-      }
+    downloadFlow(root.querySelector('#predict-gcode'), form, {
+      messages,
+      read: () => payload(predictRequest(form)),
+      path: '/api/v1/predict',
+      query: '?format=gcode',
+      name: 'corrected.nc',
+      failed: (problem) => markProblem(form, problem),
     });
     root.querySelector('#predict-save-tool').addEventListener('click', async () => {
       clear();

@@ -1,9 +1,8 @@
 // Segment view: cut a curve into G01 blocks by the control's block time (docs/spec/api.md, Segment;
 // docs/spec/segment.md). A form for the curve and the rule, the curve with its blocks, the chord error and the
 // block length along the curve, the rule side by side with a fixed tolerance, G-code download.
-import { api } from '/api.js';
 import { Timeline } from '/timeline.js';
-import { answerAndProgram, clearProblem, download, keepForm, loadMachines, machineFields, machineNote, message, number, numeric, refusalMessage, showProblem, showSummary, submitFlow, value, warningMessages } from '/form.js';
+import { answerAndProgram, downloadFlow, keepForm, loadMachines, machineFields, machineNote, message, number, numeric, programName, refusalMessage, showSummary, submitFlow, value, warningMessages } from '/form.js';
 import { drawChart } from '/plot/charts.js';
 import { CurvePlan } from '/plot/plan.js';
 
@@ -362,17 +361,12 @@ export const segmentView = {
         return refusalMessage(refusal, 'these blocks');
       },
     });
-    root.querySelector('#segment-gcode').addEventListener('click', async () => {
-      clearProblem(form);
-      try {
-        const body = request();
-        const dialect = value(form, 'dialect');
-        const query = segmentQuery(form);
-        const program = await api('POST', `/api/v1/segment${query}`, body, 'text/x-gcode');
-        download(`segment-${dialect || body.machine || 'fanuc'}.nc`, program);
-      } catch (problem) {
-        showProblem(messages, form, problem);
-      }
+    downloadFlow(root.querySelector('#segment-gcode'), form, {
+      messages,
+      read: request,
+      path: '/api/v1/segment',
+      query: () => segmentQuery(form),
+      name: () => programName('segment', form),
     });
     keepForm(id, form);
   },
