@@ -1,17 +1,17 @@
 //! Reference cases A–G of `solver/tests/fixtures/predict.json` (copied to `tests/fixtures/`),
 //! through the public API, to the tolerances stated there.
 
+use kerf_cases::predict::bare_request;
 use kerf_cases::{case, close, number, triple};
 use std::f64::consts::PI;
 
-use kerf_solver::gcode::Reference;
 use kerf_solver::predict::correct::{PassError, node_correction, polyline_corrections};
 use kerf_solver::predict::dynamics::steady_state_deflection;
 use kerf_solver::predict::shape::{Conversion, Section, shape_error_from_sections};
 use kerf_solver::predict::{
     self, CuttingCoefficients, Method, PassFlag, PathInput, Predict, PredictRequest, PrescribedDeflection, Stock,
 };
-use kerf_solver::tool::{Mode, ShapeErrorPoint, Stiffness, Tool, ToolKind, ToolRef};
+use kerf_solver::tool::{Mode, ShapeErrorPoint, Stiffness, Tool, ToolKind};
 use serde_json::Value;
 
 /// A program of separate straight passes (ball centres), linked by rapids at a safe height.
@@ -46,32 +46,9 @@ fn request(
     method: Method,
 ) -> PredictRequest {
     PredictRequest {
-        tool: ToolRef::Inline(tool.clone()),
-        stock,
-        path: PathInput::Gcode { program: program(passes, feed) },
-        reference: Reference::Centre,
-        spindle_rpm: None,
-        spindle_direction: None,
-        feed: None,
-        cutting: None,
         deflection,
         method,
-        resolution: None,
-        tooth_feed_gap: None,
-        view_correction: None,
-        view_correction_deg: None,
-        flute_zero_deg: None,
-        samples_per_revolution: None,
-        edge_elements: None,
-        arc_tolerance: None,
-        block_delete: None,
-        correction: None,
-        history: None,
-        pass_range: None,
-        exclusion_deg: None,
-        exclusion_shape_error: None,
-        merge_similar_passes: None,
-        merge_tolerance: None,
+        ..bare_request(tool, stock, PathInput::Gcode { program: program(passes, feed) })
     }
 }
 

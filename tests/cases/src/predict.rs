@@ -94,32 +94,11 @@ pub fn raster_request(
     let tool = finishing_tool(radius);
     let (program, moves) = raster_program(size, pick, step, radius, 1200.0);
     let request = PredictRequest {
-        tool: ToolRef::Inline(tool.clone()),
-        stock: raster_stock(size, radius, 0.2, 0.5),
-        path: PathInput::Gcode { program },
         reference: Reference::Tip,
-        spindle_rpm: None,
-        spindle_direction: None,
-        feed: None,
         cutting: Some(CuttingCoefficients { ktc: 2000.0, krc: 800.0, kac: 300.0, kte: 0.0, kre: 0.0, kae: 0.0 }),
-        deflection: None,
         method,
         resolution: Some(resolution),
-        tooth_feed_gap: None,
-        view_correction: None,
-        view_correction_deg: None,
-        flute_zero_deg: None,
-        samples_per_revolution: None,
-        edge_elements: None,
-        arc_tolerance: None,
-        block_delete: None,
-        correction: None,
-        history: None,
-        pass_range: None,
-        exclusion_deg: None,
-        exclusion_shape_error: None,
-        merge_similar_passes: None,
-        merge_tolerance: None,
+        ..bare_request(&tool, raster_stock(size, radius, 0.2, 0.5), PathInput::Gcode { program })
     };
     (request, tool, moves)
 }
