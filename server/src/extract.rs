@@ -213,11 +213,13 @@ struct EntityTag {
     quoted: String,
 }
 
-/// What `If-Match` or `If-None-Match` names: `*` (any stored item) or a list of entity tags.
+/// What `If-Match` or `If-None-Match` names: `*` (any stored item) or a list of entity tags; or
+/// neither, which [`Preconditions::check`] refuses.
 #[derive(Debug, Clone, PartialEq, Eq)]
 enum TagCondition {
     Any,
     Tags(Vec<EntityTag>),
+    Unreadable,
 }
 
 /// Reads `* / #entity-tag` (RFC 9110 §13.1.1); `None` when the text is neither.
@@ -249,20 +251,14 @@ fn parse_condition(text: &str) -> Option<TagCondition> {
     (!tags.is_empty()).then_some(TagCondition::Tags(tags))
 }
 
-/// The condition a header states, `None` when the request has none; a header that is neither
-/// `*` nor a list of quoted entity tags is 412 naming it: a write is never made on a condition
-/// kerf cannot read.
-fn condition(headers: &HeaderMap, name: &HeaderName, label: &'static str) -> Result<Option<TagCondition>, AppError> {
+/// The condition a header states (its lines are one list), `None` when the request has none.
+fn condition(headers: &HeaderMap, name: &HeaderName) -> Option<TagCondition> {
     let values: Vec<&HeaderValue> = headers.get_all(name).iter().collect();
     if values.is_empty() {
-        return Ok(None);
+        return None;
     }
     let text = values.iter().map(|value| value.to_str()).collect::<Result<Vec<_>, _>>().map(|parts| parts.join(","));
-    text.ok().as_deref().and_then(parse_condition).map(Some).ok_or_else(|| AppError::PreconditionFailed {
-        header: label,
-        detail: format!("{label} must be * or a list of quoted entity tags (an ETag as kerf sent it, quotes included)"),
-        etag: None,
-    })
+    Some(text.ok().as_deref().and_then(parse_condition).unwrap_or(TagCondition::Unreadable))
 }
 
 /// The preconditions of a request that writes or deletes a stored item (RFC 9110 §13.1.1–2):
@@ -302,8 +298,8 @@ impl<S: Send + Sync> FromRequestParts<S> for Preconditions {
 
     async fn from_request_parts(parts: &mut Parts, _state: &S) -> Result<Self, Self::Rejection> {
         Ok(Self {
-            if_match: condition(&parts.headers, &IF_MATCH, "If-Match")?,
-            if_none_match: condition(&parts.headers, &IF_NONE_MATCH, "If-None-Match")?,
+            if_match: condition(&parts.headers, &IF_MATCH),
+            if_none_match: condition(&parts.headers, &IF_NONE_MATCH),
         })
     }
 }
@@ -313,13 +309,26 @@ impl Preconditions {
     /// the ETag `current` (`None`: not stored).
     ///
     /// # Errors
-    /// 412 naming the header that does not hold, with the current ETag when there is one.
+    /// 412 naming the header that does not hold, with the current ETag when there is one; also
+    /// for a header that is neither `*` nor quoted entity tags: a write is never made on a
+    /// condition kerf cannot read.
     pub fn check(&self, item: &str, current: Option<&str>) -> Result<(), AppError> {
+        for (condition, header) in [(&self.if_match, "If-Match"), (&self.if_none_match, "If-None-Match")] {
+            if condition.as_ref() == Some(&TagCondition::Unreadable) {
+                let now =
+                    current.map(|current| format!("; the current ETag of {item} is {current}")).unwrap_or_default();
+                return Err(AppError::PreconditionFailed {
+                    header,
+                    detail: format!("{header} must be * or a list of quoted entity tags, as ETag gives them{now}"),
+                    etag: current.map(str::to_owned),
+                });
+            }
+        }
         if let Some(condition) = &self.if_match {
             let holds = match (condition, current) {
-                (_, None) => false,
                 (TagCondition::Any, Some(_)) => true,
                 (TagCondition::Tags(tags), Some(current)) => tags.iter().any(|tag| !tag.weak && tag.quoted == current),
+                (_, None) | (TagCondition::Unreadable, _) => false,
             };
             if !holds {
                 let detail = match current {
@@ -335,7 +344,7 @@ impl Preconditions {
         }
         if let (Some(condition), Some(current)) = (&self.if_none_match, current) {
             let matches = match condition {
-                TagCondition::Any => true,
+                TagCondition::Any | TagCondition::Unreadable => true,
                 TagCondition::Tags(tags) => tags.iter().any(|tag| tag.quoted == current),
             };
             if matches {

@@ -117,8 +117,8 @@ pub async fn conditional_writes(app: &TestApp, path: &str, first: &Value, second
         .await
         .refused("If-Match", Some(&tag2));
     let bare = tag2.trim_matches('"').to_owned();
-    let unquoted = send(app, Method::PUT, path, &[("if-match", &bare)], Some(third)).await;
-    assert_eq!((unquoted.status, &unquoted.body["errors"][0]["path"]), (412, &json!("If-Match")), "{}", unquoted.body);
+    send(app, Method::PUT, path, &[("if-match", &bare)], Some(third)).await.refused("If-Match", Some(&tag2));
+    send(app, Method::PUT, path, &[("if-none-match", &bare)], Some(third)).await.refused("If-None-Match", Some(&tag2));
     assert_eq!(get().await.body, replaced.body);
     // One of a list matches; `*` matches any stored item.
     let listed = send(app, Method::PUT, path, &[("if-match", &format!("\"0000\", {tag2}"))], Some(third)).await;
@@ -154,6 +154,21 @@ async fn tool_preconditions(store: Store) {
         &json!({"kind": "flat", "radius": 5, "flutes": 4}),
     )
     .await;
+    // A request refused for its number is refused for that, whatever its preconditions say.
+    let out_of_range = send(
+        &app,
+        Method::PUT,
+        "/api/v1/tools/0",
+        &[("if-match", "junk")],
+        Some(&json!({"kind": "flat", "radius": 5})),
+    )
+    .await;
+    assert_eq!(
+        (out_of_range.status, &out_of_range.body["errors"][0]["path"]),
+        (422, &json!("number")),
+        "{}",
+        out_of_range.body
+    );
     app.shutdown().await;
 }
 
