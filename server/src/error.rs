@@ -55,6 +55,10 @@ pub enum AppError {
     /// 409: the request conflicts with stored state.
     #[error("{0}")]
     Conflict(String),
+    /// 412: `If-Match` or `If-None-Match` (`header`) does not hold for the stored item; `etag` is
+    /// the item's current ETag when it exists, sent back so a client can show what is stored.
+    #[error("{detail}")]
+    PreconditionFailed { header: &'static str, detail: String, etag: Option<String> },
     /// 413: the body is over the limit.
     #[error("request body is larger than the limit of {limit} bytes")]
     PayloadTooLarge { limit: usize },
@@ -120,6 +124,7 @@ impl AppError {
             Self::NotFound { .. } => (StatusCode::NOT_FOUND, "Not found"),
             Self::MethodNotAllowed => (StatusCode::METHOD_NOT_ALLOWED, "Method not allowed"),
             Self::Conflict(_) => (StatusCode::CONFLICT, "Conflict"),
+            Self::PreconditionFailed { .. } => (StatusCode::PRECONDITION_FAILED, "Precondition failed"),
             Self::PayloadTooLarge { .. } => (StatusCode::PAYLOAD_TOO_LARGE, "Payload too large"),
             Self::UnsupportedMediaType(_) => (StatusCode::UNSUPPORTED_MEDIA_TYPE, "Unsupported media type"),
             Self::Unprocessable(_) => (StatusCode::UNPROCESSABLE_ENTITY, "Unprocessable request"),
@@ -137,6 +142,9 @@ impl AppError {
             Self::BadRequest { code, detail, field } => (*code, detail.clone(), field.clone()),
             Self::NotFound { detail, field } => (ErrorCode::NotFound, detail.clone(), field.clone()),
             Self::Unprocessable(error) => (error.code(), error.message().to_owned(), error.field().map(str::to_owned)),
+            Self::PreconditionFailed { header, detail, .. } => {
+                (ErrorCode::PreconditionFailed, detail.clone(), Some((*header).to_owned()))
+            }
             Self::Internal(_) => (ErrorCode::Internal, "internal error; it has been logged".to_owned(), None),
             other => {
                 let code = match other {
@@ -176,6 +184,11 @@ impl IntoResponse for AppError {
         response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("application/problem+json"));
         if matches!(self, Self::Unauthorized(_)) {
             response.headers_mut().insert(header::WWW_AUTHENTICATE, HeaderValue::from_static("Bearer"));
+        }
+        if let Self::PreconditionFailed { etag: Some(etag), .. } = &self
+            && let Ok(value) = HeaderValue::from_str(etag)
+        {
+            response.headers_mut().insert(header::ETAG, value);
         }
         if matches!(self, Self::TooManyRequests(_)) {
             // Slots and the answer budget free up within seconds.

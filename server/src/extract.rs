@@ -1,15 +1,20 @@
 //! Extractors whose rejections are problem documents: JSON bodies (415 on the wrong content type,
-//! 413 over the limit, 400 naming the field on bad shape), query strings and path parameters.
+//! 413 over the limit, 400 naming the field on bad shape), query strings, path parameters, and the
+//! preconditions of a write (`If-Match`, `If-None-Match`: 412) with the ETags they compare.
 
 use axum::body::Bytes;
 use axum::extract::path::ErrorKind;
 use axum::extract::rejection::{BytesRejection, PathRejection};
 use axum::extract::{FromRef, FromRequest, FromRequestParts, Request};
-use axum::http::HeaderMap;
-use axum::http::header::{CONTENT_LENGTH, CONTENT_TYPE};
+use axum::http::header::{CONTENT_LENGTH, CONTENT_TYPE, ETAG, IF_MATCH, IF_NONE_MATCH};
 use axum::http::request::Parts;
+use axum::http::{HeaderMap, HeaderName, HeaderValue, StatusCode};
+use axum::response::{IntoResponse, Response};
 use kerf_solver::ErrorCode;
+use serde::Serialize;
 use serde::de::DeserializeOwned;
+use sha2::{Digest, Sha256};
+use utoipa::IntoParams;
 
 use crate::error::AppError;
 use crate::state::AppState;
@@ -170,5 +175,216 @@ where
                 AppError::bad_request(ErrorCode::Path, key.unwrap_or_else(|| "path".to_owned()), rejection.body_text())
             },
         )
+    }
+}
+
+/// The strong ETag of a representation (RFC 9110 §8.8.3): a quoted hash of its bytes, so equal
+/// bytes give equal tags and any change of a byte gives another.
+pub fn strong_etag(bytes: &[u8]) -> String {
+    let digest = Sha256::digest(bytes);
+    let hex: String = digest.iter().take(12).map(|b| format!("{b:02x}")).collect();
+    format!("\"{hex}\"")
+}
+
+/// The ETag of `item`'s JSON answer: the tag of the bytes [`tagged`] sends for it.
+///
+/// # Errors
+/// 500 when `item` cannot be written as JSON.
+pub fn etag_of(item: &impl Serialize) -> Result<String, AppError> {
+    serde_json::to_vec(item).map(|bytes| strong_etag(&bytes)).map_err(|error| AppError::Internal(error.into()))
+}
+
+/// `item` as a JSON answer with `status` and its `ETag`.
+///
+/// # Errors
+/// 500 when `item` cannot be written as JSON.
+pub fn tagged(status: StatusCode, item: &impl Serialize) -> Result<Response, AppError> {
+    let bytes = serde_json::to_vec(item).map_err(|error| AppError::Internal(error.into()))?;
+    let etag = HeaderValue::from_str(&strong_etag(&bytes)).map_err(|error| AppError::Internal(error.into()))?;
+    let json = HeaderValue::from_static("application/json");
+    Ok((status, [(CONTENT_TYPE, json), (ETAG, etag)], bytes).into_response())
+}
+
+/// One entity tag of a precondition header, quotes included (`"abc"`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct EntityTag {
+    /// Written `W/"…"`: never matches in `If-Match` (strong comparison, RFC 9110 §8.8.3.2).
+    weak: bool,
+    quoted: String,
+}
+
+/// What `If-Match` or `If-None-Match` names: `*` (any stored item) or a list of entity tags; or
+/// neither, which [`Preconditions::check`] refuses.
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum TagCondition {
+    Any,
+    Tags(Vec<EntityTag>),
+    Unreadable,
+}
+
+/// Reads `* / #entity-tag` (RFC 9110 §13.1.1); `None` when the text is neither.
+fn parse_condition(text: &str) -> Option<TagCondition> {
+    if text.trim() == "*" {
+        return Some(TagCondition::Any);
+    }
+    let mut tags = Vec::new();
+    let mut rest = text;
+    loop {
+        // A list may hold empty elements (RFC 9110 §5.6.1).
+        rest = rest.trim_start_matches([' ', '\t', ',']);
+        if rest.is_empty() {
+            break;
+        }
+        let (weak, body) = rest.strip_prefix("W/").map_or((false, rest), |body| (true, body));
+        let opaque = body.strip_prefix('"')?;
+        let end = opaque.find('"')?;
+        // etagc: `!`, `#` to `~`, or non-ASCII; no space, no quote, no control.
+        if !opaque[..end].bytes().all(|b| b == b'!' || (b'#'..=b'~').contains(&b) || b >= 0x80) {
+            return None;
+        }
+        tags.push(EntityTag { weak, quoted: format!("\"{}\"", &opaque[..end]) });
+        rest = opaque[end + 1..].trim_start_matches([' ', '\t']);
+        if !rest.is_empty() && !rest.starts_with(',') {
+            return None;
+        }
+    }
+    (!tags.is_empty()).then_some(TagCondition::Tags(tags))
+}
+
+/// The condition a header states (its lines are one list), `None` when the request has none.
+fn condition(headers: &HeaderMap, name: &HeaderName) -> Option<TagCondition> {
+    let values: Vec<&HeaderValue> = headers.get_all(name).iter().collect();
+    if values.is_empty() {
+        return None;
+    }
+    let text = values.iter().map(|value| value.to_str()).collect::<Result<Vec<_>, _>>().map(|parts| parts.join(","));
+    Some(text.ok().as_deref().and_then(parse_condition).unwrap_or(TagCondition::Unreadable))
+}
+
+/// The preconditions of a request that writes or deletes a stored item (RFC 9110 §13.1.1–2):
+/// `If-Match: <etag>` (or `*`) writes only over the version the client has seen,
+/// `If-None-Match: *` only when there is none yet. Without either the write is unconditional.
+#[derive(Debug, Clone, Default)]
+pub struct Preconditions {
+    if_match: Option<TagCondition>,
+    if_none_match: Option<TagCondition>,
+}
+
+/// The headers [`Preconditions`] reads on a PUT, as the OpenAPI document lists them.
+#[derive(Debug, IntoParams)]
+#[into_params(parameter_in = Header)]
+pub struct ReplaceHeaders {
+    /// Replace only if the stored item's ETag is one of these (quoted, as `ETag` gave it), or
+    /// `*`: only if the item is stored; else 412 `E_PRECONDITION_FAILED`.
+    #[param(rename = "If-Match")]
+    pub if_match: Option<String>,
+    /// `*`: create only, never replace; else 412 `E_PRECONDITION_FAILED`.
+    #[param(rename = "If-None-Match")]
+    pub if_none_match: Option<String>,
+}
+
+/// The header [`Preconditions`] reads on a DELETE, as the OpenAPI document lists it.
+#[derive(Debug, IntoParams)]
+#[into_params(parameter_in = Header)]
+pub struct DeleteHeaders {
+    /// Delete only if the stored item's ETag is one of these (quoted, as `ETag` gave it), or
+    /// `*`: only if the item is stored; else 412 `E_PRECONDITION_FAILED`.
+    #[param(rename = "If-Match")]
+    pub if_match: Option<String>,
+}
+
+impl<S: Send + Sync> FromRequestParts<S> for Preconditions {
+    type Rejection = AppError;
+
+    async fn from_request_parts(parts: &mut Parts, _state: &S) -> Result<Self, Self::Rejection> {
+        Ok(Self {
+            if_match: condition(&parts.headers, &IF_MATCH),
+            if_none_match: condition(&parts.headers, &IF_NONE_MATCH),
+        })
+    }
+}
+
+impl Preconditions {
+    /// Whether the write may go ahead on `item` (`tool 7`, `machine "dmu50"`), stored now with
+    /// the ETag `current` (`None`: not stored).
+    ///
+    /// # Errors
+    /// 412 naming the header that does not hold, with the current ETag when there is one; also
+    /// for a header that is neither `*` nor quoted entity tags: a write is never made on a
+    /// condition kerf cannot read.
+    pub fn check(&self, item: &str, current: Option<&str>) -> Result<(), AppError> {
+        for (condition, header) in [(&self.if_match, "If-Match"), (&self.if_none_match, "If-None-Match")] {
+            if condition.as_ref() == Some(&TagCondition::Unreadable) {
+                let now =
+                    current.map(|current| format!("; the current ETag of {item} is {current}")).unwrap_or_default();
+                return Err(AppError::PreconditionFailed {
+                    header,
+                    detail: format!("{header} must be * or a list of quoted entity tags, as ETag gives them{now}"),
+                    etag: current.map(str::to_owned),
+                });
+            }
+        }
+        if let Some(condition) = &self.if_match {
+            let holds = match (condition, current) {
+                (TagCondition::Any, Some(_)) => true,
+                (TagCondition::Tags(tags), Some(current)) => tags.iter().any(|tag| !tag.weak && tag.quoted == current),
+                (_, None) | (TagCondition::Unreadable, _) => false,
+            };
+            if !holds {
+                let detail = match current {
+                    None => format!("If-Match: {item} does not exist (it was deleted or never stored)"),
+                    Some(current) => format!("If-Match: {item} has changed; its current ETag is {current}"),
+                };
+                return Err(AppError::PreconditionFailed {
+                    header: "If-Match",
+                    detail,
+                    etag: current.map(str::to_owned),
+                });
+            }
+        }
+        if let (Some(condition), Some(current)) = (&self.if_none_match, current) {
+            let matches = match condition {
+                TagCondition::Any | TagCondition::Unreadable => true,
+                TagCondition::Tags(tags) => tags.iter().any(|tag| tag.quoted == current),
+            };
+            if matches {
+                return Err(AppError::PreconditionFailed {
+                    header: "If-None-Match",
+                    detail: format!("If-None-Match: {item} already exists; its current ETag is {current}"),
+                    etag: Some(current.to_owned()),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{EntityTag, TagCondition, parse_condition};
+
+    fn strong(quoted: &str) -> EntityTag {
+        EntityTag { weak: false, quoted: quoted.to_owned() }
+    }
+
+    #[test]
+    fn reads_star_and_tag_lists() {
+        assert_eq!(parse_condition(" * "), Some(TagCondition::Any));
+        assert_eq!(parse_condition(r#""a1""#), Some(TagCondition::Tags(vec![strong(r#""a1""#)])));
+        assert_eq!(
+            parse_condition(r#"W/"x", "a,b" ,,"c""#),
+            Some(TagCondition::Tags(vec![
+                EntityTag { weak: true, quoted: r#""x""#.to_owned() },
+                strong(r#""a,b""#),
+                strong(r#""c""#)
+            ]))
+        );
+    }
+
+    #[test]
+    fn refuses_what_is_not_a_tag_list() {
+        for text in ["a1", r#""a1"x"#, r#""a1"#, r#""a b""#, "", " , ", r#""*", *"#, "W/a"] {
+            assert_eq!(parse_condition(text), None, "{text:?}");
+        }
     }
 }

@@ -9,9 +9,10 @@ use axum::Router;
 use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
 use axum::response::IntoResponse;
 use axum::routing::get;
-use sha2::{Digest, Sha256};
 use std::sync::LazyLock;
 use tower_http::compression::CompressionLayer;
+
+use crate::extract::strong_etag;
 
 /// One served file.
 #[derive(Clone, Copy)]
@@ -31,11 +32,9 @@ static CAPABILITIES_MODULE: LazyLock<String> = LazyLock::new(|| {
     format!("// Generated from the server's capability registry.\nexport const CAPABILITIES = {names};\n")
 });
 
-/// The strong ETag of `body`: a quoted hash of its bytes.
+/// The strong ETag of `body` ([`strong_etag`]) as a header value.
 fn etag(body: &[u8]) -> HeaderValue {
-    let digest = Sha256::digest(body);
-    let hex: String = digest.iter().take(12).map(|b| format!("{b:02x}")).collect();
-    HeaderValue::from_str(&format!("\"{hex}\"")).unwrap_or_else(|_| HeaderValue::from_static("\"0\""))
+    HeaderValue::from_str(&strong_etag(body)).unwrap_or_else(|_| HeaderValue::from_static("\"0\""))
 }
 
 /// Whether `If-None-Match` names `tag` (or `*`).

@@ -90,6 +90,7 @@ error_codes! {
     OffsetSelfIntersection => "E_OFFSET_SELF_INTERSECTION",
     Orientation => "E_ORIENTATION",
     Path => "E_PATH",
+    PreconditionFailed => "E_PRECONDITION_FAILED",
     Query => "E_QUERY",
     ResolutionLimit => "E_RESOLUTION_LIMIT",
     ResultTooLarge => "E_RESULT_TOO_LARGE",

@@ -1,6 +1,7 @@
 //! Output negotiation shared by every path-producing endpoint (docs/spec/api.md, Conventions: G-code):
-//! JSON by default; G-code with `Accept: text/x-gcode` or `?format=gcode`, in `?dialect=`
-//! (`fanuc` default, or the machine's) with `?reference=tip|centre` and `?arcs=g2g3|chords`.
+//! JSON by default; G-code with `?format=gcode` or an `Accept` that ranks `text/x-gcode` above
+//! `application/json` (q-values, RFC 9110 §12.5.1), in `?dialect=` (`fanuc` default, or the
+//! machine's) with `?reference=tip|centre` and `?arcs=g2g3|chords`.
 
 use axum::http::{HeaderMap, header};
 use kerf_solver::capability::OutputOptions;
@@ -26,7 +27,8 @@ pub enum Format {
 #[serde(deny_unknown_fields)]
 #[into_params(parameter_in = Query)]
 pub struct OutputQuery {
-    /// `json` (default) or `gcode`; `Accept: text/x-gcode` also selects G-code.
+    /// `json` (default) or `gcode`; without it, an `Accept` that ranks `text/x-gcode` above
+    /// `application/json` selects G-code.
     pub format: Option<Format>,
     /// G-code dialect: `fanuc` (default) or `linuxcnc`.
     pub dialect: Option<Dialect>,
@@ -44,7 +46,8 @@ pub struct OutputQuery {
 #[serde(deny_unknown_fields)]
 #[into_params(parameter_in = Query)]
 pub struct CandidateQuery {
-    /// `json` (default) or `gcode`; `Accept: text/x-gcode` also selects G-code.
+    /// `json` (default) or `gcode`; without it, an `Accept` that ranks `text/x-gcode` above
+    /// `application/json` selects G-code.
     pub format: Option<Format>,
     /// G-code dialect: `fanuc` or `linuxcnc` (default: the named machine's, else `fanuc`).
     pub dialect: Option<Dialect>,
@@ -117,14 +120,167 @@ impl Ask {
 
 /// Whether the client wants G-code: `format` if given, else the `Accept` header.
 pub fn wants_gcode(headers: &HeaderMap, format: Option<Format>) -> bool {
-    let accepts_gcode = headers
+    match format {
+        Some(format) => format == Format::Gcode,
+        None => accept_prefers_gcode(headers),
+    }
+}
+
+/// Whether `Accept` ranks G-code above JSON (RFC 9110 §12.5.1). Each answer takes the weight of
+/// the most specific range that matches it (`text/x-gcode` over `text/*` over `*/*`), 0 when none
+/// does; G-code only when its weight is higher, so a tie, a header that accepts neither and no
+/// header give JSON (kerf answers JSON rather than 406 when nothing listed is what it writes).
+/// An element that cannot be read (a bad range or q-value) counts as not sent.
+fn accept_prefers_gcode(headers: &HeaderMap) -> bool {
+    let ranges: Vec<MediaRange> = headers
         .get_all(header::ACCEPT)
         .iter()
         .filter_map(|value| value.to_str().ok())
-        .flat_map(|value| value.split(','))
-        .any(|item| item.split(';').next().unwrap_or_default().trim().eq_ignore_ascii_case(GCODE_MEDIA_TYPE));
-    match format {
-        Some(format) => format == Format::Gcode,
-        None => accepts_gcode,
+        .flat_map(|value| split_outside_quotes(value, ','))
+        .filter_map(MediaRange::parse)
+        .collect();
+    let weight = |media_type: &str| {
+        let (kind, subtype) = media_type.split_once('/').unwrap_or_default();
+        ranges
+            .iter()
+            .filter_map(|range| range.specificity(kind, subtype).map(|specificity| (specificity, range.quality)))
+            .max()
+            .map_or(0, |(_, quality)| quality)
+    };
+    weight(GCODE_MEDIA_TYPE) > weight("application/json")
+}
+
+/// One element of `Accept`: `type/subtype` (either may be `*`) with its weight in thousandths.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct MediaRange {
+    kind: String,
+    subtype: String,
+    quality: u16,
+}
+
+impl MediaRange {
+    /// Reads `type/subtype *( OWS ";" OWS parameter )`; `None` for anything else.
+    fn parse(element: &str) -> Option<Self> {
+        let mut parts = split_outside_quotes(element, ';').into_iter().map(|part| part.trim_matches([' ', '\t']));
+        let (kind, subtype) = parts.next()?.split_once('/')?;
+        if !is_token(kind) || !is_token(subtype) || (kind == "*" && subtype != "*") {
+            return None;
+        }
+        let mut quality = 1000;
+        for parameter in parts {
+            let (name, value) = parameter.split_once('=')?;
+            if !is_token(name) {
+                return None;
+            }
+            if name.eq_ignore_ascii_case("q") {
+                quality = parse_qvalue(value)?;
+            }
+        }
+        Some(Self { kind: kind.to_ascii_lowercase(), subtype: subtype.to_ascii_lowercase(), quality })
+    }
+
+    /// How closely the range names `kind/subtype`: 2 exactly, 1 as `kind/*`, 0 as `*/*`; `None`
+    /// when it does not match.
+    fn specificity(&self, kind: &str, subtype: &str) -> Option<u8> {
+        match (self.kind.as_str(), self.subtype.as_str()) {
+            ("*", "*") => Some(0),
+            (k, "*") if k == kind => Some(1),
+            (k, s) if k == kind && s == subtype => Some(2),
+            _ => None,
+        }
+    }
+}
+
+/// `qvalue = ( "0" [ "." 0*3DIGIT ] ) / ( "1" [ "." 0*3("0") ] )` (RFC 9110 §12.4.2), in thousandths.
+fn parse_qvalue(text: &str) -> Option<u16> {
+    let (whole, fraction) = text.split_once('.').unwrap_or((text, ""));
+    if fraction.len() > 3 || !fraction.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    let thousandths = format!("{fraction:0<3}").parse::<u16>().ok()?;
+    match whole {
+        "0" => Some(thousandths),
+        "1" if thousandths == 0 => Some(1000),
+        _ => None,
+    }
+}
+
+/// An RFC 9110 token (§5.6.2): one or more tchar.
+fn is_token(text: &str) -> bool {
+    !text.is_empty() && text.bytes().all(|b| b.is_ascii_alphanumeric() || b"!#$%&'*+-.^_`|~".contains(&b))
+}
+
+/// `text` cut at each `separator` that is not inside a quoted string (where `\` escapes).
+fn split_outside_quotes(text: &str, separator: char) -> Vec<&str> {
+    let mut pieces = Vec::new();
+    let (mut start, mut quoted, mut escaped) = (0, false, false);
+    for (index, character) in text.char_indices() {
+        match character {
+            _ if escaped => escaped = false,
+            '\\' if quoted => escaped = true,
+            '"' => quoted = !quoted,
+            _ if character == separator && !quoted => {
+                pieces.push(&text[start..index]);
+                start = index + character.len_utf8();
+            }
+            _ => {}
+        }
+    }
+    pieces.push(&text[start..]);
+    pieces
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{MediaRange, accept_prefers_gcode, parse_qvalue, split_outside_quotes};
+    use axum::http::{HeaderMap, HeaderValue, header};
+
+    fn gcode_for(accept: &[&str]) -> bool {
+        let mut headers = HeaderMap::new();
+        for value in accept {
+            headers.append(header::ACCEPT, HeaderValue::from_str(value).unwrap());
+        }
+        accept_prefers_gcode(&headers)
+    }
+
+    #[test]
+    fn qvalues_follow_the_grammar() {
+        assert_eq!(parse_qvalue("0"), Some(0));
+        assert_eq!(parse_qvalue("0.5"), Some(500));
+        assert_eq!(parse_qvalue("0.125"), Some(125));
+        assert_eq!(parse_qvalue("1"), Some(1000));
+        assert_eq!(parse_qvalue("1.000"), Some(1000));
+        assert_eq!(parse_qvalue("0."), Some(0), "\"0\" \".\" with no digits");
+        for bad in ["", "1.5", "1.001", "0.1234", "2", ".5", "0,5", "-0", "high"] {
+            assert_eq!(parse_qvalue(bad), None, "{bad:?}");
+        }
+    }
+
+    #[test]
+    fn ranges_are_read_with_spaces_and_quoted_parameters() {
+        let range = MediaRange::parse(" Text/X-Gcode ;\tcharset=\"a;b\" ; Q=0.25 ").unwrap();
+        assert_eq!((range.kind.as_str(), range.subtype.as_str(), range.quality), ("text", "x-gcode", 250));
+        assert_eq!(split_outside_quotes(r#"a;b="x,\"y";c"#, ','), [r#"a;b="x,\"y";c"#]);
+        for bad in ["text", "*/json", "text/", "text/x gcode", "text/x-gcode;q", "text/x-gcode;q=2"] {
+            assert_eq!(MediaRange::parse(bad), None, "{bad:?}");
+        }
+    }
+
+    #[test]
+    fn the_higher_weight_wins_and_a_tie_gives_json() {
+        assert!(!gcode_for(&[]));
+        assert!(gcode_for(&["text/x-gcode"]));
+        assert!(!gcode_for(&["application/json, text/x-gcode;q=0.1"]));
+        assert!(gcode_for(&["application/json;q=0.5, text/x-gcode"]));
+        assert!(!gcode_for(&["text/x-gcode, application/json"]), "a tie keeps JSON");
+        assert!(!gcode_for(&["text/x-gcode;q=0"]), "q=0 is not acceptable");
+        assert!(gcode_for(&["text/*"]));
+        assert!(!gcode_for(&["*/*"]));
+        assert!(gcode_for(&["*/*;q=0.1, text/x-gcode"]));
+        assert!(!gcode_for(&["text/*;q=0.9, application/*"]));
+        assert!(!gcode_for(&["text/*, text/x-gcode;q=0"]), "the exact range overrides text/*");
+        assert!(!gcode_for(&["text/html"]), "nothing kerf writes: JSON");
+        assert!(!gcode_for(&["text/x-gcode;q=high"]), "an unreadable element counts as not sent");
+        assert!(gcode_for(&["application/json;q=0.2", "text/x-gcode;q=0.3"]), "several header lines are one list");
     }
 }

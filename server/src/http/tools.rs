@@ -3,13 +3,14 @@
 use axum::Json;
 use axum::extract::State;
 use axum::http::StatusCode;
+use axum::response::Response;
 use kerf_solver::SolverError;
 use kerf_solver::tool::{TOOL_NUMBERS, Tool};
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
 use crate::error::{AppError, AppResult, Problem};
-use crate::extract::{AppJson, AppPath};
+use crate::extract::{AppJson, AppPath, DeleteHeaders, Preconditions, ReplaceHeaders, etag_of, tagged};
 use crate::state::AppState;
 use crate::store;
 
@@ -37,56 +38,73 @@ async fn list_tools(State(state): State<AppState>) -> AppResult<Json<Vec<Tool>>>
 #[utoipa::path(get, path = "/api/v1/tools/{number}", tag = "tools",
     params(("number" = u32, Path, description = "Tool number, 1–9999", minimum = 1, maximum = 9999)),
     responses(
-        (status = 200, body = Tool),
+        (status = 200, body = Tool, headers(("ETag" = String, description = "The stored tool's strong entity tag: send it in `If-Match` to replace or delete only this version"))),
         (status = 400, body = Problem, content_type = "application/problem+json"),
         (status = 404, body = Problem, content_type = "application/problem+json"),
         (status = 422, body = Problem, content_type = "application/problem+json")))]
-async fn get_tool(State(state): State<AppState>, AppPath(number): AppPath<ToolNumber>) -> AppResult<Json<Tool>> {
+async fn get_tool(State(state): State<AppState>, AppPath(number): AppPath<ToolNumber>) -> AppResult<Response> {
     let number = checked_number(number)?;
-    store::tools::get(&state.db, number)
+    let tool = store::tools::get(&state.db, number)
         .await?
-        .map(Json)
-        .ok_or_else(|| AppError::not_found(format!("tool {number} is not in the tool table")))
+        .ok_or_else(|| AppError::not_found(format!("tool {number} is not in the tool table")))?;
+    tagged(StatusCode::OK, &tool)
 }
 
-/// Registers or replaces a tool: 201 when new, 200 when replaced.
+/// Registers or replaces a tool: 201 when new, 200 when replaced. `If-Match` replaces only the
+/// version the client has seen, `If-None-Match: *` only creates; else 412 `E_PRECONDITION_FAILED`.
 #[utoipa::path(put, path = "/api/v1/tools/{number}", tag = "tools",
-    params(("number" = u32, Path, description = "Tool number, 1–9999", minimum = 1, maximum = 9999)),
+    params(
+        ("number" = u32, Path, description = "Tool number, 1–9999", minimum = 1, maximum = 9999),
+        ReplaceHeaders),
     request_body = Tool,
     responses(
-        (status = 201, description = "Created", body = Tool),
-        (status = 200, description = "Replaced", body = Tool),
+        (status = 201, description = "Created", body = Tool, headers(("ETag" = String, description = "The stored tool's strong entity tag"))),
+        (status = 200, description = "Replaced", body = Tool, headers(("ETag" = String, description = "The stored tool's strong entity tag"))),
         (status = 400, body = Problem, content_type = "application/problem+json"),
+        (status = 412, description = "`If-Match` or `If-None-Match` does not hold (`E_PRECONDITION_FAILED`, naming the header); the `ETag` header carries the current tag when the tool exists", body = Problem, content_type = "application/problem+json"),
         (status = 413, body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
         (status = 422, body = Problem, content_type = "application/problem+json")))]
 async fn put_tool(
     State(state): State<AppState>,
     AppPath(number): AppPath<ToolNumber>,
+    preconditions: Preconditions,
     AppJson(mut tool): AppJson<Tool>,
-) -> AppResult<(StatusCode, Json<Tool>)> {
+) -> AppResult<Response> {
     let number = checked_number(number)?;
     if tool.number.is_some_and(|given| given != number) {
         return Err(SolverError::input("number", format!("body number differs from the path's {number}")).into());
     }
     tool.number = Some(number);
     tool.validate("")?;
-    let created = store::tools::put(&state.db, &tool).await?;
-    let status = if created { StatusCode::CREATED } else { StatusCode::OK };
-    Ok((status, Json(tool)))
+    let item = format!("tool {number}");
+    let created = store::tools::put(&state.db, &tool, |current| {
+        preconditions.check(&item, current.map(etag_of).transpose()?.as_deref())
+    })
+    .await?;
+    tagged(if created { StatusCode::CREATED } else { StatusCode::OK }, &tool)
 }
 
-/// Removes a tool.
+/// Removes a tool; with `If-Match` only the version the client has seen (else 412).
 #[utoipa::path(delete, path = "/api/v1/tools/{number}", tag = "tools",
-    params(("number" = u32, Path, description = "Tool number, 1–9999", minimum = 1, maximum = 9999)),
+    params(
+        ("number" = u32, Path, description = "Tool number, 1–9999", minimum = 1, maximum = 9999),
+        DeleteHeaders),
     responses(
         (status = 204, description = "Deleted"),
         (status = 400, description = "The number is not a number", body = Problem, content_type = "application/problem+json"),
         (status = 404, body = Problem, content_type = "application/problem+json"),
+        (status = 412, description = "`If-Match` does not hold (`E_PRECONDITION_FAILED`); the `ETag` header carries the current tag when the tool exists", body = Problem, content_type = "application/problem+json"),
         (status = 422, description = "The number is outside 1–9999", body = Problem, content_type = "application/problem+json")))]
-async fn delete_tool(State(state): State<AppState>, AppPath(number): AppPath<ToolNumber>) -> AppResult<StatusCode> {
+async fn delete_tool(
+    State(state): State<AppState>,
+    AppPath(number): AppPath<ToolNumber>,
+    preconditions: Preconditions,
+) -> AppResult<StatusCode> {
     let number = checked_number(number)?;
-    if store::tools::delete(&state.db, number).await? {
+    let item = format!("tool {number}");
+    let guard = |current: Option<&Tool>| preconditions.check(&item, current.map(etag_of).transpose()?.as_deref());
+    if store::tools::delete(&state.db, number, guard).await? {
         Ok(StatusCode::NO_CONTENT)
     } else {
         Err(AppError::not_found(format!("tool {number} is not in the tool table")))

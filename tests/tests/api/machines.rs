@@ -1,5 +1,5 @@
 //! The machines registry: create, replace, read, list, delete, bad names and values, and
-//! survival across a restart.
+//! survival across a restart, and the preconditions of a write (`If-Match`, `If-None-Match`).
 
 use kerf_tests::{Store, TestApp, json_with, problem};
 use serde_json::json;
@@ -160,4 +160,21 @@ async fn bad_machines_are_refused_and_nothing_is_stored(store: Store) {
     assert_eq!(json_with(app.get("/api/v1/machines").await, 200).await, json!([]), "database unchanged");
 }
 
-kerf_tests::on_both_stores!(machine_crud_and_restart, bad_machines_are_refused_and_nothing_is_stored);
+async fn machine_preconditions(store: Store) {
+    let Some(mut app) = TestApp::spawn_on(store, |_| {}).await else { return };
+    super::tools::conditional_writes(
+        &app,
+        "/api/v1/machines/dmu50",
+        &json!({"block_time_ms": 4, "max_feed": 12000, "dialect": "linuxcnc"}),
+        &json!({"block_time_ms": 2, "max_feed": 15000}),
+        &json!({"block_time_ms": 2, "max_feed": 15000, "margin": 1.2}),
+    )
+    .await;
+    app.shutdown().await;
+}
+
+kerf_tests::on_both_stores!(
+    machine_crud_and_restart,
+    bad_machines_are_refused_and_nothing_is_stored,
+    machine_preconditions
+);

@@ -22,6 +22,7 @@ mod load;
 mod machines;
 mod materials;
 mod metrics;
+mod negotiation;
 mod openapi;
 mod predict;
 mod request_fuzz;

@@ -1,6 +1,6 @@
 //! The materials library: the seeded materials, create, replace, read, list, delete,
 //! bad names and values, survival across a restart; engagement requests and jobs that name a
-//! material, on both stores.
+//! material, and the preconditions of a write (`If-Match`, `If-None-Match`), on both stores.
 
 use kerf_tests::{Store, TestApp, finished, json_with, poll_job, problem};
 use serde_json::{Value, json};
@@ -252,10 +252,24 @@ async fn jobs_carry_their_materials(store: Store) {
     assert_eq!(answer["errors"][0]["path"], "materials[1].name");
 }
 
+async fn material_preconditions(store: Store) {
+    let Some(mut app) = TestApp::spawn_on(store, |_| {}).await else { return };
+    super::tools::conditional_writes(
+        &app,
+        "/api/v1/materials/S235JR",
+        &json!({"kc11": 1780, "mc": 0.17, "iso_group": "P"}),
+        &json!({"kc11": 1800, "mc": 0.2}),
+        &json!({"kc11": 1800, "mc": 0.2, "description": "measured"}),
+    )
+    .await;
+    app.shutdown().await;
+}
+
 kerf_tests::on_both_stores!(
     seeded_materials_with_their_sources,
     material_crud_and_restart,
     bad_materials_are_refused_and_nothing_is_stored,
     engagement_names_a_material,
-    jobs_carry_their_materials
+    jobs_carry_their_materials,
+    material_preconditions,
 );
