@@ -221,6 +221,7 @@ async fn segment_defaults_to_no_short_blocks_and_its_advice_names_the_page_contr
     let Some(result) = run_scenario(&app, "segmentDefault", &[]) else { return };
     assert_eq!(result["ok"], true);
     assert_eq!(result["short"], 0, "{result}");
+    eprintln!("ellipse: per-window mode {} short blocks; advice {}", result["windowShort"], result["advice"]);
 }
 
 #[tokio::test(flavor = "multi_thread")]
