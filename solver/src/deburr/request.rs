@@ -98,9 +98,9 @@ fn radius_or_diameter(
         (Some(value), None) => Ok(GivenSize { field: field(radius_name), value, diameter: false }),
         (None, Some(value)) => Ok(GivenSize { field: field(diameter_name), value, diameter: true }),
         (Some(_), Some(_)) => {
-            Err(SolverError::input(&field(diameter_name), format!("give {radius_name} or {diameter_name}, not both")))
+            Err(SolverError::input(field(diameter_name), format!("give {radius_name} or {diameter_name}, not both")))
         }
-        (None, None) => Err(SolverError::input(&field(radius_name), format!("give {radius_name} or {diameter_name}"))),
+        (None, None) => Err(SolverError::input(field(radius_name), format!("give {radius_name} or {diameter_name}"))),
     }
 }
 
