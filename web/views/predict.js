@@ -4,7 +4,7 @@
 // scale, a histogram of the errors, the worst passes with their NC lines, warnings, and the
 // corrected program. `predictResult` also shows prediction jobs.
 import { api } from '/api.js';
-import { clearProblem, downloadFlow, half, keepForm, loadTools, message, number, numeric, showProblem, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
+import { clearProblem, downloadFlow, half, keepForm, loadTools, message, number, numeric, parseDecimal, showProblem, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
 import { css, diverging, drawColourScale, drawHistogram } from '/plot/colour.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
@@ -378,7 +378,7 @@ export function predictResult(container, answer, { request, program, stockTriang
   }) : null;
   const end = (pass) => pass.corrected.map((c, k) => c - pass.correction[k]);
   const redraw = () => {
-    const band = Number(bandInput.value) / 1000;
+    const band = (parseDecimal(bandInput.value) || 0) / 1000;
     const colour = (e) => colourOf(e, limit);
     drawColourScale(scale, { low: -limit, high: limit, band, colour, format: microns, unit: 'µm' });
     drawHistogram(histogram, errors, { low, high, band, colour, format: microns, unit: 'µm', label: 'passes per error' });
