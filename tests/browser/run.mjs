@@ -1136,6 +1136,39 @@ const scenarios = {
     const refused = await page.getAttribute('#job-result [data-objects]', 'data-refused');
     return { objects, refused };
   },
+
+  // Machines and materials as tools: saving a name that exists asks first, showing what is
+  // stored, and "keep" leaves it; Edit names what it edits and Cancel leaves it as stored.
+  async registryOverwrite() {
+    const stored = (path) => page.evaluate(async (p) => (await (await fetch(p)).json()), path);
+    const seen = {};
+    for (const [view, field, first, second, path, key] of [
+      ['machines', 'block_time_ms', '4', '2', '/api/v1/machines/hsc-4ms', 'block_time_ms'],
+      ['materials', 'kc11', '1700', '2000', '/api/v1/materials/steel-c45', 'kc11'],
+    ]) {
+      const form = `#${view.slice(0, -1)}-form`;
+      const messages = `#${view.slice(0, -1)}-messages`;
+      await page.goto(`${base}/#/${view}`);
+      await page.waitForSelector(form);
+      await page.fill(`${form} input[name="${field}"]`, first);
+      await page.click(`${form} button[type="submit"]`);
+      await page.waitForSelector(`${messages} .message.ok`, { timeout: 15000 });
+      await page.fill(`${form} input[name="${field}"]`, second);
+      await page.click(`${form} button[type="submit"]`);
+      const ask = await page.waitForSelector(`${messages} [data-ask="replace"]`, { timeout: 15000 })
+        .catch(async () => { throw new Error(`${view}: saving again did not ask first; stored now: ${JSON.stringify(await stored(path))}`); });
+      seen[view] = await ask.textContent();
+      await page.click(`${messages} button[data-answer="keep"]`);
+      await page.waitForSelector(`${messages} .message.ok`, { timeout: 15000 });
+      if (String((await stored(path))[key]) !== first) throw new Error(`${view}: keep changed it: ${JSON.stringify(await stored(path))}`);
+      await page.click(`#${view.slice(0, -1)}-rows tr button:has-text("Edit")`);
+      const legend = await page.textContent(`${form} legend[data-legend]`);
+      if (!/Edit/.test(legend)) throw new Error(`${view}: editing does not say what: ${legend}`);
+      await page.click(`#${view.slice(0, -1)}-cancel-edit`);
+      if (/Edit/.test(await page.textContent(`${form} legend[data-legend]`))) throw new Error(`${view}: cancel left the form editing`);
+    }
+    return { seen };
+  },
 };
 
 try {

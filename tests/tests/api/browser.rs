@@ -247,3 +247,10 @@ async fn an_opened_deburr_job_draws_its_tube_and_hole() {
     assert_eq!(result["ok"], true);
     assert_eq!(result["refused"], "false", "{result}");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn saving_an_existing_machine_or_material_asks_first_and_keeps_it() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "registryOverwrite", &[]) else { return };
+    assert_eq!(result["ok"], true);
+}
