@@ -1084,10 +1084,15 @@ const scenarios = {
     await page.click(`#job-rows tr[data-job="${id}"] button:has-text("Re-submit")`);
     await page.waitForFunction((first) => [...document.querySelectorAll('#job-rows tr[data-status="failed"]')].some((r) => Number(r.dataset.job) > first), id, { timeout: 60000 });
     const again = await page.$$eval('#job-rows tr[data-status="failed"]', (rows) => rows.map((r) => Number(r.dataset.job)));
-    // Delete: asked first, then gone from the page and from the service.
+    // Delete: asked first, then gone from the page and from the service (the messages emptied
+    // first, so an error there is the delete's).
+    await page.waitForFunction(() => !document.querySelector('#job-rows tr[data-status="queued"], #job-rows tr[data-status="running"]'), null, { timeout: 60000 });
+    await page.$eval('#job-messages', (box) => box.replaceChildren());
     await page.click(`#job-rows tr[data-job="${id}"] button:has-text("Delete")`);
     await page.click(`#job-rows tr[data-job="${id}"] button:has-text("Yes, delete")`);
-    await page.waitForSelector(`#job-rows tr[data-job="${id}"]`, { state: 'detached', timeout: 15000 });
+    await page.waitForFunction((job) => !document.querySelector(`#job-rows tr[data-job="${job}"]`) || document.querySelector('#job-messages .message.error'), id, { timeout: 15000 });
+    const refusedDelete = await page.$('#job-messages .message.error');
+    if (refusedDelete) throw new Error(`deleting failed job #${id} was refused: ${await refusedDelete.textContent()} (${await refusedDelete.getAttribute('title')})`);
     const status = await page.evaluate(async (job) => (await fetch(`/api/v1/jobs/${job}`)).status, id);
     if (status !== 404) throw new Error(`deleted job #${id} still answers ${status}`);
     shown = await objectShown();
