@@ -14,8 +14,8 @@ function askForToken() {
 }
 
 // Sends one request with the token; resolves to the response, rejects when there is no answer.
-async function send(method, path, body, accept) {
-  const options = { method, headers: { accept } };
+async function send(method, path, body, accept, headers = {}) {
+  const options = { method, headers: { ...headers, accept } };
   if (token()) options.headers.authorization = `Bearer ${token()}`;
   if (body instanceof FormData) {
     options.body = body;
@@ -37,7 +37,7 @@ async function send(method, path, body, accept) {
 async function failure(response) {
   const type = response.headers.get('content-type') || '';
   const payload = type.includes('json') ? await response.json() : await response.text();
-  return typeof payload === 'object' ? payload : { status: response.status, detail: String(payload) };
+  return typeof payload === 'object' && payload ? { status: response.status, ...payload } : { status: response.status, detail: String(payload) };
 }
 
 // Calls the API; resolves to the parsed JSON, the text of a text answer (G-code) or a Blob of any
@@ -50,6 +50,15 @@ export async function api(method, path, body, accept = 'application/json') {
   if (type.includes('json')) return response.json();
   if (type === '' || type.startsWith('text/')) return response.text();
   return response.blob();
+}
+
+// Calls the API with extra request headers (`If-Match`, `If-None-Match`); resolves to the parsed
+// JSON and the answer's `ETag` (null without one), rejects with the problem document.
+export async function tagged(method, path, body, headers = {}) {
+  const response = await send(method, path, body, 'application/json', headers);
+  if (!response.ok) throw await failure(response);
+  const etag = response.headers.get('etag');
+  return { body: response.status === 204 ? null : await response.json(), etag };
 }
 
 // Fetches a binary answer (a job's outputs.zip) as a Blob, its bytes untouched; rejects with the

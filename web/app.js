@@ -1,5 +1,6 @@
 // kerf page shell: the tabs and `#/view` routes (Back and Forward move between views), each view
 // mounted once in its own section so its form and result stay when another view is shown.
+import { decimalInputs } from '/form.js';
 import { VIEWS } from '/views.js';
 
 const mounted = new Map();
@@ -32,6 +33,7 @@ function show(view) {
     root.setAttribute('aria-label', view.title);
     main.append(root);
     mounted.set(view.id, root);
+    decimalInputs(root);
     view.mount(root, view.id);
   } else {
     root.dispatchEvent(new Event('kerf:show'));

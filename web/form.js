@@ -3,7 +3,7 @@
 // reading fields, the tool and machine choices (machine values as placeholders, only overrides
 // sent), errors at the field, warnings as sentences, the per-view state kept in local storage,
 // summaries and downloads.
-import { api, machines, materials, plainFieldMessage, plainTitle, program, sentence, technical, tools } from '/api.js';
+import { api, machines, materials, plainFieldMessage, plainTitle, program, sentence, tagged, technical, tools } from '/api.js';
 
 // ---------------------------------------------------------------- reading fields
 
@@ -12,10 +12,54 @@ export function value(form, name) {
   return form.elements[name].value;
 }
 
-// The number in form control `name`, or undefined when it is empty.
+// The number a person typed: a decimal comma is a decimal point ("6,5" is 6.5, as a German
+// keyboard types it) and a typographic minus a minus; text that is not one plain number
+// ("6,5,1", "1.234,5", "6 mm") is NaN, never a number with a separator dropped.
+export function parseDecimal(text) {
+  const plain = String(text).trim().replace(/[\u2212\u2013]/g, '-');
+  if (!/^[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?$/.test(plain)) return NaN;
+  return Number(plain.replace(',', '.'));
+}
+
+// A problem document for input the page refuses at `control` before asking the service.
+export function fieldProblem(control, text) {
+  return { status: 400, title: 'Not a number', errors: [{ path: control.dataset.field || control.name, message: text }] };
+}
+
+// The number in form control `name`, or undefined when it is empty. Text that is not a number
+// is refused at its field (throws a problem document), so it is never sent as something else.
 export function numeric(form, name) {
-  const text = value(form, name).trim();
-  return text === '' ? undefined : Number(text);
+  const control = form.elements[name];
+  const text = control.value.trim();
+  if (text === '') return undefined;
+  const number = parseDecimal(text);
+  if (Number.isNaN(number)) throw fieldProblem(control, `“${text}” is not a number: type digits with one decimal point or comma, e.g. 6.5 or 6,5.`);
+  return number;
+}
+
+// One number field as a text field with a decimal keyboard (see decimalInputs).
+function decimalInput(input) {
+  input.type = 'text';
+  input.inputMode = 'decimal';
+  input.autocomplete = 'off';
+  input.spellcheck = false;
+}
+
+// Number fields as text fields with a decimal keyboard, in `root` and whatever is added to it
+// later: a browser's number field drops a decimal comma it does not expect ("6,5" reads as 65 or
+// as nothing), so the page reads what was typed itself (numeric).
+export function decimalInputs(root) {
+  const convert = decimalInput;
+  root.querySelectorAll('input[type="number"]').forEach(convert);
+  new MutationObserver((records) => {
+    for (const record of records) {
+      for (const node of record.addedNodes) {
+        if (node.nodeType !== Node.ELEMENT_NODE) continue;
+        if (node.matches('input[type="number"]')) convert(node);
+        node.querySelectorAll('input[type="number"]').forEach(convert);
+      }
+    }
+  }).observe(root, { childList: true, subtree: true });
 }
 
 // Half of a diameter entered in a form (the API takes radii), or undefined when empty.
@@ -39,9 +83,27 @@ export function message(kind, text, tooltip) {
   return div;
 }
 
-// The answer's warnings as sentences, the code as a tooltip.
-export function warningMessages(warnings = []) {
-  return warnings.map((w) => message('warning', sentence(w.message), `${w.code}: ${w.message}`));
+// The answer's warnings as sentences, the code as a tooltip. With the `form` that asked, advice
+// that names a request field (`radius_estimate "minimum"`) names the form's control for it, by
+// its label (“Radius estimate”), and a choice by the words the control shows for it.
+export function warningMessages(warnings = [], form) {
+  return warnings.map((w) => message('warning', sentence(form ? withLabels(w.message, form) : w.message), `${w.code}: ${w.message}`));
+}
+
+// `text` with each request field it names (snake_case, or `name "choice"`) as the label of the
+// control of `form` with that name.
+function withLabels(text, form) {
+  const control = (name) => {
+    const found = form.elements[name];
+    return found instanceof HTMLElement ? found : null;
+  };
+  return text
+    .replace(/\b([a-z]+(?:_[a-z]+)*) "([^"]+)"/g, (all, name, choice) => {
+      const found = control(name);
+      const option = found?.tagName === 'SELECT' ? [...found.options].find((o) => o.value === choice) : null;
+      return found && option ? `${labelText(found)} “${option.textContent}”` : all;
+    })
+    .replace(/\b[a-z]+(?:_[a-z]+)+\b/g, (name) => (control(name) ? labelText(control(name)) : name));
 }
 
 // Shows "computing…" and dims the last result until the answer comes.
@@ -197,13 +259,14 @@ function controlsFor(form, error) {
   const missing = /missing field `([^`]+)`/.exec(error.message || '');
   if (missing) paths.unshift(error.path === 'body' ? missing[1] : `${error.path}.${missing[1]}`);
   for (const path of paths) {
-    const found = [...form.querySelectorAll('[data-field]')].filter((e) => {
-      const field = e.dataset.field;
-      return !e.closest('[hidden]') && (path === field || path.startsWith(`${field}[`) || path.startsWith(`${field}.`));
-    });
+    // data-field may name several paths (a size entered as a radius or a diameter).
+    const found = [...form.querySelectorAll('[data-field]')].filter((e) => !e.closest('[hidden]') && e.dataset.field.split(' ')
+      .some((field) => path === field || path.startsWith(`${field}[`) || path.startsWith(`${field}.`)));
     if (found.length) return found;
   }
-  return [];
+  // A field the page refused itself may have no data-field: its control by name.
+  const named = form.elements[error.path];
+  return named instanceof HTMLElement && !named.closest('[hidden]') ? [named] : [];
 }
 
 // The API's message without its leading field path ("hole.radius must be …" → "must be …").
@@ -449,6 +512,8 @@ function restore(form, { fields = {}, dirty = [] }) {
 // (the service is deterministic, so this is the same result). Adds "Load example" and "Reset".
 // `more` ({save, restore}) keeps what has no form control name (e.g. a list of path boxes).
 export function keepForm(view, form, { onReset, more } = {}) {
+  // Before a kept "6,5" is put back: a number field would drop it.
+  form.querySelectorAll('input[type="number"]').forEach(decimalInput);
   const saved = readState(view);
   const save = (extra = {}) => writeState(view, { ...(readState(view) || {}), ...snapshot(form), more: more?.save(), ...extra });
   form.addEventListener('input', (event) => {
@@ -532,4 +597,60 @@ export function confirmButton(text, question, action) {
   yes.addEventListener('click', action);
   box.append(ask, prompt);
   return box;
+}
+
+// ---------------------------------------------------------------- saving without overwriting
+
+// Whether a problem is the service's "not as you last saw it" answer (412).
+function stale(problem) {
+  return problem?.status === 412 || problem?.code === 'E_PRECONDITION_FAILED';
+}
+
+// Saves `body` with PUT at `path` (one tool, machine or material) without overwriting what the
+// user has not seen: a new entry with `If-None-Match: *`, an edited one with `If-Match: etag` of
+// the version opened. When the service answers 412 (the entry exists, or someone changed it since
+// it was opened), what is stored now is shown in `box` as `describe(stored)` and the user is
+// asked: replace it (a PUT with `If-Match` of the version shown, so a third change is caught
+// again) or keep it (nothing sent). Resolves to {saved: true, etag} or {saved: false}.
+export async function saveGuarded(box, { path, body, etag, what, describe }) {
+  let condition = etag ? { 'if-match': etag } : { 'if-none-match': '*' };
+  for (;;) {
+    try {
+      const answer = await tagged('PUT', path, body, condition);
+      return { saved: true, etag: answer.etag };
+    } catch (problem) {
+      if (!stale(problem)) throw problem;
+      const stored = await tagged('GET', path);
+      const replace = await askToReplace(box, etag ? `${what} was changed since you opened it.` : `${what} already exists.`, `${what} as stored: ${describe(stored.body)}.`, what);
+      if (!replace) return { saved: false };
+      condition = { 'if-match': stored.etag };
+    }
+  }
+}
+
+// Shows what is stored and asks whether to replace it; resolves to the answer.
+function askToReplace(box, headline, storedText, what) {
+  return new Promise((resolve) => {
+    const ask = message('warning', `${headline} ${storedText} Replace it with the form's values?`);
+    ask.setAttribute('role', 'alertdialog');
+    ask.dataset.ask = 'replace';
+    const bar = document.createElement('div');
+    bar.className = 'actions';
+    const yes = document.createElement('button');
+    yes.type = 'button';
+    yes.className = 'danger small';
+    yes.dataset.answer = 'replace';
+    yes.textContent = `Replace ${what}`;
+    const no = document.createElement('button');
+    no.type = 'button';
+    no.className = 'secondary small';
+    no.dataset.answer = 'keep';
+    no.textContent = `Keep ${what} as stored`;
+    bar.append(yes, ' ', no);
+    ask.append(bar);
+    box.replaceChildren(ask);
+    no.focus();
+    yes.addEventListener('click', () => resolve(true), { once: true });
+    no.addEventListener('click', () => resolve(false), { once: true });
+  });
 }

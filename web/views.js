@@ -5,6 +5,7 @@
 import { CAPABILITIES } from '/capabilities.js';
 import { jobsView } from '/views/jobs.js';
 import { machinesView } from '/views/machines.js';
+import { materialsView } from '/views/materials.js';
 import { toolsView } from '/views/tools.js';
 
 // A capability whose view does not load is left out (and reported) instead of breaking the page.
@@ -23,6 +24,7 @@ export const VIEWS = [
   { id: 'jobs', title: 'Jobs', mount: jobsView.mount },
   { id: 'tools', title: 'Tools', mount: toolsView.mount },
   { id: 'machines', title: 'Machines', mount: machinesView.mount },
+  { id: 'materials', title: 'Materials', mount: materialsView.mount },
 ];
 
 // How a job's operation result is shown: the view with that id.

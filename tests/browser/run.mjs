@@ -215,7 +215,7 @@ const scenarios = {
 
     // A bad value: its message under the field, aria-invalid, aria-describedby naming the message,
     // focus on the field, the last result still there but dimmed.
-    await page.fill('input[name="hole_radius"]', '-1');
+    await page.fill('input[name="hole_size"]', '-1');
     await page.click('#deburr-compute');
     await page.waitForSelector('#deburr-form [aria-invalid="true"]', { timeout: 60000 });
     const bad = await page.$eval('#deburr-form [aria-invalid="true"]', (e) => {
@@ -224,13 +224,13 @@ const scenarios = {
       const under = note?.getBoundingClientRect();
       return { name: e.name, note: note?.textContent, below: under ? under.top >= field.bottom - 1 : false, focused: document.activeElement === e };
     });
-    if (bad.name !== 'hole_radius' || !bad.note || !bad.below || !bad.focused) throw new Error(`field error: ${JSON.stringify(bad)}`);
+    if (bad.name !== 'hole_size' || !bad.note || !bad.below || !bad.focused) throw new Error(`field error: ${JSON.stringify(bad)}`);
     const kept = await page.$$eval('#deburr-result.stale #deburr-plot', (l) => l.length);
     if (kept !== 1) throw new Error('the last good result was not kept dimmed');
     // The G-code button with the bad value: the service's refusal at the field, no file.
     const deburrRefused = await refusedDownload('#deburr-gcode', '#deburr-messages');
     const refusedMarks = await page.$$eval('#deburr-form [aria-invalid="true"]', (l) => l.map((e) => e.name));
-    if (!/marked field/.test(deburrRefused) || refusedMarks.join() !== 'hole_radius') throw new Error(`deburr download refused: "${deburrRefused}", ${refusedMarks}`);
+    if (!/marked field/.test(deburrRefused) || refusedMarks.join() !== 'hole_size') throw new Error(`deburr download refused: "${deburrRefused}", ${refusedMarks}`);
     return { segments, inked, objects, firstPlot, note: bad.note, program: deburrLines };
   },
 
@@ -348,6 +348,8 @@ const scenarios = {
   // Machines view and used, the G-code downloaded, the machine deleted.
   async segment() {
     await page.goto(`${base}/#segment`);
+    // The per-window mode of the patent (the page's default is the guarantee mode).
+    await page.selectOption('#segment-form select[name="mode"]', 'window');
     await page.click('#segment-compute');
     await page.waitForSelector('#segment-plot[data-state="drawn"]', { timeout: 60000 });
     await page.waitForSelector('#segment-chart[data-state="drawn"]', { timeout: 60000 });
@@ -857,6 +859,320 @@ const scenarios = {
     }
     const id = await page.$eval('#job-rows tr[data-status="done"]', (row) => row.dataset.job);
     return { id: Number(id), file: download.suggestedFilename(), size: bytes.length, entries: entries.sort() };
+  },
+
+  // Tools: saving a number that exists asks first (the stored tool shown), keeps the old tool on
+  // "keep", replaces it only on "replace"; Edit says which number it edits and Cancel leaves the
+  // tool as stored. The saves are conditional (If-None-Match: * to create, If-Match to replace).
+  async toolOverwrite() {
+    const conditions = [];
+    page.on('request', (request) => {
+      if (request.method() === 'PUT' && /\/api\/v1\/tools\/7$/.test(request.url())) {
+        const headers = request.headers();
+        conditions.push(headers['if-none-match'] ? `if-none-match ${headers['if-none-match']}` : headers['if-match'] ? 'if-match' : 'none');
+      }
+    });
+    const stored = () => page.evaluate(async () => (await (await fetch('/api/v1/tools/7')).json()));
+    await page.goto(`${base}/#/tools`);
+    const enter = async (kind, diameter, name) => {
+      await page.fill('#tool-form input[name="number"]', '7');
+      await page.selectOption('#tool-form select[name="kind"]', kind);
+      await page.fill('#tool-form input[name="size"]', diameter);
+      await page.fill('#tool-form input[name="name"]', name);
+      await page.click('#tool-save');
+    };
+    await enter('ball', '6', 'ball six');
+    await page.waitForSelector('#tool-rows tr[data-tool="7"]', { timeout: 60000 });
+    // The same number again, another tool: a question showing the stored one, nothing saved yet.
+    await enter('flat', '10', 'flat ten');
+    const ask = await page.waitForSelector('#tool-messages [data-ask="replace"]', { timeout: 15000 })
+      .catch(async () => { throw new Error(`saving T7 again did not ask first; stored now: ${JSON.stringify(await stored())}`); });
+    const question = await ask.textContent();
+    if (!/T7/.test(question) || !/Ø6 ball/.test(question)) throw new Error(`the question does not show the stored tool: ${question}`);
+    if ((await stored()).radius !== 3) throw new Error('T7 was replaced before the answer');
+    await page.click('#tool-messages button[data-answer="keep"]');
+    await page.waitForSelector('#tool-messages .message.ok', { timeout: 15000 });
+    const kept = await stored();
+    if (kept.kind !== 'ball' || kept.radius !== 3 || kept.name !== 'ball six') throw new Error(`keep changed T7: ${JSON.stringify(kept)}`);
+    // Edit names the number; Cancel leaves the stored tool and the form says so.
+    await page.click('#tool-rows tr[data-tool="7"] button:has-text("Edit")');
+    const legend = await page.textContent('#tool-form legend[data-legend]');
+    if (!/T7/.test(legend)) throw new Error(`editing does not say which tool: ${legend}`);
+    await page.fill('#tool-form input[name="size"]', '12');
+    await page.click('#tool-cancel-edit');
+    const after = await page.textContent('#tool-form legend[data-legend]');
+    if (/T7/.test(after)) throw new Error(`cancel left the form editing: ${after}`);
+    if ((await stored()).radius !== 3) throw new Error('cancel changed T7');
+    // Replace on purpose: asked again, then replaced with If-Match of the version shown.
+    await enter('flat', '10', 'flat ten');
+    await page.waitForSelector('#tool-messages [data-ask="replace"]', { timeout: 15000 });
+    await page.click('#tool-messages button[data-answer="replace"]');
+    await page.waitForSelector('#tool-messages .message.ok', { timeout: 15000 });
+    const replaced = await stored();
+    if (replaced.kind !== 'flat' || replaced.radius !== 5) throw new Error(`replace did not replace: ${JSON.stringify(replaced)}`);
+    if (conditions[0] !== 'if-none-match *' || !conditions.includes('if-match')) throw new Error(`conditions sent: ${conditions}`);
+    return { question, conditions };
+  },
+
+  // A decimal comma, in a German browser: "6,5" is 6.5 (never 65), "6,5,1" is refused at its
+  // field; every number field on every view names its unit.
+  async decimalComma() {
+    const context = await browser.newContext({ locale: 'de-DE', viewport: { width: 1400, height: 1000 } });
+    const german = await context.newPage();
+    german.on('pageerror', (error) => problems.push(`page error: ${error.message}`));
+    german.on('console', (m) => {
+      if (m.type() === 'error' && !/status of 4\d\d/.test(m.text())) problems.push(`console error: ${m.text()}`);
+    });
+    await german.goto(`${base}/#/tools`);
+    const language = await german.evaluate(() => navigator.language);
+    await german.fill('#tool-form input[name="number"]', '').catch(() => {});
+    await german.click('#tool-form input[name="number"]', { clickCount: 3 });
+    await german.keyboard.type('21');
+    await german.click('#tool-form input[name="size"]', { clickCount: 3 });
+    await german.keyboard.press('Backspace');
+    await german.keyboard.type('6,5');
+    await german.click('#tool-save');
+    await german.waitForSelector('#tool-messages .message', { timeout: 15000 });
+    await german.waitForTimeout(300);
+    const tool = await german.evaluate(async () => {
+      const response = await fetch('/api/v1/tools/21');
+      return response.ok ? response.json() : null;
+    });
+    const marked = await german.$$eval('#tool-form [aria-invalid="true"]', (l) => l.map((e) => e.name));
+    if (tool && tool.radius !== 3.25) throw new Error(`"6,5" saved as Ø${2 * tool.radius}`);
+    if (!tool && marked.join() !== 'size') throw new Error(`"6,5" neither saved as 6.5 nor refused at the field (marked: ${marked})`);
+    // Not one number: refused at the field, nothing sent.
+    await german.click('#tool-form input[name="number"]', { clickCount: 3 });
+    await german.keyboard.type('22');
+    await german.click('#tool-form input[name="size"]', { clickCount: 3 });
+    await german.keyboard.press('Backspace');
+    await german.keyboard.type('6,5,1');
+    await german.click('#tool-save');
+    await german.waitForSelector('#tool-form [aria-invalid="true"]', { timeout: 15000 });
+    const refused = await german.$$eval('#tool-form [aria-invalid="true"]', (l) => l.map((e) => e.name));
+    const none = await german.evaluate(async () => (await fetch('/api/v1/tools/22')).status);
+    if (refused.join() !== 'size' || none !== 404) throw new Error(`"6,5,1": marked ${refused}, T22 status ${none}`);
+    // Every number field the page shows names its unit (or says it counts something, or is an
+    // angle, a factor or a ratio without one).
+    const unitless = [];
+    for (const view of await german.$$eval('#tabs a', (l) => l.map((a) => a.dataset.view))) {
+      await german.click(`#tabs a[data-view="${view}"]`);
+      await german.waitForTimeout(300);
+      unitless.push(...await german.$$eval(`[data-view-root="${view}"] input[inputmode="decimal"], [data-view-root="${view}"] input[type="number"]`, (inputs, id) => inputs
+        .map((input) => `${id}: ${(input.closest('label')?.textContent || input.getAttribute('aria-label') || input.name).replace(/\s+/g, ' ').trim()}`)
+        .filter((label) => !/(mm|°|ms|rpm|\bs\b|%|N·m|N\/mm|kW|Hz|µm|cells|count|no unit|Flutes|exponent|ratio|Tool number T|Save as T)/.test(label)), view));
+    }
+    await context.close();
+    if (unitless.length) throw new Error(`number fields without a unit: ${[...new Set(unitless)].join('; ')}`);
+    return { language, radius: tool?.radius ?? null, marked };
+  },
+
+  // Deburr by OD, ID and Ø as a drawing gives them: the same path as by the radii; a negative
+  // OD is refused quoting the OD typed.
+  async deburrDiameters() {
+    await page.goto(`${base}/#/deburr`);
+    await page.waitForSelector('#deburr-form');
+    const computed = async () => {
+      const [response] = await Promise.all([
+        page.waitForResponse((r) => r.request().method() === 'POST' && /\/api\/v1\/deburr$/.test(r.url()), { timeout: 60000 }),
+        page.click('#deburr-compute'),
+      ]);
+      const answer = await response.json();
+      await page.waitForSelector('#deburr-result:not(.stale) #deburr-plot[data-state="drawn"]', { timeout: 60000 });
+      return { request: JSON.parse(response.request().postData()), answer, objects: await page.getAttribute('#deburr-plot', 'data-objects') };
+    };
+    if (!(await page.$('#deburr-form select[name="sizes_as"]'))) throw new Error('deburr has no OD/ID/Ø entry');
+    await page.selectOption('#deburr-form select[name="sizes_as"]', 'diameter');
+    const label = await page.textContent('#deburr-form label:has(input[name="outer_size"])');
+    await page.fill('#deburr-form input[name="outer_size"]', '50');
+    await page.fill('#deburr-form input[name="inner_size"]', '30');
+    await page.fill('#deburr-form input[name="hole_size"]', '16');
+    const byDiameter = await computed();
+    await page.selectOption('#deburr-form select[name="sizes_as"]', 'radius');
+    await page.fill('#deburr-form input[name="outer_size"]', '25');
+    await page.fill('#deburr-form input[name="inner_size"]', '15');
+    await page.fill('#deburr-form input[name="hole_size"]', '8');
+    const byRadius = await computed();
+    const { workpiece, hole } = byDiameter.request;
+    if (workpiece.outer_diameter !== 50 || workpiece.inner_diameter !== 30 || hole.diameter !== 16) throw new Error(`request by diameter: ${JSON.stringify(byDiameter.request)}`);
+    if (byRadius.request.workpiece.outer_radius !== 25 || byRadius.request.hole.radius !== 8) throw new Error(`request by radius: ${JSON.stringify(byRadius.request)}`);
+    const path = (a) => JSON.stringify(a.result?.points ?? a.points);
+    if (path(byDiameter.answer) !== path(byRadius.answer)) throw new Error('OD/ID/Ø gave another path than the radii');
+    for (const name of ['tube', 'hole']) if (!byDiameter.objects.split(' ').includes(name)) throw new Error(`no ${name} drawn by diameter: ${byDiameter.objects}`);
+    // A negative OD: refused at the OD field, quoting what was typed.
+    await page.selectOption('#deburr-form select[name="sizes_as"]', 'diameter');
+    await page.fill('#deburr-form input[name="outer_size"]', '-6');
+    await page.fill('#deburr-form input[name="inner_size"]', '30');
+    await page.fill('#deburr-form input[name="hole_size"]', '16');
+    await page.click('#deburr-compute');
+    await page.waitForSelector('#deburr-form [aria-invalid="true"]', { timeout: 60000 });
+    const bad = await page.$eval('#deburr-form [aria-invalid="true"]', (e) => ({ name: e.name, note: document.getElementById(e.getAttribute('aria-describedby'))?.textContent, tip: document.getElementById(e.getAttribute('aria-describedby'))?.title }));
+    if (bad.name !== 'outer_size' || !/-6\b/.test(bad.note) || /-3\b/.test(bad.note) || !/outer_diameter/.test(bad.tip)) throw new Error(`negative OD: ${JSON.stringify(bad)}`);
+    return { label, points: byDiameter.answer.result?.points?.length ?? byDiameter.answer.points?.length, note: bad.note };
+  },
+
+  // Segment's default is the guarantee mode: no short blocks; every piece of advice names a
+  // control the form has (and a choice it offers).
+  async segmentDefault() {
+    await page.goto(`${base}/#/segment`);
+    await page.waitForSelector('#segment-form');
+    // An ellipse, whose changing curvature leaves short blocks in the per-window mode.
+    await page.selectOption('#segment-form select[name="kind"]', 'ellipse');
+    await page.click('#segment-compute');
+    await page.waitForSelector('#segment-result:not(.stale) .summary', { timeout: 60000 });
+    const mode = await page.inputValue('#segment-form select[name="mode"]');
+    const summary = await page.textContent('#segment-result .summary');
+    const short = Number(/short blocks(?: \(<[^)]*\))?\s*(\d+)/.exec(summary)?.[1]);
+    if (mode !== 'guarantee' || short !== 0) throw new Error(`default mode ${mode}: ${short} short blocks (${summary.slice(0, 300)})`);
+    // The per-window mode leaves short blocks; the advice then names what the page offers.
+    await page.selectOption('#segment-form select[name="mode"]', 'window');
+    await page.click('#segment-compute');
+    await page.waitForFunction(() => document.querySelector('#segment-result:not(.stale) .message.warning'), null, { timeout: 60000 });
+    const advice = await page.$$eval('#segment-result .message.warning', (list) => list.map((m) => ({ text: m.textContent, raw: m.title })));
+    const missing = await page.$eval('#segment-form', (form, advice) => {
+      const lacking = [];
+      for (const { raw } of advice) {
+        const message = raw.replace(/^[A-Z_]+: /, '');
+        for (const [, name, choice] of message.matchAll(/\b([a-z]+(?:_[a-z]+)*) "([^"]+)"/g)) {
+          const control = form.elements[name];
+          if (!control || (control.tagName === 'SELECT' && ![...control.options].some((o) => o.value === choice))) lacking.push(`${name} "${choice}"`);
+        }
+        for (const [name] of message.matchAll(/\b[a-z]+(?:_[a-z]+)+\b/g)) {
+          if (!form.elements[name] && !['block_time', 'min_block_length'].includes(name)) lacking.push(name);
+        }
+        for (const name of ['margin', 'tolerance', 'window']) {
+          if (new RegExp(`(raise|lower|shorter) ${name}\\b`).test(message) && !form.elements[name]) lacking.push(name);
+        }
+      }
+      return lacking;
+    }, advice);
+    const windowSummary = await page.textContent('#segment-result .summary');
+    const windowShort = Number(/short blocks(?: \(<[^)]*\))?\s*(\d+)/.exec(windowSummary)?.[1]);
+    if (!(windowShort > 0)) throw new Error(`the per-window mode left no short blocks on the ellipse (${windowShort}): the case shows nothing`);
+    if (!advice.length) throw new Error('the per-window mode gave no advice to check');
+    if (missing.length) throw new Error(`advice names controls the page lacks: ${missing.join(', ')} in ${advice.map((a) => a.text).join(' | ')}`);
+    return { short, windowShort, advice: advice.map((a) => a.text) };
+  },
+
+  // A job that fails: its reason in words (no "[object Object]" in the page or a tooltip); it can
+  // be opened, re-submitted and deleted.
+  async jobsFailed() {
+    const bad = {
+      name: 'hole too large',
+      operations: [{ operation: 'deburr', tool: { kind: 'ball', radius: 2 }, edge: 'outer', cut_amount: 0.2,
+        workpiece: { kind: 'tube', origin: [0, 0, 0], inner_radius: 15, outer_radius: 25 }, hole: { shape: 'round', radius: 60 } }],
+    };
+    await page.goto(`${base}/#/jobs`);
+    await page.setInputFiles('#job-file', { name: 'too-large.json', mimeType: 'application/json', buffer: Buffer.from(JSON.stringify(bad)) });
+    await page.waitForSelector('#job-rows tr[data-status="failed"]', { timeout: 60000 });
+    await page.waitForSelector('#job-messages .message.error', { timeout: 15000 });
+    const objectShown = () => page.evaluate(() => {
+      const texts = [document.body.innerText, ...[...document.querySelectorAll('[title]')].map((e) => e.title)];
+      return texts.filter((t) => t.includes('[object Object]'));
+    });
+    const banner = await page.textContent('#job-messages .message.error');
+    let shown = await objectShown();
+    if (shown.length) throw new Error(`"[object Object]" shown: ${shown.map((t) => t.slice(0, 200)).join(' | ')}`);
+    if (!/hole too large|cylinder radius/i.test(banner)) throw new Error(`the banner does not say why: ${banner}`);
+    const id = Number(await page.$eval('#job-rows tr[data-status="failed"]', (row) => row.dataset.job));
+    // Open: the reason and what can be done.
+    await page.click(`#job-rows tr[data-job="${id}"] button:has-text("Open")`);
+    await page.waitForSelector('#job-result[data-state="shown"]', { timeout: 15000 });
+    const opened = await page.textContent('#job-result');
+    if (!/failed/.test(opened)) throw new Error(`opened failed job: ${opened.slice(0, 300)}`);
+    // Re-submit: a new job from the same file.
+    await page.click(`#job-rows tr[data-job="${id}"] button:has-text("Re-submit")`);
+    await page.waitForFunction((first) => [...document.querySelectorAll('#job-rows tr[data-status="failed"]')].some((r) => Number(r.dataset.job) > first), id, { timeout: 60000 });
+    const again = await page.$$eval('#job-rows tr[data-status="failed"]', (rows) => rows.map((r) => Number(r.dataset.job)));
+    // Delete: asked first, then gone from the page and from the service (the messages emptied
+    // first, so an error there is the delete's).
+    await page.waitForFunction(() => !document.querySelector('#job-rows tr[data-status="queued"], #job-rows tr[data-status="running"]'), null, { timeout: 60000 });
+    await page.$eval('#job-messages', (box) => box.replaceChildren());
+    await page.click(`#job-rows tr[data-job="${id}"] button:has-text("Delete")`);
+    await page.click(`#job-rows tr[data-job="${id}"] button:has-text("Yes, delete")`);
+    await page.waitForFunction((job) => !document.querySelector(`#job-rows tr[data-job="${job}"]`) || document.querySelector('#job-messages .message.error'), id, { timeout: 15000 });
+    const refusedDelete = await page.$('#job-messages .message.error');
+    if (refusedDelete) throw new Error(`deleting failed job #${id} was refused: ${await refusedDelete.textContent()} (${await refusedDelete.getAttribute('title')})`);
+    const status = await page.evaluate(async (job) => (await fetch(`/api/v1/jobs/${job}`)).status, id);
+    if (status !== 404) throw new Error(`deleted job #${id} still answers ${status}`);
+    shown = await objectShown();
+    if (shown.length) throw new Error(`"[object Object]" shown: ${shown.join(' | ')}`);
+    return { id, again, banner };
+  },
+
+  // Predict with an uploaded STL stock (a binary STL box round the sample path): the stock is
+  // drawn in the scene, as a box or grid stock is.
+  async predictStl() {
+    const [min, max] = [[-5, -5, -10], [25, 25, 2.2]];
+    const corner = (i) => [i & 1 ? max[0] : min[0], i & 2 ? max[1] : min[1], i & 4 ? max[2] : min[2]];
+    // Each face of the box as two triangles, outward (the corner indices by bit x, y, z).
+    const faces = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    const triangles = faces.flatMap(([a, b, c, d]) => [[a, b, c], [a, c, d]]);
+    const stl = Buffer.alloc(84 + 50 * triangles.length);
+    stl.writeUInt32LE(triangles.length, 80);
+    triangles.forEach((triangle, t) => triangle.forEach((index, v) => corner(index).forEach((x, k) => stl.writeFloatLE(x, 84 + 50 * t + 12 + 12 * v + 4 * k))));
+    await page.goto(`${base}/#/predict`);
+    await page.waitForSelector('#predict-form');
+    await page.selectOption('#predict-form select[name="stock_kind"]', 'mesh');
+    await page.setInputFiles('#predict-form input[name="stock_file"]', { name: 'box.stl', mimeType: 'model/stl', buffer: stl });
+    await page.click('#predict-compute');
+    await page.waitForSelector('#predict-result:not(.stale) #predict-plot[data-state="drawn"]', { timeout: 60000 });
+    const objects = (await page.getAttribute('#predict-plot', 'data-objects')).split(' ');
+    const summary = await page.textContent('#predict-result .summary');
+    if (!objects.includes('stock')) throw new Error(`the STL stock is not drawn: ${objects}`);
+    return { objects, triangles: triangles.length, summary: summary.slice(0, 200) };
+  },
+
+  // A deburr job opened on the Jobs view shows what the Deburr view shows: the tube and hole
+  // (sizes as OD/ID/Ø), the path and the clearance check.
+  async jobDeburrSolids() {
+    const job = {
+      name: 'tube by diameters',
+      operations: [{ operation: 'deburr', tool: { kind: 'ball', radius: 2 }, edge: 'outer', cut_amount: 0.2,
+        workpiece: { kind: 'tube', origin: [0, 0, 0], inner_diameter: 30, outer_diameter: 50 }, hole: { shape: 'round', diameter: 16 } }],
+    };
+    await page.goto(`${base}/#/jobs`);
+    await page.setInputFiles('#job-file', { name: 'tube.json', mimeType: 'application/json', buffer: Buffer.from(JSON.stringify(job)) });
+    await page.waitForSelector('#job-rows tr[data-status="done"]', { timeout: 60000 });
+    await page.click('#job-rows tr[data-status="done"] button:has-text("Open")');
+    await page.waitForSelector('#job-result[data-state="shown"]', { timeout: 60000 });
+    const objects = (await page.getAttribute('#job-result [data-objects]', 'data-objects')).split(' ');
+    for (const name of ['tube', 'hole', 'centres', 'tool']) if (!objects.includes(name)) throw new Error(`the job's deburr result has no ${name}: ${objects}`);
+    const refused = await page.getAttribute('#job-result [data-objects]', 'data-refused');
+    return { objects, refused };
+  },
+
+  // Machines and materials as tools: saving a name that exists asks first, showing what is
+  // stored, and "keep" leaves it; Edit names what it edits and Cancel leaves it as stored.
+  async registryOverwrite() {
+    const stored = (path) => page.evaluate(async (p) => (await (await fetch(p)).json()), path);
+    const seen = {};
+    for (const [view, field, first, second, path, key] of [
+      ['machines', 'block_time_ms', '4', '2', '/api/v1/machines/hsc-4ms', 'block_time_ms'],
+      ['materials', 'kc11', '1700', '2000', '/api/v1/materials/steel-c45', 'kc11'],
+    ]) {
+      const form = `#${view.slice(0, -1)}-form`;
+      const messages = `#${view.slice(0, -1)}-messages`;
+      await page.goto(`${base}/#/${view}`);
+      await page.waitForSelector(form);
+      await page.fill(`${form} input[name="${field}"]`, first);
+      await page.click(`${form} button[type="submit"]`);
+      await page.waitForSelector(`${messages} .message.ok`, { timeout: 15000 });
+      await page.fill(`${form} input[name="${field}"]`, second);
+      await page.click(`${form} button[type="submit"]`);
+      const ask = await page.waitForSelector(`${messages} [data-ask="replace"]`, { timeout: 15000 })
+        .catch(async () => { throw new Error(`${view}: saving again did not ask first; stored now: ${JSON.stringify(await stored(path))}`); });
+      seen[view] = await ask.textContent();
+      await page.click(`${messages} button[data-answer="keep"]`);
+      await page.waitForSelector(`${messages} .message.ok`, { timeout: 15000 });
+      if (String((await stored(path))[key]) !== first) throw new Error(`${view}: keep changed it: ${JSON.stringify(await stored(path))}`);
+      await page.click(`#${view.slice(0, -1)}-rows tr button:has-text("Edit")`);
+      const legend = await page.textContent(`${form} legend[data-legend]`);
+      if (!/Edit/.test(legend)) throw new Error(`${view}: editing does not say what: ${legend}`);
+      await page.click(`#${view.slice(0, -1)}-cancel-edit`);
+      if (/Edit/.test(await page.textContent(`${form} legend[data-legend]`))) throw new Error(`${view}: cancel left the form editing`);
+    }
+    return { seen };
   },
 };
 

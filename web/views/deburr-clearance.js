@@ -15,6 +15,18 @@ const SPHERE = Array.from({ length: 96 }, (_, i) => {
   return [r * Math.cos(a), r * Math.sin(a), z];
 });
 
+// A deburr request with the tube's and the hole's sizes as radii, whichever way they were given
+// (outer_diameter or outer_radius, diameter or radius).
+export function inRadii(request) {
+  const { workpiece, hole } = request;
+  if (!workpiece || !hole) return request;
+  const half = (r, d) => r ?? (d === undefined || d === null ? undefined : d / 2);
+  const tube = workpiece.kind === 'tube'
+    ? { ...workpiece, inner_radius: half(workpiece.inner_radius, workpiece.inner_diameter), outer_radius: half(workpiece.outer_radius, workpiece.outer_diameter) }
+    : workpiece;
+  return { ...request, workpiece: tube, hole: { ...hole, radius: half(hole.radius, hole.diameter) } };
+}
+
 // Machine → workpiece-local coordinates (the inverse of the view's placement).
 function localFrame(request) {
   const { workpiece, hole } = request;
@@ -68,7 +80,8 @@ function along(points, step) {
 // coordinates), approachLength (mm), neck: [centre, ...] where the neck or shank meets the wall,
 // checked (number of path points looked at), at(centre) → {ball, neck} for any other point}, or
 // null when the request has no usable solids.
-export function clearance(request, answer) {
+export function clearance(given, answer) {
+  const request = given && inRadii(given);
   const { workpiece, hole } = request || {};
   const sizes = workpiece?.kind === 'tube' ? [workpiece.inner_radius, workpiece.outer_radius] : [workpiece?.bore_radius, workpiece?.face_distance];
   if (![...sizes, hole?.radius].every((v) => Number.isFinite(v) && v > 0) || !workpiece.origin?.every(Number.isFinite)) return null;

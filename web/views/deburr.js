@@ -5,7 +5,7 @@ import { api, program as programOf, sentence } from '/api.js';
 import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, programName, showSummary, submitFlow, value, warningMessages } from '/form.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
-import { clearance } from '/views/deburr-clearance.js';
+import { clearance, inRadii } from '/views/deburr-clearance.js';
 
 const FORM = `
 <div class="layout">
@@ -22,15 +22,16 @@ const FORM = `
         <input name="oy" type="number" step="any" value="0" data-field="workpiece.origin">
         <input name="oz" type="number" step="any" value="0" data-field="workpiece.origin"></span></label>
       <label><span>Axis angle from +Y, ° <abbr class="symbol" title="arrangement angle θ_A">θA</abbr></span> <input name="arrangement" type="number" step="any" value="0" data-field="workpiece.arrangement_angle_deg"></label>
-      <label data-kind="tube">Inner radius, mm <input name="inner_radius" type="number" step="any" value="15" data-field="workpiece.inner_radius"></label>
-      <label data-kind="tube">Outer radius, mm <input name="outer_radius" type="number" step="any" value="25" data-field="workpiece.outer_radius"></label>
+      <label>Sizes entered as <select name="sizes_as"><option value="diameter">diameters (OD, ID, Ø), as drawn</option><option value="radius">radii</option></select></label>
+      <label data-kind="tube"><span data-size="outer">Outer diameter OD, mm</span> <input name="outer_size" type="number" step="any" value="50" data-field="workpiece.outer_diameter workpiece.outer_radius"></label>
+      <label data-kind="tube"><span data-size="inner">Inner diameter ID, mm</span> <input name="inner_size" type="number" step="any" value="30" data-field="workpiece.inner_diameter workpiece.inner_radius"></label>
       <label data-kind="bore_block">Bore radius, mm <input name="bore_radius" type="number" step="any" value="20" data-field="workpiece.bore_radius"></label>
       <label data-kind="bore_block">Axis to face, mm <input name="face_distance" type="number" step="any" value="40" data-field="workpiece.face_distance"></label>
     </fieldset>
     <fieldset><legend>Hole</legend>
       <label>Shape <select name="shape" data-field="hole.shape">
         <option value="round">round</option><option value="slot">slot</option><option value="rounded_rect">rounded rectangle</option></select></label>
-      <label><span>Hole radius, mm <abbr class="symbol" title="R2 in the patent">R2</abbr></span> <input name="hole_radius" type="number" step="any" value="5" data-field="hole.radius"></label>
+      <label><span data-size="hole">Hole diameter Ø, mm</span> <input name="hole_size" type="number" step="any" value="10" data-field="hole.diameter hole.radius"></label>
       <label data-shape="slot">Slot centre distance, mm <input name="slot_length" type="number" step="any" value="10" data-field="hole.centre_distance"></label>
       <label data-shape="rounded_rect">Corner centres across, along, mm <span class="pair">
         <input name="rect_across" type="number" step="any" value="8" data-field="hole.centre_distance">
@@ -70,11 +71,14 @@ export function deburrRequest(form) {
   const tool = choice === 'inline' ? { kind: 'ball', radius: half(numeric(form, 'ball_diameter')) } : Number(choice);
   const origin = [numeric(form, 'ox') ?? 0, numeric(form, 'oy') ?? 0, numeric(form, 'oz') ?? 0];
   const kind = value(form, 'workpiece_kind');
+  // Sizes go to the service as typed, in the field of what they are (outer_diameter or
+  // outer_radius), so its messages quote what the user typed.
+  const as = value(form, 'sizes_as') === 'radius' ? 'radius' : 'diameter';
   const workpiece = kind === 'tube'
-    ? { kind, origin, arrangement_angle_deg: numeric(form, 'arrangement') ?? 0, inner_radius: numeric(form, 'inner_radius'), outer_radius: numeric(form, 'outer_radius') }
+    ? { kind, origin, arrangement_angle_deg: numeric(form, 'arrangement') ?? 0, [`inner_${as}`]: numeric(form, 'inner_size'), [`outer_${as}`]: numeric(form, 'outer_size') }
     : { kind, origin, arrangement_angle_deg: numeric(form, 'arrangement') ?? 0, bore_radius: numeric(form, 'bore_radius'), face_distance: numeric(form, 'face_distance') };
   const shape = value(form, 'shape');
-  const hole = { shape, radius: numeric(form, 'hole_radius'), eccentricity: numeric(form, 'eccentricity') ?? 0, penetration_angle_deg: numeric(form, 'penetration') ?? 0 };
+  const hole = { shape, [as]: numeric(form, 'hole_size'), eccentricity: numeric(form, 'eccentricity') ?? 0, penetration_angle_deg: numeric(form, 'penetration') ?? 0 };
   if (shape === 'slot') hole.centre_distance = numeric(form, 'slot_length');
   if (shape === 'rounded_rect') hole.centre_distance = [numeric(form, 'rect_across'), numeric(form, 'rect_along')];
   const edge = value(form, 'edge');
@@ -94,7 +98,15 @@ export function deburrRequest(form) {
   };
 }
 
+// The labels of the sizes as they are entered: diameters as a drawing gives them, or radii.
+const SIZE_LABELS = {
+  diameter: { outer: 'Outer diameter OD, mm', inner: 'Inner diameter ID, mm', hole: 'Hole diameter Ø (slot width), mm' },
+  radius: { outer: 'Outer radius RT, mm', inner: 'Inner radius RN, mm', hole: 'Hole radius R2 (slot half-width), mm' },
+};
+
 function syncVisibility(form) {
+  const labels = SIZE_LABELS[value(form, 'sizes_as')] ?? SIZE_LABELS.diameter;
+  form.querySelectorAll('[data-size]').forEach((e) => { e.textContent = labels[e.dataset.size]; });
   const kind = value(form, 'workpiece_kind');
   const shape = value(form, 'shape');
   form.querySelectorAll('[data-kind]').forEach((e) => { e.hidden = e.dataset.kind !== kind; });
@@ -114,12 +126,14 @@ function addWorkpiece(scene, request) {
   const matrix = new THREE.Matrix4().makeRotationZ((workpiece.arrangement_angle_deg || 0) * deg)
     .multiply(new THREE.Matrix4().makeRotationY((hole.penetration_angle_deg || 0) * deg))
     .setPosition(...workpiece.origin);
-  const outer = workpiece.kind === 'tube' ? workpiece.outer_radius : workpiece.face_distance ?? workpiece.bore_radius * 2;
-  const inner = workpiece.kind === 'tube' ? workpiece.inner_radius : workpiece.bore_radius;
-  if (![outer, inner, hole.radius].every((v) => Number.isFinite(v) && v > 0)) return;
+  const sized = inRadii(request);
+  const outer = workpiece.kind === 'tube' ? sized.workpiece.outer_radius : workpiece.face_distance ?? workpiece.bore_radius * 2;
+  const inner = workpiece.kind === 'tube' ? sized.workpiece.inner_radius : workpiece.bore_radius;
+  const r = sized.hole.radius;
+  if (![outer, inner, r].every((v) => Number.isFinite(v) && v > 0)) return;
   const along = Array.isArray(hole.centre_distance) ? hole.centre_distance[1] : hole.centre_distance || 0;
   const across = Array.isArray(hole.centre_distance) ? hole.centre_distance[0] : 0;
-  const length = Math.max(2.4 * outer, 4 * hole.radius + 2 * along);
+  const length = Math.max(2.4 * outer, 4 * r + 2 * along);
   // Cross-sections in the x_L–z_L plane, extruded along z then turned so z becomes y_L (A1).
   const section = new THREE.Shape();
   if (workpiece.kind === 'tube') section.absarc(0, 0, outer, 0, 2 * Math.PI, false);
@@ -134,7 +148,6 @@ function addWorkpiece(scene, request) {
   scene.solid(workpiece.kind, body, { colour: '#7f97ad', opacity: 0.18, matrix, legend: workpiece.kind === 'tube' ? 'tube' : 'block with bore' });
   // The hole seen along A2: circle, slot (straight sides along A1) or rounded rectangle.
   const f = hole.eccentricity || 0;
-  const r = hole.radius;
   const a = across / 2;
   const b = along / 2;
   const wall = new THREE.Shape();

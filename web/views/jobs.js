@@ -1,7 +1,7 @@
 // Jobs workbench: drop or pick a job file, watch it queue and run, browse past jobs, open a
 // result with the view of its operation, download G-code and JSON (docs/spec/api.md, Jobs).
-import { api, binary, sentence } from '/api.js';
-import { download, message, showProblem } from '/form.js';
+import { api, binary, sentence, technical } from '/api.js';
+import { confirmButton, download, message, showProblem, showSummary } from '/form.js';
 import { resultView } from '/views.js';
 
 const LAYOUT = `
@@ -17,6 +17,47 @@ const LAYOUT = `
 </section>`;
 
 const state = { jobs: new Map(), next: null, timer: null, open: null };
+
+// Why a job failed or was cancelled, in words: the problem's detail (or title) and the field it
+// names, never the problem object itself.
+export function reasonText(error) {
+  if (!error) return '';
+  if (typeof error === 'string') return sentence(error);
+  const field = error.errors?.[0]?.path;
+  return `${sentence(error.detail || error.title || error.code || 'no reason given')}${field ? ` (field ${field})` : ''}`;
+}
+
+// The job files sent from this browser, by job id, so a failed or cancelled job can be sent
+// again: the service keeps a job's file for its outputs only once the job is done.
+const KEPT = 'kerf.v1.jobfile.';
+// A larger file is not kept (local storage holds a few MB per site).
+const KEPT_MAX = 512 * 1024;
+
+function keepJobFile(id, name, text) {
+  if (text.length > KEPT_MAX) return;
+  try {
+    localStorage.setItem(KEPT + id, JSON.stringify({ name, text }));
+  } catch (error) {
+    // Storage full or off: this job cannot be re-submitted from here, nothing else changes.
+  }
+}
+
+function keptJobFile(id) {
+  try {
+    return JSON.parse(localStorage.getItem(KEPT + id) || 'null');
+  } catch (error) {
+    return null;
+  }
+}
+
+function button(text, action, className = 'secondary') {
+  const b = document.createElement('button');
+  b.type = 'button';
+  b.className = className;
+  b.textContent = text;
+  b.addEventListener('click', action);
+  return b;
+}
 
 function cell(text) {
   const td = document.createElement('td');
@@ -61,14 +102,25 @@ function row(job, root) {
   const progress = progressCell(job);
   const status = cell(job.status);
   status.className = `status ${job.status}`;
-  if (job.error) status.title = job.error;
+  if (job.error) status.title = reasonText(job.error);
   const actions = document.createElement('td');
-  if (job.status === 'done') {
-    const open = document.createElement('button');
-    open.className = 'secondary';
-    open.textContent = 'Open';
-    open.addEventListener('click', () => openJob(job.id, root));
-    actions.append(open);
+  actions.className = 'job-actions';
+  const ended = ['done', 'failed', 'cancelled'].includes(job.status);
+  if (ended) actions.append(button('Open', () => openJob(job.id, root)));
+  if (job.status === 'failed' || job.status === 'cancelled') {
+    const kept = keptJobFile(job.id);
+    const again = button('Re-submit', () => resubmit(job.id, root));
+    again.dataset.action = 'resubmit';
+    if (!kept) {
+      again.disabled = true;
+      again.title = 'Sent from another browser or client: the service keeps no copy of a job file that did not finish, so upload the file again.';
+    }
+    actions.append(' ', again);
+  }
+  if (ended) {
+    const remove = confirmButton('Delete', `Delete job #${job.id} and its results?`, () => deleteJob(job.id, root));
+    remove.dataset.action = 'delete';
+    actions.append(' ', remove);
   }
   if (job.status === 'queued' || job.status === 'running') {
     const cancel = document.createElement('button');
@@ -86,11 +138,11 @@ function row(job, root) {
   }
   tr.append(cell(`#${job.id}`), cell(job.name ?? ''), cell(job.operations.join(', ')), status, progress,
     cell(job.submitted_at.replace('T', ' ').slice(0, 19)), actions);
-  if (job.status === 'failed' && job.error) {
+  if ((job.status === 'failed' || job.status === 'cancelled') && job.error) {
     const detail = document.createElement('tr');
     const field = job.error.errors?.[0]?.path;
-    const td = cell(`${job.error.detail}${field ? ` [${field}]` : ''}`);
-    td.title = job.error.code;
+    const td = cell(reasonText(job.error));
+    td.title = [job.error.code, field].filter(Boolean).join(' · ');
     td.colSpan = 7;
     td.className = 'error-line';
     detail.append(td);
@@ -117,7 +169,8 @@ async function refresh(root) {
     const watched = banner && state.jobs.get(Number(banner.dataset.job));
     if (watched && !['queued', 'running'].includes(watched.status)) {
       const done = watched.status === 'done';
-      const text = `Job #${watched.id} ${done ? 'is done: open it below' : watched.status}${watched.error ? `: ${watched.error}` : ''}.`;
+      const reason = reasonText(watched.error);
+      const text = done ? `Job #${watched.id} is done: open it below.` : `Job #${watched.id} ${watched.status}${reason ? `: ${reason}` : '.'}`;
       root.querySelector('#job-messages').replaceChildren(message(done ? 'ok' : 'error', text));
     }
     const active = page.jobs.some((j) => j.status === 'queued' || j.status === 'running');
@@ -135,15 +188,63 @@ async function older(root) {
   render(root);
 }
 
+// Deletes an ended job and its results (the service answers 204; it is gone).
+async function deleteJob(id, root) {
+  const messages = root.querySelector('#job-messages');
+  try {
+    await api('DELETE', `/api/v1/jobs/${id}`);
+    state.jobs.delete(id);
+    try {
+      localStorage.removeItem(KEPT + id);
+    } catch (error) {
+      // Storage off: nothing was kept.
+    }
+    const box = root.querySelector('#job-result');
+    if (box.dataset.job === String(id)) box.replaceChildren();
+    render(root);
+    messages.replaceChildren(message('ok', `Job #${id} deleted.`));
+  } catch (problem) {
+    showProblem(messages, null, problem);
+  }
+}
+
+// Sends a failed or cancelled job's file again, as a new job.
+function resubmit(id, root) {
+  const kept = keptJobFile(id);
+  if (!kept) return;
+  const type = /\.toml$/i.test(kept.name) ? 'application/toml' : 'application/json';
+  submit(new File([kept.text], kept.name, { type }), root);
+}
+
 async function openJob(id, root) {
   const box = root.querySelector('#job-result');
   try {
     const job = await api('GET', `/api/v1/jobs/${id}`);
     box.replaceChildren();
     delete box.dataset.state;
+    box.dataset.job = String(job.id);
     const title = document.createElement('h2');
     title.textContent = `Job #${job.id}${job.name ? ': ' + job.name : ''}`;
     box.append(title);
+    if (job.status !== 'done') {
+      // A failed or cancelled job: how it ended, what it was, and what can be done with it.
+      const reason = reasonText(job.error);
+      box.append(message(job.status === 'failed' ? 'error' : 'warning', `Job #${job.id} ${job.status}${reason ? `: ${reason}` : '.'}`, job.error ? technical(job.error) : undefined));
+      const facts = document.createElement('div');
+      facts.className = 'summary';
+      showSummary(facts, [['operations', job.operations.join(', ')], ['submitted', job.submitted_at.replace('T', ' ').slice(0, 19)],
+        ['ended', (job.finished_at ?? '').replace('T', ' ').slice(0, 19) || '–'], ['attempts', job.attempts]]);
+      const bar = document.createElement('div');
+      bar.className = 'actions';
+      const again = button('Re-submit', () => resubmit(job.id, root));
+      again.disabled = !keptJobFile(job.id);
+      bar.append(again, ' ', confirmButton('Delete', `Delete job #${job.id}?`, () => deleteJob(job.id, root)));
+      box.append(facts, bar);
+      box.dataset.state = 'shown';
+      box.scrollIntoView({ behavior: 'smooth', block: 'start' });
+      return;
+    }
+    const file = jobFileFrom(keptJobFile(job.id));
     // The whole job as one program: every operation with its tool change, and every
     // output in one zip (job.json, each answer and program, the job's program).
     const whole = document.createElement('div');
@@ -208,7 +309,10 @@ async function openJob(id, root) {
         const program = result.gcode
           ? await api('GET', `/api/v1/jobs/${id}/gcode?operation=${index}`, undefined, 'text/x-gcode').catch(() => null)
           : null;
-        show(view, result.result, program ? { program } : {});
+        // The operation's request from the job file: a deburr result then shows its tube and
+        // hole and the clearance check, as the deburr view does.
+        const request = file?.operations?.[index];
+        show(view, result.result, { ...(program ? { program } : {}), ...(request ? { request: requestOf(request, file) } : {}) });
       })());
     });
     await Promise.all(shown);
@@ -220,12 +324,36 @@ async function openJob(id, root) {
   }
 }
 
+// A kept JSON job file, parsed (a TOML file is not read here: its results are drawn without
+// their requests).
+function jobFileFrom(kept) {
+  if (!kept || /\.toml$/i.test(kept.name)) return null;
+  try {
+    return JSON.parse(kept.text);
+  } catch (error) {
+    return null;
+  }
+}
+
+// An operation of a job file as the request its endpoint takes: without `operation`, its tool
+// numbers resolved from the file's own tools (a result is drawn with the tool it was cut with).
+function requestOf(operation, file) {
+  const { operation: _, ...request } = operation;
+  const tools = new Map((file.tools || []).map((t) => [t.number, t]));
+  for (const key of ['tool', 'inner_tool']) {
+    if (typeof request[key] === 'number' && tools.has(request[key])) request[key] = tools.get(request[key]);
+  }
+  return request;
+}
+
 async function submit(file, root) {
   const messages = root.querySelector('#job-messages');
+  const text = await file.text();
   const form = new FormData();
   form.append('file', file, file.name);
   try {
     const answer = await api('POST', '/api/v1/jobs', form);
+    keepJobFile(answer.id, file.name, text);
     const banner = message(answer.reused ? 'ok' : 'info', answer.reused
       ? `${file.name}: identical to job #${answer.id}, reusing its result.`
       : `${file.name}: queued as job #${answer.id}.`);

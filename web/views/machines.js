@@ -1,17 +1,18 @@
 // Machines view: the controller profiles (docs/spec/api.md, Machines): list, register or replace, delete,
 // and the block time from a saturation test (docs/spec/segment.md §2.1, Eq. 1).
-import { api } from '/api.js';
-import { confirmButton, message, showProblem, submitFlow } from '/form.js';
+import { api, tagged } from '/api.js';
+import { clearProblem, confirmButton, message, numeric, parseDecimal, saveGuarded, showProblem, submitFlow } from '/form.js';
 
 const FORM = `
 <div class="layout">
   <form id="machine-form" novalidate>
-    <fieldset><legend>Register or replace a machine</legend>
+    <fieldset><legend data-legend>Register a machine</legend>
+      <p class="hint" data-editing hidden><span data-editing-text></span> <button class="secondary small" type="button" id="machine-cancel-edit">Cancel editing</button></p>
       <label>Name <input name="name" type="text" value="hsc-4ms" data-field="name"></label>
       <label>Block time, ms <input name="block_time_ms" type="number" step="any" value="4" data-field="block_time_ms"></label>
       <label>Max feed, mm/min <input name="max_feed" type="number" step="any" value="10000" data-field="max_feed"></label>
       <label>Dialect <select name="dialect" data-field="dialect"><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select></label>
-      <label><span>Block margin <abbr class="symbol" title="k_f in docs/spec/segment.md">k_f</abbr></span> <input name="margin" type="number" step="any" placeholder="1" data-field="margin"></label>
+      <label><span>Block margin (no unit) <abbr class="symbol" title="k_f in docs/spec/segment.md">k_f</abbr></span> <input name="margin" type="number" step="any" placeholder="1" data-field="margin"></label>
       <label>Min chord error, mm <input name="min_chord_error" type="number" step="any" placeholder="0" data-field="min_chord_error"></label>
       <label>Description <input name="description" type="text" placeholder="control, mode, date" data-field="description"></label>
     </fieldset>
@@ -45,25 +46,37 @@ const FORM = `
 const TEXT_FIELDS = ['dialect', 'description', 'mode', 'arcs'];
 const NUMBER_FIELDS = ['block_time_ms', 'max_feed', 'margin', 'min_chord_error', 'plunge_feed', 'max_accel', 'max_jerk', 'rapid_feed', 'tool_change_s', 'spindle_power_kw', 'spindle_torque_nm'];
 
-// The machine last opened with Edit: saving keeps the fields of it the form does not show, so
-// editing on the page never drops what was registered through the API.
+// The machine last opened with Edit and the version it was (`etag`): saving keeps the fields of
+// it the form does not show, so editing on the page never drops what was registered through the
+// API, and replaces only that version.
 let editing = null;
 
-function fill(form, machine) {
-  editing = machine;
+function setEditing(form, machine, etag) {
+  editing = machine ? { machine, etag } : null;
+  form.querySelector('[data-editing]').hidden = !machine;
+  form.querySelector('[data-legend]').textContent = machine ? `Edit machine ${machine.name}` : 'Register a machine';
+  form.querySelector('[data-editing-text]').textContent = machine ? `Editing ${machine.name}: saving replaces it.` : '';
+  form.querySelector('#machine-save').textContent = machine ? `Save ${machine.name}` : 'Save';
+}
+
+// A stored machine in words, for the question before it is replaced.
+function describeMachine(machine) {
+  return [`${machine.block_time_ms} ms`, `${machine.max_feed} mm/min`, machine.dialect, machine.description].filter(Boolean).join(', ');
+}
+
+function fill(form, machine, etag) {
+  clearProblem(form);
+  setEditing(form, machine, etag);
   form.elements.name.value = machine.name ?? '';
   for (const name of [...TEXT_FIELDS, ...NUMBER_FIELDS]) form.elements[name].value = machine[name] ?? '';
 }
 
 // The body of the PUT: the edited machine's other fields, then every field of the form.
 function machineBody(form) {
-  const body = { ...(editing ?? {}) };
+  const body = { ...(editing?.machine ?? {}) };
   delete body.name;
   for (const name of TEXT_FIELDS) body[name] = form.elements[name].value.trim() || undefined;
-  for (const name of NUMBER_FIELDS) {
-    const text = form.elements[name].value.trim();
-    body[name] = text === '' ? undefined : Number(text);
-  }
+  for (const name of NUMBER_FIELDS) body[name] = numeric(form, name);
   return body;
 }
 
@@ -86,7 +99,19 @@ async function refresh(root) {
       edit.type = 'button';
       edit.className = 'secondary small';
       edit.textContent = 'Edit';
-      edit.addEventListener('click', () => fill(form, machine));
+      edit.addEventListener('click', async () => {
+        // The listed machine at once, then the stored version with its ETag (refilled only if
+        // it changed since the list was read).
+        fill(form, machine);
+        try {
+          const stored = await tagged('GET', `/api/v1/machines/${encodeURIComponent(machine.name)}`);
+          if (editing?.machine.name !== machine.name) return;
+          if (JSON.stringify(stored.body) !== JSON.stringify(machine)) fill(form, stored.body, stored.etag);
+          else editing.etag = stored.etag;
+        } catch (problem) {
+          showProblem(messages, null, problem);
+        }
+      });
       const remove = confirmButton('Delete', `Delete machine ${machine.name}?`, async () => {
         try {
           await api('DELETE', `/api/v1/machines/${encodeURIComponent(machine.name)}`);
@@ -110,20 +135,44 @@ export const machinesView = {
     root.innerHTML = FORM;
     const form = root.querySelector('#machine-form');
     const messages = root.querySelector('#machine-messages');
+    setEditing(form, null);
     refresh(root);
     root.addEventListener('kerf:show', () => refresh(root));
+    root.querySelector('#machine-cancel-edit').addEventListener('click', () => {
+      const name = editing?.machine.name;
+      clearProblem(form);
+      form.reset();
+      setEditing(form, null);
+      messages.replaceChildren(message('info', `Editing ${name} cancelled: ${name} is unchanged.`));
+    });
     root.querySelector('#machine-saturation').addEventListener('click', () => {
-      const length = Number(form.elements.test_block.value);
-      const speed = Number(form.elements.saturated.value);
+      const length = parseDecimal(form.elements.test_block.value);
+      const speed = parseDecimal(form.elements.saturated.value);
       if (length > 0 && speed > 0) form.elements.block_time_ms.value = String(Number((length / speed * 60000).toPrecision(6)));
     });
     submitFlow(form, {
       messages,
       quiet: true,
       read: () => ({ name: form.elements.name.value.trim(), machine: machineBody(form) }),
-      ask: ({ name, machine }) => api('PUT', `/api/v1/machines/${encodeURIComponent(name || ' ')}`, machine),
-      show: () => { refresh(root); },
-      done: (answer, { name }) => `Machine ${name} saved.`,
+      // A new name is created only if it is free; the machine opened with Edit is replaced only
+      // as it was opened. Otherwise the stored machine is shown and the user asked.
+      ask: ({ name, machine }) => saveGuarded(messages, {
+        path: `/api/v1/machines/${encodeURIComponent(name || ' ')}`,
+        body: machine,
+        etag: editing?.machine.name === name ? editing.etag : undefined,
+        what: `machine ${name}`,
+        describe: describeMachine,
+      }),
+      show: async (answer, { name }) => {
+        // An edited machine stays open at its new version; a new one is saved and the form stays
+        // a form for new machines (to change a stored machine, open it with Edit).
+        if (answer.saved && editing?.machine.name === name) {
+          const stored = await tagged('GET', `/api/v1/machines/${encodeURIComponent(name)}`).catch(() => null);
+          if (stored) setEditing(form, stored.body, answer.etag ?? stored.etag);
+        }
+        refresh(root);
+      },
+      done: (answer, { name }) => (answer.saved ? `Machine ${name} saved.` : `Machine ${name} kept as stored: nothing saved.`),
     });
   },
 };

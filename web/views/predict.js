@@ -4,7 +4,7 @@
 // scale, a histogram of the errors, the worst passes with their NC lines, warnings, and the
 // corrected program. `predictResult` also shows prediction jobs.
 import { api } from '/api.js';
-import { clearProblem, downloadFlow, half, keepForm, loadTools, message, number, numeric, showProblem, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
+import { clearProblem, downloadFlow, half, keepForm, loadTools, message, number, numeric, parseDecimal, showProblem, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
 import { css, diverging, drawColourScale, drawHistogram } from '/plot/colour.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
@@ -263,6 +263,34 @@ function gridSurface(scene, stock) {
   scene.solid('stock', geometry, { legend: 'stock (height grid)', opacity: 0.3, colour: '#8fa3b5', edges: false });
 }
 
+// The triangles of an STL file (binary, or ASCII "solid … facet … vertex"), as a flat list of
+// vertex coordinates, or null when it is neither.
+export function stlTriangles(buffer) {
+  const bytes = new Uint8Array(buffer);
+  if (bytes.length >= 84) {
+    const view = new DataView(buffer);
+    const count = view.getUint32(80, true);
+    if (84 + 50 * count === bytes.length) {
+      const positions = new Float32Array(count * 9);
+      for (let t = 0; t < count; t++) {
+        for (let k = 0; k < 9; k++) positions[t * 9 + k] = view.getFloat32(84 + 50 * t + 12 + 4 * k, true);
+      }
+      return positions;
+    }
+  }
+  const text = new TextDecoder().decode(bytes);
+  const vertices = [...text.matchAll(/vertex\s+(\S+)\s+(\S+)\s+(\S+)/g)].flatMap((m) => [Number(m[1]), Number(m[2]), Number(m[3])]);
+  return vertices.length >= 9 && vertices.every(Number.isFinite) ? new Float32Array(vertices.slice(0, vertices.length - (vertices.length % 9))) : null;
+}
+
+// An STL stock as a see-through solid.
+function meshSolid(scene, triangles) {
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.Float32BufferAttribute(triangles, 3));
+  geometry.computeVertexNormals();
+  scene.solid('stock', geometry, { legend: 'stock (STL)', opacity: 0.2, colour: '#8fa3b5', edges: false });
+}
+
 // The programmed path as runs of contiguous passes: each pass ends at its programmed end point
 // (corrected − correction); a pass starts a new run when lines were skipped (a rapid between).
 function runs(passes) {
@@ -286,7 +314,7 @@ function runs(passes) {
 // Shows a prediction in `container`: path coloured by error with its scale, histogram, summary,
 // worst passes and warnings. `context`: the `request` adds the stock, the `program` the timeline
 // (a worst pass goes to its line). Used by the form and by job results.
-export function predictResult(container, answer, { request, program } = {}) {
+export function predictResult(container, answer, { request, program, stockTriangles } = {}) {
   container.replaceChildren();
   const warnings = document.createElement('div');
   const sceneBox = document.createElement('div');
@@ -340,6 +368,7 @@ export function predictResult(container, answer, { request, program } = {}) {
     else scene.dots('path', run.points, { colour: colours[0] });
   });
   if (request?.stock?.kind === 'grid') gridSurface(scene, request.stock);
+  if (stockTriangles) meshSolid(scene, stockTriangles);
   scene.tool({ radius: answer.tool.radius || 1 });
   scene.finish();
   // With the program (the form view), the timeline walks it and a worst pass goes to its line.
@@ -349,7 +378,7 @@ export function predictResult(container, answer, { request, program } = {}) {
   }) : null;
   const end = (pass) => pass.corrected.map((c, k) => c - pass.correction[k]);
   const redraw = () => {
-    const band = Number(bandInput.value) / 1000;
+    const band = (parseDecimal(bandInput.value) || 0) / 1000;
     const colour = (e) => colourOf(e, limit);
     drawColourScale(scale, { low: -limit, high: limit, band, colour, format: microns, unit: 'µm' });
     drawHistogram(histogram, errors, { low, high, band, colour, format: microns, unit: 'µm', label: 'passes per error' });
@@ -438,8 +467,10 @@ export const predictView = {
       result,
       read: () => predictRequest(form),
       ask: (request) => api('POST', '/api/v1/predict?timings=true', payload(request)),
-      show: (answer, { body }) => {
-        predictResult(result, answer, { request: body, program: body.path.program }).id = 'predict-plot';
+      show: async (answer, { body, file }) => {
+        // The uploaded STL stock, drawn as the service read it (the same file).
+        const stockTriangles = file ? stlTriangles(await file.arrayBuffer()) : null;
+        predictResult(result, answer, { request: body, program: body.path.program, stockTriangles }).id = 'predict-plot';
         result.querySelector('canvas.histogram').id = 'predict-histogram';
       },
       done: (answer, request, seconds) => `${answer.summary.passes} passes predicted in ${seconds.toFixed(2)} s.`,

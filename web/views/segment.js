@@ -13,11 +13,11 @@ const FORM = `
       <label>Curve <select name="kind" data-field="curve.kind">
         <option value="circle">circle</option><option value="arc">arc</option><option value="ellipse">ellipse</option>
         <option value="polyline">polyline (points)</option><option value="bspline">B-spline / NURBS</option></select></label>
-      <label data-kinds="circle arc ellipse">Centre x, y <span class="pair">
+      <label data-kinds="circle arc ellipse">Centre x, y, mm <span class="pair">
         <input name="cx" type="number" step="any" value="0" data-field="curve.centre">
         <input name="cy" type="number" step="any" value="0" data-field="curve.centre"></span></label>
       <label data-kinds="circle arc">Radius, mm <input name="radius" type="number" step="any" value="50" data-field="curve.radius"></label>
-      <label data-kinds="ellipse">Semi-axes a, b <span class="pair">
+      <label data-kinds="ellipse">Semi-axes a, b, mm <span class="pair">
         <input name="a" type="number" step="any" value="100" data-field="curve.semi_axes">
         <input name="b" type="number" step="any" value="50" data-field="curve.semi_axes"></span></label>
       <label data-kinds="circle arc ellipse">Start, ° <input name="start_deg" type="number" step="any" value="0" data-field="curve.start_deg"></label>
@@ -25,7 +25,7 @@ const FORM = `
       <label data-kinds="ellipse">Rotation, ° <input name="rotation_deg" type="number" step="any" value="0" data-field="curve.rotation_deg"></label>
       <label data-kinds="circle arc ellipse">Direction <select name="direction" data-field="curve.direction"><option value="ccw">ccw</option><option value="cw">cw</option></select></label>
       <label data-kinds="polyline">Points (x y [z] per line) <textarea name="points" rows="6" data-field="curve.points"></textarea></label>
-      <label data-kinds="bspline">Degree <input name="degree" type="number" min="1" max="5" value="3" data-field="curve.degree"></label>
+      <label data-kinds="bspline">Degree (no unit) <input name="degree" type="number" min="1" max="5" value="3" data-field="curve.degree"></label>
       <label data-kinds="bspline">Control points (x y [z] per line) <textarea name="control_points" rows="6" data-field="curve.control_points">0 0
 40 0
 40 40
@@ -39,10 +39,11 @@ const FORM = `
       <label>Machine <select name="machine" data-field="machine"></select></label>
       <label>Feed, mm/min <input name="feed" type="number" step="any" value="10000" data-field="feed"></label>
       <label>Block time, ms <input name="block_time_ms" type="number" step="any" value="4" data-field="block_time_ms"></label>
-      <label>Chord error chosen <select name="mode" data-field="mode"><option value="window">per window</option><option value="curve">whole curve</option><option value="guarantee">no short blocks (guarantee)</option></select></label>
+      <label>Chord error chosen <select name="mode" data-field="mode"><option value="guarantee" selected>no short blocks (guarantee)</option><option value="window">per window</option><option value="curve">whole curve</option></select></label>
       <label data-mode="window">Window length, mm <input name="window" type="number" step="any" placeholder="5 target chords" data-field="window"></label>
+      <label data-mode="window">Radius estimate <select name="radius_estimate" data-field="radius_estimate"><option value="three_point">three points per window</option><option value="minimum">smallest radius in the window</option></select></label>
       <label data-mode="curve">Rule <select name="rule" data-field="rule"><option value="extremes">smallest radius</option><option value="max">largest window value</option><option value="normal_accel">normal acceleration</option></select></label>
-      <label><span>Block margin <abbr class="symbol" title="k_f in docs/spec/segment.md">k_f</abbr></span> <input name="margin" type="number" step="any" value="1" data-field="margin"></label>
+      <label><span>Block margin (no unit) <abbr class="symbol" title="k_f in docs/spec/segment.md">k_f</abbr></span> <input name="margin" type="number" step="any" value="1" data-field="margin"></label>
       <label>Smallest chord error, mm <input name="min_chord_error" type="number" step="any" value="0" data-field="min_chord_error"></label>
       <label>Tolerance, mm <input name="tolerance" type="number" step="any" placeholder="none" data-field="tolerance"></label>
       <label>Compare with a fixed tolerance, mm <input name="compare_tolerance" type="number" step="any" value="0.01" data-field="compare_tolerance"></label>
@@ -107,6 +108,7 @@ export function segmentRequest(form) {
     block_time_ms: numeric(form, 'block_time_ms'),
     mode,
     window: mode === 'window' ? numeric(form, 'window') : undefined,
+    radius_estimate: mode === 'window' ? value(form, 'radius_estimate') : undefined,
     rule: mode === 'curve' ? value(form, 'rule') : undefined,
     margin: numeric(form, 'margin'),
     min_chord_error: numeric(form, 'min_chord_error'),
@@ -253,7 +255,7 @@ function heading(text) {
 // chord error and block length along the curve, warnings. `context`: the form view's `request`
 // adds the target curve, `machine` names the machine's values, `program` adds the timeline.
 // Used by the form and by job results.
-export function segmentResult(container, answer, { request, machine, program } = {}) {
+export function segmentResult(container, answer, { request, machine, program, form } = {}) {
   container.replaceChildren();
   const warnings = document.createElement('div');
   const summaryBox = document.createElement('div');
@@ -321,7 +323,7 @@ export function segmentResult(container, answer, { request, machine, program } =
     ['margin', machineNote(answer.margin, '', request, 'margin', machine)],
     ['machine', machineName],
   ]);
-  warnings.replaceChildren(...warningMessages(answer.warnings));
+  warnings.replaceChildren(...warningMessages(answer.warnings, form));
   return plan;
 }
 
@@ -344,6 +346,8 @@ export const segmentView = {
       try {
         return segmentRequest(form);
       } catch (error) {
+        // A field the page refused is shown at that field.
+        if (error.errors) throw error;
         throw { status: 400, title: 'Bad input', detail: String(error.message || error), errors: [{ path: 'curve.points' }] };
       }
     };
@@ -354,7 +358,7 @@ export const segmentView = {
       ask: (body) => answerAndProgram('/api/v1/segment', body, segmentQuery(form)),
       show: ({ answer, program, refusal }, body) => {
         root.querySelector('#segment-gcode').disabled = !program;
-        segmentResult(result, answer, { request: body, machine: form.elements.machine.machines?.get(body.machine), program }).id = 'segment-plot';
+        segmentResult(result, answer, { request: body, machine: form.elements.machine.machines?.get(body.machine), program, form }).id = 'segment-plot';
         const charts = result.querySelectorAll('canvas.chart');
         charts[0].id = 'segment-chart';
         charts[1].id = 'segment-lengths';

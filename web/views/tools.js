@@ -1,14 +1,15 @@
 // Tool table view: list, register or replace, edit and delete (with a confirmation) the tools
 // (docs/spec/api.md, Tools). Sizes by diameter or radius; the optional data other views need:
 // neck, stickout, flute length, helix, shape-error table and a static stiffness.
-import { api } from '/api.js';
-import { clearProblem, confirmButton, message, numeric, showProblem, submitFlow, value } from '/form.js';
+import { api, tagged } from '/api.js';
+import { clearProblem, confirmButton, fieldProblem, message, numeric, parseDecimal, saveGuarded, showProblem, submitFlow, toolLabel, value } from '/form.js';
 
 const FORM = `
 <div class="layout">
   <form id="tool-form" novalidate>
-    <fieldset><legend>Register or replace a tool</legend>
-      <label>Tool number <input name="number" type="number" min="1" max="9999" value="1" data-field="number"></label>
+    <fieldset><legend data-legend>Register a tool</legend>
+      <p class="hint" data-editing hidden><span data-editing-text></span> <button class="secondary small" type="button" id="tool-cancel-edit">Cancel editing</button></p>
+      <label>Tool number T <input name="number" type="number" min="1" max="9999" value="1" data-field="number"></label>
       <label>Kind <select name="kind" data-field="kind"><option value="ball">ball end mill</option><option value="flat">flat end mill</option><option value="bull">bull nose (corner radius)</option></select></label>
       <label>Size entered as <select name="size_as"><option value="diameter">diameter Ø</option><option value="radius">radius</option></select></label>
       <label><span data-size-label>Diameter Ø, mm</span> <input name="size" type="number" step="any" value="6" data-field="radius"></label>
@@ -42,13 +43,15 @@ function syncForm(form) {
   form.querySelectorAll('[data-kinds]').forEach((e) => { e.hidden = !e.dataset.kinds.split(' ').includes(value(form, 'kind')); });
 }
 
-// "angle error" lines into the API's table.
-function shapeError(text) {
-  const rows = text.split('\n').map((l) => l.trim()).filter(Boolean);
+// "angle error" lines into the API's table: two numbers a line, apart by spaces or a semicolon
+// (a comma is a decimal comma here: "45 0,006").
+function shapeError(control) {
+  const rows = control.value.split('\n').map((l) => l.trim()).filter(Boolean);
   if (!rows.length) return undefined;
   return rows.map((line) => {
-    const [angle, error] = line.split(/[\s,;]+/).map(Number);
-    return { angle_deg: angle, error };
+    const numbers = line.split(/[\s;]+/).map(parseDecimal);
+    if (numbers.length !== 2 || numbers.some(Number.isNaN)) throw fieldProblem(control, `“${line}” is not an angle and an error: two numbers, e.g. 45 0.006.`);
+    return { angle_deg: numbers[0], error: numbers[1] };
   });
 }
 
@@ -71,14 +74,31 @@ function toolFrom(form, keep = {}) {
     centre_cutting: value(form, 'kind') !== 'ball' && value(form, 'centre_cutting') === 'false' ? false : undefined,
     flutes: numeric(form, 'flutes'),
     name: value(form, 'name').trim() || undefined,
-    shape_error: shapeError(value(form, 'shape_error')),
+    shape_error: shapeError(form.elements.shape_error),
     stiffness: k === undefined ? keep.stiffness : { kind: 'static', x: k, y: k },
   };
 }
 
-// Puts a stored tool into the form for editing.
-function edit(form, tool) {
+// What the form edits: null for a new tool, else {number, etag} of the stored tool opened with
+// Edit (saving it then replaces exactly that version).
+function setEditing(form, editing) {
+  form.editing = editing;
+  const box = form.querySelector('[data-editing]');
+  box.hidden = !editing;
+  form.querySelector('[data-legend]').textContent = editing ? `Edit tool T${editing.number}` : 'Register a tool';
+  form.querySelector('[data-editing-text]').textContent = editing ? `Editing T${editing.number}: saving replaces it.` : '';
+  form.querySelector('#tool-save').textContent = editing ? `Save T${editing.number}` : 'Save tool';
+}
+
+// A stored tool in words, for the question before it is replaced.
+function describeTool(tool) {
+  return [toolLabel(tool), `${tool.flutes} flutes`, extras(tool)].filter(Boolean).join(', ');
+}
+
+// Puts a stored tool into the form for editing (`etag`: the version it is).
+function edit(form, tool, etag) {
   clearProblem(form);
+  setEditing(form, { number: tool.number, etag });
   form.elements.number.value = tool.number;
   form.elements.kind.value = tool.kind;
   form.elements.size_as.value = 'diameter';
@@ -121,7 +141,19 @@ async function refresh(root) {
       change.type = 'button';
       change.className = 'secondary small';
       change.textContent = 'Edit';
-      change.addEventListener('click', () => edit(form, tool));
+      change.addEventListener('click', async () => {
+        // The listed tool at once, then the stored version with its ETag (refilled only if it
+        // changed since the list was read, so what is saved replaces what the form showed).
+        edit(form, tool);
+        try {
+          const stored = await tagged('GET', `/api/v1/tools/${tool.number}`);
+          if (form.editing?.number !== tool.number) return;
+          if (JSON.stringify(stored.body) !== JSON.stringify(tool)) edit(form, stored.body, stored.etag);
+          else form.editing.etag = stored.etag;
+        } catch (problem) {
+          showProblem(messages, null, problem);
+        }
+      });
       const remove = confirmButton('Delete', `Delete T${tool.number}?`, async () => {
         try {
           await api('DELETE', `/api/v1/tools/${tool.number}`);
@@ -146,17 +178,41 @@ export const toolsView = {
     const form = root.querySelector('#tool-form');
     const messages = root.querySelector('#tool-messages');
     form.kept = {};
+    setEditing(form, null);
     form.addEventListener('change', () => syncForm(form));
     syncForm(form);
+    root.querySelector('#tool-cancel-edit').addEventListener('click', () => {
+      const number = form.editing?.number;
+      clearProblem(form);
+      form.reset();
+      form.kept = {};
+      form.querySelector('[data-kept-stiffness]').hidden = true;
+      setEditing(form, null);
+      syncForm(form);
+      messages.replaceChildren(message('info', `Editing T${number} cancelled: T${number} is unchanged.`));
+    });
     root.addEventListener('kerf:show', () => refresh(root));
     refresh(root);
     submitFlow(form, {
       messages,
       quiet: true,
-      read: () => ({ number: value(form, 'number'), tool: toolFrom(form, form.kept) }),
-      ask: ({ number, tool }) => api('PUT', `/api/v1/tools/${encodeURIComponent(number)}`, tool),
-      show: () => { refresh(root); },
-      done: (answer, { number }) => `Tool T${number} saved.`,
+      read: () => ({ number: value(form, 'number').trim(), tool: toolFrom(form, form.kept) }),
+      // A new number is created only if it is free; the tool opened with Edit is replaced only
+      // as it was opened. Otherwise the stored tool is shown and the user asked.
+      ask: ({ number, tool }) => saveGuarded(messages, {
+        path: `/api/v1/tools/${encodeURIComponent(number)}`,
+        body: tool,
+        etag: String(form.editing?.number) === number ? form.editing.etag : undefined,
+        what: `T${number}`,
+        describe: describeTool,
+      }),
+      show: (answer, { number }) => {
+        // An edited tool stays open at its new version; a new one is saved and the form stays a
+        // form for new tools (to change a stored tool, open it with Edit).
+        if (answer.saved && String(form.editing?.number) === number) form.editing.etag = answer.etag;
+        refresh(root);
+      },
+      done: (answer, { number }) => (answer.saved ? `Tool T${number} saved.` : `T${number} kept as stored: nothing saved.`),
     });
   },
 };

@@ -11,7 +11,7 @@ use crate::validate::{self, finite, non_negative, optional_positive, positive, w
 
 use super::request::{
     CentreDistance, DEFAULT_CLEARANCE, DEFAULT_FEED, DEFAULT_LEAD_DISTANCE, DEFAULT_SPINDLE_RPM, DEFAULT_TOLERANCE,
-    DeburrRequest, Direction, Edge, HoleShape, MIN_TOLERANCE, Method, Workpiece,
+    DeburrRequest, Direction, Edge, HoleShape, MIN_TOLERANCE, Method, Workpiece, tube_sizes,
 };
 
 /// A validated deburr job: every number finite and in range, the frame and profile built.
@@ -132,16 +132,36 @@ impl DeburrRequest {
     /// only, its face beyond the bore), and the placement of A1.
     fn part(&self) -> Result<Part, SolverError> {
         let (origin, arrangement, cylinder_radius, tube_radii, top_distance) = match &self.workpiece {
-            Workpiece::Tube { origin, arrangement_angle_deg, inner_radius, outer_radius } => {
-                let inner = size("workpiece.inner_radius", *inner_radius)?;
-                let outer = size("workpiece.outer_radius", *outer_radius)?;
-                if inner >= outer {
+            Workpiece::Tube {
+                origin,
+                arrangement_angle_deg,
+                inner_radius,
+                inner_diameter,
+                outer_radius,
+                outer_diameter,
+            } => {
+                let (inner, outer) = tube_sizes((*inner_radius, *inner_diameter), (*outer_radius, *outer_diameter))?;
+                size(&inner.field, inner.value)?;
+                size(&outer.field, outer.value)?;
+                if inner.radius() >= outer.radius() {
+                    let radii = if inner.diameter == outer.diameter {
+                        String::new()
+                    } else {
+                        format!(" (radii {} and {})", inner.radius(), outer.radius())
+                    };
                     return Err(SolverError::new(
                         ErrorCode::NotThrough,
-                        format!("inner_radius {inner} must be smaller than outer_radius {outer}"),
+                        format!(
+                            "{} {} must be smaller than {} {}{radii}",
+                            inner.name(),
+                            inner.value,
+                            outer.name(),
+                            outer.value
+                        ),
                     )
-                    .at("workpiece.inner_radius"));
+                    .at(&inner.field));
                 }
+                let (inner, outer) = (inner.radius(), outer.radius());
                 let r1 = if self.edge == Edge::Inner { inner } else { outer };
                 (origin, arrangement_angle_deg, r1, Some((inner, outer)), Some(outer))
             }
@@ -170,7 +190,9 @@ impl DeburrRequest {
     /// The hole: its frame on the part (§1.3) and its cross-section (§2.8).
     fn hole_model(&self, part: &Part) -> Result<(Frame, Profile), SolverError> {
         let hole = self.hole.as_ref().ok_or_else(|| SolverError::input("hole", "give hole (or holes)"))?;
-        let radius = size("hole.radius", hole.radius)?;
+        let given = hole.size("hole")?;
+        size(&given.field, given.value)?;
+        let radius = given.radius();
         let penetration = finite("hole.penetration_angle_deg", hole.penetration_angle_deg)?;
         let start = finite("start_deg", self.start_deg)?;
         if start != 0.0 && hole.shape != HoleShape::Round {

@@ -597,8 +597,9 @@ fn describe(request: &DeburrRequest, job: &Job, summary: &DeburrSummary) -> Vec<
         Edge::Both => "both",
     };
     let part = match &request.workpiece {
-        Workpiece::Tube { inner_radius, outer_radius, arrangement_angle_deg, .. } => {
-            format!("tube RN {inner_radius} RT {outer_radius} arrangement {arrangement_angle_deg} deg")
+        Workpiece::Tube { arrangement_angle_deg, .. } => {
+            let (inner, outer) = job.tube_radii.unwrap_or_default();
+            format!("tube RN {inner} RT {outer} arrangement {arrangement_angle_deg} deg")
         }
         Workpiece::BoreBlock { bore_radius, arrangement_angle_deg, .. } => {
             format!("bore block R {bore_radius} arrangement {arrangement_angle_deg} deg")
@@ -621,7 +622,9 @@ fn describe(request: &DeburrRequest, job: &Job, summary: &DeburrSummary) -> Vec<
         format!("deburr {edge} edge, {part}"),
         format!(
             "{shape} hole R {}{extent} eccentricity {} penetration {} deg",
-            hole.radius, job.profile.centre_x, hole.penetration_angle_deg
+            hole.size("hole").map_or(f64::NAN, |size| size.radius()),
+            job.profile.centre_x,
+            hole.penetration_angle_deg
         ),
         format!(
             "ball R {} Q {:.4} W {:.4} TA {} method {:?}, {} points",

@@ -117,7 +117,7 @@ pub(crate) fn finish(
 fn estimated_points(request: &DeburrRequest) -> f64 {
     let Some(hole) = &request.hole else { return 0.0 };
     let tolerance = request.tolerance.unwrap_or(super::request::DEFAULT_TOLERANCE).max(1e-6);
-    let radius = hole.radius.abs().max(1e-3);
+    let radius = hole.size("hole").map_or(0.0, |size| size.radius()).abs().max(1e-3);
     let arcs = std::f64::consts::TAU * radius / (8.0 * radius * tolerance).sqrt();
     let sides = match hole.shape {
         HoleShape::Round => 0.0,

@@ -33,10 +33,18 @@ pub enum Workpiece {
         /// θ_A: angle of A1 from +Y in the XY plane, counter-clockwise seen from +Z (docs/spec/deburr.md §1.3).
         #[serde(default)]
         arrangement_angle_deg: f64,
-        /// RN, mm.
-        inner_radius: f64,
-        /// RT, mm.
-        outer_radius: f64,
+        /// RN, the bore's radius, mm. Give this or `inner_diameter`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        inner_radius: Option<f64>,
+        /// ID, the bore's diameter (2·RN) as a drawing gives it, mm. Give this or `inner_radius`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        inner_diameter: Option<f64>,
+        /// RT, the tube's outer radius, mm. Give this or `outer_diameter`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        outer_radius: Option<f64>,
+        /// OD, the tube's outer diameter (2·RT) as a drawing gives it, mm. Give this or `outer_radius`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        outer_diameter: Option<f64>,
     },
     /// A block with a cylindrical bore (manifold block): only the inner ridge exists.
     BoreBlock {
@@ -52,6 +60,85 @@ pub enum Workpiece {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         face_distance: Option<f64>,
     },
+}
+
+/// A size as the client gave it: as a radius or as a diameter, in the field it came in. Errors
+/// about it quote that field and the value typed there.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GivenSize {
+    /// The field's path, e.g. `workpiece.outer_diameter`.
+    pub field: String,
+    /// The value as typed in that field, mm.
+    pub value: f64,
+    /// Whether `value` is a diameter (else a radius).
+    pub diameter: bool,
+}
+
+impl GivenSize {
+    /// The field's own name, without its path (`outer_diameter`).
+    pub fn name(&self) -> &str {
+        self.field.rsplit('.').next().unwrap_or(&self.field)
+    }
+
+    /// The radius the size gives, mm.
+    pub fn radius(&self) -> f64 {
+        if self.diameter { self.value / 2.0 } else { self.value }
+    }
+}
+
+/// Normalises a size given as a radius or a diameter (`{prefix}.{radius_name}` or
+/// `{prefix}.{diameter_name}`): exactly one of them, else `E_INPUT` naming both.
+fn radius_or_diameter(
+    prefix: &str,
+    (radius_name, radius): (&str, Option<f64>),
+    (diameter_name, diameter): (&str, Option<f64>),
+) -> Result<GivenSize, SolverError> {
+    let field = |name: &str| format!("{prefix}.{name}");
+    match (radius, diameter) {
+        (Some(value), None) => Ok(GivenSize { field: field(radius_name), value, diameter: false }),
+        (None, Some(value)) => Ok(GivenSize { field: field(diameter_name), value, diameter: true }),
+        (Some(_), Some(_)) => {
+            Err(SolverError::input(field(diameter_name), format!("give {radius_name} or {diameter_name}, not both")))
+        }
+        (None, None) => Err(SolverError::input(field(radius_name), format!("give {radius_name} or {diameter_name}"))),
+    }
+}
+
+impl Workpiece {
+    /// A tube given by its radii RN and RT.
+    pub fn tube(origin: [f64; 3], arrangement_angle_deg: f64, inner_radius: f64, outer_radius: f64) -> Self {
+        Workpiece::Tube {
+            origin,
+            arrangement_angle_deg,
+            inner_radius: Some(inner_radius),
+            inner_diameter: None,
+            outer_radius: Some(outer_radius),
+            outer_diameter: None,
+        }
+    }
+}
+
+/// A tube's bore and outer sizes (RN or ID, RT or OD) as given in `workpiece`.
+///
+/// # Errors
+/// `E_INPUT` naming both fields when a size is given both ways or not at all.
+pub fn tube_sizes(
+    (inner_radius, inner_diameter): (Option<f64>, Option<f64>),
+    (outer_radius, outer_diameter): (Option<f64>, Option<f64>),
+) -> Result<(GivenSize, GivenSize), SolverError> {
+    let inner = radius_or_diameter("workpiece", ("inner_radius", inner_radius), ("inner_diameter", inner_diameter))?;
+    let outer = radius_or_diameter("workpiece", ("outer_radius", outer_radius), ("outer_diameter", outer_diameter))?;
+    Ok((inner, outer))
+}
+
+impl Hole {
+    /// The hole's R2 or Ø as given, in the fields under `prefix` (`hole`).
+    ///
+    /// # Errors
+    /// `E_INPUT` naming both fields when it is given both ways or not at all.
+    pub fn size(&self, prefix: &str) -> Result<GivenSize, SolverError> {
+        radius_or_diameter(prefix, ("radius", self.radius), ("diameter", self.diameter))
+    }
 }
 
 /// Cross-section of the through hole seen along its axis (docs/spec/deburr.md §1.2).
@@ -87,8 +174,13 @@ pub enum CentreDistance {
 pub struct Hole {
     /// `round`, `slot` or `rounded_rect`.
     pub shape: HoleShape,
-    /// R2: hole radius, slot half-width or corner radius, mm.
-    pub radius: f64,
+    /// R2: hole radius, slot half-width or corner radius, mm. Give this or `diameter`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// Ø = 2·R2: hole diameter, slot width or corner diameter as a drawing gives it, mm. Give
+    /// this or `radius`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diameter: Option<f64>,
     /// Slot: L_s (a number); rounded rectangle: `[across, along]`. Not used for round holes.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub centre_distance: Option<CentreDistance>,
@@ -111,8 +203,12 @@ pub struct Hole {
 pub struct PlacedHole {
     /// `round`, `slot` or `rounded_rect`.
     pub shape: HoleShape,
-    /// R2, mm.
-    pub radius: f64,
+    /// R2, mm. Give this or `diameter`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// Ø = 2·R2, mm. Give this or `radius`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diameter: Option<f64>,
     /// As in [`Hole`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub centre_distance: Option<CentreDistance>,
@@ -276,20 +372,15 @@ impl DeburrRequest {
         // A1 points along +Y turned by θ_A about Z (docs/spec/deburr.md §1.3).
         let along = [-theta.sin(), theta.cos(), 0.0];
         let moved = [origin[0] + axial * along[0], origin[1] + axial * along[1], origin[2]];
-        match &self.workpiece {
-            Workpiece::Tube { inner_radius, outer_radius, .. } => Workpiece::Tube {
-                origin: moved,
-                arrangement_angle_deg: arrangement,
-                inner_radius: *inner_radius,
-                outer_radius: *outer_radius,
-            },
-            Workpiece::BoreBlock { bore_radius, face_distance, .. } => Workpiece::BoreBlock {
-                origin: moved,
-                arrangement_angle_deg: arrangement,
-                bore_radius: *bore_radius,
-                face_distance: *face_distance,
-            },
+        let mut workpiece = self.workpiece.clone();
+        match &mut workpiece {
+            Workpiece::Tube { origin, arrangement_angle_deg, .. }
+            | Workpiece::BoreBlock { origin, arrangement_angle_deg, .. } => {
+                *origin = moved;
+                *arrangement_angle_deg = arrangement;
+            }
         }
+        workpiece
     }
 }
 
@@ -311,6 +402,7 @@ fn listed_holes(holes: &[PlacedHole]) -> Result<Vec<ToPlace>, SolverError> {
             let hole = Hole {
                 shape: placed.shape,
                 radius: placed.radius,
+                diameter: placed.diameter,
                 centre_distance: placed.centre_distance,
                 eccentricity: placed.eccentricity,
                 penetration_angle_deg: placed.penetration_angle_deg,

@@ -180,9 +180,9 @@ pub(super) fn block_warnings(job: &Job, cut: &Cut, stats: &BlockStats) -> Vec<Wa
                     "; the tolerance or a curvature change inside windows may cause it"
                 } else if matches!(job.shape, shape::Shape::Polyline(_)) {
                     "; a polyline's own edges shorten the chords a little: raise margin (1.02 is plenty for dense \
-                     points) or use radius_estimate \"minimum\""
+                     points), use radius_estimate \"minimum\" or mode \"guarantee\""
                 } else {
-                    "; raise margin or use radius_estimate \"minimum\""
+                    "; raise margin, use radius_estimate \"minimum\" or mode \"guarantee\""
                 }
             ),
         ));

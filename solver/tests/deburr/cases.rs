@@ -31,9 +31,7 @@ fn request(case: &Value) -> (DeburrRequest, Tool) {
     let arrangement = number(&inputs["arrangement_deg"]);
     let edge = if inputs["side"] == "outer" { Edge::Outer } else { Edge::Inner };
     let workpiece = match edge {
-        Edge::Outer | Edge::Both => {
-            Workpiece::Tube { origin, arrangement_angle_deg: arrangement, inner_radius: r1 * 0.75, outer_radius: r1 }
-        }
+        Edge::Outer | Edge::Both => Workpiece::tube(origin, arrangement, r1 * 0.75, r1),
         Edge::Inner => Workpiece::BoreBlock {
             origin,
             arrangement_angle_deg: arrangement,

@@ -61,9 +61,9 @@ fn case() -> impl Strategy<Value = Case> {
             let ball = (radius * ball_ratio).clamp(0.3, 8.0);
             let width = ball * width_ratio;
             let workpiece = if inner {
-                Workpiece::Tube { origin, arrangement_angle_deg: arrangement, inner_radius: r1, outer_radius: r1 * 1.5 }
+                Workpiece::tube(origin, arrangement, r1, r1 * 1.5)
             } else {
-                Workpiece::Tube { origin, arrangement_angle_deg: arrangement, inner_radius: r1 * 0.7, outer_radius: r1 }
+                Workpiece::tube(origin, arrangement, r1 * 0.7, r1)
             };
             let shape = [HoleShape::Round, HoleShape::Slot, HoleShape::RoundedRect][shape];
             let tool = Tool::new(ToolKind::Ball, ball);
@@ -72,7 +72,8 @@ fn case() -> impl Strategy<Value = Case> {
                 workpiece,
                 hole: Some(Hole {
                     shape,
-                    radius,
+                    radius: Some(radius),
+                    diameter: None,
                     centre_distance,
                     eccentricity: Some(eccentricity),
                     penetration_angle_deg: penetration,
@@ -203,7 +204,7 @@ proptest! {
     fn wild_numbers_never_panic(values in prop::collection::vec(wild(), 12), pick in 0_u8..6) {
         let tool = Tool::new(ToolKind::Ball, values[0]);
         let workpiece = if pick % 2 == 0 {
-            Workpiece::Tube { origin: [values[1], 0.0, 0.0], arrangement_angle_deg: values[2], inner_radius: values[3], outer_radius: values[4] }
+            Workpiece::tube([values[1], 0.0, 0.0], values[2], values[3], values[4])
         } else {
             Workpiece::BoreBlock { origin: [0.0, values[1], 0.0], arrangement_angle_deg: values[2], bore_radius: values[4], face_distance: None }
         };
@@ -215,7 +216,7 @@ proptest! {
         let request = DeburrRequest {
             tool: ToolRef::Inline(tool.clone()),
             workpiece,
-            hole: Some(Hole { shape, radius: values[7], centre_distance, eccentricity: Some(values[8]), penetration_angle_deg: values[9], axis_point: None }),
+            hole: Some(Hole { shape, radius: Some(values[7]), diameter: None, centre_distance, eccentricity: Some(values[8]), penetration_angle_deg: values[9], axis_point: None }),
             holes: None,
             pattern: None,
             edge: if pick < 3 { Edge::Inner } else { Edge::Outer },

@@ -34,7 +34,7 @@ fn without(key: &str) -> Value {
 fn deburr_cases() -> Vec<(&'static str, Value, u16, &'static str, &'static str)> {
     vec![
         ("unknown top-level field", with(&["extra"], json!(1)), 400, "extra", "E_JSON"),
-        ("unknown nested field", with(&["hole", "diameter"], json!(5)), 400, "hole.diameter", "E_JSON"),
+        ("unknown nested field", with(&["hole", "depth"], json!(5)), 400, "hole.depth", "E_JSON"),
         ("missing edge", without("edge"), 400, "body", "E_JSON"),
         ("string for a number", with(&["cut_amount"], json!("0.2")), 400, "cut_amount", "E_JSON"),
         ("unknown edge", with(&["edge"], json!("middle")), 400, "edge", "E_JSON"),

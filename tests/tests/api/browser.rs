@@ -186,3 +186,71 @@ async fn jobs_page_downloads_every_output_as_a_zip() {
     let served = app.get(&format!("/api/v1/jobs/{id}/outputs.zip")).await.bytes().await.unwrap();
     assert_eq!(result["size"].as_u64().unwrap(), served.len() as u64);
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn saving_an_existing_tool_number_asks_first_and_keeps_the_old_tool() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "toolOverwrite", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    let stored = app.client.get(format!("{}/api/v1/tools/7", app.base)).send().await.unwrap();
+    let stored: serde_json::Value = stored.json().await.unwrap();
+    assert_eq!((stored["kind"].as_str(), stored["radius"].as_f64()), (Some("flat"), Some(5.0)), "{stored}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_decimal_comma_is_a_decimal_separator_never_dropped() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "decimalComma", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert_eq!(result["language"], "de-DE", "{result}");
+    // 6,5 is 6.5 (radius 3.25), or refused at the field; never 65.
+    assert!(result["radius"] == 3.25 || result["marked"] == serde_json::json!(["size"]), "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn deburr_by_od_id_and_diameter_gives_the_path_of_the_radii() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "deburrDiameters", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["points"].as_u64().unwrap() > 10, "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn segment_defaults_to_no_short_blocks_and_its_advice_names_the_page_controls() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "segmentDefault", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert_eq!(result["short"], 0, "{result}");
+    eprintln!("ellipse: per-window mode {} short blocks; advice {}", result["windowShort"], result["advice"]);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_failed_job_reads_in_words_and_can_be_resubmitted_and_deleted() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "jobsFailed", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["again"].as_array().unwrap().iter().any(|id| id.as_i64() > result["id"].as_i64()), "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn predict_draws_an_uploaded_stl_stock() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "predictStl", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert_eq!(result["triangles"], 12, "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn an_opened_deburr_job_draws_its_tube_and_hole() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "jobDeburrSolids", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert_eq!(result["refused"], "false", "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn saving_an_existing_machine_or_material_asks_first_and_keeps_it() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "registryOverwrite", &[]) else { return };
+    assert_eq!(result["ok"], true);
+}

@@ -3,7 +3,7 @@
 
 use kerf_cases::deburr::{case_1, request};
 use kerf_cases::with;
-use kerf_tests::{TestApp, json_with};
+use kerf_tests::{TestApp, json_with, problem};
 use serde_json::{Value, json};
 
 pub async fn app_with_tools() -> TestApp {
@@ -144,4 +144,65 @@ async fn warnings_are_reported() {
     side["hole"]["penetration_angle_deg"] = json!(0);
     let answer = json_with(app.post_json("/api/v1/deburr", &side).await, 200).await;
     assert!(answer["warnings"].as_array().unwrap().iter().all(|w| w["code"] != "W_SHANK_CLEARANCE"));
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn od_id_and_diameter_give_the_path_of_the_radii_and_errors_quote_what_was_typed() {
+    let app = app_with_tools().await;
+    let by_radius = request(json!({"shape": "slot", "radius": 8, "centre_distance": 6}), "inner");
+    let mut by_diameter = by_radius.clone();
+    by_diameter["workpiece"] =
+        json!({"kind": "tube", "origin": [0, 0, 0], "inner_diameter": 60, "outer_diameter": 100});
+    by_diameter["hole"] = json!({"shape": "slot", "diameter": 16, "centre_distance": 6});
+    let radii = json_with(app.post_json("/api/v1/deburr", &by_radius).await, 200).await;
+    let diameters = json_with(app.post_json("/api/v1/deburr", &by_diameter).await, 200).await;
+    assert_eq!(radii["points"], diameters["points"]);
+    assert_eq!(radii["lead_in"], diameters["lead_in"]);
+    // A radius and a diameter may be mixed, one per size.
+    let mut mixed = by_diameter.clone();
+    mixed["workpiece"] = json!({"kind": "tube", "origin": [0, 0, 0], "inner_radius": 30, "outer_diameter": 100});
+    let mixed = json_with(app.post_json("/api/v1/deburr", &mixed).await, 200).await;
+    assert_eq!(radii["points"], mixed["points"]);
+    // The same program, its header quoting the radii either way.
+    let mut programs = Vec::new();
+    for body in [&by_radius, &by_diameter] {
+        let response = app.post_json("/api/v1/deburr?format=gcode", body).await;
+        assert_eq!(response.status(), 200);
+        programs.push(response.text().await.unwrap());
+    }
+    assert_eq!(programs[0], programs[1]);
+
+    // Errors quote the field and the value typed, never the radius made of it.
+    let mut negative = by_diameter.clone();
+    negative["workpiece"]["outer_diameter"] = json!(-6);
+    let refused = problem(app.post_json("/api/v1/deburr", &negative).await, 422).await;
+    assert_eq!(refused["errors"][0]["path"], "workpiece.outer_diameter", "{refused}");
+    let message = refused["errors"][0]["message"].as_str().unwrap();
+    assert!(message.contains("outer_diameter") && message.contains("-6") && !message.contains("-3"), "{refused}");
+    let mut hole = by_diameter.clone();
+    hole["hole"]["diameter"] = json!(-16);
+    let refused = problem(app.post_json("/api/v1/deburr", &hole).await, 422).await;
+    assert_eq!(refused["errors"][0]["path"], "hole.diameter", "{refused}");
+    assert!(refused["errors"][0]["message"].as_str().unwrap().contains("-16"), "{refused}");
+    let mut inverted = by_diameter.clone();
+    inverted["workpiece"]["inner_diameter"] = json!(120);
+    let refused = problem(app.post_json("/api/v1/deburr", &inverted).await, 422).await;
+    let message = refused["errors"][0]["message"].as_str().unwrap();
+    assert!(message.contains("inner_diameter 120") && message.contains("outer_diameter 100"), "{refused}");
+
+    // Exactly one of the two: both, or neither, is refused naming both fields.
+    let mut both = by_diameter.clone();
+    both["hole"]["radius"] = json!(8);
+    let refused = problem(app.post_json("/api/v1/deburr", &both).await, 422).await;
+    let message = refused["errors"][0]["message"].as_str().unwrap();
+    assert!(message.contains("radius") && message.contains("diameter"), "{refused}");
+    let mut neither = by_diameter.clone();
+    neither["workpiece"].as_object_mut().unwrap().remove("outer_diameter");
+    let refused = problem(app.post_json("/api/v1/deburr", &neither).await, 422).await;
+    let message = refused["errors"][0]["message"].as_str().unwrap();
+    assert!(message.contains("outer_radius") && message.contains("outer_diameter"), "{refused}");
+    let mut both_tube = by_diameter.clone();
+    both_tube["workpiece"]["inner_radius"] = json!(30);
+    let refused = problem(app.post_json("/api/v1/deburr", &both_tube).await, 422).await;
+    assert_eq!(refused["errors"][0]["path"], "workpiece.inner_diameter", "{refused}");
 }
