@@ -13,7 +13,7 @@ use super::request::{self as contour_request, LoopStyle};
 use crate::capability::Control;
 use crate::error::{ErrorCode, SolverError, Warning};
 use crate::planar::{Containment, SegmentGrid, Vec2, centroid, segments_intersect, signed_area, turn_angle, vec2};
-use crate::validate::{finite, positive};
+use crate::validate::{MAX_COORDINATE, coordinates, finite, positive};
 
 /// How corners are found on a point list.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -305,8 +305,11 @@ fn path_points(request: &PathLoopRequest, max_moves: usize) -> Result<Vec<Vec2>,
     }
     let mut points: Vec<Vec2> = Vec::with_capacity(request.path.len());
     for (index, point) in request.path.iter().enumerate() {
-        let field = format!("path[{index}]");
-        let p = vec2([finite(&field, point[0])?, finite(&field, point[1])?]);
+        let p = vec2(if point.iter().all(|value| value.is_finite() && value.abs() <= MAX_COORDINATE) {
+            *point
+        } else {
+            coordinates(&format!("path[{index}]"), *point)?
+        });
         if points.last().is_none_or(|last| (p - last).norm() > super::prepare::DUPLICATE_TOLERANCE) {
             points.push(p);
         }

@@ -13,7 +13,7 @@ use super::request::{
 use crate::error::{SolverError, Warning};
 use crate::machine::{BlockRule, MachineProfile, RuleSettings};
 use crate::tool::{Tool, ToolKind};
-use crate::validate::{finite, non_negative, positive};
+use crate::validate::{coordinate, finite, non_negative, positive};
 
 /// A validated pass.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -144,17 +144,9 @@ impl ContourRequest {
     /// size here too, as it bounds the coordinates like the depths).
     fn layer_depths(&self, radius: f64) -> Result<(f64, f64, Vec<f64>), SolverError> {
         let depths = &self.depths;
-        let top = finite("depths.top", depths.top)?;
-        let bottom = finite("depths.bottom", depths.bottom)?;
+        let top = coordinate("depths.top", depths.top)?;
+        let bottom = coordinate("depths.bottom", depths.bottom)?;
         let step = positive("depths.step", depths.step)?;
-        for (field, value) in [("depths.top", top), ("depths.bottom", bottom)] {
-            if value.abs() > super::prepare::MAX_COORDINATE {
-                return Err(SolverError::input(
-                    field,
-                    format!("{field} must lie within ±{} mm", super::prepare::MAX_COORDINATE),
-                ));
-            }
-        }
         if radius > super::prepare::MAX_COORDINATE {
             return Err(SolverError::input("tool.radius", "the tool radius is implausibly large"));
         }
@@ -223,17 +215,18 @@ impl ContourRequest {
 
     /// The clearance plane (`safe_z`, else `clearance` above the top) and the `lead` length.
     fn heights(&self, top: f64, radius: f64) -> Result<(f64, f64), SolverError> {
-        let clearance = non_negative("clearance", self.clearance.unwrap_or(DEFAULT_CLEARANCE))?;
+        let clearance =
+            coordinate("clearance", non_negative("clearance", self.clearance.unwrap_or(DEFAULT_CLEARANCE))?)?;
         let safe_z = match self.safe_z {
             Some(z) => {
-                if finite("safe_z", z)? <= top {
+                if coordinate("safe_z", z)? <= top {
                     return Err(SolverError::input("safe_z", format!("safe_z {z} must lie above depths.top {top}")));
                 }
                 z
             }
             None => top + clearance.max(1e-3),
         };
-        let lead = non_negative("lead", self.lead.unwrap_or(radius))?;
+        let lead = coordinate("lead", non_negative("lead", self.lead.unwrap_or(radius))?)?;
         Ok((safe_z, lead))
     }
 

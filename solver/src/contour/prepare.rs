@@ -5,7 +5,7 @@ use super::request::MAX_POINTS;
 use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};
 use crate::planar::{self, Vec2, find_self_intersection, signed_area, turn_angle};
-use crate::validate::finite;
+use crate::validate::coordinates;
 
 /// Points closer than this are one point, mm (docs/spec/contour.md §1.4 `tol`).
 pub const DUPLICATE_TOLERANCE: f64 = 1e-6;
@@ -142,9 +142,8 @@ fn check_points(points: &[[f64; 2]]) -> Result<(), SolverError> {
         .at("contour"));
     }
     for (index, point) in points.iter().enumerate() {
-        let field = format!("contour[{index}]");
-        if finite(&field, point[0])?.abs() > MAX_COORDINATE || finite(&field, point[1])?.abs() > MAX_COORDINATE {
-            return Err(SolverError::input(field, format!("coordinates must lie within ±{MAX_COORDINATE} mm")));
+        if !point.iter().all(|value| value.is_finite() && value.abs() <= MAX_COORDINATE) {
+            coordinates(&format!("contour[{index}]"), *point)?;
         }
     }
     Ok(())

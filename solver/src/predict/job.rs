@@ -10,7 +10,7 @@ use crate::gcode::reader::{self, MoveKind, ReadMove, ReadOptions, ReadProgram, S
 use crate::gcode::{Reference, SpindleDirection};
 use crate::geometry::{Vec3, vec3};
 use crate::tool::{ShapeErrorPoint, Stiffness, Tool, ToolKind};
-use crate::validate::{finite, optional_positive, positive};
+use crate::validate::{MAX_COORDINATE, coordinates, finite, optional_positive, positive};
 
 use super::request::{
     DEFAULT_ARC_TOLERANCE, DEFAULT_EDGE_ELEMENTS, DEFAULT_MAX_CORRECTION, DEFAULT_MERGE_TOLERANCE, DEFAULT_RESOLUTION,
@@ -259,9 +259,7 @@ impl PredictRequest {
                 let source =
                     PassSource { line: None, block_number: None, feed, spindle_rpm, rotation_sign: defaults.sign };
                 for (index, p) in points.iter().enumerate() {
-                    for (axis, v) in p.iter().enumerate() {
-                        finite(&format!("path.points[{index}][{axis}]"), *v)?;
-                    }
+                    coordinates(&format!("path.points[{index}]"), *p)?;
                     let centre = centre_of(vec3(*p));
                     if index == 0 {
                         builder.start(centre);
@@ -430,6 +428,12 @@ fn build_from_program(
             node_sources.push(NodeSource { item: index, chord: 0, chords: 0 });
         }
         let source = if cutting { Some(pass_source(read_move, defaults)?) } else { None };
+        if let Some(value) = from.iter().chain(&to).find(|value| value.abs() > MAX_COORDINATE) {
+            return Err(SolverError::input(
+                field,
+                format!("line {line}: coordinates must lie within ±{MAX_COORDINATE} mm (got {value})"),
+            ));
+        }
         let points = read_move.points(arc_tolerance).unwrap_or_else(|| vec![to]);
         let chords = points.len();
         if builder.pass_count() + chords > MAX_PASSES {

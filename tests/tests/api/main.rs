@@ -10,6 +10,7 @@ mod contour;
 mod deburr;
 mod deburr_holes;
 mod deburr_machine;
+mod edge_numbers;
 mod engagement;
 mod entries;
 mod gcode;
