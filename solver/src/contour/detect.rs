@@ -205,6 +205,7 @@ pub fn loop_path_within(
 ) -> Result<PathLoopAnswer, SolverError> {
     let radius = positive("tool_radius", request.tool_radius)?;
     let points = path_points(request, max_moves)?;
+    control.check()?;
     let n = points.len();
     let tolerance = request.tolerance.unwrap_or(contour_request::DEFAULT_TOLERANCE);
     if finite("tolerance", tolerance)? < contour_request::MIN_TOLERANCE {
@@ -219,11 +220,14 @@ pub fn loop_path_within(
     let config = request.corner_loop.config(radius)?;
 
     let (centre, measures) = measures(&points);
+    control.check()?;
     let mut warnings = Vec::new();
     let corner = detect_corners(request, &measures, sigma, threshold, &config, &mut warnings);
+    control.check()?;
 
     let material_inside = (signed_area(&points) > 0.0) == (sigma > 0.0);
     let grid = SegmentGrid::new((0..n).map(|k| (points[k], points[(k + 1) % n])).collect(), 0.0);
+    control.check()?;
     let looper = Looper { points: &points, grid, material_inside, tolerance, sigma };
     let mut scratch = Vec::new();
     let mut looped = vec![false; n];

@@ -10,6 +10,7 @@ use super::request::{
     DEFAULT_SPINDLE_RPM, DEFAULT_TOLERANCE, Join, LoopStyle, MAX_LAYERS, MAX_PASSES, MAX_TILT_DEG, MIN_TOLERANCE,
     Relief, Side, TboneEdge, Tilt,
 };
+use crate::capability::Control;
 use crate::error::{SolverError, Warning};
 use crate::machine::{BlockRule, MachineProfile, RuleSettings};
 use crate::tool::{Tool, ToolKind};
@@ -86,8 +87,14 @@ impl ContourRequest {
     /// Checks every field and prepares the contour, with `machine` resolved from `self.machine`.
     /// The sections are checked in a fixed order (tool, feeds, depths, chording, spindle and
     /// entry, heights, stock and passes, loops, contour and start edge, corners, tilt,
-    /// controller): a request with several faults is refused for the first.
-    pub(crate) fn validate(&self, tool: &Tool, machine: Option<&MachineProfile>) -> Result<Job, SolverError> {
+    /// controller): a request with several faults is refused for the first; `E_CANCELLED` once
+    /// `control`'s cancel flag is set (a long contour takes a while to check).
+    pub(crate) fn validate(
+        &self,
+        tool: &Tool,
+        machine: Option<&MachineProfile>,
+        control: Control<'_>,
+    ) -> Result<Job, SolverError> {
         tool.validate("tool.")?;
         let radius = tool.radius;
         let feed = positive("feed", self.feed)?;
@@ -98,10 +105,11 @@ impl ContourRequest {
         let (safe_z, lead) = self.heights(top, radius)?;
         let (stock_allowance, passes) = self.stock_and_passes()?;
         let loop_config = self.corner_loop.config(radius)?;
-        let (contour, mut warnings) = prepare::prepare(&self.contour, self.fix_orientation)?;
+        let (contour, mut warnings) = prepare::prepare(&self.contour, self.fix_orientation, control)?;
         warnings.extend(rule_warnings);
         let start_edge = self.prepared_start_edge(&contour)?;
         let choices = self.corner_choices(&contour)?;
+        control.check()?;
         let tilt = self.tilt(&contour)?;
         let (blend_radius, servo_time_constant_s) = self.controller_model()?;
         if tilt.is_some() && tool.kind != ToolKind::Flat {

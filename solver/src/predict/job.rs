@@ -5,6 +5,7 @@
 use super::force::CuttingCoefficients;
 use super::passes::{PassSource, PathBuilder, PathModel};
 use super::stock::StockModel;
+use crate::capability::Control;
 use crate::error::{ErrorCode, SolverError};
 use crate::gcode::reader::{self, MoveKind, ReadMove, ReadOptions, ReadProgram, Spindle};
 use crate::gcode::{Reference, SpindleDirection};
@@ -99,7 +100,7 @@ impl PredictRequest {
     /// The sections are checked in a fixed order (tool, method settings, conditions, output,
     /// stock, path, then what depends on the path), so a request with several faults is always
     /// refused for the same one.
-    pub(crate) fn validate(&self, tool: &Tool, mesh: Option<&[u8]>) -> Result<Job, SolverError> {
+    pub(crate) fn validate(&self, tool: &Tool, mesh: Option<&[u8]>, control: Control<'_>) -> Result<Job, SolverError> {
         let shape_error = check_tool(tool)?;
         let radius = tool.radius;
         let method = self.method;
@@ -121,7 +122,7 @@ impl PredictRequest {
         };
         let stock = self.stock.model(mesh)?;
         let ReadPath { path, node_sources, reference_offset } =
-            self.read_path(radius, &defaults, settings.arc_tolerance)?;
+            self.read_path(radius, &defaults, settings.arc_tolerance, control)?;
         for (k, &index) in history.iter().enumerate() {
             if index >= path.passes.len() {
                 return Err(SolverError::input(
@@ -238,7 +239,13 @@ impl PredictRequest {
 
     /// The tool path as ball-centre passes, from points or a G-code program, within the pass
     /// limits.
-    fn read_path(&self, radius: f64, defaults: &Defaults, arc_tolerance: f64) -> Result<ReadPath, SolverError> {
+    fn read_path(
+        &self,
+        radius: f64,
+        defaults: &Defaults,
+        arc_tolerance: f64,
+        control: Control<'_>,
+    ) -> Result<ReadPath, SolverError> {
         let reference_offset = match self.reference {
             Reference::Tip => -radius * Vec3::z(),
             Reference::Centre => Vec3::zeros(),
@@ -272,7 +279,7 @@ impl PredictRequest {
             PathInput::Gcode { program: text } => {
                 let options =
                     ReadOptions { block_delete: self.block_delete.unwrap_or(false), ..ReadOptions::default() };
-                let read = reader::read(text, "path.program", &options)?;
+                let read = reader::read_cancellable(text, "path.program", &options, control)?;
                 build_from_program(&read, defaults, arc_tolerance, &centre_of, &mut builder, &mut node_sources)?;
             }
         }
