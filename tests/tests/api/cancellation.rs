@@ -1,5 +1,6 @@
 //! Work no one waits for stops: a contour G-code request over the time limit, timed out while its
-//! program is being written, leaves no CPU use 100 ms after its 422.
+//! program is being written, leaves no CPU use 100 ms after its 422; and SIGTERM ends the real
+//! program promptly while a long request is being solved (its work is cancelled, not waited for).
 
 use std::time::{Duration, Instant};
 
@@ -85,4 +86,37 @@ async fn a_program_timed_out_while_being_written_stops_at_once() {
         used < over / 10,
         "{used:?} of CPU in the {over:?} after the 422: the program is still being written (limit {limit} s)"
     );
+}
+
+/// Whether process `id` has ended (gone, or a zombie its parent has not reaped yet).
+fn ended(id: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{id}/stat"))
+        .map_or(true, |stat| stat.rsplit_once(") ").is_some_and(|(_, rest)| rest.starts_with('Z')))
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn sigterm_ends_the_program_while_a_long_request_is_solved() {
+    let folder = tempfile::tempdir().unwrap();
+    let server = server(folder.path(), 600).await;
+    // Far more work than the test waits for: minutes in the solver and the writer.
+    let (client, url, body) =
+        (reqwest::Client::new(), format!("{}/api/v1/contour?format=gcode", server.base), long_contour(9000));
+    let request = tokio::spawn(async move { client.post(url).json(&body).send().await });
+    tokio::time::sleep(Duration::from_millis(1500)).await;
+    assert!(!request.is_finished(), "the request is still being solved");
+    let id = server.id();
+    let signalled = Instant::now();
+    let sent = std::process::Command::new("kill").arg("-TERM").arg(id.to_string()).status().unwrap();
+    assert!(sent.success());
+    // The shutdown deadline is the 30 s grace for open connections; cancelled at the signal,
+    // the work ends in milliseconds, so the program is gone long before.
+    while !ended(id) && signalled.elapsed() < Duration::from_secs(10) {
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+    let took = signalled.elapsed();
+    assert!(ended(id), "still running {took:?} after SIGTERM, its solver work not cancelled");
+    drop(server);
+    // The client got an answer or a closed connection, not a hang.
+    let answered = tokio::time::timeout(Duration::from_secs(5), request).await;
+    assert!(answered.is_ok(), "the request ended with the program");
 }
