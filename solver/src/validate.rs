@@ -40,9 +40,15 @@ pub fn non_negative(field: &str, value: f64) -> Result<f64, SolverError> {
 /// Checks that `value` is finite and within ±`limit`, naming `field` otherwise.
 pub fn within(field: &str, value: f64, limit: f64) -> Result<f64, SolverError> {
     if finite(field, value)?.abs() > limit {
-        return Err(SolverError::input(field, format!("{field} must lie within ±{limit} mm (got {value})")));
+        return Err(SolverError::input(field, format!("{field} must lie within ±{limit} mm (got {})", quoted(value))));
     }
     Ok(value)
+}
+
+/// A number as a refusal quotes it: in exponent form when huge, so that 1e308 is not written out
+/// in 309 digits.
+pub fn quoted(value: f64) -> String {
+    if value.abs() >= 1e15 { format!("{value:e}") } else { format!("{value}") }
 }
 
 /// Checks that a coordinate is finite and within ±[`MAX_COORDINATE`], naming `field` otherwise: the

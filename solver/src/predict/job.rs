@@ -11,7 +11,7 @@ use crate::gcode::reader::{self, MoveKind, ReadMove, ReadOptions, ReadProgram, S
 use crate::gcode::{Reference, SpindleDirection};
 use crate::geometry::{Vec3, vec3};
 use crate::tool::{ShapeErrorPoint, Stiffness, Tool, ToolKind};
-use crate::validate::{MAX_COORDINATE, coordinates, finite, optional_positive, positive};
+use crate::validate::{MAX_COORDINATE, coordinates, finite, optional_positive, positive, quoted};
 
 use super::request::{
     DEFAULT_ARC_TOLERANCE, DEFAULT_EDGE_ELEMENTS, DEFAULT_MAX_CORRECTION, DEFAULT_MERGE_TOLERANCE, DEFAULT_RESOLUTION,
@@ -438,7 +438,7 @@ fn build_from_program(
         if let Some(value) = from.iter().chain(&to).find(|value| value.abs() > MAX_COORDINATE) {
             return Err(SolverError::input(
                 field,
-                format!("line {line}: coordinates must lie within ±{MAX_COORDINATE} mm (got {value})"),
+                format!("line {line}: coordinates must lie within ±{MAX_COORDINATE} mm (got {})", quoted(*value)),
             ));
         }
         let points = read_move.points(arc_tolerance).unwrap_or_else(|| vec![to]);
