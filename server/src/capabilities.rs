@@ -337,11 +337,12 @@ pub fn solve<C: Capability>(
     let mut answer = C::solve(request, resolved, run)?;
     let seconds = started.elapsed().as_secs_f64();
     if let Some(output) = program {
-        return Ok((Delivered::Program(capability::program::<C>(request, &answer, output)?), seconds));
+        return Ok((Delivered::Program(capability::program::<C>(request, &answer, output, run.control)?), seconds));
     }
     if timings {
         C::record_time(&mut answer, seconds);
     }
+    run.control.check()?;
     let bytes = C::to_json(answer).map_err(|error| AppError::Internal(error.into()))?;
     Ok((Delivered::Json(bytes), seconds))
 }
@@ -372,7 +373,7 @@ fn store_output<C: Capability>(
     let started = Instant::now();
     let mut answer = C::solve(request, resolved, run)?;
     C::record_time(&mut answer, started.elapsed().as_secs_f64());
-    stored::<C>(request, answer, output)
+    stored::<C>(request, answer, output, run)
 }
 
 fn split<C: Capability>(request: &C::Request, lookup: &impl Lookup, sizing: &Sizing) -> Option<Split> {
@@ -428,7 +429,7 @@ fn finish_output<C: Capability>(
     let started = Instant::now();
     let mut answer = C::finish(request, resolved, parts, run)?;
     C::record_time(&mut answer, seconds + started.elapsed().as_secs_f64());
-    stored::<C>(request, answer, output)
+    stored::<C>(request, answer, output, run)
 }
 
 /// A job's stored output of `answer`: its program written with `output`, the answer trimmed for
@@ -437,8 +438,15 @@ fn stored<C: Capability>(
     request: &C::Request,
     mut answer: C::Answer,
     output: &OutputOptions,
+    run: &Run<'_>,
 ) -> Result<Stored, AppError> {
-    let program = capability::program::<C>(request, &answer, output);
+    let program = capability::program::<C>(request, &answer, output, run.control);
+    // A cancelled job stops here rather than storing "cancelled" as the reason it has no program.
+    if let Err(error) = &program
+        && error.code() == kerf_solver::ErrorCode::Cancelled
+    {
+        return Err(error.clone().into());
+    }
     C::for_storage(&mut answer);
     let result = serde_json::value::to_raw_value(&answer).map_err(|error| AppError::Internal(error.into()))?;
     Ok(Stored {

@@ -219,15 +219,23 @@ pub fn main() -> anyhow::Result<()> {
         .with_env_filter(EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new("info,tower_http=info")))
         .init();
     let runtime = tokio::runtime::Runtime::new().context("starting the async runtime")?;
-    match cli.command {
+    let result = match cli.command {
         Some(Command::Serve(args)) => runtime.block_on(serve(args)),
         Some(Command::Worker(args)) => runtime.block_on(worker(args)),
         Some(Command::Run(args)) => runtime.block_on(run(args)),
         Some(Command::Migrate(args)) => runtime.block_on(migrate(args)),
         Some(Command::Jobs(JobsCommand::Prune(args))) => runtime.block_on(prune(args)),
         None => runtime.block_on(serve(cli.serve)),
-    }
+    };
+    // Solver work was told to stop; whatever has not ended by now is not waited for, so the
+    // process ends within its shutdown deadline.
+    runtime.shutdown_timeout(BLOCKING_WORK_GRACE);
+    result
 }
+
+/// How long the program waits, once it stopped, for solver work still running on blocking
+/// threads (cancelled work ends within milliseconds).
+const BLOCKING_WORK_GRACE: Duration = Duration::from_secs(2);
 
 async fn run(args: RunArgs) -> anyhow::Result<()> {
     let report = crate::jobs::local::run(&args.job_file, &args.out, Some(&args.database)).await?;
@@ -309,7 +317,12 @@ async fn serve(args: ServeArgs) -> anyhow::Result<()> {
     let (router, state) = crate::app::build(&config).await?;
     let listener = TcpListener::bind(args.bind).await.with_context(|| format!("binding {}", args.bind))?;
     tracing::info!(address = %listener.local_addr()?, database = %config.database, "kerf listening");
-    crate::serve(listener, router, config.limits.clone(), shutdown_signal()).await?;
+    let stopping = Arc::clone(&state.solving);
+    let stop = async move {
+        shutdown_signal().await;
+        stopping.stop();
+    };
+    crate::serve(listener, router, config.limits.clone(), stop).await?;
     state.jobs.release(&state.db).await;
     tracing::info!("kerf stopped");
     Ok(())

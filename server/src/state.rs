@@ -1,8 +1,8 @@
 //! Shared state of the running service: the database pool, the configured limits and the bound
 //! on concurrent solver work.
 
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, PoisonError, Weak};
 use std::time::Duration;
 
 use tokio::sync::Semaphore;
@@ -83,6 +83,39 @@ pub struct AppState {
     pub answer_budget: Arc<Semaphore>,
     /// Answers kept for questions asked again.
     pub answers: Arc<AnswerCache>,
+    /// The cancel flags of the solver work running for requests, raised at once on a stop.
+    pub solving: Arc<Solving>,
+}
+
+/// The cancel flags of the solver work running for synchronous requests, so that a stopping
+/// service ends them all within milliseconds instead of waiting for them (the blocking threads
+/// they run on would keep the process alive past its shutdown deadline).
+#[derive(Debug, Default)]
+pub struct Solving {
+    stopping: AtomicBool,
+    flags: Mutex<Vec<Weak<AtomicBool>>>,
+}
+
+impl Solving {
+    /// Keeps `flag` to raise on a stop; raises it at once when the service is stopping already.
+    fn register(&self, flag: &Arc<AtomicBool>) {
+        let mut flags = self.flags.lock().unwrap_or_else(PoisonError::into_inner);
+        flags.retain(|kept| kept.strong_count() > 0);
+        flags.push(Arc::downgrade(flag));
+        drop(flags);
+        if self.stopping.load(Ordering::SeqCst) {
+            flag.store(true, Ordering::Relaxed);
+        }
+    }
+
+    /// Raises the cancel flag of all solver work running for requests, and of any started later.
+    pub fn stop(&self) {
+        self.stopping.store(true, Ordering::SeqCst);
+        let flags = self.flags.lock().unwrap_or_else(PoisonError::into_inner);
+        for flag in flags.iter().filter_map(Weak::upgrade) {
+            flag.store(true, Ordering::Relaxed);
+        }
+    }
 }
 
 impl AppState {
@@ -99,13 +132,15 @@ impl AppState {
             solver_slots: Arc::new(Semaphore::new(solver_slots.max(1))),
             jobs: Arc::new(JobRunner::new(lease, storage)),
             auth,
+            solving: Arc::new(Solving::default()),
         }
     }
 
     /// Runs pure solver work on the blocking pool, never on an async worker thread, under the
     /// concurrency bound and the synchronous time limit. `work` gets a cancel flag that is set
-    /// when the limit passes or the client goes away (this future is dropped); the solvers check
-    /// it per unit of work, so the slot is free again within milliseconds.
+    /// when the limit passes, the client goes away (this future is dropped) or the service stops
+    /// ([`Solving::stop`]); the solvers and program writers check it per unit of work, so the
+    /// slot is free again within milliseconds.
     pub async fn solve<T, F>(&self, work: F) -> AppResult<T>
     where
         F: FnOnce(&AtomicBool) -> T + Send + 'static,
@@ -117,6 +152,7 @@ impl AppState {
                 .map_err(|_| AppError::TooManyRequests("all solver slots are busy; retry shortly".to_owned()))?
                 .map_err(|error| AppError::Internal(error.into()))?;
         let cancel = Arc::new(AtomicBool::new(false));
+        self.solving.register(&cancel);
         let _stop = CancelOnDrop(Arc::clone(&cancel));
         let task = tokio::task::spawn_blocking(move || {
             let _permit = permit;

@@ -61,11 +61,18 @@ pub trait Capability {
         run: &Run<'_>,
     ) -> Result<Self::Answer, SolverError>;
 
-    /// Writes the G-code program of a solved request.
+    /// Writes the G-code program of a solved request, checking `control` as the solve does (a
+    /// program of millions of moves takes seconds to write).
     ///
     /// # Errors
-    /// When the answer has no program (e.g. `E_NO_PROGRAM`) or an option does not apply.
-    fn program(request: &Self::Request, answer: &Self::Answer, output: &OutputOptions) -> Result<String, SolverError>;
+    /// When the answer has no program (e.g. `E_NO_PROGRAM`) or an option does not apply;
+    /// `E_CANCELLED` once `control`'s cancel flag is set.
+    fn program(
+        request: &Self::Request,
+        answer: &Self::Answer,
+        output: &OutputOptions,
+        control: Control<'_>,
+    ) -> Result<String, SolverError>;
 
     /// The machine the answer was computed for (its dialect is the program's default).
     fn machine(answer: &Self::Answer) -> Option<&MachineProfile>;
@@ -505,7 +512,8 @@ impl OutputOptions {
 }
 
 /// The program of a solved request with its output options, the dialect defaulting to the
-/// machine's: the one way every caller writes a capability's program.
+/// machine's: the one way every caller writes a capability's program, under `control` (the
+/// run's, so a cancelled request stops writing too).
 ///
 /// # Errors
 /// As [`Capability::program`].
@@ -513,9 +521,11 @@ pub fn program<C: Capability>(
     request: &C::Request,
     answer: &C::Answer,
     output: &OutputOptions,
+    control: Control<'_>,
 ) -> Result<String, SolverError> {
+    control.check()?;
     let machine = C::machine(answer);
     let output =
         OutputOptions { dialect: Some(output.dialect_for(machine)), arcs: Some(output.arcs_for(machine)), ..*output };
-    C::program(request, answer, &output)
+    C::program(request, answer, &output, control)
 }

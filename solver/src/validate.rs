@@ -4,9 +4,11 @@
 
 use crate::error::SolverError;
 
-/// Largest coordinate magnitude accepted anywhere, mm (1 km: beyond any machine, and squares stay
-/// exact enough for the geometric tests).
-pub const MAX_COORDINATE: f64 = 1e6;
+/// Largest coordinate, length or radius accepted in any request's geometry, mm (100 m: beyond the
+/// travel of any machine tool, and far enough from the float range that squares, cross products
+/// and the bisections of every solver stay finite and exact enough). Every endpoint checks its
+/// geometry with [`coordinate`] or [`point`] against it, so one range holds everywhere.
+pub const MAX_COORDINATE: f64 = 1e5;
 
 /// Checks that `value` is a finite number, naming `field` otherwise.
 pub fn finite(field: &str, value: f64) -> Result<f64, SolverError> {
@@ -38,9 +40,27 @@ pub fn non_negative(field: &str, value: f64) -> Result<f64, SolverError> {
 /// Checks that `value` is finite and within ±`limit`, naming `field` otherwise.
 pub fn within(field: &str, value: f64, limit: f64) -> Result<f64, SolverError> {
     if finite(field, value)?.abs() > limit {
-        return Err(SolverError::input(field, format!("{field} must lie within ±{limit} mm (got {value})")));
+        return Err(SolverError::input(field, format!("{field} must lie within ±{limit} mm (got {})", quoted(value))));
     }
     Ok(value)
+}
+
+/// A number as a refusal quotes it: in exponent form when huge, so that 1e308 is not written out
+/// in 309 digits.
+pub fn quoted(value: f64) -> String {
+    if value.abs() >= 1e15 { format!("{value:e}") } else { format!("{value}") }
+}
+
+/// Checks that a coordinate is finite and within ±[`MAX_COORDINATE`], naming `field` otherwise: the
+/// one range of every request's geometry.
+pub fn coordinate(field: &str, value: f64) -> Result<f64, SolverError> {
+    within(field, value, MAX_COORDINATE)
+}
+
+/// Checks every coordinate of a point is finite and within ±[`MAX_COORDINATE`], naming
+/// `field[axis]`.
+pub fn coordinates<const N: usize>(field: &str, value: [f64; N]) -> Result<[f64; N], SolverError> {
+    point(field, value, MAX_COORDINATE)
 }
 
 /// Checks that `value` is positive and at most `limit`, naming `field` otherwise.

@@ -2,6 +2,7 @@
 //! file, copied from the spec's cases), bad input and property tests; across capabilities the
 //! cycle time, progress reports and requests split into parts.
 
+mod cancellation;
 mod contour;
 mod cycle_properties;
 mod deburr;

@@ -6,7 +6,7 @@ use kerf_cases::predict;
 use kerf_cases::split::{
     Texts, context, contour_context, contour_request, deburr_context, deburr_request, engagement_request,
 };
-use kerf_solver::capability::{self, Capability, OutputOptions, Part, Purpose, Resolved, Run, Sizing, Split};
+use kerf_solver::capability::{self, Capability, Control, OutputOptions, Part, Purpose, Resolved, Run, Sizing, Split};
 use kerf_solver::contour::ContourCapability;
 use kerf_solver::deburr::DeburrCapability;
 use kerf_solver::engagement::EngagementCapability;
@@ -25,13 +25,17 @@ fn split_and_finish(request: &PredictRequest, tool: &Tool, part_seconds: f64) ->
         PredictCapability::solve_part(request, context(tool), part, &Run::default(), &mut texts).unwrap();
     }
     let answer = PredictCapability::finish(request, context(tool), &mut texts, &Run::default()).unwrap();
-    let program = capability::program::<PredictCapability>(request, &answer, &OutputOptions::default()).unwrap();
+    let program =
+        capability::program::<PredictCapability>(request, &answer, &OutputOptions::default(), Control::default())
+            .unwrap();
     Some((serde_json::to_string(&answer).unwrap(), program, parts.len()))
 }
 
 fn whole(request: &PredictRequest, tool: &Tool) -> (String, String) {
     let answer = PredictCapability::solve(request, context(tool), &Run::default()).unwrap();
-    let program = capability::program::<PredictCapability>(request, &answer, &OutputOptions::default()).unwrap();
+    let program =
+        capability::program::<PredictCapability>(request, &answer, &OutputOptions::default(), Control::default())
+            .unwrap();
     (serde_json::to_string(&answer).unwrap(), program)
 }
 
@@ -82,7 +86,8 @@ fn engagement_candidates_split_into_parts_are_the_whole_comparison() {
         || Resolved { tool: tool.clone(), machine: Some(machine.clone()), material: None, other_tools: Vec::new() };
     let whole = EngagementCapability::solve(&request, context(), &Run::default()).unwrap();
     let output = OutputOptions::default();
-    let whole_program = capability::program::<EngagementCapability>(&request, &whole, &output).unwrap();
+    let whole_program =
+        capability::program::<EngagementCapability>(&request, &whole, &output, Control::default()).unwrap();
     assert!(whole.cycle_time.is_some() && whole.result.candidates().iter().all(|c| c.blocks.is_some()));
     let Split { parts, .. } =
         EngagementCapability::split(&request, &context(), &Sizing { part_seconds: 1e-4, max_parts: 16 })
@@ -97,13 +102,14 @@ fn engagement_candidates_split_into_parts_are_the_whole_comparison() {
     for candidate in 0..3 {
         let output = OutputOptions { candidate: Some(candidate), ..output };
         assert!(
-            capability::program::<EngagementCapability>(&request, &merged, &output).unwrap()
-                == capability::program::<EngagementCapability>(&request, &whole, &output).unwrap(),
+            capability::program::<EngagementCapability>(&request, &merged, &output, Control::default()).unwrap()
+                == capability::program::<EngagementCapability>(&request, &whole, &output, Control::default()).unwrap(),
             "candidate {candidate}'s program"
         );
     }
     assert!(
-        capability::program::<EngagementCapability>(&request, &merged, &OutputOptions::default()).unwrap()
+        capability::program::<EngagementCapability>(&request, &merged, &OutputOptions::default(), Control::default())
+            .unwrap()
             == whole_program
     );
     // One path, or parts that one would hold, stay whole.
@@ -118,7 +124,8 @@ fn job_run() -> Run<'static> {
 /// The program of `answer`, or why there is none (a tilted wall's contour has none: only its
 /// JSON answer carries the axes).
 fn program_of<C: Capability>(request: &C::Request, answer: &C::Answer) -> String {
-    capability::program::<C>(request, answer, &OutputOptions::default()).unwrap_or_else(|error| format!("{error:?}"))
+    capability::program::<C>(request, answer, &OutputOptions::default(), Control::default())
+        .unwrap_or_else(|error| format!("{error:?}"))
 }
 
 /// The answer's JSON and program of solving `request` whole, as one process runs a job.

@@ -16,7 +16,7 @@ use kerf_cases::predict as support;
 use kerf_cases::split::{
     Texts, context, contour_context, contour_request, deburr_context, deburr_request, engagement_request,
 };
-use kerf_solver::capability::{self, Capability, OutputOptions, Part, Purpose, Resolved, Run, Sizing};
+use kerf_solver::capability::{self, Capability, Control, OutputOptions, Part, Purpose, Resolved, Run, Sizing};
 use kerf_solver::contour::ContourCapability;
 use kerf_solver::deburr::DeburrCapability;
 use kerf_solver::engagement::EngagementCapability;
@@ -124,7 +124,9 @@ fn predict(pool: &rayon::ThreadPool) {
         .unwrap();
     let ((answer, program), cpu) = timed(pool, || {
         let answer = PredictCapability::finish(&request, context(&tool), &mut texts, &Run::default()).unwrap();
-        let program = capability::program::<PredictCapability>(&request, &answer, &OutputOptions::default()).unwrap();
+        let program =
+            capability::program::<PredictCapability>(&request, &answer, &OutputOptions::default(), Control::default())
+                .unwrap();
         (serde_json::to_vec(&answer).unwrap().len(), program.len())
     });
     eprintln!(
@@ -172,7 +174,7 @@ where
     let ((), parts) = timed(pool, || C::solve_part(request, context.clone(), &part, &job_run(), &mut texts).unwrap());
     let (answer, finish) = timed(pool, || {
         let answer = C::finish(request, context.clone(), &mut texts, &job_run()).unwrap();
-        let _ = capability::program::<C>(request, &answer, &OutputOptions::default());
+        let _ = capability::program::<C>(request, &answer, &OutputOptions::default(), Control::default());
         let _ = serde_json::to_vec(&answer).unwrap();
         answer
     });

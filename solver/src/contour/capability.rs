@@ -101,10 +101,11 @@ impl Capability for ContourCapability {
         request: &ContourRequest,
         answer: &ContourAnswer,
         output: &OutputOptions,
+        control: Control<'_>,
     ) -> Result<String, SolverError> {
         let mut post = output.post(answer.machine.as_ref(), &answer.tool);
         post.plunge_feed = request.plunge_feed.or(post.plunge_feed);
-        super::program(&answer.result, &post)
+        super::program::program_controlled(&answer.result, &post, control)
     }
 
     fn machine(answer: &ContourAnswer) -> Option<&MachineProfile> {

@@ -13,7 +13,7 @@ use super::request::{self as contour_request, LoopStyle};
 use crate::capability::Control;
 use crate::error::{ErrorCode, SolverError, Warning};
 use crate::planar::{Containment, SegmentGrid, Vec2, centroid, segments_intersect, signed_area, turn_angle, vec2};
-use crate::validate::{finite, positive};
+use crate::validate::{MAX_COORDINATE, coordinates, finite, positive};
 
 /// How corners are found on a point list.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -205,6 +205,7 @@ pub fn loop_path_within(
 ) -> Result<PathLoopAnswer, SolverError> {
     let radius = positive("tool_radius", request.tool_radius)?;
     let points = path_points(request, max_moves)?;
+    control.check()?;
     let n = points.len();
     let tolerance = request.tolerance.unwrap_or(contour_request::DEFAULT_TOLERANCE);
     if finite("tolerance", tolerance)? < contour_request::MIN_TOLERANCE {
@@ -219,11 +220,14 @@ pub fn loop_path_within(
     let config = request.corner_loop.config(radius)?;
 
     let (centre, measures) = measures(&points);
+    control.check()?;
     let mut warnings = Vec::new();
     let corner = detect_corners(request, &measures, sigma, threshold, &config, &mut warnings);
+    control.check()?;
 
     let material_inside = (signed_area(&points) > 0.0) == (sigma > 0.0);
     let grid = SegmentGrid::new((0..n).map(|k| (points[k], points[(k + 1) % n])).collect(), 0.0);
+    control.check()?;
     let looper = Looper { points: &points, grid, material_inside, tolerance, sigma };
     let mut scratch = Vec::new();
     let mut looped = vec![false; n];
@@ -305,8 +309,11 @@ fn path_points(request: &PathLoopRequest, max_moves: usize) -> Result<Vec<Vec2>,
     }
     let mut points: Vec<Vec2> = Vec::with_capacity(request.path.len());
     for (index, point) in request.path.iter().enumerate() {
-        let field = format!("path[{index}]");
-        let p = vec2([finite(&field, point[0])?, finite(&field, point[1])?]);
+        let p = vec2(if point.iter().all(|value| value.is_finite() && value.abs() <= MAX_COORDINATE) {
+            *point
+        } else {
+            coordinates(&format!("path[{index}]"), *point)?
+        });
         if points.last().is_none_or(|last| (p - last).norm() > super::prepare::DUPLICATE_TOLERANCE) {
             points.push(p);
         }

@@ -10,10 +10,11 @@ use super::request::{
     DEFAULT_SPINDLE_RPM, DEFAULT_TOLERANCE, Join, LoopStyle, MAX_LAYERS, MAX_PASSES, MAX_TILT_DEG, MIN_TOLERANCE,
     Relief, Side, TboneEdge, Tilt,
 };
+use crate::capability::Control;
 use crate::error::{SolverError, Warning};
 use crate::machine::{BlockRule, MachineProfile, RuleSettings};
 use crate::tool::{Tool, ToolKind};
-use crate::validate::{finite, non_negative, positive};
+use crate::validate::{coordinate, finite, non_negative, positive};
 
 /// A validated pass.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -86,8 +87,14 @@ impl ContourRequest {
     /// Checks every field and prepares the contour, with `machine` resolved from `self.machine`.
     /// The sections are checked in a fixed order (tool, feeds, depths, chording, spindle and
     /// entry, heights, stock and passes, loops, contour and start edge, corners, tilt,
-    /// controller): a request with several faults is refused for the first.
-    pub(crate) fn validate(&self, tool: &Tool, machine: Option<&MachineProfile>) -> Result<Job, SolverError> {
+    /// controller): a request with several faults is refused for the first; `E_CANCELLED` once
+    /// `control`'s cancel flag is set (a long contour takes a while to check).
+    pub(crate) fn validate(
+        &self,
+        tool: &Tool,
+        machine: Option<&MachineProfile>,
+        control: Control<'_>,
+    ) -> Result<Job, SolverError> {
         tool.validate("tool.")?;
         let radius = tool.radius;
         let feed = positive("feed", self.feed)?;
@@ -98,10 +105,11 @@ impl ContourRequest {
         let (safe_z, lead) = self.heights(top, radius)?;
         let (stock_allowance, passes) = self.stock_and_passes()?;
         let loop_config = self.corner_loop.config(radius)?;
-        let (contour, mut warnings) = prepare::prepare(&self.contour, self.fix_orientation)?;
+        let (contour, mut warnings) = prepare::prepare(&self.contour, self.fix_orientation, control)?;
         warnings.extend(rule_warnings);
         let start_edge = self.prepared_start_edge(&contour)?;
         let choices = self.corner_choices(&contour)?;
+        control.check()?;
         let tilt = self.tilt(&contour)?;
         let (blend_radius, servo_time_constant_s) = self.controller_model()?;
         if tilt.is_some() && tool.kind != ToolKind::Flat {
@@ -144,17 +152,9 @@ impl ContourRequest {
     /// size here too, as it bounds the coordinates like the depths).
     fn layer_depths(&self, radius: f64) -> Result<(f64, f64, Vec<f64>), SolverError> {
         let depths = &self.depths;
-        let top = finite("depths.top", depths.top)?;
-        let bottom = finite("depths.bottom", depths.bottom)?;
+        let top = coordinate("depths.top", depths.top)?;
+        let bottom = coordinate("depths.bottom", depths.bottom)?;
         let step = positive("depths.step", depths.step)?;
-        for (field, value) in [("depths.top", top), ("depths.bottom", bottom)] {
-            if value.abs() > super::prepare::MAX_COORDINATE {
-                return Err(SolverError::input(
-                    field,
-                    format!("{field} must lie within ±{} mm", super::prepare::MAX_COORDINATE),
-                ));
-            }
-        }
         if radius > super::prepare::MAX_COORDINATE {
             return Err(SolverError::input("tool.radius", "the tool radius is implausibly large"));
         }
@@ -223,17 +223,18 @@ impl ContourRequest {
 
     /// The clearance plane (`safe_z`, else `clearance` above the top) and the `lead` length.
     fn heights(&self, top: f64, radius: f64) -> Result<(f64, f64), SolverError> {
-        let clearance = non_negative("clearance", self.clearance.unwrap_or(DEFAULT_CLEARANCE))?;
+        let clearance =
+            coordinate("clearance", non_negative("clearance", self.clearance.unwrap_or(DEFAULT_CLEARANCE))?)?;
         let safe_z = match self.safe_z {
             Some(z) => {
-                if finite("safe_z", z)? <= top {
+                if coordinate("safe_z", z)? <= top {
                     return Err(SolverError::input("safe_z", format!("safe_z {z} must lie above depths.top {top}")));
                 }
                 z
             }
             None => top + clearance.max(1e-3),
         };
-        let lead = non_negative("lead", self.lead.unwrap_or(radius))?;
+        let lead = coordinate("lead", non_negative("lead", self.lead.unwrap_or(radius))?)?;
         Ok((safe_z, lead))
     }
 

@@ -34,7 +34,7 @@ pub(crate) fn split(
     machine: Option<&MachineProfile>,
     sizing: &Sizing,
 ) -> Option<Split> {
-    let prepared = Prepared::new(request, tool, machine, MAX_MOVES).ok()?;
+    let prepared = Prepared::new(request, tool, machine, MAX_MOVES, Control::default()).ok()?;
     let plan = (prepared.corners() * prepared.job.passes.len()) as f64 * PLAN_SECONDS;
     let moves = prepared.moves_per_layer() as f64 * MOVE_SECONDS;
     // A tilted wall plans every layer; otherwise each layer repeats the first one's plan.
@@ -56,7 +56,7 @@ pub(crate) fn solve_part(
     control: Control<'_>,
     sink: &mut impl PartSink,
 ) -> Result<(), SolverError> {
-    let prepared = Prepared::new(request, tool, machine, MAX_MOVES)?;
+    let prepared = Prepared::new(request, tool, machine, MAX_MOVES, control)?;
     if part.units.end > prepared.job.layers.len() {
         return Err(mismatch(format!("layers {:?} of {}", part.units, prepared.job.layers.len())));
     }
@@ -75,7 +75,7 @@ pub(crate) fn finish(
     parts: &mut impl PartSource,
     control: Control<'_>,
 ) -> Result<ContourSolution, SolverError> {
-    let prepared = Prepared::new(request, tool, machine, MAX_MOVES)?;
+    let prepared = Prepared::new(request, tool, machine, MAX_MOVES, control)?;
     let mut layers = Vec::with_capacity(prepared.job.layers.len());
     let mut read = 0;
     while let Some(part) = parts.next_part::<PartLayers>() {
@@ -91,7 +91,7 @@ pub(crate) fn finish(
     if layers.len() != prepared.job.layers.len() {
         return Err(mismatch(format!("{} layers of {}", layers.len(), prepared.job.layers.len())));
     }
-    prepared.answer(machine, MAX_MOVES, layers)
+    prepared.answer(machine, MAX_MOVES, layers, control)
 }
 
 /// What a part hands on: its first layer's index and its layers' moves.

@@ -2,10 +2,11 @@
 //! simple-polygon check and the orientation (counter-clockwise, docs/spec/api.md Contour).
 
 use super::request::MAX_POINTS;
+use crate::capability::Control;
 use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};
 use crate::planar::{self, Vec2, find_self_intersection, signed_area, turn_angle};
-use crate::validate::finite;
+use crate::validate::coordinates;
 
 /// Points closer than this are one point, mm (docs/spec/contour.md §1.4 `tol`).
 pub const DUPLICATE_TOLERANCE: f64 = 1e-6;
@@ -80,10 +81,16 @@ impl Contour {
 /// `E_DEGENERATE` (fewer than 3 distinct points, zero area), `E_DUPLICATE_POINT`,
 /// `E_SELF_INTERSECTION`, `E_ORIENTATION` (clockwise and not `fix_orientation`),
 /// `E_TOO_MANY_POINTS`, `E_TOO_COMPLEX`, `E_INPUT` for non-finite coordinates.
-pub(crate) fn prepare(points: &[[f64; 2]], fix_orientation: bool) -> Result<(Contour, Vec<Warning>), SolverError> {
+pub(crate) fn prepare(
+    points: &[[f64; 2]],
+    fix_orientation: bool,
+    control: Control<'_>,
+) -> Result<(Contour, Vec<Warning>), SolverError> {
     check_points(points)?;
+    control.check()?;
     let mut warnings = Vec::new();
     let (kept, mut removed, used) = distinct_points(points);
+    control.check()?;
     if kept.len() < 3 {
         return Err(SolverError::new(
             ErrorCode::Degenerate,
@@ -92,8 +99,10 @@ pub(crate) fn prepare(points: &[[f64; 2]], fix_orientation: bool) -> Result<(Con
         .at("contour"));
     }
     check_duplicates(&kept)?;
+    control.check()?;
     check_area(&kept)?;
     check_simple(&kept)?;
+    control.check()?;
     let (kept, straight) = remove_straight(kept);
     removed.extend(straight);
     if kept.len() < 3 {
@@ -142,9 +151,8 @@ fn check_points(points: &[[f64; 2]]) -> Result<(), SolverError> {
         .at("contour"));
     }
     for (index, point) in points.iter().enumerate() {
-        let field = format!("contour[{index}]");
-        if finite(&field, point[0])?.abs() > MAX_COORDINATE || finite(&field, point[1])?.abs() > MAX_COORDINATE {
-            return Err(SolverError::input(field, format!("coordinates must lie within ±{MAX_COORDINATE} mm")));
+        if !point.iter().all(|value| value.is_finite() && value.abs() <= MAX_COORDINATE) {
+            coordinates(&format!("contour[{index}]"), *point)?;
         }
     }
     Ok(())
@@ -296,7 +304,7 @@ mod tests {
     #[test]
     fn closing_duplicates_and_collinear_points_are_removed() {
         let points = [[0.0, 0.0], [5.0, 0.0], [10.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0], [0.0, 0.0]];
-        let (contour, warnings) = prepare(&points, false).unwrap();
+        let (contour, warnings) = prepare(&points, false, Control::default()).unwrap();
         assert_eq!(contour.source, vec![0, 2, 4, 5]);
         assert_eq!(warnings[0].code, "W_VERTEX_REMOVED");
         assert_eq!(contour.edge_containing(0), 0);
@@ -310,8 +318,8 @@ mod tests {
     #[test]
     fn clockwise_contours_are_refused_or_reversed() {
         let points = [[0.0, 0.0], [0.0, 10.0], [10.0, 10.0], [10.0, 0.0]];
-        assert_eq!(prepare(&points, false).unwrap_err().code(), ErrorCode::Orientation);
-        let (contour, warnings) = prepare(&points, true).unwrap();
+        assert_eq!(prepare(&points, false, Control::default()).unwrap_err().code(), ErrorCode::Orientation);
+        let (contour, warnings) = prepare(&points, true, Control::default()).unwrap();
         assert!(contour.reversed);
         assert_eq!(contour.source, vec![3, 2, 1, 0]);
         assert!(signed_area(&contour.points) > 0.0);
@@ -324,7 +332,7 @@ mod tests {
 
     #[test]
     fn bad_polygons_have_their_codes() {
-        let code = |points: &[[f64; 2]]| prepare(points, false).unwrap_err().code();
+        let code = |points: &[[f64; 2]]| prepare(points, false, Control::default()).unwrap_err().code();
         assert_eq!(code(&[[0.0, 0.0], [1.0, 0.0]]), ErrorCode::Degenerate);
         assert_eq!(code(&[[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]), ErrorCode::Degenerate);
         assert_eq!(code(&[[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]]), ErrorCode::SelfIntersection);

@@ -4,6 +4,7 @@
 //! G02/G03 blocks from the arc's exact start to its exact end.
 
 use super::answer::{ContourSolution, MoveKind};
+use crate::capability::Control;
 use crate::error::ErrorCode;
 use crate::error::SolverError;
 
@@ -17,6 +18,15 @@ use crate::path::Toolpath;
 /// `E_TILT_NEEDS_5_AXIS` (at `tilt_deg`) when the walls are tilted: the moves then carry a tool
 /// axis that a 3-axis program cannot express.
 pub fn program(answer: &ContourSolution, post: &Post) -> Result<String, SolverError> {
+    program_controlled(answer, post, Control::default())
+}
+
+/// [`program`] that stops with `E_CANCELLED` once `control`'s cancel flag is set (checked per
+/// layer and every [`gcode::MOVES_PER_CHECK`] moves written).
+///
+/// # Errors
+/// As [`program`]; `E_CANCELLED` when cancelled.
+pub fn program_controlled(answer: &ContourSolution, post: &Post, control: Control<'_>) -> Result<String, SolverError> {
     if answer.tilted {
         return Err(SolverError::new(
             ErrorCode::TiltNeeds5Axis,
@@ -31,9 +41,13 @@ pub fn program(answer: &ContourSolution, post: &Post) -> Result<String, SolverEr
     let offset = Vec3::new(0.0, 0.0, lift);
     let mut path = Toolpath::default();
     for layer in &answer.layers {
+        control.check()?;
         let mut spans = layer.arcs.iter().filter(|_| post.arcs == Arcs::G2g3).peekable();
         let mut index = 0;
         while let Some(step) = layer.moves.get(index) {
+            if index % gcode::MOVES_PER_CHECK == 0 {
+                control.check()?;
+            }
             if let Some(span) = spans.next_if(|span| span.first == index)
                 && let Some(feed) = step.feed
             {
@@ -59,17 +73,21 @@ pub fn program(answer: &ContourSolution, post: &Post) -> Result<String, SolverEr
     }
     let mut comments = answer.description.clone();
     comments.push(format!("control point: {} of the {} tool", post.reference.as_str(), answer.tool_kind.as_str()));
-    Ok(gcode::write(&Program {
-        dialect: post.dialect,
-        number: 1000,
-        title: "kerf contour",
-        comments,
-        tool: post.tool.clone(),
-        spindle_rpm: answer.summary.spindle_rpm,
-        spindle_direction: SpindleDirection::Cw,
-        safe_z: answer.summary.safe_z + lift,
-        blend_tolerance: answer.summary.tolerance,
-        plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
-        path: &path,
-    }))
+    gcode::write_cancellable(
+        &Program {
+            dialect: post.dialect,
+            number: 1000,
+            title: "kerf contour",
+            comments,
+            tool: post.tool.clone(),
+            spindle_rpm: answer.summary.spindle_rpm,
+            spindle_direction: SpindleDirection::Cw,
+            safe_z: answer.summary.safe_z + lift,
+            blend_tolerance: answer.summary.tolerance,
+            plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
+            path: &path,
+        },
+        &[],
+        control,
+    )
 }

@@ -67,11 +67,11 @@ impl Setup {
 /// # Errors
 /// As [`solve`].
 pub fn plan(request: &ContourRequest, tool: &Tool) -> Result<Plan, SolverError> {
-    let job = request.validate(tool, None)?;
+    let job = request.validate(tool, None, Control::default())?;
     let setup = Setup::new(&job);
     let z = job.layers.first().copied().unwrap_or(job.bottom);
     let layer = build_layer(&job, &setup, z)?;
-    let passes = plan_passes(&job, &setup, &layer)?;
+    let passes = plan_passes(&job, &setup, &layer, Control::default())?;
     let mut warnings = job.warnings.clone();
     for pass in &passes {
         warnings.extend(pass.warnings.iter().cloned());
@@ -106,7 +106,8 @@ pub fn solve_within(request: &ContourRequest, tool: &Tool, max_moves: usize) -> 
 /// rule; `W_FEED_ABOVE_MACHINE_MAX` when `feed` is above its `max_feed`).
 ///
 /// # Errors
-/// As [`solve`], and `E_CANCELLED` once `control`'s cancel flag is set (checked per layer).
+/// As [`solve`], and `E_CANCELLED` once `control`'s cancel flag is set (checked per layer, per
+/// pass of the plan and between the steps of the answer).
 /// `machine` is the profile the request's `machine` names, resolved by the caller
 /// (`capability::resolve`).
 pub fn solve_with(
@@ -116,9 +117,9 @@ pub fn solve_with(
     max_moves: usize,
     control: Control<'_>,
 ) -> Result<ContourSolution, SolverError> {
-    let prepared = Prepared::new(request, tool, machine, max_moves)?;
+    let prepared = Prepared::new(request, tool, machine, max_moves, control)?;
     let layers = prepared.layers(0..prepared.job.layers.len(), control)?;
-    prepared.answer(machine, max_moves, layers)
+    prepared.answer(machine, max_moves, layers, control)
 }
 
 /// What every layer of a contour is made from: the validated job, how it travels the contour,
@@ -145,19 +146,22 @@ impl Prepared {
     /// most [`MAX_MOVES`]) before any other layer is made.
     ///
     /// # Errors
-    /// As [`solve`].
+    /// As [`solve`]; `E_CANCELLED` once `control`'s cancel flag is set.
     pub(crate) fn new(
         request: &ContourRequest,
         tool: &Tool,
         machine: Option<&MachineProfile>,
         max_moves: usize,
+        control: Control<'_>,
     ) -> Result<Self, SolverError> {
         let max_moves = max_moves.min(MAX_MOVES);
-        let job = request.validate(tool, machine)?;
+        let job = request.validate(tool, machine, control)?;
+        control.check()?;
         let setup = Setup::new(&job);
         let first_z = job.layers.first().copied().unwrap_or(job.bottom);
         let first_layer = build_layer(&job, &setup, first_z)?;
-        let first_passes = plan_passes(&job, &setup, &first_layer)?;
+        control.check()?;
+        let first_passes = plan_passes(&job, &setup, &first_layer, control)?;
         let per_layer = layer_move_count(&first_passes, &job.chording);
         let total = per_layer.saturating_mul(job.layers.len());
         if total > max_moves {
@@ -209,7 +213,7 @@ impl Prepared {
                 (&self.first_layer, &self.first_passes)
             } else {
                 let layer = build_layer(job, &self.setup, z)?;
-                let passes = plan_passes(job, &self.setup, &layer)?;
+                let passes = plan_passes(job, &self.setup, &layer, control)?;
                 tilted = (layer, passes);
                 (&tilted.0, &tilted.1)
             };
@@ -226,12 +230,14 @@ impl Prepared {
     /// The answer from every layer's moves, in order: corners, passes, summary, warnings.
     ///
     /// # Errors
-    /// `E_TOO_MANY_MOVES` over `max_moves`; `E_INPUT` without a pass.
+    /// `E_TOO_MANY_MOVES` over `max_moves`; `E_INPUT` without a pass; `E_CANCELLED` once
+    /// `control`'s cancel flag is set.
     pub(crate) fn answer(
         &self,
         machine: Option<&MachineProfile>,
         max_moves: usize,
         made: Vec<LayerMoves>,
+        control: Control<'_>,
     ) -> Result<ContourSolution, SolverError> {
         let max_moves = max_moves.min(MAX_MOVES);
         let Self { job, setup, first_layer, first_passes } = self;
@@ -241,6 +247,7 @@ impl Prepared {
             warnings.extend(pass.warnings.iter().cloned());
         }
         let (layers, lead_used) = answer_layers(job, made, &mut warnings);
+        control.check()?;
 
         let final_pass = first_passes
             .last()
@@ -248,12 +255,14 @@ impl Prepared {
         let corners = corner_reports(job, setup.request_order, first_layer, final_pass);
         warnings.extend(corner_warnings(job, first_passes, &corners));
         let passes: Vec<PassReport> = first_passes.iter().map(pass_report).collect();
+        control.check()?;
 
         let (feed_length, time_min, moves) = feed_travel(&layers);
         if moves > max_moves {
             return Err(too_many_moves(layers.len(), moves / layers.len().max(1), moves, max_moves));
         }
         let blocks = block_figures(job, first_passes, &layers, &mut warnings)?;
+        control.check()?;
         let loop_feed = job.loop_feed.unwrap_or(job.feed);
         let summary = ContourSummary {
             side: job.side,
@@ -380,13 +389,14 @@ fn build_layer(job: &Job, setup: &Setup, z: f64) -> Result<Layer, SolverError> {
 }
 
 /// Every pass of one layer, each with the stock the previous one left.
-fn plan_passes(job: &Job, setup: &Setup, layer: &Layer) -> Result<Vec<PassPlan>, SolverError> {
+fn plan_passes(job: &Job, setup: &Setup, layer: &Layer, control: Control<'_>) -> Result<Vec<PassPlan>, SolverError> {
     let source: Vec<usize> = layer.prepared_vertex.iter().map(|&v| job.contour.source[v]).collect();
     let edge_source: Vec<usize> =
         (0..layer.len()).map(|k| source[if setup.request_order { k } else { layer.next(k) }]).collect();
     let choices: Vec<_> = layer.prepared_vertex.iter().map(|&v| job.choices[v]).collect();
     let mut plans: Vec<PassPlan> = Vec::with_capacity(job.passes.len());
     for (index, pass) in job.passes.iter().enumerate() {
+        control.check()?;
         let edge_offsets: Vec<f64> = (0..layer.len())
             .map(|k| {
                 let beta = job.tilt.as_ref().and_then(|t| t.get(layer.prepared_edge[k]).copied()).unwrap_or(0.0);

@@ -7,7 +7,8 @@ use super::program::Leg;
 use super::request::Placement;
 use super::{Deburr, DeburrRequest, Edge};
 use crate::capability::{
-    Capability, Endpoint, OtherTool, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing, Split,
+    Capability, Control, Endpoint, OtherTool, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing,
+    Split,
 };
 use crate::error::SolverError;
 use crate::gcode::{Reference, ToolCall};
@@ -192,14 +193,19 @@ impl Capability for DeburrCapability {
         super::parts::finish(request, context, parts, run)
     }
 
-    fn program(_request: &DeburrRequest, answer: &DeburrAnswer, output: &OutputOptions) -> Result<String, SolverError> {
+    fn program(
+        _request: &DeburrRequest,
+        answer: &DeburrAnswer,
+        output: &OutputOptions,
+        control: Control<'_>,
+    ) -> Result<String, SolverError> {
         let post = output.post(answer.machine.as_ref(), &answer.tool);
         match &answer.holes {
             Some(holes) => {
                 let (legs, tools) = legs(answer, holes);
-                super::program::program_for_loops(&legs, &tools, &post)
+                super::program::program_for_loops(&legs, &tools, &post, control)
             }
-            None => super::program(&answer.result, &post),
+            None => super::program::program_for_holes(&[&answer.result], &post, control),
         }
     }
 

@@ -7,7 +7,7 @@ use crate::error::{ErrorCode, SolverError, Warning};
 use crate::geometry::vec3;
 use crate::machine::{BlockRule, MachineProfile, RuleSettings};
 use crate::tool::{Tool, ToolKind};
-use crate::validate::{self, finite, non_negative, optional_positive, positive, within};
+use crate::validate::{self, finite, non_negative, optional_positive, positive};
 
 use super::request::{
     CentreDistance, DEFAULT_CLEARANCE, DEFAULT_FEED, DEFAULT_LEAD_DISTANCE, DEFAULT_SPINDLE_RPM, DEFAULT_TOLERANCE,
@@ -43,18 +43,15 @@ pub(crate) struct Job {
     pub rule_warnings: Vec<Warning>,
 }
 
-/// Largest length or coordinate accepted, mm (100 m: beyond any part, and far enough from the
-/// float range that squares and the bisection stay exact).
-pub const MAX_LENGTH: f64 = 1e5;
 /// Smallest radius, cut amount or width accepted, mm (0.1 µm: below any tool or feature).
 pub const MIN_LENGTH: f64 = 1e-4;
 
-/// A finite value within ±[`MAX_LENGTH`].
+/// A finite value within ±[`validate::MAX_COORDINATE`].
 fn bounded(field: &str, value: f64) -> Result<f64, SolverError> {
-    within(field, value, MAX_LENGTH)
+    validate::coordinate(field, value)
 }
 
-/// A size: finite, from [`MIN_LENGTH`] to [`MAX_LENGTH`].
+/// A size: finite, from [`MIN_LENGTH`] to [`validate::MAX_COORDINATE`].
 fn size(field: &str, value: f64) -> Result<f64, SolverError> {
     let value = bounded(field, positive(field, value)?)?;
     if value < MIN_LENGTH {
@@ -63,9 +60,9 @@ fn size(field: &str, value: f64) -> Result<f64, SolverError> {
     Ok(value)
 }
 
-/// A point with every coordinate finite and within ±[`MAX_LENGTH`].
+/// A point with every coordinate finite and within ±[`validate::MAX_COORDINATE`].
 fn point(field: &str, p: [f64; 3]) -> Result<[f64; 3], SolverError> {
-    validate::point(field, p, MAX_LENGTH)
+    validate::coordinates(field, p)
 }
 
 /// The workpiece section, checked: the placement of A1 and the radii.

@@ -10,6 +10,7 @@ use super::answer::{Deburr, LeadMotion, LeadMove};
 use super::frame::Frame;
 use super::job::Job;
 use super::request::Edge;
+use crate::capability::Control;
 use crate::error::ErrorCode;
 use crate::error::SolverError;
 use crate::gcode::{self, Post, Program, Reference, SpindleDirection, ToolCall};
@@ -89,7 +90,7 @@ pub(crate) fn leads(
 
 /// The complete program for a solved deburr job.
 pub fn program(deburr: &Deburr, post: &Post) -> Result<String, SolverError> {
-    program_for_holes(&[deburr], post)
+    program_for_holes(&[deburr], post, Control::default())
 }
 
 /// One program for several holes deburred with one tool: [`program_for_loops`] with
@@ -97,9 +98,9 @@ pub fn program(deburr: &Deburr, post: &Post) -> Result<String, SolverError> {
 ///
 /// # Errors
 /// As [`program_for_loops`].
-pub fn program_for_holes(holes: &[&Deburr], post: &Post) -> Result<String, SolverError> {
+pub fn program_for_holes(holes: &[&Deburr], post: &Post, control: Control<'_>) -> Result<String, SolverError> {
     let legs: Vec<Leg<'_>> = holes.iter().map(|deburr| Leg { deburr, tool: 0, turned: false }).collect();
-    program_for_loops(&legs, std::slice::from_ref(&post.tool), post)
+    program_for_loops(&legs, std::slice::from_ref(&post.tool), post, control)
 }
 
 /// One loop of a several-loop program.
@@ -238,8 +239,13 @@ pub(crate) fn visit(legs: &[Leg<'_>], reference: Reference) -> Visit {
 ///
 /// # Errors
 /// The first loop's reason when one has no program (`program_blocker`); `E_NO_PROGRAM` without
-/// loops.
-pub fn program_for_loops(legs: &[Leg<'_>], tools: &[ToolCall], post: &Post) -> Result<String, SolverError> {
+/// loops; `E_CANCELLED` once `control`'s cancel flag is set.
+pub fn program_for_loops(
+    legs: &[Leg<'_>],
+    tools: &[ToolCall],
+    post: &Post,
+    control: Control<'_>,
+) -> Result<String, SolverError> {
     let Some(first) = legs.first() else {
         return Err(SolverError::new(ErrorCode::NoProgram, "no hole to deburr"));
     };
@@ -317,7 +323,8 @@ pub fn program_for_loops(legs: &[Leg<'_>], tools: &[ToolCall], post: &Post) -> R
     if first.turned {
         comments.push(turn_notice(true));
     }
-    Ok(gcode::write_changing(
+    control.check()?;
+    gcode::write_cancellable(
         &Program {
             dialect: post.dialect,
             number: 1000,
@@ -333,5 +340,6 @@ pub fn program_for_loops(legs: &[Leg<'_>], tools: &[ToolCall], post: &Post) -> R
             path: &visit.path,
         },
         &stops,
-    ))
+        control,
+    )
 }

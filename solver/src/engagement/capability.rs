@@ -8,7 +8,7 @@ use super::job::Job;
 use super::request::Engine;
 use super::{EngagementRequest, EngagementSolution, Stock};
 use crate::capability::{
-    Capability, Endpoint, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing, Split,
+    Capability, Control, Endpoint, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing, Split,
 };
 use crate::error::{ErrorCode, SolverError};
 use crate::gcode::SpindleDirection;
@@ -193,7 +193,9 @@ impl Capability for EngagementCapability {
         request: &EngagementRequest,
         answer: &EngagementAnswer,
         output: &OutputOptions,
+        control: Control<'_>,
     ) -> Result<String, SolverError> {
+        control.check()?;
         let mut post = output.post(answer.machine.as_ref(), &answer.tool);
         post.plunge_feed = request.plunge_feed.or(post.plunge_feed);
         let candidate = output.candidate.or(request.candidate).unwrap_or(0);

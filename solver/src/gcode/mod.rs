@@ -14,6 +14,8 @@ use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
+use crate::capability::Control;
+use crate::error::SolverError;
 use crate::geometry::Vec3;
 use crate::path::{Motion, Toolpath};
 
@@ -245,6 +247,32 @@ pub fn write(program: &Program<'_>) -> String {
 /// `M05`, `G00 Z` to the clearance plane, the notice as a comment with `M00`, the tool call as at
 /// the start, and the spindle line. Without stops, [`fn@write`].
 pub fn write_changing(program: &Program<'_>, stops: &[ProgramStop]) -> String {
+    let Ok(text) = write_checking(program, stops, || Ok::<(), std::convert::Infallible>(()));
+    text
+}
+
+/// [`write_changing`] that stops with `E_CANCELLED` once `control`'s cancel flag is set (checked
+/// every [`MOVES_PER_CHECK`] moves), so a program of millions of moves that no one waits for any
+/// more does not keep its solver slot.
+///
+/// # Errors
+/// `E_CANCELLED` when cancelled.
+pub fn write_cancellable(
+    program: &Program<'_>,
+    stops: &[ProgramStop],
+    control: Control<'_>,
+) -> Result<String, SolverError> {
+    write_checking(program, stops, || control.check())
+}
+
+/// Moves written between two cancel checks (about a millisecond of writing).
+pub const MOVES_PER_CHECK: usize = 1024;
+
+fn write_checking<E>(
+    program: &Program<'_>,
+    stops: &[ProgramStop],
+    mut check: impl FnMut() -> Result<(), E>,
+) -> Result<String, E> {
     let mut out = String::with_capacity(64 + program.path.moves.len() * 40);
     let fanuc = program.dialect == Dialect::Fanuc;
     if fanuc {
@@ -266,6 +294,9 @@ pub fn write_changing(program: &Program<'_>, stops: &[ProgramStop]) -> String {
     let mut position: Option<Vec3> = None;
     let mut stops = stops.iter().peekable();
     for (index, step) in program.path.moves.iter().enumerate() {
+        if index % MOVES_PER_CHECK == 0 {
+            check()?;
+        }
         while let Some(stop) = stops.next_if(|stop| stop.before <= index) {
             out.push_str("M05\n");
             let _ = writeln!(out, "G00 Z{}", mm(program.safe_z));
@@ -325,7 +356,7 @@ pub fn write_changing(program: &Program<'_>, stops: &[ProgramStop]) -> String {
     if fanuc {
         out.push_str("%\n");
     }
-    out
+    Ok(out)
 }
 
 /// Whether the straight move from `from` to `to` goes straight down the tool axis.

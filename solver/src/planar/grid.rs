@@ -54,7 +54,9 @@ impl SegmentGrid {
         loop {
             let estimate: f64 =
                 segments.iter().map(|(a, b)| ((b.x - a.x).abs() + (b.y - a.y).abs()) / cell + 4.0).sum();
-            if estimate <= budget {
+            // Coordinates past the float range (refused by every request's validation) would
+            // double an infinite cell forever.
+            if estimate <= budget || !estimate.is_finite() || cell.is_infinite() {
                 break;
             }
             cell *= 2.0;

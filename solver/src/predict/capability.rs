@@ -10,7 +10,7 @@ use super::pipeline::{self, Context, Outcome};
 use super::request::Method;
 use super::{PathInput, Predict, PredictRequest, ProgramOptions, Stock, correct};
 use crate::capability::{
-    Capability, Endpoint, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing, Split,
+    Capability, Control, Endpoint, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing, Split,
 };
 use crate::error::{ErrorCode, SolverError};
 use crate::gcode::{Reference, ToolCall};
@@ -94,7 +94,7 @@ impl Capability for PredictCapability {
         if matches!(request.stock, Stock::Mesh {}) {
             return None;
         }
-        let job = request.validate(&context.tool, None).ok()?;
+        let job = request.validate(&context.tool, None, Control::default()).ok()?;
         if job.iterations != 1 || job.merge_tolerance.is_some() {
             return None;
         }
@@ -114,7 +114,7 @@ impl Capability for PredictCapability {
         check_upload(request, run)?;
         let mut ranged = request.clone();
         ranged.pass_range = Some([part.units.start, part.units.end]);
-        let job = ranged.validate(&context.tool, run.upload)?;
+        let job = ranged.validate(&context.tool, run.upload, run.control)?;
         let mut outcomes = pipeline::run_round(
             &Context::new(&job),
             &job.path,
@@ -137,7 +137,7 @@ impl Capability for PredictCapability {
         run: &Run<'_>,
     ) -> Result<PredictAnswer, SolverError> {
         check_upload(request, run)?;
-        let job = request.validate(&context.tool, run.upload)?;
+        let job = request.validate(&context.tool, run.upload, run.control)?;
         let count = job.path.passes.len();
         let mut outcomes: Vec<Option<Outcome>> = vec![None; count];
         let mut read = 0;
@@ -172,8 +172,9 @@ impl Capability for PredictCapability {
             total[node] += step[node];
             clamped[node] = correct::clamp(&mut total[node], job.max_correction);
         }
+        run.control.check()?;
         let mut result = super::assemble(&job, &[outcomes], &total, &clamped, &ambiguous);
-        result.warnings.extend(super::rapid_collisions(&job));
+        result.warnings.extend(super::rapid_collisions(&job, &run.control)?);
         Ok(PredictAnswer { tool: context.tool, result, timings: None })
     }
 
@@ -184,6 +185,7 @@ impl Capability for PredictCapability {
         request: &PredictRequest,
         answer: &PredictAnswer,
         output: &OutputOptions,
+        control: Control<'_>,
     ) -> Result<String, SolverError> {
         check_reference(request, output.reference)?;
         let options = ProgramOptions { dialect: output.dialect_for(None), tool: ToolCall::for_tool(&answer.tool) };
@@ -195,9 +197,9 @@ impl Capability for PredictCapability {
                 converted.reference = asked;
                 converted.path =
                     PathInput::Points { points: points.iter().map(|p| [p[0], p[1], p[2] + shift]).collect() };
-                super::corrected_program(&converted, &answer.result, &options)
+                super::corrected_program_controlled(&converted, &answer.result, &options, control)
             }
-            _ => super::corrected_program(request, &answer.result, &options),
+            _ => super::corrected_program_controlled(request, &answer.result, &options, control),
         }
     }
 

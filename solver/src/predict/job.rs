@@ -5,12 +5,13 @@
 use super::force::CuttingCoefficients;
 use super::passes::{PassSource, PathBuilder, PathModel};
 use super::stock::StockModel;
+use crate::capability::Control;
 use crate::error::{ErrorCode, SolverError};
 use crate::gcode::reader::{self, MoveKind, ReadMove, ReadOptions, ReadProgram, Spindle};
 use crate::gcode::{Reference, SpindleDirection};
 use crate::geometry::{Vec3, vec3};
 use crate::tool::{ShapeErrorPoint, Stiffness, Tool, ToolKind};
-use crate::validate::{finite, optional_positive, positive};
+use crate::validate::{MAX_COORDINATE, coordinates, finite, optional_positive, positive, quoted};
 
 use super::request::{
     DEFAULT_ARC_TOLERANCE, DEFAULT_EDGE_ELEMENTS, DEFAULT_MAX_CORRECTION, DEFAULT_MERGE_TOLERANCE, DEFAULT_RESOLUTION,
@@ -99,7 +100,7 @@ impl PredictRequest {
     /// The sections are checked in a fixed order (tool, method settings, conditions, output,
     /// stock, path, then what depends on the path), so a request with several faults is always
     /// refused for the same one.
-    pub(crate) fn validate(&self, tool: &Tool, mesh: Option<&[u8]>) -> Result<Job, SolverError> {
+    pub(crate) fn validate(&self, tool: &Tool, mesh: Option<&[u8]>, control: Control<'_>) -> Result<Job, SolverError> {
         let shape_error = check_tool(tool)?;
         let radius = tool.radius;
         let method = self.method;
@@ -121,7 +122,7 @@ impl PredictRequest {
         };
         let stock = self.stock.model(mesh)?;
         let ReadPath { path, node_sources, reference_offset } =
-            self.read_path(radius, &defaults, settings.arc_tolerance)?;
+            self.read_path(radius, &defaults, settings.arc_tolerance, control)?;
         for (k, &index) in history.iter().enumerate() {
             if index >= path.passes.len() {
                 return Err(SolverError::input(
@@ -238,7 +239,13 @@ impl PredictRequest {
 
     /// The tool path as ball-centre passes, from points or a G-code program, within the pass
     /// limits.
-    fn read_path(&self, radius: f64, defaults: &Defaults, arc_tolerance: f64) -> Result<ReadPath, SolverError> {
+    fn read_path(
+        &self,
+        radius: f64,
+        defaults: &Defaults,
+        arc_tolerance: f64,
+        control: Control<'_>,
+    ) -> Result<ReadPath, SolverError> {
         let reference_offset = match self.reference {
             Reference::Tip => -radius * Vec3::z(),
             Reference::Centre => Vec3::zeros(),
@@ -259,9 +266,7 @@ impl PredictRequest {
                 let source =
                     PassSource { line: None, block_number: None, feed, spindle_rpm, rotation_sign: defaults.sign };
                 for (index, p) in points.iter().enumerate() {
-                    for (axis, v) in p.iter().enumerate() {
-                        finite(&format!("path.points[{index}][{axis}]"), *v)?;
-                    }
+                    coordinates(&format!("path.points[{index}]"), *p)?;
                     let centre = centre_of(vec3(*p));
                     if index == 0 {
                         builder.start(centre);
@@ -274,7 +279,7 @@ impl PredictRequest {
             PathInput::Gcode { program: text } => {
                 let options =
                     ReadOptions { block_delete: self.block_delete.unwrap_or(false), ..ReadOptions::default() };
-                let read = reader::read(text, "path.program", &options)?;
+                let read = reader::read_cancellable(text, "path.program", &options, control)?;
                 build_from_program(&read, defaults, arc_tolerance, &centre_of, &mut builder, &mut node_sources)?;
             }
         }
@@ -430,6 +435,12 @@ fn build_from_program(
             node_sources.push(NodeSource { item: index, chord: 0, chords: 0 });
         }
         let source = if cutting { Some(pass_source(read_move, defaults)?) } else { None };
+        if let Some(value) = from.iter().chain(&to).find(|value| value.abs() > MAX_COORDINATE) {
+            return Err(SolverError::input(
+                field,
+                format!("line {line}: coordinates must lie within ±{MAX_COORDINATE} mm (got {})", quoted(*value)),
+            ));
+        }
         let points = read_move.points(arc_tolerance).unwrap_or_else(|| vec![to]);
         let chords = points.len();
         if builder.pass_count() + chords > MAX_PASSES {

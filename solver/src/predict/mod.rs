@@ -115,7 +115,7 @@ pub fn solve_with(
     mesh: Option<&[u8]>,
     control: &Control<'_>,
 ) -> Result<Predict, SolverError> {
-    let job = request.validate(tool, mesh)?;
+    let job = request.validate(tool, mesh, *control)?;
     let context = Context::new(&job);
     let node_count = job.path.nodes.len();
     let total_work = (job.pass_range.len() * job.iterations as usize).max(1);
@@ -143,14 +143,15 @@ pub fn solve_with(
             current = Some(job.path.with_nodes(moved, job.radius));
         }
     }
+    control.check()?;
     let mut answer = assemble(&job, &rounds, &total, &clamped, &ambiguous);
-    answer.warnings.extend(rapid_collisions(&job));
+    answer.warnings.extend(rapid_collisions(&job, control)?);
     Ok(answer)
 }
 
 /// Rapid moves whose ball enters stock that earlier motion has not removed (§5 E17): the ball's
 /// lowest point and four points at 60° from it are tested along each rapid, every R/2.
-fn rapid_collisions(job: &Job) -> Option<Warning> {
+fn rapid_collisions(job: &Job, control: &Control<'_>) -> Result<Option<Warning>, SolverError> {
     let path = &job.path;
     let radius = job.radius;
     let mut scratch = scene::Scratch::default();
@@ -161,6 +162,7 @@ fn rapid_collisions(job: &Job) -> Option<Warning> {
         let Some(line) = segment.rapid_line else {
             continue;
         };
+        control.check()?;
         if lines.last() == Some(&line) {
             continue;
         }
@@ -209,10 +211,10 @@ fn rapid_collisions(job: &Job) -> Option<Warning> {
         }
     }
     if lines.is_empty() {
-        return None;
+        return Ok(None);
     }
     let shown: Vec<String> = lines.iter().take(10).map(ToString::to_string).collect();
-    Some(Warning::new(
+    Ok(Some(Warning::new(
         "W_RAPID_COLLISION",
         format!(
             "{} rapid move(s) run through uncut stock, at line(s) {}{}",
@@ -220,7 +222,7 @@ fn rapid_collisions(job: &Job) -> Option<Warning> {
             shown.join(", "),
             if lines.len() > 10 { ", …" } else { "" }
         ),
-    ))
+    )))
 }
 
 /// Node corrections of one round (unclamped when `limit` is infinite).
@@ -406,18 +408,35 @@ pub fn corrected_program(
     answer: &Predict,
     options: &ProgramOptions,
 ) -> Result<String, SolverError> {
+    corrected_program_controlled(request, answer, options, Control::default())
+}
+
+/// [`corrected_program`] that stops with `E_CANCELLED` once `control`'s cancel flag is set
+/// (checked while reading, correcting and writing the program).
+///
+/// # Errors
+/// As [`corrected_program`]; `E_CANCELLED` when cancelled.
+pub fn corrected_program_controlled(
+    request: &PredictRequest,
+    answer: &Predict,
+    options: &ProgramOptions,
+    control: Control<'_>,
+) -> Result<String, SolverError> {
     let corrections = &answer.corrections;
     let mismatch = || SolverError::input("path", "this answer was not computed from this request");
     match &request.path {
         PathInput::Gcode { program: text } => {
             let read_options =
                 ReadOptions { block_delete: request.block_delete.unwrap_or(false), ..ReadOptions::default() };
-            let program = reader::read(text, "path.program", &read_options)?;
+            let program = reader::read_cancellable(text, "path.program", &read_options, control)?;
             let corrected =
                 |node: usize| corrections.nodes[node] + corrections.offsets[node] + corrections.reference_offset;
             let mut edits = Vec::new();
             let mut node = 0;
             while node < corrections.sources.len() {
+                if node % gcode::MOVES_PER_CHECK == 0 {
+                    control.check()?;
+                }
                 let source = corrections.sources[node];
                 if source.chords == 0 || source.chord != 0 {
                     node += 1;
@@ -453,7 +472,7 @@ pub fn corrected_program(
                 }
                 node = last + 1;
             }
-            reader::rewrite(text, &program, &edits, "path.program")
+            reader::rewrite_cancellable(text, &program, &edits, "path.program", control)
         }
         PathInput::Points { points } => {
             if points.len() != corrections.nodes.len() {
@@ -474,27 +493,31 @@ pub fn corrected_program(
                 path.linear(*p, feed);
             }
             path.rapid(Vec3::new(last.x, last.y, safe_z));
-            Ok(gcode::write(&Program {
-                dialect: options.dialect,
-                number: 1000,
-                title: "kerf corrected path",
-                comments: vec![
-                    format!("control point: {}", request.reference.as_str()),
-                    format!(
-                        "max correction {:.4} mm, predicted max error {:.4} mm",
-                        answer.summary.max_correction,
-                        answer.summary.rounds[0].max_abs_error.unwrap_or(0.0)
-                    ),
-                ],
-                tool: options.tool.clone(),
-                spindle_rpm,
-                spindle_direction: request.spindle_direction.unwrap_or_default(),
-                safe_z,
-                blend_tolerance: 0.001,
-                // The points are the caller's path, written as given.
-                plunges: None,
-                path: &path,
-            }))
+            gcode::write_cancellable(
+                &Program {
+                    dialect: options.dialect,
+                    number: 1000,
+                    title: "kerf corrected path",
+                    comments: vec![
+                        format!("control point: {}", request.reference.as_str()),
+                        format!(
+                            "max correction {:.4} mm, predicted max error {:.4} mm",
+                            answer.summary.max_correction,
+                            answer.summary.rounds[0].max_abs_error.unwrap_or(0.0)
+                        ),
+                    ],
+                    tool: options.tool.clone(),
+                    spindle_rpm,
+                    spindle_direction: request.spindle_direction.unwrap_or_default(),
+                    safe_z,
+                    blend_tolerance: 0.001,
+                    // The points are the caller's path, written as given.
+                    plunges: None,
+                    path: &path,
+                },
+                &[],
+                control,
+            )
         }
     }
 }

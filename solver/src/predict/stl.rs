@@ -7,6 +7,7 @@ use std::collections::HashMap;
 
 use crate::error::SolverError;
 use crate::geometry::Vec3;
+use crate::validate::MAX_COORDINATE;
 
 /// Most triangles accepted in a stock mesh.
 pub const MAX_TRIANGLES: usize = 2_000_000;
@@ -79,15 +80,23 @@ fn parse_binary(bytes: &[u8], count: usize) -> Result<Vec<[Vec3; 3]>, SolverErro
         };
         let vertex = |k: usize| Vec3::new(value(12 + 12 * k), value(16 + 12 * k), value(20 + 12 * k));
         let triangle = [vertex(0), vertex(1), vertex(2)];
-        if triangle.iter().any(|v| !v.iter().all(|c| c.is_finite())) {
+        if triangle.iter().any(|v| !v.iter().all(|c| in_range(*c))) {
             return Err(mesh_error(
                 ErrorCode::MeshFormat,
-                format!("triangle {} has a coordinate that is not finite", triangles.len()),
+                format!(
+                    "triangle {} has a coordinate that is not a finite number within ±{MAX_COORDINATE} mm",
+                    triangles.len()
+                ),
             ));
         }
         triangles.push(triangle);
     }
     Ok(triangles)
+}
+
+/// Whether a vertex coordinate lies in the one range of every request's geometry.
+fn in_range(value: f64) -> bool {
+    value.is_finite() && value.abs() <= MAX_COORDINATE
 }
 
 fn parse_ascii(text: &str) -> Result<Vec<[Vec3; 3]>, SolverError> {
@@ -100,11 +109,14 @@ fn parse_ascii(text: &str) -> Result<Vec<[Vec3; 3]>, SolverError> {
                 let mut coordinates = [0.0; 3];
                 for coordinate in &mut coordinates {
                     *coordinate =
-                        tokens.next().and_then(|t| t.parse::<f64>().ok()).filter(|v| v.is_finite()).ok_or_else(
+                        tokens.next().and_then(|t| t.parse::<f64>().ok()).filter(|v| in_range(*v)).ok_or_else(
                             || {
                                 mesh_error(
                                     ErrorCode::MeshFormat,
-                                    format!("STL line {}: a vertex needs three finite numbers", index + 1),
+                                    format!(
+                                        "STL line {}: a vertex needs three finite numbers within ±{MAX_COORDINATE} mm",
+                                        index + 1
+                                    ),
                                 )
                             },
                         )?;

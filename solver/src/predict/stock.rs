@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use super::stl::{self, Mesh};
 use crate::error::SolverError;
 use crate::geometry::{Vec3, vec3};
-use crate::validate::{finite, positive};
+use crate::validate::{coordinate, coordinates, positive};
 
 /// Most nodes of a height grid.
 pub const MAX_GRID_NODES: usize = 4_000_000;
@@ -207,10 +207,7 @@ impl Stock {
     /// Validates the description and builds the model; `mesh` holds the STL bytes for `mesh`.
     pub(crate) fn model(&self, mesh: Option<&[u8]>) -> Result<StockModel, SolverError> {
         let point = |name: &str, p: [f64; 3]| -> Result<Vec3, SolverError> {
-            for (axis, v) in p.iter().enumerate() {
-                finite(&format!("stock.{name}[{axis}]"), *v)?;
-            }
-            Ok(vec3(p))
+            Ok(vec3(coordinates(&format!("stock.{name}"), p)?))
         };
         match self {
             Self::Box { min, max } => {
@@ -231,8 +228,8 @@ impl Stock {
                     ));
                 }
                 for k in 0..2 {
-                    finite(&format!("stock.min[{k}]"), min[k])?;
-                    finite(&format!("stock.max[{k}]"), max[k])?;
+                    coordinate(&format!("stock.min[{k}]"), min[k])?;
+                    coordinate(&format!("stock.max[{k}]"), max[k])?;
                     if max[k] <= min[k] {
                         return Err(stock_error("stock.max", "the footprint's max must exceed its min in x and y"));
                     }
@@ -241,7 +238,7 @@ impl Stock {
             }
             Self::Cylinder { start, end, radius } => {
                 let (a, b) = (point("start", *start)?, point("end", *end)?);
-                let radius = positive("stock.radius", *radius)?;
+                let radius = coordinate("stock.radius", positive("stock.radius", *radius)?)?;
                 let length = (b - a).norm();
                 if length == 0.0 {
                     return Err(stock_error("stock.end", "the cylinder's end equals its start"));
@@ -249,9 +246,8 @@ impl Stock {
                 Ok(StockModel::Cylinder { start: a, axis: (b - a) / length, length, radius })
             }
             Self::Grid { origin, spacing, heights, bottom } => {
-                finite("stock.origin[0]", origin[0])?;
-                finite("stock.origin[1]", origin[1])?;
-                let spacing = positive("stock.spacing", *spacing)?;
+                coordinates("stock.origin", *origin)?;
+                let spacing = coordinate("stock.spacing", positive("stock.spacing", *spacing)?)?;
                 let ny = heights.len();
                 let nx = heights.first().map_or(0, Vec::len);
                 if nx < 2 || ny < 2 {
@@ -272,11 +268,11 @@ impl Stock {
                         ));
                     }
                     for (i, h) in row.iter().enumerate() {
-                        finite(&format!("stock.heights[{j}][{i}]"), *h)?;
+                        coordinate(&format!("stock.heights[{j}][{i}]"), *h)?;
                     }
                 }
                 let bottom = match bottom {
-                    Some(b) => finite("stock.bottom", *b)?,
+                    Some(b) => coordinate("stock.bottom", *b)?,
                     None => f64::NEG_INFINITY,
                 };
                 Ok(StockModel::Grid(HeightGrid::new(*origin, spacing, heights, bottom)))

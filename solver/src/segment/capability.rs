@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use super::{SegmentRequest, SegmentSolution};
-use crate::capability::{Capability, Endpoint, OutputOptions, Refs, Resolved, Run};
+use crate::capability::{Capability, Control, Endpoint, OutputOptions, Refs, Resolved, Run};
 use crate::error::SolverError;
 use crate::gcode::{Post, Reference, ToolCall};
 use crate::machine::MachineProfile;
@@ -81,6 +81,7 @@ impl Capability for SegmentCapability {
         request: &SegmentRequest,
         answer: &SegmentAnswer,
         output: &OutputOptions,
+        control: Control<'_>,
     ) -> Result<String, SolverError> {
         let tool = match &answer.tool {
             Some(tool) => ToolCall::for_tool(tool),
@@ -96,7 +97,7 @@ impl Capability for SegmentCapability {
                 .or(answer.tool.as_ref().and_then(|tool| tool.plunge_feed))
                 .or(answer.machine.as_ref().and_then(|m| m.plunge_feed)),
         };
-        super::program(&answer.result, &post)
+        super::program::program_controlled(&answer.result, &post, control)
     }
 
     fn machine(answer: &SegmentAnswer) -> Option<&MachineProfile> {

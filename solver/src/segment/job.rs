@@ -15,7 +15,7 @@ use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
 use crate::machine::rule::{BlockRule, RuleSettings};
 use crate::machine::{MachineProfile, Mode};
-use crate::validate::{finite, positive};
+use crate::validate::{coordinate, finite, positive};
 
 /// Where the chord error comes from, resolved.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,13 +56,7 @@ fn point(field: &str, coordinates: &[f64]) -> Result<Vec3, SolverError> {
         ));
     }
     for (axis, &value) in coordinates.iter().enumerate() {
-        let path = format!("{field}[{axis}]");
-        if finite(&path, value)?.abs() > MAX_COORDINATE {
-            return Err(SolverError::input(
-                path,
-                format!("coordinates must be within ±{MAX_COORDINATE} mm (got {value})"),
-            ));
-        }
+        coordinate(&format!("{field}[{axis}]"), value)?;
     }
     Ok(Vec3::new(coordinates[0], coordinates[1], coordinates.get(2).copied().unwrap_or(0.0)))
 }
@@ -474,7 +468,7 @@ impl SegmentRequest {
         let tolerance = optional_tolerance("tolerance", self.tolerance)?;
         let compare_tolerance = optional_tolerance("compare_tolerance", self.compare_tolerance)?;
         let spindle_rpm = self.spindle_rpm.map_or(Ok(DEFAULT_SPINDLE_RPM), |rpm| positive("spindle_rpm", rpm))?;
-        let safe_z = self.safe_z.map(|z| finite("safe_z", z)).transpose()?;
+        let safe_z = self.safe_z.map(|z| coordinate("safe_z", z)).transpose()?;
         let (shape, corners, dimension, curve_warnings) = self.curve.build()?;
         warnings.extend(curve_warnings);
         let (start, end) = shape.domain();

@@ -8,6 +8,7 @@
 //! programmed point), 2-D curves at z = 0.
 
 use super::answer::{CommandPoint, SegmentSolution};
+use crate::capability::Control;
 use crate::error::ErrorCode;
 use crate::error::SolverError;
 use crate::gcode::{self, Arcs, Post, Program, SpindleDirection};
@@ -42,6 +43,14 @@ pub(crate) fn cycle_time(
 /// # Errors
 /// `E_NO_PROGRAM` when the answer has no block (it always has one when `solve` succeeded).
 pub fn program(answer: &SegmentSolution, post: &Post) -> Result<String, SolverError> {
+    program_controlled(answer, post, Control::default())
+}
+
+/// [`program`] that stops with `E_CANCELLED` once `control`'s cancel flag is set.
+///
+/// # Errors
+/// As [`program`]; `E_CANCELLED` when cancelled.
+pub fn program_controlled(answer: &SegmentSolution, post: &Post, control: Control<'_>) -> Result<String, SolverError> {
     let points: Vec<Vec3> = answer.points.iter().map(CommandPoint::to_vec3).collect();
     let Some(first) = points.first() else {
         return Err(SolverError::new(ErrorCode::NoProgram, "the answer has no points"));
@@ -58,22 +67,30 @@ pub fn program(answer: &SegmentSolution, post: &Post) -> Result<String, SolverEr
             path.arc_sweep(*first, end, arc.centre, arc.sense * arc.sweep, answer.feed);
         }
         _ => {
-            for point in &points[1..] {
+            for (index, point) in points[1..].iter().enumerate() {
+                if index % gcode::MOVES_PER_CHECK == 0 {
+                    control.check()?;
+                }
                 path.linear(*point, answer.feed);
             }
         }
     }
-    Ok(gcode::write(&Program {
-        dialect: post.dialect,
-        number: 1001,
-        title: "kerf segment",
-        comments: answer.description.clone(),
-        tool: post.tool.clone(),
-        spindle_rpm: answer.spindle_rpm,
-        spindle_direction: SpindleDirection::Cw,
-        safe_z: answer.safe_z,
-        blend_tolerance: answer.chord_error.max(1e-4),
-        plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
-        path: &path,
-    }))
+    control.check()?;
+    gcode::write_cancellable(
+        &Program {
+            dialect: post.dialect,
+            number: 1001,
+            title: "kerf segment",
+            comments: answer.description.clone(),
+            tool: post.tool.clone(),
+            spindle_rpm: answer.spindle_rpm,
+            spindle_direction: SpindleDirection::Cw,
+            safe_z: answer.safe_z,
+            blend_tolerance: answer.chord_error.max(1e-4),
+            plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
+            path: &path,
+        },
+        &[],
+        control,
+    )
 }

@@ -84,7 +84,7 @@ pub(crate) enum Shape {
 
 /// |dP/dt| of an ellipse with semi-axes a, b at angle t: √(a² sin² t + b² cos² t). Not by
 /// `hypot`, whose guard against overflow cost a quarter of an ellipse's segmentation: the
-/// semi-axes are at most `MAX_COORDINATE` (1e6 mm), far from it.
+/// semi-axes are at most `MAX_COORDINATE` (1e5 mm), far from it.
 pub(crate) fn ellipse_speed([a, b]: [f64; 2], t: f64) -> f64 {
     let (sin, cos) = t.sin_cos();
     ((a * sin).powi(2) + (b * cos).powi(2)).sqrt()

@@ -89,7 +89,7 @@ fn bad_paths_are_refused() {
     assert_eq!(loop_path(&bad).unwrap_err().code().as_str(), "E_DEGENERATE");
     bad.path = vec![[0.0, 0.0], [1.0, f64::NAN], [1.0, 1.0]];
     let error = loop_path(&bad).unwrap_err();
-    assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("path[1]")));
+    assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("path[1][1]")));
     bad.path = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]];
     bad.tool_radius = 0.0;
     assert_eq!(loop_path(&bad).unwrap_err().field(), Some("tool_radius"));

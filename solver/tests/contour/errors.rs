@@ -178,7 +178,7 @@ fn non_finite_numbers_name_their_field() {
     let mut request: ContourRequest = serde_json::from_value(base()).unwrap();
     request.contour[2] = [40.0, f64::NAN];
     let error = contour::solve(&request, &Tool::new(ToolKind::Flat, 1.0)).unwrap_err();
-    assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("contour[2]")));
+    assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("contour[2][1]")));
     let mut request: ContourRequest = serde_json::from_value(base()).unwrap();
     request.depths.top = f64::INFINITY;
     let error = contour::solve(&request, &Tool::new(ToolKind::Flat, 1.0)).unwrap_err();

@@ -30,8 +30,9 @@ mod lexer;
 mod modal;
 mod rewrite;
 
-pub use rewrite::{MoveEdit, rewrite};
+pub use rewrite::{MoveEdit, rewrite, rewrite_cancellable};
 
+use crate::capability::Control;
 use crate::error::ErrorCode;
 use crate::error::SolverError;
 use arcs::{ArcGeometry, arc_kind};
@@ -291,6 +292,20 @@ pub struct ReadProgram {
 /// `E_GCODE_POSITION` (an arc from a position the program never set) and `E_TOO_MANY_LINES`,
 /// each with the line number in the message.
 pub fn read(text: &str, field: &str, options: &ReadOptions) -> Result<ReadProgram, SolverError> {
+    read_cancellable(text, field, options, Control::default())
+}
+
+/// [`read`] that stops with `E_CANCELLED` once `control`'s cancel flag is set (checked every
+/// [`crate::gcode::MOVES_PER_CHECK`] lines: a program of millions of lines takes seconds).
+///
+/// # Errors
+/// As [`read`]; `E_CANCELLED` when cancelled.
+pub fn read_cancellable(
+    text: &str,
+    field: &str,
+    options: &ReadOptions,
+    control: Control<'_>,
+) -> Result<ReadProgram, SolverError> {
     let mut reader = Reader {
         modal: Modal::default(),
         motion: None,
@@ -305,6 +320,9 @@ pub fn read(text: &str, field: &str, options: &ReadOptions) -> Result<ReadProgra
     for (index, raw) in text.split('\n').enumerate() {
         let line_number = index + 1;
         line_count = line_number;
+        if index % crate::gcode::MOVES_PER_CHECK == 0 {
+            control.check()?;
+        }
         if line_number > options.max_lines {
             return Err(SolverError::new(
                 ErrorCode::TooManyLines,

@@ -5,6 +5,7 @@
 use std::fmt::Write as _;
 
 use super::{Distance, MoveKind, Position, ReadMove, ReadProgram, WordSpan, known};
+use crate::capability::Control;
 use crate::error::SolverError;
 
 /// New geometry for one move of a [`ReadProgram`], in mm, absolute.
@@ -35,6 +36,21 @@ pub struct MoveEdit {
 /// # Errors
 /// `E_INPUT` for an edit that names no move, or a non-finite coordinate.
 pub fn rewrite(text: &str, program: &ReadProgram, edits: &[MoveEdit], field: &str) -> Result<String, SolverError> {
+    rewrite_cancellable(text, program, edits, field, Control::default())
+}
+
+/// [`rewrite`] that stops with `E_CANCELLED` once `control`'s cancel flag is set (checked every
+/// [`crate::gcode::MOVES_PER_CHECK`] moves).
+///
+/// # Errors
+/// As [`rewrite`]; `E_CANCELLED` when cancelled.
+pub fn rewrite_cancellable(
+    text: &str,
+    program: &ReadProgram,
+    edits: &[MoveEdit],
+    field: &str,
+    control: Control<'_>,
+) -> Result<String, SolverError> {
     let count = program.moves.len();
     let targets = Targets::of(program, edits, field)?;
     // Where each move of the rewritten program really ends (written values are rounded), so
@@ -42,6 +58,9 @@ pub fn rewrite(text: &str, program: &ReadProgram, edits: &[MoveEdit], field: &st
     let mut actual: Vec<Position> = Vec::with_capacity(count);
     let mut replacements: Vec<LineEdit> = Vec::new();
     for (index, read_move) in program.moves.iter().enumerate() {
+        if index % crate::gcode::MOVES_PER_CHECK == 0 {
+            control.check()?;
+        }
         let continuous = index > 0 && program.moves[index - 1].to == read_move.from;
         let start = if continuous { actual[index - 1] } else { read_move.from };
         if start == read_move.from && targets.to[index] == read_move.to && targets.centres[index].is_none() {

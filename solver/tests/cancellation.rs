@@ -1,0 +1,212 @@
+//! Cancellation through the seam: every capability's solve and program writer, run on a large
+//! input with the cancel flag raised a few milliseconds in, returns `E_CANCELLED` within 100 ms
+//! (of its thread's CPU time) of the raise (a timed-out request, a cancelled job and a stopping server free their solver slot
+//! at once). Engagement's own loops are tested with engagement.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use kerf_cases::predict;
+use kerf_cases::split::{context, contour_context, contour_request, deburr_context, deburr_request};
+use kerf_solver::SolverError;
+use kerf_solver::capability::{self, Capability, Control, OutputOptions, Purpose, Resolved, Run};
+use kerf_solver::contour::{ContourCapability, LoopsRequest};
+use kerf_solver::deburr::DeburrCapability;
+use kerf_solver::error::ErrorCode;
+use kerf_solver::gcode::Arcs;
+use kerf_solver::predict::{Method, PredictCapability};
+use kerf_solver::segment::{SegmentCapability, SegmentRequest};
+use kerf_solver::tool::Tool;
+use serde_json::json;
+
+/// When the flag is raised after the work started.
+const RAISE_AFTER: Duration = Duration::from_millis(20);
+/// The most CPU time the work may spend after the raise. CPU time, not wall time, so that a
+/// machine busy with other work does not fail the test; it ticks in 10 ms steps.
+const BOUND: Duration = Duration::from_millis(100);
+/// The most wall time the work may take after the raise, however busy the machine.
+const WALL_BOUND: Duration = Duration::from_secs(5);
+
+/// CPU time (user and system) of thread `task` of this process, from `/proc`.
+fn thread_cpu(task: &str) -> Duration {
+    let stat = std::fs::read_to_string(format!("/proc/self/task/{task}/stat")).expect("thread stat");
+    let fields: Vec<&str> = stat.rsplit_once(") ").expect("stat fields").1.split(' ').collect();
+    let ticks: u64 = fields[11].parse::<u64>().unwrap() + fields[12].parse::<u64>().unwrap();
+    // USER_HZ is 100 on Linux.
+    Duration::from_millis(ticks * 10)
+}
+
+/// This thread's id, as `/proc/self/task` names it.
+fn this_thread() -> String {
+    let link = std::fs::read_link("/proc/thread-self").expect("/proc/thread-self");
+    link.file_name().unwrap().to_string_lossy().into_owned()
+}
+
+/// What the work did after the cancel flag was raised.
+struct AfterRaise {
+    cpu: Duration,
+    wall: Duration,
+}
+
+/// Runs `work` with a cancel flag raised [`RAISE_AFTER`] in; what it spent after the raise, and
+/// what it returned.
+fn cancel_during<T: Send>(
+    work: impl FnOnce(Control<'_>) -> Result<T, SolverError> + Send,
+) -> (AfterRaise, Result<T, SolverError>) {
+    let flag = AtomicBool::new(false);
+    let (task_sender, task) = std::sync::mpsc::channel();
+    std::thread::scope(|scope| {
+        let flag = &flag;
+        let running = scope.spawn(move || {
+            let me = this_thread();
+            task_sender.send(me.clone()).unwrap();
+            let result = work(Control { progress: None, cancel: Some(flag) });
+            (Instant::now(), thread_cpu(&me), result)
+        });
+        let task = task.recv().unwrap();
+        std::thread::sleep(RAISE_AFTER);
+        let (raised, cpu_at_raise) = (Instant::now(), thread_cpu(&task));
+        flag.store(true, Ordering::Relaxed);
+        let (ended, cpu_at_end, result) = running.join().expect("the work does not panic");
+        let after =
+            AfterRaise { cpu: cpu_at_end.saturating_sub(cpu_at_raise), wall: ended.saturating_duration_since(raised) };
+        (after, result)
+    })
+}
+
+/// `work` ended with `E_CANCELLED` within [`BOUND`] of CPU time after the raise (and was still
+/// running then: an input too small to outlast [`RAISE_AFTER`] proves nothing).
+fn stops<T: Send>(what: &str, work: impl FnOnce(Control<'_>) -> Result<T, SolverError> + Send) {
+    let (after, result) = cancel_during(work);
+    let Err(error) = result else {
+        assert!(after.wall > Duration::ZERO, "{what} finished before the cancel flag was raised: use a larger input");
+        panic!("{what} ran to its end, {:?} of CPU after the cancel flag was raised", after.cpu);
+    };
+    assert_eq!(error.code(), ErrorCode::Cancelled, "{what}: {error:?}");
+    assert!(after.cpu <= BOUND, "{what} ran on for {:?} of CPU after the cancel flag was raised", after.cpu);
+    assert!(after.wall <= WALL_BOUND, "{what} ran on for {:?} after the cancel flag was raised", after.wall);
+}
+
+/// `C`'s solve of `request` for `purpose`, under `control`.
+fn solve<C: Capability>(
+    request: &C::Request,
+    context: Resolved<C::Tool>,
+    purpose: Purpose,
+    control: Control<'_>,
+) -> Result<C::Answer, SolverError> {
+    C::solve(request, context, &Run { control, purpose, ..Run::default() })
+}
+
+/// `C`'s program of an answer, under `control`.
+fn program<C: Capability>(
+    request: &C::Request,
+    answer: &C::Answer,
+    output: &OutputOptions,
+    control: Control<'_>,
+) -> Result<String, SolverError> {
+    capability::program::<C>(request, answer, output, control)
+}
+
+fn segment_request() -> SegmentRequest {
+    // A large ellipse at a tiny chord error: hundreds of thousands of blocks.
+    serde_json::from_value(json!({
+        "curve": {"kind": "ellipse", "centre": [0, 0], "semi_axes": [1000, 625]},
+        "feed": 1000, "block_time_ms": 0.5, "mode": "curve", "tolerance": 1e-6,
+    }))
+    .unwrap()
+}
+
+#[test]
+fn segment_solve_and_program_stop() {
+    let request = segment_request();
+    let none = || Resolved { tool: None::<Tool>, machine: None, material: None, other_tools: Vec::new() };
+    stops("segment solve", |control| solve::<SegmentCapability>(&request, none(), Purpose::Program, control));
+    let answer = solve::<SegmentCapability>(&request, none(), Purpose::Program, Control::default()).unwrap();
+    stops("segment program", |control| {
+        program::<SegmentCapability>(&request, &answer, &OutputOptions::default(), control)
+    });
+}
+
+#[test]
+fn contour_solve_and_program_stop() {
+    let request = contour_request(3000, json!({"tolerance": 0.0005}));
+    stops("contour solve", |control| {
+        solve::<ContourCapability>(&request, contour_context(false), Purpose::Program, control)
+    });
+    let answer =
+        solve::<ContourCapability>(&request, contour_context(false), Purpose::Program, Control::default()).unwrap();
+    for arcs in [Arcs::Chords, Arcs::G2g3] {
+        let output = OutputOptions { arcs: Some(arcs), ..OutputOptions::default() };
+        stops(&format!("contour program ({arcs:?})"), |control| {
+            program::<ContourCapability>(&request, &answer, &output, control)
+        });
+    }
+}
+
+#[test]
+fn contour_loops_stop() {
+    // A star of 100 000 points: a loop at every other one.
+    let path: Vec<[f64; 2]> = (0..100_000)
+        .map(|k| {
+            let angle = std::f64::consts::TAU * f64::from(k) / 100_000.0;
+            let radius = if k % 2 == 0 { 5000.0 } else { 4999.0 };
+            [radius * angle.cos(), radius * angle.sin()]
+        })
+        .collect();
+    let request: LoopsRequest = serde_json::from_value(json!({
+        "tool": {"kind": "flat", "radius": 0.5}, "path": path, "tolerance": 0.0005,
+    }))
+    .unwrap();
+    let tool = Tool::new(kerf_solver::tool::ToolKind::Flat, 0.5);
+    stops("contour loops", |control| request.solve(tool, control));
+}
+
+#[test]
+fn deburr_solve_and_program_stop() {
+    let holes: Vec<(f64, f64, f64)> = (0..40).map(|k| (4.0, 90.0, 20.0 * f64::from(k))).collect();
+    let request = deburr_request(&holes, "both", json!({"tolerance": 1e-5}));
+    stops("deburr solve", |control| {
+        solve::<DeburrCapability>(&request, deburr_context(Some(2.0), false), Purpose::Program, control)
+    });
+    let answer =
+        solve::<DeburrCapability>(&request, deburr_context(Some(2.0), false), Purpose::Program, Control::default())
+            .unwrap();
+    stops("deburr program", |control| {
+        program::<DeburrCapability>(&request, &answer, &OutputOptions::default(), control)
+    });
+}
+
+#[test]
+fn predict_solve_and_program_stop() {
+    let (request, tool, _) = predict::raster_request(60.0, 0.1, 0.1, Method::Sampling, 64);
+    stops("predict solve", |control| solve::<PredictCapability>(&request, context(&tool), Purpose::Program, control));
+}
+
+#[test]
+fn a_long_contour_stops_while_planned() {
+    // 200 000 vertices (the limit), one layer: the time goes into planning the passes.
+    let contour: Vec<[f64; 2]> = (0..200_000)
+        .map(|k| {
+            let angle = std::f64::consts::TAU * f64::from(k) / 200_000.0;
+            let radius = if k % 2 == 0 { 5000.0 } else { 4999.5 };
+            [radius * angle.cos(), radius * angle.sin()]
+        })
+        .collect();
+    let request = contour_request(1, json!({"contour": contour}));
+    stops("contour plan", |control| {
+        solve::<ContourCapability>(&request, contour_context(false), Purpose::Program, control)
+    });
+}
+
+#[test]
+fn gcode_reading_stops() {
+    let text: String = (0..2_000_000).map(|k| format!("G01 X{}.5 Y1 Z0 F600\n", k % 1000)).collect();
+    stops("G-code reading", |control| {
+        kerf_solver::gcode::reader::read_cancellable(
+            &text,
+            "path.program",
+            &kerf_solver::gcode::reader::ReadOptions { max_lines: 3_000_000, ..Default::default() },
+            control,
+        )
+    });
+}
