@@ -157,13 +157,16 @@ pub async fn open_read_only(database: &Database) -> anyhow::Result<Option<Db>> {
 }
 
 async fn open_sqlite(path: &Path) -> anyhow::Result<SqlitePool> {
-    let options = SqliteConnectOptions::from_str("sqlite:")?
-        .filename(path)
-        .create_if_missing(true)
+    let mut options = SqliteConnectOptions::from_str("sqlite:")?.filename(path).create_if_missing(true);
+    if !path.exists() {
         // A new file gives pages freed by pruned jobs back to the file system (`PRAGMA
-        // incremental_vacuum` after each prune); on a file created before, this is a no-op until
-        // `kerf jobs prune` converts it.
-        .auto_vacuum(SqliteAutoVacuum::Incremental)
+        // incremental_vacuum` after each prune). Set on a new file only: on an existing one it
+        // changes nothing (`kerf jobs prune` converts an older file) but still writes, which
+        // fails on a full disk, and the service must start there (read-only until space is
+        // freed).
+        options = options.auto_vacuum(SqliteAutoVacuum::Incremental);
+    }
+    let options = options
         .journal_mode(SqliteJournalMode::Wal)
         // The write-ahead log is cut back to 64 MiB after each checkpoint instead of keeping the
         // size of the largest transaction (a job's results) for good.
@@ -181,13 +184,41 @@ async fn open_sqlite(path: &Path) -> anyhow::Result<SqlitePool> {
     Ok(pool)
 }
 
+/// How long a request waits for a database connection before it is answered 503 `E_UNAVAILABLE`
+/// (with `Retry-After`): `KERF_DATABASE_TIMEOUT_S` seconds, by default [`DEFAULT_ACQUIRE_TIMEOUT`].
+/// Short, so an outage is told to clients at once instead of holding their requests.
+pub fn acquire_timeout() -> Duration {
+    std::env::var("KERF_DATABASE_TIMEOUT_S")
+        .ok()
+        .and_then(|text| text.trim().parse::<f64>().ok())
+        .filter(|seconds| seconds.is_finite() && *seconds > 0.0)
+        .map_or(DEFAULT_ACQUIRE_TIMEOUT, |seconds| Duration::from_secs_f64(seconds.min(3600.0)))
+}
+
+/// The default of [`acquire_timeout`].
+pub const DEFAULT_ACQUIRE_TIMEOUT: Duration = Duration::from_secs(3);
+
+/// How long a starting process waits for its PostgreSQL server (which may be starting beside it).
+const START_WAIT: Duration = Duration::from_secs(10);
+
 async fn connect_postgres(url: &str, connections: u32) -> anyhow::Result<PgPool> {
     let options = PgConnectOptions::from_str(url)?.application_name("kerf");
-    Ok(PgPoolOptions::new()
-        .max_connections(connections)
-        .acquire_timeout(Duration::from_secs(10))
-        .connect_with(options)
-        .await?)
+    let started = std::time::Instant::now();
+    loop {
+        match PgPoolOptions::new()
+            .max_connections(connections)
+            .acquire_timeout(acquire_timeout())
+            .connect_with(options.clone())
+            .await
+        {
+            Ok(pool) => return Ok(pool),
+            Err(error @ (sqlx::Error::Io(_) | sqlx::Error::PoolTimedOut)) if started.elapsed() < START_WAIT => {
+                tracing::warn!(%error, "the database does not answer yet; trying again");
+                tokio::time::sleep(Duration::from_millis(500)).await;
+            }
+            Err(error) => return Err(error.into()),
+        }
+    }
 }
 
 #[cfg(test)]
