@@ -10,7 +10,9 @@ use std::time::Duration;
 
 use anyhow::Context;
 use sqlx::postgres::{PgConnectOptions, PgPoolOptions};
-use sqlx::sqlite::{SqliteAutoVacuum, SqliteConnectOptions, SqliteJournalMode, SqlitePoolOptions, SqliteSynchronous};
+use sqlx::sqlite::{
+    SqliteAutoVacuum, SqliteConnectOptions, SqliteJournalMode, SqliteLockingMode, SqlitePoolOptions, SqliteSynchronous,
+};
 use sqlx::{PgPool, SqlitePool};
 
 /// Where the data lives, as `--database` names it: a file path or `sqlite://PATH` (SQLite), or
@@ -157,8 +159,9 @@ pub async fn open_read_only(database: &Database) -> anyhow::Result<Option<Db>> {
 }
 
 async fn open_sqlite(path: &Path) -> anyhow::Result<SqlitePool> {
+    let existed = path.exists();
     let mut options = SqliteConnectOptions::from_str("sqlite:")?.filename(path).create_if_missing(true);
-    if !path.exists() {
+    if !existed {
         // A new file gives pages freed by pruned jobs back to the file system (`PRAGMA
         // incremental_vacuum` after each prune). Set on a new file only: on an existing one it
         // changes nothing (`kerf jobs prune` converts an older file) but still writes, which
@@ -175,11 +178,23 @@ async fn open_sqlite(path: &Path) -> anyhow::Result<SqlitePool> {
         .foreign_keys(true)
         // Concurrent writers wait for the lock instead of failing with "database is locked".
         .busy_timeout(Duration::from_secs(10));
-    let pool = SqlitePoolOptions::new()
-        .max_connections(8)
-        .connect_with(options)
-        .await
-        .with_context(|| format!("opening database {}", path.display()))?;
+    let pool = match SqlitePoolOptions::new().max_connections(8).connect_with(options.clone()).await {
+        Ok(pool) => pool,
+        Err(error) if existed && crate::error::disk_full(&error) => {
+            // No room for the shared-memory index (`-shm`) the connections share: one connection
+            // that holds the file alone keeps that index in its own memory instead. Reads work,
+            // writes once space is freed; a restart then brings the pool back.
+            tracing::warn!(%error, database = %path.display(), "the disk is full: one exclusive connection until a restart");
+            let exclusive = options.locking_mode(SqliteLockingMode::Exclusive);
+            SqlitePoolOptions::new()
+                .max_connections(1)
+                .connect_with(exclusive)
+                .await
+                .map_err(|_| error)
+                .with_context(|| format!("opening database {}", path.display()))?
+        }
+        Err(error) => return Err(error).with_context(|| format!("opening database {}", path.display())),
+    };
     sqlx::migrate!("../migrations/sqlite").run(&pool).await.context("applying migrations")?;
     Ok(pool)
 }

@@ -205,11 +205,11 @@ impl IntoResponse for AppError {
 /// Seconds a client is told to wait (`Retry-After`) while the database cannot be reached.
 pub const RETRY_AFTER_UNAVAILABLE: &str = "5";
 
-/// Whether `error` says the database's disk is full: SQLite's `SQLITE_FULL` (13), PostgreSQL's
-/// `disk_full` (53100).
-fn storage_full(error: &sqlx::Error) -> bool {
+/// Whether `error` says the database's disk is full: SQLite's `SQLITE_FULL` (13) or no room for
+/// its shared-memory index (`SQLITE_IOERR_SHMSIZE`, 4874), PostgreSQL's `disk_full` (53100).
+pub fn disk_full(error: &sqlx::Error) -> bool {
     let sqlx::Error::Database(error) = error else { return false };
-    matches!(error.code().as_deref(), Some("13" | "53100"))
+    matches!(error.code().as_deref(), Some("13" | "4874" | "53100"))
 }
 
 /// Whether `error` says the database cannot be reached now, but may be again: no connection
@@ -229,7 +229,7 @@ fn unavailable(error: &sqlx::Error) -> bool {
 impl From<sqlx::Error> for AppError {
     /// The cause is logged, not sent (it may name hosts and files).
     fn from(error: sqlx::Error) -> Self {
-        if storage_full(&error) {
+        if disk_full(&error) {
             tracing::warn!(%error, "the database's disk is full");
             return Self::StorageFull(
                 "the database's disk is full; nothing of this request was stored (reads still work; writes work again \

@@ -184,3 +184,37 @@ async fn a_full_disk_loses_no_acknowledged_write_and_the_service_starts_on_it() 
     app.shutdown().await;
     drop(app);
 }
+
+/// A database left as a clean stop leaves it (no write-ahead log, no shared-memory index) on a
+/// disk that filled up meanwhile: the service starts, reads work, writes are refused until space
+/// is freed, then they work.
+#[tokio::test(flavor = "multi_thread")]
+async fn the_service_starts_on_a_full_disk_from_a_clean_stop() {
+    let Some(disk) = Tmpfs::mount(4) else { return };
+    let database = disk.path().join("kerf.db");
+    let source = TestApp::spawn().await;
+    source.register_tool(1, &json!({"kind": "ball", "radius": 2.0})).await;
+    let copy = sqlx::SqlitePool::connect(&format!("sqlite:{}", source.database.display())).await.unwrap();
+    sqlx::query("VACUUM INTO $1").bind(database.display().to_string()).execute(&copy).await.unwrap();
+    copy.close().await;
+    let options = sqlx::sqlite::SqliteConnectOptions::new()
+        .filename(&database)
+        .journal_mode(sqlx::sqlite::SqliteJournalMode::Wal);
+    sqlx::SqlitePool::connect_with(options).await.unwrap().close().await;
+    let left: Vec<String> = std::fs::read_dir(disk.path())
+        .unwrap()
+        .map(|entry| entry.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(left, ["kerf.db"], "a clean stop leaves the database file alone");
+
+    disk.fill();
+    let app = TestApp::spawn_configured(|config| config.database = Database::Sqlite(database.clone())).await;
+    assert_eq!(json_with(app.get("/api/v1/tools/1").await, 200).await["kind"], "ball");
+    let tool = json!({"kind": "flat", "radius": 4.0});
+    assert_eq!(problem(app.put_json("/api/v1/tools/2", &tool).await, 507).await["code"], "E_STORAGE_FULL");
+    problem(app.get("/api/v1/tools/2").await, 404).await;
+    disk.free();
+    json_with(app.put_json("/api/v1/tools/2", &tool).await, 201).await;
+    assert_eq!(json_with(app.get("/api/v1/tools/2").await, 200).await["radius"], 4.0);
+    drop(app);
+}
