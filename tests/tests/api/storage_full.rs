@@ -2,7 +2,8 @@
 //! Every write answered with success (tool, machine and material PUTs, job submissions) is
 //! readable afterwards, also after a restart; every other one is refused 507 `E_STORAGE_FULL`
 //! and nothing of it is stored. The service starts on the full disk (reads work, writes are
-//! refused), and once space is freed writes work again and the jobs it acknowledged run.
+//! refused), and once space is freed writes work again and the jobs it acknowledged run. It
+//! also starts on a full disk after a clean stop, with no room for SQLite's shared-memory index.
 //!
 //! A real file system that fills, not SQLite's `max_page_count`: that limit fails the statement
 //! itself, while a full disk fails the write-ahead log at commit, after an `INSERT … RETURNING`
