@@ -57,6 +57,7 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
     let mut document = document;
     crate::openapi::describe_responses(&mut document);
     crate::openapi::describe_security(&mut document);
+    crate::openapi::describe_storage(&mut document);
     (routes, document)
 }
 

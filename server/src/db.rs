@@ -10,7 +10,9 @@ use std::time::Duration;
 
 use anyhow::Context;
 use sqlx::postgres::{PgConnectOptions, PgPoolOptions};
-use sqlx::sqlite::{SqliteAutoVacuum, SqliteConnectOptions, SqliteJournalMode, SqlitePoolOptions, SqliteSynchronous};
+use sqlx::sqlite::{
+    SqliteAutoVacuum, SqliteConnectOptions, SqliteJournalMode, SqliteLockingMode, SqlitePoolOptions, SqliteSynchronous,
+};
 use sqlx::{PgPool, SqlitePool};
 
 /// Where the data lives, as `--database` names it: a file path or `sqlite://PATH` (SQLite), or
@@ -157,13 +159,17 @@ pub async fn open_read_only(database: &Database) -> anyhow::Result<Option<Db>> {
 }
 
 async fn open_sqlite(path: &Path) -> anyhow::Result<SqlitePool> {
-    let options = SqliteConnectOptions::from_str("sqlite:")?
-        .filename(path)
-        .create_if_missing(true)
+    let existed = path.exists();
+    let mut options = SqliteConnectOptions::from_str("sqlite:")?.filename(path).create_if_missing(true);
+    if !existed {
         // A new file gives pages freed by pruned jobs back to the file system (`PRAGMA
-        // incremental_vacuum` after each prune); on a file created before, this is a no-op until
-        // `kerf jobs prune` converts it.
-        .auto_vacuum(SqliteAutoVacuum::Incremental)
+        // incremental_vacuum` after each prune). Set on a new file only: on an existing one it
+        // changes nothing (`kerf jobs prune` converts an older file) but still writes, which
+        // fails on a full disk, and the service must start there (read-only until space is
+        // freed).
+        options = options.auto_vacuum(SqliteAutoVacuum::Incremental);
+    }
+    let options = options
         .journal_mode(SqliteJournalMode::Wal)
         // The write-ahead log is cut back to 64 MiB after each checkpoint instead of keeping the
         // size of the largest transaction (a job's results) for good.
@@ -172,22 +178,62 @@ async fn open_sqlite(path: &Path) -> anyhow::Result<SqlitePool> {
         .foreign_keys(true)
         // Concurrent writers wait for the lock instead of failing with "database is locked".
         .busy_timeout(Duration::from_secs(10));
-    let pool = SqlitePoolOptions::new()
-        .max_connections(8)
-        .connect_with(options)
-        .await
-        .with_context(|| format!("opening database {}", path.display()))?;
+    let pool = match SqlitePoolOptions::new().max_connections(8).connect_with(options.clone()).await {
+        Ok(pool) => pool,
+        Err(error) if existed && crate::error::disk_full(&error) => {
+            // No room for the shared-memory index (`-shm`) the connections share: one connection
+            // that holds the file alone keeps that index in its own memory instead. Reads work,
+            // writes once space is freed; a restart then brings the pool back.
+            tracing::warn!(%error, database = %path.display(), "the disk is full: one exclusive connection until a restart");
+            let exclusive = options.locking_mode(SqliteLockingMode::Exclusive);
+            SqlitePoolOptions::new()
+                .max_connections(1)
+                .connect_with(exclusive)
+                .await
+                .map_err(|_| error)
+                .with_context(|| format!("opening database {}", path.display()))?
+        }
+        Err(error) => return Err(error).with_context(|| format!("opening database {}", path.display())),
+    };
     sqlx::migrate!("../migrations/sqlite").run(&pool).await.context("applying migrations")?;
     Ok(pool)
 }
 
+/// How long a request waits for a database connection before it is answered 503 `E_UNAVAILABLE`
+/// (with `Retry-After`): `KERF_DATABASE_TIMEOUT_S` seconds, by default [`DEFAULT_ACQUIRE_TIMEOUT`].
+/// Short, so an outage is told to clients at once instead of holding their requests.
+pub fn acquire_timeout() -> Duration {
+    std::env::var("KERF_DATABASE_TIMEOUT_S")
+        .ok()
+        .and_then(|text| text.trim().parse::<f64>().ok())
+        .filter(|seconds| seconds.is_finite() && *seconds > 0.0)
+        .map_or(DEFAULT_ACQUIRE_TIMEOUT, |seconds| Duration::from_secs_f64(seconds.min(3600.0)))
+}
+
+/// The default of [`acquire_timeout`].
+pub const DEFAULT_ACQUIRE_TIMEOUT: Duration = Duration::from_secs(3);
+
+/// How long a starting process waits for its PostgreSQL server (which may be starting beside it).
+const START_WAIT: Duration = Duration::from_secs(10);
+
 async fn connect_postgres(url: &str, connections: u32) -> anyhow::Result<PgPool> {
     let options = PgConnectOptions::from_str(url)?.application_name("kerf");
-    Ok(PgPoolOptions::new()
-        .max_connections(connections)
-        .acquire_timeout(Duration::from_secs(10))
-        .connect_with(options)
-        .await?)
+    let started = std::time::Instant::now();
+    loop {
+        match PgPoolOptions::new()
+            .max_connections(connections)
+            .acquire_timeout(acquire_timeout())
+            .connect_with(options.clone())
+            .await
+        {
+            Ok(pool) => return Ok(pool),
+            Err(error @ (sqlx::Error::Io(_) | sqlx::Error::PoolTimedOut)) if started.elapsed() < START_WAIT => {
+                tracing::warn!(%error, "the database does not answer yet; trying again");
+                tokio::time::sleep(Duration::from_millis(500)).await;
+            }
+            Err(error) => return Err(error.into()),
+        }
+    }
 }
 
 #[cfg(test)]

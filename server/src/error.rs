@@ -80,6 +80,15 @@ pub enum AppError {
     /// the request is well-formed but too long for a synchronous answer (docs/spec/api.md: a 5xx is a bug).
     #[error("{0}")]
     Timeout(String),
+    /// 507 `E_STORAGE_FULL`: the database's disk is full; nothing of the request was written.
+    /// Reads still work; writes succeed again once space is freed.
+    #[error("{0}")]
+    StorageFull(String),
+    /// 503 `E_UNAVAILABLE`: the database cannot be reached (down, restarting, every connection
+    /// busy past the pool's acquire timeout); nothing of the request was written. Answered with
+    /// `Retry-After`.
+    #[error("{0}")]
+    Unavailable(String),
     /// 500: a bug or an infrastructure failure. The cause is logged, not sent.
     #[error(transparent)]
     Internal(#[from] anyhow::Error),
@@ -131,6 +140,8 @@ impl AppError {
             Self::TooManyRequests(_) => (StatusCode::TOO_MANY_REQUESTS, "Too many requests"),
             Self::JobStoreFull(_) => (StatusCode::TOO_MANY_REQUESTS, "Job store full"),
             Self::Timeout(_) => (StatusCode::UNPROCESSABLE_ENTITY, "Over the synchronous time limit"),
+            Self::StorageFull(_) => (StatusCode::INSUFFICIENT_STORAGE, "Storage full"),
+            Self::Unavailable(_) => (StatusCode::SERVICE_UNAVAILABLE, "Database unavailable"),
             Self::Internal(_) => (StatusCode::INTERNAL_SERVER_ERROR, "Internal error"),
         }
     }
@@ -155,6 +166,8 @@ impl AppError {
                     Self::UnsupportedMediaType(_) => ErrorCode::ContentType,
                     Self::TooManyRequests(_) => ErrorCode::Busy,
                     Self::JobStoreFull(_) => ErrorCode::JobStoreFull,
+                    Self::StorageFull(_) => ErrorCode::StorageFull,
+                    Self::Unavailable(_) => ErrorCode::Unavailable,
                     _ => ErrorCode::Timeout,
                 };
                 (code, other.to_string(), None)
@@ -194,13 +207,64 @@ impl IntoResponse for AppError {
             // Slots and the answer budget free up within seconds.
             response.headers_mut().insert(header::RETRY_AFTER, HeaderValue::from_static("2"));
         }
+        if matches!(self, Self::Unavailable(_)) {
+            // A database restart or a failover takes seconds.
+            response.headers_mut().insert(header::RETRY_AFTER, HeaderValue::from_static(RETRY_AFTER_UNAVAILABLE));
+        }
         response
     }
 }
 
+/// Seconds a client is told to wait (`Retry-After`) while the database cannot be reached.
+pub const RETRY_AFTER_UNAVAILABLE: &str = "5";
+
+/// Whether `error` says the database's disk is full: SQLite's `SQLITE_FULL` (13) or no room for
+/// its shared-memory index (`SQLITE_IOERR_SHMSIZE`, 4874), PostgreSQL's `disk_full` (53100).
+pub fn disk_full(error: &sqlx::Error) -> bool {
+    let sqlx::Error::Database(error) = error else { return false };
+    matches!(error.code().as_deref(), Some("13" | "4874" | "53100"))
+}
+
+/// Whether `error` says the database cannot be reached now, but may be again: no connection
+/// within the pool's acquire timeout, a connection lost or refused, PostgreSQL shutting down or
+/// starting (class 57P, `cannot_connect_now`), a connection exception (class 08), or SQLite's
+/// write lock held past the busy timeout (`SQLITE_BUSY`, 5).
+fn unavailable(error: &sqlx::Error) -> bool {
+    match error {
+        sqlx::Error::PoolTimedOut | sqlx::Error::PoolClosed | sqlx::Error::Io(_) | sqlx::Error::WorkerCrashed => true,
+        sqlx::Error::Database(error) => error
+            .code()
+            .is_some_and(|code| code.starts_with("57P") || code.starts_with("08") || code == "5" || code == "53300"),
+        _ => false,
+    }
+}
+
 impl From<sqlx::Error> for AppError {
+    /// The cause is logged, not sent (it may name hosts and files).
     fn from(error: sqlx::Error) -> Self {
+        if disk_full(&error) {
+            tracing::warn!(%error, "the database's disk is full");
+            return Self::StorageFull(
+                "the database's disk is full; nothing of this request was stored (reads still work; writes work again \
+                 once space is freed)"
+                    .to_owned(),
+            );
+        }
+        if unavailable(&error) {
+            tracing::warn!(%error, "the database cannot be reached");
+            return Self::Unavailable(
+                "the database cannot be reached now; nothing of this request was stored, try again shortly".to_owned(),
+            );
+        }
         Self::Internal(error.into())
+    }
+}
+
+impl AppError {
+    /// Whether this failure may pass by itself (a full disk freed, a database back): work whose
+    /// result could not be stored keeps it and tries again.
+    pub fn is_transient(&self) -> bool {
+        matches!(self, Self::StorageFull(_) | Self::Unavailable(_))
     }
 }
 

@@ -197,11 +197,12 @@ pub async fn readyz(State(db): State<Db>) -> Response {
         title: "Not ready".to_owned(),
         status: 503,
         detail: failure,
-        code: ErrorCode::Internal,
+        code: ErrorCode::Unavailable,
         errors: Vec::new(),
     };
     let mut response = (StatusCode::SERVICE_UNAVAILABLE, axum::Json(problem)).into_response();
     response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("application/problem+json"));
+    response.headers_mut().insert(header::RETRY_AFTER, HeaderValue::from_static(crate::error::RETRY_AFTER_UNAVAILABLE));
     response
 }
 

@@ -96,3 +96,47 @@ pub fn describe_security(document: &mut utoipa::openapi::OpenApi) {
         }
     }
 }
+
+/// Documents the answers of a database in trouble: 503 `E_UNAVAILABLE` with `Retry-After` on every
+/// `/api/v1` operation and `/healthz` (each may read the store: a tool by number, a job), and 507
+/// `E_STORAGE_FULL` on every operation that writes (PUT, DELETE, a job's submission).
+pub fn describe_storage(document: &mut utoipa::openapi::OpenApi) {
+    use utoipa::openapi::{Content, Ref, RefOr, ResponseBuilder};
+    let problem = || Content::new(Some(RefOr::Ref(Ref::from_schema_name("Problem"))));
+    let unavailable = ResponseBuilder::new()
+        .description(
+            "The database cannot be reached (`E_UNAVAILABLE`); nothing was stored; try again after `Retry-After`",
+        )
+        .header(
+            "Retry-After",
+            utoipa::openapi::Header::new(
+                utoipa::openapi::ObjectBuilder::new().schema_type(utoipa::openapi::schema::Type::Integer),
+            ),
+        )
+        .content("application/problem+json", problem())
+        .build();
+    let full = ResponseBuilder::new()
+        .description("The database's disk is full (`E_STORAGE_FULL`); nothing was stored; reads still work")
+        .content("application/problem+json", problem())
+        .build();
+    for (path, item) in &mut document.paths.paths {
+        if !path.starts_with("/api/v1/") && path != "/healthz" {
+            continue;
+        }
+        let writes = path == "/api/v1/jobs";
+        for (operation, stores) in [
+            (&mut item.get, false),
+            (&mut item.put, true),
+            (&mut item.post, writes),
+            (&mut item.delete, true),
+            (&mut item.patch, true),
+            (&mut item.head, false),
+        ] {
+            let Some(operation) = operation else { continue };
+            operation.responses.responses.entry("503".to_owned()).or_insert_with(|| RefOr::T(unavailable.clone()));
+            if stores {
+                operation.responses.responses.entry("507".to_owned()).or_insert_with(|| RefOr::T(full.clone()));
+            }
+        }
+    }
+}

@@ -96,6 +96,7 @@ error_codes! {
     ResultTooLarge => "E_RESULT_TOO_LARGE",
     SelfIntersection => "E_SELF_INTERSECTION",
     Stock => "E_STOCK",
+    StorageFull => "E_STORAGE_FULL",
     TiltNeeds5Axis => "E_TILT_NEEDS_5_AXIS",
     Timeout => "E_TIMEOUT",
     Tol => "E_TOL",
@@ -111,6 +112,7 @@ error_codes! {
     TooManySamples => "E_TOO_MANY_SAMPLES",
     TooManySpindleSpeeds => "E_TOO_MANY_SPINDLE_SPEEDS",
     Unauthorized => "E_UNAUTHORIZED",
+    Unavailable => "E_UNAVAILABLE",
     WidthVsBall => "E_WIDTH_VS_BALL",
     WorkLimit => "E_WORK_LIMIT",
 }

@@ -86,15 +86,24 @@ impl PgServer {
             "initdb",
             &["-D", &data, "-U", "postgres", "--auth=trust", "-E", "UTF8", "--no-sync", "--no-instructions"],
         );
+        server.start_again();
+        Some(server)
+    }
+
+    /// Starts the server (again, after [`PgServer::stop`]) on its data and port, and waits until
+    /// it accepts connections.
+    ///
+    /// # Panics
+    /// When it does not start.
+    pub fn start_again(&self) {
         let options = format!(
             "-p {} -k {} -c listen_addresses=127.0.0.1 -c fsync=off -c synchronous_commit=off \
              -c full_page_writes=off -c max_connections=300 -c shared_buffers=32MB",
-            server.port,
-            server.directory.path().display()
+            self.port,
+            self.directory.path().display()
         );
-        let log = server.directory.path().join("log").display().to_string();
-        server.run("pg_ctl", &["-D", &data, "-l", &log, "-o", &options, "-w", "-t", "60", "start"]);
-        Some(server)
+        let log = self.directory.path().join("log").display().to_string();
+        self.run("pg_ctl", &["-D", &self.data(), "-l", &log, "-o", &options, "-w", "-t", "60", "start"]);
     }
 
     fn data(&self) -> String {
@@ -136,6 +145,13 @@ impl PgServer {
     /// The server's folder.
     pub fn directory(&self) -> &Path {
         self.directory.path()
+    }
+
+    /// Stops the server as an operator would (`pg_ctl stop -m fast`: every connection cut, every
+    /// commit kept; the immediate [`PgServer::stop`] may lose the last commits, which this
+    /// throw-away server does not flush).
+    pub fn stop_fast(&self) {
+        self.run("pg_ctl", &["-D", &self.data(), "-m", "fast", "-w", "stop"]);
     }
 
     /// Stops the server at once (as a crash would); dropping it stops it too.

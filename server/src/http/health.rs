@@ -19,7 +19,8 @@ pub struct Health {
     pub version: &'static str,
 }
 
-/// The service is up and its database is reachable.
+/// The service is up and its database is reachable (503 `E_UNAVAILABLE` with `Retry-After`
+/// within the pool's acquire timeout when it is not).
 #[utoipa::path(get, path = "/healthz", tag = "service",
     responses((status = 200, body = Health), (status = 500, body = Problem, content_type = "application/problem+json")))]
 async fn healthz(State(state): State<AppState>) -> AppResult<Json<Health>> {

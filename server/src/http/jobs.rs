@@ -377,22 +377,29 @@ async fn outputs_zip(State(state): State<AppState>, AppPath(JobId { id }): AppPa
     Ok(response)
 }
 
-/// Cancels a queued or running job.
+/// Cancels a queued or running job (200 with the job, now `cancelled`); removes an ended one
+/// (done, failed or cancelled) with its results and outputs (204; the job is 404 afterwards).
 #[utoipa::path(delete, path = "/api/v1/jobs/{id}", tag = "jobs",
     params(("id" = i64, Path, description = "Job id", minimum = 1)),
     responses(
-        (status = 200, description = "Cancelled", body = JobView),
-        (status = 404, body = Problem, content_type = "application/problem+json"),
-        (status = 409, description = "Already finished", body = Problem, content_type = "application/problem+json")))]
-async fn cancel(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobId>) -> AppResult<Json<JobView>> {
+        (status = 200, description = "Cancelled: the job was queued or running", body = JobView),
+        (status = 204, description = "Removed with its results and outputs: the job had ended (done, failed or cancelled)"),
+        (status = 404, body = Problem, content_type = "application/problem+json")))]
+async fn cancel(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobId>) -> AppResult<Response> {
+    let gone = || AppError::not_found(format!("job {id} does not exist"));
     match store::jobs::cancel(&state.db, id).await? {
-        None => Err(AppError::not_found(format!("job {id} does not exist"))),
-        Some((status, false)) => {
-            Err(AppError::Conflict(format!("job {id} already finished ({})", format!("{status:?}").to_lowercase())))
+        None => Err(gone()),
+        Some((_, false)) => {
+            if store::jobs::remove(&state.db, id).await? {
+                Ok(StatusCode::NO_CONTENT.into_response())
+            } else {
+                // Removed by another request in between.
+                Err(gone())
+            }
         }
         Some((_, true)) => {
             state.jobs.cancel(id);
-            Ok(Json(JobView { job: record(&state, id).await?, results: None }))
+            Ok(Json(JobView { job: record(&state, id).await?, results: None }).into_response())
         }
     }
 }

@@ -113,17 +113,40 @@ impl JobRunner {
     ///
     /// # Errors
     /// When the recovery update fails.
+    /// On a full disk (or a database out of reach) the recovery cannot write: the service starts
+    /// all the same (reads work, writes answer 507 or 503), and the recovery is tried again until
+    /// it succeeds, with the workers started only then (until then no job may be claimed: the
+    /// recovery would queue it again under its worker).
     pub async fn start(self: &Arc<Self>, db: &Db, slots: &Arc<Semaphore>, workers: usize) -> anyhow::Result<()> {
-        let (requeued, failed) = store::jobs::recover(db).await.map_err(|e| anyhow::anyhow!("{e}"))?;
-        if requeued + failed > 0 {
-            tracing::warn!(requeued, failed, "jobs interrupted by the last stop");
-        }
         super::pruner::start_pruner(db.clone(), self.storage);
+        match recover(db).await {
+            Ok(()) => self.start_workers(db, slots, workers),
+            Err(error) if error.is_transient() => {
+                tracing::warn!(%error, "recovering interrupted jobs failed; the job workers start once it succeeds");
+                let (runner, db, slots) = (Arc::clone(self), db.clone(), Arc::clone(slots));
+                tokio::spawn(async move {
+                    loop {
+                        tokio::time::sleep(IDLE_POLL).await;
+                        match recover(&db).await {
+                            Ok(()) => break,
+                            Err(error) if error.is_transient() => {}
+                            Err(error) => tracing::error!(%error, "recovering interrupted jobs failed"),
+                        }
+                    }
+                    runner.start_workers(&db, &slots, workers);
+                });
+            }
+            Err(error) => return Err(anyhow::anyhow!("{error}")),
+        }
+        Ok(())
+    }
+
+    fn start_workers(self: &Arc<Self>, db: &Db, slots: &Arc<Semaphore>, workers: usize) {
         if workers == 0 {
             if !db.is_postgres() {
                 tracing::warn!("no job workers: submitted jobs wait until a server with workers starts");
             }
-            return Ok(());
+            return;
         }
         if let Db::Postgres(pool) = db {
             tokio::spawn(listen(Arc::clone(self), pool.clone()));
@@ -132,8 +155,17 @@ impl JobRunner {
             tokio::spawn(work(Arc::clone(self), db.clone(), Arc::clone(slots)));
         }
         tracing::info!(workers, worker = %self.claimant.worker, "job workers started");
-        Ok(())
     }
+}
+
+/// Re-queues or fails the jobs a stopped server left running (SQLite; see
+/// [`store::jobs::recover`]).
+async fn recover(db: &Db) -> AppResult<()> {
+    let (requeued, failed) = store::jobs::recover(db).await?;
+    if requeued + failed > 0 {
+        tracing::warn!(requeued, failed, "jobs interrupted by the last stop");
+    }
+    Ok(())
 }
 
 /// Wakes idle workers on `kerf_jobs` and stops cancelled jobs on `kerf_cancel`; reconnects
@@ -181,6 +213,10 @@ async fn work(runner: Arc<JobRunner>, db: Db, slots: Arc<Semaphore>) {
             }
             Ok(None) => {
                 let _ = tokio::time::timeout(IDLE_POLL, runner.submitted.notified()).await;
+            }
+            Err(error) if error.is_transient() => {
+                tracing::warn!(%error, "claiming a job failed; trying again");
+                tokio::time::sleep(IDLE_POLL).await;
             }
             Err(error) => {
                 tracing::error!(%error, "claiming a job failed");
@@ -294,24 +330,72 @@ async fn run(
     });
     let outcome = beat.during(computing).await;
     runner.flags().remove(&work);
+    let fail = |problem: Problem| async move {
+        kept(db, work, claimant, "failure", || store::jobs::fail(db, work, claimant, &problem)).await
+    };
     let stored = match outcome {
         Ok(Ok(output)) => match finish(db, work, &task, claimant, &output, &runner.storage).await {
             Ok(Finished::Refused(problem)) => {
                 tracing::warn!(id, code = %problem.code.as_str(), "{}", problem.detail);
-                store::jobs::fail(db, work, claimant, &problem).await
+                fail(problem).await
             }
             other => other.map(drop),
         },
         Ok(Err(JobFailure::Cancelled)) => Ok(()),
-        Ok(Err(JobFailure::Refused(problem))) => store::jobs::fail(db, work, claimant, &problem).await,
+        Ok(Err(JobFailure::Refused(problem))) => fail(*problem).await,
         Err(join_error) => {
             tracing::error!(id, %join_error, "job task failed");
             let internal = AppError::Internal(anyhow::anyhow!("the job's task failed"));
-            store::jobs::fail(db, work, claimant, &internal.problem()).await
+            fail(internal.problem()).await
         }
     };
     if let Err(error) = stored {
         tracing::error!(id, %error, "storing the job outcome failed");
+    }
+}
+
+/// How often an outcome that could not be stored is tried again.
+const STORE_RETRY: Duration = Duration::from_millis(500);
+
+/// Runs `store`, a write of finished work's outcome, until it holds. A failure that may pass by
+/// itself (the database out of reach, a full disk: [`AppError::is_transient`]) is tried again
+/// every [`STORE_RETRY`], the outcome kept in memory meanwhile: in PostgreSQL for as long as the
+/// chunk's lease (after it another worker may have claimed the chunk again, and a late write
+/// finds it no longer ours), in SQLite until it holds (no other process can take the job; a
+/// stop queues it again at the next start). Any other failure is tried once more (two
+/// finishers of one job's chunks can meet in a deadlock that PostgreSQL breaks by failing one).
+async fn kept<T, Store, Stored>(db: &Db, work: Work, claimant: &Claimant, what: &str, store: Store) -> AppResult<T>
+where
+    Store: Fn() -> Stored,
+    Stored: std::future::Future<Output = AppResult<T>>,
+{
+    let deadline = db.is_postgres().then(|| std::time::Instant::now() + claimant.lease);
+    let mut tried_again = false;
+    let mut kept_since: Option<std::time::Instant> = None;
+    loop {
+        match store().await {
+            Ok(stored) => {
+                if let Some(since) = kept_since {
+                    let waited = since.elapsed().as_secs_f64();
+                    tracing::info!(id = work.id, waited, "the kept {what} is stored");
+                }
+                return Ok(stored);
+            }
+            Err(error)
+                if error.is_transient() && deadline.is_none_or(|deadline| std::time::Instant::now() < deadline) =>
+            {
+                if kept_since.is_none() {
+                    tracing::warn!(id = work.id, %error, "storing the {what} failed; kept, trying again");
+                    kept_since = Some(std::time::Instant::now());
+                }
+                tokio::time::sleep(STORE_RETRY).await;
+            }
+            Err(error) if !error.is_transient() && !tried_again => {
+                tracing::warn!(id = work.id, %error, "storing the {what} failed; once more");
+                tried_again = true;
+            }
+            Err(error) => return Err(error),
+        }
     }
 }
 
@@ -382,9 +466,9 @@ async fn divide(beat: &Beat<'_>, job: &Arc<JobFile>, task: Task) -> Option<Task>
     }
 }
 
-/// Stores finished work, once more after a failure (two finishers of one job's chunks can meet
-/// in a deadlock that PostgreSQL breaks by failing one of them). Work that cannot be stored is not
-/// lost: its chunk's lease expires and another worker runs it again.
+/// Stores finished work ([`kept`]: kept and tried again while the store cannot take it). Work
+/// that cannot be stored in the end is not lost: its chunk's lease expires and another worker
+/// runs it again.
 async fn finish(
     db: &Db,
     work: Work,
@@ -393,17 +477,11 @@ async fn finish(
     output: &Output,
     storage: &JobStorage,
 ) -> AppResult<Finished> {
-    let once = || async {
+    kept(db, work, claimant, "result", || async {
         match output {
             Output::Part(part) => store::jobs::finish_part(db, work, task.operation(), claimant, part, storage).await,
             Output::Results(outputs) => store::jobs::finish(db, work, task, claimant, outputs, storage).await,
         }
-    };
-    match once().await {
-        Ok(finished) => Ok(finished),
-        Err(error) => {
-            tracing::warn!(id = work.id, %error, "storing the result failed; once more");
-            once().await
-        }
-    }
+    })
+    .await
 }

@@ -16,7 +16,7 @@ use crate::error::AppResult;
 /// Runs one statement on the store `$db` is: `sqlx::$make` (`query` or `query_as`) over the
 /// SQL for that store (`both:` one text, or `sqlite:` and `postgres:` each their own), with the
 /// arguments bound in order, finished by `$run` (`fetch_one`, ..., or `execute`: the rows affected). Evaluates to the
-/// `Result` of `$run`. Both stores take the same arguments; SQLite leaves those its text does not
+/// `Result` of `$run`, known only once the statement (and with it its implicit commit) ended. Both stores take the same arguments; SQLite leaves those its text does not
 /// name unused (the worker and lease of the queue's statements: it has one process, no leases).
 macro_rules! on {
     // `execute` answers the number of rows affected, the same type for both stores.
@@ -29,6 +29,18 @@ macro_rules! on {
                 sqlx::query($postgres)$(.bind($bind))*.execute(pool).await.map(|done| done.rows_affected())
             }
         }
+    };
+    // A statement that answers rows is driven to its end (`fetch_all`) even when one row is
+    // wanted: outside a transaction the store commits only at the statement's end, so an
+    // `INSERT … RETURNING` read with `fetch_one` would hand back its row before a commit that may
+    // still fail (a full disk), and that failure would be lost. Reads cost nothing more: every
+    // `fetch_one`/`fetch_optional` here reads one row by key.
+    ($db:expr, $make:ident, sqlite: $sqlite:expr, postgres: $postgres:expr, [$($bind:expr),* $(,)?], fetch_one) => {
+        on!($db, $make, sqlite: $sqlite, postgres: $postgres, [$($bind),*], fetch_all)
+            .and_then(|rows| rows.into_iter().next().ok_or(sqlx::Error::RowNotFound))
+    };
+    ($db:expr, $make:ident, sqlite: $sqlite:expr, postgres: $postgres:expr, [$($bind:expr),* $(,)?], fetch_optional) => {
+        on!($db, $make, sqlite: $sqlite, postgres: $postgres, [$($bind),*], fetch_all).map(|rows| rows.into_iter().next())
     };
     ($db:expr, $make:ident, both: $sql:expr, [$($bind:expr),* $(,)?], $run:ident) => {
         on!($db, $make, sqlite: $sql, postgres: $sql, [$($bind),*], $run)

@@ -30,5 +30,6 @@ mod predict;
 mod request_fuzz;
 mod schemathesis;
 mod segment;
+mod storage_full;
 mod tools;
 mod web;

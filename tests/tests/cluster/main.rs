@@ -690,9 +690,83 @@ async fn readiness_follows_the_database() {
     let answer = app.get("/readyz").await;
     assert_eq!(answer.status(), 503);
     assert_eq!(answer.headers()["content-type"], "application/problem+json");
+    assert!(answer.headers().contains_key("retry-after"), "a load balancer is told when to look again");
     // The process itself is up: its page still answers.
     assert_eq!(app.get("/").await.status(), 200);
     drop(app);
+}
+
+/// One database route's answer while PostgreSQL is down: 503 `E_UNAVAILABLE` with `Retry-After`;
+/// how long it took (printed, not asserted: the acquire timeout bounds it).
+async fn unavailable(request: reqwest::RequestBuilder, what: &str) -> f64 {
+    let started = Instant::now();
+    let answer = request.send().await.unwrap();
+    let seconds = started.elapsed().as_secs_f64();
+    assert!(answer.headers().contains_key("retry-after"), "{what}: no Retry-After ({})", answer.status());
+    let problem = kerf_tests::problem(answer, 503).await;
+    assert_eq!(problem["code"], "E_UNAVAILABLE", "{what}: {problem}");
+    eprintln!("{what}: 503 after {seconds:.2} s");
+    seconds
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_database_outage_mid_job_loses_no_finished_result() {
+    let Some(postgres) = PgServer::start() else { return };
+    let url = postgres.url();
+    let client = Client::builder().timeout(Duration::from_secs(60)).build().unwrap();
+    let timeout = [("KERF_DATABASE_TIMEOUT_S", "2")];
+    let api =
+        ServerProcess::start_with_env(&program(), &["serve", "--database", &url, "--job-workers", "0"], &timeout).await;
+    // A lease longer than the outage: the chunks stay their worker's while it is down.
+    let worker_arguments = ["worker", "--database", &url, "--job-workers", "2", "--job-lease-s", "40"];
+    let worker = ServerProcess::start_with_env(&program(), &worker_arguments, &timeout).await;
+    let mut ids = Vec::new();
+    for n in 0..6 {
+        let mut job = predict_job(20.0, 0.5, 96);
+        job["name"] = json!(format!("outage {n}"));
+        ids.push(submit(&client, &api.base, &job).await);
+    }
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while json_with(client.get(format!("{}/api/v1/jobs/{}", api.base, ids[0])).send().await.unwrap(), 200).await["status"]
+        != "running"
+    {
+        assert!(Instant::now() < deadline, "the first job never started");
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+
+    // PostgreSQL stops while both workers compute; the work goes on.
+    postgres.stop_fast();
+    let stopped = Instant::now();
+    let mut slowest: f64 = 0.0;
+    slowest = slowest.max(unavailable(client.get(format!("{}/api/v1/tools", api.base)), "GET /api/v1/tools").await);
+    let job = format!("{}/api/v1/jobs/{}", api.base, ids[0]);
+    slowest = slowest.max(unavailable(client.get(&job), "GET /api/v1/jobs/{id}").await);
+    let tool = json!({"kind": "flat", "radius": 3});
+    let put = client.put(format!("{}/api/v1/tools/5", api.base)).json(&tool);
+    slowest = slowest.max(unavailable(put, "PUT /api/v1/tools/5").await);
+    let submitted = client.post(format!("{}/api/v1/jobs", api.base)).json(&predict_job(10.0, 0.5, 32));
+    slowest = slowest.max(unavailable(submitted, "POST /api/v1/jobs").await);
+    slowest = slowest.max(unavailable(client.get(format!("{}/readyz", api.base)), "GET /readyz (API)").await);
+    slowest = slowest.max(unavailable(client.get(format!("{}/readyz", worker.base)), "GET /readyz (worker)").await);
+    eprintln!("slowest 503 during the outage: {slowest:.2} s");
+    // Down long enough that running work finishes meanwhile and has to keep its result.
+    tokio::time::sleep(Duration::from_secs(8).saturating_sub(stopped.elapsed())).await;
+    postgres.start_again();
+    eprintln!("PostgreSQL down {:.1} s", stopped.elapsed().as_secs_f64());
+
+    // Every job ends done, run once: no finished result was dropped and computed again.
+    for &id in &ids {
+        let done = poll_job(&client, &api.base, id, 300, finished).await;
+        assert_eq!(done["status"], "done", "job {id}: {}", done["error"]);
+        assert_eq!(done["attempts"], 1, "job {id} was run again: a finished result was lost");
+    }
+    assert!(tool_absent(&client, &api.base).await, "the refused PUT stored nothing");
+    worker.terminate();
+    api.terminate();
+}
+
+async fn tool_absent(client: &Client, base: &str) -> bool {
+    client.get(format!("{base}/api/v1/tools/5")).send().await.unwrap().status() == 404
 }
 
 #[tokio::test(flavor = "multi_thread")]

@@ -30,7 +30,8 @@ pub struct Claimed {
 pub async fn claim(db: &Db, claimant: &Claimant) -> AppResult<Option<Claimed>> {
     let (work, task, json, attempt) = match db {
         Db::Sqlite(pool) => {
-            let row: Option<(i64, String, i64)> = sqlx::query_as(concat!(
+            // Driven to its end (`fetch_all`): the claim holds only once its implicit commit did.
+            let rows: Vec<(i64, String, i64)> = sqlx::query_as(concat!(
                 "UPDATE jobs SET status = 'running', attempts = attempts + 1, progress = 0, started_at = ",
                 now!(),
                 ", heartbeat_at = ",
@@ -38,9 +39,9 @@ pub async fn claim(db: &Db, claimant: &Claimant) -> AppResult<Option<Claimed>> {
                 " WHERE id = (SELECT id FROM jobs WHERE status = 'queued' ORDER BY id LIMIT 1)
                  RETURNING id, job_json, attempts"
             ))
-            .fetch_optional(pool)
+            .fetch_all(pool)
             .await?;
-            let Some((id, json, attempt)) = row else { return Ok(None) };
+            let Some((id, json, attempt)) = rows.into_iter().next() else { return Ok(None) };
             (Work { id, chunk: None }, Task::Job, json, attempt)
         }
         Db::Postgres(pool) => {
@@ -93,7 +94,10 @@ async fn claim_chunk(pool: &sqlx::PgPool, claimant: &Claimant) -> AppResult<Chun
         503,
         "Job interrupted",
         ErrorCode::Interrupted,
-        &format!("its worker stopped (lease expired) on each of its {MAX_ATTEMPTS} attempts; not retried"),
+        &format!(
+            "no word from its worker within the lease (the worker stopped, or could not reach the database) on each \
+             of its {MAX_ATTEMPTS} attempts; not retried"
+        ),
     ))?)
     .bind(MAX_ATTEMPTS)
     .execute(&mut *transaction)

@@ -6,6 +6,7 @@ use kerf_solver::ErrorCode;
 use super::{CANCEL_CHANNEL, Claimant, JobStatus, Work, job_problem, problem_json};
 use crate::db::Db;
 use crate::error::{AppResult, Problem};
+use crate::store::on;
 
 /// Marks running work's job failed with the problem (PostgreSQL: only while the chunk is the
 /// claimant's; the job's other chunks stop at their next heartbeat), and drops what its chunks
@@ -135,4 +136,14 @@ pub async fn cancel(db: &Db, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
             drop_partial_results_postgres
         ),
     }
+}
+
+/// Removes an ended job (done, failed or cancelled) with its results and outputs (they go with
+/// it: `ON DELETE CASCADE`); false when there is no such job or it has not ended (a queued or
+/// running job is cancelled first, never removed under its worker).
+pub async fn remove(db: &Db, id: i64) -> AppResult<bool> {
+    let removed = on!(db, query,
+        both: "DELETE FROM jobs WHERE id = $1 AND status IN ('done', 'failed', 'cancelled')",
+        [id], execute)?;
+    Ok(removed > 0)
 }

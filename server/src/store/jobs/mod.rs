@@ -60,7 +60,7 @@ mod storage;
 mod submit;
 
 pub use claim::{Claimed, claim, recover, release};
-pub use fail::{cancel, fail};
+pub use fail::{cancel, fail, remove};
 pub use finish::{Finished, PartOutput, finish, finish_part};
 pub use heartbeat::heartbeat;
 pub use prune::{Pruned, convert_to_incremental_vacuum, incremental_vacuum, prune};

@@ -47,16 +47,18 @@ pub async fn insert(db: &Db, job: &impl Submission, hash: &str, quota: u64) -> A
          RETURNING id";
     match db {
         Db::Sqlite(pool) => {
-            let row: Option<(i64,)> = sqlx::query_as(INSERT)
+            // Driven to its end (`fetch_all`): the implicit commit, which a full disk fails,
+            // happens there, and only then is the job stored.
+            let rows: Vec<(i64,)> = sqlx::query_as(INSERT)
                 .bind(job.job_name())
                 .bind(hash)
                 .bind(json)
                 .bind(operations)
                 .bind(size)
                 .bind(quota)
-                .fetch_optional(pool)
+                .fetch_all(pool)
                 .await?;
-            match row {
+            match rows.into_iter().next() {
                 Some((id,)) => Ok(id),
                 None => Err(store_full(db, size, quota).await?),
             }
