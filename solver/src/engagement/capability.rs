@@ -71,7 +71,7 @@ impl Capability for EngagementCapability {
         not_found: "Unknown tool number or machine",
         refused: "Impossible or over a limit: `E_INPUT`, `E_PATH`, `E_STOCK`, `E_TOO_LARGE`, \
             `E_TOO_MANY_SAMPLES`, `E_GRID_MEMORY`, `E_WORK_LIMIT` (docs/spec/engagement.md §9); `E_TIMEOUT` \
-            over the synchronous time limit: submit a job",
+            over the synchronous time limit: submit a job; `E_TOO_LARGE_ANSWER` when the answer would not fit the answer budget",
     };
     type Request = EngagementRequest;
     type Answer = EngagementAnswer;
