@@ -56,6 +56,20 @@ async fn an_answer_over_the_budget_is_refused_before_it_is_built() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+async fn engagement_samples_over_the_budget_are_refused_before_their_json() {
+    // 100 000 samples along a 100 mm cut at a step of 0.001 mm: some 30 MB of JSON, their
+    // count known before any of it is written.
+    let app = TestApp::spawn_with(Limits { answer_budget_bytes: BUDGET, ..Limits::default() }).await;
+    let request = |step: f64| {
+        json!({"tool": {"kind": "flat", "radius": 5}, "spindle_rpm": 8000, "feed_per_tooth": 0.04, "flute_counts": [4],
+               "stock": {"polygon": [[0, 0], [100, 0], [100, 80], [0, 80]]},
+               "path": [[-10, 40], [90, 40]], "step": step})
+    };
+    assert_too_large(&problem(app.post_json("/api/v1/engagement", &request(0.001)).await, 422).await);
+    json_with(app.post_json("/api/v1/engagement", &request(0.2)).await, 200).await;
+}
+
+#[tokio::test(flavor = "multi_thread")]
 async fn a_job_over_the_budget_fails_instead_of_taking_the_process_down() {
     let app = TestApp::spawn_with(Limits { answer_budget_bytes: BUDGET, ..Limits::default() }).await;
     let job = json!({"operations": [
