@@ -333,18 +333,38 @@ pub fn solve<C: Capability>(
     program: Option<&OutputOptions>,
     timings: bool,
 ) -> Result<(Delivered, f64), AppError> {
+    let run = &counted::<C>(request, &resolved, run);
     let started = Instant::now();
     let mut answer = C::solve(request, resolved, run)?;
     let seconds = started.elapsed().as_secs_f64();
     if let Some(output) = program {
-        return Ok((Delivered::Program(capability::program::<C>(request, &answer, output, run.control)?), seconds));
+        let program = capability::program::<C>(request, &answer, output, run.control)?;
+        check_size(run, program.len())?;
+        return Ok((Delivered::Program(program), seconds));
     }
     if timings {
         C::record_time(&mut answer, seconds);
     }
     run.control.check()?;
     let bytes = C::to_json(answer).map_err(|error| AppError::Internal(error.into()))?;
+    check_size(run, bytes.len())?;
     Ok((Delivered::Json(bytes), seconds))
+}
+
+/// `run` with its answer budget only when the capability's bound before solving
+/// ([`Capability::answer_bound`]) does not already show that the answer fits it: such an answer
+/// is built without counting.
+fn counted<'a, C: Capability>(request: &C::Request, resolved: &Resolved<C::Tool>, run: &Run<'a>) -> Run<'a> {
+    let budget = run
+        .budget
+        .filter(|budget| C::answer_bound(request, resolved, run.purpose).is_none_or(|bound| bound > budget.limit()));
+    Run { budget, ..*run }
+}
+
+/// Refuses a delivered answer (JSON, program, or a job's both) of `bytes` over the run's budget.
+fn check_size(run: &Run<'_>, bytes: usize) -> Result<(), AppError> {
+    let Some(budget) = run.budget else { return Ok(()) };
+    Ok(budget.check(u64::try_from(bytes).unwrap_or(u64::MAX))?)
 }
 
 /// One operation's stored output.
@@ -370,6 +390,7 @@ fn store_output<C: Capability>(
     output: &OutputOptions,
 ) -> Result<Stored, AppError> {
     let resolved = resolve::<C>(request, lookup)?;
+    let run = &counted::<C>(request, &resolved, run);
     let started = Instant::now();
     let mut answer = C::solve(request, resolved, run)?;
     C::record_time(&mut answer, started.elapsed().as_secs_f64());
@@ -426,6 +447,7 @@ fn finish_output<C: Capability>(
     seconds: f64,
 ) -> Result<Stored, AppError> {
     let resolved = resolve::<C>(request, lookup)?;
+    let run = &counted::<C>(request, &resolved, run);
     let started = Instant::now();
     let mut answer = C::finish(request, resolved, parts, run)?;
     C::record_time(&mut answer, seconds + started.elapsed().as_secs_f64());
@@ -433,7 +455,7 @@ fn finish_output<C: Capability>(
 }
 
 /// A job's stored output of `answer`: its program written with `output`, the answer trimmed for
-/// storage.
+/// storage; refused when the two are over the run's answer budget.
 fn stored<C: Capability>(
     request: &C::Request,
     mut answer: C::Answer,
@@ -449,6 +471,7 @@ fn stored<C: Capability>(
     }
     C::for_storage(&mut answer);
     let result = serde_json::value::to_raw_value(&answer).map_err(|error| AppError::Internal(error.into()))?;
+    check_size(run, result.get().len() + program.as_ref().map_or(0, String::len))?;
     Ok(Stored {
         operation: C::NAME.to_owned(),
         result,

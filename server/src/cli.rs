@@ -166,6 +166,17 @@ pub struct ServeArgs {
     /// and material values, output options) again without solving; 0 keeps none.
     #[arg(long, env = "KERF_ANSWER_CACHE_MB", default_value_t = u64::try_from(Limits::default().answer_cache_bytes).unwrap_or(u64::MAX) / MIB)]
     pub answer_cache_mb: u64,
+    /// MiB of solver answers and uploads held in memory at once; one answer (or a job's
+    /// operation) larger than it is refused with `E_TOO_LARGE_ANSWER` before it is built whole.
+    #[arg(long, env = "KERF_ANSWER_BUDGET_MB", default_value_t = u64::try_from(Limits::default().answer_budget_bytes).unwrap_or(u64::MAX) / MIB)]
+    pub answer_budget_mb: u64,
+    /// Slowest a request body may arrive, bytes per second averaged over `--body-rate-window-s`;
+    /// a slower one ends with 408. 0: no minimum.
+    #[arg(long, env = "KERF_MIN_BODY_RATE", default_value_t = Limits::default().min_body_rate)]
+    pub min_body_rate: usize,
+    /// Seconds the minimum body rate is averaged over.
+    #[arg(long, env = "KERF_BODY_RATE_WINDOW_S", default_value_t = Limits::default().body_rate_window.as_secs_f64())]
+    pub body_rate_window_s: f64,
     /// Solver calls allowed at once (default: the number of CPU cores).
     #[arg(long, env = "KERF_SOLVER_SLOTS")]
     pub solver_slots: Option<usize>,
@@ -198,6 +209,11 @@ impl ServeArgs {
                 max_upload_bytes: self.max_upload_bytes,
                 solver_time_limit: Duration::from_secs(self.solver_time_limit_s.max(1)),
                 answer_cache_bytes: usize::try_from(self.answer_cache_mb.saturating_mul(MIB)).unwrap_or(usize::MAX),
+                answer_budget_bytes: usize::try_from(self.answer_budget_mb.max(1).saturating_mul(MIB))
+                    .unwrap_or(usize::MAX),
+                min_body_rate: self.min_body_rate,
+                body_rate_window: Duration::try_from_secs_f64(self.body_rate_window_s)
+                    .unwrap_or(Limits::default().body_rate_window),
                 ..Limits::default()
             },
             solver_slots: self.solver_slots.unwrap_or(cores),

@@ -62,6 +62,9 @@ pub enum AppError {
     /// 413: the body is over the limit.
     #[error("request body is larger than the limit of {limit} bytes")]
     PayloadTooLarge { limit: usize },
+    /// 408 `E_BODY`: the body arrives slower than the minimum receive rate.
+    #[error("{0}")]
+    BodyTooSlow(String),
     /// 415: wrong content type.
     #[error("{0}")]
     UnsupportedMediaType(String),
@@ -135,6 +138,7 @@ impl AppError {
             Self::Conflict(_) => (StatusCode::CONFLICT, "Conflict"),
             Self::PreconditionFailed { .. } => (StatusCode::PRECONDITION_FAILED, "Precondition failed"),
             Self::PayloadTooLarge { .. } => (StatusCode::PAYLOAD_TOO_LARGE, "Payload too large"),
+            Self::BodyTooSlow(_) => (StatusCode::REQUEST_TIMEOUT, "Request timeout"),
             Self::UnsupportedMediaType(_) => (StatusCode::UNSUPPORTED_MEDIA_TYPE, "Unsupported media type"),
             Self::Unprocessable(_) => (StatusCode::UNPROCESSABLE_ENTITY, "Unprocessable request"),
             Self::TooManyRequests(_) => (StatusCode::TOO_MANY_REQUESTS, "Too many requests"),
@@ -163,6 +167,7 @@ impl AppError {
                     Self::MethodNotAllowed => ErrorCode::Method,
                     Self::Conflict(_) => ErrorCode::Conflict,
                     Self::PayloadTooLarge { .. } => ErrorCode::TooLarge,
+                    Self::BodyTooSlow(_) => ErrorCode::Body,
                     Self::UnsupportedMediaType(_) => ErrorCode::ContentType,
                     Self::TooManyRequests(_) => ErrorCode::Busy,
                     Self::JobStoreFull(_) => ErrorCode::JobStoreFull,

@@ -2,18 +2,23 @@
 //! 413 over the limit, 400 naming the field on bad shape), query strings, path parameters, and the
 //! preconditions of a write (`If-Match`, `If-None-Match`: 412) with the ETags they compare.
 
+use std::time::Duration;
+
 use axum::body::Bytes;
 use axum::extract::path::ErrorKind;
-use axum::extract::rejection::{BytesRejection, PathRejection};
+use axum::extract::rejection::PathRejection;
 use axum::extract::{FromRef, FromRequest, FromRequestParts, Request};
 use axum::http::header::{CONTENT_LENGTH, CONTENT_TYPE, ETAG, IF_MATCH, IF_NONE_MATCH};
 use axum::http::request::Parts;
 use axum::http::{HeaderMap, HeaderName, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
+use http_body_util::BodyExt;
 use kerf_solver::ErrorCode;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 use sha2::{Digest, Sha256};
+use tokio::sync::OwnedSemaphorePermit;
+use tokio::time::Instant;
 use utoipa::IntoParams;
 
 use crate::error::AppError;
@@ -37,8 +42,8 @@ where
                 "the body must be JSON: send Content-Type: application/json".to_owned(),
             ));
         }
-        let limit = AppState::from_ref(state).limits.max_body_bytes;
-        let bytes = body_bytes(request, state, limit).await?;
+        let state = AppState::from_ref(state);
+        let bytes = body_bytes(request, &state, state.limits.max_body_bytes).await?;
         parse_json(&bytes).map(Self)
     }
 }
@@ -82,16 +87,132 @@ pub fn refuse_declared_over(headers: &HeaderMap, limit: usize) -> Result<(), App
     }
 }
 
-/// Reads the whole body, mapping the body-limit rejection to 413 (at once when the declared length
-/// is over the limit: [`refuse_declared_over`]).
-pub async fn body_bytes<S: Send + Sync>(request: Request, state: &S, limit: usize) -> Result<Bytes, AppError> {
+/// Reads the whole body, at most `limit` bytes: 413 over it (at once when the declared length is
+/// over the limit: [`refuse_declared_over`]), 408 when it arrives slower than the minimum receive
+/// rate ([`Limits::min_body_rate`](crate::state::Limits::min_body_rate)).
+///
+/// # Errors
+/// 413 over the limit, 408 too slow, 400 `E_BODY` when the body cannot be read.
+pub async fn body_bytes(request: Request, state: &AppState, limit: usize) -> Result<Bytes, AppError> {
+    receive(request, state, limit, false).await.map(|(bytes, _)| bytes)
+}
+
+/// [`body_bytes`] charged to the memory budget ([`AppState::reserve_memory`]) as it arrives:
+/// by the bytes received, not the length declared, so a slow upload holds only what it sent.
+/// The permit holds the body's share until dropped.
+///
+/// # Errors
+/// As [`body_bytes`]; 429 when the budget is held by others.
+pub async fn charged_body_bytes(
+    request: Request,
+    state: &AppState,
+    limit: usize,
+) -> Result<(Bytes, Option<OwnedSemaphorePermit>), AppError> {
+    receive(request, state, limit, true).await
+}
+
+async fn receive(
+    request: Request,
+    state: &AppState,
+    limit: usize,
+    charged: bool,
+) -> Result<(Bytes, Option<OwnedSemaphorePermit>), AppError> {
     refuse_declared_over(request.headers(), limit)?;
-    Bytes::from_request(request, state).await.map_err(|rejection| match rejection {
-        BytesRejection::FailedToBufferBody(_) if rejection.status() == axum::http::StatusCode::PAYLOAD_TOO_LARGE => {
-            AppError::PayloadTooLarge { limit }
+    let mut body = request.into_body();
+    let mut received: Vec<u8> = Vec::new();
+    let mut share: Option<OwnedSemaphorePermit> = None;
+    let mut rate = ReceiveRate::new(state.limits.min_body_rate, state.limits.body_rate_window);
+    loop {
+        let next = match rate.deadline() {
+            Some(deadline) => match tokio::time::timeout_at(deadline, body.frame()).await {
+                Ok(next) => next,
+                Err(_) => {
+                    rate.check(Instant::now())?;
+                    continue;
+                }
+            },
+            None => body.frame().await,
+        };
+        let Some(frame) = next else { break };
+        let frame = frame.map_err(|error| {
+            AppError::bad_request(ErrorCode::Body, "body", format!("could not read the body: {error}"))
+        })?;
+        let Ok(data) = frame.into_data() else { continue };
+        if received.len().saturating_add(data.len()) > limit {
+            return Err(AppError::PayloadTooLarge { limit });
         }
-        other => AppError::bad_request(ErrorCode::Body, "body", format!("could not read the body: {other}")),
-    })
+        received.extend_from_slice(&data);
+        rate.add(data.len());
+        if charged {
+            share = Some(charge(state, share, received.len())?);
+        }
+        rate.check(Instant::now())?;
+    }
+    Ok((Bytes::from(received), share))
+}
+
+/// `share` grown to cover `bytes` received, in whole KiB (the budget's unit), never past the
+/// whole budget (an upload larger than it takes all of it, alone).
+fn charge(
+    state: &AppState,
+    share: Option<OwnedSemaphorePermit>,
+    bytes: usize,
+) -> Result<OwnedSemaphorePermit, AppError> {
+    let held = share.as_ref().map_or(0, |permit| permit.num_permits() * 1024);
+    let budget = state.limits.answer_budget_bytes.max(1);
+    let wanted = bytes.min(budget);
+    match share {
+        Some(permit) if wanted <= held => Ok(permit),
+        Some(mut permit) => {
+            permit.merge(state.reserve_memory(wanted - held)?);
+            Ok(permit)
+        }
+        None => state.reserve_memory(wanted),
+    }
+}
+
+/// The minimum receive rate: the bytes of each window of `window` since the body began must
+/// reach `bytes_per_second × window`.
+struct ReceiveRate {
+    bytes_per_second: usize,
+    window: Duration,
+    started: Instant,
+    in_window: usize,
+}
+
+impl ReceiveRate {
+    fn new(bytes_per_second: usize, window: Duration) -> Self {
+        Self { bytes_per_second, window, started: Instant::now(), in_window: 0 }
+    }
+
+    /// When the current window ends; `None` without a minimum.
+    fn deadline(&self) -> Option<Instant> {
+        (self.bytes_per_second > 0 && !self.window.is_zero()).then(|| self.started + self.window)
+    }
+
+    fn add(&mut self, bytes: usize) {
+        self.in_window = self.in_window.saturating_add(bytes);
+    }
+
+    /// At or past the end of a window: 408 when it fell short, else the next window begins.
+    fn check(&mut self, now: Instant) -> Result<(), AppError> {
+        let Some(deadline) = self.deadline() else { return Ok(()) };
+        if now < deadline {
+            return Ok(());
+        }
+        let seconds = self.window.as_secs_f64();
+        if (self.in_window as f64) < self.bytes_per_second as f64 * seconds {
+            return Err(AppError::BodyTooSlow(format!(
+                "the body arrived at {:.0} bytes/s over {seconds} s, slower than the minimum of {} bytes/s \
+                 (--min-body-rate); send it faster",
+                self.in_window as f64 / seconds,
+                self.bytes_per_second
+            )));
+        }
+        self.started = now;
+        self.in_window = 0;
+        Ok(())
+    }
 }
 
 /// Parses JSON into `T`; a failure names the JSON path of the offending field.

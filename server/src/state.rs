@@ -30,9 +30,16 @@ pub struct Limits {
     pub header_read_timeout: Duration,
     /// Longest a request body may stall between two pieces; then the request ends with 408.
     pub body_idle_timeout: Duration,
+    /// Slowest a request body may arrive, bytes per second averaged over `body_rate_window`;
+    /// slower, the request ends with 408. 0: no minimum.
+    pub min_body_rate: usize,
+    /// The window `min_body_rate` is averaged over.
+    pub body_rate_window: Duration,
     /// Bytes of solver answers (JSON or G-code) held at once while their clients read them, and of
-    /// predict uploads being received; what does not fit gets 429, so slow readers of large
-    /// answers or many large uploads cannot exhaust memory.
+    /// predict uploads as they arrive; what does not fit gets 429, so slow readers of large
+    /// answers or many large uploads cannot exhaust memory. It is also the most one answer (or a
+    /// job's operation) may take while it is built: a larger one is refused with
+    /// `E_TOO_LARGE_ANSWER`.
     pub answer_budget_bytes: usize,
     /// Bytes of solver answers kept to answer the same question again without solving
     /// ([`crate::answer_cache`]); 0 keeps none.
@@ -53,6 +60,8 @@ impl Default for Limits {
             answer_cache_bytes: 64 * 1024 * 1024,
             header_read_timeout: Duration::from_secs(10),
             body_idle_timeout: Duration::from_secs(30),
+            min_body_rate: 1024,
+            body_rate_window: Duration::from_secs(10),
             shutdown_grace: Duration::from_secs(30),
         }
     }
@@ -127,10 +136,10 @@ impl AppState {
                 limits.answer_budget_bytes.div_ceil(1024).clamp(1, Semaphore::MAX_PERMITS),
             )),
             answers: Arc::new(AnswerCache::new(limits.answer_cache_bytes)),
+            jobs: Arc::new(JobRunner::new(lease, storage).with_answer_limit(limits.answer_budget_bytes)),
             db,
             limits,
             solver_slots: Arc::new(Semaphore::new(solver_slots.max(1))),
-            jobs: Arc::new(JobRunner::new(lease, storage)),
             auth,
             solving: Arc::new(Solving::default()),
         }

@@ -7,7 +7,7 @@
 //! [`resolve`], into a
 //! [`Resolved`] context; the solver never sees an unresolved reference.
 
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use serde::Serialize;
 use serde::de::DeserializeOwned;
@@ -82,6 +82,15 @@ pub trait Capability {
 
     /// Records how long the solve took, for capabilities whose answer reports it.
     fn record_time(_answer: &mut Self::Answer, _seconds: f64) {}
+
+    /// An upper bound on the bytes the answer takes in memory for `purpose` (the answer built,
+    /// its JSON, its program, or for a job both), known before solving from the request's counts
+    /// and the solver's own caps; `None` when the capability gives none. An answer whose bound
+    /// fits [`AnswerBudget::limit`] is built without counting; the others are counted as they are
+    /// built ([`AnswerBudget::charge`]) and refused with `E_TOO_LARGE_ANSWER` when over.
+    fn answer_bound(_request: &Self::Request, _context: &Resolved<Self::Tool>, _purpose: Purpose) -> Option<u64> {
+        None
+    }
 
     /// The answer as its endpoint's JSON: `serde_json::to_vec`, or the same bytes written faster
     /// (engagement, whose samples are most of a large answer).
@@ -461,7 +470,8 @@ pub enum Purpose {
     Job,
 }
 
-/// How a solve runs: progress and cancellation, an uploaded file, and what the answer is for.
+/// How a solve runs: progress and cancellation, an uploaded file, what the answer is for and the
+/// bytes it may take.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Run<'a> {
     /// Progress and cancellation.
@@ -470,6 +480,87 @@ pub struct Run<'a> {
     pub upload: Option<&'a [u8]>,
     /// What the answer is for.
     pub purpose: Purpose,
+    /// The bytes the answer may take while it is built; `None`: no limit.
+    pub budget: Option<&'a AnswerBudget>,
+}
+
+impl Run<'_> {
+    /// Charges `bytes` of the answer, built for unit `done` of `total` (a loop of several), to
+    /// the budget, if there is one.
+    ///
+    /// # Errors
+    /// `E_TOO_LARGE_ANSWER` when the answer built so far is over the budget's limit.
+    pub fn charge(&self, bytes: u64, done: usize, total: usize) -> Result<(), SolverError> {
+        self.budget.map_or(Ok(()), |budget| budget.charge(bytes, done, total))
+    }
+}
+
+/// The bytes one answer may take while it is built (the answer in memory and its JSON or
+/// program), and what it has taken so far. The solver charges its units (a deburr loop) as they
+/// are built, so an answer over the limit is refused after at most one unit past it instead of
+/// being built whole.
+#[derive(Debug)]
+pub struct AnswerBudget {
+    limit: u64,
+    used: AtomicU64,
+}
+
+impl AnswerBudget {
+    /// A budget of `limit` bytes, none used.
+    #[must_use]
+    pub fn new(limit: u64) -> Self {
+        Self { limit, used: AtomicU64::new(0) }
+    }
+
+    /// The limit, bytes.
+    #[must_use]
+    pub fn limit(&self) -> u64 {
+        self.limit
+    }
+
+    /// The bytes charged so far.
+    #[must_use]
+    pub fn used(&self) -> u64 {
+        self.used.load(Ordering::Relaxed)
+    }
+
+    /// Charges `bytes` built for unit `done` (1-based) of `total`; over the limit, the answer is
+    /// refused with the estimate of the whole: what was built so far, extrapolated to every unit.
+    ///
+    /// # Errors
+    /// `E_TOO_LARGE_ANSWER` with the estimate and the limit.
+    pub fn charge(&self, bytes: u64, done: usize, total: usize) -> Result<(), SolverError> {
+        let used = self.used.fetch_add(bytes, Ordering::Relaxed).saturating_add(bytes);
+        if used <= self.limit {
+            return Ok(());
+        }
+        let done = done.clamp(1, total.max(1));
+        let estimate = (u128::from(used) * total.max(1) as u128 / done as u128).min(u128::from(u64::MAX));
+        Err(too_large_answer(u64::try_from(estimate).unwrap_or(u64::MAX), self.limit))
+    }
+
+    /// Checks an answer whose whole size is known (its JSON, its program).
+    ///
+    /// # Errors
+    /// `E_TOO_LARGE_ANSWER` when `bytes` is over the limit.
+    pub fn check(&self, bytes: u64) -> Result<(), SolverError> {
+        if bytes <= self.limit { Ok(()) } else { Err(too_large_answer(bytes, self.limit)) }
+    }
+}
+
+/// The refusal of an answer estimated at `estimate` bytes under a limit of `limit`.
+#[must_use]
+pub fn too_large_answer(estimate: u64, limit: u64) -> SolverError {
+    const MIB: f64 = 1024.0 * 1024.0;
+    SolverError::new(
+        ErrorCode::TooLargeAnswer,
+        format!(
+            "the answer would take about {estimate} bytes ({:.1} MiB), over the limit of {limit} bytes ({:.1} MiB) \
+             for one answer: ask for less (a coarser tolerance, fewer holes or samples) or split the request",
+            estimate as f64 / MIB,
+            limit as f64 / MIB,
+        ),
+    )
 }
 
 /// How a program is written: the caller's choices; what is left open takes the capability's or

@@ -103,6 +103,7 @@ error_codes! {
     ToolKind => "E_TOOL_KIND",
     TooComplex => "E_TOO_COMPLEX",
     TooLarge => "E_TOO_LARGE",
+    TooLargeAnswer => "E_TOO_LARGE_ANSWER",
     TooManyBlocks => "E_TOO_MANY_BLOCKS",
     TooManyLayers => "E_TOO_MANY_LAYERS",
     TooManyLines => "E_TOO_MANY_LINES",

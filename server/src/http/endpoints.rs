@@ -43,6 +43,7 @@ macro_rules! endpoint {
                     (status = 400, body = Problem, content_type = "application/problem+json"),
                     (status = 404, description = <$capability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
                     (status = 413, body = Problem, content_type = "application/problem+json"),
+                    (status = 408, description = "The body arrived slower than the minimum receive rate", body = Problem, content_type = "application/problem+json"),
                     (status = 415, body = Problem, content_type = "application/problem+json"),
                     (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json"),
                     (status = 422, description = <$capability as Capability>::ENDPOINT.refused, body = Problem, content_type = "application/problem+json")))]

@@ -176,7 +176,12 @@ fn located(id: i64, status: StatusCode, body: &Submitted) -> Response {
         (status = 429, description = "`E_JOB_STORE_FULL`: the job store is at its quota (prune finished jobs or raise the quota); nothing was stored", body = Problem, content_type = "application/problem+json")))]
 async fn submit(State(state): State<AppState>, request: Request) -> AppResult<Response> {
     let (text, format) = upload(&state, request).await?;
-    let job = file::parse(&text, format)?.resolve(Some(&state.db)).await?;
+    // Parsed on a blocking thread: a large job file is CPU work the async threads must not do.
+    let job = tokio::task::spawn_blocking(move || file::parse(&text, format))
+        .await
+        .map_err(|error| AppError::Internal(anyhow::anyhow!("parsing the job file failed: {error}")))??
+        .resolve(Some(&state.db))
+        .await?;
     let hash = job.content_hash();
     if let Some(id) = store::jobs::find_done(&state.db, &hash).await? {
         return Ok(located(id, StatusCode::OK, &Submitted { id, status: JobStatus::Done, reused: true }));

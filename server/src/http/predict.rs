@@ -8,7 +8,7 @@
 
 use axum::body::{Body, Bytes};
 use axum::extract::{DefaultBodyLimit, FromRequest, Multipart, Request, State};
-use axum::http::{HeaderMap, StatusCode, header};
+use axum::http::{HeaderMap, HeaderValue, header};
 use axum::response::Response;
 use kerf_solver::ErrorCode;
 use kerf_solver::capability::{Capability, OutputOptions};
@@ -21,7 +21,7 @@ use utoipa_axum::routes;
 
 use super::output::{Ask, Format, wants_gcode};
 use crate::error::{AppError, AppResult, Problem};
-use crate::extract::{AppQuery, body_bytes, is_json, media_type, parse_json, refuse_declared_over};
+use crate::extract::{AppQuery, charged_body_bytes, is_json, media_type, parse_json};
 use crate::state::AppState;
 
 /// Query parameters of `POST /api/v1/predict`: the output negotiation of every path-producing
@@ -59,32 +59,27 @@ struct Upload {
     mesh: Option<Bytes>,
 }
 
-fn multipart_error(part: &str, limit: usize, error: &axum::extract::multipart::MultipartError) -> AppError {
-    if error.status() == StatusCode::PAYLOAD_TOO_LARGE {
-        AppError::PayloadTooLarge { limit }
-    } else {
-        AppError::bad_request(ErrorCode::Multipart, part, format!("{part}: {}", error.body_text()))
-    }
+fn multipart_error(part: &str, error: &axum::extract::multipart::MultipartError) -> AppError {
+    AppError::bad_request(ErrorCode::Multipart, part, format!("{part}: {}", error.body_text()))
 }
 
-/// Reads the body under the upload limit: JSON, or the multipart form.
-async fn upload(state: &AppState, request: Request) -> AppResult<Upload> {
-    let limit = state.limits.max_upload_bytes;
-    refuse_declared_over(request.headers(), limit)?;
-    // The route's default limit is off (see `router`); this one applies instead.
-    let request = request.map(|body| Body::new(http_body_util::Limited::new(body, limit)));
-    if is_json(request.headers()) {
-        let bytes = body_bytes(request, state, limit).await?;
-        return Ok(Upload { request: parse_json(&bytes)?, mesh: None });
+/// Reads an upload received whole: the JSON, or the multipart form with `content_type`. CPU work
+/// on a large upload: call it on a blocking thread.
+fn read_upload(json: bool, content_type: Option<HeaderValue>, body: Bytes) -> AppResult<Upload> {
+    if json {
+        return Ok(Upload { request: parse_json(&body)?, mesh: None });
     }
-    if media_type(request.headers()).as_deref() != Some("multipart/form-data") {
-        return Err(AppError::UnsupportedMediaType(
-            "send the request as application/json, or as multipart/form-data with the JSON in part `request` \
-             and the STL file in part `stock`"
-                .to_owned(),
-        ));
+    let mut form = Request::new(Body::from(body));
+    if let Some(content_type) = content_type {
+        form.headers_mut().insert(header::CONTENT_TYPE, content_type);
     }
-    let mut multipart = Multipart::from_request(request, state)
+    // The body is all in memory: the form's parts are split without waiting for anything.
+    tokio::runtime::Handle::current().block_on(read_form(form))
+}
+
+/// The parts of the multipart form `form`: `request` (the JSON) and `stock` (the STL file).
+async fn read_form(form: Request) -> AppResult<Upload> {
+    let mut multipart = Multipart::from_request(form, &())
         .await
         .map_err(|rejection| AppError::bad_request(ErrorCode::Multipart, "body", rejection.body_text()))?;
     let (mut json, mut mesh): (Option<Bytes>, Option<Bytes>) = (None, None);
@@ -92,7 +87,7 @@ async fn upload(state: &AppState, request: Request) -> AppResult<Upload> {
         let field = match multipart.next_field().await {
             Ok(Some(field)) => field,
             Ok(None) => break,
-            Err(error) => return Err(multipart_error("body", limit, &error)),
+            Err(error) => return Err(multipart_error("body", &error)),
         };
         let name = field.name().unwrap_or_default().to_owned();
         let slot = match name.as_str() {
@@ -113,7 +108,7 @@ async fn upload(state: &AppState, request: Request) -> AppResult<Upload> {
                 format!("form part `{name}` is given twice"),
             ));
         }
-        *slot = Some(field.bytes().await.map_err(|error| multipart_error(&name, limit, &error))?);
+        *slot = Some(field.bytes().await.map_err(|error| multipart_error(&name, &error))?);
     }
     let json = json.ok_or_else(|| {
         AppError::bad_request(ErrorCode::Multipart, "request", "the form has no part `request` with the JSON request")
@@ -137,10 +132,11 @@ async fn upload(state: &AppState, request: Request) -> AppResult<Upload> {
             (String = "text/x-gcode"))),
         (status = 400, description = "Not the right shape (JSON or form)", body = Problem, content_type = "application/problem+json"),
         (status = 404, description = <PredictCapability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
+        (status = 408, description = "The body arrived slower than the minimum receive rate", body = Problem, content_type = "application/problem+json"),
         (status = 413, description = "Body over the upload limit", body = Problem, content_type = "application/problem+json"),
         (status = 415, body = Problem, content_type = "application/problem+json"),
         (status = 422, description = <PredictCapability as Capability>::ENDPOINT.refused, body = Problem, content_type = "application/problem+json"),
-        (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json")))]
+        (status = 429, description = "All solver slots busy, or uploads and answers in progress hold the memory budget", body = Problem, content_type = "application/problem+json")))]
 async fn post_predict(
     State(state): State<AppState>,
     headers: HeaderMap,
@@ -152,15 +148,20 @@ async fn post_predict(
         output: OutputOptions { dialect: query.dialect, reference: query.reference, ..OutputOptions::default() },
         timings: query.timings.unwrap_or(false),
     };
-    // While it arrives, possibly slowly, the upload holds its share of the memory budget (its
-    // declared length, else the whole upload limit); once read, the solver slots bound it.
-    let declared = request
-        .headers()
-        .get(header::CONTENT_LENGTH)
-        .and_then(|v| v.to_str().ok())
-        .and_then(|v| v.parse::<usize>().ok());
-    let upload_share = state.reserve_memory(declared.unwrap_or(state.limits.max_upload_bytes))?;
-    let Upload { request, mesh } = upload(&state, request).await?;
+    let json = is_json(request.headers());
+    if !json && media_type(request.headers()).as_deref() != Some("multipart/form-data") {
+        return Err(AppError::UnsupportedMediaType(
+            "send the request as application/json, or as multipart/form-data with the JSON in part `request` \
+             and the STL file in part `stock`"
+                .to_owned(),
+        ));
+    }
+    let content_type = request.headers().get(header::CONTENT_TYPE).cloned();
+    // While it arrives, possibly slowly, the upload holds its share of the memory budget: the
+    // bytes received so far. It is read on a blocking thread in a solver slot, off the async
+    // threads; once read, the solver slots bound it.
+    let (body, upload_share) = charged_body_bytes(request, &state, state.limits.max_upload_bytes).await?;
+    let Upload { request, mesh } = state.solve(move |_| read_upload(json, content_type, body)).await??;
     drop(upload_share);
     super::solve::answer::<PredictCapability>(&state, request, mesh, ask).await
 }

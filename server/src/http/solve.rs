@@ -7,7 +7,7 @@
 use axum::body::Bytes;
 use axum::http::{HeaderValue, header};
 use axum::response::Response;
-use kerf_solver::capability::{self, Capability, Control, Purpose, Run};
+use kerf_solver::capability::{self, AnswerBudget, Capability, Control, Purpose, Run};
 
 use super::output::Ask;
 use crate::answer_cache::{AnswerCache, CachedAnswer, Question};
@@ -44,12 +44,15 @@ pub async fn answer<C: Capability>(
             return respond(state, bytes, media_type, HeaderValue::from_static("cache;desc=\"answer cache\""));
         }
     }
+    // The answer is built within the byte budget its client's download is held to.
+    let budget = AnswerBudget::new(u64::try_from(state.limits.answer_budget_bytes).unwrap_or(u64::MAX));
     let (delivered, seconds) = state
         .solve(move |cancel| {
             let run = Run {
                 control: Control { progress: None, cancel: Some(cancel) },
                 upload: upload.as_deref(),
                 purpose: if ask.gcode { Purpose::Program } else { Purpose::Json },
+                budget: Some(&budget),
             };
             capabilities::solve::<C>(&request, resolved, &run, ask.gcode.then_some(&ask.output), ask.timings)
         })

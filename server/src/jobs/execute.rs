@@ -6,7 +6,7 @@ use kerf_solver::ErrorCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, PoisonError};
 
-use kerf_solver::capability::{Control, Part, Purpose, Run, Split};
+use kerf_solver::capability::{AnswerBudget, Control, Part, Purpose, Run, Split};
 
 use super::file::JobFile;
 use super::parts::{StoredParts, sizing};
@@ -24,7 +24,9 @@ pub enum JobFailure {
 }
 
 /// Runs `job` (already resolved: its tools and machines in it). `progress` receives the fraction
-/// done (0–1), also within long operations (from their worker threads).
+/// done (0–1), also within long operations (from their worker threads). Each operation's answer
+/// (in memory, its JSON and its program) is built within `answer_limit` bytes, and refused with
+/// `E_TOO_LARGE_ANSWER` when it would not fit, so a job's memory is bounded before it starts.
 ///
 /// # Errors
 /// The first refused operation's problem, or the cancellation.
@@ -32,12 +34,13 @@ pub fn execute(
     job: &JobFile,
     progress: &(dyn Fn(f64) + Sync),
     cancelled: &AtomicBool,
+    answer_limit: u64,
 ) -> Result<Vec<Stored>, JobFailure> {
     let count = job.operations.len();
     let mut outputs = Vec::with_capacity(count);
     for index in 0..count {
         let within = |fraction: f64| progress((index as f64 + fraction) / count as f64);
-        outputs.push(execute_operation(job, index, &within, cancelled)?);
+        outputs.push(execute_operation(job, index, &within, cancelled, answer_limit)?);
         progress((index + 1) as f64 / count as f64);
     }
     Ok(outputs)
@@ -54,8 +57,11 @@ pub fn execute_operation(
     index: usize,
     progress: &(dyn Fn(f64) + Sync),
     cancelled: &AtomicBool,
+    answer_limit: u64,
 ) -> Result<Stored, JobFailure> {
-    within(job, index, progress, cancelled, |operation, run| operation.run(job, run, &job.output.for_programs()))
+    within(job, index, progress, cancelled, answer_limit, |operation, run| {
+        operation.run(job, run, &job.output.for_programs())
+    })
 }
 
 /// How operation `index` of `job` divides into parts for different workers ([`sizing`]), or
@@ -76,8 +82,9 @@ pub fn execute_part(
     part: &Part,
     progress: &(dyn Fn(f64) + Sync),
     cancelled: &AtomicBool,
+    answer_limit: u64,
 ) -> Result<PartBytes, JobFailure> {
-    within(job, index, progress, cancelled, |operation, run| operation.run_part(job, part, run))
+    within(job, index, progress, cancelled, answer_limit, |operation, run| operation.run_part(job, part, run))
 }
 
 /// The finish step of operation `index`, split by [`plan`]: merges its parts' outputs (in order)
@@ -94,20 +101,23 @@ pub fn execute_finish(
     seconds: f64,
     progress: &(dyn Fn(f64) + Sync),
     cancelled: &AtomicBool,
+    answer_limit: u64,
 ) -> Result<Stored, JobFailure> {
     let mut parts = StoredParts::new(parts);
-    within(job, index, progress, cancelled, |operation, run| {
+    within(job, index, progress, cancelled, answer_limit, |operation, run| {
         operation.finish(job, &mut parts, run, &job.output.for_programs(), seconds)
     })
 }
 
 /// Runs `work` on operation `index` of `job` as a job runs it: with progress (passed on when it
-/// increases) and cancellation, its time recorded, its refusal under `operations[index]`.
+/// increases) and cancellation, its answer within `answer_limit` bytes, its time recorded, its
+/// refusal under `operations[index]`.
 fn within<T>(
     job: &JobFile,
     index: usize,
     progress: &(dyn Fn(f64) + Sync),
     cancelled: &AtomicBool,
+    answer_limit: u64,
     work: impl FnOnce(&Operation, &Run<'_>) -> Result<T, AppError>,
 ) -> Result<T, JobFailure> {
     let Some(operation) = job.operations.get(index) else {
@@ -126,10 +136,12 @@ fn within<T>(
             progress(fraction);
         }
     };
+    let budget = AnswerBudget::new(answer_limit);
     let run = Run {
         control: Control { progress: Some(&within), cancel: Some(cancelled) },
         upload: None,
         purpose: Purpose::Job,
+        budget: Some(&budget),
     };
     let started = std::time::Instant::now();
     let output = work(operation, &run).map_err(|error| failure(index, error))?;

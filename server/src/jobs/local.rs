@@ -153,7 +153,11 @@ pub async fn run(path: &Path, out: &Path, database: Option<&Database>) -> anyhow
     };
     show(0.0);
     let job_for_task = job.clone();
-    let outputs = tokio::task::spawn_blocking(move || execute(&job_for_task, &show, &AtomicBool::new(false))).await?;
+    // Alone in its process, with nothing else to keep alive: no limit but the machine's memory.
+    let answer_limit = u64::MAX;
+    let outputs =
+        tokio::task::spawn_blocking(move || execute(&job_for_task, &show, &AtomicBool::new(false), answer_limit))
+            .await?;
     if terminal {
         eprintln!();
     }

@@ -45,6 +45,8 @@ pub struct JobRunner {
     claimant: Claimant,
     /// The bounds of the job store: submissions and finished work are checked against them.
     pub storage: JobStorage,
+    /// Bytes one operation's answer may take while it is built (`Limits::answer_budget_bytes`).
+    pub answer_limit: u64,
 }
 
 impl Default for JobRunner {
@@ -74,7 +76,14 @@ impl JobRunner {
             cancel_flags: Mutex::default(),
             claimant: Claimant { worker: worker_name(), lease: lease.max(Duration::from_secs(1)) },
             storage,
+            answer_limit: u64::try_from(crate::state::Limits::default().answer_budget_bytes).unwrap_or(u64::MAX),
         }
+    }
+
+    /// The same runner, building each operation's answer within `bytes`.
+    #[must_use]
+    pub fn with_answer_limit(self, bytes: usize) -> Self {
+        Self { answer_limit: u64::try_from(bytes).unwrap_or(u64::MAX), ..self }
     }
 
     /// The name this process's workers write on the jobs they run.
@@ -289,6 +298,7 @@ async fn run(
         _ => Vec::new(),
     };
     let (task_progress, task_cancelled, computed) = (Arc::clone(&progress), Arc::clone(&cancelled), task.clone());
+    let answer_limit = runner.answer_limit;
     let computing = tokio::task::spawn_blocking(move || {
         let _permit = permit;
         let report = |fraction: f64| task_progress.store(fraction.to_bits(), Ordering::Relaxed);
@@ -310,10 +320,12 @@ async fn run(
             )
         };
         Ok::<_, JobFailure>(match computed {
-            Task::Job => packed(execute(&job, &report, &task_cancelled)?),
-            Task::Operation(index) => packed(vec![execute_operation(&job, index, &report, &task_cancelled)?]),
+            Task::Job => packed(execute(&job, &report, &task_cancelled, answer_limit)?),
+            Task::Operation(index) => {
+                packed(vec![execute_operation(&job, index, &report, &task_cancelled, answer_limit)?])
+            }
             Task::Part { operation, part } => {
-                let output = execute_part(&job, operation, &part, &report, &task_cancelled)?;
+                let output = execute_part(&job, operation, &part, &report, &task_cancelled, answer_limit)?;
                 Output::Part(PartOutput {
                     operation: job.operations[operation].name().to_owned(),
                     gz: gzip(&output.bytes),
@@ -324,7 +336,7 @@ async fn run(
             Task::Finish { operation } => {
                 let seconds = parts.iter().map(|(_, seconds)| seconds).sum();
                 let parts = parts.into_iter().map(|(output, _)| output).collect();
-                packed(vec![execute_finish(&job, operation, parts, seconds, &report, &task_cancelled)?])
+                packed(vec![execute_finish(&job, operation, parts, seconds, &report, &task_cancelled, answer_limit)?])
             }
         })
     });

@@ -51,7 +51,7 @@ impl Capability for ContourCapability {
             chorded by the block-time rule and the summary reports the blocks.",
         not_found: "Unknown tool number or machine",
         refused: "Impossible contour or over a limit (codes in docs/spec/contour.md §5; `E_TOO_MANY_MOVES` for \
-            answers over the move limit); `E_TIMEOUT` over the synchronous time limit: submit a job",
+            answers over the move limit); `E_TIMEOUT` over the synchronous time limit: submit a job; `E_TOO_LARGE_ANSWER` when the answer would not fit the answer budget",
     };
     type Request = ContourRequest;
     type Answer = ContourAnswer;

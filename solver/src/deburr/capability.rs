@@ -3,12 +3,13 @@
 
 use serde::Serialize;
 
+use super::answer::DeburrPoint;
 use super::program::Leg;
 use super::request::Placement;
 use super::{Deburr, DeburrRequest, Edge};
 use crate::capability::{
-    Capability, Control, Endpoint, OtherTool, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing,
-    Split,
+    Capability, Control, Endpoint, OtherTool, OutputOptions, Part, PartSink, PartSource, Purpose, Refs, Resolved, Run,
+    Sizing, Split,
 };
 use crate::error::SolverError;
 use crate::gcode::{Reference, ToolCall};
@@ -126,7 +127,7 @@ impl Capability for DeburrCapability {
             that point down.",
         not_found: "Unknown tool number (`tool`, `inner_tool`) or machine",
         refused: "Impossible geometry (codes in docs/spec/deburr.md §4); `E_TIMEOUT` over the synchronous time \
-            limit: submit a job",
+            limit: submit a job; `E_TOO_LARGE_ANSWER` when the answer would not fit the answer budget",
     };
     type Request = DeburrRequest;
     type Answer = DeburrAnswer;
@@ -140,9 +141,20 @@ impl Capability for DeburrCapability {
         request.inner_tool.iter().map(|tool| OtherTool { field: "inner_tool", tool }).collect()
     }
 
+    /// Every loop at [`MAX_POINTS`](super::MAX_POINTS) points (the solver refuses a loop that
+    /// needs more), at [`loop_bound`] each; a several-loop answer repeats its first loop at the
+    /// top.
+    fn answer_bound(request: &DeburrRequest, _context: &Resolved<Tool>, purpose: Purpose) -> Option<u64> {
+        let loops = if request.is_several() { request.placements().ok()?.len() as u64 + 1 } else { 1 };
+        Some(loops.saturating_mul(loop_bound(super::MAX_POINTS, purpose)).saturating_add(ANSWER_BYTES))
+    }
+
     fn solve(request: &DeburrRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<DeburrAnswer, SolverError> {
         if !request.is_several() {
             let result = super::solve_controlled(request, &context.tool, context.machine.as_ref(), run.control)?;
+            if run.budget.is_some() {
+                run.charge(loop_bytes(&result, run.purpose) + ANSWER_BYTES, 1, 1)?;
+            }
             let cycle_time = context
                 .machine
                 .as_ref()
@@ -159,10 +171,13 @@ impl Capability for DeburrCapability {
             });
         }
         let inner_tool = inner_tool(request, &context);
-        let mut loops = Vec::new();
-        for placement in request.placements()? {
+        let placements = request.placements()?;
+        let count = placements.len();
+        let mut loops = Vec::with_capacity(count);
+        for placement in placements {
             run.control.check()?;
             let result = solve_loop(&placement, &context, inner_tool.as_ref(), run)?;
+            charge_loop(run, &result, loops.len(), count)?;
             loops.push(hole_answer(placement, result));
         }
         Ok(arrange(context, inner_tool, loops))
@@ -212,6 +227,87 @@ impl Capability for DeburrCapability {
     fn machine(answer: &DeburrAnswer) -> Option<&MachineProfile> {
         answer.machine.as_ref()
     }
+}
+
+/// Most bytes one answer point takes as JSON: its 13 numbers at their longest (24 characters,
+/// `-2.2250738585072014e-308`), its longest segment name, its keys and separators (checked by
+/// `point_json_is_within_its_bound`).
+const POINT_JSON_BYTES: u64 = 448;
+
+/// Most bytes one answer point takes in a program: one `G01`/`G02` line with five coordinates
+/// of up to `-1000000.0000` (the coordinate range) and a feed word.
+const POINT_PROGRAM_BYTES: u64 = 128;
+
+/// Most bytes of one loop besides its points: edge, method, leads, summary, warnings, and its
+/// place among the holes (checked against the reference case by
+/// `loop_bound_holds_the_reference_case`).
+const LOOP_BYTES: u64 = 64 * 1024;
+
+/// Most bytes of an answer besides its loops: tools, machine, cycle time, visiting order.
+const ANSWER_BYTES: u64 = 256 * 1024;
+
+/// Most bytes a loop of `points` points takes for `purpose`: the points in memory, plus their
+/// JSON, their program, or for a job both.
+fn loop_bound(points: usize, purpose: Purpose) -> u64 {
+    let per_point = POINT_BYTES
+        + match purpose {
+            Purpose::Json => POINT_JSON_BYTES,
+            Purpose::Program => POINT_PROGRAM_BYTES,
+            Purpose::Job => POINT_JSON_BYTES + POINT_PROGRAM_BYTES,
+        };
+    (points as u64).saturating_mul(per_point).saturating_add(LOOP_BYTES)
+}
+
+/// Bytes of one point in memory.
+const POINT_BYTES: u64 = std::mem::size_of::<DeburrPoint>() as u64;
+
+/// The bytes the solved loop `result` takes for `purpose`: its points in memory, plus its JSON
+/// as written (counted, not kept), its program at [`POINT_PROGRAM_BYTES`] a point, or for a job
+/// both.
+fn loop_bytes(result: &Deburr, purpose: Purpose) -> u64 {
+    let points = result.points.len() as u64;
+    let json = || {
+        let mut counter = ByteCounter(0);
+        // Written to a counter, the JSON cannot fail for want of room: count what was written.
+        let _ = serde_json::to_writer(&mut counter, result);
+        counter.0 + PLACE_BYTES
+    };
+    let program = || points.saturating_mul(POINT_PROGRAM_BYTES).saturating_add(PLACE_BYTES);
+    points.saturating_mul(POINT_BYTES)
+        + match purpose {
+            Purpose::Json => json(),
+            Purpose::Program => program(),
+            Purpose::Job => json() + program(),
+        }
+}
+
+/// Most bytes of a loop's place among the holes (its field, index, tool field, angles, axial
+/// position) as JSON, and of the moves between two loops in a program.
+const PLACE_BYTES: u64 = 1024;
+
+/// Counts the bytes written to it.
+struct ByteCounter(u64);
+
+impl std::io::Write for ByteCounter {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        self.0 += bytes.len() as u64;
+        Ok(bytes.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// Charges loop `index` of `count` to the run's budget as it is built; the first loop twice (a
+/// several-loop answer repeats it at the top).
+pub(super) fn charge_loop(run: &Run<'_>, result: &Deburr, index: usize, count: usize) -> Result<(), SolverError> {
+    if run.budget.is_none() {
+        return Ok(());
+    }
+    let copies = if index == 0 { 2 } else { 1 };
+    let extra = if index == 0 { ANSWER_BYTES } else { 0 };
+    run.charge(copies * loop_bytes(result, run.purpose) + extra, index + 1, count)
 }
 
 /// The tool of the inside ridges: `inner_tool` as resolved, when the request gives one.
@@ -355,4 +451,73 @@ fn cycle_time(legs: &[Leg<'_>], dynamics: &Dynamics) -> CycleTime {
     let mut tools: Vec<usize> = legs.iter().map(|leg| leg.tool).collect();
     tools.dedup();
     crate::machine::cycle::cycle_time(start, &steps, dynamics, tools.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn point_json_is_within_its_bound() {
+        // The longest number serde writes (ryu) and the longest segment name.
+        let longest = -2.225_073_858_507_201_4e-308;
+        let point = DeburrPoint {
+            target: [longest; 3],
+            centre: [longest; 3],
+            tip: [longest; 3],
+            wedge_angle_deg: longest,
+            segment: "line_y+x",
+            parameter: longest,
+            phi_deg: Some(longest),
+            centre_offset: longest,
+        };
+        let json = serde_json::to_vec(&point).unwrap();
+        assert_eq!(serde_json::to_string(&longest).unwrap().len(), 24);
+        // With the comma that separates it from the next point.
+        assert!((json.len() as u64) < POINT_JSON_BYTES, "{} bytes: {}", json.len(), String::from_utf8_lossy(&json));
+    }
+
+    #[test]
+    fn loop_bound_holds_the_reference_case() {
+        // Reference case 1 at both edges of two holes: four loops and the first again at the top.
+        let request: DeburrRequest = serde_json::from_value(serde_json::json!({
+            "tool": {"kind": "ball", "radius": 3},
+            "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
+            "holes": [{"shape": "round", "radius": 10}, {"shape": "round", "radius": 6, "axial_position": 40}],
+            "edge": "both", "cut_amount": 0.5
+        }))
+        .unwrap();
+        let crate::tool::ToolRef::Inline(tool) = &request.tool else { unreachable!("an inline tool") };
+        let context = Resolved { tool: tool.clone(), machine: None, material: None, other_tools: Vec::new() };
+        let answer = DeburrCapability::solve(&request, context.clone(), &Run::default()).unwrap();
+        let holes = answer.holes.as_ref().unwrap();
+        let json = serde_json::to_vec(&answer).unwrap().len() as u64;
+        let program = crate::capability::program::<DeburrCapability>(
+            &request,
+            &answer,
+            &OutputOptions::default(),
+            Control::default(),
+        )
+        .unwrap()
+        .len() as u64;
+        let points: u64 = holes.iter().map(|hole| hole.result.points.len() as u64).sum();
+        let memory = (points + answer.result.points.len() as u64) * POINT_BYTES;
+        for (purpose, built) in [
+            (Purpose::Json, memory + json),
+            (Purpose::Program, memory + program),
+            (Purpose::Job, memory + json + program),
+        ] {
+            let bound = DeburrCapability::answer_bound(&request, &context, purpose).unwrap();
+            assert!(built <= bound, "{purpose:?}: {built} over the bound {bound}");
+            // What the loops are charged (the first twice) covers what is built.
+            let charged: u64 = holes.iter().map(|hole| loop_bytes(&hole.result, purpose)).sum::<u64>()
+                + loop_bytes(&holes[0].result, purpose)
+                + ANSWER_BYTES;
+            assert!(built <= charged, "{purpose:?}: {built} over the charge {charged}");
+            for hole in holes {
+                let (bytes, bound) = (loop_bytes(&hole.result, purpose), loop_bound(hole.result.points.len(), purpose));
+                assert!(bytes <= bound, "{purpose:?}: a loop of {bytes} bytes over its bound {bound}");
+            }
+        }
+    }
 }

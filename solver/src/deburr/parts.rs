@@ -98,7 +98,9 @@ pub(crate) fn finish(
         }
         for result in part.loops {
             let placement = placements.next().ok_or_else(|| mismatch(format!("more than {count} loops")))?;
-            loops.push(hole_answer(placement, result.into()));
+            let result = result.into();
+            super::capability::charge_loop(run, &result, loops.len(), count)?;
+            loops.push(hole_answer(placement, result));
         }
         read += 1;
         run.control.report(read, parts.count());

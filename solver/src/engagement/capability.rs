@@ -8,7 +8,8 @@ use super::job::Job;
 use super::request::Engine;
 use super::{EngagementRequest, EngagementSolution, Stock};
 use crate::capability::{
-    Capability, Control, Endpoint, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing, Split,
+    Capability, Control, Endpoint, OutputOptions, Part, PartSink, PartSource, Purpose, Refs, Resolved, Run, Sizing,
+    Split,
 };
 use crate::error::{ErrorCode, SolverError};
 use crate::gcode::SpindleDirection;
@@ -71,7 +72,7 @@ impl Capability for EngagementCapability {
         not_found: "Unknown tool number or machine",
         refused: "Impossible or over a limit: `E_INPUT`, `E_PATH`, `E_STOCK`, `E_TOO_LARGE`, \
             `E_TOO_MANY_SAMPLES`, `E_GRID_MEMORY`, `E_WORK_LIMIT` (docs/spec/engagement.md §9); `E_TIMEOUT` \
-            over the synchronous time limit: submit a job",
+            over the synchronous time limit: submit a job; `E_TOO_LARGE_ANSWER` when the answer would not fit the answer budget",
     };
     type Request = EngagementRequest;
     type Answer = EngagementAnswer;
@@ -97,7 +98,9 @@ impl Capability for EngagementCapability {
             &physics(request, &context),
             run.control,
         )?;
-        Ok(respond(request, context, result))
+        let answer = respond(request, context, result);
+        charge_samples(&answer, run)?;
+        Ok(answer)
     }
 
     /// The candidate paths of a request with `paths`, in runs of about `sizing.part_seconds`
@@ -209,6 +212,26 @@ impl Capability for EngagementCapability {
     fn to_json(answer: EngagementAnswer) -> serde_json::Result<Vec<u8>> {
         super::wire::to_json(answer)
     }
+}
+
+/// Charges the answer's samples, nearly all of a large answer, to the run's budget before any of
+/// their JSON is written: their memory, and for a JSON answer or a job their JSON at the size
+/// the writer reserves for it ([`super::wire`]).
+fn charge_samples(answer: &EngagementAnswer, run: &Run<'_>) -> Result<(), SolverError> {
+    if run.budget.is_none() {
+        return Ok(());
+    }
+    let candidates: &[PathEngagement] = match &answer.result {
+        EngagementSolution::Single(result) => std::slice::from_ref(result.as_ref()),
+        EngagementSolution::Comparison(comparison) => &comparison.candidates,
+    };
+    let samples = candidates.iter().flat_map(|candidate| &candidate.samples);
+    let memory = std::mem::size_of::<super::answer::EngagementSample>() as u64;
+    let bytes: u64 = match run.purpose {
+        Purpose::Program => samples.map(|_| memory).sum(),
+        Purpose::Json | Purpose::Job => samples.map(|sample| memory + super::wire::estimate(sample) as u64).sum(),
+    };
+    run.charge(bytes, 1, 1)
 }
 
 /// A plunge feed, when given, must be positive.

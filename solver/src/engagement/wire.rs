@@ -64,7 +64,7 @@ fn marker_positions(text: &[u8]) -> Vec<usize> {
     text.windows(EMPTY_SAMPLES.len()).enumerate().filter(|(_, w)| *w == EMPTY_SAMPLES).map(|(i, _)| i).collect()
 }
 
-fn estimate(sample: &EngagementSample) -> usize {
+pub(super) fn estimate(sample: &EngagementSample) -> usize {
     let items = sample.arcs.len() * 3
         + sample.thickness.len()
         + sample.teeth.len()

@@ -63,7 +63,7 @@ impl Capability for PredictCapability {
         not_found: "Unknown tool number",
         refused: "Impossible or over a limit: tool kind, no shape-error table, G-code errors with the \
             line, open mesh, resolution over the memory limit; `E_TIMEOUT` over the synchronous time \
-            limit: submit a job",
+            limit: submit a job; `E_TOO_LARGE_ANSWER` when the answer would not fit the answer budget",
     };
     type Request = PredictRequest;
     type Answer = PredictAnswer;

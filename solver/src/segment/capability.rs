@@ -46,7 +46,7 @@ impl Capability for SegmentCapability {
         not_found: "Unknown machine or tool number",
         refused: "Impossible request: `E_INPUT`, `E_DEGENERATE_CURVE`, `E_INFEASIBLE_FEED_FOR_RADIUS` (the \
             message gives the largest feasible feed), `E_TOO_MANY_BLOCKS`, `E_TOO_MANY_POINTS`, \
-            `E_NUMERIC_FAILURE`; `E_TIMEOUT` over the synchronous time limit: submit a job",
+            `E_NUMERIC_FAILURE`; `E_TIMEOUT` over the synchronous time limit: submit a job; `E_TOO_LARGE_ANSWER` when the answer would not fit the answer budget",
     };
     type Request = SegmentRequest;
     type Answer = SegmentAnswer;

@@ -213,18 +213,16 @@ async fn a_trickling_client_does_not_keep_a_stopped_server_alive() {
 
 #[tokio::test(flavor = "multi_thread")]
 async fn slow_readers_of_large_answers_hold_a_bounded_budget() {
-    // A 2 MiB budget and a 19 MB answer that its client does not read: the next answer gets 429
-    // with Retry-After until the first one has been read.
-    let app = TestApp::spawn_with(Limits { answer_budget_bytes: 2 * 1024 * 1024, ..Limits::default() }).await;
+    // A 32 MiB budget and a 19 MB answer that its client does not read: the next large answer
+    // gets 429 with Retry-After until the first one has been read.
+    let app = TestApp::spawn_with(Limits { answer_budget_bytes: 32 * 1024 * 1024, ..Limits::default() }).await;
     let large = json!({"tool": {"kind": "ball", "radius": 3}, "contour": circle(600), "side": "outside",
                        "depths": {"top": 0, "bottom": -100, "step": 0.25}, "feed": 800});
     let unread = app.post_json("/api/v1/contour", &large).await;
     assert_eq!(unread.status(), 200);
     let length: usize = unread.headers()["content-length"].to_str().unwrap().parse().unwrap();
     assert!(length > 10_000_000, "{length}");
-    let quick = json!({"curve": {"kind": "arc", "centre": [0, 0], "radius": 10, "start_deg": 0, "end_deg": 90},
-                       "feed": 1000, "block_time_ms": 4});
-    let refused = app.post_json("/api/v1/segment", &quick).await;
+    let refused = app.post_json("/api/v1/contour", &large).await;
     assert!(refused.headers().contains_key("retry-after"), "{:?}", refused.headers());
     let answer = problem(refused, 429).await;
     assert_eq!(answer["code"], "E_BUSY", "{answer}");
@@ -232,21 +230,20 @@ async fn slow_readers_of_large_answers_hold_a_bounded_budget() {
     let body = unread.bytes().await.unwrap();
     assert_eq!(body.len(), length);
     serde_json::from_slice::<serde_json::Value>(&body).unwrap();
-    json_with(app.post_json("/api/v1/segment", &quick).await, 200).await;
+    assert_eq!(app.post_json("/api/v1/contour", &large).await.bytes().await.unwrap(), body);
 }
 
 #[tokio::test(flavor = "multi_thread")]
 async fn slow_uploads_hold_a_bounded_budget() {
-    // An upload that declares 3 MiB and arrives slowly holds the 2 MiB budget while it arrives: a
-    // second upload gets 429 with Retry-After instead of piling up in memory.
+    // An upload that declares 3 MiB, sends 2.5 MiB and stalls holds the 2 MiB budget by what it
+    // sent: a second upload gets 429 with Retry-After instead of piling up in memory.
     let app = TestApp::spawn_with(Limits { answer_budget_bytes: 2 * 1024 * 1024, ..Limits::default() }).await;
-    let slow = raw_request(
-        &app,
-        b"POST /api/v1/predict HTTP/1.1\r\nHost: kerf\r\nContent-Type: multipart/form-data; boundary=XX\r\n\
-          Content-Length: 3145728\r\n\r\n--XX\r\nContent-Disposition: form-data; name=\"stock\"\r\n\r\nsolid",
-    )
-    .await;
-    // The first upload is read by then: its share is taken before the body is read.
+    let mut head = b"POST /api/v1/predict HTTP/1.1\r\nHost: kerf\r\nContent-Type: multipart/form-data; boundary=XX\r\n\
+          Content-Length: 3145728\r\n\r\n--XX\r\nContent-Disposition: form-data; name=\"stock\"\r\n\r\nsolid"
+        .to_vec();
+    head.resize(head.len() + 5 * 512 * 1024, b' ');
+    let slow = raw_request(&app, &head).await;
+    // The first upload's bytes are received by then, each charged as it arrives.
     let mut refused = None;
     for _ in 0..100 {
         let response = app
@@ -290,15 +287,19 @@ async fn slow_uploads_hold_a_bounded_budget() {
 
 #[tokio::test(flavor = "multi_thread")]
 async fn slow_readers_of_large_job_programs_hold_a_bounded_budget() {
-    // A 1 MiB budget and a job whose program is some 20 MB: while one client does not read it, the
-    // next download of a large job output gets 429 with Retry-After instead of another copy in memory.
-    let app = TestApp::spawn_with(Limits { answer_budget_bytes: 1024 * 1024, ..Limits::default() }).await;
+    // A job whose result and program (some 60 MB together) are built within a 64 MiB budget, then
+    // served under a 1 MiB budget: while one client does not read its program of some 20 MB, the
+    // next download of a large job output gets 429 with Retry-After instead of another copy in
+    // memory.
+    let mut app = TestApp::spawn_with(Limits { answer_budget_bytes: 64 * 1024 * 1024, ..Limits::default() }).await;
     let job = json!({"name": "deep contour", "operations": [{"operation": "contour",
         "tool": {"kind": "ball", "radius": 3}, "contour": circle(600), "side": "outside",
         "depths": {"top": 0, "bottom": -250, "step": 0.25}, "feed": 800}]});
     let id = json_with(app.post_json("/api/v1/jobs", &job).await, 202).await["id"].as_i64().unwrap();
     let done = kerf_tests::poll_job(&app.client, &app.base, id, 300, kerf_tests::finished).await;
     assert_eq!(done["status"], "done", "{done}");
+    app.config.limits.answer_budget_bytes = 1024 * 1024;
+    app.restart().await;
     let program = format!("/api/v1/jobs/{id}/gcode");
     let unread = app.get(&program).await;
     assert_eq!(unread.status(), 200);

@@ -5,6 +5,7 @@ mod arcs;
 mod auth;
 mod bad_requests;
 mod browser;
+mod budgets;
 mod cancellation;
 mod cli;
 mod contour;

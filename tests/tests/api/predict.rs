@@ -1071,7 +1071,7 @@ fn a_cancelled_prediction_is_a_cancelled_job_not_a_failure() {
             std::thread::sleep(Duration::from_millis(500));
             cancel.store(true, Ordering::Relaxed);
         });
-        execute(&job, &|fraction| reports.lock().unwrap().push(fraction), &cancel)
+        execute(&job, &|fraction| reports.lock().unwrap().push(fraction), &cancel, u64::MAX)
     });
     assert_eq!(outcome.unwrap_err(), JobFailure::Cancelled);
     let reports = reports.into_inner().unwrap();
