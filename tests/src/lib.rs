@@ -1,7 +1,8 @@
 //! Test harness: starts the real service on `127.0.0.1:0` with a temporary SQLite file (or a
 //! throw-away PostgreSQL server, [`postgres`]) and talks HTTP to it, and helpers for the external
-//! checks (LinuxCNC's `rs274`, headless Chromium, PostgreSQL).
+//! checks (LinuxCNC's `rs274`, headless Chromium, PostgreSQL, schemathesis; [`external`]).
 
+pub mod external;
 pub mod postgres;
 
 use std::path::{Path, PathBuf};
@@ -29,7 +30,7 @@ pub enum Store {
 }
 
 /// Runs each `async fn NAME(store: Store)` test body on both stores: a module `NAME` with the
-/// tests `sqlite` and `postgres` (which skips, printing why, when PostgreSQL is not installed).
+/// tests `sqlite` and `postgres` (ignored when PostgreSQL is not installed, see [`external`]).
 #[macro_export]
 macro_rules! on_both_stores {
     ($($test:ident),+ $(,)?) => {
@@ -41,6 +42,7 @@ macro_rules! on_both_stores {
                 }
 
                 #[tokio::test(flavor = "multi_thread")]
+                #[cfg_attr(not(kerf_has_postgres), ignore = "PostgreSQL not found: apt-get install postgresql")]
                 async fn postgres() {
                     super::$test($crate::Store::Postgres).await;
                 }
@@ -82,8 +84,8 @@ impl TestApp {
         Self::spawn_at(None, adjust).await
     }
 
-    /// Starts a service on `store` with the default configuration changed by `adjust`; `None`
-    /// (the test skips, having printed why) when the store is PostgreSQL and it is not installed.
+    /// Starts a service on `store` with the default configuration changed by `adjust`. Always
+    /// `Some`: a missing PostgreSQL fails the test (see [`PgServer::start`]).
     pub async fn spawn_on(store: Store, adjust: impl FnOnce(&mut Config)) -> Option<Self> {
         let postgres = match store {
             Store::Sqlite => None,
@@ -231,20 +233,30 @@ pub async fn problem(response: Response, status: u16) -> Value {
 
 /// Whether external programs are required (`KERF_REQUIRE_EXTERNAL=1`, set by `.ci/run`).
 pub fn external_required() -> bool {
-    std::env::var("KERF_REQUIRE_EXTERNAL").is_ok_and(|v| v == "1")
+    external::required()
 }
 
-/// Finds `program` on the PATH. When it is missing, prints why the calling test skips and
-/// returns `None` — or panics when external programs are required.
+/// Finds `program` on the PATH, where the build script looks for it too (see [`external`]).
+/// Always `Some`: a test that needs a program carries `#[cfg_attr(not(kerf_has_<name>), ignore =
+/// "…")]` and is not run without it, so a program missing here (`KERF_REQUIRE_EXTERNAL=1`, a run
+/// with `--ignored`, or a test without the attribute) fails the test instead of letting it pass
+/// unrun.
 pub fn external_program(program: &str, purpose: &str) -> Option<PathBuf> {
-    let found = std::env::var_os("PATH")
-        .and_then(|paths| std::env::split_paths(&paths).map(|dir| dir.join(program)).find(|path| path.is_file()));
-    if found.is_none() {
-        let message = format!("{program} not found on PATH: skipping {purpose}");
-        assert!(!external_required(), "{message}, but KERF_REQUIRE_EXTERNAL=1");
-        eprintln!("SKIP: {message}");
-    }
+    let found = external::on_path(program);
+    assert!(found.is_some(), "{}", missing_message(&format!("{program} not found on PATH"), purpose));
     found
+}
+
+/// Why a test that needs an external program fails without it.
+pub fn missing_message(what: &str, purpose: &str) -> String {
+    if external_required() {
+        format!("{what}, needed for {purpose}, and KERF_REQUIRE_EXTERNAL=1 requires it")
+    } else {
+        format!(
+            "{what}, needed for {purpose}; a test that needs it carries \
+             #[cfg_attr(not(kerf_has_<name>), ignore = \"…\")] to be ignored without it (CONTRIBUTING.md)"
+        )
+    }
 }
 
 /// The real `kerf` program running as a child process on a database file, for tests that
@@ -368,8 +380,8 @@ pub fn assert_moves_match(label: &str, interpreted: &[(bool, [f64; 3])], expecte
 /// Runs `program` through LinuxCNC's `rs274` (writing it to `folder/name.ngc`), asserts that the
 /// interpreter accepts it to its end without complaint, and returns its canonical moves:
 /// (is a feed move, end point). Arcs (`ARC_FEED`) count as feed moves to their end point, in the
-/// plane the program selected. Coordinates are in the program's units. `None` when `rs274` is
-/// missing (see [`external_program`]).
+/// plane the program selected. Coordinates are in the program's units. Always `Some` (see
+/// [`external_program`]).
 pub fn rs274_moves(program: &str, folder: &Path, name: &str) -> Option<Vec<(bool, [f64; 3])>> {
     let rs274 = external_program("rs274", "the LinuxCNC G-code check")?;
     let file = folder.join(format!("{name}.ngc"));

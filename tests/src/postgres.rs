@@ -3,16 +3,18 @@
 //! when dropped. PostgreSQL refuses to run as root, so as root (CI) every command runs as the
 //! `postgres` system user through `runuser`, and the directory is handed to that user.
 //!
-//! Without PostgreSQL's programs (Debian's `postgresql` package) [`PgServer::start`] prints why
-//! the test skips and returns `None`, or panics under `KERF_REQUIRE_EXTERNAL=1`.
+//! The tests that use it carry `#[cfg_attr(not(kerf_has_postgres), ignore = …)]`, set by the build
+//! script when it finds PostgreSQL where [`crate::external::postgres`] looks, so they are ignored
+//! without it; [`PgServer::start`] fails a test that runs all the same (`KERF_REQUIRE_EXTERNAL=1`
+//! sets every flag).
 
-use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use kerf_server::db::Database;
 
-use crate::{external_required, free_port};
+use crate::external::{self, postgres_user};
+use crate::{free_port, missing_message};
 
 /// A running PostgreSQL server with a database `postgres` that the user `postgres` may use
 /// without a password.
@@ -25,60 +27,24 @@ pub struct PgServer {
     port: u16,
 }
 
-fn skip(reason: &str) -> Option<PgServer> {
-    let message = format!("{reason}: skipping the PostgreSQL test");
-    assert!(!external_required(), "{message}, but KERF_REQUIRE_EXTERNAL=1");
-    eprintln!("SKIP: {message}");
-    None
-}
-
-/// The folder with `initdb` and `pg_ctl`: on the PATH, else Debian's newest
-/// `/usr/lib/postgresql/N/bin`.
-fn bin_folder() -> Option<PathBuf> {
-    let on_path = std::env::var_os("PATH").and_then(|paths| {
-        std::env::split_paths(&paths).find(|dir| dir.join("initdb").is_file() && dir.join("pg_ctl").is_file())
-    });
-    if on_path.is_some() {
-        return on_path;
-    }
-    let mut versions: Vec<(u32, PathBuf)> = std::fs::read_dir("/usr/lib/postgresql")
-        .ok()?
-        .filter_map(|entry| {
-            let entry = entry.ok()?;
-            let version = entry.file_name().to_str()?.parse().ok()?;
-            let bin = entry.path().join("bin");
-            bin.join("initdb").is_file().then_some((version, bin))
-        })
-        .collect();
-    versions.sort();
-    versions.pop().map(|(_, bin)| bin)
-}
-
-/// The uid and gid of the `postgres` system user, from `/etc/passwd`.
-fn postgres_user() -> Option<(u32, u32)> {
-    let passwd = std::fs::read_to_string("/etc/passwd").ok()?;
-    let line = passwd.lines().find(|line| line.starts_with("postgres:"))?;
-    let fields: Vec<&str> = line.split(':').collect();
-    Some((fields.get(2)?.parse().ok()?, fields.get(3)?.parse().ok()?))
+fn missing(reason: &str) -> ! {
+    panic!("{}", missing_message(reason, "the PostgreSQL test"))
 }
 
 impl PgServer {
-    /// Starts a server, or `None` when PostgreSQL is not installed (see the module).
+    /// Starts a server. Always `Some` (see the module).
     ///
     /// # Panics
-    /// When it is installed but does not start.
+    /// When PostgreSQL is missing, or installed but does not start.
     pub fn start() -> Option<Self> {
-        let Some(bin) = bin_folder() else { return skip("PostgreSQL (initdb, pg_ctl) is not installed") };
-        let root = std::fs::metadata("/proc/self").is_ok_and(|m| m.uid() == 0);
+        let (bin, root) = match external::postgres() {
+            Ok(found) => found,
+            Err(reason) => missing(reason),
+        };
         let directory = tempfile::Builder::new().prefix("kerf-pg-").tempdir().expect("temporary directory");
         if root {
-            let Some((uid, gid)) = postgres_user() else {
-                return skip("running as root and there is no postgres user to run PostgreSQL as");
-            };
+            let (uid, gid) = postgres_user().expect("the postgres user, found by external::postgres");
             std::os::unix::fs::chown(directory.path(), Some(uid), Some(gid)).expect("hand the folder to postgres");
-            if Command::new("runuser").arg("--help").output().is_err() {
-                return skip("running as root and runuser is missing");
-            }
         }
         let server = Self { directory, bin, as_postgres: root, port: free_port() };
         let data = server.data();

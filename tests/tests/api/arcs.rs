@@ -114,6 +114,7 @@ async fn check_with(
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn arcs_end_where_the_chords_end() {
     if external_program("rs274", "the LinuxCNC G-code check").is_none() {
         return;

@@ -8,20 +8,16 @@
 use std::path::Path;
 use std::process::Command;
 
-use kerf_tests::{TestApp, external_program, external_required};
+use kerf_tests::{TestApp, external_program};
 
-/// Runs `tests/browser/run.mjs <scenario>` against `app`; `None` when the tools are missing.
+/// Runs `tests/browser/run.mjs <scenario>` against `app`. Always `Some`: a missing tool fails the
+/// test, which carries `#[cfg_attr(not(kerf_has_chromium), ignore = …)]` to be ignored without it.
 pub fn run_scenario(app: &TestApp, scenario: &str, extra: &[&str]) -> Option<serde_json::Value> {
     let node = external_program("node", "the browser test")?;
     external_program("chromium", "the browser test")?;
-    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("browser");
-    if !folder.join("node_modules/playwright-core").is_dir() {
-        let message =
-            "playwright-core is not installed: run `npm ci --prefix tests/browser` (skipping the browser test)";
-        assert!(!external_required(), "{message}, but KERF_REQUIRE_EXTERNAL=1");
-        eprintln!("SKIP: {message}");
-        return None;
-    }
+    let folder = kerf_tests::external::browser_folder();
+    let driver = "playwright-core not installed (npm ci --prefix tests/browser)";
+    assert!(kerf_tests::external::browser_driver(), "{}", kerf_tests::missing_message(driver, "the browser test"));
     let screenshot = app.directory().join(format!("{scenario}.png"));
     let output = Command::new(node)
         .current_dir(&folder)
@@ -43,6 +39,10 @@ pub fn run_scenario(app: &TestApp, scenario: &str, extra: &[&str]) -> Option<ser
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn deburr_page_plots_the_sample_job() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "deburr", &[]) else { return };
@@ -54,6 +54,10 @@ async fn deburr_page_plots_the_sample_job() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn segment_page_cuts_the_sample_and_uses_a_registered_machine() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "segment", &[]) else { return };
@@ -62,6 +66,10 @@ async fn segment_page_cuts_the_sample_and_uses_a_registered_machine() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn workbench_keeps_state_honours_the_machine_and_fits_the_window() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "workbench", &[]) else { return };
@@ -70,6 +78,10 @@ async fn workbench_keeps_state_honours_the_machine_and_fits_the_window() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn jobs_page_runs_an_uploaded_example() {
     let app = TestApp::spawn().await;
     let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/deburr-tube.toml");
@@ -80,6 +92,10 @@ async fn jobs_page_runs_an_uploaded_example() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn contour_page_plots_the_sample_and_downloads_gcode() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "contour", &[]) else { return };
@@ -88,6 +104,10 @@ async fn contour_page_plots_the_sample_and_downloads_gcode() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn jobs_page_shows_the_contour_example() {
     let app = TestApp::spawn().await;
     let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/contour-arrow.toml");
@@ -97,6 +117,10 @@ async fn jobs_page_shows_the_contour_example() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn engagement_page_compares_the_sample_paths() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "engagement", &[]) else { return };
@@ -109,6 +133,10 @@ async fn engagement_page_compares_the_sample_paths() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn engagement_page_computes_with_a_library_material() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "engagementMaterial", &[]) else { return };
@@ -118,6 +146,10 @@ async fn engagement_page_computes_with_a_library_material() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn jobs_page_shows_an_engagement_job() {
     let app = TestApp::spawn().await;
     let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/engagement-pocket.toml");
@@ -129,6 +161,10 @@ async fn jobs_page_shows_an_engagement_job() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn jobs_page_shows_only_the_progress_the_service_reports() {
     // One worker, so the jobs behind the long prediction wait their turn.
     let app = TestApp::spawn_configured(|config| config.job_workers = 1).await;
@@ -143,6 +179,10 @@ async fn jobs_page_shows_only_the_progress_the_service_reports() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn predict_page_colours_the_path_by_error() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "predict", &[]) else { return };
@@ -152,6 +192,10 @@ async fn predict_page_colours_the_path_by_error() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn jobs_page_shows_a_prediction_job() {
     let app = TestApp::spawn().await;
     let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/predict-raster.toml");
@@ -161,6 +205,10 @@ async fn jobs_page_shows_a_prediction_job() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn jobs_page_downloads_every_output_as_a_zip() {
     let app = TestApp::spawn().await;
     let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/shop-job.toml");

@@ -165,6 +165,7 @@ async fn pocket_with_layers_loops_and_relief() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn gcode_of_both_dialects_matches_the_json_moves() {
     if external_program("rs274", "the LinuxCNC G-code check").is_none() {
         return;

@@ -97,6 +97,7 @@ fn four_along() -> Value {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn a_four_hole_pattern_is_one_program_with_four_closed_loops() {
     let app = TestApp::spawn().await;
     app.register_tool(7, &json!({"kind": "ball", "radius": 3})).await;
@@ -171,6 +172,7 @@ fn around(angles: &[f64]) -> Value {
 /// deburred with the tube turned (an `M00` to turn it), and no move through the wall, in both
 /// dialects. The same holes listed in `holes` give the same loops.
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn four_holes_around_the_tube_are_four_loops_clear_of_the_wall() {
     let app = TestApp::spawn().await;
     app.register_tool(7, &json!({"kind": "ball", "radius": 3})).await;
@@ -228,6 +230,7 @@ fn both_edges() -> Value {
 /// request's tool and then the inner ones with the inner tool, one tool change between them; the
 /// program passes rs274 in both dialects without a move through the wall.
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn both_edges_change_to_the_inner_tool_once() {
     let app = TestApp::spawn().await;
     app.register_tool(7, &json!({"kind": "ball", "radius": 3})).await;
@@ -320,6 +323,7 @@ async fn the_inner_tool_is_resolved_and_checked_like_the_tool() {
 /// runs on its own, and a later change in the table does not change it), and its one program
 /// changes to the inner tool once inside the deburr operation.
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn a_job_keeps_its_inner_tool_and_its_program_changes_to_it() {
     let app = TestApp::spawn().await;
     app.register_tool(7, &json!({"kind": "ball", "radius": 3})).await;
@@ -348,6 +352,7 @@ async fn a_job_keeps_its_inner_tool_and_its_program_changes_to_it() {
 /// The holes of a scrambled list are visited in a short order (along the axis here), never longer
 /// than the request's; the answer lists them in visiting order.
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn scrambled_holes_are_visited_in_a_short_order() {
     let app = TestApp::spawn().await;
     app.register_tool(7, &json!({"kind": "ball", "radius": 3})).await;

@@ -27,6 +27,7 @@ fn block_lengths(answer: &Value) -> Vec<f64> {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn a_stored_machine_spaces_the_points_by_its_block_time() {
     let app = TestApp::spawn().await;
     app.register_tool(7, &json!({"kind": "ball", "radius": 3})).await;

@@ -593,6 +593,7 @@ fn program_feeds(program: &str) -> Vec<Option<f64>> {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn gcode_of_the_feed_plan_in_both_dialects() {
     let app = TestApp::spawn().await;
     app.register_tool(3, &json!({"kind": "flat", "radius": 5, "flutes": 3})).await;

@@ -33,6 +33,7 @@ async fn gcode(app: &TestApp, path: &str, body: &Value) -> String {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn plunges_run_at_the_plunge_feed() {
     let app = TestApp::spawn().await;
     app.register_tool(3, &json!({"kind": "flat", "radius": 3, "plunge_feed": 150})).await;
@@ -212,6 +213,7 @@ fn descents(program: &str) -> Vec<([f64; 3], [f64; 3], f64)> {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn tools_that_do_not_cut_at_the_centre_ramp_into_contour_layers() {
     let app = TestApp::spawn().await;
     app.register_tool(6, &json!({"kind": "flat", "radius": 4, "centre_cutting": false, "plunge_feed": 200})).await;

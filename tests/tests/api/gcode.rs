@@ -48,6 +48,7 @@ fn jobs() -> Vec<(&'static str, Value)> {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn programs_pass_rs274_and_match_json() {
     if external_program("rs274", "the LinuxCNC G-code check").is_none() {
         return;

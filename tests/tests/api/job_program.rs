@@ -28,6 +28,7 @@ fn feed_moves(program: &str, folder: &Path, name: &str) -> Option<Vec<[f64; 3]>>
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn a_job_runs_as_one_program_in_both_dialects() {
     let app = TestApp::spawn().await;
     let folder = tempfile::tempdir().unwrap();

@@ -475,6 +475,7 @@ async fn over_the_time_limit_is_422_and_frees_the_slot() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn corrected_program_through_rs274() {
     let app = TestApp::spawn().await;
     // A G-code path: same lines, only coordinates move; rs274 reads it and its feed moves are the
@@ -547,6 +548,7 @@ async fn corrected_program_through_rs274() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn arcs_are_refitted_and_rs274_accepts_them() {
     let app = TestApp::spawn().await;
     // Finishing a round boss: full-circle G2/G3 passes at three heights.
@@ -589,6 +591,7 @@ async fn arcs_are_refitted_and_rs274_accepts_them() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn inch_programs_equal_the_metric_ones() {
     let app = TestApp::spawn().await;
     let metric = raster_request(finishing_tool(), 5, 7);

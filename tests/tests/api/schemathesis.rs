@@ -7,6 +7,7 @@
 use kerf_tests::{TestApp, external_program};
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_schemathesis), ignore = "schemathesis not found: pip install schemathesis")]
 async fn the_server_keeps_to_its_openapi_document() {
     let Some(schemathesis) = external_program("schemathesis", "the OpenAPI conformance run") else {
         return;

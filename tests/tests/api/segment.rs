@@ -315,6 +315,7 @@ async fn machine_defaults_and_overrides() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 async fn programs_pass_rs274_and_match_json() {
     if external_program("rs274", "the LinuxCNC G-code check").is_none() {
         return;
@@ -635,6 +636,10 @@ async fn jobs_carry_machines_from_the_file_or_the_registry() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn segment_page_plots_compares_and_uses_a_machine() {
     let app = TestApp::spawn().await;
     let Some(result) = crate::browser::run_scenario(&app, "segment", &[]) else { return };
@@ -647,6 +652,10 @@ async fn segment_page_plots_compares_and_uses_a_machine() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn jobs_page_shows_segment_results() {
     let app = TestApp::spawn().await;
     let example = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/segment-machine.toml");

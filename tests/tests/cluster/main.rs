@@ -181,6 +181,7 @@ async fn metric(client: &Client, base: &str, name: &str) -> Option<f64> {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_postgres), ignore = "PostgreSQL not found: apt-get install postgresql")]
 async fn workers_share_the_queue_and_survive_a_kill() {
     let Some(postgres) = PgServer::start() else { return };
     let url = postgres.url();
@@ -403,6 +404,7 @@ fn deburr_holes() -> Value {
 const PART_SECONDS: &str = "0.25";
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_postgres), ignore = "PostgreSQL not found: apt-get install postgresql")]
 async fn a_prediction_splits_across_workers_and_survives_a_kill() {
     let Some(postgres) = PgServer::start() else { return };
     let url = postgres.url();
@@ -554,6 +556,7 @@ async fn a_prediction_splits_across_workers_and_survives_a_kill() {
 /// prediction test above saw that once). The first heartbeat is held open by hand between its
 /// chunk's update and its commit, so the interleaving is certain.
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_postgres), ignore = "PostgreSQL not found: apt-get install postgresql")]
 async fn heartbeats_at_once_keep_the_job_at_its_chunks_sum() {
     use kerf_server::jobs::file::{self, Format};
     use kerf_server::store::jobs::{self as store, Claimant};
@@ -598,6 +601,7 @@ async fn heartbeats_at_once_keep_the_job_at_its_chunks_sum() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_postgres), ignore = "PostgreSQL not found: apt-get install postgresql")]
 async fn a_refused_part_fails_its_job_with_its_problem() {
     let Some(postgres) = PgServer::start() else { return };
     let url = postgres.url();
@@ -643,6 +647,7 @@ async fn a_refused_part_fails_its_job_with_its_problem() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_postgres), ignore = "PostgreSQL not found: apt-get install postgresql")]
 async fn two_api_nodes_share_the_registry_and_cancel_reaches_the_other() {
     let Some(first) = TestApp::spawn_on(Store::Postgres, |config| config.job_workers = 1).await else { return };
     // The second node runs no jobs: whatever runs, runs on the first.
@@ -683,6 +688,7 @@ async fn two_api_nodes_share_the_registry_and_cancel_reaches_the_other() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_postgres), ignore = "PostgreSQL not found: apt-get install postgresql")]
 async fn readiness_follows_the_database() {
     let Some(app) = TestApp::spawn_on(Store::Postgres, |_| {}).await else { return };
     assert_eq!(json_with(app.get("/readyz").await, 200).await["database"], "postgres");
