@@ -236,6 +236,10 @@ async fn jobs_page_downloads_every_output_as_a_zip() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn saving_an_existing_tool_number_asks_first_and_keeps_the_old_tool() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "toolOverwrite", &[]) else { return };
@@ -246,6 +250,10 @@ async fn saving_an_existing_tool_number_asks_first_and_keeps_the_old_tool() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn a_decimal_comma_is_a_decimal_separator_never_dropped() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "decimalComma", &[]) else { return };
@@ -256,6 +264,10 @@ async fn a_decimal_comma_is_a_decimal_separator_never_dropped() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn deburr_by_od_id_and_diameter_gives_the_path_of_the_radii() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "deburrDiameters", &[]) else { return };
@@ -264,6 +276,10 @@ async fn deburr_by_od_id_and_diameter_gives_the_path_of_the_radii() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn segment_defaults_to_no_short_blocks_and_its_advice_names_the_page_controls() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "segmentDefault", &[]) else { return };
@@ -273,6 +289,10 @@ async fn segment_defaults_to_no_short_blocks_and_its_advice_names_the_page_contr
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn a_failed_job_reads_in_words_and_can_be_resubmitted_and_deleted() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "jobsFailed", &[]) else { return };
@@ -281,6 +301,10 @@ async fn a_failed_job_reads_in_words_and_can_be_resubmitted_and_deleted() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn predict_draws_an_uploaded_stl_stock() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "predictStl", &[]) else { return };
@@ -289,6 +313,10 @@ async fn predict_draws_an_uploaded_stl_stock() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn an_opened_deburr_job_draws_its_tube_and_hole() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "jobDeburrSolids", &[]) else { return };
@@ -297,6 +325,10 @@ async fn an_opened_deburr_job_draws_its_tube_and_hole() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn saving_an_existing_machine_or_material_asks_first_and_keeps_it() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "registryOverwrite", &[]) else { return };

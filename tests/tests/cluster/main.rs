@@ -716,6 +716,7 @@ async fn unavailable(request: reqwest::RequestBuilder, what: &str) -> f64 {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_postgres), ignore = "PostgreSQL not found: apt-get install postgresql")]
 async fn a_database_outage_mid_job_loses_no_finished_result() {
     let Some(postgres) = PgServer::start() else { return };
     let url = postgres.url();
