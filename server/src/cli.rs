@@ -353,7 +353,10 @@ async fn worker(args: WorkerArgs) -> anyhow::Result<()> {
     let cores = std::thread::available_parallelism().map_or(2, std::num::NonZero::get);
     let workers = args.job_workers.unwrap_or(cores).max(1);
     let db = db::open(&args.database).await?;
-    let runner = Arc::new(JobRunner::new(lease(args.job_lease_s), args.storage.storage()));
+    let runner = Arc::new(
+        JobRunner::new(lease(args.job_lease_s), args.storage.storage())
+            .with_answer_limit(Limits::default().answer_budget_bytes),
+    );
     runner.start(&db, &Arc::new(tokio::sync::Semaphore::new(workers)), workers).await?;
     if let Some(bind) = args.metrics_bind {
         let listener = TcpListener::bind(bind).await.with_context(|| format!("binding {bind}"))?;

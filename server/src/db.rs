@@ -13,7 +13,7 @@ use sqlx::postgres::{PgConnectOptions, PgPoolOptions};
 use sqlx::sqlite::{
     SqliteAutoVacuum, SqliteConnectOptions, SqliteJournalMode, SqliteLockingMode, SqlitePoolOptions, SqliteSynchronous,
 };
-use sqlx::{PgPool, SqlitePool};
+use sqlx::{Connection, PgPool, SqlitePool};
 
 /// Where the data lives, as `--database` names it: a file path or `sqlite://PATH` (SQLite), or
 /// `postgres://…` / `postgresql://…` (PostgreSQL).
@@ -178,7 +178,7 @@ async fn open_sqlite(path: &Path) -> anyhow::Result<SqlitePool> {
         .foreign_keys(true)
         // Concurrent writers wait for the lock instead of failing with "database is locked".
         .busy_timeout(Duration::from_secs(10));
-    let pool = match SqlitePoolOptions::new().max_connections(8).connect_with(options.clone()).await {
+    let pool = match sqlite_pool(8).connect_with(options.clone()).await {
         Ok(pool) => pool,
         Err(error) if existed && crate::error::disk_full(&error) => {
             // No room for the shared-memory index (`-shm`) the connections share: one connection
@@ -186,8 +186,7 @@ async fn open_sqlite(path: &Path) -> anyhow::Result<SqlitePool> {
             // writes once space is freed; a restart then brings the pool back.
             tracing::warn!(%error, database = %path.display(), "the disk is full: one exclusive connection until a restart");
             let exclusive = options.locking_mode(SqliteLockingMode::Exclusive);
-            SqlitePoolOptions::new()
-                .max_connections(1)
+            sqlite_pool(1)
                 .connect_with(exclusive)
                 .await
                 .map_err(|_| error)
@@ -197,6 +196,17 @@ async fn open_sqlite(path: &Path) -> anyhow::Result<SqlitePool> {
     };
     sqlx::migrate!("../migrations/sqlite").run(&pool).await.context("applying migrations")?;
     Ok(pool)
+}
+
+/// SQLite pool options: a connection that comes back still inside a transaction is closed, not
+/// reused. A COMMIT that fails on a full disk makes SQLite roll the transaction back itself, so
+/// sqlx's ROLLBACK on drop fails and its count of open transactions stays at one: reused, such a
+/// connection would refuse every later `BEGIN IMMEDIATE` and nest every `BEGIN` as a savepoint
+/// that never commits.
+fn sqlite_pool(connections: u32) -> SqlitePoolOptions {
+    SqlitePoolOptions::new()
+        .max_connections(connections)
+        .after_release(|connection, _| Box::pin(async move { Ok(!connection.is_in_transaction()) }))
 }
 
 /// How long a request waits for a database connection before it is answered 503 `E_UNAVAILABLE`

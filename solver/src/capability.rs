@@ -7,11 +7,12 @@
 //! [`resolve`], into a
 //! [`Resolved`] context; the solver never sees an unresolved reference.
 
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
+pub use crate::control::Control;
 use crate::error::SolverError;
 use crate::error_code::ErrorCode;
 use crate::gcode::{Arcs, Dialect, Post, Reference, ToolCall};
@@ -392,70 +393,6 @@ pub fn resolve_request<C: Capability>(
 /// then one per other tool.
 pub fn all_refs<C: Capability>(request: &C::Request) -> Vec<Refs<'_>> {
     std::iter::once(C::refs(request)).chain(C::other_tools(request).into_iter().map(OtherTool::refs)).collect()
-}
-
-/// Progress reporting and cancellation for long runs.
-#[derive(Clone, Copy, Default)]
-pub struct Control<'a> {
-    /// Called with the fraction done (0–1), from worker threads, about every 0.5 %.
-    pub progress: Option<&'a (dyn Fn(f64) + Sync)>,
-    /// Set to stop: the run ends with `E_CANCELLED`.
-    pub cancel: Option<&'a AtomicBool>,
-}
-
-impl Control<'_> {
-    /// `Err(E_CANCELLED)` once the cancel flag is set. The solvers call it once per unit of work
-    /// (a block, a centre, a layer, a sample row), so a timed-out or abandoned request frees its
-    /// solver slot within milliseconds instead of running to the end.
-    ///
-    /// # Errors
-    /// `E_CANCELLED` when cancelled.
-    pub fn check(&self) -> Result<(), SolverError> {
-        if self.cancelled() {
-            return Err(SolverError::new(ErrorCode::Cancelled, "the computation was cancelled"));
-        }
-        Ok(())
-    }
-
-    /// Whether the cancel flag is set.
-    #[must_use]
-    pub fn cancelled(&self) -> bool {
-        self.cancel.is_some_and(|flag| flag.load(std::sync::atomic::Ordering::Relaxed))
-    }
-
-    /// Reports `done` of `total` units of work (a layer, a block, a sample) finished, only every
-    /// `total / 200` units so a per-sample call stays cheap.
-    pub fn report(&self, done: usize, total: usize) {
-        let Some(progress) = self.progress else { return };
-        if total == 0 {
-            return;
-        }
-        let every = (total / 200).max(1);
-        if done.is_multiple_of(every) || done >= total {
-            progress((done as f64 / total as f64).min(1.0));
-        }
-    }
-
-    /// Reports the fraction done where the work is not counted in units (along a curve).
-    pub fn report_fraction(&self, fraction: f64) {
-        if let Some(progress) = self.progress {
-            progress(fraction.clamp(0.0, 1.0));
-        }
-    }
-
-    /// Runs `work` as part `index` of `count` equal parts of this run: its progress 0–1 is
-    /// reported as `(index + fraction) / count` (the candidates of a comparison, say).
-    pub fn part<T>(&self, index: usize, count: usize, work: impl FnOnce(Control<'_>) -> T) -> T {
-        let Some(progress) = self.progress else { return work(*self) };
-        let scaled = move |fraction: f64| progress((index as f64 + fraction) / count.max(1) as f64);
-        work(Control { progress: Some(&scaled), cancel: self.cancel })
-    }
-}
-
-impl std::fmt::Debug for Control<'_> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Control").field("progress", &self.progress.is_some()).field("cancel", &self.cancel).finish()
-    }
 }
 
 /// What the answer is for: limits differ between a JSON answer, a program and a stored job.

@@ -13,6 +13,7 @@
 
 pub mod capability;
 pub mod contour;
+pub mod control;
 pub mod deburr;
 pub mod engagement;
 pub mod error;

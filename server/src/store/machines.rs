@@ -4,6 +4,7 @@ use super::on;
 use super::tools::WRITE_ATTEMPTS;
 use crate::db::Db;
 use crate::error::{AppError, AppResult};
+use crate::store::CommitChecked;
 use kerf_solver::gcode::Dialect;
 use kerf_solver::machine::MachineProfile;
 
@@ -74,7 +75,7 @@ pub async fn put(
                     return Err(AppError::Conflict(format!("machine {name:?} was written concurrently; try again")));
                 }
             };
-            transaction.commit().await?;
+            transaction.commit_checked().await?;
             Ok(created)
         }};
     }
@@ -108,7 +109,7 @@ pub async fn delete(db: &Db, name: &str, guard: impl Fn(Option<&MachineProfile>)
             guard(current.as_ref())?;
             let deleted =
                 sqlx::query("DELETE FROM machines WHERE name = $1").bind(name).execute(&mut *transaction).await?;
-            transaction.commit().await?;
+            transaction.commit_checked().await?;
             Ok(deleted.rows_affected() > 0)
         }};
     }

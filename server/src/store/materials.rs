@@ -1,6 +1,7 @@
 //! The materials library: work materials with their Kienzle values, keyed by name,
 //! seeded by migration 0006 with published values.
 
+use crate::store::CommitChecked;
 use kerf_solver::material::{IsoGroup, Material};
 
 use super::on;
@@ -92,7 +93,7 @@ pub async fn put(db: &Db, material: &Material, guard: impl Fn(Option<&Material>)
                     return Err(AppError::Conflict(format!("material {name:?} was written concurrently; try again")));
                 }
             };
-            transaction.commit().await?;
+            transaction.commit_checked().await?;
             Ok(created)
         }};
     }
@@ -126,7 +127,7 @@ pub async fn delete(db: &Db, name: &str, guard: impl Fn(Option<&Material>) -> Ap
             guard(current.as_ref())?;
             let deleted =
                 sqlx::query("DELETE FROM materials WHERE name = $1").bind(name).execute(&mut *transaction).await?;
-            transaction.commit().await?;
+            transaction.commit_checked().await?;
             Ok(deleted.rows_affected() > 0)
         }};
     }

@@ -69,3 +69,39 @@ pub async fn has_table(db: &Db, table: &str) -> AppResult<bool> {
 pub async fn job_counts(db: &Db) -> AppResult<Vec<(String, i64)>> {
     Ok(on!(db, query_as, both: "SELECT status, COUNT(*) FROM jobs GROUP BY status", [], fetch_all)?)
 }
+
+/// Commits a transaction so that a failed commit is reported and leaves its connection fit for
+/// the next request.
+pub(crate) trait CommitChecked {
+    /// Commits; the error of a failed commit (a full disk, a lost connection) is returned.
+    async fn commit_checked(self) -> Result<(), sqlx::Error>;
+}
+
+impl CommitChecked for sqlx::Transaction<'_, sqlx::Postgres> {
+    async fn commit_checked(self) -> Result<(), sqlx::Error> {
+        self.commit().await
+    }
+}
+
+impl CommitChecked for sqlx::Transaction<'_, sqlx::Sqlite> {
+    /// SQLite rolls a transaction back by itself when its COMMIT fails on a full disk; sqlx's
+    /// own COMMIT would then leave its count of open transactions at one and its ROLLBACK on drop
+    /// fail, so the pooled connection would refuse every later `BEGIN IMMEDIATE` and nest every
+    /// `BEGIN` as a savepoint that never commits. So the COMMIT is sent as plain SQL first, and
+    /// sqlx then ends an empty transaction opened for it, whichever way the COMMIT went.
+    async fn commit_checked(mut self) -> Result<(), sqlx::Error> {
+        use sqlx::Executor;
+        match self.execute(sqlx::raw_sql("COMMIT")).await {
+            Ok(_) => {
+                self.execute(sqlx::raw_sql("BEGIN")).await?;
+                self.commit().await
+            }
+            Err(error) => {
+                // Fails when SQLite kept the transaction open; the ROLLBACK then ends that one.
+                let _ = self.execute(sqlx::raw_sql("BEGIN")).await;
+                let _ = self.rollback().await;
+                Err(error)
+            }
+        }
+    }
+}

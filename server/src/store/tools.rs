@@ -1,5 +1,6 @@
 //! The tool table (docs/spec/api.md, Tools).
 
+use crate::store::CommitChecked;
 use kerf_solver::tool::{Tool, ToolRef};
 
 use super::on;
@@ -75,7 +76,7 @@ pub async fn put(db: &Db, tool: &Tool, guard: impl Fn(Option<&Tool>) -> AppResul
                     return Err(AppError::Conflict(format!("tool {number} was written concurrently; try again")));
                 }
             };
-            transaction.commit().await?;
+            transaction.commit_checked().await?;
             Ok(created)
         }};
     }
@@ -110,7 +111,7 @@ pub async fn delete(db: &Db, number: u32, guard: impl Fn(Option<&Tool>) -> AppRe
             guard(current.as_ref())?;
             let deleted =
                 sqlx::query("DELETE FROM tools WHERE number = $1").bind(number).execute(&mut *transaction).await?;
-            transaction.commit().await?;
+            transaction.commit_checked().await?;
             Ok(deleted.rows_affected() > 0)
         }};
     }

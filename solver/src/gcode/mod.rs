@@ -14,7 +14,7 @@ use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
-use crate::capability::Control;
+use crate::control::Control;
 use crate::error::SolverError;
 use crate::geometry::Vec3;
 use crate::path::{Motion, Toolpath};

@@ -1,6 +1,7 @@
 //! Claiming work: the next queued job (SQLite) or chunk (PostgreSQL) for a worker, and handing
 //! back what a stopped server or worker held.
 
+use crate::store::CommitChecked;
 use kerf_solver::ErrorCode;
 use kerf_solver::capability::Part;
 
@@ -122,7 +123,7 @@ async fn claim_chunk(pool: &sqlx::PgPool, claimant: &Claimant) -> AppResult<Chun
     .fetch_optional(&mut *transaction)
     .await?;
     let Some((id, position, attempt, kind, operation, from, to, work)) = chunk else {
-        transaction.commit().await?;
+        transaction.commit_checked().await?;
         return Ok(Chunk::None);
     };
     let index = |value: i64| usize::try_from(value).map_err(|e| AppError::Internal(e.into()));
@@ -151,7 +152,7 @@ async fn claim_chunk(pool: &sqlx::PgPool, claimant: &Claimant) -> AppResult<Chun
     };
     // A chunk claimed again starts over: the job's progress loses what it had done.
     set_job_progress(&mut transaction, id).await?;
-    transaction.commit().await?;
+    transaction.commit_checked().await?;
     Ok(Chunk::Claimed(Work { id, chunk: Some(index(position)?) }, task, json, attempt))
 }
 
@@ -206,6 +207,6 @@ pub async fn release(db: &Db, claimant: &Claimant) -> AppResult<u64> {
     if released > 0 {
         sqlx::query("SELECT pg_notify($1, '')").bind(SUBMITTED_CHANNEL).execute(&mut *transaction).await?;
     }
-    transaction.commit().await?;
+    transaction.commit_checked().await?;
     Ok(released)
 }

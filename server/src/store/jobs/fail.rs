@@ -1,6 +1,7 @@
 //! Ending a job without results: failed by its worker or cancelled by request, with what its
 //! chunks stored dropped in the same transaction.
 
+use crate::store::CommitChecked;
 use kerf_solver::ErrorCode;
 
 use super::{CANCEL_CHANNEL, Claimant, JobStatus, Work, job_problem, problem_json};
@@ -29,7 +30,7 @@ pub async fn fail(db: &Db, work: Work, claimant: &Claimant, problem: &Problem) -
             .execute(&mut *transaction)
             .await?;
             drop_partial_results_sqlite(&mut transaction, work.id).await?;
-            transaction.commit().await?;
+            transaction.commit_checked().await?;
         }
         Db::Postgres(pool) => {
             let mut transaction = pool.begin().await?;
@@ -49,7 +50,7 @@ pub async fn fail(db: &Db, work: Work, claimant: &Claimant, problem: &Problem) -
             .execute(&mut *transaction)
             .await?;
             drop_partial_results_postgres(&mut transaction, work.id).await?;
-            transaction.commit().await?;
+            transaction.commit_checked().await?;
         }
     }
     Ok(())
@@ -113,7 +114,7 @@ pub async fn cancel(db: &Db, id: i64) -> AppResult<Option<(JobStatus, bool)>> {
                 }
                 $drop(&mut transaction, id).await?;
             }
-            transaction.commit().await?;
+            transaction.commit_checked().await?;
             Ok(Some((status, cancellable)))
         }};
     }

@@ -1,6 +1,7 @@
 //! Finishing work: storing an operation's results or a part's output, if they fit the job's cap
 //! and the store's quota, and marking the work (and with its last chunk the job) done.
 
+use crate::store::CommitChecked;
 use kerf_solver::ErrorCode;
 
 use super::{Claimant, JobStorage, QUOTA_LOCK, Task, Work, bytes, job_problem, mib, set_job_progress, wake_workers};
@@ -159,7 +160,7 @@ async fn finish_sqlite(pool: &sqlx::SqlitePool, results: &Results<'_>, storage: 
         return Ok(Finished::Refused(problem));
     }
     insert_results!(transaction, results, results.added);
-    transaction.commit().await?;
+    transaction.commit_checked().await?;
     Ok(Finished::Stored)
 }
 
@@ -199,7 +200,7 @@ async fn finish_postgres(
     .execute(&mut *transaction)
     .await?;
     set_job_progress(&mut transaction, work.id).await?;
-    transaction.commit().await?;
+    transaction.commit_checked().await?;
     Ok(Finished::Stored)
 }
 
@@ -320,6 +321,6 @@ pub async fn finish_part(
     if left == 0 {
         wake_workers(&mut transaction, work.id).await?;
     }
-    transaction.commit().await?;
+    transaction.commit_checked().await?;
     Ok(Finished::Stored)
 }

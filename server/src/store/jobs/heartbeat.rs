@@ -3,6 +3,7 @@
 use super::{Claimant, Work, set_job_progress};
 use crate::db::Db;
 use crate::error::AppResult;
+use crate::store::CommitChecked;
 
 /// Records progress and the heartbeat of running work (PostgreSQL: of the chunk, extending its
 /// lease; the job's progress is the weighted sum of its chunks', written in the same transaction
@@ -43,7 +44,7 @@ pub async fn heartbeat(db: &Db, work: Work, claimant: &Claimant, progress: f64) 
                 return Ok(false);
             }
             set_job_progress(&mut transaction, work.id).await?;
-            transaction.commit().await?;
+            transaction.commit_checked().await?;
             Ok(true)
         }
     }

@@ -1,5 +1,6 @@
 //! Pruning finished jobs past their retention, and giving the space back (SQLite's vacuum).
 
+use crate::store::CommitChecked;
 use std::time::Duration;
 
 use super::PRUNE_LOCK;
@@ -53,7 +54,7 @@ pub async fn prune(db: &Db, older_than: Duration) -> AppResult<Option<Pruned>> {
             .bind(older_than.as_secs_f64())
             .fetch_all(&mut *transaction)
             .await?;
-            transaction.commit().await?;
+            transaction.commit_checked().await?;
             rows
         }
     };

@@ -1,6 +1,7 @@
 //! Splitting an operation's chunk into parts and a finish step (PostgreSQL), and reading the
 //! parts' outputs back for the finish step.
 
+use crate::store::CommitChecked;
 use kerf_solver::capability::Split;
 
 use super::{Claimant, Work, set_job_progress, wake_workers};
@@ -87,7 +88,7 @@ pub async fn split(db: &Db, work: Work, claimant: &Claimant, split: &Split) -> A
     .await?;
     set_job_progress(&mut transaction, work.id).await?;
     wake_workers(&mut transaction, work.id).await?;
-    transaction.commit().await?;
+    transaction.commit_checked().await?;
     Ok(true)
 }
 

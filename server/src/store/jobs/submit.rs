@@ -1,6 +1,7 @@
 //! Submitting a job: storing it queued (within the quota), or finding a finished one with the
 //! same content to answer instead.
 
+use crate::store::CommitChecked;
 use serde::Serialize;
 
 use super::{QUOTA_LOCK, bytes, mib, usage, wake_workers};
@@ -89,7 +90,7 @@ pub async fn insert(db: &Db, job: &impl Submission, hash: &str, quota: u64) -> A
             .execute(&mut *transaction)
             .await?;
             wake_workers(&mut transaction, id).await?;
-            transaction.commit().await?;
+            transaction.commit_checked().await?;
             Ok(id)
         }
     }

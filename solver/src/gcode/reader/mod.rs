@@ -32,7 +32,7 @@ mod rewrite;
 
 pub use rewrite::{MoveEdit, rewrite, rewrite_cancellable};
 
-use crate::capability::Control;
+use crate::control::Control;
 use crate::error::ErrorCode;
 use crate::error::SolverError;
 use arcs::{ArcGeometry, arc_kind};

@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 
 use super::{Distance, MoveKind, Position, ReadMove, ReadProgram, WordSpan, known};
-use crate::capability::Control;
+use crate::control::Control;
 use crate::error::SolverError;
 
 /// New geometry for one move of a [`ReadProgram`], in mm, absolute.
