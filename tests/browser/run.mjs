@@ -1174,6 +1174,62 @@ const scenarios = {
     }
     return { seen };
   },
+
+  // The engagement form with the machine `vmc-2nm` (2 N·m spindle, 12 000 mm/min, stored by
+  // the test): the form's max feed stays 2000 and is sent; the starred flute count's torque
+  // (the highest phase-mean torque of the API's samples, what the torque chart draws) holds the
+  // machine's 2 N·m, no flute count over it says "yes", and the verdict naming the torque limit
+  // is visible above the charts, not folded away.
+  async engagementMachineLimits() {
+    await page.goto(`${base}/#engagement`);
+    const select = '#engagement-form select[name="machine"]';
+    await page.waitForSelector(`${select} option[value="vmc-2nm"]`, { state: 'attached', timeout: 60000 });
+    await page.selectOption(select, 'vmc-2nm');
+    const maxFeed = await page.inputValue('#engagement-form input[name="max_feed"]');
+    if (maxFeed !== '2000') throw new Error(`choosing the machine changed the max feed to "${maxFeed}"`);
+    const [request] = await Promise.all([
+      page.waitForRequest((r) => r.url().endsWith('/api/v1/engagement') && r.method() === 'POST'),
+      page.click('#engagement-compute'),
+    ]);
+    const sent = request.postDataJSON();
+    if (sent.machine !== 'vmc-2nm' || sent.feed_plan?.max_feed !== 2000) throw new Error(`sent ${JSON.stringify({ machine: sent.machine, feed_plan: sent.feed_plan })}`);
+    await page.waitForSelector('#engagement-result[data-state="drawn"]', { timeout: 60000 });
+    const shown = '#engagement-result .candidate:not([hidden])';
+    const answer = await page.evaluate(async ([url, body]) => {
+      const response = await fetch(url, { method: 'POST', headers: { 'content-type': 'application/json' }, body: JSON.stringify(body) });
+      if (!response.ok) throw new Error(`API ${response.status}: ${await response.text()}`);
+      const json = await response.json();
+      return json.candidates ? json.candidates[0] : json;
+    }, [`${base}/api/v1/engagement`, sent]);
+    const limit = answer.forces?.spindle_torque_nm;
+    if (limit !== 2) throw new Error(`the answer's torque limit is ${limit}`);
+    const highest = answer.flutes.map((f, column) => Math.max(0, ...answer.samples.map((s) => s.torque_nm[column] ?? 0)));
+    const over = answer.flutes.filter((f, column) => highest[column] > limit).map((f) => f.flute_count);
+    if (!over.length) throw new Error(`no flute count needs more than ${limit} N·m: ${highest}`);
+    const rows = await page.$$eval(`${shown} table.flutes tbody tr`, (list) => list.map((r) => ({
+      k: Number(r.children[0].textContent), best: r.classList.contains('best'), verdict: r.lastElementChild.textContent,
+    })));
+    const starred = rows.find((r) => r.best);
+    if (starred) {
+      const column = answer.flutes.findIndex((f) => f.flute_count === starred.k);
+      if (highest[column] > limit) throw new Error(`★ ${starred.k} flutes at ${highest[column].toFixed(2)} N·m over the machine's ${limit} N·m`);
+    }
+    for (const row of rows) {
+      if (over.includes(row.k) && row.verdict.startsWith('yes')) throw new Error(`${row.k} flutes over the torque says "${row.verdict}"`);
+      if (over.includes(row.k) && !row.verdict.includes('spindle torque')) throw new Error(`${row.k} flutes: "${row.verdict}" does not name the torque`);
+    }
+    const verdict = `${shown} .recommendation .over-limits`;
+    const visible = await page.isVisible(verdict);
+    const text = visible ? await page.textContent(verdict) : '';
+    if (!visible || !/spindle torque [\d.]+ N·m > 2 N·m/.test(text)) throw new Error(`verdict not visible or without the torque: "${text}"`);
+    const folded = await page.$eval(verdict, (e) => Boolean(e.closest('details')));
+    if (folded) throw new Error('the verdict is folded away');
+    const program = await page.textContent(`${shown} .recommendation .program-flutes`);
+    const planned = answer.program_flute_count;
+    if (starred && planned !== starred.k) throw new Error(`the program is for ${planned} flutes, ★ is ${starred.k}`);
+    if (!program.includes(`for ${planned} flutes`)) throw new Error(`the verdict does not say which flute count the program is for: "${program}"`);
+    return { starred: starred?.k ?? null, over, program: planned, verdict: text };
+  },
 };
 
 try {

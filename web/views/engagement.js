@@ -9,7 +9,7 @@
 import { api } from '/api.js';
 import { PathChart, barChart } from '/plot/charts.js';
 import { ToolPlan } from '/plot/tool-plan.js';
-import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, machineFields, message, number, numeric, programName, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
+import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, message, number, numeric, programName, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
   { name: 'straight', text: '-10 20\n70 20' },
@@ -461,6 +461,47 @@ function fluteCharts(column, result, answer) {
 // ---------------------------------------------------------------------------------------------
 // Result renderer (form and Jobs view)
 
+// What a limit a flute count misses is called, and "spindle torque 14.7 N·m > 10 N·m (+47 %)".
+const LIMIT_NAMES = {
+  thickness: ['chip thickness', 'mm'], time: ['time', 's'], spindle_torque: ['spindle torque', 'N·m'],
+  spindle_power: ['spindle power', 'kW'], spindle_speed: ['spindle speed', 'rpm'], machine_feed: ['feed', 'mm/min'],
+};
+const MACHINE_LIMITS = ['spindle_torque', 'spindle_power', 'spindle_speed', 'machine_feed'];
+
+function overText(over) {
+  const [name, unit] = LIMIT_NAMES[over.limit] || [over.limit, ''];
+  const digits = Math.abs(over.value) >= 100 ? 0 : Math.abs(over.value) >= 1 ? 2 : 4;
+  return `${name} ${number(over.value, digits)} ${unit} > ${over.allowed} ${unit} (+${number(100 * (over.value / over.allowed - 1), 0)} %)`;
+}
+
+// The verdict above the charts: the recommended flute counts, each flute count the machine's
+// limits rule out with the limit and by how much, and the flute count the feed plan and the
+// program are for.
+function verdictMessage(result) {
+  const rec = result.recommended;
+  const lines = [rec.length
+    ? `Recommended flute counts: ${rec.join(', ')} (fastest first; ★ = ${rec[0]})`
+    : 'No flute count meets the limits'];
+  const ruledOut = result.flutes.filter((f) => (f.over_limits || []).some((o) => MACHINE_LIMITS.includes(o.limit)));
+  for (const f of ruledOut) {
+    const over = f.over_limits.filter((o) => MACHINE_LIMITS.includes(o.limit));
+    lines.push(`${f.flute_count} flutes over the machine's limits: ${over.map(overText).join(', ')}`);
+  }
+  if (result.program_flute_count !== undefined) {
+    const own = result.program_flute_count === result.time_flute_count ? " (the tool's)" : ` (the tool has ${result.time_flute_count}: use a ${result.program_flute_count}-flute cutter)`;
+    lines.push(`Feed plan and G-code for ${result.program_flute_count} flutes${own}`);
+  }
+  const box = message(rec.length ? 'ok' : 'warning', lines[0]);
+  box.classList.add('recommendation');
+  for (const line of lines.slice(1)) {
+    const p = document.createElement('p');
+    p.className = line.includes("machine's limits") ? 'over-limits' : 'program-flutes';
+    p.textContent = line;
+    box.append(p);
+  }
+  return box;
+}
+
 function fluteTable(result) {
   const table = document.createElement('table');
   table.className = 'flutes';
@@ -478,7 +519,8 @@ function fluteTable(result) {
       `${number(f.mean_power_kw, 3)} / ${number(f.peak_power_kw, 3)}`, number(f.tooth_passing_hz, 1)] : [];
     for (const text of [f.flute_count, number(f.feed_per_tooth, 4), number(f.feed, 0), number(f.max_thickness, 5),
       number(f.mean_thickness, 5), number(f.min_thickness, 5), number(f.median_thickness, 5), number(f.time_s, 2),
-      f.max_teeth, ...loads, f.recommended ? (f.flute_count === result.recommended[0] ? '★ yes (fastest)' : 'yes') : 'no']) {
+      f.max_teeth, ...loads, f.recommended ? (f.flute_count === result.recommended[0] ? '★ yes (fastest)' : 'yes')
+        : `no${f.over_limits?.length ? `: ${f.over_limits.map(overText).join(', ')}` : ''}`]) {
       const td = document.createElement('td');
       td.textContent = String(text);
       tr.append(td);
@@ -504,11 +546,7 @@ function renderColumn(column, result, answer, axis) {
   column.replaceChildren();
   const heading = document.createElement('h3');
   heading.textContent = result.name || 'path';
-  const rec = result.recommended;
-  const verdict = message(rec.length ? 'ok' : 'warning', rec.length
-    ? `Recommended flute counts: ${rec.join(', ')} (fastest first; ★ = ${rec[0]})`
-    : 'No flute count meets the limits');
-  verdict.classList.add('recommendation');
+  const verdict = verdictMessage(result);
   const summary = document.createElement('div');
   summary.className = 'summary';
   const items = [
@@ -665,7 +703,8 @@ export const engagementView = {
     form.addEventListener('change', () => syncVisibility(form));
     loadTools(form.elements.tool_choice, 'inline flat end mill (size below)', () => true, (tool) => `${toolLabel(tool)} z${tool.flutes}`).then(() => syncVisibility(form));
     loadMachines(form.elements.machine);
-    machineFields(form, { max_feed: 'max_feed' });
+    // The max feed stays what the form says: a machine caps it (the answer says so), it never
+    // replaces it; left empty, the machine's is used.
     loadMaterials(form.elements.material, 'the values below');
     // A stored material replaces the typed values: the fields show its values, greyed, and get
     // the typed ones back when "the values below" is chosen again.

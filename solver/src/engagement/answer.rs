@@ -161,6 +161,13 @@ pub struct FluteResult {
     /// T2 minus the time, s (negative: too slow).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_margin_s: Option<f64>,
+    /// Every limit this flute count misses, with its value and the limit: the chip thickness
+    /// (T1, the representative statistic) and time (T2) limits, and the machine's spindle torque
+    /// and power (the highest phase-mean value over the engaged samples, as the torque chart
+    /// draws them; with `kienzle` or `material`), spindle speed and max feed. A flute count that
+    /// misses any is not recommended.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub over_limits: Vec<OverLimit>,
     /// Most teeth in the cut at once anywhere on the path.
     pub max_teeth: u32,
     /// Path intervals `[[s_from, s_to], ...]` (sample positions) where two or more teeth cut at
@@ -188,6 +195,87 @@ pub struct FluteResult {
     pub tooth_passing_hz: Option<f64>,
 }
 
+/// A limit a flute count is judged against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum FluteLimit {
+    /// T1, `thickness_limit`, mm.
+    Thickness,
+    /// T2, `time_limit_s`, s.
+    Time,
+    /// The machine's `spindle_torque_nm`, N·m.
+    SpindleTorque,
+    /// The machine's spindle power at the spindle speed (`spindle_power_kw`, its power curve),
+    /// kW.
+    SpindlePower,
+    /// The machine's `max_spindle_rpm`, rpm.
+    SpindleSpeed,
+    /// The machine's `max_feed`, mm/min.
+    MachineFeed,
+}
+
+impl FluteLimit {
+    /// What the limit is, in words.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Thickness => "chip thickness",
+            Self::Time => "time",
+            Self::SpindleTorque => "spindle torque",
+            Self::SpindlePower => "spindle power",
+            Self::SpindleSpeed => "spindle speed",
+            Self::MachineFeed => "feed",
+        }
+    }
+
+    /// Its unit.
+    #[must_use]
+    pub fn unit(self) -> &'static str {
+        match self {
+            Self::Thickness => "mm",
+            Self::Time => "s",
+            Self::SpindleTorque => "N·m",
+            Self::SpindlePower => "kW",
+            Self::SpindleSpeed => "rpm",
+            Self::MachineFeed => "mm/min",
+        }
+    }
+}
+
+/// A limit a flute count misses, and by how much.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct OverLimit {
+    /// Which limit.
+    pub limit: FluteLimit,
+    /// The flute count's value, in the limit's unit.
+    pub value: f64,
+    /// The limit, in the same unit.
+    pub allowed: f64,
+}
+
+impl OverLimit {
+    /// "spindle torque 14.7 N·m > 10 N·m (+47 %)".
+    #[must_use]
+    pub fn describe(&self) -> String {
+        let unit = self.limit.unit();
+        format!(
+            "{} {} {unit} > {} {unit} (+{:.0} %)",
+            self.limit.name(),
+            significant(self.value),
+            self.allowed,
+            100.0 * (self.value / self.allowed - 1.0)
+        )
+    }
+}
+
+/// A value with four significant digits, for messages.
+fn significant(value: f64) -> String {
+    let digits = (3 - value.abs().max(1e-12).log10().floor() as i32).clamp(0, 9) as usize;
+    format!("{value:.digits$}")
+}
+
 /// Why a feed block has its feed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
@@ -201,6 +289,8 @@ pub enum FeedLimit {
     Power,
     /// The spindle's rated torque.
     Torque,
+    /// No contact: the tool moves through the air at the nominal feed of the plan's flute count.
+    Air,
 }
 
 /// A stretch of the path programmed with one feed.
@@ -310,6 +400,10 @@ pub struct PathEngagement {
     pub feed_length: f64,
     /// The flute count `t` and `mrr` are computed for (the tool's `flutes`).
     pub time_flute_count: u32,
+    /// The flute count the feed plan and the G-code program are for: `feed_plan.flute_count`
+    /// when given, else the first of `recommended`, else the tool's `flutes`
+    /// (`W_PROGRAM_FLUTE_COUNT` when it is not the tool's).
+    pub program_flute_count: u32,
     /// Engine used.
     pub engine: Engine,
     /// Δs used, mm.

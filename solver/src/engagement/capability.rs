@@ -157,7 +157,7 @@ impl Capability for EngagementCapability {
             let mut result = run.control.part(index, candidates.len(), |part| {
                 super::evaluate::evaluate(&job, candidate, &context.tool, part)
             })?;
-            if let Some((blocks, warnings)) = super::program::blocks(&result)? {
+            if let Some((blocks, warnings)) = super::program::blocks(&result, run.control)? {
                 result.blocks = Some(blocks);
                 result.warnings.extend(warnings);
             }

@@ -119,7 +119,7 @@ pub(crate) fn evaluate(
     let nominal_feed = job.feed_mode.feed(time_flutes, job.spindle_rpm);
     let mut warnings = job.shared_warnings.clone();
     warnings.extend(candidate.warnings.iter().cloned());
-    let sampled = sample_all(job, candidate, &stations, &contacts, nominal_feed);
+    let sampled = sample_all(job, candidate, &stations, &contacts, nominal_feed, control)?;
     let Sampled { samples, series, statistic, .. } = &sampled;
 
     let engaged_intervals = series.runs(|i| series.arc_count[i] > 0 && !series.marked(i, series::RAPID));
@@ -127,11 +127,18 @@ pub(crate) fn evaluate(
     diagnostics::vertices(&mut warnings, route);
     diagnostics::dots(&mut warnings, job);
     diagnostics::force_model(&mut warnings, job, candidate, tool);
-    let (flute_results, recommended, flute_warnings) =
-        flutes::results(job, candidate.force.as_ref(), samples, series, statistic, route.feed_length);
+    let flutes::Judged { results: flute_results, recommended, warnings: flute_warnings } =
+        flutes::results(job, candidate.force.as_ref(), samples, series, statistic, route.feed_length, control)?;
     warnings.extend(flute_warnings);
-    let feed_plan =
-        job.plan.as_ref().map(|plan| feed::plan(job, candidate.force.as_ref(), plan, route, &stations, &contacts));
+    let program_flutes = program_flute_count(job, &recommended, &mut warnings);
+    let feed_plan = job
+        .plan
+        .as_ref()
+        .map(|plan| {
+            feed::plan(job, candidate.force.as_ref(), plan, program_flutes, route, &stations, &contacts, control)
+        })
+        .transpose()?;
+    let program_feed = program_feed(job, program_flutes, &mut warnings);
 
     let (max_engaged_deg, max_engaged_at_s) = (series.engaged_deg.iter().zip(&series.s))
         .zip(statistic)
@@ -150,6 +157,7 @@ pub(crate) fn evaluate(
         path_length: route.length,
         feed_length: route.feed_length,
         time_flute_count: time_flutes,
+        program_flute_count: program_flutes,
         engine: job.engine,
         step: job.step,
         grid,
@@ -172,8 +180,52 @@ pub(crate) fn evaluate(
         feed_plan,
         blocks: None,
         warnings,
-        post: post_data(job, candidate, tool, nominal_feed),
+        post: post_data(job, candidate, tool, program_flutes, program_feed),
     })
+}
+
+/// The flute count the feed plan and the program are for: `feed_plan.flute_count` when given,
+/// else the fastest recommended count, else the tool's; `W_PROGRAM_FLUTE_COUNT` when it is not
+/// the tool's, so nobody runs a program for four flutes with a two-flute cutter unawares.
+fn program_flute_count(job: &Job, recommended: &[u32], warnings: &mut Vec<Warning>) -> u32 {
+    let chosen = job.plan.as_ref().and_then(|plan| plan.flute_count);
+    let (count, why) = match (chosen, recommended.first()) {
+        (Some(count), _) => (count, "feed_plan.flute_count"),
+        (None, Some(&count)) => (count, "the fastest recommended flute count"),
+        (None, None) => (job.tool_flutes, "the tool's"),
+    };
+    if count != job.tool_flutes {
+        warnings.push(Warning::new(
+            "W_PROGRAM_FLUTE_COUNT",
+            format!(
+                "the feed plan and the program are for {count} flutes ({why}); the tool has {}: run them with a \
+                 {count}-flute cutter, or set feed_plan.flute_count to {}",
+                job.tool_flutes, job.tool_flutes
+            ),
+        ));
+    }
+    count
+}
+
+/// The program's feed where no feed plan sets one: the nominal feed of `flutes` teeth, capped by
+/// the feed plan's and the machine's max feed (`W_FEED_CAPPED` when it is lowered).
+fn program_feed(job: &Job, flutes: u32, warnings: &mut Vec<Warning>) -> f64 {
+    let nominal = job.feed_mode.feed(flutes, job.spindle_rpm);
+    let caps = [
+        job.plan.as_ref().map(|plan| (plan.max_feed, "feed_plan.max_feed")),
+        job.machine_feed.map(|feed| (feed, "the machine's max_feed")),
+    ];
+    let Some((cap, by)) = caps.into_iter().flatten().min_by(|a, b| a.0.total_cmp(&b.0)) else { return nominal };
+    if nominal <= cap {
+        return nominal;
+    }
+    warnings.push(Warning::new(
+        "W_FEED_CAPPED",
+        format!(
+            "the nominal feed of {flutes} flutes, {nominal:.0} mm/min, is above {by}: the program runs at {cap} mm/min"
+        ),
+    ));
+    cap
 }
 
 /// Every sample of the path from the engine's contacts: arcs, a_e, Φ, flags, the tooth sums of
@@ -184,7 +236,8 @@ fn sample_all(
     stations: &[Station],
     contacts: &[Contact],
     nominal_feed: f64,
-) -> Sampled {
+    control: Control<'_>,
+) -> Result<Sampled, SolverError> {
     let route = &candidate.route;
     let radius = job.radius;
     let nominal_fz = job.feed_mode.feed_per_tooth(job.tool_flutes, job.spindle_rpm);
@@ -197,6 +250,8 @@ fn sample_all(
     // The last tangent's bits and heading: along a line every sample has the same tangent.
     let mut last_heading: Option<([u64; 2], f64)> = None;
     for (index, (station, contact)) in stations.iter().zip(contacts).enumerate() {
+        // With forces a sample costs up to milliseconds (every flute count's phase maximum).
+        control.check()?;
         let rapid = route.pieces.get(station.piece).is_some_and(|p| p.rapid);
         let arcs: &[Arc] = &contact.arcs;
         let values = arc_values.of(arcs, job, radius);
@@ -250,7 +305,7 @@ fn sample_all(
         }
     }
     let Marks { plunges, back, collisions } = marks;
-    Sampled { samples, series, statistic, plunges, back, collisions }
+    Ok(Sampled { samples, series, statistic, plunges, back, collisions })
 }
 
 /// Where the flags that the diagnostics list by position were raised.
@@ -358,7 +413,7 @@ fn contact_dots(
 
 /// What the G-code program of the path needs besides the samples (docs/spec/engagement.md §3.2,
 /// §11 item 12): the route, feeds, heights and the program's description lines.
-fn post_data(job: &Job, candidate: &CandidateJob, tool: &Tool, nominal_feed: f64) -> PostData {
+fn post_data(job: &Job, candidate: &CandidateJob, tool: &Tool, flutes: u32, nominal_feed: f64) -> PostData {
     let route = &candidate.route;
     let centre_height = match tool.kind {
         ToolKind::Ball => tool.radius,
@@ -374,6 +429,7 @@ fn post_data(job: &Job, candidate: &CandidateJob, tool: &Tool, nominal_feed: f64
         ),
         stock_description(&job.region),
         format!("tool R {} mm, {} flutes, S {} rpm", tool.radius, tool.flutes, job.spindle_rpm),
+        format!("feeds for {flutes} flutes, nominal F {nominal_feed:.0}"),
     ];
     PostData {
         route: RouteData(route.clone()),

@@ -1,13 +1,16 @@
 //! Per flute count: representative values of H_k (docs/spec/engagement.md §5.7), machining time (§5.8),
-//! multi-tooth intervals, and the recommendation under the two limits (§5.9).
+//! multi-tooth intervals, and the recommendation under the two limits (§5.9) and the machine's:
+//! a flute count whose spindle torque or power (the phase-mean values the torque chart draws),
+//! spindle speed or feed exceeds the machine's is never recommended.
 
-use super::answer::{EngagementSample, FluteResult};
+use super::answer::{EngagementSample, FluteLimit, FluteResult, OverLimit};
 use super::force::{ForceModel, power_kw};
 use super::job::{FeedMode, Job};
 use super::limits::{RESONANCE_BAND, resonance, tooth_passing_hz};
 use super::request::Representative;
 use super::series::Series;
-use crate::error::Warning;
+use crate::capability::Control;
+use crate::error::{SolverError, Warning};
 
 /// Relative slack of the limit comparisons, so a value equal to its limit passes.
 const LIMIT_SLACK: f64 = 1e-9;
@@ -36,6 +39,9 @@ fn statistics(values: &[f64], weights: &[f64]) -> (f64, f64, f64, f64) {
 
 /// The flute results, the recommended counts (fastest first) and the warnings of §9
 /// (`W_MULTI_TOOTH`, `W_TINY_FZ`, `W_NO_RECOMMENDATION`, `W_THRESHOLD_MISSING`).
+///
+/// # Errors
+/// `E_CANCELLED` once `control`'s cancel flag is set (checked per flute count).
 pub(crate) fn results(
     job: &Job,
     force: Option<&ForceModel>,
@@ -43,7 +49,8 @@ pub(crate) fn results(
     series: &Series,
     statistic: &[bool],
     feed_length: f64,
-) -> (Vec<FluteResult>, Vec<u32>, Vec<Warning>) {
+    control: Control<'_>,
+) -> Result<Judged, SolverError> {
     let mut warnings = Vec::new();
     let positions = &series.s;
     let weights: Vec<f64> = positions
@@ -55,6 +62,7 @@ pub(crate) fn results(
     let mut results = Vec::with_capacity(job.flute_counts.len());
     let mut failures = Vec::new();
     for (column, &k) in job.flute_counts.iter().enumerate() {
+        control.check()?;
         let (thickness, teeth) = (&series.thickness[column], &series.teeth[column]);
         let values: Vec<f64> = thickness.iter().zip(statistic).filter(|(_, s)| **s).map(|(&h, _)| h).collect();
         let (max, min, mean, median) = statistics(&values, &weights);
@@ -66,7 +74,8 @@ pub(crate) fn results(
             Representative::Mean => mean,
             Representative::Median => median,
         };
-        let verdict = verdict(job, k, representative, time_s);
+        let loads = highest_loads(force, samples, statistic, column);
+        let verdict = verdict(job, k, Measured { representative, time_s, feed, loads });
         failures.extend(verdict.failure);
         let multi_tooth_intervals =
             series.runs(|i| statistic.get(i).copied().unwrap_or(false) && teeth.get(i).is_some_and(|n| *n >= 2));
@@ -104,6 +113,7 @@ pub(crate) fn results(
             recommended: verdict.recommended,
             thickness_margin: verdict.thickness_margin,
             time_margin_s: verdict.time_margin_s,
+            over_limits: verdict.over_limits,
             max_teeth,
             multi_tooth_intervals,
             mean_torque_nm: forces.map(|f| f.0),
@@ -115,34 +125,80 @@ pub(crate) fn results(
         });
     }
     let recommended = recommendation(job, &results, &failures, &mut warnings);
-    (results, recommended, warnings)
+    Ok(Judged { results, recommended, warnings })
+}
+
+/// Every flute count's result, the recommended counts (fastest first) and the warnings.
+pub(crate) struct Judged {
+    pub results: Vec<FluteResult>,
+    pub recommended: Vec<u32>,
+    pub warnings: Vec<Warning>,
+}
+
+/// What one flute count is judged by.
+struct Measured {
+    /// The representative summed chip thickness, mm.
+    representative: f64,
+    time_s: f64,
+    /// V_f, mm/min.
+    feed: f64,
+    /// With a force model: the highest phase-mean torque (N·m) and power (kW) of an engaged
+    /// sample.
+    loads: Option<(f64, f64)>,
 }
 
 /// Whether flute count `k` meets the limits (§5.9) with its representative thickness and its
-/// time: the margins, the verdict, and why it fails.
+/// time, and the machine's: the margins, the verdict, every limit missed, and why it fails.
 struct Verdict {
     thickness_margin: Option<f64>,
     time_margin_s: Option<f64>,
     recommended: bool,
-    /// "k = …: thickness … > …, time … > …" when a limit is missed.
+    over_limits: Vec<OverLimit>,
+    /// "k = …: thickness … > …, spindle torque … > …" when a limit is missed.
     failure: Option<String>,
 }
 
-fn verdict(job: &Job, k: u32, representative: f64, time_s: f64) -> Verdict {
+fn verdict(job: &Job, k: u32, measured: Measured) -> Verdict {
+    let Measured { representative, time_s, feed, loads } = measured;
     let thickness_margin = job.thickness_limit.map(|limit| limit - representative);
     let time_margin_s = job.time_limit.map(|limit| limit - time_s);
-    let thickness_ok = job.thickness_limit.is_none_or(|limit| representative <= limit * (1.0 + LIMIT_SLACK));
-    let time_ok = job.time_limit.is_none_or(|limit| time_s <= limit * (1.0 + LIMIT_SLACK));
-    let recommended = (job.thickness_limit.is_some() || job.time_limit.is_some()) && thickness_ok && time_ok;
-    let mut reasons = Vec::new();
-    if let (false, Some(limit)) = (thickness_ok, job.thickness_limit) {
-        reasons.push(format!("thickness {representative:.6} mm > {limit} mm"));
-    }
-    if let (false, Some(limit)) = (time_ok, job.time_limit) {
-        reasons.push(format!("time {time_s:.4} s > {limit} s"));
-    }
-    let failure = (!reasons.is_empty()).then(|| format!("k = {k}: {}", reasons.join(", ")));
-    Verdict { thickness_margin, time_margin_s, recommended, failure }
+    let checks = [
+        (FluteLimit::Thickness, Some(representative), job.thickness_limit),
+        (FluteLimit::Time, Some(time_s), job.time_limit),
+        (FluteLimit::SpindleTorque, loads.map(|l| l.0), job.spindle.spindle_torque_nm),
+        (FluteLimit::SpindlePower, loads.map(|l| l.1), job.spindle.spindle_power_kw),
+        (FluteLimit::SpindleSpeed, Some(job.spindle_rpm), job.machine_speed),
+        (FluteLimit::MachineFeed, Some(feed), job.machine_feed),
+    ];
+    let over_limits: Vec<OverLimit> = checks
+        .into_iter()
+        .filter_map(|(limit, value, allowed)| {
+            let (value, allowed) = (value?, allowed?);
+            (value > allowed * (1.0 + LIMIT_SLACK)).then_some(OverLimit { limit, value, allowed })
+        })
+        .collect();
+    let recommended = (job.thickness_limit.is_some() || job.time_limit.is_some()) && over_limits.is_empty();
+    let failure = (!over_limits.is_empty())
+        .then(|| format!("k = {k}: {}", over_limits.iter().map(OverLimit::describe).collect::<Vec<_>>().join(", ")));
+    Verdict { thickness_margin, time_margin_s, recommended, over_limits, failure }
+}
+
+/// The highest phase-mean torque and power over the engaged samples of one flute column, as the
+/// torque chart draws them and `W_SPINDLE_TORQUE` reports them (with a force model).
+fn highest_loads(
+    force: Option<&ForceModel>,
+    samples: &[EngagementSample],
+    statistic: &[bool],
+    column: usize,
+) -> Option<(f64, f64)> {
+    force?;
+    let engaged = samples.iter().zip(statistic).filter(|(_, s)| **s).map(|(sample, _)| sample);
+    Some(engaged.fold((0.0, 0.0), |(torque, power), sample| {
+        (
+            torque.max(sample.torque_nm.get(column).copied().unwrap_or(0.0)),
+            power.max(sample.power_kw.get(column).copied().unwrap_or(0.0)),
+        )
+    }))
 }
 
 /// The tooth-passing frequency of `k` flutes, with the force model only (so that answers

@@ -85,8 +85,8 @@ mod wire;
 
 pub use crate::geometry::Direction;
 pub use answer::{
-    ArcDetail, Comparison, EngagementSample, EngagementSolution, FeedBlock, FeedLimit, FeedPlan, FluteResult,
-    ForceInfo, GridInfo, PathEngagement, SampleFlag,
+    ArcDetail, Comparison, EngagementSample, EngagementSolution, FeedBlock, FeedLimit, FeedPlan, FluteLimit,
+    FluteResult, ForceInfo, GridInfo, OverLimit, PathEngagement, SampleFlag,
 };
 pub use arcs::{MillingMode, SpindleDirection};
 pub use capability::{EngagementAnswer, EngagementCapability};
@@ -144,8 +144,8 @@ pub fn solve(request: &EngagementRequest, tool: &Tool) -> Result<EngagementSolut
 }
 
 /// [`solve`] for a request that names a machine: `machine` is the profile its `machine` names
-/// (its `max_feed` fills an absent `feed_plan.max_feed`; `W_FEED_ABOVE_MACHINE_MAX` when the
-/// request's is larger).
+/// (its `max_feed` fills an absent `feed_plan.max_feed` and lowers a larger one, with
+/// `W_FEED_ABOVE_MACHINE_MAX`; no flute count over its max feed or spindle speed is recommended).
 ///
 /// # Errors
 /// As [`solve`]. `machine` is the profile the request's `machine` names, resolved by the caller
@@ -179,7 +179,7 @@ pub fn solve_in(
     for (index, candidate) in job.candidates.iter().enumerate() {
         let mut result =
             control.part(index, job.candidates.len(), |part| evaluate::evaluate(&job, candidate, tool, part))?;
-        if let Some((blocks, warnings)) = program::blocks(&result)? {
+        if let Some((blocks, warnings)) = program::blocks(&result, control)? {
             result.blocks = Some(blocks);
             result.warnings.extend(warnings);
         }

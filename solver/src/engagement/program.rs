@@ -6,6 +6,7 @@
 
 use super::answer::{EngagementSolution, PathEngagement};
 use super::segments::{Route, Shape};
+use crate::capability::Control;
 use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};
 use crate::gcode::Arcs;
@@ -72,7 +73,7 @@ pub fn program(answer: &EngagementSolution, candidate: usize, post: &Post) -> Re
         Reference::Tip => 0.0,
         Reference::Centre => data.centre_height,
     };
-    let Cut { path, cut_z, safe_z, .. } = cut(result, lift, post.arcs)?;
+    let Cut { path, cut_z, safe_z, .. } = cut(result, lift, post.arcs, Control::default())?;
     let mut comments = data.description.clone();
     comments.push(format!("cut Z {:.4}, clearance Z {:.4}, control point {}", cut_z, safe_z, post.reference.as_str()));
     if let Some(plan) = &result.feed_plan {
@@ -117,7 +118,7 @@ pub(crate) fn cycle_time(
 ) -> Option<crate::machine::cycle::CycleTime> {
     let candidates = answer.candidates();
     let result = candidates.get(candidate)?;
-    let Cut { mut path, safe_z, .. } = cut(result, 0.0, Arcs::Chords).ok()?;
+    let Cut { mut path, safe_z, .. } = cut(result, 0.0, Arcs::Chords, Control::default()).ok()?;
     // The post's retract to the clearance plane after the spindle stops.
     let last = path.moves.last()?.to;
     path.rapid(Vec3::new(last.x, last.y, safe_z));
@@ -142,7 +143,7 @@ struct Cut {
 /// [`CHORD_TOLERANCE`], or with a block time at the block-time rule's chord error for the arc's
 /// radius and feed (chords of one block), never coarser than that; with [`Arcs::G2g3`] each arc
 /// portion is one circular move to the chords' last point.
-fn cut(result: &PathEngagement, lift: f64, arcs: Arcs) -> Result<Cut, SolverError> {
+fn cut(result: &PathEngagement, lift: f64, arcs: Arcs, control: Control<'_>) -> Result<Cut, SolverError> {
     let data = &result.post;
     let depth = data.axial_depth.ok_or_else(|| {
         SolverError::input(
@@ -167,6 +168,7 @@ fn cut(result: &PathEngagement, lift: f64, arcs: Arcs) -> Result<Cut, SolverErro
     let mut overridden_arcs = 0;
     let mut chords = 0.0;
     for run in runs(result) {
+        control.check()?;
         let Some(piece) = route.pieces.get(run.piece) else {
             continue;
         };
@@ -248,12 +250,16 @@ fn cut(result: &PathEngagement, lift: f64, arcs: Arcs) -> Result<Cut, SolverErro
 /// short straight moves, E9).
 ///
 /// # Errors
-/// As the program: `E_TOO_LARGE` for a program over the move limit.
-pub(crate) fn blocks(result: &PathEngagement) -> Result<Option<(PathBlocks, Vec<Warning>)>, SolverError> {
+/// As the program: `E_TOO_LARGE` for a program over the move limit; `E_CANCELLED` once
+/// `control`'s cancel flag is set.
+pub(crate) fn blocks(
+    result: &PathEngagement,
+    control: Control<'_>,
+) -> Result<Option<(PathBlocks, Vec<Warning>)>, SolverError> {
     let (Some(rule), Some(_)) = (&result.post.rule, result.post.axial_depth) else {
         return Ok(None);
     };
-    let cut = cut(result, 0.0, Arcs::Chords)?;
+    let cut = cut(result, 0.0, Arcs::Chords, control)?;
     let moves = cut.path.moves.iter().map(|step| (step.to, step.motion.feed()));
     let figures = path_blocks(moves, rule.block_time_ms, rule.feed, cut.finest_arc_tolerance)?;
     let mut warnings = Vec::new();

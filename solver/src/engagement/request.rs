@@ -238,10 +238,12 @@ pub struct FeedPlanRequest {
     /// h*: the chip thickness to hold, mm (per tooth, or summed with `basis: sum`).
     pub target_thickness: f64,
     /// Highest programmable feed, mm/min. Required unless the request names a `machine`, whose
-    /// `max_feed` the server puts here.
+    /// `max_feed` the server puts here; a larger one is lowered to the machine's
+    /// (`W_FEED_ABOVE_MACHINE_MAX`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_feed: Option<f64>,
-    /// Flute count of the cutter that runs the program (default: the tool's `flutes`).
+    /// Flute count of the cutter that runs the program (default: the fastest recommended flute
+    /// count, else the tool's `flutes`; the answer's `program_flute_count`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub flute_count: Option<u32>,
     /// `tooth` (default) or `sum`.
@@ -373,9 +375,10 @@ pub struct EngagementRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub block_time_ms: Option<f64>,
     /// A stored machine profile, resolved by the server: its `max_feed` fills an absent
-    /// `feed_plan.max_feed` (a larger one is kept with `W_FEED_ABOVE_MACHINE_MAX`), its dialect
-    /// is the G-code default, its spindle power and torque are the limits the cut is checked
-    /// against (with `kienzle` or `material`).
+    /// `feed_plan.max_feed` and caps a larger one (`W_FEED_ABOVE_MACHINE_MAX`) and the program's
+    /// nominal feed (`W_FEED_CAPPED`), its dialect is the G-code default; no flute count over its
+    /// `max_feed`, `max_spindle_rpm` or (with `kienzle` or `material`) spindle power and torque
+    /// is recommended.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub machine: Option<String>,
     /// Which entry of `paths` the G-code program follows (0-based, default 0; a request with

@@ -68,6 +68,10 @@ pub struct MachineProfile {
     /// Rated spindle torque, N·m (> 0), used like `spindle_power_kw`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spindle_torque_nm: Option<f64>,
+    /// Highest spindle speed, rpm (> 0): engagement recommends no flute count at a faster
+    /// spindle speed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_spindle_rpm: Option<f64>,
     /// The spindle's power curve (S1, continuous duty): `[[rpm, kW], ...]`, 2–64 points, speeds
     /// rising from 0 or more, powers above 0. The power available at a request's spindle speed
     /// is interpolated linearly between the points and held beyond the ends; with
@@ -156,6 +160,9 @@ impl MachineProfile {
                     "margin must be at least 1 (got {margin}): below 1 blocks get shorter than the control can process"
                 ),
             ));
+        }
+        if let Some(speed) = self.max_spindle_rpm {
+            positive("max_spindle_rpm", speed)?;
         }
         if let Some(plunge_feed) = self.plunge_feed {
             positive("plunge_feed", plunge_feed)?;

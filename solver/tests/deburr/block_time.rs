@@ -192,6 +192,7 @@ fn machine_values_and_bad_block_times() {
         mode: None,
         spindle_power_kw: None,
         spindle_torque_nm: None,
+        max_spindle_rpm: None,
         spindle_power_curve: None,
     };
     let tool = ball(3.0);

@@ -299,10 +299,11 @@ fn program_carries_the_planned_feeds() {
         .collect();
     let planned: std::collections::BTreeSet<u64> = plan.blocks.iter().map(|b| b.feed.unwrap() as u64).collect();
     assert!(feeds.len() >= 2, "{feeds:?}");
-    // The descent into the cut runs at half the nominal feed (2 flutes × 0.05 × 4000 = 400) at
-    // most: the plunge without a plunge feed.
+    // The descent into the cut runs at half the nominal feed of the plan's 3 flutes
+    // (3 × 0.05 × 4000 = 600) at most: the plunge without a plunge feed.
+    assert_eq!(result.program_flute_count, 3);
     for feed in &feeds {
-        assert!(planned.contains(&(*feed as u64)) || *feed == 200.0, "F{feed} not in the plan {planned:?}");
+        assert!(planned.contains(&(*feed as u64)) || *feed == 300.0, "F{feed} not in the plan {planned:?}");
     }
     // The arc's chord points lie on the arc, within the chord tolerance.
     let mut on_arc = 0;

@@ -268,6 +268,7 @@ fn machine_values_are_defaults_the_request_overrides() {
         mode: None,
         spindle_power_kw: None,
         spindle_torque_nm: None,
+        max_spindle_rpm: None,
         spindle_power_curve: None,
     };
     let request = parse(json!({"curve": circle(), "machine": "hsc"}));

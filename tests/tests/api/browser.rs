@@ -334,3 +334,15 @@ async fn saving_an_existing_machine_or_material_asks_first_and_keeps_it() {
     let Some(result) = run_scenario(&app, "registryOverwrite", &[]) else { return };
     assert_eq!(result["ok"], true);
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn engagement_page_stars_no_flute_count_over_the_machines_torque() {
+    let app = TestApp::spawn().await;
+    // The form's example needs 2.6 N·m with 4 flutes, 5.3 N·m with 8.
+    let machine = serde_json::json!({"block_time_ms": 4, "max_feed": 12000, "spindle_torque_nm": 2});
+    let response = app.put_json("/api/v1/machines/vmc-2nm", &machine).await;
+    assert_eq!(response.status(), 201);
+    let Some(result) = run_scenario(&app, "engagementMachineLimits", &[]) else { return };
+    assert_eq!(result["ok"], true, "{result}");
+    assert!(!result["over"].as_array().unwrap().is_empty(), "{result}");
+}

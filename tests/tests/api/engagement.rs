@@ -419,10 +419,14 @@ async fn a_named_machine_caps_the_feed_plan_and_sets_the_dialect() {
     let program = app.post_text(&format!("{URL}?format=gcode"), &body, 200).await;
     assert!(!program.starts_with('%') && program.contains("G64"), "linuxcnc from the machine:\n{program}");
 
+    // The machine caps a larger max feed, and says so; it never raises a smaller one.
     body["feed_plan"]["max_feed"] = json!(5000);
     let answer = json_with(app.post_json(URL, &body).await, 200).await;
-    assert_eq!(answer["feed_plan"]["max_feed"], 5000.0);
+    assert_eq!(answer["feed_plan"]["max_feed"], 900.0);
     assert!(answer["warnings"].as_array().unwrap().iter().any(|w| w["code"] == "W_FEED_ABOVE_MACHINE_MAX"));
+    body["feed_plan"]["max_feed"] = json!(400);
+    let answer = json_with(app.post_json(URL, &body).await, 200).await;
+    assert_eq!(answer["feed_plan"]["max_feed"], 400.0);
 }
 
 /// The program starts the spindle the way the analysis assumed: M03 for `cw`, M04 for `ccw`.
@@ -450,6 +454,8 @@ async fn block_time_chords_the_program_and_reports_its_blocks() {
         {"type": "arc", "to": [40, 30], "center": [30, 30], "dir": "ccw"},
         {"type": "line", "to": [40, 60]}]});
     body["axial_depth"] = json!(2);
+    // The tool's own 2 flutes, so the program is for them.
+    body["flute_counts"] = json!([2]);
     let gcode_moves = |program: &str| program.lines().filter(|l| l.starts_with("G01")).count();
     let program_of = |body: Value| {
         let request = app.client.post(app.url(&format!("{URL}?format=gcode"))).json(&body);
@@ -562,9 +568,9 @@ fn expected_moves(result: &Value, cut_z: f64, safe_z: f64) -> Vec<(bool, [f64; 3
     };
     let start = position(0.0);
     let blocks = result["feed_plan"]["blocks"].as_array().unwrap();
-    // The plunge runs no faster than the nominal feed of the tool's flutes (f_z = 0.05, N = 3000),
-    // halved (no plunge feed given).
-    let nominal = number(&result["time_flute_count"]) * 0.05 * 3000.0;
+    // The plunge runs no faster than the nominal feed of the program's flutes (f_z = 0.05,
+    // N = 3000), halved (no plunge feed given).
+    let nominal = number(&result["program_flute_count"]) * 0.05 * 3000.0;
     let first_feed = number(&blocks[0]["feed"]);
     let mut moves = vec![
         (false, [start[0], start[1], safe_z], None),
@@ -621,7 +627,11 @@ async fn gcode_of_the_feed_plan_in_both_dialects() {
             let feeds: BTreeSet<u64> =
                 plan["blocks"].as_array().unwrap().iter().map(|b| number(&b["feed"]) as u64).collect();
             assert!(feeds.len() >= 2, "the plan changes the feed: {feeds:?}");
-            assert!(feeds.contains(&1500), "capped at the max feed in the air: {feeds:?}");
+            // Through the air at the nominal feed of the plan's flute count, not at the max feed.
+            let nominal = (number(&plan["flute_count"]) * 0.05 * 3000.0).min(1500.0);
+            let air: Vec<&Value> =
+                plan["blocks"].as_array().unwrap().iter().filter(|b| b["limited_by"] == "air").collect();
+            assert!(!air.is_empty() && air.iter().all(|b| number(&b["feed"]) == nominal), "{air:?}");
             for dialect in ["fanuc", "linuxcnc"] {
                 let url = app
                     .url(&format!("{URL}?format=gcode&dialect={dialect}&reference={reference}&candidate={candidate}"));
@@ -661,10 +671,11 @@ async fn gcode_of_the_feed_plan_in_both_dialects() {
         }
     }
 
-    // Without a feed plan every cutting move runs at the nominal feed of the tool's flutes, the
-    // plunge (the first feed move) at half of it.
+    // Without a feed plan every cutting move runs at the nominal feed of the program's flutes
+    // (here the tool's 2, the only count compared), the plunge (the first feed move) at half of it.
     let mut nominal = api_example();
     nominal["axial_depth"] = json!(2);
+    nominal["flute_counts"] = json!([2]);
     let program = app
         .client
         .post(app.url(&format!("{URL}?format=gcode")))
@@ -1007,4 +1018,115 @@ async fn the_power_curve_limits_the_cut_at_its_speed() {
     let bad = json!({"block_time_ms": 4, "max_feed": 12000, "spindle_power_curve": [[0, 1], [5000, 4], [4000, 5]]});
     let problem = problem(app.put_json("/api/v1/machines/bad-curve", &bad).await, 422).await;
     assert_eq!(problem["errors"][0]["path"], "spindle_power_curve[2][0]");
+}
+
+/// Each straight feed move of `program` (G01, modal coordinates and feed) as its start, end and
+/// feed (the engagement programs here write arcs as chords).
+fn feed_moves(program: &str) -> Vec<([f64; 3], [f64; 3], f64)> {
+    let (mut at, mut feed, mut moves) = ([0.0; 3], 0.0, Vec::new());
+    for line in program.lines() {
+        let from = at;
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let Some(&motion) = words.first() else { continue };
+        for word in &words[1..] {
+            let (axis, value) = word.split_at(1);
+            let Ok(value) = value.parse::<f64>() else { continue };
+            match axis {
+                "X" => at[0] = value,
+                "Y" => at[1] = value,
+                "Z" => at[2] = value,
+                "F" => feed = value,
+                _ => {}
+            }
+        }
+        assert!(!["G02", "G03"].contains(&motion), "{line}");
+        if motion == "G01" {
+            moves.push((from, at, feed));
+        }
+    }
+    moves
+}
+
+/// Distance in the plan from `p` to the rectangle `[x0, x1] × [y0, y1]` (0 inside).
+fn rectangle_distance(p: [f64; 3], [x0, y0, x1, y1]: [f64; 4]) -> f64 {
+    let dx = (x0 - p[0]).max(p[0] - x1).max(0.0);
+    let dy = (y0 - p[1]).max(p[1] - y1).max(0.0);
+    dx.hypot(dy)
+}
+
+/// Distance in the plan from the move `from → to` to the rectangle (sampled every 0.01 mm).
+fn move_distance(from: [f64; 3], to: [f64; 3], rectangle: [f64; 4]) -> f64 {
+    let length = (to[0] - from[0]).hypot(to[1] - from[1]);
+    let steps = (length / 0.01).ceil().max(1.0) as usize;
+    (0..=steps)
+        .map(|i| {
+            let t = i as f64 / steps as f64;
+            let p = [from[0] + t * (to[0] - from[0]), from[1] + t * (to[1] - from[1]), 0.0];
+            rectangle_distance(p, rectangle)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The largest feed of any program move that comes within the tool radius of the stock (ends
+/// there or passes there) is the planned cutting feed: air moves run at the programmed feed, not
+/// at the machine's maximum up to where the cutter touches; with a machine of 12 000 mm/min and a
+/// 10 N·m spindle, with and without a feed plan.
+#[tokio::test(flavor = "multi_thread")]
+async fn no_move_reaches_the_stock_faster_than_the_planned_feed() {
+    let app = TestApp::spawn().await;
+    let machine = json!({"block_time_ms": 4, "max_feed": 12000, "spindle_torque_nm": 10});
+    json_with(app.put_json("/api/v1/machines/vmc-12k", &machine).await, 201).await;
+    let stock = [0.0, 0.0, 60.0, 40.0];
+    let radius = 5.0;
+    let mut body = api_example();
+    body["axial_depth"] = json!(2);
+    body["kienzle"] = json!({"kc11": 1800, "mc": 0.25});
+    body["machine"] = json!("vmc-12k");
+    body["feed_plan"] = json!({"target_thickness": 0.05});
+    for plan in [true, false] {
+        if !plan {
+            body.as_object_mut().unwrap().remove("feed_plan");
+        }
+        let answer = json_with(app.post_json(URL, &body).await, 200).await;
+        let samples = answer["samples"].as_array().unwrap();
+        let in_contact = |from: f64, to: f64| {
+            samples.iter().any(|sample| {
+                let s = number(&sample["s"]);
+                s > from && s <= to && !sample["arcs"].as_array().unwrap().is_empty()
+            })
+        };
+        let planned = if plan {
+            let blocks = answer["feed_plan"]["blocks"].as_array().unwrap();
+            blocks
+                .iter()
+                .filter(|b| in_contact(number(&b["from_s"]), number(&b["to_s"])))
+                .map(|b| number(&b["feed"]))
+                .fold(0.0, f64::max)
+        } else {
+            number(&answer["program_flute_count"]) * 0.05 * 3000.0
+        };
+        let program = app.post_text(&format!("{URL}?format=gcode"), &body, 200).await;
+        let near: Vec<([f64; 3], f64)> = feed_moves(&program)
+            .into_iter()
+            .filter(|(from, to, _)| move_distance(*from, *to, stock) <= radius * (1.0 + 1e-9))
+            .map(|(_, to, feed)| (to, feed))
+            .collect();
+        assert!(!near.is_empty(), "{program}");
+        let (end, fastest) = near.iter().copied().fold(([0.0; 3], 0.0), |a, b| if b.1 > a.1 { b } else { a });
+        assert!(
+            (fastest - planned).abs() < 1.0,
+            "feed plan {plan}: a move to {end:?} runs at F{fastest}, the planned cutting feed is {planned}:\n{program}"
+        );
+        // The program is for the recommended flute count, which holds the machine's torque.
+        let recommended = answer["recommended"].as_array().unwrap();
+        let flutes = answer["flutes"].as_array().unwrap();
+        for k in recommended {
+            let flute = flutes.iter().find(|f| f["flute_count"] == *k).unwrap();
+            assert!(flute.get("over_limits").is_none(), "{flute}");
+        }
+        if let Some(best) = recommended.first() {
+            assert_eq!(answer["program_flute_count"], *best);
+            assert!(program.to_lowercase().contains(&format!("feeds for {best} flutes")), "{program}");
+        }
+    }
 }

@@ -36,8 +36,10 @@ pub(crate) enum FeedMode {
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct PlanJob {
     pub target: f64,
+    /// The highest feed of the plan: the request's, never above the machine's.
     pub max_feed: f64,
-    pub flute_count: u32,
+    /// The flute count the request chose for the plan and the program (else the recommended).
+    pub flute_count: Option<u32>,
     pub basis: FeedBasis,
     pub tolerance: f64,
     pub min_block_length: f64,
@@ -87,6 +89,10 @@ pub(crate) struct Job {
     pub arc_feed: bool,
     /// The machine's spindle limits (checked only with a force model).
     pub spindle: SpindleLimits,
+    /// The machine's max feed, mm/min: no flute count whose feed exceeds it is recommended.
+    pub machine_feed: Option<f64>,
+    /// The machine's highest spindle speed, rpm: above it no flute count is recommended.
+    pub machine_speed: Option<f64>,
     /// The tool's natural frequencies, Hz, and their directions.
     pub natural: Vec<(f64, &'static str)>,
     pub contact_dots: bool,

@@ -52,10 +52,10 @@ impl EngagementRequest {
         let clearance = bounded("clearance", self.clearance.unwrap_or(5.0), MAX_COORDINATE)?;
         // Warnings of the whole request, repeated in every candidate's answer.
         let mut shared_warnings = Vec::new();
-        let plan =
-            self.feed_plan.as_ref().map(|plan| feed_plan(plan, tool, machine, &mut shared_warnings)).transpose()?;
+        let plan = self.feed_plan.as_ref().map(|plan| feed_plan(plan, machine, &mut shared_warnings)).transpose()?;
         let rule = if self.block_time_ms.is_some() || machine.is_some() {
-            let feed = feed_mode.feed(tool.flutes, spindle_rpm);
+            // The program never runs faster than the machine's max feed (see `program_feed`).
+            let feed = machine.map_or(f64::INFINITY, |m| m.max_feed).min(feed_mode.feed(tool.flutes, spindle_rpm));
             let settings =
                 RuleSettings { feed: Some(feed), block_time_ms: self.block_time_ms, ..RuleSettings::default() };
             let (rule, warnings) = BlockRule::resolve(&settings, machine)?;
@@ -92,6 +92,8 @@ impl EngagementRequest {
             rule,
             arc_feed: self.arc_feed_correction,
             spindle,
+            machine_feed: machine.map(|m| m.max_feed),
+            machine_speed: machine.and_then(|m| m.max_spindle_rpm),
             natural: natural_frequencies(tool),
             contact_dots: self.contact_dots,
             region,
@@ -211,10 +213,10 @@ impl EngagementRequest {
 }
 
 /// The feed plan's request (§11 item 3): its `max_feed` defaults to the machine's, and one above
-/// the machine's is kept with `W_FEED_ABOVE_MACHINE_MAX` in `shared_warnings`.
+/// the machine's is lowered to it with `W_FEED_ABOVE_MACHINE_MAX` in `shared_warnings` (a
+/// machine caps a user's feed, it never raises it).
 fn feed_plan(
     plan: &FeedPlanRequest,
-    tool: &Tool,
     machine: Option<&MachineProfile>,
     shared_warnings: &mut Vec<Warning>,
 ) -> Result<PlanJob, SolverError> {
@@ -225,21 +227,23 @@ fn feed_plan(
             "feed_plan.max_feed (mm/min) is required unless the request names a machine",
         )
     })?;
-    let max_feed = bounded("feed_plan.max_feed", max_feed, 1e7)?;
+    let mut max_feed = bounded("feed_plan.max_feed", max_feed, 1e7)?;
     if let Some(machine) = machine
         && max_feed > machine.max_feed
     {
         shared_warnings.push(Warning::new(
             "W_FEED_ABOVE_MACHINE_MAX",
             format!(
-                "feed_plan.max_feed {max_feed} mm/min is above the machine's max_feed {} mm/min: the \
-                 control will not reach it",
-                machine.max_feed
+                "feed_plan.max_feed {max_feed} mm/min is above the machine's max_feed {} mm/min: the feed plan \
+                 uses {} mm/min",
+                machine.max_feed, machine.max_feed
             ),
         ));
+        max_feed = machine.max_feed;
     }
-    let flute_count = plan.flute_count.unwrap_or(tool.flutes);
-    if !(1..=MAX_FLUTES).contains(&flute_count) {
+    if let Some(flute_count) = plan.flute_count
+        && !(1..=MAX_FLUTES).contains(&flute_count)
+    {
         return Err(SolverError::input(
             "feed_plan.flute_count",
             format!("a flute count must be 1 to {MAX_FLUTES} (got {flute_count})"),
@@ -247,5 +251,5 @@ fn feed_plan(
     }
     let tolerance = non_negative("feed_plan.tolerance", plan.tolerance.unwrap_or(0.05))?;
     let min_block_length = non_negative("feed_plan.min_block_length", plan.min_block_length.unwrap_or(0.5))?;
-    Ok(PlanJob { target, max_feed, flute_count, basis: plan.basis, tolerance, min_block_length })
+    Ok(PlanJob { target, max_feed, flute_count: plan.flute_count, basis: plan.basis, tolerance, min_block_length })
 }
