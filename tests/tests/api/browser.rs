@@ -336,6 +336,10 @@ async fn saving_an_existing_machine_or_material_asks_first_and_keeps_it() {
 }
 
 #[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn engagement_page_stars_no_flute_count_over_the_machines_torque() {
     let app = TestApp::spawn().await;
     // The form's example needs 2.6 N·m with 4 flutes, 5.3 N·m with 8.
