@@ -142,7 +142,7 @@ impl Capability for DeburrCapability {
     }
 
     /// Every loop at [`MAX_POINTS`](super::MAX_POINTS) points (the solver refuses a loop that
-    /// needs more), at [`loop_bound`] each; a several-loop answer repeats its first loop at the
+    /// needs more), at `loop_bound` each; a several-loop answer repeats its first loop at the
     /// top.
     fn answer_bound(request: &DeburrRequest, _context: &Resolved<Tool>, purpose: Purpose) -> Option<u64> {
         let loops = if request.is_several() { request.placements().ok()?.len() as u64 + 1 } else { 1 };
