@@ -82,6 +82,13 @@ async function refusedDownload(selector, messages) {
   return page.textContent(`${messages} .message.error`);
 }
 
+// Submits a job file as another client would (from this process, not the page); answers its id.
+async function submitElsewhere(text, type) {
+  const response = await fetch(`${base}/api/v1/jobs`, { method: 'POST', headers: { 'content-type': type }, body: text });
+  if (response.status !== 202) throw new Error(`the job was not queued: ${response.status} ${await response.text()}`);
+  return (await response.json()).id;
+}
+
 const scenarios = {
   // Loads the page, submits the sample deburr job with the button, waits for the 3-D scene: the
   // tube, the hole and the tool are in it; the timeline moves the tool and marks the G-code line
@@ -1055,8 +1062,18 @@ const scenarios = {
   },
 
   // A job that fails: its reason in words (no "[object Object]" in the page or a tooltip); it can
-  // be opened, re-submitted and deleted.
+  // be opened, re-submitted and deleted. The job re-submitted was sent as TOML by another client
+  // (this process, not the page): the page re-submits the file the service keeps.
   async jobsFailed() {
+    const elsewhere = await submitElsewhere(`name = "hole too large, from another client"
+[[operations]]
+operation = "deburr"
+tool = { kind = "ball", radius = 2 }
+edge = "outer"
+cut_amount = 0.2
+workpiece = { kind = "tube", origin = [0, 0, 0], inner_radius = 15, outer_radius = 25 }
+hole = { shape = "round", radius = 60 }
+`, 'application/toml');
     const bad = {
       name: 'hole too large',
       operations: [{ operation: 'deburr', tool: { kind: 'ball', radius: 2 }, edge: 'outer', cut_amount: 0.2,
@@ -1074,16 +1091,22 @@ const scenarios = {
     let shown = await objectShown();
     if (shown.length) throw new Error(`"[object Object]" shown: ${shown.map((t) => t.slice(0, 200)).join(' | ')}`);
     if (!/hole too large|cylinder radius/i.test(banner)) throw new Error(`the banner does not say why: ${banner}`);
-    const id = Number(await page.$eval('#job-rows tr[data-status="failed"]', (row) => row.dataset.job));
+    const fromPage = Number(await page.$eval('#job-rows tr[data-status="failed"]', (row) => row.dataset.job));
+    const id = elsewhere;
+    await page.waitForSelector(`#job-rows tr[data-job="${id}"][data-status="failed"]`, { timeout: 60000 });
     // Open: the reason and what can be done.
     await page.click(`#job-rows tr[data-job="${id}"] button:has-text("Open")`);
     await page.waitForSelector('#job-result[data-state="shown"]', { timeout: 15000 });
     const opened = await page.textContent('#job-result');
     if (!/failed/.test(opened)) throw new Error(`opened failed job: ${opened.slice(0, 300)}`);
     // Re-submit: a new job from the same file.
+    const newest = Math.max(id, fromPage);
     await page.click(`#job-rows tr[data-job="${id}"] button:has-text("Re-submit")`);
-    await page.waitForFunction((first) => [...document.querySelectorAll('#job-rows tr[data-status="failed"]')].some((r) => Number(r.dataset.job) > first), id, { timeout: 60000 });
+    await page.waitForFunction((first) => [...document.querySelectorAll('#job-rows tr[data-status="failed"]')].some((r) => Number(r.dataset.job) > first), newest, { timeout: 60000 })
+      .catch(async () => { throw new Error(`re-submitting job #${id} made no new job: ${await page.textContent('#job-messages')}`); });
     const again = await page.$$eval('#job-rows tr[data-status="failed"]', (rows) => rows.map((r) => Number(r.dataset.job)));
+    const resubmitted = await (await fetch(`${base}/api/v1/jobs/${Math.max(...again)}`)).json();
+    if (resubmitted.name !== 'hole too large, from another client') throw new Error(`the re-submitted job is not the other client's: ${JSON.stringify(resubmitted)}`);
     // Delete: asked first, then gone from the page and from the service (the messages emptied
     // first, so an error there is the delete's).
     await page.waitForFunction(() => !document.querySelector('#job-rows tr[data-status="queued"], #job-rows tr[data-status="running"]'), null, { timeout: 60000 });
@@ -1097,7 +1120,7 @@ const scenarios = {
     if (status !== 404) throw new Error(`deleted job #${id} still answers ${status}`);
     shown = await objectShown();
     if (shown.length) throw new Error(`"[object Object]" shown: ${shown.join(' | ')}`);
-    return { id, again, banner };
+    return { id, fromPage, again, banner };
   },
 
   // Predict with an uploaded STL stock (a binary STL box round the sample path): the stock is
@@ -1124,22 +1147,33 @@ const scenarios = {
   },
 
   // A deburr job opened on the Jobs view shows what the Deburr view shows: the tube and hole
-  // (sizes as OD/ID/Ø), the path and the clearance check.
+  // (sizes as OD/ID/Ø), the path and the clearance check, for a TOML job sent by another client
+  // (this process, not the page) with its tool by number.
   async jobDeburrSolids() {
-    const job = {
-      name: 'tube by diameters',
-      operations: [{ operation: 'deburr', tool: { kind: 'ball', radius: 2 }, edge: 'outer', cut_amount: 0.2,
-        workpiece: { kind: 'tube', origin: [0, 0, 0], inner_diameter: 30, outer_diameter: 50 }, hole: { shape: 'round', diameter: 16 } }],
-    };
+    const id = await submitElsewhere(`name = "tube by diameters, from another client"
+[[tools]]
+number = 31
+kind = "ball"
+radius = 2
+
+[[operations]]
+operation = "deburr"
+tool = 31
+edge = "outer"
+cut_amount = 0.2
+workpiece = { kind = "tube", origin = [0, 0, 0], inner_diameter = 30, outer_diameter = 50 }
+hole = { shape = "round", diameter = 16 }
+`, 'application/toml');
     await page.goto(`${base}/#/jobs`);
-    await page.setInputFiles('#job-file', { name: 'tube.json', mimeType: 'application/json', buffer: Buffer.from(JSON.stringify(job)) });
-    await page.waitForSelector('#job-rows tr[data-status="done"]', { timeout: 60000 });
-    await page.click('#job-rows tr[data-status="done"] button:has-text("Open")');
+    await page.waitForSelector(`#job-rows tr[data-job="${id}"][data-status="done"]`, { timeout: 60000 });
+    await page.click(`#job-rows tr[data-job="${id}"] button:has-text("Open")`);
     await page.waitForSelector('#job-result[data-state="shown"]', { timeout: 60000 });
     const objects = (await page.getAttribute('#job-result [data-objects]', 'data-objects')).split(' ');
     for (const name of ['tube', 'hole', 'centres', 'tool']) if (!objects.includes(name)) throw new Error(`the job's deburr result has no ${name}: ${objects}`);
     const refused = await page.getAttribute('#job-result [data-objects]', 'data-refused');
-    return { objects, refused };
+    const collisions = await page.getAttribute('#job-result [data-objects]', 'data-collisions');
+    if (refused !== 'false' || collisions !== '') throw new Error(`the clearance check of a ball well clear of the wall says refused=${refused}, collisions="${collisions}"`);
+    return { id, objects, refused };
   },
 
   // Machines and materials as tools: saving a name that exists asks first, showing what is

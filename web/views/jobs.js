@@ -27,27 +27,10 @@ export function reasonText(error) {
   return `${sentence(error.detail || error.title || error.code || 'no reason given')}${field ? ` (field ${field})` : ''}`;
 }
 
-// The job files sent from this browser, by job id, so a failed or cancelled job can be sent
-// again: the service keeps a job's file for its outputs only once the job is done.
-const KEPT = 'kerf.v1.jobfile.';
-// A larger file is not kept (local storage holds a few MB per site).
-const KEPT_MAX = 512 * 1024;
-
-function keepJobFile(id, name, text) {
-  if (text.length > KEPT_MAX) return;
-  try {
-    localStorage.setItem(KEPT + id, JSON.stringify({ name, text }));
-  } catch (error) {
-    // Storage full or off: this job cannot be re-submitted from here, nothing else changes.
-  }
-}
-
-function keptJobFile(id) {
-  try {
-    return JSON.parse(localStorage.getItem(KEPT + id) || 'null');
-  } catch (error) {
-    return null;
-  }
+// A job's file as the service stores it (JSON, whichever format and client submitted it): every
+// operation's `operation` and request, and the tools, machines and materials they name.
+function jobFile(id) {
+  return api('GET', `/api/v1/jobs/${id}/file`);
 }
 
 function button(text, action, className = 'secondary') {
@@ -108,13 +91,8 @@ function row(job, root) {
   const ended = ['done', 'failed', 'cancelled'].includes(job.status);
   if (ended) actions.append(button('Open', () => openJob(job.id, root)));
   if (job.status === 'failed' || job.status === 'cancelled') {
-    const kept = keptJobFile(job.id);
     const again = button('Re-submit', () => resubmit(job.id, root));
     again.dataset.action = 'resubmit';
-    if (!kept) {
-      again.disabled = true;
-      again.title = 'Sent from another browser or client: the service keeps no copy of a job file that did not finish, so upload the file again.';
-    }
     actions.append(' ', again);
   }
   if (ended) {
@@ -194,11 +172,6 @@ async function deleteJob(id, root) {
   try {
     await api('DELETE', `/api/v1/jobs/${id}`);
     state.jobs.delete(id);
-    try {
-      localStorage.removeItem(KEPT + id);
-    } catch (error) {
-      // Storage off: nothing was kept.
-    }
     const box = root.querySelector('#job-result');
     if (box.dataset.job === String(id)) box.replaceChildren();
     render(root);
@@ -208,12 +181,14 @@ async function deleteJob(id, root) {
   }
 }
 
-// Sends a failed or cancelled job's file again, as a new job.
-function resubmit(id, root) {
-  const kept = keptJobFile(id);
-  if (!kept) return;
-  const type = /\.toml$/i.test(kept.name) ? 'application/toml' : 'application/json';
-  submit(new File([kept.text], kept.name, { type }), root);
+// Sends a failed or cancelled job's file, as the service keeps it, again as a new job.
+async function resubmit(id, root) {
+  try {
+    const file = await jobFile(id);
+    submit(new File([JSON.stringify(file)], `job-${id}.json`, { type: 'application/json' }), root);
+  } catch (problem) {
+    showProblem(root.querySelector('#job-messages'), null, problem);
+  }
 }
 
 async function openJob(id, root) {
@@ -237,14 +212,14 @@ async function openJob(id, root) {
       const bar = document.createElement('div');
       bar.className = 'actions';
       const again = button('Re-submit', () => resubmit(job.id, root));
-      again.disabled = !keptJobFile(job.id);
       bar.append(again, ' ', confirmButton('Delete', `Delete job #${job.id}?`, () => deleteJob(job.id, root)));
       box.append(facts, bar);
       box.dataset.state = 'shown';
       box.scrollIntoView({ behavior: 'smooth', block: 'start' });
       return;
     }
-    const file = jobFileFrom(keptJobFile(job.id));
+    // Without its file (removed in between) the results are drawn without their requests.
+    const file = await jobFile(job.id).catch(() => null);
     // The whole job as one program: every operation with its tool change, and every
     // output in one zip (job.json, each answer and program, the job's program).
     const whole = document.createElement('div');
@@ -324,17 +299,6 @@ async function openJob(id, root) {
   }
 }
 
-// A kept JSON job file, parsed (a TOML file is not read here: its results are drawn without
-// their requests).
-function jobFileFrom(kept) {
-  if (!kept || /\.toml$/i.test(kept.name)) return null;
-  try {
-    return JSON.parse(kept.text);
-  } catch (error) {
-    return null;
-  }
-}
-
 // An operation of a job file as the request its endpoint takes: without `operation`, its tool
 // numbers resolved from the file's own tools (a result is drawn with the tool it was cut with).
 function requestOf(operation, file) {
@@ -348,12 +312,10 @@ function requestOf(operation, file) {
 
 async function submit(file, root) {
   const messages = root.querySelector('#job-messages');
-  const text = await file.text();
   const form = new FormData();
   form.append('file', file, file.name);
   try {
     const answer = await api('POST', '/api/v1/jobs', form);
-    keepJobFile(answer.id, file.name, text);
     const banner = message(answer.reused ? 'ok' : 'info', answer.reused
       ? `${file.name}: identical to job #${answer.id}, reusing its result.`
       : `${file.name}: queued as job #${answer.id}.`);

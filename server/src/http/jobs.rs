@@ -1,6 +1,7 @@
 //! Jobs over HTTP (docs/spec/api.md, Jobs): submit a job file (multipart field `file`, or the raw body as
 //! JSON or TOML), follow it, fetch its results and G-code (each operation's, or the one program
-//! of the whole job, or every output as a zip archive), cancel it, list jobs with paging.
+//! of the whole job, or every output as a zip archive), read back its stored job file, cancel it,
+//! list jobs with paging.
 
 use axum::Json;
 use axum::extract::{FromRequest, Multipart, Request, State};
@@ -258,6 +259,28 @@ async fn show(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobI
     Ok(held_download(permit, pieces_of(body.into()), length, "application/json"))
 }
 
+/// The job file as the service stores it, for any job (queued, running, done, failed or
+/// cancelled): JSON, with every operation's `operation` and request in submission order and the
+/// tools, machines and materials its operations name as they were resolved at submission (a TOML
+/// file is stored as this JSON). Submitting it again runs the same job; for a done job the
+/// submission is answered with that job (`reused`).
+#[utoipa::path(get, path = "/api/v1/jobs/{id}/file", tag = "jobs",
+    params(("id" = i64, Path, description = "Job id", minimum = 1)),
+    responses(
+        (status = 200, description = "The stored job file, byte for byte", body = JobFile, content_type = "application/json"),
+        (status = 404, description = "Unknown or removed job", body = Problem, content_type = "application/problem+json")))]
+async fn job_file(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobId>) -> AppResult<Response> {
+    let json = store::outputs::job_file(&state.db, id)
+        .await?
+        .ok_or_else(|| AppError::not_found(format!("job {id} does not exist")))?;
+    let mut response = json.into_response();
+    response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("application/json"));
+    if let Ok(disposition) = HeaderValue::from_str(&format!("inline; filename=\"kerf-job-{id}.json\"")) {
+        response.headers_mut().insert(header::CONTENT_DISPOSITION, disposition);
+    }
+    Ok(response)
+}
+
 /// A finished job's G-code program (one per operation).
 ///
 /// It is decompressed as the client reads it, never whole in memory; the compressed program holds
@@ -415,6 +438,7 @@ pub fn router() -> OpenApiRouter<AppState> {
         .routes(routes!(submit, list))
         .routes(routes!(show, cancel))
         .routes(routes!(gcode))
+        .routes(routes!(job_file))
         .routes(routes!(job_program))
         .routes(routes!(outputs_zip))
 }

@@ -1,6 +1,6 @@
 //! Jobs over HTTP: every example job file uploaded (multipart and raw) and run to the end, reuse
-//! of identical jobs, failures with their field, cancellation, paging, bad uploads, and a server
-//! killed with SIGKILL in the middle of a job.
+//! of identical jobs, failures with their field, cancellation, paging, bad uploads, the stored
+//! job file read back and run again, and a server killed with SIGKILL in the middle of a job.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -394,10 +394,81 @@ async fn jobs_answer_as_the_endpoints_do(store: Store) {
     assert!(!engagement_program.contains("Y20.0000"), "not the first candidate's path");
 }
 
+/// Submits `text`, waits for the job to end and answers its id and its results' raw text.
+async fn run_to_the_end(app: &TestApp, text: String, media_type: &str) -> (i64, Value, Vec<String>) {
+    let submitted = json_with(upload_raw(app, text, media_type).await, 202).await;
+    let id = submitted["id"].as_i64().unwrap();
+    let job = poll_job(&app.client, &app.base, id, 60, finished).await;
+    let results = if job["status"] == "done" {
+        raw_results(&app.get(&format!("/api/v1/jobs/{id}")).await.text().await.unwrap())
+    } else {
+        Vec::new()
+    };
+    (id, job, results)
+}
+
+/// The stored job file read back: JSON with every operation in order, for TOML and JSON uploads
+/// and for failed jobs; submitted again it runs the same job; 404 once the job is removed.
+async fn job_file_round_trips(store: Store) {
+    let Some(app) = TestApp::spawn_on(store, |_| {}).await else { return };
+    problem(app.get("/api/v1/jobs/999999/file").await, 404).await;
+    for path in examples()
+        .into_iter()
+        .filter(|path| path.file_name().is_some_and(|n| n.to_string_lossy().starts_with("deburr")))
+    {
+        let text = std::fs::read_to_string(&path).unwrap().replacen("name = \"", "name = \"file ", 1).replacen(
+            "\"name\": \"",
+            "\"name\": \"file ",
+            1,
+        );
+        let (id, job, results) = run_to_the_end(&app, text, media_type(&path)).await;
+        assert_eq!(job["status"], "done", "{}: {job}", path.display());
+        let response = app.get(&format!("/api/v1/jobs/{id}/file")).await;
+        assert_eq!(response.status(), 200, "{}", path.display());
+        assert_eq!(response.headers()["content-type"], "application/json");
+        let file_text = response.text().await.unwrap();
+        let file: Value = serde_json::from_str(&file_text).unwrap();
+        let names: Vec<&str> =
+            file["operations"].as_array().unwrap().iter().map(|o| o["operation"].as_str().unwrap()).collect();
+        assert_eq!(json!(names), job["operations"], "{}: every operation, in order", path.display());
+        assert!(file["name"].as_str().unwrap().starts_with("file "), "{file}");
+        assert!(!file["tools"].as_array().unwrap().is_empty(), "the tools the operations name: {file}");
+        // Submitted again while the job is there, it is that job.
+        let again = json_with(upload_raw(&app, file_text.clone(), "application/json").await, 200).await;
+        assert_eq!(again, json!({"id": id, "status": "done", "reused": true}), "{}", path.display());
+        // Removed, the job has no file; the file read back runs as a new job to the same results.
+        assert_eq!(app.delete(&format!("/api/v1/jobs/{id}")).await.status(), 204);
+        problem(app.get(&format!("/api/v1/jobs/{id}/file")).await, 404).await;
+        let (rerun, job, rerun_results) = run_to_the_end(&app, file_text, "application/json").await;
+        assert_ne!(rerun, id);
+        assert_eq!(job["status"], "done", "{job}");
+        assert_eq!(rerun_results, results, "{}: the re-submitted file gives the same results", path.display());
+    }
+    // A failed job's file is kept, and submitted again it fails the same way.
+    let mut bad = long_job(1);
+    bad["name"] = json!("file refused");
+    bad["operations"][0]["hole"]["radius"] = json!(60);
+    let (id, job, _) = run_to_the_end(&app, bad.to_string(), "application/json").await;
+    assert_eq!(job["status"], "failed", "{job}");
+    let file_text = app.get_text(&format!("/api/v1/jobs/{id}/file"), 200).await;
+    let file: Value = serde_json::from_str(&file_text).unwrap();
+    // The request as parsed: what was sent, with the defaults it ran with written out.
+    let operation = &file["operations"][0];
+    assert_eq!(operation["operation"], "deburr", "{file}");
+    assert_eq!(operation["tool"]["kind"], "ball", "an inline tool stays inline: {file}");
+    assert_eq!(operation["hole"]["radius"], 60.0, "{file}");
+    assert_eq!(operation["workpiece"]["outer_radius"], 50.0, "{file}");
+    let (rerun, again, _) = run_to_the_end(&app, file_text, "application/json").await;
+    assert_ne!(rerun, id, "a failed job is not reused");
+    assert_eq!(again["status"], "failed", "{again}");
+    assert_eq!(again["error"], job["error"]);
+}
+
 kerf_tests::on_both_stores!(
     example_jobs_run_to_the_end,
     raw_uploads_run_and_refusals_name_the_field,
     bad_uploads,
     cancel_paging_and_conflicts,
-    jobs_answer_as_the_endpoints_do
+    jobs_answer_as_the_endpoints_do,
+    job_file_round_trips
 );
