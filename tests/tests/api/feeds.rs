@@ -135,9 +135,15 @@ async fn a_machine_caps_every_feed_near_the_stock() {
     // Contour: the outside of a rectangle 80 × 60 from Z 0 down to −4.
     let rectangle = [[0.0, 0.0], [80.0, 0.0], [80.0, 60.0], [0.0, 60.0]];
     let body = json!({"tool": 3, "contour": rectangle, "side": "outside", "depths": {"top": 0, "bottom": -4, "step": 2},
-                      "feed": REQUESTED, "plunge_feed": 1800, "machine": "slow"});
+                      "feed": REQUESTED, "loop_feed": 3000, "plunge_feed": 1800, "machine": "slow"});
     let (answer, program) = answer_and_program(&app, "/api/v1/contour", &body).await;
     capped(&answer, "contour");
+    let messages: Vec<&str> =
+        answer["warnings"].as_array().unwrap().iter().filter_map(|w| w["message"].as_str()).collect();
+    for said in ["loop_feed capped from 3000 to 600", "plunge_feed capped from 1800 to 600"] {
+        assert!(messages.iter().any(|m| m.contains(said)), "contour: no \"{said}\" in {messages:?}");
+    }
+    assert_eq!(answer["summary"]["loop_feed"], MACHINE_MAX, "the answer's loop feed is the program's");
     let found = feeds(&program, |p| {
         polygon_distance(&rectangle, p[0], p[1]).hypot(p[2].max(0.0)) <= RADIUS && p[2] >= -4.0 - RADIUS
     });
