@@ -12,7 +12,7 @@ use super::request::{
 };
 use crate::capability::Control;
 use crate::error::{SolverError, Warning};
-use crate::machine::{BlockRule, MachineProfile, RuleSettings};
+use crate::machine::{BlockRule, MachineProfile, RuleSettings, cap_feed};
 use crate::tool::{Tool, ToolKind};
 use crate::validate::{coordinate, finite, non_negative, positive};
 
@@ -97,15 +97,22 @@ impl ContourRequest {
     ) -> Result<Job, SolverError> {
         tool.validate("tool.")?;
         let radius = tool.radius;
-        let feed = positive("feed", self.feed)?;
-        let loop_feed = self.loop_feed.map(|f| positive("loop_feed", f)).transpose()?;
+        // The machine's max feed caps every feed the program writes (never raises one).
+        let mut capped = Vec::new();
+        let feed = cap_feed(machine, "feed", positive("feed", self.feed)?, &mut capped);
+        let loop_feed = self
+            .loop_feed
+            .map(|f| positive("loop_feed", f).map(|f| cap_feed(machine, "loop_feed", f, &mut capped)))
+            .transpose()?;
         let (top, bottom, layers) = self.layer_depths(radius)?;
         let (tolerance, chording, rule_warnings) = self.chording(feed, loop_feed, machine)?;
         let (spindle_rpm, plunge_feed, ramp) = self.spindle_and_entry(tool, machine)?;
+        let plunge_feed = plunge_feed.map(|f| cap_feed(machine, "plunge_feed", f, &mut capped));
         let (safe_z, lead) = self.heights(top, radius)?;
         let (stock_allowance, passes) = self.stock_and_passes()?;
         let loop_config = self.corner_loop.config(radius)?;
         let (contour, mut warnings) = prepare::prepare(&self.contour, self.fix_orientation, control)?;
+        warnings.extend(capped);
         warnings.extend(rule_warnings);
         let start_edge = self.prepared_start_edge(&contour)?;
         let choices = self.corner_choices(&contour)?;

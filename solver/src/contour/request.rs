@@ -283,8 +283,9 @@ pub struct ContourRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub block_time_ms: Option<f64>,
     /// A registered machine (controller profile): its block time, margin and minimum chord error
-    /// chord the arcs as `block_time_ms` does, and its dialect is the G-code default. The server
-    /// resolves it; the request's own `block_time_ms` wins.
+    /// chord the arcs as `block_time_ms` does, its dialect is the G-code default, and its
+    /// `max_feed` caps `feed`, `loop_feed` and `plunge_feed` (`W_FEED_ABOVE_MACHINE_MAX`). The
+    /// server resolves it; the request's own `block_time_ms` wins.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub machine: Option<String>,
     /// Spindle speed, rpm (default 6000).

@@ -103,7 +103,7 @@ pub fn solve_within(request: &ContourRequest, tool: &Tool, max_moves: usize) -> 
 
 /// [`solve_within`] for a request that names a machine: `machine` is the profile its
 /// `machine` names (block time, margin and minimum chord error as defaults of the block-time
-/// rule; `W_FEED_ABOVE_MACHINE_MAX` when `feed` is above its `max_feed`).
+/// rule; its `max_feed` caps `feed`, `loop_feed` and `plunge_feed`, `W_FEED_ABOVE_MACHINE_MAX`).
 ///
 /// # Errors
 /// As [`solve`], and `E_CANCELLED` once `control`'s cancel flag is set (checked per layer, per

@@ -5,7 +5,7 @@ use super::frame::Frame;
 use super::profile::Profile;
 use crate::error::{ErrorCode, SolverError, Warning};
 use crate::geometry::vec3;
-use crate::machine::{BlockRule, MachineProfile, RuleSettings};
+use crate::machine::{BlockRule, MachineProfile, RuleSettings, cap_feed};
 use crate::tool::{Tool, ToolKind};
 use crate::validate::{self, finite, non_negative, optional_positive, positive};
 
@@ -39,7 +39,7 @@ pub(crate) struct Job {
     pub safe_z: Option<f64>,
     /// The block-time rule at `feed`, when a block time is known (request or machine).
     pub rule: Option<BlockRule>,
-    /// Warnings from resolving the rule (`W_FEED_ABOVE_MACHINE_MAX`).
+    /// Warnings from capping the feed to the machine's and resolving the rule (`W_FEED_ABOVE_MACHINE_MAX`).
     pub rule_warnings: Vec<Warning>,
 }
 
@@ -263,14 +263,17 @@ impl DeburrRequest {
     /// heights and distances.
     fn conditions(&self, machine: Option<&MachineProfile>) -> Result<Conditions, SolverError> {
         let safe_z = self.safe_z.map(|z| bounded("safe_z", z)).transpose()?;
-        let feed = optional_positive("feed", self.feed, DEFAULT_FEED)?;
-        let (rule, rule_warnings) = if self.block_time_ms.is_some() || machine.is_some() {
+        // The machine's max feed caps the deburring feed (never raises it).
+        let mut rule_warnings = Vec::new();
+        let feed = cap_feed(machine, "feed", optional_positive("feed", self.feed, DEFAULT_FEED)?, &mut rule_warnings);
+        let rule = if self.block_time_ms.is_some() || machine.is_some() {
             let settings =
                 RuleSettings { feed: Some(feed), block_time_ms: self.block_time_ms, ..RuleSettings::default() };
             let (rule, warnings) = BlockRule::resolve(&settings, machine)?;
-            (Some(rule), warnings)
+            rule_warnings.extend(warnings);
+            Some(rule)
         } else {
-            (None, Vec::new())
+            None
         };
         Ok(Conditions {
             safe_z,

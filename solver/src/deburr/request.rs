@@ -534,7 +534,8 @@ pub struct DeburrRequest {
     pub safe_z: Option<f64>,
     /// A registered machine (controller profile): its block time, margin and minimum chord error
     /// make the points follow the block-time rule (like `block_time_ms`), its dialect is the
-    /// G-code default. Its `max_feed` is not the deburring feed (`feed` keeps its default).
+    /// G-code default. Its `max_feed` is not the deburring feed (`feed` keeps its default) but
+    /// caps a larger one (`W_FEED_ABOVE_MACHINE_MAX`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub machine: Option<String>,
     /// T_b: the control's block processing time, ms (default: the machine's). With it the points

@@ -15,7 +15,7 @@ pub use stats::{BlockStats, PathBlocks, block_stats, path_blocks, short_block_wa
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::SolverError;
+use crate::error::{SolverError, Warning};
 
 use crate::gcode::Dialect;
 use crate::validate::{non_negative, positive, positive_at_most};
@@ -101,6 +101,27 @@ pub struct MachineProfile {
     /// Time of one tool change, s (≥ 0; default 0), for `cycle_time`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tool_change_s: Option<f64>,
+}
+
+/// A feed the request asks for (`field`, mm/min) as the program may write it: capped by
+/// `machine`'s `max_feed`, with `W_FEED_ABOVE_MACHINE_MAX` saying from what to what when it is
+/// lowered. A machine caps a user's feed; it never raises it (a value at or below the machine's,
+/// or one that is not a number, which validation refuses, comes back unchanged).
+pub fn cap_feed(machine: Option<&MachineProfile>, field: &str, feed: f64, warnings: &mut Vec<Warning>) -> f64 {
+    let Some(machine) = machine else { return feed };
+    if feed > machine.max_feed {
+        warnings.push(Warning::new(
+            "W_FEED_ABOVE_MACHINE_MAX",
+            format!(
+                "{field} {feed} mm/min is above the machine's max_feed {max} mm/min: {field} capped from {feed} to \
+                 {max} mm/min",
+                max = machine.max_feed
+            ),
+        ));
+        machine.max_feed
+    } else {
+        feed
+    }
 }
 
 impl MachineProfile {
@@ -249,6 +270,20 @@ pub fn validate_machine_name(name: &str) -> Result<(), SolverError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_machine_caps_a_feed_and_never_raises_one() {
+        let machine: MachineProfile = serde_json::from_str(r#"{"block_time_ms": 4, "max_feed": 600}"#).unwrap();
+        let mut warnings = Vec::new();
+        assert_eq!(cap_feed(Some(&machine), "loop_feed", 2400.0, &mut warnings), 600.0);
+        assert_eq!(warnings.len(), 1);
+        assert_eq!(warnings[0].code, "W_FEED_ABOVE_MACHINE_MAX");
+        assert!(warnings[0].message.contains("loop_feed capped from 2400 to 600"), "{}", warnings[0].message);
+        assert_eq!(cap_feed(Some(&machine), "feed", 300.0, &mut warnings), 300.0, "never raised");
+        assert_eq!(cap_feed(Some(&machine), "feed", 600.0, &mut warnings), 600.0);
+        assert_eq!(cap_feed(None, "feed", 2400.0, &mut warnings), 2400.0, "no machine, no cap");
+        assert_eq!(warnings.len(), 1, "a kept feed says nothing");
+    }
 
     #[test]
     fn power_curve_interpolates_and_holds_its_ends() {

@@ -103,7 +103,8 @@ pub struct RuleSettings {
 
 impl BlockRule {
     /// The rule of a request: `settings` over `machine`'s defaults, validated (safe factors
-    /// only). Also returns `W_FEED_ABOVE_MACHINE_MAX` when the feed exceeds the machine's.
+    /// only). A feed above the machine's `max_feed` is capped to it (`W_FEED_ABOVE_MACHINE_MAX`,
+    /// from what to what): the rule, and the program built on it, never asks for more.
     ///
     /// # Errors
     /// `E_INPUT` naming `feed`, `block_time_ms`, `margin` or `min_chord_error` for a missing or
@@ -127,10 +128,13 @@ impl BlockRule {
                 SolverError::input("machine", format!("the stored machine is invalid: {}", error.message()))
             })?;
         }
-        let feed = settings
-            .feed
-            .or(machine.map(|m| m.max_feed))
-            .ok_or_else(|| SolverError::input("feed", "feed is required (or name a machine: its max_feed is used)"))?;
+        let mut capped = Vec::new();
+        let feed = match settings.feed {
+            Some(feed) => super::cap_feed(machine, "feed", feed, &mut capped),
+            None => machine.map(|m| m.max_feed).ok_or_else(|| {
+                SolverError::input("feed", "feed is required (or name a machine: its max_feed is used)")
+            })?,
+        };
         let block_time_ms = settings.block_time_ms.or(machine.map(|m| m.block_time_ms)).ok_or_else(|| {
             SolverError::input("block_time_ms", "block_time_ms is required (or name a machine that has it)")
         })?;
@@ -139,17 +143,7 @@ impl BlockRule {
         rule.min_chord_error = settings.min_chord_error.or(machine.and_then(|m| m.min_chord_error)).unwrap_or(0.0);
         adjust(&mut rule);
         let mut warnings = rule.validate(allow_unsafe)?;
-        if let Some(profile) = machine
-            && feed > profile.max_feed
-        {
-            warnings.push(Warning::new(
-                "W_FEED_ABOVE_MACHINE_MAX",
-                format!(
-                    "feed {feed} mm/min is above the machine's max_feed {} mm/min: the control will not reach it",
-                    profile.max_feed
-                ),
-            ));
-        }
+        warnings.extend(capped);
         Ok((rule, warnings))
     }
 

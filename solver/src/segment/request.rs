@@ -141,7 +141,8 @@ pub enum RadiusEstimate {
 pub struct SegmentRequest {
     /// The target curve.
     pub curve: Curve,
-    /// F: commanded feed, mm/min (default: the machine's `max_feed`).
+    /// F: commanded feed, mm/min (default: the machine's `max_feed`, which also caps a larger one:
+    /// `W_FEED_ABOVE_MACHINE_MAX`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub feed: Option<f64>,
     /// T_b: block processing time of the control, ms (default: the machine's).

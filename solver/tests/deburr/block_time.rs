@@ -196,13 +196,17 @@ fn machine_values_and_bad_block_times() {
         spindle_power_curve: None,
     };
     let tool = ball(3.0);
-    // The machine's block time applies at the request's feed (deburr keeps its own feed).
+    // The machine's block time applies at the request's feed, capped by the machine's max feed
+    // (deburr keeps its own feed otherwise: the machine never raises it).
     let named = request(tube(json!({"machine": "hsc", "feed": 3000})));
     let result = deburr::solve_with(&named, &tool, Some(&machine)).unwrap();
     assert_eq!(result.summary.block_time_ms, Some(4.0));
-    assert_eq!(result.summary.feed, 3000.0);
+    assert_eq!(result.summary.feed, machine.max_feed);
     assert_eq!(result.summary.short_blocks, Some(0));
-    assert!(codes(&result).contains(&"W_FEED_ABOVE_MACHINE_MAX"));
+    let capped = result.warnings.iter().find(|w| w.code == "W_FEED_ABOVE_MACHINE_MAX").expect("the feed is capped");
+    assert!(capped.message.contains("capped from 3000 to 2000"), "{}", capped.message);
+    let slower = deburr::solve_with(&request(tube(json!({"machine": "hsc", "feed": 1500}))), &tool, Some(&machine));
+    assert_eq!(slower.unwrap().summary.feed, 1500.0, "a feed below the machine's is kept");
     // min_chord_error 0.002: no interval is cut finer than that where the rule asks for less.
     assert!(result.summary.max_deviation >= 0.001, "{}", result.summary.max_deviation);
     // The request's block time overrides the machine's.

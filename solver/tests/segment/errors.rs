@@ -280,7 +280,8 @@ fn machine_values_are_defaults_the_request_overrides() {
         "curve": circle(), "machine": "hsc", "feed": 12000, "margin": 1.0, "min_chord_error": 0.002
     }));
     let answer = segment::solve(&overridden, Some(&machine)).unwrap();
-    assert_eq!((answer.feed, answer.margin, answer.min_chord_error), (12_000.0, 1.0, 0.002));
+    // The machine caps the request's feed (it never raises one).
+    assert_eq!((answer.feed, answer.margin, answer.min_chord_error), (10_000.0, 1.0, 0.002));
     assert_eq!(answer.windows[0].status, WindowStatus::ClampedToMinChordError);
     assert!(codes(&answer).contains(&"W_FEED_ABOVE_MACHINE_MAX"));
     assert!(codes(&answer).contains(&"I_CLAMPED_TO_CEMIN"));

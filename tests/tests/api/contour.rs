@@ -713,8 +713,10 @@ async fn a_named_machine_gives_the_block_time_and_dialect() {
     let codes: Vec<&str> =
         from_machine["warnings"].as_array().unwrap().iter().map(|w| w["code"].as_str().unwrap()).collect();
     assert!(codes.contains(&"W_FEED_ABOVE_MACHINE_MAX"), "feed 800 over the machine's 600: {codes:?}");
+    // The machine caps feed 800 to its 600: the program is that of feed 600.
     let mut explicit = reference("C1");
     explicit["block_time_ms"] = json!(4);
+    explicit["feed"] = json!(600);
     let explicit = json_with(app.post_json("/api/v1/contour", &explicit).await, 200).await;
     assert_eq!(from_machine["layers"], explicit["layers"], "the machine's block time chords as the request's");
 

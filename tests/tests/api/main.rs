@@ -15,6 +15,7 @@ mod deburr_machine;
 mod edge_numbers;
 mod engagement;
 mod entries;
+mod feeds;
 mod gcode;
 mod job_fuzz;
 mod job_program;

@@ -357,7 +357,7 @@ pub fn raster_program(lines: usize, points: usize, inch: bool) -> String {
     text
 }
 
-fn finishing_tool() -> Value {
+pub(crate) fn finishing_tool() -> Value {
     let mut tool = ball(3.0, &[(0.0, 0.004), (45.0, 0.006), (90.0, 0.009)]);
     tool["flutes"] = json!(2);
     tool["stiffness"] = json!({"kind": "modal",

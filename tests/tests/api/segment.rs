@@ -269,18 +269,24 @@ async fn machine_defaults_and_overrides() {
     close("C_ep with k_f 1.1", number(&answer["chord_error"]), 0.001_344_5, 1e-6);
     assert!(answer["warnings"].as_array().unwrap().iter().all(|w| w["code"] != "W_FEED_ABOVE_MACHINE_MAX"));
 
-    // The request overrides each of them.
+    // The request overrides each of them; a feed below the machine's is kept.
     let answer = segment(
         &app,
-        &json!({"curve": circle, "machine": "hsc", "feed": 12000, "block_time_ms": 2, "margin": 1.0, "min_chord_error": 0.0}),
+        &json!({"curve": circle, "machine": "hsc", "feed": 6000, "block_time_ms": 2, "margin": 1.0, "min_chord_error": 0.0}),
     )
     .await;
-    assert_eq!((&answer["feed"], &answer["block_time_ms"]), (&json!(12000.0), &json!(2.0)));
+    assert_eq!((&answer["feed"], &answer["block_time_ms"]), (&json!(6000.0), &json!(2.0)));
     assert_eq!((&answer["margin"], &answer["min_chord_error"]), (&json!(1.0), &json!(0.0)));
-    // h = 12000·2/120000 = 0.2 mm on R50.
-    close("C_ep overridden", number(&answer["chord_error"]), 0.04 / (50.0 + (2500.0_f64 - 0.04).sqrt()), 1e-12);
-    let codes: Vec<&str> = answer["warnings"].as_array().unwrap().iter().map(|w| w["code"].as_str().unwrap()).collect();
-    assert!(codes.contains(&"W_FEED_ABOVE_MACHINE_MAX"), "{codes:?}");
+    // h = 6000·2/120000 = 0.1 mm on R50.
+    close("C_ep overridden", number(&answer["chord_error"]), 0.01 / (50.0 + (2500.0_f64 - 0.01).sqrt()), 1e-12);
+    assert!(answer["warnings"].as_array().unwrap().iter().all(|w| w["code"] != "W_FEED_ABOVE_MACHINE_MAX"));
+
+    // A feed above the machine's is capped to it, never the other way, and the answer says so.
+    let answer = segment(&app, &json!({"curve": circle, "machine": "hsc", "feed": 12000, "block_time_ms": 2})).await;
+    assert_eq!(answer["feed"], json!(10000.0));
+    let capped = answer["warnings"].as_array().unwrap().iter().find(|w| w["code"] == "W_FEED_ABOVE_MACHINE_MAX");
+    let message = capped.expect("W_FEED_ABOVE_MACHINE_MAX")["message"].as_str().unwrap();
+    assert!(message.contains("capped from 12000 to 10000"), "{message}");
 
     // The clamp of the machine applies where the rule asks for less (large radius).
     let answer = segment(
