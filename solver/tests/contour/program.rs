@@ -1,6 +1,7 @@
 //! The G-code program of a contour: both dialects, feeds of cuts, loops and links, the reference
-//! point, and the refusal for tilted walls. When LinuxCNC's `rs274` interpreter is installed, the
-//! programs are also run through it.
+//! point, and the refusal for tilted walls. LinuxCNC's `rs274` runs the programs in kerf-tests
+//! (`contour::gcode_of_both_dialects_matches_the_json_moves`, whose pocket has dogbones and a loop), where a missing interpreter shows
+//! as an ignored test.
 
 use kerf_solver::contour::{self, ContourRequest};
 use kerf_solver::gcode::Post;
@@ -66,34 +67,4 @@ fn ball_centre_reference_lifts_the_program_and_tilt_is_refused() {
     let tilted = contour::solve(&request(json!({"tilt_deg": 5})), &Tool::new(ToolKind::Flat, 3.0)).unwrap();
     let error = contour::program(&tilted, &post(Dialect::Fanuc, Reference::Tip)).unwrap_err();
     assert_eq!(error.code().as_str(), "E_TILT_NEEDS_5_AXIS");
-}
-
-#[test]
-fn rs274_accepts_both_dialects() {
-    let Ok(status) = std::process::Command::new("rs274").arg("--help").output() else {
-        eprintln!("rs274 not installed: skipped");
-        return;
-    };
-    let _ = status;
-    let tool = Tool::new(ToolKind::Flat, 3.0);
-    let answer = contour::solve(&request(json!({"inside_corner_relief": "dogbone"})), &tool).unwrap();
-    let directory = std::env::temp_dir().join(format!("kerf-corners-{}", std::process::id()));
-    std::fs::create_dir_all(&directory).unwrap();
-    for dialect in [Dialect::Fanuc, Dialect::Linuxcnc] {
-        let text = contour::program(&answer, &post(dialect, Reference::Tip)).unwrap();
-        let file = directory.join(format!("{dialect:?}.ngc"));
-        std::fs::write(&file, &text).unwrap();
-        let output = std::process::Command::new("rs274").arg("-g").arg(&file).output().unwrap();
-        let stdout = String::from_utf8_lossy(&output.stdout);
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        // rs274 stops at the first bad block: every motion block must reach the canonical output.
-        let blocks = text.lines().filter(|l| l.starts_with("G00") || l.starts_with("G01")).count();
-        let executed =
-            stdout.lines().filter(|l| l.contains("STRAIGHT_FEED") || l.contains("STRAIGHT_TRAVERSE")).count();
-        let complaints: Vec<&str> =
-            stderr.lines().filter(|l| !l.trim().is_empty() && l.trim() != "executing").collect();
-        assert!(output.status.success() && complaints.is_empty(), "{dialect:?}: {stderr}");
-        assert!(executed >= blocks, "{dialect:?}: {executed} of {blocks} motion blocks ran");
-    }
-    let _ = std::fs::remove_dir_all(&directory);
 }
