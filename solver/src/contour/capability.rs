@@ -5,8 +5,10 @@
 use crate::error::ErrorCode;
 use serde::{Deserialize, Serialize};
 
+use super::answer::{ArcSpan, ContourMove};
 use super::detect::{self, DetectMode, MaterialSide, PathLoopAnswer, PathLoopRequest};
 use super::request::MAX_MOVES;
+use super::solve::LayerMoves;
 use super::{ContourRequest, ContourSolution, CornerLoop};
 use crate::capability::{
     Capability, Control, Endpoint, OutputOptions, Part, PartSink, PartSource, Purpose, Refs, Resolved, Run, Sizing,
@@ -39,6 +41,50 @@ pub struct ContourAnswer {
     pub result: ContourSolution,
 }
 
+/// Bytes of one move in memory: the move, its boxed axis (tilted walls) and at most one arc
+/// span.
+const MOVE_BYTES: u64 = (std::mem::size_of::<ContourMove>() + 3 * 8 + std::mem::size_of::<ArcSpan>()) as u64;
+
+/// Most bytes one move takes as JSON: `{"kind":"rapid","to":[x,y,z],"feed":f,"axis":[a,b,c]},`
+/// with its seven numbers at their longest (24 characters; checked by
+/// `move_json_is_within_its_bound`).
+const MOVE_JSON_BYTES: u64 = 256;
+
+/// Most bytes one move takes in a program: one `G01`/`G02` line with three coordinates and an
+/// arc centre of up to `-1000000.0000` (the coordinate range) and a feed word.
+const MOVE_PROGRAM_BYTES: u64 = 128;
+
+/// Most bytes of one corner's or pass's report as JSON (its loop, relief, material, warnings).
+const REPORT_BYTES: u64 = 16 * 1024;
+
+/// Most bytes of an answer besides its moves and reports: tool, machine, summary.
+const ANSWER_BYTES: u64 = 256 * 1024;
+
+/// Most bytes one move takes for `purpose`: in memory, plus its JSON, its program, or for a job
+/// both.
+fn move_bound(purpose: Purpose) -> u64 {
+    MOVE_BYTES
+        + match purpose {
+            Purpose::Json => MOVE_JSON_BYTES,
+            Purpose::Program => MOVE_PROGRAM_BYTES,
+            Purpose::Job => MOVE_JSON_BYTES + MOVE_PROGRAM_BYTES,
+        }
+}
+
+/// The bytes the layer made takes for `purpose`: its moves in memory, plus their JSON as written
+/// (counted, not kept), their program at [`MOVE_PROGRAM_BYTES`] a move, or for a job both.
+fn layer_bytes(layer: &LayerMoves, purpose: Purpose) -> u64 {
+    let moves = layer.moves.len() as u64;
+    let json = || crate::capability::json_bytes(&layer.moves) + 64;
+    let program = || moves.saturating_mul(MOVE_PROGRAM_BYTES);
+    moves.saturating_mul(MOVE_BYTES)
+        + match purpose {
+            Purpose::Json => json(),
+            Purpose::Program => program(),
+            Purpose::Job => json() + program(),
+        }
+}
+
 impl Capability for ContourCapability {
     const NAME: &'static str = "contour";
     const ENDPOINT: Endpoint = Endpoint {
@@ -61,10 +107,36 @@ impl Capability for ContourCapability {
         Refs { tool: Some(&request.tool), machine: request.machine.as_deref(), material: None }
     }
 
+    /// The move cap of the answer ([`MAX_JSON_MOVES`] for JSON, else [`MAX_MOVES`]) at
+    /// [`move_bound`] each, and the corners' and passes' reports.
+    fn answer_bound(request: &ContourRequest, _context: &Resolved<Tool>, purpose: Purpose) -> Option<u64> {
+        let max_moves = if purpose == Purpose::Json { MAX_JSON_MOVES } else { MAX_MOVES };
+        let passes = request.passes.as_ref().map_or(1, Vec::len) as u64;
+        let reports = (request.contour.len() as u64).saturating_add(passes).saturating_mul(REPORT_BYTES);
+        Some(
+            (max_moves as u64).saturating_mul(move_bound(purpose)).saturating_add(reports).saturating_add(ANSWER_BYTES),
+        )
+    }
+
     /// A JSON answer holds at most [`MAX_JSON_MOVES`] moves; a program or a job up to [`MAX_MOVES`].
+    /// Each layer's moves are charged to the run's budget as the layer is made.
     fn solve(request: &ContourRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<ContourAnswer, SolverError> {
         let max_moves = if run.purpose == Purpose::Json { MAX_JSON_MOVES } else { MAX_MOVES };
-        let result = super::solve_with(request, &context.tool, context.machine.as_ref(), max_moves, run.control);
+        let charge = |layer: &LayerMoves, done: usize, count: usize| {
+            if run.budget.is_none() {
+                return Ok(());
+            }
+            let extra = if done == 1 { ANSWER_BYTES } else { 0 };
+            run.charge(layer_bytes(layer, run.purpose) + extra, done, count)
+        };
+        let result = super::solve::solve_charged(
+            request,
+            &context.tool,
+            context.machine.as_ref(),
+            max_moves,
+            run.control,
+            charge,
+        );
         let result = if run.purpose == Purpose::Json { result.map_err(json_limit_advice)? } else { result? };
         Ok(ContourAnswer { tool: context.tool, machine: context.machine, result })
     }
@@ -226,5 +298,26 @@ impl LoopsRequest {
         };
         let result = detect::loop_path_within(&path_request, MAX_JSON_MOVES, control)?;
         Ok(LoopsAnswer { tool, result })
+    }
+}
+
+#[cfg(test)]
+mod budget_tests {
+    use super::*;
+    use crate::contour::answer::MoveKind;
+
+    #[test]
+    fn move_json_is_within_its_bound() {
+        // The longest number serde writes (ryu) in every field, the longest kind.
+        let longest = -2.225_073_858_507_201_4e-308;
+        let step = ContourMove {
+            kind: MoveKind::Rapid,
+            to: [longest; 3],
+            feed: Some(longest),
+            axis: Some(Box::new([longest; 3])),
+        };
+        // With the comma that separates it from the next move.
+        let json = serde_json::to_vec(&step).unwrap().len() as u64 + 1;
+        assert!(json <= MOVE_JSON_BYTES, "{json} bytes");
     }
 }

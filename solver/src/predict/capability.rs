@@ -80,7 +80,7 @@ impl Capability for PredictCapability {
     /// A `mesh` stock needs the uploaded STL file, and an upload needs a `mesh` stock.
     fn solve(request: &PredictRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<PredictAnswer, SolverError> {
         check_upload(request, run)?;
-        let result = super::solve_with(request, &context.tool, run.upload, &run.control)?;
+        let result = super::solve_run(request, &context.tool, run)?;
         Ok(PredictAnswer { tool: context.tool, result, timings: None })
     }
 
@@ -121,8 +121,11 @@ impl Capability for PredictCapability {
             &run.control,
             &AtomicUsize::new(0),
             job.pass_range.len().max(1),
-        )
-        .ok_or_else(pipeline::cancelled)?;
+            &|outcome| match run.budget {
+                None => Ok(()),
+                Some(budget) => budget.charge(super::answer::pass_bytes(outcome, run.purpose, true), 1, 1),
+            },
+        )?;
         let passes = outcomes.drain(job.pass_range.clone()).collect();
         sink.put(&PartPasses { from: job.pass_range.start, passes })
     }

@@ -67,7 +67,7 @@ impl Capability for SegmentCapability {
         if let Some(feed) = request.plunge_feed {
             crate::validate::positive("plunge_feed", feed)?;
         }
-        let result = super::solve_controlled(request, context.machine.as_ref(), run.control)?;
+        let result = super::solve_run(request, context.machine.as_ref(), run)?;
         let cycle_time = context.machine.as_ref().and_then(|machine| {
             let plunge =
                 request.plunge_feed.or(context.tool.as_ref().and_then(|t| t.plunge_feed)).or(machine.plunge_feed);
