@@ -41,9 +41,12 @@ pub struct ContourAnswer {
     pub result: ContourSolution,
 }
 
-/// Bytes of one move in memory: the move, its boxed axis (tilted walls) and at most one arc
+/// Most bytes of one move in memory: the move, its boxed axis (tilted walls) and at most one arc
 /// span.
-const MOVE_BYTES: u64 = (std::mem::size_of::<ContourMove>() + 3 * 8 + std::mem::size_of::<ArcSpan>()) as u64;
+const MOVE_BYTES: u64 = (std::mem::size_of::<ContourMove>() + AXIS_BYTES + std::mem::size_of::<ArcSpan>()) as u64;
+
+/// Bytes of a move's boxed tool axis.
+const AXIS_BYTES: usize = std::mem::size_of::<[f64; 3]>();
 
 /// Most bytes one move takes as JSON: `{"kind":"rapid","to":[x,y,z],"feed":f,"axis":[a,b,c]},`
 /// with its seven numbers at their longest (24 characters; checked by
@@ -60,30 +63,37 @@ const REPORT_BYTES: u64 = 16 * 1024;
 /// Most bytes of an answer besides its moves and reports: tool, machine, summary.
 const ANSWER_BYTES: u64 = 256 * 1024;
 
-/// Most bytes one move takes for `purpose`: in memory, plus its JSON, its program, or for a job
-/// both.
+/// Most bytes one move takes for `purpose` (see [`layer_bytes`]): in memory and as JSON, in
+/// memory and as a program line, or for a job as JSON and a program line.
 fn move_bound(purpose: Purpose) -> u64 {
-    MOVE_BYTES
-        + match purpose {
-            Purpose::Json => MOVE_JSON_BYTES,
-            Purpose::Program => MOVE_PROGRAM_BYTES,
-            Purpose::Job => MOVE_JSON_BYTES + MOVE_PROGRAM_BYTES,
-        }
+    match purpose {
+        Purpose::Json => MOVE_BYTES + MOVE_JSON_BYTES,
+        Purpose::Program => MOVE_BYTES + MOVE_PROGRAM_BYTES,
+        Purpose::Job => MOVE_JSON_BYTES + MOVE_PROGRAM_BYTES,
+    }
 }
 
-/// The bytes the layer made takes for `purpose`: its moves in memory, plus their JSON as written
-/// (counted, not kept), their program at [`MOVE_PROGRAM_BYTES`] a move, or for a job both.
+/// The bytes the layer made is charged for `purpose`, what the answer's delivery is later
+/// checked on, counted as it is built: for JSON its moves in memory and their JSON as written
+/// (counted, not kept); for a program its moves in memory (the program itself is checked whole
+/// once written); for a job the JSON it stores (the program is checked beside it once written:
+/// the moves' memory is not counted, as the stored result and program are what a job's budget
+/// holds).
 fn layer_bytes(layer: &LayerMoves, purpose: Purpose) -> u64 {
-    let moves = layer.moves.len() as u64;
-    let json = || crate::capability::json_bytes(&layer.moves) + 64;
-    let program = || moves.saturating_mul(MOVE_PROGRAM_BYTES);
-    moves.saturating_mul(MOVE_BYTES)
-        + match purpose {
-            Purpose::Json => json(),
-            Purpose::Program => program(),
-            Purpose::Job => json() + program(),
-        }
+    let axes = layer.moves.iter().filter(|step| step.axis.is_some()).count();
+    let memory = (layer.moves.len() * std::mem::size_of::<ContourMove>()
+        + axes * AXIS_BYTES
+        + layer.arcs.len() * std::mem::size_of::<ArcSpan>()) as u64;
+    let json = || crate::capability::json_bytes(&layer.moves) + LAYER_JSON_BYTES;
+    match purpose {
+        Purpose::Json => memory + json(),
+        Purpose::Program => memory,
+        Purpose::Job => json(),
+    }
 }
+
+/// Most bytes of a layer's JSON besides its moves: `{"z":…,"moves":[…]},`.
+const LAYER_JSON_BYTES: u64 = 64;
 
 impl Capability for ContourCapability {
     const NAME: &'static str = "contour";
@@ -319,5 +329,77 @@ mod budget_tests {
         // With the comma that separates it from the next move.
         let json = serde_json::to_vec(&step).unwrap().len() as u64 + 1;
         assert!(json <= MOVE_JSON_BYTES, "{json} bytes");
+    }
+
+    /// A 600-gon of `layers` layers of 0.1 mm, some 606 moves each.
+    fn polygon(layers: f64) -> ContourRequest {
+        let contour: Vec<[f64; 2]> = (0..600)
+            .map(|k| {
+                let angle = std::f64::consts::TAU * f64::from(k) / 600.0;
+                [30.0 * angle.cos(), 30.0 * angle.sin()]
+            })
+            .collect();
+        serde_json::from_value(serde_json::json!({
+            "tool": {"kind": "flat", "radius": 3}, "contour": contour, "side": "outside",
+            "depths": {"top": 0, "bottom": -layers * 0.1, "step": 0.1}, "feed": 800
+        }))
+        .unwrap()
+    }
+
+    fn context(request: &ContourRequest) -> Resolved<Tool> {
+        let ToolRef::Inline(tool) = &request.tool else { unreachable!("an inline tool") };
+        Resolved { tool: tool.clone(), machine: None, material: None, other_tools: Vec::new() }
+    }
+
+    #[test]
+    fn layers_over_the_budget_are_refused_a_layer_past_it() {
+        let request = polygon(400.0);
+        for purpose in [Purpose::Json, Purpose::Program, Purpose::Job] {
+            let budget = crate::capability::AnswerBudget::new(1 << 20);
+            let run = Run { budget: Some(&budget), purpose, ..Run::default() };
+            let error = ContourCapability::solve(&request, context(&request), &run).unwrap_err();
+            assert_eq!(error.code(), ErrorCode::TooLargeAnswer, "{purpose:?}: {error}");
+            let layer = 700 * move_bound(purpose) + ANSWER_BYTES;
+            assert!(budget.used() <= budget.limit() + layer, "{purpose:?}: {} charged", budget.used());
+        }
+    }
+
+    #[test]
+    fn the_bound_and_the_charges_cover_what_is_built() {
+        let request = polygon(10.0);
+        let context = context(&request);
+        let answer = ContourCapability::solve(&request, context.clone(), &Run::default()).unwrap();
+        let moves: u64 = answer.result.layers.iter().map(|layer| layer.moves.len() as u64).sum();
+        let json = serde_json::to_vec(&answer).unwrap().len() as u64;
+        let program = crate::capability::program::<ContourCapability>(
+            &request,
+            &answer,
+            &OutputOptions::default(),
+            Control::default(),
+        )
+        .unwrap()
+        .len() as u64;
+        let memory = moves * std::mem::size_of::<ContourMove>() as u64;
+        // What each purpose is charged: the answer's JSON and its moves, the moves of a program,
+        // the JSON a job stores.
+        for (purpose, built, delivered) in [
+            (Purpose::Json, memory + json, json),
+            (Purpose::Program, memory, program),
+            (Purpose::Job, json, json + program),
+        ] {
+            let budget = crate::capability::AnswerBudget::new(u64::MAX);
+            let run = Run { budget: Some(&budget), purpose, ..Run::default() };
+            ContourCapability::solve(&request, context.clone(), &run).unwrap();
+            assert!(built <= budget.used(), "{purpose:?}: {built} built, {} charged", budget.used());
+            // The bound covers the charges and what is delivered.
+            let bound = ContourCapability::answer_bound(&request, &context, purpose).unwrap();
+            assert!(
+                budget.used().max(delivered) <= bound,
+                "{purpose:?}: {} charged over the bound {bound}",
+                budget.used()
+            );
+        }
+        // A JSON answer at its move cap fits the default budget: counted only under a smaller one.
+        assert!(ContourCapability::answer_bound(&request, &context, Purpose::Json).unwrap() < 512 << 20);
     }
 }
