@@ -485,6 +485,29 @@ impl AnswerBudget {
     }
 }
 
+/// The bytes `value` takes as JSON, counted as it is written (nothing is kept): what a unit of an
+/// answer is charged for its JSON ([`AnswerBudget::charge`]).
+pub fn json_bytes<T: Serialize + ?Sized>(value: &T) -> u64 {
+    let mut counter = ByteCounter(0);
+    // Written to a counter, the JSON cannot fail for want of room: count what was written.
+    let _ = serde_json::to_writer(&mut counter, value);
+    counter.0
+}
+
+/// Counts the bytes written to it.
+struct ByteCounter(u64);
+
+impl std::io::Write for ByteCounter {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        self.0 += bytes.len() as u64;
+        Ok(bytes.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
 /// The refusal of an answer estimated at `estimate` bytes under a limit of `limit`.
 #[must_use]
 pub fn too_large_answer(estimate: u64, limit: u64) -> SolverError {

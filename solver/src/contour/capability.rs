@@ -5,8 +5,10 @@
 use crate::error::ErrorCode;
 use serde::{Deserialize, Serialize};
 
+use super::answer::{ArcSpan, ContourMove};
 use super::detect::{self, DetectMode, MaterialSide, PathLoopAnswer, PathLoopRequest};
 use super::request::MAX_MOVES;
+use super::solve::LayerMoves;
 use super::{ContourRequest, ContourSolution, CornerLoop};
 use crate::capability::{
     Capability, Control, Endpoint, OutputOptions, Part, PartSink, PartSource, Purpose, Refs, Resolved, Run, Sizing,
@@ -39,6 +41,60 @@ pub struct ContourAnswer {
     pub result: ContourSolution,
 }
 
+/// Most bytes of one move in memory: the move, its boxed axis (tilted walls) and at most one arc
+/// span.
+const MOVE_BYTES: u64 = (std::mem::size_of::<ContourMove>() + AXIS_BYTES + std::mem::size_of::<ArcSpan>()) as u64;
+
+/// Bytes of a move's boxed tool axis.
+const AXIS_BYTES: usize = std::mem::size_of::<[f64; 3]>();
+
+/// Most bytes one move takes as JSON: `{"kind":"rapid","to":[x,y,z],"feed":f,"axis":[a,b,c]},`
+/// with its seven numbers at their longest (24 characters; checked by
+/// `move_json_is_within_its_bound`).
+const MOVE_JSON_BYTES: u64 = 256;
+
+/// Most bytes one move takes in a program: one `G01`/`G02` line with three coordinates and an
+/// arc centre of up to `-1000000.0000` (the coordinate range) and a feed word.
+const MOVE_PROGRAM_BYTES: u64 = 128;
+
+/// Most bytes of one corner's or pass's report as JSON (its loop, relief, material, warnings).
+const REPORT_BYTES: u64 = 16 * 1024;
+
+/// Most bytes of an answer besides its moves and reports: tool, machine, summary.
+const ANSWER_BYTES: u64 = 256 * 1024;
+
+/// Most bytes one move takes for `purpose` (see [`layer_bytes`]): in memory and as JSON, in
+/// memory and as a program line, or for a job as JSON and a program line.
+fn move_bound(purpose: Purpose) -> u64 {
+    match purpose {
+        Purpose::Json => MOVE_BYTES + MOVE_JSON_BYTES,
+        Purpose::Program => MOVE_BYTES + MOVE_PROGRAM_BYTES,
+        Purpose::Job => MOVE_JSON_BYTES + MOVE_PROGRAM_BYTES,
+    }
+}
+
+/// The bytes the layer made is charged for `purpose`, what the answer's delivery is later
+/// checked on, counted as it is built: for JSON its moves in memory and their JSON as written
+/// (counted, not kept); for a program its moves in memory (the program itself is checked whole
+/// once written); for a job the JSON it stores (the program is checked beside it once written:
+/// the moves' memory is not counted, as the stored result and program are what a job's budget
+/// holds).
+fn layer_bytes(layer: &LayerMoves, purpose: Purpose) -> u64 {
+    let axes = layer.moves.iter().filter(|step| step.axis.is_some()).count();
+    let memory = (layer.moves.len() * std::mem::size_of::<ContourMove>()
+        + axes * AXIS_BYTES
+        + layer.arcs.len() * std::mem::size_of::<ArcSpan>()) as u64;
+    let json = || crate::capability::json_bytes(&layer.moves) + LAYER_JSON_BYTES;
+    match purpose {
+        Purpose::Json => memory + json(),
+        Purpose::Program => memory,
+        Purpose::Job => json(),
+    }
+}
+
+/// Most bytes of a layer's JSON besides its moves: `{"z":…,"moves":[…]},`.
+const LAYER_JSON_BYTES: u64 = 64;
+
 impl Capability for ContourCapability {
     const NAME: &'static str = "contour";
     const ENDPOINT: Endpoint = Endpoint {
@@ -61,10 +117,36 @@ impl Capability for ContourCapability {
         Refs { tool: Some(&request.tool), machine: request.machine.as_deref(), material: None }
     }
 
+    /// The move cap of the answer ([`MAX_JSON_MOVES`] for JSON, else [`MAX_MOVES`]) at
+    /// [`move_bound`] each, and the corners' and passes' reports.
+    fn answer_bound(request: &ContourRequest, _context: &Resolved<Tool>, purpose: Purpose) -> Option<u64> {
+        let max_moves = if purpose == Purpose::Json { MAX_JSON_MOVES } else { MAX_MOVES };
+        let passes = request.passes.as_ref().map_or(1, Vec::len) as u64;
+        let reports = (request.contour.len() as u64).saturating_add(passes).saturating_mul(REPORT_BYTES);
+        Some(
+            (max_moves as u64).saturating_mul(move_bound(purpose)).saturating_add(reports).saturating_add(ANSWER_BYTES),
+        )
+    }
+
     /// A JSON answer holds at most [`MAX_JSON_MOVES`] moves; a program or a job up to [`MAX_MOVES`].
+    /// Each layer's moves are charged to the run's budget as the layer is made.
     fn solve(request: &ContourRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<ContourAnswer, SolverError> {
         let max_moves = if run.purpose == Purpose::Json { MAX_JSON_MOVES } else { MAX_MOVES };
-        let result = super::solve_with(request, &context.tool, context.machine.as_ref(), max_moves, run.control);
+        let charge = |layer: &LayerMoves, done: usize, count: usize| {
+            if run.budget.is_none() {
+                return Ok(());
+            }
+            let extra = if done == 1 { ANSWER_BYTES } else { 0 };
+            run.charge(layer_bytes(layer, run.purpose) + extra, done, count)
+        };
+        let result = super::solve::solve_charged(
+            request,
+            &context.tool,
+            context.machine.as_ref(),
+            max_moves,
+            run.control,
+            charge,
+        );
         let result = if run.purpose == Purpose::Json { result.map_err(json_limit_advice)? } else { result? };
         Ok(ContourAnswer { tool: context.tool, machine: context.machine, result })
     }
@@ -226,5 +308,98 @@ impl LoopsRequest {
         };
         let result = detect::loop_path_within(&path_request, MAX_JSON_MOVES, control)?;
         Ok(LoopsAnswer { tool, result })
+    }
+}
+
+#[cfg(test)]
+mod budget_tests {
+    use super::*;
+    use crate::contour::answer::MoveKind;
+
+    #[test]
+    fn move_json_is_within_its_bound() {
+        // The longest number serde writes (ryu) in every field, the longest kind.
+        let longest = -2.225_073_858_507_201_4e-308;
+        let step = ContourMove {
+            kind: MoveKind::Rapid,
+            to: [longest; 3],
+            feed: Some(longest),
+            axis: Some(Box::new([longest; 3])),
+        };
+        // With the comma that separates it from the next move.
+        let json = serde_json::to_vec(&step).unwrap().len() as u64 + 1;
+        assert!(json <= MOVE_JSON_BYTES, "{json} bytes");
+    }
+
+    /// A 600-gon of `layers` layers of 0.1 mm, some 606 moves each.
+    fn polygon(layers: f64) -> ContourRequest {
+        let contour: Vec<[f64; 2]> = (0..600)
+            .map(|k| {
+                let angle = std::f64::consts::TAU * f64::from(k) / 600.0;
+                [30.0 * angle.cos(), 30.0 * angle.sin()]
+            })
+            .collect();
+        serde_json::from_value(serde_json::json!({
+            "tool": {"kind": "flat", "radius": 3}, "contour": contour, "side": "outside",
+            "depths": {"top": 0, "bottom": -layers * 0.1, "step": 0.1}, "feed": 800
+        }))
+        .unwrap()
+    }
+
+    fn context(request: &ContourRequest) -> Resolved<Tool> {
+        let ToolRef::Inline(tool) = &request.tool else { unreachable!("an inline tool") };
+        Resolved { tool: tool.clone(), machine: None, material: None, other_tools: Vec::new() }
+    }
+
+    #[test]
+    fn layers_over_the_budget_are_refused_a_layer_past_it() {
+        let request = polygon(400.0);
+        for purpose in [Purpose::Json, Purpose::Program, Purpose::Job] {
+            let budget = crate::capability::AnswerBudget::new(1 << 20);
+            let run = Run { budget: Some(&budget), purpose, ..Run::default() };
+            let error = ContourCapability::solve(&request, context(&request), &run).unwrap_err();
+            assert_eq!(error.code(), ErrorCode::TooLargeAnswer, "{purpose:?}: {error}");
+            let layer = 700 * move_bound(purpose) + ANSWER_BYTES;
+            assert!(budget.used() <= budget.limit() + layer, "{purpose:?}: {} charged", budget.used());
+        }
+    }
+
+    #[test]
+    fn the_bound_and_the_charges_cover_what_is_built() {
+        let request = polygon(10.0);
+        let context = context(&request);
+        let answer = ContourCapability::solve(&request, context.clone(), &Run::default()).unwrap();
+        let moves: u64 = answer.result.layers.iter().map(|layer| layer.moves.len() as u64).sum();
+        let json = serde_json::to_vec(&answer).unwrap().len() as u64;
+        let program = crate::capability::program::<ContourCapability>(
+            &request,
+            &answer,
+            &OutputOptions::default(),
+            Control::default(),
+        )
+        .unwrap()
+        .len() as u64;
+        let memory = moves * std::mem::size_of::<ContourMove>() as u64;
+        // What each purpose is charged: the answer's JSON and its moves, the moves of a program,
+        // the JSON a job stores.
+        for (purpose, built, delivered) in [
+            (Purpose::Json, memory + json, json),
+            (Purpose::Program, memory, program),
+            (Purpose::Job, json, json + program),
+        ] {
+            let budget = crate::capability::AnswerBudget::new(u64::MAX);
+            let run = Run { budget: Some(&budget), purpose, ..Run::default() };
+            ContourCapability::solve(&request, context.clone(), &run).unwrap();
+            assert!(built <= budget.used(), "{purpose:?}: {built} built, {} charged", budget.used());
+            // The bound covers the charges and what is delivered.
+            let bound = ContourCapability::answer_bound(&request, &context, purpose).unwrap();
+            assert!(
+                budget.used().max(delivered) <= bound,
+                "{purpose:?}: {} charged over the bound {bound}",
+                budget.used()
+            );
+        }
+        // A JSON answer at its move cap fits the default budget: counted only under a smaller one.
+        assert!(ContourCapability::answer_bound(&request, &context, Purpose::Json).unwrap() < 512 << 20);
     }
 }

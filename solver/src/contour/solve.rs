@@ -117,8 +117,25 @@ pub fn solve_with(
     max_moves: usize,
     control: Control<'_>,
 ) -> Result<ContourSolution, SolverError> {
+    solve_charged(request, tool, machine, max_moves, control, |_, _, _| Ok(()))
+}
+
+/// As [`solve_with`], handing each layer as it is made to `charge` with its place (1-based) and
+/// the count of layers (an answer budget's unit of work).
+///
+/// # Errors
+/// As [`solve_with`], and what `charge` refuses.
+pub(crate) fn solve_charged(
+    request: &ContourRequest,
+    tool: &Tool,
+    machine: Option<&MachineProfile>,
+    max_moves: usize,
+    control: Control<'_>,
+    mut charge: impl FnMut(&LayerMoves, usize, usize) -> Result<(), SolverError>,
+) -> Result<ContourSolution, SolverError> {
     let prepared = Prepared::new(request, tool, machine, max_moves, control)?;
-    let layers = prepared.layers(0..prepared.job.layers.len(), control)?;
+    let count = prepared.job.layers.len();
+    let layers = prepared.layers_with(0..count, control, |layer, done| charge(layer, done, count))?;
     prepared.answer(machine, max_moves, layers, control)
 }
 
@@ -201,6 +218,20 @@ impl Prepared {
         range: std::ops::Range<usize>,
         control: Control<'_>,
     ) -> Result<Vec<LayerMoves>, SolverError> {
+        self.layers_with(range, control, |_, _| Ok(()))
+    }
+
+    /// As [`Prepared::layers`], handing each layer as it is made to `each` with its place in the
+    /// range (1-based), so its moves are charged to an answer budget before the next is made.
+    ///
+    /// # Errors
+    /// As [`Prepared::layers`], and what `each` refuses.
+    pub(crate) fn layers_with(
+        &self,
+        range: std::ops::Range<usize>,
+        control: Control<'_>,
+        mut each: impl FnMut(&LayerMoves, usize) -> Result<(), SolverError>,
+    ) -> Result<Vec<LayerMoves>, SolverError> {
         let job = &self.job;
         let mut layers = Vec::with_capacity(range.len());
         let (from, count) = (range.start, range.len());
@@ -222,7 +253,9 @@ impl Prepared {
             let previous_z = if index == 0 { job.top } else { job.layers[index - 1] };
             let (moves, arcs) =
                 layer_moves(job, layer, passes, lead_point.map(|(point, _)| point), index == 0, previous_z, z);
-            layers.push(LayerMoves { z, moves, arcs, lead });
+            let made = LayerMoves { z, moves, arcs, lead };
+            each(&made, index - from + 1)?;
+            layers.push(made);
         }
         Ok(layers)
     }

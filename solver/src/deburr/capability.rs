@@ -266,12 +266,7 @@ const POINT_BYTES: u64 = std::mem::size_of::<DeburrPoint>() as u64;
 /// both.
 fn loop_bytes(result: &Deburr, purpose: Purpose) -> u64 {
     let points = result.points.len() as u64;
-    let json = || {
-        let mut counter = ByteCounter(0);
-        // Written to a counter, the JSON cannot fail for want of room: count what was written.
-        let _ = serde_json::to_writer(&mut counter, result);
-        counter.0 + PLACE_BYTES
-    };
+    let json = || crate::capability::json_bytes(result) + PLACE_BYTES;
     let program = || points.saturating_mul(POINT_PROGRAM_BYTES).saturating_add(PLACE_BYTES);
     points.saturating_mul(POINT_BYTES)
         + match purpose {
@@ -284,20 +279,6 @@ fn loop_bytes(result: &Deburr, purpose: Purpose) -> u64 {
 /// Most bytes of a loop's place among the holes (its field, index, tool field, angles, axial
 /// position) as JSON, and of the moves between two loops in a program.
 const PLACE_BYTES: u64 = 1024;
-
-/// Counts the bytes written to it.
-struct ByteCounter(u64);
-
-impl std::io::Write for ByteCounter {
-    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
-        self.0 += bytes.len() as u64;
-        Ok(bytes.len())
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        Ok(())
-    }
-}
 
 /// Charges loop `index` of `count` to the run's budget as it is built; the first loop twice (a
 /// several-loop answer repeats it at the top).

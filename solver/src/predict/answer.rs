@@ -250,3 +250,44 @@ pub(crate) struct Corrections {
     pub(crate) sources: Vec<NodeSource>,
     pub(crate) reference_offset: Vec3,
 }
+
+/// Most bytes a pass's record takes as JSON beyond its outcome's JSON (which skips what it does
+/// not have): its index, line and block number, correction and corrected point, residual error,
+/// the longer names of its angles and the `null`s of what was not predicted, every number at its
+/// longest (24 characters; checked by `pass_json_is_within_its_bound`).
+pub(crate) const RECORD_JSON_BYTES: u64 = 768;
+
+/// Most bytes one pass takes in a program: its point's line, up to five words of up to
+/// `-1000000.0000` (the coordinate range).
+const PASS_PROGRAM_BYTES: u64 = 128;
+
+/// The bytes one predicted pass takes for `purpose`: its outcome in memory (and its record, when
+/// it is `delivered`: a pass of the last round), plus its record's JSON (the outcome's as written,
+/// counted, not kept, and [`RECORD_JSON_BYTES`]), its program line, or for a job both.
+pub(crate) fn pass_bytes(
+    outcome: &super::pipeline::Outcome,
+    purpose: crate::capability::Purpose,
+    delivered: bool,
+) -> u64 {
+    use crate::capability::Purpose;
+    let history = outcome.history.as_ref().map_or(0, |history| {
+        (history.force.len() * std::mem::size_of::<[f64; 3]>()
+            + history.deflection.len() * std::mem::size_of::<[f64; 2]>()) as u64
+    });
+    let memory = std::mem::size_of::<super::pipeline::Outcome>() as u64
+        + (outcome.flags.len() * std::mem::size_of::<PassFlag>()) as u64
+        + history;
+    if !delivered {
+        return memory;
+    }
+    let record =
+        std::mem::size_of::<PredictedPass>() as u64 + memory - std::mem::size_of::<super::pipeline::Outcome>() as u64;
+    let json = || crate::capability::json_bytes(outcome) + RECORD_JSON_BYTES;
+    memory
+        + record
+        + match purpose {
+            Purpose::Json => json(),
+            Purpose::Program => PASS_PROGRAM_BYTES,
+            Purpose::Job => json() + PASS_PROGRAM_BYTES,
+        }
+}

@@ -80,7 +80,7 @@ impl Capability for PredictCapability {
     /// A `mesh` stock needs the uploaded STL file, and an upload needs a `mesh` stock.
     fn solve(request: &PredictRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<PredictAnswer, SolverError> {
         check_upload(request, run)?;
-        let result = super::solve_with(request, &context.tool, run.upload, &run.control)?;
+        let result = super::solve_run(request, &context.tool, run)?;
         Ok(PredictAnswer { tool: context.tool, result, timings: None })
     }
 
@@ -121,8 +121,11 @@ impl Capability for PredictCapability {
             &run.control,
             &AtomicUsize::new(0),
             job.pass_range.len().max(1),
-        )
-        .ok_or_else(pipeline::cancelled)?;
+            &|outcome| match run.budget {
+                None => Ok(()),
+                Some(budget) => budget.charge(super::answer::pass_bytes(outcome, run.purpose, true), 1, 1),
+            },
+        )?;
         let passes = outcomes.drain(job.pass_range.clone()).collect();
         sink.put(&PartPasses { from: job.pass_range.start, passes })
     }
@@ -309,5 +312,64 @@ fn check_reference(request: &PredictRequest, reference: Option<Reference>) -> Re
             ),
         )),
         _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod budget_tests {
+    use super::*;
+    use crate::capability::{AnswerBudget, Purpose};
+    use crate::tool::ToolRef;
+
+    /// A raster of `lines` lines of `points` points over a 40 mm box, ball R3 with a modal
+    /// stiffness.
+    fn raster(lines: usize, points: usize) -> (PredictRequest, Resolved<Tool>) {
+        let mut program = String::from("G21 G90 G17\nS8000 M03\nG0 X-4 Y-3 Z10\nG1 Z0 F1600\n");
+        for line in 0..lines {
+            let y = -3.0 + 0.5 * line as f64;
+            for k in 0..points {
+                let i = if line % 2 == 0 { k } else { points - 1 - k };
+                let x = -4.0 + 8.0 * i as f64 / (points - 1) as f64;
+                program.push_str(&format!("X{x:.4} Y{y:.4}\n"));
+            }
+        }
+        let modal = serde_json::json!([{"stiffness": 3000, "frequency_hz": 1800, "damping_ratio": 0.04}]);
+        let request: PredictRequest = serde_json::from_value(serde_json::json!({
+            "tool": {"kind": "ball", "radius": 3, "flutes": 2, "stiffness": {"kind": "modal", "x": modal, "y": modal},
+                     "shape_error": [{"angle_deg": 0, "error": 0.004}, {"angle_deg": 90, "error": 0.009}]},
+            "stock": {"kind": "box", "min": [-20, -20, -10], "max": [20, 20, 0.25]},
+            "path": {"kind": "gcode", "program": program},
+            "cutting": {"ktc": 2000, "krc": 800, "kac": 300},
+            "resolution": 32
+        }))
+        .unwrap();
+        let ToolRef::Inline(tool) = &request.tool else { unreachable!("an inline tool") };
+        let context = Resolved { tool: tool.clone(), machine: None, material: None, other_tools: Vec::new() };
+        (request, context)
+    }
+
+    #[test]
+    fn passes_over_the_budget_are_refused_a_pass_past_it() {
+        let (request, context) = raster(40, 81);
+        let budget = AnswerBudget::new(256 * 1024);
+        let run = Run { budget: Some(&budget), ..Run::default() };
+        let error = PredictCapability::solve(&request, context, &run).unwrap_err();
+        assert_eq!(error.code(), ErrorCode::TooLargeAnswer, "{error}");
+        // Each worker thread may finish the pass it is on.
+        let passes = rayon::current_num_threads() as u64 + 1;
+        assert!(budget.used() <= budget.limit() + passes * 8 * 1024, "{} charged", budget.used());
+    }
+
+    #[test]
+    fn the_charges_cover_what_is_built() {
+        let (request, context) = raster(6, 9);
+        let answer = PredictCapability::solve(&request, context.clone(), &Run::default()).unwrap();
+        let records: u64 =
+            answer.result.passes.len() as u64 * std::mem::size_of::<super::super::PredictedPass>() as u64;
+        let json = serde_json::to_vec(&answer.result.passes).unwrap().len() as u64;
+        let budget = AnswerBudget::new(u64::MAX);
+        let run = Run { budget: Some(&budget), purpose: Purpose::Json, ..Run::default() };
+        PredictCapability::solve(&request, context, &run).unwrap();
+        assert!(records + json <= budget.used(), "{} built, {} charged", records + json, budget.used());
     }
 }

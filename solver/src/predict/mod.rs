@@ -115,6 +115,30 @@ pub fn solve_with(
     mesh: Option<&[u8]>,
     control: &Control<'_>,
 ) -> Result<Predict, SolverError> {
+    solve_charged(request, tool, mesh, control, None)
+}
+
+/// As [`solve_with`] under `run`: its control and upload, and its answer budget charged for every
+/// pass as it is predicted (in memory, and at most as delivered for `run.purpose`), so a path
+/// whose answer would not fit is refused a pass past the budget instead of after every pass.
+///
+/// # Errors
+/// As [`solve_with`]; `E_TOO_LARGE_ANSWER` over the budget.
+pub fn solve_run(
+    request: &PredictRequest,
+    tool: &Tool,
+    run: &crate::capability::Run<'_>,
+) -> Result<Predict, SolverError> {
+    solve_charged(request, tool, run.upload, &run.control, run.budget.map(|budget| (budget, run.purpose)))
+}
+
+fn solve_charged(
+    request: &PredictRequest,
+    tool: &Tool,
+    mesh: Option<&[u8]>,
+    control: &Control<'_>,
+    budget: Option<(&crate::capability::AnswerBudget, crate::capability::Purpose)>,
+) -> Result<Predict, SolverError> {
     let job = request.validate(tool, mesh, *control)?;
     let context = Context::new(&job);
     let node_count = job.path.nodes.len();
@@ -127,8 +151,16 @@ pub fn solve_with(
     let mut current: Option<PathModel> = None;
     for round in 0..job.iterations {
         let path = current.as_ref().unwrap_or(&job.path);
-        let outcomes =
-            pipeline::run_round(&context, path, control, &done, total_work).ok_or_else(pipeline::cancelled)?;
+        // Every round's outcomes are held to the end; the last round's are the answer's passes.
+        let delivered = round + 1 == job.iterations;
+        let charge = |outcome: &pipeline::Outcome| match budget {
+            None => Ok(()),
+            Some((budget, purpose)) => {
+                let bytes = answer::pass_bytes(outcome, purpose, delivered);
+                budget.charge(bytes, done.load(std::sync::atomic::Ordering::Relaxed), total_work)
+            }
+        };
+        let outcomes = pipeline::run_round(&context, path, control, &done, total_work, &charge)?;
         let (step, _, round_ambiguous) = node_corrections(path, &outcomes, f64::INFINITY);
         for node in 0..node_count {
             total[node] += step[node];

@@ -163,6 +163,30 @@ pub(crate) fn run_round(
     control: &Control<'_>,
     done: &AtomicUsize,
     total_work: usize,
+    charge: &(dyn Fn(&Outcome) -> Result<(), SolverError> + Sync),
+) -> Result<Vec<Outcome>, SolverError> {
+    let refused: std::sync::Mutex<Option<SolverError>> = std::sync::Mutex::new(None);
+    let charged = |outcome: &Outcome| match charge(outcome) {
+        Ok(()) => true,
+        Err(error) => {
+            refused.lock().unwrap_or_else(std::sync::PoisonError::into_inner).get_or_insert(error);
+            false
+        }
+    };
+    round_outcomes(context, path, control, done, total_work, &charged).ok_or_else(|| {
+        refused.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner).unwrap_or_else(cancelled)
+    })
+}
+
+/// [`run_round`]'s outcomes, each handed to `charged` as it is made; `None` once cancelled or
+/// once `charged` refuses one.
+fn round_outcomes(
+    context: &Context<'_>,
+    path: &PathModel,
+    control: &Control<'_>,
+    done: &AtomicUsize,
+    total_work: usize,
+    charged: &(dyn Fn(&Outcome) -> bool + Sync),
 ) -> Option<Vec<Outcome>> {
     let cancelled = AtomicBool::new(false);
     let report_every = (total_work / 200).max(1);
@@ -187,7 +211,7 @@ pub(crate) fn run_round(
         let outcomes: Vec<Option<Outcome>> = indices
             .par_iter()
             .map_init(Scratch::default, |scratch, &index| {
-                if control.cancelled() {
+                if control.cancelled() || cancelled.load(Ordering::Relaxed) {
                     cancelled.store(true, Ordering::Relaxed);
                     return None;
                 }
@@ -201,6 +225,10 @@ pub(crate) fn run_round(
                     predict_pass(context, path, index, scratch)
                 };
                 report(done.fetch_add(1, Ordering::Relaxed) + 1);
+                if !charged(&outcome) {
+                    cancelled.store(true, Ordering::Relaxed);
+                    return None;
+                }
                 Some(outcome)
             })
             .collect();
@@ -221,11 +249,14 @@ pub(crate) fn run_round(
     };
     let mut predicted = predicted.into_iter();
     (0..path.passes.len())
-        .map(
-            |index| {
-                if range.contains(&index) { predicted.next() } else { Some(Outcome::empty(PassStatus::NotPredicted)) }
-            },
-        )
+        .map(|index| {
+            if range.contains(&index) {
+                predicted.next()
+            } else {
+                let outcome = Outcome::empty(PassStatus::NotPredicted);
+                charged(&outcome).then_some(outcome)
+            }
+        })
         .collect()
 }
 

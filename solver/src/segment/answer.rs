@@ -171,3 +171,66 @@ pub struct SegmentSolution {
     #[serde(skip)]
     pub(crate) circle: Option<super::shape::Arc>,
 }
+
+/// Most bytes one command point takes in memory while the answer is built: the cut's vertex and
+/// deviation, the position copied for the block statistics, the command point and its arc length.
+pub(crate) const POINT_MEMORY_BYTES: u64 = (std::mem::size_of::<super::cut::Vertex>()
+    + std::mem::size_of::<Option<f64>>()
+    + std::mem::size_of::<Vec3>()
+    + std::mem::size_of::<CommandPoint>()
+    + std::mem::size_of::<f64>()) as u64;
+
+/// Most bytes one command point takes as JSON: `[x,y,z],` in `points` and its `s`, each number at
+/// its longest (24 characters; checked by `point_json_is_within_its_bound`).
+pub(crate) const POINT_JSON_BYTES: u64 = 128;
+
+/// Most bytes one command point takes in a program: one `G01`/`G02` line with three coordinates
+/// and an arc centre of up to `-1000000.0000` (the coordinate range) and a feed word.
+pub(crate) const POINT_PROGRAM_BYTES: u64 = 128;
+
+/// Most bytes one command point takes for `purpose`: in memory, plus its JSON, its program, or for
+/// a job both.
+pub(crate) fn point_bound(purpose: crate::capability::Purpose) -> u64 {
+    use crate::capability::Purpose;
+    POINT_MEMORY_BYTES
+        + match purpose {
+            Purpose::Json => POINT_JSON_BYTES,
+            Purpose::Program => POINT_PROGRAM_BYTES,
+            Purpose::Job => POINT_JSON_BYTES + POINT_PROGRAM_BYTES,
+        }
+}
+
+/// Most bytes one window takes in memory and as JSON, every number at its longest (checked by
+/// `window_json_is_within_its_bound`).
+pub(crate) const WINDOW_BYTES: u64 = 512;
+
+#[cfg(test)]
+mod budget_tests {
+    use super::*;
+
+    /// The longest number serde writes (ryu).
+    const LONGEST: f64 = -2.225_073_858_507_201_4e-308;
+
+    #[test]
+    fn point_json_is_within_its_bound() {
+        let point = CommandPoint::new(&Vec3::new(LONGEST, LONGEST, LONGEST), 3);
+        // The point and its arc length, each with the comma that separates it from the next.
+        let json = serde_json::to_vec(&point).unwrap().len() + serde_json::to_vec(&LONGEST).unwrap().len() + 2;
+        assert!(json as u64 <= POINT_JSON_BYTES, "{json} bytes");
+    }
+
+    #[test]
+    fn window_json_is_within_its_bound() {
+        let window = SegmentWindow {
+            s_start: LONGEST,
+            s_end: LONGEST,
+            radius: Some(LONGEST),
+            chord_error: LONGEST,
+            rule_chord_error: LONGEST,
+            status: WindowStatus::ClampedToMinChordError,
+            blocks: usize::MAX,
+        };
+        let json = serde_json::to_vec(&window).unwrap().len() + 1;
+        assert!((json + std::mem::size_of::<SegmentWindow>()) as u64 <= WINDOW_BYTES, "{json} bytes");
+    }
+}

@@ -67,7 +67,7 @@ impl Capability for SegmentCapability {
         if let Some(feed) = request.plunge_feed {
             crate::validate::positive("plunge_feed", feed)?;
         }
-        let result = super::solve_controlled(request, context.machine.as_ref(), run.control)?;
+        let result = super::solve_run(request, context.machine.as_ref(), run)?;
         let cycle_time = context.machine.as_ref().and_then(|machine| {
             let plunge =
                 request.plunge_feed.or(context.tool.as_ref().and_then(|t| t.plunge_feed)).or(machine.plunge_feed);
@@ -102,5 +102,29 @@ impl Capability for SegmentCapability {
 
     fn machine(answer: &SegmentAnswer) -> Option<&MachineProfile> {
         answer.machine.as_ref()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::capability::{AnswerBudget, Purpose};
+    use crate::error::ErrorCode;
+
+    #[test]
+    fn points_over_the_budget_are_refused_a_block_past_it() {
+        // Some 270 000 command points: refused while they are cut, not after.
+        let request: SegmentRequest = serde_json::from_value(serde_json::json!({
+            "curve": {"kind": "ellipse", "centre": [0, 0], "semi_axes": [50, 20], "start_deg": 0, "end_deg": 270},
+            "feed": 10, "block_time_ms": 4
+        }))
+        .unwrap();
+        let budget = AnswerBudget::new(1 << 20);
+        let run = Run { budget: Some(&budget), ..Run::default() };
+        let context = Resolved { tool: None, machine: None, material: None, other_tools: Vec::new() };
+        let error = SegmentCapability::solve(&request, context, &run).unwrap_err();
+        assert_eq!(error.code(), ErrorCode::TooLargeAnswer, "{error}");
+        let block = super::super::cut::CHARGED_POINTS as u64 * super::super::answer::point_bound(Purpose::Json);
+        assert!(budget.used() <= budget.limit() + block, "{} charged", budget.used());
     }
 }

@@ -8,7 +8,7 @@ use std::cell::Cell;
 
 use super::shape::{Shape, circumradius};
 use super::{reference, search};
-use crate::capability::Control;
+use crate::capability::{AnswerBudget, Control};
 use crate::error::SolverError;
 use crate::geometry::Vec3;
 use crate::machine::rule::{BlockRule, ChordStatus, Infeasible, chord_length};
@@ -133,7 +133,23 @@ pub(crate) struct Cutter<'a> {
     pub limit_field: &'a str,
     /// Checked once per block: a cancelled request stops here.
     pub control: Control<'a>,
+    /// The answer budget the command points are charged to, a block of points at a time; `None`:
+    /// not counted.
+    pub charge: Option<PointCharge<'a>>,
 }
+
+/// How a cutter's command points are charged to an answer budget.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PointCharge<'a> {
+    /// The budget.
+    pub budget: &'a AnswerBudget,
+    /// Most bytes one command point takes, in memory and as the answer is delivered.
+    pub point_bytes: u64,
+}
+
+/// Command points charged to the budget at once: a unit of work small against any budget (a few
+/// hundred kB), large enough that charging costs nothing beside the search.
+pub(crate) const CHARGED_POINTS: usize = 4096;
 
 impl<'a> Cutter<'a> {
     /// A cutter for `spans` of `shape`, failing past `max_blocks` blocks with `limit_field`.
@@ -154,6 +170,7 @@ impl<'a> Cutter<'a> {
             max_blocks,
             limit_field,
             control,
+            charge: None,
         }
     }
 
@@ -291,6 +308,16 @@ impl<'a> Cutter<'a> {
         }
         if cut.vertices.len().is_multiple_of(256) {
             self.control.report_fraction(vertex.s / self.shape.length());
+        }
+        if let Some(charge) = self.charge
+            && cut.vertices.len().is_multiple_of(CHARGED_POINTS)
+        {
+            // Charged ahead for the block of points this one starts; the estimate scales what was
+            // charged by the share of the curve's length cut so far.
+            const PARTS: usize = 1_000_000;
+            let done = ((vertex.s / self.shape.length()) * PARTS as f64).ceil();
+            let done = if done.is_finite() { (done as usize).clamp(1, PARTS) } else { PARTS };
+            charge.budget.charge(CHARGED_POINTS as u64 * charge.point_bytes, done, PARTS)?;
         }
         cut.vertices.push(vertex);
         cut.deviations.push(self.last_deviation.take());

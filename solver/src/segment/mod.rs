@@ -113,7 +113,7 @@ pub const MAX_BLOCKS: usize = 1_000_000;
 /// feed), `E_TOO_MANY_BLOCKS` (over [`MAX_BLOCKS`]), `E_TOO_MANY_POINTS` (arc-length table over
 /// its limit), `E_NUMERIC_FAILURE` (E14).
 pub fn solve(request: &SegmentRequest, machine: Option<&MachineProfile>) -> Result<SegmentSolution, SolverError> {
-    solve_by(request, machine, Numerics::Fast, Control::default())
+    solve_by(request, machine, Numerics::Fast, Control::default(), None)
 }
 
 /// [`solve`] that stops with `E_CANCELLED` once `control`'s cancel flag is set (checked per block).
@@ -125,7 +125,23 @@ pub fn solve_controlled(
     machine: Option<&MachineProfile>,
     control: Control<'_>,
 ) -> Result<SegmentSolution, SolverError> {
-    solve_by(request, machine, Numerics::Fast, control)
+    solve_by(request, machine, Numerics::Fast, control, None)
+}
+
+/// As [`solve_controlled`] under `run`: its control, and its answer budget charged for the
+/// command points a block at a time as they are cut (in memory and at most as delivered for
+/// `run.purpose`), so a curve whose answer would not fit is refused after a block past the
+/// budget instead of after the whole cut.
+///
+/// # Errors
+/// As [`solve_controlled`]; `E_TOO_LARGE_ANSWER` over the budget.
+pub fn solve_run(
+    request: &SegmentRequest,
+    machine: Option<&MachineProfile>,
+    run: &crate::capability::Run<'_>,
+) -> Result<SegmentSolution, SolverError> {
+    let charge = run.budget.map(|budget| cut::PointCharge { budget, point_bytes: answer::point_bound(run.purpose) });
+    solve_by(request, machine, Numerics::Fast, run.control, charge)
 }
 
 /// [`solve`] by the reference numerics of docs/spec/segment.md §2.9 (about 400 curve evaluations per
@@ -138,7 +154,7 @@ pub fn solve_reference(
     request: &SegmentRequest,
     machine: Option<&MachineProfile>,
 ) -> Result<SegmentSolution, SolverError> {
-    solve_by(request, machine, Numerics::Reference, Control::default())
+    solve_by(request, machine, Numerics::Reference, Control::default(), None)
 }
 
 fn solve_by(
@@ -146,11 +162,13 @@ fn solve_by(
     machine: Option<&MachineProfile>,
     numerics: Numerics,
     control: Control<'_>,
+    charge: Option<cut::PointCharge<'_>>,
 ) -> Result<SegmentSolution, SolverError> {
     let job = request.validate(machine)?;
     let rule = &job.rule;
     let limit_field = if job.tolerance.is_some() { "tolerance" } else { "min_chord_error" };
-    let cutter = Cutter::new(&job.shape, &job.spans, MAX_BLOCKS, limit_field, numerics, control);
+    let mut cutter = Cutter::new(&job.shape, &job.spans, MAX_BLOCKS, limit_field, numerics, control);
+    cutter.charge = charge;
     let cut = match job.plan {
         Plan::Window { length, estimate } => {
             cutter.windows(rule, job.tolerance, length, estimate).map_err(|error| cut_error(&job, error))?
@@ -321,6 +339,9 @@ fn answer(job: &Job, request: &SegmentRequest, cutter: &Cutter<'_>, cut: &Cut) -
             blocks: w.blocks,
         })
         .collect();
+    if let Some(charge) = cutter.charge {
+        charge.budget.charge(windows.len() as u64 * answer::WINDOW_BYTES, 1, 1)?;
+    }
     let chord_error = cut.windows.iter().map(|w| w.chord_error).fold(0.0, f64::max);
     let min_window_chord_error = cut.windows.iter().map(|w| w.chord_error).fold(f64::INFINITY, f64::min);
     let min_radius = cut.windows.iter().map(|w| w.radius).fold(f64::INFINITY, f64::min);
@@ -335,8 +356,11 @@ fn answer(job: &Job, request: &SegmentRequest, cutter: &Cutter<'_>, cut: &Cut) -
 
     let comparison = match job.compare_tolerance {
         Some(tolerance) => {
-            let fixed_cutter =
+            let mut fixed_cutter =
                 Cutter::new(&job.shape, &job.spans, MAX_BLOCKS, "compare_tolerance", cutter.numerics, cutter.control);
+            // The comparison's cut is held beside the answer's while it is measured.
+            fixed_cutter.charge =
+                cutter.charge.map(|charge| cut::PointCharge { point_bytes: answer::POINT_MEMORY_BYTES, ..charge });
             let fixed = fixed_cutter.constant(tolerance, min_radius)?;
             let fixed_points: Vec<Vec3> = fixed.vertices.iter().map(|v| v.point).collect();
             Some(Comparison {

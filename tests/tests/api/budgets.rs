@@ -29,12 +29,17 @@ fn many_loops(tolerance: f64) -> Value {
 /// Checks a refusal for an answer over [`BUDGET`]: its code, and its estimate (more than the
 /// budget) and limit in the message.
 fn assert_too_large(answer: &Value) {
+    assert_too_large_for(answer, BUDGET);
+}
+
+/// Checks a refusal for an answer over `budget`, as [`assert_too_large`].
+fn assert_too_large_for(answer: &Value, budget: usize) {
     assert_eq!(answer["code"], "E_TOO_LARGE_ANSWER", "{answer}");
     let detail = answer["detail"].as_str().unwrap();
-    assert!(detail.contains(&format!("over the limit of {BUDGET} bytes")), "{detail}");
+    assert!(detail.contains(&format!("over the limit of {budget} bytes")), "{detail}");
     let estimate: u64 =
         detail.split("about ").nth(1).and_then(|rest| rest.split(' ').next()).and_then(|n| n.parse().ok()).unwrap();
-    assert!(estimate > BUDGET as u64, "{detail}");
+    assert!(estimate > budget as u64, "{detail}");
 }
 
 #[tokio::test(flavor = "multi_thread")]
@@ -67,6 +72,55 @@ async fn engagement_samples_over_the_budget_are_refused_before_their_json() {
     };
     assert_too_large(&problem(app.post_json("/api/v1/engagement", &request(0.001)).await, 422).await);
     json_with(app.post_json("/api/v1/engagement", &request(0.2)).await, 200).await;
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn segment_points_over_the_budget_are_refused_as_they_are_cut() {
+    // An ellipse arc of some 180 mm in chords of feed × 4 ms: some 270 000 command points at
+    // 10 mm/min (tens of MB built), 2 700 at 1 000 mm/min.
+    let app = TestApp::spawn_with(Limits { answer_budget_bytes: BUDGET, ..Limits::default() }).await;
+    let request = |feed: f64| {
+        json!({"curve": {"kind": "ellipse", "centre": [0, 0], "semi_axes": [50, 20], "start_deg": 0, "end_deg": 270},
+               "feed": feed, "block_time_ms": 4})
+    };
+    for path in ["/api/v1/segment", "/api/v1/segment?format=gcode"] {
+        assert_too_large(&problem(app.post_json(path, &request(10.0)).await, 422).await);
+    }
+    let answer = json_with(app.post_json("/api/v1/segment", &request(1000.0)).await, 200).await;
+    assert!(answer["points"].as_array().unwrap().len() > 1000, "{}", answer["points"].as_array().unwrap().len());
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn contour_layers_over_the_budget_are_refused_as_they_are_made() {
+    // A 600-gon of some 606 moves a layer: as JSON 400 layers (some 240 000 moves, within the
+    // JSON move limit) take 14 MB in memory and 19 MB as JSON; as a program 990 layers (600 000
+    // moves) take 34 MB in memory; 10 layers well under 1 MB.
+    let app = TestApp::spawn_with(Limits { answer_budget_bytes: BUDGET, ..Limits::default() }).await;
+    let request = |layers: f64| {
+        json!({"tool": {"kind": "flat", "radius": 3}, "contour": kerf_cases::contour::circle(600), "side": "outside",
+               "depths": {"top": 0, "bottom": -layers * 0.1, "step": 0.1}, "feed": 800})
+    };
+    for (path, layers) in [("/api/v1/contour", 400.0), ("/api/v1/contour?format=gcode", 990.0)] {
+        assert_too_large(&problem(app.post_json(path, &request(layers)).await, 422).await);
+    }
+    let answer = json_with(app.post_json("/api/v1/contour", &request(10.0)).await, 200).await;
+    assert_eq!(answer["layers"].as_array().unwrap().len(), 10);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn predict_passes_over_the_budget_are_refused_as_they_are_predicted() {
+    // 1 MiB: a raster of 40 lines × 81 points (3 240 passes, some 1 kB each) does not fit, one
+    // of 6 × 9 does.
+    const SMALL: usize = 1024 * 1024;
+    let app = TestApp::spawn_with(Limits { answer_budget_bytes: SMALL, ..Limits::default() }).await;
+    let request = |lines: usize, points: usize| {
+        let mut request = crate::predict::raster_request(crate::predict::finishing_tool(), lines, points);
+        request["resolution"] = json!(32);
+        request
+    };
+    assert_too_large_for(&problem(app.post_json("/api/v1/predict", &request(40, 81)).await, 422).await, SMALL);
+    let answer = json_with(app.post_json("/api/v1/predict", &request(6, 9)).await, 200).await;
+    assert_eq!(answer["passes"].as_array().unwrap().len(), 54);
 }
 
 #[tokio::test(flavor = "multi_thread")]
