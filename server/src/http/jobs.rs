@@ -103,6 +103,13 @@ async fn upload(state: &AppState, request: Request) -> AppResult<(String, Format
     let media = media_type(request.headers());
     let (bytes, name, media) = match media.as_deref() {
         Some("multipart/form-data") => {
+            // Received whole first, so a form is held to the size limit and the minimum receive
+            // rate like every other body; the form is then read from memory.
+            let (parts, body) = request.into_parts();
+            let mut received = Request::new(body);
+            *received.headers_mut() = parts.headers.clone();
+            let bytes = body_bytes(received, state, limit).await?;
+            let request = Request::from_parts(parts, axum::body::Body::from(bytes));
             let mut multipart = Multipart::from_request(request, state)
                 .await
                 .map_err(|rejection| AppError::bad_request(ErrorCode::Multipart, "file", rejection.body_text()))?;

@@ -151,9 +151,10 @@ async fn connect(app: &TestApp, head: &[u8]) -> tokio::net::TcpStream {
 
 #[tokio::test(flavor = "multi_thread")]
 async fn trickling_uploads_do_not_starve_a_small_call() {
-    // Four uploads that declare 128 MiB each and send a byte every 200 ms: they hold the budget
-    // by what they sent (a few bytes), so a small call is answered while they trickle; then each
-    // is dropped with 408 for arriving slower than 1 KiB/s over the window.
+    // Four uploads (three predict uploads declaring 128 MiB, a job file as a form) that send a
+    // byte every 200 ms: they hold the budget by what they sent (a few bytes), so a small call is
+    // answered while they trickle; then each is dropped with 408 for arriving slower than
+    // 1 KiB/s over the window.
     let app = TestApp::spawn_with(Limits {
         answer_budget_bytes: 2 * 1024 * 1024,
         min_body_rate: 1024,
@@ -161,10 +162,14 @@ async fn trickling_uploads_do_not_starve_a_small_call() {
         ..Limits::default()
     })
     .await;
-    let head = b"POST /api/v1/predict HTTP/1.1\r\nHost: kerf\r\nContent-Type: multipart/form-data; boundary=XX\r\n\
+    let predict: &[u8] =
+        b"POST /api/v1/predict HTTP/1.1\r\nHost: kerf\r\nContent-Type: multipart/form-data; boundary=XX\r\n\
                  Content-Length: 134217728\r\n\r\n--XX\r\nContent-Disposition: form-data; name=\"stock\"\r\n\r\n";
+    // A job file sent as a form is held to the same rate.
+    let job: &[u8] = b"POST /api/v1/jobs HTTP/1.1\r\nHost: kerf\r\nContent-Type: multipart/form-data; boundary=XX\r\n\
+                 Content-Length: 1000000\r\n\r\n--XX\r\nContent-Disposition: form-data; name=\"file\"\r\n\r\n";
     let mut trickles = Vec::new();
-    for _ in 0..4 {
+    for head in [predict, predict, predict, job] {
         let mut stream = connect(&app, head).await;
         trickles.push(tokio::spawn(async move {
             use tokio::io::AsyncReadExt;
