@@ -118,7 +118,7 @@ impl Capability for ContourCapability {
     }
 
     /// The move cap of the answer ([`MAX_JSON_MOVES`] for JSON, else [`MAX_MOVES`]) at
-    /// [`move_bound`] each, and the corners' and passes' reports.
+    /// `move_bound` each, and the corners' and passes' reports.
     fn answer_bound(request: &ContourRequest, _context: &Resolved<Tool>, purpose: Purpose) -> Option<u64> {
         let max_moves = if purpose == Purpose::Json { MAX_JSON_MOVES } else { MAX_MOVES };
         let passes = request.passes.as_ref().map_or(1, Vec::len) as u64;
