@@ -237,7 +237,14 @@ async fn slow_readers_of_large_answers_hold_a_bounded_budget() {
 async fn slow_uploads_hold_a_bounded_budget() {
     // An upload that declares 3 MiB, sends 2.5 MiB and stalls holds the 2 MiB budget by what it
     // sent: a second upload gets 429 with Retry-After instead of piling up in memory.
-    let app = TestApp::spawn_with(Limits { answer_budget_bytes: 2 * 1024 * 1024, ..Limits::default() }).await;
+    // The rate window is longer than the test, so the stalled upload is not dropped for its rate
+    // before the second one asks, however slowly a loaded machine receives it.
+    let app = TestApp::spawn_with(Limits {
+        answer_budget_bytes: 2 * 1024 * 1024,
+        body_rate_window: Duration::from_secs(120),
+        ..Limits::default()
+    })
+    .await;
     let mut head = b"POST /api/v1/predict HTTP/1.1\r\nHost: kerf\r\nContent-Type: multipart/form-data; boundary=XX\r\n\
           Content-Length: 3145728\r\n\r\n--XX\r\nContent-Disposition: form-data; name=\"stock\"\r\n\r\nsolid"
         .to_vec();
@@ -245,7 +252,7 @@ async fn slow_uploads_hold_a_bounded_budget() {
     let slow = raw_request(&app, &head).await;
     // The first upload's bytes are received by then, each charged as it arrives.
     let mut refused = None;
-    for _ in 0..100 {
+    for _ in 0..400 {
         let response = app
             .client
             .post(app.url("/api/v1/predict"))
