@@ -15,7 +15,7 @@ fn main() {
     }
     let required = external::required();
     let mut missing = Vec::new();
-    for program in &external::EXTERNALS {
+    for program in external::EXTERNALS {
         println!("cargo::rustc-check-cfg=cfg(kerf_has_{})", program.name);
         let (found, watched) = external::probe(program);
         for path in watched.0 {

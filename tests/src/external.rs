@@ -17,19 +17,28 @@ pub struct External {
     pub what: &'static str,
     /// The commands that install it on Debian.
     pub install: &'static str,
+    /// A Python module that `python3` on `PATH` must import (a PyPI tool of `tests/requirements.txt`
+    /// used as a library), instead of a program of [`External::name`] on `PATH`.
+    pub python_module: Option<&'static str>,
 }
 
 /// Every external program the tests use. A test's `ignore` reason is [`External::reason`]
 /// written out (an attribute takes only a literal).
-pub const EXTERNALS: [External; 4] = [
-    External { name: "rs274", what: "rs274", install: "apt-get install linuxcnc-uspace" },
+pub const EXTERNALS: &[External] = &[
+    External { name: "rs274", what: "rs274", install: "apt-get install linuxcnc-uspace", python_module: None },
     External {
         name: "chromium",
         what: "chromium or its driver",
         install: "apt-get install chromium npm; npm ci --prefix tests/browser",
+        python_module: None,
     },
-    External { name: "postgres", what: "PostgreSQL", install: "apt-get install postgresql" },
-    External { name: "schemathesis", what: "schemathesis", install: "pip install schemathesis" },
+    External { name: "postgres", what: "PostgreSQL", install: "apt-get install postgresql", python_module: None },
+    External {
+        name: "schemathesis",
+        what: "schemathesis",
+        install: "pip install -r tests/requirements.txt",
+        python_module: None,
+    },
 ];
 
 impl External {
@@ -192,15 +201,33 @@ pub fn postgres() -> Result<(PathBuf, bool), &'static str> {
 /// Whether `external` is installed as its tests need it, and the paths that answer depends on.
 pub fn probe(external: &External) -> (bool, Watched) {
     let mut watched = Watched::default();
-    let found = match external.name {
-        "chromium" => {
+    let found = match (external.name, external.python_module) {
+        (_, Some(module)) => python_imports(module, &mut watched),
+        ("chromium", None) => {
             // Evaluate every part so each one's paths are watched.
             let node = on_path_watched("node", &mut watched).is_some();
             let chromium = on_path_watched("chromium", &mut watched).is_some();
             node & chromium & browser_driver_watched(&mut watched)
         }
-        "postgres" => postgres_watched(&mut watched).is_ok(),
-        program => on_path_watched(program, &mut watched).is_some(),
+        ("postgres", None) => postgres_watched(&mut watched).is_ok(),
+        (program, None) => on_path_watched(program, &mut watched).is_some(),
     };
     (found && !withheld(external.name), watched)
+}
+
+/// Whether `python3` on `PATH` imports `module`. Watches the interpreter found (a venv's
+/// `python3` is replaced when its packages are reinstalled), else the folders of `PATH`.
+fn python_imports(module: &str, watched: &mut Watched) -> bool {
+    let Some(python) = on_path_watched("python3", watched) else {
+        return false;
+    };
+    if let Some(site) = python.parent().and_then(Path::parent) {
+        watched.add(site.join("lib"));
+    }
+    std::process::Command::new(&python)
+        .args(["-c", &format!("import {module}")])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .status()
+        .is_ok_and(|status| status.success())
 }
