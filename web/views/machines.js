@@ -1,7 +1,7 @@
 // Machines view: the controller profiles (docs/spec/api.md, Machines): list, register or replace, delete,
 // and the block time from a saturation test (docs/spec/segment.md §2.1, Eq. 1).
-import { api, tagged } from '/api.js';
-import { clearProblem, confirmButton, message, numeric, parseDecimal, saveGuarded, showProblem, submitFlow } from '/form.js';
+import { parseDecimal } from '/form.js';
+import { registryView } from '/views/registry.js';
 
 const FORM = `
 <div class="layout">
@@ -42,137 +42,20 @@ const FORM = `
   </section>
 </div>`;
 
-// The profile's fields the form edits; text and choices, the rest numbers (empty: not sent).
-const TEXT_FIELDS = ['dialect', 'description', 'mode', 'arcs'];
-const NUMBER_FIELDS = ['block_time_ms', 'max_feed', 'margin', 'min_chord_error', 'plunge_feed', 'max_accel', 'max_jerk', 'rapid_feed', 'tool_change_s', 'spindle_power_kw', 'spindle_torque_nm'];
-
-// The machine last opened with Edit and the version it was (`etag`): saving keeps the fields of
-// it the form does not show, so editing on the page never drops what was registered through the
-// API, and replaces only that version.
-let editing = null;
-
-function setEditing(form, machine, etag) {
-  editing = machine ? { machine, etag } : null;
-  form.querySelector('[data-editing]').hidden = !machine;
-  form.querySelector('[data-legend]').textContent = machine ? `Edit machine ${machine.name}` : 'Register a machine';
-  form.querySelector('[data-editing-text]').textContent = machine ? `Editing ${machine.name}: saving replaces it.` : '';
-  form.querySelector('#machine-save').textContent = machine ? `Save ${machine.name}` : 'Save';
-}
-
-// A stored machine in words, for the question before it is replaced.
-function describeMachine(machine) {
-  return [`${machine.block_time_ms} ms`, `${machine.max_feed} mm/min`, machine.dialect, machine.description].filter(Boolean).join(', ');
-}
-
-function fill(form, machine, etag) {
-  clearProblem(form);
-  setEditing(form, machine, etag);
-  form.elements.name.value = machine.name ?? '';
-  for (const name of [...TEXT_FIELDS, ...NUMBER_FIELDS]) form.elements[name].value = machine[name] ?? '';
-}
-
-// The body of the PUT: the edited machine's other fields, then every field of the form.
-function machineBody(form) {
-  const body = { ...(editing?.machine ?? {}) };
-  delete body.name;
-  for (const name of TEXT_FIELDS) body[name] = form.elements[name].value.trim() || undefined;
-  for (const name of NUMBER_FIELDS) body[name] = numeric(form, name);
-  return body;
-}
-
-async function refresh(root) {
-  const rows = root.querySelector('#machine-rows');
-  const messages = root.querySelector('#machine-messages');
-  const form = root.querySelector('#machine-form');
-  try {
-    const machines = await api('GET', '/api/v1/machines');
-    rows.replaceChildren(...machines.map((machine) => {
-      const tr = document.createElement('tr');
-      tr.dataset.machine = machine.name;
-      for (const cell of [machine.name, machine.block_time_ms, machine.max_feed, machine.dialect, machine.margin ?? '', machine.min_chord_error ?? '', machine.description ?? '']) {
-        const td = document.createElement('td');
-        td.textContent = String(cell);
-        tr.append(td);
-      }
-      const td = document.createElement('td');
-      const edit = document.createElement('button');
-      edit.type = 'button';
-      edit.className = 'secondary small';
-      edit.textContent = 'Edit';
-      edit.addEventListener('click', async () => {
-        // The listed machine at once, then the stored version with its ETag (refilled only if
-        // it changed since the list was read).
-        fill(form, machine);
-        try {
-          const stored = await tagged('GET', `/api/v1/machines/${encodeURIComponent(machine.name)}`);
-          if (editing?.machine.name !== machine.name) return;
-          if (JSON.stringify(stored.body) !== JSON.stringify(machine)) fill(form, stored.body, stored.etag);
-          else editing.etag = stored.etag;
-        } catch (problem) {
-          showProblem(messages, null, problem);
-        }
-      });
-      const remove = confirmButton('Delete', `Delete machine ${machine.name}?`, async () => {
-        try {
-          await api('DELETE', `/api/v1/machines/${encodeURIComponent(machine.name)}`);
-          messages.replaceChildren(message('ok', `Machine ${machine.name} deleted.`));
-          refresh(root);
-        } catch (problem) {
-          showProblem(messages, null, problem);
-        }
-      });
-      td.append(edit, ' ', remove);
-      tr.append(td);
-      return tr;
-    }));
-  } catch (problem) {
-    showProblem(messages, null, problem);
-  }
-}
-
-export const machinesView = {
-  mount(root) {
-    root.innerHTML = FORM;
-    const form = root.querySelector('#machine-form');
-    const messages = root.querySelector('#machine-messages');
-    setEditing(form, null);
-    refresh(root);
-    root.addEventListener('kerf:show', () => refresh(root));
-    root.querySelector('#machine-cancel-edit').addEventListener('click', () => {
-      const name = editing?.machine.name;
-      clearProblem(form);
-      form.reset();
-      setEditing(form, null);
-      messages.replaceChildren(message('info', `Editing ${name} cancelled: ${name} is unchanged.`));
-    });
+export const machinesView = registryView({
+  kind: 'machine',
+  plural: 'machines',
+  title: 'Machine',
+  form: FORM,
+  textFields: ['dialect', 'description', 'mode', 'arcs'],
+  numberFields: ['block_time_ms', 'max_feed', 'margin', 'min_chord_error', 'plunge_feed', 'max_accel', 'max_jerk', 'rapid_feed', 'tool_change_s', 'spindle_power_kw', 'spindle_torque_nm'],
+  columns: (machine) => [machine.block_time_ms, machine.max_feed, machine.dialect, machine.margin, machine.min_chord_error, machine.description],
+  describe: (machine) => [`${machine.block_time_ms} ms`, `${machine.max_feed} mm/min`, machine.dialect, machine.description].filter(Boolean).join(', '),
+  mount(root, form) {
     root.querySelector('#machine-saturation').addEventListener('click', () => {
       const length = parseDecimal(form.elements.test_block.value);
       const speed = parseDecimal(form.elements.saturated.value);
       if (length > 0 && speed > 0) form.elements.block_time_ms.value = String(Number((length / speed * 60000).toPrecision(6)));
     });
-    submitFlow(form, {
-      messages,
-      quiet: true,
-      read: () => ({ name: form.elements.name.value.trim(), machine: machineBody(form) }),
-      // A new name is created only if it is free; the machine opened with Edit is replaced only
-      // as it was opened. Otherwise the stored machine is shown and the user asked.
-      ask: ({ name, machine }) => saveGuarded(messages, {
-        path: `/api/v1/machines/${encodeURIComponent(name || ' ')}`,
-        body: machine,
-        etag: editing?.machine.name === name ? editing.etag : undefined,
-        what: `machine ${name}`,
-        describe: describeMachine,
-      }),
-      show: async (answer, { name }) => {
-        // An edited machine stays open at its new version; a new one is saved and the form stays
-        // a form for new machines (to change a stored machine, open it with Edit).
-        if (answer.saved && editing?.machine.name === name) {
-          const stored = await tagged('GET', `/api/v1/machines/${encodeURIComponent(name)}`).catch(() => null);
-          if (stored) setEditing(form, stored.body, answer.etag ?? stored.etag);
-        }
-        refresh(root);
-      },
-      done: (answer, { name }) => (answer.saved ? `Machine ${name} saved.` : `Machine ${name} kept as stored: nothing saved.`),
-    });
   },
-};
+});

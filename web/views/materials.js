@@ -1,7 +1,6 @@
 // Materials view: the work materials library (docs/spec/api.md, Materials): list, register,
-// edit (saving replaces only the version opened) and delete (with a confirmation).
-import { api, tagged } from '/api.js';
-import { clearProblem, confirmButton, message, numeric, saveGuarded, showProblem, submitFlow } from '/form.js';
+// edit and delete through the shared registry view.
+import { registryView } from '/views/registry.js';
 
 const FORM = `
 <div class="layout">
@@ -24,126 +23,13 @@ const FORM = `
   </section>
 </div>`;
 
-// The material opened with Edit and its version (`etag`), or null for a new one.
-let editing = null;
-
-function setEditing(form, material, etag) {
-  editing = material ? { material, etag } : null;
-  form.querySelector('[data-editing]').hidden = !material;
-  form.querySelector('[data-legend]').textContent = material ? `Edit material ${material.name}` : 'Register a material';
-  form.querySelector('[data-editing-text]').textContent = material ? `Editing ${material.name}: saving replaces it.` : '';
-  form.querySelector('#material-save').textContent = material ? `Save ${material.name}` : 'Save';
-}
-
-// A stored material in words, for the question before it is replaced.
-function describeMaterial(material) {
-  return [`kc1.1 ${material.kc11} N/mm²`, `mc ${material.mc}`, material.iso_group && `ISO ${material.iso_group}`, material.description].filter(Boolean).join(', ');
-}
-
-function fill(form, material, etag) {
-  clearProblem(form);
-  setEditing(form, material, etag);
-  form.elements.name.value = material.name ?? '';
-  for (const name of ['kc11', 'mc', 'radial_ratio', 'iso_group', 'description']) form.elements[name].value = material[name] ?? '';
-}
-
-// The body of the PUT: the form's fields (empty: not sent).
-function materialBody(form) {
-  return {
-    kc11: numeric(form, 'kc11'),
-    mc: numeric(form, 'mc'),
-    radial_ratio: numeric(form, 'radial_ratio'),
-    iso_group: form.elements.iso_group.value || undefined,
-    description: form.elements.description.value.trim() || undefined,
-  };
-}
-
-async function refresh(root) {
-  const rows = root.querySelector('#material-rows');
-  const messages = root.querySelector('#material-messages');
-  const form = root.querySelector('#material-form');
-  try {
-    const list = await api('GET', '/api/v1/materials');
-    rows.replaceChildren(...list.map((material) => {
-      const tr = document.createElement('tr');
-      tr.dataset.material = material.name;
-      for (const cell of [material.name, material.kc11, material.mc, material.radial_ratio ?? '', material.iso_group ?? '', material.description ?? '']) {
-        const td = document.createElement('td');
-        td.textContent = String(cell);
-        tr.append(td);
-      }
-      const td = document.createElement('td');
-      const edit = document.createElement('button');
-      edit.type = 'button';
-      edit.className = 'secondary small';
-      edit.textContent = 'Edit';
-      edit.addEventListener('click', async () => {
-        // The listed material at once, then the stored version with its ETag (refilled only if
-        // it changed since the list was read).
-        fill(form, material);
-        try {
-          const stored = await tagged('GET', `/api/v1/materials/${encodeURIComponent(material.name)}`);
-          if (editing?.material.name !== material.name) return;
-          if (JSON.stringify(stored.body) !== JSON.stringify(material)) fill(form, stored.body, stored.etag);
-          else editing.etag = stored.etag;
-        } catch (problem) {
-          showProblem(messages, null, problem);
-        }
-      });
-      const remove = confirmButton('Delete', `Delete material ${material.name}?`, async () => {
-        try {
-          await api('DELETE', `/api/v1/materials/${encodeURIComponent(material.name)}`);
-          messages.replaceChildren(message('ok', `Material ${material.name} deleted.`));
-          refresh(root);
-        } catch (problem) {
-          showProblem(messages, null, problem);
-        }
-      });
-      td.append(edit, ' ', remove);
-      tr.append(td);
-      return tr;
-    }));
-  } catch (problem) {
-    showProblem(messages, null, problem);
-  }
-}
-
-export const materialsView = {
-  mount(root) {
-    root.innerHTML = FORM;
-    const form = root.querySelector('#material-form');
-    const messages = root.querySelector('#material-messages');
-    setEditing(form, null);
-    refresh(root);
-    root.addEventListener('kerf:show', () => refresh(root));
-    root.querySelector('#material-cancel-edit').addEventListener('click', () => {
-      const name = editing?.material.name;
-      clearProblem(form);
-      form.reset();
-      setEditing(form, null);
-      messages.replaceChildren(message('info', `Editing ${name} cancelled: ${name} is unchanged.`));
-    });
-    submitFlow(form, {
-      messages,
-      quiet: true,
-      read: () => ({ name: form.elements.name.value.trim(), material: materialBody(form) }),
-      // A new name is created only if it is free; the material opened with Edit is replaced
-      // only as it was opened. Otherwise the stored material is shown and the user asked.
-      ask: ({ name, material }) => saveGuarded(messages, {
-        path: `/api/v1/materials/${encodeURIComponent(name || ' ')}`,
-        body: material,
-        etag: editing?.material.name === name ? editing.etag : undefined,
-        what: `material ${name}`,
-        describe: describeMaterial,
-      }),
-      show: async (answer, { name }) => {
-        if (answer.saved && editing?.material.name === name) {
-          const stored = await tagged('GET', `/api/v1/materials/${encodeURIComponent(name)}`).catch(() => null);
-          if (stored) setEditing(form, stored.body, answer.etag ?? stored.etag);
-        }
-        refresh(root);
-      },
-      done: (answer, { name }) => (answer.saved ? `Material ${name} saved.` : `Material ${name} kept as stored: nothing saved.`),
-    });
-  },
-};
+export const materialsView = registryView({
+  kind: 'material',
+  plural: 'materials',
+  title: 'Material',
+  form: FORM,
+  textFields: ['iso_group', 'description'],
+  numberFields: ['kc11', 'mc', 'radial_ratio'],
+  columns: (material) => [material.kc11, material.mc, material.radial_ratio, material.iso_group, material.description],
+  describe: (material) => [`kc1.1 ${material.kc11} N/mm²`, `mc ${material.mc}`, material.iso_group && `ISO ${material.iso_group}`, material.description].filter(Boolean).join(', '),
+});
