@@ -1,7 +1,8 @@
 //! Cancellation through the seam: every capability's solve and program writer, run on a large
 //! input with the cancel flag raised a few milliseconds in, returns `E_CANCELLED` within 100 ms
 //! (of its thread's CPU time) of the raise (a timed-out request, a cancelled job and a stopping server free their solver slot
-//! at once). Engagement's own loops are tested with engagement.
+//! at once), also when raised early or late in the work (engagement: in the contact, the samples'
+//! forces, the flute statistics).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -9,15 +10,18 @@ use std::time::{Duration, Instant};
 use kerf_cases::predict;
 use kerf_cases::split::{context, contour_context, contour_request, deburr_context, deburr_request};
 use kerf_solver::SolverError;
-use kerf_solver::capability::{self, Capability, Control, OutputOptions, Purpose, Resolved, Run};
+use kerf_solver::capability::{self, Capability, Control, OutputOptions, Purpose, Resolved, Run, resolve};
 use kerf_solver::contour::{ContourCapability, LoopsRequest};
 use kerf_solver::deburr::DeburrCapability;
+use kerf_solver::engagement::EngagementCapability;
 use kerf_solver::error::ErrorCode;
 use kerf_solver::gcode::Arcs;
 use kerf_solver::predict::{Method, PredictCapability};
 use kerf_solver::segment::{SegmentCapability, SegmentRequest};
 use kerf_solver::tool::Tool;
 use serde_json::json;
+
+use crate::inline::Inline;
 
 /// When the flag is raised after the work started.
 const RAISE_AFTER: Duration = Duration::from_millis(20);
@@ -48,9 +52,10 @@ struct AfterRaise {
     wall: Duration,
 }
 
-/// Runs `work` with a cancel flag raised [`RAISE_AFTER`] in; what it spent after the raise, and
+/// Runs `work` with a cancel flag raised `raise_after` in; what it spent after the raise, and
 /// what it returned.
 fn cancel_during<T: Send>(
+    raise_after: Duration,
     work: impl FnOnce(Control<'_>) -> Result<T, SolverError> + Send,
 ) -> (AfterRaise, Result<T, SolverError>) {
     let flag = AtomicBool::new(false);
@@ -64,7 +69,7 @@ fn cancel_during<T: Send>(
             (Instant::now(), thread_cpu(&me), result)
         });
         let task = task.recv().unwrap();
-        std::thread::sleep(RAISE_AFTER);
+        std::thread::sleep(raise_after);
         let (raised, cpu_at_raise) = (Instant::now(), thread_cpu(&task));
         flag.store(true, Ordering::Relaxed);
         let (ended, cpu_at_end, result) = running.join().expect("the work does not panic");
@@ -74,10 +79,19 @@ fn cancel_during<T: Send>(
     })
 }
 
-/// `work` ended with `E_CANCELLED` within [`BOUND`] of CPU time after the raise (and was still
-/// running then: an input too small to outlast [`RAISE_AFTER`] proves nothing).
+/// `work` ended with `E_CANCELLED` within [`BOUND`] of CPU time after a raise [`RAISE_AFTER`] in.
 fn stops<T: Send>(what: &str, work: impl FnOnce(Control<'_>) -> Result<T, SolverError> + Send) {
-    let (after, result) = cancel_during(work);
+    stops_raised_after(what, RAISE_AFTER, work);
+}
+
+/// `work` ended with `E_CANCELLED` within [`BOUND`] of CPU time after a raise `raise_after` in
+/// (and was still running then: an input too small to outlast the raise proves nothing).
+fn stops_raised_after<T: Send>(
+    what: &str,
+    raise_after: Duration,
+    work: impl FnOnce(Control<'_>) -> Result<T, SolverError> + Send,
+) {
+    let (after, result) = cancel_during(raise_after, work);
     let Err(error) = result else {
         assert!(after.wall > Duration::ZERO, "{what} finished before the cancel flag was raised: use a larger input");
         panic!("{what} ran to its end, {:?} of CPU after the cancel flag was raised", after.cpu);
@@ -209,4 +223,34 @@ fn gcode_reading_stops() {
             control,
         )
     });
+}
+
+/// A flat end with a helix slotting 220 mm at a 0.05 mm step (4 400 samples), 8 flute counts
+/// with Kienzle forces, a feed plan and a block time: seconds of work after the contact, most of
+/// it the forces of every flute count at every sample.
+fn large_engagement_request() -> serde_json::Value {
+    json!({
+        "tool": {"kind": "flat", "radius": 5, "flutes": 4, "helix_deg": 30},
+        "stock": {"polygon": [[0, -20], [200, -20], [200, 20], [0, 20]]},
+        "path": [[-10, 0], [210, 0]],
+        "spindle_rpm": 6000, "feed_per_tooth": 0.05, "flute_counts": [1, 2, 3, 4, 5, 6, 7, 8],
+        "thickness_limit": 0.2, "time_limit_s": 5000, "step": 0.05, "axial_depth": 3,
+        "kienzle": {"kc11": 1800, "mc": 0.25},
+        "feed_plan": {"target_thickness": 0.05, "max_feed": 5000},
+        "block_time_ms": 2,
+    })
+}
+
+#[test]
+fn engagement_solve_stops_early_and_late() {
+    let request = serde_json::from_value(large_engagement_request()).expect("a valid request");
+    // Early (in the contact), later (in the samples' forces) and later still.
+    for raise_after_ms in [5, 30, 300] {
+        let context: Resolved<Tool> = resolve(EngagementCapability::refs(&request), &Inline).expect("inline tool");
+        stops_raised_after(
+            &format!("engagement solve, raised after {raise_after_ms} ms"),
+            Duration::from_millis(raise_after_ms),
+            |control| solve::<EngagementCapability>(&request, context, Purpose::Json, control),
+        );
+    }
 }

@@ -7,6 +7,7 @@ mod contour;
 mod cycle_properties;
 mod deburr;
 mod engagement;
+mod inline;
 mod predict;
 mod progress;
 mod segment;

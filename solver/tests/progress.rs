@@ -3,30 +3,14 @@
 
 use std::sync::Mutex;
 
-use kerf_solver::capability::{Capability, Control, Lookup, Resolved, Run, resolve};
+use kerf_solver::capability::{Capability, Control, Resolved, Run, resolve};
 use kerf_solver::contour::ContourCapability;
 use kerf_solver::deburr::DeburrCapability;
 use kerf_solver::engagement::EngagementCapability;
-use kerf_solver::machine::MachineProfile;
-use kerf_solver::material::Material;
 use kerf_solver::segment::SegmentCapability;
-use kerf_solver::tool::Tool;
 use serde_json::{Value, json};
 
-/// No registry: the requests carry their tools inline.
-struct Inline;
-
-impl Lookup for Inline {
-    fn tool(&self, _number: u32) -> Option<Tool> {
-        None
-    }
-    fn machine(&self, _name: &str) -> Option<MachineProfile> {
-        None
-    }
-    fn material(&self, _name: &str) -> Option<Material> {
-        None
-    }
-}
+use crate::inline::Inline;
 
 /// The fractions `C` reports while solving `body`.
 fn reported<C: Capability>(body: Value) -> Vec<f64> {

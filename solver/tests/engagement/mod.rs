@@ -1,6 +1,5 @@
 //! Tool engagement and flute counts (docs/spec/engagement.md): reference cases, bad input, forces, heights, programs, the answer's JSON, properties.
 
-mod cancel;
 mod cases;
 mod errors;
 mod features;
