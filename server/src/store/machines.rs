@@ -25,10 +25,11 @@ pub async fn get(db: &Db, name: &str) -> AppResult<Option<MachineProfile>> {
     row.map(|(json,)| decode(&json)).transpose()
 }
 
-/// All machines ordered by name.
-pub async fn list(db: &Db) -> AppResult<Vec<MachineProfile>> {
-    let rows: Vec<(String,)> =
-        on!(db, query_as, both: "SELECT machine_json FROM machines ORDER BY name", [], fetch_all)?;
+/// Up to `limit` machines named after `after` (all when `None`), ordered by name.
+pub async fn list(db: &Db, after: Option<&str>, limit: i64) -> AppResult<Vec<MachineProfile>> {
+    let rows: Vec<(String,)> = on!(db, query_as,
+        both: "SELECT machine_json FROM machines WHERE $1 IS NULL OR name > $1 ORDER BY name LIMIT $2",
+        [after, limit], fetch_all)?;
     rows.iter().map(|(json,)| decode(json)).collect()
 }
 
@@ -42,7 +43,8 @@ fn registry(name: &str) -> Registry {
              revision = revision + 1, updated_at = strftime('%Y-%m-%dT%H:%M:%fZ', 'now') WHERE name = $1",
         update_postgres: "UPDATE machines SET block_time_ms = $2, max_feed = $3, dialect = $4, machine_json = $5,
              revision = revision + 1, updated_at = now() WHERE name = $1",
-        insert: "INSERT INTO machines (name, block_time_ms, max_feed, dialect, machine_json) VALUES ($1, $2, $3, $4, $5)
+        insert:
+            "INSERT INTO machines (name, block_time_ms, max_feed, dialect, machine_json) VALUES ($1, $2, $3, $4, $5)
              ON CONFLICT (name) DO NOTHING",
         delete: "DELETE FROM machines WHERE name = $1",
     }

@@ -45,11 +45,12 @@ pub async fn get(db: &Db, name: &str) -> AppResult<Option<Material>> {
     row.map(decode).transpose()
 }
 
-/// All materials ordered by name.
-pub async fn list(db: &Db) -> AppResult<Vec<Material>> {
+/// Up to `limit` materials named after `after` (all when `None`), ordered by name.
+pub async fn list(db: &Db, after: Option<&str>, limit: i64) -> AppResult<Vec<Material>> {
     let rows: Vec<Row> = on!(db, query_as,
-        both: "SELECT name, kc11, mc, radial_ratio, iso_group, description FROM materials ORDER BY name",
-        [], fetch_all)?;
+        both: "SELECT name, kc11, mc, radial_ratio, iso_group, description FROM materials
+               WHERE $1 IS NULL OR name > $1 ORDER BY name LIMIT $2",
+        [after, limit], fetch_all)?;
     rows.into_iter().map(decode).collect()
 }
 

@@ -18,9 +18,11 @@ pub async fn get(db: &Db, number: u32) -> AppResult<Option<Tool>> {
     row.map(|(json,)| decode(&json)).transpose()
 }
 
-/// All tools ordered by number.
-pub async fn list(db: &Db) -> AppResult<Vec<Tool>> {
-    let rows: Vec<(String,)> = on!(db, query_as, both: "SELECT tool_json FROM tools ORDER BY number", [], fetch_all)?;
+/// Up to `limit` tools numbered above `after`, ordered by number.
+pub async fn list(db: &Db, after: u32, limit: i64) -> AppResult<Vec<Tool>> {
+    let rows: Vec<(String,)> = on!(db, query_as,
+        both: "SELECT tool_json FROM tools WHERE number > $1 ORDER BY number LIMIT $2",
+        [i64::from(after), limit], fetch_all)?;
     rows.iter().map(|(json,)| decode(json)).collect()
 }
 
@@ -45,7 +47,12 @@ fn registry(number: i64) -> Registry {
 pub async fn put(db: &Db, tool: &Tool, guard: impl Fn(Option<&Tool>) -> AppResult<()>) -> AppResult<bool> {
     let number = i64::from(tool.number.ok_or_else(|| AppError::Internal(anyhow::anyhow!("tool without number")))?);
     let json = serde_json::to_string(tool).map_err(|error| AppError::Internal(error.into()))?;
-    let values = [Bind::Text(tool.kind.as_str()), Bind::Real(tool.radius), Bind::OptionalText(tool.name.as_deref()), Bind::Text(&json)];
+    let values = [
+        Bind::Text(tool.kind.as_str()),
+        Bind::Real(tool.radius),
+        Bind::OptionalText(tool.name.as_deref()),
+        Bind::Text(&json),
+    ];
     guarded_put(db, &registry(number), Bind::Integer(number), &values, |(json,): (String,)| decode(&json), guard).await
 }
 
