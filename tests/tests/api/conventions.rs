@@ -9,7 +9,7 @@ use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
 use kerf_server::state::Limits;
-use kerf_tests::{TestApp, free_port, json_with, problem};
+use kerf_tests::{Store, TestApp, free_port, json_with, problem};
 use reqwest::Client;
 use serde_json::{Value, json};
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
@@ -404,9 +404,10 @@ async fn names(app: &TestApp, path: &str, key: &str) -> Vec<Value> {
     list.as_array().unwrap_or_else(|| panic!("{path}: {list}")).iter().map(|item| item[key].clone()).collect()
 }
 
-#[tokio::test(flavor = "multi_thread")]
-async fn registry_lists_page_with_limit_and_after() {
-    let app = TestApp::spawn().await;
+kerf_tests::on_both_stores!(registry_lists_page_with_limit_and_after);
+
+async fn registry_lists_page_with_limit_and_after(store: Store) {
+    let app = TestApp::spawn_on(store, |_| {}).await.expect("a service on the store");
     for number in [3, 1, 9, 4, 7] {
         app.register_tool(number, &json!({"kind": "flat", "radius": 2})).await;
     }
