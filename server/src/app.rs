@@ -1,17 +1,26 @@
 //! Assembles the service: routes, OpenAPI document and docs, the page, problem+json for every
-//! rejection (unknown path, wrong method, panics), body limit and request tracing.
+//! rejection (unknown path, wrong method, panics), body limit, and the conventions every answer
+//! follows (docs/spec/api.md, Conventions): CORS for the configured origins, gzip above 1 KiB,
+//! `X-Request-Id` with one log line per request, `Connection: close` on 413.
 
 use std::any::Any;
-use std::time::Duration;
+use std::hash::BuildHasher;
+use std::sync::LazyLock;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
 
 use axum::Router;
 use axum::body::Body;
-use axum::extract::DefaultBodyLimit;
-use axum::http::Response;
+use axum::extract::{DefaultBodyLimit, MatchedPath, Request};
+use axum::http::{HeaderName, HeaderValue, Method, Response, StatusCode, header};
+use axum::middleware::Next;
 use axum::response::IntoResponse;
 use tower_http::catch_panic::CatchPanicLayer;
+use tower_http::compression::predicate::{NotForContentType, Predicate, SizeAbove};
+use tower_http::compression::{CompressionLayer, DefaultPredicate};
+use tower_http::cors::{AllowOrigin, CorsLayer};
 use tower_http::timeout::RequestBodyTimeoutLayer;
-use tower_http::trace::TraceLayer;
+use tracing::Instrument;
 use utoipa::OpenApi;
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_swagger_ui::SwaggerUi;
@@ -41,6 +50,9 @@ pub struct Config {
     pub auth: Auth,
     /// The job store's quota, per-job cap and retention.
     pub job_storage: JobStorage,
+    /// Origins whose pages may call the API from a browser (CORS): `scheme://host[:port]`, or
+    /// `*` for any; none by default.
+    pub cors_origins: Vec<String>,
 }
 
 /// The OpenAPI document and the API routes.
@@ -61,14 +73,19 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
     (routes, document)
 }
 
-/// The whole service over `state`.
+/// The whole service over `state`, with no CORS origin.
 pub fn router(state: AppState) -> Router {
+    router_for(state, &[])
+}
+
+/// The whole service over `state`, whose API pages of `cors_origins` may call.
+pub fn router_for(state: AppState, cors_origins: &[String]) -> Router {
     let max_body = state.limits.max_body_bytes;
     let (api_routes, document) = api();
     // The docs' own handler answers an unknown file with an empty 404: make it a problem.
     let docs = Router::from(SwaggerUi::new("/docs").url("/api/v1/openapi.json", document))
         .layer(axum::middleware::map_response(empty_not_found_as_problem));
-    api_routes
+    let mut routes = api_routes
         .merge(docs)
         .merge(web::router())
         .merge(metrics::routes())
@@ -77,10 +94,121 @@ pub fn router(state: AppState) -> Router {
         .layer(axum::middleware::from_fn_with_state(state.auth.clone(), require_token))
         .layer(DefaultBodyLimit::max(max_body))
         .layer(RequestBodyTimeoutLayer::new(state.limits.body_idle_timeout))
-        .layer(axum::middleware::from_fn(metrics::track))
-        .layer(TraceLayer::new_for_http())
+        .layer(axum::middleware::from_fn(metrics::track));
+    // Outside the token check: a browser's preflight carries no token.
+    if let Some(cors) = cors(cors_origins) {
+        routes = routes.layer(cors);
+    }
+    routes
+        .layer(compression())
         .layer(CatchPanicLayer::custom(panic_response))
+        .layer(axum::middleware::from_fn(observe))
         .with_state(state)
+}
+
+/// Answers smaller than this are sent as they are: gzip's header and the work outweigh the gain.
+pub const COMPRESS_ABOVE_BYTES: u64 = 1024;
+
+/// gzip for answers of [`COMPRESS_ABOVE_BYTES`] or more (streamed ones too, whose size is not
+/// known) when `Accept-Encoding` allows it; not for zip archives, which are compressed already.
+fn compression() -> CompressionLayer<impl Predicate> {
+    CompressionLayer::new().compress_when(
+        DefaultPredicate::new()
+            .and(SizeAbove::new(COMPRESS_ABOVE_BYTES))
+            .and(NotForContentType::const_new("application/zip")),
+    )
+}
+
+/// The request id header: the client's when usable ([`usable_request_id`]), else one made here.
+pub static REQUEST_ID: HeaderName = HeaderName::from_static("x-request-id");
+
+/// CORS for `origins` (`*`: any), `None` for none: the methods and request headers the API
+/// reads, and the answer headers a page needs (the entity tag for `If-Match`, the request id,
+/// `Retry-After` of 429/503, the `Location` of a submitted job).
+fn cors(origins: &[String]) -> Option<CorsLayer> {
+    if origins.is_empty() {
+        return None;
+    }
+    let allowed = if origins.iter().any(|origin| origin == "*") {
+        AllowOrigin::any()
+    } else {
+        AllowOrigin::list(origins.iter().filter_map(|origin| HeaderValue::from_str(origin).ok()))
+    };
+    Some(
+        CorsLayer::new()
+            .allow_origin(allowed)
+            .allow_methods([Method::GET, Method::HEAD, Method::POST, Method::PUT, Method::DELETE])
+            .allow_headers([
+                header::ACCEPT,
+                header::AUTHORIZATION,
+                header::CONTENT_TYPE,
+                header::IF_MATCH,
+                header::IF_NONE_MATCH,
+                REQUEST_ID.clone(),
+            ])
+            .expose_headers([
+                header::ETAG,
+                REQUEST_ID.clone(),
+                header::RETRY_AFTER,
+                header::LOCATION,
+                header::CONTENT_DISPOSITION,
+            ])
+            .max_age(Duration::from_secs(600)),
+    )
+}
+
+/// Longest request id taken from a client.
+pub const REQUEST_ID_MAX_LEN: usize = 128;
+
+/// Whether a client's `X-Request-Id` is kept: 1 to [`REQUEST_ID_MAX_LEN`] visible ASCII
+/// characters (no spaces or control characters, which would garble a log line).
+pub fn usable_request_id(value: &HeaderValue) -> bool {
+    let bytes = value.as_bytes();
+    (1..=REQUEST_ID_MAX_LEN).contains(&bytes.len()) && bytes.iter().all(|b| b.is_ascii_graphic())
+}
+
+/// A new request id: 32 hex digits, from a per-process random key and a counter (unique within
+/// the process, unlikely to repeat across processes).
+fn new_request_id() -> HeaderValue {
+    static KEY: LazyLock<std::collections::hash_map::RandomState> =
+        LazyLock::new(std::collections::hash_map::RandomState::new);
+    static COUNT: AtomicU64 = AtomicU64::new(0);
+    let count = COUNT.fetch_add(1, Ordering::Relaxed);
+    let id = format!("{:016x}{:016x}", KEY.hash_one((count, 0_u8)), KEY.hash_one((count, 1_u8)));
+    HeaderValue::from_str(&id).unwrap_or_else(|_| HeaderValue::from_static("0"))
+}
+
+/// Middleware around everything else: gives the request its id ([`REQUEST_ID`]), runs it in a
+/// `request` span carrying method, matched route and id (so every line logged for it names
+/// them), writes one `info` line when the answer's head is ready (status, milliseconds), and sets
+/// the id on the answer. A 413 also says `Connection: close`: its body was not read, so the
+/// connection cannot carry another request.
+async fn observe(mut request: Request, next: Next) -> Response<Body> {
+    let id = request
+        .headers()
+        .get(&REQUEST_ID)
+        .filter(|value| usable_request_id(value))
+        .cloned()
+        .unwrap_or_else(new_request_id);
+    request.headers_mut().insert(REQUEST_ID.clone(), id.clone());
+    let route = request.extensions().get::<MatchedPath>().map_or("unmatched", MatchedPath::as_str).to_owned();
+    let span = tracing::info_span!(
+        "request",
+        method = %request.method(),
+        route = %route,
+        request_id = %id.to_str().unwrap_or_default(),
+    );
+    let started = Instant::now();
+    let mut response = next.run(request).instrument(span.clone()).await;
+    let status = response.status();
+    span.in_scope(|| {
+        tracing::info!(status = status.as_u16(), duration_ms = started.elapsed().as_secs_f64() * 1000.0, "answered");
+    });
+    if status == StatusCode::PAYLOAD_TOO_LARGE {
+        response.headers_mut().insert(header::CONNECTION, HeaderValue::from_static("close"));
+    }
+    response.headers_mut().insert(REQUEST_ID.clone(), id);
+    response
 }
 
 async fn empty_not_found_as_problem(response: Response<Body>) -> Response<Body> {
@@ -123,5 +251,5 @@ pub async fn build(config: &Config) -> anyhow::Result<(Router, AppState)> {
         );
     }
     state.jobs.start(&state.db, &state.solver_slots, config.job_workers).await?;
-    Ok((router(state.clone()), state))
+    Ok((router_for(state.clone(), &config.cors_origins), state))
 }

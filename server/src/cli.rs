@@ -2,13 +2,14 @@
 //! SIGTERM), `worker` (claims and runs jobs from PostgreSQL, no API), `run`, `migrate` and `jobs
 //! prune`.
 
+use std::io::IsTerminal;
 use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::Context;
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use tokio::net::TcpListener;
 use tracing_subscriber::EnvFilter;
 
@@ -29,6 +30,20 @@ pub struct Cli {
     /// Options of `serve` when no subcommand is given.
     #[command(flatten)]
     pub serve: ServeArgs,
+    /// How log lines are written to standard error: `text` (without colours unless standard
+    /// error is a terminal) or `json` (one object per line, for a log collector).
+    #[arg(long, global = true, env = "KERF_LOG_FORMAT", value_enum, default_value_t = LogFormat::Text)]
+    pub log_format: LogFormat,
+}
+
+/// The form of log lines.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum LogFormat {
+    /// Human-readable lines.
+    Text,
+    /// One JSON object per line: `timestamp`, `level`, `fields` (with `message`), `target`, and
+    /// `span` (the request's `method`, `route` and `request_id`) where one is open.
+    Json,
 }
 
 /// Subcommands.
@@ -193,9 +208,31 @@ pub struct ServeArgs {
     /// With a token, reads of the API need it too.
     #[arg(long, env = "KERF_PRIVATE")]
     pub private: bool,
+    /// An origin whose pages may call the API from a browser (CORS), as `scheme://host[:port]`
+    /// (`https://cam.example.com`), or `*` for any. Repeat it for several; from the environment,
+    /// separated by commas. None by default: browsers then allow only pages served by kerf itself.
+    #[arg(long = "cors-origin", env = "KERF_CORS_ORIGINS", value_delimiter = ',', value_parser = cors_origin)]
+    pub cors_origins: Vec<String>,
     /// The job store's bounds.
     #[command(flatten)]
     pub storage: JobStorageArgs,
+}
+
+/// Reads one `--cors-origin`: `*`, or `scheme://host[:port]` with nothing after (an origin as a
+/// browser sends it in `Origin`).
+fn cors_origin(text: &str) -> Result<String, String> {
+    let text = text.trim();
+    if text == "*" {
+        return Ok(text.to_owned());
+    }
+    let usage = || format!("{text:?} is not an origin: write scheme://host[:port], e.g. https://cam.example.com");
+    let (scheme, rest) = text.split_once("://").ok_or_else(usage)?;
+    let scheme_ok = scheme.starts_with(|c: char| c.is_ascii_alphabetic())
+        && scheme.chars().all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c));
+    let host_ok = !rest.is_empty()
+        && rest.chars().all(|c| c.is_ascii_alphanumeric() || "-.:[]".contains(c))
+        && !rest.starts_with(':');
+    if scheme_ok && host_ok { Ok(text.to_owned()) } else { Err(usage()) }
 }
 
 impl ServeArgs {
@@ -221,6 +258,7 @@ impl ServeArgs {
             job_lease: lease(self.job_lease_s),
             auth: Auth { token: self.api_token.clone().filter(|t| !t.is_empty()), private: self.private },
             job_storage: self.storage.storage(),
+            cors_origins: self.cors_origins.clone(),
         }
     }
 }
@@ -231,9 +269,14 @@ impl ServeArgs {
 /// Whatever the command fails with.
 pub fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
-    tracing_subscriber::fmt()
-        .with_env_filter(EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new("info,tower_http=info")))
-        .init();
+    let filter = EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new("info"));
+    // Standard error, so what `run`, `migrate` and `jobs prune` print on standard output stays
+    // theirs alone.
+    let lines = tracing_subscriber::fmt().with_env_filter(filter).with_writer(std::io::stderr);
+    match cli.log_format {
+        LogFormat::Text => lines.with_ansi(std::io::stderr().is_terminal()).init(),
+        LogFormat::Json => lines.json().with_current_span(true).with_span_list(false).init(),
+    }
     let runtime = tokio::runtime::Runtime::new().context("starting the async runtime")?;
     let result = match cli.command {
         Some(Command::Serve(args)) => runtime.block_on(serve(args)),

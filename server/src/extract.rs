@@ -62,24 +62,16 @@ pub fn media_type(headers: &HeaderMap) -> Option<String> {
     (!essence.is_empty()).then_some(essence)
 }
 
-/// 413 at once when a request with `Expect: 100-continue` declares a body longer than `limit`
-/// (`Content-Length`), before anything reads it: the client gets the 413 instead of `100
-/// Continue` (hyper sends that only when the body is first read) and never sends the body.
-///
-/// Only then: a client that is already sending its body gets its 413 from reading up to the
-/// limit, as before. Answering it without reading would close the connection on unread bytes,
-/// and the reset that follows can destroy the 413 before the client reads it.
+/// 413 at once when a request declares a body longer than `limit` (`Content-Length`), before
+/// anything reads it: a client with `Expect: 100-continue` gets the 413 instead of `100
+/// Continue` (hyper sends that only when the body is first read) and never sends the body; one
+/// already sending it gets the 413 without the server reading up to the limit first. The answer
+/// says `Connection: close` (the unread body cannot be skipped), and the connection is closed
+/// after a lingering read ([`crate::serve`]) so the client reads the 413 rather than a reset.
 ///
 /// # Errors
 /// 413 when the declared length is over the limit.
 pub fn refuse_declared_over(headers: &HeaderMap, limit: usize) -> Result<(), AppError> {
-    let waits_to_send = headers
-        .get(axum::http::header::EXPECT)
-        .and_then(|v| v.to_str().ok())
-        .is_some_and(|v| v.trim().eq_ignore_ascii_case("100-continue"));
-    if !waits_to_send {
-        return Ok(());
-    }
     let declared = headers.get(CONTENT_LENGTH).and_then(|v| v.to_str().ok()).and_then(|v| v.trim().parse::<u64>().ok());
     match declared {
         Some(length) if length > u64::try_from(limit).unwrap_or(u64::MAX) => Err(AppError::PayloadTooLarge { limit }),

@@ -98,7 +98,7 @@ pub fn describe_security(document: &mut utoipa::openapi::OpenApi) {
 }
 
 /// Documents the answers of a database in trouble: 503 `E_UNAVAILABLE` with `Retry-After` on every
-/// `/api/v1` operation and `/healthz` (each may read the store: a tool by number, a job), and 507
+/// `/api/v1` operation (each may read the store: a tool by number, a job), and 507
 /// `E_STORAGE_FULL` on every operation that writes (PUT, DELETE, a job's submission).
 pub fn describe_storage(document: &mut utoipa::openapi::OpenApi) {
     use utoipa::openapi::{Content, Ref, RefOr, ResponseBuilder};
@@ -120,7 +120,7 @@ pub fn describe_storage(document: &mut utoipa::openapi::OpenApi) {
         .content("application/problem+json", problem())
         .build();
     for (path, item) in &mut document.paths.paths {
-        if !path.starts_with("/api/v1/") && path != "/healthz" {
+        if !path.starts_with("/api/v1/") {
             continue;
         }
         let writes = path == "/api/v1/jobs";

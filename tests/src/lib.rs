@@ -113,6 +113,7 @@ impl TestApp {
             job_lease: Duration::from_secs(15),
             auth: kerf_server::auth::Auth::default(),
             job_storage: kerf_server::store::jobs::JobStorage::default(),
+            cors_origins: Vec::new(),
         };
         adjust(&mut config);
         let mut app = Self {

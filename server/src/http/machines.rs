@@ -12,8 +12,9 @@ use kerf_solver::machine::{MachineProfile, validate_machine_name};
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
+use super::{NamePage, page_limit};
 use crate::error::{AppError, AppResult, Problem};
-use crate::extract::{AppJson, AppPath, DeleteHeaders, Preconditions, ReplaceHeaders, etag_of, tagged};
+use crate::extract::{AppJson, AppPath, AppQuery, DeleteHeaders, Preconditions, ReplaceHeaders, etag_of, tagged};
 use crate::state::AppState;
 use crate::store;
 
@@ -32,11 +33,17 @@ fn unknown(name: &str) -> AppError {
     AppError::not_found(format!("machine {name:?} is not registered"))
 }
 
-/// All registered machines, ordered by name.
-#[utoipa::path(get, path = "/api/v1/machines", tag = "machines",
-    responses((status = 200, body = Vec<MachineProfile>)))]
-async fn list_machines(State(state): State<AppState>) -> AppResult<Json<Vec<MachineProfile>>> {
-    Ok(Json(store::machines::list(&state.db).await?))
+/// The registered machines, ordered by name, a page at a time with `limit` and `after`.
+#[utoipa::path(get, path = "/api/v1/machines", tag = "machines", params(NamePage),
+    responses(
+        (status = 200, body = Vec<MachineProfile>),
+        (status = 400, description = "`limit` is not a number from 1 to 1000 (`E_QUERY`, naming it)", body = Problem, content_type = "application/problem+json")))]
+async fn list_machines(
+    State(state): State<AppState>,
+    AppQuery(page): AppQuery<NamePage>,
+) -> AppResult<Json<Vec<MachineProfile>>> {
+    let limit = page_limit(page.limit)?;
+    Ok(Json(store::machines::list(&state.db, page.after.as_deref(), limit).await?))
 }
 
 /// One machine.

@@ -11,8 +11,9 @@ use kerf_solver::material::{Material, validate_material_name};
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
+use super::{NamePage, page_limit};
 use crate::error::{AppError, AppResult, Problem};
-use crate::extract::{AppJson, AppPath, DeleteHeaders, Preconditions, ReplaceHeaders, etag_of, tagged};
+use crate::extract::{AppJson, AppPath, AppQuery, DeleteHeaders, Preconditions, ReplaceHeaders, etag_of, tagged};
 use crate::state::AppState;
 use crate::store;
 
@@ -31,11 +32,18 @@ fn unknown(name: &str) -> AppError {
     AppError::not_found(format!("material {name:?} is not in the materials library"))
 }
 
-/// All materials of the library, ordered by name (the seeded ones included).
-#[utoipa::path(get, path = "/api/v1/materials", tag = "materials",
-    responses((status = 200, body = Vec<Material>)))]
-async fn list_materials(State(state): State<AppState>) -> AppResult<Json<Vec<Material>>> {
-    Ok(Json(store::materials::list(&state.db).await?))
+/// The materials of the library, ordered by name (the seeded ones included), a page at a time
+/// with `limit` and `after`.
+#[utoipa::path(get, path = "/api/v1/materials", tag = "materials", params(NamePage),
+    responses(
+        (status = 200, body = Vec<Material>),
+        (status = 400, description = "`limit` is not a number from 1 to 1000 (`E_QUERY`, naming it)", body = Problem, content_type = "application/problem+json")))]
+async fn list_materials(
+    State(state): State<AppState>,
+    AppQuery(page): AppQuery<NamePage>,
+) -> AppResult<Json<Vec<Material>>> {
+    let limit = page_limit(page.limit)?;
+    Ok(Json(store::materials::list(&state.db, page.after.as_deref(), limit).await?))
 }
 
 /// One material.

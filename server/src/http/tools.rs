@@ -4,13 +4,14 @@ use axum::Json;
 use axum::extract::State;
 use axum::http::StatusCode;
 use axum::response::Response;
-use kerf_solver::SolverError;
 use kerf_solver::tool::{TOOL_NUMBERS, Tool};
+use kerf_solver::{ErrorCode, SolverError};
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
+use super::page_limit;
 use crate::error::{AppError, AppResult, Problem};
-use crate::extract::{AppJson, AppPath, DeleteHeaders, Preconditions, ReplaceHeaders, etag_of, tagged};
+use crate::extract::{AppJson, AppPath, AppQuery, DeleteHeaders, Preconditions, ReplaceHeaders, etag_of, tagged};
 use crate::state::AppState;
 use crate::store;
 
@@ -28,10 +29,35 @@ fn checked_number(ToolNumber { number }: ToolNumber) -> AppResult<u32> {
     }
 }
 
-/// All registered tools, ordered by number.
-#[utoipa::path(get, path = "/api/v1/tools", tag = "tools", responses((status = 200, body = Vec<Tool>)))]
-async fn list_tools(State(state): State<AppState>) -> AppResult<Json<Vec<Tool>>> {
-    Ok(Json(store::tools::list(&state.db).await?))
+/// Paging of the tool table: keyset, as the job list pages.
+#[derive(Debug, Default, serde::Deserialize, utoipa::IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+struct ToolPage {
+    /// Tools per page, 1–1000; without it, every tool. A page shorter than `limit` is the last.
+    #[param(minimum = 1, maximum = 1000)]
+    limit: Option<i64>,
+    /// Only the tools numbered above this one: the last number of the previous page.
+    #[param(minimum = 0, maximum = 9999)]
+    after: Option<u32>,
+}
+
+/// The registered tools, ordered by number, a page at a time with `limit` and `after`.
+#[utoipa::path(get, path = "/api/v1/tools", tag = "tools", params(ToolPage),
+    responses(
+        (status = 200, body = Vec<Tool>),
+        (status = 400, description = "`limit` or `after` is not a number in its range (`E_QUERY`, naming it)", body = Problem, content_type = "application/problem+json")))]
+async fn list_tools(State(state): State<AppState>, AppQuery(page): AppQuery<ToolPage>) -> AppResult<Json<Vec<Tool>>> {
+    let limit = page_limit(page.limit)?;
+    let after = page.after.unwrap_or(0);
+    if after > *TOOL_NUMBERS.end() {
+        return Err(AppError::bad_request(
+            ErrorCode::Query,
+            "after",
+            format!("after must be a tool number, 0 to {} (got {after})", TOOL_NUMBERS.end()),
+        ));
+    }
+    Ok(Json(store::tools::list(&state.db, after, limit).await?))
 }
 
 /// One tool.

@@ -9,6 +9,7 @@ mod budgets;
 mod cancellation;
 mod cli;
 mod contour;
+mod conventions;
 mod deburr;
 mod deburr_holes;
 mod deburr_machine;
