@@ -21,7 +21,7 @@ pub struct Health {
 
 /// The service is up and its database is reachable (503 `E_UNAVAILABLE` with `Retry-After`
 /// within the pool's acquire timeout when it is not).
-#[utoipa::path(get, path = "/healthz", tag = "service",
+#[utoipa::path(get, path = "/healthz", tag = "service", operation_id = "get_health",
     responses((status = 200, body = Health), (status = 500, body = Problem, content_type = "application/problem+json")))]
 async fn healthz(State(state): State<AppState>) -> AppResult<Json<Health>> {
     state.db.ping().await?;
