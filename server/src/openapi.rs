@@ -1,5 +1,6 @@
 //! The OpenAPI document (utoipa): its header here, the paths and schemas from the route modules.
 
+use serde_json::{Map, Value, json};
 use utoipa::OpenApi;
 
 /// Document header; `app::router` adds every route's path and schemas.
@@ -13,7 +14,7 @@ use utoipa::OpenApi;
         license(name = "MIT OR Apache-2.0")
     ),
     servers((url = "/", description = "The service that serves this document")),
-    components(schemas(crate::http::output::Format, crate::http::contour::JsonOnly)),
+    components(schemas(crate::http::contour::JsonOnly)),
     tags(
         (name = "service", description = "Health"),
         (name = "tools", description = "The tool table, keyed by tool number"),
@@ -161,8 +162,6 @@ pub fn shape_for_generators(document: &mut utoipa::openapi::OpenApi) {
     }
     *document = serde_json::from_value(json).expect("the reshaped OpenAPI document reads back");
 }
-
-use serde_json::{Map, Value, json};
 
 /// The schema `schema` names through `$ref`s.
 fn resolve<'a>(schema: &'a Value, schemas: &'a Map<String, Value>) -> &'a Value {

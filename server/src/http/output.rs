@@ -9,13 +9,13 @@ use axum::http::{HeaderMap, header};
 use kerf_solver::capability::OutputOptions;
 use kerf_solver::gcode::{Arcs, Dialect, Reference};
 use serde::Deserialize;
-use utoipa::{IntoParams, ToSchema};
+use utoipa::IntoParams;
 
 /// Media type of G-code answers.
 pub const GCODE_MEDIA_TYPE: &str = "text/x-gcode";
 
 /// `json` or `gcode`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Format {
     /// The JSON answer (default).
@@ -24,10 +24,10 @@ pub enum Format {
     Gcode,
 }
 
-/// Query parameters of path-producing endpoints.
-#[derive(Debug, Clone, Default, Deserialize, IntoParams)]
+/// Query parameters of path-producing endpoints (not in the OpenAPI document, which documents
+/// the program routes' [`ProgramQuery`] instead).
+#[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
-#[into_params(parameter_in = Query)]
 pub struct OutputQuery {
     /// `json` (default) or `gcode`; without it, an `Accept` that ranks `text/x-gcode` above
     /// `application/json` selects G-code.
@@ -44,9 +44,8 @@ pub struct OutputQuery {
 
 /// Query parameters of an endpoint whose answer holds several candidate paths (engagement): the
 /// output negotiation of [`OutputQuery`] plus which candidate to program.
-#[derive(Debug, Clone, Default, Deserialize, IntoParams)]
+#[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
-#[into_params(parameter_in = Query)]
 pub struct CandidateQuery {
     /// `json` (default) or `gcode`; without it, an `Accept` that ranks `text/x-gcode` above
     /// `application/json` selects G-code.

@@ -26,10 +26,9 @@ use crate::extract::{AppQuery, charged_body_bytes, is_json, media_type, parse_js
 use crate::state::AppState;
 
 /// Query parameters of `POST /api/v1/predict`: the output negotiation of every path-producing
-/// endpoint, plus `timings`.
-#[derive(Debug, Clone, Default, Deserialize, IntoParams)]
+/// endpoint, plus `timings` (the document lists [`PredictJsonQuery`]).
+#[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
-#[into_params(parameter_in = Query)]
 pub struct PredictQuery {
     /// `json` (default) or `gcode` (the corrected program); `Accept: text/x-gcode` also selects
     /// G-code.
