@@ -147,8 +147,9 @@ pub fn describe_storage(document: &mut utoipa::openapi::OpenApi) {
 /// meant (openapi-python-client, openapi-typescript, `@hey-api/openapi-ts`; `clients/generate`
 /// runs them): every tagged union a `oneOf` of named, titled schemas with a `discriminator`; an
 /// answer that flattens a union (`EngagementAnswer`) one object; each job result typed by its
-/// operation; `Problem.code` an open string that lists the known codes. The wire is unchanged:
-/// these are the same JSON values, described in other words.
+/// operation; `Problem.code` an open string that lists the known codes; a tool number in a
+/// request 1–9999 as the tool table's keys. The wire is unchanged: these are the same JSON
+/// values, described in other words.
 ///
 /// # Panics
 /// If the document does not read back after reshaping, which the snapshot test shows first.
@@ -159,11 +160,12 @@ pub fn shape_for_generators(document: &mut utoipa::openapi::OpenApi) {
         flatten_unions_in_all_of(schemas);
         type_job_results(schemas, &answer_schemas());
         open_problem_code(schemas);
+        limit_tool_numbers(schemas);
     }
     *document = serde_json::from_value(json).expect("the reshaped OpenAPI document reads back");
 }
 
-/// The schema `schema` names through `$ref`s.
+/// The schema `schema` names through `$ref`s (at most 16 deep, so a circle of references ends).
 fn resolve<'a>(schema: &'a Value, schemas: &'a Map<String, Value>) -> &'a Value {
     let mut schema = schema;
     for _ in 0..16 {
@@ -390,4 +392,16 @@ fn open_problem_code(schemas: &mut Map<String, Value>) {
         "anyOf": [{ "$ref": "#/components/schemas/ErrorCode" }, { "type": "string" }],
         "description": format!("{description} One of `ErrorCode` today; later versions may add codes, so read it as an open string."),
     });
+}
+
+/// Gives the tool number of `ToolRef` (a request's `tool`, a number or an inline tool) the range
+/// of the tool table's keys; utoipa takes no limits on an enum variant's field.
+fn limit_tool_numbers(schemas: &mut Map<String, Value>) {
+    let members = schemas.get_mut("ToolRef").and_then(|tool| tool.get_mut("oneOf")).and_then(Value::as_array_mut);
+    for member in members.into_iter().flatten() {
+        if member.get("type").and_then(Value::as_str) == Some("integer") {
+            member["minimum"] = json!(kerf_solver::tool::TOOL_NUMBERS.start());
+            member["maximum"] = json!(kerf_solver::tool::TOOL_NUMBERS.end());
+        }
+    }
 }

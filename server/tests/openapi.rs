@@ -156,6 +156,8 @@ fn generators_read_the_document_as_meant() {
     assert_eq!(resolve(&zip["schema"])["format"], "binary", "{zip}");
     assert_eq!(schemas["Tool"]["properties"]["number"]["maximum"], 9999);
     assert_eq!(schemas["Tool"]["properties"]["flutes"]["maximum"], 32);
+    let number = schemas["ToolRef"]["oneOf"].as_array().unwrap().iter().find(|member| member["type"] == "integer");
+    assert_eq!(number.map(|number| (&number["minimum"], &number["maximum"])), Some((&1.into(), &9999.into())));
     assert_eq!(schemas["CurveCircle"]["properties"]["centre"]["minItems"], 2);
     assert_eq!(schemas["CurveCircle"]["properties"]["centre"]["maxItems"], 3);
     assert_eq!(schemas["StockBox"]["properties"]["min"]["maxItems"], 3);
