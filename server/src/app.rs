@@ -70,6 +70,7 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
     crate::openapi::describe_responses(&mut document);
     crate::openapi::describe_security(&mut document);
     crate::openapi::describe_storage(&mut document);
+    crate::openapi::shape_for_generators(&mut document);
     (routes, document)
 }
 

@@ -85,17 +85,23 @@ fn every_reference_is_defined() {
     }
 }
 
-/// Routes that answer JSON or a program document both media types on their 200, and every API
-/// operation its 401 (the token) with the bearer scheme.
+/// Every solver endpoint answers JSON only and its `/program` sibling G-code only, so a generated
+/// client has one answer type per operation; every API operation documents its 401 (the token)
+/// with the bearer scheme.
 #[test]
 fn answers_and_the_token_are_documented() {
     let (_, document) = kerf_server::app::api();
     let json = serde_json::to_value(&document).unwrap();
     assert_eq!(json["components"]["securitySchemes"]["bearer"]["scheme"], "bearer");
     for path in ["/api/v1/deburr", "/api/v1/segment", "/api/v1/contour", "/api/v1/engagement", "/api/v1/predict"] {
-        let content = &json["paths"][path]["post"]["responses"]["200"]["content"];
-        assert!(content["application/json"].is_object() && content["text/x-gcode"].is_object(), "{path}: {content}");
-        assert!(json["paths"][path]["post"]["responses"]["429"].is_object(), "{path} has no 429");
+        let content = json["paths"][path]["post"]["responses"]["200"]["content"].as_object().unwrap();
+        assert_eq!(content.keys().collect::<Vec<_>>(), ["application/json"], "{path}");
+        let program = format!("{path}/program");
+        let content = json["paths"][&program]["post"]["responses"]["200"]["content"].as_object().unwrap();
+        assert_eq!(content.keys().collect::<Vec<_>>(), ["text/x-gcode"], "{program}");
+        for path in [path, &program] {
+            assert!(json["paths"][path]["post"]["responses"]["429"].is_object(), "{path} has no 429");
+        }
     }
     for (path, item) in json["paths"].as_object().unwrap() {
         if !path.starts_with("/api/v1/") {
@@ -103,6 +109,79 @@ fn answers_and_the_token_are_documented() {
         }
         for (method, operation) in item.as_object().unwrap() {
             assert!(operation["responses"]["401"].is_object(), "{method} {path} has no 401");
+        }
+    }
+}
+
+/// What client generators need to read the document as meant: every union of objects tagged by
+/// a property has a `discriminator` whose mapping names schemas with a `title`; no `allOf` takes
+/// a `oneOf` (generators drop such a schema); every JSON answer an object (an `allOf` of
+/// objects, with the check before), an array or a tagged union; binaries
+/// are `format: binary`; `Problem.code` is open; every operation has an `operationId`.
+#[test]
+fn generators_read_the_document_as_meant() {
+    let (_, document) = kerf_server::app::api();
+    let json = serde_json::to_value(&document).unwrap();
+    let schemas = json["components"]["schemas"].as_object().unwrap();
+    let resolve = |schema: &serde_json::Value| -> serde_json::Value {
+        match schema["$ref"].as_str() {
+            Some(reference) => schemas[reference.trim_start_matches("#/components/schemas/")].clone(),
+            None => schema.clone(),
+        }
+    };
+    for union in ["Curve", "Stock", "Workpiece", "Stiffness", "PathInput", "SegmentInput", "Operation", "JobResult"] {
+        let schema = &schemas[union];
+        let property = schema["discriminator"]["propertyName"].as_str().unwrap_or_else(|| panic!("{union}: {schema}"));
+        let mapping = schema["discriminator"]["mapping"].as_object().unwrap();
+        assert_eq!(mapping.len(), schema["oneOf"].as_array().unwrap().len(), "{union}");
+        for (tag, reference) in mapping {
+            let member = resolve(&serde_json::json!({ "$ref": reference }));
+            assert!(member["title"].is_string(), "{union} {tag} has no title");
+            let text = member.to_string();
+            assert!(text.contains(&format!("\"{property}\"")), "{union} {tag} lacks {property}");
+        }
+    }
+    for (name, schema) in schemas {
+        for part in schema["allOf"].as_array().into_iter().flatten() {
+            assert!(resolve(part)["oneOf"].is_null(), "{name} is an allOf over a oneOf");
+        }
+    }
+    for (tag, reference) in schemas["JobResult"]["discriminator"]["mapping"].as_object().unwrap() {
+        let member = resolve(&serde_json::json!({ "$ref": reference }));
+        assert!(member["properties"]["result"]["$ref"].is_string(), "JobResult {tag}: {member}");
+    }
+    assert!(schemas["Problem"]["properties"]["code"]["anyOf"][1]["type"] == "string", "Problem.code is open");
+    assert_eq!(schemas["JobForm"]["properties"]["file"]["format"], "binary");
+    let zip = &json["paths"]["/api/v1/jobs/{id}/outputs.zip"]["get"]["responses"]["200"]["content"]["application/zip"];
+    assert_eq!(resolve(&zip["schema"])["format"], "binary", "{zip}");
+    assert_eq!(schemas["Tool"]["properties"]["number"]["maximum"], 9999);
+    assert_eq!(schemas["Tool"]["properties"]["flutes"]["maximum"], 32);
+    let number = schemas["ToolRef"]["oneOf"].as_array().unwrap().iter().find(|member| member["type"] == "integer");
+    assert_eq!(number.map(|number| (&number["minimum"], &number["maximum"])), Some((&1.into(), &9999.into())));
+    assert_eq!(schemas["CurveCircle"]["properties"]["centre"]["minItems"], 2);
+    assert_eq!(schemas["CurveCircle"]["properties"]["centre"]["maxItems"], 3);
+    assert_eq!(schemas["StockBox"]["properties"]["min"]["maxItems"], 3);
+    assert!(json["servers"].as_array().is_some_and(|servers| !servers.is_empty()));
+    let mut operation_ids = std::collections::BTreeSet::new();
+    for (path, item) in json["paths"].as_object().unwrap() {
+        for (method, operation) in item.as_object().unwrap() {
+            let id = operation["operationId"].as_str().unwrap_or_else(|| panic!("{method} {path}: no operationId"));
+            assert!(operation_ids.insert(id.to_owned()), "operationId {id} twice");
+            for (status, response) in operation["responses"].as_object().unwrap() {
+                let success = status.starts_with('2');
+                for (media, content) in response["content"].as_object().into_iter().flatten() {
+                    let schema = resolve(&content["schema"]);
+                    if success && media == "application/json" {
+                        assert!(
+                            schema["type"] == "object"
+                                || schema["type"] == "array"
+                                || schema["allOf"].is_array()
+                                || schema["discriminator"].is_object(),
+                            "{method} {path} {status}: the answer is not an object: {schema}"
+                        );
+                    }
+                }
+            }
         }
     }
 }

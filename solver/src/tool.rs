@@ -42,6 +42,7 @@ pub struct Tool {
     /// path's number; the body may repeat it). For an inline tool it is the pocket the G-code
     /// calls (`T`/`H`); without it the program stops for a manual tool change.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "schema", schema(minimum = 1, maximum = 9999))]
     pub number: Option<u32>,
     /// End shape.
     pub kind: ToolKind,
@@ -52,6 +53,7 @@ pub struct Tool {
     pub corner_radius: Option<f64>,
     /// Number of flutes (1–32).
     #[serde(default = "default_flutes")]
+    #[cfg_attr(feature = "schema", schema(minimum = 1, maximum = 32))]
     pub flutes: u32,
     /// Free-text name shown in listings and G-code comments (at most 200 characters).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -39,6 +39,18 @@ pub const EXTERNALS: &[External] = &[
         install: "pip install -r tests/requirements.txt",
         python_module: None,
     },
+    External {
+        name: "openapi_python_client",
+        what: "openapi-python-client",
+        install: "pip install -r tests/requirements.txt",
+        python_module: None,
+    },
+    External {
+        name: "typescript_clients",
+        what: "node or the TypeScript client generators",
+        install: "apt-get install npm; npm ci --prefix clients/typescript",
+        python_module: None,
+    },
 ];
 
 impl External {
@@ -110,6 +122,7 @@ fn external_of(program: &str) -> &str {
     match program {
         "node" | "chromium" => "chromium",
         "initdb" | "pg_ctl" | "runuser" => "postgres",
+        "openapi-python-client" => "openapi_python_client",
         other => other,
     }
 }
@@ -131,6 +144,42 @@ fn browser_driver_watched(watched: &mut Watched) -> bool {
 /// Whether the browser driver (playwright-core) is installed (and not withheld).
 pub fn browser_driver() -> bool {
     browser_driver_watched(&mut Watched::default()) && !withheld("chromium")
+}
+
+/// The folder of the TypeScript clients' `package.json` (`clients/typescript`).
+pub fn typescript_clients_folder() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../clients/typescript")
+}
+
+/// The npm packages `clients/generate` and the TypeScript workflows run.
+const TYPESCRIPT_CLIENT_PACKAGES: [&str; 5] =
+    ["openapi-typescript", "openapi-fetch", "@hey-api/openapi-ts", "typescript", "tsx"];
+
+/// Whether `npm ci --prefix clients/typescript` installed every package the TypeScript clients
+/// need. Watches each `package.json` found, else the folder `npm ci` fills.
+fn typescript_clients_watched(watched: &mut Watched) -> bool {
+    let modules = typescript_clients_folder().join("node_modules");
+    let mut found = true;
+    for package in TYPESCRIPT_CLIENT_PACKAGES {
+        let manifest = modules.join(package).join("package.json");
+        if manifest.is_file() {
+            watched.add(manifest);
+        } else {
+            found = false;
+        }
+    }
+    if !found {
+        watched.add(typescript_clients_folder());
+    }
+    found
+}
+
+/// Whether node and the TypeScript client generators are installed (and not withheld).
+pub fn typescript_clients() -> bool {
+    let mut watched = Watched::default();
+    on_path_watched("node", &mut watched).is_some()
+        && typescript_clients_watched(&mut watched)
+        && !withheld("typescript_clients")
 }
 
 /// Whether this process runs as root (PostgreSQL then runs as the `postgres` user).
@@ -210,6 +259,11 @@ pub fn probe(external: &External) -> (bool, Watched) {
             node & chromium & browser_driver_watched(&mut watched)
         }
         ("postgres", None) => postgres_watched(&mut watched).is_ok(),
+        ("openapi_python_client", None) => on_path_watched("openapi-python-client", &mut watched).is_some(),
+        ("typescript_clients", None) => {
+            let node = on_path_watched("node", &mut watched).is_some();
+            node & typescript_clients_watched(&mut watched)
+        }
         (program, None) => on_path_watched(program, &mut watched).is_some(),
     };
     (found && !withheld(external.name), watched)

@@ -39,7 +39,7 @@ pub struct LoopsQuery {
 ///
 /// JSON only: the path has no heights or feeds, so its moves go into the client's own program.
 /// At most 500 000 moves.
-#[utoipa::path(post, path = "/api/v1/contour/loops", tag = "contour",
+#[utoipa::path(post, path = "/api/v1/contour/loops", tag = "contour", operation_id = "contour_loops",
     params(LoopsQuery),
     request_body = LoopsRequest,
     responses(

@@ -1,6 +1,6 @@
 //! The solver endpoints `POST /api/v1/{name}` (docs/spec/api.md), generated from the capability registry
-//! (`capabilities::with_registry!`): one small `#[utoipa::path]` handler per capability with a
-//! JSON body, documented with the capability's own [`Endpoint`](kerf_solver::capability::Endpoint)
+//! (`capabilities::with_registry!`): two small `#[utoipa::path]` handlers per capability with a
+//! JSON body, the JSON answer and `POST /api/v1/{name}/program` with the program, documented with the capability's own [`Endpoint`](kerf_solver::capability::Endpoint)
 //! texts, so the OpenAPI document names each capability's concrete request and answer. A
 //! capability with an upload (`upload` in the registry) keeps its handler in `http/<module>.rs`.
 
@@ -27,19 +27,21 @@ macro_rules! endpoint {
             use crate::extract::{AppJson, AppQuery};
             use crate::state::AppState;
 
+            /// The query of the program route (`POST /api/v1/{name}/program`).
+            type ProgramParams = <$query as Negotiate>::Program;
+
+            /// The JSON answer; `?format=gcode` or an `Accept` preferring `text/x-gcode` still
+            /// answer the program here (undocumented: the program route is the documented way).
             #[utoipa::path(post,
                 context_path = "/api/v1/",
                 path = <$capability as Capability>::NAME,
-                operation_id = format!("post_{}", <$capability as Capability>::NAME),
+                operation_id = <$capability as Capability>::NAME,
                 tag = <$capability as Capability>::NAME,
                 summary = <$capability as Capability>::ENDPOINT.summary,
                 description = <$capability as Capability>::ENDPOINT.description,
-                params($query),
                 request_body = $request,
                 responses(
-                    (status = 200, description = "The answer as JSON, or the program (`?format=gcode`)", content(
-                        ($answer = "application/json"),
-                        (String = "text/x-gcode"))),
+                    (status = 200, description = "The answer", body = $answer, content_type = "application/json"),
                     (status = 400, body = Problem, content_type = "application/problem+json"),
                     (status = 404, description = <$capability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
                     (status = 413, body = Problem, content_type = "application/problem+json"),
@@ -55,6 +57,33 @@ macro_rules! endpoint {
             ) -> AppResult<Response> {
                 super::super::solve::answer::<$capability>(&state, request, None, query.ask(&headers)).await
             }
+
+            /// The program of the same request: the answer's path as G-code.
+            #[utoipa::path(post,
+                context_path = "/api/v1/",
+                path = format!("{}/program", <$capability as Capability>::NAME),
+                operation_id = format!("{}_program", <$capability as Capability>::NAME),
+                tag = <$capability as Capability>::NAME,
+                summary = "The same request's answer as a G-code program",
+                description = <$capability as Capability>::ENDPOINT.description,
+                params(ProgramParams),
+                request_body = $request,
+                responses(
+                    (status = 200, description = "The program", body = String, content_type = "text/x-gcode"),
+                    (status = 400, body = Problem, content_type = "application/problem+json"),
+                    (status = 404, description = <$capability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
+                    (status = 413, body = Problem, content_type = "application/problem+json"),
+                    (status = 408, description = "The body arrived slower than the minimum receive rate", body = Problem, content_type = "application/problem+json"),
+                    (status = 415, body = Problem, content_type = "application/problem+json"),
+                    (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json"),
+                    (status = 422, description = <$capability as Capability>::ENDPOINT.refused, body = Problem, content_type = "application/problem+json")))]
+            pub async fn program(
+                State(state): State<AppState>,
+                AppQuery(query): AppQuery<ProgramParams>,
+                AppJson(request): AppJson<$request>,
+            ) -> AppResult<Response> {
+                super::super::solve::answer::<$capability>(&state, request, None, <$query as Negotiate>::program(query)).await
+            }
         }
     };
     ($variant:ident, $module:ident, $capability:ident, $request:ident, $answer:ident, upload) => {};
@@ -63,7 +92,9 @@ macro_rules! endpoint {
 /// The routes of one capability's endpoint.
 macro_rules! route {
     ($variant:ident, $module:ident, json) => {
-        OpenApiRouter::new().routes(utoipa_axum::routes!($variant::post))
+        OpenApiRouter::new()
+            .routes(utoipa_axum::routes!($variant::post))
+            .routes(utoipa_axum::routes!($variant::program))
     };
     ($variant:ident, $module:ident, upload) => {
         super::$module::router()

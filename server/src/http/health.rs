@@ -23,7 +23,7 @@ pub struct Health {
 /// It does not touch the database, so an outage of the database does not get every API process
 /// restarted; `GET /readyz` (503 with
 /// `Retry-After` while the database does not answer) is the readiness probe.
-#[utoipa::path(get, path = "/healthz", tag = "service", responses((status = 200, body = Health)))]
+#[utoipa::path(get, path = "/healthz", tag = "service", operation_id = "get_health", responses((status = 200, body = Health)))]
 async fn healthz() -> Json<Health> {
     Json(Health { status: "ok", version: env!("CARGO_PKG_VERSION") })
 }

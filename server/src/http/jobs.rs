@@ -34,6 +34,24 @@ pub struct Submitted {
     pub reused: bool,
 }
 
+/// The form of a multipart submission (for the OpenAPI document).
+#[derive(Debug, ToSchema)]
+pub struct JobForm {
+    /// The job file, JSON or TOML (told by its name's extension or media type, else by its text).
+    #[schema(value_type = String, format = Binary)]
+    pub file: Vec<u8>,
+}
+
+/// A job file as TOML text (for the OpenAPI document): the raw body, UTF-8.
+#[derive(Debug, ToSchema)]
+#[schema(value_type = String, format = Binary)]
+pub struct JobFileToml(pub String);
+
+/// A zip archive (for the OpenAPI document).
+#[derive(Debug, ToSchema)]
+#[schema(value_type = String, format = Binary)]
+pub struct ZipArchive(pub Vec<u8>);
+
 /// One operation's result in a finished job.
 #[derive(Debug, Serialize, ToSchema)]
 pub struct JobResult {
@@ -167,12 +185,12 @@ fn located(id: i64, status: StatusCode, body: &Submitted) -> Response {
 }
 
 /// Submits a job file. 202 with the queued job; 200 when an identical finished job is reused.
-#[utoipa::path(post, path = "/api/v1/jobs", tag = "jobs",
+#[utoipa::path(post, path = "/api/v1/jobs", tag = "jobs", operation_id = "submit_job",
     request_body(description = "The job file: JSON, TOML (`application/toml`), or a form with it in field `file`.",
         content(
             (JobFile = "application/json"),
-            (String = "application/toml"),
-            (String = "multipart/form-data"))),
+            (JobFileToml = "application/toml"),
+            (JobForm = "multipart/form-data"))),
     responses(
         (status = 202, description = "Queued", body = Submitted, headers(("Location" = String))),
         (status = 200, description = "An identical finished job", body = Submitted, headers(("Location" = String))),
@@ -200,7 +218,7 @@ async fn submit(State(state): State<AppState>, request: Request) -> AppResult<Re
 }
 
 /// Jobs, newest first, a page at a time.
-#[utoipa::path(get, path = "/api/v1/jobs", tag = "jobs", params(PageQuery),
+#[utoipa::path(get, path = "/api/v1/jobs", tag = "jobs", operation_id = "list_jobs", params(PageQuery),
     responses((status = 200, body = JobPage), (status = 400, body = Problem, content_type = "application/problem+json")))]
 async fn list(State(state): State<AppState>, AppQuery(query): AppQuery<PageQuery>) -> AppResult<Json<JobPage>> {
     let limit = query.limit.unwrap_or(50);
@@ -232,7 +250,7 @@ async fn done_record(state: &AppState, id: i64) -> AppResult<JobRecord> {
 /// The results of a done job are held in memory twice (decompressed, then the answer) while the
 /// client reads them: that share of the memory budget is taken before they are read from the
 /// store (429 when other answers hold it).
-#[utoipa::path(get, path = "/api/v1/jobs/{id}", tag = "jobs",
+#[utoipa::path(get, path = "/api/v1/jobs/{id}", tag = "jobs", operation_id = "get_job",
     params(("id" = i64, Path, description = "Job id", minimum = 1)),
     responses(
         (status = 200, body = JobView),
@@ -271,7 +289,7 @@ async fn show(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobI
 /// tools, machines and materials its operations name as they were resolved at submission (a TOML
 /// file is stored as this JSON). Submitting it again runs the same job; for a done job the
 /// submission is answered with that job (`reused`).
-#[utoipa::path(get, path = "/api/v1/jobs/{id}/file", tag = "jobs",
+#[utoipa::path(get, path = "/api/v1/jobs/{id}/file", tag = "jobs", operation_id = "get_job_file",
     params(("id" = i64, Path, description = "Job id", minimum = 1)),
     responses(
         (status = 200, description = "The stored job file, byte for byte", body = JobFile, content_type = "application/json"),
@@ -292,7 +310,7 @@ async fn job_file(State(state): State<AppState>, AppPath(JobId { id }): AppPath<
 ///
 /// It is decompressed as the client reads it, never whole in memory; the compressed program holds
 /// its share of the memory budget until sent (429 when other answers hold it).
-#[utoipa::path(get, path = "/api/v1/jobs/{id}/gcode", tag = "jobs",
+#[utoipa::path(get, path = "/api/v1/jobs/{id}/gcode", tag = "jobs", operation_id = "get_job_operation_program",
     params(("id" = i64, Path, description = "Job id", minimum = 1), ProgramQuery),
     responses(
         (status = 200, body = String, content_type = "text/x-gcode"),
@@ -371,7 +389,7 @@ fn operation_outputs(rows: &[store::outputs::OperationRow]) -> Vec<OperationOutp
 /// coolant, one program number (`[output] program_number`, else `2000 + (id − 1) mod 6000`), a
 /// header listing operations, tools and estimated times. Operations without a program are named
 /// in the header as not included.
-#[utoipa::path(get, path = "/api/v1/jobs/{id}/program", tag = "jobs",
+#[utoipa::path(get, path = "/api/v1/jobs/{id}/program", tag = "jobs", operation_id = "get_job_program",
     params(("id" = i64, Path, description = "Job id", minimum = 1)),
     responses(
         (status = 200, body = String, content_type = "text/x-gcode"),
@@ -391,10 +409,10 @@ async fn job_program(State(state): State<AppState>, AppPath(JobId { id }): AppPa
 /// Every output of a finished job as a zip archive (stored, uncompressed): `job.json`, each
 /// operation's answer `NN-operation.json` and program `NN-operation.nc`, and the job's one
 /// program `program.nc` (the files `kerf run -o DIR` writes).
-#[utoipa::path(get, path = "/api/v1/jobs/{id}/outputs.zip", tag = "jobs",
+#[utoipa::path(get, path = "/api/v1/jobs/{id}/outputs.zip", tag = "jobs", operation_id = "get_job_outputs",
     params(("id" = i64, Path, description = "Job id", minimum = 1)),
     responses(
-        (status = 200, body = Vec<u8>, content_type = "application/zip"),
+        (status = 200, description = "The archive", body = ZipArchive, content_type = "application/zip"),
         (status = 404, body = Problem, content_type = "application/problem+json"),
         (status = 409, description = "Not finished", body = Problem, content_type = "application/problem+json"),
         (status = 429, description = "Large answers being read hold the memory budget; retry", body = Problem, content_type = "application/problem+json")))]
@@ -414,7 +432,7 @@ async fn outputs_zip(State(state): State<AppState>, AppPath(JobId { id }): AppPa
 
 /// Cancels a queued or running job (200 with the job, now `cancelled`); removes an ended one
 /// (done, failed or cancelled) with its results and outputs (204; the job is 404 afterwards).
-#[utoipa::path(delete, path = "/api/v1/jobs/{id}", tag = "jobs",
+#[utoipa::path(delete, path = "/api/v1/jobs/{id}", tag = "jobs", operation_id = "cancel_job",
     params(("id" = i64, Path, description = "Job id", minimum = 1)),
     responses(
         (status = 200, description = "Cancelled: the job was queued or running", body = JobView),

@@ -1,19 +1,21 @@
 //! Output negotiation shared by every path-producing endpoint (docs/spec/api.md, Conventions: G-code):
 //! JSON by default; G-code with `?format=gcode` or an `Accept` that ranks `text/x-gcode` above
 //! `application/json` (q-values, RFC 9110 §12.5.1), in `?dialect=` (`fanuc` default, or the
-//! machine's) with `?reference=tip|centre` and `?arcs=g2g3|chords`.
+//! machine's) with `?reference=tip|centre` and `?arcs=g2g3|chords`. Each endpoint's program route
+//! (`POST /api/v1/{name}/program`) answers the program only, so a generated client has one
+//! answer type per operation.
 
 use axum::http::{HeaderMap, header};
 use kerf_solver::capability::OutputOptions;
 use kerf_solver::gcode::{Arcs, Dialect, Reference};
 use serde::Deserialize;
-use utoipa::{IntoParams, ToSchema};
+use utoipa::IntoParams;
 
 /// Media type of G-code answers.
 pub const GCODE_MEDIA_TYPE: &str = "text/x-gcode";
 
 /// `json` or `gcode`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Format {
     /// The JSON answer (default).
@@ -22,10 +24,10 @@ pub enum Format {
     Gcode,
 }
 
-/// Query parameters of path-producing endpoints.
-#[derive(Debug, Clone, Default, Deserialize, IntoParams)]
+/// Query parameters of path-producing endpoints (not in the OpenAPI document, which documents
+/// the program routes' [`ProgramQuery`] instead).
+#[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
-#[into_params(parameter_in = Query)]
 pub struct OutputQuery {
     /// `json` (default) or `gcode`; without it, an `Accept` that ranks `text/x-gcode` above
     /// `application/json` selects G-code.
@@ -42,9 +44,8 @@ pub struct OutputQuery {
 
 /// Query parameters of an endpoint whose answer holds several candidate paths (engagement): the
 /// output negotiation of [`OutputQuery`] plus which candidate to program.
-#[derive(Debug, Clone, Default, Deserialize, IntoParams)]
+#[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
-#[into_params(parameter_in = Query)]
 pub struct CandidateQuery {
     /// `json` (default) or `gcode`; without it, an `Accept` that ranks `text/x-gcode` above
     /// `application/json` selects G-code.
@@ -64,19 +65,91 @@ pub struct CandidateQuery {
     pub arcs: Option<Arcs>,
 }
 
+/// Query parameters of a program route (`POST /api/v1/{name}/program`): how the program is
+/// written. The route answers G-code only, so it takes no `format`.
+#[derive(Debug, Clone, Default, Deserialize, IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+pub struct ProgramQuery {
+    /// G-code dialect: `fanuc` (default: the named machine's, else `fanuc`) or `linuxcnc`.
+    pub dialect: Option<Dialect>,
+    /// Programmed point: `tip` (default; length offset to the tool tip) or `centre`.
+    pub reference: Option<Reference>,
+    /// Circular moves: `g2g3` (G02/G03 with I/J in the XY plane, end points those of the chords)
+    /// or `chords` (G01 within the tolerance); default the named machine's `arcs`, else `chords`.
+    /// Ellipses, NURBS and polylines stay chords.
+    pub arcs: Option<Arcs>,
+}
+
+/// Query parameters of the program route of an endpoint whose answer holds several candidate
+/// paths (engagement): [`ProgramQuery`] plus which candidate to program.
+#[derive(Debug, Clone, Default, Deserialize, IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+pub struct CandidateProgramQuery {
+    /// G-code dialect: `fanuc` or `linuxcnc` (default: the named machine's, else `fanuc`).
+    pub dialect: Option<Dialect>,
+    /// Programmed point: `tip` (default; length offset to the tool tip) or `centre` (the centre
+    /// of the tool's end rounding: the ball centre, the bull-nose corner centre, the tip for a
+    /// flat end mill).
+    pub reference: Option<Reference>,
+    /// Which entry of the answer's `paths` to program (0-based; default the request's
+    /// `candidate`, else 0); a request with `path` has only candidate 0.
+    #[param(minimum = 0)]
+    pub candidate: Option<usize>,
+    /// Arc segments of the path: `g2g3` (G02/G03 with I/J, end points those of the chords) or
+    /// `chords` (G01 within 0.001 mm, or by the block-time rule); default the machine's `arcs`,
+    /// else `chords`.
+    pub arcs: Option<Arcs>,
+}
+
 /// A query that says what the client asks for (with the `Accept` header).
 pub trait Negotiate {
+    /// The query of the same endpoint's program route.
+    type Program: serde::de::DeserializeOwned + Send;
     /// What the client asked for; an explicit `format` wins over `Accept`.
     fn ask(&self, headers: &HeaderMap) -> Ask;
+    /// What a program route's client asks for: the program, written as `query` says.
+    fn program(query: Self::Program) -> Ask;
 }
 
 impl Negotiate for OutputQuery {
+    type Program = ProgramQuery;
+
     fn ask(&self, headers: &HeaderMap) -> Ask {
         Ask::negotiate(headers, self)
+    }
+
+    fn program(query: ProgramQuery) -> Ask {
+        Ask {
+            gcode: true,
+            output: OutputOptions {
+                dialect: query.dialect,
+                reference: query.reference,
+                candidate: None,
+                arcs: query.arcs,
+            },
+            timings: false,
+        }
     }
 }
 
 impl Negotiate for CandidateQuery {
+    type Program = CandidateProgramQuery;
+
+    fn program(query: CandidateProgramQuery) -> Ask {
+        Ask {
+            gcode: true,
+            output: OutputOptions {
+                dialect: query.dialect,
+                reference: query.reference,
+                candidate: query.candidate,
+                arcs: query.arcs,
+            },
+            timings: false,
+        }
+    }
+
     fn ask(&self, headers: &HeaderMap) -> Ask {
         Ask {
             gcode: wants_gcode(headers, self.format),

@@ -1,5 +1,6 @@
 //! `POST /api/v1/predict` (docs/spec/api.md, Error prediction): machining-error prediction and path
-//! correction for ball-end-mill finishing, as JSON or as the corrected G-code program.
+//! correction for ball-end-mill finishing, as JSON; `POST /api/v1/predict/program` answers the
+//! corrected G-code program.
 //!
 //! The request is JSON, or `multipart/form-data` with the JSON in part `request` and the stock's
 //! STL file (binary or ASCII) in part `stock` when `"stock": {"kind": "mesh"}`. This route has
@@ -25,10 +26,9 @@ use crate::extract::{AppQuery, charged_body_bytes, is_json, media_type, parse_js
 use crate::state::AppState;
 
 /// Query parameters of `POST /api/v1/predict`: the output negotiation of every path-producing
-/// endpoint, plus `timings`.
-#[derive(Debug, Clone, Default, Deserialize, IntoParams)]
+/// endpoint, plus `timings` (the document lists [`PredictJsonQuery`]).
+#[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
-#[into_params(parameter_in = Query)]
 pub struct PredictQuery {
     /// `json` (default) or `gcode` (the corrected program); `Accept: text/x-gcode` also selects
     /// G-code.
@@ -116,20 +116,41 @@ async fn read_form(form: Request) -> AppResult<Upload> {
     Ok(Upload { request: parse_json(&json)?, mesh })
 }
 
+/// The query of the predict endpoint's JSON answer, as documented.
+#[derive(Debug, Clone, Default, Deserialize, IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+pub struct PredictJsonQuery {
+    /// Add `timings` to the JSON answer (default false).
+    pub timings: Option<bool>,
+}
+
+/// The query of `POST /api/v1/predict/program`: how the corrected program is written.
+#[derive(Debug, Clone, Default, Deserialize, IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+pub struct PredictProgramQuery {
+    /// Dialect of the program written for a `points` path: `fanuc` (default) or `linuxcnc`. A
+    /// G-code path is written back in its own format.
+    pub dialect: Option<Dialect>,
+    /// Programmed point of the corrected program: the request's `reference` by default. A
+    /// `points` path is converted; a G-code path keeps its own (another value is refused).
+    pub reference: Option<Reference>,
+}
+
 /// The predict capability's endpoint, with its upload (documented with the capability's
-/// [`Endpoint`](kerf_solver::capability::Endpoint) texts like the generated ones).
-#[utoipa::path(post, path = "/api/v1/predict", tag = "predict",
+/// [`Endpoint`](kerf_solver::capability::Endpoint) texts like the generated ones): the JSON
+/// answer; `?format=gcode` or an `Accept` preferring `text/x-gcode` still answer the program here (undocumented: `POST /api/v1/predict/program` is the documented way).
+#[utoipa::path(post, path = "/api/v1/predict", tag = "predict", operation_id = "predict",
     summary = <PredictCapability as Capability>::ENDPOINT.summary,
     description = <PredictCapability as Capability>::ENDPOINT.description,
-    params(PredictQuery),
+    params(PredictJsonQuery),
     request_body(description = "The request as JSON, or a form with it in part `request` and the STL stock in part `stock`.",
         content(
             (PredictRequest = "application/json"),
             (PredictForm = "multipart/form-data"))),
     responses(
-        (status = 200, description = "The prediction as JSON, or the corrected program (`?format=gcode`)", content(
-            (PredictAnswer = "application/json"),
-            (String = "text/x-gcode"))),
+        (status = 200, description = "The prediction", body = PredictAnswer, content_type = "application/json"),
         (status = 400, description = "Not the right shape (JSON or form)", body = Problem, content_type = "application/problem+json"),
         (status = 404, description = <PredictCapability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
         (status = 408, description = "The body arrived slower than the minimum receive rate", body = Problem, content_type = "application/problem+json"),
@@ -148,6 +169,42 @@ async fn post_predict(
         output: OutputOptions { dialect: query.dialect, reference: query.reference, ..OutputOptions::default() },
         timings: query.timings.unwrap_or(false),
     };
+    predict(&state, request, ask).await
+}
+
+/// The corrected program of the same request.
+#[utoipa::path(post, path = "/api/v1/predict/program", tag = "predict", operation_id = "predict_program",
+    summary = "The same request's corrected path as a G-code program",
+    description = <PredictCapability as Capability>::ENDPOINT.description,
+    params(PredictProgramQuery),
+    request_body(description = "The request as JSON, or a form with it in part `request` and the STL stock in part `stock`.",
+        content(
+            (PredictRequest = "application/json"),
+            (PredictForm = "multipart/form-data"))),
+    responses(
+        (status = 200, description = "The corrected program", body = String, content_type = "text/x-gcode"),
+        (status = 400, description = "Not the right shape (JSON or form)", body = Problem, content_type = "application/problem+json"),
+        (status = 404, description = <PredictCapability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
+        (status = 408, description = "The body arrived slower than the minimum receive rate", body = Problem, content_type = "application/problem+json"),
+        (status = 413, description = "Body over the upload limit", body = Problem, content_type = "application/problem+json"),
+        (status = 415, body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = <PredictCapability as Capability>::ENDPOINT.refused, body = Problem, content_type = "application/problem+json"),
+        (status = 429, description = "All solver slots busy, or uploads and answers in progress hold the memory budget", body = Problem, content_type = "application/problem+json")))]
+async fn post_predict_program(
+    State(state): State<AppState>,
+    AppQuery(query): AppQuery<PredictProgramQuery>,
+    request: Request,
+) -> AppResult<Response> {
+    let ask = Ask {
+        gcode: true,
+        output: OutputOptions { dialect: query.dialect, reference: query.reference, ..OutputOptions::default() },
+        timings: false,
+    };
+    predict(&state, request, ask).await
+}
+
+/// Reads the JSON or form `request` and answers it as `ask` says.
+async fn predict(state: &AppState, request: Request, ask: Ask) -> AppResult<Response> {
     let json = is_json(request.headers());
     if !json && media_type(request.headers()).as_deref() != Some("multipart/form-data") {
         return Err(AppError::UnsupportedMediaType(
@@ -160,13 +217,16 @@ async fn post_predict(
     // While it arrives, possibly slowly, the upload holds its share of the memory budget: the
     // bytes received so far. It is read on a blocking thread in a solver slot, off the async
     // threads; once read, the solver slots bound it.
-    let (body, upload_share) = charged_body_bytes(request, &state, state.limits.max_upload_bytes).await?;
+    let (body, upload_share) = charged_body_bytes(request, state, state.limits.max_upload_bytes).await?;
     let Upload { request, mesh } = state.solve(move |_| read_upload(json, content_type, body)).await??;
     drop(upload_share);
-    super::solve::answer::<PredictCapability>(&state, request, mesh, ask).await
+    super::solve::answer::<PredictCapability>(state, request, mesh, ask).await
 }
 
 /// Routes of this module; the upload limit replaces the default body limit here.
 pub fn router() -> OpenApiRouter<AppState> {
-    OpenApiRouter::new().routes(routes!(post_predict)).layer(DefaultBodyLimit::disable())
+    OpenApiRouter::new()
+        .routes(routes!(post_predict))
+        .routes(routes!(post_predict_program))
+        .layer(DefaultBodyLimit::disable())
 }

@@ -29,6 +29,7 @@ pub enum Workpiece {
     /// A thick-walled tube: both the outer and the inner ridge exist.
     Tube {
         /// A point on the tube axis A1 at the hole station, machine/work coordinates.
+        #[cfg_attr(feature = "schema", schema(min_items = 3, max_items = 3))]
         origin: [f64; 3],
         /// θ_A: angle of A1 from +Y in the XY plane, counter-clockwise seen from +Z (docs/spec/deburr.md §1.3).
         #[serde(default)]
@@ -49,6 +50,7 @@ pub enum Workpiece {
     /// A block with a cylindrical bore (manifold block): only the inner ridge exists.
     BoreBlock {
         /// A point on the bore axis A1 at the hole station.
+        #[cfg_attr(feature = "schema", schema(min_items = 3, max_items = 3))]
         origin: [f64; 3],
         /// θ_A as for the tube.
         #[serde(default)]
@@ -193,6 +195,7 @@ pub struct Hole {
     /// Any point on the hole axis A2 (the patent's "third position"): its station along A1 moves
     /// the origin there, and it fixes f (which must agree if also given).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "schema", schema(min_items = 3, max_items = 3))]
     pub axis_point: Option<[f64; 3]>,
 }
 

@@ -19,6 +19,7 @@ pub enum SegmentInput {
     /// Straight move to `to` (G1; G0 when `rapid`).
     Line {
         /// End point [x, y], mm.
+        #[cfg_attr(feature = "schema", schema(min_items = 2, max_items = 2))]
         to: [f64; 2],
         /// A positioning move (G0): it does not cut and is not timed; touching material is
         /// reported as a collision (docs/spec/engagement.md §5.8).
@@ -29,10 +30,12 @@ pub enum SegmentInput {
     /// makes a full circle.
     Arc {
         /// End point [x, y], mm.
+        #[cfg_attr(feature = "schema", schema(min_items = 2, max_items = 2))]
         to: [f64; 2],
         /// Arc centre [x, y], mm; its distances to the start and end points must agree within
         /// 1e-6·r.
         #[serde(alias = "centre")]
+        #[cfg_attr(feature = "schema", schema(min_items = 2, max_items = 2))]
         center: [f64; 2],
         /// `ccw` (G3) or `cw` (G2).
         #[serde(alias = "direction")]
@@ -47,6 +50,7 @@ pub enum SegmentInput {
 pub struct PathSegments {
     /// Start point of the tool centre [x, y], mm (required with `segments`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "schema", schema(min_items = 2, max_items = 2))]
     pub start: Option<[f64; 2]>,
     /// The moves in order (at least one of non-zero length).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -141,6 +145,7 @@ pub struct StockPolygon {
 #[serde(deny_unknown_fields)]
 pub struct StockBitmap {
     /// Corner [x0, y0] of cell (0, 0), mm.
+    #[cfg_attr(feature = "schema", schema(min_items = 2, max_items = 2))]
     pub origin: [f64; 2],
     /// Cell side, mm.
     pub cell: f64,
@@ -245,6 +250,7 @@ pub struct FeedPlanRequest {
     /// Flute count of the cutter that runs the program (default: the fastest recommended flute
     /// count, else the tool's `flutes`; the answer's `program_flute_count`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "schema", schema(minimum = 1, maximum = 32))]
     pub flute_count: Option<u32>,
     /// `tooth` (default) or `sum`.
     #[serde(default)]

@@ -29,27 +29,35 @@ pub enum Stock {
     /// An axis-aligned box.
     Box {
         /// Lowest corner, mm.
+        #[cfg_attr(feature = "schema", schema(min_items = 3, max_items = 3))]
         min: [f64; 3],
         /// Highest corner, mm.
+        #[cfg_attr(feature = "schema", schema(min_items = 3, max_items = 3))]
         max: [f64; 3],
     },
     /// The material below a plane, limited to an xy footprint rectangle (e.g. a semi-finished
     /// face with its allowance).
     Plane {
         /// A point of the plane, mm.
+        #[cfg_attr(feature = "schema", schema(min_items = 3, max_items = 3))]
         point: [f64; 3],
         /// Normal pointing out of the material (needs a positive z component).
+        #[cfg_attr(feature = "schema", schema(min_items = 3, max_items = 3))]
         normal: [f64; 3],
         /// Footprint's lowest x and y, mm.
+        #[cfg_attr(feature = "schema", schema(min_items = 2, max_items = 2))]
         min: [f64; 2],
         /// Footprint's highest x and y, mm.
+        #[cfg_attr(feature = "schema", schema(min_items = 2, max_items = 2))]
         max: [f64; 2],
     },
     /// A solid cylinder between two points of its axis.
     Cylinder {
         /// One end of the axis, mm.
+        #[cfg_attr(feature = "schema", schema(min_items = 3, max_items = 3))]
         start: [f64; 3],
         /// The other end of the axis, mm.
+        #[cfg_attr(feature = "schema", schema(min_items = 3, max_items = 3))]
         end: [f64; 3],
         /// Radius, mm.
         radius: f64,
@@ -57,6 +65,7 @@ pub enum Stock {
     /// A height field (Z-map): the top of the material at grid nodes, bilinear in between.
     Grid {
         /// xy of node `heights[0][0]`, mm.
+        #[cfg_attr(feature = "schema", schema(min_items = 2, max_items = 2))]
         origin: [f64; 2],
         /// Node spacing in x and y, mm.
         spacing: f64,

@@ -30,6 +30,7 @@ pub enum Curve {
     /// A full circle, starting and ending at `start_deg`.
     Circle {
         /// Centre, `[x, y]` or `[x, y, z]`.
+        #[cfg_attr(feature = "schema", schema(min_items = 2, max_items = 3))]
         centre: Vec<f64>,
         /// Radius, mm.
         radius: f64,
@@ -44,6 +45,7 @@ pub enum Curve {
     /// 0 and 360, make a full circle).
     Arc {
         /// Centre, `[x, y]` or `[x, y, z]`.
+        #[cfg_attr(feature = "schema", schema(min_items = 2, max_items = 3))]
         centre: Vec<f64>,
         /// Radius, mm.
         radius: f64,
@@ -59,8 +61,10 @@ pub enum Curve {
     /// to `end_deg`: the parametric (eccentric) angle, not the polar angle of the point.
     Ellipse {
         /// Centre, `[x, y]` or `[x, y, z]`.
+        #[cfg_attr(feature = "schema", schema(min_items = 2, max_items = 3))]
         centre: Vec<f64>,
         /// `[a, b]`: semi-axis along the ellipse's first axis and across it, mm.
+        #[cfg_attr(feature = "schema", schema(min_items = 2, max_items = 2))]
         semi_axes: [f64; 2],
         /// Start parameter t, degrees (default 0).
         #[serde(default)]

@@ -8,6 +8,7 @@ mod browser;
 mod budgets;
 mod cancellation;
 mod cli;
+mod clients;
 mod contour;
 mod conventions;
 mod deburr;

@@ -45,7 +45,11 @@ async fn capability_views_follow_the_registry() {
     for name in &names {
         let operation = &document["paths"][format!("/api/v1/{name}")]["post"];
         assert_eq!(operation["tags"][0], name.as_str(), "{name}: the endpoint is the capability's");
-        assert_eq!(operation["operationId"], format!("post_{name}"));
+        assert_eq!(operation["operationId"], name.as_str());
+        assert_eq!(
+            document["paths"][format!("/api/v1/{name}/program")]["post"]["operationId"],
+            format!("{name}_program")
+        );
         assert!(operation["summary"].as_str().is_some_and(|s| !s.is_empty()), "{name}: documented");
         let view = app.get(&format!("/views/{name}.js")).await;
         assert_eq!(view.status(), 200, "{name}: its view module");
