@@ -87,8 +87,8 @@ pub(super) fn layer_moves(
     if approach < job.safe_z {
         out.push(MoveKind::Rapid, at(&entry, approach), None);
     }
-    let towards = if entry == first_start { first_chord_end(job, &passes[0]) } else { Some(first_start) };
-    for (to, feed) in entry_moves(job, entry, towards, approach.min(job.safe_z), z) {
+    let route = if entry == first_start { Route::Pass(&passes[0]) } else { Route::Lead(first_start, &passes[0]) };
+    for (to, feed) in entry_moves(job, entry, route, approach.min(job.safe_z), z) {
         out.push(MoveKind::Link, to, Some(feed));
     }
     let mut here = entry;
@@ -140,8 +140,7 @@ impl LayerWriter {
             if approach < job.safe_z {
                 self.push(MoveKind::Rapid, at(&pass.start, approach), None);
             }
-            let towards = first_chord_end(job, pass);
-            for (to, feed) in entry_moves(job, pass.start, towards, approach.min(job.safe_z), z) {
+            for (to, feed) in entry_moves(job, pass.start, Route::Pass(pass), approach.min(job.safe_z), z) {
                 self.push(MoveKind::Link, to, Some(feed));
             }
         }
@@ -207,23 +206,65 @@ const MAX_RAMP_RADII: f64 = 4.0;
 /// Most legs of one ramp entry.
 const MAX_RAMP_LEGS: usize = 10_000;
 
-/// The end of the first chord of `pass`: the direction a ramp entry at its start runs along.
-fn first_chord_end(job: &Job, pass: &PassPlan) -> Option<Vec2> {
-    let element = pass.elements.first()?;
-    element.chords(&job.chording, MAX_ARC_STEPS).first().copied()
+/// What a ramp entry runs along: from a lead point to S and on along the pass, or along the pass
+/// from its S.
+#[derive(Clone, Copy)]
+enum Route<'a> {
+    Lead(Vec2, &'a PassPlan),
+    Pass(&'a PassPlan),
+}
+
+impl Route<'_> {
+    /// The first point the ramp runs towards: S from a lead point, else the end of the pass's
+    /// first chord.
+    fn towards(self, job: &Job) -> Option<Vec2> {
+        match self {
+            Self::Lead(start, _) => Some(start),
+            Self::Pass(pass) => pass.elements.first()?.chords(&job.chording, MAX_ARC_STEPS).first().copied(),
+        }
+    }
+
+    /// The points after the ramp's start along the route, until they are `length` long or the
+    /// pass ends: S (from a lead point), then the ends of the pass's chords.
+    fn points(self, job: &Job, from: Vec2, length: f64) -> Vec<Vec2> {
+        let (mut points, pass) = match self {
+            Self::Lead(start, pass) => (vec![start], pass),
+            Self::Pass(pass) => (Vec::new(), pass),
+        };
+        let mut travelled = points.first().map_or(0.0, |start| (start - from).norm());
+        let mut here = points.last().copied().unwrap_or(from);
+        for element in &pass.elements {
+            if travelled >= length {
+                break;
+            }
+            for point in element.chords(&job.chording, MAX_ARC_STEPS) {
+                travelled += (point - here).norm();
+                points.push(point);
+                here = point;
+                if travelled >= length {
+                    break;
+                }
+            }
+        }
+        points
+    }
 }
 
 /// The feed moves (end, feed) from `point` at `from_z` down to `point` at `z`: one
 /// plunge when the tool cuts at its centre (at the cutting feed in the answer; the post writes it
 /// at the plunge feed); otherwise a ramp at the plunge feed that runs from `point` towards
-/// `towards` and back, legs of at most [`MAX_RAMP_RADII`] tool radii, each descending the same
-/// height at no more than the ramp angle, ending at `point` at `z`. Without a direction (no lead
+/// the route's first point and back, legs of at most [`MAX_RAMP_RADII`] tool radii, each
+/// descending the same height at no more than the ramp angle, ending at `point` at `z`. When
+/// that first stretch is too short to descend within [`MAX_RAMP_LEGS`] legs at the angle (a
+/// pass whose first chord is a few micrometres long), the legs follow the route further, along
+/// the pass's path, which keeps the tool radius from the contour. Without a direction (no lead
 /// and a zero-length first move) the tool plunges.
-fn entry_moves(job: &Job, point: Vec2, towards: Option<Vec2>, from_z: f64, z: f64) -> Vec<([f64; 3], f64)> {
+fn entry_moves(job: &Job, point: Vec2, route: Route<'_>, from_z: f64, z: f64) -> Vec<([f64; 3], f64)> {
     let bottom = vec![([point.x, point.y, z], job.feed)];
     let drop = from_z - z;
     let Some(angle) = job.ramp else { return bottom };
-    let Some((direction, length)) = towards
+    let Some((direction, length)) = route
+        .towards(job)
         .map(|t| t - point)
         .and_then(|d| d.try_normalize(1e-9).map(|u| (u, d.norm().min(MAX_RAMP_RADII * job.radius))))
     else {
@@ -234,7 +275,13 @@ fn entry_moves(job: &Job, point: Vec2, towards: Option<Vec2>, from_z: f64, z: f6
     }
     let feed = crate::gcode::plunge_feed(job.feed, job.plunge_feed);
     let legs = (drop / (length * angle.tan())).ceil() as usize;
-    let legs = (legs + legs % 2).clamp(2, MAX_RAMP_LEGS);
+    let legs = legs + legs % 2;
+    if legs > MAX_RAMP_LEGS {
+        if let Some(moves) = route_ramp(job, point, route, angle, (from_z, z), feed) {
+            return moves;
+        }
+    }
+    let legs = legs.clamp(2, MAX_RAMP_LEGS);
     let far = point + direction * length;
     (1..=legs)
         .map(|leg| {
@@ -243,4 +290,68 @@ fn entry_moves(job: &Job, point: Vec2, towards: Option<Vec2>, from_z: f64, z: f6
             ([at.x, at.y, height], feed)
         })
         .collect()
+}
+
+/// A ramp whose legs run from `point` along `route` up to [`MAX_RAMP_RADII`] tool radii and
+/// back, each point's height falling with the distance travelled, from `from_z` to `z`; `None`
+/// when even that route is too short for [`MAX_RAMP_LEGS`] legs at `angle`.
+fn route_ramp(
+    job: &Job,
+    point: Vec2,
+    route: Route<'_>,
+    angle: f64,
+    (from_z, z): (f64, f64),
+    feed: f64,
+) -> Option<Vec<([f64; 3], f64)>> {
+    let reach = MAX_RAMP_RADII * job.radius;
+    // The leg: `point`, then the route's points clipped at `reach`, none repeated.
+    let mut leg = vec![point];
+    let mut travelled = 0.0;
+    for next in route.points(job, point, reach) {
+        let here = leg[leg.len() - 1];
+        let step = (next - here).norm();
+        if step <= 1e-12 {
+            continue;
+        }
+        if travelled + step >= reach {
+            leg.push(here + (next - here) * ((reach - travelled) / step));
+            break;
+        }
+        leg.push(next);
+        travelled += step;
+    }
+    // Distance along the leg of every point of it.
+    let along: Vec<f64> = leg
+        .iter()
+        .scan((point, 0.0), |(here, sum), next| {
+            *sum += (next - *here).norm();
+            *here = *next;
+            Some(*sum)
+        })
+        .collect();
+    let travelled = along[along.len() - 1];
+    let drop = from_z - z;
+    let legs = (drop / (travelled * angle.tan())).ceil() as usize;
+    let legs = (legs + legs % 2).max(2);
+    if travelled <= 1e-6 || legs > MAX_RAMP_LEGS {
+        return None;
+    }
+    let mut moves = Vec::with_capacity(legs * (leg.len() - 1));
+    for index in 0..legs {
+        let top = from_z - drop * index as f64 / legs as f64;
+        let low = if index + 1 == legs { z } else { from_z - drop * (index + 1) as f64 / legs as f64 };
+        let height = |distance: f64| top - (top - low) * distance / travelled;
+        if index % 2 == 0 {
+            for (at, &distance) in leg.iter().zip(&along).skip(1) {
+                let h = if distance >= travelled { low } else { height(distance) };
+                moves.push(([at.x, at.y, h], feed));
+            }
+        } else {
+            for (at, &distance) in leg.iter().zip(&along).rev().skip(1) {
+                let h = if distance <= 0.0 { low } else { height(travelled - distance) };
+                moves.push(([at.x, at.y, h], feed));
+            }
+        }
+    }
+    Some(moves)
 }
