@@ -190,6 +190,12 @@ impl Capability for ContourCapability {
         answer.machine.as_ref()
     }
 
+    /// The layers' moves, nearly all of a large answer, written by hand (`wire`): the same
+    /// bytes as serde's.
+    fn to_json(answer: ContourAnswer) -> serde_json::Result<Vec<u8>> {
+        super::wire::to_json(answer)
+    }
+
     /// Keeps a stored result within [`MAX_JSON_MOVES`]: from the first layer that would pass the
     /// limit on, layers keep their `z` but lose their moves, and `W_MOVES_NOT_STORED` says so
     /// (the program, written before, has every move).

@@ -60,15 +60,42 @@ fn continues(line: &Element, a: &Vec2, b: &Vec2) -> bool {
     along.norm() > 1e-9 && scale > 0.0 && along.dot(&tangent) > 0.0 && cross(&along, &tangent).abs() <= 1e-9 * scale
 }
 
+/// One pass's moves as chords in the layer plane, with its arcs' spans (from its first move): the
+/// same at every height but for the moves' z, so layers that share their passes (walls that are
+/// not tilted) make them once and copy them ([`PassMoves::lift`]).
+pub(super) struct PassMoves {
+    moves: Vec<ContourMove>,
+    arcs: Vec<ArcSpan>,
+}
+
+impl PassMoves {
+    /// The moves of `pass` at height `z`.
+    pub(super) fn new(job: &Job, layer: &Layer, pass: &PassPlan, z: f64) -> Self {
+        let mut out = LayerWriter { moves: Vec::new(), arcs: Vec::new(), start_axis: None, z };
+        out.pass(job, layer, pass, job.loop_feed.unwrap_or(job.feed));
+        Self { moves: out.moves, arcs: out.arcs }
+    }
+
+    /// Every pass of a layer at height `z`.
+    pub(super) fn all(job: &Job, layer: &Layer, passes: &[PassPlan], z: f64) -> Vec<Self> {
+        passes.iter().map(|pass| Self::new(job, layer, pass, z)).collect()
+    }
+
+    fn len(&self) -> usize {
+        self.moves.len()
+    }
+}
+
 /// Every move of one layer: down from the clearance plane at the lead point, each pass with its
 /// lead-in and lead-out, back up. Without a lead point the first pass starts by plunging at its S,
 /// and later passes are reached by a straight link where it clears the contour, else over the
-/// clearance plane.
+/// clearance plane. `made` holds each pass's moves ([`PassMoves`], at any height).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn layer_moves(
     job: &Job,
     layer: &Layer,
     passes: &[PassPlan],
+    made: &[PassMoves],
     lead_point: Option<Vec2>,
     first: bool,
     previous_z: f64,
@@ -78,7 +105,10 @@ pub(super) fn layer_moves(
     let Some(first_start) = passes.first().map(|p| p.start) else {
         return (Vec::new(), Vec::new());
     };
-    let mut out = LayerWriter { moves: Vec::new(), arcs: Vec::new(), start_axis, z };
+    // The passes, and a few moves round each: descent, entry, links, retract.
+    let capacity = made.iter().map(|pass| pass.len() + 8).sum::<usize>() + 8;
+    let arcs = made.iter().map(|pass| pass.arcs.len()).sum();
+    let mut out = LayerWriter { moves: Vec::with_capacity(capacity), arcs: Vec::with_capacity(arcs), start_axis, z };
     let entry = lead_point.unwrap_or(first_start);
     let approach = (previous_z + APPROACH_GAP.min(job.safe_z - previous_z)).max(z);
     if first {
@@ -92,12 +122,11 @@ pub(super) fn layer_moves(
         out.push(MoveKind::Link, to, Some(feed));
     }
     let mut here = entry;
-    let loop_feed = job.loop_feed.unwrap_or(job.feed);
-    for pass in passes {
+    for (pass, pass_moves) in passes.iter().zip(made) {
         if here != pass.start {
             out.link(job, layer, here, pass, lead_point.is_some(), approach);
         }
-        out.pass(job, layer, pass, loop_feed);
+        out.lift(pass_moves);
         here = pass.start;
         if let Some(lead) = lead_point {
             out.push(MoveKind::Link, at(&lead, z), Some(job.feed));
@@ -126,6 +155,20 @@ impl LayerWriter {
     /// Appends a move with the start edge's tool axis.
     fn push(&mut self, kind: MoveKind, to: [f64; 3], feed: Option<f64>) {
         self.moves.push(ContourMove { kind, to, feed, axis: self.start_axis.clone() });
+    }
+
+    /// Appends a pass's moves at this layer's height, its arcs' spans after the moves so far.
+    fn lift(&mut self, pass: &PassMoves) {
+        let (z, from) = (self.z, self.moves.len());
+        self.moves.extend(pass.moves.iter().map(|step| {
+            let [x, y, _] = step.to;
+            ContourMove { kind: step.kind, to: [x, y, z], feed: step.feed, axis: step.axis.clone() }
+        }));
+        self.arcs.extend(pass.arcs.iter().map(|span| ArcSpan {
+            first: span.first + from,
+            last: span.last + from,
+            ..*span
+        }));
     }
 
     /// From `here` to the start of `pass`: straight at the layer's height where that clears the
