@@ -44,7 +44,16 @@ pub(crate) fn to_json(mut answer: ContourAnswer) -> serde_json::Result<Vec<u8>> 
 }
 
 /// `layers` as a JSON array.
+///
+/// Layers repeat one another's moves at another height, and a layer's moves share a few heights
+/// and feeds: a move whose kind, x and y are those of its counterpart in the layer before
+/// (counted from the end, as the first layer's first moves differ) copies that text instead of
+/// writing it again, and heights and feeds are formatted once each ([`Numbers`]). Copying text
+/// of the same values gives the same text.
 pub(crate) fn write_layers(out: &mut Vec<u8>, layers: &[ContourLayer]) {
+    let mut previous: Vec<Written> = Vec::new();
+    let mut current: Vec<Written> = Vec::new();
+    let mut numbers = Numbers::default();
     out.push(b'[');
     for (index, layer) in layers.iter().enumerate() {
         if index > 0 {
@@ -53,34 +62,98 @@ pub(crate) fn write_layers(out: &mut Vec<u8>, layers: &[ContourLayer]) {
         out.extend_from_slice(b"{\"z\":");
         float(out, layer.z);
         out.extend_from_slice(b",\"moves\":[");
+        let skipped = previous.len().checked_sub(layer.moves.len());
         for (index, step) in layer.moves.iter().enumerate() {
             if index > 0 {
                 out.push(b',');
             }
-            write_move(out, step);
+            let written = Written::of(step, out.len());
+            let twin = skipped.and_then(|skipped| previous.get(index + skipped));
+            match twin.filter(|twin| twin.same_start(&written)) {
+                Some(twin) => out.extend_from_within(twin.start..twin.end),
+                None => {
+                    out.extend_from_slice(kind_prefix(step.kind));
+                    float(out, step.to[0]);
+                    out.push(b',');
+                    float(out, step.to[1]);
+                    out.push(b',');
+                }
+            }
+            current.push(Written { end: out.len(), ..written });
+            numbers.write(out, step.to[2]);
+            out.push(b']');
+            if let Some(feed) = step.feed {
+                out.extend_from_slice(b",\"feed\":");
+                numbers.write(out, feed);
+            }
+            if let Some(axis) = &step.axis {
+                out.extend_from_slice(b",\"axis\":[");
+                triple(out, axis);
+            }
+            out.push(b'}');
         }
         out.extend_from_slice(b"]}");
+        std::mem::swap(&mut previous, &mut current);
+        current.clear();
     }
     out.push(b']');
 }
 
-fn write_move(out: &mut Vec<u8>, step: &ContourMove) {
-    out.extend_from_slice(match step.kind {
+/// Where a move's text up to its z begins and ends in the output (`{"kind":…,"to":[x,y,`), and
+/// the values it was written from.
+#[derive(Clone, Copy)]
+struct Written {
+    kind: MoveKind,
+    x: u64,
+    y: u64,
+    start: usize,
+    end: usize,
+}
+
+impl Written {
+    fn of(step: &ContourMove, start: usize) -> Self {
+        Self { kind: step.kind, x: step.to[0].to_bits(), y: step.to[1].to_bits(), start, end: start }
+    }
+
+    /// Whether `other`'s text up to its z is this one's.
+    fn same_start(&self, other: &Self) -> bool {
+        self.kind == other.kind && self.x == other.x && self.y == other.y
+    }
+}
+
+/// The text of the last few distinct numbers written through it (a layer's heights and feeds).
+#[derive(Default)]
+struct Numbers {
+    entries: [(u64, [u8; 32], usize); 4],
+    filled: usize,
+    next: usize,
+}
+
+impl Numbers {
+    fn write(&mut self, out: &mut Vec<u8>, value: f64) {
+        let bits = value.to_bits();
+        if let Some((_, text, length)) = self.entries[..self.filled].iter().find(|(b, _, _)| *b == bits) {
+            out.extend_from_slice(&text[..*length]);
+            return;
+        }
+        let from = out.len();
+        float(out, value);
+        let written = &out[from..];
+        let mut text = [0u8; 32];
+        text[..written.len()].copy_from_slice(written);
+        self.entries[self.next] = (bits, text, written.len());
+        self.next = (self.next + 1) % self.entries.len();
+        self.filled = (self.filled + 1).min(self.entries.len());
+    }
+}
+
+fn kind_prefix(kind: MoveKind) -> &'static [u8] {
+    match kind {
         MoveKind::Cut => b"{\"kind\":\"cut\",\"to\":[",
         MoveKind::Loop => b"{\"kind\":\"loop\",\"to\":[",
         MoveKind::Link => b"{\"kind\":\"link\",\"to\":[",
         MoveKind::Rapid => b"{\"kind\":\"rapid\",\"to\":[",
-    });
-    triple(out, &step.to);
-    if let Some(feed) = step.feed {
-        out.extend_from_slice(b",\"feed\":");
-        float(out, feed);
     }
-    if let Some(axis) = &step.axis {
-        out.extend_from_slice(b",\"axis\":[");
-        triple(out, axis);
-    }
-    out.push(b'}');
 }
 
 /// Three numbers and the closing bracket of their array.
@@ -155,6 +228,43 @@ mod tests {
         )
     }
 
+    /// Layers that repeat a first one's moves at other heights, with some moves dropped from the
+    /// front, some of another kind or place, some with other heights and feeds.
+    fn repeated_layers() -> impl Strategy<Value = Vec<ContourLayer>> {
+        (
+            prop::collection::vec(step(), 1..16),
+            prop::collection::vec(
+                (number(), 0usize..4, prop::collection::vec((0u8..8, step()), 16), prop::option::of(number())),
+                1..6,
+            ),
+        )
+            .prop_map(|(base, copies)| {
+                copies
+                    .into_iter()
+                    .map(|(z, skip, changes, feed)| {
+                        let moves = base
+                            .iter()
+                            .zip(&changes)
+                            .skip(skip.min(base.len() - 1))
+                            .map(|(step, (change, other))| {
+                                let mut step = step.clone();
+                                match change {
+                                    0 => step.kind = other.kind,
+                                    1 => step.to[0] = other.to[0],
+                                    2 => step.to[1] = other.to[1],
+                                    3 => step.feed = feed,
+                                    4 => step.to[2] = other.to[2],
+                                    _ => step.to[2] = z,
+                                }
+                                step
+                            })
+                            .collect();
+                        ContourLayer { z, moves, arcs: Vec::new() }
+                    })
+                    .collect()
+            })
+    }
+
     fn request(side: &str, tilt: Option<f64>) -> ContourRequest {
         let mut body = serde_json::json!({
             "tool": {"kind": "flat", "radius": 1.5, "name": "a \"layers\":[] tool"},
@@ -185,7 +295,7 @@ mod tests {
 
     proptest! {
         #[test]
-        fn random_moves_are_written_as_serde_writes_them(layers in layers()) {
+        fn random_moves_are_written_as_serde_writes_them(layers in prop_oneof![layers(), repeated_layers()]) {
             let mut answer = solved(&request("outside", None));
             answer.result.layers = layers;
             prop_assert_eq!(
