@@ -319,10 +319,10 @@ fn entry_moves(job: &Job, point: Vec2, route: Route<'_>, from_z: f64, z: f64) ->
     let feed = crate::gcode::plunge_feed(job.feed, job.plunge_feed);
     let legs = (drop / (length * angle.tan())).ceil() as usize;
     let legs = legs + legs % 2;
-    if legs > MAX_RAMP_LEGS {
-        if let Some(moves) = route_ramp(job, point, route, angle, (from_z, z), feed) {
-            return moves;
-        }
+    if legs > MAX_RAMP_LEGS
+        && let Some(moves) = route_ramp(job, point, route, angle, (from_z, z), feed)
+    {
+        return moves;
     }
     let legs = legs.clamp(2, MAX_RAMP_LEGS);
     let far = point + direction * length;
