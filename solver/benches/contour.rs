@@ -3,6 +3,9 @@
 //! * contour vertices per second for a 100 000-vertex contour with 50 layers (the full answer,
 //!   every move of every layer), and for one layer's 2-D plan;
 //! * the simple-polygon check of `planar` on the same 100 000 vertices;
+//! * the two cases measured against Clipper2 (offset once, copied to every layer): a star of 50
+//!   tips with 100 layers, and a 20 000-vertex wavy outline with 8 layers, each solved as the
+//!   endpoint solves it and its answer written as the endpoint writes its JSON;
 //! * printed once before timing: the material left and over-cut at every corner of the three
 //!   reference cases with and without loops, ideal and under the control models M1/M2.
 //!
@@ -10,8 +13,10 @@
 
 use std::hint::black_box;
 
+use criterion::BatchSize;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use kerf_solver::contour::{self, ContourRequest, ControllerModel, LoopStyle};
+use kerf_solver::capability::{Capability, Resolved, Run};
+use kerf_solver::contour::{self, ContourCapability, ContourRequest, ControllerModel, LoopStyle};
 use kerf_solver::planar::{Vec2, find_self_intersection};
 use kerf_solver::tool::{Tool, ToolKind};
 use serde_json::{Value, json};
@@ -43,6 +48,54 @@ fn big_request() -> ContourRequest {
         "loop_feed": 4000
     }))
     .unwrap_or_else(|e| panic!("bench request: {e}"))
+}
+
+/// A star of 50 tips (radius 50 mm, valleys at 30 mm), outside, arc loops at the tips, 100 layers
+/// of 1 mm, tool radius 3 mm.
+fn star_request() -> ContourRequest {
+    let contour: Vec<[f64; 2]> = (0..100)
+        .map(|k| {
+            let angle = std::f64::consts::TAU * f64::from(k) / 100.0;
+            let radius = if k % 2 == 0 { 50.0 } else { 30.0 };
+            [radius * angle.cos(), radius * angle.sin()]
+        })
+        .collect();
+    serde_json::from_value(json!({
+        "tool": {"kind": "flat", "radius": 3.0},
+        "contour": contour,
+        "side": "outside",
+        "depths": {"top": 0.0, "bottom": -100.0, "step": 1.0},
+        "corner_loop": {"style": "arc"},
+        "feed": 1200,
+        "loop_feed": 4000
+    }))
+    .unwrap_or_else(|e| panic!("star request: {e}"))
+}
+
+/// A wavy outline of 20 000 vertices (radius 100 mm ± 2 mm, 20 waves), outside, 8 layers of
+/// 1 mm, tool radius 3 mm.
+fn wavy_request() -> ContourRequest {
+    let contour: Vec<[f64; 2]> = (0..20_000)
+        .map(|k| {
+            let angle = std::f64::consts::TAU * f64::from(k) / 20_000.0;
+            let radius = 100.0 + 2.0 * (20.0 * angle).sin();
+            [radius * angle.cos(), radius * angle.sin()]
+        })
+        .collect();
+    serde_json::from_value(json!({
+        "tool": {"kind": "flat", "radius": 3.0},
+        "contour": contour,
+        "side": "outside",
+        "depths": {"top": 0.0, "bottom": -8.0, "step": 1.0},
+        "corner_loop": {"style": "arc"},
+        "feed": 1200,
+        "loop_feed": 4000
+    }))
+    .unwrap_or_else(|e| panic!("wavy request: {e}"))
+}
+
+fn resolved(tool: &Tool) -> Resolved<Tool> {
+    Resolved { tool: tool.clone(), machine: None, material: None, other_tools: Vec::new() }
 }
 
 fn fixture_request(case: &Value, loops: bool, controller: Option<ControllerModel>) -> (ContourRequest, Tool) {
@@ -158,6 +211,33 @@ fn bench(c: &mut Criterion) {
     });
     let polygon: Vec<Vec2> = castellated_ring().into_iter().map(|[x, y]| Vec2::new(x, y)).collect();
     group.bench_function("simple_polygon_check_100k", |b| b.iter(|| find_self_intersection(black_box(&polygon))));
+    group.finish();
+
+    let mut group = c.benchmark_group("contour_peers");
+    group.sample_size(20);
+    let tool = Tool::new(ToolKind::Flat, 3.0);
+    for (name, request) in [("star_50_tips_100_layers", star_request()), ("wavy_20k_vertices_8_layers", wavy_request())]
+    {
+        let answer = ContourCapability::solve(&request, resolved(&tool), &Run::default())
+            .unwrap_or_else(|e| panic!("{name}: {}", e.message()));
+        let json = ContourCapability::to_json(answer.clone()).map(|j| j.len()).unwrap_or(0);
+        println!("{name}: {} moves, {json} bytes of JSON", answer.result.summary.moves);
+        group.bench_function(format!("{name}/solve"), |b| {
+            b.iter(|| {
+                ContourCapability::solve(black_box(&request), resolved(&tool), &Run::default())
+                    .map(|a| a.result.summary.moves)
+            })
+        });
+        group.bench_function(format!("{name}/json"), |b| {
+            b.iter_batched(|| answer.clone(), |a| ContourCapability::to_json(a).map(|j| j.len()), BatchSize::LargeInput)
+        });
+        group.bench_function(format!("{name}/request"), |b| {
+            b.iter(|| {
+                let answer = ContourCapability::solve(black_box(&request), resolved(&tool), &Run::default());
+                answer.map(|a| ContourCapability::to_json(a).map(|j| j.len()))
+            })
+        });
+    }
     group.finish();
 }
 

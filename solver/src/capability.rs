@@ -430,6 +430,21 @@ impl Run<'_> {
     pub fn charge(&self, bytes: u64, done: usize, total: usize) -> Result<(), SolverError> {
         self.budget.map_or(Ok(()), |budget| budget.charge(bytes, done, total))
     }
+
+    /// [`AnswerBudget::charge_unit`] on the budget, if there is one (without one the unit's bytes
+    /// are not counted).
+    ///
+    /// # Errors
+    /// `E_TOO_LARGE_ANSWER` when the answer built so far is over the budget's limit.
+    pub fn charge_unit(
+        &self,
+        done: usize,
+        total: usize,
+        answer_bytes: u64,
+        unit_bytes: impl FnOnce() -> u64,
+    ) -> Result<(), SolverError> {
+        self.budget.map_or(Ok(()), |budget| budget.charge_unit(done, total, answer_bytes, unit_bytes))
+    }
 }
 
 /// The bytes one answer may take while it is built (the answer in memory and its JSON or
@@ -474,6 +489,23 @@ impl AnswerBudget {
         let done = done.clamp(1, total.max(1));
         let estimate = (u128::from(used) * total.max(1) as u128 / done as u128).min(u128::from(u64::MAX));
         Err(too_large_answer(u64::try_from(estimate).unwrap_or(u64::MAX), self.limit))
+    }
+
+    /// Charges unit `done` (1-based) of `total` as it is built: `unit_bytes()`, and with the first
+    /// unit `answer_bytes`, what the answer holds besides its units (tool, machine, summary).
+    /// The unit's bytes are counted only here, as counting its JSON writes it.
+    ///
+    /// # Errors
+    /// As [`AnswerBudget::charge`].
+    pub fn charge_unit(
+        &self,
+        done: usize,
+        total: usize,
+        answer_bytes: u64,
+        unit_bytes: impl FnOnce() -> u64,
+    ) -> Result<(), SolverError> {
+        let extra = if done == 1 { answer_bytes } else { 0 };
+        self.charge(unit_bytes() + extra, done, total)
     }
 
     /// Checks an answer whose whole size is known (its JSON, its program).

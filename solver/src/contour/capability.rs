@@ -133,11 +133,7 @@ impl Capability for ContourCapability {
     fn solve(request: &ContourRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<ContourAnswer, SolverError> {
         let max_moves = if run.purpose == Purpose::Json { MAX_JSON_MOVES } else { MAX_MOVES };
         let charge = |layer: &LayerMoves, done: usize, count: usize| {
-            if run.budget.is_none() {
-                return Ok(());
-            }
-            let extra = if done == 1 { ANSWER_BYTES } else { 0 };
-            run.charge(layer_bytes(layer, run.purpose) + extra, done, count)
+            run.charge_unit(done, count, ANSWER_BYTES, || layer_bytes(layer, run.purpose))
         };
         let result = super::solve::solve_charged(
             request,
@@ -192,6 +188,12 @@ impl Capability for ContourCapability {
 
     fn machine(answer: &ContourAnswer) -> Option<&MachineProfile> {
         answer.machine.as_ref()
+    }
+
+    /// The layers' moves, nearly all of a large answer, written by hand (`wire`): the same
+    /// bytes as serde's.
+    fn to_json(answer: ContourAnswer) -> serde_json::Result<Vec<u8>> {
+        super::wire::to_json(answer)
     }
 
     /// Keeps a stored result within [`MAX_JSON_MOVES`]: from the first layer that would pass the

@@ -28,7 +28,8 @@
 //!   added to such a path ([`detect::loop_path`]);
 //! * [`program`](mod@program): G-code;
 //! * `blocks`: with `block_time_ms`, the block figures of the answer;
-//! * `parts`: a job's layers split into ranges that several workers make at once.
+//! * `parts`: a job's layers split into ranges that several workers make at once;
+//! * `wire`: the answer as JSON, its moves written by hand (the same text as serde's).
 //!
 //! Choices where the spec is open (see also the module docs):
 //! * `direction` `climb` (default) puts the material on the right of travel (σ = −1);
@@ -77,6 +78,7 @@ mod relief;
 mod report;
 pub mod request;
 mod solve;
+mod wire;
 
 pub use answer::{
     ContourCorner, ContourLayer, ContourMove, ContourSolution, ContourSummary, Convexity, CornerAction, LoopReport,

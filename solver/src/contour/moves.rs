@@ -60,15 +60,42 @@ fn continues(line: &Element, a: &Vec2, b: &Vec2) -> bool {
     along.norm() > 1e-9 && scale > 0.0 && along.dot(&tangent) > 0.0 && cross(&along, &tangent).abs() <= 1e-9 * scale
 }
 
+/// One pass's moves as chords in the layer plane, with its arcs' spans (from its first move): the
+/// same at every height but for the moves' z, so layers that share their passes (walls that are
+/// not tilted) make them once and copy them ([`PassMoves::lift`]).
+pub(super) struct PassMoves {
+    moves: Vec<ContourMove>,
+    arcs: Vec<ArcSpan>,
+}
+
+impl PassMoves {
+    /// The moves of `pass` at height `z`.
+    pub(super) fn new(job: &Job, layer: &Layer, pass: &PassPlan, z: f64) -> Self {
+        let mut out = LayerWriter { moves: Vec::new(), arcs: Vec::new(), start_axis: None, z };
+        out.pass(job, layer, pass, job.loop_feed.unwrap_or(job.feed));
+        Self { moves: out.moves, arcs: out.arcs }
+    }
+
+    /// Every pass of a layer at height `z`.
+    pub(super) fn all(job: &Job, layer: &Layer, passes: &[PassPlan], z: f64) -> Vec<Self> {
+        passes.iter().map(|pass| Self::new(job, layer, pass, z)).collect()
+    }
+
+    fn len(&self) -> usize {
+        self.moves.len()
+    }
+}
+
 /// Every move of one layer: down from the clearance plane at the lead point, each pass with its
 /// lead-in and lead-out, back up. Without a lead point the first pass starts by plunging at its S,
 /// and later passes are reached by a straight link where it clears the contour, else over the
-/// clearance plane.
+/// clearance plane. `made` holds each pass's moves ([`PassMoves`], at any height).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn layer_moves(
     job: &Job,
     layer: &Layer,
     passes: &[PassPlan],
+    made: &[PassMoves],
     lead_point: Option<Vec2>,
     first: bool,
     previous_z: f64,
@@ -78,7 +105,10 @@ pub(super) fn layer_moves(
     let Some(first_start) = passes.first().map(|p| p.start) else {
         return (Vec::new(), Vec::new());
     };
-    let mut out = LayerWriter { moves: Vec::new(), arcs: Vec::new(), start_axis, z };
+    // The passes, and a few moves round each: descent, entry, links, retract.
+    let capacity = made.iter().map(|pass| pass.len() + 8).sum::<usize>() + 8;
+    let arcs = made.iter().map(|pass| pass.arcs.len()).sum();
+    let mut out = LayerWriter { moves: Vec::with_capacity(capacity), arcs: Vec::with_capacity(arcs), start_axis, z };
     let entry = lead_point.unwrap_or(first_start);
     let approach = (previous_z + APPROACH_GAP.min(job.safe_z - previous_z)).max(z);
     if first {
@@ -87,17 +117,16 @@ pub(super) fn layer_moves(
     if approach < job.safe_z {
         out.push(MoveKind::Rapid, at(&entry, approach), None);
     }
-    let towards = if entry == first_start { first_chord_end(job, &passes[0]) } else { Some(first_start) };
-    for (to, feed) in entry_moves(job, entry, towards, approach.min(job.safe_z), z) {
+    let route = if entry == first_start { Route::Pass(&passes[0]) } else { Route::Lead(first_start, &passes[0]) };
+    for (to, feed) in entry_moves(job, entry, route, approach.min(job.safe_z), z) {
         out.push(MoveKind::Link, to, Some(feed));
     }
     let mut here = entry;
-    let loop_feed = job.loop_feed.unwrap_or(job.feed);
-    for pass in passes {
+    for (pass, pass_moves) in passes.iter().zip(made) {
         if here != pass.start {
             out.link(job, layer, here, pass, lead_point.is_some(), approach);
         }
-        out.pass(job, layer, pass, loop_feed);
+        out.lift(pass_moves);
         here = pass.start;
         if let Some(lead) = lead_point {
             out.push(MoveKind::Link, at(&lead, z), Some(job.feed));
@@ -128,6 +157,20 @@ impl LayerWriter {
         self.moves.push(ContourMove { kind, to, feed, axis: self.start_axis.clone() });
     }
 
+    /// Appends a pass's moves at this layer's height, its arcs' spans after the moves so far.
+    fn lift(&mut self, pass: &PassMoves) {
+        let (z, from) = (self.z, self.moves.len());
+        self.moves.extend(pass.moves.iter().map(|step| {
+            let [x, y, _] = step.to;
+            ContourMove { kind: step.kind, to: [x, y, z], feed: step.feed, axis: step.axis.clone() }
+        }));
+        self.arcs.extend(pass.arcs.iter().map(|span| ArcSpan {
+            first: span.first + from,
+            last: span.last + from,
+            ..*span
+        }));
+    }
+
     /// From `here` to the start of `pass`: straight at the layer's height where that clears the
     /// contour (always from a lead point), else up, over and down again with an entry.
     fn link(&mut self, job: &Job, layer: &Layer, here: Vec2, pass: &PassPlan, from_lead: bool, approach: f64) {
@@ -140,8 +183,7 @@ impl LayerWriter {
             if approach < job.safe_z {
                 self.push(MoveKind::Rapid, at(&pass.start, approach), None);
             }
-            let towards = first_chord_end(job, pass);
-            for (to, feed) in entry_moves(job, pass.start, towards, approach.min(job.safe_z), z) {
+            for (to, feed) in entry_moves(job, pass.start, Route::Pass(pass), approach.min(job.safe_z), z) {
                 self.push(MoveKind::Link, to, Some(feed));
             }
         }
@@ -207,23 +249,65 @@ const MAX_RAMP_RADII: f64 = 4.0;
 /// Most legs of one ramp entry.
 const MAX_RAMP_LEGS: usize = 10_000;
 
-/// The end of the first chord of `pass`: the direction a ramp entry at its start runs along.
-fn first_chord_end(job: &Job, pass: &PassPlan) -> Option<Vec2> {
-    let element = pass.elements.first()?;
-    element.chords(&job.chording, MAX_ARC_STEPS).first().copied()
+/// What a ramp entry runs along: from a lead point to S and on along the pass, or along the pass
+/// from its S.
+#[derive(Clone, Copy)]
+enum Route<'a> {
+    Lead(Vec2, &'a PassPlan),
+    Pass(&'a PassPlan),
+}
+
+impl Route<'_> {
+    /// The first point the ramp runs towards: S from a lead point, else the end of the pass's
+    /// first chord.
+    fn towards(self, job: &Job) -> Option<Vec2> {
+        match self {
+            Self::Lead(start, _) => Some(start),
+            Self::Pass(pass) => pass.elements.first()?.chords(&job.chording, MAX_ARC_STEPS).first().copied(),
+        }
+    }
+
+    /// The points after the ramp's start along the route, until they are `length` long or the
+    /// pass ends: S (from a lead point), then the ends of the pass's chords.
+    fn points(self, job: &Job, from: Vec2, length: f64) -> Vec<Vec2> {
+        let (mut points, pass) = match self {
+            Self::Lead(start, pass) => (vec![start], pass),
+            Self::Pass(pass) => (Vec::new(), pass),
+        };
+        let mut travelled = points.first().map_or(0.0, |start| (start - from).norm());
+        let mut here = points.last().copied().unwrap_or(from);
+        for element in &pass.elements {
+            if travelled >= length {
+                break;
+            }
+            for point in element.chords(&job.chording, MAX_ARC_STEPS) {
+                travelled += (point - here).norm();
+                points.push(point);
+                here = point;
+                if travelled >= length {
+                    break;
+                }
+            }
+        }
+        points
+    }
 }
 
 /// The feed moves (end, feed) from `point` at `from_z` down to `point` at `z`: one
 /// plunge when the tool cuts at its centre (at the cutting feed in the answer; the post writes it
 /// at the plunge feed); otherwise a ramp at the plunge feed that runs from `point` towards
-/// `towards` and back, legs of at most [`MAX_RAMP_RADII`] tool radii, each descending the same
-/// height at no more than the ramp angle, ending at `point` at `z`. Without a direction (no lead
+/// the route's first point and back, legs of at most [`MAX_RAMP_RADII`] tool radii, each
+/// descending the same height at no more than the ramp angle, ending at `point` at `z`. When
+/// that first stretch is too short to descend within [`MAX_RAMP_LEGS`] legs at the angle (a
+/// pass whose first chord is a few micrometres long), the legs follow the route further, along
+/// the pass's path, which keeps the tool radius from the contour. Without a direction (no lead
 /// and a zero-length first move) the tool plunges.
-fn entry_moves(job: &Job, point: Vec2, towards: Option<Vec2>, from_z: f64, z: f64) -> Vec<([f64; 3], f64)> {
+fn entry_moves(job: &Job, point: Vec2, route: Route<'_>, from_z: f64, z: f64) -> Vec<([f64; 3], f64)> {
     let bottom = vec![([point.x, point.y, z], job.feed)];
     let drop = from_z - z;
     let Some(angle) = job.ramp else { return bottom };
-    let Some((direction, length)) = towards
+    let Some((direction, length)) = route
+        .towards(job)
         .map(|t| t - point)
         .and_then(|d| d.try_normalize(1e-9).map(|u| (u, d.norm().min(MAX_RAMP_RADII * job.radius))))
     else {
@@ -234,7 +318,13 @@ fn entry_moves(job: &Job, point: Vec2, towards: Option<Vec2>, from_z: f64, z: f6
     }
     let feed = crate::gcode::plunge_feed(job.feed, job.plunge_feed);
     let legs = (drop / (length * angle.tan())).ceil() as usize;
-    let legs = (legs + legs % 2).clamp(2, MAX_RAMP_LEGS);
+    let legs = legs + legs % 2;
+    if legs > MAX_RAMP_LEGS
+        && let Some(moves) = route_ramp(job, point, route, angle, (from_z, z), feed)
+    {
+        return moves;
+    }
+    let legs = legs.clamp(2, MAX_RAMP_LEGS);
     let far = point + direction * length;
     (1..=legs)
         .map(|leg| {
@@ -243,4 +333,68 @@ fn entry_moves(job: &Job, point: Vec2, towards: Option<Vec2>, from_z: f64, z: f6
             ([at.x, at.y, height], feed)
         })
         .collect()
+}
+
+/// A ramp whose legs run from `point` along `route` up to [`MAX_RAMP_RADII`] tool radii and
+/// back, each point's height falling with the distance travelled, from `from_z` to `z`; `None`
+/// when even that route is too short for [`MAX_RAMP_LEGS`] legs at `angle`.
+fn route_ramp(
+    job: &Job,
+    point: Vec2,
+    route: Route<'_>,
+    angle: f64,
+    (from_z, z): (f64, f64),
+    feed: f64,
+) -> Option<Vec<([f64; 3], f64)>> {
+    let reach = MAX_RAMP_RADII * job.radius;
+    // The leg: `point`, then the route's points clipped at `reach`, none repeated.
+    let mut leg = vec![point];
+    let mut travelled = 0.0;
+    for next in route.points(job, point, reach) {
+        let here = leg[leg.len() - 1];
+        let step = (next - here).norm();
+        if step <= 1e-12 {
+            continue;
+        }
+        if travelled + step >= reach {
+            leg.push(here + (next - here) * ((reach - travelled) / step));
+            break;
+        }
+        leg.push(next);
+        travelled += step;
+    }
+    // Distance along the leg of every point of it.
+    let along: Vec<f64> = leg
+        .iter()
+        .scan((point, 0.0), |(here, sum), next| {
+            *sum += (next - *here).norm();
+            *here = *next;
+            Some(*sum)
+        })
+        .collect();
+    let travelled = along[along.len() - 1];
+    let drop = from_z - z;
+    let legs = (drop / (travelled * angle.tan())).ceil() as usize;
+    let legs = (legs + legs % 2).max(2);
+    if travelled <= 1e-6 || legs > MAX_RAMP_LEGS {
+        return None;
+    }
+    let mut moves = Vec::with_capacity(legs * (leg.len() - 1));
+    for index in 0..legs {
+        let top = from_z - drop * index as f64 / legs as f64;
+        let low = if index + 1 == legs { z } else { from_z - drop * (index + 1) as f64 / legs as f64 };
+        let height = |distance: f64| top - (top - low) * distance / travelled;
+        if index % 2 == 0 {
+            for (at, &distance) in leg.iter().zip(&along).skip(1) {
+                let h = if distance >= travelled { low } else { height(distance) };
+                moves.push(([at.x, at.y, h], feed));
+            }
+        } else {
+            for (at, &distance) in leg.iter().zip(&along).rev().skip(1) {
+                let h = if distance <= 0.0 { low } else { height(travelled - distance) };
+                moves.push(([at.x, at.y, h], feed));
+            }
+        }
+    }
+    Some(moves)
 }

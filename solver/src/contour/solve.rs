@@ -8,7 +8,7 @@ use super::blocks;
 use super::element::Chording;
 use super::job::Job;
 use super::layer::Layer;
-use super::moves::{layer_moves, lead_point};
+use super::moves::{PassMoves, layer_moves, lead_point};
 use super::pass::{self, MAX_ARC_STEPS, PassInput, PassPlan, Stock};
 use super::report::{contour_cycle_time, corner_reports, corner_warnings, describe, pass_report};
 use super::request::{ContourRequest, CutDirection, Join, MAX_MOVES, Side};
@@ -147,6 +147,9 @@ pub(crate) struct Prepared {
     setup: Setup,
     first_layer: Layer,
     first_passes: Vec<PassPlan>,
+    /// Whether layers with the same passes share their moves (always, but in the test that
+    /// compares the answers made each way).
+    share: bool,
 }
 
 /// One layer's moves and the lead its passes start from (0 without a lead point).
@@ -195,7 +198,7 @@ impl Prepared {
             )
             .at("depths.step"));
         }
-        Ok(Self { job, setup, first_layer, first_passes })
+        Ok(Self { job, setup, first_layer, first_passes, share: true })
     }
 
     /// The vertices of one layer's contour.
@@ -235,6 +238,12 @@ impl Prepared {
         let job = &self.job;
         let mut layers = Vec::with_capacity(range.len());
         let (from, count) = (range.start, range.len());
+        // Walls that are not tilted: every layer has the first layer's passes, so their moves and
+        // the lead point are made once and lifted to each layer's height.
+        let shared = (self.share && job.tilt.is_none() && !range.is_empty()).then(|| {
+            let (layer, passes) = (&self.first_layer, &self.first_passes);
+            (lead_point(job, layer, passes), PassMoves::all(job, layer, passes, job.layers[from]))
+        });
         for index in range {
             let z = job.layers[index];
             control.check()?;
@@ -248,11 +257,18 @@ impl Prepared {
                 tilted = (layer, passes);
                 (&tilted.0, &tilted.1)
             };
-            let lead_point = lead_point(job, layer, passes);
+            let alone;
+            let (lead_point, made) = match &shared {
+                Some((lead_point, made)) => (*lead_point, made),
+                None => {
+                    alone = PassMoves::all(job, layer, passes, z);
+                    (lead_point(job, layer, passes), &alone)
+                }
+            };
             let lead = lead_point.map_or(0.0, |(_, lead)| lead);
             let previous_z = if index == 0 { job.top } else { job.layers[index - 1] };
             let (moves, arcs) =
-                layer_moves(job, layer, passes, lead_point.map(|(point, _)| point), index == 0, previous_z, z);
+                layer_moves(job, layer, passes, made, lead_point.map(|(point, _)| point), index == 0, previous_z, z);
             let made = LayerMoves { z, moves, arcs, lead };
             each(&made, index - from + 1)?;
             layers.push(made);
@@ -273,7 +289,7 @@ impl Prepared {
         control: Control<'_>,
     ) -> Result<ContourSolution, SolverError> {
         let max_moves = max_moves.min(MAX_MOVES);
-        let Self { job, setup, first_layer, first_passes } = self;
+        let Self { job, setup, first_layer, first_passes, .. } = self;
         let job: &Job = job;
         let mut warnings = job.warnings.clone();
         for pass in first_passes {
@@ -507,4 +523,107 @@ fn layer_move_count(passes: &[PassPlan], chording: &Chording) -> usize {
         .map(|pass| pass.elements.iter().map(|e| e.chords_count(chording, MAX_ARC_STEPS)).sum::<usize>() + 2)
         .sum::<usize>()
         + 4
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The answer with every layer's pass moves and lead point made for that layer alone, as
+    /// tilted walls make them.
+    fn solve_alone(request: &ContourRequest, tool: &Tool) -> Result<ContourSolution, SolverError> {
+        let mut prepared = Prepared::new(request, tool, None, MAX_MOVES, Control::default())?;
+        prepared.share = false;
+        let layers = prepared.layers(0..prepared.job.layers.len(), Control::default())?;
+        prepared.answer(None, MAX_MOVES, layers, Control::default())
+    }
+
+    fn same_either_way(body: serde_json::Value) -> Result<(), TestCaseError> {
+        let request: ContourRequest = serde_json::from_value(body).unwrap();
+        let crate::tool::ToolRef::Inline(tool) = &request.tool else { unreachable!("an inline tool") };
+        let shared = solve(&request, tool);
+        let alone = solve_alone(&request, tool);
+        match (shared, alone) {
+            (Ok(shared), Ok(alone)) => {
+                prop_assert_eq!(serde_json::to_string(&shared).unwrap(), serde_json::to_string(&alone).unwrap());
+                // Arcs as G02/G03: the arcs' spans among the moves match too.
+                let post = crate::gcode::Post {
+                    dialect: crate::gcode::Dialect::default(),
+                    reference: crate::gcode::Reference::default(),
+                    tool: crate::gcode::ToolCall::Table(1),
+                    arcs: crate::gcode::Arcs::G2g3,
+                    plunge_feed: None,
+                };
+                prop_assert_eq!(
+                    crate::contour::program(&shared, &post).unwrap(),
+                    crate::contour::program(&alone, &post).unwrap()
+                );
+            }
+            (shared, alone) => prop_assert_eq!(shared.err(), alone.err()),
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn layers_sharing_their_passes_answer_as_layers_made_alone() {
+        for side in ["outside", "inside"] {
+            for block_time in [None, Some(2.0)] {
+                let mut body = serde_json::json!({
+                    "tool": {"kind": "flat", "radius": 1.5, "centre_cutting": side == "inside"},
+                    "contour": [[0, 0], [40, 0], [40, 30], [25, 30], [20, 12], [15, 30], [0, 30]],
+                    "side": side, "depths": {"top": 0, "bottom": -3.5, "step": 1},
+                    "corner_loop": {"style": "arc"}, "feed": 800, "loop_feed": 1500,
+                    "passes": [{"allowance": 0.3, "join": "round"}, {"allowance": 0}],
+                    "inside_corner_relief": "dogbone", "stock_allowance": 0.5
+                });
+                if let Some(block_time) = block_time {
+                    body["block_time_ms"] = serde_json::json!(block_time);
+                }
+                same_either_way(body).unwrap();
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+        #[test]
+        fn random_contours_answer_the_same_with_shared_layers(
+            radii in prop::collection::vec(2.0f64..10.0, 3..12),
+            radius in 0.02f64..0.4,
+            outside in any::<bool>(),
+            climb in any::<bool>(),
+            two_passes in any::<bool>(),
+            centre_cutting in any::<bool>(),
+            block_time in prop::option::of(0.5f64..8.0),
+            step in 0.3f64..1.5,
+        ) {
+            // Star-shaped about the origin, so simple and counter-clockwise.
+            let n = radii.len();
+            let contour: Vec<[f64; 2]> = radii
+                .iter()
+                .enumerate()
+                .map(|(k, r)| {
+                    let angle = std::f64::consts::TAU * k as f64 / n as f64;
+                    [r * angle.cos(), r * angle.sin()]
+                })
+                .collect();
+            let mut body = serde_json::json!({
+                "tool": {"kind": "flat", "radius": radius, "centre_cutting": centre_cutting},
+                "contour": contour,
+                "side": if outside { "outside" } else { "inside" },
+                "direction": if climb { "climb" } else { "conventional" },
+                "depths": {"top": 0.0, "bottom": -3.0, "step": step},
+                "corner_loop": {"style": "arc"}, "feed": 600, "loop_feed": 2000, "tolerance": 0.005
+            });
+            if two_passes {
+                body["passes"] = serde_json::json!([{"allowance": 0.2, "join": "round"}, {"allowance": 0.0}]);
+            }
+            if let Some(block_time) = block_time {
+                body["block_time_ms"] = serde_json::json!(block_time);
+            }
+            same_either_way(body)?;
+        }
+    }
 }

@@ -152,9 +152,7 @@ impl Capability for DeburrCapability {
     fn solve(request: &DeburrRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<DeburrAnswer, SolverError> {
         if !request.is_several() {
             let result = super::solve_controlled(request, &context.tool, context.machine.as_ref(), run.control)?;
-            if run.budget.is_some() {
-                run.charge(loop_bytes(&result, run.purpose) + ANSWER_BYTES, 1, 1)?;
-            }
+            run.charge_unit(1, 1, ANSWER_BYTES, || loop_bytes(&result, run.purpose))?;
             let cycle_time = context
                 .machine
                 .as_ref()
@@ -283,12 +281,8 @@ const PLACE_BYTES: u64 = 1024;
 /// Charges loop `index` of `count` to the run's budget as it is built; the first loop twice (a
 /// several-loop answer repeats it at the top).
 pub(super) fn charge_loop(run: &Run<'_>, result: &Deburr, index: usize, count: usize) -> Result<(), SolverError> {
-    if run.budget.is_none() {
-        return Ok(());
-    }
     let copies = if index == 0 { 2 } else { 1 };
-    let extra = if index == 0 { ANSWER_BYTES } else { 0 };
-    run.charge(copies * loop_bytes(result, run.purpose) + extra, index + 1, count)
+    run.charge_unit(index + 1, count, ANSWER_BYTES, || copies * loop_bytes(result, run.purpose))
 }
 
 /// The tool of the inside ridges: `inner_tool` as resolved, when the request gives one.

@@ -218,20 +218,18 @@ impl Capability for EngagementCapability {
 /// their JSON is written: their memory, and for a JSON answer or a job their JSON at the size
 /// the writer reserves for it ([`super::wire`]).
 fn charge_samples(answer: &EngagementAnswer, run: &Run<'_>) -> Result<(), SolverError> {
-    if run.budget.is_none() {
-        return Ok(());
-    }
-    let candidates: &[PathEngagement] = match &answer.result {
-        EngagementSolution::Single(result) => std::slice::from_ref(result.as_ref()),
-        EngagementSolution::Comparison(comparison) => &comparison.candidates,
-    };
-    let samples = candidates.iter().flat_map(|candidate| &candidate.samples);
-    let memory = std::mem::size_of::<super::answer::EngagementSample>() as u64;
-    let bytes: u64 = match run.purpose {
-        Purpose::Program => samples.map(|_| memory).sum(),
-        Purpose::Json | Purpose::Job => samples.map(|sample| memory + super::wire::estimate(sample) as u64).sum(),
-    };
-    run.charge(bytes, 1, 1)
+    run.charge_unit(1, 1, 0, || {
+        let candidates: &[PathEngagement] = match &answer.result {
+            EngagementSolution::Single(result) => std::slice::from_ref(result.as_ref()),
+            EngagementSolution::Comparison(comparison) => &comparison.candidates,
+        };
+        let samples = candidates.iter().flat_map(|candidate| &candidate.samples);
+        let memory = std::mem::size_of::<super::answer::EngagementSample>() as u64;
+        match run.purpose {
+            Purpose::Program => samples.map(|_| memory).sum(),
+            Purpose::Json | Purpose::Job => samples.map(|sample| memory + super::wire::estimate(sample) as u64).sum(),
+        }
+    })
 }
 
 /// A plunge feed, when given, must be positive.

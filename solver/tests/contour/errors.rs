@@ -209,3 +209,36 @@ fn malformed_bodies_fail_to_parse() {
         assert!(serde_json::from_value::<ContourRequest>(body).is_err());
     }
 }
+
+/// A pocket whose first pass (allowance 0.2, round joins) comes too near an edge between its
+/// corners: refused by the global clearance check of the cuts against the edges near them, the
+/// same distance and edge as when every nearby edge's exact distance was measured.
+#[test]
+fn a_cut_too_near_another_edge_is_found_by_the_clearance_check() {
+    let request: ContourRequest = serde_json::from_value(json!({
+        "block_time_ms": 2.3565128841951193,
+        "contour": [[-7.184573213903681, 6.156619420489011], [-3.3481220819619044, 1.1157147824317797],
+            [-3.465881213158125, -1.1161552770525018], [-2.3196213609975116, -2.8765021366723724],
+            [-1.096309154864816, -2.1284283902725956], [0.8783137984975954, -9.259809547495236],
+            [4.67369423262394, -5.179057371577678], [8.722046338593803, -2.7355083943464216],
+            [4.944435817524319, 1.319884422071827], [1.8170280927709404, 2.783238814402929],
+            [0.3107937018648377, 3.6785623666229292], [-0.20021936935860704, 5.463578280906071],
+            [-0.33856266236322713, 4.185829235949789], [-1.7870167398077712, 8.574957898185115]],
+        "corner_loop": {"max_angle_deg": 118.55027800319954, "style": "triangle"},
+        "depths": {"bottom": -4.176015467076267, "step": 1.1160465154640435, "top": 0.0},
+        "direction": "conventional", "feed": 600, "loop_feed": 2000,
+        "passes": [{"allowance": 0.2, "join": "round"}, {"allowance": 0.0}],
+        "ramp_angle_deg": 9.470834850335324, "side": "inside", "tolerance": 0.005,
+        "tool": {"centre_cutting": false, "kind": "flat", "radius": 0.26719959095108076}
+    }))
+    .unwrap();
+    let tool = Tool { centre_cutting: Some(false), ..Tool::new(ToolKind::Flat, 0.26719959095108076) };
+    let error = contour::solve(&request, &tool).unwrap_err();
+    assert_eq!(error.code().as_str(), "E_OFFSET_SELF_INTERSECTION");
+    assert_eq!(error.field(), Some("contour[10]"));
+    assert_eq!(
+        error.message(),
+        "the tool (radius 0.26719959095108076 + allowance 0.2) does not fit: near (-0.1732, 3.7487) the path comes \
+         within 0.446032 of the edge from contour[10] (a neck narrower than twice that)"
+    );
+}

@@ -269,32 +269,70 @@ proptest! {
 
     #[test]
     fn layers_of_a_tool_that_does_not_cut_at_its_centre_enter_on_ramps(setup in setup()) {
-        let setup = Setup { centre_cutting: false, ..setup };
-        let Some(answer) = solve(&setup) else { return Ok(()); };
-        let slope = setup.ramp_angle_deg.to_radians().tan();
-        let plunge_feed = 600.0 * kerf_solver::gcode::DEFAULT_PLUNGE_FRACTION;
-        let polygon: Vec<Vec2> = setup.contour.iter().copied().map(vec2).collect();
-        let mut ramps = 0;
-        for layer in &answer.layers {
-            for pair in layer.moves.windows(2) {
-                let (from, to) = (pair[0].to, pair[1].to);
-                let Some(feed) = pair[1].feed else { continue };
-                if pair[1].kind == MoveKind::Rapid || to[2] >= from[2] {
-                    continue;
-                }
-                let run = (xy(to) - xy(from)).norm();
-                let drop = from[2] - to[2];
-                prop_assert!(run > 0.0, "a plunge straight down at {to:?}");
-                prop_assert!(drop <= run * slope * (1.0 + 1e-9) + 1e-12, "{drop} down over {run} at {to:?}");
-                prop_assert!(feed <= plunge_feed, "ramp at F{feed}");
-                for k in 0..polygon.len() {
-                    let distance =
-                        segment_segment_distance(&xy(from), &xy(to), &polygon[k], &polygon[(k + 1) % polygon.len()]);
-                    prop_assert!(distance >= setup.radius - GOUGE, "ramp {from:?}→{to:?} within {distance} of edge {k}");
-                }
-                ramps += 1;
+        check_ramps(&Setup { centre_cutting: false, ..setup })?;
+    }
+}
+
+/// No feed move of a tool that does not cut at its centre goes down steeper than the ramp angle
+/// or faster than the plunge feed, none comes within the tool radius of the contour, and every
+/// layer enters on a ramp.
+fn check_ramps(setup: &Setup) -> Result<(), TestCaseError> {
+    let Some(answer) = solve(setup) else { return Ok(()) };
+    let slope = setup.ramp_angle_deg.to_radians().tan();
+    let plunge_feed = 600.0 * kerf_solver::gcode::DEFAULT_PLUNGE_FRACTION;
+    let polygon: Vec<Vec2> = setup.contour.iter().copied().map(vec2).collect();
+    let mut ramps = 0;
+    for layer in &answer.layers {
+        for pair in layer.moves.windows(2) {
+            let (from, to) = (pair[0].to, pair[1].to);
+            let Some(feed) = pair[1].feed else { continue };
+            if pair[1].kind == MoveKind::Rapid || to[2] >= from[2] {
+                continue;
             }
+            let run = (xy(to) - xy(from)).norm();
+            let drop = from[2] - to[2];
+            prop_assert!(run > 0.0, "a plunge straight down at {to:?}");
+            prop_assert!(drop <= run * slope * (1.0 + 1e-9) + 1e-12, "{drop} down over {run} at {to:?}");
+            prop_assert!(feed <= plunge_feed, "ramp at F{feed}");
+            for k in 0..polygon.len() {
+                let distance =
+                    segment_segment_distance(&xy(from), &xy(to), &polygon[k], &polygon[(k + 1) % polygon.len()]);
+                prop_assert!(distance >= setup.radius - GOUGE, "ramp {from:?}→{to:?} within {distance} of edge {k}");
+            }
+            ramps += 1;
         }
-        prop_assert!(ramps >= answer.layers.len(), "every layer enters on a ramp");
+    }
+    prop_assert!(ramps >= answer.layers.len(), "every layer enters on a ramp");
+    Ok(())
+}
+
+/// A pass whose first chord is a few micrometres long (the middle of a tiny offset edge): at a
+/// shallow ramp angle its legs along that chord alone would need more than the most legs a ramp
+/// may have.
+#[test]
+fn a_ramp_whose_first_chord_is_very_short_keeps_its_angle() {
+    let setup = Setup {
+        contour: vec![
+            [5.1328, 0.0],
+            [8.0749, 1.0213],
+            [2.2024, 0.9274],
+            [-1.4454, 1.3824],
+            [0.9214, -1.7751],
+            [1.0528, -1.7005],
+        ],
+        radius: 0.24669,
+        outside: false,
+        climb: false,
+        style: "arc",
+        two_passes: false,
+        round: false,
+        max_angle_deg: 100.0,
+        block_time: None,
+        centre_cutting: false,
+        ramp_angle_deg: 0.5,
+    };
+    assert!(solve(&setup).is_some(), "the contour is solved");
+    if let Err(error) = check_ramps(&setup) {
+        panic!("{error}");
     }
 }

@@ -181,11 +181,22 @@ pub(super) fn check_clearance(
     input: &PassInput<'_>,
     scratch: &mut Vec<usize>,
 ) -> Result<(), SolverError> {
+    let radius = clear - GOUGE_TOLERANCE;
     for element in elements.iter().filter(|e| e.kind() == ElementKind::Cut) {
         let mut from = element.start();
         for to in element.chords(&input.chording, MAX_ARC_STEPS) {
-            if let Some((distance, edge)) = layer.grid.nearest(&from, &to, clear - GOUGE_TOLERANCE, scratch, |_| false)
-            {
+            // An edge whose middle lies farther from the move's middle than the radius and both
+            // half-lengths cannot come within the radius (each point of a segment lies within
+            // its half-length of its middle): passed over without its exact distance, most of
+            // the edges near a finely tessellated contour. The margin keeps the test on the safe
+            // side of rounding.
+            let (middle, half) = (0.5 * (from + to), 0.5 * (to - from).norm());
+            let far = |edge: usize| {
+                let edge_middle = 0.5 * (layer.vertices[edge] + layer.vertices[layer.next(edge)]);
+                let reach = radius + half + 0.5 * layer.lengths[edge];
+                (edge_middle - middle).norm_squared() > reach * reach * (1.0 + 1e-9)
+            };
+            if let Some((distance, edge)) = layer.grid.nearest(&from, &to, radius, scratch, far) {
                 let source = input.edge_source[edge];
                 return Err(SolverError::new(
                     ErrorCode::OffsetSelfIntersection,
