@@ -1,5 +1,5 @@
 //! Probes for the external programs the tests need (LinuxCNC's `rs274`, Chromium and its driver,
-//! PostgreSQL, schemathesis) where the tests look for them, and sets `kerf_has_<name>` for each one
+//! PostgreSQL, openssl, schemathesis) where the tests look for them, and sets `kerf_has_<name>` for each one
 //! found: a test that needs a missing one is `ignored` in cargo's summary, with the reason, instead
 //! of passing without having run. Under `KERF_REQUIRE_EXTERNAL=1` every flag is set, so such a
 //! test runs and fails. One warning line lists what will not run and how to install it.

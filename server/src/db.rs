@@ -63,13 +63,16 @@ impl fmt::Display for Database {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::Sqlite(path) => write!(f, "{}", path.display()),
-            Self::Postgres(url) => match url.split_once('@') {
-                Some((credentials, rest)) => match credentials.rsplit_once(':') {
-                    Some((user, _password)) if !user.ends_with('/') => write!(f, "{user}:***@{rest}"),
-                    _ => write!(f, "{url}"),
-                },
-                None => write!(f, "{url}"),
-            },
+            Self::Postgres(url) => {
+                let parts = url.split_once("://").and_then(|(scheme, rest)| Some((scheme, rest.rsplit_once('@')?)));
+                match parts {
+                    Some((scheme, (credentials, host))) => match credentials.split_once(':') {
+                        Some((user, _password)) => write!(f, "{scheme}://{user}:***@{host}"),
+                        None => write!(f, "{url}"),
+                    },
+                    None => write!(f, "{url}"),
+                }
+            }
         }
     }
 }
@@ -259,5 +262,8 @@ mod tests {
         assert_eq!(Database::parse(url), Database::Postgres(url.to_owned()));
         assert_eq!(Database::parse(url).to_string(), "postgres://kerf:***@db:5432/kerf");
         assert_eq!(Database::parse("postgresql://db/kerf").to_string(), "postgresql://db/kerf");
+        // A user without a password is shown as it is.
+        let url = "postgres://postgres@127.0.0.1:5432/kerf?sslmode=require";
+        assert_eq!(Database::parse(url).to_string(), url);
     }
 }

@@ -18,7 +18,6 @@ pub mod openapi;
 pub mod state;
 pub mod store;
 pub mod web;
-pub mod zip;
 
 use std::future::Future;
 use std::io;

@@ -5,8 +5,10 @@
 //!
 //! Conventions: points and vectors are [`Vec2`] in mm; angles in radians; a polygon is a slice of
 //! its vertices without the closing repeat; positive signed area means counter-clockwise. The
-//! predicates use plain `f64` arithmetic with exact zero tests (no epsilon), so results are
-//! deterministic; callers decide their own tolerances.
+//! predicates (which side of a line a point lies on, whether segments meet, whether a point is on
+//! a polygon's boundary) take the exact sign of the orientation determinant from Shewchuk's
+//! adaptive arithmetic ([`orientation`], the `robust` crate): a point exactly on a line is on it
+//! and one a rounding error off is not, with no epsilon; callers decide their own tolerances.
 //!
 //! * this file: points, orientation, area, point-in-polygon, segment intersection and distance,
 //!   line intersection, miter points and polyline offsets;
@@ -70,6 +72,16 @@ pub fn orient(a: &Vec2, b: &Vec2, c: &Vec2) -> f64 {
     cross(&(b - a), &(c - a))
 }
 
+/// The exact side of the line through `a` and `b` that `c` lies on: `Greater` when `a, b, c` turn
+/// counter-clockwise (the sign of [`orient`] computed without rounding), `Equal` when the three
+/// points are exactly collinear. Adaptive: as fast as [`orient`] unless the points are within
+/// rounding error of a line.
+pub fn orientation(a: &Vec2, b: &Vec2, c: &Vec2) -> std::cmp::Ordering {
+    let coord = |p: &Vec2| robust::Coord { x: p.x, y: p.y };
+    // −0.0 is collinear too; a NaN coordinate makes no turn either way.
+    robust::orient2d(coord(a), coord(b), coord(c)).partial_cmp(&0.0).unwrap_or(std::cmp::Ordering::Equal)
+}
+
 /// Signed area of a closed polygon (shoelace formula, positive counter-clockwise). Coordinates are
 /// taken relative to the first vertex, which keeps the sum accurate far from the origin.
 pub fn signed_area(polygon: &[Vec2]) -> f64 {
@@ -120,17 +132,19 @@ pub fn closest_on_segment(p: &Vec2, a: &Vec2, b: &Vec2) -> Vec2 {
     a + t * ab
 }
 
-/// Whether the closed segments `[a, b]` and `[c, d]` have a point in common.
+/// Whether the closed segments `[a, b]` and `[c, d]` have a point in common (exactly: touching
+/// and collinear overlapping segments do, segments a rounding error apart do not).
 pub fn segments_intersect(a: &Vec2, b: &Vec2, c: &Vec2, d: &Vec2) -> bool {
-    let (o1, o2) = (orient(a, b, c), orient(a, b, d));
-    let (o3, o4) = (orient(c, d, a), orient(c, d, b));
-    if ((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0)) && ((o3 > 0.0 && o4 < 0.0) || (o3 < 0.0 && o4 > 0.0)) {
+    use std::cmp::Ordering::Equal;
+    let (o1, o2) = (orientation(a, b, c), orientation(a, b, d));
+    let (o3, o4) = (orientation(c, d, a), orientation(c, d, b));
+    if o1 != Equal && o2 != Equal && o1 != o2 && o3 != Equal && o4 != Equal && o3 != o4 {
         return true;
     }
-    (o1 == 0.0 && within_box(c, a, b))
-        || (o2 == 0.0 && within_box(d, a, b))
-        || (o3 == 0.0 && within_box(a, c, d))
-        || (o4 == 0.0 && within_box(b, c, d))
+    (o1 == Equal && within_box(c, a, b))
+        || (o2 == Equal && within_box(d, a, b))
+        || (o3 == Equal && within_box(a, c, d))
+        || (o4 == Equal && within_box(b, c, d))
 }
 
 /// Whether `p` (known to be collinear with `a`, `b`) lies within their bounding box.
@@ -160,26 +174,29 @@ pub enum Containment {
     Outside,
 }
 
-/// Locates `p` relative to a closed polygon of either orientation (even-odd crossing rule, exact
-/// boundary test).
+/// Locates `p` relative to a closed polygon of either orientation (even-odd crossing rule with the
+/// ray cast towards +x; the boundary test and the side of each crossed edge are exact).
 pub fn point_in_polygon(p: &Vec2, polygon: &[Vec2]) -> Containment {
     let mut inside = false;
     for (index, a) in polygon.iter().enumerate() {
         let b = &polygon[(index + 1) % polygon.len()];
-        if orient(a, b, p) == 0.0 && within_box(p, a, b) {
+        let side = orientation(a, b, p);
+        if side == std::cmp::Ordering::Equal && within_box(p, a, b) {
             return Containment::Boundary;
         }
-        if (a.y > p.y) != (b.y > p.y) {
-            let x = a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y);
-            if p.x < x {
-                inside = !inside;
-            }
+        // The edge crosses the ray when it spans p's height and p lies on its west side: the
+        // left of an edge going up, the right of one going down.
+        let upwards = b.y > p.y;
+        if (a.y > p.y) != upwards && (side == std::cmp::Ordering::Greater) == upwards {
+            inside = !inside;
         }
     }
     if inside { Containment::Inside } else { Containment::Outside }
 }
 
-/// Intersection of the lines `p + s·dp` and `q + u·dq`, or `None` when they are parallel.
+/// Intersection of the lines `p + s·dp` and `q + u·dq`, or `None` when they are parallel (or so
+/// nearly that their cross product rounds to zero). Exactly parallel directions always have a
+/// zero cross product: its two terms are the same product, rounded alike.
 pub fn line_intersection(p: &Vec2, dp: &Vec2, q: &Vec2, dq: &Vec2) -> Option<Vec2> {
     let denominator = cross(dp, dq);
     if denominator == 0.0 {
@@ -271,6 +288,78 @@ mod tests {
             segment_segment_distance(&p(0.0, 0.0), &p(1.0, 0.0), &p(2.0, 1.0), &p(3.0, 5.0)),
             2.0_f64.sqrt()
         );
+    }
+
+    /// Three points exactly on the line y = 3x (each y is 3x without rounding) whose orientation,
+    /// computed in plain floats, rounds to a small non-zero number whichever point is the pivot.
+    fn collinear_off_by_rounding() -> (Vec2, Vec2, Vec2) {
+        let a = Vec2::new(0.813679185267957, 2.441037555803871);
+        let b = Vec2::new(10.94123456229218, 32.82370368687654);
+        let c = Vec2::new(3.7306113636207296, 11.191834090862189);
+        for (x, y) in [a, b, c].map(|p| (p.x, p.y)) {
+            assert_eq!(3.0 * x, y);
+        }
+        assert!(orient(&a, &b, &c) < 0.0 && orient(&b, &a, &c) < 0.0, "plain floats see no line");
+        (a, b, c)
+    }
+
+    #[test]
+    fn an_exactly_collinear_point_is_on_the_line() {
+        let (a, b, c) = collinear_off_by_rounding();
+        for (p, q, r) in [(a, b, c), (b, a, c), (c, a, b), (a, c, b)] {
+            assert_eq!(orientation(&p, &q, &r), std::cmp::Ordering::Equal);
+        }
+        assert_eq!(orientation(&a, &b, &(c + Vec2::new(-1e-15, 0.0))), std::cmp::Ordering::Greater);
+        assert_eq!(orientation(&a, &b, &(c + Vec2::new(1e-15, 0.0))), std::cmp::Ordering::Less);
+    }
+
+    #[test]
+    fn an_edge_ending_exactly_on_another_touches_it() {
+        let (a, b, c) = collinear_off_by_rounding();
+        // [c, d] leaves [a, b] towards the side plain floats put c on.
+        let d = c + Vec2::new(3.0, -1.0);
+        assert!(segments_intersect(&a, &b, &c, &d));
+        assert!(segments_intersect(&c, &d, &b, &a));
+        assert_eq!(segment_segment_distance(&a, &b, &c, &d), 0.0);
+    }
+
+    #[test]
+    fn an_edge_a_rounding_error_off_another_does_not_touch_it() {
+        // c lies one unit in the last place above the line y = 3x through a and b, where the
+        // plain-float orientation of a, b, c is exactly zero.
+        let a = Vec2::new(0.42507094125014566, 1.275212823750437);
+        let b = Vec2::new(11.659560571297455, 34.978681713892364);
+        let c = Vec2::new(2.3113171858661428, 6.933951557598429);
+        assert_eq!(orient(&a, &b, &c), 0.0);
+        assert!(3.0 * c.x < c.y);
+        let d = c + Vec2::new(-3.0, 1.0);
+        assert!(!segments_intersect(&a, &b, &c, &d));
+        assert!(!segments_intersect(&c, &d, &a, &b));
+        assert!(segment_segment_distance(&a, &b, &c, &d) > 0.0);
+    }
+
+    #[test]
+    fn a_point_exactly_on_an_edge_is_on_the_boundary() {
+        let (a, b, c) = collinear_off_by_rounding();
+        let mut triangle = vec![a, Vec2::new(b.x, a.y), b];
+        assert_eq!(point_in_polygon(&c, &triangle), Containment::Boundary);
+        triangle.reverse();
+        assert_eq!(point_in_polygon(&c, &triangle), Containment::Boundary);
+        let edges: Vec<(Vec2, Vec2)> =
+            (0..triangle.len()).map(|k| (triangle[k], triangle[(k + 1) % triangle.len()])).collect();
+        assert_eq!(SegmentGrid::new(edges, 0.0).containment(&c, &mut Vec::new()), Containment::Boundary);
+        // Either side of the diagonal, off it by about 1e-15 mm.
+        let (inside, outside) = (c + Vec2::new(2e-15, 0.0), c - Vec2::new(2e-15, 0.0));
+        assert_eq!(point_in_polygon(&inside, &triangle), Containment::Inside);
+        assert_eq!(point_in_polygon(&outside, &triangle), Containment::Outside);
+    }
+
+    #[test]
+    fn a_polygon_touching_itself_exactly_is_not_simple() {
+        let (a, b, c) = collinear_off_by_rounding();
+        // The vertex c of edges 2 and 3 lies on edge 0, both edges on its right.
+        let polygon = [a, b, Vec2::new(30.0, 20.0), c, Vec2::new(20.0, 0.0)];
+        assert_eq!(find_self_intersection(&polygon).unwrap(), Some((0, 2)));
     }
 
     #[test]

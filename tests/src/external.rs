@@ -33,6 +33,8 @@ pub const EXTERNALS: &[External] = &[
         python_module: None,
     },
     External { name: "postgres", what: "PostgreSQL", install: "apt-get install postgresql", python_module: None },
+    External { name: "openssl", what: "openssl", install: "apt-get install openssl", python_module: None },
+    External { name: "python3", what: "python3", install: "apt-get install python3", python_module: None },
     External {
         name: "schemathesis",
         what: "schemathesis",

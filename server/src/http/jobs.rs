@@ -406,9 +406,10 @@ async fn job_program(State(state): State<AppState>, AppPath(JobId { id }): AppPa
     Ok(held_download(permit, pieces_of(text.into()), length, "text/x-gcode; charset=utf-8"))
 }
 
-/// Every output of a finished job as a zip archive (stored, uncompressed): `job.json`, each
-/// operation's answer `NN-operation.json` and program `NN-operation.nc`, and the job's one
-/// program `program.nc` (the files `kerf run -o DIR` writes).
+/// Every output of a finished job as a zip archive (deflated, ZIP64 where an entry or the archive
+/// passes 4 GiB): `job.json`, each operation's answer `NN-operation.json` and program
+/// `NN-operation.nc`, and the job's one program `program.nc` (the files `kerf run -o DIR` writes).
+/// The archive is sent as it is compressed, entry by entry, so its length is not known up front.
 #[utoipa::path(get, path = "/api/v1/jobs/{id}/outputs.zip", tag = "jobs", operation_id = "get_job_outputs",
     params(("id" = i64, Path, description = "Job id", minimum = 1)),
     responses(
@@ -418,16 +419,88 @@ async fn job_program(State(state): State<AppState>, AppPath(JobId { id }): AppPa
         (status = 429, description = "Large answers being read hold the memory budget; retry", body = Problem, content_type = "application/problem+json")))]
 async fn outputs_zip(State(state): State<AppState>, AppPath(JobId { id }): AppPath<JobId>) -> AppResult<Response> {
     let (file, rows, permit) = finished(&state, id).await?;
-    let number = program::program_number(&file, Some(id));
-    let files = program::files(&file, number, &operation_outputs(&rows));
-    let archive = crate::zip::stored(&files).map_err(|message| AppError::Internal(anyhow::anyhow!(message)))?;
-    drop((files, rows));
-    let length = archive.len();
-    let mut response = held_download(permit, pieces_of(archive.into()), length, "application/zip");
+    // A few pieces in flight between the compressing thread and the connection.
+    let (sender, receiver) = tokio::sync::mpsc::channel::<std::io::Result<axum::body::Bytes>>(4);
+    tokio::task::spawn_blocking(move || {
+        let number = program::program_number(&file, Some(id));
+        let files = program::files(&file, number, &operation_outputs(&rows));
+        drop(rows);
+        let mut sink = PieceSender { sender, piece: Vec::with_capacity(PIECE) };
+        match write_zip(files, &mut sink).and_then(|()| sink.send_piece()) {
+            Ok(()) => {}
+            // The client went away: nothing to tell.
+            Err(error) if error.kind() == std::io::ErrorKind::BrokenPipe => {}
+            Err(error) => {
+                // End the body with the error, so the connection is cut rather than the archive
+                // ending short as if whole.
+                tracing::warn!(job = id, %error, "outputs.zip not sent whole");
+                let _ = sink.sender.blocking_send(Err(error));
+            }
+        }
+    });
+    // The permit goes back once the last piece is out of our hands or the client went away.
+    let pieces = futures_util::stream::unfold((receiver, permit), |(mut receiver, permit)| async move {
+        receiver.recv().await.map(|piece| (piece, (receiver, permit)))
+    });
+    let mut response = axum::body::Body::from_stream(pieces).into_response();
+    response.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("application/zip"));
     if let Ok(disposition) = HeaderValue::from_str(&format!("attachment; filename=\"kerf-job-{id}.zip\"")) {
         response.headers_mut().insert(header::CONTENT_DISPOSITION, disposition);
     }
     Ok(response)
+}
+
+/// Writes the zip archive of `files` (name, contents) to `sink` one entry at a time, each deflated
+/// and dropped once written; every entry dated 1980-01-01 00:00 so that a job's archive is the
+/// same bytes whenever it is made.
+fn write_zip(files: Vec<(String, Vec<u8>)>, sink: impl std::io::Write) -> std::io::Result<()> {
+    use std::io::Write as _;
+    let mut archive = zip::ZipWriter::new_stream(sink);
+    for (name, data) in files {
+        let options = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Deflated)
+            .last_modified_time(zip::DateTime::default())
+            .large_file(u32::try_from(data.len()).is_err());
+        archive.start_file(name, options)?;
+        archive.write_all(&data)?;
+    }
+    archive.finish()?;
+    Ok(())
+}
+
+/// A writer that hands what it is given to a response body in pieces of [`PIECE`] bytes, waiting
+/// while the body holds as many as its channel does (the client reads slower than we compress).
+struct PieceSender {
+    sender: tokio::sync::mpsc::Sender<std::io::Result<axum::body::Bytes>>,
+    piece: Vec<u8>,
+}
+
+impl PieceSender {
+    /// Sends the piece gathered so far, if any.
+    fn send_piece(&mut self) -> std::io::Result<()> {
+        if self.piece.is_empty() {
+            return Ok(());
+        }
+        let piece = std::mem::replace(&mut self.piece, Vec::with_capacity(PIECE));
+        self.sender
+            .blocking_send(Ok(piece.into()))
+            .map_err(|_| std::io::Error::new(std::io::ErrorKind::BrokenPipe, "the client went away"))
+    }
+}
+
+impl std::io::Write for PieceSender {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        let taken = bytes.len().min(PIECE - self.piece.len());
+        self.piece.extend_from_slice(&bytes[..taken]);
+        if self.piece.len() == PIECE {
+            self.send_piece()?;
+        }
+        Ok(taken)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
 }
 
 /// Cancels a queued or running job (200 with the job, now `cancelled`); removes an ended one

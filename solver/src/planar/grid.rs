@@ -8,7 +8,7 @@
 //! length (or the caller's query radius, if larger) and doubles until the entry count stays within
 //! a budget, so long or clustered edges cannot blow up memory. Everything is deterministic.
 
-use super::{Containment, Vec2, orient, segment_segment_distance, segments_intersect, within_box};
+use super::{Containment, Vec2, orientation, segment_segment_distance, segments_intersect, within_box};
 
 /// Largest cell index per axis (cells are addressed by two 31-bit numbers).
 const MAX_CELLS_PER_AXIS: f64 = 1_048_576.0;
@@ -168,14 +168,15 @@ impl SegmentGrid {
         let mut inside = false;
         for &index in scratch.iter() {
             let (a, b) = self.segments[index];
-            if orient(&a, &b, point) == 0.0 && within_box(point, &a, &b) {
+            let side = orientation(&a, &b, point);
+            if side == std::cmp::Ordering::Equal && within_box(point, &a, &b) {
                 return Containment::Boundary;
             }
-            if (a.x > point.x) != (b.x > point.x) {
-                let y = a.y + (point.x - a.x) * (b.y - a.y) / (b.x - a.x);
-                if point.y < y {
-                    inside = !inside;
-                }
+            // The edge crosses the ray when it spans the point's abscissa and the point lies
+            // below it: on the right of an edge going +x, on the left of one going −x.
+            let rightwards = b.x > point.x;
+            if (a.x > point.x) != rightwards && (side == std::cmp::Ordering::Less) == rightwards {
+                inside = !inside;
             }
         }
         if inside { Containment::Inside } else { Containment::Outside }
@@ -266,7 +267,7 @@ pub fn find_self_intersection(polygon: &[Vec2]) -> Result<Option<(usize, usize)>
 
 /// Whether two edges leaving the shared vertex `shared` towards `p` and `q` overlap.
 fn folds_back(shared: &Vec2, p: &Vec2, q: &Vec2) -> bool {
-    orient(shared, p, q) == 0.0 && (p - shared).dot(&(q - shared)) > 0.0
+    orientation(shared, p, q) == std::cmp::Ordering::Equal && (p - shared).dot(&(q - shared)) > 0.0
 }
 
 #[cfg(test)]

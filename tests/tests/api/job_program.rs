@@ -103,6 +103,13 @@ async fn the_zip_holds_every_output_and_kerf_run_writes_the_same_program() {
             "program.nc"
         ]
     );
+    let (mut stored, mut packed) = (0, 0);
+    for index in 0..archive.len() {
+        let entry = archive.by_index(index).unwrap();
+        assert_eq!(entry.compression(), zip::CompressionMethod::Deflated, "{:?}", entry.name());
+        (stored, packed) = (stored + entry.size(), packed + entry.compressed_size());
+    }
+    assert!(packed * 3 < stored, "G-code and JSON deflate to under a third: {packed} of {stored} bytes");
     let mut read = |name: &str| {
         let mut text = String::new();
         archive.by_name(name).unwrap().read_to_string(&mut text).expect("the CRC and size check out");
@@ -126,6 +133,40 @@ async fn the_zip_holds_every_output_and_kerf_run_writes_the_same_program() {
         .unwrap();
     assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
     assert_eq!(std::fs::read_to_string(out.path().join("program.nc")).unwrap(), program);
+}
+
+/// Python's `zipfile` (not the crate that wrote it) opens the archive, finds every entry deflated
+/// with its CRC right (`testzip`), and reads the same texts the API answers.
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_python3), ignore = "python3 not found: apt-get install python3")]
+async fn pythons_zipfile_reads_the_deflated_outputs() {
+    let app = TestApp::spawn().await;
+    let id = run_job(&app, &shop_job()).await;
+    let bytes = app.get(&format!("/api/v1/jobs/{id}/outputs.zip")).await.bytes().await.unwrap();
+    let folder = tempfile::tempdir().unwrap();
+    let path = folder.path().join("outputs.zip");
+    std::fs::write(&path, &bytes).unwrap();
+    let script = "import json, sys, zipfile\n\
+        with zipfile.ZipFile(sys.argv[1]) as archive:\n\
+        \x20   assert archive.testzip() is None, archive.testzip()\n\
+        \x20   print(json.dumps({i.filename: [i.compress_type == zipfile.ZIP_DEFLATED, archive.read(i).decode()]\n\
+        \x20                     for i in archive.infolist()}))\n";
+    let output = std::process::Command::new("python3").args(["-c", script]).arg(&path).output().expect("python3 runs");
+    assert!(output.status.success(), "zipfile refused it: {}", String::from_utf8_lossy(&output.stderr));
+    let entries: Value = serde_json::from_slice(&output.stdout).unwrap();
+    let entries = entries.as_object().unwrap();
+    assert_eq!(entries.len(), 8, "{:?}", entries.keys());
+    for (name, entry) in entries {
+        assert_eq!(entry[0], true, "{name} is deflated");
+    }
+    let program = app.get(&format!("/api/v1/jobs/{id}/program")).await.text().await.unwrap();
+    assert_eq!(entries["program.nc"][1], program.as_str());
+    let contour = app.get(&format!("/api/v1/jobs/{id}/gcode?operation=1")).await.text().await.unwrap();
+    assert_eq!(entries["01-contour.nc"][1], contour.as_str());
+    let job = app.get(&format!("/api/v1/jobs/{id}")).await;
+    let answer = json_with(job, 200).await["results"][1]["result"].clone();
+    let zipped: Value = serde_json::from_str(entries["01-contour.json"][1].as_str().unwrap()).unwrap();
+    assert_eq!(zipped, answer);
 }
 
 #[tokio::test(flavor = "multi_thread")]

@@ -2,6 +2,12 @@
 //! accepts: every command line in the Dockerfile, compose.yaml and kubernetes.yaml, with the
 //! `KERF_*` variables set beside it turned into the flags they stand for, parses with the real
 //! command-line parser (`Cli::try_parse_from`), and every `KERF_*` variable is one a flag reads.
+//! Each kerf container runs the image of this release (an explicit tag and pull policy) as a
+//! non-root user on a read-only root file system, without capabilities or privilege escalation,
+//! within resource limits; on Kubernetes a PodDisruptionBudget covers each Deployment, liveness
+//! is `/healthz` and readiness `/readyz`. (What is checked is these files' keys, read as YAML: no
+//! Kubernetes schema validator or cluster runs here.) The toolchain the workspace declares and the
+//! Dockerfile builds with is at least what every locked package needs (`cargo metadata`).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -13,6 +19,15 @@ use yaml_rust2::{Yaml, YamlLoader};
 fn deploy(name: &str) -> String {
     let path: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR")).join("../deploy").join(name);
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// The workspace's version: the image tag the deployment files run.
+fn release() -> String {
+    let manifest: toml::Table = toml::from_str(
+        &std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../Cargo.toml")).expect("Cargo.toml"),
+    )
+    .expect("Cargo.toml is TOML");
+    manifest["workspace"]["package"]["version"].as_str().expect("workspace version").to_owned()
 }
 
 /// The flag that reads environment variable `variable` in `subcommand`'s options.
@@ -85,6 +100,12 @@ fn dockerfile_runs_the_binary_with_flags_it_accepts() {
     assert_eq!(dockerfile.matches("\nFROM ").count() + usize::from(dockerfile.starts_with("FROM ")), 2, "two stages");
     assert_eq!(instruction("ENTRYPOINT"), [Cli::command().get_name()], "the image runs the binary");
     assert!(dockerfile.contains("--bin kerf") && dockerfile.contains("target/release/kerf"), "builds and copies it");
+    let user = dockerfile.lines().rev().find_map(|l| l.strip_prefix("USER ")).expect("the image names its user");
+    let ids: Vec<u32> = user.split(':').map(|id| id.trim().parse().expect("a numeric user")).collect();
+    assert!(
+        ids.iter().all(|&id| id != 0),
+        "the image runs as a numeric non-root user (runAsNonRoot checks it): {user}"
+    );
     let command = parses("Dockerfile CMD", &instruction("CMD"), &BTreeMap::new());
     assert!(matches!(command, Command::Serve(_)));
 }
@@ -102,6 +123,16 @@ fn compose_mirrors_the_tested_topology() {
             assert!(image.starts_with("postgres"), "{name}: only kerf and PostgreSQL ({image})");
             continue;
         }
+        assert_eq!(image, format!("kerf:{}", release()), "{name}: the image of this release");
+        let key = |key: &str| service.get(&Yaml::from_str(key)).cloned().unwrap_or(Yaml::BadValue);
+        assert_eq!(text(&key("pull_policy")), "build", "{name}: built here, never pulled");
+        assert_eq!(key("read_only").as_bool(), Some(true), "{name}: read-only root file system");
+        assert_eq!(strings(&key("cap_drop")), ["ALL"], "{name}: no capabilities");
+        assert!(strings(&key("security_opt")).contains(&"no-new-privileges:true".to_owned()), "{name}");
+        let user = text(&key("user"));
+        assert!(user.split(':').all(|id| id.parse::<u32>().is_ok_and(|id| id != 0)), "{name}: non-root, not {user}");
+        let limits = &key("deploy")["resources"]["limits"];
+        assert!(!limits["cpus"].is_badvalue() && !limits["memory"].is_badvalue(), "{name}: CPU and memory limits");
         let arguments = strings(service.get(&Yaml::from_str("command")).expect("a command"));
         let environment: BTreeMap<String, String> = service
             .get(&Yaml::from_str("environment"))
@@ -131,6 +162,7 @@ fn kubernetes_example_mirrors_the_tested_topology() {
     let documents = YamlLoader::load_from_str(&deploy("kubernetes.yaml")).expect("kubernetes.yaml is YAML");
     let mut kinds = Vec::new();
     let (mut api, mut worker) = (false, false);
+    let budgets: Vec<&Yaml> = documents.iter().filter(|d| text(&d["kind"]) == "PodDisruptionBudget").collect();
     for document in &documents {
         let kind = text(&document["kind"]);
         kinds.push(kind.clone());
@@ -138,7 +170,32 @@ fn kubernetes_example_mirrors_the_tested_topology() {
             continue;
         }
         let name = text(&document["metadata"]["name"]);
-        for container in document["spec"]["template"]["spec"]["containers"].as_vec().expect("containers") {
+        let labels = &document["spec"]["template"]["metadata"]["labels"];
+        assert!(
+            budgets.iter().any(|budget| {
+                let selector = budget["spec"]["selector"]["matchLabels"].as_hash().expect("a budget selects by labels");
+                selector.iter().all(|(label, value)| labels[text(label).as_str()] == *value)
+            }),
+            "{name}: a PodDisruptionBudget selects its pods"
+        );
+        let pod = &document["spec"]["template"]["spec"];
+        assert_eq!(pod["securityContext"]["runAsNonRoot"].as_bool(), Some(true), "{name}: runAsNonRoot");
+        for container in pod["containers"].as_vec().expect("containers") {
+            assert_eq!(text(&container["image"]), format!("kerf:{}", release()), "{name}: the image of this release");
+            let policy = text(&container["imagePullPolicy"]);
+            assert!(["IfNotPresent", "Always", "Never"].contains(&policy.as_str()), "{name}: pull policy {policy}");
+            for (bound, resource) in
+                [("requests", "cpu"), ("requests", "memory"), ("limits", "cpu"), ("limits", "memory")]
+            {
+                let value = &container["resources"][bound][resource];
+                assert!(!value.is_badvalue(), "{name}: resources.{bound}.{resource}");
+            }
+            let security = &container["securityContext"];
+            assert_eq!(security["allowPrivilegeEscalation"].as_bool(), Some(false), "{name}: privilege escalation");
+            assert_eq!(security["readOnlyRootFilesystem"].as_bool(), Some(true), "{name}: read-only root");
+            assert_eq!(strings(&security["capabilities"]["drop"]), ["ALL"], "{name}: capabilities dropped");
+            assert_eq!(text(&container["livenessProbe"]["httpGet"]["path"]), "/healthz", "{name}: liveness");
+            assert_eq!(text(&container["readinessProbe"]["httpGet"]["path"]), "/readyz", "{name}: readiness");
             let mut arguments = strings(&container["command"]);
             if arguments.first().is_some_and(|first| first == "kerf") {
                 arguments.remove(0);
@@ -157,10 +214,6 @@ fn kubernetes_example_mirrors_the_tested_topology() {
                         .collect()
                 })
                 .unwrap_or_default();
-            for probe in ["readinessProbe", "livenessProbe"] {
-                let path = text(&container[probe]["httpGet"]["path"]);
-                assert!(["/readyz", "/healthz"].contains(&path.as_str()), "{name}: {probe} on {path}");
-            }
             match parses(&name, &arguments, &environment) {
                 Command::Serve(serve) => {
                     assert_eq!(serve.job_workers, Some(0), "{name}: the API runs no jobs");
@@ -191,4 +244,63 @@ fn a_wrong_flag_would_be_caught() {
         parses("bad", &["serve".to_owned()], &environment)
     });
     assert!(result.is_err(), "an unknown variable fails the check");
+}
+
+/// A `major.minor[.patch]` version as three numbers (a missing patch is 0), for comparing.
+fn version(text: &str) -> [u64; 3] {
+    let mut numbers = [0; 3];
+    for (number, part) in numbers.iter_mut().zip(text.split('.')) {
+        *number = part.parse().unwrap_or_else(|e| panic!("version {text}: {e}"));
+    }
+    numbers
+}
+
+/// The highest `rust-version` among the packages the lock file resolves, with the package
+/// declaring it, as `cargo metadata` reads them from the locked sources.
+fn locked_minimum() -> ([u64; 3], String) {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let output = std::process::Command::new(cargo)
+        .args(["metadata", "--format-version", "1", "--locked"])
+        .current_dir(&root)
+        .output()
+        .expect("cargo metadata runs");
+    assert!(output.status.success(), "cargo metadata: {}", String::from_utf8_lossy(&output.stderr));
+    let metadata: serde_json::Value = serde_json::from_slice(&output.stdout).expect("cargo metadata answers JSON");
+    let members = metadata["workspace_members"].as_array().expect("workspace_members");
+    metadata["packages"]
+        .as_array()
+        .expect("packages")
+        .iter()
+        .filter(|package| !members.contains(&package["id"]))
+        .filter_map(|package| {
+            let needs = package["rust_version"].as_str()?;
+            let (name, release) = (package["name"].as_str()?, package["version"].as_str()?);
+            Some((version(needs), format!("{name} {release} needs {needs}")))
+        })
+        .max()
+        .expect("some locked package declares a rust-version")
+}
+
+#[test]
+fn the_declared_toolchain_is_the_one_the_lock_needs() {
+    let manifest: toml::Table = toml::from_str(
+        &std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../Cargo.toml"))
+            .expect("the workspace manifest"),
+    )
+    .expect("Cargo.toml is TOML");
+    let declared = manifest["workspace"]["package"]["rust-version"].as_str().expect("workspace rust-version");
+    let (needed, by) = locked_minimum();
+    assert!(version(declared) >= needed, "rust-version = {declared}, but {by}");
+    let dockerfile = deploy("Dockerfile");
+    let image = dockerfile
+        .lines()
+        .find_map(|line| line.strip_prefix("FROM rust:"))
+        .expect("the build stage starts FROM rust:VERSION");
+    let image_version = image.split(['-', ' ']).next().unwrap_or_default();
+    assert_eq!(
+        version(image_version),
+        version(declared),
+        "the Dockerfile builds with rust:{image_version}, the workspace declares rust-version = {declared}"
+    );
 }

@@ -8,9 +8,11 @@
 //! database see each other's tools, machines and jobs, and a cancel through one reaches the job
 //! running on the other within two seconds.
 //! Each test skips, printing why, when PostgreSQL is not installed (fails under
-//! `KERF_REQUIRE_EXTERNAL=1`). The deployment files are checked against the same binary (`deploy`).
+//! `KERF_REQUIRE_EXTERNAL=1`). The deployment files are checked against the same binary and the
+//! locked packages (`deploy`); `tls` connects to PostgreSQL over TLS.
 
 mod deploy;
+mod tls;
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
