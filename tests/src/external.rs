@@ -39,6 +39,12 @@ pub const EXTERNALS: &[External] = &[
         install: "pip install -r tests/requirements.txt",
         python_module: None,
     },
+    External {
+        name: "manifold3d",
+        what: "manifold3d",
+        install: "pip install -r tests/requirements.txt",
+        python_module: Some("manifold3d"),
+    },
 ];
 
 impl External {

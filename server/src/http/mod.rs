@@ -13,3 +13,4 @@ pub mod predict;
 pub mod solve;
 pub mod stream;
 pub mod tools;
+pub mod verify;

@@ -34,4 +34,5 @@ mod schemathesis;
 mod segment;
 mod storage_full;
 mod tools;
+mod verify;
 mod web;
