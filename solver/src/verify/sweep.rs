@@ -5,9 +5,11 @@
 //! z(t) + upper(dist(t)) on the ray, where dist(t) is the horizontal distance from the ray to the
 //! axis. dist is convex in t, `lower` convex and non-decreasing, `upper` concave and
 //! non-increasing, so the first is convex and the second concave in t: each has one extremum,
-//! found in closed form for horizontal and vertical moves and by golden-section search otherwise.
+//! found in closed form for horizontal and vertical moves, for the flat parts (a linear function:
+//! at an end of the interval) and for spheres (a capsule), by golden-section search for a bull
+//! nose's torus.
 
-use super::assembly::Body;
+use super::assembly::{Body, Shape};
 use super::dexel::Interval;
 
 /// Golden-section steps: the bracket shrinks to 0.618⁶⁰ ≈ 3·10⁻¹³ of the move.
@@ -74,9 +76,60 @@ impl Segment {
             let d = distance(closest.clamp(t_in, t_out));
             return Some([z0 + body.lower(d), z0 + body.upper(d)]);
         }
-        let low = golden(t_in, t_out, |t| height(t) + body.lower(distance(t)));
-        let high = -golden(t_in, t_out, |t| -(height(t) + body.upper(distance(t))));
+        let ends = [height(t_in), height(t_out)];
+        let low = match body.shape {
+            Shape::Cylinder { base } => ends[0].min(ends[1]) + base,
+            Shape::Rounded { corner } if corner == 0.0 => ends[0].min(ends[1]),
+            Shape::Rounded { corner } if corner == body.radius => self.capsule(body.radius, x, y)?[0],
+            Shape::Sphere => self.capsule(body.radius, x, y)?[0],
+            Shape::Rounded { .. } => golden(t_in, t_out, |t| height(t) + body.lower(distance(t))),
+        };
+        let high = match body.shape {
+            Shape::Sphere => self.capsule(body.radius, x, y)?[1],
+            Shape::Rounded { .. } | Shape::Cylinder { .. } => ends[0].max(ends[1]) + body.top,
+        };
         Some([low, high])
+    }
+
+    /// Where the ray through `(x, y)` enters and leaves the capsule of `radius` round the
+    /// segment of centres `radius` above the tip: the lowest point of a ball's sweep (and both
+    /// ends of a sphere's). The capsule is the two end spheres and the cylinder between them;
+    /// the cylinder counts where the point's projection falls on the segment (elsewhere its
+    /// surface lies inside an end sphere).
+    fn capsule(&self, radius: f64, x: f64, y: f64) -> Option<Interval> {
+        let mut low = f64::INFINITY;
+        let mut high = f64::NEG_INFINITY;
+        let r2 = radius * radius;
+        for centre in [self.from, self.to] {
+            let d2 = (x - centre[0]).powi(2) + (y - centre[1]).powi(2);
+            if d2 <= r2 {
+                let half = (r2 - d2).sqrt();
+                low = low.min(centre[2] + radius - half);
+                high = high.max(centre[2] + radius + half);
+            }
+        }
+        // Points P = (x, y, s) at `radius` from the axis line C0 + t·v: |(q + s·ẑ) × v|² = r²·|v|²
+        // with q = (x, y, 0) − C0.
+        let v = [self.ux, self.uy, self.to[2] - self.from[2]];
+        let vv = self.uu + v[2] * v[2];
+        let q = [x - self.from[0], y - self.from[1], -(self.from[2] + radius)];
+        let a = [q[1] * v[2] - q[2] * v[1], q[2] * v[0] - q[0] * v[2], q[0] * v[1] - q[1] * v[0]];
+        let b = [-v[1], v[0], 0.0];
+        let bb = b[0] * b[0] + b[1] * b[1];
+        let ab = a[0] * b[0] + a[1] * b[1];
+        let aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+        let discriminant = ab * ab - bb * (aa - r2 * vv);
+        if discriminant >= 0.0 {
+            let root = discriminant.sqrt();
+            for s in [(-ab - root) / bb, (-ab + root) / bb] {
+                let t = (q[0] * v[0] + q[1] * v[1] + (q[2] + s) * v[2]) / vv;
+                if (0.0..=1.0).contains(&t) {
+                    low = low.min(s);
+                    high = high.max(s);
+                }
+            }
+        }
+        (low <= high).then_some([low, high])
     }
 }
 
