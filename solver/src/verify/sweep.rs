@@ -79,7 +79,7 @@ impl Segment {
         let ends = [height(t_in), height(t_out)];
         let low = match body.shape {
             Shape::Cylinder { base } => ends[0].min(ends[1]) + base,
-            Shape::Rounded { corner } if corner == 0.0 => ends[0].min(ends[1]),
+            Shape::Rounded { corner: 0.0 } => ends[0].min(ends[1]),
             Shape::Rounded { corner } if corner == body.radius => self.capsule(body.radius, x, y)?[0],
             Shape::Sphere => self.capsule(body.radius, x, y)?[0],
             Shape::Rounded { .. } => golden(t_in, t_out, |t| height(t) + body.lower(distance(t))),
