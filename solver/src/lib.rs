@@ -8,7 +8,7 @@
 //! [`path`] (typed moves), [`gcode`] (posts for the supported dialects), [`capability`] (the seam
 //! every way in dispatches through), [`material`] (work materials' Kienzle values), and one
 //! module per capability: [`deburr`], [`segment`],
-//! [`contour`], [`engagement`], [`predict`].
+//! [`contour`], [`engagement`], [`predict`], and [`verify`], which cuts a program to check it.
 #![deny(missing_docs)]
 
 pub mod capability;
@@ -28,5 +28,6 @@ pub mod predict;
 pub mod segment;
 pub mod tool;
 pub mod validate;
+pub mod verify;
 
 pub use error::{ErrorCode, SolverError, Warning};

@@ -82,6 +82,24 @@ pub struct Tool {
     /// wide as the cutter.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub neck_radius: Option<f64>,
+    /// Length from the tip to the top of the neck in mm (> 0), only with `neck_radius`: how far
+    /// the thin neck reaches before the shank. Default: the stickout (the neck reaches the
+    /// holder). Only the verify simulation uses it (docs/spec/verify.md §2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub neck_length: Option<f64>,
+    /// Shank radius in mm (> 0) between the cutting part (or the neck) and the holder. Default:
+    /// the cutter radius. Only the verify simulation uses it (docs/spec/verify.md §2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shank_radius: Option<f64>,
+    /// Diameter of the tool holder in mm (> 0), from the holder face (`stickout` above the tip)
+    /// upward. Default: three shank diameters (a collet nut). Only the verify simulation uses it
+    /// (docs/spec/verify.md §2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub holder_diameter: Option<f64>,
+    /// Length of the tool holder in mm (> 0) above the holder face. Default: 40 mm. Only the
+    /// verify simulation uses it (docs/spec/verify.md §2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub holder_length: Option<f64>,
     /// Shape-error table δ(θ) of the rotating cutting edge (docs/spec/predict.md §3.13): the
     /// outward deviation of the edge envelope from the nominal ball along its normal, in mm, at
     /// contact angles θ from 0° (tip) to 90° (equator), angles strictly increasing. Linear
@@ -193,6 +211,10 @@ impl Tool {
             plunge_feed: None,
             centre_cutting: None,
             neck_radius: None,
+            neck_length: None,
+            shank_radius: None,
+            holder_diameter: None,
+            holder_length: None,
             shape_error: None,
             stiffness: None,
         }
@@ -263,6 +285,21 @@ impl Tool {
                     field("neck_radius"),
                     format!("neck_radius {neck} must be smaller than radius {}", self.radius),
                 ));
+            }
+        }
+        if let Some(length) = self.neck_length {
+            positive(&field("neck_length"), length)?;
+            if self.neck_radius.is_none() {
+                return Err(SolverError::input(field("neck_length"), "neck_length needs a neck_radius"));
+            }
+        }
+        for (name, value) in [
+            ("shank_radius", self.shank_radius),
+            ("holder_diameter", self.holder_diameter),
+            ("holder_length", self.holder_length),
+        ] {
+            if let Some(value) = value {
+                positive(&field(name), value)?;
             }
         }
         if let Some(table) = &self.shape_error {

@@ -53,6 +53,12 @@ pub const EXTERNALS: &[External] = &[
         install: "apt-get install npm; npm ci --prefix clients/typescript",
         python_module: None,
     },
+    External {
+        name: "manifold3d",
+        what: "manifold3d",
+        install: "pip install -r tests/requirements.txt",
+        python_module: Some("manifold3d"),
+    },
 ];
 
 impl External {

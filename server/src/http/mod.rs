@@ -13,6 +13,7 @@ pub mod predict;
 pub mod solve;
 pub mod stream;
 pub mod tools;
+pub mod verify;
 
 use kerf_solver::ErrorCode;
 

@@ -36,4 +36,5 @@ mod schemathesis;
 mod segment;
 mod storage_full;
 mod tools;
+mod verify;
 mod web;

@@ -1,0 +1,93 @@
+//! Verification as a capability (the seam of docs/architecture.md; docs/spec/verify.md §1, §5):
+//! `POST /api/v1/verify`, job operation `verify`. It answers findings, not a program.
+
+use serde::Serialize;
+
+use super::request::VerifyRequest;
+use super::simulate::{self, Cut, MAX_FINDINGS};
+use crate::capability::{Capability, Control, Endpoint, OtherTool, OutputOptions, Purpose, Refs, Resolved, Run};
+use crate::error::{ErrorCode, SolverError};
+use crate::machine::MachineProfile;
+use crate::tool::Tool;
+
+/// The verify capability.
+#[derive(Debug, Clone, Copy)]
+pub struct VerifyCapability;
+
+/// The answer: the tools as resolved, and what cutting the program found.
+#[derive(Debug, Clone, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct VerifyAnswer {
+    /// The tools, in the order of the request, as resolved from the table or given inline.
+    pub tools: Vec<Tool>,
+    /// The findings, volumes, times and removal per block.
+    #[serde(flatten)]
+    pub cut: Cut,
+}
+
+/// Bytes of JSON one block's removal record takes at most.
+const BLOCK_BYTES: u64 = 200;
+/// Bytes of JSON one finding takes at most.
+const FINDING_BYTES: u64 = 300;
+
+impl Capability for VerifyCapability {
+    const NAME: &'static str = "verify";
+    const ENDPOINT: Endpoint = Endpoint {
+        summary: "Verifies a G-code program by cutting it: a material-removal simulation.",
+        description: "Cuts the program, move by move, out of the stock with the tools it calls (cutter, \
+            neck, shank and holder) on a grid of z-dexels, and answers what it found, each at its G-code \
+            line with a position and an amount: gouges into the part, material left outside it, rapid \
+            moves through material, neck, shank or holder contact with the stock, and feed moves in air \
+            beyond a share of the cutting time; with the volumes, cutting time and the removed volume \
+            and removal rate of every block that cut (docs/spec/verify.md). JSON only: `?format=gcode` \
+            is refused with `E_NO_PROGRAM`.",
+        not_found: "A tool number in `tools` that is not in the tool table",
+        refused: "The program as the reader refuses it (`E_GCODE_SYNTAX`, `E_GCODE_UNSUPPORTED`, ... with \
+            the line), a bad tool, stock or part (`E_INPUT` naming the field), a move calling a tool \
+            `tools` does not name, a resolution whose dexels would exceed the memory limit \
+            (`E_GRID_MEMORY` at `resolution`), a stock no tool reaches (`E_STOCK`); `E_TIMEOUT` over the \
+            synchronous time limit: submit a job; `E_TOO_LARGE_ANSWER` over the answer budget",
+    };
+    type Request = VerifyRequest;
+    type Answer = VerifyAnswer;
+    type Tool = Option<Tool>;
+
+    fn refs(_request: &VerifyRequest) -> Refs<'_> {
+        Refs::default()
+    }
+
+    fn other_tools(request: &VerifyRequest) -> Vec<OtherTool<'_>> {
+        request.tools.iter().map(|tool| OtherTool { field: "tools", tool }).collect()
+    }
+
+    fn solve(
+        request: &VerifyRequest,
+        context: Resolved<Option<Tool>>,
+        run: &Run<'_>,
+    ) -> Result<VerifyAnswer, SolverError> {
+        let job = request.validate(&context.other_tools, run.control)?;
+        let cut = simulate::cut(&job, run)?;
+        Ok(VerifyAnswer { tools: context.other_tools, cut })
+    }
+
+    fn program(
+        _request: &VerifyRequest,
+        _answer: &VerifyAnswer,
+        _output: &OutputOptions,
+        _control: Control<'_>,
+    ) -> Result<String, SolverError> {
+        Err(SolverError::new(ErrorCode::NoProgram, "verify answers findings, not a program: ask for JSON"))
+    }
+
+    fn machine(_answer: &VerifyAnswer) -> Option<&MachineProfile> {
+        None
+    }
+
+    /// Every block may remove material and every finding is capped, so the program's line count
+    /// bounds the answer.
+    fn answer_bound(request: &VerifyRequest, context: &Resolved<Option<Tool>>, _purpose: Purpose) -> Option<u64> {
+        let lines = request.program.split('\n').count() as u64;
+        let tools = crate::capability::json_bytes(&context.other_tools);
+        Some(4096 + tools + lines * BLOCK_BYTES + MAX_FINDINGS as u64 * FINDING_BYTES)
+    }
+}

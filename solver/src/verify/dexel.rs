@@ -1,0 +1,175 @@
+//! The z-dexel field (docs/spec/verify.md §3 Stock model): a regular grid of vertical rays, each
+//! holding the material on it as sorted, disjoint intervals of z; removing an interval from a ray
+//! and measuring how much of one lies in the material.
+
+use smallvec::SmallVec;
+
+/// An interval of z on a ray, `[low, high]` with `low < high`, mm.
+pub(crate) type Interval = [f64; 2];
+
+/// The material on one ray: sorted, disjoint intervals (most rays hold one).
+pub(crate) type Ray = SmallVec<[Interval; 1]>;
+
+/// Bytes one ray takes in memory (its inline interval; a ray with more spills to the heap).
+pub(crate) const RAY_BYTES: u64 = std::mem::size_of::<Ray>() as u64;
+
+/// The grid of rays: ray `(i, j)` is the vertical line through
+/// `(origin.x + (i + ½)·spacing, origin.y + (j + ½)·spacing)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Grid {
+    pub origin: [f64; 2],
+    pub spacing: f64,
+    pub nx: usize,
+    pub ny: usize,
+}
+
+impl Grid {
+    /// The grid covering the rectangle `[lo, hi]` at `spacing`.
+    pub fn covering(lo: [f64; 2], hi: [f64; 2], spacing: f64) -> Self {
+        let count = |k: usize| (((hi[k] - lo[k]) / spacing).ceil().max(1.0)) as usize;
+        Self { origin: lo, spacing, nx: count(0), ny: count(1) }
+    }
+
+    /// The number of rays the rectangle `[lo, hi]` needs at `spacing` (as a float: a refused
+    /// request may ask for more than `usize` holds).
+    pub fn rays_for(lo: [f64; 2], hi: [f64; 2], spacing: f64) -> f64 {
+        let count = |k: usize| ((hi[k] - lo[k]) / spacing).ceil().max(1.0);
+        count(0) * count(1)
+    }
+
+    pub fn len(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    pub fn x(&self, i: usize) -> f64 {
+        self.origin[0] + (i as f64 + 0.5) * self.spacing
+    }
+
+    pub fn y(&self, j: usize) -> f64 {
+        self.origin[1] + (j as f64 + 0.5) * self.spacing
+    }
+
+    /// The cell area each ray stands for, mm².
+    pub fn cell_area(&self) -> f64 {
+        self.spacing * self.spacing
+    }
+
+    /// The columns whose rays lie in `[low, high]` of x (`axis` 0) or y (1), empty when none.
+    pub fn span(&self, axis: usize, low: f64, high: f64) -> std::ops::Range<usize> {
+        let count = if axis == 0 { self.nx } else { self.ny };
+        let first = ((low - self.origin[axis]) / self.spacing - 0.5).ceil().max(0.0);
+        let last = ((high - self.origin[axis]) / self.spacing - 0.5).floor();
+        if last.is_nan() || last < first {
+            return 0..0;
+        }
+        (first as usize).min(count)..((last as usize).saturating_add(1)).min(count)
+    }
+}
+
+/// The material of a solid on the grid.
+#[derive(Debug, Clone)]
+pub(crate) struct Field {
+    pub grid: Grid,
+    pub rays: Vec<Ray>,
+}
+
+impl Field {
+    /// The total length of material on every ray times the cell area, mm³.
+    pub fn volume(&self) -> f64 {
+        self.rays.iter().map(|ray| length(ray)).sum::<f64>() * self.grid.cell_area()
+    }
+}
+
+/// The total length of the intervals of `ray`.
+pub(crate) fn length(ray: &[Interval]) -> f64 {
+    ray.iter().map(|[low, high]| high - low).sum()
+}
+
+/// The highest z of material on `ray`, −∞ when it is empty.
+pub(crate) fn top(ray: &[Interval]) -> f64 {
+    ray.last().map_or(f64::NEG_INFINITY, |interval| interval[1])
+}
+
+/// Removes `cut` from `ray`, pushing each removed piece to `removed`.
+pub(crate) fn subtract(ray: &mut Ray, cut: Interval, removed: &mut Vec<Interval>) {
+    let [low, high] = cut;
+    if low.partial_cmp(&high) != Some(std::cmp::Ordering::Less)
+        || ray.last().is_none_or(|last| last[1] <= low)
+        || ray[0][0] >= high
+    {
+        return;
+    }
+    let mut kept = Ray::new();
+    for &[a, b] in ray.iter() {
+        if b <= low || a >= high {
+            kept.push([a, b]);
+            continue;
+        }
+        removed.push([a.max(low), b.min(high)]);
+        if a < low {
+            kept.push([a, low]);
+        }
+        if b > high {
+            kept.push([high, b]);
+        }
+    }
+    *ray = kept;
+}
+
+/// The length of `probe` inside the intervals of `ray`, and the lowest z of that overlap.
+pub(crate) fn overlap(ray: &[Interval], probe: Interval) -> Option<(f64, f64)> {
+    let mut total = 0.0;
+    let mut lowest = f64::INFINITY;
+    for &[a, b] in ray {
+        let (from, to) = (a.max(probe[0]), b.min(probe[1]));
+        if to > from {
+            total += to - from;
+            lowest = lowest.min(from);
+        }
+    }
+    (total > 0.0).then_some((total, lowest))
+}
+
+/// The pieces of `ray` outside the intervals of `other` grown by `margin` at both ends.
+pub(crate) fn outside(ray: &[Interval], other: &[Interval], margin: f64, pieces: &mut Vec<Interval>) {
+    for &interval in ray {
+        let mut rest: Ray = smallvec::smallvec![interval];
+        for &[a, b] in other {
+            let mut scratch = Vec::new();
+            subtract(&mut rest, [a - margin, b + margin], &mut scratch);
+        }
+        pieces.extend(rest);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn subtract_splits_and_reports() {
+        let mut ray: Ray = smallvec::smallvec![[0.0, 10.0], [20.0, 30.0]];
+        let mut removed = Vec::new();
+        subtract(&mut ray, [5.0, 25.0], &mut removed);
+        assert_eq!(ray.as_slice(), &[[0.0, 5.0], [25.0, 30.0]]);
+        assert_eq!(removed, vec![[5.0, 10.0], [20.0, 25.0]]);
+        removed.clear();
+        subtract(&mut ray, [1.0, 2.0], &mut removed);
+        assert_eq!(ray.as_slice(), &[[0.0, 1.0], [2.0, 5.0], [25.0, 30.0]]);
+        assert_eq!(length(&ray), 9.0);
+        assert_eq!(overlap(&ray, [0.5, 3.0]), Some((1.5, 0.5)));
+        let mut pieces = Vec::new();
+        outside(&ray, &[[0.0, 4.0]], 0.5, &mut pieces);
+        assert_eq!(pieces, vec![[4.5, 5.0], [25.0, 30.0]]);
+    }
+
+    #[test]
+    fn spans_cover_the_rays_in_range() {
+        let grid = Grid::covering([0.0, 0.0], [10.0, 5.0], 1.0);
+        assert_eq!((grid.nx, grid.ny), (10, 5));
+        assert_eq!(grid.span(0, 0.4, 2.6), 0..3);
+        assert!(grid.span(0, 0.6, 1.4).is_empty());
+        assert_eq!(grid.span(1, -5.0, 100.0), 0..5);
+        assert_eq!(grid.span(0, 20.0, 30.0), 10..10);
+    }
+}

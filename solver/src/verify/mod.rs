@@ -1,0 +1,40 @@
+//! Verifying a program by cutting it (docs/spec/verify.md): a material-removal simulation of the
+//! stock as z-dexels, swept by the tool assembly along the program's G0–G3 moves as kerf's reader
+//! reads them, compared with the part.
+//!
+//! [`request`] holds the wire types, `job` their validation, `solid` the stock and part on the
+//! grid, `dexel` the rays, `assembly` the tool's bodies, `sweep` a body swept along a move,
+//! `simulate` the cutting and its findings, and `capability` the seam's entry.
+
+mod assembly;
+mod capability;
+mod dexel;
+mod job;
+pub mod request;
+mod simulate;
+mod solid;
+mod sweep;
+#[cfg(test)]
+mod tests;
+
+pub use assembly::{FLUTE_RADII, HOLDER_LENGTH, HOLDER_SHANK_DIAMETERS, Member, STICKOUT_RADII};
+pub use capability::{VerifyAnswer, VerifyCapability};
+pub use job::{
+    DEFAULT_AIR_SHARE_LIMIT, DEFAULT_ALLOWANCE, DEFAULT_RESOLUTION_RADII, DEFAULT_TOLERANCE, MAX_DEFAULT_RAYS,
+    MAX_DEXEL_BYTES,
+};
+pub use request::{Hollow, Solid, VerifyRequest};
+pub use simulate::{ARC_CHORD_TOLERANCE, BlockRemoval, Cut, Finding, FindingKind, MAX_FINDINGS};
+
+use crate::capability::Run;
+use crate::error::SolverError;
+use crate::tool::Tool;
+
+/// Cuts `request`'s program with its resolved `tools` (in the order of `request.tools`).
+///
+/// # Errors
+/// As the capability's solve: the request's refusals, each naming its field.
+pub fn verify(request: &VerifyRequest, tools: &[Tool], run: &Run<'_>) -> Result<Cut, SolverError> {
+    let job = request.validate(tools, run.control)?;
+    simulate::cut(&job, run)
+}

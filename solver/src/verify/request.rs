@@ -1,0 +1,118 @@
+//! The verify request as the client sends it (docs/spec/verify.md §1 Request): the program, the
+//! tools it calls, the stock and optionally the part, and the simulation's settings.
+
+use serde::de::{self, Deserializer};
+use serde::{Deserialize, Serialize};
+
+use crate::predict::Stock;
+use crate::tool::ToolRef;
+
+/// Most tools one request may name.
+pub const MAX_TOOLS: usize = 100;
+
+/// A verify request: cut `program` with `tools` out of `stock` and compare with `part`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct VerifyRequest {
+    /// The G-code program, as kerf's reader takes it (docs/guide/gcode.md): G0–G3, G17–G19,
+    /// G20/G21, G90/G91; at most 2 000 000 lines.
+    pub program: String,
+    /// The tools the program calls (1–100): a number in the tool table, or a tool given inline
+    /// whose `number` is the `T` word that calls it. One tool without a number cuts every move.
+    pub tools: Vec<ToolRef>,
+    /// The stock before the program: `box`, `cylinder`, `tube` or `grid` (with `bottom`).
+    pub stock: Solid,
+    /// The part (the design) the program should leave, same kinds as `stock`: with it the answer
+    /// reports gouges and material left; without it only the stock and the tools are checked.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub part: Option<Solid>,
+    /// Dexel spacing, mm (> 0): the distance between neighbouring rays of the stock model.
+    /// Default: a twentieth of the smallest cutter radius, coarsened so the grid holds at most
+    /// 4 000 000 rays. A spacing whose grid would exceed the memory limit is refused
+    /// (`E_GRID_MEMORY`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub resolution: Option<f64>,
+    /// Material removed inside the part deeper than this (mm, along the dexel ray) is a gouge.
+    /// Default 0.01.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
+    /// Material left outside the part thicker than this (mm, along the dexel ray) is reported.
+    /// Default 0.1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub allowance: Option<f64>,
+    /// A program whose feed moves cut air for more than this share of the cutting time gets an
+    /// `air_cutting` finding (0–1). Default 0.5.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub air_share_limit: Option<f64>,
+    /// Skip blocks starting with `/` (the block-delete switch on). Default false.
+    #[serde(default)]
+    pub block_delete: bool,
+}
+
+/// A solid of the stock or the part: predict's stock kinds (docs/spec/predict.md §1.2), or a tube.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[cfg_attr(feature = "schema", schema(as = VerifySolid))]
+#[serde(untagged)]
+pub enum Solid {
+    /// A hollow cylinder.
+    Tube(Hollow),
+    /// Box, cylinder, grid (needs `bottom` here), as predict takes them; `plane` and `mesh` are
+    /// refused (no bottom; no upload).
+    Stock(Stock),
+}
+
+/// A hollow solid.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Hollow {
+    /// A tube between two points of its axis: the material between `inner_radius` and
+    /// `outer_radius` from the axis.
+    Tube {
+        /// One end of the axis, mm.
+        start: [f64; 3],
+        /// The other end of the axis, mm.
+        end: [f64; 3],
+        /// Outer radius, mm.
+        outer_radius: f64,
+        /// Inner radius (the bore), mm; 0 < inner_radius < outer_radius.
+        inner_radius: f64,
+    },
+}
+
+// By the `kind` field: `tube` is read as [`Hollow`], every other kind as predict's [`Stock`], so a
+// bad field is reported by the type that has it (an untagged enum would only say that nothing
+// matched).
+impl<'de> Deserialize<'de> for Solid {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let value = serde_json::Value::deserialize(deserializer)?;
+        if value.get("kind").and_then(serde_json::Value::as_str) == Some("tube") {
+            serde_json::from_value(value).map(Solid::Tube).map_err(de::Error::custom)
+        } else {
+            serde_json::from_value(value).map(Solid::Stock).map_err(de::Error::custom)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solids_read_by_kind() {
+        let tube: Solid = serde_json::from_str(
+            r#"{"kind": "tube", "start": [0, 0, 0], "end": [0, 0, 10], "outer_radius": 5, "inner_radius": 3}"#,
+        )
+        .unwrap();
+        assert!(matches!(tube, Solid::Tube(Hollow::Tube { .. })));
+        let block: Solid = serde_json::from_str(r#"{"kind": "box", "min": [0, 0, 0], "max": [1, 1, 1]}"#).unwrap();
+        assert!(matches!(block, Solid::Stock(Stock::Box { .. })));
+        let round = serde_json::to_string(&tube).unwrap();
+        assert_eq!(serde_json::from_str::<Solid>(&round).unwrap(), tube);
+        let bad = serde_json::from_str::<Solid>(r#"{"kind": "tube", "start": [0, 0, 0]}"#).unwrap_err();
+        assert!(bad.to_string().contains("end"), "{bad}");
+        assert!(serde_json::from_str::<Solid>(r#"{"kind": "cone"}"#).is_err());
+    }
+}

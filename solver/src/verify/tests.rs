@@ -1,0 +1,275 @@
+//! The simulation against analytic removals and deliberate faults (docs/spec/verify.md §7 Tests).
+
+use std::f64::consts::PI;
+
+use proptest::prelude::*;
+use serde_json::{Value, json};
+
+use super::{Cut, FindingKind, VerifyRequest, verify};
+use crate::capability::Run;
+use crate::tool::{Tool, ToolRef};
+
+fn request(body: Value) -> VerifyRequest {
+    serde_json::from_value(body).expect("a valid request")
+}
+
+/// The tools of `request` as resolution gives them (inline only here).
+fn tools(request: &VerifyRequest) -> Vec<Tool> {
+    request
+        .tools
+        .iter()
+        .map(|tool| match tool {
+            ToolRef::Inline(tool) => tool.clone(),
+            ToolRef::Number(_) => panic!("inline tools only"),
+        })
+        .collect()
+}
+
+fn run(body: Value) -> Cut {
+    let request = request(body);
+    verify(&request, &tools(&request), &Run::default()).expect("verified")
+}
+
+fn slot(resolution: Option<f64>) -> Value {
+    let mut body = json!({
+        "program": "G21 G90\nG0 X0 Y0 Z5\nG1 Z-2 F300\nG1 X50 F600\nG0 Z5\nM30",
+        "tools": [{"kind": "flat", "radius": 5}],
+        "stock": {"kind": "box", "min": [-20, -20, -10], "max": [70, 20, 0]},
+    });
+    if let Some(resolution) = resolution {
+        body["resolution"] = json!(resolution);
+    }
+    body
+}
+
+#[test]
+fn a_flat_slot_removes_its_exact_volume_and_converges() {
+    let exact = 2.0 * (10.0 * 50.0 + PI * 25.0);
+    let default = run(slot(None));
+    assert_eq!(default.resolution, 0.25);
+    let error = |cut: &Cut| (cut.removed_volume_mm3 / exact - 1.0).abs();
+    assert!(error(&default) < 0.005, "{} against {exact}", default.removed_volume_mm3);
+    let errors: Vec<f64> = [1.0, 0.5, 0.1, 0.05].iter().map(|&h| error(&run(slot(Some(h))))).collect();
+    assert!(errors[3] < errors[0] && errors[3] < 0.001, "{errors:?}");
+    assert!((default.stock_volume_mm3 - 90.0 * 40.0 * 10.0).abs() < 1e-6);
+    assert!((default.final_volume_mm3 + default.removed_volume_mm3 - default.stock_volume_mm3).abs() < 1e-6);
+    let blocks: Vec<usize> = default.blocks.iter().map(|block| block.line).collect();
+    assert_eq!(blocks, [3, 4]);
+    let along = &default.blocks[1];
+    assert_eq!(along.time_s, Some(5.0));
+    assert!((along.removal_rate_mm3_per_min.unwrap() - along.removed_mm3 * 12.0).abs() < 1e-9);
+    assert!(default.ok, "{:?}", default.findings);
+}
+
+#[test]
+fn a_ball_groove_has_the_circular_segment_as_its_cross_section() {
+    // Ball R3, 1 deep, 40 long between centres: the circular segment along the groove plus one
+    // spherical cap (its two halves at the ends).
+    let (radius, depth, length): (f64, f64, f64) = (3.0, 1.0, 40.0);
+    let segment = radius * radius * ((radius - depth) / radius).acos()
+        - (radius - depth) * (2.0 * radius * depth - depth * depth).sqrt();
+    let cap = PI * depth * depth * (3.0 * radius - depth) / 3.0;
+    let cut = run(json!({
+        "program": "G0 X0 Y0 Z1\nG1 Z-1 F200\nG1 X40\nG0 Z5",
+        "tools": [{"kind": "ball", "radius": 3}],
+        "stock": {"kind": "box", "min": [-10, -10, -5], "max": [50, 10, 0]},
+        "resolution": 0.02,
+    }));
+    let exact = segment * length + cap;
+    assert!((cut.removed_volume_mm3 / exact - 1.0).abs() < 0.002, "{} against {exact}", cut.removed_volume_mm3);
+    // The plunge takes the whole cap; the move along then adds the segment times its length (its
+    // end's half cap, less the half of the plunge's cap it passes through).
+    let plunge = cut.blocks.iter().find(|block| block.line == 2).unwrap();
+    assert!((plunge.removed_mm3 / cap - 1.0).abs() < 0.003, "{} against {cap}", plunge.removed_mm3);
+    let middle = cut.blocks.iter().find(|block| block.line == 3).unwrap();
+    let expected = segment * length;
+    assert!((middle.removed_mm3 / expected - 1.0).abs() < 0.003, "{} against {expected}", middle.removed_mm3);
+}
+
+#[test]
+fn a_helical_ramp_and_its_clean_up_circle_remove_the_annulus() {
+    // A flat Ø10 on a circle of radius 10 ramps down two turns to z = −2, then a full circle at
+    // the bottom: the annulus 5 < r < 15, 2 deep.
+    let cut = run(json!({
+        "program": "G0 X10 Y0 Z1\nG1 Z0 F300\nG3 X10 Y0 Z-1 I-10 J0\nG3 X10 Y0 Z-2 I-10 J0\nG3 X10 Y0 I-10 J0\nG0 Z5",
+        "tools": [{"kind": "flat", "radius": 5}],
+        "stock": {"kind": "box", "min": [-20, -20, -10], "max": [20, 20, 0]},
+        "resolution": 0.1,
+    }));
+    let exact = PI * (15.0 * 15.0 - 5.0 * 5.0) * 2.0;
+    assert!((cut.removed_volume_mm3 / exact - 1.0).abs() < 0.003, "{} against {exact}", cut.removed_volume_mm3);
+    // The first turn of the ramp takes less than the 1 mm layer it ends at (it starts at the top)
+    // and more than half of it.
+    let first = cut.blocks.iter().find(|block| block.line == 3).unwrap();
+    assert!(first.removed_mm3 < exact / 2.0 && first.removed_mm3 > exact / 4.0, "{}", first.removed_mm3);
+}
+
+fn kinds(cut: &Cut) -> Vec<(FindingKind, Option<usize>)> {
+    cut.findings.iter().map(|finding| (finding.kind, finding.line)).collect()
+}
+
+#[test]
+fn a_dip_into_the_part_is_a_gouge_at_its_line() {
+    // A face pass over a part whose top is at z = −1, dipping 0.2 mm into it on line 5.
+    let cut = run(json!({
+        "program": "G0 X-10 Y0 Z5\nG1 Z-1 F500\nG1 X10\nG1 X12 Z-1.2\nG1 X14 Z-1\nG1 X30\nG0 Z5",
+        "tools": [{"kind": "flat", "radius": 5}],
+        "stock": {"kind": "box", "min": [-5, -4, -10], "max": [25, 4, 0]},
+        "part": {"kind": "box", "min": [-5, -4, -10], "max": [25, 4, -1]},
+    }));
+    // Line 5 climbs back out and still takes 0.1 mm at the far side of the tool.
+    let gouges: Vec<_> = cut.findings.iter().filter(|finding| finding.kind == FindingKind::Gouge).collect();
+    assert_eq!(gouges.iter().map(|gouge| gouge.line).collect::<Vec<_>>(), [Some(4), Some(5)], "{:?}", cut.findings);
+    assert!((gouges[0].depth - 0.2).abs() < 1e-9, "{:?}", gouges[0]);
+    assert!((gouges[0].position[2] + 1.2).abs() < 1e-9 && (gouges[0].position[0] - 12.0).abs() < 5.5);
+    assert!(!cut.ok);
+}
+
+#[test]
+fn a_rapid_through_the_stock_is_found_at_its_line() {
+    let cut = run(json!({
+        "program": "G0 X-20 Y0 Z5\nG0 Z-2\nG0 X40\nG0 Z5",
+        "tools": [{"kind": "flat", "radius": 3}],
+        "stock": {"kind": "box", "min": [0, -10, -10], "max": [20, 10, 0]},
+    }));
+    assert_eq!(kinds(&cut), [(FindingKind::RapidThroughMaterial, Some(3))]);
+    assert!((cut.findings[0].depth - 2.0).abs() < 1e-9);
+    assert!((cut.findings[0].volume_mm3 / (20.0 * 6.0 * 2.0) - 1.0).abs() < 0.01);
+}
+
+#[test]
+fn a_holder_in_a_deep_pocket_is_found_at_the_line_that_takes_it_down() {
+    // Ø6 flat, 20 out of the holder (Ø30): stepping down a pocket 4 mm a layer, the holder face
+    // reaches the top at the sixth layer (z = −24 puts the face at −4).
+    let mut program = String::from("G0 X0 Y0 Z5\n");
+    for layer in 1..=6 {
+        program.push_str(&format!("G1 Z{} F200\nG1 X10 F600\nG1 X0\n", -4 * layer));
+    }
+    program.push_str("G0 Z40\n");
+    let cut = run(json!({
+        "program": program,
+        "tools": [{"kind": "flat", "radius": 3, "stickout": 20, "flute_length": 20, "holder_diameter": 30}],
+        "stock": {"kind": "box", "min": [-30, -30, -40], "max": [40, 30, 0]},
+        "resolution": 0.2,
+    }));
+    let holder: Vec<_> = cut.findings.iter().filter(|finding| finding.kind == FindingKind::HolderContact).collect();
+    assert!(!holder.is_empty(), "{:?}", cut.findings);
+    assert_eq!(holder[0].line, Some(17), "{holder:?}");
+    assert!((holder[0].depth - 4.0).abs() < 1e-9);
+    assert!(cut.findings.iter().all(|finding| finding.kind == FindingKind::HolderContact));
+}
+
+#[test]
+fn a_tool_cutting_air_most_of_the_time_is_found() {
+    // 5 mm of cut, 45 mm in air beyond the stock: 90 % of the cutting time in air.
+    let cut = run(json!({
+        "program": "G0 X0 Y0 Z5\nG0 Z-1\nG1 X5 F600\nG1 X50\nG0 Z5",
+        "tools": [{"kind": "flat", "radius": 2}],
+        "stock": {"kind": "box", "min": [-10, -5, -5], "max": [5, 5, 0]},
+    }));
+    assert!((cut.air_share - 0.9).abs() < 1e-9, "{}", cut.air_share);
+    assert_eq!(kinds(&cut), [(FindingKind::RapidThroughMaterial, Some(2)), (FindingKind::AirCutting, Some(4))]);
+    assert_eq!(cut.findings[1].share, Some(cut.air_share));
+}
+
+#[test]
+fn a_tube_is_cut_through_its_wall_only() {
+    // A flat Ø4 drilling down through a horizontal tube (bore Ø12, wall 2): two wall pieces.
+    let cut = run(json!({
+        "program": "G0 X0 Y0 Z12\nG1 Z-12 F100\nG0 Z12",
+        "tools": [{"kind": "flat", "radius": 2, "flute_length": 30, "stickout": 40}],
+        "stock": {"kind": "tube", "start": [-20, 0, 0], "end": [20, 0, 0], "outer_radius": 8, "inner_radius": 6},
+        "resolution": 0.02,
+    }));
+    // Each wall piece: over the disc x² + y² < 4, the length between the circles of radius 6 and 8
+    // (in y–z).
+    let mut exact = 0.0;
+    let steps = 400;
+    for a in 0..steps {
+        for b in 0..steps {
+            let (x, y) = (
+                -2.0 + 4.0 * (f64::from(a) + 0.5) / f64::from(steps),
+                -2.0 + 4.0 * (f64::from(b) + 0.5) / f64::from(steps),
+            );
+            if x * x + y * y < 4.0 {
+                exact += 2.0 * ((64.0 - y * y).sqrt() - (36.0 - y * y).sqrt()) * (4.0 / f64::from(steps)).powi(2);
+            }
+        }
+    }
+    assert!((cut.removed_volume_mm3 / exact - 1.0).abs() < 0.005, "{} against {exact}", cut.removed_volume_mm3);
+}
+
+#[test]
+fn refusals_name_their_field() {
+    let cases = [
+        (
+            json!({"program": "G1 X10 Y0 Z0 F100\nG41 X1", "tools": [{"kind": "flat", "radius": 2}],
+                "stock": {"kind": "box", "min": [0, 0, -1], "max": [20, 20, 0]}}),
+            "program",
+        ),
+        (
+            json!({"program": "G0 X100 Y100 Z5\nG1 X120 F100", "tools": [{"kind": "flat", "radius": 2}],
+                "stock": {"kind": "box", "min": [0, 0, -1], "max": [20, 20, 0]}}),
+            "stock",
+        ),
+        (
+            json!({"program": "G1 X10 Y0 Z-1 F100", "tools": [{"kind": "flat", "radius": 2}],
+                "stock": {"kind": "box", "min": [0, 0, -1], "max": [20, 20, 0]}, "resolution": 0.0001}),
+            "resolution",
+        ),
+        (
+            json!({"program": "T3 M6\nG1 X10 Y0 Z-1 F100", "tools": [{"kind": "flat", "radius": 2, "number": 1},
+                {"kind": "flat", "radius": 1, "number": 2}],
+                "stock": {"kind": "box", "min": [0, 0, -1], "max": [20, 20, 0]}}),
+            "tools",
+        ),
+        (
+            json!({"program": "G1 X10 Y0 Z-1 F100", "tools": [{"kind": "flat", "radius": 2, "neck_length": 3}],
+                "stock": {"kind": "box", "min": [0, 0, -1], "max": [20, 20, 0]}}),
+            "tools[0].neck_length",
+        ),
+    ];
+    for (body, field) in cases {
+        let request = request(body);
+        let error = verify(&request, &tools(&request), &Run::default()).unwrap_err();
+        assert_eq!(error.field(), Some(field), "{error:?}");
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    #[test]
+    fn removal_is_bounded_and_cutting_twice_removes_nothing_more(
+        points in prop::collection::vec((-12.0..32.0f64, -12.0..12.0f64, -6.0..3.0f64), 2..6),
+        radius in 0.5..4.0f64,
+        kind in prop::sample::select(vec!["ball", "flat", "bull"]),
+    ) {
+        let mut program = String::from("F500\n");
+        for (x, y, z) in points.iter().chain(&points[..1]) {
+            program.push_str(&format!("G1 X{x:.3} Y{y:.3} Z{z:.3}\n"));
+        }
+        let mut tool = json!({"kind": kind, "radius": radius, "flute_length": 40, "stickout": 40});
+        if kind == "bull" {
+            tool["corner_radius"] = json!(radius / 2.0);
+        }
+        let body = |program: &str| json!({
+            "program": program, "tools": [tool.clone()], "resolution": 0.25,
+            "stock": {"kind": "tube", "start": [-5, 0, -3], "end": [25, 0, -3], "outer_radius": 6, "inner_radius": 3},
+        });
+        let request = request(body(&program));
+        match verify(&request, &tools(&request), &Run::default()) {
+            Ok(once) => {
+                prop_assert!(once.removed_volume_mm3 >= 0.0);
+                prop_assert!(once.removed_volume_mm3 <= once.stock_volume_mm3 + 1e-9);
+                prop_assert!((once.final_volume_mm3 + once.removed_volume_mm3 - once.stock_volume_mm3).abs() < 1e-6);
+                let twice = run(body(&format!("{program}{program}")));
+                prop_assert!((twice.removed_volume_mm3 - once.removed_volume_mm3).abs() < 1e-6,
+                    "{} then {}", once.removed_volume_mm3, twice.removed_volume_mm3);
+                let replayed: f64 = twice.blocks.iter().filter(|b| b.line > points.len() + 2).map(|b| b.removed_mm3).sum();
+                prop_assert!(replayed < 1e-6, "{replayed}");
+            }
+            Err(error) => prop_assert_eq!(error.field(), Some("stock")),
+        }
+    }
+}

@@ -1,0 +1,242 @@
+//! `POST /api/v1/verify` over HTTP: a slot's removed volume with a tool from the table, faults
+//! found at their lines, bad requests refused naming their field (nothing stored), and removed
+//! volumes against a CSG computation by manifold3d (`tests/verify_csg.py`).
+
+use std::f64::consts::PI;
+use std::io::Write;
+use std::process::{Command, Stdio};
+
+use kerf_cases::number;
+use kerf_tests::{TestApp, external_program, json_with, problem};
+use serde_json::{Value, json};
+
+async fn verify(app: &TestApp, body: &Value) -> Value {
+    json_with(app.post_json("/api/v1/verify", body).await, 200).await
+}
+
+fn slot_program() -> &'static str {
+    "G21 G90\nT5 M6\nG0 X0 Y0 Z5\nG1 Z-2 F300\nG1 X50 F600\nG0 Z5\nM30"
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_slot_with_a_table_tool_removes_its_volume() {
+    let app = TestApp::spawn().await;
+    app.register_tool(5, &json!({"kind": "flat", "radius": 5, "holder_diameter": 40})).await;
+    let body = json!({
+        "program": slot_program(),
+        "tools": [5],
+        "stock": {"kind": "box", "min": [-20, -20, -10], "max": [70, 20, 0]},
+    });
+    let answer = verify(&app, &body).await;
+    let exact = 2.0 * (10.0 * 50.0 + 25.0 * PI);
+    let removed = number(&answer["removed_volume_mm3"]);
+    assert!((removed / exact - 1.0).abs() < 0.005, "{removed} against {exact}");
+    assert_eq!(answer["ok"], true, "{answer}");
+    assert_eq!(answer["resolution"], 0.25);
+    assert_eq!(answer["tools"][0]["holder_diameter"], 40.0);
+    let lines: Vec<u64> = answer["blocks"].as_array().unwrap().iter().map(|b| b["line"].as_u64().unwrap()).collect();
+    assert_eq!(lines, [4, 5]);
+    assert_eq!(answer["blocks"][1]["tool"], 5);
+    assert_eq!(answer["blocks"][1]["time_s"], 5.0);
+    // JSON only: there is no program to write.
+    let gcode = app.client.post(app.url("/api/v1/verify?format=gcode")).json(&body).send().await.unwrap();
+    problem(gcode, 400).await;
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn faults_are_found_at_their_lines() {
+    let app = TestApp::spawn().await;
+    // Two tools: T1 faces the part's top at z = −1 and dips 0.2 into it (line 5); T2, a long
+    // Ø6 in a Ø30 holder 20 out, takes a pocket down until the holder meets the top (line 10).
+    let program = "T1 M6\nG0 X-10 Y0 Z5\nG1 Z-1 F500\nG1 X10\nG1 X12 Z-1.2\nG1 X14 Z-1\nG1 X30\nG0 Z50\n\
+                   T2 M6\nG0 X0 Y20 Z5\nG1 Z-12 F200\nG1 Z-24\nG1 X8\nG0 Z50\nM30";
+    let answer = verify(
+        &app,
+        &json!({
+            "program": program,
+            "tools": [{"number": 1, "kind": "flat", "radius": 5},
+                      {"number": 2, "kind": "flat", "radius": 3, "stickout": 20, "flute_length": 20, "holder_diameter": 30}],
+            "stock": {"kind": "box", "min": [-5, -4, -40], "max": [25, 30, 0]},
+            "part": {"kind": "box", "min": [-5, -4, -40], "max": [25, 4, -1]},
+            "allowance": 50,
+        }),
+    )
+    .await;
+    let found: Vec<(String, u64)> = answer["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| (f["kind"].as_str().unwrap().to_owned(), f["line"].as_u64().unwrap_or(0)))
+        .collect();
+    let gouge = found.iter().position(|(kind, _)| kind == "gouge").expect("a gouge");
+    assert_eq!(found[gouge].1, 5, "{found:?}");
+    close_to(&answer["findings"][gouge]["depth"], 0.2);
+    let holder = found.iter().position(|(kind, _)| kind == "holder_contact").expect("a holder contact");
+    assert_eq!(found[holder].1, 12, "{found:?}");
+    assert_eq!(answer["findings"][holder]["tool"], 2);
+    close_to(&answer["findings"][holder]["depth"], 4.0);
+    assert_eq!(answer["ok"], false);
+}
+
+fn close_to(value: &Value, expected: f64) {
+    assert!((number(value) - expected).abs() < 1e-9, "{value} against {expected}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn bad_requests_name_their_field() {
+    let app = TestApp::spawn().await;
+    let jobs_before = json_with(app.get("/api/v1/jobs").await, 200).await;
+    let block = json!({"kind": "box", "min": [0, 0, -5], "max": [20, 20, 0]});
+    let flat = json!({"kind": "flat", "radius": 2});
+    let cases = [
+        (
+            "a program the reader refuses",
+            json!({"program": "G1 X5 Y5 Z-1 F100\nG41 X1", "tools": [flat], "stock": block}),
+            422,
+            "program",
+            "E_GCODE_UNSUPPORTED",
+        ),
+        (
+            "a stock no tool reaches",
+            json!({"program": "G0 X100 Y100 Z5\nG1 Z-1 F100\nG1 X150", "tools": [flat], "stock": block}),
+            422,
+            "stock",
+            "E_STOCK",
+        ),
+        (
+            "a resolution over the memory bound",
+            json!({"program": "G1 X5 Y5 Z-1 F100", "tools": [flat], "stock": block,
+         "resolution": 0.001}),
+            422,
+            "resolution",
+            "E_GRID_MEMORY",
+        ),
+        (
+            "a tool number not in the table",
+            json!({"program": "G1 X5 Y5 Z-1 F100", "tools": [7], "stock": block}),
+            404,
+            "tools",
+            "E_NOT_FOUND",
+        ),
+        (
+            "a tube with its bore as wide as itself",
+            json!({"program": "G1 X5 Y5 Z-1 F100", "tools": [flat],
+         "stock": {"kind": "tube", "start": [0, 0, 0], "end": [0, 0, 10], "outer_radius": 5, "inner_radius": 5}}),
+            422,
+            "stock.inner_radius",
+            "E_INPUT",
+        ),
+        (
+            "a plane stock, which has no bottom",
+            json!({"program": "G1 X5 Y5 Z-1 F100", "tools": [flat],
+         "stock": {"kind": "plane", "point": [0, 0, 0], "normal": [0, 0, 1], "min": [0, 0], "max": [9, 9]}}),
+            422,
+            "stock.kind",
+            "E_INPUT",
+        ),
+        (
+            "a move calling a tool not named",
+            json!({"program": "T4 M6\nG1 X5 Y5 Z-1 F100",
+         "tools": [{"kind": "flat", "radius": 2, "number": 3}, {"kind": "flat", "radius": 1, "number": 2}], "stock": block}),
+            422,
+            "tools",
+            "E_INPUT",
+        ),
+        (
+            "a share over 1",
+            json!({"program": "G1 X5 Y5 Z-1 F100", "tools": [flat], "stock": block, "air_share_limit": 2}),
+            422,
+            "air_share_limit",
+            "E_INPUT",
+        ),
+    ];
+    let mut mismatches = Vec::new();
+    for (what, body, status, field, code) in cases {
+        let answer = problem(app.post_json("/api/v1/verify", &body).await, status).await;
+        if answer["code"] != code || answer["errors"][0]["path"] != field {
+            mismatches.push(format!("{what}: expected {code} at {field}, got {answer}"));
+        }
+    }
+    assert!(mismatches.is_empty(), "{mismatches:#?}");
+    assert_eq!(json_with(app.get("/api/v1/jobs").await, 200).await, jobs_before, "nothing stored");
+}
+
+/// A program of G1 moves through `points` (tip positions), with the same polyline for the CSG.
+fn polyline_case(tool: &Value, length: f64, points: &[[f64; 3]], stock: ([f64; 3], [f64; 3])) -> (Value, Value) {
+    let mut program = format!("G0 X{:.6} Y{:.6} Z5\nF400\n", points[0][0], points[0][1]);
+    for p in points {
+        program.push_str(&format!("G1 X{:.6} Y{:.6} Z{:.6}\n", p[0], p[1], p[2]));
+    }
+    let mut path = vec![[points[0][0], points[0][1], 5.0]];
+    path.extend_from_slice(points);
+    let request = json!({
+        "program": program, "tools": [tool], "resolution": 0.05,
+        "stock": {"kind": "box", "min": stock.0, "max": stock.1},
+    });
+    let csg = json!({
+        "stock": {"min": stock.0, "max": stock.1},
+        "tool": {"kind": tool["kind"], "radius": tool["radius"], "length": length},
+        "paths": [path],
+    });
+    (request, csg)
+}
+
+fn csg_removed(python: &std::path::Path, case: &Value) -> f64 {
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/verify_csg.py");
+    let mut child = Command::new(python)
+        .arg(script)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("python3 runs");
+    child.stdin.take().unwrap().write_all(case.to_string().as_bytes()).unwrap();
+    let output = child.wait_with_output().unwrap();
+    assert!(output.status.success(), "verify_csg.py: {}", String::from_utf8_lossy(&output.stderr));
+    let answer: Value = serde_json::from_slice(&output.stdout).expect("JSON from verify_csg.py");
+    number(&answer["removed_mm3"])
+}
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_manifold3d), ignore = "manifold3d not found: pip install -r tests/requirements.txt")]
+async fn removed_volumes_agree_with_manifold3d() {
+    let python = external_program("python3", "the CSG check of removed volumes").unwrap();
+    let app = TestApp::spawn().await;
+    let flat = json!({"kind": "flat", "radius": 5});
+    let ball = json!({"kind": "ball", "radius": 3});
+    let helix: Vec<[f64; 3]> = (0..=60)
+        .map(|k| {
+            let angle = 3.0 * PI * f64::from(k) / 60.0;
+            [8.0 * angle.cos(), 8.0 * angle.sin(), 0.5 - 3.0 * f64::from(k) / 60.0]
+        })
+        .collect();
+    let cases = [
+        (
+            "flat slot",
+            polyline_case(
+                &flat,
+                20.0,
+                &[[0.0, 0.0, -2.0], [50.0, 0.0, -2.0]],
+                ([-20.0, -20.0, -10.0], [70.0, 20.0, 0.0]),
+            ),
+        ),
+        (
+            "ball ramps",
+            polyline_case(
+                &ball,
+                12.0,
+                &[[-5.0, -3.0, 1.0], [30.0, 10.0, -2.0], [40.0, -5.0, -1.0], [20.0, -8.0, -2.5]],
+                ([-10.0, -15.0, -8.0], [45.0, 15.0, 0.0]),
+            ),
+        ),
+        ("ball helix", polyline_case(&ball, 12.0, &helix, ([-15.0, -15.0, -8.0], [15.0, 15.0, 0.0]))),
+    ];
+    for (what, (request, csg)) in cases {
+        let simulated = number(&verify(&app, &request).await["removed_volume_mm3"]);
+        let independent = csg_removed(&python, &csg);
+        assert!(
+            (simulated / independent - 1.0).abs() < 0.005,
+            "{what}: simulated {simulated} mm³, manifold3d {independent} mm³"
+        );
+    }
+}
