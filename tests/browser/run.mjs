@@ -1264,6 +1264,26 @@ hole = { shape = "round", diameter = 16 }
     if (!program.includes(`for ${planned} flutes`)) throw new Error(`the verdict does not say which flute count the program is for: "${program}"`);
     return { starred: starred?.k ?? null, over, program: planned, verdict: text };
   },
+
+  // The Verify view cuts its sample program (a slot 0.1 mm too deep, then a rapid through the
+  // stock) and lists the findings at their lines; a finding marks its line in the listing.
+  async verify() {
+    await page.goto(`${base}/#/verify`);
+    await page.click('#verify-run');
+    await page.waitForSelector('#verify-findings tr', { timeout: 60000 });
+    const findings = await page.$$eval('#verify-findings tr', (rows) => rows.map((r) => ({ kind: r.dataset.kind, line: Number(r.dataset.line || 0) })));
+    const at = (kind) => findings.filter((f) => f.kind === kind).map((f) => f.line);
+    if (!at('gouge').includes(4)) throw new Error(`no gouge at line 4: ${JSON.stringify(findings)}`);
+    if (!at('rapid_through_material').includes(5)) throw new Error(`no rapid through material at line 5: ${JSON.stringify(findings)}`);
+    const marked = await page.$$eval('#verify-listing li.finding', (l) => l.map((e) => Number(e.dataset.line)));
+    if (!marked.includes(5)) throw new Error(`line 5 not marked in the listing: ${marked}`);
+    await page.click('#verify-findings tr[data-kind="rapid_through_material"]');
+    const current = await page.$$eval('#verify-listing li[aria-current="true"]', (l) => l.map((e) => e.textContent));
+    if (current.length !== 1 || !current[0].startsWith('G0 X60')) throw new Error(`the finding opened ${JSON.stringify(current)}`);
+    const summary = await page.textContent('#verify-summary');
+    if (!/findings/.test(summary)) throw new Error(`summary: ${summary}`);
+    return { findings: findings.length, marked: marked.length };
+  },
 };
 
 try {

@@ -29,7 +29,7 @@ pub struct VerifyQuery {
 
 /// The verify capability's endpoint, documented with the capability's own texts.
 #[utoipa::path(post, path = "/api/v1/verify", tag = "verify",
-    operation_id = "post_verify",
+    operation_id = "verify",
     summary = <VerifyCapability as Capability>::ENDPOINT.summary,
     description = <VerifyCapability as Capability>::ENDPOINT.description,
     params(VerifyQuery),

@@ -350,3 +350,15 @@ async fn engagement_page_stars_no_flute_count_over_the_machines_torque() {
     assert_eq!(result["ok"], true, "{result}");
     assert!(!result["over"].as_array().unwrap().is_empty(), "{result}");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
+async fn verify_page_lists_findings_at_their_lines() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "verify", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["findings"].as_u64().unwrap() >= 2, "{result}");
+}

@@ -1,0 +1,136 @@
+// Verify view: cut a G-code program out of the stock with the tools it calls and list what went
+// wrong at which line (docs/spec/verify.md): gouges, material left, rapids through material, the
+// neck, shank or holder meeting the stock, air cutting; each finding opens its line in the listing.
+import { api } from '/api.js';
+import { loadTools, message, number, numeric, showSummary, submitFlow, value } from '/form.js';
+
+const EXAMPLE = 'G21 G90\nG0 X0 Y0 Z5\nG1 Z-2 F300\nG1 X50 F600\nG0 X60 Z-2\nG0 Z5\nM30';
+
+const FORM = `
+<div class="layout">
+  <form id="verify-form" novalidate>
+    <fieldset><legend>Program</legend>
+      <label>G-code file <input name="file" type="file" accept=".nc,.ngc,.tap,.gcode,.txt"></label>
+      <label class="stacked">Program <textarea name="program" rows="10" spellcheck="false" data-field="program">${EXAMPLE}</textarea></label>
+    </fieldset>
+    <fieldset><legend>Tool</legend>
+      <label>Tool <select name="tool" data-field="tools"></select></label>
+      <label data-inline>Kind <select name="kind"><option value="flat">flat end mill</option><option value="ball">ball end mill</option></select></label>
+      <label data-inline>Radius, mm <input name="radius" type="number" step="any" value="5" data-field="tools"></label>
+    </fieldset>
+    <fieldset><legend>Stock and part (boxes, mm)</legend>
+      <label>Stock min x y z <input name="stock_min" type="text" value="-20 -20 -10" data-field="stock"></label>
+      <label>Stock max x y z <input name="stock_max" type="text" value="70 20 0" data-field="stock"></label>
+      <label>Part top z <input name="part_top" type="number" step="any" value="-1.9" placeholder="none: no part" data-field="part"></label>
+      <label>Spacing, mm <input name="resolution" type="number" step="any" placeholder="a twentieth of the cutter radius" data-field="resolution"></label>
+    </fieldset>
+    <div class="actions"><button class="primary" type="submit" id="verify-run">Verify</button></div>
+  </form>
+  <section id="verify-result">
+    <div id="verify-messages"></div>
+    <div class="summary" id="verify-summary"></div>
+    <div class="table-scroll"><table class="worst"><thead><tr><th>finding</th><th>line</th><th>position, mm</th><th>depth, mm</th><th>volume, mm³</th></tr></thead>
+      <tbody id="verify-findings"></tbody></table></div>
+    <ol class="listing" id="verify-listing" aria-label="G-code program" tabindex="0"></ol>
+  </section>
+</div>`;
+
+// "x y z" (spaces or semicolons; a comma is a decimal comma) into three numbers, or a problem at
+// the field.
+function point(form, name, field) {
+  const parts = value(form, name).trim().split(/[\s;]+/).map((p) => Number(p.replace(',', '.')));
+  if (parts.length !== 3 || parts.some((p) => !Number.isFinite(p))) {
+    throw { status: 400, title: 'Three numbers are needed', detail: `${field}: enter x y z, e.g. 0 0 -10`, field };
+  }
+  return parts;
+}
+
+function request(form) {
+  const min = point(form, 'stock_min', 'stock');
+  const max = point(form, 'stock_max', 'stock');
+  const tool = value(form, 'tool') === 'inline'
+    ? { kind: value(form, 'kind'), radius: numeric(form, 'radius') }
+    : Number(value(form, 'tool'));
+  const top = numeric(form, 'part_top');
+  return {
+    program: form.elements.program.value,
+    tools: [tool],
+    stock: { kind: 'box', min, max },
+    part: top === undefined ? undefined : { kind: 'box', min, max: [max[0], max[1], top] },
+    resolution: numeric(form, 'resolution'),
+  };
+}
+
+// The program's lines, numbered as the findings count them (from 1), those with a finding marked.
+function showListing(listing, program, findings) {
+  const marked = new Map(findings.filter((f) => f.line).map((f) => [f.line, f.kind]));
+  listing.replaceChildren(...program.split('\n').map((text, i) => {
+    const line = document.createElement('li');
+    line.dataset.line = String(i + 1);
+    line.textContent = text;
+    if (marked.has(i + 1)) {
+      line.className = 'finding';
+      line.title = marked.get(i + 1).replaceAll('_', ' ');
+    }
+    return line;
+  }));
+}
+
+function showAnswer(root, answer, program) {
+  showSummary(root.querySelector('#verify-summary'), [
+    ['Result ', answer.ok ? 'no findings' : `${answer.findings.length} findings`],
+    ['Removed ', `${number(answer.removed_volume_mm3, 1)} mm³`],
+    ['Cutting time ', `${number(answer.cutting_time_s, 1)} s`],
+    ['In air ', `${number(100 * answer.air_share, 1)} %`],
+    ['Spacing ', `${number(answer.resolution)} mm`],
+  ]);
+  const listing = root.querySelector('#verify-listing');
+  showListing(listing, program, answer.findings);
+  root.querySelector('#verify-findings').replaceChildren(...answer.findings.map((finding) => {
+    const tr = document.createElement('tr');
+    tr.dataset.kind = finding.kind;
+    const cells = [finding.kind.replaceAll('_', ' '), finding.line ?? '', (finding.position ?? []).map((v) => number(v, 3)).join(' '), finding.depth === undefined ? '' : number(finding.depth, 3), finding.volume_mm3 === undefined ? '' : number(finding.volume_mm3, 1)];
+    for (const cell of cells) {
+      const td = document.createElement('td');
+      td.textContent = String(cell);
+      tr.append(td);
+    }
+    if (finding.line) {
+      tr.dataset.line = String(finding.line);
+      tr.addEventListener('click', () => {
+        listing.querySelectorAll('[aria-current]').forEach((li) => li.removeAttribute('aria-current'));
+        const item = listing.querySelector(`[data-line="${finding.line}"]`);
+        item?.setAttribute('aria-current', 'true');
+        if (item) listing.scrollTop = item.offsetTop - listing.clientHeight / 2;
+      });
+    }
+    return tr;
+  }));
+}
+
+export const verifyView = {
+  mount(root) {
+    root.innerHTML = FORM;
+    const form = root.querySelector('#verify-form');
+    const messages = root.querySelector('#verify-messages');
+    const select = form.elements.tool;
+    const syncInline = () => form.querySelectorAll('[data-inline]').forEach((e) => { e.hidden = select.value !== 'inline'; });
+    loadTools(select, 'inline tool').then(syncInline);
+    select.addEventListener('change', syncInline);
+    form.elements.file.addEventListener('change', async () => {
+      const file = form.elements.file.files[0];
+      if (file) form.elements.program.value = await file.text();
+    });
+    submitFlow(form, {
+      messages,
+      result: root.querySelector('#verify-result'),
+      read: () => request(form),
+      ask: (body) => api('POST', '/api/v1/verify', body),
+      show: (answer, body) => {
+        showAnswer(root, answer, body.program);
+        return answer.ok ? null : message('error', `The program cut wrong: ${[...new Set(answer.findings.map((f) => f.kind.replaceAll('_', ' ')))].join(', ')}.`);
+      },
+      done: (answer) => (answer.ok ? 'Verified: the program cuts the part as it should.' : 'Verified.'),
+    });
+  },
+};
