@@ -37,7 +37,7 @@ use crate::state::Limits;
 /// Serves `router` on `listener` until `shutdown` completes, then lets the open requests finish
 /// for at most `limits.shutdown_grace` and drops what is left, so a slow or hostile client cannot
 /// keep a stopped server alive. A client that takes longer than `limits.header_read_timeout` to
-/// send its headers is disconnected. Each connection closes lingering ([`Lingering`]).
+/// send its headers is disconnected. Each connection closes lingering (`Lingering`).
 ///
 /// # Errors
 /// Never at present: a failed accept (for example out of file descriptors) is logged and retried.
@@ -87,10 +87,10 @@ pub async fn serve(
     Ok(())
 }
 
-/// How long a closed connection still reads what its client sends ([`Lingering`]).
+/// How long a closed connection still reads what its client sends (`Lingering`).
 const LINGER: Duration = Duration::from_secs(2);
 
-/// The most a closed connection reads and discards ([`Lingering`]).
+/// The most a closed connection reads and discards (`Lingering`).
 const LINGER_BYTES: usize = 64 * 1024 * 1024;
 
 /// A client connection that closes lingering: once the server is done with it, it sends its end

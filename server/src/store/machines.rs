@@ -51,7 +51,7 @@ fn registry(name: &str) -> Registry {
 }
 
 /// Stores `machine` (whose `name` is set) if `guard` accepts the machine stored under its name
-/// now (`None`: none is), and says whether it was new ([`guarded_put`]).
+/// now (`None`: none is), and says whether it was new (`guarded_put`).
 pub async fn put(
     db: &Db,
     machine: &MachineProfile,

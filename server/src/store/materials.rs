@@ -72,7 +72,7 @@ fn registry(name: &str) -> Registry {
 
 /// Stores `material` (whose `name` is set) whole, replacing any earlier record, if `guard` accepts
 /// the material stored under its name now (`None`: none is), and says whether it was new
-/// ([`guarded_put`]).
+/// (`guarded_put`).
 pub async fn put(db: &Db, material: &Material, guard: impl Fn(Option<&Material>) -> AppResult<()>) -> AppResult<bool> {
     let name = material.name.as_deref().ok_or_else(|| AppError::Internal(anyhow::anyhow!("material without name")))?;
     let values = [

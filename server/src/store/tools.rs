@@ -43,7 +43,7 @@ fn registry(number: i64) -> Registry {
 }
 
 /// Stores `tool` (whose `number` is set) if `guard` accepts the tool stored under its number now
-/// (`None`: none is), and says whether it was new ([`guarded_put`]).
+/// (`None`: none is), and says whether it was new (`guarded_put`).
 pub async fn put(db: &Db, tool: &Tool, guard: impl Fn(Option<&Tool>) -> AppResult<()>) -> AppResult<bool> {
     let number = i64::from(tool.number.ok_or_else(|| AppError::Internal(anyhow::anyhow!("tool without number")))?);
     let json = serde_json::to_string(tool).map_err(|error| AppError::Internal(error.into()))?;
