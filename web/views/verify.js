@@ -19,9 +19,9 @@ const FORM = `
       <label data-inline>Radius, mm <input name="radius" type="number" step="any" value="5" data-field="tools"></label>
     </fieldset>
     <fieldset><legend>Stock and part (boxes, mm)</legend>
-      <label>Stock min x y z <input name="stock_min" type="text" value="-20 -20 -10" data-field="stock"></label>
-      <label>Stock max x y z <input name="stock_max" type="text" value="70 20 0" data-field="stock"></label>
-      <label>Part top z <input name="part_top" type="number" step="any" value="-1.9" placeholder="none: no part" data-field="part"></label>
+      <label>Stock min x y z, mm <input name="stock_min" type="text" value="-20 -20 -10" data-field="stock"></label>
+      <label>Stock max x y z, mm <input name="stock_max" type="text" value="70 20 0" data-field="stock"></label>
+      <label>Part top z, mm <input name="part_top" type="number" step="any" value="-1.9" placeholder="none: no part" data-field="part"></label>
       <label>Spacing, mm <input name="resolution" type="number" step="any" placeholder="a twentieth of the cutter radius" data-field="resolution"></label>
     </fieldset>
     <div class="actions"><button class="primary" type="submit" id="verify-run">Verify</button></div>
