@@ -5,19 +5,11 @@ use super::tools::WRITE_ATTEMPTS;
 use crate::db::Db;
 use crate::error::{AppError, AppResult};
 use crate::store::CommitChecked;
-use kerf_solver::gcode::Dialect;
 use kerf_solver::machine::MachineProfile;
 
 fn decode(json: &str) -> AppResult<MachineProfile> {
     serde_json::from_str(json)
         .map_err(|error| AppError::Internal(anyhow::anyhow!("stored machine is unreadable: {error}")))
-}
-
-fn dialect_name(dialect: Dialect) -> &'static str {
-    match dialect {
-        Dialect::Fanuc => "fanuc",
-        Dialect::Linuxcnc => "linuxcnc",
-    }
 }
 
 /// The machine called `name`, if registered.
@@ -44,7 +36,7 @@ pub async fn put(
 ) -> AppResult<bool> {
     let name = machine.name.as_deref().ok_or_else(|| AppError::Internal(anyhow::anyhow!("machine without name")))?;
     let json = serde_json::to_string(machine).map_err(|error| AppError::Internal(error.into()))?;
-    let (block_time_ms, max_feed, dialect) = (machine.block_time_ms, machine.max_feed, dialect_name(machine.dialect));
+    let (block_time_ms, max_feed, dialect) = (machine.block_time_ms, machine.max_feed, machine.dialect.as_str());
     macro_rules! put_in {
         ($begin:expr, $select:expr, $update:expr) => {{
             let mut transaction = $begin.await?;
