@@ -59,6 +59,18 @@ pub const EXTERNALS: &[External] = &[
         install: "pip install -r tests/requirements.txt",
         python_module: Some("manifold3d"),
     },
+    External {
+        name: "nc_gcode_interpreter",
+        what: "nc-gcode-interpreter",
+        install: "pip install -r tests/requirements.txt",
+        python_module: Some("nc_gcode_interpreter"),
+    },
+    External {
+        name: "pygcode",
+        what: "pygcode",
+        install: "pip install -r tests/requirements.txt",
+        python_module: Some("pygcode"),
+    },
 ];
 
 impl External {

@@ -32,7 +32,9 @@ pub struct OutputQuery {
     /// `json` (default) or `gcode`; without it, an `Accept` that ranks `text/x-gcode` above
     /// `application/json` selects G-code.
     pub format: Option<Format>,
-    /// G-code dialect: `fanuc` (default) or `linuxcnc`.
+    /// G-code dialect (the post): `fanuc` (default; also Mazak and Okuma in ISO mode), `haas`,
+    /// `linuxcnc`, `sinumerik` (840D), `heidenhain` (Klartext), `heidenhain_iso` or `grbl`; default
+    /// the named machine's `dialect`, else `fanuc`.
     pub dialect: Option<Dialect>,
     /// Programmed point: `tip` (default; length offset to the tool tip) or `centre`.
     pub reference: Option<Reference>,
@@ -50,7 +52,8 @@ pub struct CandidateQuery {
     /// `json` (default) or `gcode`; without it, an `Accept` that ranks `text/x-gcode` above
     /// `application/json` selects G-code.
     pub format: Option<Format>,
-    /// G-code dialect: `fanuc` or `linuxcnc` (default: the named machine's, else `fanuc`).
+    /// G-code dialect (the post): `fanuc`, `haas`, `linuxcnc`, `sinumerik`, `heidenhain`,
+    /// `heidenhain_iso` or `grbl` (default: the named machine's, else `fanuc`).
     pub dialect: Option<Dialect>,
     /// Programmed point: `tip` (default; length offset to the tool tip) or `centre` (the centre
     /// of the tool's end rounding: the ball centre, the bull-nose corner centre, the tip for a

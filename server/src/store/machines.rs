@@ -3,19 +3,11 @@
 use super::{Bind, Registry, guarded_delete, guarded_put, on};
 use crate::db::Db;
 use crate::error::{AppError, AppResult};
-use kerf_solver::gcode::Dialect;
 use kerf_solver::machine::MachineProfile;
 
 fn decode(json: &str) -> AppResult<MachineProfile> {
     serde_json::from_str(json)
         .map_err(|error| AppError::Internal(anyhow::anyhow!("stored machine is unreadable: {error}")))
-}
-
-fn dialect_name(dialect: Dialect) -> &'static str {
-    match dialect {
-        Dialect::Fanuc => "fanuc",
-        Dialect::Linuxcnc => "linuxcnc",
-    }
 }
 
 /// The machine called `name`, if registered.
@@ -62,7 +54,7 @@ pub async fn put(
     let values = [
         Bind::Real(machine.block_time_ms),
         Bind::Real(machine.max_feed),
-        Bind::Text(dialect_name(machine.dialect)),
+        Bind::Text(machine.dialect.as_str()),
         Bind::Text(&json),
     ];
     guarded_put(db, &registry(name), Bind::Text(name), &values, |(json,): (String,)| decode(&json), guard).await

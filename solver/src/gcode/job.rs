@@ -13,11 +13,9 @@ use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
-use super::{Dialect, comment, mm};
+use super::table::{ArcCentre, Blending, CommentStyle, Heading, PostTable, ToolChange};
+use super::{Blocks, Dialect, comment, mm};
 use crate::error::SolverError;
-
-/// The safety line every program of [`super::write`] starts its blocks with.
-const SAFETY_LINE: &str = "G21 G17 G90 G40 G49 G80 G94";
 
 /// Lowest and highest program number a job may ask for: Fanuc's `O1`–`O7999` (8000–9999 hold
 /// the machine builder's protected programs and macros).
@@ -53,7 +51,8 @@ pub fn check_number(field: &str, number: u32) -> Result<(), SolverError> {
     }
 }
 
-/// Coolant for every operation of a job program.
+/// Coolant for every operation of a job program (the post's codes: `M08`/`M07` on, `M09` off
+/// on Fanuc).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
@@ -65,16 +64,6 @@ pub enum Coolant {
     Flood,
     /// `M07` after the spindle starts, `M09` after it stops.
     Mist,
-}
-
-impl Coolant {
-    fn on_code(self) -> Option<&'static str> {
-        match self {
-            Self::Off => None,
-            Self::Flood => Some("M08"),
-            Self::Mist => Some("M07"),
-        }
-    }
 }
 
 /// One operation of a job as the job program needs it.
@@ -107,19 +96,21 @@ pub struct Job<'a> {
     pub coolant: Coolant,
 }
 
-/// One operation's program, read back into its parts.
+/// One operation's program, read back into its parts (line numbers and block ends taken off).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Section<'a> {
     /// The program's title comment (`(KERF DEBURR)`).
     pub title: &'a str,
     /// Its header comment lines.
     pub comments: Vec<&'a str>,
-    /// LinuxCNC's `G64 P…` line, if written.
+    /// The blending line (LinuxCNC's `G64 P…`, Sinumerik's `G642`), if written.
     pub blend: Option<&'a str>,
-    /// The tool number of `T n M06`; `None` for a manual change (`M00`).
+    /// The tool number of the tool call (`T n M06`); `None` for a manual change.
     pub tool_number: Option<u32>,
     /// The tool-change lines up to the length offset, without the clearance move.
     pub tool_change: Vec<&'a str>,
+    /// The clearance move's words before its Z (`G00 G43 H7`).
+    pub clearance_words: &'a str,
     /// Z of the operation's clearance plane.
     pub safe_z: f64,
     /// The spindle line (`S6000 M03`).
@@ -131,86 +122,159 @@ pub struct Section<'a> {
     pub changes: Vec<Option<u32>>,
 }
 
+/// A block without its line number and block end.
+fn bare<'t>(line: &'t str, table: &PostTable) -> &'t str {
+    let line = match (table.line_numbers, line.strip_prefix('N')) {
+        (Some(_), Some(rest)) => rest
+            .split_once(' ')
+            .map_or(line, |(number, rest)| if number.bytes().all(|b| b.is_ascii_digit()) { rest } else { line }),
+        _ => line,
+    };
+    if table.block_end.is_empty() { line } else { line.strip_suffix(table.block_end).unwrap_or(line) }
+}
+
+/// Whether a line is a comment of `table`'s style.
+fn is_comment(line: &str, table: &PostTable) -> bool {
+    match table.comment {
+        CommentStyle::Parentheses => line.starts_with('(') && line.ends_with(')'),
+        CommentStyle::Semicolon => line.starts_with(';'),
+    }
+}
+
+/// The tool number a tool-call line of `table` names.
+fn tool_call_number(line: &str, table: &PostTable) -> Option<u32> {
+    let call = match table.tool_change {
+        ToolChange::M06WithG43 => line.strip_prefix('T')?.strip_suffix(" M06")?,
+        ToolChange::SinumerikD1 => line.strip_prefix('T')?.strip_suffix(" D1")?,
+        ToolChange::HeidenhainIso => line.strip_prefix('T')?.strip_suffix(" G17")?,
+        ToolChange::Pause => {
+            let text = line.strip_prefix("(LOAD TOOL T")?;
+            &text[..text.find(' ')?]
+        }
+    };
+    call.parse().ok()
+}
+
 impl<'a> Section<'a> {
-    /// Reads a program written by [`super::write`]; `None` for any other layout.
-    pub fn parse(text: &'a str) -> Option<Self> {
-        let mut lines = text.lines().filter(|line| *line != "%").peekable();
+    /// Reads a program written by [`super::write`] for a post of `table`'s words; `None` for any
+    /// other layout.
+    pub fn parse(text: &'a str, table: &PostTable) -> Option<Self> {
+        let mut lines = text
+            .lines()
+            .filter(|line| *line != "%" && !(line.starts_with('%') || line.starts_with("N99999999 %")))
+            .map(|line| bare(line, table))
+            .peekable();
         let first = lines.next()?;
         let title = match first.strip_prefix('O') {
             Some(rest) => rest.split_once(' ')?.1,
             None => first,
         };
-        title.starts_with('(').then_some(())?;
+        is_comment(title, table).then_some(())?;
         let mut comments = Vec::new();
-        while let Some(line) = lines.next_if(|line| line.starts_with('(')) {
+        while let Some(line) = lines.next_if(|line| is_comment(line, table)) {
             comments.push(line);
         }
-        (lines.next()? == SAFETY_LINE).then_some(())?;
-        let blend = lines.next_if(|line| line.starts_with("G64 "));
+        (lines.next()? == table.safety).then_some(())?;
+        let blend = lines.next_if(|line| match table.blending {
+            Blending::Word(word) => *line == word,
+            _ => line.starts_with("G64 "),
+        });
         let mut tool_change = Vec::new();
-        let (tool_number, clearance) = if let Some(call) = lines.next_if(|line| line.starts_with('T')) {
-            let number: u32 = call.strip_prefix('T')?.strip_suffix(" M06")?.parse().ok()?;
-            tool_change.push(call);
-            let offset = lines.next()?;
-            let z = offset.strip_prefix(&format!("G00 G43 H{number} Z"))?;
-            (Some(number), z)
-        } else {
-            while let Some(line) = lines.next_if(|line| line.starts_with('(')) {
-                tool_change.push(line);
+        let rapid = table.motion[0];
+        let mut tool_number = None;
+        while let Some(line) = lines.next_if(|line| !line.starts_with(rapid)) {
+            if let Some(number) = tool_call_number(line, table) {
+                tool_number = Some(number);
             }
-            (lines.next()? == "M00").then_some(())?;
-            tool_change.push("M00");
-            (None, lines.next()?.strip_prefix("G00 Z")?)
-        };
+            tool_change.push(line);
+        }
+        let (clearance_words, clearance) = lines.next()?.rsplit_once(" Z")?;
         let safe_z: f64 = clearance.parse().ok()?;
         let spindle = lines.next()?;
-        (spindle.starts_with('S') && (spindle.ends_with(" M03") || spindle.ends_with(" M04"))).then_some(())?;
+        let spindle_on = |line: &str| {
+            line.starts_with('S')
+                && table.spindle[..2].iter().any(|code| line.strip_suffix(code).is_some_and(|s| s.ends_with(' ')))
+        };
+        spindle_on(spindle).then_some(())?;
         let rest: Vec<&str> = lines.collect();
-        let tail = ["M05", &format!("G00 Z{clearance}"), "M30"];
+        let lift = format!("{rapid} Z{clearance}");
+        let tail = [table.spindle[2], &lift, table.end];
         let body = rest.len().checked_sub(tail.len())?;
         (rest[body..] == tail).then_some(())?;
         let moves = rest[..body].to_vec();
+        let is_move = |line: &str| {
+            table.motion.iter().any(|word| line.strip_prefix(word).is_some_and(|rest| rest.starts_with(" X")))
+                || (table.arcs == ArcCentre::AbsoluteBlock && line.starts_with('I') && line.contains(" J"))
+        };
+        let is_change = |line: &str| {
+            line == table.spindle[2]
+                || line == table.pause
+                || is_comment(line, table)
+                || line.starts_with(&format!("{rapid} "))
+                || tool_call_number(line, table).is_some()
+                || line == "M6"
+                || spindle_on(line)
+        };
         moves.iter().all(|line| is_move(line) || is_change(line)).then_some(())?;
         let mut changes = Vec::new();
         for line in &moves {
-            if let Some(call) = line.strip_prefix('T') {
-                changes.push(Some(call.strip_suffix(" M06")?.parse().ok()?));
-            } else if line.starts_with("(TOOL NOT IN THE TOOL TABLE") {
+            if let Some(number) = tool_call_number(line, table) {
+                changes.push(Some(number));
+            } else if line.contains("TOOL NOT IN THE TOOL TABLE") {
                 changes.push(None);
             }
         }
-        Some(Self { title, comments, blend, tool_number, tool_change, safe_z, spindle, moves, changes })
+        Some(Self {
+            title,
+            comments,
+            blend,
+            tool_number,
+            tool_change,
+            clearance_words,
+            safe_z,
+            spindle,
+            moves,
+            changes,
+        })
     }
 
     /// The feed time of the moves (every feed move at its feed) and their rapid length, s and mm.
-    fn feed_time_and_rapids(&self) -> (f64, f64) {
+    fn feed_time_and_rapids(&self, table: &PostTable) -> (f64, f64) {
         let (mut feed_s, mut rapid_mm) = (0.0, 0.0);
         let mut at: Option<[f64; 3]> = None;
         let mut feed = 0.0;
+        let mut centre: Option<[f64; 2]> = None;
         for line in &self.moves {
-            if !is_move(line) {
-                // A tool change: the tool goes up (or comes down to the offset) where it is.
-                if line.starts_with("G00 ")
-                    && let (Some(z), Some(here)) = (Words::of(line).z, at.as_mut())
+            let words = Words::of(line, table);
+            if words.code.is_none() || words.x.is_none() {
+                if let (Some(i), Some(j)) = (words.i, words.j) {
+                    // Heidenhain ISO's absolute centre block.
+                    centre = Some([i, j]);
+                } else if line.starts_with(table.motion[0])
+                    && let (Some(z), Some(here)) = (words.z, at.as_mut())
                 {
+                    // A tool change: the tool goes up (or comes down to the offset) where it is.
                     here[2] = z;
                 }
                 continue;
             }
-            let words = Words::of(line);
+            let code = words.code.unwrap_or(0);
             if let Some(f) = words.f {
                 feed = f;
             }
             let to = [words.x.unwrap_or(0.0), words.y.unwrap_or(0.0), words.z.unwrap_or(0.0)];
             let Some(from) = at.replace(to) else { continue };
             let straight = ((to[0] - from[0]).powi(2) + (to[1] - from[1]).powi(2) + (to[2] - from[2]).powi(2)).sqrt();
-            let length = match (words.code, words.i, words.j) {
-                ("G02" | "G03", Some(i), Some(j)) => {
-                    arc_length(from, to, [from[0] + i, from[1] + j], words.code == "G02")
-                }
+            let arc_centre = match (table.arcs, words.i, words.j) {
+                (ArcCentre::Relative, Some(i), Some(j)) => Some([from[0] + i, from[1] + j]),
+                (ArcCentre::AbsoluteBlock, ..) => centre,
+                _ => None,
+            };
+            let length = match (code, arc_centre) {
+                (2 | 3, Some(centre)) => arc_length(from, to, centre, code == 2),
                 _ => straight,
             };
-            if words.code == "G00" {
+            if code == 0 {
                 rapid_mm += length;
             } else if feed > 0.0 {
                 feed_s += length / feed * 60.0;
@@ -220,28 +284,10 @@ impl<'a> Section<'a> {
     }
 }
 
-/// Whether a line is one of the motion blocks [`super::write`] writes.
-fn is_move(line: &str) -> bool {
-    ["G00 X", "G01 X", "G02 X", "G03 X"].iter().any(|start| line.starts_with(start))
-}
-
-/// Whether a line is one of those [`super::write_changing`] writes for a stop between moves:
-/// spindle stop, the lift, the operator's notice and `M00`, the tool call with its length offset
-/// (or the manual change with its comments) and the spindle start.
-fn is_change(line: &str) -> bool {
-    let number = |text: &str| !text.is_empty() && text.bytes().all(|b| b.is_ascii_digit());
-    line == "M05"
-        || line == "M00"
-        || (line.starts_with('(') && line.ends_with(')'))
-        || line.starts_with("G00 Z")
-        || line.starts_with("G00 G43 H")
-        || line.strip_prefix('T').and_then(|rest| rest.strip_suffix(" M06")).is_some_and(number)
-        || (line.starts_with('S') && (line.ends_with(" M03") || line.ends_with(" M04")))
-}
-
 /// The words of one motion block.
-struct Words<'a> {
-    code: &'a str,
+struct Words {
+    /// 0 rapid, 1 linear, 2 clockwise, 3 counter-clockwise; `None`: not a motion block.
+    code: Option<usize>,
     x: Option<f64>,
     y: Option<f64>,
     z: Option<f64>,
@@ -250,10 +296,13 @@ struct Words<'a> {
     f: Option<f64>,
 }
 
-impl<'a> Words<'a> {
-    fn of(line: &'a str) -> Self {
-        let mut words = line.split(' ');
-        let code = words.next().unwrap_or("");
+impl Words {
+    fn of(line: &str, table: &PostTable) -> Self {
+        let mut words = line.split(' ').peekable();
+        let code = words.peek().and_then(|first| table.motion.iter().position(|word| word == first));
+        if code.is_some() {
+            words.next();
+        }
         let mut read = Self { code, x: None, y: None, z: None, i: None, j: None, f: None };
         for word in words {
             let value = word.get(1..).and_then(|v| v.parse().ok());
@@ -285,22 +334,31 @@ fn arc_length(from: [f64; 3], to: [f64; 3], centre: [f64; 2], clockwise: bool) -
 
 /// The estimated time of one operation, s: feed moves at their feed, rapids at the machine's
 /// rapid feed, one tool change at the machine's tool-change time.
-fn estimated_time_s(section: &Section<'_>, operation: &Operation<'_>) -> f64 {
-    let (feed_s, rapid_mm) = section.feed_time_and_rapids();
+fn estimated_time_s(section: &Section<'_>, operation: &Operation<'_>, table: &PostTable) -> f64 {
+    let (feed_s, rapid_mm) = section.feed_time_and_rapids(table);
     let rapid_s = operation.rapid_feed.filter(|f| *f > 0.0).map_or(0.0, |f| rapid_mm / f * 60.0);
     let changes = usize::from(section.tool_number.is_some()) + section.changes.iter().flatten().count();
     let change_s = operation.tool_change_s.unwrap_or(0.0) * changes as f64;
     feed_s + rapid_s + change_s
 }
 
-/// The one program of a job: every operation that has a program of [`super::write`]'s layout, in
-/// order. Operations without one are named in the header as not included.
+/// The one program of a job: every operation that has a program of [`super::write`]'s layout
+/// for the job's post, in order. Operations without one are named in the header as not
+/// included.
 ///
 /// # Errors
-/// `E_NO_PROGRAM` when no operation has a program.
+/// `E_NO_PROGRAM` when no operation has a program, or the post is Heidenhain's Klartext (whose
+/// operations run as programs of their own, called by `CALL PGM`).
 pub fn write(job: &Job<'_>, operations: &[Operation<'_>]) -> Result<String, SolverError> {
+    let Some(table) = job.dialect.table() else {
+        return Err(SolverError::new(
+            crate::error::ErrorCode::NoProgram,
+            "a job's operations are not joined into one Heidenhain Klartext program: run each operation's \
+             program (CALL PGM from a main program)",
+        ));
+    };
     let sections: Vec<Option<Section<'_>>> =
-        operations.iter().map(|operation| operation.program.and_then(Section::parse)).collect();
+        operations.iter().map(|operation| operation.program.and_then(|text| Section::parse(text, &table))).collect();
     if sections.iter().all(Option::is_none) {
         return Err(SolverError::new(
             crate::error::ErrorCode::NoProgram,
@@ -308,31 +366,49 @@ pub fn write(job: &Job<'_>, operations: &[Operation<'_>]) -> Result<String, Solv
         ));
     }
     let clearance = sections.iter().flatten().map(|s| s.safe_z).fold(f64::NEG_INFINITY, f64::max);
-    let mut out = String::new();
+    let mut out = Blocks::new(table, 0);
     write_header(&mut out, job, operations, &sections, clearance);
     for (index, (section, operation)) in sections.iter().zip(operations).enumerate() {
         let Some(section) = section else { continue };
         write_section(&mut out, job, index, operation, section, clearance);
     }
-    out.push_str("M30\n%\n");
-    Ok(out)
+    out.block(table.end);
+    match table.heading {
+        Heading::HeidenhainIso => {
+            let _ = writeln!(out.text, "N99999999 %KERF{} G71 *", job.number);
+        }
+        Heading::Percent(_) => out.text.push_str("%\n"),
+        Heading::Title if job.dialect == Dialect::Linuxcnc => out.text.push_str("%\n"),
+        Heading::Title => {}
+    }
+    Ok(out.text.into_string())
 }
 
 /// The job program's head: number and title, the operations with their tools and times (or why
 /// they are left out), the clearance height and the safety line.
 fn write_header(
-    out: &mut String,
+    out: &mut Blocks,
     job: &Job<'_>,
     operations: &[Operation<'_>],
     sections: &[Option<Section<'_>>],
     clearance: f64,
 ) {
-    out.push_str("%\n");
-    if job.dialect == Dialect::Fanuc {
-        let _ = writeln!(out, "O{:04} {}", job.number, comment(job.title));
-    } else {
-        // LinuxCNC reads an O word as a subroutine label: the number is in the title instead.
-        let _ = writeln!(out, "{}", comment(&format!("O{:04} {}", job.number, job.title)));
+    let table = out.table;
+    match table.heading {
+        Heading::Percent(digits) => {
+            let _ = writeln!(out.text, "%\nO{:0digits$} {}", job.number, comment(job.title));
+        }
+        Heading::HeidenhainIso => {
+            let _ = writeln!(out.text, "%KERF{} G71 *", job.number);
+            out.comment(&format!("O{} {}", job.number, job.title));
+        }
+        Heading::Title => {
+            if job.dialect == Dialect::Linuxcnc {
+                out.text.push_str("%\n");
+            }
+            // LinuxCNC reads an O word as a subroutine label: the number is in the title instead.
+            out.comment(&format!("O{:04} {}", job.number, job.title));
+        }
     }
     let included = sections.iter().flatten().count();
     let mut tools: Vec<u32> = sections
@@ -346,18 +422,14 @@ fn write_header(
     let times: Vec<Option<f64>> = sections
         .iter()
         .zip(operations)
-        .map(|(section, operation)| section.as_ref().map(|s| estimated_time_s(s, operation)))
+        .map(|(section, operation)| section.as_ref().map(|s| estimated_time_s(s, operation, &table)))
         .collect();
     let total: f64 = times.iter().flatten().sum();
-    let _ = writeln!(
-        out,
-        "{}",
-        comment(&format!(
-            "{} operations, {included} in this program, tools {}, estimated {total:.1} s",
-            operations.len(),
-            if tools.is_empty() { "manual".to_owned() } else { tools.join(" ") }
-        ))
-    );
+    out.comment(&format!(
+        "{} operations, {included} in this program, tools {}, estimated {total:.1} s",
+        operations.len(),
+        if tools.is_empty() { "manual".to_owned() } else { tools.join(" ") }
+    ));
     for (index, (operation, time)) in operations.iter().zip(&times).enumerate() {
         let tool = operation.tool.unwrap_or("no tool");
         let line = match (time, &sections[index]) {
@@ -378,71 +450,78 @@ fn write_header(
                     .unwrap_or("its program keeps the layout of the program it corrects: run its own file")
             ),
         };
-        let _ = writeln!(out, "{}", comment(&line));
+        out.comment(&line);
     }
-    let _ = writeln!(out, "{}", comment(&format!("clearance between operations Z{}", mm(clearance))));
-    let _ = writeln!(out, "{SAFETY_LINE}");
+    out.comment(&format!("clearance between operations Z{}", mm(clearance)));
+    out.block(table.safety);
 }
 
 /// One operation (number `index` from 0) in the job program: its head and tool change, the
 /// spindle and coolant on, across at the common clearance height to its first point, its moves,
 /// and everything off and up again.
 fn write_section(
-    out: &mut String,
+    out: &mut Blocks,
     job: &Job<'_>,
     index: usize,
     operation: &Operation<'_>,
     section: &Section<'_>,
     clearance: f64,
 ) {
-    let _ = writeln!(out, "{}", comment(&format!("operation {} {}", index + 1, operation.name)));
-    let _ = writeln!(out, "{}", section.title);
+    let table = out.table;
+    out.comment(&format!("operation {} {}", index + 1, operation.name));
+    out.block(section.title);
     for line in &section.comments {
-        let _ = writeln!(out, "{line}");
+        out.block(line);
     }
     if job.dialect != Dialect::Fanuc
         && let Some(blend) = section.blend
     {
-        let _ = writeln!(out, "{blend}");
+        out.block(blend);
     }
     for line in &section.tool_change {
-        let _ = writeln!(out, "{line}");
+        out.block(line);
     }
-    match section.tool_number {
-        Some(number) => {
-            let _ = writeln!(out, "G00 G43 H{number} Z{}", mm(clearance));
-        }
-        None => {
-            let _ = writeln!(out, "G00 Z{}", mm(clearance));
-        }
-    }
-    let _ = writeln!(out, "{}", section.spindle);
-    if let Some(code) = job.coolant.on_code() {
-        let _ = writeln!(out, "{code}");
+    out.begin();
+    out.text.push_str(section.clearance_words);
+    out.word('Z', clearance);
+    out.end();
+    out.block(section.spindle);
+    let coolant = match job.coolant {
+        Coolant::Off => None,
+        Coolant::Flood => Some(table.coolant[0]),
+        Coolant::Mist => Some(table.coolant[1]),
+    };
+    if let Some(code) = coolant {
+        out.block(code);
     }
     // Across to the first point at the clearance height, then down as the operation goes.
     if let Some(first) = section.moves.first() {
-        let words = Words::of(first);
+        let words = Words::of(first, &table);
         if let (Some(x), Some(y)) = (words.x, words.y) {
-            let across = format!("G00 X{} Y{} Z{}", mm(x), mm(y), mm(clearance));
-            if across != *first {
-                let _ = writeln!(out, "{across}");
+            let mut across = Blocks::new(table, 0);
+            across.text.push_str(table.motion[0]);
+            across.word('X', x);
+            across.word('Y', y);
+            across.word('Z', clearance);
+            if across.text.0 != first.as_bytes() {
+                out.block(&across.text.into_string());
             }
         }
     }
     for line in &section.moves {
-        let _ = writeln!(out, "{line}");
+        out.block(line);
     }
-    out.push_str("M05\n");
-    if job.coolant.on_code().is_some() {
-        out.push_str("M09\n");
+    out.block(table.spindle[2]);
+    if coolant.is_some() {
+        out.block(table.coolant[2]);
     }
-    let _ = writeln!(out, "G00 Z{}", mm(clearance));
+    out.rapid_z(clearance);
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gcode::table::FANUC;
     use crate::gcode::{Program, SpindleDirection, ToolCall};
     use crate::geometry::Vec3;
     use crate::path::Toolpath;
@@ -470,22 +549,65 @@ mod tests {
 
     #[test]
     fn sections_read_back_what_write_writes() {
-        for dialect in [Dialect::Fanuc, Dialect::Linuxcnc] {
+        for dialect in Dialect::ALL {
+            let Some(table) = dialect.table() else { continue };
             let text = program(dialect, ToolCall::Table(7), 30.0);
-            let section = Section::parse(&text).expect("a section");
-            assert_eq!(section.title, "(KERF TEST)");
+            let section = Section::parse(&text, &table).expect("a section");
+            assert!(section.title.contains("KERF TEST"), "{text}");
             assert_eq!(section.tool_number, Some(7));
             assert_eq!(section.safe_z, 30.0);
             assert_eq!(section.moves.len(), 4);
-            assert_eq!(section.blend.is_some(), dialect == Dialect::Linuxcnc);
+            assert_eq!(section.blend.is_some(), matches!(dialect, Dialect::Linuxcnc | Dialect::Sinumerik));
             // 2 mm... the plunge: 31 mm at 150 mm/min, then 60 mm at 600 mm/min.
-            let (feed_s, rapid_mm) = section.feed_time_and_rapids();
+            let (feed_s, rapid_mm) = section.feed_time_and_rapids(&table);
             assert!((feed_s - (31.0 / 150.0 + 60.0 / 600.0) * 60.0).abs() < 1e-9, "{feed_s}");
             assert!((rapid_mm - 31.0).abs() < 1e-9);
             let manual = program(dialect, ToolCall::Manual("ball R3".to_owned()), 30.0);
-            assert_eq!(Section::parse(&manual).expect("a manual section").tool_number, None);
+            assert_eq!(Section::parse(&manual, &table).expect("a manual section").tool_number, None);
         }
-        assert!(Section::parse("G0 X1\nM30\n").is_none());
+        assert!(Section::parse("G0 X1\nM30\n", &FANUC).is_none());
+    }
+
+    #[test]
+    fn every_word_post_joins_its_programs_and_klartext_is_refused() {
+        for dialect in Dialect::ALL {
+            let first = program(dialect, ToolCall::Table(7), 30.0);
+            let second = program(dialect, ToolCall::Manual("ball R3".to_owned()), 5.0);
+            let operation = |text| Operation {
+                name: "deburr",
+                program: Some(text),
+                problem: None,
+                tool: Some("ball R3"),
+                rapid_feed: None,
+                tool_change_s: None,
+            };
+            let job = Job { dialect, number: 2042, title: "kerf job 42", coolant: Coolant::Flood };
+            let joined = write(&job, &[operation(&first), operation(&second)]);
+            let Some(table) = dialect.table() else {
+                assert_eq!(joined.unwrap_err().code(), crate::error::ErrorCode::NoProgram);
+                continue;
+            };
+            let text = joined.unwrap();
+            assert!(text.contains("2 OPERATIONS, 2 IN THIS PROGRAM"), "{dialect:?}: {text}");
+            assert_eq!(
+                text.lines().filter(|l| l.ends_with(table.end) || l.contains(&format!(" {} ", table.end))).count(),
+                1,
+                "{text}"
+            );
+            assert_eq!(text.matches(table.coolant[0]).count(), 2, "{text}");
+            if let Some(step) = table.line_numbers {
+                // Numbered again from the start: every block's number one step above the last.
+                let numbers: Vec<u32> = text
+                    .lines()
+                    .filter_map(|l| l.strip_prefix('N')?.split(' ').next()?.parse().ok())
+                    .filter(|n| *n != 99_999_999)
+                    .collect();
+                assert!(numbers.windows(2).all(|w| w[1] == w[0] + step), "{text}");
+            }
+            if let Some(max) = table.max_line {
+                assert!(text.lines().all(|l| l.len() <= max), "{text}");
+            }
+        }
     }
 
     #[test]
@@ -548,7 +670,7 @@ mod tests {
             text.contains("G00 X1.0000 Y2.0000 Z30.0000\nM05\nG00 Z30.0000\n(TURN THE TUBE)\nM00\nT8 M06\nG00 G43 H8 Z30.0000\nS5000 M03\nG00 X5.0000"),
             "{text}"
         );
-        let section = Section::parse(&text).expect("a section with a stop");
+        let section = Section::parse(&text, &FANUC).expect("a section with a stop");
         assert_eq!((section.tool_number, section.changes.clone()), (Some(7), vec![Some(8)]));
         // 10 mm down at 300 mm/min twice, the rapids up and across, two tool changes.
         let operation = Operation {
@@ -559,7 +681,7 @@ mod tests {
             rapid_feed: Some(6000.0),
             tool_change_s: Some(5.0),
         };
-        let time = estimated_time_s(&section, &operation);
+        let time = estimated_time_s(&section, &operation, &FANUC);
         assert!((time - (2.0 * 10.0 / 300.0 * 60.0 + 14.0 / 6000.0 * 60.0 + 10.0)).abs() < 1e-9, "{time}");
         let job = Job { dialect: Dialect::Fanuc, number: 2001, title: "kerf job", coolant: Coolant::Off };
         let joined = write(&job, &[operation]).unwrap();

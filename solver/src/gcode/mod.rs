@@ -1,34 +1,78 @@
-//! G-code posts: turns a [`Toolpath`] into a complete program for a Fanuc-style control or
-//! LinuxCNC (docs/spec/api.md, G-code conventions; docs/guide/gcode.md).
+//! G-code posts: turns a [`Toolpath`] into a complete program for the control a machine runs
+//! (docs/spec/api.md, G-code conventions; docs/guide/gcode.md).
 //!
-//! Both dialects print every coordinate with 4 decimals in mm (never `-0.0000`), absolute mode,
-//! feed per minute, and start with a safety line, the tool change with its length offset and the
-//! spindle, and end with spindle stop and `M30`. They differ where the controls differ: the Fanuc
-//! post wraps the program in `%` with an `O` number; the LinuxCNC post adds `G64 P` (path blending
-//! held within the path tolerance). Both are accepted by LinuxCNC's `rs274` interpreter.
+//! Every post prints every coordinate with 4 decimals in mm (never `-0.0000`), absolute mode,
+//! feed per minute, and starts with a safety line, the tool call with its length offset and the
+//! spindle, and ends with spindle stop and the program end. Where controls differ only in words
+//! (program start and end, comments, tool call, spindle and coolant codes, arc centres, line
+//! numbers, decimal format, longest line) the post is a row of the post table
+//! ([`table::PostTable`]): Fanuc (also Mazak and Okuma in ISO mode), Haas, LinuxCNC, Siemens
+//! Sinumerik 840D, Heidenhain ISO and grbl. Heidenhain's conversational Klartext differs in
+//! structure and is code of its own (module `klartext`). The program is written into one buffer, its
+//! numbers from scaled integers ([`number`]).
 
 pub mod job;
+mod klartext;
+pub mod number;
 pub mod reader;
+#[cfg(test)]
+mod reference;
+pub mod table;
 
 use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
+use self::table::{ArcCentre, Blending, CommentStyle, Heading, PostTable, ToolChange};
 use crate::control::Control;
 use crate::error::SolverError;
 use crate::geometry::Vec3;
 use crate::path::{Motion, Toolpath};
 
-/// The control the program is written for.
+/// The control the program is written for: the post.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum Dialect {
-    /// Fanuc-style controls (also Haas, Okuma in G-code mode, ...): `%`, `O` number.
+    /// Fanuc 0i/30i (also Mazak and Okuma in their ISO mode): `%`, `O` number, `T M06` with
+    /// `G43 H`.
     #[default]
     Fanuc,
+    /// Haas: as Fanuc with a five-digit `O` number (no `G187`: the control's smoothing setting
+    /// applies).
+    Haas,
     /// LinuxCNC (rs274ngc): adds `G64 P` blending tolerance.
     Linuxcnc,
+    /// Siemens Sinumerik 840D: `;` comments, `G71` (mm), `G642` blending, `T D1` with `M6`.
+    Sinumerik,
+    /// Heidenhain TNC conversational (Klartext): `BEGIN PGM`, `TOOL CALL`, `L`, `CC`/`C`,
+    /// `END PGM`.
+    Heidenhain,
+    /// Heidenhain TNC ISO: numbered blocks ending in `*`, `T G17` tool call, arc centre as an
+    /// absolute `I J` block.
+    HeidenhainIso,
+    /// grbl: no tool changer (the program pauses with `M0` and a comment), no `G43`, lines of at
+    /// most 80 characters.
+    Grbl,
+}
+
+impl Dialect {
+    /// Every post, in the order the page lists them.
+    pub const ALL: [Self; 7] =
+        [Self::Fanuc, Self::Haas, Self::Linuxcnc, Self::Sinumerik, Self::Heidenhain, Self::HeidenhainIso, Self::Grbl];
+
+    /// The name used in JSON and `?dialect=`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Fanuc => "fanuc",
+            Self::Haas => "haas",
+            Self::Linuxcnc => "linuxcnc",
+            Self::Sinumerik => "sinumerik",
+            Self::Heidenhain => "heidenhain",
+            Self::HeidenhainIso => "heidenhain_iso",
+            Self::Grbl => "grbl",
+        }
+    }
 }
 
 /// How circular moves are written: as the control's own circular interpolation or as
@@ -192,17 +236,49 @@ impl SpindleDirection {
 
 /// A coordinate or value in mm with 4 decimals, never printed as `-0.0000`.
 pub fn mm(value: f64) -> String {
-    let text = format!("{value:.4}");
-    if text.starts_with('-') && text[1..].bytes().all(|b| b == b'0' || b == b'.') { text[1..].to_owned() } else { text }
+    number::fixed(value, 4, false)
 }
 
-/// A comment safe for both dialects: upper case, no parentheses or control characters.
+/// A comment in parentheses: upper case, no parentheses or control characters.
 pub fn comment(text: &str) -> String {
-    let cleaned: String = text
-        .chars()
-        .map(|c| if c == '(' || c == ')' || c.is_control() || !c.is_ascii() { ' ' } else { c.to_ascii_uppercase() })
-        .collect();
-    format!("({})", cleaned.trim())
+    let mut out = Buffer::default();
+    push_comment(&mut out, CommentStyle::Parentheses, text, None);
+    out.into_string()
+}
+
+/// A program's text as it is written: bytes, each ASCII or from a whole `str`, so the text is
+/// UTF-8; digits are copied in without a check per number.
+#[derive(Debug, Default)]
+struct Buffer(Vec<u8>);
+
+impl Buffer {
+    fn with_capacity(capacity: usize) -> Self {
+        Self(Vec::with_capacity(capacity))
+    }
+
+    fn push_str(&mut self, text: &str) {
+        self.0.extend_from_slice(text.as_bytes());
+    }
+
+    fn push(&mut self, c: char) {
+        self.push_str(c.encode_utf8(&mut [0; 4]));
+    }
+
+    /// Where the current line starts.
+    fn line_start(&self) -> usize {
+        self.0.iter().rposition(|b| *b == b'\n').map_or(0, |at| at + 1)
+    }
+
+    fn into_string(self) -> String {
+        number::text(self.0)
+    }
+}
+
+impl std::fmt::Write for Buffer {
+    fn write_str(&mut self, text: &str) -> std::fmt::Result {
+        self.push_str(text);
+        Ok(())
+    }
 }
 
 /// A stop in the middle of a program (a deburr of both edges whose inside needs another
@@ -220,22 +296,6 @@ pub struct ProgramStop {
     pub tool: Option<ToolCall>,
     /// The spindle speed after it, rpm (the direction stays the program's).
     pub spindle_rpm: f64,
-}
-
-/// Writes the tool call of `tool` with its length offset at `safe_z`.
-fn write_tool_call(out: &mut String, tool: &ToolCall, safe_z: f64) {
-    match tool {
-        ToolCall::Table(number) => {
-            let _ = writeln!(out, "T{number} M06");
-            let _ = writeln!(out, "G00 G43 H{number} Z{}", mm(safe_z));
-        }
-        ToolCall::Manual(description) => {
-            let _ = writeln!(out, "{}", comment(&format!("TOOL NOT IN THE TOOL TABLE: {description}")));
-            let _ = writeln!(out, "{}", comment("LOAD IT, ACTIVATE ITS LENGTH OFFSET, THEN CYCLE START"));
-            out.push_str("M00\n");
-            let _ = writeln!(out, "G00 Z{}", mm(safe_z));
-        }
-    }
 }
 
 /// Writes the whole program.
@@ -268,105 +328,373 @@ pub fn write_cancellable(
 /// Moves written between two cancel checks (about a millisecond of writing).
 pub const MOVES_PER_CHECK: usize = 1024;
 
+/// Bytes a program takes per move, about: the buffer is sized once for the whole program.
+const BYTES_PER_MOVE: usize = 40;
+
 fn write_checking<E>(
     program: &Program<'_>,
     stops: &[ProgramStop],
-    mut check: impl FnMut() -> Result<(), E>,
+    check: impl FnMut() -> Result<(), E>,
 ) -> Result<String, E> {
-    let mut out = String::with_capacity(64 + program.path.moves.len() * 40);
-    let fanuc = program.dialect == Dialect::Fanuc;
-    if fanuc {
-        out.push_str("%\n");
-        let _ = writeln!(out, "O{:04} {}", program.number, comment(program.title));
-    } else {
-        let _ = writeln!(out, "{}", comment(program.title));
-    }
-    for line in &program.comments {
-        let _ = writeln!(out, "{}", comment(line));
-    }
-    out.push_str("G21 G17 G90 G40 G49 G80 G94\n");
-    if !fanuc {
-        let _ = writeln!(out, "G64 P{}", mm(program.blend_tolerance));
-    }
-    write_tool_call(&mut out, &program.tool, program.safe_z);
-    let _ = writeln!(out, "S{} {}", program.spindle_rpm.round(), program.spindle_direction.m_code());
-    let mut current_feed: Option<f64> = None;
-    let mut position: Option<Vec3> = None;
-    let mut stops = stops.iter().peekable();
-    for (index, step) in program.path.moves.iter().enumerate() {
-        if index % MOVES_PER_CHECK == 0 {
-            check()?;
+    match program.dialect.table() {
+        Some(table) => {
+            let mut out = Blocks::new(table, program.path.moves.len());
+            out.program(program, stops, check)?;
+            let text = out.text.into_string();
+            #[cfg(test)]
+            reference::check(program, stops, &text);
+            Ok(text)
         }
-        while let Some(stop) = stops.next_if(|stop| stop.before <= index) {
-            out.push_str("M05\n");
-            let _ = writeln!(out, "G00 Z{}", mm(program.safe_z));
-            if let Some(notice) = &stop.notice {
-                let _ = writeln!(out, "{}", comment(notice));
-                out.push_str("M00\n");
-            }
-            if let Some(tool) = &stop.tool {
-                write_tool_call(&mut out, tool, program.safe_z);
-            }
-            let _ = writeln!(out, "S{} {}", stop.spindle_rpm.round(), program.spindle_direction.m_code());
-            if let Some(at) = &mut position {
-                at.z = program.safe_z;
-            }
-            // The first feed move after the change states its feed again.
-            current_feed = None;
+        None => klartext::write(program, stops, check),
+    }
+}
+
+/// A program being written by a post of the table: one buffer, line numbers, block ends.
+struct Blocks {
+    table: PostTable,
+    text: Buffer,
+    line: u32,
+}
+
+impl Blocks {
+    fn new(table: PostTable, moves: usize) -> Self {
+        Self { table, text: Buffer::with_capacity(256 + moves * BYTES_PER_MOVE), line: 0 }
+    }
+
+    /// Starts a block: its line number, if the post numbers lines.
+    fn begin(&mut self) {
+        if let Some(step) = self.table.line_numbers {
+            self.line += step;
+            self.text.push('N');
+            number::push_whole(&mut self.text.0, f64::from(self.line));
+            self.text.push(' ');
         }
-        let (x, y, z) = (mm(step.to.x), mm(step.to.y), mm(step.to.z));
-        let feed = match step.motion {
-            Motion::Rapid => {
-                let _ = writeln!(out, "G00 X{x} Y{y} Z{z}");
-                position = Some(step.to);
-                continue;
-            }
-            // An arc needs its start; a path never starts with one (the post writes a straight
-            // move there rather than a wrong centre). An arc whose printed end is its printed
-            // start would be a full circle on one control and nothing on another: written as the
-            // straight move it is meant to be (producers split full circles).
-            Motion::Arc { feed, centre, clockwise }
-                if position.is_some_and(|start| mm(start.x) != x || mm(start.y) != y) =>
-            {
-                let start = position.unwrap_or_default();
-                let word = if clockwise { "G02" } else { "G03" };
-                let (i, j) = (mm(centre.x - start.x), mm(centre.y - start.y));
-                let _ = write!(out, "{word} X{x} Y{y} Z{z} I{i} J{j}");
-                feed
-            }
-            Motion::Linear { feed } | Motion::Arc { feed, .. } => {
-                let _ = write!(out, "G01 X{x} Y{y} Z{z}");
-                match (program.plunges, position) {
-                    (Some(plunges), Some(from)) if is_plunge(from, step.to) => plunge_feed(feed, plunges.feed),
-                    _ => feed,
+    }
+
+    /// Ends a block.
+    fn end(&mut self) {
+        self.text.push_str(self.table.block_end);
+        self.text.push('\n');
+    }
+
+    /// One block of fixed words.
+    fn block(&mut self, words: &str) {
+        self.begin();
+        self.text.push_str(words);
+        self.end();
+    }
+
+    /// A comment block, cut to the longest line the control takes.
+    fn comment(&mut self, text: &str) {
+        self.begin();
+        let room = self.table.max_line.map(|max| max.saturating_sub(self.text.0.len() - self.text.line_start()));
+        push_comment(&mut self.text, self.table.comment, text, room);
+        self.end();
+    }
+
+    /// ` X…` in the post's decimal format.
+    fn word(&mut self, letter: char, value: f64) {
+        self.text.push(' ');
+        self.text.push(letter);
+        number::push_fixed(&mut self.text.0, value, self.table.decimals, self.table.plus_sign);
+    }
+
+    /// `G00 Z…` (the rapid word of the post) to the clearance plane.
+    fn rapid_z(&mut self, z: f64) {
+        self.begin();
+        self.text.push_str(self.table.motion[0]);
+        self.word('Z', z);
+        self.end();
+    }
+
+    /// The spindle speed and start.
+    fn spindle(&mut self, rpm: f64, direction: SpindleDirection) {
+        self.begin();
+        self.text.push('S');
+        number::push_whole(&mut self.text.0, rpm.round());
+        self.text.push(' ');
+        self.text.push_str(self.table.spindle[direction as usize]);
+        self.end();
+    }
+
+    /// The tool call of `tool` with its length offset at `safe_z`.
+    fn tool_call(&mut self, tool: &ToolCall, safe_z: f64) {
+        match tool {
+            ToolCall::Table(number) => match self.table.tool_change {
+                ToolChange::M06WithG43 => {
+                    self.block(&format!("T{number} M06"));
+                    self.begin();
+                    let _ = write!(self.text, "{} G43 H{number}", self.table.motion[0]);
+                    self.word('Z', safe_z);
+                    self.end();
                 }
+                ToolChange::SinumerikD1 => {
+                    self.block(&format!("T{number} D1"));
+                    self.block("M6");
+                    self.rapid_z(safe_z);
+                }
+                ToolChange::HeidenhainIso => {
+                    self.block(&format!("T{number} G17"));
+                    self.begin();
+                    let _ = write!(self.text, "{} G40 G90", self.table.motion[0]);
+                    self.word('Z', safe_z);
+                    self.end();
+                }
+                ToolChange::Pause => {
+                    self.comment(&format!("load tool T{number} and set its length, then cycle start"));
+                    self.block(self.table.pause);
+                    self.rapid_z(safe_z);
+                }
+            },
+            ToolCall::Manual(description) => {
+                self.comment(&format!("TOOL NOT IN THE TOOL TABLE: {description}"));
+                self.comment("LOAD IT, ACTIVATE ITS LENGTH OFFSET, THEN CYCLE START");
+                self.block(self.table.pause);
+                self.rapid_z(safe_z);
             }
-        };
-        if current_feed == Some(feed) {
-            out.push('\n');
-        } else {
-            let _ = writeln!(out, " F{}", feed_word(feed));
-            current_feed = Some(feed);
         }
-        position = Some(step.to);
     }
-    out.push_str("M05\n");
-    let _ = writeln!(out, "G00 Z{}", mm(program.safe_z));
-    out.push_str("M30\n");
-    if fanuc {
-        out.push_str("%\n");
+
+    /// The program's start up to its first move.
+    fn heading(&mut self, program: &Program<'_>) {
+        match self.table.heading {
+            Heading::Percent(digits) => {
+                self.text.push_str("%\n");
+                let _ = write!(self.text, "O{:0digits$} ", program.number);
+                push_comment(&mut self.text, self.table.comment, program.title, None);
+                self.text.push('\n');
+            }
+            Heading::Title => self.comment(program.title),
+            Heading::HeidenhainIso => {
+                let _ = writeln!(self.text, "%KERF{} G71 *", program.number);
+                self.comment(program.title);
+            }
+        }
+        for line in &program.comments {
+            self.comment(line);
+        }
+        self.block(self.table.safety);
+        match self.table.blending {
+            Blending::None => {}
+            Blending::Tolerance => {
+                self.begin();
+                self.text.push_str("G64 P");
+                number::push_fixed(&mut self.text.0, program.blend_tolerance, self.table.decimals, false);
+                self.end();
+            }
+            Blending::Word(word) => self.block(word),
+        }
+        self.tool_call(&program.tool, program.safe_z);
+        self.spindle(program.spindle_rpm, program.spindle_direction);
     }
-    Ok(out)
+
+    /// A stop between moves.
+    fn stop(&mut self, program: &Program<'_>, stop: &ProgramStop) {
+        self.block(self.table.spindle[2]);
+        self.rapid_z(program.safe_z);
+        if let Some(notice) = &stop.notice {
+            self.comment(notice);
+            self.block(self.table.pause);
+        }
+        if let Some(tool) = &stop.tool {
+            self.tool_call(tool, program.safe_z);
+        }
+        self.spindle(stop.spindle_rpm, program.spindle_direction);
+    }
+
+    /// The end: spindle stop, up to the clearance plane, program end.
+    fn ending(&mut self, program: &Program<'_>) {
+        self.block(self.table.spindle[2]);
+        self.rapid_z(program.safe_z);
+        self.block(self.table.end);
+        match self.table.heading {
+            Heading::Percent(_) => self.text.push_str("%\n"),
+            Heading::Title => {}
+            Heading::HeidenhainIso => {
+                let _ = writeln!(self.text, "N99999999 %KERF{} G71 *", program.number);
+            }
+        }
+    }
+
+    fn program<E>(
+        &mut self,
+        program: &Program<'_>,
+        stops: &[ProgramStop],
+        mut check: impl FnMut() -> Result<(), E>,
+    ) -> Result<(), E> {
+        self.heading(program);
+        let decimals = self.table.decimals;
+        let mut current_feed: Option<f64> = None;
+        let mut position: Option<Vec3> = None;
+        let mut stops = stops.iter().peekable();
+        for (index, step) in program.path.moves.iter().enumerate() {
+            if index % MOVES_PER_CHECK == 0 {
+                check()?;
+            }
+            while let Some(stop) = stops.next_if(|stop| stop.before <= index) {
+                self.stop(program, stop);
+                if let Some(at) = &mut position {
+                    at.z = program.safe_z;
+                }
+                // The first feed move after the change states its feed again.
+                current_feed = None;
+            }
+            let feed = match step.motion {
+                Motion::Rapid => {
+                    self.motion(0, step.to);
+                    self.end();
+                    position = Some(step.to);
+                    continue;
+                }
+                // An arc needs its start; a path never starts with one (the post writes a
+                // straight move there rather than a wrong centre). An arc whose printed end is its
+                // printed start would be a full circle on one control and nothing on another:
+                // written as the straight move it is meant to be (producers split full circles).
+                Motion::Arc { feed, centre, clockwise }
+                    if position.is_some_and(|start| !same_printed(start, step.to, decimals)) =>
+                {
+                    let start = position.unwrap_or_default();
+                    if self.table.arcs == ArcCentre::AbsoluteBlock {
+                        if !number::prints_equal(start.z, step.to.z, decimals) {
+                            // Heidenhain ISO has no helix in Cartesian words: chords.
+                            self.helix_chords(
+                                start,
+                                step.to,
+                                centre,
+                                clockwise,
+                                feed,
+                                program.blend_tolerance,
+                                &mut current_feed,
+                            );
+                            position = Some(step.to);
+                            continue;
+                        }
+                        self.begin();
+                        self.text.push('I');
+                        number::push_fixed(&mut self.text.0, centre.x, decimals, self.table.plus_sign);
+                        self.word('J', centre.y);
+                        self.end();
+                    }
+                    self.motion(if clockwise { 2 } else { 3 }, step.to);
+                    if self.table.arcs == ArcCentre::Relative {
+                        self.word('I', centre.x - start.x);
+                        self.word('J', centre.y - start.y);
+                    }
+                    feed
+                }
+                Motion::Linear { feed } | Motion::Arc { feed, .. } => {
+                    self.motion(1, step.to);
+                    match (program.plunges, position) {
+                        (Some(plunges), Some(from)) if is_plunge(from, step.to) => plunge_feed(feed, plunges.feed),
+                        _ => feed,
+                    }
+                }
+            };
+            self.feed(feed, &mut current_feed);
+            self.end();
+            position = Some(step.to);
+        }
+        self.ending(program);
+        Ok(())
+    }
+
+    /// Starts a motion block: its word (0 rapid, 1 linear, 2 clockwise, 3 counter-clockwise) and
+    /// end point.
+    fn motion(&mut self, word: usize, to: Vec3) {
+        self.begin();
+        self.text.push_str(self.table.motion[word]);
+        self.word('X', to.x);
+        self.word('Y', to.y);
+        self.word('Z', to.z);
+    }
+
+    /// ` F…` when the feed changes.
+    fn feed(&mut self, feed: f64, current: &mut Option<f64>) {
+        if *current != Some(feed) {
+            self.text.push_str(" F");
+            number::push_feed(&mut self.text.0, feed);
+            *current = Some(feed);
+        }
+    }
+
+    /// A helical arc as straight feed moves within `tolerance` of it.
+    #[allow(clippy::too_many_arguments)]
+    fn helix_chords(
+        &mut self,
+        start: Vec3,
+        end: Vec3,
+        centre: Vec3,
+        clockwise: bool,
+        feed: f64,
+        tolerance: f64,
+        current_feed: &mut Option<f64>,
+    ) {
+        for point in helix_points(start, end, centre, clockwise, tolerance) {
+            self.motion(1, point);
+            self.feed(feed, current_feed);
+            self.end();
+        }
+    }
+}
+
+/// The points ending the chords of a helical arc from `start` to `end` about `centre` (the arc
+/// of at most a full turn in the given sense), each chord within `tolerance` of the arc; the last
+/// is `end`.
+pub(crate) fn helix_points(start: Vec3, end: Vec3, centre: Vec3, clockwise: bool, tolerance: f64) -> Vec<Vec3> {
+    let radius = (start.x - centre.x).hypot(start.y - centre.y);
+    let from = (start.y - centre.y).atan2(start.x - centre.x);
+    let to = (end.y - centre.y).atan2(end.x - centre.x);
+    let mut sweep = if clockwise { from - to } else { to - from };
+    if sweep <= 0.0 {
+        sweep += std::f64::consts::TAU;
+    }
+    let tolerance = tolerance.max(1e-6);
+    let step = if radius > tolerance { 2.0 * (1.0 - tolerance / radius).acos() } else { sweep };
+    let count = (sweep / step.max(1e-6)).ceil().clamp(1.0, 100_000.0) as usize;
+    let sense = if clockwise { -1.0 } else { 1.0 };
+    (1..=count)
+        .map(|k| {
+            if k == count {
+                return end;
+            }
+            let t = k as f64 / count as f64;
+            let angle = from + sense * sweep * t;
+            Vec3::new(centre.x + radius * angle.cos(), centre.y + radius * angle.sin(), start.z + (end.z - start.z) * t)
+        })
+        .collect()
+}
+
+/// Appends a comment in `style` (upper case, no parentheses or control characters), its text cut
+/// so the comment takes at most `room` characters.
+fn push_comment(out: &mut Buffer, style: CommentStyle, text: &str, room: Option<usize>) {
+    let cleaned = clean_comment(text);
+    let (open, close) = match style {
+        CommentStyle::Parentheses => ("(", ")"),
+        CommentStyle::Semicolon => ("; ", ""),
+    };
+    let fits = room.map_or(cleaned.len(), |room| room.saturating_sub(open.len() + close.len()).min(cleaned.len()));
+    out.push_str(open);
+    out.push_str(cleaned[..fits].trim_end());
+    out.push_str(close);
+}
+
+/// A comment's text: upper case ASCII, no parentheses or control characters, trimmed.
+fn clean_comment(text: &str) -> String {
+    let cleaned: String = text
+        .chars()
+        .map(|c| if c == '(' || c == ')' || c.is_control() || !c.is_ascii() { ' ' } else { c.to_ascii_uppercase() })
+        .collect();
+    cleaned.trim().to_owned()
+}
+
+/// Whether `a` and `b` print as the same X and Y.
+pub(crate) fn same_printed(a: Vec3, b: Vec3, decimals: usize) -> bool {
+    number::prints_equal(a.x, b.x, decimals) && number::prints_equal(a.y, b.y, decimals)
 }
 
 /// Whether the straight move from `from` to `to` goes straight down the tool axis.
 fn is_plunge(from: Vec3, to: Vec3) -> bool {
     to.z < from.z - 1e-9 && (to.x - from.x).abs() <= 1e-9 && (to.y - from.y).abs() <= 1e-9
-}
-
-/// Feed word value: whole mm/min where exact, else one decimal.
-fn feed_word(feed: f64) -> String {
-    if feed.fract() == 0.0 { format!("{feed:.0}") } else { format!("{feed:.1}") }
 }
 
 #[cfg(test)]
@@ -451,5 +779,74 @@ mod tests {
             ),
             "{text}"
         );
+    }
+}
+
+/// Every post's program of one small path (a plunge, a line, two half circles, a helical arc, a
+/// stop turning the part with a tool change, a manual tool), kept as golden files in
+/// `solver/src/gcode/golden/` that a reviewer reads against the control's manual.
+/// `KERF_UPDATE_GOLDEN=1` writes them anew.
+#[cfg(test)]
+mod golden {
+    use super::*;
+
+    fn path() -> Toolpath {
+        let mut path = Toolpath::default();
+        path.rapid(Vec3::new(10.0, 0.0, 30.0));
+        path.linear(Vec3::new(10.0, 0.0, -1.0), 400.0);
+        path.linear(Vec3::new(20.0, 0.0, -1.0), 400.0);
+        let centre = Vec3::new(10.0, 0.0, -1.0);
+        path.arc(Vec3::new(0.0, 0.0, -1.0), centre, false, 600.0);
+        path.arc(Vec3::new(20.0, 0.0, -1.0), centre, false, 600.0);
+        path.arc(Vec3::new(0.0, 0.0, -2.0), centre, true, 600.0);
+        path.rapid(Vec3::new(0.0, 0.0, 30.0));
+        path.rapid(Vec3::new(-5.0, 0.0, 30.0));
+        path.linear(Vec3::new(-5.0, 0.0, -0.00001), 333.3);
+        path.rapid(Vec3::new(-5.0, 0.0, 30.0));
+        path
+    }
+
+    fn program(dialect: Dialect, path: &Toolpath, tool: ToolCall) -> Program<'_> {
+        Program {
+            dialect,
+            number: 1000,
+            title: "kerf golden (test)",
+            comments: vec![
+                "tool T7 ball R3.0000, a comment long enough to be cut where a control takes short lines only"
+                    .to_owned(),
+            ],
+            tool,
+            spindle_rpm: 6000.4,
+            spindle_direction: SpindleDirection::Cw,
+            safe_z: 30.0,
+            blend_tolerance: 0.01,
+            plunges: Some(Plunges { feed: None }),
+            path,
+        }
+    }
+
+    #[test]
+    fn every_post_writes_its_golden_file() {
+        let path = path();
+        let stop = ProgramStop {
+            before: 6,
+            notice: Some("turn the part".to_owned()),
+            tool: Some(ToolCall::Table(8)),
+            spindle_rpm: 5000.0,
+        };
+        let folder = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/gcode/golden");
+        for dialect in Dialect::ALL {
+            let mut text = write_changing(&program(dialect, &path, ToolCall::Table(7)), std::slice::from_ref(&stop));
+            text.push_str(&write(&program(dialect, &path, ToolCall::Manual("ball R3.0000".to_owned()))));
+            let file = folder.join(format!("{}.nc", dialect.as_str()));
+            if std::env::var("KERF_UPDATE_GOLDEN").is_ok_and(|v| v == "1") {
+                std::fs::write(&file, &text).unwrap();
+            }
+            let golden = std::fs::read_to_string(&file).unwrap_or_default();
+            assert_eq!(text, golden, "{} differs from {}", dialect.as_str(), file.display());
+            if let Some(max) = dialect.table().and_then(|table| table.max_line) {
+                assert!(text.lines().all(|line| line.len() <= max), "{text}");
+            }
+        }
     }
 }

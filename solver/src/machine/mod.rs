@@ -43,7 +43,8 @@ pub struct MachineProfile {
     pub block_time_ms: f64,
     /// Highest programmable cutting feed, mm/min (> 0); the feed of a request that gives none.
     pub max_feed: f64,
-    /// G-code dialect of the control (default `fanuc`).
+    /// The post its programs are written for (`fanuc` default, `haas`, `linuxcnc`, `sinumerik`,
+    /// `heidenhain`, `heidenhain_iso`, `grbl`; docs/guide/gcode.md).
     #[serde(default)]
     pub dialect: Dialect,
     /// k_f: margin factor on the feed for the block-time rule (≥ 1, e.g. 1.1; default 1).

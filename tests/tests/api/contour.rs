@@ -466,7 +466,7 @@ fn contour_cases() -> Vec<Case> {
         ("unknown side", url, with(json!({"side": "middle"})), 400, "side", "E_JSON"),
         ("missing feed", url, without("feed"), 400, "body", "E_JSON"),
         ("string for a number", url, with(json!({"feed": "800"})), 400, "feed", "E_JSON"),
-        ("bad dialect", "/api/v1/contour?format=gcode&dialect=heidenhain", valid(), 400, "dialect", "E_QUERY"),
+        ("bad dialect", "/api/v1/contour?format=gcode&dialect=mazak", valid(), 400, "dialect", "E_QUERY"),
         ("unknown query parameter", "/api/v1/contour?units=inch", valid(), 400, "units", "E_QUERY"),
         ("tilted walls as G-code", gcode, with(json!({"tilt_deg": 5})), 422, "tilt_deg", "E_TILT_NEEDS_5_AXIS"),
         (

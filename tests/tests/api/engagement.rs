@@ -861,7 +861,7 @@ fn bad_cases() -> Vec<(&'static str, Value, &'static str, u16, &'static str, &'s
         ),
         ("candidate not a number", api_example(), "?format=gcode&candidate=first", 400, "candidate", "E_QUERY"),
         ("unknown query parameter", api_example(), "?colour=red", 400, "colour", "E_QUERY"),
-        ("bad dialect", api_example(), "?format=gcode&dialect=heidenhain", 400, "dialect", "E_QUERY"),
+        ("bad dialect", api_example(), "?format=gcode&dialect=mazak", 400, "dialect", "E_QUERY"),
     ]
 }
 

@@ -122,7 +122,7 @@ async fn bad_machines_are_refused_and_nothing_is_stored(store: Store) {
         (
             "unknown dialect",
             "/api/v1/machines/m1",
-            json!({"block_time_ms": 4, "max_feed": 1e4, "dialect": "heidenhain"}),
+            json!({"block_time_ms": 4, "max_feed": 1e4, "dialect": "mazak"}),
             400,
             "dialect",
             "E_JSON",

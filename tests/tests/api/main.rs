@@ -30,6 +30,7 @@ mod materials;
 mod metrics;
 mod negotiation;
 mod openapi;
+mod posts;
 mod predict;
 mod request_fuzz;
 mod schemathesis;

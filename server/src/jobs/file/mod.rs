@@ -95,7 +95,8 @@ impl store::jobs::Submission for JobFile {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct OutputOptions {
-    /// `fanuc` or `linuxcnc`; default: each operation's machine's, else `fanuc`.
+    /// The post (`fanuc`, `haas`, `linuxcnc`, `sinumerik`, `heidenhain`, `heidenhain_iso`, `grbl`;
+    /// docs/guide/gcode.md); default: each operation's machine's, else `fanuc`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dialect: Option<Dialect>,
     /// `tip` or `centre`; default `tip` (a predict operation's G-code path keeps its own).
