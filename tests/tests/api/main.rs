@@ -30,6 +30,7 @@ mod negotiation;
 mod openapi;
 mod predict;
 mod request_fuzz;
+mod resegment;
 mod schemathesis;
 mod segment;
 mod storage_full;
