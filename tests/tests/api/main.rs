@@ -12,6 +12,7 @@ mod contour;
 mod deburr;
 mod deburr_holes;
 mod deburr_machine;
+mod dxf;
 mod edge_numbers;
 mod engagement;
 mod entries;
