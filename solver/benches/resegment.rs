@@ -15,7 +15,8 @@ use kerf_solver::segment::resegment::{ResegmentRequest, resegment, write};
 const LINES: usize = 1_000_000;
 
 fn dense_program() -> String {
-    let mut text = String::from("%\nO1000 (DENSE CIRCLES)\nG21 G17 G90 G40 G49 G80 G94\nT1 M06\nG00 G43 H1 Z25.\nS8000 M03\n");
+    let mut text =
+        String::from("%\nO1000 (DENSE CIRCLES)\nG21 G17 G90 G40 G49 G80 G94\nT1 M06\nG00 G43 H1 Z25.\nS8000 M03\n");
     let mut lines = text.lines().count();
     let mut radius = 100.0_f64;
     'circles: loop {

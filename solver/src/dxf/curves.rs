@@ -6,6 +6,12 @@ use std::collections::HashMap;
 use crate::error::SolverError;
 
 /// An open piece of the profile: its points and the entity it came from.
+/// A closed loop of the profile (the last point not repeated) and the entity it starts with.
+pub(super) type Loop = (Vec<[f64; 2]>, String);
+
+/// The outer boundary and the islands.
+pub(super) type Nested = (Vec<[f64; 2]>, Vec<Vec<[f64; 2]>>);
+
 pub(super) struct Piece {
     pub(super) points: Vec<[f64; 2]>,
     pub(super) label: String,
@@ -94,8 +100,9 @@ fn nurbs_point(degree: usize, control: &[[f64; 2]], knots: &[f64], weights: &[f6
             let i = span - degree + j;
             let denominator = knots[i + degree + 1 - r] - knots[i];
             let alpha = if denominator == 0.0 { 0.0 } else { (u - knots[i]) / denominator };
-            for c in 0..3 {
-                d[j][c] = (1.0 - alpha) * d[j - 1][c] + alpha * d[j][c];
+            let before = d[j - 1];
+            for (value, previous) in d[j].iter_mut().zip(before) {
+                *value = (1.0 - alpha) * previous + alpha * *value;
             }
         }
     }
@@ -154,11 +161,7 @@ fn format_point(p: [f64; 2]) -> String {
 ///
 /// # Errors
 /// An open chain: the end with no other end within the tolerance, and the nearest other end.
-pub(super) fn join(
-    pieces: Vec<Piece>,
-    tolerance: f64,
-    field: &str,
-) -> Result<Vec<(Vec<[f64; 2]>, String)>, SolverError> {
+pub(super) fn join(pieces: Vec<Piece>, tolerance: f64, field: &str) -> Result<Vec<Loop>, SolverError> {
     let cell = tolerance.max(1e-9);
     let key = |p: [f64; 2]| ((p[0] / cell).floor() as i64, (p[1] / cell).floor() as i64);
     // Every piece end by cell: (piece, whether it is the piece's last point).
@@ -216,9 +219,9 @@ pub(super) fn join(
                     });
                 let gap = nearest.map_or(String::new(), |p| {
                     format!(
-                        "; the nearest end is {} at {} mm (join_tolerance {tolerance} mm)",
+                        "; the nearest end is {} at {:.4} mm (join_tolerance {tolerance} mm)",
                         format_point(p),
-                        format!("{:.4}", (p[0] - end[0]).hypot(p[1] - end[1]))
+                        (p[0] - end[0]).hypot(p[1] - end[1])
                     )
                 });
                 return Err(SolverError::input(
@@ -330,10 +333,7 @@ fn inside(p: [f64; 2], polygon: &[[f64; 2]]) -> bool {
 ///
 /// # Errors
 /// A loop outside the boundary: the drawing holds more than one part.
-pub(super) fn nest(
-    loops: Vec<(Vec<[f64; 2]>, String)>,
-    field: &str,
-) -> Result<(Vec<[f64; 2]>, Vec<Vec<[f64; 2]>>), SolverError> {
+pub(super) fn nest(loops: Vec<Loop>, field: &str) -> Result<Nested, SolverError> {
     let Some(outer) = (0..loops.len()).max_by(|&a, &b| area(&loops[a].0).abs().total_cmp(&area(&loops[b].0).abs()))
     else {
         return Err(SolverError::input(field, "the drawing has no closed loop"));

@@ -243,7 +243,13 @@ fn entities(groups: &[Group], field: &str) -> Result<(Vec<Entity>, Vec<String>),
         if out.len() >= MAX_ENTITIES {
             return Err(SolverError::input(field, format!("the drawing has more than {MAX_ENTITIES} entities")));
         }
-        out.push(Entity { kind: kind.clone(), handle: value(5).unwrap_or_default(), layer, groups: body, vertices: Vec::new() });
+        out.push(Entity {
+            kind: kind.clone(),
+            handle: value(5).unwrap_or_default(),
+            layer,
+            groups: body,
+            vertices: Vec::new(),
+        });
     }
     layers.sort();
     Ok((out, layers))
@@ -262,9 +268,9 @@ impl Entity {
     fn number(&self, code: i32, default: Option<f64>, field: &str) -> Result<f64, SolverError> {
         match self.numbers(code).next() {
             Some(text) => parse(text, code, &self.label(), field),
-            None => default.ok_or_else(|| {
-                SolverError::input(field, format!("{} has no group code {code}", self.label()))
-            }),
+            None => {
+                default.ok_or_else(|| SolverError::input(field, format!("{} has no group code {code}", self.label())))
+            }
         }
     }
 
@@ -286,7 +292,7 @@ impl Entity {
             "CIRCLE" | "ARC" => {
                 let centre = point(self.number(10, None, field)?, self.number(20, None, field)?);
                 let radius = self.number(40, None, field)? * scale;
-                if !(radius > 0.0) {
+                if radius.is_nan() || radius <= 0.0 {
                     return Err(SolverError::input(field, format!("{label}: radius {radius} is not positive")));
                 }
                 if self.kind == "CIRCLE" {
@@ -311,8 +317,11 @@ impl Entity {
                 let ratio = self.number(40, None, field)?;
                 let start = self.number(41, Some(0.0), field)?;
                 let end = self.number(42, Some(std::f64::consts::TAU), field)?;
-                if !(ratio > 0.0 && ratio <= 1.0) || major[0].hypot(major[1]) == 0.0 {
-                    return Err(SolverError::input(field, format!("{label}: ratio {ratio} or its major axis is not valid")));
+                if ratio.is_nan() || ratio <= 0.0 || ratio > 1.0 || major[0].hypot(major[1]) == 0.0 {
+                    return Err(SolverError::input(
+                        field,
+                        format!("{label}: ratio {ratio} or its major axis is not valid"),
+                    ));
                 }
                 let mut sweep = (end - start).rem_euclid(std::f64::consts::TAU);
                 let full = sweep < 1e-12 || (sweep - std::f64::consts::TAU).abs() < 1e-12;
@@ -359,7 +368,9 @@ impl Entity {
                     let get = |code: i32, default: Option<f64>| -> Result<f64, SolverError> {
                         match vertex.iter().find(|g| g.code == code) {
                             Some(g) => parse(&g.value, code, &label, field),
-                            None => default.ok_or_else(|| SolverError::input(field, format!("{label}: a VERTEX has no group code {code}"))),
+                            None => default.ok_or_else(|| {
+                                SolverError::input(field, format!("{label}: a VERTEX has no group code {code}"))
+                            }),
                         }
                     };
                     vertices.push((point(get(10, None)?, get(20, None)?), mirror * get(42, Some(0.0))?));
@@ -386,11 +397,15 @@ impl Entity {
         if !(1..=11).contains(&degree) || knots.len() != control.len() + degree + 1 || xs.len() != ys.len() {
             return Err(SolverError::input(
                 field,
-                format!("{label}: degree {degree}, {} knots and {} control points do not fit", knots.len(), control.len()),
+                format!(
+                    "{label}: degree {degree}, {} knots and {} control points do not fit",
+                    knots.len(),
+                    control.len()
+                ),
             ));
         }
         let weights = if weights.len() == control.len() { weights } else { vec![1.0; control.len()] };
-        if weights.iter().any(|w| !(*w > 0.0)) || knots.windows(2).any(|k| k[1] < k[0]) {
+        if weights.iter().any(|w| w.is_nan() || *w <= 0.0) || knots.windows(2).any(|k| k[1] < k[0]) {
             return Err(SolverError::input(field, format!("{label}: a weight is not positive or the knots fall")));
         }
         let mut points = flatten_spline(degree, &control, &knots, &weights, tolerance);

@@ -284,9 +284,8 @@ pub fn resegment(
         control.check()?;
         control.report(done, runs.len());
         let run = &moves[range.clone()];
-        let (curve, feed, first) = match run_curve(run, request.corner_angle_deg) {
-            Some(found) => found,
-            None => continue,
+        let Some((curve, feed, first)) = run_curve(run, request.corner_angle_deg) else {
+            continue;
         };
         let decimals = shapes[range.clone()].iter().map(|s| s.decimals).max().unwrap_or(0);
         let rounding = ROUNDING_FLOOR_UNITS * 10f64.powi(-(decimals as i32)) * run[0].modal.units.scale();
@@ -504,7 +503,8 @@ fn run_curve(run: &[ReadMove], corner_angle_deg: Option<f64>) -> Option<(Curve, 
                 end_deg = start_deg + 360.0;
             }
             let direction = if clockwise { Direction::Cw } else { Direction::Ccw };
-            let curve = Curve::Arc { centre: vec![centre[0], centre[1], start[2]], radius, start_deg, end_deg, direction };
+            let curve =
+                Curve::Arc { centre: vec![centre[0], centre[1], start[2]], radius, start_deg, end_deg, direction };
             Some((curve, feed, start))
         }
         _ => {
@@ -670,7 +670,8 @@ mod tests {
 
     /// A 0.01 mm-step circle of radius 100 at 6000 mm/min between a rapid and a retract.
     fn dense_circle() -> String {
-        let mut text = String::from("%\nO1000 (DENSE)\nG21 G17 G90\nT1 M06\nS6000 M03\nM08\nG00 X100. Y0. Z5.\nG01 Z-1. F300\n");
+        let mut text =
+            String::from("%\nO1000 (DENSE)\nG21 G17 G90\nT1 M06\nS6000 M03\nM08\nG00 X100. Y0. Z5.\nG01 Z-1. F300\n");
         let steps = (std::f64::consts::TAU * 100.0 / 0.01).round() as usize;
         for k in 1..=steps {
             let angle = std::f64::consts::TAU * k as f64 / steps as f64;

@@ -79,7 +79,8 @@ async fn bad_drawings_are_refused_naming_the_entity() {
         assert_eq!(answer["errors"][0]["path"], field, "{name}{query}: {answer}");
         assert!(answer.to_string().contains(words), "{name}{query}: {answer}");
     }
-    let response = app.client.post(app.url("/api/v1/dxf")).body("0\nSECTION\n2\nENTITIES\n0\nLINE\n").send().await.unwrap();
+    let response =
+        app.client.post(app.url("/api/v1/dxf")).body("0\nSECTION\n2\nENTITIES\n0\nLINE\n").send().await.unwrap();
     let answer = problem(response, 422).await;
     assert_eq!(answer["errors"][0]["path"], "units", "{answer}");
     let response = app.client.post(app.url("/api/v1/dxf?units=mm")).body("hello").send().await.unwrap();

@@ -35,7 +35,8 @@ fn to_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
     let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let ap = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
     let length = ab.iter().map(|v| v * v).sum::<f64>();
-    let t = if length > 0.0 { (ab.iter().zip(&ap).map(|(x, y)| x * y).sum::<f64>() / length).clamp(0.0, 1.0) } else { 0.0 };
+    let t =
+        if length > 0.0 { (ab.iter().zip(&ap).map(|(x, y)| x * y).sum::<f64>() / length).clamp(0.0, 1.0) } else { 0.0 };
     distance(p, &[a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2]])
 }
 
@@ -108,7 +109,8 @@ async fn a_program_is_resegmented_as_a_job() {
         source.push_str(&format!("G01 X{x:.3} Y{:.3}{feed}\n", (x / 5.0).sin() * 3.0));
     }
     source.push_str("G00 Z10\nM30\n");
-    let job = json!({"name": "resegment", "operations": [{"operation": "resegment", "program": source, "block_time_ms": 2}]});
+    let job =
+        json!({"name": "resegment", "operations": [{"operation": "resegment", "program": source, "block_time_ms": 2}]});
     let created = json_with(app.post_json("/api/v1/jobs", &job).await, 202).await;
     let id = created["id"].as_i64().unwrap();
     let done = poll_job(&app.client, &app.url(""), id, 120, finished).await;
@@ -136,7 +138,9 @@ async fn bad_programs_are_refused_naming_the_field_and_line() {
         assert_eq!(answer["errors"][0]["path"], field, "{answer}");
         assert!(answer.to_string().contains(words), "{answer}");
     }
-    let answer = problem(app.post_json("/api/v1/resegment", &json!({"program": "G01 X1", "machine": "nowhere"})).await, 404).await;
+    let answer =
+        problem(app.post_json("/api/v1/resegment", &json!({"program": "G01 X1", "machine": "nowhere"})).await, 404)
+            .await;
     assert_eq!(answer["errors"][0]["path"], "machine", "{answer}");
     let answer = problem(app.post_json("/api/v1/resegment", &json!({"program": 5})).await, 400).await;
     assert!(answer.to_string().contains("program"), "{answer}");
