@@ -89,3 +89,16 @@ async fn bad_drawings_are_refused_naming_the_entity() {
     let answer = problem(upload(&app, "plate_mm.dxf", "?units=yards").await, 400).await;
     assert!(answer.to_string().contains("units"), "{answer}");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
+async fn the_page_draws_a_drawing_before_computing() {
+    let app = TestApp::spawn().await;
+    let plate = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("dxf/plate_mm.dxf");
+    let Some(result) = crate::browser::run_scenario(&app, "dxf", &[plate.to_str().unwrap()]) else { return };
+    assert_eq!(result["ok"], true);
+    assert_eq!(result["loops"], 3, "{result}");
+}
