@@ -171,7 +171,7 @@ pub(super) fn join(pieces: Vec<Piece>, tolerance: f64, field: &str) -> Result<Ve
         ends.entry(key(piece.points[piece.points.len() - 1])).or_default().push((index, true));
     }
     let mut used = vec![false; pieces.len()];
-    let nearest_free = |p: [f64; 2], used: &[bool]| -> Option<(usize, bool)> {
+    let nearest_free = |p: [f64; 2], used: &[bool]| -> Option<(usize, bool, f64)> {
         let (cx, cy) = key(p);
         let mut best: Option<(f64, usize, bool)> = None;
         for x in cx - 1..=cx + 1 {
@@ -189,7 +189,7 @@ pub(super) fn join(pieces: Vec<Piece>, tolerance: f64, field: &str) -> Result<Ve
                 }
             }
         }
-        best.map(|(_, index, is_last)| (index, is_last))
+        best.map(|(gap, index, is_last)| (index, is_last, gap))
     };
     let mut loops = Vec::new();
     for first in 0..pieces.len() {
@@ -200,11 +200,15 @@ pub(super) fn join(pieces: Vec<Piece>, tolerance: f64, field: &str) -> Result<Ve
         let mut points = pieces[first].points.clone();
         loop {
             let end = points[points.len() - 1];
-            if points.len() > 2 && (end[0] - points[0][0]).hypot(end[1] - points[0][1]) <= tolerance {
+            let next = nearest_free(end, &used);
+            // The chain closes at its start unless a free piece goes on nearer (pieces shorter
+            // than the tolerance would otherwise close the loop one piece early).
+            let closing = (end[0] - points[0][0]).hypot(end[1] - points[0][1]);
+            if points.len() > 2 && closing <= tolerance && next.is_none_or(|(_, _, gap)| closing <= gap) {
                 points.pop();
                 break;
             }
-            let Some((next, reversed)) = nearest_free(end, &used) else {
+            let Some((next, reversed, _)) = next else {
                 let nearest = pieces
                     .iter()
                     .enumerate()

@@ -99,3 +99,28 @@ fn lines_round_trip_to_the_typed_polygon() {
     rotated.rotate_left(start);
     assert_eq!(rotated, typed);
 }
+
+#[test]
+fn lines_shorter_than_the_join_tolerance_close_only_at_the_start() {
+    // A 1000-gon of 0.0063 mm lines in a stride order, every other one reversed: with a join
+    // tolerance of 0.01 mm the chain could close one line early.
+    let count = 1000;
+    let point = |k: usize| {
+        let angle = std::f64::consts::TAU * (k % count) as f64 / count as f64;
+        [angle.cos(), angle.sin()]
+    };
+    let mut text = String::from("0\nSECTION\n2\nENTITIES\n");
+    for index in 0..count {
+        let k = (index * 7) % count;
+        let (mut a, mut b) = (point(k), point(k + 1));
+        if index % 2 == 1 {
+            std::mem::swap(&mut a, &mut b);
+        }
+        text.push_str(&format!("0\nLINE\n8\nA\n10\n{}\n20\n{}\n11\n{}\n21\n{}\n", a[0], a[1], b[0], b[1]));
+    }
+    text.push_str("0\nENDSEC\n0\nEOF\n");
+    let options = DxfOptions { units: Some(DrawingUnits::Mm), ..DxfOptions::default() };
+    let profile = read(text.as_bytes(), "file", &options).unwrap();
+    assert_eq!(profile.boundary.len(), count);
+    assert!(profile.islands.is_empty());
+}
