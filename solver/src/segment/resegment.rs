@@ -178,7 +178,8 @@ impl Capability for ResegmentCapability {
             as arcs) in mode `guarantee` for the machine's block time, and returns the block figures before \
             and after and the largest deviation (JSON), or with `Accept: text/x-gcode` / `?format=gcode` the \
             program with every other line (rapids, tool changes, spindle, coolant, comments) byte for byte as \
-            sent.",
+            sent. The program keeps its own dialect and programmed point: `dialect`, `reference` and `arcs` \
+            do not apply.",
         not_found: "Unknown machine",
         refused: "Impossible request: `E_INPUT` (no block time, bad factors), `E_GCODE_SYNTAX`, \
             `E_GCODE_UNSUPPORTED`, `E_ARC_NOT_CLOSED`, `E_ARC_RADIUS`, `E_TOO_MANY_LINES` (each naming \
