@@ -701,6 +701,17 @@ mod tests {
     }
 
     #[test]
+    fn a_cancelled_run_stops_reading_cutting_and_writing() {
+        let source = dense_circle();
+        let cancel = std::sync::atomic::AtomicBool::new(true);
+        let control = Control { progress: None, cancel: Some(&cancel) };
+        let error = resegment(&request(source.clone()), None, control).unwrap_err();
+        assert_eq!(error.code(), ErrorCode::Cancelled);
+        let answer = resegment(&request(source.clone()), None, Control::default()).unwrap();
+        assert_eq!(write(&source, &answer.cuts, control).unwrap_err().code(), ErrorCode::Cancelled);
+    }
+
+    #[test]
     fn lines_with_more_than_motion_stay() {
         let shape = line_shape("G01 X1 Y2 F300");
         assert!(shape.pure && shape.motion_word && shape.feed == Some((10, 14)));
