@@ -19,6 +19,10 @@ async function send(method, path, body, accept, headers = {}) {
   if (token()) options.headers.authorization = `Bearer ${token()}`;
   if (body instanceof FormData) {
     options.body = body;
+  } else if (body instanceof Blob) {
+    // A file sent as it is (a DXF drawing).
+    options.headers['content-type'] = body.type || 'application/octet-stream';
+    options.body = body;
   } else if (body !== undefined) {
     options.headers['content-type'] = 'application/json';
     options.body = JSON.stringify(body);
@@ -41,7 +45,8 @@ async function failure(response) {
 }
 
 // Calls the API; resolves to the parsed JSON, the text of a text answer (G-code) or a Blob of any
-// other (a zip); rejects with the problem document. A FormData body is sent as multipart/form-data.
+// other (a zip); rejects with the problem document. A FormData body is sent as multipart/form-data,
+// a Blob (a file) as its bytes.
 export async function api(method, path, body, accept = 'application/json') {
   const response = await send(method, path, body, accept);
   if (response.status === 204) return null;

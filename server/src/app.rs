@@ -62,6 +62,7 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
         .merge(http::tools::router())
         .merge(http::endpoints::router())
         .merge(http::contour::router())
+        .merge(http::dxf::router())
         .merge(http::jobs::router())
         .merge(http::machines::router())
         .merge(http::materials::router())

@@ -34,6 +34,8 @@ macro_rules! with_registry {
                 "`POST /api/v1/deburr`.";
             Segment => segment::{SegmentCapability, SegmentRequest, SegmentAnswer}, json(OutputQuery),
                 "`POST /api/v1/segment`.";
+            Resegment => segment::{ResegmentCapability, ResegmentRequest, ResegmentAnswer}, json(OutputQuery),
+                "`POST /api/v1/resegment`: a G-code program's feed moves cut again by the block-time rule.";
             Contour => contour::{ContourCapability, ContourRequest, ContourAnswer}, json(OutputQuery),
                 "`POST /api/v1/contour`.";
             Engagement => engagement::{EngagementCapability, EngagementRequest, EngagementAnswer}, json(CandidateQuery),

@@ -15,6 +15,7 @@ pub mod capability;
 pub mod contour;
 pub mod control;
 pub mod deburr;
+pub mod dxf;
 pub mod engagement;
 pub mod error;
 mod error_code;

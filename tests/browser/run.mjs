@@ -1018,6 +1018,38 @@ const scenarios = {
     return { label, points: byDiameter.answer.result?.points?.length ?? byDiameter.answer.points?.length, note: bad.note };
   },
 
+  // A DXF drawing (the job-file argument) into Contour and Segment: every layer at once is
+  // refused naming the open line and its field; layer CUT is drawn (boundary and two islands)
+  // before anything is computed and fills the points, which then compute.
+  async dxf() {
+    await page.goto(`${base}/#contour`);
+    await page.setInputFiles('#contour-form input[name="dxf_file"]', jobFile);
+    await page.waitForSelector('#contour-messages .message.error', { timeout: 60000 });
+    const refusal = await page.textContent('#contour-messages');
+    if (!/open chain/i.test(refusal) || !/NOTES/.test(refusal)) throw new Error(`refusal: ${refusal}`);
+    const highlighted = await page.$$eval('.invalid', (list) => list.map((e) => e.name));
+    if (!highlighted.includes('dxf_file')) throw new Error(`file not highlighted: ${highlighted}`);
+    await page.fill('#contour-form input[name="dxf_layer"]', 'CUT');
+    await page.dispatchEvent('#contour-form input[name="dxf_layer"]', 'change');
+    await page.waitForSelector('#contour-form [data-dxf-preview] polygon[data-loop="island 2"]', { timeout: 60000 });
+    const loops = await page.$$eval('#contour-form [data-dxf-preview] polygon', (list) => list.length);
+    const points = (await page.inputValue('#contour-form textarea[name="points"]')).split('\n').length;
+    if (loops !== 3 || points < 100) throw new Error(`drawn ${loops} loops, ${points} points`);
+    await page.click('#contour-compute');
+    await page.waitForSelector('#contour-result:not(.stale) #contour-plot[data-state="drawn"]', { timeout: 60000 });
+
+    await page.click('#tabs a[data-view="segment"]');
+    await page.selectOption('#segment-form select[name="kind"]', 'polyline');
+    await page.fill('#segment-form input[name="dxf_layer"]', 'CUT');
+    await page.setInputFiles('#segment-form input[name="dxf_file"]', jobFile);
+    await page.waitForSelector('#segment-form [data-dxf-preview] polygon[data-loop="island 1"]', { timeout: 60000 });
+    await page.selectOption('#segment-form select[name="dxf_loop"]', '1');
+    const circle = (await page.inputValue('#segment-form textarea[name="points"]')).split('\n');
+    if (circle[0] !== circle[circle.length - 1] || circle.length < 50) throw new Error(`island polyline: ${circle.length} points`);
+    await page.screenshot({ path: screenshot });
+    return { loops, points, island: circle.length };
+  },
+
   // Segment's default is the guarantee mode: no short blocks; every piece of advice names a
   // control the form has (and a choice it offers).
   async segmentDefault() {

@@ -4,6 +4,7 @@
 // double-click to fit), the corner table with the material left or over-cut, the summary, the
 // warnings and the G-code download. `contourResult` also renders job results.
 import { Timeline } from '/timeline.js';
+import { DXF_FIELDS, dxfUpload } from '/dxf.js';
 import { ContourPlan } from '/plot/plan.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
 import { answerAndProgram, downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, programName, refusalMessage, showSummary, submitFlow, value, warningMessages } from '/form.js';
@@ -28,6 +29,7 @@ const FORM = `
     <fieldset><legend>Contour</legend>
       <label class="stacked">Points <span class="hint">x, y a line; # comments</span>
         <textarea name="points" rows="9" spellcheck="false" data-field="contour"></textarea></label>
+${DXF_FIELDS}
       <label>Side <select name="side" data-field="side">
         <option value="outside">outside (island, outer profile)</option><option value="inside">inside (pocket)</option></select></label>
       <label>Cutting direction <select name="direction" data-field="direction"><option value="climb">climb</option><option value="conventional">conventional</option></select></label>
@@ -391,6 +393,13 @@ export const contourView = {
     loadMachines(form.elements.machine);
     machineFields(form, { block_time_ms: 'block_time_ms' });
     sync();
+    // A drawing's loop fills the points box, 4 decimals a coordinate.
+    dxfUpload(form, {
+      messages,
+      fill: (points) => {
+        form.elements.points.value = points.map((p) => `${p[0].toFixed(4)}, ${p[1].toFixed(4)}`).join('\n');
+      },
+    });
     // The request, or a problem at the points box for a line that is not "x, y".
     const request = () => {
       try {

@@ -1,6 +1,7 @@
 // Segment view: cut a curve into G01 blocks by the control's block time (docs/spec/api.md, Segment;
 // docs/spec/segment.md). A form for the curve and the rule, the curve with its blocks, the chord error and the
 // block length along the curve, the rule side by side with a fixed tolerance, G-code download.
+import { DXF_FIELDS, dxfUpload } from '/dxf.js';
 import { Timeline } from '/timeline.js';
 import { answerAndProgram, downloadFlow, keepForm, loadMachines, machineFields, machineNote, message, number, numeric, programName, refusalMessage, showSummary, submitFlow, value, warningMessages } from '/form.js';
 import { drawChart } from '/plot/charts.js';
@@ -25,6 +26,7 @@ const FORM = `
       <label data-kinds="ellipse">Rotation, ° <input name="rotation_deg" type="number" step="any" value="0" data-field="curve.rotation_deg"></label>
       <label data-kinds="circle arc ellipse">Direction <select name="direction" data-field="curve.direction"><option value="ccw">ccw</option><option value="cw">cw</option></select></label>
       <label data-kinds="polyline">Points (x y [z] per line) <textarea name="points" rows="6" data-field="curve.points"></textarea></label>
+      <div data-kinds="polyline">${DXF_FIELDS}</div>
       <label data-kinds="bspline">Degree (no unit) <input name="degree" type="number" min="1" max="5" value="3" data-field="curve.degree"></label>
       <label data-kinds="bspline">Control points (x y [z] per line) <textarea name="control_points" rows="6" data-field="curve.control_points">0 0
 40 0
@@ -339,6 +341,13 @@ export const segmentView = {
     }).join('\n');
     form.addEventListener('change', () => syncVisibility(form));
     syncVisibility(form);
+    // A drawing's loop becomes the polyline, closed: back to its first point.
+    dxfUpload(form, {
+      messages,
+      fill: (points) => {
+        form.elements.points.value = [...points, points[0]].map((p) => `${p[0].toFixed(4)} ${p[1].toFixed(4)}`).join('\n');
+      },
+    });
     loadMachines(form.elements.machine, 'none (values below)');
     machineFields(form, { feed: 'max_feed', block_time_ms: 'block_time_ms', margin: 'margin', min_chord_error: 'min_chord_error' });
     // The request, or a problem at the points box for a line that is not a point.

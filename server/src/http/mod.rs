@@ -3,6 +3,7 @@
 //! a piece at a time.
 
 pub mod contour;
+pub mod dxf;
 pub mod endpoints;
 pub mod health;
 pub mod jobs;

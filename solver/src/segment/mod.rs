@@ -82,6 +82,7 @@ mod radius;
 mod reference;
 mod report;
 pub mod request;
+pub mod resegment;
 mod search;
 mod shape;
 
@@ -91,6 +92,7 @@ pub use nurbs::{MAX_CONTROL_POINTS, MAX_DEGREE};
 pub(crate) use program::cycle_time;
 pub use program::program;
 pub use request::{Curve, CurveRule, Direction, RadiusEstimate, SegmentRequest};
+pub use resegment::{ResegmentAnswer, ResegmentCapability, ResegmentRequest};
 
 use crate::capability::Control;
 use crate::error::ErrorCode;

@@ -39,7 +39,7 @@ async fn capability_views_follow_the_registry() {
     let text = module.text().await.unwrap();
     let list = text.split("export const CAPABILITIES = ").nth(1).expect("the export").trim().trim_end_matches(';');
     let names: Vec<String> = serde_json::from_str(list).expect("a JSON list of names");
-    assert_eq!(names, ["deburr", "segment", "contour", "engagement", "predict"]);
+    assert_eq!(names, ["deburr", "segment", "resegment", "contour", "engagement", "predict"]);
 
     let document: serde_json::Value = app.get("/api/v1/openapi.json").await.json().await.unwrap();
     for name in &names {
