@@ -37,7 +37,8 @@ pub(crate) fn to_json(mut answer: SegmentAnswer) -> serde_json::Result<Vec<u8>> 
         return serde_json::to_vec(&answer);
     };
     let coordinates: usize = points.iter().map(CommandPoint::dimension).sum();
-    let size = rest.len() + WINDOW_TEXT_BYTES * windows.len() + NUMBER_BYTES * (coordinates + s.len()) + 2 * points.len();
+    let size =
+        rest.len() + WINDOW_TEXT_BYTES * windows.len() + NUMBER_BYTES * (coordinates + s.len()) + 2 * points.len();
     let mut out = Vec::with_capacity(size);
     out.extend_from_slice(&rest[..mark]);
     out.extend_from_slice(b"\"windows\":");
@@ -170,7 +171,12 @@ mod tests {
     fn assert_as_serde(answer: &SegmentAnswer) {
         let serde = serde_json::to_vec(answer).unwrap();
         let ours = to_json(answer.clone()).unwrap();
-        assert!(ours == serde, "differs:\nours  {}\nserde {}", String::from_utf8_lossy(&ours), String::from_utf8_lossy(&serde));
+        assert!(
+            ours == serde,
+            "differs:\nours  {}\nserde {}",
+            String::from_utf8_lossy(&ours),
+            String::from_utf8_lossy(&serde)
+        );
     }
 
     #[test]
@@ -193,7 +199,8 @@ mod tests {
             }
         }
         // With a machine (cycle time) and a tool whose name holds the marker's text.
-        let machine = json!({"name": "m1", "block_time_ms": 2, "max_feed": 12000, "max_accel": 2000, "rapid_feed": 20000});
+        let machine =
+            json!({"name": "m1", "block_time_ms": 2, "max_feed": 12000, "max_accel": 2000, "rapid_feed": 20000});
         let tool = json!({"kind": "flat", "radius": 3, "name": "\"windows\":[],\"points\":[],\"s\":[]"});
         let request = json!({"curve": {"kind": "circle", "centre": [0, 0], "radius": 5}, "feed": 3000,
             "machine": "m1", "tool": tool});
@@ -228,7 +235,7 @@ mod tests {
                 .map(|_| SegmentWindow {
                     s_start: random.float(),
                     s_end: random.float(),
-                    radius: (random.next() % 3 > 0).then(|| random.float()),
+                    radius: (!random.next().is_multiple_of(3)).then(|| random.float()),
                     chord_error: random.float(),
                     rule_chord_error: random.float(),
                     status: statuses[(random.next() % 4) as usize],
