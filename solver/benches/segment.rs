@@ -14,8 +14,7 @@
 //! task-clock`, instructions under callgrind); `KERF_BENCH_DUMP=dir` writes each kept
 //! configuration's answer JSON to `dir/<name>.json` (to `cmp` two builds).
 //!
-//! `KERF_BENCH_SPANS=n` instead times, n rounds each (the least of them printed, CPU of this
-//! thread), where a request of `tests/load/peers.py` spends its time: reading its JSON, solving
+//! `KERF_BENCH_SPANS=n` instead times, n rounds each (the least wall time printed), where a request of `tests/load/peers.py` spends its time: reading its JSON, solving
 //! it, writing the answer's JSON (the endpoint's writer and serde's), for the B-spline of 5 000
 //! poles at 0.001 mm and the ellipse 30 000 × 15 000 at 1e-5 mm (about 100 000 points each).
 
@@ -118,26 +117,16 @@ fn peers_request(curve: Value, tolerance: f64) -> Vec<u8> {
     .expect("request")
 }
 
-/// CPU time of the calling thread, s.
-fn thread_cpu() -> f64 {
-    let stat = std::fs::read_to_string("/proc/thread-self/stat").unwrap_or_default();
-    let fields: Vec<&str> = stat.rsplit(')').next().unwrap_or_default().split_whitespace().collect();
-    let ticks: f64 = fields.get(11..13).map_or(0.0, |t| t.iter().filter_map(|v| v.parse::<f64>().ok()).sum());
-    ticks / 100.0
-}
-
-/// The least time of `rounds` calls of `work`, s: wall time, checked against the thread's CPU
-/// time over all rounds (a loaded machine shows as wall well above CPU).
-fn least(rounds: usize, mut work: impl FnMut()) -> (f64, f64) {
-    let cpu = thread_cpu();
-    let least = (0..rounds)
+/// The least wall time of `rounds` calls of `work`, s (on a loaded machine the least of many
+/// rounds is the one that ran alone).
+fn least(rounds: usize, mut work: impl FnMut()) -> f64 {
+    (0..rounds)
         .map(|_| {
             let started = std::time::Instant::now();
             work();
             started.elapsed().as_secs_f64()
         })
-        .fold(f64::INFINITY, f64::min);
-    (least, (thread_cpu() - cpu) / rounds as f64)
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Where the peers' segment requests spend their time (`KERF_BENCH_SPANS`).
@@ -154,23 +143,22 @@ fn spans(rounds: usize) {
         let request: SegmentRequest = serde_json::from_slice(&body).expect("request");
         let answer = SegmentCapability::solve(&request, context(), &Run::default()).expect("solve");
         let json = SegmentCapability::to_json(answer.clone()).expect("json");
-        let (parse, _) = least(rounds, || drop(std::hint::black_box(serde_json::from_slice::<SegmentRequest>(&body))));
-        let (solve, solve_cpu) = least(rounds, || {
+        let parse = least(rounds, || drop(std::hint::black_box(serde_json::from_slice::<SegmentRequest>(&body))));
+        let solve = least(rounds, || {
             drop(std::hint::black_box(SegmentCapability::solve(&request, context(), &Run::default())))
         });
-        let (clone, _) = least(rounds, || drop(std::hint::black_box(answer.clone())));
-        let (writer, _) =
+        let clone = least(rounds, || drop(std::hint::black_box(answer.clone())));
+        let writer =
             least(rounds, || drop(std::hint::black_box(SegmentCapability::to_json(answer.clone()).map(|j| j.len()))));
-        let (serde, _) = least(rounds, || drop(std::hint::black_box(serde_json::to_vec(&answer).map(|j| j.len()))));
+        let serde = least(rounds, || drop(std::hint::black_box(serde_json::to_vec(&answer).map(|j| j.len()))));
         let ms = |seconds: f64| seconds * 1e3;
         println!(
-            "{name}: {} points, {} bytes of JSON; least of {rounds}: parse {:.2} ms, solve {:.2} ms \
-             (CPU {:.2} ms), JSON {:.2} ms by the endpoint's writer, {:.2} ms by serde",
+            "{name}: {} points, {} bytes of JSON; least of {rounds}: parse {:.2} ms, solve {:.2} ms, \
+             JSON {:.2} ms by the endpoint's writer, {:.2} ms by serde",
             answer.result.points.len(),
             json.len(),
             ms(parse),
             ms(solve),
-            ms(solve_cpu),
             ms(writer - clone),
             ms(serde),
         );
