@@ -461,7 +461,7 @@ def main():
                     gcode_cpu, _ = kerf.timed(path + "?format=gcode", body, repeats[name])
                     if round_ == 0:
                         print(f"{name}: {describe(name, answer, peer, result)}; JSON {len(answer)} bytes; "
-                              f"{repeats[name]} requests and calls per measurement", flush=True)
+                              f"{repeats[name]} requests and {peer_repeats[name]} calls per measurement", flush=True)
                         continue
                     figures[name]["kerf"].append(cpu)
                     figures[name]["peer"].append(peer_cpu)
