@@ -13,9 +13,14 @@
 //! kept configuration n more times instead of benchmarking it (CPU time under `perf stat -e
 //! task-clock`, instructions under callgrind); `KERF_BENCH_DUMP=dir` writes each kept
 //! configuration's answer JSON to `dir/<name>.json` (to `cmp` two builds).
+//!
+//! `KERF_BENCH_SPANS=n` instead times, n rounds each (the least wall time printed), where a request of `tests/load/peers.py` spends its time: reading its JSON, solving
+//! it, writing the answer's JSON (the endpoint's writer and serde's), for the B-spline of 5 000
+//! poles at 0.001 mm and the ellipse 30 000 × 15 000 at 1e-5 mm (about 100 000 points each).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use kerf_solver::segment::{self, SegmentRequest};
+use kerf_solver::capability::{Capability, Resolved, Run};
+use kerf_solver::segment::{self, SegmentCapability, SegmentRequest};
 use serde_json::{Value, json};
 
 /// A cubic B-spline through an Archimedean spiral (pitch 12 mm, radius 50 to 520 mm) with a
@@ -92,7 +97,79 @@ fn run(
     group.bench_function(name, |b| b.iter(|| segment::solve(std::hint::black_box(request), None)));
 }
 
+/// The B-spline of `tests/load/peers.py`: 5 000 poles 20 mm apart along a spiral from radius
+/// 10 mm, 2 mm pitch, a 0.5 mm wave in z.
+fn peers_spiral() -> Value {
+    let mut control = Vec::new();
+    let mut angle: f64 = 0.0;
+    for _ in 0..5000 {
+        let radius = 10.0 + 2.0 * angle / std::f64::consts::TAU;
+        control.push([radius * angle.cos(), radius * angle.sin(), 0.5 * (3.0 * angle).sin()]);
+        angle += 20.0 / radius;
+    }
+    json!({"kind": "bspline", "degree": 3, "control_points": control})
+}
+
+/// A request of `tests/load/peers.py`: the curve cut at the fixed chord error `tolerance`.
+fn peers_request(curve: Value, tolerance: f64) -> Vec<u8> {
+    serde_json::to_vec(&json!({"curve": curve, "mode": "curve", "feed": 1000, "block_time_ms": 1,
+        "min_chord_error": tolerance, "tolerance": tolerance}))
+    .expect("request")
+}
+
+/// The least wall time of `rounds` calls of `work`, s (on a loaded machine the least of many
+/// rounds is the one that ran alone).
+fn least(rounds: usize, mut work: impl FnMut()) -> f64 {
+    (0..rounds)
+        .map(|_| {
+            let started = std::time::Instant::now();
+            work();
+            started.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Where the peers' segment requests spend their time (`KERF_BENCH_SPANS`).
+fn spans(rounds: usize) {
+    let cases = [
+        ("bspline 5000 poles, 0.001 mm", peers_request(peers_spiral(), 0.001)),
+        (
+            "ellipse 30000 x 15000, 1e-5 mm",
+            peers_request(json!({"kind": "ellipse", "centre": [0, 0], "semi_axes": [30000, 15000]}), 1e-5),
+        ),
+    ];
+    let context = || Resolved { tool: None, machine: None, material: None, other_tools: Vec::new() };
+    for (name, body) in cases {
+        let request: SegmentRequest = serde_json::from_slice(&body).expect("request");
+        let answer = SegmentCapability::solve(&request, context(), &Run::default()).expect("solve");
+        let json = SegmentCapability::to_json(answer.clone()).expect("json");
+        let parse = least(rounds, || drop(std::hint::black_box(serde_json::from_slice::<SegmentRequest>(&body))));
+        let solve = least(rounds, || {
+            drop(std::hint::black_box(SegmentCapability::solve(&request, context(), &Run::default())))
+        });
+        let clone = least(rounds, || drop(std::hint::black_box(answer.clone())));
+        let writer =
+            least(rounds, || drop(std::hint::black_box(SegmentCapability::to_json(answer.clone()).map(|j| j.len()))));
+        let serde = least(rounds, || drop(std::hint::black_box(serde_json::to_vec(&answer).map(|j| j.len()))));
+        let ms = |seconds: f64| seconds * 1e3;
+        println!(
+            "{name}: {} points, {} bytes of JSON; least of {rounds}: parse {:.2} ms, solve {:.2} ms, \
+             JSON {:.2} ms by the endpoint's writer, {:.2} ms by serde",
+            answer.result.points.len(),
+            json.len(),
+            ms(parse),
+            ms(solve),
+            ms(writer - clone),
+            ms(serde),
+        );
+    }
+}
+
 fn bench(c: &mut Criterion) {
+    if let Some(rounds) = std::env::var("KERF_BENCH_SPANS").ok().and_then(|n| n.parse::<usize>().ok()) {
+        spans(rounds.max(1));
+        return;
+    }
     let mut group = c.benchmark_group("segment");
     group.sample_size(10);
     let curves = [("bspline", spiral()), ("ellipse", ellipse()), ("polyline", polyline())];

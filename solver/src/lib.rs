@@ -30,5 +30,6 @@ pub mod segment;
 pub mod tool;
 pub mod validate;
 pub mod verify;
+pub(crate) mod wire;
 
 pub use error::{ErrorCode, SolverError, Warning};

@@ -8,6 +8,7 @@
 
 use super::answer::{ContourLayer, ContourMove, MoveKind};
 use super::capability::ContourAnswer;
+use crate::wire::float;
 
 /// What `serde_json` writes for the answer whose layers were taken out.
 const EMPTY_LAYERS: &[u8] = b"\"layers\":[]";
@@ -28,8 +29,7 @@ pub(crate) fn to_json(mut answer: ContourAnswer) -> serde_json::Result<Vec<u8>> 
     let rest = serde_json::to_vec(&answer)?;
     // The key is written once, and no string can hold the unescaped quotes of the marker; a key
     // `layers` elsewhere (none today) leaves the answer to serde.
-    let mut marks = rest.windows(EMPTY_LAYERS.len()).enumerate().filter(|(_, w)| *w == EMPTY_LAYERS).map(|(i, _)| i);
-    let (Some(mark), None) = (marks.next(), marks.next()) else {
+    let [mark] = crate::wire::marks(&rest, EMPTY_LAYERS)[..] else {
         answer.result.layers = layers;
         return serde_json::to_vec(&answer);
     };
@@ -164,16 +164,6 @@ fn triple(out: &mut Vec<u8>, values: &[f64; 3]) {
     out.push(b',');
     float(out, values[2]);
     out.push(b']');
-}
-
-/// Writes a float as `serde_json` does: the shortest text that reads back the same, `null` when
-/// not finite.
-fn float(out: &mut Vec<u8>, value: f64) {
-    if value.is_finite() {
-        out.extend_from_slice(zmij::Buffer::new().format_finite(value).as_bytes());
-    } else {
-        out.extend_from_slice(b"null");
-    }
 }
 
 #[cfg(test)]

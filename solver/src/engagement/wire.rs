@@ -11,6 +11,7 @@
 use super::answer::{ArcDetail, EngagementSample, EngagementSolution, PathEngagement, SampleFlag};
 use super::arcs::MillingMode;
 use super::capability::EngagementAnswer;
+use crate::wire::float;
 
 /// What `serde_json` writes for a candidate whose samples were taken out.
 const EMPTY_SAMPLES: &[u8] = b"\"samples\":[]";
@@ -31,7 +32,7 @@ pub fn to_json(mut answer: EngagementAnswer) -> serde_json::Result<Vec<u8>> {
     // Each candidate's `samples` key is written once, in candidate order, and no string can hold
     // the unescaped quotes of the marker; anything else (a key `samples` in a map the request
     // gave) is left to serde.
-    let marks: Vec<usize> = marker_positions(&rest);
+    let marks: Vec<usize> = crate::wire::marks(&rest, EMPTY_SAMPLES);
     if marks.len() != taken.len() {
         for (candidate, samples) in candidates_mut(&mut answer.result).zip(taken.drain(..)) {
             candidate.samples = samples;
@@ -60,10 +61,6 @@ fn candidates_mut(answer: &mut EngagementSolution) -> impl Iterator<Item = &mut 
     slice.iter_mut()
 }
 
-fn marker_positions(text: &[u8]) -> Vec<usize> {
-    text.windows(EMPTY_SAMPLES.len()).enumerate().filter(|(_, w)| *w == EMPTY_SAMPLES).map(|(i, _)| i).collect()
-}
-
 pub(super) fn estimate(sample: &EngagementSample) -> usize {
     let items = sample.arcs.len() * 3
         + sample.thickness.len()
@@ -86,16 +83,6 @@ pub(crate) fn write_samples(out: &mut Vec<u8>, samples: &[EngagementSample]) {
         write_sample(out, sample);
     }
     out.push(b']');
-}
-
-/// Writes a float as `serde_json` does: the shortest text that reads back the same, `null` when
-/// not finite.
-fn float(out: &mut Vec<u8>, value: f64) {
-    if value.is_finite() {
-        out.extend_from_slice(zmij::Buffer::new().format_finite(value).as_bytes());
-    } else {
-        out.extend_from_slice(b"null");
-    }
 }
 
 fn key(out: &mut Vec<u8>, name: &[u8]) {

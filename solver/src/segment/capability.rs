@@ -103,6 +103,11 @@ impl Capability for SegmentCapability {
     fn machine(answer: &SegmentAnswer) -> Option<&MachineProfile> {
         answer.machine.as_ref()
     }
+
+    /// Serde's text, the command points written by hand (`wire`).
+    fn to_json(answer: SegmentAnswer) -> serde_json::Result<Vec<u8>> {
+        super::wire::to_json(answer)
+    }
 }
 
 #[cfg(test)]

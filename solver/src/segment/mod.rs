@@ -15,7 +15,8 @@
 //! * `cut`: greedy chords, the window procedure with carry-over and progress rule, the
 //!   single-value run (§2.9); `search`: the fast chord search (§2.9a; `polyline` for polylines), `reference`: the §2.9
 //!   numerics it is tested against ([`solve_reference`]); `guarantee`: mode `guarantee` (§2.9a);
-//! * [`stats`]: block figures of any polyline ([`block_stats`]); `report`: warnings (§4);
+//! * [`stats`]: block figures of any polyline ([`block_stats`]); `report`: warnings (§4); `wire`:
+//!   the answer's JSON, written as serde writes it but faster;
 //! * [`machine`]: controller profiles; [`mod@program`]: G-code.
 //!
 //! # Calling it
@@ -85,6 +86,7 @@ pub mod request;
 pub mod resegment;
 mod search;
 mod shape;
+mod wire;
 
 pub use answer::{CommandPoint, Comparison, SegmentSolution, SegmentWindow, WindowStatus};
 pub use capability::{SegmentAnswer, SegmentCapability};
