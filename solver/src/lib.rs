@@ -31,5 +31,7 @@ pub mod tool;
 pub mod validate;
 pub mod verify;
 pub(crate) mod wire;
+#[cfg(test)]
+mod writer_as_before;
 
 pub use error::{ErrorCode, SolverError, Warning};

@@ -16,7 +16,7 @@ mod klartext;
 pub mod number;
 pub mod reader;
 #[cfg(test)]
-mod reference;
+pub(crate) mod reference;
 pub mod table;
 
 use std::fmt::Write as _;
