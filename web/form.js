@@ -456,6 +456,9 @@ export function gcodeQuery(form) {
   return `?format=gcode${dialect ? `&dialect=${dialect}` : ''}${reference}`;
 }
 
+// The posts kerf writes (docs/guide/gcode.md), as the options of a dialect <select>.
+export const POST_OPTIONS = '<option value="fanuc">Fanuc (also Mazak, Okuma ISO)</option><option value="haas">Haas</option><option value="linuxcnc">LinuxCNC</option><option value="sinumerik">Siemens Sinumerik 840D</option><option value="heidenhain">Heidenhain Klartext</option><option value="heidenhain_iso">Heidenhain ISO</option><option value="grbl">grbl</option>';
+
 // The download name of a program: `kind-dialect.nc`, or the machine's name for its dialect.
 export function programName(kind, form) {
   return `${kind}-${form.elements.dialect.value || form.elements.machine?.value || 'fanuc'}.nc`;

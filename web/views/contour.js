@@ -7,7 +7,7 @@ import { Timeline } from '/timeline.js';
 import { DXF_FIELDS, dxfUpload } from '/dxf.js';
 import { ContourPlan } from '/plot/plan.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
-import { answerAndProgram, downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, programName, refusalMessage, showSummary, submitFlow, value, warningMessages } from '/form.js';
+import { answerAndProgram, downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, POST_OPTIONS, programName, refusalMessage, showSummary, submitFlow, value, warningMessages } from '/form.js';
 
 // An arrow-shaped island: five protruding corners (a 64° tip among them) and two inside corners.
 const SAMPLE = `# x, y in mm, counter-clockwise; one point a line
@@ -57,7 +57,7 @@ ${DXF_FIELDS}
     </fieldset>
     <div class="actions">
       <button class="primary" type="submit" id="contour-compute">Compute</button>
-      <select name="dialect" aria-label="G-code dialect"><option value="">machine's dialect (else Fanuc)</option><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select>
+      <select name="dialect" aria-label="G-code dialect"><option value="">machine's dialect (else Fanuc)</option>${POST_OPTIONS}</select>
       <select name="reference" aria-label="Programmed point"><option value="tip">tip</option><option value="centre">centre</option></select>
       <button class="secondary" type="button" id="contour-gcode">G-code</button>
     </div>

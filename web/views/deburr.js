@@ -2,7 +2,7 @@
 // where the tool would meet the wall, the summary, warnings and the G-code download (docs/spec/api.md,
 // Deburr).
 import { api, program as programOf, sentence } from '/api.js';
-import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, programName, showSummary, submitFlow, value, warningMessages } from '/form.js';
+import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, POST_OPTIONS, programName, showSummary, submitFlow, value, warningMessages } from '/form.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
 import { clearance, inRadii } from '/views/deburr-clearance.js';
@@ -53,7 +53,7 @@ const FORM = `
     </fieldset>
     <div class="actions">
       <button class="primary" type="submit" id="deburr-compute">Compute</button>
-      <select name="dialect" aria-label="G-code dialect"><option value="">machine's dialect (else Fanuc)</option><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select>
+      <select name="dialect" aria-label="G-code dialect"><option value="">machine's dialect (else Fanuc)</option>${POST_OPTIONS}</select>
       <select name="reference" aria-label="Programmed point"><option value="tip">tip</option><option value="centre">ball centre</option></select>
       <button class="secondary" type="button" id="deburr-gcode" aria-describedby="deburr-gcode-note">G-code</button>
       <output id="deburr-gcode-note" class="hint"></output>

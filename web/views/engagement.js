@@ -9,7 +9,7 @@
 import { api } from '/api.js';
 import { PathChart, barChart } from '/plot/charts.js';
 import { ToolPlan } from '/plot/tool-plan.js';
-import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, message, number, numeric, programName, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
+import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, message, number, numeric, POST_OPTIONS, programName, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
   { name: 'straight', text: '-10 20\n70 20' },
@@ -68,7 +68,7 @@ const FORM = `
     </fieldset>
     <div class="actions">
       <button class="primary" type="submit" id="engagement-compute">Compute</button>
-      <select name="dialect" aria-label="G-code dialect"><option value="">machine's dialect (else Fanuc)</option><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select>
+      <select name="dialect" aria-label="G-code dialect"><option value="">machine's dialect (else Fanuc)</option>${POST_OPTIONS}</select>
       <select name="reference" aria-label="Programmed point"><option value="tip">tip</option><option value="centre">centre</option></select>
       <select name="candidate" aria-label="Path to program" data-field="candidate"></select>
       <button class="secondary" type="button" id="engagement-gcode">G-code</button>

@@ -1,6 +1,6 @@
 // Machines view: the controller profiles (docs/spec/api.md, Machines): list, register or replace, delete,
 // and the block time from a saturation test (docs/spec/segment.md §2.1, Eq. 1).
-import { parseDecimal } from '/form.js';
+import { POST_OPTIONS, parseDecimal } from '/form.js';
 import { registryView } from '/views/registry.js';
 
 const FORM = `
@@ -11,7 +11,7 @@ const FORM = `
       <label>Name <input name="name" type="text" value="hsc-4ms" data-field="name"></label>
       <label>Block time, ms <input name="block_time_ms" type="number" step="any" value="4" data-field="block_time_ms"></label>
       <label>Max feed, mm/min <input name="max_feed" type="number" step="any" value="10000" data-field="max_feed"></label>
-      <label>Dialect <select name="dialect" data-field="dialect"><option value="fanuc">Fanuc (also Mazak, Okuma ISO)</option><option value="haas">Haas</option><option value="linuxcnc">LinuxCNC</option><option value="sinumerik">Siemens Sinumerik 840D</option><option value="heidenhain">Heidenhain Klartext</option><option value="heidenhain_iso">Heidenhain ISO</option><option value="grbl">grbl</option></select></label>
+      <label>Dialect <select name="dialect" data-field="dialect">${POST_OPTIONS}</select></label>
       <label><span>Block margin (no unit) <abbr class="symbol" title="k_f in docs/spec/segment.md">k_f</abbr></span> <input name="margin" type="number" step="any" placeholder="1" data-field="margin"></label>
       <label>Min chord error, mm <input name="min_chord_error" type="number" step="any" placeholder="0" data-field="min_chord_error"></label>
       <label>Description <input name="description" type="text" placeholder="control, mode, date" data-field="description"></label>

@@ -3,7 +3,7 @@
 // block length along the curve, the rule side by side with a fixed tolerance, G-code download.
 import { DXF_FIELDS, dxfUpload } from '/dxf.js';
 import { Timeline } from '/timeline.js';
-import { answerAndProgram, downloadFlow, keepForm, loadMachines, machineFields, machineNote, message, number, numeric, programName, refusalMessage, showSummary, submitFlow, value, warningMessages } from '/form.js';
+import { answerAndProgram, downloadFlow, keepForm, loadMachines, machineFields, machineNote, message, number, numeric, POST_OPTIONS, programName, refusalMessage, showSummary, submitFlow, value, warningMessages } from '/form.js';
 import { drawChart } from '/plot/charts.js';
 import { CurvePlan } from '/plot/plan.js';
 
@@ -52,7 +52,7 @@ const FORM = `
     </fieldset>
     <div class="actions">
       <button class="primary" type="submit" id="segment-compute">Compute</button>
-      <select name="dialect" aria-label="G-code dialect"><option value="">machine's dialect</option><option value="fanuc">Fanuc</option><option value="linuxcnc">LinuxCNC</option></select>
+      <select name="dialect" aria-label="G-code dialect"><option value="">machine's dialect</option>${POST_OPTIONS}</select>
       <button class="secondary" type="button" id="segment-gcode">G-code</button>
     </div>
     <p class="hint">With a machine chosen, its values show greyed in the empty fields and are used; type a value to override it.</p>
