@@ -161,6 +161,7 @@ pub fn shape_for_generators(document: &mut utoipa::openapi::OpenApi) {
         type_job_results(schemas, &answer_schemas());
         open_problem_code(schemas);
         limit_tool_numbers(schemas);
+        limit_point_lengths(schemas);
     }
     *document = serde_json::from_value(json).expect("the reshaped OpenAPI document reads back");
 }
@@ -402,6 +403,34 @@ fn limit_tool_numbers(schemas: &mut Map<String, Value>) {
         if member.get("type").and_then(Value::as_str) == Some("integer") {
             member["minimum"] = json!(kerf_solver::tool::TOOL_NUMBERS.start());
             member["maximum"] = json!(kerf_solver::tool::TOOL_NUMBERS.end());
+        }
+    }
+}
+
+/// The point lists of the requests, as (schema, JSON pointer to the list in it, fewest and most
+/// coordinates of a point): the server reads these points as `[x, y]` or `[x, y, z]` arrays of
+/// that length, which utoipa cannot say of a list's items.
+const POINT_LISTS: [(&str, &str, u64, u64); 9] = [
+    ("ContourRequest", "/properties/contour", 2, 2),
+    ("LoopsRequest", "/properties/path", 2, 2),
+    ("StockPolygon", "/properties/outer", 2, 2),
+    ("StockPolygon", "/properties/holes/items", 2, 2),
+    ("EngagementStock", "/properties/holes/items", 2, 2),
+    ("EngagementPath", "/oneOf/0", 2, 2),
+    ("PathInputPoints", "/properties/points", 3, 3),
+    ("CurvePolyline", "/properties/points", 2, 3),
+    ("CurveBspline", "/properties/control_points", 2, 3),
+];
+
+/// Gives the points of the requests' point lists their number of coordinates ([`POINT_LISTS`]);
+/// a list the document no longer has is left out (the snapshot test shows it).
+fn limit_point_lengths(schemas: &mut Map<String, Value>) {
+    for (schema, list, fewest, most) in POINT_LISTS {
+        let point =
+            schemas.get_mut(schema).and_then(|schema| schema.pointer_mut(list)).and_then(|list| list.get_mut("items"));
+        if let Some(point) = point.filter(|point| point.get("type").and_then(Value::as_str) == Some("array")) {
+            point["minItems"] = json!(fewest);
+            point["maxItems"] = json!(most);
         }
     }
 }

@@ -146,6 +146,21 @@ fn generators_read_the_document_as_meant() {
             assert!(resolve(part)["oneOf"].is_null(), "{name} is an allOf over a oneOf");
         }
     }
+    // Points inside the requests' point lists have their number of coordinates.
+    for (schema, list, fewest, most) in [
+        ("ContourRequest", "/properties/contour", 2, 2),
+        ("StockPolygon", "/properties/holes/items", 2, 2),
+        ("EngagementPath", "/oneOf/0", 2, 2),
+        ("PathInputPoints", "/properties/points", 3, 3),
+        ("CurvePolyline", "/properties/points", 2, 3),
+    ] {
+        let point = &schemas[schema].pointer(list).unwrap_or_else(|| panic!("{schema}{list}"))["items"];
+        assert_eq!(
+            (point["minItems"].as_u64(), point["maxItems"].as_u64()),
+            (Some(fewest), Some(most)),
+            "{schema}{list}: {point}"
+        );
+    }
     for (tag, reference) in schemas["JobResult"]["discriminator"]["mapping"].as_object().unwrap() {
         let member = resolve(&serde_json::json!({ "$ref": reference }));
         assert!(member["properties"]["result"]["$ref"].is_string(), "JobResult {tag}: {member}");
