@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use axum::Router;
 use axum::body::Body;
 use axum::extract::{DefaultBodyLimit, MatchedPath, Request};
-use axum::http::{HeaderName, HeaderValue, Method, Response, StatusCode, header};
+use axum::http::{Extensions, HeaderMap, HeaderName, HeaderValue, Method, Response, StatusCode, Version, header};
 use axum::middleware::Next;
 use axum::response::IntoResponse;
 use tower_http::catch_panic::CatchPanicLayer;
@@ -113,12 +113,18 @@ pub fn router_for(state: AppState, cors_origins: &[String]) -> Router {
 pub const COMPRESS_ABOVE_BYTES: u64 = 1024;
 
 /// gzip for answers of [`COMPRESS_ABOVE_BYTES`] or more (streamed ones too, whose size is not
-/// known) when `Accept-Encoding` allows it; not for zip archives, which are compressed already.
+/// known) when `Accept-Encoding` allows it; not for zip archives, which are compressed already,
+/// nor for an answer with a strong `ETag` (a stored tool, machine or material): the tag names the
+/// bytes sent, and a gzipped body under the same strong tag would be another representation
+/// with the tag a client sends back in `If-Match`.
 fn compression() -> CompressionLayer<impl Predicate> {
+    let without_entity_tag =
+        |_: StatusCode, _: Version, headers: &HeaderMap, _: &Extensions| !headers.contains_key(header::ETAG);
     CompressionLayer::new().compress_when(
         DefaultPredicate::new()
             .and(SizeAbove::new(COMPRESS_ABOVE_BYTES))
-            .and(NotForContentType::const_new("application/zip")),
+            .and(NotForContentType::const_new("application/zip"))
+            .and(without_entity_tag),
     )
 }
 

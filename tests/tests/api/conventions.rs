@@ -123,6 +123,17 @@ async fn answers_above_a_kibibyte_are_gzipped_when_the_client_accepts_it() {
     let small = app.client.get(app.url("/healthz")).header("accept-encoding", "gzip").send().await.unwrap();
     assert!(small.headers().get("content-encoding").is_none(), "{small:?}");
     json_with(small, 200).await;
+    // A stored item is sent with its strong ETag as it is, never gzipped under that tag.
+    // 500 characters, the most a description may have, of two bytes each: over the size.
+    let description = "ü".repeat(500);
+    let material = json!({"kc11": 1700, "mc": 0.25, "description": description});
+    let put = app.client.put(app.url("/api/v1/materials/long")).json(&material).send().await.unwrap();
+    assert!(put.status().is_success(), "{put:?}");
+    let stored =
+        app.client.get(app.url("/api/v1/materials/long")).header("accept-encoding", "gzip").send().await.unwrap();
+    assert!(stored.headers().get("etag").is_some(), "{stored:?}");
+    assert!(stored.headers().get("content-encoding").is_none(), "{stored:?}");
+    assert!(stored.bytes().await.unwrap().len() as u64 > kerf_server::app::COMPRESS_ABOVE_BYTES);
     // A problem above the size is gzipped too, and still reads as one.
     let mut body = segment.clone();
     body["padding"] = json!("x".repeat(4000));
