@@ -18,6 +18,11 @@ use crate::error::{AppResult, Problem};
 use crate::extract::{AppQuery, charged_body_bytes};
 use crate::state::AppState;
 
+/// A DXF file as the request body (for the OpenAPI document): its bytes as they are.
+#[derive(Debug, utoipa::ToSchema)]
+#[schema(value_type = String, format = Binary)]
+pub struct DxfFile(pub Vec<u8>);
+
 /// How to read the drawing.
 #[derive(Debug, Clone, Default, Deserialize, IntoParams)]
 #[serde(deny_unknown_fields)]
@@ -37,9 +42,9 @@ pub struct DxfQuery {
 /// Reads a DXF drawing's profile: the outer boundary (counter-clockwise) and the islands inside
 /// it (clockwise), in mm, from LWPOLYLINE/POLYLINE (bulges), LINE/ARC chains, CIRCLE, ELLIPSE and
 /// SPLINE entities.
-#[utoipa::path(post, path = "/api/v1/dxf", tag = "dxf",
+#[utoipa::path(post, path = "/api/v1/dxf", tag = "dxf", operation_id = "read_dxf",
     params(DxfQuery),
-    request_body(description = "The DXF file (ASCII or binary, R12 to 2018).", content = Vec<u8>, content_type = "application/dxf"),
+    request_body(description = "The DXF file (ASCII or binary, R12 to 2018), sent as it is under any media type; documented as `application/octet-stream`, the raw-bytes type client generators know.", content = DxfFile, content_type = "application/octet-stream"),
     responses(
         (status = 200, description = "The profile", body = Profile),
         (status = 400, body = Problem, content_type = "application/problem+json"),
