@@ -493,6 +493,6 @@ mod tests {
             let error = serde_json::from_value::<Operation>(json).unwrap_err().to_string();
             assert!(!error.contains("unknown variant"), "{name}: {error}");
         }
-        assert_eq!(NAMES, ["deburr", "segment", "contour", "engagement", "predict"]);
+        assert_eq!(NAMES, ["deburr", "segment", "resegment", "contour", "engagement", "predict"]);
     }
 }
