@@ -174,9 +174,10 @@ pub struct ServeArgs {
     /// Largest accepted body of upload routes (`POST /api/v1/predict`: STL stock, long programs), bytes.
     #[arg(long, env = "KERF_MAX_UPLOAD_BYTES", default_value_t = Limits::default().max_upload_bytes)]
     pub max_upload_bytes: usize,
-    /// Longest synchronous solver call, seconds, before the client is told to submit a job.
-    #[arg(long, env = "KERF_SOLVER_TIME_LIMIT_S", default_value_t = Limits::default().solver_time_limit.as_secs())]
-    pub solver_time_limit_s: u64,
+    /// Longest synchronous solver call, seconds (a fraction allowed, 0.01 to 86 400), before the
+    /// client is told to submit a job.
+    #[arg(long, env = "KERF_SOLVER_TIME_LIMIT_S", default_value_t = Limits::default().solver_time_limit.as_secs_f64(), value_parser = time_limit_seconds)]
+    pub solver_time_limit_s: f64,
     /// MiB of solver answers kept to answer the same question (request, stored tool, machine
     /// and material values, output options) again without solving; 0 keeps none.
     #[arg(long, env = "KERF_ANSWER_CACHE_MB", default_value_t = u64::try_from(Limits::default().answer_cache_bytes).unwrap_or(u64::MAX) / MIB)]
@@ -218,6 +219,12 @@ pub struct ServeArgs {
     pub storage: JobStorageArgs,
 }
 
+/// Reads `--solver-time-limit-s`: seconds from 0.01 to 86 400 (a day), a fraction allowed.
+fn time_limit_seconds(text: &str) -> Result<f64, String> {
+    let seconds: f64 = text.trim().parse().map_err(|_| format!("{text:?} is not a number of seconds"))?;
+    if (0.01..=86_400.0).contains(&seconds) { Ok(seconds) } else { Err(format!("{text} s is outside 0.01 to 86400 s")) }
+}
+
 /// Reads one `--cors-origin`: `*`, or `scheme://host[:port]` with nothing after (an origin as a
 /// browser sends it in `Origin`).
 fn cors_origin(text: &str) -> Result<String, String> {
@@ -244,7 +251,7 @@ impl ServeArgs {
             limits: Limits {
                 max_body_bytes: self.max_body_bytes,
                 max_upload_bytes: self.max_upload_bytes,
-                solver_time_limit: Duration::from_secs(self.solver_time_limit_s.max(1)),
+                solver_time_limit: Duration::from_secs_f64(self.solver_time_limit_s),
                 answer_cache_bytes: usize::try_from(self.answer_cache_mb.saturating_mul(MIB)).unwrap_or(usize::MAX),
                 answer_budget_bytes: usize::try_from(self.answer_budget_mb.max(1).saturating_mul(MIB))
                     .unwrap_or(usize::MAX),

@@ -8,11 +8,17 @@ use kerf_cases::contour::circle;
 use kerf_tests::{ServerProcess, problem};
 use serde_json::{Value, json};
 
-/// A contour of `layers` layers of a 600-point circle: 600 moves and more per layer, so its
-/// program takes seconds to write (over the JSON answer's move limit: G-code only).
-fn long_contour(layers: usize) -> Value {
-    json!({"tool": {"kind": "ball", "radius": 3}, "contour": circle(600), "side": "outside",
-           "depths": {"top": 0, "bottom": -(layers as f64) * 0.025, "step": 0.025}, "feed": 800})
+/// A contour of `layers` layers of a `points`-point circle: that many moves and more per layer, so
+/// its program takes seconds to write (over the JSON answer's move limit: G-code only). Upright
+/// walls share one plan across the layers (a fast solve); tilted ones (`tilt_deg`) are planned
+/// layer by layer (a long solve).
+fn long_contour(layers: usize, points: usize, tilt_deg: Option<f64>) -> Value {
+    let mut body = json!({"tool": {"kind": "ball", "radius": 3}, "contour": circle(points), "side": "outside",
+           "depths": {"top": 0, "bottom": -(layers as f64) * 0.025, "step": 0.025}, "feed": 800});
+    if let Some(tilt) = tilt_deg {
+        body["tilt_deg"] = json!(tilt);
+    }
+    body
 }
 
 /// CPU time process `id` has used (user and system), from `/proc/{id}/stat`.
@@ -34,7 +40,7 @@ fn solve_seconds(response: &reqwest::Response) -> f64 {
 
 /// The real program serving a new database in `folder` with a time limit of `limit_s` seconds
 /// and no answer cache (a process of its own, so its CPU time is its work alone).
-async fn server(folder: &std::path::Path, limit_s: u64) -> ServerProcess {
+async fn server(folder: &std::path::Path, limit_s: f64) -> ServerProcess {
     let program = std::path::PathBuf::from(env!("CARGO_BIN_EXE_kerf-under-test"));
     let database = folder.join(format!("kerf-{limit_s}.db"));
     let limit = limit_s.to_string();
@@ -57,9 +63,10 @@ async fn server(folder: &std::path::Path, limit_s: u64) -> ServerProcess {
 async fn a_program_timed_out_while_being_written_stops_at_once() {
     let folder = tempfile::tempdir().unwrap();
     let client = reqwest::Client::new();
-    let body = long_contour(6000);
+    // The most moves a contour may have (6 000 000), on upright walls: a short solve, a long write.
+    let body = long_contour(10_000, 590, None);
     // How long the solve and the writing take here, with no limit.
-    let generous = server(folder.path(), 600).await;
+    let generous = server(folder.path(), 600.0).await;
     let started = Instant::now();
     let url = format!("{}/api/v1/contour?format=gcode", generous.base);
     let response = client.post(&url).json(&body).send().await.unwrap();
@@ -69,17 +76,17 @@ async fn a_program_timed_out_while_being_written_stops_at_once() {
     let total = started.elapsed().as_secs_f64();
     generous.terminate();
 
-    // A limit (whole seconds) after the solve and at least 0.7 s before the writing ends: the
-    // request is told to submit a job while its program is being written.
-    let limit = (solve + 0.3).ceil();
-    assert!(limit + 0.7 < total, "solve {solve:.2} s, solve and writing {total:.2} s: use more layers");
-    let server = server(folder.path(), limit as u64).await;
+    // A limit 0.1 s after the solve and at least 0.4 s before the writing ends: the request is
+    // told to submit a job while its program is being written.
+    let limit = solve + 0.1;
+    assert!(limit + 0.4 < total, "solve {solve:.2} s, solve and writing {total:.2} s: use more layers");
+    let server = server(folder.path(), limit).await;
     let url = format!("{}/api/v1/contour?format=gcode", server.base);
     let answer = problem(client.post(&url).json(&body).send().await.unwrap(), 422).await;
     assert_eq!(answer["code"], "E_TIMEOUT", "{answer}");
     tokio::time::sleep(Duration::from_millis(100)).await;
     let (before, at) = (process_cpu(server.id()), Instant::now());
-    tokio::time::sleep(Duration::from_millis(500)).await;
+    tokio::time::sleep(Duration::from_millis(300)).await;
     let (used, over) = (process_cpu(server.id()).saturating_sub(before), at.elapsed());
     // An idle service uses next to nothing; the abandoned writing would use a whole core.
     assert!(
@@ -97,10 +104,13 @@ fn ended(id: u32) -> bool {
 #[tokio::test(flavor = "multi_thread")]
 async fn sigterm_ends_the_program_while_a_long_request_is_solved() {
     let folder = tempfile::tempdir().unwrap();
-    let server = server(folder.path(), 600).await;
-    // Far more work than the test waits for: minutes in the solver and the writer.
-    let (client, url, body) =
-        (reqwest::Client::new(), format!("{}/api/v1/contour?format=gcode", server.base), long_contour(9000));
+    let server = server(folder.path(), 600.0).await;
+    // Far more work than the test waits for: seconds in the solver, layer by layer, and the writer.
+    let (client, url, body) = (
+        reqwest::Client::new(),
+        format!("{}/api/v1/contour?format=gcode", server.base),
+        long_contour(9000, 600, Some(1.0)),
+    );
     let request = tokio::spawn(async move { client.post(url).json(&body).send().await });
     tokio::time::sleep(Duration::from_millis(1500)).await;
     assert!(!request.is_finished(), "the request is still being solved");
