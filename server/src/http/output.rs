@@ -74,7 +74,8 @@ pub struct CandidateQuery {
 #[serde(deny_unknown_fields)]
 #[into_params(parameter_in = Query)]
 pub struct ProgramQuery {
-    /// G-code dialect: `fanuc` (default: the named machine's, else `fanuc`) or `linuxcnc`.
+    /// G-code dialect (the post): `fanuc`, `haas`, `linuxcnc`, `sinumerik`, `heidenhain`, `heidenhain_iso` or `grbl`
+    /// (default: the named machine's, else `fanuc`).
     pub dialect: Option<Dialect>,
     /// Programmed point: `tip` (default; length offset to the tool tip) or `centre`.
     pub reference: Option<Reference>,
@@ -90,7 +91,8 @@ pub struct ProgramQuery {
 #[serde(deny_unknown_fields)]
 #[into_params(parameter_in = Query)]
 pub struct CandidateProgramQuery {
-    /// G-code dialect: `fanuc` or `linuxcnc` (default: the named machine's, else `fanuc`).
+    /// G-code dialect (the post): `fanuc`, `haas`, `linuxcnc`, `sinumerik`, `heidenhain`, `heidenhain_iso` or `grbl`
+    /// (default: the named machine's, else `fanuc`).
     pub dialect: Option<Dialect>,
     /// Programmed point: `tip` (default; length offset to the tool tip) or `centre` (the centre
     /// of the tool's end rounding: the ball centre, the bull-nose corner centre, the tip for a

@@ -33,8 +33,9 @@ pub struct PredictQuery {
     /// `json` (default) or `gcode` (the corrected program); `Accept: text/x-gcode` also selects
     /// G-code.
     pub format: Option<Format>,
-    /// Dialect of the program written for a `points` path: `fanuc` (default) or `linuxcnc`. A
-    /// G-code path is written back in its own format.
+    /// Dialect (the post) of the program written for a `points` path: `fanuc` (default), `haas`,
+    /// `linuxcnc`, `sinumerik`, `heidenhain`, `heidenhain_iso` or `grbl`. A G-code path is
+    /// written back in its own format.
     pub dialect: Option<Dialect>,
     /// Programmed point of the corrected program: the request's `reference` by default. A
     /// `points` path is converted; a G-code path keeps its own (another value is refused).
@@ -130,8 +131,9 @@ pub struct PredictJsonQuery {
 #[serde(deny_unknown_fields)]
 #[into_params(parameter_in = Query)]
 pub struct PredictProgramQuery {
-    /// Dialect of the program written for a `points` path: `fanuc` (default) or `linuxcnc`. A
-    /// G-code path is written back in its own format.
+    /// Dialect (the post) of the program written for a `points` path: `fanuc` (default), `haas`,
+    /// `linuxcnc`, `sinumerik`, `heidenhain`, `heidenhain_iso` or `grbl`. A G-code path is
+    /// written back in its own format.
     pub dialect: Option<Dialect>,
     /// Programmed point of the corrected program: the request's `reference` by default. A
     /// `points` path is converted; a G-code path keeps its own (another value is refused).
