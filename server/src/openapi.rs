@@ -26,7 +26,13 @@ use utoipa::OpenApi;
         (name = "contour", description = "Layered contour milling with corner loops and inside-corner relief (docs/spec/contour.md)"),
         (name = "engagement", description = "Tool–workpiece engagement along a path, chip thickness per flute count and \
                                               the recommended flute counts (docs/spec/engagement.md)"),
-        (name = "predict", description = "Machining-error prediction and path correction for ball-end-mill finishing (docs/spec/predict.md)")
+        (name = "predict", description = "Machining-error prediction and path correction for ball-end-mill finishing (docs/spec/predict.md)"),
+        (name = "resegment", description = "A G-code program's runs of feed moves cut again by the block-time rule (docs/spec/resegment.md)"),
+        (name = "dxf", description = "Outlines and curves read from a DXF drawing (docs/spec/dxf.md)"),
+        (name = "verify", description = "A G-code program cut out of the stock by its tool assembly, with what it gouges, leaves \
+                                          or hits (docs/spec/verify.md)"),
+        (name = "jobs", description = "Long or many computations as stored jobs, run by the service or by `kerf worker` processes \
+                                        (docs/guide/jobs.md)")
     )
 )]
 pub struct ApiDoc;

@@ -72,6 +72,29 @@ fn every_response_has_a_description() {
     }
 }
 
+/// Every tag an operation carries is listed with a description, so documentation generators
+/// group and explain every operation.
+#[test]
+fn every_tag_is_described() {
+    let (_, document) = kerf_server::app::api();
+    let json = serde_json::to_value(&document).unwrap();
+    let described: Vec<&str> = json["tags"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|tag| tag["description"].as_str().is_some_and(|text| !text.is_empty()))
+        .map(|tag| tag["name"].as_str().unwrap())
+        .collect();
+    for (path, item) in json["paths"].as_object().unwrap() {
+        for (method, operation) in item.as_object().unwrap() {
+            for tag in operation["tags"].as_array().into_iter().flatten() {
+                let tag = tag.as_str().unwrap();
+                assert!(described.contains(&tag), "{method} {path}: tag {tag} has no description");
+            }
+        }
+    }
+}
+
 /// Every `$ref` names a schema the document defines.
 #[test]
 fn every_reference_is_defined() {
