@@ -1327,21 +1327,21 @@ hole = { shape = "round", diameter = 16 }
       return found;
     }, PIXELS);
     if (red < 500) throw new Error(`the gouge is not drawn red: ${red} red pixels`);
-    await page.click('#verify-findings tr[data-kind="gouge"]');
+    await page.click('#verify-findings tr[data-kind="gouge"][data-line="4"]');
     const marked3d = await page.getAttribute('#verify-stock', 'data-marked');
     if (marked3d !== 'gouge 4') throw new Error(`the gouge finding marked ${marked3d} in 3-D`);
     // Playback: the stock cut up to the plunge (line 3), then played to the end at 1000×.
-    const full = Number(stock.stockVertices);
+    const full = Number(stock.removedVolume);
     await page.$eval('#verify-position', (slider) => { slider.value = '1'; slider.dispatchEvent(new Event('input')); });
     await page.waitForSelector('#verify-stock[data-upto-line="3"]', { timeout: 60000 });
-    const plunged = Number(await page.getAttribute('#verify-stock', 'data-stock-vertices'));
-    if (plunged === full) throw new Error(`the stock cut up to line 3 has the whole program's ${full} vertices`);
+    const plunged = Number(await page.getAttribute('#verify-stock', 'data-removed-volume'));
+    if (!(plunged > 0 && plunged < full / 3)) throw new Error(`the stock cut up to line 3 lost ${plunged} mm³, the whole program ${full} mm³`);
     await page.selectOption('#verify-speed', '1000');
     await page.click('#verify-play');
     await page.waitForSelector('#verify-stock[data-upto-line="6"]', { timeout: 60000 });
-    const played = Number(await page.getAttribute('#verify-stock', 'data-stock-vertices'));
-    if (played !== full) throw new Error(`played to the end, the stock has ${played} vertices, not ${full}`);
-    return { findings: findings.length, marked: marked.length, red, vertices: full, plunged };
+    const played = Number(await page.getAttribute('#verify-stock', 'data-removed-volume'));
+    if (played !== full) throw new Error(`played to the end, the stock lost ${played} mm³, not ${full}`);
+    return { findings: findings.length, marked: marked.length, red, removed: full, plunged };
   },
 };
 

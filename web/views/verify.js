@@ -157,8 +157,8 @@ class CutStock {
   }
 
   async draw() {
-    const { geometry } = await askMesh(this.body);
-    if (geometry) this.show(geometry, undefined);
+    const { json, geometry } = await askMesh(this.body);
+    if (geometry) this.show(geometry, undefined, json);
     for (const [kind, colour] of Object.entries(FINDING_COLOURS)) {
       const points = this.findings.filter((f) => f.kind === kind).map((f) => f.position);
       this.scene.dots(`findings-${kind}`, points, { colour, size: 8, legend: `${kind.replaceAll('_', ' ')} (finding)` });
@@ -169,8 +169,9 @@ class CutStock {
     this.playback();
   }
 
-  // Shows the stock `geometry` as cut up to `line` (undefined: the whole program).
-  show(geometry, line) {
+  // Shows the stock `geometry` as cut up to `line` (undefined: the whole program); `json` is the
+  // GLB's glTF JSON, with the answer in `extras.verify`.
+  show(geometry, line, json) {
     const first = !this.scene.scene?.getObjectByName('stock');
     this.scene.coloured('stock', geometry, first ? { legend: 'cut stock: red gouge, blue material left, grey within tolerance', colour: 'linear-gradient(90deg, #d62728 33%, #b0b0b0 33% 66%, #1f77b4 66%)' } : {});
     const deviation = geometry.getAttribute('deviation');
@@ -180,6 +181,7 @@ class CutStock {
     view.stockVertices = String(geometry.getAttribute('position').count);
     view.deepestDeviation = deepest.toFixed(4);
     view.uptoLine = line === undefined ? 'end' : String(line);
+    view.removedVolume = String(json.extras?.verify?.removed_volume_mm3 ?? 0);
     this.scene.render();
   }
 
@@ -238,8 +240,8 @@ class CutStock {
       while (this.asked !== this.wanted && this.root.isConnected) {
         this.asked = this.wanted;
         const line = this.moves[this.asked].line + 1;
-        const { geometry } = await askMesh(this.body, line);
-        if (geometry) this.show(geometry, line);
+        const { json, geometry } = await askMesh(this.body, line);
+        if (geometry) this.show(geometry, line, json);
       }
     } catch (problem) {
       this.root.querySelector('#verify-playback-readout').textContent = `The stock cut up to that line cannot be drawn: ${problem.detail ?? problem.message ?? problem}`;
