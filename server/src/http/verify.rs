@@ -44,7 +44,7 @@ pub struct VerifyQuery {
     request_body = VerifyRequest,
     responses(
         (status = 200, description = "The findings, volumes and removal per block (JSON), or the cut stock as binary glTF coloured by deviation from the part",
-            content((VerifyAnswer = "application/json"), (Vec<u8> = "model/gltf-binary"))),
+            content((VerifyAnswer = "application/json"), (verify_mesh::GlbFile = "model/gltf-binary"))),
         (status = 400, body = Problem, content_type = "application/problem+json"),
         (status = 404, description = <VerifyCapability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
         (status = 408, description = "The body arrived slower than the minimum receive rate", body = Problem, content_type = "application/problem+json"),

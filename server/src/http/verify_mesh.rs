@@ -27,6 +27,11 @@ pub enum VerifyFormat {
     Glb,
 }
 
+/// A GLB file (for the OpenAPI document): the cut stock as binary glTF.
+#[derive(Debug, ToSchema)]
+#[schema(value_type = String, format = Binary)]
+pub struct GlbFile(pub Vec<u8>);
+
 /// Whether the client asks for the mesh: `format` if given, else the `Accept` header.
 pub fn wants_glb(headers: &HeaderMap, format: Option<VerifyFormat>) -> bool {
     match format {
