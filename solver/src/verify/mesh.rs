@@ -383,10 +383,10 @@ fn glb(mesh: &Mesh, extras: Value) -> Vec<u8> {
     }
     // Serialising a `Value` cannot fail.
     let mut text = serde_json::to_vec(&document).unwrap_or_default();
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let total = 12 + 8 + text.len() + if bin.is_empty() { 0 } else { 8 + bin.len() };
