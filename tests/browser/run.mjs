@@ -1298,7 +1298,8 @@ hole = { shape = "round", diameter = 16 }
   },
 
   // The Verify view cuts its sample program (a slot 0.1 mm too deep, then a rapid through the
-  // stock) and lists the findings at their lines; a finding marks its line in the listing.
+  // stock) and lists the findings at their lines; a finding marks its line in the listing and its
+  // position on the cut stock, drawn in 3-D with the gouge red; playback cuts up to a line.
   async verify() {
     await page.goto(`${base}/#/verify`);
     await page.click('#verify-run');
@@ -1314,7 +1315,33 @@ hole = { shape = "round", diameter = 16 }
     if (current.length !== 1 || !current[0].startsWith('G0 X60')) throw new Error(`the finding opened ${JSON.stringify(current)}`);
     const summary = await page.textContent('#verify-summary');
     if (!/findings/.test(summary)) throw new Error(`summary: ${summary}`);
-    return { findings: findings.length, marked: marked.length };
+    // The cut stock in 3-D from the GLB answer: the slot's floor 0.1 below the part is red.
+    await page.waitForSelector('#verify-stock[data-state="drawn"][data-stock-vertices]', { timeout: 60000 });
+    const stock = await page.$eval('#verify-stock', (e) => ({ ...e.dataset }));
+    if (!(Number(stock.deepestDeviation) < -0.09)) throw new Error(`no gouge in the stock's deviations: ${JSON.stringify(stock)}`);
+    await page.click('#verify-stock button:text("Top")');
+    const red = await page.$eval('#verify-stock canvas', (canvas, pixels) => {
+      const data = eval(pixels)(canvas);
+      let found = 0;
+      for (let i = 0; i < data.length; i += 4) if (data[i] > 150 && data[i] - data[i + 1] > 80 && data[i] - data[i + 2] > 80) found++;
+      return found;
+    }, PIXELS);
+    if (red < 500) throw new Error(`the gouge is not drawn red: ${red} red pixels`);
+    await page.click('#verify-findings tr[data-kind="gouge"][data-line="4"]');
+    const marked3d = await page.getAttribute('#verify-stock', 'data-marked');
+    if (marked3d !== 'gouge 4') throw new Error(`the gouge finding marked ${marked3d} in 3-D`);
+    // Playback: the stock cut up to the plunge (line 3), then played to the end at 1000×.
+    const full = Number(stock.removedVolume);
+    await page.$eval('#verify-position', (slider) => { slider.value = '1'; slider.dispatchEvent(new Event('input')); });
+    await page.waitForSelector('#verify-stock[data-upto-line="3"]', { timeout: 60000 });
+    const plunged = Number(await page.getAttribute('#verify-stock', 'data-removed-volume'));
+    if (!(plunged > 0 && plunged < full / 3)) throw new Error(`the stock cut up to line 3 lost ${plunged} mm³, the whole program ${full} mm³`);
+    await page.selectOption('#verify-speed', '1000');
+    await page.click('#verify-play');
+    await page.waitForSelector('#verify-stock[data-upto-line="6"]', { timeout: 60000 });
+    const played = Number(await page.getAttribute('#verify-stock', 'data-removed-volume'));
+    if (played !== full) throw new Error(`played to the end, the stock lost ${played} mm³, not ${full}`);
+    return { findings: findings.length, marked: marked.length, red, removed: full, plunged };
   },
 };
 

@@ -32,6 +32,12 @@ pub const EXTERNALS: &[External] = &[
         install: "apt-get install chromium npm; npm ci --prefix tests/browser",
         python_module: None,
     },
+    External {
+        name: "gltf_validator",
+        what: "node or the Khronos glTF validator",
+        install: "apt-get install npm; npm ci --prefix tests/gltf",
+        python_module: None,
+    },
     External { name: "postgres", what: "PostgreSQL", install: "apt-get install postgresql", python_module: None },
     External { name: "openssl", what: "openssl", install: "apt-get install openssl", python_module: None },
     External { name: "python3", what: "python3", install: "apt-get install python3", python_module: None },
@@ -166,6 +172,11 @@ pub fn browser_driver() -> bool {
     browser_driver_watched(&mut Watched::default()) && !withheld("chromium")
 }
 
+/// The folder with the glTF validator's `package.json` and its script (`tests/gltf`).
+pub fn gltf_folder() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("gltf")
+}
+
 /// The folder of the TypeScript clients' `package.json` (`clients/typescript`).
 pub fn typescript_clients_folder() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../clients/typescript")
@@ -277,6 +288,13 @@ pub fn probe(external: &External) -> (bool, Watched) {
             let node = on_path_watched("node", &mut watched).is_some();
             let chromium = on_path_watched("chromium", &mut watched).is_some();
             node & chromium & browser_driver_watched(&mut watched)
+        }
+        ("gltf_validator", None) => {
+            let node = on_path_watched("node", &mut watched).is_some();
+            let package = gltf_folder().join("node_modules/gltf-validator/package.json");
+            let found = package.is_file();
+            watched.add(if found { package } else { gltf_folder() });
+            node & found
         }
         ("postgres", None) => postgres_watched(&mut watched).is_ok(),
         ("openapi_python_client", None) => on_path_watched("openapi-python-client", &mut watched).is_some(),

@@ -1,5 +1,6 @@
-// The 3-D scene with three.js (vendored in /vendor/three, no CDN): solids see-through, paths, the
-// tool (ball, neck, shank) at a cursor, a mm grid and axes, view presets and zoom to fit.
+// The 3-D scene with three.js (vendored in /vendor/three, no CDN): solids see-through or coloured
+// per vertex (a GLB mesh), paths, the tool (ball, neck, shank) at a cursor, a mm grid and axes,
+// view presets and zoom to fit.
 import * as THREE from 'three';
 import { OrbitControls } from '/vendor/three/OrbitControls.js';
 
@@ -22,6 +23,37 @@ function webglAvailable() {
   } catch (error) {
     return false;
   }
+}
+
+// Reads a binary glTF (GLB) of one indexed triangle mesh as `POST /api/v1/verify?format=glb`
+// answers it (docs/spec/verify.md §8): the 12-byte header, the JSON chunk and the binary chunk.
+// Gives the glTF JSON and a BufferGeometry with `position`, `normal`, `color` (COLOR_0) and
+// `deviation` (_DEVIATION, when the request had a part); `geometry` is null for an empty mesh.
+export function readGlb(buffer) {
+  const view = new DataView(buffer);
+  if (buffer.byteLength < 20 || view.getUint32(0, true) !== 0x46546c67 || view.getUint32(4, true) !== 2) {
+    throw new Error('not a glTF 2.0 binary');
+  }
+  const jsonLength = view.getUint32(12, true);
+  const json = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 20, jsonLength)));
+  const primitive = json.meshes?.[0]?.primitives?.[0];
+  if (!primitive) return { json, geometry: null };
+  const binary = 20 + jsonLength + 8;
+  const attribute = (index) => {
+    const accessor = json.accessors[index];
+    const bufferView = json.bufferViews[accessor.bufferView];
+    const size = { SCALAR: 1, VEC3: 3, VEC4: 4 }[accessor.type];
+    const Type = { 5126: Float32Array, 5125: Uint32Array, 5121: Uint8Array }[accessor.componentType];
+    const values = new Type(buffer, binary + (bufferView.byteOffset ?? 0) + (accessor.byteOffset ?? 0), accessor.count * size);
+    return new THREE.BufferAttribute(values, size, Boolean(accessor.normalized));
+  };
+  const geometry = new THREE.BufferGeometry();
+  const names = { POSITION: 'position', NORMAL: 'normal', COLOR_0: 'color', _DEVIATION: 'deviation' };
+  for (const [name, index] of Object.entries(primitive.attributes)) {
+    if (names[name]) geometry.setAttribute(names[name], attribute(index));
+  }
+  geometry.setIndex(attribute(primitive.indices));
+  return { json, geometry };
 }
 
 // A 3-D scene in `container`: a toolbar (view presets, zoom to fit), the WebGL canvas (drag to
@@ -126,6 +158,20 @@ export class Scene3D {
     if (matrix) mesh.applyMatrix4(matrix);
     if (edges) mesh.add(new THREE.LineSegments(new THREE.EdgesGeometry(geometry, 30), new THREE.LineBasicMaterial({ color: colour, transparent: true, opacity: Math.min(1, opacity * 2.5) })));
     return this.add(name, mesh, legend, colour);
+  }
+
+  // An opaque solid coloured per vertex (its `color` attribute), e.g. the cut stock of a GLB
+  // answer; it replaces the object of the same `name`, so playback can swap it step by step.
+  coloured(name, geometry, { legend, colour } = {}) {
+    if (!this.scene) return null;
+    const old = this.scene.getObjectByName(name);
+    if (old) {
+      this.scene.remove(old);
+      old.geometry.dispose();
+      old.material.dispose();
+    }
+    const mesh = new THREE.Mesh(geometry, new THREE.MeshLambertMaterial({ vertexColors: true }));
+    return this.add(name, mesh, old ? undefined : legend, colour);
   }
 
   // A polyline; `colours` (one CSS colour per point) colours each segment by its end point;

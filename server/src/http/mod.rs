@@ -15,6 +15,7 @@ pub mod solve;
 pub mod stream;
 pub mod tools;
 pub mod verify;
+pub mod verify_mesh;
 
 use kerf_solver::ErrorCode;
 

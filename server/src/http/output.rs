@@ -204,12 +204,17 @@ pub fn wants_gcode(headers: &HeaderMap, format: Option<Format>) -> bool {
     }
 }
 
-/// Whether `Accept` ranks G-code above JSON (RFC 9110 §12.5.1). Each answer takes the weight of
-/// the most specific range that matches it (`text/x-gcode` over `text/*` over `*/*`), 0 when none
-/// does; G-code only when its weight is higher, so a tie, a header that accepts neither and no
-/// header give JSON (kerf answers JSON rather than 406 when nothing listed is what it writes).
-/// An element that cannot be read (a bad range or q-value) counts as not sent.
+/// Whether `Accept` ranks G-code above JSON (RFC 9110 §12.5.1): [`accept_prefers`].
 fn accept_prefers_gcode(headers: &HeaderMap) -> bool {
+    accept_prefers(headers, GCODE_MEDIA_TYPE)
+}
+
+/// Whether `Accept` ranks `media_type` above JSON (RFC 9110 §12.5.1). Each answer takes the
+/// weight of the most specific range that matches it (`text/x-gcode` over `text/*` over `*/*`), 0
+/// when none does; `media_type` only when its weight is higher, so a tie, a header that accepts
+/// neither and no header give JSON (kerf answers JSON rather than 406 when nothing listed is what
+/// it writes). An element that cannot be read (a bad range or q-value) counts as not sent.
+pub fn accept_prefers(headers: &HeaderMap, media_type: &str) -> bool {
     let ranges: Vec<MediaRange> = headers
         .get_all(header::ACCEPT)
         .iter()
@@ -225,7 +230,7 @@ fn accept_prefers_gcode(headers: &HeaderMap) -> bool {
             .max()
             .map_or(0, |(_, quality)| quality)
     };
-    weight(GCODE_MEDIA_TYPE) > weight("application/json")
+    weight(media_type) > weight("application/json")
 }
 
 /// One element of `Accept`: `type/subtype` (either may be `*`) with its weight in thousandths.

@@ -1,9 +1,10 @@
 //! `POST /api/v1/verify` (docs/spec/verify.md): cuts a G-code program out of the stock with the
 //! tools it calls and answers what it found, through the capability seam (`solve::answer`). It is
 //! routed here rather than from the capability registry, which would also give it a job operation
-//! and a tab on the page; its answer is JSON only.
+//! and a tab on the page. It answers JSON, or the cut stock as binary glTF (`verify_mesh`).
 
 use axum::extract::State;
+use axum::http::HeaderMap;
 use axum::response::Response;
 use kerf_solver::capability::Capability;
 use kerf_solver::verify::{VerifyAnswer, VerifyCapability, VerifyRequest};
@@ -12,19 +13,26 @@ use utoipa::IntoParams;
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
-use super::contour::JsonOnly;
 use super::output::Ask;
+use super::verify_mesh::{self, VerifyFormat};
 use crate::error::{AppResult, Problem};
 use crate::extract::{AppJson, AppQuery};
 use crate::state::AppState;
 
-/// Query parameters of `POST /api/v1/verify`: the answer is JSON only (verify writes no program).
+/// Query parameters of `POST /api/v1/verify`: the findings as JSON, or the cut stock as binary
+/// glTF (verify writes no program).
 #[derive(Debug, Clone, Default, Deserialize, IntoParams)]
 #[serde(deny_unknown_fields)]
 #[into_params(parameter_in = Query)]
 pub struct VerifyQuery {
-    /// `json`, the only format.
-    pub format: Option<JsonOnly>,
+    /// `json` (default) or `glb` (the cut stock as binary glTF, `model/gltf-binary`, with the
+    /// JSON answer in its `extras.verify`); without it, an `Accept` that ranks
+    /// `model/gltf-binary` above `application/json` selects the mesh.
+    pub format: Option<VerifyFormat>,
+    /// Mesh only: cut the moves on lines up to this one (1-based) and answer the stock as they
+    /// left it (playback); default every move.
+    #[param(minimum = 0)]
+    pub upto_line: Option<usize>,
 }
 
 /// The verify capability's endpoint, documented with the capability's own texts.
@@ -35,7 +43,8 @@ pub struct VerifyQuery {
     params(VerifyQuery),
     request_body = VerifyRequest,
     responses(
-        (status = 200, description = "The findings, volumes and removal per block", body = VerifyAnswer),
+        (status = 200, description = "The findings, volumes and removal per block (JSON), or the cut stock as binary glTF coloured by deviation from the part",
+            content((VerifyAnswer = "application/json"), (verify_mesh::GlbFile = "model/gltf-binary"))),
         (status = 400, body = Problem, content_type = "application/problem+json"),
         (status = 404, description = <VerifyCapability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
         (status = 408, description = "The body arrived slower than the minimum receive rate", body = Problem, content_type = "application/problem+json"),
@@ -45,9 +54,16 @@ pub struct VerifyQuery {
         (status = 422, description = <VerifyCapability as Capability>::ENDPOINT.refused, body = Problem, content_type = "application/problem+json")))]
 async fn post_verify(
     State(state): State<AppState>,
-    AppQuery(_query): AppQuery<VerifyQuery>,
+    headers: HeaderMap,
+    AppQuery(query): AppQuery<VerifyQuery>,
     AppJson(request): AppJson<VerifyRequest>,
 ) -> AppResult<Response> {
+    if verify_mesh::wants_glb(&headers, query.format) {
+        return verify_mesh::answer(&state, request, query.upto_line).await;
+    }
+    if query.upto_line.is_some() {
+        return Err(kerf_solver::SolverError::input("upto_line", "upto_line cuts the mesh: ask for format=glb").into());
+    }
     super::solve::answer::<VerifyCapability>(&state, request, None, Ask::default()).await
 }
 

@@ -39,8 +39,11 @@ impl Capability for VerifyCapability {
             line with a position and an amount: gouges into the part, material left outside it, rapid \
             moves through material, neck, shank or holder contact with the stock, and feed moves in air \
             beyond a share of the cutting time; with the volumes, cutting time and the removed volume \
-            and removal rate of every block that cut (docs/spec/verify.md). JSON only: `?format=gcode` \
-            is refused with `E_NO_PROGRAM`.",
+            and removal rate of every block that cut (docs/spec/verify.md). With `?format=glb` or an \
+            `Accept` preferring `model/gltf-binary`: the cut stock as binary glTF, each vertex coloured \
+            (gouge red, material left blue, within tolerance grey) and carrying its signed deviation from \
+            the part in `_DEVIATION`, the JSON answer in `extras.verify`; `upto_line` cuts only the moves \
+            up to that line (playback). It writes no program.",
         not_found: "A tool number in `tools` that is not in the tool table",
         refused: "The program as the reader refuses it (`E_GCODE_SYNTAX`, `E_GCODE_UNSUPPORTED`, ... with \
             the line), a bad tool, stock or part (`E_INPUT` naming the field), a move calling a tool \

@@ -4,12 +4,14 @@
 //!
 //! [`request`] holds the wire types, `job` their validation, `solid` the stock and part on the
 //! grid, `dexel` the rays, `assembly` the tool's bodies, `sweep` a body swept along a move,
-//! `simulate` the cutting and its findings, and `capability` the seam's entry.
+//! `simulate` the cutting and its findings, `mesh` the cut stock as binary glTF, and `capability`
+//! the seam's entry.
 
 mod assembly;
 mod capability;
 mod dexel;
 mod job;
+mod mesh;
 pub mod request;
 mod simulate;
 mod solid;
@@ -23,6 +25,7 @@ pub use job::{
     DEFAULT_AIR_SHARE_LIMIT, DEFAULT_ALLOWANCE, DEFAULT_RESOLUTION_RADII, DEFAULT_TOLERANCE, MAX_DEFAULT_RAYS,
     MAX_DEXEL_BYTES,
 };
+pub use mesh::{GLB_MEDIA_TYPE, GOUGE_COLOUR, LEFT_COLOUR, NEUTRAL_COLOUR, cut_stock_glb};
 pub use request::{Hollow, Solid, VerifyRequest};
 pub use simulate::{ARC_CHORD_TOLERANCE, BlockRemoval, Cut, Finding, FindingKind, MAX_FINDINGS};
 

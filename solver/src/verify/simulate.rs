@@ -331,6 +331,11 @@ impl Simulation<'_> {
 /// `E_CANCELLED`; `E_INPUT` at `tools` when a move's tool is not named; `E_STOCK` at `stock`
 /// when no tool ever reaches the stock; `E_TOO_LARGE_ANSWER` over the budget.
 pub(crate) fn cut(job: &Job, run: &Run<'_>) -> Result<Cut, SolverError> {
+    cut_stock(job, run).map(|(cut, _)| cut)
+}
+
+/// As [`cut`], with the stock as the program left it (the mesh is built from it).
+pub(crate) fn cut_stock(job: &Job, run: &Run<'_>) -> Result<(Cut, Field), SolverError> {
     let stock = job.stock.field(job.grid);
     let part = job.part.as_ref().map(|part| part.field(job.grid));
     let stock_volume = stock.volume();
@@ -406,7 +411,7 @@ pub(crate) fn cut(job: &Job, run: &Run<'_>) -> Result<Cut, SolverError> {
     }
     let final_volume = simulation.stock.volume();
     let grid = job.grid;
-    Ok(Cut {
+    let cut = Cut {
         ok: simulation.findings.is_empty(),
         findings: simulation.findings,
         findings_left_off: simulation.left_off,
@@ -423,7 +428,8 @@ pub(crate) fn cut(job: &Job, run: &Run<'_>) -> Result<Cut, SolverError> {
         moves_unplaced: unplaced,
         dexel_updates: simulation.updates,
         blocks,
-    })
+    };
+    Ok((cut, simulation.stock))
 }
 
 /// The material left outside the part thicker than `allowance`: one finding at the thickest.

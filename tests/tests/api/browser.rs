@@ -361,4 +361,8 @@ async fn verify_page_lists_findings_at_their_lines() {
     let Some(result) = run_scenario(&app, "verify", &[]) else { return };
     assert_eq!(result["ok"], true);
     assert!(result["findings"].as_u64().unwrap() >= 2, "{result}");
+    assert!(
+        result["red"].as_u64().unwrap() >= 500 && result["plunged"].as_f64() < result["removed"].as_f64(),
+        "{result}"
+    );
 }

@@ -40,4 +40,5 @@ mod segment;
 mod storage_full;
 mod tools;
 mod verify;
+mod verify_mesh;
 mod web;
