@@ -87,7 +87,10 @@ pub trait Capability {
     /// # Errors
     /// `E_INPUT` at `units` for a capability whose requests are read in millimetres only.
     fn scale_request(_request: &mut Self::Request, _scaling: Scaling) -> Result<(), SolverError> {
-        Err(SolverError::input("units", format!("{} requests are read in mm only: leave out `units`", Self::NAME)))
+        Err(SolverError::input(
+            "units",
+            format!("{} requests are read in mm only (also when their machine's `units` is inch): send mm", Self::NAME),
+        ))
     }
 
     /// Converts every length and feed of the answer by `scaling` (from mm into the request's

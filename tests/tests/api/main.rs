@@ -39,5 +39,6 @@ mod schemathesis;
 mod segment;
 mod storage_full;
 mod tools;
+mod units;
 mod verify;
 mod web;
