@@ -785,6 +785,7 @@ mod tests {
             blend_tolerance: 0.01,
             plunges: None,
             path: &path,
+            units: crate::units::Units::Mm,
         };
         let fanuc = write(&program);
         assert!(fanuc.starts_with("%\nO1000 (KERF TEST)\n(TOOL T7)\nG21"));
@@ -819,6 +820,7 @@ mod tests {
             blend_tolerance: 0.01,
             plunges: None,
             path: &path,
+            units: crate::units::Units::Mm,
         };
         let text = write(&program);
         assert!(
@@ -873,6 +875,7 @@ mod golden {
             blend_tolerance: 0.01,
             plunges: Some(Plunges { feed: None }),
             path,
+            units: crate::units::Units::Mm,
         }
     }
 
