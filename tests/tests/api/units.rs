@@ -232,7 +232,8 @@ async fn a_bad_units_value_is_refused_naming_units() {
         let problem = problem(response, status).await;
         assert!(problem.to_string().contains("units"), "{endpoint}: {problem}");
     }
-    let response = app.put_json("/api/v1/machines/bad", &json!({"block_time_ms": 4, "max_feed": 5000, "units": "cm"})).await;
+    let response =
+        app.put_json("/api/v1/machines/bad", &json!({"block_time_ms": 4, "max_feed": 5000, "units": "cm"})).await;
     let status = response.status().as_u16();
     assert!(status == 400 || status == 422, "machine: {status}");
     let problem = problem(response, status).await;
@@ -262,6 +263,13 @@ async fn machine_units_are_stored_and_are_the_requests_default(store: Store) {
     assert_in_inch("segment", &inch_answer, &mm_answer, Kind::Same);
     let program = app.post_text("/api/v1/segment?format=gcode", &inch, 200).await;
     assert!(program.starts_with("%\nO01001") && program.contains("\nG20 G17"), "{program}");
+
+    // A capability that reads mm only refuses a request whose machine is in inch, at `units`.
+    app.register_tool(7, &json!({"kind": "ball", "radius": 3})).await;
+    let mut deburr = kerf_cases::deburr::tube_request();
+    deburr["machine"] = json!("vf2");
+    let refused = problem(app.post_json("/api/v1/deburr", &deburr).await, 422).await;
+    assert!(refused.to_string().contains("units"), "{refused}");
 
     // Back to mm: the column and the profile follow.
     let metric = json!({"block_time_ms": 4, "max_feed": 5080, "dialect": "haas"});
