@@ -3,11 +3,13 @@
 //! dispatch, and the names the page and the OpenAPI document list. HTTP handlers, the job
 //! executor, `kerf run` and the workers all solve through [`solve`] here.
 
+use std::borrow::Cow;
 use std::time::Instant;
 
 use kerf_solver::SolverError;
 use kerf_solver::capability::{
     self, Capability, Lookup, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing, Split, ToolNeed,
+    Units,
 };
 use kerf_solver::machine::MachineProfile;
 use kerf_solver::material::Material;
@@ -313,6 +315,55 @@ pub fn resolve_refs<T: ToolNeed>(refs: Refs<'_>, lookup: &impl Lookup) -> Result
     capability::resolve(refs, lookup).map_err(|unresolved| AppError::unknown(unresolved.field, unresolved.message))
 }
 
+/// Capability `C`'s request in mm, as the solver reads it, and the units it was written in (its
+/// `units`, else its machine's from `lookup`, else mm): the one conversion of a request at the edge.
+///
+/// # Errors
+/// 422 naming `units` when the capability reads its requests in mm only.
+pub fn in_mm<'a, C: Capability>(
+    request: &'a C::Request,
+    lookup: &impl Lookup,
+) -> Result<(Cow<'a, C::Request>, Units), AppError> {
+    let units = capability::units_of::<C>(request, lookup);
+    Ok((capability::request_in_mm::<C>(request, units)?, units))
+}
+
+/// A refusal of a request written in `units`: the solver quotes lengths in mm, which the message
+/// then says.
+fn refusal_in(error: SolverError, units: Units) -> SolverError {
+    if units == Units::Mm || error.code() == kerf_solver::ErrorCode::Cancelled {
+        return error;
+    }
+    let message = format!(
+        "{} (the request's lengths were converted from {} to mm: lengths in this message are in mm and feeds in mm/min)",
+        error.message(),
+        units.as_str()
+    );
+    let converted = SolverError::new(error.code(), message);
+    match error.field() {
+        Some(field) => converted.at(field),
+        None => converted,
+    }
+}
+
+/// An answer's JSON object with `units` first.
+fn with_units(mut json: Vec<u8>, units: Units) -> Vec<u8> {
+    if json.first() == Some(&b'{') {
+        let field = format!("\"units\":\"{}\"{}", units.as_str(), if json.get(1) == Some(&b'}') { "" } else { "," });
+        json.splice(1..1, field.into_bytes());
+    }
+    json
+}
+
+/// `answer` in `units` (converted from mm), as its endpoint's JSON with `units` echoed.
+fn answer_json<C: Capability>(mut answer: C::Answer, units: Units) -> Result<Vec<u8>, AppError> {
+    if let Some(scaling) = units.from_mm() {
+        C::scale_answer(&mut answer, scaling);
+    }
+    let bytes = C::to_json(answer).map_err(|error| AppError::Internal(error.into()))?;
+    Ok(with_units(bytes, units))
+}
+
 /// What a solve gives its caller: the answer as JSON, or the program.
 #[derive(Debug)]
 pub enum Delivered {
@@ -322,9 +373,10 @@ pub enum Delivered {
     Program(String),
 }
 
-/// Solves a resolved request of capability `C` and delivers the JSON answer, or the program
-/// when `program` gives its output options. `timings` adds the solve time to answers that report
-/// it. Returns the delivery and the seconds the solve took. Runs on a blocking thread.
+/// Solves a resolved request of capability `C` (in mm, [`in_mm`]) and delivers the JSON answer
+/// in `units`, or the program in `units` when `program` gives its output options. `timings` adds
+/// the solve time to answers that report it. Returns the delivery and the seconds the solve
+/// took. Runs on a blocking thread.
 ///
 /// # Errors
 /// The solver's refusal, or a failure to serialise.
@@ -334,13 +386,15 @@ pub fn solve<C: Capability>(
     run: &Run<'_>,
     program: Option<&OutputOptions>,
     timings: bool,
+    units: Units,
 ) -> Result<(Delivered, f64), AppError> {
     let run = &counted::<C>(request, &resolved, run);
     let started = Instant::now();
-    let mut answer = C::solve(request, resolved, run)?;
+    let mut answer = C::solve(request, resolved, run).map_err(|error| refusal_in(error, units))?;
     let seconds = started.elapsed().as_secs_f64();
     if let Some(output) = program {
-        let program = capability::program::<C>(request, &answer, output, run.control)?;
+        let output = OutputOptions { units: Some(units), ..*output };
+        let program = capability::program::<C>(request, &answer, &output, run.control)?;
         check_size(run, program.len())?;
         return Ok((Delivered::Program(program), seconds));
     }
@@ -348,7 +402,7 @@ pub fn solve<C: Capability>(
         C::record_time(&mut answer, seconds);
     }
     run.control.check()?;
-    let bytes = C::to_json(answer).map_err(|error| AppError::Internal(error.into()))?;
+    let bytes = answer_json::<C>(answer, units)?;
     check_size(run, bytes.len())?;
     Ok((Delivered::Json(bytes), seconds))
 }
@@ -391,17 +445,20 @@ fn store_output<C: Capability>(
     run: &Run<'_>,
     output: &OutputOptions,
 ) -> Result<Stored, AppError> {
+    let (request, units) = in_mm::<C>(request, lookup)?;
+    let request = request.as_ref();
     let resolved = resolve::<C>(request, lookup)?;
     let run = &counted::<C>(request, &resolved, run);
     let started = Instant::now();
-    let mut answer = C::solve(request, resolved, run)?;
+    let mut answer = C::solve(request, resolved, run).map_err(|error| refusal_in(error, units))?;
     C::record_time(&mut answer, started.elapsed().as_secs_f64());
-    stored::<C>(request, answer, output, run)
+    stored::<C>(request, answer, output, run, units)
 }
 
 fn split<C: Capability>(request: &C::Request, lookup: &impl Lookup, sizing: &Sizing) -> Option<Split> {
-    let resolved = resolve::<C>(request, lookup).ok()?;
-    C::split(request, &resolved, sizing)
+    let (request, _) = in_mm::<C>(request, lookup).ok()?;
+    let resolved = resolve::<C>(&request, lookup).ok()?;
+    C::split(&request, &resolved, sizing)
 }
 
 /// A part's output, serialised (CBOR: every number exactly as computed, non-finite ones too), and
@@ -433,10 +490,11 @@ fn part_output<C: Capability>(
     part: &Part,
     run: &Run<'_>,
 ) -> Result<PartBytes, AppError> {
-    let resolved = resolve::<C>(request, lookup)?;
+    let (request, units) = in_mm::<C>(request, lookup)?;
+    let resolved = resolve::<C>(&request, lookup)?;
     let started = Instant::now();
     let mut sink = CborSink::default();
-    C::solve_part(request, resolved, part, run, &mut sink)?;
+    C::solve_part(&request, resolved, part, run, &mut sink).map_err(|error| refusal_in(error, units))?;
     Ok(PartBytes { bytes: sink.0, seconds: started.elapsed().as_secs_f64() })
 }
 
@@ -448,23 +506,27 @@ fn finish_output<C: Capability>(
     output: &OutputOptions,
     seconds: f64,
 ) -> Result<Stored, AppError> {
+    let (request, units) = in_mm::<C>(request, lookup)?;
+    let request = request.as_ref();
     let resolved = resolve::<C>(request, lookup)?;
     let run = &counted::<C>(request, &resolved, run);
     let started = Instant::now();
-    let mut answer = C::finish(request, resolved, parts, run)?;
+    let mut answer = C::finish(request, resolved, parts, run).map_err(|error| refusal_in(error, units))?;
     C::record_time(&mut answer, seconds + started.elapsed().as_secs_f64());
-    stored::<C>(request, answer, output, run)
+    stored::<C>(request, answer, output, run, units)
 }
 
-/// A job's stored output of `answer`: its program written with `output`, the answer trimmed for
-/// storage; refused when the two are over the run's answer budget.
+/// A job's stored output of `answer` (in mm): its program written with `output` in `units`, the
+/// answer in `units` trimmed for storage; refused when the two are over the run's answer budget.
 fn stored<C: Capability>(
     request: &C::Request,
     mut answer: C::Answer,
     output: &OutputOptions,
     run: &Run<'_>,
+    units: Units,
 ) -> Result<Stored, AppError> {
-    let program = capability::program::<C>(request, &answer, output, run.control);
+    let output = OutputOptions { units: Some(units), ..*output };
+    let program = capability::program::<C>(request, &answer, &output, run.control);
     // A cancelled job stops here rather than storing "cancelled" as the reason it has no program.
     if let Err(error) = &program
         && error.code() == kerf_solver::ErrorCode::Cancelled
@@ -472,7 +534,12 @@ fn stored<C: Capability>(
         return Err(error.clone().into());
     }
     C::for_storage(&mut answer);
-    let result = serde_json::value::to_raw_value(&answer).map_err(|error| AppError::Internal(error.into()))?;
+    if let Some(scaling) = units.from_mm() {
+        C::scale_answer(&mut answer, scaling);
+    }
+    let json = with_units(serde_json::to_vec(&answer).map_err(|error| AppError::Internal(error.into()))?, units);
+    let result = RawValue::from_string(String::from_utf8(json).map_err(|error| AppError::Internal(error.into()))?)
+        .map_err(|error| AppError::Internal(error.into()))?;
     check_size(run, result.get().len() + program.as_ref().map_or(0, String::len))?;
     Ok(Stored {
         operation: C::NAME.to_owned(),

@@ -19,6 +19,7 @@ use crate::gcode::{Arcs, Dialect, Post, Reference, ToolCall};
 use crate::machine::MachineProfile;
 use crate::material::Material;
 use crate::tool::{Tool, ToolRef};
+pub use crate::units::{Scale, Scaling, Units};
 
 /// One capability: deburr, segment, contour, engagement, predict.
 pub trait Capability {
@@ -74,6 +75,27 @@ pub trait Capability {
         output: &OutputOptions,
         control: Control<'_>,
     ) -> Result<String, SolverError>;
+
+    /// The units the request says it is written in (its `units`), if it says.
+    fn units(_request: &Self::Request) -> Option<Units> {
+        None
+    }
+
+    /// Converts every length and feed of the request by `scaling` (from its units into mm),
+    /// before it is resolved and solved.
+    ///
+    /// # Errors
+    /// `E_INPUT` at `units` for a capability whose requests are read in millimetres only.
+    fn scale_request(_request: &mut Self::Request, _scaling: Scaling) -> Result<(), SolverError> {
+        Err(SolverError::input(
+            "units",
+            format!("{} requests are read in mm only (also when their machine's `units` is inch): send mm", Self::NAME),
+        ))
+    }
+
+    /// Converts every length and feed of the answer by `scaling` (from mm into the request's
+    /// units), after its program is written from the answer in mm.
+    fn scale_answer(_answer: &mut Self::Answer, _scaling: Scaling) {}
 
     /// The machine the answer was computed for (its dialect is the program's default).
     fn machine(answer: &Self::Answer) -> Option<&MachineProfile>;
@@ -395,6 +417,33 @@ pub fn all_refs<C: Capability>(request: &C::Request) -> Vec<Refs<'_>> {
     std::iter::once(C::refs(request)).chain(C::other_tools(request).into_iter().map(OtherTool::refs)).collect()
 }
 
+/// The units of capability `C`'s request: its own `units`, else those of the machine it names
+/// (found in `lookup`), else mm.
+pub fn units_of<C: Capability>(request: &C::Request, lookup: &impl Lookup) -> Units {
+    C::units(request)
+        .or_else(|| C::refs(request).machine.and_then(|name| lookup.machine(name)).and_then(|machine| machine.units))
+        .unwrap_or_default()
+}
+
+/// Capability `C`'s request in mm, as the solver reads it: `request` itself when it is in mm,
+/// else a copy with every length and feed converted from `units`.
+///
+/// # Errors
+/// As [`Capability::scale_request`].
+pub fn request_in_mm<C: Capability>(
+    request: &C::Request,
+    units: Units,
+) -> Result<std::borrow::Cow<'_, C::Request>, SolverError> {
+    match units.into_mm() {
+        None => Ok(std::borrow::Cow::Borrowed(request)),
+        Some(scaling) => {
+            let mut request = request.clone();
+            C::scale_request(&mut request, scaling)?;
+            Ok(std::borrow::Cow::Owned(request))
+        }
+    }
+}
+
 /// What the answer is for: limits differ between a JSON answer, a program and a stored job.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Purpose {
@@ -568,6 +617,8 @@ pub struct OutputOptions {
     pub candidate: Option<usize>,
     /// Circular moves as G02/G03 or chords; `None`: the machine's `arcs`, else chords.
     pub arcs: Option<Arcs>,
+    /// The program's units (G20 or G21; the request's); `None`: mm.
+    pub units: Option<Units>,
 }
 
 impl OutputOptions {
@@ -590,6 +641,7 @@ impl OutputOptions {
             tool: ToolCall::for_tool(tool),
             arcs: self.arcs_for(machine),
             plunge_feed: tool.plunge_feed.or(machine.and_then(|m| m.plunge_feed)),
+            units: self.units.unwrap_or_default(),
         }
     }
 }

@@ -28,6 +28,7 @@ pub mod planar;
 pub mod predict;
 pub mod segment;
 pub mod tool;
+pub mod units;
 pub mod validate;
 pub mod verify;
 pub(crate) mod wire;

@@ -44,6 +44,7 @@ fn main() {
         tool: ToolCall::Table(7),
         arcs: Arcs::Chords,
         plunge_feed: None,
+        units: kerf_solver::units::Units::Mm,
     };
     for (name, job) in cases {
         let answer = deburr::solve(&job, &tool);

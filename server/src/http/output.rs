@@ -133,6 +133,7 @@ impl Negotiate for OutputQuery {
                 reference: query.reference,
                 candidate: None,
                 arcs: query.arcs,
+                units: None,
             },
             timings: false,
         }
@@ -150,6 +151,7 @@ impl Negotiate for CandidateQuery {
                 reference: query.reference,
                 candidate: query.candidate,
                 arcs: query.arcs,
+                units: None,
             },
             timings: false,
         }
@@ -163,6 +165,7 @@ impl Negotiate for CandidateQuery {
                 reference: self.reference,
                 candidate: self.candidate,
                 arcs: self.arcs,
+                units: None,
             },
             timings: false,
         }
@@ -190,6 +193,7 @@ impl Ask {
                 reference: query.reference,
                 candidate: None,
                 arcs: query.arcs,
+                units: None,
             },
             timings: false,
         }

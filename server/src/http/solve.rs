@@ -29,14 +29,24 @@ pub async fn answer<C: Capability>(
 ) -> AppResult<Response> {
     let catalog =
         capabilities::catalog(&state.db, capability::all_refs::<C>(&request), capabilities::Catalog::default()).await?;
+    // An upload is not part of the question's key, and timings differ from run to run. The
+    // question is the request as written; the solver reads it in mm.
+    let question = (state.answers.enabled() && upload.is_none() && !ask.timings)
+        .then(|| question::<C>(&request, &catalog, &ask))
+        .flatten();
+    let units = capability::units_of::<C>(&request, &catalog);
+    let request = match units.into_mm() {
+        None => request,
+        Some(scaling) => {
+            let mut request = request;
+            C::scale_request(&mut request, scaling)?;
+            request
+        }
+    };
     let resolved = capabilities::resolve::<C>(&request, &catalog)?;
     if ask.gcode {
         C::check_output(&request, &ask.output)?;
     }
-    // An upload is not part of the question's key, and timings differ from run to run.
-    let question = (state.answers.enabled() && upload.is_none() && !ask.timings)
-        .then(|| question::<C>(&request, &catalog, &ask))
-        .flatten();
     if let Some(question) = &question {
         let cached = state.answers.get(question);
         crate::metrics::answer_cache_lookup(cached.is_some());
@@ -54,7 +64,7 @@ pub async fn answer<C: Capability>(
                 purpose: if ask.gcode { Purpose::Program } else { Purpose::Json },
                 budget: Some(&budget),
             };
-            capabilities::solve::<C>(&request, resolved, &run, ask.gcode.then_some(&ask.output), ask.timings)
+            capabilities::solve::<C>(&request, resolved, &run, ask.gcode.then_some(&ask.output), ask.timings, units)
         })
         .await??;
     crate::metrics::observe_solver(C::NAME, seconds);

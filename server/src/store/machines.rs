@@ -31,12 +31,12 @@ fn registry(name: &str) -> Registry {
         item: format!("machine {name:?}"),
         select_sqlite: "SELECT machine_json FROM machines WHERE name = $1",
         select_postgres: "SELECT machine_json FROM machines WHERE name = $1 FOR UPDATE",
-        update_sqlite: "UPDATE machines SET block_time_ms = $2, max_feed = $3, dialect = $4, machine_json = $5,
+        update_sqlite: "UPDATE machines SET block_time_ms = $2, max_feed = $3, dialect = $4, machine_json = $5, units = $6,
              revision = revision + 1, updated_at = strftime('%Y-%m-%dT%H:%M:%fZ', 'now') WHERE name = $1",
-        update_postgres: "UPDATE machines SET block_time_ms = $2, max_feed = $3, dialect = $4, machine_json = $5,
+        update_postgres: "UPDATE machines SET block_time_ms = $2, max_feed = $3, dialect = $4, machine_json = $5, units = $6,
              revision = revision + 1, updated_at = now() WHERE name = $1",
         insert:
-            "INSERT INTO machines (name, block_time_ms, max_feed, dialect, machine_json) VALUES ($1, $2, $3, $4, $5)
+            "INSERT INTO machines (name, block_time_ms, max_feed, dialect, machine_json, units) VALUES ($1, $2, $3, $4, $5, $6)
              ON CONFLICT (name) DO NOTHING",
         delete: "DELETE FROM machines WHERE name = $1",
     }
@@ -56,6 +56,7 @@ pub async fn put(
         Bind::Real(machine.max_feed),
         Bind::Text(machine.dialect.as_str()),
         Bind::Text(&json),
+        Bind::Text(machine.units.unwrap_or_default().as_str()),
     ];
     guarded_put(db, &registry(name), Bind::Text(name), &values, |(json,): (String,)| decode(&json), guard).await
 }

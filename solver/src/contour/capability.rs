@@ -186,6 +186,19 @@ impl Capability for ContourCapability {
         super::program::program_controlled(&answer.result, &post, control)
     }
 
+    fn units(request: &ContourRequest) -> Option<crate::units::Units> {
+        request.units
+    }
+
+    fn scale_request(request: &mut ContourRequest, scaling: crate::units::Scaling) -> Result<(), SolverError> {
+        crate::units::Scale::scale(request, scaling);
+        Ok(())
+    }
+
+    fn scale_answer(answer: &mut ContourAnswer, scaling: crate::units::Scaling) {
+        crate::units::Scale::scale(answer, scaling);
+    }
+
     fn machine(answer: &ContourAnswer) -> Option<&MachineProfile> {
         answer.machine.as_ref()
     }

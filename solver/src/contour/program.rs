@@ -86,6 +86,7 @@ pub fn program_controlled(answer: &ContourSolution, post: &Post, control: Contro
             blend_tolerance: answer.summary.tolerance,
             plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
             path: &path,
+            units: post.units,
         },
         &[],
         control,

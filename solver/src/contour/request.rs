@@ -310,4 +310,8 @@ pub struct ContourRequest {
     /// Optional control model for predictions and allowance checks.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub controller: Option<ControllerModel>,
+    /// `mm` or `inch`: the units of every length (and, per minute, feed) in this request and its
+    /// answer (default: the named machine's `units`, else `mm`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<crate::units::Units>,
 }

@@ -554,6 +554,7 @@ mod tests {
                     tool: crate::gcode::ToolCall::Table(1),
                     arcs: crate::gcode::Arcs::G2g3,
                     plunge_feed: None,
+                    units: crate::units::Units::Mm,
                 };
                 prop_assert_eq!(
                     crate::contour::program(&shared, &post).unwrap(),

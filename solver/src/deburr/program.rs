@@ -338,6 +338,7 @@ pub fn program_for_loops(
             // Every move down runs in air: to the lead point beside the edge, or down the hole.
             plunges: None,
             path: &visit.path,
+            units: post.units,
         },
         &stops,
         control,

@@ -103,6 +103,7 @@ pub fn program(answer: &EngagementSolution, candidate: usize, post: &Post) -> Re
         blend_tolerance: CHORD_TOLERANCE * 5.0,
         plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
         path: &path,
+        units: post.units,
     }))
 }
 

@@ -544,6 +544,7 @@ mod tests {
             blend_tolerance: 0.01,
             plunges: Some(super::super::Plunges { feed: None }),
             path: &path,
+            units: crate::units::Units::Mm,
         })
     }
 
@@ -658,6 +659,7 @@ mod tests {
             blend_tolerance: 0.01,
             plunges: None,
             path: &path,
+            units: crate::units::Units::Mm,
         };
         let stop = crate::gcode::ProgramStop {
             before: 3,

@@ -121,7 +121,12 @@ pub(super) fn write<E>(
 ) -> Result<String, E> {
     let mut out = Klartext { text: Buffer::with_capacity(256 + program.path.moves.len() * 48), line: 0 };
     let name = format!("KERF{}", program.number);
-    out.block(&format!("BEGIN PGM {name} MM"));
+    // Feeds in inch programs are inch/min, as lengths are inches.
+    let units = match program.units {
+        crate::units::Units::Mm => "MM",
+        crate::units::Units::Inch => "INCH",
+    };
+    out.block(&format!("BEGIN PGM {name} {units}"));
     out.comment(program.title);
     for line in &program.comments {
         out.comment(line);
@@ -194,6 +199,6 @@ pub(super) fn write<E>(
     }
     out.up(program.safe_z, "M5");
     out.up(program.safe_z, "M30");
-    out.block(&format!("END PGM {name} MM"));
+    out.block(&format!("END PGM {name} {units}"));
     Ok(out.text.into_string())
 }

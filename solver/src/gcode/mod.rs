@@ -28,6 +28,7 @@ use crate::control::Control;
 use crate::error::SolverError;
 use crate::geometry::Vec3;
 use crate::path::{Motion, Toolpath};
+use crate::units::{Scale, Units};
 
 /// The control the program is written for: the post.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -157,6 +158,8 @@ pub struct Post {
     /// Feed of plunges, mm/min (the tool's, else the machine's); `None`: a fraction
     /// [`DEFAULT_PLUNGE_FRACTION`] of the cutting feed.
     pub plunge_feed: Option<f64>,
+    /// The program's units: mm (G21) or inch (G20); the path stays in mm until it is written.
+    pub units: Units,
 }
 
 /// A plunge runs at this fraction of the cutting feed when neither tool nor machine gives a
@@ -172,7 +175,7 @@ pub fn plunge_feed(feed: f64, plunge_feed: Option<f64>) -> f64 {
 impl Post {
     /// A post writing arcs as chords (the default of every option but the tool).
     pub fn new(dialect: Dialect, reference: Reference, tool: ToolCall) -> Self {
-        Self { dialect, reference, tool, arcs: Arcs::Chords, plunge_feed: None }
+        Self { dialect, reference, tool, arcs: Arcs::Chords, plunge_feed: None, units: Units::Mm }
     }
 }
 
@@ -203,6 +206,9 @@ pub struct Program<'a> {
     pub plunges: Option<Plunges>,
     /// The moves; the first should start from the clearance plane.
     pub path: &'a Toolpath,
+    /// The units the program is written in; every length and feed above is in mm (mm/min) and
+    /// converted as it is written.
+    pub units: Units,
 }
 
 /// How a program slows its plunges.
@@ -332,6 +338,40 @@ pub const MOVES_PER_CHECK: usize = 1024;
 const BYTES_PER_MOVE: usize = 40;
 
 fn write_checking<E>(
+    program: &Program<'_>,
+    stops: &[ProgramStop],
+    check: impl FnMut() -> Result<(), E>,
+) -> Result<String, E> {
+    let Some(scaling) = program.units.from_mm() else { return write_words(program, stops, check) };
+    // Converted once here, so every word below is written in the program's units as it is.
+    let mut path = program.path.clone();
+    for step in &mut path.moves {
+        Scale::scale(&mut step.to, scaling);
+        match &mut step.motion {
+            Motion::Rapid => {}
+            Motion::Linear { feed } => feed.scale(scaling),
+            Motion::Arc { feed, centre, .. } => {
+                feed.scale(scaling);
+                Scale::scale(centre, scaling);
+            }
+        }
+    }
+    let plunges = program.plunges.map(|mut plunges| {
+        plunges.feed.scale(scaling);
+        plunges
+    });
+    let program = Program {
+        safe_z: scaling.apply(program.safe_z),
+        blend_tolerance: scaling.apply(program.blend_tolerance),
+        plunges,
+        path: &path,
+        ..program.clone()
+    };
+    write_words(&program, stops, check)
+}
+
+/// Writes `program`, its lengths and feeds already in its units.
+fn write_words<E>(
     program: &Program<'_>,
     stops: &[ProgramStop],
     check: impl FnMut() -> Result<(), E>,
@@ -466,14 +506,17 @@ impl Blocks {
             }
             Heading::Title => self.comment(program.title),
             Heading::HeidenhainIso => {
-                let _ = writeln!(self.text, "%KERF{} G71 *", program.number);
+                let _ = writeln!(self.text, "%KERF{} {} *", program.number, iso_units(program.units));
                 self.comment(program.title);
             }
         }
         for line in &program.comments {
             self.comment(line);
         }
-        self.block(self.table.safety);
+        self.block(match program.units {
+            Units::Mm => self.table.safety,
+            Units::Inch => self.table.inch_safety,
+        });
         match self.table.blending {
             Blending::None => {}
             Blending::Tolerance => {
@@ -511,7 +554,7 @@ impl Blocks {
             Heading::Percent(_) => self.text.push_str("%\n"),
             Heading::Title => {}
             Heading::HeidenhainIso => {
-                let _ = writeln!(self.text, "N99999999 %KERF{} G71 *", program.number);
+                let _ = writeln!(self.text, "N99999999 %KERF{} {} *", program.number, iso_units(program.units));
             }
         }
     }
@@ -687,6 +730,14 @@ fn clean_comment(text: &str) -> String {
     cleaned.trim().to_owned()
 }
 
+/// Heidenhain ISO's units word: G71 mm, G70 inch.
+fn iso_units(units: Units) -> &'static str {
+    match units {
+        Units::Mm => "G71",
+        Units::Inch => "G70",
+    }
+}
+
 /// Whether `a` and `b` print as the same X and Y.
 pub(crate) fn same_printed(a: Vec3, b: Vec3, decimals: usize) -> bool {
     number::prints_equal(a.x, b.x, decimals) && number::prints_equal(a.y, b.y, decimals)
@@ -734,6 +785,7 @@ mod tests {
             blend_tolerance: 0.01,
             plunges: None,
             path: &path,
+            units: crate::units::Units::Mm,
         };
         let fanuc = write(&program);
         assert!(fanuc.starts_with("%\nO1000 (KERF TEST)\n(TOOL T7)\nG21"));
@@ -768,6 +820,7 @@ mod tests {
             blend_tolerance: 0.01,
             plunges: None,
             path: &path,
+            units: crate::units::Units::Mm,
         };
         let text = write(&program);
         assert!(
@@ -822,6 +875,7 @@ mod golden {
             blend_tolerance: 0.01,
             plunges: Some(Plunges { feed: None }),
             path,
+            units: crate::units::Units::Mm,
         }
     }
 

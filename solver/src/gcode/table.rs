@@ -71,6 +71,8 @@ pub struct PostTable {
     pub comment: CommentStyle,
     /// The safety block: units, plane, absolute, no compensation, feed per minute.
     pub safety: &'static str,
+    /// The safety block of an inch program (G20, Sinumerik's G700: inch lengths and feeds).
+    pub inch_safety: &'static str,
     /// Path blending.
     pub blending: Blending,
     /// Tool call and length offset.
@@ -91,7 +93,7 @@ pub struct PostTable {
     pub line_numbers: Option<u32>,
     /// What ends a block besides the line feed (Heidenhain ISO's ` *`).
     pub block_end: &'static str,
-    /// Decimals of lengths (4 in mm; an inch format would be 4 too at 0.0001 in).
+    /// Decimals of lengths (4: 0.0001 mm, and 0.0001 in in an inch program).
     pub decimals: usize,
     /// Whether positive numbers carry a `+` (Heidenhain).
     pub plus_sign: bool,
@@ -104,6 +106,7 @@ pub const FANUC: PostTable = PostTable {
     heading: Heading::Percent(4),
     comment: CommentStyle::Parentheses,
     safety: "G21 G17 G90 G40 G49 G80 G94",
+    inch_safety: "G20 G17 G90 G40 G49 G80 G94",
     blending: Blending::None,
     tool_change: ToolChange::M06WithG43,
     motion: ["G00", "G01", "G02", "G03"],
@@ -131,6 +134,7 @@ impl Dialect {
                 heading: Heading::Title,
                 comment: CommentStyle::Semicolon,
                 safety: "G71 G17 G90 G40 G94",
+                inch_safety: "G700 G17 G90 G40 G94",
                 blending: Blending::Word("G642"),
                 tool_change: ToolChange::SinumerikD1,
                 motion: ["G0", "G1", "G2", "G3"],
@@ -143,6 +147,7 @@ impl Dialect {
                 heading: Heading::HeidenhainIso,
                 comment: CommentStyle::Semicolon,
                 safety: "G17 G40 G90",
+                inch_safety: "G17 G40 G90",
                 tool_change: ToolChange::HeidenhainIso,
                 arcs: ArcCentre::AbsoluteBlock,
                 line_numbers: Some(10),
@@ -153,6 +158,7 @@ impl Dialect {
             Self::Grbl => PostTable {
                 heading: Heading::Title,
                 safety: "G21 G17 G90 G94",
+                inch_safety: "G20 G17 G90 G94",
                 tool_change: ToolChange::Pause,
                 motion: ["G0", "G1", "G2", "G3"],
                 spindle: ["M3", "M4", "M5"],

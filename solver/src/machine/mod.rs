@@ -102,6 +102,11 @@ pub struct MachineProfile {
     /// Time of one tool change, s (≥ 0; default 0), for `cycle_time`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tool_change_s: Option<f64>,
+    /// The units of the requests that name this machine and give none (`mm` or `inch`; default
+    /// `mm`), and so of their answers and programs (G20 for inch). The profile's own values are in
+    /// mm and mm/min whatever this says.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<crate::units::Units>,
 }
 
 /// A feed the request asks for (`field`, mm/min) as the program may write it: capped by

@@ -546,6 +546,7 @@ pub fn corrected_program_controlled(
                     // The points are the caller's path, written as given.
                     plunges: None,
                     path: &path,
+                    units: crate::units::Units::Mm,
                 },
                 &[],
                 control,

@@ -96,8 +96,22 @@ impl Capability for SegmentCapability {
                 .plunge_feed
                 .or(answer.tool.as_ref().and_then(|tool| tool.plunge_feed))
                 .or(answer.machine.as_ref().and_then(|m| m.plunge_feed)),
+            units: output.units.unwrap_or_default(),
         };
         super::program::program_controlled(&answer.result, &post, control)
+    }
+
+    fn units(request: &SegmentRequest) -> Option<crate::units::Units> {
+        request.units
+    }
+
+    fn scale_request(request: &mut SegmentRequest, scaling: crate::units::Scaling) -> Result<(), SolverError> {
+        crate::units::Scale::scale(request, scaling);
+        Ok(())
+    }
+
+    fn scale_answer(answer: &mut SegmentAnswer, scaling: crate::units::Scaling) {
+        crate::units::Scale::scale(answer, scaling);
     }
 
     fn machine(answer: &SegmentAnswer) -> Option<&MachineProfile> {

@@ -376,6 +376,7 @@ impl SegmentRequest {
             spindle_rpm: None,
             plunge_feed: None,
             safe_z: None,
+            units: None,
         }
     }
 

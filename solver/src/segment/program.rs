@@ -89,6 +89,7 @@ pub fn program_controlled(answer: &SegmentSolution, post: &Post, control: Contro
             blend_tolerance: answer.chord_error.max(1e-4),
             plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
             path: &path,
+            units: post.units,
         },
         &[],
         control,

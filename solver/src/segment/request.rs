@@ -218,4 +218,8 @@ pub struct SegmentRequest {
     /// Z of the clearance plane for the G-code program, mm (default 5 above the curve's highest point).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub safe_z: Option<f64>,
+    /// `mm` or `inch`: the units of every length (and, per minute, feed) in this request and its
+    /// answer (default: the named machine's `units`, else `mm`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<crate::units::Units>,
 }

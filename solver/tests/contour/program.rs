@@ -27,7 +27,14 @@ fn request(extra: serde_json::Value) -> ContourRequest {
 }
 
 fn post(dialect: Dialect, reference: Reference) -> Post {
-    Post { dialect, reference, tool: ToolCall::Table(3), arcs: kerf_solver::gcode::Arcs::Chords, plunge_feed: None }
+    Post {
+        dialect,
+        reference,
+        tool: ToolCall::Table(3),
+        arcs: kerf_solver::gcode::Arcs::Chords,
+        plunge_feed: None,
+        units: kerf_solver::units::Units::Mm,
+    }
 }
 
 #[test]

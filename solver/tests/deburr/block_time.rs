@@ -194,6 +194,7 @@ fn machine_values_and_bad_block_times() {
         spindle_torque_nm: None,
         max_spindle_rpm: None,
         spindle_power_curve: None,
+        units: None,
     };
     let tool = ball(3.0);
     // The machine's block time applies at the request's feed, capped by the machine's max feed
@@ -228,6 +229,7 @@ fn machine_values_and_bad_block_times() {
         tool: kerf_solver::gcode::ToolCall::Table(7),
         arcs: kerf_solver::gcode::Arcs::Chords,
         plunge_feed: None,
+        units: kerf_solver::units::Units::Mm,
     };
     let program = deburr::program(&result, &post).unwrap();
     assert!(program.contains("(BLOCK TIME 4 MS MARGIN 1.2:"), "{program}");

@@ -216,6 +216,7 @@ fn program_needs_the_cutting_depth() {
         tool: ToolCall::Table(3),
         arcs: kerf_solver::gcode::Arcs::Chords,
         plunge_feed: None,
+        units: kerf_solver::units::Units::Mm,
     };
     let error = program(&answer, 0, &post).unwrap_err();
     assert_eq!((error.code().as_str(), error.field()), ("E_INPUT", Some("axial_depth")));

@@ -286,6 +286,7 @@ fn program_carries_the_planned_feeds() {
         tool: ToolCall::Table(4),
         arcs: kerf_solver::gcode::Arcs::Chords,
         plunge_feed: None,
+        units: kerf_solver::units::Units::Mm,
     };
     let text = program(&answer, 0, &post).unwrap();
     assert!(text.contains("T4 M06") && text.contains("S4000 M03") && text.ends_with("M30\n"));

@@ -593,6 +593,7 @@ fn the_program_cuts_at_the_paths_z() {
         tool: ToolCall::Table(4),
         arcs: kerf_solver::gcode::Arcs::Chords,
         plunge_feed: None,
+        units: kerf_solver::units::Units::Mm,
     };
     let mut body = slot_at(json!({"stock_top_z": 10, "cut_z": 7.25}));
     body.as_object_mut().unwrap().remove("kienzle");

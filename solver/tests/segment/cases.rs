@@ -143,6 +143,7 @@ fn case_a_gcode_head() {
             tool: ToolCall::Table(1),
             arcs: kerf_solver::gcode::Arcs::Chords,
             plunge_feed: None,
+            units: kerf_solver::units::Units::Mm,
         },
     )
     .unwrap();

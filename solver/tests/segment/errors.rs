@@ -270,6 +270,7 @@ fn machine_values_are_defaults_the_request_overrides() {
         spindle_torque_nm: None,
         max_spindle_rpm: None,
         spindle_power_curve: None,
+        units: None,
     };
     let request = parse(json!({"curve": circle(), "machine": "hsc"}));
     let answer = segment::solve(&request, Some(&machine)).unwrap();
@@ -401,6 +402,7 @@ fn programs_in_both_dialects() {
             tool: ToolCall::Table(3),
             arcs: kerf_solver::gcode::Arcs::Chords,
             plunge_feed: None,
+            units: kerf_solver::units::Units::Mm,
         },
     )
     .unwrap();
@@ -417,6 +419,7 @@ fn programs_in_both_dialects() {
             tool: ToolCall::Table(3),
             arcs: kerf_solver::gcode::Arcs::Chords,
             plunge_feed: Some(120.0),
+            units: kerf_solver::units::Units::Mm,
         },
     )
     .unwrap();
@@ -432,6 +435,7 @@ fn programs_in_both_dialects() {
             tool: ToolCall::Manual("as set up".to_owned()),
             arcs: kerf_solver::gcode::Arcs::Chords,
             plunge_feed: None,
+            units: kerf_solver::units::Units::Mm,
         },
     )
     .unwrap();

@@ -39,6 +39,7 @@ mod schemathesis;
 mod segment;
 mod storage_full;
 mod tools;
+mod units;
 mod verify;
 mod verify_mesh;
 mod web;

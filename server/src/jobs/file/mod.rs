@@ -120,7 +120,13 @@ pub struct OutputOptions {
 impl OutputOptions {
     /// The options every operation's program is written with.
     pub fn for_programs(&self) -> capability::OutputOptions {
-        capability::OutputOptions { dialect: self.dialect, reference: self.reference, candidate: None, arcs: self.arcs }
+        capability::OutputOptions {
+            dialect: self.dialect,
+            reference: self.reference,
+            candidate: None,
+            arcs: self.arcs,
+            units: None,
+        }
     }
 }
 
