@@ -5,7 +5,11 @@
 //!
 //! Run: `cargo bench -p kerf-solver --bench verify -- --warm-up-time 1 --measurement-time 10`.
 //! `KERF_BENCH_ROWS=n` sets the raster's rows (default 50, 1 mm apart over the middle 50 mm;
-//! 200 steps of 0.5 mm per row, so 10 000 blocks), `KERF_BENCH_SPACING=h` the dexel spacing.
+//! 200 steps of 0.5 mm per row, so 10 000 blocks; 500 rows 0.1 mm apart give the 100 502-block
+//! finishing raster), `KERF_BENCH_SPACING=h` the dexel spacing, `KERF_BENCH_PROGRAM=file` a
+//! G-code file to cut instead (tests/load/verify_numpy.py passes its own copy of the raster).
+//! The one solve's time is printed as wall time and as the CPU time of the thread (from
+//! /proc/thread-self/schedstat: on a shared machine the wall time counts other processes' turns).
 
 use std::time::Instant;
 
@@ -36,28 +40,41 @@ fn raster(rows: usize) -> String {
     program
 }
 
+/// The CPU time this thread has run, s (Linux; none elsewhere).
+fn thread_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    Some(stat.split_whitespace().next()?.parse::<f64>().ok()? * 1e-9)
+}
+
 fn bench(c: &mut Criterion) {
     let rows = std::env::var("KERF_BENCH_ROWS").ok().and_then(|v| v.parse().ok()).unwrap_or(50);
     let spacing: f64 = std::env::var("KERF_BENCH_SPACING").ok().and_then(|v| v.parse().ok()).unwrap_or(0.1);
+    let program = match std::env::var("KERF_BENCH_PROGRAM") {
+        Ok(path) => std::fs::read_to_string(&path).expect("KERF_BENCH_PROGRAM names a readable G-code file"),
+        Err(_) => raster(rows),
+    };
     let request: VerifyRequest = serde_json::from_value(json!({
-        "program": raster(rows),
+        "program": program,
         "tools": [{"kind": "ball", "radius": 3, "flute_length": 20, "stickout": 30}],
         "stock": {"kind": "box", "min": [0, 0, -40], "max": [100, 100, 0]},
         "resolution": spacing,
     }))
     .expect("a valid request");
     let tools = [Tool { flute_length: Some(20.0), stickout: Some(30.0), ..Tool::new(ToolKind::Ball, 3.0) }];
-    let started = Instant::now();
+    let (started, cpu_started) = (Instant::now(), thread_cpu_seconds());
     let cut = verify::verify(&request, &tools, &Run::default()).expect("verified");
     let seconds = started.elapsed().as_secs_f64();
+    let cpu = thread_cpu_seconds().zip(cpu_started).map(|(end, start)| end - start);
     println!(
         "verify raster: {} blocks, spacing {spacing} mm, {} rays, {} dexel updates, removed {:.1} mm³; one solve \
-         {seconds:.2} s, {:.3e} updates/s",
+         {seconds:.2} s, {:.3e} updates/s; CPU {} s, {} updates/s",
         cut.moves,
         cut.rays[0] * cut.rays[1],
         cut.dexel_updates,
         cut.removed_volume_mm3,
-        cut.dexel_updates as f64 / seconds
+        cut.dexel_updates as f64 / seconds,
+        cpu.map_or("-".into(), |cpu| format!("{cpu:.2}")),
+        cpu.map_or("-".into(), |cpu| format!("{:.3e}", cut.dexel_updates as f64 / cpu)),
     );
     let mut group = c.benchmark_group("verify");
     group.sample_size(10);
