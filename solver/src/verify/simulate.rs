@@ -171,7 +171,7 @@ struct Simulation<'a> {
     findings: Vec<Finding>,
     left_off: usize,
     updates: u64,
-    removed_pieces: Vec<Interval>,
+    scratch: Scratch,
     /// Whether a non-cutting member met the stock.
     touched: bool,
 }
@@ -189,13 +189,8 @@ impl Simulation<'_> {
     fn cut(&mut self, body: &Body, segment: &Segment, outcome: &mut MoveOutcome) {
         let area = self.stock.grid.cell_area();
         let (part, tolerance) = (&self.part, self.job.tolerance);
-        self.updates += sweep_cutter(
-            &mut self.stock,
-            &mut self.tops,
-            body,
-            segment,
-            &mut self.removed_pieces,
-            |index, x, y, pieces| {
+        self.updates +=
+            sweep_cutter(&mut self.stock, &mut self.tops, body, segment, &mut self.scratch, |index, x, y, pieces| {
                 for &[low, high] in pieces {
                     outcome.removed += (high - low) * area;
                     outcome.deepest.add(high - low, (high - low) * area, [x, y, low]);
@@ -206,8 +201,7 @@ impl Simulation<'_> {
                         outcome.gouge.add(depth, depth * area, [x, y, lowest]);
                     }
                 }
-            },
-        );
+            });
     }
 
     /// Checks the non-cutting `body` (slot `slot` of the contacts) along `segment` against the
@@ -328,14 +322,14 @@ impl Simulation<'_> {
 /// of the swept footprint, row by row, those whose material reaches above the body's lowest
 /// point there. A ray holding one interval that the body's top clears (the common case of a
 /// z-map) is clipped from above; any other goes through the general interval subtraction.
-/// `removed` is called with the ray's index, x and y and the pieces removed from it (in
-/// `pieces`, scratch space); the answer is the number of rays queried.
+/// `removed` is called with the ray's index, x and y and the pieces removed from it; the answer
+/// is the number of rays queried.
 pub(crate) fn sweep_cutter(
     stock: &mut Field,
     tops: &mut Tops,
     body: &Body,
     segment: &Segment,
-    pieces: &mut Vec<Interval>,
+    scratch: &mut Scratch,
     mut removed: impl FnMut(usize, f64, f64, &[Interval]),
 ) -> u64 {
     let grid = stock.grid;
@@ -350,13 +344,18 @@ pub(crate) fn sweep_cutter(
         Shape::Sphere => f64::NEG_INFINITY,
         Shape::Rounded { .. } | Shape::Cylinder { .. } => segment.low_z() + body.top,
     };
+    let capsule = segment.sweeps_capsule(body);
     let mut queries = 0;
     for j in rows {
         let y = grid.y(j);
         let Some([from, to]) = segment.row(body.radius, y) else {
             continue;
         };
-        for i in grid.span(0, from, to) {
+        let columns = grid.span(0, from, to);
+        if capsule {
+            segment.lowest_on_row(body.radius, grid.origin[0], grid.spacing, columns.clone(), y, &mut scratch.lows);
+        }
+        for i in columns.clone() {
             let index = j * grid.nx + i;
             let ray = &mut stock.rays[index];
             let top = dexel::top(ray);
@@ -365,13 +364,19 @@ pub(crate) fn sweep_cutter(
             }
             let x = grid.x(i);
             queries += 1;
-            let Some(low) = segment.lowest(body, x, y) else {
-                continue;
+            let low = if capsule {
+                scratch.lows[i - columns.start]
+            } else {
+                match segment.lowest(body, x, y) {
+                    Some(low) => low,
+                    None => continue,
+                }
             };
             if top <= low {
                 continue;
             }
             tops.cut(i, j);
+            let pieces = &mut scratch.pieces;
             pieces.clear();
             if ray.len() == 1 && top <= roof {
                 let [bottom, _] = ray[0];
@@ -393,6 +398,15 @@ pub(crate) fn sweep_cutter(
     queries
 }
 
+/// Space a sweep reuses from move to move.
+#[derive(Debug, Default)]
+pub(crate) struct Scratch {
+    /// The pieces removed from one ray.
+    pieces: Vec<Interval>,
+    /// The body's lowest point on the rays of one row.
+    lows: Vec<f64>,
+}
+
 /// Cuts `job`'s program under `run` (progress, cancellation, the answer budget).
 ///
 /// # Errors
@@ -412,7 +426,7 @@ pub(crate) fn cut(job: &Job, run: &Run<'_>) -> Result<Cut, SolverError> {
         findings: Vec::new(),
         left_off: 0,
         updates: 0,
-        removed_pieces: Vec::new(),
+        scratch: Scratch::default(),
         touched: false,
     };
     let moves = &job.program.moves;
@@ -613,7 +627,7 @@ mod tests {
                 };
                 let segment = Segment::new(from, to);
                 let mut removed = Vec::new();
-                sweep_cutter(&mut fast, &mut tops, &body, &segment, &mut Vec::new(), |index, _, _, pieces| {
+                sweep_cutter(&mut fast, &mut tops, &body, &segment, &mut Scratch::default(), |index, _, _, pieces| {
                     removed.extend(pieces.iter().map(|&piece| (index, piece)));
                 });
                 prop_assert_eq!(&removed, &sweep_every_ray(&mut every, &body, &segment));
