@@ -159,9 +159,9 @@ def main():
     kerf_removed = kerf_runs[0][1]
     numpy_removed = numpy_runs[0][0]
     numpy_seconds = min(run[1] for run in numpy_runs)
-    blocks = len(program.splitlines()) - 4
+    blocks = sum(1 for line in program.splitlines() if line.startswith("G1"))
     print(kerf_runs[0][2])
-    print(f"raster: {blocks} blocks (G1), spacing {args.spacing} mm, {args.rounds} rounds, least time")
+    print(f"raster: {blocks} feed moves, spacing {args.spacing} mm, {args.rounds} rounds, least time")
     print(f"kerf  : {kerf_seconds:8.2f} s CPU (the solve), removed {kerf_removed:.1f} mm³")
     print(f"numpy : {numpy_seconds:8.2f} s CPU (the moves), removed {numpy_removed:.1f} mm³")
     print(f"ratio numpy ÷ kerf: {numpy_seconds / kerf_seconds:.1f}")

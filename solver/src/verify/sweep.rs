@@ -167,7 +167,7 @@ impl Segment {
             Shape::Sphere => self.capsule_high(body.radius, px, py).unwrap_or(low),
             Shape::Rounded { .. } | Shape::Cylinder { .. } => {
                 let half = (room / self.uu).sqrt();
-                let t_in = (closest - half).max(0.0).min(1.0);
+                let t_in = (closest - half).clamp(0.0, 1.0);
                 let t_out = (closest + half).min(1.0).max(t_in);
                 (z0 + t_in * (z1 - z0)).max(z0 + t_out * (z1 - z0)) + body.top
             }
