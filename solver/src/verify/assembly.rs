@@ -83,6 +83,16 @@ impl Body {
         }
     }
 
+    /// Whether the solid's lower surface is a sphere's (a ball end or a lollipop head): its
+    /// sweep along a line is a capsule.
+    pub fn is_round(&self) -> bool {
+        match self.shape {
+            Shape::Sphere => true,
+            Shape::Rounded { corner } => corner == self.radius,
+            Shape::Cylinder { .. } => false,
+        }
+    }
+
     /// The lowest height of the solid (at its axis).
     pub fn bottom(&self) -> f64 {
         self.lower(0.0)

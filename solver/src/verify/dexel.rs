@@ -80,6 +80,79 @@ impl Field {
     }
 }
 
+/// Rays on a side of a tile of [`Tops`].
+const TILE: usize = 32;
+
+/// An upper bound of the highest material over square tiles of the grid's rays: a body whose
+/// lowest point over a tile is at or above it cannot meet anything there, so its rays are not
+/// visited. Material is only ever removed, so a bound once true stays true; a tile whose rays
+/// were cut is marked and its bound is tightened (rescanned) only when a check needs it.
+#[derive(Debug, Clone)]
+pub(crate) struct Tops {
+    columns: usize,
+    bounds: Vec<f64>,
+    stale: Vec<bool>,
+}
+
+impl Tops {
+    pub fn new(field: &Field) -> Self {
+        let grid = field.grid;
+        let (columns, rows) = (grid.nx.div_ceil(TILE), grid.ny.div_ceil(TILE));
+        let mut tops =
+            Self { columns, bounds: vec![f64::NEG_INFINITY; columns * rows], stale: vec![false; columns * rows] };
+        for j in 0..grid.ny {
+            for i in 0..grid.nx {
+                let bound = &mut tops.bounds[(j / TILE) * columns + i / TILE];
+                *bound = bound.max(top(&field.rays[j * grid.nx + i]));
+            }
+        }
+        tops
+    }
+
+    /// Marks the tile of ray `(i, j)` as cut.
+    pub fn cut(&mut self, i: usize, j: usize) {
+        self.stale[(j / TILE) * self.columns + i / TILE] = true;
+    }
+
+    /// Whether some ray of `columns` × `rows` may hold material above `floor`: the tiles they
+    /// cover are checked, stale ones rescanned.
+    pub fn above(
+        &mut self,
+        field: &Field,
+        columns: std::ops::Range<usize>,
+        rows: std::ops::Range<usize>,
+        floor: f64,
+    ) -> bool {
+        if columns.is_empty() || rows.is_empty() {
+            return false;
+        }
+        let grid = field.grid;
+        for tj in rows.start / TILE..=(rows.end - 1) / TILE {
+            for ti in columns.start / TILE..=(columns.end - 1) / TILE {
+                let tile = tj * self.columns + ti;
+                if self.bounds[tile] <= floor {
+                    continue;
+                }
+                if self.stale[tile] {
+                    let mut bound = f64::NEG_INFINITY;
+                    for j in tj * TILE..((tj + 1) * TILE).min(grid.ny) {
+                        for ray in &field.rays[j * grid.nx + ti * TILE..j * grid.nx + ((ti + 1) * TILE).min(grid.nx)] {
+                            bound = bound.max(top(ray));
+                        }
+                    }
+                    self.bounds[tile] = bound;
+                    self.stale[tile] = false;
+                    if bound <= floor {
+                        continue;
+                    }
+                }
+                return true;
+            }
+        }
+        false
+    }
+}
+
 /// The total length of the intervals of `ray`.
 pub(crate) fn length(ray: &[Interval]) -> f64 {
     ray.iter().map(|[low, high]| high - low).sum()

@@ -9,8 +9,8 @@ use crate::capability::Run;
 use crate::error::{ErrorCode, SolverError};
 use crate::gcode::reader::{MoveKind, ReadMove};
 
-use super::assembly::{Body, Member};
-use super::dexel::{self, Field, Interval};
+use super::assembly::{Body, Member, Shape};
+use super::dexel::{self, Field, Interval, Tops};
 use super::job::Job;
 use super::sweep::Segment;
 
@@ -165,11 +165,13 @@ struct MoveOutcome {
 struct Simulation<'a> {
     job: &'a Job,
     stock: Field,
+    /// Bounds of the stock's highest material over tiles of rays.
+    tops: Tops,
     part: Option<Field>,
     findings: Vec<Finding>,
     left_off: usize,
     updates: u64,
-    removed_pieces: Vec<Interval>,
+    scratch: Scratch,
     /// Whether a non-cutting member met the stock.
     touched: bool,
 }
@@ -185,37 +187,21 @@ impl Simulation<'_> {
 
     /// Sweeps the cutter `body` along `segment`, removing material.
     fn cut(&mut self, body: &Body, segment: &Segment, outcome: &mut MoveOutcome) {
-        let grid = self.stock.grid;
-        let area = grid.cell_area();
-        let (lo, hi) = segment.reach(body.radius);
-        let floor = segment.low_z() + body.bottom();
-        for j in grid.span(1, lo[1], hi[1]) {
-            let y = grid.y(j);
-            for i in grid.span(0, lo[0], hi[0]) {
-                let index = j * grid.nx + i;
-                let ray = &mut self.stock.rays[index];
-                if dexel::top(ray) <= floor {
-                    continue;
-                }
-                let x = grid.x(i);
-                self.updates += 1;
-                let Some(cut) = segment.cut(body, x, y) else {
-                    continue;
-                };
-                self.removed_pieces.clear();
-                dexel::subtract(ray, cut, &mut self.removed_pieces);
-                for &[low, high] in &self.removed_pieces {
+        let area = self.stock.grid.cell_area();
+        let (part, tolerance) = (&self.part, self.job.tolerance);
+        self.updates +=
+            sweep_cutter(&mut self.stock, &mut self.tops, body, segment, &mut self.scratch, |index, x, y, pieces| {
+                for &[low, high] in pieces {
                     outcome.removed += (high - low) * area;
                     outcome.deepest.add(high - low, (high - low) * area, [x, y, low]);
-                    if let Some(part) = &self.part
+                    if let Some(part) = part
                         && let Some((depth, lowest)) = dexel::overlap(&part.rays[index], [low, high])
-                        && depth > self.job.tolerance
+                        && depth > tolerance
                     {
                         outcome.gouge.add(depth, depth * area, [x, y, lowest]);
                     }
                 }
-            }
-        }
+            });
     }
 
     /// Checks the non-cutting `body` (slot `slot` of the contacts) along `segment` against the
@@ -224,9 +210,16 @@ impl Simulation<'_> {
         let grid = self.stock.grid;
         let (lo, hi) = segment.reach(body.radius);
         let floor = segment.low_z() + body.bottom();
-        for j in grid.span(1, lo[1], hi[1]) {
+        let rows = grid.span(1, lo[1], hi[1]);
+        if !self.tops.above(&self.stock, grid.span(0, lo[0], hi[0]), rows.clone(), floor) {
+            return;
+        }
+        for j in rows {
             let y = grid.y(j);
-            for i in grid.span(0, lo[0], hi[0]) {
+            let Some([from, to]) = segment.row(body.radius, y) else {
+                continue;
+            };
+            for i in grid.span(0, from, to) {
                 let ray = &self.stock.rays[j * grid.nx + i];
                 if dexel::top(ray) <= floor {
                     continue;
@@ -325,6 +318,95 @@ impl Simulation<'_> {
     }
 }
 
+/// Sweeps the cutter `body` along `segment` through `stock`, removing material: over the rays
+/// of the swept footprint, row by row, those whose material reaches above the body's lowest
+/// point there. A ray holding one interval that the body's top clears (the common case of a
+/// z-map) is clipped from above; any other goes through the general interval subtraction.
+/// `removed` is called with the ray's index, x and y and the pieces removed from it; the answer
+/// is the number of rays queried.
+pub(crate) fn sweep_cutter(
+    stock: &mut Field,
+    tops: &mut Tops,
+    body: &Body,
+    segment: &Segment,
+    scratch: &mut Scratch,
+    mut removed: impl FnMut(usize, f64, f64, &[Interval]),
+) -> u64 {
+    let grid = stock.grid;
+    let (lo, hi) = segment.reach(body.radius);
+    let floor = segment.low_z() + body.bottom();
+    let rows = grid.span(1, lo[1], hi[1]);
+    if !tops.above(stock, grid.span(0, lo[0], hi[0]), rows.clone(), floor) {
+        return 0;
+    }
+    // The body's top along the move is at least this high on every ray it reaches.
+    let roof = match body.shape {
+        Shape::Sphere => f64::NEG_INFINITY,
+        Shape::Rounded { .. } | Shape::Cylinder { .. } => segment.low_z() + body.top,
+    };
+    let capsule = segment.sweeps_capsule(body);
+    let mut queries = 0;
+    for j in rows {
+        let y = grid.y(j);
+        let Some([from, to]) = segment.row(body.radius, y) else {
+            continue;
+        };
+        let columns = grid.span(0, from, to);
+        if capsule {
+            segment.lowest_on_row(body.radius, grid.origin[0], grid.spacing, columns.clone(), y, &mut scratch.lows);
+        }
+        for i in columns.clone() {
+            let index = j * grid.nx + i;
+            let ray = &mut stock.rays[index];
+            let top = dexel::top(ray);
+            if top <= floor {
+                continue;
+            }
+            let x = grid.x(i);
+            queries += 1;
+            let low = if capsule {
+                scratch.lows[i - columns.start]
+            } else {
+                match segment.lowest(body, x, y) {
+                    Some(low) => low,
+                    None => continue,
+                }
+            };
+            if top <= low {
+                continue;
+            }
+            tops.cut(i, j);
+            let pieces = &mut scratch.pieces;
+            pieces.clear();
+            if ray.len() == 1 && top <= roof {
+                let [bottom, _] = ray[0];
+                pieces.push([bottom.max(low), top]);
+                if low <= bottom {
+                    ray.clear();
+                } else {
+                    ray[0][1] = low;
+                }
+            } else {
+                let Some(cut) = segment.cut(body, x, y) else {
+                    continue;
+                };
+                dexel::subtract(ray, cut, pieces);
+            }
+            removed(index, x, y, pieces);
+        }
+    }
+    queries
+}
+
+/// Space a sweep reuses from move to move.
+#[derive(Debug, Default)]
+pub(crate) struct Scratch {
+    /// The pieces removed from one ray.
+    pieces: Vec<Interval>,
+    /// The body's lowest point on the rays of one row.
+    lows: Vec<f64>,
+}
+
 /// Cuts `job`'s program under `run` (progress, cancellation, the answer budget).
 ///
 /// # Errors
@@ -340,14 +422,16 @@ pub(crate) fn cut_stock(job: &Job, run: &Run<'_>) -> Result<(Cut, Field), Solver
     let part = job.part.as_ref().map(|part| part.field(job.grid));
     let stock_volume = stock.volume();
     let part_volume = part.as_ref().map(Field::volume);
+    let tops = Tops::new(&stock);
     let mut simulation = Simulation {
         job,
         stock,
+        tops,
         part,
         findings: Vec::new(),
         left_off: 0,
         updates: 0,
-        removed_pieces: Vec::new(),
+        scratch: Scratch::default(),
         touched: false,
     };
     let moves = &job.program.moves;
@@ -457,4 +541,104 @@ fn left_material(simulation: &Simulation<'_>, allowance: f64) -> Option<Finding>
         volume_mm3: worst.volume,
         share: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::super::assembly::Shape;
+    use super::super::dexel::{Grid, Ray};
+    use super::*;
+
+    /// The sweep without its shortcuts: every ray of the move's bounding rectangle, the body's
+    /// interval on it subtracted from the interval list.
+    fn sweep_every_ray(stock: &mut Field, body: &Body, segment: &Segment) -> Vec<(usize, Interval)> {
+        let grid = stock.grid;
+        let (lo, hi) = segment.reach(body.radius);
+        let mut removed = Vec::new();
+        for j in grid.span(1, lo[1], hi[1]) {
+            for i in grid.span(0, lo[0], hi[0]) {
+                let index = j * grid.nx + i;
+                if let Some(cut) = segment.cut(body, grid.x(i), grid.y(j)) {
+                    let mut pieces = Vec::new();
+                    dexel::subtract(&mut stock.rays[index], cut, &mut pieces);
+                    removed.extend(pieces.into_iter().map(|piece| (index, piece)));
+                }
+            }
+        }
+        removed
+    }
+
+    /// A stock on a 0.1 mm grid over [−8, 8]²: a block from −6 to 0 with a bore along x (two
+    /// intervals on the rays over it) and, where `stepped`, a step cut into one side.
+    fn stock(stepped: bool) -> Field {
+        let grid = Grid::covering([-8.0, -8.0], [8.0, 8.0], 0.1);
+        let mut rays = Vec::with_capacity(grid.len());
+        for j in 0..grid.ny {
+            for i in 0..grid.nx {
+                let (x, y) = (grid.x(i), grid.y(j));
+                let top = if stepped && x > 2.0 { -2.0 } else { 0.0 };
+                let mut ray: Ray = smallvec::smallvec![[-6.0, top]];
+                if y.abs() < 1.5 {
+                    let half = (2.25 - y * y).sqrt();
+                    dexel::subtract(&mut ray, [-3.0 - half, -3.0 + half], &mut Vec::new());
+                }
+                rays.push(ray);
+            }
+        }
+        Field { grid, rays }
+    }
+
+    fn shape() -> impl Strategy<Value = (Shape, f64)> {
+        (0..4usize, 0.5..3.0f64).prop_map(|(kind, radius)| {
+            let shape = match kind {
+                0 => Shape::Rounded { corner: radius },
+                1 => Shape::Rounded { corner: 0.0 },
+                2 => Shape::Rounded { corner: radius / 3.0 },
+                _ => Shape::Sphere,
+            };
+            (shape, radius)
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        #[test]
+        fn the_sweep_leaves_the_same_rays_as_subtracting_on_every_ray(
+            moves in prop::collection::vec(
+                (prop::array::uniform3(-7.0..7.0f64), prop::array::uniform3(-7.0..7.0f64), 0..3usize), 1..5),
+            (shape, radius) in shape(),
+            short in prop::bool::ANY,
+            stepped in prop::bool::ANY,
+        ) {
+            // Short flutes let material stand above the cutter's top (the general path), long
+            // ones clip every ray from above.
+            let top = match shape {
+                Shape::Sphere => 2.0 * radius,
+                _ if short => 1.5,
+                _ => 30.0,
+            };
+            let body = Body { member: Member::Cutter, shape, radius, top };
+            let (mut fast, mut every) = (stock(stepped), stock(stepped));
+            let mut tops = Tops::new(&fast);
+            for (from, to, kind) in moves {
+                // Horizontal, vertical and sloping moves.
+                let from = [from[0], from[1], from[2] * 0.6 - 2.0];
+                let to = match kind {
+                    0 => [to[0], to[1], from[2]],
+                    1 => [from[0], from[1], to[2] * 0.6 - 2.0],
+                    _ => [to[0], to[1], to[2] * 0.6 - 2.0],
+                };
+                let segment = Segment::new(from, to);
+                let mut removed = Vec::new();
+                sweep_cutter(&mut fast, &mut tops, &body, &segment, &mut Scratch::default(), |index, _, _, pieces| {
+                    removed.extend(pieces.iter().map(|&piece| (index, piece)));
+                });
+                prop_assert_eq!(&removed, &sweep_every_ray(&mut every, &body, &segment));
+                prop_assert!(fast.rays == every.rays);
+            }
+        }
+    }
 }

@@ -26,12 +26,20 @@ pub(crate) struct Segment {
     ux: f64,
     uy: f64,
     uu: f64,
+    /// 1 / uu, the rise b_z − a_z and |b − a|², for the capsule of a sloping move.
+    inverse_uu: f64,
+    vz: f64,
+    vv: f64,
+    /// Whether the move slopes (neither horizontal nor vertical).
+    sloping: bool,
 }
 
 impl Segment {
     pub fn new(from: [f64; 3], to: [f64; 3]) -> Self {
-        let (ux, uy) = (to[0] - from[0], to[1] - from[1]);
-        Self { from, to, ux, uy, uu: ux * ux + uy * uy }
+        let (ux, uy, vz) = (to[0] - from[0], to[1] - from[1], to[2] - from[2]);
+        let uu = ux * ux + uy * uy;
+        let sloping = uu >= VERTICAL && from[2] != to[2];
+        Self { from, to, ux, uy, uu, inverse_uu: 1.0 / uu, vz, vv: uu + vz * vz, sloping }
     }
 
     /// The xy rectangle a body of `radius` sweeps.
@@ -47,16 +55,70 @@ impl Segment {
         self.from[2].min(self.to[2])
     }
 
-    /// The interval of the ray through `(x, y)` that `body` sweeps, if it reaches the ray.
-    pub fn cut(&self, body: &Body, x: f64, y: f64) -> Option<Interval> {
+    /// The interval of x on the row of rays at `y` within `radius` of the move horizontally
+    /// (the footprint of a body of that radius), if any. Rays outside it are out of reach;
+    /// the interval is widened by a rounding margin, so [`Self::lowest`] still decides each ray.
+    pub fn row(&self, radius: f64, y: f64) -> Option<[f64; 2]> {
+        let (ax, ay) = (self.from[0], self.from[1]);
+        let mut low = f64::INFINITY;
+        let mut high = f64::NEG_INFINITY;
+        let mut disc = |cx: f64, cy: f64| {
+            let room = radius * radius - (y - cy) * (y - cy);
+            if room >= 0.0 {
+                let half = room.sqrt();
+                low = low.min(cx - half);
+                high = high.max(cx + half);
+            }
+        };
+        disc(ax, ay);
+        disc(self.to[0], self.to[1]);
+        if self.uu >= VERTICAL {
+            // The strip between the end discs: 0 ≤ (p − a)·u ≤ |u|² and |(p − a) × u| ≤ r·|u|,
+            // each a slab that meets the row in an interval of x (or all or none of it).
+            let dy = y - ay;
+            let slab = |slope: f64, offset: f64, from: f64, to: f64| -> Option<[f64; 2]> {
+                // from ≤ offset + slope·(x − ax) ≤ to
+                if slope == 0.0 {
+                    return (from <= offset && offset <= to).then_some([f64::NEG_INFINITY, f64::INFINITY]);
+                }
+                let (p, q) = (ax + (from - offset) / slope, ax + (to - offset) / slope);
+                Some([p.min(q), p.max(q)])
+            };
+            let across = radius * self.uu.sqrt();
+            if let (Some(along), Some(side)) =
+                (slab(self.ux, dy * self.uy, 0.0, self.uu), slab(-self.uy, self.ux * dy, -across, across))
+            {
+                let (from, to) = (along[0].max(side[0]), along[1].min(side[1]));
+                if from <= to {
+                    low = low.min(from);
+                    high = high.max(to);
+                }
+            }
+        }
+        let margin = 1e-9 * (1.0 + low.abs().max(high.abs()));
+        (low <= high).then_some([low - margin, high + margin])
+    }
+
+    /// The lowest z `body` reaches on the ray through `(x, y)` along the move, if it reaches the
+    /// ray: the first end of [`Self::cut`], without its top.
+    #[inline(always)]
+    pub fn lowest(&self, body: &Body, x: f64, y: f64) -> Option<f64> {
+        if self.sloping && body.is_round() {
+            return self.capsule_low(body.radius, x - self.from[0], y - self.from[1]);
+        }
+        self.lowest_otherwise(body, x, y)
+    }
+
+    /// [`Self::lowest`] of a body that does not sweep a capsule, or of a move that does not slope.
+    #[inline(never)]
+    fn lowest_otherwise(&self, body: &Body, x: f64, y: f64) -> Option<f64> {
         let (px, py) = (x - self.from[0], y - self.from[1]);
         let reach = body.radius;
         let (z0, z1) = (self.from[2], self.to[2]);
         if self.uu < VERTICAL {
             let d = (px * px + py * py).sqrt();
-            return (d <= reach).then(|| [z0.min(z1) + body.lower(d), z0.max(z1) + body.upper(d)]);
+            return (d <= reach).then(|| z0.min(z1) + body.lower(d));
         }
-        // dist²(t) = uu·t² − 2·pu·t + pp ≤ reach² on [t_in, t_out].
         let pu = px * self.ux + py * self.uy;
         let pp = px * px + py * py;
         let closest = pu / self.uu;
@@ -73,63 +135,133 @@ impl Segment {
         let distance = |t: f64| (self.uu * t * t - 2.0 * pu * t + pp).max(0.0).sqrt();
         let height = |t: f64| z0 + t * (z1 - z0);
         if z0 == z1 {
-            let d = distance(closest.clamp(t_in, t_out));
-            return Some([z0 + body.lower(d), z0 + body.upper(d)]);
+            return Some(z0 + body.lower(distance(closest.clamp(t_in, t_out))));
         }
-        let ends = [height(t_in), height(t_out)];
-        let low = match body.shape {
-            Shape::Cylinder { base } => ends[0].min(ends[1]) + base,
-            Shape::Rounded { corner: 0.0 } => ends[0].min(ends[1]),
-            Shape::Rounded { corner } if corner == body.radius => self.capsule(body.radius, x, y)?[0],
-            Shape::Sphere => self.capsule(body.radius, x, y)?[0],
-            Shape::Rounded { .. } => golden(t_in, t_out, |t| height(t) + body.lower(distance(t))),
-        };
+        Some(match body.shape {
+            Shape::Cylinder { base } => height(t_in).min(height(t_out)) + base,
+            Shape::Rounded { corner: 0.0 } => height(t_in).min(height(t_out)),
+            _ => golden(t_in, t_out, |t| height(t) + body.lower(distance(t))),
+        })
+    }
+
+    /// The interval of the ray through `(x, y)` that `body` sweeps, if it reaches the ray.
+    pub fn cut(&self, body: &Body, x: f64, y: f64) -> Option<Interval> {
+        let low = self.lowest(body, x, y)?;
+        let (px, py) = (x - self.from[0], y - self.from[1]);
+        let (z0, z1) = (self.from[2], self.to[2]);
+        if self.uu < VERTICAL {
+            let d = (px * px + py * py).sqrt();
+            return Some([low, z0.max(z1) + body.upper(d)]);
+        }
+        let pu = px * self.ux + py * self.uy;
+        let pp = px * px + py * py;
+        let closest = pu / self.uu;
+        let room = (body.radius * body.radius - (pp - pu * closest)).max(0.0);
+        if z0 == z1 {
+            let half = (room / self.uu).sqrt();
+            let t = closest.clamp((closest - half).max(0.0), (closest + half).min(1.0));
+            let d = (self.uu * t * t - 2.0 * pu * t + pp).max(0.0).sqrt();
+            return Some([low, z0 + body.upper(d)]);
+        }
         let high = match body.shape {
-            Shape::Sphere => self.capsule(body.radius, x, y)?[1],
-            Shape::Rounded { .. } | Shape::Cylinder { .. } => ends[0].max(ends[1]) + body.top,
+            Shape::Sphere => self.capsule_high(body.radius, px, py).unwrap_or(low),
+            Shape::Rounded { .. } | Shape::Cylinder { .. } => {
+                let half = (room / self.uu).sqrt();
+                let t_in = (closest - half).clamp(0.0, 1.0);
+                let t_out = (closest + half).min(1.0).max(t_in);
+                (z0 + t_in * (z1 - z0)).max(z0 + t_out * (z1 - z0)) + body.top
+            }
         };
         Some([low, high])
     }
 
-    /// Where the ray through `(x, y)` enters and leaves the capsule of `radius` round the
-    /// segment of centres `radius` above the tip: the lowest point of a ball's sweep (and both
-    /// ends of a sphere's). The capsule is the two end spheres and the cylinder between them;
-    /// the cylinder counts where the point's projection falls on the segment (elsewhere its
-    /// surface lies inside an end sphere).
-    fn capsule(&self, radius: f64, x: f64, y: f64) -> Option<Interval> {
-        let mut low = f64::INFINITY;
-        let mut high = f64::NEG_INFINITY;
+    /// Where the ray at `(px, py)` from the start enters the capsule of `radius` round the
+    /// segment of centres `radius` above the tip (the lowest point of a ball's or sphere's
+    /// sweep), for a sloping move.
+    ///
+    /// The lowest point of the ball over the ray is c_z(t) − √(r² − dist(t)²), convex in t; over
+    /// all t it is where the ray enters the infinite cylinder round the centres' line, at the
+    /// lower root σ (height above the start's centre) of |(p + σẑ) × v|² = r²|v|² (v the move,
+    /// u its horizontal part): |u|²σ² − 2 v_z (p·u) σ + |v|²(|p|² − r²) − (p·u)² = 0, whose
+    /// discriminant over 4 is |v|²·w with w = |u|²(r² − |p|²) + (p·u)², |u|² times r² less the
+    /// squared distance from the ray to the move's line. Where that point's foot on the line is
+    /// within the move (0 ≤ p·u + σ v_z ≤ |v|²) it is the answer; before the start (after the
+    /// end) the least over the move is at the start (end), on its sphere, which then reaches the
+    /// ray exactly when the move's reach does.
+    #[inline(always)]
+    fn capsule_low(&self, radius: f64, px: f64, py: f64) -> Option<f64> {
+        let pu = px * self.ux + py * self.uy;
+        let pp = px * px + py * py;
         let r2 = radius * radius;
-        for centre in [self.from, self.to] {
-            let d2 = (x - centre[0]).powi(2) + (y - centre[1]).powi(2);
-            if d2 <= r2 {
-                let half = (r2 - d2).sqrt();
-                low = low.min(centre[2] + radius - half);
-                high = high.max(centre[2] + radius + half);
-            }
+        let w = self.uu * (r2 - pp) + pu * pu;
+        if w < 0.0 {
+            return None;
         }
-        // Points P = (x, y, s) at `radius` from the axis line C0 + t·v: |(q + s·ẑ) × v|² = r²·|v|²
-        // with q = (x, y, 0) − C0.
-        let v = [self.ux, self.uy, self.to[2] - self.from[2]];
-        let vv = self.uu + v[2] * v[2];
-        let q = [x - self.from[0], y - self.from[1], -(self.from[2] + radius)];
-        let a = [q[1] * v[2] - q[2] * v[1], q[2] * v[0] - q[0] * v[2], q[0] * v[1] - q[1] * v[0]];
-        let b = [-v[1], v[0], 0.0];
-        let bb = b[0] * b[0] + b[1] * b[1];
-        let ab = a[0] * b[0] + a[1] * b[1];
-        let aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-        let discriminant = ab * ab - bb * (aa - r2 * vv);
-        if discriminant >= 0.0 {
-            let root = discriminant.sqrt();
-            for s in [(-ab - root) / bb, (-ab + root) / bb] {
-                let t = (q[0] * v[0] + q[1] * v[1] + (q[2] + s) * v[2]) / vv;
-                if (0.0..=1.0).contains(&t) {
-                    low = low.min(s);
-                    high = high.max(s);
-                }
-            }
+        let sigma = (self.vz * pu - (self.vv * w).sqrt()) * self.inverse_uu;
+        let foot = pu + sigma * self.vz;
+        if foot >= 0.0 && foot <= self.vv {
+            return Some(self.from[2] + radius + sigma);
         }
-        (low <= high).then_some([low, high])
+        let (z, d2) = if foot < 0.0 { (self.from[2], pp) } else { (self.to[2], pp - 2.0 * pu + self.uu) };
+        (d2 <= r2).then(|| z + radius - (r2 - d2).sqrt())
+    }
+
+    /// Whether [`Self::lowest_on_row`] applies: `body` sweeps a capsule along this move.
+    pub fn sweeps_capsule(&self, body: &Body) -> bool {
+        self.sloping && body.is_round()
+    }
+
+    /// [`Self::lowest`] of a body that sweeps a capsule on the rays at x = `origin + (k + ½)·step`
+    /// for `k` in `columns` of the row at `y`, into `lows` (+∞ where it does not reach the ray):
+    /// the same operations as [`Self::capsule_low`], bit for bit, without branches, so that a
+    /// whole row is computed in vector registers.
+    pub fn lowest_on_row(
+        &self,
+        radius: f64,
+        origin: f64,
+        step: f64,
+        columns: std::ops::Range<usize>,
+        y: f64,
+        lows: &mut Vec<f64>,
+    ) {
+        let py = y - self.from[1];
+        let r2 = radius * radius;
+        let (from_z, to_z) = (self.from[2] + radius, self.to[2] + radius);
+        lows.clear();
+        lows.extend(columns.map(|k| {
+            let px = (origin + (k as f64 + 0.5) * step) - self.from[0];
+            let pu = px * self.ux + py * self.uy;
+            let pp = px * px + py * py;
+            let w = self.uu * (r2 - pp) + pu * pu;
+            let sigma = (self.vz * pu - (self.vv * w.max(0.0)).sqrt()) * self.inverse_uu;
+            let foot = pu + sigma * self.vz;
+            let on_move = self.from[2] + radius + sigma;
+            let before = foot < 0.0;
+            let d2 = if before { pp } else { pp - 2.0 * pu + self.uu };
+            let centre = if before { from_z } else { to_z };
+            let sphere = if d2 <= r2 { centre - (r2 - d2).max(0.0).sqrt() } else { f64::INFINITY };
+            let low = if foot >= 0.0 && foot <= self.vv { on_move } else { sphere };
+            if w < 0.0 { f64::INFINITY } else { low }
+        }));
+    }
+
+    /// Where the ray at `(px, py)` from the start leaves that capsule (the highest point of a
+    /// sphere's sweep): the upper root, or the end sphere beyond which its foot falls.
+    fn capsule_high(&self, radius: f64, px: f64, py: f64) -> Option<f64> {
+        let pu = px * self.ux + py * self.uy;
+        let pp = px * px + py * py;
+        let r2 = radius * radius;
+        let w = self.uu * (r2 - pp) + pu * pu;
+        if w < 0.0 {
+            return None;
+        }
+        let sigma = (self.vz * pu + (self.vv * w).sqrt()) * self.inverse_uu;
+        let foot = pu + sigma * self.vz;
+        if foot >= 0.0 && foot <= self.vv {
+            return Some(self.from[2] + radius + sigma);
+        }
+        let (z, d2) = if foot < 0.0 { (self.from[2], pp) } else { (self.to[2], pp - 2.0 * pu + self.uu) };
+        (d2 <= r2).then(|| z + radius + (r2 - d2).sqrt())
     }
 }
 
@@ -163,6 +295,8 @@ fn golden(mut a: f64, mut b: f64, f: impl Fn(f64) -> f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use proptest::prelude::prop;
+
     use super::super::assembly::{Body, Member, Shape};
     use super::*;
 
@@ -183,6 +317,98 @@ mod tests {
             }
         }
         result
+    }
+
+    /// The capsule met as the union of its two end spheres and the cylinder between them, each
+    /// root kept where its foot falls on the move: the reference the closed form is held to.
+    fn capsule_by_parts(segment: &Segment, radius: f64, x: f64, y: f64) -> Option<Interval> {
+        let mut low = f64::INFINITY;
+        let mut high = f64::NEG_INFINITY;
+        let r2 = radius * radius;
+        for centre in [segment.from, segment.to] {
+            let d2 = (x - centre[0]).powi(2) + (y - centre[1]).powi(2);
+            if d2 <= r2 {
+                let half = (r2 - d2).sqrt();
+                low = low.min(centre[2] + radius - half);
+                high = high.max(centre[2] + radius + half);
+            }
+        }
+        let v = [segment.ux, segment.uy, segment.to[2] - segment.from[2]];
+        let vv = segment.uu + v[2] * v[2];
+        let q = [x - segment.from[0], y - segment.from[1], -(segment.from[2] + radius)];
+        let a = [q[1] * v[2] - q[2] * v[1], q[2] * v[0] - q[0] * v[2], q[0] * v[1] - q[1] * v[0]];
+        let b = [-v[1], v[0], 0.0];
+        let bb = b[0] * b[0] + b[1] * b[1];
+        let ab = a[0] * b[0] + a[1] * b[1];
+        let aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+        let discriminant = ab * ab - bb * (aa - r2 * vv);
+        if discriminant >= 0.0 {
+            let root = discriminant.sqrt();
+            for s in [(-ab - root) / bb, (-ab + root) / bb] {
+                let t = (q[0] * v[0] + q[1] * v[1] + (q[2] + s) * v[2]) / vv;
+                if (0.0..=1.0).contains(&t) {
+                    low = low.min(s);
+                    high = high.max(s);
+                }
+            }
+        }
+        (low <= high).then_some([low, high])
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(256))]
+
+        #[test]
+        fn the_closed_form_capsule_is_the_union_of_its_parts(
+            from in proptest::array::uniform3(-5.0..5.0f64),
+            to in proptest::array::uniform3(-5.0..5.0f64),
+            x in -9.0..9.0f64,
+            y in -9.0..9.0f64,
+            radius in 0.2..4.0f64,
+        ) {
+            let segment = Segment::new(from, to);
+            proptest::prop_assume!(segment.uu >= VERTICAL && from[2] != to[2]);
+            let sphere = Body { member: Member::Cutter, shape: Shape::Sphere, radius, top: 2.0 * radius };
+            let parts = capsule_by_parts(&segment, radius, x, y);
+            let closed = segment.cut(&sphere, x, y);
+            let ball = segment.lowest(&ball(radius), x, y);
+            match (parts, closed) {
+                (Some(p), Some(c)) => {
+                    proptest::prop_assert!((p[0] - c[0]).abs() < 1e-6 && (p[1] - c[1]).abs() < 1e-6, "{p:?} {c:?}");
+                    proptest::prop_assert_eq!(ball, Some(c[0]));
+                }
+                (None, None) => proptest::prop_assert_eq!(ball, None),
+                // Only a ray grazing the capsule (within rounding) may be taken by one and not the other.
+                (p, c) => {
+                    let [low, high] = p.or(c).unwrap();
+                    proptest::prop_assert!(high - low < 1e-6, "{p:?} {c:?}");
+                }
+            }
+        }
+
+        #[test]
+        fn every_ray_a_body_reaches_is_in_its_row(
+            from in proptest::array::uniform3(-5.0..5.0f64),
+            to in proptest::array::uniform3(-5.0..5.0f64),
+            along in prop::bool::ANY,
+            x in -9.0..9.0f64,
+            y in -9.0..9.0f64,
+            radius in 0.2..4.0f64,
+        ) {
+            // Moves along an axis too, where a slab of the strip is a whole row or none.
+            let to = if along { [to[0], from[1], to[2]] } else { to };
+            let segment = Segment::new(from, to);
+            for body in [ball(radius), Body { member: Member::Cutter, shape: Shape::Rounded { corner: 0.0 }, radius, top: 9.0 }] {
+                if segment.lowest(&body, x, y).is_some() {
+                    let row = segment.row(radius, y);
+                    proptest::prop_assert!(row.is_some_and(|[a, b]| a <= x && x <= b), "{row:?} {x}");
+                }
+            }
+            let swapped = Segment::new([from[1], from[0], from[2]], [to[1], to[0], to[2]]);
+            if swapped.lowest(&ball(radius), y, x).is_some() {
+                proptest::prop_assert!(swapped.row(radius, x).is_some_and(|[a, b]| a <= y && y <= b));
+            }
+        }
     }
 
     #[test]
