@@ -71,6 +71,7 @@ fn deburr_case(spacing: f64) -> (VerifyRequest, [Tool; 1]) {
         tool: ToolCall::Table(1),
         arcs: Arcs::Chords,
         plunge_feed: None,
+        units: kerf_solver::units::Units::Mm,
     };
     let program = deburr::program(&answer, &post).expect("a program");
     // The outer wall z = √(50² − x²) over [−14, 14]², sampled every 0.05 mm, the hole at the bottom.
