@@ -39,7 +39,8 @@ pub fn program_controlled(answer: &ContourSolution, post: &Post, control: Contro
         Reference::Centre => answer.centre_height,
     };
     let offset = Vec3::new(0.0, 0.0, lift);
-    let mut path = Toolpath::default();
+    // Sized once: a large contour's path would otherwise be copied as it doubles.
+    let mut path = Toolpath { moves: Vec::with_capacity(answer.layers.iter().map(|layer| layer.moves.len()).sum()) };
     for layer in &answer.layers {
         control.check()?;
         let mut spans = layer.arcs.iter().filter(|_| post.arcs == Arcs::G2g3).peekable();

@@ -371,6 +371,9 @@ fn answer_layers(job: &Job, made: Vec<LayerMoves>, warnings: &mut Vec<Warning>) 
 }
 
 /// Length (mm) and time (min) of the feed moves, and the count of all moves.
+// Not inlined: inside `Prepared::answer` the two sums were kept in memory, each addition waiting
+// on a store and a load.
+#[inline(never)]
 fn feed_travel(layers: &[ContourLayer]) -> (f64, f64, usize) {
     let mut feed_length = 0.0;
     let mut time_min = 0.0;

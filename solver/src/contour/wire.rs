@@ -46,10 +46,13 @@ pub(crate) fn to_json(mut answer: ContourAnswer) -> serde_json::Result<Vec<u8>> 
 /// `layers` as a JSON array.
 ///
 /// Layers repeat one another's moves at another height, and a layer's moves share a few heights
-/// and feeds: a move whose kind, x and y are those of its counterpart in the layer before
-/// (counted from the end, as the first layer's first moves differ) copies that text instead of
-/// writing it again, and heights and feeds are formatted once each ([`Numbers`]). Copying text
-/// of the same values gives the same text.
+/// and feeds. A move's text is three pieces, each copied from its counterpart in the layer before
+/// (counted from the end, as the first layer's first moves differ) when the values it is written
+/// from are the same, else written: the head (the comma before it, kind, x and y), the z, and the
+/// tail (the feed and the closing brace; written whenever either has a tool axis). Copies of
+/// pieces that lie one after another there are made as one, so a stretch of moves differing only
+/// in height is copied in runs between its heights. Heights and feeds are formatted once each
+/// ([`Numbers`]). Copying text of the same values gives the same text.
 pub(crate) fn write_layers(out: &mut Vec<u8>, layers: &[ContourLayer]) {
     let mut previous: Vec<Written> = Vec::new();
     let mut current: Vec<Written> = Vec::new();
@@ -63,15 +66,18 @@ pub(crate) fn write_layers(out: &mut Vec<u8>, layers: &[ContourLayer]) {
         float(out, layer.z);
         out.extend_from_slice(b",\"moves\":[");
         let skipped = previous.len().checked_sub(layer.moves.len());
+        let mut copies = Copies::default();
         for (index, step) in layer.moves.iter().enumerate() {
-            if index > 0 {
-                out.push(b',');
-            }
-            let written = Written::of(step, out.len());
+            let written = Written::of(step, index > 0);
             let twin = skipped.and_then(|skipped| previous.get(index + skipped));
-            match twin.filter(|twin| twin.same_start(&written)) {
-                Some(twin) => out.extend_from_within(twin.start..twin.end),
+            let start = copies.end(out);
+            match twin.filter(|twin| twin.same_head(&written)) {
+                Some(twin) => copies.copy(out, twin.start, twin.z_start),
                 None => {
+                    copies.flush(out);
+                    if index > 0 {
+                        out.push(b',');
+                    }
                     out.extend_from_slice(kind_prefix(step.kind));
                     float(out, step.to[0]);
                     out.push(b',');
@@ -79,19 +85,34 @@ pub(crate) fn write_layers(out: &mut Vec<u8>, layers: &[ContourLayer]) {
                     out.push(b',');
                 }
             }
-            current.push(Written { end: out.len(), ..written });
-            numbers.write(out, step.to[2]);
-            out.push(b']');
-            if let Some(feed) = step.feed {
-                out.extend_from_slice(b",\"feed\":");
-                numbers.write(out, feed);
+            let z_start = copies.end(out);
+            match twin.filter(|twin| twin.z == written.z) {
+                Some(twin) => copies.copy(out, twin.z_start, twin.z_end),
+                None => {
+                    copies.flush(out);
+                    numbers.write(out, step.to[2]);
+                }
             }
-            if let Some(axis) = &step.axis {
-                out.extend_from_slice(b",\"axis\":[");
-                triple(out, axis);
+            let z_end = copies.end(out);
+            match twin.filter(|twin| twin.same_tail(&written)) {
+                Some(twin) => copies.copy(out, twin.z_end, twin.end),
+                None => {
+                    copies.flush(out);
+                    out.push(b']');
+                    if let Some(feed) = step.feed {
+                        out.extend_from_slice(b",\"feed\":");
+                        numbers.write(out, feed);
+                    }
+                    if let Some(axis) = &step.axis {
+                        out.extend_from_slice(b",\"axis\":[");
+                        triple(out, axis);
+                    }
+                    out.push(b'}');
+                }
             }
-            out.push(b'}');
+            current.push(Written { start, z_start, z_end, end: copies.end(out), ..written });
         }
+        copies.flush(out);
         out.extend_from_slice(b"]}");
         std::mem::swap(&mut previous, &mut current);
         current.clear();
@@ -99,25 +120,83 @@ pub(crate) fn write_layers(out: &mut Vec<u8>, layers: &[ContourLayer]) {
     out.push(b']');
 }
 
-/// Where a move's text up to its z begins and ends in the output (`{"kind":…,"to":[x,y,`), and
-/// the values it was written from.
+/// A range of the output waiting to be copied to its end: the next range that starts where it
+/// ends joins it, anything else written first flushes it.
+#[derive(Default)]
+struct Copies {
+    from: usize,
+    to: usize,
+}
+
+impl Copies {
+    /// Where the output ends once the waiting copy is made.
+    fn end(&self, out: &[u8]) -> usize {
+        out.len() + (self.to - self.from)
+    }
+
+    /// Copies `from..to` of the output to its end (later, joined with what follows it there).
+    fn copy(&mut self, out: &mut Vec<u8>, from: usize, to: usize) {
+        if self.to != from || self.from == self.to {
+            self.flush(out);
+            self.from = from;
+        }
+        self.to = to;
+    }
+
+    fn flush(&mut self, out: &mut Vec<u8>) {
+        if self.to > self.from {
+            out.extend_from_within(self.from..self.to);
+        }
+        self.from = 0;
+        self.to = 0;
+    }
+}
+
+/// Where a move's text lies in the output (from the comma before it, the start of its z, the end
+/// of its z, its end), and the values it was written from.
 #[derive(Clone, Copy)]
 struct Written {
+    /// Whether a comma precedes it (not the first move of its layer).
+    comma: bool,
     kind: MoveKind,
     x: u64,
     y: u64,
+    z: u64,
+    /// The feed's bits, `None` without one.
+    feed: Option<u64>,
+    /// Whether its tail is the feed alone (no tool axis).
+    tail_plain: bool,
     start: usize,
+    z_start: usize,
+    z_end: usize,
     end: usize,
 }
 
 impl Written {
-    fn of(step: &ContourMove, start: usize) -> Self {
-        Self { kind: step.kind, x: step.to[0].to_bits(), y: step.to[1].to_bits(), start, end: start }
+    fn of(step: &ContourMove, comma: bool) -> Self {
+        Self {
+            comma,
+            kind: step.kind,
+            x: step.to[0].to_bits(),
+            y: step.to[1].to_bits(),
+            z: step.to[2].to_bits(),
+            feed: step.feed.map(f64::to_bits),
+            tail_plain: step.axis.is_none(),
+            start: 0,
+            z_start: 0,
+            z_end: 0,
+            end: 0,
+        }
     }
 
     /// Whether `other`'s text up to its z is this one's.
-    fn same_start(&self, other: &Self) -> bool {
-        self.kind == other.kind && self.x == other.x && self.y == other.y
+    fn same_head(&self, other: &Self) -> bool {
+        self.comma == other.comma && self.kind == other.kind && self.x == other.x && self.y == other.y
+    }
+
+    /// Whether `other`'s text after its z is this one's (both without a tool axis).
+    fn same_tail(&self, other: &Self) -> bool {
+        self.tail_plain && other.tail_plain && self.feed == other.feed
     }
 }
 

@@ -394,11 +394,48 @@ struct Blocks {
     table: PostTable,
     text: Buffer,
     line: u32,
+    /// Where the buffer already holds the words of recent end points.
+    words: WordCache,
+}
+
+/// Most slots of [`WordCache::pairs`]: a layered program (a contour's layers repeat one plan at
+/// other heights) returns to a few thousand X/Y pairs.
+const PAIR_SLOTS: usize = 1 << 13;
+
+/// Where the program's buffer already holds the ` X… Y…` words of an end point (by the bits of
+/// its x and y, a slot per hash, the last written wins) and the ` Z…` word of the last height:
+/// the text of a word depends only on its value and the post, so a repeated value copies its
+/// text instead of formatting it again (a layered program repeats its X/Y pairs layer after
+/// layer, and most of its moves share their layer's height).
+struct WordCache {
+    /// x bits, y bits, start and end of their text in the buffer (end 0: empty slot).
+    pairs: Vec<(u64, u64, usize, usize)>,
+    /// z bits, start and end of its text (end 0: none yet).
+    z: (u64, usize, usize),
+}
+
+impl WordCache {
+    /// A table of about a slot per move (a power of two, at most [`PAIR_SLOTS`]); none for a
+    /// program of a few blocks (a job's section).
+    fn new(moves: usize) -> Self {
+        let slots = if moves < 16 { 0 } else { moves.next_power_of_two().min(PAIR_SLOTS) };
+        Self { pairs: vec![(0, 0, 0, 0); slots], z: (0, 0, 0) }
+    }
+
+    /// The slot of the pair `(x, y)` (bits), when there is a table.
+    fn slot(&self, x: u64, y: u64) -> Option<usize> {
+        if self.pairs.is_empty() {
+            return None;
+        }
+        let hash = (x ^ y.rotate_left(29)).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        // The top bits, as many as the table has slots (a power of two).
+        Some((hash >> (64 - self.pairs.len().trailing_zeros())) as usize)
+    }
 }
 
 impl Blocks {
     fn new(table: PostTable, moves: usize) -> Self {
-        Self { table, text: Buffer::with_capacity(256 + moves * BYTES_PER_MOVE), line: 0 }
+        Self { table, text: Buffer::with_capacity(256 + moves * BYTES_PER_MOVE), line: 0, words: WordCache::new(moves) }
     }
 
     /// Starts a block: its line number, if the post numbers lines.
@@ -646,9 +683,32 @@ impl Blocks {
     fn motion(&mut self, word: usize, to: Vec3) {
         self.begin();
         self.text.push_str(self.table.motion[word]);
-        self.word('X', to.x);
-        self.word('Y', to.y);
-        self.word('Z', to.z);
+        let (x, y, z) = (to.x.to_bits(), to.y.to_bits(), to.z.to_bits());
+        match self.words.slot(x, y) {
+            Some(slot) => {
+                let (x0, y0, start, end) = self.words.pairs[slot];
+                if end > 0 && x0 == x && y0 == y {
+                    self.text.0.extend_from_within(start..end);
+                } else {
+                    let start = self.text.0.len();
+                    self.word('X', to.x);
+                    self.word('Y', to.y);
+                    self.words.pairs[slot] = (x, y, start, self.text.0.len());
+                }
+            }
+            None => {
+                self.word('X', to.x);
+                self.word('Y', to.y);
+            }
+        }
+        let (z0, start, end) = self.words.z;
+        if end > 0 && z0 == z {
+            self.text.0.extend_from_within(start..end);
+        } else {
+            let start = self.text.0.len();
+            self.word('Z', to.z);
+            self.words.z = (z, start, self.text.0.len());
+        }
     }
 
     /// ` F…` when the feed changes.
@@ -796,6 +856,66 @@ mod tests {
         assert!(linuxcnc.starts_with("(KERF TEST)\n"));
         assert!(linuxcnc.contains("G64 P0.0100\n"));
         assert!(!linuxcnc.contains('%'));
+    }
+
+    /// A layered path: the same X/Y pairs at four heights (more pairs than table slots, so pairs
+    /// share slots), with values whose bits differ but whose text is the same (±0, a hair apart),
+    /// ties of the rounding and repeated heights.
+    fn layered_path() -> Toolpath {
+        let mut draw = 0x2545_f491_4f6c_dd1du64;
+        let mut unit = || {
+            draw ^= draw >> 12;
+            draw ^= draw << 25;
+            draw ^= draw >> 27;
+            (draw.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let special = [0.0, -0.0, 0.00005, -0.00005, 1.00001, 1.00002, 12.0, -1e-7, 1.23455];
+        let pairs: Vec<(f64, f64)> = (0..9000)
+            .map(|k| match k % 5 {
+                0 => (special[k % special.len()], special[(k / 5) % special.len()]),
+                1 => ((unit() - 0.5) * 2000.0, (unit() - 0.5) * 1e-3),
+                _ => ((unit() - 0.5) * 200.0, (unit() - 0.5) * 200.0),
+            })
+            .collect();
+        let mut path = Toolpath::default();
+        for (layer, z) in [-1.0, -2.0, -2.0, -0.0].into_iter().enumerate() {
+            path.rapid(Vec3::new(pairs[0].0, pairs[0].1, 50.0));
+            for (k, (x, y)) in pairs.iter().enumerate().skip(layer) {
+                let z = if k % 97 == 0 { z - 0.5 } else { z };
+                path.linear(Vec3::new(*x, *y, z), 1000.0 + (k % 3) as f64);
+            }
+        }
+        path
+    }
+
+    #[test]
+    fn repeated_end_points_are_written_as_formatted_afresh() {
+        let path = layered_path();
+        let before = reference::COMPARED.with(std::cell::Cell::get);
+        for dialect in Dialect::ALL {
+            let Some(table) = dialect.table() else { continue };
+            let program = Program {
+                dialect,
+                number: 1000,
+                title: "layers",
+                comments: Vec::new(),
+                tool: ToolCall::Table(3),
+                spindle_rpm: 6000.0,
+                spindle_direction: SpindleDirection::Cw,
+                safe_z: 50.0,
+                blend_tolerance: 0.01,
+                plunges: Some(Plunges { feed: Some(300.0) }),
+                path: &path,
+            };
+            let cached = write(&program);
+            // A writer sized for no moves keeps no table of written words: every word formatted.
+            let mut fresh = Blocks::new(table, 0);
+            assert!(fresh.words.pairs.is_empty());
+            let Ok(()) = fresh.program(&program, &[], || Ok::<(), std::convert::Infallible>(()));
+            assert_eq!(cached, fresh.text.into_string(), "{dialect:?}");
+        }
+        // Fanuc and LinuxCNC were also compared with the old writer (`reference::check`).
+        assert_eq!(reference::COMPARED.with(std::cell::Cell::get), before + 2);
     }
 
     #[test]
