@@ -905,6 +905,7 @@ mod tests {
                 safe_z: 50.0,
                 blend_tolerance: 0.01,
                 plunges: Some(Plunges { feed: Some(300.0) }),
+                units: Units::Mm,
                 path: &path,
             };
             let cached = write(&program);
