@@ -48,7 +48,7 @@ fn bench(c: &mut Criterion) {
     .expect("a valid request");
     let tools = [Tool { flute_length: Some(20.0), stickout: Some(30.0), ..Tool::new(ToolKind::Ball, 3.0) }];
     let started = Instant::now();
-    let cut = verify::verify(&request, &tools, &Run::default()).expect("verified");
+    let cut = verify::verify(&request, &tools, verify::Found::default(), &Run::default()).expect("verified");
     let seconds = started.elapsed().as_secs_f64();
     println!(
         "verify raster: {} blocks, spacing {spacing} mm, {} rays, {} dexel updates, removed {:.1} mm³; one solve \
@@ -63,7 +63,7 @@ fn bench(c: &mut Criterion) {
     group.sample_size(10);
     group.throughput(Throughput::Elements(cut.dexel_updates));
     group.bench_function("raster_ball_dome", |b| {
-        b.iter(|| verify::verify(&request, &tools, &Run::default()).expect("verified"))
+        b.iter(|| verify::verify(&request, &tools, verify::Found::default(), &Run::default()).expect("verified"))
     });
     group.finish();
 }

@@ -134,3 +134,5 @@ export const verifyView = {
     });
   },
 };
+
+export const view = { title: 'Verify', mount: verifyView.mount };
