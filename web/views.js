@@ -7,7 +7,6 @@ import { jobsView } from '/views/jobs.js';
 import { machinesView } from '/views/machines.js';
 import { materialsView } from '/views/materials.js';
 import { toolsView } from '/views/tools.js';
-import { verifyView } from '/views/verify.js';
 
 // A capability whose view does not load is left out (and reported) instead of breaking the page.
 const capabilityViews = (await Promise.all(CAPABILITIES.map(async (id) => {
@@ -22,7 +21,6 @@ const capabilityViews = (await Promise.all(CAPABILITIES.map(async (id) => {
 
 export const VIEWS = [
   ...capabilityViews,
-  { id: 'verify', title: 'Verify', mount: verifyView.mount },
   { id: 'jobs', title: 'Jobs', mount: jobsView.mount },
   { id: 'tools', title: 'Tools', mount: toolsView.mount },
   { id: 'machines', title: 'Machines', mount: machinesView.mount },

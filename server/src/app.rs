@@ -66,7 +66,6 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
         .merge(http::jobs::router())
         .merge(http::machines::router())
         .merge(http::materials::router())
-        .merge(http::verify::router())
         .split_for_parts();
     let mut document = document;
     crate::openapi::describe_responses(&mut document);

@@ -28,7 +28,8 @@ use crate::store;
 /// module with the capability, request and answer types (named so the OpenAPI document shows the
 /// concrete schemas; the compiler checks that they are the capability's); the endpoint's body,
 /// `json(Query)` with the query parameters it takes (a type of `http::output`) or `upload` for a
-/// capability with its own handler in `http/<module>.rs`; and the operation's description.
+/// capability with its own handler in `http/<module>.rs` (which also routes its program, if it
+/// writes one: verify answers findings only); and the operation's description.
 macro_rules! with_registry {
     ($callback:ident) => {
         $callback! {
@@ -44,6 +45,8 @@ macro_rules! with_registry {
                 "`POST /api/v1/engagement`; the job's program is that of the request's `candidate` path (default the first).";
             Predict => predict::{PredictCapability, PredictRequest, PredictAnswer}, upload,
                 "`POST /api/v1/predict` (a job file cannot carry an STL file: no `mesh` stock).";
+            Verify => verify::{VerifyCapability, VerifyRequest, VerifyAnswer}, upload,
+                "`POST /api/v1/verify`: its findings, no program (a job file cannot carry an STL file: no `mesh` part or stock).";
         }
     };
 }
@@ -560,6 +563,6 @@ mod tests {
             let error = serde_json::from_value::<Operation>(json).unwrap_err().to_string();
             assert!(!error.contains("unknown variant"), "{name}: {error}");
         }
-        assert_eq!(NAMES, ["deburr", "segment", "resegment", "contour", "engagement", "predict"]);
+        assert_eq!(NAMES, ["deburr", "segment", "resegment", "contour", "engagement", "predict", "verify"]);
     }
 }

@@ -114,7 +114,7 @@ fn bench(c: &mut Criterion) {
     .expect("a valid request");
     let tools = [Tool { flute_length: Some(20.0), stickout: Some(30.0), ..Tool::new(ToolKind::Ball, 3.0) }];
     let (started, cpu_started) = (Instant::now(), thread_cpu_seconds());
-    let cut = verify::verify(&request, &tools, &Run::default()).expect("verified");
+    let cut = verify::verify(&request, &tools, verify::Found::default(), &Run::default()).expect("verified");
     let seconds = started.elapsed().as_secs_f64();
     let cpu = thread_cpu_seconds().zip(cpu_started).map(|(end, start)| end - start);
     println!(
@@ -132,7 +132,7 @@ fn bench(c: &mut Criterion) {
         std::env::var("KERF_BENCH_DEBURR_SPACING").ok().and_then(|v| v.parse().ok()).unwrap_or(0.01);
     let (deburr_request, deburr_tools) = deburr_case(deburr_spacing);
     let (started, cpu_started) = (Instant::now(), thread_cpu_seconds());
-    let deburr_cut = verify::verify(&deburr_request, &deburr_tools, &Run::default()).expect("verified");
+    let deburr_cut = verify::verify(&deburr_request, &deburr_tools, verify::Found::default(), &Run::default()).expect("verified");
     let seconds = started.elapsed().as_secs_f64();
     let cpu = thread_cpu_seconds().zip(cpu_started).map(|(end, start)| end - start);
     println!(
@@ -148,10 +148,10 @@ fn bench(c: &mut Criterion) {
     group.sample_size(10);
     group.throughput(Throughput::Elements(cut.dexel_updates));
     group.bench_function("raster_ball_dome", |b| {
-        b.iter(|| verify::verify(&request, &tools, &Run::default()).expect("verified"))
+        b.iter(|| verify::verify(&request, &tools, verify::Found::default(), &Run::default()).expect("verified"))
     });
     group.bench_function("deburr_program", |b| {
-        b.iter(|| verify::verify(&deburr_request, &deburr_tools, &Run::default()).expect("verified"))
+        b.iter(|| verify::verify(&deburr_request, &deburr_tools, verify::Found::default(), &Run::default()).expect("verified"))
     });
     group.finish();
 }

@@ -326,3 +326,5 @@ export const verifyView = {
     });
   },
 };
+
+export const view = { title: 'Verify', mount: verifyView.mount };

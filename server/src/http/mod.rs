@@ -14,6 +14,7 @@ pub mod predict;
 pub mod solve;
 pub mod stream;
 pub mod tools;
+mod upload;
 pub mod verify;
 pub mod verify_mesh;
 

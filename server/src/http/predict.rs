@@ -7,11 +7,9 @@
 //! its own body limit (`Limits::max_upload_bytes`, 128 MiB by default) instead of the service's
 //! default one.
 
-use axum::body::{Body, Bytes};
-use axum::extract::{DefaultBodyLimit, FromRequest, Multipart, Request, State};
-use axum::http::{HeaderMap, HeaderValue, header};
+use axum::extract::{DefaultBodyLimit, Request, State};
+use axum::http::{HeaderMap, header};
 use axum::response::Response;
-use kerf_solver::ErrorCode;
 use kerf_solver::capability::{Capability, OutputOptions};
 use kerf_solver::gcode::{Dialect, Reference};
 use kerf_solver::predict::{PredictAnswer, PredictCapability, PredictRequest};
@@ -21,8 +19,9 @@ use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
 use super::output::{Ask, Format, wants_gcode};
-use crate::error::{AppError, AppResult, Problem};
-use crate::extract::{AppQuery, charged_body_bytes, is_json, media_type, parse_json};
+use super::upload;
+use crate::error::{AppResult, Problem};
+use crate::extract::{AppQuery, charged_body_bytes, is_json, media_type};
 use crate::state::AppState;
 
 /// Query parameters of `POST /api/v1/predict`: the output negotiation of every path-producing
@@ -52,69 +51,6 @@ pub struct PredictForm {
     /// The stock as an STL file (binary or ASCII), a closed surface.
     #[schema(value_type = String, format = Binary)]
     pub stock: Vec<u8>,
-}
-
-/// A request as uploaded: the JSON and, for a mesh stock, the STL bytes.
-struct Upload {
-    request: PredictRequest,
-    mesh: Option<Bytes>,
-}
-
-fn multipart_error(part: &str, error: &axum::extract::multipart::MultipartError) -> AppError {
-    AppError::bad_request(ErrorCode::Multipart, part, format!("{part}: {}", error.body_text()))
-}
-
-/// Reads an upload received whole: the JSON, or the multipart form with `content_type`. CPU work
-/// on a large upload: call it on a blocking thread.
-fn read_upload(json: bool, content_type: Option<HeaderValue>, body: Bytes) -> AppResult<Upload> {
-    if json {
-        return Ok(Upload { request: parse_json(&body)?, mesh: None });
-    }
-    let mut form = Request::new(Body::from(body));
-    if let Some(content_type) = content_type {
-        form.headers_mut().insert(header::CONTENT_TYPE, content_type);
-    }
-    // The body is all in memory: the form's parts are split without waiting for anything.
-    tokio::runtime::Handle::current().block_on(read_form(form))
-}
-
-/// The parts of the multipart form `form`: `request` (the JSON) and `stock` (the STL file).
-async fn read_form(form: Request) -> AppResult<Upload> {
-    let mut multipart = Multipart::from_request(form, &())
-        .await
-        .map_err(|rejection| AppError::bad_request(ErrorCode::Multipart, "body", rejection.body_text()))?;
-    let (mut json, mut mesh): (Option<Bytes>, Option<Bytes>) = (None, None);
-    loop {
-        let field = match multipart.next_field().await {
-            Ok(Some(field)) => field,
-            Ok(None) => break,
-            Err(error) => return Err(multipart_error("body", &error)),
-        };
-        let name = field.name().unwrap_or_default().to_owned();
-        let slot = match name.as_str() {
-            "request" => &mut json,
-            "stock" => &mut mesh,
-            _ => {
-                return Err(AppError::bad_request(
-                    ErrorCode::Multipart,
-                    if name.is_empty() { "body".to_owned() } else { name.clone() },
-                    format!("unexpected form part `{name}`: send `request` (the JSON) and `stock` (the STL file)"),
-                ));
-            }
-        };
-        if slot.is_some() {
-            return Err(AppError::bad_request(
-                ErrorCode::Multipart,
-                name.clone(),
-                format!("form part `{name}` is given twice"),
-            ));
-        }
-        *slot = Some(field.bytes().await.map_err(|error| multipart_error(&name, &error))?);
-    }
-    let json = json.ok_or_else(|| {
-        AppError::bad_request(ErrorCode::Multipart, "request", "the form has no part `request` with the JSON request")
-    })?;
-    Ok(Upload { request: parse_json(&json)?, mesh })
 }
 
 /// The query of the predict endpoint's JSON answer, as documented.
@@ -209,19 +145,17 @@ async fn post_predict_program(
 async fn predict(state: &AppState, request: Request, ask: Ask) -> AppResult<Response> {
     let json = is_json(request.headers());
     if !json && media_type(request.headers()).as_deref() != Some("multipart/form-data") {
-        return Err(AppError::UnsupportedMediaType(
-            "send the request as application/json, or as multipart/form-data with the JSON in part `request` \
-             and the STL file in part `stock`"
-                .to_owned(),
-        ));
+        return Err(upload::unsupported(&["stock"]));
     }
     let content_type = request.headers().get(header::CONTENT_TYPE).cloned();
     // While it arrives, possibly slowly, the upload holds its share of the memory budget: the
     // bytes received so far. It is read on a blocking thread in a solver slot, off the async
     // threads; once read, the solver slots bound it.
     let (body, upload_share) = charged_body_bytes(request, state, state.limits.max_upload_bytes).await?;
-    let Upload { request, mesh } = state.solve(move |_| read_upload(json, content_type, body)).await??;
+    let upload::Upload { request, mut files } =
+        state.solve(move |_| upload::read::<PredictRequest>(json, content_type, body, &["stock"])).await??;
     drop(upload_share);
+    let mesh = files.pop().flatten();
     super::solve::answer::<PredictCapability>(state, request, mesh, ask).await
 }
 

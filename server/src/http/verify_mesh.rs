@@ -7,7 +7,7 @@ use axum::body::Bytes;
 use axum::http::{HeaderMap, HeaderValue, header};
 use axum::response::Response;
 use kerf_solver::capability::{AnswerBudget, Control, Purpose, Run};
-use kerf_solver::verify::{GLB_MEDIA_TYPE, VerifyCapability, VerifyRequest, cut_stock_glb};
+use kerf_solver::verify::{Found, GLB_MEDIA_TYPE, VerifyCapability, VerifyRequest, cut_stock_glb};
 use serde::Deserialize;
 use utoipa::ToSchema;
 
@@ -45,7 +45,12 @@ pub fn wants_glb(headers: &HeaderMap, format: Option<VerifyFormat>) -> bool {
 /// # Errors
 /// As the JSON answer: 404 for an unknown tool, 422 for the solver's refusal (a mesh over the
 /// answer budget is refused at `resolution`), 429 when every solver slot is busy.
-pub async fn answer(state: &AppState, request: VerifyRequest, upto_line: Option<usize>) -> AppResult<Response> {
+pub async fn answer(
+    state: &AppState,
+    request: VerifyRequest,
+    upload: Option<Bytes>,
+    upto_line: Option<usize>,
+) -> AppResult<Response> {
     let refs = kerf_solver::capability::all_refs::<VerifyCapability>(&request);
     let catalog = capabilities::catalog(&state.db, refs, capabilities::Catalog::default()).await?;
     let resolved = capabilities::resolve::<VerifyCapability>(&request, &catalog)?;
@@ -55,11 +60,12 @@ pub async fn answer(state: &AppState, request: VerifyRequest, upto_line: Option<
         .solve(move |cancel| {
             let run = Run {
                 control: Control { progress: None, cancel: Some(cancel) },
-                upload: None,
+                upload: upload.as_deref(),
                 purpose: Purpose::Json,
                 budget: Some(&budget),
             };
-            cut_stock_glb(&request, resolved.other_tools, upto_line, &run)
+            let found = Found { material: resolved.material.as_ref(), machine: resolved.machine.as_ref() };
+            cut_stock_glb(&request, resolved.other_tools, found, upto_line, &run)
         })
         .await?
         .map_err(AppError::from)?;

@@ -57,7 +57,7 @@ pub mod request;
 mod sampling;
 mod scene;
 pub mod shape;
-mod stl;
+pub(crate) mod stl;
 pub mod stock;
 
 use std::sync::atomic::AtomicUsize;

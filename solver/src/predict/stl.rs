@@ -191,6 +191,12 @@ pub(crate) fn check_closed(triangles: &[[Vec3; 3]]) -> Result<(), SolverError> {
     Ok(())
 }
 
+/// The signed volume the triangles enclose, mm³: positive when their normals (by the right-hand
+/// rule) point outward, negative for a surface turned inside out.
+pub(crate) fn signed_volume(triangles: &[[Vec3; 3]]) -> f64 {
+    triangles.iter().map(|[a, b, c]| a.dot(&b.cross(c))).sum::<f64>() / 6.0
+}
+
 /// Orientation of (p - a) relative to the edge a→b in xy, computed the same way for both
 /// directions of an edge so neighbouring triangles agree exactly.
 #[inline]
@@ -287,6 +293,24 @@ impl Mesh {
         &self.bin_items[self.bin_start[bin] as usize..self.bin_start[bin + 1] as usize]
     }
 
+    /// The height at which triangle `t` owns the vertical line through `(x, y)`, if it does
+    /// (the fill rule gives a point on a shared edge or vertex to exactly one triangle).
+    fn crossing(t: &Triangle, x: f64, y: f64) -> Option<f64> {
+        if t.vertical || x < t.lo.x || x > t.hi.x || y < t.lo.y || y > t.hi.y {
+            return None;
+        }
+        let [a, b, c] = &t.p;
+        let w0 = edge_function(b, c, x, y);
+        let w1 = edge_function(c, a, x, y);
+        let w2 = edge_function(a, b, x, y);
+        let covered = |w: f64, u: &Vec3, v: &Vec3| w > 0.0 || (w == 0.0 && owns_edge(u, v));
+        if !(covered(w0, b, c) && covered(w1, c, a) && covered(w2, a, b)) {
+            return None;
+        }
+        let sum = w0 + w1 + w2;
+        (sum > 0.0).then(|| (w0 * a.z + w1 * b.z + w2 * c.z) / sum)
+    }
+
     /// Whether `q` is inside the solid: the upward vertical ray from `q` crosses the surface an
     /// odd number of times, counting only crossings more than `margin` above `q`.
     pub(crate) fn contains(&self, q: &Vec3, margin: f64) -> bool {
@@ -299,27 +323,29 @@ impl Mesh {
         let mut inside = false;
         for &index in self.bin_triangles(bin) {
             let t = &self.triangles[index as usize];
-            if t.vertical || q.x < t.lo.x || q.x > t.hi.x || q.y < t.lo.y || q.y > t.hi.y || t.hi.z <= q.z {
+            if t.hi.z <= q.z {
                 continue;
             }
-            let [a, b, c] = &t.p;
-            let w0 = edge_function(b, c, q.x, q.y);
-            let w1 = edge_function(c, a, q.x, q.y);
-            let w2 = edge_function(a, b, q.x, q.y);
-            let covered = |w: f64, u: &Vec3, v: &Vec3| w > 0.0 || (w == 0.0 && owns_edge(u, v));
-            if !(covered(w0, b, c) && covered(w1, c, a) && covered(w2, a, b)) {
-                continue;
-            }
-            let sum = w0 + w1 + w2;
-            if sum <= 0.0 {
-                continue;
-            }
-            let z = (w0 * a.z + w1 * b.z + w2 * c.z) / sum;
-            if z > q.z + margin {
+            if let Some(z) = Self::crossing(t, q.x, q.y)
+                && z > q.z + margin
+            {
                 inside = !inside;
             }
         }
         inside
+    }
+
+    /// The heights at which the vertical line through `(x, y)` crosses the surface, sorted
+    /// (into `heights`, cleared first): on a closed surface, pairs of them bound the solid.
+    pub(crate) fn crossings(&self, x: f64, y: f64, heights: &mut Vec<f64>) {
+        heights.clear();
+        let Some(bin) = self.bin(x, y) else {
+            return;
+        };
+        for &index in self.bin_triangles(bin) {
+            heights.extend(Self::crossing(&self.triangles[index as usize], x, y));
+        }
+        heights.sort_by(f64::total_cmp);
     }
 
     /// Whether any triangle's box meets the box `[lo, hi]`; if not, the box lies entirely inside

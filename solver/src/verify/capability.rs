@@ -3,6 +3,7 @@
 
 use serde::Serialize;
 
+use super::job::Found;
 use super::request::VerifyRequest;
 use super::simulate::{self, Cut, MAX_FINDINGS};
 use crate::capability::{Capability, Control, Endpoint, OtherTool, OutputOptions, Purpose, Refs, Resolved, Run};
@@ -37,17 +38,21 @@ impl Capability for VerifyCapability {
         description: "Cuts the program, move by move, out of the stock with the tools it calls (cutter, \
             neck, shank and holder) on a grid of z-dexels, and answers what it found, each at its G-code \
             line with a position and an amount: gouges into the part, material left outside it, rapid \
-            moves through material, neck, shank or holder contact with the stock, and feed moves in air \
-            beyond a share of the cutting time; with the volumes, cutting time and the removed volume \
-            and removal rate of every block that cut (docs/spec/verify.md). With `?format=glb` or an \
+            moves through material, neck, shank or holder contact with the stock, feed moves in air \
+            beyond a share of the cutting time, and with a material and machine blocks over the spindle's \
+            power; with the volumes, cutting time and the removed volume, removal rate and (with a \
+            material) spindle power of every block that cut (docs/spec/verify.md). The part and stock may \
+            be STL files (`\"kind\": \"mesh\"`, sent as a multipart form). With `?format=glb` or an \
             `Accept` preferring `model/gltf-binary`: the cut stock as binary glTF, each vertex coloured \
             (gouge red, material left blue, within tolerance grey) and carrying its signed deviation from \
             the part in `_DEVIATION`, the JSON answer in `extras.verify`; `upto_line` cuts only the moves \
             up to that line (playback). It writes no program.",
-        not_found: "A tool number in `tools` that is not in the tool table",
+        not_found: "A tool number in `tools` that is not in the tool table, or a `material` or `machine` not registered",
         refused: "The program as the reader refuses it (`E_GCODE_SYNTAX`, `E_GCODE_UNSUPPORTED`, ... with \
             the line), a bad tool, stock or part (`E_INPUT` naming the field), a move calling a tool \
-            `tools` does not name, a resolution whose dexels would exceed the memory limit \
+            `tools` does not name, an open or inside-out STL file or a part outside the stock (at `part` \
+            or `stock`), a block cutting without a spindle speed when `material` asks for its power, a \
+            resolution whose dexels would exceed the memory limit \
             (`E_GRID_MEMORY` at `resolution`), a stock no tool reaches (`E_STOCK`); `E_TIMEOUT` over the \
             synchronous time limit: submit a job; `E_TOO_LARGE_ANSWER` over the answer budget",
     };
@@ -55,8 +60,8 @@ impl Capability for VerifyCapability {
     type Answer = VerifyAnswer;
     type Tool = Option<Tool>;
 
-    fn refs(_request: &VerifyRequest) -> Refs<'_> {
-        Refs::default()
+    fn refs(request: &VerifyRequest) -> Refs<'_> {
+        Refs { tool: None, machine: request.machine.as_deref(), material: request.material.as_deref() }
     }
 
     fn other_tools(request: &VerifyRequest) -> Vec<OtherTool<'_>> {
@@ -68,7 +73,8 @@ impl Capability for VerifyCapability {
         context: Resolved<Option<Tool>>,
         run: &Run<'_>,
     ) -> Result<VerifyAnswer, SolverError> {
-        let job = request.validate(&context.other_tools, run.control)?;
+        let found = Found { material: context.material.as_ref(), machine: context.machine.as_ref() };
+        let job = request.validate(&context.other_tools, found, run.upload, run.control)?;
         let cut = simulate::cut(&job, run)?;
         Ok(VerifyAnswer { tools: context.other_tools, cut })
     }

@@ -11,6 +11,7 @@ use crate::tool::Tool;
 
 use super::capability::VerifyAnswer;
 use super::dexel::{self, Field, Interval};
+use super::job::Found;
 use super::request::VerifyRequest;
 use super::simulate;
 use super::solid::SolidModel;
@@ -416,10 +417,11 @@ fn glb(mesh: &Mesh, extras: Value) -> Vec<u8> {
 pub fn cut_stock_glb(
     request: &VerifyRequest,
     tools: Vec<Tool>,
+    found: Found<'_>,
     upto_line: Option<usize>,
     run: &Run<'_>,
 ) -> Result<Vec<u8>, SolverError> {
-    let mut job = request.validate(&tools, run.control)?;
+    let mut job = request.validate(&tools, found, run.upload, run.control)?;
     let intervals: u64 = if matches!(job.stock, SolidModel::Tube { .. }) { 2 } else { 1 };
     let bound = job.grid.len() as u64 * intervals * QUADS_PER_INTERVAL * quad_bytes(job.part.is_some());
     if let Some(budget) = run.budget
@@ -497,7 +499,7 @@ mod tests {
                 ToolRef::Number(_) => panic!("inline tools only"),
             })
             .collect();
-        cut_stock_glb(&request, tools, upto_line, &Run::default()).expect("a mesh")
+        cut_stock_glb(&request, tools, Found::default(), upto_line, &Run::default()).expect("a mesh")
     }
 
     /// The slot of `tests.rs` with a part 1.9 below the top, cut to 2: a gouge of 0.1 along the slot,
@@ -588,7 +590,7 @@ mod tests {
         let tools = vec![Tool { ..serde_json::from_value(json!({"kind": "flat", "radius": 5})).unwrap() }];
         let budget = AnswerBudget::new(100_000);
         let run = Run { budget: Some(&budget), ..Run::default() };
-        let error = cut_stock_glb(&request, tools, None, &run).unwrap_err();
+        let error = cut_stock_glb(&request, tools, Found::default(), None, &run).unwrap_err();
         assert_eq!(error.code(), ErrorCode::TooLargeAnswer);
         assert_eq!(error.field(), Some("resolution"));
         assert_eq!(budget.used(), 0, "refused before anything was built");

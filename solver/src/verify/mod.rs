@@ -22,22 +22,23 @@ mod tests;
 pub use assembly::{FLUTE_RADII, HOLDER_LENGTH, HOLDER_SHANK_DIAMETERS, Member, STICKOUT_RADII};
 pub use capability::{VerifyAnswer, VerifyCapability};
 pub use job::{
-    DEFAULT_AIR_SHARE_LIMIT, DEFAULT_ALLOWANCE, DEFAULT_RESOLUTION_RADII, DEFAULT_TOLERANCE, MAX_DEFAULT_RAYS,
+    DEFAULT_AIR_SHARE_LIMIT, DEFAULT_ALLOWANCE, DEFAULT_RESOLUTION_RADII, DEFAULT_TOLERANCE, Found, MAX_DEFAULT_RAYS,
     MAX_DEXEL_BYTES,
 };
 pub use mesh::{GLB_MEDIA_TYPE, GOUGE_COLOUR, LEFT_COLOUR, NEUTRAL_COLOUR, cut_stock_glb};
-pub use request::{Hollow, Solid, VerifyRequest};
+pub use request::{CrossHole, Hollow, MAX_CROSS_HOLES, Meshes, Solid, VerifyRequest};
 pub use simulate::{ARC_CHORD_TOLERANCE, BlockRemoval, Cut, Finding, FindingKind, MAX_FINDINGS};
 
 use crate::capability::Run;
 use crate::error::SolverError;
 use crate::tool::Tool;
 
-/// Cuts `request`'s program with its resolved `tools` (in the order of `request.tools`).
+/// Cuts `request`'s program with its resolved `tools` (in the order of `request.tools`) and the
+/// material and machine it names (`found`).
 ///
 /// # Errors
 /// As the capability's solve: the request's refusals, each naming its field.
-pub fn verify(request: &VerifyRequest, tools: &[Tool], run: &Run<'_>) -> Result<Cut, SolverError> {
-    let job = request.validate(tools, run.control)?;
+pub fn verify(request: &VerifyRequest, tools: &[Tool], found: Found<'_>, run: &Run<'_>) -> Result<Cut, SolverError> {
+    let job = request.validate(tools, found, run.upload, run.control)?;
     simulate::cut(&job, run)
 }

@@ -4,6 +4,7 @@
 use serde::de::{self, Deserializer};
 use serde::{Deserialize, Serialize};
 
+use crate::error::SolverError;
 use crate::predict::Stock;
 use crate::tool::ToolRef;
 
@@ -48,6 +49,16 @@ pub struct VerifyRequest {
     /// Skip blocks starting with `/` (the block-delete switch on). Default false.
     #[serde(default)]
     pub block_delete: bool,
+    /// The work material, by name in the materials library: with it every block that cuts gets
+    /// the spindle power its removal rate needs (from the material's Kienzle values at the
+    /// block's feed per tooth; the program must set a spindle speed, `S`, before it cuts).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<String>,
+    /// A registered machine, by name (needs `material`): a block needing more spindle power than
+    /// the machine has at the block's spindle speed (`spindle_power_kw`, lowered to its power
+    /// curve) is a `spindle_power` finding.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub machine: Option<String>,
 }
 
 /// A solid of the stock or the part: predict's stock kinds (docs/spec/predict.md §1.2), or a tube.
@@ -58,8 +69,9 @@ pub struct VerifyRequest {
 pub enum Solid {
     /// A hollow cylinder.
     Tube(Hollow),
-    /// Box, cylinder, grid (needs `bottom` here), as predict takes them; `plane` and `mesh` are
-    /// refused (no bottom; no upload).
+    /// Box, cylinder, grid (needs `bottom` here), as predict takes them, or `mesh`: a closed,
+    /// outward-oriented STL file uploaded with the request (form part `part` or `stock`); `plane`
+    /// is refused (no bottom).
     Stock(Stock),
 }
 
@@ -79,7 +91,85 @@ pub enum Hollow {
         outer_radius: f64,
         /// Inner radius (the bore), mm; 0 < inner_radius < outer_radius.
         inner_radius: f64,
+        /// Cross holes drilled through it (at most 100), each a cylinder between two points of
+        /// its axis: the material within `radius` of that segment is taken away. Default none.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        holes: Vec<CrossHole>,
     },
+}
+
+/// Most cross holes of one tube.
+pub const MAX_CROSS_HOLES: usize = 100;
+
+/// A cross hole of a tube: a cylinder between two points of its axis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct CrossHole {
+    /// One end of the hole's axis, mm.
+    pub start: [f64; 3],
+    /// The other end of the hole's axis, mm.
+    pub end: [f64; 3],
+    /// The hole's radius, mm (> 0).
+    pub radius: f64,
+}
+
+/// The STL files of a request's `mesh` solids as the capability takes them, in one upload (the
+/// run's): the one file when one solid is a mesh; when both are, the part's file's length as 8
+/// bytes (little-endian), the part's file, then the stock's ([`Meshes::pack`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Meshes<'a> {
+    /// The part's STL file.
+    pub part: Option<&'a [u8]>,
+    /// The stock's STL file.
+    pub stock: Option<&'a [u8]>,
+}
+
+impl Solid {
+    /// Whether the solid is an uploaded mesh.
+    pub fn is_mesh(&self) -> bool {
+        matches!(self, Self::Stock(Stock::Mesh {}))
+    }
+}
+
+impl<'a> Meshes<'a> {
+    /// The one upload holding the part's and the stock's files.
+    pub fn pack(part: &[u8], stock: &[u8]) -> Vec<u8> {
+        let mut upload = Vec::with_capacity(8 + part.len() + stock.len());
+        upload.extend_from_slice(&(part.len() as u64).to_le_bytes());
+        upload.extend_from_slice(part);
+        upload.extend_from_slice(stock);
+        upload
+    }
+
+    /// The files of `upload` for `request`'s mesh solids.
+    ///
+    /// # Errors
+    /// `E_INPUT` at `part.kind` for an upload when no solid is a mesh, at `body` for an upload
+    /// holding both files that is not laid out as [`Meshes::pack`] lays it out.
+    pub fn unpack(request: &VerifyRequest, upload: Option<&'a [u8]>) -> Result<Self, SolverError> {
+        let part_mesh = request.part.as_ref().is_some_and(Solid::is_mesh);
+        match (part_mesh, request.stock.is_mesh(), upload) {
+            (_, _, None) => Ok(Self::default()),
+            (true, true, Some(both)) => {
+                let length = both
+                    .get(..8)
+                    .and_then(|prefix| usize::try_from(u64::from_le_bytes(prefix.try_into().ok()?)).ok())
+                    .filter(|length| length.checked_add(8).is_some_and(|end| end <= both.len()))
+                    .ok_or_else(|| {
+                        SolverError::input("body", "the upload does not hold the part's and the stock's files")
+                    })?;
+                let (part, stock) = both[8..].split_at(length);
+                Ok(Self { part: Some(part), stock: Some(stock) })
+            }
+            (true, false, Some(part)) => Ok(Self { part: Some(part), stock: None }),
+            (false, true, Some(stock)) => Ok(Self { part: None, stock: Some(stock) }),
+            (false, false, Some(_)) => Err(SolverError::input(
+                "part.kind",
+                "an STL file was uploaded but neither part.kind nor stock.kind is \"mesh\"",
+            )),
+        }
+    }
 }
 
 // By the `kind` field: `tube` is read as [`Hollow`], every other kind as predict's [`Stock`], so a

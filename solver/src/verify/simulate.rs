@@ -11,7 +11,7 @@ use crate::gcode::reader::{MoveKind, ReadMove};
 
 use super::assembly::{Body, Member, Shape};
 use super::dexel::{self, Field, Interval, Tops};
-use super::job::Job;
+use super::job::{Job, PowerModel};
 use super::sweep::Segment;
 
 /// Most findings listed; the rest are counted in `findings_left_off`.
@@ -38,6 +38,8 @@ pub enum FindingKind {
     HolderContact,
     /// Feed moves cut nothing for more than `air_share_limit` of the cutting time.
     AirCutting,
+    /// A block needs more spindle power than the machine has at its spindle speed.
+    SpindlePower,
 }
 
 /// One finding, at the G-code line of the move that caused it.
@@ -63,6 +65,12 @@ pub struct Finding {
     /// For `air_cutting`, the share of the cutting time in air (0–1).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub share: Option<f64>,
+    /// For `spindle_power`, the power the block needs, kW.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub power_kw: Option<f64>,
+    /// For `spindle_power`, the machine's spindle power at the block's speed, kW.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limit_kw: Option<f64>,
 }
 
 /// The material one block removed.
@@ -82,6 +90,9 @@ pub struct BlockRemoval {
     /// Material-removal rate, mm³/min (removed volume over the move's time).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub removal_rate_mm3_per_min: Option<f64>,
+    /// With a `material`: the spindle power the removal rate needs, kW (feed moves).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spindle_power_kw: Option<f64>,
 }
 
 /// What cutting the program gave.
@@ -143,13 +154,14 @@ impl Worst {
     }
 }
 
-/// A move as cut: the volume it removed, its time at the programmed feed (feed moves) and the
-/// number of its tool.
+/// A move as cut: the volume it removed, its time at the programmed feed (feed moves), the
+/// number of its tool and the tool's flutes.
 #[derive(Debug, Clone, Copy)]
 struct MoveCut {
     removed: f64,
     time: Option<f64>,
     tool: Option<u32>,
+    flutes: u32,
 }
 
 /// What one move did.
@@ -282,6 +294,8 @@ impl Simulation<'_> {
                 depth: worst.depth,
                 volume_mm3: worst.volume,
                 share: None,
+                power_kw: None,
+                limit_kw: None,
             });
         }
         if outcome.gouge.seen {
@@ -294,6 +308,8 @@ impl Simulation<'_> {
                 depth: worst.depth,
                 volume_mm3: worst.volume,
                 share: None,
+                power_kw: None,
+                limit_kw: None,
             });
         }
         let kinds = [FindingKind::NeckContact, FindingKind::ShankContact, FindingKind::HolderContact];
@@ -307,6 +323,8 @@ impl Simulation<'_> {
                     depth: worst.depth,
                     volume_mm3: 0.0,
                     share: None,
+                    power_kw: None,
+                    limit_kw: None,
                 });
             }
         }
@@ -314,7 +332,7 @@ impl Simulation<'_> {
             if rapid { None } else { read.modal.feed.filter(|feed| *feed > 0.0).map(|feed| 60.0 * length / feed) };
         let touched = outcome.contacts.iter().any(|worst| worst.seen);
         self.touched |= touched;
-        Ok(Some(MoveCut { removed: outcome.removed, time, tool: number }))
+        Ok(Some(MoveCut { removed: outcome.removed, time, tool: number, flutes: tool.flutes }))
     }
 }
 
@@ -420,6 +438,9 @@ pub(crate) fn cut(job: &Job, run: &Run<'_>) -> Result<Cut, SolverError> {
 pub(crate) fn cut_stock(job: &Job, run: &Run<'_>) -> Result<(Cut, Field), SolverError> {
     let stock = job.stock.field(job.grid);
     let part = job.part.as_ref().map(|part| part.field(job.grid));
+    if let Some(part) = &part {
+        super::solid::check_part_in_stock(part, &stock, job.tolerance)?;
+    }
     let stock_volume = stock.volume();
     let part_volume = part.as_ref().map(Field::volume);
     let tops = Tops::new(&stock);
@@ -442,7 +463,7 @@ pub(crate) fn cut_stock(job: &Job, run: &Run<'_>) -> Result<(Cut, Field), Solver
     for (index, read) in moves.iter().enumerate() {
         run.control.check()?;
         run.control.report(index, moves.len());
-        let Some(MoveCut { removed: volume, time, tool }) = simulation.run_move(read)? else {
+        let Some(MoveCut { removed: volume, time, tool, flutes }) = simulation.run_move(read)? else {
             unplaced += 1;
             continue;
         };
@@ -458,12 +479,18 @@ pub(crate) fn cut_stock(job: &Job, run: &Run<'_>) -> Result<(Cut, Field), Solver
             }
         }
         if volume > 0.0 {
+            let rate = time.filter(|t| *t > 0.0).map(|t| volume / t * 60.0);
+            let power = match (&job.power, rate) {
+                (Some(model), Some(rate)) => Some(spindle_power(&mut simulation, model, read, rate, flutes, tool)?),
+                _ => None,
+            };
             let block = BlockRemoval {
                 line: read.line,
                 tool,
                 removed_mm3: volume,
                 time_s: time,
-                removal_rate_mm3_per_min: time.filter(|t| *t > 0.0).map(|t| volume / t * 60.0),
+                removal_rate_mm3_per_min: rate,
+                spindle_power_kw: power,
             };
             run.charge(crate::capability::json_bytes(&block), index + 1, moves.len())?;
             blocks.push(block);
@@ -488,6 +515,8 @@ pub(crate) fn cut_stock(job: &Job, run: &Run<'_>) -> Result<(Cut, Field), Solver
             depth: 0.0,
             volume_mm3: 0.0,
             share: Some(air_share),
+            power_kw: None,
+            limit_kw: None,
         });
     }
     if let Some(left) = left_material(&simulation, job.allowance) {
@@ -516,6 +545,48 @@ pub(crate) fn cut_stock(job: &Job, run: &Run<'_>) -> Result<(Cut, Field), Solver
     Ok((cut, simulation.stock))
 }
 
+/// The spindle power, kW, block `read` needs to remove `rate` mm³/min with `flutes` teeth (tool
+/// `tool`), with a finding when it is more than the machine's spindle gives.
+///
+/// # Errors
+/// `E_INPUT` at `program` when the block cuts before the program sets a spindle speed.
+fn spindle_power(
+    simulation: &mut Simulation<'_>,
+    model: &PowerModel,
+    read: &ReadMove,
+    rate: f64,
+    flutes: u32,
+    tool: Option<u32>,
+) -> Result<f64, SolverError> {
+    let (Some(feed), Some(spindle_rpm)) = (read.modal.feed, read.modal.spindle_rpm.filter(|rpm| *rpm > 0.0)) else {
+        return Err(SolverError::input(
+            "program",
+            format!(
+                "line {}: the block cuts before the program sets a spindle speed (S word), which the spindle power \
+                 with `material` needs",
+                read.line
+            ),
+        ));
+    };
+    let power = model.kilowatts(rate, feed, spindle_rpm, flutes);
+    if let Some(limit) = model.limit(spindle_rpm)
+        && power > limit
+    {
+        simulation.find(Finding {
+            kind: FindingKind::SpindlePower,
+            line: Some(read.line),
+            tool,
+            position: read.to_xyz().unwrap_or_default(),
+            depth: 0.0,
+            volume_mm3: 0.0,
+            share: None,
+            power_kw: Some(power),
+            limit_kw: Some(limit),
+        });
+    }
+    Ok(power)
+}
+
 /// The material left outside the part thicker than `allowance`: one finding at the thickest.
 fn left_material(simulation: &Simulation<'_>, allowance: f64) -> Option<Finding> {
     let part = simulation.part.as_ref()?;
@@ -540,6 +611,8 @@ fn left_material(simulation: &Simulation<'_>, allowance: f64) -> Option<Finding>
         depth: worst.depth,
         volume_mm3: worst.volume,
         share: None,
+        power_kw: None,
+        limit_kw: None,
     })
 }
 

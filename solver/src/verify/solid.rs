@@ -1,23 +1,62 @@
 //! The stock and the part as solids on the dexel grid (docs/spec/verify.md §3 Stock model):
-//! predict's box, cylinder and height grid (validated by predict's own model), and the tube; each
-//! gives the intervals of z it holds on a vertical ray.
+//! predict's box, cylinder, height grid and STL mesh (validated and read by predict's own model),
+//! and the tube with its cross holes; each gives the intervals of z it holds on a vertical ray.
 
 use crate::error::SolverError;
 use crate::geometry::{Vec3, vec3};
 use crate::predict::Stock;
+use crate::predict::stl::{self, Mesh};
 use crate::predict::stock::StockModel;
 use crate::validate::{coordinate, coordinates, positive};
 
-use super::dexel::{Field, Grid, Interval, Ray};
-use super::request::{Hollow, Solid};
+use super::dexel::{self, Field, Grid, Interval, Ray};
+use super::request::{CrossHole, Hollow, MAX_CROSS_HOLES, Solid};
+
+/// A segment of an axis: from `start` along the unit `axis` for `length`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Axis {
+    start: Vec3,
+    axis: Vec3,
+    length: f64,
+}
 
 /// A validated solid.
 #[derive(Debug, Clone)]
 pub(crate) enum SolidModel {
-    /// Box, cylinder or height grid with a bottom.
+    /// Box, cylinder, height grid with a bottom, or a closed mesh.
     Stock(StockModel),
-    /// A cylinder of `outer` radius minus the same of `inner` radius.
-    Tube { start: Vec3, axis: Vec3, length: f64, outer: f64, inner: f64 },
+    /// A cylinder of `outer` radius minus the same of `inner` radius and minus each cross hole
+    /// (an axis and its radius).
+    Tube { axis: Axis, outer: f64, inner: f64, holes: Vec<(Axis, f64)> },
+}
+
+/// The axis between `start` and `end` given at fields `{field}.start` and `{field}.end`.
+fn axis(field: &str, start: [f64; 3], end: [f64; 3]) -> Result<Axis, SolverError> {
+    let a = vec3(coordinates(&format!("{field}.start"), start)?);
+    let b = vec3(coordinates(&format!("{field}.end"), end)?);
+    let length = (b - a).norm();
+    if length == 0.0 {
+        return Err(SolverError::input(format!("{field}.end"), "the axis's end equals its start"));
+    }
+    Ok(Axis { start: a, axis: (b - a) / length, length })
+}
+
+/// The closed, outward-oriented mesh of the STL file `bytes` given for the solid at `prefix`:
+/// predict's reading and closedness check, and a positive enclosed volume.
+fn mesh(bytes: &[u8], prefix: &str) -> Result<Mesh, SolverError> {
+    let triangles = stl::parse(bytes).map_err(|error| renamed(error, prefix))?;
+    stl::check_closed(&triangles).map_err(|error| renamed(error, prefix))?;
+    let volume = stl::signed_volume(&triangles);
+    if volume <= 0.0 {
+        return Err(SolverError::input(
+            prefix,
+            format!(
+                "the {prefix}'s mesh is inside out: the volume its triangles enclose is {volume:.6} mm³, so their \
+                 normals point inward; reverse the order of every triangle's vertices"
+            ),
+        ));
+    }
+    Ok(Mesh::new(&triangles))
 }
 
 /// `error` with its field moved from predict's `stock.` to `prefix` (`part`).
@@ -29,13 +68,13 @@ fn renamed(error: SolverError, prefix: &str) -> SolverError {
 }
 
 impl Solid {
-    /// Validates the solid given at request field `prefix` (`stock` or `part`).
-    pub(crate) fn model(&self, prefix: &str) -> Result<SolidModel, SolverError> {
+    /// Validates the solid given at request field `prefix` (`stock` or `part`); `upload` is its
+    /// STL file when it is a `mesh`.
+    pub(crate) fn model(&self, prefix: &str, upload: Option<&[u8]>) -> Result<SolidModel, SolverError> {
         let field = |name: &str| format!("{prefix}.{name}");
         match self {
-            Self::Tube(Hollow::Tube { start, end, outer_radius, inner_radius }) => {
-                let a = vec3(coordinates(&field("start"), *start)?);
-                let b = vec3(coordinates(&field("end"), *end)?);
+            Self::Tube(Hollow::Tube { start, end, outer_radius, inner_radius, holes }) => {
+                let tube = axis(prefix, *start, *end)?;
                 let outer = coordinate(&field("outer_radius"), positive(&field("outer_radius"), *outer_radius)?)?;
                 let inner = positive(&field("inner_radius"), *inner_radius)?;
                 if inner >= outer {
@@ -44,20 +83,35 @@ impl Solid {
                         format!("inner_radius {inner} must be smaller than outer_radius {outer}"),
                     ));
                 }
-                let length = (b - a).norm();
-                if length == 0.0 {
-                    return Err(SolverError::input(field("end"), "the tube's end equals its start"));
+                if holes.len() > MAX_CROSS_HOLES {
+                    return Err(SolverError::input(
+                        field("holes"),
+                        format!("at most {MAX_CROSS_HOLES} cross holes (got {})", holes.len()),
+                    ));
                 }
-                Ok(SolidModel::Tube { start: a, axis: (b - a) / length, length, outer, inner })
+                let holes = holes
+                    .iter()
+                    .enumerate()
+                    .map(|(index, CrossHole { start, end, radius })| {
+                        let hole = field(&format!("holes[{index}]"));
+                        let radius =
+                            coordinate(&format!("{hole}.radius"), positive(&format!("{hole}.radius"), *radius)?)?;
+                        Ok((axis(&hole, *start, *end)?, radius))
+                    })
+                    .collect::<Result<_, SolverError>>()?;
+                Ok(SolidModel::Tube { axis: tube, outer, inner, holes })
             }
             Self::Stock(Stock::Plane { .. }) => Err(SolverError::input(
                 field("kind"),
                 "a plane has no bottom, so its volume is unbounded: give a box or a grid with a bottom",
             )),
-            Self::Stock(Stock::Mesh {}) => Err(SolverError::input(
-                field("kind"),
-                "verify takes no uploaded file: give a box, cylinder, tube or grid",
-            )),
+            Self::Stock(Stock::Mesh {}) => match upload {
+                Some(bytes) => Ok(SolidModel::Stock(StockModel::Mesh(Box::new(mesh(bytes, prefix)?)))),
+                None => Err(SolverError::input(
+                    prefix,
+                    format!("a mesh {prefix} needs its STL file uploaded with the request (form part `{prefix}`)"),
+                )),
+            },
             Self::Stock(stock @ Stock::Grid { bottom: None, .. }) => {
                 stock.model(None).map_err(|error| renamed(error, prefix))?;
                 Err(SolverError::input(field("bottom"), "a grid needs a bottom here: its volume is counted"))
@@ -69,7 +123,8 @@ impl Solid {
 
 /// The interval of z on the vertical line through `(x, y)` within `radius` of the segment from
 /// `start` along the unit `axis` for `length`.
-fn cylinder_interval(x: f64, y: f64, start: &Vec3, axis: &Vec3, length: f64, radius: f64) -> Option<Interval> {
+fn cylinder_interval(x: f64, y: f64, Axis { start, axis, length }: &Axis, radius: f64) -> Option<Interval> {
+    let length = *length;
     // A point (x, y, start.z + w) is within `radius` of the axis line where
     // (1 − a_z²)·w² − 2·k·a_z·w + (c − k² − r²) ≤ 0, and between the end planes where
     // 0 ≤ k + a_z·w ≤ length (k, c: the axial and squared horizontal offsets at w = 0).
@@ -106,14 +161,14 @@ impl SolidModel {
     pub(crate) fn footprint(&self) -> ([f64; 2], [f64; 2]) {
         match self {
             Self::Stock(model) => model.footprint(),
-            Self::Tube { start, axis, length, outer, .. } => {
+            Self::Tube { axis: Axis { start, axis, length }, outer, .. } => {
                 StockModel::Cylinder { start: *start, axis: *axis, length: *length, radius: *outer }.footprint()
             }
         }
     }
 
-    /// The material on the vertical ray through `(x, y)`, sorted.
-    pub(crate) fn ray(&self, x: f64, y: f64) -> Ray {
+    /// The material on the vertical ray through `(x, y)`, sorted; `heights` is scratch space.
+    pub(crate) fn ray(&self, x: f64, y: f64, heights: &mut Vec<f64>) -> Ray {
         let mut ray = Ray::new();
         match self {
             Self::Stock(StockModel::Box { lo, hi }) => {
@@ -122,7 +177,7 @@ impl SolidModel {
                 }
             }
             Self::Stock(StockModel::Cylinder { start, axis, length, radius }) => {
-                ray.extend(cylinder_interval(x, y, start, axis, *length, *radius));
+                ray.extend(cylinder_interval(x, y, &Axis { start: *start, axis: *axis, length: *length }, *radius));
             }
             Self::Stock(StockModel::Grid(grid)) => {
                 if let Some(top) = grid.top_at(x, y)
@@ -131,13 +186,29 @@ impl SolidModel {
                     ray.push([grid.bottom(), top]);
                 }
             }
+            Self::Stock(StockModel::Mesh(mesh)) => {
+                // A closed surface is crossed an even number of times: each pair bounds the solid
+                // (an odd one left over, from a crossing at the very edge of a triangle the fill
+                // rule gave away inconsistently, adds nothing).
+                mesh.crossings(x, y, heights);
+                for pair in heights.chunks_exact(2) {
+                    if pair[1] > pair[0] {
+                        ray.push([pair[0], pair[1]]);
+                    }
+                }
+            }
             // Refused by `Solid::model`.
-            Self::Stock(StockModel::Plane { .. } | StockModel::Mesh(_)) => {}
-            Self::Tube { start, axis, length, outer, inner } => {
-                if let Some(material) = cylinder_interval(x, y, start, axis, *length, *outer) {
+            Self::Stock(StockModel::Plane { .. }) => {}
+            Self::Tube { axis, outer, inner, holes } => {
+                if let Some(material) = cylinder_interval(x, y, axis, *outer) {
                     ray.push(material);
-                    if let Some(bore) = cylinder_interval(x, y, start, axis, *length, *inner) {
-                        super::dexel::subtract(&mut ray, bore, &mut Vec::new());
+                    let mut removed = Vec::new();
+                    let bores =
+                        std::iter::once((axis, *inner)).chain(holes.iter().map(|(hole, radius)| (hole, *radius)));
+                    for (bore, radius) in bores {
+                        if let Some(cut) = cylinder_interval(x, y, bore, radius) {
+                            dexel::subtract(&mut ray, cut, &mut removed);
+                        }
                     }
                 }
             }
@@ -148,12 +219,49 @@ impl SolidModel {
     /// The solid on `grid`.
     pub(crate) fn field(&self, grid: Grid) -> Field {
         let mut rays = Vec::with_capacity(grid.len());
+        let mut heights = Vec::new();
         for j in 0..grid.ny {
             for i in 0..grid.nx {
-                rays.push(self.ray(grid.x(i), grid.y(j)));
+                rays.push(self.ray(grid.x(i), grid.y(j), &mut heights));
             }
         }
         Field { grid, rays }
+    }
+}
+
+/// Refuses a `part` that holds no material on the grid or has material the `stock` does not
+/// have, thicker than `tolerance` on a ray: a program cannot leave what the stock lacks, so the
+/// part or the stock is in the wrong place.
+pub(crate) fn check_part_in_stock(part: &Field, stock: &Field, tolerance: f64) -> Result<(), SolverError> {
+    let grid = stock.grid;
+    let mut pieces = Vec::new();
+    let mut worst: Option<(f64, [f64; 3])> = None;
+    let mut empty = true;
+    for (index, (part_ray, stock_ray)) in part.rays.iter().zip(&stock.rays).enumerate() {
+        empty &= part_ray.is_empty();
+        pieces.clear();
+        dexel::outside(part_ray, stock_ray, 0.0, &mut pieces);
+        for &[low, high] in &pieces {
+            if high - low > tolerance && worst.is_none_or(|(thickest, _)| high - low > thickest) {
+                worst = Some((high - low, [grid.x(index % grid.nx), grid.y(index / grid.nx), low]));
+            }
+        }
+    }
+    if empty {
+        return Err(SolverError::input(
+            "part",
+            "the part holds no material on the stock's dexel grid: is it in the stock?",
+        ));
+    }
+    match worst {
+        Some((thickness, [x, y, z])) => Err(SolverError::input(
+            "part",
+            format!(
+                "the part lies outside the stock: {thickness:.3} mm of it on the ray through ({x:.3}, {y:.3}) from z = \
+                 {z:.3} is not stock material; place the part in the stock, in the program's coordinates"
+            ),
+        )),
+        None => Ok(()),
     }
 }
 
@@ -162,7 +270,7 @@ mod tests {
     use super::*;
 
     fn solid(json: &str) -> SolidModel {
-        serde_json::from_str::<Solid>(json).unwrap().model("stock").unwrap()
+        serde_json::from_str::<Solid>(json).unwrap().model("stock", None).unwrap()
     }
 
     #[test]
@@ -194,7 +302,7 @@ mod tests {
         let tube = solid(
             r#"{"kind": "tube", "start": [-20, 0, 0], "end": [20, 0, 0], "outer_radius": 10, "inner_radius": 6}"#,
         );
-        let ray = tube.ray(0.0, 0.0);
+        let ray = tube.ray(0.0, 0.0, &mut Vec::new());
         assert_eq!(ray.len(), 2);
         assert!((ray[0][0] + 10.0).abs() < 1e-12 && (ray[0][1] + 6.0).abs() < 1e-12);
         assert!((ray[1][0] - 6.0).abs() < 1e-12 && (ray[1][1] - 10.0).abs() < 1e-12);
@@ -215,7 +323,7 @@ mod tests {
             ),
         ];
         for (json, field) in cases {
-            let error = serde_json::from_str::<Solid>(json).unwrap().model("part").unwrap_err();
+            let error = serde_json::from_str::<Solid>(json).unwrap().model("part", None).unwrap_err();
             assert_eq!(error.field(), Some(field), "{json}");
         }
     }

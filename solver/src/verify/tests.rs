@@ -5,8 +5,11 @@ use std::f64::consts::PI;
 use proptest::prelude::*;
 use serde_json::{Value, json};
 
-use super::{Cut, FindingKind, VerifyRequest, verify};
+use super::{Cut, FindingKind, Found, Meshes, VerifyRequest, verify};
 use crate::capability::Run;
+use crate::error::ErrorCode;
+use crate::geometry::Vec3;
+use crate::predict::stl::tests::{binary_stl, box_triangles};
 use crate::tool::{Tool, ToolRef};
 
 fn request(body: Value) -> VerifyRequest {
@@ -27,7 +30,7 @@ fn tools(request: &VerifyRequest) -> Vec<Tool> {
 
 fn run(body: Value) -> Cut {
     let request = request(body);
-    verify(&request, &tools(&request), &Run::default()).expect("verified")
+    verify(&request, &tools(&request), Found::default(), &Run::default()).expect("verified")
 }
 
 fn slot(resolution: Option<f64>) -> Value {
@@ -231,9 +234,163 @@ fn refusals_name_their_field() {
     ];
     for (body, field) in cases {
         let request = request(body);
-        let error = verify(&request, &tools(&request), &Run::default()).unwrap_err();
+        let error = verify(&request, &tools(&request), Found::default(), &Run::default()).unwrap_err();
         assert_eq!(error.field(), Some(field), "{error:?}");
     }
+}
+
+/// `request` verified with `upload` as its uploaded STL files.
+fn run_with(body: Value, upload: &[u8]) -> Result<Cut, crate::error::SolverError> {
+    let request = request(body);
+    verify(&request, &tools(&request), Found::default(), &Run { upload: Some(upload), ..Run::default() })
+}
+
+/// A closed box mesh from `lo` to `hi`, its faces turned inward when `inward`.
+fn box_mesh(lo: [f64; 3], hi: [f64; 3], inward: bool) -> Vec<[Vec3; 3]> {
+    let mut triangles = box_triangles(Vec3::from(lo), Vec3::from(hi));
+    if inward {
+        triangles.iter_mut().for_each(|triangle| triangle.swap(1, 2));
+    }
+    triangles
+}
+
+#[test]
+fn an_stl_part_is_checked_like_the_same_box() {
+    // The dip of `a_dip_into_the_part_is_a_gouge_at_its_line` against the part as an STL file:
+    // the same gouges at the same lines; a program that follows the part's top finds none.
+    let part = binary_stl(&box_mesh([-5.0, -4.0, -10.0], [25.0, 4.0, -1.0], false));
+    let body = |program: &str| {
+        json!({
+            "program": program,
+            "tools": [{"kind": "flat", "radius": 5}],
+            "stock": {"kind": "box", "min": [-5, -4, -10], "max": [25, 4, 0]},
+            "part": {"kind": "mesh"},
+        })
+    };
+    let dip =
+        run_with(body("G0 X-10 Y0 Z5\nG1 Z-1 F500\nG1 X10\nG1 X12 Z-1.2\nG1 X14 Z-1\nG1 X30\nG0 Z5"), &part).unwrap();
+    let gouges: Vec<_> = dip.findings.iter().filter(|finding| finding.kind == FindingKind::Gouge).collect();
+    assert_eq!(gouges.iter().map(|gouge| gouge.line).collect::<Vec<_>>(), [Some(4), Some(5)], "{:?}", dip.findings);
+    assert!((gouges[0].depth - 0.2).abs() < 1e-6, "{:?}", gouges[0]);
+    let level = run_with(body("G0 X-10 Y0 Z5\nG1 Z-0.995 F500\nG1 X30\nG0 Z5"), &part).unwrap();
+    assert!(level.ok, "{:?}", level.findings);
+    assert!((level.part_volume_mm3.unwrap() - 30.0 * 8.0 * 9.0).abs() < 1e-6);
+}
+
+#[test]
+fn a_hollow_stl_part_gives_two_intervals_per_ray_through_its_cavity() {
+    // A 20 mm cube with a 10 mm cubic cavity under a 5 mm roof, in a block 2 mm higher: a drill
+    // down to the part's top gouges nothing; one 12 mm down breaks through the roof into the
+    // cavity: a gouge of the roof's 5 mm, not more (the cavity is not part). The block's material
+    // in the cavity, which no tool reaches, is left material.
+    let mut triangles = box_mesh([0.0, 0.0, -20.0], [20.0, 20.0, 0.0], false);
+    triangles.extend(box_mesh([5.0, 5.0, -15.0], [15.0, 15.0, -5.0], true));
+    let part = binary_stl(&triangles);
+    let body = |program: &str| {
+        json!({
+            "program": program,
+            "tools": [{"kind": "flat", "radius": 1, "flute_length": 20, "stickout": 30}],
+            "stock": {"kind": "box", "min": [0, 0, -20], "max": [20, 20, 2]},
+            "part": {"kind": "mesh"},
+            "resolution": 0.1,
+        })
+    };
+    let roof = run_with(body("G0 X10 Y10 Z5\nG1 Z0 F100\nG0 Z5"), &part).unwrap();
+    assert_eq!(kinds(&roof), [(FindingKind::LeftMaterial, None)]);
+    assert!((roof.part_volume_mm3.unwrap() - (8000.0 - 1000.0)).abs() < 1e-6);
+    let drill = run_with(body("G0 X10 Y10 Z5\nG1 Z-12 F100\nG0 Z5"), &part).unwrap();
+    let gouge = drill.findings.iter().find(|finding| finding.kind == FindingKind::Gouge).unwrap();
+    assert_eq!(gouge.line, Some(2));
+    assert!((gouge.depth - 5.0).abs() < 1e-6, "{gouge:?}");
+    assert!((gouge.position[2] + 5.0).abs() < 1e-6, "{gouge:?}");
+}
+
+#[test]
+fn an_stl_stock_and_part_come_in_one_upload() {
+    let stock = binary_stl(&box_mesh([-5.0, -4.0, -10.0], [25.0, 4.0, 0.0], false));
+    let part = binary_stl(&box_mesh([-5.0, -4.0, -10.0], [25.0, 4.0, -1.0], false));
+    let cut = run_with(
+        json!({
+            "program": "G0 X-10 Y0 Z5\nG1 Z-1 F500\nG1 X30\nG0 Z5",
+            "tools": [{"kind": "flat", "radius": 5}],
+            "stock": {"kind": "mesh"},
+            "part": {"kind": "mesh"},
+        }),
+        &Meshes::pack(&part, &stock),
+    )
+    .unwrap();
+    assert!(cut.ok, "{:?}", cut.findings);
+    assert!((cut.stock_volume_mm3 - 30.0 * 8.0 * 10.0).abs() < 1e-6);
+    assert!((cut.removed_volume_mm3 - 30.0 * 8.0).abs() < 1e-6, "{}", cut.removed_volume_mm3);
+}
+
+#[test]
+fn bad_stl_parts_are_refused_naming_the_part() {
+    let body = json!({
+        "program": "G0 X-10 Y0 Z5\nG1 Z-1 F500\nG1 X30\nG0 Z5",
+        "tools": [{"kind": "flat", "radius": 5}],
+        "stock": {"kind": "box", "min": [-5, -4, -10], "max": [25, 4, 0]},
+        "part": {"kind": "mesh"},
+    });
+    let mut open = box_mesh([-5.0, -4.0, -10.0], [25.0, 4.0, -1.0], false);
+    open.pop();
+    let cases = [
+        (binary_stl(&open), ErrorCode::MeshNotClosed),
+        (binary_stl(&box_mesh([-5.0, -4.0, -10.0], [25.0, 4.0, -1.0], true)), ErrorCode::Input),
+        (binary_stl(&box_mesh([-5.0, -4.0, -10.0], [25.0, 4.0, 3.0], false)), ErrorCode::Input),
+        (binary_stl(&box_mesh([-5.0, -4.0, 5.0], [25.0, 4.0, 8.0], false)), ErrorCode::Input),
+        (binary_stl(&box_mesh([-5.0, -4.0, -10.0], [40.0, 4.0, -1.0], false)), ErrorCode::Input),
+        (b"not an stl".to_vec(), ErrorCode::MeshFormat),
+    ];
+    for (index, (bytes, code)) in cases.into_iter().enumerate() {
+        let error = run_with(body.clone(), &bytes).unwrap_err();
+        assert_eq!((error.code(), error.field()), (code, Some("part")), "case {index}: {error:?}");
+    }
+    let request = request(body);
+    let error = verify(&request, &tools(&request), Found::default(), &Run::default()).unwrap_err();
+    assert_eq!(error.field(), Some("part"), "{error:?}");
+}
+
+#[test]
+fn spindle_power_per_block_from_kienzle_against_the_machine() {
+    // A flat Ø10 (2 flutes) slots 2 deep from outside the stock to x = 50 at F600, S10000: it
+    // removes 2·(10·50 + π·5²/2) = 1078.54 mm³ in 6 s, Q = 10 785.4 mm³/min. f_z = 600/(10 000·2)
+    // = 0.03 mm, h_m = 2·0.03/π = 0.019099 mm, k_c = 1800·h_m^−0.25 = 4841.97 N/mm², so
+    // P = 4841.97 · 10 785.4 / 60·10⁶ = 0.87038 kW: over the machine's 0.5 kW.
+    let material: crate::material::Material = serde_json::from_value(json!({"kc11": 1800, "mc": 0.25})).unwrap();
+    let machine: crate::machine::MachineProfile =
+        serde_json::from_value(json!({"block_time_ms": 2, "max_feed": 10000, "spindle_power_kw": 0.5})).unwrap();
+    let found = Found { material: Some(&material), machine: Some(&machine) };
+    let body = |program: &str| {
+        json!({
+            "program": program,
+            "tools": [{"kind": "flat", "radius": 5, "flutes": 2}],
+            "stock": {"kind": "box", "min": [0, -20, -10], "max": [70, 20, 0]},
+            "resolution": 0.05,
+        })
+    };
+    let slot = request(body("S10000 M3\nG0 X-10 Y0 Z5\nG0 Z-2\nG1 X50 F600\nG0 Z5"));
+    let cut = verify(&slot, &tools(&slot), found, &Run::default()).unwrap();
+    let block = cut.blocks.iter().find(|block| block.line == 4).unwrap();
+    let power = block.spindle_power_kw.unwrap();
+    assert!((power / 0.870_376 - 1.0).abs() < 0.002, "{power}");
+    assert_eq!(kinds(&cut), [(FindingKind::SpindlePower, Some(4))]);
+    assert_eq!((cut.findings[0].power_kw, cut.findings[0].limit_kw), (Some(power), Some(0.5)));
+    // Half the feed per tooth at twice the speed: k_c rises by 2^0.25, the removal rate is the same.
+    let fast = request(body("S20000 M3\nG0 X-10 Y0 Z5\nG0 Z-2\nG1 X50 F600\nG0 Z5"));
+    let faster =
+        verify(&fast, &tools(&fast), Found { material: Some(&material), machine: None }, &Run::default()).unwrap();
+    let doubled = faster.blocks.iter().find(|block| block.line == 4).unwrap().spindle_power_kw.unwrap();
+    assert!((doubled / power - 2f64.powf(0.25)).abs() < 1e-9, "{doubled} against {power}");
+    assert!(faster.ok, "no machine, no limit: {:?}", faster.findings);
+    // Without a spindle speed the chip thickness is unknown; a machine without a material has
+    // nothing to check.
+    let no_speed = request(body("G0 X-10 Y0 Z5\nG0 Z-2\nG1 X50 F600\nG0 Z5"));
+    let error = verify(&no_speed, &tools(&no_speed), found, &Run::default()).unwrap_err();
+    assert_eq!(error.field(), Some("program"), "{error:?}");
+    let error =
+        verify(&slot, &tools(&slot), Found { material: None, machine: Some(&machine) }, &Run::default()).unwrap_err();
+    assert_eq!(error.field(), Some("machine"), "{error:?}");
 }
 
 proptest! {
@@ -258,7 +415,7 @@ proptest! {
             "stock": {"kind": "tube", "start": [-5, 0, -3], "end": [25, 0, -3], "outer_radius": 6, "inner_radius": 3},
         });
         let request = request(body(&program));
-        match verify(&request, &tools(&request), &Run::default()) {
+        match verify(&request, &tools(&request), Found::default(), &Run::default()) {
             Ok(once) => {
                 prop_assert!(once.removed_volume_mm3 >= 0.0);
                 prop_assert!(once.removed_volume_mm3 <= once.stock_volume_mm3 + 1e-9);
@@ -271,5 +428,122 @@ proptest! {
             }
             Err(error) => prop_assert_eq!(error.field(), Some("stock")),
         }
+    }
+}
+
+/// The chamfer kerf's deburr program cuts on reference case 1 (docs/spec/deburr.md §5.2: tube
+/// R 50 (bore 40) along y, hole R 10 along z, ball R 3, Q 0.5, so W = 0.7071), with `method`:
+/// per angle φ of 0°, 90°, 180° and 270° (where the ridge's normal plane is the vertical plane
+/// through the hole axis) the band's edges G1 on the tube and G2 on the hole wall as the dexels
+/// show them, the distance |G1 G2|, and the outermost reach of any removal.
+struct Band {
+    widths: Vec<f64>,
+    summary: crate::deburr::DeburrSummary,
+    /// The largest radius from the hole axis of a ray that lost material, and the largest band
+    /// edge radius measured.
+    reach: (f64, f64),
+    /// Material removed from the tube's lower wall, mm³.
+    lower_removed: f64,
+}
+
+fn deburr_band(method: &str, spacing: f64) -> Band {
+    // The program is cut with the tool's tip programmed, as verify reads it.
+    let (outer, hole) = (50.0_f64, 10.0_f64);
+    let deburr: crate::deburr::DeburrRequest = serde_json::from_value(json!({
+        "tool": {"kind": "ball", "radius": 3},
+        "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": outer},
+        "hole": {"shape": "round", "radius": hole}, "edge": "outer", "cut_amount": 0.5, "tolerance": 0.01,
+        "method": method,
+    }))
+    .unwrap();
+    let ToolRef::Inline(tool) = &deburr.tool else { unreachable!("an inline tool") };
+    let answer = crate::deburr::solve(&deburr, tool).unwrap();
+    let post = crate::gcode::Post {
+        dialect: crate::gcode::Dialect::Fanuc,
+        reference: crate::gcode::Reference::Tip,
+        tool: crate::gcode::ToolCall::Table(7),
+        arcs: crate::gcode::Arcs::Chords,
+        plunge_feed: None,
+        units: crate::units::Units::Mm,
+    };
+    let program = crate::deburr::program(&answer, &post).unwrap();
+    let body = json!({
+        "program": program,
+        "tools": [{"kind": "ball", "radius": 3}],
+        "stock": {"kind": "tube", "start": [0, -16, 0], "end": [0, 16, 0], "outer_radius": outer, "inner_radius": 40,
+                  "holes": [{"start": [0, 0, -60], "end": [0, 0, 60], "radius": hole}]},
+        "resolution": spacing,
+    });
+    let request = request(body);
+    let job = request.validate(&tools(&request), Found::default(), None, Default::default()).unwrap();
+    let (cut, stock) = super::simulate::cut_stock(&job, &Run::default()).unwrap();
+    assert!(cut.ok, "{:?}", cut.findings);
+    let original = job.stock.field(job.grid);
+    let grid = job.grid;
+    // The top of the upper wall on each ray before and after, and what the lower wall lost.
+    let mut rays = Vec::new();
+    let mut lower_removed = 0.0;
+    let mut reach = 0.0_f64;
+    for (index, (before, after)) in original.rays.iter().zip(&stock.rays).enumerate() {
+        let (x, y) = (grid.x(index % grid.nx), grid.y(index / grid.nx));
+        let lower =
+            |ray: &super::dexel::Ray| ray.iter().filter(|piece| piece[1] <= 0.0).map(|p| p[1] - p[0]).sum::<f64>();
+        lower_removed += (lower(before) - lower(after)) * grid.cell_area();
+        let (Some(top_before), Some(top_after)) = (before.last(), after.last()) else { continue };
+        if top_before[1] - top_after[1] > 1e-9 {
+            reach = reach.max(x.hypot(y));
+            rays.push((x, y, top_after[1], top_before[1]));
+        }
+    }
+    let mut widths = Vec::new();
+    let mut edge = 0.0_f64;
+    for phi in [0.0_f64, 90.0, 180.0, 270.0] {
+        let (c, s) = (phi.to_radians().cos(), phi.to_radians().sin());
+        // The rays on the radial line at φ (within half a spacing of it, on one side), outward.
+        let mut line: Vec<(f64, f64, f64)> = rays
+            .iter()
+            .filter(|(x, y, ..)| {
+                let across = -s * x + c * y;
+                (0.0..spacing).contains(&across) && c * x + s * y > 0.0
+            })
+            .map(|&(x, y, after, before)| (x.hypot(y), after, before - after))
+            .collect();
+        line.sort_by(|a, b| a.0.total_cmp(&b.0));
+        assert!(line.len() >= 4, "φ {phi}: {line:?}");
+        // G1: where the depth removed, extrapolated along the two outermost rays, reaches 0, on
+        // the tube (z = √(R² − x²)); G2: the chamfer's floor extrapolated along the two innermost
+        // rays to the hole wall.
+        let [.., (r_a, _, d_a), (r_b, _, d_b)] = line[..] else { unreachable!() };
+        let r1 = r_b + d_b * (r_b - r_a) / (d_a - d_b);
+        let x1 = r1 * c;
+        let z1 = (outer * outer - x1 * x1).sqrt();
+        let [(r_c, z_c, _), (r_d, z_d, _), ..] = line[..] else { unreachable!() };
+        let z2 = z_c + (z_d - z_c) * (hole - r_c) / (r_d - r_c);
+        widths.push((r1 - hole).hypot(z1 - z2));
+        edge = edge.max(r1);
+    }
+    Band { widths, summary: answer.summary, reach: (reach, edge), lower_removed }
+}
+
+#[test]
+fn the_deburr_program_cuts_its_chamfer_band_w_wide_and_nothing_beyond() {
+    // The exact method promises a swept width within W ± max(0.005, TA) = ± 0.01 mm here; the
+    // dexels measure it within that at 0.1 mm and 0.05 mm spacing (figures in the commit), and no
+    // ray beyond the band's outer edge (by more than a spacing) nor the tube's lower wall loses
+    // material.
+    for spacing in [0.1, 0.05] {
+        let band = deburr_band("exact", spacing);
+        let w = band.summary.width;
+        let promise = 0.005_f64.max(band.summary.tolerance);
+        eprintln!(
+            "exact at {spacing}: W {w}, measured {:?}, swept {}–{}, reach {:?}",
+            band.widths, band.summary.swept_width_min, band.summary.swept_width_max, band.reach
+        );
+        for width in &band.widths {
+            assert!((width - w).abs() <= promise, "spacing {spacing}: {:?} against W = {w}", band.widths);
+        }
+        assert!(band.reach.0 <= band.reach.1 + spacing, "spacing {spacing}: removal out to {:?}", band.reach);
+        assert!(band.reach.1 < 10.0 + w, "{:?}", band.reach);
+        assert_eq!(band.lower_removed, 0.0);
     }
 }

@@ -1,13 +1,16 @@
 //! `POST /api/v1/verify` over HTTP: a slot's removed volume with a tool from the table, faults
-//! found at their lines, bad requests refused naming their field (nothing stored), and removed
-//! volumes against a CSG computation by manifold3d (`tests/verify_csg.py`).
+//! found at their lines, bad requests refused naming their field (nothing stored), removed
+//! volumes against a CSG computation by manifold3d (`tests/verify_csg.py`), and a part (and
+//! stock) uploaded as STL files.
 
 use std::f64::consts::PI;
 use std::io::Write;
 use std::process::{Command, Stdio};
 
 use kerf_cases::number;
+use kerf_server::state::Limits;
 use kerf_tests::{TestApp, external_program, json_with, problem};
+use reqwest::multipart::{Form, Part};
 use serde_json::{Value, json};
 
 async fn verify(app: &TestApp, body: &Value) -> Value {
@@ -239,4 +242,197 @@ async fn removed_volumes_agree_with_manifold3d() {
             "{what}: simulated {simulated} mm³, manifold3d {independent} mm³"
         );
     }
+}
+
+/// A binary STL file of `triangles`, each turned so its normal (right-hand rule) points along
+/// the outward direction given with it.
+fn stl(triangles: &[([[f64; 3]; 3], [f64; 3])]) -> Vec<u8> {
+    let mut bytes = vec![0u8; 80];
+    bytes.extend_from_slice(&u32::try_from(triangles.len()).unwrap().to_le_bytes());
+    for &([a, b, c], outward) in triangles {
+        let (u, v) = ([b[0] - a[0], b[1] - a[1], b[2] - a[2]], [c[0] - a[0], c[1] - a[1], c[2] - a[2]]);
+        let normal = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+        let along: f64 = (0..3).map(|k| normal[k] * outward[k]).sum();
+        let corners = if along > 0.0 { [a, b, c] } else { [a, c, b] };
+        bytes.extend_from_slice(&[0u8; 12]);
+        for corner in corners {
+            for coordinate in corner {
+                #[allow(clippy::cast_possible_truncation, reason = "STL stores f32; the figures here are exact in it")]
+                bytes.extend_from_slice(&(coordinate as f32).to_le_bytes());
+            }
+        }
+        bytes.extend_from_slice(&[0u8; 2]);
+    }
+    bytes
+}
+
+/// A stepped part as an STL file: the L profile 40 wide in x, 10 high for x < 20 and 6 high
+/// beyond, extruded 40 along y from y = 0 (its volume 40·(20·10 + 20·6) = 12 800 mm³).
+fn stepped_part() -> Vec<u8> {
+    // Counter-clockwise in (x, z), so the outward normal of edge p → q is (dz, −dx).
+    let profile = [[0.0, 0.0], [40.0, 0.0], [40.0, 6.0], [20.0, 6.0], [20.0, 10.0], [0.0, 10.0]];
+    let at = |[x, z]: [f64; 2], y: f64| [x, y, z];
+    let mut triangles = Vec::new();
+    for (k, &p) in profile.iter().enumerate() {
+        let q = profile[(k + 1) % profile.len()];
+        let outward = [q[1] - p[1], 0.0, p[0] - q[0]];
+        triangles.push(([at(p, 0.0), at(q, 0.0), at(q, 40.0)], outward));
+        triangles.push(([at(p, 0.0), at(q, 40.0), at(p, 40.0)], outward));
+    }
+    // The L cut into four triangles; each cap faces away from the part.
+    for [a, b, c] in [[0, 1, 2], [0, 2, 3], [0, 3, 5], [3, 4, 5]] {
+        let corners = |y: f64| [at(profile[a], y), at(profile[b], y), at(profile[c], y)];
+        triangles.push((corners(0.0), [0.0, -1.0, 0.0]));
+        triangles.push((corners(40.0), [0.0, 1.0, 0.0]));
+    }
+    stl(&triangles)
+}
+
+/// Posts `body` with the STL `files` (form part name and bytes) as a multipart form.
+async fn verify_form(app: &TestApp, body: &Value, files: Vec<(&'static str, Vec<u8>)>) -> reqwest::Response {
+    let mut form = Form::new().part("request", Part::text(body.to_string()).mime_str("application/json").unwrap());
+    for (name, bytes) in files {
+        form = form.part(name, Part::bytes(bytes).file_name(format!("{name}.stl")));
+    }
+    app.client.post(app.url("/api/v1/verify")).multipart(form).send().await.unwrap()
+}
+
+/// Facing the step's lower level (z = 6, x > 20) with a flat Ø10 in four passes along y;
+/// `dip` lowers the third pass (line 7) by that much.
+fn step_program(dip: f64) -> String {
+    format!(
+        "G0 X25 Y-10 Z15\nG0 Z6\nG1 Y50 F1000\nG1 X30\nG1 Y-10\nG1 X35 Z{}\nG1 Y50\nG1 X40 Z6\nG1 Y-10\nG0 Z15\nM30",
+        6.0 - dip
+    )
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn an_stl_part_is_cut_to_and_a_gouge_into_it_found_at_its_line() {
+    let app = TestApp::spawn().await;
+    let body = |program: String| {
+        json!({
+            "program": program,
+            "tools": [{"kind": "flat", "radius": 5}],
+            "stock": {"kind": "box", "min": [0, 0, 0], "max": [40, 40, 10]},
+            "part": {"kind": "mesh"},
+        })
+    };
+    let follows =
+        json_with(verify_form(&app, &body(step_program(0.0)), vec![("part", stepped_part())]).await, 200).await;
+    assert_eq!(follows["ok"], true, "{follows}");
+    for (field, exact) in [("part_volume_mm3", 12_800.0), ("removed_volume_mm3", 20.0 * 40.0 * 4.0)] {
+        assert!((number(&follows[field]) / exact - 1.0).abs() < 1e-9, "{field}: {follows}");
+    }
+    let gouges =
+        json_with(verify_form(&app, &body(step_program(0.2)), vec![("part", stepped_part())]).await, 200).await;
+    let findings = gouges["findings"].as_array().unwrap();
+    assert_eq!(findings.len(), 1, "{gouges}");
+    assert_eq!((&findings[0]["kind"], &findings[0]["line"]), (&json!("gouge"), &json!(7)), "{gouges}");
+    assert!((number(&findings[0]["depth"]) - 0.2).abs() < 1e-6, "{gouges}");
+    // The stock as an STL file too, in the same form: the same answer.
+    let block = stl(&[
+        ([[0.0, 0.0, 0.0], [40.0, 0.0, 0.0], [40.0, 40.0, 0.0]], [0.0, 0.0, -1.0]),
+        ([[0.0, 0.0, 0.0], [40.0, 40.0, 0.0], [0.0, 40.0, 0.0]], [0.0, 0.0, -1.0]),
+        ([[0.0, 0.0, 10.0], [40.0, 0.0, 10.0], [40.0, 40.0, 10.0]], [0.0, 0.0, 1.0]),
+        ([[0.0, 0.0, 10.0], [40.0, 40.0, 10.0], [0.0, 40.0, 10.0]], [0.0, 0.0, 1.0]),
+        ([[0.0, 0.0, 0.0], [40.0, 0.0, 0.0], [40.0, 0.0, 10.0]], [0.0, -1.0, 0.0]),
+        ([[0.0, 0.0, 0.0], [40.0, 0.0, 10.0], [0.0, 0.0, 10.0]], [0.0, -1.0, 0.0]),
+        ([[0.0, 40.0, 0.0], [40.0, 40.0, 0.0], [40.0, 40.0, 10.0]], [0.0, 1.0, 0.0]),
+        ([[0.0, 40.0, 0.0], [40.0, 40.0, 10.0], [0.0, 40.0, 10.0]], [0.0, 1.0, 0.0]),
+        ([[0.0, 0.0, 0.0], [0.0, 40.0, 0.0], [0.0, 40.0, 10.0]], [-1.0, 0.0, 0.0]),
+        ([[0.0, 0.0, 0.0], [0.0, 40.0, 10.0], [0.0, 0.0, 10.0]], [-1.0, 0.0, 0.0]),
+        ([[40.0, 0.0, 0.0], [40.0, 40.0, 0.0], [40.0, 40.0, 10.0]], [1.0, 0.0, 0.0]),
+        ([[40.0, 0.0, 0.0], [40.0, 40.0, 10.0], [40.0, 0.0, 10.0]], [1.0, 0.0, 0.0]),
+    ]);
+    let mut both = body(step_program(0.2));
+    both["stock"] = json!({"kind": "mesh"});
+    let answer = json_with(verify_form(&app, &both, vec![("part", stepped_part()), ("stock", block)]).await, 200).await;
+    assert_eq!(answer["findings"], gouges["findings"]);
+    assert_eq!(answer["removed_volume_mm3"], gouges["removed_volume_mm3"]);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn bad_stl_uploads_are_refused_naming_their_field() {
+    let app = TestApp::spawn_with(Limits { max_upload_bytes: 256 * 1024, ..Limits::default() }).await;
+    let jobs_before = json_with(app.get("/api/v1/jobs").await, 200).await;
+    let body = json!({
+        "program": step_program(0.0),
+        "tools": [{"kind": "flat", "radius": 5}],
+        "stock": {"kind": "box", "min": [0, 0, 0], "max": [40, 40, 10]},
+        "part": {"kind": "mesh"},
+    });
+    let part = stepped_part();
+    // Without its last triangle (50 bytes, the count lowered to match).
+    let mut open = part[..part.len() - 50].to_vec();
+    let count = u32::from_le_bytes(open[80..84].try_into().unwrap()) - 1;
+    open[80..84].copy_from_slice(&count.to_le_bytes());
+    // Every triangle's second and third corners swapped: the same surface, normals inward.
+    let mut inside_out = part.clone();
+    for record in inside_out[84..].chunks_exact_mut(50) {
+        let (second, third) = (record[24..36].to_vec(), record[36..48].to_vec());
+        record[24..36].copy_from_slice(&third);
+        record[36..48].copy_from_slice(&second);
+    }
+    let mut box_part = body.clone();
+    box_part["part"] = json!({"kind": "box", "min": [0, 0, 0], "max": [40, 40, 6]});
+    let mut raised = body.clone();
+    raised["stock"] = json!({"kind": "box", "min": [0, 0, 0], "max": [40, 40, 8]});
+    let cases = [
+        ("an open mesh", &body, vec![("part", open)], 422, "part", "E_MESH_NOT_CLOSED"),
+        ("an inside-out mesh", &body, vec![("part", inside_out)], 422, "part", "E_INPUT"),
+        ("a part reaching out of the stock", &raised, vec![("part", part.clone())], 422, "part", "E_INPUT"),
+        ("a mesh part without its file", &body, vec![], 422, "part", "E_INPUT"),
+        ("a file for a box part", &box_part, vec![("part", part.clone())], 422, "part.kind", "E_INPUT"),
+        ("not an STL file", &body, vec![("part", b"not an stl".to_vec())], 422, "part", "E_MESH_FORMAT"),
+        ("a file over the upload limit", &body, vec![("part", vec![b' '; 400 * 1024])], 413, "", "E_TOO_LARGE"),
+    ];
+    let mut mismatches = Vec::new();
+    for (what, body, files, status, field, code) in cases {
+        let answer = problem(verify_form(&app, body, files).await, status).await;
+        if answer["code"] != code || (!field.is_empty() && answer["errors"][0]["path"] != field) {
+            mismatches.push(format!("{what}: expected {code} at {field}, got {answer}"));
+        }
+    }
+    assert!(mismatches.is_empty(), "{mismatches:#?}");
+    assert_eq!(json_with(app.get("/api/v1/jobs").await, 200).await, jobs_before, "nothing stored");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn verify_runs_as_a_job_with_the_same_answer_and_the_spindle_power() {
+    let app = TestApp::spawn().await;
+    app.register_tool(5, &json!({"kind": "flat", "radius": 5, "flutes": 2})).await;
+    json_with(app.put_json("/api/v1/materials/steel", &json!({"kc11": 1800, "mc": 0.25})).await, 201).await;
+    json_with(
+        app.put_json("/api/v1/machines/mill", &json!({"block_time_ms": 2, "max_feed": 10000, "spindle_power_kw": 0.5}))
+            .await,
+        201,
+    )
+    .await;
+    // The slot of the solver's spindle-power test: 0.870 kW over the mill's 0.5 at line 5.
+    let request = json!({
+        "program": "T5 M6\nS10000 M3\nG0 X-10 Y0 Z5\nG0 Z-2\nG1 X50 F600\nG0 Z5\nM30",
+        "tools": [5],
+        "stock": {"kind": "box", "min": [0, -20, -10], "max": [70, 20, 0]},
+        "material": "steel",
+        "machine": "mill",
+    });
+    let answer = verify(&app, &request).await;
+    let findings = answer["findings"].as_array().unwrap();
+    assert_eq!(findings.len(), 1, "{answer}");
+    assert_eq!((&findings[0]["kind"], &findings[0]["line"]), (&json!("spindle_power"), &json!(5)));
+    assert!((number(&findings[0]["power_kw"]) / 0.870_376 - 1.0).abs() < 0.005, "{answer}");
+    assert_eq!(findings[0]["limit_kw"], 0.5);
+    let mut operation = request.clone();
+    operation["operation"] = json!("verify");
+    let job = json!({"operations": [operation]});
+    let id = json_with(app.post_json("/api/v1/jobs", &job).await, 202).await["id"].as_i64().unwrap();
+    let done = kerf_tests::poll_job(&app.client, &app.base, id, 120, kerf_tests::finished).await;
+    assert_eq!(done["status"], "done", "{done}");
+    assert_eq!(done["results"][0]["operation"], "verify");
+    assert_eq!(done["results"][0]["result"], answer, "the job answers as the endpoint does");
+    // A job file carries no STL file: refused when submitted.
+    let mut mesh = operation.clone();
+    mesh["part"] = json!({"kind": "mesh"});
+    let refused = problem(app.post_json("/api/v1/jobs", &json!({"operations": [mesh]})).await, 400).await;
+    assert_eq!(refused["errors"][0]["path"], "operations[0].part.kind", "{refused}");
 }

@@ -46,6 +46,19 @@ pub(super) fn check(job: &JobFile) -> AppResult<()> {
                  stock, or send the request to POST /api/v1/predict as multipart/form-data",
             ));
         }
+        if let Operation::Verify(request) = operation {
+            let meshes = [("part", request.part.as_ref()), ("stock", Some(&request.stock))];
+            if let Some((name, _)) = meshes.into_iter().find(|(_, solid)| solid.is_some_and(|solid| solid.is_mesh())) {
+                return Err(file_error(
+                    &format!("operations[{index}].{name}.kind"),
+                    None,
+                    &format!(
+                        "a job file cannot carry the STL file of a mesh {name}: use a box, cylinder, tube or height \
+                         grid, or send the request to POST /api/v1/verify as multipart/form-data"
+                    ),
+                ));
+            }
+        }
     }
     check_machines(&job.machines)?;
     check_materials(&job.materials)
