@@ -1,7 +1,8 @@
 //! Benchmark for re-segmenting a CAM program (docs/spec/resegment.md): a program of 1 000 000
 //! lines of dense G01 points (0.01 mm steps on concentric circles of 100 mm radius and smaller at
 //! 6000 mm/min, one run each between a rapid and a plunge) read, cut again for a 4 ms control and
-//! written; criterion reports lines per second (`thrpt`, in elements/s).
+//! written, in the program's own post and re-posted for Sinumerik; criterion reports lines per
+//! second (`thrpt`, in elements/s).
 //!
 //! Run: `cargo bench -p kerf-solver --bench resegment -- --warm-up-time 1 --measurement-time 20`.
 //! The program is also written to `$TMPDIR/kerf-resegment-1m.ngc`, to time another reader on the
@@ -9,7 +10,8 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use kerf_solver::capability::Control;
-use kerf_solver::segment::resegment::{ResegmentRequest, resegment, write};
+use kerf_solver::gcode::Dialect;
+use kerf_solver::segment::resegment::{ResegmentRequest, resegment, write, write_posted};
 
 /// Lines of the program.
 const LINES: usize = 1_000_000;
@@ -53,6 +55,7 @@ fn bench(c: &mut Criterion) {
         min_chord_error: None,
         tolerance: None,
         corner_angle_deg: None,
+        program_dialect: None,
     };
     let answer = resegment(&request, None, Control::default()).expect("resegments");
     eprintln!(
@@ -74,6 +77,13 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             let answer = resegment(&request, None, Control::default()).expect("resegments");
             write(&request.program, &answer.cuts, Control::default()).expect("writes")
+        });
+    });
+    group.bench_function("dense_1m_lines_reposted_for_sinumerik", |b| {
+        b.iter(|| {
+            let answer = resegment(&request, None, Control::default()).expect("resegments");
+            write_posted(&request.program, &answer.cuts, Dialect::Fanuc, Dialect::Sinumerik, Control::default())
+                .expect("re-posts")
         });
     });
     group.finish();

@@ -132,7 +132,8 @@ fn bench(c: &mut Criterion) {
         std::env::var("KERF_BENCH_DEBURR_SPACING").ok().and_then(|v| v.parse().ok()).unwrap_or(0.01);
     let (deburr_request, deburr_tools) = deburr_case(deburr_spacing);
     let (started, cpu_started) = (Instant::now(), thread_cpu_seconds());
-    let deburr_cut = verify::verify(&deburr_request, &deburr_tools, verify::Found::default(), &Run::default()).expect("verified");
+    let deburr_cut =
+        verify::verify(&deburr_request, &deburr_tools, verify::Found::default(), &Run::default()).expect("verified");
     let seconds = started.elapsed().as_secs_f64();
     let cpu = thread_cpu_seconds().zip(cpu_started).map(|(end, start)| end - start);
     println!(
@@ -151,7 +152,9 @@ fn bench(c: &mut Criterion) {
         b.iter(|| verify::verify(&request, &tools, verify::Found::default(), &Run::default()).expect("verified"))
     });
     group.bench_function("deburr_program", |b| {
-        b.iter(|| verify::verify(&deburr_request, &deburr_tools, verify::Found::default(), &Run::default()).expect("verified"))
+        b.iter(|| {
+            verify::verify(&deburr_request, &deburr_tools, verify::Found::default(), &Run::default()).expect("verified")
+        })
     });
     group.finish();
 }

@@ -660,7 +660,17 @@ pub fn program<C: Capability>(
 ) -> Result<String, SolverError> {
     control.check()?;
     let machine = C::machine(answer);
-    let output =
-        OutputOptions { dialect: Some(output.dialect_for(machine)), arcs: Some(output.arcs_for(machine)), ..*output };
-    C::program(request, answer, &output, control)
+    // No dialect asked and no machine: each capability's own default (Fanuc; resegment keeps the
+    // program's post).
+    let output = OutputOptions {
+        dialect: output.dialect.or(machine.map(|m| m.dialect)),
+        arcs: Some(output.arcs_for(machine)),
+        ..*output
+    };
+    let text = C::program(request, answer, &output, control)?;
+    Ok(crate::gcode::with_haas_smoothing(
+        text,
+        output.dialect.unwrap_or_default(),
+        machine.and_then(|m| m.haas_smoothing),
+    ))
 }

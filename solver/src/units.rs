@@ -207,6 +207,7 @@ impl Scale for MachineProfile {
             rapid_feed,
             tool_change_s: _,
             units: _,
+            haas_smoothing: _,
         } = self;
         max_feed.scale(scaling);
         for value in [min_chord_error, plunge_feed, max_accel, max_jerk, rapid_feed] {

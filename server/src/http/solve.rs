@@ -47,11 +47,20 @@ pub async fn answer<C: Capability>(
     if ask.gcode {
         C::check_output(&request, &ask.output)?;
     }
+    // The post the program is written in, for its file name: asked, else the machine's.
+    let machine_dialect = capability::all_refs::<C>(&request)
+        .iter()
+        .find_map(|refs| refs.machine)
+        .and_then(|name| catalog.machines.iter().find(|m| m.name.as_deref() == Some(name)))
+        .map(|m| m.dialect);
+    let disposition =
+        super::output::program_disposition(C::NAME, ask.output.dialect.or(machine_dialect).unwrap_or_default());
     if let Some(question) = &question {
         let cached = state.answers.get(question);
         crate::metrics::answer_cache_lookup(cached.is_some());
         if let Some(CachedAnswer { bytes, media_type }) = cached {
-            return respond(state, bytes, media_type, HeaderValue::from_static("cache;desc=\"answer cache\""));
+            let timing = HeaderValue::from_static("cache;desc=\"answer cache\"");
+            return respond(state, bytes, media_type, timing, disposition);
         }
     }
     // The answer is built within the byte budget its client's download is held to.
@@ -77,7 +86,7 @@ pub async fn answer<C: Capability>(
     }
     let timing = HeaderValue::from_str(&format!("solve;dur={:.1}", seconds * 1e3))
         .unwrap_or_else(|_| HeaderValue::from_static("solve"));
-    respond(state, bytes, media_type, timing)
+    respond(state, bytes, media_type, timing, disposition)
 }
 
 /// The answer cache's key: the capability, the request, the stored values it resolved to and
@@ -90,11 +99,21 @@ fn question<C: Capability>(request: &C::Request, catalog: &Catalog, ask: &Ask) -
     Some(AnswerCache::question(&[C::NAME.as_bytes(), &request, &found, asked.as_bytes()]))
 }
 
-/// The answer's bytes as a response held against the memory budget.
-fn respond(state: &AppState, bytes: Bytes, media_type: &'static str, timing: HeaderValue) -> AppResult<Response> {
+/// The answer's bytes as a response held against the memory budget; a program is an attachment
+/// named `disposition`.
+fn respond(
+    state: &AppState,
+    bytes: Bytes,
+    media_type: &'static str,
+    timing: HeaderValue,
+    disposition: HeaderValue,
+) -> AppResult<Response> {
     let length = bytes.len();
     let mut response = held_download(state.reserve_memory(length)?, pieces_of(bytes), length, media_type);
     response.headers_mut().insert("server-timing", timing);
     response.headers_mut().insert(header::VARY, HeaderValue::from_static("accept"));
+    if media_type.starts_with("text/x-gcode") {
+        response.headers_mut().insert(header::CONTENT_DISPOSITION, disposition);
+    }
     Ok(response)
 }

@@ -277,7 +277,7 @@ pub fn program_for_loops(
         let names: Vec<String> = used
             .iter()
             .map(|&index| match tool_of(index) {
-                ToolCall::Table(number) => format!("T{number}"),
+                ToolCall::Table(number) | ToolCall::Named { number, .. } => format!("T{number}"),
                 ToolCall::Manual(description) => description,
             })
             .collect();

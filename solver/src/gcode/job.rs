@@ -145,6 +145,8 @@ fn is_comment(line: &str, table: &PostTable) -> bool {
 fn tool_call_number(line: &str, table: &PostTable) -> Option<u32> {
     let call = match table.tool_change {
         ToolChange::M06WithG43 => line.strip_prefix('T')?.strip_suffix(" M06")?,
+        // A call by name carries its number as a comment (`T="NAME" D1 ; T7`).
+        ToolChange::SinumerikD1 if line.starts_with("T=\"") => line.rsplit_once(" D1 ; T")?.1,
         ToolChange::SinumerikD1 => line.strip_prefix('T')?.strip_suffix(" D1")?,
         ToolChange::HeidenhainIso => line.strip_prefix('T')?.strip_suffix(" G17")?,
         ToolChange::Pause => {

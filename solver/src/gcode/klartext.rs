@@ -64,7 +64,7 @@ impl Klartext {
     /// the call without a number keeps the loaded tool and sets the speed).
     fn tool_call(&mut self, tool: Option<&ToolCall>, rpm: f64) {
         let number = match tool {
-            Some(ToolCall::Table(number)) => Some(*number),
+            Some(ToolCall::Table(number) | ToolCall::Named { number, .. }) => Some(*number),
             Some(ToolCall::Manual(description)) => {
                 self.comment(&format!("TOOL NOT IN THE TOOL TABLE: {description}"));
                 self.comment("LOAD IT, ACTIVATE ITS LENGTH OFFSET, THEN CYCLE START");

@@ -17,6 +17,7 @@ pub mod number;
 pub mod reader;
 #[cfg(test)]
 pub(crate) mod reference;
+pub mod repost;
 pub mod table;
 
 use std::fmt::Write as _;
@@ -39,8 +40,8 @@ pub enum Dialect {
     /// `G43 H`.
     #[default]
     Fanuc,
-    /// Haas: as Fanuc with a five-digit `O` number (no `G187`: the control's smoothing setting
-    /// applies).
+    /// Haas: as Fanuc with a five-digit `O` number; `G187` only when the machine's
+    /// `haas_smoothing` asks ([`with_haas_smoothing`]), else the control's setting applies.
     Haas,
     /// LinuxCNC (rs274ngc): adds `G64 P` blending tolerance.
     Linuxcnc,
@@ -72,6 +73,17 @@ impl Dialect {
             Self::Heidenhain => "heidenhain",
             Self::HeidenhainIso => "heidenhain_iso",
             Self::Grbl => "grbl",
+        }
+    }
+
+    /// The extension of a program file for the control: `mpf` (Sinumerik main program), `h`
+    /// (Heidenhain conversational), `i` (Heidenhain ISO), else `nc`.
+    pub fn file_extension(self) -> &'static str {
+        match self {
+            Self::Sinumerik => "mpf",
+            Self::Heidenhain => "h",
+            Self::HeidenhainIso => "i",
+            Self::Fanuc | Self::Haas | Self::Linuxcnc | Self::Grbl => "nc",
         }
     }
 }
@@ -129,6 +141,14 @@ impl Reference {
 pub enum ToolCall {
     /// A tool from the machine's table: `T n M06` and length offset `H n`.
     Table(u32),
+    /// A tool from the machine's table that has a name: Sinumerik's tool management calls it
+    /// by name (`T="NAME"`), every other post by its number as [`ToolCall::Table`].
+    Named {
+        /// Its number in the table.
+        number: u32,
+        /// Its name as Sinumerik takes it (see [`ToolCall::for_tool`]).
+        name: String,
+    },
     /// A tool given inline, unknown to the control: the program stops (`M00`) and asks the
     /// operator to load it and activate its length offset.
     Manual(String),
@@ -137,11 +157,34 @@ pub enum ToolCall {
 impl ToolCall {
     /// The call for `tool`: from the table when it has a number, otherwise a manual change.
     pub fn for_tool(tool: &crate::tool::Tool) -> Self {
-        match tool.number {
-            Some(number) => Self::Table(number),
-            None => Self::Manual(format!("{} R{}", tool.kind.as_str(), mm(tool.radius))),
+        match (tool.number, tool.name.as_deref().map(sinumerik_tool_name).filter(|n| !n.is_empty())) {
+            (Some(number), Some(name)) => Self::Named { number, name },
+            (Some(number), None) => Self::Table(number),
+            (None, _) => Self::Manual(format!("{} R{}", tool.kind.as_str(), mm(tool.radius))),
         }
     }
+
+    /// The tool's number in the machine's table, if it is from the table.
+    pub fn number(&self) -> Option<u32> {
+        match self {
+            Self::Table(number) | Self::Named { number, .. } => Some(*number),
+            Self::Manual(_) => None,
+        }
+    }
+}
+
+/// Longest tool name Sinumerik's tool management takes, characters.
+pub const SINUMERIK_TOOL_NAME_CHARS: usize = 32;
+
+/// A tool's name as Sinumerik's `T="…"` takes it: printable ASCII without `"`, upper case as
+/// the program's comments, at most [`SINUMERIK_TOOL_NAME_CHARS`] characters, trimmed.
+fn sinumerik_tool_name(name: &str) -> String {
+    let cleaned: String = name
+        .chars()
+        .map(|c| if c == '"' || c.is_control() || !c.is_ascii() { ' ' } else { c.to_ascii_uppercase() })
+        .take(SINUMERIK_TOOL_NAME_CHARS)
+        .collect();
+    cleaned.trim().to_owned()
 }
 
 /// How a caller wants a capability's program written: every `program(answer, &Post)` takes one.
@@ -302,6 +345,28 @@ pub struct ProgramStop {
     pub tool: Option<ToolCall>,
     /// The spindle speed after it, rpm (the direction stays the program's).
     pub spindle_rpm: f64,
+}
+
+/// `text`, a program of `dialect`'s post, with Haas smoothing `G187 P<level>` after its safety
+/// block when the post is Haas and `level` is given (a machine's `haas_smoothing`); otherwise, or
+/// in a program without the post's safety block (a re-segmented program keeps the source's
+/// heading), `text` as it is.
+pub fn with_haas_smoothing(text: String, dialect: Dialect, level: Option<u8>) -> String {
+    let (Some(level), Dialect::Haas, Some(table)) = (level, dialect, dialect.table()) else { return text };
+    // The safety block of either units: an inch program writes its own.
+    let found = [table.safety, table.inch_safety]
+        .into_iter()
+        .find_map(|safety| text.find(&format!("\n{safety}\n")).map(|at| at + safety.len() + 2));
+    match found {
+        Some(end) => {
+            let mut out = String::with_capacity(text.len() + 8);
+            out.push_str(&text[..end]);
+            let _ = writeln!(out, "G187 P{level}");
+            out.push_str(&text[end..]);
+            out
+        }
+        None => text,
+    }
 }
 
 /// Writes the whole program.
@@ -496,8 +561,15 @@ impl Blocks {
 
     /// The tool call of `tool` with its length offset at `safe_z`.
     fn tool_call(&mut self, tool: &ToolCall, safe_z: f64) {
+        if let (ToolCall::Named { number, name }, ToolChange::SinumerikD1) = (tool, self.table.tool_change) {
+            // The number as a comment: the operator's and the job program's key to the table.
+            self.block(&format!("T=\"{name}\" D1 ; T{number}"));
+            self.block("M6");
+            self.rapid_z(safe_z);
+            return;
+        }
         match tool {
-            ToolCall::Table(number) => match self.table.tool_change {
+            ToolCall::Table(number) | ToolCall::Named { number, .. } => match self.table.tool_change {
                 ToolChange::M06WithG43 => {
                     self.block(&format!("T{number} M06"));
                     self.begin();
@@ -821,6 +893,38 @@ mod tests {
     }
 
     #[test]
+    fn haas_smoothing_is_written_only_on_haas_and_when_asked() {
+        let mut path = Toolpath::default();
+        path.rapid(Vec3::new(1.0, 2.0, 50.0));
+        path.linear(Vec3::new(1.0, 2.0, 3.0), 300.0);
+        let program = |dialect| Program {
+            dialect,
+            number: 1000,
+            title: "smooth",
+            comments: Vec::new(),
+            tool: ToolCall::Table(7),
+            spindle_rpm: 6000.0,
+            spindle_direction: SpindleDirection::Cw,
+            safe_z: 50.0,
+            blend_tolerance: 0.01,
+            plunges: None,
+            units: Units::Mm,
+            path: &path,
+        };
+        let haas = write(&program(Dialect::Haas));
+        let smooth = with_haas_smoothing(haas.clone(), Dialect::Haas, Some(2));
+        assert!(smooth.starts_with("%\nO01000 (SMOOTH)\nG21 G17 G90 G40 G49 G80 G94\nG187 P2\nT7 M06\n"), "{smooth}");
+        assert_eq!(smooth.len(), haas.len() + "G187 P2\n".len());
+        assert_eq!(with_haas_smoothing(haas.clone(), Dialect::Haas, None), haas);
+        let inch = write(&Program { units: Units::Inch, ..program(Dialect::Haas) });
+        let smooth_inch = with_haas_smoothing(inch, Dialect::Haas, Some(3));
+        assert!(smooth_inch.contains("\nG20 G17 G90 G40 G49 G80 G94\nG187 P3\n"), "{smooth_inch}");
+        let fanuc = write(&program(Dialect::Fanuc));
+        assert_eq!(with_haas_smoothing(fanuc.clone(), Dialect::Fanuc, Some(2)), fanuc);
+        assert_eq!(with_haas_smoothing("G00 X1\n".to_owned(), Dialect::Haas, Some(3)), "G00 X1\n");
+    }
+
+    #[test]
     fn comments_cannot_break_out() {
         assert_eq!(comment("a (b) c"), "(A  B  C)");
         assert_eq!(comment("ø3\nx"), "(3 X)");
@@ -957,7 +1061,7 @@ mod tests {
 }
 
 /// Every post's program of one small path (a plunge, a line, two half circles, a helical arc, a
-/// stop turning the part with a tool change, a manual tool), kept as golden files in
+/// stop turning the part with a change to a named tool, a manual tool), kept as golden files in
 /// `solver/src/gcode/golden/` that a reviewer reads against the control's manual.
 /// `KERF_UPDATE_GOLDEN=1` writes them anew.
 #[cfg(test)]
@@ -1006,7 +1110,8 @@ mod golden {
         let stop = ProgramStop {
             before: 6,
             notice: Some("turn the part".to_owned()),
-            tool: Some(ToolCall::Table(8)),
+            // A named tool: Sinumerik calls it by name, the others by number.
+            tool: Some(ToolCall::Named { number: 8, name: "BALL R3 LONG".to_owned() }),
             spindle_rpm: 5000.0,
         };
         let folder = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/gcode/golden");

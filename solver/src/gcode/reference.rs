@@ -53,7 +53,7 @@ fn comment(text: &str) -> String {
 /// Writes the tool call of `tool` with its length offset at `safe_z`.
 fn old_tool_call(out: &mut String, tool: &ToolCall, safe_z: f64) {
     match tool {
-        ToolCall::Table(number) => {
+        ToolCall::Table(number) | ToolCall::Named { number, .. } => {
             let _ = writeln!(out, "T{number} M06");
             let _ = writeln!(out, "G00 G43 H{number} Z{}", mm(safe_z));
         }

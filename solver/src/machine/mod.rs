@@ -107,6 +107,12 @@ pub struct MachineProfile {
     /// mm and mm/min whatever this says.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub units: Option<crate::units::Units>,
+    /// Haas high-speed smoothing written by the Haas post after its safety block: `G187 P1`
+    /// (rough), `P2` (medium) or `P3` (finish). Default none: the control's setting applies.
+    /// Other posts ignore it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "schema", schema(minimum = 1, maximum = 3))]
+    pub haas_smoothing: Option<u8>,
 }
 
 /// A feed the request asks for (`field`, mm/min) as the program may write it: capped by
@@ -211,6 +217,14 @@ impl MachineProfile {
         }
         if let Some(description) = &self.description {
             crate::validate::text("description", description, MAX_DESCRIPTION_CHARS)?;
+        }
+        if let Some(level) = self.haas_smoothing
+            && !(1..=3).contains(&level)
+        {
+            return Err(SolverError::input(
+                "haas_smoothing",
+                format!("haas_smoothing is G187's P: 1 (rough), 2 (medium) or 3 (finish), not {level}"),
+            ));
         }
         Ok(())
     }

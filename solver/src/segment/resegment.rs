@@ -13,14 +13,18 @@
 //! smallest radius, a run without length) stays as it was, with a warning.
 //!
 //! The re-cut blocks are written as kerf's posts write G01 blocks: `G01 X Y Z` with every axis, 4
-//! decimals in the run's units, the run's first `F` word (as written) on its first block.
+//! decimals in the run's units, the run's first `F` word (as written) on its first block. A
+//! program asked for in another post than its own is re-posted line by line
+//! ([`crate::gcode::repost`]).
 
 use serde::{Deserialize, Serialize};
 
 use super::{Curve, Direction, SegmentRequest, SegmentSolution};
 use crate::capability::{Capability, Control, Endpoint, OutputOptions, Refs, Resolved, Run};
 use crate::error::{ErrorCode, SolverError, Warning};
+use crate::gcode::Dialect;
 use crate::gcode::reader::{self, Distance, MoveKind, Plane, ReadMove, ReadOptions, Units};
+use crate::gcode::repost::Reposter;
 use crate::machine::MachineProfile;
 use crate::machine::rule::MS_PER_MIN;
 
@@ -77,6 +81,11 @@ pub struct ResegmentRequest {
     /// (default 20): corners stay command points.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub corner_angle_deg: Option<f64>,
+    /// The post the program was written for (default `fanuc`; the reader takes the RS274
+    /// family: `fanuc`, `haas`, `linuxcnc`, `grbl`). A program asked for in another post (the
+    /// machine's, or `?dialect=`) is re-posted line by line; in this one its lines stay as sent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub program_dialect: Option<Dialect>,
 }
 
 /// Block figures of a program's feed moves (`G1`, `G2`, `G3`; rapids are not counted).
@@ -178,8 +187,9 @@ impl Capability for ResegmentCapability {
             as arcs) in mode `guarantee` for the machine's block time, and returns the block figures before \
             and after and the largest deviation (JSON), or with `Accept: text/x-gcode` / `?format=gcode` the \
             program with every other line (rapids, tool changes, spindle, coolant, comments) byte for byte as \
-            sent. The program keeps its own dialect and programmed point: `dialect`, `reference` and `arcs` \
-            do not apply.",
+            sent, or re-posted line by line in the post of `?dialect=` or the machine when it is not the \
+            program's own (`program_dialect`; a code without a counterpart there is refused naming its line). \
+            The program keeps its programmed point: `reference` and `arcs` do not apply.",
         not_found: "Unknown machine",
         refused: "Impossible request: `E_INPUT` (no block time, bad factors), `E_GCODE_SYNTAX`, \
             `E_GCODE_UNSUPPORTED`, `E_ARC_NOT_CLOSED`, `E_ARC_RADIUS`, `E_TOO_MANY_LINES` (each naming \
@@ -201,13 +211,23 @@ impl Capability for ResegmentCapability {
         resegment(request, context.machine, run.control)
     }
 
+    fn check_output(_request: &ResegmentRequest, output: &OutputOptions) -> Result<(), SolverError> {
+        match output.dialect {
+            Some(dialect) => crate::gcode::repost::check_target(dialect).map(|_| ()),
+            None => Ok(()),
+        }
+    }
+
     fn program(
         request: &ResegmentRequest,
         answer: &ResegmentAnswer,
-        _output: &OutputOptions,
+        output: &OutputOptions,
         control: Control<'_>,
     ) -> Result<String, SolverError> {
-        write(&request.program, &answer.cuts, control)
+        match output.dialect {
+            Some(target) => write_posted(&request.program, &answer.cuts, program_dialect(request)?, target, control),
+            None => write(&request.program, &answer.cuts, control),
+        }
     }
 
     fn machine(answer: &ResegmentAnswer) -> Option<&MachineProfile> {
@@ -228,6 +248,7 @@ pub fn resegment(
     if request.program.trim().is_empty() {
         return Err(SolverError::input("program", "the program is empty"));
     }
+    program_dialect(request)?;
     let block_time_ms = match request.block_time_ms.or(machine.as_ref().map(|m| m.block_time_ms)) {
         Some(value) => crate::validate::positive("block_time_ms", value)?,
         None => {
@@ -328,6 +349,20 @@ pub fn resegment(
     }
     answer.warnings = condense(warnings);
     Ok(answer)
+}
+
+/// The post the request's program was written for: one of the RS274 family the reader takes.
+fn program_dialect(request: &ResegmentRequest) -> Result<Dialect, SolverError> {
+    match request.program_dialect.unwrap_or_default() {
+        dialect @ (Dialect::Fanuc | Dialect::Haas | Dialect::Linuxcnc | Dialect::Grbl) => Ok(dialect),
+        other => Err(SolverError::input(
+            "program_dialect",
+            format!(
+                "the G-code reader takes RS274/Fanuc programs (fanuc, haas, linuxcnc, grbl), not {}",
+                other.as_str()
+            ),
+        )),
+    }
 }
 
 /// What a move's source line holds besides its motion.
@@ -631,6 +666,53 @@ pub fn write(source: &str, cuts: &[RunCut], control: Control<'_>) -> Result<Stri
     Ok(out)
 }
 
+/// The program for the post `target`: each run's lines replaced by its new blocks in the post's
+/// words, every other line re-posted in order ([`Reposter`]), or kept as sent when `target` is
+/// the program's own post (`source_dialect`).
+///
+/// # Errors
+/// `E_INPUT` naming `dialect` for a post the re-poster cannot write; `E_GCODE_UNSUPPORTED` naming
+/// the line whose code has no counterpart in `target`; `E_CANCELLED`.
+pub fn write_posted(
+    source: &str,
+    cuts: &[RunCut],
+    source_dialect: Dialect,
+    target: Dialect,
+    control: Control<'_>,
+) -> Result<String, SolverError> {
+    if target == source_dialect {
+        return write(source, cuts, control);
+    }
+    let mut out = Reposter::new(target, source, "program")?;
+    let program = reader::read_cancellable(source, "program", &ReadOptions::default(), control)?;
+    let mut moves = program.moves.iter().peekable();
+    let mut cuts = cuts.iter().peekable();
+    let mut skip_until = 0;
+    let last = source.split('\n').count();
+    for (index, line) in source.split('\n').enumerate() {
+        let number = index + 1;
+        if index % crate::gcode::MOVES_PER_CHECK == 0 {
+            control.check()?;
+        }
+        while moves.next_if(|m| m.line < number).is_some() {}
+        if number <= skip_until {
+            continue;
+        }
+        if line.is_empty() && number == last {
+            // The text after the last line end.
+            break;
+        }
+        match cuts.next_if(|cut| cut.first_line == number) {
+            Some(cut) => {
+                out.feed_blocks(&cut.points, cut.units, feed_word_of(line).as_deref());
+                skip_until = cut.last_line;
+            }
+            None => out.line(number, line, moves.peek().copied().filter(|m| m.line == number))?,
+        }
+    }
+    Ok(out.finish(source))
+}
+
 /// The `F` word of a line as written, if it has one.
 fn feed_word_of(line: &str) -> Option<String> {
     let shape = line_shape(line.strip_suffix('\n').unwrap_or(line));
@@ -666,6 +748,7 @@ mod tests {
             min_chord_error: None,
             tolerance: None,
             corner_angle_deg: None,
+            program_dialect: None,
         }
     }
 
@@ -745,5 +828,53 @@ mod tests {
         let answer = resegment(&request(source.clone()), None, Control::default()).unwrap();
         let text = write(&source, &answer.cuts, Control::default()).unwrap();
         assert!(text.contains("G01 X0.2000 Y0.0000 Z0.0000 F100\nM30"), "{text}");
+    }
+
+    #[test]
+    fn a_fanuc_program_is_reposted_for_sinumerik_in_its_words_and_order() {
+        let source = dense_circle();
+        let answer = resegment(&request(source.clone()), None, Control::default()).unwrap();
+        let text = write_posted(&source, &answer.cuts, Dialect::Fanuc, Dialect::Sinumerik, Control::default()).unwrap();
+        assert!(
+            text.starts_with("; DENSE\nG71 G17 G90\nT1 D1\nM6\nS6000 M3\nM8\nG0 X100. Y0. Z5.\nG1 Z-1. F300\nG1 X"),
+            "{}",
+            &text[..200]
+        );
+        assert!(text.ends_with(" Z-1.0000\nG0 Z5.\nM9\nM5\nM30\n"), "{}", &text[text.len() - 200..]);
+        assert!(!text.contains('(') && !text.contains('%') && !text.contains("G01"));
+        assert_eq!(text.lines().filter(|l| l.starts_with("G1 X")).count(), answer.after.blocks - 1);
+    }
+
+    #[test]
+    fn heidenhain_iso_numbers_the_blocks_and_writes_arc_centres_absolute() {
+        let source = "%\nO0042 (ARC)\nG21 G17 G90\nT3 M06\nG00 G43 H3 Z5.\nG00 X10 Y0\nG01 Z-1 F100\nG03 X-10 Y0 I-10 J0 F600 (HALF)\nM30\n%\n";
+        let answer = resegment(&request(source.to_owned()), None, Control::default()).unwrap();
+        assert!(answer.cuts.is_empty(), "a line with a comment stays");
+        let text =
+            write_posted(source, &answer.cuts, Dialect::Fanuc, Dialect::HeidenhainIso, Control::default()).unwrap();
+        assert_eq!(
+            text,
+            "%KERF42 G71 *\nN10 ; ARC *\nN20 G71 G17 G90 *\nN30 T3 G17 *\nN40 G00 Z+5. *\nN50 G00 X+10 Y+0 *\n\
+             N60 G01 Z-1 F100 *\nN70 I+0.0000 J+0.0000 *\nN80 G03 X-10 Y+0 F600 *\nN90 ; HALF *\nN100 M30 *\nN99999999 %KERF42 G71 *\n"
+        );
+    }
+
+    #[test]
+    fn a_line_without_a_counterpart_is_refused_naming_it_unless_the_post_is_the_programs() {
+        let source = "G21 G17 G90\nG00 X0 Y0 Z1\nG04 P500\nM30\n";
+        let answer = resegment(&request(source.to_owned()), None, Control::default()).unwrap();
+        for target in [Dialect::Sinumerik, Dialect::Linuxcnc, Dialect::Grbl] {
+            let error = write_posted(source, &answer.cuts, Dialect::Fanuc, target, Control::default()).unwrap_err();
+            assert_eq!(error.code(), ErrorCode::GcodeUnsupported);
+            assert!(error.to_string().contains("line 3: G04"), "{error}");
+        }
+        let same = write_posted(source, &answer.cuts, Dialect::Fanuc, Dialect::Fanuc, Control::default()).unwrap();
+        assert_eq!(same, source);
+        let klartext = write_posted(source, &answer.cuts, Dialect::Fanuc, Dialect::Heidenhain, Control::default());
+        assert_eq!(klartext.unwrap_err().field(), Some("dialect"));
+        let mut sinumerik = request(source.to_owned());
+        sinumerik.program_dialect = Some(Dialect::Sinumerik);
+        let error = resegment(&sinumerik, None, Control::default()).unwrap_err();
+        assert_eq!(error.field(), Some("program_dialect"));
     }
 }

@@ -182,6 +182,7 @@ fn machine_values_and_bad_block_times() {
         max_jerk: None,
         rapid_feed: None,
         tool_change_s: None,
+        haas_smoothing: None,
         name: Some("hsc".to_owned()),
         block_time_ms: 4.0,
         max_feed: 2000.0,

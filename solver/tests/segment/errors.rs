@@ -258,6 +258,7 @@ fn machine_values_are_defaults_the_request_overrides() {
         max_jerk: None,
         rapid_feed: None,
         tool_change_s: None,
+        haas_smoothing: None,
         name: None,
         block_time_ms: 4.0,
         max_feed: 10_000.0,

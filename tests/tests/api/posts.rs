@@ -93,7 +93,7 @@ fn assert_moves_among(label: &str, got: &[Move], want: &[Move]) {
 }
 
 /// Runs `script` with `python3` on `program` (its standard input); its standard output as JSON.
-fn python(script: &str, program: &str, label: &str) -> Value {
+pub(crate) fn python(script: &str, program: &str, label: &str) -> Value {
     let python = external_program("python3", "the PyPI G-code interpreters").expect("python3");
     let mut child = std::process::Command::new(python)
         .args(["-c", script])
@@ -109,7 +109,7 @@ fn python(script: &str, program: &str, label: &str) -> Value {
 }
 
 /// Moves as the Python scripts print them: `[[feed, x, y, z], ...]`.
-fn moves_of(value: &Value) -> Vec<Move> {
+pub(crate) fn moves_of(value: &Value) -> Vec<Move> {
     value
         .as_array()
         .unwrap()
@@ -123,7 +123,7 @@ fn moves_of(value: &Value) -> Vec<Move> {
 
 /// Sinumerik: `nc_to_dataframe` reads the program as an 840D does; every block that names an
 /// axis is a move to the modal position.
-const SINUMERIK: &str = r#"
+pub(crate) const SINUMERIK: &str = r#"
 import json, sys
 import nc_gcode_interpreter as nc
 frame, state = nc.nc_to_dataframe(sys.stdin.read(), disable_forward_fill=True)
@@ -432,4 +432,52 @@ async fn a_machine_names_its_post_and_an_unknown_post_is_refused() {
     let bad = json!({"block_time_ms": 4, "max_feed": 6000, "dialect": "mazak"});
     let status = app.put_json("/api/v1/machines/bad", &bad).await.status();
     assert!(status.is_client_error(), "{status}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
+#[cfg_attr(
+    not(kerf_has_nc_gcode_interpreter),
+    ignore = "nc-gcode-interpreter not found: pip install -r tests/requirements.txt"
+)]
+async fn sinumerik_calls_a_named_tool_by_name_and_programs_download_under_their_posts_names() {
+    let app = app().await;
+    app.register_tool(9, &json!({"kind": "flat", "radius": 3, "flutes": 3, "name": "Flat \"6\" end mill, long reach"}))
+        .await;
+    let mut body = kerf_cases::contour::arrow_request(1);
+    body["tool"] = json!(9);
+    let sinumerik = program(&app, "contour", &body, "sinumerik").await;
+    assert!(sinumerik.contains("\nT=\"FLAT  6  END MILL, LONG REACH\" D1 ; T9\nM6\nG0 Z"), "{sinumerik}");
+    let fanuc = program(&app, "contour", &body, "fanuc").await;
+    assert!(fanuc.contains("\nT9 M06\nG00 G43 H9 Z"), "{fanuc}");
+    let linuxcnc = program(&app, "contour", &body, "linuxcnc").await;
+    let want = rs274_moves(&linuxcnc, app.directory(), "named_linuxcnc").expect("rs274 present");
+    let got = moves_of(&python(SINUMERIK, &sinumerik, "named_sinumerik"));
+    assert_same_moves("named_sinumerik", &got, &want);
+
+    for (dialect, extension) in [
+        ("fanuc", "nc"),
+        ("haas", "nc"),
+        ("linuxcnc", "nc"),
+        ("grbl", "nc"),
+        ("sinumerik", "mpf"),
+        ("heidenhain", "h"),
+        ("heidenhain_iso", "i"),
+    ] {
+        for _ in 0..2 {
+            // The second answer comes from the answer cache: the same name.
+            let url = app.url(&format!("/api/v1/contour?format=gcode&dialect={dialect}"));
+            let response = app.client.post(url).json(&body).send().await.unwrap();
+            assert_eq!(response.status(), 200);
+            let disposition = response.headers()["content-disposition"].to_str().unwrap().to_owned();
+            assert_eq!(disposition, format!("attachment; filename=\"kerf-contour.{extension}\""));
+        }
+    }
+    let machine = json!({"block_time_ms": 4, "max_feed": 6000, "dialect": "sinumerik"});
+    assert!(app.put_json("/api/v1/machines/840d", &machine).await.status().is_success());
+    body["machine"] = json!("840d");
+    let response = app.client.post(app.url("/api/v1/contour?format=gcode")).json(&body).send().await.unwrap();
+    assert_eq!(response.headers()["content-disposition"], "attachment; filename=\"kerf-contour.mpf\"");
+    let json = app.client.post(app.url("/api/v1/contour")).json(&body).send().await.unwrap();
+    assert!(json.headers().get("content-disposition").is_none(), "the JSON answer is not a download");
 }

@@ -99,6 +99,68 @@ async fn a_dense_circle_loses_its_short_blocks_within_the_chord_error() {
     }
 }
 
+/// The re-segmented program of `body` in `dialect`.
+async fn reposted(app: &TestApp, body: &Value, dialect: &str) -> String {
+    let url = app.url(&format!("/api/v1/resegment?format=gcode&dialect={dialect}"));
+    let response = app.client.post(url).json(body).send().await.unwrap();
+    assert_eq!(response.status(), 200, "{dialect}");
+    response.text().await.unwrap()
+}
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
+#[cfg_attr(
+    not(kerf_has_nc_gcode_interpreter),
+    ignore = "nc-gcode-interpreter not found: pip install -r tests/requirements.txt"
+)]
+async fn a_fanuc_program_reposted_for_linuxcnc_and_sinumerik_moves_the_same() {
+    let app = TestApp::spawn().await;
+    let source = dense_circle_program();
+    let body = json!({"program": source, "block_time_ms": 4});
+    let fanuc = reposted(&app, &body, "fanuc").await;
+    let linuxcnc = reposted(&app, &body, "linuxcnc").await;
+    assert!(linuxcnc.starts_with("(DENSE CIRCLE FROM CAM)\nG21 G17 G90 G40 G49 G80 G94\nT1 M06\n"), "{linuxcnc}");
+    assert!(!linuxcnc.contains('%') && !linuxcnc.contains("O1234"), "LinuxCNC reads O words as subroutines");
+    let want = rs274_moves(&fanuc, app.directory(), "reposted_fanuc").expect("rs274 present");
+    let got = rs274_moves(&linuxcnc, app.directory(), "reposted_linuxcnc").expect("rs274 present");
+    assert!(want.len() > 100, "{} moves", want.len());
+    assert_eq!(got, want, "the LinuxCNC program moves as the Fanuc one");
+
+    // The machine's post writes the program when the request names one.
+    let machine = json!({"block_time_ms": 4, "max_feed": 10000, "dialect": "sinumerik"});
+    assert!(app.put_json("/api/v1/machines/840d", &machine).await.status().is_success());
+    let on_machine = json!({"program": source, "machine": "840d"});
+    let response = app.client.post(app.url("/api/v1/resegment?format=gcode")).json(&on_machine).send().await.unwrap();
+    assert_eq!(response.status(), 200);
+    let sinumerik = response.text().await.unwrap();
+    assert_eq!(sinumerik, reposted(&app, &body, "sinumerik").await);
+    assert!(
+        sinumerik
+            .starts_with("; DENSE CIRCLE FROM CAM\nG71 G17 G90 G40 G94\nT1 D1\nM6\nG0 Z25.\nS8000 M3\nM8\n; CONTOUR\n"),
+        "{sinumerik}"
+    );
+    assert!(sinumerik.contains("\n; SECOND TOOL\nT2 D1\nM6\nG0 Z25.\nS3000 M3\n"), "{sinumerik}");
+    assert!(!sinumerik.contains('(') && !sinumerik.contains("G01") && !sinumerik.contains('%'), "{sinumerik}");
+    let got = crate::posts::moves_of(&crate::posts::python(crate::posts::SINUMERIK, &sinumerik, "reposted_sinumerik"));
+    // The reader starts at 0, 0, 0 and counts `G0 Z25.` after the tool change as a move, as rs274 does.
+    assert_eq!(got.len(), want.len(), "move count");
+    for (index, (got, want)) in got.iter().zip(&want).enumerate() {
+        assert_eq!(got.0, want.0, "move {index} kind");
+        assert!((0..3).all(|k| (got.1[k] - want.1[k]).abs() <= 1e-4), "move {index}: {got:?} vs {want:?}");
+    }
+
+    // A line with no counterpart on the 840D is refused naming it; in the program's own post it stays.
+    let dwell = json!({"program": "G21 G90\nG00 X0 Y0 Z1\nG04 P500\nM30\n", "block_time_ms": 4});
+    let url = app.url("/api/v1/resegment?format=gcode&dialect=sinumerik");
+    let answer = problem(app.client.post(url).json(&dwell).send().await.unwrap(), 422).await;
+    assert_eq!(answer["errors"][0]["path"], "program", "{answer}");
+    assert!(answer.to_string().contains("line 3: G04"), "{answer}");
+    assert!(reposted(&app, &dwell, "fanuc").await.contains("\nG04 P500\n"));
+    let url = app.url("/api/v1/resegment?format=gcode&dialect=heidenhain");
+    let answer = problem(app.client.post(url).json(&dwell).send().await.unwrap(), 422).await;
+    assert_eq!(answer["errors"][0]["path"], "dialect", "{answer}");
+}
+
 #[tokio::test(flavor = "multi_thread")]
 async fn a_program_is_resegmented_as_a_job() {
     let app = TestApp::spawn().await;
@@ -126,12 +188,17 @@ async fn a_program_is_resegmented_as_a_job() {
 #[tokio::test(flavor = "multi_thread")]
 async fn bad_programs_are_refused_naming_the_field_and_line() {
     let app = TestApp::spawn().await;
-    let cases: [(Value, &str, &str); 5] = [
+    let cases: [(Value, &str, &str); 6] = [
         (json!({"program": "G00 X0 Y0\nG01 X1 Y( F100\n", "block_time_ms": 4}), "program", "line 2"),
         (json!({"program": "G00 X0 Y0\nG41 D1\n", "block_time_ms": 4}), "program", "line 2"),
         (json!({"program": "G00 X0 Y0\nG01 X1 F100\n"}), "block_time_ms", "block_time_ms"),
         (json!({"program": "  \n", "block_time_ms": 4}), "program", "empty"),
         (json!({"program": "G01 X1 F100\n", "block_time_ms": 4, "margin": 0.5}), "margin", "at least 1"),
+        (
+            json!({"program": "G01 X1 F100\n", "block_time_ms": 4, "program_dialect": "heidenhain"}),
+            "program_dialect",
+            "RS274",
+        ),
     ];
     for (body, field, words) in cases {
         let answer = problem(app.post_json("/api/v1/resegment", &body).await, 422).await;
