@@ -70,6 +70,13 @@ export function dxfUpload(form, { messages, fill }) {
       showProblem(messages, form, problem);
       return;
     }
+    if (profile.boundary.length === 0) {
+      // One open SPLINE: a curve for segment, with no loop to draw or fill.
+      preview.replaceChildren();
+      messages.replaceChildren(message('ok', `Read ${file.name}: one open SPLINE of degree ${profile.curve.degree}, no closed loop: send the file with a segment request as its "drawing" curve.`));
+      profile = null;
+      return;
+    }
     loop.replaceChildren(new Option('outer boundary', 'boundary'), ...profile.islands.map((_, i) => new Option(`island ${i + 1}`, String(i + 1))));
     loop.disabled = profile.islands.length === 0;
     choose();

@@ -27,19 +27,20 @@ use crate::store;
 /// `http::endpoints` the HTTP endpoints. An entry names the variant of [`Operation`]; the solver
 /// module with the capability, request and answer types (named so the OpenAPI document shows the
 /// concrete schemas; the compiler checks that they are the capability's); the endpoint's body,
-/// `json(Query)` with the query parameters it takes (a type of `http::output`) or `upload` for a
-/// capability with its own handler in `http/<module>.rs` (which also routes its program, if it
-/// writes one: verify answers findings only); and the operation's description.
+/// `json(Query)` with the query parameters it takes (a type of `http::output`), `drawing(Query)` for
+/// JSON or a form with a DXF file (`http::dxf::Submitted`), or `upload` for a capability with its
+/// own handler in `http/<module>.rs` (which also routes its program, if it writes one: verify
+/// answers findings only); and the operation's description.
 macro_rules! with_registry {
     ($callback:ident) => {
         $callback! {
             Deburr => deburr::{DeburrCapability, DeburrRequest, DeburrAnswer}, json(OutputQuery),
                 "`POST /api/v1/deburr`.";
-            Segment => segment::{SegmentCapability, SegmentRequest, SegmentAnswer}, json(OutputQuery),
+            Segment => segment::{SegmentCapability, SegmentRequest, SegmentAnswer}, drawing(OutputQuery),
                 "`POST /api/v1/segment`.";
             Resegment => segment::{ResegmentCapability, ResegmentRequest, ResegmentAnswer}, json(OutputQuery),
                 "`POST /api/v1/resegment`: a G-code program's feed moves cut again by the block-time rule.";
-            Contour => contour::{ContourCapability, ContourRequest, ContourAnswer}, json(OutputQuery),
+            Contour => contour::{ContourCapability, ContourRequest, ContourAnswer}, drawing(OutputQuery),
                 "`POST /api/v1/contour`.";
             Engagement => engagement::{EngagementCapability, EngagementRequest, EngagementAnswer}, json(CandidateQuery),
                 "`POST /api/v1/engagement`; the job's program is that of the request's `candidate` path (default the first).";

@@ -2,7 +2,9 @@
 //! shuffled order and half of them reversed, that join into one 100 000-gon (a 200 mm circle) with
 //! 100 CIRCLE islands; criterion reports entities per second (`thrpt`, in elements/s).
 //!
-//! Run: `cargo bench -p kerf-solver --bench dxf -- --warm-up-time 1 --measurement-time 10`.
+//! Run: `cargo bench -p kerf-solver --bench dxf -- --warm-up-time 1 --measurement-time 10`, or
+//! `tests/load/dxf.sh`, which also times ezdxf reading the same file (written to
+//! `$CARGO_TARGET_TMPDIR/dxf-100k.dxf`).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use kerf_solver::dxf::{DxfOptions, read};
@@ -36,6 +38,9 @@ fn drawing() -> String {
 fn bench(c: &mut Criterion) {
     let text = drawing();
     let profile = read(text.as_bytes(), "file", &DxfOptions::default()).expect("reads");
+    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("dxf-100k.dxf");
+    std::fs::write(&path, &text).expect("the drawing is written for the ezdxf comparison");
+    eprintln!("the drawing: {}", path.display());
     eprintln!(
         "{} entities, {} bytes: boundary of {} points, {} islands",
         profile.entities,

@@ -298,6 +298,11 @@ impl Scale for crate::segment::Curve {
             }
             Curve::Polyline { points, .. } => points.scale(scaling),
             Curve::Bspline { control_points, .. } => control_points.scale(scaling),
+            // The drawing's geometry is in the drawing's own units; its tolerances are the request's.
+            Curve::Drawing { join_tolerance, chord_tolerance, .. } => {
+                join_tolerance.scale(scaling);
+                chord_tolerance.scale(scaling);
+            }
         }
     }
 }
@@ -382,6 +387,15 @@ impl Scale for crate::machine::PathBlocks {
     }
 }
 
+/// A DXF drawing's tolerances (its geometry is in the drawing's own units, `$INSUNITS` or `units`).
+impl Scale for crate::dxf::Drawing {
+    fn scale(&mut self, scaling: Scaling) {
+        let Self { units: _, layer: _, island: _, join_tolerance, chord_tolerance } = self;
+        join_tolerance.scale(scaling);
+        chord_tolerance.scale(scaling);
+    }
+}
+
 /// A contour request's lengths and feeds: the outline, depths, loop sizes, allowances, feeds,
 /// clearances, tolerance and the inline tool (not angles, times or counts).
 impl Scale for crate::contour::ContourRequest {
@@ -389,6 +403,7 @@ impl Scale for crate::contour::ContourRequest {
         let Self {
             tool,
             contour,
+            drawing,
             side: _,
             depths,
             corner_loop,
@@ -417,6 +432,9 @@ impl Scale for crate::contour::ContourRequest {
         } = self;
         tool.scale(scaling);
         contour.scale(scaling);
+        if let Some(drawing) = drawing {
+            drawing.scale(scaling);
+        }
         let crate::contour::Depths { top, bottom, step } = depths;
         for value in [top, bottom, step] {
             value.scale(scaling);

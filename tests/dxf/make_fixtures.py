@@ -83,3 +83,62 @@ polygon = [(0, 0), (80, 0), (80, 30), (40, 30), (40, 60), (0, 60)]
 for a, b in zip(polygon, polygon[1:] + polygon[:1]):
     msp.add_line(a, b)
 save(doc, "l_plate_lines.dxf")
+
+# An open cubic SPLINE, clamped, in mm: segment's exact curve (the same control points, knots
+# and weights typed in give the same answer).
+doc, msp = new("R2018", units.MM)
+msp.add_open_spline([(0, 0), (20, 30), (50, -10), (80, 25), (100, 0)], degree=3)
+save(doc, "spline_open_mm.dxf")
+
+# A rational quadratic SPLINE (weights) in inch: a quarter circle of radius 2 in.
+doc, msp = new("R2018", units.IN)
+msp.add_rational_spline([(2, 0), (2, 2), (0, 2)], [1, math.sqrt(0.5), 1], degree=2, knots=[0, 0, 0, 1, 1, 1])
+save(doc, "spline_rational_inch.dxf")
+
+# A closed periodic cubic SPLINE (unclamped knots) round a 40 x 30 mm blob.
+doc, msp = new("R2018", units.MM)
+blob = [(20 * math.cos(t), 15 * math.sin(t)) for t in [k * math.tau / 8 for k in range(8)]]
+spline = msp.add_spline(dxfattribs={"degree": 3})
+spline.control_points = blob + blob[:3]
+spline.knots = list(range(len(blob) + 3 + 3 + 1))
+spline.closed = True
+save(doc, "spline_periodic_mm.dxf")
+
+# Blocks: a 120 x 80 plate of LINEs in block PLATE (base (10, 10), placed at (10, 10)); block
+# HOLE, a radius-2 circle on layer 0 (it takes its INSERT's layer), placed twice inside block
+# PAIR (at x = 0 and x = 20), and PAIR placed at (30, 40) scaled 1.5 and at (70, 20) turned 90°;
+# block SLOT, an open slot of lines and arcs, placed at (100, 60) mirrored (x scale -1); one
+# MINSERT-style array of HOLE 3 columns x 1 row spaced 10 at (20, 70); a TEXT on layer NOTES.
+doc, msp = new("R2018", units.MM)
+plate = doc.blocks.new("PLATE", base_point=(10, 10))
+corners = [(10, 10), (130, 10), (130, 90), (10, 90)]
+for a, b in zip(corners, corners[1:] + corners[:1]):
+    plate.add_line(a, b, dxfattribs={"layer": "CUT"})
+hole = doc.blocks.new("HOLE")
+hole.add_circle((0, 0), 2)
+pair = doc.blocks.new("PAIR")
+pair.add_blockref("HOLE", (0, 0))
+pair.add_blockref("HOLE", (20, 0))
+slot = doc.blocks.new("SLOT")
+slot.add_line((0, -3), (8, -3))
+slot.add_arc((8, 0), 3, -90, 90)
+slot.add_line((8, 3), (0, 3))
+slot.add_arc((0, 0), 3, 90, 270)
+msp.add_blockref("PLATE", (10, 10))
+msp.add_blockref("PAIR", (30, 40), dxfattribs={"layer": "CUT", "xscale": 1.5, "yscale": 1.5})
+msp.add_blockref("PAIR", (70, 20), dxfattribs={"layer": "CUT", "rotation": 90})
+msp.add_blockref("SLOT", (100, 60), dxfattribs={"layer": "CUT", "xscale": -1})
+msp.add_blockref(
+    "HOLE", (20, 70), dxfattribs={"layer": "CUT", "column_count": 3, "row_count": 1, "column_spacing": 10}
+)
+msp.add_text("PLATE 1", dxfattribs={"layer": "NOTES"})
+save(doc, "blocks_mm.dxf")
+save(doc, "blocks_mm_binary.dxf", binary=True)
+
+# A block that places itself.
+doc, msp = new("R2018", units.MM)
+loop = doc.blocks.new("LOOP")
+loop.add_circle((0, 0), 1)
+loop.add_blockref("LOOP", (5, 0))
+msp.add_blockref("LOOP", (0, 0))
+save(doc, "block_loop.dxf")

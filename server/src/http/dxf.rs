@@ -7,16 +7,114 @@
 //! has the upload limit (`Limits::max_upload_bytes`) instead of the default body limit.
 
 use axum::Json;
-use axum::extract::{DefaultBodyLimit, Request, State};
+use axum::body::{Body, Bytes};
+use axum::extract::{DefaultBodyLimit, FromRef, FromRequest, Multipart, Request, State};
+use axum::http::header;
+use kerf_solver::ErrorCode;
 use kerf_solver::dxf::{self, DrawingUnits, DxfOptions, Profile};
 use serde::Deserialize;
+use serde::de::DeserializeOwned;
 use utoipa::IntoParams;
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
-use crate::error::{AppResult, Problem};
-use crate::extract::{AppQuery, charged_body_bytes};
+use crate::error::{AppError, AppResult, Problem};
+use crate::extract::{AppJson, AppQuery, charged_body_bytes, media_type, parse_json};
 use crate::state::AppState;
+
+/// The form of a contour or segment request with its drawing (for the OpenAPI document).
+#[derive(Debug, utoipa::ToSchema)]
+pub struct DrawingForm {
+    /// The request, as the JSON body would be, with a `drawing` (contour) or a `drawing` curve
+    /// (segment).
+    pub request: String,
+    /// The DXF file (ASCII or binary, R12 to 2018).
+    #[schema(value_type = String, format = Binary)]
+    pub drawing: Vec<u8>,
+}
+
+/// A request of a capability whose outline or curve may come from a DXF drawing
+/// (docs/spec/dxf.md §5): JSON as every capability takes it (its body limit), or a
+/// `multipart/form-data` form (the upload limit, charged to the memory budget while it
+/// arrives, as predict's STL) with the JSON in part `request` and the file in part `drawing`.
+#[derive(Debug)]
+pub struct Submitted<T>(pub T, pub Option<Bytes>);
+
+impl<T, S> FromRequest<S> for Submitted<T>
+where
+    T: DeserializeOwned + Send + 'static,
+    S: Send + Sync,
+    AppState: FromRef<S>,
+{
+    type Rejection = AppError;
+
+    async fn from_request(request: Request, state: &S) -> Result<Self, Self::Rejection> {
+        if media_type(request.headers()).as_deref() != Some("multipart/form-data") {
+            return AppJson::<T>::from_request(request, state).await.map(|AppJson(request)| Self(request, None));
+        }
+        let state = AppState::from_ref(state);
+        let content_type = request.headers().get(header::CONTENT_TYPE).cloned();
+        // The route lifts the default body limit; the form read from memory keeps that.
+        let extensions = request.extensions().clone();
+        let (body, share) = charged_body_bytes(request, &state, state.limits.max_upload_bytes).await?;
+        let read = state
+            .solve(move |_| {
+                let mut form = Request::new(Body::from(body));
+                *form.extensions_mut() = extensions;
+                if let Some(content_type) = content_type {
+                    form.headers_mut().insert(header::CONTENT_TYPE, content_type);
+                }
+                // The body is all in memory: the form's parts are split without waiting.
+                tokio::runtime::Handle::current().block_on(read_form::<T>(form))
+            })
+            .await??;
+        drop(share);
+        Ok(read)
+    }
+}
+
+fn multipart_error(part: &str, error: &axum::extract::multipart::MultipartError) -> AppError {
+    AppError::bad_request(ErrorCode::Multipart, part, format!("{part}: {}", error.body_text()))
+}
+
+/// The parts of the form: `request` (the JSON) and `drawing` (the DXF file).
+async fn read_form<T: DeserializeOwned>(form: Request) -> AppResult<Submitted<T>> {
+    let mut multipart = Multipart::from_request(form, &())
+        .await
+        .map_err(|rejection| AppError::bad_request(ErrorCode::Multipart, "body", rejection.body_text()))?;
+    let (mut json, mut drawing): (Option<Bytes>, Option<Bytes>) = (None, None);
+    loop {
+        let field = match multipart.next_field().await {
+            Ok(Some(field)) => field,
+            Ok(None) => break,
+            Err(error) => return Err(multipart_error("body", &error)),
+        };
+        let name = field.name().unwrap_or_default().to_owned();
+        let slot = match name.as_str() {
+            "request" => &mut json,
+            "drawing" => &mut drawing,
+            _ => {
+                return Err(AppError::bad_request(
+                    ErrorCode::Multipart,
+                    if name.is_empty() { "body".to_owned() } else { name.clone() },
+                    format!("unexpected form part `{name}`: send `request` (the JSON) and `drawing` (the DXF file)"),
+                ));
+            }
+        };
+        if slot.is_some() {
+            return Err(AppError::bad_request(
+                ErrorCode::Multipart,
+                name.clone(),
+                format!("form part `{name}` is given twice"),
+            ));
+        }
+        *slot = Some(field.bytes().await.map_err(|error| multipart_error(&name, &error))?);
+    }
+    let json = json.ok_or_else(|| {
+        AppError::bad_request(ErrorCode::Multipart, "request", "the form has no part `request` with the JSON request")
+    })?;
+    Ok(Submitted(parse_json(&json)?, drawing))
+}
 
 /// A DXF file as the request body (for the OpenAPI document): its bytes as they are.
 #[derive(Debug, utoipa::ToSchema)]

@@ -2,7 +2,8 @@
 //! (`capabilities::with_registry!`): two small `#[utoipa::path]` handlers per capability with a
 //! JSON body, the JSON answer and `POST /api/v1/{name}/program` with the program, documented with the capability's own [`Endpoint`](kerf_solver::capability::Endpoint)
 //! texts, so the OpenAPI document names each capability's concrete request and answer. A
-//! capability with an upload (`upload` in the registry) keeps its handler in `http/<module>.rs`.
+//! capability with an upload (`upload` in the registry) keeps its handler in `http/<module>.rs`; one
+//! whose request may read a DXF drawing (`drawing`) takes JSON or a form with the file (`http::dxf::Submitted`).
 
 use utoipa_axum::router::OpenApiRouter;
 
@@ -86,6 +87,84 @@ macro_rules! endpoint {
             }
         }
     };
+    ($variant:ident, $module:ident, $capability:ident, $request:ident, $answer:ident, drawing($query:ident)) => {
+        #[allow(non_snake_case, reason = "named after the registry's variant")]
+        mod $variant {
+            use axum::extract::State;
+            use axum::http::HeaderMap;
+            use axum::response::Response;
+            use kerf_solver::capability::Capability;
+            use kerf_solver::$module::{$answer, $capability, $request};
+
+            use super::super::output::Negotiate;
+            #[allow(unused_imports, reason = "one of them is this endpoint's query")]
+            use super::super::output::{CandidateQuery, OutputQuery};
+            use crate::error::{AppResult, Problem};
+            use crate::extract::AppQuery;
+            use crate::http::dxf::{DrawingForm, Submitted};
+            use crate::state::AppState;
+
+            /// The query of the program route (`POST /api/v1/{name}/program`).
+            type ProgramParams = <$query as Negotiate>::Program;
+
+            /// The JSON answer (the request as JSON, or as a form with the DXF file of its `drawing`); `?format=gcode` or an `Accept` preferring `text/x-gcode` still
+            /// answer the program here (undocumented: the program route is the documented way).
+            #[utoipa::path(post,
+                context_path = "/api/v1/",
+                path = <$capability as Capability>::NAME,
+                operation_id = <$capability as Capability>::NAME,
+                tag = <$capability as Capability>::NAME,
+                summary = <$capability as Capability>::ENDPOINT.summary,
+                description = <$capability as Capability>::ENDPOINT.description,
+                request_body(description = "The request as JSON, or a form with it in part `request` and the DXF file its `drawing` reads in part `drawing`.",
+                    content(($request = "application/json"), (DrawingForm = "multipart/form-data"))),
+                responses(
+                    (status = 200, description = "The answer", body = $answer, content_type = "application/json"),
+                    (status = 400, body = Problem, content_type = "application/problem+json"),
+                    (status = 404, description = <$capability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
+                    (status = 413, body = Problem, content_type = "application/problem+json"),
+                    (status = 408, description = "The body arrived slower than the minimum receive rate", body = Problem, content_type = "application/problem+json"),
+                    (status = 415, body = Problem, content_type = "application/problem+json"),
+                    (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json"),
+                    (status = 422, description = <$capability as Capability>::ENDPOINT.refused, body = Problem, content_type = "application/problem+json")))]
+            pub async fn post(
+                State(state): State<AppState>,
+                headers: HeaderMap,
+                AppQuery(query): AppQuery<$query>,
+                Submitted(request, drawing): Submitted<$request>,
+            ) -> AppResult<Response> {
+                super::super::solve::answer::<$capability>(&state, request, drawing, query.ask(&headers)).await
+            }
+
+            /// The program of the same request: the answer's path as G-code.
+            #[utoipa::path(post,
+                context_path = "/api/v1/",
+                path = format!("{}/program", <$capability as Capability>::NAME),
+                operation_id = format!("{}_program", <$capability as Capability>::NAME),
+                tag = <$capability as Capability>::NAME,
+                summary = "The same request's answer as a G-code program",
+                description = <$capability as Capability>::ENDPOINT.description,
+                params(ProgramParams),
+                request_body(description = "The request as JSON, or a form with it in part `request` and the DXF file its `drawing` reads in part `drawing`.",
+                    content(($request = "application/json"), (DrawingForm = "multipart/form-data"))),
+                responses(
+                    (status = 200, description = "The program", body = String, content_type = "text/x-gcode"),
+                    (status = 400, body = Problem, content_type = "application/problem+json"),
+                    (status = 404, description = <$capability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
+                    (status = 413, body = Problem, content_type = "application/problem+json"),
+                    (status = 408, description = "The body arrived slower than the minimum receive rate", body = Problem, content_type = "application/problem+json"),
+                    (status = 415, body = Problem, content_type = "application/problem+json"),
+                    (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json"),
+                    (status = 422, description = <$capability as Capability>::ENDPOINT.refused, body = Problem, content_type = "application/problem+json")))]
+            pub async fn program(
+                State(state): State<AppState>,
+                AppQuery(query): AppQuery<ProgramParams>,
+                Submitted(request, drawing): Submitted<$request>,
+            ) -> AppResult<Response> {
+                super::super::solve::answer::<$capability>(&state, request, drawing, <$query as Negotiate>::program(query)).await
+            }
+        }
+    };
     ($variant:ident, $module:ident, $capability:ident, $request:ident, $answer:ident, upload) => {};
 }
 
@@ -95,6 +174,13 @@ macro_rules! route {
         OpenApiRouter::new()
             .routes(utoipa_axum::routes!($variant::post))
             .routes(utoipa_axum::routes!($variant::program))
+    };
+    ($variant:ident, $module:ident, drawing) => {
+        OpenApiRouter::new()
+            .routes(utoipa_axum::routes!($variant::post))
+            .routes(utoipa_axum::routes!($variant::program))
+            // A form's DXF file has the upload limit; a JSON body keeps its own (`Submitted`).
+            .layer(axum::extract::DefaultBodyLimit::disable())
     };
     ($variant:ident, $module:ident, upload) => {
         super::$module::router()

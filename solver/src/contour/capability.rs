@@ -120,6 +120,10 @@ impl Capability for ContourCapability {
     /// The move cap of the answer ([`MAX_JSON_MOVES`] for JSON, else [`MAX_MOVES`]) at
     /// `move_bound` each, and the corners' and passes' reports.
     fn answer_bound(request: &ContourRequest, _context: &Resolved<Tool>, purpose: Purpose) -> Option<u64> {
+        if request.drawing.is_some() {
+            // The polygon's length is known once the drawing is read: the answer is counted.
+            return None;
+        }
         let max_moves = if purpose == Purpose::Json { MAX_JSON_MOVES } else { MAX_MOVES };
         let passes = request.passes.as_ref().map_or(1, Vec::len) as u64;
         let reports = (request.contour.len() as u64).saturating_add(passes).saturating_mul(REPORT_BYTES);
@@ -131,6 +135,14 @@ impl Capability for ContourCapability {
     /// A JSON answer holds at most [`MAX_JSON_MOVES`] moves; a program or a job up to [`MAX_MOVES`].
     /// Each layer's moves are charged to the run's budget as the layer is made.
     fn solve(request: &ContourRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<ContourAnswer, SolverError> {
+        let read;
+        let request = match request.from_upload(run.upload)? {
+            Some(drawn) => {
+                read = drawn;
+                &read
+            }
+            None => request,
+        };
         let max_moves = if run.purpose == Purpose::Json { MAX_JSON_MOVES } else { MAX_MOVES };
         let charge = |layer: &LayerMoves, done: usize, count: usize| {
             run.charge_unit(done, count, ANSWER_BYTES, || layer_bytes(layer, run.purpose))
@@ -150,6 +162,10 @@ impl Capability for ContourCapability {
     /// Ranges of layers of about `sizing.part_seconds` each (`parts`): a job's contour only,
     /// which may hold up to [`MAX_MOVES`] moves.
     fn split(request: &ContourRequest, context: &Resolved<Tool>, sizing: &Sizing) -> Option<Split> {
+        if request.drawing.is_some() {
+            // Solved whole, where a drawing without its file is refused.
+            return None;
+        }
         super::parts::split(request, &context.tool, context.machine.as_ref(), sizing)
     }
 

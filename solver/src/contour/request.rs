@@ -224,8 +224,13 @@ pub struct ContourRequest {
     /// A registered tool number or an inline tool; its `radius` is the cutting radius.
     pub tool: ToolRef,
     /// The closed polygon `[[x, y], ...]`, counter-clockwise (the last point need not repeat the
-    /// first). Curved faces are given as fine polylines.
+    /// first). Curved faces are given as fine polylines. Left out with `drawing`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub contour: Vec<[f64; 2]>,
+    /// The polygon read from the DXF file uploaded with the request in form part `drawing`
+    /// (docs/spec/dxf.md §5) instead of `contour`: the outer boundary, or the island chosen.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drawing: Option<crate::dxf::Drawing>,
     /// `outside` (material inside the polygon) or `inside` (a pocket: material outside it).
     pub side: Side,
     /// Layer heights.
@@ -314,4 +319,32 @@ pub struct ContourRequest {
     /// answer (default: the named machine's `units`, else `mm`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub units: Option<crate::units::Units>,
+}
+
+impl ContourRequest {
+    /// The request with `contour` read from `upload`, the DXF file sent with it, when it has a
+    /// `drawing`; `None` when it has none (and then no file may be sent).
+    ///
+    /// # Errors
+    /// `E_INPUT`: a drawing with points too, a drawing without its file, a file without a
+    /// drawing, the reader's refusals.
+    pub fn from_upload(&self, upload: Option<&[u8]>) -> Result<Option<Self>, crate::error::SolverError> {
+        match &self.drawing {
+            Some(drawing) => {
+                if !self.contour.is_empty() {
+                    return Err(crate::error::SolverError::input(
+                        "contour",
+                        "give the polygon either as contour or as a drawing, not both",
+                    ));
+                }
+                let contour = drawing.outline(upload, "drawing")?;
+                Ok(Some(Self { contour, drawing: None, ..self.clone() }))
+            }
+            None if upload.is_some() => Err(crate::error::SolverError::input(
+                "drawing",
+                "a DXF file was uploaded but the request has no `drawing`",
+            )),
+            None => Ok(None),
+        }
+    }
 }

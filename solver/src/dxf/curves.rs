@@ -82,7 +82,7 @@ pub(super) fn flatten_ellipse(
 }
 
 /// A NURBS point at parameter `u` (de Boor's algorithm on homogeneous points).
-fn nurbs_point(degree: usize, control: &[[f64; 2]], knots: &[f64], weights: &[f64], u: f64) -> [f64; 2] {
+pub(super) fn nurbs_point(degree: usize, control: &[[f64; 2]], knots: &[f64], weights: &[f64], u: f64) -> [f64; 2] {
     let n = control.len();
     let mut span = degree;
     while span + 1 < n && knots[span + 1] <= u {
@@ -108,6 +108,67 @@ fn nurbs_point(degree: usize, control: &[[f64; 2]], knots: &[f64], weights: &[f6
     }
     let p = d[degree];
     [p[0] / p[2], p[1] / p[2]]
+}
+
+/// A NURBS with clamped knots (the first and last knot `degree + 1` times) describing the same
+/// curve on its domain [knots[degree], knots[n]]: each end's knot is inserted (Boehm's
+/// algorithm, on homogeneous points) until it is repeated `degree` times, then the knots and
+/// control points outside the domain are dropped.
+pub(super) fn clamped(
+    degree: usize,
+    control: Vec<[f64; 2]>,
+    knots: Vec<f64>,
+    weights: Vec<f64>,
+) -> (Vec<[f64; 2]>, Vec<f64>, Vec<f64>) {
+    let mut points: Vec<[f64; 3]> = control.iter().zip(&weights).map(|(p, w)| [p[0] * w, p[1] * w, *w]).collect();
+    let mut knots = knots;
+    clamp_start(degree, &mut points, &mut knots);
+    // The end is the start of the reversed curve (parameter mirrored).
+    points.reverse();
+    let (low, high) = (knots[0], knots[knots.len() - 1]);
+    knots = knots.iter().rev().map(|k| low + high - k).collect();
+    clamp_start(degree, &mut points, &mut knots);
+    points.reverse();
+    knots = knots.iter().rev().map(|k| low + high - k).collect();
+    let control = points.iter().map(|p| [p[0] / p[2], p[1] / p[2]]).collect();
+    let weights = points.iter().map(|p| p[2]).collect();
+    (control, knots, weights)
+}
+
+fn clamp_start(degree: usize, points: &mut Vec<[f64; 3]>, knots: &mut Vec<f64>) {
+    let start = knots[degree];
+    if knots[..=degree].iter().all(|k| *k == start) {
+        return;
+    }
+    // Insert `start` until it is there `degree` times.
+    while knots.iter().filter(|k| **k == start).count() < degree {
+        let span = knots.iter().rposition(|k| *k <= start).unwrap_or(degree);
+        let mut inserted = Vec::with_capacity(points.len() + 1);
+        for i in 0..=points.len() {
+            if i + degree <= span {
+                inserted.push(points[i]);
+            } else if i > span {
+                inserted.push(points[i - 1]);
+            } else {
+                let alpha = (start - knots[i]) / (knots[i + degree] - knots[i]);
+                let (a, b) = (points[i - 1], points[i]);
+                inserted.push([
+                    (1.0 - alpha) * a[0] + alpha * b[0],
+                    (1.0 - alpha) * a[1] + alpha * b[1],
+                    (1.0 - alpha) * a[2] + alpha * b[2],
+                ]);
+            }
+        }
+        knots.insert(span + 1, start);
+        *points = inserted;
+    }
+    // `start` at knots[j..j + degree]: the curve starts at control point j − 1.
+    let j = knots.iter().position(|k| *k == start).unwrap_or(0);
+    if j > 0 {
+        points.drain(..j - 1);
+        knots.drain(..j - 1);
+        knots[0] = start;
+    }
 }
 
 /// A spline as chords: each knot span halved until the curve's midpoint stays within

@@ -124,3 +124,95 @@ fn lines_shorter_than_the_join_tolerance_close_only_at_the_start() {
     assert_eq!(profile.boundary.len(), count);
     assert!(profile.islands.is_empty());
 }
+
+#[test]
+fn blocks_are_placed_scaled_turned_mirrored_and_arrayed_ascii_and_binary() {
+    let ascii = read(&fixture("blocks_mm.dxf"), "file", &with_layer("CUT")).unwrap();
+    let binary = read(&fixture("blocks_mm_binary.dxf"), "file", &with_layer("CUT")).unwrap();
+    assert_eq!(ascii, binary);
+    assert_eq!(ascii.layers, ["CUT"]);
+    assert!((area(&ascii.boundary) - 9600.0).abs() < 1e-9, "{}", area(&ascii.boundary));
+    assert_eq!(ascii.islands.len(), 8);
+    let pi = std::f64::consts::PI;
+    let holes: f64 = ascii.islands.iter().map(|i| -area(i)).sum();
+    assert!((holes - (47.0 * pi + 48.0)).abs() < 0.1, "{holes}");
+    let centre = |island: &Vec<[f64; 2]>| {
+        let n = island.len() as f64;
+        [island.iter().map(|p| p[0]).sum::<f64>() / n, island.iter().map(|p| p[1]).sum::<f64>() / n]
+    };
+    let near = |c: [f64; 2], x: f64, y: f64| (c[0] - x).abs() < 0.01 && (c[1] - y).abs() < 0.01;
+    for (x, y, r) in [(30.0, 40.0, 3.0), (60.0, 40.0, 3.0), (70.0, 20.0, 2.0), (70.0, 40.0, 2.0), (40.0, 70.0, 2.0)] {
+        let island = ascii.islands.iter().find(|i| near(centre(i), x, y)).unwrap_or_else(|| panic!("({x}, {y})"));
+        assert!((-area(island) - pi * r * r).abs() < 0.02, "({x}, {y})");
+    }
+    // The slot placed with x scale −1: its arcs' centres at x = 100 and 92.
+    let slot = ascii.islands.iter().find(|i| -area(i) > 60.0).unwrap();
+    let xs = slot.iter().map(|p| p[0]);
+    let (low, high) = (xs.clone().fold(f64::INFINITY, f64::min), xs.fold(f64::NEG_INFINITY, f64::max));
+    assert!((low - 89.0).abs() < 0.002 && (high - 103.0).abs() < 0.002, "{low} {high}");
+}
+
+#[test]
+fn a_block_that_places_itself_is_refused_at_the_depth_bound() {
+    let error = read(&fixture("block_loop.dxf"), "file", &DxfOptions::default()).unwrap_err().to_string();
+    assert!(error.contains("INSERT") && error.contains("block LOOP") && error.contains("8 deep"), "{error}");
+}
+
+#[test]
+fn an_open_spline_is_segments_curve_exactly() {
+    let profile = read(&fixture("spline_open_mm.dxf"), "file", &DxfOptions::default()).unwrap();
+    assert!(profile.boundary.is_empty() && profile.islands.is_empty());
+    let Some(crate::segment::Curve::Bspline { degree, control_points, knots, weights, .. }) = profile.curve else {
+        panic!("{:?}", profile.curve)
+    };
+    assert_eq!(degree, 3);
+    assert_eq!(control_points, [[0.0, 0.0], [20.0, 30.0], [50.0, -10.0], [80.0, 25.0], [100.0, 0.0]]);
+    let knots = knots.unwrap();
+    assert_eq!((&knots[..4], &knots[5..]), (&[0.0; 4][..], &[knots[8]; 4][..]), "{knots:?}");
+    assert_eq!(weights, None);
+}
+
+#[test]
+fn a_rational_spline_in_inch_keeps_its_weights_and_lies_on_its_circle() {
+    let profile = read(&fixture("spline_rational_inch.dxf"), "file", &DxfOptions::default()).unwrap();
+    let Some(crate::segment::Curve::Bspline { degree, control_points, knots, weights, .. }) = profile.curve else {
+        panic!("{:?}", profile.curve)
+    };
+    assert_eq!(degree, 2);
+    assert_eq!(control_points, [[50.8, 0.0], [50.8, 50.8], [0.0, 50.8]]);
+    let weights = weights.unwrap();
+    assert!((weights[1] - 0.5f64.sqrt()).abs() < 1e-12, "{weights:?}");
+    let control: Vec<[f64; 2]> = control_points.iter().map(|p| [p[0], p[1]]).collect();
+    for k in 0..=10 {
+        let p = super::curves::nurbs_point(2, &control, &knots.clone().unwrap(), &weights, k as f64 / 10.0);
+        assert!((p[0].hypot(p[1]) - 50.8).abs() < 1e-9, "{p:?}");
+    }
+}
+
+#[test]
+fn a_periodic_spline_is_clamped_to_the_same_curve() {
+    let profile = read(&fixture("spline_periodic_mm.dxf"), "file", &DxfOptions::default()).unwrap();
+    assert!(area(&profile.boundary) > 100.0);
+    let Some(crate::segment::Curve::Bspline { degree, control_points, knots, weights, .. }) = profile.curve else {
+        panic!("{:?}", profile.curve)
+    };
+    let knots = knots.unwrap();
+    assert_eq!(degree, 3);
+    assert!(knots[..4].iter().all(|k| *k == 3.0) && knots[knots.len() - 4..].iter().all(|k| *k == 11.0), "{knots:?}");
+    // The fixture's curve: 11 control points on uniform knots 0 to 14, domain [3, 11].
+    let blob: Vec<[f64; 2]> = (0..11)
+        .map(|k| {
+            let t = (k % 8) as f64 * std::f64::consts::TAU / 8.0;
+            [20.0 * t.cos(), 15.0 * t.sin()]
+        })
+        .collect();
+    let uniform: Vec<f64> = (0..15).map(f64::from).collect();
+    let clamped: Vec<[f64; 2]> = control_points.iter().map(|p| [p[0], p[1]]).collect();
+    let weights = weights.unwrap_or_else(|| vec![1.0; clamped.len()]);
+    for k in 0..=80 {
+        let u = 3.0 + 8.0 * f64::from(k) / 80.0;
+        let a = super::curves::nurbs_point(3, &blob, &uniform, &[1.0; 11], u);
+        let b = super::curves::nurbs_point(3, &clamped, &knots, &weights, u);
+        assert!((a[0] - b[0]).hypot(a[1] - b[1]) < 1e-9, "{u}: {a:?} {b:?}");
+    }
+}

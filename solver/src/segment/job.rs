@@ -157,6 +157,12 @@ impl Curve {
             Self::Bspline { degree, control_points, knots, weights, corner_angle_deg } => {
                 build_bspline(*degree, control_points, knots.as_deref(), weights.as_deref(), *corner_angle_deg)?
             }
+            Self::Drawing { .. } => {
+                return Err(SolverError::input(
+                    "curve",
+                    "a drawing curve needs its DXF file uploaded with the request (form part `drawing`)",
+                ));
+            }
         };
         let field = match self {
             Self::Polyline { .. } => "curve.points",

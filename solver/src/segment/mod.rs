@@ -145,7 +145,13 @@ pub fn solve_run(
     run: &crate::capability::Run<'_>,
 ) -> Result<SegmentSolution, SolverError> {
     let charge = run.budget.map(|budget| cut::PointCharge { budget, point_bytes: answer::point_bound(run.purpose) });
-    solve_by(request, machine, Numerics::Fast, run.control, charge)
+    match request.curve.from_upload(run.upload)? {
+        Some(curve) => {
+            let request = SegmentRequest { curve, ..request.clone() };
+            solve_by(&request, machine, Numerics::Fast, run.control, charge)
+        }
+        None => solve_by(request, machine, Numerics::Fast, run.control, charge),
+    }
 }
 
 /// [`solve`] by the reference numerics of docs/spec/segment.md §2.9 (about 400 curve evaluations per

@@ -107,6 +107,57 @@ pub enum Curve {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         corner_angle_deg: Option<f64>,
     },
+    /// The curve of the DXF file uploaded with the request in form part `drawing`
+    /// (docs/spec/dxf.md §5): a drawing of one SPLINE is that NURBS exactly (as `bspline`), else
+    /// the loop chosen (the outer boundary, or `island`) as a closed `polyline`.
+    Drawing {
+        /// Units of a drawing that does not say them (`$INSUNITS` 0 or missing).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        units: Option<crate::dxf::DrawingUnits>,
+        /// Only the entities of this layer (default all).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        layer: Option<String>,
+        /// Island n (from 1, as `POST /api/v1/dxf` lists them) instead of the outer boundary.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        island: Option<usize>,
+        /// Largest gap between two entity ends joined, in the request's units (default 0.01 mm).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        join_tolerance: Option<f64>,
+        /// Largest distance of a chord from its arc, bulge or ellipse, in the request's units (default
+        /// 0.001 mm).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        chord_tolerance: Option<f64>,
+        /// Smallest direction change that makes a corner, degrees (default 20).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        corner_angle_deg: Option<f64>,
+    },
+}
+
+impl Curve {
+    /// A `drawing` curve read from `upload`, the DXF file sent with the request; any other curve
+    /// as it is (and then no file may be sent).
+    ///
+    /// # Errors
+    /// `E_INPUT`: a drawing without its file, a file without a drawing, the reader's refusals.
+    pub fn from_upload(&self, upload: Option<&[u8]>) -> Result<Option<Self>, crate::error::SolverError> {
+        match self {
+            Self::Drawing { units, layer, island, join_tolerance, chord_tolerance, corner_angle_deg } => {
+                let drawing = crate::dxf::Drawing {
+                    units: *units,
+                    layer: layer.clone(),
+                    island: *island,
+                    join_tolerance: *join_tolerance,
+                    chord_tolerance: *chord_tolerance,
+                };
+                drawing.curve(upload, "curve", *corner_angle_deg).map(Some)
+            }
+            _ if upload.is_some() => Err(crate::error::SolverError::input(
+                "drawing",
+                "a DXF file was uploaded but curve.kind is not \"drawing\"",
+            )),
+            _ => Ok(None),
+        }
+    }
 }
 
 /// The whole-curve rule of `mode: curve`.

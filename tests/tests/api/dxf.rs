@@ -1,7 +1,9 @@
 //! Reading DXF drawings over HTTP (files ezdxf wrote: tests/dxf/make_fixtures.py): a plate with
 //! bulges, a circle and a slot of lines and arcs; binary R12 in the units given; lines that make
-//! the same contour as the typed polygon; refusals naming the entity, the gap, the point, the units.
+//! the same contour as the typed polygon; refusals naming the entity, the gap, the point, the units;
+//! contour and segment requests that carry their drawing as a form part.
 
+use reqwest::multipart::{Form, Part};
 use serde_json::{Value, json};
 
 use kerf_tests::{TestApp, json_with, problem};
@@ -101,4 +103,115 @@ async fn the_page_draws_a_drawing_before_computing() {
     let Some(result) = crate::browser::run_scenario(&app, "dxf", &[plate.to_str().unwrap()]) else { return };
     assert_eq!(result["ok"], true);
     assert_eq!(result["loops"], 3, "{result}");
+}
+
+/// `request` with the DXF file `name` as a form to `path`.
+async fn with_drawing(app: &TestApp, path: &str, request: &Value, name: &str) -> reqwest::Response {
+    let form = Form::new()
+        .part("request", Part::text(request.to_string()).mime_str("application/json").unwrap())
+        .part("drawing", Part::bytes(fixture(name)).file_name(name.to_owned()));
+    app.client.post(app.url(path)).multipart(form).send().await.unwrap()
+}
+
+fn contour_request(outline: (&str, Value)) -> Value {
+    let mut request = json!({"tool": {"kind": "flat", "radius": 3}, "side": "outside",
+        "depths": {"top": 0, "bottom": -4, "step": 2}, "corner_loop": {"style": "arc"}, "feed": 800});
+    request[outline.0] = outline.1;
+    request
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn contour_takes_its_polygon_from_the_drawing_sent_with_it() {
+    let app = TestApp::spawn().await;
+    let typed = json!([[0, 0], [80, 0], [80, 30], [40, 30], [40, 60], [0, 60]]);
+    // The reader's boundary starts where the drawing's first line does: the same polygon from
+    // that vertex, typed in.
+    let profile = json_with(upload(&app, "l_plate_lines.dxf", "").await, 200).await;
+    let from_read = json_with(
+        app.post_json("/api/v1/contour", &contour_request(("contour", profile["boundary"].clone()))).await,
+        200,
+    )
+    .await;
+    let request = contour_request(("drawing", json!({"layer": "0"})));
+    let from_drawing = json_with(with_drawing(&app, "/api/v1/contour", &request, "l_plate_lines.dxf").await, 200).await;
+    assert_eq!(from_drawing, from_read);
+    let from_typing =
+        json_with(app.post_json("/api/v1/contour", &contour_request(("contour", typed))).await, 200).await;
+    assert_eq!(from_drawing["summary"], from_typing["summary"]);
+    // The program route takes the form too.
+    let program = with_drawing(&app, "/api/v1/contour/program", &request, "l_plate_lines.dxf").await;
+    assert_eq!(program.status(), 200);
+    assert!(program.text().await.unwrap().contains("G1"));
+    // An island of a drawing with blocks: the radius-3 hole placed by PAIR at (30, 40).
+    let request = contour_request(("drawing", json!({"layer": "CUT", "island": 1})));
+    let answer = json_with(with_drawing(&app, "/api/v1/contour", &request, "blocks_mm_binary.dxf").await, 200).await;
+    assert!(answer["layers"].as_array().is_some_and(|layers| !layers.is_empty()), "{answer}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn segment_cuts_a_drawings_spline_exactly_as_the_curve_typed_in() {
+    let app = TestApp::spawn().await;
+    let request = |curve: Value| json!({"curve": curve, "feed": 3000, "block_time_ms": 4, "tolerance": 0.01});
+    // The control points and knots make_fixtures.py gave ezdxf.
+    let typed = json!({"kind": "bspline", "degree": 3,
+        "control_points": [[0, 0], [20, 30], [50, -10], [80, 25], [100, 0]],
+        "knots": [0, 0, 0, 0, 0.5, 1, 1, 1, 1]});
+    let profile = json_with(upload(&app, "spline_open_mm.dxf", "").await, 200).await;
+    assert_eq!(profile["curve"]["kind"], "bspline", "{profile}");
+    let control: Vec<[f64; 2]> = serde_json::from_value(profile["curve"]["control_points"].clone()).unwrap();
+    assert_eq!(control, [[0.0, 0.0], [20.0, 30.0], [50.0, -10.0], [80.0, 25.0], [100.0, 0.0]]);
+    let knots: Vec<f64> = serde_json::from_value(profile["curve"]["knots"].clone()).unwrap();
+    let typed = json!({"kind": "bspline", "degree": 3, "control_points": typed["control_points"], "knots": knots});
+    let from_typing = json_with(app.post_json("/api/v1/segment", &request(typed)).await, 200).await;
+    let from_drawing = json_with(
+        with_drawing(&app, "/api/v1/segment", &request(json!({"kind": "drawing"})), "spline_open_mm.dxf").await,
+        200,
+    )
+    .await;
+    assert_eq!(from_drawing, from_typing);
+    assert!(from_drawing["points"].as_array().is_some_and(|p| p.len() > 100), "{}", from_drawing["blocks"]);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_drawing_request_refuses_what_it_cannot_read_naming_the_field() {
+    let app = TestApp::spawn().await;
+    let contour = |drawing: Value| contour_request(("drawing", drawing));
+    let cases = [
+        ("/api/v1/contour", contour(json!({})), "broken_chain.dxf", 422, "drawing", "open chain"),
+        ("/api/v1/contour", contour(json!({})), "bow_tie.dxf", 422, "drawing", "crosses itself at (5.0000, 5.0000)"),
+        ("/api/v1/contour", contour(json!({})), "square_inch_r12.dxf", 422, "drawing.units", "give units"),
+        ("/api/v1/contour", contour(json!({"layer": "HOLES"})), "plate_mm.dxf", 422, "drawing.layer", "CUT, NOTES"),
+        ("/api/v1/contour", contour(json!({"island": 3})), "l_plate_lines.dxf", 422, "drawing.island", "no island 3"),
+        ("/api/v1/contour", contour(json!({})), "block_loop.dxf", 422, "drawing", "8 deep"),
+        (
+            "/api/v1/segment",
+            json!({"curve": {"kind": "drawing"}, "feed": 3000}),
+            "no_units.dxf",
+            422,
+            "curve.units",
+            "give units",
+        ),
+        (
+            "/api/v1/segment",
+            json!({"curve": {"kind": "circle", "centre": [0, 0], "radius": 5}}),
+            "no_units.dxf",
+            422,
+            "drawing",
+            "curve.kind is not",
+        ),
+    ];
+    for (path, request, name, status, field, words) in cases {
+        let answer = problem(with_drawing(&app, path, &request, name).await, status).await;
+        assert_eq!(answer["errors"][0]["path"], field, "{path} {name}: {answer}");
+        assert!(answer.to_string().contains(words), "{path} {name}: {answer}");
+    }
+    // A drawing sent without its file, as JSON.
+    let answer = problem(app.post_json("/api/v1/contour", &contour(json!({}))).await, 422).await;
+    assert_eq!(answer["errors"][0]["path"], "drawing", "{answer}");
+    assert!(answer.to_string().contains("part `drawing`"), "{answer}");
+    // A form without its JSON part.
+    let form = Form::new().part("drawing", Part::bytes(fixture("plate_mm.dxf")));
+    let response = app.client.post(app.url("/api/v1/contour")).multipart(form).send().await.unwrap();
+    let answer = problem(response, 400).await;
+    assert_eq!(answer["errors"][0]["path"], "request", "{answer}");
 }
