@@ -310,4 +310,9 @@ pub struct ContourRequest {
     /// Optional control model for predictions and allowance checks.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub controller: Option<ControllerModel>,
+    /// Cut the program on the contour's own model and answer `verification`
+    /// (docs/spec/verify.md §8): default on; `{"enabled": false}` turns it off, `resolution` sets
+    /// the dexel spacing.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verification: Option<crate::verify::VerificationOptions>,
 }

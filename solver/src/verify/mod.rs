@@ -4,12 +4,14 @@
 //!
 //! [`request`] holds the wire types, `job` their validation, `solid` the stock and part on the
 //! grid, `dexel` the rays, `assembly` the tool's bodies, `sweep` a body swept along a move,
-//! `simulate` the cutting and its findings, and `capability` the seam's entry.
+//! `simulate` the cutting and its findings, `capability` the seam's entry, and [`own`] the
+//! verification of the programs the other capabilities write, on their own models.
 
 mod assembly;
 mod capability;
 mod dexel;
 mod job;
+pub mod own;
 pub mod request;
 mod simulate;
 mod solid;
@@ -19,6 +21,7 @@ mod tests;
 
 pub use assembly::{FLUTE_RADII, HOLDER_LENGTH, HOLDER_SHANK_DIAMETERS, Member, STICKOUT_RADII};
 pub use capability::{VerifyAnswer, VerifyCapability};
+pub use own::{Verification, VerificationOptions};
 pub use job::{
     DEFAULT_AIR_SHARE_LIMIT, DEFAULT_ALLOWANCE, DEFAULT_RESOLUTION_RADII, DEFAULT_TOLERANCE, MAX_DEFAULT_RAYS,
     MAX_DEXEL_BYTES,

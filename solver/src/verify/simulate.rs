@@ -333,6 +333,15 @@ impl Simulation<'_> {
 pub(crate) fn cut(job: &Job, run: &Run<'_>) -> Result<Cut, SolverError> {
     let stock = job.stock.field(job.grid);
     let part = job.part.as_ref().map(|part| part.field(job.grid));
+    cut_fields(job, stock, part, run)
+}
+
+/// [`cut`] out of `stock`, compared with `part`, both already on `job.grid`: a capability's own
+/// model, which no request solid describes (`own`).
+///
+/// # Errors
+/// As [`cut`].
+pub(crate) fn cut_fields(job: &Job, stock: Field, part: Option<Field>, run: &Run<'_>) -> Result<Cut, SolverError> {
     let stock_volume = stock.volume();
     let part_volume = part.as_ref().map(Field::volume);
     let mut simulation = Simulation {
