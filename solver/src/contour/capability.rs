@@ -152,7 +152,11 @@ impl Capability for ContourCapability {
             charge,
         );
         let result = if run.purpose == Purpose::Json { result.map_err(json_limit_advice)? } else { result? };
-        verified(request, ContourAnswer { tool: context.tool, machine: context.machine, result, verification: None }, run)
+        verified(
+            request,
+            ContourAnswer { tool: context.tool, machine: context.machine, result, verification: None },
+            run,
+        )
     }
 
     /// Ranges of layers of about `sizing.part_seconds` each (`parts`): a job's contour only,
@@ -181,7 +185,11 @@ impl Capability for ContourCapability {
     ) -> Result<ContourAnswer, SolverError> {
         verification_grid(request, &context.tool)?;
         let result = super::parts::finish(request, &context.tool, context.machine.as_ref(), parts, run.control)?;
-        verified(request, ContourAnswer { tool: context.tool, machine: context.machine, result, verification: None }, run)
+        verified(
+            request,
+            ContourAnswer { tool: context.tool, machine: context.machine, result, verification: None },
+            run,
+        )
     }
 
     fn program(
@@ -242,9 +250,8 @@ impl Capability for ContourCapability {
 /// the relief discs (`reliefs`) cut out; the stock adds the band `stock_allowance` wide beyond the
 /// outline (without it, the band the first pass cuts: its allowance plus the tool radius).
 fn prism(request: &ContourRequest, tool: &Tool, reliefs: Vec<[f64; 2]>, wall_tolerance: f64) -> Prism {
-    let allowances: Vec<f64> = request.passes.as_ref().map_or_else(|| vec![0.0], |passes| {
-        passes.iter().map(|pass| pass.allowance).collect()
-    });
+    let allowances: Vec<f64> =
+        request.passes.as_ref().map_or_else(|| vec![0.0], |passes| passes.iter().map(|pass| pass.allowance).collect());
     let first = allowances.first().copied().unwrap_or(0.0);
     let finish = allowances.last().copied().unwrap_or(0.0);
     Prism {
@@ -286,7 +293,8 @@ fn verified(request: &ContourRequest, mut answer: ContourAnswer, run: &Run<'_>) 
     let reliefs = answer.result.corners.iter().filter_map(|corner| corner.relief.as_ref()).map(|relief| relief.target);
     let wall_tolerance = answer.result.summary.tolerance + own::OWN_TOLERANCE;
     let model = prism(request, &answer.tool, reliefs.collect(), wall_tolerance);
-    let limits = own::Limits { tolerance: own::OWN_TOLERANCE, allowance: crate::verify::DEFAULT_ALLOWANCE, wall_tolerance };
+    let limits =
+        own::Limits { tolerance: own::OWN_TOLERANCE, allowance: crate::verify::DEFAULT_ALLOWANCE, wall_tolerance };
     let mut verification = own::verify(&model, grid, &program, &answer.tool, limits, run)?;
     own::report(&mut verification, &mut answer.result.warnings, &mut answer.result.description);
     answer.verification = Some(verification);

@@ -21,11 +21,11 @@ mod tests;
 
 pub use assembly::{FLUTE_RADII, HOLDER_LENGTH, HOLDER_SHANK_DIAMETERS, Member, STICKOUT_RADII};
 pub use capability::{VerifyAnswer, VerifyCapability};
-pub use own::{Verification, VerificationOptions};
 pub use job::{
     DEFAULT_AIR_SHARE_LIMIT, DEFAULT_ALLOWANCE, DEFAULT_RESOLUTION_RADII, DEFAULT_TOLERANCE, MAX_DEFAULT_RAYS,
     MAX_DEXEL_BYTES,
 };
+pub use own::{Verification, VerificationOptions};
 pub use request::{Hollow, Solid, VerifyRequest};
 pub use simulate::{ARC_CHORD_TOLERANCE, BlockRemoval, Cut, Finding, FindingKind, MAX_FINDINGS};
 

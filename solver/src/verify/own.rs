@@ -11,9 +11,11 @@ pub(crate) use super::dexel::Grid;
 use super::dexel::{Field, RAY_BYTES, Ray};
 use super::job::{CallableTool, DEFAULT_TOLERANCE, Job, MAX_DEXEL_BYTES};
 use super::simulate::{self, Finding, FindingKind};
+use super::solid::SolidModel;
 use crate::capability::{Control, Run};
 use crate::error::{ErrorCode, SolverError, Warning};
 use crate::gcode::reader::{self, ReadOptions};
+use crate::geometry::Vec3;
 use crate::planar::{Containment, Vec2, point_in_polygon, point_segment_distance, vec2};
 use crate::predict::stock::StockModel;
 use crate::tool::Tool;
@@ -66,6 +68,9 @@ pub struct Verification {
     pub findings: Vec<Finding>,
     /// Findings beyond the first 1000, counted only.
     pub findings_left_off: usize,
+    /// Why `ok` is false without findings: the program never meets the model's stock.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
     /// What was cut and compared: the stock and the part as modelled.
     pub model: String,
     /// The dexel spacing used, mm.
@@ -164,16 +169,35 @@ pub(crate) fn verify(
     limits: Limits,
     run: &Run<'_>,
 ) -> Result<Verification, SolverError> {
+    verify_tools(model, grid, program, &[(None, tool)], limits, run)
+}
+
+/// [`verify`] with several tools, each with the `T` number the program calls it by (one tool
+/// without a number cuts every move).
+///
+/// # Errors
+/// As [`verify`].
+pub(crate) fn verify_tools(
+    model: &dyn OwnModel,
+    grid: Grid,
+    program: &str,
+    tools: &[(Option<u32>, &Tool)],
+    limits: Limits,
+    run: &Run<'_>,
+) -> Result<Verification, SolverError> {
     let options = ReadOptions { max_lines: usize::MAX, ..ReadOptions::default() };
     let read = reader::read_cancellable(program, "program", &options, run.control)?;
     let (stock, part) = model.fields(grid, run.control)?;
     let (lo, hi) = model.footprint();
     let job = Job {
-        tools: vec![CallableTool { number: None, assembly: Assembly::new(tool, "tool")? }],
+        tools: tools
+            .iter()
+            .map(|(number, tool)| Ok(CallableTool { number: *number, assembly: Assembly::new(tool, "tool")? }))
+            .collect::<Result<_, SolverError>>()?,
         // The fields are built here; the job's solids are only their bounds.
-        stock: super::solid::SolidModel::Stock(StockModel::Box {
-            lo: crate::geometry::Vec3::new(lo[0], lo[1], 0.0),
-            hi: crate::geometry::Vec3::new(hi[0], hi[1], 0.0),
+        stock: SolidModel::Stock(StockModel::Box {
+            lo: Vec3::new(lo[0], lo[1], 0.0),
+            hi: Vec3::new(hi[0], hi[1], 0.0),
         }),
         part: None,
         grid,
@@ -187,11 +211,27 @@ pub(crate) fn verify(
     let description = model.describe();
     let cut = match simulate::cut_fields(&job, stock, Some(part), &unbudgeted) {
         Ok(cut) => cut,
+        // The model and the program disagree (the tool never meets the stock): said, not refused,
+        // since the program itself was solved.
         Err(error) if error.code() == ErrorCode::Stock => {
-            return Err(SolverError::new(
-                ErrorCode::Internal,
-                format!("the program never reaches its own stock ({description})"),
-            ));
+            return Ok(Verification {
+                ok: false,
+                findings: Vec::new(),
+                findings_left_off: 0,
+                note: Some("the program never reaches its own stock: the model does not fit the program".to_owned()),
+                model: description,
+                resolution: grid.spacing,
+                rays: [grid.nx, grid.ny],
+                tolerance: limits.tolerance,
+                allowance: limits.allowance,
+                wall_tolerance: limits.wall_tolerance,
+                stock_volume_mm3: 0.0,
+                part_volume_mm3: 0.0,
+                removed_volume_mm3: 0.0,
+                air_share: 0.0,
+                moves: job.program.moves.len(),
+                dexel_updates: 0,
+            });
         }
         Err(error) => return Err(error),
     };
@@ -199,6 +239,7 @@ pub(crate) fn verify(
         ok: cut.ok,
         findings: cut.findings,
         findings_left_off: cut.findings_left_off,
+        note: None,
         model: description,
         resolution: cut.resolution,
         rays: cut.rays,
@@ -249,8 +290,7 @@ pub(crate) fn warnings(verification: &Verification) -> Vec<Warning> {
     let mut warnings = Vec::new();
     for kind in [FindingKind::Gouge, FindingKind::RapidThroughMaterial, FindingKind::HolderContact] {
         let found: Vec<&Finding> = verification.findings.iter().filter(|finding| finding.kind == kind).collect();
-        let (Some(code), Some(worst)) =
-            (warning_code(kind), found.iter().max_by(|a, b| a.depth.total_cmp(&b.depth)))
+        let (Some(code), Some(worst)) = (warning_code(kind), found.iter().max_by(|a, b| a.depth.total_cmp(&b.depth)))
         else {
             continue;
         };
@@ -366,8 +406,7 @@ impl OwnModel for Prism {
                 let inside = point_in_polygon(&Vec2::new(x, y), &self.outline) == Containment::Inside;
                 // Signed distance from the designed wall, positive in the part.
                 let s = if inside == self.material_inside { d } else { -d } + self.finish;
-                let in_relief =
-                    self.reliefs.iter().any(|centre| (x - centre.x).hypot(y - centre.y) < relief);
+                let in_relief = self.reliefs.iter().any(|centre| (x - centre.x).hypot(y - centre.y) < relief);
                 let column = |material: bool| -> Ray {
                     let top = if material { self.top } else { self.bottom };
                     let mut ray = Ray::new();
@@ -392,9 +431,134 @@ impl OwnModel for Prism {
             self.stock,
             self.bottom,
             self.top,
-            if self.finish > 0.0 { format!(" with its walls {:.3} mm out (the last pass's allowance)", self.finish) } else { String::new() },
+            if self.finish > 0.0 {
+                format!(" with its walls {:.3} mm out (the last pass's allowance)", self.finish)
+            } else {
+                String::new()
+            },
             self.reliefs.len()
         )
+    }
+}
+
+/// What a point of a sampled solid is: outside the stock, stock to be cut away, or the part.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Matter {
+    Air,
+    Cut,
+    Part,
+}
+
+/// A tube (its material between `inner` and `outer` from the axis `start`–`end`) whose rays
+/// through the `windows` are sampled with `classify`: holes (air) and the bands to be cut away
+/// near them (deburr's chamfers), found along each ray at steps of `step` and placed by
+/// bisection.
+pub(crate) struct SampledTube {
+    pub start: Vec3,
+    pub end: Vec3,
+    pub outer: f64,
+    pub inner: f64,
+    /// xy rectangles outside which the tube is whole.
+    pub windows: Vec<([f64; 2], [f64; 2])>,
+    /// What a point inside the tube's material is.
+    pub classify: Box<dyn Fn(&Vec3) -> Matter + Send + Sync>,
+    /// Largest sampling step along a ray, mm: smaller than the thinnest band.
+    pub step: f64,
+    pub description: String,
+}
+
+/// Steps of the bisection placing a boundary on a ray: 2⁻⁴⁰ of the sampling step.
+const BISECTIONS: usize = 40;
+
+impl SampledTube {
+    fn tube(&self) -> SolidModel {
+        let length = (self.end - self.start).norm();
+        SolidModel::Tube {
+            start: self.start,
+            axis: (self.end - self.start) / length,
+            length,
+            outer: self.outer,
+            inner: self.inner,
+        }
+    }
+
+    /// The runs of matter along `[low, high]` of the ray through `(x, y)`: (start, matter).
+    fn runs(&self, x: f64, y: f64, [low, high]: [f64; 2], runs: &mut Vec<(f64, Matter)>) {
+        let at = |z: f64| (self.classify)(&Vec3::new(x, y, z));
+        let steps = ((high - low) / self.step).ceil().max(1.0) as usize;
+        let mut previous = (low, at(low));
+        runs.push((low, previous.1));
+        for k in 1..=steps {
+            let z = low + (high - low) * k as f64 / steps as f64;
+            let matter = at(z);
+            if matter != previous.1 {
+                // The boundary between the two samples, by bisection.
+                let (mut a, mut b) = (previous.0, z);
+                for _ in 0..BISECTIONS {
+                    let middle = 0.5 * (a + b);
+                    if at(middle) == previous.1 { a = middle } else { b = middle }
+                }
+                runs.push((0.5 * (a + b), matter));
+            }
+            previous = (z, matter);
+        }
+    }
+}
+
+impl OwnModel for SampledTube {
+    fn footprint(&self) -> ([f64; 2], [f64; 2]) {
+        self.tube().footprint()
+    }
+
+    fn fields(&self, grid: Grid, control: Control<'_>) -> Result<(Field, Field), SolverError> {
+        let tube = self.tube();
+        let (mut stock, mut part) = (Vec::with_capacity(grid.len()), Vec::with_capacity(grid.len()));
+        let mut runs = Vec::new();
+        for j in 0..grid.ny {
+            control.check()?;
+            let y = grid.y(j);
+            for i in 0..grid.nx {
+                let x = grid.x(i);
+                let whole = tube.ray(x, y);
+                let windowed = self.windows.iter().any(|(lo, hi)| x >= lo[0] && x <= hi[0] && y >= lo[1] && y <= hi[1]);
+                if !windowed {
+                    part.push(whole.clone());
+                    stock.push(whole);
+                    continue;
+                }
+                let (mut stock_ray, mut part_ray) = (Ray::new(), Ray::new());
+                for &interval in &whole {
+                    runs.clear();
+                    self.runs(x, y, interval, &mut runs);
+                    for (index, &(from, matter)) in runs.iter().enumerate() {
+                        let to = runs.get(index + 1).map_or(interval[1], |next| next.0);
+                        if to <= from || matter == Matter::Air {
+                            continue;
+                        }
+                        push_merged(&mut stock_ray, [from, to]);
+                        if matter == Matter::Part {
+                            push_merged(&mut part_ray, [from, to]);
+                        }
+                    }
+                }
+                stock.push(stock_ray);
+                part.push(part_ray);
+            }
+        }
+        Ok((Field { grid, rays: stock }, Field { grid, rays: part }))
+    }
+
+    fn describe(&self) -> String {
+        self.description.clone()
+    }
+}
+
+/// Appends `[from, to]` (above everything on `ray`) to `ray`, joined to the last interval when
+/// they touch.
+fn push_merged(ray: &mut Ray, [from, to]: [f64; 2]) {
+    match ray.last_mut() {
+        Some(last) if last[1] >= from => last[1] = last[1].max(to),
+        _ => ray.push([from, to]),
     }
 }
 
