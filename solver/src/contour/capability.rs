@@ -131,7 +131,11 @@ impl Capability for ContourCapability {
         let passes = request.passes.as_ref().map_or(1, Vec::len) as u64;
         let reports = (request.contour.len() as u64).saturating_add(passes).saturating_mul(REPORT_BYTES);
         Some(
-            (max_moves as u64).saturating_mul(move_bound(purpose)).saturating_add(reports).saturating_add(ANSWER_BYTES),
+            (max_moves as u64)
+                .saturating_mul(move_bound(purpose))
+                .saturating_add(reports)
+                .saturating_add(ANSWER_BYTES)
+                .saturating_add(own::VERIFICATION_BYTES),
         )
     }
 

@@ -155,7 +155,12 @@ impl Capability for DeburrCapability {
     /// top.
     fn answer_bound(request: &DeburrRequest, _context: &Resolved<Tool>, purpose: Purpose) -> Option<u64> {
         let loops = if request.is_several() { request.placements().ok()?.len() as u64 + 1 } else { 1 };
-        Some(loops.saturating_mul(loop_bound(super::MAX_POINTS, purpose)).saturating_add(ANSWER_BYTES))
+        Some(
+            loops
+                .saturating_mul(loop_bound(super::MAX_POINTS, purpose))
+                .saturating_add(ANSWER_BYTES)
+                .saturating_add(own::VERIFICATION_BYTES),
+        )
     }
 
     fn solve(request: &DeburrRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<DeburrAnswer, SolverError> {
@@ -307,14 +312,14 @@ fn own_model(
         let station = (job.frame.origin - base).dot(&axis);
         first = first.min(station - half_y - 2.0 * ball);
         last = last.max(station + half_y + 2.0 * ball);
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for corner in 0..8 {
             let x = profile.centre_x + if corner & 1 == 0 { -half_x } else { half_x };
             let y = if corner & 2 == 0 { -half_y } else { half_y };
             let z = if corner & 4 == 0 { 0.0 } else { outer + reach };
             let point = job.frame.point(&Vec3::new(x, y, z));
-            lo = [lo[0].min(point.x), lo[1].min(point.y)];
-            hi = [hi[0].max(point.x), hi[1].max(point.y)];
+            lo = [lo[0].min(point.x), lo[1].min(point.y), lo[2].min(point.z)];
+            hi = [hi[0].max(point.x), hi[1].max(point.y), hi[2].max(point.z)];
         }
         windows.push((lo, hi));
         thinnest = thinnest.min(job.width);

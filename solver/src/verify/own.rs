@@ -16,7 +16,7 @@ use crate::capability::{Control, Run};
 use crate::error::{ErrorCode, SolverError, Warning};
 use crate::gcode::reader::{self, ReadOptions};
 use crate::geometry::Vec3;
-use crate::planar::{Containment, Vec2, point_in_polygon, point_segment_distance, vec2};
+use crate::planar::{Vec2, point_segment_distance, vec2};
 use crate::predict::stock::StockModel;
 use crate::tool::Tool;
 use crate::validate::positive;
@@ -27,6 +27,10 @@ use crate::validate::positive;
 pub const OWN_MAX_DEFAULT_RAYS: f64 = 250_000.0;
 /// The default resolution, in radii of the capability's tool (before the ray cap coarsens it).
 pub const OWN_RESOLUTION_RADII: f64 = 0.1;
+/// Most bytes of a `verification` section in an answer: its figures and at most
+/// [`MAX_FINDINGS`](super::MAX_FINDINGS) findings of at most 300 bytes of JSON each (the answer
+/// bounds of the capabilities that verify add it).
+pub const VERIFICATION_BYTES: u64 = 4096 + super::simulate::MAX_FINDINGS as u64 * 300;
 /// Thickness of the floor modelled under the deepest cut, mm: a move below the last layer cuts
 /// into it and gouges.
 pub const FLOOR_THICKNESS: f64 = 1.0;
@@ -397,13 +401,28 @@ impl OwnModel for Prism {
         let floor = self.bottom - FLOOR_THICKNESS;
         let (mut stock, mut part) = (Vec::with_capacity(grid.len()), Vec::with_capacity(grid.len()));
         let relief = self.relief_radius + self.wall_tolerance;
+        let mut crossings = Vec::new();
         for j in 0..grid.ny {
             control.check()?;
             let y = grid.y(j);
+            // Where the outline crosses the row (even-odd rule): a ray is inside past an odd count.
+            crossings.clear();
+            let n = self.outline.len();
+            for (index, a) in self.outline.iter().enumerate() {
+                let b = &self.outline[(index + 1) % n];
+                if (a.y > y) != (b.y > y) {
+                    crossings.push(a.x + (y - a.y) * (b.x - a.x) / (b.y - a.y));
+                }
+            }
+            crossings.sort_by(f64::total_cmp);
+            let mut passed = 0;
             for i in 0..grid.nx {
                 let x = grid.x(i);
+                while passed < crossings.len() && crossings[passed] < x {
+                    passed += 1;
+                }
                 let d = distance[j * grid.nx + i];
-                let inside = point_in_polygon(&Vec2::new(x, y), &self.outline) == Containment::Inside;
+                let inside = passed % 2 == 1;
                 // Signed distance from the designed wall, positive in the part.
                 let s = if inside == self.material_inside { d } else { -d } + self.finish;
                 let in_relief = self.reliefs.iter().any(|centre| (x - centre.x).hypot(y - centre.y) < relief);
@@ -458,8 +477,9 @@ pub(crate) struct SampledTube {
     pub end: Vec3,
     pub outer: f64,
     pub inner: f64,
-    /// xy rectangles outside which the tube is whole.
-    pub windows: Vec<([f64; 2], [f64; 2])>,
+    /// Boxes outside which the tube is whole: only the rays through one are sampled, and only
+    /// within its heights.
+    pub windows: Vec<([f64; 3], [f64; 3])>,
     /// What a point inside the tube's material is.
     pub classify: Box<dyn Fn(&Vec3) -> Matter + Send + Sync>,
     /// Largest sampling step along a ray, mm: smaller than the thinnest band.
@@ -520,8 +540,13 @@ impl OwnModel for SampledTube {
             for i in 0..grid.nx {
                 let x = grid.x(i);
                 let whole = tube.ray(x, y);
-                let windowed = self.windows.iter().any(|(lo, hi)| x >= lo[0] && x <= hi[0] && y >= lo[1] && y <= hi[1]);
-                if !windowed {
+                let (mut low, mut high) = (f64::INFINITY, f64::NEG_INFINITY);
+                for (lo, hi) in &self.windows {
+                    if x >= lo[0] && x <= hi[0] && y >= lo[1] && y <= hi[1] {
+                        (low, high) = (low.min(lo[2]), high.max(hi[2]));
+                    }
+                }
+                if low > high {
                     part.push(whole.clone());
                     stock.push(whole);
                     continue;
@@ -529,7 +554,19 @@ impl OwnModel for SampledTube {
                 let (mut stock_ray, mut part_ray) = (Ray::new(), Ray::new());
                 for &interval in &whole {
                     runs.clear();
-                    self.runs(x, y, interval, &mut runs);
+                    // Whole part below and above the heights of the windows.
+                    let (from, to) = (interval[0].max(low), interval[1].min(high));
+                    if to > from {
+                        if from > interval[0] {
+                            runs.push((interval[0], Matter::Part));
+                        }
+                        self.runs(x, y, [from, to], &mut runs);
+                        if to < interval[1] {
+                            runs.push((to, Matter::Part));
+                        }
+                    } else {
+                        runs.push((interval[0], Matter::Part));
+                    }
                     for (index, &(from, matter)) in runs.iter().enumerate() {
                         let to = runs.get(index + 1).map_or(interval[1], |next| next.0);
                         if to <= from || matter == Matter::Air {
