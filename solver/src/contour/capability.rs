@@ -17,6 +17,8 @@ use crate::capability::{
 use crate::error::{SolverError, Warning};
 use crate::machine::MachineProfile;
 use crate::tool::{Tool, ToolRef};
+use crate::verify::Verification;
+use crate::verify::own::{self, OwnModel, Prism};
 
 /// Most moves in a JSON answer (about 35 MB of JSON). A G-code program and a job may hold up to
 /// the solver's own limit, [`MAX_MOVES`].
@@ -39,6 +41,11 @@ pub struct ContourAnswer {
     /// Layers with their moves, corners, passes, summary and warnings.
     #[serde(flatten)]
     pub result: ContourSolution,
+    /// The program cut on the contour's own model (docs/spec/verify.md §9): the stock band and
+    /// the part prism. Absent when the request turns verification off, and for tilted walls
+    /// (no 3-axis program).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verification: Option<Verification>,
 }
 
 /// Most bytes of one move in memory: the move, its boxed axis (tilted walls) and at most one arc
@@ -128,7 +135,11 @@ impl Capability for ContourCapability {
         let passes = request.passes.as_ref().map_or(1, Vec::len) as u64;
         let reports = (request.contour.len() as u64).saturating_add(passes).saturating_mul(REPORT_BYTES);
         Some(
-            (max_moves as u64).saturating_mul(move_bound(purpose)).saturating_add(reports).saturating_add(ANSWER_BYTES),
+            (max_moves as u64)
+                .saturating_mul(move_bound(purpose))
+                .saturating_add(reports)
+                .saturating_add(ANSWER_BYTES)
+                .saturating_add(own::VERIFICATION_BYTES),
         )
     }
 
@@ -144,6 +155,7 @@ impl Capability for ContourCapability {
             None => request,
         };
         let max_moves = if run.purpose == Purpose::Json { MAX_JSON_MOVES } else { MAX_MOVES };
+        verification_grid(request, &context.tool)?;
         let charge = |layer: &LayerMoves, done: usize, count: usize| {
             run.charge_unit(done, count, ANSWER_BYTES, || layer_bytes(layer, run.purpose))
         };
@@ -156,7 +168,11 @@ impl Capability for ContourCapability {
             charge,
         );
         let result = if run.purpose == Purpose::Json { result.map_err(json_limit_advice)? } else { result? };
-        Ok(ContourAnswer { tool: context.tool, machine: context.machine, result })
+        verified(
+            request,
+            ContourAnswer { tool: context.tool, machine: context.machine, result, verification: None },
+            run,
+        )
     }
 
     /// Ranges of layers of about `sizing.part_seconds` each (`parts`): a job's contour only,
@@ -187,8 +203,13 @@ impl Capability for ContourCapability {
         parts: &mut impl PartSource,
         run: &Run<'_>,
     ) -> Result<ContourAnswer, SolverError> {
+        verification_grid(request, &context.tool)?;
         let result = super::parts::finish(request, &context.tool, context.machine.as_ref(), parts, run.control)?;
-        Ok(ContourAnswer { tool: context.tool, machine: context.machine, result })
+        verified(
+            request,
+            ContourAnswer { tool: context.tool, machine: context.machine, result, verification: None },
+            run,
+        )
     }
 
     fn program(
@@ -255,6 +276,62 @@ impl Capability for ContourCapability {
             ));
         }
     }
+}
+
+/// The contour's own model (docs/spec/verify.md §9.2): the part prism of the outline from a floor
+/// under `depths.bottom` up to `depths.top`, its walls moved out by the last pass's allowance and
+/// the relief discs (`reliefs`) cut out; the stock adds the band `stock_allowance` wide beyond the
+/// outline (without it, the band the first pass cuts: its allowance plus the tool radius).
+fn prism(request: &ContourRequest, tool: &Tool, reliefs: Vec<[f64; 2]>, wall_tolerance: f64) -> Prism {
+    let allowances: Vec<f64> =
+        request.passes.as_ref().map_or_else(|| vec![0.0], |passes| passes.iter().map(|pass| pass.allowance).collect());
+    let first = allowances.first().copied().unwrap_or(0.0);
+    let finish = allowances.last().copied().unwrap_or(0.0);
+    Prism {
+        outline: own::outline(&request.contour),
+        material_inside: request.side == super::Side::Outside,
+        top: request.depths.top,
+        bottom: request.depths.bottom,
+        stock: request.stock_allowance.unwrap_or(first + tool.radius).max(finish),
+        finish,
+        reliefs: own::outline(&reliefs),
+        relief_radius: tool.radius,
+        reach: tool.radius,
+        wall_tolerance,
+    }
+}
+
+/// The grid of the verification, checked before any work: a resolution over the memory limit is
+/// refused up front.
+fn verification_grid(request: &ContourRequest, tool: &Tool) -> Result<Option<own::Grid>, SolverError> {
+    let options = request.verification.unwrap_or_default();
+    if !options.enabled || request.contour.is_empty() || !tool.radius.is_finite() || tool.radius <= 0.0 {
+        return Ok(None);
+    }
+    let model = prism(request, tool, Vec::new(), 0.0);
+    own::grid(model.footprint(), tool, &options).map(Some)
+}
+
+/// `answer` with its program cut on the contour's own model: its `verification`, and the
+/// warnings and header comments of what that found.
+fn verified(request: &ContourRequest, mut answer: ContourAnswer, run: &Run<'_>) -> Result<ContourAnswer, SolverError> {
+    let Some(grid) = verification_grid(request, &answer.tool)? else {
+        return Ok(answer);
+    };
+    if answer.result.tilted {
+        return Ok(answer);
+    }
+    let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
+    let program = crate::capability::program::<ContourCapability>(request, &answer, &output, run.control)?;
+    let reliefs = answer.result.corners.iter().filter_map(|corner| corner.relief.as_ref()).map(|relief| relief.target);
+    let wall_tolerance = answer.result.summary.tolerance + own::OWN_TOLERANCE;
+    let model = prism(request, &answer.tool, reliefs.collect(), wall_tolerance);
+    let limits =
+        own::Limits { tolerance: own::OWN_TOLERANCE, allowance: crate::verify::DEFAULT_ALLOWANCE, wall_tolerance };
+    let mut verification = own::verify(&model, grid, &program, &answer.tool, limits, run)?;
+    own::report(&mut verification, &mut answer.result.warnings, &mut answer.result.description);
+    answer.verification = Some(verification);
+    Ok(answer)
 }
 
 /// A JSON answer over [`MAX_JSON_MOVES`] gets the advice to ask for G-code or submit a job.
@@ -432,5 +509,103 @@ mod budget_tests {
         }
         // A JSON answer at its move cap fits the default budget: counted only under a smaller one.
         assert!(ContourCapability::answer_bound(&request, &context, Purpose::Json).unwrap() < 512 << 20);
+    }
+}
+
+#[cfg(test)]
+mod verification_tests {
+    use super::*;
+    use crate::verify::{FindingKind, VerificationOptions};
+
+    /// The arrow island of `examples/contour-arrow.toml`.
+    fn arrow() -> ContourRequest {
+        serde_json::from_value(serde_json::json!({
+            "tool": {"kind": "flat", "radius": 3, "number": 3},
+            "contour": [[0, 10], [40, 10], [40, 0], [80, 25], [40, 50], [40, 40], [0, 40]],
+            "side": "outside", "depths": {"top": 0, "bottom": -9, "step": 3},
+            "corner_loop": {"style": "arc"}, "inside_corner_relief": "dogbone",
+            "feed": 800, "loop_feed": 2000, "stock_allowance": 0.5, "spindle_rpm": 8000,
+            "passes": [{"allowance": 0.3, "join": "round"}, {"allowance": 0}]
+        }))
+        .unwrap()
+    }
+
+    fn context(request: &ContourRequest) -> Resolved<Tool> {
+        let ToolRef::Inline(tool) = &request.tool else { unreachable!("an inline tool") };
+        Resolved { tool: tool.clone(), machine: None, material: None, other_tools: Vec::new() }
+    }
+
+    fn fanuc(request: &ContourRequest, answer: &ContourAnswer) -> String {
+        let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
+        crate::capability::program::<ContourCapability>(request, answer, &output, Control::default()).unwrap()
+    }
+
+    #[test]
+    fn the_arrow_cuts_clean_on_its_own_model() {
+        let request = arrow();
+        let answer = ContourCapability::solve(&request, context(&request), &Run::default()).unwrap();
+        let verification = answer.verification.as_ref().expect("verified");
+        assert!(verification.ok, "{:#?}", verification.findings);
+        assert!(verification.removed_volume_mm3 > 0.0);
+        assert!(answer.result.warnings.iter().all(|warning| !warning.code.starts_with("W_VERIFY")));
+        assert!(!fanuc(&request, &answer).contains("WARNING"));
+    }
+
+    #[test]
+    fn verification_can_be_turned_off_and_a_grid_too_fine_is_refused_up_front() {
+        let mut request = arrow();
+        request.verification = Some(VerificationOptions { enabled: false, resolution: None });
+        let answer = ContourCapability::solve(&request, context(&request), &Run::default()).unwrap();
+        assert!(answer.verification.is_none());
+        assert!(!serde_json::to_string(&answer).unwrap().contains("verification"));
+        request.verification = Some(VerificationOptions { enabled: true, resolution: Some(0.001) });
+        let error = ContourCapability::solve(&request, context(&request), &Run::default()).unwrap_err();
+        assert_eq!((error.code(), error.field()), (ErrorCode::GridMemory, Some("verification.resolution")));
+    }
+
+    /// Every move of the finishing pass of the middle layer pushed 0.5 mm into the island (a tool
+    /// radius offset too large): gouges, warned, in the header, at lines of the program written.
+    #[test]
+    fn a_path_pushed_into_the_part_gouges() {
+        let request = arrow();
+        let context = context(&request);
+        let mut request_off = request.clone();
+        request_off.verification = Some(VerificationOptions { enabled: false, resolution: None });
+        let mut answer = ContourCapability::solve(&request_off, context.clone(), &Run::default()).unwrap();
+        let centre = [45.0, 25.0];
+        let layer = &mut answer.result.layers[1];
+        let from = layer.moves.len() / 2;
+        for step in &mut layer.moves[from..] {
+            let (dx, dy) = (centre[0] - step.to[0], centre[1] - step.to[1]);
+            let length = dx.hypot(dy);
+            step.to[0] += 0.5 * dx / length;
+            step.to[1] += 0.5 * dy / length;
+        }
+        layer.arcs.clear();
+        let unverified = fanuc(&request, &answer);
+        let answer = verified(&request, answer, &Run::default()).unwrap();
+        let verification = answer.verification.as_ref().unwrap();
+        assert!(!verification.ok);
+        let gouges: Vec<_> =
+            verification.findings.iter().filter(|finding| finding.kind == FindingKind::Gouge).collect();
+        assert!(!gouges.is_empty(), "{:#?}", verification.findings);
+        assert!(answer.result.warnings.iter().any(|warning| warning.code == "W_VERIFY_GOUGE"));
+        // Fanuc comments are upper case.
+        let program = fanuc(&request, &answer);
+        assert!(program.contains("(WARNING VERIFICATION FOUND"), "{program}");
+        let first = gouges[0].line.unwrap();
+        assert!(program.contains(&format!("(WARNING GOUGE AT LINE {first}: ")), "{program}");
+        // The finding's line is the move of the program the answer writes: the same text as in
+        // the program before the comments were added, a feed move at the gouge's height.
+        let lines: Vec<&str> = program.lines().collect();
+        let before: Vec<&str> = unverified.lines().collect();
+        let added = lines.len() - before.len();
+        assert!(added >= 2);
+        for gouge in gouges {
+            let line = gouge.line.unwrap();
+            assert_eq!(lines[line - 1], before[line - 1 - added]);
+            assert!(lines[line - 1].starts_with("G01") || lines[line - 1].contains("X"), "{}", lines[line - 1]);
+            assert!(gouge.position[2] >= -6.0 - 1e-9, "{gouge:?}");
+        }
     }
 }

@@ -319,6 +319,11 @@ pub struct ContourRequest {
     /// answer (default: the named machine's `units`, else `mm`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub units: Option<crate::units::Units>,
+    /// Cut the program on the contour's own model and answer `verification`
+    /// (docs/spec/verify.md §9): default on; `{"enabled": false}` turns it off, `resolution` sets
+    /// the dexel spacing.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verification: Option<crate::verify::VerificationOptions>,
 }
 
 impl ContourRequest {

@@ -17,6 +17,8 @@ use crate::geometry::Vec3;
 use crate::machine::MachineProfile;
 use crate::machine::cycle::{CycleTime, Dynamics, Step};
 use crate::tool::Tool;
+use crate::verify::Verification;
+use crate::verify::own::{self, Matter, OwnModel, SampledTube};
 
 /// The deburr capability.
 #[derive(Debug, Clone, Copy)]
@@ -52,6 +54,13 @@ pub struct DeburrAnswer {
     /// The loop of centres, leads, summary and warnings.
     #[serde(flatten)]
     pub result: Deburr,
+    /// The program cut on the deburr's own model (docs/spec/verify.md §9): the tube with its
+    /// holes as the stock, the tube with the chamfer bands W wide as the part. Absent when the
+    /// request turns verification off, for a `bore_block` (its extent is not known), when the
+    /// program cannot be written, and for two tools without numbers (the program cannot say
+    /// which cuts).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verification: Option<Verification>,
 }
 
 /// One loop of a several-loop answer: a hole at one edge.
@@ -146,40 +155,20 @@ impl Capability for DeburrCapability {
     /// top.
     fn answer_bound(request: &DeburrRequest, _context: &Resolved<Tool>, purpose: Purpose) -> Option<u64> {
         let loops = if request.is_several() { request.placements().ok()?.len() as u64 + 1 } else { 1 };
-        Some(loops.saturating_mul(loop_bound(super::MAX_POINTS, purpose)).saturating_add(ANSWER_BYTES))
+        Some(
+            loops
+                .saturating_mul(loop_bound(super::MAX_POINTS, purpose))
+                .saturating_add(ANSWER_BYTES)
+                .saturating_add(own::VERIFICATION_BYTES),
+        )
     }
 
     fn solve(request: &DeburrRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<DeburrAnswer, SolverError> {
-        if !request.is_several() {
-            let result = super::solve_controlled(request, &context.tool, context.machine.as_ref(), run.control)?;
-            run.charge_unit(1, 1, ANSWER_BYTES, || loop_bytes(&result, run.purpose))?;
-            let cycle_time = context
-                .machine
-                .as_ref()
-                .and_then(MachineProfile::dynamics)
-                .map(|d| cycle_time(&[Leg { deburr: &result, tool: 0, turned: false }], &d));
-            return Ok(DeburrAnswer {
-                tool: context.tool,
-                inner_tool: None,
-                machine: context.machine,
-                cycle_time,
-                holes: None,
-                visiting_order: None,
-                result,
-            });
-        }
-        let inner_tool = inner_tool(request, &context);
-        let placements = request.placements()?;
-        let count = placements.len();
-        let mut loops = Vec::with_capacity(count);
-        for placement in placements {
-            run.control.check()?;
-            let result = solve_loop(&placement, &context, inner_tool.as_ref(), run)?;
-            charge_loop(run, &result, loops.len(), count)?;
-            loops.push(hole_answer(placement, result));
-        }
-        Ok(arrange(context, inner_tool, loops))
+        let model = own_model(request, &context)?;
+        let answer = solve_unverified(request, context, run)?;
+        verified(request, model, answer, run)
     }
+
     /// A several-loop request's loops in ranges of about `sizing.part_seconds` (`parts`).
     fn split(request: &DeburrRequest, _context: &Resolved<Tool>, sizing: &Sizing) -> Option<Split> {
         super::parts::split(request, sizing)
@@ -203,7 +192,9 @@ impl Capability for DeburrCapability {
         parts: &mut impl PartSource,
         run: &Run<'_>,
     ) -> Result<DeburrAnswer, SolverError> {
-        super::parts::finish(request, context, parts, run)
+        let model = own_model(request, &context)?;
+        let answer = super::parts::finish(request, context, parts, run)?;
+        verified(request, model, answer, run)
     }
 
     fn program(
@@ -225,6 +216,209 @@ impl Capability for DeburrCapability {
     fn machine(answer: &DeburrAnswer) -> Option<&MachineProfile> {
         answer.machine.as_ref()
     }
+}
+
+/// The answer before verification: one loop, or every loop arranged.
+fn solve_unverified(
+    request: &DeburrRequest,
+    context: Resolved<Tool>,
+    run: &Run<'_>,
+) -> Result<DeburrAnswer, SolverError> {
+    if !request.is_several() {
+        let result = super::solve_controlled(request, &context.tool, context.machine.as_ref(), run.control)?;
+        run.charge_unit(1, 1, ANSWER_BYTES, || loop_bytes(&result, run.purpose))?;
+        let cycle_time = context
+            .machine
+            .as_ref()
+            .and_then(MachineProfile::dynamics)
+            .map(|d| cycle_time(&[Leg { deburr: &result, tool: 0, turned: false }], &d));
+        return Ok(DeburrAnswer {
+            tool: context.tool,
+            inner_tool: None,
+            machine: context.machine,
+            cycle_time,
+            holes: None,
+            visiting_order: None,
+            result,
+            verification: None,
+        });
+    }
+    let inner_tool = inner_tool(request, &context);
+    let placements = request.placements()?;
+    let count = placements.len();
+    let mut loops = Vec::with_capacity(count);
+    for placement in placements {
+        run.control.check()?;
+        let result = solve_loop(&placement, &context, inner_tool.as_ref(), run)?;
+        charge_loop(run, &result, loops.len(), count)?;
+        loops.push(hole_answer(placement, result));
+    }
+    Ok(arrange(context, inner_tool, loops))
+}
+
+/// The deburr's own model and its grid (docs/spec/verify.md §9.2), built before any work so a
+/// resolution over the memory limit is refused up front: the tube (its bore and outer radius)
+/// along the holes' stations with every hole as the stock, less every loop's chamfer band as
+/// the part. A point of the tube is in a hole where the hole's profile holds it (on the side of
+/// the axis the hole is drilled from); it is in the chamfer band of a ridge where its distances
+/// d_s from the ridge's cylinder and d_h from the hole wall satisfy d_s + d_h < W·cos(β/2),
+/// β the wedge angle between the two faces there: the flat chamfer whose edges lie W apart.
+/// `None`: no verification (turned off, a `bore_block`, or two tools the program cannot tell
+/// apart).
+fn own_model(
+    request: &DeburrRequest,
+    context: &Resolved<Tool>,
+) -> Result<Option<(SampledTube, own::Grid)>, SolverError> {
+    let options = request.verification.unwrap_or_default();
+    if !options.enabled {
+        return Ok(None);
+    }
+    let inner = inner_tool(request, context);
+    let two_tools = inner.as_ref().is_some_and(|inner| *inner != context.tool);
+    if two_tools && (context.tool.number.is_none() || inner.as_ref().is_some_and(|inner| inner.number.is_none())) {
+        return Ok(None);
+    }
+    // Refusals of the request itself are left to the solve, which names them.
+    let jobs: Vec<super::job::Job> = if request.is_several() {
+        let Ok(placements) = request.placements() else { return Ok(None) };
+        let mut jobs = Vec::with_capacity(placements.len());
+        for placement in placements {
+            let tool = match &inner {
+                Some(inner) if placement.tool_field == "inner_tool" => inner,
+                _ => &context.tool,
+            };
+            let Ok(job) = placement.request.validate(tool, context.machine.as_ref()) else { return Ok(None) };
+            jobs.push(job);
+        }
+        jobs
+    } else {
+        let Ok(job) = request.validate(&context.tool, context.machine.as_ref()) else { return Ok(None) };
+        vec![job]
+    };
+    let Some((bore, outer)) = jobs.first().and_then(|job| job.tube_radii) else {
+        return Ok(None);
+    };
+    let ball = jobs.iter().map(|job| job.tool.radius).fold(0.0, f64::max);
+    let axis = jobs[0].frame.vector(&Vec3::y());
+    let base = jobs[0].frame.origin;
+    let (mut first, mut last) = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut windows = Vec::with_capacity(jobs.len());
+    let mut thinnest = f64::INFINITY;
+    for job in &jobs {
+        let profile = &job.profile;
+        let reach = job.width + ball + 1.0;
+        let half_x = profile.half_across + profile.radius + reach;
+        let half_y = profile.half_along + profile.radius + reach;
+        let station = (job.frame.origin - base).dot(&axis);
+        first = first.min(station - half_y - 2.0 * ball);
+        last = last.max(station + half_y + 2.0 * ball);
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for corner in 0..8 {
+            let x = profile.centre_x + if corner & 1 == 0 { -half_x } else { half_x };
+            let y = if corner & 2 == 0 { -half_y } else { half_y };
+            let z = if corner & 4 == 0 { 0.0 } else { outer + reach };
+            let point = job.frame.point(&Vec3::new(x, y, z));
+            lo = [lo[0].min(point.x), lo[1].min(point.y), lo[2].min(point.z)];
+            hi = [hi[0].max(point.x), hi[1].max(point.y), hi[2].max(point.z)];
+        }
+        windows.push((lo, hi));
+        thinnest = thinnest.min(job.width);
+    }
+    let holes = jobs.len();
+    let width = jobs[0].width;
+    let classify = move |point: &Vec3| -> Matter {
+        let mut matter = Matter::Part;
+        for job in &jobs {
+            let local = job.frame.rotation.transpose() * (point - job.frame.origin);
+            if local.z <= 0.0 {
+                continue;
+            }
+            let (wall, (gx, _)) = job.profile.signed_distance(local.x, local.y);
+            if wall < 0.0 {
+                return Matter::Air;
+            }
+            let rho = local.x.hypot(local.z);
+            // Distance from the ridge's cylinder into the material, and cos β from the faces'
+            // outward normals (the hole wall's is −∇d_h, the cylinder's ±radial).
+            let (surface, cos_beta) = match job.edge {
+                Edge::Inner => (rho - bore, -gx * local.x / rho),
+                Edge::Outer | Edge::Both => (outer - rho, gx * local.x / rho),
+            };
+            let half_beta = 0.5 * cos_beta.clamp(-1.0, 1.0).acos();
+            if surface + wall < job.width * half_beta.cos() {
+                matter = Matter::Cut;
+            }
+        }
+        matter
+    };
+    let model = SampledTube {
+        start: base + first * axis,
+        end: base + last * axis,
+        outer,
+        inner: bore,
+        windows,
+        classify: Box::new(classify),
+        step: thinnest / 8.0,
+        description: format!(
+            "stock: the tube (bore radius {bore}, outer radius {outer}) with its {holes} hole(s); part: the same with              the chamfer band of every loop cut away, its edges W = {width:.4} mm apart"
+        ),
+    };
+    let ball_tool = Tool { radius: ball, ..context.tool.clone() };
+    let grid = own::grid(model.footprint(), &ball_tool, &options)?;
+    Ok(Some((model, grid)))
+}
+
+/// `answer` with its program cut on the deburr's own `model`: its `verification`, the warnings
+/// and the program's header comments of what that found. A ball cuts an arc where the part's
+/// chamfer is flat: the arc lies deeper than the chord by the sagitta D − √(D² − W²/4), which
+/// the depth along z may double on the chamfer's slopes (up to 60°); the width may be off by
+/// the method's tolerance max(0.005, `tolerance`). Both are allowed besides the default
+/// tolerance.
+fn verified(
+    request: &DeburrRequest,
+    model: Option<(SampledTube, own::Grid)>,
+    mut answer: DeburrAnswer,
+    run: &Run<'_>,
+) -> Result<DeburrAnswer, SolverError> {
+    let Some((model, grid)) = model else {
+        return Ok(answer);
+    };
+    let loops: Vec<&Deburr> = match &answer.holes {
+        Some(holes) => holes.iter().map(|hole| &hole.result).collect(),
+        None => vec![&answer.result],
+    };
+    if loops.iter().any(|deburr| deburr.program_blocker.is_some()) {
+        return Ok(answer);
+    }
+    let (mut slack, mut allowance) = (0.0_f64, 0.0_f64);
+    for deburr in &loops {
+        let (ball, width) = (deburr.ball_radius, deburr.summary.width);
+        let sagitta = ball - (ball * ball - 0.25 * width * width).max(0.0).sqrt();
+        let off = deburr.summary.tolerance.max(0.005);
+        slack = slack.max(2.0 * (sagitta + off));
+        allowance = allowance.max(2.0 * off);
+    }
+    let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
+    let program = crate::capability::program::<DeburrCapability>(request, &answer, &output, run.control)?;
+    let limits = own::Limits {
+        tolerance: own::OWN_TOLERANCE + slack,
+        allowance: crate::verify::DEFAULT_ALLOWANCE + allowance,
+        wall_tolerance: 0.0,
+    };
+    let inner = answer.inner_tool.as_ref().filter(|inner| **inner != answer.tool);
+    let mut tools = vec![(inner.map(|_| answer.tool.number).unwrap_or(None), &answer.tool)];
+    if let Some(inner) = inner {
+        tools.push((inner.number, inner));
+    }
+    let mut verification = own::verify_tools(&model, grid, &program, &tools, limits, run)?;
+    let mut description = Vec::new();
+    own::report(&mut verification, &mut answer.result.warnings, &mut description);
+    answer.result.description.extend(description.iter().cloned());
+    if let Some(first) = answer.holes.as_mut().and_then(|holes| holes.first_mut()) {
+        first.result.description.extend(description);
+    }
+    answer.verification = Some(verification);
+    Ok(answer)
 }
 
 /// Most bytes one answer point takes as JSON: its 13 numbers at their longest (24 characters,
@@ -386,6 +580,7 @@ pub(super) fn arrange(context: Resolved<Tool>, inner_tool: Option<Tool>, loops: 
         holes: Some(holes),
         visiting_order: Some(visiting_order),
         result,
+        verification: None,
     }
 }
 
@@ -494,5 +689,80 @@ mod tests {
                 assert!(bytes <= bound, "{purpose:?}: a loop of {bytes} bytes over its bound {bound}");
             }
         }
+    }
+
+    /// Reference case 1 of docs/spec/deburr.md: a Ø20 hole in a tube of radii 40 and 50, ball R3,
+    /// Q 0.5.
+    fn reference() -> DeburrRequest {
+        serde_json::from_value(serde_json::json!({
+            "tool": {"kind": "ball", "radius": 3},
+            "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_radius": 40, "outer_radius": 50},
+            "hole": {"shape": "round", "radius": 10},
+            "edge": "outer", "cut_amount": 0.5
+        }))
+        .unwrap()
+    }
+
+    fn context(request: &DeburrRequest) -> Resolved<Tool> {
+        let crate::tool::ToolRef::Inline(tool) = &request.tool else { unreachable!("an inline tool") };
+        Resolved { tool: tool.clone(), machine: None, material: None, other_tools: Vec::new() }
+    }
+
+    fn fanuc(request: &DeburrRequest, answer: &DeburrAnswer) -> String {
+        let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
+        crate::capability::program::<DeburrCapability>(request, answer, &output, Control::default()).unwrap()
+    }
+
+    /// The inside ridge with a lollipop cutter (a Ø3 neck): a plain ball's flutes above the ball
+    /// cut into the hole wall on the way out to the bore (found as gouges at the lines of the
+    /// move out and the loop).
+    #[test]
+    fn the_reference_chamfer_cuts_clean_on_its_own_model() {
+        for edge in ["outer", "inner", "both"] {
+            let mut request = reference();
+            request.edge = serde_json::from_value(serde_json::json!(edge)).unwrap();
+            request.tool =
+                serde_json::from_value(serde_json::json!({"kind": "ball", "radius": 3, "neck_radius": 1.5})).unwrap();
+            let answer = DeburrCapability::solve(&request, context(&request), &Run::default()).unwrap();
+            let verification = answer.verification.as_ref().expect("verified");
+            assert!(verification.ok, "{edge}: {:#?}", verification.findings);
+            // The band: W long in section, about Q² / 2 in area, around the ridge (2π·10 long).
+            let band = verification.stock_volume_mm3 - verification.part_volume_mm3;
+            let removed = verification.removed_volume_mm3;
+            assert!(band > 0.0 && removed >= band, "{edge}: band {band}, removed {removed}");
+            assert!(!fanuc(&request, &answer).contains("WARNING"));
+        }
+        let mut plain = reference();
+        plain.edge = Edge::Inner;
+        let answer = DeburrCapability::solve(&plain, context(&plain), &Run::default()).unwrap();
+        let verification = answer.verification.as_ref().unwrap();
+        assert!(verification.findings.iter().any(|f| f.kind == crate::verify::FindingKind::Gouge));
+        assert!(answer.result.warnings.iter().any(|warning| warning.code == "W_VERIFY_GOUGE"));
+    }
+
+    /// The loop's centres 0.3 mm lower than solved: the ball cuts past the chamfer into the
+    /// part, warned and written in the program's header at the lines of the program.
+    #[test]
+    fn a_loop_run_too_deep_gouges() {
+        let request = reference();
+        let context = context(&request);
+        let model = own_model(&request, &context).unwrap();
+        let mut answer = solve_unverified(&request, context, &Run::default()).unwrap();
+        for point in &mut answer.result.points {
+            point.centre[2] -= 0.3;
+        }
+        let unverified = fanuc(&request, &answer);
+        let answer = verified(&request, model, answer, &Run::default()).unwrap();
+        let verification = answer.verification.as_ref().unwrap();
+        let gouge = verification.findings.iter().find(|f| f.kind == crate::verify::FindingKind::Gouge);
+        let gouge = gouge.unwrap_or_else(|| panic!("{:#?}", verification.findings));
+        assert!(answer.result.warnings.iter().any(|warning| warning.code == "W_VERIFY_GOUGE"));
+        let program = fanuc(&request, &answer);
+        let line = gouge.line.unwrap();
+        assert!(program.contains(&format!("(WARNING GOUGE AT LINE {line}: ")), "{program}");
+        let (lines, before): (Vec<&str>, Vec<&str>) = (program.lines().collect(), unverified.lines().collect());
+        let added = lines.len() - before.len();
+        assert_eq!(lines[line - 1], before[line - 1 - added]);
+        assert!(lines[line - 1].starts_with("G01"), "{}", lines[line - 1]);
     }
 }

@@ -547,4 +547,9 @@ pub struct DeburrRequest {
     /// coarser than `tolerance`; the summary then reports the blocks.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub block_time_ms: Option<f64>,
+    /// Cut the program on the deburr's own model and answer `verification`
+    /// (docs/spec/verify.md §9): default on; `{"enabled": false}` turns it off, `resolution` sets
+    /// the dexel spacing.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verification: Option<crate::verify::VerificationOptions>,
 }

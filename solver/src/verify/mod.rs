@@ -4,14 +4,16 @@
 //!
 //! [`request`] holds the wire types, `job` their validation, `solid` the stock and part on the
 //! grid, `dexel` the rays, `assembly` the tool's bodies, `sweep` a body swept along a move,
-//! `simulate` the cutting and its findings, `mesh` the cut stock as binary glTF, and `capability`
-//! the seam's entry.
+//! `simulate` the cutting and its findings, `mesh` the cut stock as binary glTF, `capability` the
+//! seam's entry, and [`own`] the verification of the programs the other capabilities write, on
+//! their own models.
 
 mod assembly;
 mod capability;
 mod dexel;
 mod job;
 mod mesh;
+pub mod own;
 pub mod request;
 mod simulate;
 mod solid;
@@ -26,6 +28,7 @@ pub use job::{
     MAX_DEXEL_BYTES,
 };
 pub use mesh::{GLB_MEDIA_TYPE, GOUGE_COLOUR, LEFT_COLOUR, NEUTRAL_COLOUR, cut_stock_glb};
+pub use own::{Verification, VerificationOptions};
 pub use request::{CrossHole, Hollow, MAX_CROSS_HOLES, Meshes, Solid, VerifyRequest};
 pub use simulate::{ARC_CHORD_TOLERANCE, BlockRemoval, Cut, Finding, FindingKind, MAX_FINDINGS};
 

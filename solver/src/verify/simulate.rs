@@ -441,6 +441,20 @@ pub(crate) fn cut_stock(job: &Job, run: &Run<'_>) -> Result<(Cut, Field), Solver
     if let Some(part) = &part {
         super::solid::check_part_in_stock(part, &stock, job.tolerance)?;
     }
+    cut_fields(job, stock, part, run)
+}
+
+/// [`cut_stock`] out of `stock`, compared with `part`, both already on `job.grid`: a capability's own
+/// model, which no request solid describes (`own`).
+///
+/// # Errors
+/// As [`cut`].
+pub(crate) fn cut_fields(
+    job: &Job,
+    stock: Field,
+    part: Option<Field>,
+    run: &Run<'_>,
+) -> Result<(Cut, Field), SolverError> {
     let stock_volume = stock.volume();
     let part_volume = part.as_ref().map(Field::volume);
     let tops = Tops::new(&stock);

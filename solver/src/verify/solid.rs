@@ -15,9 +15,9 @@ use super::request::{CrossHole, Hollow, MAX_CROSS_HOLES, Solid};
 /// A segment of an axis: from `start` along the unit `axis` for `length`.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Axis {
-    start: Vec3,
-    axis: Vec3,
-    length: f64,
+    pub(crate) start: Vec3,
+    pub(crate) axis: Vec3,
+    pub(crate) length: f64,
 }
 
 /// A validated solid.
