@@ -37,6 +37,9 @@ answer's CPU ÷ the JSON answer's. The cases (`--only` takes their names):
   sample the tool circle intersected with the material left: the stock less the path before the
   sample within 2R, buffered by the tool radius).
 
+Contour requests turn their `verification` off (the peer only offsets); `--verified` leaves it on,
+as the service's default, to measure what cutting the program costs.
+
 Before the table, once: each segment case's point count and largest chord deviation, kerf's
 (from its answer) and the peer's (sampled at 8 points inside every chord).
 """
@@ -210,8 +213,12 @@ class ClipperOffset:
 
 
 def contour_body(outline, layers):
+    # The peer offsets only; kerf's cut of its own program (on by default) is measured on its own
+    # by `--verified`.
+    verification = {"enabled": VERIFIED}
     return json.dumps({"tool": {"kind": "flat", "radius": 3}, "contour": outline, "side": "outside",
-                       "depths": {"top": 0, "bottom": -float(layers), "step": 1}, "feed": 1200}).encode()
+                       "depths": {"top": 0, "bottom": -float(layers), "step": 1}, "feed": 1200,
+                       "verification": verification}).encode()
 
 
 def star_case():
@@ -394,6 +401,8 @@ def engagement_case(kerf):
 
 # The shortest a measurement of kerf is made by repeating the request, seconds.
 MEASURED_S = 0.5
+# Whether contour requests ask for the verification section (`--verified`).
+VERIFIED = False
 
 CASES = {
     "bspline": ("B-spline, 5 000 poles, δ 0.001 mm", "OCCT TangentialDeflection", lambda kerf: bspline_case()),
@@ -427,7 +436,11 @@ def main():
     parser.add_argument("binary")
     parser.add_argument("--rounds", type=int, default=7)
     parser.add_argument("--only", default=",".join(CASES))
+    parser.add_argument("--verified", action="store_true",
+                        help="contour answers cut their own program (the service's default; the peer does not)")
     arguments = parser.parse_args()
+    global VERIFIED
+    VERIFIED = arguments.verified
     names = [name for name in arguments.only.split(",") if name]
     for name in names:
         if name not in CASES:

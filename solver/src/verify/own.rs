@@ -214,7 +214,9 @@ pub(crate) fn verify_tools(
         program: read,
     };
     // The answer's budget is the capability's: the verification's own records are capped.
-    let unbudgeted = Run { budget: None, ..*run };
+    // The capability's solve has reported its progress up to here; the simulation's own 0 → 1
+    // would send a job's bar back, so it reports none (cancellation still reaches it).
+    let unbudgeted = Run { budget: None, control: Control { progress: None, ..run.control }, ..*run };
     let description = model.describe();
     let cut = match simulate::cut_fields(&job, stock, Some(part), &unbudgeted).map(|(cut, _)| cut) {
         Ok(cut) => cut,
