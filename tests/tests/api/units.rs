@@ -65,10 +65,36 @@ const LENGTHS: &[&str] = &[
     "safe_z",
     "lead",
     "finest_arc_tolerance",
+    // engagement
+    "polygon",
+    "position",
+    "radial_depth",
+    "mean_chip_thickness",
+    "thickness",
+    "feed_per_tooth",
+    "max_thickness",
+    "mean_thickness",
+    "min_thickness",
+    "median_thickness",
+    "thickness_margin",
+    "thickness_limit",
+    "multi_tooth_intervals",
+    "step",
+    "engaged_intervals",
+    "max_engaged_at_s",
+    "max_radial_depth",
+    "axial_depth",
+    "target_thickness",
+    "from_s",
+    "to_s",
+    "feed_range",
 ];
 
 /// Keys whose numbers are areas.
 const AREAS: &[&str] = &["left_area", "overcut_area"];
+
+/// Keys whose numbers are volumes (per minute).
+const VOLUMES: &[&str] = &["mrr", "max_mrr"];
 
 /// How a number at a key compares: as a length (÷ 25.4), an area (÷ 25.4²) or unchanged.
 #[derive(Clone, Copy, Debug)]
@@ -76,6 +102,7 @@ enum Kind {
     Same,
     Length,
     Area,
+    Volume,
 }
 
 fn kind_of(key: &str, inherited: Kind) -> Kind {
@@ -83,6 +110,8 @@ fn kind_of(key: &str, inherited: Kind) -> Kind {
         Kind::Length
     } else if AREAS.contains(&key) {
         Kind::Area
+    } else if VOLUMES.contains(&key) {
+        Kind::Volume
     } else {
         inherited
     }
@@ -115,6 +144,7 @@ fn assert_in_inch(path: &str, inch: &Value, mm: &Value, kind: Kind) -> usize {
                 Kind::Same => mm,
                 Kind::Length => mm / 25.4,
                 Kind::Area => mm / 25.4 / 25.4,
+                Kind::Volume => mm / 25.4 / 25.4 / 25.4,
             };
             assert!((inch - want).abs() <= 1e-9 * want.abs().max(1e-12), "{path}: {inch} in vs {mm} mm ({kind:?})");
             usize::from(!matches!(kind, Kind::Same))
@@ -147,6 +177,23 @@ fn contour_request(k: f64) -> Value {
            "passes": [{"allowance": 0.012 * k, "join": "round"}, {"allowance": 0}], "block_time_ms": 2})
 }
 
+/// An engagement request in units of `k` mm: a slot, an arc and a side cut through a plate with
+/// an inline tool, forces from inline Kienzle values (N/mm², never scaled), a feed plan and a block
+/// time.
+fn engagement_request(k: f64) -> Value {
+    json!({"tool": {"kind": "flat", "radius": 0.2 * k, "flutes": 3, "helix_deg": 30},
+           "stock": {"polygon": [[0, 0], [2.4 * k, 0], [2.4 * k, 1.6 * k], [0, 1.6 * k]]},
+           "path": {"start": [-0.4 * k, 0.8 * k], "segments": [
+               {"type": "line", "to": [1.2 * k, 0.8 * k]},
+               {"type": "arc", "to": [1.6 * k, 1.2 * k], "center": [1.2 * k, 1.2 * k], "dir": "ccw"},
+               {"type": "line", "to": [1.6 * k, 2.0 * k]}]},
+           "spindle_rpm": 8000, "feed_per_tooth": 0.002 * k, "flute_counts": [2, 3, 4],
+           "thickness_limit": 0.1 * k, "time_limit_s": 60, "step": 0.01 * k,
+           "axial_depth": 0.08 * k, "clearance": 0.2 * k, "kienzle": {"kc11": 1700, "mc": 0.25},
+           "feed_plan": {"target_thickness": 0.002 * k, "max_feed": 60.0 * k, "min_block_length": 0.02 * k},
+           "block_time_ms": 4})
+}
+
 /// `body` in inch (`units: inch`) and its mm twin.
 fn pair(request: fn(f64) -> Value) -> (Value, Value) {
     let mut inch = request(1.0);
@@ -157,7 +204,11 @@ fn pair(request: fn(f64) -> Value) -> (Value, Value) {
 #[tokio::test]
 async fn inch_answers_are_the_mm_answers_divided_by_25_4() {
     let app = TestApp::spawn().await;
-    for (endpoint, request) in [("segment", segment_request as fn(f64) -> Value), ("contour", contour_request)] {
+    for (endpoint, request) in [
+        ("segment", segment_request as fn(f64) -> Value),
+        ("contour", contour_request),
+        ("engagement", engagement_request),
+    ] {
         let (inch, mm) = pair(request);
         let inch_answer = json_with(app.post_json(&format!("/api/v1/{endpoint}"), &inch).await, 200).await;
         let mm_answer = json_with(app.post_json(&format!("/api/v1/{endpoint}"), &mm).await, 200).await;
@@ -176,6 +227,7 @@ async fn inch_programs_move_as_the_mm_programs_in_rs274() {
         ("segment", "", segment_request as fn(f64) -> Value),
         ("contour", "&arcs=g2g3", contour_request),
         ("contour", "", contour_request),
+        ("engagement", "", engagement_request),
     ] {
         let (inch, mm) = pair(request);
         for dialect in ["linuxcnc", "fanuc", "haas"] {
@@ -224,7 +276,9 @@ async fn every_post_writes_inch_programs_in_its_own_words() {
 #[tokio::test]
 async fn a_bad_units_value_is_refused_naming_units() {
     let app = TestApp::spawn().await;
-    for (endpoint, mut body) in [("segment", segment_request(1.0)), ("contour", contour_request(1.0))] {
+    for (endpoint, mut body) in
+        [("segment", segment_request(1.0)), ("contour", contour_request(1.0)), ("engagement", engagement_request(1.0))]
+    {
         body["units"] = json!("furlong");
         let response = app.post_json(&format!("/api/v1/{endpoint}"), &body).await;
         let status = response.status().as_u16();
