@@ -547,4 +547,8 @@ pub struct DeburrRequest {
     /// coarser than `tolerance`; the summary then reports the blocks.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub block_time_ms: Option<f64>,
+    /// `mm` or `inch`: the units of every length (and, per minute, feed) in this request and its
+    /// answer (default: the named machine's `units`, else `mm`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<crate::units::Units>,
 }

@@ -76,6 +76,7 @@ fn request(case: &Value) -> (DeburrRequest, Tool) {
         safe_z: None,
         machine: None,
         block_time_ms: None,
+        units: None,
     };
     (request, tool)
 }

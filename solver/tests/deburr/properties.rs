@@ -96,6 +96,7 @@ fn case() -> impl Strategy<Value = Case> {
                 safe_z: None,
                 machine: None,
                 block_time_ms: None,
+                units: None,
             };
             Case { request, tool, cylinder_radius: r1, width }
         })
@@ -234,6 +235,7 @@ proptest! {
             safe_z: None,
             machine: None,
             block_time_ms: None,
+            units: None,
         };
         match deburr::solve(&request, &tool) {
             Ok(result) => {

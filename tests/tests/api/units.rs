@@ -88,6 +88,20 @@ const LENGTHS: &[&str] = &[
     "from_s",
     "to_s",
     "feed_range",
+    // deburr
+    "tip",
+    "centre_offset",
+    "cut_amount",
+    "width",
+    "true_width_min",
+    "true_width_max",
+    "swept_width_min",
+    "swept_width_max",
+    "max_exact_offset",
+    "safe_centre_z",
+    "axial_position",
+    "travel",
+    "request_order_travel",
 ];
 
 /// Keys whose numbers are areas.
@@ -105,8 +119,13 @@ enum Kind {
     Volume,
 }
 
+/// Keys whose numbers are never converted, even inside a length's object (deburr's `points`).
+const UNSCALED: &[&str] = &["parameter"];
+
 fn kind_of(key: &str, inherited: Kind) -> Kind {
-    if LENGTHS.contains(&key) {
+    if key.ends_with("_deg") || UNSCALED.contains(&key) {
+        Kind::Same
+    } else if LENGTHS.contains(&key) {
         Kind::Length
     } else if AREAS.contains(&key) {
         Kind::Area
@@ -194,6 +213,18 @@ fn engagement_request(k: f64) -> Value {
            "block_time_ms": 4})
 }
 
+/// A deburr request in units of `k` mm: both ridges of a round hole and a slot in a tube, inline
+/// ball tools, the exact method and a block time.
+fn deburr_request(k: f64) -> Value {
+    json!({"tool": {"kind": "ball", "radius": 0.12 * k}, "inner_tool": {"kind": "ball", "radius": 0.08 * k},
+           "workpiece": {"kind": "tube", "origin": [0.1 * k, 0.2 * k, 0], "inner_diameter": 1.2 * k, "outer_radius": k},
+           "holes": [{"shape": "round", "radius": 0.3 * k},
+                     {"shape": "slot", "radius": 0.2 * k, "centre_distance": 0.3 * k, "penetration_angle_deg": 45,
+                      "axial_position": 1.5 * k}],
+           "edge": "both", "width": 0.02 * k, "tolerance": 0.0005 * k, "method": "exact", "feed": 12.0 * k,
+           "clearance": 0.2 * k, "lead_distance": 0.04 * k, "spindle_rpm": 8000, "block_time_ms": 2})
+}
+
 /// `body` in inch (`units: inch`) and its mm twin.
 fn pair(request: fn(f64) -> Value) -> (Value, Value) {
     let mut inch = request(1.0);
@@ -208,6 +239,7 @@ async fn inch_answers_are_the_mm_answers_divided_by_25_4() {
         ("segment", segment_request as fn(f64) -> Value),
         ("contour", contour_request),
         ("engagement", engagement_request),
+        ("deburr", deburr_request),
     ] {
         let (inch, mm) = pair(request);
         let inch_answer = json_with(app.post_json(&format!("/api/v1/{endpoint}"), &inch).await, 200).await;
@@ -228,6 +260,7 @@ async fn inch_programs_move_as_the_mm_programs_in_rs274() {
         ("contour", "&arcs=g2g3", contour_request),
         ("contour", "", contour_request),
         ("engagement", "", engagement_request),
+        ("deburr", "", deburr_request),
     ] {
         let (inch, mm) = pair(request);
         for dialect in ["linuxcnc", "fanuc", "haas"] {
@@ -318,11 +351,18 @@ async fn machine_units_are_stored_and_are_the_requests_default(store: Store) {
     let program = app.post_text("/api/v1/segment?format=gcode", &inch, 200).await;
     assert!(program.starts_with("%\nO01001") && program.contains("\nG20 G17"), "{program}");
 
-    // A capability that reads mm only refuses a request whose machine is in inch, at `units`.
+    // A deburr request naming it is read in inch too, its stored tool staying in mm.
     app.register_tool(7, &json!({"kind": "ball", "radius": 3})).await;
-    let mut deburr = kerf_cases::deburr::tube_request();
+    let mut deburr = deburr_request(1.0);
+    deburr["tool"] = json!(7);
     deburr["machine"] = json!("vf2");
-    let refused = problem(app.post_json("/api/v1/deburr", &deburr).await, 422).await;
+    let answer = json_with(app.post_json("/api/v1/deburr", &deburr).await, 200).await;
+    assert_eq!(answer["units"], "inch");
+    assert_eq!(answer["tool"]["radius"], 3.0 / 25.4, "the echoed tool in inch");
+
+    // A capability that reads mm only refuses a request whose machine is in inch, at `units`.
+    let resegment = json!({"program": "G00 X0 Y0\nG01 X1 F100\n", "block_time_ms": 4, "machine": "vf2"});
+    let refused = problem(app.post_json("/api/v1/resegment", &resegment).await, 422).await;
     assert!(refused.to_string().contains("units"), "{refused}");
 
     // Back to mm: the column and the profile follow.
