@@ -53,6 +53,7 @@ fn bench(c: &mut Criterion) {
         min_chord_error: None,
         tolerance: None,
         corner_angle_deg: None,
+        units: None,
     };
     let answer = resegment(&request, None, Control::default()).expect("resegments");
     eprintln!(

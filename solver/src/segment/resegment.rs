@@ -77,6 +77,10 @@ pub struct ResegmentRequest {
     /// (default 20): corners stay command points.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub corner_angle_deg: Option<f64>,
+    /// `mm` or `inch`: the units of `min_chord_error`, `tolerance` and the answer's lengths
+    /// (default: the named machine's `units`, else `mm`); the program keeps its own G20/G21.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<crate::units::Units>,
 }
 
 /// Block figures of a program's feed moves (`G1`, `G2`, `G3`; rapids are not counted).
@@ -208,6 +212,50 @@ impl Capability for ResegmentCapability {
         control: Control<'_>,
     ) -> Result<String, SolverError> {
         write(&request.program, &answer.cuts, control)
+    }
+
+    fn units(request: &ResegmentRequest) -> Option<crate::units::Units> {
+        request.units
+    }
+
+    /// The chord-error bounds; the program is read in its own G20/G21.
+    fn scale_request(request: &mut ResegmentRequest, scaling: crate::units::Scaling) -> Result<(), SolverError> {
+        use crate::units::Scale;
+        let ResegmentRequest {
+            program: _,
+            machine: _,
+            block_time_ms: _,
+            margin: _,
+            min_chord_error,
+            tolerance,
+            corner_angle_deg: _,
+            units: _,
+        } = request;
+        min_chord_error.scale(scaling);
+        tolerance.scale(scaling);
+        Ok(())
+    }
+
+    /// The echoed machine, the deviation and the chord error (the figures are counts and times;
+    /// the new blocks, kept for the program, stay in mm).
+    fn scale_answer(answer: &mut ResegmentAnswer, scaling: crate::units::Scaling) {
+        use crate::units::Scale;
+        let ResegmentAnswer {
+            machine,
+            block_time_ms: _,
+            lines: _,
+            runs: _,
+            run_moves: _,
+            before: _,
+            after: _,
+            max_deviation,
+            chord_error,
+            warnings: _,
+            cuts: _,
+        } = answer;
+        machine.scale(scaling);
+        max_deviation.scale(scaling);
+        chord_error.scale(scaling);
     }
 
     fn machine(answer: &ResegmentAnswer) -> Option<&MachineProfile> {
@@ -666,6 +714,7 @@ mod tests {
             min_chord_error: None,
             tolerance: None,
             corner_angle_deg: None,
+            units: None,
         }
     }
 

@@ -225,6 +225,37 @@ fn deburr_request(k: f64) -> Value {
            "clearance": 0.2 * k, "lead_distance": 0.04 * k, "spindle_rpm": 8000, "block_time_ms": 2})
 }
 
+/// A mm program (G21) of 0.1 mm G01 steps along a quarter circle of radius 20 mm at 3000 mm/min.
+fn dense_arc_program() -> String {
+    let mut text = String::from("G21 G17 G90\nG00 X20. Y0. Z5.\nG01 Z-1. F300\nG01 X20. Y0. F3000\n");
+    for k in 1..=314 {
+        let angle = f64::from(k) * 0.005;
+        text.push_str(&format!("X{:.4} Y{:.4}\n", 20.0 * angle.cos(), 20.0 * angle.sin()));
+    }
+    text.push_str("G00 Z5.\nM30\n");
+    text
+}
+
+/// A resegment request in inch keeps its program's G21 and reads its tolerances in inch: its
+/// answer is the mm twin's with the deviation and chord error divided by 25.4, its program the
+/// same text.
+#[tokio::test]
+async fn resegment_reads_its_tolerances_in_inch_and_keeps_the_programs_units() {
+    let app = TestApp::spawn().await;
+    let request = |k: f64| json!({"program": dense_arc_program(), "block_time_ms": 4, "tolerance": 0.0002 * k, "min_chord_error": 0.00004 * k});
+    let (inch, mm) = pair(request);
+    let inch_answer = json_with(app.post_json("/api/v1/resegment", &inch).await, 200).await;
+    let mm_answer = json_with(app.post_json("/api/v1/resegment", &mm).await, 200).await;
+    assert_eq!(inch_answer["units"], "inch");
+    assert!(mm_answer["max_deviation"].as_f64().unwrap() > 0.0, "{mm_answer}");
+    assert!(mm_answer["before"]["short_blocks"].as_u64().unwrap() > 100, "{mm_answer}");
+    assert_eq!(assert_in_inch("resegment", &inch_answer, &mm_answer, Kind::Same), 2);
+    let inch_program = app.post_text("/api/v1/resegment?format=gcode", &inch, 200).await;
+    let mm_program = app.post_text("/api/v1/resegment?format=gcode", &mm, 200).await;
+    assert_eq!(inch_program, mm_program);
+    assert!(inch_program.contains("G21") && !inch_program.contains("G20"), "{inch_program}");
+}
+
 /// `body` in inch (`units: inch`) and its mm twin.
 fn pair(request: fn(f64) -> Value) -> (Value, Value) {
     let mut inch = request(1.0);
@@ -360,10 +391,10 @@ async fn machine_units_are_stored_and_are_the_requests_default(store: Store) {
     assert_eq!(answer["units"], "inch");
     assert_eq!(answer["tool"]["radius"], 3.0 / 25.4, "the echoed tool in inch");
 
-    // A capability that reads mm only refuses a request whose machine is in inch, at `units`.
-    let resegment = json!({"program": "G00 X0 Y0\nG01 X1 F100\n", "block_time_ms": 4, "machine": "vf2"});
-    let refused = problem(app.post_json("/api/v1/resegment", &resegment).await, 422).await;
-    assert!(refused.to_string().contains("units"), "{refused}");
+    // Resegment reads its tolerances in the machine's units (its program keeps its own G21).
+    let resegment = json!({"program": dense_arc_program(), "block_time_ms": 4, "machine": "vf2"});
+    let answer = json_with(app.post_json("/api/v1/resegment", &resegment).await, 200).await;
+    assert_eq!(answer["units"], "inch");
 
     // Back to mm: the column and the profile follow.
     let metric = json!({"block_time_ms": 4, "max_feed": 5080, "dialect": "haas"});
