@@ -56,6 +56,7 @@ fn bench(c: &mut Criterion) {
         tolerance: None,
         corner_angle_deg: None,
         program_dialect: None,
+        units: None,
     };
     let answer = resegment(&request, None, Control::default()).expect("resegments");
     eprintln!(

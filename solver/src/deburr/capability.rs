@@ -213,6 +213,19 @@ impl Capability for DeburrCapability {
         }
     }
 
+    fn units(request: &DeburrRequest) -> Option<crate::units::Units> {
+        request.units
+    }
+
+    fn scale_request(request: &mut DeburrRequest, scaling: crate::units::Scaling) -> Result<(), SolverError> {
+        crate::units::Scale::scale(request, scaling);
+        Ok(())
+    }
+
+    fn scale_answer(answer: &mut DeburrAnswer, scaling: crate::units::Scaling) {
+        crate::units::Scale::scale(answer, scaling);
+    }
+
     fn machine(answer: &DeburrAnswer) -> Option<&MachineProfile> {
         answer.machine.as_ref()
     }

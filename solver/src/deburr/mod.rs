@@ -34,6 +34,7 @@ pub mod program;
 pub mod request;
 mod swept_width;
 mod tolerance;
+mod units;
 
 pub use answer::{Deburr, DeburrPoint, DeburrSummary, LeadMotion, LeadMove};
 pub use capability::{DeburrAnswer, DeburrCapability, HoleAnswer, VisitStop, VisitingOrder};

@@ -552,4 +552,8 @@ pub struct DeburrRequest {
     /// the dexel spacing.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub verification: Option<crate::verify::VerificationOptions>,
+    /// `mm` or `inch`: the units of every length (and, per minute, feed) in this request and its
+    /// answer (default: the named machine's `units`, else `mm`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<crate::units::Units>,
 }

@@ -205,6 +205,19 @@ impl Capability for EngagementCapability {
         super::program(&answer.result, candidate, &post)
     }
 
+    fn units(request: &EngagementRequest) -> Option<crate::units::Units> {
+        request.units
+    }
+
+    fn scale_request(request: &mut EngagementRequest, scaling: crate::units::Scaling) -> Result<(), SolverError> {
+        crate::units::Scale::scale(request, scaling);
+        Ok(())
+    }
+
+    fn scale_answer(answer: &mut EngagementAnswer, scaling: crate::units::Scaling) {
+        crate::units::Scale::scale(answer, scaling);
+    }
+
     fn machine(answer: &EngagementAnswer) -> Option<&MachineProfile> {
         answer.machine.as_ref()
     }

@@ -81,6 +81,7 @@ mod segments;
 mod series;
 mod stock;
 mod teeth;
+mod units;
 mod wire;
 
 pub use crate::geometry::Direction;

@@ -406,6 +406,11 @@ pub struct EngagementRequest {
     /// `kienzle`; 404 naming `material` when unknown).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
+    /// `mm` or `inch`: the units of every length (and, per minute, feed) in this request and its
+    /// answer (default: the named machine's `units`, else `mm`); `kienzle` stays in N/mm² and mm,
+    /// and a G-code path in its own G20/G21.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<crate::units::Units>,
 }
 
 fn yes() -> bool {

@@ -86,6 +86,10 @@ pub struct ResegmentRequest {
     /// machine's, or `?dialect=`) is re-posted line by line; in this one its lines stay as sent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub program_dialect: Option<Dialect>,
+    /// `mm` or `inch`: the units of `min_chord_error`, `tolerance` and the answer's lengths
+    /// (default: the named machine's `units`, else `mm`); the program keeps its own G20/G21.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<crate::units::Units>,
 }
 
 /// Block figures of a program's feed moves (`G1`, `G2`, `G3`; rapids are not counted).
@@ -228,6 +232,51 @@ impl Capability for ResegmentCapability {
             Some(target) => write_posted(&request.program, &answer.cuts, program_dialect(request)?, target, control),
             None => write(&request.program, &answer.cuts, control),
         }
+    }
+
+    fn units(request: &ResegmentRequest) -> Option<crate::units::Units> {
+        request.units
+    }
+
+    /// The chord-error bounds; the program is read in its own G20/G21.
+    fn scale_request(request: &mut ResegmentRequest, scaling: crate::units::Scaling) -> Result<(), SolverError> {
+        use crate::units::Scale;
+        let ResegmentRequest {
+            program: _,
+            machine: _,
+            block_time_ms: _,
+            margin: _,
+            min_chord_error,
+            tolerance,
+            corner_angle_deg: _,
+            program_dialect: _,
+            units: _,
+        } = request;
+        min_chord_error.scale(scaling);
+        tolerance.scale(scaling);
+        Ok(())
+    }
+
+    /// The echoed machine, the deviation and the chord error (the figures are counts and times;
+    /// the new blocks, kept for the program, stay in mm).
+    fn scale_answer(answer: &mut ResegmentAnswer, scaling: crate::units::Scaling) {
+        use crate::units::Scale;
+        let ResegmentAnswer {
+            machine,
+            block_time_ms: _,
+            lines: _,
+            runs: _,
+            run_moves: _,
+            before: _,
+            after: _,
+            max_deviation,
+            chord_error,
+            warnings: _,
+            cuts: _,
+        } = answer;
+        machine.scale(scaling);
+        max_deviation.scale(scaling);
+        chord_error.scale(scaling);
     }
 
     fn machine(answer: &ResegmentAnswer) -> Option<&MachineProfile> {
@@ -749,6 +798,7 @@ mod tests {
             tolerance: None,
             corner_angle_deg: None,
             program_dialect: None,
+            units: None,
         }
     }
 

@@ -77,6 +77,7 @@ fn request(case: &Value) -> (DeburrRequest, Tool) {
         machine: None,
         block_time_ms: None,
         verification: None,
+        units: None,
     };
     (request, tool)
 }

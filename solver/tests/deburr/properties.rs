@@ -97,6 +97,7 @@ fn case() -> impl Strategy<Value = Case> {
                 machine: None,
                 block_time_ms: None,
                 verification: None,
+                units: None,
             };
             Case { request, tool, cylinder_radius: r1, width }
         })
@@ -236,6 +237,7 @@ proptest! {
             machine: None,
             block_time_ms: None,
             verification: None,
+            units: None,
         };
         match deburr::solve(&request, &tool) {
             Ok(result) => {

@@ -65,10 +65,50 @@ const LENGTHS: &[&str] = &[
     "safe_z",
     "lead",
     "finest_arc_tolerance",
+    // engagement
+    "polygon",
+    "position",
+    "radial_depth",
+    "mean_chip_thickness",
+    "thickness",
+    "feed_per_tooth",
+    "max_thickness",
+    "mean_thickness",
+    "min_thickness",
+    "median_thickness",
+    "thickness_margin",
+    "thickness_limit",
+    "multi_tooth_intervals",
+    "step",
+    "engaged_intervals",
+    "max_engaged_at_s",
+    "max_radial_depth",
+    "axial_depth",
+    "target_thickness",
+    "from_s",
+    "to_s",
+    "feed_range",
+    // deburr
+    "tip",
+    "centre_offset",
+    "cut_amount",
+    "width",
+    "true_width_min",
+    "true_width_max",
+    "swept_width_min",
+    "swept_width_max",
+    "max_exact_offset",
+    "safe_centre_z",
+    "axial_position",
+    "travel",
+    "request_order_travel",
 ];
 
 /// Keys whose numbers are areas.
 const AREAS: &[&str] = &["left_area", "overcut_area"];
+
+/// Keys whose numbers are volumes (per minute).
+const VOLUMES: &[&str] = &["mrr", "max_mrr"];
 
 /// How a number at a key compares: as a length (÷ 25.4), an area (÷ 25.4²) or unchanged.
 #[derive(Clone, Copy, Debug)]
@@ -76,13 +116,21 @@ enum Kind {
     Same,
     Length,
     Area,
+    Volume,
 }
 
+/// Keys whose numbers are never converted, even inside a length's object (deburr's `points`).
+const UNSCALED: &[&str] = &["parameter"];
+
 fn kind_of(key: &str, inherited: Kind) -> Kind {
-    if LENGTHS.contains(&key) {
+    if key.ends_with("_deg") || UNSCALED.contains(&key) {
+        Kind::Same
+    } else if LENGTHS.contains(&key) {
         Kind::Length
     } else if AREAS.contains(&key) {
         Kind::Area
+    } else if VOLUMES.contains(&key) {
+        Kind::Volume
     } else {
         inherited
     }
@@ -115,6 +163,7 @@ fn assert_in_inch(path: &str, inch: &Value, mm: &Value, kind: Kind) -> usize {
                 Kind::Same => mm,
                 Kind::Length => mm / 25.4,
                 Kind::Area => mm / 25.4 / 25.4,
+                Kind::Volume => mm / 25.4 / 25.4 / 25.4,
             };
             assert!((inch - want).abs() <= 1e-9 * want.abs().max(1e-12), "{path}: {inch} in vs {mm} mm ({kind:?})");
             usize::from(!matches!(kind, Kind::Same))
@@ -147,6 +196,66 @@ fn contour_request(k: f64) -> Value {
            "passes": [{"allowance": 0.012 * k, "join": "round"}, {"allowance": 0}], "block_time_ms": 2})
 }
 
+/// An engagement request in units of `k` mm: a slot, an arc and a side cut through a plate with
+/// an inline tool, forces from inline Kienzle values (N/mm², never scaled), a feed plan and a block
+/// time.
+fn engagement_request(k: f64) -> Value {
+    json!({"tool": {"kind": "flat", "radius": 0.2 * k, "flutes": 3, "helix_deg": 30},
+           "stock": {"polygon": [[0, 0], [2.4 * k, 0], [2.4 * k, 1.6 * k], [0, 1.6 * k]]},
+           "path": {"start": [-0.4 * k, 0.8 * k], "segments": [
+               {"type": "line", "to": [1.2 * k, 0.8 * k]},
+               {"type": "arc", "to": [1.6 * k, 1.2 * k], "center": [1.2 * k, 1.2 * k], "dir": "ccw"},
+               {"type": "line", "to": [1.6 * k, 2.0 * k]}]},
+           "spindle_rpm": 8000, "feed_per_tooth": 0.002 * k, "flute_counts": [2, 3, 4],
+           "thickness_limit": 0.1 * k, "time_limit_s": 60, "step": 0.01 * k,
+           "axial_depth": 0.08 * k, "clearance": 0.2 * k, "kienzle": {"kc11": 1700, "mc": 0.25},
+           "feed_plan": {"target_thickness": 0.002 * k, "max_feed": 60.0 * k, "min_block_length": 0.02 * k},
+           "block_time_ms": 4})
+}
+
+/// A deburr request in units of `k` mm: both ridges of a round hole and a slot in a tube, inline
+/// ball tools, the exact method and a block time.
+fn deburr_request(k: f64) -> Value {
+    json!({"tool": {"kind": "ball", "radius": 0.12 * k}, "inner_tool": {"kind": "ball", "radius": 0.08 * k},
+           "workpiece": {"kind": "tube", "origin": [0.1 * k, 0.2 * k, 0], "inner_diameter": 1.2 * k, "outer_radius": k},
+           "holes": [{"shape": "round", "radius": 0.3 * k},
+                     {"shape": "slot", "radius": 0.2 * k, "centre_distance": 0.3 * k, "penetration_angle_deg": 45,
+                      "axial_position": 1.5 * k}],
+           "edge": "both", "width": 0.02 * k, "tolerance": 0.0005 * k, "method": "exact", "feed": 12.0 * k,
+           "clearance": 0.2 * k, "lead_distance": 0.04 * k, "spindle_rpm": 8000, "block_time_ms": 2})
+}
+
+/// A mm program (G21) of 0.1 mm G01 steps along a quarter circle of radius 20 mm at 3000 mm/min.
+fn dense_arc_program() -> String {
+    let mut text = String::from("G21 G17 G90\nG00 X20. Y0. Z5.\nG01 Z-1. F300\nG01 X20. Y0. F3000\n");
+    for k in 1..=314 {
+        let angle = f64::from(k) * 0.005;
+        text.push_str(&format!("X{:.4} Y{:.4}\n", 20.0 * angle.cos(), 20.0 * angle.sin()));
+    }
+    text.push_str("G00 Z5.\nM30\n");
+    text
+}
+
+/// A resegment request in inch keeps its program's G21 and reads its tolerances in inch: its
+/// answer is the mm twin's with the deviation and chord error divided by 25.4, its program the
+/// same text.
+#[tokio::test]
+async fn resegment_reads_its_tolerances_in_inch_and_keeps_the_programs_units() {
+    let app = TestApp::spawn().await;
+    let request = |k: f64| json!({"program": dense_arc_program(), "block_time_ms": 4, "tolerance": 0.0002 * k, "min_chord_error": 0.00004 * k});
+    let (inch, mm) = pair(request);
+    let inch_answer = json_with(app.post_json("/api/v1/resegment", &inch).await, 200).await;
+    let mm_answer = json_with(app.post_json("/api/v1/resegment", &mm).await, 200).await;
+    assert_eq!(inch_answer["units"], "inch");
+    assert!(mm_answer["max_deviation"].as_f64().unwrap() > 0.0, "{mm_answer}");
+    assert!(mm_answer["before"]["short_blocks"].as_u64().unwrap() > 100, "{mm_answer}");
+    assert_eq!(assert_in_inch("resegment", &inch_answer, &mm_answer, Kind::Same), 2);
+    let inch_program = app.post_text("/api/v1/resegment?format=gcode", &inch, 200).await;
+    let mm_program = app.post_text("/api/v1/resegment?format=gcode", &mm, 200).await;
+    assert_eq!(inch_program, mm_program);
+    assert!(inch_program.contains("G21") && !inch_program.contains("G20"), "{inch_program}");
+}
+
 /// `body` in inch (`units: inch`) and its mm twin.
 fn pair(request: fn(f64) -> Value) -> (Value, Value) {
     let mut inch = request(1.0);
@@ -157,7 +266,12 @@ fn pair(request: fn(f64) -> Value) -> (Value, Value) {
 #[tokio::test]
 async fn inch_answers_are_the_mm_answers_divided_by_25_4() {
     let app = TestApp::spawn().await;
-    for (endpoint, request) in [("segment", segment_request as fn(f64) -> Value), ("contour", contour_request)] {
+    for (endpoint, request) in [
+        ("segment", segment_request as fn(f64) -> Value),
+        ("contour", contour_request),
+        ("engagement", engagement_request),
+        ("deburr", deburr_request),
+    ] {
         let (inch, mm) = pair(request);
         let inch_answer = json_with(app.post_json(&format!("/api/v1/{endpoint}"), &inch).await, 200).await;
         let mm_answer = json_with(app.post_json(&format!("/api/v1/{endpoint}"), &mm).await, 200).await;
@@ -176,6 +290,8 @@ async fn inch_programs_move_as_the_mm_programs_in_rs274() {
         ("segment", "", segment_request as fn(f64) -> Value),
         ("contour", "&arcs=g2g3", contour_request),
         ("contour", "", contour_request),
+        ("engagement", "", engagement_request),
+        ("deburr", "", deburr_request),
     ] {
         let (inch, mm) = pair(request);
         for dialect in ["linuxcnc", "fanuc", "haas"] {
@@ -224,7 +340,9 @@ async fn every_post_writes_inch_programs_in_its_own_words() {
 #[tokio::test]
 async fn a_bad_units_value_is_refused_naming_units() {
     let app = TestApp::spawn().await;
-    for (endpoint, mut body) in [("segment", segment_request(1.0)), ("contour", contour_request(1.0))] {
+    for (endpoint, mut body) in
+        [("segment", segment_request(1.0)), ("contour", contour_request(1.0)), ("engagement", engagement_request(1.0))]
+    {
         body["units"] = json!("furlong");
         let response = app.post_json(&format!("/api/v1/{endpoint}"), &body).await;
         let status = response.status().as_u16();
@@ -264,12 +382,19 @@ async fn machine_units_are_stored_and_are_the_requests_default(store: Store) {
     let program = app.post_text("/api/v1/segment?format=gcode", &inch, 200).await;
     assert!(program.starts_with("%\nO01001") && program.contains("\nG20 G17"), "{program}");
 
-    // A capability that reads mm only refuses a request whose machine is in inch, at `units`.
+    // A deburr request naming it is read in inch too, its stored tool staying in mm.
     app.register_tool(7, &json!({"kind": "ball", "radius": 3})).await;
-    let mut deburr = kerf_cases::deburr::tube_request();
+    let mut deburr = deburr_request(1.0);
+    deburr["tool"] = json!(7);
     deburr["machine"] = json!("vf2");
-    let refused = problem(app.post_json("/api/v1/deburr", &deburr).await, 422).await;
-    assert!(refused.to_string().contains("units"), "{refused}");
+    let answer = json_with(app.post_json("/api/v1/deburr", &deburr).await, 200).await;
+    assert_eq!(answer["units"], "inch");
+    assert_eq!(answer["tool"]["radius"], 3.0 / 25.4, "the echoed tool in inch");
+
+    // Resegment reads its tolerances in the machine's units (its program keeps its own G21).
+    let resegment = json!({"program": dense_arc_program(), "block_time_ms": 4, "machine": "vf2"});
+    let answer = json_with(app.post_json("/api/v1/resegment", &resegment).await, 200).await;
+    assert_eq!(answer["units"], "inch");
 
     // Back to mm: the column and the profile follow.
     let metric = json!({"block_time_ms": 4, "max_feed": 5080, "dialect": "haas"});
