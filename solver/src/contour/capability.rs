@@ -305,7 +305,15 @@ fn prism(request: &ContourRequest, tool: &Tool, reliefs: Vec<[f64; 2]>, wall_tol
 /// refused up front.
 fn verification_grid(request: &ContourRequest, tool: &Tool) -> Result<Option<own::Grid>, SolverError> {
     let options = request.verification.unwrap_or_default();
-    if !options.enabled || request.contour.is_empty() || !tool.radius.is_finite() || tool.radius <= 0.0 {
+    // A request the solve's validation refuses is refused there, naming its field, not here by
+    // the size of a grid over an outline out of range.
+    let in_range = |value: f64| value.abs() <= crate::validate::MAX_COORDINATE;
+    if !options.enabled
+        || request.contour.is_empty()
+        || !request.contour.iter().flatten().all(|value| in_range(*value))
+        || !tool.radius.is_finite()
+        || tool.radius <= 0.0
+    {
         return Ok(None);
     }
     let model = prism(request, tool, Vec::new(), 0.0);

@@ -435,8 +435,13 @@ pub fn cut_stock_glb(
     let shading = Shading { part: job.part.is_some(), tolerance: job.tolerance, allowance: job.allowance };
     let (extras, stock) = match simulate::cut_stock(&job, run) {
         Ok((cut, stock)) => {
-            let answer = serde_json::to_value(VerifyAnswer { tools, cut })
+            let mut answer = serde_json::to_value(VerifyAnswer { tools, cut })
                 .map_err(|error| SolverError::new(ErrorCode::Internal, error.to_string()))?;
+            // As the JSON answer, which names its units first (verify reads a program's G20/G21
+            // and answers in mm).
+            if let Value::Object(fields) = &mut answer {
+                fields.insert("units".to_owned(), Value::from("mm"));
+            }
             (json!({"verify": answer}), stock)
         }
         Err(error) if upto_line.is_some() && error.code() == ErrorCode::Stock => (json!({}), job.stock.field(job.grid)),

@@ -102,6 +102,10 @@ const LENGTHS: &[&str] = &[
     "axial_position",
     "travel",
     "request_order_travel",
+    // the verification of a program (volumes keep the mm³ their names say)
+    "resolution",
+    "wall_tolerance",
+    "depth",
 ];
 
 /// Keys whose numbers are areas.
