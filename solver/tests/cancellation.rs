@@ -60,18 +60,24 @@ fn cancel_during<T: Send>(
 ) -> (AfterRaise, Result<T, SolverError>) {
     let flag = AtomicBool::new(false);
     let (task_sender, task) = std::sync::mpsc::channel();
+    let (read_sender, read) = std::sync::mpsc::channel();
     std::thread::scope(|scope| {
         let flag = &flag;
         let running = scope.spawn(move || {
             let me = this_thread();
             task_sender.send(me.clone()).unwrap();
             let result = work(Control { progress: None, cancel: Some(flag) });
-            (Instant::now(), thread_cpu(&me), result)
+            let ended = Instant::now();
+            // The thread stays until its CPU time at the raise is read, so work that ended
+            // first (a busy machine may wake the raise late) is told apart from a missing thread.
+            read.recv().unwrap();
+            (ended, thread_cpu(&me), result)
         });
         let task = task.recv().unwrap();
         std::thread::sleep(raise_after);
         let (raised, cpu_at_raise) = (Instant::now(), thread_cpu(&task));
         flag.store(true, Ordering::Relaxed);
+        read_sender.send(()).unwrap();
         let (ended, cpu_at_end, result) = running.join().expect("the work does not panic");
         let after =
             AfterRaise { cpu: cpu_at_end.saturating_sub(cpu_at_raise), wall: ended.saturating_duration_since(raised) };
@@ -143,7 +149,9 @@ fn segment_solve_and_program_stop() {
 
 #[test]
 fn contour_solve_and_program_stop() {
-    let request = contour_request(3000, json!({"tolerance": 0.0005}));
+    // Layers enough that the faster writer still writes their program for longer than the
+    // raise; the program alone (its verification would cut it within the solve).
+    let request = contour_request(6_000, json!({"tolerance": 0.0005, "verification": {"enabled": false}}));
     stops("contour solve", |control| {
         solve::<ContourCapability>(&request, contour_context(false), Purpose::Program, control)
     });
@@ -151,7 +159,8 @@ fn contour_solve_and_program_stop() {
         solve::<ContourCapability>(&request, contour_context(false), Purpose::Program, Control::default()).unwrap();
     for arcs in [Arcs::Chords, Arcs::G2g3] {
         let output = OutputOptions { arcs: Some(arcs), ..OutputOptions::default() };
-        stops(&format!("contour program ({arcs:?})"), |control| {
+        // With arcs the program is a few blocks a layer: raised early.
+        stops_raised_after(&format!("contour program ({arcs:?})"), Duration::from_millis(5), |control| {
             program::<ContourCapability>(&request, &answer, &output, control)
         });
     }
