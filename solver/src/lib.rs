@@ -12,6 +12,8 @@
 #![deny(missing_docs)]
 
 pub mod capability;
+#[cfg(test)]
+mod chamfer_cut;
 pub mod contour;
 pub mod control;
 pub mod deburr;

@@ -78,6 +78,7 @@ mod relief;
 mod report;
 pub mod request;
 mod solve;
+mod units;
 mod wire;
 
 pub use answer::{

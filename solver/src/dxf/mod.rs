@@ -30,51 +30,7 @@ pub const MAX_ENTITIES: usize = 1_000_000;
 /// Most points of all loops together.
 pub const MAX_POINTS: usize = 2_000_000;
 
-/// Length units of a drawing.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
-#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
-#[serde(rename_all = "snake_case")]
-pub enum DrawingUnits {
-    /// Millimetres (`$INSUNITS` 4).
-    Mm,
-    /// Centimetres (5).
-    Cm,
-    /// Metres (6).
-    M,
-    /// Inches (1).
-    Inch,
-    /// Feet (2).
-    Foot,
-    /// Micrometres (13).
-    Micron,
-}
-
-impl DrawingUnits {
-    /// Millimetres per unit.
-    pub fn scale(self) -> f64 {
-        match self {
-            Self::Mm => 1.0,
-            Self::Cm => 10.0,
-            Self::M => 1000.0,
-            Self::Inch => 25.4,
-            Self::Foot => 304.8,
-            Self::Micron => 0.001,
-        }
-    }
-
-    /// The units of an `$INSUNITS` value; `None` for unitless (0) and units kerf does not take.
-    fn from_insunits(code: i64) -> Option<Self> {
-        Some(match code {
-            1 => Self::Inch,
-            2 => Self::Foot,
-            4 => Self::Mm,
-            5 => Self::Cm,
-            6 => Self::M,
-            13 => Self::Micron,
-            _ => return None,
-        })
-    }
-}
+pub use crate::units::DrawingUnits;
 
 /// How to read a drawing.
 #[derive(Debug, Clone, PartialEq)]
@@ -824,3 +780,41 @@ fn polyline(
 
 #[cfg(test)]
 mod tests;
+
+/// A DXF drawing's tolerances (its geometry is in the drawing's own units, `$INSUNITS` or `units`).
+impl crate::units::Scale for Drawing {
+    fn scale(&mut self, scaling: crate::units::Scaling) {
+        let Self { units: _, layer: _, island: _, join_tolerance, chord_tolerance } = self;
+        join_tolerance.scale(scaling);
+        chord_tolerance.scale(scaling);
+    }
+}
+
+/// Segment's `drawing` curve read from its file: here, so the reader's types stay below
+/// segment's.
+impl Curve {
+    /// A `drawing` curve read from `upload`, the DXF file sent with the request; any other curve
+    /// as it is (and then no file may be sent).
+    ///
+    /// # Errors
+    /// `E_INPUT`: a drawing without its file, a file without a drawing, the reader's refusals.
+    pub fn from_upload(&self, upload: Option<&[u8]>) -> Result<Option<Self>, crate::error::SolverError> {
+        match self {
+            Self::Drawing { units, layer, island, join_tolerance, chord_tolerance, corner_angle_deg } => {
+                let drawing = Drawing {
+                    units: *units,
+                    layer: layer.clone(),
+                    island: *island,
+                    join_tolerance: *join_tolerance,
+                    chord_tolerance: *chord_tolerance,
+                };
+                drawing.curve(upload, "curve", *corner_angle_deg).map(Some)
+            }
+            _ if upload.is_some() => Err(crate::error::SolverError::input(
+                "drawing",
+                "a DXF file was uploaded but curve.kind is not \"drawing\"",
+            )),
+            _ => Ok(None),
+        }
+    }
+}

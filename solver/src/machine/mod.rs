@@ -8,6 +8,7 @@ pub mod cycle;
 pub mod rule;
 mod spindle;
 pub mod stats;
+mod units;
 
 pub use rule::{BlockRule, ChordStatus, Infeasible, Mode, RuleSettings, block_time_from_saturation, chord_length};
 pub use spindle::SpindleLimits;

@@ -86,6 +86,7 @@ pub mod request;
 pub mod resegment;
 mod search;
 mod shape;
+mod units;
 mod wire;
 
 pub use answer::{CommandPoint, Comparison, SegmentSolution, SegmentWindow, WindowStatus};

@@ -113,7 +113,7 @@ pub enum Curve {
     Drawing {
         /// Units of a drawing that does not say them (`$INSUNITS` 0 or missing).
         #[serde(default, skip_serializing_if = "Option::is_none")]
-        units: Option<crate::dxf::DrawingUnits>,
+        units: Option<crate::units::DrawingUnits>,
         /// Only the entities of this layer (default all).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         layer: Option<String>,
@@ -131,33 +131,6 @@ pub enum Curve {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         corner_angle_deg: Option<f64>,
     },
-}
-
-impl Curve {
-    /// A `drawing` curve read from `upload`, the DXF file sent with the request; any other curve
-    /// as it is (and then no file may be sent).
-    ///
-    /// # Errors
-    /// `E_INPUT`: a drawing without its file, a file without a drawing, the reader's refusals.
-    pub fn from_upload(&self, upload: Option<&[u8]>) -> Result<Option<Self>, crate::error::SolverError> {
-        match self {
-            Self::Drawing { units, layer, island, join_tolerance, chord_tolerance, corner_angle_deg } => {
-                let drawing = crate::dxf::Drawing {
-                    units: *units,
-                    layer: layer.clone(),
-                    island: *island,
-                    join_tolerance: *join_tolerance,
-                    chord_tolerance: *chord_tolerance,
-                };
-                drawing.curve(upload, "curve", *corner_angle_deg).map(Some)
-            }
-            _ if upload.is_some() => Err(crate::error::SolverError::input(
-                "drawing",
-                "a DXF file was uploaded but curve.kind is not \"drawing\"",
-            )),
-            _ => Ok(None),
-        }
-    }
 }
 
 /// The whole-curve rule of `mode: curve`.

@@ -10,16 +10,17 @@
 
 mod assembly;
 mod capability;
-mod dexel;
+pub(crate) mod dexel;
 mod job;
 mod mesh;
 pub mod own;
 pub mod request;
-mod simulate;
+pub(crate) mod simulate;
 mod solid;
 mod sweep;
 #[cfg(test)]
 mod tests;
+mod units;
 
 pub use assembly::{FLUTE_RADII, HOLDER_LENGTH, HOLDER_SHANK_DIAMETERS, Member, STICKOUT_RADII};
 pub use capability::{VerifyAnswer, VerifyCapability};
