@@ -2,27 +2,12 @@
 //! width W the deburr spec promises (docs/spec/verify.md §7, docs/spec/deburr.md §5.2). A
 //! crate-root test, as it drives both the deburr and verify modules.
 
-use serde_json::{Value, json};
+use serde_json::json;
 
 use crate::capability::Run;
-use crate::tool::{Tool, ToolRef};
-use crate::verify::{Found, VerifyRequest};
-
-fn request(body: Value) -> VerifyRequest {
-    serde_json::from_value(body).expect("a valid request")
-}
-
-/// The tools of `request` as resolution gives them (inline only here).
-fn tools(request: &VerifyRequest) -> Vec<Tool> {
-    request
-        .tools
-        .iter()
-        .map(|tool| match tool {
-            ToolRef::Inline(tool) => tool.clone(),
-            ToolRef::Number(_) => panic!("inline tools only"),
-        })
-        .collect()
-}
+use crate::tool::ToolRef;
+use crate::verify::Found;
+use crate::verify::tests::{request, tools};
 
 /// The chamfer kerf's deburr program cuts on reference case 1 (docs/spec/deburr.md §5.2: tube
 /// R 50 (bore 40) along y, hole R 10 along z, ball R 3, Q 0.5, so W = 0.7071), with `method`:

@@ -8,9 +8,8 @@
 
 use axum::Json;
 use axum::body::{Body, Bytes};
-use axum::extract::{DefaultBodyLimit, FromRef, FromRequest, Multipart, Request, State};
+use axum::extract::{DefaultBodyLimit, FromRef, FromRequest, Request, State};
 use axum::http::header;
-use kerf_solver::ErrorCode;
 use kerf_solver::dxf::{self, DrawingUnits, DxfOptions, Profile};
 use serde::Deserialize;
 use serde::de::DeserializeOwned;
@@ -19,7 +18,7 @@ use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
 use crate::error::{AppError, AppResult, Problem};
-use crate::extract::{AppJson, AppQuery, charged_body_bytes, media_type, parse_json};
+use crate::extract::{AppJson, AppQuery, charged_body_bytes, media_type};
 use crate::state::AppState;
 
 /// The form of a contour or segment request with its drawing (for the OpenAPI document).
@@ -57,7 +56,7 @@ where
         // The route lifts the default body limit; the form read from memory keeps that.
         let extensions = request.extensions().clone();
         let (body, share) = charged_body_bytes(request, &state, state.limits.max_upload_bytes).await?;
-        let read = state
+        let super::upload::Upload { request, mut files } = state
             .solve(move |_| {
                 let mut form = Request::new(Body::from(body));
                 *form.extensions_mut() = extensions;
@@ -65,55 +64,12 @@ where
                     form.headers_mut().insert(header::CONTENT_TYPE, content_type);
                 }
                 // The body is all in memory: the form's parts are split without waiting.
-                tokio::runtime::Handle::current().block_on(read_form::<T>(form))
+                tokio::runtime::Handle::current().block_on(super::upload::read_form::<T>(form, &["drawing"], "DXF"))
             })
             .await??;
         drop(share);
-        Ok(read)
+        Ok(Self(request, files.pop().flatten()))
     }
-}
-
-fn multipart_error(part: &str, error: &axum::extract::multipart::MultipartError) -> AppError {
-    AppError::bad_request(ErrorCode::Multipart, part, format!("{part}: {}", error.body_text()))
-}
-
-/// The parts of the form: `request` (the JSON) and `drawing` (the DXF file).
-async fn read_form<T: DeserializeOwned>(form: Request) -> AppResult<Submitted<T>> {
-    let mut multipart = Multipart::from_request(form, &())
-        .await
-        .map_err(|rejection| AppError::bad_request(ErrorCode::Multipart, "body", rejection.body_text()))?;
-    let (mut json, mut drawing): (Option<Bytes>, Option<Bytes>) = (None, None);
-    loop {
-        let field = match multipart.next_field().await {
-            Ok(Some(field)) => field,
-            Ok(None) => break,
-            Err(error) => return Err(multipart_error("body", &error)),
-        };
-        let name = field.name().unwrap_or_default().to_owned();
-        let slot = match name.as_str() {
-            "request" => &mut json,
-            "drawing" => &mut drawing,
-            _ => {
-                return Err(AppError::bad_request(
-                    ErrorCode::Multipart,
-                    if name.is_empty() { "body".to_owned() } else { name.clone() },
-                    format!("unexpected form part `{name}`: send `request` (the JSON) and `drawing` (the DXF file)"),
-                ));
-            }
-        };
-        if slot.is_some() {
-            return Err(AppError::bad_request(
-                ErrorCode::Multipart,
-                name.clone(),
-                format!("form part `{name}` is given twice"),
-            ));
-        }
-        *slot = Some(field.bytes().await.map_err(|error| multipart_error(&name, &error))?);
-    }
-    let json = json.ok_or_else(|| {
-        AppError::bad_request(ErrorCode::Multipart, "request", "the form has no part `request` with the JSON request")
-    })?;
-    Ok(Submitted(parse_json(&json)?, drawing))
 }
 
 /// A DXF file as the request body (for the OpenAPI document): its bytes as they are.

@@ -56,11 +56,12 @@ pub(crate) fn read<T: DeserializeOwned>(
         form.headers_mut().insert(header::CONTENT_TYPE, content_type);
     }
     // The body is all in memory: the form's parts are split without waiting for anything.
-    tokio::runtime::Handle::current().block_on(read_form(form, files))
+    tokio::runtime::Handle::current().block_on(read_form(form, files, "STL"))
 }
 
-/// The parts of the multipart form `form`: `request` (the JSON) and the files named `files`.
-async fn read_form<T: DeserializeOwned>(form: Request, files: &[&str]) -> AppResult<Upload<T>> {
+/// The parts of the multipart form `form`: `request` (the JSON) and the files named `files`, each
+/// a file of `kind` (`STL`, `DXF`) as the refusal of an unexpected part says.
+pub(crate) async fn read_form<T: DeserializeOwned>(form: Request, files: &[&str], kind: &str) -> AppResult<Upload<T>> {
     let mut multipart = Multipart::from_request(form, &())
         .await
         .map_err(|rejection| AppError::bad_request(ErrorCode::Multipart, "body", rejection.body_text()))?;
@@ -82,7 +83,7 @@ async fn read_form<T: DeserializeOwned>(form: Request, files: &[&str]) -> AppRes
                 ErrorCode::Multipart,
                 if name.is_empty() { "body".to_owned() } else { name.clone() },
                 format!(
-                    "unexpected form part `{name}`: send `request` (the JSON) and {} (the STL file)",
+                    "unexpected form part `{name}`: send `request` (the JSON) and {} (the {kind} file)",
                     listed(files).replace(" or ", " and ")
                 ),
             ));

@@ -12,12 +12,12 @@ use crate::geometry::Vec3;
 use crate::predict::stl::tests::{binary_stl, box_triangles};
 use crate::tool::{Tool, ToolRef};
 
-fn request(body: Value) -> VerifyRequest {
+pub(crate) fn request(body: Value) -> VerifyRequest {
     serde_json::from_value(body).expect("a valid request")
 }
 
 /// The tools of `request` as resolution gives them (inline only here).
-fn tools(request: &VerifyRequest) -> Vec<Tool> {
+pub(crate) fn tools(request: &VerifyRequest) -> Vec<Tool> {
     request
         .tools
         .iter()
