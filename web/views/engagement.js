@@ -555,13 +555,13 @@ function renderColumn(column, result, answer, axis) {
     ['feed length, mm', number(result.feed_length, 2)],
     ['largest engaged angle, °', `${number(result.max_engaged_deg, 1)} at s ${number(result.max_engaged_at_s, 2)}`],
     ['max radial depth, mm', number(result.max_radial_depth, 3)],
-    ['engine, step', `${result.engine}, ${result.step} mm`],
+    ['engine, step', `${result.engine}, ${+result.step.toPrecision(4)} mm`],
     ['samples', result.samples.length],
   ];
   if (result.feed_plan) {
     const plan = result.feed_plan;
     items.push(['feed plan time, s', `${number(plan.time_s, 2)} (nominal ${number(plan.nominal_time_s, 2)})`]);
-    items.push(['planned feeds, mm/min', `${plan.feed_range[0]} – ${plan.feed_range[1]}`]);
+    items.push(['planned feeds, mm/min', `${+plan.feed_range[0].toPrecision(5)} – ${+plan.feed_range[1].toPrecision(5)}`]);
   }
   if (result.blocks) {
     const b = result.blocks;
