@@ -118,7 +118,23 @@ export function unitScenarios({ page, base }) {
       if (units !== 'inch' || !/haas-inch/.test(why) || segmentBody.units !== 'inch') throw new Error(`machine units not followed: ${units}, "${why}", ${segmentBody.units}`);
       if (radiusMm !== '50' || radiusInch !== '1.9685') throw new Error(`radius ${radiusMm} mm became ${radiusInch} in`);
       if (feedHint !== '5000 mm/min (machine)') throw new Error(`the machine's feed in an inch form: ${feedHint}`);
-      return { flipped, summary: inch.slice(0, 120), readout, why, feedHint };
+
+      // A job's operation is shown in the units of its answer, whatever the switch: the inch
+      // contour request the page sent, run as a job and opened with the switch at mm.
+      const job = await fetch(`${base}/api/v1/jobs`, {
+        method: 'POST',
+        headers: { 'content-type': 'application/json' },
+        body: JSON.stringify({ name: 'inch contour', operations: [{ operation: 'contour', ...body }] }),
+      });
+      if (job.status !== 202) throw new Error(`the job was not queued: ${job.status} ${await job.text()}`);
+      await page.selectOption('#units', 'mm');
+      await page.goto(`${base}/#/jobs`);
+      await page.waitForSelector('#job-rows tr[data-status="done"]', { timeout: 120000 });
+      await page.click('#job-rows tr[data-status="done"] button');
+      await page.waitForSelector('#job-result[data-state="shown"]', { timeout: 60000 });
+      const jobSummary = await page.textContent('#job-result .summary');
+      if (!/tool Ø, in\s*0\.250/.test(jobSummary) || /\bmm\b/.test(jobSummary)) throw new Error(`the inch job's summary: ${jobSummary}`);
+      return { flipped, summary: inch.slice(0, 120), readout, why, feedHint, jobSummary: jobSummary.slice(0, 120) };
     },
 
     // The machine form offers every post the service has (the Dialect enum of its OpenAPI
