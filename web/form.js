@@ -369,8 +369,10 @@ export function loadTools(select, inlineLabel, accepts = () => true, describe = 
     const chosen = select.value;
     const table = await tools();
     select.replaceChildren(new Option(inlineLabel, 'inline'));
+    // A stored tool's sizes are in mm whatever the form's units: said so in an inch form.
+    const inMm = unitsOf(select) === 'inch' ? ' (mm)' : '';
     for (const tool of table.values()) {
-      if (accepts(tool)) select.append(new Option(describe(tool), String(tool.number)));
+      if (accepts(tool)) select.append(new Option(`${describe(tool)}${inMm}`, String(tool.number)));
     }
     select.tools = table;
     restoreChoice(select, chosen);
@@ -378,6 +380,7 @@ export function loadTools(select, inlineLabel, accepts = () => true, describe = 
   // The inline choice is there at once, so a form sent before the table arrives is still whole.
   if (!select.options.length) select.append(new Option(inlineLabel, 'inline'));
   onShow(select, fill);
+  select.form?.addEventListener('kerf:units', fill);
   return track(select.form, fill());
 }
 
@@ -389,7 +392,7 @@ export function loadMachines(select, noneLabel = 'none') {
     const table = await machines();
     select.replaceChildren(new Option(noneLabel, ''));
     for (const machine of table.values()) {
-      select.append(new Option(`${machine.name}: ${machine.block_time_ms} ms, ${machine.max_feed} mm/min, ${machine.dialect}`, machine.name));
+      select.append(new Option(`${machine.name}: ${machine.block_time_ms} ms, ${machine.max_feed} mm/min, ${machine.dialect}${machine.units ? `, ${machine.units}` : ''}`, machine.name));
     }
     select.machines = table;
     restoreChoice(select, chosen);

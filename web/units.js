@@ -278,5 +278,7 @@ export function unitsSwitch() {
   const select = document.getElementById('units');
   select.value = currentUnits();
   select.addEventListener('change', () => setUnits(select.value));
+  // Off in the markup until here, so a choice made while the page loads is not lost.
+  select.disabled = false;
   followWords(document.getElementById('view'));
 }

@@ -157,9 +157,14 @@ export function unitScenarios({ page, base }) {
       const row = await page.textContent('#machine-rows tr[data-machine="haas-smooth"]');
       if (!/G187 P2/.test(row) || !/inch/.test(row)) throw new Error(`row: ${row}`);
       // Edit shows the stored level; "none" sends no smoothing.
-      await page.click('#machine-rows tr[data-machine="haas-smooth"] button:has-text("Edit")');
-      await page.waitForFunction(() => document.querySelector('#machine-form select[name="haas_smoothing"]').value === '2', null, { timeout: 60000 });
+      // (Edit reads the stored version's ETag, which the save sends as If-Match.)
+      await Promise.all([
+        page.waitForResponse((r) => r.request().method() === 'GET' && /\/api\/v1\/machines\/haas-smooth$/.test(r.url()), { timeout: 60000 }),
+        page.click('#machine-rows tr[data-machine="haas-smooth"] button:has-text("Edit")'),
+      ]);
+      if (await page.inputValue('#machine-form select[name="haas_smoothing"]') !== '2') throw new Error('Edit did not show the smoothing level');
       await page.selectOption('#machine-form select[name="haas_smoothing"]', '');
+      await page.$eval('#machine-messages', (box) => box.replaceChildren());
       await page.click('#machine-save');
       await page.waitForFunction(() => /saved/.test(document.querySelector('#machine-messages .message.ok')?.textContent ?? ''), null, { timeout: 60000 });
       const cleared = await (await fetch(`${base}/api/v1/machines/haas-smooth`)).json();
