@@ -1,6 +1,7 @@
 // kerf page shell: the tabs and `#/view` routes (Back and Forward move between views), each view
 // mounted once in its own section so its form and result stay when another view is shown.
 import { decimalInputs } from '/form.js';
+import { mountUnits, prepareRoot, unitsSwitch } from '/units.js';
 import { VIEWS } from '/views.js';
 
 const mounted = new Map();
@@ -34,7 +35,9 @@ function show(view) {
     main.append(root);
     mounted.set(view.id, root);
     decimalInputs(root);
+    prepareRoot(root, view.id);
     view.mount(root, view.id);
+    mountUnits(root, view.id);
   } else {
     root.dispatchEvent(new Event('kerf:show'));
   }
@@ -47,6 +50,7 @@ document.getElementById('token-box').addEventListener('submit', (event) => {
   event.target.hidden = true;
 });
 
+unitsSwitch();
 const tabs = document.getElementById('tabs');
 for (const view of VIEWS) {
   const link = document.createElement('a');

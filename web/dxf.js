@@ -3,6 +3,7 @@
 // anything is computed), and the chosen loop fills the view's points box.
 import { api } from '/api.js';
 import { clearProblem, message, showProblem } from '/form.js';
+import { setUnits, unitsOf } from '/units.js';
 
 // The form fields: the file, the units of a drawing that has none, the layer, the loop.
 export const DXF_FIELDS = `
@@ -79,8 +80,12 @@ export function dxfUpload(form, { messages, fill }) {
     }
     loop.replaceChildren(new Option('outer boundary', 'boundary'), ...profile.islands.map((_, i) => new Option(`island ${i + 1}`, String(i + 1))));
     loop.disabled = profile.islands.length === 0;
+    // The points are the drawing's numbers: a drawing in mm or inch moves the units switch to
+    // its units (the values already typed are converted once), one in other units is said.
+    if (profile.units !== unitsOf(form) && ['mm', 'inch'].includes(profile.units)) setUnits(profile.units, `units of drawing ${file.name}`);
     choose();
     messages.replaceChildren(message('ok', `Read ${file.name}: ${profile.entities} entities in ${profile.units}, the outer boundary of ${profile.boundary.length} points and ${profile.islands.length} islands (layers: ${profile.layers.join(', ')}).`));
+    if (unitsOf(form) !== profile.units) messages.append(message('warning', `The drawing is in ${profile.units} and its points are in the box as the drawing gives them, but this view works in ${unitsOf(form)}: scale them, or read the drawing with its units as mm or inch.`));
   };
   form.elements.dxf_file.addEventListener('change', read);
   form.elements.dxf_units.addEventListener('change', read);

@@ -3,6 +3,7 @@
 // reading fields, the tool and machine choices (machine values as placeholders, only overrides
 // sent), errors at the field, warnings as sentences, the per-view state kept in local storage,
 // summaries and downloads.
+import { convertForm, inUnits, mmWords, UNIT_VIEWS, unitsOf } from '/units.js';
 import { api, machines, materials, plainFieldMessage, plainTitle, program, sentence, tagged, technical, tools } from '/api.js';
 
 // ---------------------------------------------------------------- reading fields
@@ -129,6 +130,15 @@ export async function answerAndProgram(path, body, query) {
   }
 }
 
+// The request a form of a view that takes units builds, with the units of its section (the
+// values were typed in them; the service converts at its edge). A request that says its units
+// keeps them.
+function withUnits(form, request) {
+  const root = form.closest('[data-view-root]');
+  if (!request || typeof request !== 'object' || !UNIT_VIEWS.includes(root?.dataset.viewRoot) || 'units' in request) return request;
+  return { ...request, units: unitsOf(form) };
+}
+
 // The flow of a form that asks the service, the same in every view. On submit the marks of an
 // earlier problem go and `read()` builds the request from the form (throwing a problem document
 // for input the page can already tell is wrong). `ask(request)` then asks the service while
@@ -149,7 +159,7 @@ export function submitFlow(form, { messages, result, read = () => null, ask, sho
     clearProblem(form);
     let request;
     try {
-      request = read();
+      request = withUnits(form, read());
     } catch (problem) {
       fail(problem);
       return;
@@ -183,7 +193,7 @@ export function downloadFlow(button, form, { messages, read, path, query, name, 
   button.addEventListener('click', async () => {
     if (!keepMarks) clearProblem(form);
     try {
-      const body = read();
+      const body = withUnits(form, read());
       const fileName = now(name);
       download(fileName, await program(path, body, now(query)));
       done?.();
@@ -205,6 +215,8 @@ export function showSummary(box, items) {
     const div = document.createElement('div');
     const b = document.createElement('b');
     b.textContent = String(value);
+    // A machine's value in a summary is in the profile's mm, whatever the answer's units.
+    if (/\(machine[:)]/.test(b.textContent)) b.dataset.unitsFixed = '';
     div.append(name, b);
     return div;
   }));
@@ -346,7 +358,8 @@ function restoreChoice(select, chosen) {
     select.value = wanted;
     delete select.dataset.wanted;
   }
-  if (select.value !== chosen) select.dispatchEvent(new Event('change', { bubbles: true }));
+  // Marked as put back, not chosen (a machine put back does not move the units switch).
+  if (select.value !== chosen) select.dispatchEvent(new CustomEvent('change', { bubbles: true, detail: 'restore' }));
 }
 
 // Fills a tool <select> with an "inline" entry and the table's tools that `accepts`, keeping
@@ -356,8 +369,10 @@ export function loadTools(select, inlineLabel, accepts = () => true, describe = 
     const chosen = select.value;
     const table = await tools();
     select.replaceChildren(new Option(inlineLabel, 'inline'));
+    // A stored tool's sizes are in mm whatever the form's units: said so in an inch form.
+    const inMm = unitsOf(select) === 'inch' ? ' (mm)' : '';
     for (const tool of table.values()) {
-      if (accepts(tool)) select.append(new Option(describe(tool), String(tool.number)));
+      if (accepts(tool)) select.append(new Option(`${describe(tool)}${inMm}`, String(tool.number)));
     }
     select.tools = table;
     restoreChoice(select, chosen);
@@ -365,6 +380,7 @@ export function loadTools(select, inlineLabel, accepts = () => true, describe = 
   // The inline choice is there at once, so a form sent before the table arrives is still whole.
   if (!select.options.length) select.append(new Option(inlineLabel, 'inline'));
   onShow(select, fill);
+  select.form?.addEventListener('kerf:units', fill);
   return track(select.form, fill());
 }
 
@@ -376,7 +392,7 @@ export function loadMachines(select, noneLabel = 'none') {
     const table = await machines();
     select.replaceChildren(new Option(noneLabel, ''));
     for (const machine of table.values()) {
-      select.append(new Option(`${machine.name}: ${machine.block_time_ms} ms, ${machine.max_feed} mm/min, ${machine.dialect}`, machine.name));
+      select.append(new Option(`${machine.name}: ${machine.block_time_ms} ms, ${machine.max_feed} mm/min, ${machine.dialect}${machine.units ? `, ${machine.units}` : ''}`, machine.name));
     }
     select.machines = table;
     restoreChoice(select, chosen);
@@ -426,7 +442,9 @@ export function machineFields(form, fields) {
         if (input.dataset.dirty !== 'true') input.value = '';
         // A value the machine does not set: the service's default, which is the example's.
         const fallback = input.defaultValue ? `${input.defaultValue} (default)` : input.dataset.placeholder;
-        input.placeholder = machine[key] == null ? fallback : `${machine[key]} (machine)`;
+        // A profile's values are in mm whatever the request's units: said so, not converted.
+        const mm = unitsOf(form) === 'inch' && mmWords(input) ? ` ${mmWords(input)}` : '';
+        input.placeholder = machine[key] == null ? fallback : `${machine[key]}${mm} (machine)`;
       } else {
         input.placeholder = input.dataset.placeholder;
         if (input.dataset.dirty !== 'true' && input.value === '') input.value = input.defaultValue;
@@ -435,12 +453,15 @@ export function machineFields(form, fields) {
   };
   select.addEventListener('change', apply);
   select.addEventListener('kerf:machines', apply);
+  form.addEventListener('kerf:units', apply);
 }
 
 // How a summary states a value that a machine may supply: "4 ms (machine: 2 ms, overridden)",
 // "2 ms (machine)" or "4 ms".
+// `unit` is in mm words; in an inch request the value used is in the request's units and the
+// machine's stays in the profile's mm.
 export function machineNote(used, unit, request, field, machine, key = field) {
-  const shown = `${used} ${unit}`.trim();
+  const shown = `${used} ${inUnits(unit, request?.units)}`.trim();
   if (!machine || machine[key] == null) return shown;
   if (request && request[field] !== undefined) return `${shown} (machine: ${machine[key]} ${unit}, overridden)`.replace(' ,', ',');
   return `${shown} (machine)`;
@@ -497,7 +518,7 @@ function snapshot(form) {
     fields[e.name] = e.type === 'checkbox' || e.type === 'radio' ? e.checked : e.value;
     if (e.dataset.dirty === 'true') dirty.push(e.name);
   }
-  return { fields, dirty };
+  return { fields, dirty, units: unitsOf(form) };
 }
 
 function restore(form, { fields = {}, dirty = [] }) {
@@ -517,6 +538,9 @@ function restore(form, { fields = {}, dirty = [] }) {
 export function keepForm(view, form, { onReset, more } = {}) {
   // Before a kept "6,5" is put back: a number field would drop it.
   form.querySelectorAll('input[type="number"]').forEach(decimalInput);
+  // The markup's examples are in mm: in an inch section they are converted once, so "Load
+  // example" gives the same part.
+  convertForm(form, 'mm', unitsOf(form));
   const saved = readState(view);
   const save = (extra = {}) => writeState(view, { ...(readState(view) || {}), ...snapshot(form), more: more?.save(), ...extra });
   form.addEventListener('input', (event) => {
@@ -556,6 +580,8 @@ export function keepForm(view, form, { onReset, more } = {}) {
   if (saved) {
     if (saved.more !== undefined) more?.restore(saved.more);
     restore(form, saved);
+    // Kept in other units (the switch flipped while this view was not open): converted once.
+    convertForm(form, saved.units ?? 'mm', unitsOf(form), { examples: false });
     form.dispatchEvent(new Event('change'));
     if (saved.computed) Promise.all(form.loading || []).then(() => form.requestSubmit());
   }

@@ -3,6 +3,7 @@
 // Prints one JSON line with what it saw; exits non-zero with the reason when a check fails.
 import { readFileSync } from 'node:fs';
 import { chromium } from 'playwright-core';
+import { unitScenarios } from './units.mjs';
 
 const [scenario, base, screenshot, jobFile, secondJobFile] = process.argv.slice(2);
 const browser = await chromium.launch({
@@ -1344,6 +1345,9 @@ hole = { shape = "round", diameter = 16 }
     return { findings: findings.length, marked: marked.length, red, removed: full, plunged };
   },
 };
+
+// Scenarios kept in files of their own.
+Object.assign(scenarios, unitScenarios({ page, base }));
 
 try {
   const result = await scenarios[scenario]();

@@ -1,5 +1,6 @@
 // What every 2-D plot of the page draws with: a canvas sized for the screen's pixel ratio and
 // cleared to white, a line legend, and round tick steps and tick labels.
+import { canvasText } from '/units.js';
 
 export const FONT = '14px system-ui, sans-serif';
 
@@ -35,7 +36,7 @@ export function legend(g, items, x = 12, y = 20) {
     g.stroke();
     g.setLineDash([]);
     g.fillStyle = '#222';
-    g.fillText(item.label, x + 30, y);
+    g.fillText(canvasText(g.canvas, item.label), x + 30, y);
     y += 20;
   }
 }

@@ -1,5 +1,6 @@
 // Line and bar charts: a chart of y against x with a log option (drawChart), charts of quantities
 // along a path sharing a cursor (PathChart), and bar charts per category (barChart).
+import { canvasText } from '/units.js';
 import { FONT, formatTick, legend, niceStep, sizeCanvas } from '/plot/canvas.js';
 
 // A chart of y against x (x along the curve, mm). series: [{label, points: [[x, y], ...], colour,
@@ -61,11 +62,11 @@ export function drawChart(canvas, series, options = {}) {
     g.beginPath(); g.moveTo(x, height - bottom); g.lineTo(x, height - bottom + 5); g.stroke();
     g.fillText(formatTick(v), x, height - bottom + 20);
   }
-  g.fillText(options.xLabel || '', (left + width - right) / 2, height - 6);
+  g.fillText(canvasText(g.canvas, options.xLabel || ''), (left + width - right) / 2, height - 6);
   g.save();
   g.translate(16, (top + height - bottom) / 2);
   g.rotate(-Math.PI / 2);
-  g.fillText(options.yLabel || '', 0, 0);
+  g.fillText(canvasText(g.canvas, options.yLabel || ''), 0, 0);
   g.restore();
   g.textAlign = 'left';
   // Series.
@@ -137,7 +138,7 @@ function drawLegendRows(g, placed) {
     g.stroke();
     g.setLineDash([]);
     g.fillStyle = '#1d2327';
-    g.fillText(item.label, x + 26, y);
+    g.fillText(canvasText(g.canvas, item.label), x + 26, y);
   }
 }
 
@@ -245,13 +246,13 @@ export class PathChart {
     g.fillStyle = '#1d2327';
     g.font = '13px system-ui, sans-serif';
     g.textBaseline = 'bottom';
-    g.fillText(spec.xLabel || '', (left + right) / 2, height - 2);
+    g.fillText(canvasText(g.canvas, spec.xLabel || ''), (left + right) / 2, height - 2);
     const vertical = (text, x) => {
       g.save();
       g.translate(x, (top + bottom) / 2);
       g.rotate(-Math.PI / 2);
       g.textBaseline = 'top';
-      g.fillText(text, 0, 0);
+      g.fillText(canvasText(g.canvas, text), 0, 0);
       g.restore();
     };
     vertical(spec.yLabel || '', 2);
@@ -384,9 +385,9 @@ export function barChart(parent, label, spec, height = 230) {
     g.font = '13px system-ui, sans-serif';
     g.textAlign = 'left';
     g.textBaseline = 'bottom';
-    g.fillText(fitText(g, spec.title, width - 16), Math.min(left, width < 520 ? 8 : left), legendHeight + 18);
+    g.fillText(fitText(g, canvasText(g.canvas, spec.title), width - 16), Math.min(left, width < 520 ? 8 : left), legendHeight + 18);
     g.textAlign = 'center';
-    g.fillText(spec.xLabel || '', (left + right) / 2, full - 2);
+    g.fillText(canvasText(g.canvas, spec.xLabel || ''), (left + right) / 2, full - 2);
     drawLegendRows(g, placed);
     canvas.dataset.state = 'drawn';
   };

@@ -2,6 +2,7 @@
 // (drag to pan, wheel to zoom about the pointer, double-click to fit; focused, arrow keys pan,
 // + and − zoom, 0 fits), and what each draws: a curve and its blocks (CurvePlan) or a contour
 // with its material, passes, corner marks and tool (ContourPlan).
+import { canvasText } from '/units.js';
 import { FONT, legend, roundLength, sizeCanvas } from '/plot/canvas.js';
 
 // Makes a plan usable from the keyboard: focusable; arrow keys pan, + and − zoom, 0 fits.
@@ -227,7 +228,7 @@ export class CurvePlan extends PlanView {
     g.stroke();
     g.fillStyle = '#222';
     g.font = FONT;
-    g.fillText(`${length < 1 ? length.toPrecision(1) : length} mm`, x + length * scale + 6, y);
+    g.fillText(canvasText(g.canvas, `${length < 1 ? length.toPrecision(1) : length} mm`), x + length * scale + 6, y);
   }
 }
 
@@ -369,7 +370,7 @@ export class ContourPlan extends PlanView {
       g.stroke();
       g.setLineDash([]);
       g.fillStyle = '#1d2327';
-      g.fillText(label, 42, y);
+      g.fillText(canvasText(g.canvas, label), 42, y);
       y += 21;
     }
   }
@@ -388,6 +389,6 @@ export class ContourPlan extends PlanView {
     g.stroke();
     g.fillStyle = '#1d2327';
     g.font = '14px sans-serif';
-    g.fillText(`${length} mm`, x, y - 7);
+    g.fillText(canvasText(g.canvas, `${length} mm`), x, y - 7);
   }
 }

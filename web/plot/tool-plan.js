@@ -1,5 +1,6 @@
 // The engagement view's plan: a tool moving over stock, always fitted to the canvas (it has no
 // pan or zoom), with the tool's engaged arcs at a cursor.
+import { canvasText } from '/units.js';
 import { sizeCanvas } from '/plot/canvas.js';
 
 // A plan view (XY, equal scales, fitted) of a tool moving over stock: `rings` filled under the
@@ -107,8 +108,9 @@ export class ToolPlan {
       g.fillStyle = item.colour;
       g.fillRect(lx, 4, 14, 10);
       g.fillStyle = '#1d2327';
-      g.fillText(item.label, lx + 17, 3);
-      lx += g.measureText(item.label).width + 30;
+      const label = canvasText(g.canvas, item.label);
+      g.fillText(label, lx + 17, 3);
+      lx += g.measureText(label).width + 30;
     }
     this.image = g.getImageData(0, 0, this.canvas.width, this.canvas.height);
     this.canvas.dataset.state = 'drawn';

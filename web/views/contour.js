@@ -28,7 +28,7 @@ const FORM = `
     </fieldset>
     <fieldset><legend>Contour</legend>
       <label class="stacked">Points <span class="hint">x, y a line; # comments</span>
-        <textarea name="points" rows="9" spellcheck="false" data-field="contour"></textarea></label>
+        <textarea name="points" rows="9" spellcheck="false" data-field="contour" data-dim="points"></textarea></label>
 ${DXF_FIELDS}
       <label>Side <select name="side" data-field="side">
         <option value="outside">outside (island, outer profile)</option><option value="inside">inside (pocket)</option></select></label>
@@ -44,7 +44,7 @@ ${DXF_FIELDS}
         <option value="arc">arc</option><option value="triangle">triangle</option><option value="parallelogram">parallelogram</option><option value="none">none</option></select></label>
       <label>Inside corners <select name="relief" data-field="inside_corner_relief">
         <option value="dogbone">dogbone relief</option><option value="tbone">T-bone relief</option><option value="none">none (fillet)</option></select></label>
-      <label>Roughing pass <select name="roughing">
+      <label>Roughing pass <select name="roughing" data-dim="length">
         <option value="0.3">0.3 mm, round joins</option><option value="">none</option></select></label>
     </fieldset>
     <fieldset><legend>Feeds</legend>

@@ -92,10 +92,12 @@ export function clearance(given, answer) {
   if (!(ball > 0)) return null;
   // The ball cuts the chamfer where the path starts: the ridge sits (W/2)/tan(α/2) inside the
   // ball at most (chamfer width W, least wedge angle α). Only a deeper cut counts as a collision.
+  // The check's slack and sampling step are set in mm; an inch answer's lengths are in inches.
+  const mm = answer.units === 'inch' ? 1 / 25.4 : 1;
   const s = answer.summary || {};
   const wedge = Math.max(5, s.wedge_angle_min_deg || 90) * Math.PI / 180;
   const width = Math.max(s.width || 0, s.true_width_max || 0);
-  const allowance = (width / 2) / Math.tan(wedge / 2) + (request.tolerance || 0) + 0.01;
+  const allowance = (width / 2) / Math.tan(wedge / 2) + (request.tolerance || 0) + 0.01 * mm;
   const shell = Math.max(ball - allowance, ball * 0.2);
   const ballInWall = (c) => inside(toLocal(c)) || SPHERE.some((d) => inside(toLocal([c[0] + d[0] * shell, c[1] + d[1] * shell, c[2] + d[2] * shell])));
 
@@ -107,7 +109,7 @@ export function clearance(given, answer) {
     [lastCentre, ...answer.lead_out.map((m) => m.centre)],
   ].filter((l) => l.length > 1);
   const approach = [];
-  const step = Math.max(0.05, Math.min(0.5, ball / 4));
+  const step = Math.max(0.05 * mm, Math.min(0.5 * mm, ball / 4));
   // Runs of consecutive sample points with the ball in the wall, as stretches of the lead.
   for (const lead of leads) {
     let run = null;
@@ -128,7 +130,7 @@ export function clearance(given, answer) {
 
   // The neck (or, without one, a shank as wide as the ball) straight up from the ball centre,
   // from where it leaves the ball to above the workpiece.
-  const neck = Math.min(tool.neck_radius ?? ball, ball) - 0.001;
+  const neck = Math.min(tool.neck_radius ?? ball, ball) - 0.001 * mm;
   // High enough to clear the workpiece however it is turned (it lies within √2·size of its origin).
   const top = workpiece.origin[2] + 1.5 * Math.max(...sizes, hole.radius * 2);
   const ring = Array.from({ length: 24 }, (_, i) => [Math.cos(i * Math.PI / 12), Math.sin(i * Math.PI / 12)]);

@@ -6,6 +6,7 @@ import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadTools, mach
 import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
 import { clearance, inRadii } from '/views/deburr-clearance.js';
+import { inUnits } from '/units.js';
 
 const FORM = `
 <div class="layout">
@@ -204,11 +205,11 @@ export function deburrResult(container, answer, context = {}) {
   scene.root.dataset.collisions = [blocked ? 'approach' : '', found?.neck.length ? 'neck' : ''].filter(Boolean).join(' ');
   const notes = [];
   if (blocked) {
-    scene.root.dataset.blocked = `the ball's way in or out runs through the wall for ${number(found.approachLength, 1)} mm (red in the view)`;
+    scene.root.dataset.blocked = `the ball's way in or out runs through the wall for ${number(found.approachLength, 1)} ${inUnits('mm', answer.units)} (red in the view)`;
     notes.push(message('error', `No G-code: ${scene.root.dataset.blocked}.`));
   }
   if (found?.neck.length) {
-    const part = tool.neck_radius ? `neck (radius ${tool.neck_radius} mm)` : 'shank (as wide as the ball: no neck given)';
+    const part = tool.neck_radius ? `neck (radius ${tool.neck_radius} ${inUnits('mm', answer.units)})` : 'shank (as wide as the ball: no neck given)';
     notes.push(message('warning', `The ${part} meets the wall at ${found.neck.length} of ${found.checked} path points checked (red dots).`));
   }
   scene.finish();

@@ -9,6 +9,7 @@
 import { api } from '/api.js';
 import { PathChart, barChart } from '/plot/charts.js';
 import { ToolPlan } from '/plot/tool-plan.js';
+import { examplePoints } from '/units.js';
 import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, message, number, numeric, POST_OPTIONS, programName, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
@@ -182,7 +183,7 @@ function addPath(form, name = '', text = '') {
   const box = document.createElement('div');
   box.className = 'engagement-path';
   box.innerHTML = `<label>Name <input type="text"></label>
-    <label>Points or G-code <textarea rows="4" spellcheck="false"></textarea></label>
+    <label>Points or G-code <textarea rows="4" spellcheck="false" data-dim="points"></textarea></label>
     <div class="actions"><label class="pick secondary">Open a G-code file<input type="file" accept=".nc,.ngc,.tap,.gcode,.cnc,.txt"></label>
       <button class="secondary" type="button">Remove</button></div>`;
   box.querySelector('input[type="file"]').addEventListener('change', async (event) => {
@@ -554,13 +555,13 @@ function renderColumn(column, result, answer, axis) {
     ['feed length, mm', number(result.feed_length, 2)],
     ['largest engaged angle, °', `${number(result.max_engaged_deg, 1)} at s ${number(result.max_engaged_at_s, 2)}`],
     ['max radial depth, mm', number(result.max_radial_depth, 3)],
-    ['engine, step', `${result.engine}, ${result.step} mm`],
+    ['engine, step', `${result.engine}, ${+result.step.toPrecision(4)} mm`],
     ['samples', result.samples.length],
   ];
   if (result.feed_plan) {
     const plan = result.feed_plan;
     items.push(['feed plan time, s', `${number(plan.time_s, 2)} (nominal ${number(plan.nominal_time_s, 2)})`]);
-    items.push(['planned feeds, mm/min', `${plan.feed_range[0]} – ${plan.feed_range[1]}`]);
+    items.push(['planned feeds, mm/min', `${+plan.feed_range[0].toPrecision(5)} – ${+plan.feed_range[1].toPrecision(5)}`]);
   }
   if (result.blocks) {
     const b = result.blocks;
@@ -766,7 +767,7 @@ export const engagementView = {
       },
       onReset: (clear) => {
         pathBoxes(form).forEach((box) => box.remove());
-        for (const sample of clear ? [{ name: 'path 1', text: '' }] : SAMPLE_PATHS) addPath(form, sample.name, sample.text);
+        for (const sample of clear ? [{ name: 'path 1', text: '' }] : SAMPLE_PATHS) addPath(form, sample.name, examplePoints(form, sample.text));
         fillCandidates();
       },
     });

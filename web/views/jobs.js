@@ -276,6 +276,8 @@ async function openJob(id, root) {
         actions.append(message('warning', `No G-code: ${sentence(result.gcode_problem)}`));
       }
       const view = document.createElement('div');
+      // Its labels and plots in the units the operation's answer is in (`units`, mm without).
+      view.dataset.units = result.result?.units === 'inch' ? 'inch' : 'mm';
       section.append(heading, actions, view);
       box.append(section);
       const show = resultView(result.operation) || ((c, r) => { c.textContent = JSON.stringify(r).slice(0, 2000); });

@@ -18,6 +18,8 @@ const FORM = `
     </fieldset>
     <fieldset><legend>Programs, motion and spindle (optional)</legend>
       <label>Chord error rule <select name="mode" data-field="mode"><option value="">default (window)</option><option value="window">window</option><option value="curve">curve</option><option value="guarantee">guarantee: no short block</option></select></label>
+      <label>Units of its requests and programs <select name="units" data-field="units"><option value="">default (mm)</option><option value="mm">mm</option><option value="inch">inch (G20)</option></select></label>
+      <label>Haas smoothing <select name="haas_smoothing" data-field="haas_smoothing"><option value="">none: the control's setting</option><option value="1">G187 P1 rough</option><option value="2">G187 P2 medium</option><option value="3">G187 P3 finish</option></select></label>
       <label>Circular moves <select name="arcs" data-field="arcs"><option value="">default (chords)</option><option value="chords">chords (G01)</option><option value="g2g3">G02/G03</option></select></label>
       <label>Plunge feed, mm/min <input name="plunge_feed" type="number" step="any" placeholder="half the cutting feed" data-field="plunge_feed"></label>
       <label>Acceleration, mm/s² <input name="max_accel" type="number" step="any" placeholder="none: no cycle time" data-field="max_accel"></label>
@@ -36,9 +38,9 @@ const FORM = `
   </form>
   <section>
     <div id="machine-messages"></div>
-    <div class="table-scroll"><table><thead><tr><th>name</th><th>block time, ms</th><th>max feed</th><th>dialect</th><th>margin</th><th>min chord error</th><th>description</th><th></th></tr></thead>
+    <div class="table-scroll"><table><thead><tr><th>name</th><th>block time, ms</th><th>max feed</th><th>dialect</th><th>units</th><th>margin</th><th>min chord error</th><th>description</th><th></th></tr></thead>
       <tbody id="machine-rows"></tbody></table></div>
-    <p class="hint">A request that names a machine takes its values as defaults: block time and margin for deburr, segment and contour, <code>max_feed</code> for segment and the engagement feed plan, the dialect for G-code.</p>
+    <p class="hint">A request that names a machine takes its values as defaults: block time and margin for deburr, segment and contour, <code>max_feed</code> for segment and the engagement feed plan, the dialect for G-code, and its units (mm or inch) for the requests that name it and give none: choosing a machine with units on a form moves the page's units switch to them. The profile's own values are in mm and mm/min whatever its units. Haas smoothing writes <code>G187 P1</code>–<code>P3</code> in the Haas post's programs; other posts ignore it.</p>
   </section>
 </div>`;
 
@@ -47,10 +49,10 @@ export const machinesView = registryView({
   plural: 'machines',
   title: 'Machine',
   form: FORM,
-  textFields: ['dialect', 'description', 'mode', 'arcs'],
-  numberFields: ['block_time_ms', 'max_feed', 'margin', 'min_chord_error', 'plunge_feed', 'max_accel', 'max_jerk', 'rapid_feed', 'tool_change_s', 'spindle_power_kw', 'spindle_torque_nm'],
-  columns: (machine) => [machine.block_time_ms, machine.max_feed, machine.dialect, machine.margin, machine.min_chord_error, machine.description],
-  describe: (machine) => [`${machine.block_time_ms} ms`, `${machine.max_feed} mm/min`, machine.dialect, machine.description].filter(Boolean).join(', '),
+  textFields: ['dialect', 'description', 'mode', 'arcs', 'units'],
+  numberFields: ['block_time_ms', 'max_feed', 'margin', 'min_chord_error', 'plunge_feed', 'max_accel', 'max_jerk', 'rapid_feed', 'tool_change_s', 'spindle_power_kw', 'spindle_torque_nm', 'haas_smoothing'],
+  columns: (machine) => [machine.block_time_ms, machine.max_feed, [machine.dialect, machine.haas_smoothing ? `G187 P${machine.haas_smoothing}` : ''].filter(Boolean).join(', '), machine.units ?? 'mm', machine.margin, machine.min_chord_error, machine.description],
+  describe: (machine) => [`${machine.block_time_ms} ms`, `${machine.max_feed} mm/min`, machine.dialect, machine.units, machine.haas_smoothing && `G187 P${machine.haas_smoothing}`, machine.description].filter(Boolean).join(', '),
   mount(root, form) {
     root.querySelector('#machine-saturation').addEventListener('click', () => {
       const length = parseDecimal(form.elements.test_block.value);

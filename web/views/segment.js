@@ -25,10 +25,10 @@ const FORM = `
       <label data-kinds="arc ellipse">End, ° <input name="end_deg" type="number" step="any" value="90" data-field="curve.end_deg"></label>
       <label data-kinds="ellipse">Rotation, ° <input name="rotation_deg" type="number" step="any" value="0" data-field="curve.rotation_deg"></label>
       <label data-kinds="circle arc ellipse">Direction <select name="direction" data-field="curve.direction"><option value="ccw">ccw</option><option value="cw">cw</option></select></label>
-      <label data-kinds="polyline">Points (x y [z] per line) <textarea name="points" rows="6" data-field="curve.points"></textarea></label>
+      <label data-kinds="polyline">Points (x y [z] per line) <textarea name="points" rows="6" data-field="curve.points" data-dim="points"></textarea></label>
       <div data-kinds="polyline">${DXF_FIELDS}</div>
       <label data-kinds="bspline">Degree (no unit) <input name="degree" type="number" min="1" max="5" value="3" data-field="curve.degree"></label>
-      <label data-kinds="bspline">Control points (x y [z] per line) <textarea name="control_points" rows="6" data-field="curve.control_points">0 0
+      <label data-kinds="bspline">Control points (x y [z] per line) <textarea name="control_points" rows="6" data-field="curve.control_points" data-dim="points">0 0
 40 0
 40 40
 0 40

@@ -366,3 +366,26 @@ async fn verify_page_lists_findings_at_their_lines() {
         "{result}"
     );
 }
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
+async fn the_units_switch_sends_inch_and_labels_plots_and_readouts_in_inches() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "units", &[]) else { return };
+    assert_eq!(result["flipped"], "0.23622", "{result}");
+    assert_eq!(result["feedHint"], "5000 mm/min (machine)", "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
+async fn the_machine_form_lists_every_post_and_saves_haas_smoothing() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "machinePosts", &[]) else { return };
+    assert_eq!(result["stored"]["haas_smoothing"], 2, "{result}");
+}
