@@ -362,18 +362,14 @@ pub(crate) fn sweep_cutter(
         Shape::Sphere => f64::NEG_INFINITY,
         Shape::Rounded { .. } | Shape::Cylinder { .. } => segment.low_z() + body.top,
     };
-    let capsule = segment.sweeps_capsule(body);
+    let bound = segment.low_bound(body);
     let mut queries = 0;
     for j in rows {
         let y = grid.y(j);
         let Some([from, to]) = segment.row(body.radius, y) else {
             continue;
         };
-        let columns = grid.span(0, from, to);
-        if capsule {
-            segment.lowest_on_row(body.radius, grid.origin[0], grid.spacing, columns.clone(), y, &mut scratch.lows);
-        }
-        for i in columns.clone() {
+        for i in grid.span(0, from, to) {
             let index = j * grid.nx + i;
             let ray = &mut stock.rays[index];
             let top = dexel::top(ray);
@@ -382,13 +378,13 @@ pub(crate) fn sweep_cutter(
             }
             let x = grid.x(i);
             queries += 1;
-            let low = if capsule {
-                scratch.lows[i - columns.start]
-            } else {
-                match segment.lowest(body, x, y) {
-                    Some(low) => low,
-                    None => continue,
-                }
+            // Most rays of a finishing pass are already at or below the body (cut by the
+            // moves before): the bound passes them over without the lowest point's roots.
+            if bound.is_some_and(|bound| top <= bound.at(x, y)) {
+                continue;
+            }
+            let Some(low) = segment.lowest(body, x, y) else {
+                continue;
             };
             if top <= low {
                 continue;
@@ -421,8 +417,6 @@ pub(crate) fn sweep_cutter(
 pub(crate) struct Scratch {
     /// The pieces removed from one ray.
     pieces: Vec<Interval>,
-    /// The body's lowest point on the rays of one row.
-    lows: Vec<f64>,
 }
 
 /// Cuts `job`'s program under `run` (progress, cancellation, the answer budget).

@@ -206,43 +206,36 @@ impl Segment {
         (d2 <= r2).then(|| z + radius - (r2 - d2).sqrt())
     }
 
-    /// Whether [`Self::lowest_on_row`] applies: `body` sweeps a capsule along this move.
-    pub fn sweeps_capsule(&self, body: &Body) -> bool {
-        self.sloping && body.is_round()
-    }
-
-    /// [`Self::lowest`] of a body that sweeps a capsule on the rays at x = `origin + (k + ½)·step`
-    /// for `k` in `columns` of the row at `y`, into `lows` (+∞ where it does not reach the ray):
-    /// the same operations as [`Self::capsule_low`], bit for bit, without branches, so that a
-    /// whole row is computed in vector registers.
-    pub fn lowest_on_row(
-        &self,
-        radius: f64,
-        origin: f64,
-        step: f64,
-        columns: std::ops::Range<usize>,
-        y: f64,
-        lows: &mut Vec<f64>,
-    ) {
-        let py = y - self.from[1];
-        let r2 = radius * radius;
-        let (from_z, to_z) = (self.from[2] + radius, self.to[2] + radius);
-        lows.clear();
-        lows.extend(columns.map(|k| {
-            let px = (origin + (k as f64 + 0.5) * step) - self.from[0];
-            let pu = px * self.ux + py * self.uy;
-            let pp = px * px + py * py;
-            let w = self.uu * (r2 - pp) + pu * pu;
-            let sigma = (self.vz * pu - (self.vv * w.max(0.0)).sqrt()) * self.inverse_uu;
-            let foot = pu + sigma * self.vz;
-            let on_move = self.from[2] + radius + sigma;
-            let before = foot < 0.0;
-            let d2 = if before { pp } else { pp - 2.0 * pu + self.uu };
-            let centre = if before { from_z } else { to_z };
-            let sphere = if d2 <= r2 { centre - (r2 - d2).max(0.0).sqrt() } else { f64::INFINITY };
-            let low = if foot >= 0.0 && foot <= self.vv { on_move } else { sphere };
-            if w < 0.0 { f64::INFINITY } else { low }
-        }));
+    /// A lower bound of [`Self::lowest`] of a round `body` (a ball end or a sphere) along this
+    /// move, for a move that is not vertical: cheaper than the lowest point itself (no square
+    /// root), so that the rays a move cannot lower are passed over before it is computed.
+    pub fn low_bound(&self, body: &Body) -> Option<LowBound> {
+        if !body.is_round() || self.uu < VERTICAL {
+            return None;
+        }
+        let radius = body.radius;
+        // The rounding of the lowest point as computed: the relative rounding of the heights, and
+        // the square root of the rounding of w in `capsule_low` (at most 4ε·|u|²(r² + 2|p|²) with
+        // |p| ≤ r + |u|), which its division by |u|² turns into at most 2√3·√ε·√(|v|²/|u|²)·(r + |u|)
+        // ≈ 4·10⁻⁸·√(|v|²/|u|²)·(r + |u|), and a grazing end sphere's √(r² − d²) (√ε·r): the margin
+        // is over twenty times the largest.
+        let length = self.uu.sqrt();
+        let margin = 1e-6
+            * (1.0
+                + radius
+                + self.from[2].abs()
+                + self.to[2].abs()
+                + (self.vv * self.inverse_uu).sqrt() * (radius + length));
+        Some(LowBound {
+            from: self.from,
+            ux: self.ux,
+            uy: self.uy,
+            vz: self.vz,
+            inverse_uu: self.inverse_uu,
+            radius,
+            half_curvature: 0.5 / radius,
+            margin,
+        })
     }
 
     /// Where the ray at `(px, py)` from the start leaves that capsule (the highest point of a
@@ -262,6 +255,35 @@ impl Segment {
         }
         let (z, d2) = if foot < 0.0 { (self.from[2], pp) } else { (self.to[2], pp - 2.0 * pu + self.uu) };
         (d2 <= r2).then(|| z + radius + (r2 - d2).sqrt())
+    }
+}
+
+/// [`Segment::low_bound`]: a ball of radius r is above the paraboloid of its tip,
+/// r − √(r² − d²) ≥ d²/(2r), so the lowest point of its sweep over a ray is at least the least of
+/// z(t) + dist(t)²/(2r) over the whole move, a quadratic in t whose least is in closed form; that
+/// less a margin for the rounding of both.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LowBound {
+    from: [f64; 3],
+    ux: f64,
+    uy: f64,
+    vz: f64,
+    inverse_uu: f64,
+    radius: f64,
+    /// 1 / (2r).
+    half_curvature: f64,
+    margin: f64,
+}
+
+impl LowBound {
+    /// The bound on the ray through `(x, y)`.
+    #[inline(always)]
+    pub fn at(&self, x: f64, y: f64) -> f64 {
+        let (px, py) = (x - self.from[0], y - self.from[1]);
+        // d/dt [t·v_z + |p − t·u|²/(2r)] = 0 at t = (p·u − r·v_z)/|u|².
+        let t = ((px * self.ux + py * self.uy - self.radius * self.vz) * self.inverse_uu).clamp(0.0, 1.0);
+        let (dx, dy) = (px - t * self.ux, py - t * self.uy);
+        self.from[2] + t * self.vz + (dx * dx + dy * dy) * self.half_curvature - self.margin
     }
 }
 
@@ -407,6 +429,47 @@ mod tests {
             let swapped = Segment::new([from[1], from[0], from[2]], [to[1], to[0], to[2]]);
             if swapped.lowest(&ball(radius), y, x).is_some() {
                 proptest::prop_assert!(swapped.row(radius, x).is_some_and(|[a, b]| a <= y && y <= b));
+            }
+        }
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(2048))]
+
+        #[test]
+        fn the_low_bound_is_below_the_lowest_point(
+            from in proptest::array::uniform3(-5.0..5.0f64),
+            to in proptest::array::uniform3(-5.0..5.0f64),
+            kind in 0..4usize,
+            along in 0.0..1.0f64,
+            angle in 0.0..std::f64::consts::TAU,
+            inside in prop::sample::select(vec![0.0, 1e-15, 1e-12, 1e-9, 1e-6, 1e-3, 0.1, 0.5, 0.9, -1e-12]),
+            shift in prop::sample::select(vec![0.0, 0.3, 250.0, -4000.0]),
+            radius in 0.05..6.0f64,
+        ) {
+            // Sloping, level, steep (nearly vertical) and long moves, away from the origin too.
+            let to = match kind {
+                0 => to,
+                1 => [to[0], to[1], from[2]],
+                2 => [from[0] + 1e-5 * to[0], from[1] + 1e-5 * to[1], to[2]],
+                _ => [from[0] + 40.0 * to[0], from[1] + 40.0 * to[1], to[2]],
+            };
+            let (from, to) = (from.map(|c| c + shift), to.map(|c| c + shift));
+            let segment = Segment::new(from, to);
+            // A ray at distance r·(1 − inside) from a point of the move: on the edge of its reach
+            // and just inside or outside, where the roots round the most.
+            let (x, y) = (
+                from[0] + along * (to[0] - from[0]) + radius * (1.0 - inside) * angle.cos(),
+                from[1] + along * (to[1] - from[1]) + radius * (1.0 - inside) * angle.sin(),
+            );
+            for body in [ball(radius), Body { member: Member::Cutter, shape: Shape::Sphere, radius, top: 2.0 * radius }] {
+                let Some(bound) = segment.low_bound(&body) else {
+                    proptest::prop_assert!(segment.uu < VERTICAL);
+                    continue;
+                };
+                if let Some(low) = segment.lowest(&body, x, y) {
+                    proptest::prop_assert!(bound.at(x, y) <= low, "{} > {low}", bound.at(x, y));
+                }
             }
         }
     }
