@@ -332,18 +332,14 @@ pub fn in_mm<'a, C: Capability>(
     Ok((capability::request_in_mm::<C>(request, units)?, units))
 }
 
-/// A refusal of a request written in `units`: the solver quotes lengths in mm, which the message
-/// then says.
-fn refusal_in(error: SolverError, units: Units) -> SolverError {
-    if units == Units::Mm || error.code() == kerf_solver::ErrorCode::Cancelled {
+/// A refusal of a request written in `units`: the solver writes its lengths and feeds in mm, which
+/// the message restates in the request's units (`Scaling::restate`).
+pub fn refusal_in(error: SolverError, units: Units) -> SolverError {
+    let Some(scaling) = units.from_mm() else { return error };
+    if error.code() == kerf_solver::ErrorCode::Cancelled {
         return error;
     }
-    let message = format!(
-        "{} (the request's lengths were converted from {} to mm: lengths in this message are in mm and feeds in mm/min)",
-        error.message(),
-        units.as_str()
-    );
-    let converted = SolverError::new(error.code(), message);
+    let converted = SolverError::new(error.code(), scaling.restate(error.message()));
     match error.field() {
         Some(field) => converted.at(field),
         None => converted,

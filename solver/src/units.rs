@@ -116,6 +116,140 @@ impl Scaling {
     pub fn apply(self, value: f64) -> f64 {
         if self.into_mm { value * self.mm_per_unit } else { value / self.mm_per_unit }
     }
+
+    /// The units other than mm this conversion is from or into.
+    pub fn units(self) -> Units {
+        if self.mm_per_unit == MM_PER_INCH { Units::Inch } else { Units::Mm }
+    }
+
+    /// `text` (a warning, a refusal's detail, a program's comment) written in mm, restated in the
+    /// units of this conversion's answer: every number followed by `mm`, `mm/min`, `mm/tooth`,
+    /// `mm²` or `mm³` is converted and followed by `in`, `in/min`, `in/tooth`, `in²` or `in³`, and
+    /// a unit named alone in parentheses, `(mm)`, `(mm/min)`, `(mm/tooth)`, is renamed. The
+    /// solvers write every length and feed of a message with its unit after it, so this one
+    /// rewrite at the edge restates them all. A conversion into mm leaves the text as it is.
+    #[must_use]
+    pub fn restate(self, text: &str) -> String {
+        if self.into_mm || self.units() == Units::Mm {
+            return text.to_owned();
+        }
+        restate_in(text, self.mm_per_unit)
+    }
+}
+
+/// A unit of a message, after a number: its text in mm and in inches, and the power of the length
+/// it holds (feeds per minute and per tooth are lengths).
+type MessageUnit = (&'static str, &'static str, i32);
+
+/// The units a message's numbers may carry, longest first where one begins another.
+const MESSAGE_UNITS: [MessageUnit; 5] =
+    [("mm/min", "in/min", 1), ("mm/tooth", "in/tooth", 1), ("mm²", "in²", 2), ("mm³", "in³", 3), ("mm", "in", 1)];
+
+/// Fewest decimals of a length restated in inches: 0.0001 in, the programs' step.
+const INCH_DECIMALS: usize = 4;
+
+/// [`Scaling::restate`] for inches of `mm_per_unit` millimetres.
+fn restate_in(text: &str, mm_per_unit: f64) -> String {
+    let mut out = String::with_capacity(text.len() + 16);
+    let mut rest = text;
+    while !rest.is_empty() {
+        if let Some((number, unit, used)) = number_with_unit(rest) {
+            let (value, digits) = number;
+            let value = value / mm_per_unit.powi(unit.2);
+            let decimals =
+                decimals_for(value, digits, if unit.2 == 1 && unit.0 != "mm/min" { INCH_DECIMALS } else { 1 });
+            out.push_str(&format!("{value:.decimals$} {}", unit.1));
+            rest = &rest[used..];
+            continue;
+        }
+        if let Some(renamed) = ["(mm/min)", "(mm/tooth)", "(mm)"].iter().find(|name| rest.starts_with(**name)) {
+            out.push_str(&renamed.replace("mm", "in"));
+            rest = &rest[renamed.len()..];
+            continue;
+        }
+        // Copy up to the start of the next token (a digit or sign after a non-word character, or
+        // an opening parenthesis) in one step.
+        let mut chars = rest.char_indices();
+        let (_, first) = chars.next().expect("not empty");
+        let mut end = first.len_utf8();
+        if first.is_alphanumeric() || first == '_' || first == '.' {
+            // Inside a word or a number that is not a length: to the word's end.
+            for (index, c) in chars {
+                if !(c.is_alphanumeric() || c == '_' || c == '.') {
+                    break;
+                }
+                end = index + c.len_utf8();
+            }
+        }
+        out.push_str(&rest[..end]);
+        rest = &rest[end..];
+    }
+    out
+}
+
+/// The decimals that give `value` the significant `digits` its mm text had (at least 4, at most
+/// 8 of them), never fewer than `least` nor more than 12.
+fn decimals_for(value: f64, digits: usize, least: usize) -> usize {
+    let digits = digits.clamp(4, 8) as i32;
+    let magnitude = if value == 0.0 { 0 } else { value.abs().log10().floor() as i32 };
+    usize::try_from(digits - 1 - magnitude).unwrap_or(0).clamp(least, 12)
+}
+
+/// A number at the start of `text` followed by a unit of [`MESSAGE_UNITS`] (one space or none
+/// between, the unit not running on into a word): the number's value and significant digits, the
+/// unit, and the bytes they take.
+fn number_with_unit(text: &str) -> Option<((f64, usize), MessageUnit, usize)> {
+    let bytes = text.as_bytes();
+    let mut end = 0;
+    if matches!(bytes.first(), Some(b'-' | b'+')) {
+        end = 1;
+    }
+    let start_digits = end;
+    let mut digits = 0;
+    let mut leading = true;
+    let mut seen_point = false;
+    while let Some(&b) = bytes.get(end) {
+        if b.is_ascii_digit() {
+            // Leading zeros only place the digits.
+            if b != b'0' || !leading {
+                leading = false;
+                digits += 1;
+            }
+            end += 1;
+        } else if b == b'.' && !seen_point && bytes.get(end + 1).is_some_and(u8::is_ascii_digit) {
+            seen_point = true;
+            end += 1;
+        } else {
+            break;
+        }
+    }
+    if end == start_digits || !bytes[start_digits].is_ascii_digit() {
+        return None;
+    }
+    if matches!(bytes.get(end), Some(b'e' | b'E')) {
+        let mut exponent = end + 1;
+        if matches!(bytes.get(exponent), Some(b'-' | b'+')) {
+            exponent += 1;
+        }
+        if bytes.get(exponent).is_some_and(u8::is_ascii_digit) {
+            while bytes.get(exponent).is_some_and(u8::is_ascii_digit) {
+                exponent += 1;
+            }
+            end = exponent;
+        }
+    }
+    let value: f64 = text[..end].parse().ok()?;
+    let after = &text[end..];
+    let (gap, after) = match after.strip_prefix(' ') {
+        Some(after) => (1, after),
+        None => (0, after),
+    };
+    let unit = MESSAGE_UNITS.iter().find(|(mm, _, _)| {
+        after.strip_prefix(mm).is_some_and(|tail| {
+            tail.chars().next().is_none_or(|c| !(c.is_alphanumeric() || c == '_' || c == '/' || c == '²' || c == '³'))
+        })
+    })?;
+    Some(((value, digits.max(1)), *unit, end + gap + unit.0.len()))
 }
 
 /// A value whose lengths and feeds are converted by a [`Scaling`]: each implementation lists
@@ -226,6 +360,20 @@ impl Scale for ToolRef {
     }
 }
 
+/// A warning's message, restated in the answer's units.
+impl Scale for crate::error::Warning {
+    fn scale(&mut self, scaling: Scaling) {
+        self.message = scaling.restate(&self.message);
+    }
+}
+
+/// A sentence of an answer (a description, a note), restated in the answer's units.
+impl Scale for String {
+    fn scale(&mut self, scaling: Scaling) {
+        *self = scaling.restate(self);
+    }
+}
+
 /// An area, mm²: scaled by the square of the length's conversion.
 pub(crate) fn scale_area(area: &mut f64, scaling: Scaling) {
     *area = scaling.apply(scaling.apply(*area));
@@ -236,6 +384,37 @@ mod tests {
     use proptest::prelude::*;
 
     use super::*;
+
+    #[test]
+    fn messages_are_restated_in_inches() {
+        let inch = Units::Inch.from_mm().unwrap();
+        assert_eq!(
+            inch.restate("tool radius 3.0000 mm exceeds the hole's 2.54 mm; feed 2540 mm/min (±25400 mm)"),
+            "tool radius 0.11811 in exceeds the hole's 0.1000 in; feed 100.0 in/min (±1000.0000 in)"
+        );
+        assert_eq!(
+            inch.restate("chord error 0.0005 mm, 645.16 mm², 16387.064 mm³"),
+            "chord error 0.00001969 in, 1.0000 in², 1.0000000 in³"
+        );
+        assert_eq!(
+            inch.restate("feed_per_tooth (mm/tooth) or feed (mm/min); a_p = 25.4mm."),
+            "feed_per_tooth (in/tooth) or feed (in/min); a_p = 1.0000 in."
+        );
+        assert_eq!(inch.restate("-12.7 mm at s = 1e1 mm"), "-0.5000 in at s = 0.3937 in");
+        // Not lengths in mm: counts, words of a program, other units, the name of the units.
+        for kept in [
+            "12 blocks",
+            "X10 mm",
+            "stiffness 3000 N/mm",
+            "1 mm/N",
+            "requests are read in mm only",
+            "5 mmHg",
+            "T1 (M3)",
+        ] {
+            assert_eq!(inch.restate(kept), kept);
+        }
+        assert_eq!(Units::Inch.into_mm().unwrap().restate("3 mm"), "3 mm");
+    }
 
     proptest! {
         #[test]

@@ -40,7 +40,10 @@ pub fn non_negative(field: &str, value: f64) -> Result<f64, SolverError> {
 /// Checks that `value` is finite and within ±`limit`, naming `field` otherwise.
 pub fn within(field: &str, value: f64, limit: f64) -> Result<f64, SolverError> {
     if finite(field, value)?.abs() > limit {
-        return Err(SolverError::input(field, format!("{field} must lie within ±{limit} mm (got {})", quoted(value))));
+        return Err(SolverError::input(
+            field,
+            format!("{field} must lie within ±{limit} mm (got {} mm)", quoted(value)),
+        ));
     }
     Ok(value)
 }

@@ -53,6 +53,9 @@ pub async fn answer(
 ) -> AppResult<Response> {
     let refs = kerf_solver::capability::all_refs::<VerifyCapability>(&request);
     let catalog = capabilities::catalog(&state.db, refs, capabilities::Catalog::default()).await?;
+    // Read in mm as the JSON answer's request is; the mesh and its answer in the request's units.
+    let (request, units) = capabilities::in_mm::<VerifyCapability>(&request, &catalog)?;
+    let request = request.into_owned();
     let resolved = capabilities::resolve::<VerifyCapability>(&request, &catalog)?;
     let budget = AnswerBudget::new(u64::try_from(state.limits.answer_budget_bytes).unwrap_or(u64::MAX));
     let started = std::time::Instant::now();
@@ -65,7 +68,8 @@ pub async fn answer(
                 budget: Some(&budget),
             };
             let found = Found { material: resolved.material.as_ref(), machine: resolved.machine.as_ref() };
-            cut_stock_glb(&request, resolved.other_tools, found, upto_line, &run)
+            cut_stock_glb(&request, resolved.other_tools, found, upto_line, units, &run)
+                .map_err(|error| capabilities::refusal_in(error, units))
         })
         .await?
         .map_err(AppError::from)?;

@@ -186,7 +186,7 @@ impl ContourRequest {
         if finite("tolerance", tolerance)? < MIN_TOLERANCE {
             return Err(SolverError::input(
                 "tolerance",
-                format!("tolerance must be at least {MIN_TOLERANCE} mm (got {tolerance})"),
+                format!("tolerance must be at least {MIN_TOLERANCE} mm (got {tolerance} mm)"),
             ));
         }
         let mut rule_warnings = Vec::new();
@@ -399,7 +399,7 @@ pub(crate) fn layer_heights(top: f64, bottom: f64, step: f64) -> Result<Vec<f64>
     if count > MAX_LAYERS as f64 {
         return Err(SolverError::new(
             ErrorCode::TooManyLayers,
-            format!("{count} layers of at most {step} mm from {top} to {bottom}: the limit is {MAX_LAYERS}"),
+            format!("{count} layers of at most {step} mm from {top} mm to {bottom} mm: the limit is {MAX_LAYERS}"),
         )
         .at("depths.step"));
     }

@@ -95,6 +95,7 @@ impl Scale for crate::contour::ContourSolution {
         self.passes.scale(scaling);
         self.summary.scale(scaling);
         self.centre_height.scale(scaling);
+        self.warnings.scale(scaling);
     }
 }
 

@@ -210,7 +210,7 @@ pub(crate) fn inner_access(
     if tightest < 0.0 {
         let error = SolverError::new(
             ErrorCode::NeckCollision,
-            format!("the neck (radius {neck}) would cut the hole wall: it is short of room by {:.4} mm", -tightest),
+            format!("the neck (radius {neck} mm) would cut the hole wall: it is short of room by {:.4} mm", -tightest),
         )
         .at("tool.neck_radius");
         return (warnings, Some(approach.unwrap_or(error)));

@@ -55,7 +55,7 @@ fn bounded(field: &str, value: f64) -> Result<f64, SolverError> {
 fn size(field: &str, value: f64) -> Result<f64, SolverError> {
     let value = bounded(field, positive(field, value)?)?;
     if value < MIN_LENGTH {
-        return Err(SolverError::input(field, format!("{field} must be at least {MIN_LENGTH} mm (got {value})")));
+        return Err(SolverError::input(field, format!("{field} must be at least {MIN_LENGTH} mm (got {value} mm)")));
     }
     Ok(value)
 }
@@ -252,7 +252,7 @@ impl DeburrRequest {
         if tolerance < MIN_TOLERANCE {
             return Err(SolverError::new(
                 ErrorCode::Tol,
-                format!("tolerance {tolerance} is below the smallest reachable {MIN_TOLERANCE} mm"),
+                format!("tolerance {tolerance} mm is below the smallest reachable {MIN_TOLERANCE} mm"),
             )
             .at("tolerance"));
         }

@@ -173,11 +173,12 @@ impl Scale for Deburr {
             lead_in,
             lead_out,
             summary,
-            warnings: _,
+            warnings,
             program_blocker: _,
             description: _,
             ball_radius: _,
         } = self;
+        warnings.scale(scaling);
         points.scale(scaling);
         lead_in.scale(scaling);
         lead_out.scale(scaling);

@@ -211,9 +211,10 @@ impl Scale for PathEngagement {
             forces,
             feed_plan,
             blocks,
-            warnings: _,
+            warnings,
             post: _,
         } = self;
+        warnings.scale(scaling);
         samples.scale(scaling);
         flutes.scale(scaling);
         for value in [path_length, feed_length, step, max_engaged_at_s, max_radial_depth] {

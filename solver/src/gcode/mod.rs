@@ -425,7 +425,10 @@ fn write_checking<E>(
         plunges.feed.scale(scaling);
         plunges
     });
+    // The header's sentences quote lengths and feeds in mm: restated in the program's units.
+    let comments = program.comments.iter().map(|comment| scaling.restate(comment)).collect();
     let program = Program {
+        comments,
         safe_z: scaling.apply(program.safe_z),
         blend_tolerance: scaling.apply(program.blend_tolerance),
         plunges,

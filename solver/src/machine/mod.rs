@@ -126,8 +126,8 @@ pub fn cap_feed(machine: Option<&MachineProfile>, field: &str, feed: f64, warnin
         warnings.push(Warning::new(
             "W_FEED_ABOVE_MACHINE_MAX",
             format!(
-                "{field} {feed} mm/min is above the machine's max_feed {max} mm/min: {field} capped from {feed} to \
-                 {max} mm/min",
+                "{field} {feed} mm/min is above the machine's max_feed {max} mm/min: {field} capped from {feed} \
+                 mm/min to {max} mm/min",
                 max = machine.max_feed
             ),
         ));
@@ -299,7 +299,11 @@ mod tests {
         assert_eq!(cap_feed(Some(&machine), "loop_feed", 2400.0, &mut warnings), 600.0);
         assert_eq!(warnings.len(), 1);
         assert_eq!(warnings[0].code, "W_FEED_ABOVE_MACHINE_MAX");
-        assert!(warnings[0].message.contains("loop_feed capped from 2400 to 600"), "{}", warnings[0].message);
+        assert!(
+            warnings[0].message.contains("loop_feed capped from 2400 mm/min to 600 mm/min"),
+            "{}",
+            warnings[0].message
+        );
         assert_eq!(cap_feed(Some(&machine), "feed", 300.0, &mut warnings), 300.0, "never raised");
         assert_eq!(cap_feed(Some(&machine), "feed", 600.0, &mut warnings), 600.0);
         assert_eq!(cap_feed(None, "feed", 2400.0, &mut warnings), 2400.0, "no machine, no cap");

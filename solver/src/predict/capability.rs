@@ -91,7 +91,7 @@ impl Capability for PredictCapability {
     /// similar passes would be cut at the part boundaries (the merged answer would differ from
     /// one process's).
     fn split(request: &PredictRequest, context: &Resolved<Tool>, sizing: &Sizing) -> Option<Split> {
-        if matches!(request.stock, Stock::Mesh {}) {
+        if matches!(request.stock, Stock::Mesh { .. }) {
             return None;
         }
         let job = request.validate(&context.tool, None, Control::default()).ok()?;
@@ -191,7 +191,11 @@ impl Capability for PredictCapability {
         control: Control<'_>,
     ) -> Result<String, SolverError> {
         check_reference(request, output.reference)?;
-        let options = ProgramOptions { dialect: output.dialect_for(None), tool: ToolCall::for_tool(&answer.tool) };
+        let options = ProgramOptions {
+            dialect: output.dialect_for(None),
+            tool: ToolCall::for_tool(&answer.tool),
+            units: output.units.unwrap_or_default(),
+        };
         match (&request.path, output.reference) {
             (PathInput::Points { points }, Some(asked)) if asked != request.reference => {
                 // Tip = centre − R·z: move the points to the other programmed point.
@@ -204,6 +208,19 @@ impl Capability for PredictCapability {
             }
             _ => super::corrected_program_controlled(request, &answer.result, &options, control),
         }
+    }
+
+    fn units(request: &PredictRequest) -> Option<crate::units::Units> {
+        request.units
+    }
+
+    fn scale_request(request: &mut PredictRequest, scaling: crate::units::Scaling) -> Result<(), SolverError> {
+        crate::units::Scale::scale(request, scaling);
+        Ok(())
+    }
+
+    fn scale_answer(answer: &mut PredictAnswer, scaling: crate::units::Scaling) {
+        crate::units::Scale::scale(answer, scaling);
     }
 
     fn machine(_answer: &PredictAnswer) -> Option<&MachineProfile> {
@@ -225,12 +242,12 @@ impl Capability for PredictCapability {
 /// A `mesh` stock needs the uploaded STL file, and an upload needs a `mesh` stock.
 fn check_upload(request: &PredictRequest, run: &Run<'_>) -> Result<(), SolverError> {
     match (&request.stock, run.upload) {
-        (Stock::Mesh {}, None) => Err(SolverError::input(
+        (Stock::Mesh { .. }, None) => Err(SolverError::input(
             "stock",
             "a mesh stock needs its STL file: send multipart/form-data with the JSON in part `request` and the STL \
              file in part `stock`",
         )),
-        (stock, Some(_)) if !matches!(stock, Stock::Mesh {}) => {
+        (stock, Some(_)) if !matches!(stock, Stock::Mesh { .. }) => {
             Err(SolverError::input("stock.kind", "an STL file was uploaded but stock.kind is not \"mesh\""))
         }
         _ => Ok(()),

@@ -324,7 +324,7 @@ impl PredictRequest {
         match (self.merge_similar_passes.unwrap_or(false), self.merge_tolerance) {
             (_, Some(t)) if !(t.is_finite() && t > 0.0 && t <= MAX_MERGE_TOLERANCE) => Err(SolverError::input(
                 "merge_tolerance",
-                format!("merge_tolerance must be above 0 and at most {MAX_MERGE_TOLERANCE} mm (got {t})"),
+                format!("merge_tolerance must be above 0 and at most {MAX_MERGE_TOLERANCE} mm (got {t} mm)"),
             )),
             (false, Some(_)) => {
                 Err(SolverError::input("merge_tolerance", "merge_tolerance applies with merge_similar_passes: true"))
@@ -438,7 +438,7 @@ fn build_from_program(
         if let Some(value) = from.iter().chain(&to).find(|value| value.abs() > MAX_COORDINATE) {
             return Err(SolverError::input(
                 field,
-                format!("line {line}: coordinates must lie within ±{MAX_COORDINATE} mm (got {})", quoted(*value)),
+                format!("line {line}: coordinates must lie within ±{MAX_COORDINATE} mm (got {} mm)", quoted(*value)),
             ));
         }
         let points = read_move.points(arc_tolerance).unwrap_or_else(|| vec![to]);

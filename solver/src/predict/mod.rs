@@ -59,6 +59,7 @@ mod scene;
 pub mod shape;
 pub(crate) mod stl;
 pub mod stock;
+mod units;
 
 use std::sync::atomic::AtomicUsize;
 
@@ -424,6 +425,8 @@ pub struct ProgramOptions {
     pub dialect: Dialect,
     /// Tool selection.
     pub tool: ToolCall,
+    /// The program's units (G20 or G21).
+    pub units: crate::units::Units,
 }
 
 /// The corrected program for `answer` (computed from `request`).
@@ -546,7 +549,7 @@ pub fn corrected_program_controlled(
                     // The points are the caller's path, written as given.
                     plunges: None,
                     path: &path,
-                    units: crate::units::Units::Mm,
+                    units: options.units,
                 },
                 &[],
                 control,

@@ -192,4 +192,9 @@ pub struct PredictRequest {
     /// passes may differ, and how far the errors of the simulated passes around them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub merge_tolerance: Option<f64>,
+    /// `mm` (default) or `inch`: the units of every length and feed of the request and the
+    /// answer, and of a `mesh` stock's STL file unless its `units` says otherwise (docs/spec/api.md,
+    /// Units). A G-code path keeps its own G20/G21.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<crate::units::Units>,
 }

@@ -43,6 +43,27 @@ fn mesh_error(code: ErrorCode, message: impl Into<String>) -> SolverError {
     SolverError::new(code, message).at("stock")
 }
 
+/// Reads an STL file (ASCII or binary) whose coordinates are in `units` into triangles in mm.
+///
+/// # Errors
+/// As [`parse`]; `E_MESH_FORMAT` for a coordinate beyond the range once in mm.
+pub(crate) fn parse_in(bytes: &[u8], units: crate::units::Units) -> Result<Vec<[Vec3; 3]>, SolverError> {
+    let mut triangles = parse(bytes)?;
+    let Some(scaling) = units.into_mm() else { return Ok(triangles) };
+    for (index, triangle) in triangles.iter_mut().enumerate() {
+        for vertex in triangle.iter_mut() {
+            crate::units::Scale::scale(vertex, scaling);
+            if !vertex.iter().all(|c| in_range(*c)) {
+                return Err(mesh_error(
+                    ErrorCode::MeshFormat,
+                    format!("triangle {index} has a coordinate beyond ±{MAX_COORDINATE} mm once in mm"),
+                ));
+            }
+        }
+    }
+    Ok(triangles)
+}
+
 /// Reads an STL file (ASCII or binary) into triangles.
 pub(crate) fn parse(bytes: &[u8]) -> Result<Vec<[Vec3; 3]>, SolverError> {
     if bytes.len() >= 84 {

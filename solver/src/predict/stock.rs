@@ -78,7 +78,12 @@ pub enum Stock {
     },
     /// A closed triangle mesh (ASCII or binary STL) uploaded with the request: the solver entry
     /// takes its bytes separately.
-    Mesh {},
+    Mesh {
+        /// The units of the file's coordinates (an STL file names none): default the request's
+        /// `units`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        units: Option<crate::units::Units>,
+    },
 }
 
 /// Where a box lies relative to the stock.
@@ -286,11 +291,11 @@ impl Stock {
                 };
                 Ok(StockModel::Grid(HeightGrid::new(*origin, spacing, heights, bottom)))
             }
-            Self::Mesh {} => {
+            Self::Mesh { units } => {
                 let Some(bytes) = mesh else {
                     return Err(stock_error("stock", "a mesh stock needs its STL file uploaded with the request"));
                 };
-                let triangles = stl::parse(bytes)?;
+                let triangles = stl::parse_in(bytes, units.unwrap_or_default())?;
                 stl::check_closed(&triangles)?;
                 Ok(StockModel::Mesh(Box::new(Mesh::new(&triangles))))
             }
@@ -442,7 +447,7 @@ mod tests {
                 .unwrap(),
             Stock::Cylinder { start: [0.0, -2.0, 0.0], end: [0.0, 2.0, 0.0], radius: 1.5 }.model(None).unwrap(),
             Stock::Grid { origin: [-1.5, -1.0], spacing: 0.1, heights, bottom: Some(-2.0) }.model(None).unwrap(),
-            Stock::Mesh {}.model(Some(&super::super::stl::tests::binary_stl(&triangles))).unwrap(),
+            Stock::Mesh { units: None }.model(Some(&super::super::stl::tests::binary_stl(&triangles))).unwrap(),
         ]
     }
 
@@ -506,7 +511,7 @@ mod tests {
                 },
                 "stock.heights[1]",
             ),
-            (Stock::Mesh {}, "stock"),
+            (Stock::Mesh { units: None }, "stock"),
         ];
         for (stock, field) in bad {
             assert_eq!(stock.model(None).unwrap_err().field(), Some(field));

@@ -91,7 +91,7 @@ fn points(field: &str, list: &[Vec<f64>]) -> Result<(Vec<Vec3>, usize), SolverEr
 
 fn radius(field: &str, value: f64) -> Result<f64, SolverError> {
     if positive(field, value)? > MAX_COORDINATE {
-        return Err(SolverError::input(field, format!("{field} must be at most {MAX_COORDINATE} mm (got {value})")));
+        return Err(SolverError::input(field, format!("{field} must be at most {MAX_COORDINATE} mm (got {value} mm)")));
     }
     Ok(value)
 }
@@ -348,7 +348,7 @@ fn optional_tolerance(field: &str, value: Option<f64>) -> Result<Option<f64>, So
         return Ok(None);
     };
     if positive(field, value)? < MIN_TOLERANCE {
-        return Err(SolverError::input(field, format!("{field} must be at least {MIN_TOLERANCE} mm (got {value})")));
+        return Err(SolverError::input(field, format!("{field} must be at least {MIN_TOLERANCE} mm (got {value} mm)")));
     }
     Ok(Some(value))
 }

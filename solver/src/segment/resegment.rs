@@ -271,10 +271,11 @@ impl Capability for ResegmentCapability {
             after: _,
             max_deviation,
             chord_error,
-            warnings: _,
+            warnings,
             cuts: _,
         } = answer;
         machine.scale(scaling);
+        warnings.scale(scaling);
         max_deviation.scale(scaling);
         chord_error.scale(scaling);
     }

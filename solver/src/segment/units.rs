@@ -90,6 +90,7 @@ impl Scale for crate::segment::SegmentSolution {
         self.s.scale(scaling);
         self.stats.scale(scaling);
         self.comparison.scale(scaling);
+        self.warnings.scale(scaling);
     }
 }
 

@@ -88,6 +88,19 @@ impl Capability for VerifyCapability {
         Err(SolverError::new(ErrorCode::NoProgram, "verify answers findings, not a program: ask for JSON"))
     }
 
+    fn units(request: &VerifyRequest) -> Option<crate::units::Units> {
+        request.units
+    }
+
+    fn scale_request(request: &mut VerifyRequest, scaling: crate::units::Scaling) -> Result<(), SolverError> {
+        crate::units::Scale::scale(request, scaling);
+        Ok(())
+    }
+
+    fn scale_answer(answer: &mut VerifyAnswer, scaling: crate::units::Scaling) {
+        crate::units::Scale::scale(answer, scaling);
+    }
+
     fn machine(_answer: &VerifyAnswer) -> Option<&MachineProfile> {
         None
     }

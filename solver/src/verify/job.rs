@@ -111,7 +111,7 @@ impl VerifyRequest {
             return Err(SolverError::new(
                 ErrorCode::GridMemory,
                 format!(
-                    "a dexel spacing of {spacing} mm over the stock's {:.1} × {:.1} mm needs {rays:.3e} rays ({:.0} MiB); \
+                    "a dexel spacing of {spacing} mm over the stock's {:.1} mm × {:.1} mm needs {rays:.3e} rays ({:.0} MiB); \
                      the limit is {} MiB: use a coarser resolution",
                     hi[0] - lo[0],
                     hi[1] - lo[1],
@@ -201,8 +201,8 @@ fn within_footprint(part: &SolidModel, stock: &SolidModel, tolerance: f64) -> Re
             return Err(SolverError::input(
                 "part",
                 format!(
-                    "the part reaches {beyond:.3} mm beyond the stock in {axis} (part {:.3} to {:.3}, stock {:.3} to \
-                     {:.3}): the part must lie in the stock, in the program's coordinates",
+                    "the part reaches {beyond:.3} mm beyond the stock in {axis} (part {:.3} mm to {:.3} mm, stock {:.3} mm \
+                     to {:.3} mm): the part must lie in the stock, in the program's coordinates",
                     part_lo[k], part_hi[k], stock_lo[k], stock_hi[k]
                 ),
             ));

@@ -8,6 +8,7 @@ use serde_json::{Value, json};
 use crate::capability::{Run, too_large_answer};
 use crate::error::{ErrorCode, SolverError};
 use crate::tool::Tool;
+use crate::units::{Scale, Units};
 
 use super::capability::VerifyAnswer;
 use super::dexel::{self, Field, Interval};
@@ -406,9 +407,9 @@ fn glb(mesh: &Mesh, extras: Value) -> Vec<u8> {
     out
 }
 
-/// Cuts `request`'s program with its resolved `tools` (moves on lines after `upto_line` left out)
-/// and answers the stock as the program left it as GLB, the JSON answer in the glTF's
-/// `extras.verify`. With `upto_line`, a program that has not reached the stock by then answers
+/// Cuts `request`'s program (in mm) with its resolved `tools` (moves on lines after `upto_line`
+/// left out) and answers the stock as the program left it as GLB in `units` (positions and
+/// `_DEVIATION`), the JSON answer in `units` in the glTF's `extras.verify`. With `upto_line`, a program that has not reached the stock by then answers
 /// the stock as given, without `extras.verify`.
 ///
 /// # Errors
@@ -419,6 +420,7 @@ pub fn cut_stock_glb(
     tools: Vec<Tool>,
     found: Found<'_>,
     upto_line: Option<usize>,
+    units: Units,
     run: &Run<'_>,
 ) -> Result<Vec<u8>, SolverError> {
     let mut job = request.validate(&tools, found, run.upload, run.control)?;
@@ -435,12 +437,15 @@ pub fn cut_stock_glb(
     let shading = Shading { part: job.part.is_some(), tolerance: job.tolerance, allowance: job.allowance };
     let (extras, stock) = match simulate::cut_stock(&job, run) {
         Ok((cut, stock)) => {
-            let mut answer = serde_json::to_value(VerifyAnswer { tools, cut })
+            let mut answer = VerifyAnswer { tools, cut };
+            if let Some(scaling) = units.from_mm() {
+                answer.scale(scaling);
+            }
+            let mut answer = serde_json::to_value(answer)
                 .map_err(|error| SolverError::new(ErrorCode::Internal, error.to_string()))?;
-            // As the JSON answer, which names its units first (verify reads a program's G20/G21
-            // and answers in mm).
+            // As the JSON answer, which names its units first.
             if let Value::Object(fields) = &mut answer {
-                fields.insert("units".to_owned(), Value::from("mm"));
+                fields.insert("units".to_owned(), Value::from(units.as_str()));
             }
             (json!({"verify": answer}), stock)
         }
@@ -448,8 +453,17 @@ pub fn cut_stock_glb(
         Err(error) => return Err(error),
     };
     let part = job.part.as_ref().map(|part| part.field(job.grid));
-    let mesh = surface(&stock, part.as_ref(), shading, run)?;
+    let mut mesh = surface(&stock, part.as_ref(), shading, run)?;
     run.control.check()?;
+    if let Some(scaling) = units.from_mm() {
+        // Positions and deviations in the request's units (the colours were chosen in mm).
+        for position in &mut mesh.positions {
+            *position = position.map(|v| scaling.apply(f64::from(v)) as f32);
+        }
+        for deviation in &mut mesh.deviations {
+            *deviation = scaling.apply(f64::from(*deviation)) as f32;
+        }
+    }
     Ok(glb(&mesh, extras))
 }
 
@@ -504,7 +518,7 @@ mod tests {
                 ToolRef::Number(_) => panic!("inline tools only"),
             })
             .collect();
-        cut_stock_glb(&request, tools, Found::default(), upto_line, &Run::default()).expect("a mesh")
+        cut_stock_glb(&request, tools, Found::default(), upto_line, Units::Mm, &Run::default()).expect("a mesh")
     }
 
     /// The slot of `tests.rs` with a part 1.9 below the top, cut to 2: a gouge of 0.1 along the slot,
@@ -595,7 +609,7 @@ mod tests {
         let tools = vec![Tool { ..serde_json::from_value(json!({"kind": "flat", "radius": 5})).unwrap() }];
         let budget = AnswerBudget::new(100_000);
         let run = Run { budget: Some(&budget), ..Run::default() };
-        let error = cut_stock_glb(&request, tools, Found::default(), None, &run).unwrap_err();
+        let error = cut_stock_glb(&request, tools, Found::default(), None, Units::Mm, &run).unwrap_err();
         assert_eq!(error.code(), ErrorCode::TooLargeAnswer);
         assert_eq!(error.field(), Some("resolution"));
         assert_eq!(budget.used(), 0, "refused before anything was built");

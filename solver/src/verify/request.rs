@@ -59,6 +59,12 @@ pub struct VerifyRequest {
     /// curve) is a `spindle_power` finding.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub machine: Option<String>,
+    /// `mm` (default, or the machine's) or `inch`: the units of every length of the request and
+    /// the answer (volumes stay in the mm³ their names say), and of `mesh` solids' STL files
+    /// unless their `units` says otherwise (docs/spec/api.md, Units). The program keeps its own
+    /// G20/G21.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<crate::units::Units>,
 }
 
 /// A solid of the stock or the part: predict's stock kinds (docs/spec/predict.md §1.2), or a tube.
@@ -128,7 +134,7 @@ pub struct Meshes<'a> {
 impl Solid {
     /// Whether the solid is an uploaded mesh.
     pub fn is_mesh(&self) -> bool {
-        matches!(self, Self::Stock(Stock::Mesh {}))
+        matches!(self, Self::Stock(Stock::Mesh { .. }))
     }
 }
 

@@ -43,8 +43,8 @@ fn axis(field: &str, start: [f64; 3], end: [f64; 3]) -> Result<Axis, SolverError
 
 /// The closed, outward-oriented mesh of the STL file `bytes` given for the solid at `prefix`:
 /// predict's reading and closedness check, and a positive enclosed volume.
-fn mesh(bytes: &[u8], prefix: &str) -> Result<Mesh, SolverError> {
-    let triangles = stl::parse(bytes).map_err(|error| renamed(error, prefix))?;
+fn mesh(bytes: &[u8], units: crate::units::Units, prefix: &str) -> Result<Mesh, SolverError> {
+    let triangles = stl::parse_in(bytes, units).map_err(|error| renamed(error, prefix))?;
     stl::check_closed(&triangles).map_err(|error| renamed(error, prefix))?;
     let volume = stl::signed_volume(&triangles);
     if volume <= 0.0 {
@@ -105,8 +105,10 @@ impl Solid {
                 field("kind"),
                 "a plane has no bottom, so its volume is unbounded: give a box or a grid with a bottom",
             )),
-            Self::Stock(Stock::Mesh {}) => match upload {
-                Some(bytes) => Ok(SolidModel::Stock(StockModel::Mesh(Box::new(mesh(bytes, prefix)?)))),
+            Self::Stock(Stock::Mesh { units }) => match upload {
+                Some(bytes) => {
+                    Ok(SolidModel::Stock(StockModel::Mesh(Box::new(mesh(bytes, units.unwrap_or_default(), prefix)?))))
+                }
                 None => Err(SolverError::input(
                     prefix,
                     format!("a mesh {prefix} needs its STL file uploaded with the request (form part `{prefix}`)"),
@@ -257,8 +259,8 @@ pub(crate) fn check_part_in_stock(part: &Field, stock: &Field, tolerance: f64) -
         Some((thickness, [x, y, z])) => Err(SolverError::input(
             "part",
             format!(
-                "the part lies outside the stock: {thickness:.3} mm of it on the ray through ({x:.3}, {y:.3}) from z = \
-                 {z:.3} is not stock material; place the part in the stock, in the program's coordinates"
+                "the part lies outside the stock: {thickness:.3} mm of it on the ray through x = {x:.3} mm, y = {y:.3} mm \
+                 from z = {z:.3} mm is not stock material; place the part in the stock, in the program's coordinates"
             ),
         )),
         None => Ok(()),

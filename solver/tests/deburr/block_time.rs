@@ -206,7 +206,7 @@ fn machine_values_and_bad_block_times() {
     assert_eq!(result.summary.feed, machine.max_feed);
     assert_eq!(result.summary.short_blocks, Some(0));
     let capped = result.warnings.iter().find(|w| w.code == "W_FEED_ABOVE_MACHINE_MAX").expect("the feed is capped");
-    assert!(capped.message.contains("capped from 3000 to 2000"), "{}", capped.message);
+    assert!(capped.message.contains("capped from 3000 mm/min to 2000"), "{}", capped.message);
     let slower = deburr::solve_with(&request(tube(json!({"machine": "hsc", "feed": 1500}))), &tool, Some(&machine));
     assert_eq!(slower.unwrap().summary.feed, 1500.0, "a feed below the machine's is kept");
     // min_chord_error 0.002: no interval is cut finer than that where the rule asks for less.

@@ -101,7 +101,7 @@ fn a_depth_buffer_over_the_memory_limit_is_refused() {
 fn an_open_mesh_is_refused_and_a_closed_one_equals_the_box() {
     let (mut request, tool) = flat_case();
     let box_answer = predict::solve(&request, &tool, None).unwrap();
-    request.stock = Stock::Mesh {};
+    request.stock = Stock::Mesh { units: None };
     expect(predict::solve(&request, &tool, None), "E_INPUT", "stock");
     let mut triangles = box_triangles([0.0, -5.0, -10.0], [20.0, 5.0, 0.1]);
     let closed = stl(&triangles);

@@ -30,7 +30,7 @@ fn request(program: &str) -> (PredictRequest, Tool) {
 }
 
 fn options() -> ProgramOptions {
-    ProgramOptions { dialect: Dialect::Fanuc, tool: ToolCall::Table(1) }
+    ProgramOptions { dialect: Dialect::Fanuc, tool: ToolCall::Table(1), units: kerf_solver::units::Units::Mm }
 }
 
 /// The line without its coordinate words.

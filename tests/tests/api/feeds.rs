@@ -119,7 +119,7 @@ async fn a_machine_caps_every_feed_near_the_stock() {
             .find(|w| w["code"] == "W_FEED_ABOVE_MACHINE_MAX")
             .unwrap_or_else(|| panic!("{name}: no W_FEED_ABOVE_MACHINE_MAX in {:?}", codes(answer)));
         let message = warning["message"].as_str().unwrap();
-        assert!(message.contains("capped from 2400 to 600"), "{name}: {message}");
+        assert!(message.contains("capped from 2400 mm/min to 600"), "{name}: {message}");
     };
 
     // Segment: a circle of radius 20 at Z −2, the part is the curve itself.
@@ -140,7 +140,7 @@ async fn a_machine_caps_every_feed_near_the_stock() {
     capped(&answer, "contour");
     let messages: Vec<&str> =
         answer["warnings"].as_array().unwrap().iter().filter_map(|w| w["message"].as_str()).collect();
-    for said in ["loop_feed capped from 3000 to 600", "plunge_feed capped from 1800 to 600"] {
+    for said in ["loop_feed capped from 3000 mm/min to 600", "plunge_feed capped from 1800 mm/min to 600"] {
         assert!(messages.iter().any(|m| m.contains(said)), "contour: no \"{said}\" in {messages:?}");
     }
     assert_eq!(answer["summary"]["loop_feed"], MACHINE_MAX, "the answer's loop feed is the program's");

@@ -286,7 +286,7 @@ async fn machine_defaults_and_overrides() {
     assert_eq!(answer["feed"], json!(10000.0));
     let capped = answer["warnings"].as_array().unwrap().iter().find(|w| w["code"] == "W_FEED_ABOVE_MACHINE_MAX");
     let message = capped.expect("W_FEED_ABOVE_MACHINE_MAX")["message"].as_str().unwrap();
-    assert!(message.contains("capped from 12000 to 10000"), "{message}");
+    assert!(message.contains("capped from 12000 mm/min to 10000"), "{message}");
 
     // The clamp of the machine applies where the rule asks for less (large radius).
     let answer = segment(

@@ -4,6 +4,7 @@
 //! default of the requests that name it; a bad `units` is refused naming it.
 
 use kerf_tests::{Store, TestApp, finished, json_with, poll_job, problem, rs274_moves};
+use reqwest::multipart::{Form, Part};
 use serde_json::{Value, json};
 
 /// Keys whose numbers (and arrays of numbers) are lengths or feeds in the answers compared here.
@@ -102,10 +103,31 @@ const LENGTHS: &[&str] = &[
     "axial_position",
     "travel",
     "request_order_travel",
-    // the verification of a program (volumes keep the mm³ their names say)
+    // the verification of a program, and verify (volumes keep the mm³ their names say)
     "resolution",
     "wall_tolerance",
     "depth",
+    "outer_radius",
+    "inner_radius",
+    "flute_length",
+    "stickout",
+    // predict
+    "error",
+    "error_deflection",
+    "error_shape",
+    "generation_point",
+    "deflection",
+    "residual_error",
+    "correction",
+    "corrected",
+    "merge_bound",
+    "min_error",
+    "max_error",
+    "mean_error",
+    "rms_error",
+    "max_correction",
+    "max_abs_error",
+    "pixel_size",
 ];
 
 /// Keys whose numbers are areas.
@@ -122,6 +144,10 @@ enum Kind {
     Area,
     Volume,
 }
+
+/// Paths whose numbers are counts although their key names a length elsewhere (predict's
+/// pixels per side).
+const UNSCALED_AT: &[&str] = &["predict.summary.resolution"];
 
 /// Keys whose numbers are never converted, even inside a length's object (deburr's `points`).
 const UNSCALED: &[&str] = &["parameter"];
@@ -152,8 +178,13 @@ fn assert_in_inch(path: &str, inch: &Value, mm: &Value, kind: Kind) -> usize {
             assert_eq!(keys, mm_keys, "{path}: keys");
             keys.iter()
                 .map(|key| {
-                    let kind = kind_of(key, if matches!(kind, Kind::Length) { Kind::Length } else { Kind::Same });
-                    assert_in_inch(&format!("{path}.{key}"), &inch[key.as_str()], &mm[key.as_str()], kind)
+                    let at = format!("{path}.{key}");
+                    let kind = if UNSCALED_AT.iter().any(|end| at.ends_with(end)) {
+                        Kind::Same
+                    } else {
+                        kind_of(key, if matches!(kind, Kind::Length) { Kind::Length } else { Kind::Same })
+                    };
+                    assert_in_inch(&at, &inch[key.as_str()], &mm[key.as_str()], kind)
                 })
                 .sum()
         }
@@ -172,11 +203,55 @@ fn assert_in_inch(path: &str, inch: &Value, mm: &Value, kind: Kind) -> usize {
             assert!((inch - want).abs() <= 1e-9 * want.abs().max(1e-12), "{path}: {inch} in vs {mm} mm ({kind:?})");
             usize::from(!matches!(kind, Kind::Same))
         }
+        (Value::String(inch), Value::String(mm)) => {
+            // A sentence (a warning, a note) quotes its lengths in the answer's units.
+            assert!(!quotes_mm(inch), "{path}: {inch:?} quotes mm");
+            assert_eq!(sentence(inch), sentence(mm), "{path}: {inch:?} vs {mm:?}");
+            0
+        }
         _ => {
             assert_eq!(inch, mm, "{path}");
             0
         }
     }
+}
+
+/// Whether `text` gives a number in mm or mm/min.
+fn quotes_mm(text: &str) -> bool {
+    let bytes = text.as_bytes();
+    text.match_indices("mm").any(|(at, _)| {
+        let before = text[..at].trim_end_matches(' ');
+        let after = bytes.get(at + 2).copied();
+        before.ends_with(|c: char| c.is_ascii_digit()) && !after.is_some_and(|b| b.is_ascii_alphabetic())
+    })
+}
+
+/// `text` without its numbers and with `in` read as `mm`: an inch sentence and its mm twin agree.
+fn sentence(text: &str) -> String {
+    let chars: Vec<char> = text.chars().collect();
+    let digit = |k: Option<usize>| k.and_then(|k| chars.get(k)).is_some_and(char::is_ascii_digit);
+    let kept: Vec<char> = (0..chars.len())
+        .filter(|&k| {
+            let c = chars[k];
+            !(c.is_ascii_digit()
+                || (matches!(c, '.' | '-' | '+' | 'e') && (digit(k.checked_sub(1)) || digit(Some(k + 1)))))
+        })
+        .map(|k| chars[k])
+        .collect();
+    let word = |c: Option<&char>| c.is_some_and(|c| c.is_alphanumeric() && !matches!(c, '²' | '³'));
+    let mut out = String::new();
+    let mut k = 0;
+    while k < kept.len() {
+        let unit = kept[k] == 'i' && kept.get(k + 1) == Some(&'n');
+        if unit && !word(k.checked_sub(1).and_then(|p| kept.get(p))) && !word(kept.get(k + 2)) {
+            out.push_str("mm");
+            k += 2;
+        } else {
+            out.push(kept[k]);
+            k += 1;
+        }
+    }
+    out
 }
 
 /// A segment request with its lengths in units of `k` mm (1 for mm values written as inches,
@@ -428,4 +503,215 @@ async fn a_job_operation_in_inch_stores_the_inch_answer_and_program() {
     assert_eq!(stored["points"], direct["points"]);
     let program = app.get_text(&format!("/api/v1/jobs/{id}/gcode?operation=0"), 200).await;
     assert!(program.contains("\nG20 G17"), "{program}");
+}
+
+/// A predict request in units of `k` mm: a ball with a shape-error table and a modal stiffness
+/// (N/mm, never scaled) over a box stock, cutting force coefficients (N/mm², never scaled) and a
+/// G20 raster, which both twins read alike (a program keeps its own units).
+fn predict_request(k: f64) -> Value {
+    json!({"tool": {"kind": "ball", "radius": 0.125 * k, "flutes": 2,
+                    "shape_error": [{"angle_deg": 0, "error": 0.00016 * k}, {"angle_deg": 45, "error": 0.00024 * k},
+                                    {"angle_deg": 90, "error": 0.00035 * k}],
+                    "stiffness": {"kind": "modal",
+                                  "x": [{"stiffness": 3000, "frequency_hz": 1800, "damping_ratio": 0.04}],
+                                  "y": [{"stiffness": 3000, "frequency_hz": 1800, "damping_ratio": 0.04}]}},
+           "stock": {"kind": "box", "min": [-k, -k, -0.5 * k], "max": [k, k, 0.01 * k]},
+           "path": {"kind": "gcode", "program": crate::predict::raster_program(5, 7, true)},
+           "cutting": {"ktc": 2000, "krc": 800, "kac": 300},
+           "correction": {"max_correction": 0.004 * k},
+           "resolution": 64, "history": [3]})
+}
+
+/// The same prediction along points (in the request's units), written as a program by kerf.
+fn predict_points_request(k: f64) -> Value {
+    let mut request = predict_request(k);
+    let points: Vec<[f64; 3]> = (0..9).map(|i| [(-0.15 + 0.0375 * f64::from(i)) * k, 0.0, 0.0]).collect();
+    request["path"] = json!({"kind": "points", "points": points});
+    request["feed"] = json!(60.0 * k);
+    request["spindle_rpm"] = json!(8000);
+    request["reference"] = json!("tip");
+    request
+}
+
+/// A verify request in units of `k` mm with its program written in them: a flat end mill faces a
+/// block, gouging the part below on one pass and leaving material on another.
+fn verify_request(k: f64) -> Value {
+    let moves: [(&str, [f64; 3], Option<f64>); 7] = [
+        ("G0", [-0.25, 0.5, 0.25], None),
+        ("G1", [-0.25, 0.5, -0.0625], Some(20.0)),
+        ("G1", [2.25, 0.5, -0.0625], None),
+        ("G1", [2.25, 1.0, -0.0625], None),
+        ("G1", [1.0, 1.0, -0.125], None),
+        ("G1", [-0.25, 1.0, -0.125], None),
+        ("G0", [-0.25, 1.0, 0.25], None),
+    ];
+    let mut program =
+        String::from(if k == 1.0 { "G20 G90 G17\nT1 M6\nS8000 M3\n" } else { "G21 G90 G17\nT1 M6\nS8000 M3\n" });
+    for (word, [x, y, z], feed) in moves {
+        program.push_str(&format!("{word} X{} Y{} Z{}", x * k, y * k, z * k));
+        if let Some(feed) = feed {
+            program.push_str(&format!(" F{}", feed * k));
+        }
+        program.push('\n');
+    }
+    program.push_str("M30\n");
+    json!({"program": program,
+           "tools": [{"number": 1, "kind": "flat", "radius": 0.125 * k, "flute_length": k, "stickout": 2.0 * k}],
+           "stock": {"kind": "box", "min": [0, 0, -0.5 * k], "max": [2.0 * k, 2.0 * k, 0]},
+           "part": {"kind": "box", "min": [0, 0, -0.5 * k], "max": [2.0 * k, 2.0 * k, -0.09375 * k]},
+           "resolution": 0.03125 * k, "tolerance": 0.0004 * k, "allowance": 0.004 * k})
+}
+
+/// An inch prediction answers the mm prediction divided by 25.4 (the stiffness and the cutting
+/// coefficients keep their N/mm units), a G-code path and a path of points alike; the program of
+/// a path of points is written in G20 and its header quotes inches; a job answers the same.
+#[tokio::test(flavor = "multi_thread")]
+async fn an_inch_prediction_is_the_mm_prediction_divided_by_25_4() {
+    let app = TestApp::spawn().await;
+    for request in [predict_request as fn(f64) -> Value, predict_points_request] {
+        let (inch, mm) = pair(request);
+        let inch_answer = json_with(app.post_json("/api/v1/predict", &inch).await, 200).await;
+        let mm_answer = json_with(app.post_json("/api/v1/predict", &mm).await, 200).await;
+        assert_eq!(inch_answer["units"], "inch");
+        assert!(mm_answer["summary"]["predicted"].as_u64().unwrap() > 5, "{mm_answer}");
+        assert!(mm_answer["summary"]["rms_error"].as_f64().unwrap() > 1e-3, "{}", mm_answer["summary"]);
+        let converted = assert_in_inch("predict", &inch_answer, &mm_answer, Kind::Same);
+        assert!(converted > 100, "only {converted} lengths compared");
+    }
+    let (inch, mm) = pair(predict_points_request);
+    let inch_program = app.post_text("/api/v1/predict/program?dialect=linuxcnc", &inch, 200).await;
+    let mm_program = app.post_text("/api/v1/predict/program?dialect=linuxcnc", &mm, 200).await;
+    assert!(inch_program.contains("\nG20 G17") && !inch_program.contains("G21"), "{inch_program}");
+    assert!(mm_program.contains("\nG21 G17"), "{mm_program}");
+    let header = inch_program
+        .lines()
+        .map(str::to_lowercase)
+        .find(|line| line.contains("max correction"))
+        .unwrap_or_else(|| panic!("{inch_program}"));
+    assert!(header.contains(" in, predicted max error ") && !quotes_mm(&header), "{header}");
+
+    let mut operation = inch.clone();
+    operation["operation"] = json!("predict");
+    let submitted = json_with(app.post_json("/api/v1/jobs", &json!({"operations": [operation]})).await, 202).await;
+    let id = submitted["id"].as_i64().unwrap();
+    let done = poll_job(&app.client, &app.base, id, 120, finished).await;
+    assert_eq!(done["status"], "done", "{done}");
+    let stored = &done["results"][0]["result"];
+    let direct = json_with(app.post_json("/api/v1/predict", &inch).await, 200).await;
+    assert_eq!(stored["units"], "inch");
+    assert_eq!(stored["passes"], direct["passes"]);
+    let program = app.get_text(&format!("/api/v1/jobs/{id}/gcode?operation=0"), 200).await;
+    assert!(program.contains("G20"), "{program}");
+}
+
+/// A mesh stock's STL file is read in the request's units unless the stock names its own.
+#[tokio::test(flavor = "multi_thread")]
+async fn an_inch_stl_stock_is_read_in_inches() {
+    let app = TestApp::spawn().await;
+    let (inch, _) = pair(predict_request);
+    let from_box = json_with(app.post_json("/api/v1/predict", &inch).await, 200).await;
+    let form = |body: &Value, bytes: Vec<u8>| {
+        Form::new()
+            .part("request", Part::text(body.to_string()).mime_str("application/json").unwrap())
+            .part("stock", Part::bytes(bytes).file_name("stock.stl"))
+    };
+    let mut body = inch.clone();
+    body["stock"] = json!({"kind": "mesh"});
+    let in_inches = crate::predict::box_stl_binary([-1.0, -1.0, -0.5], [1.0, 1.0, 0.01]);
+    let response = app.client.post(app.url("/api/v1/predict")).multipart(form(&body, in_inches)).send().await.unwrap();
+    let from_inches = json_with(response, 200).await;
+    body["stock"] = json!({"kind": "mesh", "units": "mm"});
+    let in_mm = crate::predict::box_stl_binary([-25.4, -25.4, -12.7], [25.4, 25.4, 0.254]);
+    let response = app.client.post(app.url("/api/v1/predict")).multipart(form(&body, in_mm)).send().await.unwrap();
+    let from_mm = json_with(response, 200).await;
+    for from_mesh in [&from_inches, &from_mm] {
+        assert_eq!(from_mesh["units"], "inch");
+        let (a, b) = (from_box["passes"].as_array().unwrap(), from_mesh["passes"].as_array().unwrap());
+        assert_eq!(a.len(), b.len());
+        for (p, q) in a.iter().zip(b) {
+            assert_eq!(p["status"], q["status"], "{p} vs {q}");
+            if let (Some(x), Some(y)) = (p["error"].as_f64(), q["error"].as_f64()) {
+                assert!((x - y).abs() <= 1e-6, "pass {}: {x} in vs {y} in", p["index"]);
+            }
+        }
+    }
+}
+
+/// The inch verification of an inch program is the mm verification of its mm twin, its lengths
+/// divided by 25.4 and its volumes the same mm³; its GLB mesh too, positions and `_DEVIATION` in
+/// inches; as a job the same answer.
+#[tokio::test(flavor = "multi_thread")]
+async fn an_inch_verification_is_the_mm_verification_of_the_mm_twin() {
+    let app = TestApp::spawn().await;
+    let (inch, mm) = pair(verify_request);
+    let inch_answer = json_with(app.post_json("/api/v1/verify", &inch).await, 200).await;
+    let mm_answer = json_with(app.post_json("/api/v1/verify", &mm).await, 200).await;
+    assert_eq!(inch_answer["units"], "inch");
+    let kinds: Vec<&Value> = mm_answer["findings"].as_array().unwrap().iter().map(|f| &f["kind"]).collect();
+    assert!(kinds.contains(&&json!("gouge")) && kinds.contains(&&json!("left_material")), "{mm_answer}");
+    let converted = assert_in_inch("verify", &inch_answer, &mm_answer, Kind::Same);
+    assert!(converted > 10, "only {converted} lengths compared");
+
+    let glb = |body: Value| {
+        let app = &app;
+        async move {
+            let response = app.client.post(app.url("/api/v1/verify?format=glb")).json(&body).send().await.unwrap();
+            assert_eq!(response.status().as_u16(), 200);
+            crate::verify_mesh::chunks(&response.bytes().await.unwrap())
+        }
+    };
+    let (inch_json, inch_bin) = glb(inch.clone()).await;
+    let (mm_json, mm_bin) = glb(mm).await;
+    assert_eq!(inch_json["extras"]["verify"], inch_answer);
+    for name in ["POSITION", "_DEVIATION"] {
+        let inch_values = crate::verify_mesh::values(&inch_json, &inch_bin, name);
+        let mm_values = crate::verify_mesh::values(&mm_json, &mm_bin, name);
+        assert_eq!(inch_values.len(), mm_values.len(), "{name}");
+        assert!(inch_values.len() > 100, "{name}");
+        for (got, want) in inch_values.iter().zip(&mm_values) {
+            assert!((got - want / 25.4).abs() <= 1e-6 * want.abs().max(1.0), "{name}: {got} in vs {want} mm");
+        }
+    }
+
+    let mut operation = inch.clone();
+    operation["operation"] = json!("verify");
+    let submitted = json_with(app.post_json("/api/v1/jobs", &json!({"operations": [operation]})).await, 202).await;
+    let id = submitted["id"].as_i64().unwrap();
+    let done = poll_job(&app.client, &app.base, id, 60, finished).await;
+    assert_eq!(done["status"], "done", "{done}");
+    assert_eq!(done["results"][0]["result"]["findings"], inch_answer["findings"]);
+}
+
+/// A refusal and a warning of an inch request quote its lengths and feeds in inches.
+#[tokio::test]
+async fn an_inch_requests_refusals_and_warnings_read_inches() {
+    let app = TestApp::spawn().await;
+    // A tolerance below the smallest: the detail gives the limit and the value in inches.
+    let mut body = segment_request(1.0);
+    body["units"] = json!("inch");
+    body["tolerance"] = json!(1e-9);
+    let refused = problem(app.post_json("/api/v1/segment", &body).await, 422).await;
+    let detail = refused["detail"].as_str().unwrap();
+    assert!(detail.contains(" in (got 0.000000001000 in)") && !quotes_mm(detail), "{detail}");
+    // A verify spacing over the memory limit: the stock's size in inches.
+    let (mut inch, _) = pair(verify_request);
+    inch["resolution"] = json!(0.00001);
+    let refused = problem(app.post_json("/api/v1/verify", &inch).await, 422).await;
+    let detail = refused["detail"].as_str().unwrap();
+    assert!(detail.contains("over the stock's 2.0000 in × 2.0000 in") && !quotes_mm(detail), "{detail}");
+    // A feed above the machine's: the warning in in/min.
+    app.put_json("/api/v1/machines/slow", &json!({"block_time_ms": 4, "max_feed": 2540})).await;
+    let mut body = segment_request(1.0);
+    body["units"] = json!("inch");
+    body["machine"] = json!("slow");
+    body["feed"] = json!(150.0);
+    let answer = json_with(app.post_json("/api/v1/segment", &body).await, 200).await;
+    let warning = answer["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|w| w["code"] == "W_FEED_ABOVE_MACHINE_MAX")
+        .unwrap_or_else(|| panic!("{answer}"));
+    let message = warning["message"].as_str().unwrap();
+    assert!(message.contains("feed 150.0 in/min is above the machine's max_feed 100.0 in/min"), "{message}");
 }

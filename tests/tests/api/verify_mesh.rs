@@ -9,7 +9,7 @@ use kerf_tests::{TestApp, json_with, problem};
 use serde_json::{Value, json};
 
 /// A GLB's JSON chunk and binary chunk, the container checked on the way.
-fn chunks(bytes: &[u8]) -> (Value, Vec<u8>) {
+pub(crate) fn chunks(bytes: &[u8]) -> (Value, Vec<u8>) {
     let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
     assert_eq!(&bytes[0..4], b"glTF");
     assert_eq!((word(4), word(8)), (2, bytes.len()));
@@ -22,7 +22,7 @@ fn chunks(bytes: &[u8]) -> (Value, Vec<u8>) {
 }
 
 /// The values of accessor `name` of the first primitive (`indices` or an attribute), as f64.
-fn values(json: &Value, bin: &[u8], name: &str) -> Vec<f64> {
+pub(crate) fn values(json: &Value, bin: &[u8], name: &str) -> Vec<f64> {
     let primitive = &json["meshes"][0]["primitives"][0];
     let index = if name == "indices" { &primitive["indices"] } else { &primitive["attributes"][name] };
     let accessor = &json["accessors"][index.as_u64().unwrap() as usize];

@@ -37,7 +37,7 @@ pub(super) fn check(job: &JobFile) -> AppResult<()> {
     }
     for (index, operation) in job.operations.iter().enumerate() {
         if let Operation::Predict(request) = operation
-            && matches!(request.stock, Stock::Mesh {})
+            && matches!(request.stock, Stock::Mesh { .. })
         {
             return Err(file_error(
                 &format!("operations[{index}].stock.kind"),

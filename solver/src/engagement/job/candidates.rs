@@ -186,7 +186,7 @@ fn path_depth(
             warnings.push(Warning::new(
                 "W_AXIAL_DEPTH",
                 format!(
-                    "{field} = {depth} mm is used; the path's Z {z} ({z_field}) under the stock top {top} would give a_p = {} mm",
+                    "{field} = {depth} mm is used; the path's Z {z} mm ({z_field}) under the stock top {top} mm would give a_p = {} mm",
                     (top - z).max(0.0)
                 ),
             ));

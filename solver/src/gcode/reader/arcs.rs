@@ -120,7 +120,10 @@ fn radius_centre(
     if radius.abs() < half - ARC_CLOSURE_MM.max(ARC_CLOSURE_RELATIVE * half) {
         return Err(SolverError::new(
             ErrorCode::ArcRadius,
-            format!("line {line}: arc radius R{} is shorter than half the chord ({:.4} mm)", r_word, half / scale),
+            format!(
+                "line {line}: arc radius R{r_word} ({:.4} mm) is shorter than half the chord ({half:.4} mm)",
+                radius.abs()
+            ),
         )
         .at(field));
     }
