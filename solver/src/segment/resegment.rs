@@ -979,6 +979,41 @@ mod tests {
     }
 
     #[test]
+    fn a_haas_machine_with_smoothing_gets_g187_after_the_heading_and_no_other_does() {
+        let source = dense_circle();
+        let program = |machine: &str, dialect: Option<Dialect>| {
+            let machine: MachineProfile = serde_json::from_str(machine).unwrap();
+            let request = request(source.clone());
+            let answer = resegment(&request, Some(machine), Control::default()).unwrap();
+            let output = OutputOptions { dialect, ..OutputOptions::default() };
+            crate::capability::program::<ResegmentCapability>(&request, &answer, &output, Control::default()).unwrap()
+        };
+        let smooth = r#"{"block_time_ms": 4, "max_feed": 10000, "dialect": "haas", "haas_smoothing": 2}"#;
+        // The program's own post (fanuc) asked for on the Haas: its heading, then G187.
+        let kept = program(smooth, Some(Dialect::Fanuc));
+        assert!(!kept.contains("G187"), "a Fanuc program has no G187");
+        let haas = program(smooth, None);
+        assert!(haas.starts_with("%\nO01000 (DENSE)\nG187 P2\nG21 G17 G90\n"), "{}", &haas[..100]);
+        assert_eq!(haas.matches("G187").count(), 1);
+        let plain = program(r#"{"block_time_ms": 4, "max_feed": 10000, "dialect": "haas"}"#, None);
+        assert!(!plain.contains("G187"), "{}", &plain[..100]);
+        assert_eq!(haas.replacen("G187 P2\n", "", 1), plain);
+        // A Haas source kept as sent (its own post) gets it too.
+        let mut own = request(source.clone());
+        own.program_dialect = Some(Dialect::Haas);
+        let machine: MachineProfile = serde_json::from_str(smooth).unwrap();
+        let answer = resegment(&own, Some(machine), Control::default()).unwrap();
+        let text = crate::capability::program::<ResegmentCapability>(
+            &own,
+            &answer,
+            &OutputOptions::default(),
+            Control::default(),
+        )
+        .unwrap();
+        assert!(text.starts_with("%\nO1000 (DENSE)\nG187 P2\nG21 G17 G90\n"), "{}", &text[..100]);
+    }
+
+    #[test]
     fn heidenhain_iso_numbers_the_blocks_and_writes_arc_centres_absolute() {
         let source = "%\nO0042 (ARC)\nG21 G17 G90\nT3 M06\nG00 G43 H3 Z5.\nG00 X10 Y0\nG01 Z-1 F100\nG03 X-10 Y0 I-10 J0 F600 (HALF)\nM30\n%\n";
         let answer = resegment(&request(source.to_owned()), None, Control::default()).unwrap();

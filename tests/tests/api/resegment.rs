@@ -188,7 +188,9 @@ async fn a_dense_circle_reposted_as_klartext_moves_within_the_chord_error() {
     let chord_error = answer["chord_error"].as_f64().unwrap();
     let klartext = reposted(&app, &body, "heidenhain").await;
     assert!(
-        klartext.starts_with("0 BEGIN PGM KERF1234 MM\n1 ; DENSE CIRCLE FROM CAM\n2 TOOL CALL 1 Z\n3 L Z+25.0000 R0 FMAX\n"),
+        klartext.starts_with(
+            "0 BEGIN PGM KERF1234 MM\n1 ; DENSE CIRCLE FROM CAM\n2 TOOL CALL 1 Z\n3 L Z+25.0000 R0 FMAX\n"
+        ),
         "{klartext}"
     );
     assert!(klartext.contains("\n; SECOND TOOL\n") || klartext.contains(" ; SECOND TOOL\n"), "{klartext}");
@@ -201,9 +203,14 @@ async fn a_dense_circle_reposted_as_klartext_moves_within_the_chord_error() {
             rapids.push(*point);
         }
     }
-    let want = [[0.0, 0.0, 25.0], [100.0, 0.0, 25.0], [100.0, 0.0, 2.0], [100.0, 0.0, 25.0], [0.0, 0.0, 25.0], [
-        0.0, 0.0, 2.0,
-    ]];
+    let want = [
+        [0.0, 0.0, 25.0],
+        [100.0, 0.0, 25.0],
+        [100.0, 0.0, 2.0],
+        [100.0, 0.0, 25.0],
+        [0.0, 0.0, 25.0],
+        [0.0, 0.0, 2.0],
+    ];
     assert_eq!(rapids[..want.len()], want, "{rapids:?}");
     // The circle: every point of the new blocks within the chord error of the program's path.
     let old_path = dense_circle_path(&source);
