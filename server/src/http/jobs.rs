@@ -15,6 +15,7 @@ use utoipa_axum::routes;
 
 use crate::error::{AppError, AppResult, Problem};
 use crate::extract::{AppPath, AppQuery, body_bytes, media_type, refuse_declared_over};
+use crate::http::output::program_disposition;
 use crate::http::stream::{held_download, pieces_of};
 use crate::jobs::file::{self, Format, JobFile};
 use crate::jobs::program::{self, OperationOutput};
@@ -306,14 +307,16 @@ async fn job_file(State(state): State<AppState>, AppPath(JobId { id }): AppPath<
     Ok(response)
 }
 
-/// A finished job's G-code program (one per operation).
+/// A finished job's G-code program (one per operation), a download named by its post
+/// (`kerf-job-{id}-{operation}.nc`, `.mpf`, `.h`, `.i`).
 ///
 /// It is decompressed as the client reads it, never whole in memory; the compressed program holds
 /// its share of the memory budget until sent (429 when other answers hold it).
 #[utoipa::path(get, path = "/api/v1/jobs/{id}/gcode", tag = "jobs", operation_id = "get_job_operation_program",
     params(("id" = i64, Path, description = "Job id", minimum = 1), ProgramQuery),
     responses(
-        (status = 200, body = String, content_type = "text/x-gcode"),
+        (status = 200, body = String, content_type = "text/x-gcode", headers(("Content-Disposition" = String,
+            description = "attachment named `kerf-job-{id}-{operation}` with the post's extension (`.nc`, `.mpf`, `.h`, `.i`)"))),
         (status = 404, body = Problem, content_type = "application/problem+json"),
         (status = 409, description = "Not finished", body = Problem, content_type = "application/problem+json"),
         (status = 422, description = "No program for that operation, or several to choose from", body = Problem, content_type = "application/problem+json"),
@@ -353,9 +356,16 @@ async fn gcode(
         .at("operation")
         .into());
     };
+    let file = store::outputs::job_file(&state.db, id)
+        .await?
+        .and_then(|json| serde_json::from_str::<JobFile>(&json).ok())
+        .ok_or_else(|| AppError::not_found(format!("job {id} does not exist")))?;
+    let disposition = program_disposition(&format!("job-{id}-{index}"), program::operation_dialect(&file, index));
     let permit = state.reserve_memory(program.held() + PIECE)?;
     let length = program.length();
-    Ok(held_download(permit, program.pieces(), length, "text/x-gcode; charset=utf-8"))
+    let mut response = held_download(permit, program.pieces(), length, "text/x-gcode; charset=utf-8");
+    response.headers_mut().insert(header::CONTENT_DISPOSITION, disposition);
+    Ok(response)
 }
 
 /// A finished job's stored file and every operation's stored outputs: 404 for an unknown job,
@@ -385,14 +395,15 @@ fn operation_outputs(rows: &[store::outputs::OperationRow]) -> Vec<OperationOutp
         .collect()
 }
 
-/// A finished job's one program: every operation in order with its tool change, spindle and
-/// coolant, one program number (`[output] program_number`, else `2000 + (id − 1) mod 6000`), a
+/// A finished job's one program (a download named by its post: `kerf-job-{id}.nc`, `.mpf`, `.i`):
+/// every operation in order with its tool change, spindle and coolant, one program number (`[output] program_number`, else `2000 + (id − 1) mod 6000`), a
 /// header listing operations, tools and estimated times. Operations without a program are named
 /// in the header as not included.
 #[utoipa::path(get, path = "/api/v1/jobs/{id}/program", tag = "jobs", operation_id = "get_job_program",
     params(("id" = i64, Path, description = "Job id", minimum = 1)),
     responses(
-        (status = 200, body = String, content_type = "text/x-gcode"),
+        (status = 200, body = String, content_type = "text/x-gcode", headers(("Content-Disposition" = String,
+            description = "attachment named `kerf-job-{id}` with the post's extension (`.nc`, `.mpf`, `.h`, `.i`)"))),
         (status = 404, body = Problem, content_type = "application/problem+json"),
         (status = 409, description = "Not finished", body = Problem, content_type = "application/problem+json"),
         (status = 422, description = "No operation has a program (`E_NO_PROGRAM`)", body = Problem, content_type = "application/problem+json"),
@@ -403,7 +414,10 @@ async fn job_program(State(state): State<AppState>, AppPath(JobId { id }): AppPa
     let text = program::job_program(&file, number, &operation_outputs(&rows))?;
     drop(rows);
     let length = text.len();
-    Ok(held_download(permit, pieces_of(text.into()), length, "text/x-gcode; charset=utf-8"))
+    let mut response = held_download(permit, pieces_of(text.into()), length, "text/x-gcode; charset=utf-8");
+    let disposition = program_disposition(&format!("job-{id}"), program::dialect(&file));
+    response.headers_mut().insert(header::CONTENT_DISPOSITION, disposition);
+    Ok(response)
 }
 
 /// Every output of a finished job as a zip archive (deflated, ZIP64 where an entry or the archive

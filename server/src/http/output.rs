@@ -14,9 +14,10 @@ use utoipa::IntoParams;
 /// Media type of G-code answers.
 pub const GCODE_MEDIA_TYPE: &str = "text/x-gcode";
 
-/// The `Content-Disposition` of a program of capability `name` in `dialect`: an attachment
-/// named `kerf-{name}.{extension}` with the post's file extension (`.nc`, `.mpf` for Sinumerik,
-/// `.h` for Heidenhain conversational, `.i` for Heidenhain ISO).
+/// The `Content-Disposition` of a program `name` (a capability's, `job-{id}` for a job's) in
+/// `dialect`: an attachment named `kerf-{name}.{extension}` with the post's file extension
+/// (`.nc`, `.mpf` for Sinumerik, `.h` for Heidenhain conversational, `.i` for Heidenhain ISO);
+/// every program download is named by it.
 pub fn program_disposition(name: &str, dialect: Dialect) -> axum::http::HeaderValue {
     let file = format!("attachment; filename=\"kerf-{name}.{}\"", dialect.file_extension());
     axum::http::HeaderValue::from_str(&file).unwrap_or_else(|_| axum::http::HeaderValue::from_static("attachment"))

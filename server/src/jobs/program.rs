@@ -6,6 +6,7 @@
 use kerf_solver::SolverError;
 use kerf_solver::capability::Lookup;
 use kerf_solver::gcode::{self, Dialect, job};
+use kerf_solver::machine::MachineProfile;
 use kerf_solver::tool::ToolRef;
 
 use super::file::JobFile;
@@ -32,15 +33,27 @@ pub fn program_number(job: &JobFile, id: Option<i64>) -> u32 {
     job.output.program_number.unwrap_or_else(|| job::number_for_job(id.unwrap_or(1)))
 }
 
-/// The dialect of the job program: the job's `[output] dialect`, else the first operation's
-/// machine's, else Fanuc.
-fn dialect(job: &JobFile) -> Dialect {
-    job.output.dialect.unwrap_or_else(|| {
-        job.operations
-            .iter()
-            .find_map(|operation| operation.refs().machine.and_then(|name| job.machine(name)))
-            .map_or_else(Dialect::default, |machine| machine.dialect)
-    })
+/// The job's machine: the first operation's that names one.
+fn machine(job: &JobFile) -> Option<MachineProfile> {
+    job.operations.iter().find_map(|operation| operation.refs().machine.and_then(|name| job.machine(name)))
+}
+
+/// The dialect of the job program: the job's `[output] dialect`, else the job's machine's, else
+/// Fanuc.
+pub fn dialect(job: &JobFile) -> Dialect {
+    job.output.dialect.unwrap_or_else(|| machine(job).map_or_else(Dialect::default, |machine| machine.dialect))
+}
+
+/// The post of operation `index`'s program: the job's `[output] dialect`, else its machine's,
+/// else Fanuc (as its program was written).
+pub fn operation_dialect(job: &JobFile, index: usize) -> Dialect {
+    job.output
+        .dialect
+        .or_else(|| {
+            let operation = job.operations.get(index)?;
+            operation.refs().machine.and_then(|name| job.machine(name)).map(|machine| machine.dialect)
+        })
+        .unwrap_or_default()
 }
 
 /// The one program of `job` (numbered `number`) from its operations' outputs.
@@ -82,7 +95,8 @@ pub fn job_program(job: &JobFile, number: u32, outputs: &[OperationOutput<'_>]) 
         None => "kerf job".to_owned(),
     };
     let coolant = job.output.coolant.unwrap_or_default();
-    job::write(&job::Job { dialect: dialect(job), number, title: &title, coolant }, &operations)
+    let haas_smoothing = machine(job).and_then(|machine| machine.haas_smoothing);
+    job::write(&job::Job { dialect: dialect(job), number, title: &title, coolant, haas_smoothing }, &operations)
 }
 
 /// Every output file of a job, in order: `job.json` (name, program number, and per operation

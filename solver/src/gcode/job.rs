@@ -94,6 +94,9 @@ pub struct Job<'a> {
     pub title: &'a str,
     /// Coolant of every operation.
     pub coolant: Coolant,
+    /// The job's machine's Haas smoothing level (`G187 P…` after the safety block, as in every
+    /// Haas program; [`super::with_haas_smoothing`]).
+    pub haas_smoothing: Option<u8>,
 }
 
 /// One operation's program, read back into its parts (line numbers and block ends taken off).
@@ -177,6 +180,8 @@ impl<'a> Section<'a> {
             comments.push(line);
         }
         (lines.next()? == table.safety).then_some(())?;
+        // Haas smoothing, which the joined program sets once for the job.
+        lines.next_if(|line| line.starts_with("G187 P"));
         let blend = lines.next_if(|line| match table.blending {
             Blending::Word(word) => *line == word,
             _ => line.starts_with("G64 "),
@@ -383,7 +388,7 @@ pub fn write(job: &Job<'_>, operations: &[Operation<'_>]) -> Result<String, Solv
         Heading::Title if job.dialect == Dialect::Linuxcnc => out.text.push_str("%\n"),
         Heading::Title => {}
     }
-    Ok(out.text.into_string())
+    Ok(super::with_haas_smoothing(out.text.into_string(), job.dialect, job.haas_smoothing))
 }
 
 /// The job program's head: number and title, the operations with their tools and times (or why
@@ -584,7 +589,8 @@ mod tests {
                 rapid_feed: None,
                 tool_change_s: None,
             };
-            let job = Job { dialect, number: 2042, title: "kerf job 42", coolant: Coolant::Flood };
+            let job =
+                Job { dialect, number: 2042, title: "kerf job 42", coolant: Coolant::Flood, haas_smoothing: None };
             let joined = write(&job, &[operation(&first), operation(&second)]);
             let Some(table) = dialect.table() else {
                 assert_eq!(joined.unwrap_err().code(), crate::error::ErrorCode::NoProgram);
@@ -626,7 +632,13 @@ mod tests {
             tool_change_s: None,
         };
         let missing = Operation { program: None, problem: Some("no path"), ..operation("") };
-        let job = Job { dialect: Dialect::Fanuc, number: 2042, title: "kerf job 42", coolant: Coolant::Flood };
+        let job = Job {
+            dialect: Dialect::Fanuc,
+            number: 2042,
+            title: "kerf job 42",
+            coolant: Coolant::Flood,
+            haas_smoothing: Some(2),
+        };
         let text = write(&job, &[operation(&first), missing, operation(&second)]).unwrap();
         assert!(text.starts_with("%\nO2042 (KERF JOB 42)\n"), "{text}");
         assert_eq!(text.lines().filter(|l| l.starts_with('O')).count(), 1);
@@ -687,10 +699,50 @@ mod tests {
         };
         let time = estimated_time_s(&section, &operation, &FANUC);
         assert!((time - (2.0 * 10.0 / 300.0 * 60.0 + 14.0 / 6000.0 * 60.0 + 10.0)).abs() < 1e-9, "{time}");
-        let job = Job { dialect: Dialect::Fanuc, number: 2001, title: "kerf job", coolant: Coolant::Off };
+        let job = Job {
+            dialect: Dialect::Fanuc,
+            number: 2001,
+            title: "kerf job",
+            coolant: Coolant::Off,
+            haas_smoothing: None,
+        };
         let joined = write(&job, &[operation]).unwrap();
         assert!(joined.contains("TOOLS T7 T8,") && joined.contains("(1 DEBURR: T7 THEN T8 BALL R3"), "{joined}");
         assert_eq!(joined.matches("M06").count(), 2);
+    }
+
+    #[test]
+    fn a_haas_job_sets_its_machines_smoothing_once_after_the_safety_block() {
+        let smoothed = |text: String| super::super::with_haas_smoothing(text, Dialect::Haas, Some(3));
+        // The operations' programs as a Haas machine with smoothing writes them.
+        let first = smoothed(program(Dialect::Haas, ToolCall::Table(7), 30.0));
+        let second = smoothed(program(Dialect::Haas, ToolCall::Table(3), 5.0));
+        assert!(first.contains("\nG187 P3\nT7 M06\n"), "{first}");
+        let operation = |text| Operation {
+            name: "contour",
+            program: Some(text),
+            problem: None,
+            tool: None,
+            rapid_feed: None,
+            tool_change_s: None,
+        };
+        let job = |haas_smoothing| Job {
+            dialect: Dialect::Haas,
+            number: 2042,
+            title: "kerf job 42",
+            coolant: Coolant::Off,
+            haas_smoothing,
+        };
+        let text = write(&job(Some(3)), &[operation(&first), operation(&second)]).unwrap();
+        assert!(text.contains("\nG21 G17 G90 G40 G49 G80 G94\nG187 P3\n(OPERATION 1 CONTOUR)\n"), "{text}");
+        assert_eq!(text.matches("G187").count(), 1, "{text}");
+        assert!(text.contains("(2 CONTOUR: T3"), "both operations are joined: {text}");
+        let plain = write(&job(None), &[operation(&first), operation(&second)]).unwrap();
+        assert!(!plain.contains("G187"), "{plain}");
+        assert_eq!(text.replacen("G187 P3\n", "", 1), plain);
+        let fanuc = Job { dialect: Dialect::Fanuc, ..job(Some(3)) };
+        let fanuc_text = write(&fanuc, &[operation(&program(Dialect::Fanuc, ToolCall::Table(7), 30.0))]).unwrap();
+        assert!(!fanuc_text.contains("G187"), "{fanuc_text}");
     }
 
     #[test]

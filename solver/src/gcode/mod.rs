@@ -347,26 +347,58 @@ pub struct ProgramStop {
     pub spindle_rpm: f64,
 }
 
-/// `text`, a program of `dialect`'s post, with Haas smoothing `G187 P<level>` after its safety
-/// block when the post is Haas and `level` is given (a machine's `haas_smoothing`); otherwise, or
-/// in a program without the post's safety block (a re-segmented program keeps the source's
-/// heading), `text` as it is.
+/// `text`, a program of `dialect`'s post, with Haas smoothing `G187 P<level>` when the post is
+/// Haas and `level` is given (a machine's `haas_smoothing`): after the post's safety block in a
+/// program kerf wrote (a capability's, a job's joined program), else (a re-segmented program,
+/// which keeps the source's heading) after the heading: the `%`, `O` and comment lines before
+/// the first block of words. A program that sets its own smoothing (a `G187` word) stays as it
+/// is, and so does every other post's.
 pub fn with_haas_smoothing(text: String, dialect: Dialect, level: Option<u8>) -> String {
     let (Some(level), Dialect::Haas, Some(table)) = (level, dialect, dialect.table()) else { return text };
     // The safety block of either units: an inch program writes its own.
     let found = [table.safety, table.inch_safety]
         .into_iter()
         .find_map(|safety| text.find(&format!("\n{safety}\n")).map(|at| at + safety.len() + 2));
-    match found {
-        Some(end) => {
-            let mut out = String::with_capacity(text.len() + 8);
-            out.push_str(&text[..end]);
-            let _ = writeln!(out, "G187 P{level}");
-            out.push_str(&text[end..]);
-            out
+    let (at, ending) = match found {
+        Some(end) => (end, "\n"),
+        None => {
+            if text.lines().any(|line| words_of(line).to_ascii_uppercase().contains("G187")) {
+                return text;
+            }
+            let mut at = 0;
+            for line in text.split_inclusive('\n') {
+                let words = words_of(line);
+                let words = words.trim();
+                let heading = words.is_empty() || words.starts_with('%') || words.starts_with(['O', 'o']);
+                if !heading {
+                    break;
+                }
+                at += line.len();
+            }
+            (at, if text.contains("\r\n") { "\r\n" } else { "\n" })
         }
-        None => text,
+    };
+    let mut out = String::with_capacity(text.len() + 10);
+    out.push_str(&text[..at]);
+    let _ = write!(out, "G187 P{level}{ending}");
+    out.push_str(&text[at..]);
+    out
+}
+
+/// A line without its comments (`( )` and from `;`).
+fn words_of(line: &str) -> String {
+    let code = line.split(';').next().unwrap_or_default();
+    let mut words = String::with_capacity(code.len());
+    let mut depth = 0usize;
+    for c in code.chars() {
+        match c {
+            '(' => depth += 1,
+            ')' => depth = depth.saturating_sub(1),
+            _ if depth == 0 => words.push(c),
+            _ => {}
+        }
     }
+    words
 }
 
 /// Writes the whole program.
@@ -924,7 +956,16 @@ mod tests {
         assert!(smooth_inch.contains("\nG20 G17 G90 G40 G49 G80 G94\nG187 P3\n"), "{smooth_inch}");
         let fanuc = write(&program(Dialect::Fanuc));
         assert_eq!(with_haas_smoothing(fanuc.clone(), Dialect::Fanuc, Some(2)), fanuc);
-        assert_eq!(with_haas_smoothing("G00 X1\n".to_owned(), Dialect::Haas, Some(3)), "G00 X1\n");
+        // A program of another layout: after its heading, unless it sets its own smoothing.
+        assert_eq!(with_haas_smoothing("G00 X1\n".to_owned(), Dialect::Haas, Some(3)), "G187 P3\nG00 X1\n");
+        assert_eq!(
+            with_haas_smoothing("%\r\nO1234 (CAM)\r\n(OP 1)\r\nG21 G90\r\n".to_owned(), Dialect::Haas, Some(1)),
+            "%\r\nO1234 (CAM)\r\n(OP 1)\r\nG187 P1\r\nG21 G90\r\n"
+        );
+        let own = "%\nO1234\nG187 P3 E0.01\nG01 X1 F100\n".to_owned();
+        assert_eq!(with_haas_smoothing(own.clone(), Dialect::Haas, Some(1)), own);
+        let commented = "(NO G187 HERE)\nG01 X1 F100\n".to_owned();
+        assert_eq!(with_haas_smoothing(commented, Dialect::Haas, Some(2)), "(NO G187 HERE)\nG187 P2\nG01 X1 F100\n");
     }
 
     #[test]

@@ -1,10 +1,12 @@
-//! Re-posting a program read as RS274/Fanuc (module `reader`) for another post of the table,
-//! line by line and in order: motion, units, plane, distance mode, tool calls with their length
-//! offset, spindle, coolant, stops, program end and comments come out in the target's words
-//! (docs/spec/resegment.md §4). A code with no counterpart known here (a dwell, a home return, a
-//! machine's own M code, smoothing words) cannot be translated honestly: the line is refused
-//! with `E_GCODE_UNSUPPORTED` naming it. Coordinates keep their units and their digits as
-//! written (with a `+` where the post signs every number).
+//! Re-posting a program read as RS274/Fanuc (module `reader`) for another post, line by line
+//! and in order: motion, units, plane, distance mode, tool calls with their length offset,
+//! spindle, coolant, stops, program end and comments come out in the target's words
+//! (docs/spec/resegment.md §4). A post of the table keeps the coordinates' units and digits as
+//! written (with a `+` where the post signs every number); Heidenhain's Klartext, whose blocks
+//! differ in structure, is written from what the reader made of each move (module `klartext`).
+//! A code with no counterpart known here (a dwell, a home return, a machine's own M code,
+//! smoothing words) cannot be translated honestly: the line is refused with
+//! `E_GCODE_UNSUPPORTED` naming it.
 
 use std::fmt::Write as _;
 
@@ -18,14 +20,14 @@ const DECIMALS: usize = 4;
 
 /// A word of a source line: its letter and its number as written.
 #[derive(Debug, Clone, Copy)]
-struct Word<'a> {
-    letter: u8,
-    text: &'a str,
-    value: f64,
+pub(super) struct Word<'a> {
+    pub(super) letter: u8,
+    pub(super) text: &'a str,
+    pub(super) value: f64,
 }
 
 /// What a source line holds, in order: words and comments.
-enum Item<'a> {
+pub(super) enum Item<'a> {
     Word(Word<'a>),
     Comment(&'a str),
 }
@@ -36,8 +38,72 @@ enum Extra {
     Comment(String),
 }
 
-/// A program being re-posted.
-pub struct Reposter {
+/// A program being re-posted: in the words of a post of the table, or as Heidenhain Klartext.
+pub enum Reposter {
+    /// A post of the table ([`PostTable`]).
+    Words(WordReposter),
+    /// Heidenhain's conversational post (module `klartext`).
+    Klartext(super::klartext::Reposter),
+}
+
+impl Reposter {
+    /// A re-poster for `dialect` of `source`, whose errors name `field`.
+    pub fn new(dialect: Dialect, source: &str, field: &'static str) -> Self {
+        match dialect.table() {
+            Some(table) => Self::Words(WordReposter::new(dialect, table, source, field)),
+            None => Self::Klartext(super::klartext::Reposter::new(source, field)),
+        }
+    }
+
+    /// The straight feed blocks of a re-cut run: `points` in mm written in `units`, `feed_word`
+    /// (as the source wrote it) on the first.
+    ///
+    /// # Errors
+    /// `E_GCODE_UNSUPPORTED` naming `line` (the run's first) where the target cannot say them
+    /// (Klartext: a run in other units than the program's).
+    pub fn feed_blocks(
+        &mut self,
+        line: usize,
+        points: &[[f64; 3]],
+        units: Units,
+        feed_word: Option<&str>,
+    ) -> Result<(), SolverError> {
+        match self {
+            Self::Words(words) => {
+                words.feed_blocks(points, units, feed_word);
+                Ok(())
+            }
+            Self::Klartext(klartext) => klartext.feed_blocks(line, points, units, feed_word),
+        }
+    }
+
+    /// Re-posts source line `number` (without its line end); `read` is its move, if it has one.
+    ///
+    /// # Errors
+    /// `E_GCODE_UNSUPPORTED` naming the line and the code that has no counterpart in the
+    /// target post; `E_GCODE_SYNTAX` for text that is not G-code (after the program end).
+    pub fn line(&mut self, number: usize, raw: &str, read: Option<&ReadMove>) -> Result<(), SolverError> {
+        match self {
+            Self::Words(words) => words.line(number, raw, read),
+            Self::Klartext(klartext) => klartext.line(number, raw, read),
+        }
+    }
+
+    /// The program written.
+    ///
+    /// # Errors
+    /// Klartext: `E_GCODE_UNSUPPORTED` naming the line of an M function left without a
+    /// positioning block to carry it.
+    pub fn finish(self, source: &str) -> Result<String, SolverError> {
+        match self {
+            Self::Words(words) => Ok(words.finish(source)),
+            Self::Klartext(klartext) => klartext.finish(),
+        }
+    }
+}
+
+/// A program being re-posted for a post of the table.
+pub struct WordReposter {
     dialect: Dialect,
     table: PostTable,
     out: Buffer,
@@ -49,23 +115,10 @@ pub struct Reposter {
     field: &'static str,
 }
 
-impl Reposter {
-    /// A re-poster for `dialect` (a post of the table) of `source`, whose errors name `field`.
-    ///
-    /// # Errors
-    /// `E_INPUT` naming `dialect` for Heidenhain's conversational post, which is not a table
-    /// post.
-    pub fn new(dialect: Dialect, source: &str, field: &'static str) -> Result<Self, SolverError> {
-        let table = check_target(dialect)?;
-        let number = source
-            .lines()
-            .map(str::trim_start)
-            .find_map(|l| {
-                let rest = l.strip_prefix(['O', 'o'])?;
-                let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
-                digits.parse().ok()
-            })
-            .unwrap_or(1000);
+impl WordReposter {
+    /// A re-poster for `dialect`, a post of `table`, of `source`, whose errors name `field`.
+    fn new(dialect: Dialect, table: PostTable, source: &str, field: &'static str) -> Self {
+        let number = program_number(source);
         let mut reposter = Self {
             dialect,
             table,
@@ -79,11 +132,11 @@ impl Reposter {
             let units = if source_units(source) == Units::Inch { "G70" } else { "G71" };
             let _ = writeln!(reposter.out, "%KERF{} {units} *", reposter.number);
         }
-        Ok(reposter)
+        reposter
     }
 
     /// The program written.
-    pub fn finish(mut self, source: &str) -> String {
+    fn finish(mut self, source: &str) -> String {
         if self.table.heading == Heading::HeidenhainIso {
             let units = if source_units(source) == Units::Inch { "G70" } else { "G71" };
             let _ = writeln!(self.out, "N99999999 %KERF{} {units} *", self.number);
@@ -121,7 +174,7 @@ impl Reposter {
 
     /// The straight feed blocks of a re-cut run: `points` in mm written in `units`, `feed_word`
     /// (as the source wrote it) on the first.
-    pub fn feed_blocks(&mut self, points: &[[f64; 3]], units: Units, feed_word: Option<&str>) {
+    fn feed_blocks(&mut self, points: &[[f64; 3]], units: Units, feed_word: Option<&str>) {
         let scale = units.scale();
         for (index, point) in points.iter().enumerate() {
             self.begin();
@@ -141,12 +194,7 @@ impl Reposter {
         }
     }
 
-    /// Re-posts source line `number` (without its line end); `read` is its move, if it has one.
-    ///
-    /// # Errors
-    /// `E_GCODE_UNSUPPORTED` naming the line and the code that has no counterpart in the
-    /// target post; `E_GCODE_SYNTAX` for text that is not G-code (after the program end).
-    pub fn line(&mut self, number: usize, raw: &str, read: Option<&ReadMove>) -> Result<(), SolverError> {
+    fn line(&mut self, number: usize, raw: &str, read: Option<&ReadMove>) -> Result<(), SolverError> {
         let line = raw.strip_suffix('\r').unwrap_or(raw);
         let trimmed = line.trim();
         if trimmed.is_empty() {
@@ -166,21 +214,12 @@ impl Reposter {
         if delete && self.dialect == Dialect::Grbl {
             return Err(self.refuse(number, "block delete (/)"));
         }
-        let items = items(code).map_err(|message| {
-            SolverError::new(ErrorCode::GcodeSyntax, format!("line {number}: {message}")).at(self.field)
-        })?;
+        let items = read_items(number, code, self.field)?;
         self.translate(number, delete, &items, read)
     }
 
     fn refuse(&self, number: usize, what: &str) -> SolverError {
-        SolverError::new(
-            ErrorCode::GcodeUnsupported,
-            format!(
-                "line {number}: {what} has no counterpart in the {} post: the program cannot be re-posted",
-                self.dialect.as_str()
-            ),
-        )
-        .at(self.field)
+        refusal(self.dialect, self.field, number, what)
     }
 
     /// A number as the target writes it: the source's digits, signed where the post signs all.
@@ -390,25 +429,42 @@ impl Reposter {
     }
 }
 
-/// The table of `dialect` when programs can be re-posted for it.
+/// `E_GCODE_UNSUPPORTED` at `field`: line `number`'s `what` cannot be said in `dialect`'s post.
+pub(super) fn refusal(dialect: Dialect, field: &'static str, number: usize, what: &str) -> SolverError {
+    SolverError::new(
+        ErrorCode::GcodeUnsupported,
+        format!(
+            "line {number}: {what} has no counterpart in the {} post: the program cannot be re-posted",
+            dialect.as_str()
+        ),
+    )
+    .at(field)
+}
+
+/// The words and comments of line `number`'s `code`.
 ///
 /// # Errors
-/// `E_INPUT` naming `dialect` for Heidenhain's conversational post, which is not a table post.
-pub fn check_target(dialect: Dialect) -> Result<PostTable, SolverError> {
-    dialect.table().ok_or_else(|| {
-        SolverError::input(
-            "dialect",
-            format!(
-                "a program cannot be re-posted for {}: its blocks differ in structure from G-code; choose \
-                 heidenhain_iso",
-                dialect.as_str()
-            ),
-        )
-    })
+/// `E_GCODE_SYNTAX` at `field` naming the line for text that is not G-code.
+pub(super) fn read_items<'a>(number: usize, code: &'a str, field: &'static str) -> Result<Vec<Item<'a>>, SolverError> {
+    items(code)
+        .map_err(|message| SolverError::new(ErrorCode::GcodeSyntax, format!("line {number}: {message}")).at(field))
+}
+
+/// The program number the heading names (its first `O` word), else 1000.
+pub(super) fn program_number(source: &str) -> u32 {
+    source
+        .lines()
+        .map(str::trim_start)
+        .find_map(|l| {
+            let rest = l.strip_prefix(['O', 'o'])?;
+            let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
+            digits.parse().ok()
+        })
+        .unwrap_or(1000)
 }
 
 /// The units the program starts in: those of its first `G20`/`G21`, else mm.
-fn source_units(source: &str) -> Units {
+pub(super) fn source_units(source: &str) -> Units {
     for line in source.lines() {
         let upper = line.to_ascii_uppercase();
         if upper.contains("G20") {

@@ -215,13 +215,6 @@ impl Capability for ResegmentCapability {
         resegment(request, context.machine, run.control)
     }
 
-    fn check_output(_request: &ResegmentRequest, output: &OutputOptions) -> Result<(), SolverError> {
-        match output.dialect {
-            Some(dialect) => crate::gcode::repost::check_target(dialect).map(|_| ()),
-            None => Ok(()),
-        }
-    }
-
     fn program(
         request: &ResegmentRequest,
         answer: &ResegmentAnswer,
@@ -721,8 +714,8 @@ pub fn write(source: &str, cuts: &[RunCut], control: Control<'_>) -> Result<Stri
 /// the program's own post (`source_dialect`).
 ///
 /// # Errors
-/// `E_INPUT` naming `dialect` for a post the re-poster cannot write; `E_GCODE_UNSUPPORTED` naming
-/// the line whose code has no counterpart in `target`; `E_CANCELLED`.
+/// `E_GCODE_UNSUPPORTED` naming the line whose code has no counterpart in `target`;
+/// `E_CANCELLED`.
 pub fn write_posted(
     source: &str,
     cuts: &[RunCut],
@@ -733,7 +726,7 @@ pub fn write_posted(
     if target == source_dialect {
         return write(source, cuts, control);
     }
-    let mut out = Reposter::new(target, source, "program")?;
+    let mut out = Reposter::new(target, source, "program");
     let program = reader::read_cancellable(source, "program", &ReadOptions::default(), control)?;
     let mut moves = program.moves.iter().peekable();
     let mut cuts = cuts.iter().peekable();
@@ -754,13 +747,13 @@ pub fn write_posted(
         }
         match cuts.next_if(|cut| cut.first_line == number) {
             Some(cut) => {
-                out.feed_blocks(&cut.points, cut.units, feed_word_of(line).as_deref());
+                out.feed_blocks(number, &cut.points, cut.units, feed_word_of(line).as_deref())?;
                 skip_until = cut.last_line;
             }
             None => out.line(number, line, moves.peek().copied().filter(|m| m.line == number))?,
         }
     }
-    Ok(out.finish(source))
+    out.finish(source)
 }
 
 /// The `F` word of a line as written, if it has one.
@@ -897,6 +890,131 @@ mod tests {
     }
 
     #[test]
+    fn a_fanuc_program_is_reposted_as_klartext_blocks_in_order() {
+        let source = dense_circle();
+        let answer = resegment(&request(source.clone()), None, Control::default()).unwrap();
+        let text =
+            write_posted(&source, &answer.cuts, Dialect::Fanuc, Dialect::Heidenhain, Control::default()).unwrap();
+        // The speed by a tool call without a tool; spindle and coolant on the next move, which
+        // the program gives before any Z.
+        assert!(
+            text.starts_with(
+                "0 BEGIN PGM KERF1000 MM\n1 ; DENSE\n2 TOOL CALL 1 Z\n3 TOOL CALL Z S6000\n\
+                 4 L X+100.0000 Y+0.0000 Z+5.0000 R0 FMAX M3 M8\n5 L Z-1.0000 R0 F300\n6 L X+99.9986 Y+0.5182 Z-1.0000 R0 F6000\n"
+            ),
+            "{}",
+            &text[..400]
+        );
+        let blocks: Vec<&str> = text.lines().map(|l| l.split_once(' ').unwrap().1).collect();
+        assert!(text.lines().enumerate().all(|(k, l)| l.starts_with(&format!("{k} "))), "block numbers");
+        let tail = &blocks[blocks.len() - 6..];
+        assert_eq!(
+            tail,
+            [
+                "L X+100.0000 Y+0.0000 Z-1.0000 R0",
+                "L Z+5.0000 R0 FMAX",
+                "L Z+5.0000 R0 FMAX M9",
+                "L Z+5.0000 R0 FMAX M5",
+                "L Z+5.0000 R0 FMAX M30",
+                "END PGM KERF1000 MM"
+            ]
+        );
+        assert_eq!(
+            blocks.iter().filter(|b| b.starts_with("L X") && !b.contains("FMAX")).count(),
+            answer.after.blocks - 1
+        );
+    }
+
+    #[test]
+    fn klartext_says_inch_feeds_arcs_and_helices_and_refuses_what_it_cannot() {
+        let source = "%\nO0042 (ARCS)\nG20 G17 G90 G54\nT3 M06\nS5000 M03\nG00 X1. Y0. Z0.2\nG01 Z-0.1 F10.\n\
+                      G03 X-1. Y0. I-1. J0. F20. (HALF)\nG02 X1. Y0. Z-0.2 R1.\nG00 Z0.2\nM00\nM05\nM30\n%\n";
+        let answer = resegment(&request(source.to_owned()), None, Control::default()).unwrap();
+        let text = write_posted(source, &answer.cuts, Dialect::Fanuc, Dialect::Heidenhain, Control::default()).unwrap();
+        let blocks: Vec<&str> = text.lines().map(|l| l.split_once(' ').unwrap().1).collect();
+        // F in 0.1 inch/min; the M3 before any position on the first move.
+        assert_eq!(
+            blocks[..9],
+            [
+                "BEGIN PGM KERF42 INCH",
+                "; ARCS",
+                "TOOL CALL 3 Z",
+                "TOOL CALL Z S5000",
+                "L X+1.0000 Y+0.0000 Z+0.2000 R0 FMAX M3",
+                "L Z-0.1000 R0 F100",
+                "CC X+0.0000 Y+0.0000",
+                "C X-1.0000 Y+0.0000 DR+ F200",
+                "; HALF",
+            ],
+            "{text}"
+        );
+        // The helical half turn as straight blocks, ending at its end.
+        let helix: Vec<&&str> = blocks[9..].iter().take_while(|b| b.starts_with("L X")).collect();
+        assert!(helix.len() > 20, "{text}");
+        assert_eq!(*helix[helix.len() - 1], "L X+1.0000 Y+0.0000 Z-0.2000 R0");
+        assert!(
+            blocks.ends_with(&[
+                "L Z+0.2000 R0 FMAX",
+                "STOP",
+                "L Z+0.2000 R0 FMAX M5",
+                "L Z+0.2000 R0 FMAX M30",
+                "END PGM KERF42 INCH"
+            ]),
+            "{text}"
+        );
+        for (program, line, what) in [
+            ("G21 G90\nG00 X0 Y0 Z1\nG55\n", 3, "G55"),
+            ("G21 G90\nG00 X0 Y0 Z1\nG20\n", 3, "G20"),
+            ("G21 G90\nG00 X0 Y0 Z1\nM06\n", 3, "M6 without a tool"),
+            ("G21 G90 G18\nG00 X0 Y0 Z1\nG02 X2 Z1 I1 K0 F100\n", 3, "outside the XY plane"),
+            ("G21 G90\nG95\n", 2, "G95"),
+            ("G21 G90\nM08\nT1 M06\n", 2, "M8 before any Z"),
+        ] {
+            let answer = resegment(&request(program.to_owned()), None, Control::default()).unwrap();
+            let error = write_posted(program, &answer.cuts, Dialect::Fanuc, Dialect::Heidenhain, Control::default())
+                .unwrap_err();
+            assert_eq!((error.code(), error.field()), (ErrorCode::GcodeUnsupported, Some("program")), "{program}");
+            let message = error.to_string();
+            assert!(message.contains(&format!("line {line}: ")) && message.contains(what), "{message}");
+        }
+    }
+
+    #[test]
+    fn a_haas_machine_with_smoothing_gets_g187_after_the_heading_and_no_other_does() {
+        let source = dense_circle();
+        let program = |machine: &str, dialect: Option<Dialect>| {
+            let machine: MachineProfile = serde_json::from_str(machine).unwrap();
+            let request = request(source.clone());
+            let answer = resegment(&request, Some(machine), Control::default()).unwrap();
+            let output = OutputOptions { dialect, ..OutputOptions::default() };
+            crate::capability::program::<ResegmentCapability>(&request, &answer, &output, Control::default()).unwrap()
+        };
+        let smooth = r#"{"block_time_ms": 4, "max_feed": 10000, "dialect": "haas", "haas_smoothing": 2}"#;
+        // The program's own post (fanuc) asked for on the Haas: its heading, then G187.
+        let kept = program(smooth, Some(Dialect::Fanuc));
+        assert!(!kept.contains("G187"), "a Fanuc program has no G187");
+        let haas = program(smooth, None);
+        assert!(haas.starts_with("%\nO01000 (DENSE)\nG187 P2\nG21 G17 G90\n"), "{}", &haas[..100]);
+        assert_eq!(haas.matches("G187").count(), 1);
+        let plain = program(r#"{"block_time_ms": 4, "max_feed": 10000, "dialect": "haas"}"#, None);
+        assert!(!plain.contains("G187"), "{}", &plain[..100]);
+        assert_eq!(haas.replacen("G187 P2\n", "", 1), plain);
+        // A Haas source kept as sent (its own post) gets it too.
+        let mut own = request(source.clone());
+        own.program_dialect = Some(Dialect::Haas);
+        let machine: MachineProfile = serde_json::from_str(smooth).unwrap();
+        let answer = resegment(&own, Some(machine), Control::default()).unwrap();
+        let text = crate::capability::program::<ResegmentCapability>(
+            &own,
+            &answer,
+            &OutputOptions::default(),
+            Control::default(),
+        )
+        .unwrap();
+        assert!(text.starts_with("%\nO1000 (DENSE)\nG187 P2\nG21 G17 G90\n"), "{}", &text[..100]);
+    }
+
+    #[test]
     fn heidenhain_iso_numbers_the_blocks_and_writes_arc_centres_absolute() {
         let source = "%\nO0042 (ARC)\nG21 G17 G90\nT3 M06\nG00 G43 H3 Z5.\nG00 X10 Y0\nG01 Z-1 F100\nG03 X-10 Y0 I-10 J0 F600 (HALF)\nM30\n%\n";
         let answer = resegment(&request(source.to_owned()), None, Control::default()).unwrap();
@@ -914,15 +1032,13 @@ mod tests {
     fn a_line_without_a_counterpart_is_refused_naming_it_unless_the_post_is_the_programs() {
         let source = "G21 G17 G90\nG00 X0 Y0 Z1\nG04 P500\nM30\n";
         let answer = resegment(&request(source.to_owned()), None, Control::default()).unwrap();
-        for target in [Dialect::Sinumerik, Dialect::Linuxcnc, Dialect::Grbl] {
+        for target in [Dialect::Sinumerik, Dialect::Linuxcnc, Dialect::Grbl, Dialect::Heidenhain] {
             let error = write_posted(source, &answer.cuts, Dialect::Fanuc, target, Control::default()).unwrap_err();
             assert_eq!(error.code(), ErrorCode::GcodeUnsupported);
             assert!(error.to_string().contains("line 3: G04"), "{error}");
         }
         let same = write_posted(source, &answer.cuts, Dialect::Fanuc, Dialect::Fanuc, Control::default()).unwrap();
         assert_eq!(same, source);
-        let klartext = write_posted(source, &answer.cuts, Dialect::Fanuc, Dialect::Heidenhain, Control::default());
-        assert_eq!(klartext.unwrap_err().field(), Some("dialect"));
         let mut sinumerik = request(source.to_owned());
         sinumerik.program_dialect = Some(Dialect::Sinumerik);
         let error = resegment(&sinumerik, None, Control::default()).unwrap_err();

@@ -212,3 +212,38 @@ async fn bad_program_requests_get_their_problem() {
     let body = problem(app.get(&format!("/api/v1/jobs/{id}/program")).await, 422).await;
     assert_eq!(body["code"], "E_NO_PROGRAM", "{body}");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+async fn job_downloads_are_named_by_their_post_and_haas_smoothing_is_set_once() {
+    let app = TestApp::spawn().await;
+    for (dialect, extension) in [("sinumerik", "mpf"), ("heidenhain_iso", "i"), ("haas", "nc")] {
+        let mut job = shop_job();
+        job["output"]["dialect"] = json!(dialect);
+        job["machines"][0]["haas_smoothing"] = json!(2);
+        let id = run_job(&app, &job).await;
+        let response = app.get(&format!("/api/v1/jobs/{id}/program")).await;
+        assert_eq!(response.status(), 200, "{dialect}");
+        let disposition = response.headers()["content-disposition"].to_str().unwrap().to_owned();
+        assert_eq!(disposition, format!("attachment; filename=\"kerf-job-{id}.{extension}\""), "{dialect}");
+        let program = response.text().await.unwrap();
+        let response = app.get(&format!("/api/v1/jobs/{id}/gcode?operation=1")).await;
+        assert_eq!(response.status(), 200, "{dialect}");
+        let disposition = response.headers()["content-disposition"].to_str().unwrap().to_owned();
+        assert_eq!(disposition, format!("attachment; filename=\"kerf-job-{id}-1.{extension}\""), "{dialect}");
+        let operation = response.text().await.unwrap();
+        if dialect == "haas" {
+            // The machine's smoothing once, after the safety block, in the job's program as in each
+            // operation's.
+            assert_eq!(program.matches("G187").count(), 1, "{program}");
+            assert!(program.contains("\nG21 G17 G90 G40 G49 G80 G94\nG187 P2\n(OPERATION 1 "), "{program}");
+            assert!(operation.contains("\nG21 G17 G90 G40 G49 G80 G94\nG187 P2\n"), "{operation}");
+            let mut plain = shop_job();
+            plain["output"]["dialect"] = json!("haas");
+            let id = run_job(&app, &plain).await;
+            let program = app.get(&format!("/api/v1/jobs/{id}/program")).await.text().await.unwrap();
+            assert!(!program.contains("G187") && program.contains("O04711"), "{program}");
+        } else {
+            assert!(!program.contains("G187") && !operation.contains("G187"), "{dialect}: {program}");
+        }
+    }
+}

@@ -188,7 +188,7 @@ fn signed(word: &str) -> Option<f64> {
 /// Reads a Klartext program: block numbers from 0 up, `BEGIN PGM` and `END PGM` with one name,
 /// only the blocks the post writes, the tool call before any move, every `C` right after its
 /// `CC` with the centre as far from the start as from the end; its moves.
-fn read_klartext(label: &str, text: &str) -> Vec<Move> {
+pub(crate) fn read_klartext(label: &str, text: &str) -> Vec<Move> {
     let lines: Vec<&str> = text.lines().collect();
     let mut blocks = Vec::new();
     for (index, line) in lines.iter().enumerate() {
@@ -211,8 +211,11 @@ fn read_klartext(label: &str, text: &str) -> Vec<Move> {
         }
         if let Some(call) = block.strip_prefix("TOOL CALL ") {
             let words: Vec<&str> = call.split(' ').collect();
-            let speed = words.last().and_then(|w| w.strip_prefix('S')).and_then(|s| s.parse::<u32>().ok());
-            assert!(speed.is_some() && words.contains(&"Z"), "{label}: {block}");
+            // `TOOL CALL [n] Z [S…]`: a call without a tool sets the speed, one without a speed keeps it.
+            let speed = words.last().and_then(|w| w.strip_prefix('S')).map(|s| s.parse::<u32>().is_ok());
+            let tool = words[0] == "Z" || (words[0].parse::<u32>().is_ok() && words.get(1) == Some(&"Z"));
+            assert!(tool && speed != Some(false) && words.len() <= 3, "{label}: {block}");
+            assert!(speed.is_some() || words[0] != "Z", "{label}: a tool call that does nothing: {block}");
             tool_called = true;
             continue;
         }
@@ -225,7 +228,7 @@ fn read_klartext(label: &str, text: &str) -> Vec<Move> {
                 "R0" => {}
                 "FMAX" => rapid = true,
                 "DR+" | "DR-" => direction = Some(word),
-                "M3" | "M4" | "M5" | "M30" => {}
+                "M1" | "M2" | "M3" | "M4" | "M5" | "M7" | "M8" | "M9" | "M30" => {}
                 _ if word.starts_with('F') => {
                     assert!(word[1..].parse::<f64>().is_ok_and(|f| f > 0.0), "{label}: {block}");
                     feed_given = true;

@@ -158,7 +158,83 @@ async fn a_fanuc_program_reposted_for_linuxcnc_and_sinumerik_moves_the_same() {
     assert!(reposted(&app, &dwell, "fanuc").await.contains("\nG04 P500\n"));
     let url = app.url("/api/v1/resegment?format=gcode&dialect=heidenhain");
     let answer = problem(app.client.post(url).json(&dwell).send().await.unwrap(), 422).await;
-    assert_eq!(answer["errors"][0]["path"], "dialect", "{answer}");
+    assert_eq!(answer["errors"][0]["path"], "program", "{answer}");
+    assert!(answer.to_string().contains("line 3: G04"), "{answer}");
+}
+
+/// The feed points of the dense circle program as written: the plunge's end, then every point.
+fn dense_circle_path(source: &str) -> Vec<[f64; 3]> {
+    let mut path = vec![[100.0, 0.0, -1.0]];
+    for line in source.lines().filter(|l| l.starts_with('X')) {
+        let mut point = [0.0, 0.0, -1.0];
+        for word in line.split(' ') {
+            match word.split_at(1) {
+                ("X", value) => point[0] = value.parse().unwrap(),
+                ("Y", value) => point[1] = value.parse().unwrap(),
+                _ => {}
+            }
+        }
+        path.push(point);
+    }
+    path
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_dense_circle_reposted_as_klartext_moves_within_the_chord_error() {
+    let app = TestApp::spawn().await;
+    let source = dense_circle_program();
+    let body = json!({"program": source, "block_time_ms": 4});
+    let answer = json_with(app.post_json("/api/v1/resegment", &body).await, 200).await;
+    let chord_error = answer["chord_error"].as_f64().unwrap();
+    let klartext = reposted(&app, &body, "heidenhain").await;
+    assert!(
+        klartext.starts_with(
+            "0 BEGIN PGM KERF1234 MM\n1 ; DENSE CIRCLE FROM CAM\n2 TOOL CALL 1 Z\n3 L Z+25.0000 R0 FMAX\n"
+        ),
+        "{klartext}"
+    );
+    assert!(klartext.contains("\n; SECOND TOOL\n") || klartext.contains(" ; SECOND TOOL\n"), "{klartext}");
+    let moves = crate::posts::read_klartext("resegment_klartext", &klartext);
+    // The rapids: the same end points in the same order (a block that carries an M function where
+    // the tool already is goes nowhere).
+    let mut rapids: Vec<[f64; 3]> = Vec::new();
+    for (feed, point) in &moves {
+        if !feed && rapids.last() != Some(point) {
+            rapids.push(*point);
+        }
+    }
+    let want = [
+        [0.0, 0.0, 25.0],
+        [100.0, 0.0, 25.0],
+        [100.0, 0.0, 2.0],
+        [100.0, 0.0, 25.0],
+        [0.0, 0.0, 25.0],
+        [0.0, 0.0, 2.0],
+    ];
+    assert_eq!(rapids[..want.len()], want, "{rapids:?}");
+    // The circle: every point of the new blocks within the chord error of the program's path.
+    let old_path = dense_circle_path(&source);
+    let new_path: Vec<[f64; 3]> = moves.iter().filter(|m| m.0 && m.1[2] == -1.0).map(|m| m.1).collect();
+    assert_eq!(new_path.len() as u64, answer["after"]["blocks"].as_u64().unwrap() - 1, "{}", answer["after"]);
+    let bound = chord_error + 1e-4;
+    let mut near = 0;
+    for pair in new_path.windows(2) {
+        for step in 0..=8 {
+            let t = f64::from(step) / 8.0;
+            let p = [0, 1, 2].map(|axis| pair[0][axis] + t * (pair[1][axis] - pair[0][axis]));
+            let window = near..(near + 2_000).min(old_path.len() - 1);
+            let (index, gap) = window
+                .map(|i| (i, to_segment(&p, &old_path[i], &old_path[i + 1])))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap();
+            assert!(gap <= bound, "{p:?} is {gap} mm off the old path (chord error {chord_error})");
+            near = index;
+        }
+    }
+    assert!(near + 2_100 > old_path.len(), "the new blocks run round the whole circle");
+    // The second tool drills at 100 mm/min after its own tool call.
+    assert!(klartext.contains(" TOOL CALL 2 Z S8000\n"), "{klartext}");
+    assert!(klartext.contains(" L Z-5.0000 R0 F100\n"), "{klartext}");
 }
 
 #[tokio::test(flavor = "multi_thread")]
