@@ -192,4 +192,8 @@ pub struct PredictRequest {
     /// passes may differ, and how far the errors of the simulated passes around them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub merge_tolerance: Option<f64>,
+    /// Cut the program the answer writes on the given stock (docs/spec/verify.md §9): default
+    /// on; `{"enabled": false}` turns it off, `resolution` sets the dexel spacing.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verification: Option<crate::verify::VerificationOptions>,
 }

@@ -132,6 +132,7 @@ pub fn bare_request(tool: &Tool, stock: Stock, path: PathInput) -> PredictReques
         exclusion_shape_error: None,
         merge_similar_passes: None,
         merge_tolerance: None,
+        verification: None,
     }
 }
 
