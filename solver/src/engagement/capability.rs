@@ -16,6 +16,8 @@ use crate::gcode::SpindleDirection;
 use crate::machine::MachineProfile;
 use crate::material::Material;
 use crate::tool::Tool;
+use crate::verify::Verification;
+use crate::verify::own::{self, Extrusion};
 
 /// The engagement capability.
 #[derive(Debug, Clone, Copy)]
@@ -55,6 +57,12 @@ pub struct EngagementAnswer {
     /// Samples, flute counts and recommendation (or `candidates`, one such result per path).
     #[serde(flatten)]
     pub result: EngagementSolution,
+    /// The program of the request's `candidate` cut on the plan-view stock extruded
+    /// (docs/spec/verify.md §9.2): rapids through material, neck, shank and holder contact and
+    /// the air share; the request gives no finished shape, so no gouge or material left. Absent
+    /// when the request turns verification off or the answer has no program (no a_p).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verification: Option<Verification>,
 }
 
 impl Capability for EngagementCapability {
@@ -91,6 +99,7 @@ impl Capability for EngagementCapability {
         run: &Run<'_>,
     ) -> Result<EngagementAnswer, SolverError> {
         check_plunge_feed(request)?;
+        let grid = verification_grid(request, &context.tool)?;
         let result = super::solve_in(
             request,
             &context.tool,
@@ -100,7 +109,7 @@ impl Capability for EngagementCapability {
         )?;
         let answer = respond(request, context, result);
         charge_samples(&answer, run)?;
-        Ok(answer)
+        verified(request, grid, answer, run)
     }
 
     /// The candidate paths of a request with `paths`, in runs of about `sizing.part_seconds`
@@ -175,6 +184,7 @@ impl Capability for EngagementCapability {
         run: &Run<'_>,
     ) -> Result<EngagementAnswer, SolverError> {
         check_plunge_feed(request)?;
+        let grid = verification_grid(request, &context.tool)?;
         let job = request.validate(&context.tool, context.machine.as_ref(), &physics(request, &context))?;
         let mut candidates = Vec::with_capacity(job.candidates.len());
         while let Some(part) = parts.next_part::<Vec<PartCandidate>>() {
@@ -188,7 +198,8 @@ impl Capability for EngagementCapability {
         if job.single || candidates.len() != job.candidates.len() {
             return Err(mismatch("fewer candidates"));
         }
-        Ok(respond(request, context, EngagementSolution::Comparison(Comparison { candidates })))
+        let answer = respond(request, context, EngagementSolution::Comparison(Comparison { candidates }));
+        verified(request, grid, answer, run)
     }
 
     /// The program of one path: `output.candidate`, else the request's `candidate`, else 0.
@@ -279,7 +290,107 @@ fn respond(request: &EngagementRequest, context: Resolved<Tool>, result: Engagem
         thickness_limit: request.thickness_limit,
         time_limit_s: request.time_limit_s,
         result,
+        verification: None,
     }
+}
+
+/// The xy rectangle of the plan-view stock as the request gives it (its outlines' points, or the
+/// bitmap's cells), `None` for a stock the solve refuses (which names its field).
+fn stock_extent(stock: &Stock) -> Option<([f64; 2], [f64; 2])> {
+    let mut points: Vec<[f64; 2]> = Vec::new();
+    match (&stock.polygon, &stock.polygons, &stock.bitmap) {
+        (Some(polygon), None, None) => points.extend(polygon.iter().copied()),
+        (None, Some(polygons), None) => {
+            points.extend(polygons.iter().flat_map(|polygon| polygon.outer.iter().copied()))
+        }
+        (None, None, Some(bitmap)) => {
+            let [x, y] = bitmap.origin;
+            points.push([x, y]);
+            points.push([x + bitmap.cell * f64::from(bitmap.width), y + bitmap.cell * f64::from(bitmap.height)]);
+        }
+        _ => return None,
+    }
+    let in_range = |value: f64| value.is_finite() && value.abs() <= crate::validate::MAX_COORDINATE;
+    if points.is_empty() || !points.iter().flatten().all(|value| in_range(*value)) {
+        return None;
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for [x, y] in points {
+        lo = [lo[0].min(x), lo[1].min(y)];
+        hi = [hi[0].max(x), hi[1].max(y)];
+    }
+    (hi[0] > lo[0] && hi[1] > lo[1]).then_some((lo, hi))
+}
+
+/// The stock's xy extent and the verification's grid over it.
+type StockGrid = (([f64; 2], [f64; 2]), own::Grid);
+
+/// The grid of the verification over the stock's extent, checked before any work (whether or
+/// not the answer will have a program): a resolution over the memory limit is refused up front.
+fn verification_grid(request: &EngagementRequest, tool: &Tool) -> Result<Option<StockGrid>, SolverError> {
+    let options = request.verification.unwrap_or_default();
+    if !options.enabled || !tool.radius.is_finite() || tool.radius <= 0.0 {
+        return Ok(None);
+    }
+    let Some(extent) = stock_extent(&request.stock) else {
+        return Ok(None);
+    };
+    Ok(Some((extent, own::grid(extent, tool, &options)?)))
+}
+
+/// `answer` with the program of the request's candidate cut on the plan-view stock extruded
+/// from 1 mm under the cut up to `stock_top_z` (earlier cuts removed): its `verification`, and
+/// the warnings and program header comments of what that found, on that candidate.
+fn verified(
+    request: &EngagementRequest,
+    grid: Option<StockGrid>,
+    mut answer: EngagementAnswer,
+    run: &Run<'_>,
+) -> Result<EngagementAnswer, SolverError> {
+    let Some(((lo, hi), grid)) = grid else {
+        return Ok(answer);
+    };
+    let index = request.candidate.unwrap_or(0);
+    let Some(post) = answer.result.candidates().get(index).map(|candidate| &candidate.post) else {
+        return Ok(answer);
+    };
+    if post.axial_depth.is_none() {
+        // No a_p: no program.
+        return Ok(answer);
+    }
+    let top = post.stock_top_z;
+    let context = Resolved {
+        tool: answer.tool.clone(),
+        machine: answer.machine.clone(),
+        material: answer.material.clone(),
+        other_tools: Vec::new(),
+    };
+    let region = request.validate(&context.tool, context.machine.as_ref(), &physics(request, &context))?.region;
+    let earlier = request.stock.previous_cuts.len();
+    let model = Extrusion {
+        lo,
+        hi,
+        top,
+        inside: Box::new(move |x, y| region.contains(super::P2::new(x, y), &mut 0)),
+        description: format!(
+            "stock: the plan-view stock{} extruded from 1 mm under the program's lowest tip up to Z{top:.3}; part: \
+             none (the request gives no finished shape), so only rapids through material, neck, shank and holder \
+             contact and the air share are checked",
+            if earlier > 0 { format!(" less its {earlier} earlier cut(s)") } else { String::new() }
+        ),
+    };
+    let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
+    let program = crate::capability::program::<EngagementCapability>(request, &answer, &output, run.control)?;
+    let limits =
+        own::Limits { tolerance: own::OWN_TOLERANCE, allowance: crate::verify::DEFAULT_ALLOWANCE, wall_tolerance: 0.0 };
+    let mut verification = own::verify(&model, grid, &program, &answer.tool, limits, run)?;
+    let candidate = match &mut answer.result {
+        EngagementSolution::Single(result) => result.as_mut(),
+        EngagementSolution::Comparison(comparison) => &mut comparison.candidates[index],
+    };
+    own::report(&mut verification, &mut candidate.warnings, &mut candidate.post.description);
+    answer.verification = Some(verification);
+    Ok(answer)
 }
 
 fn mismatch(what: &str) -> SolverError {
@@ -367,5 +478,83 @@ impl PartPost {
             centre_height: self.centre_height,
             description: self.description,
         }
+    }
+}
+
+#[cfg(test)]
+mod verification_tests {
+    use super::*;
+    use crate::tool::ToolRef;
+    use crate::verify::{FindingKind, VerificationOptions};
+
+    /// The docs/spec/api.md example, 2 mm deep; `tool` changes the tool.
+    fn request(tool: serde_json::Value) -> (EngagementRequest, Resolved<Tool>) {
+        let request: EngagementRequest = serde_json::from_value(serde_json::json!({
+            "tool": tool, "stock": {"polygon": [[0, 0], [60, 0], [60, 40], [0, 40]]},
+            "path": [[-10, 20], [70, 20]], "spindle_rpm": 3000, "feed_per_tooth": 0.05, "axial_depth": 2
+        }))
+        .unwrap();
+        let ToolRef::Inline(tool) = &request.tool else { unreachable!("an inline tool") };
+        let context = Resolved { tool: tool.clone(), machine: None, material: None, other_tools: Vec::new() };
+        (request, context)
+    }
+
+    fn fanuc(request: &EngagementRequest, answer: &EngagementAnswer) -> String {
+        let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
+        crate::capability::program::<EngagementCapability>(request, answer, &output, Control::default()).unwrap()
+    }
+
+    #[test]
+    fn the_slot_cuts_clean_on_the_stock_extruded() {
+        let (request, context) = request(serde_json::json!({"kind": "flat", "radius": 5}));
+        let answer = EngagementCapability::solve(&request, context, &Run::default()).unwrap();
+        let verification = answer.verification.as_ref().expect("verified");
+        assert!(verification.ok, "{verification:#?}");
+        // The slot: 60 long, 10 wide, 2 deep, within the grid's cells.
+        let removed = verification.removed_volume_mm3;
+        assert!((removed / 1200.0 - 1.0).abs() < 0.03, "{removed}");
+        assert!(!fanuc(&request, &answer).contains("WARNING"));
+    }
+
+    #[test]
+    fn verification_can_be_turned_off_and_a_grid_too_fine_is_refused_up_front() {
+        let (mut request, context) = request(serde_json::json!({"kind": "flat", "radius": 5}));
+        request.verification = Some(VerificationOptions { enabled: false, resolution: None });
+        let answer = EngagementCapability::solve(&request, context.clone(), &Run::default()).unwrap();
+        assert!(answer.verification.is_none());
+        request.verification = Some(VerificationOptions { enabled: true, resolution: Some(0.001) });
+        let error = EngagementCapability::solve(&request, context.clone(), &Run::default()).unwrap_err();
+        assert_eq!((error.code(), error.field()), (ErrorCode::GridMemory, Some("verification.resolution")));
+        // Without a_p there is no program to verify.
+        request.verification = None;
+        request.axial_depth = None;
+        let answer = EngagementCapability::solve(&request, context, &Run::default()).unwrap();
+        assert!(answer.verification.is_none());
+    }
+
+    /// A tool held 1.5 mm above its tip cutting 2 deep: the holder runs through the stock, found
+    /// on the cutting move, warned, and in the program's header.
+    #[test]
+    fn a_holder_too_close_to_the_tip_touches_the_stock() {
+        let (request, context) = request(serde_json::json!({"kind": "flat", "radius": 5, "stickout": 1.5}));
+        let answer = EngagementCapability::solve(&request, context, &Run::default()).unwrap();
+        let verification = answer.verification.as_ref().unwrap();
+        assert!(!verification.ok);
+        let holder: Vec<_> =
+            verification.findings.iter().filter(|finding| finding.kind == FindingKind::HolderContact).collect();
+        assert!(!holder.is_empty(), "{:#?}", verification.findings);
+        let EngagementSolution::Single(result) = &answer.result else { unreachable!("one path") };
+        assert!(result.warnings.iter().any(|warning| warning.code == "W_VERIFY_HOLDER_CONTACT"));
+        let program = fanuc(&request, &answer);
+        let lines: Vec<&str> = program.lines().collect();
+        let line = holder[0].line.unwrap();
+        assert!(program.contains(&format!("(WARNING HOLDER CONTACT AT LINE {line}: ")), "{program}");
+        // 0.5 mm deep (the holder's face 1.5 above the tip at Z-2, the stock's top at 0), on the
+        // plunge, the cut and the retract: moves of the program.
+        for finding in &holder {
+            assert!((finding.depth - 0.5).abs() < 1e-9, "{finding:?}");
+            assert!(lines[finding.line.unwrap() - 1].starts_with("G0"), "{program}");
+        }
+        assert!(holder.iter().any(|finding| lines[finding.line.unwrap() - 1].starts_with("G01 X70.")), "{program}");
     }
 }

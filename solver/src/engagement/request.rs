@@ -411,6 +411,11 @@ pub struct EngagementRequest {
     /// and a G-code path in its own G20/G21.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub units: Option<crate::units::Units>,
+    /// Cut the program of the request's `candidate` on the plan-view stock extruded
+    /// (docs/spec/verify.md §9): default on; `{"enabled": false}` turns it off, `resolution`
+    /// sets the dexel spacing.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verification: Option<crate::verify::VerificationOptions>,
 }
 
 fn yes() -> bool {

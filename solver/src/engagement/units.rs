@@ -58,7 +58,9 @@ impl Scale for EngagementRequest {
             kienzle: _,
             material: _,
             units: _,
+            verification,
         } = self;
+        verification.scale(scaling);
         tool.scale(scaling);
         stock.scale(scaling);
         path.scale(scaling);
@@ -167,7 +169,18 @@ impl Scale for FeedPlanRequest {
 /// path's result; the material's Kienzle values are not lengths.
 impl Scale for EngagementAnswer {
     fn scale(&mut self, scaling: Scaling) {
-        let Self { tool, machine, material: _, stock, thickness_limit, time_limit_s: _, cycle_time, result } = self;
+        let Self {
+            tool,
+            machine,
+            material: _,
+            stock,
+            thickness_limit,
+            time_limit_s: _,
+            cycle_time,
+            result,
+            verification,
+        } = self;
+        verification.scale(scaling);
         tool.scale(scaling);
         machine.scale(scaling);
         stock.scale(scaling);

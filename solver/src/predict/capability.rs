@@ -17,6 +17,8 @@ use crate::gcode::{Reference, ToolCall};
 use crate::geometry::Vec3;
 use crate::machine::MachineProfile;
 use crate::tool::Tool;
+use crate::verify::Verification;
+use crate::verify::own::{self, GivenStock, OwnModel};
 
 /// The predict capability.
 #[derive(Debug, Clone, Copy)]
@@ -48,6 +50,12 @@ pub struct PredictAnswer {
     /// Timings, when asked for (`?timings=true`) and in job results.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub timings: Option<Timings>,
+    /// The corrected program (the one the answer writes) cut on the given stock
+    /// (docs/spec/verify.md §9.2): rapids through material, neck, shank and holder contact and
+    /// the air share; no part is given, so no gouge or material left. Absent when the request
+    /// turns verification off.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verification: Option<Verification>,
 }
 
 impl Capability for PredictCapability {
@@ -80,8 +88,9 @@ impl Capability for PredictCapability {
     /// A `mesh` stock needs the uploaded STL file, and an upload needs a `mesh` stock.
     fn solve(request: &PredictRequest, context: Resolved<Tool>, run: &Run<'_>) -> Result<PredictAnswer, SolverError> {
         check_upload(request, run)?;
+        let model = own_model(request, &context.tool, run.upload)?;
         let result = super::solve_run(request, &context.tool, run)?;
-        Ok(PredictAnswer { tool: context.tool, result, timings: None })
+        verified(request, model, PredictAnswer { tool: context.tool, result, timings: None, verification: None }, run)
     }
 
     /// Pass ranges of about `sizing.part_seconds` each (see `cost`). Not split: a refused
@@ -140,6 +149,7 @@ impl Capability for PredictCapability {
         run: &Run<'_>,
     ) -> Result<PredictAnswer, SolverError> {
         check_upload(request, run)?;
+        let model = own_model(request, &context.tool, run.upload)?;
         let job = request.validate(&context.tool, run.upload, run.control)?;
         let count = job.path.passes.len();
         let mut outcomes: Vec<Option<Outcome>> = vec![None; count];
@@ -178,7 +188,7 @@ impl Capability for PredictCapability {
         run.control.check()?;
         let mut result = super::assemble(&job, &[outcomes], &total, &clamped, &ambiguous);
         result.warnings.extend(super::rapid_collisions(&job, &run.control)?);
-        Ok(PredictAnswer { tool: context.tool, result, timings: None })
+        verified(request, model, PredictAnswer { tool: context.tool, result, timings: None, verification: None }, run)
     }
 
     /// A G-code path is the input program with only the coordinates of moved end points changed
@@ -196,6 +206,7 @@ impl Capability for PredictCapability {
             tool: ToolCall::for_tool(&answer.tool),
             units: output.units.unwrap_or_default(),
         };
+        let header = answer.verification.as_ref().map(own::comments).unwrap_or_default();
         match (&request.path, output.reference) {
             (PathInput::Points { points }, Some(asked)) if asked != request.reference => {
                 // Tip = centre − R·z: move the points to the other programmed point.
@@ -204,9 +215,9 @@ impl Capability for PredictCapability {
                 converted.reference = asked;
                 converted.path =
                     PathInput::Points { points: points.iter().map(|p| [p[0], p[1], p[2] + shift]).collect() };
-                super::corrected_program_controlled(&converted, &answer.result, &options, control)
+                super::corrected_program_headed(&converted, &answer.result, &options, &header, control)
             }
-            _ => super::corrected_program_controlled(request, &answer.result, &options, control),
+            _ => super::corrected_program_headed(request, &answer.result, &options, &header, control),
         }
     }
 
@@ -252,6 +263,63 @@ fn check_upload(request: &PredictRequest, run: &Run<'_>) -> Result<(), SolverErr
         }
         _ => Ok(()),
     }
+}
+
+/// The prediction's own model and its grid (docs/spec/verify.md §9.2), built before any work so a
+/// resolution over the memory limit is refused up front: the given stock, raised by the ball's
+/// radius for a path of ball centres, with no part (the design surface is not an input).
+/// `None`: verification turned off, or a stock the solve refuses (which names its field).
+fn own_model(
+    request: &PredictRequest,
+    tool: &Tool,
+    upload: Option<&[u8]>,
+) -> Result<Option<(GivenStock, own::Grid)>, SolverError> {
+    let options = request.verification.unwrap_or_default();
+    if !options.enabled || !tool.radius.is_finite() || tool.radius <= 0.0 {
+        return Ok(None);
+    }
+    let mesh = if matches!(request.stock, Stock::Mesh { .. }) { upload } else { None };
+    let Ok(stock) = request.stock.model(mesh) else {
+        return Ok(None);
+    };
+    let lift = if request.reference == Reference::Centre { tool.radius } else { 0.0 };
+    let description = format!(
+        "stock: the given {} from 1 mm under the program's lowest tip up{}; part: none (the design surface is not \
+         an input), so only rapids through material, neck, shank and holder contact and the air share are checked",
+        match request.stock {
+            Stock::Box { .. } => "box",
+            Stock::Plane { .. } => "plane",
+            Stock::Cylinder { .. } => "cylinder",
+            Stock::Grid { .. } => "height grid",
+            Stock::Mesh { .. } => "mesh",
+        },
+        if lift > 0.0 { format!(", raised {lift} mm as the program gives ball centres") } else { String::new() }
+    );
+    let model = GivenStock { stock, lift, description };
+    let grid = own::grid(model.footprint(), tool, &options)?;
+    Ok(Some((model, grid)))
+}
+
+/// `answer` with the program it writes cut on the given stock: its `verification`, and the
+/// warnings and program header comments of what that found.
+fn verified(
+    request: &PredictRequest,
+    model: Option<(GivenStock, own::Grid)>,
+    mut answer: PredictAnswer,
+    run: &Run<'_>,
+) -> Result<PredictAnswer, SolverError> {
+    let Some((model, grid)) = model else {
+        return Ok(answer);
+    };
+    let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
+    let program = crate::capability::program::<PredictCapability>(request, &answer, &output, run.control)?;
+    let limits =
+        own::Limits { tolerance: own::OWN_TOLERANCE, allowance: crate::verify::DEFAULT_ALLOWANCE, wall_tolerance: 0.0 };
+    let mut verification = own::verify(&model, grid, &program, &answer.tool, limits, run)?;
+    // The header lines are written from the verification by `program`.
+    own::report(&mut verification, &mut answer.result.warnings, &mut Vec::new());
+    answer.verification = Some(verification);
+    Ok(answer)
 }
 
 fn mismatch(detail: String) -> SolverError {
@@ -388,5 +456,111 @@ mod budget_tests {
         let run = Run { budget: Some(&budget), purpose: Purpose::Json, ..Run::default() };
         PredictCapability::solve(&request, context, &run).unwrap();
         assert!(records + json <= budget.used(), "{} built, {} charged", records + json, budget.used());
+    }
+}
+
+#[cfg(test)]
+mod verification_tests {
+    use super::*;
+    use crate::tool::ToolRef;
+    use crate::verify::{FindingKind, VerificationOptions};
+
+    /// Two finishing lines over a 40 mm box at Z0, 0.25 mm under its top, with a ball R3.
+    const CLEAN: &str = "G21 G90 G17\nS8000 M03\nG0 X-4 Y-3 Z10\nG1 Z0 F1600\nX4\nY-2.5\nX-4\nG0 Z10\nM05\nM30\n";
+    /// The same with a rapid at the cutting height across uncut stock, at line 8.
+    const RAPID_THROUGH: &str =
+        "G21 G90 G17\nS8000 M03\nG0 X-4 Y-3 Z10\nG1 Z0 F1600\nX4\nY-2.5\nX-4\nG0 Y6\nG1 X4\nG0 Z10\nM05\nM30\n";
+
+    fn request(path: serde_json::Value, reference: &str) -> (PredictRequest, Resolved<Tool>) {
+        let modal = serde_json::json!([{"stiffness": 3000, "frequency_hz": 1800, "damping_ratio": 0.04}]);
+        let request: PredictRequest = serde_json::from_value(serde_json::json!({
+            "tool": {"kind": "ball", "radius": 3, "flutes": 2, "stiffness": {"kind": "modal", "x": modal, "y": modal},
+                     "shape_error": [{"angle_deg": 0, "error": 0.004}, {"angle_deg": 90, "error": 0.009}]},
+            "stock": {"kind": "box", "min": [-20, -20, -10], "max": [20, 20, 0.25]},
+            "path": path, "reference": reference, "feed": 1600, "spindle_rpm": 8000,
+            "cutting": {"ktc": 2000, "krc": 800, "kac": 300},
+            "resolution": 32
+        }))
+        .unwrap();
+        let ToolRef::Inline(tool) = &request.tool else { unreachable!("an inline tool") };
+        let context = Resolved { tool: tool.clone(), machine: None, material: None, other_tools: Vec::new() };
+        (request, context)
+    }
+
+    fn gcode(program: &str) -> (PredictRequest, Resolved<Tool>) {
+        request(serde_json::json!({"kind": "gcode", "program": program}), "tip")
+    }
+
+    fn fanuc(request: &PredictRequest, answer: &PredictAnswer) -> String {
+        let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
+        crate::capability::program::<PredictCapability>(request, answer, &output, Control::default()).unwrap()
+    }
+
+    #[test]
+    fn finishing_lines_cut_clean_on_the_given_stock() {
+        let (request, context) = gcode(CLEAN);
+        let answer = PredictCapability::solve(&request, context, &Run::default()).unwrap();
+        let verification = answer.verification.as_ref().expect("verified");
+        assert!(verification.ok, "{verification:#?}");
+        assert!(verification.removed_volume_mm3 > 0.0);
+        assert_eq!(verification.part_volume_mm3, 0.0);
+        assert!(answer.result.warnings.iter().all(|warning| !warning.code.starts_with("W_VERIFY")));
+        assert!(!fanuc(&request, &answer).contains("WARNING"));
+    }
+
+    /// Points of ball centres: the stock is raised by the radius, so the same lines remove the
+    /// same material as the tip-referenced program.
+    #[test]
+    fn a_path_of_ball_centres_cuts_where_the_tip_runs() {
+        let points =
+            serde_json::json!({"kind": "points", "points": [[-4, -3, 3], [4, -3, 3], [4, -2.5, 3], [-4, -2.5, 3]]});
+        let (request, context) = request(points, "centre");
+        let answer = PredictCapability::solve(&request, context, &Run::default()).unwrap();
+        let centres = answer.verification.expect("verified");
+        let (request, context) = gcode(CLEAN);
+        let tips = PredictCapability::solve(&request, context, &Run::default()).unwrap().verification.unwrap();
+        assert!(centres.ok, "{centres:#?}");
+        let (a, b) = (centres.removed_volume_mm3, tips.removed_volume_mm3);
+        // The tip program's plunge from Z10 at X-4 Y-3 is the points program's first move too.
+        assert!((a / b - 1.0).abs() < 0.02, "{a} against {b}");
+    }
+
+    #[test]
+    fn verification_can_be_turned_off_and_a_grid_too_fine_is_refused_up_front() {
+        let (mut request, context) = gcode(CLEAN);
+        request.verification = Some(VerificationOptions { enabled: false, resolution: None });
+        let answer = PredictCapability::solve(&request, context.clone(), &Run::default()).unwrap();
+        assert!(answer.verification.is_none());
+        assert!(!serde_json::to_string(&answer).unwrap().contains("verification"));
+        request.verification = Some(VerificationOptions { enabled: true, resolution: Some(0.001) });
+        let error = PredictCapability::solve(&request, context, &Run::default()).unwrap_err();
+        assert_eq!((error.code(), error.field()), (ErrorCode::GridMemory, Some("verification.resolution")));
+    }
+
+    /// A rapid at the cutting height across stock no pass has cut: found at its line of the
+    /// corrected program, warned, and in the header after the program's first line.
+    #[test]
+    fn a_rapid_through_the_stock_is_found_at_its_line() {
+        let (request, context) = gcode(RAPID_THROUGH);
+        let answer = PredictCapability::solve(&request, context, &Run::default()).unwrap();
+        let verification = answer.verification.as_ref().unwrap();
+        assert!(!verification.ok);
+        let rapids: Vec<_> =
+            verification.findings.iter().filter(|finding| finding.kind == FindingKind::RapidThroughMaterial).collect();
+        assert_eq!(rapids.len(), 1, "{:#?}", verification.findings);
+        assert!(answer.result.warnings.iter().any(|warning| warning.code == "W_VERIFY_RAPID_THROUGH_MATERIAL"));
+        let program = fanuc(&request, &answer);
+        let lines: Vec<&str> = program.lines().collect();
+        let line = rapids[0].line.unwrap();
+        assert_eq!(lines[line - 1], "G0 Y6", "{program}");
+        assert_eq!(line, 8 + 2, "{program}");
+        assert!(lines[0].starts_with("(WARNING VERIFICATION FOUND 1 PROBLEMS"), "{program}");
+        assert!(lines[1].starts_with(&format!("(WARNING RAPID THROUGH MATERIAL AT LINE {line}: ")), "{program}");
+        // The rest is the corrected program as before.
+        assert_eq!(lines[2..].join("\n"), {
+            let mut unverified = answer.clone();
+            unverified.verification = None;
+            fanuc(&request, &unverified).trim_end().to_owned()
+        });
     }
 }

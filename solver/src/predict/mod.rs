@@ -457,6 +457,19 @@ pub fn corrected_program_controlled(
     options: &ProgramOptions,
     control: Control<'_>,
 ) -> Result<String, SolverError> {
+    corrected_program_headed(request, answer, options, &[], control)
+}
+
+/// [`corrected_program_controlled`] with `header` comment lines before every move, one line each:
+/// a G-code path gets them after its leading `%` and `O` number lines, as `( )` comments; a
+/// program written from points among its header comments.
+pub(crate) fn corrected_program_headed(
+    request: &PredictRequest,
+    answer: &Predict,
+    options: &ProgramOptions,
+    header: &[String],
+    control: Control<'_>,
+) -> Result<String, SolverError> {
     let corrections = &answer.corrections;
     let mismatch = || SolverError::input("path", "this answer was not computed from this request");
     match &request.path {
@@ -507,7 +520,8 @@ pub fn corrected_program_controlled(
                 }
                 node = last + 1;
             }
-            reader::rewrite_cancellable(text, &program, &edits, "path.program", control)
+            let rewritten = reader::rewrite_cancellable(text, &program, &edits, "path.program", control)?;
+            Ok(with_header(rewritten, header))
         }
         PathInput::Points { points } => {
             if points.len() != corrections.nodes.len() {
@@ -540,7 +554,10 @@ pub fn corrected_program_controlled(
                             answer.summary.max_correction,
                             answer.summary.rounds[0].max_abs_error.unwrap_or(0.0)
                         ),
-                    ],
+                    ]
+                    .into_iter()
+                    .chain(header.iter().cloned())
+                    .collect(),
                     tool: options.tool.clone(),
                     spindle_rpm,
                     spindle_direction: request.spindle_direction.unwrap_or_default(),
@@ -556,4 +573,30 @@ pub fn corrected_program_controlled(
             )
         }
     }
+}
+
+/// `text` with a `( )` comment line per `header` line after its leading `%` and `O` number
+/// lines (which a control expects first).
+fn with_header(text: String, header: &[String]) -> String {
+    if header.is_empty() {
+        return text;
+    }
+    let mut at = 0;
+    for line in text.split_inclusive('\n') {
+        let word = line.trim_start();
+        let leading = word.starts_with('%')
+            || word.strip_prefix(['O', 'o']).is_some_and(|rest| rest.starts_with(|c: char| c.is_ascii_digit()));
+        if !leading || !line.ends_with('\n') {
+            break;
+        }
+        at += line.len();
+    }
+    let mut headed = String::with_capacity(text.len() + header.iter().map(|line| line.len() + 3).sum::<usize>());
+    headed.push_str(&text[..at]);
+    for line in header {
+        headed.push_str(&gcode::comment(line));
+        headed.push('\n');
+    }
+    headed.push_str(&text[at..]);
+    headed
 }

@@ -197,4 +197,8 @@ pub struct PredictRequest {
     /// Units). A G-code path keeps its own G20/G21.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub units: Option<crate::units::Units>,
+    /// Cut the program the answer writes on the given stock (docs/spec/verify.md §9): default
+    /// on; `{"enabled": false}` turns it off, `resolution` sets the dexel spacing.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verification: Option<crate::verify::VerificationOptions>,
 }

@@ -41,6 +41,7 @@ impl Scale for PredictRequest {
             merge_similar_passes: _,
             merge_tolerance,
             units: _,
+            verification,
         } = self;
         tool.scale(scaling);
         stock.scale(scaling);
@@ -50,6 +51,7 @@ impl Scale for PredictRequest {
         }
         deflection.scale(scaling);
         correction.scale(scaling);
+        verification.scale(scaling);
     }
 }
 
@@ -110,12 +112,14 @@ impl Scale for CorrectionOptions {
     }
 }
 
-/// A predict answer: the echoed tool and the prediction (its timings are times).
+/// A predict answer: the echoed tool, the prediction and the verification of its program (its
+/// timings are times).
 impl Scale for PredictAnswer {
     fn scale(&mut self, scaling: Scaling) {
-        let Self { tool, result, timings: _ } = self;
+        let Self { tool, result, timings: _, verification } = self;
         tool.scale(scaling);
         result.scale(scaling);
+        verification.scale(scaling);
     }
 }
 

@@ -90,7 +90,7 @@ pub struct Verification {
     pub wall_tolerance: f64,
     /// Stock volume before the program, mm³.
     pub stock_volume_mm3: f64,
-    /// Part volume, mm³.
+    /// Part volume, mm³ (0 when the capability knows no part: predict and engagement).
     pub part_volume_mm3: f64,
     /// Volume the program removed, mm³.
     pub removed_volume_mm3: f64,
@@ -107,8 +107,10 @@ pub struct Verification {
 pub(crate) trait OwnModel {
     /// The xy rectangle holding the stock and every ray the tool may reach.
     fn footprint(&self) -> ([f64; 2], [f64; 2]);
-    /// The stock and the part on `grid`.
-    fn fields(&self, grid: Grid, control: Control<'_>) -> Result<(Field, Field), SolverError>;
+    /// The stock and the part on `grid` (`None`: the capability knows no part, so nothing is
+    /// compared with one). `lowest` is the lowest tip height the program reaches: a stock with
+    /// no bottom of its own is floored [`FLOOR_THICKNESS`] under it.
+    fn fields(&self, grid: Grid, lowest: f64, control: Control<'_>) -> Result<(Field, Option<Field>), SolverError>;
     /// What is modelled, in a sentence.
     fn describe(&self) -> String;
 }
@@ -191,7 +193,8 @@ pub(crate) fn verify_tools(
 ) -> Result<Verification, SolverError> {
     let options = ReadOptions { max_lines: usize::MAX, ..ReadOptions::default() };
     let read = reader::read_cancellable(program, "program", &options, run.control)?;
-    let (stock, part) = model.fields(grid, run.control)?;
+    let lowest = read.moves.iter().filter_map(|read| read.to_xyz().map(|[_, _, z]| z)).fold(f64::INFINITY, f64::min);
+    let (stock, part) = model.fields(grid, lowest, run.control)?;
     let (lo, hi) = model.footprint();
     let job = Job {
         tools: tools
@@ -218,7 +221,7 @@ pub(crate) fn verify_tools(
     // would send a job's bar back, so it reports none (cancellation still reaches it).
     let unbudgeted = Run { budget: None, control: Control { progress: None, ..run.control }, ..*run };
     let description = model.describe();
-    let cut = match simulate::cut_fields(&job, stock, Some(part), &unbudgeted).map(|(cut, _)| cut) {
+    let cut = match simulate::cut_fields(&job, stock, part, &unbudgeted).map(|(cut, _)| cut) {
         Ok(cut) => cut,
         // The model and the program disagree (the tool never meets the stock): said, not refused,
         // since the program itself was solved.
@@ -401,7 +404,7 @@ impl OwnModel for Prism {
         (lo, hi)
     }
 
-    fn fields(&self, grid: Grid, control: Control<'_>) -> Result<(Field, Field), SolverError> {
+    fn fields(&self, grid: Grid, _lowest: f64, control: Control<'_>) -> Result<(Field, Option<Field>), SolverError> {
         let limit = self.stock.max(self.finish + self.wall_tolerance) + grid.spacing;
         let distance = self.distances(grid, limit, control)?;
         let floor = self.bottom - FLOOR_THICKNESS;
@@ -445,7 +448,7 @@ impl OwnModel for Prism {
                 part.push(column(part_material));
             }
         }
-        Ok((Field { grid, rays: stock }, Field { grid, rays: part }))
+        Ok((Field { grid, rays: stock }, Some(Field { grid, rays: part })))
     }
 
     fn describe(&self) -> String {
@@ -535,7 +538,7 @@ impl OwnModel for SampledTube {
         self.tube().footprint()
     }
 
-    fn fields(&self, grid: Grid, control: Control<'_>) -> Result<(Field, Field), SolverError> {
+    fn fields(&self, grid: Grid, _lowest: f64, control: Control<'_>) -> Result<(Field, Option<Field>), SolverError> {
         let tube = self.tube();
         let (mut stock, mut part) = (Vec::with_capacity(grid.len()), Vec::with_capacity(grid.len()));
         let (mut runs, mut heights) = (Vec::new(), Vec::new());
@@ -587,7 +590,7 @@ impl OwnModel for SampledTube {
                 part.push(part_ray);
             }
         }
-        Ok((Field { grid, rays: stock }, Field { grid, rays: part }))
+        Ok((Field { grid, rays: stock }, Some(Field { grid, rays: part })))
     }
 
     fn describe(&self) -> String {
@@ -601,6 +604,100 @@ fn push_merged(ray: &mut Ray, [from, to]: [f64; 2]) {
     match ray.last_mut() {
         Some(last) if last[1] >= from => last[1] = last[1].max(to),
         _ => ray.push([from, to]),
+    }
+}
+
+/// A stock the request gives as a solid (predict's), with no part: the program is checked for
+/// rapids through material and for the neck, shank and holder touching the stock, and its air
+/// share reported. The stock is modelled down to [`FLOOR_THICKNESS`] under the program's lowest
+/// tip, which no move reaches below: a plane or a height grid without a bottom has a floor. `lift` is the programmed point's height above the tip (the
+/// ball's radius for a program of ball centres): the stock is raised by it, so the tip the
+/// engine moves to the programmed point meets it where the real tip would, and the findings
+/// are at the program's coordinates.
+pub(crate) struct GivenStock {
+    pub stock: StockModel,
+    pub lift: f64,
+    pub description: String,
+}
+
+impl OwnModel for GivenStock {
+    fn footprint(&self) -> ([f64; 2], [f64; 2]) {
+        self.stock.footprint()
+    }
+
+    fn fields(&self, grid: Grid, lowest: f64, control: Control<'_>) -> Result<(Field, Option<Field>), SolverError> {
+        let floor = lowest - FLOOR_THICKNESS;
+        let solid = SolidModel::Stock(self.stock.clone());
+        let mut rays = Vec::with_capacity(grid.len());
+        let mut heights = Vec::new();
+        for j in 0..grid.ny {
+            control.check()?;
+            let y = grid.y(j);
+            for i in 0..grid.nx {
+                let x = grid.x(i);
+                let mut ray = match &self.stock {
+                    StockModel::Plane { point, normal, lo, hi } => {
+                        let mut ray = Ray::new();
+                        if x > lo[0] && x < hi[0] && y > lo[1] && y < hi[1] {
+                            // The plane's height over (x, y): (q − point)·normal = 0.
+                            let top = point.z - ((x - point.x) * normal.x + (y - point.y) * normal.y) / normal.z;
+                            ray.push([f64::NEG_INFINITY, top]);
+                        }
+                        ray
+                    }
+                    _ => solid.ray(x, y, &mut heights),
+                };
+                // Raised into the program's coordinates, cut at the floor.
+                ray.retain(|interval| {
+                    *interval = [(interval[0] + self.lift).max(floor), interval[1] + self.lift];
+                    interval[1] > interval[0]
+                });
+                rays.push(ray);
+            }
+        }
+        Ok((Field { grid, rays }, None))
+    }
+
+    fn describe(&self) -> String {
+        self.description.clone()
+    }
+}
+
+/// A plan-view stock extruded (engagement's): the material where `inside` holds, from a floor
+/// [`FLOOR_THICKNESS`] under the program's lowest tip up to `top`, with no part: checked as a
+/// [`GivenStock`] is.
+pub(crate) struct Extrusion {
+    pub lo: [f64; 2],
+    pub hi: [f64; 2],
+    pub top: f64,
+    pub inside: Box<dyn Fn(f64, f64) -> bool + Send + Sync>,
+    pub description: String,
+}
+
+impl OwnModel for Extrusion {
+    fn footprint(&self) -> ([f64; 2], [f64; 2]) {
+        (self.lo, self.hi)
+    }
+
+    fn fields(&self, grid: Grid, lowest: f64, control: Control<'_>) -> Result<(Field, Option<Field>), SolverError> {
+        let floor = lowest - FLOOR_THICKNESS;
+        let mut rays = Vec::with_capacity(grid.len());
+        for j in 0..grid.ny {
+            control.check()?;
+            let y = grid.y(j);
+            for i in 0..grid.nx {
+                let mut ray = Ray::new();
+                if self.top > floor && (self.inside)(grid.x(i), y) {
+                    ray.push([floor, self.top]);
+                }
+                rays.push(ray);
+            }
+        }
+        Ok((Field { grid, rays }, None))
+    }
+
+    fn describe(&self) -> String {
+        self.description.clone()
     }
 }
 

@@ -133,6 +133,7 @@ pub fn bare_request(tool: &Tool, stock: Stock, path: PathInput) -> PredictReques
         merge_similar_passes: None,
         merge_tolerance: None,
         units: None,
+        verification: None,
     }
 }
 

@@ -1130,3 +1130,41 @@ async fn no_move_reaches_the_stock_faster_than_the_planned_feed() {
         }
     }
 }
+
+/// The docs/spec/api.md example cut 2 deep, with `tool`.
+fn slot_request(tool: Value) -> Value {
+    json!({"tool": tool, "stock": {"polygon": [[0,0],[60,0],[60,40],[0,40]]}, "path": [[-10,20],[70,20]],
+           "spindle_rpm": 3000, "feed_per_tooth": 0.05, "axial_depth": 2})
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn the_program_is_cut_on_the_stock_extruded_and_a_holder_in_it_found_at_its_lines() {
+    let app = TestApp::spawn().await;
+    let answer = json_with(app.post_json(URL, &slot_request(json!({"kind": "flat", "radius": 5}))).await, 200).await;
+    let verification = &answer["verification"];
+    assert_eq!(verification["ok"], true, "{verification}");
+    close_rel("removed volume", number(&verification["removed_volume_mm3"]), 1200.0, 0.03);
+
+    // The holder 1.5 mm above the tip, 2 deep: in the stock on the plunge, the cut and the retract.
+    let body = slot_request(json!({"kind": "flat", "radius": 5, "stickout": 1.5}));
+    let answer = json_with(app.post_json(URL, &body).await, 200).await;
+    let verification = &answer["verification"];
+    assert_eq!(verification["ok"], false);
+    let findings = verification["findings"].as_array().unwrap();
+    assert!(!findings.is_empty() && findings.iter().all(|f| f["kind"] == "holder_contact"), "{verification}");
+    assert!(answer["warnings"].as_array().unwrap().iter().any(|w| w["code"] == "W_VERIFY_HOLDER_CONTACT"));
+    let program = app.post_text(&format!("{URL}?format=gcode&dialect=fanuc"), &body, 200).await;
+    let lines: Vec<&str> = program.lines().collect();
+    assert!(program.contains("(WARNING VERIFICATION FOUND"), "{program}");
+    for finding in findings {
+        let line = finding["line"].as_u64().unwrap() as usize;
+        assert!(program.contains(&format!("(WARNING HOLDER CONTACT AT LINE {line}: ")), "{program}");
+        assert!(lines[line - 1].starts_with("G0"), "line {line}: {program}");
+    }
+
+    let mut fine = body.clone();
+    fine["verification"] = json!({"resolution": 0.0005});
+    let refused = problem(app.post_json(URL, &fine).await, 422).await;
+    assert_eq!(refused["code"], "E_GRID_MEMORY");
+    assert_eq!(refused["errors"][0]["path"], "verification.resolution");
+}

@@ -267,7 +267,12 @@ async fn case_d_force_and_deflection_chain_over_http() {
         let got = history["force"].as_array().unwrap().iter().map(|f| number(&f[axis]).abs()).fold(0.0, f64::max);
         close("F peak", got, *want, number(&tolerances["F_peak_relative"]) * want);
     }
-    assert!(answer["warnings"].as_array().unwrap().is_empty(), "{}", answer["warnings"]);
+    // The reference program drops each pass's ball by G0 to its start, where it already cuts
+    // the tilted plane: the verification reports those rapids; the prediction warns of nothing.
+    let codes: Vec<&str> = answer["warnings"].as_array().unwrap().iter().map(|w| w["code"].as_str().unwrap()).collect();
+    assert_eq!(codes, ["W_VERIFY_RAPID_THROUGH_MATERIAL"], "{}", answer["warnings"]);
+    let rapids = answer["verification"]["findings"].as_array().unwrap();
+    assert!(rapids.iter().all(|f| f["kind"] == "rapid_through_material" && number(&f["depth"]) < 0.2), "{rapids:?}");
     // Without cutting coefficients the error is the shape error alone, with a warning.
     body.as_object_mut().unwrap().remove("cutting");
     let answer = predict(&app, &body).await;
@@ -1124,4 +1129,55 @@ async fn corrections_follow_the_node_rule_of_case_f() {
             close("case F offset", got[k], want[k], number(&case["tolerances"]["offset"]));
         }
     }
+}
+
+/// Two finishing lines of a ball R3 at Z0 over a box 0.25 mm higher, then a rapid at Z0 across
+/// stock no pass has cut (line 8), then a line there.
+fn rapid_through_request(program: &str) -> Value {
+    json!({
+        "tool": {"kind": "ball", "radius": 3, "flutes": 2,
+                 "shape_error": [{"angle_deg": 0, "error": 0.004}, {"angle_deg": 90, "error": 0.009}]},
+        "stock": {"kind": "box", "min": [-20, -20, -10], "max": [20, 20, 0.25]},
+        "path": {"kind": "gcode", "program": program},
+        "resolution": 32
+    })
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn the_corrected_program_is_cut_on_the_stock_and_a_rapid_through_it_found_at_its_line() {
+    let app = TestApp::spawn().await;
+    let clean = "G21 G90 G17\nS8000 M03\nG0 X-4 Y-3 Z10\nG1 Z0 F1600\nX4\nY-2.5\nX-4\nG0 Z10\nM05\nM30\n";
+    let answer = json_with(app.post_json("/api/v1/predict", &rapid_through_request(clean)).await, 200).await;
+    let verification = &answer["verification"];
+    assert_eq!(verification["ok"], true, "{verification}");
+    assert!(number(&verification["removed_volume_mm3"]) > 0.0, "{verification}");
+    assert!(verification["model"].as_str().unwrap().contains("part: none"), "{verification}");
+
+    let faulty =
+        "G21 G90 G17\nS8000 M03\nG0 X-4 Y-3 Z10\nG1 Z0 F1600\nX4\nY-2.5\nX-4\nG0 Y6\nG1 X4\nG0 Z10\nM05\nM30\n";
+    let body = rapid_through_request(faulty);
+    let answer = json_with(app.post_json("/api/v1/predict", &body).await, 200).await;
+    let verification = &answer["verification"];
+    assert_eq!(verification["ok"], false);
+    let finding = &verification["findings"][0];
+    assert_eq!(finding["kind"], "rapid_through_material", "{verification}");
+    // Line 8 of the program, below the two header lines.
+    assert_eq!(finding["line"], 10, "{verification}");
+    let codes: Vec<&str> = answer["warnings"].as_array().unwrap().iter().map(|w| w["code"].as_str().unwrap()).collect();
+    assert!(codes.contains(&"W_VERIFY_RAPID_THROUGH_MATERIAL"), "{codes:?}");
+    let program = app.post_text("/api/v1/predict?format=gcode", &body, 200).await;
+    let lines: Vec<&str> = program.lines().collect();
+    assert!(lines[0].starts_with("(WARNING VERIFICATION FOUND 1 PROBLEMS"), "{program}");
+    assert!(lines[1].starts_with("(WARNING RAPID THROUGH MATERIAL AT LINE 10: "), "{program}");
+    assert_eq!(lines[9], "G0 Y6", "{program}");
+
+    let mut fine = body.clone();
+    fine["verification"] = json!({"resolution": 0.0005});
+    let refused = problem(app.post_json("/api/v1/predict", &fine).await, 422).await;
+    assert_eq!(refused["code"], "E_GRID_MEMORY");
+    assert_eq!(refused["errors"][0]["path"], "verification.resolution");
+    let mut off = body;
+    off["verification"] = json!({"enabled": false});
+    let answer = json_with(app.post_json("/api/v1/predict", &off).await, 200).await;
+    assert!(answer.get("verification").is_none());
 }
