@@ -42,6 +42,10 @@ as the service's default, to measure what cutting the program costs.
 
 Before the table, once: each segment case's point count and largest chord deviation, kerf's
 (from its answer) and the peer's (sampled at 8 points inside every chord).
+
+`--answers DIR` keeps kerf's answers of the warm-up round (JSON and G-code) in DIR, or where DIR
+already holds a case's answers, says whether today's are byte for byte the same: a speed-up must
+not change a byte (save with one binary, compare with the next).
 """
 
 import argparse
@@ -431,11 +435,29 @@ def describe(name, answer, peer, result):
     return f"kerf {samples} samples; shapely {len(result)} samples"
 
 
+def keep_or_compare(directory, name, answer, gcode):
+    """Keeps a case's answers in `directory`, or compares them with those kept there."""
+    os.makedirs(directory, exist_ok=True)
+    for suffix, text in (("json", answer), ("gcode", gcode)):
+        kept = os.path.join(directory, f"{name}.{suffix}")
+        if not os.path.exists(kept):
+            with open(kept, "wb") as out:
+                out.write(text)
+            print(f"{name}: {suffix} answer kept in {kept}", flush=True)
+            continue
+        with open(kept, "rb") as before:
+            same = before.read() == text
+        print(f"{name}: {suffix} answer {'byte for byte the same as' if same else 'DIFFERS from'} {kept}",
+              flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("binary")
     parser.add_argument("--rounds", type=int, default=7)
     parser.add_argument("--only", default=",".join(CASES))
+    parser.add_argument("--answers", metavar="DIR",
+                        help="keep the answers in DIR, or compare them with those kept there")
     parser.add_argument("--verified", action="store_true",
                         help="contour answers cut their own program (the service's default; the peer does not)")
     arguments = parser.parse_args()
@@ -471,7 +493,9 @@ def main():
                     for _ in range(peer_repeats[name]):
                         result = peer.run()
                     peer_cpu = (time.process_time() - started) / peer_repeats[name]
-                    gcode_cpu, _ = kerf.timed(path + "?format=gcode", body, repeats[name])
+                    gcode_cpu, gcode_answer = kerf.timed(path + "?format=gcode", body, repeats[name])
+                    if round_ == 0 and arguments.answers:
+                        keep_or_compare(arguments.answers, name, answer, gcode_answer)
                     if round_ == 0:
                         print(f"{name}: {describe(name, answer, peer, result)}; JSON {len(answer)} bytes; "
                               f"{repeats[name]} requests and {peer_repeats[name]} calls per measurement", flush=True)

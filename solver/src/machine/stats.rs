@@ -80,6 +80,18 @@ pub fn block_stats(points: &[Vec3], feed: f64, block_time_ms: f64) -> Result<Blo
 /// One pass over the blocks, without a list of their lengths or of the angles between them (a
 /// segment answer of a long curve has about 100 000 blocks).
 pub(crate) fn stats_with_ends(points: &[Vec3], feed: f64, block_time_ms: f64, span_ends: &[usize]) -> BlockStats {
+    stats_along(points, |point| point, feed, block_time_ms, span_ends)
+}
+
+/// [`stats_with_ends`] of the positions `position` reads from `points` (a segmentation's command
+/// points, without copying their positions out first).
+pub(crate) fn stats_along<P>(
+    points: &[P],
+    position: impl Fn(&P) -> &Vec3,
+    feed: f64,
+    block_time_ms: f64,
+    span_ends: &[usize],
+) -> BlockStats {
     let block_length = feed * block_time_ms / MS_PER_MIN;
     let short_below = block_length * (1.0 - SHORT_SLACK);
     let (mut inner_min, mut all_min, mut max) = (f64::INFINITY, f64::INFINITY, 0.0_f64);
@@ -93,7 +105,7 @@ pub(crate) fn stats_with_ends(points: &[Vec3], feed: f64, block_time_ms: f64, sp
     // The previous block's vector and length: the direction change is taken where it ends.
     let mut previous: Option<(Vec3, f64)> = None;
     for (index, pair) in points.windows(2).enumerate() {
-        let step = pair[1] - pair[0];
+        let step = position(&pair[1]) - position(&pair[0]);
         let length = step.norm();
         let span_end = span_ends.binary_search(&index).is_ok();
         all_min = all_min.min(length);

@@ -104,7 +104,6 @@ use cut::{Cut, CutError, Cutter, InfeasibleAt, Numerics, Status};
 use job::{Job, Plan};
 
 use crate::error::SolverError;
-use crate::geometry::Vec3;
 
 /// Most blocks one cut may have (`E_TOO_MANY_BLOCKS`).
 pub const MAX_BLOCKS: usize = 1_000_000;
@@ -335,8 +334,15 @@ fn max_deviation(cutter: &Cutter<'_>, cut: &Cut) -> f64 {
 
 fn answer(job: &Job, request: &SegmentRequest, cutter: &Cutter<'_>, cut: &Cut) -> Result<SegmentSolution, SolverError> {
     let rule = &job.rule;
-    let positions: Vec<Vec3> = cut.vertices.iter().map(|v| v.point).collect();
-    let stats = crate::machine::stats::stats_with_ends(&positions, rule.feed, rule.block_time_ms, &cut.span_ends);
+    // Read from the cut's vertices as they are: a copy of 100 000 positions is megabytes of
+    // fresh pages for the allocator to fault in.
+    let stats = crate::machine::stats::stats_along(
+        &cut.vertices,
+        |vertex| &vertex.point,
+        rule.feed,
+        rule.block_time_ms,
+        &cut.span_ends,
+    );
     let windows: Vec<SegmentWindow> = cut
         .windows
         .iter()
@@ -373,12 +379,12 @@ fn answer(job: &Job, request: &SegmentRequest, cutter: &Cutter<'_>, cut: &Cut) -
             fixed_cutter.charge =
                 cutter.charge.map(|charge| cut::PointCharge { point_bytes: answer::POINT_MEMORY_BYTES, ..charge });
             let fixed = fixed_cutter.constant(tolerance, min_radius)?;
-            let fixed_points: Vec<Vec3> = fixed.vertices.iter().map(|v| v.point).collect();
             Some(Comparison {
                 tolerance,
                 max_deviation: max_deviation(&fixed_cutter, &fixed),
-                stats: crate::machine::stats::stats_with_ends(
-                    &fixed_points,
+                stats: crate::machine::stats::stats_along(
+                    &fixed.vertices,
+                    |vertex| &vertex.point,
                     rule.feed,
                     rule.block_time_ms,
                     &fixed.span_ends,
@@ -388,7 +394,7 @@ fn answer(job: &Job, request: &SegmentRequest, cutter: &Cutter<'_>, cut: &Cut) -
         None => None,
     };
 
-    let highest = positions.iter().map(|p| p.z).fold(f64::NEG_INFINITY, f64::max);
+    let highest = cut.vertices.iter().map(|v| v.point.z).fold(f64::NEG_INFINITY, f64::max);
     let safe_z = match job.safe_z {
         Some(z) if z < highest => {
             return Err(SolverError::input(
@@ -404,7 +410,7 @@ fn answer(job: &Job, request: &SegmentRequest, cutter: &Cutter<'_>, cut: &Cut) -
         chord_error,
         min_window_chord_error: if min_window_chord_error.is_finite() { min_window_chord_error } else { 0.0 },
         windows,
-        points: positions.iter().map(|p| CommandPoint::new(p, job.dimension)).collect(),
+        points: cut.vertices.iter().map(|v| CommandPoint::new(&v.point, job.dimension)).collect(),
         s: cut.vertices.iter().map(|v| v.s).collect(),
         max_deviation: max_deviation(cutter, cut),
         stats,
