@@ -29,6 +29,7 @@ pub mod path;
 pub mod planar;
 pub mod predict;
 pub mod segment;
+pub mod stock;
 pub mod tool;
 pub mod units;
 pub mod validate;

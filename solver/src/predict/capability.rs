@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::answer::PassStatus;
 use super::pipeline::{self, Context, Outcome};
 use super::request::Method;
-use super::{PathInput, Predict, PredictRequest, ProgramOptions, Stock, correct};
+use super::{PathInput, Predict, PredictRequest, ProgramOptions, correct};
 use crate::capability::{
     Capability, Control, Endpoint, OutputOptions, Part, PartSink, PartSource, Refs, Resolved, Run, Sizing, Split,
 };
@@ -16,6 +16,7 @@ use crate::error::{ErrorCode, SolverError};
 use crate::gcode::{Reference, ToolCall};
 use crate::geometry::Vec3;
 use crate::machine::MachineProfile;
+use crate::stock::Stock;
 use crate::tool::Tool;
 use crate::verify::Verification;
 use crate::verify::own::{self, GivenStock, OwnModel};

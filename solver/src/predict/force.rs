@@ -13,9 +13,9 @@
 use serde::{Deserialize, Serialize};
 
 use super::scene::{Cover, Scene, Side, TileLists};
-use super::stock::{Region, StockModel};
 use crate::error::SolverError;
 use crate::geometry::Vec3;
+use crate::stock::{Region, StockModel};
 use crate::validate::finite;
 
 /// Rings per engagement tile.

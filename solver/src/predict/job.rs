@@ -4,12 +4,12 @@
 
 use super::force::CuttingCoefficients;
 use super::passes::{PassSource, PathBuilder, PathModel};
-use super::stock::StockModel;
 use crate::capability::Control;
 use crate::error::{ErrorCode, SolverError};
 use crate::gcode::reader::{self, MoveKind, ReadMove, ReadOptions, ReadProgram, Spindle};
 use crate::gcode::{Reference, SpindleDirection};
 use crate::geometry::{Vec3, vec3};
+use crate::stock::StockModel;
 use crate::tool::{ShapeErrorPoint, Stiffness, Tool, ToolKind};
 use crate::validate::{MAX_COORDINATE, coordinates, finite, optional_positive, positive, quoted};
 

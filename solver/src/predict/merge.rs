@@ -29,8 +29,8 @@ use super::job::Job;
 use super::passes::PathModel;
 use super::pipeline::Outcome;
 use super::scene::{self, Piece, Scratch, Side};
-use super::stock::StockModel;
 use crate::geometry::Vec3;
+use crate::stock::StockModel;
 
 /// Simulated passes are at most this many passes apart in a run.
 pub(crate) const STRIDE: usize = 16;

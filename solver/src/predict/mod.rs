@@ -57,8 +57,6 @@ pub mod request;
 mod sampling;
 mod scene;
 pub mod shape;
-pub(crate) mod stl;
-pub mod stock;
 mod units;
 
 use std::sync::atomic::AtomicUsize;
@@ -70,7 +68,6 @@ pub use answer::{
 pub use capability::{PredictAnswer, PredictCapability, Timings};
 pub use force::CuttingCoefficients;
 pub use request::{CorrectionOptions, Method, PathInput, PredictRequest, PrescribedDeflection, SpindleDirection};
-pub use stock::Stock;
 
 use answer::Corrections;
 use correct::PassError;

@@ -9,8 +9,8 @@
 use std::collections::HashMap;
 
 use super::scene::{SampleState, Scene, TileLists};
-use super::stock::{Region, StockModel};
 use crate::geometry::Vec3;
+use crate::stock::{Region, StockModel};
 
 /// Pixels per tile side.
 const TILE: usize = 16;

@@ -5,8 +5,8 @@ pub use crate::gcode::SpindleDirection;
 use serde::{Deserialize, Serialize};
 
 use super::force::CuttingCoefficients;
-use super::stock::Stock;
 use crate::gcode::Reference;
+use crate::stock::Stock;
 use crate::tool::ToolRef;
 
 /// Default pixels per side N (the patent's 512 × 512).

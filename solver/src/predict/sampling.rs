@@ -14,8 +14,8 @@
 //! largest region is the representative one (§5 E8).
 
 use super::scene::{SampleState, Scene, TileLists};
-use super::stock::{Region, StockModel};
 use crate::geometry::Vec3;
+use crate::stock::{Region, StockModel};
 
 /// Samples per α tile. (Tile and block sizes only trade candidate-list work against point-test
 /// work: the lists are conservative, so the answer does not depend on them. 16 × 8 did the least

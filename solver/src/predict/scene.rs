@@ -7,8 +7,8 @@ use nalgebra::Matrix3;
 
 use super::capsule::{BoxProbe, Capsule};
 use super::passes::{PathModel, Stamps};
-use super::stock::{Region, StockModel};
 use crate::geometry::Vec3;
+use crate::stock::{Region, StockModel};
 
 /// Which swept volumes a capsule belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -17,7 +17,7 @@ use crate::error::{ErrorCode, SolverError, Warning};
 use crate::gcode::reader::{self, ReadOptions};
 use crate::geometry::Vec3;
 use crate::planar::{Vec2, point_segment_distance, vec2};
-use crate::predict::stock::StockModel;
+use crate::stock::StockModel;
 use crate::tool::Tool;
 use crate::validate::positive;
 

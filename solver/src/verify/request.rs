@@ -5,7 +5,7 @@ use serde::de::{self, Deserializer};
 use serde::{Deserialize, Serialize};
 
 use crate::error::SolverError;
-use crate::predict::Stock;
+use crate::stock::Stock;
 use crate::tool::ToolRef;
 
 /// Most tools one request may name.

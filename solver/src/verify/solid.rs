@@ -4,9 +4,9 @@
 
 use crate::error::SolverError;
 use crate::geometry::{Vec3, vec3};
-use crate::predict::Stock;
-use crate::predict::stl::{self, Mesh};
-use crate::predict::stock::StockModel;
+use crate::stock::Stock;
+use crate::stock::StockModel;
+use crate::stock::stl::{self, Mesh};
 use crate::validate::{coordinate, coordinates, positive};
 
 use super::dexel::{self, Field, Grid, Interval, Ray};

@@ -9,7 +9,7 @@ use super::{Cut, FindingKind, Found, Meshes, VerifyRequest, verify};
 use crate::capability::Run;
 use crate::error::ErrorCode;
 use crate::geometry::Vec3;
-use crate::predict::stl::tests::{binary_stl, box_triangles};
+use crate::stock::stl::tests::{binary_stl, box_triangles};
 use crate::tool::{Tool, ToolRef};
 
 pub(crate) fn request(body: Value) -> VerifyRequest {

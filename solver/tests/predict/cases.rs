@@ -9,8 +9,9 @@ use kerf_solver::predict::correct::{PassError, node_correction, polyline_correct
 use kerf_solver::predict::dynamics::steady_state_deflection;
 use kerf_solver::predict::shape::{Conversion, Section, shape_error_from_sections};
 use kerf_solver::predict::{
-    self, CuttingCoefficients, Method, PassFlag, PathInput, Predict, PredictRequest, PrescribedDeflection, Stock,
+    self, CuttingCoefficients, Method, PassFlag, PathInput, Predict, PredictRequest, PrescribedDeflection,
 };
+use kerf_solver::stock::Stock;
 use kerf_solver::tool::{Mode, ShapeErrorPoint, Stiffness, Tool, ToolKind};
 use serde_json::Value;
 

@@ -6,7 +6,8 @@ use std::sync::atomic::AtomicBool;
 
 use kerf_cases::predict::{bare_request, finishing_tool, inclined_case};
 use kerf_solver::SolverError;
-use kerf_solver::predict::{self, Control, Method, PassStatus, PathInput, PredictRequest, Stock};
+use kerf_solver::predict::{self, Control, Method, PassStatus, PathInput, PredictRequest};
+use kerf_solver::stock::Stock;
 use kerf_solver::tool::{Tool, ToolKind};
 
 fn flat_case() -> (PredictRequest, Tool) {

@@ -6,7 +6,8 @@
 //! blurs each by at most one pixel.
 
 use kerf_cases::predict::{bare_request, finishing_tool};
-use kerf_solver::predict::{self, PassStatus, PathInput, PredictRequest, Stock};
+use kerf_solver::predict::{self, PassStatus, PathInput, PredictRequest};
+use kerf_solver::stock::Stock;
 use kerf_solver::tool::Tool;
 
 fn flat_case(exclusion: Option<f64>) -> (PredictRequest, Tool) {

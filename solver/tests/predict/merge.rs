@@ -4,7 +4,8 @@
 //! simulated passes are unchanged, and a long uniform program simulates far fewer passes.
 
 use kerf_cases::predict::{bare_request, finishing_tool};
-use kerf_solver::predict::{self, CuttingCoefficients, PathInput, Predict, PredictRequest, Stock};
+use kerf_solver::predict::{self, CuttingCoefficients, PathInput, Predict, PredictRequest};
+use kerf_solver::stock::Stock;
 use kerf_solver::tool::Tool;
 use proptest::prelude::*;
 

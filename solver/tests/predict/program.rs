@@ -7,8 +7,8 @@ use kerf_solver::gcode::reader::{self, ReadOptions};
 use kerf_solver::gcode::{Dialect, Reference, SpindleDirection, ToolCall};
 use kerf_solver::predict::{
     self, CorrectionOptions, PassFlag, PassStatus, PathInput, PredictRequest, PrescribedDeflection, ProgramOptions,
-    Stock,
 };
+use kerf_solver::stock::Stock;
 use kerf_solver::tool::Tool;
 
 const PROGRAM: &str = "%\nO0002 (CORRECT ME)\nN10 G21 G90 G17 G94\nN20 T1 M06\nN30 S8000 M03\n\

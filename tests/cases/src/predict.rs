@@ -3,7 +3,8 @@
 //! model; a request with every option at its default; contour passes on an inclined plane.
 
 use kerf_solver::gcode::Reference;
-use kerf_solver::predict::{CuttingCoefficients, Method, PathInput, PredictRequest, Stock};
+use kerf_solver::predict::{CuttingCoefficients, Method, PathInput, PredictRequest};
+use kerf_solver::stock::Stock;
 use kerf_solver::tool::{Mode, ShapeErrorPoint, Stiffness, Tool, ToolKind, ToolRef};
 
 /// The finished surface: a smooth double wave, slopes up to about 26°.

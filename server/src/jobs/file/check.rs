@@ -2,7 +2,7 @@
 
 use kerf_solver::machine::{MachineProfile, validate_machine_name};
 use kerf_solver::material::{Material, validate_material_name};
-use kerf_solver::predict::Stock;
+use kerf_solver::stock::Stock;
 
 use super::parse::file_error;
 use super::{JobFile, MAX_OPERATIONS};

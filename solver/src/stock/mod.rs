@@ -1,15 +1,19 @@
-//! The stock W before the analysed operation (docs/spec/predict.md §1.2 I1, §3.5): analytic solids
+//! A stock as a solid, shared by prediction (the stock W before the analysed operation,
+//! docs/spec/predict.md §1.2 I1, §3.5) and verification (docs/spec/verify.md): analytic solids
 //! (box, half-space under a plane, cylinder), a height grid, or a closed STL mesh; point
 //! membership, a conservative classification of boxes used to skip whole tiles of samples, and a
 //! bound of the top under the ball that narrows the motion a scene gathers.
 
+pub mod stl;
+mod units;
+
 use crate::error::ErrorCode;
 use serde::{Deserialize, Serialize};
 
-use super::stl::{self, Mesh};
 use crate::error::SolverError;
 use crate::geometry::{Vec3, vec3};
 use crate::validate::{coordinate, coordinates, positive};
+use stl::Mesh;
 
 /// Most nodes of a height grid.
 pub const MAX_GRID_NODES: usize = 4_000_000;
@@ -439,7 +443,7 @@ mod tests {
     fn models() -> Vec<StockModel> {
         let heights: Vec<Vec<f64>> =
             (0..21).map(|j| (0..31).map(|i| 0.1 * f64::from(i) - 0.05 * f64::from(j)).collect()).collect();
-        let triangles = super::super::stl::tests::box_triangles(Vec3::new(-1.0, -2.0, -3.0), Vec3::new(2.0, 1.0, 0.5));
+        let triangles = super::stl::tests::box_triangles(Vec3::new(-1.0, -2.0, -3.0), Vec3::new(2.0, 1.0, 0.5));
         vec![
             Stock::Box { min: [-1.0, -2.0, -3.0], max: [2.0, 1.0, 0.5] }.model(None).unwrap(),
             Stock::Plane { point: [0.0, 0.0, 0.2], normal: [-0.3, 0.2, 1.0], min: [-2.0, -2.0], max: [2.0, 2.0] }
@@ -447,7 +451,7 @@ mod tests {
                 .unwrap(),
             Stock::Cylinder { start: [0.0, -2.0, 0.0], end: [0.0, 2.0, 0.0], radius: 1.5 }.model(None).unwrap(),
             Stock::Grid { origin: [-1.5, -1.0], spacing: 0.1, heights, bottom: Some(-2.0) }.model(None).unwrap(),
-            Stock::Mesh { units: None }.model(Some(&super::super::stl::tests::binary_stl(&triangles))).unwrap(),
+            Stock::Mesh { units: None }.model(Some(&super::stl::tests::binary_stl(&triangles))).unwrap(),
         ]
     }
 
