@@ -366,3 +366,28 @@ async fn verify_page_lists_findings_at_their_lines() {
         "{result}"
     );
 }
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
+async fn deburr_page_draws_the_cut_tube_with_its_chamfer() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "deburrCut", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["green"].as_u64().unwrap() >= 300 && result["tube"].as_u64().unwrap() >= 20000, "{result}");
+    assert!(result["partly"].as_f64() < result["removed"].as_f64(), "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
+async fn contour_page_draws_its_cut_stock() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "contourCut", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["partly"].as_f64() < result["removed"].as_f64(), "{result}");
+}
