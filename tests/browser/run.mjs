@@ -1353,8 +1353,10 @@ hole = { shape = "round", diameter = 16 }
   // stock cut up to an early line has lost less than the whole program removes.
   async deburrCut() {
     await page.goto(`${base}/`);
+    const started = Date.now();
     await page.click('#deburr-compute');
     await page.waitForSelector('#deburr-plot[data-cut-tube="drawn"], #deburr-result .message.warning', { timeout: 120000 });
+    const seconds = (Date.now() - started) / 1000;
     const refused = await page.$$eval('#deburr-result .message.warning', (l) => l.map((e) => e.textContent));
     if (refused.length) throw new Error(`the cut tube is not drawn: ${refused.join(' ')}`);
     const stock = await page.$eval('#deburr-plot', (e) => ({ ...e.dataset }));
@@ -1388,7 +1390,7 @@ hole = { shape = "round", diameter = 16 }
     await page.waitForSelector(`#deburr-plot[data-upto-line="${line}"]`, { timeout: 120000 });
     const partly = Number(await page.getAttribute('#deburr-plot', 'data-removed-volume'));
     if (!(partly < full)) throw new Error(`cut up to line ${line} the tube lost ${partly} mm³, the whole program ${full} mm³`);
-    return { ...counts, removed: full, partly, line: Number(line), vertices: Number(stock.stockVertices) };
+    return { ...counts, removed: full, partly, line: Number(line), vertices: Number(stock.stockVertices), seconds };
   },
 
   // The contour view draws the stock block its program cuts (the server's cut stock of the
