@@ -436,9 +436,13 @@ fn own_program(request: &DeburrRequest, answer: &DeburrAnswer, run: &Run<'_>) ->
     crate::capability::program::<DeburrCapability>(request, answer, &output, run.control)
 }
 
-/// The tools `answer`'s program calls, with the numbers it calls them by, and the limits of its
-/// verification; `None` when a loop has no program.
-fn own_cut(answer: &DeburrAnswer) -> Option<(Vec<(Option<u32>, &Tool)>, own::Limits)> {
+/// The tools a program calls, each with the `T` number it calls it by (one without a number cuts
+/// every move).
+type CalledTools<'a> = Vec<(Option<u32>, &'a Tool)>;
+
+/// The tools `answer`'s program calls and the limits of its verification; `None` when a loop has
+/// no program.
+fn own_cut(answer: &DeburrAnswer) -> Option<(CalledTools<'_>, own::Limits)> {
     let loops: Vec<&Deburr> = match &answer.holes {
         Some(holes) => holes.iter().map(|hole| &hole.result).collect(),
         None => vec![&answer.result],
