@@ -76,6 +76,24 @@ pub trait Capability {
         control: Control<'_>,
     ) -> Result<String, SolverError>;
 
+    /// The stock as the capability's own verification cuts it (docs/spec/verify.md §9.4): the
+    /// program the answer writes with the default output options (Fanuc), its moves on lines up to
+    /// `upto_line` (every line: `None`), cut on the capability's model, as binary glTF coloured by
+    /// deviation from the model's part. `None` when the request has no model (verification turned
+    /// off, or a request or capability without one). Default `None`.
+    ///
+    /// # Errors
+    /// The solve's refusals; `E_TOO_LARGE_ANSWER` at `verification.resolution` for a mesh over the
+    /// answer budget.
+    fn cut_stock(
+        _request: &Self::Request,
+        _context: Resolved<Self::Tool>,
+        _upto_line: Option<usize>,
+        _run: &Run<'_>,
+    ) -> Result<Option<Vec<u8>>, SolverError> {
+        Ok(None)
+    }
+
     /// The units the request says it is written in (its `units`), if it says.
     fn units(_request: &Self::Request) -> Option<Units> {
         None

@@ -372,6 +372,9 @@ const scenarios = {
     if (inked < 500 || chartInked < 300 || lengthsInked < 300) throw new Error(`plots nearly blank: ${inked}, ${chartInked}, ${lengthsInked}`);
     if (!/blocks\s*472/.test(summary)) throw new Error(`no summary: ${summary}`);
     if (comparison.join('|') !== 'blocks|472|158') throw new Error(`comparison: ${comparison}`);
+    // Segment has no stock to cut: the page says so rather than drawing nothing.
+    const noStock = await page.textContent('#segment-result .no-stock');
+    if (!/No cut stock/.test(noStock)) throw new Error(`no word on the missing cut stock: ${noStock}`);
 
     // The G-code download.
     const [file] = await Promise.all([page.waitForEvent('download'), page.click('#segment-gcode')]);
@@ -1343,6 +1346,74 @@ hole = { shape = "round", diameter = 16 }
     const played = Number(await page.getAttribute('#verify-stock', 'data-removed-volume'));
     if (played !== full) throw new Error(`played to the end, the stock lost ${played} mm³, not ${full}`);
     return { findings: findings.length, marked: marked.length, red, removed: full, plunged };
+  },
+
+  // The deburr view draws the tube its program cuts, from the server's cut stock of the deburr's
+  // own verification: the tube with its hole in the scene (the see-through hole wall gone), the
+  // chamfer band green (cut to the part), the findings' table and listing, and playback: the
+  // stock cut up to an early line has lost less than the whole program removes.
+  async deburrCut() {
+    await page.goto(`${base}/`);
+    const started = Date.now();
+    await page.click('#deburr-compute');
+    await page.waitForSelector('#deburr-plot[data-cut-tube="drawn"], #deburr-result .message.warning', { timeout: 120000 });
+    const seconds = (Date.now() - started) / 1000;
+    const refused = await page.$$eval('#deburr-result .message.warning', (l) => l.map((e) => e.textContent));
+    if (refused.length) throw new Error(`the cut tube is not drawn: ${refused.join(' ')}`);
+    const stock = await page.$eval('#deburr-plot', (e) => ({ ...e.dataset }));
+    if (!stock.objects.split(' ').includes('stock')) throw new Error(`no cut stock in the scene: ${stock.objects}`);
+    const listed = await page.$$eval('#deburr-listing li', (l) => l.length);
+    if (listed < 20) throw new Error(`the verified program lists ${listed} lines`);
+    await page.click('#deburr-plot button:text("Along hole axis")');
+    const counts = await page.$eval('#deburr-plot canvas', (canvas, pixels) => {
+      const data = eval(pixels)(canvas);
+      let green = 0;
+      let tube = 0;
+      for (let i = 0; i < data.length; i += 4) {
+        const [r, g, b] = [data[i], data[i + 1], data[i + 2]];
+        if (g > 110 && g - r > 50 && g - b > 50) green++;
+        else if (Math.abs(r - g) < 12 && Math.abs(g - b) < 12 && r > 110 && r < 235) tube++;
+      }
+      return { green, tube };
+    }, PIXELS);
+    if (counts.tube < 20000) throw new Error(`the cut tube is not drawn: ${counts.tube} grey pixels`);
+    if (counts.green < 300) throw new Error(`the chamfer band is not drawn green: ${counts.green} green pixels`);
+    const full = Number(stock.removedVolume);
+    if (!(full > 0) || !(Number(stock.cutVertices) > 0)) throw new Error(`nothing cut: ${JSON.stringify(stock)}`);
+    // Playback: a third of the way through the moves.
+    const moves = Number(await page.getAttribute('#deburr-position', 'max'));
+    const early = Math.floor(moves / 3);
+    const line = await page.$eval('#deburr-position', (slider, early) => {
+      slider.value = String(early);
+      slider.dispatchEvent(new Event('input'));
+      return /line (\d+)/.exec(document.querySelector('#deburr-playback-readout').textContent)[1];
+    }, early);
+    await page.waitForSelector(`#deburr-plot[data-upto-line="${line}"]`, { timeout: 120000 });
+    const partly = Number(await page.getAttribute('#deburr-plot', 'data-removed-volume'));
+    if (!(partly < full)) throw new Error(`cut up to line ${line} the tube lost ${partly} mm³, the whole program ${full} mm³`);
+    return { ...counts, removed: full, partly, line: Number(line), vertices: Number(stock.stockVertices), seconds };
+  },
+
+  // The contour view draws the stock block its program cuts (the server's cut stock of the
+  // contour's own verification) under the plan, with playback.
+  async contourCut() {
+    await page.goto(`${base}/#contour`);
+    await page.click('#contour-compute');
+    await page.waitForSelector('#contour-stock[data-state="drawn"][data-stock-vertices]', { timeout: 120000 });
+    const stock = await page.$eval('#contour-stock', (e) => ({ ...e.dataset }));
+    const inked = await inkedPixels('#contour-stock canvas');
+    if (inked < 20000) throw new Error(`the cut stock is nearly blank: ${inked} inked pixels`);
+    const full = Number(stock.removedVolume);
+    if (!(full > 0)) throw new Error(`nothing cut: ${JSON.stringify(stock)}`);
+    const line = await page.$eval('#contour-position', (slider) => {
+      slider.value = String(Math.floor(Number(slider.max) / 4));
+      slider.dispatchEvent(new Event('input'));
+      return /line (\d+)/.exec(document.querySelector('#contour-playback-readout').textContent)[1];
+    });
+    await page.waitForSelector(`#contour-stock[data-upto-line="${line}"]`, { timeout: 120000 });
+    const partly = Number(await page.getAttribute('#contour-stock', 'data-removed-volume'));
+    if (!(partly < full)) throw new Error(`cut up to line ${line} the stock lost ${partly} mm³, the whole program ${full} mm³`);
+    return { inked, removed: full, partly, line: Number(line), vertices: Number(stock.stockVertices) };
   },
 };
 

@@ -5,6 +5,7 @@
 // warnings and the G-code download. `contourResult` also renders job results.
 import { Timeline } from '/timeline.js';
 import { DXF_FIELDS, dxfUpload } from '/dxf.js';
+import { verificationPanel, verifiedProgram } from '/plot/cut-stock.js';
 import { ContourPlan } from '/plot/plan.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
 import { answerAndProgram, downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, POST_OPTIONS, programName, refusalMessage, showSummary, submitFlow, value, warningMessages } from '/form.js';
@@ -223,9 +224,11 @@ function summaryItems(answer) {
   return items;
 }
 
-// Shows a contour answer in `container`: layer selector, plot, corner table, summary, warnings.
-// Used by the form and by job results. Returns the canvas.
-export function contourResult(container, answer, { program } = {}) {
+// Shows a contour answer in `container`: layer selector, plot, corner table, summary, warnings,
+// and with a program its verification (`cutStock`: with the stock as cut, which cuts the program
+// again: the form's, not a job's, whose work may be long). Used by the form and by job results.
+// Returns the canvas.
+export function contourResult(container, answer, { program, request, cutStock = false } = {}) {
   container.replaceChildren();
   const bar = document.createElement('div');
   bar.className = 'actions layer-bar';
@@ -321,7 +324,33 @@ export function contourResult(container, answer, { program } = {}) {
     });
     sceneBox.after(timeline.root);
   }
+  if (program && request && answer.verification) drawCutStock(container, answer, request, cutStock);
   return canvas;
+}
+
+// The findings of the contour's own verification, and (`cutStock`) the stock block as the program
+// cuts it, from the server's cut stock of that verification (POST /api/v1/contour/stock, at the verification's spacing, in the program's
+// default Fanuc form, whose lines the findings count), with the findings and playback.
+async function drawCutStock(container, answer, request, cutStock) {
+  let program = null;
+  // A job's answer is listed without its program: fetching it solves the job's work again.
+  if (cutStock) {
+    try {
+      program = await verifiedProgram('contour', request);
+    } catch (problem) {
+      container.append(message('warning', `The cut stock cannot be drawn: ${problem.detail || problem.title}`));
+      return;
+    }
+  }
+  await verificationPanel(container, {
+    id: 'contour',
+    verification: answer.verification,
+    program,
+    path: cutStock ? '/api/v1/contour/stock' : undefined,
+    why: 'a job\'s program is cut again only in the Contour view',
+    body: request,
+    resolution: answer.verification.resolution,
+  });
 }
 
 // Every layer in 3-D: the part's outline as a see-through prism from the lowest layer to the top,
@@ -413,9 +442,9 @@ export const contourView = {
       result,
       read: request,
       ask: (body) => answerAndProgram('/api/v1/contour', body, gcodeQuery(form)),
-      show: ({ answer, program, refusal }) => {
+      show: ({ answer, program, refusal }, request) => {
         root.querySelector('#contour-gcode').disabled = !program;
-        contourResult(result, answer, { program }).id = 'contour-plot';
+        contourResult(result, answer, { program, request, cutStock: true }).id = 'contour-plot';
         return refusalMessage(refusal, 'this path');
       },
       failed: (problem) => markContour(form, messages, problem),

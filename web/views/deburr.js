@@ -3,6 +3,7 @@
 // Deburr).
 import { api, program as programOf, sentence } from '/api.js';
 import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, POST_OPTIONS, programName, showSummary, submitFlow, value, warningMessages } from '/form.js';
+import { verificationPanel, verifiedProgram } from '/plot/cut-stock.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
 import { clearance, inRadii } from '/views/deburr-clearance.js';
@@ -165,11 +166,12 @@ function addWorkpiece(scene, request) {
 
 // Shows a deburr answer in `container`: the 3-D scene (solids when the request is known, ridge,
 // ball-centre path, approach and retract, the tool at the timeline's move), summary, warnings,
-// and with a program the timeline and its listing. `context`: {request, program, problem,
-// reference}. Used by the form and by job results.
+// and with a program the timeline and its listing, and its verification (`cutStock`: with the
+// tube as cut, which cuts the program again: the form's, not a job's, whose work may be long).
+// `context`: {request, program, problem, reference, cutStock}. Used by the form and by job results.
 export function deburrResult(container, answer, context = {}) {
   container.replaceChildren();
-  const { request, program, problem, reference = 'tip' } = context;
+  const { request, program, problem, reference = 'tip', cutStock = false } = context;
   const warnings = document.createElement('div');
   const summaryBox = document.createElement('div');
   summaryBox.className = 'summary';
@@ -216,11 +218,11 @@ export function deburrResult(container, answer, context = {}) {
   scene.moveTool(points[0].centre);
   if (found) scene.markTool(Object.values(found.at(points[0].centre)).some(Boolean));
   if (program) {
-    const lift = reference === 'tip' ? tool.radius || 0 : 0;
+    const centreLift = lift(tool, reference);
     new Timeline(container, program, {
       label: 'Timeline',
       onMove: (move) => {
-        const centre = [move.position[0], move.position[1], move.position[2] + lift];
+        const centre = [move.position[0], move.position[1], move.position[2] + centreLift];
         scene.moveTool(centre);
         // Red where the ball or the neck is in the wall at this move.
         if (found) {
@@ -255,7 +257,69 @@ export function deburrResult(container, answer, context = {}) {
   if (answer.cycle_time) items.push(['cycle time, s', number(answer.cycle_time.total_s, 1)]);
   showSummary(summaryBox, items);
   warnings.replaceChildren(...notes, ...warningMessages(answer.warnings));
+  if (request && program && answer.verification) drawCutTube(container, scene, answer, request, lift(tool, 'tip'), cutStock);
   return scene.root;
+}
+
+// The height of the ball centre above the programmed point: the ball radius for the tip.
+function lift(tool, reference) {
+  return reference === 'tip' ? tool.radius || 0 : 0;
+}
+
+// Most rays of the cut tube the page asks for: the tube's faces are curved, so each ray keeps its
+// own quads (about four a ray on the reference tube), and this many keep the mesh about a million
+// vertices (some 40 MB from the service) and a few seconds to cut and draw.
+const TUBE_RAYS = 60000;
+
+// The spacing the page asks the cut tube at: a third of the chamfer width W (so the band is a few
+// rays wide), coarsened to at most TUBE_RAYS over the verification's footprint.
+export function tubeResolution(answer) {
+  const { rays: [nx, ny], resolution } = answer.verification;
+  const area = nx * ny * resolution * resolution;
+  return Math.max((answer.summary.width || resolution) / 3, Math.sqrt(area / TUBE_RAYS));
+}
+
+// The tube with its holes and the chamfers as the program cuts them, from the server's cut stock
+// of the deburr's own verification (POST /api/v1/deburr/stock, in the program's default Fanuc
+// form, whose lines the findings count), drawn in the deburr scene in place of the see-through
+// tube and hole wall (the view closes in on the chamfers); the findings listed under it, and playback that
+// cuts the chamfer move by move.
+async function drawCutTube(container, scene, answer, request, centreLift, cutStock) {
+  let program = null;
+  // A job's answer is listed without its program: fetching it solves the job's work again.
+  if (cutStock) {
+    try {
+      program = await verifiedProgram('deburr', request);
+    } catch (problem) {
+      container.append(message('warning', `The cut tube cannot be drawn: ${sentence(problem.detail || problem.title)}`));
+      return;
+    }
+  }
+  const stock = await verificationPanel(container, {
+    id: 'deburr',
+    verification: answer.verification,
+    program,
+    path: cutStock ? '/api/v1/deburr/stock' : undefined,
+    why: 'a job\'s program is cut again only in the Deburr view',
+    body: request,
+    resolution: tubeResolution(answer),
+    scene,
+    onMove: (move) => scene.moveTool([move.position[0], move.position[1], move.position[2] + centreLift]),
+  });
+  const cut = scene.scene?.getObjectByName('stock');
+  if (stock && cut) {
+    // The cut tube replaces the see-through solids, and the view closes in on the chamfers.
+    for (const name of ['tube', 'bore_block', 'hole']) {
+      const solid = scene.scene.getObjectByName(name);
+      if (solid) solid.visible = false;
+    }
+    // The chamfer is the subject: the ridges and a ball's width about them.
+    const reach = 2 * (answer.tool?.radius || 1) + (answer.summary.width || 0);
+    const ridges = [answer.points, ...(answer.holes ?? []).map((loop) => loop.points)].flat().map((p) => new THREE.Vector3(...p.target));
+    scene.box.setFromPoints(ridges).expandByScalar(reach);
+    scene.fit();
+    scene.root.dataset.cutTube = 'drawn';
+  }
 }
 
 // The direction the hole axis A2 points (the view "along the hole axis" looks down it).
@@ -293,7 +357,7 @@ export const deburrView = {
       } catch (refused) {
         problem = refused;
       }
-      const scene = deburrResult(result, last.answer, { request: last.request, program, problem, reference });
+      const scene = deburrResult(result, last.answer, { request: last.request, program, problem, reference, cutStock: true });
       scene.id = 'deburr-plot';
       // Off when the service refuses the program or the page sees the approach cut the wall;
       // the reason is beside the button (a tooltip alone is out of reach on a touch screen).

@@ -2,6 +2,7 @@
 // (docs/guide/resegment.md). A form (the program, pasted or loaded from a file, the machine or a
 // block time), the block figures before and after, the largest deviation, warnings, and the new
 // program to download.
+import { noStockNote } from '/plot/cut-stock.js';
 import { answerAndProgram, clearProblem, download, loadMachines, message, number, numeric, refusalMessage, showSummary, submitFlow, value, warningMessages } from '/form.js';
 
 const FORM = `
@@ -44,7 +45,7 @@ function show(container, answer) {
     ['Largest deviation, mm ', number(answer.max_deviation, 5)],
     ['Largest chord error, mm ', number(answer.chord_error, 5)],
   ]);
-  container.replaceChildren(box, ...warningMessages(answer.warnings));
+  container.replaceChildren(box, ...warningMessages(answer.warnings), noStockNote('resegment'));
 }
 
 export const view = {

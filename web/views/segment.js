@@ -3,6 +3,7 @@
 // block length along the curve, the rule side by side with a fixed tolerance, G-code download.
 import { DXF_FIELDS, dxfUpload } from '/dxf.js';
 import { Timeline } from '/timeline.js';
+import { noStockNote } from '/plot/cut-stock.js';
 import { answerAndProgram, downloadFlow, keepForm, loadMachines, machineFields, machineNote, message, number, numeric, POST_OPTIONS, programName, refusalMessage, showSummary, submitFlow, value, warningMessages } from '/form.js';
 import { drawChart } from '/plot/charts.js';
 import { CurvePlan } from '/plot/plan.js';
@@ -325,7 +326,7 @@ export function segmentResult(container, answer, { request, machine, program, fo
     ['margin', machineNote(answer.margin, '', request, 'margin', machine)],
     ['machine', machineName],
   ]);
-  warnings.replaceChildren(...warningMessages(answer.warnings, form));
+  warnings.replaceChildren(...warningMessages(answer.warnings, form), noStockNote('segment'));
   return plan;
 }
 

@@ -30,6 +30,8 @@ macro_rules! endpoint {
 
             /// The query of the program route (`POST /api/v1/{name}/program`).
             type ProgramParams = <$query as Negotiate>::Program;
+            /// The query of the stock route (`POST /api/v1/{name}/stock`).
+            type StockParams = super::super::own_stock::StockQuery;
 
             /// The JSON answer; `?format=gcode` or an `Accept` preferring `text/x-gcode` still
             /// answer the program here (undocumented: the program route is the documented way).
@@ -85,6 +87,33 @@ macro_rules! endpoint {
             ) -> AppResult<Response> {
                 super::super::solve::answer::<$capability>(&state, request, None, <$query as Negotiate>::program(query)).await
             }
+
+            /// The stock as the request's own verification cuts its program, as binary glTF.
+            #[utoipa::path(post,
+                context_path = "/api/v1/",
+                path = format!("{}/stock", <$capability as Capability>::NAME),
+                operation_id = format!("{}_stock", <$capability as Capability>::NAME),
+                tag = <$capability as Capability>::NAME,
+                summary = "The stock as the request's own verification cuts its program, as binary glTF",
+                description = "The program the answer writes (default output options, Fanuc) cut on the capability's own model (the model of the answer's `verification`, docs/spec/verify.md §9), as binary glTF (`model/gltf-binary`) coloured by deviation from the model's part, with that cut's `verification` in its `extras.verification`; `upto_line` cuts only the moves up to a line (playback). In mm whatever the request's units. A request without a model (verification off, a `bore_block`, segment and resegment) is refused naming `verification`.",
+                params(StockParams),
+                request_body = $request,
+                responses(
+                    (status = 200, description = "The cut stock", body = super::super::verify_mesh::GlbFile, content_type = "model/gltf-binary"),
+                    (status = 400, body = Problem, content_type = "application/problem+json"),
+                    (status = 404, description = <$capability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
+                    (status = 413, body = Problem, content_type = "application/problem+json"),
+                    (status = 408, description = "The body arrived slower than the minimum receive rate", body = Problem, content_type = "application/problem+json"),
+                    (status = 415, body = Problem, content_type = "application/problem+json"),
+                    (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json"),
+                    (status = 422, description = <$capability as Capability>::ENDPOINT.refused, body = Problem, content_type = "application/problem+json")))]
+            pub async fn stock(
+                State(state): State<AppState>,
+                AppQuery(query): AppQuery<StockParams>,
+                AppJson(request): AppJson<$request>,
+            ) -> AppResult<Response> {
+                super::super::own_stock::answer::<$capability>(&state, request, None, query.upto_line).await
+            }
         }
     };
     ($variant:ident, $module:ident, $capability:ident, $request:ident, $answer:ident, drawing($query:ident)) => {
@@ -106,6 +135,8 @@ macro_rules! endpoint {
 
             /// The query of the program route (`POST /api/v1/{name}/program`).
             type ProgramParams = <$query as Negotiate>::Program;
+            /// The query of the stock route (`POST /api/v1/{name}/stock`).
+            type StockParams = super::super::own_stock::StockQuery;
 
             /// The JSON answer (the request as JSON, or as a form with the DXF file of its `drawing`); `?format=gcode` or an `Accept` preferring `text/x-gcode` still
             /// answer the program here (undocumented: the program route is the documented way).
@@ -163,6 +194,34 @@ macro_rules! endpoint {
             ) -> AppResult<Response> {
                 super::super::solve::answer::<$capability>(&state, request, drawing, <$query as Negotiate>::program(query)).await
             }
+
+            /// The stock as the request's own verification cuts its program, as binary glTF.
+            #[utoipa::path(post,
+                context_path = "/api/v1/",
+                path = format!("{}/stock", <$capability as Capability>::NAME),
+                operation_id = format!("{}_stock", <$capability as Capability>::NAME),
+                tag = <$capability as Capability>::NAME,
+                summary = "The stock as the request's own verification cuts its program, as binary glTF",
+                description = "The program the answer writes (default output options, Fanuc) cut on the capability's own model (the model of the answer's `verification`, docs/spec/verify.md §9), as binary glTF (`model/gltf-binary`) coloured by deviation from the model's part, with that cut's `verification` in its `extras.verification`; `upto_line` cuts only the moves up to a line (playback). In mm whatever the request's units. A request without a model (verification off, a `bore_block`, segment and resegment) is refused naming `verification`.",
+                params(StockParams),
+                request_body(description = "The request as JSON, or a form with it in part `request` and the DXF file its `drawing` reads in part `drawing`.",
+                    content(($request = "application/json"), (DrawingForm = "multipart/form-data"))),
+                responses(
+                    (status = 200, description = "The cut stock", body = super::super::verify_mesh::GlbFile, content_type = "model/gltf-binary"),
+                    (status = 400, body = Problem, content_type = "application/problem+json"),
+                    (status = 404, description = <$capability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
+                    (status = 413, body = Problem, content_type = "application/problem+json"),
+                    (status = 408, description = "The body arrived slower than the minimum receive rate", body = Problem, content_type = "application/problem+json"),
+                    (status = 415, body = Problem, content_type = "application/problem+json"),
+                    (status = 429, description = "All solver slots busy", body = Problem, content_type = "application/problem+json"),
+                    (status = 422, description = <$capability as Capability>::ENDPOINT.refused, body = Problem, content_type = "application/problem+json")))]
+            pub async fn stock(
+                State(state): State<AppState>,
+                AppQuery(query): AppQuery<StockParams>,
+                Submitted(request, drawing): Submitted<$request>,
+            ) -> AppResult<Response> {
+                super::super::own_stock::answer::<$capability>(&state, request, drawing, query.upto_line).await
+            }
         }
     };
     ($variant:ident, $module:ident, $capability:ident, $request:ident, $answer:ident, upload) => {};
@@ -174,11 +233,13 @@ macro_rules! route {
         OpenApiRouter::new()
             .routes(utoipa_axum::routes!($variant::post))
             .routes(utoipa_axum::routes!($variant::program))
+            .routes(utoipa_axum::routes!($variant::stock))
     };
     ($variant:ident, $module:ident, drawing) => {
         OpenApiRouter::new()
             .routes(utoipa_axum::routes!($variant::post))
             .routes(utoipa_axum::routes!($variant::program))
+            .routes(utoipa_axum::routes!($variant::stock))
             // A form's DXF file has the upload limit; a JSON body keeps its own (`Submitted`).
             .layer(axum::extract::DefaultBodyLimit::disable())
     };

@@ -10,6 +10,7 @@ pub mod jobs;
 pub mod machines;
 pub mod materials;
 pub mod output;
+pub mod own_stock;
 pub mod predict;
 pub mod solve;
 pub mod stream;

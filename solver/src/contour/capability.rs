@@ -175,6 +175,30 @@ impl Capability for ContourCapability {
         )
     }
 
+    /// The stock block less what the program (with its verification's header comments) cut, up to
+    /// `upto_line`, against the part prism.
+    fn cut_stock(
+        request: &ContourRequest,
+        context: Resolved<Tool>,
+        upto_line: Option<usize>,
+        run: &Run<'_>,
+    ) -> Result<Option<Vec<u8>>, SolverError> {
+        let answer = Self::solve(request, context, run)?;
+        let read;
+        let request = match request.from_upload(run.upload)? {
+            Some(drawn) => {
+                read = drawn;
+                &read
+            }
+            None => request,
+        };
+        let Some((model, grid, limits)) = own_model(request, &answer)? else {
+            return Ok(None);
+        };
+        let program = own_program(request, &answer, run)?;
+        own::cut_stock_glb(&model, grid, &program, &[(None, &answer.tool)], limits, upto_line, run).map(Some)
+    }
+
     /// Ranges of layers of about `sizing.part_seconds` each (`parts`): a job's contour only,
     /// which may hold up to [`MAX_MOVES`] moves.
     fn split(request: &ContourRequest, context: &Resolved<Tool>, sizing: &Sizing) -> Option<Split> {
@@ -323,23 +347,40 @@ fn verification_grid(request: &ContourRequest, tool: &Tool) -> Result<Option<own
 /// `answer` with its program cut on the contour's own model: its `verification`, and the
 /// warnings and header comments of what that found.
 fn verified(request: &ContourRequest, mut answer: ContourAnswer, run: &Run<'_>) -> Result<ContourAnswer, SolverError> {
-    let Some(grid) = verification_grid(request, &answer.tool)? else {
+    let Some((model, grid, limits)) = own_model(request, &answer)? else {
         return Ok(answer);
     };
-    if answer.result.tilted {
-        return Ok(answer);
-    }
+    let program = own_program(request, &answer, run)?;
+    let mut verification = own::verify(&model, grid, &program, &answer.tool, limits, run)?;
+    own::report(&mut verification, &mut answer.result.warnings, &mut answer.result.description);
+    answer.verification = Some(verification);
+    Ok(answer)
+}
+
+/// The program a verification cuts: the answer's, with the default output options (Fanuc).
+fn own_program(request: &ContourRequest, answer: &ContourAnswer, run: &Run<'_>) -> Result<String, SolverError> {
     let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
-    let program = crate::capability::program::<ContourCapability>(request, &answer, &output, run.control)?;
+    crate::capability::program::<ContourCapability>(request, answer, &output, run.control)
+}
+
+/// The model `answer`'s program is cut on, its grid and its limits; `None` without a
+/// verification (turned off, tilted walls).
+fn own_model(
+    request: &ContourRequest,
+    answer: &ContourAnswer,
+) -> Result<Option<(Prism, own::Grid, own::Limits)>, SolverError> {
+    let Some(grid) = verification_grid(request, &answer.tool)? else {
+        return Ok(None);
+    };
+    if answer.result.tilted {
+        return Ok(None);
+    }
     let reliefs = answer.result.corners.iter().filter_map(|corner| corner.relief.as_ref()).map(|relief| relief.target);
     let wall_tolerance = answer.result.summary.tolerance + own::OWN_TOLERANCE;
     let model = prism(request, &answer.tool, reliefs.collect(), wall_tolerance);
     let limits =
         own::Limits { tolerance: own::OWN_TOLERANCE, allowance: crate::verify::DEFAULT_ALLOWANCE, wall_tolerance };
-    let mut verification = own::verify(&model, grid, &program, &answer.tool, limits, run)?;
-    own::report(&mut verification, &mut answer.result.warnings, &mut answer.result.description);
-    answer.verification = Some(verification);
-    Ok(answer)
+    Ok(Some((model, grid, limits)))
 }
 
 /// A JSON answer over [`MAX_JSON_MOVES`] gets the advice to ask for G-code or submit a job.

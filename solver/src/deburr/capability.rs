@@ -169,6 +169,25 @@ impl Capability for DeburrCapability {
         verified(request, model, answer, run)
     }
 
+    /// The tube with its holes less what the program (with its verification's header comments)
+    /// cut, up to `upto_line`, against the tube with its chamfer bands.
+    fn cut_stock(
+        request: &DeburrRequest,
+        context: Resolved<Tool>,
+        upto_line: Option<usize>,
+        run: &Run<'_>,
+    ) -> Result<Option<Vec<u8>>, SolverError> {
+        let Some((model, grid)) = own_model(request, &context)? else {
+            return Ok(None);
+        };
+        let answer = Self::solve(request, context, run)?;
+        let Some((tools, limits)) = own_cut(&answer) else {
+            return Ok(None);
+        };
+        let program = own_program(request, &answer, run)?;
+        own::cut_stock_glb(&model, grid, &program, &tools, limits, upto_line, run).map(Some)
+    }
+
     /// A several-loop request's loops in ranges of about `sizing.part_seconds` (`parts`).
     fn split(request: &DeburrRequest, _context: &Resolved<Tool>, sizing: &Sizing) -> Option<Split> {
         super::parts::split(request, sizing)
@@ -396,12 +415,40 @@ fn verified(
     let Some((model, grid)) = model else {
         return Ok(answer);
     };
+    let Some((tools, limits)) = own_cut(&answer) else {
+        return Ok(answer);
+    };
+    let program = own_program(request, &answer, run)?;
+    let mut verification = own::verify_tools(&model, grid, &program, &tools, limits, run)?;
+    let mut description = Vec::new();
+    own::report(&mut verification, &mut answer.result.warnings, &mut description);
+    answer.result.description.extend(description.iter().cloned());
+    if let Some(first) = answer.holes.as_mut().and_then(|holes| holes.first_mut()) {
+        first.result.description.extend(description);
+    }
+    answer.verification = Some(verification);
+    Ok(answer)
+}
+
+/// The program a verification cuts: the answer's, with the default output options (Fanuc).
+fn own_program(request: &DeburrRequest, answer: &DeburrAnswer, run: &Run<'_>) -> Result<String, SolverError> {
+    let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
+    crate::capability::program::<DeburrCapability>(request, answer, &output, run.control)
+}
+
+/// The tools a program calls, each with the `T` number it calls it by (one without a number cuts
+/// every move).
+type CalledTools<'a> = Vec<(Option<u32>, &'a Tool)>;
+
+/// The tools `answer`'s program calls and the limits of its verification; `None` when a loop has
+/// no program.
+fn own_cut(answer: &DeburrAnswer) -> Option<(CalledTools<'_>, own::Limits)> {
     let loops: Vec<&Deburr> = match &answer.holes {
         Some(holes) => holes.iter().map(|hole| &hole.result).collect(),
         None => vec![&answer.result],
     };
     if loops.iter().any(|deburr| deburr.program_blocker.is_some()) {
-        return Ok(answer);
+        return None;
     }
     let (mut slack, mut allowance) = (0.0_f64, 0.0_f64);
     for deburr in &loops {
@@ -411,8 +458,6 @@ fn verified(
         slack = slack.max(2.0 * (sagitta + off));
         allowance = allowance.max(2.0 * off);
     }
-    let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
-    let program = crate::capability::program::<DeburrCapability>(request, &answer, &output, run.control)?;
     let limits = own::Limits {
         tolerance: own::OWN_TOLERANCE + slack,
         allowance: crate::verify::DEFAULT_ALLOWANCE + allowance,
@@ -423,15 +468,7 @@ fn verified(
     if let Some(inner) = inner {
         tools.push((inner.number, inner));
     }
-    let mut verification = own::verify_tools(&model, grid, &program, &tools, limits, run)?;
-    let mut description = Vec::new();
-    own::report(&mut verification, &mut answer.result.warnings, &mut description);
-    answer.result.description.extend(description.iter().cloned());
-    if let Some(first) = answer.holes.as_mut().and_then(|holes| holes.first_mut()) {
-        first.result.description.extend(description);
-    }
-    answer.verification = Some(verification);
-    Ok(answer)
+    Some((tools, limits))
 }
 
 /// Most bytes one answer point takes as JSON: its 13 numbers at their longest (24 characters,

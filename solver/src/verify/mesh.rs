@@ -467,6 +467,31 @@ pub fn cut_stock_glb(
     Ok(glb(&mesh, extras))
 }
 
+/// `stock` as a capability's own verification left it (docs/spec/verify.md §9.4), compared with
+/// `part` on the same grid, as GLB with `extras` (the caller checks the bound, [`mesh_bound`],
+/// before cutting).
+///
+/// # Errors
+/// `E_TOO_LARGE_ANSWER` at `verification.resolution` over the run's answer budget.
+pub(crate) fn fields_glb(
+    stock: &Field,
+    part: &Field,
+    [tolerance, allowance]: [f64; 2],
+    extras: Value,
+    run: &Run<'_>,
+) -> Result<Vec<u8>, SolverError> {
+    let mesh = surface(stock, Some(part), Shading { part: true, tolerance, allowance }, run).map_err(|error| {
+        if error.field() == Some("resolution") { error.at("verification.resolution") } else { error }
+    })?;
+    run.control.check()?;
+    Ok(glb(&mesh, extras))
+}
+
+/// The bound of the mesh of `rays` rays of `intervals` intervals each with a part (§8 Bound).
+pub(crate) fn mesh_bound(rays: usize, intervals: u64) -> u64 {
+    rays as u64 * intervals * QUADS_PER_INTERVAL * quad_bytes(true)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -191,37 +191,10 @@ pub(crate) fn verify_tools(
     limits: Limits,
     run: &Run<'_>,
 ) -> Result<Verification, SolverError> {
-    let options = ReadOptions { max_lines: usize::MAX, ..ReadOptions::default() };
-    let read = reader::read_cancellable(program, "program", &options, run.control)?;
-    let lowest = read.moves.iter().filter_map(|read| read.to_xyz().map(|[_, _, z]| z)).fold(f64::INFINITY, f64::min);
-    let (stock, part) = model.fields(grid, lowest, run.control)?;
-    let (lo, hi) = model.footprint();
-    let job = Job {
-        tools: tools
-            .iter()
-            .map(|(number, tool)| {
-                Ok(CallableTool { number: *number, assembly: Assembly::new(tool, "tool")?, flutes: tool.flutes })
-            })
-            .collect::<Result<_, SolverError>>()?,
-        // The fields are built here; the job's solids are only their bounds.
-        stock: SolidModel::Stock(StockModel::Box {
-            lo: Vec3::new(lo[0], lo[1], 0.0),
-            hi: Vec3::new(hi[0], hi[1], 0.0),
-        }),
-        part: None,
-        grid,
-        tolerance: limits.tolerance,
-        allowance: limits.allowance,
-        air_share_limit: 1.0,
-        power: None,
-        program: read,
-    };
-    // The answer's budget is the capability's: the verification's own records are capped.
-    // The capability's solve has reported its progress up to here; the simulation's own 0 → 1
-    // would send a job's bar back, so it reports none (cancellation still reaches it).
-    let unbudgeted = Run { budget: None, control: Control { progress: None, ..run.control }, ..*run };
+    let job = own_job(model, grid, program, tools, limits, run)?;
+    let (stock, part) = model.fields(grid, lowest_tip(&job), run.control)?;
     let description = model.describe();
-    let cut = match simulate::cut_fields(&job, stock, part, &unbudgeted).map(|(cut, _)| cut) {
+    let cut = match simulate::cut_fields(&job, stock, part, &unbudgeted(run)).map(|(cut, _)| cut) {
         Ok(cut) => cut,
         // The model and the program disagree (the tool never meets the stock): said, not refused,
         // since the program itself was solved.
@@ -247,12 +220,65 @@ pub(crate) fn verify_tools(
         }
         Err(error) => return Err(error),
     };
-    Ok(Verification {
+    Ok(verification_of(cut, description, limits))
+}
+
+/// The simulation's job for `program` on `model`'s grid: the fields are built by the caller, the
+/// job's solids are only their bounds.
+fn own_job(
+    model: &dyn OwnModel,
+    grid: Grid,
+    program: &str,
+    tools: &[(Option<u32>, &Tool)],
+    limits: Limits,
+    run: &Run<'_>,
+) -> Result<Job, SolverError> {
+    let options = ReadOptions { max_lines: usize::MAX, ..ReadOptions::default() };
+    let read = reader::read_cancellable(program, "program", &options, run.control)?;
+    let (lo, hi) = model.footprint();
+    Ok(Job {
+        tools: tools
+            .iter()
+            .map(|(number, tool)| {
+                Ok(CallableTool { number: *number, assembly: Assembly::new(tool, "tool")?, flutes: tool.flutes })
+            })
+            .collect::<Result<_, SolverError>>()?,
+        stock: SolidModel::Stock(StockModel::Box {
+            lo: Vec3::new(lo[0], lo[1], 0.0),
+            hi: Vec3::new(hi[0], hi[1], 0.0),
+        }),
+        part: None,
+        grid,
+        tolerance: limits.tolerance,
+        allowance: limits.allowance,
+        air_share_limit: 1.0,
+        power: None,
+        program: read,
+    })
+}
+
+/// The lowest tip height the program `job` moves to (+∞ with no move): the models of a
+/// capability with no part of its own are floored under it.
+fn lowest_tip(job: &Job) -> f64 {
+    job.program.moves.iter().filter_map(|read| read.to_xyz().map(|[_, _, z]| z)).fold(f64::INFINITY, f64::min)
+}
+
+/// `run` without its budget and progress: the answer's budget is the capability's (the
+/// verification's own records are capped), and the capability's solve has reported its progress
+/// up to here; the simulation's own 0 → 1 would send a job's bar back, so it reports none
+/// (cancellation still reaches it).
+fn unbudgeted<'a>(run: &Run<'a>) -> Run<'a> {
+    Run { budget: None, control: Control { progress: None, ..run.control }, ..*run }
+}
+
+/// The `verification` section of `cut`.
+fn verification_of(cut: simulate::Cut, model: String, limits: Limits) -> Verification {
+    Verification {
         ok: cut.ok,
         findings: cut.findings,
         findings_left_off: cut.findings_left_off,
         note: None,
-        model: description,
+        model,
         resolution: cut.resolution,
         rays: cut.rays,
         tolerance: limits.tolerance,
@@ -264,7 +290,59 @@ pub(crate) fn verify_tools(
         air_share: cut.air_share,
         moves: cut.moves,
         dexel_updates: cut.dexel_updates,
-    })
+    }
+}
+
+/// The stock of `model` as `program`'s moves on lines up to `upto_line` (every line: `None`) left
+/// it, as binary glTF coloured by deviation from the model's part (docs/spec/verify.md §9.4), that
+/// cut's `verification` in the glTF's `extras.verification`. A program that has not reached the
+/// stock by then answers the stock as modelled, with `extras` empty.
+///
+/// # Errors
+/// As [`verify_tools`]; `E_TOO_LARGE_ANSWER` at `verification.resolution` when the mesh's bound
+/// (two intervals a ray, a tube's), checked before cutting, or the mesh as it is built passes the
+/// run's answer budget.
+pub(crate) fn cut_stock_glb(
+    model: &dyn OwnModel,
+    grid: Grid,
+    program: &str,
+    tools: &[(Option<u32>, &Tool)],
+    limits: Limits,
+    upto_line: Option<usize>,
+    run: &Run<'_>,
+) -> Result<Vec<u8>, SolverError> {
+    let bound = super::mesh::mesh_bound(grid.len(), 2);
+    if let Some(budget) = run.budget
+        && bound > budget.limit()
+    {
+        return Err(crate::capability::too_large_answer(bound, budget.limit()).at("verification.resolution"));
+    }
+    let mut job = own_job(model, grid, program, tools, limits, run)?;
+    // The whole program's lowest tip, so every step of a playback cuts the same model.
+    let lowest = lowest_tip(&job);
+    if let Some(last) = upto_line {
+        job.program.moves.retain(|read| read.line <= last);
+    }
+    let (stock, part) = model.fields(grid, lowest, run.control)?;
+    let Some(compared) = part.clone() else {
+        return Err(SolverError::new(
+            ErrorCode::Input,
+            "this capability's verification has no part to colour the cut stock against",
+        )
+        .at("verification"));
+    };
+    let shading = [limits.tolerance, limits.allowance];
+    match simulate::cut_fields(&job, stock, part, &unbudgeted(run)) {
+        Ok((cut, left)) => {
+            let extras = serde_json::json!({"verification": verification_of(cut, model.describe(), limits)});
+            super::mesh::fields_glb(&left, &compared, shading, extras, run)
+        }
+        Err(error) if error.code() == ErrorCode::Stock => {
+            let (stock, _) = model.fields(grid, lowest, run.control)?;
+            super::mesh::fields_glb(&stock, &compared, shading, serde_json::json!({}), run)
+        }
+        Err(error) => Err(error),
+    }
 }
 
 /// The warning code of a finding that is also a warning of the answer: a gouge, a rapid through

@@ -384,8 +384,34 @@ async fn the_units_switch_sends_inch_and_labels_plots_and_readouts_in_inches() {
     not(kerf_has_chromium),
     ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
 )]
+async fn deburr_page_draws_the_cut_tube_with_its_chamfer() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "deburrCut", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["green"].as_u64().unwrap() >= 300 && result["tube"].as_u64().unwrap() >= 20000, "{result}");
+    assert!(result["partly"].as_f64() < result["removed"].as_f64(), "{result}");
+    eprintln!("compute to cut tube drawn: {} s, {} vertices", result["seconds"], result["vertices"]);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn the_machine_form_lists_every_post_and_saves_haas_smoothing() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "machinePosts", &[]) else { return };
     assert_eq!(result["stored"]["haas_smoothing"], 2, "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
+async fn contour_page_draws_its_cut_stock() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "contourCut", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["partly"].as_f64() < result["removed"].as_f64(), "{result}");
 }

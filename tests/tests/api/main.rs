@@ -31,6 +31,7 @@ mod materials;
 mod metrics;
 mod negotiation;
 mod openapi;
+mod own_stock;
 mod posts;
 mod predict;
 mod request_fuzz;
