@@ -543,6 +543,8 @@ const scenarios = {
     const states = await page.$$eval(`${shown} canvas`, (list) => list.map((c) => c.dataset.state));
     const hiddenCharts = await page.$$eval('#engagement-result .candidate[hidden] canvas', (list) => list.length);
     if (hiddenCharts !== 0) throw new Error(`${hiddenCharts} charts drawn for paths not shown`);
+    // The answer's own verification: its findings (or none) and why no cut stock is drawn.
+    const verification = await page.textContent('#engagement-verification', { timeout: 30000 });
     // Torque and power over the path (power on the right axis) and per flute count in the table.
     const torqueChart = `${shown} canvas[aria-label^="Spindle torque and power"]`;
     const torqueInked = await inkedPixels(torqueChart);
@@ -608,7 +610,7 @@ const scenarios = {
     const left = await page.$$eval('#engagement-messages > *', (list) => list.length);
     const marksLeft = await page.$$eval('#engagement-form .invalid', (list) => list.length);
     if (again.name !== 'engagement-1-fanuc.nc' || !again.text.includes('M30') || left || marksLeft) throw new Error(`download after the fix: ${again.name}, ${left} messages, ${marksLeft} marks left`);
-    return { columns, charts: states.length, torqueInked, inked, cursor, recommendation, feeds: feeds.size, file: download.suggestedFilename() };
+    return { columns, charts: states.length, torqueInked, inked, cursor, recommendation, feeds: feeds.size, file: download.suggestedFilename(), verification };
   },
 
   // Predict page: runs the sample raster over the dome, checks the path coloured by error (several
@@ -622,6 +624,7 @@ const scenarios = {
     if (radius !== 3) throw new Error(`Ø6 sent as radius ${radius}`);
     await page.waitForSelector('#predict-plot[data-state="drawn"]', { timeout: 30000 });
     await page.waitForSelector('#predict-histogram[data-state="drawn"]', { timeout: 60000 });
+    const verification = await page.textContent('#predict-verification', { timeout: 30000 });
     const segments = Number(await page.getAttribute('#predict-plot', 'data-segments'));
     const inked = await inkedPixels('#predict-plot canvas');
     const histogram = await inkedPixels('#predict-histogram');
@@ -686,7 +689,7 @@ const scenarios = {
     const predictRefused = await refusedDownload('#predict-gcode', '#predict-messages');
     const selected = await page.$eval('textarea[name="program"]', (area) => area.value.slice(area.selectionStart, area.selectionEnd));
     if (!/line 3/i.test(predictRefused) || selected !== 'G1 Z0 F500 Q1') throw new Error(`corrected program refused: "${predictRefused}", selected "${selected}"`);
-    return { segments, inked, histogram, colours, worst: lines.length, programLines: program.split('\n').length };
+    return { segments, inked, histogram, colours, worst: lines.length, programLines: program.split('\n').length, verification };
   },
 
   // Job progress as the service reports it, with one job worker: a prediction long enough to

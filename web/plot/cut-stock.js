@@ -279,10 +279,18 @@ export async function verificationPanel(container, { id, verification, program, 
   const summary = document.createElement('p');
   summary.className = 'hint';
   const found = verification.findings.length;
-  summary.textContent = `${verification.ok ? 'No findings' : `${found} finding${found === 1 ? '' : 's'}`}${verification.note ? ` (${verification.note})` : ''}; removed ${number(verification.removed_volume_mm3, 1)} mm³ at ${number(verification.resolution)} mm spacing. ${verification.model}.`;
+  // The removed volume is in mm³ whatever the units (its field's name says so): kept from the
+  // units switch's relabelling, unlike the spacing.
+  const removed = Object.assign(document.createElement('span'), { textContent: `${number(verification.removed_volume_mm3, 1)} mm³` });
+  removed.dataset.unitsFixed = '';
+  summary.append(
+    `${verification.ok ? 'No findings' : `${found} finding${found === 1 ? '' : 's'}`}${verification.note ? ` (${verification.note})` : ''}; removed `,
+    removed,
+    ` at ${number(verification.resolution)} mm spacing. ${verification.model}.`,
+  );
   const table = document.createElement('div');
   table.className = 'table-scroll';
-  table.innerHTML = '<table class="worst"><thead><tr><th>finding</th><th>line</th><th>position, mm</th><th>depth, mm</th><th>volume, mm³</th></tr></thead><tbody></tbody></table>';
+  table.innerHTML = '<table class="worst"><thead><tr><th>finding</th><th>line</th><th>position, mm</th><th>depth, mm</th><th data-units-fixed>volume, mm³</th></tr></thead><tbody></tbody></table>';
   const listing = document.createElement('ol');
   listing.className = 'listing';
   listing.id = `${id}-listing`;

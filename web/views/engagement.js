@@ -10,6 +10,7 @@ import { api } from '/api.js';
 import { PathChart, barChart } from '/plot/charts.js';
 import { ToolPlan } from '/plot/tool-plan.js';
 import { examplePoints } from '/units.js';
+import { verificationPanel } from '/plot/cut-stock.js';
 import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, message, number, numeric, POST_OPTIONS, programName, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
@@ -638,6 +639,13 @@ export function engagementResult(container, answer, { onSelect } = {}) {
   const columns = document.createElement('div');
   columns.className = 'candidates';
   container.append(controls, columns);
+  if (answer.verification) {
+    verificationPanel(container, {
+      id: 'engagement',
+      verification: answer.verification,
+      why: 'engagement gives no finished shape to colour the stock against; the findings are listed with their lines',
+    });
+  }
   const id = `candidate-${Math.random().toString(36).slice(2, 8)}`;
   const cells = candidates.map((result, i) => {
     const column = document.createElement('div');

@@ -6,6 +6,7 @@
 import { api } from '/api.js';
 import { clearProblem, downloadFlow, half, keepForm, loadTools, message, number, numeric, parseDecimal, showProblem, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
 import { css, diverging, drawColourScale, drawHistogram } from '/plot/colour.js';
+import { verificationPanel } from '/plot/cut-stock.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
 
@@ -436,6 +437,13 @@ export function predictResult(container, answer, { request, program, stockTriang
   });
   worst.replaceChildren(head, ...body);
   warnings.replaceChildren(...warningMessages(answer.warnings));
+  if (answer.verification) {
+    verificationPanel(container, {
+      id: 'predict',
+      verification: answer.verification,
+      why: 'prediction gives no design surface to colour the stock against; the findings are listed with their lines',
+    });
+  }
   return scene.root;
 }
 

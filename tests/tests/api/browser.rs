@@ -130,6 +130,10 @@ async fn engagement_page_compares_the_sample_paths() {
     assert_eq!(result["charts"], 8, "the charts of the path shown, no more: {result}");
     assert!(result["recommendation"].as_str().unwrap().contains("Recommended flute counts"), "{result}");
     assert_eq!(result["file"], "engagement-1-fanuc.nc");
+    // The answer's verification of its program, listed though no stock is drawn.
+    let verification = result["verification"].as_str().unwrap();
+    assert!(verification.contains("the program cut on its own model") && verification.contains("mm³"), "{result}");
+    assert!(verification.contains("no finished shape to colour the stock against"), "{result}");
 }
 
 #[tokio::test(flavor = "multi_thread")]
@@ -189,6 +193,9 @@ async fn predict_page_colours_the_path_by_error() {
     assert_eq!(result["ok"], true);
     assert!(result["colours"].as_u64().unwrap() >= 4, "{result}");
     assert_eq!(result["worst"], 20, "{result}");
+    let verification = result["verification"].as_str().unwrap();
+    assert!(verification.contains("the program cut on its own model") && verification.contains("mm³"), "{result}");
+    assert!(verification.contains("no design surface"), "{result}");
 }
 
 #[tokio::test(flavor = "multi_thread")]
