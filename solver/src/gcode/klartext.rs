@@ -8,7 +8,7 @@
 
 use std::fmt::Write as _;
 
-use super::repost::{Item, Word, program_number, read_items, refusal, source_units};
+use super::repost::{Item, has_word, program_number, read_items, refusal, source_units, words_in};
 use super::table::CommentStyle;
 use super::{
     Buffer, Dialect, MOVES_PER_CHECK, Program, ProgramStop, SpindleDirection, ToolCall, helix_points, is_plunge,
@@ -386,14 +386,8 @@ impl Reposter {
             None => (false, trimmed),
         };
         let items = read_items(number, code, self.field)?;
-        let words: Vec<Word<'_>> = items
-            .iter()
-            .filter_map(|item| match item {
-                Item::Word(word) => Some(*word),
-                Item::Comment(_) => None,
-            })
-            .collect();
-        let has = |letter: u8, value: f64| words.iter().any(|w| w.letter == letter && (w.value - value).abs() < 1e-9);
+        let words = words_in(&items);
+        let has = |letter: u8, value: f64| has_word(&words, letter, value);
         let changes_tool = has(b'M', 6.0);
         let mut m: Vec<&'static str> = Vec::new();
         let (mut stop, mut speed, mut axes) = (false, None, [false; 3]);

@@ -236,14 +236,8 @@ impl WordReposter {
         read: Option<&ReadMove>,
     ) -> Result<(), SolverError> {
         let table = self.table;
-        let words: Vec<Word<'_>> = items
-            .iter()
-            .filter_map(|item| match item {
-                Item::Word(word) => Some(*word),
-                Item::Comment(_) => None,
-            })
-            .collect();
-        let has = |letter: u8, value: f64| words.iter().any(|w| w.letter == letter && (w.value - value).abs() < 1e-9);
+        let words = words_in(items);
+        let has = |letter: u8, value: f64| has_word(&words, letter, value);
         let tool_word = words.iter().find(|w| w.letter == b'T').map(|w| w.text.to_owned());
         let changes_tool = has(b'M', 6.0);
         let relative_centres = read.is_some_and(|m| !m.modal.absolute_arc_centre);
@@ -444,6 +438,23 @@ pub(super) fn refusal(dialect: Dialect, field: &'static str, number: usize, what
 /// The words and comments of line `number`'s `code`.
 ///
 /// # Errors
+/// The words of a line's items, its comments left out.
+pub(super) fn words_in<'a>(items: &[Item<'a>]) -> Vec<Word<'a>> {
+    items
+        .iter()
+        .filter_map(|item| match item {
+            Item::Word(word) => Some(*word),
+            Item::Comment(_) => None,
+        })
+        .collect()
+}
+
+/// Whether `words` hold `letter` with `value` (`M6`, `G0`), as a program's number may be written
+/// `M06` or `M6.`.
+pub(super) fn has_word(words: &[Word<'_>], letter: u8, value: f64) -> bool {
+    words.iter().any(|w| w.letter == letter && (w.value - value).abs() < 1e-9)
+}
+
 /// `E_GCODE_SYNTAX` at `field` naming the line for text that is not G-code.
 pub(super) fn read_items<'a>(number: usize, code: &'a str, field: &'static str) -> Result<Vec<Item<'a>>, SolverError> {
     items(code)
