@@ -1431,7 +1431,10 @@ try {
   await browser.close();
 } catch (error) {
   if (screenshot) await page.screenshot({ path: screenshot, fullPage: true }).catch(() => {});
-  console.log(JSON.stringify({ ok: false, error: String(error.message || error) }));
+  // What the page itself said (a refusal or a failed request shows as an error message): a wait
+  // that timed out is often explained there.
+  const shown = await page.$$eval('.message.error, .message.warning', (list) => list.map((m) => m.textContent.trim())).catch(() => []);
+  console.log(JSON.stringify({ ok: false, error: String(error.message || error).slice(0, 800), shown, problems }));
   await browser.close();
   process.exit(1);
 }
