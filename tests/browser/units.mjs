@@ -180,7 +180,7 @@ export function unitScenarios({ page, base }) {
     // error's errors but not its angles) and computes again; the request says inch, the answer's
     // errors are the mm answer's ÷ 25.4 and are read in tenths (0.0001 in) in the summary, the
     // worst passes, the tolerance band and the plots' axes; the program keeps its own mm in the
-    // timeline. Back to mm gives what was typed. An STL stock is said to be in mm (its default) in
+    // timeline; a saved tool is stored in mm. Back to mm gives what was typed. An STL stock is said to be in mm (its default) in
     // an inch request; an inch job is shown in tenths with the switch at mm.
     async unitsPredict() {
       await page.addInitScript(RECORD_CANVAS_TEXT);
@@ -246,6 +246,13 @@ export function unitScenarios({ page, base }) {
       for (let i = 0; i < 3; i++) await page.keyboard.press('ArrowRight');
       const readout = await page.textContent('#predict-result .timeline-readout');
       if (!/Z -?[\d.]+ mm\b/.test(readout)) throw new Error(`the G21 program's readout: ${readout}`);
+
+      // "Save tool" stores the inch inline ball in the tool table's mm.
+      await page.fill('#predict-form input[name="save_number"]', '7');
+      await page.click('#predict-save-tool');
+      await page.waitForSelector('#predict-messages .message.ok', { timeout: 60000 });
+      const saved = await (await fetch(`${base}/api/v1/tools/7`)).json();
+      if (Math.abs(saved.radius - 3) > 1e-4 || Math.abs(saved.shape_error?.[1]?.error - 0.005) > 1e-7) throw new Error(`the inch ball saved as ${JSON.stringify(saved)}`);
 
       // Back to mm: what was typed, computed again in µm.
       const again = await exchanged('/api/v1/predict', () => page.selectOption('#units', 'mm'));
