@@ -1,5 +1,6 @@
 // Browser checks of the page's units switch and the machine form's post fields (run by run.mjs:
-// `node run.mjs units|machinePosts <base-url> <screenshot.png>`).
+// `node run.mjs units|unitsPredict|unitsVerify|machinePosts <base-url> <screenshot.png>`).
+import { readFile } from 'node:fs/promises';
 
 // Every text the page draws on a canvas, with the view it is in, recorded in the page (a plot's
 // axis and scale bar are canvas text, not DOM).
@@ -275,6 +276,11 @@ export function unitScenarios({ page, base }) {
       if (m.predicted !== x.predicted || m.no_surface !== x.no_surface || errorFields.some((k) => Math.abs(m[k] - x[k]) > 1e-6)) {
         throw new Error(`the mm STL read in inch: ${JSON.stringify({ ...m, worst: undefined })}, the box typed in inch: ${JSON.stringify({ ...x, worst: undefined })}`);
       }
+
+      // The corrected program of the STL request (multipart) in inch: the G21 program's own lines.
+      const [download] = await Promise.all([page.waitForEvent('download'), page.click('#predict-gcode')]);
+      const corrected = await readFile(await download.path(), 'utf8');
+      if (!corrected.includes('O3100') || !/\bG21\b/.test(corrected)) throw new Error(`the corrected program: ${corrected.slice(0, 200)}`);
 
       // An inch prediction run as a job, opened with the switch at mm: shown in tenths.
       const job = await fetch(`${base}/api/v1/jobs`, {
