@@ -337,6 +337,9 @@ export function unitScenarios({ page, base }) {
       const head = await page.textContent('#verify-result table.worst thead');
       if (!summary.includes(`Spacing ${inch.answer.resolution.toFixed(4)} in`) || !/Removed [\d.]+ mm³/.test(summary)) throw new Error(`inch summary: ${summary}`);
       if (!head.includes('position, in') || !head.includes('depth, in') || !head.includes('volume, mm³')) throw new Error(`findings head: ${head}`);
+      // Lengths to 0.0001 in.
+      const depth = await page.textContent('#verify-findings tr[data-kind="gouge"][data-line="4"] td:nth-child(4)');
+      if (depth !== g.depth.toFixed(4)) throw new Error(`the gouge's depth shown as ${depth}, ${g.depth} in`);
       // The cut stock's deviations from the inch GLB: the slot's floor 0.1 mm = 0.0039 in deep.
       await page.waitForFunction(() => Number(document.querySelector('#verify-stock')?.dataset.deepestDeviation) > -0.05, null, { timeout: 60000 });
       if (!inchOf(await deepest(), mmDeepest, 0.004)) throw new Error(`deepest deviation ${await deepest()} in, ${mmDeepest} mm`);
