@@ -246,9 +246,9 @@ function colourOf(error, limit) {
 // `unit`: the reading's words after a figure, `heading(name)` a column or line named with it.
 function errorReading(units) {
   if (units === 'inch') {
-    return { units, per: 10000, unit: '× 0.0001 in', heading: (name) => `${name} (0.0001 in)` };
+    return { per: 10000, unit: '× 0.0001 in', heading: (name) => `${name} (0.0001 in)` };
   }
-  return { units: 'mm', per: 1000, unit: 'µm', heading: (name) => `${name}, µm` };
+  return { per: 1000, unit: 'µm', heading: (name) => `${name}, µm` };
 }
 
 // An error (in the answer's units) as its reading, to a tenth of the reading's unit.
