@@ -132,10 +132,10 @@ export async function answerAndProgram(path, body, query) {
 
 // The request a form of a view that takes units builds, with the units of its section (the
 // values were typed in them; the service converts at its edge). A request that says its units
-// keeps them.
+// keeps them, and so does a multipart one (its JSON part says them).
 function withUnits(form, request) {
   const root = form.closest('[data-view-root]');
-  if (!request || typeof request !== 'object' || !UNIT_VIEWS.includes(root?.dataset.viewRoot) || 'units' in request) return request;
+  if (!request || typeof request !== 'object' || request instanceof FormData || !UNIT_VIEWS.includes(root?.dataset.viewRoot) || 'units' in request) return request;
   return { ...request, units: unitsOf(form) };
 }
 

@@ -8,9 +8,8 @@
 const KEY = 'kerf.units';
 const MM_PER_INCH = 25.4;
 
-// The views whose capability takes `units`, and those that work in mm only.
-export const UNIT_VIEWS = ['deburr', 'segment', 'contour', 'engagement', 'resegment'];
-export const MM_VIEWS = ['predict', 'verify'];
+// The views whose capability takes `units`.
+export const UNIT_VIEWS = ['deburr', 'segment', 'contour', 'engagement', 'resegment', 'predict', 'verify'];
 
 // The capability paths that take `units` (a POST of their JSON request, with or without a query).
 const UNIT_PATHS = new RegExp(`^/api/v1/(${UNIT_VIEWS.join('|')})(\\?|$)`);
@@ -84,6 +83,13 @@ function relabelAll(root) {
   for (let node = walker.nextNode(); node; node = walker.nextNode()) relabel(node);
 }
 
+// Shows `element` (an answer's result) in `units`, the answer's, whatever its section's: the
+// words already there follow, and those added later.
+export function showInUnits(element, units) {
+  element.dataset.units = units === 'inch' ? 'inch' : 'mm';
+  relabelAll(element);
+}
+
 // Keeps the words of `root` in the units of their sections as the page adds and changes text.
 function followWords(root) {
   new MutationObserver((records) => {
@@ -101,7 +107,7 @@ function followWords(root) {
 
 // What a control holds, from its label's mm words: a length, a feed (mm/min), an acceleration
 // or jerk (the same factor) or an area; `data-dim` in the markup says it where the label does
-// not (a points box, a choice of lengths).
+// not (a points box, a choice of lengths, a table of keyed lengths).
 function dimensionOf(control) {
   if (control.dataset.dim) return control.dataset.dim;
   const label = control.closest('label');
@@ -125,7 +131,13 @@ function dimensionOf(control) {
 
 // The mm words of a control's quantity ('mm/min' for a feed), '' for one without a length.
 export function mmWords(control) {
-  return { length: 'mm', points: 'mm', feed: 'mm/min', acceleration: 'mm/s²', jerk: 'mm/s³', area: 'mm²' }[dimensionOf(control)] ?? '';
+  return { length: 'mm', points: 'mm', 'keyed-lengths': 'mm', feed: 'mm/min', acceleration: 'mm/s²', jerk: 'mm/s³', area: 'mm²' }[dimensionOf(control)] ?? '';
+}
+
+// The factor that takes a length in `from` to `to` (1, 25.4 or 1/25.4).
+export function lengthFactor(from, to) {
+  if (from === to) return 1;
+  return from === 'inch' ? MM_PER_INCH : 1 / MM_PER_INCH;
 }
 
 // `value` (a number in `from`) in `to`, to six significant digits.
@@ -147,6 +159,21 @@ function convertedPoints(text, from, to) {
   return text.split('\n').map((line) => {
     if (/^\s*#/.test(line)) return to === 'inch' ? line.replace(/\bin mm\b/g, 'in inches') : line.replace(/\bin inches\b/g, 'in mm');
     return line.replace(/[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?/g, (n) => converted(Number(n), 1, from, to));
+  }).join('\n');
+}
+
+// A table of keyed lengths (a tool's shape error: a contact angle, then its error, a row a line):
+// every number of a row but its first.
+function convertedKeyedLengths(text, from, to) {
+  return text.split('\n').map((line) => {
+    let first = true;
+    return line.replace(/[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?/g, (n) => {
+      if (first) {
+        first = false;
+        return n;
+      }
+      return converted(Number(n), 1, from, to);
+    });
   }).join('\n');
 }
 
@@ -172,6 +199,7 @@ export function examplePoints(form, text) {
 function convertText(control, text, from, to) {
   if (from === to) return text;
   const dim = dimensionOf(control);
+  if (dim === 'keyed-lengths') return convertedKeyedLengths(text, from, to);
   if (dim === 'points' || control.tagName === 'TEXTAREA') return convertedPoints(text, from, to);
   const number = typed(text);
   return Number.isNaN(number) ? text : converted(number, dim === 'area' ? 2 : 1, from, to);
@@ -245,21 +273,12 @@ export function setUnits(units, why = '') {
 // The units a view's section works in, set before its view is mounted (so its form's examples
 // are converted before what was kept is put back, see keepForm).
 export function prepareRoot(root, id) {
-  if (MM_VIEWS.includes(id)) root.dataset.units = 'mm';
-  else if (UNIT_VIEWS.includes(id)) root.dataset.units = currentUnits();
+  if (UNIT_VIEWS.includes(id)) root.dataset.units = currentUnits();
 }
 
-// Finishes a view's section once its view is mounted: its labels in its units, a note where the
-// view works in mm only, and a machine with units moves the switch to them.
+// Finishes a view's section once its view is mounted: its labels in its units, and a machine
+// with units moves the switch to them.
 export function mountUnits(root, id) {
-  if (MM_VIEWS.includes(id)) {
-    const note = document.createElement('p');
-    note.className = 'hint units-mm';
-    note.dataset.unitsFixed = '';
-    note.textContent = 'This view works in mm: every length, plot and readout here is in mm (feeds in mm/min) whatever the units switch says.';
-    root.prepend(note);
-    return;
-  }
   if (!UNIT_VIEWS.includes(id)) return;
   root.addEventListener('kerf:computed', (event) => computed.add(event.target), true);
   relabelAll(root);

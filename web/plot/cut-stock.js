@@ -8,6 +8,7 @@ import { api } from '/api.js';
 import { number } from '/form.js';
 import { Scene3D, THREE, readGlb } from '/plot/scene3d.js';
 import { parseProgram } from '/timeline.js';
+import { unitsOf } from '/units.js';
 
 // Rapid moves are timed at this feed in playback, mm/min (the program gives none).
 const PLAYBACK_RAPID = 10000;
@@ -68,10 +69,12 @@ function openLine(listing, line) {
 // The rows of the findings table in `tbody`: a click opens the finding's line in `listing` and
 // marks it on the cut stock `stock()` gives (when there is one).
 export function showFindings(tbody, findings, listing, stock) {
+  // Lengths to 0.001 mm or 0.0001 in, as the table's section shows them.
+  const digits = unitsOf(tbody) === 'inch' ? 4 : 3;
   tbody.replaceChildren(...findings.map((finding) => {
     const tr = document.createElement('tr');
     tr.dataset.kind = finding.kind;
-    const cells = [finding.kind.replaceAll('_', ' '), finding.line ?? '', (finding.position ?? []).map((v) => number(v, 3)).join(' '), finding.depth === undefined ? '' : number(finding.depth, 3), finding.volume_mm3 === undefined ? '' : number(finding.volume_mm3, 1)];
+    const cells = [finding.kind.replaceAll('_', ' '), finding.line ?? '', (finding.position ?? []).map((v) => number(v, digits)).join(' '), finding.depth === undefined ? '' : number(finding.depth, digits), finding.volume_mm3 === undefined ? '' : number(finding.volume_mm3, 1)];
     for (const cell of cells) {
       const td = document.createElement('td');
       td.textContent = String(cell);

@@ -9,6 +9,7 @@ import { css, diverging, drawColourScale, drawHistogram } from '/plot/colour.js'
 import { verificationPanel } from '/plot/cut-stock.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
+import { inUnits, lengthFactor, showInUnits, unitsOf } from '/units.js';
 
 // The sample: a raster finishing program over a gentle dome (20 × 20 mm, 2 mm high) with an R3
 // ball, and the dome plus a 0.2 mm allowance as a height grid (as examples/predict-raster.toml).
@@ -77,7 +78,7 @@ const FORM = `
         <label><span data-size-label>Ball diameter Ø, mm</span> <input name="ball_size" type="number" step="any" value="6" data-field="tool.radius"></label>
         <label>Flutes <input name="flutes" type="number" value="2" data-field="tool.flutes"></label>
         <label>Helix angle, ° <input name="helix" type="number" step="any" value="30" data-field="tool.helix_deg"></label>
-        <label class="stacked"><span>Shape error: contact angle in ° (0 = tip, 90 = equator) and error in mm, one pair a line <abbr class="symbol" title="δ(θ)">δ(θ)</abbr></span><textarea name="shape_error" rows="4" data-field="tool.shape_error" title="one row per contact angle: angle in degrees (0 = tip, 90 = equator), error in mm">0 0.004
+        <label class="stacked"><span>Shape error: contact angle in ° (0 = tip, 90 = equator) and error in mm, one pair a line <abbr class="symbol" title="δ(θ)">δ(θ)</abbr></span><textarea name="shape_error" rows="4" data-dim="keyed-lengths" data-field="tool.shape_error" title="one row per contact angle: angle in degrees (0 = tip, 90 = equator), error in mm">0 0.004
 30 0.005
 60 0.007
 90 0.009</textarea></label>
@@ -108,6 +109,7 @@ const FORM = `
       <label data-stock="grid">Bottom z, mm <input name="bottom" type="number" step="any" value="-20" data-field="stock.bottom"></label>
       <label class="stacked" data-stock="grid">Heights, mm (a row per y, along x)<textarea name="heights" rows="4" data-field="stock.heights" title="one row per y, heights along x"></textarea></label>
       <label data-stock="mesh">STL file <input name="stock_file" type="file" accept=".stl,model/stl,application/sla" data-field="stock"></label>
+      <label data-stock="mesh">STL units <select name="stl_units" data-field="stock.units" title="an STL file names no units; most are exported in mm whatever the shop works in"><option value="mm">mm</option><option value="inch">inch</option></select></label>
     </fieldset>
     <fieldset><legend>Path</legend>
       <label class="stacked">G-code program<textarea name="program" rows="14" spellcheck="false" class="code" data-field="path.program"></textarea></label>
@@ -170,9 +172,12 @@ export function predictRequest(form) {
   } else if (kind === 'grid') {
     stock = { kind, origin: [numeric(form, 'origin_x'), numeric(form, 'origin_y')], spacing: numeric(form, 'spacing'), heights: rows(value(form, 'heights')), bottom: numeric(form, 'bottom') };
   } else {
+    // An STL file names no units: the solid says which it was exported in.
+    stock.units = value(form, 'stl_units');
     file = form.elements.stock_file.files[0] || null;
   }
   const body = {
+    units: unitsOf(form),
     tool, stock,
     path: { kind: 'gcode', program: value(form, 'program') },
     reference: value(form, 'reference'),
@@ -236,8 +241,30 @@ function colourOf(error, limit) {
   return Number.isFinite(error) ? css(diverging(error, limit)) : '#9aa4ad';
 }
 
-function microns(e) {
-  return Number.isFinite(e) ? (e * 1000).toFixed(1) : '–';
+// How an answer's machining errors are read: in µm in mm, and in an inch answer in tenths
+// (0.0001 in), as an inch shop reads small errors. `per`: reading units per answer unit;
+// `unit`: the reading's words after a figure, `heading(name)` a column or line named with it.
+function errorReading(units) {
+  if (units === 'inch') {
+    return { per: 10000, unit: '× 0.0001 in', heading: (name) => `${name} (0.0001 in)` };
+  }
+  return { per: 1000, unit: 'µm', heading: (name) => `${name}, µm` };
+}
+
+// An error (in the answer's units) as its reading, to a tenth of the reading's unit.
+function reading(e, { per }) {
+  return Number.isFinite(e) ? (e * per).toFixed(1) : '–';
+}
+
+// A length of the answer with its unit: mm to 3 decimals, inch to 4 (0.0001 in).
+function length(v, units) {
+  return `${Number(v.toFixed(units === 'inch' ? 4 : 3))} ${inUnits('mm', units)}`;
+}
+
+// The units a G-code program's coordinates are in: its first G20 (inch) or G21 (mm), mm without.
+function programUnits(program) {
+  const word = /G0*2([01])(?![\d.])/i.exec(program.replace(/\([^)]*\)|;.*$/gm, ''));
+  return word?.[1] === '0' ? 'inch' : 'mm';
 }
 
 // A height-grid stock as a see-through surface (heights: a row per y, along x).
@@ -317,6 +344,11 @@ function runs(passes) {
 // (a worst pass goes to its line). Used by the form and by job results.
 export function predictResult(container, answer, { request, program, stockTriangles } = {}) {
   container.replaceChildren();
+  // Everything here is in the answer's units, whatever the switch says until it is computed again.
+  const units = answer.units === 'inch' ? 'inch' : 'mm';
+  showInUnits(container, units);
+  const errorIn = errorReading(units);
+  const shown = (e) => reading(e, errorIn);
   const warnings = document.createElement('div');
   const sceneBox = document.createElement('div');
   const timelineBox = document.createElement('div');
@@ -332,7 +364,7 @@ export function predictResult(container, answer, { request, program, stockTriang
   bandInput.placeholder = 'none';
   bandInput.name = 'tolerance_band';
   bandInput.style.width = '6rem';
-  bandLabel.append('Tolerance band ±', bandInput, 'µm');
+  bandLabel.append('Tolerance band ±', bandInput, errorIn.unit);
   const bandCount = document.createElement('output');
   bandBox.append(bandLabel, bandCount);
   const scale = document.createElement('canvas');
@@ -373,18 +405,23 @@ export function predictResult(container, answer, { request, program, stockTriang
   scene.tool({ radius: answer.tool.radius || 1 });
   scene.finish();
   // With the program (the form view), the timeline walks it and a worst pass goes to its line.
+  // The program keeps its own G20/G21: its readout says those, its positions are drawn in the
+  // answer's units.
   const lift = request?.reference === 'centre' ? 0 : answer.tool.radius;
+  const ownUnits = program ? programUnits(program) : units;
+  const toAnswer = lengthFactor(ownUnits, units);
+  timelineBox.dataset.units = ownUnits;
   const timeline = program ? new Timeline(timelineBox, program, {
-    onMove: (move) => scene.moveTool([move.position[0], move.position[1], move.position[2] + lift]),
+    onMove: (move) => scene.moveTool([move.position[0] * toAnswer, move.position[1] * toAnswer, move.position[2] * toAnswer + lift]),
   }) : null;
   const end = (pass) => pass.corrected.map((c, k) => c - pass.correction[k]);
   const redraw = () => {
-    const band = (parseDecimal(bandInput.value) || 0) / 1000;
+    const band = (parseDecimal(bandInput.value) || 0) / errorIn.per;
     const colour = (e) => colourOf(e, limit);
-    drawColourScale(scale, { low: -limit, high: limit, band, colour, format: microns, unit: 'µm' });
-    drawHistogram(histogram, errors, { low, high, band, colour, format: microns, unit: 'µm', label: 'passes per error' });
+    drawColourScale(scale, { low: -limit, high: limit, band, colour, format: shown, unit: errorIn.unit });
+    drawHistogram(histogram, errors, { low, high, band, colour, format: shown, unit: errorIn.unit, label: 'passes per error' });
     const outside = band > 0 ? errors.filter((e) => Math.abs(e) > band).length : null;
-    bandCount.textContent = outside === null ? '' : `${outside} of ${errors.length} passes outside ±${bandInput.value} µm.`;
+    bandCount.textContent = outside === null ? '' : `${outside} of ${errors.length} passes outside ±${bandInput.value} ${errorIn.unit}.`;
   };
   bandInput.addEventListener('input', redraw);
   redraw();
@@ -392,19 +429,21 @@ export function predictResult(container, answer, { request, program, stockTriang
 
   const s = answer.summary;
   summaryBox.replaceChildren();
+  // The pixel is a length: in µm in mm (it is of the errors' size), in inches to 0.0001 in.
+  const pixel = units === 'inch' ? length(s.pixel_size, units) : `${number(s.pixel_size * 1000, 1)} µm`;
   showSummary(summaryBox, [
     ['passes', `${s.predicted} of ${s.passes} predicted`],
-    ['error range, µm', `${microns(s.min_error)} … ${microns(s.max_error)}`],
-    ['mean / RMS error, µm', `${microns(s.mean_error)} / ${microns(s.rms_error)}`],
-    ['largest correction, µm', `${microns(s.max_correction)}${s.clamped ? ` (${s.clamped} clamped)` : ''}`],
+    [errorIn.heading('error range'), `${shown(s.min_error)} … ${shown(s.max_error)}`],
+    [errorIn.heading('mean / RMS error'), `${shown(s.mean_error)} / ${shown(s.rms_error)}`],
+    [errorIn.heading('largest correction'), `${shown(s.max_correction)}${s.clamped ? ` (${s.clamped} clamped)` : ''}`],
     ['no cut / no surface / outside', `${s.no_cut} / ${s.no_surface} / ${s.outside_stock}`],
-    ['method', `${s.method.replace('_', ' ')}, N ${s.resolution} (${number(s.pixel_size * 1000, 1)} µm)`],
-    ['tool', `${answer.tool.number ? 'T' + answer.tool.number + ' ' : ''}ball Ø${Number((2 * answer.tool.radius).toFixed(3))} mm`],
-  ].concat(s.merge ? [['merged passes', `${s.merge.merged} (${s.merge.simulated} simulated), error of the merge ≤ ${microns(s.merge.max_bound)} µm`]] : [])
+    ['method', `${s.method.replace('_', ' ')}, N ${s.resolution} (${pixel})`],
+    ['tool', `${answer.tool.number ? 'T' + answer.tool.number + ' ' : ''}ball Ø${length(2 * answer.tool.radius, units)}`],
+  ].concat(s.merge ? [['merged passes', `${s.merge.merged} (${s.merge.simulated} simulated), error of the merge ≤ ${shown(s.merge.max_bound)} ${errorIn.unit}`]] : [])
     .concat(answer.timings ? [['time', `${number(answer.timings.solve_ms / 1000, 2)} s (${Math.round(answer.timings.passes_per_s)} passes/s)`]] : []));
 
   const head = document.createElement('tr');
-  for (const title of ['#', 'pass', 'NC line', 'error, µm', 'contact angle, °', 'flags']) {
+  for (const title of ['#', 'pass', 'NC line', errorIn.heading('error'), 'contact angle, °', 'flags']) {
     const th = document.createElement('th');
     th.textContent = title;
     head.append(th);
@@ -425,7 +464,7 @@ export function predictResult(container, answer, { request, program, stockTriang
     };
     tr.addEventListener('click', select);
     tr.addEventListener('keydown', (e) => { if (e.key === 'Enter' || e.key === ' ') { e.preventDefault(); select(); } });
-    const cells = [String(rank + 1), String(w.index), w.line === undefined ? '–' : String(w.line), microns(w.error),
+    const cells = [String(rank + 1), String(w.index), w.line === undefined ? '–' : String(w.line), shown(w.error),
       number(pass.contact_angle_deg, 1), (pass.flags || []).join(', ')];
     cells.forEach((text, k) => {
       const td = document.createElement('td');
@@ -476,8 +515,10 @@ export const predictView = {
       read: () => predictRequest(form),
       ask: (request) => api('POST', '/api/v1/predict?timings=true', payload(request)),
       show: async (answer, { body, file }) => {
-        // The uploaded STL stock, drawn as the service read it (the same file).
+        // The uploaded STL stock, drawn as the service read it (the same file, in its units).
         const stockTriangles = file ? stlTriangles(await file.arrayBuffer()) : null;
+        const toAnswer = lengthFactor(body.stock.units ?? body.units, answer.units ?? 'mm');
+        if (stockTriangles && toAnswer !== 1) stockTriangles.forEach((v, k) => { stockTriangles[k] = v * toAnswer; });
         predictResult(result, answer, { request: body, program: body.path.program, stockTriangles }).id = 'predict-plot';
         result.querySelector('canvas.histogram').id = 'predict-histogram';
       },
@@ -496,8 +537,15 @@ export const predictView = {
       clear();
       const { body } = predictRequest(form);
       const slot = value(form, 'save_number');
+      // The tool table is in mm whatever the form's units.
+      const toMm = lengthFactor(body.units, 'mm');
+      const tool = {
+        ...body.tool,
+        radius: body.tool.radius * toMm,
+        shape_error: body.tool.shape_error?.map(({ angle_deg, error }) => ({ angle_deg, error: error * toMm })),
+      };
       try {
-        await api('PUT', `/api/v1/tools/${encodeURIComponent(slot)}`, { ...body.tool, name: `Ø${2 * body.tool.radius} ball, shape error` });
+        await api('PUT', `/api/v1/tools/${encodeURIComponent(slot)}`, { ...tool, name: `Ø${Number((2 * tool.radius).toPrecision(6))} ball, shape error` });
         messages.replaceChildren(message('ok', `tool ${slot} saved with its shape-error table`));
         await loadTools(form.elements.tool_choice, 'inline ball (below)', isBall, predictToolLabel);
       } catch (problem) {

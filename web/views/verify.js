@@ -7,6 +7,7 @@
 import { api } from '/api.js';
 import { loadTools, message, number, numeric, showSummary, submitFlow, value } from '/form.js';
 import { CutStock, showFindings, showListing } from '/plot/cut-stock.js';
+import { convertForm, lengthFactor, showInUnits, unitsOf } from '/units.js';
 
 // Most rays of the mesh the page asks for: a coarser spacing than the findings' beyond it, so the
 // download and the drawing stay small.
@@ -26,10 +27,13 @@ const FORM = `
       <label data-inline>Kind <select name="kind"><option value="flat">flat end mill</option><option value="ball">ball end mill</option></select></label>
       <label data-inline>Radius, mm <input name="radius" type="number" step="any" value="5" data-field="tools"></label>
     </fieldset>
-    <fieldset><legend>Stock and part (boxes, mm)</legend>
-      <label>Stock min x y z, mm <input name="stock_min" type="text" value="-20 -20 -10" data-field="stock"></label>
-      <label>Stock max x y z, mm <input name="stock_max" type="text" value="70 20 0" data-field="stock"></label>
-      <label>Part top z, mm <input name="part_top" type="number" step="any" value="-1.9" placeholder="none: no part" data-field="part"></label>
+    <fieldset><legend>Stock (a box) and part</legend>
+      <label>Stock min x y z, mm <input name="stock_min" type="text" value="-20 -20 -10" data-dim="points" data-field="stock"></label>
+      <label>Stock max x y z, mm <input name="stock_max" type="text" value="70 20 0" data-dim="points" data-field="stock"></label>
+      <label>Part <select name="part_kind" data-field="part.kind"><option value="box">the stock box down to a top</option><option value="mesh">STL file</option></select></label>
+      <label data-part="box">Part top z, mm <input name="part_top" type="number" step="any" value="-1.9" placeholder="none: no part" data-field="part"></label>
+      <label data-part="mesh">Part STL file <input name="part_file" type="file" accept=".stl,model/stl,application/sla" data-field="part"></label>
+      <label data-part="mesh">STL units <select name="stl_units" data-field="part.units" title="an STL file names no units; most are exported in mm whatever the shop works in"><option value="mm">mm</option><option value="inch">inch</option></select></label>
       <label>Spacing, mm <input name="resolution" type="number" step="any" placeholder="a twentieth of the cutter radius" data-field="resolution"></label>
     </fieldset>
     <div class="actions"><button class="primary" type="submit" id="verify-run">Verify</button></div>
@@ -37,7 +41,7 @@ const FORM = `
   <section id="verify-result">
     <div id="verify-messages"></div>
     <div class="summary" id="verify-summary"></div>
-    <div class="table-scroll"><table class="worst"><thead><tr><th>finding</th><th>line</th><th>position, mm</th><th>depth, mm</th><th>volume, mm³</th></tr></thead>
+    <div class="table-scroll"><table class="worst"><thead><tr><th>finding</th><th>line</th><th>position, mm</th><th>depth, mm</th><th data-units-fixed>volume, mm³</th></tr></thead>
       <tbody id="verify-findings"></tbody></table></div>
     <div id="verify-scene"></div>
     <ol class="listing" id="verify-listing" aria-label="G-code program" tabindex="0"></ol>
@@ -61,23 +65,46 @@ function request(form) {
     ? { kind: value(form, 'kind'), radius: numeric(form, 'radius') }
     : Number(value(form, 'tool'));
   const top = numeric(form, 'part_top');
+  // An STL file names no units: the part says which it was exported in.
+  const part = value(form, 'part_kind') === 'mesh'
+    ? { kind: 'mesh', units: value(form, 'stl_units') }
+    : top === undefined ? undefined : { kind: 'box', min, max: [max[0], max[1], top] };
   return {
+    units: unitsOf(form),
     program: form.elements.program.value,
     tools: [tool],
     stock: { kind: 'box', min, max },
-    part: top === undefined ? undefined : { kind: 'box', min, max: [max[0], max[1], top] },
+    part,
     resolution: numeric(form, 'resolution'),
   };
 }
 
+// The part's STL file, when the part is one.
+function partFile(form) {
+  return value(form, 'part_kind') === 'mesh' ? form.elements.part_file.files[0] || null : null;
+}
+
+// The body to send: JSON, or a form with the JSON and the part's STL file.
+function payload(body, file) {
+  if (!file) return body;
+  const form = new FormData();
+  form.append('request', new Blob([JSON.stringify(body)], { type: 'application/json' }));
+  form.append('part', file, file.name);
+  return form;
+}
+
+// The answer, in its own units (lengths in mm or in; volumes in the mm³ their names say).
 function showAnswer(root, answer, program) {
-  showSummary(root.querySelector('#verify-summary'), [
+  showInUnits(root.querySelector('#verify-result'), answer.units);
+  const summary = root.querySelector('#verify-summary');
+  showSummary(summary, [
     ['Result ', answer.ok ? 'no findings' : `${answer.findings.length} findings`],
     ['Removed ', `${number(answer.removed_volume_mm3, 1)} mm³`],
     ['Cutting time ', `${number(answer.cutting_time_s, 1)} s`],
     ['In air ', `${number(100 * answer.air_share, 1)} %`],
     ['Spacing ', `${number(answer.resolution)} mm`],
   ]);
+  summary.children[1].dataset.unitsFixed = '';
   const listing = root.querySelector('#verify-listing');
   showListing(listing, program, answer.findings);
   showFindings(root.querySelector('#verify-findings'), answer.findings, listing, () => root.verifyStock);
@@ -93,19 +120,21 @@ function meshBody(body, answer) {
 
 // Draws the cut stock of `answer` under the findings; a refusal of the mesh (too large) is shown
 // as a message, the findings stay.
-async function drawStock(root, answer, body) {
+async function drawStock(root, answer, body, file) {
   const mesh = meshBody(body, answer);
+  // The service's tolerance and allowance when the request gives none are in mm.
+  const fromMm = lengthFactor('mm', answer.units ?? 'mm');
   const container = root.querySelector('#verify-scene');
   container.replaceChildren();
   const stock = new CutStock(container, {
     id: 'verify',
     program: body.program,
     findings: answer.findings,
-    tolerance: body.tolerance ?? 0.01,
-    allowance: body.allowance ?? 0.1,
+    tolerance: body.tolerance ?? 0.01 * fromMm,
+    allowance: body.allowance ?? 0.1 * fromMm,
     ask: async (line) => {
       const query = line === undefined ? '?format=glb' : `?format=glb&upto_line=${line}`;
-      return (await api('POST', `/api/v1/verify${query}`, mesh, 'model/gltf-binary')).arrayBuffer();
+      return (await api('POST', `/api/v1/verify${query}`, payload(mesh, file), 'model/gltf-binary')).arrayBuffer();
     },
   });
   root.verifyStock = stock;
@@ -123,8 +152,13 @@ export const verifyView = {
     const messages = root.querySelector('#verify-messages');
     const select = form.elements.tool;
     const syncInline = () => form.querySelectorAll('[data-inline]').forEach((e) => { e.hidden = select.value !== 'inline'; });
+    const syncPart = () => form.querySelectorAll('[data-part]').forEach((e) => { e.hidden = e.dataset.part !== value(form, 'part_kind'); });
     loadTools(select, 'inline tool').then(syncInline);
     select.addEventListener('change', syncInline);
+    form.elements.part_kind.addEventListener('change', syncPart);
+    syncPart();
+    // The markup's example is in mm: in an inch section it is converted once (the same part).
+    convertForm(form, 'mm', unitsOf(form));
     form.elements.file.addEventListener('change', async () => {
       const file = form.elements.file.files[0];
       if (file) form.elements.program.value = await file.text();
@@ -133,10 +167,10 @@ export const verifyView = {
       messages,
       result: root.querySelector('#verify-result'),
       read: () => request(form),
-      ask: (body) => api('POST', '/api/v1/verify', body),
+      ask: (body) => api('POST', '/api/v1/verify', payload(body, partFile(form))),
       show: (answer, body) => {
         showAnswer(root, answer, body.program);
-        drawStock(root, answer, body);
+        drawStock(root, answer, body, partFile(form));
         return answer.ok ? null : message('error', `The program cut wrong: ${[...new Set(answer.findings.map((f) => f.kind.replaceAll('_', ' ')))].join(', ')}.`);
       },
       done: (answer) => (answer.ok ? 'Verified: the program cuts the part as it should.' : 'Verified.'),

@@ -391,6 +391,30 @@ async fn the_units_switch_sends_inch_and_labels_plots_and_readouts_in_inches() {
     not(kerf_has_chromium),
     ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
 )]
+async fn the_predict_view_follows_the_units_switch_with_errors_in_tenths() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "unitsPredict", &[]) else { return };
+    assert_eq!(result["flipped"], "0.23622", "{result}");
+    assert_eq!(result["back"], "6", "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
+async fn the_verify_view_follows_the_units_switch_and_reads_an_stl_part_in_mm() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "unitsVerify", &[]) else { return };
+    assert_eq!(result["flipped"], "0.19685", "{result}");
+    assert_eq!(result["back"], "5", "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
 async fn deburr_page_draws_the_cut_tube_with_its_chamfer() {
     let app = TestApp::spawn().await;
     let Some(result) = run_scenario(&app, "deburrCut", &[]) else { return };
