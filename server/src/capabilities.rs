@@ -394,7 +394,8 @@ pub fn solve<C: Capability>(
     let seconds = started.elapsed().as_secs_f64();
     if let Some(output) = program {
         let output = OutputOptions { units: Some(units), ..*output };
-        let program = capability::program::<C>(request, &answer, &output, run.control)?;
+        let program = capability::program::<C>(request, &answer, &output, run.control)
+            .map_err(|error| refusal_in(error, units))?;
         check_size(run, program.len())?;
         return Ok((Delivered::Program(program), seconds));
     }
@@ -544,7 +545,11 @@ fn stored<C: Capability>(
     Ok(Stored {
         operation: C::NAME.to_owned(),
         result,
-        gcode_problem: program.as_ref().err().map(|e: &SolverError| format!("{} ({})", e.message(), e.code())),
+        // The reason quotes lengths in mm, as every refusal: restated in the operation's units.
+        gcode_problem: program.as_ref().err().map(|error: &SolverError| {
+            let error = refusal_in(error.clone(), units);
+            format!("{} ({})", error.message(), error.code())
+        }),
         gcode: program.ok(),
     })
 }

@@ -426,21 +426,39 @@ const scenarios = {
       if (!response.ok) throw new Error(`machine not stored: ${response.status}`);
     }, [`${base}/api/v1/machines/api-full`, full]);
     await page.click('#tabs a[data-view="machines"]');
+    // The stored version Edit asks for (its ETag) arrives only after Save is clicked, as from a
+    // busy service: the save waits for it and replaces that version rather than finding a
+    // machine of that name "already exists".
+    const apiFull = `${base}/api/v1/machines/api-full`;
+    let releaseVersion;
+    const versionHeld = new Promise((resolve) => { releaseVersion = resolve; });
+    const holdVersion = async (route) => {
+      if (route.request().method() === 'GET') await versionHeld;
+      await route.continue();
+    };
+    await page.route(apiFull, holdVersion);
+    const versionAsked = page.waitForRequest((r) => r.url() === apiFull && r.method() === 'GET', { timeout: 60000 });
     await page.click('#machine-rows tr[data-machine="api-full"] button:has-text("Edit")');
     if (await page.inputValue('#machine-form input[name="spindle_power_kw"]') !== '5.5') throw new Error('Edit did not fill the spindle power');
     await page.fill('#machine-form input[name="margin"]', '1.2');
+    await versionAsked;
+    // The rows as they are before the save, which lists the machines again.
+    await page.$$eval('#machine-rows tr', (rows) => rows.forEach((row) => { row.dataset.old = 'yes'; }));
     await page.click('#machine-save');
+    releaseVersion();
     // The message of hsc-page's save is still there: wait for the one naming this machine.
     await page.waitForFunction(() => /Machine api-full saved/.test(document.querySelector('#machine-messages .message.ok')?.textContent ?? ''), null, { timeout: 60000 });
+    await page.unroute(apiFull, holdVersion);
     const edited = await page.evaluate(async (url) => (await fetch(url)).json(), `${base}/api/v1/machines/api-full`);
     for (const [key, expected] of Object.entries({ ...full, margin: 1.2 })) {
       if (edited[key] !== expected) throw new Error(`editing on the page changed ${key}: ${JSON.stringify(edited)}`);
     }
     await page.evaluate(async (url) => { await fetch(url, { method: 'DELETE' }); }, `${base}/api/v1/machines/api-full`);
 
-    // Delete it again.
+    // Delete it again, in the rows listed after the save (a list arriving between Delete and
+    // its confirmation would put back the row unasked).
     await page.click('#tabs a[data-view="machines"]');
-    await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { timeout: 60000 });
+    await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]:not([data-old])', { timeout: 60000 });
     await page.click('#machine-rows tr[data-machine="hsc-page"] button:has-text("Delete")');
     await page.click('#machine-rows tr[data-machine="hsc-page"] button:has-text("Yes, delete")');
     await page.waitForSelector('#machine-rows tr[data-machine="hsc-page"]', { state: 'detached', timeout: 60000 });

@@ -62,16 +62,16 @@ export function registryView(spec) {
         edit.textContent = 'Edit';
         edit.addEventListener('click', async () => {
           // The listed item at once, then the stored version with its ETag (refilled only if it
-          // changed since the list was read).
+          // changed since the list was read). A save waits for it (`editing.version`): without
+          // its ETag the save would find the item "already exists".
           fill(form, item);
-          try {
-            const stored = await tagged('GET', path(item.name));
-            if (editing?.item.name !== item.name) return;
+          const opened = editing;
+          opened.version = tagged('GET', path(item.name)).then((stored) => {
+            if (editing !== opened) return;
             if (JSON.stringify(stored.body) !== JSON.stringify(item)) fill(form, stored.body, stored.etag);
             else editing.etag = stored.etag;
-          } catch (problem) {
-            showProblem(messages, null, problem);
-          }
+          }, (problem) => showProblem(messages, null, problem));
+          await opened.version;
         });
         const remove = confirmButton('Delete', `Delete ${kind} ${item.name}?`, async () => {
           try {
@@ -113,13 +113,19 @@ export function registryView(spec) {
         read: () => ({ name: form.elements.name.value.trim(), item: body(form) }),
         // A new name is created only if it is free; the item opened with Edit is replaced only
         // as it was opened. Otherwise the stored item is shown and the user asked.
-        ask: ({ name, item }) => saveGuarded(messages, {
-          path: path(name || ' '),
-          body: item,
-          etag: editing?.item.name === name ? editing.etag : undefined,
-          what: `${kind} ${name}`,
-          describe: spec.describe,
-        }),
+        ask: async ({ name, item }) => {
+          // The version Edit opened, once its ETag is there; a stored version other than the
+          // listed one refills the form, and the save asks before it replaces it.
+          const opened = editing;
+          await opened?.version;
+          return saveGuarded(messages, {
+            path: path(name || ' '),
+            body: item,
+            etag: opened && editing === opened && opened.item.name === name ? opened.etag : undefined,
+            what: `${kind} ${name}`,
+            describe: spec.describe,
+          });
+        },
         show: async (answer, { name }) => {
           // An edited item stays open at its new version; a new one is saved and the form stays
           // a form for new items (to change a stored one, open it with Edit).

@@ -75,10 +75,15 @@ pub fn program(answer: &EngagementSolution, candidate: usize, post: &Post) -> Re
     };
     let Cut { path, cut_z, safe_z, .. } = cut(result, lift, post.arcs, Control::default())?;
     let mut comments = data.description.clone();
-    comments.push(format!("cut Z {:.4}, clearance Z {:.4}, control point {}", cut_z, safe_z, post.reference.as_str()));
+    comments.push(format!(
+        "cut Z {:.4} mm, clearance Z {:.4} mm, control point {}",
+        cut_z,
+        safe_z,
+        post.reference.as_str()
+    ));
     if let Some(plan) = &result.feed_plan {
         comments.push(format!(
-            "feeds hold {} mm chip thickness ({} basis) for {} flutes, max feed {}",
+            "feeds hold {} mm chip thickness ({} basis) for {} flutes, max feed {} mm/min",
             plan.target_thickness,
             match plan.basis {
                 super::request::FeedBasis::Tooth => "tooth",

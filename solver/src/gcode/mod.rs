@@ -29,7 +29,7 @@ use crate::control::Control;
 use crate::error::SolverError;
 use crate::geometry::Vec3;
 use crate::path::{Motion, Toolpath};
-use crate::units::{Scale, Units};
+use crate::units::{Scale, Scaling, Units};
 
 /// The control the program is written for: the post.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -160,7 +160,17 @@ impl ToolCall {
         match (tool.number, tool.name.as_deref().map(sinumerik_tool_name).filter(|n| !n.is_empty())) {
             (Some(number), Some(name)) => Self::Named { number, name },
             (Some(number), None) => Self::Table(number),
-            (None, _) => Self::Manual(format!("{} R{}", tool.kind.as_str(), mm(tool.radius))),
+            (None, _) => Self::Manual(format!("{} radius {} mm", tool.kind.as_str(), mm(tool.radius))),
+        }
+    }
+
+    /// The call with a manual change's description (which quotes the tool's radius in mm)
+    /// restated in the units of `scaling` ([`Scaling::restate`]).
+    #[must_use]
+    pub fn restated(&self, scaling: Scaling) -> Self {
+        match self {
+            Self::Manual(description) => Self::Manual(scaling.restate(description)),
+            other => other.clone(),
         }
     }
 
@@ -457,17 +467,27 @@ fn write_checking<E>(
         plunges.feed.scale(scaling);
         plunges
     });
-    // The header's sentences quote lengths and feeds in mm: restated in the program's units.
+    // The header's sentences, the stops' notices and a manual tool change's description quote
+    // lengths and feeds in mm: restated in the program's units.
     let comments = program.comments.iter().map(|comment| scaling.restate(comment)).collect();
+    let stops: Vec<ProgramStop> = stops
+        .iter()
+        .map(|stop| ProgramStop {
+            notice: stop.notice.as_deref().map(|notice| scaling.restate(notice)),
+            tool: stop.tool.as_ref().map(|tool| tool.restated(scaling)),
+            ..stop.clone()
+        })
+        .collect();
     let program = Program {
         comments,
+        tool: program.tool.restated(scaling),
         safe_z: scaling.apply(program.safe_z),
         blend_tolerance: scaling.apply(program.blend_tolerance),
         plunges,
         path: &path,
         ..program.clone()
     };
-    write_words(&program, stops, check)
+    write_words(&program, &stops, check)
 }
 
 /// Writes `program`, its lengths and feeds already in its units.
@@ -969,6 +989,50 @@ mod tests {
     }
 
     #[test]
+    fn a_manual_tool_change_quotes_the_radius_in_the_programs_units() {
+        let mut path = Toolpath::default();
+        path.rapid(Vec3::new(0.0, 0.0, 25.4));
+        path.linear(Vec3::new(25.4, 0.0, -2.54), 254.0);
+        path.linear(Vec3::new(50.8, 0.0, -2.54), 254.0);
+        let tool = crate::tool::Tool::new(crate::tool::ToolKind::Flat, 3.175);
+        let stop = ProgramStop {
+            before: 2,
+            notice: Some("check the 12.7 mm bore".to_owned()),
+            tool: Some(ToolCall::for_tool(&tool)),
+            spindle_rpm: 5000.0,
+        };
+        for (units, radius, notice) in [
+            (Units::Mm, "RADIUS 3.1750 MM)", "(CHECK THE 12.7 MM BORE)"),
+            (Units::Inch, "RADIUS 0.12500 IN)", "(CHECK THE 0.5000 IN BORE)"),
+        ] {
+            for dialect in Dialect::ALL {
+                let program = Program {
+                    dialect,
+                    number: 1000,
+                    title: "manual",
+                    comments: Vec::new(),
+                    tool: ToolCall::for_tool(&tool),
+                    spindle_rpm: 6000.0,
+                    spindle_direction: SpindleDirection::Cw,
+                    safe_z: 25.4,
+                    blend_tolerance: 0.01,
+                    plunges: None,
+                    units,
+                    path: &path,
+                };
+                let text = write_changing(&program, std::slice::from_ref(&stop));
+                let changes: Vec<&str> = text.lines().filter(|l| l.contains("TOOL NOT IN THE TOOL TABLE")).collect();
+                assert_eq!(changes.len(), 2, "{text}");
+                // The post's comment style around it (`(…)`, `; …`, line numbers, block ends).
+                let bare = |line: &str| line.trim_end_matches(" *").trim_end_matches(')').to_owned() + ")";
+                assert!(changes.iter().all(|line| bare(line).ends_with(radius)), "{dialect:?} {units:?}: {text}");
+                let notice = notice.trim_matches(|c| c == '(' || c == ')');
+                assert!(text.contains(notice), "{dialect:?} {units:?}: {text}");
+            }
+        }
+    }
+
+    #[test]
     fn comments_cannot_break_out() {
         assert_eq!(comment("a (b) c"), "(A  B  C)");
         assert_eq!(comment("ø3\nx"), "(3 X)");
@@ -1161,7 +1225,7 @@ mod golden {
         let folder = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/gcode/golden");
         for dialect in Dialect::ALL {
             let mut text = write_changing(&program(dialect, &path, ToolCall::Table(7)), std::slice::from_ref(&stop));
-            text.push_str(&write(&program(dialect, &path, ToolCall::Manual("ball R3.0000".to_owned()))));
+            text.push_str(&write(&program(dialect, &path, ToolCall::Manual("ball radius 3.0000 mm".to_owned()))));
             let file = folder.join(format!("{}.nc", dialect.as_str()));
             if std::env::var("KERF_UPDATE_GOLDEN").is_ok_and(|v| v == "1") {
                 std::fs::write(&file, &text).unwrap();

@@ -16,10 +16,10 @@ thread_local! {
     pub(crate) static COMPARED: Cell<usize> = const { Cell::new(0) };
 }
 
-/// Panics unless `written` is what the old writer writes for `program` (Fanuc and LinuxCNC, the
-/// posts it had).
+/// Panics unless `written` is what the old writer writes for `program` (Fanuc and LinuxCNC in mm,
+/// the posts and units it had).
 pub(super) fn check(program: &Program<'_>, stops: &[ProgramStop], written: &str) {
-    if !matches!(program.dialect, Dialect::Fanuc | Dialect::Linuxcnc) {
+    if !matches!(program.dialect, Dialect::Fanuc | Dialect::Linuxcnc) || program.units != crate::units::Units::Mm {
         return;
     }
     let Ok(old) = old_write_checking(program, stops, || Ok::<(), std::convert::Infallible>(()));

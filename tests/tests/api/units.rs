@@ -715,3 +715,72 @@ async fn an_inch_requests_refusals_and_warnings_read_inches() {
     let message = warning["message"].as_str().unwrap();
     assert!(message.contains("feed 150.0 in/min is above the machine's max_feed 100.0 in/min"), "{message}");
 }
+
+/// The line of `program` that holds `text`.
+fn line_with<'p>(program: &'p str, text: &str) -> &'p str {
+    program.lines().find(|line| line.contains(text)).unwrap_or_else(|| panic!("no {text:?} in {program}"))
+}
+
+/// An inch program's header quotes inches where it quotes a length or a feed: the radius of an
+/// inline tool the operator loads by hand, engagement's cutting and clearance heights and its feed
+/// plan; the mm twin's quote mm.
+#[tokio::test]
+async fn an_inch_programs_header_reads_inches() {
+    let app = TestApp::spawn().await;
+    let (inch, mm) = pair(contour_request);
+    let inch_program = app.post_text("/api/v1/contour?format=gcode", &inch, 200).await;
+    let mm_program = app.post_text("/api/v1/contour?format=gcode", &mm, 200).await;
+    let manual = "TOOL NOT IN THE TOOL TABLE";
+    assert_eq!(line_with(&inch_program, manual), "(TOOL NOT IN THE TOOL TABLE: FLAT RADIUS 0.12500 IN)");
+    assert_eq!(line_with(&mm_program, manual), "(TOOL NOT IN THE TOOL TABLE: FLAT RADIUS 3.1750 MM)");
+    let (inch, mm) = pair(engagement_request);
+    let inch_program = app.post_text("/api/v1/engagement?format=gcode", &inch, 200).await;
+    let mm_program = app.post_text("/api/v1/engagement?format=gcode", &mm, 200).await;
+    assert_eq!(line_with(&inch_program, "CUT Z"), "(CUT Z -0.080000 IN, CLEARANCE Z 0.20000 IN, CONTROL POINT TIP)");
+    assert_eq!(line_with(&mm_program, "CUT Z"), "(CUT Z -2.0320 MM, CLEARANCE Z 5.0800 MM, CONTROL POINT TIP)");
+    assert_eq!(
+        line_with(&inch_program, "FEEDS HOLD"),
+        "(FEEDS HOLD 0.002000 IN CHIP THICKNESS  TOOTH BASIS  FOR 4 FLUTES, MAX FEED 60.00 IN/MIN)"
+    );
+    assert_eq!(
+        line_with(&mm_program, "FEEDS HOLD"),
+        "(FEEDS HOLD 0.0508 MM CHIP THICKNESS  TOOTH BASIS  FOR 4 FLUTES, MAX FEED 1524 MM/MIN)"
+    );
+    assert_eq!(line_with(&inch_program, manual), "(TOOL NOT IN THE TOOL TABLE: FLAT RADIUS 0.20000 IN)");
+    assert_eq!(line_with(&mm_program, manual), "(TOOL NOT IN THE TOOL TABLE: FLAT RADIUS 5.0800 MM)");
+}
+
+/// A deburr request in units of `k` mm whose inner edge a lollipop cutter cannot reach: its neck
+/// would cut the hole wall, so it has an answer but no program.
+fn blocked_deburr_request(k: f64) -> Value {
+    json!({"tool": {"kind": "ball", "radius": 0.12 * k, "neck_radius": 0.11 * k},
+           "workpiece": {"kind": "tube", "origin": [0, 0, 0], "inner_diameter": 1.2 * k, "outer_radius": k},
+           "holes": [{"shape": "round", "radius": 0.3 * k}],
+           "edge": "inner", "width": 0.02 * k, "feed": 12.0 * k, "spindle_rpm": 8000})
+}
+
+/// Why an inch operation has no program quotes inches, at its endpoint and in its job; the mm
+/// twin's quotes mm, in the same words.
+#[tokio::test]
+async fn an_inch_operations_reason_for_no_program_reads_inches() {
+    let app = TestApp::spawn().await;
+    let (inch, mm) = pair(blocked_deburr_request);
+    let mut reasons = Vec::new();
+    for body in [&inch, &mm] {
+        let refused = problem(app.post_json("/api/v1/deburr?format=gcode", body).await, 422).await;
+        assert_eq!(refused["code"], "E_NECK_COLLISION", "{refused}");
+        let detail = refused["detail"].as_str().unwrap().to_owned();
+        let mut operation = body.clone();
+        operation["operation"] = json!("deburr");
+        let job = json!({"operations": [operation]});
+        let id = json_with(app.post_json("/api/v1/jobs", &job).await, 202).await["id"].as_i64().unwrap();
+        let done = poll_job(&app.client, &app.base, id, 60, finished).await;
+        assert_eq!(done["status"], "done", "{done}");
+        assert_eq!(done["results"][0]["gcode"], false, "{done}");
+        let problem = done["results"][0]["gcode_problem"].as_str().unwrap_or_else(|| panic!("{done}"));
+        assert_eq!(problem, format!("{detail} (E_NECK_COLLISION)"));
+        reasons.push(detail);
+    }
+    assert_eq!(reasons[0], "the neck (radius 0.1100 in) would cut the hole wall: it is short of room by 0.03251 in");
+    assert_eq!(reasons[1], "the neck (radius 2.794 mm) would cut the hole wall: it is short of room by 0.8258 mm");
+}
