@@ -92,6 +92,14 @@ macro_rules! registry {
                 }
             }
 
+            /// The units the operation is written in: its `units`, else its machine's from
+            /// `lookup`, else mm.
+            pub fn units(&self, lookup: &impl Lookup) -> Units {
+                match self {
+                    $(Self::$variant(request) => capability::units_of::<$capability>(request, lookup),)+
+                }
+            }
+
             /// Every reference of the operation, for a lookup to fetch: its [`Self::refs`], then
             /// one per further tool (deburr's `inner_tool`).
             pub fn all_refs(&self) -> Vec<Refs<'_>> {

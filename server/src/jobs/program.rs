@@ -65,12 +65,17 @@ pub fn job_program(job: &JobFile, number: u32, outputs: &[OperationOutput<'_>]) 
         .operations
         .iter()
         .map(|operation| {
-            let tool = match operation.refs().tool? {
-                ToolRef::Number(number) => job.tool(*number)?,
-                ToolRef::Inline(tool) => tool.clone(),
+            // A stored tool is in mm; an inline one in its operation's units.
+            let (tool, radius_mm) = match operation.refs().tool? {
+                ToolRef::Number(number) => {
+                    let tool = job.tool(*number)?;
+                    let radius = tool.radius;
+                    (tool, radius)
+                }
+                ToolRef::Inline(tool) => (tool.clone(), tool.radius * operation.units(job).mm_per_unit()),
             };
             let name = tool.name.as_deref().map(|name| format!(" {name}")).unwrap_or_default();
-            Some(format!("{} R{}{name}", tool.kind.as_str(), gcode::mm(tool.radius)))
+            Some(format!("{} radius {} mm{name}", tool.kind.as_str(), gcode::mm(radius_mm)))
         })
         .collect();
     let machines: Vec<_> =

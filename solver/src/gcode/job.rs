@@ -16,6 +16,7 @@ use serde::{Deserialize, Serialize};
 use super::table::{ArcCentre, Blending, CommentStyle, Heading, PostTable, ToolChange};
 use super::{Blocks, Dialect, comment, mm};
 use crate::error::SolverError;
+use crate::units::Units;
 
 /// Lowest and highest program number a job may ask for: Fanuc's `O1`–`O7999` (8000–9999 hold
 /// the machine builder's protected programs and macros).
@@ -75,7 +76,8 @@ pub struct Operation<'a> {
     pub program: Option<&'a str>,
     /// Why none was written, if so.
     pub problem: Option<&'a str>,
-    /// The tool in words (`ball R3.0000`), if the operation has one.
+    /// The tool in words with its lengths in mm (`ball radius 3.0000 mm`), if the operation has
+    /// one; an inch job program restates them.
     pub tool: Option<&'a str>,
     /// Rapid feed of its machine, mm/min (for the time estimate; rapids untimed without it).
     pub rapid_feed: Option<f64>,
@@ -106,6 +108,8 @@ pub struct Section<'a> {
     pub title: &'a str,
     /// Its header comment lines.
     pub comments: Vec<&'a str>,
+    /// The units of its lengths and feeds, from its safety block (G21 or G20, and the like).
+    pub units: Units,
     /// The blending line (LinuxCNC's `G64 P…`, Sinumerik's `G642`), if written.
     pub blend: Option<&'a str>,
     /// The tool number of the tool call (`T n M06`); `None` for a manual change.
@@ -179,7 +183,17 @@ impl<'a> Section<'a> {
         while let Some(line) = lines.next_if(|line| is_comment(line, table)) {
             comments.push(line);
         }
-        (lines.next()? == table.safety).then_some(())?;
+        let safety = lines.next()?;
+        let units = match (safety == table.safety, safety == table.inch_safety) {
+            // Heidenhain ISO says its units in the `%` line (G70 inch, G71 mm), not in the block.
+            (true, true) => match text.lines().next()?.split(' ').find(|word| matches!(*word, "G70" | "G71"))? {
+                "G70" => Units::Inch,
+                _ => Units::Mm,
+            },
+            (true, false) => Units::Mm,
+            (false, true) => Units::Inch,
+            (false, false) => return None,
+        };
         // Haas smoothing, which the joined program sets once for the job.
         lines.next_if(|line| line.starts_with("G187 P"));
         let blend = lines.next_if(|line| match table.blending {
@@ -234,6 +248,7 @@ impl<'a> Section<'a> {
         Some(Self {
             title,
             comments,
+            units,
             blend,
             tool_number,
             tool_change,
@@ -245,7 +260,8 @@ impl<'a> Section<'a> {
         })
     }
 
-    /// The feed time of the moves (every feed move at its feed) and their rapid length, s and mm.
+    /// The feed time of the moves (every feed move at its feed) and their rapid length, s and the
+    /// section's units.
     fn feed_time_and_rapids(&self, table: &PostTable) -> (f64, f64) {
         let (mut feed_s, mut rapid_mm) = (0.0, 0.0);
         let mut at: Option<[f64; 3]> = None;
@@ -342,7 +358,8 @@ fn arc_length(from: [f64; 3], to: [f64; 3], centre: [f64; 2], clockwise: bool) -
 /// The estimated time of one operation, s: feed moves at their feed, rapids at the machine's
 /// rapid feed, one tool change at the machine's tool-change time.
 fn estimated_time_s(section: &Section<'_>, operation: &Operation<'_>, table: &PostTable) -> f64 {
-    let (feed_s, rapid_mm) = section.feed_time_and_rapids(table);
+    let (feed_s, rapid_length) = section.feed_time_and_rapids(table);
+    let rapid_mm = rapid_length * section.units.mm_per_unit();
     let rapid_s = operation.rapid_feed.filter(|f| *f > 0.0).map_or(0.0, |f| rapid_mm / f * 60.0);
     let changes = usize::from(section.tool_number.is_some()) + section.changes.iter().flatten().count();
     let change_s = operation.tool_change_s.unwrap_or(0.0) * changes as f64;
@@ -364,17 +381,45 @@ pub fn write(job: &Job<'_>, operations: &[Operation<'_>]) -> Result<String, Solv
              program (CALL PGM from a main program)",
         ));
     };
-    let sections: Vec<Option<Section<'_>>> =
+    let mut sections: Vec<Option<Section<'_>>> =
         operations.iter().map(|operation| operation.program.and_then(|text| Section::parse(text, &table))).collect();
-    if sections.iter().all(Option::is_none) {
+    // One program runs in one unit system: the first joined operation's. An operation written in
+    // the other is left out (named in the header) rather than switched to mid-program, where a
+    // machinist restarting at an operation could run it in the wrong units.
+    let Some(units) = sections.iter().flatten().map(|section| section.units).next() else {
         return Err(SolverError::new(
             crate::error::ErrorCode::NoProgram,
             "no operation of this job has a program to join",
         ));
+    };
+    let mut left_out: Vec<Option<String>> = operations
+        .iter()
+        .map(|operation| {
+            Some(
+                operation
+                    .problem
+                    .unwrap_or("its program keeps the layout of the program it corrects: run its own file")
+                    .to_owned(),
+            )
+        })
+        .collect();
+    for (section, reason) in sections.iter_mut().zip(&mut left_out) {
+        match section {
+            Some(joined) if joined.units != units => {
+                *reason = Some(format!(
+                    "its program is in {}, this program in {}: run its own file",
+                    joined.units.as_str(),
+                    units.as_str()
+                ));
+                *section = None;
+            }
+            Some(_) => *reason = None,
+            None => {}
+        }
     }
     let clearance = sections.iter().flatten().map(|s| s.safe_z).fold(f64::NEG_INFINITY, f64::max);
     let mut out = Blocks::new(table, 0);
-    write_header(&mut out, job, operations, &sections, clearance);
+    write_header(&mut out, job, operations, &sections, &left_out, units, clearance);
     for (index, (section, operation)) in sections.iter().zip(operations).enumerate() {
         let Some(section) = section else { continue };
         write_section(&mut out, job, index, operation, section, clearance);
@@ -382,7 +427,7 @@ pub fn write(job: &Job<'_>, operations: &[Operation<'_>]) -> Result<String, Solv
     out.block(table.end);
     match table.heading {
         Heading::HeidenhainIso => {
-            let _ = writeln!(out.text, "N99999999 %KERF{} G71 *", job.number);
+            let _ = writeln!(out.text, "N99999999 %KERF{} {} *", job.number, super::iso_units(units));
         }
         Heading::Percent(_) => out.text.push_str("%\n"),
         Heading::Title if job.dialect == Dialect::Linuxcnc => out.text.push_str("%\n"),
@@ -392,12 +437,14 @@ pub fn write(job: &Job<'_>, operations: &[Operation<'_>]) -> Result<String, Solv
 }
 
 /// The job program's head: number and title, the operations with their tools and times (or why
-/// they are left out), the clearance height and the safety line.
+/// they are left out, `left_out`), the clearance height and the safety line of `units`.
 fn write_header(
     out: &mut Blocks,
     job: &Job<'_>,
     operations: &[Operation<'_>],
     sections: &[Option<Section<'_>>],
+    left_out: &[Option<String>],
+    units: Units,
     clearance: f64,
 ) {
     let table = out.table;
@@ -406,7 +453,7 @@ fn write_header(
             let _ = writeln!(out.text, "%\nO{:0digits$} {}", job.number, comment(job.title));
         }
         Heading::HeidenhainIso => {
-            let _ = writeln!(out.text, "%KERF{} G71 *", job.number);
+            let _ = writeln!(out.text, "%KERF{} {} *", job.number, super::iso_units(units));
             out.comment(&format!("O{} {}", job.number, job.title));
         }
         Heading::Title => {
@@ -452,15 +499,21 @@ fn write_header(
                 "{} {}: not in this program: {}",
                 index + 1,
                 operation.name,
-                operation
-                    .problem
-                    .unwrap_or("its program keeps the layout of the program it corrects: run its own file")
+                left_out[index].as_deref().unwrap_or_default()
             ),
+        };
+        // The tools' and the reasons' lengths are written in mm: an inch program quotes inches.
+        let line = match units.from_mm() {
+            Some(scaling) => scaling.restate(&line),
+            None => line,
         };
         out.comment(&line);
     }
     out.comment(&format!("clearance between operations Z{}", mm(clearance)));
-    out.block(table.safety);
+    out.block(match units {
+        Units::Mm => table.safety,
+        Units::Inch => table.inch_safety,
+    });
 }
 
 /// One operation (number `index` from 0) in the job program: its head and tool change, the
@@ -534,6 +587,10 @@ mod tests {
     use crate::path::Toolpath;
 
     fn program(dialect: Dialect, tool: ToolCall, safe_z: f64) -> String {
+        program_in(dialect, tool, safe_z, crate::units::Units::Mm)
+    }
+
+    fn program_in(dialect: Dialect, tool: ToolCall, safe_z: f64, units: Units) -> String {
         let mut path = Toolpath::default();
         path.rapid(Vec3::new(1.0, 2.0, safe_z));
         path.linear(Vec3::new(1.0, 2.0, -1.0), 300.0);
@@ -551,7 +608,7 @@ mod tests {
             blend_tolerance: 0.01,
             plunges: Some(super::super::Plunges { feed: None }),
             path: &path,
-            units: crate::units::Units::Mm,
+            units,
         })
     }
 
@@ -616,6 +673,50 @@ mod tests {
             if let Some(max) = table.max_line {
                 assert!(text.lines().all(|l| l.len() <= max), "{text}");
             }
+        }
+    }
+
+    #[test]
+    fn inch_operations_join_into_an_inch_program_and_the_other_units_are_left_out() {
+        for dialect in Dialect::ALL {
+            let Some(table) = dialect.table() else { continue };
+            let inch = program_in(dialect, ToolCall::Table(7), 25.4, Units::Inch);
+            let mm = program_in(dialect, ToolCall::Table(3), 30.0, Units::Mm);
+            let operation = |text| Operation {
+                name: "contour",
+                program: Some(text),
+                problem: None,
+                tool: Some("ball radius 3.0000 mm"),
+                rapid_feed: Some(25_400.0),
+                tool_change_s: None,
+            };
+            let job = Job { dialect, number: 2042, title: "kerf job 42", coolant: Coolant::Off, haas_smoothing: None };
+            let text = write(&job, &[operation(&inch), operation(&mm), operation(&inch)]).unwrap();
+            let safety_blocks: Vec<&str> = text
+                .lines()
+                .map(|line| bare(line, &table))
+                .filter(|line| [table.safety, table.inch_safety].contains(line))
+                .collect();
+            assert_eq!(safety_blocks, [table.inch_safety], "{dialect:?}: {text}");
+            let upper = text.to_uppercase();
+            assert!(upper.contains("3 OPERATIONS, 2 IN THIS PROGRAM"), "{dialect:?}: {text}");
+            assert!(
+                upper.contains("2 CONTOUR: NOT IN THIS PROGRAM: ITS PROGRAM IS IN MM, THIS PROGRAM IN INCH"),
+                "{text}"
+            );
+            // The tools' lengths are restated in the program's units.
+            assert!(upper.contains("BALL RADIUS 0.11811 IN"), "{dialect:?}: {text}");
+            assert!(!upper.contains("3.0000 MM"), "{dialect:?}: {text}");
+            if dialect == Dialect::HeidenhainIso {
+                assert!(text.starts_with("%KERF2042 G70 *") && text.trim_end().ends_with("%KERF2042 G70 *"), "{text}");
+            }
+            // The rapids are read in inches (26.4 mm of them) and timed at the machine's mm/min.
+            let section = Section::parse(&inch, &table).unwrap();
+            assert_eq!(section.units, Units::Inch);
+            let (feed_s, rapid_in) = section.feed_time_and_rapids(&table);
+            assert!((rapid_in - 26.4 / 25.4).abs() < 2e-4, "{rapid_in}");
+            let time = estimated_time_s(&section, &operation(&inch), &table);
+            assert!((time - feed_s - rapid_in * 25.4 / 25_400.0 * 60.0).abs() < 1e-9, "{time}");
         }
     }
 

@@ -918,7 +918,7 @@ fn clean_comment(text: &str) -> String {
 }
 
 /// Heidenhain ISO's units word: G71 mm, G70 inch.
-fn iso_units(units: Units) -> &'static str {
+pub(crate) fn iso_units(units: Units) -> &'static str {
     match units {
         Units::Mm => "G71",
         Units::Inch => "G70",

@@ -247,3 +247,45 @@ async fn job_downloads_are_named_by_their_post_and_haas_smoothing_is_set_once() 
         }
     }
 }
+
+/// A job of inch operations joins into one inch program: G20, the tools' radii in inches, the
+/// rapids timed at the machine's mm/min, every operation's feed moves as rs274 reads them in its
+/// own program; an operation in mm is left out, and the header says why.
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
+async fn an_inch_job_joins_into_one_inch_program_and_leaves_an_mm_operation_out() {
+    let app = TestApp::spawn().await;
+    let folder = tempfile::tempdir().unwrap();
+    let mut job = shop_job();
+    let deburr_in_mm = job["operations"][0].clone();
+    job["operations"] = json!([
+        {"operation": "contour", "tool": 3, "machine": "vmc", "units": "inch",
+         "contour": [[0, 0], [2.4, 0], [2.4, 1.6], [0, 1.6]], "side": "outside",
+         "depths": {"top": 0, "bottom": -0.16, "step": 0.08}, "feed": 30, "spindle_rpm": 8000},
+        {"operation": "segment", "tool": 10, "machine": "vmc", "units": "inch",
+         "curve": {"kind": "circle", "centre": [1.2, 0.8, -0.08], "radius": 0.8}, "feed": 45},
+        deburr_in_mm,
+    ]);
+    let id = run_job(&app, &job).await;
+    let response = app.get(&format!("/api/v1/jobs/{id}/program")).await;
+    assert_eq!(response.status(), 200);
+    let program = response.text().await.unwrap();
+    assert_eq!(program.matches("\nG20 G17 G90 G40 G49 G80 G94\n").count(), 1, "{program}");
+    assert!(!program.contains("G21"), "{program}");
+    assert!(program.contains("(3 OPERATIONS, 2 IN THIS PROGRAM, TOOLS T3 T10, ESTIMATED"), "{program}");
+    assert!(program.contains("(1 CONTOUR: T3 FLAT RADIUS 0.11811 IN D6 FLAT END MILL,"), "{program}");
+    assert!(
+        program.contains("(3 DEBURR: NOT IN THIS PROGRAM: ITS PROGRAM IS IN MM, THIS PROGRAM IN INCH"),
+        "{program}"
+    );
+    assert_eq!(program.matches("M06").count(), 2, "{program}");
+
+    let Some(joined) = feed_moves(&program, folder.path(), "inch-job") else { return };
+    let mut expected = Vec::new();
+    for index in 0..2 {
+        let single = app.get(&format!("/api/v1/jobs/{id}/gcode?operation={index}")).await.text().await.unwrap();
+        assert!(single.contains("\nG20 "), "{single}");
+        expected.extend(feed_moves(&single, folder.path(), &format!("inch-op-{index}")).unwrap());
+    }
+    assert_eq!(joined, expected, "the joined program's feed moves are the inch operations'");
+}
