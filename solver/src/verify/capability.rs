@@ -3,10 +3,13 @@
 
 use serde::Serialize;
 
-use super::job::Found;
+use super::job::{Found, Job};
 use super::request::VerifyRequest;
-use super::simulate::{self, Cut, MAX_FINDINGS};
-use crate::capability::{Capability, Control, Endpoint, OtherTool, OutputOptions, Purpose, Refs, Resolved, Run};
+use super::simulate::{self, Cut, MAX_FINDINGS, PartCut};
+use crate::capability::{
+    Capability, Control, Endpoint, OtherTool, OutputOptions, Part, PartSink, PartSource, Purpose, Refs, Resolved, Run,
+    Sizing, Split,
+};
 use crate::error::{ErrorCode, SolverError};
 use crate::machine::MachineProfile;
 use crate::tool::Tool;
@@ -30,6 +33,28 @@ pub struct VerifyAnswer {
 const BLOCK_BYTES: u64 = 200;
 /// Bytes of JSON one finding takes at most.
 const FINDING_BYTES: u64 = 300;
+
+/// Core-seconds per ray of a cutter's footprint along a move (the rays a sweep looks at): the
+/// 100 502-block raster of the verify bench, 1.26·10⁹ footprint rays, cut in six parts in 7.4 s
+/// of one core besides what each part repeats (docs/guide/performance.md, "Split cost models").
+const FOOTPRINT_RAY_SECONDS: f64 = 5.8e-9;
+/// Core-seconds per ray to build the stock's (and again the part's) dexels of a strip.
+const FIELD_RAY_SECONDS: f64 = 1.0e-8;
+/// Core-seconds per move every part repeats: reading the program and planning each move
+/// (measured 0.6 µs: 0.061 s for a strip of the raster no move reaches).
+const SETUP_MOVE_SECONDS: f64 = 6.0e-7;
+/// Core-seconds per move of the finish step: reading the program and the parts' records,
+/// merging them, the findings and blocks (measured 0.9 µs), and writing the answer.
+const FINISH_MOVE_SECONDS: f64 = 1.5e-6;
+
+impl VerifyCapability {
+    /// The request validated as a job holds it (no upload), with `context`'s tools, material
+    /// and machine.
+    fn job(request: &VerifyRequest, context: &Resolved<Option<Tool>>, run: &Run<'_>) -> Result<Job, SolverError> {
+        let found = Found { material: context.material.as_ref(), machine: context.machine.as_ref() };
+        request.validate(&context.other_tools, found, run.upload, run.control)
+    }
+}
 
 impl Capability for VerifyCapability {
     const NAME: &'static str = "verify";
@@ -73,9 +98,65 @@ impl Capability for VerifyCapability {
         context: Resolved<Option<Tool>>,
         run: &Run<'_>,
     ) -> Result<VerifyAnswer, SolverError> {
-        let found = Found { material: context.material.as_ref(), machine: context.machine.as_ref() };
-        let job = request.validate(&context.other_tools, found, run.upload, run.control)?;
+        let job = Self::job(request, &context, run)?;
         let cut = simulate::cut(&job, run)?;
+        Ok(VerifyAnswer { tools: context.other_tools, cut })
+    }
+
+    /// Strips of the dexel grid's rows, in parts of about `sizing.part_seconds` by the rays the
+    /// cutter's footprints cover on them (docs/spec/verify.md §5). Not split: a refused request
+    /// (solving it whole reports why), one a job cannot carry (an STL file), a grid of one strip.
+    fn split(request: &VerifyRequest, context: &Resolved<Option<Tool>>, sizing: &Sizing) -> Option<Split> {
+        let job = Self::job(request, context, &Run::default()).ok()?;
+        let footprints = simulate::strip_work(&job)?;
+        let grid = job.grid;
+        let fields = if job.part.is_some() { 2.0 } else { 1.0 };
+        let work: Vec<f64> = footprints
+            .iter()
+            .enumerate()
+            .map(|(strip, rays)| {
+                let built = (grid.strip_rows(strip..strip + 1).len() * grid.nx) as f64 * fields;
+                rays * FOOTPRINT_RAY_SECONDS + built * FIELD_RAY_SECONDS
+            })
+            .collect();
+        let moves = job.program.moves.len() as f64;
+        let setup = moves * SETUP_MOVE_SECONDS;
+        let finish = moves * FINISH_MOVE_SECONDS;
+        by_work(&work, setup, finish, sizing)
+    }
+
+    /// Cuts the program on the rays of the part's strips and hands on what each move did there.
+    fn solve_part(
+        request: &VerifyRequest,
+        context: Resolved<Option<Tool>>,
+        part: &Part,
+        run: &Run<'_>,
+        sink: &mut impl PartSink,
+    ) -> Result<(), SolverError> {
+        let job = Self::job(request, &context, run)?;
+        if part.units.is_empty() || part.units.end > job.grid.strips() {
+            return Err(SolverError::new(
+                ErrorCode::Internal,
+                format!("strips {:?} are not strips of this verification's {}", part.units, job.grid.strips()),
+            ));
+        }
+        sink.put(&simulate::cut_part(&job, part.units.clone(), run)?)
+    }
+
+    /// Merges the parts' strips into the answer [`Capability::solve`] gives.
+    fn finish(
+        request: &VerifyRequest,
+        context: Resolved<Option<Tool>>,
+        parts: &mut impl PartSource,
+        run: &Run<'_>,
+    ) -> Result<VerifyAnswer, SolverError> {
+        let job = Self::job(request, &context, run)?;
+        let mut cuts = Vec::with_capacity(parts.count());
+        while let Some(part) = parts.next_part::<PartCut>() {
+            cuts.push(part?);
+            run.control.check()?;
+        }
+        let cut = simulate::finish_parts(&job, &cuts, run)?;
         Ok(VerifyAnswer { tools: context.other_tools, cut })
     }
 
@@ -112,4 +193,37 @@ impl Capability for VerifyCapability {
         let tools = crate::capability::json_bytes(&context.other_tools);
         Some(4096 + tools + lines * BLOCK_BYTES + MAX_FINDINGS as u64 * FINDING_BYTES)
     }
+}
+
+/// Consecutive strips of `work` core-seconds each cut into parts of about `sizing.part_seconds`
+/// (at least ten times the `setup` every part repeats), each ending where the work before it
+/// reaches its share; `None` when one part would do.
+fn by_work(work: &[f64], setup: f64, finish: f64, sizing: &Sizing) -> Option<Split> {
+    let mut prefix = Vec::with_capacity(work.len() + 1);
+    prefix.push(0.0);
+    for seconds in work {
+        prefix.push(prefix.last().copied().unwrap_or(0.0) + seconds);
+    }
+    let total = prefix.last().copied().unwrap_or(0.0);
+    let per_part = sizing.part_seconds.max(10.0 * setup);
+    if !(total.is_finite() && per_part > 0.0) {
+        return None;
+    }
+    let count = ((total / per_part).round() as usize).clamp(1, sizing.max_parts.max(1)).min(work.len());
+    if count < 2 {
+        return None;
+    }
+    let mut bounds = vec![0];
+    for k in 1..count {
+        let share = total * k as f64 / count as f64;
+        let at = prefix.partition_point(|&sum| sum < share);
+        let previous = bounds.last().copied().unwrap_or(0);
+        bounds.push(at.clamp(previous + 1, work.len() - (count - k)));
+    }
+    bounds.push(work.len());
+    let parts = bounds
+        .windows(2)
+        .map(|pair| Part { units: pair[0]..pair[1], seconds: prefix[pair[1]] - prefix[pair[0]] + setup })
+        .collect();
+    Some(Split { parts, finish_seconds: finish })
 }

@@ -66,18 +66,83 @@ impl Grid {
     }
 }
 
-/// The material of a solid on the grid.
+/// Rows of rays in one strip: the unit a verification is split into for several workers, and
+/// the grouping every sum over rays follows, so that a split cut adds the same numbers in the
+/// same order as one process (docs/spec/verify.md §5).
+pub(crate) const STRIP_ROWS: usize = 32;
+
+impl Grid {
+    /// The number of strips of [`STRIP_ROWS`] rows.
+    pub fn strips(&self) -> usize {
+        self.ny.div_ceil(STRIP_ROWS)
+    }
+
+    /// The rows of strips `strips`.
+    pub fn strip_rows(&self, strips: std::ops::Range<usize>) -> std::ops::Range<usize> {
+        (strips.start * STRIP_ROWS).min(self.ny)..(strips.end * STRIP_ROWS).min(self.ny)
+    }
+}
+
+/// The material of a solid on the rows `rows` of the grid (all of them but in a part of a split
+/// cut), ray `(i, j)` at `rays[(j − rows.start)·nx + i]`.
 #[derive(Debug, Clone)]
 pub(crate) struct Field {
     pub grid: Grid,
+    pub rows: std::ops::Range<usize>,
     pub rays: Vec<Ray>,
 }
 
 impl Field {
-    /// The total length of material on every ray times the cell area, mm³.
-    pub fn volume(&self) -> f64 {
-        self.rays.iter().map(|ray| length(ray)).sum::<f64>() * self.grid.cell_area()
+    /// The field of `rays` over every row of `grid`.
+    pub fn new(grid: Grid, rays: Vec<Ray>) -> Self {
+        Self { grid, rows: 0..grid.ny, rays }
     }
+
+    /// Where ray `(i, j)` is in `rays`.
+    #[inline(always)]
+    pub fn index(&self, i: usize, j: usize) -> usize {
+        (j - self.rows.start) * self.grid.nx + i
+    }
+
+    /// The column and row of the ray at `index` in `rays`.
+    pub fn ray_at(&self, index: usize) -> (usize, usize) {
+        (index % self.grid.nx, self.rows.start + index / self.grid.nx)
+    }
+
+    /// `rows` within the field's.
+    pub fn within(&self, rows: std::ops::Range<usize>) -> std::ops::Range<usize> {
+        rows.start.max(self.rows.start)..rows.end.min(self.rows.end)
+    }
+
+    /// The strips the field's rows make up.
+    pub fn strips(&self) -> std::ops::Range<usize> {
+        self.rows.start / STRIP_ROWS..self.rows.end.div_ceil(STRIP_ROWS)
+    }
+
+    /// The total length of material on the rays of each of the field's strips, in order, each
+    /// summed ray by ray in row order.
+    pub fn strip_lengths(&self) -> Vec<f64> {
+        self.strips()
+            .map(|strip| {
+                let rows = self.within(self.grid.strip_rows(strip..strip + 1));
+                let rays = &self.rays[self.index(0, rows.start)..self.index(0, rows.end)];
+                rays.iter().map(|ray| length(ray)).sum::<f64>()
+            })
+            .collect()
+    }
+
+    /// The total length of material on every ray times the cell area, mm³: [`volume`] of its
+    /// [`Field::strip_lengths`].
+    #[cfg(test)]
+    pub fn volume(&self) -> f64 {
+        volume(&self.strip_lengths(), self.grid.cell_area())
+    }
+}
+
+/// The volume of strips holding `lengths` of material on their rays of `area` each: their sum in
+/// strip order times the area.
+pub(crate) fn volume(lengths: &[f64], area: f64) -> f64 {
+    lengths.iter().fold(0.0, |sum, length| sum + length) * area
 }
 
 /// Rays on a side of a tile of [`Tops`].
@@ -100,10 +165,10 @@ impl Tops {
         let (columns, rows) = (grid.nx.div_ceil(TILE), grid.ny.div_ceil(TILE));
         let mut tops =
             Self { columns, bounds: vec![f64::NEG_INFINITY; columns * rows], stale: vec![false; columns * rows] };
-        for j in 0..grid.ny {
+        for j in field.rows.clone() {
             for i in 0..grid.nx {
                 let bound = &mut tops.bounds[(j / TILE) * columns + i / TILE];
-                *bound = bound.max(top(&field.rays[j * grid.nx + i]));
+                *bound = bound.max(top(&field.rays[field.index(i, j)]));
             }
         }
         tops
@@ -114,8 +179,8 @@ impl Tops {
         self.stale[(j / TILE) * self.columns + i / TILE] = true;
     }
 
-    /// Whether some ray of `columns` × `rows` may hold material above `floor`: the tiles they
-    /// cover are checked, stale ones rescanned.
+    /// Whether some ray of `columns` × `rows` (rows of the field) may hold material above
+    /// `floor`: the tiles they cover are checked, stale ones rescanned.
     pub fn above(
         &mut self,
         field: &Field,
@@ -135,8 +200,10 @@ impl Tops {
                 }
                 if self.stale[tile] {
                     let mut bound = f64::NEG_INFINITY;
-                    for j in tj * TILE..((tj + 1) * TILE).min(grid.ny) {
-                        for ray in &field.rays[j * grid.nx + ti * TILE..j * grid.nx + ((ti + 1) * TILE).min(grid.nx)] {
+                    for j in field.within(tj * TILE..((tj + 1) * TILE).min(grid.ny)) {
+                        for ray in
+                            &field.rays[field.index(ti * TILE, j)..field.index(((ti + 1) * TILE).min(grid.nx), j)]
+                        {
                             bound = bound.max(top(ray));
                         }
                     }

@@ -175,11 +175,11 @@ struct Surface<'a> {
 
 impl Surface<'_> {
     fn ray(&self, i: usize, j: usize) -> &[Interval] {
-        &self.stock.rays[j * self.stock.grid.nx + i]
+        &self.stock.rays[self.stock.index(i, j)]
     }
 
     fn deviation(&self, i: usize, j: usize, piece: Interval) -> f64 {
-        self.part.map_or(0.0, |part| deviation(piece, &part.rays[j * part.grid.nx + i]))
+        self.part.map_or(0.0, |part| deviation(piece, &part.rays[part.index(i, j)]))
     }
 
     /// The tops and bottoms of row `j`, merged along x.

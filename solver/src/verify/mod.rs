@@ -4,9 +4,9 @@
 //!
 //! [`request`] holds the wire types, `job` their validation, `solid` the stock and part on the
 //! grid, `dexel` the rays, `assembly` the tool's bodies, `sweep` a body swept along a move,
-//! `simulate` the cutting and its findings, `mesh` the cut stock as binary glTF, `capability` the
-//! seam's entry, and [`own`] the verification of the programs the other capabilities write, on
-//! their own models.
+//! `simulate` the cutting and its findings (whole, or by strips of the grid's rows for a job split
+//! among workers), `mesh` the cut stock as binary glTF, `capability` the seam's entry, and [`own`]
+//! the verification of the programs the other capabilities write, on their own models.
 
 mod assembly;
 mod capability;

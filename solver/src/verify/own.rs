@@ -526,7 +526,7 @@ impl OwnModel for Prism {
                 part.push(column(part_material));
             }
         }
-        Ok((Field { grid, rays: stock }, Some(Field { grid, rays: part })))
+        Ok((Field::new(grid, stock), Some(Field::new(grid, part))))
     }
 
     fn describe(&self) -> String {
@@ -668,7 +668,7 @@ impl OwnModel for SampledTube {
                 part.push(part_ray);
             }
         }
-        Ok((Field { grid, rays: stock }, Some(Field { grid, rays: part })))
+        Ok((Field::new(grid, stock), Some(Field::new(grid, part))))
     }
 
     fn describe(&self) -> String {
@@ -733,7 +733,7 @@ impl OwnModel for GivenStock {
                 rays.push(ray);
             }
         }
-        Ok((Field { grid, rays }, None))
+        Ok((Field::new(grid, rays), None))
     }
 
     fn describe(&self) -> String {
@@ -771,7 +771,7 @@ impl OwnModel for Extrusion {
                 rays.push(ray);
             }
         }
-        Ok((Field { grid, rays }, None))
+        Ok((Field::new(grid, rays), None))
     }
 
     fn describe(&self) -> String {

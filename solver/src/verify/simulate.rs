@@ -3,15 +3,16 @@
 //! and holder are then checked against what is left; removals inside the part are gouges, and
 //! after the last move what is left outside the part is measured.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::capability::Run;
 use crate::error::{ErrorCode, SolverError};
 use crate::gcode::reader::{MoveKind, ReadMove};
 
 use super::assembly::{Body, Member, Shape};
-use super::dexel::{self, Field, Interval, Tops};
-use super::job::{Job, PowerModel};
+use super::dexel::{self, Field, Interval, STRIP_ROWS, Tops};
+use super::job::{CallableTool, Job, PowerModel};
+use super::solid::PartCheck;
 use super::sweep::Segment;
 
 /// Most findings listed; the rest are counted in `findings_left_off`.
@@ -134,9 +135,9 @@ pub struct Cut {
     pub blocks: Vec<BlockRemoval>,
 }
 
-/// The worst of one kind of finding over one move.
+/// The worst of one kind of finding over one move, or over the rays of one strip of it.
 #[derive(Debug, Clone, Copy, Default)]
-struct Worst {
+pub(crate) struct Worst {
     depth: f64,
     volume: f64,
     position: [f64; 3],
@@ -152,60 +153,206 @@ impl Worst {
         }
         self.seen = true;
     }
+
+    /// Adds the worst of the rays after these (a later strip): the volumes summed, the first of
+    /// equal depths kept.
+    fn merge(&mut self, next: &Self) {
+        if !next.seen {
+            return;
+        }
+        self.volume += next.volume;
+        if !self.seen || next.depth > self.depth {
+            self.depth = next.depth;
+            self.position = next.position;
+        }
+        self.seen = true;
+    }
+
+    /// As a part hands it on: depth, volume and position, if seen.
+    fn to_record(self) -> Option<[f64; 5]> {
+        let [x, y, z] = self.position;
+        self.seen.then_some([self.depth, self.volume, x, y, z])
+    }
+
+    fn from_record(record: Option<[f64; 5]>) -> Self {
+        record.map_or_else(Self::default, |[depth, volume, x, y, z]| Self {
+            depth,
+            volume,
+            position: [x, y, z],
+            seen: true,
+        })
+    }
 }
 
-/// A move as cut: the volume it removed, its time at the programmed feed (feed moves), the
-/// number of its tool and the tool's flutes.
-#[derive(Debug, Clone, Copy)]
-struct MoveCut {
-    removed: f64,
+/// A move as planned: its tool, the straight segments it is cut along, its length, and its time
+/// at the programmed feed (feed moves).
+struct MovePlan<'a> {
+    tool: &'a CallableTool,
+    /// The tool's number, or the one the program called.
+    number: Option<u32>,
+    segments: Vec<Segment>,
+    rapid: bool,
     time: Option<f64>,
-    tool: Option<u32>,
-    flutes: u32,
 }
 
-/// What one move did.
-#[derive(Debug, Default)]
+/// The plan of move `read`; `None` when the program has not yet set every axis of its end.
+fn plan_move<'a>(job: &'a Job, read: &ReadMove) -> Result<Option<MovePlan<'a>>, SolverError> {
+    let Some(to) = read.to_xyz() else {
+        return Ok(None);
+    };
+    let called = read.modal.tool;
+    let tool = job.tool(called, read.line)?;
+    let from = read.from_xyz().unwrap_or(to);
+    let points = match read.kind {
+        MoveKind::Arc { .. } if read.from_xyz().is_some() => {
+            read.points(ARC_CHORD_TOLERANCE).unwrap_or_else(|| vec![to])
+        }
+        _ => vec![to],
+    };
+    let mut length = 0.0;
+    let mut start = from;
+    let mut segments = Vec::with_capacity(points.len());
+    for end in points {
+        segments.push(Segment::new(start, end));
+        length += (0..3).map(|k| (end[k] - start[k]).powi(2)).sum::<f64>().sqrt();
+        start = end;
+    }
+    let rapid = read.kind == MoveKind::Rapid;
+    let time = if rapid { None } else { read.modal.feed.filter(|feed| *feed > 0.0).map(|feed| 60.0 * length / feed) };
+    Ok(Some(MovePlan { tool, number: tool.number.or(called), segments, rapid, time }))
+}
+
+/// What one move did, over the rays of one strip or, strips merged in order, over all of them.
+#[derive(Debug, Clone, Copy, Default)]
 struct MoveOutcome {
     removed: f64,
+    /// The longest piece removed (kept for rapid moves only, the one kind that reports it).
     deepest: Worst,
     gouge: Worst,
+    /// Neck, shank, holder.
     contacts: [Worst; 3],
 }
 
-/// The simulation's state: the stock as cut so far, the part, and what was found.
-struct Simulation<'a> {
+impl MoveOutcome {
+    fn is_empty(&self) -> bool {
+        self.removed == 0.0 && !self.deepest.seen && !self.gouge.seen && self.contacts.iter().all(|worst| !worst.seen)
+    }
+
+    /// Adds what the move did on a later strip.
+    fn merge(&mut self, next: &Self) {
+        self.removed += next.removed;
+        self.deepest.merge(&next.deepest);
+        self.gouge.merge(&next.gouge);
+        for (contact, next) in self.contacts.iter_mut().zip(&next.contacts) {
+            contact.merge(next);
+        }
+    }
+}
+
+/// What move `index` did on strip `strip`, as a part of a split cut hands it on (moves that did
+/// nothing there are left out).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct StripRecord {
+    index: usize,
+    strip: usize,
+    removed: f64,
+    /// The worsts seen, by slot: 0 the deepest piece, 1 the gouge, 2–4 the contacts.
+    worsts: Vec<(u8, [f64; 5])>,
+}
+
+impl StripRecord {
+    fn new(index: usize, strip: usize, outcome: &MoveOutcome) -> Self {
+        let all = [outcome.deepest, outcome.gouge, outcome.contacts[0], outcome.contacts[1], outcome.contacts[2]];
+        let worsts =
+            (0u8..).zip(all).filter_map(|(slot, worst)| worst.to_record().map(|record| (slot, record))).collect();
+        Self { index, strip, removed: outcome.removed, worsts }
+    }
+
+    fn outcome(&self) -> MoveOutcome {
+        let mut all = [Worst::default(); 5];
+        for &(slot, record) in &self.worsts {
+            if let Some(worst) = all.get_mut(usize::from(slot)) {
+                *worst = Worst::from_record(Some(record));
+            }
+        }
+        let [deepest, gouge, neck, shank, holder] = all;
+        MoveOutcome { removed: self.removed, deepest, gouge, contacts: [neck, shank, holder] }
+    }
+}
+
+/// The stock as cut so far and the part, on all or some rows of the grid, and what the move
+/// being cut did on each strip.
+struct Sweeper<'a> {
     job: &'a Job,
     stock: Field,
     /// Bounds of the stock's highest material over tiles of rays.
     tops: Tops,
     part: Option<Field>,
-    findings: Vec<Finding>,
-    left_off: usize,
     updates: u64,
     scratch: Scratch,
-    /// Whether a non-cutting member met the stock.
-    touched: bool,
+    /// What the move did on each strip of the grid.
+    strips: Vec<MoveOutcome>,
+    /// The strips it reached: `[first, last + 1)`, empty when none.
+    reached: [usize; 2],
 }
 
-impl Simulation<'_> {
-    fn find(&mut self, finding: Finding) {
-        if self.findings.len() < MAX_FINDINGS {
-            self.findings.push(finding);
-        } else {
-            self.left_off += 1;
+impl<'a> Sweeper<'a> {
+    fn new(job: &'a Job, stock: Field, part: Option<Field>) -> Self {
+        let tops = Tops::new(&stock);
+        let strips = vec![MoveOutcome::default(); stock.grid.strips()];
+        Self { job, stock, tops, part, updates: 0, scratch: Scratch::default(), strips, reached: [usize::MAX, 0] }
+    }
+
+    /// Cuts the move `plan`: each segment sweeps the cutter, removing material, then the other
+    /// bodies are checked against what is left.
+    fn sweep(&mut self, plan: &MovePlan<'_>) {
+        let assembly = &plan.tool.assembly;
+        for segment in &plan.segments {
+            self.cut(assembly.cutter(), segment, plan.rapid);
+            for body in &assembly.bodies[1..] {
+                let slot = match body.member {
+                    Member::Neck => 0,
+                    Member::Shank => 1,
+                    Member::Cutter | Member::Holder => 2,
+                };
+                self.touch(body, slot, segment);
+            }
         }
     }
 
-    /// Sweeps the cutter `body` along `segment`, removing material.
-    fn cut(&mut self, body: &Body, segment: &Segment, outcome: &mut MoveOutcome) {
+    /// Hands on what the move did on each strip it reached, in strip order, and clears it for
+    /// the next move.
+    fn take(&mut self, mut each: impl FnMut(usize, &MoveOutcome)) {
+        let [first, end] = std::mem::replace(&mut self.reached, [usize::MAX, 0]);
+        for strip in first..end {
+            let outcome = std::mem::take(&mut self.strips[strip]);
+            if !outcome.is_empty() {
+                each(strip, &outcome);
+            }
+        }
+    }
+
+    /// Sweeps the cutter `body` along `segment`, removing material; `rapid`: keeping the
+    /// deepest piece.
+    fn cut(&mut self, body: &Body, segment: &Segment, rapid: bool) {
         let area = self.stock.grid.cell_area();
         let (part, tolerance) = (&self.part, self.job.tolerance);
-        self.updates +=
-            sweep_cutter(&mut self.stock, &mut self.tops, body, segment, &mut self.scratch, |index, x, y, pieces| {
+        let (strips, reached) = (&mut self.strips, &mut self.reached);
+        self.updates += sweep_cutter(
+            &mut self.stock,
+            &mut self.tops,
+            body,
+            segment,
+            &mut self.scratch,
+            |index, j, x, y, pieces| {
+                let strip = j / STRIP_ROWS;
+                reach(reached, strip);
+                let outcome = &mut strips[strip];
                 for &[low, high] in pieces {
                     outcome.removed += (high - low) * area;
-                    outcome.deepest.add(high - low, (high - low) * area, [x, y, low]);
+                    if rapid {
+                        outcome.deepest.add(high - low, (high - low) * area, [x, y, low]);
+                    }
                     if let Some(part) = part
                         && let Some((depth, lowest)) = dexel::overlap(&part.rays[index], [low, high])
                         && depth > tolerance
@@ -213,16 +360,17 @@ impl Simulation<'_> {
                         outcome.gouge.add(depth, depth * area, [x, y, lowest]);
                     }
                 }
-            });
+            },
+        );
     }
 
     /// Checks the non-cutting `body` (slot `slot` of the contacts) along `segment` against the
     /// stock left.
-    fn touch(&mut self, body: &Body, slot: usize, segment: &Segment, outcome: &mut MoveOutcome) {
+    fn touch(&mut self, body: &Body, slot: usize, segment: &Segment) {
         let grid = self.stock.grid;
         let (lo, hi) = segment.reach(body.radius);
         let floor = segment.low_z() + body.bottom();
-        let rows = grid.span(1, lo[1], hi[1]);
+        let rows = self.stock.within(grid.span(1, lo[1], hi[1]));
         if !self.tops.above(&self.stock, grid.span(0, lo[0], hi[0]), rows.clone(), floor) {
             return;
         }
@@ -231,8 +379,9 @@ impl Simulation<'_> {
             let Some([from, to]) = segment.row(body.radius, y) else {
                 continue;
             };
+            let base = self.stock.index(0, j);
             for i in grid.span(0, from, to) {
-                let ray = &self.stock.rays[j * grid.nx + i];
+                let ray = &self.stock.rays[base + i];
                 if dexel::top(ray) <= floor {
                     continue;
                 }
@@ -242,118 +391,71 @@ impl Simulation<'_> {
                     && let Some((depth, lowest)) = dexel::overlap(ray, probe)
                     && depth > self.job.tolerance
                 {
-                    outcome.contacts[slot].add(depth, 0.0, [x, y, lowest]);
+                    let strip = j / STRIP_ROWS;
+                    reach(&mut self.reached, strip);
+                    self.strips[strip].contacts[slot].add(depth, 0.0, [x, y, lowest]);
                 }
             }
         }
     }
 
-    /// Cuts one move; its removal record when it removed anything, and its feed time.
-    fn run_move(&mut self, read: &ReadMove) -> Result<Option<MoveCut>, SolverError> {
-        let Some(to) = read.to_xyz() else {
-            return Ok(None);
+    /// After the last move: the length of material left on each strip's rays and, with a part,
+    /// each strip's thickest material left outside it thicker than `allowance`.
+    fn left(&self, allowance: f64) -> (Vec<f64>, Vec<Worst>) {
+        let lengths = self.stock.strip_lengths();
+        let Some(part) = &self.part else {
+            return (lengths, Vec::new());
         };
-        let called = read.modal.tool;
-        let job = self.job;
-        let tool = job.tool(called, read.line)?;
-        let number = tool.number.or(called);
-        let from = read.from_xyz().unwrap_or(to);
-        let points = match read.kind {
-            MoveKind::Arc { .. } if read.from_xyz().is_some() => {
-                read.points(ARC_CHORD_TOLERANCE).unwrap_or_else(|| vec![to])
-            }
-            _ => vec![to],
-        };
-        let assembly = &tool.assembly;
-        let mut outcome = MoveOutcome::default();
-        let mut length = 0.0;
-        let mut start = from;
-        for end in points {
-            let segment = Segment::new(start, end);
-            length += (0..3).map(|k| (end[k] - start[k]).powi(2)).sum::<f64>().sqrt();
-            self.cut(assembly.cutter(), &segment, &mut outcome);
-            for body in &assembly.bodies[1..] {
-                let slot = match body.member {
-                    Member::Neck => 0,
-                    Member::Shank => 1,
-                    Member::Cutter | Member::Holder => 2,
-                };
-                self.touch(body, slot, &segment, &mut outcome);
-            }
-            start = end;
-        }
-        let line = Some(read.line);
-        let rapid = read.kind == MoveKind::Rapid;
-        if rapid && outcome.deepest.seen && outcome.deepest.depth > self.job.tolerance {
-            let worst = outcome.deepest;
-            self.find(Finding {
-                kind: FindingKind::RapidThroughMaterial,
-                line,
-                tool: number,
-                position: worst.position,
-                depth: worst.depth,
-                volume_mm3: worst.volume,
-                share: None,
-                power_kw: None,
-                limit_kw: None,
-            });
-        }
-        if outcome.gouge.seen {
-            let worst = outcome.gouge;
-            self.find(Finding {
-                kind: FindingKind::Gouge,
-                line,
-                tool: number,
-                position: worst.position,
-                depth: worst.depth,
-                volume_mm3: worst.volume,
-                share: None,
-                power_kw: None,
-                limit_kw: None,
-            });
-        }
-        let kinds = [FindingKind::NeckContact, FindingKind::ShankContact, FindingKind::HolderContact];
-        for (worst, kind) in outcome.contacts.into_iter().zip(kinds) {
-            if worst.seen {
-                self.find(Finding {
-                    kind,
-                    line,
-                    tool: number,
-                    position: worst.position,
-                    depth: worst.depth,
-                    volume_mm3: 0.0,
-                    share: None,
-                    power_kw: None,
-                    limit_kw: None,
-                });
-            }
-        }
-        let time =
-            if rapid { None } else { read.modal.feed.filter(|feed| *feed > 0.0).map(|feed| 60.0 * length / feed) };
-        let touched = outcome.contacts.iter().any(|worst| worst.seen);
-        self.touched |= touched;
-        Ok(Some(MoveCut { removed: outcome.removed, time, tool: number, flutes: tool.flutes }))
+        let (stock, grid) = (&self.stock, self.stock.grid);
+        let mut pieces = Vec::new();
+        let left = stock
+            .strips()
+            .map(|strip| {
+                let mut worst = Worst::default();
+                for j in stock.within(grid.strip_rows(strip..strip + 1)) {
+                    for i in 0..grid.nx {
+                        let index = stock.index(i, j);
+                        pieces.clear();
+                        dexel::outside(&stock.rays[index], &part.rays[index], 0.0, &mut pieces);
+                        for &[low, high] in &pieces {
+                            if high - low > allowance {
+                                worst.add(high - low, (high - low) * grid.cell_area(), [grid.x(i), grid.y(j), low]);
+                            }
+                        }
+                    }
+                }
+                worst
+            })
+            .collect();
+        (lengths, left)
     }
 }
 
+/// Widens `reached` to hold `strip`.
+#[inline(always)]
+fn reach(reached: &mut [usize; 2], strip: usize) {
+    reached[0] = reached[0].min(strip);
+    reached[1] = reached[1].max(strip + 1);
+}
+
 /// Sweeps the cutter `body` along `segment` through `stock`, removing material: over the rays
-/// of the swept footprint, row by row, those whose material reaches above the body's lowest
-/// point there. A ray holding one interval that the body's top clears (the common case of a
-/// z-map) is clipped from above; any other goes through the general interval subtraction.
-/// `removed` is called with the ray's index, x and y and the pieces removed from it; the answer
-/// is the number of rays queried.
+/// of the swept footprint (on the field's rows), row by row, those whose material reaches above
+/// the body's lowest point there. A ray holding one interval that the body's top clears (the
+/// common case of a z-map) is clipped from above; any other goes through the general interval
+/// subtraction. `removed` is called with the ray's index in the field, its row, x and y and the
+/// pieces removed from it; the answer is the number of rays queried.
 pub(crate) fn sweep_cutter(
     stock: &mut Field,
     tops: &mut Tops,
     body: &Body,
     segment: &Segment,
     scratch: &mut Scratch,
-    mut removed: impl FnMut(usize, f64, f64, &[Interval]),
+    mut removed: impl FnMut(usize, usize, f64, f64, &[Interval]),
 ) -> u64 {
     let grid = stock.grid;
     let (lo, hi) = segment.reach(body.radius);
     let floor = segment.low_z() + body.bottom();
-    let rows = grid.span(1, lo[1], hi[1]);
+    let rows = stock.within(grid.span(1, lo[1], hi[1]));
     if !tops.above(stock, grid.span(0, lo[0], hi[0]), rows.clone(), floor) {
         return 0;
     }
@@ -369,8 +471,9 @@ pub(crate) fn sweep_cutter(
         let Some([from, to]) = segment.row(body.radius, y) else {
             continue;
         };
+        let base = stock.index(0, j);
         for i in grid.span(0, from, to) {
-            let index = j * grid.nx + i;
+            let index = base + i;
             let ray = &mut stock.rays[index];
             let top = dexel::top(ray);
             if top <= floor {
@@ -406,7 +509,7 @@ pub(crate) fn sweep_cutter(
                 };
                 dexel::subtract(ray, cut, pieces);
             }
-            removed(index, x, y, pieces);
+            removed(index, j, x, y, pieces);
         }
     }
     queries
@@ -417,6 +520,195 @@ pub(crate) fn sweep_cutter(
 pub(crate) struct Scratch {
     /// The pieces removed from one ray.
     pieces: Vec<Interval>,
+}
+
+/// The findings, times and removal of the moves in program order, from what each did over all
+/// strips: the same whether one process swept every strip or parts of a split cut did.
+struct Tally<'a> {
+    job: &'a Job,
+    findings: Vec<Finding>,
+    left_off: usize,
+    removed: f64,
+    cutting_time: f64,
+    air_time: f64,
+    longest_air: Option<(f64, usize, [f64; 3], Option<u32>)>,
+    blocks: Vec<BlockRemoval>,
+    unplaced: usize,
+    /// Whether a non-cutting member met the stock.
+    touched: bool,
+}
+
+/// The dexel fields' totals after the last move, over every strip in order.
+struct Totals {
+    stock_lengths: Vec<f64>,
+    part_lengths: Option<Vec<f64>>,
+    final_lengths: Vec<f64>,
+    /// With a part: each strip's thickest material left outside it.
+    left: Vec<Worst>,
+    updates: u64,
+}
+
+impl<'a> Tally<'a> {
+    fn new(job: &'a Job) -> Self {
+        Self {
+            job,
+            findings: Vec::new(),
+            left_off: 0,
+            removed: 0.0,
+            cutting_time: 0.0,
+            air_time: 0.0,
+            longest_air: None,
+            blocks: Vec::new(),
+            unplaced: 0,
+            touched: false,
+        }
+    }
+
+    fn find(&mut self, finding: Finding) {
+        if self.findings.len() < MAX_FINDINGS {
+            self.findings.push(finding);
+        } else {
+            self.left_off += 1;
+        }
+    }
+
+    /// Move `index` (`read`, planned as `plan`) did `outcome`: its findings, time and removal.
+    ///
+    /// # Errors
+    /// As [`spindle_power`]; `E_TOO_LARGE_ANSWER` over the run's budget.
+    fn record(
+        &mut self,
+        index: usize,
+        read: &ReadMove,
+        plan: &MovePlan<'_>,
+        outcome: &MoveOutcome,
+        run: &Run<'_>,
+    ) -> Result<(), SolverError> {
+        let (line, number) = (Some(read.line), plan.number);
+        let finding = |kind, worst: Worst, volume| Finding {
+            kind,
+            line,
+            tool: number,
+            position: worst.position,
+            depth: worst.depth,
+            volume_mm3: volume,
+            share: None,
+            power_kw: None,
+            limit_kw: None,
+        };
+        if plan.rapid && outcome.deepest.seen && outcome.deepest.depth > self.job.tolerance {
+            self.find(finding(FindingKind::RapidThroughMaterial, outcome.deepest, outcome.deepest.volume));
+        }
+        if outcome.gouge.seen {
+            self.find(finding(FindingKind::Gouge, outcome.gouge, outcome.gouge.volume));
+        }
+        let kinds = [FindingKind::NeckContact, FindingKind::ShankContact, FindingKind::HolderContact];
+        for (worst, kind) in outcome.contacts.into_iter().zip(kinds) {
+            if worst.seen {
+                self.find(finding(kind, worst, 0.0));
+            }
+        }
+        self.touched |= outcome.contacts.iter().any(|worst| worst.seen);
+        let (volume, time, tool) = (outcome.removed, plan.time, plan.number);
+        self.removed += volume;
+        if let Some(time) = time {
+            self.cutting_time += time;
+            if volume == 0.0 {
+                self.air_time += time;
+                if self.longest_air.is_none_or(|(longest, ..)| time > longest) {
+                    let start = read.from_xyz().or(read.to_xyz()).unwrap_or_default();
+                    self.longest_air = Some((time, read.line, start, tool));
+                }
+            }
+        }
+        if volume > 0.0 {
+            let rate = time.filter(|t| *t > 0.0).map(|t| volume / t * 60.0);
+            let power = match (&self.job.power, rate) {
+                (Some(model), Some(rate)) => Some(spindle_power(self, model, read, rate, plan.tool.flutes, tool)?),
+                _ => None,
+            };
+            let block = BlockRemoval {
+                line: read.line,
+                tool,
+                removed_mm3: volume,
+                time_s: time,
+                removal_rate_mm3_per_min: rate,
+                spindle_power_kw: power,
+            };
+            let moves = self.job.program.moves.len();
+            run.charge(crate::capability::json_bytes(&block), index + 1, moves)?;
+            self.blocks.push(block);
+        }
+        Ok(())
+    }
+
+    /// The answer, after the last move.
+    ///
+    /// # Errors
+    /// `E_STOCK` at `stock` when no tool reached the stock.
+    fn finish(mut self, totals: Totals) -> Result<Cut, SolverError> {
+        let job = self.job;
+        if self.removed == 0.0 && !self.touched {
+            return Err(SolverError::new(
+                ErrorCode::Stock,
+                "no tool of the program reaches the stock: check the stock's position against the program's coordinates",
+            )
+            .at("stock"));
+        }
+        let air_share = if self.cutting_time > 0.0 { self.air_time / self.cutting_time } else { 0.0 };
+        if air_share > job.air_share_limit
+            && let Some((_, line, start, tool)) = self.longest_air
+        {
+            self.find(Finding {
+                kind: FindingKind::AirCutting,
+                line: Some(line),
+                tool,
+                position: start,
+                depth: 0.0,
+                volume_mm3: 0.0,
+                share: Some(air_share),
+                power_kw: None,
+                limit_kw: None,
+            });
+        }
+        let mut left = Worst::default();
+        for strip in &totals.left {
+            left.merge(strip);
+        }
+        if left.seen {
+            self.find(Finding {
+                kind: FindingKind::LeftMaterial,
+                line: None,
+                tool: None,
+                position: left.position,
+                depth: left.depth,
+                volume_mm3: left.volume,
+                share: None,
+                power_kw: None,
+                limit_kw: None,
+            });
+        }
+        let grid = job.grid;
+        let area = grid.cell_area();
+        Ok(Cut {
+            ok: self.findings.is_empty(),
+            findings: self.findings,
+            findings_left_off: self.left_off,
+            resolution: grid.spacing,
+            rays: [grid.nx, grid.ny],
+            stock_volume_mm3: dexel::volume(&totals.stock_lengths, area),
+            part_volume_mm3: totals.part_lengths.map(|lengths| dexel::volume(&lengths, area)),
+            removed_volume_mm3: self.removed,
+            final_volume_mm3: dexel::volume(&totals.final_lengths, area),
+            cutting_time_s: self.cutting_time,
+            air_time_s: self.air_time,
+            air_share,
+            moves: job.program.moves.len(),
+            moves_unplaced: self.unplaced,
+            dexel_updates: totals.updates,
+            blocks: self.blocks,
+        })
+    }
 }
 
 /// Cuts `job`'s program under `run` (progress, cancellation, the answer budget).
@@ -441,6 +733,9 @@ pub(crate) fn cut_stock(job: &Job, run: &Run<'_>) -> Result<(Cut, Field), Solver
 /// [`cut_stock`] out of `stock`, compared with `part`, both already on `job.grid`: a capability's own
 /// model, which no request solid describes (`own`).
 ///
+/// Every sum over rays is taken strip by strip and the strips' sums added in strip order, as
+/// [`finish_parts`] adds those of a split cut's parts.
+///
 /// # Errors
 /// As [`cut`].
 pub(crate) fn cut_fields(
@@ -449,108 +744,189 @@ pub(crate) fn cut_fields(
     part: Option<Field>,
     run: &Run<'_>,
 ) -> Result<(Cut, Field), SolverError> {
-    let stock_volume = stock.volume();
-    let part_volume = part.as_ref().map(Field::volume);
-    let tops = Tops::new(&stock);
-    let mut simulation = Simulation {
-        job,
-        stock,
-        tops,
-        part,
-        findings: Vec::new(),
-        left_off: 0,
-        updates: 0,
-        scratch: Scratch::default(),
-        touched: false,
-    };
+    let stock_lengths = stock.strip_lengths();
+    let part_lengths = part.as_ref().map(Field::strip_lengths);
+    let mut sweeper = Sweeper::new(job, stock, part);
+    let mut tally = Tally::new(job);
     let moves = &job.program.moves;
-    let (mut removed, mut cutting_time, mut air_time) = (0.0, 0.0, 0.0);
-    let mut longest_air: Option<(f64, usize, [f64; 3], Option<u32>)> = None;
-    let mut blocks = Vec::new();
-    let mut unplaced = 0;
     for (index, read) in moves.iter().enumerate() {
         run.control.check()?;
         run.control.report(index, moves.len());
-        let Some(MoveCut { removed: volume, time, tool, flutes }) = simulation.run_move(read)? else {
-            unplaced += 1;
+        let Some(plan) = plan_move(job, read)? else {
+            tally.unplaced += 1;
             continue;
         };
-        removed += volume;
-        if let Some(time) = time {
-            cutting_time += time;
-            if volume == 0.0 {
-                air_time += time;
-                if longest_air.is_none_or(|(longest, ..)| time > longest) {
-                    let start = read.from_xyz().or(read.to_xyz()).unwrap_or_default();
-                    longest_air = Some((time, read.line, start, tool));
-                }
+        sweeper.sweep(&plan);
+        let mut outcome = MoveOutcome::default();
+        sweeper.take(|_, strip| outcome.merge(strip));
+        tally.record(index, read, &plan, &outcome, run)?;
+    }
+    let (final_lengths, left) = sweeper.left(job.allowance);
+    let totals = Totals { stock_lengths, part_lengths, final_lengths, left, updates: sweeper.updates };
+    Ok((tally.finish(totals)?, sweeper.stock))
+}
+
+/// What one part of a split cut hands on: the strips it cut, the part's check on them, and per
+/// strip the material before and after and what each move did there.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub(crate) struct PartCut {
+    /// The strips, `[first, end)`.
+    strips: [usize; 2],
+    /// With a part: the check of the part against the stock on these strips.
+    check: Option<PartCheck>,
+    stock_lengths: Vec<f64>,
+    part_lengths: Option<Vec<f64>>,
+    final_lengths: Vec<f64>,
+    /// With a part: each strip's thickest material left outside it.
+    left: Vec<Option<[f64; 5]>>,
+    /// What the moves did, move by move, strip by strip.
+    records: Vec<StripRecord>,
+    updates: u64,
+}
+
+/// Cuts `job`'s program on the rays of strips `strips` only (a part of a split cut): each ray's
+/// material changes only by the moves that reach it, so these rays end as one process leaves
+/// them. A part whose own rays show the part outside the stock (which refuses the request) cuts
+/// nothing.
+///
+/// # Errors
+/// As [`cut`], but for what only the whole tells (`E_STOCK`, the spindle power, the budget).
+pub(crate) fn cut_part(job: &Job, strips: std::ops::Range<usize>, run: &Run<'_>) -> Result<PartCut, SolverError> {
+    let grid = job.grid;
+    let rows = grid.strip_rows(strips.clone());
+    let stock = job.stock.field_rows(grid, rows.clone());
+    let part = job.part.as_ref().map(|part| part.field_rows(grid, rows));
+    let check = part.as_ref().map(|part| PartCheck::of(part, &stock, job.tolerance));
+    let mut cut = PartCut {
+        strips: [strips.start, strips.end],
+        check,
+        stock_lengths: stock.strip_lengths(),
+        part_lengths: part.as_ref().map(Field::strip_lengths),
+        final_lengths: Vec::new(),
+        left: Vec::new(),
+        records: Vec::new(),
+        updates: 0,
+    };
+    if check.is_some_and(|check| check.worst.is_some()) {
+        return Ok(cut);
+    }
+    let mut sweeper = Sweeper::new(job, stock, part);
+    let moves = &job.program.moves;
+    for (index, read) in moves.iter().enumerate() {
+        run.control.check()?;
+        run.control.report(index, moves.len());
+        let Some(plan) = plan_move(job, read)? else {
+            continue;
+        };
+        sweeper.sweep(&plan);
+        sweeper.take(|strip, outcome| cut.records.push(StripRecord::new(index, strip, outcome)));
+    }
+    let (final_lengths, left) = sweeper.left(job.allowance);
+    cut.final_lengths = final_lengths;
+    cut.left = left.into_iter().map(Worst::to_record).collect();
+    cut.updates = sweeper.updates;
+    Ok(cut)
+}
+
+/// The answer of a cut split into `parts` (in strip order, together every strip once), equal to
+/// [`cut`]'s: the part's check merged, then each move's strips merged in strip order and tallied
+/// in program order.
+///
+/// # Errors
+/// As [`cut`]; `E_INTERNAL` when the parts do not make up the grid's strips.
+pub(crate) fn finish_parts(job: &Job, parts: &[PartCut], run: &Run<'_>) -> Result<Cut, SolverError> {
+    let mut next = 0;
+    for part in parts {
+        let [first, end] = part.strips;
+        let count = end.saturating_sub(first);
+        let lengths_fit = part.stock_lengths.len() == count
+            && part.part_lengths.as_ref().is_none_or(|lengths| lengths.len() == count)
+            && part.part_lengths.is_some() == job.part.is_some();
+        if first != next || end <= first || !lengths_fit {
+            return Err(mismatch(format!("a part of strips {first}..{end} after strip {next}")));
+        }
+        next = end;
+    }
+    if next != job.grid.strips() {
+        return Err(mismatch(format!("the parts end at strip {next} of {}", job.grid.strips())));
+    }
+    if job.part.is_some() {
+        let check = parts.iter().filter_map(|part| part.check).reduce(PartCheck::merge);
+        check.ok_or_else(|| mismatch("no part checked the part".to_owned()))?.verdict()?;
+    }
+    if parts.iter().any(|part| part.final_lengths.len() != part.stock_lengths.len()) {
+        return Err(mismatch("a part did not cut its strips".to_owned()));
+    }
+    let mut tally = Tally::new(job);
+    let mut cursors = vec![0; parts.len()];
+    let moves = &job.program.moves;
+    for (index, read) in moves.iter().enumerate() {
+        run.control.check()?;
+        run.control.report(index, moves.len());
+        let Some(plan) = plan_move(job, read)? else {
+            tally.unplaced += 1;
+            continue;
+        };
+        let mut outcome = MoveOutcome::default();
+        for (part, cursor) in parts.iter().zip(&mut cursors) {
+            while let Some(record) = part.records.get(*cursor).filter(|record| record.index == index) {
+                outcome.merge(&record.outcome());
+                *cursor += 1;
             }
         }
-        if volume > 0.0 {
-            let rate = time.filter(|t| *t > 0.0).map(|t| volume / t * 60.0);
-            let power = match (&job.power, rate) {
-                (Some(model), Some(rate)) => Some(spindle_power(&mut simulation, model, read, rate, flutes, tool)?),
-                _ => None,
-            };
-            let block = BlockRemoval {
-                line: read.line,
-                tool,
-                removed_mm3: volume,
-                time_s: time,
-                removal_rate_mm3_per_min: rate,
-                spindle_power_kw: power,
-            };
-            run.charge(crate::capability::json_bytes(&block), index + 1, moves.len())?;
-            blocks.push(block);
+        tally.record(index, read, &plan, &outcome, run)?;
+    }
+    if parts.iter().zip(&cursors).any(|(part, cursor)| *cursor != part.records.len()) {
+        return Err(mismatch("a part holds records of no move".to_owned()));
+    }
+    let concat = |each: fn(&PartCut) -> &Vec<f64>| parts.iter().flat_map(each).copied().collect::<Vec<f64>>();
+    let totals = Totals {
+        stock_lengths: concat(|part| &part.stock_lengths),
+        part_lengths: job
+            .part
+            .is_some()
+            .then(|| parts.iter().flat_map(|part| part.part_lengths.iter().flatten()).copied().collect::<Vec<f64>>()),
+        final_lengths: concat(|part| &part.final_lengths),
+        left: parts.iter().flat_map(|part| part.left.iter().map(|record| Worst::from_record(*record))).collect(),
+        updates: parts.iter().map(|part| part.updates).sum(),
+    };
+    tally.finish(totals)
+}
+
+/// The rays the cutter's footprints cover on each strip over the whole program (the work of a
+/// strip: [`super::capability`]'s cost model), with the program's moves; `None` when a move
+/// calls a tool the request does not name (solving whole refuses it at its line).
+pub(crate) fn strip_work(job: &Job) -> Option<Vec<f64>> {
+    let grid = job.grid;
+    let mut work = vec![0.0; grid.strips()];
+    for read in &job.program.moves {
+        let plan = plan_move(job, read).ok()?;
+        let Some(plan) = plan else {
+            continue;
+        };
+        let radius = plan.tool.assembly.cutter().radius;
+        for segment in &plan.segments {
+            let (lo, hi) = segment.reach(radius);
+            let rows = grid.span(1, lo[1], hi[1]);
+            if rows.is_empty() {
+                continue;
+            }
+            let along = (segment.to[0] - segment.from[0]).hypot(segment.to[1] - segment.from[1]);
+            let area = 2.0 * radius * along + std::f64::consts::PI * radius * radius;
+            let per_row = area / grid.cell_area() / rows.len() as f64;
+            let strips = rows.start / STRIP_ROWS..rows.end.div_ceil(STRIP_ROWS);
+            for (strip, rays) in strips.clone().zip(&mut work[strips]) {
+                let within = grid.strip_rows(strip..strip + 1);
+                let overlap = within.end.min(rows.end) - within.start.max(rows.start);
+                *rays += overlap as f64 * per_row;
+            }
         }
     }
-    if removed == 0.0 && !simulation.touched {
-        return Err(SolverError::new(
-            ErrorCode::Stock,
-            "no tool of the program reaches the stock: check the stock's position against the program's coordinates",
-        )
-        .at("stock"));
-    }
-    let air_share = if cutting_time > 0.0 { air_time / cutting_time } else { 0.0 };
-    if air_share > job.air_share_limit
-        && let Some((_, line, start, tool)) = longest_air
-    {
-        simulation.find(Finding {
-            kind: FindingKind::AirCutting,
-            line: Some(line),
-            tool,
-            position: start,
-            depth: 0.0,
-            volume_mm3: 0.0,
-            share: Some(air_share),
-            power_kw: None,
-            limit_kw: None,
-        });
-    }
-    if let Some(left) = left_material(&simulation, job.allowance) {
-        simulation.find(left);
-    }
-    let final_volume = simulation.stock.volume();
-    let grid = job.grid;
-    let cut = Cut {
-        ok: simulation.findings.is_empty(),
-        findings: simulation.findings,
-        findings_left_off: simulation.left_off,
-        resolution: grid.spacing,
-        rays: [grid.nx, grid.ny],
-        stock_volume_mm3: stock_volume,
-        part_volume_mm3: part_volume,
-        removed_volume_mm3: removed,
-        final_volume_mm3: final_volume,
-        cutting_time_s: cutting_time,
-        air_time_s: air_time,
-        air_share,
-        moves: moves.len(),
-        moves_unplaced: unplaced,
-        dexel_updates: simulation.updates,
-        blocks,
-    };
-    Ok((cut, simulation.stock))
+    Some(work)
+}
+
+fn mismatch(detail: String) -> SolverError {
+    SolverError::new(ErrorCode::Internal, format!("the parts do not belong to this verification: {detail}"))
 }
 
 /// The spindle power, kW, block `read` needs to remove `rate` mm³/min with `flutes` teeth (tool
@@ -559,7 +935,7 @@ pub(crate) fn cut_fields(
 /// # Errors
 /// `E_INPUT` at `program` when the block cuts before the program sets a spindle speed.
 fn spindle_power(
-    simulation: &mut Simulation<'_>,
+    tally: &mut Tally<'_>,
     model: &PowerModel,
     read: &ReadMove,
     rate: f64,
@@ -580,7 +956,7 @@ fn spindle_power(
     if let Some(limit) = model.limit(spindle_rpm)
         && power > limit
     {
-        simulation.find(Finding {
+        tally.find(Finding {
             kind: FindingKind::SpindlePower,
             line: Some(read.line),
             tool,
@@ -593,35 +969,6 @@ fn spindle_power(
         });
     }
     Ok(power)
-}
-
-/// The material left outside the part thicker than `allowance`: one finding at the thickest.
-fn left_material(simulation: &Simulation<'_>, allowance: f64) -> Option<Finding> {
-    let part = simulation.part.as_ref()?;
-    let grid = simulation.stock.grid;
-    let mut worst = Worst::default();
-    let mut pieces = Vec::new();
-    for (index, (ray, part_ray)) in simulation.stock.rays.iter().zip(&part.rays).enumerate() {
-        pieces.clear();
-        dexel::outside(ray, part_ray, 0.0, &mut pieces);
-        for &[low, high] in &pieces {
-            if high - low > allowance {
-                let (i, j) = (index % grid.nx, index / grid.nx);
-                worst.add(high - low, (high - low) * grid.cell_area(), [grid.x(i), grid.y(j), low]);
-            }
-        }
-    }
-    worst.seen.then_some(Finding {
-        kind: FindingKind::LeftMaterial,
-        line: None,
-        tool: None,
-        position: worst.position,
-        depth: worst.depth,
-        volume_mm3: worst.volume,
-        share: None,
-        power_kw: None,
-        limit_kw: None,
-    })
 }
 
 #[cfg(test)]
@@ -668,7 +1015,7 @@ mod tests {
                 rays.push(ray);
             }
         }
-        Field { grid, rays }
+        Field::new(grid, rays)
     }
 
     fn shape() -> impl Strategy<Value = (Shape, f64)> {
@@ -714,7 +1061,7 @@ mod tests {
                 };
                 let segment = Segment::new(from, to);
                 let mut removed = Vec::new();
-                sweep_cutter(&mut fast, &mut tops, &body, &segment, &mut Scratch::default(), |index, _, _, pieces| {
+                sweep_cutter(&mut fast, &mut tops, &body, &segment, &mut Scratch::default(), |index, _, _, _, pieces| {
                     removed.extend(pieces.iter().map(|&piece| (index, piece)));
                 });
                 prop_assert_eq!(&removed, &sweep_every_ray(&mut every, &body, &segment));

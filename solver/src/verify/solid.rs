@@ -220,14 +220,19 @@ impl SolidModel {
 
     /// The solid on `grid`.
     pub(crate) fn field(&self, grid: Grid) -> Field {
-        let mut rays = Vec::with_capacity(grid.len());
+        self.field_rows(grid, 0..grid.ny)
+    }
+
+    /// The solid on rows `rows` of `grid`.
+    pub(crate) fn field_rows(&self, grid: Grid, rows: std::ops::Range<usize>) -> Field {
+        let mut rays = Vec::with_capacity(grid.nx * rows.len());
         let mut heights = Vec::new();
-        for j in 0..grid.ny {
+        for j in rows.clone() {
             for i in 0..grid.nx {
                 rays.push(self.ray(grid.x(i), grid.y(j), &mut heights));
             }
         }
-        Field { grid, rays }
+        Field { grid, rows, rays }
     }
 }
 
@@ -235,35 +240,68 @@ impl SolidModel {
 /// have, thicker than `tolerance` on a ray: a program cannot leave what the stock lacks, so the
 /// part or the stock is in the wrong place.
 pub(crate) fn check_part_in_stock(part: &Field, stock: &Field, tolerance: f64) -> Result<(), SolverError> {
-    let grid = stock.grid;
-    let mut pieces = Vec::new();
-    let mut worst: Option<(f64, [f64; 3])> = None;
-    let mut empty = true;
-    for (index, (part_ray, stock_ray)) in part.rays.iter().zip(&stock.rays).enumerate() {
-        empty &= part_ray.is_empty();
-        pieces.clear();
-        dexel::outside(part_ray, stock_ray, 0.0, &mut pieces);
-        for &[low, high] in &pieces {
-            if high - low > tolerance && worst.is_none_or(|(thickest, _)| high - low > thickest) {
-                worst = Some((high - low, [grid.x(index % grid.nx), grid.y(index / grid.nx), low]));
+    PartCheck::of(part, stock, tolerance).verdict()
+}
+
+/// What [`check_part_in_stock`] finds on some rows of the grid; the checks of consecutive rows
+/// merge ([`PartCheck::merge`]) into the check of all of them.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub(crate) struct PartCheck {
+    /// Whether the part holds no material on the rows.
+    pub empty: bool,
+    /// The thickest piece of the part outside the stock (the first of equals in row order), and
+    /// where it starts.
+    pub worst: Option<(f64, [f64; 3])>,
+}
+
+impl PartCheck {
+    /// The check of the rows both fields hold (the same).
+    pub fn of(part: &Field, stock: &Field, tolerance: f64) -> Self {
+        let grid = stock.grid;
+        let mut pieces = Vec::new();
+        let mut check = Self { empty: true, worst: None };
+        for (index, (part_ray, stock_ray)) in part.rays.iter().zip(&stock.rays).enumerate() {
+            check.empty &= part_ray.is_empty();
+            pieces.clear();
+            dexel::outside(part_ray, stock_ray, 0.0, &mut pieces);
+            for &[low, high] in &pieces {
+                if high - low > tolerance && check.worst.is_none_or(|(thickest, _)| high - low > thickest) {
+                    let (i, j) = stock.ray_at(index);
+                    check.worst = Some((high - low, [grid.x(i), grid.y(j), low]));
+                }
             }
         }
+        check
     }
-    if empty {
-        return Err(SolverError::input(
-            "part",
-            "the part holds no material on the stock's dexel grid: is it in the stock?",
-        ));
+
+    /// The check of these rows and the `next` ones after them.
+    pub fn merge(self, next: Self) -> Self {
+        let worst = match (self.worst, next.worst) {
+            (Some(first), Some(second)) if second.0 > first.0 => Some(second),
+            (None, second) => second,
+            (first, _) => first,
+        };
+        Self { empty: self.empty && next.empty, worst }
     }
-    match worst {
-        Some((thickness, [x, y, z])) => Err(SolverError::input(
-            "part",
-            format!(
-                "the part lies outside the stock: {thickness:.3} mm of it on the ray through x = {x:.3} mm, y = {y:.3} mm \
-                 from z = {z:.3} mm is not stock material; place the part in the stock, in the program's coordinates"
-            ),
-        )),
-        None => Ok(()),
+
+    /// The refusal, if any.
+    pub fn verdict(self) -> Result<(), SolverError> {
+        if self.empty {
+            return Err(SolverError::input(
+                "part",
+                "the part holds no material on the stock's dexel grid: is it in the stock?",
+            ));
+        }
+        match self.worst {
+            Some((thickness, [x, y, z])) => Err(SolverError::input(
+                "part",
+                format!(
+                    "the part lies outside the stock: {thickness:.3} mm of it on the ray through x = {x:.3} mm, y = {y:.3} mm \
+                     from z = {z:.3} mm is not stock material; place the part in the stock, in the program's coordinates"
+                ),
+            )),
+            None => Ok(()),
+        }
     }
 }
 

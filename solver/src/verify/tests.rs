@@ -430,3 +430,236 @@ proptest! {
         }
     }
 }
+
+/// Parts' outputs as JSON text, as a job's store keeps them (CBOR there).
+#[derive(Default)]
+struct Texts(Vec<String>, usize);
+
+impl crate::capability::PartSink for Texts {
+    fn put<T: serde::Serialize>(&mut self, value: &T) -> Result<(), crate::error::SolverError> {
+        self.0.push(serde_json::to_string(value).expect("a part's output as JSON"));
+        Ok(())
+    }
+}
+
+impl crate::capability::PartSource for Texts {
+    fn count(&self) -> usize {
+        self.0.len()
+    }
+
+    fn next_part<T: serde::de::DeserializeOwned>(&mut self) -> Option<Result<T, crate::error::SolverError>> {
+        let text = self.0.get(self.1)?;
+        self.1 += 1;
+        Some(Ok(serde_json::from_str(text).expect("a part's output read back")))
+    }
+}
+
+/// The context the server resolves for `request`: its inline tools, and `material` and
+/// `machine` when given.
+fn context(
+    request: &VerifyRequest,
+    material: Option<crate::material::Material>,
+    machine: Option<crate::machine::MachineProfile>,
+) -> crate::capability::Resolved<Option<Tool>> {
+    crate::capability::Resolved { tool: None, machine, material, other_tools: tools(request) }
+}
+
+/// The answer's JSON of solving `request` whole, or its refusal.
+fn whole_json(request: &VerifyRequest, context: &crate::capability::Resolved<Option<Tool>>) -> String {
+    use crate::capability::Capability;
+    match super::VerifyCapability::solve(request, context.clone(), &Run::default()) {
+        Ok(answer) => serde_json::to_string(&answer).expect("JSON"),
+        Err(error) => format!("{error:?}"),
+    }
+}
+
+/// The answer's JSON of solving `parts` (ranges of strips) apart and finishing, or its refusal.
+fn parts_json(
+    request: &VerifyRequest,
+    context: &crate::capability::Resolved<Option<Tool>>,
+    parts: &[crate::capability::Part],
+) -> String {
+    use crate::capability::Capability;
+    let mut texts = Texts::default();
+    for part in parts {
+        if let Err(error) =
+            super::VerifyCapability::solve_part(request, context.clone(), part, &Run::default(), &mut texts)
+        {
+            return format!("{error:?}");
+        }
+    }
+    match super::VerifyCapability::finish(request, context.clone(), &mut texts, &Run::default()) {
+        Ok(answer) => serde_json::to_string(&answer).expect("JSON"),
+        Err(error) => format!("{error:?}"),
+    }
+}
+
+/// `strips` cut at `cuts` (each taken modulo `strips`) into consecutive parts.
+fn strip_parts(strips: usize, cuts: &[usize]) -> Vec<crate::capability::Part> {
+    let mut bounds: Vec<usize> = cuts.iter().map(|cut| cut % strips).filter(|&cut| cut > 0).collect();
+    bounds.sort_unstable();
+    bounds.dedup();
+    bounds.insert(0, 0);
+    bounds.push(strips);
+    bounds.windows(2).map(|pair| crate::capability::Part { units: pair[0]..pair[1], seconds: 1.0 }).collect()
+}
+
+/// The strips of `request`'s dexel grid.
+fn strips_of(request: &VerifyRequest) -> usize {
+    let job = request.validate(&tools(request), Found::default(), None, crate::capability::Control::default()).unwrap();
+    job.grid.strips()
+}
+
+#[test]
+fn a_verification_split_by_the_cost_model_is_the_whole_one() {
+    use crate::capability::{Capability, Sizing, Split};
+    // A raster over a dome-shaped part with rapids through the stock, a gouge, a short holder and
+    // a spindle over its power; split into parts of the cost model's size, and at every strip.
+    let mut program = String::from("T1 M6\nS8000 M3\nG0 X-5 Y-5 Z5\n");
+    for row in 0..30 {
+        let y = -4.0 + 0.7 * f64::from(row);
+        program.push_str(&format!(
+            "G1 X-5 Y{y:.3} Z-0.8 F900\nG1 X25 Z{:.3}\nG0 Z2\nG0 X-5\n",
+            -1.2 - 0.01 * f64::from(row)
+        ));
+    }
+    program.push_str("G0 X-5 Y19.5\nG0 Z-0.5\nG0 X25\nG0 Z2\nG0 X12 Y19\nG2 X12 Y19 I-2 J0 Z-4 F600\nG0 Z30\nM30\n");
+    let request = request(json!({
+        "program": program,
+        "tools": [{"kind": "ball", "radius": 2, "number": 1, "stickout": 2.5, "flute_length": 2, "holder_diameter": 8}],
+        "stock": {"kind": "box", "min": [0, 0, -10], "max": [20, 20, 0]},
+        "part": {"kind": "box", "min": [0, 0, -10], "max": [20, 20, -1.25]},
+        "resolution": 0.05,
+        "material": "steel",
+        "machine": "mill",
+    }));
+    let material: crate::material::Material = serde_json::from_value(json!({"kc11": 1800, "mc": 0.25})).unwrap();
+    let machine: crate::machine::MachineProfile =
+        serde_json::from_value(json!({"block_time_ms": 2, "max_feed": 10000, "spindle_power_kw": 0.01})).unwrap();
+    let context = context(&request, Some(material), Some(machine));
+    let whole = whole_json(&request, &context);
+    let answer: Value = serde_json::from_str(&whole).expect(&whole);
+    let kinds: std::collections::BTreeSet<&str> =
+        answer["findings"].as_array().unwrap().iter().map(|finding| finding["kind"].as_str().unwrap()).collect();
+    for kind in ["gouge", "rapid_through_material", "holder_contact", "spindle_power", "left_material"] {
+        assert!(kinds.contains(kind), "{kind} in {kinds:?}");
+    }
+    let strips = strips_of(&request);
+    assert_eq!(strips, 13);
+    let Split { parts, finish_seconds } =
+        super::VerifyCapability::split(&request, &context, &Sizing { part_seconds: 0.002, max_parts: 1000 })
+            .expect("splits into parts");
+    assert!(parts.len() >= 2 && finish_seconds > 0.0, "{parts:?}");
+    assert!(parts.windows(2).all(|pair| pair[0].units.end == pair[1].units.start) && parts[0].units.start == 0);
+    assert_eq!(parts.last().unwrap().units.end, strips);
+    assert!(parts_json(&request, &context, &parts) == whole, "the split answer differs ({} parts)", parts.len());
+    let every: Vec<usize> = (1..strips).collect();
+    assert!(parts_json(&request, &context, &strip_parts(strips, &every)) == whole, "one part a strip");
+    // Large parts: one would do.
+    assert!(super::VerifyCapability::split(&request, &context, &Sizing { part_seconds: 1e6, max_parts: 9 }).is_none());
+}
+
+#[test]
+fn findings_past_the_cap_are_counted_in_program_order_when_split() {
+    // 1 300 rapids through the stock, each on its own strips: 1 000 listed, 300 counted, split or not.
+    let mut program = String::from("G0 X-2 Y0.5 Z-1\n");
+    for k in 0..1300 {
+        let y = 0.5 + f64::from(k % 13) * 1.5;
+        let x = if k % 2 == 0 { 22.0 } else { -2.0 };
+        program.push_str(&format!("G0 Y{y:.2}\nG0 X{x}\n"));
+    }
+    let request = request(json!({
+        "program": program,
+        "tools": [{"kind": "flat", "radius": 0.3}],
+        "stock": {"kind": "tube", "start": [-5, 10, -3], "end": [25, 10, -3], "outer_radius": 10, "inner_radius": 1},
+        "resolution": 0.05,
+    }));
+    let context = context(&request, None, None);
+    let whole = whole_json(&request, &context);
+    let answer: Value = serde_json::from_str(&whole).expect(&whole);
+    assert_eq!(answer["findings"].as_array().unwrap().len(), 1000);
+    assert!(answer["findings_left_off"].as_u64().unwrap() > 0, "{}", answer["findings_left_off"]);
+    let strips = strips_of(&request);
+    for cuts in [vec![3], vec![1, 5, 9], (1..strips).collect()] {
+        assert!(parts_json(&request, &context, &strip_parts(strips, &cuts)) == whole, "cut at {cuts:?}");
+    }
+}
+
+#[test]
+fn refusals_of_a_split_verification_are_the_whole_ones() {
+    // The part outside the stock (on one strip only), and a program that never reaches the stock.
+    let outside = request(json!({
+        "program": "G0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10",
+        "tools": [{"kind": "flat", "radius": 1}],
+        "stock": {"kind": "box", "min": [0, 0, -5], "max": [10, 10, 0]},
+        "part": {"kind": "box", "min": [0, 8, -5], "max": [10, 10, 1]},
+        "resolution": 0.1,
+    }));
+    let away = request(json!({
+        "program": "G0 X0 Y0 Z5\nG1 X10 F100",
+        "tools": [{"kind": "flat", "radius": 1}],
+        "stock": {"kind": "box", "min": [0, 0, -5], "max": [10, 10, 0]},
+        "resolution": 0.1,
+    }));
+    for request in [outside, away] {
+        let context = context(&request, None, None);
+        let whole = whole_json(&request, &context);
+        assert!(whole.contains("Input") || whole.contains("Stock"), "{whole}");
+        let strips = strips_of(&request);
+        assert!(parts_json(&request, &context, &strip_parts(strips, &[1, 2])) == whole);
+    }
+}
+
+/// A random program of rapids, lines and helical circles over a 20 × 12 mm area, z from −3 to 2.
+fn random_program() -> impl Strategy<Value = String> {
+    let step = (0..4usize, -2.0..22.0f64, -2.0..14.0f64, -3.0..2.0f64, 0.5..4.0f64);
+    prop::collection::vec(step, 1..25).prop_map(|steps| {
+        let mut program = String::from("G0 X-2 Y-2 Z5\n");
+        for (kind, x, y, z, radius) in steps {
+            program.push_str(&match kind {
+                0 => format!("G0 X{x:.3} Y{y:.3} Z{z:.3}\n"),
+                1 | 2 => format!("G1 X{x:.3} Y{y:.3} Z{z:.3} F800\n"),
+                _ => format!("G3 I{radius:.3} J0 Z{z:.3} F500\n"),
+            });
+        }
+        program
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Any program on a box, a tube or a cylinder, with or without a part, cut in 1 to 5 parts
+    /// of whole strips anywhere, finishes as the whole cut, byte for byte (or is refused as it).
+    #[test]
+    fn a_verification_cut_into_strips_anywhere_is_the_whole_one(
+        program in random_program(),
+        stock in 0..3usize,
+        tool in 0..3usize,
+        radius in 0.5..3.0f64,
+        with_part in any::<bool>(),
+        cuts in prop::collection::vec(0usize..100, 0..4),
+    ) {
+        let stock = match stock {
+            0 => json!({"kind": "box", "min": [0, 0, -6], "max": [20, 12, 0]}),
+            1 => json!({"kind": "tube", "start": [0, 6, -5], "end": [20, 6, -5], "outer_radius": 6, "inner_radius": 3}),
+            _ => json!({"kind": "cylinder", "start": [10, 6, -6], "end": [10, 6, 0], "radius": 6}),
+        };
+        let tool = match tool {
+            0 => json!({"kind": "ball", "radius": radius, "stickout": 2.5, "holder_diameter": 12}),
+            1 => json!({"kind": "flat", "radius": radius, "neck_radius": radius * 0.6, "flute_length": 1}),
+            _ => json!({"kind": "bull", "radius": radius, "corner_radius": radius / 3.0}),
+        };
+        let mut body = json!({"program": program, "tools": [tool], "stock": stock, "resolution": 0.08});
+        if with_part {
+            body["part"] = json!({"kind": "box", "min": [5, 3, -6], "max": [15, 9, -1.5]});
+        }
+        let request = request(body);
+        let context = context(&request, None, None);
+        let strips = strips_of(&request);
+        prop_assert!(strips >= 5);
+        let parts = strip_parts(strips, &cuts);
+        let whole = whole_json(&request, &context);
+        prop_assert!(parts_json(&request, &context, &parts) == whole, "{} parts: {}", parts.len(), whole);
+    }
+}

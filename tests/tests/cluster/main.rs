@@ -4,7 +4,8 @@
 //! SQLite run of the same files. A large prediction is split into parts that both workers run at
 //! once, one killed in the middle of a part, and its merged result and program are a one-process
 //! run's byte for byte, as are those of an engagement comparison, a contour and a deburring split
-//! into parts; a refused part fails its job with its problem. Two API nodes on one
+//! into parts, and a verification split into strips of rows answers as `POST /api/v1/verify`; a
+//! refused part fails its job with its problem. Two API nodes on one
 //! database see each other's tools, machines and jobs, and a cancel through one reaches the job
 //! running on the other within two seconds.
 //! Each test skips, printing why, when PostgreSQL is not installed (fails under
@@ -401,6 +402,38 @@ fn deburr_holes() -> Value {
     })
 }
 
+/// A verification of a finishing raster (the verify bench's: a Ø6 ball over a dome, 100 rows of
+/// 201 moves, 20 000 blocks) over a 100 × 100 × 40 mm box, against a part whose top the dome dips
+/// under (gouges past the cap of 1000 findings, material left beside the raster), at 0.06 mm
+/// dexels (1 667 rows, 53 strips; about 1 core-s by the cost model) to be split into strips of
+/// rows at [`PART_SECONDS`].
+fn verify_raster() -> Value {
+    let dome = |x: f64, y: f64| {
+        let r2 = ((x - 50.0).powi(2) + (y - 50.0).powi(2)) / 2500.0;
+        5.0 * (1.0 - r2).max(0.0) - 6.0
+    };
+    let mut program = String::from("G21 G90\nG0 X0 Y25 Z10\nF3000\n");
+    for row in 0..100 {
+        let y = 25.0 + 0.5 * f64::from(row);
+        for step in 0..=200 {
+            let k = if row % 2 == 0 { step } else { 200 - step };
+            let x = 0.5 * f64::from(k);
+            program.push_str(&format!("G1 X{x:.4} Y{y:.4} Z{:.4}\n", dome(x, y)));
+        }
+    }
+    program.push_str("G0 Z50\nM30\n");
+    json!({
+        "name": "verify, a finishing raster",
+        "operations": [{
+            "operation": "verify", "program": program,
+            "tools": [{"kind": "ball", "radius": 3, "number": 1, "flute_length": 20, "stickout": 30}],
+            "stock": {"kind": "box", "min": [0, 0, -40], "max": [100, 100, 0]},
+            "part": {"kind": "box", "min": [0, 0, -40], "max": [100, 100, -3]},
+            "resolution": 0.06
+        }]
+    })
+}
+
 /// Workers that split work into parts of this many core-seconds (`KERF_JOB_PART_S`; the default
 /// 8 would leave this test's operations whole).
 const PART_SECONDS: &str = "0.25";
@@ -547,6 +580,58 @@ async fn a_prediction_splits_across_workers_and_survives_a_kill() {
     assert!(shared[0].0.contains("\"timings\":{"), "the merged prediction reports its time");
     pool.close().await;
     for worker in workers.into_iter().flatten() {
+        worker.terminate();
+    }
+    api.terminate();
+}
+
+/// A verification job is split into strips of the dexel grid's rows that both workers cut, and
+/// its stored answer is `POST /api/v1/verify`'s for the same request, byte for byte.
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(not(kerf_has_postgres), ignore = "PostgreSQL not found: apt-get install postgresql")]
+async fn a_verification_splits_into_strips_across_workers() {
+    let Some(postgres) = PgServer::start() else { return };
+    let url = postgres.url();
+    let client = Client::builder().timeout(Duration::from_secs(120)).build().unwrap();
+    let api = ServerProcess::start_with(&program(), &["serve", "--database", &url, "--job-workers", "0"]).await;
+    let worker_arguments = ["worker", "--database", &url, "--job-workers", "1"];
+    let mut workers = Vec::new();
+    for _ in 0..2 {
+        workers.push(
+            ServerProcess::start_with_env(&program(), &worker_arguments, &[("KERF_JOB_PART_S", PART_SECONDS)]).await,
+        );
+    }
+    let pool = connect(&postgres).await;
+    let job = verify_raster();
+    let id = submit(&client, &api.base, &job).await;
+    let done = poll_job(&client, &api.base, id, 900, finished).await;
+    assert_eq!(done["status"], "done", "{}", done["error"]);
+    assert_eq!(done["progress"], 1.0);
+    let (parts, cut_by): (i64, i64) = sqlx::query_as(
+        "SELECT COUNT(*), COUNT(DISTINCT split_part(worker, ':', 2)) FROM job_chunks
+         WHERE job_id = $1 AND kind = 'part' AND status = 'done'",
+    )
+    .bind(id)
+    .fetch_one(&pool)
+    .await
+    .unwrap();
+    assert!(parts >= 2, "the verification is split into strips: {parts} parts");
+    eprintln!("verification: {parts} parts, cut by {cut_by} workers");
+
+    let mut request = job["operations"][0].clone();
+    request.as_object_mut().unwrap().remove("operation");
+    let response = client.post(format!("{}/api/v1/verify", api.base)).json(&request).send().await.unwrap();
+    assert_eq!(response.status(), 200);
+    let answer = response.text().await.unwrap();
+    let stored = outputs(&client, &api.base, id).await;
+    assert_eq!(stored.len(), 1);
+    assert!(stored[0].0 == answer, "the merged verification differs from the endpoint's answer");
+    let answer: Value = serde_json::from_str(&answer).unwrap();
+    assert_eq!(answer["findings"].as_array().unwrap().len(), 1000, "findings past the cap");
+    assert!(answer["findings_left_off"].as_u64().unwrap() > 0);
+    assert_eq!(answer["findings"][999]["kind"], "gouge");
+    pool.close().await;
+    for worker in workers {
         worker.terminate();
     }
     api.terminate();
