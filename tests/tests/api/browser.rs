@@ -422,3 +422,29 @@ async fn contour_page_draws_its_cut_stock() {
     assert_eq!(result["ok"], true);
     assert!(result["partly"].as_f64() < result["removed"].as_f64(), "{result}");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
+async fn predict_page_draws_the_stock_its_corrected_program_cuts() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "predictCut", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["partly"].as_f64() < result["removed"].as_f64(), "{result}");
+    assert!(result["green"].as_u64() > Some(0) && result["listed"].as_u64() > Some(10), "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
+async fn engagement_page_draws_the_stock_its_program_cuts() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "engagementCut", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["partly"].as_f64() < result["removed"].as_f64(), "{result}");
+    assert!(result["green"].as_u64() > Some(0), "{result}");
+}
