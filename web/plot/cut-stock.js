@@ -1,9 +1,10 @@
 // The cut stock in 3-D, shared by every view that draws a program: the stock as a program left it
 // (a GLB answer: `POST /api/v1/verify?format=glb`, or `POST /api/v1/{name}/stock` for a
 // capability's own verification, docs/spec/verify.md §8 and §9.4) coloured by deviation from the
-// part, or without a part by what the program cut, the findings as a list linked to the program's lines and marked in 3-D, and playback that
-// removes material: at each step the stock cut up to the line the clock has reached is asked for,
-// the clock running at the program's feeds times the chosen speed.
+// part, or without a part by what the program cut, the findings as a list linked to the program's
+// lines and marked in 3-D, and playback that removes material: at each step the stock cut up to
+// the line the clock has reached is asked for, the clock running at the program's feeds times the
+// chosen speed.
 import { api } from '/api.js';
 import { number } from '/form.js';
 import { Scene3D, THREE, readGlb } from '/plot/scene3d.js';
@@ -377,8 +378,7 @@ export async function partlessPanel(container, { name, verification, body, send 
   try {
     program = await verifiedProgram(name, send(body));
   } catch (problem) {
-    container.append(Object.assign(document.createElement('p'), { className: 'message warning', textContent: `The cut stock cannot be drawn: ${problem.detail ?? problem.title ?? problem}` }));
-    return verificationPanel(container, panel);
+    return verificationPanel(container, { ...panel, why: `its program cannot be written again: ${problem.detail ?? problem.title ?? problem}` });
   }
   return verificationPanel(container, { ...panel, program, path: `/api/v1/${name}/stock`, body, send, resolution: verification.resolution });
 }
