@@ -62,6 +62,49 @@ async function colouredPixels(selector, colour) {
   }, [colour, PIXELS]);
 }
 
+// The cut stock of a view whose model has no part (`id`: predict, engagement), seen from the top:
+// drawn (inked), green where the program cut and said to be coloured so; playback to a quarter, a
+// half or three quarters of the moves removes less than the whole program (the first that removes
+// some, less than all, is reported; a program of one cutting move removes none before it).
+async function partlessCut(id) {
+  const scene = `#${id}-stock`;
+  await page.waitForSelector(`${scene}[data-state="drawn"][data-stock-vertices]`, { timeout: 120000 });
+  const stock = await page.$eval(scene, (e) => ({ ...e.dataset }));
+  if (stock.colouring !== 'cut' || !(Number(stock.cutVertices) > 0)) throw new Error(`not coloured by what was cut: ${JSON.stringify(stock)}`);
+  await page.click(`${scene} button:text("Top")`);
+  const counts = await page.$eval(`${scene} canvas`, (canvas, pixels) => {
+    const data = eval(pixels)(canvas);
+    let green = 0;
+    let inked = 0;
+    for (let i = 0; i < data.length; i += 4) {
+      const [r, g, b] = [data[i], data[i + 1], data[i + 2]];
+      if (r < 200 || g < 200 || b < 200) inked++;
+      if (g > 60 && g - r > 40 && g - b > 40) green++;
+    }
+    return { green, inked };
+  }, PIXELS);
+  if (counts.inked < 20000) throw new Error(`the cut stock is nearly blank: ${counts.inked} inked pixels`);
+  if (counts.green < 500) throw new Error(`what the program cut is not drawn green: ${counts.green} green pixels`);
+  const full = Number(stock.removedVolume);
+  if (!(full > 0)) throw new Error(`nothing cut: ${JSON.stringify(stock)}`);
+  let played = null;
+  for (const share of [0.25, 0.5, 0.75]) {
+    const line = await page.$eval(`#${id}-position`, (slider, [id, share]) => {
+      slider.value = String(Math.floor(Number(slider.max) * share));
+      slider.dispatchEvent(new Event('input'));
+      return /line (\d+)/.exec(document.querySelector(`#${id}-playback-readout`).textContent)[1];
+    }, [id, share]);
+    await page.waitForSelector(`${scene}[data-upto-line="${line}"]`, { timeout: 120000 });
+    const partly = Number(await page.getAttribute(scene, 'data-removed-volume'));
+    if (partly < full && !(played?.partly > 0)) played = { line: Number(line), partly };
+    if (partly > 0 && partly < full) break;
+  }
+  if (!played) throw new Error(`playback to a quarter, half and three quarters of the moves cut all ${full} mm³`);
+  const { line, partly } = played;
+  const listed = await page.$$eval(`#${id}-listing li`, (l) => l.length);
+  return { ...counts, removed: full, partly, line, listed, vertices: Number(stock.stockVertices) };
+}
+
 // Every file the page downloads, by name: a refused download must add none.
 const downloads = [];
 page.on('download', (file) => downloads.push(file.suggestedFilename()));
@@ -688,8 +731,10 @@ const scenarios = {
     // Entered as a radius, the size is sent as it is.
     await page.selectOption('#predict-form select[name="size_as"]', 'radius');
     await page.fill('#predict-form input[name="ball_size"]', '2.5');
-    const [byRadius] = await Promise.all([page.waitForRequest((r) => r.url().includes('/api/v1/predict')),
-      page.waitForResponse((r) => r.url().includes('/api/v1/predict'), { timeout: 60000 }), page.click('#predict-compute')]);
+    // The prediction itself, not the cut stock's program and stock the answer's panel asks for.
+    const prediction = (r) => new URL(r.url()).pathname === '/api/v1/predict';
+    const [byRadius] = await Promise.all([page.waitForRequest(prediction),
+      page.waitForResponse(prediction, { timeout: 60000 }), page.click('#predict-compute')]);
     if (byRadius.postDataJSON().tool.radius !== 2.5) throw new Error(`radius 2.5 sent as ${byRadius.postDataJSON().tool.radius}`);
     const sizeLabel = await page.textContent('#predict-form [data-size-label]');
     if (sizeLabel !== 'Ball radius, mm') throw new Error(`size label: ${sizeLabel}`);
@@ -1435,6 +1480,21 @@ hole = { shape = "round", diameter = 16 }
     const partly = Number(await page.getAttribute('#contour-stock', 'data-removed-volume'));
     if (!(partly < full)) throw new Error(`cut up to line ${line} the stock lost ${partly} mm³, the whole program ${full} mm³`);
     return { inked, removed: full, partly, line: Number(line), vertices: Number(stock.stockVertices) };
+  },
+
+  // The predict view draws the stock the corrected program cuts (the server's cut stock of the
+  // prediction's own verification, no part: green where cut), with the program listed and playback.
+  async predictCut() {
+    await page.goto(`${base}/#predict`);
+    await page.click('#predict-compute');
+    return partlessCut('predict');
+  },
+
+  // The engagement view draws the plan-view stock extruded as the candidate's program cuts it.
+  async engagementCut() {
+    await page.goto(`${base}/#engagement`);
+    await page.click('#engagement-compute');
+    return partlessCut('engagement');
   },
 };
 

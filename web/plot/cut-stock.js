@@ -1,9 +1,10 @@
 // The cut stock in 3-D, shared by every view that draws a program: the stock as a program left it
 // (a GLB answer: `POST /api/v1/verify?format=glb`, or `POST /api/v1/{name}/stock` for a
 // capability's own verification, docs/spec/verify.md §8 and §9.4) coloured by deviation from the
-// part, the findings as a list linked to the program's lines and marked in 3-D, and playback that
-// removes material: at each step the stock cut up to the line the clock has reached is asked for,
-// the clock running at the program's feeds times the chosen speed.
+// part, or without a part by what the program cut, the findings as a list linked to the program's
+// lines and marked in 3-D, and playback that removes material: at each step the stock cut up to
+// the line the clock has reached is asked for, the clock running at the program's feeds times the
+// chosen speed.
 import { api } from '/api.js';
 import { number } from '/form.js';
 import { Scene3D, THREE, readGlb } from '/plot/scene3d.js';
@@ -23,6 +24,21 @@ const DEVIATION_LEGEND = {
   text: 'cut stock: red gouge, blue material left, green cut to the part, grey untouched',
   colour: `linear-gradient(90deg, ${DEVIATION_COLOURS.gouge} 25%, ${DEVIATION_COLOURS.left} 25% 50%, ${DEVIATION_COLOURS.cut} 50% 75%, ${DEVIATION_COLOURS.untouched} 75%)`,
 };
+
+// Without a part (`extras.colouring` "cut") the GLB's own colours: green where the program cut,
+// grey where the stock is as given.
+const CUT_LEGEND = {
+  text: 'cut stock: green cut by the program, grey as given (no part to compare with)',
+  colour: `linear-gradient(90deg, ${DEVIATION_COLOURS.cut} 50%, ${DEVIATION_COLOURS.untouched} 50%)`,
+};
+
+// The vertices of `geometry` the GLB colours green (cut, without a part): green well above red.
+function cutColoured(geometry) {
+  const colour = geometry.getAttribute('color');
+  let count = 0;
+  if (colour) for (let k = 0; k < colour.count; k += 1) if (colour.getY(k) > 2 * colour.getX(k)) count += 1;
+  return count;
+}
 
 // Recolours `geometry` from its `deviation` attribute with `tolerance` and `allowance` (mm);
 // the counts of vertices of each colour.
@@ -145,8 +161,10 @@ export class CutStock {
   // GLB's glTF JSON.
   show(geometry, line, json) {
     const first = !this.scene.scene?.getObjectByName('stock');
-    const counts = recolour(geometry, ...this.limits);
-    this.scene.coloured('stock', geometry, first ? { legend: DEVIATION_LEGEND.text, colour: DEVIATION_LEGEND.colour } : {});
+    const byCut = json.extras?.colouring === 'cut';
+    const counts = byCut ? { cut: cutColoured(geometry) } : recolour(geometry, ...this.limits);
+    const legend = byCut ? CUT_LEGEND : DEVIATION_LEGEND;
+    this.scene.coloured('stock', geometry, first ? { legend: legend.text, colour: legend.colour } : {});
     const deviation = geometry.getAttribute('deviation');
     let deepest = 0;
     if (deviation) for (let k = 0; k < deviation.count; k += 1) deepest = Math.min(deepest, deviation.getX(k));
@@ -155,6 +173,7 @@ export class CutStock {
     view.cutVertices = String(counts.cut);
     view.deepestDeviation = deepest.toFixed(4);
     view.uptoLine = line === undefined ? 'end' : String(line);
+    view.colouring = byCut ? 'cut' : 'deviation';
     const answer = json.extras?.verify ?? json.extras?.verification;
     view.removedVolume = String(answer?.removed_volume_mm3 ?? 0);
     this.scene.render();
@@ -270,10 +289,11 @@ export class CutStock {
 // in `container`: a summary, the findings linked to the lines of `program` (the program the
 // verification cut: default output options, Fanuc) and, where the capability answers its cut
 // stock (`path`: `/api/v1/{name}/stock`), the stock in 3-D with playback, drawn into `scene` when
-// given (`why` says why not, without `path`). `body` is the capability's request; `resolution` the
-// spacing the page asks the stock at.
+// given (`why` says why not, without `path`). `body` is the capability's request, `send(body)` what
+// is posted for it (default the JSON; a form with a file the request reads); `resolution` the
+// spacing the page asks the stock at; `label` names the scene.
 // Resolves to the CutStock, or null when the stock cannot be drawn (said in the panel).
-export async function verificationPanel(container, { id, verification, program, path, body, resolution, scene, onMove, why = 'this capability does not answer its cut stock' }) {
+export async function verificationPanel(container, { id, verification, program, path, body, send = (request) => request, resolution, scene, label, onMove, why = 'this capability does not answer its cut stock' }) {
   const box = document.createElement('section');
   box.className = 'verification';
   box.id = `${id}-verification`;
@@ -317,10 +337,11 @@ export async function verificationPanel(container, { id, verification, program, 
     tolerance: verification.tolerance,
     allowance: verification.allowance,
     scene,
+    label,
     onMove,
     ask: async (line) => {
       const query = line === undefined ? '' : `?upto_line=${line}`;
-      return (await api('POST', `${path}${query}`, request, 'model/gltf-binary')).arrayBuffer();
+      return (await api('POST', `${path}${query}`, send(request), 'model/gltf-binary')).arrayBuffer();
     },
   });
   try {
@@ -343,7 +364,24 @@ export function noStockNote(capability) {
 
 // The program a capability's verification cuts (docs/spec/verify.md §9): the answer's with the
 // default output options in the Fanuc dialect, from the capability's program route, whose lines
-// the findings and `upto_line` count.
+// the findings and `upto_line` count. `body` as posted (JSON, or a form).
 export function verifiedProgram(name, body) {
   return api('POST', `/api/v1/${name}/program?dialect=fanuc`, body, 'text/x-gcode');
+}
+
+// The verification of a capability whose model has no part (predict, engagement), in `container`:
+// with `cutStock` (the form's answer, whose request `body` the page holds) the program it cut and
+// the stock it cut in 3-D, coloured by what was cut, with playback (`POST /api/v1/{name}/stock`);
+// without (a job's answer), the findings only, `why` saying why. `send(body)` is what is posted.
+// Resolves to the CutStock, or null.
+export async function partlessPanel(container, { name, verification, body, send = (request) => request, cutStock, why }) {
+  const panel = { id: name, verification, why, label: 'Cut stock coloured by what the program cut' };
+  if (!cutStock || !body) return verificationPanel(container, panel);
+  let program;
+  try {
+    program = await verifiedProgram(name, send(body));
+  } catch (problem) {
+    return verificationPanel(container, { ...panel, why: `its program cannot be written again: ${problem.detail ?? problem.title ?? problem}` });
+  }
+  return verificationPanel(container, { ...panel, program, path: `/api/v1/${name}/stock`, body, send, resolution: verification.resolution });
 }

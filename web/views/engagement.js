@@ -10,7 +10,7 @@ import { api } from '/api.js';
 import { PathChart, barChart } from '/plot/charts.js';
 import { ToolPlan } from '/plot/tool-plan.js';
 import { examplePoints } from '/units.js';
-import { verificationPanel } from '/plot/cut-stock.js';
+import { partlessPanel } from '/plot/cut-stock.js';
 import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, message, number, numeric, POST_OPTIONS, programName, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
@@ -622,8 +622,9 @@ function renderColumn(column, result, answer, axis) {
 
 // Shows an engagement answer in `container`: one candidate path at a time, chosen with tabs that
 // name each path's best flute count; the charts take the width of the result column.
-// `onSelect(index)` hears which candidate is shown (the form's G-code choice follows it).
-export function engagementResult(container, answer, { onSelect } = {}) {
+// `onSelect(index)` hears which candidate is shown (the form's G-code choice follows it); with
+// `cutStock` (the form's answer) the stock its `request`'s program cuts is drawn in 3-D.
+export function engagementResult(container, answer, { onSelect, request, cutStock = false } = {}) {
   container.replaceChildren();
   const candidates = answer.candidates || [answer];
   const controls = document.createElement('div');
@@ -640,10 +641,12 @@ export function engagementResult(container, answer, { onSelect } = {}) {
   columns.className = 'candidates';
   container.append(controls, columns);
   if (answer.verification) {
-    verificationPanel(container, {
-      id: 'engagement',
+    partlessPanel(container, {
+      name: 'engagement',
       verification: answer.verification,
-      why: 'engagement gives no finished shape to colour the stock against; the findings are listed with their lines',
+      body: request,
+      cutStock,
+      why: 'a job\'s program is cut again only in the Engagement view',
     });
   }
   const id = `candidate-${Math.random().toString(36).slice(2, 8)}`;
@@ -748,8 +751,8 @@ export const engagementView = {
         return engagementRequest(form);
       },
       ask: (body) => api('POST', '/api/v1/engagement', body),
-      show: (answer) => {
-        engagementResult(result, answer, { onSelect: (i) => { form.elements.candidate.value = String(i); } });
+      show: (answer, body) => {
+        engagementResult(result, answer, { onSelect: (i) => { form.elements.candidate.value = String(i); }, request: body, cutStock: true });
         result.dataset.state = 'drawn';
       },
     });

@@ -95,7 +95,7 @@ macro_rules! endpoint {
                 operation_id = format!("{}_stock", <$capability as Capability>::NAME),
                 tag = <$capability as Capability>::NAME,
                 summary = "The stock as the request's own verification cuts its program, as binary glTF",
-                description = "The program the answer writes (default output options, Fanuc) cut on the capability's own model (the model of the answer's `verification`, docs/spec/verify.md §9), as binary glTF (`model/gltf-binary`) coloured by deviation from the model's part, with that cut's `verification` in its `extras.verification`; `upto_line` cuts only the moves up to a line (playback). In mm whatever the request's units. A request without a model (verification off, a `bore_block`, segment and resegment) is refused naming `verification`.",
+                description = "The program the answer writes (default output options, Fanuc) cut on the capability's own model (the model of the answer's `verification`, docs/spec/verify.md §9), as binary glTF (`model/gltf-binary`) coloured by deviation from the model's part (a model without a part, engagement's: by what the program cut, `extras.colouring` `cut`), with that cut's `verification` in its `extras.verification`; `upto_line` cuts only the moves up to a line (playback). In mm whatever the request's units. A request without a model (verification off, a `bore_block`, segment and resegment) is refused naming `verification`.",
                 params(StockParams),
                 request_body = $request,
                 responses(
@@ -202,7 +202,7 @@ macro_rules! endpoint {
                 operation_id = format!("{}_stock", <$capability as Capability>::NAME),
                 tag = <$capability as Capability>::NAME,
                 summary = "The stock as the request's own verification cuts its program, as binary glTF",
-                description = "The program the answer writes (default output options, Fanuc) cut on the capability's own model (the model of the answer's `verification`, docs/spec/verify.md §9), as binary glTF (`model/gltf-binary`) coloured by deviation from the model's part, with that cut's `verification` in its `extras.verification`; `upto_line` cuts only the moves up to a line (playback). In mm whatever the request's units. A request without a model (verification off, a `bore_block`, segment and resegment) is refused naming `verification`.",
+                description = "The program the answer writes (default output options, Fanuc) cut on the capability's own model (the model of the answer's `verification`, docs/spec/verify.md §9), as binary glTF (`model/gltf-binary`) coloured by deviation from the model's part (a model without a part, engagement's: by what the program cut, `extras.colouring` `cut`), with that cut's `verification` in its `extras.verification`; `upto_line` cuts only the moves up to a line (playback). In mm whatever the request's units. A request without a model (verification off, a `bore_block`, segment and resegment) is refused naming `verification`.",
                 params(StockParams),
                 request_body(description = "The request as JSON, or a form with it in part `request` and the DXF file its `drawing` reads in part `drawing`.",
                     content(($request = "application/json"), (DrawingForm = "multipart/form-data"))),

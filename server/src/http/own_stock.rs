@@ -1,6 +1,6 @@
 //! `POST /api/v1/{name}/stock` (docs/spec/verify.md §9.4): the stock as a capability's own
 //! verification cuts the program it writes, as binary glTF coloured by deviation from the
-//! capability's part, up to a line for playback. The same request as the capability's endpoint;
+//! capability's part (without one, by what the program cut), up to a line for playback. The same request as the capability's endpoint;
 //! the mesh is built on the blocking pool within the answer budget, as verify's (`verify_mesh`).
 
 use axum::body::Bytes;

@@ -1,12 +1,13 @@
 //! `POST /api/v1/predict` (docs/spec/api.md, Error prediction): machining-error prediction and path
 //! correction for ball-end-mill finishing, as JSON; `POST /api/v1/predict/program` answers the
-//! corrected G-code program.
+//! corrected G-code program, `POST /api/v1/predict/stock` the stock as its verification cuts it.
 //!
 //! The request is JSON, or `multipart/form-data` with the JSON in part `request` and the stock's
 //! STL file (binary or ASCII) in part `stock` when `"stock": {"kind": "mesh"}`. This route has
 //! its own body limit (`Limits::max_upload_bytes`, 128 MiB by default) instead of the service's
 //! default one.
 
+use axum::body::Bytes;
 use axum::extract::{DefaultBodyLimit, Request, State};
 use axum::http::{HeaderMap, header};
 use axum::response::Response;
@@ -19,7 +20,9 @@ use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
 use super::output::{Ask, Format, wants_gcode};
+use super::own_stock::{self, StockQuery};
 use super::upload;
+use super::verify_mesh::GlbFile;
 use crate::error::{AppResult, Problem};
 use crate::extract::{AppQuery, charged_body_bytes, is_json, media_type};
 use crate::state::AppState;
@@ -141,8 +144,41 @@ async fn post_predict_program(
     predict(&state, request, ask).await
 }
 
+/// The stock as the request's verification cuts the corrected program, as binary glTF.
+#[utoipa::path(post, path = "/api/v1/predict/stock", tag = "predict", operation_id = "predict_stock",
+    summary = "The stock as the request's own verification cuts its corrected program, as binary glTF",
+    description = "The corrected program (the one the answer writes with the default output options, Fanuc) cut on the given stock (the model of the answer's `verification`, docs/spec/verify.md §9), as binary glTF (`model/gltf-binary`) coloured by what the program cut (the request gives no part: `extras.colouring` is `cut`), with that cut's `verification` in its `extras.verification`; `upto_line` cuts only the moves up to a line (playback). In mm whatever the request's units. A request with verification off is refused naming `verification`.",
+    params(StockQuery),
+    request_body(description = "The request as JSON, or a form with it in part `request` and the STL stock in part `stock`.",
+        content(
+            (PredictRequest = "application/json"),
+            (PredictForm = "multipart/form-data"))),
+    responses(
+        (status = 200, description = "The cut stock", body = GlbFile, content_type = "model/gltf-binary"),
+        (status = 400, description = "Not the right shape (JSON or form)", body = Problem, content_type = "application/problem+json"),
+        (status = 404, description = <PredictCapability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
+        (status = 408, description = "The body arrived slower than the minimum receive rate", body = Problem, content_type = "application/problem+json"),
+        (status = 413, description = "Body over the upload limit", body = Problem, content_type = "application/problem+json"),
+        (status = 415, body = Problem, content_type = "application/problem+json"),
+        (status = 422, description = <PredictCapability as Capability>::ENDPOINT.refused, body = Problem, content_type = "application/problem+json"),
+        (status = 429, description = "All solver slots busy, or uploads and answers in progress hold the memory budget", body = Problem, content_type = "application/problem+json")))]
+async fn post_predict_stock(
+    State(state): State<AppState>,
+    AppQuery(query): AppQuery<StockQuery>,
+    request: Request,
+) -> AppResult<Response> {
+    let (request, mesh) = read(&state, request).await?;
+    own_stock::answer::<PredictCapability>(&state, request, mesh, query.upto_line).await
+}
+
 /// Reads the JSON or form `request` and answers it as `ask` says.
 async fn predict(state: &AppState, request: Request, ask: Ask) -> AppResult<Response> {
+    let (request, mesh) = read(state, request).await?;
+    super::solve::answer::<PredictCapability>(state, request, mesh, ask).await
+}
+
+/// Reads the JSON or form `request`: the request and the STL file of its stock, if sent.
+async fn read(state: &AppState, request: Request) -> AppResult<(PredictRequest, Option<Bytes>)> {
     let json = is_json(request.headers());
     if !json && media_type(request.headers()).as_deref() != Some("multipart/form-data") {
         return Err(upload::unsupported(&["stock"]));
@@ -155,8 +191,7 @@ async fn predict(state: &AppState, request: Request, ask: Ask) -> AppResult<Resp
     let upload::Upload { request, mut files } =
         state.solve(move |_| upload::read::<PredictRequest>(json, content_type, body, &["stock"])).await??;
     drop(upload_share);
-    let mesh = files.pop().flatten();
-    super::solve::answer::<PredictCapability>(state, request, mesh, ask).await
+    Ok((request, files.pop().flatten()))
 }
 
 /// Routes of this module; the upload limit replaces the default body limit here.
@@ -164,5 +199,6 @@ pub fn router() -> OpenApiRouter<AppState> {
     OpenApiRouter::new()
         .routes(routes!(post_predict))
         .routes(routes!(post_predict_program))
+        .routes(routes!(post_predict_stock))
         .layer(DefaultBodyLimit::disable())
 }

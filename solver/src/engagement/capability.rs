@@ -202,6 +202,23 @@ impl Capability for EngagementCapability {
         verified(request, grid, answer, run)
     }
 
+    /// The plan-view stock extruded less what the candidate's program (with its verification's
+    /// header comments) cut, up to `upto_line`, coloured by what it cut (there is no part).
+    fn cut_stock(
+        request: &EngagementRequest,
+        context: Resolved<Tool>,
+        upto_line: Option<usize>,
+        run: &Run<'_>,
+    ) -> Result<Option<Vec<u8>>, SolverError> {
+        let grid = verification_grid(request, &context.tool)?;
+        let answer = Self::solve(request, context, run)?;
+        let Some((model, grid)) = own_model(request, grid, &answer)? else {
+            return Ok(None);
+        };
+        let program = own_program(request, &answer, run)?;
+        own::cut_stock_glb(&model, grid, &program, &[(None, &answer.tool)], own_limits(), upto_line, run).map(Some)
+    }
+
     /// The program of one path: `output.candidate`, else the request's `candidate`, else 0.
     fn program(
         request: &EngagementRequest,
@@ -338,25 +355,24 @@ fn verification_grid(request: &EngagementRequest, tool: &Tool) -> Result<Option<
     Ok(Some((extent, own::grid(extent, tool, &options)?)))
 }
 
-/// `answer` with the program of the request's candidate cut on the plan-view stock extruded
-/// from 1 mm under the cut up to `stock_top_z` (earlier cuts removed): its `verification`, and
-/// the warnings and program header comments of what that found, on that candidate.
-fn verified(
+/// The model the program of the request's candidate is cut on: the plan-view stock extruded
+/// from 1 mm under the cut up to `stock_top_z` (earlier cuts removed), and its grid; `None`
+/// without a verification or a program.
+fn own_model(
     request: &EngagementRequest,
     grid: Option<StockGrid>,
-    mut answer: EngagementAnswer,
-    run: &Run<'_>,
-) -> Result<EngagementAnswer, SolverError> {
+    answer: &EngagementAnswer,
+) -> Result<Option<(Extrusion, own::Grid)>, SolverError> {
     let Some(((lo, hi), grid)) = grid else {
-        return Ok(answer);
+        return Ok(None);
     };
     let index = request.candidate.unwrap_or(0);
     let Some(post) = answer.result.candidates().get(index).map(|candidate| &candidate.post) else {
-        return Ok(answer);
+        return Ok(None);
     };
     if post.axial_depth.is_none() {
         // No a_p: no program.
-        return Ok(answer);
+        return Ok(None);
     }
     let top = post.stock_top_z;
     let context = Resolved {
@@ -379,11 +395,35 @@ fn verified(
             if earlier > 0 { format!(" less its {earlier} earlier cut(s)") } else { String::new() }
         ),
     };
+    Ok(Some((model, grid)))
+}
+
+/// The program a verification cuts: the candidate's, with the default output options (Fanuc).
+fn own_program(request: &EngagementRequest, answer: &EngagementAnswer, run: &Run<'_>) -> Result<String, SolverError> {
     let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
-    let program = crate::capability::program::<EngagementCapability>(request, &answer, &output, run.control)?;
-    let limits =
-        own::Limits { tolerance: own::OWN_TOLERANCE, allowance: crate::verify::DEFAULT_ALLOWANCE, wall_tolerance: 0.0 };
-    let mut verification = own::verify(&model, grid, &program, &answer.tool, limits, run)?;
+    crate::capability::program::<EngagementCapability>(request, answer, &output, run.control)
+}
+
+/// The verification's limits: the defaults, there being no part to set them by.
+fn own_limits() -> own::Limits {
+    own::Limits { tolerance: own::OWN_TOLERANCE, allowance: crate::verify::DEFAULT_ALLOWANCE, wall_tolerance: 0.0 }
+}
+
+/// `answer` with the program of the request's candidate cut on its model ([`own_model`]): its
+/// `verification`, and the warnings and program header comments of what that found, on that
+/// candidate.
+fn verified(
+    request: &EngagementRequest,
+    grid: Option<StockGrid>,
+    mut answer: EngagementAnswer,
+    run: &Run<'_>,
+) -> Result<EngagementAnswer, SolverError> {
+    let Some((model, grid)) = own_model(request, grid, &answer)? else {
+        return Ok(answer);
+    };
+    let index = request.candidate.unwrap_or(0);
+    let program = own_program(request, &answer, run)?;
+    let mut verification = own::verify(&model, grid, &program, &answer.tool, own_limits(), run)?;
     let candidate = match &mut answer.result {
         EngagementSolution::Single(result) => result.as_mut(),
         EngagementSolution::Comparison(comparison) => &mut comparison.candidates[index],

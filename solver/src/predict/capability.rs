@@ -192,6 +192,24 @@ impl Capability for PredictCapability {
         verified(request, model, PredictAnswer { tool: context.tool, result, timings: None, verification: None }, run)
     }
 
+    /// The given stock less what the corrected program (with its verification's header comments)
+    /// cut, up to `upto_line`, coloured by what it cut (there is no part).
+    fn cut_stock(
+        request: &PredictRequest,
+        context: Resolved<Tool>,
+        upto_line: Option<usize>,
+        run: &Run<'_>,
+    ) -> Result<Option<Vec<u8>>, SolverError> {
+        check_upload(request, run)?;
+        let model = own_model(request, &context.tool, run.upload)?;
+        let answer = Self::solve(request, context, run)?;
+        let Some((model, grid)) = model else {
+            return Ok(None);
+        };
+        let program = own_program(request, &answer, run)?;
+        own::cut_stock_glb(&model, grid, &program, &[(None, &answer.tool)], own_limits(), upto_line, run).map(Some)
+    }
+
     /// A G-code path is the input program with only the coordinates of moved end points changed
     /// (same lines, comments and modal words; the dialect does not apply); a `points` path becomes
     /// a complete program written for `output.reference` (the request's when not given).
@@ -301,6 +319,17 @@ fn own_model(
     Ok(Some((model, grid)))
 }
 
+/// The program a verification cuts: the corrected one, with the default output options (Fanuc).
+fn own_program(request: &PredictRequest, answer: &PredictAnswer, run: &Run<'_>) -> Result<String, SolverError> {
+    let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
+    crate::capability::program::<PredictCapability>(request, answer, &output, run.control)
+}
+
+/// The verification's limits: the defaults, there being no part to set them by.
+fn own_limits() -> own::Limits {
+    own::Limits { tolerance: own::OWN_TOLERANCE, allowance: crate::verify::DEFAULT_ALLOWANCE, wall_tolerance: 0.0 }
+}
+
 /// `answer` with the program it writes cut on the given stock: its `verification`, and the
 /// warnings and program header comments of what that found.
 fn verified(
@@ -312,11 +341,8 @@ fn verified(
     let Some((model, grid)) = model else {
         return Ok(answer);
     };
-    let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
-    let program = crate::capability::program::<PredictCapability>(request, &answer, &output, run.control)?;
-    let limits =
-        own::Limits { tolerance: own::OWN_TOLERANCE, allowance: crate::verify::DEFAULT_ALLOWANCE, wall_tolerance: 0.0 };
-    let mut verification = own::verify(&model, grid, &program, &answer.tool, limits, run)?;
+    let program = own_program(request, &answer, run)?;
+    let mut verification = own::verify(&model, grid, &program, &answer.tool, own_limits(), run)?;
     // The header lines are written from the verification by `program`.
     own::report(&mut verification, &mut answer.result.warnings, &mut Vec::new());
     answer.verification = Some(verification);

@@ -1,7 +1,8 @@
 //! The cut stock as a triangle mesh in binary glTF (docs/spec/verify.md §8 Mesh): every material
 //! interval of every dexel ray as a column of its cell, the faces two neighbouring columns share
-//! left out, coplanar neighbours of equal deviation merged into one quad; each vertex coloured by
-//! the signed deviation from the part along the ray and carrying it as `_DEVIATION`.
+//! left out, coplanar neighbours of equal shade merged into one quad; each vertex coloured by the
+//! signed deviation from the part along the ray and carrying it as `_DEVIATION`, or without a part
+//! by whether the program cut its face.
 
 use serde_json::{Value, json};
 
@@ -25,9 +26,13 @@ pub const GLB_MEDIA_TYPE: &str = "model/gltf-binary";
 pub const GOUGE_COLOUR: [u8; 4] = [171, 5, 5, 255];
 /// Colour of a surface with material left thicker than the allowance: blue, sRGB #1f77b4.
 pub const LEFT_COLOUR: [u8; 4] = [3, 47, 116, 255];
-/// Colour of a surface within tolerance and allowance, and of every surface without a part:
-/// grey, sRGB #b0b0b0.
+/// Colour of a surface within tolerance and allowance, and without a part of the stock's surface
+/// as given: grey, sRGB #b0b0b0.
 pub const NEUTRAL_COLOUR: [u8; 4] = [111, 111, 111, 255];
+/// Colour of a surface the program cut, without a part: green, sRGB #2ca02c.
+pub const CUT_COLOUR: [u8; 4] = [6, 90, 6, 255];
+/// `extras.colouring` of a mesh without a part: its colours say what the program cut.
+const CUT_COLOURING: &str = "cut";
 
 /// Quads one interval of one ray may need before merging, for the bound checked before cutting:
 /// its top, its bottom and a wall to each of two neighbours (the other two walls are counted by
@@ -50,40 +55,68 @@ struct Mesh {
     indices: Vec<u32>,
 }
 
-/// How deviations are coloured and whether there is a part to deviate from.
+/// What the faces of the cut stock are coloured against, on the stock's grid.
 #[derive(Debug, Clone, Copy)]
-struct Shading {
-    part: bool,
-    tolerance: f64,
-    allowance: f64,
+pub(crate) enum Against<'a> {
+    /// The part: each interval's signed deviation from it (§8 Deviation), a face's shade, carried
+    /// as `_DEVIATION`.
+    Part { part: &'a Field, tolerance: f64, allowance: f64 },
+    /// The stock as given, when there is no part: a face's shade is 1 where the program cut it
+    /// (the given stock had material beyond it), else 0; no `_DEVIATION`.
+    Given(&'a Field),
 }
 
-impl Shading {
-    fn colour(&self, deviation: f64) -> [u8; 4] {
-        if !self.part {
-            NEUTRAL_COLOUR
-        } else if deviation < -self.tolerance {
-            GOUGE_COLOUR
-        } else if deviation > self.allowance {
-            LEFT_COLOUR
-        } else {
-            NEUTRAL_COLOUR
+impl Against<'_> {
+    fn part(&self) -> bool {
+        matches!(self, Self::Part { .. })
+    }
+
+    fn colour(&self, shade: f64) -> [u8; 4] {
+        match *self {
+            Self::Part { tolerance, .. } if shade < -tolerance => GOUGE_COLOUR,
+            Self::Part { allowance, .. } if shade > allowance => LEFT_COLOUR,
+            Self::Given(_) if shade > 0.0 => CUT_COLOUR,
+            _ => NEUTRAL_COLOUR,
         }
     }
 }
 
+/// Adds `colouring: "cut"` to the `extras` of a mesh without a part (an object, as every caller
+/// builds it).
+fn say_colouring(extras: &mut Value, against: &Against<'_>) {
+    if let (Value::Object(fields), Against::Given(_)) = (extras, against) {
+        fields.insert("colouring".to_owned(), Value::from(CUT_COLOURING));
+    }
+}
+
+/// Whether the given stock `given` (one ray) had material just above `top`: the program cut the
+/// top face there.
+fn cut_above(top: f64, given: &[Interval]) -> bool {
+    given.iter().any(|&[c, d]| c <= top && top < d)
+}
+
+/// Whether the given stock `given` (one ray) had material just below `bottom`.
+fn cut_below(bottom: f64, given: &[Interval]) -> bool {
+    given.iter().any(|&[c, d]| c < bottom && bottom <= d)
+}
+
+/// The shade of a face without a part: 1 cut, 0 as given.
+fn shade_of(cut: bool) -> f64 {
+    if cut { 1.0 } else { 0.0 }
+}
+
 impl Mesh {
     /// A quad with its corners counter-clockwise seen from outside (along `normal`).
-    fn quad(&mut self, corners: [[f64; 3]; 4], normal: [f32; 3], deviation: f64, shading: &Shading) {
+    fn quad(&mut self, corners: [[f64; 3]; 4], normal: [f32; 3], shade: f64, against: &Against<'_>) {
         // A mesh too large for u32 indices is refused by the byte budget long before.
         let first = self.positions.len() as u32;
-        let colour = shading.colour(deviation);
+        let colour = against.colour(shade);
         for corner in corners {
             self.positions.push(corner.map(|v| v as f32));
             self.normals.push(normal);
             self.colours.push(colour);
-            if shading.part {
-                self.deviations.push(deviation as f32);
+            if against.part() {
+                self.deviations.push(shade as f32);
             }
         }
         self.indices.extend([first, first + 1, first + 2, first, first + 2, first + 3]);
@@ -121,15 +154,16 @@ struct Strip {
     last: usize,
     low: f64,
     high: f64,
-    deviation: f64,
+    /// The faces' shade ([`Against`]).
+    shade: f64,
     facing: bool,
 }
 
 impl Strip {
-    fn same(&self, low: f64, high: f64, deviation: f64, facing: bool) -> bool {
+    fn same(&self, low: f64, high: f64, shade: f64, facing: bool) -> bool {
         self.low.to_bits() == low.to_bits()
             && self.high.to_bits() == high.to_bits()
-            && self.deviation.to_bits() == deviation.to_bits()
+            && self.shade.to_bits() == shade.to_bits()
             && self.facing == facing
     }
 }
@@ -143,12 +177,11 @@ struct Strips {
 }
 
 impl Strips {
-    fn add(&mut self, at: usize, low: f64, high: f64, deviation: f64, facing: bool) {
-        if let Some(run) = self.open.iter_mut().find(|run| run.last + 1 == at && run.same(low, high, deviation, facing))
-        {
+    fn add(&mut self, at: usize, low: f64, high: f64, shade: f64, facing: bool) {
+        if let Some(run) = self.open.iter_mut().find(|run| run.last + 1 == at && run.same(low, high, shade, facing)) {
             run.last = at;
         } else {
-            self.open.push(Strip { first: at, last: at, low, high, deviation, facing });
+            self.open.push(Strip { first: at, last: at, low, high, shade, facing });
         }
     }
 
@@ -165,11 +198,10 @@ impl Strips {
     }
 }
 
-/// The surface of `stock` (deviations from `part` when given).
+/// The surface of `stock`, its faces shaded against the part or the stock as given.
 struct Surface<'a> {
     stock: &'a Field,
-    part: Option<&'a Field>,
-    shading: Shading,
+    against: Against<'a>,
     mesh: Mesh,
 }
 
@@ -178,8 +210,19 @@ impl Surface<'_> {
         &self.stock.rays[self.stock.index(i, j)]
     }
 
-    fn deviation(&self, i: usize, j: usize, piece: Interval) -> f64 {
-        self.part.map_or(0.0, |part| deviation(piece, &part.rays[part.index(i, j)]))
+    /// The ray of the part or the given stock at cell `(i, j)`.
+    fn reference(&self, i: usize, j: usize) -> &[Interval] {
+        let (Against::Part { part: field, .. } | Against::Given(field)) = self.against;
+        &field.rays[field.index(i, j)]
+    }
+
+    /// The shades of the top and the bottom face of `piece` of ray `(i, j)`.
+    fn ends(&self, i: usize, j: usize, piece: Interval) -> [f64; 2] {
+        let reference = self.reference(i, j);
+        match self.against {
+            Against::Part { .. } => [deviation(piece, reference); 2],
+            Against::Given(_) => [shade_of(cut_above(piece[1], reference)), shade_of(cut_below(piece[0], reference))],
+        }
     }
 
     /// The tops and bottoms of row `j`, merged along x.
@@ -188,9 +231,9 @@ impl Surface<'_> {
         let mut runs = Strips::default();
         for i in 0..grid.nx {
             for &piece in self.ray(i, j) {
-                let deviation = self.deviation(i, j, piece);
-                runs.add(i, piece[1], piece[1], deviation, true);
-                runs.add(i, piece[0], piece[0], deviation, false);
+                let [top, bottom] = self.ends(i, j, piece);
+                runs.add(i, piece[1], piece[1], top, true);
+                runs.add(i, piece[0], piece[0], bottom, false);
             }
             runs.close_before(i);
         }
@@ -202,9 +245,9 @@ impl Surface<'_> {
             let z = run.low;
             let [a, b, c, d] = [[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]];
             if run.facing {
-                self.mesh.quad([a, b, c, d], [0.0, 0.0, 1.0], run.deviation, &self.shading);
+                self.mesh.quad([a, b, c, d], [0.0, 0.0, 1.0], run.shade, &self.against);
             } else {
-                self.mesh.quad([a, d, c, b], [0.0, 0.0, -1.0], run.deviation, &self.shading);
+                self.mesh.quad([a, d, c, b], [0.0, 0.0, -1.0], run.shade, &self.against);
             }
         }
     }
@@ -216,7 +259,7 @@ impl Surface<'_> {
         let (count, along) = if across_x { (grid.nx, grid.ny) } else { (grid.ny, grid.nx) };
         let cell = |k: usize, at: usize| if across_x { (k, at) } else { (at, k) };
         let mut runs = Strips::default();
-        let mut pieces = Vec::new();
+        let (mut pieces, mut kept, mut cut) = (Vec::new(), Vec::new(), Vec::new());
         for at in 0..along {
             let before = wall.checked_sub(1).map(|k| cell(k, at));
             let after = (wall < count).then(|| cell(wall, at));
@@ -229,9 +272,26 @@ impl Surface<'_> {
                     if pieces.is_empty() {
                         continue;
                     }
-                    let deviation = self.deviation(i, j, piece);
-                    for &[low, high] in &pieces {
-                        runs.add(at, low, high, deviation, facing);
+                    match self.against {
+                        Against::Part { .. } => {
+                            let deviation = deviation(piece, self.reference(i, j));
+                            for &[low, high] in &pieces {
+                                runs.add(at, low, high, deviation, facing);
+                            }
+                        }
+                        Against::Given(_) => {
+                            // A wall is cut where the neighbour's given stock stood against it.
+                            let given = to.map_or(&[][..], |(i, j)| self.reference(i, j));
+                            kept.clear();
+                            cut.clear();
+                            dexel::outside(&pieces, given, 0.0, &mut kept);
+                            dexel::outside(&pieces, &kept, 0.0, &mut cut);
+                            for (shaded, shade) in [(&kept, 0.0), (&cut, 1.0)] {
+                                for &[low, high] in shaded {
+                                    runs.add(at, low, high, shade, facing);
+                                }
+                            }
+                        }
                     }
                 }
             }
@@ -247,16 +307,16 @@ impl Surface<'_> {
             if across_x {
                 let [a, b, c, d] = [[position, s0, lo], [position, s1, lo], [position, s1, hi], [position, s0, hi]];
                 if run.facing {
-                    self.mesh.quad([a, b, c, d], [1.0, 0.0, 0.0], run.deviation, &self.shading);
+                    self.mesh.quad([a, b, c, d], [1.0, 0.0, 0.0], run.shade, &self.against);
                 } else {
-                    self.mesh.quad([a, d, c, b], [-1.0, 0.0, 0.0], run.deviation, &self.shading);
+                    self.mesh.quad([a, d, c, b], [-1.0, 0.0, 0.0], run.shade, &self.against);
                 }
             } else {
                 let [a, b, c, d] = [[s0, position, lo], [s0, position, hi], [s1, position, hi], [s1, position, lo]];
                 if run.facing {
-                    self.mesh.quad([a, b, c, d], [0.0, 1.0, 0.0], run.deviation, &self.shading);
+                    self.mesh.quad([a, b, c, d], [0.0, 1.0, 0.0], run.shade, &self.against);
                 } else {
-                    self.mesh.quad([a, d, c, b], [0.0, -1.0, 0.0], run.deviation, &self.shading);
+                    self.mesh.quad([a, d, c, b], [0.0, -1.0, 0.0], run.shade, &self.against);
                 }
             }
         }
@@ -264,11 +324,11 @@ impl Surface<'_> {
 }
 
 /// The surface of `stock` as a mesh, charged to `run`'s budget line by line.
-fn surface(stock: &Field, part: Option<&Field>, shading: Shading, run: &Run<'_>) -> Result<Mesh, SolverError> {
+fn surface(stock: &Field, against: Against<'_>, run: &Run<'_>) -> Result<Mesh, SolverError> {
     let grid = stock.grid;
-    let mut surface = Surface { stock, part, shading, mesh: Mesh::default() };
+    let mut surface = Surface { stock, against, mesh: Mesh::default() };
     let lines = grid.ny + (grid.nx + 1) + (grid.ny + 1);
-    let quad = quad_bytes(shading.part);
+    let quad = quad_bytes(against.part());
     let mut charged = 0;
     let mut charge = |surface: &Surface<'_>, done: usize| -> Result<(), SolverError> {
         let quads = surface.mesh.quads();
@@ -409,8 +469,9 @@ fn glb(mesh: &Mesh, extras: Value) -> Vec<u8> {
 
 /// Cuts `request`'s program (in mm) with its resolved `tools` (moves on lines after `upto_line`
 /// left out) and answers the stock as the program left it as GLB in `units` (positions and
-/// `_DEVIATION`), the JSON answer in `units` in the glTF's `extras.verify`. With `upto_line`, a program that has not reached the stock by then answers
-/// the stock as given, without `extras.verify`.
+/// `_DEVIATION`), the JSON answer in `units` in the glTF's `extras.verify`; without a part,
+/// coloured by what the program cut (`extras.colouring`). With `upto_line`, a program that has not
+/// reached the stock by then answers the stock as given, without `extras.verify`.
 ///
 /// # Errors
 /// As the JSON answer; `E_TOO_LARGE_ANSWER` at `resolution` when the mesh's bound, checked
@@ -434,8 +495,7 @@ pub fn cut_stock_glb(
     if let Some(last) = upto_line {
         job.program.moves.retain(|read| read.line <= last);
     }
-    let shading = Shading { part: job.part.is_some(), tolerance: job.tolerance, allowance: job.allowance };
-    let (extras, stock) = match simulate::cut_stock(&job, run) {
+    let (mut extras, stock) = match simulate::cut_stock(&job, run) {
         Ok((cut, stock)) => {
             let mut answer = VerifyAnswer { tools, cut };
             if let Some(scaling) = units.from_mm() {
@@ -452,8 +512,15 @@ pub fn cut_stock_glb(
         Err(error) if upto_line.is_some() && error.code() == ErrorCode::Stock => (json!({}), job.stock.field(job.grid)),
         Err(error) => return Err(error),
     };
-    let part = job.part.as_ref().map(|part| part.field(job.grid));
-    let mut mesh = surface(&stock, part.as_ref(), shading, run)?;
+    // Against the part, or without one the stock as given.
+    let reference = job.part.as_ref().unwrap_or(&job.stock).field(job.grid);
+    let against = if job.part.is_some() {
+        Against::Part { part: &reference, tolerance: job.tolerance, allowance: job.allowance }
+    } else {
+        Against::Given(&reference)
+    };
+    say_colouring(&mut extras, &against);
+    let mut mesh = surface(&stock, against, run)?;
     run.control.check()?;
     if let Some(scaling) = units.from_mm() {
         // Positions and deviations in the request's units (the colours were chosen in mm).
@@ -467,20 +534,20 @@ pub fn cut_stock_glb(
     Ok(glb(&mesh, extras))
 }
 
-/// `stock` as a capability's own verification left it (docs/spec/verify.md §9.4), compared with
-/// `part` on the same grid, as GLB with `extras` (the caller checks the bound, [`mesh_bound`],
-/// before cutting).
+/// `stock` as a capability's own verification left it (docs/spec/verify.md §9.4), coloured
+/// `against` the part or the stock as modelled on the same grid, as GLB with `extras` (with
+/// `colouring` added without a part; the caller checks the bound, [`mesh_bound`], before cutting).
 ///
 /// # Errors
 /// `E_TOO_LARGE_ANSWER` at `verification.resolution` over the run's answer budget.
 pub(crate) fn fields_glb(
     stock: &Field,
-    part: &Field,
-    [tolerance, allowance]: [f64; 2],
-    extras: Value,
+    against: Against<'_>,
+    mut extras: Value,
     run: &Run<'_>,
 ) -> Result<Vec<u8>, SolverError> {
-    let mesh = surface(stock, Some(part), Shading { part: true, tolerance, allowance }, run).map_err(|error| {
+    say_colouring(&mut extras, &against);
+    let mesh = surface(stock, against, run).map_err(|error| {
         if error.field() == Some("resolution") { error.at("verification.resolution") } else { error }
     })?;
     run.control.check()?;
@@ -638,6 +705,48 @@ mod tests {
         assert_eq!(error.code(), ErrorCode::TooLargeAnswer);
         assert_eq!(error.field(), Some("resolution"));
         assert_eq!(budget.used(), 0, "refused before anything was built");
+    }
+
+    #[test]
+    fn without_a_part_the_faces_the_program_cut_are_green() {
+        let mut body = slot();
+        body.as_object_mut().unwrap().remove("part");
+        let (json, bin) = read(&glb_of(body.clone(), None));
+        assert_eq!(json["extras"]["colouring"], "cut");
+        let attributes = &json["meshes"][0]["primitives"][0]["attributes"];
+        assert!(attributes.get("_DEVIATION").is_none(), "{attributes}");
+        let positions = floats(&json, &bin, attributes["POSITION"].as_u64().unwrap() as usize);
+        let normals = floats(&json, &bin, attributes["NORMAL"].as_u64().unwrap() as usize);
+        let view = &json["bufferViews"]
+            [json["accessors"][attributes["COLOR_0"].as_u64().unwrap() as usize]["bufferView"].as_u64().unwrap()
+                as usize];
+        let colours = &bin[view["byteOffset"].as_u64().unwrap() as usize..];
+        let (mut floor, mut walls) = (0, 0);
+        for k in 0..positions.len() / 3 {
+            let (x, y, z) = (positions[3 * k], positions[3 * k + 1], positions[3 * k + 2]);
+            let colour = &colours[4 * k..4 * k + 4];
+            let normal = &normals[3 * k..3 * k + 3];
+            if normal[2] == 1.0 && z == -2.0 {
+                floor += 1;
+                assert_eq!(colour, CUT_COLOUR, "the slot's floor at {x} {y}");
+            } else if normal[2] == 1.0 && z == 0.0 {
+                assert_eq!(colour, NEUTRAL_COLOUR, "the block's top at {x} {y}");
+            } else if (normal[1].abs() == 1.0 && y.abs() == 20.0) || normal[2] == -1.0 {
+                assert_eq!(colour, NEUTRAL_COLOUR, "the block's outer wall or bottom at {x} {y} {z}");
+            } else if normal[1].abs() == 1.0 && z > -2.0 && y.abs() < 6.0 {
+                walls += 1;
+                assert_eq!(colour, CUT_COLOUR, "the slot's wall at {x} {y} {z}");
+            }
+        }
+        assert!(floor > 0 && walls > 0, "floor {floor}, walls {walls}");
+        // Before the plunge: the stock as given, all grey, still said to have no part.
+        let (before, bin) = read(&glb_of(body, Some(2)));
+        assert_eq!(before["extras"], json!({"colouring": "cut"}));
+        let view = &before["bufferViews"][before["accessors"][2]["bufferView"].as_u64().unwrap() as usize];
+        assert_eq!(before["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"], 2);
+        let offset = view["byteOffset"].as_u64().unwrap() as usize;
+        let length = view["byteLength"].as_u64().unwrap() as usize;
+        assert!(bin[offset..offset + length].chunks(4).all(|c| c == NEUTRAL_COLOUR));
     }
 
     #[test]

@@ -10,6 +10,7 @@ use super::assembly::Assembly;
 pub(crate) use super::dexel::Grid;
 use super::dexel::{Field, RAY_BYTES, Ray};
 use super::job::{CallableTool, DEFAULT_TOLERANCE, Job, MAX_DEXEL_BYTES};
+use super::mesh::Against;
 use super::simulate::{self, Finding, FindingKind};
 use super::solid::{Axis, SolidModel};
 use crate::capability::{Control, Run};
@@ -294,9 +295,10 @@ fn verification_of(cut: simulate::Cut, model: String, limits: Limits) -> Verific
 }
 
 /// The stock of `model` as `program`'s moves on lines up to `upto_line` (every line: `None`) left
-/// it, as binary glTF coloured by deviation from the model's part (docs/spec/verify.md §9.4), that
-/// cut's `verification` in the glTF's `extras.verification`. A program that has not reached the
-/// stock by then answers the stock as modelled, with `extras` empty.
+/// it, as binary glTF coloured by deviation from the model's part, or for a model without a part
+/// by what the program cut (`extras.colouring`, docs/spec/verify.md §9.4), that cut's
+/// `verification` in the glTF's `extras.verification`. A program that has not reached the stock by
+/// then answers the stock as modelled, without `extras.verification`.
 ///
 /// # Errors
 /// As [`verify_tools`]; `E_TOO_LARGE_ANSWER` at `verification.resolution` when the mesh's bound
@@ -324,22 +326,21 @@ pub(crate) fn cut_stock_glb(
         job.program.moves.retain(|read| read.line <= last);
     }
     let (stock, part) = model.fields(grid, lowest, run.control)?;
-    let Some(compared) = part.clone() else {
-        return Err(SolverError::new(
-            ErrorCode::Input,
-            "this capability's verification has no part to colour the cut stock against",
-        )
-        .at("verification"));
+    // Coloured against the part, or without one against the stock as modelled.
+    let reference = part.clone().unwrap_or_else(|| stock.clone());
+    let against = if part.is_some() {
+        Against::Part { part: &reference, tolerance: limits.tolerance, allowance: limits.allowance }
+    } else {
+        Against::Given(&reference)
     };
-    let shading = [limits.tolerance, limits.allowance];
     match simulate::cut_fields(&job, stock, part, &unbudgeted(run)) {
         Ok((cut, left)) => {
             let extras = serde_json::json!({"verification": verification_of(cut, model.describe(), limits)});
-            super::mesh::fields_glb(&left, &compared, shading, extras, run)
+            super::mesh::fields_glb(&left, against, extras, run)
         }
         Err(error) if error.code() == ErrorCode::Stock => {
             let (stock, _) = model.fields(grid, lowest, run.control)?;
-            super::mesh::fields_glb(&stock, &compared, shading, serde_json::json!({}), run)
+            super::mesh::fields_glb(&stock, against, serde_json::json!({}), run)
         }
         Err(error) => Err(error),
     }

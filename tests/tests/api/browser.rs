@@ -130,10 +130,11 @@ async fn engagement_page_compares_the_sample_paths() {
     assert_eq!(result["charts"], 8, "the charts of the path shown, no more: {result}");
     assert!(result["recommendation"].as_str().unwrap().contains("Recommended flute counts"), "{result}");
     assert_eq!(result["file"], "engagement-1-fanuc.nc");
-    // The answer's verification of its program, listed though no stock is drawn.
+    // The answer's verification of its program, with its stock drawn (`engagementCut`), not
+    // explained away.
     let verification = result["verification"].as_str().unwrap();
     assert!(verification.contains("the program cut on its own model") && verification.contains("mm³"), "{result}");
-    assert!(verification.contains("no finished shape to colour the stock against"), "{result}");
+    assert!(verification.contains("part: none") && !verification.contains("not drawn here"), "{result}");
 }
 
 #[tokio::test(flavor = "multi_thread")]
@@ -195,7 +196,7 @@ async fn predict_page_colours_the_path_by_error() {
     assert_eq!(result["worst"], 20, "{result}");
     let verification = result["verification"].as_str().unwrap();
     assert!(verification.contains("the program cut on its own model") && verification.contains("mm³"), "{result}");
-    assert!(verification.contains("no design surface"), "{result}");
+    assert!(verification.contains("part: none") && !verification.contains("not drawn here"), "{result}");
 }
 
 #[tokio::test(flavor = "multi_thread")]
@@ -445,4 +446,33 @@ async fn contour_page_draws_its_cut_stock() {
     let Some(result) = run_scenario(&app, "contourCut", &[]) else { return };
     assert_eq!(result["ok"], true);
     assert!(result["partly"].as_f64() < result["removed"].as_f64(), "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
+async fn predict_page_draws_the_stock_its_corrected_program_cuts() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "predictCut", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    eprintln!("{result}");
+    assert!(result["partly"].as_f64() < result["removed"].as_f64(), "{result}");
+    assert!(result["partly"].as_f64() > Some(0.0), "playback cut some of the stock: {result}");
+    assert!(result["green"].as_u64() > Some(0) && result["listed"].as_u64() > Some(10), "{result}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
+async fn engagement_page_draws_the_stock_its_program_cuts() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "engagementCut", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    eprintln!("{result}");
+    assert!(result["partly"].as_f64() < result["removed"].as_f64(), "{result}");
+    assert!(result["green"].as_u64() > Some(0), "{result}");
 }
