@@ -79,8 +79,9 @@ pub trait Capability {
     /// The stock as the capability's own verification cuts it (docs/spec/verify.md §9.4): the
     /// program the answer writes with the default output options (Fanuc), its moves on lines up to
     /// `upto_line` (every line: `None`), cut on the capability's model, as binary glTF coloured by
-    /// deviation from the model's part. `None` when the request has no model (verification turned
-    /// off, or a request or capability without one). Default `None`.
+    /// deviation from the model's part, its positions and lengths in `units` (the request's, as its
+    /// answer). `None` when the request has no model (verification turned off, or a request or
+    /// capability without one). Default `None`.
     ///
     /// # Errors
     /// The solve's refusals; `E_TOO_LARGE_ANSWER` at `verification.resolution` for a mesh over the
@@ -89,6 +90,7 @@ pub trait Capability {
         _request: &Self::Request,
         _context: Resolved<Self::Tool>,
         _upto_line: Option<usize>,
+        _units: Units,
         _run: &Run<'_>,
     ) -> Result<Option<Vec<u8>>, SolverError> {
         Ok(None)

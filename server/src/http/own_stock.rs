@@ -29,8 +29,8 @@ pub struct StockQuery {
     pub upto_line: Option<usize>,
 }
 
-/// Answers the stock of `request`'s own verification (up to `upto_line`) as GLB, in mm whatever
-/// units the request is written in.
+/// Answers the stock of `request`'s own verification (up to `upto_line`) as GLB, in the units the
+/// request is written in (as its answer).
 ///
 /// # Errors
 /// As the capability's endpoint: 404 for an unknown tool or machine, 422 for its refusals; 422
@@ -45,7 +45,7 @@ pub async fn answer<C: Capability>(
 ) -> AppResult<Response> {
     let catalog =
         capabilities::catalog(&state.db, capability::all_refs::<C>(&request), capabilities::Catalog::default()).await?;
-    let (request, _units) = capabilities::in_mm::<C>(&request, &catalog)?;
+    let (request, units) = capabilities::in_mm::<C>(&request, &catalog)?;
     let request = request.into_owned();
     let resolved = capabilities::resolve::<C>(&request, &catalog)?;
     let budget = AnswerBudget::new(u64::try_from(state.limits.answer_budget_bytes).unwrap_or(u64::MAX));
@@ -58,7 +58,7 @@ pub async fn answer<C: Capability>(
                 purpose: Purpose::Json,
                 budget: Some(&budget),
             };
-            C::cut_stock(&request, resolved, upto_line, &run)
+            C::cut_stock(&request, resolved, upto_line, units, &run)
         })
         .await?
         .map_err(AppError::from)?

@@ -147,7 +147,7 @@ async fn post_predict_program(
 /// The stock as the request's verification cuts the corrected program, as binary glTF.
 #[utoipa::path(post, path = "/api/v1/predict/stock", tag = "predict", operation_id = "predict_stock",
     summary = "The stock as the request's own verification cuts its corrected program, as binary glTF",
-    description = "The corrected program (the one the answer writes with the default output options, Fanuc) cut on the given stock (the model of the answer's `verification`, docs/spec/verify.md §9), as binary glTF (`model/gltf-binary`) coloured by what the program cut (the request gives no part: `extras.colouring` is `cut`), with that cut's `verification` in its `extras.verification`; `upto_line` cuts only the moves up to a line (playback). In mm whatever the request's units. A request with verification off is refused naming `verification`.",
+    description = "The corrected program (the one the answer writes with the default output options, Fanuc) cut on the given stock (the model of the answer's `verification`, docs/spec/verify.md §9), as binary glTF (`model/gltf-binary`) coloured by what the program cut (the request gives no part: `extras.colouring` is `cut`), with that cut's `verification` in its `extras.verification`; `upto_line` cuts only the moves up to a line (playback). In the request's units, as its answer (positions, `_DEVIATION` and `extras.verification`; `extras.units` names them). A request with verification off is refused naming `verification`.",
     params(StockQuery),
     request_body(description = "The request as JSON, or a form with it in part `request` and the STL stock in part `stock`.",
         content(

@@ -181,6 +181,7 @@ impl Capability for ContourCapability {
         request: &ContourRequest,
         context: Resolved<Tool>,
         upto_line: Option<usize>,
+        units: crate::units::Units,
         run: &Run<'_>,
     ) -> Result<Option<Vec<u8>>, SolverError> {
         let answer = Self::solve(request, context, run)?;
@@ -196,7 +197,16 @@ impl Capability for ContourCapability {
             return Ok(None);
         };
         let program = own_program(request, &answer, run)?;
-        own::cut_stock_glb(&model, grid, &program, &[(None, &answer.tool)], limits, upto_line, run).map(Some)
+        own::cut_stock_glb(
+            &model,
+            grid,
+            &program,
+            &[(None, &answer.tool)],
+            limits,
+            own::StockAsk { upto_line, units },
+            run,
+        )
+        .map(Some)
     }
 
     /// Ranges of layers of about `sizing.part_seconds` each (`parts`): a job's contour only,

@@ -175,6 +175,7 @@ impl Capability for DeburrCapability {
         request: &DeburrRequest,
         context: Resolved<Tool>,
         upto_line: Option<usize>,
+        units: crate::units::Units,
         run: &Run<'_>,
     ) -> Result<Option<Vec<u8>>, SolverError> {
         let Some((model, grid)) = own_model(request, &context)? else {
@@ -185,7 +186,7 @@ impl Capability for DeburrCapability {
             return Ok(None);
         };
         let program = own_program(request, &answer, run)?;
-        own::cut_stock_glb(&model, grid, &program, &tools, limits, upto_line, run).map(Some)
+        own::cut_stock_glb(&model, grid, &program, &tools, limits, own::StockAsk { upto_line, units }, run).map(Some)
     }
 
     /// A several-loop request's loops in ranges of about `sizing.part_seconds` (`parts`).

@@ -208,6 +208,7 @@ impl Capability for EngagementCapability {
         request: &EngagementRequest,
         context: Resolved<Tool>,
         upto_line: Option<usize>,
+        units: crate::units::Units,
         run: &Run<'_>,
     ) -> Result<Option<Vec<u8>>, SolverError> {
         let grid = verification_grid(request, &context.tool)?;
@@ -216,7 +217,16 @@ impl Capability for EngagementCapability {
             return Ok(None);
         };
         let program = own_program(request, &answer, run)?;
-        own::cut_stock_glb(&model, grid, &program, &[(None, &answer.tool)], own_limits(), upto_line, run).map(Some)
+        own::cut_stock_glb(
+            &model,
+            grid,
+            &program,
+            &[(None, &answer.tool)],
+            own_limits(),
+            own::StockAsk { upto_line, units },
+            run,
+        )
+        .map(Some)
     }
 
     /// The program of one path: `output.candidate`, else the request's `candidate`, else 0.
@@ -389,7 +399,7 @@ fn own_model(
         top,
         inside: Box::new(move |x, y| region.contains(super::P2::new(x, y), &mut 0)),
         description: format!(
-            "stock: the plan-view stock{} extruded from 1 mm under the program's lowest tip up to Z{top:.3}; part: \
+            "stock: the plan-view stock{} extruded from 1 mm under the program's lowest tip up to height {top:.3} mm; part: \
              none (the request gives no finished shape), so only rapids through material, neck, shank and holder \
              contact and the air share are checked",
             if earlier > 0 { format!(" less its {earlier} earlier cut(s)") } else { String::new() }

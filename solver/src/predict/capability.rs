@@ -198,6 +198,7 @@ impl Capability for PredictCapability {
         request: &PredictRequest,
         context: Resolved<Tool>,
         upto_line: Option<usize>,
+        units: crate::units::Units,
         run: &Run<'_>,
     ) -> Result<Option<Vec<u8>>, SolverError> {
         check_upload(request, run)?;
@@ -207,7 +208,16 @@ impl Capability for PredictCapability {
             return Ok(None);
         };
         let program = own_program(request, &answer, run)?;
-        own::cut_stock_glb(&model, grid, &program, &[(None, &answer.tool)], own_limits(), upto_line, run).map(Some)
+        own::cut_stock_glb(
+            &model,
+            grid,
+            &program,
+            &[(None, &answer.tool)],
+            own_limits(),
+            own::StockAsk { upto_line, units },
+            run,
+        )
+        .map(Some)
     }
 
     /// A G-code path is the input program with only the coordinates of moved end points changed

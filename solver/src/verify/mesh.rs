@@ -522,21 +522,27 @@ pub fn cut_stock_glb(
     say_colouring(&mut extras, &against);
     let mut mesh = surface(&stock, against, run)?;
     run.control.check()?;
-    if let Some(scaling) = units.from_mm() {
-        // Positions and deviations in the request's units (the colours were chosen in mm).
-        for position in &mut mesh.positions {
-            *position = position.map(|v| scaling.apply(f64::from(v)) as f32);
-        }
-        for deviation in &mut mesh.deviations {
-            *deviation = scaling.apply(f64::from(*deviation)) as f32;
-        }
-    }
+    mesh.restate(units);
     Ok(glb(&mesh, extras))
 }
 
+impl Mesh {
+    /// Positions and deviations in `units` (built in mm; the colours were chosen in mm).
+    fn restate(&mut self, units: Units) {
+        let Some(scaling) = units.from_mm() else { return };
+        for position in &mut self.positions {
+            *position = position.map(|v| scaling.apply(f64::from(v)) as f32);
+        }
+        for deviation in &mut self.deviations {
+            *deviation = scaling.apply(f64::from(*deviation)) as f32;
+        }
+    }
+}
+
 /// `stock` as a capability's own verification left it (docs/spec/verify.md §9.4), coloured
-/// `against` the part or the stock as modelled on the same grid, as GLB with `extras` (with
-/// `colouring` added without a part; the caller checks the bound, [`mesh_bound`], before cutting).
+/// `against` the part or the stock as modelled on the same grid, as GLB in `units` with `extras`
+/// (with `colouring` added without a part; the caller checks the bound, [`mesh_bound`], before
+/// cutting).
 ///
 /// # Errors
 /// `E_TOO_LARGE_ANSWER` at `verification.resolution` over the run's answer budget.
@@ -544,13 +550,15 @@ pub(crate) fn fields_glb(
     stock: &Field,
     against: Against<'_>,
     mut extras: Value,
+    units: Units,
     run: &Run<'_>,
 ) -> Result<Vec<u8>, SolverError> {
     say_colouring(&mut extras, &against);
-    let mesh = surface(stock, against, run).map_err(|error| {
+    let mut mesh = surface(stock, against, run).map_err(|error| {
         if error.field() == Some("resolution") { error.at("verification.resolution") } else { error }
     })?;
     run.control.check()?;
+    mesh.restate(units);
     Ok(glb(&mesh, extras))
 }
 

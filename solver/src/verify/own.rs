@@ -20,6 +20,7 @@ use crate::geometry::Vec3;
 use crate::planar::{Vec2, point_segment_distance, vec2};
 use crate::stock::StockModel;
 use crate::tool::Tool;
+use crate::units::{Scale, Units};
 use crate::validate::positive;
 
 /// Most rays the default resolution of a capability's own verification gives: a coarser grid
@@ -114,6 +115,14 @@ pub(crate) trait OwnModel {
     fn fields(&self, grid: Grid, lowest: f64, control: Control<'_>) -> Result<(Field, Option<Field>), SolverError>;
     /// What is modelled, in a sentence.
     fn describe(&self) -> String;
+}
+
+/// What a cut-stock request asks besides its model: the last line cut (every line: `None`) and
+/// the units of the answer.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StockAsk {
+    pub upto_line: Option<usize>,
+    pub units: Units,
 }
 
 /// How the model is compared: tolerances along z and across walls.
@@ -296,9 +305,10 @@ fn verification_of(cut: simulate::Cut, model: String, limits: Limits) -> Verific
 
 /// The stock of `model` as `program`'s moves on lines up to `upto_line` (every line: `None`) left
 /// it, as binary glTF coloured by deviation from the model's part, or for a model without a part
-/// by what the program cut (`extras.colouring`, docs/spec/verify.md §9.4), that cut's
-/// `verification` in the glTF's `extras.verification`. A program that has not reached the stock by
-/// then answers the stock as modelled, without `extras.verification`.
+/// by what the program cut (`extras.colouring`, docs/spec/verify.md §9.4), its positions and that
+/// cut's `verification` (in the glTF's `extras.verification`, with the `units` it is in) in
+/// `units`. A program that has not reached the stock by then answers the stock as modelled,
+/// without `extras.verification`.
 ///
 /// # Errors
 /// As [`verify_tools`]; `E_TOO_LARGE_ANSWER` at `verification.resolution` when the mesh's bound
@@ -310,7 +320,7 @@ pub(crate) fn cut_stock_glb(
     program: &str,
     tools: &[(Option<u32>, &Tool)],
     limits: Limits,
-    upto_line: Option<usize>,
+    StockAsk { upto_line, units }: StockAsk,
     run: &Run<'_>,
 ) -> Result<Vec<u8>, SolverError> {
     let bound = super::mesh::mesh_bound(grid.len(), 2);
@@ -335,12 +345,16 @@ pub(crate) fn cut_stock_glb(
     };
     match simulate::cut_fields(&job, stock, part, &unbudgeted(run)) {
         Ok((cut, left)) => {
-            let extras = serde_json::json!({"verification": verification_of(cut, model.describe(), limits)});
-            super::mesh::fields_glb(&left, against, extras, run)
+            let mut verification = verification_of(cut, model.describe(), limits);
+            if let Some(scaling) = units.from_mm() {
+                verification.scale(scaling);
+            }
+            let extras = serde_json::json!({"verification": verification, "units": units.as_str()});
+            super::mesh::fields_glb(&left, against, extras, units, run)
         }
         Err(error) if error.code() == ErrorCode::Stock => {
             let (stock, _) = model.fields(grid, lowest, run.control)?;
-            super::mesh::fields_glb(&stock, against, serde_json::json!({}), run)
+            super::mesh::fields_glb(&stock, against, serde_json::json!({"units": units.as_str()}), units, run)
         }
         Err(error) => Err(error),
     }
@@ -533,8 +547,8 @@ impl OwnModel for Prism {
     fn describe(&self) -> String {
         let side = if self.material_inside { "inside" } else { "outside" };
         format!(
-            "stock: the material {side} the outline and a band {:.3} mm wide beyond it, from Z{:.3} to Z{:.3} over a \
-             floor {FLOOR_THICKNESS} mm thick; part: the material {side} the outline{}, {} relief disc(s) cut out",
+            "stock: the material {side} the outline and a band {:.3} mm wide beyond it, from height {:.3} mm up to \
+             {:.3} mm over a floor {FLOOR_THICKNESS} mm thick; part: the material {side} the outline{}, {} relief disc(s) cut out",
             self.stock,
             self.bottom,
             self.top,

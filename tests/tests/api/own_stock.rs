@@ -85,6 +85,56 @@ async fn contour_stock_is_its_verification_cut() {
     assert!(!deviations.is_empty());
 }
 
+/// An inch request's cut stock is in inches, as its answer is: the same solid as the mm
+/// request's, scaled by 1/25.4, its `extras` saying `inch`; volumes stay mm³ as their names say.
+#[tokio::test(flavor = "multi_thread")]
+async fn an_inch_requests_stock_is_in_inches() {
+    let app = TestApp::spawn().await;
+    let inch = json!({
+        "units": "inch",
+        "tool": {"kind": "flat", "radius": 0.125},
+        "contour": [[0, 0], [1.5, 0], [1.5, 1.25], [0, 1.25]],
+        "side": "outside",
+        "depths": {"top": 0, "bottom": -0.125, "step": 0.0625},
+        "feed": 24,
+        "verification": {"resolution": 0.0113},
+    });
+    // The same contour typed in mm.
+    let scaled = json!({
+        "tool": {"kind": "flat", "radius": 3.175},
+        "contour": [[0, 0], [38.1, 0], [38.1, 31.75], [0, 31.75]],
+        "side": "outside",
+        "depths": {"top": 0, "bottom": -3.175, "step": 1.5875},
+        "feed": 609.6,
+        "verification": {"resolution": 0.28702},
+    });
+    let (mm_json, mm_bin) = glb(&app, "/api/v1/contour/stock", &scaled).await;
+    let (inch_json, inch_bin) = glb(&app, "/api/v1/contour/stock", &inch).await;
+    assert_eq!(inch_json["extras"]["units"], "inch", "{}", inch_json["extras"]);
+    assert_eq!(mm_json["extras"]["units"], "mm", "{}", mm_json["extras"]);
+    let position = |json: &Value, bound: &str| -> Vec<f64> {
+        let index = json["meshes"][0]["primitives"][0]["attributes"]["POSITION"].as_u64().unwrap() as usize;
+        json["accessors"][index][bound].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect()
+    };
+    for bound in ["min", "max"] {
+        let (inches, millimetres) = (position(&inch_json, bound), position(&mm_json, bound));
+        for (a, b) in inches.iter().zip(&millimetres) {
+            assert!((a * 25.4 - b).abs() < 1e-3, "{bound}: {inches:?} in against {millimetres:?} mm");
+        }
+    }
+    let (in3, mm3) = (enclosed(&inch_json, &inch_bin), enclosed(&mm_json, &mm_bin));
+    // The inch program's coordinates are rounded to 0.0001 in, the mm program's to 0.0001 mm: a
+    // ray on a wall may fall either side, hence a relative 1e-3 rather than exactly.
+    assert!((in3 * 25.4f64.powi(3) / mm3 - 1.0).abs() < 1e-3, "{in3} in³ against {mm3} mm³");
+    let removed = |json: &Value| json["extras"]["verification"]["removed_volume_mm3"].as_f64().unwrap();
+    assert!(
+        (removed(&inch_json) / removed(&mm_json) - 1.0).abs() < 1e-3,
+        "{} against {}",
+        inch_json["extras"],
+        mm_json["extras"]
+    );
+}
+
 #[tokio::test(flavor = "multi_thread")]
 async fn a_request_without_a_model_is_refused_naming_verification() {
     let app = TestApp::spawn().await;
@@ -179,7 +229,7 @@ async fn predict_stock_is_its_verification_cut_coloured_by_what_was_cut() {
     );
     // Before the plunge nothing is cut: the stock as given, all grey, still said to have no part.
     let (before, bin) = glb(&app, "/api/v1/predict/stock?upto_line=3", &body).await;
-    assert_eq!(before["extras"], json!({"colouring": "cut"}));
+    assert_eq!(before["extras"], json!({"colouring": "cut", "units": "mm"}));
     assert!(values(&before, &bin, "COLOR_0").chunks(4).all(|c| c == GIVEN));
 
     // The same request as a form with the stock's STL file: the same cut as its JSON answer.
