@@ -3,7 +3,7 @@
 // Prints one JSON line with what it saw; exits non-zero with the reason when a check fails.
 import { readFileSync } from 'node:fs';
 import { chromium } from 'playwright-core';
-import { unitScenarios } from './units.mjs';
+import { boxStl, unitScenarios } from './units.mjs';
 
 const [scenario, base, screenshot, jobFile, secondJobFile] = process.argv.slice(2);
 const browser = await chromium.launch({
@@ -1228,14 +1228,7 @@ hole = { shape = "round", radius = 60 }
   // Predict with an uploaded STL stock (a binary STL box round the sample path): the stock is
   // drawn in the scene, as a box or grid stock is.
   async predictStl() {
-    const [min, max] = [[-5, -5, -10], [25, 25, 2.2]];
-    const corner = (i) => [i & 1 ? max[0] : min[0], i & 2 ? max[1] : min[1], i & 4 ? max[2] : min[2]];
-    // Each face of the box as two triangles, outward (the corner indices by bit x, y, z).
-    const faces = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-    const triangles = faces.flatMap(([a, b, c, d]) => [[a, b, c], [a, c, d]]);
-    const stl = Buffer.alloc(84 + 50 * triangles.length);
-    stl.writeUInt32LE(triangles.length, 80);
-    triangles.forEach((triangle, t) => triangle.forEach((index, v) => corner(index).forEach((x, k) => stl.writeFloatLE(x, 84 + 50 * t + 12 + 12 * v + 4 * k))));
+    const stl = boxStl([-5, -5, -10], [25, 25, 2.2]);
     await page.goto(`${base}/#/predict`);
     await page.waitForSelector('#predict-form');
     await page.selectOption('#predict-form select[name="stock_kind"]', 'mesh');
@@ -1245,7 +1238,7 @@ hole = { shape = "round", radius = 60 }
     const objects = (await page.getAttribute('#predict-plot', 'data-objects')).split(' ');
     const summary = await page.textContent('#predict-result .summary');
     if (!objects.includes('stock')) throw new Error(`the STL stock is not drawn: ${objects}`);
-    return { objects, triangles: triangles.length, summary: summary.slice(0, 200) };
+    return { objects, triangles: stl.readUInt32LE(80), summary: summary.slice(0, 200) };
   },
 
   // A deburr job opened on the Jobs view shows what the Deburr view shows: the tube and hole

@@ -24,8 +24,9 @@ const RECORD_MULTIPART = () => {
   };
 };
 
-// A binary STL of the box from `min` to `max`, each face two triangles facing out.
-function boxStl(min, max) {
+// A binary STL of the box from `min` to `max`, each face two triangles facing out (the corner
+// indices by bit x, y, z).
+export function boxStl(min, max) {
   const corner = (i) => [i & 1 ? max[0] : min[0], i & 2 ? max[1] : min[1], i & 4 ? max[2] : min[2]];
   const faces = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
   const triangles = faces.flatMap(([a, b, c, d]) => [[a, b, c], [a, c, d]]);
@@ -41,6 +42,22 @@ function inchOf(a, b, within) {
 }
 
 export function unitScenarios({ page, base }) {
+  // Runs `operation` as a job named `name` and opens its result on the Jobs view with the switch
+  // at mm: a job's operation is shown in its answer's units, whatever the switch says.
+  async function openJobAtMm(name, operation) {
+    const job = await fetch(`${base}/api/v1/jobs`, {
+      method: 'POST',
+      headers: { 'content-type': 'application/json' },
+      body: JSON.stringify({ name, operations: [operation] }),
+    });
+    if (job.status !== 202) throw new Error(`the job was not queued: ${job.status} ${await job.text()}`);
+    await page.selectOption('#units', 'mm');
+    await page.goto(`${base}/#/jobs`);
+    await page.waitForSelector('#job-rows tr[data-status="done"]', { timeout: 120000 });
+    await page.click('#job-rows tr[data-status="done"] button');
+    await page.waitForSelector('#job-result[data-state="shown"]', { timeout: 60000 });
+  }
+
   // The JSON request and answer of the next POST to `path` (with any query but a program's or a
   // mesh's `format`) while `action` runs.
   // The JSON of a request: its body, or a multipart request's `request` part as the page sent it.
@@ -161,17 +178,7 @@ export function unitScenarios({ page, base }) {
 
       // A job's operation is shown in the units of its answer, whatever the switch: the inch
       // contour request the page sent, run as a job and opened with the switch at mm.
-      const job = await fetch(`${base}/api/v1/jobs`, {
-        method: 'POST',
-        headers: { 'content-type': 'application/json' },
-        body: JSON.stringify({ name: 'inch contour', operations: [{ operation: 'contour', ...body }] }),
-      });
-      if (job.status !== 202) throw new Error(`the job was not queued: ${job.status} ${await job.text()}`);
-      await page.selectOption('#units', 'mm');
-      await page.goto(`${base}/#/jobs`);
-      await page.waitForSelector('#job-rows tr[data-status="done"]', { timeout: 120000 });
-      await page.click('#job-rows tr[data-status="done"] button');
-      await page.waitForSelector('#job-result[data-state="shown"]', { timeout: 60000 });
+      await openJobAtMm('inch contour', { operation: 'contour', ...body });
       const jobSummary = await page.textContent('#job-result .summary');
       if (!/tool Ø, in\s*0\.250/.test(jobSummary) || /\bmm\b/.test(jobSummary)) throw new Error(`the inch job's summary: ${jobSummary}`);
       return { flipped, summary: inch.slice(0, 120), readout, why, feedHint, jobSummary: jobSummary.slice(0, 120) };
@@ -283,17 +290,7 @@ export function unitScenarios({ page, base }) {
       if (!corrected.includes('O3100') || !/\bG21\b/.test(corrected)) throw new Error(`the corrected program: ${corrected.slice(0, 200)}`);
 
       // An inch prediction run as a job, opened with the switch at mm: shown in tenths.
-      const job = await fetch(`${base}/api/v1/jobs`, {
-        method: 'POST',
-        headers: { 'content-type': 'application/json' },
-        body: JSON.stringify({ name: 'inch prediction', operations: [{ operation: 'predict', ...inch.request }] }),
-      });
-      if (job.status !== 202) throw new Error(`the job was not queued: ${job.status} ${await job.text()}`);
-      await page.selectOption('#units', 'mm');
-      await page.goto(`${base}/#/jobs`);
-      await page.waitForSelector('#job-rows tr[data-status="done"]', { timeout: 120000 });
-      await page.click('#job-rows tr[data-status="done"] button');
-      await page.waitForSelector('#job-result[data-state="shown"]', { timeout: 60000 });
+      await openJobAtMm('inch prediction', { operation: 'predict', ...inch.request });
       const jobSummary = await page.textContent('#job-result .summary');
       if (!jobSummary.includes(wanted[0]) || !jobSummary.includes('ball Ø0.2362 in') || /µm/.test(jobSummary)) throw new Error(`the inch job's summary: ${jobSummary}`);
       return { flipped, back, summary: summary.slice(0, 160), readout, band: outside, jobSummary: jobSummary.slice(0, 120) };
