@@ -324,6 +324,11 @@ pub trait Lookup {
     fn machine(&self, name: &str) -> Option<MachineProfile>;
     /// The material called `name`, if any.
     fn material(&self, name: &str) -> Option<Material>;
+    /// The units of a request that does not say its own, before its machine's (a job file's
+    /// `units`); default none.
+    fn units(&self) -> Option<Units> {
+        None
+    }
 }
 
 /// A request's references, resolved.
@@ -437,10 +442,11 @@ pub fn all_refs<C: Capability>(request: &C::Request) -> Vec<Refs<'_>> {
     std::iter::once(C::refs(request)).chain(C::other_tools(request).into_iter().map(OtherTool::refs)).collect()
 }
 
-/// The units of capability `C`'s request: its own `units`, else those of the machine it names
-/// (found in `lookup`), else mm.
+/// The units of capability `C`'s request: its own `units`, else the lookup's (a job file's), else
+/// those of the machine it names (found in `lookup`), else mm.
 pub fn units_of<C: Capability>(request: &C::Request, lookup: &impl Lookup) -> Units {
     C::units(request)
+        .or_else(|| lookup.units())
         .or_else(|| C::refs(request).machine.and_then(|name| lookup.machine(name)).and_then(|machine| machine.units))
         .unwrap_or_default()
 }

@@ -248,7 +248,8 @@ async fn job_downloads_are_named_by_their_post_and_haas_smoothing_is_set_once() 
     }
 }
 
-/// A job of inch operations joins into one inch program: G20, the tools' radii in inches, the
+/// A job file in inch (`units` at the top, or an operation's own) joins into one inch program:
+/// G20, the tools' radii in inches, the
 /// rapids timed at the machine's mm/min, every operation's feed moves as rs274 reads them in its
 /// own program; an operation in mm is left out, and the header says why.
 #[tokio::test(flavor = "multi_thread")]
@@ -257,9 +258,12 @@ async fn an_inch_job_joins_into_one_inch_program_and_leaves_an_mm_operation_out(
     let app = TestApp::spawn().await;
     let folder = tempfile::tempdir().unwrap();
     let mut job = shop_job();
-    let deburr_in_mm = job["operations"][0].clone();
+    let mut deburr_in_mm = job["operations"][0].clone();
+    deburr_in_mm["units"] = json!("mm");
+    // The file's units for an operation that says none; one that says its own keeps them.
+    job["units"] = json!("inch");
     job["operations"] = json!([
-        {"operation": "contour", "tool": 3, "machine": "vmc", "units": "inch",
+        {"operation": "contour", "tool": 3, "machine": "vmc",
          "contour": [[0, 0], [2.4, 0], [2.4, 1.6], [0, 1.6]], "side": "outside",
          "depths": {"top": 0, "bottom": -0.16, "step": 0.08}, "feed": 30, "spindle_rpm": 8000},
         {"operation": "segment", "tool": 10, "machine": "vmc", "units": "inch",
@@ -267,6 +271,9 @@ async fn an_inch_job_joins_into_one_inch_program_and_leaves_an_mm_operation_out(
         deburr_in_mm,
     ]);
     let id = run_job(&app, &job).await;
+    let state = json_with(app.get(&format!("/api/v1/jobs/{id}")).await, 200).await;
+    let units: Vec<&str> = (0..3).map(|i| state["results"][i]["result"]["units"].as_str().unwrap()).collect();
+    assert_eq!(units, ["inch", "inch", "mm"], "{state}");
     let response = app.get(&format!("/api/v1/jobs/{id}/program")).await;
     assert_eq!(response.status(), 200);
     let program = response.text().await.unwrap();

@@ -27,7 +27,7 @@
 //! Reading a file is `parse` (the text into a [`JobFile`]) and `check` (what its shape does not
 //! say); this module holds the job file's types and its resolution against the store.
 
-use kerf_solver::capability::{self, Lookup, Refs};
+use kerf_solver::capability::{self, Lookup, Refs, Units};
 use kerf_solver::gcode::job::Coolant;
 use kerf_solver::gcode::{Arcs, Dialect, Reference};
 use kerf_solver::machine::MachineProfile;
@@ -74,6 +74,10 @@ pub struct JobFile {
     /// materials its operations name, from the file or the library.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub materials: Vec<Material>,
+    /// `mm` or `inch`: the units of every operation that does not say its own `units` (before its
+    /// machine's; default: each operation's machine's, else mm).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<Units>,
     /// How the G-code of every operation is written.
     #[serde(default)]
     pub output: OutputOptions,
@@ -196,5 +200,9 @@ impl Lookup for JobFile {
 
     fn material(&self, name: &str) -> Option<Material> {
         material_in(&self.materials, name)
+    }
+
+    fn units(&self) -> Option<Units> {
+        self.units
     }
 }
