@@ -196,7 +196,7 @@ impl Capability for ContourCapability {
         let Some((model, grid, limits)) = own_model(request, &answer)? else {
             return Ok(None);
         };
-        let program = own_program(request, &answer, run)?;
+        let program = own::program::<ContourCapability>(request, &answer, run)?;
         own::cut_stock_glb(
             &model,
             grid,
@@ -360,17 +360,11 @@ fn verified(request: &ContourRequest, mut answer: ContourAnswer, run: &Run<'_>) 
     let Some((model, grid, limits)) = own_model(request, &answer)? else {
         return Ok(answer);
     };
-    let program = own_program(request, &answer, run)?;
+    let program = own::program::<ContourCapability>(request, &answer, run)?;
     let mut verification = own::verify(&model, grid, &program, &answer.tool, limits, run)?;
     own::report(&mut verification, &mut answer.result.warnings, &mut answer.result.description);
     answer.verification = Some(verification);
     Ok(answer)
-}
-
-/// The program a verification cuts: the answer's, with the default output options (Fanuc).
-fn own_program(request: &ContourRequest, answer: &ContourAnswer, run: &Run<'_>) -> Result<String, SolverError> {
-    let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
-    crate::capability::program::<ContourCapability>(request, answer, &output, run.control)
 }
 
 /// The model `answer`'s program is cut on, its grid and its limits; `None` without a

@@ -185,7 +185,7 @@ impl Capability for DeburrCapability {
         let Some((tools, limits)) = own_cut(&answer) else {
             return Ok(None);
         };
-        let program = own_program(request, &answer, run)?;
+        let program = own::program::<DeburrCapability>(request, &answer, run)?;
         own::cut_stock_glb(&model, grid, &program, &tools, limits, own::StockAsk { upto_line, units }, run).map(Some)
     }
 
@@ -419,7 +419,7 @@ fn verified(
     let Some((tools, limits)) = own_cut(&answer) else {
         return Ok(answer);
     };
-    let program = own_program(request, &answer, run)?;
+    let program = own::program::<DeburrCapability>(request, &answer, run)?;
     let mut verification = own::verify_tools(&model, grid, &program, &tools, limits, run)?;
     let mut description = Vec::new();
     own::report(&mut verification, &mut answer.result.warnings, &mut description);
@@ -429,12 +429,6 @@ fn verified(
     }
     answer.verification = Some(verification);
     Ok(answer)
-}
-
-/// The program a verification cuts: the answer's, with the default output options (Fanuc).
-fn own_program(request: &DeburrRequest, answer: &DeburrAnswer, run: &Run<'_>) -> Result<String, SolverError> {
-    let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
-    crate::capability::program::<DeburrCapability>(request, answer, &output, run.control)
 }
 
 /// The tools a program calls, each with the `T` number it calls it by (one without a number cuts

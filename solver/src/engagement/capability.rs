@@ -216,13 +216,13 @@ impl Capability for EngagementCapability {
         let Some((model, grid)) = own_model(request, grid, &answer)? else {
             return Ok(None);
         };
-        let program = own_program(request, &answer, run)?;
+        let program = own::program::<EngagementCapability>(request, &answer, run)?;
         own::cut_stock_glb(
             &model,
             grid,
             &program,
             &[(None, &answer.tool)],
-            own_limits(),
+            own::Limits::WITHOUT_PART,
             own::StockAsk { upto_line, units },
             run,
         )
@@ -408,17 +408,6 @@ fn own_model(
     Ok(Some((model, grid)))
 }
 
-/// The program a verification cuts: the candidate's, with the default output options (Fanuc).
-fn own_program(request: &EngagementRequest, answer: &EngagementAnswer, run: &Run<'_>) -> Result<String, SolverError> {
-    let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
-    crate::capability::program::<EngagementCapability>(request, answer, &output, run.control)
-}
-
-/// The verification's limits: the defaults, there being no part to set them by.
-fn own_limits() -> own::Limits {
-    own::Limits { tolerance: own::OWN_TOLERANCE, allowance: crate::verify::DEFAULT_ALLOWANCE, wall_tolerance: 0.0 }
-}
-
 /// `answer` with the program of the request's candidate cut on its model ([`own_model`]): its
 /// `verification`, and the warnings and program header comments of what that found, on that
 /// candidate.
@@ -432,8 +421,8 @@ fn verified(
         return Ok(answer);
     };
     let index = request.candidate.unwrap_or(0);
-    let program = own_program(request, &answer, run)?;
-    let mut verification = own::verify(&model, grid, &program, &answer.tool, own_limits(), run)?;
+    let program = own::program::<EngagementCapability>(request, &answer, run)?;
+    let mut verification = own::verify(&model, grid, &program, &answer.tool, own::Limits::WITHOUT_PART, run)?;
     let candidate = match &mut answer.result {
         EngagementSolution::Single(result) => result.as_mut(),
         EngagementSolution::Comparison(comparison) => &mut comparison.candidates[index],

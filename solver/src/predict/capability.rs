@@ -207,13 +207,13 @@ impl Capability for PredictCapability {
         let Some((model, grid)) = model else {
             return Ok(None);
         };
-        let program = own_program(request, &answer, run)?;
+        let program = own::program::<PredictCapability>(request, &answer, run)?;
         own::cut_stock_glb(
             &model,
             grid,
             &program,
             &[(None, &answer.tool)],
-            own_limits(),
+            own::Limits::WITHOUT_PART,
             own::StockAsk { upto_line, units },
             run,
         )
@@ -329,17 +329,6 @@ fn own_model(
     Ok(Some((model, grid)))
 }
 
-/// The program a verification cuts: the corrected one, with the default output options (Fanuc).
-fn own_program(request: &PredictRequest, answer: &PredictAnswer, run: &Run<'_>) -> Result<String, SolverError> {
-    let output = OutputOptions { dialect: Some(crate::gcode::Dialect::Fanuc), ..OutputOptions::default() };
-    crate::capability::program::<PredictCapability>(request, answer, &output, run.control)
-}
-
-/// The verification's limits: the defaults, there being no part to set them by.
-fn own_limits() -> own::Limits {
-    own::Limits { tolerance: own::OWN_TOLERANCE, allowance: crate::verify::DEFAULT_ALLOWANCE, wall_tolerance: 0.0 }
-}
-
 /// `answer` with the program it writes cut on the given stock: its `verification`, and the
 /// warnings and program header comments of what that found.
 fn verified(
@@ -351,8 +340,8 @@ fn verified(
     let Some((model, grid)) = model else {
         return Ok(answer);
     };
-    let program = own_program(request, &answer, run)?;
-    let mut verification = own::verify(&model, grid, &program, &answer.tool, own_limits(), run)?;
+    let program = own::program::<PredictCapability>(request, &answer, run)?;
+    let mut verification = own::verify(&model, grid, &program, &answer.tool, own::Limits::WITHOUT_PART, run)?;
     // The header lines are written from the verification by `program`.
     own::report(&mut verification, &mut answer.result.warnings, &mut Vec::new());
     answer.verification = Some(verification);

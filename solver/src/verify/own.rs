@@ -133,6 +133,30 @@ pub(crate) struct Limits {
     pub wall_tolerance: f64,
 }
 
+impl Limits {
+    /// The limits of a model without a part (predict's, engagement's): the defaults, there being
+    /// no part to set them by.
+    pub(crate) const WITHOUT_PART: Self =
+        Self { tolerance: OWN_TOLERANCE, allowance: crate::verify::DEFAULT_ALLOWANCE, wall_tolerance: 0.0 };
+}
+
+/// The program a capability's own verification cuts: the one its answer writes with the default
+/// output options (Fanuc), whose lines the findings and a playback's `upto_line` count.
+///
+/// # Errors
+/// As the capability's program writer.
+pub(crate) fn program<C: crate::capability::Capability>(
+    request: &C::Request,
+    answer: &C::Answer,
+    run: &Run<'_>,
+) -> Result<String, SolverError> {
+    let output = crate::capability::OutputOptions {
+        dialect: Some(crate::gcode::Dialect::Fanuc),
+        ..crate::capability::OutputOptions::default()
+    };
+    crate::capability::program::<C>(request, answer, &output, run.control)
+}
+
 /// The grid of `footprint` at the request's resolution, or the default for `tool`.
 ///
 /// # Errors
