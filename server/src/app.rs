@@ -64,6 +64,7 @@ pub fn api() -> (Router<AppState>, utoipa::openapi::OpenApi) {
         .merge(http::contour::router())
         .merge(http::dxf::router())
         .merge(http::jobs::router())
+        .merge(http::job_stock::router())
         .merge(http::machines::router())
         .merge(http::materials::router())
         .split_for_parts();

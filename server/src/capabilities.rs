@@ -169,6 +169,28 @@ macro_rules! registry {
                 }
             }
 
+            /// The stock as the operation's program cut it ([`cut_stock`]), resolved against
+            /// `lookup`: GLB in the operation's units.
+            ///
+            /// # Errors
+            /// As [`cut_stock`].
+            pub fn cut_stock(&self, lookup: &impl Lookup, ask: StockAsk, run: &Run<'_>) -> Result<Vec<u8>, AppError> {
+                match self {
+                    $(Self::$variant(request) => cut_stock::<$capability>(request, lookup, ask, run),)+
+                }
+            }
+
+            /// The program [`Operation::cut_stock`] cuts ([`cut_program`]), in the operation's
+            /// units.
+            ///
+            /// # Errors
+            /// As [`cut_program`].
+            pub fn cut_program(&self, lookup: &impl Lookup, run: &Run<'_>) -> Result<String, AppError> {
+                match self {
+                    $(Self::$variant(request) => cut_program::<$capability>(request, lookup, run),)+
+                }
+            }
+
             /// Reads the request of the capability called `name` from `fields`.
             fn read<'de, D: serde::Deserializer<'de>>(name: &str, fields: D) -> Result<Self, D::Error> {
                 $(
@@ -370,6 +392,74 @@ fn answer_json<C: Capability>(mut answer: C::Answer, units: Units) -> Result<Vec
     }
     let bytes = C::to_json(answer).map_err(|error| AppError::Internal(error.into()))?;
     Ok(with_units(bytes, units))
+}
+
+/// What a cut-stock request asks besides the capability's request: the last line cut (every
+/// line: `None`) and a dexel spacing in place of the request's (in its units).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StockAsk {
+    /// Cut the moves on lines up to this one (1-based, of the program cut).
+    pub upto_line: Option<usize>,
+    /// Dexel spacing, in the request's units.
+    pub resolution: Option<f64>,
+}
+
+/// Capability `C`'s cut stock ([`Capability::cut_stock`]) of `request` resolved against `lookup`:
+/// GLB in the request's units. Runs on a blocking thread.
+///
+/// # Errors
+/// As the capability's endpoint: 404 for an unknown reference, 422 for its refusals (restated in
+/// the request's units); 422 `E_INPUT` at `verification` when the request has no model to cut
+/// (verification turned off, or a capability without one).
+pub fn cut_stock<C: Capability>(
+    request: &C::Request,
+    lookup: &impl Lookup,
+    ask: StockAsk,
+    run: &Run<'_>,
+) -> Result<Vec<u8>, AppError> {
+    let mut asked = Cow::Borrowed(request);
+    if let Some(resolution) = ask.resolution {
+        C::set_cut_resolution(asked.to_mut(), resolution);
+    }
+    let (request, units) = in_mm::<C>(&asked, lookup)?;
+    let request = request.as_ref();
+    let resolved = resolve::<C>(request, lookup)?;
+    C::cut_stock(request, resolved, ask.upto_line, units, run).map_err(|error| refusal_in(error, units))?.ok_or_else(
+        || {
+            AppError::from(SolverError::input(
+                "verification",
+                format!(
+                    "this {} request has no model to cut its program on: its verification is turned off, or it has \
+                     none (docs/spec/verify.md §9.2)",
+                    C::NAME
+                ),
+            ))
+        },
+    )
+}
+
+/// The program [`cut_stock`] cuts, in the request's units: the one the request gives
+/// ([`Capability::given_program`]), else the one its answer writes with the default output
+/// options in the Fanuc dialect. Runs on a blocking thread.
+///
+/// # Errors
+/// As [`solve`], and the refusal of a capability that writes no program.
+pub fn cut_program<C: Capability>(
+    request: &C::Request,
+    lookup: &impl Lookup,
+    run: &Run<'_>,
+) -> Result<String, AppError> {
+    if let Some(program) = C::given_program(request) {
+        return Ok(program.to_owned());
+    }
+    let (request, units) = in_mm::<C>(request, lookup)?;
+    let request = request.as_ref();
+    let resolved = resolve::<C>(request, lookup)?;
+    let fanuc = OutputOptions { dialect: Some(kerf_solver::gcode::Dialect::Fanuc), ..OutputOptions::default() };
+    match solve::<C>(request, resolved, run, Some(&fanuc), false, units)? {
+        (Delivered::Program(program), _) => Ok(program),
+        (Delivered::Json(_), _) => Err(AppError::Internal(anyhow::anyhow!("a program was asked for"))),
+    }
 }
 
 /// What a solve gives its caller: the answer as JSON, or the program.

@@ -252,12 +252,15 @@ where
         let deserializer = serde_urlencoded::Deserializer::new(form_urlencoded::parse(query.as_bytes()));
         serde_path_to_error::deserialize(deserializer).map(Self).map_err(|error| {
             let path = error.path().to_string();
-            let field = if path == "." { "query".to_owned() } else { path };
-            AppError::bad_request(
-                ErrorCode::Query,
-                field.clone(),
-                format!("query parameter {field}: {}", error.into_inner()),
-            )
+            let message = error.into_inner().to_string();
+            // A required parameter left out is reported at the root; the message names it.
+            let missing = message.strip_prefix("missing field `").and_then(|rest| rest.strip_suffix('`'));
+            let field = match (path.as_str(), missing) {
+                (".", Some(name)) => name.to_owned(),
+                (".", None) => "query".to_owned(),
+                _ => path,
+            };
+            AppError::bad_request(ErrorCode::Query, field.clone(), format!("query parameter {field}: {message}"))
         })
     }
 }

@@ -14,7 +14,7 @@ use utoipa::OpenApi;
         license(name = "MIT OR Apache-2.0")
     ),
     servers((url = "/", description = "The service that serves this document")),
-    components(schemas(crate::http::contour::JsonOnly, crate::http::verify_mesh::VerifyFormat)),
+    components(schemas(crate::http::contour::JsonOnly, crate::http::verify::VerifyFormat)),
     tags(
         (name = "service", description = "Health"),
         (name = "tools", description = "The tool table, keyed by tool number"),

@@ -96,6 +96,18 @@ pub trait Capability {
         Ok(None)
     }
 
+    /// Asks [`Self::cut_stock`] at dexel spacing `resolution` (in the request's units) instead of
+    /// the request's own: its `verification.resolution` (verify's `resolution`). Default: nothing
+    /// to set, for a capability that cuts no stock.
+    fn set_cut_resolution(_request: &mut Self::Request, _resolution: f64) {}
+
+    /// The program the request gives to be cut (verify's `program`), whose lines
+    /// [`Self::cut_stock`]'s `upto_line` and the findings count; `None` (the default) when the
+    /// program cut is the one the answer writes with the default output options (Fanuc).
+    fn given_program(_request: &Self::Request) -> Option<&str> {
+        None
+    }
+
     /// The units the request says it is written in (its `units`), if it says.
     fn units(_request: &Self::Request) -> Option<Units> {
         None

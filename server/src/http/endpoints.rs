@@ -99,7 +99,7 @@ macro_rules! endpoint {
                 params(StockParams),
                 request_body = $request,
                 responses(
-                    (status = 200, description = "The cut stock", body = super::super::verify_mesh::GlbFile, content_type = "model/gltf-binary"),
+                    (status = 200, description = "The cut stock", body = super::super::own_stock::GlbFile, content_type = "model/gltf-binary"),
                     (status = 400, body = Problem, content_type = "application/problem+json"),
                     (status = 404, description = <$capability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
                     (status = 413, body = Problem, content_type = "application/problem+json"),
@@ -207,7 +207,7 @@ macro_rules! endpoint {
                 request_body(description = "The request as JSON, or a form with it in part `request` and the DXF file its `drawing` reads in part `drawing`.",
                     content(($request = "application/json"), (DrawingForm = "multipart/form-data"))),
                 responses(
-                    (status = 200, description = "The cut stock", body = super::super::verify_mesh::GlbFile, content_type = "model/gltf-binary"),
+                    (status = 200, description = "The cut stock", body = super::super::own_stock::GlbFile, content_type = "model/gltf-binary"),
                     (status = 400, body = Problem, content_type = "application/problem+json"),
                     (status = 404, description = <$capability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
                     (status = 413, body = Problem, content_type = "application/problem+json"),

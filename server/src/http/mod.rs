@@ -6,6 +6,7 @@ pub mod contour;
 pub mod dxf;
 pub mod endpoints;
 pub mod health;
+pub mod job_stock;
 pub mod jobs;
 pub mod machines;
 pub mod materials;
@@ -17,7 +18,6 @@ pub mod stream;
 pub mod tools;
 mod upload;
 pub mod verify;
-pub mod verify_mesh;
 
 use kerf_solver::ErrorCode;
 

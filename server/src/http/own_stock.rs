@@ -1,21 +1,26 @@
 //! `POST /api/v1/{name}/stock` (docs/spec/verify.md §9.4): the stock as a capability's own
-//! verification cuts the program it writes, as binary glTF coloured by deviation from the
-//! capability's part (without one, by what the program cut), up to a line for playback. The same request as the capability's endpoint;
-//! the mesh is built on the blocking pool within the answer budget, as verify's (`verify_mesh`).
+//! verification cuts the program it writes (verify: the program it is given), as binary glTF
+//! coloured by deviation from the capability's part (without one, by what the program cut), up to
+//! a line for playback. The same request as the capability's endpoint; the mesh is built on the
+//! blocking pool within the answer budget ([`glb_answer`], also a job operation's cut stock's).
 
 use axum::body::Bytes;
 use axum::http::{HeaderValue, header};
 use axum::response::Response;
-use kerf_solver::SolverError;
 use kerf_solver::capability::{self, AnswerBudget, Capability, Control, Purpose, Run};
 use kerf_solver::verify::GLB_MEDIA_TYPE;
 use serde::Deserialize;
-use utoipa::IntoParams;
+use utoipa::{IntoParams, ToSchema};
 
-use crate::capabilities;
+use crate::capabilities::{self, StockAsk};
 use crate::error::{AppError, AppResult};
 use crate::http::stream::{held_download, pieces_of};
 use crate::state::AppState;
+
+/// A GLB file (for the OpenAPI document): the cut stock as binary glTF.
+#[derive(Debug, ToSchema)]
+#[schema(value_type = String, format = Binary)]
+pub struct GlbFile(pub Vec<u8>);
 
 /// Query parameters of `POST /api/v1/{name}/stock`.
 #[derive(Debug, Clone, Default, Deserialize, IntoParams)]
@@ -29,14 +34,12 @@ pub struct StockQuery {
     pub upto_line: Option<usize>,
 }
 
-/// Answers the stock of `request`'s own verification (up to `upto_line`) as GLB, in the units the
-/// request is written in (as its answer).
+/// Answers the stock of `request`'s own verification (up to `ask.upto_line`) as GLB, in the units
+/// the request is written in (as its answer).
 ///
 /// # Errors
-/// As the capability's endpoint: 404 for an unknown tool or machine, 422 for its refusals; 422
-/// `E_INPUT` at `verification` when the request has no model to cut (verification turned off,
-/// or a capability or request without one); `E_TOO_LARGE_ANSWER` at `verification.resolution`
-/// for a mesh over the answer budget; 429 when every solver slot is busy.
+/// As [`capabilities::cut_stock`]; `E_TOO_LARGE_ANSWER` at `verification.resolution` for a mesh
+/// over the answer budget; 429 when every solver slot is busy.
 pub async fn answer<C: Capability>(
     state: &AppState,
     request: C::Request,
@@ -45,9 +48,21 @@ pub async fn answer<C: Capability>(
 ) -> AppResult<Response> {
     let catalog =
         capabilities::catalog(&state.db, capability::all_refs::<C>(&request), capabilities::Catalog::default()).await?;
-    let (request, units) = capabilities::in_mm::<C>(&request, &catalog)?;
-    let request = request.into_owned();
-    let resolved = capabilities::resolve::<C>(&request, &catalog)?;
+    let ask = StockAsk { upto_line, resolution: None };
+    glb_answer(state, C::NAME, upload, move |run| capabilities::cut_stock::<C>(&request, &catalog, ask, run)).await
+}
+
+/// Runs `cut` (a cut stock's GLB) on the blocking pool within the answer budget, with `upload` as
+/// the run's file, and answers its bytes as `model/gltf-binary`, timed under `name`.
+///
+/// # Errors
+/// `cut`'s; 429 when every solver slot is busy or the memory budget cannot hold the answer.
+pub async fn glb_answer(
+    state: &AppState,
+    name: &'static str,
+    upload: Option<Bytes>,
+    cut: impl FnOnce(&Run<'_>) -> Result<Vec<u8>, AppError> + Send + 'static,
+) -> AppResult<Response> {
     let budget = AnswerBudget::new(u64::try_from(state.limits.answer_budget_bytes).unwrap_or(u64::MAX));
     let started = std::time::Instant::now();
     let bytes = state
@@ -58,22 +73,11 @@ pub async fn answer<C: Capability>(
                 purpose: Purpose::Json,
                 budget: Some(&budget),
             };
-            C::cut_stock(&request, resolved, upto_line, units, &run)
+            cut(&run)
         })
-        .await?
-        .map_err(AppError::from)?
-        .ok_or_else(|| {
-            AppError::from(SolverError::input(
-                "verification",
-                format!(
-                    "this {} request has no model to cut its program on: its verification is turned off, or it has \
-                     none (docs/spec/verify.md §9.2)",
-                    C::NAME
-                ),
-            ))
-        })?;
+        .await??;
     let seconds = started.elapsed().as_secs_f64();
-    crate::metrics::observe_solver(C::NAME, seconds);
+    crate::metrics::observe_solver(name, seconds);
     let length = bytes.len();
     let mut response =
         held_download(state.reserve_memory(length)?, pieces_of(Bytes::from(bytes)), length, GLB_MEDIA_TYPE);

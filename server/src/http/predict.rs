@@ -20,9 +20,9 @@ use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
 use super::output::{Ask, Format, wants_gcode};
+use super::own_stock::GlbFile;
 use super::own_stock::{self, StockQuery};
 use super::upload;
-use super::verify_mesh::GlbFile;
 use crate::error::{AppResult, Problem};
 use crate::extract::{AppQuery, charged_body_bytes, is_json, media_type};
 use crate::state::AppState;

@@ -1,6 +1,7 @@
 //! `POST /api/v1/verify` (docs/spec/verify.md): cuts a G-code program out of the stock with the
 //! tools it calls and answers what it found, through the capability seam (`solve::answer`): JSON,
-//! or the cut stock as binary glTF (`verify_mesh`).
+//! or the cut stock as binary glTF (`own_stock`), asked for with `?format=glb` or an `Accept` that
+//! ranks `model/gltf-binary` above `application/json` (docs/spec/verify.md §8 Mesh).
 //!
 //! The request is JSON, or `multipart/form-data` with the JSON in part `request` and the STL files
 //! of a `"kind": "mesh"` part or stock in parts `part` and `stock`. This route has the upload body
@@ -8,19 +9,19 @@
 
 use axum::body::Bytes;
 use axum::extract::{DefaultBodyLimit, Request, State};
-use axum::http::header;
+use axum::http::{HeaderMap, header};
 use axum::response::Response;
 use kerf_solver::SolverError;
 use kerf_solver::capability::Capability;
-use kerf_solver::verify::{Meshes, Solid, VerifyAnswer, VerifyCapability, VerifyRequest};
+use kerf_solver::verify::{GLB_MEDIA_TYPE, Meshes, Solid, VerifyAnswer, VerifyCapability, VerifyRequest};
 use serde::Deserialize;
 use utoipa::{IntoParams, ToSchema};
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
-use super::output::Ask;
+use super::output::{Ask, accept_prefers};
+use super::own_stock::{self, GlbFile};
 use super::upload;
-use super::verify_mesh::{self, VerifyFormat};
 use crate::error::{AppResult, Problem};
 use crate::extract::{AppQuery, charged_body_bytes, is_json, media_type};
 use crate::state::AppState;
@@ -36,6 +37,24 @@ pub struct VerifyForm {
     /// The stock as an STL file, likewise.
     #[schema(value_type = Option<String>, format = Binary)]
     pub stock: Option<Vec<u8>>,
+}
+
+/// The answer formats of the verify endpoint.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum VerifyFormat {
+    /// The findings as JSON (default).
+    Json,
+    /// The cut stock as binary glTF (`model/gltf-binary`), the JSON answer in its `extras.verify`.
+    Glb,
+}
+
+/// Whether the client asks for the mesh: `format` if given, else the `Accept` header.
+fn wants_glb(headers: &HeaderMap, format: Option<VerifyFormat>) -> bool {
+    match format {
+        Some(format) => format == VerifyFormat::Glb,
+        None => accept_prefers(headers, GLB_MEDIA_TYPE),
+    }
 }
 
 /// The form's file parts.
@@ -88,7 +107,7 @@ pub struct VerifyQuery {
             (VerifyForm = "multipart/form-data"))),
     responses(
         (status = 200, description = "The findings, volumes and removal per block (JSON), or the cut stock as binary glTF coloured by deviation from the part",
-            content((VerifyAnswer = "application/json"), (verify_mesh::GlbFile = "model/gltf-binary"))),
+            content((VerifyAnswer = "application/json"), (GlbFile = "model/gltf-binary"))),
         (status = 400, body = Problem, content_type = "application/problem+json"),
         (status = 404, description = <VerifyCapability as Capability>::ENDPOINT.not_found, body = Problem, content_type = "application/problem+json"),
         (status = 408, description = "The body arrived slower than the minimum receive rate", body = Problem, content_type = "application/problem+json"),
@@ -101,7 +120,7 @@ async fn post_verify(
     AppQuery(query): AppQuery<VerifyQuery>,
     request: Request,
 ) -> AppResult<Response> {
-    let glb = verify_mesh::wants_glb(request.headers(), query.format);
+    let glb = wants_glb(request.headers(), query.format);
     if !glb && query.upto_line.is_some() {
         return Err(SolverError::input("upto_line", "upto_line cuts the mesh: ask for format=glb").into());
     }
@@ -119,7 +138,7 @@ async fn post_verify(
     let [part, stock]: [Option<Bytes>; 2] = files.try_into().unwrap_or_default();
     let meshes = meshes(&request, part, stock)?;
     if glb {
-        return verify_mesh::answer(&state, request, meshes, query.upto_line).await;
+        return own_stock::answer::<VerifyCapability>(&state, request, meshes, query.upto_line).await;
     }
     super::solve::answer::<VerifyCapability>(&state, request, meshes, Ask::default()).await
 }

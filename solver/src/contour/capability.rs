@@ -175,6 +175,10 @@ impl Capability for ContourCapability {
         )
     }
 
+    fn set_cut_resolution(request: &mut ContourRequest, resolution: f64) {
+        request.verification.get_or_insert_with(Default::default).resolution = Some(resolution);
+    }
+
     /// The stock block less what the program (with its verification's header comments) cut, up to
     /// `upto_line`, against the part prism.
     fn cut_stock(

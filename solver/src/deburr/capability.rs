@@ -169,6 +169,10 @@ impl Capability for DeburrCapability {
         verified(request, model, answer, run)
     }
 
+    fn set_cut_resolution(request: &mut DeburrRequest, resolution: f64) {
+        request.verification.get_or_insert_with(Default::default).resolution = Some(resolution);
+    }
+
     /// The tube with its holes less what the program (with its verification's header comments)
     /// cut, up to `upto_line`, against the tube with its chamfer bands.
     fn cut_stock(

@@ -202,6 +202,10 @@ impl Capability for EngagementCapability {
         verified(request, grid, answer, run)
     }
 
+    fn set_cut_resolution(request: &mut EngagementRequest, resolution: f64) {
+        request.verification.get_or_insert_with(Default::default).resolution = Some(resolution);
+    }
+
     /// The plan-view stock extruded less what the candidate's program (with its verification's
     /// header comments) cut, up to `upto_line`, coloured by what it cut (there is no part).
     fn cut_stock(

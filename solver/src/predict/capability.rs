@@ -192,6 +192,10 @@ impl Capability for PredictCapability {
         verified(request, model, PredictAnswer { tool: context.tool, result, timings: None, verification: None }, run)
     }
 
+    fn set_cut_resolution(request: &mut PredictRequest, resolution: f64) {
+        request.verification.get_or_insert_with(Default::default).resolution = Some(resolution);
+    }
+
     /// The given stock less what the corrected program (with its verification's header comments)
     /// cut, up to `upto_line`, coloured by what it cut (there is no part).
     fn cut_stock(

@@ -103,6 +103,27 @@ impl Capability for VerifyCapability {
         Ok(VerifyAnswer { tools: context.other_tools, cut })
     }
 
+    /// The stock as the request's program (up to `upto_line`) left it, against its part: the
+    /// mesh of `?format=glb` (docs/spec/verify.md §8).
+    fn cut_stock(
+        request: &VerifyRequest,
+        context: Resolved<Option<Tool>>,
+        upto_line: Option<usize>,
+        units: crate::units::Units,
+        run: &Run<'_>,
+    ) -> Result<Option<Vec<u8>>, SolverError> {
+        let found = Found { material: context.material.as_ref(), machine: context.machine.as_ref() };
+        super::cut_stock_glb(request, context.other_tools, found, upto_line, units, run).map(Some)
+    }
+
+    fn set_cut_resolution(request: &mut VerifyRequest, resolution: f64) {
+        request.resolution = Some(resolution);
+    }
+
+    fn given_program(request: &VerifyRequest) -> Option<&str> {
+        Some(&request.program)
+    }
+
     /// Strips of the dexel grid's rows, in parts of about `sizing.part_seconds` by the rays the
     /// cutter's footprints cover on them (docs/spec/verify.md §5). Not split: a refused request
     /// (solving it whole reports why), one a job cannot carry (an STL file), a grid of one strip.

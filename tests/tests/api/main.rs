@@ -22,6 +22,7 @@ mod feeds;
 mod gcode;
 mod job_fuzz;
 mod job_program;
+mod job_stock;
 mod job_store;
 mod jobs;
 mod limits;
