@@ -1489,6 +1489,82 @@ hole = { shape = "round", diameter = 16 }
     await page.click('#engagement-compute');
     return partlessCut('engagement');
   },
+  // An opened job draws an operation's cut stock when asked ("Cut stock"), not before: a contour
+  // on a machine only the job file gives (which the capability's own stock route cannot find),
+  // with its program listed, playback removing less; and a verify operation's stock with its
+  // gouge (a negative deviation) at the finding's line.
+  async jobCut() {
+    const id = await submitElsewhere(`name = "cut stock of a job"
+[[machines]]
+name = "only-in-this-file"
+block_time_ms = 2
+max_feed = 10000
+
+[[tools]]
+number = 3
+kind = "flat"
+radius = 3
+
+[[operations]]
+operation = "contour"
+tool = 3
+machine = "only-in-this-file"
+contour = [[0, 0], [40, 0], [40, 30], [0, 30]]
+side = "outside"
+depths = { top = 0, bottom = -4, step = 2 }
+feed = 800
+
+[[operations]]
+operation = "verify"
+program = """T1 M6
+G0 X-10 Y0 Z5
+G1 Z-1 F500
+G1 X10
+G1 X12 Z-1.2
+G1 X14 Z-1
+G1 X30
+G0 Z50
+M30"""
+tools = [{ number = 1, kind = "flat", radius = 5 }]
+stock = { kind = "box", min = [-5, -4, -10], max = [25, 30, 0] }
+part = { kind = "box", min = [-5, -4, -10], max = [25, 30, -1] }
+resolution = 0.25
+`, 'application/toml');
+    await page.goto(`${base}/#/jobs`);
+    await page.waitForSelector(`#job-rows tr[data-job="${id}"][data-status="done"]`, { timeout: 60000 });
+    await page.click(`#job-rows tr[data-job="${id}"] button:has-text("Open")`);
+    await page.waitForSelector('#job-result[data-state="shown"]', { timeout: 60000 });
+    const contour = '#job-result section[data-operation="0"]';
+    const before = await page.$$eval(`${contour} #contour-stock`, (l) => l.length);
+    if (before) throw new Error('the cut stock was drawn before it was asked for');
+    const hint = await page.textContent(`${contour} .verification .hint:last-child`);
+    if (!/Cut stock/.test(hint)) throw new Error(`the verification does not say how to draw the stock: ${hint}`);
+    await page.click(`${contour} button[data-action="cut-stock"]`);
+    await page.waitForSelector(`${contour} #contour-stock[data-state="drawn"][data-stock-vertices]`, { timeout: 120000 });
+    const stock = await page.$eval(`${contour} #contour-stock`, (e) => ({ ...e.dataset }));
+    const inked = await inkedPixels(`${contour} #contour-stock canvas`);
+    if (inked < 20000) throw new Error(`the job's cut stock is nearly blank: ${inked} inked pixels`);
+    const full = Number(stock.removedVolume);
+    if (!(full > 0)) throw new Error(`nothing cut: ${JSON.stringify(stock)}`);
+    const listed = await page.$$eval(`${contour} #contour-listing li`, (l) => l.length);
+    if (listed < 10) throw new Error(`the program cut is not listed: ${listed} lines`);
+    const line = await page.$eval(`${contour} #contour-position`, (slider) => {
+      slider.value = String(Math.floor(Number(slider.max) / 4));
+      slider.dispatchEvent(new Event('input'));
+      return /line (\d+)/.exec(slider.closest('section').querySelector('#contour-playback-readout').textContent)[1];
+    });
+    await page.waitForSelector(`${contour} #contour-stock[data-upto-line="${line}"]`, { timeout: 120000 });
+    const partly = Number(await page.getAttribute(`${contour} #contour-stock`, 'data-removed-volume'));
+    if (!(partly < full)) throw new Error(`cut up to line ${line} the stock lost ${partly} mm³, the whole program ${full} mm³`);
+    const verify = '#job-result section[data-operation="1"]';
+    const findings = await page.$$eval(`${verify} #verify-findings tr`, (rows) => rows.map((r) => `${r.dataset.kind} ${r.dataset.line}`));
+    if (!findings.includes('gouge 5')) throw new Error(`the verify result lists ${findings}`);
+    await page.click(`${verify} button[data-action="cut-stock"]`);
+    await page.waitForSelector(`${verify} #verify-stock[data-state="drawn"][data-stock-vertices]`, { timeout: 120000 });
+    const deepest = Number(await page.getAttribute(`${verify} #verify-stock`, 'data-deepest-deviation'));
+    if (!(deepest < -0.1)) throw new Error(`the verify operation's gouge is not in its stock: deepest deviation ${deepest}`);
+    return { id, inked, removed: full, partly, line: Number(line), listed, findings, deepest };
+  },
 };
 
 // Scenarios kept in files of their own.

@@ -287,13 +287,12 @@ export class CutStock {
 
 // The verification of a capability's answer (its `verification` section, docs/spec/verify.md §9)
 // in `container`: a summary, the findings linked to the lines of `program` (the program the
-// verification cut: default output options, Fanuc) and, where the capability answers its cut
-// stock (`path`: `/api/v1/{name}/stock`), the stock in 3-D with playback, drawn into `scene` when
-// given (`why` says why not, without `path`). `body` is the capability's request, `send(body)` what
-// is posted for it (default the JSON; a form with a file the request reads); `resolution` the
-// spacing the page asks the stock at; `label` names the scene.
+// verification cut: default output options, Fanuc) and, with a `source` of its cut stock
+// (`requestStock`, `jobStock`), the stock in 3-D with playback, drawn into `scene` when given
+// (`why` says why not, without `source`); `resolution` the spacing the page asks the stock at;
+// `label` names the scene.
 // Resolves to the CutStock, or null when the stock cannot be drawn (said in the panel).
-export async function verificationPanel(container, { id, verification, program, path, body, send = (request) => request, resolution, scene, label, onMove, why = 'this capability does not answer its cut stock' }) {
+export async function verificationPanel(container, { id, verification, program, source, resolution, scene, label, onMove, why = 'this capability does not answer its cut stock' }) {
   const box = document.createElement('section');
   box.className = 'verification';
   box.id = `${id}-verification`;
@@ -325,11 +324,10 @@ export async function verificationPanel(container, { id, verification, program, 
   let stock = null;
   showFindings(table.querySelector('tbody'), verification.findings, listing, () => stock);
   if (program) showListing(listing, program, verification.findings);
-  if (!path || !program) {
+  if (!source || !program) {
     stockBox.append(Object.assign(document.createElement('p'), { className: 'hint', textContent: `The cut stock is not drawn here: ${why}.` }));
     return null;
   }
-  const request = { ...body, verification: { ...(body.verification ?? {}), resolution } };
   stock = new CutStock(stockBox, {
     id,
     program,
@@ -339,10 +337,7 @@ export async function verificationPanel(container, { id, verification, program, 
     scene,
     label,
     onMove,
-    ask: async (line) => {
-      const query = line === undefined ? '' : `?upto_line=${line}`;
-      return (await api('POST', `${path}${query}`, send(request), 'model/gltf-binary')).arrayBuffer();
-    },
+    ask: (line) => source.ask(line, resolution),
   });
   try {
     await stock.draw();
@@ -351,6 +346,38 @@ export async function verificationPanel(container, { id, verification, program, 
     stockBox.append(Object.assign(document.createElement('p'), { className: 'message warning', textContent: `The cut stock cannot be drawn: ${problem.detail ?? problem.message ?? problem}` }));
     return null;
   }
+}
+
+// Where a capability's cut stock comes from when the page holds its request: the program its
+// verification cuts (the answer's with the default output options in the Fanuc dialect, from the
+// capability's program route, whose lines the findings and `upto_line` count) and the stock cut
+// up to a line at a spacing (`POST /api/v1/{name}/stock`). `body` as posted; `send(body)` what is
+// posted for it (default the JSON; a form with a file the request reads).
+export function requestStock(name, body, send = (request) => request) {
+  return {
+    program: () => api('POST', `/api/v1/${name}/program?dialect=fanuc`, send(body), 'text/x-gcode'),
+    ask: async (line, resolution) => {
+      const request = resolution === undefined ? body : { ...body, verification: { ...(body.verification ?? {}), resolution } };
+      const query = line === undefined ? '' : `?upto_line=${line}`;
+      return (await api('POST', `/api/v1/${name}/stock${query}`, send(request), 'model/gltf-binary')).arrayBuffer();
+    },
+  };
+}
+
+// Where a job operation's cut stock comes from: the job's stored file, through
+// `GET /api/v1/jobs/{id}/stock` and `/stock/program` (the program cut, as the stored findings
+// count its lines), so an operation on a machine or tool given only in the job file draws too.
+export function jobStock(id, operation) {
+  const at = `/api/v1/jobs/${id}/stock`;
+  return {
+    program: () => api('GET', `${at}/program?operation=${operation}`, undefined, 'text/x-gcode'),
+    ask: async (line, resolution) => {
+      const query = new URLSearchParams({ operation: String(operation) });
+      if (line !== undefined) query.set('upto_line', String(line));
+      if (resolution !== undefined) query.set('resolution', String(resolution));
+      return (await api('GET', `${at}?${query}`, undefined, 'model/gltf-binary')).arrayBuffer();
+    },
+  };
 }
 
 // The note of a view whose program has no stock to cut (segment, resegment): said on the page,
@@ -362,26 +389,18 @@ export function noStockNote(capability) {
   });
 }
 
-// The program a capability's verification cuts (docs/spec/verify.md §9): the answer's with the
-// default output options in the Fanuc dialect, from the capability's program route, whose lines
-// the findings and `upto_line` count. `body` as posted (JSON, or a form).
-export function verifiedProgram(name, body) {
-  return api('POST', `/api/v1/${name}/program?dialect=fanuc`, body, 'text/x-gcode');
-}
-
 // The verification of a capability whose model has no part (predict, engagement), in `container`:
-// with `cutStock` (the form's answer, whose request `body` the page holds) the program it cut and
-// the stock it cut in 3-D, coloured by what was cut, with playback (`POST /api/v1/{name}/stock`);
-// without (a job's answer), the findings only, `why` saying why. `send(body)` is what is posted.
-// Resolves to the CutStock, or null.
-export async function partlessPanel(container, { name, verification, body, send = (request) => request, cutStock, why }) {
+// with the `source` of its cut stock (`requestStock`, `jobStock`) the program it cut and the
+// stock it cut in 3-D, coloured by what was cut, with playback; without, the findings only, `why`
+// saying why. Resolves to the CutStock, or null.
+export async function partlessPanel(container, { name, verification, source, why }) {
   const panel = { id: name, verification, why, label: 'Cut stock coloured by what the program cut' };
-  if (!cutStock || !body) return verificationPanel(container, panel);
+  if (!source) return verificationPanel(container, panel);
   let program;
   try {
-    program = await verifiedProgram(name, send(body));
+    program = await source.program();
   } catch (problem) {
     return verificationPanel(container, { ...panel, why: `its program cannot be written again: ${problem.detail ?? problem.title ?? problem}` });
   }
-  return verificationPanel(container, { ...panel, program, path: `/api/v1/${name}/stock`, body, send, resolution: verification.resolution });
+  return verificationPanel(container, { ...panel, program, source, resolution: verification.resolution });
 }

@@ -5,7 +5,7 @@
 // warnings and the G-code download. `contourResult` also renders job results.
 import { Timeline } from '/timeline.js';
 import { DXF_FIELDS, dxfUpload } from '/dxf.js';
-import { verificationPanel, verifiedProgram } from '/plot/cut-stock.js';
+import { requestStock, verificationPanel } from '/plot/cut-stock.js';
 import { ContourPlan } from '/plot/plan.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
 import { answerAndProgram, downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, POST_OPTIONS, programName, refusalMessage, showSummary, submitFlow, value, warningMessages } from '/form.js';
@@ -225,10 +225,11 @@ function summaryItems(answer) {
 }
 
 // Shows a contour answer in `container`: layer selector, plot, corner table, summary, warnings,
-// and with a program its verification (`cutStock`: with the stock as cut, which cuts the program
-// again: the form's, not a job's, whose work may be long). Used by the form and by job results.
+// and with a program its verification (`cutStock`: where the stock as cut comes from,
+// `requestStock` or `jobStock`; drawing it cuts the program again, so a job result asks for it
+// with a button). Used by the form and by job results.
 // Returns the canvas.
-export function contourResult(container, answer, { program, request, cutStock = false } = {}) {
+export function contourResult(container, answer, { program, request, cutStock = null } = {}) {
   container.replaceChildren();
   const bar = document.createElement('div');
   bar.className = 'actions layer-bar';
@@ -324,19 +325,18 @@ export function contourResult(container, answer, { program, request, cutStock = 
     });
     sceneBox.after(timeline.root);
   }
-  if (program && request && answer.verification) drawCutStock(container, answer, request, cutStock);
+  if (program && request && answer.verification) drawCutStock(container, answer, cutStock);
   return canvas;
 }
 
 // The findings of the contour's own verification, and (`cutStock`) the stock block as the program
 // cuts it, from the server's cut stock of that verification (POST /api/v1/contour/stock, at the verification's spacing, in the program's
 // default Fanuc form, whose lines the findings count), with the findings and playback.
-async function drawCutStock(container, answer, request, cutStock) {
+async function drawCutStock(container, answer, cutStock) {
   let program = null;
-  // A job's answer is listed without its program: fetching it solves the job's work again.
   if (cutStock) {
     try {
-      program = await verifiedProgram('contour', request);
+      program = await cutStock.program();
     } catch (problem) {
       container.append(message('warning', `The cut stock cannot be drawn: ${problem.detail || problem.title}`));
       return;
@@ -346,9 +346,8 @@ async function drawCutStock(container, answer, request, cutStock) {
     id: 'contour',
     verification: answer.verification,
     program,
-    path: cutStock ? '/api/v1/contour/stock' : undefined,
-    why: 'a job\'s program is cut again only in the Contour view',
-    body: request,
+    source: cutStock,
+    why: 'press “Cut stock” to cut the program again',
     resolution: answer.verification.resolution,
   });
 }
@@ -444,7 +443,7 @@ export const contourView = {
       ask: (body) => answerAndProgram('/api/v1/contour', body, gcodeQuery(form)),
       show: ({ answer, program, refusal }, request) => {
         root.querySelector('#contour-gcode').disabled = !program;
-        contourResult(result, answer, { program, request, cutStock: true }).id = 'contour-plot';
+        contourResult(result, answer, { program, request, cutStock: requestStock('contour', request) }).id = 'contour-plot';
         return refusalMessage(refusal, 'this path');
       },
       failed: (problem) => markContour(form, messages, problem),

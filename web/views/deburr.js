@@ -3,7 +3,7 @@
 // Deburr).
 import { api, program as programOf, sentence } from '/api.js';
 import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadTools, machineFields, message, number, numeric, POST_OPTIONS, programName, showSummary, submitFlow, value, warningMessages } from '/form.js';
-import { verificationPanel, verifiedProgram } from '/plot/cut-stock.js';
+import { requestStock, verificationPanel } from '/plot/cut-stock.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
 import { clearance, inRadii } from '/views/deburr-clearance.js';
@@ -166,12 +166,13 @@ function addWorkpiece(scene, request) {
 
 // Shows a deburr answer in `container`: the 3-D scene (solids when the request is known, ridge,
 // ball-centre path, approach and retract, the tool at the timeline's move), summary, warnings,
-// and with a program the timeline and its listing, and its verification (`cutStock`: with the
-// tube as cut, which cuts the program again: the form's, not a job's, whose work may be long).
-// `context`: {request, program, problem, reference, cutStock}. Used by the form and by job results.
+// and with a program the timeline and its listing, and its verification (`cutStock`: where the
+// tube as cut comes from, `requestStock` or `jobStock`; drawing it cuts the program again, so a
+// job result asks for it with a button). `context`: {request, program, problem, reference,
+// cutStock}. Used by the form and by job results.
 export function deburrResult(container, answer, context = {}) {
   container.replaceChildren();
-  const { request, program, problem, reference = 'tip', cutStock = false } = context;
+  const { request, program, problem, reference = 'tip', cutStock = null } = context;
   const warnings = document.createElement('div');
   const summaryBox = document.createElement('div');
   summaryBox.className = 'summary';
@@ -257,7 +258,7 @@ export function deburrResult(container, answer, context = {}) {
   if (answer.cycle_time) items.push(['cycle time, s', number(answer.cycle_time.total_s, 1)]);
   showSummary(summaryBox, items);
   warnings.replaceChildren(...notes, ...warningMessages(answer.warnings));
-  if (request && program && answer.verification) drawCutTube(container, scene, answer, request, lift(tool, 'tip'), cutStock);
+  if (request && program && answer.verification) drawCutTube(container, scene, answer, lift(tool, 'tip'), cutStock);
   return scene.root;
 }
 
@@ -280,16 +281,15 @@ export function tubeResolution(answer) {
 }
 
 // The tube with its holes and the chamfers as the program cuts them, from the server's cut stock
-// of the deburr's own verification (POST /api/v1/deburr/stock, in the program's default Fanuc
-// form, whose lines the findings count), drawn in the deburr scene in place of the see-through
-// tube and hole wall (the view closes in on the chamfers); the findings listed under it, and playback that
-// cuts the chamfer move by move.
-async function drawCutTube(container, scene, answer, request, centreLift, cutStock) {
+// of the deburr's own verification (`cutStock`: POST /api/v1/deburr/stock, or a job operation's,
+// in the program's default Fanuc form, whose lines the findings count), drawn in the deburr scene
+// in place of the see-through tube and hole wall (the view closes in on the chamfers); the
+// findings listed under it, and playback that cuts the chamfer move by move.
+async function drawCutTube(container, scene, answer, centreLift, cutStock) {
   let program = null;
-  // A job's answer is listed without its program: fetching it solves the job's work again.
   if (cutStock) {
     try {
-      program = await verifiedProgram('deburr', request);
+      program = await cutStock.program();
     } catch (problem) {
       container.append(message('warning', `The cut tube cannot be drawn: ${sentence(problem.detail || problem.title)}`));
       return;
@@ -299,9 +299,8 @@ async function drawCutTube(container, scene, answer, request, centreLift, cutSto
     id: 'deburr',
     verification: answer.verification,
     program,
-    path: cutStock ? '/api/v1/deburr/stock' : undefined,
-    why: 'a job\'s program is cut again only in the Deburr view',
-    body: request,
+    source: cutStock,
+    why: 'press “Cut stock” to cut the program again',
     resolution: tubeResolution(answer),
     scene,
     onMove: (move) => scene.moveTool([move.position[0], move.position[1], move.position[2] + centreLift]),
@@ -357,7 +356,7 @@ export const deburrView = {
       } catch (refused) {
         problem = refused;
       }
-      const scene = deburrResult(result, last.answer, { request: last.request, program, problem, reference, cutStock: true });
+      const scene = deburrResult(result, last.answer, { request: last.request, program, problem, reference, cutStock: requestStock('deburr', last.request) });
       scene.id = 'deburr-plot';
       // Off when the service refuses the program or the page sees the approach cut the wall;
       // the reason is beside the button (a tooltip alone is out of reach on a touch screen).

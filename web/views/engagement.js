@@ -10,7 +10,7 @@ import { api } from '/api.js';
 import { PathChart, barChart } from '/plot/charts.js';
 import { ToolPlan } from '/plot/tool-plan.js';
 import { examplePoints } from '/units.js';
-import { partlessPanel } from '/plot/cut-stock.js';
+import { partlessPanel, requestStock } from '/plot/cut-stock.js';
 import { downloadFlow, gcodeQuery, half, keepForm, loadMachines, loadMaterials, loadTools, message, number, numeric, POST_OPTIONS, programName, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
 
 const SAMPLE_PATHS = [
@@ -623,8 +623,9 @@ function renderColumn(column, result, answer, axis) {
 // Shows an engagement answer in `container`: one candidate path at a time, chosen with tabs that
 // name each path's best flute count; the charts take the width of the result column.
 // `onSelect(index)` hears which candidate is shown (the form's G-code choice follows it); with
-// `cutStock` (the form's answer) the stock its `request`'s program cuts is drawn in 3-D.
-export function engagementResult(container, answer, { onSelect, request, cutStock = false } = {}) {
+// `cutStock` (where it comes from: `requestStock`, `jobStock`) the stock its program cuts is drawn
+// in 3-D.
+export function engagementResult(container, answer, { onSelect, cutStock = null } = {}) {
   container.replaceChildren();
   const candidates = answer.candidates || [answer];
   const controls = document.createElement('div');
@@ -644,9 +645,8 @@ export function engagementResult(container, answer, { onSelect, request, cutStoc
     partlessPanel(container, {
       name: 'engagement',
       verification: answer.verification,
-      body: request,
-      cutStock,
-      why: 'a job\'s program is cut again only in the Engagement view',
+      source: cutStock,
+      why: 'press “Cut stock” to cut the program again',
     });
   }
   const id = `candidate-${Math.random().toString(36).slice(2, 8)}`;
@@ -752,7 +752,7 @@ export const engagementView = {
       },
       ask: (body) => api('POST', '/api/v1/engagement', body),
       show: (answer, body) => {
-        engagementResult(result, answer, { onSelect: (i) => { form.elements.candidate.value = String(i); }, request: body, cutStock: true });
+        engagementResult(result, answer, { onSelect: (i) => { form.elements.candidate.value = String(i); }, cutStock: requestStock('engagement', body) });
         result.dataset.state = 'drawn';
       },
     });

@@ -2,6 +2,7 @@
 // result with the view of its operation, download G-code and JSON (docs/spec/api.md, Jobs).
 import { api, binary, sentence, technical } from '/api.js';
 import { confirmButton, download, message, showProblem, showSummary } from '/form.js';
+import { jobStock } from '/plot/cut-stock.js';
 import { resultView } from '/views.js';
 
 const LAYOUT = `
@@ -289,7 +290,19 @@ async function openJob(id, root) {
         // The operation's request from the job file: a deburr result then shows its tube and
         // hole and the clearance check, as the deburr view does.
         const request = file?.operations?.[index];
-        show(view, result.result, { ...(program ? { program } : {}), ...(request ? { request: requestOf(request, file) } : {}) });
+        const context = { ...(program ? { program } : {}), ...(request ? { request: requestOf(request, file) } : {}) };
+        show(view, result.result, context);
+        // The stock as the operation's program cut it solves the operation again, so it is drawn
+        // when asked for, not on opening the job.
+        if (request && cutsStock(result)) {
+          const cut = button('Cut stock', () => {
+            cut.disabled = true;
+            show(view, result.result, { ...context, cutStock: jobStock(id, index) });
+          });
+          cut.dataset.action = 'cut-stock';
+          cut.title = 'Cut the program again on the operation\'s model and draw the stock it leaves, with playback';
+          actions.append(cut);
+        }
       })());
     });
     await Promise.all(shown);
@@ -299,6 +312,12 @@ async function openJob(id, root) {
   } catch (problem) {
     showProblem(root.querySelector('#job-messages'), null, problem);
   }
+}
+
+// Whether a job result has a cut stock to draw: a verify operation's, or a capability's whose
+// answer carries its own verification (it has a model and verification was on).
+function cutsStock(result) {
+  return result.operation === 'verify' || Boolean(result.result?.verification);
 }
 
 // An operation of a job file as the request its endpoint takes: without `operation`, its tool

@@ -6,7 +6,7 @@
 import { api } from '/api.js';
 import { clearProblem, downloadFlow, half, keepForm, loadTools, message, number, numeric, parseDecimal, showProblem, showSummary, submitFlow, toolLabel, value, warningMessages } from '/form.js';
 import { css, diverging, drawColourScale, drawHistogram } from '/plot/colour.js';
-import { partlessPanel } from '/plot/cut-stock.js';
+import { partlessPanel, requestStock } from '/plot/cut-stock.js';
 import { Scene3D, THREE } from '/plot/scene3d.js';
 import { Timeline } from '/timeline.js';
 import { inUnits, lengthFactor, showInUnits, unitsOf } from '/units.js';
@@ -341,10 +341,10 @@ function runs(passes) {
 
 // Shows a prediction in `container`: path coloured by error with its scale, histogram, summary,
 // worst passes and warnings. `context`: the `request` adds the stock, the `program` the timeline
-// (a worst pass goes to its line), with `cutStock` (the form's answer) the stock the corrected
-// program cuts in 3-D (`stockFile`: the STL stock the request was sent with). Used by the form and
-// by job results.
-export function predictResult(container, answer, { request, program, stockTriangles, stockFile, cutStock = false } = {}) {
+// (a worst pass goes to its line), with `cutStock` (where the stock the corrected program cuts
+// comes from: `requestStock` with the STL stock the request was sent with, or `jobStock`) that
+// stock in 3-D. Used by the form and by job results.
+export function predictResult(container, answer, { request, program, stockTriangles, cutStock = null } = {}) {
   container.replaceChildren();
   // Everything here is in the answer's units, whatever the switch says until it is computed again.
   const units = answer.units === 'inch' ? 'inch' : 'mm';
@@ -482,10 +482,8 @@ export function predictResult(container, answer, { request, program, stockTriang
     partlessPanel(container, {
       name: 'predict',
       verification: answer.verification,
-      body: request,
-      send: (body) => payload({ body, file: stockFile }),
-      cutStock,
-      why: 'a job\'s program is cut again only in the Predict view',
+      source: cutStock,
+      why: 'press “Cut stock” to cut the program again',
     });
   }
   return scene.root;
@@ -524,7 +522,7 @@ export const predictView = {
         const stockTriangles = file ? stlTriangles(await file.arrayBuffer()) : null;
         const toAnswer = lengthFactor(body.stock.units ?? body.units, answer.units ?? 'mm');
         if (stockTriangles && toAnswer !== 1) stockTriangles.forEach((v, k) => { stockTriangles[k] = v * toAnswer; });
-        predictResult(result, answer, { request: body, program: body.path.program, stockTriangles, stockFile: file, cutStock: true }).id = 'predict-plot';
+        predictResult(result, answer, { request: body, program: body.path.program, stockTriangles, cutStock: requestStock('predict', body, (request) => payload({ body: request, file })) }).id = 'predict-plot';
         result.querySelector('canvas.histogram').id = 'predict-histogram';
       },
       done: (answer, request, seconds) => `${answer.summary.passes} passes predicted in ${seconds.toFixed(2)} s.`,

@@ -40,13 +40,17 @@ const FORM = `
   </form>
   <section id="verify-result">
     <div id="verify-messages"></div>
-    <div class="summary" id="verify-summary"></div>
-    <div class="table-scroll"><table class="worst"><thead><tr><th>finding</th><th>line</th><th>position, mm</th><th>depth, mm</th><th data-units-fixed>volume, mm³</th></tr></thead>
-      <tbody id="verify-findings"></tbody></table></div>
-    <div id="verify-scene"></div>
-    <ol class="listing" id="verify-listing" aria-label="G-code program" tabindex="0"></ol>
+    <div id="verify-answer"></div>
   </section>
 </div>`;
+
+// A verify answer: its figures, the findings linked to the program's lines, the cut stock.
+const ANSWER = `
+  <div class="summary" id="verify-summary"></div>
+  <div class="table-scroll"><table class="worst"><thead><tr><th>finding</th><th>line</th><th>position, mm</th><th>depth, mm</th><th data-units-fixed>volume, mm³</th></tr></thead>
+    <tbody id="verify-findings"></tbody></table></div>
+  <div id="verify-scene"></div>
+  <ol class="listing" id="verify-listing" aria-label="G-code program" tabindex="0"></ol>`;
 
 // "x y z" (spaces or semicolons; a comma is a decimal comma) into three numbers, or a problem at
 // the field.
@@ -93,10 +97,14 @@ function payload(body, file) {
   return form;
 }
 
-// The answer, in its own units (lengths in mm or in; volumes in the mm³ their names say).
-function showAnswer(root, answer, program) {
-  showInUnits(root.querySelector('#verify-result'), answer.units);
-  const summary = root.querySelector('#verify-summary');
+// Shows a verify answer in `container`, in its own units (lengths in mm or in; volumes in the mm³
+// their names say): its figures, the findings linked to the lines of `request.program`, and with
+// `cutStock` (where the stock comes from: `formStock`, or a job operation's `jobStock`) the stock
+// as the program cut it. Used by the form and by job results.
+export function verifyResult(container, answer, { request, cutStock = null } = {}) {
+  container.innerHTML = ANSWER;
+  showInUnits(container, answer.units);
+  const summary = container.querySelector('#verify-summary');
   showSummary(summary, [
     ['Result ', answer.ok ? 'no findings' : `${answer.findings.length} findings`],
     ['Removed ', `${number(answer.removed_volume_mm3, 1)} mm³`],
@@ -105,43 +113,52 @@ function showAnswer(root, answer, program) {
     ['Spacing ', `${number(answer.resolution)} mm`],
   ]);
   summary.children[1].dataset.unitsFixed = '';
-  const listing = root.querySelector('#verify-listing');
-  showListing(listing, program, answer.findings);
-  showFindings(root.querySelector('#verify-findings'), answer.findings, listing, () => root.verifyStock);
+  const listing = container.querySelector('#verify-listing');
+  if (request?.program) showListing(listing, request.program, answer.findings);
+  showFindings(container.querySelector('#verify-findings'), answer.findings, listing, () => container.verifyStock);
+  if (request && cutStock) drawStock(container, answer, request, cutStock);
+  return container;
 }
 
-// The mesh request: the same cut, at a spacing coarsened to at most MESH_RAYS rays.
-function meshBody(body, answer) {
+// The spacing the page asks the mesh at: the answer's, coarsened to at most MESH_RAYS rays.
+function meshResolution(answer) {
   const [nx, ny] = answer.rays;
   const rays = nx * ny;
-  const resolution = rays > MESH_RAYS ? answer.resolution * Math.sqrt(rays / MESH_RAYS) * 1.001 : answer.resolution;
-  return { ...body, resolution };
+  return rays > MESH_RAYS ? answer.resolution * Math.sqrt(rays / MESH_RAYS) * 1.001 : answer.resolution;
+}
+
+// Where the form's cut stock comes from: the same request (and part file) with `?format=glb`.
+function formStock(body, file) {
+  return {
+    program: async () => body.program,
+    ask: async (line, resolution) => {
+      const query = line === undefined ? '?format=glb' : `?format=glb&upto_line=${line}`;
+      return (await api('POST', `/api/v1/verify${query}`, payload({ ...body, resolution }, file), 'model/gltf-binary')).arrayBuffer();
+    },
+  };
 }
 
 // Draws the cut stock of `answer` under the findings; a refusal of the mesh (too large) is shown
 // as a message, the findings stay.
-async function drawStock(root, answer, body, file) {
-  const mesh = meshBody(body, answer);
+async function drawStock(container, answer, request, source) {
+  const resolution = meshResolution(answer);
   // The service's tolerance and allowance when the request gives none are in mm.
   const fromMm = lengthFactor('mm', answer.units ?? 'mm');
-  const container = root.querySelector('#verify-scene');
-  container.replaceChildren();
-  const stock = new CutStock(container, {
+  const scene = container.querySelector('#verify-scene');
+  scene.replaceChildren();
+  const stock = new CutStock(scene, {
     id: 'verify',
-    program: body.program,
+    program: request.program,
     findings: answer.findings,
-    tolerance: body.tolerance ?? 0.01 * fromMm,
-    allowance: body.allowance ?? 0.1 * fromMm,
-    ask: async (line) => {
-      const query = line === undefined ? '?format=glb' : `?format=glb&upto_line=${line}`;
-      return (await api('POST', `/api/v1/verify${query}`, payload(mesh, file), 'model/gltf-binary')).arrayBuffer();
-    },
+    tolerance: request.tolerance ?? 0.01 * fromMm,
+    allowance: request.allowance ?? 0.1 * fromMm,
+    ask: (line) => source.ask(line, resolution),
   });
-  root.verifyStock = stock;
+  container.verifyStock = stock;
   try {
     await stock.draw();
   } catch (problem) {
-    root.querySelector('#verify-messages').append(message('warning', `The cut stock cannot be drawn: ${problem.detail ?? problem.message ?? problem}`));
+    scene.append(message('warning', `The cut stock cannot be drawn: ${problem.detail ?? problem.message ?? problem}`));
   }
 }
 
@@ -169,8 +186,9 @@ export const verifyView = {
       read: () => request(form),
       ask: (body) => api('POST', '/api/v1/verify', payload(body, partFile(form))),
       show: (answer, body) => {
-        showAnswer(root, answer, body.program);
-        drawStock(root, answer, body, partFile(form));
+        // The messages too are in the answer's units.
+        showInUnits(root.querySelector('#verify-result'), answer.units);
+        verifyResult(root.querySelector('#verify-answer'), answer, { request: body, cutStock: formStock(body, partFile(form)) });
         return answer.ok ? null : message('error', `The program cut wrong: ${[...new Set(answer.findings.map((f) => f.kind.replaceAll('_', ' ')))].join(', ')}.`);
       },
       done: (answer) => (answer.ok ? 'Verified: the program cuts the part as it should.' : 'Verified.'),
@@ -178,4 +196,4 @@ export const verifyView = {
   },
 };
 
-export const view = { title: 'Verify', mount: verifyView.mount };
+export const view = { title: 'Verify', mount: verifyView.mount, result: verifyResult };

@@ -476,3 +476,16 @@ async fn engagement_page_draws_the_stock_its_program_cuts() {
     assert!(result["partly"].as_f64() < result["removed"].as_f64(), "{result}");
     assert!(result["green"].as_u64() > Some(0), "{result}");
 }
+
+#[tokio::test(flavor = "multi_thread")]
+#[cfg_attr(
+    not(kerf_has_chromium),
+    ignore = "chromium or its driver not found: apt-get install chromium npm; npm ci --prefix tests/browser"
+)]
+async fn an_opened_job_draws_an_operations_cut_stock_when_asked() {
+    let app = TestApp::spawn().await;
+    let Some(result) = run_scenario(&app, "jobCut", &[]) else { return };
+    assert_eq!(result["ok"], true);
+    assert!(result["partly"].as_f64() < result["removed"].as_f64(), "{result}");
+    assert!(result["deepest"].as_f64() < Some(-0.1), "{result}");
+}
