@@ -3,11 +3,12 @@
 //! only in the file (which `POST /api/v1/{name}/stock` cannot find) draws; the cut is the stored
 //! result's verification (same removed volume and findings), playback up to a line removes less,
 //! the program listed is the one whose lines the findings count (Fanuc, whatever the job's post;
-//! verify's own program), an inch job's stock is in inches, and bad asks get their problem.
+//! verify's own program), on SQLite and PostgreSQL; an inch job's stock is in inches, and bad asks
+//! get their problem.
 
 use std::path::Path;
 
-use kerf_tests::{TestApp, finished, json_with, poll_job, problem};
+use kerf_tests::{Store, TestApp, finished, json_with, poll_job, problem};
 use serde_json::{Value, json};
 
 use crate::verify_mesh::chunks;
@@ -40,9 +41,10 @@ fn removed(verification: &Value) -> f64 {
     verification["removed_volume_mm3"].as_f64().unwrap_or(0.0)
 }
 
-#[tokio::test(flavor = "multi_thread")]
-async fn a_jobs_operation_is_cut_on_the_machine_its_file_gives() {
-    let app = TestApp::spawn().await;
+kerf_tests::on_both_stores!(a_jobs_operation_is_cut_on_the_machine_its_file_gives);
+
+async fn a_jobs_operation_is_cut_on_the_machine_its_file_gives(store: Store) {
+    let app = TestApp::spawn_on(store, |_| {}).await.expect("a service on the store");
     let mut job = shop_job();
     job["output"]["dialect"] = json!("linuxcnc");
     let (id, state) = run(&app, &job).await;
