@@ -15,6 +15,7 @@ use utoipa::IntoParams;
 use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
+use super::jobs::{JobId, done_record};
 use super::own_stock::{GlbFile, glb_answer};
 use crate::capabilities::StockAsk;
 use crate::error::{AppError, AppResult, Problem};
@@ -22,7 +23,6 @@ use crate::extract::{AppPath, AppQuery};
 use crate::jobs::file::JobFile;
 use crate::state::AppState;
 use crate::store;
-use crate::store::jobs::JobStatus;
 
 /// Which operation's stock, cut how far, at which spacing.
 #[derive(Debug, Deserialize, IntoParams)]
@@ -50,21 +50,13 @@ pub struct JobOperationQuery {
     pub operation: usize,
 }
 
-/// The `{id}` path parameter.
-#[derive(Debug, Deserialize)]
-struct JobId {
-    id: i64,
-}
-
 /// The stored job file of finished job `id`: 404 for an unknown job, 409 for one not done, 400
 /// naming `operation` for an index it does not have.
 async fn done_file(state: &AppState, id: i64, operation: usize) -> AppResult<JobFile> {
-    let gone = || AppError::not_found(format!("job {id} does not exist"));
-    let job = store::jobs::get(&state.db, id).await?.ok_or_else(gone)?;
-    if job.status != JobStatus::Done {
-        return Err(AppError::Conflict(format!("job {id} is {:?}, not done", job.status).to_lowercase()));
-    }
-    let json = store::outputs::job_file(&state.db, id).await?.ok_or_else(gone)?;
+    done_record(state, id).await?;
+    let json = store::outputs::job_file(&state.db, id)
+        .await?
+        .ok_or_else(|| AppError::not_found(format!("job {id} does not exist")))?;
     let file: JobFile = serde_json::from_str(&json).map_err(|error| AppError::Internal(error.into()))?;
     let count = file.operations.len();
     if operation >= count {

@@ -111,8 +111,8 @@ pub struct ProgramQuery {
 
 /// The `{id}` path parameter.
 #[derive(Debug, Deserialize)]
-struct JobId {
-    id: i64,
+pub(super) struct JobId {
+    pub(super) id: i64,
 }
 
 /// Reads the uploaded job file's text and its format.
@@ -238,7 +238,7 @@ async fn record(state: &AppState, id: i64) -> AppResult<JobRecord> {
 }
 
 /// The record of a finished job: 404 for an unknown one, 409 for one not done.
-async fn done_record(state: &AppState, id: i64) -> AppResult<JobRecord> {
+pub(super) async fn done_record(state: &AppState, id: i64) -> AppResult<JobRecord> {
     let job = record(state, id).await?;
     if job.status != JobStatus::Done {
         return Err(AppError::Conflict(format!("job {id} is {:?}, not done", job.status).to_lowercase()));
