@@ -16,28 +16,17 @@ use serde_json::{Value, json};
 use crate::predict::box_stl_binary;
 use crate::verify_mesh::{chunks, values};
 
-/// A GLB's JSON chunk and the `_DEVIATION` values of its one primitive.
-fn read(bytes: &[u8]) -> (Value, Vec<f32>) {
-    let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
-    assert_eq!(&bytes[0..4], b"glTF");
-    assert_eq!(word(8), bytes.len());
-    let length = word(12);
-    let json: Value = serde_json::from_slice(&bytes[20..20 + length]).unwrap();
-    let bin = &bytes[20 + length + 8..];
-    let Some(index) = json["meshes"][0]["primitives"][0]["attributes"]["_DEVIATION"].as_u64() else {
+/// A GLB's JSON chunk and the `_DEVIATION` values of its one primitive (none without them).
+fn read(bytes: &[u8]) -> (Value, Vec<f64>) {
+    let (json, bin) = chunks(bytes);
+    if json["meshes"][0]["primitives"][0]["attributes"]["_DEVIATION"].is_null() {
         return (json, Vec::new());
-    };
-    let accessor = &json["accessors"][index as usize];
-    let view = &json["bufferViews"][accessor["bufferView"].as_u64().unwrap() as usize];
-    let offset = view["byteOffset"].as_u64().unwrap() as usize;
-    let deviations = bin[offset..offset + view["byteLength"].as_u64().unwrap() as usize]
-        .chunks(4)
-        .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
-        .collect();
+    }
+    let deviations = values(&json, &bin, "_DEVIATION");
     (json, deviations)
 }
 
-async fn stock(app: &TestApp, path: &str, body: &Value) -> (Value, Vec<f32>) {
+async fn stock(app: &TestApp, path: &str, body: &Value) -> (Value, Vec<f64>) {
     let response = app.client.post(app.url(path)).json(body).send().await.unwrap();
     let status = response.status().as_u16();
     let kind = response.headers()["content-type"].to_str().unwrap().to_owned();
@@ -58,7 +47,7 @@ async fn deburr_stock_is_its_verification_cut_with_the_chamfer_band() {
     assert_eq!(cut["findings"], verification["findings"]);
     // The chamfer band: surfaces a cut left within tolerance of the part (a non-zero deviation);
     // the tube elsewhere is the part exactly.
-    let tolerance = verification["tolerance"].as_f64().unwrap() as f32;
+    let tolerance = verification["tolerance"].as_f64().unwrap();
     let band = deviations.iter().filter(|d| d.abs() > 1e-7 && d.abs() <= tolerance).count();
     let untouched = deviations.iter().filter(|d| **d == 0.0).count();
     assert!(band > 100 && untouched > band, "band {band}, untouched {untouched} of {}", deviations.len());
