@@ -706,9 +706,20 @@ pub fn program<C: Capability>(
         ..*output
     };
     let text = C::program(request, answer, &output, control)?;
-    Ok(crate::gcode::with_haas_smoothing(
-        text,
-        output.dialect.unwrap_or_default(),
-        machine.and_then(|m| m.haas_smoothing),
-    ))
+    let dialect = output.dialect.unwrap_or_default();
+    let text = crate::gcode::with_haas_smoothing(text, dialect, machine.and_then(|m| m.haas_smoothing));
+    if dialect == Dialect::Fanuc || !text.contains(" AT LINE ") {
+        return Ok(text);
+    }
+    // The verification's warnings name lines of the Fanuc program it cut (the default output
+    // options, `verify::own::program`), here in this program's units and reference so that the
+    // same moves print the same: their lines are this program's own once matched.
+    let verified = OutputOptions {
+        dialect: Some(Dialect::Fanuc),
+        units: output.units,
+        reference: output.reference,
+        ..OutputOptions::default()
+    };
+    let verified = program::<C>(request, answer, &verified, control)?;
+    Ok(crate::gcode::renumber::warnings_in_own_lines(text, &verified))
 }

@@ -26,7 +26,9 @@ fn every_capability_writes_as_before() {
                 let text = capability::program::<C>(&request, &answer, &output, Control::default())
                     .unwrap_or_else(|error| panic!("{} writes: {error:?}", C::NAME));
                 assert!(text.lines().count() > 10, "{}: {text}", C::NAME);
-                assert_eq!(COMPARED.with(Cell::get), before + 1, "{} was compared with the old writer", C::NAME);
+                // More than once where the program's verification warnings name lines: the Fanuc
+                // program is written again to find them in this post's.
+                assert!(COMPARED.with(Cell::get) > before, "{} was compared with the old writer", C::NAME);
             }
         }
     }

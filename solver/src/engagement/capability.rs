@@ -575,6 +575,51 @@ mod verification_tests {
         assert!(answer.verification.is_none());
     }
 
+    /// The numbers of a block (its line number, `+` signs and words' letters left out): `G01
+    /// X70.0000 Y20.0000 Z-2.0000 F300` and `7 L X+70.0000 Y+20.0000 Z-2.0000 R0 F300` both give
+    /// the point 70, 20, -2 first.
+    fn point_of(block: &str) -> Vec<f64> {
+        block
+            .split_ascii_whitespace()
+            .filter(|word| matches!(word.as_bytes().first(), Some(b'X' | b'Y' | b'Z')))
+            .filter_map(|word| word[1..].parse().ok())
+            .collect()
+    }
+
+    /// A warning in any post's program names the line of that program where the move is, the
+    /// same move the Fanuc program's warning names (grbl has no `%` line, Heidenhain ISO and
+    /// Klartext number their blocks, Haas's smoothing adds a line).
+    #[test]
+    fn every_posts_warnings_name_its_own_lines() {
+        let (request, context) = request(serde_json::json!({"kind": "flat", "radius": 5, "stickout": 1.5}));
+        let mut answer = EngagementCapability::solve(&request, context, &Run::default()).unwrap();
+        let at_lines = |program: &str| -> Vec<usize> {
+            program.lines().filter_map(|line| line.split_once(" AT LINE ")?.1.split_once(':')?.0.parse().ok()).collect()
+        };
+        let named = |program: &str| -> Vec<Vec<f64>> {
+            let lines: Vec<&str> = program.lines().collect();
+            at_lines(program).iter().map(|line| point_of(lines[line - 1])).collect()
+        };
+        for smoothing in [None, Some(2)] {
+            answer.machine = Some(
+                serde_json::from_value(
+                    serde_json::json!({"block_time_ms": 2, "max_feed": 10000, "haas_smoothing": smoothing}),
+                )
+                .unwrap(),
+            );
+            let fanuc = fanuc(&request, &answer);
+            let expected = named(&fanuc);
+            assert!(expected.len() >= 2 && expected.iter().all(|point| !point.is_empty()), "{fanuc}");
+            for dialect in crate::gcode::Dialect::ALL {
+                let output = OutputOptions { dialect: Some(dialect), ..OutputOptions::default() };
+                let program =
+                    crate::capability::program::<EngagementCapability>(&request, &answer, &output, Control::default())
+                        .unwrap();
+                assert_eq!(named(&program), expected, "{dialect:?}:\n{program}");
+            }
+        }
+    }
+
     /// A tool held 1.5 mm above its tip cutting 2 deep: the holder runs through the stock, found
     /// on the cutting move, warned, and in the program's header.
     #[test]

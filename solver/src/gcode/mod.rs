@@ -17,6 +17,7 @@ pub mod number;
 pub mod reader;
 #[cfg(test)]
 pub(crate) mod reference;
+pub(crate) mod renumber;
 pub mod repost;
 pub mod table;
 
