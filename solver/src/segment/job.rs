@@ -10,7 +10,7 @@ use super::request::{
     Curve, CurveRule, DEFAULT_CORNER_ANGLE_DEG, DEFAULT_SPINDLE_RPM, DEFAULT_WINDOW_CHORDS, Direction, MAX_COORDINATE,
     MAX_POLYLINE_POINTS, MIN_TOLERANCE, RadiusEstimate, SegmentRequest,
 };
-use super::shape::{Arc, Ellipse, Polyline, Shape, Spline, ellipse_speed, require_length};
+use super::shape::{AngleMemo, Arc, Ellipse, Polyline, Shape, Spline, ellipse_speed, require_length};
 use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
 use crate::machine::rule::{BlockRule, RuleSettings};
@@ -261,6 +261,7 @@ fn build_ellipse(
         sense,
         sweep: swept,
         table,
+        angles: AngleMemo::default(),
     });
     Ok((shape, Vec::new(), centre.len()))
 }

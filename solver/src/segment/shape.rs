@@ -8,12 +8,13 @@
 
 use super::arclength::{ArcLengthTable, NODES, Speed, WEIGHTS};
 use super::cubic;
-use super::numeric::minimise;
+use super::numeric::{minimise, small_sin_cos};
 use super::nurbs::{CubicStretch, Nurbs};
 use super::radius::SpanMinima;
 use crate::error::ErrorCode;
 use crate::error::SolverError;
 use crate::geometry::{Segment, Vec3, distance_to_segment};
+use std::cell::Cell;
 
 /// Sub-intervals sampled before the deviation is refined (docs/spec/segment.md §2.9).
 const DEVIATION_SAMPLES: usize = 32;
@@ -52,6 +53,35 @@ pub(crate) struct Ellipse {
     pub sense: f64,
     pub sweep: f64,
     pub table: ArcLengthTable,
+    /// The sines and cosines of angles the segmentation asks for again and again.
+    pub angles: AngleMemo,
+}
+
+/// sin and cos of an ellipse's angle at the parameter where they were last taken, `f64::sin_cos`'s
+/// values: a chord's end is the next chord's start, and an arc-length panel's start is that of
+/// the next hundred lookups, so a chord's mean angle and a panel's nodes are turned from there by
+/// a small angle ([`small_sin_cos`]) instead of reducing the whole angle again. What is
+/// remembered never changes a value: it is the value a miss computes.
+#[derive(Debug, Clone)]
+pub(crate) struct AngleMemo {
+    /// At the last point asked for (a chord's end, the next one's start).
+    point: Cell<(f64, f64, f64)>,
+    /// At the start of the last arc-length panel.
+    panel: Cell<(f64, f64, f64)>,
+}
+
+/// Two ellipses are the same whatever they remember.
+impl PartialEq for AngleMemo {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl Default for AngleMemo {
+    fn default() -> Self {
+        // NaN is no parameter: the first lookup computes.
+        Self { point: Cell::new((f64::NAN, 0.0, 1.0)), panel: Cell::new((f64::NAN, 0.0, 1.0)) }
+    }
 }
 
 /// A polyline taken as the true curve: P(s) runs along its edges.
@@ -95,12 +125,20 @@ impl Ellipse {
         self.start + self.sense * u
     }
 
-    fn local(&self, t: f64) -> (f64, f64) {
-        (self.semi_axes[0] * t.cos(), self.semi_axes[1] * t.sin())
+    /// sin and cos of the angle at `u`, remembered in `slot` (see [`AngleMemo`]).
+    fn sin_cos_at(&self, u: f64, slot: &Cell<(f64, f64, f64)>) -> (f64, f64) {
+        let (at, sin, cos) = slot.get();
+        if at == u {
+            return (sin, cos);
+        }
+        let (sin, cos) = self.angle(u).sin_cos();
+        slot.set((u, sin, cos));
+        (sin, cos)
     }
 
     fn point(&self, u: f64) -> Vec3 {
-        let (x, y) = self.local(self.angle(u));
+        let (sin_t, cos_t) = self.sin_cos_at(u, &self.angles.point);
+        let (x, y) = (self.semi_axes[0] * cos_t, self.semi_axes[1] * sin_t);
         let (sin, cos) = self.rotation_sin_cos;
         self.centre + Vec3::new(cos * x - sin * y, sin * x + cos * y, 0.0)
     }
@@ -110,19 +148,29 @@ impl Ellipse {
         ellipse_speed(self.semi_axes, self.angle(u))
     }
 
-    /// The deviation of the chord from `ua` to `ub` (at most a quarter turn apart), as in
-    /// [`Shape::fast_deviation`], with its rate per unit of u as `ub` moves (worked out when
-    /// asked, [`EllipseChord::rate`]): with the half angle δ = (ub − ua)/2 and the mean angle t_m,
-    /// dev = 2·sin²(δ/2)·ab/v(t_m) for v = (a² sin² t + b² cos² t)^½, and
-    /// dv/dt = (a² − b²)·sin t·cos t/v.
-    fn deviation_with_rate(&self, ua: f64, ub: f64) -> (f64, DeviationRate<'_>) {
+    /// The chord from `ua` to `ub ≥ ua` (at most a quarter turn apart) measured in closed form:
+    /// the affine image of a circle, its farthest point is at the mean angle t_m; with the half
+    /// angle δ = (ub − ua)/2, dev = 2·sin²(δ/2)·ab/v(t_m) for v = (a² sin² t + b² cos² t)^½.
+    /// The angles at t_m are those at `ua` (remembered: the previous chord's end) turned by δ.
+    fn chord(&self, ua: f64, ub: f64) -> EllipseChord<'_> {
         let [a, b] = self.semi_axes;
         let half = 0.5 * (ub - ua);
-        let (sin, cos) = self.angle(0.5 * (ua + ub)).sin_cos();
+        let (sin_a, cos_a) = self.sin_cos_at(ua, &self.angles.point);
+        let (sin_quarter, cos_quarter) = small_sin_cos(0.5 * half);
+        let half_sin = 2.0 * sin_quarter * cos_quarter;
+        let half_cos = 1.0 - 2.0 * sin_quarter * sin_quarter;
+        let turn = self.sense * half_sin;
+        let (sin, cos) = (sin_a * half_cos + cos_a * turn, cos_a * half_cos - sin_a * turn);
         let speed = ((a * sin).powi(2) + (b * cos).powi(2)).sqrt();
-        let bulge = 2.0 * (0.5 * half).sin().powi(2);
-        let deviation = bulge * a * b / speed;
-        (deviation, DeviationRate::Ellipse(EllipseChord { ellipse: self, half, sin, cos, speed, deviation }))
+        let deviation = 2.0 * sin_quarter * sin_quarter * a * b / speed;
+        EllipseChord { ellipse: self, half_sin, sin, cos, speed, deviation }
+    }
+
+    /// The deviation of the chord from `ua` to `ub` ([`Ellipse::chord`]), with its rate per unit
+    /// of u as `ub` moves (worked out when asked, [`EllipseChord::rate`]; dv/dt = (a² − b²)·sin t·cos t/v).
+    fn deviation_with_rate(&self, ua: f64, ub: f64) -> (f64, DeviationRate<'_>) {
+        let chord = self.chord(ua, ub);
+        (chord.deviation, DeviationRate::Ellipse(chord))
     }
 
     /// Radius of curvature at t: (a² sin² t + b² cos² t)^{3/2} / (a·b).
@@ -138,16 +186,20 @@ impl Speed for Ellipse {
     }
 
     /// The five nodes' angles by turning the middle's sine and cosine by the nodes' offsets,
-    /// which come in ± pairs: three sine–cosine pairs per panel instead of five (an ellipse's arc
-    /// length costs its trigonometry).
+    /// which come in ± pairs, and the middle's by turning the panel's start (remembered: the
+    /// table's node, the start of the next lookups too); the turns are small angles
+    /// ([`small_sin_cos`]), no whole angle is reduced but the start (an ellipse's arc length
+    /// costs its trigonometry).
     fn panel(&self, a: f64, b: f64) -> f64 {
         let [semi_a, semi_b] = self.semi_axes;
         let speed = |sin: f64, cos: f64| ((semi_a * sin).powi(2) + (semi_b * cos).powi(2)).sqrt();
         let half = 0.5 * (b - a);
-        let (sin, cos) = self.angle(0.5 * (a + b)).sin_cos();
+        let (sin_a, cos_a) = self.sin_cos_at(a, &self.angles.panel);
+        let (turn_sin, turn_cos) = small_sin_cos(self.sense * half);
+        let (sin, cos) = (sin_a * turn_cos + cos_a * turn_sin, cos_a * turn_cos - sin_a * turn_sin);
         let mut sum = WEIGHTS[2] * speed(sin, cos);
         for k in [3, 4] {
-            let (turn_sin, turn_cos) = (self.sense * half * NODES[k]).sin_cos();
+            let (turn_sin, turn_cos) = small_sin_cos(self.sense * half * NODES[k]);
             let ahead = speed(sin * turn_cos + cos * turn_sin, cos * turn_cos - sin * turn_sin);
             let behind = speed(sin * turn_cos - cos * turn_sin, cos * turn_cos + sin * turn_sin);
             sum += WEIGHTS[k] * (ahead + behind);
@@ -182,7 +234,8 @@ impl DeviationRate<'_> {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct EllipseChord<'a> {
     ellipse: &'a Ellipse,
-    half: f64,
+    /// sin of the half angle δ.
+    half_sin: f64,
     sin: f64,
     cos: f64,
     speed: f64,
@@ -192,10 +245,10 @@ pub(crate) struct EllipseChord<'a> {
 impl EllipseChord<'_> {
     /// d dev/d ub: the half angle and the mean angle (through the sense of the parameter) move by ½.
     fn rate(&self) -> f64 {
-        let Self { ellipse, half, sin, cos, speed, deviation } = *self;
+        let Self { ellipse, half_sin, sin, cos, speed, deviation } = *self;
         let [a, b] = ellipse.semi_axes;
         let speed_rate = (a * a - b * b) * sin * cos / speed * 0.5 * ellipse.sense;
-        0.5 * half.sin() * a * b / speed - deviation * speed_rate / speed
+        0.5 * half_sin * a * b / speed - deviation * speed_rate / speed
     }
 }
 
@@ -630,12 +683,7 @@ impl Shape {
         match self {
             Self::Arc(_) | Self::Polyline(_) => (self.deviation(ua, ub), true),
             Self::Ellipse(ellipse) if (ub - ua).abs() <= std::f64::consts::FRAC_PI_2 => {
-                // The affine image of a circle: the farthest point is at the mean angle, its
-                // distance (1 − cos δ)·ab/√(a² sin² t_m + b² cos² t_m) for half-angle δ.
-                let [a, b] = ellipse.semi_axes;
-                let half = 0.5 * (ub - ua).abs();
-                let middle = ellipse.angle(0.5 * (ua + ub));
-                (2.0 * (0.5 * half).sin().powi(2) * a * b / ellipse_speed(ellipse.semi_axes, middle), true)
+                (ellipse.chord(ua.min(ub), ua.max(ub)).deviation, true)
             }
             Self::Ellipse(_) => (self.sampled_deviation(ua, ub, Some(limit)), false),
             Self::Spline(spline) => match spline.exact_deviation(ua, ub) {

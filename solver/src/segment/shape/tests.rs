@@ -138,6 +138,7 @@ fn ellipse() -> Shape {
         sense: 1.0,
         sweep: std::f64::consts::FRAC_PI_2,
         table,
+        angles: AngleMemo::default(),
     })
 }
 
