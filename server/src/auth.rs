@@ -1,5 +1,6 @@
 //! Optional bearer token: when `KERF_API_TOKEN` is set, every request that changes
-//! state needs `Authorization: Bearer <token>`; with `--private` reads of the API need it too.
+//! state or solves needs `Authorization: Bearer <token>` (a job operation's cut stock is read
+//! with GET but solves the operation again); with `--private` reads of the API need it too.
 //! The health check, the page's files and the API documentation stay open: they hold no data.
 
 use axum::extract::{Request, State};
@@ -25,7 +26,9 @@ impl Auth {
         }
         let reading = matches!(*method, Method::GET | Method::HEAD | Method::OPTIONS);
         let data = path.starts_with("/api/") && path != "/api/v1/openapi.json";
-        if reading { self.private && data } else { true }
+        let solving =
+            path.starts_with("/api/v1/jobs/") && (path.ends_with("/stock") || path.ends_with("/stock/program"));
+        if reading && !solving { self.private && data } else { true }
     }
 
     fn accepts(&self, request: &Request) -> bool {
@@ -65,6 +68,9 @@ mod tests {
         assert!(token.needs_token(&Method::PUT, "/api/v1/tools/1"));
         assert!(token.needs_token(&Method::POST, "/api/v1/deburr"));
         assert!(!token.needs_token(&Method::GET, "/api/v1/tools"));
+        assert!(!token.needs_token(&Method::GET, "/api/v1/jobs/3/gcode"));
+        assert!(token.needs_token(&Method::GET, "/api/v1/jobs/3/stock"));
+        assert!(token.needs_token(&Method::GET, "/api/v1/jobs/3/stock/program"));
         let private = Auth { private: true, ..token };
         assert!(private.needs_token(&Method::GET, "/api/v1/tools"));
         assert!(!private.needs_token(&Method::GET, "/healthz"));

@@ -29,6 +29,12 @@ async fn token_guards_writes(store: Store) {
     let response =
         app.client.post(app.url("/api/v1/deburr")).bearer_auth("shop-floor-7").json(&body).send().await.unwrap();
     assert_eq!(response.status(), 200);
+    // A job operation's cut stock is read with GET but solves the operation again.
+    problem(app.get("/api/v1/jobs/1/stock?operation=0").await, 401).await;
+    problem(app.get("/api/v1/jobs/1/stock/program?operation=0").await, 401).await;
+    let response =
+        app.client.get(app.url("/api/v1/jobs/1/stock?operation=0")).bearer_auth("shop-floor-7").send().await.unwrap();
+    problem(response, 404).await;
     problem(app.delete("/api/v1/tools/7").await, 401).await;
     assert_eq!(json_with(app.get("/api/v1/tools").await, 200).await.as_array().unwrap().len(), 1, "not deleted");
 }
