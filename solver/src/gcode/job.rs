@@ -127,6 +127,15 @@ pub struct Section<'a> {
     pub moves: Vec<&'a str>,
     /// The tools the moves change to, in order (`None`: a manual change).
     pub changes: Vec<Option<u32>>,
+    /// The line (from 1) of the first of `moves` in the operation's program, which its warnings'
+    /// `AT LINE` count (0 without moves).
+    pub first_move_line: usize,
+}
+
+/// The line (from 1) of `text` on which `part`, a slice of it, starts.
+fn line_of(text: &str, part: &str) -> usize {
+    let at = (part.as_ptr() as usize).saturating_sub(text.as_ptr() as usize).min(text.len());
+    text.as_bytes()[..at].iter().filter(|&&byte| byte == b'\n').count() + 1
 }
 
 /// A block without its line number and block end.
@@ -255,6 +264,7 @@ impl<'a> Section<'a> {
             clearance_words,
             safe_z,
             spindle,
+            first_move_line: moves.first().map_or(0, |first| line_of(text, first)),
             moves,
             changes,
         })
@@ -420,9 +430,12 @@ pub fn write(job: &Job<'_>, operations: &[Operation<'_>]) -> Result<String, Solv
     let clearance = sections.iter().flatten().map(|s| s.safe_z).fold(f64::NEG_INFINITY, f64::max);
     let mut out = Blocks::new(table, 0);
     write_header(&mut out, job, operations, &sections, &left_out, units, clearance);
+    // Haas smoothing adds its line to the header once the program is written.
+    let smoothing_line = usize::from(job.dialect == Dialect::Haas && job.haas_smoothing.is_some());
+    let mut lines = LineCount { bytes: 0, lines: smoothing_line };
     for (index, (section, operation)) in sections.iter().zip(operations).enumerate() {
         let Some(section) = section else { continue };
-        write_section(&mut out, job, index, operation, section, clearance);
+        write_section(&mut out, job, index, operation, section, clearance, &mut lines);
     }
     out.block(table.end);
     match table.heading {
@@ -519,6 +532,21 @@ fn write_header(
 /// One operation (number `index` from 0) in the job program: its head and tool change, the
 /// spindle and coolant on, across at the common clearance height to its first point, its moves,
 /// and everything off and up again.
+/// The lines of a program being written, counted as far as `bytes`.
+struct LineCount {
+    bytes: usize,
+    lines: usize,
+}
+
+impl LineCount {
+    /// The lines `text` holds, counting only what was added since the last call.
+    fn of(&mut self, text: &[u8]) -> usize {
+        self.lines += text[self.bytes..].iter().filter(|&&byte| byte == b'\n').count();
+        self.bytes = text.len();
+        self.lines
+    }
+}
+
 fn write_section(
     out: &mut Blocks,
     job: &Job<'_>,
@@ -526,13 +554,16 @@ fn write_section(
     operation: &Operation<'_>,
     section: &Section<'_>,
     clearance: f64,
+    lines: &mut LineCount,
 ) {
     let table = out.table;
     out.comment(&format!("operation {} {}", index + 1, operation.name));
     out.block(section.title);
+    let comments_at = out.text.0.len();
     for line in &section.comments {
         out.block(line);
     }
+    let comments_end = out.text.0.len();
     if job.dialect != Dialect::Fanuc
         && let Some(blend) = section.blend
     {
@@ -567,6 +598,17 @@ fn write_section(
                 out.block(&across.text.into_string());
             }
         }
+    }
+    // The warnings count the lines of the operation's own program: here its moves start elsewhere.
+    let first_move = lines.of(&out.text.0) + 1;
+    let moves = section.first_move_line..section.first_move_line + section.moves.len();
+    let comments = String::from_utf8_lossy(&out.text.0[comments_at..comments_end]).into_owned();
+    let restated = super::renumber::restate_warnings(&comments, |line| {
+        moves.contains(&line).then(|| first_move + (line - section.first_move_line))
+    });
+    if restated != comments {
+        out.text.0.splice(comments_at..comments_end, restated.into_bytes());
+        lines.bytes = out.text.0.len();
     }
     for line in &section.moves {
         out.block(line);
@@ -752,6 +794,77 @@ mod tests {
         assert!(text.ends_with("M05\nM09\nG00 Z30.0000\nM30\n%\n"));
         let none = write(&job, &[missing]).unwrap_err();
         assert_eq!(none.code(), crate::error::ErrorCode::NoProgram);
+    }
+
+    /// An operation's warning names a line of its own program; in the job's program its moves
+    /// come later, after the other operation's, and the warning names them there (with Haas's
+    /// smoothing line in the head too); a line outside the moves (the retract the job writes
+    /// anew) loses its number.
+    #[test]
+    fn an_operations_warnings_name_the_job_programs_lines() {
+        let mut path = Toolpath::default();
+        path.rapid(Vec3::new(1.0, 2.0, 30.0));
+        path.linear(Vec3::new(1.0, 2.0, -1.0), 300.0);
+        path.linear(Vec3::new(61.0, 2.0, -1.0), 600.0);
+        path.rapid(Vec3::new(61.0, 2.0, 30.0));
+        for (dialect, smoothing) in [(Dialect::Fanuc, None), (Dialect::Haas, Some(2)), (Dialect::HeidenhainIso, None)] {
+            let written = |tool, comments: Vec<String>| {
+                super::super::write(&Program {
+                    dialect,
+                    number: 1000,
+                    title: "kerf test",
+                    comments,
+                    tool,
+                    spindle_rpm: 6000.0,
+                    spindle_direction: SpindleDirection::Cw,
+                    safe_z: 30.0,
+                    blend_tolerance: 0.01,
+                    plunges: None,
+                    path: &path,
+                    units: Units::Mm,
+                })
+            };
+            let warnings = |cut: usize, retract: usize| {
+                vec![
+                    format!("WARNING GOUGE AT LINE {cut}: 0.200 MM DEEP"),
+                    format!("WARNING HOLDER CONTACT AT LINE {retract}: 1 MM DEEP"),
+                ]
+            };
+            let draft = written(ToolCall::Table(7), warnings(0, 0));
+            let draft_lines: Vec<&str> = draft.lines().collect();
+            let cut = 1 + draft_lines.iter().position(|line| line.contains("X61") || line.contains("X+61")).unwrap();
+            let retract =
+                1 + draft_lines.iter().rposition(|line| line.contains("Z30") || line.contains("Z+30")).unwrap();
+            let own = written(ToolCall::Table(7), warnings(cut, retract));
+            let own_lines: Vec<&str> = own.lines().collect();
+            let operation = |text| Operation {
+                name: "contour",
+                program: Some(text),
+                problem: None,
+                tool: None,
+                rapid_feed: None,
+                tool_change_s: None,
+            };
+            let plain = written(ToolCall::Table(3), Vec::new());
+            let job =
+                Job { dialect, number: 2042, title: "kerf job", coolant: Coolant::Off, haas_smoothing: smoothing };
+            let text = write(&job, &[operation(&plain), operation(&own)]).unwrap();
+            let lines: Vec<&str> = text.lines().collect();
+            let table = dialect.table().unwrap();
+            let gouge = lines.iter().find(|line| line.contains("WARNING GOUGE")).unwrap();
+            let named: usize = gouge.split(" AT LINE ").nth(1).unwrap().split(':').next().unwrap().parse().unwrap();
+            assert_eq!(
+                bare(lines[named - 1], &table),
+                bare(own_lines[cut - 1], &table),
+                "{dialect:?}: {named}:\n{text}"
+            );
+            assert!(named > cut + 5, "{dialect:?}: the second operation's moves come later: {named} (own {cut})");
+            let holder = lines.iter().find(|line| line.contains("WARNING HOLDER CONTACT")).unwrap();
+            assert!(
+                !holder.contains("AT LINE") && holder.contains("HOLDER CONTACT: 1 MM DEEP"),
+                "{dialect:?}: {holder}"
+            );
+        }
     }
 
     #[test]

@@ -32,26 +32,30 @@ pub(crate) fn warnings_in_own_lines(program: String, verified: &str) -> String {
         lines.iter().take(first_motion.saturating_sub(1)).filter_map(|line| referenced_line(line)).collect();
     let Some(&last) = referenced.iter().max() else { return program };
     let map = line_map(verified, &program, last);
-    let mut out = String::with_capacity(program.len());
-    for (index, line) in lines.iter().enumerate() {
-        match (index + 1 < first_motion).then(|| referenced_line(line)).flatten() {
-            Some(number) => {
-                let at = line.find(AT_LINE).unwrap_or(0);
-                let digits = line[at + AT_LINE.len()..].bytes().take_while(u8::is_ascii_digit).count();
-                let rest = &line[at + AT_LINE.len() + digits..];
-                out.push_str(&line[..at]);
-                if let Some(own) = map.get(&number) {
-                    out.push_str(AT_LINE);
-                    out.push_str(&own.to_string());
-                }
-                out.push_str(rest);
-            }
-            None => out.push_str(line),
+    let header_end = lines.iter().take(first_motion.saturating_sub(1)).map(|line| line.len() + 1).sum::<usize>();
+    let header_end = header_end.min(program.len());
+    let mut out = restate_warnings(&program[..header_end], |line| map.get(&line).copied());
+    out.push_str(&program[header_end..]);
+    out
+}
+
+/// `lines` (a program's comments) with the line of every warning's `AT LINE n` restated as
+/// `restate(n)`; a line it has none for is left out (the comment keeps its position).
+pub(crate) fn restate_warnings(lines: &str, restate: impl Fn(usize) -> Option<usize>) -> String {
+    let mut out = String::with_capacity(lines.len());
+    for line in lines.split_inclusive('\n') {
+        let Some(number) = referenced_line(line) else {
+            out.push_str(line);
+            continue;
+        };
+        let at = line.find(AT_LINE).unwrap_or(0);
+        let digits = line[at + AT_LINE.len()..].bytes().take_while(u8::is_ascii_digit).count();
+        out.push_str(&line[..at]);
+        if let Some(own) = restate(number) {
+            out.push_str(AT_LINE);
+            out.push_str(&own.to_string());
         }
-        out.push('\n');
-    }
-    if !program.ends_with('\n') {
-        out.pop();
+        out.push_str(&line[at + AT_LINE.len() + digits..]);
     }
     out
 }
