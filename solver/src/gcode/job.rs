@@ -654,6 +654,18 @@ mod tests {
         })
     }
 
+    /// A contour operation of `text`, with no tool name, rapid feed or tool-change time.
+    fn contour(text: &str) -> Operation<'_> {
+        Operation {
+            name: "contour",
+            program: Some(text),
+            problem: None,
+            tool: None,
+            rapid_feed: None,
+            tool_change_s: None,
+        }
+    }
+
     #[test]
     fn sections_read_back_what_write_writes() {
         for dialect in Dialect::ALL {
@@ -837,18 +849,10 @@ mod tests {
                 1 + draft_lines.iter().rposition(|line| line.contains("Z30") || line.contains("Z+30")).unwrap();
             let own = written(ToolCall::Table(7), warnings(cut, retract));
             let own_lines: Vec<&str> = own.lines().collect();
-            let operation = |text| Operation {
-                name: "contour",
-                program: Some(text),
-                problem: None,
-                tool: None,
-                rapid_feed: None,
-                tool_change_s: None,
-            };
             let plain = written(ToolCall::Table(3), Vec::new());
             let job =
                 Job { dialect, number: 2042, title: "kerf job", coolant: Coolant::Off, haas_smoothing: smoothing };
-            let text = write(&job, &[operation(&plain), operation(&own)]).unwrap();
+            let text = write(&job, &[contour(&plain), contour(&own)]).unwrap();
             let lines: Vec<&str> = text.lines().collect();
             let table = dialect.table().unwrap();
             let gouge = lines.iter().find(|line| line.contains("WARNING GOUGE")).unwrap();
@@ -932,14 +936,6 @@ mod tests {
         let first = smoothed(program(Dialect::Haas, ToolCall::Table(7), 30.0));
         let second = smoothed(program(Dialect::Haas, ToolCall::Table(3), 5.0));
         assert!(first.contains("\nG187 P3\nT7 M06\n"), "{first}");
-        let operation = |text| Operation {
-            name: "contour",
-            program: Some(text),
-            problem: None,
-            tool: None,
-            rapid_feed: None,
-            tool_change_s: None,
-        };
         let job = |haas_smoothing| Job {
             dialect: Dialect::Haas,
             number: 2042,
@@ -947,15 +943,15 @@ mod tests {
             coolant: Coolant::Off,
             haas_smoothing,
         };
-        let text = write(&job(Some(3)), &[operation(&first), operation(&second)]).unwrap();
+        let text = write(&job(Some(3)), &[contour(&first), contour(&second)]).unwrap();
         assert!(text.contains("\nG21 G17 G90 G40 G49 G80 G94\nG187 P3\n(OPERATION 1 CONTOUR)\n"), "{text}");
         assert_eq!(text.matches("G187").count(), 1, "{text}");
         assert!(text.contains("(2 CONTOUR: T3"), "both operations are joined: {text}");
-        let plain = write(&job(None), &[operation(&first), operation(&second)]).unwrap();
+        let plain = write(&job(None), &[contour(&first), contour(&second)]).unwrap();
         assert!(!plain.contains("G187"), "{plain}");
         assert_eq!(text.replacen("G187 P3\n", "", 1), plain);
         let fanuc = Job { dialect: Dialect::Fanuc, ..job(Some(3)) };
-        let fanuc_text = write(&fanuc, &[operation(&program(Dialect::Fanuc, ToolCall::Table(7), 30.0))]).unwrap();
+        let fanuc_text = write(&fanuc, &[contour(&program(Dialect::Fanuc, ToolCall::Table(7), 30.0))]).unwrap();
         assert!(!fanuc_text.contains("G187"), "{fanuc_text}");
     }
 
