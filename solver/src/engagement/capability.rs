@@ -220,17 +220,8 @@ impl Capability for EngagementCapability {
         let Some((model, grid)) = own_model(request, grid, &answer)? else {
             return Ok(None);
         };
-        let program = own::program::<EngagementCapability>(request, &answer, run)?;
-        own::cut_stock_glb(
-            &model,
-            grid,
-            &program,
-            &[(None, &answer.tool)],
-            own::Limits::WITHOUT_PART,
-            own::StockAsk { upto_line, units },
-            run,
-        )
-        .map(Some)
+        let ask = own::StockAsk { upto_line, units };
+        own::partless_cut_stock::<EngagementCapability>(&model, grid, request, &answer, &answer.tool, ask, run)
     }
 
     /// The program of one path: `output.candidate`, else the request's `candidate`, else 0.

@@ -211,17 +211,8 @@ impl Capability for PredictCapability {
         let Some((model, grid)) = model else {
             return Ok(None);
         };
-        let program = own::program::<PredictCapability>(request, &answer, run)?;
-        own::cut_stock_glb(
-            &model,
-            grid,
-            &program,
-            &[(None, &answer.tool)],
-            own::Limits::WITHOUT_PART,
-            own::StockAsk { upto_line, units },
-            run,
-        )
-        .map(Some)
+        let ask = own::StockAsk { upto_line, units };
+        own::partless_cut_stock::<PredictCapability>(&model, grid, request, &answer, &answer.tool, ask, run)
     }
 
     /// A G-code path is the input program with only the coordinates of moved end points changed

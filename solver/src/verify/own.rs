@@ -327,6 +327,24 @@ fn verification_of(cut: simulate::Cut, model: String, limits: Limits) -> Verific
     }
 }
 
+/// The cut stock of a capability's own model without a part (predict's, engagement's): the
+/// program its answer writes ([`program`]) cut with its one tool, coloured by what it cut.
+///
+/// # Errors
+/// As [`program`] and [`cut_stock_glb`].
+pub(crate) fn partless_cut_stock<C: crate::capability::Capability>(
+    model: &dyn OwnModel,
+    grid: Grid,
+    request: &C::Request,
+    answer: &C::Answer,
+    tool: &Tool,
+    ask: StockAsk,
+    run: &Run<'_>,
+) -> Result<Option<Vec<u8>>, SolverError> {
+    let program = program::<C>(request, answer, run)?;
+    cut_stock_glb(model, grid, &program, &[(None, tool)], Limits::WITHOUT_PART, ask, run).map(Some)
+}
+
 /// The stock of `model` as `program`'s moves on lines up to `upto_line` (every line: `None`) left
 /// it, as binary glTF coloured by deviation from the model's part, or for a model without a part
 /// by what the program cut (`extras.colouring`, docs/spec/verify.md §9.4), its positions and that
