@@ -53,6 +53,12 @@ pub trait Capability {
         Ok(())
     }
 
+    /// Sets in the request what `output` chooses of the program where the request has its own
+    /// say in it (engagement's `?candidate=` over its `candidate`), before a solve whose answer is
+    /// that program: the solve then verifies the program that is written, and its header carries
+    /// that program's own findings. Default: nothing to set.
+    fn set_programmed(_request: &mut Self::Request, _output: &OutputOptions) {}
+
     /// Solves the request in its resolved context.
     ///
     /// # Errors

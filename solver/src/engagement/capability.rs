@@ -224,6 +224,13 @@ impl Capability for EngagementCapability {
         own::partless_cut_stock::<EngagementCapability>(&model, grid, request, &answer, &answer.tool, ask, run)
     }
 
+    /// The candidate asked for is the one verified: its program is the one written.
+    fn set_programmed(request: &mut EngagementRequest, output: &OutputOptions) {
+        if output.candidate.is_some() {
+            request.candidate = output.candidate;
+        }
+    }
+
     /// The program of one path: `output.candidate`, else the request's `candidate`, else 0.
     fn program(
         request: &EngagementRequest,

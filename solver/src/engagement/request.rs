@@ -387,8 +387,10 @@ pub struct EngagementRequest {
     /// is recommended.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub machine: Option<String>,
-    /// Which entry of `paths` the G-code program follows (0-based, default 0; a request with
-    /// `path` has only 0). The endpoint's `?candidate=` overrides it; a job's program uses it.
+    /// Which entry of `paths` the G-code program follows and the verification cuts (0-based,
+    /// default 0; a request with `path` has only 0; past the last path: `E_INPUT`). The
+    /// endpoint's `?candidate=` overrides it for the program it writes, which is then the one
+    /// verified; a job's program uses it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub candidate: Option<usize>,
     /// Correct the chip thickness on arcs of the path for the feed at the cutting edge,

@@ -1168,3 +1168,49 @@ async fn the_program_is_cut_on_the_stock_extruded_and_a_holder_in_it_found_at_it
     assert_eq!(refused["code"], "E_GRID_MEMORY");
     assert_eq!(refused["errors"][0]["path"], "verification.resolution");
 }
+
+/// The candidate a program is asked for is the one cut: of two paths, the deep one puts the
+/// holder in the stock, and its program says so whichever candidate the request itself names.
+#[tokio::test(flavor = "multi_thread")]
+async fn the_candidate_programmed_is_the_candidate_verified() {
+    let app = TestApp::spawn().await;
+    let mut body = slot_request(json!({"kind": "flat", "radius": 5, "stickout": 4}));
+    body.as_object_mut().unwrap().remove("path");
+    body["paths"] = json!([
+        {"name": "2 deep", "path": [[-10, 20], [70, 20]]},
+        {"name": "6 deep", "path": [[-10, 20], [70, 20]], "axial_depth": 6},
+    ]);
+    let answer = json_with(app.post_json(URL, &body).await, 200).await;
+    assert_eq!(answer["verification"]["ok"], true, "candidate 0 is the one verified: {}", answer["verification"]);
+    let shallow = app.post_text(&format!("{URL}?format=gcode&candidate=0"), &body, 200).await;
+    assert!(!shallow.contains("WARNING") && shallow.contains("Z-2.0000"), "{shallow}");
+
+    let deep = app.post_text(&format!("{URL}?format=gcode&candidate=1"), &body, 200).await;
+    assert!(deep.contains("Z-6.0000"), "{deep}");
+    assert!(deep.contains("(WARNING VERIFICATION FOUND"), "the deep path's holder contact: {deep}");
+    let lines: Vec<&str> = deep.lines().collect();
+    let mut named = body.clone();
+    named["candidate"] = json!(1);
+    let answer = json_with(app.post_json(URL, &named).await, 200).await;
+    let findings = answer["verification"]["findings"].as_array().unwrap();
+    assert!(!findings.is_empty() && findings.iter().all(|f| f["kind"] == "holder_contact"), "{answer}");
+    for finding in findings {
+        let line = finding["line"].as_u64().unwrap() as usize;
+        assert!(deep.contains(&format!("(WARNING HOLDER CONTACT AT LINE {line}: ")), "{deep}");
+        assert!(lines[line - 1].contains("Z-6.0000") || lines[line - 1].starts_with("G0"), "line {line}: {deep}");
+    }
+    // The same program from the request naming the candidate, from the program route, and for
+    // candidate 0 from a request naming 1.
+    assert_eq!(app.post_text(&format!("{URL}?format=gcode"), &named, 200).await, deep);
+    assert_eq!(app.post_text(&format!("{URL}/program?candidate=1"), &body, 200).await, deep);
+    assert_eq!(app.post_text(&format!("{URL}?format=gcode&candidate=0"), &named, 200).await, shallow);
+
+    // A candidate past the last path, in the request or the query, is refused before any work.
+    for (request, query) in [(json!(2), ""), (json!(0), "?format=gcode&candidate=2")] {
+        let mut missing = body.clone();
+        missing["candidate"] = request;
+        let refused = problem(app.post_json(&format!("{URL}{query}"), &missing).await, 422).await;
+        assert_eq!(refused["code"], "E_INPUT");
+        assert_eq!(refused["errors"][0]["path"], "candidate", "{refused}");
+    }
+}

@@ -67,6 +67,12 @@ impl EngagementRequest {
         let (region, _) = read_stock(&self.stock, radius, &mut shared_warnings)?;
         let heights = Heights { axial_depth, stock_top_z, top_given: self.stock_top_z.is_some() };
         let candidates = self.candidates(tool, radius, step, &heights, kienzle)?;
+        if let Some(index) = self.candidate
+            && index >= candidates.jobs.len()
+        {
+            let count = candidates.jobs.len();
+            return Err(SolverError::input("candidate", format!("candidate {index} does not exist ({count} path(s))")));
+        }
         let job = Job {
             radius,
             flute_counts,
