@@ -37,8 +37,9 @@ answer's CPU ÷ the JSON answer's. The cases (`--only` takes their names):
   sample the tool circle intersected with the material left: the stock less the path before the
   sample within 2R, buffered by the tool radius).
 
-Contour requests turn their `verification` off (the peer only offsets); `--verified` leaves it on,
-as the service's default, to measure what cutting the program costs.
+Contour, prediction and engagement requests turn their `verification` off (the peers offset,
+stamp or intersect, and cut no program); `--verified` leaves it on, as the service's default, to
+measure what cutting the program costs.
 
 Before the table, once: each segment case's point count and largest chord deviation, kerf's
 (from its answer) and the peer's (sampled at 8 points inside every chord).
@@ -216,13 +217,16 @@ class ClipperOffset:
         return copies
 
 
+def verification():
+    """The requests' `verification`: off unless `--verified` (the peers cut no program; kerf's
+    cut of its own, on by default, is measured on its own)."""
+    return {"enabled": VERIFIED}
+
+
 def contour_body(outline, layers):
-    # The peer offsets only; kerf's cut of its own program (on by default) is measured on its own
-    # by `--verified`.
-    verification = {"enabled": VERIFIED}
     return json.dumps({"tool": {"kind": "flat", "radius": 3}, "contour": outline, "side": "outside",
                        "depths": {"top": 0, "bottom": -float(layers), "step": 1}, "feed": 1200,
-                       "verification": verification}).encode()
+                       "verification": verification()}).encode()
 
 
 def star_case():
@@ -332,7 +336,7 @@ def predict_case(kerf):
                                             "heights": heights, "bottom": -100.0},
                        "path": {"kind": "gcode", "program": "\n".join(program) + "\n"},
                        "cutting": {"ktc": 2000, "krc": 800, "kac": 300}, "method": "sampling",
-                       "resolution": 256}).encode()
+                       "resolution": 256, "verification": verification()}).encode()
     # The program's y rows are the z-map's rows: heights[j][i] is at (x_i, y_j).
     return "/api/v1/predict", body, ZMap(tips, spacing, np.asarray(heights).T.T, -margin)
 
@@ -397,7 +401,7 @@ def engagement_case(kerf):
     body = json.dumps({"tool": 2, "stock": {"polygon": [[0, 0], [POCKET, 0], [POCKET, POCKET], [0, POCKET]]},
                        "path": path, "spindle_rpm": 8000, "feed_per_tooth": 0.05, "flute_counts": [2, 3, 4],
                        "thickness_limit": 0.08, "time_limit_s": 600, "step": STEP,
-                       "axial_depth": 5}).encode()
+                       "axial_depth": 5, "verification": verification()}).encode()
     return "/api/v1/engagement", body, Shapely(path)
 
 
@@ -405,7 +409,7 @@ def engagement_case(kerf):
 
 # The shortest a measurement of kerf is made by repeating the request, seconds.
 MEASURED_S = 0.5
-# Whether contour requests ask for the verification section (`--verified`).
+# Whether contour, prediction and engagement requests ask for the verification section (`--verified`).
 VERIFIED = False
 
 CASES = {
@@ -459,7 +463,7 @@ def main():
     parser.add_argument("--answers", metavar="DIR",
                         help="keep the answers in DIR, or compare them with those kept there")
     parser.add_argument("--verified", action="store_true",
-                        help="contour answers cut their own program (the service's default; the peer does not)")
+                        help="contour, prediction and engagement answers cut their own program (the service's default; the peers do not)")
     arguments = parser.parse_args()
     global VERIFIED
     VERIFIED = arguments.verified
