@@ -597,6 +597,7 @@ const scenarios = {
     const [request] = await Promise.all([page.waitForRequest((r) => r.url().endsWith('/api/v1/engagement')), page.click('#engagement-compute')]);
     const sent = request.postDataJSON();
     if (sent.kienzle?.kc11 !== 1800 || sent.kienzle?.mc !== 0.25 || sent.axial_depth !== 2) throw new Error(`no Kienzle values sent: ${JSON.stringify(sent.kienzle)}`);
+    if (sent.candidate !== 0) throw new Error(`the path chosen for G-code is not the one verified: candidate ${sent.candidate}`);
     await page.waitForSelector('#engagement-result[data-state="drawn"]', { timeout: 30000 });
     const columns = await page.$$eval('#engagement-result [role="tabpanel"]', (list) => list.length);
     const shown = '#engagement-result .candidate:not([hidden])';
@@ -606,6 +607,9 @@ const scenarios = {
     if (hiddenCharts !== 0) throw new Error(`${hiddenCharts} charts drawn for paths not shown`);
     // The answer's own verification: its findings (or none) and why no cut stock is drawn.
     const verification = await page.textContent('#engagement-verification', { timeout: 30000 });
+    const firstName = await page.$eval('#engagement-result .candidate:not([hidden])', (e) => e.querySelector('h3').textContent);
+    const verifiedTitle = await page.textContent('#engagement-verification h3');
+    if (!verifiedTitle.includes(`the program of ${firstName}`)) throw new Error(`verification of which path: "${verifiedTitle}" (shown: ${firstName})`);
     // Torque and power over the path (power on the right axis) and per flute count in the table.
     const torqueChart = `${shown} canvas[aria-label^="Spindle torque and power"]`;
     const torqueInked = await inkedPixels(torqueChart);
@@ -656,6 +660,13 @@ const scenarios = {
     const program = await readFile(await download.path(), 'utf8');
     const feeds = new Set([...program.matchAll(/ F(\d+(?:\.\d)?)/g)].map((m) => m[1]));
     if (!program.includes('M30') || feeds.size < 2) throw new Error(`program without its feed plan: ${program.slice(0, 400)}`);
+    // Computed again with the second path chosen: that path's program is the one verified, named
+    // so, and its tab is shown first.
+    const [again1] = await Promise.all([page.waitForRequest((r) => r.url().endsWith('/api/v1/engagement')), page.click('#engagement-compute')]);
+    if (again1.postDataJSON().candidate !== 1) throw new Error(`second path chosen, candidate ${again1.postDataJSON().candidate} sent`);
+    await page.waitForFunction(() => /the program of two bends/.test(document.querySelector('#engagement-verification h3')?.textContent ?? ''), null, { timeout: 30000 });
+    const shownAgain = await page.$eval(shown, (e) => e.querySelector('h3').textContent);
+    if (shownAgain !== 'two bends' || await page.inputValue('select[name="candidate"]') !== '1') throw new Error(`after computing again: ${shownAgain} shown`);
     // A flute count out of range is refused with the field highlighted.
     const fluteCounts = await page.inputValue('input[name="flute_counts"]');
     await page.fill('input[name="flute_counts"]', '2, 40');

@@ -292,12 +292,12 @@ export class CutStock {
 // (`why` says why not, without `source`); `resolution` the spacing the page asks the stock at;
 // `label` names the scene.
 // Resolves to the CutStock, or null when the stock cannot be drawn (said in the panel).
-export async function verificationPanel(container, { id, verification, program, source, resolution, scene, label, onMove, why = 'this capability does not answer its cut stock' }) {
+export async function verificationPanel(container, { id, verification, program, source, resolution, scene, label, onMove, why = 'this capability does not answer its cut stock', title: heading = 'Verification: the program cut on its own model' }) {
   const box = document.createElement('section');
   box.className = 'verification';
   box.id = `${id}-verification`;
   const title = document.createElement('h3');
-  title.textContent = 'Verification: the program cut on its own model';
+  title.textContent = heading;
   const summary = document.createElement('p');
   summary.className = 'hint';
   const found = verification.findings.length;
@@ -393,8 +393,8 @@ export function noStockNote(capability) {
 // with the `source` of its cut stock (`requestStock`, `jobStock`) the program it cut and the
 // stock it cut in 3-D, coloured by what was cut, with playback; without, the findings only, `why`
 // saying why. Resolves to the CutStock, or null.
-export async function partlessPanel(container, { name, verification, source, why }) {
-  const panel = { id: name, verification, why, label: 'Cut stock coloured by what the program cut' };
+export async function partlessPanel(container, { name, verification, source, why, title }) {
+  const panel = { id: name, verification, why, title, label: 'Cut stock coloured by what the program cut' };
   if (!source) return verificationPanel(container, panel);
   let program;
   try {

@@ -155,7 +155,11 @@ export function engagementRequest(form) {
     return { name: box.querySelector('input').value.trim() || undefined, path: isGcode(text) ? { gcode: text } : parsePoints(text, field) };
   });
   if (paths.length === 1) body.path = paths[0].path;
-  else body.paths = paths;
+  else {
+    body.paths = paths;
+    // The path chosen for G-code is the one the answer's verification cuts.
+    body.candidate = Number(value(form, 'candidate') || 0);
+  }
   Object.assign(body, {
     spindle_rpm: numeric(form, 'spindle_rpm'),
     feed_per_tooth: numeric(form, 'feed_per_tooth'),
@@ -624,8 +628,9 @@ function renderColumn(column, result, answer, axis) {
 // name each path's best flute count; the charts take the width of the result column.
 // `onSelect(index)` hears which candidate is shown (the form's G-code choice follows it); with
 // `cutStock` (where it comes from: `requestStock`, `jobStock`) the stock its program cuts is drawn
-// in 3-D.
-export function engagementResult(container, answer, { onSelect, cutStock = null } = {}) {
+// in 3-D. With the `request`, the verification names the path whose program it cut (its
+// `candidate`), whichever tab is shown.
+export function engagementResult(container, answer, { onSelect, cutStock = null, request = null } = {}) {
   container.replaceChildren();
   const candidates = answer.candidates || [answer];
   const controls = document.createElement('div');
@@ -641,12 +646,16 @@ export function engagementResult(container, answer, { onSelect, cutStock = null 
   const columns = document.createElement('div');
   columns.className = 'candidates';
   container.append(controls, columns);
+  // The path the request programs and verifies, shown first.
+  const programmed = request?.candidate ?? 0;
+  const verified = answer.candidates && request ? candidates[programmed] : null;
   if (answer.verification) {
     partlessPanel(container, {
       name: 'engagement',
       verification: answer.verification,
       source: cutStock,
       why: 'press “Cut stock” to cut the program again',
+      title: verified ? `Verification: the program of ${verified.name || `path ${programmed}`} cut on its own model` : undefined,
     });
   }
   const id = `candidate-${Math.random().toString(36).slice(2, 8)}`;
@@ -673,7 +682,7 @@ export function engagementResult(container, answer, { onSelect, cutStock = null 
     columns.append(column);
     return column;
   });
-  let shown = 0;
+  let shown = verified ? programmed : 0;
   const select = (index) => {
     shown = index;
     cells.forEach((cell, i) => {
@@ -752,7 +761,7 @@ export const engagementView = {
       },
       ask: (body) => api('POST', '/api/v1/engagement', body),
       show: (answer, body) => {
-        engagementResult(result, answer, { onSelect: (i) => { form.elements.candidate.value = String(i); }, cutStock: requestStock('engagement', body) });
+        engagementResult(result, answer, { onSelect: (i) => { form.elements.candidate.value = String(i); }, cutStock: requestStock('engagement', body), request: body });
         result.dataset.state = 'drawn';
       },
     });

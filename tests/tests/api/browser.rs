@@ -130,10 +130,13 @@ async fn engagement_page_compares_the_sample_paths() {
     assert_eq!(result["charts"], 8, "the charts of the path shown, no more: {result}");
     assert!(result["recommendation"].as_str().unwrap().contains("Recommended flute counts"), "{result}");
     assert_eq!(result["file"], "engagement-1-fanuc.nc");
-    // The answer's verification of its program, with its stock drawn (`engagementCut`), not
-    // explained away.
+    // The answer's verification of the program of the path chosen for G-code (the first, named),
+    // with its stock drawn (`engagementCut`), not explained away.
     let verification = result["verification"].as_str().unwrap();
-    assert!(verification.contains("the program cut on its own model") && verification.contains("mm³"), "{result}");
+    assert!(
+        verification.contains("the program of straight cut on its own model") && verification.contains("mm³"),
+        "{result}"
+    );
     assert!(verification.contains("part: none") && !verification.contains("not drawn here"), "{result}");
 }
 
