@@ -290,7 +290,7 @@ export class CutStock {
 // verification cut: default output options, Fanuc) and, with a `source` of its cut stock
 // (`requestStock`, `jobStock`), the stock in 3-D with playback, drawn into `scene` when given
 // (`why` says why not, without `source`); `resolution` the spacing the page asks the stock at;
-// `label` names the scene.
+// `label` names the scene; `title` heads the panel (which program was cut, where that needs saying).
 // Resolves to the CutStock, or null when the stock cannot be drawn (said in the panel).
 export async function verificationPanel(container, { id, verification, program, source, resolution, scene, label, onMove, why = 'this capability does not answer its cut stock', title: heading = 'Verification: the program cut on its own model' }) {
   const box = document.createElement('section');
@@ -392,7 +392,7 @@ export function noStockNote(capability) {
 // The verification of a capability whose model has no part (predict, engagement), in `container`:
 // with the `source` of its cut stock (`requestStock`, `jobStock`) the program it cut and the
 // stock it cut in 3-D, coloured by what was cut, with playback; without, the findings only, `why`
-// saying why. Resolves to the CutStock, or null.
+// saying why; `title` as for `verificationPanel`. Resolves to the CutStock, or null.
 export async function partlessPanel(container, { name, verification, source, why, title }) {
   const panel = { id: name, verification, why, title, label: 'Cut stock coloured by what the program cut' };
   if (!source) return verificationPanel(container, panel);

@@ -69,9 +69,8 @@ pub struct CandidateQuery {
     /// flat end mill).
     pub reference: Option<Reference>,
     /// G-code only: which entry of `paths` to program (0-based; default the request's
-    /// `candidate`, else 0); a request with `path` has only candidate 0. The
-    /// candidate programmed is the one the answer's verification cuts, so its program carries its own
-    /// findings.
+    /// `candidate`, else 0); a request with `path` has only candidate 0. The candidate
+    /// programmed is the one the verification cuts, so its program carries its own findings.
     pub candidate: Option<usize>,
     /// Arc segments of the path: `g2g3` (G02/G03 with I/J, end points those of the chords) or
     /// `chords` (G01 within 0.001 mm, or by the block-time rule); default the machine's `arcs`,
@@ -110,9 +109,8 @@ pub struct CandidateProgramQuery {
     /// flat end mill).
     pub reference: Option<Reference>,
     /// Which entry of the answer's `paths` to program (0-based; default the request's
-    /// `candidate`, else 0); a request with `path` has only candidate 0. The
-    /// candidate programmed is the one the answer's verification cuts, so its program carries its own
-    /// findings.
+    /// `candidate`, else 0); a request with `path` has only candidate 0. The candidate
+    /// programmed is the one the verification cuts, so its program carries its own findings.
     #[param(minimum = 0)]
     pub candidate: Option<usize>,
     /// Arc segments of the path: `g2g3` (G02/G03 with I/J, end points those of the chords) or
