@@ -308,7 +308,7 @@ export async function verificationPanel(container, { id, verification, program, 
   summary.append(
     `${verification.ok ? 'No findings' : `${found} finding${found === 1 ? '' : 's'}`}${verification.note ? ` (${verification.note})` : ''}; removed `,
     removed,
-    ` at ${number(verification.resolution)} mm spacing. ${verification.model}.`,
+    ` at ${number(verification.resolution)} mm spacing. ${verification.model}.${(verification.assumed ?? []).map((sentence) => ` ${sentence[0].toUpperCase()}${sentence.slice(1)}.`).join('')}`,
   );
   const table = document.createElement('div');
   table.className = 'table-scroll';

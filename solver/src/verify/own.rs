@@ -79,6 +79,11 @@ pub struct Verification {
     pub note: Option<String>,
     /// What was cut and compared: the stock and the part as modelled.
     pub model: String,
+    /// What the cut assumed of a tool that does not say (the defaults of docs/spec/verify.md §2),
+    /// one sentence per such tool: where the holder sits and how wide it is, which decide every
+    /// holder contact found. Absent when every tool gives its `stickout` and `holder_diameter`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub assumed: Vec<String>,
     /// The dexel spacing used, mm.
     pub resolution: f64,
     /// Rays of the model (x by y).
@@ -239,6 +244,7 @@ pub(crate) fn verify_tools(
                 findings_left_off: 0,
                 note: Some("the program never reaches its own stock: the model does not fit the program".to_owned()),
                 model: description,
+                assumed: assumed_holders(tools),
                 resolution: grid.spacing,
                 rays: [grid.nx, grid.ny],
                 tolerance: limits.tolerance,
@@ -254,7 +260,35 @@ pub(crate) fn verify_tools(
         }
         Err(error) => return Err(error),
     };
-    Ok(verification_of(cut, description, limits))
+    Ok(verification_of(cut, description, assumed_holders(tools), limits))
+}
+
+/// The holder each tool of `tools` that does not give its `stickout` or `holder_diameter` is
+/// assumed to have ([`Verification::assumed`]), from the assembly the cut used.
+fn assumed_holders(tools: &[(Option<u32>, &Tool)]) -> Vec<String> {
+    tools
+        .iter()
+        .filter_map(|&(number, tool)| {
+            if tool.stickout.is_some() && tool.holder_diameter.is_some() {
+                return None;
+            }
+            let assembly = Assembly::new(tool, "tool").ok()?;
+            let holder = assembly.bodies.last()?;
+            let super::assembly::Shape::Cylinder { base: face } = holder.shape else { return None };
+            let mut assumed = Vec::new();
+            let mut missing = Vec::new();
+            if tool.stickout.is_none() {
+                assumed.push(format!("the holder face {face:.3} mm above the tip"));
+                missing.push("stickout");
+            }
+            if tool.holder_diameter.is_none() {
+                assumed.push(format!("the holder {:.3} mm across", 2.0 * holder.radius));
+                missing.push("holder_diameter");
+            }
+            let name = number.map_or_else(|| "the tool".to_owned(), |number| format!("T{number}"));
+            Some(format!("{name}: {} assumed (the tool gives no {})", assumed.join(" and "), missing.join(" or ")))
+        })
+        .collect()
 }
 
 /// The simulation's job for `program` on `model`'s grid: the fields are built by the caller, the
@@ -306,13 +340,14 @@ fn unbudgeted<'a>(run: &Run<'a>) -> Run<'a> {
 }
 
 /// The `verification` section of `cut`.
-fn verification_of(cut: simulate::Cut, model: String, limits: Limits) -> Verification {
+fn verification_of(cut: simulate::Cut, model: String, assumed: Vec<String>, limits: Limits) -> Verification {
     Verification {
         ok: cut.ok,
         findings: cut.findings,
         findings_left_off: cut.findings_left_off,
         note: None,
         model,
+        assumed,
         resolution: cut.resolution,
         rays: cut.rays,
         tolerance: limits.tolerance,
@@ -387,7 +422,7 @@ pub(crate) fn cut_stock_glb(
     };
     match simulate::cut_fields(&job, stock, part, &unbudgeted(run)) {
         Ok((cut, left)) => {
-            let mut verification = verification_of(cut, model.describe(), limits);
+            let mut verification = verification_of(cut, model.describe(), assumed_holders(tools), limits);
             if let Some(scaling) = units.from_mm() {
                 verification.scale(scaling);
             }
@@ -442,10 +477,15 @@ pub(crate) fn warnings(verification: &Verification) -> Vec<Warning> {
         else {
             continue;
         };
+        let assumed = if kind == FindingKind::HolderContact && !verification.assumed.is_empty() {
+            format!("; {}", verification.assumed.join("; "))
+        } else {
+            String::new()
+        };
         warnings.push(Warning::new(
             code,
             format!(
-                "cutting the program on its own model found {} {} moves; the worst: {} (see verification)",
+                "cutting the program on its own model found {} {} moves; the worst: {} (see verification){assumed}",
                 found.len(),
                 kind_name(kind),
                 sentence(worst)
@@ -464,6 +504,10 @@ pub(crate) fn comments(verification: &Verification) -> Vec<String> {
     }
     let mut lines = vec![format!("WARNING verification found {} problems cutting this program", found.len())];
     lines.extend(found.iter().take(5).map(|finding| format!("WARNING {}", sentence(finding))));
+    // A holder contact is only as real as the holder it was found with.
+    if found.iter().any(|finding| finding.kind == FindingKind::HolderContact) {
+        lines.extend(verification.assumed.iter().map(|sentence| format!("WARNING {sentence}")));
+    }
     lines
 }
 

@@ -108,6 +108,7 @@ impl Scale for crate::verify::Verification {
             findings_left_off: _,
             note,
             model,
+            assumed,
             resolution,
             rays: _,
             tolerance,
@@ -123,6 +124,9 @@ impl Scale for crate::verify::Verification {
         findings.scale(scaling);
         note.scale(scaling);
         model.scale(scaling);
+        for sentence in assumed {
+            sentence.scale(scaling);
+        }
         for value in [resolution, tolerance, allowance, wall_tolerance] {
             value.scale(scaling);
         }

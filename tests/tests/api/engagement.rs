@@ -1161,6 +1161,37 @@ async fn the_program_is_cut_on_the_stock_extruded_and_a_holder_in_it_found_at_it
         assert!(program.contains(&format!("(WARNING HOLDER CONTACT AT LINE {line}: ")), "{program}");
         assert!(lines[line - 1].starts_with("G0"), "line {line}: {program}");
     }
+    // The tool gives its stickout but not its holder's diameter: the contact is said to be found
+    // with an assumed holder (three shank diameters), in the answer, its warning and the header.
+    let assumed = "the tool: the holder 30.000 mm across assumed (the tool gives no holder_diameter)";
+    assert_eq!(verification["assumed"], json!([assumed]), "{verification}");
+    let warning =
+        answer["warnings"].as_array().unwrap().iter().find(|w| w["code"] == "W_VERIFY_HOLDER_CONTACT").unwrap();
+    assert!(warning["message"].as_str().unwrap().ends_with(&format!("; {assumed}")), "{warning}");
+    assert!(program.contains("(WARNING THE TOOL: THE HOLDER 30.000 MM ACROSS ASSUMED "), "{program}");
+    let mut given = body.clone();
+    given["tool"]["holder_diameter"] = json!(30);
+    let answer = json_with(app.post_json(URL, &given).await, 200).await;
+    assert!(answer["verification"].get("assumed").is_none(), "{}", answer["verification"]);
+    // The same contacts, one line earlier: the header has no line on the holder.
+    let positions = |findings: &Value| -> Vec<(Value, u64)> {
+        findings.as_array().unwrap().iter().map(|f| (f["position"].clone(), f["line"].as_u64().unwrap())).collect()
+    };
+    let earlier: Vec<(Value, u64)> =
+        positions(&verification["findings"]).into_iter().map(|(p, l)| (p, l - 1)).collect();
+    assert_eq!(positions(&answer["verification"]["findings"]), earlier);
+    let program = app.post_text(&format!("{URL}?format=gcode&dialect=fanuc"), &given, 200).await;
+    assert!(program.contains("(WARNING VERIFICATION FOUND") && !program.contains("ASSUMED"), "{program}");
+    // Without either, both are said; a tool that gives no lengths cutting in the open says it
+    // assumed them, but no warning does.
+    let open = json_with(app.post_json(URL, &slot_request(json!({"kind": "flat", "radius": 5}))).await, 200).await;
+    assert_eq!(
+        open["verification"]["assumed"],
+        json!([
+            "the tool: the holder face 40.000 mm above the tip and the holder 30.000 mm across assumed (the tool gives no stickout or holder_diameter)"
+        ])
+    );
+    assert!(!open["warnings"].to_string().contains("assumed"), "{}", open["warnings"]);
 
     let mut fine = body.clone();
     fine["verification"] = json!({"resolution": 0.0005});
