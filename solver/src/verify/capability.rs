@@ -24,9 +24,23 @@ pub struct VerifyCapability;
 pub struct VerifyAnswer {
     /// The tools, in the order of the request, as resolved from the table or given inline.
     pub tools: Vec<Tool>,
+    /// Per tool that gives no `stickout` or no `holder_diameter`, the holder the cut assumed
+    /// (docs/spec/verify.md §2 defaults), in a sentence: every holder contact found with it is
+    /// only as real as it is. Absent when every tool gives both.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub assumed: Vec<String>,
     /// The findings, volumes, times and removal per block.
     #[serde(flatten)]
     pub cut: Cut,
+}
+
+impl VerifyAnswer {
+    /// The answer of `cut` made with `tools`.
+    pub(crate) fn new(tools: Vec<Tool>, cut: Cut) -> Self {
+        let numbered: Vec<(Option<u32>, &Tool)> = tools.iter().map(|tool| (tool.number, tool)).collect();
+        let assumed = super::own::assumed_holders(&numbered);
+        Self { tools, assumed, cut }
+    }
 }
 
 /// Bytes of JSON one block's removal record takes at most.
@@ -100,7 +114,7 @@ impl Capability for VerifyCapability {
     ) -> Result<VerifyAnswer, SolverError> {
         let job = Self::job(request, &context, run)?;
         let cut = simulate::cut(&job, run)?;
-        Ok(VerifyAnswer { tools: context.other_tools, cut })
+        Ok(VerifyAnswer::new(context.other_tools, cut))
     }
 
     /// The stock as the request's program (up to `upto_line`) left it, against its part: the
@@ -178,7 +192,7 @@ impl Capability for VerifyCapability {
             run.control.check()?;
         }
         let cut = simulate::finish_parts(&job, &cuts, run)?;
-        Ok(VerifyAnswer { tools: context.other_tools, cut })
+        Ok(VerifyAnswer::new(context.other_tools, cut))
     }
 
     fn program(

@@ -497,7 +497,7 @@ pub fn cut_stock_glb(
     }
     let (mut extras, stock) = match simulate::cut_stock(&job, run) {
         Ok((cut, stock)) => {
-            let mut answer = VerifyAnswer { tools, cut };
+            let mut answer = VerifyAnswer::new(tools, cut);
             if let Some(scaling) = units.from_mm() {
                 answer.scale(scaling);
             }

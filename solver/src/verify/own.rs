@@ -265,7 +265,7 @@ pub(crate) fn verify_tools(
 
 /// The holder each tool of `tools` that does not give its `stickout` or `holder_diameter` is
 /// assumed to have ([`Verification::assumed`]), from the assembly the cut used.
-fn assumed_holders(tools: &[(Option<u32>, &Tool)]) -> Vec<String> {
+pub(crate) fn assumed_holders(tools: &[(Option<u32>, &Tool)]) -> Vec<String> {
     tools
         .iter()
         .filter_map(|&(number, tool)| {

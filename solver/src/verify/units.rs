@@ -65,8 +65,11 @@ impl Scale for CrossHole {
 /// The echoed tools and the cut.
 impl Scale for VerifyAnswer {
     fn scale(&mut self, scaling: Scaling) {
-        let Self { tools, cut } = self;
+        let Self { tools, assumed, cut } = self;
         tools.scale(scaling);
+        for sentence in assumed {
+            sentence.scale(scaling);
+        }
         cut.scale(scaling);
     }
 }

@@ -79,6 +79,13 @@ async fn faults_are_found_at_their_lines() {
     assert_eq!(answer["findings"][holder]["tool"], 2);
     close_to(&answer["findings"][holder]["depth"], 4.0);
     assert_eq!(answer["ok"], false);
+    // T1 gives no holder: the one the cut took is named; T2 gives its own.
+    assert_eq!(
+        answer["assumed"],
+        json!([
+            "T1: the holder face 40.000 mm above the tip and the holder 30.000 mm across assumed (the tool gives no stickout or holder_diameter)"
+        ])
+    );
 }
 
 fn close_to(value: &Value, expected: f64) {
