@@ -44,14 +44,11 @@ pub async fn answer<C: Capability>(
         }
     };
     let resolved = capabilities::resolve::<C>(&request, &catalog)?;
-    let request = if ask.gcode {
+    let mut request = request;
+    if ask.gcode {
         C::check_output(&request, &ask.output)?;
-        let mut request = request;
         C::set_programmed(&mut request, &ask.output);
-        request
-    } else {
-        request
-    };
+    }
     // The post the program is written in, for its file name: asked, else the machine's.
     let machine_dialect = capability::all_refs::<C>(&request)
         .iter()

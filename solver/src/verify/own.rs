@@ -233,6 +233,7 @@ pub(crate) fn verify_tools(
     let job = own_job(model, grid, program, tools, limits, run)?;
     let (stock, part) = model.fields(grid, lowest_tip(&job), run.control)?;
     let description = model.describe();
+    let assumed = assumed_holders(tools);
     let cut = match simulate::cut_fields(&job, stock, part, &unbudgeted(run)).map(|(cut, _)| cut) {
         Ok(cut) => cut,
         // The model and the program disagree (the tool never meets the stock): said, not refused,
@@ -244,7 +245,7 @@ pub(crate) fn verify_tools(
                 findings_left_off: 0,
                 note: Some("the program never reaches its own stock: the model does not fit the program".to_owned()),
                 model: description,
-                assumed: assumed_holders(tools),
+                assumed,
                 resolution: grid.spacing,
                 rays: [grid.nx, grid.ny],
                 tolerance: limits.tolerance,
@@ -260,7 +261,7 @@ pub(crate) fn verify_tools(
         }
         Err(error) => return Err(error),
     };
-    Ok(verification_of(cut, description, assumed_holders(tools), limits))
+    Ok(verification_of(cut, description, assumed, limits))
 }
 
 /// The holder each tool of `tools` that does not give its `stickout` or `holder_diameter` is
