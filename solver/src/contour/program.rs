@@ -74,22 +74,20 @@ pub fn program_controlled(answer: &ContourSolution, post: &Post, control: Contro
     }
     let mut comments = answer.description.clone();
     comments.push(format!("control point: {} of the {} tool", post.reference.as_str(), answer.tool_kind.as_str()));
-    gcode::write_cancellable(
-        &Program {
-            dialect: post.dialect,
-            number: 1000,
-            title: "kerf contour",
-            comments,
-            tool: post.tool.clone(),
-            spindle_rpm: answer.summary.spindle_rpm,
-            spindle_direction: SpindleDirection::Cw,
-            safe_z: answer.summary.safe_z + lift,
-            blend_tolerance: answer.summary.tolerance,
-            plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
-            path: &path,
-            units: post.units,
-        },
-        &[],
-        control,
-    )
+    let program = Program {
+        dialect: post.dialect,
+        number: 1000,
+        title: "kerf contour",
+        comments,
+        tool: post.tool.clone(),
+        spindle_rpm: answer.summary.spindle_rpm,
+        spindle_direction: SpindleDirection::Cw,
+        safe_z: answer.summary.safe_z + lift,
+        blend_tolerance: answer.summary.tolerance,
+        plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
+        path: &path,
+        units: post.units,
+    };
+    program.check_written(&[], "spindle_rpm", "feed")?;
+    gcode::write_cancellable(&program, &[], control)
 }

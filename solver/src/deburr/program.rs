@@ -324,23 +324,21 @@ pub fn program_for_loops(
         comments.push(turn_notice(true));
     }
     control.check()?;
-    gcode::write_cancellable(
-        &Program {
-            dialect: post.dialect,
-            number: 1000,
-            title: "kerf deburr",
-            comments,
-            tool: tool_of(first.tool),
-            spindle_rpm: deburr.summary.spindle_rpm,
-            spindle_direction: SpindleDirection::Cw,
-            safe_z: visit.safe_z,
-            blend_tolerance: deburr.summary.tolerance,
-            // Every move down runs in air: to the lead point beside the edge, or down the hole.
-            plunges: None,
-            path: &visit.path,
-            units: post.units,
-        },
-        &stops,
-        control,
-    )
+    let program = Program {
+        dialect: post.dialect,
+        number: 1000,
+        title: "kerf deburr",
+        comments,
+        tool: tool_of(first.tool),
+        spindle_rpm: deburr.summary.spindle_rpm,
+        spindle_direction: SpindleDirection::Cw,
+        safe_z: visit.safe_z,
+        blend_tolerance: deburr.summary.tolerance,
+        // Every move down runs in air: to the lead point beside the edge, or down the hole.
+        plunges: None,
+        path: &visit.path,
+        units: post.units,
+    };
+    program.check_written(&stops, "spindle_rpm", "feed")?;
+    gcode::write_cancellable(&program, &stops, control)
 }

@@ -481,6 +481,9 @@ impl EngagementSolution {
 pub(crate) struct PostData {
     pub route: RouteData,
     pub nominal_feed: f64,
+    /// The request's field the feeds come from (`feed_per_tooth` or `feed`), named when the
+    /// program cannot write them.
+    pub feed_field: &'static str,
     pub spindle_rpm: f64,
     pub spindle_direction: crate::gcode::SpindleDirection,
     /// The block-time rule the program's arcs are chorded by (its feed replaced by each block's).
@@ -511,6 +514,7 @@ impl Default for PostData {
                 feed_length: 0.0,
             }),
             nominal_feed: 0.0,
+            feed_field: "feed",
             spindle_rpm: 0.0,
             spindle_direction: crate::gcode::SpindleDirection::default(),
             rule: None,

@@ -508,6 +508,7 @@ impl PartPost {
         PostData {
             route: RouteData(route.clone()),
             nominal_feed: self.nominal_feed,
+            feed_field: job.feed_mode.field(),
             spindle_rpm: self.spindle_rpm,
             spindle_direction: self.spindle_direction,
             rule: job.rule,

@@ -434,6 +434,7 @@ fn post_data(job: &Job, candidate: &CandidateJob, tool: &Tool, flutes: u32, nomi
     PostData {
         route: RouteData(route.clone()),
         nominal_feed,
+        feed_field: job.feed_mode.field(),
         spindle_rpm: job.spindle_rpm,
         spindle_direction: job.direction,
         rule: job.rule,

@@ -96,7 +96,7 @@ pub fn program(answer: &EngagementSolution, candidate: usize, post: &Post) -> Re
     if let Some(rule) = &data.rule {
         comments.push(format!("arcs chorded for a {} ms block time", rule.block_time_ms));
     }
-    Ok(gcode::write(&Program {
+    let program = Program {
         dialect: post.dialect,
         number: 1000,
         title: "kerf engagement",
@@ -109,7 +109,9 @@ pub fn program(answer: &EngagementSolution, candidate: usize, post: &Post) -> Re
         plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
         path: &path,
         units: post.units,
-    }))
+    };
+    program.check_written(&[], "spindle_rpm", data.feed_field)?;
+    Ok(gcode::write(&program))
 }
 
 /// The cycle time of candidate `candidate`'s chord program on a machine with `dynamics`

@@ -265,6 +265,69 @@ pub struct Program<'a> {
     pub units: Units,
 }
 
+/// The least spindle speed a program writes other than `S0`, rpm: it writes whole rpm.
+const LEAST_SPINDLE_RPM: f64 = 0.5;
+
+/// The least feed a program writes other than `F0`, in its units per minute: it writes feeds to
+/// 0.1 mm/min (0.1 in/min in inch).
+const LEAST_FEED: f64 = 0.05;
+
+impl Program<'_> {
+    /// Refuses a program whose spindle speed (or a stop's) would be written `S0`, or one of
+    /// whose feeds (a plunge's slowed feed included) would be written `F0`, naming
+    /// `spindle_field` or `feed_field`: `S0 M03` starts no spindle under the cutting moves that
+    /// follow it, and no control runs a feed move at `F0`. Values are quoted in mm (a refusal
+    /// is restated in the request's units at the edge).
+    ///
+    /// # Errors
+    /// `E_INPUT` at `spindle_field` or `feed_field`.
+    pub fn check_written(
+        &self,
+        stops: &[ProgramStop],
+        spindle_field: &str,
+        feed_field: &str,
+    ) -> Result<(), SolverError> {
+        let mut speeds = std::iter::once(self.spindle_rpm).chain(stops.iter().map(|stop| stop.spindle_rpm));
+        if let Some(rpm) = speeds.find(|rpm| rpm.is_nan() || *rpm < LEAST_SPINDLE_RPM) {
+            return Err(SolverError::input(
+                spindle_field,
+                format!(
+                    "{spindle_field} must be at least {LEAST_SPINDLE_RPM} rpm: the program writes whole rpm, and S0 \
+                     would start no spindle under its cutting moves (got {})",
+                    crate::validate::quoted(rpm)
+                ),
+            ));
+        }
+        let least_mm = LEAST_FEED * self.units.mm_per_unit();
+        let mut position = None;
+        for step in &self.path.moves {
+            let feed = match step.motion {
+                Motion::Rapid => None,
+                Motion::Arc { feed, .. } => Some((feed, false)),
+                Motion::Linear { feed } => Some(match (self.plunges, position) {
+                    (Some(plunges), Some(from)) if is_plunge(from, step.to) => (plunge_feed(feed, plunges.feed), true),
+                    _ => (feed, false),
+                }),
+            };
+            position = Some(step.to);
+            if let Some((feed, plunge)) = feed
+                && (feed.is_nan() || feed < least_mm)
+            {
+                let which = if plunge { "a plunge's feed" } else { "a feed" };
+                return Err(SolverError::input(
+                    feed_field,
+                    format!(
+                        "{feed_field}: the program would write {which} of {} mm/min as F0 (it writes feeds to \
+                         0.1 of its units per minute), which no control runs; the least it writes is {least_mm} mm/min",
+                        crate::validate::quoted(feed)
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// How a program slows its plunges.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Plunges {

@@ -539,35 +539,33 @@ pub(crate) fn corrected_program_headed(
                 path.linear(*p, feed);
             }
             path.rapid(Vec3::new(last.x, last.y, safe_z));
-            gcode::write_cancellable(
-                &Program {
-                    dialect: options.dialect,
-                    number: 1000,
-                    title: "kerf corrected path",
-                    comments: vec![
-                        format!("control point: {}", request.reference.as_str()),
-                        format!(
-                            "max correction {:.4} mm, predicted max error {:.4} mm",
-                            answer.summary.max_correction,
-                            answer.summary.rounds[0].max_abs_error.unwrap_or(0.0)
-                        ),
-                    ]
-                    .into_iter()
-                    .chain(header.iter().cloned())
-                    .collect(),
-                    tool: options.tool.clone(),
-                    spindle_rpm,
-                    spindle_direction: request.spindle_direction.unwrap_or_default(),
-                    safe_z,
-                    blend_tolerance: 0.001,
-                    // The points are the caller's path, written as given.
-                    plunges: None,
-                    path: &path,
-                    units: options.units,
-                },
-                &[],
-                control,
-            )
+            let program = Program {
+                dialect: options.dialect,
+                number: 1000,
+                title: "kerf corrected path",
+                comments: vec![
+                    format!("control point: {}", request.reference.as_str()),
+                    format!(
+                        "max correction {:.4} mm, predicted max error {:.4} mm",
+                        answer.summary.max_correction,
+                        answer.summary.rounds[0].max_abs_error.unwrap_or(0.0)
+                    ),
+                ]
+                .into_iter()
+                .chain(header.iter().cloned())
+                .collect(),
+                tool: options.tool.clone(),
+                spindle_rpm,
+                spindle_direction: request.spindle_direction.unwrap_or_default(),
+                safe_z,
+                blend_tolerance: 0.001,
+                // The points are the caller's path, written as given.
+                plunges: None,
+                path: &path,
+                units: options.units,
+            };
+            program.check_written(&[], "spindle_rpm", "feed")?;
+            gcode::write_cancellable(&program, &[], control)
         }
     }
 }

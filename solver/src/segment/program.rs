@@ -76,22 +76,20 @@ pub fn program_controlled(answer: &SegmentSolution, post: &Post, control: Contro
         }
     }
     control.check()?;
-    gcode::write_cancellable(
-        &Program {
-            dialect: post.dialect,
-            number: 1001,
-            title: "kerf segment",
-            comments: answer.description.clone(),
-            tool: post.tool.clone(),
-            spindle_rpm: answer.spindle_rpm,
-            spindle_direction: SpindleDirection::Cw,
-            safe_z: answer.safe_z,
-            blend_tolerance: answer.chord_error.max(1e-4),
-            plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
-            path: &path,
-            units: post.units,
-        },
-        &[],
-        control,
-    )
+    let program = Program {
+        dialect: post.dialect,
+        number: 1001,
+        title: "kerf segment",
+        comments: answer.description.clone(),
+        tool: post.tool.clone(),
+        spindle_rpm: answer.spindle_rpm,
+        spindle_direction: SpindleDirection::Cw,
+        safe_z: answer.safe_z,
+        blend_tolerance: answer.chord_error.max(1e-4),
+        plunges: Some(gcode::Plunges { feed: post.plunge_feed }),
+        path: &path,
+        units: post.units,
+    };
+    program.check_written(&[], "spindle_rpm", "feed")?;
+    gcode::write_cancellable(&program, &[], control)
 }

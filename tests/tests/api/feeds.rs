@@ -104,6 +104,7 @@ fn assert_feeds(name: &str, program: &str, found: &Feeds, cutting: f64, plunge: 
     }
 }
 
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
 #[tokio::test(flavor = "multi_thread")]
 async fn a_machine_caps_every_feed_near_the_stock() {
     let app = TestApp::spawn().await;
@@ -207,4 +208,90 @@ async fn a_machine_never_raises_a_feed() {
     let answer = json_with(app.post_json("/api/v1/deburr", &body).await, 200).await;
     assert_eq!(answer["summary"]["feed"], REQUESTED);
     assert!(!codes(&answer).contains(&"W_FEED_ABOVE_MACHINE_MAX"), "{:?}", codes(&answer));
+}
+
+/// A program never writes a spindle speed as `S0` (it writes whole rpm) nor a feed as `F0` (it
+/// writes 0.1 mm/min, or 0.1 in/min in inch): such a request is refused at the field it came from,
+/// for every capability that writes a program; the least values that write are kept.
+#[cfg_attr(not(kerf_has_rs274), ignore = "rs274 not found: apt-get install linuxcnc-uspace")]
+#[tokio::test(flavor = "multi_thread")]
+async fn a_spindle_speed_or_feed_a_program_would_write_as_zero_is_refused_at_its_field() {
+    let app = TestApp::spawn().await;
+    app.register_tool(3, &json!({"kind": "flat", "radius": RADIUS})).await;
+    app.register_tool(7, &json!({"kind": "ball", "radius": RADIUS})).await;
+    let rectangle = [[0.0, 0.0], [80.0, 0.0], [80.0, 60.0], [0.0, 60.0]];
+    let points: Vec<[f64; 3]> = (0..=16).map(|i| [-4.0 + 0.5 * f64::from(i), 0.0, 0.0]).collect();
+    let mut predict = crate::predict::raster_request(crate::predict::finishing_tool(), 1, 2);
+    predict["path"] = json!({"kind": "points", "points": points});
+    predict["tool"]["number"] = json!(3);
+    // Each capability's request with a spindle speed and a feed field set by the case.
+    let requests: Vec<(&str, Value, &str)> = vec![
+        (
+            "/api/v1/segment",
+            json!({"curve": {"kind": "circle", "centre": [0, 0, -2], "radius": 20}, "tool": 3, "block_time_ms": 1,
+                   "min_chord_error": 0.01}),
+            "feed",
+        ),
+        (
+            "/api/v1/contour",
+            json!({"tool": 3, "contour": rectangle, "side": "outside", "depths": {"top": 0, "bottom": -2, "step": 2}}),
+            "feed",
+        ),
+        ("/api/v1/deburr", kerf_cases::deburr::tube_request(), "feed"),
+        (
+            "/api/v1/engagement",
+            json!({"tool": {"kind": "flat", "radius": 5}, "stock": {"polygon": [[0, 0], [60, 0], [60, 40], [0, 40]]},
+                   "path": [[-10, 20], [70, 20]], "flute_counts": [2], "axial_depth": 2}),
+            "feed_per_tooth",
+        ),
+        ("/api/v1/predict", predict, "feed"),
+    ];
+    for (path, body, feed_field) in &requests {
+        // A feed per tooth of 0.0001 mm on two flutes: 0.6 mm/min at 3000 rpm.
+        let feed = if *feed_field == "feed" { 1000.0 } else { 0.1 };
+        let slow = if *feed_field == "feed" { 0.01 } else { 0.000_001 };
+        let with =
+            |rpm: f64, feed: f64| kerf_cases::with(body.clone(), json!({"spindle_rpm": rpm, (*feed_field): feed}));
+        for (case, request, field, said) in [
+            ("spindle 0.3 rpm", with(0.3, feed), "spindle_rpm", "S0"),
+            ("a feed of 0.01 mm/min", with(3000.0, slow), *feed_field, "F0"),
+        ] {
+            for query in ["?format=gcode", "?format=gcode&dialect=heidenhain"] {
+                let refused = kerf_tests::problem(app.post_json(&format!("{path}{query}"), &request).await, 422).await;
+                assert_eq!(refused["code"], "E_INPUT", "{path}{query}, {case}: {refused}");
+                assert_eq!(refused["errors"][0]["path"], field, "{path}{query}, {case}: {refused}");
+                let detail = refused["detail"].as_str().unwrap();
+                assert!(detail.contains(said), "{path}{query}, {case}: {detail}");
+            }
+        }
+    }
+
+    // The least values that write are written: 0.6 rpm as S1; a contour feed of 0.2 mm/min as
+    // F0.2 and its plunges at half of it as F0.1; half of 0.08 mm/min is refused as a plunge's.
+    let (path, body, _) = &requests[1];
+    let least = kerf_cases::with(body.clone(), json!({"spindle_rpm": 0.6, "feed": 0.2}));
+    let program = app.post_text(&format!("{path}?format=gcode&dialect=linuxcnc"), &least, 200).await;
+    for word in ["S1 M03", " F0.2", " F0.1"] {
+        assert!(program.contains(word), "no {word:?} in\n{program}");
+    }
+    rs274_moves(&program, app.directory(), "feeds_least");
+    let plunge = kerf_cases::with(body.clone(), json!({"feed": 0.08}));
+    let refused = kerf_tests::problem(app.post_json(&format!("{path}?format=gcode"), &plunge).await, 422).await;
+    assert_eq!(refused["errors"][0]["path"], "feed", "{refused}");
+    assert!(refused["detail"].as_str().unwrap().contains("a plunge's feed of 0.04 mm/min"), "{refused}");
+
+    // An inch program writes 0.1 in/min: 0.02 in/min is refused, in inches.
+    let inch = kerf_cases::with(
+        body.clone(),
+        json!({"units": "inch", "tool": {"kind": "flat", "radius": 0.125}, "contour": [[0, 0], [3, 0], [3, 2], [0, 2]],
+               "depths": {"top": 0, "bottom": -0.1, "step": 0.1}, "feed": 0.02}),
+    );
+    let refused = kerf_tests::problem(app.post_json(&format!("{path}?format=gcode"), &inch).await, 422).await;
+    assert_eq!(refused["errors"][0]["path"], "feed", "{refused}");
+    let detail = refused["detail"].as_str().unwrap();
+    assert!(detail.contains("in/min") && !detail.contains("mm/min"), "{detail}");
+    // The JSON answer of a contour cuts its program (the verification): refused the same way.
+    let slow_spindle = kerf_cases::with(body.clone(), json!({"spindle_rpm": 0.3, "feed": 1000}));
+    let refused = kerf_tests::problem(app.post_json(path, &slow_spindle).await, 422).await;
+    assert_eq!(refused["errors"][0]["path"], "spindle_rpm", "{refused}");
 }

@@ -112,6 +112,14 @@ impl FeedMode {
         }
     }
 
+    /// The request's field the feeds come from: `feed_per_tooth` or `feed`.
+    pub(crate) fn field(self) -> &'static str {
+        match self {
+            Self::PerTooth(_) => "feed_per_tooth",
+            Self::Rate(_) => "feed",
+        }
+    }
+
     /// V_f,k for `flutes` teeth at `spindle_rpm`, mm/min.
     pub(crate) fn feed(self, flutes: u32, spindle_rpm: f64) -> f64 {
         match self {
