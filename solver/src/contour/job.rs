@@ -210,7 +210,11 @@ impl ContourRequest {
         tool: &Tool,
         machine: Option<&MachineProfile>,
     ) -> Result<(f64, Option<f64>, Option<f64>), SolverError> {
-        let spindle_rpm = positive("spindle_rpm", self.spindle_rpm.unwrap_or(DEFAULT_SPINDLE_RPM))?;
+        let spindle_rpm = crate::machine::spindle_within(
+            machine.and_then(|machine| machine.max_spindle_rpm),
+            "spindle_rpm",
+            positive("spindle_rpm", self.spindle_rpm.unwrap_or(DEFAULT_SPINDLE_RPM))?,
+        )?;
         let plunge_feed = self
             .plunge_feed
             .map(|f| positive("plunge_feed", f))

@@ -280,7 +280,11 @@ impl DeburrRequest {
             feed,
             rule,
             rule_warnings,
-            spindle_rpm: optional_positive("spindle_rpm", self.spindle_rpm, DEFAULT_SPINDLE_RPM)?,
+            spindle_rpm: crate::machine::spindle_within(
+                machine.and_then(|machine| machine.max_spindle_rpm),
+                "spindle_rpm",
+                optional_positive("spindle_rpm", self.spindle_rpm, DEFAULT_SPINDLE_RPM)?,
+            )?,
             clearance: bounded("clearance", optional_positive("clearance", self.clearance, DEFAULT_CLEARANCE)?)?,
             lead_distance: bounded(
                 "lead_distance",

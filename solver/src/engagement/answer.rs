@@ -485,6 +485,8 @@ pub(crate) struct PostData {
     /// program cannot write them.
     pub feed_field: &'static str,
     pub spindle_rpm: f64,
+    /// The machine's `max_spindle_rpm`: no program is written above it.
+    pub max_spindle_rpm: Option<f64>,
     pub spindle_direction: crate::gcode::SpindleDirection,
     /// The block-time rule the program's arcs are chorded by (its feed replaced by each block's).
     pub rule: Option<crate::machine::BlockRule>,
@@ -515,6 +517,7 @@ impl Default for PostData {
             }),
             nominal_feed: 0.0,
             feed_field: "feed",
+            max_spindle_rpm: None,
             spindle_rpm: 0.0,
             spindle_direction: crate::gcode::SpindleDirection::default(),
             rule: None,

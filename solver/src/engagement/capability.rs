@@ -509,6 +509,7 @@ impl PartPost {
             route: RouteData(route.clone()),
             nominal_feed: self.nominal_feed,
             feed_field: job.feed_mode.field(),
+            max_spindle_rpm: job.machine_speed,
             spindle_rpm: self.spindle_rpm,
             spindle_direction: self.spindle_direction,
             rule: job.rule,

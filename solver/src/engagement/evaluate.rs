@@ -435,6 +435,7 @@ fn post_data(job: &Job, candidate: &CandidateJob, tool: &Tool, flutes: u32, nomi
         route: RouteData(route.clone()),
         nominal_feed,
         feed_field: job.feed_mode.field(),
+        max_spindle_rpm: job.machine_speed,
         spindle_rpm: job.spindle_rpm,
         spindle_direction: job.direction,
         rule: job.rule,

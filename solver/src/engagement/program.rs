@@ -61,14 +61,17 @@ fn runs(result: &PathEngagement) -> Vec<Run> {
 /// The complete program for candidate `candidate` (0 for a single-path answer).
 ///
 /// # Errors
-/// `E_INPUT` at `candidate` for an index out of range, and at `axial_depth` when the request
-/// gave no axial depth (the cutting Z is `stock_top_z − axial_depth`).
+/// `E_INPUT` at `candidate` for an index out of range, at `axial_depth` when the request
+/// gave no axial depth (the cutting Z is `stock_top_z − axial_depth`), and at `spindle_rpm` or
+/// the feed's field when the program cannot run as asked (above the machine's
+/// `max_spindle_rpm`, or a value written as `S0` or `F0`).
 pub fn program(answer: &EngagementSolution, candidate: usize, post: &Post) -> Result<String, SolverError> {
     let candidates = answer.candidates();
     let result = candidates.get(candidate).ok_or_else(|| {
         SolverError::input("candidate", format!("candidate {candidate} does not exist ({} path(s))", candidates.len()))
     })?;
     let data = &result.post;
+    crate::machine::spindle_within(data.max_spindle_rpm, "spindle_rpm", data.spindle_rpm)?;
     let lift = match post.reference {
         Reference::Tip => 0.0,
         Reference::Centre => data.centre_height,

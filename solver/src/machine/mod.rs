@@ -70,8 +70,9 @@ pub struct MachineProfile {
     /// Rated spindle torque, N·m (> 0), used like `spindle_power_kw`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spindle_torque_nm: Option<f64>,
-    /// Highest spindle speed, rpm (> 0): engagement recommends no flute count at a faster
-    /// spindle speed.
+    /// Highest spindle speed, rpm (> 0): no program is written faster (a contour, deburr or
+    /// segment request, or an engagement program, at a faster `spindle_rpm` is refused at it),
+    /// and engagement recommends no flute count at a faster spindle speed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_spindle_rpm: Option<f64>,
     /// The spindle's power curve (S1, continuous duty): `[[rpm, kW], ...]`, 2–64 points, speeds
@@ -134,6 +135,26 @@ pub fn cap_feed(machine: Option<&MachineProfile>, field: &str, feed: f64, warnin
         machine.max_feed
     } else {
         feed
+    }
+}
+
+/// A spindle speed the request asks for (`field`, rpm), refused above the machine's
+/// `max_spindle_rpm` (`max`, none without a machine or a maximum): a control clamps the speed it cannot reach and keeps the programmed feeds,
+/// so every tooth would cut a thicker chip than the request planned (a feed is capped instead,
+/// [`cap_feed`]: a slower feed only thins the chip).
+///
+/// # Errors
+/// `E_INPUT` at `field`.
+pub fn spindle_within(max: Option<f64>, field: &str, rpm: f64) -> Result<f64, SolverError> {
+    match max {
+        Some(max) if rpm > max => Err(SolverError::input(
+            field,
+            format!(
+                "{field} {rpm} rpm is above the machine's max_spindle_rpm {max} rpm: its control would run the \
+                 spindle slower under the same feeds, a thicker chip than planned; ask for at most {max} rpm"
+            ),
+        )),
+        _ => Ok(rpm),
     }
 }
 

@@ -475,7 +475,11 @@ impl SegmentRequest {
         }
         let tolerance = optional_tolerance("tolerance", self.tolerance)?;
         let compare_tolerance = optional_tolerance("compare_tolerance", self.compare_tolerance)?;
-        let spindle_rpm = self.spindle_rpm.map_or(Ok(DEFAULT_SPINDLE_RPM), |rpm| positive("spindle_rpm", rpm))?;
+        let spindle_rpm = crate::machine::spindle_within(
+            machine.and_then(|machine| machine.max_spindle_rpm),
+            "spindle_rpm",
+            self.spindle_rpm.map_or(Ok(DEFAULT_SPINDLE_RPM), |rpm| positive("spindle_rpm", rpm))?,
+        )?;
         let safe_z = self.safe_z.map(|z| coordinate("safe_z", z)).transpose()?;
         let (shape, corners, dimension, curve_warnings) = self.curve.build()?;
         warnings.extend(curve_warnings);

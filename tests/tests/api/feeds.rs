@@ -295,3 +295,58 @@ async fn a_spindle_speed_or_feed_a_program_would_write_as_zero_is_refused_at_its
     let refused = kerf_tests::problem(app.post_json(path, &slow_spindle).await, 422).await;
     assert_eq!(refused["errors"][0]["path"], "spindle_rpm", "{refused}");
 }
+
+/// A program is never written above the machine's `max_spindle_rpm` (its control would clamp
+/// the speed under the same feeds: a thicker chip than planned): contour, deburr and segment
+/// refuse such a request at `spindle_rpm`, engagement its program (and an answer whose
+/// verification cuts it); engagement's analysis without a program still answers the limit as
+/// its own (no flute count recommended at that speed).
+#[tokio::test(flavor = "multi_thread")]
+async fn a_spindle_speed_above_the_machines_max_is_refused_for_every_program() {
+    let app = TestApp::spawn().await;
+    app.register_tool(3, &json!({"kind": "flat", "radius": RADIUS})).await;
+    app.register_tool(7, &json!({"kind": "ball", "radius": RADIUS})).await;
+    let machine = json!({"block_time_ms": 1, "max_feed": 12000, "max_spindle_rpm": 8000});
+    json_with(app.put_json("/api/v1/machines/small", &machine).await, 201).await;
+    let requests = [
+        (
+            "/api/v1/segment",
+            json!({"curve": {"kind": "circle", "centre": [0, 0, -2], "radius": 20}, "tool": 3, "feed": 1000}),
+        ),
+        (
+            "/api/v1/contour",
+            json!({"tool": 3, "contour": [[0, 0], [80, 0], [80, 60], [0, 60]], "side": "outside",
+                   "depths": {"top": 0, "bottom": -2, "step": 2}, "feed": 1000}),
+        ),
+        ("/api/v1/deburr", kerf_cases::deburr::tube_request()),
+    ];
+    for (path, body) in &requests {
+        let fast = kerf_cases::with(body.clone(), json!({"machine": "small", "spindle_rpm": 12000}));
+        for query in ["", "?format=gcode"] {
+            let refused = kerf_tests::problem(app.post_json(&format!("{path}{query}"), &fast).await, 422).await;
+            assert_eq!(refused["errors"][0]["path"], "spindle_rpm", "{path}{query}: {refused}");
+            let detail = refused["detail"].as_str().unwrap();
+            assert!(detail.contains("max_spindle_rpm 8000 rpm"), "{path}{query}: {detail}");
+        }
+        let at_most = kerf_cases::with(body.clone(), json!({"machine": "small", "spindle_rpm": 8000}));
+        let program = app.post_text(&format!("{path}?format=gcode"), &at_most, 200).await;
+        assert!(program.contains("S8000 M03"), "{path}: {program}");
+        // The defaults' 6000 rpm is within it.
+        let default = kerf_cases::with(body.clone(), json!({"machine": "small"}));
+        json_with(app.post_json(path, &default).await, 200).await;
+    }
+
+    let engagement = json!({"tool": {"kind": "flat", "radius": 5}, "stock": {"polygon": [[0, 0], [60, 0], [60, 40], [0, 40]]},
+                            "path": [[-10, 20], [70, 20]], "flute_counts": [2, 3], "feed_per_tooth": 0.02,
+                            "spindle_rpm": 12000, "machine": "small"});
+    let answer = json_with(app.post_json("/api/v1/engagement", &engagement).await, 200).await;
+    assert_eq!(answer["recommended"], json!([]), "{answer}");
+    assert_eq!(answer["flutes"][0]["over_limits"][0]["limit"], "spindle_speed", "{answer}");
+    let programmed = kerf_cases::with(engagement, json!({"axial_depth": 2}));
+    let refused = kerf_tests::problem(app.post_json("/api/v1/engagement?format=gcode", &programmed).await, 422).await;
+    assert_eq!(refused["errors"][0]["path"], "spindle_rpm", "{refused}");
+    assert!(refused["detail"].as_str().unwrap().contains("max_spindle_rpm 8000 rpm"), "{refused}");
+    // With a_p the answer's verification cuts that program: refused the same way.
+    let refused = kerf_tests::problem(app.post_json("/api/v1/engagement", &programmed).await, 422).await;
+    assert_eq!(refused["errors"][0]["path"], "spindle_rpm", "{refused}");
+}
