@@ -139,9 +139,9 @@ pub fn cap_feed(machine: Option<&MachineProfile>, field: &str, feed: f64, warnin
 }
 
 /// A spindle speed the request asks for (`field`, rpm), refused above the machine's
-/// `max_spindle_rpm` (`max`, none without a machine or a maximum): a control clamps the speed it cannot reach and keeps the programmed feeds,
-/// so every tooth would cut a thicker chip than the request planned (a feed is capped instead,
-/// [`cap_feed`]: a slower feed only thins the chip).
+/// `max_spindle_rpm` (`max`, none without a machine or a maximum): a control clamps the speed it
+/// cannot reach and keeps the programmed feeds, so every tooth would cut a thicker chip than the
+/// request planned (a feed is capped instead, [`cap_feed`]: a slower feed only thins the chip).
 ///
 /// # Errors
 /// `E_INPUT` at `field`.

@@ -336,7 +336,8 @@ async fn a_spindle_speed_above_the_machines_max_is_refused_for_every_program() {
         json_with(app.post_json(path, &default).await, 200).await;
     }
 
-    let engagement = json!({"tool": {"kind": "flat", "radius": 5}, "stock": {"polygon": [[0, 0], [60, 0], [60, 40], [0, 40]]},
+    let engagement = json!({"tool": {"kind": "flat", "radius": 5},
+                            "stock": {"polygon": [[0, 0], [60, 0], [60, 40], [0, 40]]},
                             "path": [[-10, 20], [70, 20]], "flute_counts": [2, 3], "feed_per_tooth": 0.02,
                             "spindle_rpm": 12000, "machine": "small"});
     let answer = json_with(app.post_json("/api/v1/engagement", &engagement).await, 200).await;
