@@ -11,8 +11,8 @@ use std::fmt::Write as _;
 use super::repost::{Item, has_word, program_number, read_items, refusal, source_units, words_in};
 use super::table::CommentStyle;
 use super::{
-    Buffer, Dialect, MOVES_PER_CHECK, Program, ProgramStop, SpindleDirection, ToolCall, helix_points, is_plunge,
-    number, plunge_feed, push_comment, same_printed,
+    Buffer, Dialect, MOVES_PER_CHECK, Program, ProgramStop, SpindleDirection, ToolCall, helix_points, number,
+    push_comment, same_printed,
 };
 use crate::error::SolverError;
 use crate::gcode::reader::{MoveKind, Plane, Position, ReadMove, Units};
@@ -204,10 +204,7 @@ pub(super) fn write<E>(
                 }
             }
             Motion::Linear { feed } | Motion::Arc { feed, .. } => {
-                let feed = match (program.plunges, position) {
-                    (Some(plunges), Some(from)) if is_plunge(from, step.to) => plunge_feed(feed, plunges.feed),
-                    _ => feed,
-                };
+                let feed = program.plunge_feed_of(position, step.to, feed).unwrap_or(feed);
                 out.line_to(step.to, feed, &mut current_feed);
             }
         }

@@ -304,10 +304,9 @@ impl Program<'_> {
             let feed = match step.motion {
                 Motion::Rapid => None,
                 Motion::Arc { feed, .. } => Some((feed, false)),
-                Motion::Linear { feed } => Some(match (self.plunges, position) {
-                    (Some(plunges), Some(from)) if is_plunge(from, step.to) => (plunge_feed(feed, plunges.feed), true),
-                    _ => (feed, false),
-                }),
+                Motion::Linear { feed } => {
+                    Some(self.plunge_feed_of(position, step.to, feed).map_or((feed, false), |slowed| (slowed, true)))
+                }
             };
             position = Some(step.to);
             if let Some((feed, plunge)) = feed
@@ -325,6 +324,15 @@ impl Program<'_> {
             }
         }
         Ok(())
+    }
+
+    /// The slowed feed of a straight move at `feed` from `from` to `to` when it is a plunge the
+    /// program slows ([`Self::plunges`]), else `None` (it runs at `feed`).
+    fn plunge_feed_of(&self, from: Option<Vec3>, to: Vec3, feed: f64) -> Option<f64> {
+        match (self.plunges, from) {
+            (Some(plunges), Some(from)) if is_plunge(from, to) => Some(plunge_feed(feed, plunges.feed)),
+            _ => None,
+        }
     }
 }
 
@@ -855,10 +863,7 @@ impl Blocks {
                 }
                 Motion::Linear { feed } | Motion::Arc { feed, .. } => {
                     self.motion(1, step.to);
-                    match (program.plunges, position) {
-                        (Some(plunges), Some(from)) if is_plunge(from, step.to) => plunge_feed(feed, plunges.feed),
-                        _ => feed,
-                    }
+                    program.plunge_feed_of(position, step.to, feed).unwrap_or(feed)
                 }
             };
             self.feed(feed, &mut current_feed);
