@@ -7,7 +7,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::SolverError;
-use crate::validate::positive_at_most;
+use crate::validate::{Measure, positive_at_most};
 
 /// Kienzle's specific cutting force of a work material (docs/spec/engagement.md §11 item 4): the
 /// tangential force on one tooth is `kc11 · a_p · h^(1 − mc)` for a chip of thickness h and
@@ -41,7 +41,7 @@ impl Kienzle {
     /// # Errors
     /// `E_INPUT` when `kc11` is not in (0, [`MAX_KC11`]] or `mc` is outside [0, 1).
     pub fn validate(&self, prefix: &str) -> Result<(), SolverError> {
-        positive_at_most(&format!("{prefix}kc11"), self.kc11, MAX_KC11)?;
+        positive_at_most(&format!("{prefix}kc11"), self.kc11, MAX_KC11, Measure::Number)?;
         if !(self.mc.is_finite() && (0.0..1.0).contains(&self.mc)) {
             return Err(SolverError::input(
                 format!("{prefix}mc"),

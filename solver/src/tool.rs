@@ -7,7 +7,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 
 use crate::error::SolverError;
 
-use crate::validate::{finite, positive};
+use crate::validate::{Measure, finite, positive};
 
 /// The cutter's end shape.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -233,17 +233,21 @@ impl Tool {
         {
             return Err(SolverError::input(field("number"), format!("tool number must be 1 to 9999 (got {number})")));
         }
-        positive(&field("radius"), self.radius)?;
+        positive(&field("radius"), self.radius, Measure::Length)?;
         match (self.kind, self.corner_radius) {
             (ToolKind::Bull, None) => {
                 return Err(SolverError::input(field("corner_radius"), "a bull-nose tool needs corner_radius"));
             }
             (ToolKind::Bull, Some(corner)) => {
-                positive(&field("corner_radius"), corner)?;
+                positive(&field("corner_radius"), corner, Measure::Length)?;
                 if corner > self.radius {
                     return Err(SolverError::input(
                         field("corner_radius"),
-                        format!("corner_radius {corner} must not exceed radius {}", self.radius),
+                        format!(
+                            "corner_radius {} must not exceed radius {}",
+                            Measure::Length.quote(corner),
+                            Measure::Length.quote(self.radius)
+                        ),
                     ));
                 }
             }
@@ -267,28 +271,32 @@ impl Tool {
             return Err(SolverError::input(field("helix_deg"), format!("helix_deg must be in [0, 90) (got {helix})")));
         }
         if let Some(stickout) = self.stickout {
-            positive(&field("stickout"), stickout)?;
+            positive(&field("stickout"), stickout, Measure::Length)?;
         }
         if let Some(flute_length) = self.flute_length {
-            positive(&field("flute_length"), flute_length)?;
+            positive(&field("flute_length"), flute_length, Measure::Length)?;
         }
         if let Some(plunge_feed) = self.plunge_feed {
-            positive(&field("plunge_feed"), plunge_feed)?;
+            positive(&field("plunge_feed"), plunge_feed, Measure::Feed)?;
         }
         if self.kind == ToolKind::Ball && self.centre_cutting == Some(false) {
             return Err(SolverError::input(field("centre_cutting"), "a ball end mill always cuts at its centre"));
         }
         if let Some(neck) = self.neck_radius {
-            positive(&field("neck_radius"), neck)?;
+            positive(&field("neck_radius"), neck, Measure::Length)?;
             if neck >= self.radius {
                 return Err(SolverError::input(
                     field("neck_radius"),
-                    format!("neck_radius {neck} must be smaller than radius {}", self.radius),
+                    format!(
+                        "neck_radius {} must be smaller than radius {}",
+                        Measure::Length.quote(neck),
+                        Measure::Length.quote(self.radius)
+                    ),
                 ));
             }
         }
         if let Some(length) = self.neck_length {
-            positive(&field("neck_length"), length)?;
+            positive(&field("neck_length"), length, Measure::Length)?;
             if self.neck_radius.is_none() {
                 return Err(SolverError::input(field("neck_length"), "neck_length needs a neck_radius"));
             }
@@ -299,7 +307,7 @@ impl Tool {
             ("holder_length", self.holder_length),
         ] {
             if let Some(value) = value {
-                positive(&field(name), value)?;
+                positive(&field(name), value, Measure::Length)?;
             }
         }
         if let Some(table) = &self.shape_error {
@@ -346,8 +354,8 @@ impl Stiffness {
     pub fn validate(&self, field: &str) -> Result<(), SolverError> {
         match self {
             Self::Static { x, y } => {
-                positive(&format!("{field}.x"), *x)?;
-                positive(&format!("{field}.y"), *y)?;
+                positive(&format!("{field}.x"), *x, Measure::Number)?;
+                positive(&format!("{field}.y"), *y, Measure::Number)?;
             }
             Self::Modal { x, y } => {
                 for (axis, modes) in [("x", x), ("y", y)] {
@@ -360,9 +368,9 @@ impl Stiffness {
                     }
                     for (index, mode) in modes.iter().enumerate() {
                         let at = format!("{axis_field}[{index}]");
-                        positive(&format!("{at}.stiffness"), mode.stiffness)?;
-                        positive(&format!("{at}.frequency_hz"), mode.frequency_hz)?;
-                        let damping = positive(&format!("{at}.damping_ratio"), mode.damping_ratio)?;
+                        positive(&format!("{at}.stiffness"), mode.stiffness, Measure::Number)?;
+                        positive(&format!("{at}.frequency_hz"), mode.frequency_hz, Measure::Number)?;
+                        let damping = positive(&format!("{at}.damping_ratio"), mode.damping_ratio, Measure::Number)?;
                         if damping >= 1.0 {
                             return Err(SolverError::input(
                                 format!("{at}.damping_ratio"),

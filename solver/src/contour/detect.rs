@@ -13,7 +13,7 @@ use super::request::{self as contour_request, LoopStyle};
 use crate::capability::Control;
 use crate::error::{ErrorCode, SolverError, Warning};
 use crate::planar::{Containment, SegmentGrid, Vec2, centroid, segments_intersect, signed_area, turn_angle, vec2};
-use crate::validate::{MAX_COORDINATE, coordinates, finite, positive};
+use crate::validate::{MAX_COORDINATE, Measure, coordinates, finite, positive};
 
 /// How corners are found on a point list.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -203,7 +203,7 @@ pub fn loop_path_within(
     max_moves: usize,
     control: Control<'_>,
 ) -> Result<PathLoopAnswer, SolverError> {
-    let radius = positive("tool_radius", request.tool_radius)?;
+    let radius = positive("tool_radius", request.tool_radius, Measure::Length)?;
     let points = path_points(request, max_moves)?;
     control.check()?;
     let n = points.len();
@@ -339,7 +339,7 @@ fn path_points(request: &PathLoopRequest, max_moves: usize) -> Result<Vec<Vec2>,
 /// mode's default when the request gives none.
 fn detect_threshold(request: &PathLoopRequest, radius: f64) -> Result<f64, SolverError> {
     let threshold = match (request.detect, request.threshold) {
-        (_, Some(value)) => positive("threshold", value)?,
+        (_, Some(value)) => positive("threshold", value, Measure::Number)?,
         (DetectMode::TurnAngle, None) => 10.0,
         (DetectMode::PatentCurvature, None) => 1.0 / radius,
         (DetectMode::PatentDeltaL, None) => 5f64.to_radians().sin(),

@@ -14,7 +14,7 @@ use crate::capability::Control;
 use crate::error::{SolverError, Warning};
 use crate::machine::{BlockRule, MachineProfile, RuleSettings, cap_feed};
 use crate::tool::{Tool, ToolKind};
-use crate::validate::{coordinate, finite, non_negative, positive};
+use crate::validate::{Measure, coordinate, finite, non_negative, positive};
 
 /// A validated pass.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -99,10 +99,10 @@ impl ContourRequest {
         let radius = tool.radius;
         // The machine's max feed caps every feed the program writes (never raises one).
         let mut capped = Vec::new();
-        let feed = cap_feed(machine, "feed", positive("feed", self.feed)?, &mut capped);
+        let feed = cap_feed(machine, "feed", positive("feed", self.feed, Measure::Feed)?, &mut capped);
         let loop_feed = self
             .loop_feed
-            .map(|f| positive("loop_feed", f).map(|f| cap_feed(machine, "loop_feed", f, &mut capped)))
+            .map(|f| positive("loop_feed", f, Measure::Feed).map(|f| cap_feed(machine, "loop_feed", f, &mut capped)))
             .transpose()?;
         let (top, bottom, layers) = self.layer_depths(radius)?;
         let (tolerance, chording, rule_warnings) = self.chording(feed, loop_feed, machine)?;
@@ -161,14 +161,18 @@ impl ContourRequest {
         let depths = &self.depths;
         let top = coordinate("depths.top", depths.top)?;
         let bottom = coordinate("depths.bottom", depths.bottom)?;
-        let step = positive("depths.step", depths.step)?;
+        let step = positive("depths.step", depths.step, Measure::Length)?;
         if radius > super::prepare::MAX_COORDINATE {
             return Err(SolverError::input("tool.radius", "the tool radius is implausibly large"));
         }
         if bottom > top {
             return Err(SolverError::input(
                 "depths.bottom",
-                format!("depths.bottom {bottom} lies above depths.top {top}"),
+                format!(
+                    "depths.bottom {} lies above depths.top {}",
+                    Measure::Length.quote(bottom),
+                    Measure::Length.quote(top)
+                ),
             ));
         }
         Ok((top, bottom, layer_heights(top, bottom, step)?))
@@ -186,7 +190,7 @@ impl ContourRequest {
         if finite("tolerance", tolerance)? < MIN_TOLERANCE {
             return Err(SolverError::input(
                 "tolerance",
-                format!("tolerance must be at least {MIN_TOLERANCE} mm (got {tolerance} mm)"),
+                format!("tolerance must be at least {MIN_TOLERANCE} mm (got {})", Measure::Length.quote(tolerance)),
             ));
         }
         let mut rule_warnings = Vec::new();
@@ -213,11 +217,11 @@ impl ContourRequest {
         let spindle_rpm = crate::machine::spindle_within(
             machine.and_then(|machine| machine.max_spindle_rpm),
             "spindle_rpm",
-            positive("spindle_rpm", self.spindle_rpm.unwrap_or(DEFAULT_SPINDLE_RPM))?,
+            positive("spindle_rpm", self.spindle_rpm.unwrap_or(DEFAULT_SPINDLE_RPM), Measure::Number)?,
         )?;
         let plunge_feed = self
             .plunge_feed
-            .map(|f| positive("plunge_feed", f))
+            .map(|f| positive("plunge_feed", f, Measure::Feed))
             .transpose()?
             .or(tool.plunge_feed)
             .or(machine.and_then(|m| m.plunge_feed));
@@ -234,31 +238,45 @@ impl ContourRequest {
 
     /// The clearance plane (`safe_z`, else `clearance` above the top) and the `lead` length.
     fn heights(&self, top: f64, radius: f64) -> Result<(f64, f64), SolverError> {
-        let clearance =
-            coordinate("clearance", non_negative("clearance", self.clearance.unwrap_or(DEFAULT_CLEARANCE))?)?;
+        let clearance = coordinate(
+            "clearance",
+            non_negative("clearance", self.clearance.unwrap_or(DEFAULT_CLEARANCE), Measure::Length)?,
+        )?;
         let safe_z = match self.safe_z {
             Some(z) => {
                 if coordinate("safe_z", z)? <= top {
-                    return Err(SolverError::input("safe_z", format!("safe_z {z} must lie above depths.top {top}")));
+                    return Err(SolverError::input(
+                        "safe_z",
+                        format!(
+                            "safe_z {} must lie above depths.top {}",
+                            Measure::Length.quote(z),
+                            Measure::Length.quote(top)
+                        ),
+                    ));
                 }
                 z
             }
             None => top + clearance.max(1e-3),
         };
-        let lead = coordinate("lead", non_negative("lead", self.lead.unwrap_or(radius))?)?;
+        let lead = coordinate("lead", non_negative("lead", self.lead.unwrap_or(radius), Measure::Length)?)?;
         Ok((safe_z, lead))
     }
 
     /// `stock_allowance` and the passes; the stock must be at least the first pass's allowance.
     fn stock_and_passes(&self) -> Result<(Option<f64>, Vec<PassJob>), SolverError> {
-        let stock_allowance = self.stock_allowance.map(|s| non_negative("stock_allowance", s)).transpose()?;
+        let stock_allowance =
+            self.stock_allowance.map(|s| non_negative("stock_allowance", s, Measure::Length)).transpose()?;
         let passes = self.pass_jobs()?;
         if let (Some(stock), Some(first)) = (stock_allowance, passes.first())
             && stock < first.allowance
         {
             return Err(SolverError::input(
                 "stock_allowance",
-                format!("stock_allowance {stock} is smaller than the first pass's allowance {}", first.allowance),
+                format!(
+                    "stock_allowance {} is smaller than the first pass's allowance {}",
+                    Measure::Length.quote(stock),
+                    Measure::Length.quote(first.allowance)
+                ),
             ));
         }
         Ok((stock_allowance, passes))
@@ -281,10 +299,10 @@ impl ContourRequest {
         Ok(match &self.controller {
             None => (None, None),
             Some(model) => (
-                model.blend_radius.map(|b| non_negative("controller.blend_radius", b)).transpose()?,
+                model.blend_radius.map(|b| non_negative("controller.blend_radius", b, Measure::Length)).transpose()?,
                 model
                     .servo_time_constant_ms
-                    .map(|t| non_negative("controller.servo_time_constant_ms", t).map(|t| t / 1000.0))
+                    .map(|t| non_negative("controller.servo_time_constant_ms", t, Measure::Number).map(|t| t / 1000.0))
                     .transpose()?,
             ),
         })
@@ -304,12 +322,14 @@ impl ContourRequest {
             .enumerate()
             .map(|(index, pass)| {
                 let field = format!("passes[{index}].allowance");
-                let allowance = non_negative(&field, pass.allowance)?;
+                let allowance = non_negative(&field, pass.allowance, Measure::Length)?;
                 if allowance > previous {
                     return Err(SolverError::input(
                         field,
                         format!(
-                            "passes run from outside in: allowance {allowance} exceeds the previous pass's {previous}"
+                            "passes run from outside in: allowance {} exceeds the previous pass's {}",
+                            Measure::Length.quote(allowance),
+                            Measure::Length.quote(previous)
                         ),
                     ));
                 }
@@ -418,24 +438,32 @@ impl CornerLoop {
     pub(crate) fn config(&self, radius: f64) -> Result<LoopConfig, SolverError> {
         let spec = self;
         let positive_or = |name: &str, value: Option<f64>, default: f64| {
-            positive(&format!("corner_loop.{name}"), value.unwrap_or(default))
+            positive(&format!("corner_loop.{name}"), value.unwrap_or(default), Measure::Length)
         };
         let loop_radius = positive_or("radius", spec.radius, radius)?;
         let leg = positive_or("leg", spec.leg, radius)?;
-        let min_leg = non_negative("corner_loop.min_leg", spec.min_leg.unwrap_or(0.0))?;
+        let min_leg = non_negative("corner_loop.min_leg", spec.min_leg.unwrap_or(0.0), Measure::Length)?;
         let max_leg = positive_or("max_leg", spec.max_leg, 10.0 * radius)?;
         let min_radius = positive_or("min_radius", spec.min_radius, 0.1 * radius)?;
         let max_radius = positive_or("max_radius", spec.max_radius, 5.0 * radius)?;
         if min_leg > max_leg {
             return Err(SolverError::input(
                 "corner_loop.min_leg",
-                format!("min_leg {min_leg} exceeds max_leg {max_leg}"),
+                format!(
+                    "min_leg {} exceeds max_leg {}",
+                    Measure::Length.quote(min_leg),
+                    Measure::Length.quote(max_leg)
+                ),
             ));
         }
         if min_radius > max_radius {
             return Err(SolverError::input(
                 "corner_loop.min_radius",
-                format!("min_radius {min_radius} exceeds max_radius {max_radius}"),
+                format!(
+                    "min_radius {} exceeds max_radius {}",
+                    Measure::Length.quote(min_radius),
+                    Measure::Length.quote(max_radius)
+                ),
             ));
         }
         let max_angle = spec.max_angle_deg.unwrap_or(DEFAULT_MAX_ANGLE_DEG);

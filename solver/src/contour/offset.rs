@@ -226,7 +226,7 @@ fn collapse(describe_tool: &str, field: &str, length: f64, offset_length: f64) -
     SolverError::new(
         ErrorCode::OffsetCollapse,
         format!(
-            "{describe_tool} does not fit at the edge from {field} (length {length:.6}): its offset edge has length {offset_length:.6} and the neighbouring offsets do not meet"
+            "{describe_tool} does not fit at the edge from {field} (length {length:.6} mm): its offset edge has length {offset_length:.6} mm and the neighbouring offsets do not meet"
         ),
     )
     .at(field.to_owned())

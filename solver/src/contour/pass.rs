@@ -14,6 +14,7 @@ use super::relief::{self, ReliefShape};
 use super::request::{Join, LoopStyle, Relief};
 use crate::error::{SolverError, Warning};
 use crate::planar::{SegmentGrid, Vec2};
+use crate::validate::Measure;
 use clearance::{check_clearance, check_loop_budget, check_offset, gouge_fallbacks, stock_clearance};
 
 /// Clearance below which a move gouges, mm.
@@ -202,7 +203,11 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
     let n = layer.len();
     let offsets = &input.edge_offsets;
     let clear = input.radius + input.pass.allowance;
-    let tool = format!("the tool (radius {} + allowance {})", input.radius, input.pass.allowance);
+    let tool = format!(
+        "the tool (radius {} + allowance {})",
+        Measure::Length.quote(input.radius),
+        Measure::Length.quote(input.pass.allowance)
+    );
     let offset = offset::offset(layer, offsets, &input.edge_source, &tool)?;
     check_offset(layer, &offset, input, &tool)?;
     let cl = offset.cl.clone();

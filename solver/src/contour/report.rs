@@ -17,6 +17,7 @@ use crate::error::Warning;
 use crate::geometry::Vec3;
 use crate::machine::MachineProfile;
 use crate::planar::array2;
+use crate::validate::Measure;
 
 /// Material angle below which a corner is reported as a fragile tip (`W_ACUTE_TIP`), degrees.
 const ACUTE_TIP_DEG: f64 = 15.0;
@@ -259,9 +260,9 @@ fn allowance_warnings(job: &Job, passes: &[PassPlan], warnings: &mut Vec<Warning
             warnings.push(Warning::new(
                 "W_EMBODIMENT1_UNSAFE",
                 format!(
-                    "pass {} (allowance {}) may cut into the final tips under the control model: it needs an allowance of at least {needed:.6}",
+                    "pass {} (allowance {}) may cut into the final tips under the control model: it needs an allowance of at least {needed:.6} mm",
                     pass.index + 1,
-                    pass.allowance
+                    Measure::Length.quote(pass.allowance)
                 ),
             ));
         }

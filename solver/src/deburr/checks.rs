@@ -21,7 +21,9 @@ pub(crate) fn ridge(job: &Job) -> Result<Vec<Warning>, SolverError> {
     if reach >= r1 {
         return Err(SolverError::new(
             ErrorCode::HoleTooLarge,
-            format!("hole too large: |eccentricity| + half-width = {reach} must be below the cylinder radius {r1}"),
+            format!(
+                "hole too large: |eccentricity| + half-width = {reach} mm must be below the cylinder radius {r1} mm"
+            ),
         )
         .at("hole.radius"));
     }
@@ -32,8 +34,8 @@ pub(crate) fn ridge(job: &Job) -> Result<Vec<Warning>, SolverError> {
         return Err(SolverError::new(
             ErrorCode::NotThrough,
             format!(
-                "the hole reaches |x| = {reach} across the tube, not below the inner radius {inner}: it does not \
-                 meet the bore as a separate loop"
+                "the hole reaches |x| = {reach} mm across the tube, not below the inner radius {inner} mm: it does \
+                not meet the bore as a separate loop"
             ),
         )
         .at("hole.radius"));
@@ -43,7 +45,7 @@ pub(crate) fn ridge(job: &Job) -> Result<Vec<Warning>, SolverError> {
         return Err(SolverError::new(
             ErrorCode::WidthVsBall,
             format!(
-                "ball too small for Q: the band width W = {:.4} must be below the ball diameter {}",
+                "ball too small for Q: the band width W = {:.4} mm must be below the ball diameter {} mm",
                 job.width,
                 2.0 * ball
             ),
@@ -155,7 +157,7 @@ fn far_gouge_error(job: &Job, target: &Target, what: &str) -> SolverError {
     SolverError::new(
         ErrorCode::FarGouge,
         format!(
-            "{what} at {} s = {:.4}: ball radius {} is too large for this hole (R2 = {})",
+            "{what} at {} s = {:.4}: ball radius {} mm is too large for this hole (R2 = {} mm)",
             segment.name, target.parameter, job.tool.radius, job.profile.radius
         ),
     )
@@ -179,8 +181,8 @@ pub(crate) fn inner_access(
         SolverError::new(
             ErrorCode::NoApproach,
             format!(
-                "the ball (radius {ball}) cannot pass through the hole (half-width {}), so no approach down the hole \
-                 axis exists; approach from the bore end instead",
+                "the ball (radius {ball} mm) cannot pass through the hole (half-width {} mm), so no approach down the \
+                hole axis exists; approach from the bore end instead",
                 profile.inscribed_radius()
             ),
         )
@@ -274,7 +276,7 @@ pub(crate) fn outer_shank(job: &Job, ridges: &[RidgeCentre]) -> Option<Warning> 
         Warning::new(
             "W_SHANK_CLEARANCE",
             format!(
-                "at {blocked} points the vertical shank above the ball (radius {shank}) would meet the tube (by up to \
+                "at {blocked} points the vertical shank above the ball (radius {shank} mm) would meet the tube (by up to \
                  {overlap:.3} mm at the first): a vertical tool cannot reach that part of the edge; turn the part so the \
                  hole points up"
             ),

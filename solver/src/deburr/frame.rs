@@ -38,7 +38,7 @@ impl Frame {
             if (given - from_point).abs() > 1e-6 * scale {
                 return Err(SolverError::new(
                     ErrorCode::InconsistentEcc,
-                    format!("eccentricity {given} disagrees with axis_point, which gives {from_point:.6}"),
+                    format!("eccentricity {given} mm disagrees with axis_point, which gives {from_point:.6} mm"),
                 )
                 .at("hole.eccentricity"));
             }

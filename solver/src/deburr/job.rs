@@ -7,7 +7,7 @@ use crate::error::{ErrorCode, SolverError, Warning};
 use crate::geometry::vec3;
 use crate::machine::{BlockRule, MachineProfile, RuleSettings, cap_feed};
 use crate::tool::{Tool, ToolKind};
-use crate::validate::{self, finite, non_negative, optional_positive, positive};
+use crate::validate::{self, Measure, finite, non_negative, optional_positive, positive};
 
 use super::request::{
     CentreDistance, DEFAULT_CLEARANCE, DEFAULT_FEED, DEFAULT_LEAD_DISTANCE, DEFAULT_SPINDLE_RPM, DEFAULT_TOLERANCE,
@@ -53,9 +53,12 @@ fn bounded(field: &str, value: f64) -> Result<f64, SolverError> {
 
 /// A size: finite, from [`MIN_LENGTH`] to [`validate::MAX_COORDINATE`].
 fn size(field: &str, value: f64) -> Result<f64, SolverError> {
-    let value = bounded(field, positive(field, value)?)?;
+    let value = bounded(field, positive(field, value, Measure::Length)?)?;
     if value < MIN_LENGTH {
-        return Err(SolverError::input(field, format!("{field} must be at least {MIN_LENGTH} mm (got {value} mm)")));
+        return Err(SolverError::input(
+            field,
+            format!("{field} must be at least {MIN_LENGTH} mm (got {})", Measure::Length.quote(value)),
+        ));
     }
     Ok(value)
 }
@@ -144,12 +147,12 @@ impl DeburrRequest {
                     let radii = if inner.diameter == outer.diameter {
                         String::new()
                     } else {
-                        format!(" (radii {} and {})", inner.radius(), outer.radius())
+                        format!(" (radii {} mm and {} mm)", inner.radius(), outer.radius())
                     };
                     return Err(SolverError::new(
                         ErrorCode::NotThrough,
                         format!(
-                            "{} {} must be smaller than {} {}{radii}",
+                            "{} {} mm must be smaller than {} {} mm{radii}",
                             inner.name(),
                             inner.value,
                             outer.name(),
@@ -172,7 +175,7 @@ impl DeburrRequest {
                     if *face <= bore {
                         return Err(SolverError::input(
                             "workpiece.face_distance",
-                            format!("face_distance {face} must exceed bore_radius {bore}"),
+                            format!("face_distance {face} mm must exceed bore_radius {bore} mm"),
                         ));
                     }
                 }
@@ -203,12 +206,19 @@ impl DeburrRequest {
         let profile = match (hole.shape, hole.centre_distance) {
             (HoleShape::Round, None) => Profile::round(radius, eccentricity, start.to_radians()),
             (HoleShape::Slot, Some(CentreDistance::Along(length))) => {
-                let length = bounded("hole.centre_distance", non_negative("hole.centre_distance", length)?)?;
+                let length =
+                    bounded("hole.centre_distance", non_negative("hole.centre_distance", length, Measure::Length)?)?;
                 Profile::rounded_rect(radius, eccentricity, 0.0, length / 2.0, true)
             }
             (HoleShape::RoundedRect, Some(CentreDistance::AcrossAlong([across, along]))) => {
-                let across = bounded("hole.centre_distance[0]", non_negative("hole.centre_distance[0]", across)?)?;
-                let along = bounded("hole.centre_distance[1]", non_negative("hole.centre_distance[1]", along)?)?;
+                let across = bounded(
+                    "hole.centre_distance[0]",
+                    non_negative("hole.centre_distance[0]", across, Measure::Length)?,
+                )?;
+                let along = bounded(
+                    "hole.centre_distance[1]",
+                    non_negative("hole.centre_distance[1]", along, Measure::Length)?,
+                )?;
                 Profile::rounded_rect(radius, eccentricity, across / 2.0, along / 2.0, false)
             }
             (HoleShape::Round, Some(_)) => {
@@ -248,7 +258,7 @@ impl DeburrRequest {
                 return Err(SolverError::input("cut_amount", "cut_amount (Q) or width (W) is required"));
             }
         };
-        let tolerance = optional_positive("tolerance", self.tolerance, DEFAULT_TOLERANCE)?;
+        let tolerance = optional_positive("tolerance", self.tolerance, DEFAULT_TOLERANCE, Measure::Length)?;
         if tolerance < MIN_TOLERANCE {
             return Err(SolverError::new(
                 ErrorCode::Tol,
@@ -265,7 +275,12 @@ impl DeburrRequest {
         let safe_z = self.safe_z.map(|z| bounded("safe_z", z)).transpose()?;
         // The machine's max feed caps the deburring feed (never raises it).
         let mut rule_warnings = Vec::new();
-        let feed = cap_feed(machine, "feed", optional_positive("feed", self.feed, DEFAULT_FEED)?, &mut rule_warnings);
+        let feed = cap_feed(
+            machine,
+            "feed",
+            optional_positive("feed", self.feed, DEFAULT_FEED, Measure::Feed)?,
+            &mut rule_warnings,
+        );
         let rule = if self.block_time_ms.is_some() || machine.is_some() {
             let settings =
                 RuleSettings { feed: Some(feed), block_time_ms: self.block_time_ms, ..RuleSettings::default() };
@@ -283,12 +298,15 @@ impl DeburrRequest {
             spindle_rpm: crate::machine::spindle_within(
                 machine.and_then(|machine| machine.max_spindle_rpm),
                 "spindle_rpm",
-                optional_positive("spindle_rpm", self.spindle_rpm, DEFAULT_SPINDLE_RPM)?,
+                optional_positive("spindle_rpm", self.spindle_rpm, DEFAULT_SPINDLE_RPM, Measure::Number)?,
             )?,
-            clearance: bounded("clearance", optional_positive("clearance", self.clearance, DEFAULT_CLEARANCE)?)?,
+            clearance: bounded(
+                "clearance",
+                optional_positive("clearance", self.clearance, DEFAULT_CLEARANCE, Measure::Length)?,
+            )?,
             lead_distance: bounded(
                 "lead_distance",
-                optional_positive("lead_distance", self.lead_distance, DEFAULT_LEAD_DISTANCE)?,
+                optional_positive("lead_distance", self.lead_distance, DEFAULT_LEAD_DISTANCE, Measure::Length)?,
             )?,
         })
     }

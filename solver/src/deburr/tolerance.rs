@@ -240,7 +240,7 @@ where
         if depth >= MAX_DEPTH {
             return Err(SolverError::new(
                 ErrorCode::Tol,
-                format!("tolerance {} not reached after {MAX_DEPTH} bisections", self.spacing.tolerance()),
+                format!("tolerance {} mm not reached after {MAX_DEPTH} bisections", self.spacing.tolerance()),
             )
             .at("tolerance"));
         }
@@ -315,7 +315,7 @@ where
             if deviation > limit {
                 return Err(SolverError::new(
                     ErrorCode::Tol,
-                    format!("tolerance {tolerance} not reached after {MAX_DEPTH} bisections"),
+                    format!("tolerance {tolerance} mm not reached after {MAX_DEPTH} bisections"),
                 )
                 .at("tolerance"));
             }

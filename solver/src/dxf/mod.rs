@@ -12,6 +12,7 @@
 mod codes;
 mod curves;
 
+use crate::validate::Measure;
 use serde::Serialize;
 
 use std::collections::HashMap;
@@ -188,8 +189,8 @@ pub struct Profile {
 /// itself and where, a loop outside the boundary), at `units` when the drawing has no units
 /// and none are given, at `layer` when the layer has no entities.
 pub fn read(bytes: &[u8], field: &str, options: &DxfOptions) -> Result<Profile, SolverError> {
-    crate::validate::positive("join_tolerance", options.join_tolerance)?;
-    crate::validate::positive("chord_tolerance", options.chord_tolerance)?;
+    crate::validate::positive("join_tolerance", options.join_tolerance, Measure::Length)?;
+    crate::validate::positive("chord_tolerance", options.chord_tolerance, Measure::Length)?;
     let groups = codes::groups(bytes, field)?;
     let units = units_of(&groups, options.units)?;
     let scale = units.scale();

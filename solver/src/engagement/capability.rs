@@ -1,6 +1,7 @@
 //! Engagement analysis as a capability (the seam of engineering.md; docs/spec/api.md, Engagement;
 //! docs/spec/engagement.md §3): `POST /api/v1/engagement`, job operation `engagement`.
 
+use crate::validate::Measure;
 use serde::{Deserialize, Serialize};
 
 use super::answer::{Comparison, PathEngagement, PostData, RouteData};
@@ -288,7 +289,7 @@ fn charge_samples(answer: &EngagementAnswer, run: &Run<'_>) -> Result<(), Solver
 /// A plunge feed, when given, must be positive.
 fn check_plunge_feed(request: &EngagementRequest) -> Result<(), SolverError> {
     if let Some(feed) = request.plunge_feed {
-        crate::validate::positive("plunge_feed", feed)?;
+        crate::validate::positive("plunge_feed", feed, Measure::Feed)?;
     }
     Ok(())
 }

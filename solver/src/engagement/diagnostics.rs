@@ -104,7 +104,7 @@ pub(super) fn vertices(warnings: &mut Vec<Warning>, route: &Route) {
             let out = pair[0].shape.tangent(pair[0].shape.length());
             let into = pair[1].shape.tangent(0.0);
             let turn = turn_angle(&out, &into).to_degrees();
-            (turn.abs() > 1.0).then(|| format!("s = {:.3} ({turn:+.1}°)", pair[0].end_s()))
+            (turn.abs() > 1.0).then(|| format!("s = {:.3} mm ({turn:+.1}°)", pair[0].end_s()))
         })
         .collect();
     if !vertices.is_empty() {
@@ -184,7 +184,7 @@ fn list_intervals(intervals: &[[f64; 2]]) -> String {
     let shown: Vec<String> = intervals
         .iter()
         .take(LISTED)
-        .map(|[a, b]| if (b - a).abs() < 1e-9 { format!("{a:.3}") } else { format!("{a:.3}–{b:.3}") })
+        .map(|[a, b]| if (b - a).abs() < 1e-9 { format!("{a:.3} mm") } else { format!("{a:.3} mm–{b:.3} mm") })
         .collect();
     let more = intervals.len().saturating_sub(LISTED);
     if more > 0 { format!("s = {} and {more} more", shown.join(", ")) } else { format!("s = {}", shown.join(", ")) }

@@ -83,7 +83,7 @@ pub(crate) fn results(
             warnings.push(Warning::new(
                 "W_MULTI_TOOTH",
                 format!(
-                    "k = {k}: two or more teeth cut at once over {} interval(s), first at s = {:.3}",
+                    "k = {k}: two or more teeth cut at once over {} interval(s), first at s = {:.3} mm",
                     multi_tooth_intervals.len(),
                     multi_tooth_intervals.first().map_or(0.0, |i| i[0])
                 ),
@@ -301,7 +301,7 @@ fn limit_warnings(
         warnings.push(Warning::new(
             code,
             format!(
-                "k = {k}: the spindle {what} reaches {highest:.3} {unit}, above the machine's {limit} {unit}, over {} interval(s), first at s = {:.3} (a feed_plan caps the feed there)",
+                "k = {k}: the spindle {what} reaches {highest:.3} {unit}, above the machine's {limit} {unit}, over {} interval(s), first at s = {:.3} mm (a feed_plan caps the feed there)",
                 intervals.len(),
                 intervals.first().map_or(0.0, |i| i[0])
             ),

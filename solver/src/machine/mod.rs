@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{SolverError, Warning};
 
 use crate::gcode::Dialect;
-use crate::validate::{non_negative, positive, positive_at_most};
+use crate::validate::{Measure, non_negative, positive, positive_at_most};
 
 /// Largest `max_jerk`, mm/s³ (10⁶ m/s³: far beyond any machine axis; more is a unit mistake).
 pub const MAX_JERK: f64 = 1e9;
@@ -200,14 +200,14 @@ impl MachineProfile {
         if let Some(name) = &self.name {
             validate_machine_name(name)?;
         }
-        positive("block_time_ms", self.block_time_ms)?;
-        positive("max_feed", self.max_feed)?;
+        positive("block_time_ms", self.block_time_ms, Measure::Number)?;
+        positive("max_feed", self.max_feed, Measure::Feed)?;
         self.spindle().validate()?;
         if let Some(curve) = &self.spindle_power_curve {
             validate_power_curve(curve)?;
         }
         if let Some(margin) = self.margin
-            && positive("margin", margin)? < 1.0
+            && positive("margin", margin, Measure::Number)? < 1.0
         {
             return Err(SolverError::input(
                 "margin",
@@ -217,25 +217,25 @@ impl MachineProfile {
             ));
         }
         if let Some(speed) = self.max_spindle_rpm {
-            positive("max_spindle_rpm", speed)?;
+            positive("max_spindle_rpm", speed, Measure::Number)?;
         }
         if let Some(plunge_feed) = self.plunge_feed {
-            positive("plunge_feed", plunge_feed)?;
+            positive("plunge_feed", plunge_feed, Measure::Feed)?;
         }
         if let Some(max_accel) = self.max_accel {
-            positive("max_accel", max_accel)?;
+            positive("max_accel", max_accel, Measure::Number)?;
         }
         if let Some(max_jerk) = self.max_jerk {
-            positive_at_most("max_jerk", max_jerk, MAX_JERK)?;
+            positive_at_most("max_jerk", max_jerk, MAX_JERK, Measure::Number)?;
         }
         if let Some(rapid_feed) = self.rapid_feed {
-            positive("rapid_feed", rapid_feed)?;
+            positive("rapid_feed", rapid_feed, Measure::Feed)?;
         }
         if let Some(tool_change_s) = self.tool_change_s {
-            non_negative("tool_change_s", tool_change_s)?;
+            non_negative("tool_change_s", tool_change_s, Measure::Number)?;
         }
         if let Some(min_chord_error) = self.min_chord_error {
-            non_negative("min_chord_error", min_chord_error)?;
+            non_negative("min_chord_error", min_chord_error, Measure::Length)?;
         }
         if let Some(description) = &self.description {
             crate::validate::text("description", description, MAX_DESCRIPTION_CHARS)?;
@@ -265,8 +265,8 @@ fn validate_power_curve(curve: &[[f64; 2]]) -> Result<(), SolverError> {
     }
     for (index, [rpm, power]) in curve.iter().enumerate() {
         let speed_field = format!("spindle_power_curve[{index}][0]");
-        non_negative(&speed_field, *rpm)?;
-        positive(&format!("spindle_power_curve[{index}][1]"), *power)?;
+        non_negative(&speed_field, *rpm, Measure::Number)?;
+        positive(&format!("spindle_power_curve[{index}][1]"), *power, Measure::Number)?;
         if index > 0 && *rpm <= curve[index - 1][0] {
             return Err(SolverError::input(
                 speed_field,

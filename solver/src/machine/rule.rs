@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::MachineProfile;
 use crate::error::{SolverError, Warning};
-use crate::validate::{finite, non_negative, positive};
+use crate::validate::{Measure, finite, non_negative, positive};
 
 /// Where the chord error comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -154,8 +154,8 @@ impl BlockRule {
     /// `E_INPUT` naming `feed` or `block_time_ms` when one is not a positive finite number.
     pub fn new(feed: f64, block_time_ms: f64) -> Result<Self, SolverError> {
         Ok(Self {
-            feed: positive("feed", feed)?,
-            block_time_ms: positive("block_time_ms", block_time_ms)?,
+            feed: positive("feed", feed, Measure::Feed)?,
+            block_time_ms: positive("block_time_ms", block_time_ms, Measure::Number)?,
             margin: 1.0,
             chord_error_factor: 1.0,
             radius_factor: 1.0,
@@ -185,9 +185,9 @@ impl BlockRule {
     /// # Errors
     /// `E_INPUT` for a bad number or an unsafe factor that is not allowed.
     pub fn validate(&self, allow_unsafe: bool) -> Result<Vec<Warning>, SolverError> {
-        positive("feed", self.feed)?;
-        positive("block_time_ms", self.block_time_ms)?;
-        non_negative("min_chord_error", self.min_chord_error)?;
+        positive("feed", self.feed, Measure::Feed)?;
+        positive("block_time_ms", self.block_time_ms, Measure::Number)?;
+        non_negative("min_chord_error", self.min_chord_error, Measure::Length)?;
         let mut warnings = Vec::new();
         let factors = [
             ("margin", self.margin, true),
@@ -196,7 +196,7 @@ impl BlockRule {
             ("radius_factor", self.radius_factor, false),
         ];
         for (field, value, at_least_one) in factors {
-            positive(field, value)?;
+            positive(field, value, Measure::Number)?;
             let unsafe_side = if at_least_one { value < 1.0 } else { value > 1.0 };
             if !unsafe_side {
                 continue;
@@ -332,8 +332,8 @@ pub fn chord_length(radius: f64, chord_error: f64) -> f64 {
 /// # Errors
 /// `E_INPUT` when an argument is not a positive finite number.
 pub fn block_time_from_saturation(test_block_length: f64, saturated_feed: f64) -> Result<f64, SolverError> {
-    let length = positive("test_block_length", test_block_length)?;
-    let feed = positive("saturated_feed", saturated_feed)?;
+    let length = positive("test_block_length", test_block_length, Measure::Length)?;
+    let feed = positive("saturated_feed", saturated_feed, Measure::Feed)?;
     finite("block_time_ms", length / feed * MS_PER_MIN)
 }
 

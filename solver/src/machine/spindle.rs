@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::SolverError;
-use crate::validate::positive;
+use crate::validate::{Measure, positive};
 
 /// The spindle's ratings, from the machine profile (docs/spec/engagement.md §11 item 4). The cut is
 /// compared through its torque averaged over the tooth phase: that is the load the spindle
@@ -28,10 +28,10 @@ impl SpindleLimits {
     /// `E_INPUT` for a value that is not positive and finite.
     pub fn validate(&self) -> Result<(), SolverError> {
         if let Some(power) = self.spindle_power_kw {
-            positive("spindle_power_kw", power)?;
+            positive("spindle_power_kw", power, Measure::Number)?;
         }
         if let Some(torque) = self.spindle_torque_nm {
-            positive("spindle_torque_nm", torque)?;
+            positive("spindle_torque_nm", torque, Measure::Number)?;
         }
         Ok(())
     }

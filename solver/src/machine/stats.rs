@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::rule::{BlockRule, MS_PER_MIN};
 use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
-use crate::validate::positive;
+use crate::validate::{Measure, positive};
 
 /// A block counts as short when it is below `F·T_b/60000` by more than this fraction (rounding
 /// of a chord that sits exactly on the surface must not count).
@@ -69,8 +69,8 @@ pub struct BlockStats {
 /// # Errors
 /// `E_INPUT` when `feed` or `block_time_ms` is not a positive finite number.
 pub fn block_stats(points: &[Vec3], feed: f64, block_time_ms: f64) -> Result<BlockStats, SolverError> {
-    let feed = positive("feed", feed)?;
-    let block_time_ms = positive("block_time_ms", block_time_ms)?;
+    let feed = positive("feed", feed, Measure::Feed)?;
+    let block_time_ms = positive("block_time_ms", block_time_ms, Measure::Number)?;
     let last = points.len().saturating_sub(2);
     Ok(stats_with_ends(points, feed, block_time_ms, &[last]))
 }

@@ -11,7 +11,7 @@ use crate::gcode::{Reference, SpindleDirection};
 use crate::geometry::{Vec3, vec3};
 use crate::stock::StockModel;
 use crate::tool::{ShapeErrorPoint, Stiffness, Tool, ToolKind};
-use crate::validate::{MAX_COORDINATE, coordinates, finite, optional_positive, positive, quoted};
+use crate::validate::{MAX_COORDINATE, Measure, coordinates, finite, optional_positive, positive, quoted};
 
 use super::request::{
     DEFAULT_ARC_TOLERANCE, DEFAULT_EDGE_ELEMENTS, DEFAULT_MAX_CORRECTION, DEFAULT_MERGE_TOLERANCE, DEFAULT_RESOLUTION,
@@ -113,8 +113,8 @@ impl PredictRequest {
             return Err(SolverError::input("history", format!("ask for at most {MAX_HISTORIES} pass histories")));
         }
         let defaults = Defaults {
-            feed: self.feed.map(|f| positive("feed", f)).transpose()?,
-            spindle_rpm: self.spindle_rpm.map(|s| positive("spindle_rpm", s)).transpose()?,
+            feed: self.feed.map(|f| positive("feed", f, Measure::Feed)).transpose()?,
+            spindle_rpm: self.spindle_rpm.map(|s| positive("spindle_rpm", s, Measure::Number)).transpose()?,
             sign: match self.spindle_direction.unwrap_or_default() {
                 SpindleDirection::Cw => -1.0,
                 SpindleDirection::Ccw => 1.0,
@@ -201,7 +201,8 @@ impl PredictRequest {
         let steps = range_u32("samples_per_revolution", self.samples_per_revolution, DEFAULT_STEPS, 36, 4096)? as usize;
         let steps = steps.div_ceil(flutes) * flutes;
         let edge_elements = range_u32("edge_elements", self.edge_elements, DEFAULT_EDGE_ELEMENTS, 9, 720)? as usize;
-        let arc_tolerance = optional_positive("arc_tolerance", self.arc_tolerance, DEFAULT_ARC_TOLERANCE)?;
+        let arc_tolerance =
+            optional_positive("arc_tolerance", self.arc_tolerance, DEFAULT_ARC_TOLERANCE, Measure::Length)?;
         Ok(Settings { resolution, tooth_feed_gap, view_threshold, flute_zero, steps, edge_elements, arc_tolerance })
     }
 
@@ -231,7 +232,12 @@ impl PredictRequest {
         Ok(match &self.correction {
             None => (DEFAULT_MAX_CORRECTION, 1),
             Some(c) => (
-                optional_positive("correction.max_correction", c.max_correction, DEFAULT_MAX_CORRECTION)?,
+                optional_positive(
+                    "correction.max_correction",
+                    c.max_correction,
+                    DEFAULT_MAX_CORRECTION,
+                    Measure::Length,
+                )?,
                 range_u32("correction.iterations", c.iterations, 1, 1, 3)?,
             ),
         })
@@ -324,7 +330,10 @@ impl PredictRequest {
         match (self.merge_similar_passes.unwrap_or(false), self.merge_tolerance) {
             (_, Some(t)) if !(t.is_finite() && t > 0.0 && t <= MAX_MERGE_TOLERANCE) => Err(SolverError::input(
                 "merge_tolerance",
-                format!("merge_tolerance must be above 0 and at most {MAX_MERGE_TOLERANCE} mm (got {t} mm)"),
+                format!(
+                    "merge_tolerance must be above 0 and at most {MAX_MERGE_TOLERANCE} mm (got {})",
+                    Measure::Length.quote(t)
+                ),
             )),
             (false, Some(_)) => {
                 Err(SolverError::input("merge_tolerance", "merge_tolerance applies with merge_similar_passes: true"))

@@ -6,7 +6,7 @@
 use crate::error::SolverError;
 
 use crate::tool::ShapeErrorPoint;
-use crate::validate::{finite, positive};
+use crate::validate::{Measure, finite, positive};
 
 /// δ(θ) in mm at contact angle `theta_deg`, and whether the angle was outside the table.
 pub(crate) fn delta(table: &[ShapeErrorPoint], theta_deg: f64) -> (f64, bool) {
@@ -55,7 +55,7 @@ pub fn shape_error_from_sections(
     angles_deg: &[f64],
     conversion: Conversion,
 ) -> Result<Vec<ShapeErrorPoint>, SolverError> {
-    positive("radius", radius)?;
+    positive("radius", radius, Measure::Length)?;
     if sections.len() < 2 {
         return Err(SolverError::input("sections", "give at least two sections"));
     }

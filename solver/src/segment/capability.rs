@@ -1,6 +1,7 @@
 //! Segmentation as a capability (docs/spec/segment.md, docs/spec/api.md Segment; the seam of
 //! engineering.md): `POST /api/v1/segment`, job operation `segment`.
 
+use crate::validate::Measure;
 use serde::Serialize;
 
 use super::{SegmentRequest, SegmentSolution};
@@ -65,7 +66,7 @@ impl Capability for SegmentCapability {
             tool.validate("tool.")?;
         }
         if let Some(feed) = request.plunge_feed {
-            crate::validate::positive("plunge_feed", feed)?;
+            crate::validate::positive("plunge_feed", feed, Measure::Feed)?;
         }
         let result = super::solve_run(request, context.machine.as_ref(), run)?;
         let cycle_time = context.machine.as_ref().and_then(|machine| {

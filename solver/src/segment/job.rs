@@ -15,7 +15,7 @@ use crate::error::{SolverError, Warning};
 use crate::geometry::Vec3;
 use crate::machine::rule::{BlockRule, RuleSettings};
 use crate::machine::{MachineProfile, Mode};
-use crate::validate::{coordinate, finite, positive};
+use crate::validate::{Measure, coordinate, finite, positive};
 
 /// Where the chord error comes from, resolved.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -90,8 +90,11 @@ fn points(field: &str, list: &[Vec<f64>]) -> Result<(Vec<Vec3>, usize), SolverEr
 }
 
 fn radius(field: &str, value: f64) -> Result<f64, SolverError> {
-    if positive(field, value)? > MAX_COORDINATE {
-        return Err(SolverError::input(field, format!("{field} must be at most {MAX_COORDINATE} mm (got {value} mm)")));
+    if positive(field, value, Measure::Length)? > MAX_COORDINATE {
+        return Err(SolverError::input(
+            field,
+            format!("{field} must be at most {MAX_COORDINATE} mm (got {})", Measure::Length.quote(value)),
+        ));
     }
     Ok(value)
 }
@@ -348,8 +351,11 @@ fn optional_tolerance(field: &str, value: Option<f64>) -> Result<Option<f64>, So
     let Some(value) = value else {
         return Ok(None);
     };
-    if positive(field, value)? < MIN_TOLERANCE {
-        return Err(SolverError::input(field, format!("{field} must be at least {MIN_TOLERANCE} mm (got {value} mm)")));
+    if positive(field, value, Measure::Length)? < MIN_TOLERANCE {
+        return Err(SolverError::input(
+            field,
+            format!("{field} must be at least {MIN_TOLERANCE} mm (got {})", Measure::Length.quote(value)),
+        ));
     }
     Ok(Some(value))
 }
@@ -417,13 +423,13 @@ impl SegmentRequest {
     /// Validates the request with the resolved machine (if it names one).
     pub(crate) fn validate(&self, machine: Option<&MachineProfile>) -> Result<Job, SolverError> {
         let (rule, mut warnings) = self.block_rule(machine)?;
-        let window = self.window.map(|w| positive("window", w)).transpose()?;
+        let window = self.window.map(|w| positive("window", w, Measure::Length)).transpose()?;
         let default_window = DEFAULT_WINDOW_CHORDS * rule.target_chord();
         let estimate = match self.radius_estimate.unwrap_or_default() {
             RadiusEstimate::ThreePoint => Estimate::ThreePoint,
             RadiusEstimate::Minimum => Estimate::Minimum,
         };
-        let min_radius = self.min_radius.map(|r| positive("min_radius", r)).transpose()?;
+        let min_radius = self.min_radius.map(|r| positive("min_radius", r, Measure::Length)).transpose()?;
         let mode = self.mode.or(machine.and_then(|m| m.mode)).unwrap_or_default();
         let plan = match (mode, self.rule) {
             (Mode::Window, Some(_)) => {
@@ -478,7 +484,7 @@ impl SegmentRequest {
         let spindle_rpm = crate::machine::spindle_within(
             machine.and_then(|machine| machine.max_spindle_rpm),
             "spindle_rpm",
-            self.spindle_rpm.map_or(Ok(DEFAULT_SPINDLE_RPM), |rpm| positive("spindle_rpm", rpm))?,
+            self.spindle_rpm.map_or(Ok(DEFAULT_SPINDLE_RPM), |rpm| positive("spindle_rpm", rpm, Measure::Number))?,
         )?;
         let safe_z = self.safe_z.map(|z| coordinate("safe_z", z)).transpose()?;
         let (shape, corners, dimension, curve_warnings) = self.curve.build()?;

@@ -100,6 +100,7 @@ pub use resegment::{ResegmentAnswer, ResegmentCapability, ResegmentRequest};
 use crate::capability::Control;
 use crate::error::ErrorCode;
 use crate::machine::{ChordStatus, MachineProfile};
+use crate::validate::Measure;
 use cut::{Cut, CutError, Cutter, InfeasibleAt, Numerics, Status};
 use job::{Job, Plan};
 
@@ -399,7 +400,11 @@ fn answer(job: &Job, request: &SegmentRequest, cutter: &Cutter<'_>, cut: &Cut) -
         Some(z) if z < highest => {
             return Err(SolverError::input(
                 "safe_z",
-                format!("safe_z {z} is below the curve's highest point z = {highest}"),
+                format!(
+                    "safe_z {} is below the curve's highest point z = {}",
+                    Measure::Length.quote(z),
+                    Measure::Length.quote(highest)
+                ),
             ));
         }
         Some(z) => z,

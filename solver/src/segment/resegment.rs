@@ -17,6 +17,7 @@
 //! program asked for in another post than its own is re-posted line by line
 //! ([`crate::gcode::repost`]).
 
+use crate::validate::Measure;
 use serde::{Deserialize, Serialize};
 
 use super::{Curve, Direction, SegmentRequest, SegmentSolution};
@@ -293,7 +294,7 @@ pub fn resegment(
     }
     program_dialect(request)?;
     let block_time_ms = match request.block_time_ms.or(machine.as_ref().map(|m| m.block_time_ms)) {
-        Some(value) => crate::validate::positive("block_time_ms", value)?,
+        Some(value) => crate::validate::positive("block_time_ms", value, Measure::Number)?,
         None => {
             return Err(SolverError::input("block_time_ms", "give block_time_ms or a machine that has one"));
         }
@@ -308,11 +309,11 @@ pub fn resegment(
         None => 1.0,
     };
     let min_chord_error = match request.min_chord_error.or(machine_ref.and_then(|m| m.min_chord_error)) {
-        Some(value) => crate::validate::non_negative("min_chord_error", value)?,
+        Some(value) => crate::validate::non_negative("min_chord_error", value, Measure::Length)?,
         None => 0.0,
     };
     if let Some(tolerance) = request.tolerance {
-        crate::validate::positive("tolerance", tolerance)?;
+        crate::validate::positive("tolerance", tolerance, Measure::Length)?;
     }
     let program = reader::read_cancellable(&request.program, "program", &ReadOptions::default(), control)?;
     let lines: Vec<&str> = request.program.split('\n').collect();

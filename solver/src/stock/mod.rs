@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::SolverError;
 use crate::geometry::{Vec3, vec3};
-use crate::validate::{coordinate, coordinates, positive};
+use crate::validate::{Measure, coordinate, coordinates, positive};
 use stl::Mesh;
 
 /// Most nodes of a height grid.
@@ -256,7 +256,7 @@ impl Stock {
             }
             Self::Cylinder { start, end, radius } => {
                 let (a, b) = (point("start", *start)?, point("end", *end)?);
-                let radius = coordinate("stock.radius", positive("stock.radius", *radius)?)?;
+                let radius = coordinate("stock.radius", positive("stock.radius", *radius, Measure::Length)?)?;
                 let length = (b - a).norm();
                 if length == 0.0 {
                     return Err(stock_error("stock.end", "the cylinder's end equals its start"));
@@ -265,7 +265,7 @@ impl Stock {
             }
             Self::Grid { origin, spacing, heights, bottom } => {
                 coordinates("stock.origin", *origin)?;
-                let spacing = coordinate("stock.spacing", positive("stock.spacing", *spacing)?)?;
+                let spacing = coordinate("stock.spacing", positive("stock.spacing", *spacing, Measure::Length)?)?;
                 let ny = heights.len();
                 let nx = heights.first().map_or(0, Vec::len);
                 if nx < 2 || ny < 2 {

@@ -2,6 +2,7 @@
 //! shank and the holder as convex solids of revolution about the vertical tool axis, each known
 //! by the lowest and highest height above the tip it occupies at a distance from the axis.
 
+use crate::validate::Measure;
 use serde::Serialize;
 
 use crate::error::SolverError;
@@ -123,7 +124,11 @@ impl Assembly {
         let too_long = |name: &str, length: f64| {
             SolverError::input(
                 format!("{field}.{name}"),
-                format!("{name} {length} must not exceed the stickout {stickout} (tip to holder face)"),
+                format!(
+                    "{name} {} must not exceed the stickout {} (tip to holder face)",
+                    Measure::Length.quote(length),
+                    Measure::Length.quote(stickout)
+                ),
             )
         };
         let neck_base = match (tool.neck_radius, tool.kind) {
@@ -150,7 +155,11 @@ impl Assembly {
             if top <= neck_base {
                 return Err(SolverError::input(
                     format!("{field}.neck_length"),
-                    format!("neck_length {top} must reach above the cutting head ({neck_base} above the tip)"),
+                    format!(
+                        "neck_length {} must reach above the cutting head ({} above the tip)",
+                        Measure::Length.quote(top),
+                        Measure::Length.quote(neck_base)
+                    ),
                 ));
             }
             bodies.push(Body { member: Member::Neck, shape: Shape::Cylinder { base: neck_base }, radius: neck, top });

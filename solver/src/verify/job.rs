@@ -8,7 +8,7 @@ use crate::gcode::reader::{self, ReadOptions, ReadProgram};
 use crate::machine::MachineProfile;
 use crate::material::{Kienzle, Material};
 use crate::tool::{Tool, ToolRef};
-use crate::validate::{non_negative, positive};
+use crate::validate::{Measure, non_negative, positive};
 
 use super::assembly::Assembly;
 use super::dexel::{Grid, RAY_BYTES};
@@ -97,7 +97,7 @@ impl VerifyRequest {
         let (lo, hi) = stock.footprint();
         let fields = if self.part.is_some() { 2 } else { 1 };
         let spacing = match self.resolution {
-            Some(spacing) => positive("resolution", spacing)?,
+            Some(spacing) => positive("resolution", spacing, Measure::Length)?,
             None => {
                 let smallest = tools.iter().map(|tool| tool.radius).fold(f64::INFINITY, f64::min);
                 let spacing = DEFAULT_RESOLUTION_RADII * smallest;
@@ -165,12 +165,13 @@ impl VerifyRequest {
         let meshes = Meshes::unpack(self, upload)?;
         let stock = self.stock.model("stock", meshes.stock)?;
         let part = self.part.as_ref().map(|part| part.model("part", meshes.part)).transpose()?;
-        let tolerance = non_negative("tolerance", self.tolerance.unwrap_or(DEFAULT_TOLERANCE))?;
+        let tolerance = non_negative("tolerance", self.tolerance.unwrap_or(DEFAULT_TOLERANCE), Measure::Length)?;
         if let Some(part) = &part {
             within_footprint(part, &stock, tolerance)?;
         }
-        let allowance = non_negative("allowance", self.allowance.unwrap_or(DEFAULT_ALLOWANCE))?;
-        let air_share_limit = non_negative("air_share_limit", self.air_share_limit.unwrap_or(DEFAULT_AIR_SHARE_LIMIT))?;
+        let allowance = non_negative("allowance", self.allowance.unwrap_or(DEFAULT_ALLOWANCE), Measure::Length)?;
+        let air_share_limit =
+            non_negative("air_share_limit", self.air_share_limit.unwrap_or(DEFAULT_AIR_SHARE_LIMIT), Measure::Number)?;
         if air_share_limit > 1.0 {
             return Err(SolverError::input("air_share_limit", "air_share_limit is a share: 0 to 1"));
         }

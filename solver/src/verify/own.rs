@@ -21,7 +21,7 @@ use crate::planar::{Vec2, point_segment_distance, vec2};
 use crate::stock::StockModel;
 use crate::tool::Tool;
 use crate::units::{Scale, Units};
-use crate::validate::positive;
+use crate::validate::{Measure, positive};
 
 /// Most rays the default resolution of a capability's own verification gives: a coarser grid
 /// than `POST /api/v1/verify`'s, so that verifying adds little to the request (docs/spec/verify.md
@@ -174,7 +174,7 @@ pub(crate) fn grid(
 ) -> Result<Grid, SolverError> {
     let (lo, hi) = footprint;
     let spacing = match options.resolution {
-        Some(spacing) => positive("verification.resolution", spacing)?,
+        Some(spacing) => positive("verification.resolution", spacing, Measure::Length)?,
         None => {
             let spacing = OWN_RESOLUTION_RADII * tool.radius;
             let rays = Grid::rays_for(lo, hi, spacing);
@@ -466,7 +466,11 @@ fn kind_name(kind: FindingKind) -> &'static str {
 fn sentence(finding: &Finding) -> String {
     let [x, y, z] = finding.position;
     let line = finding.line.map_or_else(String::new, |line| format!(" at line {line}"));
-    format!("{}{line}: {:.3} mm deep at X{x:.3} Y{y:.3} Z{z:.3}", kind_name(finding.kind), finding.depth)
+    format!(
+        "{}{line}: {:.3} mm deep at x = {x:.3} mm, y = {y:.3} mm, z = {z:.3} mm",
+        kind_name(finding.kind),
+        finding.depth
+    )
 }
 
 /// One warning per kind of warning finding: its count and the worst.

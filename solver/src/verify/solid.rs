@@ -7,7 +7,7 @@ use crate::geometry::{Vec3, vec3};
 use crate::stock::Stock;
 use crate::stock::StockModel;
 use crate::stock::stl::{self, Mesh};
-use crate::validate::{coordinate, coordinates, positive};
+use crate::validate::{Measure, coordinate, coordinates, positive};
 
 use super::dexel::{self, Field, Grid, Interval, Ray};
 use super::request::{CrossHole, Hollow, MAX_CROSS_HOLES, Solid};
@@ -75,12 +75,19 @@ impl Solid {
         match self {
             Self::Tube(Hollow::Tube { start, end, outer_radius, inner_radius, holes }) => {
                 let tube = axis(prefix, *start, *end)?;
-                let outer = coordinate(&field("outer_radius"), positive(&field("outer_radius"), *outer_radius)?)?;
-                let inner = positive(&field("inner_radius"), *inner_radius)?;
+                let outer = coordinate(
+                    &field("outer_radius"),
+                    positive(&field("outer_radius"), *outer_radius, Measure::Length)?,
+                )?;
+                let inner = positive(&field("inner_radius"), *inner_radius, Measure::Length)?;
                 if inner >= outer {
                     return Err(SolverError::input(
                         field("inner_radius"),
-                        format!("inner_radius {inner} must be smaller than outer_radius {outer}"),
+                        format!(
+                            "inner_radius {} must be smaller than outer_radius {}",
+                            Measure::Length.quote(inner),
+                            Measure::Length.quote(outer)
+                        ),
                     ));
                 }
                 if holes.len() > MAX_CROSS_HOLES {
@@ -94,8 +101,10 @@ impl Solid {
                     .enumerate()
                     .map(|(index, CrossHole { start, end, radius })| {
                         let hole = field(&format!("holes[{index}]"));
-                        let radius =
-                            coordinate(&format!("{hole}.radius"), positive(&format!("{hole}.radius"), *radius)?)?;
+                        let radius = coordinate(
+                            &format!("{hole}.radius"),
+                            positive(&format!("{hole}.radius"), *radius, Measure::Length)?,
+                        )?;
                         Ok((axis(&hole, *start, *end)?, radius))
                     })
                     .collect::<Result<_, SolverError>>()?;

@@ -238,7 +238,7 @@ fn a_cut_too_near_another_edge_is_found_by_the_clearance_check() {
     assert_eq!(error.field(), Some("contour[10]"));
     assert_eq!(
         error.message(),
-        "the tool (radius 0.26719959095108076 + allowance 0.2) does not fit: near (-0.1732, 3.7487) the path comes \
-         within 0.446032 of the edge from contour[10] (a neck narrower than twice that)"
+        "the tool (radius 0.267199590951 mm + allowance 0.2 mm) does not fit: near (-0.1732 mm, 3.7487 mm) the path \
+         comes within 0.446032 mm of the edge from contour[10] (a neck narrower than twice that)"
     );
 }

@@ -716,6 +716,131 @@ async fn an_inch_requests_refusals_and_warnings_read_inches() {
     assert!(message.contains("feed 150.0 in/min is above the machine's max_feed 100.0 in/min"), "{message}");
 }
 
+/// The numbers a sentence quotes, each with its sign, decimals and exponent, and the step of its
+/// last digit.
+fn numbers(text: &str) -> Vec<(f64, f64)> {
+    let bytes = text.as_bytes();
+    let mut found = Vec::new();
+    let mut at = 0;
+    while at < bytes.len() {
+        let starts =
+            bytes[at].is_ascii_digit() || (bytes[at] == b'-' && bytes.get(at + 1).is_some_and(u8::is_ascii_digit));
+        let in_word = at > 0 && (bytes[at - 1].is_ascii_alphanumeric() || bytes[at - 1] == b'_');
+        if !starts || in_word {
+            at += 1;
+            continue;
+        }
+        let mut end = at + 1;
+        while end < bytes.len()
+            && (bytes[end].is_ascii_digit()
+                || (bytes[end] == b'.' && bytes.get(end + 1).is_some_and(u8::is_ascii_digit))
+                || (bytes[end] == b'e' && bytes.get(end + 1).is_some_and(|b| b.is_ascii_digit() || *b == b'-')))
+        {
+            end += if bytes[end] == b'e' && bytes[end + 1] == b'-' { 2 } else { 1 };
+        }
+        let written = &text[at..end];
+        let value: f64 = written.parse().unwrap_or_else(|_| panic!("{written:?} in {text:?}"));
+        let (mantissa, exponent) = written.split_once('e').unwrap_or((written, "0"));
+        let decimals = mantissa.split_once('.').map_or(0, |(_, fraction)| fraction.len());
+        let exponent: i32 = exponent.parse().unwrap_or(0);
+        found.push((value, 10f64.powi(exponent - i32::try_from(decimals).unwrap_or(0))));
+        at = end;
+    }
+    found
+}
+
+/// A sentence of an inch answer quotes the numbers its twin in mm with the same numbers quotes:
+/// every length and feed restated in inches reads as the request gave it, and one quoted in mm
+/// (25.4 times the twin's) or bare shows.
+fn assert_same_numbers(what: &str, inch: &str, mm: &str) {
+    let (inch_numbers, mm_numbers) = (numbers(inch), numbers(mm));
+    assert_eq!(inch_numbers.len(), mm_numbers.len(), "{what}: {inch:?} vs {mm:?}");
+    for ((a, a_step), (b, b_step)) in inch_numbers.iter().zip(&mm_numbers) {
+        // Equal to the last digit either writes.
+        assert!((a - b).abs() <= a_step.max(*b_step), "{what}: {a} vs {b} in {inch:?} vs {mm:?}");
+    }
+    assert!(!quotes_mm(inch), "{what}: {inch:?} quotes mm");
+}
+
+/// A request of the tests above in units of `k` mm.
+type Request = fn(f64) -> Value;
+
+/// `request(1.0)` with `value` at `pointer`, in `units`.
+fn changed(request: Request, pointer: &str, value: f64, units: &str) -> Value {
+    let mut body = request(1.0);
+    *body.pointer_mut(pointer).unwrap_or_else(|| panic!("{pointer}")) = json!(value);
+    body["units"] = json!(units);
+    body
+}
+
+/// Every refusal and warning of an inch request quotes its lengths and feeds as the request gave
+/// them, in inches: a refusal checks the request in mm, and a length it quoted without its unit
+/// would reach the machinist 25.4 times too large ("feed must be greater than 0 (got -76.2)" for
+/// -3 in/min).
+#[tokio::test]
+async fn an_inch_requests_refusals_and_warnings_quote_its_own_numbers() {
+    let app = TestApp::spawn().await;
+    let bad: [(&str, Request, &str, f64); 16] = [
+        ("contour", contour_request, "/feed", -3.0),
+        ("contour", contour_request, "/loop_feed", -3.0),
+        ("contour", contour_request, "/depths/step", -0.5),
+        ("contour", contour_request, "/depths/bottom", 0.3),
+        ("contour", contour_request, "/stock_allowance", 0.005),
+        ("contour", contour_request, "/passes/1/allowance", 0.5),
+        ("contour", contour_request, "/tool/radius", -0.125),
+        ("deburr", deburr_request, "/holes/0/radius", -1.0),
+        ("deburr", deburr_request, "/holes/0/radius", 1.2),
+        ("deburr", deburr_request, "/workpiece/outer_radius", 0.5),
+        ("deburr", deburr_request, "/tolerance", -0.001),
+        ("engagement", engagement_request, "/feed_per_tooth", -0.002),
+        ("engagement", engagement_request, "/thickness_limit", -0.1),
+        ("engagement", engagement_request, "/tool/radius", -0.2),
+        ("segment", segment_request, "/curve/semi_axes/0", -1.5),
+        ("segment", segment_request, "/safe_z", -0.1),
+    ];
+    for (endpoint, request, pointer, value) in bad {
+        let what = format!("{endpoint} {pointer} = {value}");
+        let path = format!("/api/v1/{endpoint}");
+        let inch = problem(app.post_json(&path, &changed(request, pointer, value, "inch")).await, 422).await;
+        let mm = problem(app.post_json(&path, &changed(request, pointer, value, "mm")).await, 422).await;
+        assert_eq!(inch["code"], mm["code"], "{what}: {inch} vs {mm}");
+        assert_same_numbers(&what, inch["detail"].as_str().unwrap(), mm["detail"].as_str().unwrap());
+    }
+    let mut compared = 0;
+    for (endpoint, request) in [
+        ("segment", segment_request as fn(f64) -> Value),
+        ("contour", contour_request),
+        ("engagement", engagement_request),
+        ("deburr", deburr_request),
+    ] {
+        let path = format!("/api/v1/{endpoint}");
+        let mut inch = request(1.0);
+        inch["units"] = json!("inch");
+        let inch = json_with(app.post_json(&path, &inch).await, 200).await;
+        let mm = json_with(app.post_json(&path, &request(1.0)).await, 200).await;
+        let warnings = |answer: &Value| -> Vec<(String, String)> {
+            answer["warnings"].as_array().map_or_else(Vec::new, |all| {
+                all.iter()
+                    .map(|w| (w["code"].as_str().unwrap().to_owned(), w["message"].as_str().unwrap().to_owned()))
+                    .collect()
+            })
+        };
+        // The G-code's increment is 0.0001 of the program's unit, not a length of the request.
+        for (code, message) in warnings(&inch).into_iter().filter(|(code, _)| code != "W_RESOLUTION_LIMITED") {
+            // The twin warning of the same code about the same thing (`k = 3: …`): what the
+            // answers recommend may differ, forces are not scaled.
+            let about =
+                |text: &str| text.strip_prefix("k = ").and_then(|rest| rest.split_once(':')).map(|(k, _)| k.to_owned());
+            let twin = warnings(&mm).into_iter().find(|(other, text)| *other == code && about(text) == about(&message));
+            if let Some((_, twin)) = twin {
+                assert_same_numbers(&format!("{endpoint} {code}"), &message, &twin);
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared >= 5, "only {compared} warnings compared");
+}
+
 /// The line of `program` that holds `text`.
 fn line_with<'p>(program: &'p str, text: &str) -> &'p str {
     program.lines().find(|line| line.contains(text)).unwrap_or_else(|| panic!("no {text:?} in {program}"))

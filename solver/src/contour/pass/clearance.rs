@@ -12,6 +12,7 @@ use crate::contour::request::{LoopStyle, MAX_MOVES};
 use crate::error::ErrorCode;
 use crate::error::SolverError;
 use crate::planar::{Vec2, find_self_intersection, signed_area};
+use crate::validate::Measure;
 
 /// Refuses before building any loop when the loops alone would need more moves than an answer
 /// may hold (huge loop radii with a fine chord tolerance on many corners).
@@ -201,9 +202,9 @@ pub(super) fn check_clearance(
                 return Err(SolverError::new(
                     ErrorCode::OffsetSelfIntersection,
                     format!(
-                        "the tool (radius {} + allowance {}) does not fit: near ({:.4}, {:.4}) the path comes within {distance:.6} of the edge from {} (a neck narrower than twice that)",
-                        input.radius,
-                        input.pass.allowance,
+                        "the tool (radius {} + allowance {}) does not fit: near ({:.4} mm, {:.4} mm) the path comes within {distance:.6} mm of the edge from {} (a neck narrower than twice that)",
+                        Measure::Length.quote(input.radius),
+                        Measure::Length.quote(input.pass.allowance),
                         to.x,
                         to.y,
                         field(source)

@@ -12,7 +12,7 @@ use super::{CandidateJob, ForceModel, bounded, too_large, z_value};
 use crate::error::{ErrorCode, SolverError, Warning};
 use crate::material::Kienzle;
 use crate::tool::Tool;
-use crate::validate::MAX_COORDINATE;
+use crate::validate::{MAX_COORDINATE, Measure};
 
 /// The request's heights every path's a_p may come from.
 pub(super) struct Heights {
@@ -55,8 +55,9 @@ impl EngagementRequest {
         let mut total_samples = 0.0;
         let mut section_radii = 0.0_f64;
         for (name, input, field, prefix, own_depth, own_cut_z) in inputs {
-            let own_depth =
-                own_depth.map(|d| bounded(&format!("{prefix}axial_depth"), d, MAX_COORDINATE)).transpose()?;
+            let own_depth = own_depth
+                .map(|d| bounded(&format!("{prefix}axial_depth"), d, MAX_COORDINATE, Measure::Length))
+                .transpose()?;
             let own_cut_z = own_cut_z.map(|z| z_value(&format!("{prefix}cut_z"), z)).transpose()?;
             let mut warnings = Vec::new();
             let mut levels = Vec::new();
@@ -148,7 +149,9 @@ fn program_level(
                 warnings.push(Warning::new(
                     "W_AXIAL_DEPTH",
                     format!(
-                        "the program's XY feed moves run at several Z levels (Z {first} at line {line}, Z {z} at line {other_line}): no a_p from the stock height; the 2-D model takes one level per path, so give axial_depth or cut_z, or each level as its own entry of paths"
+                        "the program's XY feed moves run at several Z levels (Z {} at line {line}, Z {} at line {other_line}): no a_p from the stock height; the 2-D model takes one level per path, so give axial_depth or cut_z, or each level as its own entry of paths",
+                        Measure::Length.quote(first),
+                        Measure::Length.quote(*z)
                     ),
                 ));
             }
@@ -202,7 +205,9 @@ fn path_depth(
         warnings.push(Warning::new(
             "W_AXIAL_DEPTH",
             format!(
-                "the tool tip runs at Z {z} ({field}), at or above the stock top {top}: a_p = 0, the path cuts no chip (torque, power and removal rate are 0)"
+                "the tool tip runs at Z {} ({field}), at or above the stock top {}: a_p = 0, the path cuts no chip (torque, power and removal rate are 0)",
+                Measure::Length.quote(z),
+                Measure::Length.quote(top)
             ),
         ));
         return Ok((Some(0.0), Some(z)));

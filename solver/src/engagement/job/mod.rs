@@ -21,7 +21,7 @@ use super::stock::Region;
 use crate::error::{ErrorCode, SolverError, Warning};
 use crate::machine::{BlockRule, SpindleLimits};
 use crate::material::Kienzle;
-use crate::validate::{self, MAX_COORDINATE, positive_at_most};
+use crate::validate::{self, MAX_COORDINATE, Measure, positive_at_most};
 
 /// How the flute counts share the feed (docs/spec/engagement.md §2.5).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -135,16 +135,17 @@ fn point(field: &str, p: [f64; 2]) -> Result<P2, SolverError> {
 }
 
 /// `value` must be positive and at most `limit`.
-fn bounded(field: &str, value: f64, limit: f64) -> Result<f64, SolverError> {
-    positive_at_most(field, value, limit)
+fn bounded(field: &str, value: f64, limit: f64, measure: Measure) -> Result<f64, SolverError> {
+    positive_at_most(field, value, limit, measure)
 }
 
 fn optional(
     field: &str,
     value: Option<f64>,
-    check: fn(&str, f64) -> Result<f64, SolverError>,
+    check: fn(&str, f64, Measure) -> Result<f64, SolverError>,
+    measure: Measure,
 ) -> Result<Option<f64>, SolverError> {
-    value.map(|v| check(field, v)).transpose()
+    value.map(|v| check(field, v, measure)).transpose()
 }
 
 fn too_large(field: &str, what: &str, count: usize, limit: usize) -> SolverError {

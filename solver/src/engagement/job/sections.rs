@@ -12,7 +12,7 @@ use super::{FeedMode, Job, Physics, PlanJob, bounded, optional, too_large, z_val
 use crate::error::{SolverError, Warning};
 use crate::machine::{BlockRule, MachineProfile, RuleSettings};
 use crate::tool::Tool;
-use crate::validate::{MAX_COORDINATE, finite, non_negative, positive};
+use crate::validate::{MAX_COORDINATE, Measure, finite, non_negative, positive};
 
 /// The tool and cutting conditions of a request: what every sample is evaluated at.
 struct Cutting {
@@ -42,14 +42,15 @@ impl EngagementRequest {
         physics: &Physics,
     ) -> Result<Job, SolverError> {
         let Cutting { radius, spindle_rpm, feed_mode, flute_counts } = self.cutting(tool)?;
-        let thickness_limit = optional("thickness_limit", self.thickness_limit, positive)?;
-        let time_limit = optional("time_limit_s", self.time_limit_s, positive)?;
+        let thickness_limit = optional("thickness_limit", self.thickness_limit, positive, Measure::Length)?;
+        let time_limit = optional("time_limit_s", self.time_limit_s, positive, Measure::Number)?;
         let (step, grid) = self.sampling(radius)?;
         let flags = self.flags()?;
-        let axial_depth = self.axial_depth.map(|d| bounded("axial_depth", d, MAX_COORDINATE)).transpose()?;
+        let axial_depth =
+            self.axial_depth.map(|d| bounded("axial_depth", d, MAX_COORDINATE, Measure::Length)).transpose()?;
         let (kienzle, spindle) = self.kienzle(physics)?;
         let stock_top_z = z_value("stock_top_z", self.stock_top_z.unwrap_or(0.0))?;
-        let clearance = bounded("clearance", self.clearance.unwrap_or(5.0), MAX_COORDINATE)?;
+        let clearance = bounded("clearance", self.clearance.unwrap_or(5.0), MAX_COORDINATE, Measure::Length)?;
         // Warnings of the whole request, repeated in every candidate's answer.
         let mut shared_warnings = Vec::new();
         let plan = self.feed_plan.as_ref().map(|plan| feed_plan(plan, machine, &mut shared_warnings)).transpose()?;
@@ -115,11 +116,11 @@ impl EngagementRequest {
     /// flute counts to compare (the tool's own when none are given).
     fn cutting(&self, tool: &Tool) -> Result<Cutting, SolverError> {
         tool.validate("tool.")?;
-        let radius = bounded("tool.radius", tool.radius, MAX_COORDINATE)?;
-        let spindle_rpm = bounded("spindle_rpm", self.spindle_rpm, 1e6)?;
+        let radius = bounded("tool.radius", tool.radius, MAX_COORDINATE, Measure::Length)?;
+        let spindle_rpm = bounded("spindle_rpm", self.spindle_rpm, 1e6, Measure::Number)?;
         let feed_mode = match (self.feed_per_tooth, self.feed) {
-            (Some(fz), None) => FeedMode::PerTooth(bounded("feed_per_tooth", fz, 1e3)?),
-            (None, Some(vf)) => FeedMode::Rate(bounded("feed", vf, 1e7)?),
+            (Some(fz), None) => FeedMode::PerTooth(bounded("feed_per_tooth", fz, 1e3, Measure::FeedPerTooth)?),
+            (None, Some(vf)) => FeedMode::Rate(bounded("feed", vf, 1e7, Measure::Feed)?),
             (Some(_), Some(_)) => {
                 return Err(SolverError::input(
                     "feed",
@@ -164,7 +165,7 @@ impl EngagementRequest {
     /// default); `grid` is refused with the exact engine.
     fn sampling(&self, radius: f64) -> Result<(f64, Option<f64>), SolverError> {
         let step = match self.step {
-            Some(step) => bounded("step", step, MAX_COORDINATE)?,
+            Some(step) => bounded("step", step, MAX_COORDINATE, Measure::Length)?,
             None => 2.0 * radius / 50.0,
         };
         let grid = match (self.engine, self.grid) {
@@ -172,7 +173,7 @@ impl EngagementRequest {
                 return Err(SolverError::input("grid", "grid applies only to engine \"dots\""));
             }
             (Engine::Exact, None) => None,
-            (Engine::Dots, Some(g)) => Some(bounded("grid", g, MAX_COORDINATE)?),
+            (Engine::Dots, Some(g)) => Some(bounded("grid", g, MAX_COORDINATE, Measure::Length)?),
             (Engine::Dots, None) => Some(match &self.stock.bitmap {
                 Some(bitmap) if bitmap.cell.is_finite() && bitmap.cell > 0.0 => bitmap.cell,
                 _ => 2.0 * radius / 200.0,
@@ -195,18 +196,23 @@ impl EngagementRequest {
         let burr_disengage = angle("burr_disengage_deg", self.burr_disengage_deg, DEFAULT_BURR_DISENGAGE_DEG)?;
         let chipping_disengage =
             angle("chipping_disengage_deg", self.chipping_disengage_deg, DEFAULT_CHIPPING_DISENGAGE_DEG)?;
-        let radial_depth_min = optional("radial_depth_min", self.radial_depth_min, non_negative)?;
-        let radial_depth_max = optional("radial_depth_max", self.radial_depth_max, positive)?;
+        let radial_depth_min = optional("radial_depth_min", self.radial_depth_min, non_negative, Measure::Length)?;
+        let radial_depth_max = optional("radial_depth_max", self.radial_depth_max, positive, Measure::Length)?;
         if let (Some(low), Some(high)) = (radial_depth_min, radial_depth_max)
             && low > high
         {
             return Err(SolverError::input(
                 "radial_depth_min",
-                format!("radial_depth_min {low} exceeds radial_depth_max {high}"),
+                format!(
+                    "radial_depth_min {} exceeds radial_depth_max {}",
+                    Measure::Length.quote(low),
+                    Measure::Length.quote(high)
+                ),
             ));
         }
-        let spike_threshold = optional("spike_threshold_deg", self.spike_threshold_deg, positive)?;
-        let min_feed_per_tooth = optional("min_feed_per_tooth", self.min_feed_per_tooth, positive)?;
+        let spike_threshold = optional("spike_threshold_deg", self.spike_threshold_deg, positive, Measure::Number)?;
+        let min_feed_per_tooth =
+            optional("min_feed_per_tooth", self.min_feed_per_tooth, positive, Measure::FeedPerTooth)?;
         Ok(Flags {
             burr_disengage,
             chipping_disengage,
@@ -226,14 +232,14 @@ fn feed_plan(
     machine: Option<&MachineProfile>,
     shared_warnings: &mut Vec<Warning>,
 ) -> Result<PlanJob, SolverError> {
-    let target = bounded("feed_plan.target_thickness", plan.target_thickness, 1e3)?;
+    let target = bounded("feed_plan.target_thickness", plan.target_thickness, 1e3, Measure::Length)?;
     let max_feed = plan.max_feed.or(machine.map(|m| m.max_feed)).ok_or_else(|| {
         SolverError::input(
             "feed_plan.max_feed",
             "feed_plan.max_feed (mm/min) is required unless the request names a machine",
         )
     })?;
-    let mut max_feed = bounded("feed_plan.max_feed", max_feed, 1e7)?;
+    let mut max_feed = bounded("feed_plan.max_feed", max_feed, 1e7, Measure::Feed)?;
     if let Some(machine) = machine
         && max_feed > machine.max_feed
     {
@@ -255,7 +261,8 @@ fn feed_plan(
             format!("a flute count must be 1 to {MAX_FLUTES} (got {flute_count})"),
         ));
     }
-    let tolerance = non_negative("feed_plan.tolerance", plan.tolerance.unwrap_or(0.05))?;
-    let min_block_length = non_negative("feed_plan.min_block_length", plan.min_block_length.unwrap_or(0.5))?;
+    let tolerance = non_negative("feed_plan.tolerance", plan.tolerance.unwrap_or(0.05), Measure::Length)?;
+    let min_block_length =
+        non_negative("feed_plan.min_block_length", plan.min_block_length.unwrap_or(0.5), Measure::Length)?;
     Ok(PlanJob { target, max_feed, flute_count: plan.flute_count, basis: plan.basis, tolerance, min_block_length })
 }
