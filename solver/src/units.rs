@@ -249,7 +249,17 @@ fn number_with_unit(text: &str) -> Option<((f64, usize), MessageUnit, usize)> {
             tail.chars().next().is_none_or(|c| !(c.is_alphanumeric() || c == '_' || c == '/' || c == '²' || c == '³'))
         })
     })?;
+    // A number written out in full f64 digits counts those it holds rounded to 12.
+    let digits = if digits > 12 { written_digits(value) } else { digits };
     Some(((value, digits.max(1)), *unit, end + gap + unit.0.len()))
+}
+
+/// The significant digits of `value` rounded to 12 of them: a length converted from inches and
+/// written out in full (-152.39999999999998 mm) has 5, as its inch value has.
+fn written_digits(value: f64) -> usize {
+    let mantissa = format!("{:.11e}", value.abs());
+    let mantissa = mantissa.split('e').next().unwrap_or_default();
+    mantissa.trim_end_matches('0').bytes().filter(u8::is_ascii_digit).count()
 }
 
 /// A value whose lengths and feeds are converted by a [`Scaling`]: each implementation lists
@@ -401,6 +411,8 @@ mod tests {
             "feed_per_tooth (in/tooth) or feed (in/min); a_p = 1.0000 in."
         );
         assert_eq!(inch.restate("-12.7 mm at s = 1e1 mm"), "-0.5000 in at s = 0.3937 in");
+        // A length converted from inches, written out in full, reads as the inches it was.
+        assert_eq!(inch.restate("from 0 mm to -152.39999999999998 mm"), "from 0.0000 in to -6.0000 in");
         // Not lengths in mm: counts, words of a program, other units, the name of the units.
         for kept in [
             "12 blocks",
