@@ -314,10 +314,20 @@ pub(super) fn describe(job: &Job, summary: &ContourSummary) -> Vec<String> {
             },
             summary.corners,
             summary.layers,
-            job.top,
-            job.bottom
+            Measure::Length.quote(job.top),
+            Measure::Length.quote(job.bottom)
         ),
-        format!("{} R {} corner loops {style}, {} passes", job.tool.kind.as_str(), job.radius, summary.passes),
-        format!("feed {} mm/min loop feed {} mm/min spindle {} rpm", job.feed, summary.loop_feed, job.spindle_rpm),
+        format!(
+            "{} R {} corner loops {style}, {} passes",
+            job.tool.kind.as_str(),
+            Measure::Length.quote(job.radius),
+            summary.passes
+        ),
+        format!(
+            "feed {} loop feed {} spindle {} rpm",
+            Measure::Feed.quote(job.feed),
+            Measure::Feed.quote(summary.loop_feed),
+            job.spindle_rpm
+        ),
     ]
 }

@@ -397,7 +397,7 @@ fn own_model(
         classify: Box::new(classify),
         step: thinnest / 8.0,
         description: format!(
-            "stock: the tube (bore radius {bore} mm, outer radius {outer} mm) with its {holes} hole(s); part: the same with              the chamfer band of every loop cut away, its edges W = {width:.4} mm apart"
+            "stock: the tube (bore radius {bore} mm, outer radius {outer} mm) with its {holes} hole(s); part: the same with the chamfer band of every loop cut away, its edges W = {width:.4} mm apart"
         ),
     };
     let ball_tool = Tool { radius: ball, ..context.tool.clone() };

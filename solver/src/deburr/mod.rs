@@ -47,6 +47,7 @@ pub use request::{
 
 use crate::capability::Control;
 use crate::error::ErrorCode;
+use crate::validate::Measure;
 use centre::{Construction, RidgeCentre};
 use envelope::EnvelopePath;
 use swept_width::SweptWidths;
@@ -600,10 +601,14 @@ fn describe(request: &DeburrRequest, job: &Job, summary: &DeburrSummary) -> Vec<
     let part = match &request.workpiece {
         Workpiece::Tube { arrangement_angle_deg, .. } => {
             let (inner, outer) = job.tube_radii.unwrap_or_default();
-            format!("tube RN {inner} RT {outer} arrangement {arrangement_angle_deg} deg")
+            format!(
+                "tube RN {} RT {} arrangement {arrangement_angle_deg} deg",
+                Measure::Length.quote(inner),
+                Measure::Length.quote(outer)
+            )
         }
         Workpiece::BoreBlock { bore_radius, arrangement_angle_deg, .. } => {
-            format!("bore block R {bore_radius} arrangement {arrangement_angle_deg} deg")
+            format!("bore block R {} arrangement {arrangement_angle_deg} deg", Measure::Length.quote(*bore_radius))
         }
     };
     let Some(hole) = &request.hole else { return Vec::new() };
@@ -613,9 +618,9 @@ fn describe(request: &DeburrRequest, job: &Job, summary: &DeburrSummary) -> Vec<
         HoleShape::RoundedRect => "rounded rect",
     };
     let extent = match hole.centre_distance {
-        Some(CentreDistance::Along(length)) => format!(" centres {length}"),
+        Some(CentreDistance::Along(length)) => format!(" centres {}", Measure::Length.quote(length)),
         Some(CentreDistance::AcrossAlong([across, along])) => {
-            format!(" centres {across} x {along}")
+            format!(" centres {} x {}", Measure::Length.quote(across), Measure::Length.quote(along))
         }
         None => String::new(),
     };
@@ -623,15 +628,20 @@ fn describe(request: &DeburrRequest, job: &Job, summary: &DeburrSummary) -> Vec<
         format!("deburr {edge} edge, {part}"),
         format!(
             "{shape} hole R {}{extent} eccentricity {} penetration {} deg",
-            hole.size("hole").map_or(f64::NAN, |size| size.radius()),
-            job.profile.centre_x,
+            Measure::Length.quote(hole.size("hole").map_or(f64::NAN, |size| size.radius())),
+            Measure::Length.quote(job.profile.centre_x),
             hole.penetration_angle_deg
         ),
         format!(
-            "ball R {} Q {:.4} W {:.4} TA {} method {:?}, {} points",
-            job.tool.radius, job.cut_amount, job.width, job.tolerance, job.method, summary.count
+            "ball R {} Q {:.4} mm W {:.4} mm TA {} method {:?}, {} points",
+            Measure::Length.quote(job.tool.radius),
+            job.cut_amount,
+            job.width,
+            Measure::Length.quote(job.tolerance),
+            job.method,
+            summary.count
         ),
-        format!("feed {} mm/min spindle {} rpm", job.feed, job.spindle_rpm),
+        format!("feed {} spindle {} rpm", Measure::Feed.quote(job.feed), job.spindle_rpm),
     ]
     .into_iter()
     .chain(job.rule.map(|rule| {

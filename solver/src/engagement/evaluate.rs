@@ -21,6 +21,7 @@ use super::{MAX_CONTACT_DOTS, diagnostics, feed, flutes};
 use crate::capability::Control;
 use crate::error::{SolverError, Warning};
 use crate::tool::{Tool, ToolKind};
+use crate::validate::Measure;
 
 /// Engagement on the back half deeper than this (degrees) marks `back_contact` (§9 W_PLUNGE).
 const BACK_TOLERANCE_DEG: f64 = 1.0;
@@ -428,8 +429,8 @@ fn post_data(job: &Job, candidate: &CandidateJob, tool: &Tool, flutes: u32, nomi
             route.feed_length
         ),
         stock_description(&job.region),
-        format!("tool R {} mm, {} flutes, S {} rpm", tool.radius, tool.flutes, job.spindle_rpm),
-        format!("feeds for {flutes} flutes, nominal F {nominal_feed:.0}"),
+        format!("tool R {}, {} flutes, S {} rpm", Measure::Length.quote(tool.radius), tool.flutes, job.spindle_rpm),
+        format!("feeds for {flutes} flutes, nominal F {nominal_feed:.0} mm/min"),
     ];
     PostData {
         route: RouteData(route.clone()),
@@ -456,7 +457,12 @@ fn stock_description(region: &Region) -> String {
             format!("stock: polygon rings {}, vertices {}", rings.len(), rings.iter().map(Vec::len).sum::<usize>())
         }
         Base::Bitmap(bitmap) => {
-            format!("stock: bitmap {} x {} cells of {} mm", bitmap.width, bitmap.height, bitmap.cell)
+            format!(
+                "stock: bitmap {} x {} cells of {}",
+                bitmap.width,
+                bitmap.height,
+                Measure::Length.quote(bitmap.cell)
+            )
         }
     }
 }

@@ -7,6 +7,7 @@ use super::request::SegmentRequest;
 use super::shape;
 use crate::error::Warning;
 use crate::machine::stats::BlockStats;
+use crate::validate::Measure;
 
 /// Least increment of the G-code (4 decimals), mm; a chord error below 5 of them is
 /// resolution-limited (E13).
@@ -215,7 +216,10 @@ pub(super) fn describe(
     let mut lines = vec![
         format!(
             "block time {} ms feed {} margin {} min chord error {}",
-            rule.block_time_ms, rule.feed, rule.margin, rule.min_chord_error
+            rule.block_time_ms,
+            Measure::Feed.quote(rule.feed),
+            rule.margin,
+            Measure::Length.quote(rule.min_chord_error)
         ),
         mode,
         format!("chord error {min_chord_error:.6} to {chord_error:.6} mm"),

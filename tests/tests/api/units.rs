@@ -839,6 +839,36 @@ async fn an_inch_requests_refusals_and_warnings_quote_its_own_numbers() {
         }
     }
     assert!(compared >= 5, "only {compared} warnings compared");
+    // A program's header comments: the job's lengths and feeds in the program's units (a
+    // segmentation's chord errors have floors in mm, so its header is read for the feed).
+    let mut inch = segment_request(1.0);
+    inch["units"] = json!("inch");
+    let program = app.post_text("/api/v1/segment?format=gcode", &inch, 200).await;
+    assert!(program.contains("(BLOCK TIME 4 MS FEED 120.0 IN/MIN MARGIN 1 MIN CHORD ERROR"), "{program}");
+    for (endpoint, request) in [
+        ("contour", contour_request as Request),
+        ("engagement", engagement_request),
+        ("deburr", deburr_request),
+    ] {
+        let path = format!("/api/v1/{endpoint}?format=gcode");
+        let mut inch = request(1.0);
+        inch["units"] = json!("inch");
+        let inch = app.post_text(&path, &inch, 200).await;
+        let mm = app.post_text(&path, &request(1.0), 200).await;
+        let header = |program: &str| -> Vec<String> {
+            program
+                .lines()
+                .skip_while(|line| !line.starts_with('('))
+                .take_while(|line| line.starts_with('('))
+                .map(str::to_owned)
+                .collect()
+        };
+        let (inch_header, mm_header) = (header(&inch), header(&mm));
+        assert!(inch_header.len() >= 3 && inch_header.len() == mm_header.len(), "{endpoint}: {inch}\nvs\n{mm}");
+        for (inch_line, mm_line) in inch_header.iter().zip(&mm_header) {
+            assert_same_numbers(&format!("{endpoint} program"), inch_line, mm_line);
+        }
+    }
 }
 
 /// The line of `program` that holds `text`.
