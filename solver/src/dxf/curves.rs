@@ -214,7 +214,7 @@ fn to_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 }
 
 fn format_point(p: [f64; 2]) -> String {
-    format!("({:.4}, {:.4})", p[0], p[1])
+    format!("({:.4} mm, {:.4} mm)", p[0], p[1])
 }
 
 /// Open pieces joined end to end within `tolerance` into closed loops (each with the label of

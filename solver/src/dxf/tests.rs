@@ -71,12 +71,12 @@ fn a_closed_spline_round_an_ellipse_in_cm_binary() {
 #[test]
 fn a_gap_a_crossing_and_missing_units_are_named() {
     let error = read(&fixture("broken_chain.dxf"), "file", &DxfOptions::default()).unwrap_err().to_string();
-    assert!(error.contains("open chain") && error.contains("(40.0000, 30.0000)"), "{error}");
+    assert!(error.contains("open chain") && error.contains("(40.0000 mm, 30.0000 mm)"), "{error}");
     assert!(error.contains("0.5000 mm"), "{error}");
     let wide = DxfOptions { join_tolerance: 0.6, ..DxfOptions::default() };
     assert_eq!(read(&fixture("broken_chain.dxf"), "file", &wide).unwrap().boundary.len(), 4);
     let error = read(&fixture("bow_tie.dxf"), "file", &DxfOptions::default()).unwrap_err().to_string();
-    assert!(error.contains("self-intersection") && error.contains("(5.0000, 5.0000)"), "{error}");
+    assert!(error.contains("self-intersection") && error.contains("(5.0000 mm, 5.0000 mm)"), "{error}");
     assert!(error.contains("LWPOLYLINE"), "{error}");
     let error = read(&fixture("no_units.dxf"), "file", &DxfOptions::default()).unwrap_err();
     assert_eq!(error.field(), Some("units"));

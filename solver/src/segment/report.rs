@@ -222,7 +222,7 @@ pub(super) fn describe(
             Measure::Length.quote(rule.min_chord_error)
         ),
         mode,
-        format!("chord error {min_chord_error:.6} to {chord_error:.6} mm"),
+        format!("chord error {min_chord_error:.6} mm to {chord_error:.6} mm"),
         format!(
             "blocks {} shortest {:.4} mm short {} est time {:.3} s",
             stats.blocks, stats.min_block_length, stats.short_blocks, stats.estimated_time_s

@@ -188,7 +188,7 @@ pub(crate) fn grid(
         return Err(SolverError::new(
             ErrorCode::GridMemory,
             format!(
-                "a verification spacing of {spacing} mm over {:.1} × {:.1} mm needs {rays:.3e} rays ({:.0} MiB); the \
+                "a verification spacing of {spacing} mm over {:.1} mm × {:.1} mm needs {rays:.3e} rays ({:.0} MiB); the \
                  limit is {} MiB: use a coarser verification.resolution or turn verification off",
                 hi[0] - lo[0],
                 hi[1] - lo[1],

@@ -67,8 +67,8 @@ async fn bad_drawings_are_refused_naming_the_entity() {
     let app = TestApp::spawn().await;
     let cases = [
         ("broken_chain.dxf", "", "file", "open chain"),
-        ("broken_chain.dxf", "", "file", "(40.0000, 30.0000)"),
-        ("bow_tie.dxf", "", "file", "crosses itself at (5.0000, 5.0000)"),
+        ("broken_chain.dxf", "", "file", "(40.0000 mm, 30.0000 mm)"),
+        ("bow_tie.dxf", "", "file", "crosses itself at (5.0000 mm, 5.0000 mm)"),
         ("bow_tie.dxf", "", "file", "LWPOLYLINE"),
         ("plate_mm.dxf", "", "file", "LINE"),
         ("plate_mm.dxf", "?layer=HOLES", "layer", "CUT, NOTES"),
@@ -178,7 +178,14 @@ async fn a_drawing_request_refuses_what_it_cannot_read_naming_the_field() {
     let contour = |drawing: Value| contour_request(("drawing", drawing));
     let cases = [
         ("/api/v1/contour", contour(json!({})), "broken_chain.dxf", 422, "drawing", "open chain"),
-        ("/api/v1/contour", contour(json!({})), "bow_tie.dxf", 422, "drawing", "crosses itself at (5.0000, 5.0000)"),
+        (
+            "/api/v1/contour",
+            contour(json!({})),
+            "bow_tie.dxf",
+            422,
+            "drawing",
+            "crosses itself at (5.0000 mm, 5.0000 mm)",
+        ),
         ("/api/v1/contour", contour(json!({})), "square_inch_r12.dxf", 422, "drawing.units", "give units"),
         ("/api/v1/contour", contour(json!({"layer": "HOLES"})), "plate_mm.dxf", 422, "drawing.layer", "CUT, NOTES"),
         ("/api/v1/contour", contour(json!({"island": 3})), "l_plate_lines.dxf", 422, "drawing.island", "no island 3"),

@@ -845,11 +845,10 @@ async fn an_inch_requests_refusals_and_warnings_quote_its_own_numbers() {
     inch["units"] = json!("inch");
     let program = app.post_text("/api/v1/segment?format=gcode", &inch, 200).await;
     assert!(program.contains("(BLOCK TIME 4 MS FEED 120.0 IN/MIN MARGIN 1 MIN CHORD ERROR"), "{program}");
-    for (endpoint, request) in [
-        ("contour", contour_request as Request),
-        ("engagement", engagement_request),
-        ("deburr", deburr_request),
-    ] {
+    assert_eq!(line_with(&program, "(CHORD ERROR").matches(" IN").count(), 2, "{program}");
+    for (endpoint, request) in
+        [("contour", contour_request as Request), ("engagement", engagement_request), ("deburr", deburr_request)]
+    {
         let path = format!("/api/v1/{endpoint}?format=gcode");
         let mut inch = request(1.0);
         inch["units"] = json!("inch");
