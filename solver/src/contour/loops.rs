@@ -173,7 +173,7 @@ pub(crate) fn sized(
                 (
                     LoopShape::parallelogram(p, d1, d2, fallback_leg),
                     Some(format!(
-                        "arc radius {radius:.4} outside [{:.4}, {:.4}]: parallelogram with leg {fallback_leg:.4}",
+                        "arc radius {radius:.4} mm outside [{:.4} mm, {:.4} mm]: parallelogram with leg {fallback_leg:.4} mm",
                         config.min_radius, config.max_radius
                     )),
                 )

@@ -201,7 +201,7 @@ fn shape_warnings(job: &Job, passes: &[PassPlan], corners: &[ContourCorner], war
             format!(
                 "{} inside corners keep a fillet of radius {} (up to {largest:.6} mm² left; set inside_corner_relief to cut them): {}",
                 inside.len(),
-                job.radius,
+                Measure::Length.quote(job.radius),
                 list_indices(&indices)
             ),
         ));

@@ -586,7 +586,10 @@ impl Entity<'_> {
                 let centre = point(self.number(10, None, field)?, self.number(20, None, field)?);
                 let radius = self.number(40, None, field)? * scale;
                 if radius.is_nan() || radius <= 0.0 {
-                    return Err(SolverError::input(field, format!("{label}: radius {radius} is not positive")));
+                    return Err(SolverError::input(
+                        field,
+                        format!("{label}: radius {} is not positive", Measure::Length.quote(radius)),
+                    ));
                 }
                 if self.raw.kind == "CIRCLE" {
                     let mut points = flatten_arc(centre, radius, 0.0, std::f64::consts::TAU, tolerance);

@@ -213,6 +213,14 @@ fn path_depth(
         return Ok((Some(0.0), Some(z)));
     }
     let field_name = field.split(' ').next().unwrap_or(&field).to_owned();
-    reach(depth, &field_name, &format!("the stock top {top} less the path's Z {z} ({field}) gives"))?;
+    reach(
+        depth,
+        &field_name,
+        &format!(
+            "the stock top {} less the path's Z {} ({field}) gives",
+            Measure::Length.quote(top),
+            Measure::Length.quote(z)
+        ),
+    )?;
     Ok((Some(depth), Some(z)))
 }
