@@ -210,7 +210,9 @@ fn bench(c: &mut Criterion) {
         b.iter(|| contour::plan(black_box(&request), &tool).map(|p| p.passes.len()))
     });
     let polygon: Vec<Vec2> = castellated_ring().into_iter().map(|[x, y]| Vec2::new(x, y)).collect();
-    group.bench_function("simple_polygon_check_100k", |b| b.iter(|| find_self_intersection(black_box(&polygon))));
+    group.bench_function("simple_polygon_check_100k", |b| {
+        b.iter(|| find_self_intersection(black_box(&polygon), kerf_solver::control::Control::default()))
+    });
     group.finish();
 
     let mut group = c.benchmark_group("contour_peers");

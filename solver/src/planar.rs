@@ -24,7 +24,7 @@ pub mod grid;
 
 pub use arc::{arc_max_step, arc_steps, circumscribed_arc, circumscribed_arc_steps};
 pub use area::{capsule_convex_area, clip_half_plane, disk_polygon_area};
-pub use grid::{GridBudgetExceeded, SegmentGrid, find_self_intersection};
+pub use grid::{CheckStopped, SegmentGrid, find_self_intersection};
 
 use nalgebra::Vector2;
 
@@ -359,7 +359,7 @@ mod tests {
         let (a, b, c) = collinear_off_by_rounding();
         // The vertex c of edges 2 and 3 lies on edge 0, both edges on its right.
         let polygon = [a, b, Vec2::new(30.0, 20.0), c, Vec2::new(20.0, 0.0)];
-        assert_eq!(find_self_intersection(&polygon).unwrap(), Some((0, 2)));
+        assert_eq!(find_self_intersection(&polygon, crate::control::Control::default()).unwrap(), Some((0, 2)));
     }
 
     #[test]

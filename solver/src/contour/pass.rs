@@ -12,6 +12,7 @@ use super::loops::{self, LoopShape};
 use super::offset::{self, Offset};
 use super::relief::{self, ReliefShape};
 use super::request::{Join, LoopStyle, Relief};
+use crate::control::Control;
 use crate::error::{SolverError, Warning};
 use crate::planar::{SegmentGrid, Vec2};
 use crate::validate::Measure;
@@ -199,7 +200,7 @@ fn field(source: usize) -> String {
 /// # Errors
 /// `E_DEGENERATE` (180° reversal), `E_OFFSET_COLLAPSE` (O4), `E_OFFSET_SELF_INTERSECTION` (O5 or
 /// the global clearance of the cut moves), `E_TOO_COMPLEX`.
-pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan, SolverError> {
+pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>, control: Control<'_>) -> Result<PassPlan, SolverError> {
     let n = layer.len();
     let offsets = &input.edge_offsets;
     let clear = input.radius + input.pass.allowance;
@@ -209,7 +210,8 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
         Measure::Length.quote(input.pass.allowance)
     );
     let offset = offset::offset(layer, offsets, &input.edge_source, &tool)?;
-    check_offset(layer, &offset, input, &tool)?;
+    control.check()?;
+    check_offset(layer, &offset, input, &tool, control)?;
     let cl = offset.cl.clone();
 
     check_loop_budget(layer, &offset, input)?;
@@ -226,11 +228,14 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>) -> Result<PassPlan
     };
     let mut corners: Vec<Option<CornerPlan>> = vec![None; n];
     for step in 1..=n {
+        if step % 1024 == 0 {
+            control.check()?;
+        }
         let k = (first_edge + step) % n;
         corners[k] = Some(walk.corner(layer, input, &offset, clear, k));
     }
     walk.path.push(cut(walk.current, start), first_edge, first_edge, false);
-    check_clearance(layer, &walk.path.elements, clear, input, &mut walk.scratch)?;
+    check_clearance(layer, &walk.path.elements, clear, input, &mut walk.scratch, control)?;
 
     let warnings = pass_warnings(input, &offset, &walk, &tool);
     let corners: Vec<CornerPlan> = corners.into_iter().flatten().collect();

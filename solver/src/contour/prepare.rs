@@ -5,7 +5,7 @@ use super::request::MAX_POINTS;
 use crate::capability::Control;
 use crate::error::ErrorCode;
 use crate::error::{SolverError, Warning};
-use crate::planar::{self, Vec2, find_self_intersection, signed_area, turn_angle};
+use crate::planar::{self, CheckStopped, Vec2, find_self_intersection, signed_area, turn_angle};
 use crate::validate::coordinates;
 
 /// Points closer than this are one point, mm (docs/spec/contour.md §1.4 `tol`).
@@ -101,7 +101,7 @@ pub(crate) fn prepare(
     check_duplicates(&kept)?;
     control.check()?;
     check_area(&kept)?;
-    check_simple(&kept)?;
+    check_simple(&kept, control)?;
     control.check()?;
     let (kept, straight) = remove_straight(kept);
     removed.extend(straight);
@@ -189,9 +189,9 @@ fn distinct_points(points: &[[f64; 2]]) -> (Vec<(Vec2, usize)>, Vec<usize>, usiz
 
 /// `E_SELF_INTERSECTION` when two edges meet; `E_TOO_COMPLEX` when the check cannot finish in
 /// bounded time.
-fn check_simple(kept: &[(Vec2, usize)]) -> Result<(), SolverError> {
+fn check_simple(kept: &[(Vec2, usize)], control: Control<'_>) -> Result<(), SolverError> {
     let polygon: Vec<Vec2> = kept.iter().map(|(p, _)| *p).collect();
-    match find_self_intersection(&polygon) {
+    match find_self_intersection(&polygon, control) {
         Ok(None) => {}
         Ok(Some((i, j))) => {
             let (first, second) = (kept[i].1, kept[j].1);
@@ -203,7 +203,8 @@ fn check_simple(kept: &[(Vec2, usize)]) -> Result<(), SolverError> {
             )
             .at(format!("contour[{second}]")));
         }
-        Err(_) => {
+        Err(CheckStopped::Cancelled) => return control.check(),
+        Err(CheckStopped::Budget) => {
             return Err(SolverError::new(
                 ErrorCode::TooComplex,
                 "the contour's edges are too crowded to check for self-intersection in bounded time",

@@ -469,7 +469,7 @@ fn plan_passes(job: &Job, setup: &Setup, layer: &Layer, control: Control<'_>) ->
             source: source.clone(),
             edge_source: edge_source.clone(),
         };
-        plans.push(pass::plan_pass(layer, &input)?);
+        plans.push(pass::plan_pass(layer, &input, control)?);
     }
     Ok(plans)
 }

@@ -17,9 +17,8 @@
 //!   that share grid cells are tested here with `planar::segments_intersect`.
 
 use super::P2;
-use crate::planar::{
-    GridBudgetExceeded, SegmentGrid, find_self_intersection, point_segment_distance, segments_intersect,
-};
+use crate::control::Control;
+use crate::planar::{CheckStopped, SegmentGrid, find_self_intersection, point_segment_distance, segments_intersect};
 
 thread_local! {
     /// Candidate buffer of [`Outline::contains`] (called for every sub-arc of every sample).
@@ -125,11 +124,12 @@ impl Outline {
     /// ring is simple and no two rings meet.
     ///
     /// # Errors
-    /// [`GridBudgetExceeded`] when a ring, or the rings together, crowd so many edges into the
+    /// [`CheckStopped::Budget`] when a ring, or the rings together, crowd so many edges into the
     /// same grid cells that more than `64·n + 10⁶` pairs would need testing.
-    pub(crate) fn first_crossing(&self) -> Result<Option<(EdgeAt, EdgeAt)>, GridBudgetExceeded> {
+    pub(crate) fn first_crossing(&self) -> Result<Option<(EdgeAt, EdgeAt)>, CheckStopped> {
         for (ring_index, ring) in self.rings.iter().enumerate() {
-            if let Some((i, j)) = find_self_intersection(ring)? {
+            // A stock's rings are checked whole, as the request is read.
+            if let Some((i, j)) = find_self_intersection(ring, Control::default())? {
                 return Ok(Some(((ring_index, i), (ring_index, j))));
             }
         }
@@ -150,7 +150,7 @@ impl Outline {
                 }
                 tests += 1;
                 if tests > budget {
-                    return Err(GridBudgetExceeded);
+                    return Err(CheckStopped::Budget);
                 }
                 if let Some((c, d)) = self.grid.segment(other)
                     && segments_intersect(&a, &b, &c, &d)

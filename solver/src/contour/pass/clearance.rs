@@ -9,9 +9,10 @@ use crate::contour::layer::{Class, Layer};
 use crate::contour::loops::{self, LoopShape};
 use crate::contour::offset::Offset;
 use crate::contour::request::{LoopStyle, MAX_MOVES};
+use crate::control::Control;
 use crate::error::ErrorCode;
 use crate::error::SolverError;
-use crate::planar::{Vec2, find_self_intersection, signed_area};
+use crate::planar::{CheckStopped, Vec2, find_self_intersection, signed_area};
 use crate::validate::Measure;
 
 /// Refuses before building any loop when the loops alone would need more moves than an answer
@@ -53,10 +54,11 @@ pub(super) fn check_offset(
     offset: &Offset,
     input: &PassInput<'_>,
     tool: &str,
+    control: Control<'_>,
 ) -> Result<(), SolverError> {
     let edges: Vec<usize> = (0..layer.len()).filter(|&k| offset.active[k]).collect();
     let polygon = offset.polygon(layer);
-    match find_self_intersection(&polygon) {
+    match find_self_intersection(&polygon, control) {
         Ok(None) => {}
         Ok(Some((i, j))) => {
             let (first, second) = (input.edge_source[edges[i]], input.edge_source[edges[j]]);
@@ -70,7 +72,8 @@ pub(super) fn check_offset(
             )
             .at(field(second)));
         }
-        Err(_) => {
+        Err(CheckStopped::Cancelled) => return control.check(),
+        Err(CheckStopped::Budget) => {
             return Err(SolverError::new(
                 ErrorCode::TooComplex,
                 "the offset path's edges are too crowded to check in bounded time",
@@ -181,9 +184,13 @@ pub(super) fn check_clearance(
     clear: f64,
     input: &PassInput<'_>,
     scratch: &mut Vec<usize>,
+    control: Control<'_>,
 ) -> Result<(), SolverError> {
     let radius = clear - GOUGE_TOLERANCE;
-    for element in elements.iter().filter(|e| e.kind() == ElementKind::Cut) {
+    for (index, element) in elements.iter().filter(|e| e.kind() == ElementKind::Cut).enumerate() {
+        if index % 1024 == 0 {
+            control.check()?;
+        }
         let mut from = element.start();
         for to in element.chords(&input.chording, MAX_ARC_STEPS) {
             // An edge whose middle lies farther from the move's middle than the radius and both
