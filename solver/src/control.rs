@@ -29,6 +29,16 @@ impl Control<'_> {
         Ok(())
     }
 
+    /// [`Control::check`] at every 1 024th of many small units of work (an edge, a corner, a
+    /// move), `index` counting them: often enough to stop within milliseconds, rarely enough that
+    /// the flag's load costs nothing.
+    ///
+    /// # Errors
+    /// `E_CANCELLED` when cancelled and `index` is a multiple of 1 024.
+    pub fn check_at(&self, index: usize) -> Result<(), SolverError> {
+        if index.is_multiple_of(1024) { self.check() } else { Ok(()) }
+    }
+
     /// Whether the cancel flag is set.
     #[must_use]
     pub fn cancelled(&self) -> bool {

@@ -228,9 +228,7 @@ pub(crate) fn plan_pass(layer: &Layer, input: &PassInput<'_>, control: Control<'
     };
     let mut corners: Vec<Option<CornerPlan>> = vec![None; n];
     for step in 1..=n {
-        if step % 1024 == 0 {
-            control.check()?;
-        }
+        control.check_at(step)?;
         let k = (first_edge + step) % n;
         corners[k] = Some(walk.corner(layer, input, &offset, clear, k));
     }

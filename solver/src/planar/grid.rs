@@ -246,7 +246,7 @@ pub fn find_self_intersection(polygon: &[Vec2], control: Control<'_>) -> Result<
     let mut tests = 0usize;
     let mut candidates = Vec::new();
     for i in 0..n {
-        if i % 1024 == 0 && control.cancelled() {
+        if control.check_at(i).is_err() {
             return Err(CheckStopped::Cancelled);
         }
         let (a, b) = (polygon[i], polygon[(i + 1) % n]);

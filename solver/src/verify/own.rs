@@ -558,9 +558,7 @@ impl Prism {
         let mut distance = vec![limit; grid.len()];
         let n = self.outline.len();
         for (index, a) in self.outline.iter().enumerate() {
-            if index % 1024 == 0 {
-                control.check()?;
-            }
+            control.check_at(index)?;
             let b = &self.outline[(index + 1) % n];
             for j in grid.span(1, a.y.min(b.y) - limit, a.y.max(b.y) + limit) {
                 let y = grid.y(j);

@@ -188,9 +188,7 @@ pub(super) fn check_clearance(
 ) -> Result<(), SolverError> {
     let radius = clear - GOUGE_TOLERANCE;
     for (index, element) in elements.iter().filter(|e| e.kind() == ElementKind::Cut).enumerate() {
-        if index % 1024 == 0 {
-            control.check()?;
-        }
+        control.check_at(index)?;
         let mut from = element.start();
         for to in element.chords(&input.chording, MAX_ARC_STEPS) {
             // An edge whose middle lies farther from the move's middle than the radius and both
