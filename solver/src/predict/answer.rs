@@ -135,8 +135,9 @@ pub struct PredictedPass {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub merged_with: Option<usize>,
     /// The error of the merge, mm: how much `error` can differ from simulating this pass (the
-    /// spread of the errors of the simulated passes on either side plus the resolution of one
-    /// prediction).
+    /// spread of the errors of the simulated passes on either side plus twice the resolution of
+    /// one prediction, which includes how far the deflection moves over the rotation angles the
+    /// generation point's sample spans).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub merge_bound: Option<f64>,
 }

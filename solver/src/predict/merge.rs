@@ -16,9 +16,12 @@
 //! flags and |e_a − e_b| ≤ τ; otherwise the middle one is simulated too, and so on down to
 //! neighbours. A merged pass copies the nearer simulated pass (position along the pass, the
 //! generation point and normal relative to its own ball centre, the errors) and reports
-//! `merge_bound` = |e_a − e_b| + (Δ/R)·(max |dδ/dθ| + |D|): its error lies between e_a and e_b
-//! when the error changes monotonically over the gap, up to the resolution of one prediction
-//! (the generation point is found to about one sample spacing Δ, see [`Resolution`]). The
+//! `merge_bound` = |e_a − e_b| + 2·r, r = (Δ/R)·(max |dδ/dθ| + |D|) + (how far e_D moves over
+//! the rotation angles ψ_c takes within Δ): its error lies between e_a and e_b when the error
+//! changes monotonically over the gap, up to the resolution r of each of the two predictions, the
+//! one carried over and the one simulating the pass would give (the generation point is found to
+//! about one sample spacing Δ, see [`Resolution`]; where it falls on the sample grid changes from
+//! pass to pass, and with it ψ_c and the deflection there). The
 //! similar neighbourhoods make that the expected case: a local feature between them changes the
 //! neighbourhood and ends the run. It is not a proof for every input: a feature smaller than the
 //! 81-point stock pattern, or an error that rises and falls back between two simulated passes,
@@ -159,8 +162,10 @@ pub(crate) fn similar(
 
 /// How finely one prediction resolves the error: the generation point is located to about one
 /// sample spacing Δ (the pixel), so θ_c and the normal to about Δ/R, and e to about
-/// (Δ/R)·(max |dδ/dθ| + |D|). Passes whose neighbourhoods agree within τ ≤ Δ can differ by that
-/// much even when the error does not change along the run (coordinates rounded by the post).
+/// (Δ/R)·(max |dδ/dθ| + |D|) plus how far e_D moves over the rotation angles that spans (each
+/// simulated pass's `deflection_spread`). Passes whose neighbourhoods agree within τ ≤ Δ can
+/// differ by that much even when the error does not change along the run (coordinates rounded
+/// by the post).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Resolution {
     /// Δ/R, rad.
@@ -182,15 +187,17 @@ impl Resolution {
 }
 
 /// Whether the passes between two simulated ones can take their results, and the bound on the
-/// difference: the spread |e_a − e_b| plus the resolution of one prediction.
+/// difference: the spread |e_a − e_b| plus the resolution of each of the two predictions.
 fn agree(a: &Outcome, b: &Outcome, tolerance: f64, resolution: Resolution) -> Option<f64> {
     if a.status != PassStatus::Ok || b.status != PassStatus::Ok || a.flags != b.flags {
         return None;
     }
     let spread = (a.error? - b.error?).abs();
     let deflection = |o: &Outcome| o.deflection.map_or(0.0, |d| d[0].hypot(d[1]));
-    let floor = resolution.angle * (resolution.shape_slope + deflection(a).max(deflection(b)));
-    (spread <= tolerance).then_some(spread + floor)
+    let deflection_spread = |o: &Outcome| o.deflection_spread.unwrap_or(0.0);
+    let floor = resolution.angle * (resolution.shape_slope + deflection(a).max(deflection(b)))
+        + deflection_spread(a).max(deflection_spread(b));
+    (spread <= tolerance).then_some(spread + 2.0 * floor)
 }
 
 /// Simulates the passes `indices` (consecutive pass indices; `links[k]` joins `indices[k]` and

@@ -61,6 +61,10 @@ pub(crate) struct Outcome {
     pub(crate) normal: Option<Vec3>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) deflection: Option<[f64; 2]>,
+    /// With merging: how far e_D moves while ψ_c moves by the rotation angle the generation
+    /// point is located to (one sample either way), mm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(crate) deflection_spread: Option<f64>,
     #[serde(default)]
     pub(crate) cut_count: usize,
     #[serde(default)]
@@ -93,6 +97,7 @@ impl Outcome {
             point: None,
             normal: None,
             deflection: None,
+            deflection_spread: None,
             cut_count: 0,
             finished_count: 0,
             view: None,
@@ -431,6 +436,10 @@ fn predict_pass_with(
     let normal = contact.normal;
     let error_deflection =
         deflection.map(|d| if contact.azimuth.is_none() { 0.0 } else { d[0] * normal.x + d[1] * normal.y });
+    if job.merge_tolerance.is_some() {
+        outcome.deflection_spread =
+            deflection_spread(context, source.spindle_rpm, coefficients, force_history, &contact, error_deflection);
+    }
     outcome.error_deflection = error_deflection;
     outcome.error = Some(contact.error_shape + error_deflection.unwrap_or(0.0));
     outcome.deflection = deflection;
@@ -627,6 +636,41 @@ fn deflection_at_contact(
         None
     };
     (deflection, history_deflection)
+}
+
+/// How far e_D = D(ψ)·n moves while ψ moves over the rotation angles the generation point can
+/// take within one sample Δ of where it was found: Δ moves the point's azimuth by Δ/(R sin θ_c)
+/// and its contact angle by Δ/R, which the helix turns into Δ/R · sin θ_c · tan β of ψ. D is
+/// linear between the history's steps, so the largest move over the window is at a step or an
+/// end of it. `None` without a deflection or at the tip (e_D is 0 there).
+fn deflection_spread(
+    context: &Context<'_>,
+    spindle_rpm: f64,
+    coefficients: Option<&force::CuttingCoefficients>,
+    force_history: &[[f64; 3]],
+    contact: &Contact,
+    error_deflection: Option<f64>,
+) -> Option<f64> {
+    let job = context.job;
+    let (psi, centre_value) = (contact.rotation_angle?, error_deflection?);
+    let sample_angle = 2.0 / f64::from(job.resolution);
+    let sin_theta = contact.contact_angle.sin();
+    let half_width =
+        (sample_angle / sin_theta + sample_angle * sin_theta * job.helix.tan().abs()).min(std::f64::consts::PI);
+    let (at, steps): (Box<dyn Fn(f64) -> [f64; 2]>, usize) = if let Some(prescribed) = &job.deflection {
+        (Box::new(move |psi| prescribed_at(prescribed, psi)), prescribed.x.len())
+    } else {
+        let kernels = &coefficients.and(context.kernels.get(&spindle_rpm.to_bits()))?.kernels;
+        (Box::new(move |psi| dynamics::deflection_at(kernels, force_history, psi)), force_history.len())
+    };
+    let step = std::f64::consts::TAU / steps as f64;
+    let first = ((psi - half_width) / step).ceil();
+    let last = ((psi + half_width) / step).floor();
+    let angles = [psi - half_width, psi + half_width]
+        .into_iter()
+        .chain((0..(last - first + 1.0).max(0.0) as usize).map(|k| (first + k as f64) * step));
+    let normal = contact.normal;
+    Some(angles.map(&at).map(|d| (d[0] * normal.x + d[1] * normal.y - centre_value).abs()).fold(0.0, f64::max))
 }
 
 /// D(ψ) of a prescribed history, periodic, linear between samples.
