@@ -756,9 +756,18 @@ impl Blocks {
         match self.table.blending {
             Blending::None => {}
             Blending::Tolerance => {
+                // `G64 P0` is LinuxCNC's `G64` without a tolerance (blend as far as the speed
+                // asks): a tolerance finer than the program's least increment (0.001 mm in an
+                // inch program) is written as that increment, the tightest the program can say.
+                let least_increment = 10f64.powi(-(self.table.decimals.min(number::MAX_DECIMALS) as i32));
                 self.begin();
                 self.text.push_str("G64 P");
-                number::push_fixed(&mut self.text.0, program.blend_tolerance, self.table.decimals, false);
+                number::push_fixed(
+                    &mut self.text.0,
+                    program.blend_tolerance.max(least_increment),
+                    self.table.decimals,
+                    false,
+                );
                 self.end();
             }
             Blending::Word(word) => self.block(word),
@@ -1133,10 +1142,22 @@ mod tests {
         assert!(fanuc.contains("T7 M06\nG00 G43 H7 Z50.0000\nS6000 M03\n"));
         assert!(fanuc.contains("G01 X1.0000 Y2.0000 Z3.0000 F300\nG01 X2.0000 Y2.0000 Z3.0000\n"));
         assert!(fanuc.ends_with("M05\nG00 Z50.0000\nM30\n%\n"));
-        let linuxcnc = write(&Program { dialect: Dialect::Linuxcnc, ..program });
+        let linuxcnc = write(&Program { dialect: Dialect::Linuxcnc, ..program.clone() });
         assert!(linuxcnc.starts_with("(KERF TEST)\n"));
         assert!(linuxcnc.contains("G64 P0.0100\n"));
         assert!(!linuxcnc.contains('%'));
+        // Finer than 0.0001 of the program's unit: the least increment, never `G64 P0.0000`
+        // (no tolerance at all).
+        for (tolerance, units, written) in [
+            (0.001, Units::Inch, "G64 P0.0001\n"),
+            (0.00004, Units::Mm, "G64 P0.0001\n"),
+            (0.0002, Units::Mm, "G64 P0.0002\n"),
+            (0.00254 * 3.0, Units::Inch, "G64 P0.0003\n"),
+        ] {
+            let text =
+                write(&Program { dialect: Dialect::Linuxcnc, blend_tolerance: tolerance, units, ..program.clone() });
+            assert!(text.contains(written), "{tolerance} mm in {units:?}:\n{text}");
+        }
     }
 
     /// A layered path: the same X/Y pairs at four heights (more pairs than table slots, so pairs

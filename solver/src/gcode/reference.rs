@@ -84,7 +84,8 @@ fn old_write_checking<E>(
     }
     out.push_str("G21 G17 G90 G40 G49 G80 G94\n");
     if !fanuc {
-        let _ = writeln!(out, "G64 P{}", mm(program.blend_tolerance));
+        // As the writer: never `G64 P0.0000`, which LinuxCNC reads as no tolerance at all.
+        let _ = writeln!(out, "G64 P{}", mm(program.blend_tolerance.max(1e-4)));
     }
     old_tool_call(&mut out, &program.tool, program.safe_z);
     let _ = writeln!(out, "S{} {}", program.spindle_rpm.round(), program.spindle_direction.m_code());

@@ -108,6 +108,9 @@ impl Capability for SegmentCapability {
 
     fn scale_request(request: &mut SegmentRequest, scaling: crate::units::Scaling) -> Result<(), SolverError> {
         crate::units::Scale::scale(request, scaling);
+        // Its lengths are now mm, but its program is written in the units it came in, and the
+        // program's least increment (E13) is 0.0001 of those.
+        request.units = Some(scaling.units());
         Ok(())
     }
 

@@ -41,6 +41,8 @@ pub(crate) struct Job {
     pub compare_tolerance: Option<f64>,
     pub spindle_rpm: f64,
     pub safe_z: Option<f64>,
+    /// The least increment of the job's program, mm: 0.0001 of the units it is written in.
+    pub least_increment: f64,
     pub warnings: Vec<Warning>,
 }
 
@@ -98,6 +100,9 @@ fn radius(field: &str, value: f64) -> Result<f64, SolverError> {
     }
     Ok(value)
 }
+
+/// The least increment of a program (4 decimals), in the program's units.
+const LEAST_INCREMENT: f64 = 1e-4;
 
 /// Largest angle accepted, degrees (about 2 800 turns): beyond it the angle's rounding in
 /// radians exceeds a micro-radian, and a quarter-turn search could no longer advance.
@@ -499,7 +504,20 @@ impl SegmentRequest {
             }
         }
         spans.push((from, end));
-        Ok(Job { shape, spans, dimension, rule, plan, tolerance, compare_tolerance, spindle_rpm, safe_z, warnings })
+        let least_increment = LEAST_INCREMENT * self.units.unwrap_or_default().mm_per_unit();
+        Ok(Job {
+            shape,
+            spans,
+            dimension,
+            rule,
+            plan,
+            tolerance,
+            compare_tolerance,
+            spindle_rpm,
+            safe_z,
+            least_increment,
+            warnings,
+        })
     }
 }
 

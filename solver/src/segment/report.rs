@@ -9,10 +9,6 @@ use crate::error::Warning;
 use crate::machine::stats::BlockStats;
 use crate::validate::Measure;
 
-/// Least increment of the G-code (4 decimals), mm; a chord error below 5 of them is
-/// resolution-limited (E13).
-const LEAST_INCREMENT: f64 = 1e-4;
-
 /// A polyline is its own true curve: where its points are not much closer than the chords, its
 /// corners (not the curve they sample) decide the chord lengths.
 pub(super) fn sparse_polyline(job: &Job) -> Option<Warning> {
@@ -121,12 +117,15 @@ pub(super) fn window_warnings(job: &Job, cut: &Cut) -> Vec<Warning> {
         }
     }
     let finest = cut.windows.iter().map(|w| w.chord_error).filter(|&c| c > 0.0).fold(f64::INFINITY, f64::min);
-    if finest < 5.0 * LEAST_INCREMENT {
+    // A chord error below 5 of the program's least increments is resolution-limited (E13).
+    if finest < 5.0 * job.least_increment {
         warnings.push(Warning::new(
             "W_RESOLUTION_LIMITED",
             format!(
-                "chord error {finest:.6} mm is below 5 increments of the G-code's {LEAST_INCREMENT} mm: rounding \
-                 the points adds up to about half an increment of error (E13)"
+                "chord error {} is below 5 increments of the G-code's {}: rounding the points adds up to \
+                 about half an increment of error (E13)",
+                Measure::Length.quote(finest),
+                Measure::Length.quote(job.least_increment)
             ),
         ));
     }

@@ -380,6 +380,18 @@ async fn inch_programs_move_as_the_mm_programs_in_rs274() {
             assert!(inch_text.contains("G20 ") && !inch_text.contains("G21"), "{inch_text}");
             assert!(mm_text.contains("G21 ") && !mm_text.contains("G20"), "{mm_text}");
             let label = format!("{endpoint}_{dialect}{}", query.replace(['&', '='], "_"));
+            if dialect == "linuxcnc" {
+                // Blending within a tolerance, never `G64 P0` (no tolerance at all), and within
+                // the mm program's where the inch program can say it.
+                let tolerance =
+                    |text: &str| -> f64 { line_with(text, "G64 P")["G64 P".len()..].trim().parse().unwrap() };
+                let (inch_tolerance, mm_tolerance) = (tolerance(&inch_text), tolerance(&mm_text));
+                assert!(inch_tolerance >= 1e-4, "{label}: G64 P{inch_tolerance}");
+                assert!(
+                    inch_tolerance <= (mm_tolerance / 25.4).max(1e-4) + 5e-5,
+                    "{label}: {inch_tolerance} in vs {mm_tolerance} mm"
+                );
+            }
             let inch_moves = rs274_moves(&inch_text, app.directory(), &format!("{label}_inch")).expect("rs274");
             let mm_moves = rs274_moves(&mm_text, app.directory(), &format!("{label}_mm")).expect("rs274");
             assert_eq!(inch_moves.len(), mm_moves.len(), "{label}: move count");
@@ -825,8 +837,7 @@ async fn an_inch_requests_refusals_and_warnings_quote_its_own_numbers() {
                     .collect()
             })
         };
-        // The G-code's increment is 0.0001 of the program's unit, not a length of the request.
-        for (code, message) in warnings(&inch).into_iter().filter(|(code, _)| code != "W_RESOLUTION_LIMITED") {
+        for (code, message) in warnings(&inch) {
             // The twin warning of the same code about the same thing (`k = 3: …`): what the
             // answers recommend may differ, forces are not scaled.
             let about =
@@ -839,6 +850,25 @@ async fn an_inch_requests_refusals_and_warnings_quote_its_own_numbers() {
         }
     }
     assert!(compared >= 5, "only {compared} warnings compared");
+    // The G-code's least increment is 0.0001 of the program's unit: a chord error of 0.0002 in
+    // (5.08 µm: blocks of 1.016 mm round a 25.4 mm circle) is within 5 increments of an inch
+    // program, not of a mm program.
+    let circle = |k: f64| json!({"curve": {"kind": "circle", "centre": [0, 0], "radius": k}, "feed": 600.0 * k, "block_time_ms": 4});
+    let mut inch = circle(1.0);
+    inch["units"] = json!("inch");
+    let mm = circle(25.4);
+    let limited = |answer: &Value| {
+        answer["warnings"]
+            .as_array()
+            .and_then(|all| all.iter().find(|w| w["code"] == "W_RESOLUTION_LIMITED"))
+            .map(|w| w["message"].as_str().unwrap().to_owned())
+    };
+    let inch = json_with(app.post_json("/api/v1/segment", &inch).await, 200).await;
+    let message = limited(&inch).unwrap_or_else(|| panic!("no W_RESOLUTION_LIMITED in {inch}"));
+    let increment = message.split_once("of the G-code's ").and_then(|(_, rest)| rest.split_once(':')).unwrap().0;
+    assert_eq!(increment.strip_suffix(" in").map(|number| number.parse::<f64>()), Some(Ok(0.0001)), "{message}");
+    let mm = json_with(app.post_json("/api/v1/segment", &mm).await, 200).await;
+    assert_eq!(limited(&mm), None, "{mm}");
     // A program's header comments: the job's lengths and feeds in the program's units (a
     // segmentation's chord errors have floors in mm, so its header is read for the feed).
     let mut inch = segment_request(1.0);
