@@ -8,11 +8,11 @@ use super::super::request::{EngagementRequest, PathInput};
 use super::super::{MAX_CANDIDATES, MAX_SAMPLES};
 use super::path::read_path_levels;
 use super::physics::force_model;
-use super::{CandidateJob, ForceModel, bounded, too_large, z_value};
+use super::{CandidateJob, ForceModel, too_large, z_value};
 use crate::error::{ErrorCode, SolverError, Warning};
 use crate::material::Kienzle;
 use crate::tool::Tool;
-use crate::validate::{MAX_COORDINATE, Measure};
+use crate::validate::{MAX_COORDINATE, Measure, positive_at_most};
 
 /// The request's heights every path's a_p may come from.
 pub(super) struct Heights {
@@ -56,7 +56,7 @@ impl EngagementRequest {
         let mut section_radii = 0.0_f64;
         for (name, input, field, prefix, own_depth, own_cut_z) in inputs {
             let own_depth = own_depth
-                .map(|d| bounded(&format!("{prefix}axial_depth"), d, MAX_COORDINATE, Measure::Length))
+                .map(|d| positive_at_most(&format!("{prefix}axial_depth"), d, MAX_COORDINATE, Measure::Length))
                 .transpose()?;
             let own_cut_z = own_cut_z.map(|z| z_value(&format!("{prefix}cut_z"), z)).transpose()?;
             let mut warnings = Vec::new();

@@ -21,7 +21,7 @@ use super::stock::Region;
 use crate::error::{ErrorCode, SolverError, Warning};
 use crate::machine::{BlockRule, SpindleLimits};
 use crate::material::Kienzle;
-use crate::validate::{self, MAX_COORDINATE, Measure, positive_at_most};
+use crate::validate::{self, MAX_COORDINATE, Measure};
 
 /// How the flute counts share the feed (docs/spec/engagement.md §2.5).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -132,11 +132,6 @@ impl FeedMode {
 fn point(field: &str, p: [f64; 2]) -> Result<P2, SolverError> {
     let [x, y] = validate::point(field, p, MAX_COORDINATE)?;
     Ok(P2::new(x, y))
-}
-
-/// `value` must be positive and at most `limit`.
-fn bounded(field: &str, value: f64, limit: f64, measure: Measure) -> Result<f64, SolverError> {
-    positive_at_most(field, value, limit, measure)
 }
 
 fn optional(

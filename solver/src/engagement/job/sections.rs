@@ -8,11 +8,11 @@ use super::super::{DEFAULT_BURR_DISENGAGE_DEG, DEFAULT_CHIPPING_DISENGAGE_DEG, M
 use super::candidates::Heights;
 use super::limits::check_work;
 use super::stock::read_stock;
-use super::{FeedMode, Job, Physics, PlanJob, bounded, optional, too_large, z_value};
+use super::{FeedMode, Job, Physics, PlanJob, optional, too_large, z_value};
 use crate::error::{SolverError, Warning};
 use crate::machine::{BlockRule, MachineProfile, RuleSettings};
 use crate::tool::Tool;
-use crate::validate::{MAX_COORDINATE, Measure, finite, non_negative, positive};
+use crate::validate::{MAX_COORDINATE, Measure, finite, non_negative, positive, positive_at_most};
 
 /// The tool and cutting conditions of a request: what every sample is evaluated at.
 struct Cutting {
@@ -46,11 +46,13 @@ impl EngagementRequest {
         let time_limit = optional("time_limit_s", self.time_limit_s, positive, Measure::Number)?;
         let (step, grid) = self.sampling(radius)?;
         let flags = self.flags()?;
-        let axial_depth =
-            self.axial_depth.map(|d| bounded("axial_depth", d, MAX_COORDINATE, Measure::Length)).transpose()?;
+        let axial_depth = self
+            .axial_depth
+            .map(|d| positive_at_most("axial_depth", d, MAX_COORDINATE, Measure::Length))
+            .transpose()?;
         let (kienzle, spindle) = self.kienzle(physics)?;
         let stock_top_z = z_value("stock_top_z", self.stock_top_z.unwrap_or(0.0))?;
-        let clearance = bounded("clearance", self.clearance.unwrap_or(5.0), MAX_COORDINATE, Measure::Length)?;
+        let clearance = positive_at_most("clearance", self.clearance.unwrap_or(5.0), MAX_COORDINATE, Measure::Length)?;
         // Warnings of the whole request, repeated in every candidate's answer.
         let mut shared_warnings = Vec::new();
         let plan = self.feed_plan.as_ref().map(|plan| feed_plan(plan, machine, &mut shared_warnings)).transpose()?;
@@ -116,11 +118,11 @@ impl EngagementRequest {
     /// flute counts to compare (the tool's own when none are given).
     fn cutting(&self, tool: &Tool) -> Result<Cutting, SolverError> {
         tool.validate("tool.")?;
-        let radius = bounded("tool.radius", tool.radius, MAX_COORDINATE, Measure::Length)?;
-        let spindle_rpm = bounded("spindle_rpm", self.spindle_rpm, 1e6, Measure::Number)?;
+        let radius = positive_at_most("tool.radius", tool.radius, MAX_COORDINATE, Measure::Length)?;
+        let spindle_rpm = positive_at_most("spindle_rpm", self.spindle_rpm, 1e6, Measure::Number)?;
         let feed_mode = match (self.feed_per_tooth, self.feed) {
-            (Some(fz), None) => FeedMode::PerTooth(bounded("feed_per_tooth", fz, 1e3, Measure::FeedPerTooth)?),
-            (None, Some(vf)) => FeedMode::Rate(bounded("feed", vf, 1e7, Measure::Feed)?),
+            (Some(fz), None) => FeedMode::PerTooth(positive_at_most("feed_per_tooth", fz, 1e3, Measure::FeedPerTooth)?),
+            (None, Some(vf)) => FeedMode::Rate(positive_at_most("feed", vf, 1e7, Measure::Feed)?),
             (Some(_), Some(_)) => {
                 return Err(SolverError::input(
                     "feed",
@@ -165,7 +167,7 @@ impl EngagementRequest {
     /// default); `grid` is refused with the exact engine.
     fn sampling(&self, radius: f64) -> Result<(f64, Option<f64>), SolverError> {
         let step = match self.step {
-            Some(step) => bounded("step", step, MAX_COORDINATE, Measure::Length)?,
+            Some(step) => positive_at_most("step", step, MAX_COORDINATE, Measure::Length)?,
             None => 2.0 * radius / 50.0,
         };
         let grid = match (self.engine, self.grid) {
@@ -173,7 +175,7 @@ impl EngagementRequest {
                 return Err(SolverError::input("grid", "grid applies only to engine \"dots\""));
             }
             (Engine::Exact, None) => None,
-            (Engine::Dots, Some(g)) => Some(bounded("grid", g, MAX_COORDINATE, Measure::Length)?),
+            (Engine::Dots, Some(g)) => Some(positive_at_most("grid", g, MAX_COORDINATE, Measure::Length)?),
             (Engine::Dots, None) => Some(match &self.stock.bitmap {
                 Some(bitmap) if bitmap.cell.is_finite() && bitmap.cell > 0.0 => bitmap.cell,
                 _ => 2.0 * radius / 200.0,
@@ -232,14 +234,14 @@ fn feed_plan(
     machine: Option<&MachineProfile>,
     shared_warnings: &mut Vec<Warning>,
 ) -> Result<PlanJob, SolverError> {
-    let target = bounded("feed_plan.target_thickness", plan.target_thickness, 1e3, Measure::Length)?;
+    let target = positive_at_most("feed_plan.target_thickness", plan.target_thickness, 1e3, Measure::Length)?;
     let max_feed = plan.max_feed.or(machine.map(|m| m.max_feed)).ok_or_else(|| {
         SolverError::input(
             "feed_plan.max_feed",
             "feed_plan.max_feed (mm/min) is required unless the request names a machine",
         )
     })?;
-    let mut max_feed = bounded("feed_plan.max_feed", max_feed, 1e7, Measure::Feed)?;
+    let mut max_feed = positive_at_most("feed_plan.max_feed", max_feed, 1e7, Measure::Feed)?;
     if let Some(machine) = machine
         && max_feed > machine.max_feed
     {

@@ -6,10 +6,10 @@ use super::super::request::{Stock, StockBitmap};
 use super::super::stock::{Base, Bitmap, Cut, Region, decode_base64};
 use super::super::{MAX_GRID_DOTS, MAX_STOCK_VERTICES, P2};
 use super::path::read_path;
-use super::{bounded, point, too_large};
+use super::{point, too_large};
 use crate::error::{ErrorCode, SolverError, Warning};
 use crate::planar::signed_area;
-use crate::validate::{MAX_COORDINATE, Measure};
+use crate::validate::{MAX_COORDINATE, Measure, positive_at_most};
 
 /// A ring of distinct points (closing repeat and consecutive duplicates removed).
 fn read_ring(field: &str, points: &[[f64; 2]]) -> Result<Vec<P2>, SolverError> {
@@ -62,7 +62,7 @@ pub(super) fn read_stock(
 /// (`W_STOCK_EMPTY` when it holds no material).
 fn read_bitmap(bitmap: &StockBitmap, warnings: &mut Vec<Warning>) -> Result<Base, SolverError> {
     let origin = point("stock.bitmap.origin", bitmap.origin)?;
-    let cell = bounded("stock.bitmap.cell", bitmap.cell, MAX_COORDINATE, Measure::Length)?;
+    let cell = positive_at_most("stock.bitmap.cell", bitmap.cell, MAX_COORDINATE, Measure::Length)?;
     if bitmap.width == 0 || bitmap.height == 0 {
         return Err(SolverError::input("stock.bitmap.width", "the bitmap needs at least one row and one column"));
     }
@@ -168,7 +168,7 @@ fn read_previous_cuts(stock: &Stock, warnings: &mut Vec<Warning>) -> Result<(Vec
     let mut cut_fields = Vec::new();
     for (index, previous) in stock.previous_cuts.iter().enumerate() {
         let field = format!("stock.previous_cuts[{index}]");
-        let radius = bounded(&format!("{field}.radius"), previous.radius, MAX_COORDINATE, Measure::Length)?;
+        let radius = positive_at_most(&format!("{field}.radius"), previous.radius, MAX_COORDINATE, Measure::Length)?;
         let route = read_path(&previous.path, &format!("{field}.path"), warnings)?;
         let shapes = route.pieces.iter().filter(|p| !p.rapid).map(|p| p.shape).collect();
         cuts.push(Cut::new(shapes, radius));
