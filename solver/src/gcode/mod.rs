@@ -757,8 +757,8 @@ impl Blocks {
             Blending::None => {}
             Blending::Tolerance => {
                 // `G64 P0` is LinuxCNC's `G64` without a tolerance (blend as far as the speed
-                // asks): a tolerance finer than the program's least increment (0.001 mm in an
-                // inch program) is written as that increment, the tightest the program can say.
+                // asks): a tolerance finer than the program's least increment (0.0001 in, 0.00254
+                // mm, in an inch program) is written as that increment, the tightest it can say.
                 let least_increment = 10f64.powi(-(self.table.decimals.min(number::MAX_DECIMALS) as i32));
                 self.begin();
                 self.text.push_str("G64 P");
