@@ -759,15 +759,10 @@ impl Blocks {
                 // `G64 P0` is LinuxCNC's `G64` without a tolerance (blend as far as the speed
                 // asks): a tolerance finer than the program's least increment (0.0001 in, 0.00254
                 // mm, in an inch program) is written as that increment, the tightest it can say.
-                let least_increment = 10f64.powi(-(self.table.decimals.min(number::MAX_DECIMALS) as i32));
+                let tolerance = program.blend_tolerance.max(number::least_increment(self.table.decimals));
                 self.begin();
                 self.text.push_str("G64 P");
-                number::push_fixed(
-                    &mut self.text.0,
-                    program.blend_tolerance.max(least_increment),
-                    self.table.decimals,
-                    false,
-                );
+                number::push_fixed(&mut self.text.0, tolerance, self.table.decimals, false);
                 self.end();
             }
             Blending::Word(word) => self.block(word),

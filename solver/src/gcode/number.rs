@@ -14,6 +14,12 @@ const SCALES: [f64; 7] = [1.0, 10.0, 100.0, 1_000.0, 10_000.0, 100_000.0, 1_000_
 /// The most decimals a post prints (a decimal format of 4 for mm, 5 or 6 for inch and degrees).
 pub const MAX_DECIMALS: usize = SCALES.len() - 1;
 
+/// The least value above zero a post printing `decimals` decimals writes: one unit in its last
+/// place.
+pub fn least_increment(decimals: usize) -> f64 {
+    1.0 / SCALES[decimals.min(MAX_DECIMALS)]
+}
+
 /// Largest scaled magnitude written from an integer: far below 2^53, so the product's own
 /// rounding error (half a unit in its last place) is below 2^-10 of a unit.
 const SCALED_LIMIT: f64 = 1e15;

@@ -424,21 +424,16 @@ fn predict_pass_with(
         return outcome;
     }
     let force_history = &station.engagement.force;
-    let (deflection, history_deflection) = deflection_at_contact(
-        context,
-        index,
-        source.spindle_rpm,
-        coefficients,
-        force_history,
-        contact.rotation_angle,
-        &mut outcome,
-    );
+    let deflection_source = DeflectionSource::of(context, source.spindle_rpm, coefficients, force_history);
+    let (deflection, history_deflection) =
+        deflection_at_contact(context, index, deflection_source.as_ref(), contact.rotation_angle, &mut outcome);
     let normal = contact.normal;
     let error_deflection =
         deflection.map(|d| if contact.azimuth.is_none() { 0.0 } else { d[0] * normal.x + d[1] * normal.y });
     if job.merge_tolerance.is_some() {
-        outcome.deflection_spread =
-            deflection_spread(context, source.spindle_rpm, coefficients, force_history, &contact, error_deflection);
+        outcome.deflection_spread = deflection_source
+            .as_ref()
+            .and_then(|deflection_source| deflection_spread(job, deflection_source, &contact, error_deflection));
     }
     outcome.error_deflection = error_deflection;
     outcome.error = Some(contact.error_shape + error_deflection.unwrap_or(0.0));
@@ -603,38 +598,71 @@ fn finished_surface(
     })
 }
 
-/// The deflection D at the contact's rotation angle (§3.8): prescribed, or from the force
-/// history through the spindle speed's kernels, with D over the whole revolution for the passes
-/// whose history is asked for; `None` (flagged) without a deflection model.
+/// Where D(ψ) comes from (§3.8): the request's prescribed history, or the pass's force history
+/// through its spindle speed's kernels (with a force model).
+enum DeflectionSource<'a> {
+    Prescribed(&'a super::request::PrescribedDeflection),
+    Force { spindle: &'a SpindleKernels, force_history: &'a [[f64; 3]] },
+}
+
+impl<'a> DeflectionSource<'a> {
+    /// `None`: neither a prescribed history nor a force model with kernels for `spindle_rpm`.
+    fn of(
+        context: &'a Context<'_>,
+        spindle_rpm: f64,
+        coefficients: Option<&force::CuttingCoefficients>,
+        force_history: &'a [[f64; 3]],
+    ) -> Option<Self> {
+        if let Some(prescribed) = &context.job.deflection {
+            return Some(Self::Prescribed(prescribed));
+        }
+        let spindle = coefficients.and(context.kernels.get(&spindle_rpm.to_bits()))?;
+        Some(Self::Force { spindle, force_history })
+    }
+
+    /// D(ψ), linear between the history's steps.
+    fn at(&self, psi: f64) -> [f64; 2] {
+        match self {
+            Self::Prescribed(prescribed) => prescribed_at(prescribed, psi),
+            Self::Force { spindle, force_history } => dynamics::deflection_at(&spindle.kernels, force_history, psi),
+        }
+    }
+
+    /// Steps of the history per revolution.
+    fn steps(&self) -> usize {
+        match self {
+            Self::Prescribed(prescribed) => prescribed.x.len(),
+            Self::Force { force_history, .. } => force_history.len(),
+        }
+    }
+}
+
+/// The deflection D at the contact's rotation angle (§3.8), with D over the whole revolution
+/// for the passes whose history is asked for; `None` (flagged) without a deflection source.
 fn deflection_at_contact(
     context: &Context<'_>,
     index: usize,
-    spindle_rpm: f64,
-    coefficients: Option<&force::CuttingCoefficients>,
-    force_history: &[[f64; 3]],
+    source: Option<&DeflectionSource<'_>>,
     rotation_angle: Option<f64>,
     outcome: &mut Outcome,
 ) -> (Option<[f64; 2]>, Option<Vec<[f64; 2]>>) {
-    let job = context.job;
     let mut history_deflection: Option<Vec<[f64; 2]>> = None;
-    let deflection: Option<[f64; 2]> = if let Some(prescribed) = &job.deflection {
-        rotation_angle.map_or(Some([0.0, 0.0]), |psi| Some(prescribed_at(prescribed, psi)))
-    } else if let (Some(_), Some(spindle)) = (coefficients, context.kernels.get(&spindle_rpm.to_bits())) {
-        if spindle.outside {
-            outcome.flags.push(PassFlag::OutsideFrfBand);
+    match source {
+        Some(DeflectionSource::Force { spindle, force_history }) => {
+            if spindle.outside {
+                outcome.flags.push(PassFlag::OutsideFrfBand);
+            }
+            if force_history.iter().all(|f| f[0] == 0.0 && f[1] == 0.0 && f[2] == 0.0) {
+                outcome.flags.push(PassFlag::NoLoad);
+            }
+            if context.job.history.contains(&index) {
+                history_deflection = Some(dynamics::deflection_history(&spindle.kernels, force_history));
+            }
         }
-        if force_history.iter().all(|f| f[0] == 0.0 && f[1] == 0.0 && f[2] == 0.0) {
-            outcome.flags.push(PassFlag::NoLoad);
-        }
-        let kernels = &spindle.kernels;
-        if job.history.contains(&index) {
-            history_deflection = Some(dynamics::deflection_history(kernels, force_history));
-        }
-        Some(rotation_angle.map_or([0.0, 0.0], |psi| dynamics::deflection_at(kernels, force_history, psi)))
-    } else {
-        outcome.flags.push(PassFlag::NoDeflection);
-        None
-    };
+        Some(DeflectionSource::Prescribed(_)) => {}
+        None => outcome.flags.push(PassFlag::NoDeflection),
+    }
+    let deflection = source.map(|source| rotation_angle.map_or([0.0, 0.0], |psi| source.at(psi)));
     (deflection, history_deflection)
 }
 
@@ -642,35 +670,31 @@ fn deflection_at_contact(
 /// take within one sample Δ of where it was found: Δ moves the point's azimuth by Δ/(R sin θ_c)
 /// and its contact angle by Δ/R, which the helix turns into Δ/R · sin θ_c · tan β of ψ. D is
 /// linear between the history's steps, so the largest move over the window is at a step or an
-/// end of it. `None` without a deflection or at the tip (e_D is 0 there).
+/// end of it. `None` at the tip (e_D is 0 there).
 fn deflection_spread(
-    context: &Context<'_>,
-    spindle_rpm: f64,
-    coefficients: Option<&force::CuttingCoefficients>,
-    force_history: &[[f64; 3]],
+    job: &Job,
+    source: &DeflectionSource<'_>,
     contact: &Contact,
     error_deflection: Option<f64>,
 ) -> Option<f64> {
-    let job = context.job;
     let (psi, centre_value) = (contact.rotation_angle?, error_deflection?);
     let sample_angle = 2.0 / f64::from(job.resolution);
     let sin_theta = contact.contact_angle.sin();
     let half_width =
         (sample_angle / sin_theta + sample_angle * sin_theta * job.helix.tan().abs()).min(std::f64::consts::PI);
-    let (at, steps): (Box<dyn Fn(f64) -> [f64; 2]>, usize) = if let Some(prescribed) = &job.deflection {
-        (Box::new(move |psi| prescribed_at(prescribed, psi)), prescribed.x.len())
-    } else {
-        let kernels = &coefficients.and(context.kernels.get(&spindle_rpm.to_bits()))?.kernels;
-        (Box::new(move |psi| dynamics::deflection_at(kernels, force_history, psi)), force_history.len())
-    };
-    let step = std::f64::consts::TAU / steps as f64;
+    let step = std::f64::consts::TAU / source.steps() as f64;
     let first = ((psi - half_width) / step).ceil();
     let last = ((psi + half_width) / step).floor();
     let angles = [psi - half_width, psi + half_width]
         .into_iter()
         .chain((0..(last - first + 1.0).max(0.0) as usize).map(|k| (first + k as f64) * step));
     let normal = contact.normal;
-    Some(angles.map(&at).map(|d| (d[0] * normal.x + d[1] * normal.y - centre_value).abs()).fold(0.0, f64::max))
+    Some(
+        angles
+            .map(|angle| source.at(angle))
+            .map(|d| (d[0] * normal.x + d[1] * normal.y - centre_value).abs())
+            .fold(0.0, f64::max),
+    )
 }
 
 /// D(ψ) of a prescribed history, periodic, linear between samples.
